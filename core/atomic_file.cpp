@@ -1,0 +1,143 @@
+#include "core/atomic_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+namespace dpoint {
+namespace {
+
+constexpr size_t kBufferSize = 1 << 20;
+
+Error ioError(const std::string& what, const std::string& path, int err) {
+  return Error{what + " '" + path + "': " + std::strerror(err), ExitCode::kBadInput};
+}
+
+std::string folderOf(const std::string& path) {
+  std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  return parent.empty() ? std::string(".") : parent.string();
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string path, std::string temp_path, int fd, bool direct)
+    : path_(std::move(path)), temp_path_(std::move(temp_path)), fd_(fd), direct_(direct) {
+  buffer_.reserve(kBufferSize);
+}
+
+AtomicFile::AtomicFile(AtomicFile&& other) noexcept
+    : path_(std::move(other.path_)),
+      temp_path_(std::move(other.temp_path_)),
+      fd_(other.fd_),
+      direct_(other.direct_),
+      committed_(other.committed_),
+      written_(other.written_),
+      buffer_(std::move(other.buffer_)) {
+  other.fd_ = -1;
+  other.temp_path_.clear();
+}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
+}
+
+Result<AtomicFile> AtomicFile::create(const std::string& path) {
+  if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
+    if (!S_ISREG(st.st_mode)) {
+      int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+      if (fd < 0) return ioError("cannot open", path, errno);
+      return AtomicFile(path, "", fd, true);
+    }
+  }
+  const std::string folder = folderOf(path);
+  struct stat folder_st {};
+  if (::stat(folder.c_str(), &folder_st) != 0)
+    return Error{"cannot write '" + path + "': folder '" + folder + "' does not exist"};
+  if (!S_ISDIR(folder_st.st_mode))
+    return Error{"cannot write '" + path + "': '" + folder + "' is not a folder"};
+
+  int fd = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  if (fd >= 0) return AtomicFile(path, "", fd, false);
+  if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
+    return ioError("cannot write into folder", folder, errno);
+
+  // Fallback for file systems without O_TMPFILE: a named temporary beside the target.
+  std::string temp = path + ".dpoint-XXXXXX";
+  fd = ::mkstemp(temp.data());
+  if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
+  ::fchmod(fd, 0644);
+  return AtomicFile(path, temp, fd, false);
+}
+
+Status AtomicFile::flush() {
+  const char* data = buffer_.data();
+  size_t left = buffer_.size();
+  while (left > 0) {
+    ssize_t n = ::write(fd_, data, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return ioError("cannot write", path_, errno);
+    }
+    data += n;
+    left -= static_cast<size_t>(n);
+    written_ += static_cast<uint64_t>(n);
+  }
+  buffer_.clear();
+  return okStatus();
+}
+
+Status AtomicFile::write(const void* data, size_t size) {
+  assert(fd_ >= 0 && !committed_);
+  if (buffer_.size() + size > kBufferSize) {
+    if (Status s = flush(); !s) return s;
+  }
+  if (size >= kBufferSize) {  // large blocks bypass the buffer
+    buffer_.assign(static_cast<const char*>(data), static_cast<const char*>(data) + size);
+    Status s = flush();
+    buffer_.reserve(kBufferSize);
+    return s;
+  }
+  buffer_.insert(buffer_.end(), static_cast<const char*>(data), static_cast<const char*>(data) + size);
+  return okStatus();
+}
+
+Status AtomicFile::commit() {
+  assert(fd_ >= 0 && !committed_);
+  if (Status s = flush(); !s) return s;
+  if (direct_) {
+    ::close(fd_);
+    fd_ = -1;
+    committed_ = true;
+    return okStatus();
+  }
+  std::string named = temp_path_;
+  if (named.empty()) {
+    // Give the unnamed file a temporary name, then rename it over the target (rename is atomic;
+    // linkat alone would fail on an existing target).
+    named = path_ + ".dpoint-" + std::to_string(::getpid());
+    ::unlink(named.c_str());
+    const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
+    if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, named.c_str(), AT_SYMLINK_FOLLOW) != 0)
+      return ioError("cannot create", named, errno);
+    temp_path_ = named;
+  }
+  if (::close(fd_) != 0) {
+    fd_ = -1;
+    return ioError("cannot write", path_, errno);
+  }
+  fd_ = -1;
+  if (::rename(named.c_str(), path_.c_str()) != 0) return ioError("cannot rename into", path_, errno);
+  committed_ = true;
+  temp_path_.clear();
+  return okStatus();
+}
+
+}  // namespace dpoint

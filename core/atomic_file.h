@@ -1,0 +1,52 @@
+// Output that appears whole or not at all (DESIGN §10).
+//
+// The data goes to an unnamed temporary file (O_TMPFILE) in the target's folder; commit() gives it
+// a name beside the target and renames it over the target. A failed run (destructor without
+// commit) or a killed one (SIGKILL: the kernel frees the unnamed inode) leaves nothing behind.
+// Where the file system lacks O_TMPFILE, a named temporary beside the target is used and removed
+// on failure. Targets that are not regular files (/dev/null, a pipe) are written directly.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/result.h"
+
+namespace dpoint {
+
+class AtomicFile {
+ public:
+  // Opens the temporary file. Fails (with a message naming the path) when the folder does not
+  // exist, is not writable, or the target is a folder.
+  static Result<AtomicFile> create(const std::string& path);
+
+  AtomicFile(AtomicFile&& other) noexcept;
+  AtomicFile& operator=(AtomicFile&&) = delete;
+  AtomicFile(const AtomicFile&) = delete;
+  ~AtomicFile();  // discards the output unless commit() succeeded
+
+  // Buffered append. Errors (disk full) are reported here or at commit.
+  Status write(const void* data, size_t size);
+  Status write(std::string_view text) { return write(text.data(), text.size()); }
+  // Flushes, syncs nothing (page cache is enough for atomicity against crashes of the process),
+  // and moves the file into place.
+  Status commit();
+
+  const std::string& path() const { return path_; }
+  uint64_t bytesWritten() const { return written_ + buffer_.size(); }
+
+ private:
+  AtomicFile(std::string path, std::string temp_path, int fd, bool direct);
+  Status flush();
+
+  std::string path_;
+  std::string temp_path_;  // non-empty only for the named fallback
+  int fd_ = -1;
+  bool direct_ = false;    // target is not a regular file: no temporary
+  bool committed_ = false;
+  uint64_t written_ = 0;
+  std::vector<char> buffer_;
+};
+
+}  // namespace dpoint

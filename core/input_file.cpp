@@ -1,0 +1,44 @@
+#include "core/input_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace dpoint {
+
+Result<InputFile> InputFile::open(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return Error{path + ": file not found"};
+    return Error{path + ": " + std::strerror(errno)};
+  }
+  if (S_ISDIR(st.st_mode)) return Error{path + ": is a folder, not a file"};
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return Error{path + ": cannot open: " + std::strerror(errno)};
+  return InputFile(path, fd, S_ISREG(st.st_mode) ? static_cast<uint64_t>(st.st_size) : 0);
+}
+
+InputFile::~InputFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Result<size_t> InputFile::readAt(uint64_t offset, void* data, size_t size) const {
+  size_t total = 0;
+  char* out = static_cast<char*>(data);
+  while (total < size) {
+    ssize_t n = ::pread(fd_, out + total, size - total, static_cast<off_t>(offset + total));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return Error{path_ + ": read error at byte " + std::to_string(offset + total) + ": " +
+                   std::strerror(errno)};
+    }
+    if (n == 0) break;
+    total += static_cast<size_t>(n);
+  }
+  return total;
+}
+
+}  // namespace dpoint

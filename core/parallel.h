@@ -1,0 +1,40 @@
+// Work splitting over all cores. Items are handed out dynamically, so callers whose items write
+// to disjoint, preassigned places get output that does not depend on the thread count.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <thread>
+#include <vector>
+
+namespace dpoint {
+
+// 0 means "all cores".
+inline unsigned resolveThreads(unsigned requested) {
+  if (requested != 0) return requested;
+  unsigned n = std::thread::hardware_concurrency();
+  return n == 0 ? 1 : n;
+}
+
+// Calls fn(item, worker) for every item in [0, count) on up to `threads` threads (worker < threads).
+inline void parallelFor(size_t count, unsigned threads,
+                        const std::function<void(size_t item, unsigned worker)>& fn) {
+  threads = resolveThreads(threads);
+  if (threads > count) threads = static_cast<unsigned>(count == 0 ? 1 : count);
+  std::atomic<size_t> next{0};
+  auto run = [&](unsigned worker) {
+    for (size_t i = next.fetch_add(1); i < count; i = next.fetch_add(1)) fn(i, worker);
+  };
+  if (threads <= 1) {
+    run(0);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(threads - 1);
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run, t);
+  run(0);
+  for (std::thread& t : pool) t.join();
+}
+
+}  // namespace dpoint

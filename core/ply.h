@@ -1,0 +1,38 @@
+// PLY point and mesh files (ASCII and binary little-endian).
+//
+// Reading: a `vertex` element with x, y, z of any numeric type (float and double are the usual
+// ones), optional red, green, blue (uchar scaled by 1/255, or float/double taken as 0..1),
+// other vertex properties skipped; an optional `face` element whose vertex_indices (or
+// vertex_index) list is fan-triangulated. Other elements are skipped. Errors name the file and
+// the header line, or the byte offset / ASCII line of the bad data.
+//
+// Writing: `double x,y,z`, colours as `uchar` (default, read by every tool) or `float`,
+// and `face` lists of three `uint` indices for meshes.
+#pragma once
+
+#include <string>
+
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+enum class PlyEncoding { kBinary, kAscii };
+enum class PlyColorType { kUchar, kFloat };
+
+struct PlyReadOptions {
+  bool allow_nonfinite = false;
+  Progress* progress = nullptr;
+};
+
+struct PlyWriteOptions {
+  PlyEncoding encoding = PlyEncoding::kBinary;
+  PlyColorType color_type = PlyColorType::kUchar;
+  Progress* progress = nullptr;
+};
+
+Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});
+Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options = {});
+
+}  // namespace dpoint

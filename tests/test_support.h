@@ -1,0 +1,41 @@
+// Helpers shared by the test suites: scratch folders, whole-file I/O, running the dpoint binary.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/point_set.h"
+#include "test_config.h"
+
+namespace dpoint::test {
+
+// A fresh folder under $TMPDIR (or /tmp), removed with its content at scope exit.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+  // Names of the entries in the folder, sorted.
+  std::vector<std::string> entries() const;
+
+ private:
+  std::string path_;
+};
+
+std::string readFile(const std::string& path);
+void writeFile(const std::string& path, const std::string& bytes);
+bool fileExists(const std::string& path);
+
+struct CommandResult {
+  int exit_code = -1;  // -1 when killed by a signal
+  std::string out;
+  std::string err;
+};
+// Runs argv[0] with the arguments (no shell), capturing stdout and stderr.
+CommandResult runCommand(const std::vector<std::string>& argv);
+// Runs build/dpoint with the arguments.
+CommandResult runDpoint(const std::vector<std::string>& args);
+
+}  // namespace dpoint::test
