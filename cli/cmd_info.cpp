@@ -1,1 +1,110 @@
-// placeholder
+// dpoint info FILE [--json]: counts, bounds and the precision the data needs.
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "cli/commands.h"
+#include "converters/point_io.h"
+#include "core/info.h"
+
+namespace dpoint {
+namespace {
+
+struct InfoOptions {
+  std::string input;
+  bool json = false;
+  bool allow_nonfinite = false;
+  size_t sample = 10000;
+  CommonOptions common;
+};
+
+// Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
+std::string num(double v, bool json = false) {
+  if (json && !std::isfinite(v)) return "null";
+  char text[32];
+  auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
+
+std::string vec(const glm::dvec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
+std::string jsonVec(const glm::dvec3& v) { return "[" + num(v.x, true) + ", " + num(v.y, true) + ", " + num(v.z, true) + "]"; }
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\u%04x", c);
+      out += esc;
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+void printText(const std::string& path, const PointSetInfo& i) {
+  std::printf("file:               %s\n", path.c_str());
+  std::printf("points:             %zu\n", i.count);
+  std::printf("triangles:          %zu\n", i.triangles);
+  std::printf("colours:            %s\n", i.has_colors ? "yes" : "no");
+  std::printf("min:                %s\n", vec(i.min).c_str());
+  std::printf("max:                %s\n", vec(i.max).c_str());
+  std::printf("extent:             %s\n", vec(i.extent).c_str());
+  std::printf("largest |coord|:    %s\n", num(i.max_abs).c_str());
+  std::printf("float32 spacing:    %s (at the largest |coordinate|)\n", num(i.float_spacing).c_str());
+  std::printf("nearest neighbour:  %s (smallest non-zero, %zu points sampled)\n",
+              num(i.min_neighbor_distance).c_str(), i.neighbor_sample);
+  if (i.floatRepresents()) {
+    std::printf("float32 enough:     yes (no two distinct points merge)\n");
+  } else if (i.float_overflow > 0) {
+    std::printf("float32 enough:     no (%zu coordinates beyond float range)\n", i.float_overflow);
+  } else {
+    std::printf("float32 enough:     no (%zu distinct points merge with another)\n", i.float_merged);
+  }
+}
+
+void printJson(const std::string& path, const PointSetInfo& i) {
+  std::printf("{\n");
+  std::printf("  \"file\": %s,\n", jsonString(path).c_str());
+  std::printf("  \"points\": %zu,\n  \"triangles\": %zu,\n  \"colors\": %s,\n", i.count, i.triangles,
+              i.has_colors ? "true" : "false");
+  std::printf("  \"min\": %s,\n  \"max\": %s,\n  \"extent\": %s,\n", jsonVec(i.min).c_str(), jsonVec(i.max).c_str(),
+              jsonVec(i.extent).c_str());
+  std::printf("  \"max_abs\": %s,\n  \"float32_spacing\": %s,\n", num(i.max_abs, true).c_str(),
+              num(i.float_spacing, true).c_str());
+  std::printf("  \"min_neighbor_distance\": %s,\n  \"neighbor_sample\": %zu,\n",
+              num(i.min_neighbor_distance, true).c_str(), i.neighbor_sample);
+  std::printf("  \"float32_merged_points\": %zu,\n  \"float32_overflow\": %zu,\n  \"float32_represents\": %s\n",
+              i.float_merged, i.float_overflow, i.floatRepresents() ? "true" : "false");
+  std::printf("}\n");
+}
+
+int runInfo(const InfoOptions& o) {
+  Progress progress(progressSink(o.common.quiet || o.json), "info");
+  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  if (!points) return reportError(points.error());
+  const PointSetInfo info = computeInfo(*points, o.sample, o.common.threads);
+  if (o.json) printJson(o.input, info);
+  else printText(o.input, info);
+  return 0;
+}
+
+}  // namespace
+
+void addInfoCommand(CLI::App& app, RunCommand& run) {
+  auto o = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand("info", "Counts, bounds, and whether float32 can hold the data");
+  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf)")->required();
+  cmd->add_flag("--json", o->json, "Print JSON instead of text");
+  cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
+      ->default_val(10000)
+      ->check(CLI::Range(size_t{1}, size_t{100000000}));
+  cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
+  addCommonOptions(*cmd, o->common);
+  cmd->callback([o, &run] { run = [o] { return runInfo(*o); }; });
+}
+
+}  // namespace dpoint

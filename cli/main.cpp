@@ -1,1 +1,49 @@
-int main() { return 0; }
+// dpoint: one executable, one subcommand per job. Parsing and printing only; the work is in
+// the libraries. One top-level catch turns failures into exit codes.
+#include <cstdio>
+#include <new>
+
+#include "cli/commands.h"
+#include "cli/version.h"
+
+namespace dpoint {
+
+int reportError(const Error& error) {
+  std::fprintf(stderr, "dpoint: error: %s\n", error.message.c_str());
+  return static_cast<int>(error.code);
+}
+
+void addCommonOptions(CLI::App& command, CommonOptions& options) {
+  command.add_option("--threads", options.threads, "Worker threads (0: all cores)")->default_val(0);
+  command.add_flag("--quiet,-q", options.quiet, "No progress output");
+}
+
+}  // namespace dpoint
+
+int main(int argc, char** argv) {
+  using namespace dpoint;
+  CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
+               "CSV, PLY and GLB, and inspect the precision a dataset needs.\n"
+               "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit.",
+               "dpoint"};
+  app.set_version_flag("--version", "dpoint " DPOINT_VERSION);
+  app.require_subcommand(1);
+  RunCommand run;
+  addGenerateCommand(app, run);
+  addConvertCommand(app, run);
+  addInfoCommand(app, run);
+  addBenchCommand(app, run);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);  // prints help, version or the usage error
+    return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
+  }
+  try {
+    return run ? run() : static_cast<int>(ExitCode::kUsage);
+  } catch (const std::bad_alloc&) {
+    return reportError(Error{"out of memory", ExitCode::kResourceLimit});
+  } catch (const std::exception& e) {
+    return reportError(Error{std::string("internal error: ") + e.what(), ExitCode::kBadInput});
+  }
+}

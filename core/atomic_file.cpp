@@ -77,21 +77,24 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
   return AtomicFile(path, temp, fd, false);
 }
 
-Status AtomicFile::flush() {
-  const char* data = buffer_.data();
-  size_t left = buffer_.size();
-  while (left > 0) {
-    ssize_t n = ::write(fd_, data, left);
+Status AtomicFile::writeAll(const char* data, size_t size) {
+  while (size > 0) {
+    ssize_t n = ::write(fd_, data, size);
     if (n < 0) {
       if (errno == EINTR) continue;
       return ioError("cannot write", path_, errno);
     }
     data += n;
-    left -= static_cast<size_t>(n);
+    size -= static_cast<size_t>(n);
     written_ += static_cast<uint64_t>(n);
   }
-  buffer_.clear();
   return okStatus();
+}
+
+Status AtomicFile::flush() {
+  Status s = writeAll(buffer_.data(), buffer_.size());
+  buffer_.clear();
+  return s;
 }
 
 Status AtomicFile::write(const void* data, size_t size) {
@@ -99,12 +102,7 @@ Status AtomicFile::write(const void* data, size_t size) {
   if (buffer_.size() + size > kBufferSize) {
     if (Status s = flush(); !s) return s;
   }
-  if (size >= kBufferSize) {  // large blocks bypass the buffer
-    buffer_.assign(static_cast<const char*>(data), static_cast<const char*>(data) + size);
-    Status s = flush();
-    buffer_.reserve(kBufferSize);
-    return s;
-  }
+  if (size >= kBufferSize) return writeAll(static_cast<const char*>(data), size);  // no copy
   buffer_.insert(buffer_.end(), static_cast<const char*>(data), static_cast<const char*>(data) + size);
   return okStatus();
 }

@@ -39,6 +39,7 @@ class AtomicFile {
  private:
   AtomicFile(std::string path, std::string temp_path, int fd, bool direct);
   Status flush();
+  Status writeAll(const char* data, size_t size);
 
   std::string path_;
   std::string temp_path_;  // non-empty only for the named fallback

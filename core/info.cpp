@@ -1,1 +1,150 @@
-// placeholder
+#include "core/info.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <glm/common.hpp>
+
+#include "core/parallel.h"
+
+namespace dpoint {
+namespace {
+
+// A k-d tree laid out in place: the median of each range sits at its middle, split along the
+// axis of largest extent, which is recorded at the median's index. Leaves are small ranges.
+class KdTree {
+ public:
+  explicit KdTree(std::vector<glm::dvec3> points) : pts_(std::move(points)), axis_(pts_.size(), 0) {
+    build(0, pts_.size());
+  }
+
+  // Smallest distance > 0 from q to a point of the tree (infinity if none).
+  double nearestNonzero(const glm::dvec3& q) const {
+    double best = std::numeric_limits<double>::infinity();
+    search(0, pts_.size(), q, best);
+    return std::sqrt(best);
+  }
+
+ private:
+  static constexpr size_t kLeaf = 8;
+
+  void build(size_t lo, size_t hi) {
+    if (hi - lo <= kLeaf) return;
+    glm::dvec3 mn = pts_[lo], mx = pts_[lo];
+    for (size_t i = lo + 1; i < hi; ++i) {
+      mn = glm::min(mn, pts_[i]);
+      mx = glm::max(mx, pts_[i]);
+    }
+    const glm::dvec3 size = mx - mn;
+    const int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
+    const size_t mid = lo + (hi - lo) / 2;
+    std::nth_element(pts_.begin() + static_cast<ptrdiff_t>(lo), pts_.begin() + static_cast<ptrdiff_t>(mid),
+                     pts_.begin() + static_cast<ptrdiff_t>(hi),
+                     [axis](const glm::dvec3& a, const glm::dvec3& b) { return a[axis] < b[axis]; });
+    axis_[mid] = static_cast<uint8_t>(axis);
+    build(lo, mid);
+    build(mid + 1, hi);
+  }
+
+  void visit(const glm::dvec3& p, const glm::dvec3& q, double& best) const {
+    const glm::dvec3 d = p - q;
+    const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+    if (d2 > 0.0 && d2 < best) best = d2;
+  }
+
+  void search(size_t lo, size_t hi, const glm::dvec3& q, double& best) const {
+    if (hi - lo <= kLeaf) {
+      for (size_t i = lo; i < hi; ++i) visit(pts_[i], q, best);
+      return;
+    }
+    const size_t mid = lo + (hi - lo) / 2;
+    const int axis = axis_[mid];
+    visit(pts_[mid], q, best);
+    const double diff = q[axis] - pts_[mid][axis];
+    // Points left of mid are <= the median along the axis, points right of it >= it.
+    if (diff <= 0.0) {
+      search(lo, mid, q, best);
+      if (diff * diff <= best) search(mid + 1, hi, q, best);
+    } else {
+      search(mid + 1, hi, q, best);
+      if (diff * diff <= best) search(lo, mid, q, best);
+    }
+  }
+
+  std::vector<glm::dvec3> pts_;
+  std::vector<uint8_t> axis_;
+};
+
+// Counts distinct points that float32 rounding merges with another distinct point.
+size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
+  std::vector<uint32_t> order(positions.size());
+  std::iota(order.begin(), order.end(), 0u);
+  auto as_float = [&](uint32_t i) { return glm::vec3(positions[i]); };
+  auto less_float = [](const glm::vec3& a, const glm::vec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  auto less_double = [](const glm::dvec3& a, const glm::dvec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    glm::vec3 fa = as_float(a), fb = as_float(b);
+    if (less_float(fa, fb)) return true;
+    if (less_float(fb, fa)) return false;
+    return less_double(positions[a], positions[b]);
+  });
+  // Within a run of equal floats, every change of the double value is one more merged point.
+  size_t merged = 0;
+  for (size_t k = 1; k < order.size(); ++k) {
+    const uint32_t a = order[k - 1], b = order[k];
+    if (as_float(a) == as_float(b) && positions[a] != positions[b]) ++merged;
+  }
+  return merged;
+}
+
+}  // namespace
+
+PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigned threads) {
+  PointSetInfo info;
+  info.count = points.size();
+  info.triangles = points.triangles.size() / 3;
+  info.has_colors = points.hasColors();
+  if (points.positions.empty()) return info;
+
+  info.min = info.max = points.positions[0];
+  for (const glm::dvec3& p : points.positions) {
+    info.min = glm::min(info.min, p);
+    info.max = glm::max(info.max, p);
+    for (int k = 0; k < 3; ++k) {
+      if (std::fabs(p[k]) > static_cast<double>(FLT_MAX)) ++info.float_overflow;
+    }
+  }
+  info.extent = info.max - info.min;
+  info.max_abs = std::max({std::fabs(info.min.x), std::fabs(info.min.y), std::fabs(info.min.z),
+                           std::fabs(info.max.x), std::fabs(info.max.y), std::fabs(info.max.z)});
+  // The spacing of float32 at max_abs: the gap above the float nearest to it.
+  const float f = static_cast<float>(info.max_abs);
+  info.float_spacing = std::isfinite(f)
+      ? static_cast<double>(std::nextafter(f, std::numeric_limits<float>::infinity())) - static_cast<double>(f)
+      : std::numeric_limits<double>::infinity();
+
+  // The merge count needs 32-bit indices; larger sets are beyond the renderer anyway.
+  if (info.float_overflow == 0 && points.size() <= UINT32_MAX) info.float_merged = countFloatMerges(points.positions);
+
+  const size_t n = points.size();
+  const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
+  if (n >= 2) {
+    const KdTree tree(points.positions);
+    const size_t step = n / sample;
+    std::vector<double> nearest(sample, std::numeric_limits<double>::infinity());
+    parallelFor(sample, threads, [&](size_t k, unsigned) { nearest[k] = tree.nearestNonzero(points.positions[k * step]); });
+    const double smallest = *std::min_element(nearest.begin(), nearest.end());
+    info.min_neighbor_distance = std::isfinite(smallest) ? smallest : 0.0;
+    info.neighbor_sample = sample;
+  }
+  return info;
+}
+
+}  // namespace dpoint

@@ -1,1 +1,50 @@
-// placeholder
+#include "generators/random2d.h"
+
+#include "core/memory.h"
+#include "core/parallel.h"
+
+namespace dpoint {
+namespace {
+
+constexpr uint64_t kGamma = 0x9E3779B97F4A7C15ull;  // splitmix64's increment (2^64 / golden ratio)
+constexpr size_t kPointsPerChunk = 1u << 16;
+
+// (u >> 11) is an integer m < 2^53; (m - 2^52) · 2^-52 lies in [-1, 1) and both steps are exact
+// (an integer below 2^53 in magnitude, then a power-of-two scaling).
+double unitSigned(uint64_t u) {
+  const int64_t m = static_cast<int64_t>(u >> 11) - (int64_t{1} << 52);
+  return static_cast<double>(m) * 0x1p-52;
+}
+
+}  // namespace
+
+uint64_t splitmix64At(uint64_t seed, uint64_t index) {
+  uint64_t z = seed + (index + 1) * kGamma;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+Result<PointSet> generateRandom2d(const Random2dParams& params) {
+  if (params.count == 0) return Error{"--count must be at least 1", ExitCode::kUsage};
+  if (Status s = checkMemory("random2d with " + std::to_string(params.count) + " points",
+                             params.count * sizeof(glm::dvec3), params.max_memory);
+      !s)
+    return s.error();
+  PointSet points;
+  points.positions.resize(params.count);
+  const size_t chunks = (params.count + kPointsPerChunk - 1) / kPointsPerChunk;
+  if (params.progress) params.progress->start("random2d", params.count);
+  parallelFor(chunks, params.threads, [&](size_t chunk, unsigned) {
+    const size_t end = std::min<size_t>(params.count, (chunk + 1) * kPointsPerChunk);
+    for (size_t i = chunk * kPointsPerChunk; i < end; ++i) {
+      points.positions[i] = glm::dvec3(unitSigned(splitmix64At(params.seed, 2 * i)),
+                                       unitSigned(splitmix64At(params.seed, 2 * i + 1)), 0.0);
+    }
+    if (params.progress) params.progress->advance(end - chunk * kPointsPerChunk);
+  });
+  if (params.progress) params.progress->finish();
+  return points;
+}
+
+}  // namespace dpoint

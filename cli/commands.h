@@ -1,0 +1,30 @@
+// Subcommands of the dpoint executable. Each add*Command registers its options on the app and,
+// when the subcommand is chosen, stores in `run` the action that does the work and returns the
+// exit code (DESIGN §1: 0 ok, 1 usage, 2 bad input, 3 no Vulkan device, 4 resource limit).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+#include "core/result.h"
+
+namespace dpoint {
+
+using RunCommand = std::function<int()>;
+
+void addInfoCommand(CLI::App& app, RunCommand& run);
+void addConvertCommand(CLI::App& app, RunCommand& run);
+void addGenerateCommand(CLI::App& app, RunCommand& run);
+void addBenchCommand(CLI::App& app, RunCommand& run);
+
+// Prints "dpoint: error: <message>" on stderr and returns the error's exit code.
+int reportError(const Error& error);
+
+// Options every long-running command shares.
+struct CommonOptions {
+  unsigned threads = 0;
+  bool quiet = false;
+};
+void addCommonOptions(CLI::App& command, CommonOptions& options);
+
+}  // namespace dpoint

@@ -1,0 +1,52 @@
+#include "core/memory.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace dpoint {
+
+uint64_t defaultMemoryLimit() {
+  long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return uint64_t{4} << 30;
+  return static_cast<uint64_t>(pages) * static_cast<uint64_t>(page) / 2;
+}
+
+Result<uint64_t> parseMemorySize(const std::string& flag, const std::string& text) {
+  size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (...) {
+    used = 0;
+  }
+  std::string unit = text.substr(used);
+  double scale = 0.0;
+  if (unit.empty() || unit == "B") scale = 1.0;
+  else if (unit == "K" || unit == "KiB" || unit == "KB") scale = 1024.0;
+  else if (unit == "M" || unit == "MiB" || unit == "MB") scale = 1024.0 * 1024.0;
+  else if (unit == "G" || unit == "GiB" || unit == "GB") scale = 1024.0 * 1024.0 * 1024.0;
+  if (used == 0 || scale == 0.0 || !(value > 0.0) || !std::isfinite(value) || value * scale > 1e19)
+    return Error{flag + ": '" + text + "' is not a size (examples: 512M, 8G, 1000000)", ExitCode::kUsage};
+  return static_cast<uint64_t>(value * scale);
+}
+
+std::string formatBytes(uint64_t bytes) {
+  char text[64];
+  const double b = static_cast<double>(bytes);
+  if (b >= 1024.0 * 1024.0 * 1024.0) std::snprintf(text, sizeof text, "%.2f GiB", b / (1024.0 * 1024.0 * 1024.0));
+  else if (b >= 1024.0 * 1024.0) std::snprintf(text, sizeof text, "%.1f MiB", b / (1024.0 * 1024.0));
+  else std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
+  return text;
+}
+
+Status checkMemory(const std::string& what, uint64_t needed, uint64_t limit) {
+  if (limit == 0) limit = defaultMemoryLimit();
+  if (needed <= limit) return okStatus();
+  return Error{what + " needs about " + formatBytes(needed) + ", more than the limit of " + formatBytes(limit) +
+                   " (--max-memory)",
+               ExitCode::kResourceLimit};
+}
+
+}  // namespace dpoint
