@@ -128,24 +128,18 @@ class LineParser {
     // fast_float follows std::from_chars and refuses a leading '+'; CSV writers emit it.
     if (end - start >= 2 && *start == '+' && start[1] != '-' && start[1] != '+') ++start;
     auto result = fast_float::from_chars(start, end, value);
-    const std::string where = lineText(line) + "column " + std::to_string(column) + ": '" + excerpt(begin, end) + "' ";
-    if (result.ec != std::errc() || result.ptr != end) {
-      error = {line, where + "is not a number"};
+    // The message is built only on failure: this runs for every number of the file.
+    auto fail = [&](const std::string& why) {
+      error = {line, lineText(line) + "column " + std::to_string(column) + ": '" + excerpt(begin, end) + "' " + why};
       return false;
-    }
-    if (std::isinf(value) && !looksLikeInfinityText(begin, end)) {
-      error = {line, where + "is out of " + (sizeof(T) == 8 ? "double" : "float") + " range"};
-      return false;
-    }
-    if (value == T(0) && hasNonzeroMantissa(begin, end)) {
-      error = {line, where + "is out of " + (sizeof(T) == 8 ? "double" : "float") +
-                         " range (underflows to zero)"};
-      return false;
-    }
-    if (!allow_nonfinite_ && !std::isfinite(value)) {
-      error = {line, where + "is not a finite number (--allow-nonfinite accepts it)"};
-      return false;
-    }
+    };
+    const char* type = sizeof(T) == 8 ? "double" : "float";
+    if (result.ec != std::errc() || result.ptr != end) return fail("is not a number");
+    if (std::isinf(value) && !looksLikeInfinityText(begin, end)) return fail(std::string("is out of ") + type + " range");
+    if (value == T(0) && hasNonzeroMantissa(begin, end))
+      return fail(std::string("is out of ") + type + " range (underflows to zero)");
+    if (!allow_nonfinite_ && !std::isfinite(value))
+      return fail("is not a finite number (--allow-nonfinite accepts it)");
     return true;
   }
 

@@ -1,1 +1,52 @@
 #include <gtest/gtest.h>
+
+#include "core/atomic_file.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::TempDir;
+
+TEST(AtomicFile, nothingVisibleBeforeCommit) {
+  TempDir dir;
+  Result<AtomicFile> f = AtomicFile::create(dir.file("out.txt"));
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  ASSERT_TRUE(f->write(std::string(3 << 20, 'a')).ok());  // past the buffer: real writes happen
+  EXPECT_TRUE(dir.entries().empty());
+  ASSERT_TRUE(f->commit().ok());
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+  EXPECT_EQ(test::readFile(dir.file("out.txt")).size(), size_t{3} << 20);
+}
+
+TEST(AtomicFile, discardedWithoutCommitLeavesNothing) {
+  TempDir dir;
+  test::writeFile(dir.file("out.txt"), "previous");
+  {
+    Result<AtomicFile> f = AtomicFile::create(dir.file("out.txt"));
+    ASSERT_TRUE(f.ok());
+    ASSERT_TRUE(f->write(std::string(2 << 20, 'b')).ok());
+  }
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.txt"});
+  EXPECT_EQ(test::readFile(dir.file("out.txt")), "previous");
+}
+
+TEST(AtomicFile, rejectsMissingFolderAndFolderTarget) {
+  TempDir dir;
+  Result<AtomicFile> missing = AtomicFile::create(dir.file("nope/out.txt"));
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("nope"), std::string::npos);
+  Result<AtomicFile> folder = AtomicFile::create(dir.path());
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.error().message.find("is a folder"), std::string::npos);
+}
+
+TEST(AtomicFile, writesDevicesDirectly) {
+  Result<AtomicFile> f = AtomicFile::create("/dev/null");
+  ASSERT_TRUE(f.ok());
+  ASSERT_TRUE(f->write("x").ok());
+  EXPECT_TRUE(f->commit().ok());
+}
+
+}  // namespace
+}  // namespace dpoint

@@ -1,0 +1,87 @@
+#!/usr/bin/python3
+"""CSV I/O benchmark (issue #2): a 10-million-row x,y,z,r,g,b CSV, whole process, median of N runs.
+
+  dpoint parse:  `dpoint bench io data.csv`                       (MB/s = CSV bytes / wall time)
+  dpoint write:  `dpoint convert data.ply -o out.csv --decimals 15` (MB/s = CSV bytes / wall time;
+                 reading the binary PLY is part of the time)
+  pandas parse:  python3 -c 'pandas.read_csv(data.csv)'            (interpreter start included)
+  pandas write:  python3 -c 'DataFrame from data.npz; to_csv(float_format="%.15f")'
+Peak memory is the child's max RSS (wait4). Usage: bench/csv_io.py build/dpoint [rows] [runs] [dir]
+"""
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+exe = os.path.abspath(sys.argv[1])
+rows = int(sys.argv[2]) if len(sys.argv) > 2 else 10_000_000
+runs = int(sys.argv[3]) if len(sys.argv) > 3 else 5
+work = sys.argv[4] if len(sys.argv) > 4 else "/tmp/dpoint-bench-csv"
+os.makedirs(work, exist_ok=True)
+npz, csv, ply, out = (os.path.join(work, n) for n in ("data.npz", "data.csv", "data.ply", "out.csv"))
+python = "/usr/bin/python3"
+
+
+def timed(argv):
+    """Wall seconds and peak RSS (bytes) of one child process."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    stdout, stderr = proc.stdout.read(), proc.stderr.read()
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.exit(f"{' '.join(argv)} failed: {stderr.decode()}")
+    return wall, usage.ru_maxrss * 1024, stdout.decode()
+
+
+def median_of(argv):
+    results = [timed(argv) for _ in range(runs)]
+    return statistics.median(r[0] for r in results), max(r[1] for r in results), results[-1][2]
+
+
+rng = np.random.default_rng(2)
+np.savez(npz, xyz=rng.uniform(-1000.0, 1000.0, size=(rows, 3)),
+         rgb=rng.uniform(0.0, 1.0, size=(rows, 3)).astype(np.float32))
+pandas_write = [python, "-c", f"""
+import numpy as np, pandas as pd
+d = np.load({npz!r})
+f = pd.DataFrame({{'x': d['xyz'][:, 0], 'y': d['xyz'][:, 1], 'z': d['xyz'][:, 2],
+                  'r': d['rgb'][:, 0].astype(np.float64), 'g': d['rgb'][:, 1].astype(np.float64),
+                  'b': d['rgb'][:, 2].astype(np.float64)}})
+f.to_csv({csv!r}, index=False, float_format='%.15f')
+"""]
+pandas_read = [python, "-c", f"import pandas as pd; pd.read_csv({csv!r})"]
+
+pw_s, pw_rss, _ = median_of(pandas_write)      # also makes data.csv
+csv_bytes = os.path.getsize(csv)
+subprocess.run([exe, "convert", csv, "-o", ply, "--ply-colors", "float", "--quiet"], check=True)
+dr_s, dr_rss, inner = median_of([exe, "bench", "io", csv])
+dw_s, dw_rss, _ = median_of([exe, "convert", ply, "-o", out, "--decimals", "15", "--quiet"])
+out_bytes = os.path.getsize(out)
+same = subprocess.run(["cmp", "-s", csv, out]).returncode == 0
+ds_s, _, _ = median_of([exe, "convert", ply, "-o", out, "--quiet"])
+short_bytes = os.path.getsize(out)
+pr_s, pr_rss, _ = median_of(pandas_read)
+
+pointset_bytes = rows * (24 + 12)
+mb = 1e6
+result = {
+    "machine": f"{platform.node()} ({os.cpu_count()} cores)",
+    "rows": rows, "runs": runs, "csv_bytes": csv_bytes,
+    "dpoint_parse": {"s": dr_s, "MBps": csv_bytes / mb / dr_s, "peak_rss_MB": dr_rss / mb,
+                     "in_process": json.loads(inner)},
+    "dpoint_write_decimals15": {"s": dw_s, "MBps": out_bytes / mb / dw_s, "identical_to_pandas_file": same},
+    "dpoint_write_shortest": {"s": ds_s, "MBps": short_bytes / mb / ds_s, "bytes": short_bytes},
+    "pandas_read_csv": {"s": pr_s, "MBps": csv_bytes / mb / pr_s, "peak_rss_MB": pr_rss / mb},
+    "pandas_to_csv_15f": {"s": pw_s, "MBps": csv_bytes / mb / pw_s},
+    "parse_speedup_vs_pandas": pr_s / dr_s,
+    "write_speedup_vs_pandas": pw_s / dw_s,
+    "parse_peak_limit_MB": (1.3 * pointset_bytes + 64 * 2**20) / mb,
+    "pointset_MB": pointset_bytes / mb,
+}
+print(json.dumps(result, indent=1))
