@@ -1,1 +1,427 @@
+// GLB writer and glTF/GLB reader: round trips at Earth-radius offsets, the file layout seen through
+// tinygltf itself, node transforms, malformed input, and the official validator.
 #include <gtest/gtest.h>
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "converters/gltf_read.h"
+#include "converters/gltf_write.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::TempDir;
+
+constexpr double kEarthRadius = 6.378e6;
+
+// 2000 points with millimetre detail in a ~2 m box at Earth radius, with colours.
+PointSet offsetCloud() {
+  PointSet set;
+  for (int i = 0; i < 2000; ++i) {
+    set.positions.push_back({kEarthRadius + 0.001 * (i % 1000) + 0.0001 * (i % 7),
+                             -kEarthRadius + 0.001 * ((i * 37) % 1500),
+                             kEarthRadius * 0.5 + 0.001 * ((i * 11) % 2000) - 0.0003 * (i % 3)});
+    set.colors.push_back({float(i % 256) / 255.0f, 0.1f * float(i % 10), 1.0f / float(1 + i)});
+  }
+  return set;
+}
+
+// A tetrahedron far from the origin: 4 vertices, 4 triangles.
+PointSet tetrahedron(bool colours) {
+  PointSet set;
+  const glm::dvec3 base(1e8, -2e7, 3.5e6);
+  set.positions = {base, base + glm::dvec3(1, 0, 0), base + glm::dvec3(0, 1, 0),
+                   base + glm::dvec3(0, 0, 1)};
+  if (colours) set.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5f, 0.5f, 0.5f}};
+  set.triangles = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  return set;
+}
+
+double extentOf(const PointSet& set) {
+  glm::dvec3 lo = set.positions[0], hi = set.positions[0];
+  for (const glm::dvec3& p : set.positions) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  }
+  return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+}
+
+double maxError(const PointSet& a, const PointSet& b) {
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      worst = std::max(worst, std::abs(a.positions[i][k] - b.positions[i][k]));
+  return worst;
+}
+
+tinygltf::Model loadWithTinygltf(const std::string& path) {
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string err, warn;
+  EXPECT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, path)) << err;
+  return model;
+}
+
+TEST(Gltf, glbPointRoundTripWithinFloatOfExtent) {
+  TempDir dir;
+  const PointSet set = offsetCloud();
+  ASSERT_TRUE(writeGlb(dir.file("cloud.glb"), set));
+  Result<PointSet> back = readGltf(dir.file("cloud.glb"));
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->size(), set.size());
+  EXPECT_FALSE(back->isMesh());
+
+  // Offsets from the box centre are at most extent/2, so float rounding is ≤ extent·2^-25 and
+  // the bound below has room for the double arithmetic around it.
+  const double extent = extentOf(set);
+  const double error = maxError(set, *back);
+  EXPECT_LE(error, extent * 0x1p-23);
+  // Float rounding of the absolute coordinate would be up to 6.378e6·2^-24 ≈ 0.38 m.
+  EXPECT_LT(error, 1e-6 * kEarthRadius * 0x1p-24);
+
+  ASSERT_EQ(back->colors.size(), set.colors.size());
+  for (size_t i = 0; i < set.size(); ++i) {
+    EXPECT_EQ(std::memcmp(&back->colors[i], &set.colors[i], sizeof(glm::vec3)), 0)
+        << "colour " << i;
+  }
+}
+
+TEST(Gltf, glbMeshKeepsTriangles) {
+  for (bool colours : {false, true}) {
+    TempDir dir;
+    const PointSet set = tetrahedron(colours);
+    ASSERT_TRUE(writeGlb(dir.file("mesh.glb"), set));
+    Result<PointSet> back = readGltf(dir.file("mesh.glb"));
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->triangles, set.triangles);
+    EXPECT_EQ(back->hasColors(), colours);
+    ASSERT_EQ(back->size(), set.size());
+    // Vertices at ±0.5 from the centre are exact in float: the round trip is exact.
+    EXPECT_EQ(maxError(set, *back), 0.0);
+    if (colours) {
+      for (size_t i = 0; i < set.size(); ++i) EXPECT_EQ(back->colors[i], set.colors[i]);
+    }
+  }
+}
+
+TEST(Gltf, glbMinMaxMatchStoredFloats) {
+  TempDir dir;
+  const PointSet set = offsetCloud();
+  ASSERT_TRUE(writeGlb(dir.file("cloud.glb"), set));
+  const tinygltf::Model model = loadWithTinygltf(dir.file("cloud.glb"));
+  ASSERT_EQ(model.meshes.size(), 1u);
+  ASSERT_EQ(model.meshes[0].primitives.size(), 1u);
+  const tinygltf::Primitive& primitive = model.meshes[0].primitives[0];
+  EXPECT_EQ(primitive.mode, TINYGLTF_MODE_POINTS);
+  EXPECT_EQ(primitive.indices, -1);
+
+  const tinygltf::Accessor& accessor = model.accessors[size_t(primitive.attributes.at("POSITION"))];
+  ASSERT_EQ(accessor.componentType, TINYGLTF_COMPONENT_TYPE_FLOAT);
+  ASSERT_EQ(accessor.type, TINYGLTF_TYPE_VEC3);
+  ASSERT_EQ(accessor.count, set.size());
+  const tinygltf::BufferView& view = model.bufferViews[size_t(accessor.bufferView)];
+  EXPECT_EQ(view.target, TINYGLTF_TARGET_ARRAY_BUFFER);
+  EXPECT_EQ(view.byteOffset % 4, 0u);
+  EXPECT_EQ(view.byteLength % 4, 0u);
+  const unsigned char* data = model.buffers[0].data.data() + view.byteOffset + accessor.byteOffset;
+
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::numeric_limits<float>::infinity();
+    hi[k] = -lo[k];
+  }
+  for (size_t i = 0; i < accessor.count; ++i) {
+    float v[3];
+    std::memcpy(v, data + 12 * i, sizeof(v));
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], v[k]);
+      hi[k] = std::max(hi[k], v[k]);
+    }
+  }
+  ASSERT_EQ(accessor.minValues.size(), 3u);
+  ASSERT_EQ(accessor.maxValues.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(accessor.minValues[size_t(k)], double(lo[k])) << "axis " << k;
+    EXPECT_EQ(accessor.maxValues[size_t(k)], double(hi[k])) << "axis " << k;
+  }
+  // The double origin sits in the node translation, the floats are offsets around it.
+  ASSERT_EQ(model.nodes.size(), 1u);
+  ASSERT_EQ(model.nodes[0].translation.size(), 3u);
+  EXPECT_NEAR(model.nodes[0].translation[0], kEarthRadius + 0.5, 0.01);
+  EXPECT_EQ(model.asset.generator, "dpoint");
+  EXPECT_EQ(model.defaultScene, 0);
+}
+
+TEST(Gltf, glbMeshUsesUint32ElementArray) {
+  TempDir dir;
+  ASSERT_TRUE(writeGlb(dir.file("mesh.glb"), tetrahedron(false)));
+  const tinygltf::Model model = loadWithTinygltf(dir.file("mesh.glb"));
+  const tinygltf::Primitive& primitive = model.meshes.at(0).primitives.at(0);
+  EXPECT_EQ(primitive.mode, TINYGLTF_MODE_TRIANGLES);
+  ASSERT_GE(primitive.indices, 0);
+  const tinygltf::Accessor& indices = model.accessors[size_t(primitive.indices)];
+  EXPECT_EQ(indices.componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
+  EXPECT_EQ(indices.count, 12u);
+  const tinygltf::BufferView& view = model.bufferViews[size_t(indices.bufferView)];
+  EXPECT_EQ(view.target, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  EXPECT_EQ(view.byteOffset % 4, 0u);
+  EXPECT_EQ(primitive.attributes.count("COLOR_0"), 0u);
+}
+
+TEST(Gltf, glbRejectsEmptyPointSet) {
+  TempDir dir;
+  Status s = writeGlb(dir.file("empty.glb"), PointSet{});
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().message, "nothing to write: the point set is empty");
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(Gltf, glbWriteToMissingFolderLeavesNothing) {
+  TempDir dir;
+  Status s = writeGlb(dir.file("missing/out.glb"), offsetCloud());
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("missing"), std::string::npos) << s.error().message;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+// --- Hand-written .gltf files with an embedded buffer -------------------------------------------
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static const char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    uint32_t chunk = uint32_t(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) chunk |= uint32_t(bytes[i + 1]) << 8;
+    if (i + 2 < bytes.size()) chunk |= bytes[i + 2];
+    for (size_t k = 0; k < 4; ++k)
+      out += i + k <= bytes.size() ? kDigits[(chunk >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+template <typename T>
+void append(std::vector<unsigned char>& bytes, std::initializer_list<T> values) {
+  for (T v : values) {
+    unsigned char raw[sizeof(T)];
+    std::memcpy(raw, &v, sizeof(T));
+    bytes.insert(bytes.end(), raw, raw + sizeof(T));
+  }
+}
+
+// Buffer: 3 float VEC3 positions (36 B), 3 normalized ubyte VEC4 colours (12 B), 3 u16 indices.
+std::string fixtureBuffer() {
+  std::vector<unsigned char> bytes;
+  append<float>(bytes, {1, 2, 3, 0, 0, 0, -1, 0.5f, 2});
+  append<uint8_t>(bytes, {255, 0, 0, 10, 0, 255, 0, 20, 51, 102, 204, 255});
+  append<uint16_t>(bytes, {0, 1, 2, 0});
+  return base64(bytes);
+}
+
+// Node 0: matrix (scale 2, then translate by Earth radius in x) with the points mesh 1 (material
+// colour, no COLOR_0). Node 1, its child: T(0,5,0)·R(90° about z, quaternion not normalized)·
+// S(1,1,3) with the triangle mesh 0 (ubyte COLOR_0).
+std::string fixtureGltf() {
+  return R"({
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [
+    {"matrix": [2,0,0,0, 0,2,0,0, 0,0,2,0, 6378000,0,0,1], "mesh": 1, "children": [1]},
+    {"translation": [0,5,0], "rotation": [0,0,1.4142135623730951,1.4142135623730951],
+     "scale": [1,1,3], "mesh": 0}
+  ],
+  "meshes": [
+    {"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2, "mode": 4}]},
+    {"primitives": [{"attributes": {"POSITION": 0}, "material": 0, "mode": 0}]}
+  ],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.25, 0.5, 0.75, 1]}}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+     "min": [-1, 0, 0], "max": [1, 2, 3]},
+    {"bufferView": 1, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC4"},
+    {"bufferView": 2, "componentType": 5123, "count": 3, "type": "SCALAR"}
+  ],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+    {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+    {"buffer": 0, "byteOffset": 48, "byteLength": 6}
+  ],
+  "buffers": [{"byteLength": 56, "uri": "data:application/octet-stream;base64,)" +
+         fixtureBuffer() + R"("}]
+})";
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+Result<PointSet> readText(const TempDir& dir, const std::string& json) {
+  test::writeFile(dir.file("scene.gltf"), json);
+  return readGltf(dir.file("scene.gltf"));
+}
+
+TEST(Gltf, gltfNodeHierarchyComposesMatrixAndTrs) {
+  TempDir dir;
+  Result<PointSet> set = readText(dir, fixtureGltf());
+  ASSERT_TRUE(set) << set.error().message;
+  const std::vector<glm::dvec3> expected = {
+      {6378002, 4, 6},   {6378000, 0, 0},  {6377998, 1, 4},   // node 0: M·p
+      {6377996, 12, 18}, {6378000, 10, 0}, {6377999, 8, 12},  // node 1: M·T·R·S·p
+  };
+  ASSERT_EQ(set->size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(set->positions[i][k], expected[i][k], 1e-9) << "point " << i << " axis " << k;
+  EXPECT_EQ(set->triangles, (std::vector<uint32_t>{3, 4, 5}));
+}
+
+TEST(Gltf, gltfMissingColoursTakeMaterialColour) {
+  TempDir dir;
+  Result<PointSet> set = readText(dir, fixtureGltf());
+  ASSERT_TRUE(set) << set.error().message;
+  const std::vector<glm::vec3> expected = {
+      {0.25f, 0.5f, 0.75f}, {0.25f, 0.5f, 0.75f}, {0.25f, 0.5f, 0.75f}, {1, 0, 0}, {0, 1, 0},
+      {0.2f, 0.4f, 0.8f}};
+  EXPECT_EQ(set->colors, expected);
+}
+
+void expectReadError(const std::string& json, const std::vector<std::string>& parts) {
+  TempDir dir;
+  Result<PointSet> set = readText(dir, json);
+  ASSERT_FALSE(set);
+  const std::string& message = set.error().message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_EQ(message.rfind(dir.file("scene.gltf") + ": ", 0), 0u) << message;
+  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+}
+
+TEST(Gltf, gltfRejectsNodeCycle) {
+  expectReadError(replaced(fixtureGltf(), R"("scale": [1,1,3], "mesh": 0})",
+                           R"("scale": [1,1,3], "mesh": 0, "children": [0]})"),
+                  {"node 0", "cycle"});
+}
+
+TEST(Gltf, gltfRejectsNodeWithTwoParents) {
+  expectReadError(replaced(fixtureGltf(), R"("children": [1])", R"("children": [1, 1])"),
+                  {"node 1", "more than one parent"});
+}
+
+TEST(Gltf, gltfRejectsAccessorPastBuffer) {
+  // Four positions in a 36-byte view that holds three.
+  expectReadError(replaced(fixtureGltf(), R"("componentType": 5126, "count": 3)",
+                           R"("componentType": 5126, "count": 4)"),
+                  {"accessor 0", "past the end of bufferView 0"});
+  // A stride that walks out of the view.
+  expectReadError(replaced(fixtureGltf(), R"("byteOffset": 0, "byteLength": 36})",
+                           R"("byteOffset": 0, "byteLength": 36, "byteStride": 16})"),
+                  {"accessor 0", "past the end"});
+}
+
+TEST(Gltf, gltfRejectsBufferViewPastBuffer) {
+  expectReadError(replaced(fixtureGltf(), R"("byteOffset": 48, "byteLength": 6)",
+                           R"("byteOffset": 48, "byteLength": 60)"),
+                  {"accessor 2", "bufferView 2", "past the end of buffer 0"});
+}
+
+TEST(Gltf, gltfRejectsIndexOutOfRange) {
+  // The colour bytes read as u8 indices: 255 is no vertex.
+  expectReadError(replaced(fixtureGltf(), R"({"bufferView": 2, "componentType": 5123,)",
+                           R"({"bufferView": 1, "componentType": 5121,)"),
+                  {"accessor 2", "element 0 is 255, out of range for 3 vertices"});
+}
+
+TEST(Gltf, gltfRejectsUnsupportedPositionType) {
+  expectReadError(replaced(fixtureGltf(), R"("componentType": 5126, "count": 3)",
+                           R"("componentType": 5121, "count": 3)"),
+                  {"accessor 0: POSITION componentType 5121 not supported yet"});
+}
+
+TEST(Gltf, gltfRejectsSparseAccessor) {
+  expectReadError(replaced(fixtureGltf(), R"("min": [-1, 0, 0], "max": [1, 2, 3]})",
+                           R"("min": [-1, 0, 0], "max": [1, 2, 3], "sparse": {"count": 1,
+                  "indices": {"bufferView": 2, "componentType": 5123},
+                  "values": {"bufferView": 0}}})"),
+                  {"accessor 0", "sparse", "not supported yet"});
+}
+
+TEST(Gltf, gltfRefusesBufferOutsideFolder) {
+  TempDir dir;
+  test::writeFile(dir.file("outside.bin"), std::string(56, '\0'));
+  const std::string sub = dir.file("model");
+  ASSERT_TRUE(std::filesystem::create_directory(sub));
+  std::string json = fixtureGltf();
+  const size_t uri = json.find("data:application");
+  json.replace(uri, json.find('"', uri) - uri, "../outside.bin");
+  test::writeFile(sub + "/scene.gltf", json);
+  Result<PointSet> set = readGltf(sub + "/scene.gltf");
+  ASSERT_FALSE(set);
+  EXPECT_NE(set.error().message.find("outside.bin"), std::string::npos) << set.error().message;
+}
+
+TEST(Gltf, gltfReportsMalformedJsonOnOneLine) { expectReadError("{ \"asset\": ", {}); }
+
+TEST(Gltf, gltfReportsMissingFile) {
+  TempDir dir;
+  Result<PointSet> set = readGltf(dir.file("absent.glb"));
+  ASSERT_FALSE(set);
+  EXPECT_EQ(set.error().message, dir.file("absent.glb") + ": file not found");
+}
+
+TEST(Gltf, gltfReportsEmptyFile) {
+  TempDir dir;
+  test::writeFile(dir.file("empty.glb"), "");
+  Result<PointSet> set = readGltf(dir.file("empty.glb"));
+  ASSERT_FALSE(set);
+  EXPECT_EQ(set.error().message, dir.file("empty.glb") + ": file is empty");
+}
+
+TEST(Gltf, glbTruncatedFileIsAnError) {
+  TempDir dir;
+  ASSERT_TRUE(writeGlb(dir.file("cloud.glb"), offsetCloud()));
+  const std::string bytes = test::readFile(dir.file("cloud.glb"));
+  test::writeFile(dir.file("cut.glb"), bytes.substr(0, bytes.size() / 2));
+  Result<PointSet> set = readGltf(dir.file("cut.glb"));
+  ASSERT_FALSE(set);
+  EXPECT_EQ(set.error().message.rfind(dir.file("cut.glb") + ": ", 0), 0u) << set.error().message;
+  EXPECT_EQ(set.error().message.find('\n'), std::string::npos) << set.error().message;
+}
+
+// --- The official Khronos validator --------------------------------------------------------------
+
+TEST(Gltf, glbPassesOfficialValidator) {
+  const std::string node = "/usr/bin/node";
+  if (!test::fileExists(node) ||
+      !test::fileExists(std::string(DPOINT_GLTF_VALIDATOR) + "/package.json"))
+    GTEST_SKIP() << "node or the glTF validator is not installed";
+  TempDir dir;
+  ASSERT_TRUE(writeGlb(dir.file("points.glb"), offsetCloud()));
+  ASSERT_TRUE(writeGlb(dir.file("mesh.glb"), tetrahedron(true)));
+  ASSERT_TRUE(writeGlb(dir.file("plain.glb"), tetrahedron(false)));
+  const std::string script =
+      "const v = require(process.argv[1]); const fs = require('fs');"
+      "v.validateBytes(new Uint8Array(fs.readFileSync(process.argv[2]))).then(r => {"
+      "  console.log(r.issues.numErrors + ' errors ' + r.issues.numWarnings + ' warnings');"
+      "  console.log(JSON.stringify(r.issues.messages));"
+      "}).catch(e => { console.error(String(e)); process.exit(1); });";
+  for (const char* name : {"points.glb", "mesh.glb", "plain.glb"}) {
+    test::CommandResult r =
+        test::runCommand({node, "-e", script, DPOINT_GLTF_VALIDATOR, dir.file(name)});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out.rfind("0 errors 0 warnings\n", 0), 0u) << name << ": " << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace dpoint
