@@ -2,9 +2,8 @@
 //
 // Shortest round-trip output is std::to_chars(double) (Ryu in libstdc++): the fewest digits that
 // parse back to the same double, so CSV -> PointSet -> CSV is byte- and bit-identical.
-// Fixed output is std::to_chars(..., chars_format::fixed, N), which the standard defines as
-// printf("%.*f") in the C locale: exact decimal expansion, rounded half to even on the exact
-// binary value, as glibc does. Colours are floats: shortest float form, or their exact double
+// Fixed output is formatFixed (core/fixed_format.h): printf("%.*f") rounding, exactly, as glibc
+// does: the exact binary value rounded half to even. Colours are floats: shortest float form, or their exact double
 // value in fixed form (as the seed printed its double colours with %.15f).
 #include <array>
 #include <charconv>
@@ -13,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/csv.h"
+#include "core/fixed_format.h"
 #include "core/parallel.h"
 
 namespace dpoint {
@@ -21,7 +21,7 @@ namespace {
 constexpr size_t kRowsPerChunk = 1u << 16;
 constexpr int kMaxDecimals = 100;
 // DBL_MAX in fixed form has 309 integer digits; plus sign, point, decimals and a separator.
-constexpr size_t kMaxFieldChars = 312 + kMaxDecimals;
+constexpr size_t kMaxFieldChars = fixedFormatMaxChars(kMaxDecimals) + 1;
 
 class RowFormatter {
  public:
@@ -68,6 +68,7 @@ class RowFormatter {
 
  private:
   char* number(char* p, char* limit, double v) const {
+    if (decimals_ >= 0 && std::isfinite(v)) return formatFixed(p, v, decimals_);
     std::to_chars_result r = decimals_ < 0 ? std::to_chars(p, limit, v)
                                            : std::to_chars(p, limit, v, std::chars_format::fixed, decimals_);
     assert(r.ec == std::errc());

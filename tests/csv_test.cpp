@@ -3,9 +3,11 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <charconv>
 #include <random>
 
 #include "core/csv.h"
+#include "core/fixed_format.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -262,6 +264,42 @@ TEST(Csv, failedWriteLeavesNothing) {
   ASSERT_TRUE(writeCsv(dir.file("a.csv"), s).ok());
   EXPECT_EQ(readFile(dir.file("a.csv")), "x,y,z\n1,2,3\n");
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"a.csv"});
+}
+
+}  // namespace
+}  // namespace dpoint
+
+namespace dpoint {
+namespace {
+
+// formatFixed must agree with std::to_chars' fixed form (printf's rounding) everywhere.
+TEST(FixedFormat, matchesToCharsOnRandomAndTieValues) {
+  std::mt19937_64 rng(99);
+  char a[512], b[512];
+  auto check = [&](double v, int decimals) {
+    char* end_a = formatFixed(a, v, decimals);
+    auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::fixed, decimals);
+    ASSERT_EQ(std::string(a, end_a), std::string(b, r.ptr)) << "decimals " << decimals;
+  };
+  for (int i = 0; i < 300000; ++i) {
+    const uint64_t bits = rng();
+    double v;
+    std::memcpy(&v, &bits, sizeof v);
+    if (!std::isfinite(v)) continue;
+    const int decimals = static_cast<int>(rng() % 30);
+    check(v, decimals);
+    check(std::ldexp(static_cast<double>(bits >> 11), -static_cast<int>(rng() % 80)), decimals);  // moderate
+    check(static_cast<double>(static_cast<int64_t>(bits >> 40)) * 0.001, 15);
+  }
+  for (int k = 1; k < 80; ++k) {  // exact ties at every position
+    for (int decimals = 0; decimals < 30; ++decimals) {
+      check(std::ldexp(1.0, -k), decimals);
+      check(-3.0 * std::ldexp(1.0, -k), decimals);
+      check(2.5 + std::ldexp(1.0, -k), decimals);
+    }
+  }
+  for (double v : {0.0, -0.0, DBL_MAX, -DBL_MAX, DBL_TRUE_MIN, 1e23, 9.5, 0.5, 1.5, -0.5, 1e-7})
+    for (int decimals : {0, 1, 15, 27, 28, 60, 100}) check(v, decimals);
 }
 
 }  // namespace
