@@ -11,12 +11,13 @@ Peak memory is the child's max RSS (wait4). Usage: bench/csv_io.py build/dpoint 
 import json
 import os
 import platform
-import statistics
 import subprocess
 import sys
-import time
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from timing import median_of, remover  # noqa: E402
 
 exe = os.path.abspath(sys.argv[1])
 rows = int(sys.argv[2]) if len(sys.argv) > 2 else 10_000_000
@@ -25,23 +26,6 @@ work = sys.argv[4] if len(sys.argv) > 4 else "/tmp/dpoint-bench-csv"
 os.makedirs(work, exist_ok=True)
 npz, csv, ply, out = (os.path.join(work, n) for n in ("data.npz", "data.csv", "data.ply", "out.csv"))
 python = "/usr/bin/python3"
-
-
-def timed(argv):
-    """Wall seconds and peak RSS (bytes) of one child process."""
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    stdout, stderr = proc.stdout.read(), proc.stderr.read()
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit(f"{' '.join(argv)} failed: {stderr.decode()}")
-    return wall, usage.ru_maxrss * 1024, stdout.decode()
-
-
-def median_of(argv):
-    results = [timed(argv) for _ in range(runs)]
-    return statistics.median(r[0] for r in results), max(r[1] for r in results), results[-1][2]
 
 
 rng = np.random.default_rng(2)
@@ -57,16 +41,16 @@ f.to_csv({csv!r}, index=False, float_format='%.15f')
 """]
 pandas_read = [python, "-c", f"import pandas as pd; pd.read_csv({csv!r})"]
 
-pw_s, pw_rss, _ = median_of(pandas_write)      # also makes data.csv
+pw_s, pw_rss, _ = median_of(pandas_write, runs, remover(csv))  # also makes data.csv
 csv_bytes = os.path.getsize(csv)
 subprocess.run([exe, "convert", csv, "-o", ply, "--ply-colors", "float", "--quiet"], check=True)
-dr_s, dr_rss, inner = median_of([exe, "bench", "io", csv])
-dw_s, dw_rss, _ = median_of([exe, "convert", ply, "-o", out, "--decimals", "15", "--quiet"])
+dr_s, dr_rss, inner = median_of([exe, "bench", "io", csv], runs)
+dw_s, dw_rss, _ = median_of([exe, "convert", ply, "-o", out, "--decimals", "15", "--quiet"], runs, remover(out))
 out_bytes = os.path.getsize(out)
 same = subprocess.run(["cmp", "-s", csv, out]).returncode == 0
-ds_s, _, _ = median_of([exe, "convert", ply, "-o", out, "--quiet"])
+ds_s, _, _ = median_of([exe, "convert", ply, "-o", out, "--quiet"], runs, remover(out))
 short_bytes = os.path.getsize(out)
-pr_s, pr_rss, _ = median_of(pandas_read)
+pr_s, pr_rss, _ = median_of(pandas_read, runs)
 
 pointset_bytes = rows * (24 + 12)
 mb = 1e6
