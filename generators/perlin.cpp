@@ -1,1 +1,103 @@
-// placeholder: issue #3
+#include "generators/perlin.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/parallel.h"
+
+namespace dpoint {
+namespace {
+
+// Ken Perlin's reference permutation of 0..255 (improved noise, 2002). Lookups index up to 511,
+// so the table is used as if written twice (kPermutation[i & 255]).
+constexpr uint8_t kPermutation[256] = {
+    151, 160, 137, 91,  90,  15,  131, 13,  201, 95,  96,  53,  194, 233, 7,   225, 140, 36,  103, 30,
+    69,  142, 8,   99,  37,  240, 21,  10,  23,  190, 6,   148, 247, 120, 234, 75,  0,   26,  197, 62,
+    94,  252, 219, 203, 117, 35,  11,  32,  57,  177, 33,  88,  237, 149, 56,  87,  174, 20,  125, 136,
+    171, 168, 68,  175, 74,  165, 71,  134, 139, 48,  27,  166, 77,  146, 158, 231, 83,  111, 229, 122,
+    60,  211, 133, 230, 220, 105, 92,  41,  55,  46,  245, 40,  244, 102, 143, 54,  65,  25,  63,  161,
+    1,   216, 80,  73,  209, 76,  132, 187, 208, 89,  18,  169, 200, 196, 135, 130, 116, 188, 159, 86,
+    164, 100, 109, 198, 173, 186, 3,   64,  52,  217, 226, 250, 124, 123, 5,   202, 38,  147, 118, 126,
+    255, 82,  85,  212, 207, 206, 59,  227, 47,  16,  58,  17,  182, 189, 28,  42,  223, 183, 170, 213,
+    119, 248, 152, 2,   44,  154, 163, 70,  221, 153, 101, 155, 167, 43,  172, 9,   129, 22,  39,  253,
+    19,  98,  108, 110, 79,  113, 224, 232, 178, 185, 112, 104, 218, 246, 97,  228, 251, 34,  242, 193,
+    238, 210, 144, 12,  191, 179, 162, 241, 81,  51,  145, 235, 249, 14,  239, 107, 49,  192, 214, 31,
+    181, 199, 106, 157, 184, 84,  204, 176, 115, 121, 50,  45,  127, 4,   150, 254, 138, 236, 205, 93,
+    222, 114, 67,  29,  24,  72,  243, 141, 128, 195, 78,  66,  215, 61,  156, 180};
+
+// The noise package's gradients: the 12 edge midpoints of the cube, then 4 of them again so a
+// 4-bit hash can pick one without a modulo.
+constexpr float kGradients[16][3] = {
+    {1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1}, {1, 0, -1}, {-1, 0, -1},
+    {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1}, {1, 0, -1}, {-1, 0, -1}, {0, -1, 1}, {0, 1, 1}};
+
+constexpr int kRepeat = 1024;  // the package's default repeatx/y/z
+
+int perm(int index) { return kPermutation[index & 255]; }
+
+// Every component is 0 or ±1, so the products are exact and the sum rounds once, as in C.
+float gradient(int hash, float x, float y, float z) {
+  const float* g = kGradients[hash & 15];
+  return x * g[0] + y * g[1] + z * g[2];
+}
+
+float lerp(float t, float a, float b) { return a + t * (b - a); }
+
+float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+
+// The lattice cell along one axis, wrapped like the package: floor of fmod(v, repeat) (which
+// keeps the sign of v), and the next cell as fmod(cell + 1, repeat) in float.
+void cellIndices(float v, int& lo, int& hi) {
+  const float repeat = static_cast<float>(kRepeat);
+  lo = static_cast<int>(std::floor(std::fmod(v, repeat)));
+  hi = static_cast<int>(std::fmod(static_cast<float>(lo + 1), repeat));
+  lo &= 255;
+  hi &= 255;
+}
+
+}  // namespace
+
+float pnoise3(float x, float y, float z) {
+  int i, ii, j, jj, k, kk;
+  cellIndices(x, i, ii);
+  cellIndices(y, j, jj);
+  cellIndices(z, k, kk);
+  // The fractional parts come from the unwrapped coordinates, as in the package.
+  x -= std::floor(x);
+  y -= std::floor(y);
+  z -= std::floor(z);
+  const float fx = fade(x), fy = fade(y), fz = fade(z);
+
+  const int a = perm(i), aa = perm(a + j), ab = perm(a + jj);
+  const int b = perm(ii), ba = perm(b + j), bb = perm(b + jj);
+  const float x1 = x - 1.0f, y1 = y - 1.0f, z1 = z - 1.0f;
+  const float near_z = lerp(fy, lerp(fx, gradient(perm(aa + k), x, y, z), gradient(perm(ba + k), x1, y, z)),
+                            lerp(fx, gradient(perm(ab + k), x, y1, z), gradient(perm(bb + k), x1, y1, z)));
+  const float far_z = lerp(fy, lerp(fx, gradient(perm(aa + kk), x, y, z1), gradient(perm(ba + kk), x1, y, z1)),
+                           lerp(fx, gradient(perm(ab + kk), x, y1, z1), gradient(perm(bb + kk), x1, y1, z1)));
+  return lerp(fz, near_z, far_z);
+}
+
+glm::vec3 seedColor(const glm::dvec3& p) {
+  glm::vec3 color;
+  for (int c = 0; c < 3; ++c) {
+    const double offset = 100.0 * c;
+    const double n = pnoise3(static_cast<float>(p.x + offset), static_cast<float>(p.y + offset),
+                             static_cast<float>(p.z + offset));
+    color[c] = static_cast<float>(0.5 + 0.5 * n);
+  }
+  return color;
+}
+
+void colorByNoise(PointSet& points, unsigned threads) {
+  constexpr size_t kPointsPerChunk = size_t{1} << 14;
+  points.colors.resize(points.positions.size());
+  const size_t chunks = (points.positions.size() + kPointsPerChunk - 1) / kPointsPerChunk;
+  parallelFor(chunks, threads, [&](size_t chunk, unsigned) {
+    const size_t end = std::min(points.positions.size(), (chunk + 1) * kPointsPerChunk);
+    for (size_t i = chunk * kPointsPerChunk; i < end; ++i) points.colors[i] = seedColor(points.positions[i]);
+  });
+}
+
+}  // namespace dpoint

@@ -1,0 +1,50 @@
+// The Menger sponge as an exact surface mesh (--method exact).
+//
+// Level n is the union of the 20^n unit cells (x, y, z) of the integer lattice [0, 3^n)³ for
+// which no base-3 digit position has a 1 in two or more of x, y, z. The mesh is the set of
+// exposed cell faces (a face whose neighbouring cell is outside the sponge or outside the cube),
+// 2·20^n + 4·8^n unit quads, each split into 2 triangles, counter-clockwise seen from outside.
+// Exact by construction: every vertex is a lattice point, and the coordinate of lattice integer k
+// is computed once as (k·size)/3^n (for size 1 a single correctly rounded division, k/3^n), so
+// points on one lattice plane share one coordinate bit for bit and vertices are welded by their
+// integer coordinates, never by comparing doubles.
+#pragma once
+
+#include <cstdint>
+
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+constexpr int kMengerMaxLevel = 8;
+
+struct MengerParams {
+  int level = 4;                 // 0..kMengerMaxLevel
+  double size = 1.0;             // edge length; the sponge spans [0, size]³
+  unsigned threads = 0;          // 0: all cores
+  uint64_t max_memory = 0;       // bytes; 0: half of physical memory
+  Progress* progress = nullptr;
+};
+
+// The exact method (`--method exact`, so far the only one). Vertices: every lattice point that is a corner of an exposed face, once, ordered by (x, y, z)
+// lattice coordinates (x slowest). Triangles: the quads of the cell slabs x = 0, 1, ... in turn;
+// within a slab by cell row y, then face direction (−x, +x, −y, +y, −z, +z), then z.
+// The surface is closed and consistently oriented, and it has no edge where it touches itself:
+// every directed edge of the triangles appears exactly once and its reverse exactly once (tested
+// for levels 0..4, seen for 5: of the 4 cells around a lattice edge, never just a diagonal pair is
+// in the sponge).
+// Errors: level outside 0..kMengerMaxLevel or size not finite and positive (kUsage); over the
+// memory limit (kResourceLimit, checked before anything large is allocated).
+Result<PointSet> generateMenger(const MengerParams& params);
+
+// 2·20^n + 4·8^n: the number of exposed unit faces of the level-n sponge.
+uint64_t mengerFaceCount(int level);
+
+// The number of vertices of the level-n mesh, (224·20^n + 456·8^n + 384)/133 (8, 64, 896, 15232,
+// ...). Fitted to the exact counts of levels 0..5, which it matches with three to spare (the tests
+// check it against the generator), and used to size the memory check before anything is built.
+uint64_t mengerVertexCount(int level);
+
+}  // namespace dpoint
