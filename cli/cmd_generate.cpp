@@ -1,55 +1,232 @@
-// dpoint generate KIND -o OUT: datasets of the study. random2d now; the fractals are issue #3.
+// dpoint generate KIND -o OUT: the datasets of the study (DESIGN §8).
+// Parsing and reporting only; every generator is a library function.
+#include <charconv>
+#include <cmath>
 #include <memory>
 
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
+#include "generators/julia.h"
+#include "generators/mandelbrot2d.h"
+#include "generators/mandelbulb.h"
+#include "generators/menger.h"
+#include "generators/perlin.h"
 #include "generators/random2d.h"
+#include "generators/sierpinski.h"
 
 namespace dpoint {
 namespace {
 
+// Options every generator shares: where the output goes and what is done to it after generation.
 struct OutputOptions {
   std::string output;
+  std::string colors = "auto";
+  std::string offset;
   int decimals = -1;
   std::string max_memory;
   CommonOptions common;
 };
 
-void addOutputOptions(CLI::App& cmd, OutputOptions& o) {
+void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
   cmd.add_option("-o,--output", o.output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
+  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (the seed's pnoise3), none")
+      ->check(CLI::IsMember({"auto", "noise", "none"}))
+      ->default_val("auto");
+  cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
   cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")
       ->check(CLI::Range(0, 100));
   cmd.add_option("--max-memory", o.max_memory, "Refuse (exit 4) when the estimate is above this (default: half of RAM)");
   addCommonOptions(cmd, o.common);
 }
 
+// "a,b,c" → exactly `count` finite doubles; the error names the flag and the text.
+Result<std::vector<double>> parseNumbers(const std::string& flag, const std::string& text, size_t count) {
+  std::vector<double> values;
+  const char* p = text.data();
+  const char* end = p + text.size();
+  while (true) {
+    double v = 0.0;
+    while (p < end && *p == ' ') ++p;
+    if (p < end && *p == '+') ++p;
+    auto r = std::from_chars(p, end, v);
+    if (r.ec != std::errc() || !std::isfinite(v)) break;
+    values.push_back(v);
+    p = r.ptr;
+    while (p < end && *p == ' ') ++p;
+    if (p == end) {
+      if (values.size() == count) return values;
+      break;
+    }
+    if (*p != ',') break;
+    ++p;
+  }
+  return Error{flag + ": '" + text + "' is not " + std::to_string(count) + " comma-separated finite numbers",
+               ExitCode::kUsage};
+}
+
+Result<uint64_t> memoryLimit(const OutputOptions& o) {
+  if (o.max_memory.empty()) return uint64_t{0};
+  return parseMemorySize("--max-memory", o.max_memory);
+}
+
+// Colours, offset and writing: the steps after any generator.
+int finish(Result<PointSet> generated, const OutputOptions& o, bool auto_noise, Progress& progress) {
+  if (!generated) return reportError(generated.error());
+  PointSet& points = *generated;
+  const bool noise = o.colors == "noise" || (o.colors == "auto" && auto_noise);
+  if (o.colors == "none") points.colors.clear();
+  if (noise) {
+    Result<uint64_t> limit = memoryLimit(o);
+    if (!limit) return reportError(limit.error());
+    // The generators' own estimates cover positions and triangles; colours come on top.
+    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + sizeof(glm::vec3)) + points.triangles.size() * 4;
+    if (Status s = checkMemory("colouring " + std::to_string(points.size()) + " points", needed, *limit); !s)
+      return reportError(s.error());
+    colorByNoise(points, o.common.threads);  // on the fractal's own coordinates, before the offset
+  }
+  if (!o.offset.empty()) {
+    Result<std::vector<double>> offset = parseNumbers("--offset", o.offset, 3);
+    if (!offset) return reportError(offset.error());
+    const glm::dvec3 d((*offset)[0], (*offset)[1], (*offset)[2]);
+    for (glm::dvec3& p : points.positions) p += d;
+  }
+  WriteOptions w;
+  w.threads = o.common.threads;
+  w.decimals = o.decimals;
+  w.progress = &progress;
+  if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
+  return 0;
+}
+
+// Checks the output path's extension before any work, so a typo does not cost a long run.
+bool outputTypeOk(const OutputOptions& o, int& code) {
+  Result<FileFormat> format = formatOf(o.output);
+  if (format && *format != FileFormat::kGltf) return true;
+  code = reportError(format ? Error{o.output + ": write .glb, not .gltf", ExitCode::kUsage} : format.error());
+  return false;
+}
+
+template <typename Params, typename Options>
+void registerKind(CLI::App& parent, RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* cmd,
+                  bool auto_noise, Result<PointSet> (*generate)(const Params&),
+                  Result<Params> (*makeParams)(const Options&, Progress*)) {
+  cmd->callback([o, &run, auto_noise, generate, makeParams, name = cmd->get_name()] {
+    run = [o, auto_noise, generate, makeParams, name] {
+      int code = 0;
+      if (!outputTypeOk(o->out, code)) return code;
+      Progress progress(progressSink(o->out.common.quiet), name);
+      Result<Params> params = makeParams(*o, &progress);
+      if (!params) return reportError(params.error());
+      return finish(generate(*params), o->out, auto_noise, progress);
+    };
+  });
+  (void)parent;
+}
+
+// Fills the shared fields of a generator's Params.
+template <typename Params>
+Result<Params> withCommon(Params p, const OutputOptions& out, Progress* progress) {
+  Result<uint64_t> limit = memoryLimit(out);
+  if (!limit) return limit.error();
+  p.threads = out.common.threads;
+  p.max_memory = *limit;
+  p.progress = progress;
+  return p;
+}
+
+// ---- random2d ----
 struct Random2dOptions {
-  uint64_t count = 1000000;
-  uint64_t seed = 1;
+  Random2dParams params;
   OutputOptions out;
 };
+Result<Random2dParams> random2dParams(const Random2dOptions& o, Progress* progress) {
+  return withCommon(o.params, o.out, progress);
+}
 
-int runRandom2d(const Random2dOptions& o) {
-  Progress progress(progressSink(o.out.common.quiet), "random2d");
-  Random2dParams params;
-  params.count = o.count;
-  params.seed = o.seed;
-  params.threads = o.out.common.threads;
-  params.progress = &progress;
-  if (!o.out.max_memory.empty()) {
-    Result<uint64_t> limit = parseMemorySize("--max-memory", o.out.max_memory);
-    if (!limit) return reportError(limit.error());
-    params.max_memory = *limit;
-  }
-  Result<PointSet> points = generateRandom2d(params);
-  if (!points) return reportError(points.error());
-  WriteOptions w;
-  w.threads = o.out.common.threads;
-  w.decimals = o.out.decimals;
-  w.progress = &progress;
-  if (Status s = writePoints(o.out.output, *points, w); !s) return reportError(s.error());
-  return 0;
+// ---- mandelbulb ----
+struct MandelbulbOptions {
+  MandelbulbParams params;
+  std::string bounds = "-1.5,1.5";
+  std::string variant = "seed", frame = "native";
+  OutputOptions out;
+};
+Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* progress) {
+  MandelbulbParams p = o.params;
+  Result<std::vector<double>> bounds = parseNumbers("--bounds", o.bounds, 2);
+  if (!bounds) return bounds.error();
+  p.lo = (*bounds)[0];
+  p.hi = (*bounds)[1];
+  p.variant = o.variant == "fast" ? MandelbulbVariant::kFast : MandelbulbVariant::kSeed;
+  p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
+  return withCommon(p, o.out, progress);
+}
+
+// ---- julia ----
+struct JuliaOptions {
+  JuliaParams params;
+  std::string c = "-0.7,0.27015,0.27015,0";
+  std::string bounds = "-1.5,1.5";
+  std::string frame = "native";
+  OutputOptions out;
+};
+Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
+  JuliaParams p = o.params;
+  Result<std::vector<double>> c = parseNumbers("--c", o.c, 4);
+  if (!c) return c.error();
+  p.c = glm::dvec4((*c)[0], (*c)[1], (*c)[2], (*c)[3]);
+  Result<std::vector<double>> bounds = parseNumbers("--bounds", o.bounds, 2);
+  if (!bounds) return bounds.error();
+  p.lo = (*bounds)[0];
+  p.hi = (*bounds)[1];
+  p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
+  return withCommon(p, o.out, progress);
+}
+
+// ---- menger ----
+struct MengerOptions {
+  MengerParams params;
+  OutputOptions out;
+};
+Result<MengerParams> mengerParams(const MengerOptions& o, Progress* progress) {
+  return withCommon(o.params, o.out, progress);
+}
+
+// ---- sierpinski ----
+struct SierpinskiOptions {
+  SierpinskiParams params;
+  OutputOptions out;
+};
+Result<SierpinskiParams> sierpinskiParams(const SierpinskiOptions& o, Progress* progress) {
+  return withCommon(o.params, o.out, progress);
+}
+
+// ---- mandelbrot2d ----
+struct Mandelbrot2dOptions {
+  Mandelbrot2dParams params;
+  std::string center = "-0.7436450,0.1318259";
+  OutputOptions out;
+};
+Result<Mandelbrot2dParams> mandelbrot2dParams(const Mandelbrot2dOptions& o, Progress* progress) {
+  Mandelbrot2dParams p = o.params;
+  Result<std::vector<double>> c = parseNumbers("--center", o.center, 2);
+  if (!c) return c.error();
+  p.center_x = (*c)[0];
+  p.center_y = (*c)[1];
+  return withCommon(p, o.out, progress);
+}
+
+void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double& level, std::string& bounds,
+                          std::string& frame, std::string& grid_out, int default_iter) {
+  cmd->add_option("--resolution", resolution, "Grid points per axis (2..65536)")->default_val(200);
+  cmd->add_option("--max-iter", max_iter, "Iterations before a point counts as inside")->default_val(default_iter);
+  cmd->add_option("--level", level, "Surface level on the escape-count field (default: max_iter/4)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--bounds", bounds, "Grid range LO,HI on every axis")->default_val("-1.5,1.5");
+  cmd->add_option("--frame", frame, "Coordinates: native (the fractal's own) or seed (grid corner at 0, like skimage)")
+      ->check(CLI::IsMember({"native", "seed"}))
+      ->default_val("native");
+  cmd->add_option("--grid-out", grid_out, "Also write the raw escape-count grid (uint8 if max_iter <= 255, else uint16)");
 }
 
 }  // namespace
@@ -58,13 +235,59 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   CLI::App* generate = app.add_subcommand("generate", "Generate a dataset of the study");
   generate->require_subcommand(1);
 
+  auto mb = std::make_shared<MandelbulbOptions>();
+  CLI::App* mandelbulb = generate->add_subcommand("mandelbulb", "Power-8 Mandelbulb surface (marching cubes on escape counts)");
+  addEscapeGridOptions(mandelbulb, mb->params.resolution, mb->params.max_iter, mb->params.level, mb->bounds, mb->frame,
+                       mb->params.grid_out, 100);
+  mandelbulb->add_option("--power", mb->params.power, "Exponent of the Mandelbulb map")->default_val(8);
+  mandelbulb->add_option("--variant", mb->variant, "seed: the study's trigonometric escape function, bit for bit; "
+                                                   "fast: trig-free power-8 form")
+      ->check(CLI::IsMember({"seed", "fast"}))
+      ->default_val("seed");
+  addOutputOptions(*mandelbulb, mb->out, "noise");
+  registerKind(*generate, run, mb, mandelbulb, true, &generateMandelbulb, &mandelbulbParams);
+
+  auto ju = std::make_shared<JuliaOptions>();
+  CLI::App* julia = generate->add_subcommand("julia", "Quaternion Julia set surface (the seed's iteration, k = 0 slice)");
+  addEscapeGridOptions(julia, ju->params.resolution, ju->params.max_iter, ju->params.level, ju->bounds, ju->frame,
+                       ju->params.grid_out, 200);
+  julia->add_option("--c", ju->c, "Julia constant as 4 numbers")->default_val("-0.7,0.27015,0.27015,0");
+  addOutputOptions(*julia, ju->out, "noise");
+  registerKind(*generate, run, ju, julia, true, &generateJulia, &juliaParams);
+
+  auto me = std::make_shared<MengerOptions>();
+  CLI::App* menger = generate->add_subcommand("menger", "Menger sponge: exposed faces of its 20^n cubes");
+  menger->add_option("--level", me->params.level, "Subdivision level (0..8)")->default_val(4);
+  menger->add_option("--size", me->params.size, "Edge length of the sponge")->default_val(1.0);
+  addOutputOptions(*menger, me->out, "noise");
+  registerKind(*generate, run, me, menger, true, &generateMenger, &mengerParams);
+
+  auto si = std::make_shared<SierpinskiOptions>();
+  CLI::App* sierpinski = generate->add_subcommand("sierpinski", "Sierpinski tetrahedron: 4^n tetrahedra from the seed's corners");
+  sierpinski->add_option("--level", si->params.level, "Subdivision level (0..12)")->default_val(9);
+  sierpinski->add_flag("--unwelded", si->params.unwelded, "The seed's 4^(n+1) rows instead of the 2*4^n+2 distinct vertices");
+  addOutputOptions(*sierpinski, si->out, "noise");
+  registerKind(*generate, run, si, sierpinski, true, &generateSierpinski, &sierpinskiParams);
+
   auto r = std::make_shared<Random2dOptions>();
   CLI::App* random2d = generate->add_subcommand(
       "random2d", "N points uniform in [-1,1)^2 (z = 0); identical on every machine and thread count");
-  random2d->add_option("--count,-n", r->count, "Number of points")->default_val(1000000)->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40));
-  random2d->add_option("--seed", r->seed, "Seed of the generator")->default_val(1);
-  addOutputOptions(*random2d, r->out);
-  random2d->callback([r, &run] { run = [r] { return runRandom2d(*r); }; });
+  random2d->add_option("--count,-n", r->params.count, "Number of points")
+      ->default_val(1000000)
+      ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40));
+  random2d->add_option("--seed", r->params.seed, "Seed of the generator")->default_val(1);
+  addOutputOptions(*random2d, r->out, "none");
+  registerKind(*generate, run, r, random2d, false, &generateRandom2d, &random2dParams);
+
+  auto m2 = std::make_shared<Mandelbrot2dOptions>();
+  CLI::App* mandelbrot2d = generate->add_subcommand(
+      "mandelbrot2d", "2D Mandelbrot deep zoom: a resolution^2 grid coloured by escape count (perturbation when deep)");
+  mandelbrot2d->add_option("--center", m2->center, "View centre X,Y")->default_val("-0.7436450,0.1318259");
+  mandelbrot2d->add_option("--width", m2->params.width, "View width")->default_val(1e-6);
+  mandelbrot2d->add_option("--resolution", m2->params.resolution, "Points per side (2..65536)")->default_val(1024);
+  mandelbrot2d->add_option("--max-iter", m2->params.max_iter, "Iterations before a point counts as inside")->default_val(2000);
+  addOutputOptions(*mandelbrot2d, m2->out, "escape count");
+  registerKind(*generate, run, m2, mandelbrot2d, false, &generateMandelbrot2d, &mandelbrot2dParams);
 }
 
 }  // namespace dpoint

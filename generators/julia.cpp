@@ -1,1 +1,48 @@
-// placeholder: issue #3
+#include "generators/julia.h"
+
+#include <cmath>
+
+namespace dpoint {
+
+int juliaEscape(double x, double y, double z, const glm::dvec4& c, int max_iter) {
+  double w = 0.0;
+  for (int i = 0; i < max_iter; ++i) {
+    const double x2 = x * x, rest = y * y + z * z + w * w;
+    if (std::sqrt(x2 + rest) > 2.0) return i;
+    const double nx = x2 - rest + c.x;
+    const double ny = 2.0 * x * y + c.y;
+    const double nz = 2.0 * x * z + c.z;
+    w = 2.0 * x * w + c.w;
+    x = nx;
+    y = ny;
+    z = nz;
+  }
+  return max_iter;
+}
+
+EscapeRowFunction juliaRow(const glm::dvec4& c) {
+  return [c](double x, double y, const double* zs, size_t n, int limit, uint32_t* counts) {
+    for (size_t k = 0; k < n; ++k) counts[k] = static_cast<uint32_t>(juliaEscape(x, y, zs[k], c, limit));
+  };
+}
+
+Result<PointSet> generateJulia(const JuliaParams& params) {
+  if (Status s = validateEscapeParams(params.resolution, params.max_iter, params.lo, params.hi, params.level); !s)
+    return s.error();
+  for (int d = 0; d < 4; ++d)
+    if (!std::isfinite(params.c[d])) return Error{"--c: every component must be finite", ExitCode::kUsage};
+  EscapeSurfaceParams surface;
+  surface.name = "julia";
+  surface.axis = {params.resolution, params.lo, params.hi};
+  surface.max_iter = params.max_iter;
+  surface.level = resolveLevel(params.max_iter, params.level);
+  surface.frame = params.frame;
+  surface.lazy = params.grid_out.empty();
+  surface.grid_out = params.grid_out;
+  surface.threads = params.threads;
+  surface.max_memory = params.max_memory;
+  surface.progress = params.progress;
+  return generateEscapeSurface(surface, juliaRow(params.c));
+}
+
+}  // namespace dpoint

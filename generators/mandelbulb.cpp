@@ -1,1 +1,284 @@
-// placeholder: issue #3
+#include "generators/mandelbulb.h"
+
+#include <algorithm>
+#include <cassert>
+#include <charconv>
+#include <cmath>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace dpoint {
+namespace {
+
+// Off the polar axis the fast map divides by ρ^8 = (x² + y²)^4, which stays a normal double
+// while x² + y² > 1e-60. Closer to the axis the map's limit is used instead; it differs from the
+// map by |Im (z + iρ)^8| ≤ 8·r^7·ρ < 1e-27 (r ≤ 2: only such points are updated).
+constexpr double kAxisRho2 = 1e-60;
+
+// (re + i·im)^8 by three complex squarings.
+inline void power8(double& re, double& im) {
+  for (int s = 0; s < 3; ++s) {
+    const double r2 = re * re - im * im;
+    im = 2.0 * re * im;
+    re = r2;
+  }
+}
+
+// One step of the fast map; false when r² > 4 (escaped before the update, as the seed tests).
+// (cos 8φ, sin 8φ) = (x + iy)^8 / (x² + y²)^4 and r^8 (cos 8θ, sin 8θ) = (z + iρ)^8: the division
+// does not wait for the square root, which keeps the chain of dependent operations short.
+inline bool fastStep(double& x, double& y, double& z, double cx, double cy, double cz) {
+  const double rho2 = x * x + y * y;
+  if (rho2 + z * z > 4.0) return false;
+  double wr = z, wi = std::sqrt(rho2);  // r (cos θ + i sin θ)
+  double cp = x, sp = y;
+  power8(cp, sp);
+  if (rho2 > kAxisRho2) {
+    const double q = rho2 * rho2;
+    const double inv = 1.0 / (q * q);
+    cp = cp * inv;
+    sp = sp * inv;
+  } else {  // φ = 0 on the axis, as the seed's atan2(0, 0)
+    cp = 1.0;
+    sp = 0.0;
+  }
+  power8(wr, wi);
+  x = wi * cp + cx;
+  y = wi * sp + cy;
+  z = wr + cz;
+  return true;
+}
+
+#if defined(__SSE2__)
+inline void power8(__m128d& re, __m128d& im) {
+  const __m128d two = _mm_set1_pd(2.0);
+  for (int s = 0; s < 3; ++s) {
+    const __m128d r2 = _mm_sub_pd(_mm_mul_pd(re, re), _mm_mul_pd(im, im));
+    im = _mm_mul_pd(_mm_mul_pd(two, re), im);
+    re = r2;
+  }
+}
+
+// fastStep on two points at once (SSE2, part of every x86-64): the same IEEE operations in the
+// same order, so the same bits. Returns a bit per lane with r² > 4; the update is computed for
+// those lanes too and discarded by the caller.
+inline int fastStep2(__m128d& x, __m128d& y, __m128d& z, __m128d cx, __m128d cy, __m128d cz) {
+  const __m128d rho2 = _mm_add_pd(_mm_mul_pd(x, x), _mm_mul_pd(y, y));
+  const int escaped = _mm_movemask_pd(_mm_cmpgt_pd(_mm_add_pd(rho2, _mm_mul_pd(z, z)), _mm_set1_pd(4.0)));
+  __m128d wr = z, wi = _mm_sqrt_pd(rho2);
+  __m128d cp = x, sp = y;
+  power8(cp, sp);
+  const __m128d off_axis = _mm_cmpgt_pd(rho2, _mm_set1_pd(kAxisRho2));
+  const __m128d q = _mm_mul_pd(rho2, rho2);
+  const __m128d inv = _mm_div_pd(_mm_set1_pd(1.0), _mm_mul_pd(q, q));
+  cp = _mm_or_pd(_mm_and_pd(off_axis, _mm_mul_pd(cp, inv)), _mm_andnot_pd(off_axis, _mm_set1_pd(1.0)));
+  sp = _mm_and_pd(off_axis, _mm_mul_pd(sp, inv));
+  power8(wr, wi);
+  x = _mm_add_pd(_mm_mul_pd(wi, cp), cx);
+  y = _mm_add_pd(_mm_mul_pd(wi, sp), cy);
+  z = _mm_add_pd(wr, cz);
+  return escaped;
+}
+
+// Points still inside r ≤ 2 after the first iterations of a row, with their state.
+struct Survivors {
+  std::vector<double> x, y, z;
+  std::vector<size_t> index;
+  size_t size = 0;
+  void reset(size_t n) {
+    if (x.size() < n) {
+      x.resize(n);
+      y.resize(n);
+      z.resize(n);
+      index.resize(n);
+    }
+    size = 0;
+  }
+  void push(double px, double py, double pz, size_t k) {
+    x[size] = px;
+    y[size] = py;
+    z[size] = pz;
+    index[size++] = k;
+  }
+};
+
+// Fast counts of a row, in two phases. Most points of the cube escape within two iterations;
+// phase one runs those two on every point, two per SSE2 register, in a plain loop. Phase two
+// keeps 2·kVectors survivors in flight: one point's iteration is a chain of dependent operations,
+// so independent points fill the pipeline; a lane whose point is done takes the next survivor.
+constexpr int kVectors = 3;
+constexpr int kFirstSteps = 2;
+
+void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32_t* counts) {
+  assert(limit >= 1);
+  thread_local Survivors survivors;
+  survivors.reset(n);
+  const int first_steps = std::min(limit, kFirstSteps);
+  const __m128d cx = _mm_set1_pd(x0), cy = _mm_set1_pd(y0);
+  size_t k = 0;
+  for (; k + 2 <= n; k += 2) {
+    __m128d xv = cx, yv = cy, zv = _mm_loadu_pd(zs + k);
+    const __m128d czv = zv;
+    unsigned alive = 3;
+    for (int step = 0; step < first_steps && alive != 0; ++step) {
+      const unsigned escaped = static_cast<unsigned>(fastStep2(xv, yv, zv, cx, cy, czv)) & alive;
+      if (escaped & 1u) counts[k] = static_cast<uint32_t>(step);
+      if (escaped & 2u) counts[k + 1] = static_cast<uint32_t>(step);
+      alive &= ~escaped;
+    }
+    if (alive == 0) continue;
+    alignas(16) double px[2], py[2], pz[2];
+    _mm_store_pd(px, xv);
+    _mm_store_pd(py, yv);
+    _mm_store_pd(pz, zv);
+    for (unsigned lane = 0; lane < 2; ++lane) {
+      if (((alive >> lane) & 1u) == 0) continue;
+      if (first_steps == limit) counts[k + lane] = static_cast<uint32_t>(limit);
+      else survivors.push(px[lane], py[lane], pz[lane], k + lane);
+    }
+  }
+  for (; k < n; ++k) {
+    double px = x0, py = y0, pz = zs[k];
+    int step = 0;
+    while (step < first_steps && fastStep(px, py, pz, x0, y0, zs[k])) ++step;
+    if (step < first_steps || first_steps == limit) counts[k] = static_cast<uint32_t>(step);
+    else survivors.push(px, py, pz, k);
+  }
+
+  constexpr int kLanes = 2 * kVectors;
+  alignas(16) double x[kLanes], y[kLanes], z[kLanes], cz[kLanes];
+  int iter[kLanes] = {};
+  size_t index[kLanes] = {};
+  unsigned live = 0;  // bit per lane holding a point
+  size_t next = 0;
+  auto start = [&](int lane) {
+    if (next < survivors.size) {
+      x[lane] = survivors.x[next];
+      y[lane] = survivors.y[next];
+      z[lane] = survivors.z[next];
+      index[lane] = survivors.index[next++];
+      cz[lane] = zs[index[lane]];
+      iter[lane] = first_steps;
+      live |= 1u << lane;
+    } else {
+      x[lane] = y[lane] = z[lane] = cz[lane] = 0.0;
+      live &= ~(1u << lane);
+    }
+  };
+  for (int lane = 0; lane < kLanes; ++lane) start(lane);
+  while (live != 0) {
+    __m128d xv[kVectors], yv[kVectors], zv[kVectors];
+    for (int v = 0; v < kVectors; ++v) {
+      xv[v] = _mm_load_pd(x + 2 * v);
+      yv[v] = _mm_load_pd(y + 2 * v);
+      zv[v] = _mm_load_pd(z + 2 * v);
+    }
+    unsigned done = 0;
+    while (done == 0) {
+      unsigned escaped = 0;
+      for (int v = 0; v < kVectors; ++v)
+        escaped |= static_cast<unsigned>(fastStep2(xv[v], yv[v], zv[v], cx, cy, _mm_load_pd(cz + 2 * v))) << (2 * v);
+      for (int lane = 0; lane < kLanes; ++lane) {
+        if (((live >> lane) & 1u) == 0) continue;
+        if (((escaped >> lane) & 1u) != 0 || ++iter[lane] == limit) done |= 1u << lane;
+      }
+    }
+    for (int v = 0; v < kVectors; ++v) {
+      _mm_store_pd(x + 2 * v, xv[v]);
+      _mm_store_pd(y + 2 * v, yv[v]);
+      _mm_store_pd(z + 2 * v, zv[v]);
+    }
+    for (int lane = 0; lane < kLanes; ++lane) {
+      if (((done >> lane) & 1u) == 0) continue;
+      counts[index[lane]] = static_cast<uint32_t>(iter[lane]);  // escaped lanes were not advanced
+      start(lane);
+    }
+  }
+}
+#else
+void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32_t* counts) {
+  for (size_t k = 0; k < n; ++k) counts[k] = static_cast<uint32_t>(mandelbulbEscapeFast(x0, y0, zs[k], limit));
+}
+#endif
+
+}  // namespace
+
+int mandelbulbEscapeSeed(double cx, double cy, double cz, int max_iter, double power) {
+  double x = cx, y = cy, z = cz;
+  const bool eight = power == 8.0;
+  for (int i = 0; i < max_iter; ++i) {
+    const double r = std::sqrt(x * x + y * y + z * z);
+    if (r > 2.0) return i;
+    if (r == 0.0) {  // r^n · anything = 0: the next point is c (the seed divided 0/0 here)
+      x = cx;
+      y = cy;
+      z = cz;
+      continue;
+    }
+    const double theta = std::acos(z / r);
+    const double phi = std::atan2(y, x);
+    double rn;
+    if (eight) {
+      const double r2 = r * r;
+      const double r4 = r2 * r2;
+      rn = r4 * r4;
+    } else {
+      rn = std::pow(r, power);
+    }
+    const double nt = power * theta, np = power * phi;
+    const double sin_t = std::sin(nt);
+    x = rn * sin_t * std::cos(np) + cx;
+    y = rn * sin_t * std::sin(np) + cy;
+    z = rn * std::cos(nt) + cz;
+  }
+  return max_iter;
+}
+
+int mandelbulbEscapeFast(double cx, double cy, double cz, int max_iter) {
+  double x = cx, y = cy, z = cz;
+  for (int i = 0; i < max_iter; ++i)
+    if (!fastStep(x, y, z, cx, cy, cz)) return i;
+  return max_iter;
+}
+
+EscapeRowFunction mandelbulbRow(MandelbulbVariant variant, double power) {
+  if (variant == MandelbulbVariant::kFast)
+    return fastRow;
+  return [power](double x, double y, const double* zs, size_t n, int limit, uint32_t* counts) {
+    for (size_t k = 0; k < n; ++k) counts[k] = static_cast<uint32_t>(mandelbulbEscapeSeed(x, y, zs[k], limit, power));
+  };
+}
+
+namespace {
+std::string powerText(double power) {
+  char buffer[32];
+  const std::to_chars_result r = std::to_chars(buffer, buffer + sizeof buffer, power);
+  return std::string(buffer, r.ptr);
+}
+}  // namespace
+
+Result<PointSet> generateMandelbulb(const MandelbulbParams& params) {
+  if (Status s = validateEscapeParams(params.resolution, params.max_iter, params.lo, params.hi, params.level); !s)
+    return s.error();
+  if (!std::isfinite(params.power) || params.power < 2.0 || params.power > 64.0)
+    return Error{"--power: " + powerText(params.power) + " is outside 2..64", ExitCode::kUsage};
+  if (params.variant == MandelbulbVariant::kFast && params.power != 8.0)
+    return Error{"--variant fast: only --power 8 has a trig-free form; use --variant seed", ExitCode::kUsage};
+  EscapeSurfaceParams surface;
+  surface.name = "mandelbulb";
+  surface.axis = {params.resolution, params.lo, params.hi};
+  surface.max_iter = params.max_iter;
+  surface.level = resolveLevel(params.max_iter, params.level);
+  surface.frame = params.frame;
+  surface.lazy = params.grid_out.empty();
+  surface.grid_out = params.grid_out;
+  surface.threads = params.threads;
+  surface.max_memory = params.max_memory;
+  surface.progress = params.progress;
+  return generateEscapeSurface(surface, mandelbulbRow(params.variant, params.power));
+}
+
+}  // namespace dpoint

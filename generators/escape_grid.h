@@ -1,0 +1,94 @@
+// Escape-time fractals on a grid, meshed at a level of the escape count (DESIGN §8): the part the
+// Mandelbulb and the quaternion Julia share.
+//
+// Grid convention (shared/reference/README.md): axis value v[i] = lo + i·step with
+// step = (hi − lo)/(res − 1) in double and v[res − 1] = hi exactly (numpy.linspace, which the
+// seed used: its grids are reproduced byte for byte); layout [i][j][k], i along x, k fastest.
+//
+// Only what is needed: the surface at level L separates counts ≤ L from counts > L, so a first
+// pass iterates every point only up to cap = ⌊L⌋ + 1 (min(count, cap) > L exactly when
+// count > L), and the full count is finished only at the points above the level that end a
+// crossed grid edge — the only values marching cubes interpolates. Points below the level already
+// hold their exact count (it is < cap). Interior points far from the surface thus cost cap
+// iterations instead of max_iter, and the mesh is the one the full grid gives, bit for bit.
+//
+// Slabs and streaming: the x-planes are cut into slabs of a few planes, meshed in parallel
+// (parallelFor) by marching_cubes.h, two planes in memory per worker; a slab's result is appended
+// in slab order as soon as its predecessors are done, so the whole grid is never held (a
+// resolution-1024 run keeps a few 1024² planes per worker plus the mesh) and the output does not
+// depend on the thread count. --grid-out needs every count, so it turns the lazy pass off and
+// streams the planes to the file in the same order.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+// Coordinates of the output vertices.
+enum class GridFrame {
+  kNative,  // the fractal's own: v = lo + index·step ([-1.5, 1.5]³ by default)
+  kSeed,    // the seed's (skimage with spacing = step): index·step, grid corner at the origin
+};
+
+constexpr int kMaxGridResolution = 65536;
+constexpr int kMaxEscapeIterations = 65535;  // counts fit the uint16 grid file
+
+// Samples of one axis: v[i] = lo + i·step, the last exactly hi (numpy.linspace).
+struct GridAxis {
+  int resolution = 200;
+  double lo = -1.5, hi = 1.5;
+  double step() const { return (hi - lo) / (resolution - 1); }
+  double value(int i) const { return i == resolution - 1 ? hi : lo + i * step(); }
+};
+
+// Escape counts of the points (x, y, zs[0..n)), each iterated at most `limit` times: counts[k] =
+// min(count, limit). Must be a pure function of its arguments (called from several threads).
+using EscapeRowFunction =
+    std::function<void(double x, double y, const double* zs, size_t n, int limit, uint32_t* counts)>;
+
+struct EscapeSurfaceParams {
+  std::string name = "fractal";  // for messages and progress
+  GridAxis axis;
+  int max_iter = 100;
+  double level = 25.0;           // resolved: inside (0, max_iter)
+  GridFrame frame = GridFrame::kNative;
+  bool lazy = true;              // false: every count to max_iter (tests; implied by grid_out)
+  std::string grid_out;          // non-empty: also write the raw count grid there
+  unsigned threads = 0;          // 0: all cores
+  uint64_t max_memory = 0;       // bytes; 0: half of physical memory
+  Progress* progress = nullptr;
+};
+
+// Checks the user-facing parameters; errors name the flag and the limit (kUsage).
+// `level` < 0 means "the default", max_iter/4.
+Status validateEscapeParams(int resolution, int max_iter, double lo, double hi, double level);
+double resolveLevel(int max_iter, double level);
+
+// Bytes the run is expected to hold at its peak: per-worker planes, the streamed grid slabs and a
+// mesh of 0.5·res^2.5 vertices (the Mandelbulb has 13,112 at res 64, 226,382 at res 200 and
+// 16.6 million at res 1024: a fractal surface grows faster than res²).
+uint64_t estimateEscapeSurfaceMemory(const EscapeSurfaceParams& params);
+
+// Welded marching-cubes mesh of {count > level} on the grid (marching_cubes.h), outward normals
+// (counter-clockwise seen from the lower counts). Vertices in the canonical order of
+// marching_cubes.h, independent of the thread count. Writes params.grid_out (whole or not at all)
+// when set. Errors: over the memory limit (kResourceLimit), grid file errors.
+Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const EscapeRowFunction& row);
+
+// The full count grid of x-planes [first_plane, first_plane + planes), layout [i][j][k]; for tests
+// and measurements (holds planes·res² counts).
+Result<std::vector<uint32_t>> computeEscapeGrid(const GridAxis& axis, int max_iter, const EscapeRowFunction& row,
+                                                unsigned threads, int first_plane, int planes);
+
+// The grid file format: uint8 per count when max_iter ≤ 255, else little-endian uint16.
+int escapeGridBytesPerCount(int max_iter);
+Status writeEscapeGrid(const std::string& path, const std::vector<uint32_t>& counts, int max_iter);
+
+}  // namespace dpoint

@@ -1,0 +1,45 @@
+// The seed study's "quaternion Julia" set: the quaternion map q → q² + c on the slice where the
+// fourth component of the start point is 0, c = (−0.7, 0.27015, 0.27015, 0), sampled on a grid and
+// meshed by marching cubes at max_iter/4 (escape_grid.h).
+//
+// Escape function, matching shared/reference/julia_r64_i200_escape.u8 byte for byte: start at
+// q = (x, y, z, 0); per iteration i, if |q| > 2 return i, else q ← (x² − y² − z² − w², 2xy, 2xz,
+// 2xw) + c (the square of a quaternion); max_iter if it never escapes. The sums are grouped as
+// x² − (y² + z² + w²) and x² + (y² + z² + w²), which are symmetric in y and z, so with cy = cz the
+// grid is exactly mirror symmetric (grid[i][j][k] = grid[i][k][j]); grouping left to right gives
+// the same reference grid but no such guarantee.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <glm/vec4.hpp>
+
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+#include "generators/escape_grid.h"
+
+namespace dpoint {
+
+struct JuliaParams {
+  int resolution = 200;          // grid points per axis, 2..65536
+  int max_iter = 200;            // 1..65535
+  glm::dvec4 c = glm::dvec4(-0.7, 0.27015, 0.27015, 0.0);
+  double lo = -1.5, hi = 1.5;    // --bounds
+  double level = -1.0;           // -1: max_iter / 4; else inside (0, max_iter)
+  GridFrame frame = GridFrame::kNative;
+  std::string grid_out;          // also write the count grid there (escape_grid.h format)
+  unsigned threads = 0;          // 0: all cores
+  uint64_t max_memory = 0;       // bytes; 0: half of physical memory
+  Progress* progress = nullptr;
+};
+
+// Welded surface mesh (no colours). Errors: bad parameters name the flag and the limit (kUsage);
+// over the memory limit (kResourceLimit).
+Result<PointSet> generateJulia(const JuliaParams& params);
+
+int juliaEscape(double x, double y, double z, const glm::dvec4& c, int max_iter);
+EscapeRowFunction juliaRow(const glm::dvec4& c);
+
+}  // namespace dpoint
