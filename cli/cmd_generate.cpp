@@ -186,10 +186,13 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
 // ---- menger ----
 struct MengerOptions {
   MengerParams params;
+  std::string method = "exact";
   OutputOptions out;
 };
 Result<MengerParams> mengerParams(const MengerOptions& o, Progress* progress) {
-  return withCommon(o.params, o.out, progress);
+  MengerParams p = o.params;
+  p.method = o.method == "voxel" ? MengerMethod::kVoxel : MengerMethod::kExact;
+  return withCommon(p, o.out, progress);
 }
 
 // ---- sierpinski ----
@@ -259,6 +262,11 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   CLI::App* menger = generate->add_subcommand("menger", "Menger sponge: exposed faces of its 20^n cubes");
   menger->add_option("--level", me->params.level, "Subdivision level (0..8)")->default_val(4);
   menger->add_option("--size", me->params.size, "Edge length of the sponge")->default_val(1.0);
+  menger->add_option("--method", me->method, "exact: the exposed faces of the lattice cubes; voxel: sampled grid + "
+                                             "marching cubes, as the seed did")
+      ->check(CLI::IsMember({"exact", "voxel"}))
+      ->default_val("exact");
+  menger->add_option("--resolution", me->params.resolution, "Voxel method: samples per axis (2..4096)")->default_val(200);
   addOutputOptions(*menger, me->out, "noise");
   registerKind(*generate, run, me, menger, true, &generateMenger, &mengerParams);
 

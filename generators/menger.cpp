@@ -142,7 +142,16 @@ uint64_t mengerVertexCount(int level) {
   return (224 * power(20, level) + 456 * power(8, level) + 384) / 133;
 }
 
+bool mengerCellInSponge(uint64_t x, uint64_t y, uint64_t z) {
+  for (; x != 0 || y != 0 || z != 0; x /= 3, y /= 3, z /= 3) {
+    const int ones = (x % 3 == 1) + (y % 3 == 1) + (z % 3 == 1);
+    if (ones >= 2) return false;
+  }
+  return true;
+}
+
 Result<PointSet> generateMenger(const MengerParams& params) {
+  if (params.method == MengerMethod::kVoxel) return generateMengerVoxel(params);
   const int n = params.level;
   if (n < 0 || n > kMengerMaxLevel)
     return Error{"--level " + std::to_string(n) + " is out of range for menger (0.." +

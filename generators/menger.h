@@ -20,9 +20,16 @@ namespace dpoint {
 
 constexpr int kMengerMaxLevel = 8;
 
+enum class MengerMethod {
+  kExact,  // the exposed faces of the lattice cubes (this file)
+  kVoxel,  // sampled on a grid and meshed by marching cubes, as the seed did (menger_voxel.cpp)
+};
+
 struct MengerParams {
   int level = 4;                 // 0..kMengerMaxLevel
   double size = 1.0;             // edge length; the sponge spans [0, size]³
+  MengerMethod method = MengerMethod::kExact;
+  int resolution = 200;          // voxel method: samples per axis across the sponge
   unsigned threads = 0;          // 0: all cores
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
@@ -38,6 +45,15 @@ struct MengerParams {
 // Errors: level outside 0..kMengerMaxLevel or size not finite and positive (kUsage); over the
 // memory limit (kResourceLimit, checked before anything large is allocated).
 Result<PointSet> generateMenger(const MengerParams& params);
+
+// The voxel method: the sponge's occupancy sampled at the centres of resolution³ voxels over
+// [0, size]³ (1 inside, 0 outside, with a border of empty samples so the surface closes), meshed
+// by marching cubes at level 0.5. Approximates the surface within one voxel; kept to reproduce
+// the seed's datasets. Errors: level or resolution (2..4096) out of range (kUsage), memory.
+Result<PointSet> generateMengerVoxel(const MengerParams& params);
+
+// True when lattice cell (x, y, z) of level n (coordinates in [0, 3^n)) belongs to the sponge.
+bool mengerCellInSponge(uint64_t x, uint64_t y, uint64_t z);
 
 // 2·20^n + 4·8^n: the number of exposed unit faces of the level-n sponge.
 uint64_t mengerFaceCount(int level);

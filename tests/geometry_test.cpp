@@ -451,3 +451,52 @@ TEST(Geometry, generatorsIdenticalForAnyThreadCount) {
 
 }  // namespace
 }  // namespace dpoint
+
+namespace dpoint {
+namespace {
+
+double enclosedVolume(const PointSet& mesh) {
+  double volume = 0.0;
+  for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+    const glm::dvec3& a = mesh.positions[mesh.triangles[t]];
+    const glm::dvec3& b = mesh.positions[mesh.triangles[t + 1]];
+    const glm::dvec3& c = mesh.positions[mesh.triangles[t + 2]];
+    volume += glm::dot(a, glm::cross(b, c)) / 6.0;
+  }
+  return volume;
+}
+
+TEST(Menger, voxelMethodEnclosesAboutTheSpongeVolume) {
+  MengerParams params;
+  params.level = 2;
+  params.method = MengerMethod::kVoxel;
+  params.resolution = 81;  // 9 samples per lattice cell
+  Result<PointSet> mesh = generateMenger(params);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+  for (const glm::dvec3& p : mesh->positions) {
+    ASSERT_GE(std::min({p.x, p.y, p.z}), 0.0);
+    ASSERT_LE(std::max({p.x, p.y, p.z}), 1.0);
+  }
+  // Marching cubes cuts the voxel corners, so the volume is a little below (20/27)^2 = 0.5487;
+  // the sign says the triangles face outward.
+  const double volume = enclosedVolume(*mesh);
+  EXPECT_GT(volume, 0.5487 * 0.95);
+  EXPECT_LT(volume, 0.5487 * 1.001);
+  params.threads = 1;
+  Result<PointSet> one = generateMenger(params);
+  ASSERT_TRUE(one.ok());
+  EXPECT_TRUE(one->positions == mesh->positions && one->triangles == mesh->triangles);
+}
+
+TEST(Menger, voxelMethodRejectsResolutionOutOfRange) {
+  MengerParams params;
+  params.method = MengerMethod::kVoxel;
+  params.resolution = 1;
+  Result<PointSet> r = generateMenger(params);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, ExitCode::kUsage);
+  EXPECT_NE(r.error().message.find("--resolution"), std::string::npos) << r.error().message;
+}
+
+}  // namespace
+}  // namespace dpoint
