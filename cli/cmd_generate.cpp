@@ -236,7 +236,16 @@ void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double&
 
 void addGenerateCommand(CLI::App& app, RunCommand& run) {
   CLI::App* generate = app.add_subcommand("generate", "Generate a dataset of the study");
-  generate->require_subcommand(1);
+  // Optional for CLI11, so that an unknown kind is reported by name ("not expected: spiral")
+  // rather than as "a subcommand is required"; no kind at all gets the list here.
+  generate->require_subcommand(0, 1);
+  generate->callback([generate, &run] {
+    if (!generate->get_subcommands().empty()) return;
+    run = [] {
+      return reportError(Error{"generate: name a kind: mandelbulb, julia, menger, sierpinski, random2d, mandelbrot2d",
+                               ExitCode::kUsage});
+    };
+  });
 
   auto mb = std::make_shared<MandelbulbOptions>();
   CLI::App* mandelbulb = generate->add_subcommand("mandelbulb", "Power-8 Mandelbulb surface (marching cubes on escape counts)");
