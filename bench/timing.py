@@ -3,21 +3,26 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 
 def timed(argv, before=None):
-    """Wall seconds, peak RSS (bytes) and stdout of one run. `before` runs first, untimed."""
+    """Wall seconds, peak RSS (bytes) and stdout of one run. `before` runs first, untimed.
+
+    Peak RSS comes from /usr/bin/time, not from wait4 here: Linux carries the high-water RSS of
+    the memory image a process had before exec into its ru_maxrss, and a child forked from this
+    Python process would report Python's own size."""
     if before:
         before()
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    stdout, stderr = proc.stdout.read(), proc.stderr.read()
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit(f"{' '.join(argv)} failed: {stderr.decode()}")
-    return wall, usage.ru_maxrss * 1024, stdout.decode()
+    with tempfile.NamedTemporaryFile(mode="r") as rss_file:
+        t0 = time.perf_counter()
+        proc = subprocess.run(["/usr/bin/time", "-f", "%M", "-o", rss_file.name, *argv], capture_output=True)
+        wall = time.perf_counter() - t0
+        if proc.returncode != 0:
+            sys.exit(f"{' '.join(argv)} failed: {proc.stderr.decode()}")
+        peak_kib = int(rss_file.read().split()[-1])
+    return wall, peak_kib * 1024, proc.stdout.decode()
 
 
 def median_of(argv, runs, before=None):

@@ -65,6 +65,14 @@ Result<std::vector<double>> parseNumbers(const std::string& flag, const std::str
                ExitCode::kUsage};
 }
 
+Status parseBounds(const std::string& text, double& lo, double& hi) {
+  Result<std::vector<double>> bounds = parseNumbers("--bounds", text, 2);
+  if (!bounds) return bounds.error();
+  lo = (*bounds)[0];
+  hi = (*bounds)[1];
+  return okStatus();
+}
+
 Result<uint64_t> memoryLimit(const OutputOptions& o) {
   if (o.max_memory.empty()) return uint64_t{0};
   return parseMemorySize("--max-memory", o.max_memory);
@@ -108,7 +116,7 @@ bool outputTypeOk(const OutputOptions& o, int& code) {
 }
 
 template <typename Params, typename Options>
-void registerKind(CLI::App& parent, RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* cmd,
+void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* cmd,
                   bool auto_noise, Result<PointSet> (*generate)(const Params&),
                   Result<Params> (*makeParams)(const Options&, Progress*)) {
   cmd->callback([o, &run, auto_noise, generate, makeParams, name = cmd->get_name()] {
@@ -121,7 +129,6 @@ void registerKind(CLI::App& parent, RunCommand& run, const std::shared_ptr<Optio
       return finish(generate(*params), o->out, auto_noise, progress);
     };
   });
-  (void)parent;
 }
 
 // Fills the shared fields of a generator's Params.
@@ -135,12 +142,14 @@ Result<Params> withCommon(Params p, const OutputOptions& out, Progress* progress
   return p;
 }
 
-// ---- random2d ----
-struct Random2dOptions {
-  Random2dParams params;
+// Kinds whose options are their Params plus the output options.
+template <typename Params>
+struct PlainOptions {
+  Params params;
   OutputOptions out;
 };
-Result<Random2dParams> random2dParams(const Random2dOptions& o, Progress* progress) {
+template <typename Params>
+Result<Params> plainParams(const PlainOptions<Params>& o, Progress* progress) {
   return withCommon(o.params, o.out, progress);
 }
 
@@ -153,10 +162,7 @@ struct MandelbulbOptions {
 };
 Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* progress) {
   MandelbulbParams p = o.params;
-  Result<std::vector<double>> bounds = parseNumbers("--bounds", o.bounds, 2);
-  if (!bounds) return bounds.error();
-  p.lo = (*bounds)[0];
-  p.hi = (*bounds)[1];
+  if (Status s = parseBounds(o.bounds, p.lo, p.hi); !s) return s.error();
   p.variant = o.variant == "fast" ? MandelbulbVariant::kFast : MandelbulbVariant::kSeed;
   p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
   return withCommon(p, o.out, progress);
@@ -175,10 +181,7 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
   Result<std::vector<double>> c = parseNumbers("--c", o.c, 4);
   if (!c) return c.error();
   p.c = glm::dvec4((*c)[0], (*c)[1], (*c)[2], (*c)[3]);
-  Result<std::vector<double>> bounds = parseNumbers("--bounds", o.bounds, 2);
-  if (!bounds) return bounds.error();
-  p.lo = (*bounds)[0];
-  p.hi = (*bounds)[1];
+  if (Status s = parseBounds(o.bounds, p.lo, p.hi); !s) return s.error();
   p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
   return withCommon(p, o.out, progress);
 }
@@ -193,15 +196,6 @@ Result<MengerParams> mengerParams(const MengerOptions& o, Progress* progress) {
   MengerParams p = o.params;
   p.method = o.method == "voxel" ? MengerMethod::kVoxel : MengerMethod::kExact;
   return withCommon(p, o.out, progress);
-}
-
-// ---- sierpinski ----
-struct SierpinskiOptions {
-  SierpinskiParams params;
-  OutputOptions out;
-};
-Result<SierpinskiParams> sierpinskiParams(const SierpinskiOptions& o, Progress* progress) {
-  return withCommon(o.params, o.out, progress);
 }
 
 // ---- mandelbrot2d ----
@@ -257,7 +251,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::IsMember({"seed", "fast"}))
       ->default_val("seed");
   addOutputOptions(*mandelbulb, mb->out, "noise");
-  registerKind(*generate, run, mb, mandelbulb, true, &generateMandelbulb, &mandelbulbParams);
+  registerKind(run, mb, mandelbulb, true, &generateMandelbulb, &mandelbulbParams);
 
   auto ju = std::make_shared<JuliaOptions>();
   CLI::App* julia = generate->add_subcommand("julia", "Quaternion Julia set surface (the seed's iteration, k = 0 slice)");
@@ -265,7 +259,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
                        ju->params.grid_out, 200);
   julia->add_option("--c", ju->c, "Julia constant as 4 numbers")->default_val("-0.7,0.27015,0.27015,0");
   addOutputOptions(*julia, ju->out, "noise");
-  registerKind(*generate, run, ju, julia, true, &generateJulia, &juliaParams);
+  registerKind(run, ju, julia, true, &generateJulia, &juliaParams);
 
   auto me = std::make_shared<MengerOptions>();
   CLI::App* menger = generate->add_subcommand("menger", "Menger sponge: exposed faces of its 20^n cubes");
@@ -277,16 +271,16 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
       ->default_val("exact");
   menger->add_option("--resolution", me->params.resolution, "Voxel method: samples per axis (2..4096)")->default_val(200);
   addOutputOptions(*menger, me->out, "noise");
-  registerKind(*generate, run, me, menger, true, &generateMenger, &mengerParams);
+  registerKind(run, me, menger, true, &generateMenger, &mengerParams);
 
-  auto si = std::make_shared<SierpinskiOptions>();
+  auto si = std::make_shared<PlainOptions<SierpinskiParams>>();
   CLI::App* sierpinski = generate->add_subcommand("sierpinski", "Sierpinski tetrahedron: 4^n tetrahedra from the seed's corners");
   sierpinski->add_option("--level", si->params.level, "Subdivision level (0..12)")->default_val(9);
   sierpinski->add_flag("--unwelded", si->params.unwelded, "The seed's 4^(n+1) rows instead of the 2*4^n+2 distinct vertices");
   addOutputOptions(*sierpinski, si->out, "noise");
-  registerKind(*generate, run, si, sierpinski, true, &generateSierpinski, &sierpinskiParams);
+  registerKind(run, si, sierpinski, true, &generateSierpinski, &plainParams<SierpinskiParams>);
 
-  auto r = std::make_shared<Random2dOptions>();
+  auto r = std::make_shared<PlainOptions<Random2dParams>>();
   CLI::App* random2d = generate->add_subcommand(
       "random2d", "N points uniform in [-1,1)^2 (z = 0); identical on every machine and thread count");
   random2d->add_option("--count,-n", r->params.count, "Number of points")
@@ -294,7 +288,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40));
   random2d->add_option("--seed", r->params.seed, "Seed of the generator")->default_val(1);
   addOutputOptions(*random2d, r->out, "none");
-  registerKind(*generate, run, r, random2d, false, &generateRandom2d, &random2dParams);
+  registerKind(run, r, random2d, false, &generateRandom2d, &plainParams<Random2dParams>);
 
   auto m2 = std::make_shared<Mandelbrot2dOptions>();
   CLI::App* mandelbrot2d = generate->add_subcommand(
@@ -304,7 +298,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   mandelbrot2d->add_option("--resolution", m2->params.resolution, "Points per side (2..65536)")->default_val(1024);
   mandelbrot2d->add_option("--max-iter", m2->params.max_iter, "Iterations before a point counts as inside")->default_val(2000);
   addOutputOptions(*mandelbrot2d, m2->out, "escape count");
-  registerKind(*generate, run, m2, mandelbrot2d, false, &generateMandelbrot2d, &mandelbrot2dParams);
+  registerKind(run, m2, mandelbrot2d, false, &generateMandelbrot2d, &mandelbrot2dParams);
 }
 
 }  // namespace dpoint

@@ -66,10 +66,31 @@ struct EscapeSurfaceParams {
   Progress* progress = nullptr;
 };
 
+// The surface parameters of a fractal whose Params have the shared grid fields (resolution,
+// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress).
+template <typename FractalParams>
+EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& params);
+
 // Checks the user-facing parameters; errors name the flag and the limit (kUsage).
 // `level` < 0 means "the default", max_iter/4.
 Status validateEscapeParams(int resolution, int max_iter, double lo, double hi, double level);
 double resolveLevel(int max_iter, double level);
+
+template <typename FractalParams>
+EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& params) {
+  EscapeSurfaceParams surface;
+  surface.name = std::move(name);
+  surface.axis = {params.resolution, params.lo, params.hi};
+  surface.max_iter = params.max_iter;
+  surface.level = resolveLevel(params.max_iter, params.level);
+  surface.frame = params.frame;
+  surface.lazy = params.grid_out.empty();
+  surface.grid_out = params.grid_out;
+  surface.threads = params.threads;
+  surface.max_memory = params.max_memory;
+  surface.progress = params.progress;
+  return surface;
+}
 
 // Bytes the run is expected to hold at its peak: per-worker planes, the streamed grid slabs and a
 // mesh of 0.5·res^2.5 vertices (the Mandelbulb has 13,112 at res 64, 226,382 at res 200 and

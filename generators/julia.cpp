@@ -31,18 +31,7 @@ Result<PointSet> generateJulia(const JuliaParams& params) {
     return s.error();
   for (int d = 0; d < 4; ++d)
     if (!std::isfinite(params.c[d])) return Error{"--c: every component must be finite", ExitCode::kUsage};
-  EscapeSurfaceParams surface;
-  surface.name = "julia";
-  surface.axis = {params.resolution, params.lo, params.hi};
-  surface.max_iter = params.max_iter;
-  surface.level = resolveLevel(params.max_iter, params.level);
-  surface.frame = params.frame;
-  surface.lazy = params.grid_out.empty();
-  surface.grid_out = params.grid_out;
-  surface.threads = params.threads;
-  surface.max_memory = params.max_memory;
-  surface.progress = params.progress;
-  return generateEscapeSurface(surface, juliaRow(params.c));
+  return generateEscapeSurface(escapeSurfaceParams("julia", params), juliaRow(params.c));
 }
 
 }  // namespace dpoint

@@ -267,18 +267,7 @@ Result<PointSet> generateMandelbulb(const MandelbulbParams& params) {
     return Error{"--power: " + powerText(params.power) + " is outside 2..64", ExitCode::kUsage};
   if (params.variant == MandelbulbVariant::kFast && params.power != 8.0)
     return Error{"--variant fast: only --power 8 has a trig-free form; use --variant seed", ExitCode::kUsage};
-  EscapeSurfaceParams surface;
-  surface.name = "mandelbulb";
-  surface.axis = {params.resolution, params.lo, params.hi};
-  surface.max_iter = params.max_iter;
-  surface.level = resolveLevel(params.max_iter, params.level);
-  surface.frame = params.frame;
-  surface.lazy = params.grid_out.empty();
-  surface.grid_out = params.grid_out;
-  surface.threads = params.threads;
-  surface.max_memory = params.max_memory;
-  surface.progress = params.progress;
-  return generateEscapeSurface(surface, mandelbulbRow(params.variant, params.power));
+  return generateEscapeSurface(escapeSurfaceParams("mandelbulb", params), mandelbulbRow(params.variant, params.power));
 }
 
 }  // namespace dpoint

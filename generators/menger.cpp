@@ -151,7 +151,6 @@ bool mengerCellInSponge(uint64_t x, uint64_t y, uint64_t z) {
 }
 
 Result<PointSet> generateMenger(const MengerParams& params) {
-  if (params.method == MengerMethod::kVoxel) return generateMengerVoxel(params);
   const int n = params.level;
   if (n < 0 || n > kMengerMaxLevel)
     return Error{"--level " + std::to_string(n) + " is out of range for menger (0.." +
@@ -159,6 +158,7 @@ Result<PointSet> generateMenger(const MengerParams& params) {
                  ExitCode::kUsage};
   if (!(params.size > 0.0) || !std::isfinite(params.size))
     return Error{"--size " + std::to_string(params.size) + " must be a finite number above 0", ExitCode::kUsage};
+  if (params.method == MengerMethod::kVoxel) return generateMengerVoxel(params);
 
   const uint64_t faces = mengerFaceCount(n);
   const uint64_t vertices = mengerVertexCount(n);

@@ -49,7 +49,8 @@ Result<PointSet> generateMenger(const MengerParams& params);
 // The voxel method: the sponge's occupancy sampled at the centres of resolution³ voxels over
 // [0, size]³ (1 inside, 0 outside, with a border of empty samples so the surface closes), meshed
 // by marching cubes at level 0.5. Approximates the surface within one voxel; kept to reproduce
-// the seed's datasets. Errors: level or resolution (2..4096) out of range (kUsage), memory.
+// the seed's datasets. Called by generateMenger after its checks of level and size; errors:
+// resolution out of 2..4096 (kUsage), memory.
 Result<PointSet> generateMengerVoxel(const MengerParams& params);
 
 // True when lattice cell (x, y, z) of level n (coordinates in [0, 3^n)) belongs to the sponge.

@@ -15,13 +15,7 @@
 namespace dpoint {
 
 Result<PointSet> generateMengerVoxel(const MengerParams& params) {
-  const int n = params.level;
-  if (n < 0 || n > kMengerMaxLevel)
-    return Error{"--level " + std::to_string(n) + " is out of range for menger (0.." +
-                     std::to_string(kMengerMaxLevel) + ")",
-                 ExitCode::kUsage};
-  if (!(params.size > 0.0) || !std::isfinite(params.size))
-    return Error{"--size " + std::to_string(params.size) + " must be a finite number above 0", ExitCode::kUsage};
+  const int n = params.level;  // level and size were checked by generateMenger
   constexpr int kMaxResolution = 4096;
   if (params.resolution < 2 || params.resolution > kMaxResolution)
     return Error{"--resolution " + std::to_string(params.resolution) + " is out of range for the voxel method (2.." +
