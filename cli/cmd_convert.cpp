@@ -1,8 +1,10 @@
-// dpoint convert IN -o OUT: CSV, PLY and GLB in any direction (glTF input is read as a first
-// version; full glTF coverage is issue #4).
+// dpoint convert IN -o OUT: CSV, PLY and GLB in any direction, and glTF/GLB input with scene
+// selection (converters/gltf_read.h says what a glTF file turns into).
 #include <memory>
 
 #include "cli/commands.h"
+#include "converters/gltf_read.h"
+#include "converters/point_filters.h"
 #include "converters/point_io.h"
 
 namespace dpoint {
@@ -15,14 +17,42 @@ struct ConvertOptions {
   std::string ply_colors = "uchar";
   bool allow_nonfinite = false;
   bool no_colors = false;
+  int scene = -1;
+  bool all_scenes = false;
+  bool unique = false;
+  std::string color_format = "linear";
+  uint64_t max_points = 0;
   CommonOptions common;
 };
 
+Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
+  Result<FileFormat> format = formatOf(o.input);
+  if (!format) return format.error();
+  if (*format == FileFormat::kGlb || *format == FileFormat::kGltf) {
+    GltfReadOptions g;
+    g.scene = o.scene;
+    g.all_scenes = o.all_scenes;
+    g.allow_nonfinite = o.allow_nonfinite;
+    g.max_points = o.max_points;
+    return readGltf(o.input, g);
+  }
+  if (o.scene >= 0 || o.all_scenes)
+    return Error{o.input + ": --scene and --all-scenes apply to .glb/.gltf input only", ExitCode::kUsage};
+  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  if (points && o.max_points != 0 && points->size() > o.max_points)
+    return Error{o.input + ": " + std::to_string(points->size()) + " points exceed --max-points " +
+                     std::to_string(o.max_points),
+                 ExitCode::kResourceLimit};
+  return points;
+}
+
 int runConvert(const ConvertOptions& o) {
   Progress progress(progressSink(o.common.quiet), "convert");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  Result<PointSet> points = readInput(o, progress);
   if (!points) return reportError(points.error());
   if (o.no_colors) points->colors.clear();
+  if (o.unique) dropDuplicatePositions(*points);
+  if (o.color_format == "srgb8") encodeColorsSrgb8(*points);
   WriteOptions w;
   w.threads = o.common.threads;
   w.decimals = o.decimals;
@@ -49,6 +79,21 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->default_val("uchar");
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");
+  auto* scene = cmd->add_option("--scene", o->scene,
+                                "glTF: walk scene N instead of the default scene (else scene 0)")
+                    ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--all-scenes", o->all_scenes, "glTF: walk every scene, one after the other")->excludes(scene);
+  cmd->add_flag("--unique", o->unique,
+                "Drop points whose x,y,z exactly equal an earlier point's (first kept; triangles renumbered, "
+                "collapsed ones dropped)");
+  cmd->add_option("--color-format", o->color_format,
+                  "linear: colours as read (linear 0..1; glTF primitives without COLOR_0 take their material's "
+                  "baseColorFactor); srgb8: each channel sRGB-encoded and rounded to 8 bits, written as k/255")
+      ->check(CLI::IsMember({"linear", "srgb8"}))
+      ->default_val("linear");
+  cmd->add_option("--max-points", o->max_points,
+                  "Refuse (exit 4) input of more than N points, before --unique; glTF is refused before allocating")
+      ->check(CLI::PositiveNumber);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runConvert(*o); }; });
 }

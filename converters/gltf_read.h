@@ -1,16 +1,48 @@
-// glTF/GLB input (tinygltf parses; decoding and every bounds check are ours).
-// World-space positions in double: node matrices / TRS composed in double over the default scene.
-// This first version reads float POSITION, float/unorm COLOR_0 and u8/u16/u32 indices;
-// the full accessor coverage, hostile-input hardening and compressed data are issue #4.
+// glTF 2.0 / GLB input (DESIGN §9). tinygltf parses; pre-checks, accessor decoding, transforms
+// and every bounds check are ours (gltf_load.h, gltf_accessor.h).
+//
+// What a file turns into:
+// - World-space positions in double: the default scene (else scene 0; with no scenes, every node
+//   that has no parent), node `matrix` or T·R·S composed in double, quaternions normalised.
+//   A mesh used by several nodes is emitted once per node. Skins are ignored (bind pose: the
+//   node transform applies); morph targets are ignored.
+// - Per primitive, the vertices it references: all of POSITION when not indexed, else each
+//   vertex some index names, once, in vertex order. Triangle modes keep their triangles
+//   (TRIANGLE_STRIP and TRIANGLE_FAN become triangle lists); points and lines are points.
+// - Colours (linear 0..1) when any primitive has COLOR_0 (float, unorm8 or unorm16, VEC3/VEC4,
+//   alpha dropped); primitives without COLOR_0 then take their material's baseColorFactor rgb
+//   (white without a material).
+// - Required extensions: KHR_mesh_quantization is decoded; shading-only ones are accepted;
+//   any other (KHR_draco_mesh_compression, EXT_meshopt_compression, EXT_mesh_gpu_instancing, …)
+//   is refused by name.
+// Errors are one line: "PATH: /json/pointer: what" (ExitCode::kBadInput), or kResourceLimit for
+// the size and point limits.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/point_set.h"
 #include "core/result.h"
 
 namespace dpoint {
 
-Result<PointSet> readGltf(const std::string& path);
+// GLB stores lengths in 32 bits; 2 GiB keeps every size in tinygltf's int-typed fields.
+constexpr uint64_t kGltfDefaultMaxFileBytes = uint64_t(1) << 31;
+
+struct GltfReadOptions {
+  int scene = -1;            // -1: the default scene (else scene 0)
+  bool all_scenes = false;   // every scene in order; a node in several scenes is emitted per scene
+  bool allow_nonfinite = false;
+  uint64_t max_points = 0;   // 0: no limit; else more points is kResourceLimit, checked before allocating
+  uint64_t max_file_bytes = kGltfDefaultMaxFileBytes;  // the file and each external buffer
+};
+
+Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});
+
+// Every component of accessor `index` decoded as the spec defines it (normalisation and sparse
+// substitution applied), element after element. For tests and tools that check the decoder.
+Result<std::vector<double>> readGltfAccessor(const std::string& path, int index);
 
 }  // namespace dpoint

@@ -28,8 +28,11 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress});
     case FileFormat::kGlb:
-    case FileFormat::kGltf:
-      return readGltf(path);
+    case FileFormat::kGltf: {
+      GltfReadOptions gltf;
+      gltf.allow_nonfinite = options.allow_nonfinite;
+      return readGltf(path, gltf);
+    }
   }
   return Error{path + ": unreachable format"};
 }

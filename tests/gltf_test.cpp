@@ -12,6 +12,7 @@
 
 #include "converters/gltf_read.h"
 #include "converters/gltf_write.h"
+#include "converters/point_filters.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -310,50 +311,63 @@ void expectReadError(const std::string& json, const std::vector<std::string>& pa
 TEST(Gltf, gltfRejectsNodeCycle) {
   expectReadError(replaced(fixtureGltf(), R"("scale": [1,1,3], "mesh": 0})",
                            R"("scale": [1,1,3], "mesh": 0, "children": [0]})"),
-                  {"node 0", "cycle"});
+                  {"/nodes/0", "cycle"});
 }
 
 TEST(Gltf, gltfRejectsNodeWithTwoParents) {
   expectReadError(replaced(fixtureGltf(), R"("children": [1])", R"("children": [1, 1])"),
-                  {"node 1", "more than one parent"});
+                  {"/nodes/1", "two parents"});
 }
 
 TEST(Gltf, gltfRejectsAccessorPastBuffer) {
   // Four positions in a 36-byte view that holds three.
   expectReadError(replaced(fixtureGltf(), R"("componentType": 5126, "count": 3)",
                            R"("componentType": 5126, "count": 4)"),
-                  {"accessor 0", "past the end of bufferView 0"});
+                  {"/accessors/0: byteOffset + stride*(count-1) + 12 = 48 exceeds bufferView 0 length 36"});
   // A stride that walks out of the view.
   expectReadError(replaced(fixtureGltf(), R"("byteOffset": 0, "byteLength": 36})",
                            R"("byteOffset": 0, "byteLength": 36, "byteStride": 16})"),
-                  {"accessor 0", "past the end"});
+                  {"/accessors/0", "exceeds bufferView 0 length 36"});
 }
 
 TEST(Gltf, gltfRejectsBufferViewPastBuffer) {
   expectReadError(replaced(fixtureGltf(), R"("byteOffset": 48, "byteLength": 6)",
                            R"("byteOffset": 48, "byteLength": 60)"),
-                  {"accessor 2", "bufferView 2", "past the end of buffer 0"});
+                  {"/accessors/2", "bufferView 2", "exceeds buffer 0 length 56"});
 }
 
 TEST(Gltf, gltfRejectsIndexOutOfRange) {
   // The colour bytes read as u8 indices: 255 is no vertex.
   expectReadError(replaced(fixtureGltf(), R"({"bufferView": 2, "componentType": 5123,)",
                            R"({"bufferView": 1, "componentType": 5121,)"),
-                  {"accessor 2", "element 0 is 255, out of range for 3 vertices"});
+                  {"/accessors/2", "element 0 is 255, out of range for 3 vertices"});
 }
 
-TEST(Gltf, gltfRejectsUnsupportedPositionType) {
+TEST(Gltf, gltfRejectsUnsignedIntPosition) {
   expectReadError(replaced(fixtureGltf(), R"("componentType": 5126, "count": 3)",
-                           R"("componentType": 5121, "count": 3)"),
-                  {"accessor 0: POSITION componentType 5121 not supported yet"});
+                           R"("componentType": 5125, "count": 3)"),
+                  {"/accessors/0: POSITION must be VEC3"});
 }
 
-TEST(Gltf, gltfRejectsSparseAccessor) {
+TEST(Gltf, gltfSparseAccessorReplacesElements) {
+  // Sparse index 1 (the second u16 of view 2) takes the first position (1,2,3) as its value.
+  TempDir dir;
+  Result<PointSet> set = readText(
+      dir, replaced(fixtureGltf(), R"("min": [-1, 0, 0], "max": [1, 2, 3]})",
+                    R"("min": [-1, 0, 0], "max": [1, 2, 3], "sparse": {"count": 1,
+                  "indices": {"bufferView": 2, "byteOffset": 2, "componentType": 5123},
+                  "values": {"bufferView": 0}}})"));
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_EQ(set->positions[1], glm::dvec3(6378002, 4, 6));  // node 0: 2·(1,2,3) + (6378000,0,0)
+}
+
+TEST(Gltf, gltfRejectsSparseIndicesNotIncreasing) {
+  // View 2's bytes read as u8 indices: 0, 0, 1; the second does not increase.
   expectReadError(replaced(fixtureGltf(), R"("min": [-1, 0, 0], "max": [1, 2, 3]})",
-                           R"("min": [-1, 0, 0], "max": [1, 2, 3], "sparse": {"count": 1,
-                  "indices": {"bufferView": 2, "componentType": 5123},
+                           R"("min": [-1, 0, 0], "max": [1, 2, 3], "sparse": {"count": 3,
+                  "indices": {"bufferView": 2, "byteOffset": 0, "componentType": 5121},
                   "values": {"bufferView": 0}}})"),
-                  {"accessor 0", "sparse", "not supported yet"});
+                  {"/accessors/0/sparse/indices: element 1"});
 }
 
 TEST(Gltf, gltfRefusesBufferOutsideFolder) {
@@ -396,6 +410,210 @@ TEST(Gltf, glbTruncatedFileIsAnError) {
   ASSERT_FALSE(set);
   EXPECT_EQ(set.error().message.rfind(dir.file("cut.glb") + ": ", 0), 0u) << set.error().message;
   EXPECT_EQ(set.error().message.find('\n'), std::string::npos) << set.error().message;
+}
+
+// --- Accessor forms, primitive modes, options ---------------------------------------------------
+
+// The validator's decoding oracles (corpus README): every component of each accessor, exactly.
+TEST(Gltf, accessorOraclesGiveValidatorValues) {
+  const std::string dir = std::string(DPOINT_CORPUS_DIR) + "/gltf-validator/base/data/accessor_data/";
+  if (!test::fileExists(dir + "get_elements.gltf")) GTEST_SKIP() << "corpus not found at " << dir;
+  const auto expect = [&](const std::string& file, int index, const std::vector<double>& values) {
+    Result<std::vector<double>> got = readGltfAccessor(dir + file, index);
+    ASSERT_TRUE(got) << got.error().message;
+    EXPECT_EQ(*got, values) << file << " accessor " << index;
+  };
+  expect("get_elements.gltf", 0, {0, -5, 27, -0.0, 10.5, 0.5});
+  expect("get_elements.gltf", 1, {1000, 0.25});                                    // stride 8
+  expect("get_elements.gltf", 2, {50 / 65535.0, 45 / 65535.0, 12345 / 65535.0, 0});  // normalized ushort
+  expect("get_elements.gltf", 3, {1 / 127.0, 126 / 127.0, -1, 0, 50 / 127.0, -125 / 127.0});  // -127 → -1
+  expect("get_elements.gltf", 4,
+         {50 / 32767.0, 45 / 32767.0, 12345 / 32767.0, 0, -1 / 32767.0, 45 / 32767.0, 12345 / 32767.0, 0});
+  expect("get_elements_sparse.gltf", 0, {0, 0});            // no bufferView: zeros
+  expect("get_elements_sparse.gltf", 1, {0.125, 1024});     // sparse over zeros
+  expect("get_elements_sparse.gltf", 2, {70000, 100001, 54321, 200002});  // partial sparse
+  // MAT2 of bytes: each 2-byte column padded to 4 bytes.
+  Result<std::vector<double>> matrix = readGltfAccessor(dir + "get_elements_matrix.gltf", 0);
+  ASSERT_TRUE(matrix) << matrix.error().message;
+  EXPECT_EQ(*matrix, (std::vector<double>{1, 2, -3, -4, 5, 6, -7, -8}));
+}
+
+TEST(Gltf, gltfDecodesQuantizedPositions) {
+  // KHR_mesh_quantization: POSITION as normalized signed bytes read from the colour bytes
+  // (255 → -1/127, 0, 0 → ...): check one element against max(c/127, -1).
+  TempDir dir;
+  std::string json = replaced(fixtureGltf(), R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+     "min": [-1, 0, 0], "max": [1, 2, 3]})",
+                              R"({"bufferView": 1, "componentType": 5120, "normalized": true, "count": 3, "type": "VEC3", "byteOffset": 0})");
+  json = replaced(json, R"("byteOffset": 36, "byteLength": 12})", R"("byteOffset": 36, "byteLength": 12, "byteStride": 4})");
+  json = replaced(json, R"("asset": {"version": "2.0"},)",
+                  R"("asset": {"version": "2.0"}, "extensionsUsed": ["KHR_mesh_quantization"],
+                     "extensionsRequired": ["KHR_mesh_quantization"],)");
+  // Colours then share view 1 with stride 4: fine for the reader.
+  Result<PointSet> set = readText(dir, json);
+  ASSERT_TRUE(set) << set.error().message;
+  // Node 0 (scale 2): element 0 bytes (255, 0, 0) = (-1/127, 0, 0).
+  EXPECT_EQ(set->positions[0], glm::dvec3(6378000 + 2 * (-1 / 127.0), 0, 0));
+  // Element 2 bytes (51, 102, -52): (51/127, 102/127, -52/127).
+  EXPECT_EQ(set->positions[2], glm::dvec3(6378000 + 2 * (51 / 127.0), 2 * (102 / 127.0), 2 * (-52 / 127.0)));
+}
+
+TEST(Gltf, gltfStripAndFanBecomeTriangleLists) {
+  TempDir dir;
+  // Indices 0,1,2 in mode 5 (strip): one triangle; mode 6 (fan): one triangle (1, 2, 0).
+  Result<PointSet> strip = readText(dir, replaced(fixtureGltf(), R"("indices": 2, "mode": 4)", R"("indices": 2, "mode": 5)"));
+  ASSERT_TRUE(strip) << strip.error().message;
+  EXPECT_EQ(strip->triangles, (std::vector<uint32_t>{3, 4, 5}));
+  Result<PointSet> fan = readText(dir, replaced(fixtureGltf(), R"("indices": 2, "mode": 4)", R"("indices": 2, "mode": 6)"));
+  ASSERT_TRUE(fan) << fan.error().message;
+  EXPECT_EQ(fan->triangles, (std::vector<uint32_t>{4, 5, 3}));
+  // Lines (1): the referenced vertices as points, no triangles.
+  Result<PointSet> lines = readText(dir, replaced(fixtureGltf(), R"("indices": 2, "mode": 4)", R"("indices": 2, "mode": 1)"));
+  ASSERT_TRUE(lines) << lines.error().message;
+  EXPECT_EQ(lines->size(), 6u);
+  EXPECT_TRUE(lines->triangles.empty());
+}
+
+TEST(Gltf, gltfIndexedPrimitiveEmitsReferencedVerticesOnce) {
+  // Index accessor of count 2 over (0, 1): vertex 2 is not referenced and not emitted.
+  TempDir dir;
+  Result<PointSet> set = readText(dir, replaced(fixtureGltf(), R"({"bufferView": 2, "componentType": 5123, "count": 3,)",
+                                                R"({"bufferView": 2, "componentType": 5123, "count": 2,)"));
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_EQ(set->size(), 5u);  // 3 points of node 0, 2 referenced vertices of node 1
+  EXPECT_TRUE(set->triangles.empty());  // 2 indices make no triangle
+}
+
+TEST(Gltf, gltfMeshUsedByTwoNodesIsEmittedTwice) {
+  TempDir dir;
+  Result<PointSet> set = readText(dir, replaced(fixtureGltf(), R"("scale": [1,1,3], "mesh": 0})", R"("scale": [1,1,3], "mesh": 1})"));
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_EQ(set->size(), 6u);
+  EXPECT_NE(set->positions[0], set->positions[3]);  // the second instance has its own transform
+}
+
+TEST(Gltf, gltfSceneSelection) {
+  TempDir dir;
+  test::writeFile(dir.file("scene.gltf"), replaced(fixtureGltf(), R"("scenes": [{"nodes": [0]}],)",
+                                                   R"("scenes": [{"nodes": [0]}, {"nodes": [1]}],)"));
+  GltfReadOptions options;
+  options.scene = 1;  // node 1 alone: T·R·S without node 0's matrix
+  Result<PointSet> one = readGltf(dir.file("scene.gltf"), options);
+  ASSERT_TRUE(one) << one.error().message;
+  ASSERT_EQ(one->size(), 3u);
+  EXPECT_NEAR(one->positions[0].x, -2, 1e-12);
+  EXPECT_NEAR(one->positions[0].y, 6, 1e-12);
+  EXPECT_NEAR(one->positions[0].z, 9, 1e-12);
+  options.scene = -1;
+  options.all_scenes = true;
+  Result<PointSet> all = readGltf(dir.file("scene.gltf"), options);
+  ASSERT_TRUE(all) << all.error().message;
+  EXPECT_EQ(all->size(), 9u);
+  options.all_scenes = false;
+  options.scene = 5;
+  Result<PointSet> missing = readGltf(dir.file("scene.gltf"), options);
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("--scene: scene 5 does not exist"), std::string::npos) << missing.error().message;
+}
+
+TEST(Gltf, gltfRefusesGltf1) {
+  expectReadError(replaced(fixtureGltf(), R"("version": "2.0")", R"("version": "1.0")"),
+                  {"/asset/version: '1.0' is not supported; only glTF 2.x"});
+  expectReadError(R"({"asset": {}, "meshes": {}})", {"/asset/version: missing"});
+}
+
+TEST(Gltf, gltfRefusesRequiredCompressionByName) {
+  for (const char* name : {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "EXT_mesh_gpu_instancing"})
+    expectReadError(replaced(fixtureGltf(), R"("asset": {"version": "2.0"},)",
+                             std::string(R"("asset": {"version": "2.0"}, "extensionsRequired": [")") + name + "\"],"),
+                    {"/extensionsRequired/0: requires extension " + std::string(name)});
+}
+
+TEST(Gltf, gltfRejectsDeepNesting) {
+  const std::string deep = R"({"asset": {"version": "2.0"}, "extras": )" + std::string(200000, '[') +
+                           std::string(200000, ']') + "}";
+  expectReadError(deep, {"JSON nested deeper than 64 levels"});
+}
+
+TEST(Gltf, gltfRejectsIntegersTinygltfWouldMangle) {
+  expectReadError(replaced(fixtureGltf(), R"("byteOffset": 48, "byteLength": 6)", R"("byteOffset": -4, "byteLength": 6)"),
+                  {"/bufferViews/2/byteOffset: must be an integer"});
+  expectReadError(replaced(fixtureGltf(), R"("indices": 2,)", R"("indices": 4294967298,)"),
+                  {"/meshes/0/primitives/0/indices: must be an integer"});
+}
+
+TEST(Gltf, gltfRefusesUriThatIsAFolder) {
+  for (const char* uri : {".", "..", "/etc/passwd", "sub/../../x.bin"}) {
+    std::string json = fixtureGltf();
+    const size_t at = json.find("data:application");
+    json.replace(at, json.find('"', at) - at, uri);
+    expectReadError(json, {"/buffers/0/uri"});
+  }
+}
+
+TEST(Gltf, glbRejectsChunkPastTheEnd) {
+  TempDir dir;
+  ASSERT_TRUE(writeGlb(dir.file("cloud.glb"), offsetCloud()));
+  std::string bytes = test::readFile(dir.file("cloud.glb"));
+  uint32_t json_length;
+  std::memcpy(&json_length, bytes.data() + 12, 4);
+  // The BIN chunk claims 4 bytes more than remain (tinygltf would read past the end).
+  const size_t bin = 20 + json_length;
+  uint32_t bin_length;
+  std::memcpy(&bin_length, bytes.data() + bin, 4);
+  bin_length += 4;
+  std::memcpy(bytes.data() + bin, &bin_length, 4);
+  test::writeFile(dir.file("bad.glb"), bytes);
+  Result<PointSet> set = readGltf(dir.file("bad.glb"));
+  ASSERT_FALSE(set);
+  EXPECT_NE(set.error().message.find("GLB: chunk 1 at byte " + std::to_string(bin) + ": length"), std::string::npos)
+      << set.error().message;
+}
+
+TEST(Gltf, gltfNonFinitePositionIsAnErrorUnlessAllowed) {
+  TempDir dir;
+  // Scale node 1 by 1e308 twice over: finite input, infinite world position.
+  const std::string json = replaced(fixtureGltf(), R"("scale": [1,1,3])", R"("scale": [1e308,1,3])");
+  test::writeFile(dir.file("scene.gltf"), json);
+  Result<PointSet> set = readGltf(dir.file("scene.gltf"));
+  ASSERT_FALSE(set);
+  EXPECT_NE(set.error().message.find("/accessors/0: POSITION element 0 is not finite in world space"),
+            std::string::npos) << set.error().message;
+  GltfReadOptions options;
+  options.allow_nonfinite = true;
+  EXPECT_TRUE(readGltf(dir.file("scene.gltf"), options));
+}
+
+TEST(Gltf, gltfMaxPointsRefusesWithResourceLimit) {
+  TempDir dir;
+  test::writeFile(dir.file("scene.gltf"), fixtureGltf());
+  GltfReadOptions options;
+  options.max_points = 5;
+  Result<PointSet> set = readGltf(dir.file("scene.gltf"), options);
+  ASSERT_FALSE(set);
+  EXPECT_EQ(set.error().code, ExitCode::kResourceLimit);
+  options.max_points = 6;
+  EXPECT_TRUE(readGltf(dir.file("scene.gltf"), options));
+}
+
+TEST(Gltf, uniqueKeepsFirstOccurrenceAndRenumbersTriangles) {
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 0, 0}, {-0.0, 0, 0}, {0, 1, 0}, {1, 0, 0}};
+  set.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}};
+  set.triangles = {0, 1, 3, 2, 4, 3, 0, 2, 1};  // the last loses a corner: 0 and 2 merge
+  dropDuplicatePositions(set);
+  EXPECT_EQ(set.positions, (std::vector<glm::dvec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+  EXPECT_EQ(set.colors, (std::vector<glm::vec3>{{1, 0, 0}, {0, 1, 0}, {1, 1, 0}}));
+  EXPECT_EQ(set.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 1, 2}));
+}
+
+TEST(Gltf, srgb8EncodesLinearColours) {
+  PointSet set;
+  set.positions = {{0, 0, 0}};
+  set.colors = {{0.0f, 1.0f, 0.5f}};
+  encodeColorsSrgb8(set);
+  // linear 0.5 → sRGB 0.7354 → 188/255.
+  EXPECT_EQ(set.colors[0], glm::vec3(0.0f, 1.0f, float(188 / 255.0)));
 }
 
 // --- The official Khronos validator --------------------------------------------------------------

@@ -1,0 +1,37 @@
+// A small JSON reader for the glTF pre-checks, run before tinygltf sees the text.
+// tinygltf 2.7.0 overflows the stack on deep nesting and silently turns bad integers into 0
+// (2^32, -4), so we parse the document once ourselves with a depth cap and check the fields whose
+// values tinygltf would mangle. Only what the checks need is kept: no serialisation.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/result.h"
+
+namespace dpoint {
+
+struct JsonValue {
+  enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject };
+  Kind kind = Kind::kNull;
+  bool boolean = false;
+  double number = 0.0;
+  bool is_integer = false;  // number written without fraction or exponent and fits int64
+  int64_t integer = 0;      // valid when is_integer
+  std::string text;         // kString: decoded UTF-8
+  std::vector<JsonValue> items;                              // kArray
+  std::vector<std::pair<std::string, JsonValue>> members;    // kObject, in file order
+
+  // Member of an object by key; nullptr when absent or when this is not an object.
+  const JsonValue* find(std::string_view key) const;
+};
+
+// Parses one JSON document. Nesting deeper than max_depth arrays/objects is an error, so the
+// recursion is bounded. Errors say "byte N: what" (the caller prefixes the file name).
+Result<JsonValue> parseJson(std::string_view text, int max_depth);
+
+}  // namespace dpoint

@@ -1,0 +1,365 @@
+// Pre-checks and tinygltf loading. Every check here exists because tinygltf 2.7.0 crashes, reads
+// out of bounds or silently changes a value on that input (corpus README, "Known traps").
+#include "converters/gltf_load.h"
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <new>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "converters/gltf_json.h"
+#include "core/input_file.h"
+
+namespace dpoint {
+namespace {
+
+constexpr uint32_t kGlbMagic = 0x46546C67;      // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;     // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;      // "BIN\0"
+// tinygltf keeps indices in int; sizes in size_t but we want them exact in a double too.
+constexpr int64_t kMaxIndex = std::numeric_limits<int32_t>::max();
+constexpr int64_t kMaxSize = int64_t(1) << 53;
+
+uint32_t readU32(const std::vector<unsigned char>& bytes, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, bytes.data() + at, 4);  // GLB is little-endian, as is every target we build for
+  return v;
+}
+
+struct GlbLayout {
+  size_t json_offset = 0, json_length = 0;
+  std::optional<uint64_t> bin_length;  // the BIN chunk right after JSON, if any
+};
+
+// Walks every chunk header with 64-bit arithmetic; tinygltf reads 8 bytes past the end when the
+// BIN chunk's length does not leave room for its own header.
+Result<GlbLayout> checkGlb(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const auto fail = [&](const std::string& what) { return Error{path + ": GLB: " + what}; };
+  if (bytes.size() < 20) return fail("file of " + std::to_string(bytes.size()) + " bytes is shorter than a GLB header and chunk");
+  if (readU32(bytes, 0) != kGlbMagic) return fail("no 'glTF' magic at byte 0");
+  const uint32_t version = readU32(bytes, 4);
+  if (version == 1) return fail("version 1 (glTF 1.0) is not supported; only glTF 2.x");
+  if (version != 2) return fail("header version " + std::to_string(version) + " is not 2");
+  const uint64_t length = readU32(bytes, 8);
+  // Bytes after `length` are not part of the GLB (the validator only warns); fewer is truncation.
+  if (length > bytes.size())
+    return fail("header length " + std::to_string(length) + " exceeds the file size " +
+                std::to_string(bytes.size()));
+  GlbLayout layout;
+  uint64_t at = 12;
+  for (int chunk = 0; at < length; ++chunk) {
+    const std::string name = "chunk " + std::to_string(chunk) + " at byte " + std::to_string(at);
+    if (length - at < 8) return fail(name + ": " + std::to_string(length - at) + " bytes left, less than a chunk header");
+    const uint64_t chunk_length = readU32(bytes, size_t(at));
+    const uint32_t type = readU32(bytes, size_t(at + 4));
+    if (chunk_length > length - at - 8)
+      return fail(name + ": length " + std::to_string(chunk_length) + " runs past the end of the file");
+    if (chunk == 0) {
+      if (type != kChunkJson) return fail("first chunk is not JSON");
+      if (chunk_length == 0) return fail("JSON chunk is empty");
+      layout.json_offset = size_t(at + 8);
+      layout.json_length = size_t(chunk_length);
+    } else if (type == kChunkJson) {
+      return fail(name + ": a second JSON chunk");
+    } else if (chunk == 1 && type == kChunkBin) {
+      layout.bin_length = chunk_length;
+    }
+    at += 8 + chunk_length;
+  }
+  if (layout.json_length == 0) return fail("no JSON chunk");
+  return layout;
+}
+
+std::string pointerTo(const std::string& base, size_t index) { return base + "/" + std::to_string(index); }
+
+// Checks the integer-valued fields tinygltf would wrap (2^32 → 0) or clamp (−4 → 0).
+class FieldChecker {
+ public:
+  explicit FieldChecker(const std::string& path) : path_(path) {}
+  std::optional<Error> error;
+
+  void integer(const JsonValue* v, const std::string& pointer, int64_t max) {
+    if (!v || error) return;
+    // 1.0 is an integer to the validator (JSON has one number type); 1.5, −4 and 2^32 are not.
+    if (v->kind != JsonValue::Kind::kNumber || !(v->number >= 0) || v->number > double(max) ||
+        v->number != double(int64_t(v->number)))
+      error = Error{path_ + ": " + pointer + ": must be an integer from 0 to " + std::to_string(max)};
+  }
+  void index(const JsonValue& object, const char* key, const std::string& base) {
+    integer(object.find(key), base + "/" + key, kMaxIndex);
+  }
+  void size(const JsonValue& object, const char* key, const std::string& base) {
+    integer(object.find(key), base + "/" + key, kMaxSize);
+  }
+  // Each element of an array member (e.g. children) must be an index.
+  void indexArray(const JsonValue& object, const char* key, const std::string& base) {
+    const JsonValue* a = object.find(key);
+    if (!a || error) return;
+    if (a->kind != JsonValue::Kind::kArray) {
+      error = Error{path_ + ": " + base + "/" + key + ": must be an array"};
+      return;
+    }
+    for (size_t i = 0; i < a->items.size(); ++i) integer(&a->items[i], pointerTo(base + "/" + key, i), kMaxIndex);
+  }
+  // Top-level arrays of objects; glTF 1.0 used objects keyed by id here.
+  const std::vector<JsonValue>* objects(const JsonValue& root, const char* key) {
+    static const std::vector<JsonValue> kNone;
+    const JsonValue* a = root.find(key);
+    if (!a || error) return &kNone;
+    if (a->kind != JsonValue::Kind::kArray) {
+      error = Error{path_ + ": /" + key + ": must be an array (glTF 2.0)"};
+      return &kNone;
+    }
+    for (size_t i = 0; i < a->items.size(); ++i)
+      if (a->items[i].kind != JsonValue::Kind::kObject && !error)
+        error = Error{path_ + ": " + pointerTo(std::string("/") + key, i) + ": must be an object"};
+    return error ? &kNone : &a->items;
+  }
+
+ private:
+  const std::string& path_;
+};
+
+std::optional<Error> checkUri(const std::string& path, const std::string& pointer, const std::string& uri) {
+  if (uri.rfind("data:", 0) == 0) return std::nullopt;
+  const auto fail = [&](const std::string& why) {
+    return Error{path + ": " + pointer + ": '" + uri + "' " + why};
+  };
+  if (uri.empty() || uri == "." || uri == "..") return fail("is not a file name");
+  if (uri.find(':') != std::string::npos) return fail("is not a relative file name (only data: URIs and files beside the model)");
+  if (uri.front() == '/' || uri.find('\\') != std::string::npos) return fail("is not a relative path inside the model's folder");
+  for (const auto& part : std::filesystem::path(uri))
+    if (part == "..") return fail("leaves the model's folder");
+  return std::nullopt;
+}
+
+std::optional<Error> checkDocument(const std::string& path, const JsonValue& root,
+                                   const std::optional<uint64_t>& glb_bin) {
+  if (root.kind != JsonValue::Kind::kObject) return Error{path + ": the JSON document is not an object"};
+  const JsonValue* asset = root.find("asset");
+  const JsonValue* version = asset ? asset->find("version") : nullptr;
+  if (!version || version->kind != JsonValue::Kind::kString)
+    return Error{path + ": /asset/version: missing; not a glTF 2.0 file (glTF 1.0 is not supported)"};
+  if (version->text.rfind("2.", 0) != 0)
+    return Error{path + ": /asset/version: '" + version->text + "' is not supported; only glTF 2.x"};
+  if (const JsonValue* min = asset->find("minVersion"); min && min->kind == JsonValue::Kind::kString &&
+                                                          min->text != "2.0")
+    return Error{path + ": /asset/minVersion: '" + min->text + "' is newer than glTF 2.0"};
+
+  if (const JsonValue* required = root.find("extensionsRequired")) {
+    if (required->kind != JsonValue::Kind::kArray) return Error{path + ": /extensionsRequired: must be an array"};
+    for (size_t i = 0; i < required->items.size(); ++i) {
+      const JsonValue& name = required->items[i];
+      if (name.kind != JsonValue::Kind::kString) return Error{path + ": " + pointerTo("/extensionsRequired", i) + ": must be a string"};
+      if (!gltfRequiredExtensionSupported(name.text))
+        return Error{path + ": " + pointerTo("/extensionsRequired", i) + ": requires extension " + name.text +
+                     ", which dpoint does not decode"};
+    }
+  }
+
+  FieldChecker check(path);
+  check.index(root, "scene", "");
+  const auto& scenes = *check.objects(root, "scenes");
+  for (size_t i = 0; i < scenes.size(); ++i) check.indexArray(scenes[i], "nodes", pointerTo("/scenes", i));
+  const auto& nodes = *check.objects(root, "nodes");
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const std::string at = pointerTo("/nodes", i);
+    for (const char* key : {"mesh", "skin", "camera"}) check.index(nodes[i], key, at);
+    check.indexArray(nodes[i], "children", at);
+  }
+  const auto& meshes = *check.objects(root, "meshes");
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    const JsonValue* primitives = meshes[m].find("primitives");
+    if (!primitives || primitives->kind != JsonValue::Kind::kArray) continue;  // tinygltf reports it
+    for (size_t p = 0; p < primitives->items.size(); ++p) {
+      const JsonValue& primitive = primitives->items[p];
+      const std::string at = pointerTo(pointerTo("/meshes", m) + "/primitives", p);
+      for (const char* key : {"indices", "material", "mode"}) check.index(primitive, key, at);
+      if (const JsonValue* attributes = primitive.find("attributes"))
+        for (const auto& [name, value] : attributes->members) check.integer(&value, at + "/attributes/" + name, kMaxIndex);
+    }
+  }
+  const auto& accessors = *check.objects(root, "accessors");
+  for (size_t i = 0; i < accessors.size(); ++i) {
+    const std::string at = pointerTo("/accessors", i);
+    check.index(accessors[i], "bufferView", at);
+    check.index(accessors[i], "componentType", at);
+    check.size(accessors[i], "byteOffset", at);
+    check.size(accessors[i], "count", at);
+    if (const JsonValue* sparse = accessors[i].find("sparse")) {
+      check.size(*sparse, "count", at + "/sparse");
+      for (const char* part : {"indices", "values"}) {
+        const JsonValue* p = sparse->find(part);
+        if (!p) continue;
+        const std::string sub = at + "/sparse/" + part;
+        check.index(*p, "bufferView", sub);
+        check.index(*p, "componentType", sub);
+        check.index(*p, "byteOffset", sub);  // tinygltf keeps sparse offsets in int
+      }
+    }
+  }
+  const auto& views = *check.objects(root, "bufferViews");
+  for (size_t i = 0; i < views.size(); ++i) {
+    const std::string at = pointerTo("/bufferViews", i);
+    check.index(views[i], "buffer", at);
+    check.index(views[i], "target", at);
+    for (const char* key : {"byteOffset", "byteLength", "byteStride"}) check.size(views[i], key, at);
+  }
+  const auto& buffers = *check.objects(root, "buffers");
+  for (size_t i = 0; i < buffers.size(); ++i) {
+    const std::string at = pointerTo("/buffers", i);
+    check.size(buffers[i], "byteLength", at);
+    if (check.error) break;
+    const JsonValue* uri = buffers[i].find("uri");
+    if (uri && uri->kind == JsonValue::Kind::kString) {
+      if (auto e = checkUri(path, at + "/uri", uri->text)) return e;
+    } else if (i == 0 && glb_bin) {
+      const JsonValue* length = buffers[i].find("byteLength");
+      if (length && uint64_t(length->number) > *glb_bin)
+        return Error{path + ": " + at + "/byteLength: " + std::to_string(uint64_t(length->number)) +
+                     " exceeds the GLB BIN chunk (" + std::to_string(*glb_bin) + " bytes)"};
+    }  // other buffers without uri hold no data; an accessor using one fails its bounds check
+  }
+  return check.error;
+}
+
+// File-system callbacks: only regular files under the model's folder, by relative names without
+// "..", size-capped. tinygltf also tries the current directory and absolute paths; both refused.
+struct FolderJail {
+  std::string base;                  // the folder string handed to tinygltf as its base dir
+  std::filesystem::path canonical;   // the folder with links resolved
+  uint64_t max_bytes = 0;
+};
+
+bool allowed(const std::string& file, const FolderJail& jail) {
+  if (file.size() <= jail.base.size() + 1 || file.compare(0, jail.base.size(), jail.base) != 0 ||
+      file[jail.base.size()] != '/')
+    return false;  // not JoinPath(base, name): the cwd fallback or an absolute name
+  const std::filesystem::path relative(file.substr(jail.base.size() + 1));
+  if (relative.is_absolute()) return false;
+  for (const auto& part : relative)
+    if (part == "..") return false;
+  std::error_code ec;
+  const std::filesystem::path full = std::filesystem::canonical(file, ec);  // follows links
+  if (ec || !std::filesystem::is_regular_file(full, ec) || ec) return false;
+  const auto mismatch = std::mismatch(jail.canonical.begin(), jail.canonical.end(), full.begin(), full.end());
+  return mismatch.first == jail.canonical.end();
+}
+
+bool jailedFileExists(const std::string& file, void* user) {
+  return allowed(file, *static_cast<const FolderJail*>(user));
+}
+
+std::string noExpansion(const std::string& file, void*) { return file; }
+
+bool jailedReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
+  const auto& jail = *static_cast<const FolderJail*>(user);
+  const auto refuse = [&](const std::string& why) {
+    if (err) *err += "'" + file + "' " + why;
+    return false;
+  };
+  if (!allowed(file, jail)) return refuse("is not a regular file inside the model's folder");
+  Result<InputFile> input = InputFile::open(file);
+  if (!input) return refuse(input.error().message);
+  if (input->size() > jail.max_bytes) return refuse("is larger than the size limit");
+  out->resize(size_t(input->size()));
+  Result<size_t> got = input->readAt(0, out->data(), out->size());
+  if (!got || *got != out->size()) return refuse("could not be read whole");
+  return true;
+}
+
+bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "the reader writes no files";
+  return false;
+}
+
+// We take points, never textures: keep image bytes undecoded (tinygltf's own decoder reads past
+// the end of an image stored in a bufferView).
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  std::replace(text.begin(), text.end(), '\n', ';');
+  return text.empty() ? "tinygltf gave no reason" : text;
+}
+
+Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
+  Result<InputFile> input = InputFile::open(path);
+  if (!input) return input.error();
+  if (input->size() == 0) return Error{path + ": file is empty"};
+  if (input->size() > max_file_bytes)
+    return Error{path + ": " + std::to_string(input->size()) + " bytes exceeds the glTF input limit of " +
+                     std::to_string(max_file_bytes) + " bytes",
+                 ExitCode::kResourceLimit};
+  std::vector<unsigned char> bytes(size_t(input->size()));
+  Result<size_t> got = input->readAt(0, bytes.data(), bytes.size());
+  if (!got) return got.error();
+  if (*got != bytes.size()) return Error{path + ": the file shrank while being read"};
+
+  const bool binary = bytes.size() >= 4 && readU32(bytes, 0) == kGlbMagic;
+  std::string_view json(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  std::optional<uint64_t> bin_length;
+  if (binary) {
+    Result<GlbLayout> layout = checkGlb(path, bytes);
+    if (!layout) return layout.error();
+    json = json.substr(layout->json_offset, layout->json_length);
+    bin_length = layout->bin_length;
+  } else if (json.size() >= 3 && json.substr(0, 3) == "\xEF\xBB\xBF") {
+    return Error{path + ": starts with a UTF-8 byte order mark, which glTF forbids"};
+  }
+  {
+    Result<JsonValue> document = parseJson(json, kGltfMaxJsonDepth);
+    if (!document) return Error{path + ": JSON " + document.error().message};
+    if (auto e = checkDocument(path, *document, bin_length)) return *e;
+  }  // the DOM is freed before tinygltf builds its own
+
+  std::error_code ec;
+  FolderJail jail;
+  jail.base = std::filesystem::absolute(path, ec).parent_path().string();
+  if (!ec) jail.canonical = std::filesystem::weakly_canonical(jail.base, ec);
+  if (ec) return Error{path + ": cannot resolve its folder: " + ec.message()};
+  jail.max_bytes = max_file_bytes;
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks({&jailedFileExists, &noExpansion, &jailedReadWholeFile, &refuseWrite, &jail});
+  loader.SetImageLoader(&skipImage, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  const auto length = static_cast<unsigned int>(bytes.size());  // ≤ 2^32−1: checked by the GLB header / cap
+  const bool loaded = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), length, jail.base)
+                             : loader.LoadASCIIFromString(&model, &err, &warn, json.data(), length, jail.base);
+  if (!loaded) return Error{path + ": " + oneLine(err)};
+  return model;
+}
+
+}  // namespace
+
+bool gltfRequiredExtensionSupported(const std::string& name) {
+  // Geometry we decode, or extensions that only change shading; anything else that is required
+  // may change positions (draco, meshopt, instancing) and is refused by name.
+  static const char* const kAccepted[] = {"KHR_mesh_quantization", "KHR_texture_transform", "KHR_texture_basisu",
+                                          "EXT_texture_webp",      "KHR_lights_punctual",   "KHR_materials_"};
+  for (const char* accepted : kAccepted) {
+    const std::string_view a(accepted);
+    if (a.back() == '_' ? name.rfind(a, 0) == 0 : name == a) return true;
+  }
+  return false;
+}
+
+Result<tinygltf::Model> loadGltfModel(const std::string& path, uint64_t max_file_bytes) {
+  // tinygltf throws (std::bad_alloc on huge byteLength, nlohmann exceptions); none may escape.
+  try {
+    return load(path, max_file_bytes);
+  } catch (const std::bad_alloc&) {
+    return Error{path + ": out of memory while loading", ExitCode::kResourceLimit};
+  } catch (const std::exception& e) {
+    return Error{path + ": " + oneLine(e.what())};
+  }
+}
+
+}  // namespace dpoint

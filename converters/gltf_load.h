@@ -1,0 +1,31 @@
+// Loading a glTF/GLB file into a tinygltf::Model safely (internal to converters/).
+//
+// Before tinygltf sees the bytes we check what it gets wrong on hostile input (see
+// ../shared/corpus/README.md, "Known traps"): the file size, the GLB header and every chunk
+// header, JSON nesting depth, asset.version (2.x only), extensionsRequired, integer fields that
+// tinygltf would silently wrap or clamp, and buffer URIs. tinygltf then loads with a no-op image
+// loader and file-system callbacks that only read regular files inside the model's folder.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <cstdint>
+#include <string>
+
+#include "converters/gltf_read.h"  // kGltfDefaultMaxFileBytes
+#include "core/result.h"
+
+namespace dpoint {
+
+// Deeper nesting than any real glTF (the schema itself nests about 8 levels).
+constexpr int kGltfMaxJsonDepth = 64;
+
+// Errors are one line: "PATH: /json/pointer: what". Files (and external buffers) larger than
+// max_file_bytes fail with ExitCode::kResourceLimit. Never throws.
+Result<tinygltf::Model> loadGltfModel(const std::string& path, uint64_t max_file_bytes);
+
+// Extensions listed in extensionsRequired that we accept: those we decode
+// (KHR_mesh_quantization) and those that do not change geometry (materials, textures, lights).
+bool gltfRequiredExtensionSupported(const std::string& name);
+
+}  // namespace dpoint
