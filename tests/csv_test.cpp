@@ -2,6 +2,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <charconv>
 #include <random>
@@ -272,14 +273,18 @@ TEST(Csv, failedWriteLeavesNothing) {
 namespace dpoint {
 namespace {
 
-// formatFixed must agree with std::to_chars' fixed form (printf's rounding) everywhere.
-TEST(FixedFormat, matchesToCharsOnRandomAndTieValues) {
+// formatFixed must agree with glibc printf("%.*f") and std::to_chars' fixed form everywhere.
+TEST(FixedFormat, matchesGlibcPrintfAndToCharsOnRandomAndTieValues) {
   std::mt19937_64 rng(99);
   char a[512], b[512];
+  char c[512];
   auto check = [&](double v, int decimals) {
     char* end_a = formatFixed(a, v, decimals);
     auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::fixed, decimals);
     ASSERT_EQ(std::string(a, end_a), std::string(b, r.ptr)) << "decimals " << decimals;
+    // And glibc's printf itself, the behaviour --decimals promises.
+    std::snprintf(c, sizeof c, "%.*f", decimals, v);
+    ASSERT_EQ(std::string(a, end_a), std::string(c)) << "decimals " << decimals;
   };
   for (int i = 0; i < 300000; ++i) {
     const uint64_t bits = rng();
