@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "converters/gltf_json.h"
+#include "converters/gltf_meshopt.h"
 #include "core/input_file.h"
 
 namespace dpoint {
@@ -208,6 +209,11 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
     check.index(views[i], "buffer", at);
     check.index(views[i], "target", at);
     for (const char* key : {"byteOffset", "byteLength", "byteStride"}) check.size(views[i], key, at);
+    // tinygltf keeps extension numbers in int, wrapping larger ones.
+    const JsonValue* extensions = views[i].find("extensions");
+    if (const JsonValue* meshopt = extensions ? extensions->find("EXT_meshopt_compression") : nullptr)
+      for (const char* key : {"buffer", "byteOffset", "byteLength", "byteStride", "count"})
+        check.index(*meshopt, key, at + "/extensions/EXT_meshopt_compression");
   }
   const auto& buffers = *check.objects(root, "buffers");
   for (size_t i = 0; i < buffers.size(); ++i) {
@@ -305,9 +311,11 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
   const bool binary = bytes.size() >= 4 && readU32(bytes, 0) == kGlbMagic;
   std::string_view json(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   std::optional<uint64_t> bin_length;
+  GlbLayout glb;
   if (binary) {
     Result<GlbLayout> layout = checkGlb(path, bytes);
     if (!layout) return layout.error();
+    glb = *layout;
     json = json.substr(layout->json_offset, layout->json_length);
     bin_length = layout->bin_length;
   } else if (json.size() >= 3 && json.substr(0, 3) == "\xEF\xBB\xBF") {
@@ -317,6 +325,24 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
     Result<JsonValue> document = parseJson(json, kGltfMaxJsonDepth);
     if (!document) return Error{path + ": JSON " + document.error().message};
     if (auto e = checkDocument(path, *document, bin_length)) return *e;
+    if (std::optional<std::string> rewritten = emptyMeshoptFallbackBuffers(*document, binary)) {
+      if (binary) {
+        // Same chunks after the JSON one; the JSON chunk padded with spaces to 4 bytes (GLB §4.4.3.1).
+        rewritten->append((4 - rewritten->size() % 4) % 4, ' ');
+        const size_t rest = glb.json_offset + glb.json_length;
+        const size_t end = readU32(bytes, 8);  // checkGlb: ≤ bytes.size()
+        std::vector<unsigned char> glb_bytes(12 + 8 + rewritten->size() + (end - rest));
+        const uint32_t header[5] = {kGlbMagic, 2, uint32_t(glb_bytes.size()), uint32_t(rewritten->size()), kChunkJson};
+        std::memcpy(glb_bytes.data(), header, sizeof header);
+        std::memcpy(glb_bytes.data() + 20, rewritten->data(), rewritten->size());
+        std::copy(bytes.begin() + std::ptrdiff_t(rest), bytes.begin() + std::ptrdiff_t(end),
+                  glb_bytes.begin() + std::ptrdiff_t(20 + rewritten->size()));
+        bytes = std::move(glb_bytes);
+      } else {
+        bytes.assign(rewritten->begin(), rewritten->end());
+        json = std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+      }
+    }
   }  // the DOM is freed before tinygltf builds its own
 
   std::error_code ec;
@@ -334,6 +360,8 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
   const bool loaded = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), length, jail.base)
                              : loader.LoadASCIIFromString(&model, &err, &warn, json.data(), length, jail.base);
   if (!loaded) return Error{path + ": " + oneLine(err)};
+  // Decoded here so every reader of the model sees plain views; the input cap bounds the output.
+  if (Status s = decodeMeshoptViews(path, model, max_file_bytes); !s) return s.error();
   return model;
 }
 
@@ -341,8 +369,8 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
 
 bool gltfRequiredExtensionSupported(const std::string& name) {
   // Geometry we decode, or extensions that only change shading; anything else that is required
-  // may change positions (draco, meshopt, instancing) and is refused by name.
-  static const char* const kAccepted[] = {"KHR_mesh_quantization", "KHR_texture_transform", "KHR_texture_basisu",
+  // may change positions (draco, instancing) and is refused by name.
+  static const char* const kAccepted[] = {"KHR_mesh_quantization", "EXT_meshopt_compression", "KHR_texture_transform", "KHR_texture_basisu",
                                           "EXT_texture_webp",      "KHR_lights_punctual",   "KHR_materials_"};
   for (const char* accepted : kAccepted) {
     const std::string_view a(accepted);

@@ -12,9 +12,9 @@
 // - Colours (linear 0..1) when any primitive has COLOR_0 (float, unorm8 or unorm16, VEC3/VEC4,
 //   alpha dropped); primitives without COLOR_0 then take their material's baseColorFactor rgb
 //   (white without a material).
-// - Required extensions: KHR_mesh_quantization is decoded; shading-only ones are accepted;
-//   any other (KHR_draco_mesh_compression, EXT_meshopt_compression, EXT_mesh_gpu_instancing, …)
-//   is refused by name.
+// - Required extensions: KHR_mesh_quantization and EXT_meshopt_compression (gltf_meshopt.h) are
+//   decoded; shading-only ones are accepted; any other (KHR_draco_mesh_compression,
+//   EXT_mesh_gpu_instancing, …) is refused by name.
 // Errors are one line: "PATH: /json/pointer: what" (ExitCode::kBadInput), or kResourceLimit for
 // the size and point limits.
 #pragma once

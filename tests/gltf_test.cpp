@@ -1,6 +1,7 @@
 // GLB writer and glTF/GLB reader: round trips at Earth-radius offsets, the file layout seen through
 // tinygltf itself, node transforms, malformed input, and the official validator.
 #include <gtest/gtest.h>
+#include <meshoptimizer.h>
 #include <tiny_gltf.h>
 
 #include <cmath>
@@ -523,10 +524,86 @@ TEST(Gltf, gltfRefusesGltf1) {
 }
 
 TEST(Gltf, gltfRefusesRequiredCompressionByName) {
-  for (const char* name : {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "EXT_mesh_gpu_instancing"})
+  for (const char* name : {"KHR_draco_mesh_compression", "EXT_mesh_gpu_instancing"})
     expectReadError(replaced(fixtureGltf(), R"("asset": {"version": "2.0"},)",
                              std::string(R"("asset": {"version": "2.0"}, "extensionsRequired": [")") + name + "\"],"),
                     {"/extensionsRequired/0: requires extension " + std::string(name)});
+}
+
+// The fixture's triangle mesh with EXT_meshopt_compression: positions (stride 12) and indices
+// (u16) encoded by meshoptimizer itself, behind a one-byte fallback buffer that has no data.
+std::string meshoptGltf() {
+  const float positions[9] = {1, 2, 3, 0, 0, 0, -1, 0.5f, 2};
+  const uint16_t indices[3] = {0, 1, 2};
+  std::vector<unsigned char> vertex_bytes(meshopt_encodeVertexBufferBound(3, 12));
+  vertex_bytes.resize(meshopt_encodeVertexBuffer(vertex_bytes.data(), vertex_bytes.size(), positions, 3, 12));
+  std::vector<unsigned char> index_bytes(meshopt_encodeIndexBufferBound(3, 3));
+  const unsigned int index_source[3] = {indices[0], indices[1], indices[2]};
+  index_bytes.resize(meshopt_encodeIndexBuffer(index_bytes.data(), index_bytes.size(), index_source, 3));
+  std::vector<unsigned char> blob = vertex_bytes;
+  blob.insert(blob.end(), index_bytes.begin(), index_bytes.end());
+  const std::string vertex_length = std::to_string(vertex_bytes.size());
+  return R"({
+  "asset": {"version": "2.0"},
+  "extensionsUsed": ["EXT_meshopt_compression"],
+  "extensionsRequired": ["EXT_meshopt_compression"],
+  "nodes": [{"mesh": 0, "translation": [10, 0, 0]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, 0, 0], "max": [1, 2, 3]},
+    {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}
+  ],
+  "bufferViews": [
+    {"buffer": 1, "byteLength": 36, "byteStride": 12, "extensions": {"EXT_meshopt_compression":
+      {"buffer": 0, "byteLength": )" + vertex_length + R"(, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}}},
+    {"buffer": 1, "byteOffset": 36, "byteLength": 6, "extensions": {"EXT_meshopt_compression":
+      {"buffer": 0, "byteOffset": )" + vertex_length + ", \"byteLength\": " + std::to_string(index_bytes.size()) +
+         R"(, "byteStride": 2, "count": 3, "mode": "TRIANGLES"}}}
+  ],
+  "buffers": [
+    {"byteLength": )" + std::to_string(blob.size()) + R"(, "uri": "data:application/octet-stream;base64,)" +
+         base64(blob) + R"("},
+    {"byteLength": 44, "extensions": {"EXT_meshopt_compression": {"fallback": true}}}
+  ]
+})";
+}
+
+TEST(Gltf, gltfDecodesMeshoptViewsBehindFallbackBuffer) {
+  TempDir dir;
+  Result<PointSet> set = readText(dir, meshoptGltf());
+  ASSERT_TRUE(set) << set.error().message;
+  const std::vector<glm::dvec3> expected = {{11, 2, 3}, {10, 0, 0}, {9, 0.5, 2}};
+  EXPECT_EQ(set->positions, expected);
+  EXPECT_EQ(set->triangles, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(Gltf, gltfMeshoptRejectsCountTimesStrideNotViewLength) {
+  expectReadError(replaced(meshoptGltf(), R"("byteStride": 12, "count": 3)", R"("byteStride": 12, "count": 4)"),
+                  {"/bufferViews/0/extensions/EXT_meshopt_compression: count 4 * byteStride 12 = 48 differs from "
+                   "the view's byteLength 36"});
+}
+
+TEST(Gltf, gltfMeshoptRejectsBadStrideAndMode) {
+  expectReadError(replaced(meshoptGltf(), R"("byteStride": 12, "count": 3)", R"("byteStride": 6, "count": 6)"),
+                  {"/bufferViews/0/extensions/EXT_meshopt_compression/byteStride: 6 is not a multiple of 4"});
+  expectReadError(replaced(meshoptGltf(), R"("mode": "TRIANGLES")", R"("mode": "STRIPS")"),
+                  {"/bufferViews/1/extensions/EXT_meshopt_compression/mode: 'STRIPS' is not ATTRIBUTES"});
+  expectReadError(replaced(meshoptGltf(), R"("mode": "TRIANGLES")", R"("mode": "TRIANGLES", "filter": "OCTAHEDRAL")"),
+                  {"/filter: 'OCTAHEDRAL' is only allowed with mode ATTRIBUTES"});
+}
+
+TEST(Gltf, gltfMeshoptRejectsSourcePastBufferAndCorruptData) {
+  expectReadError(replaced(meshoptGltf(), R"("buffer": 0, "byteLength": )", R"("buffer": 0, "byteOffset": 1000, "byteLength": )"),
+                  {"/bufferViews/0/extensions/EXT_meshopt_compression: byteOffset 1000 + byteLength"});
+  // The index data decoded as vertices: meshoptimizer's own checks must refuse it.
+  std::string json = meshoptGltf();
+  json.insert(json.find("\"mode\": \"ATTRIBUTES\""), R"("byteOffset": 1, )");
+  expectReadError(json, {"/bufferViews/0/extensions/EXT_meshopt_compression: meshoptimizer could not decode"});
+}
+
+TEST(Gltf, gltfMeshoptRejectsFieldTinygltfWouldWrap) {
+  expectReadError(replaced(meshoptGltf(), R"("byteStride": 12, "count": 3)", R"("byteStride": 12, "count": 4294967299)"),
+                  {"/bufferViews/0/extensions/EXT_meshopt_compression/count: must be an integer"});
 }
 
 TEST(Gltf, gltfRejectsDeepNesting) {

@@ -7,8 +7,9 @@ tests/external/node/read_points.mjs, computes world-space positions in double fo
    points equal the reference's as sorted multisets within 1e-9 relative.
 2. Variants of 2CylinderEngine.glb (and of the hand-made model) made by gltf-transform and
    gltfpack: dpoint equals the reference reader on THAT file within 1e-9, and the original within
-   the variant's quantization step. Only Draco and meshopt without a fallback may be refused,
-   and then with exit 2 and a message naming the extension.
+   the variant's quantization step. meshopt (EXT_meshopt_compression, with or without a fallback
+   buffer) is decoded and compared like the others; only Draco may be refused, and then with
+   exit 2 and a message naming the extension.
 
 "1e-9 relative" is per coordinate: |ours − theirs| ≤ 1e-9 · max(model extent, |theirs|), so points
 near the origin of a large model are held to the model's scale, far ones to their own magnitude.
@@ -48,7 +49,7 @@ MODELS = [
 GT = [gltf_transform]
 VARIANTS = [
     ("gltf-transform quantize", GT + ["quantize", "IN", "OUT"], 14, ()),
-    ("gltf-transform meshopt", GT + ["meshopt", "IN", "OUT"], 14, ("EXT_meshopt_compression",)),
+    ("gltf-transform meshopt", GT + ["meshopt", "IN", "OUT"], 14, ()),  # decoded, no fallback buffer
     ("gltf-transform draco", GT + ["draco", "IN", "OUT"], 14, ("KHR_draco_mesh_compression",)),
     ("gltf-transform sparse", GT + ["sparse", "IN", "OUT"], None, ()),
     ("gltf-transform flatten", GT + ["flatten", "IN", "OUT"], None, ()),
@@ -56,6 +57,8 @@ VARIANTS = [
     ("gltfpack", ["gltfpack", "-i", "IN", "-o", "OUT"], 14, ()),
     ("gltfpack -noq", ["gltfpack", "-i", "IN", "-o", "OUT", "-noq"], None, ()),
     ("gltfpack -cf", ["gltfpack", "-i", "IN", "-o", "OUT", "-cf"], 14, ()),  # has a fallback buffer
+    ("gltfpack -c", ["gltfpack", "-i", "IN", "-o", "OUT", "-c"], 14, ()),    # meshopt, data-less fallback
+    ("gltfpack -cc", ["gltfpack", "-i", "IN", "-o", "OUT", "-cc"], 14, ()),  # meshopt with filters
 ]
 
 
