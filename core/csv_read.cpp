@@ -17,6 +17,7 @@
 #include "core/csv.h"
 #include "core/input_file.h"
 #include "core/parallel.h"
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -31,21 +32,7 @@ enum class Layout { kXy = 2, kXyz = 3, kXyzRgb = 6 };
 bool isBlank(char c) { return c == ' ' || c == '\t'; }
 
 std::string excerpt(const char* begin, const char* end) {
-  constexpr size_t kMax = 40;
-  std::string text;
-  for (const char* p = begin; p < end && text.size() < kMax; ++p) {
-    unsigned char c = static_cast<unsigned char>(*p);
-    if (c >= 0x20 && c < 0x7f) {
-      text += *p;
-    } else {
-      static const char kHex[] = "0123456789abcdef";
-      text += "\\x";
-      text += kHex[c >> 4];
-      text += kHex[c & 15];
-    }
-  }
-  if (static_cast<size_t>(end - begin) > kMax) text += "...";
-  return text;
+  return printableExcerpt(std::string_view(begin, static_cast<size_t>(end - begin)));
 }
 
 // True when the decimal mantissa in [begin, end) has a non-zero digit: a value that parses to

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/input_file.h"
+#include "core/text.h"
 
 namespace dpoint {
 
@@ -100,12 +101,7 @@ bool parseAscii(Type t, std::string_view token, double& out) {
   return true;
 }
 
-// Bad text goes into a one-line message: short, printable.
-std::string quote(std::string_view text) {
-  std::string s = "'";
-  for (char c : text.substr(0, 40)) s += (c >= 32 && c < 127) ? c : '?';
-  return s + (text.size() > 40 ? "...'" : "'");
-}
+std::string quote(std::string_view text) { return "'" + printableExcerpt(text) + "'"; }
 
 std::string numberText(double v) {
   char buf[32];
