@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
@@ -41,30 +42,6 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
 }
 
 // "a,b,c" → exactly `count` finite doubles; the error names the flag and the text.
-Result<std::vector<double>> parseNumbers(const std::string& flag, const std::string& text, size_t count) {
-  std::vector<double> values;
-  const char* p = text.data();
-  const char* end = p + text.size();
-  while (true) {
-    double v = 0.0;
-    while (p < end && *p == ' ') ++p;
-    if (p < end && *p == '+') ++p;
-    auto r = std::from_chars(p, end, v);
-    if (r.ec != std::errc() || !std::isfinite(v)) break;
-    values.push_back(v);
-    p = r.ptr;
-    while (p < end && *p == ' ') ++p;
-    if (p == end) {
-      if (values.size() == count) return values;
-      break;
-    }
-    if (*p != ',') break;
-    ++p;
-  }
-  return Error{flag + ": '" + text + "' is not " + std::to_string(count) + " comma-separated finite numbers",
-               ExitCode::kUsage};
-}
-
 Status parseBounds(const std::string& text, double& lo, double& hi) {
   Result<std::vector<double>> bounds = parseNumbers("--bounds", text, 2);
   if (!bounds) return bounds.error();

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/info.h"
@@ -19,31 +20,9 @@ struct InfoOptions {
   CommonOptions common;
 };
 
-// Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
-std::string num(double v, bool json = false) {
-  if (json && !std::isfinite(v)) return "null";
-  char text[32];
-  auto r = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, r.ptr);
-}
-
+std::string num(double v, bool json = false) { return formatNumber(v, json); }
 std::string vec(const glm::dvec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
 std::string jsonVec(const glm::dvec3& v) { return "[" + num(v.x, true) + ", " + num(v.y, true) + ", " + num(v.z, true) + "]"; }
-
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\u%04x", c);
-      out += esc;
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
-}
 
 void printText(const std::string& path, const PointSetInfo& i) {
   std::printf("file:               %s\n", path.c_str());

@@ -16,6 +16,8 @@ void addInfoCommand(CLI::App& app, RunCommand& run);
 void addConvertCommand(CLI::App& app, RunCommand& run);
 void addGenerateCommand(CLI::App& app, RunCommand& run);
 void addBenchCommand(CLI::App& app, RunCommand& run);
+void addRenderCommand(CLI::App& app, RunCommand& run);
+void addDevicesCommand(CLI::App& app, RunCommand& run);
 
 // Prints "dpoint: error: <message>" on stderr and returns the error's exit code.
 int reportError(const Error& error);

@@ -23,7 +23,8 @@ void addCommonOptions(CLI::App& command, CommonOptions& options) {
 int main(int argc, char** argv) {
   using namespace dpoint;
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
-               "CSV, PLY and GLB, and inspect the precision a dataset needs.\n"
+               "CSV, PLY and GLB, render them offscreen with Vulkan in six precision modes, and inspect the\n"
+               "precision a dataset needs.\n"
                "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit.",
                "dpoint"};
   app.set_version_flag("--version", "dpoint " DPOINT_VERSION);
@@ -31,7 +32,9 @@ int main(int argc, char** argv) {
   RunCommand run;
   addGenerateCommand(app, run);
   addConvertCommand(app, run);
+  addRenderCommand(app, run);
   addInfoCommand(app, run);
+  addDevicesCommand(app, run);
   addBenchCommand(app, run);
   try {
     app.parse(argc, argv);

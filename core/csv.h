@@ -1,4 +1,4 @@
-// CSV point files: `x,y,z,r,g,b`, `x,y,z` or `x,y` (z = 0), with or without a header.
+// CSV point files: `x,y,z,r,g,b`, `x,y,z`, `x,y,r,g,b` or `x,y` (z = 0), with or without a header.
 //
 // Reading: LF or CRLF line ends, an optional UTF-8 BOM, spaces or tabs around fields, blank lines
 // skipped. Numbers are parsed correctly rounded (fast_float): positions to double, colours to

@@ -27,7 +27,20 @@ constexpr size_t kBlockSize = 8u << 20;
 // longer is not a point row (and would otherwise make a block read unbounded).
 constexpr size_t kMaxLineLength = 64u << 10;
 
-enum class Layout { kXy = 2, kXyz = 3, kXyzRgb = 6 };
+// The value is the column count. 2D files written with colours have `x,y,r,g,b` (the writer's
+// planar form), so that layout is read too.
+enum class Layout { kXy = 2, kXyz = 3, kXyRgb = 5, kXyzRgb = 6 };
+int positionColumns(Layout layout) { return layout == Layout::kXy || layout == Layout::kXyRgb ? 2 : 3; }
+bool hasColorColumns(Layout layout) { return layout == Layout::kXyRgb || layout == Layout::kXyzRgb; }
+const char* layoutText(Layout layout) {
+  switch (layout) {
+    case Layout::kXy: return "x,y";
+    case Layout::kXyz: return "x,y,z";
+    case Layout::kXyRgb: return "x,y,r,g,b";
+    case Layout::kXyzRgb: return "x,y,z,r,g,b";
+  }
+  return "";
+}
 
 bool isBlank(char c) { return c == ' ' || c == '\t'; }
 
@@ -58,7 +71,8 @@ struct LineError {
 class LineParser {
  public:
   LineParser(const std::string& path, Layout layout, bool allow_nonfinite)
-      : path_(path), columns_(static_cast<int>(layout)), allow_nonfinite_(allow_nonfinite) {}
+      : path_(path), layout_(layout), columns_(static_cast<int>(layout)), position_columns_(positionColumns(layout)),
+        allow_nonfinite_(allow_nonfinite) {}
 
   // Parses one line (without its line end, '\r' already removed). Returns false on error.
   bool parse(const char* begin, const char* end, uint64_t line, glm::dvec3& position, glm::vec3& color,
@@ -83,8 +97,9 @@ class LineParser {
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
       }
-      bool ok = column <= 3 ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
-                            : parseNumber(number_begin, number_end, colors[column - 4], line, column, error);
+      bool ok = column <= position_columns_
+                    ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
+                    : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error);
       if (!ok) return false;
       p = field_end;
       if (p == end) break;
@@ -104,8 +119,7 @@ class LineParser {
 
   std::string countMessage(const char* begin, const char* end) const {
     size_t commas = static_cast<size_t>(std::count(begin, end, ','));
-    return std::to_string(commas + 1) + " columns, expected " + std::to_string(columns_) +
-           (columns_ == 2 ? " (x,y)" : columns_ == 3 ? " (x,y,z)" : " (x,y,z,r,g,b)");
+    return std::to_string(commas + 1) + " columns, expected " + std::to_string(columns_) + " (" + layoutText(layout_) + ")";
   }
 
   template <typename T>
@@ -131,7 +145,9 @@ class LineParser {
   }
 
   const std::string& path_;
+  Layout layout_;
   int columns_;
+  int position_columns_;
   bool allow_nonfinite_;
 };
 
@@ -162,20 +178,21 @@ bool isHeaderLine(const std::vector<std::string>& fields) {
 
 Result<Layout> layoutFromHeader(const std::string& path, const std::vector<std::string>& fields,
                                 uint64_t line, std::string_view text) {
-  static const std::vector<std::string> kXy{"x", "y"}, kXyz{"x", "y", "z"}, kXyzRgb{"x", "y", "z", "r", "g", "b"};
-  if (fields == kXy) return Layout::kXy;
-  if (fields == kXyz) return Layout::kXyz;
-  if (fields == kXyzRgb) return Layout::kXyzRgb;
+  std::string joined;
+  for (const std::string& f : fields) joined += (joined.empty() ? "" : ",") + f;
+  for (Layout layout : {Layout::kXy, Layout::kXyz, Layout::kXyRgb, Layout::kXyzRgb})
+    if (joined == layoutText(layout)) return layout;
   return Error{path + ":" + std::to_string(line) + ": header '" + excerpt(text.data(), text.data() + text.size()) +
-               "' is not one of x,y | x,y,z | x,y,z,r,g,b"};
+               "' is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b"};
 }
 
 Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line) {
   if (columns == 2) return Layout::kXy;
   if (columns == 3) return Layout::kXyz;
+  if (columns == 5) return Layout::kXyRgb;
   if (columns == 6) return Layout::kXyzRgb;
   return Error{path + ":" + std::to_string(line) + ": " + std::to_string(columns) +
-               " columns without a header; expected 2 (x,y), 3 (x,y,z) or 6 (x,y,z,r,g,b)"};
+               " columns without a header; expected 2 (x,y), 3 (x,y,z), 5 (x,y,r,g,b) or 6 (x,y,z,r,g,b)"};
 }
 
 struct Header {
@@ -281,11 +298,11 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options)
   const Layout layout = header.layout;
   PointSet points;
   points.positions.resize(lines);
-  if (layout == Layout::kXyzRgb) points.colors.resize(lines);
+  if (hasColorColumns(layout)) points.colors.resize(lines);
 
   // Pass 2: parse. The first error by line number wins, whatever the thread count.
   const LineParser parser(path, layout, options.allow_nonfinite);
-  const bool has_colors = layout == Layout::kXyzRgb;
+  const bool has_colors = hasColorColumns(layout);
   std::mutex error_mutex;
   std::optional<LineError> first_error;
   std::atomic<uint64_t> error_line{UINT64_MAX};

@@ -145,6 +145,25 @@ TEST(Csv, writesPlanarSetsAsXy) {
   EXPECT_EQ(readFile(dir.file("b.csv")), "x,y,z\n1,2,0\n3,4,-0\n");
 }
 
+// 2D sets with colours are written `x,y,r,g,b` and must read back (the mandelbrot2d output).
+TEST(Csv, planarColouredSetsRoundTripAsXyRgb) {
+  TempDir dir;
+  PointSet s;
+  s.positions = {{-0.7436450000001, 0.1318259, 0}, {3, 4, 0}};
+  s.colors = {{0.25f, 0.5f, 1.0f}, {0.0f, 0.125f, 0.75f}};
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), s).ok());
+  EXPECT_EQ(readFile(dir.file("a.csv")).substr(0, 10), "x,y,r,g,b\n");
+  Result<PointSet> back = readCsv(dir.file("a.csv"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->positions, s.positions);
+  EXPECT_EQ(back->colors, s.colors);
+  EXPECT_TRUE(back->isPlanar());
+  writeFile(dir.file("b.csv"), "1,2,0.5,0.5,0.5\n3,4,0,0,1\n");  // no header: five columns
+  Result<PointSet> headless = readCsv(dir.file("b.csv"));
+  ASSERT_TRUE(headless.ok()) << headless.error().message;
+  EXPECT_EQ(headless->colors[1], glm::vec3(0, 0, 1));
+}
+
 // A failing read returns an Error whose message contains every expected part.
 void expectReadError(const std::string& path, const std::vector<std::string>& parts, bool allow_nonfinite = false) {
   Result<PointSet> r = readCsv(path, CsvReadOptions{0, allow_nonfinite, nullptr});

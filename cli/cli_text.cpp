@@ -1,0 +1,63 @@
+#include "cli/cli_text.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+namespace dpoint {
+
+Result<std::vector<double>> parseNumbers(const std::string& flag, const std::string& text, size_t min_count,
+                                         size_t max_count) {
+  std::vector<double> values;
+  const char* p = text.data();
+  const char* end = p + text.size();
+  while (true) {
+    double v = 0.0;
+    while (p < end && *p == ' ') ++p;
+    if (p < end && *p == '+') ++p;
+    auto r = std::from_chars(p, end, v);
+    if (r.ec != std::errc() || !std::isfinite(v)) break;
+    values.push_back(v);
+    p = r.ptr;
+    while (p < end && *p == ' ') ++p;
+    if (p == end) {
+      if (values.size() >= min_count && values.size() <= max_count) return values;
+      break;
+    }
+    if (*p != ',') break;
+    ++p;
+  }
+  std::string count = min_count == max_count ? std::to_string(min_count)
+                                             : std::to_string(min_count) + " to " + std::to_string(max_count);
+  return Error{flag + ": '" + text + "' is not " + count + " comma-separated finite numbers", ExitCode::kUsage};
+}
+
+Result<glm::dvec3> parseVec3(const std::string& flag, const std::string& text) {
+  Result<std::vector<double>> v = parseNumbers(flag, text, 3);
+  if (!v) return v.error();
+  return glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
+}
+
+std::string formatNumber(double v, bool json) {
+  if (json && !std::isfinite(v)) return "null";
+  char text[32];
+  auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\u%04x", c);
+      out += esc;
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace dpoint

@@ -1,0 +1,276 @@
+#include "viewer/camera.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "viewer/reference.h"
+
+namespace dpoint {
+namespace {
+
+std::vector<glm::dvec3> cornersOf(const Bounds& b) {
+  std::vector<glm::dvec3> out;
+  for (int i = 0; i < 8; ++i) {
+    out.push_back({(i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z});
+  }
+  return out;
+}
+
+Camera make(const CameraSpec& spec, const Bounds& bounds) {
+  Result<Camera> camera = makeCamera(spec, bounds);
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return camera.ok() ? camera.value() : Camera{};
+}
+
+WindowPoint project(const Camera& camera, const glm::dvec3& p) { return projectReference({p}, camera)[0]; }
+
+bool allFinite(const glm::dmat4& m) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) return false;
+    }
+  }
+  return true;
+}
+
+void expectUsable(const Camera& camera) {
+  EXPECT_TRUE(allFinite(camera.rotation));
+  EXPECT_TRUE(allFinite(camera.projection));
+  EXPECT_TRUE(std::isfinite(camera.near_plane) && std::isfinite(camera.far_plane));
+  EXPECT_LT(camera.near_plane, camera.far_plane);
+  if (!camera.ortho) {
+    EXPECT_GT(camera.near_plane, 0.0);
+  }
+}
+
+// Every corner inside the viewport with depth in [0, 1], and the box not lost in a corner of it:
+// its projection spans at least `min_fill` of the width or of the height.
+void expectFramed(const Camera& camera, const Bounds& bounds, double min_fill) {
+  expectUsable(camera);
+  double lo_x = HUGE_VAL, hi_x = -HUGE_VAL, lo_y = HUGE_VAL, hi_y = -HUGE_VAL;
+  for (const WindowPoint& w : projectReference(cornersOf(bounds), camera)) {
+    ASSERT_TRUE(w.visible);
+    EXPECT_GE(w.depth, 0.0);
+    EXPECT_LE(w.depth, 1.0);
+    lo_x = std::min(lo_x, w.x), hi_x = std::max(hi_x, w.x);
+    lo_y = std::min(lo_y, w.y), hi_y = std::max(hi_y, w.y);
+  }
+  EXPECT_GE(std::max((hi_x - lo_x) / camera.width, (hi_y - lo_y) / camera.height), min_fill);
+}
+
+TEST(Camera, fitFramesTheBoundingBox) {
+  const std::vector<Bounds> boxes = {
+      {{-1, -1, -1}, {1, 1, 1}},
+      {{-5, 20, 0.5}, {100, 22, 0.75}},
+      {{0, 0, -300}, {1, 1, 300}},
+      {{6.378e6, 6.378e6, 6.378e6}, {6.378e6 + 0.01, 6.378e6 + 0.01, 6.378e6 + 0.01}},
+      {{6.378e6, -2.0, 1e-3}, {6.378e6 + 0.01, -1.99, 1e-3 + 0.01}},
+  };
+  const std::array<std::array<uint32_t, 2>, 3> viewports = {{{1024, 768}, {300, 1000}, {1, 1}}};
+  for (const Bounds& bounds : boxes) {
+    for (const auto& [width, height] : viewports) {
+      SCOPED_TRACE(std::to_string(bounds.min.x) + " " + std::to_string(width) + "x" + std::to_string(height));
+      CameraSpec spec;
+      spec.width = width, spec.height = height;
+      const Camera camera = make(spec, bounds);
+      EXPECT_FALSE(camera.ortho);
+      expectFramed(camera, bounds, 0.3);
+    }
+  }
+}
+
+TEST(Camera, fitOfOnePointLooksAtIt) {
+  for (const glm::dvec3 p : {glm::dvec3(0.0), glm::dvec3(6.378e6, 1.0, -3.0), glm::dvec3(-0.7, 0.13, 0.0)}) {
+    for (bool planar : {false, true}) {
+      const Bounds bounds{p, p, planar && p.z == 0.0};
+      const Camera camera = make(CameraSpec{}, bounds);
+      expectUsable(camera);
+      EXPECT_NE(camera.eye, p);
+      const WindowPoint w = project(camera, p);
+      ASSERT_TRUE(w.visible);
+      EXPECT_NEAR(w.x, 512.0, 1e-6);
+      EXPECT_NEAR(w.y, 384.0, 1e-6);
+    }
+  }
+}
+
+TEST(Camera, fit2DIsOrthographicStraightDownWithASmallMargin) {
+  const Bounds bounds{{-2, -1, 0}, {2, 1, 0}, true};
+  const Camera camera = make(CameraSpec{}, bounds);
+  EXPECT_TRUE(camera.ortho);
+  EXPECT_EQ(camera.rotation, glm::dmat4(1.0));
+  expectFramed(camera, bounds, 0.9);
+  // x spans the width less the 2% margin; +y is up on screen (smaller window y).
+  EXPECT_NEAR(project(camera, {2, 0, 0}).x - project(camera, {-2, 0, 0}).x, 1024.0 / 1.02, 1e-9);
+  EXPECT_LT(project(camera, {0, 1, 0}).y, project(camera, {0, -1, 0}).y);
+  EXPECT_NEAR(project(camera, {0, 0, 0}).x, 512.0, 1e-9);
+}
+
+TEST(Camera, fitPerspectiveOn2DDataLooksStraightDown) {
+  const Bounds bounds{{10, 20, 0}, {14, 21, 0}, true};
+  CameraSpec spec;
+  spec.ortho = false;
+  const Camera camera = make(spec, bounds);
+  EXPECT_FALSE(camera.ortho);
+  expectFramed(camera, bounds, 0.9);
+  EXPECT_DOUBLE_EQ(camera.eye.x, 12.0);
+  EXPECT_DOUBLE_EQ(camera.eye.y, 20.5);
+  EXPECT_GT(camera.eye.z, 0.0);
+}
+
+TEST(Camera, lookAtPutsTheTargetAtTheViewportCentre) {
+  CameraSpec spec;
+  spec.eye = glm::dvec3(10, 5, 3), spec.target = glm::dvec3(1, 2, -4), spec.up = glm::dvec3(0, 0, 1);
+  const Bounds bounds{{-5, -5, -5}, {5, 5, 5}};
+  const Camera camera = make(spec, bounds);
+  expectUsable(camera);
+  const WindowPoint centre = project(camera, *spec.target);
+  ASSERT_TRUE(centre.visible);
+  EXPECT_NEAR(centre.x, 512.0, 1e-9);
+  EXPECT_NEAR(centre.y, 384.0, 1e-9);
+  // Up in the world is up on screen (y down), and right = forward × up is right on screen.
+  const glm::dvec3 forward = glm::normalize(*spec.target - *spec.eye);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, *spec.up));
+  EXPECT_LT(project(camera, *spec.target + 0.5 * *spec.up).y, 384.0);
+  EXPECT_GT(project(camera, *spec.target + 0.5 * right).x, 512.0);
+  // Look-at does not frame the box, but near and far still enclose it.
+  for (const glm::dvec3& corner : cornersOf(bounds)) {
+    const glm::dvec4 clip = camera.viewProjection() * glm::dvec4(corner, 1.0);
+    EXPECT_GT(clip.w, 0.0);
+    EXPECT_GE(clip.z / clip.w, 0.0);
+    EXPECT_LE(clip.z / clip.w, 1.0);
+  }
+}
+
+TEST(Camera, pointsBehindOrAtTheEyeAreInvisibleAndFinite) {
+  CameraSpec spec;
+  spec.eye = glm::dvec3(0.5, 0.5, 0.5), spec.target = glm::dvec3(0.5, 0.5, -1), spec.up = glm::dvec3(0, 1, 0);
+  const Bounds bounds{{0, 0, 0}, {1, 1, 1}};  // the eye is inside the box
+  const Camera camera = make(spec, bounds);
+  expectUsable(camera);
+  const std::vector<glm::dvec3> points = {*spec.eye, *spec.eye + glm::dvec3(0, 0, 0.25),
+                                          *spec.eye + glm::dvec3(0.1, 0.2, 1e-3),
+                                          *spec.eye + glm::dvec3(0, 0, -1e-9)};  // in front, nearer than near
+  for (const WindowPoint& w : projectReference(points, camera)) {
+    EXPECT_FALSE(w.visible);
+    EXPECT_EQ(w.x, 0.0);
+    EXPECT_EQ(w.y, 0.0);
+    EXPECT_EQ(w.depth, 0.0);
+  }
+  // The box in front of the eye is still seen.
+  EXPECT_TRUE(project(camera, {0.5, 0.5, 0.0}).visible);
+}
+
+TEST(Camera, reversedZGivesTheNearerPointTheGreaterDepth) {
+  for (bool ortho : {false, true}) {
+    CameraSpec spec;
+    spec.eye = glm::dvec3(0, 0, 10), spec.target = glm::dvec3(0, 0, 0), spec.up = glm::dvec3(0, 1, 0);
+    spec.ortho = ortho;
+    const Camera camera = make(spec, {{-1, -1, -1}, {1, 1, 1}});
+    const WindowPoint nearer = project(camera, {0.1, 0.1, 0.5});
+    const WindowPoint farther = project(camera, {0.1, 0.1, -0.5});
+    ASSERT_TRUE(nearer.visible && farther.visible);
+    EXPECT_GT(nearer.depth, farther.depth) << "ortho " << ortho;
+    // The planes themselves map to 1 (near) and 0 (far).
+    EXPECT_NEAR(project(camera, {0, 0, 10 - camera.near_plane}).depth, 1.0, 1e-12);
+    EXPECT_NEAR(project(camera, {0, 0, 10 - camera.far_plane}).depth, 0.0, 1e-12);
+  }
+}
+
+// The deep-zoom hard case: a 1e-9 wide window at the Mandelbrot seahorse valley, 1024 px wide, so
+// a pixel is ~1e-12 against coordinates ~0.74 (float resolves 6e-8 there). The exact window x of
+// a double input p is 512 + (p − cx)·1024/w (p − cx is exact); the projection must hit it within
+// 1e-6 px, and points placed at pixel centres (up to the ~6e-5 px rounding of p) land on their pixel.
+TEST(Camera, orthoDeepZoomPutsPixelCentresAtHalfPixels) {
+  const double cx = -0.7436450, cy = 0.1318259, view_width = 1e-9;
+  CameraSpec spec;
+  spec.ortho = true, spec.view_center = glm::dvec3(cx, cy, 0), spec.view_width = view_width;
+  const Bounds bounds{{cx - 1e-9, cy - 1e-9, 0}, {cx + 1e-9, cy + 1e-9, 0}, true};
+  const Camera camera = make(spec, bounds);
+  ASSERT_TRUE(camera.ortho);
+  const double pixel = view_width / 1024;
+  std::vector<glm::dvec3> points;
+  std::vector<int> columns, rows;
+  for (int k = -512; k < 512; ++k) {
+    const int j = (k * 7 + 100000) % 768 - 384;  // rows spread over the whole height
+    points.push_back({cx + (k + 0.5) * pixel, cy - (j + 0.5) * pixel, 0.0});
+    columns.push_back(512 + k), rows.push_back(384 + j);
+  }
+  const std::vector<WindowPoint> window = projectReference(points, camera);
+  for (size_t i = 0; i < points.size(); ++i) {
+    ASSERT_TRUE(window[i].visible) << i;
+    const long double exact_x = 512.0L + (long double)(points[i].x - cx) * 1024.0L / (long double)view_width;
+    const long double exact_y = 384.0L - (long double)(points[i].y - cy) * 1024.0L / (long double)view_width;
+    EXPECT_NEAR(window[i].x, double(exact_x), 1e-6) << i;
+    EXPECT_NEAR(window[i].y, double(exact_y), 1e-6) << i;
+    EXPECT_NEAR(window[i].x, columns[i] + 0.5, 1e-3) << i;
+    EXPECT_NEAR(window[i].y, rows[i] + 0.5, 1e-3) << i;
+    EXPECT_EQ(int(std::floor(window[i].x)), columns[i]);
+    EXPECT_EQ(int(std::floor(window[i].y)), rows[i]);
+  }
+}
+
+TEST(Camera, viewWidthOverridesThePerspectiveFitWindow) {
+  CameraSpec spec;
+  spec.view_center = glm::dvec3(3, 4, 5), spec.view_width = 2.0;
+  const Camera camera = make(spec, {{0, 0, 0}, {10, 10, 10}});
+  EXPECT_FALSE(camera.ortho);
+  const glm::dvec3 right(camera.rotation[0][0], camera.rotation[1][0], camera.rotation[2][0]);
+  EXPECT_NEAR(project(camera, *spec.view_center).x, 512.0, 1e-9);
+  // The window is 2 wide at the target: half of it to the right is the right edge.
+  EXPECT_NEAR(project(camera, *spec.view_center + 0.5 * right).x, 768.0, 1e-9);
+}
+
+TEST(Camera, viewIsRotationAfterTranslationAndViewProjectionMatchesTheReference) {
+  const Camera camera = make(CameraSpec{}, {{1, 2, 3}, {4, 5, 7}});
+  const glm::dvec4 at_eye = camera.view() * glm::dvec4(camera.eye, 1.0);
+  EXPECT_NEAR(glm::length(glm::dvec3(at_eye)), 0.0, 1e-12);
+  const glm::dvec3 p(2, 3, 4);
+  const glm::dvec4 clip = camera.viewProjection() * glm::dvec4(p, 1.0);
+  const WindowPoint w = project(camera, p);
+  EXPECT_NEAR((clip.x / clip.w * 0.5 + 0.5) * camera.width, w.x, 1e-9);
+  EXPECT_NEAR((clip.y / clip.w * 0.5 + 0.5) * camera.height, w.y, 1e-9);
+  EXPECT_NEAR(clip.z / clip.w, w.depth, 1e-12);
+}
+
+void expectUsageError(const CameraSpec& spec, const std::string& needle) {
+  Result<Camera> camera = makeCamera(spec, {{0, 0, 0}, {1, 1, 1}});
+  ASSERT_FALSE(camera.ok()) << needle;
+  EXPECT_EQ(camera.error().code, ExitCode::kUsage);
+  EXPECT_NE(camera.error().message.find(needle), std::string::npos) << camera.error().message;
+}
+
+TEST(Camera, rejectsBadOptionsNamingThem) {
+  CameraSpec spec;
+  spec.height = 0;
+  expectUsageError(spec, "--width and --height must be positive, got 1024x0");
+  for (double fov : {0.0, 180.0, -10.0, double(NAN)}) {
+    spec = {};
+    spec.fov_degrees = fov;
+    expectUsageError(spec, "--fov must be in (0, 180)");
+  }
+  for (double width : {0.0, -1.0, double(INFINITY), double(NAN)}) {
+    spec = {};
+    spec.view_width = width;
+    expectUsageError(spec, "--view-width must be positive and finite");
+  }
+  spec = {};
+  spec.eye = glm::dvec3(1, 2, 3), spec.target = glm::dvec3(1, 2, 3), spec.up = glm::dvec3(0, 1, 0);
+  expectUsageError(spec, "--eye and --target are the same point (1, 2, 3)");
+  spec.target = glm::dvec3(1, 5, 3);
+  expectUsageError(spec, "--up (0, 1, 0) is parallel to the view direction");
+  spec.up = glm::dvec3(0, 0, 0);
+  expectUsageError(spec, "--up must be a finite non-zero vector");
+  spec.up.reset();
+  expectUsageError(spec, "missing --up");
+  spec = {};
+  spec.eye = glm::dvec3(NAN, 0, 0), spec.target = glm::dvec3(0, 0, 0), spec.up = glm::dvec3(0, 1, 0);
+  expectUsageError(spec, "--eye must be finite");
+}
+
+}  // namespace
+}  // namespace dpoint

@@ -1,0 +1,48 @@
+// Buffers and images as plain structs with create/destroy pairs (one allocation each: a render
+// holds a handful of them, so a sub-allocator would buy nothing), and one-shot command submission.
+#pragma once
+
+#include <functional>
+
+#include "viewer/context.h"
+
+namespace dpoint {
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  void* mapped = nullptr;  // set when the memory is host-visible (mapped for the buffer's life)
+  bool coherent = false;
+};
+
+// Device-local when `host_visible` is false (filled through uploadBuffer), else host-visible
+// and mapped (cached preferred, for readback). Fails naming `what` and the size.
+Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                            bool host_visible, const std::string& what);
+void destroyBuffer(const VulkanContext& context, Buffer& buffer);
+
+// Makes device writes visible to the host for a mapped, non-coherent buffer.
+Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
+
+// Records with `record` into a fresh primary command buffer, submits it, waits.
+Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record);
+
+// Fills `size` bytes at the start of `target` (usage must include TRANSFER_DST) through `fill`,
+// writing into mapped memory directly when the target is host-visible, else through a staging
+// buffer of at most `staging_limit` bytes, in pieces; `fill(dst, offset, bytes)` writes
+// bytes [offset, offset + bytes) of the contents.
+Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size,
+                    const std::function<void(void* dst, VkDeviceSize offset, VkDeviceSize bytes)>& fill,
+                    VkDeviceSize staging_limit = 64u << 20);
+
+struct GpuImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+};
+Result<GpuImage> createImage(const VulkanContext& context, uint32_t width, uint32_t height, VkFormat format,
+                          VkImageUsageFlags usage, VkImageAspectFlags aspect);
+void destroyImage(const VulkanContext& context, GpuImage& image);
+
+}  // namespace dpoint

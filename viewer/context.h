@@ -1,0 +1,91 @@
+// Headless Vulkan 1.2 setup (DESIGN §4): instance (with the Khronos validation layer on request),
+// the choice of physical device, one graphics queue, and the facts each precision mode needs.
+// No window, no surface.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "core/result.h"
+
+namespace dpoint {
+
+struct DeviceFacts {
+  uint32_t index = 0;  // position in vkEnumeratePhysicalDevices
+  std::string name, type;  // type: discrete, integrated, virtual, cpu, other
+  uint32_t vendor_id = 0, device_id = 0;
+  uint32_t api_version = 0, driver_version = 0;
+  std::string driver_name, driver_info;  // VkPhysicalDeviceDriverProperties
+  bool shader_float64 = false;     // native mode
+  bool vertex_stores = false;      // vertexPipelineStoresAndAtomics: the probe
+  bool large_points = false;       // --point-size > 1
+  bool r64g64b64_vertex = false;   // native mode reads double vertex attributes (else pulls)
+  uint64_t max_storage_buffer_range = 0, max_memory_allocation = 0;
+  float max_point_size = 1.0f;
+  float timestamp_period_ns = 0.0f;  // 0: no timestamps on the graphics queue
+  uint32_t queue_family = 0;
+  bool has_graphics_queue = false;
+  bool vulkan12 = false;  // apiVersion ≥ 1.2
+};
+
+// "1.3.239", and the driver version decoded as the vendor writes it (NVIDIA: 10.8.8.6 bits).
+std::string formatApiVersion(uint32_t version);
+std::string formatDriverVersion(uint32_t vendor_id, uint32_t version);
+
+struct ContextOptions {
+  std::string device = "auto";  // auto (a discrete GPU if any, else the best other), cpu, or an index
+  bool validate = false;        // enable VK_LAYER_KHRONOS_validation and collect its messages
+};
+
+class VulkanContext {
+ public:
+  // Fails with kNoDevice (naming what is missing) when there is no Vulkan loader or driver, no
+  // device matching `device`, or the chosen device lacks Vulkan 1.2 or a graphics queue.
+  static Result<std::unique_ptr<VulkanContext>> create(const ContextOptions& options);
+  ~VulkanContext();
+  VulkanContext(const VulkanContext&) = delete;
+  VulkanContext& operator=(const VulkanContext&) = delete;
+
+  // Index of a memory type allowed by `type_bits` that has all of `required`; prefers one that
+  // also has `preferred`. Fails (no silent type 0) when none has `required`.
+  Result<uint32_t> memoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
+                              VkMemoryPropertyFlags preferred = 0) const;
+
+  // Validation messages (warnings and errors) seen so far, one line each.
+  const std::vector<std::string>& validationMessages() const { return messages_; }
+
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkCommandPool command_pool = VK_NULL_HANDLE;
+  DeviceFacts facts;
+  VkPhysicalDeviceMemoryProperties memory{};
+
+ private:
+  VulkanContext() = default;
+  static VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                 VkDebugUtilsMessageTypeFlagsEXT types,
+                                                 const VkDebugUtilsMessengerCallbackDataEXT* data, void* self);
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  std::vector<std::string> messages_;
+};
+
+// Every physical device the loader reports, with its facts (creates and destroys an instance).
+Result<std::vector<DeviceFacts>> listDevices();
+
+// Error for a failed Vulkan call: out-of-memory results map to kResourceLimit, others to kNoDevice.
+Error vulkanError(const std::string& what, VkResult result);
+const char* vkResultName(VkResult result);
+
+}  // namespace dpoint
+
+// Every VkResult is checked: in a function returning Result/Status, returns the error naming the call.
+#define VK_TRY(call)                                                      \
+  do {                                                                    \
+    VkResult vk_try_result_ = (call);                                     \
+    if (vk_try_result_ != VK_SUCCESS) return ::dpoint::vulkanError(#call, vk_try_result_); \
+  } while (0)

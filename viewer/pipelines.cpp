@@ -1,0 +1,244 @@
+#include "viewer/pipelines.h"
+
+#include "shaders/points_batch.vert.h"
+#include "shaders/points_df64.vert.h"
+#include "shaders/points_fp32.vert.h"
+#include "shaders/points_native_attr.vert.h"
+#include "shaders/points_native_pull.vert.h"
+#include "shaders/points_rte.vert.h"
+#include "shaders/points_split.vert.h"
+#include "shaders/points.frag.h"
+
+namespace dpoint {
+namespace {
+
+struct Spirv {
+  const uint32_t* code;
+  size_t bytes;
+};
+
+Spirv vertexShader(PrecisionMode mode, bool pull) {
+  switch (mode) {
+    case PrecisionMode::kFp32: return {kPointsFp32Vert, sizeof(kPointsFp32Vert)};
+    case PrecisionMode::kSplit: return {kPointsSplitVert, sizeof(kPointsSplitVert)};
+    case PrecisionMode::kRte: return {kPointsRteVert, sizeof(kPointsRteVert)};
+    case PrecisionMode::kDf64: return {kPointsDf64Vert, sizeof(kPointsDf64Vert)};
+    case PrecisionMode::kNative:
+      return pull ? Spirv{kPointsNativePullVert, sizeof(kPointsNativePullVert)}
+                  : Spirv{kPointsNativeAttrVert, sizeof(kPointsNativeAttrVert)};
+    case PrecisionMode::kBatch: return {kPointsBatchVert, sizeof(kPointsBatchVert)};
+  }
+  return {nullptr, 0};
+}
+
+Result<VkRenderPass> createRenderPass(const VulkanContext& context) {
+  VkAttachmentDescription attachments[2] = {};
+  attachments[0].format = kColorFormat;
+  attachments[0].samples = VK_SAMPLE_COUNT_1_BIT;
+  attachments[0].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  attachments[0].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+  attachments[0].stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+  attachments[0].stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  attachments[0].initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  attachments[0].finalLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  attachments[1] = attachments[0];
+  attachments[1].format = kDepthFormat;
+  attachments[1].storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  attachments[1].finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+  VkAttachmentReference color_ref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+  VkAttachmentReference depth_ref{1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+  VkSubpassDescription subpass{};
+  subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+  subpass.colorAttachmentCount = 1;
+  subpass.pColorAttachments = &color_ref;
+  subpass.pDepthStencilAttachment = &depth_ref;
+  // Frames follow one another on the same attachments, and the colour is copied out after.
+  VkSubpassDependency dependencies[2] = {};
+  dependencies[0].srcSubpass = VK_SUBPASS_EXTERNAL;
+  dependencies[0].dstSubpass = 0;
+  dependencies[0].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT |
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT;
+  dependencies[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT;
+  dependencies[0].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                                  VK_ACCESS_TRANSFER_READ_BIT;
+  dependencies[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                                  VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT;
+  dependencies[1].srcSubpass = 0;
+  dependencies[1].dstSubpass = VK_SUBPASS_EXTERNAL;
+  dependencies[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  dependencies[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  dependencies[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  dependencies[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  VkRenderPassCreateInfo info = {VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+  info.attachmentCount = 2;
+  info.pAttachments = attachments;
+  info.subpassCount = 1;
+  info.pSubpasses = &subpass;
+  info.dependencyCount = 2;
+  info.pDependencies = dependencies;
+  VkRenderPass render_pass = VK_NULL_HANDLE;
+  VK_TRY(vkCreateRenderPass(context.device, &info, nullptr, &render_pass));
+  return render_pass;
+}
+
+Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipelines& p, PrecisionMode mode, bool pull,
+                                  bool probe, uint32_t width, uint32_t height) {
+  Spirv vertex_code = vertexShader(mode, pull);
+  Result<VkShaderModule> vertex = createShaderModule(context, vertex_code.code, vertex_code.bytes);
+  if (!vertex) return vertex.error();
+  Result<VkShaderModule> fragment = createShaderModule(context, kPointsFrag, sizeof(kPointsFrag));
+  if (!fragment) {
+    vkDestroyShaderModule(context.device, *vertex, nullptr);
+    return fragment.error();
+  }
+  VkBool32 probe_value = probe ? VK_TRUE : VK_FALSE;
+  VkSpecializationMapEntry entry{0, 0, sizeof(VkBool32)};
+  VkSpecializationInfo specialization{1, &entry, sizeof(probe_value), &probe_value};
+  VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+                                               {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+  stages[0].module = *vertex;
+  stages[0].pName = "main";
+  stages[0].pSpecializationInfo = &specialization;
+  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+  stages[1].module = *fragment;
+  stages[1].pName = "main";
+
+  // Binding 0: positions in the mode's layout; binding 1: RGBA8 colours (location 2).
+  std::vector<VkVertexInputBindingDescription> bindings;
+  std::vector<VkVertexInputAttributeDescription> attributes;
+  if (!p.pulls_positions) bindings.push_back({0, positionBytes(mode), VK_VERTEX_INPUT_RATE_VERTEX});
+  bindings.push_back({1, 4, VK_VERTEX_INPUT_RATE_VERTEX});
+  switch (mode) {
+    case PrecisionMode::kFp32:
+    case PrecisionMode::kBatch: attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}); break;
+    case PrecisionMode::kSplit:
+    case PrecisionMode::kRte:
+    case PrecisionMode::kDf64:
+      attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0});
+      attributes.push_back({1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12});
+      break;
+    case PrecisionMode::kNative:
+      if (!p.pulls_positions) attributes.push_back({0, 0, VK_FORMAT_R64G64B64_SFLOAT, 0});
+      break;
+  }
+  attributes.push_back({2, 1, VK_FORMAT_R8G8B8A8_UNORM, 0});
+  VkPipelineVertexInputStateCreateInfo vertex_input = {VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  vertex_input.vertexBindingDescriptionCount = static_cast<uint32_t>(bindings.size());
+  vertex_input.pVertexBindingDescriptions = bindings.data();
+  vertex_input.vertexAttributeDescriptionCount = static_cast<uint32_t>(attributes.size());
+  vertex_input.pVertexAttributeDescriptions = attributes.data();
+
+  VkPipelineInputAssemblyStateCreateInfo assembly = {VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  assembly.topology = VK_PRIMITIVE_TOPOLOGY_POINT_LIST;
+  VkViewport viewport{0.0f, 0.0f, static_cast<float>(width), static_cast<float>(height), 0.0f, 1.0f};
+  VkRect2D scissor{{0, 0}, {width, height}};
+  VkPipelineViewportStateCreateInfo viewport_state = {VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  viewport_state.viewportCount = 1;
+  viewport_state.pViewports = &viewport;
+  viewport_state.scissorCount = 1;
+  viewport_state.pScissors = &scissor;
+  VkPipelineRasterizationStateCreateInfo raster = {VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  raster.polygonMode = VK_POLYGON_MODE_FILL;
+  raster.cullMode = VK_CULL_MODE_NONE;
+  raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  raster.lineWidth = 1.0f;
+  VkPipelineMultisampleStateCreateInfo multisample = {VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  // Reversed Z: cleared to 0, nearer is greater; on a tie the point drawn first stays.
+  VkPipelineDepthStencilStateCreateInfo depth = {VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  depth.depthTestEnable = VK_TRUE;
+  depth.depthWriteEnable = VK_TRUE;
+  depth.depthCompareOp = VK_COMPARE_OP_GREATER;
+  VkPipelineColorBlendAttachmentState blend_attachment{};
+  blend_attachment.colorWriteMask =
+      VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  VkPipelineColorBlendStateCreateInfo blend = {VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  blend.attachmentCount = 1;
+  blend.pAttachments = &blend_attachment;
+
+  VkGraphicsPipelineCreateInfo info = {VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+  info.stageCount = 2;
+  info.pStages = stages;
+  info.pVertexInputState = &vertex_input;
+  info.pInputAssemblyState = &assembly;
+  info.pViewportState = &viewport_state;
+  info.pRasterizationState = &raster;
+  info.pMultisampleState = &multisample;
+  info.pDepthStencilState = &depth;
+  info.pColorBlendState = &blend;
+  info.layout = p.layout;
+  info.renderPass = p.render_pass;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkResult result = vkCreateGraphicsPipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(context.device, *vertex, nullptr);
+  vkDestroyShaderModule(context.device, *fragment, nullptr);
+  if (result != VK_SUCCESS)
+    return vulkanError("creating the " + std::string(modeName(mode)) + (probe ? " probe" : "") + " pipeline", result);
+  return pipeline;
+}
+
+}  // namespace
+
+Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes) {
+  VkShaderModuleCreateInfo info = {VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  info.codeSize = bytes;
+  info.pCode = code;
+  VkShaderModule module = VK_NULL_HANDLE;
+  VK_TRY(vkCreateShaderModule(context.device, &info, nullptr, &module));
+  return module;
+}
+
+Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
+                                            bool with_probe, uint32_t width, uint32_t height) {
+  PointPipelines p;
+  p.pulls_positions = mode == PrecisionMode::kNative && pull;
+  auto fail = [&](const Error& error) -> Result<PointPipelines> {
+    destroyPointPipelines(context, p);
+    return error;
+  };
+  Result<VkRenderPass> render_pass = createRenderPass(context);
+  if (!render_pass) return fail(render_pass.error());
+  p.render_pass = *render_pass;
+
+  VkDescriptorSetLayoutBinding bindings[4] = {
+      {kBindingCamera, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+      {kBindingPositions, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+      {kBindingBatches, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+      {kBindingProbe, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+  };
+  VkDescriptorSetLayoutCreateInfo set_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  set_info.bindingCount = 4;
+  set_info.pBindings = bindings;
+  VkResult result = vkCreateDescriptorSetLayout(context.device, &set_info, nullptr, &p.set_layout);
+  if (result != VK_SUCCESS) return fail(vulkanError("vkCreateDescriptorSetLayout", result));
+  VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)};
+  VkPipelineLayoutCreateInfo layout_info = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout_info.setLayoutCount = 1;
+  layout_info.pSetLayouts = &p.set_layout;
+  layout_info.pushConstantRangeCount = 1;
+  layout_info.pPushConstantRanges = &push;
+  result = vkCreatePipelineLayout(context.device, &layout_info, nullptr, &p.layout);
+  if (result != VK_SUCCESS) return fail(vulkanError("vkCreatePipelineLayout", result));
+
+  Result<VkPipeline> draw = createPipeline(context, p, mode, pull, false, width, height);
+  if (!draw) return fail(draw.error());
+  p.draw = *draw;
+  if (with_probe) {
+    Result<VkPipeline> probe = createPipeline(context, p, mode, pull, true, width, height);
+    if (!probe) return fail(probe.error());
+    p.probe = *probe;
+  }
+  return p;
+}
+
+void destroyPointPipelines(const VulkanContext& context, PointPipelines& p) {
+  if (p.probe) vkDestroyPipeline(context.device, p.probe, nullptr);
+  if (p.draw) vkDestroyPipeline(context.device, p.draw, nullptr);
+  if (p.layout) vkDestroyPipelineLayout(context.device, p.layout, nullptr);
+  if (p.set_layout) vkDestroyDescriptorSetLayout(context.device, p.set_layout, nullptr);
+  if (p.render_pass) vkDestroyRenderPass(context.device, p.render_pass, nullptr);
+  p = PointPipelines{};
+}
+
+}  // namespace dpoint

@@ -1,0 +1,43 @@
+// The graphics pipeline of the raster backend: render pass (RGBA8 colour + D32 depth, reversed Z),
+// and one pipeline per precision mode, built from the SPIR-V compiled at build time. The probe
+// pipeline is the same shader with the specialization constant kProbe on (DESIGN §5).
+#pragma once
+
+#include "viewer/context.h"
+#include "viewer/encode.h"
+
+namespace dpoint {
+
+inline constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
+inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+// Descriptor bindings shared by every mode (shaders/points.vert): 0 camera uniform,
+// 1 double positions (native mode pulling), 2 batch matrices, 3 probe output.
+inline constexpr uint32_t kBindingCamera = 0, kBindingPositions = 1, kBindingBatches = 2, kBindingProbe = 3;
+
+// Push constants of shaders/points.vert.
+struct PushConstants {
+  float splitter = 4097.0f;  // 2^12 + 1: Dekker's split of a 24-bit significand
+  float point_size = 1.0f;
+  uint32_t first_index = 0;  // index of the draw's first point in the whole set (batch mode)
+  uint32_t batch_size = kBatchSize;
+};
+
+struct PointPipelines {
+  VkRenderPass render_pass = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline draw = VK_NULL_HANDLE;
+  VkPipeline probe = VK_NULL_HANDLE;  // only when asked for
+  bool pulls_positions = false;       // native mode reads a storage buffer instead of vertex input
+};
+
+// `pull` selects vertex pulling for native mode (ignored by the other modes).
+Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
+                                            bool with_probe, uint32_t width, uint32_t height);
+void destroyPointPipelines(const VulkanContext& context, PointPipelines& pipelines);
+
+// Creates a shader module from SPIR-V words.
+Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);
+
+}  // namespace dpoint

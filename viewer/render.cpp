@@ -1,0 +1,408 @@
+#include "viewer/render.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "viewer/buffers.h"
+#include "viewer/pipelines.h"
+#include "viewer/selftest.h"
+
+namespace dpoint {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+struct Chunk {
+  size_t first = 0, count = 0;
+  Buffer positions, colors, probe;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+};
+
+// Everything one render creates, destroyed in reverse on every path out.
+struct Resources {
+  explicit Resources(const VulkanContext& c) : context(c) {}
+  ~Resources() {
+    VkDevice device = context.device;
+    vkDeviceWaitIdle(device);
+    if (fence) vkDestroyFence(device, fence, nullptr);
+    if (frame_commands) vkFreeCommandBuffers(device, context.command_pool, 1, &frame_commands);
+    if (queries) vkDestroyQueryPool(device, queries, nullptr);
+    if (framebuffer) vkDestroyFramebuffer(device, framebuffer, nullptr);
+    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
+    for (Chunk& chunk : chunks) {
+      destroyBuffer(context, chunk.positions);
+      destroyBuffer(context, chunk.colors);
+      destroyBuffer(context, chunk.probe);
+    }
+    destroyBuffer(context, camera);
+    destroyBuffer(context, batches);
+    destroyBuffer(context, dummy);
+    destroyBuffer(context, readback);
+    destroyImage(context, color);
+    destroyImage(context, depth);
+    destroyPointPipelines(context, pipelines);
+  }
+  const VulkanContext& context;
+  PointPipelines pipelines;
+  Buffer camera, batches, dummy, readback;
+  GpuImage color, depth;
+  VkFramebuffer framebuffer = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  VkCommandBuffer frame_commands = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  std::vector<Chunk> chunks;
+};
+
+// Points per draw: every per-chunk buffer must fit one allocation and, when read as a storage
+// buffer (pulled positions, probe output), one descriptor range.
+size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool pulled) {
+  uint64_t limit = uint64_t{1} << 30;
+  if (facts.max_memory_allocation) limit = std::min(limit, facts.max_memory_allocation);
+  uint64_t per_point = std::max<uint64_t>(positionBytes(options.mode), 4);
+  if (pulled || options.probe) {
+    limit = std::min(limit, facts.max_storage_buffer_range);
+    if (options.probe) per_point = std::max<uint64_t>(per_point, sizeof(glm::vec4));
+  }
+  uint64_t points = std::max<uint64_t>(1, limit / per_point);
+  if (options.max_chunk_points) points = std::min(points, options.max_chunk_points);
+  return static_cast<size_t>(points);
+}
+
+Status checkOptions(const VulkanContext& context, const PointSet& points, const RenderOptions& options) {
+  if (points.size() == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
+  if (points.size() > UINT32_MAX)
+    return Error{"more than 2^32 points (" + std::to_string(points.size()) + ") are not supported", ExitCode::kResourceLimit};
+  if (options.frames == 0) return Error{"--frames must be at least 1", ExitCode::kUsage};
+  const DeviceFacts& f = context.facts;
+  if (!(options.point_size >= 1.0f) || options.point_size > f.max_point_size)
+    return Error{"--point-size must be in [1, " + std::to_string(f.max_point_size) + "] on " + f.name,
+                 ExitCode::kUsage};
+  if (options.point_size != 1.0f && !f.large_points)
+    return Error{"--point-size above 1 needs the largePoints feature, which " + f.name + " lacks", ExitCode::kNoDevice};
+  if (options.mode == PrecisionMode::kNative && options.native_path == NativePath::kAttribute && !f.r64g64b64_vertex)
+    return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; native mode must pull positions",
+                 ExitCode::kNoDevice};
+  return okStatus();
+}
+
+void writeDescriptors(const VulkanContext& context, const Resources& r, const Chunk& chunk, bool pulled, bool probe) {
+  auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
+  VkDescriptorBufferInfo infos[4] = {
+      whole(r.camera),
+      pulled ? whole(chunk.positions) : whole(r.dummy),
+      r.batches.buffer ? whole(r.batches) : whole(r.dummy),
+      probe ? whole(chunk.probe) : whole(r.dummy),
+  };
+  VkWriteDescriptorSet writes[4];
+  for (uint32_t b = 0; b < 4; ++b) {
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = chunk.set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = b == kBindingCamera ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(context.device, 4, writes, 0, nullptr);
+}
+
+void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeline, const RenderOptions& options,
+                 uint32_t width, uint32_t height, bool timed) {
+  VkClearValue clears[2] = {};
+  for (int c = 0; c < 4; ++c)
+    clears[0].color.float32[c] = static_cast<float>((options.background_rgba8 >> (8 * c)) & 0xffu) / 255.0f;
+  clears[1].depthStencil = {0.0f, 0};  // reversed Z: 0 is the far plane
+  VkRenderPassBeginInfo begin = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+  begin.renderPass = r.pipelines.render_pass;
+  begin.framebuffer = r.framebuffer;
+  begin.renderArea = {{0, 0}, {width, height}};
+  begin.clearValueCount = 2;
+  begin.pClearValues = clears;
+  if (timed) vkCmdResetQueryPool(commands, r.queries, 0, 2);
+  vkCmdBeginRenderPass(commands, &begin, VK_SUBPASS_CONTENTS_INLINE);
+  if (timed) vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r.queries, 0);
+  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+  for (const Chunk& chunk : r.chunks) {
+    PushConstants push;
+    push.point_size = options.point_size;
+    push.first_index = static_cast<uint32_t>(chunk.first);
+    vkCmdPushConstants(commands, r.pipelines.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
+    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, r.pipelines.layout, 0, 1, &chunk.set, 0, nullptr);
+    VkDeviceSize offset = 0;
+    if (!r.pipelines.pulls_positions) vkCmdBindVertexBuffers(commands, 0, 1, &chunk.positions.buffer, &offset);
+    vkCmdBindVertexBuffers(commands, 1, 1, &chunk.colors.buffer, &offset);
+    vkCmdDraw(commands, static_cast<uint32_t>(chunk.count), 1, 0, 0);
+  }
+  if (timed) vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r.queries, 1);
+  vkCmdEndRenderPass(commands);
+}
+
+Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& points, const RenderOptions& options,
+                    const std::vector<glm::dvec3>& origins, bool pulled, size_t per_chunk) {
+  std::vector<uint32_t> colors = encodeColors(points);
+  const uint32_t stride = positionBytes(options.mode);
+  VkBufferUsageFlags position_usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+      (pulled ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  for (size_t first = 0; first < points.size(); first += per_chunk) {
+    Chunk& chunk = r.chunks.emplace_back();
+    chunk.first = first;
+    chunk.count = std::min(per_chunk, points.size() - first);
+    std::string what = "points " + std::to_string(first) + ".." + std::to_string(first + chunk.count - 1);
+    Result<Buffer> positions = createBuffer(context, chunk.count * stride, position_usage, false, what + " positions");
+    if (!positions) return positions.error();
+    chunk.positions = *positions;
+    // Staging pieces hold whole points.
+    VkDeviceSize piece = (VkDeviceSize{64} << 20) / stride * stride;
+    Status status = uploadBuffer(context, chunk.positions, chunk.count * stride,
+        [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+          encodePositions(options.mode, points, origins, chunk.first + offset / stride, bytes / stride, dst);
+        }, piece);
+    if (!status) return status;
+    Result<Buffer> color_buffer = createBuffer(context, chunk.count * 4,
+        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, what + " colours");
+    if (!color_buffer) return color_buffer.error();
+    chunk.colors = *color_buffer;
+    status = uploadBuffer(context, chunk.colors, chunk.count * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+      std::memcpy(dst, colors.data() + chunk.first + offset / 4, bytes);
+    });
+    if (!status) return status;
+    if (options.probe) {
+      Result<Buffer> probe = createBuffer(context, chunk.count * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                          true, what + " probe");
+      if (!probe) return probe.error();
+      chunk.probe = *probe;
+    }
+  }
+  return okStatus();
+}
+
+Status createTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height) {
+  Result<GpuImage> color = createImage(context, width, height, kColorFormat,
+      VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
+  if (!color) return color.error();
+  r.color = *color;
+  Result<GpuImage> depth = createImage(context, width, height, kDepthFormat,
+      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
+  if (!depth) return depth.error();
+  r.depth = *depth;
+  VkImageView views[2] = {r.color.view, r.depth.view};
+  VkFramebufferCreateInfo info = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+  info.renderPass = r.pipelines.render_pass;
+  info.attachmentCount = 2;
+  info.pAttachments = views;
+  info.width = width;
+  info.height = height;
+  info.layers = 1;
+  VK_TRY(vkCreateFramebuffer(context.device, &info, nullptr, &r.framebuffer));
+  Result<Buffer> readback = createBuffer(context, VkDeviceSize{width} * height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                         true, "picture readback");
+  if (!readback) return readback.error();
+  r.readback = *readback;
+  return okStatus();
+}
+
+Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
+  uint32_t sets = static_cast<uint32_t>(r.chunks.size());
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3 * sets}};
+  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = sets;
+  pool_info.poolSizeCount = 2;
+  pool_info.pPoolSizes = sizes;
+  VK_TRY(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &r.descriptor_pool));
+  for (Chunk& chunk : r.chunks) {
+    VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    allocate.descriptorPool = r.descriptor_pool;
+    allocate.descriptorSetCount = 1;
+    allocate.pSetLayouts = &r.pipelines.set_layout;
+    VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &chunk.set));
+    writeDescriptors(context, r, chunk, pulled, probe);
+  }
+  return okStatus();
+}
+
+Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
+                      const std::vector<glm::dvec3>& origins) {
+  std::vector<uint8_t> uniform = cameraUniform(options.mode, camera);
+  uniform.resize(std::max<size_t>(uniform.size(), 256), 0);
+  Result<Buffer> ubo = createBuffer(context, uniform.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                    false, "camera uniform");
+  if (!ubo) return ubo.error();
+  r.camera = *ubo;
+  Status status = uploadBuffer(context, r.camera, uniform.size(), [&](void* dst, VkDeviceSize, VkDeviceSize bytes) {
+    std::memcpy(dst, uniform.data(), bytes);
+  });
+  if (!status) return status;
+  Result<Buffer> dummy = createBuffer(context, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "unused binding");
+  if (!dummy) return dummy.error();
+  r.dummy = *dummy;
+  if (options.mode == PrecisionMode::kBatch) {
+    std::vector<glm::mat4> matrices = batchMatrices(camera, origins);
+    VkDeviceSize bytes = matrices.size() * sizeof(glm::mat4);
+    Result<Buffer> batches = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                          false, "batch matrices");
+    if (!batches) return batches.error();
+    r.batches = *batches;
+    status = uploadBuffer(context, r.batches, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize n) {
+      std::memcpy(dst, reinterpret_cast<const uint8_t*>(matrices.data()) + offset, n);
+    });
+    if (!status) return status;
+  }
+  return okStatus();
+}
+
+Status timeFrames(const VulkanContext& context, Resources& r, const RenderOptions& options, uint32_t width,
+                  uint32_t height, RenderResult& out) {
+  bool timestamps = context.facts.timestamp_period_ns > 0.0f;
+  if (timestamps) {
+    VkQueryPoolCreateInfo query_info = {VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = 2;
+    VK_TRY(vkCreateQueryPool(context.device, &query_info, nullptr, &r.queries));
+  }
+  VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  allocate.commandPool = context.command_pool;
+  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  allocate.commandBufferCount = 1;
+  VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &r.frame_commands));
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  VK_TRY(vkBeginCommandBuffer(r.frame_commands, &begin));
+  recordDraws(r.frame_commands, r, r.pipelines.draw, options, width, height, timestamps);
+  VK_TRY(vkEndCommandBuffer(r.frame_commands));
+  VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
+
+  for (uint32_t frame = 0; frame < options.warmup_frames + options.frames; ++frame) {
+    Clock::time_point start = Clock::now();
+    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &r.frame_commands;
+    VK_TRY(vkQueueSubmit(context.queue, 1, &submit, r.fence));
+    VK_TRY(vkWaitForFences(context.device, 1, &r.fence, VK_TRUE, UINT64_MAX));
+    double wall = msSince(start);
+    VK_TRY(vkResetFences(context.device, 1, &r.fence));
+    if (frame < options.warmup_frames) continue;
+    out.frame_ms.push_back(wall);
+    if (timestamps) {
+      uint64_t ticks[2] = {0, 0};
+      VK_TRY(vkGetQueryPoolResults(context.device, r.queries, 0, 2, sizeof(ticks), ticks, sizeof(uint64_t),
+                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+      out.gpu_ms.push_back(static_cast<double>(ticks[1] - ticks[0]) * context.facts.timestamp_period_ns * 1e-6);
+    }
+  }
+  return okStatus();
+}
+
+Status readPicture(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, RenderResult& out) {
+  Clock::time_point start = Clock::now();
+  Status status = submitOnce(context, [&](VkCommandBuffer commands) {
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {width, height, 1};  // bufferRowLength 0: rows packed, pitch = width · 4
+    vkCmdCopyImageToBuffer(commands, r.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r.readback.buffer, 1, &copy);
+    VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
+                         nullptr, 0, nullptr);
+  });
+  if (!status) return status;
+  status = invalidateBuffer(context, r.readback);
+  if (!status) return status;
+  out.image.width = width;
+  out.image.height = height;
+  const auto* bytes = static_cast<const uint8_t*>(r.readback.mapped);
+  out.image.rgba.assign(bytes, bytes + size_t{width} * height * 4);
+  out.readback_ms = msSince(start);
+  return okStatus();
+}
+
+Status runProbe(const VulkanContext& context, Resources& r, const RenderOptions& options, uint32_t width,
+                uint32_t height, size_t count, RenderResult& out) {
+  Status status = submitOnce(context, [&](VkCommandBuffer commands) {
+    recordDraws(commands, r, r.pipelines.probe, options, width, height, false);
+    VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_VERTEX_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
+                         nullptr, 0, nullptr);
+  });
+  if (!status) return status;
+  out.probe_clip.resize(count);
+  for (const Chunk& chunk : r.chunks) {
+    status = invalidateBuffer(context, chunk.probe);
+    if (!status) return status;
+    std::memcpy(out.probe_clip.data() + chunk.first, chunk.probe.mapped, chunk.count * sizeof(glm::vec4));
+  }
+  return okStatus();
+}
+
+}  // namespace
+
+Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                                  const RenderOptions& options) {
+  Status status = checkOptions(context, points, options);
+  if (!status) return status.error();
+  SelfTest self_test{true, ""};
+  if (options.mode == PrecisionMode::kRte || options.mode == PrecisionMode::kDf64) {
+    Result<SelfTest> ran = runPrecisionSelfTest(context);
+    if (!ran) return ran.error();
+    self_test = *ran;
+  }
+  status = modeUsable(context, options.mode, self_test, options.probe);
+  if (!status) return status.error();
+
+  Clock::time_point upload_start = Clock::now();
+  std::vector<glm::dvec3> origins = batchOrigins(options.mode, points);
+  status = checkEncodable(options.mode, points, origins);
+  if (!status) return status.error();
+
+  bool pulled = options.mode == PrecisionMode::kNative &&
+                (options.native_path == NativePath::kPull ||
+                 (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
+  Resources r(context);
+  Result<PointPipelines> pipelines =
+      createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height);
+  if (!pipelines) return pipelines.error();
+  r.pipelines = *pipelines;
+
+  RenderResult out;
+  out.pulled_positions = pulled;
+  status = createUniforms(context, r, camera, options, origins);
+  if (status) status = uploadPoints(context, r, points, options, origins, pulled, chunkPoints(context.facts, options, pulled));
+  if (!status) return status.error();
+  out.chunks = static_cast<uint32_t>(r.chunks.size());
+  out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * points.size();
+  out.upload_ms = msSince(upload_start);
+
+  status = createTargets(context, r, camera.width, camera.height);
+  if (status) status = createDescriptors(context, r, pulled, options.probe);
+  if (status) status = timeFrames(context, r, options, camera.width, camera.height, out);
+  if (status) status = readPicture(context, r, camera.width, camera.height, out);
+  if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, points.size(), out);
+  if (!status) return status.error();
+  return out;
+}
+
+double medianOf(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
+  double upper = values[mid];
+  if (values.size() % 2) return upper;
+  double lower = *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid));
+  return 0.5 * (lower + upper);
+}
+
+double percentileOf(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  size_t rank = static_cast<size_t>(std::ceil(p / 100.0 * static_cast<double>(values.size())));
+  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
+}
+
+}  // namespace dpoint

@@ -1,0 +1,57 @@
+// The raster backend (DESIGN §4, §6): uploads a point set in one precision mode, draws it as
+// POINT_LIST into an offscreen RGBA8 + D32 (reversed Z) target, times the draws with GPU
+// timestamps, reads the picture back, and with `probe` also reads every point's clip position.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "core/point_set.h"
+#include "viewer/camera.h"
+#include "viewer/context.h"
+#include "viewer/encode.h"
+#include "viewer/reference.h"
+
+namespace dpoint {
+
+enum class NativePath { kAuto, kAttribute, kPull };
+
+struct RenderOptions {
+  PrecisionMode mode = PrecisionMode::kNative;
+  float point_size = 1.0f;
+  uint32_t background_rgba8 = 0xff000000u;  // opaque black, R in the low byte
+  uint32_t warmup_frames = 1;
+  uint32_t frames = 1;  // timed frames after warm-up (≥ 1)
+  bool probe = false;   // also store clip positions (DESIGN §5)
+  NativePath native_path = NativePath::kAuto;  // auto: R64G64B64 vertex input where listed, else pull
+  // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
+  // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
+  uint64_t max_chunk_points = 0;
+};
+
+struct RenderResult {
+  Image image;                     // the last frame
+  std::vector<double> gpu_ms;      // per timed frame, from timestamps; empty if the queue has none
+  std::vector<double> frame_ms;    // per timed frame, submit to fence on the host
+  double upload_ms = 0.0;          // encode + upload of every buffer
+  double readback_ms = 0.0;        // copy of the picture to the host
+  std::vector<glm::vec4> probe_clip;  // with `probe`: clip position of every point, in input order
+  uint32_t chunks = 0;
+  bool pulled_positions = false;   // native mode read positions from a storage buffer
+  uint64_t gpu_bytes = 0;          // point data on the GPU (positions + colours)
+};
+
+// Fails with kBadInput when the set is empty or a position does not fit the mode's encoding,
+// kNoDevice when the device cannot run the mode (see modeUsable), kResourceLimit when memory
+// runs out. The caller's context collects validation messages.
+Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                                  const RenderOptions& options);
+
+// Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
+double medianOf(std::vector<double> values);
+double percentileOf(std::vector<double> values, double p);
+
+}  // namespace dpoint
