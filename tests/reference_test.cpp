@@ -64,7 +64,7 @@ TEST(Reference, windowFromClipDividesInDoubleAndRejectsWhatIsNotInView) {
   EXPECT_EQ(windowFromClip({1.0f, 0.0f, 0.5f, 3.0f}, camera).x, (1.0 / 3.0 * 0.5 + 0.5) * 200.0);
   const std::vector<glm::vec4> rejected = {
       {0, 0, 0.5f, 0},         {0, 0, -0.5f, -1},      {NAN, 0, 0.5f, 1}, {0, INFINITY, 0.5f, 1},
-      {0, 0, 1.5f, 1},         {0, 0, -0.1f, 1},       {1, 0, 0.5f, 1},   {0, 1, 0.5f, 1},
+      {0, 0, 1.5f, 1},         {0, 0, -0.1f, 1},       {-1, 0, 0.5f, 1},  {0, -1, 0.5f, 1},
       {0, 0, 0.5f, INFINITY},
   };
   for (const glm::vec4& clip : rejected) {
@@ -74,8 +74,9 @@ TEST(Reference, windowFromClipDividesInDoubleAndRejectsWhatIsNotInView) {
     EXPECT_EQ(r.y, 0.0);
     EXPECT_EQ(r.depth, 0.0);
   }
-  // The left and top edges are in, the right and bottom ones out.
-  EXPECT_TRUE(windowFromClip({-1, -1, 0.5f, 1}, camera).visible);
+  // The right and bottom edges are in, the left and top ones out: a point exactly on a pixel
+  // corner lights the pixel up and left of it (top-left fill rule), and at x = 0 that is none.
+  EXPECT_TRUE(windowFromClip({1, 1, 0.5f, 1}, camera).visible);
 }
 
 TEST(Reference, compareReportsMaxRmsP99ShareAndLost) {
@@ -123,13 +124,14 @@ std::vector<uint8_t> pixelAt(const Image& image, uint32_t x, uint32_t y) {
 }
 
 TEST(Reference, rasterCoversTheFloorPixelRowMajorTopFirstWithRInTheLowByte) {
-  const std::vector<WindowPoint> window = {at(2.999, 0.0), at(0.5, 1.999), at(1.0, 1.0), WindowPoint{}};
+  // (1, 1) is a pixel corner: the top-left rule gives it to pixel (0, 0).
+  const std::vector<WindowPoint> window = {at(2.999, 0.001), at(0.5, 1.999), at(1.0, 1.0), WindowPoint{}};
   const std::vector<uint32_t> colors = {0x44332211u, 0xff0000ffu, 0x80ff00ffu, 0xffffffffu};
   const Image image = rasterReference(window, colors, 4, 3, 0xff302010u);
   ASSERT_EQ(image.rgba.size(), 4u * 3u * 4u);
   EXPECT_EQ(pixelAt(image, 2, 0), (std::vector<uint8_t>{0x11, 0x22, 0x33, 0x44}));
   EXPECT_EQ(pixelAt(image, 0, 1), (std::vector<uint8_t>{0xff, 0x00, 0x00, 0xff}));
-  EXPECT_EQ(pixelAt(image, 1, 1), (std::vector<uint8_t>{0xff, 0x00, 0xff, 0x80}));
+  EXPECT_EQ(pixelAt(image, 0, 0), (std::vector<uint8_t>{0xff, 0x00, 0xff, 0x80}));
   EXPECT_EQ(std::vector<uint8_t>(image.rgba.begin() + 8, image.rgba.begin() + 12), pixelAt(image, 2, 0));
   const std::vector<uint8_t> background = {0x10, 0x20, 0x30, 0xff};
   size_t background_pixels = 0;

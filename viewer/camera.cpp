@@ -248,7 +248,12 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     camera.projection = orthoProjection(view_width, view_width * double(spec.height) / double(spec.width),
                                         camera.near_plane, camera.far_plane);
   } else {
-    camera.projection = perspectiveProjection(2.0 * half_fov, aspect, camera.near_plane, camera.far_plane);
+    // Clip space is homogeneous: scaling the whole matrix by 1/far changes no x/w, y/w or z/w,
+    // but keeps clip coordinates near 1 whatever the scene's scale. Without it a scene at 1e-37 m
+    // gives clip values below float's normal range, which a GPU flushes to zero, and even native
+    // fp64 (whose clip position ends as float) would lose it.
+    camera.projection = perspectiveProjection(2.0 * half_fov, aspect, camera.near_plane, camera.far_plane) *
+                        (1.0 / camera.far_plane);
   }
   return camera;
 }

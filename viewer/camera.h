@@ -43,7 +43,9 @@ struct Camera {
   bool ortho = false;
   glm::dvec3 eye{0.0};         // world position of the eye
   glm::dmat4 rotation{1.0};    // world directions → eye space (view = rotation · translate(−eye))
-  glm::dmat4 projection{1.0};  // eye space → clip space (Vulkan y-down, reversed Z)
+  // eye space → clip space (Vulkan y-down, reversed Z); perspective is scaled by 1/far (clip is
+  // homogeneous, so no window position changes) to keep clip values near 1 at any scene scale.
+  glm::dmat4 projection{1.0};
   double near_plane = 0.0, far_plane = 0.0;
 
   glm::dmat4 view() const;            // rotation · translate(−eye)

@@ -56,6 +56,7 @@ class VulkanContext {
 
   // Validation messages (warnings and errors) seen so far, one line each.
   const std::vector<std::string>& validationMessages() const { return messages_; }
+  void clearValidationMessages() { messages_.clear(); }
 
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;

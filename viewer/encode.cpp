@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <charconv>
 #include <cstring>
 #include <limits>
 
@@ -11,6 +12,12 @@ namespace dpoint {
 namespace {
 
 constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
+
+std::string shortest(double v) {
+  char text[32];
+  auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
 
 const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 
@@ -87,16 +94,17 @@ FloatPair splitDouble(double d) {
 
 Status checkEncodable(PrecisionMode mode, const PointSet& points, const std::vector<glm::dvec3>& batch_origins) {
   if (mode == PrecisionMode::kNative) return okStatus();
+  const bool batch = mode == PrecisionMode::kBatch;
   for (size_t i = 0; i < points.size(); ++i) {
     glm::dvec3 p = points.positions[i];
-    if (mode == PrecisionMode::kBatch) p -= batch_origins[i / kBatchSize];
+    if (batch) p -= batch_origins[i / kBatchSize];
     for (int axis = 0; axis < 3; ++axis) {
-      if (!fitsFloat(p[axis])) {
-        return Error{"point " + std::to_string(i) + ": " + axisName(axis) + " = " +
-                         std::to_string(points.positions[i][axis]) + " is beyond float32 range, which mode " +
-                         std::string(modeName(mode)) + " needs; use --mode native",
-                     ExitCode::kBadInput};
-      }
+      if (fitsFloat(p[axis])) continue;
+      std::string what = std::string(axisName(axis)) + " = " + shortest(points.positions[i][axis]);
+      if (batch) what += " (" + shortest(p[axis]) + " from its batch's centre)";
+      return Error{"point " + std::to_string(i) + ": " + what + " is beyond float32 range, which mode " +
+                       std::string(modeName(mode)) + " needs; use --mode native",
+                   ExitCode::kBadInput};
     }
   }
   return okStatus();

@@ -43,7 +43,8 @@ WindowPoint toWindow(T x, T y, T z, T w, uint32_t width, uint32_t height) {
   const double x_win = static_cast<double>((x / w * T(0.5) + T(0.5)) * static_cast<T>(width));
   const double y_win = static_cast<double>((y / w * T(0.5) + T(0.5)) * static_cast<T>(height));
   if (!(depth >= 0.0 && depth <= 1.0)) return {};
-  if (!(x_win >= 0.0 && x_win < double(width) && y_win >= 0.0 && y_win < double(height))) return {};
+  // (0, width] × (0, height]: a point exactly on the left or top edge lights pixel −1 (below).
+  if (!(x_win > 0.0 && x_win <= double(width) && y_win > 0.0 && y_win <= double(height))) return {};
   return {x_win, y_win, depth, true};
 }
 
@@ -131,9 +132,12 @@ Image rasterReference(const std::vector<WindowPoint>& window, const std::vector<
     const WindowPoint& p = window[i];
     if (!p.visible) continue;
     // Checked before the conversion: a window for another viewport size must not index out of bounds.
-    if (!(p.x >= 0.0 && p.x < double(width) && p.y >= 0.0 && p.y < double(height))) continue;
-    const auto px = static_cast<uint32_t>(std::floor(p.x));
-    const auto py = static_cast<uint32_t>(std::floor(p.y));
+    if (!(p.x > 0.0 && p.x <= double(width) && p.y > 0.0 && p.y <= double(height))) continue;
+    // The pixel whose centre lies in [x − 0.5, x + 0.5): a size-1 point square with the top-left
+    // fill rule (a centre on the left/top edge is in, on the right/bottom edge out), which is what
+    // lavapipe does when a point falls exactly on a pixel corner. Off the corners it is floor(x).
+    const auto px = static_cast<uint32_t>(std::ceil(p.x) - 1.0);
+    const auto py = static_cast<uint32_t>(std::ceil(p.y) - 1.0);
     const size_t pixel = size_t(py) * width + px;
     if (covered[pixel] && !(p.depth > depth[pixel])) continue;
     covered[pixel] = true;

@@ -14,7 +14,7 @@ namespace dpoint {
 
 // Window position of one point: x, y in pixels (see camera.h), depth in [0, 1] (reversed Z).
 // `visible` is false for points outside the view volume: w ≤ 0 (behind or at the eye), depth
-// outside [0, 1], or x, y outside [0, width) × [0, height). Invisible points carry no numbers
+// outside [0, 1], or x, y outside (0, width] × (0, height]. Invisible points carry no numbers
 // (x = y = depth = 0) so nothing downstream meets a NaN.
 struct WindowPoint {
   double x = 0.0, y = 0.0, depth = 0.0;
@@ -44,7 +44,8 @@ struct ErrorStats {
 ErrorStats compareToReference(const std::vector<WindowPoint>& reference, const std::vector<WindowPoint>& probe);
 
 // The reference raster: RGBA8 image, row-major, top row first, `background` where no point is.
-// A point of size 1 covers pixel (floor x, floor y). Depth test as the renderer's: the greater
+// A point of size 1 covers pixel (ceil x − 1, ceil y − 1): floor except exactly on a pixel
+// corner, where the top-left fill rule takes the pixel up and left. Depth test as the renderer's: the greater
 // depth wins; on equal depth the point drawn first (lower index) stays. The first visible point
 // on a pixel is always drawn, even at depth exactly 0 (a GREATER test against a depth buffer
 // cleared to 0 would drop it; makeCamera's far plane keeps every box point above depth 0).

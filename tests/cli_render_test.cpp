@@ -1,0 +1,134 @@
+// dpoint render and dpoint devices as a user runs them (on lavapipe in CI, validation layer on).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::runDpoint;
+using test::TempDir;
+using test::writeFile;
+
+// The number after "key": in a JSON text written by dpoint (flat enough for a search).
+double jsonNumber(const std::string& json, const std::string& key) {
+  size_t at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return -1.0;
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+TEST(CliRender, helpNamesEveryModeAndOption) {
+  test::CommandResult help = runDpoint({"render", "--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* word : {"fp32", "split", "rte", "df64", "native", "batch", "--view-center", "--error", "--validate",
+                           "--frames", "--device", "lavapipe"})
+    EXPECT_NE(help.out.find(word), std::string::npos) << word;
+  EXPECT_EQ(runDpoint({"devices", "--help"}).exit_code, 0);
+}
+
+TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "33", "--quiet", "-o", dir.file("mb.csv")}).exit_code, 0);
+  test::CommandResult r = runDpoint({"render", dir.file("mb.csv"), "-o", dir.file("mb.png"), "--mode", "df64", "--error",
+                                     "--validate", "--frames", "3", "--width", "320", "--height", "240", "--json",
+                                     dir.file("mb.json")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(readFile(dir.file("mb.png")).substr(0, 8), "\x89PNG\r\n\x1a\n");
+  const std::string json = readFile(dir.file("mb.json"));
+  for (const char* key : {"mode", "backend", "device", "driver_version", "points", "width", "height", "gpu_ms", "median",
+                          "p95", "e2e_ms", "points_per_s", "bytes_per_point", "error_px", "max", "p99", "rms",
+                          "share_off_half_px", "pixels_differing"})
+    EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key << " in " << json;
+  EXPECT_NE(json.find("\"mode\": \"df64\""), std::string::npos);
+  EXPECT_EQ(jsonNumber(json, "bytes_per_point"), 28.0);
+  EXPECT_EQ(jsonNumber(json, "width"), 320.0);
+  EXPECT_GT(jsonNumber(json, "points_per_s"), 0.0);
+  EXPECT_LT(jsonNumber(json, "max"), 0.01);
+  EXPECT_NE(r.out.find("error: max"), std::string::npos) << r.out;
+}
+
+// DESIGN §7 offset, end to end: a generated fractal moved to the Earth's radius.
+TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "33", "--offset", "6378137,0,0", "--quiet", "-o",
+                       dir.file("far.ply")}).exit_code, 0);
+  double max_px[2] = {0, 0};
+  int i = 0;
+  for (const char* mode : {"fp32", "native"}) {
+    std::string json = dir.file(std::string(mode) + ".json");
+    test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--mode", mode,
+                                       "--error", "--validate", "--width", "256", "--height", "256", "--json", json});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    max_px[i++] = jsonNumber(readFile(json), "max");
+  }
+  EXPECT_GE(max_px[0], 1.0) << "fp32";
+  EXPECT_LE(max_px[1], 0.01) << "native";
+}
+
+TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
+  TempDir dir;
+  writeFile(dir.file("empty.csv"), "x,y,z\n");
+  writeFile(dir.file("one.csv"), "x,y,z\n1,2,3\n");
+  struct Case {
+    std::vector<std::string> args;
+    int code;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {{dir.file("empty.csv")}, 2, "empty.csv"},
+      {{dir.file("missing.csv")}, 2, "missing.csv"},
+      {{dir.file("one.csv"), "--mode", "emulated"}, 1, "--mode"},
+      {{dir.file("one.csv"), "--eye", "0,0,5"}, 1, "--target"},
+      {{dir.file("one.csv"), "--eye", "0,0,5", "--target", "0,0,5"}, 1, "--eye"},
+      {{dir.file("one.csv"), "--view-width", "-1"}, 1, "--view-width"},
+      {{dir.file("one.csv"), "--point-size", "0"}, 1, "--point-size"},
+      {{dir.file("one.csv"), "--background", "300,0,0"}, 1, "--background"},
+      {{dir.file("one.csv"), "--device", "7"}, 3, "--device 7"},
+      {{dir.file("one.csv"), "--backend", "compute"}, 1, "--backend"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"render"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    args.insert(args.end(), {"-o", dir.file("out.png")});
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, c.code) << c.message << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(test::fileExists(dir.file("out.png"))) << c.message;
+  }
+  test::CommandResult jpg = runDpoint({"render", dir.file("one.csv"), "-o", dir.file("out.jpg")});
+  EXPECT_EQ(jpg.exit_code, 1);
+  EXPECT_NE(jpg.err.find(".png"), std::string::npos);
+}
+
+// Large sets: 16.7M points are more than lavapipe's 128 MiB storage-buffer range holds, so
+// native mode (vertex pulling there) draws them in several chunks.
+TEST(CliRender, sixteenMillionPointsRenderInChunks) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "11", "--unwelded", "--quiet", "-o", dir.file("s.ply")}).exit_code, 0);
+  test::CommandResult r = runDpoint({"render", dir.file("s.ply"), "-o", dir.file("s.png"), "--mode", "native",
+                                     "--validate", "--width", "128", "--height", "128", "--warmup", "0", "--quiet",
+                                     "--json", dir.file("s.json")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string json = readFile(dir.file("s.json"));
+  EXPECT_EQ(jsonNumber(json, "points"), 16777216.0);
+  EXPECT_GE(jsonNumber(json, "chunks"), 2.0) << json;
+  EXPECT_GT(readFile(dir.file("s.png")).size(), 1000u);
+}
+
+TEST(CliDevices, listsADeviceWithTheSelfTestAndUsableModes) {
+  test::CommandResult text = runDpoint({"devices"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("self-test: pass"), std::string::npos) << text.out;
+  test::CommandResult json = runDpoint({"devices", "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  for (const char* key : {"\"name\"", "\"shader_float64\"", "\"r64g64b64_vertex\"", "\"max_storage_buffer_range\"",
+                          "\"self_test\": \"pass\"", "\"native\""})
+    EXPECT_NE(json.out.find(key), std::string::npos) << key << " in " << json.out;
+}
+
+}  // namespace
+}  // namespace dpoint

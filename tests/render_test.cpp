@@ -1,0 +1,363 @@
+// The renderer on real Vulkan (Mesa lavapipe in CI) with the Khronos validation layer on: every
+// test fails on any validation message. The hard cases are DESIGN §7's, at small sizes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "generators/mandelbrot2d.h"
+#include "viewer/camera.h"
+#include "viewer/context.h"
+#include "viewer/probe.h"
+#include "viewer/render.h"
+#include "viewer/selftest.h"
+
+namespace dpoint {
+namespace {
+
+class Render : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Result<std::unique_ptr<VulkanContext>> created = VulkanContext::create(ContextOptions{"auto", true});
+    ASSERT_TRUE(created.ok()) << created.error().message;
+    context_ = std::move(*created);
+  }
+  void TearDown() override {
+    if (!context_) return;
+    for (const std::string& m : context_->validationMessages()) ADD_FAILURE() << m;
+  }
+
+  struct Measured {
+    RenderResult render;
+    ErrorReport error;
+  };
+  Measured measure(const PointSet& points, const Camera& camera, PrecisionMode mode, RenderOptions options = {}) {
+    options.mode = mode;
+    options.probe = true;
+    Result<RenderResult> r = renderPoints(*context_, points, camera, options);
+    EXPECT_TRUE(r.ok()) << modeName(mode) << ": " << r.error().message;
+    if (!r.ok()) return {};
+    ErrorReport e = measureError(points, camera, *r, options.background_rgba8);
+    return {std::move(*r), std::move(e)};
+  }
+
+  std::unique_ptr<VulkanContext> context_;
+};
+
+// 10 × 10 × 10 points `spacing` apart, centred on `centre`, coloured by position.
+PointSet cloud(const glm::dvec3& centre, double spacing) {
+  PointSet s;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 10; ++k) {
+        s.positions.push_back(centre + spacing * glm::dvec3(i - 4.5, j - 4.5, k - 4.5));
+        s.colors.emplace_back(0.1f * static_cast<float>(i), 0.1f * static_cast<float>(j), 0.1f * static_cast<float>(k));
+      }
+  return s;
+}
+
+Bounds boundsOf(const PointSet& s) {
+  Bounds b{s.positions[0], s.positions[0], s.isPlanar()};
+  for (const glm::dvec3& p : s.positions) {
+    b.min = glm::min(b.min, p);
+    b.max = glm::max(b.max, p);
+  }
+  return b;
+}
+
+// Looks at the cloud's centre from `distance` away along +z (and a little off axis, so no
+// coordinate of the eye-relative vector is zero), 1024 × 1024.
+Camera lookAtCloud(const PointSet& s, const glm::dvec3& centre, double distance) {
+  CameraSpec spec;
+  spec.width = spec.height = 1024;
+  spec.eye = centre + distance * glm::dvec3(0.1, 0.2, 1.0);
+  spec.target = centre;
+  spec.up = glm::dvec3(0, 1, 0);
+  Result<Camera> camera = makeCamera(spec, boundsOf(s));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
+// The guard itself: the layer is on and a misuse reaches the message list the tests check.
+TEST_F(Render, validationLayerReportsMisuse) {
+  VkBufferCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  info.size = 0;  // VUID-VkBufferCreateInfo-size-00912
+  info.usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  if (vkCreateBuffer(context_->device, &info, nullptr, &buffer) == VK_SUCCESS && buffer)
+    vkDestroyBuffer(context_->device, buffer, nullptr);
+  ASSERT_FALSE(context_->validationMessages().empty());
+  EXPECT_NE(context_->validationMessages()[0].find("00912"), std::string::npos) << context_->validationMessages()[0];
+  context_->clearValidationMessages();
+}
+
+TEST_F(Render, selfTestKeepsTheLowPartsOnThisDevice) {
+  Result<SelfTest> t = runPrecisionSelfTest(*context_);
+  ASSERT_TRUE(t.ok()) << t.error().message;
+  EXPECT_TRUE(t->low_parts_survive) << t->detail;
+}
+
+// DESIGN §7 offset: 1000 points 1 mm apart at the Earth's radius, the camera 1 m away.
+TEST_F(Render, earthRadiusOffsetSeparatesTheFloatModesFromTheDoubleOnes) {
+  const glm::dvec3 centre(6.378e6, 0.0, 0.0);
+  PointSet s = cloud(centre, 1e-3);
+  Camera camera = lookAtCloud(s, centre, 1.0);
+  for (PrecisionMode mode : kAllModes) {
+    Measured m = measure(s, camera, mode);
+    const ErrorStats& e = m.error.stats;
+    ASSERT_EQ(e.points, s.size()) << "the reference sees the whole cloud";
+    if (mode == PrecisionMode::kFp32 || mode == PrecisionMode::kSplit) {
+      // float spacing at 6.4e6 is 0.5 m: the cloud collapses; points land far off or leave the view.
+      EXPECT_TRUE(e.max_px >= 1.0 || e.lost > 0) << modeName(mode) << " max " << e.max_px;
+      EXPECT_GT(e.share_off_half_px, 0.5) << modeName(mode);
+    } else {
+      EXPECT_EQ(e.lost, 0u) << modeName(mode);
+      EXPECT_LE(e.max_px, 0.01) << modeName(mode);
+      EXPECT_EQ(e.share_off_half_px, 0.0) << modeName(mode);
+    }
+  }
+}
+
+// Measured on lavapipe: at 1e8 every emulated mode still holds to 0.01 px; fp32 and split fail.
+TEST_F(Render, offset1e8HoldsForEveryDoubleMode) {
+  const glm::dvec3 centre(1e8, -2e7, 5e7);
+  PointSet s = cloud(centre, 1e-3);
+  Camera camera = lookAtCloud(s, centre, 1.0);
+  for (PrecisionMode mode : kAllModes) {
+    const ErrorStats e = measure(s, camera, mode).error.stats;
+    RecordProperty(std::string(modeName(mode)) + "_max_px", std::to_string(e.max_px));
+    if (mode == PrecisionMode::kFp32 || mode == PrecisionMode::kSplit) {
+      EXPECT_GT(e.share_off_half_px, 0.5) << modeName(mode);
+    } else {
+      EXPECT_EQ(e.lost, 0u) << modeName(mode);
+      EXPECT_LE(e.max_px, 0.01) << modeName(mode) << " rms " << e.rms_px;
+    }
+  }
+}
+
+// The same cloud scaled down to 1e-40 m spacing at the origin, camera 1e-37 m away. Float
+// underflows there (1e-40 is subnormal and GPUs flush subnormals), and double-float keeps
+// float's exponent range, so only native holds: its positions and matrix are double, and the
+// camera's projection is scaled (homogeneously) so the clip position it casts to float is near 1.
+TEST_F(Render, tinyScaleNearTheOriginHoldsOnlyInNative) {
+  const glm::dvec3 centre(0.0);
+  PointSet s = cloud(centre, 1e-40);
+  Camera camera = lookAtCloud(s, centre, 1e-37);
+  for (PrecisionMode mode : kAllModes) {
+    const ErrorStats e = measure(s, camera, mode).error.stats;
+    ASSERT_EQ(e.points, s.size());
+    if (mode == PrecisionMode::kNative) {
+      EXPECT_EQ(e.lost, 0u);
+      EXPECT_LE(e.max_px, 0.01) << "rms " << e.rms_px;
+    } else {
+      EXPECT_GT(e.share_off_half_px, 0.5) << modeName(mode) << " max " << e.max_px << " lost " << e.lost;
+    }
+  }
+}
+
+// DESIGN §7 deepzoom at view width 1e-9: one grid point per pixel centre.
+TEST_F(Render, deepZoomPutsEveryPointOnItsOwnPixelInDoubleModes) {
+  Mandelbrot2dParams params;
+  params.width = 1e-9;
+  params.resolution = 96;
+  params.max_iter = 600;
+  Result<PointSet> grid = generateMandelbrot2d(params);
+  ASSERT_TRUE(grid.ok()) << grid.error().message;
+  CameraSpec spec;
+  spec.width = spec.height = 96;
+  spec.view_center = glm::dvec3(params.center_x, params.center_y, 0.0);
+  spec.view_width = params.width;
+  Result<Camera> camera = makeCamera(spec, boundsOf(*grid));
+  ASSERT_TRUE(camera.ok()) << camera.error().message;
+  ASSERT_TRUE(camera->ortho) << "2D data defaults to orthographic";
+  for (PrecisionMode mode : kAllModes) {
+    Measured m = measure(*grid, *camera, mode);
+    if (mode == PrecisionMode::kFp32 || mode == PrecisionMode::kSplit) {
+      EXPECT_GT(m.error.pixels_differing, grid->size() / 2) << modeName(mode);
+    } else {
+      EXPECT_EQ(m.error.pixels_differing, 0u) << modeName(mode);
+      EXPECT_EQ(m.error.stats.share_off_half_px, 0.0) << modeName(mode);
+      EXPECT_LT(m.error.stats.max_px, 0.01) << modeName(mode);
+    }
+  }
+}
+
+TEST_F(Render, emptySetIsAClearError) {
+  PointSet empty;
+  Camera camera = *makeCamera(CameraSpec{}, Bounds{});
+  Result<RenderResult> r = renderPoints(*context_, empty, camera, RenderOptions{});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, ExitCode::kBadInput);
+  EXPECT_NE(r.error().message.find("empty"), std::string::npos) << r.error().message;
+}
+
+size_t litPixels(const Image& image, uint32_t background) {
+  size_t lit = 0;
+  for (size_t i = 0; i < image.rgba.size(); i += 4) {
+    uint32_t v = image.rgba[i] | image.rgba[i + 1] << 8 | image.rgba[i + 2] << 16 | uint32_t{image.rgba[i + 3]} << 24;
+    lit += v != background;
+  }
+  return lit;
+}
+
+TEST_F(Render, onePointAndIdenticalPointsLightOnePixelInTheCentre) {
+  for (size_t copies : {size_t{1}, size_t{500}}) {
+    PointSet s;
+    s.positions.assign(copies, glm::dvec3(6.378e6, 1.5, -2.25));
+    CameraSpec spec;
+    spec.width = 101;  // odd, so the view axis goes through a pixel centre
+    spec.height = 75;
+    Camera camera = *makeCamera(spec, boundsOf(s));  // the fit of a degenerate box
+    for (PrecisionMode mode : kAllModes) {
+      Measured m = measure(s, camera, mode);
+      if (mode == PrecisionMode::kFp32 || mode == PrecisionMode::kSplit) {
+        // The fit stands 6.4e-4 m away; float's 0.5 m spacing at 6.4e6 throws the point out.
+        EXPECT_LE(litPixels(m.render.image, RenderOptions{}.background_rgba8), 1u) << modeName(mode);
+        continue;
+      }
+      EXPECT_EQ(litPixels(m.render.image, RenderOptions{}.background_rgba8), 1u) << modeName(mode) << " x" << copies;
+      EXPECT_EQ(m.render.image.rgba[4 * (37 * 101 + 50)], 255) << "the centre pixel is lit";
+      EXPECT_EQ(m.error.pixels_differing, 0u) << modeName(mode) << " x" << copies;
+    }
+  }
+}
+
+TEST_F(Render, pointsBehindAtAndBesideTheEyeAreCulledWithoutNaN) {
+  PointSet s;
+  s.positions = {{0, 0, -5}, {0, 0, 5}, {0, 0, 10}, {0, 0, 0}, {3, 0, 0}};  // front, behind ×2, at the eye, beside
+  CameraSpec spec;
+  spec.width = 101;
+  spec.height = 75;
+  spec.eye = glm::dvec3(0, 0, 0);
+  spec.target = glm::dvec3(0, 0, -1);
+  spec.up = glm::dvec3(0, 1, 0);
+  Camera camera = *makeCamera(spec, boundsOf(s));
+  for (PrecisionMode mode : kAllModes) {
+    Measured m = measure(s, camera, mode);
+    for (const glm::vec4& clip : m.render.probe_clip)
+      for (int c = 0; c < 4; ++c) EXPECT_TRUE(std::isfinite(clip[c])) << modeName(mode);
+    EXPECT_EQ(litPixels(m.render.image, RenderOptions{}.background_rgba8), 1u) << modeName(mode);
+    EXPECT_EQ(m.error.stats.points, 1u);
+    EXPECT_EQ(m.error.pixels_differing, 0u) << modeName(mode);
+  }
+}
+
+TEST_F(Render, aPointOnTheNearPlaneLeavesNoNaN) {
+  PointSet s;
+  s.positions = {{0, 0, -1}, {0, 0, -2}};
+  CameraSpec spec;
+  spec.eye = glm::dvec3(0, 0, 0);
+  spec.target = glm::dvec3(0, 0, -1);
+  spec.up = glm::dvec3(0, 1, 0);
+  Camera camera = *makeCamera(spec, boundsOf(s));
+  s.positions.push_back({0, 0, -camera.near_plane});  // exactly on the near plane
+  for (PrecisionMode mode : kAllModes) {
+    Measured m = measure(s, camera, mode);
+    for (const glm::vec4& clip : m.render.probe_clip)
+      for (int c = 0; c < 4; ++c) EXPECT_TRUE(std::isfinite(clip[c])) << modeName(mode);
+  }
+}
+
+// Splitting into several draws (as large sets are) changes nothing: same picture, same probe.
+TEST_F(Render, chunkedDrawsGiveTheSamePictureAndProbe) {
+  const glm::dvec3 centre(1e6, 2e6, -3e6);
+  PointSet s = cloud(centre, 1e-3);
+  Camera camera = lookAtCloud(s, centre, 0.5);
+  for (PrecisionMode mode : kAllModes) {
+    Measured whole = measure(s, camera, mode);
+    RenderOptions chunked;
+    chunked.max_chunk_points = 300;  // 4 draws, batch mode's 4096-point batches cut across them
+    Measured parts = measure(s, camera, mode, chunked);
+    EXPECT_EQ(whole.render.chunks, 1u);
+    EXPECT_EQ(parts.render.chunks, 4u);
+    EXPECT_EQ(whole.render.image.rgba, parts.render.image.rgba) << modeName(mode);
+    EXPECT_EQ(0, std::memcmp(whole.render.probe_clip.data(), parts.render.probe_clip.data(),
+                             s.size() * sizeof(glm::vec4))) << modeName(mode);
+  }
+}
+
+// Both ways for native: vertex attributes where the device lists R64G64B64_SFLOAT (NVIDIA), a
+// storage buffer otherwise (lavapipe). Each path that the device has must give the same picture.
+TEST_F(Render, nativeVertexInputAndVertexPullingAgree) {
+  const glm::dvec3 centre(6.378e6, 0.0, 0.0);
+  PointSet s = cloud(centre, 1e-3);
+  Camera camera = lookAtCloud(s, centre, 1.0);
+  RenderOptions pull;
+  pull.native_path = NativePath::kPull;
+  Measured pulled = measure(s, camera, PrecisionMode::kNative, pull);
+  EXPECT_TRUE(pulled.render.pulled_positions);
+  RenderOptions attribute;
+  attribute.native_path = NativePath::kAttribute;
+  attribute.mode = PrecisionMode::kNative;
+  attribute.probe = true;
+  Result<RenderResult> r = renderPoints(*context_, s, camera, attribute);
+  if (!context_->facts.r64g64b64_vertex) {
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ExitCode::kNoDevice);
+    EXPECT_NE(r.error().message.find("R64G64B64_SFLOAT"), std::string::npos) << r.error().message;
+    return;
+  }
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_FALSE(r->pulled_positions);
+  EXPECT_EQ(r->image.rgba, pulled.render.image.rgba);
+}
+
+TEST_F(Render, floatModesRefuseCoordinatesBeyondFloatRange) {
+  PointSet s;
+  s.positions = {{0, 0, 0}, {1e39, 0, 0}};
+  Camera camera = *makeCamera(CameraSpec{}, boundsOf(s));
+  for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kRte, PrecisionMode::kDf64, PrecisionMode::kBatch}) {
+    RenderOptions options;
+    options.mode = mode;
+    Result<RenderResult> r = renderPoints(*context_, s, camera, options);
+    ASSERT_FALSE(r.ok()) << modeName(mode);
+    EXPECT_EQ(r.error().code, ExitCode::kBadInput);
+    // batch: the offsets from the batch's centre (5e38) overflow, the first at point 0.
+    const char* expected = mode == PrecisionMode::kBatch ? "point 0: x = 0 (-5e+38 from its batch's centre)" : "point 1: x = 1e+39";
+    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+  }
+  RenderOptions native;
+  native.mode = PrecisionMode::kNative;
+  EXPECT_TRUE(renderPoints(*context_, s, camera, native).ok());
+}
+
+TEST_F(Render, pointSizeCoversASquareAndTheBackgroundFillsTheRest) {
+  PointSet s;
+  s.positions = {{0, 0, 0}, {1, 1, 0}, {2, 2, 0}};
+  s.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  CameraSpec spec;
+  spec.width = spec.height = 65;
+  spec.view_center = glm::dvec3(1, 1, 0);
+  spec.view_width = 20.0;  // the points land 3.25 px apart on the diagonal, the middle one on a pixel centre
+  Camera camera = *makeCamera(spec, boundsOf(s));
+  RenderOptions options;
+  options.point_size = 3.0f;
+  options.background_rgba8 = 0xff332211u;
+  Result<RenderResult> r = renderPoints(*context_, s, camera, options);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(litPixels(r->image, options.background_rgba8), 27u);
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) EXPECT_EQ(r->image.rgba[4 * ((32 + dy) * 65 + 32 + dx) + 1], 255);
+  EXPECT_EQ(r->image.rgba[0], 0x11);
+  EXPECT_EQ(r->image.rgba[1], 0x22);
+  EXPECT_EQ(r->image.rgba[2], 0x33);
+}
+
+TEST_F(Render, timedFramesReportGpuTimestamps) {
+  PointSet s = cloud(glm::dvec3(0.0), 1.0);
+  Camera camera = *makeCamera(CameraSpec{}, boundsOf(s));
+  RenderOptions options;
+  options.frames = 5;
+  Result<RenderResult> r = renderPoints(*context_, s, camera, options);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_GT(context_->facts.timestamp_period_ns, 0.0f) << "lavapipe has timestamps";
+  ASSERT_EQ(r->gpu_ms.size(), 5u);
+  ASSERT_EQ(r->frame_ms.size(), 5u);
+  for (double ms : r->gpu_ms) EXPECT_GT(ms, 0.0);
+  EXPECT_EQ(r->gpu_bytes, s.size() * 28u);
+}
+
+}  // namespace
+}  // namespace dpoint
