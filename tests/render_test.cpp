@@ -38,7 +38,7 @@ class Render : public ::testing::Test {
     Result<RenderResult> r = renderPoints(*context_, points, camera, options);
     EXPECT_TRUE(r.ok()) << modeName(mode) << ": " << r.error().message;
     if (!r.ok()) return {};
-    ErrorReport e = measureError(points, camera, *r, options.background_rgba8);
+    ErrorReport e = measureError(points, camera, *r, options);
     return {std::move(*r), std::move(e)};
   }
 

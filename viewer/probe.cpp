@@ -5,15 +5,19 @@
 namespace dpoint {
 
 ErrorReport measureError(const PointSet& points, const Camera& camera, const RenderResult& render,
-                         uint32_t background_rgba8) {
+                         const RenderOptions& options) {
   assert(render.probe_clip.size() == points.size());
   std::vector<WindowPoint> reference = projectReference(points.positions, camera);
   std::vector<WindowPoint> probe(points.size());
   for (size_t i = 0; i < points.size(); ++i) probe[i] = windowFromClip(render.probe_clip[i], camera);
   ErrorReport report;
   report.stats = compareToReference(reference, probe);
-  report.reference = rasterReference(reference, encodeColors(points), camera.width, camera.height, background_rgba8);
-  report.pixels_differing = countDifferingPixels(render.image, report.reference);
+  if (options.point_size == 1.0f) {
+    report.reference =
+        rasterReference(reference, encodeColors(points), camera.width, camera.height, options.background_rgba8);
+    report.pixels_compared = true;
+    report.pixels_differing = countDifferingPixels(render.image, report.reference);
+  }
   return report;
 }
 

@@ -10,12 +10,15 @@ namespace dpoint {
 
 struct ErrorReport {
   ErrorStats stats;
-  size_t pixels_differing = 0;  // rendered picture vs reference raster (point size 1)
+  // Rendered picture vs reference raster; the reference draws size-1 points only, so with a
+  // larger point size there is no image check (pixels_compared false).
+  bool pixels_compared = false;
+  size_t pixels_differing = 0;
   Image reference;              // the reference raster
 };
 
-// `render` must come from renderPoints with options.probe set.
+// `render` must come from renderPoints with options.probe set, and `options` be those it used.
 ErrorReport measureError(const PointSet& points, const Camera& camera, const RenderResult& render,
-                         uint32_t background_rgba8);
+                         const RenderOptions& options);
 
 }  // namespace dpoint
