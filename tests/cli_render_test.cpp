@@ -88,7 +88,8 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
       {{dir.file("one.csv"), "--point-size", "0"}, 1, "--point-size"},
       {{dir.file("one.csv"), "--background", "300,0,0"}, 1, "--background"},
       {{dir.file("one.csv"), "--device", "7"}, 3, "--device 7"},
-      {{dir.file("one.csv"), "--backend", "compute"}, 1, "--backend"},
+      {{dir.file("one.csv"), "--backend", "mesh"}, 1, "--backend"},
+      {{dir.file("one.csv"), "--backend", "compute", "--point-size", "2"}, 1, "--point-size"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = {"render"};

@@ -57,6 +57,13 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
   facts.large_points = features.largePoints;
 
   if (facts.vulkan12) {
+    VkPhysicalDeviceVulkan12Features features12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    VkPhysicalDeviceFeatures2 features2 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    features2.pNext = &features12;
+    vkGetPhysicalDeviceFeatures2(physical, &features2);
+    facts.int64_atomics = features.shaderInt64 && features12.shaderBufferInt64Atomics;
+  }
+  if (facts.vulkan12) {
     VkPhysicalDeviceMaintenance3Properties maintenance3 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
     VkPhysicalDeviceProperties2 with_m3 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
     with_m3.pNext = &maintenance3;
@@ -251,6 +258,9 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   enabled.shaderFloat64 = context->facts.shader_float64;
   enabled.vertexPipelineStoresAndAtomics = context->facts.vertex_stores;
   enabled.largePoints = context->facts.large_points;
+  enabled.shaderInt64 = context->facts.int64_atomics;
+  VkPhysicalDeviceVulkan12Features enabled12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  enabled12.shaderBufferInt64Atomics = context->facts.int64_atomics;
   float priority = 1.0f;
   VkDeviceQueueCreateInfo queue_info = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   queue_info.queueFamilyIndex = context->facts.queue_family;
@@ -260,6 +270,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   device_info.queueCreateInfoCount = 1;
   device_info.pQueueCreateInfos = &queue_info;
   device_info.pEnabledFeatures = &enabled;
+  device_info.pNext = &enabled12;
   VK_TRY(vkCreateDevice(context->physical, &device_info, nullptr, &context->device));
   vkGetDeviceQueue(context->device, context->facts.queue_family, 0, &context->queue);
 

@@ -22,6 +22,7 @@ struct DeviceFacts {
   bool shader_float64 = false;     // native mode
   bool vertex_stores = false;      // vertexPipelineStoresAndAtomics: the probe
   bool large_points = false;       // --point-size > 1
+  bool int64_atomics = false;      // shaderInt64 + shaderBufferInt64Atomics: the compute backend
   bool r64g64b64_vertex = false;   // native mode reads double vertex attributes (else pulls)
   uint64_t max_storage_buffer_range = 0, max_memory_allocation = 0;
   float max_point_size = 1.0f;

@@ -8,6 +8,13 @@
 #include "shaders/points_rte.vert.h"
 #include "shaders/points_split.vert.h"
 #include "shaders/points.frag.h"
+#include "shaders/points_resolve.comp.h"
+#include "shaders/splat_batch.comp.h"
+#include "shaders/splat_df64.comp.h"
+#include "shaders/splat_fp32.comp.h"
+#include "shaders/splat_native.comp.h"
+#include "shaders/splat_rte.comp.h"
+#include "shaders/splat_split.comp.h"
 
 namespace dpoint {
 namespace {
@@ -29,6 +36,61 @@ Spirv vertexShader(PrecisionMode mode, bool pull) {
     case PrecisionMode::kBatch: return {kPointsBatchVert, sizeof(kPointsBatchVert)};
   }
   return {nullptr, 0};
+}
+
+Spirv splatShader(PrecisionMode mode) {
+  switch (mode) {
+    case PrecisionMode::kFp32: return {kSplatFp32Comp, sizeof(kSplatFp32Comp)};
+    case PrecisionMode::kSplit: return {kSplatSplitComp, sizeof(kSplatSplitComp)};
+    case PrecisionMode::kRte: return {kSplatRteComp, sizeof(kSplatRteComp)};
+    case PrecisionMode::kDf64: return {kSplatDf64Comp, sizeof(kSplatDf64Comp)};
+    case PrecisionMode::kNative: return {kSplatNativeComp, sizeof(kSplatNativeComp)};
+    case PrecisionMode::kBatch: return {kSplatBatchComp, sizeof(kSplatBatchComp)};
+  }
+  return {nullptr, 0};
+}
+
+Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
+                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
+  VkDescriptorSetLayoutCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  info.bindingCount = static_cast<uint32_t>(bindings.size());
+  info.pBindings = bindings.data();
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  VK_TRY(vkCreateDescriptorSetLayout(context.device, &info, nullptr, &layout));
+  return layout;
+}
+
+Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
+                                        VkShaderStageFlags stages) {
+  VkPushConstantRange push{stages, 0, push_bytes};
+  VkPipelineLayoutCreateInfo info = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  info.setLayoutCount = 1;
+  info.pSetLayouts = &set;
+  info.pushConstantRangeCount = 1;
+  info.pPushConstantRanges = &push;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VK_TRY(vkCreatePipelineLayout(context.device, &info, nullptr, &layout));
+  return layout;
+}
+
+Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe) {
+  Result<VkShaderModule> module = createShaderModule(context, code.code, code.bytes);
+  if (!module) return module.error();
+  VkBool32 probe_value = probe ? VK_TRUE : VK_FALSE;
+  VkSpecializationMapEntry entry{0, 0, sizeof(VkBool32)};
+  VkSpecializationInfo specialization{1, &entry, sizeof(probe_value), &probe_value};
+  VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = *module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = &specialization;
+  info.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkResult result = vkCreateComputePipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(context.device, *module, nullptr);
+  if (result != VK_SUCCESS) return vulkanError("creating a compute pipeline", result);
+  return pipeline;
 }
 
 Result<VkRenderPass> createRenderPass(const VulkanContext& context) {
@@ -230,6 +292,53 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
     p.probe = *probe;
   }
   return p;
+}
+
+Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe) {
+  ComputePipelines p;
+  auto fail = [&](const Error& error) -> Result<ComputePipelines> {
+    destroyComputePipelines(context, p);
+    return error;
+  };
+  auto storage = [](uint32_t binding) {
+    return VkDescriptorSetLayoutBinding{binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  };
+  Result<VkDescriptorSetLayout> splat_set = storageSetLayout(context, {
+      {kBindingCamera, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      storage(kBindingPositions), storage(kBindingBatches), storage(kBindingProbe), storage(kBindingVisibility)});
+  if (!splat_set) return fail(splat_set.error());
+  p.splat_set = *splat_set;
+  Result<VkDescriptorSetLayout> resolve_set = storageSetLayout(context, {storage(0), storage(1), storage(2)});
+  if (!resolve_set) return fail(resolve_set.error());
+  p.resolve_set = *resolve_set;
+  Result<VkPipelineLayout> splat_layout = pipelineLayout(context, p.splat_set, sizeof(PushConstants), VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!splat_layout) return fail(splat_layout.error());
+  p.splat_layout = *splat_layout;
+  Result<VkPipelineLayout> resolve_layout = pipelineLayout(context, p.resolve_set, sizeof(ResolvePush), VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!resolve_layout) return fail(resolve_layout.error());
+  p.resolve_layout = *resolve_layout;
+  Result<VkPipeline> splat = computePipeline(context, splatShader(mode), p.splat_layout, false);
+  if (!splat) return fail(splat.error());
+  p.splat = *splat;
+  if (with_probe) {
+    Result<VkPipeline> probe = computePipeline(context, splatShader(mode), p.splat_layout, true);
+    if (!probe) return fail(probe.error());
+    p.probe = *probe;
+  }
+  Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout, false);
+  if (!resolve) return fail(resolve.error());
+  p.resolve = *resolve;
+  return p;
+}
+
+void destroyComputePipelines(const VulkanContext& context, ComputePipelines& p) {
+  for (VkPipeline pipeline : {p.splat, p.probe, p.resolve})
+    if (pipeline) vkDestroyPipeline(context.device, pipeline, nullptr);
+  for (VkPipelineLayout layout : {p.splat_layout, p.resolve_layout})
+    if (layout) vkDestroyPipelineLayout(context.device, layout, nullptr);
+  for (VkDescriptorSetLayout set : {p.splat_set, p.resolve_set})
+    if (set) vkDestroyDescriptorSetLayout(context.device, set, nullptr);
+  p = ComputePipelines{};
 }
 
 void destroyPointPipelines(const VulkanContext& context, PointPipelines& p) {

@@ -15,13 +15,19 @@ inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 // 1 double positions (native mode pulling), 2 batch matrices, 3 probe output.
 inline constexpr uint32_t kBindingCamera = 0, kBindingPositions = 1, kBindingBatches = 2, kBindingProbe = 3;
 
-// Push constants of shaders/points.vert.
+// Push constants of shaders/project.glsl (both backends).
 struct PushConstants {
   float splitter = 4097.0f;  // 2^12 + 1: Dekker's split of a 24-bit significand
   float point_size = 1.0f;
-  uint32_t first_index = 0;  // index of the draw's first point in the whole set (batch mode)
+  uint32_t first_index = 0;  // index of the draw's first point in the whole set
   uint32_t batch_size = kBatchSize;
+  uint32_t width = 0, height = 0, count = 0;  // compute backend
 };
+
+// Descriptor bindings of the compute backend beyond the shared four: 4 the visibility buffer
+// (one uint64 per pixel); the resolve pass has its own set (visibility, colours, picture).
+inline constexpr uint32_t kBindingVisibility = 4;
+inline constexpr uint32_t kComputeGroupSize = 256;  // local_size_x of both compute shaders
 
 struct PointPipelines {
   VkRenderPass render_pass = VK_NULL_HANDLE;
@@ -36,6 +42,19 @@ struct PointPipelines {
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
                                             bool with_probe, uint32_t width, uint32_t height);
 void destroyPointPipelines(const VulkanContext& context, PointPipelines& pipelines);
+
+// The compute backend (DESIGN §4): a splat pass per mode (and its probe twin) and the resolve.
+struct ComputePipelines {
+  VkDescriptorSetLayout splat_set = VK_NULL_HANDLE, resolve_set = VK_NULL_HANDLE;
+  VkPipelineLayout splat_layout = VK_NULL_HANDLE, resolve_layout = VK_NULL_HANDLE;
+  VkPipeline splat = VK_NULL_HANDLE, probe = VK_NULL_HANDLE, resolve = VK_NULL_HANDLE;
+};
+struct ResolvePush {
+  uint32_t pixels = 0;
+  uint32_t background = 0;
+};
+Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe);
+void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
 // Creates a shader module from SPIR-V words.
 Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);

@@ -7,57 +7,19 @@
 
 #include "viewer/buffers.h"
 #include "viewer/pipelines.h"
+#include "viewer/render_internal.h"
 #include "viewer/selftest.h"
 
 namespace dpoint {
 namespace {
 
+using detail::Chunk;
+using detail::Resources;
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
-
-struct Chunk {
-  size_t first = 0, count = 0;
-  Buffer positions, colors, probe;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-};
-
-// Everything one render creates, destroyed in reverse on every path out.
-struct Resources {
-  explicit Resources(const VulkanContext& c) : context(c) {}
-  ~Resources() {
-    VkDevice device = context.device;
-    vkDeviceWaitIdle(device);
-    if (fence) vkDestroyFence(device, fence, nullptr);
-    if (frame_commands) vkFreeCommandBuffers(device, context.command_pool, 1, &frame_commands);
-    if (queries) vkDestroyQueryPool(device, queries, nullptr);
-    if (framebuffer) vkDestroyFramebuffer(device, framebuffer, nullptr);
-    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
-    for (Chunk& chunk : chunks) {
-      destroyBuffer(context, chunk.positions);
-      destroyBuffer(context, chunk.colors);
-      destroyBuffer(context, chunk.probe);
-    }
-    destroyBuffer(context, camera);
-    destroyBuffer(context, batches);
-    destroyBuffer(context, dummy);
-    destroyBuffer(context, readback);
-    destroyImage(context, color);
-    destroyImage(context, depth);
-    destroyPointPipelines(context, pipelines);
-  }
-  const VulkanContext& context;
-  PointPipelines pipelines;
-  Buffer camera, batches, dummy, readback;
-  GpuImage color, depth;
-  VkFramebuffer framebuffer = VK_NULL_HANDLE;
-  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
-  VkQueryPool queries = VK_NULL_HANDLE;
-  VkCommandBuffer frame_commands = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  std::vector<Chunk> chunks;
-};
 
 // Points per draw: every per-chunk buffer must fit one allocation and, when read as a storage
 // buffer (pulled positions, probe output), one descriptor range.
@@ -85,6 +47,17 @@ Status checkOptions(const VulkanContext& context, const PointSet& points, const 
                  ExitCode::kUsage};
   if (options.point_size != 1.0f && !f.large_points)
     return Error{"--point-size above 1 needs the largePoints feature, which " + f.name + " lacks", ExitCode::kNoDevice};
+  if (options.backend == Backend::kCompute) {
+    if (!f.int64_atomics)
+      return Error{"--backend compute needs shaderInt64 and shaderBufferInt64Atomics, which " + f.name + " lacks",
+                   ExitCode::kNoDevice};
+    if (options.point_size != 1.0f)
+      return Error{"--backend compute draws points of size 1; --point-size needs --backend raster", ExitCode::kUsage};
+    if (uint64_t{4} * points.size() > f.max_storage_buffer_range)
+      return Error{"--backend compute keeps every colour in one storage buffer: " + std::to_string(points.size()) +
+                       " points exceed " + f.name + "'s maxStorageBufferRange; use --backend raster",
+                   ExitCode::kResourceLimit};
+  }
   if (options.mode == PrecisionMode::kNative && options.native_path == NativePath::kAttribute && !f.r64g64b64_vertex)
     return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; native mode must pull positions",
                  ExitCode::kNoDevice};
@@ -146,8 +119,19 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
                     const std::vector<glm::dvec3>& origins, bool pulled, size_t per_chunk) {
   std::vector<uint32_t> colors = encodeColors(points);
   const uint32_t stride = positionBytes(options.mode);
+  const bool compute = options.backend == Backend::kCompute;
   VkBufferUsageFlags position_usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-      (pulled ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+      (pulled || compute ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  if (compute) {
+    Result<Buffer> all = createBuffer(context, points.size() * 4,
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, "colours");
+    if (!all) return all.error();
+    r.all_colors = *all;
+    Status status = uploadBuffer(context, r.all_colors, points.size() * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+      std::memcpy(dst, colors.data() + offset / 4, bytes);
+    });
+    if (!status) return status;
+  }
   for (size_t first = 0; first < points.size(); first += per_chunk) {
     Chunk& chunk = r.chunks.emplace_back();
     chunk.first = first;
@@ -163,6 +147,7 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
           encodePositions(options.mode, points, origins, chunk.first + offset / stride, bytes / stride, dst);
         }, piece);
     if (!status) return status;
+    if (!compute) {
     Result<Buffer> color_buffer = createBuffer(context, chunk.count * 4,
         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, what + " colours");
     if (!color_buffer) return color_buffer.error();
@@ -171,6 +156,7 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
       std::memcpy(dst, colors.data() + chunk.first + offset / 4, bytes);
     });
     if (!status) return status;
+    }
     if (options.probe) {
       Result<Buffer> probe = createBuffer(context, chunk.count * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                           true, what + " probe");
@@ -271,7 +257,10 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
   VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &r.frame_commands));
   VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   VK_TRY(vkBeginCommandBuffer(r.frame_commands, &begin));
-  recordDraws(r.frame_commands, r, r.pipelines.draw, options, width, height, timestamps);
+  if (options.backend == Backend::kCompute)
+    detail::recordCompute(r.frame_commands, r, r.compute.splat, options, width, height, timestamps);
+  else
+    recordDraws(r.frame_commands, r, r.pipelines.draw, options, width, height, timestamps);
   VK_TRY(vkEndCommandBuffer(r.frame_commands));
   VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
@@ -300,10 +289,15 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
 Status readPicture(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, RenderResult& out) {
   Clock::time_point start = Clock::now();
   Status status = submitOnce(context, [&](VkCommandBuffer commands) {
-    VkBufferImageCopy copy{};
-    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    copy.imageExtent = {width, height, 1};  // bufferRowLength 0: rows packed, pitch = width · 4
-    vkCmdCopyImageToBuffer(commands, r.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r.readback.buffer, 1, &copy);
+    if (r.picture.buffer) {  // compute: the resolve wrote packed RGBA8 rows
+      VkBufferCopy copy{0, 0, VkDeviceSize{width} * height * 4};
+      vkCmdCopyBuffer(commands, r.picture.buffer, r.readback.buffer, 1, &copy);
+    } else {
+      VkBufferImageCopy copy{};
+      copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      copy.imageExtent = {width, height, 1};  // bufferRowLength 0: rows packed, pitch = width · 4
+      vkCmdCopyImageToBuffer(commands, r.color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r.readback.buffer, 1, &copy);
+    }
     VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
@@ -324,12 +318,16 @@ Status readPicture(const VulkanContext& context, Resources& r, uint32_t width, u
 Status runProbe(const VulkanContext& context, Resources& r, const RenderOptions& options, uint32_t width,
                 uint32_t height, size_t count, RenderResult& out) {
   Status status = submitOnce(context, [&](VkCommandBuffer commands) {
-    recordDraws(commands, r, r.pipelines.probe, options, width, height, false);
+    const bool compute = options.backend == Backend::kCompute;
+    if (compute)
+      detail::recordCompute(commands, r, r.compute.probe, options, width, height, false);
+    else
+      recordDraws(commands, r, r.pipelines.probe, options, width, height, false);
     VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
     barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_VERTEX_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
-                         nullptr, 0, nullptr);
+    vkCmdPipelineBarrier(commands, compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
+                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
   });
   if (!status) return status;
   out.probe_clip.resize(count);
@@ -353,7 +351,9 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
     if (!ran) return ran.error();
     self_test = *ran;
   }
-  status = modeUsable(context, options.mode, self_test, options.probe);
+  const bool compute = options.backend == Backend::kCompute;
+  // The compute probe writes from a compute shader, which needs no vertex-stage stores.
+  status = modeUsable(context, options.mode, self_test, options.probe && !compute);
   if (!status) return status.error();
 
   Clock::time_point upload_start = Clock::now();
@@ -361,26 +361,39 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
   status = checkEncodable(options.mode, points, origins);
   if (!status) return status.error();
 
+  // Positions come from a storage buffer in the compute backend, and for native mode on a device
+  // without double vertex attributes.
   bool pulled = options.mode == PrecisionMode::kNative &&
-                (options.native_path == NativePath::kPull ||
+                (compute || options.native_path == NativePath::kPull ||
                  (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
   Resources r(context);
-  Result<PointPipelines> pipelines =
-      createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height);
-  if (!pipelines) return pipelines.error();
-  r.pipelines = *pipelines;
+  if (compute) {
+    Result<ComputePipelines> pipelines = createComputePipelines(context, options.mode, options.probe);
+    if (!pipelines) return pipelines.error();
+    r.compute = *pipelines;
+  } else {
+    Result<PointPipelines> pipelines =
+        createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height);
+    if (!pipelines) return pipelines.error();
+    r.pipelines = *pipelines;
+  }
 
   RenderResult out;
   out.pulled_positions = pulled;
   status = createUniforms(context, r, camera, options, origins);
-  if (status) status = uploadPoints(context, r, points, options, origins, pulled, chunkPoints(context.facts, options, pulled));
+  if (status) status = uploadPoints(context, r, points, options, origins, pulled, chunkPoints(context.facts, options, pulled || compute));
   if (!status) return status.error();
   out.chunks = static_cast<uint32_t>(r.chunks.size());
   out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * points.size();
   out.upload_ms = msSince(upload_start);
 
-  status = createTargets(context, r, camera.width, camera.height);
-  if (status) status = createDescriptors(context, r, pulled, options.probe);
+  if (compute) {
+    status = detail::createComputeTargets(context, r, camera.width, camera.height);
+    if (status) status = detail::createComputeDescriptors(context, r, options.probe);
+  } else {
+    status = createTargets(context, r, camera.width, camera.height);
+    if (status) status = createDescriptors(context, r, pulled, options.probe);
+  }
   if (status) status = timeFrames(context, r, options, camera.width, camera.height, out);
   if (status) status = readPicture(context, r, camera.width, camera.height, out);
   if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, points.size(), out);

@@ -1,6 +1,7 @@
-// The raster backend (DESIGN §4, §6): uploads a point set in one precision mode, draws it as
-// POINT_LIST into an offscreen RGBA8 + D32 (reversed Z) target, times the draws with GPU
-// timestamps, reads the picture back, and with `probe` also reads every point's clip position.
+// Offscreen point rendering (DESIGN §4, §6): uploads a point set in one precision mode, draws it
+// with the raster backend (POINT_LIST into RGBA8 + D32, reversed Z) or the compute backend,
+// times the GPU work with timestamps, reads the picture back, and with `probe` also reads every
+// point's clip position.
 #pragma once
 
 #include <cstdint>
@@ -19,8 +20,14 @@ namespace dpoint {
 
 enum class NativePath { kAuto, kAttribute, kPull };
 
+// raster: graphics pipeline, POINT_LIST, D32 depth (the study's design). compute: one thread per
+// point, 64-bit atomicMax into a per-pixel visibility buffer, then a resolve pass (DESIGN §4);
+// same projection code, same picture, size-1 points only.
+enum class Backend { kRaster, kCompute };
+
 struct RenderOptions {
   PrecisionMode mode = PrecisionMode::kNative;
+  Backend backend = Backend::kRaster;
   float point_size = 1.0f;
   uint32_t background_rgba8 = 0xff000000u;  // opaque black, R in the low byte
   uint32_t warmup_frames = 1;

@@ -1,0 +1,50 @@
+#version 450
+// Compute backend, pass 1 (DESIGN §4): one thread per point projects it with the same code as the
+// raster path (project.glsl), finds its pixel as the rasterizer would (top-left rule for a size-1
+// point) and keeps the nearest point per pixel with a 64-bit atomicMax of
+// (depth bits << 32 | ~index): reversed Z, so the greater depth wins, and on a tie the lower
+// index, as the raster depth test GREATER keeps the point drawn first.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_atomic_int64 : require
+#extension GL_ARB_gpu_shader_int64 : require
+#include "project.glsl"
+
+layout(constant_id = 0) const bool kProbe = false;
+layout(local_size_x = 256) in;
+
+layout(std430, set = 0, binding = 3) writeonly buffer Probe { vec4 probe_clip[]; };
+layout(std430, set = 0, binding = 4) buffer Visibility { uint64_t visibility[]; };
+#if defined(MODE_NATIVE_PULL)
+layout(std430, set = 0, binding = 1) readonly buffer Positions { double positions[]; };
+#else
+layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
+#endif
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.count) return;
+  PointInput point;
+#if defined(MODE_SPLIT) || defined(MODE_RTE) || defined(MODE_DF64)
+  uint base = 6u * i;
+  point.hi = vec3(positions[base], positions[base + 1u], positions[base + 2u]);
+  point.lo = vec3(positions[base + 3u], positions[base + 4u], positions[base + 5u]);
+#elif defined(MODE_NATIVE_PULL)
+  uint base = 3u * i;
+  point.position = dvec3(positions[base], positions[base + 1u], positions[base + 2u]);
+#else
+  uint base = 3u * i;
+  point.position = vec3(positions[base], positions[base + 1u], positions[base + 2u]);
+#endif
+  uint index = pc.first_index + i;
+  vec4 clip = projectPoint(point, index);
+  if (kProbe) probe_clip[i] = clip;
+  // The view volume as the rasterizer clips it: w > 0, |x|, |y| ≤ w, 0 ≤ z ≤ w.
+  if (!(clip.w > 0.0) || abs(clip.x) > clip.w || abs(clip.y) > clip.w || clip.z < 0.0 || clip.z > clip.w) return;
+  float depth = clip.z / clip.w;
+  float x = (clip.x / clip.w * 0.5 + 0.5) * float(pc.width);
+  float y = (clip.y / clip.w * 0.5 + 0.5) * float(pc.height);
+  int px = int(ceil(x)) - 1, py = int(ceil(y)) - 1;
+  if (px < 0 || py < 0 || px >= int(pc.width) || py >= int(pc.height)) return;
+  uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
+  atomicMax(visibility[uint(py) * pc.width + uint(px)], key);
+}

@@ -1,0 +1,68 @@
+// The per-mode projection (DESIGN §4), shared by the raster vertex shader (points.vert) and the
+// compute splat (points_splat.comp), so both backends and the probe run the same arithmetic.
+// The mode is a define: MODE_FP32, MODE_SPLIT, MODE_RTE, MODE_DF64, MODE_NATIVE_ATTR,
+// MODE_NATIVE_PULL (native reading a storage buffer) or MODE_BATCH.
+
+layout(push_constant) uniform Push {
+  float splitter;    // 2^12 + 1, at run time so the split cannot be folded
+  float point_size;
+  uint first_index;  // index of this draw's first point in the whole set (batch mode, compute)
+  uint batch_size;
+  uint width, height, count;  // compute backend: target size, points in this dispatch
+} pc;
+
+#if defined(MODE_FP32) || defined(MODE_SPLIT)
+layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 mvp; } cam;
+#elif defined(MODE_RTE)
+layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 projection_rotation; vec4 eye_hi; vec4 eye_lo; } cam;
+#elif defined(MODE_DF64)
+#include "df64.glsl"
+layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 mvp_hi; mat4 mvp_lo; } cam;
+#elif defined(MODE_NATIVE_ATTR) || defined(MODE_NATIVE_PULL)
+layout(std140, set = 0, binding = 0) uniform CameraBlock { dmat4 mvp; } cam;
+#elif defined(MODE_BATCH)
+layout(std430, set = 0, binding = 2) readonly buffer Batches { mat4 batch_mvp[]; };
+#else
+#error "no MODE_* defined"
+#endif
+
+// What one point carries, per mode.
+#if defined(MODE_FP32) || defined(MODE_BATCH)
+struct PointInput { vec3 position; };
+#elif defined(MODE_SPLIT) || defined(MODE_RTE) || defined(MODE_DF64)
+struct PointInput { vec3 hi; vec3 lo; };
+#else
+struct PointInput { dvec3 position; };
+#endif
+
+// Clip position of point `index` (its index in the whole set: batch mode needs it).
+vec4 projectPoint(PointInput point, uint index) {
+#if defined(MODE_FP32)
+  return cam.mvp * vec4(point.position, 1.0);
+#elif defined(MODE_SPLIT)
+  // The study's listing: hi + lo rounds back to hi, so this is fp32 with twice the bytes.
+  return cam.mvp * vec4(point.hi + point.lo, 1.0);
+#elif defined(MODE_RTE)
+  // (hi − eye_hi) is exact when the point is near the eye (Sterbenz); adding the low parts'
+  // difference keeps the eye-relative vector to float rounding.
+  precise vec3 d_hi = point.hi - cam.eye_hi.xyz;
+  precise vec3 d_lo = point.lo - cam.eye_lo.xyz;
+  precise vec3 relative = d_hi + d_lo;
+  return cam.projection_rotation * vec4(relative, 1.0);
+#elif defined(MODE_DF64)
+  vec2 p[4] = vec2[4](vec2(point.hi.x, point.lo.x), vec2(point.hi.y, point.lo.y), vec2(point.hi.z, point.lo.z),
+                      vec2(1.0, 0.0));
+  vec4 clip;
+  for (int r = 0; r < 4; ++r) {
+    vec2 sum = vec2(cam.mvp_hi[3][r], cam.mvp_lo[3][r]);
+    for (int c = 0; c < 3; ++c)
+      sum = dfAdd(sum, dfMul(vec2(cam.mvp_hi[c][r], cam.mvp_lo[c][r]), p[c], pc.splitter));
+    clip[r] = sum.x;  // hi is the float nearest the double-float value
+  }
+  return clip;
+#elif defined(MODE_NATIVE_ATTR) || defined(MODE_NATIVE_PULL)
+  return vec4(cam.mvp * dvec4(point.position, 1.0));
+#elif defined(MODE_BATCH)
+  return batch_mvp[index / pc.batch_size] * vec4(point.position, 1.0);
+#endif
+}

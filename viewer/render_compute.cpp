@@ -1,0 +1,111 @@
+// The compute backend (DESIGN §4): one thread per point projects it with the mode's code
+// (shaders/project.glsl, the same as the raster vertex shader) and keeps the nearest point per
+// pixel with a 64-bit atomicMax into a visibility buffer; a resolve pass per pixel then fetches
+// the winner's colour. No rasterizer, no depth attachment: on GPUs whose graphics front end is
+// small next to their compute (H100/H200 run graphics on two TPCs) this is the fast path.
+#include <cstring>
+
+#include "viewer/render_internal.h"
+
+namespace dpoint::detail {
+
+Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height) {
+  const VkDeviceSize pixels = VkDeviceSize{width} * height;
+  Result<Buffer> visibility = createBuffer(context, pixels * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                           false, "visibility buffer");
+  if (!visibility) return visibility.error();
+  r.visibility = *visibility;
+  Result<Buffer> picture = createBuffer(context, pixels * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                        false, "picture");
+  if (!picture) return picture.error();
+  r.picture = *picture;
+  Result<Buffer> readback = createBuffer(context, pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "picture readback");
+  if (!readback) return readback.error();
+  r.readback = *readback;
+  return okStatus();
+}
+
+Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe) {
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1;
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * sets}};
+  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = sets;
+  pool_info.poolSizeCount = 2;
+  pool_info.pPoolSizes = sizes;
+  VK_TRY(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &r.descriptor_pool));
+  auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
+  auto allocate = [&](VkDescriptorSetLayout layout, VkDescriptorSet& set) -> Status {
+    VkDescriptorSetAllocateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    info.descriptorPool = r.descriptor_pool;
+    info.descriptorSetCount = 1;
+    info.pSetLayouts = &layout;
+    VK_TRY(vkAllocateDescriptorSets(context.device, &info, &set));
+    return okStatus();
+  };
+  auto write = [&](VkDescriptorSet set, const std::vector<VkDescriptorBufferInfo>& infos, bool first_is_uniform) {
+    std::vector<VkWriteDescriptorSet> writes(infos.size());
+    for (uint32_t b = 0; b < infos.size(); ++b) {
+      writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[b].dstSet = set;
+      writes[b].dstBinding = b;
+      writes[b].descriptorCount = 1;
+      writes[b].descriptorType = b == 0 && first_is_uniform ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[b].pBufferInfo = &infos[b];
+    }
+    vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  };
+  for (Chunk& chunk : r.chunks) {
+    if (Status status = allocate(r.compute.splat_set, chunk.set); !status) return status;
+    write(chunk.set, {whole(r.camera), whole(chunk.positions), r.batches.buffer ? whole(r.batches) : whole(r.dummy),
+                      probe ? whole(chunk.probe) : whole(r.dummy), whole(r.visibility)}, true);
+  }
+  if (Status status = allocate(r.compute.resolve_set, r.resolve_set); !status) return status;
+  write(r.resolve_set, {whole(r.visibility), whole(r.all_colors), whole(r.picture)}, false);
+  return okStatus();
+}
+
+void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
+                   uint32_t width, uint32_t height, bool timed) {
+  auto barrier = [&](VkPipelineStageFlags src_stage, VkAccessFlags src, VkPipelineStageFlags dst_stage, VkAccessFlags dst) {
+    VkMemoryBarrier b = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = src;
+    b.dstAccessMask = dst;
+    vkCmdPipelineBarrier(commands, src_stage, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
+  };
+  const uint32_t pixels = width * height;
+  if (timed) {
+    vkCmdResetQueryPool(commands, r.queries, 0, 2);
+    vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r.queries, 0);
+  }
+  // The previous frame's resolve read the keys; then they start again from 0 (nothing drawn).
+  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT);
+  vkCmdFillBuffer(commands, r.visibility.buffer, 0, VK_WHOLE_SIZE, 0);
+  barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, splat);
+  for (const Chunk& chunk : r.chunks) {
+    PushConstants push;
+    push.point_size = options.point_size;
+    push.first_index = static_cast<uint32_t>(chunk.first);
+    push.width = width;
+    push.height = height;
+    push.count = static_cast<uint32_t>(chunk.count);
+    vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
+    vkCmdDispatch(commands, static_cast<uint32_t>((chunk.count + kComputeGroupSize - 1) / kComputeGroupSize), 1, 1);
+  }
+  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_SHADER_READ_BIT);
+  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve);
+  ResolvePush resolve{pixels, options.background_rgba8};
+  vkCmdPushConstants(commands, r.compute.resolve_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(resolve), &resolve);
+  vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve_layout, 0, 1, &r.resolve_set, 0, nullptr);
+  vkCmdDispatch(commands, (pixels + kComputeGroupSize - 1) / kComputeGroupSize, 1, 1);
+  if (timed) vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r.queries, 1);
+  // The picture is copied out by a later submission.
+  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_TRANSFER_READ_BIT);
+}
+
+}  // namespace dpoint::detail

@@ -1,0 +1,70 @@
+// Internals shared by the two backends of viewer/render.cpp (raster) and
+// viewer/render_compute.cpp (compute). Not part of the library's interface.
+#pragma once
+
+#include <vector>
+
+#include "viewer/buffers.h"
+#include "viewer/pipelines.h"
+#include "viewer/render.h"
+
+namespace dpoint::detail {
+
+struct Chunk {
+  size_t first = 0, count = 0;
+  Buffer positions, colors, probe;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+};
+
+// Everything one render creates, destroyed in reverse on every path out.
+struct Resources {
+  explicit Resources(const VulkanContext& c) : context(c) {}
+  ~Resources() {
+    VkDevice device = context.device;
+    vkDeviceWaitIdle(device);
+    if (fence) vkDestroyFence(device, fence, nullptr);
+    if (frame_commands) vkFreeCommandBuffers(device, context.command_pool, 1, &frame_commands);
+    if (queries) vkDestroyQueryPool(device, queries, nullptr);
+    if (framebuffer) vkDestroyFramebuffer(device, framebuffer, nullptr);
+    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
+    for (Chunk& chunk : chunks) {
+      destroyBuffer(context, chunk.positions);
+      destroyBuffer(context, chunk.colors);
+      destroyBuffer(context, chunk.probe);
+    }
+    destroyBuffer(context, camera);
+    destroyBuffer(context, batches);
+    destroyBuffer(context, dummy);
+    destroyBuffer(context, readback);
+    destroyBuffer(context, all_colors);
+    destroyBuffer(context, visibility);
+    destroyBuffer(context, picture);
+    destroyImage(context, color);
+    destroyImage(context, depth);
+    destroyPointPipelines(context, pipelines);
+    destroyComputePipelines(context, compute);
+  }
+  const VulkanContext& context;
+  PointPipelines pipelines;
+  Buffer camera, batches, dummy, readback;
+  GpuImage color, depth;
+  VkFramebuffer framebuffer = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  VkCommandBuffer frame_commands = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  std::vector<Chunk> chunks;
+  // Compute backend: one colour buffer for the resolve, the per-pixel keys, the RGBA8 picture.
+  ComputePipelines compute;
+  Buffer all_colors, visibility, picture;
+  VkDescriptorSet resolve_set = VK_NULL_HANDLE;
+};
+
+// Compute backend pieces (viewer/render_compute.cpp).
+Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height);
+Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe);
+// Clears the visibility buffer, splats every chunk with `splat`, resolves into the picture.
+void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
+                   uint32_t width, uint32_t height, bool timed);
+
+}  // namespace dpoint::detail
