@@ -29,7 +29,10 @@ if not os.path.exists(glb):  # the input is the same every time; make it once
     median_of([exe, "generate", "sierpinski", "--level", "11", "--unwelded", "--quiet", "-o", glb], 1)
 
 results = {"machine": f"{platform.node()} ({os.cpu_count()} cores)", "runs": runs,
-           "input": "sierpinski --level 11 --unwelded (GLB)", "input_bytes": os.path.getsize(glb), "cases": []}
+           "input": "sierpinski --level 11 --unwelded (GLB)", "input_bytes": os.path.getsize(glb),
+           # Other work on the machine skews whole-process timings: the 1-minute load average
+           # before the first and after the last case is kept with the numbers.
+           "load_average_before": round(os.getloadavg()[0], 2), "cases": []}
 cases = [
     # name, argv, output written
     # dpoint adds r,g,b (the material's base colour) since the model has a material; the node
@@ -46,6 +49,8 @@ for name, argv, output in cases:
     size = os.path.getsize(path)
     results["cases"].append({"name": name, "command": " ".join(os.path.basename(a) for a in argv),
                              "s": round(seconds, 2), "peak_rss_MB": round(rss / 1e6, 1),
+                             "peak_rss_per_input_byte": round(rss / results["input_bytes"], 2),
                              "output_bytes": size, "output_MB_per_s": round(size / seconds / 1e6, 1)})
     os.remove(path)  # several GB of text; keep the disk free for the next case
+results["load_average_after"] = round(os.getloadavg()[0], 2)
 print(json.dumps(results, indent=2))

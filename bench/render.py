@@ -4,7 +4,8 @@
 run; and each mode's error on the hard cases (DESIGN §7). Every number comes from
 `dpoint render --json` (GPU timestamps, median of --frames after warm-up).
 
-Usage: bench/render.py DPOINT OUT_PREFIX [--frames N] [--sizes 1m,10m,16m] [--device auto] [--work DIR]
+Usage: bench/render.py DPOINT OUT_PREFIX [--frames N] [--sizes 1m,10m,16m] [--backends raster,compute]
+                       [--device auto] [--work DIR]
 Writes OUT_PREFIX.json and OUT_PREFIX.md (tables) and OUT_PREFIX.svg (time against error).
 Datasets (made with DPOINT itself, so the GPU machine needs nothing else):
   1m   sierpinski --level 9 --unwelded   (1,048,576 points, 3D)
@@ -54,6 +55,7 @@ def main():
     ap.add_argument("out_prefix")
     ap.add_argument("--frames", type=int, default=20)
     ap.add_argument("--sizes", default="1m,10m,16m")
+    ap.add_argument("--backends", default="raster,compute")
     ap.add_argument("--device", default="auto")
     ap.add_argument("--work", default="/tmp/dpoint-bench-render")
     a = ap.parse_args()
@@ -61,20 +63,22 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     common = ["--device", a.device]
 
+    backends = a.backends.split(",")
     speed = []
     for size in a.sizes.split(","):
         data = generate(dpoint, a.work, size, SIZES[size])
-        rows = {}
-        for mode in MODES:
-            r = render(dpoint, a.work, data, mode, common + ["--width", "1920", "--height", "1080", "--frames",
-                                                             str(a.frames), "--warmup", "2"])
-            rows[mode] = r
-            print(f"{size} {mode}: {r['gpu_ms']['median']:.3f} ms", file=sys.stderr, flush=True)
-        base = rows["fp32"]["gpu_ms"]["median"]
-        for mode, r in rows.items():
-            r["dataset"] = size
-            r["ratio_to_fp32"] = r["gpu_ms"]["median"] / base
-            speed.append(r)
+        for backend in backends:
+            rows = {}
+            for mode in MODES:
+                r = render(dpoint, a.work, data, mode, common + ["--backend", backend, "--width", "1920", "--height",
+                                                                 "1080", "--frames", str(a.frames), "--warmup", "2"])
+                rows[mode] = r
+                print(f"{size} {backend} {mode}: {r['gpu_ms']['median']:.3f} ms", file=sys.stderr, flush=True)
+            base = rows["fp32"]["gpu_ms"]["median"]
+            for mode, r in rows.items():
+                r["dataset"] = size
+                r["ratio_to_fp32"] = r["gpu_ms"]["median"] / base
+                speed.append(r)
 
     mb = generate(dpoint, a.work, "mandelbulb_earth", ["mandelbulb", "--resolution", "65", "--offset", "6378137,0,0"])
     zoom = generate(dpoint, a.work, "deepzoom_1e-9", ["mandelbrot2d", "--width", "1e-9", "--resolution", "512", "--max-iter", "1000"])
@@ -85,10 +89,11 @@ def main():
         ("deepzoom 1e-9 (mandelbrot2d 512²)", zoom,
          ["--view-center", "-0.7436450,0.1318259", "--view-width", "1e-9", "--width", "512", "--height", "512"]),
     ]:
-        for mode in MODES:
-            r = render(dpoint, a.work, data, mode, common + camera + ["--error", "--frames", "5"])
-            r["case"] = name
-            hard.append(r)
+        for backend in backends:
+            for mode in MODES:
+                r = render(dpoint, a.work, data, mode, common + camera + ["--backend", backend, "--error", "--frames", "5"])
+                r["case"] = name
+                hard.append(r)
 
     device = speed[0] if speed else hard[0]
     result = {"device": device["device"], "driver": device["driver"], "driver_version": device["driver_version"],
@@ -105,36 +110,38 @@ def main():
 def markdown(result):
     lines = [f"Device: {result['device']}, driver {result['driver']} ({result['driver_version']}); "
              f"1920x1080, GPU timestamps, median of {result['frames']} frames after 2 warm-up.", "",
-             "| points | mode | B/pt | GPU ms/frame (median) | p95 | points/s | × fp32 |", "| --- | --- | --- | --- | --- | --- | --- |"]
+             "| points | backend | mode | B/pt | GPU ms/frame (median) | p95 | points/s | × fp32 |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in result["speed"]:
-        lines.append(f"| {r['points']:,} | {r['mode']} | {r['bytes_per_point']} | {r['gpu_ms']['median']:.3f} | "
+        lines.append(f"| {r['points']:,} | {r['backend']} | {r['mode']} | {r['bytes_per_point']} | {r['gpu_ms']['median']:.3f} | "
                      f"{r['gpu_ms']['p95']:.3f} | {r['points_per_s']:.3g} | {r['ratio_to_fp32']:.2f} |")
-    lines += ["", "| hard case | mode | max px | p99 px | rms px | share ≥ 0.5 px | lost | pixels differing |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    lines += ["", "| hard case | backend | mode | max px | p99 px | rms px | share ≥ 0.5 px | lost | pixels differing |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in result["hard_cases"]:
         e = r["error_px"]
-        lines.append(f"| {r['case']} | {r['mode']} | {e['max']:.3g} | {e['p99']:.3g} | {e['rms']:.3g} | "
+        lines.append(f"| {r['case']} | {r['backend']} | {r['mode']} | {e['max']:.3g} | {e['p99']:.3g} | {e['rms']:.3g} | "
                      f"{r['share_off_half_px']:.3g} | {r['points_lost']} | {r['pixels_differing'] if r['pixels_differing'] is not None else '–'} |")
     return "\n".join(lines) + "\n"
 
 
 def svg(result):
-    """Time (× fp32, largest set) against max error on the offset case, one dot per mode."""
+    """GPU ms/frame (largest set) against max error on the offset case, one dot per mode and backend."""
     largest = max(r["points"] for r in result["speed"]) if result["speed"] else 0
-    ratio = {r["mode"]: r["ratio_to_fp32"] for r in result["speed"] if r["points"] == largest}
-    error = {r["mode"]: r["error_px"]["max"] for r in result["hard_cases"] if r["case"].startswith("offset")}
-    lost = {r["mode"]: r["points_lost"] for r in result["hard_cases"] if r["case"].startswith("offset")}
+    key = lambda r: r["mode"] + ("" if r["backend"] == "raster" else " (compute)")
+    ratio = {key(r): r["gpu_ms"]["median"] for r in result["speed"] if r["points"] == largest}
+    error = {key(r): r["error_px"]["max"] for r in result["hard_cases"] if r["case"].startswith("offset")}
+    lost = {key(r): r["points_lost"] for r in result["hard_cases"] if r["case"].startswith("offset")}
     import math
     w, h, pad = 640, 400, 60
     parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
              f'<rect width="{w}" height="{h}" fill="white"/>',
              f'<text x="{w/2}" y="20" text-anchor="middle">{result["device"]}: time vs error per mode</text>',
-             f'<text x="{w/2}" y="{h-10}" text-anchor="middle">GPU time × fp32 ({largest:,} points, 1920x1080)</text>',
+             f'<text x="{w/2}" y="{h-10}" text-anchor="middle">GPU ms/frame ({largest:,} points, 1920x1080)</text>',
              f'<text x="15" y="{h/2}" transform="rotate(-90 15 {h/2})" text-anchor="middle">max error, px (Earth-radius offset; log)</text>']
-    rmax = max(list(ratio.values()) + [1.0]) * 1.1
+    rmax = max(list(ratio.values()) + [1e-9]) * 1.1
     lo, hi = -7, 4
-    for mode in MODES:
-        if mode not in ratio or mode not in error:
+    for mode in sorted(ratio):
+        if mode not in error:
             continue
         e = error[mode] if lost.get(mode, 0) == 0 else 10 ** hi
         y = h - pad - (min(max(math.log10(max(e, 10 ** lo)), lo), hi) - lo) / (hi - lo) * (h - 2 * pad)

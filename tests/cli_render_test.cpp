@@ -106,7 +106,7 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
 }
 
 // Large sets: 16.7M points are more than lavapipe's 128 MiB storage-buffer range holds, so
-// native mode (vertex pulling there) draws them in several chunks.
+// native mode (vertex pulling there) draws them in several chunks, on both backends.
 TEST(CliRender, sixteenMillionPointsRenderInChunks) {
   TempDir dir;
   ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "11", "--unwelded", "--quiet", "-o", dir.file("s.ply")}).exit_code, 0);
@@ -118,6 +118,12 @@ TEST(CliRender, sixteenMillionPointsRenderInChunks) {
   EXPECT_EQ(jsonNumber(json, "points"), 16777216.0);
   EXPECT_GE(jsonNumber(json, "chunks"), 2.0) << json;
   EXPECT_GT(readFile(dir.file("s.png")).size(), 1000u);
+  // The compute backend on the same set (its positions are a storage buffer too).
+  test::CommandResult c = runDpoint({"render", dir.file("s.ply"), "-o", dir.file("c.png"), "--mode", "native",
+                                     "--backend", "compute", "--validate", "--width", "128", "--height", "128",
+                                     "--warmup", "0", "--quiet", "--json", dir.file("c.json")});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_GE(jsonNumber(readFile(dir.file("c.json")), "chunks"), 2.0);
 }
 
 TEST(CliDevices, listsADeviceWithTheSelfTestAndUsableModes) {

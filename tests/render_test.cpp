@@ -19,10 +19,18 @@ namespace {
 // Every test runs on both backends (raster and compute): same modes, same projection code.
 class Render : public ::testing::TestWithParam<Backend> {
  protected:
-  void SetUp() override {
+  // One context (instance and device) for the whole suite, as an application holds one: the
+  // NVIDIA driver stops creating instances after some dozens of load/unload cycles in a process.
+  static void SetUpTestSuite() {
     Result<std::unique_ptr<VulkanContext>> created = VulkanContext::create(ContextOptions{"auto", true});
-    ASSERT_TRUE(created.ok()) << created.error().message;
-    context_ = std::move(*created);
+    if (created.ok()) shared_ = std::move(*created);
+    else setup_error_ = created.error().message;
+  }
+  static void TearDownTestSuite() { shared_.reset(); }
+  void SetUp() override {
+    ASSERT_TRUE(shared_) << setup_error_;
+    context_ = shared_.get();
+    context_->clearValidationMessages();
   }
   void TearDown() override {
     if (!context_) return;
@@ -44,7 +52,9 @@ class Render : public ::testing::TestWithParam<Backend> {
     return {std::move(*r), std::move(e)};
   }
 
-  std::unique_ptr<VulkanContext> context_;
+  VulkanContext* context_ = nullptr;
+  static inline std::unique_ptr<VulkanContext> shared_;
+  static inline std::string setup_error_;
 };
 
 // 10 × 10 × 10 points `spacing` apart, centred on `centre`, coloured by position.

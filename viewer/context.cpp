@@ -49,6 +49,7 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
   facts.driver_version = basic.driverVersion;
   facts.max_storage_buffer_range = basic.limits.maxStorageBufferRange;
   facts.max_point_size = basic.limits.pointSizeRange[1];
+  facts.max_dispatch_groups_x = basic.limits.maxComputeWorkGroupCount[0];
 
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(physical, &features);

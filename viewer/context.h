@@ -26,6 +26,7 @@ struct DeviceFacts {
   bool r64g64b64_vertex = false;   // native mode reads double vertex attributes (else pulls)
   uint64_t max_storage_buffer_range = 0, max_memory_allocation = 0;
   float max_point_size = 1.0f;
+  uint32_t max_dispatch_groups_x = 0;  // maxComputeWorkGroupCount[0]: caps a compute chunk
   float timestamp_period_ns = 0.0f;  // 0: no timestamps on the graphics queue
   uint32_t queue_family = 0;
   bool has_graphics_queue = false;
