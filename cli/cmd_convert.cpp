@@ -34,6 +34,9 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
     g.all_scenes = o.all_scenes;
     g.allow_nonfinite = o.allow_nonfinite;
     g.max_points = o.max_points;
+    // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
+    Result<FileFormat> out_format = formatOf(o.output);
+    g.triangles = !out_format || *out_format != FileFormat::kCsv;
     return readGltf(o.input, g);
   }
   if (o.scene >= 0 || o.all_scenes)
@@ -50,6 +53,9 @@ int runConvert(const ConvertOptions& o) {
   Progress progress(progressSink(o.common.quiet), "convert");
   Result<PointSet> points = readInput(o, progress);
   if (!points) return reportError(points.error());
+  // Named here rather than by the writer, which only knows the output: the input is what is empty
+  // (a glTF file whose scene places no mesh, a CSV with a header only).
+  if (points->positions.empty()) return reportError(Error{o.input + ": no points to convert"});
   if (o.no_colors) points->colors.clear();
   if (o.unique) dropDuplicatePositions(*points);
   if (o.color_format == "srgb8") encodeColorsSrgb8(*points);

@@ -2,8 +2,11 @@
 // what makes it safe on hostile input where tinygltf's parser is not.
 #include "converters/gltf_json.h"
 
+#include <algorithm>
+#include <cassert>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace dpoint {
@@ -13,6 +16,42 @@ const JsonValue* JsonValue::find(std::string_view key) const {
   for (const auto& [name, value] : members)
     if (name == key) return &value;
   return nullptr;
+}
+
+JsonValue* JsonValue::find(std::string_view key) {
+  return const_cast<JsonValue*>(static_cast<const JsonValue&>(*this).find(key));
+}
+
+void JsonValue::set(const std::string& key, JsonValue value) {
+  assert(kind == Kind::kObject);
+  if (JsonValue* member = find(key)) {
+    *member = std::move(value);
+    return;
+  }
+  members.emplace_back(key, std::move(value));
+}
+
+bool JsonValue::erase(std::string_view key) {
+  const auto it = std::find_if(members.begin(), members.end(), [&](const auto& m) { return m.first == key; });
+  if (it == members.end()) return false;
+  members.erase(it);
+  return true;
+}
+
+JsonValue JsonValue::integerValue(int64_t v) {
+  JsonValue out;
+  out.kind = Kind::kNumber;
+  out.number = double(v);
+  out.is_integer = true;
+  out.integer = v;
+  return out;
+}
+
+JsonValue JsonValue::stringValue(const std::string& text) {
+  JsonValue out;
+  out.kind = Kind::kString;
+  out.text = text;
+  return out;
 }
 
 namespace {
@@ -234,6 +273,68 @@ class JsonParser {
 
 Result<JsonValue> parseJson(std::string_view text, int max_depth) {
   return JsonParser(text, max_depth).document();
+}
+
+namespace {
+
+void appendJson(const JsonValue& v, std::string& out) {
+  switch (v.kind) {
+    case JsonValue::Kind::kNull: out += "null"; return;
+    case JsonValue::Kind::kBool: out += v.boolean ? "true" : "false"; return;
+    case JsonValue::Kind::kNumber: {
+      if (v.is_integer) {
+        out += std::to_string(v.integer);
+      } else {
+        char digits[32];
+        std::snprintf(digits, sizeof digits, "%.17g", v.number);
+        out += digits;
+      }
+      return;
+    }
+    case JsonValue::Kind::kString: {
+      out += '"';
+      for (const char c : v.text) {
+        if (c == '"' || c == '\\') {
+          out += '\\';
+          out += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+          char escape[8];
+          std::snprintf(escape, sizeof escape, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
+          out += escape;
+        } else {
+          out += c;
+        }
+      }
+      out += '"';
+      return;
+    }
+    case JsonValue::Kind::kArray:
+      out += '[';
+      for (size_t i = 0; i < v.items.size(); ++i) {
+        if (i) out += ',';
+        appendJson(v.items[i], out);
+      }
+      out += ']';
+      return;
+    case JsonValue::Kind::kObject:
+      out += '{';
+      for (size_t i = 0; i < v.members.size(); ++i) {
+        if (i) out += ',';
+        appendJson(JsonValue::stringValue(v.members[i].first), out);
+        out += ':';
+        appendJson(v.members[i].second, out);
+      }
+      out += '}';
+      return;
+  }
+}
+
+}  // namespace
+
+std::string writeJson(const JsonValue& value) {
+  std::string out;
+  appendJson(value, out);
+  return out;
 }
 
 }  // namespace dpoint

@@ -1,7 +1,9 @@
 // A small JSON reader for the glTF pre-checks, run before tinygltf sees the text.
 // tinygltf 2.7.0 overflows the stack on deep nesting and silently turns bad integers into 0
 // (2^32, -4), so we parse the document once ourselves with a depth cap and check the fields whose
-// values tinygltf would mangle. Only what the checks need is kept: no serialisation.
+// values tinygltf would mangle. writeJson turns a (rewritten) document back into text for
+// tinygltf, for the few files whose JSON must change before it can load them (gltf_meshopt.h,
+// gltf_draco.h).
 #pragma once
 
 #include <cstdint>
@@ -28,10 +30,22 @@ struct JsonValue {
 
   // Member of an object by key; nullptr when absent or when this is not an object.
   const JsonValue* find(std::string_view key) const;
+  JsonValue* find(std::string_view key);
+  // Replaces the member `key` of an object, or appends it. Requires kind == kObject.
+  void set(const std::string& key, JsonValue value);
+  // Removes the member `key` of an object if present; returns whether it was.
+  bool erase(std::string_view key);
+
+  static JsonValue integerValue(int64_t v);
+  static JsonValue stringValue(const std::string& text);
 };
 
 // Parses one JSON document. Nesting deeper than max_depth arrays/objects is an error, so the
 // recursion is bounded. Errors say "byte N: what" (the caller prefixes the file name).
 Result<JsonValue> parseJson(std::string_view text, int max_depth);
+
+// Just enough JSON output to hand a rewritten document to tinygltf: integers as written, other
+// numbers with 17 significant digits (round-trips a double), strings escaped per RFC 8259.
+std::string writeJson(const JsonValue& value);
 
 }  // namespace dpoint

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "converters/gltf_draco.h"
 #include "converters/gltf_json.h"
 #include "converters/gltf_meshopt.h"
 #include "core/input_file.h"
@@ -171,6 +172,11 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
     const std::string at = pointerTo("/nodes", i);
     for (const char* key : {"mesh", "skin", "camera"}) check.index(nodes[i], key, at);
     check.indexArray(nodes[i], "children", at);
+    const JsonValue* extensions = nodes[i].find("extensions");
+    const JsonValue* instancing = extensions ? extensions->find("EXT_mesh_gpu_instancing") : nullptr;
+    if (const JsonValue* attributes = instancing ? instancing->find("attributes") : nullptr)
+      for (const auto& [name, value] : attributes->members)
+        check.integer(&value, at + "/extensions/EXT_mesh_gpu_instancing/attributes/" + name, kMaxIndex);
   }
   const auto& meshes = *check.objects(root, "meshes");
   for (size_t m = 0; m < meshes.size(); ++m) {
@@ -182,6 +188,14 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
       for (const char* key : {"indices", "material", "mode"}) check.index(primitive, key, at);
       if (const JsonValue* attributes = primitive.find("attributes"))
         for (const auto& [name, value] : attributes->members) check.integer(&value, at + "/attributes/" + name, kMaxIndex);
+      // tinygltf keeps extension numbers in int, wrapping larger ones.
+      const JsonValue* extensions = primitive.find("extensions");
+      if (const JsonValue* draco = extensions ? extensions->find("KHR_draco_mesh_compression") : nullptr) {
+        const std::string ext_at = at + "/extensions/KHR_draco_mesh_compression";
+        check.index(*draco, "bufferView", ext_at);
+        if (const JsonValue* ids = draco->find("attributes"))
+          for (const auto& [name, value] : ids->members) check.integer(&value, ext_at + "/attributes/" + name, kMaxIndex);
+      }
     }
   }
   const auto& accessors = *check.objects(root, "accessors");
@@ -321,25 +335,30 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
   } else if (json.size() >= 3 && json.substr(0, 3) == "\xEF\xBB\xBF") {
     return Error{path + ": starts with a UTF-8 byte order mark, which glTF forbids"};
   }
+  std::vector<DracoIndices> draco_indices;
   {
     Result<JsonValue> document = parseJson(json, kGltfMaxJsonDepth);
     if (!document) return Error{path + ": JSON " + document.error().message};
     if (auto e = checkDocument(path, *document, bin_length)) return *e;
-    if (std::optional<std::string> rewritten = emptyMeshoptFallbackBuffers(*document, binary)) {
+    // JSON tinygltf 2.7.0 cannot load as written (gltf_meshopt.h, gltf_draco.h) is rewritten.
+    const bool fallback_emptied = emptyMeshoptFallbackBuffers(*document, binary);
+    draco_indices = detachDracoIndices(*document);
+    if (fallback_emptied || !draco_indices.empty()) {
+      std::string rewritten = writeJson(*document);
       if (binary) {
         // Same chunks after the JSON one; the JSON chunk padded with spaces to 4 bytes (GLB §4.4.3.1).
-        rewritten->append((4 - rewritten->size() % 4) % 4, ' ');
+        rewritten.append((4 - rewritten.size() % 4) % 4, ' ');
         const size_t rest = glb.json_offset + glb.json_length;
         const size_t end = readU32(bytes, 8);  // checkGlb: ≤ bytes.size()
-        std::vector<unsigned char> glb_bytes(12 + 8 + rewritten->size() + (end - rest));
-        const uint32_t header[5] = {kGlbMagic, 2, uint32_t(glb_bytes.size()), uint32_t(rewritten->size()), kChunkJson};
+        std::vector<unsigned char> glb_bytes(12 + 8 + rewritten.size() + (end - rest));
+        const uint32_t header[5] = {kGlbMagic, 2, uint32_t(glb_bytes.size()), uint32_t(rewritten.size()), kChunkJson};
         std::memcpy(glb_bytes.data(), header, sizeof header);
-        std::memcpy(glb_bytes.data() + 20, rewritten->data(), rewritten->size());
+        std::memcpy(glb_bytes.data() + 20, rewritten.data(), rewritten.size());
         std::copy(bytes.begin() + std::ptrdiff_t(rest), bytes.begin() + std::ptrdiff_t(end),
-                  glb_bytes.begin() + std::ptrdiff_t(20 + rewritten->size()));
+                  glb_bytes.begin() + std::ptrdiff_t(20 + rewritten.size()));
         bytes = std::move(glb_bytes);
       } else {
-        bytes.assign(rewritten->begin(), rewritten->end());
+        bytes.assign(rewritten.begin(), rewritten.end());
         json = std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
       }
     }
@@ -362,6 +381,7 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
   if (!loaded) return Error{path + ": " + oneLine(err)};
   // Decoded here so every reader of the model sees plain views; the input cap bounds the output.
   if (Status s = decodeMeshoptViews(path, model, max_file_bytes); !s) return s.error();
+  if (Status s = decodeDracoPrimitives(path, model, draco_indices, max_file_bytes); !s) return s.error();
   return model;
 }
 
@@ -369,9 +389,11 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
 
 bool gltfRequiredExtensionSupported(const std::string& name) {
   // Geometry we decode, or extensions that only change shading; anything else that is required
-  // may change positions (draco, instancing) and is refused by name.
-  static const char* const kAccepted[] = {"KHR_mesh_quantization", "EXT_meshopt_compression", "KHR_texture_transform", "KHR_texture_basisu",
-                                          "EXT_texture_webp",      "KHR_lights_punctual",   "KHR_materials_"};
+  // may change positions and is refused by name.
+  static const char* const kAccepted[] = {
+      "KHR_mesh_quantization", "EXT_meshopt_compression", "KHR_draco_mesh_compression", "EXT_mesh_gpu_instancing",
+      "KHR_texture_transform", "KHR_texture_basisu",      "EXT_texture_webp",           "KHR_lights_punctual",
+      "KHR_materials_"};
   for (const char* accepted : kAccepted) {
     const std::string_view a(accepted);
     if (a.back() == '_' ? name.rfind(a, 0) == 0 : name == a) return true;

@@ -24,8 +24,9 @@ constexpr int kGltfMaxJsonDepth = 64;
 // max_file_bytes fail with ExitCode::kResourceLimit. Never throws.
 Result<tinygltf::Model> loadGltfModel(const std::string& path, uint64_t max_file_bytes);
 
-// Extensions listed in extensionsRequired that we accept: those we decode
-// (KHR_mesh_quantization) and those that do not change geometry (materials, textures, lights).
+// Extensions listed in extensionsRequired that we accept: those we decode (KHR_mesh_quantization,
+// EXT_meshopt_compression, KHR_draco_mesh_compression, EXT_mesh_gpu_instancing) and those that do
+// not change geometry (materials, textures, lights).
 bool gltfRequiredExtensionSupported(const std::string& name);
 
 }  // namespace dpoint

@@ -9,7 +9,6 @@
 #include <meshoptimizer.h>
 
 #include <cmath>
-#include <cstdio>
 #include <vector>
 
 namespace dpoint {
@@ -122,109 +121,23 @@ class ViewDecoder {
   std::string pointer_;
 };
 
-JsonValue integerValue(int64_t v) {
-  JsonValue out;
-  out.kind = JsonValue::Kind::kNumber;
-  out.number = double(v);
-  out.is_integer = true;
-  out.integer = v;
-  return out;
-}
-
-JsonValue stringValue(const std::string& text) {
-  JsonValue out;
-  out.kind = JsonValue::Kind::kString;
-  out.text = text;
-  return out;
-}
-
-void setMember(JsonValue& object, const std::string& key, JsonValue value) {
-  for (auto& [name, member] : object.members)
-    if (name == key) {
-      member = std::move(value);
-      return;
-    }
-  object.members.emplace_back(key, std::move(value));
-}
-
-// Just enough JSON output to hand a rewritten document to tinygltf: integers as written, other
-// numbers with 17 significant digits (round-trips a double), strings escaped per RFC 8259.
-void writeJson(const JsonValue& v, std::string& out) {
-  switch (v.kind) {
-    case JsonValue::Kind::kNull: out += "null"; return;
-    case JsonValue::Kind::kBool: out += v.boolean ? "true" : "false"; return;
-    case JsonValue::Kind::kNumber: {
-      if (v.is_integer) {
-        out += std::to_string(v.integer);
-      } else {
-        char digits[32];
-        std::snprintf(digits, sizeof digits, "%.17g", v.number);
-        out += digits;
-      }
-      return;
-    }
-    case JsonValue::Kind::kString: {
-      out += '"';
-      for (const char c : v.text) {
-        if (c == '"' || c == '\\') {
-          out += '\\';
-          out += c;
-        } else if (static_cast<unsigned char>(c) < 0x20) {
-          char escape[8];
-          std::snprintf(escape, sizeof escape, "\\u%04x", unsigned(static_cast<unsigned char>(c)));
-          out += escape;
-        } else {
-          out += c;
-        }
-      }
-      out += '"';
-      return;
-    }
-    case JsonValue::Kind::kArray:
-      out += '[';
-      for (size_t i = 0; i < v.items.size(); ++i) {
-        if (i) out += ',';
-        writeJson(v.items[i], out);
-      }
-      out += ']';
-      return;
-    case JsonValue::Kind::kObject:
-      out += '{';
-      for (size_t i = 0; i < v.members.size(); ++i) {
-        if (i) out += ',';
-        writeJson(stringValue(v.members[i].first), out);
-        out += ':';
-        writeJson(v.members[i].second, out);
-      }
-      out += '}';
-      return;
-  }
-}
-
 }  // namespace
 
-std::optional<std::string> emptyMeshoptFallbackBuffers(const JsonValue& root, bool binary) {
-  const JsonValue* buffers = root.find("buffers");
-  if (!buffers || buffers->kind != JsonValue::Kind::kArray) return std::nullopt;
-  JsonValue copy;
+bool emptyMeshoptFallbackBuffers(JsonValue& root, bool binary) {
+  JsonValue* buffers = root.find("buffers");
+  if (!buffers || buffers->kind != JsonValue::Kind::kArray) return false;
   bool changed = false;
-  for (size_t i = 0; i < buffers->items.size(); ++i) {
-    const JsonValue& buffer = buffers->items[i];
+  for (JsonValue& buffer : buffers->items) {
     const JsonValue* extensions = buffer.find("extensions");
     const JsonValue* ext = extensions ? extensions->find(kExtension) : nullptr;
     const JsonValue* fallback = ext ? ext->find("fallback") : nullptr;
     if (buffer.find("uri") || !fallback || fallback->kind != JsonValue::Kind::kBool || !fallback->boolean) continue;
-    if (!changed) copy = root;  // copied only for the rare file that needs it
     changed = true;
-    JsonValue& target = const_cast<JsonValue&>(*copy.find("buffers")).items[i];
     // One byte, not zero: tinygltf 2.7.0 indexes data.at(0) when copying a GLB buffer.
-    setMember(target, "byteLength", integerValue(1));
-    if (!binary) setMember(target, "uri", stringValue("data:application/octet-stream;base64,AA=="));
+    buffer.set("byteLength", JsonValue::integerValue(1));
+    if (!binary) buffer.set("uri", JsonValue::stringValue("data:application/octet-stream;base64,AA=="));
   }
-  if (!changed) return std::nullopt;
-  std::string text;
-  writeJson(copy, text);
-  return text;
+  return changed;
 }
 
 Status decodeMeshoptViews(const std::string& path, tinygltf::Model& model, uint64_t max_decoded_bytes) {

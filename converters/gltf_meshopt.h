@@ -8,7 +8,6 @@
 #include <tiny_gltf.h>
 
 #include <cstdint>
-#include <optional>
 #include <string>
 
 #include "converters/gltf_json.h"
@@ -22,11 +21,12 @@ namespace dpoint {
 // max_decoded_bytes in all are ExitCode::kResourceLimit. Errors: "PATH: /bufferViews/I/...: what".
 // tinygltf 2.7.0 refuses a buffer without uri whose byteLength exceeds the GLB BIN chunk (or any
 // uri-less buffer in a .gltf), which is exactly what an EXT_meshopt_compression fallback buffer
-// (`"fallback": true`, data never stored) is. Returns the JSON text with each such buffer made an
-// one-byte placeholder (in a .gltf through a data: URI), or nullopt when there is none.
-// Views into a fallback buffer are replaced by decodeMeshoptViews; any other view into one fails
-// the accessor bounds check. `root` is the depth-capped pre-parse of the document.
-std::optional<std::string> emptyMeshoptFallbackBuffers(const JsonValue& root, bool binary);
+// (`"fallback": true`, data never stored) is. Makes each such buffer of `root` (the depth-capped
+// pre-parse of the document) a one-byte placeholder (in a .gltf through a data: URI) and returns
+// whether there was one; the caller hands writeJson(root) to tinygltf then. Views into a fallback
+// buffer are replaced by decodeMeshoptViews; any other view into one fails the accessor bounds
+// check.
+bool emptyMeshoptFallbackBuffers(JsonValue& root, bool binary);
 
 Status decodeMeshoptViews(const std::string& path, tinygltf::Model& model, uint64_t max_decoded_bytes);
 

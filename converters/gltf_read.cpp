@@ -11,6 +11,8 @@
 #include <glm/vec4.hpp>
 #include <limits>
 #include <new>
+#include <optional>
+#include <string_view>
 
 #include "converters/gltf_accessor.h"
 #include "converters/gltf_load.h"
@@ -32,6 +34,14 @@ glm::dmat4 rotationMatrix(double x, double y, double z, double w) {
   r[1] = glm::dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0);
   r[2] = glm::dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0);
   return r;
+}
+
+// Room for `extra` more elements: exactly for the first (often the only, and largest) primitive,
+// then growing by half at least, so many small primitives do not copy the arrays once each.
+template <typename T>
+void reserveMore(std::vector<T>& v, size_t extra) {
+  const size_t needed = v.size() + extra;
+  if (needed > v.capacity()) v.reserve(std::max(needed, v.capacity() + v.capacity() / 2));
 }
 
 bool allFinite(const std::vector<double>& values) {
@@ -148,6 +158,89 @@ class SceneReader {
     return t * r * s;
   }
 
+  // Where node `index` places its mesh: its world matrix, or with EXT_mesh_gpu_instancing one
+  // matrix per instance, world · T·R·S of the instance's TRANSLATION, ROTATION and SCALE
+  // (KhronosGroup/glTF extensions/2.0/Vendor/EXT_mesh_gpu_instancing), composed in double like
+  // node transforms. The node's children are not instanced.
+  Result<std::vector<glm::dmat4>> instanceMatrices(size_t index, const glm::dmat4& world) const {
+    const auto ext_it = model_.nodes[index].extensions.find("EXT_mesh_gpu_instancing");
+    if (ext_it == model_.nodes[index].extensions.end()) return std::vector<glm::dmat4>{world};
+    const std::string pointer = nodePointer(index) + "/extensions/EXT_mesh_gpu_instancing";
+    const tinygltf::Value& ext = ext_it->second;
+    if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject())
+      return fail(pointer + "/attributes: must be an object");
+    const tinygltf::Value& attributes = ext.Get("attributes");
+    struct Part {
+      const char* name;
+      int components;
+      std::optional<AccessorElements> elements;
+    };
+    Part parts[3] = {{"TRANSLATION", 3, {}}, {"ROTATION", 4, {}}, {"SCALE", 3, {}}};
+    std::optional<size_t> count;
+    const char* count_from = nullptr;
+    for (Part& part : parts) {
+      if (!attributes.Has(part.name)) continue;
+      const std::string at = pointer + "/attributes/" + part.name;
+      const tinygltf::Value& v = attributes.Get(part.name);
+      const double d = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+      if (!(d >= 0) || d > 2147483647.0 || d != std::floor(d)) return fail(at + ": must be an accessor index");
+      const int accessor = int(d);
+      Result<AccessorElements> elements = decoder_.open(accessor);
+      if (!elements) return elements.error();
+      const int ct = elements->componentType();
+      // Float, or the integer forms KHR_mesh_quantization allows (ROTATION: normalized signed only).
+      const bool float_type = ct == TINYGLTF_COMPONENT_TYPE_FLOAT;
+      const bool type_ok = part.components == 4
+                               ? float_type || ((ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT) &&
+                                                elements->normalized())
+                               : ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+      if (elements->components() != part.components || !type_ok)
+        return fail(at + ": accessor " + std::to_string(accessor) + " must be VEC" + std::to_string(part.components) +
+                    (part.components == 4 ? " of float or normalized byte/short" : " of float, (u)byte or (u)short") +
+                    ", not " + std::to_string(elements->components()) + " components of componentType " +
+                    std::to_string(ct));
+      if (count && *count != elements->count())
+        return fail(at + ": accessor " + std::to_string(accessor) + " has count " + std::to_string(elements->count()) +
+                    ", " + count_from + " has " + std::to_string(*count) + " (all must be equal)");
+      count = elements->count();
+      count_from = part.name;
+      part.elements = std::move(*elements);
+    }
+    if (!count) return fail(pointer + "/attributes: has none of TRANSLATION, ROTATION, SCALE");
+    if (options_.max_points != 0 && *count > options_.max_points)
+      return fail(pointer + ": " + std::to_string(*count) + " instances exceed --max-points " +
+                      std::to_string(options_.max_points),
+                  ExitCode::kResourceLimit);
+    std::vector<glm::dmat4> placements;
+    placements.reserve(*count);
+    for (size_t e = 0; e < *count; ++e) {
+      glm::dmat4 t(1.0), r(1.0), s(1.0);
+      double q[4] = {0, 0, 0, 1};
+      for (const Part& part : parts) {
+        if (!part.elements) continue;
+        double v[4] = {0, 0, 0, 0};
+        for (int k = 0; k < part.components; ++k) v[k] = part.elements->value(e, k);
+        if (!std::isfinite(v[0] + v[1] + v[2] + v[3]))
+          return fail(pointer + "/attributes/" + part.name + ": instance " + std::to_string(e) + " is not finite");
+        if (part.components == 4) {
+          std::copy(v, v + 4, q);
+        } else if (std::string_view(part.name) == "TRANSLATION") {
+          t[3] = glm::dvec4(v[0], v[1], v[2], 1.0);
+        } else {
+          s[0][0] = v[0];
+          s[1][1] = v[1];
+          s[2][2] = v[2];
+        }
+      }
+      // As for node rotations: quantized quaternions are not unit length; normalizing keeps R a rotation.
+      const double length = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (!(length > 0.0)) return fail(pointer + "/attributes/ROTATION: instance " + std::to_string(e) + " has zero length");
+      r = rotationMatrix(q[0] / length, q[1] / length, q[2] / length, q[3] / length);
+      placements.push_back(world * (t * r * s));
+    }
+    return placements;
+  }
+
   Status walk(int index, const glm::dmat4& parent, int depth) {
     if (index < 0 || size_t(index) >= model_.nodes.size()) return fail("node " + std::to_string(index) + " does not exist");
     const size_t i = size_t(index);
@@ -164,11 +257,14 @@ class SceneReader {
     if (node.mesh != -1) {  // -1: tinygltf's "no mesh"
       if (node.mesh < 0 || size_t(node.mesh) >= model_.meshes.size())
         return fail(nodePointer(i) + "/mesh: mesh " + std::to_string(node.mesh) + " does not exist");
+      Result<std::vector<glm::dmat4>> placements = instanceMatrices(i, world);
+      if (!placements) return placements.error();
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
-      for (size_t p = 0; p < mesh.primitives.size(); ++p) {
-        const std::string pointer = "/meshes/" + std::to_string(node.mesh) + "/primitives/" + std::to_string(p);
-        if (Status s = readPrimitive(mesh.primitives[p], pointer, world); !s) return s;
-      }
+      for (const glm::dmat4& placement : *placements)
+        for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+          const std::string pointer = "/meshes/" + std::to_string(node.mesh) + "/primitives/" + std::to_string(p);
+          if (Status s = readPrimitive(mesh.primitives[p], pointer, placement); !s) return s;
+        }
     }
     for (int child : node.children)
       if (Status s = walk(child, world, depth + 1); !s) return s;
@@ -176,10 +272,13 @@ class SceneReader {
     return okStatus();
   }
 
-  // The primitive's indices (each < vertex_count), or none when it is not indexed.
-  Result<std::vector<uint32_t>> readIndices(const tinygltf::Primitive& primitive, size_t vertex_count) const {
-    std::vector<uint32_t> indices;
-    if (primitive.indices == -1) return indices;  // tinygltf's "no indices"
+  // The primitive's index accessor, checked (unsigned SCALAR, each element < vertex_count), with
+  // the vertices it names marked in `remap` (sized vertex_count, kUnused elsewhere); nullopt when
+  // the primitive is not indexed. The elements are read again for triangles rather than kept as
+  // a copy: for large meshes that copy was the size of the output's triangle list.
+  Result<std::optional<AccessorElements>> readIndices(const tinygltf::Primitive& primitive, size_t vertex_count,
+                                                      std::vector<uint32_t>& remap) const {
+    if (primitive.indices == -1) return std::optional<AccessorElements>();  // tinygltf's "no indices"
     Result<AccessorElements> elements = decoder_.open(primitive.indices);
     if (!elements) return elements.error();
     const int ct = elements->componentType();
@@ -188,16 +287,16 @@ class SceneReader {
          ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
       return decoder_.fail(primitive.indices, "indices must be unsigned byte, short or int SCALAR, not componentType " +
                                                   std::to_string(ct));
-    indices.resize(elements->count());
-    for (size_t e = 0; e < indices.size(); ++e) {
+    remap.assign(vertex_count, kUnused);
+    for (size_t e = 0; e < elements->count(); ++e) {
       const double v = elements->value(e, 0);  // an unsigned integer < 2^32, exact in double
       if (v >= double(vertex_count))
         return decoder_.fail(primitive.indices, "element " + std::to_string(e) + " is " +
                                                     std::to_string(uint64_t(v)) + ", out of range for " +
                                                     std::to_string(vertex_count) + " vertices");
-      indices[e] = uint32_t(v);
+      remap[size_t(v)] = 0;
     }
-    return indices;
+    return std::optional<AccessorElements>(std::move(*elements));
   }
 
   Status readPrimitive(const tinygltf::Primitive& primitive, const std::string& pointer, const glm::dmat4& world) {
@@ -216,14 +315,12 @@ class SceneReader {
                                                std::to_string(ct));
     const size_t count = positions->count();
 
-    Result<std::vector<uint32_t>> indices = readIndices(primitive, count);
-    if (!indices) return indices.error();
     // Which vertices the primitive references, renumbered in vertex order.
     std::vector<uint32_t> remap;
+    Result<std::optional<AccessorElements>> indices = readIndices(primitive, count, remap);
+    if (!indices) return indices.error();
     size_t emitted = count;
-    if (primitive.indices != -1) {
-      remap.assign(count, kUnused);
-      for (uint32_t v : *indices) remap[v] = 0;
+    if (*indices) {
       emitted = 0;
       for (uint32_t& r : remap)
         if (r != kUnused) r = uint32_t(emitted++);
@@ -233,7 +330,7 @@ class SceneReader {
       return fail("more than --max-points " + std::to_string(options_.max_points) + " points", ExitCode::kResourceLimit);
     if (emitted > size_t(kUnused) - begin) return fail("more than 2^32-1 vertices", ExitCode::kResourceLimit);
 
-    out_.positions.reserve(begin + emitted);
+    reserveMore(out_.positions, emitted);
     for (size_t e = 0; e < count; ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
       const glm::dvec4 local(positions->value(e, 0), positions->value(e, 1), positions->value(e, 2), 1.0);
@@ -246,15 +343,23 @@ class SceneReader {
     if (Status s = readColours(primitive, pointer, remap, count, begin); !s) return s;
 
     // Triangles in the output numbering; points and lines add none.
-    const size_t n = primitive.indices == -1 ? count : indices->size();
+    if (!options_.triangles) return okStatus();
+    const AccessorElements* index_elements = *indices ? &**indices : nullptr;
+    const size_t n = index_elements ? index_elements->count() : count;
     const auto vertex = [&](size_t i) -> uint32_t {
-      const uint32_t v = primitive.indices == -1 ? uint32_t(i) : (*indices)[i];
+      // Indices were checked against the vertex count by readIndices.
+      const uint32_t v = index_elements ? uint32_t(index_elements->value(i, 0)) : uint32_t(i);
       return uint32_t(begin) + (remap.empty() ? v : remap[v]);
     };
     const auto triangle = [&](size_t a, size_t b, size_t c) {
       out_.triangles.insert(out_.triangles.end(), {vertex(a), vertex(b), vertex(c)});
     };
     // Spec §3.7.2.1; a trailing incomplete triangle is not drawn (the validator warns, no error).
+    // Reserved up front: growth by doubling briefly holds 1.5 times a large mesh's triangle list.
+    if (primitive.mode == TINYGLTF_MODE_TRIANGLES)
+      reserveMore(out_.triangles, n / 3 * 3);
+    else if ((primitive.mode == TINYGLTF_MODE_TRIANGLE_STRIP || primitive.mode == TINYGLTF_MODE_TRIANGLE_FAN) && n >= 3)
+      reserveMore(out_.triangles, 3 * (n - 2));
     if (primitive.mode == TINYGLTF_MODE_TRIANGLES) {
       for (size_t i = 0; i + 3 <= n; i += 3) triangle(i, i + 1, i + 2);
     } else if (primitive.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
@@ -297,6 +402,7 @@ class SceneReader {
                                       std::to_string(count));
     any_colour_ = true;
     out_.colors.resize(emitted_begin);  // earlier uncoloured primitives are filled at the end
+    reserveMore(out_.colors, out_.positions.size() - emitted_begin);
     for (size_t e = 0; e < count; ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
       // Linear colour (spec §3.7.2.1); alpha is dropped.

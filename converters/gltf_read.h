@@ -4,17 +4,18 @@
 // What a file turns into:
 // - World-space positions in double: the default scene (else scene 0; with no scenes, every node
 //   that has no parent), node `matrix` or T·R·S composed in double, quaternions normalised.
-//   A mesh used by several nodes is emitted once per node. Skins are ignored (bind pose: the
-//   node transform applies); morph targets are ignored.
+//   A mesh used by several nodes is emitted once per node, and once per instance of a node with
+//   EXT_mesh_gpu_instancing (node world matrix · instance T·R·S). Skins are ignored (bind pose:
+//   the node transform applies); morph targets are ignored.
 // - Per primitive, the vertices it references: all of POSITION when not indexed, else each
 //   vertex some index names, once, in vertex order. Triangle modes keep their triangles
 //   (TRIANGLE_STRIP and TRIANGLE_FAN become triangle lists); points and lines are points.
 // - Colours (linear 0..1) when any primitive has COLOR_0 (float, unorm8 or unorm16, VEC3/VEC4,
 //   alpha dropped); primitives without COLOR_0 then take their material's baseColorFactor rgb
 //   (white without a material).
-// - Required extensions: KHR_mesh_quantization and EXT_meshopt_compression (gltf_meshopt.h) are
-//   decoded; shading-only ones are accepted; any other (KHR_draco_mesh_compression,
-//   EXT_mesh_gpu_instancing, …) is refused by name.
+// - Required extensions: KHR_mesh_quantization, EXT_meshopt_compression (gltf_meshopt.h),
+//   KHR_draco_mesh_compression (gltf_draco.h) and EXT_mesh_gpu_instancing are decoded;
+//   shading-only ones are accepted; any other is refused by name.
 // Errors are one line: "PATH: /json/pointer: what" (ExitCode::kBadInput), or kResourceLimit for
 // the size and point limits.
 #pragma once
@@ -37,6 +38,7 @@ struct GltfReadOptions {
   bool allow_nonfinite = false;
   uint64_t max_points = 0;   // 0: no limit; else more points is kResourceLimit, checked before allocating
   uint64_t max_file_bytes = kGltfDefaultMaxFileBytes;  // the file and each external buffer
+  bool triangles = true;     // false: points only (CSV output stores no triangles; saves 12 B/triangle)
 };
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});

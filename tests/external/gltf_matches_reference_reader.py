@@ -8,8 +8,10 @@ tests/external/node/read_points.mjs, computes world-space positions in double fo
 2. Variants of 2CylinderEngine.glb (and of the hand-made model) made by gltf-transform and
    gltfpack: dpoint equals the reference reader on THAT file within 1e-9, and the original within
    the variant's quantization step. meshopt (EXT_meshopt_compression, with or without a fallback
-   buffer) is decoded and compared like the others; only Draco may be refused, and then with
-   exit 2 and a message naming the extension.
+   buffer) and Draco (KHR_draco_mesh_compression) are decoded and compared like the others, and
+   so is gltfpack -mi (EXT_mesh_gpu_instancing: the reference reader applies instance T·R·S too).
+3. The Draco variant (gltf-transform draco: 14-bit positions) of every other model above, the
+   same two ways, and assimp's own Draco model (draco/2CylinderEngine.gltf) against the reference.
 
 "1e-9 relative" is per coordinate: |ours − theirs| ≤ 1e-9 · max(model extent, |theirs|), so points
 near the origin of a large model are held to the model's scale, far ones to their own magnitude.
@@ -42,6 +44,7 @@ MODELS = [
     "cameras/Cameras.gltf",                              # TRS with rotation, camera nodes without mesh
     "glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf",  # morph targets (ignored)
     "issue_3269/texcoord_crash.gltf",
+    "draco/2CylinderEngine.gltf",                        # KHR_draco_mesh_compression, made by Draco's tools
 ] + [f"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_{i:02}.gltf" for i in range(16)]
 
 # Variants: (name, tool command with IN/OUT placeholders, quantization bits of POSITION or None for
@@ -50,7 +53,7 @@ GT = [gltf_transform]
 VARIANTS = [
     ("gltf-transform quantize", GT + ["quantize", "IN", "OUT"], 14, ()),
     ("gltf-transform meshopt", GT + ["meshopt", "IN", "OUT"], 14, ()),  # decoded, no fallback buffer
-    ("gltf-transform draco", GT + ["draco", "IN", "OUT"], 14, ("KHR_draco_mesh_compression",)),
+    ("gltf-transform draco", GT + ["draco", "IN", "OUT"], 14, ()),
     ("gltf-transform sparse", GT + ["sparse", "IN", "OUT"], None, ()),
     ("gltf-transform flatten", GT + ["flatten", "IN", "OUT"], None, ()),
     ("gltf-transform join", GT + ["join", "IN", "OUT"], None, ()),
@@ -59,7 +62,14 @@ VARIANTS = [
     ("gltfpack -cf", ["gltfpack", "-i", "IN", "-o", "OUT", "-cf"], 14, ()),  # has a fallback buffer
     ("gltfpack -c", ["gltfpack", "-i", "IN", "-o", "OUT", "-c"], 14, ()),    # meshopt, data-less fallback
     ("gltfpack -cc", ["gltfpack", "-i", "IN", "-o", "OUT", "-cc"], 14, ()),  # meshopt with filters
+    # EXT_mesh_gpu_instancing: the engine's repeated meshes become instanced nodes.
+    ("gltfpack -mi", ["gltfpack", "-i", "IN", "-o", "OUT", "-mi"], 14, ()),
+    ("gltfpack -mi -noq", ["gltfpack", "-i", "IN", "-o", "OUT", "-mi", "-noq"], None, ()),
 ]
+# gltfpack stores instance rotations as normalized shorts: each quaternion component is off by up
+# to 2^-16, turning a point by up to about 2^-14 rad about its instance origin, which lies within
+# the model's diagonal of it; 2^-13 · diagonal leaves room for the composition.
+ROTATION_QUANTIZED = {"gltfpack -mi", "gltfpack -mi -noq"}
 
 
 def write_hierarchy_glb(path):
@@ -153,9 +163,13 @@ def compare_variant(original, original_points, name, command, bits, may_refuse, 
     diagonal = float(((hi - lo) ** 2).sum() ** 0.5)
     magnitude = float(abs(original_points).max())
     step = diagonal / (2 ** bits - 1) if bits else 2.0 ** -23 * max(magnitude, diagonal)
+    if name in ROTATION_QUANTIZED:
+        check("EXT_mesh_gpu_instancing" in required, f"{name}: made no instanced nodes ({required})")
+        step += diagonal * 2.0 ** -13
     ok2, message2 = within(ours, original_points, step)
     check(ok2, f"{name}: against the original model: {message2}")
     print(f"match  {os.path.basename(original)} {name}: {message}; original {message2}")
+    return required
 
 
 with scratch() as work:
@@ -172,6 +186,18 @@ with scratch() as work:
         compare_variant(engine, engine_points, name, command, bits, may_refuse, work)
     for name, command, bits, may_refuse in VARIANTS[:4]:
         compare_variant(hierarchy, hierarchy_points, name, command, bits, may_refuse, work)
+    draco = next(v for v in VARIANTS if v[0] == "gltf-transform draco")
+    compressed = []
+    for relative in MODELS:
+        if relative in (ENGINE, "draco/2CylinderEngine.gltf"):
+            continue
+        model = os.path.join(models_dir, relative)
+        required = compare_variant(model, read_xyz(os.path.join(work, os.path.basename(model) + ".ref.csv")), *draco, work)
+        if "KHR_draco_mesh_compression" in required:
+            compressed.append(relative)
+    # gltf-transform compresses triangle primitives only; the point and line modes stay plain.
+    print(f"draco  {len(compressed)} of {len(MODELS) - 2} further models came out Draco-compressed")
+    check(len(compressed) >= 10, f"only {compressed} were Draco-compressed")
     # The point of the hand-made model's sparse variant: a POSITION accessor really is sparse.
     sparse = glb_json(os.path.join(work, "hierarchy.glb.gltftransform_sparse.glb"))
     check(any("sparse" in a for a in sparse["accessors"]), "gltf-transform sparse made no sparse accessor")

@@ -89,9 +89,34 @@ function worldMatrix(node, nodeIndex, matrices) {
   return parent ? multiply(worldMatrix(parent, nodeIndex, matrices), local) : local;
 }
 
-function writeInstance(node, m, out, allVertices) {
-  if (node.getExtension('EXT_mesh_gpu_instancing'))
-    throw new Error('EXT_mesh_gpu_instancing is not handled by this reference reader');
+// EXT_mesh_gpu_instancing: one matrix T·R·S per instance (quaternion divided by its length, as
+// for nodes), or null when the node is not instanced. getElement() applies normalization.
+function instanceMatrices(node) {
+  const instancing = node.getExtension('EXT_mesh_gpu_instancing');
+  if (!instancing) return null;
+  const t = instancing.getAttribute('TRANSLATION');
+  const r = instancing.getAttribute('ROTATION');
+  const s = instancing.getAttribute('SCALE');
+  const first = t || r || s;
+  if (!first) throw new Error('EXT_mesh_gpu_instancing without TRANSLATION, ROTATION or SCALE');
+  const matrices = [];
+  for (let i = 0; i < first.getCount(); i++) {
+    const tv = t ? t.getElement(i, [0, 0, 0]) : [0, 0, 0];
+    const q = r ? r.getElement(i, [0, 0, 0, 0]) : [0, 0, 0, 1];
+    const sv = s ? s.getElement(i, [0, 0, 0]) : [1, 1, 1];
+    const length = Math.hypot(q[0], q[1], q[2], q[3]);
+    matrices.push(MathUtils.compose(tv, q.map((v) => v / length), sv, new Array(16)));
+  }
+  return matrices;
+}
+
+function writeInstance(node, world, out, allVertices) {
+  const instances = instanceMatrices(node);
+  if (!instances) return writeMesh(node, world, out, allVertices);
+  for (const instance of instances) writeMesh(node, multiply(world, instance), out, allVertices);
+}
+
+function writeMesh(node, m, out, allVertices) {
   if (node.getSkin()) process.stderr.write('read_points: skinned mesh placed by its node matrix\n');
   const p = [0, 0, 0];
   for (const primitive of node.getMesh().listPrimitives()) {
