@@ -49,23 +49,19 @@ void destroyBuffer(const VulkanContext& context, Buffer& buffer) {
   buffer = Buffer{};
 }
 
-Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer) {
+// Host caches and device memory agree already for coherent memory; otherwise one range call.
+static Status syncMapped(const VulkanContext& context, const Buffer& buffer, bool device_to_host) {
   if (buffer.coherent || !buffer.mapped) return okStatus();
   VkMappedMemoryRange range = {VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
   range.memory = buffer.memory;
   range.size = VK_WHOLE_SIZE;
-  VK_TRY(vkInvalidateMappedMemoryRanges(context.device, 1, &range));
+  if (device_to_host) VK_TRY(vkInvalidateMappedMemoryRanges(context.device, 1, &range));
+  else VK_TRY(vkFlushMappedMemoryRanges(context.device, 1, &range));
   return okStatus();
 }
 
-static Status flushBuffer(const VulkanContext& context, const Buffer& buffer) {
-  if (buffer.coherent || !buffer.mapped) return okStatus();
-  VkMappedMemoryRange range = {VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
-  range.memory = buffer.memory;
-  range.size = VK_WHOLE_SIZE;
-  VK_TRY(vkFlushMappedMemoryRanges(context.device, 1, &range));
-  return okStatus();
-}
+Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, true); }
+static Status flushBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, false); }
 
 Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record) {
   VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};

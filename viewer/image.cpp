@@ -7,21 +7,11 @@
 
 #include "core/atomic_file.h"
 
-// stb is C-style code that trips -Wconversion, -Wshadow and friends; its warnings are not ours.
+// stb lives in /usr/include, a system header folder, so GCC keeps its warnings out of ours.
 // STB_IMAGE_WRITE_STATIC keeps its symbols in this file, so nothing else linked in can clash.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
-#pragma GCC diagnostic ignored "-Wdouble-promotion"
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
-#pragma GCC diagnostic pop
 
 namespace dpoint {
 namespace {

@@ -125,15 +125,19 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
   const bool compute = options.backend == Backend::kCompute;
   VkBufferUsageFlags position_usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
       (pulled || compute ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  if (compute) {
-    Result<Buffer> all = createBuffer(context, points.size() * 4,
-        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, "colours");
-    if (!all) return all.error();
-    r.all_colors = *all;
-    Status status = uploadBuffer(context, r.all_colors, points.size() * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-      std::memcpy(dst, colors.data() + offset / 4, bytes);
+  // RGBA8 colours [first, first + count) in a buffer of their own: one per chunk for the raster
+  // backend's vertex input, one for the whole set for the compute resolve.
+  auto upload_colors = [&](Buffer& out, size_t first, size_t count, VkBufferUsageFlags usage, const std::string& what) {
+    Result<Buffer> buffer = createBuffer(context, count * 4, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, what);
+    if (!buffer) return Status(buffer.error());
+    out = *buffer;
+    return uploadBuffer(context, out, count * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+      std::memcpy(dst, colors.data() + first + offset / 4, bytes);
     });
-    if (!status) return status;
+  };
+  if (compute) {
+    if (Status status = upload_colors(r.all_colors, 0, points.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "colours"); !status)
+      return status;
   }
   for (size_t first = 0; first < points.size(); first += per_chunk) {
     Chunk& chunk = r.chunks.emplace_back();
@@ -151,14 +155,8 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
         }, piece);
     if (!status) return status;
     if (!compute) {
-    Result<Buffer> color_buffer = createBuffer(context, chunk.count * 4,
-        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, what + " colours");
-    if (!color_buffer) return color_buffer.error();
-    chunk.colors = *color_buffer;
-    status = uploadBuffer(context, chunk.colors, chunk.count * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-      std::memcpy(dst, colors.data() + chunk.first + offset / 4, bytes);
-    });
-    if (!status) return status;
+      status = upload_colors(chunk.colors, chunk.first, chunk.count, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, what + " colours");
+      if (!status) return status;
     }
     if (options.probe) {
       Result<Buffer> probe = createBuffer(context, chunk.count * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
@@ -196,13 +194,8 @@ Status createTargets(const VulkanContext& context, Resources& r, uint32_t width,
 }
 
 Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
-  uint32_t sets = static_cast<uint32_t>(r.chunks.size());
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3 * sets}};
-  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = sets;
-  pool_info.poolSizeCount = 2;
-  pool_info.pPoolSizes = sizes;
-  VK_TRY(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &r.descriptor_pool));
+  if (Status status = detail::createDescriptorPool(context, r, static_cast<uint32_t>(r.chunks.size()), 3); !status)
+    return status;
   for (Chunk& chunk : r.chunks) {
     VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     allocate.descriptorPool = r.descriptor_pool;
@@ -343,6 +336,17 @@ Status runProbe(const VulkanContext& context, Resources& r, const RenderOptions&
 }
 
 }  // namespace
+
+Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets}};
+  VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  info.maxSets = sets;
+  info.poolSizeCount = 2;
+  info.pPoolSizes = sizes;
+  VK_TRY(vkCreateDescriptorPool(context.device, &info, nullptr, &r.descriptor_pool));
+  return okStatus();
+}
 
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                   const RenderOptions& options) {

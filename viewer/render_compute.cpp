@@ -26,13 +26,9 @@ Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t
 }
 
 Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe) {
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1;
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4 * sets}};
-  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = sets;
-  pool_info.poolSizeCount = 2;
-  pool_info.pPoolSizes = sizes;
-  VK_TRY(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &r.descriptor_pool));
+  // One splat set per chunk (camera, positions, batches, probe, visibility) and the resolve set.
+  if (Status status = createDescriptorPool(context, r, static_cast<uint32_t>(r.chunks.size()) + 1, 4); !status)
+    return status;
   auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
   auto allocate = [&](VkDescriptorSetLayout layout, VkDescriptorSet& set) -> Status {
     VkDescriptorSetAllocateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};

@@ -60,6 +60,9 @@ struct Resources {
   VkDescriptorSet resolve_set = VK_NULL_HANDLE;
 };
 
+// The render's descriptor pool: `sets` sets of one uniform and `storage_per_set` storage buffers.
+Status createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set);
+
 // Compute backend pieces (viewer/render_compute.cpp).
 Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height);
 Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe);
