@@ -25,15 +25,24 @@ struct ConvertOptions {
   CommonOptions common;
 };
 
+GltfReadOptions gltfOptions(const ConvertOptions& o) {
+  GltfReadOptions g;
+  g.scene = o.scene;
+  g.all_scenes = o.all_scenes;
+  g.allow_nonfinite = o.allow_nonfinite;
+  g.max_points = o.max_points;
+  return g;
+}
+
+bool isGltf(const Result<FileFormat>& format) {
+  return format && (*format == FileFormat::kGlb || *format == FileFormat::kGltf);
+}
+
 Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
   Result<FileFormat> format = formatOf(o.input);
   if (!format) return format.error();
-  if (*format == FileFormat::kGlb || *format == FileFormat::kGltf) {
-    GltfReadOptions g;
-    g.scene = o.scene;
-    g.all_scenes = o.all_scenes;
-    g.allow_nonfinite = o.allow_nonfinite;
-    g.max_points = o.max_points;
+  if (isGltf(format)) {
+    GltfReadOptions g = gltfOptions(o);
     // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
     Result<FileFormat> out_format = formatOf(o.output);
     g.triangles = !out_format || *out_format != FileFormat::kCsv;
@@ -51,20 +60,28 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
 
 int runConvert(const ConvertOptions& o) {
   Progress progress(progressSink(o.common.quiet), "convert");
-  Result<PointSet> points = readInput(o, progress);
-  if (!points) return reportError(points.error());
-  // Named here rather than by the writer, which only knows the output: the input is what is empty
-  // (a glTF file whose scene places no mesh, a CSV with a header only).
-  if (points->positions.empty()) return reportError(Error{o.input + ": no points to convert"});
-  if (o.no_colors) points->colors.clear();
-  if (o.unique) dropDuplicatePositions(*points);
-  if (o.color_format == "srgb8") encodeColorsSrgb8(*points);
   WriteOptions w;
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.ply_encoding = o.ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
   w.ply_colors = o.ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
   w.progress = &progress;
+  const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
+  // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
+  // point set; --unique needs the whole set, so it takes the path below.
+  const Result<FileFormat> out_format = formatOf(o.output);
+  if (isGltf(formatOf(o.input)) && out_format && *out_format == FileFormat::kCsv && !o.unique) {
+    if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
+    return 0;
+  }
+  Result<PointSet> points = readInput(o, progress);
+  if (!points) return reportError(points.error());
+  // Named here rather than by the writer, which only knows the output: the input is what is empty
+  // (a glTF file whose scene places no mesh, a CSV with a header only).
+  if (points->positions.empty()) return reportError(Error{o.input + ": no points to convert"});
+  if (filters.drop) points->colors.clear();
+  if (o.unique) dropDuplicatePositions(*points);
+  if (filters.srgb8) encodeColorsSrgb8(*points);
   if (Status s = writePoints(o.output, *points, w); !s) return reportError(s.error());
   return 0;
 }

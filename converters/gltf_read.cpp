@@ -3,10 +3,16 @@
 //
 // Node transforms are composed in double (glTF 2.0 §3.5.3: local = T·R·S, or `matrix`), so
 // positions stored relative to a far-away node translation keep their float precision.
+//
+// One walk serves three passes: building a PointSet (readGltf), and streamGltf's checking pass
+// (every check of the build pass, nothing kept) and emitting pass (no checks left to fail; points
+// handed out in blocks). Vertex placement, colour decoding and material colours are shared
+// functions, so a streamed point is bit-identical to the built one.
 #include "converters/gltf_read.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 #include <limits>
@@ -48,6 +54,22 @@ bool allFinite(const std::vector<double>& values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
+bool isPositiveZero(double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits == 0;
+}
+
+// Vertex e of a POSITION accessor in world space.
+glm::dvec3 placeVertex(const AccessorElements& positions, const glm::dmat4& world, size_t e) {
+  return glm::dvec3(world * glm::dvec4(positions.value(e, 0), positions.value(e, 1), positions.value(e, 2), 1.0));
+}
+
+// Linear colour (spec §3.7.2.1); alpha is dropped.
+glm::vec3 vertexColour(const AccessorElements& colours, size_t e) {
+  return glm::vec3(float(colours.value(e, 0)), float(colours.value(e, 1)), float(colours.value(e, 2)));
+}
+
 // A primitive without COLOR_0; it gets its material colour if any other primitive has colours.
 struct Uncoloured {
   size_t begin = 0, end = 0;
@@ -60,15 +82,8 @@ class SceneReader {
       : path_(path), model_(model), options_(options), decoder_(path, model, kMaxUnbackedValues) {}
 
   Result<PointSet> read() {
-    if (Status s = checkParents(); !s) return s.error();
-    std::vector<std::vector<int>> scenes;
-    if (Status s = sceneRoots(scenes); !s) return s.error();
-    for (const std::vector<int>& roots : scenes) {
-      on_path_.assign(model_.nodes.size(), false);
-      visited_.assign(model_.nodes.size(), false);
-      for (int root : roots)
-        if (Status s = walk(root, glm::dmat4(1.0), 0); !s) return s.error();
-    }
+    pass_ = Pass::kBuild;
+    if (Status s = walkScenes(); !s) return s.error();
     if (any_colour_) {
       out_.colors.resize(out_.positions.size());
       for (const Uncoloured& u : uncoloured_)
@@ -77,7 +92,35 @@ class SceneReader {
     return std::move(out_);
   }
 
+  Status stream(GltfPointSink& sink) {
+    pass_ = Pass::kCheck;
+    if (Status s = walkScenes(); !s) return s;
+    if (Status s = sink.begin(GltfSummary{emitted_total_, any_colour_, planar_}); !s) return s;
+    pass_ = Pass::kEmit;
+    sink_ = &sink;
+    emitted_total_ = 0;
+    block_.positions.reserve(kGltfStreamBlockPoints);
+    if (any_colour_) block_.colors.reserve(kGltfStreamBlockPoints);
+    if (Status s = walkScenes(); !s) return s;
+    return block_.positions.empty() ? okStatus() : flushBlock();
+  }
+
  private:
+  enum class Pass { kBuild, kCheck, kEmit };
+
+  Status walkScenes() {
+    if (Status s = checkParents(); !s) return s;
+    std::vector<std::vector<int>> scenes;
+    if (Status s = sceneRoots(scenes); !s) return s;
+    for (const std::vector<int>& roots : scenes) {
+      on_path_.assign(model_.nodes.size(), false);
+      visited_.assign(model_.nodes.size(), false);
+      for (int root : roots)
+        if (Status s = walk(root, glm::dmat4(1.0), 0); !s) return s;
+    }
+    return okStatus();
+  }
+
   Error fail(const std::string& what, ExitCode code = ExitCode::kBadInput) const {
     return Error{path_ + ": " + what, code};
   }
@@ -325,25 +368,32 @@ class SceneReader {
       for (uint32_t& r : remap)
         if (r != kUnused) r = uint32_t(emitted++);
     }
-    const size_t begin = out_.positions.size();
+    const size_t begin = emitted_total_;  // in the build pass, out_.positions.size()
     if (options_.max_points != 0 && emitted > options_.max_points - std::min<uint64_t>(begin, options_.max_points))
       return fail("more than --max-points " + std::to_string(options_.max_points) + " points", ExitCode::kResourceLimit);
     if (emitted > size_t(kUnused) - begin) return fail("more than 2^32-1 vertices", ExitCode::kResourceLimit);
+    emitted_total_ += emitted;
+    if (pass_ == Pass::kEmit) return emitPrimitive(primitive, pointer, *positions, remap, world);
 
-    reserveMore(out_.positions, emitted);
+    if (pass_ == Pass::kBuild) reserveMore(out_.positions, emitted);
     for (size_t e = 0; e < count; ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
-      const glm::dvec4 local(positions->value(e, 0), positions->value(e, 1), positions->value(e, 2), 1.0);
-      const glm::dvec3 w = glm::dvec3(world * local);
-      if (!options_.allow_nonfinite && (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)))
+      const glm::dvec3 w = placeVertex(*positions, world, e);
+      if (!options_.allow_nonfinite && (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))) {
+        const bool local_finite =
+            std::isfinite(positions->value(e, 0) + positions->value(e, 1) + positions->value(e, 2));
         return decoder_.fail(position_index, "POSITION element " + std::to_string(e) + " is not finite" +
-                                                 (std::isfinite(local.x + local.y + local.z) ? " in world space" : ""));
-      out_.positions.push_back(w);
+                                                 (local_finite ? " in world space" : ""));
+      }
+      if (pass_ == Pass::kBuild)
+        out_.positions.push_back(w);
+      else
+        planar_ = planar_ && isPositiveZero(w.z);
     }
-    if (Status s = readColours(primitive, pointer, remap, count, begin); !s) return s;
+    if (Status s = readColours(primitive, pointer, remap, count, begin, begin + emitted); !s) return s;
 
     // Triangles in the output numbering; points and lines add none.
-    if (!options_.triangles) return okStatus();
+    if (pass_ != Pass::kBuild || !options_.triangles) return okStatus();
     const AccessorElements* index_elements = *indices ? &**indices : nullptr;
     const size_t n = index_elements ? index_elements->count() : count;
     const auto vertex = [&](size_t i) -> uint32_t {
@@ -370,22 +420,28 @@ class SceneReader {
     return okStatus();
   }
 
+  // The colour of a primitive without COLOR_0: its material's base colour, white without one.
+  Result<glm::vec3> materialColour(const tinygltf::Primitive& primitive, const std::string& pointer) const {
+    if (primitive.material == -1) return glm::vec3(1.0f);  // -1: tinygltf's "no material"
+    if (primitive.material < 0 || size_t(primitive.material) >= model_.materials.size())
+      return fail(pointer + "/material: material " + std::to_string(primitive.material) + " does not exist");
+    const std::vector<double>& factor =
+        model_.materials[size_t(primitive.material)].pbrMetallicRoughness.baseColorFactor;
+    if (factor.size() != 4 || !allFinite(factor))
+      return fail("/materials/" + std::to_string(primitive.material) +
+                  "/pbrMetallicRoughness/baseColorFactor: must be 4 finite numbers");
+    return glm::vec3(float(factor[0]), float(factor[1]), float(factor[2]));
+  }
+
+  // Checks the primitive's colours (and in the build pass stores them) for its points
+  // [emitted_begin, emitted_end).
   Status readColours(const tinygltf::Primitive& primitive, const std::string& pointer,
-                     const std::vector<uint32_t>& remap, size_t count, size_t emitted_begin) {
+                     const std::vector<uint32_t>& remap, size_t count, size_t emitted_begin, size_t emitted_end) {
     const auto colour_it = primitive.attributes.find("COLOR_0");
     if (colour_it == primitive.attributes.end()) {
-      glm::vec3 fill(1.0f);
-      if (primitive.material != -1) {  // -1: tinygltf's "no material"
-        if (primitive.material < 0 || size_t(primitive.material) >= model_.materials.size())
-          return fail(pointer + "/material: material " + std::to_string(primitive.material) + " does not exist");
-        const std::vector<double>& factor =
-            model_.materials[size_t(primitive.material)].pbrMetallicRoughness.baseColorFactor;
-        if (factor.size() != 4 || !allFinite(factor))
-          return fail("/materials/" + std::to_string(primitive.material) +
-                      "/pbrMetallicRoughness/baseColorFactor: must be 4 finite numbers");
-        fill = glm::vec3(float(factor[0]), float(factor[1]), float(factor[2]));
-      }
-      uncoloured_.push_back({emitted_begin, out_.positions.size(), fill});
+      Result<glm::vec3> fill = materialColour(primitive, pointer);
+      if (!fill) return fill.error();
+      if (pass_ == Pass::kBuild) uncoloured_.push_back({emitted_begin, emitted_end, *fill});
       return okStatus();
     }
     const int index = colour_it->second;
@@ -401,27 +457,68 @@ class SceneReader {
       return decoder_.fail(index, "COLOR_0 count " + std::to_string(colours->count()) + " differs from POSITION count " +
                                       std::to_string(count));
     any_colour_ = true;
-    out_.colors.resize(emitted_begin);  // earlier uncoloured primitives are filled at the end
-    reserveMore(out_.colors, out_.positions.size() - emitted_begin);
+    if (pass_ == Pass::kBuild) {
+      out_.colors.resize(emitted_begin);  // earlier uncoloured primitives are filled at the end
+      reserveMore(out_.colors, emitted_end - emitted_begin);
+    }
     for (size_t e = 0; e < count; ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
-      // Linear colour (spec §3.7.2.1); alpha is dropped.
-      const glm::vec3 c(float(colours->value(e, 0)), float(colours->value(e, 1)), float(colours->value(e, 2)));
+      const glm::vec3 c = vertexColour(*colours, e);
       if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b))
         return decoder_.fail(index, "COLOR_0 element " + std::to_string(e) + " is not finite");
-      out_.colors.push_back(c);
+      if (pass_ == Pass::kBuild) out_.colors.push_back(c);
     }
     return okStatus();
+  }
+
+  // The emitting pass: the primitive's points (and colours, when the checking pass found any) in
+  // the build pass's order. The checking pass made every check on the same data, so none fails.
+  Status emitPrimitive(const tinygltf::Primitive& primitive, const std::string& pointer,
+                       const AccessorElements& positions, const std::vector<uint32_t>& remap, const glm::dmat4& world) {
+    std::optional<AccessorElements> colours;
+    glm::vec3 fill(1.0f);
+    if (any_colour_) {
+      const auto colour_it = primitive.attributes.find("COLOR_0");
+      if (colour_it != primitive.attributes.end()) {
+        Result<AccessorElements> opened = decoder_.open(colour_it->second);
+        if (!opened) return opened.error();
+        colours = std::move(*opened);
+      } else {
+        Result<glm::vec3> material = materialColour(primitive, pointer);
+        if (!material) return material.error();
+        fill = *material;
+      }
+    }
+    for (size_t e = 0; e < positions.count(); ++e) {
+      if (!remap.empty() && remap[e] == kUnused) continue;
+      block_.positions.push_back(placeVertex(positions, world, e));
+      if (any_colour_) block_.colors.push_back(colours ? vertexColour(*colours, e) : fill);
+      if (block_.positions.size() == kGltfStreamBlockPoints)
+        if (Status s = flushBlock(); !s) return s;
+    }
+    return okStatus();
+  }
+
+  Status flushBlock() {
+    Status s = sink_->points(block_);
+    block_.positions.clear();
+    block_.colors.clear();
+    return s;
   }
 
   const std::string& path_;
   const tinygltf::Model& model_;
   const GltfReadOptions& options_;
   AccessorDecoder decoder_;
-  PointSet out_;
+  Pass pass_ = Pass::kBuild;
+  size_t emitted_total_ = 0;  // points placed so far in this pass
+  PointSet out_;              // the build pass's result
   std::vector<bool> on_path_, visited_;
   std::vector<Uncoloured> uncoloured_;
-  bool any_colour_ = false;
+  bool any_colour_ = false;  // kept from the checking pass into the emitting pass
+  bool planar_ = true;       // checking pass: every z so far is +0.0
+  GltfPointSink* sink_ = nullptr;
+  PointSet block_;  // emitting pass: points not yet handed to sink_
 };
 
 }  // namespace
@@ -431,6 +528,16 @@ Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& option
     Result<tinygltf::Model> model = loadGltfModel(path, options.max_file_bytes);
     if (!model) return model.error();
     return SceneReader(path, *model, options).read();
+  } catch (const std::bad_alloc&) {
+    return Error{path + ": out of memory while converting", ExitCode::kResourceLimit};
+  }
+}
+
+Status streamGltf(const std::string& path, const GltfReadOptions& options, GltfPointSink& sink) {
+  try {
+    Result<tinygltf::Model> model = loadGltfModel(path, options.max_file_bytes);
+    if (!model) return model.error();
+    return SceneReader(path, *model, options).stream(sink);
   } catch (const std::bad_alloc&) {
     return Error{path + ": out of memory while converting", ExitCode::kResourceLimit};
   }

@@ -43,6 +43,34 @@ struct GltfReadOptions {
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});
 
+// What readGltf's set would be, found by streamGltf's first walk without keeping points.
+struct GltfSummary {
+  uint64_t points = 0;
+  bool colors = false;  // some primitive has COLOR_0 (then every point has a colour)
+  bool planar = true;   // every world-space z is +0.0 (PointSet::isPlanar)
+};
+
+// Receives streamGltf's points: begin() once, after the checking walk, then points() with
+// consecutive blocks of at most kGltfStreamBlockPoints, in readGltf's order and with readGltf's
+// colours (a block has colours exactly when summary.colors). An error from either stops the walk
+// and is what streamGltf returns.
+class GltfPointSink {
+ public:
+  virtual ~GltfPointSink() = default;
+  virtual Status begin(const GltfSummary& summary) = 0;
+  // The block is the sink's to change; the walk clears it afterwards. No triangles.
+  virtual Status points(PointSet& block) = 0;
+};
+
+constexpr size_t kGltfStreamBlockPoints = size_t(1) << 16;
+
+// readGltf without the point set: the model is loaded once and walked twice. The first walk makes
+// every check readGltf makes, in its order and with its errors (--max-points included), and keeps
+// only the summary; sink.begin() is called only when it succeeds. The second walk hands the
+// points to the sink. Memory: the model, one primitive's vertex map, one block. Triangles are not
+// produced (options.triangles is ignored).
+Status streamGltf(const std::string& path, const GltfReadOptions& options, GltfPointSink& sink);
+
 // Every component of accessor `index` decoded as the spec defines it (normalisation and sparse
 // substitution applied), element after element. For tests and tools that check the decoder.
 Result<std::vector<double>> readGltfAccessor(const std::string& path, int index);

@@ -3,11 +3,49 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <optional>
 
-#include "converters/gltf_read.h"
 #include "converters/gltf_write.h"
+#include "converters/point_filters.h"
 
 namespace dpoint {
+namespace {
+
+// The CSV file is created only once the checking walk has passed, so input errors come first
+// and a refused input leaves no output behind, as with readGltf then writeCsv.
+class CsvPointSink final : public GltfPointSink {
+ public:
+  CsvPointSink(const std::string& input, const std::string& output, const ColorFilters& filters,
+               const WriteOptions& options)
+      : input_(input), output_(output), filters_(filters), options_(options) {}
+
+  Status begin(const GltfSummary& summary) override {
+    if (summary.points == 0) return Error{input_ + ": no points to convert"};
+    const CsvLayout layout{summary.planar, summary.colors && !filters_.drop};
+    Result<CsvRowWriter> writer = CsvRowWriter::create(
+        output_, layout, CsvWriteOptions{options_.decimals, options_.threads, options_.progress}, summary.points);
+    if (!writer) return writer.error();
+    writer_.emplace(std::move(*writer));
+    return okStatus();
+  }
+
+  Status points(PointSet& block) override {
+    if (filters_.drop) block.colors.clear();
+    if (filters_.srgb8) encodeColorsSrgb8(block);
+    return writer_->append(block.positions, block.colors);
+  }
+
+  Status commit() { return writer_->commit(); }
+
+ private:
+  const std::string& input_;
+  const std::string& output_;
+  const ColorFilters& filters_;
+  const WriteOptions& options_;
+  std::optional<CsvRowWriter> writer_;
+};
+
+}  // namespace
 
 Result<FileFormat> formatOf(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -52,6 +90,13 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return Error{path + ": writing .gltf is not supported; write .glb", ExitCode::kUsage};
   }
   return Error{path + ": unreachable format"};
+}
+
+Status convertGltfToCsv(const std::string& input, const GltfReadOptions& read, const ColorFilters& filters,
+                        const std::string& output, const WriteOptions& options) {
+  CsvPointSink sink(input, output, filters, options);
+  if (Status s = streamGltf(input, read, sink); !s) return s;
+  return sink.commit();
 }
 
 }  // namespace dpoint

@@ -1,8 +1,10 @@
-// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input).
+// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input), and
+// glTF/GLB to CSV streamed without a PointSet.
 #pragma once
 
 #include <string>
 
+#include "converters/gltf_read.h"
 #include "core/csv.h"
 #include "core/ply.h"
 #include "core/point_set.h"
@@ -31,5 +33,19 @@ struct WriteOptions {
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options = {});
+
+// What `dpoint convert` does to colours between reading and writing.
+struct ColorFilters {
+  bool drop = false;   // --no-colors
+  bool srgb8 = false;  // --color-format srgb8: encodeColorsSrgb8 (point_filters.h)
+};
+
+// glTF/GLB input to a CSV file written block by block as the scene is walked (streamGltf):
+// memory is the loaded model plus a few blocks of rows, however many points the scene places.
+// The file is byte-identical to readGltf(input, read), then the filters, then writePoints(output);
+// the errors are the same and come in the same order: the input's, then "INPUT: no points to
+// convert", then the output's. On any error, nothing is left at `output`. options.ply_* are unused.
+Status convertGltfToCsv(const std::string& input, const GltfReadOptions& read, const ColorFilters& filters,
+                        const std::string& output, const WriteOptions& options = {});
 
 }  // namespace dpoint

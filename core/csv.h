@@ -8,10 +8,15 @@
 //
 // Writing: doubles in shortest round-trip form (std::to_chars), or with `decimals` fixed digits
 // after the point, rounded exactly like glibc printf("%.*f"). Colours as shortest floats.
+// writeCsv writes a whole PointSet; CsvRowWriter (which writeCsv is built on) takes rows as they
+// come, for writers that never hold the whole set (glTF input, converters/point_io.h).
 #pragma once
 
+#include <span>
 #include <string>
+#include <vector>
 
+#include "core/atomic_file.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -35,5 +40,44 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options 
 // Writes atomically (AtomicFile). Header `x,y` when the set is planar (every z is +0.0),
 // else `x,y,z`; `,r,g,b` when it has colours. Triangles are not stored in CSV.
 Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options = {});
+
+// The columns: `x,y` (planar: z is not written) or `x,y,z`, then `,r,g,b` when colors.
+struct CsvLayout {
+  bool planar = false;
+  bool colors = false;
+};
+
+// Rows appended in any number of calls give the same bytes as one writeCsv of all of them with
+// the same layout: rows are formatted in chunks on all cores and written in order, so neither
+// the split into calls nor the thread count shows in the output. Memory: a few chunks of rows
+// and of text per thread. The file appears only at commit(); a writer destroyed before (an
+// error mid-way) leaves nothing at the path (AtomicFile).
+class CsvRowWriter {
+ public:
+  // Checks options.decimals, creates the output and writes the header. `rows`: the expected
+  // count, for options.progress only.
+  static Result<CsvRowWriter> create(const std::string& path, CsvLayout layout, const CsvWriteOptions& options,
+                                     uint64_t rows = 0);
+
+  // colors: one per position when the layout has colours, else empty. Positions of a planar
+  // layout must have z == +0.0 (z is not written).
+  Status append(std::span<const glm::dvec3> positions, std::span<const glm::vec3> colors);
+  // Writes the rows still held and moves the file into place.
+  Status commit();
+
+ private:
+  CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOptions& options);
+  Status writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count);
+
+  AtomicFile file_;
+  CsvLayout layout_;
+  int decimals_;
+  unsigned threads_;
+  Progress* progress_;
+  size_t batch_rows_;  // rows formatted in one parallel batch
+  std::vector<glm::dvec3> pending_positions_;  // fewer than batch_rows_ rows from earlier calls
+  std::vector<glm::vec3> pending_colors_;
+  std::vector<std::string> texts_;  // one per chunk of a batch
+};
 
 }  // namespace dpoint

@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <charconv>
+#include <iterator>
 #include <random>
+#include <span>
 
 #include "core/csv.h"
 #include "core/fixed_format.h"
@@ -284,6 +287,57 @@ TEST(Csv, failedWriteLeavesNothing) {
   ASSERT_TRUE(writeCsv(dir.file("a.csv"), s).ok());
   EXPECT_EQ(readFile(dir.file("a.csv")), "x,y,z\n1,2,3\n");
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"a.csv"});
+}
+
+// Rows appended in uneven pieces (empty ones, one row, more than a batch) give writeCsv's bytes
+// for every layout, thread count and --decimals.
+TEST(Csv, rowWriterInPiecesEqualsWriteCsv) {
+  TempDir dir;
+  PointSet set = setFromDoubles(hardDoubles(3 * 300001), true);
+  PointSet planar = set;
+  for (glm::dvec3& p : planar.positions) p.z = 0.0;
+  const size_t pieces[] = {0, 1, 65535, 0, 2, 300000, 7};
+  for (const PointSet* source : {&set, &planar})
+    for (const bool colours : {true, false})
+      for (const int decimals : {-1, 15})
+        for (const unsigned threads : {1u, 2u}) {
+          PointSet whole = *source;
+          if (!colours) whole.colors.clear();
+          const CsvWriteOptions options{decimals, threads, nullptr};
+          ASSERT_TRUE(writeCsv(dir.file("whole.csv"), whole, options));
+          Result<CsvRowWriter> writer =
+              CsvRowWriter::create(dir.file("rows.csv"), CsvLayout{whole.isPlanar(), colours}, options);
+          ASSERT_TRUE(writer) << writer.error().message;
+          size_t at = 0;
+          for (size_t k = 0; at < whole.size(); k = (k + 1) % std::size(pieces)) {
+            const size_t n = std::min(pieces[k], whole.size() - at);
+            const std::span<const glm::vec3> c =
+                colours ? std::span<const glm::vec3>(whole.colors).subspan(at, n) : std::span<const glm::vec3>();
+            ASSERT_TRUE(writer->append(std::span<const glm::dvec3>(whole.positions).subspan(at, n), c));
+            at += n;
+          }
+          ASSERT_TRUE(writer->commit());
+          EXPECT_TRUE(readFile(dir.file("rows.csv")) == readFile(dir.file("whole.csv")))
+              << "planar " << whole.isPlanar() << " colours " << colours << " decimals " << decimals << " threads "
+              << threads;
+        }
+}
+
+TEST(Csv, rowWriterWithoutCommitLeavesNothing) {
+  TempDir dir;
+  PointSet set = setFromDoubles(hardDoubles(3 * 200000), false);
+  {
+    // One thread: batches of 2 chunks (131072 rows), so megabytes reach the file before the end.
+    Result<CsvRowWriter> writer = CsvRowWriter::create(dir.file("a.csv"), CsvLayout{}, CsvWriteOptions{-1, 1, nullptr});
+    ASSERT_TRUE(writer) << writer.error().message;
+    ASSERT_TRUE(writer->append(set.positions, {}));
+  }
+  EXPECT_TRUE(dir.entries().empty());
+  Result<CsvRowWriter> bad = CsvRowWriter::create(dir.file("a.csv"), CsvLayout{}, CsvWriteOptions{101, 0, nullptr});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ExitCode::kUsage);
+  EXPECT_NE(bad.error().message.find("--decimals 101"), std::string::npos) << bad.error().message;
+  EXPECT_TRUE(dir.entries().empty());
 }
 
 }  // namespace
