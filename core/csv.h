@@ -68,6 +68,7 @@ class CsvRowWriter {
  private:
   CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOptions& options);
   Status writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count);
+  Status flushPending();  // writes the rows held back for a whole batch
 
   AtomicFile file_;
   CsvLayout layout_;

@@ -148,12 +148,7 @@ Status CsvRowWriter::append(std::span<const glm::dvec3> positions, std::span<con
     if (layout_.colors)
       pending_colors_.insert(pending_colors_.end(), colors.begin(), colors.begin() + std::ptrdiff_t(at));
     if (pending_positions_.size() < batch_rows_) return okStatus();
-    if (Status s = writeBatch(pending_positions_.data(), layout_.colors ? pending_colors_.data() : nullptr,
-                              pending_positions_.size());
-        !s)
-      return s;
-    pending_positions_.clear();
-    pending_colors_.clear();
+    if (Status s = flushPending(); !s) return s;
   }
   // Whole batches straight from the caller's arrays (writeCsv's one call copies nothing but its tail).
   for (; n - at >= batch_rows_; at += batch_rows_)
@@ -163,15 +158,17 @@ Status CsvRowWriter::append(std::span<const glm::dvec3> positions, std::span<con
   return okStatus();
 }
 
+Status CsvRowWriter::flushPending() {
+  if (pending_positions_.empty()) return okStatus();
+  Status s = writeBatch(pending_positions_.data(), layout_.colors ? pending_colors_.data() : nullptr,
+                        pending_positions_.size());
+  pending_positions_.clear();
+  pending_colors_.clear();
+  return s;
+}
+
 Status CsvRowWriter::commit() {
-  if (!pending_positions_.empty()) {
-    if (Status s = writeBatch(pending_positions_.data(), layout_.colors ? pending_colors_.data() : nullptr,
-                              pending_positions_.size());
-        !s)
-      return s;
-    pending_positions_.clear();
-    pending_colors_.clear();
-  }
+  if (Status s = flushPending(); !s) return s;
   if (progress_) progress_->finish();
   return file_.commit();
 }

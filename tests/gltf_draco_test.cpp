@@ -14,26 +14,18 @@
 #include <vector>
 
 #include "converters/gltf_read.h"
+#include "gltf_test_support.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::base64;
+using test::expectReadError;
+using test::readText;
 using test::TempDir;
 
 constexpr const char* kDracoPointer = "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression";
-
-std::string base64(const std::vector<unsigned char>& bytes) {
-  static const char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    uint32_t chunk = uint32_t(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) chunk |= uint32_t(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) chunk |= bytes[i + 2];
-    for (size_t k = 0; k < 4; ++k) out += i + k <= bytes.size() ? kDigits[(chunk >> (18 - 6 * k)) & 63] : '=';
-  }
-  return out;
-}
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
@@ -118,21 +110,6 @@ std::string dracoGltf(const Encoded& e) {
   "bufferViews": [{"buffer": 0, "byteLength": )" + length + R"(}],
   "buffers": [{"byteLength": )" + length + R"(, "uri": "data:application/octet-stream;base64,)" + base64(e.bytes) + R"("}]
 })";
-}
-
-Result<PointSet> readText(const TempDir& dir, const std::string& json) {
-  test::writeFile(dir.file("scene.gltf"), json);
-  return readGltf(dir.file("scene.gltf"));
-}
-
-void expectReadError(const std::string& json, const std::vector<std::string>& parts) {
-  TempDir dir;
-  Result<PointSet> set = readText(dir, json);
-  ASSERT_FALSE(set);
-  const std::string& message = set.error().message;
-  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  EXPECT_EQ(message.rfind(dir.file("scene.gltf") + ": ", 0), 0u) << message;
-  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
 }
 
 // Points with their colours, in a canonical order (Draco may reorder points).

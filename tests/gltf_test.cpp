@@ -14,11 +14,15 @@
 #include "converters/gltf_read.h"
 #include "converters/gltf_write.h"
 #include "converters/point_filters.h"
+#include "gltf_test_support.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::base64;
+using test::expectReadError;
+using test::readText;
 using test::TempDir;
 
 constexpr double kEarthRadius = 6.378e6;
@@ -197,19 +201,6 @@ TEST(Gltf, glbWriteToMissingFolderLeavesNothing) {
 
 // --- Hand-written .gltf files with an embedded buffer -------------------------------------------
 
-std::string base64(const std::vector<unsigned char>& bytes) {
-  static const char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    uint32_t chunk = uint32_t(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) chunk |= uint32_t(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) chunk |= bytes[i + 2];
-    for (size_t k = 0; k < 4; ++k)
-      out += i + k <= bytes.size() ? kDigits[(chunk >> (18 - 6 * k)) & 63] : '=';
-  }
-  return out;
-}
-
 template <typename T>
 void append(std::vector<unsigned char>& bytes, std::initializer_list<T> values) {
   for (T v : values) {
@@ -269,11 +260,6 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-Result<PointSet> readText(const TempDir& dir, const std::string& json) {
-  test::writeFile(dir.file("scene.gltf"), json);
-  return readGltf(dir.file("scene.gltf"));
-}
-
 TEST(Gltf, gltfNodeHierarchyComposesMatrixAndTrs) {
   TempDir dir;
   Result<PointSet> set = readText(dir, fixtureGltf());
@@ -297,16 +283,6 @@ TEST(Gltf, gltfMissingColoursTakeMaterialColour) {
       {0.25f, 0.5f, 0.75f}, {0.25f, 0.5f, 0.75f}, {0.25f, 0.5f, 0.75f}, {1, 0, 0}, {0, 1, 0},
       {0.2f, 0.4f, 0.8f}};
   EXPECT_EQ(set->colors, expected);
-}
-
-void expectReadError(const std::string& json, const std::vector<std::string>& parts) {
-  TempDir dir;
-  Result<PointSet> set = readText(dir, json);
-  ASSERT_FALSE(set);
-  const std::string& message = set.error().message;
-  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  EXPECT_EQ(message.rfind(dir.file("scene.gltf") + ": ", 0), 0u) << message;
-  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
 }
 
 TEST(Gltf, gltfRejectsNodeCycle) {
