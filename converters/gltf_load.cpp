@@ -309,6 +309,48 @@ std::string oneLine(std::string text) {
   return text.empty() ? "tinygltf gave no reason" : text;
 }
 
+struct BinHandOver {
+  size_t bin_offset = 0;        // of the BIN chunk's data in the file
+  size_t byte_length = 0;       // buffer 0's byteLength
+  size_t stand_in_length = 0;   // zeros tinygltf gets instead (covers image views, which it reads)
+};
+
+// For a GLB whose buffer 0 is its BIN chunk: shrinks buffers[0].byteLength in the DOM to a
+// stand-in that still covers every image bufferView on buffer 0 (tinygltf takes a pointer into
+// the buffer for each; the image loader is a no-op), and says where the real bytes are.
+// checkDocument has already checked byteLength against the chunk and every view against its buffer.
+std::optional<BinHandOver> standInForBin(JsonValue& document, const GlbLayout& glb) {
+  if (!glb.bin_length || *glb.bin_length == 0) return std::nullopt;
+  JsonValue* buffers = document.find("buffers");
+  if (!buffers || buffers->kind != JsonValue::Kind::kArray || buffers->items.empty()) return std::nullopt;
+  JsonValue& buffer = buffers->items[0];
+  const JsonValue* byte_length = buffer.find("byteLength");
+  if (buffer.find("uri") || !byte_length || byte_length->kind != JsonValue::Kind::kNumber) return std::nullopt;
+  BinHandOver out;
+  out.bin_offset = glb.json_offset + glb.json_length + 8;
+  out.byte_length = size_t(byte_length->number);
+  if (!(byte_length->number >= 0) || byte_length->number > double(*glb.bin_length)) return std::nullopt;  // tinygltf refuses it
+  size_t covered = 4;
+  const JsonValue* images = document.find("images");
+  const JsonValue* views = document.find("bufferViews");
+  if (images && images->kind == JsonValue::Kind::kArray && views && views->kind == JsonValue::Kind::kArray) {
+    for (const JsonValue& image : images->items) {
+      const JsonValue* index = image.find("bufferView");
+      if (!index || index->kind != JsonValue::Kind::kNumber || index->number >= double(views->items.size())) continue;
+      const JsonValue& view = views->items[size_t(index->number)];
+      const JsonValue* offset = view.find("byteOffset");
+      const JsonValue* length = view.find("byteLength");
+      if (!length || length->kind != JsonValue::Kind::kNumber) continue;
+      const double end = (offset && offset->kind == JsonValue::Kind::kNumber ? offset->number : 0.0) + length->number;
+      covered = std::max(covered, size_t(end));
+    }
+  }
+  covered = std::min(covered, out.byte_length == 0 ? size_t{4} : std::max<size_t>(out.byte_length, 4));
+  out.stand_in_length = (covered + 3) / 4 * 4;
+  buffer.set("byteLength", JsonValue::integerValue(int64_t(out.stand_in_length)));
+  return out;
+}
+
 Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
   Result<InputFile> input = InputFile::open(path);
   if (!input) return input.error();
@@ -318,6 +360,7 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
                      std::to_string(max_file_bytes) + " bytes",
                  ExitCode::kResourceLimit};
   std::vector<unsigned char> bytes(size_t(input->size()));
+  std::vector<unsigned char> tinygltf_input;  // the GLB tinygltf parses when the BIN chunk is handed over
   Result<size_t> got = input->readAt(0, bytes.data(), bytes.size());
   if (!got) return got.error();
   if (*got != bytes.size()) return Error{path + ": the file shrank while being read"};
@@ -336,6 +379,10 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
     return Error{path + ": starts with a UTF-8 byte order mark, which glTF forbids"};
   }
   std::vector<DracoIndices> draco_indices;
+  // A GLB's BIN chunk is not handed to tinygltf, which would copy it (the file and the copy, twice
+  // the input, would be held at once): tinygltf gets the JSON with buffer 0 shrunk to a stand-in
+  // of zeros, and the chunk's bytes are moved into buffer 0 in place afterwards.
+  std::optional<BinHandOver> hand_over;
   {
     Result<JsonValue> document = parseJson(json, kGltfMaxJsonDepth);
     if (!document) return Error{path + ": JSON " + document.error().message};
@@ -343,20 +390,29 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
     // JSON tinygltf 2.7.0 cannot load as written (gltf_meshopt.h, gltf_draco.h) is rewritten.
     const bool fallback_emptied = emptyMeshoptFallbackBuffers(*document, binary);
     draco_indices = detachDracoIndices(*document);
-    if (fallback_emptied || !draco_indices.empty()) {
+    if (binary) hand_over = standInForBin(*document, glb);
+    if (fallback_emptied || !draco_indices.empty() || hand_over) {
       std::string rewritten = writeJson(*document);
       if (binary) {
-        // Same chunks after the JSON one; the JSON chunk padded with spaces to 4 bytes (GLB §4.4.3.1).
+        // Same chunks after the JSON one (or the stand-in BIN); the JSON chunk padded with spaces
+        // to 4 bytes (GLB §4.4.3.1).
         rewritten.append((4 - rewritten.size() % 4) % 4, ' ');
         const size_t rest = glb.json_offset + glb.json_length;
-        const size_t end = readU32(bytes, 8);  // checkGlb: ≤ bytes.size()
-        std::vector<unsigned char> glb_bytes(12 + 8 + rewritten.size() + (end - rest));
+        const size_t end = hand_over ? rest : readU32(bytes, 8);  // checkGlb: ≤ bytes.size()
+        const size_t stand_in = hand_over ? 8 + hand_over->stand_in_length : 0;
+        std::vector<unsigned char> glb_bytes(12 + 8 + rewritten.size() + (end - rest) + stand_in);
         const uint32_t header[5] = {kGlbMagic, 2, uint32_t(glb_bytes.size()), uint32_t(rewritten.size()), kChunkJson};
         std::memcpy(glb_bytes.data(), header, sizeof header);
         std::memcpy(glb_bytes.data() + 20, rewritten.data(), rewritten.size());
         std::copy(bytes.begin() + std::ptrdiff_t(rest), bytes.begin() + std::ptrdiff_t(end),
                   glb_bytes.begin() + std::ptrdiff_t(20 + rewritten.size()));
-        bytes = std::move(glb_bytes);
+        if (hand_over) {
+          const uint32_t bin_header[2] = {uint32_t(hand_over->stand_in_length), kChunkBin};
+          std::memcpy(glb_bytes.data() + 20 + rewritten.size(), bin_header, sizeof bin_header);  // zeros follow
+          tinygltf_input = std::move(glb_bytes);  // the file's bytes stay in `bytes` for the hand-over
+        } else {
+          bytes = std::move(glb_bytes);
+        }
       } else {
         bytes.assign(rewritten.begin(), rewritten.end());
         json = std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
@@ -375,10 +431,19 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
   loader.SetImageLoader(&skipImage, nullptr);
   tinygltf::Model model;
   std::string err, warn;
-  const auto length = static_cast<unsigned int>(bytes.size());  // ≤ 2^32−1: checked by the GLB header / cap
-  const bool loaded = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), length, jail.base)
+  const std::vector<unsigned char>& input_bytes = hand_over ? tinygltf_input : bytes;
+  const auto length = static_cast<unsigned int>(input_bytes.size());  // ≤ 2^32−1: the GLB header / cap
+  const bool loaded = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, input_bytes.data(), length, jail.base)
                              : loader.LoadASCIIFromString(&model, &err, &warn, json.data(), length, jail.base);
   if (!loaded) return Error{path + ": " + oneLine(err)};
+  if (hand_over) {
+    // Buffer 0 becomes the BIN chunk's first byte_length bytes, moved down inside the file's own
+    // allocation: no second copy of the data exists at any time.
+    assert(!model.buffers.empty());
+    std::memmove(bytes.data(), bytes.data() + hand_over->bin_offset, hand_over->byte_length);
+    bytes.resize(hand_over->byte_length);
+    model.buffers[0].data = std::move(bytes);
+  }
   // Decoded here so every reader of the model sees plain views; the input cap bounds the output.
   if (Status s = decodeMeshoptViews(path, model, max_file_bytes); !s) return s.error();
   if (Status s = decodeDracoPrimitives(path, model, draco_indices, max_file_bytes); !s) return s.error();
