@@ -84,18 +84,6 @@ Result<uint32_t> parseBackground(const std::string& text) {
   return packed;
 }
 
-Bounds boundsOf(const PointSet& points) {
-  Bounds b;
-  if (points.size() == 0) return b;
-  b.min = b.max = points.positions[0];
-  for (const glm::dvec3& p : points.positions) {
-    b.min = glm::min(b.min, p);
-    b.max = glm::max(b.max, p);
-  }
-  b.planar = points.isPlanar();
-  return b;
-}
-
 std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
                        const RenderResult& r, const ErrorReport* error) {
   const DeviceFacts& f = context.facts;

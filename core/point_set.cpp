@@ -1,6 +1,9 @@
 #include "core/point_set.h"
 
+#include <cassert>
 #include <cstring>
+
+#include <glm/common.hpp>
 
 namespace dpoint {
 
@@ -11,6 +14,16 @@ bool PointSet::isPlanar() const {
     if (bits != 0) return false;
   }
   return true;
+}
+
+Box boundingBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {
+  assert(first < last && last <= positions.size());
+  Box box{positions[first], positions[first]};
+  for (size_t i = first + 1; i < last; ++i) {
+    box.min = glm::min(box.min, positions[i]);
+    box.max = glm::max(box.max, positions[i]);
+  }
+  return box;
 }
 
 }  // namespace dpoint

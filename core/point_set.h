@@ -1,6 +1,7 @@
 // The data model (DESIGN §2): only what a scene needs.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -19,5 +20,12 @@ struct PointSet {
   // True when every z is +0.0 (bit pattern zero): the set is 2D and CSV writes `x,y`.
   bool isPlanar() const;
 };
+
+// Smallest and largest coordinates of positions [first, last); asserts first < last.
+struct Box {
+  glm::dvec3 min{0.0}, max{0.0};
+};
+Box boundingBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last);
+inline Box boundingBox(const std::vector<glm::dvec3>& positions) { return boundingBox(positions, 0, positions.size()); }
 
 }  // namespace dpoint

@@ -69,15 +69,6 @@ PointSet cloud(const glm::dvec3& centre, double spacing) {
   return s;
 }
 
-Bounds boundsOf(const PointSet& s) {
-  Bounds b{s.positions[0], s.positions[0], s.isPlanar()};
-  for (const glm::dvec3& p : s.positions) {
-    b.min = glm::min(b.min, p);
-    b.max = glm::max(b.max, p);
-  }
-  return b;
-}
-
 // Looks at the cloud's centre from `distance` away along +z (and a little off axis, so no
 // coordinate of the eye-relative vector is zero), 1024 × 1024.
 Camera lookAtCloud(const PointSet& s, const glm::dvec3& centre, double distance) {

@@ -258,4 +258,9 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
   return camera;
 }
 
+Bounds boundsOf(const PointSet& points) {
+  const Box box = boundingBox(points.positions);
+  return Bounds{box.min, box.max, points.isPlanar()};
+}
+
 }  // namespace dpoint

@@ -15,6 +15,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/point_set.h"
 #include "core/result.h"
 
 namespace dpoint {
@@ -67,5 +68,8 @@ struct Bounds {
 // the eye gets near = far·1e-6, and points nearer than that or behind the eye are outside the view
 // volume. Ortho near may be < 0 (the slab then reaches behind the eye and holds the whole box).
 Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds);
+
+// The bounding box of a non-empty set, and whether it is 2D (PointSet::isPlanar).
+Bounds boundsOf(const PointSet& points);
 
 }  // namespace dpoint

@@ -116,14 +116,10 @@ std::vector<glm::dvec3> batchOrigins(PrecisionMode mode, const PointSet& points)
   size_t batches = (points.size() + kBatchSize - 1) / kBatchSize;
   origins.resize(batches);
   for (size_t b = 0; b < batches; ++b) {
-    size_t first = b * kBatchSize, last = std::min(points.size(), first + kBatchSize);
-    glm::dvec3 lo = points.positions[first], hi = lo;
-    for (size_t i = first + 1; i < last; ++i) {
-      lo = glm::min(lo, points.positions[i]);
-      hi = glm::max(hi, points.positions[i]);
-    }
-    // lo/2 + hi/2 cannot overflow where (lo + hi)/2 could.
-    origins[b] = lo * 0.5 + hi * 0.5;
+    const size_t first = b * kBatchSize;
+    const Box box = boundingBox(points.positions, first, std::min(points.size(), first + kBatchSize));
+    // min/2 + max/2 cannot overflow where (min + max)/2 could.
+    origins[b] = box.min * 0.5 + box.max * 0.5;
   }
   return origins;
 }
