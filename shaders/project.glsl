@@ -1,5 +1,7 @@
 // The per-mode projection (DESIGN §4), shared by the raster vertex shader (points.vert) and the
 // compute splat (points_splat.comp), so both backends and the probe run the same arithmetic.
+// Every mode but fp32 and split works in the scene frame (viewer/encode.h): positions, eye and
+// matrices arrive scaled by a power of two so no intermediate leaves float's range.
 // The mode is a define: MODE_FP32, MODE_SPLIT, MODE_RTE, MODE_DF64, MODE_NATIVE_ATTR,
 // MODE_NATIVE_PULL (native reading a storage buffer) or MODE_BATCH.
 
@@ -19,7 +21,7 @@ layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 projection_rotat
 #include "df64.glsl"
 layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 mvp_hi; mat4 mvp_lo; } cam;
 #elif defined(MODE_NATIVE_ATTR) || defined(MODE_NATIVE_PULL)
-layout(std140, set = 0, binding = 0) uniform CameraBlock { dmat4 mvp; } cam;
+layout(std140, set = 0, binding = 0) uniform CameraBlock { dmat4 projection_rotation; dvec4 eye; } cam;
 #elif defined(MODE_BATCH)
 layout(std430, set = 0, binding = 2) readonly buffer Batches { mat4 batch_mvp[]; };
 #else
@@ -61,8 +63,13 @@ vec4 projectPoint(PointInput point, uint index) {
   }
   return clip;
 #elif defined(MODE_NATIVE_ATTR) || defined(MODE_NATIVE_PULL)
-  return vec4(cam.mvp * dvec4(point.position, 1.0));
+  // The eye first: p − eye is exact when p is near the eye (Sterbenz), so the translation's
+  // rounding never reaches the picture (a folded MVP would add half an ulp of |eye|). Only the
+  // final clip position is rounded to float.
+  dvec3 relative = point.position - cam.eye.xyz;
+  return vec4(cam.projection_rotation * dvec4(relative, 1.0));
 #elif defined(MODE_BATCH)
+  // Offsets are normalized to the batch's box ([−1, 1]); the matrix carries origin and extent.
   return batch_mvp[index / pc.batch_size] * vec4(point.position, 1.0);
 #endif
 }

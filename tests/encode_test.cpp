@@ -22,11 +22,36 @@ TEST(Encode, modeNamesRoundTripAndBytesPerPointMatchDesign) {
 // hi + lo carries d to 48 bits, and lo is the exact float remainder. Done over arrays because the
 // bug this guards against (GCC 12 folding (double)(float)d back to d) appears only when the
 // compiler vectorizes several splits together.
+// A camera looking down −z at `centre` through an orthographic window `width` wide.
+Camera orthoCamera(const glm::dvec3& centre, double width) {
+  CameraSpec spec;
+  spec.width = spec.height = 64;
+  spec.view_center = centre;
+  spec.view_width = width;
+  PointSet s;
+  s.positions = {centre};
+  Result<Camera> camera = makeCamera(spec, boundsOf(s));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
+ModeEncoding encoding(PrecisionMode mode, const PointSet& s, const Camera& camera) {
+  Result<ModeEncoding> e = prepareEncoding(mode, s, camera);
+  EXPECT_TRUE(e.ok()) << modeName(mode) << ": " << e.error().message;
+  return e.ok() ? *e : ModeEncoding{};
+}
+
+// hi + lo carries d to 48 bits, and lo is the exact float remainder. Done over arrays because the
+// bug this guards against (GCC 12 folding (double)(float)d back to d) appears only when the
+// compiler vectorizes several splits together. A view 2 units wide keeps the scene frame at 2^0.
 TEST(Encode, encodeRoundTripKeepsLowParts) {
   PointSet s;
   for (int i = 0; i < 257; ++i) s.positions.emplace_back(6.378e6 + 1e-3 * i, -0.7436450 + 1e-11 * i, 0.1318259 * i);
+  Camera camera = orthoCamera({-0.7436450, 0.1318259, 6.378e6 + 0.1}, 1.5);
+  ModeEncoding rte = encoding(PrecisionMode::kRte, s, camera);
+  ASSERT_EQ(rte.frame.exponent, 0);
   std::vector<float> out(6 * s.size());
-  encodePositions(PrecisionMode::kRte, s, {}, 0, s.size(), out.data());
+  encodePositions(rte, s, 0, s.size(), out.data());
   size_t nonzero_lo = 0;
   for (size_t i = 0; i < s.size(); ++i) {
     for (int a = 0; a < 3; ++a) {
@@ -39,56 +64,93 @@ TEST(Encode, encodeRoundTripKeepsLowParts) {
     }
   }
   EXPECT_GT(nonzero_lo, s.size() * 2);
-  Camera camera;
-  camera.eye = {-0.7436450, 0.1318259, 6.378e6 + 0.1};
-  std::vector<uint8_t> rte = cameraUniform(PrecisionMode::kRte, camera);
-  ASSERT_EQ(rte.size(), 96u);  // mat4, vec4 eye_hi, vec4 eye_lo (std140)
+  std::vector<uint8_t> uniform = cameraUniform(rte, camera);
+  ASSERT_EQ(uniform.size(), 96u);  // mat4, vec4 eye_hi, vec4 eye_lo (std140)
   float eye[8];
-  std::memcpy(eye, rte.data() + 64, sizeof(eye));
+  std::memcpy(eye, uniform.data() + 64, sizeof(eye));
   for (int a = 0; a < 3; ++a) {
     EXPECT_EQ(eye[a], splitDouble(camera.eye[a]).hi);
     EXPECT_EQ(eye[4 + a], splitDouble(camera.eye[a]).lo);
-    EXPECT_NE(eye[4 + a], 0.0f) << "axis " << a;
+  }
+  EXPECT_NE(eye[4], 0.0f);
+}
+
+// The scene frame scales by a power of two so the view is 1 to 2 units wide: exact, and the same
+// exponent for the positions, the eye and (inverted) the matrix.
+TEST(Encode, sceneFrameScalesByAPowerOfTwoToTheViewSize) {
+  for (double width : {1e-40, 1e-13, 1.0, 3e5, 1e30}) {
+    Camera camera = orthoCamera({1e-30, 2e-30, 0.0}, width);
+    SceneFrame frame = sceneFrame(PrecisionMode::kNative, camera);
+    EXPECT_EQ(frame.scale, std::ldexp(1.0, frame.exponent));
+    EXPECT_GE(width * frame.scale, 1.0) << width;
+    EXPECT_LT(width * frame.scale, 2.0) << width;
+    EXPECT_EQ(frame.eye, camera.eye * frame.scale);
+    EXPECT_DOUBLE_EQ(frame.projection_rotation[0][0], 2.0 / (width * frame.scale));
+    EXPECT_EQ(sceneFrame(PrecisionMode::kFp32, camera).exponent, 0) << "fp32 stays absolute";
+    EXPECT_EQ(sceneFrame(PrecisionMode::kSplit, camera).exponent, 0) << "split stays absolute";
   }
 }
 
-TEST(Encode, nativeIsTheDoublesThemselves) {
+TEST(Encode, nativeIsTheDoublesThemselvesInTheSceneFrame) {
   PointSet s;
   s.positions = {{1.0 / 3.0, -2e300, 6.378e6 + 1e-9}};
+  Camera camera = orthoCamera({0.0, 0.0, 0.0}, 1.0);
   double out[3];
-  encodePositions(PrecisionMode::kNative, s, {}, 0, 1, out);
+  encodePositions(encoding(PrecisionMode::kNative, s, camera), s, 0, 1, out);
   EXPECT_EQ(glm::dvec3(out[0], out[1], out[2]), s.positions[0]);
+  Camera tiny = orthoCamera({0.0, 0.0, 0.0}, 1e-40);
+  Result<ModeEncoding> overflow = prepareEncoding(PrecisionMode::kNative, s, tiny);
+  ASSERT_FALSE(overflow.ok()) << "2e300 is 2e340 views of 1e-40 from the origin";
+  EXPECT_NE(overflow.error().message.find("point 0: y = -2e+300 overflows double"), std::string::npos)
+      << overflow.error().message;
+  s.positions = {{1e-40 / 3.0, -2e-40, 0.0}};
+  ModeEncoding e = encoding(PrecisionMode::kNative, s, tiny);
+  encodePositions(e, s, 0, 1, out);
+  EXPECT_EQ(out[0], std::ldexp(1e-40 / 3.0, e.frame.exponent));
+  EXPECT_EQ(out[1], std::ldexp(-2e-40, e.frame.exponent));
+  std::vector<uint8_t> uniform = cameraUniform(e, tiny);
+  ASSERT_EQ(uniform.size(), 160u);  // dmat4 projection_rotation, dvec4 eye (std140)
 }
 
-TEST(Encode, batchOffsetsAreRelativeToTheirBatchCentre) {
+TEST(Encode, batchOffsetsAreNormalizedToTheirBatchBox) {
   PointSet s;
   for (uint32_t i = 0; i < kBatchSize + 10; ++i) s.positions.emplace_back(1e8 + i * 1e-3, 0.0, i < kBatchSize ? 0.0 : 5.0);
-  std::vector<glm::dvec3> origins = batchOrigins(PrecisionMode::kBatch, s);
-  ASSERT_EQ(origins.size(), 2u);
-  EXPECT_DOUBLE_EQ(origins[0].x, 1e8 + (kBatchSize - 1) * 0.5e-3);
-  EXPECT_EQ(origins[1].z, 5.0);
+  Camera camera = orthoCamera({1e8, 0.0, 0.0}, 1.0);
+  ModeEncoding e = encoding(PrecisionMode::kBatch, s, camera);
+  ASSERT_EQ(e.batches.size(), 2u);
+  EXPECT_DOUBLE_EQ(e.batches[0].origin.x, 1e8 + (kBatchSize - 1) * 0.5e-3);
+  EXPECT_EQ(e.batches[1].origin.z, 5.0);
+  EXPECT_EQ(e.batches[0].extent, 4.0) << "half of 4.095 m, up to a power of two";
+  EXPECT_EQ(e.batches[1].extent, 0.0078125) << "half of 9 mm, up to a power of two";
   std::vector<float> out(3 * s.size());
-  encodePositions(PrecisionMode::kBatch, s, origins, 0, s.size(), out.data());
+  encodePositions(e, s, 0, s.size(), out.data());
   for (size_t i = 0; i < s.size(); ++i) {
-    const glm::dvec3& origin = origins[i / kBatchSize];
-    EXPECT_EQ(out[3 * i], static_cast<float>(s.positions[i].x - origin.x));
-    EXPECT_LT(std::fabs(out[3 * i]), 3.0f);
+    const BatchFrame& batch = e.batches[i / kBatchSize];
+    EXPECT_EQ(out[3 * i], static_cast<float>((s.positions[i].x - batch.origin.x) / batch.extent));
+    EXPECT_LE(std::fabs(out[3 * i]), 1.0f);
   }
-  EXPECT_TRUE(batchOrigins(PrecisionMode::kFp32, s).empty());
+  const glm::dmat4 m = batchMatrix(e, 1);
+  EXPECT_EQ(m[0][0], camera.projection[0][0] * e.batches[1].extent) << "the extent is folded into the matrix";
 }
 
-TEST(Encode, checkEncodableNamesThePointAndCoordinate) {
+TEST(Encode, prepareEncodingNamesThePointAndCoordinateBeyondFloat) {
   PointSet s;
   s.positions = {{0, 0, 0}, {0, -4e38, 0}};
+  Camera camera = orthoCamera({0.0, 0.0, 0.0}, 1.0);
   for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kSplit, PrecisionMode::kRte, PrecisionMode::kDf64}) {
-    Status status = checkEncodable(mode, s, {});
-    ASSERT_FALSE(status.ok()) << modeName(mode);
-    EXPECT_NE(status.error().message.find("point 1: y = -4e+38 is beyond float32 range"), std::string::npos) << status.error().message;
-    EXPECT_NE(status.error().message.find("--mode native"), std::string::npos);
+    Result<ModeEncoding> e = prepareEncoding(mode, s, camera);
+    ASSERT_FALSE(e.ok()) << modeName(mode);
+    EXPECT_NE(e.error().message.find("point 1: y = -4e+38"), std::string::npos) << e.error().message;
+    EXPECT_NE(e.error().message.find("beyond float32 range"), std::string::npos) << e.error().message;
+    EXPECT_NE(e.error().message.find("--mode native"), std::string::npos);
   }
-  EXPECT_TRUE(checkEncodable(PrecisionMode::kNative, s, {}).ok());
-  s.positions = {{3e38, 0, 0}, {-3e38, 0, 0}};  // batch: each within float, the offset from the centre too
-  EXPECT_TRUE(checkEncodable(PrecisionMode::kBatch, s, batchOrigins(PrecisionMode::kBatch, s)).ok());
+  EXPECT_TRUE(prepareEncoding(PrecisionMode::kNative, s, camera).ok());
+  // In a view as wide as the set, the scene frame brings rte and df64 back into range; batch's
+  // normalized offsets never leave it.
+  Camera wide = orthoCamera({0.0, -2e38, 0.0}, 8e38);
+  for (PrecisionMode mode : {PrecisionMode::kRte, PrecisionMode::kDf64, PrecisionMode::kBatch})
+    EXPECT_TRUE(prepareEncoding(mode, s, wide).ok()) << modeName(mode);
+  EXPECT_FALSE(prepareEncoding(PrecisionMode::kFp32, s, wide).ok());
 }
 
 TEST(Encode, coloursRoundToNearestByteWithOpaqueAlphaAndWhiteWithoutColours) {
@@ -100,16 +162,16 @@ TEST(Encode, coloursRoundToNearestByteWithOpaqueAlphaAndWhiteWithoutColours) {
 }
 
 TEST(Encode, df64UniformSplitsEveryMatrixEntry) {
-  Camera camera;
-  camera.eye = {6.378e6 + 0.1, 1.0 / 3.0, 0.0};
-  camera.projection[2][3] = -1.0;
-  camera.projection[3][3] = 0.0;
-  std::vector<uint8_t> bytes = cameraUniform(PrecisionMode::kDf64, camera);
+  Camera camera = orthoCamera({6.378e6 + 0.1, 1.0 / 3.0, 0.0}, 1.5);
+  ModeEncoding e = encoding(PrecisionMode::kDf64, PointSet{}, camera);
+  std::vector<uint8_t> bytes = cameraUniform(e, camera);
   ASSERT_EQ(bytes.size(), 128u);
   float hi[16], lo[16];
   std::memcpy(hi, bytes.data(), 64);
   std::memcpy(lo, bytes.data() + 64, 64);
-  glm::dmat4 mvp = camera.viewProjection();
+  glm::dmat4 translate(1.0);
+  translate[3] = glm::dvec4(-e.frame.eye, 1.0);
+  const glm::dmat4 mvp = e.frame.projection_rotation * translate;  // in the scene frame
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r) {
       EXPECT_EQ(hi[4 * c + r], splitDouble(mvp[c][r]).hi);

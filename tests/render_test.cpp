@@ -12,75 +12,13 @@
 #include "viewer/probe.h"
 #include "viewer/render.h"
 #include "viewer/selftest.h"
+#include "render_test_support.h"
 
 namespace dpoint {
 namespace {
 
 // Every test runs on both backends (raster and compute): same modes, same projection code.
-class Render : public ::testing::TestWithParam<Backend> {
- protected:
-  // One context (instance and device) for the whole suite, as an application holds one: the
-  // NVIDIA driver stops creating instances after some dozens of load/unload cycles in a process.
-  static void SetUpTestSuite() {
-    Result<std::unique_ptr<VulkanContext>> created = VulkanContext::create(ContextOptions{"auto", true});
-    if (created.ok()) shared_ = std::move(*created);
-    else setup_error_ = created.error().message;
-  }
-  static void TearDownTestSuite() { shared_.reset(); }
-  void SetUp() override {
-    ASSERT_TRUE(shared_) << setup_error_;
-    context_ = shared_.get();
-    context_->clearValidationMessages();
-  }
-  void TearDown() override {
-    if (!context_) return;
-    for (const std::string& m : context_->validationMessages()) ADD_FAILURE() << m;
-  }
-
-  struct Measured {
-    RenderResult render;
-    ErrorReport error;
-  };
-  Measured measure(const PointSet& points, const Camera& camera, PrecisionMode mode, RenderOptions options = {}) {
-    options.mode = mode;
-    options.backend = GetParam();
-    options.probe = true;
-    Result<RenderResult> r = renderPoints(*context_, points, camera, options);
-    EXPECT_TRUE(r.ok()) << modeName(mode) << ": " << r.error().message;
-    if (!r.ok()) return {};
-    ErrorReport e = measureError(points, camera, *r, options);
-    return {std::move(*r), std::move(e)};
-  }
-
-  VulkanContext* context_ = nullptr;
-  static inline std::unique_ptr<VulkanContext> shared_;
-  static inline std::string setup_error_;
-};
-
-// 10 × 10 × 10 points `spacing` apart, centred on `centre`, coloured by position.
-PointSet cloud(const glm::dvec3& centre, double spacing) {
-  PointSet s;
-  for (int i = 0; i < 10; ++i)
-    for (int j = 0; j < 10; ++j)
-      for (int k = 0; k < 10; ++k) {
-        s.positions.push_back(centre + spacing * glm::dvec3(i - 4.5, j - 4.5, k - 4.5));
-        s.colors.emplace_back(0.1f * static_cast<float>(i), 0.1f * static_cast<float>(j), 0.1f * static_cast<float>(k));
-      }
-  return s;
-}
-
-// Looks at the cloud's centre from `distance` away along +z (and a little off axis, so no
-// coordinate of the eye-relative vector is zero), 1024 × 1024.
-Camera lookAtCloud(const PointSet& s, const glm::dvec3& centre, double distance) {
-  CameraSpec spec;
-  spec.width = spec.height = 1024;
-  spec.eye = centre + distance * glm::dvec3(0.1, 0.2, 1.0);
-  spec.target = centre;
-  spec.up = glm::dvec3(0, 1, 0);
-  Result<Camera> camera = makeCamera(spec, boundsOf(s));
-  EXPECT_TRUE(camera.ok()) << camera.error().message;
-  return *camera;
-}
+class Render : public VulkanRenderTest {};
 
 // The guard itself: the layer is on and a misuse reaches the message list the tests check.
 TEST_P(Render, validationLayerReportsMisuse) {
@@ -140,34 +78,22 @@ TEST_P(Render, offset1e8HoldsForEveryDoubleMode) {
   }
 }
 
-// The same cloud scaled down to 1e-40 m spacing at the origin, camera 1e-37 m away. Measured on
-// lavapipe (and stated here as the test's expectations):
-// - native holds (max 5e-7 px): double positions and matrix, and the projection is scaled
-//   (homogeneously) so the clip position it finally casts to float is near 1;
-// - df64 loses every point: double-float keeps float's exponent range, and Dekker's split of the
-//   ~1e37 matrix entries overflows (4097·a > FLT_MAX), so every clip position is NaN;
-// - fp32, split, rte, batch hinge on float subnormals (1e-40 is one): lavapipe's vertex stage
-//   flushes them to zero (raster: off by up to 127 px), its compute stage keeps them (compute:
-//   within 4e-5 px). Other devices flush as they like, so there these are only recorded.
-TEST_P(Render, tinyScaleNearTheOriginHoldsInNativeAndWhereSubnormalsSurvive) {
+// The same cloud scaled down to 1e-40 m spacing at the origin, camera 1e-37 m away. Every mode
+// that works in the scene frame (viewer/encode.h) sees the same numbers as at 1 mm and holds;
+// fp32 and split (absolute) hinge on float subnormals, which devices flush as they like: only
+// recorded. (Before the scene frame, df64 lost every point here and rte/batch failed on
+// lavapipe's vertex stage.)
+TEST_P(Render, tinyScaleNearTheOriginHoldsInEverySceneFrameMode) {
   const glm::dvec3 centre(0.0);
   PointSet s = cloud(centre, 1e-40);
   Camera camera = lookAtCloud(s, centre, 1e-37);
-  const bool lavapipe = context_->facts.driver_name.find("llvmpipe") != std::string::npos;
   for (PrecisionMode mode : kAllModes) {
     const ErrorStats e = measure(s, camera, mode).error.stats;
     ASSERT_EQ(e.points, s.size());
     RecordProperty(std::string(modeName(mode)) + "_max_px", std::to_string(e.max_px));
-    if (mode == PrecisionMode::kNative) {
-      EXPECT_EQ(e.lost, 0u);
-      EXPECT_LE(e.max_px, 0.01) << "rms " << e.rms_px;
-    } else if (mode == PrecisionMode::kDf64) {
-      EXPECT_EQ(e.lost, s.size());
-    } else if (lavapipe && GetParam() == Backend::kRaster) {
-      EXPECT_GT(e.share_off_half_px, 0.5) << modeName(mode) << " max " << e.max_px;
-    } else if (lavapipe) {
-      EXPECT_LE(e.max_px, 0.01) << modeName(mode);
-    }
+    if (!modeInfo(mode).scene_frame) continue;
+    EXPECT_EQ(e.lost, 0u) << modeName(mode);
+    EXPECT_LE(e.max_px, 0.01) << modeName(mode) << " rms " << e.rms_px;
   }
 }
 
@@ -321,25 +247,25 @@ TEST_P(Render, nativeVertexInputAndVertexPullingAgree) {
   EXPECT_EQ(r->image.rgba, pulled.render.image.rgba);
 }
 
-TEST_P(Render, floatModesRefuseCoordinatesBeyondFloatRange) {
+// fp32 and split hold absolute floats and refuse what float cannot hold; the scene-frame modes
+// see the set scaled to the view, where it fits.
+TEST_P(Render, absoluteFloatModesRefuseCoordinatesBeyondFloatRange) {
   PointSet s;
   s.positions = {{0, 0, 0}, {1e39, 0, 0}};
   Camera camera = *makeCamera(CameraSpec{}, boundsOf(s));
-  for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kRte, PrecisionMode::kDf64, PrecisionMode::kBatch}) {
+  for (PrecisionMode mode : kAllModes) {
     RenderOptions options;
     options.mode = mode;
     options.backend = GetParam();
     Result<RenderResult> r = renderPoints(*context_, s, camera, options);
+    if (modeInfo(mode).scene_frame) {
+      EXPECT_TRUE(r.ok()) << modeName(mode) << ": " << r.error().message;
+      continue;
+    }
     ASSERT_FALSE(r.ok()) << modeName(mode);
     EXPECT_EQ(r.error().code, ExitCode::kBadInput);
-    // batch: the offsets from the batch's centre (5e38) overflow, the first at point 0.
-    const char* expected = mode == PrecisionMode::kBatch ? "point 0: x = 0 (-5e+38 from its batch's centre)" : "point 1: x = 1e+39";
-    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find("point 1: x = 1e+39 is beyond float32 range"), std::string::npos) << r.error().message;
   }
-  RenderOptions native;
-  native.mode = PrecisionMode::kNative;
-  native.backend = GetParam();
-  EXPECT_TRUE(renderPoints(*context_, s, camera, native).ok());
 }
 
 TEST_P(Render, pointSizeCoversASquareAndTheBackgroundFillsTheRest) {
@@ -413,10 +339,7 @@ TEST_P(Render, computeBackendRefusesLargePointsAndAgreesWithRasterOn2D) {
   EXPECT_EQ(a->image.rgba, b->image.rgba);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Render, ::testing::Values(Backend::kRaster, Backend::kCompute),
-                         [](const ::testing::TestParamInfo<Backend>& param) {
-                           return std::string(param.param == Backend::kRaster ? "raster" : "compute");
-                         });
+INSTANTIATE_TEST_SUITE_P(Backends, Render, ::testing::Values(Backend::kRaster, Backend::kCompute), backendName);
 
 }  // namespace
 }  // namespace dpoint

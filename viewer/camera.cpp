@@ -54,6 +54,14 @@ bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(
 
 double maxAbs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
 
+// glm::length and glm::normalize square the components, which underflows for a scene at 1e-300 m
+// (and overflows at 1e200 m); dividing by the largest component first keeps every square in range.
+double safeLength(const glm::dvec3& v) {
+  const double largest = maxAbs(v);
+  return largest > 0.0 && std::isfinite(largest) ? largest * glm::length(v / largest) : largest;
+}
+glm::dvec3 safeNormalize(const glm::dvec3& v) { return glm::normalize(v / maxAbs(v)); }
+
 // Half-extent floor for framing around `position`; 1 near the origin, where no relative scale exists.
 double minHalfExtent(const glm::dvec3& position) {
   const double relative = kMinRelativeExtent * maxAbs(position);
@@ -65,8 +73,8 @@ Error usage(std::string message) { return Error{std::move(message), ExitCode::kU
 // World → eye rotation: rows are right, up and −forward (the eye looks down its −z).
 // The caller has checked that forward and up are non-zero and not parallel.
 glm::dmat4 lookAtRotation(const glm::dvec3& forward, const glm::dvec3& up) {
-  const glm::dvec3 f = glm::normalize(forward);
-  const glm::dvec3 s = glm::normalize(glm::cross(f, up));
+  const glm::dvec3 f = safeNormalize(forward);
+  const glm::dvec3 s = safeNormalize(glm::cross(f, safeNormalize(up)));
   const glm::dvec3 u = glm::cross(s, f);
   glm::dmat4 rotation(1.0);  // glm is column-major: rotation[column][row]
   for (int i = 0; i < 3; ++i) {
@@ -96,7 +104,7 @@ void choosePlanes(Camera& camera, const Bounds& bounds) {
                            camera.rotation[2][2] * relative.z);
     nearest = std::min(nearest, along);
     farthest = std::max(farthest, along);
-    farthest_distance = std::max(farthest_distance, glm::length(relative));
+    farthest_distance = std::max(farthest_distance, safeLength(relative));
   }
   if (camera.ortho) {
     // Any slab works for ortho. Near = 0 when the box is wholly in front keeps z_clip = z_e/far + 1
@@ -113,15 +121,20 @@ void choosePlanes(Camera& camera, const Bounds& bounds) {
   }
 }
 
-// Vulkan clip: y down, reversed Z (depth = z_c/w_c: near → 1, far → 0).
+// Vulkan clip: y down, reversed Z (depth = z_c/w_c: near → 1, far → 0), the whole matrix scaled by
+// 1/far. Clip space is homogeneous, so the scale changes no x/w, y/w or z/w, but it keeps clip
+// coordinates near 1 whatever the scene's scale: without it a scene at 1e-37 m gives clip values
+// below float's normal range, which a GPU flushes to zero. Each entry is formed so that no
+// intermediate leaves double's range either: near·far would underflow for a scene at 1e-300 m.
 glm::dmat4 perspectiveProjection(double fov_radians, double aspect, double near_plane, double far_plane) {
   const double focal = 1.0 / std::tan(fov_radians / 2.0);
+  const double near_share = near_plane / (far_plane - near_plane);  // near/(far − near), O(1)
   glm::dmat4 p(0.0);
-  p[0][0] = focal / aspect;
-  p[1][1] = -focal;
-  p[2][2] = near_plane / (far_plane - near_plane);
-  p[3][2] = near_plane * far_plane / (far_plane - near_plane);
-  p[2][3] = -1.0;
+  p[0][0] = focal / aspect / far_plane;
+  p[1][1] = -focal / far_plane;
+  p[2][2] = near_share / far_plane;
+  p[3][2] = near_share;
+  p[2][3] = -1.0 / far_plane;
   return p;
 }
 
@@ -162,8 +175,8 @@ Status checkSpec(const CameraSpec& spec) {
   if (!isFinite(up) || maxAbs(up) == 0.0) return usage("--up must be a finite non-zero vector, got " + shortest(up));
   if (eye == target) return usage("--eye and --target are the same point " + shortest(eye));
   // Parallel when the sine of the angle between them is below 1e-9: the right vector would be noise.
-  const glm::dvec3 forward = glm::normalize(target - eye);
-  if (glm::length(glm::cross(forward, glm::normalize(up))) < 1e-9) {
+  const glm::dvec3 forward = safeNormalize(target - eye);
+  if (glm::length(glm::cross(forward, safeNormalize(up))) < 1e-9) {
     return usage("--up " + shortest(up) + " is parallel to the view direction " + shortest(forward));
   }
   return okStatus();
@@ -232,7 +245,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
       distance = kFitMargin * std::max(half_x / std::tan(half_fov_x), 0.5 * extent.y / std::tan(half_fov));
     } else {
       // The bounding sphere fits the narrower of the two half-angles.
-      const double radius = std::max(0.5 * glm::length(extent), minHalfExtent(centre));
+      const double radius = std::max(0.5 * safeLength(extent), minHalfExtent(centre));
       distance = kFitMargin * radius / std::sin(std::min(half_fov, half_fov_x));
     }
     camera.eye = target + distance * direction;
@@ -248,12 +261,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     camera.projection = orthoProjection(view_width, view_width * double(spec.height) / double(spec.width),
                                         camera.near_plane, camera.far_plane);
   } else {
-    // Clip space is homogeneous: scaling the whole matrix by 1/far changes no x/w, y/w or z/w,
-    // but keeps clip coordinates near 1 whatever the scene's scale. Without it a scene at 1e-37 m
-    // gives clip values below float's normal range, which a GPU flushes to zero, and even native
-    // fp64 (whose clip position ends as float) would lose it.
-    camera.projection = perspectiveProjection(2.0 * half_fov, aspect, camera.near_plane, camera.far_plane) *
-                        (1.0 / camera.far_plane);
+    camera.projection = perspectiveProjection(2.0 * half_fov, aspect, camera.near_plane, camera.far_plane);
   }
   return camera;
 }

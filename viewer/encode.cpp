@@ -1,17 +1,26 @@
 #include "viewer/encode.h"
 
 #include <algorithm>
-#include <cmath>
+#include <cassert>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <limits>
-
-#include <glm/gtc/matrix_transform.hpp>
 
 namespace dpoint {
 namespace {
 
 constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
+
+constexpr ModeInfo kModes[] = {
+    {PrecisionMode::kFp32, "fp32", 12, false, false, "float positions, float MVP (absolute; the study's baseline)"},
+    {PrecisionMode::kSplit, "split", 24, false, false, "the study's hi+lo in float: rounds back to fp32"},
+    {PrecisionMode::kRte, "rte", 24, true, true, "hi/lo floats relative to the eye, then a float matrix"},
+    {PrecisionMode::kDf64, "df64", 24, true, true, "double-float MVP (two-sum, Dekker two-prod)"},
+    {PrecisionMode::kNative, "native", 24, true, false, "fp64: p - eye, then projection·rotation in double"},
+    {PrecisionMode::kBatch, "batch", 12, true, false, "per-batch double origin and scale, normalized float offsets"},
+};
+static_assert(std::size(kModes) == kModeCount);
 
 std::string shortest(double v) {
   char text[32];
@@ -25,45 +34,85 @@ const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z";
 // under FLT_MAX to keep the test simple and safe.
 bool fitsFloat(double d) { return std::fabs(d) <= kFloatMax; }
 
-template <typename Matrix>
-void appendBytes(std::vector<uint8_t>& out, const Matrix& m) {
-  size_t at = out.size();
-  out.resize(at + sizeof(Matrix));
-  std::memcpy(out.data() + at, &m, sizeof(Matrix));
+glm::dvec3 scaled(const glm::dvec3& p, int exponent) {
+  return {std::ldexp(p.x, exponent), std::ldexp(p.y, exponent), std::ldexp(p.z, exponent)};
 }
 
-glm::mat4 toFloat(const glm::dmat4& m) { return glm::mat4(m); }
+template <typename Value>
+void appendBytes(std::vector<uint8_t>& out, const Value& v) {
+  size_t at = out.size();
+  out.resize(at + sizeof(Value));
+  std::memcpy(out.data() + at, &v, sizeof(Value));
+}
+
+// The smallest power of two ≥ d (d ≥ 0); 1 for 0.
+double powerOfTwoAbove(double d) {
+  if (!(d > 0.0)) return 1.0;
+  int exponent = 0;
+  const double mantissa = std::frexp(d, &exponent);  // d = mantissa · 2^exponent, mantissa in [0.5, 1)
+  return mantissa == 0.5 ? d : std::ldexp(1.0, exponent);
+}
+
+std::vector<BatchFrame> makeBatchFrames(const PointSet& points, int exponent) {
+  const size_t batches = (points.size() + kBatchSize - 1) / kBatchSize;
+  std::vector<BatchFrame> frames(batches);
+  for (size_t b = 0; b < batches; ++b) {
+    const size_t first = b * kBatchSize, last = std::min(points.size(), first + kBatchSize);
+    const Box box = boundingBox(points.positions, first, last);
+    // min/2 + max/2 cannot overflow where (min + max)/2 could; scaling by 2^exponent is exact.
+    const glm::dvec3 origin = scaled(box.min * 0.5 + box.max * 0.5, exponent);
+    // The extent bounds the offsets as they are computed (p·scale − origin, rounded), so every
+    // stored offset is within [−1, 1] whatever the rounding of the box centre.
+    double largest = 0.0;
+    for (size_t i = first; i < last; ++i) {
+      const glm::dvec3 offset = scaled(points.positions[i], exponent) - origin;
+      largest = std::max({largest, std::fabs(offset.x), std::fabs(offset.y), std::fabs(offset.z)});
+    }
+    frames[b] = {origin, powerOfTwoAbove(largest)};
+  }
+  return frames;
+}
+
+Error beyondFloat(PrecisionMode mode, size_t index, int axis, double value, const std::string& how) {
+  return Error{"point " + std::to_string(index) + ": " + axisName(axis) + " = " + shortest(value) + how +
+                   " is beyond float32 range, which mode " + std::string(modeName(mode)) + " needs; use --mode native",
+               ExitCode::kBadInput};
+}
+
+Status checkPositions(const ModeEncoding& e, const PointSet& points) {
+  const ModeInfo& info = modeInfo(e.mode);
+  const bool floats = e.mode != PrecisionMode::kNative && e.mode != PrecisionMode::kBatch;
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const double value = points.positions[i][axis];
+      const double in_frame = std::ldexp(value, e.frame.exponent);
+      if (floats && !fitsFloat(in_frame)) {
+        std::string how = info.scene_frame
+            ? " (" + shortest(in_frame) + " view sizes from the origin)" : std::string();
+        return beyondFloat(e.mode, i, axis, value, how);
+      }
+      if (!std::isfinite(in_frame)) {
+        return Error{"point " + std::to_string(i) + ": " + axisName(axis) + " = " + shortest(value) +
+                         " overflows double when scaled to the view (" + shortest(in_frame) + ")",
+                     ExitCode::kBadInput};
+      }
+    }
+  }
+  return okStatus();
+}
 
 }  // namespace
 
-std::string_view modeName(PrecisionMode mode) {
-  switch (mode) {
-    case PrecisionMode::kFp32: return "fp32";
-    case PrecisionMode::kSplit: return "split";
-    case PrecisionMode::kRte: return "rte";
-    case PrecisionMode::kDf64: return "df64";
-    case PrecisionMode::kNative: return "native";
-    case PrecisionMode::kBatch: return "batch";
-  }
-  return "?";
+const ModeInfo& modeInfo(PrecisionMode mode) {
+  const ModeInfo& info = kModes[modeIndex(mode)];
+  assert(info.mode == mode);
+  return info;
 }
 
 std::optional<PrecisionMode> parseMode(std::string_view name) {
-  for (PrecisionMode mode : kAllModes)
-    if (modeName(mode) == name) return mode;
+  for (const ModeInfo& info : kModes)
+    if (info.name == name) return info.mode;
   return std::nullopt;
-}
-
-uint32_t positionBytes(PrecisionMode mode) {
-  switch (mode) {
-    case PrecisionMode::kFp32:
-    case PrecisionMode::kBatch: return 12;
-    case PrecisionMode::kSplit:
-    case PrecisionMode::kRte:
-    case PrecisionMode::kDf64:
-    case PrecisionMode::kNative: return 24;
-  }
-  return 0;
 }
 
 uint32_t encodeColor(const glm::vec3& color) {
@@ -92,44 +141,54 @@ FloatPair splitDouble(double d) {
   return {hi_value, lo};
 }
 
-Status checkEncodable(PrecisionMode mode, const PointSet& points, const std::vector<glm::dvec3>& batch_origins) {
-  if (mode == PrecisionMode::kNative) return okStatus();
-  const bool batch = mode == PrecisionMode::kBatch;
-  for (size_t i = 0; i < points.size(); ++i) {
-    glm::dvec3 p = points.positions[i];
-    if (batch) p -= batch_origins[i / kBatchSize];
-    for (int axis = 0; axis < 3; ++axis) {
-      if (fitsFloat(p[axis])) continue;
-      std::string what = std::string(axisName(axis)) + " = " + shortest(points.positions[i][axis]);
-      if (batch) what += " (" + shortest(p[axis]) + " from its batch's centre)";
-      return Error{"point " + std::to_string(i) + ": " + what + " is beyond float32 range, which mode " +
-                       std::string(modeName(mode)) + " needs; use --mode native",
-                   ExitCode::kBadInput};
-    }
-  }
-  return okStatus();
+SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera) {
+  SceneFrame frame;
+  frame.eye = camera.eye;
+  frame.projection_rotation = camera.projection * camera.rotation;
+  if (!modeInfo(mode).scene_frame) return frame;
+  // The view's size: the window for ortho; for perspective the far plane, which bounds every
+  // eye-relative distance of a visible point (the projection is already scaled by 1/far).
+  double size = camera.far_plane;
+  if (camera.ortho)
+    size = std::max(2.0 / std::fabs(camera.projection[0][0]), 2.0 / std::fabs(camera.projection[1][1]));
+  assert(std::isfinite(size) && size > 0.0);
+  frame.exponent = -std::ilogb(size);  // size · 2^exponent in [1, 2)
+  frame.scale = std::ldexp(1.0, frame.exponent);
+  frame.eye = scaled(camera.eye, frame.exponent);
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 4; ++r)
+      frame.projection_rotation[c][r] = std::ldexp(frame.projection_rotation[c][r], -frame.exponent);
+  return frame;
 }
 
-std::vector<glm::dvec3> batchOrigins(PrecisionMode mode, const PointSet& points) {
-  std::vector<glm::dvec3> origins;
-  if (mode != PrecisionMode::kBatch) return origins;
-  size_t batches = (points.size() + kBatchSize - 1) / kBatchSize;
-  origins.resize(batches);
-  for (size_t b = 0; b < batches; ++b) {
-    const size_t first = b * kBatchSize;
-    const Box box = boundingBox(points.positions, first, std::min(points.size(), first + kBatchSize));
-    // min/2 + max/2 cannot overflow where (min + max)/2 could.
-    origins[b] = box.min * 0.5 + box.max * 0.5;
+Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera) {
+  ModeEncoding e;
+  e.mode = mode;
+  e.frame = sceneFrame(mode, camera);
+  if (Status status = checkPositions(e, points); !status) return status.error();
+  if (mode != PrecisionMode::kBatch) return e;
+  e.batches = makeBatchFrames(points, e.frame.exponent);
+  for (size_t b = 0; b < e.batches.size(); ++b) {
+    const glm::dmat4 m = batchMatrix(e, b);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) {
+        if (fitsFloat(m[c][r])) continue;
+        const size_t first = b * kBatchSize;
+        return Error{"batch " + std::to_string(b) + " (points " + std::to_string(first) + "..): its origin is " +
+                         shortest(glm::length(e.batches[b].origin - e.frame.eye)) +
+                         " view sizes from the eye, and its float matrix overflows; use --mode native",
+                     ExitCode::kBadInput};
+      }
   }
-  return origins;
+  return e;
 }
 
-void encodePositions(PrecisionMode mode, const PointSet& points, const std::vector<glm::dvec3>& batch_origins,
-                     size_t first, size_t count, void* out) {
+void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first, size_t count, void* out) {
   assert(first + count <= points.size());
   auto* f = static_cast<float*>(out);
   const glm::dvec3* p = points.positions.data() + first;
-  switch (mode) {
+  const int exponent = e.frame.exponent;
+  switch (e.mode) {
     case PrecisionMode::kFp32:
       for (size_t i = 0; i < count; ++i)
         for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(p[i][a]);
@@ -140,35 +199,45 @@ void encodePositions(PrecisionMode mode, const PointSet& points, const std::vect
       // Interleaved per point: hi.xyz then lo.xyz (one 24-byte vertex binding).
       for (size_t i = 0; i < count; ++i) {
         for (int a = 0; a < 3; ++a) {
-          FloatPair pair = splitDouble(p[i][a]);
+          FloatPair pair = splitDouble(std::ldexp(p[i][a], exponent));
           f[6 * i + a] = pair.hi;
           f[6 * i + 3 + a] = pair.lo;
         }
       }
       break;
-    case PrecisionMode::kNative: std::memcpy(out, p, count * sizeof(glm::dvec3)); break;
+    case PrecisionMode::kNative:
+      if (exponent == 0) {
+        std::memcpy(out, p, count * sizeof(glm::dvec3));
+      } else {
+        auto* d = static_cast<double*>(out);
+        for (size_t i = 0; i < count; ++i)
+          for (int a = 0; a < 3; ++a) d[3 * i + a] = std::ldexp(p[i][a], exponent);
+      }
+      break;
     case PrecisionMode::kBatch:
       for (size_t i = 0; i < count; ++i) {
-        const glm::dvec3& origin = batch_origins[(first + i) / kBatchSize];
-        for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(p[i][a] - origin[a]);
+        const BatchFrame& batch = e.batches[(first + i) / kBatchSize];
+        // p·scale − origin rounds once in double; the division by a power of two is exact.
+        const glm::dvec3 offset = (scaled(p[i], exponent) - batch.origin) / batch.extent;
+        for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(offset[a]);
       }
       break;
   }
 }
 
-std::vector<uint8_t> cameraUniform(PrecisionMode mode, const Camera& camera) {
+std::vector<uint8_t> cameraUniform(const ModeEncoding& e, const Camera& camera) {
   std::vector<uint8_t> out;
-  switch (mode) {
+  const SceneFrame& frame = e.frame;
+  switch (e.mode) {
     case PrecisionMode::kFp32:
-    case PrecisionMode::kSplit: appendBytes(out, toFloat(camera.viewProjection())); break;
+    case PrecisionMode::kSplit: appendBytes(out, glm::mat4(camera.viewProjection())); break;
     case PrecisionMode::kRte: {
       // The translation is done in the shader against the eye's hi/lo parts, so the matrix
       // holds only projection · rotation and never sees a large number.
-      appendBytes(out, toFloat(camera.projection * camera.rotation));
-      // vec4 eye_hi, vec4 eye_lo (std140).
-      float eye[8] = {};
+      appendBytes(out, glm::mat4(frame.projection_rotation));
+      float eye[8] = {};  // vec4 eye_hi, vec4 eye_lo (std140)
       for (int a = 0; a < 3; ++a) {
-        FloatPair pair = splitDouble(camera.eye[a]);
+        FloatPair pair = splitDouble(frame.eye[a]);
         eye[a] = pair.hi;
         eye[4 + a] = pair.lo;
       }
@@ -176,7 +245,9 @@ std::vector<uint8_t> cameraUniform(PrecisionMode mode, const Camera& camera) {
       break;
     }
     case PrecisionMode::kDf64: {
-      glm::dmat4 mvp = camera.viewProjection();
+      glm::dmat4 translate(1.0);
+      translate[3] = glm::dvec4(-frame.eye, 1.0);
+      const glm::dmat4 mvp = frame.projection_rotation * translate;
       glm::mat4 hi(0.0f), lo(0.0f);
       for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) {
@@ -188,17 +259,30 @@ std::vector<uint8_t> cameraUniform(PrecisionMode mode, const Camera& camera) {
       appendBytes(out, lo);
       break;
     }
-    case PrecisionMode::kNative: appendBytes(out, camera.viewProjection()); break;
+    case PrecisionMode::kNative:
+      // dmat4 projection_rotation, dvec4 eye (std140): the shader subtracts the eye first.
+      appendBytes(out, frame.projection_rotation);
+      appendBytes(out, glm::dvec4(frame.eye, 0.0));
+      break;
     case PrecisionMode::kBatch: break;
   }
   return out;
 }
 
-std::vector<glm::mat4> batchMatrices(const Camera& camera, const std::vector<glm::dvec3>& batch_origins) {
-  std::vector<glm::mat4> out(batch_origins.size());
-  glm::dmat4 projection_rotation = camera.projection * camera.rotation;
-  for (size_t b = 0; b < batch_origins.size(); ++b)
-    out[b] = toFloat(glm::translate(projection_rotation, batch_origins[b] - camera.eye));
+glm::dmat4 batchMatrix(const ModeEncoding& e, size_t batch) {
+  const BatchFrame& b = e.batches[batch];
+  glm::dmat4 m = e.frame.projection_rotation;
+  const glm::dvec3 relative = b.origin - e.frame.eye;  // both in the scene frame
+  glm::dvec4 translation = m[3];
+  for (int c = 0; c < 3; ++c) translation += m[c] * relative[c];
+  for (int c = 0; c < 3; ++c) m[c] *= b.extent;  // a power of two: exact
+  m[3] = translation;
+  return m;
+}
+
+std::vector<glm::mat4> batchMatrices(const ModeEncoding& e) {
+  std::vector<glm::mat4> out(e.batches.size());
+  for (size_t b = 0; b < e.batches.size(); ++b) out[b] = glm::mat4(batchMatrix(e, b));
   return out;
 }
 

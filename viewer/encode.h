@@ -7,9 +7,17 @@
 //   rte     hi, lo floats (24)          (hi − eye_hi) + (lo − eye_lo) under `precise`, then a float
 //                                       projection·rotation with no translation
 //   df64    hi, lo floats (24)          double-float MVP (two-sum, split two-prod), splitter at run time
-//   native  double xyz (24)             dmat4 MVP in fp64; clip position cast to float at the end
-//   batch   float offsets (12)          per-batch float matrix projection·rotation·translate(origin − eye)
+//   native  double xyz (24)             p − eye in double, then projection·rotation in double; the clip
+//                                       position is cast to float at the end
+//   batch   float offsets (12)          per batch of 4096 points: a double origin and power-of-two scale,
+//                                       offsets normalized to [−1, 1], a float matrix built in double
 // Every mode adds 4 bytes of RGBA8 colour.
+//
+// The scene frame (DESIGN §4): every mode but fp32 and split (the study's absolute baselines) sees
+// positions multiplied by 2^exponent, chosen so the view's size is in [1, 2). Scaling by a power
+// of two is exact, and 2^−exponent is folded into the projection, so no window position changes;
+// what changes is that no intermediate of any mode underflows or overflows float, whether the
+// scene is 1e-300 m or 1e300 m across. A mode's error then depends only on its significand.
 #pragma once
 
 #include <cstdint>
@@ -30,15 +38,28 @@ enum class PrecisionMode { kFp32, kSplit, kRte, kDf64, kNative, kBatch };
 inline constexpr PrecisionMode kAllModes[] = {PrecisionMode::kFp32, PrecisionMode::kSplit,
                                               PrecisionMode::kRte,  PrecisionMode::kDf64,
                                               PrecisionMode::kNative, PrecisionMode::kBatch};
+inline constexpr size_t kModeCount = std::size(kAllModes);
 
-std::string_view modeName(PrecisionMode mode);
+// One row per mode: the facts every part of the renderer asks about.
+struct ModeInfo {
+  PrecisionMode mode;
+  std::string_view name;
+  uint32_t position_bytes;  // per point, colour not included
+  bool scene_frame;         // works in the scaled scene frame (all but the absolute baselines)
+  bool needs_self_test;     // emulated double: unusable where the compiler folds low parts away
+  std::string_view summary; // one line for --help and reports
+};
+const ModeInfo& modeInfo(PrecisionMode mode);
+inline size_t modeIndex(PrecisionMode mode) { return static_cast<size_t>(mode); }
+
+inline std::string_view modeName(PrecisionMode mode) { return modeInfo(mode).name; }
 std::optional<PrecisionMode> parseMode(std::string_view name);
 
 // Bytes of position data per point (colour not included).
-uint32_t positionBytes(PrecisionMode mode);
+inline uint32_t positionBytes(PrecisionMode mode) { return modeInfo(mode).position_bytes; }
 inline uint32_t bytesPerPoint(PrecisionMode mode) { return positionBytes(mode) + 4; }
 
-// Points per batch in `batch` mode: consecutive points share one double origin.
+// Points per batch in `batch` mode: consecutive points share one double origin and scale.
 inline constexpr uint32_t kBatchSize = 4096;
 
 // Linear 0..1 colour → RGBA8 (R in the low byte), rounded to nearest, alpha 255. The image is
@@ -53,25 +74,47 @@ struct FloatPair {
 };
 FloatPair splitDouble(double d);
 
-// Fails (kBadInput, naming the point and coordinate) when the mode's encoding cannot hold a
-// position: beyond float range in fp32/split/rte/df64, or a batch offset beyond float range.
-// NaN and infinity never reach the GPU: inputs are finite (readers reject the rest), and this
-// check keeps every encoded float finite too.
-Status checkEncodable(PrecisionMode mode, const PointSet& points, const std::vector<glm::dvec3>& batch_origins);
+// The frame a mode's GPU arithmetic works in (see the top of this file). For fp32 and split it is
+// the world itself (exponent 0).
+struct SceneFrame {
+  int exponent = 0;
+  double scale = 1.0;                   // 2^exponent
+  glm::dvec3 eye{0.0};                  // camera.eye · scale, exact
+  glm::dmat4 projection_rotation{1.0};  // projection · rotation · 2^−exponent (x, y, z columns)
+};
+SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera);
 
-// Centre of each batch's bounding box (batch mode); empty for the other modes.
-std::vector<glm::dvec3> batchOrigins(PrecisionMode mode, const PointSet& points);
+// Batch mode: offsets = (p·scale − origin) / extent in the scene frame, each within [−1, 1];
+// extent is a power of two, so the division is exact.
+struct BatchFrame {
+  glm::dvec3 origin{0.0};  // centre of the batch's box, in the scene frame
+  double extent = 1.0;     // power of two ≥ every |p·scale − origin| of the batch (1 if all equal)
+};
+
+// Everything the encoders and uniform builders need for one mode, one camera and one set.
+struct ModeEncoding {
+  PrecisionMode mode = PrecisionMode::kNative;
+  SceneFrame frame;
+  std::vector<BatchFrame> batches;  // batch mode only
+};
+
+// Builds the encoding. Fails (kBadInput, naming the point, the coordinate and the way out) when
+// the mode cannot hold the set: a coordinate beyond float range in fp32/split, or beyond it in the
+// scene frame in rte/df64 (a point ~1e38 view sizes from the origin); a batch whose origin is so
+// far from the eye that its float matrix overflows. NaN and infinity never reach the GPU: inputs
+// are finite (readers reject the rest), and these checks keep every encoded value finite too.
+Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera);
 
 // Writes positions [first, first + count) in the mode's layout to `out`
-// (count · positionBytes(mode) bytes). Batch offsets are relative to their batch's origin.
-void encodePositions(PrecisionMode mode, const PointSet& points, const std::vector<glm::dvec3>& batch_origins,
-                     size_t first, size_t count, void* out);
+// (count · positionBytes(mode) bytes).
+void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_t first, size_t count, void* out);
 
-// The mode's uniform block (std140, as declared in shaders/points.vert); empty for batch.
-std::vector<uint8_t> cameraUniform(PrecisionMode mode, const Camera& camera);
+// The mode's uniform block (std140, as declared in shaders/project.glsl); empty for batch.
+std::vector<uint8_t> cameraUniform(const ModeEncoding& encoding, const Camera& camera);
 
-// Batch mode: one float matrix per batch, projection · rotation · translate(origin − eye), built
-// in double so only the final float rounding remains.
-std::vector<glm::mat4> batchMatrices(const Camera& camera, const std::vector<glm::dvec3>& batch_origins);
+// Batch mode, in double, per batch: projection · rotation · translate(origin − eye) · extent, all in
+// the scene frame. The GPU gets these cast to float (batchMatrices); the error bound uses them as is.
+glm::dmat4 batchMatrix(const ModeEncoding& encoding, size_t batch);
+std::vector<glm::mat4> batchMatrices(const ModeEncoding& encoding);
 
 }  // namespace dpoint

@@ -119,7 +119,7 @@ void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeli
 }
 
 Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& points, const RenderOptions& options,
-                    const std::vector<glm::dvec3>& origins, bool pulled, size_t per_chunk) {
+                    const ModeEncoding& encoding, bool pulled, size_t per_chunk) {
   std::vector<uint32_t> colors = encodeColors(points);
   const uint32_t stride = positionBytes(options.mode);
   const bool compute = options.backend == Backend::kCompute;
@@ -151,7 +151,7 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
     VkDeviceSize piece = (VkDeviceSize{64} << 20) / stride * stride;
     Status status = uploadBuffer(context, chunk.positions, chunk.count * stride,
         [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-          encodePositions(options.mode, points, origins, chunk.first + offset / stride, bytes / stride, dst);
+          encodePositions(encoding, points, chunk.first + offset / stride, bytes / stride, dst);
         }, piece);
     if (!status) return status;
     if (!compute) {
@@ -208,8 +208,8 @@ Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled
 }
 
 Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
-                      const std::vector<glm::dvec3>& origins) {
-  std::vector<uint8_t> uniform = cameraUniform(options.mode, camera);
+                      const ModeEncoding& encoding) {
+  std::vector<uint8_t> uniform = cameraUniform(encoding, camera);
   uniform.resize(std::max<size_t>(uniform.size(), 256), 0);
   Result<Buffer> ubo = createBuffer(context, uniform.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                     false, "camera uniform");
@@ -223,7 +223,7 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
   if (!dummy) return dummy.error();
   r.dummy = *dummy;
   if (options.mode == PrecisionMode::kBatch) {
-    std::vector<glm::mat4> matrices = batchMatrices(camera, origins);
+    std::vector<glm::mat4> matrices = batchMatrices(encoding);
     VkDeviceSize bytes = matrices.size() * sizeof(glm::mat4);
     Result<Buffer> batches = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                           false, "batch matrices");
@@ -353,7 +353,7 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
   Status status = checkOptions(context, points, options);
   if (!status) return status.error();
   SelfTest self_test{true, ""};
-  if (options.mode == PrecisionMode::kRte || options.mode == PrecisionMode::kDf64) {
+  if (modeInfo(options.mode).needs_self_test) {
     Result<SelfTest> ran = runPrecisionSelfTest(context);
     if (!ran) return ran.error();
     self_test = *ran;
@@ -364,9 +364,8 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
   if (!status) return status.error();
 
   Clock::time_point upload_start = Clock::now();
-  std::vector<glm::dvec3> origins = batchOrigins(options.mode, points);
-  status = checkEncodable(options.mode, points, origins);
-  if (!status) return status.error();
+  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera);
+  if (!encoding) return encoding.error();
 
   // Positions come from a storage buffer in the compute backend, and for native mode on a device
   // without double vertex attributes.
@@ -387,8 +386,8 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
 
   RenderResult out;
   out.pulled_positions = pulled;
-  status = createUniforms(context, r, camera, options, origins);
-  if (status) status = uploadPoints(context, r, points, options, origins, pulled, chunkPoints(context.facts, options, pulled || compute));
+  status = createUniforms(context, r, camera, options, *encoding);
+  if (status) status = uploadPoints(context, r, points, options, *encoding, pulled, chunkPoints(context.facts, options, pulled || compute));
   if (!status) return status.error();
   out.chunks = static_cast<uint32_t>(r.chunks.size());
   out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * points.size();
@@ -406,6 +405,15 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
   if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, points.size(), out);
   if (!status) return status.error();
   return out;
+}
+
+Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                                      Backend backend, bool probe) {
+  Result<SelfTest> self_test = runPrecisionSelfTest(context);
+  if (!self_test) return self_test.error();
+  const bool compute = backend == Backend::kCompute;
+  auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
+  return chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable);
 }
 
 double medianOf(std::vector<double> values) {

@@ -14,6 +14,7 @@
 #include "viewer/camera.h"
 #include "viewer/context.h"
 #include "viewer/encode.h"
+#include "viewer/precision.h"
 #include "viewer/reference.h"
 
 namespace dpoint {
@@ -56,6 +57,12 @@ struct RenderResult {
 // runs out. The caller's context collects validation messages.
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                   const RenderOptions& options);
+
+// --mode auto on this device (viewer/precision.h): the measured speed order of the device's
+// class and backend, restricted to the modes the device runs (features, the emulation
+// self-test, and with `probe` the probe's needs).
+Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                                      Backend backend, bool probe);
 
 // Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
 double medianOf(std::vector<double> values);

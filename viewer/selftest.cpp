@@ -111,7 +111,7 @@ Status modeUsable(const VulkanContext& context, PrecisionMode mode, const SelfTe
   std::string name(modeName(mode));
   if (mode == PrecisionMode::kNative && !f.shader_float64)
     return Error{"--mode native needs shaderFloat64, which " + f.name + " lacks", ExitCode::kNoDevice};
-  if ((mode == PrecisionMode::kRte || mode == PrecisionMode::kDf64) && !self_test.low_parts_survive)
+  if (modeInfo(mode).needs_self_test && !self_test.low_parts_survive)
     return Error{"--mode " + name + " is unusable on " + f.name +
                      ": its shader compiler folds away the low parts of exact sums despite `precise` (self-test: " +
                      self_test.detail + ")",
