@@ -3,11 +3,14 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
+#include "cli/cli_camera.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/info.h"
+#include "viewer/precision.h"
 
 namespace dpoint {
 namespace {
@@ -17,14 +20,25 @@ struct InfoOptions {
   bool json = false;
   bool allow_nonfinite = false;
   size_t sample = 10000;
+  CameraCliOptions camera;
   CommonOptions common;
 };
+
+// Every mode's predicted error for one view (viewer/precision.h), as advice.
+struct ViewAdvice {
+  Camera camera;
+  ErrorBounds bounds;
+};
+
+std::string viewName(const Camera& c) {
+  return std::to_string(c.width) + "x" + std::to_string(c.height) + (c.ortho ? " orthographic" : " perspective");
+}
 
 std::string num(double v, bool json = false) { return formatNumber(v, json); }
 std::string vec(const glm::dvec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
 std::string jsonVec(const glm::dvec3& v) { return "[" + num(v.x, true) + ", " + num(v.y, true) + ", " + num(v.z, true) + "]"; }
 
-void printText(const std::string& path, const PointSetInfo& i) {
+void printText(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice) {
   std::printf("file:               %s\n", path.c_str());
   std::printf("points:             %zu\n", i.count);
   std::printf("triangles:          %zu\n", i.triangles);
@@ -43,9 +57,18 @@ void printText(const std::string& path, const PointSetInfo& i) {
   } else {
     std::printf("float32 enough:     no (%zu distinct points merge with another)\n", i.float_merged);
   }
+  if (!advice) return;
+  std::printf("error bound by mode, for the view (%s, %zu points visible; float floor %s):\n",
+              viewName(advice->camera).c_str(), advice->bounds.visible, formatBound(advice->bounds.float_floor_px).c_str());
+  for (PrecisionMode mode : kAllModes) {
+    const double px = advice->bounds.px[modeIndex(mode)];
+    const char* verdict = px <= kAutoBoundPx ? "within --mode auto's 0.1 px" : px < 0.5 ? "under half a pixel"
+                                                                            : "points leave their pixel";
+    std::printf("  %-7s %-12s %s\n", std::string(modeName(mode)).c_str(), formatBound(px).c_str(), verdict);
+  }
 }
 
-void printJson(const std::string& path, const PointSetInfo& i) {
+void printJson(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice) {
   std::printf("{\n");
   std::printf("  \"file\": %s,\n", jsonString(path).c_str());
   std::printf("  \"points\": %zu,\n  \"triangles\": %zu,\n  \"colors\": %s,\n", i.count, i.triangles,
@@ -56,18 +79,40 @@ void printJson(const std::string& path, const PointSetInfo& i) {
               num(i.float_spacing, true).c_str());
   std::printf("  \"min_neighbor_distance\": %s,\n  \"neighbor_sample\": %zu,\n",
               num(i.min_neighbor_distance, true).c_str(), i.neighbor_sample);
-  std::printf("  \"float32_merged_points\": %zu,\n  \"float32_overflow\": %zu,\n  \"float32_represents\": %s\n",
+  std::printf("  \"float32_merged_points\": %zu,\n  \"float32_overflow\": %zu,\n  \"float32_represents\": %s",
               i.float_merged, i.float_overflow, i.floatRepresents() ? "true" : "false");
-  std::printf("}\n");
+  if (advice) {
+    const Camera& c = advice->camera;
+    std::printf(",\n  \"view\": {\"width\": %u, \"height\": %u, \"ortho\": %s, \"points_visible\": %zu},\n", c.width,
+                c.height, c.ortho ? "true" : "false", advice->bounds.visible);
+    std::printf("  \"float_floor_px\": %s,\n  \"error_bound_px\": {", num(advice->bounds.float_floor_px, true).c_str());
+    const char* separator = "";
+    for (PrecisionMode mode : kAllModes) {  // null: unbounded (the mode may lose points)
+      const double px = advice->bounds.px[modeIndex(mode)];
+      std::printf("%s\"%s\": %s", separator, std::string(modeName(mode)).c_str(),
+                  std::isfinite(px) ? num(px, true).c_str() : "null");
+      separator = ", ";
+    }
+    std::printf("}");
+  }
+  std::printf("\n}\n");
 }
 
 int runInfo(const InfoOptions& o) {
   Progress progress(progressSink(o.common.quiet || o.json), "info");
   Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
   if (!points) return reportError(points.error());
+  Result<CameraSpec> spec = cameraSpec(o.camera);
+  if (!spec) return reportError(spec.error());
   const PointSetInfo info = computeInfo(*points, o.sample, o.common.threads);
-  if (o.json) printJson(o.input, info);
-  else printText(o.input, info);
+  std::optional<ViewAdvice> advice;
+  if (points->size() > 0) {
+    Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
+    if (!camera) return reportError(camera.error());
+    advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera)};
+  }
+  if (o.json) printJson(o.input, info, advice);
+  else printText(o.input, info, advice);
   return 0;
 }
 
@@ -75,13 +120,17 @@ int runInfo(const InfoOptions& o) {
 
 void addInfoCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<InfoOptions>();
-  CLI::App* cmd = app.add_subcommand("info", "Counts, bounds, and whether float32 can hold the data");
+  CLI::App* cmd = app.add_subcommand(
+      "info",
+      "Counts, bounds, whether float32 can hold the data, and each render mode's predicted error in pixels for a\n"
+      "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
   cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf)")->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
       ->default_val(10000)
       ->check(CLI::Range(size_t{1}, size_t{100000000}));
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
+  addCameraOptions(*cmd, o->camera);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runInfo(*o); }; });
 }

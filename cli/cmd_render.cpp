@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli/cli_camera.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_io.h"
@@ -20,11 +21,11 @@ namespace dpoint {
 namespace {
 
 struct RenderCliOptions {
-  std::string input, output, mode = "native", backend = "raster", device = "auto", json, native_path = "auto";
-  uint32_t width = 1024, height = 768;
-  std::string eye, target, up, view_center, background = "0,0,0";
-  bool fit = false, ortho = false, error = false, validate = false;
-  double fov = 45.0, view_width = 0.0, point_size = 1.0;
+  std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
+  CameraCliOptions camera;
+  std::string background = "0,0,0";
+  bool error = false, validate = false;
+  double point_size = 1.0;
   uint32_t frames = 1, warmup = 1;
   uint64_t chunk_points = 0;
   CommonOptions common;
@@ -35,40 +36,6 @@ bool endsWithPng(const std::string& path) {
   std::string tail = path.substr(path.size() - 4);
   std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return tail == ".png";
-}
-
-Result<CameraSpec> cameraSpec(const RenderCliOptions& o) {
-  CameraSpec spec;
-  spec.width = o.width;
-  spec.height = o.height;
-  spec.fov_degrees = o.fov;
-  bool look_at = !o.eye.empty() || !o.target.empty() || !o.up.empty();
-  if (look_at) {
-    if (o.fit) return Error{"--fit and --eye/--target/--up exclude each other", ExitCode::kUsage};
-    if (o.eye.empty() || o.target.empty())
-      return Error{"--eye and --target go together (and --up, default 0,1,0)", ExitCode::kUsage};
-    Result<glm::dvec3> eye = parseVec3("--eye", o.eye);
-    if (!eye) return eye.error();
-    Result<glm::dvec3> target = parseVec3("--target", o.target);
-    if (!target) return target.error();
-    Result<glm::dvec3> up = parseVec3("--up", o.up.empty() ? "0,1,0" : o.up);
-    if (!up) return up.error();
-    spec.eye = *eye;
-    spec.target = *target;
-    spec.up = *up;
-  }
-  if (o.ortho) spec.ortho = true;
-  if (!o.view_center.empty()) {
-    Result<std::vector<double>> c = parseNumbers("--view-center", o.view_center, 2, 3);
-    if (!c) return c.error();
-    spec.view_center = glm::dvec3((*c)[0], (*c)[1], c->size() == 3 ? (*c)[2] : 0.0);
-    spec.ortho = true;
-  }
-  if (o.view_width != 0.0) {
-    spec.view_width = o.view_width;
-    spec.ortho = true;
-  }
-  return spec;
 }
 
 Result<uint32_t> parseBackground(const std::string& text) {
@@ -84,21 +51,43 @@ Result<uint32_t> parseBackground(const std::string& text) {
   return packed;
 }
 
+// What the run predicted for its mode: the bound, and with --mode auto the choice made.
+struct Prediction {
+  PrecisionMode mode = PrecisionMode::kNative;
+  double bound_px = 0.0;
+  std::optional<ModeChoice> choice;  // --mode auto
+};
+
+// Points the probe measured: visible in the reference and not lost.
+bool anyMeasured(const ErrorStats& e) { return e.points > e.lost; }
+
 std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
-                       const RenderResult& r, const ErrorReport* error) {
+                       const RenderResult& r, const Prediction& prediction, const ErrorReport* error) {
   const DeviceFacts& f = context.facts;
-  PrecisionMode mode = *parseMode(o.mode);
+  const PrecisionMode mode = prediction.mode;
   double gpu_median = medianOf(r.gpu_ms), frame_median = medianOf(r.frame_ms);
   double per_frame_ms = r.gpu_ms.empty() ? frame_median : gpu_median;
   auto num = [](double v) { return formatNumber(v, true); };
   std::string s = "{\n";
-  s += "  \"mode\": " + jsonString(o.mode) + ",\n  \"backend\": " + jsonString(o.backend) + ",\n";
+  auto bound = [&](double px) { return std::isfinite(px) ? num(px) : std::string("null"); };
+  s += "  \"mode\": " + jsonString(std::string(modeName(mode))) + ",\n  \"mode_requested\": " + jsonString(o.mode) + ",\n";
+  s += "  \"predicted_bound_px\": " + bound(prediction.bound_px) + ",\n";
+  if (prediction.choice) {
+    const ModeChoice& c = *prediction.choice;
+    s += "  \"auto\": {\"enough\": " + std::string(c.enough ? "true" : "false") + ", \"limit_px\": " + num(kAutoBoundPx) +
+         ", \"device_class\": " + jsonString(std::string(deviceClassName(deviceClassOf(f.type)))) + ", \"runner_up\": " +
+         (c.runner_up ? "{\"mode\": " + jsonString(std::string(modeName(*c.runner_up))) +
+                            ", \"predicted_bound_px\": " + bound(c.runner_up_bound_px) + "}"
+                      : std::string("null")) +
+         "},\n";
+  }
+  s += "  \"backend\": " + jsonString(o.backend) + ",\n";
   s += "  \"device\": " + jsonString(f.name) + ",\n  \"device_type\": " + jsonString(f.type) + ",\n";
   s += "  \"driver\": " + jsonString(f.driver_name + " " + f.driver_info) + ",\n";
   s += "  \"driver_version\": " + jsonString(formatDriverVersion(f.vendor_id, f.driver_version)) + ",\n";
   s += "  \"api_version\": " + jsonString(formatApiVersion(f.api_version)) + ",\n";
   s += "  \"points\": " + std::to_string(points.size()) + ",\n";
-  s += "  \"width\": " + std::to_string(o.width) + ",\n  \"height\": " + std::to_string(o.height) + ",\n";
+  s += "  \"width\": " + std::to_string(o.camera.width) + ",\n  \"height\": " + std::to_string(o.camera.height) + ",\n";
   s += "  \"frames\": " + std::to_string(r.frame_ms.size()) + ",\n";
   if (r.gpu_ms.empty()) {
     s += "  \"gpu_ms\": null,\n";
@@ -115,7 +104,11 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   s += "  \"native_path\": " + std::string(mode != PrecisionMode::kNative ? "null" : r.pulled_positions ? "\"pull\"" : "\"attribute\"");
   if (error) {
     const ErrorStats& e = error->stats;
-    s += ",\n  \"error_px\": {\"max\": " + num(e.max_px) + ", \"p99\": " + num(e.p99_px) + ", \"rms\": " + num(e.rms_px) + "},\n";
+    // With every visible point lost there is no error to report: null, never a perfect 0.
+    if (anyMeasured(e))
+      s += ",\n  \"error_px\": {\"max\": " + num(e.max_px) + ", \"p99\": " + num(e.p99_px) + ", \"rms\": " + num(e.rms_px) + "},\n";
+    else
+      s += ",\n  \"error_px\": null,\n";
     s += "  \"share_off_half_px\": " + num(e.share_off_half_px) + ",\n";
     s += "  \"points_visible\": " + std::to_string(e.points) + ",\n  \"points_lost\": " + std::to_string(e.lost) + ",\n";
     s += "  \"pixels_differing\": " + (error->pixels_compared ? std::to_string(error->pixels_differing) : "null");
@@ -123,9 +116,45 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   return s + "\n}\n";
 }
 
+// --mode auto picks on the device; an explicit mode gets its bound computed for the report.
+Result<Prediction> predict(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
+                           const Camera& camera, Backend backend) {
+  Prediction p;
+  if (o.mode != "auto") {
+    p.mode = *parseMode(o.mode);
+    const PrecisionMode one[] = {p.mode};
+    p.bound_px = predictErrorBounds(points, camera, one).px[modeIndex(p.mode)];
+    return p;
+  }
+  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, backend, o.error);
+  if (!choice) return choice.error();
+  p.mode = choice->mode;
+  p.bound_px = choice->bound_px;
+  p.choice = std::move(*choice);
+  return p;
+}
+
+void printChoice(const Prediction& p, const DeviceFacts& f, Backend backend) {
+  if (!p.choice) {
+    std::printf("mode %s: predicted error bound %s\n", std::string(modeName(p.mode)).c_str(), formatBound(p.bound_px).c_str());
+    return;
+  }
+  const ModeChoice& c = *p.choice;
+  std::string runner_up = c.runner_up ? std::string(modeName(*c.runner_up)) + " (" + formatBound(c.runner_up_bound_px) + ")"
+                                      : std::string("none within the limit");
+  std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the fastest within %g px on %s, %s backend\n",
+              std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(), kAutoBoundPx,
+              std::string(deviceClassName(deviceClassOf(f.type))).c_str(), backend == Backend::kCompute ? "compute" : "raster");
+  if (!c.enough) {
+    std::fprintf(stderr, "dpoint: warning: no mode this device runs stays within %g px for this view; %s is the most "
+                 "accurate here (bound %s)\n", kAutoBoundPx, std::string(modeName(c.mode)).c_str(),
+                 formatBound(c.bound_px).c_str());
+  }
+}
+
 int runRender(const RenderCliOptions& o) {
-  std::optional<PrecisionMode> mode = parseMode(o.mode);
-  if (!mode) return reportError(Error{"--mode must be fp32, split, rte, df64, native or batch, got '" + o.mode + "'", ExitCode::kUsage});
+  if (o.mode != "auto" && !parseMode(o.mode))
+    return reportError(Error{"--mode must be auto, fp32, split, rte, df64, native or batch, got '" + o.mode + "'", ExitCode::kUsage});
   if (o.backend != "raster" && o.backend != "compute")
     return reportError(Error{"--backend must be raster or compute, got '" + o.backend + "'", ExitCode::kUsage});
   if (!endsWithPng(o.output) && o.output.rfind("/dev/", 0) != 0)
@@ -135,7 +164,7 @@ int runRender(const RenderCliOptions& o) {
   else if (o.native_path == "pull") native_path = NativePath::kPull;
   else if (o.native_path != "auto")
     return reportError(Error{"--native-path must be auto, attribute or pull, got '" + o.native_path + "'", ExitCode::kUsage});
-  Result<CameraSpec> spec = cameraSpec(o);
+  Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
   Result<uint32_t> background = parseBackground(o.background);
   if (!background) return reportError(background.error());
@@ -149,9 +178,12 @@ int runRender(const RenderCliOptions& o) {
 
   Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
   if (!context) return reportError(context.error());
+  const Backend backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
+  Result<Prediction> prediction = predict(o, **context, *points, *camera, backend);
+  if (!prediction) return reportError(prediction.error());
   RenderOptions options;
-  options.mode = *mode;
-  options.backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
+  options.mode = prediction->mode;
+  options.backend = backend;
   options.point_size = static_cast<float>(o.point_size);
   options.background_rgba8 = *background;
   options.frames = o.frames;
@@ -169,28 +201,35 @@ int runRender(const RenderCliOptions& o) {
   if (!o.json.empty()) {
     Result<AtomicFile> file = AtomicFile::create(o.json);
     if (!file) return reportError(file.error());
-    Status status = file->write(jsonReport(o, **context, *points, *rendered, error ? &*error : nullptr));
+    Status status = file->write(jsonReport(o, **context, *points, *rendered, *prediction, error ? &*error : nullptr));
     if (status) status = file->commit();
     if (!status) return reportError(status.error());
   }
 
   const DeviceFacts& f = (*context)->facts;
   const RenderResult& r = *rendered;
+  const PrecisionMode mode = prediction->mode;
   std::printf("%s: %zu points, mode %s, %s backend, %ux%u, %s (%s, driver %s)\n", o.output.c_str(), points->size(),
-              o.mode.c_str(), o.backend.c_str(), o.width, o.height, f.name.c_str(), f.type.c_str(), formatDriverVersion(f.vendor_id, f.driver_version).c_str());
+              std::string(modeName(mode)).c_str(), o.backend.c_str(), o.camera.width, o.camera.height, f.name.c_str(),
+              f.type.c_str(), formatDriverVersion(f.vendor_id, f.driver_version).c_str());
+  printChoice(*prediction, f, backend);
   if (!r.gpu_ms.empty())
     std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f), %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
                 r.gpu_ms.size(), percentileOf(r.gpu_ms, 95),
-                static_cast<double>(points->size()) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(*mode));
+                static_cast<double>(points->size()) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(mode));
   std::printf("host: upload %.1f ms, frame %.3f ms, readback %.1f ms\n", r.upload_ms, medianOf(r.frame_ms), r.readback_ms);
   if (error) {
     const ErrorStats& e = error->stats;
     std::string image_check = error->pixels_compared
         ? std::to_string(error->pixels_differing) + " pixels differ from the reference raster"
         : "no image check (the reference raster draws --point-size 1 only)";
-    std::printf("error: max %.4g px, p99 %.4g px, rms %.4g px, %.4g%% of %zu visible points off by >= 0.5 px, "
-                "%zu lost; %s\n",
-                e.max_px, e.p99_px, e.rms_px, 100.0 * e.share_off_half_px, e.points, e.lost, image_check.c_str());
+    if (anyMeasured(e)) {
+      std::printf("error: max %.4g px, p99 %.4g px, rms %.4g px, %.4g%% of %zu visible points off by >= 0.5 px, "
+                  "%zu lost; %s\n",
+                  e.max_px, e.p99_px, e.rms_px, 100.0 * e.share_off_half_px, e.points, e.lost, image_check.c_str());
+    } else {
+      std::printf("error: no point measured: %zu of %zu visible points lost; %s\n", e.lost, e.points, image_check.c_str());
+    }
   }
   const std::vector<std::string>& messages = (*context)->validationMessages();
   if (!messages.empty()) {
@@ -209,24 +248,20 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       "Offscreen Vulkan point renderer: draws IN in one precision mode, writes a PNG, times the GPU, and with\n"
       "--error measures the mode against the exact CPU reference. Works without a GPU (Mesa lavapipe).\n"
       "Modes: fp32 (float positions), split (the study's hi+lo, no better than fp32), rte (relative to eye),\n"
-      "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins).");
+      "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins); all but fp32\n"
+      "and split work in a frame scaled to the view, so they hold at 1e-300 m as at 1 m. Each run prints the\n"
+      "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.");
   cmd->add_option("input", o->input, "Point set: .csv, .ply, .glb or .gltf")->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required();
-  cmd->add_option("--mode", o->mode, "fp32|split|rte|df64|native|batch")->default_val("native");
+  cmd->add_option("--mode", o->mode,
+                  "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"
+                  "order) whose predicted error bound is <= 0.1 px for this view; native when none is")
+      ->default_val("auto");
   cmd->add_option("--backend", o->backend,
                   "raster (graphics pipeline, POINT_LIST, the study's design) or compute (a thread per point,\n"
                   "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)")
       ->default_val("raster");
-  cmd->add_option("--width", o->width, "Picture width in pixels")->default_val(1024);
-  cmd->add_option("--height", o->height, "Picture height in pixels")->default_val(768);
-  cmd->add_option("--eye", o->eye, "Camera position X,Y,Z (with --target)");
-  cmd->add_option("--target", o->target, "Point looked at X,Y,Z");
-  cmd->add_option("--up", o->up, "Up direction X,Y,Z (default 0,1,0)");
-  cmd->add_flag("--fit", o->fit, "Frame the bounding box (the default without --eye)");
-  cmd->add_option("--fov", o->fov, "Vertical field of view in degrees")->default_val(45.0);
-  cmd->add_flag("--ortho", o->ortho, "Orthographic projection (the default for 2D data, z = 0)");
-  cmd->add_option("--view-center", o->view_center, "Orthographic window centre X,Y[,Z]");
-  cmd->add_option("--view-width", o->view_width, "Orthographic window width (height follows the aspect)");
+  addCameraOptions(*cmd, o->camera);
   cmd->add_option("--point-size", o->point_size, "Point size in pixels")->default_val(1.0);
   cmd->add_option("--background", o->background, "Background colour R,G,B (0..255)")->default_val("0,0,0");
   cmd->add_option("--device", o->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")

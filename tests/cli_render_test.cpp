@@ -24,8 +24,8 @@ double jsonNumber(const std::string& json, const std::string& key) {
 TEST(CliRender, helpNamesEveryModeAndOption) {
   test::CommandResult help = runDpoint({"render", "--help"});
   EXPECT_EQ(help.exit_code, 0);
-  for (const char* word : {"fp32", "split", "rte", "df64", "native", "batch", "--view-center", "--error", "--validate",
-                           "--frames", "--device", "lavapipe"})
+  for (const char* word : {"auto", "fp32", "split", "rte", "df64", "native", "batch", "--view-center", "--error",
+                           "--validate", "--frames", "--device", "lavapipe", "0.1 px"})
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   EXPECT_EQ(runDpoint({"devices", "--help"}).exit_code, 0);
 }
@@ -44,6 +44,8 @@ TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
                           "share_off_half_px", "pixels_differing"})
     EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key << " in " << json;
   EXPECT_NE(json.find("\"mode\": \"df64\""), std::string::npos);
+  EXPECT_NE(json.find("\"mode_requested\": \"df64\""), std::string::npos);
+  EXPECT_GE(jsonNumber(json, "predicted_bound_px"), jsonNumber(json, "max")) << "the bound holds";
   EXPECT_EQ(jsonNumber(json, "bytes_per_point"), 28.0);
   EXPECT_EQ(jsonNumber(json, "width"), 320.0);
   EXPECT_GT(jsonNumber(json, "points_per_s"), 0.0);
@@ -67,6 +69,52 @@ TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {
   }
   EXPECT_GE(max_px[0], 1.0) << "fp32";
   EXPECT_LE(max_px[1], 0.01) << "native";
+}
+
+// The default is --mode auto: it names the mode it took, its bound and the runner-up, and the
+// measured error stays within the bound. fp32 at the Earth's radius would not.
+TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "33", "--offset", "6378137,0,0", "--quiet", "-o",
+                       dir.file("far.ply")}).exit_code, 0);
+  for (const char* backend : {"raster", "compute"}) {
+    test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--backend", backend,
+                                       "--error", "--validate", "--width", "256", "--height", "256", "--json",
+                                       dir.file("far.json")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("mode auto: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("runner-up "), std::string::npos) << r.out;
+    const std::string json = readFile(dir.file("far.json"));
+    EXPECT_NE(json.find("\"mode_requested\": \"auto\""), std::string::npos) << json;
+    EXPECT_EQ(json.find("\"mode\": \"fp32\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"enough\": true"), std::string::npos) << json;
+    EXPECT_LE(jsonNumber(json, "predicted_bound_px"), 0.1);
+    EXPECT_LE(jsonNumber(json, "max"), jsonNumber(json, "predicted_bound_px"));
+    EXPECT_EQ(jsonNumber(json, "share_off_half_px"), 0.0);
+  }
+}
+
+// fp32 at a 1e-40 view loses every point: there is no error to report, and the report says so
+// (null in JSON, never a perfect 0), next to an unbounded prediction.
+TEST(CliRender, everyPointLostReportsNoErrorRatherThanZero) {
+  TempDir dir;
+  writeFile(dir.file("tiny.csv"), "x,y\n1e-30,2e-30\n1.00000000003e-30,2e-30\n1e-30,2.00000000004e-30\n");
+  test::CommandResult r = runDpoint({"render", dir.file("tiny.csv"), "-o", dir.file("tiny.png"), "--mode", "fp32",
+                                     "--error", "--validate", "--view-center", "1e-30,2e-30", "--view-width", "1e-40",
+                                     "--width", "64", "--height", "64", "--json", dir.file("tiny.json")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("no point measured"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bound unbounded"), std::string::npos) << r.out;
+  const std::string json = readFile(dir.file("tiny.json"));
+  EXPECT_NE(json.find("\"error_px\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"predicted_bound_px\": null"), std::string::npos) << json;
+  EXPECT_EQ(jsonNumber(json, "points_lost"), 3.0) << json;
+  // The same view in native: every point measured, on its pixel.
+  r = runDpoint({"render", dir.file("tiny.csv"), "-o", dir.file("tiny.png"), "--mode", "native", "--error",
+                 "--view-center", "1e-30,2e-30", "--view-width", "1e-40", "--width", "64", "--height", "64", "--json",
+                 dir.file("tiny.json")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LT(jsonNumber(readFile(dir.file("tiny.json")), "max"), 1e-4);
 }
 
 TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {

@@ -243,5 +243,31 @@ TEST(Cli, infoReportsFloatMergesAsJson) {
   EXPECT_NE(text.out.find("float32 enough:     no"), std::string::npos) << text.out;
 }
 
+// info prints each render mode's predicted error for a view: fp32 fails at a 1e-13 zoom of 0.74,
+// native and batch do not; the camera flags are render's.
+TEST(Cli, infoAdvisesEachModesErrorBoundForAView) {
+  TempDir dir;
+  writeFile(dir.file("zoom.csv"), "x,y\n-0.743645,0.1318259\n-0.74364500000001,0.13182590000001\n");
+  test::CommandResult r = runDpoint({"info", dir.file("zoom.csv"), "--view-center", "-0.743645,0.1318259",
+                                     "--view-width", "1e-13", "--width", "512", "--height", "512", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"error_bound_px\": {\"fp32\": "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"ortho\": true"), std::string::npos) << r.out;
+  auto bound = [&](const std::string& mode) {
+    size_t at = r.out.find("\"" + mode + "\": ", r.out.find("error_bound_px"));
+    return std::strtod(r.out.c_str() + at + mode.size() + 4, nullptr);
+  };
+  EXPECT_GT(bound("fp32"), 0.5);
+  EXPECT_GT(bound("rte"), 0.5) << "48 bits of 0.74 are several pixels at this zoom";
+  EXPECT_LT(bound("native"), 1e-4);
+  EXPECT_LT(bound("batch"), 1e-3);
+  test::CommandResult text = runDpoint({"info", dir.file("zoom.csv"), "--view-center", "-0.743645,0.1318259",
+                                        "--view-width", "1e-13"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("error bound by mode"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("points leave their pixel"), std::string::npos) << text.out;
+  EXPECT_EQ(runDpoint({"info", dir.file("zoom.csv"), "--view-width", "-1"}).exit_code, 1);
+}
+
 }  // namespace
 }  // namespace dpoint

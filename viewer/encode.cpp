@@ -34,9 +34,6 @@ const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z";
 // under FLT_MAX to keep the test simple and safe.
 bool fitsFloat(double d) { return std::fabs(d) <= kFloatMax; }
 
-glm::dvec3 scaled(const glm::dvec3& p, int exponent) {
-  return {std::ldexp(p.x, exponent), std::ldexp(p.y, exponent), std::ldexp(p.z, exponent)};
-}
 
 template <typename Value>
 void appendBytes(std::vector<uint8_t>& out, const Value& v) {
@@ -53,19 +50,19 @@ double powerOfTwoAbove(double d) {
   return mantissa == 0.5 ? d : std::ldexp(1.0, exponent);
 }
 
-std::vector<BatchFrame> makeBatchFrames(const PointSet& points, int exponent) {
+std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame& frame) {
   const size_t batches = (points.size() + kBatchSize - 1) / kBatchSize;
   std::vector<BatchFrame> frames(batches);
   for (size_t b = 0; b < batches; ++b) {
     const size_t first = b * kBatchSize, last = std::min(points.size(), first + kBatchSize);
     const Box box = boundingBox(points.positions, first, last);
     // min/2 + max/2 cannot overflow where (min + max)/2 could; scaling by 2^exponent is exact.
-    const glm::dvec3 origin = scaled(box.min * 0.5 + box.max * 0.5, exponent);
+    const glm::dvec3 origin = scaleBy(box.min * 0.5 + box.max * 0.5, frame);
     // The extent bounds the offsets as they are computed (p·scale − origin, rounded), so every
     // stored offset is within [−1, 1] whatever the rounding of the box centre.
     double largest = 0.0;
     for (size_t i = first; i < last; ++i) {
-      const glm::dvec3 offset = scaled(points.positions[i], exponent) - origin;
+      const glm::dvec3 offset = scaleBy(points.positions[i], frame) - origin;
       largest = std::max({largest, std::fabs(offset.x), std::fabs(offset.y), std::fabs(offset.z)});
     }
     frames[b] = {origin, powerOfTwoAbove(largest)};
@@ -85,7 +82,7 @@ Status checkPositions(const ModeEncoding& e, const PointSet& points) {
   for (size_t i = 0; i < points.size(); ++i) {
     for (int axis = 0; axis < 3; ++axis) {
       const double value = points.positions[i][axis];
-      const double in_frame = std::ldexp(value, e.frame.exponent);
+      const double in_frame = scaleBy(value, e.frame);
       if (floats && !fitsFloat(in_frame)) {
         std::string how = info.scene_frame
             ? " (" + shortest(in_frame) + " view sizes from the origin)" : std::string();
@@ -154,7 +151,7 @@ SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera) {
   assert(std::isfinite(size) && size > 0.0);
   frame.exponent = -std::ilogb(size);  // size · 2^exponent in [1, 2)
   frame.scale = std::ldexp(1.0, frame.exponent);
-  frame.eye = scaled(camera.eye, frame.exponent);
+  frame.eye = scaleBy(camera.eye, frame);
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 4; ++r)
       frame.projection_rotation[c][r] = std::ldexp(frame.projection_rotation[c][r], -frame.exponent);
@@ -167,7 +164,7 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
   e.frame = sceneFrame(mode, camera);
   if (Status status = checkPositions(e, points); !status) return status.error();
   if (mode != PrecisionMode::kBatch) return e;
-  e.batches = makeBatchFrames(points, e.frame.exponent);
+  e.batches = makeBatchFrames(points, e.frame);
   for (size_t b = 0; b < e.batches.size(); ++b) {
     const glm::dmat4 m = batchMatrix(e, b);
     for (int c = 0; c < 4; ++c)
@@ -187,7 +184,7 @@ void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first
   assert(first + count <= points.size());
   auto* f = static_cast<float*>(out);
   const glm::dvec3* p = points.positions.data() + first;
-  const int exponent = e.frame.exponent;
+  const SceneFrame& frame = e.frame;
   switch (e.mode) {
     case PrecisionMode::kFp32:
       for (size_t i = 0; i < count; ++i)
@@ -199,26 +196,26 @@ void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first
       // Interleaved per point: hi.xyz then lo.xyz (one 24-byte vertex binding).
       for (size_t i = 0; i < count; ++i) {
         for (int a = 0; a < 3; ++a) {
-          FloatPair pair = splitDouble(std::ldexp(p[i][a], exponent));
+          FloatPair pair = splitDouble(scaleBy(p[i][a], frame));
           f[6 * i + a] = pair.hi;
           f[6 * i + 3 + a] = pair.lo;
         }
       }
       break;
     case PrecisionMode::kNative:
-      if (exponent == 0) {
+      if (frame.exponent == 0) {
         std::memcpy(out, p, count * sizeof(glm::dvec3));
       } else {
         auto* d = static_cast<double*>(out);
         for (size_t i = 0; i < count; ++i)
-          for (int a = 0; a < 3; ++a) d[3 * i + a] = std::ldexp(p[i][a], exponent);
+          for (int a = 0; a < 3; ++a) d[3 * i + a] = scaleBy(p[i][a], frame);
       }
       break;
     case PrecisionMode::kBatch:
       for (size_t i = 0; i < count; ++i) {
         const BatchFrame& batch = e.batches[(first + i) / kBatchSize];
         // p·scale − origin rounds once in double; the division by a power of two is exact.
-        const glm::dvec3 offset = (scaled(p[i], exponent) - batch.origin) / batch.extent;
+        const glm::dvec3 offset = (scaleBy(p[i], frame) - batch.origin) / batch.extent;
         for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(offset[a]);
       }
       break;

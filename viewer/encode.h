@@ -20,6 +20,7 @@
 // scene is 1e-300 m or 1e300 m across. A mode's error then depends only on its significand.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -83,6 +84,15 @@ struct SceneFrame {
   glm::dmat4 projection_rotation{1.0};  // projection · rotation · 2^−exponent (x, y, z columns)
 };
 SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera);
+
+// x · 2^exponent, correctly rounded (exact unless it over- or underflows): a multiplication by the
+// power of two where that is a normal double, ldexp beyond.
+inline double scaleBy(double x, const SceneFrame& frame) {
+  return frame.exponent >= -1022 && frame.exponent <= 1023 ? x * frame.scale : std::ldexp(x, frame.exponent);
+}
+inline glm::dvec3 scaleBy(const glm::dvec3& p, const SceneFrame& frame) {
+  return {scaleBy(p.x, frame), scaleBy(p.y, frame), scaleBy(p.z, frame)};
+}
 
 // Batch mode: offsets = (p·scale − origin) / extent in the scene frame, each within [−1, 1];
 // extent is a power of two, so the division is exact.

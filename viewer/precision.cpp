@@ -38,7 +38,7 @@ constexpr Vec4 kUnbounded = {kInf, kInf, kInf, kInf};
 bool constantRow(const glm::dmat4& m, int r) { return m[0][r] == 0.0 && m[1][r] == 0.0 && m[2][r] == 0.0; }
 double floatRounding(double x) { return std::fabs(double(static_cast<float>(x)) - x); }
 
-Vec4 floatAffine(const glm::dmat4& m, const glm::dvec3& v, const glm::dvec3& dv) {
+inline Vec4 floatAffine(const glm::dmat4& m, const glm::dvec3& v, const glm::dvec3& dv) {
   Vec4 out;
   for (int r = 0; r < 4; ++r) {
     if (constantRow(m, r)) {
@@ -60,17 +60,19 @@ Vec4 floatAffine(const glm::dmat4& m, const glm::dvec3& v, const glm::dvec3& dv)
   return out;
 }
 
-// Window-pixel distance from a clip error d around the exact clip position c (visible: w > 0,
-// |x|, |y| ≤ w): δ(x/w) ≤ (δx + |x/w|·δw) / (w − δw), and a window pixel is width/2 of x/w.
-double pixels(const Vec4& c, const Vec4& d, uint32_t width, uint32_t height) {
+// Squared window-pixel distance from a clip error d around the exact clip position c (visible:
+// w > 0, |x|, |y| ≤ w): δ(x/w) ≤ (δx + |x/w|·δw) / (w − δw), and a window pixel is width/2 of x/w.
+// Squared so the pass takes one square root at the end; +inf once δw could reach w/2 or the
+// distance passes 1e150 px (no point is on its pixel then anyway).
+inline double pixelsSquared(const Vec4& c, const Vec4& d, double half_width, double half_height) {
   const double w = c[3];
   if (!(d[3] < 0.5 * w)) return kInf;
-  const double ex = 0.5 * width * (d[0] + std::fabs(c[0] / w) * d[3]) / (w - d[3]);
-  const double ey = 0.5 * height * (d[1] + std::fabs(c[1] / w) * d[3]) / (w - d[3]);
-  return std::hypot(ex, ey) * (1.0 + 1e-9);
+  const double inverse = 1.0 / (w - d[3]);
+  const double ex = half_width * (d[0] + std::fabs(c[0]) * (d[3] / w)) * inverse;
+  const double ey = half_height * (d[1] + std::fabs(c[1]) * (d[3] / w)) * inverse;
+  if (!(std::max(ex, ey) < 1e150)) return kInf;
+  return ex * ex + ey * ey;
 }
-
-glm::dvec3 scaled(const glm::dvec3& p, int k) { return {std::ldexp(p.x, k), std::ldexp(p.y, k), std::ldexp(p.z, k)}; }
 
 // Float rounding of a stored coordinate, with a flush to zero below FLT_MIN.
 double storedFloatError(double x) {
@@ -208,6 +210,66 @@ Setup makeSetup(const PointSet& points, const Camera& camera, std::span<const Pr
   return s;
 }
 
+// The exact clip position of p (double: only visibility and x/w, y/w use it) and whether the
+// view volume holds it.
+struct Projected {
+  glm::dvec3 ps;  // p in the scene frame
+  Vec4 clip;
+  bool visible;
+};
+inline Projected project(const Setup& s, const glm::dvec3& p) {
+  Projected out;
+  out.ps = scaleBy(p, s.frame);
+  const glm::dvec3 d = out.ps - s.frame.eye;
+  const glm::dmat4& m = s.frame.projection_rotation;
+  for (int r = 0; r < 4; ++r) out.clip[static_cast<size_t>(r)] = m[0][r] * d.x + m[1][r] * d.y + m[2][r] * d.z + m[3][r];
+  const Vec4& c = out.clip;
+  out.visible = c[3] > 0.0 && std::fabs(c[0]) <= c[3] && std::fabs(c[1]) <= c[3] && c[2] >= 0.0 && c[2] <= c[3];
+  return out;
+}
+
+// The largest bound of one mode over points [first, end): one loop per mode, so each is compiled
+// for its own arithmetic.
+struct Worst {
+  double squared_px = 0.0;
+  size_t visible = 0;
+};
+
+// The largest bound of one mode over points [first, end): one loop per mode, so each is compiled
+// for its own arithmetic.
+template <PrecisionMode kMode>
+Worst worstOf(const Setup& s, const PointSet& points, size_t first, size_t end, const Camera& camera) {
+  Worst worst;
+  const double half_width = 0.5 * camera.width, half_height = 0.5 * camera.height;
+  for (size_t i = first; i < end; ++i) {
+    const glm::dvec3& p = points.positions[i];
+    const Projected q = project(s, p);
+    if (!q.visible) continue;
+    ++worst.visible;
+    Vec4 error;
+    if constexpr (kMode == PrecisionMode::kFp32) error = fp32Error(s, p, false);
+    else if constexpr (kMode == PrecisionMode::kSplit) error = fp32Error(s, p, true);
+    else if constexpr (kMode == PrecisionMode::kRte) error = rteError(s, q.ps);
+    else if constexpr (kMode == PrecisionMode::kDf64) error = df64Error(s, q.ps, q.clip);
+    else if constexpr (kMode == PrecisionMode::kNative) error = nativeError(s, q.ps, q.clip);
+    else error = batchError(s, q.ps, i);
+    worst.squared_px = std::max(worst.squared_px, pixelsSquared(q.clip, error, half_width, half_height));
+  }
+  return worst;
+}
+
+Worst worstOf(PrecisionMode mode, const Setup& s, const PointSet& points, size_t first, size_t end, const Camera& c) {
+  switch (mode) {
+    case PrecisionMode::kFp32: return worstOf<PrecisionMode::kFp32>(s, points, first, end, c);
+    case PrecisionMode::kSplit: return worstOf<PrecisionMode::kSplit>(s, points, first, end, c);
+    case PrecisionMode::kRte: return worstOf<PrecisionMode::kRte>(s, points, first, end, c);
+    case PrecisionMode::kDf64: return worstOf<PrecisionMode::kDf64>(s, points, first, end, c);
+    case PrecisionMode::kNative: return worstOf<PrecisionMode::kNative>(s, points, first, end, c);
+    case PrecisionMode::kBatch: return worstOf<PrecisionMode::kBatch>(s, points, first, end, c);
+  }
+  return {};
+}
+
 }  // namespace
 
 ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes) {
@@ -218,34 +280,18 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
   std::vector<std::array<double, kModeCount>> worst(threads, std::array<double, kModeCount>{});
   std::vector<size_t> visible(threads, 0);
   parallelFor(chunks, threads, [&](size_t chunk, unsigned worker) {
-    std::array<double, kModeCount>& mine = worst[worker];
-    const size_t end = std::min(points.size(), (chunk + 1) * kChunk);
-    for (size_t i = chunk * kChunk; i < end; ++i) {
-      const glm::dvec3& p = points.positions[i];
-      const glm::dvec3 ps = scaled(p, s.frame.exponent);
-      const glm::dvec3 d = ps - s.frame.eye;
-      Vec4 clip;
-      for (int r = 0; r < 4; ++r) {
-        const glm::dmat4& m = s.frame.projection_rotation;
-        clip[static_cast<size_t>(r)] = m[0][r] * d.x + m[1][r] * d.y + m[2][r] * d.z + m[3][r];
-      }
-      const double w = clip[3];
-      if (!(w > 0.0 && std::fabs(clip[0]) <= w && std::fabs(clip[1]) <= w && clip[2] >= 0.0 && clip[2] <= w)) continue;
-      ++visible[worker];
-      for (PrecisionMode mode : kAllModes) {
-        const size_t m = modeIndex(mode);
-        if (!s.wanted[m] || s.unbounded[m]) continue;
-        Vec4 error;
-        switch (mode) {
-          case PrecisionMode::kFp32: error = fp32Error(s, p, false); break;
-          case PrecisionMode::kSplit: error = fp32Error(s, p, true); break;
-          case PrecisionMode::kRte: error = rteError(s, ps); break;
-          case PrecisionMode::kDf64: error = df64Error(s, ps, clip); break;
-          case PrecisionMode::kNative: error = nativeError(s, ps, clip); break;
-          case PrecisionMode::kBatch: error = batchError(s, ps, i); break;
-        }
-        mine[m] = std::max(mine[m], pixels(clip, error, camera.width, camera.height));
-      }
+    const size_t first = chunk * kChunk, end = std::min(points.size(), first + kChunk);
+    bool counted = false;
+    for (PrecisionMode mode : kAllModes) {
+      const size_t m = modeIndex(mode);
+      if (!s.wanted[m] || s.unbounded[m]) continue;
+      const Worst w = worstOf(mode, s, points, first, end, camera);
+      worst[worker][m] = std::max(worst[worker][m], w.squared_px);
+      if (!counted) visible[worker] += w.visible;
+      counted = true;
+    }
+    if (!counted) {  // every wanted mode is unbounded: count what the camera sees all the same
+      for (size_t i = first; i < end; ++i) visible[worker] += project(s, points.positions[i]).visible;
     }
   });
   ErrorBounds out;
@@ -254,6 +300,7 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
     for (size_t m = 0; m < kModeCount; ++m) out.px[m] = std::max(out.px[m], worst[t][m]);
   }
   for (size_t m = 0; m < kModeCount; ++m) {
+    out.px[m] = std::sqrt(out.px[m]) * (1.0 + 1e-9);
     out.computed[m] = s.wanted[m];
     if (s.unbounded[m] && out.visible > 0) out.px[m] = kInf;
   }

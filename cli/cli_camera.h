@@ -1,0 +1,26 @@
+// The camera options `render` and `info` share: one parser, one set of flags.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "core/result.h"
+#include "viewer/camera.h"
+
+namespace dpoint {
+
+struct CameraCliOptions {
+  uint32_t width = 1024, height = 768;
+  std::string eye, target, up, view_center;
+  bool fit = false, ortho = false;
+  double fov = 45.0, view_width = 0.0;
+};
+
+void addCameraOptions(CLI::App& command, CameraCliOptions& options);
+
+// Fails (kUsage, naming the flag) on malformed vectors and on --fit with --eye/--target/--up.
+Result<CameraSpec> cameraSpec(const CameraCliOptions& options);
+
+}  // namespace dpoint
