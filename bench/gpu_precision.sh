@@ -5,12 +5,7 @@
 # with the GPU's speed order), prints the precision table, and times --mode auto's choice and the
 # fp32/native/batch compute frames on 16.7M points. Results go to $OUT.
 set -euo pipefail
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-export LD_LIBRARY_PATH=$PWD/.gpu/lib
-out=${OUT:-/tmp/out}
-nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+source bench/gpu_env.sh
 .gpu/viewer_tests > "$out/viewer_tests.txt" 2>&1 || true
 grep -E "^\[  (PASSED|FAILED|SKIPPED) " "$out/viewer_tests.txt" | head -20
 grep "^precision: " "$out/viewer_tests.txt" > "$out/precision_table.txt" || true

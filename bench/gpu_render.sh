@@ -7,12 +7,7 @@
 # Runs the viewer tests there (validation layer on; covers native's R64G64B64 vertex-input path,
 # which lavapipe lacks), `dpoint devices`, then bench/render.py. Results go to $OUT.
 set -euo pipefail
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-export LD_LIBRARY_PATH=$PWD/.gpu/lib
-out=${OUT:-/tmp/out}
-nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+source bench/gpu_env.sh
 .gpu/dpoint devices | tee "$out/devices.txt"
 .gpu/viewer_tests --gtest_brief=1 2>&1 | tee "$out/viewer_tests.txt" | tail -5
 python3 bench/render.py .gpu/dpoint "$out/render-gpu" --frames "${FRAMES:-50}" --work /tmp/dpoint-bench 2>&1 | tail -40

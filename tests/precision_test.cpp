@@ -11,7 +11,6 @@
 #include <random>
 #include <set>
 
-#include "generators/mandelbrot2d.h"
 #include "generators/mandelbulb.h"
 #include "render_test_support.h"
 #include "viewer/precision.h"
@@ -229,18 +228,10 @@ TEST_P(Precision, tinyScenesErrAsTheyDoAtOneMetre) {
 // The deep-zoom sweep 1e-1 … 1e-15 around the study's centre, one point per pixel centre.
 TEST_P(Precision, deepZoomSweepStaysWithinTheBounds) {
   for (double width : {1e-1, 1e-4, 1e-6, 1e-9, 1e-12, 1e-13, 1e-14, 1e-15}) {
-    Mandelbrot2dParams params;
-    params.width = width;
-    params.resolution = 48;
-    params.max_iter = 300;
-    Result<PointSet> grid = generateMandelbrot2d(params);
-    ASSERT_TRUE(grid.ok()) << grid.error().message;
-    CameraSpec spec;
-    spec.width = spec.height = 48;
-    spec.view_center = glm::dvec3(params.center_x, params.center_y, 0.0);
-    spec.view_width = width;
-    Result<Camera> camera = makeCamera(spec, boundsOf(*grid));
-    ASSERT_TRUE(camera.ok()) << camera.error().message;
+    const DeepZoom zoom = deepZoom(width, 48, 300);
+    ASSERT_FALSE(zoom.grid.positions.empty());
+    const PointSet* grid = &zoom.grid;
+    const Camera* camera = &zoom.camera;
     char label[48];
     std::snprintf(label, sizeof label, "deepzoom %g", width);
     everyModeWithinItsBound(label, *grid, *camera);

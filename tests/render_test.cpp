@@ -99,19 +99,10 @@ TEST_P(Render, tinyScaleNearTheOriginHoldsInEverySceneFrameMode) {
 
 // DESIGN §7 deepzoom at view width 1e-9: one grid point per pixel centre.
 TEST_P(Render, deepZoomPutsEveryPointOnItsOwnPixelInDoubleModes) {
-  Mandelbrot2dParams params;
-  params.width = 1e-9;
-  params.resolution = 96;
-  params.max_iter = 600;
-  Result<PointSet> grid = generateMandelbrot2d(params);
-  ASSERT_TRUE(grid.ok()) << grid.error().message;
-  CameraSpec spec;
-  spec.width = spec.height = 96;
-  spec.view_center = glm::dvec3(params.center_x, params.center_y, 0.0);
-  spec.view_width = params.width;
-  Result<Camera> camera = makeCamera(spec, boundsOf(*grid));
-  ASSERT_TRUE(camera.ok()) << camera.error().message;
-  ASSERT_TRUE(camera->ortho) << "2D data defaults to orthographic";
+  const DeepZoom zoom = deepZoom(1e-9, 96, 600);
+  ASSERT_FALSE(zoom.grid.positions.empty());
+  const PointSet* grid = &zoom.grid;
+  const Camera* camera = &zoom.camera;
   for (PrecisionMode mode : kAllModes) {
     Measured m = measure(*grid, *camera, mode);
     if (mode == PrecisionMode::kFp32 || mode == PrecisionMode::kSplit) {
@@ -319,22 +310,13 @@ TEST_P(Render, computeBackendRefusesLargePointsAndAgreesWithRasterOn2D) {
   EXPECT_NE(refused.error().message.find("--point-size"), std::string::npos) << refused.error().message;
   // A 2D grid with one point per pixel centre: no depth ties, no pixel edges, so both backends
   // must draw the very same picture.
-  Mandelbrot2dParams params;
-  params.width = 1e-6;
-  params.resolution = 64;
-  params.max_iter = 300;
-  Result<PointSet> grid = generateMandelbrot2d(params);
-  ASSERT_TRUE(grid.ok());
-  CameraSpec spec;
-  spec.width = spec.height = 64;
-  spec.view_center = glm::dvec3(params.center_x, params.center_y, 0.0);
-  spec.view_width = params.width;
-  Camera zoom = *makeCamera(spec, boundsOf(*grid));
+  const DeepZoom zoom = deepZoom(1e-6, 64, 300);
+  ASSERT_FALSE(zoom.grid.positions.empty());
   RenderOptions raster, compute;
   raster.mode = compute.mode = PrecisionMode::kDf64;
   compute.backend = Backend::kCompute;
-  Result<RenderResult> a = renderPoints(*context_, *grid, zoom, raster);
-  Result<RenderResult> b = renderPoints(*context_, *grid, zoom, compute);
+  Result<RenderResult> a = renderPoints(*context_, zoom.grid, zoom.camera, raster);
+  Result<RenderResult> b = renderPoints(*context_, zoom.grid, zoom.camera, compute);
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_EQ(a->image.rgba, b->image.rgba);
 }

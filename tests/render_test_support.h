@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "generators/mandelbrot2d.h"
 #include "viewer/camera.h"
 #include "viewer/context.h"
 #include "viewer/probe.h"
@@ -78,6 +79,31 @@ inline Camera lookAtCloud(const PointSet& s, const glm::dvec3& centre, double di
   Result<Camera> camera = makeCamera(spec, boundsOf(s));
   EXPECT_TRUE(camera.ok()) << camera.error().message;
   return *camera;
+}
+
+// DESIGN §7 deepzoom: the Mandelbrot grid around the study's centre at view `width`, one point per
+// pixel centre of a `side`² orthographic view of the same window.
+struct DeepZoom {
+  PointSet grid;
+  Camera camera;
+};
+inline DeepZoom deepZoom(double width, int side, int max_iter) {
+  Mandelbrot2dParams params;
+  params.width = width;
+  params.resolution = side;
+  params.max_iter = max_iter;
+  Result<PointSet> grid = generateMandelbrot2d(params);
+  EXPECT_TRUE(grid.ok()) << grid.error().message;
+  if (!grid.ok()) return {};
+  CameraSpec spec;
+  spec.width = spec.height = static_cast<uint32_t>(side);
+  spec.view_center = glm::dvec3(params.center_x, params.center_y, 0.0);
+  spec.view_width = width;
+  Result<Camera> camera = makeCamera(spec, boundsOf(*grid));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  EXPECT_TRUE(camera.ok() && camera->ortho) << "2D data defaults to orthographic";
+  if (!camera.ok()) return {};
+  return {std::move(*grid), *camera};
 }
 
 inline std::string backendName(const ::testing::TestParamInfo<Backend>& param) {
