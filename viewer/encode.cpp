@@ -13,12 +13,12 @@ namespace {
 constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
 
 constexpr ModeInfo kModes[] = {
-    {PrecisionMode::kFp32, "fp32", 12, false, false, "float positions, float MVP (absolute; the study's baseline)"},
-    {PrecisionMode::kSplit, "split", 24, false, false, "the study's hi+lo in float: rounds back to fp32"},
-    {PrecisionMode::kRte, "rte", 24, true, true, "hi/lo floats relative to the eye, then a float matrix"},
-    {PrecisionMode::kDf64, "df64", 24, true, true, "double-float MVP (two-sum, Dekker two-prod)"},
-    {PrecisionMode::kNative, "native", 24, true, false, "fp64: p - eye, then projection·rotation in double"},
-    {PrecisionMode::kBatch, "batch", 12, true, false, "per-batch double origin and scale, normalized float offsets"},
+    {PrecisionMode::kFp32, "fp32", 12, false, false},
+    {PrecisionMode::kSplit, "split", 24, false, false},
+    {PrecisionMode::kRte, "rte", 24, true, true},
+    {PrecisionMode::kDf64, "df64", 24, true, true},
+    {PrecisionMode::kNative, "native", 24, true, false},
+    {PrecisionMode::kBatch, "batch", 12, true, false},
 };
 static_assert(std::size(kModes) == kModeCount);
 
@@ -68,6 +68,17 @@ std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame
     frames[b] = {origin, powerOfTwoAbove(largest)};
   }
   return frames;
+}
+
+// projection · rotation · translate(origin − eye) · extent, in the scene frame.
+glm::dmat4 batchMatrix(const SceneFrame& frame, const BatchFrame& b) {
+  glm::dmat4 m = frame.projection_rotation;
+  const glm::dvec3 relative = b.origin - frame.eye;  // both in the scene frame
+  glm::dvec4 translation = m[3];
+  for (int c = 0; c < 3; ++c) translation += m[c] * relative[c];
+  for (int c = 0; c < 3; ++c) m[c] *= b.extent;  // a power of two: exact
+  m[3] = translation;
+  return m;
 }
 
 Error beyondFloat(PrecisionMode mode, size_t index, int axis, double value, const std::string& how) {
@@ -165,8 +176,9 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
   if (Status status = checkPositions(e, points); !status) return status.error();
   if (mode != PrecisionMode::kBatch) return e;
   e.batches = makeBatchFrames(points, e.frame);
+  e.batch_matrices.reserve(e.batches.size());
   for (size_t b = 0; b < e.batches.size(); ++b) {
-    const glm::dmat4 m = batchMatrix(e, b);
+    const glm::dmat4& m = e.batch_matrices.emplace_back(batchMatrix(e.frame, e.batches[b]));
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) {
         if (fitsFloat(m[c][r])) continue;
@@ -266,20 +278,9 @@ std::vector<uint8_t> cameraUniform(const ModeEncoding& e, const Camera& camera) 
   return out;
 }
 
-glm::dmat4 batchMatrix(const ModeEncoding& e, size_t batch) {
-  const BatchFrame& b = e.batches[batch];
-  glm::dmat4 m = e.frame.projection_rotation;
-  const glm::dvec3 relative = b.origin - e.frame.eye;  // both in the scene frame
-  glm::dvec4 translation = m[3];
-  for (int c = 0; c < 3; ++c) translation += m[c] * relative[c];
-  for (int c = 0; c < 3; ++c) m[c] *= b.extent;  // a power of two: exact
-  m[3] = translation;
-  return m;
-}
-
 std::vector<glm::mat4> batchMatrices(const ModeEncoding& e) {
   std::vector<glm::mat4> out(e.batches.size());
-  for (size_t b = 0; b < e.batches.size(); ++b) out[b] = glm::mat4(batchMatrix(e, b));
+  for (size_t b = 0; b < e.batches.size(); ++b) out[b] = glm::mat4(e.batch_matrices[b]);
   return out;
 }
 

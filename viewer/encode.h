@@ -48,7 +48,6 @@ struct ModeInfo {
   uint32_t position_bytes;  // per point, colour not included
   bool scene_frame;         // works in the scaled scene frame (all but the absolute baselines)
   bool needs_self_test;     // emulated double: unusable where the compiler folds low parts away
-  std::string_view summary; // one line for --help and reports
 };
 const ModeInfo& modeInfo(PrecisionMode mode);
 inline size_t modeIndex(PrecisionMode mode) { return static_cast<size_t>(mode); }
@@ -106,6 +105,10 @@ struct ModeEncoding {
   PrecisionMode mode = PrecisionMode::kNative;
   SceneFrame frame;
   std::vector<BatchFrame> batches;  // batch mode only
+  // Batch mode, one per batch, in double: projection · rotation · translate(origin − eye) · extent,
+  // all in the scene frame. The GPU gets them cast to float (batchMatrices); the error bound
+  // uses them as they are.
+  std::vector<glm::dmat4> batch_matrices;
 };
 
 // Builds the encoding. Fails (kBadInput, naming the point, the coordinate and the way out) when
@@ -122,9 +125,7 @@ void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_
 // The mode's uniform block (std140, as declared in shaders/project.glsl); empty for batch.
 std::vector<uint8_t> cameraUniform(const ModeEncoding& encoding, const Camera& camera);
 
-// Batch mode, in double, per batch: projection · rotation · translate(origin − eye) · extent, all in
-// the scene frame. The GPU gets these cast to float (batchMatrices); the error bound uses them as is.
-glm::dmat4 batchMatrix(const ModeEncoding& encoding, size_t batch);
+// Batch mode: encoding.batch_matrices cast to float, as the GPU gets them.
 std::vector<glm::mat4> batchMatrices(const ModeEncoding& encoding);
 
 }  // namespace dpoint

@@ -9,6 +9,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include "core/parallel.h"
@@ -34,15 +35,19 @@ constexpr Vec4 kUnbounded = {kInf, kInf, kInf, kInf};
 // three sums: γ_4; the matrix's own rounding: u; its computation in double: a few ud. A GPU may
 // flush subnormal operands and results: FLT_MIN per operation, and a whole matrix entry's term
 // where the entry itself is subnormal. A fused multiply-add only tightens this.
-// A row with no linear part (ortho's w row: 0, 0, 0, 1) is its constant, rounded once to float.
-bool constantRow(const glm::dmat4& m, int r) { return m[0][r] == 0.0 && m[1][r] == 0.0 && m[2][r] == 0.0; }
-double floatRounding(double x) { return std::fabs(double(static_cast<float>(x)) - x); }
+// A row with no linear part (ortho's w row: 0, 0, 0, 1) is its constant, rounded once to float
+// (and flushed below FLT_MIN): its error, or nothing when the row has a linear part.
+std::optional<double> constantRowError(const glm::dmat4& m, int r) {
+  if (m[0][r] != 0.0 || m[1][r] != 0.0 || m[2][r] != 0.0) return std::nullopt;
+  const double x = m[3][r];
+  return std::fabs(double(static_cast<float>(x)) - x) + (std::fabs(x) < kFloatMin ? kFloatMin : 0.0);
+}
 
 inline Vec4 floatAffine(const glm::dmat4& m, const glm::dvec3& v, const glm::dvec3& dv) {
   Vec4 out;
   for (int r = 0; r < 4; ++r) {
-    if (constantRow(m, r)) {
-      out[static_cast<size_t>(r)] = floatRounding(m[3][r]) + (std::fabs(m[3][r]) < kFloatMin ? kFloatMin : 0.0);
+    if (const std::optional<double> constant = constantRowError(m, r)) {
+      out[static_cast<size_t>(r)] = *constant;
       continue;
     }
     double sum = std::fabs(m[3][r]), input = 0.0, flushed = 8.0 * kFloatMin;
@@ -81,12 +86,11 @@ double storedFloatError(double x) {
 }
 
 struct Setup {
-  SceneFrame frame;  // the scaled scene frame  // fp32/split's frame (the world) and the scaled scene frame
+  SceneFrame frame;  // the scaled scene frame (fp32 and split use world_mvp)
   glm::dmat4 world_mvp, df64_mvp;
   std::array<FloatPair, 3> eye_split{};
   std::array<bool, kModeCount> wanted{}, unbounded{};
   ModeEncoding batch;
-  std::vector<glm::dmat4> batch_matrices;
   std::vector<Vec4> batch_translation_error;  // the double rounding of each batch matrix's translation
 };
 
@@ -142,8 +146,8 @@ Vec4 nativeError(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
   const glm::dmat4& m = s.frame.projection_rotation;
   Vec4 out;
   for (int r = 0; r < 4; ++r) {
-    if (constantRow(m, r)) {
-      out[static_cast<size_t>(r)] = floatRounding(m[3][r]) + (std::fabs(m[3][r]) < kFloatMin ? kFloatMin : 0.0);
+    if (const std::optional<double> constant = constantRowError(m, r)) {
+      out[static_cast<size_t>(r)] = *constant;
       continue;
     }
     double sum = std::fabs(m[3][r]), input = 0.0;
@@ -167,7 +171,7 @@ Vec4 batchError(const Setup& s, const glm::dvec3& ps, size_t index) {
   const glm::dvec3 offset = (ps - frame.origin) / frame.extent;
   glm::dvec3 dv;
   for (int a = 0; a < 3; ++a) dv[a] = storedFloatError(offset[a]) + 2.0 * kUd * std::fabs(offset[a]);
-  Vec4 out = floatAffine(s.batch_matrices[b], offset, dv);
+  Vec4 out = floatAffine(s.batch.batch_matrices[b], offset, dv);
   for (size_t r = 0; r < 4; ++r) out[r] += s.batch_translation_error[b][r];
   return out;
 }
@@ -197,7 +201,6 @@ Setup makeSetup(const PointSet& points, const Camera& camera, std::span<const Pr
         if (!(std::fabs(s.df64_mvp[c][r]) <= kDekkerMax)) s.unbounded[modeIndex(PrecisionMode::kDf64)] = true;
   }
   for (size_t b = 0; b < s.batch.batches.size(); ++b) {
-    s.batch_matrices.push_back(batchMatrix(s.batch, b));
     const glm::dvec3 relative = s.batch.batches[b].origin - s.frame.eye;
     Vec4 error{};
     for (int r = 0; r < 4; ++r) {
@@ -228,8 +231,6 @@ inline Projected project(const Setup& s, const glm::dvec3& p) {
   return out;
 }
 
-// The largest bound of one mode over points [first, end): one loop per mode, so each is compiled
-// for its own arithmetic.
 struct Worst {
   double squared_px = 0.0;
   size_t visible = 0;
