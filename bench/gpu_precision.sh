@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Precision (issue #9) on the GPU machine (device tool: NVIDIA H100/H200, Ubuntu 24.04). Carry
-# .gl/ and .gpu/ as bench/gpu_render.sh describes. Runs the viewer tests there (validation layer
+# .gl/ and .gpu/ as bench/gpu_bench.sh describes. Runs the viewer tests there (validation layer
 # on: the Precision suite's pixel-centre views, every DESIGN §7 case within its bound, --mode auto
 # with the GPU's speed order), prints the precision table, and times --mode auto's choice and the
 # fp32/native/batch compute frames on 16.7M points. Results go to $OUT.

@@ -38,26 +38,4 @@ Result<glm::dvec3> parseVec3(const std::string& flag, const std::string& text) {
   return glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
 }
 
-std::string formatNumber(double v, bool json) {
-  if (json && !std::isfinite(v)) return "null";
-  char text[32];
-  auto r = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, r.ptr);
-}
-
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\u%04x", c);
-      out += esc;
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
-}
-
 }  // namespace dpoint

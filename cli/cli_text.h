@@ -7,6 +7,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/result.h"
+#include "core/text.h"  // formatNumber, jsonString
 
 namespace dpoint {
 
@@ -18,9 +19,5 @@ inline Result<std::vector<double>> parseNumbers(const std::string& flag, const s
   return parseNumbers(flag, text, count, count);
 }
 Result<glm::dvec3> parseVec3(const std::string& flag, const std::string& text);
-
-// Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
-std::string formatNumber(double v, bool json = false);
-std::string jsonString(const std::string& s);
 
 }  // namespace dpoint

@@ -1,12 +1,24 @@
+// dpoint bench: the speed-against-error report (issue #10, DESIGN §5–7): suites of datasets drawn
+// in every precision mode on each backend, timed and measured against the exact reference, written
+// as report.md, results.json, speed_vs_error.svg, breakdown.svg and montage.png.
 // dpoint bench io FILE: times reading (and optionally writing) a file inside one process, for
 // the I/O benchmark in bench/ (which also times the whole process from outside).
 #include <chrono>
 #include <cstdio>
+#include <cerrno>
+#include <cstring>
+#include <ctime>
 #include <memory>
+#include <spawn.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 
+#include "bench/report.h"
+#include "bench/run.h"
 #include "cli/commands.h"
+#include "cli/version.h"
 #include "converters/point_io.h"
+#include "core/progress.h"
 
 namespace dpoint {
 namespace {
@@ -47,11 +59,133 @@ int runBenchIo(const BenchIoOptions& o) {
   return 0;
 }
 
+struct BenchReportOptions {
+  std::string suite = "ci", out = "bench-out", cache = "bench-cache", device = "auto", backend = "both";
+  std::vector<std::string> sizes;
+  uint32_t frames = 20, warmup = 2;
+  bool validate = false;
+  CommonOptions common;
+};
+
+extern "C" char** environ;
+
+// `dpoint generate ARGS -o PATH --quiet` run as a child of this very executable, so the bench's
+// datasets are exactly what a user would make.
+Status runGenerate(const std::vector<std::string>& args, const std::string& path, unsigned threads) {
+  std::vector<std::string> argv = {"dpoint", "generate"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  argv.insert(argv.end(), {"-o", path, "--quiet"});
+  if (threads) argv.insert(argv.end(), {"--threads", std::to_string(threads)});
+  std::vector<char*> c_argv;
+  for (std::string& a : argv) c_argv.push_back(a.data());
+  c_argv.push_back(nullptr);
+  std::string command;
+  for (size_t i = 0; i + 1 < c_argv.size(); ++i) command += (i ? " " : "") + argv[i];
+  pid_t pid = 0;
+  if (int e = posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, c_argv.data(), environ); e != 0)
+    return Error{"cannot run " + command + ": " + std::strerror(e), ExitCode::kBadInput};
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return Error{"waiting for " + command + ": " + std::strerror(errno), ExitCode::kBadInput};
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return okStatus();
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return Error{command + " failed (exit " + std::to_string(code) + ")",
+               code == static_cast<int>(ExitCode::kResourceLimit) ? ExitCode::kResourceLimit : ExitCode::kBadInput};
+}
+
+std::string utcNow() {
+  std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+// The command as a user would type it to get this run again, every setting spelled out.
+std::string commandLine(const BenchReportOptions& o) {
+  std::string s = "dpoint bench --suite " + o.suite + " --backend " + o.backend + " --device " + o.device +
+                  " --frames " + std::to_string(o.frames) + " --warmup " + std::to_string(o.warmup);
+  if (!o.sizes.empty()) {
+    s += " --sizes ";
+    for (size_t i = 0; i < o.sizes.size(); ++i) s += (i ? "," : "") + o.sizes[i];
+  }
+  return s + " --out " + o.out + " --cache " + o.cache;
+}
+
+int runBenchReport(const BenchReportOptions& o) {
+  BenchOptions options;
+  if (o.suite == "ci") options.suites = {BenchSuite::kCi};
+  else if (o.suite == "paper") options.suites = {BenchSuite::kPaper};
+  else if (o.suite == "hard") options.suites = {BenchSuite::kHard};
+  else if (o.suite == "all") options.suites = {BenchSuite::kPaper, BenchSuite::kHard};
+  else return reportError(Error{"--suite must be ci, paper, hard or all, got '" + o.suite + "'", ExitCode::kUsage});
+  if (o.backend == "raster") options.backends = {Backend::kRaster};
+  else if (o.backend == "compute") options.backends = {Backend::kCompute};
+  else if (o.backend == "both") options.backends = {Backend::kRaster, Backend::kCompute};
+  else return reportError(Error{"--backend must be raster, compute or both, got '" + o.backend + "'", ExitCode::kUsage});
+  if (o.frames == 0) return reportError(Error{"--frames must be at least 1", ExitCode::kUsage});
+  options.sizes = o.sizes;
+  options.frames = o.frames;
+  options.warmup = o.warmup;
+  options.cache_dir = o.cache;
+  const unsigned threads = o.common.threads;
+  options.make_dataset = [threads](const std::vector<std::string>& args, const std::string& path) {
+    return runGenerate(args, path, threads);
+  };
+  std::FILE* sink = progressSink(o.common.quiet);
+  if (sink) options.log = [sink](const std::string& line) { std::fprintf(sink, "bench: %s\n", line.c_str()); };
+
+  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
+  if (!context) return reportError(context.error());
+  Result<BenchRun> run = runBench(**context, options);
+  if (!run) return reportError(run.error());
+  if (run->rows.empty())
+    return reportError(Error{"--sizes " + commandLine(o) + ": no dataset of the suite has these sizes", ExitCode::kUsage});
+  Result<std::vector<std::string>> written = writeReport(*run, ReportContext{commandLine(o), utcNow(), DPOINT_VERSION}, o.out);
+  if (!written) return reportError(written.error());
+
+  size_t skipped = 0;
+  for (const BenchRow& row : run->rows) skipped += !row.skipped.empty();
+  const size_t failures = checkRun(*run).size();
+  std::printf("bench: %zu runs (%zu cases, %zu did not run) on %s in %.0f s\n", run->rows.size(), run->cases.size(), skipped,
+              run->device.name.c_str(), run->seconds);
+  for (const std::string& path : *written) std::printf("wrote %s\n", path.c_str());
+  if (failures) std::fprintf(stderr, "dpoint: warning: %zu check(s) failed; see report.md\n", failures);
+  const std::vector<std::string>& messages = (*context)->validationMessages();
+  if (!messages.empty()) {
+    for (const std::string& m : messages) std::fprintf(stderr, "dpoint: %s\n", m.c_str());
+    return reportError(Error{std::to_string(messages.size()) + " Vulkan validation message(s)", ExitCode::kNoDevice});
+  }
+  return 0;
+}
+
 }  // namespace
 
 void addBenchCommand(CLI::App& app, RunCommand& run) {
-  CLI::App* bench = app.add_subcommand("bench", "Benchmarks (the renderer's speed-vs-error matrix comes with the renderer)");
-  bench->require_subcommand(1);
+  CLI::App* bench = app.add_subcommand(
+      "bench",
+      "The speed-against-error report: every precision mode on both backends over a suite of datasets, timed\n"
+      "(GPU timestamps) and measured against the exact reference. Writes report.md, results.json,\n"
+      "speed_vs_error.svg, breakdown.svg and montage.png into --out. Datasets are made once with\n"
+      "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the study's\n"
+      "datasets at 1920x1080, its RTX 3090 figures beside ours), hard (DESIGN's hard cases: offset and\n"
+      "deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
+      "`dpoint bench io FILE` times reading a file instead.");
+  bench->require_subcommand(0, 1);
+  auto r = std::make_shared<BenchReportOptions>();
+  bench->add_option("--suite", r->suite, "ci, paper, hard or all")->default_val("ci");
+  bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")->default_val("bench-out");
+  bench->add_option("--cache", r->cache, "Folder the datasets are made in and reused from")->default_val("bench-cache");
+  bench->add_option("--device", r->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
+      ->default_val("auto");
+  bench->add_option("--backend", r->backend, "raster, compute or both")->default_val("both");
+  bench->add_option("--frames", r->frames, "Timed frames per run (the median is reported)")->default_val(20);
+  bench->add_option("--warmup", r->warmup, "Untimed frames first")->default_val(2);
+  bench->add_option("--sizes", r->sizes, "paper suite: only these of the study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
+  bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");
+  addCommonOptions(*bench, r->common);
   auto o = std::make_shared<BenchIoOptions>();
   CLI::App* io = bench->add_subcommand("io", "Time reading a point file (and writing it with --write)");
   io->add_option("input", o->input, "Input file")->required();
@@ -59,6 +193,9 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   io->add_option("--decimals", o->decimals, "CSV output: fixed digits after the point")->check(CLI::Range(0, 100));
   addCommonOptions(*io, o->common);
   io->callback([o, &run] { run = [o] { return runBenchIo(*o); }; });
+  bench->callback([bench, io, r, &run] {
+    if (!io->parsed()) run = [r] { return runBenchReport(*r); };
+  });
 }
 
 }  // namespace dpoint

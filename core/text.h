@@ -1,5 +1,5 @@
-// Bad input text quoted in a one-line error message: at most 40 characters, control and
-// non-ASCII bytes written as \xNN so the message stays one printable line.
+// Text for messages and reports: bad input quoted in a one-line error message, numbers in
+// shortest round-trip form, JSON strings. Shared by the readers, the CLI and the bench report.
 #pragma once
 
 #include <string>
@@ -7,6 +7,8 @@
 
 namespace dpoint {
 
+// Bad input text quoted in a one-line error message: at most 40 characters, control and
+// non-ASCII bytes written as \xNN so the message stays one printable line.
 inline std::string printableExcerpt(std::string_view text) {
   constexpr size_t kMax = 40;
   static const char kHex[] = "0123456789abcdef";
@@ -24,5 +26,10 @@ inline std::string printableExcerpt(std::string_view text) {
   if (text.size() > kMax) out += "...";
   return out;
 }
+
+// Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
+std::string formatNumber(double v, bool json = false);
+// A JSON string literal: quotes, with '"', '\\' and control characters escaped.
+std::string jsonString(const std::string& s);
 
 }  // namespace dpoint

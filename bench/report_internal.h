@@ -1,0 +1,57 @@
+// Helpers the report's parts share (report.cpp: JSON and checks; report_md.cpp: Markdown;
+// figures.cpp: the charts and the montage). Not part of the bench library's interface.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "bench/run.h"
+
+namespace dpoint::report {
+
+using ModeRows = std::array<const BenchRow*, kModeCount>;  // by modeIndex; null: not in the run
+
+inline std::string backendText(Backend backend) { return backend == Backend::kCompute ? "compute" : "raster"; }
+inline std::string modeText(PrecisionMode mode) { return std::string(modeName(mode)); }
+
+// Three significant digits, as the tables print numbers.
+inline std::string g3(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+inline bool ran(const BenchRow* row) { return row && row->skipped.empty(); }
+
+// The backends in the run, in the order they ran.
+inline std::vector<Backend> backendsOf(const BenchRun& run) {
+  std::vector<Backend> out;
+  for (const BenchRow& row : run.rows)
+    if (std::find(out.begin(), out.end(), row.backend) == out.end()) out.push_back(row.backend);
+  return out;
+}
+
+inline ModeRows rowsFor(const BenchRun& run, const BenchCase* c, Backend backend) {
+  ModeRows out{};
+  for (const BenchRow& row : run.rows)
+    if (row.bench_case == c && row.backend == backend) out[modeIndex(row.mode)] = &row;
+  return out;
+}
+
+inline const BenchRow* rowOf(const ModeRows& rows, PrecisionMode mode) { return rows[modeIndex(mode)]; }
+
+// GPU time per frame, or the host's frame time where the queue has no timestamps.
+inline double frameMs(const BenchRow& row) { return row.gpu_ms_median.value_or(row.frame_ms_median); }
+
+// The backend the sweeps and the montage are drawn from: compute when it ran (the fast path).
+inline Backend figureBackend(const BenchRun& run) {
+  std::vector<Backend> backends = backendsOf(run);
+  return std::find(backends.begin(), backends.end(), Backend::kCompute) != backends.end() || backends.empty()
+             ? Backend::kCompute
+             : backends.front();
+}
+
+}  // namespace dpoint::report

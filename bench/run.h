@@ -1,0 +1,80 @@
+// Runs the bench's cases (bench/suites.h) on one Vulkan device: each case's dataset is made once
+// into the cache folder (by the caller's `make_dataset`, which runs `dpoint generate`) and read
+// back, its exact reference projected once, then every mode on every backend is drawn twice: timed
+// (GPU timestamps, median of `frames` after warm-up, no probe) and probed (clip positions of every
+// point against the reference). One row per (case, backend, mode).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/suites.h"
+#include "viewer/context.h"
+#include "viewer/encode.h"
+#include "viewer/render.h"
+
+namespace dpoint {
+
+struct BenchRow {
+  const BenchCase* bench_case = nullptr;  // into BenchRun::cases
+  uint64_t points = 0;
+  PrecisionMode mode = PrecisionMode::kFp32;
+  Backend backend = Backend::kRaster;
+  std::string skipped;  // why the mode did not run (unusable on the device, encoding refused); else empty
+  // Speed: GPU timestamps (empty when the queue has none), host frame times, upload and readback.
+  std::optional<double> gpu_ms_median, gpu_ms_p95, gpu_ms_min;
+  double frame_ms_median = 0.0, upload_ms = 0.0, readback_ms = 0.0;
+  double e2e_ms = 0.0;        // upload + one frame (median) + readback, as `dpoint render --json`
+  double points_per_s = 0.0;  // from the GPU median (else the host frame median)
+  uint32_t bytes_per_point = 0;
+  // Error: the bound predicted before drawing (+inf: unbounded) and what the probe measured.
+  double predicted_bound_px = 0.0;
+  double float_floor_px = 0.0;
+  std::optional<double> error_max_px, error_p99_px, error_rms_px;  // empty when every visible point was lost
+  double share_off_half_px = 0.0;
+  uint64_t points_visible = 0, points_lost = 0;
+  std::optional<uint64_t> pixels_differing;
+};
+
+// The montage's view drawn in one mode: the picture and each point's error (NaN: lost).
+struct MontageMode {
+  PrecisionMode mode = PrecisionMode::kFp32;
+  Image picture;
+  std::vector<double> error_px;
+  std::string caption;
+};
+struct MontageCapture {
+  const BenchCase* bench_case = nullptr;
+  Backend backend = Backend::kRaster;
+  std::vector<WindowPoint> reference;
+  std::vector<MontageMode> modes;
+};
+
+struct BenchOptions {
+  std::vector<BenchSuite> suites;
+  std::vector<Backend> backends;
+  std::vector<std::string> sizes;  // paper cases kept by size label (case-insensitive); empty: all
+  uint32_t frames = 20, warmup = 2;
+  std::string cache_dir;
+  // Makes `path` from `dpoint generate ARGS -o path`; the caller runs the real command.
+  std::function<Status(const std::vector<std::string>& args, const std::string& path)> make_dataset;
+  // One line per step for the user (progress); may be empty.
+  std::function<void(const std::string&)> log;
+};
+
+struct BenchRun {
+  std::vector<BenchCase> cases;  // every case run, in order (rows point into it: not resized after)
+  std::vector<BenchRow> rows;
+  std::optional<MontageCapture> montage;
+  DeviceFacts device;
+  double seconds = 0.0;  // wall time of the whole run
+};
+
+// Fails on a dataset that cannot be made or read, or a Vulkan failure other than a mode the
+// device cannot run (those become skipped rows).
+Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& options);
+
+}  // namespace dpoint

@@ -1,0 +1,163 @@
+// The bench's suites and its report logic on made-up runs (issue #10): the checks catch each broken
+// expectation of DESIGN §4–5, results.json carries nulls where nothing was measured, and the suites
+// hold the datasets and sweeps the issue lists. The real runs are in external/bench_ci_suite.py.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "bench/report.h"
+#include "bench/suites.h"
+
+namespace dpoint {
+namespace {
+
+// One case, one backend, every mode measured with `errors` (NaN: every point lost) and `bounds`.
+BenchRun madeUpRun(const std::array<double, kModeCount>& errors, const std::array<double, kModeCount>& bounds) {
+  BenchRun run;
+  BenchCase c;
+  c.name = "made up";
+  c.family = "offset";
+  c.hard = true;
+  run.cases.push_back(c);
+  for (size_t m = 0; m < kModeCount; ++m) {
+    BenchRow row;
+    row.bench_case = &run.cases.front();
+    row.mode = kAllModes[m];
+    row.backend = Backend::kCompute;
+    row.points = row.points_visible = 100;
+    row.predicted_bound_px = bounds[m];
+    row.float_floor_px = 1e-5;
+    row.gpu_ms_median = row.gpu_ms_p95 = row.gpu_ms_min = 1.0;
+    if (std::isnan(errors[m])) {
+      row.points_lost = 100;
+    } else {
+      row.error_max_px = row.error_p99_px = row.error_rms_px = errors[m];
+    }
+    run.rows.push_back(row);
+  }
+  return run;
+}
+
+const double kInf = std::numeric_limits<double>::infinity();
+const double kLost = std::nan("");
+
+std::vector<std::string> failedModes(const BenchRun& run) {
+  std::vector<std::string> out;
+  for (const CheckFailure& f : checkRun(run)) out.push_back(f.mode);
+  return out;
+}
+
+TEST(BenchReport, checksPassARunThatBehavesAsDesignSays) {
+  // fp32 far off, every double mode near the float floor, native best.
+  BenchRun run = madeUpRun({30, 30, 2e-5, 3e-5, 1e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5});
+  EXPECT_TRUE(checkRun(run).empty());
+}
+
+TEST(BenchReport, checksCatchAnErrorAboveItsBound) {
+  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-4, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  EXPECT_EQ(failedModes(run), std::vector<std::string>{"rte"});
+}
+
+TEST(BenchReport, checksCatchEveryPointLostUnderASmallBound) {
+  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-5, kLost, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 0.01, 2e-5, 5e-5});
+  const std::vector<std::string> failed = failedModes(run);
+  EXPECT_EQ(std::set<std::string>(failed.begin(), failed.end()), std::set<std::string>{"df64"});
+}
+
+TEST(BenchReport, checksCatchSplitDifferingFromFp32) {
+  BenchRun run = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  EXPECT_EQ(failedModes(run), std::vector<std::string>{"split"});
+}
+
+TEST(BenchReport, checksCatchNativeBeatenByMoreThanOneFloatFloor) {
+  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-5, 3e-5, 5e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 1e-4, 5e-5});
+  EXPECT_EQ(failedModes(run), (std::vector<std::string>{"native", "native", "native"}));
+  // Within one floor (1e-5) of the best is no failure.
+  BenchRun close = madeUpRun({1e-4, 1e-4, 2e-5, 3e-5, 2.5e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 1e-4, 5e-5});
+  EXPECT_TRUE(checkRun(close).empty());
+}
+
+TEST(BenchReport, checksCatchADoubleModeNoBetterThanFp32WhereFp32IsOff) {
+  BenchRun run = madeUpRun({3, 3, 2e-5, 4, 1e-5, 2e-5}, {kInf, kInf, 1e-4, kInf, 2e-5, 5e-5});
+  EXPECT_EQ(failedModes(run), std::vector<std::string>{"df64"});
+}
+
+TEST(BenchReport, resultsJsonWritesNullForWhatWasNotMeasured) {
+  BenchRun run = madeUpRun({kLost, kLost, 2e-5, 3e-5, 1e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5});
+  run.rows[2].gpu_ms_median.reset();
+  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, checkRun(run));
+  EXPECT_NE(json.find("\"mode\": \"fp32\""), std::string::npos);
+  EXPECT_NE(json.find("\"predicted_bound_px\": null"), std::string::npos) << "an unbounded mode has no number";
+  EXPECT_NE(json.find("\"error_px\": null"), std::string::npos) << "every point lost: no error";
+  EXPECT_NE(json.find("\"gpu_ms\": null"), std::string::npos) << "no timestamps: no GPU time";
+  EXPECT_EQ(json.find("inf"), std::string::npos);
+  EXPECT_EQ(json.find("nan"), std::string::npos);
+}
+
+TEST(BenchSuites, paperSuiteHoldsTheStudysDatasetsWithItsFigures) {
+  const std::vector<BenchCase> paper = suiteCases(BenchSuite::kPaper);
+  std::vector<std::string> labels;
+  for (const BenchCase& c : paper) labels.push_back(c.size_label);
+  EXPECT_EQ(labels, (std::vector<std::string>{"10K", "100K", "1M", "10M", "200K", "2M", "200K", "1.85M", "5M", "11.9M",
+                                              "1M", "16.7M", "1.4M"}));
+  size_t with_figures = 0;
+  for (const BenchCase& c : paper) {
+    EXPECT_EQ(c.width, 1920u);
+    EXPECT_EQ(c.height, 1080u);
+    EXPECT_FALSE(c.hard);
+    with_figures += c.study.has_value();
+  }
+  EXPECT_EQ(with_figures, 2u) << "the study's 10M 2D and 16.7M Sierpinski figures";
+}
+
+TEST(BenchSuites, hardSuiteSweepsEveryDecade) {
+  for (BenchSuite suite : {BenchSuite::kHard, BenchSuite::kCi}) {
+    std::set<double> zoom, offset;
+    for (const BenchCase& c : suiteCases(suite)) {
+      if (c.sweep == Sweep::kDeepZoom) zoom.insert(c.sweep_x);
+      if (c.sweep == Sweep::kOffset) offset.insert(c.sweep_x);
+    }
+    std::set<double> zoom_expected, offset_expected;
+    for (int e = 1; e <= 15; ++e) zoom_expected.insert(std::pow(10.0, -e));
+    for (int e = 0; e <= 8; ++e) offset_expected.insert(std::pow(10.0, e));
+    EXPECT_EQ(zoom.size(), 15u);
+    EXPECT_EQ(offset.size(), 9u);
+    for (double x : zoom) EXPECT_TRUE(std::any_of(zoom_expected.begin(), zoom_expected.end(), [&](double e) {
+      return std::abs(x / e - 1) < 1e-15;
+    })) << x;
+    for (double x : offset) EXPECT_TRUE(offset_expected.count(x)) << x;
+  }
+}
+
+TEST(BenchSuites, everyCaseHasItsOwnNameAndCacheFile) {
+  for (BenchSuite suite : {BenchSuite::kCi, BenchSuite::kPaper, BenchSuite::kHard}) {
+    std::set<std::string> names;
+    std::map<std::string, std::vector<std::string>> files;  // a file may be shared only by identical arguments
+    size_t montages = 0;
+    for (const BenchCase& c : suiteCases(suite)) {
+      EXPECT_TRUE(names.insert(c.name).second) << c.name;
+      auto [it, fresh] = files.emplace(cacheFileName(c), c.generate);
+      EXPECT_TRUE(fresh || it->second == c.generate) << cacheFileName(c);
+      EXPECT_EQ(cacheFileName(c).find('/'), std::string::npos);
+      montages += c.montage;
+    }
+    EXPECT_EQ(montages, suite == BenchSuite::kPaper ? 0u : 1u);
+  }
+}
+
+TEST(BenchSuites, nearViewLooksAtTheBoxCentreFromTheGivenDistance) {
+  BenchCase c;
+  c.view.kind = BenchView::Kind::kNear;
+  c.view.distance = 2.0;
+  Bounds b;
+  b.min = {6378137.0, -1.0, 0.0};
+  b.max = {6378139.0, 1.0, 2.0};
+  CameraSpec spec = cameraSpecFor(c, b);
+  ASSERT_TRUE(spec.eye && spec.target && spec.up);
+  EXPECT_EQ(*spec.target, glm::dvec3(6378138.0, 0.0, 1.0));
+  EXPECT_EQ(*spec.eye, glm::dvec3(6378138.2, 0.4, 3.0));
+}
+
+}  // namespace
+}  // namespace dpoint
