@@ -6,8 +6,11 @@
 #include <filesystem>
 #include <limits>
 
+#include "converters/gltf_json.h"
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
+#include "core/input_file.h"
+#include "core/text.h"
 #include "viewer/precision.h"
 #include "viewer/reference.h"
 #include "viewer/selftest.h"
@@ -25,9 +28,13 @@ bool keptBySizes(const BenchCase& c, const std::vector<std::string>& sizes) {
   return std::any_of(sizes.begin(), sizes.end(), [&](const std::string& s) { return lower(s) == lower(c.size_label); });
 }
 
+std::string cachePath(const BenchOptions& options, const std::string& name) {
+  return (std::filesystem::path(options.cache_dir) / name).string();
+}
+
 // The case's dataset from the cache, made first when it is not there.
 Result<PointSet> loadDataset(const BenchCase& c, const BenchOptions& options) {
-  const std::string path = (std::filesystem::path(options.cache_dir) / cacheFileName(c)).string();
+  const std::string path = cachePath(options, cacheFileName(c));
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     if (options.log) options.log("making " + path);
@@ -38,7 +45,10 @@ Result<PointSet> loadDataset(const BenchCase& c, const BenchOptions& options) {
       if (status) status = file->commit();
       if (!status) return status.error();
     } else {
-      Status made = options.make_dataset(c.generate, path);
+      std::vector<std::string> args = {"generate"};
+      args.insert(args.end(), c.generate.begin(), c.generate.end());
+      args.insert(args.end(), {"-o", path, "--quiet"});
+      Status made = options.run_dpoint(args);
       if (!made) return made.error();
     }
   }
@@ -73,35 +83,58 @@ Result<Prepared> prepare(const BenchCase& c, const BenchOptions& options) {
   Prepared p;
   p.points = std::move(*points);
   p.camera = *camera;
-  p.reference = projectReference(p.points.positions, p.camera);
-  p.reference_raster = rasterReference(p.reference, encodeColors(p.points), p.camera.width, p.camera.height, 0xff000000u);
+  if (options.measure_error) {
+    p.reference = projectReference(p.points.positions, p.camera);
+    p.reference_raster = rasterReference(p.reference, encodeColors(p.points), p.camera.width, p.camera.height, 0xff000000u);
+  }
   p.bounds = predictErrorBounds(p.points, p.camera);
   return p;
 }
 
-// The timed draw: no probe, so the GPU does exactly what `dpoint render` does.
-void timeMode(const VulkanContext& context, const Prepared& p, const BenchOptions& options, BenchRow& row) {
-  RenderOptions r;
-  r.mode = row.mode;
-  r.backend = row.backend;
-  r.frames = std::max<uint32_t>(options.frames, 1);
-  r.warmup_frames = options.warmup;
-  Result<RenderResult> timed = renderPoints(context, p.points, p.camera, r);
-  if (!timed) {
-    row.skipped = timed.error().message;
-    return;
+// `dpoint render` flags for the case's camera, every number in shortest round-trip form (exact).
+std::vector<std::string> cameraFlags(const CameraSpec& spec) {
+  auto vec = [](const glm::dvec3& v) { return formatNumber(v.x) + "," + formatNumber(v.y) + "," + formatNumber(v.z); };
+  std::vector<std::string> flags = {"--width", std::to_string(spec.width), "--height", std::to_string(spec.height)};
+  if (spec.eye) flags.insert(flags.end(), {"--eye", vec(*spec.eye), "--target", vec(*spec.target), "--up", vec(*spec.up)});
+  if (spec.view_center) flags.insert(flags.end(), {"--view-center", vec(*spec.view_center)});
+  if (spec.view_width) flags.insert(flags.end(), {"--view-width", formatNumber(*spec.view_width)});
+  return flags;
+}
+
+double numberAt(const JsonValue& object, std::string_view key) {
+  const JsonValue* v = object.find(key);
+  return v && v->kind == JsonValue::Kind::kNumber ? v->number : 0.0;
+}
+
+// The timed draw: a fresh `dpoint render` process without the probe, exactly what a user runs.
+Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& options, BenchRow& row) {
+  const std::string json_path = cachePath(options, "timed-draw.json");
+  std::vector<std::string> args = {"render", cachePath(options, cacheFileName(c)), "-o", cachePath(options, "timed-draw.png"),
+                                   "--mode", std::string(modeName(row.mode)), "--backend",
+                                   row.backend == Backend::kCompute ? "compute" : "raster", "--device", options.device,
+                                   "--frames", std::to_string(std::max<uint32_t>(options.frames, 1)), "--warmup",
+                                   std::to_string(options.warmup), "--json", json_path, "--quiet"};
+  for (const std::string& flag : cameraFlags(cameraSpecFor(c, boundsOf(p.points)))) args.push_back(flag);
+  if (options.validate) args.push_back("--validate");
+  if (Status ran = options.run_dpoint(args); !ran) return ran;
+  Result<InputFile> file = InputFile::open(json_path);
+  if (!file) return file.error();
+  std::string text(file->size(), '\0');
+  Result<size_t> got = file->readAt(0, text.data(), text.size());
+  if (!got) return got.error();
+  Result<JsonValue> json = parseJson(text, 8);
+  if (!json) return Error{json_path + ": " + json.error().message, ExitCode::kBadInput};
+  if (const JsonValue* gpu = json->find("gpu_ms"); gpu && gpu->kind == JsonValue::Kind::kObject) {
+    row.gpu_ms_median = numberAt(*gpu, "median");
+    row.gpu_ms_p95 = numberAt(*gpu, "p95");
+    row.gpu_ms_min = numberAt(*gpu, "min");
   }
-  if (!timed->gpu_ms.empty()) {
-    row.gpu_ms_median = medianOf(timed->gpu_ms);
-    row.gpu_ms_p95 = percentileOf(timed->gpu_ms, 95);
-    row.gpu_ms_min = *std::min_element(timed->gpu_ms.begin(), timed->gpu_ms.end());
-  }
-  row.frame_ms_median = medianOf(timed->frame_ms);
-  row.upload_ms = timed->upload_ms;
-  row.readback_ms = timed->readback_ms;
-  row.e2e_ms = row.upload_ms + row.frame_ms_median + row.readback_ms;
-  const double per_frame_ms = row.gpu_ms_median.value_or(row.frame_ms_median);
-  row.points_per_s = per_frame_ms > 0 ? static_cast<double>(row.points) / (per_frame_ms * 1e-3) : 0.0;
+  if (const JsonValue* frame = json->find("frame_ms"); frame) row.frame_ms_median = numberAt(*frame, "median");
+  row.upload_ms = numberAt(*json, "upload_ms");
+  row.readback_ms = numberAt(*json, "readback_ms");
+  row.e2e_ms = numberAt(*json, "e2e_ms");
+  row.points_per_s = numberAt(*json, "points_per_s");
+  return okStatus();
 }
 
 // The probed draw: every point's clip position against the exact reference, and the picture
@@ -168,7 +201,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
     Result<Prepared> prepared = prepare(c, options);
     if (!prepared) return prepared.error();
     const Prepared& p = *prepared;
-    const bool wants_montage = c.montage && !run.montage;
+    const bool wants_montage = c.montage && !run.montage && options.measure_error;
     const Backend montage_backend = std::find(options.backends.begin(), options.backends.end(), Backend::kCompute) !=
                                             options.backends.end() ? Backend::kCompute : options.backends.front();
     if (wants_montage) run.montage = MontageCapture{&c, montage_backend, p.reference, {}};
@@ -184,11 +217,13 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
         row.float_floor_px = p.bounds.float_floor_px;
         Status usable = modeUsable(context, row.mode, *self_test, backend == Backend::kRaster);
         if (!usable) row.skipped = usable.error().message;
-        if (row.skipped.empty()) timeMode(context, p, options, row);
+        if (row.skipped.empty()) {
+          if (Status timed = timeMode(c, p, options, row); !timed) row.skipped = timed.error().message;
+        }
         const bool capture = wants_montage && backend == montage_backend;
         MontageMode shot;
         shot.mode = row.mode;
-        if (row.skipped.empty()) {
+        if (row.skipped.empty() && options.measure_error) {
           Result<Image> picture = measureMode(context, p, row, capture ? &shot.error_px : nullptr);
           if (picture) shot.picture = std::move(*picture);
           else row.skipped = picture.error().message;
@@ -212,6 +247,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
       }
     }
   }
+  for (const char* scratch : {"timed-draw.json", "timed-draw.png"}) std::filesystem::remove(cachePath(options, scratch), ec);
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return run;
 }

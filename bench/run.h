@@ -1,8 +1,15 @@
 // Runs the bench's cases (bench/suites.h) on one Vulkan device: each case's dataset is made once
-// into the cache folder (by the caller's `make_dataset`, which runs `dpoint generate`) and read
-// back, its exact reference projected once, then every mode on every backend is drawn twice: timed
-// (GPU timestamps, median of `frames` after warm-up, no probe) and probed (clip positions of every
-// point against the reference). One row per (case, backend, mode).
+// into the cache folder by `dpoint generate` and read back, its exact reference projected once,
+// then every mode on every backend is drawn twice: timed, by a fresh `dpoint render --json` process
+// (GPU timestamps, median of `frames` after warm-up, no probe: what a user's run gets), and probed,
+// in this process (clip positions of every point against the reference). One row per (case,
+// backend, mode).
+//
+// Why a process per timed draw: on the H100 (driver 580.159), once one process had drawn and
+// probed a 10M-point set, every later draw of 10M points in that process ran 4–6× slower (0.18 ms
+// became 0.7–1.1 ms for the same compute draw), on a second VkDevice too; fresh processes and
+// runs without probes were unaffected. Until that is understood (issue #11 keeps buffers across
+// frames and will meet it), the bench times what `dpoint render` times.
 #pragma once
 
 #include <cstdint>
@@ -58,9 +65,12 @@ struct BenchOptions {
   std::vector<Backend> backends;
   std::vector<std::string> sizes;  // paper cases kept by size label (case-insensitive); empty: all
   uint32_t frames = 20, warmup = 2;
+  bool measure_error = true;  // false: timed draws only; error columns stay empty
   std::string cache_dir;
-  // Makes `path` from `dpoint generate ARGS -o path`; the caller runs the real command.
-  std::function<Status(const std::vector<std::string>& args, const std::string& path)> make_dataset;
+  std::string device = "auto";  // passed to every `dpoint render`; the context given must be that device
+  bool validate = false;        // --validate for every `dpoint render`
+  // Runs `dpoint ARGS` (this executable) to its end; fails naming the command and its exit code.
+  std::function<Status(const std::vector<std::string>& args)> run_dpoint;
   // One line per step for the user (progress); may be empty.
   std::function<void(const std::string&)> log;
 };
@@ -73,8 +83,8 @@ struct BenchRun {
   double seconds = 0.0;  // wall time of the whole run
 };
 
-// Fails on a dataset that cannot be made or read, or a Vulkan failure other than a mode the
-// device cannot run (those become skipped rows).
+// Fails on a dataset that cannot be made or read; a mode the device cannot run or a draw that fails
+// becomes a skipped row naming why.
 Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& options);
 
 }  // namespace dpoint

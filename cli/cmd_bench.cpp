@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cerrno>
 #include <cstring>
+#include <fcntl.h>
+#include <unistd.h>
 #include <ctime>
 #include <memory>
 #include <spawn.h>
@@ -63,27 +65,31 @@ struct BenchReportOptions {
   std::string suite = "ci", out = "bench-out", cache = "bench-cache", device = "auto", backend = "both";
   std::vector<std::string> sizes;
   uint32_t frames = 20, warmup = 2;
-  bool validate = false;
+  bool validate = false, no_error = false;
   CommonOptions common;
 };
 
 extern "C" char** environ;
 
-// `dpoint generate ARGS -o PATH --quiet` run as a child of this very executable, so the bench's
-// datasets are exactly what a user would make.
-Status runGenerate(const std::vector<std::string>& args, const std::string& path, unsigned threads) {
-  std::vector<std::string> argv = {"dpoint", "generate"};
+// `dpoint ARGS` run as a child of this very executable: the bench's datasets and timed draws are
+// exactly what a user's `dpoint generate` and `dpoint render` give.
+Status runDpoint(const std::vector<std::string>& args, unsigned threads) {
+  std::vector<std::string> argv = {"dpoint"};
   argv.insert(argv.end(), args.begin(), args.end());
-  argv.insert(argv.end(), {"-o", path, "--quiet"});
   if (threads) argv.insert(argv.end(), {"--threads", std::to_string(threads)});
   std::vector<char*> c_argv;
   for (std::string& a : argv) c_argv.push_back(a.data());
   c_argv.push_back(nullptr);
   std::string command;
   for (size_t i = 0; i + 1 < c_argv.size(); ++i) command += (i ? " " : "") + argv[i];
+  // The child's report goes nowhere (the bench reads its --json); its errors reach our stderr.
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   pid_t pid = 0;
-  if (int e = posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, c_argv.data(), environ); e != 0)
-    return Error{"cannot run " + command + ": " + std::strerror(e), ExitCode::kBadInput};
+  const int spawned = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, c_argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return Error{"cannot run " + command + ": " + std::strerror(spawned), ExitCode::kBadInput};
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) return Error{"waiting for " + command + ": " + std::strerror(errno), ExitCode::kBadInput};
@@ -111,6 +117,7 @@ std::string commandLine(const BenchReportOptions& o) {
     s += " --sizes ";
     for (size_t i = 0; i < o.sizes.size(); ++i) s += (i ? "," : "") + o.sizes[i];
   }
+  if (o.no_error) s += " --no-error";
   return s + " --out " + o.out + " --cache " + o.cache;
 }
 
@@ -129,11 +136,12 @@ int runBenchReport(const BenchReportOptions& o) {
   options.sizes = o.sizes;
   options.frames = o.frames;
   options.warmup = o.warmup;
+  options.measure_error = !o.no_error;
   options.cache_dir = o.cache;
   const unsigned threads = o.common.threads;
-  options.make_dataset = [threads](const std::vector<std::string>& args, const std::string& path) {
-    return runGenerate(args, path, threads);
-  };
+  options.device = o.device;
+  options.validate = o.validate;
+  options.run_dpoint = [threads](const std::vector<std::string>& args) { return runDpoint(args, threads); };
   std::FILE* sink = progressSink(o.common.quiet);
   if (sink) options.log = [sink](const std::string& line) { std::fprintf(sink, "bench: %s\n", line.c_str()); };
 
@@ -184,6 +192,7 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   bench->add_option("--frames", r->frames, "Timed frames per run (the median is reported)")->default_val(20);
   bench->add_option("--warmup", r->warmup, "Untimed frames first")->default_val(2);
   bench->add_option("--sizes", r->sizes, "paper suite: only these of the study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
+  bench->add_flag("--no-error", r->no_error, "Time only: skip the probe draws and the exact reference (no error columns)");
   bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");
   addCommonOptions(*bench, r->common);
   auto o = std::make_shared<BenchIoOptions>();
