@@ -33,11 +33,13 @@ std::string fpsText(double fps) {
   return fps >= 100 ? withCommas(static_cast<uint64_t>(std::llround(fps))) : g3(fps);
 }
 
+std::string msText(double ms) { return ms >= 100 ? withCommas(static_cast<uint64_t>(std::llround(ms))) : g3(ms); }
+
 std::string fpsCell(const BenchRow* row) {
   if (!row) return "–";
   if (!row->skipped.empty()) return "did not run";
   const double ms = frameMs(*row);
-  return fpsText(1000.0 / ms) + " fps (" + g3(ms) + " ms" + (row->gpu_ms_median ? ")" : ", host)");
+  return fpsText(1000.0 / ms) + " fps (" + msText(ms) + " ms" + (row->gpu_ms_median ? ")" : ", host)");
 }
 
 std::string errorCell(const BenchRow* row) {
@@ -164,7 +166,7 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   s += "- Device: **" + d.name + "** (" + d.type + "), driver " + d.driver_name + " " + d.driver_info + " (" +
        formatDriverVersion(d.vendor_id, d.driver_version) + "), Vulkan " + formatApiVersion(d.api_version) + "\n";
   s += "- Command: `" + context.command + "` (dpoint " + context.version + ", " + context.date + "; whole run " +
-       g3(run.seconds) + " s)\n";
+       withCommas(static_cast<uint64_t>(std::llround(run.seconds))) + " s)\n";
   s += "- Speed: GPU timestamps around the draw (raster) or the splat and resolve passes (compute), median of the timed "
        "frames after warm-up; p95, min and the end-to-end time (upload, one frame, readback) are in results.json. "
        "Absolute times count on a GPU; on lavapipe (a CPU) compare modes as ratios.\n";

@@ -1,5 +1,7 @@
 #include "bench/run.h"
 
+#include "bench/report_internal.h"  // report::backendText
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -57,8 +59,6 @@ Result<PointSet> loadDataset(const BenchCase& c, const BenchOptions& options) {
 
 double distancePx(const WindowPoint& a, const WindowPoint& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
-std::string backendText(Backend backend) { return backend == Backend::kCompute ? "compute" : "raster"; }
-
 std::string shortNumber(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", value);
@@ -111,7 +111,7 @@ Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& optio
   const std::string json_path = cachePath(options, "timed-draw.json");
   std::vector<std::string> args = {"render", cachePath(options, cacheFileName(c)), "-o", cachePath(options, "timed-draw.png"),
                                    "--mode", std::string(modeName(row.mode)), "--backend",
-                                   row.backend == Backend::kCompute ? "compute" : "raster", "--device", options.device,
+                                   report::backendText(row.backend), "--device", options.device,
                                    "--frames", std::to_string(std::max<uint32_t>(options.frames, 1)), "--warmup",
                                    std::to_string(options.warmup), "--json", json_path, "--quiet"};
   for (const std::string& flag : cameraFlags(cameraSpecFor(c, boundsOf(p.points)))) args.push_back(flag);
@@ -235,7 +235,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
         ++done;
         if (options.log) {
           std::string line = '[' + std::to_string(done) + '/' + std::to_string(total) + "] " + std::string(suiteName(c.suite)) +
-                             " " + c.name + ", " + backendText(backend) + " " + std::string(modeName(row.mode)) + ": ";
+                             " " + c.name + ", " + report::backendText(backend) + " " + std::string(modeName(row.mode)) + ": ";
           if (!row.skipped.empty()) line += "skipped (" + row.skipped + ")";
           else {
             line += row.gpu_ms_median ? shortNumber(*row.gpu_ms_median) + " ms" : shortNumber(row.frame_ms_median) + " ms (host)";

@@ -12,6 +12,7 @@
 #include <ctime>
 #include <memory>
 #include <spawn.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -133,6 +134,20 @@ int runBenchReport(const BenchReportOptions& o) {
   else if (o.backend == "both") options.backends = {Backend::kRaster, Backend::kCompute};
   else return reportError(Error{"--backend must be raster, compute or both, got '" + o.backend + "'", ExitCode::kUsage});
   if (o.frames == 0) return reportError(Error{"--frames must be at least 1", ExitCode::kUsage});
+  if (!o.sizes.empty()) {
+    if (o.suite != "paper" && o.suite != "all")
+      return reportError(Error{"--sizes picks datasets of the paper suite; --suite is " + o.suite, ExitCode::kUsage});
+    std::string known;
+    for (const BenchCase& c : suiteCases(BenchSuite::kPaper))
+      if (known.find(" " + c.size_label + ",") == std::string::npos) known += " " + c.size_label + ",";
+    for (const std::string& size : o.sizes) {
+      bool found = false;
+      for (const BenchCase& c : suiteCases(BenchSuite::kPaper)) found = found || strcasecmp(c.size_label.c_str(), size.c_str()) == 0;
+      if (!found)
+        return reportError(Error{"--sizes: the paper suite has no dataset of size '" + size + "' (it has" +
+                                     known.substr(0, known.size() - 1) + ")", ExitCode::kUsage});
+    }
+  }
   options.sizes = o.sizes;
   options.frames = o.frames;
   options.warmup = o.warmup;
@@ -149,8 +164,6 @@ int runBenchReport(const BenchReportOptions& o) {
   if (!context) return reportError(context.error());
   Result<BenchRun> run = runBench(**context, options);
   if (!run) return reportError(run.error());
-  if (run->rows.empty())
-    return reportError(Error{"--sizes " + commandLine(o) + ": no dataset of the suite has these sizes", ExitCode::kUsage});
   Result<std::vector<std::string>> written = writeReport(*run, ReportContext{commandLine(o), utcNow(), DPOINT_VERSION}, o.out);
   if (!written) return reportError(written.error());
 

@@ -69,6 +69,24 @@ std::string binaryPly(int vertices_declared, int vertices_written) {
   return s;
 }
 
+TEST(Cli, benchRefusesUnknownSuiteBackendFramesAndSizesBeforeDrawing) {
+  test::TempDir dir;
+  const std::vector<std::vector<std::string>> bad = {
+      {"--suite", "fast"}, {"--backend", "vertex"}, {"--frames", "0"}, {"--suite", "paper", "--sizes", "3M"},
+      {"--suite", "ci", "--sizes", "1M"}};
+  for (const std::vector<std::string>& flags : bad) {
+    std::vector<std::string> args = {"bench", "--out", dir.file("out"), "--cache", dir.file("cache")};
+    args.insert(args.end(), flags.begin(), flags.end());
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 1) << flags[1];
+    EXPECT_NE(r.err.find(flags[flags.size() - 2]), std::string::npos) << "names the flag: " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out"))) << "nothing written for " << flags[1];
+    EXPECT_FALSE(std::filesystem::exists(dir.file("cache"))) << "nothing made for " << flags[1];
+  }
+  test::CommandResult sizes = runDpoint({"bench", "--suite", "paper", "--sizes", "3M"});
+  EXPECT_NE(sizes.err.find("16.7M"), std::string::npos) << "lists the sizes there are: " << sizes.err;
+}
+
 TEST(Cli, badInputExitsTwoWithOneLineAndWritesNothing) {
   std::string garbage;
   std::mt19937 rng(11);
