@@ -1,11 +1,8 @@
 #include "bench/report.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <map>
 
 #include "core/atomic_file.h"
 #include "core/text.h"
@@ -148,7 +145,8 @@ std::string resultsJson(const BenchRun& run, const ReportContext& context, const
   return s + (failures.empty() ? "]\n}\n" : "\n  ]\n}\n");
 }
 
-Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportContext& context, const std::string& dir) {
+Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportContext& context,
+                                             const std::vector<CheckFailure>& failures, const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return Error{"cannot create " + dir + ": " + ec.message(), ExitCode::kBadInput};
@@ -162,7 +160,6 @@ Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportCo
     if (status) written.push_back(path);
     return status;
   };
-  const std::vector<CheckFailure> failures = checkRun(run);
   if (Status s = put("results.json", resultsJson(run, context, failures)); !s) return s.error();
   if (Status s = put("report.md", reportMarkdown(run, context, failures)); !s) return s.error();
   if (Status s = put("speed_vs_error.svg", renderChartSvg(speedVsErrorChart(run))); !s) return s.error();

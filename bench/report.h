@@ -39,7 +39,8 @@ std::optional<Chart> breakdownChart(const BenchRun& run);
 std::optional<Image> montageImage(const BenchRun& run);
 
 // Writes every file above into `dir` (created if missing), each atomically; the SVGs and the PNG
-// only when there is something to draw. Returns the paths written.
-Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportContext& context, const std::string& dir);
+// only when there is something to draw. `failures` is checkRun(run). Returns the paths written.
+Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportContext& context,
+                                             const std::vector<CheckFailure>& failures, const std::string& dir);
 
 }  // namespace dpoint

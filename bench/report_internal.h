@@ -47,11 +47,11 @@ inline const BenchRow* rowOf(const ModeRows& rows, PrecisionMode mode) { return 
 inline double frameMs(const BenchRow& row) { return row.gpu_ms_median.value_or(row.frame_ms_median); }
 
 // The backend the sweeps and the montage are drawn from: compute when it ran (the fast path).
-inline Backend figureBackend(const BenchRun& run) {
-  std::vector<Backend> backends = backendsOf(run);
+inline Backend figureBackend(const std::vector<Backend>& backends) {
   return std::find(backends.begin(), backends.end(), Backend::kCompute) != backends.end() || backends.empty()
              ? Backend::kCompute
              : backends.front();
 }
+inline Backend figureBackend(const BenchRun& run) { return figureBackend(backendsOf(run)); }
 
 }  // namespace dpoint::report

@@ -1,33 +1,30 @@
 #include "bench/run.h"
 
-#include "bench/report_internal.h"  // report::backendText
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 
+#include "bench/report_internal.h"  // backendText, figureBackend, g3
 #include "converters/gltf_json.h"
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
 #include "core/input_file.h"
 #include "core/text.h"
 #include "viewer/precision.h"
+#include "viewer/probe.h"
 #include "viewer/reference.h"
 #include "viewer/selftest.h"
 
 namespace dpoint {
 namespace {
 
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
+using report::g3;
 
 bool keptBySizes(const BenchCase& c, const std::vector<std::string>& sizes) {
   if (sizes.empty() || c.suite != BenchSuite::kPaper) return true;
-  return std::any_of(sizes.begin(), sizes.end(), [&](const std::string& s) { return lower(s) == lower(c.size_label); });
+  return std::any_of(sizes.begin(), sizes.end(), [&](const std::string& s) { return hasSizeLabel(c, s); });
 }
 
 std::string cachePath(const BenchOptions& options, const std::string& name) {
@@ -59,15 +56,10 @@ Result<PointSet> loadDataset(const BenchCase& c, const BenchOptions& options) {
 
 double distancePx(const WindowPoint& a, const WindowPoint& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
-std::string shortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
-
 // Everything a case's rows share: the data, the camera, the reference and the bounds.
 struct Prepared {
   PointSet points;
+  CameraSpec spec;  // what the timed `dpoint render` is given
   Camera camera;
   std::vector<WindowPoint> reference;
   Image reference_raster;
@@ -78,9 +70,11 @@ Result<Prepared> prepare(const BenchCase& c, const BenchOptions& options) {
   Result<PointSet> points = loadDataset(c, options);
   if (!points) return points.error();
   if (points->size() == 0) return Error{c.name + ": the dataset is empty", ExitCode::kBadInput};
-  Result<Camera> camera = makeCamera(cameraSpecFor(c, boundsOf(*points)), boundsOf(*points));
-  if (!camera) return Error{c.name + ": " + camera.error().message, camera.error().code};
+  const Bounds bounds = boundsOf(*points);
   Prepared p;
+  p.spec = cameraSpecFor(c, bounds);
+  Result<Camera> camera = makeCamera(p.spec, bounds);
+  if (!camera) return Error{c.name + ": " + camera.error().message, camera.error().code};
   p.points = std::move(*points);
   p.camera = *camera;
   if (options.measure_error) {
@@ -114,7 +108,7 @@ Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& optio
                                    report::backendText(row.backend), "--device", options.device,
                                    "--frames", std::to_string(std::max<uint32_t>(options.frames, 1)), "--warmup",
                                    std::to_string(options.warmup), "--json", json_path, "--quiet"};
-  for (const std::string& flag : cameraFlags(cameraSpecFor(c, boundsOf(p.points)))) args.push_back(flag);
+  for (const std::string& flag : cameraFlags(p.spec)) args.push_back(flag);
   if (options.validate) args.push_back("--validate");
   if (Status ran = options.run_dpoint(args); !ran) return ran;
   Result<InputFile> file = InputFile::open(json_path);
@@ -149,8 +143,7 @@ Result<Image> measureMode(const VulkanContext& context, const Prepared& p, Bench
   r.probe = true;
   Result<RenderResult> probed = renderPoints(context, p.points, p.camera, r);
   if (!probed) return probed.error();
-  std::vector<WindowPoint> probe(p.points.size());
-  for (size_t i = 0; i < probe.size(); ++i) probe[i] = windowFromClip(probed->probe_clip[i], p.camera);
+  const std::vector<WindowPoint> probe = probeWindows(*probed, p.camera);
   const ErrorStats e = compareToReference(p.reference, probe);
   if (e.points > e.lost) {
     row.error_max_px = e.max_px;
@@ -174,7 +167,7 @@ Result<Image> measureMode(const VulkanContext& context, const Prepared& p, Bench
 std::string montageCaption(const BenchRow& row) {
   if (!row.skipped.empty()) return "did not run";
   if (!row.error_max_px) return "all " + std::to_string(row.points_lost) + " lost";
-  std::string text = "max " + shortNumber(*row.error_max_px) + " px";
+  std::string text = "max " + g3(*row.error_max_px) + " px";
   if (row.points_lost) text += ", " + std::to_string(row.points_lost) + " lost";
   return text;
 }
@@ -202,8 +195,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
     if (!prepared) return prepared.error();
     const Prepared& p = *prepared;
     const bool wants_montage = c.montage && !run.montage && options.measure_error;
-    const Backend montage_backend = std::find(options.backends.begin(), options.backends.end(), Backend::kCompute) !=
-                                            options.backends.end() ? Backend::kCompute : options.backends.front();
+    const Backend montage_backend = report::figureBackend(options.backends);
     if (wants_montage) run.montage = MontageCapture{&c, montage_backend, p.reference, {}};
     for (Backend backend : options.backends) {
       for (size_t m = 0; m < kModeCount; ++m) {
@@ -238,8 +230,8 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
                              " " + c.name + ", " + report::backendText(backend) + " " + std::string(modeName(row.mode)) + ": ";
           if (!row.skipped.empty()) line += "skipped (" + row.skipped + ")";
           else {
-            line += row.gpu_ms_median ? shortNumber(*row.gpu_ms_median) + " ms" : shortNumber(row.frame_ms_median) + " ms (host)";
-            line += row.error_max_px ? ", max error " + shortNumber(*row.error_max_px) + " px" : ", every point lost";
+            line += row.gpu_ms_median ? g3(*row.gpu_ms_median) + " ms" : g3(row.frame_ms_median) + " ms (host)";
+            line += row.error_max_px ? ", max error " + g3(*row.error_max_px) + " px" : ", every point lost";
           }
           options.log(line);
         }

@@ -1,6 +1,7 @@
 #include "bench/suites.h"
 
 #include <cstdio>
+#include <strings.h>
 
 #include "core/text.h"
 
@@ -174,6 +175,11 @@ std::vector<BenchCase> suiteCases(BenchSuite suite) {
     case BenchSuite::kHard: return hardCases(BenchSuite::kHard, false);
   }
   return {};
+}
+
+bool hasSizeLabel(const BenchCase& bench_case, std::string_view label) {
+  return !bench_case.size_label.empty() && label.size() == bench_case.size_label.size() &&
+         strncasecmp(label.data(), bench_case.size_label.data(), label.size()) == 0;
 }
 
 std::string cacheFileName(const BenchCase& bench_case) {

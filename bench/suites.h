@@ -65,6 +65,9 @@ struct BenchCase {
 // The cases of a suite, in the order they run.
 std::vector<BenchCase> suiteCases(BenchSuite suite);
 
+// Whether `label` (from --sizes) names the case's size: case-insensitive, "16.7m" is "16.7M".
+bool hasSizeLabel(const BenchCase& bench_case, std::string_view label);
+
 // The file the case's dataset is cached in, inside the cache folder: a name made of the generate
 // arguments (so a change of arguments never reuses a stale file), ".ply" (binary: fast to read).
 std::string cacheFileName(const BenchCase& bench_case);

@@ -3,6 +3,7 @@
 // as report.md, results.json, speed_vs_error.svg, breakdown.svg and montage.png.
 // dpoint bench io FILE: times reading (and optionally writing) a file inside one process, for
 // the I/O benchmark in bench/ (which also times the whole process from outside).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cerrno>
@@ -12,7 +13,6 @@
 #include <ctime>
 #include <memory>
 #include <spawn.h>
-#include <strings.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -137,13 +137,12 @@ int runBenchReport(const BenchReportOptions& o) {
   if (!o.sizes.empty()) {
     if (o.suite != "paper" && o.suite != "all")
       return reportError(Error{"--sizes picks datasets of the paper suite; --suite is " + o.suite, ExitCode::kUsage});
+    const std::vector<BenchCase> paper = suiteCases(BenchSuite::kPaper);
     std::string known;
-    for (const BenchCase& c : suiteCases(BenchSuite::kPaper))
+    for (const BenchCase& c : paper)
       if (known.find(" " + c.size_label + ",") == std::string::npos) known += " " + c.size_label + ",";
     for (const std::string& size : o.sizes) {
-      bool found = false;
-      for (const BenchCase& c : suiteCases(BenchSuite::kPaper)) found = found || strcasecmp(c.size_label.c_str(), size.c_str()) == 0;
-      if (!found)
+      if (std::none_of(paper.begin(), paper.end(), [&](const BenchCase& c) { return hasSizeLabel(c, size); }))
         return reportError(Error{"--sizes: the paper suite has no dataset of size '" + size + "' (it has" +
                                      known.substr(0, known.size() - 1) + ")", ExitCode::kUsage});
     }
@@ -164,16 +163,17 @@ int runBenchReport(const BenchReportOptions& o) {
   if (!context) return reportError(context.error());
   Result<BenchRun> run = runBench(**context, options);
   if (!run) return reportError(run.error());
-  Result<std::vector<std::string>> written = writeReport(*run, ReportContext{commandLine(o), utcNow(), DPOINT_VERSION}, o.out);
+  const std::vector<CheckFailure> failures = checkRun(*run);
+  Result<std::vector<std::string>> written =
+      writeReport(*run, ReportContext{commandLine(o), utcNow(), DPOINT_VERSION}, failures, o.out);
   if (!written) return reportError(written.error());
 
   size_t skipped = 0;
   for (const BenchRow& row : run->rows) skipped += !row.skipped.empty();
-  const size_t failures = checkRun(*run).size();
   std::printf("bench: %zu runs (%zu cases, %zu did not run) on %s in %.0f s\n", run->rows.size(), run->cases.size(), skipped,
               run->device.name.c_str(), run->seconds);
   for (const std::string& path : *written) std::printf("wrote %s\n", path.c_str());
-  if (failures) std::fprintf(stderr, "dpoint: warning: %zu check(s) failed; see report.md\n", failures);
+  if (!failures.empty()) std::fprintf(stderr, "dpoint: warning: %zu check(s) failed; see report.md\n", failures.size());
   const std::vector<std::string>& messages = (*context)->validationMessages();
   if (!messages.empty()) {
     for (const std::string& m : messages) std::fprintf(stderr, "dpoint: %s\n", m.c_str());

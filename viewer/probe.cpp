@@ -4,12 +4,17 @@
 
 namespace dpoint {
 
+std::vector<WindowPoint> probeWindows(const RenderResult& render, const Camera& camera) {
+  std::vector<WindowPoint> probe(render.probe_clip.size());
+  for (size_t i = 0; i < probe.size(); ++i) probe[i] = windowFromClip(render.probe_clip[i], camera);
+  return probe;
+}
+
 ErrorReport measureError(const PointSet& points, const Camera& camera, const RenderResult& render,
                          const RenderOptions& options) {
   assert(render.probe_clip.size() == points.size());
   std::vector<WindowPoint> reference = projectReference(points.positions, camera);
-  std::vector<WindowPoint> probe(points.size());
-  for (size_t i = 0; i < points.size(); ++i) probe[i] = windowFromClip(render.probe_clip[i], camera);
+  std::vector<WindowPoint> probe = probeWindows(render, camera);
   ErrorReport report;
   report.stats = compareToReference(reference, probe);
   if (options.point_size == 1.0f) {

@@ -17,6 +17,10 @@ struct ErrorReport {
   Image reference;              // the reference raster
 };
 
+// Each point's window position from the clip position the probe stored, in input order (`render`
+// from renderPoints with options.probe set).
+std::vector<WindowPoint> probeWindows(const RenderResult& render, const Camera& camera);
+
 // `render` must come from renderPoints with options.probe set, and `options` be those it used.
 ErrorReport measureError(const PointSet& points, const Camera& camera, const RenderResult& render,
                          const RenderOptions& options);
