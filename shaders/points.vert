@@ -12,8 +12,10 @@ layout(location = 0) out vec4 v_color;
 
 layout(std430, set = 0, binding = 3) writeonly buffer Probe { vec4 probe_clip[]; };
 
-#if defined(MODE_FP32) || defined(MODE_BATCH)
+#if defined(MODE_FP32)
 layout(location = 0) in vec3 a_position;
+#elif defined(MODE_BATCH)
+layout(location = 0) in uvec2 a_packed;  // R32G32_UINT: the 3×21-bit offset
 #elif defined(MODE_SPLIT) || defined(MODE_RTE) || defined(MODE_DF64)
 layout(location = 0) in vec3 a_hi;
 layout(location = 1) in vec3 a_lo;
@@ -31,6 +33,8 @@ void main() {
 #elif defined(MODE_NATIVE_PULL)
   uint base = 3u * uint(gl_VertexIndex);
   point.position = dvec3(positions[base], positions[base + 1u], positions[base + 2u]);
+#elif defined(MODE_BATCH)
+  point.position = unpackOffset(a_packed);
 #else
   point.position = a_position;
 #endif

@@ -3,19 +3,24 @@
 // raster path (project.glsl), finds its pixel as the rasterizer would (top-left rule for a size-1
 // point) and keeps the nearest point per pixel with a 64-bit atomicMax of
 // (depth bits << 32 | ~index): reversed Z, so the greater depth wins, and on a tie the lower
-// index, as the raster depth test GREATER keeps the point drawn first.
+// index, as the raster depth test GREATER keeps the point drawn first. Only positions are read here
+// (colours are fetched per pixel by the resolve), and a point whose key cannot beat the pixel's
+// current one skips the atomic (kEarlyDepth): keys only grow, so a stale read never drops a winner.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_atomic_int64 : require
 #extension GL_ARB_gpu_shader_int64 : require
 #include "project.glsl"
 
 layout(constant_id = 0) const bool kProbe = false;
+layout(constant_id = 1) const bool kEarlyDepth = true;
 layout(local_size_x = 256) in;
 
 layout(std430, set = 0, binding = 3) writeonly buffer Probe { vec4 probe_clip[]; };
 layout(std430, set = 0, binding = 4) buffer Visibility { uint64_t visibility[]; };
 #if defined(MODE_NATIVE_PULL)
 layout(std430, set = 0, binding = 1) readonly buffer Positions { double positions[]; };
+#elif defined(MODE_BATCH)
+layout(std430, set = 0, binding = 1) readonly buffer Positions { uvec2 positions[]; };  // one 64-bit load
 #else
 layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
 #endif
@@ -31,6 +36,8 @@ void main() {
 #elif defined(MODE_NATIVE_PULL)
   uint base = 3u * i;
   point.position = dvec3(positions[base], positions[base + 1u], positions[base + 2u]);
+#elif defined(MODE_BATCH)
+  point.position = unpackOffset(positions[i]);
 #else
   uint base = 3u * i;
   point.position = vec3(positions[base], positions[base + 1u], positions[base + 2u]);
@@ -46,5 +53,7 @@ void main() {
   int px = int(ceil(x)) - 1, py = int(ceil(y)) - 1;
   if (px < 0 || py < 0 || px >= int(pc.width) || py >= int(pc.height)) return;
   uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
-  atomicMax(visibility[uint(py) * pc.width + uint(px)], key);
+  uint pixel = uint(py) * pc.width + uint(px);
+  if (kEarlyDepth && visibility[pixel] >= key) return;
+  atomicMax(visibility[pixel], key);
 }

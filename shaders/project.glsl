@@ -24,6 +24,14 @@ layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 mvp_hi; mat4 mvp
 layout(std140, set = 0, binding = 0) uniform CameraBlock { dmat4 projection_rotation; dvec4 eye; } cam;
 #elif defined(MODE_BATCH)
 layout(std430, set = 0, binding = 2) readonly buffer Batches { mat4 batch_mvp[]; };
+// A point's offset in its batch (viewer/encode.h): three 21-bit two's-complement integers in one
+// 64-bit word, x in bits 0–20, y in 21–41, z in 42–62; each is exact as a float.
+vec3 unpackOffset(uvec2 word) {
+  int x = bitfieldExtract(int(word.x), 0, 21);
+  int y = bitfieldExtract(int((word.x >> 21) | (word.y << 11)), 0, 21);
+  int z = bitfieldExtract(int(word.y), 10, 21);
+  return vec3(x, y, z);
+}
 #else
 #error "no MODE_* defined"
 #endif
@@ -69,7 +77,7 @@ vec4 projectPoint(PointInput point, uint index) {
   dvec3 relative = point.position - cam.eye.xyz;
   return vec4(cam.projection_rotation * dvec4(relative, 1.0));
 #elif defined(MODE_BATCH)
-  // Offsets are normalized to the batch's box ([−1, 1]); the matrix carries origin and extent.
+  // Offsets are integers in the batch's box; the matrix carries origin, extent and 2^−20.
   return batch_mvp[index / pc.batch_size] * vec4(point.position, 1.0);
 #endif
 }

@@ -10,7 +10,8 @@ namespace dpoint {
 namespace {
 
 TEST(Encode, modeNamesRoundTripAndBytesPerPointMatchDesign) {
-  const uint32_t expected[] = {16, 28, 28, 28, 28, 16};  // DESIGN §4 plus 4 bytes of RGBA8
+  // DESIGN §4 plus 4 bytes of RGBA8, but batch: 3×21-bit integer offsets in 8 bytes (issue #11).
+  const uint32_t expected[] = {16, 28, 28, 28, 28, 12};
   int i = 0;
   for (PrecisionMode mode : kAllModes) {
     EXPECT_EQ(parseMode(modeName(mode)), mode);
@@ -122,16 +123,46 @@ TEST(Encode, batchOffsetsAreNormalizedToTheirBatchBox) {
   EXPECT_EQ(e.batches[1].origin.z, 5.0);
   EXPECT_EQ(e.batches[0].extent, 4.0) << "half of 4.095 m, up to a power of two";
   EXPECT_EQ(e.batches[1].extent, 0.0078125) << "half of 9 mm, up to a power of two";
-  std::vector<float> out(3 * s.size());
+  std::vector<uint64_t> out(s.size());
   encodePositions(e, s, 0, s.size(), out.data());
   for (size_t i = 0; i < s.size(); ++i) {
     const BatchFrame& batch = e.batches[i / kBatchSize];
-    EXPECT_EQ(out[3 * i], static_cast<float>((s.positions[i].x - batch.origin.x) / batch.extent));
-    EXPECT_LE(std::fabs(out[3 * i]), 1.0f);
+    const glm::ivec3 q = unpackBatchOffset(out[i]);
+    const double t = (s.positions[i].x - batch.origin.x) / batch.extent;
+    EXPECT_LE(std::fabs(q.x - t * kBatchSteps), 0.5) << i << ": within half a step";
+    EXPECT_EQ(q.y, 0);
+    EXPECT_EQ(q.z, 0);
   }
+  EXPECT_EQ(unpackBatchOffset(out[kBatchSize]).z, 0) << "the second batch's z is its origin";
   ASSERT_EQ(e.batch_matrices.size(), 2u);
   const glm::dmat4& m = e.batch_matrices[1];
-  EXPECT_EQ(m[0][0], camera.projection[0][0] * e.batches[1].extent) << "the extent is folded into the matrix";
+  EXPECT_EQ(m[0][0], camera.projection[0][0] * e.batches[1].extent / kBatchSteps)
+      << "the extent and the step are folded into the matrix";
+}
+
+// The 21-bit fields hold every step from −2^20 to 2^20 − 1 and round half to even; t = 1 (the box's
+// edge, where the extent is exactly the largest offset) clamps one step short.
+TEST(Encode, batchOffsetsPackThreeSignedTwentyOneBitIntegers) {
+  const double step = 1.0 / kBatchSteps;
+  struct Case {
+    glm::dvec3 t;
+    glm::ivec3 q;
+  } cases[] = {
+      {{0.0, 0.0, 0.0}, {0, 0, 0}},
+      {{-1.0, 1.0, -0.0}, {-(1 << 20), (1 << 20) - 1, 0}},
+      {{step, -step, 0.5}, {1, -1, 1 << 19}},
+      {{2.5 * step, -2.5 * step, 3.5 * step}, {2, -2, 4}},
+      {{1.0 - step, -1.0 + step, 0.49 * step}, {(1 << 20) - 1, -(1 << 20) + 1, 0}},
+  };
+  for (const Case& c : cases) {
+    const uint64_t word = packBatchOffset(c.t);
+    EXPECT_EQ(unpackBatchOffset(word), c.q) << c.t.x << " " << c.t.y << " " << c.t.z;
+    EXPECT_EQ(word >> 63, 0u) << "bit 63 stays clear";
+  }
+  // Fields do not bleed into each other: the all-ones field next to zeros.
+  EXPECT_EQ(packBatchOffset({-step, 0.0, 0.0}), (uint64_t{1} << 21) - 1);
+  EXPECT_EQ(packBatchOffset({0.0, -step, 0.0}), ((uint64_t{1} << 21) - 1) << 21);
+  EXPECT_EQ(packBatchOffset({0.0, 0.0, -step}), ((uint64_t{1} << 21) - 1) << 42);
 }
 
 TEST(Encode, prepareEncodingNamesThePointAndCoordinateBeyondFloat) {

@@ -3,11 +3,17 @@
 #include <algorithm>
 
 #include "core/memory.h"
+#include "core/parallel.h"
 
 namespace dpoint {
 
-Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
-                            bool host_visible, const std::string& what) {
+namespace {
+
+// A buffer of `size` bytes bound to memory of the type `pick` chooses from the buffer's allowed
+// types (mapped for the buffer's life when host-visible).
+Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                              const std::string& what,
+                              const std::function<Result<uint32_t>(const VkMemoryRequirements&)>& pick) {
   assert(size > 0);
   Buffer out;
   out.size = size;
@@ -19,9 +25,7 @@ Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkB
   if (result != VK_SUCCESS) return vulkanError("vkCreateBuffer (" + what + ", " + formatBytes(size) + ")", result);
   VkMemoryRequirements needs{};
   vkGetBufferMemoryRequirements(context.device, out.buffer, &needs);
-  Result<uint32_t> type = host_visible
-      ? context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-      : context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  Result<uint32_t> type = pick(needs);
   if (!type) {
     vkDestroyBuffer(context.device, out.buffer, nullptr);
     return type.error();
@@ -41,6 +45,35 @@ Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkB
     return vulkanError("allocating " + formatBytes(size) + " for " + what, result);
   }
   return out;
+}
+
+}  // namespace
+
+Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                            bool host_visible, const std::string& what) {
+  return allocateBuffer(context, size, usage, what, [&](const VkMemoryRequirements& needs) {
+    return host_visible
+        ? context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+        : context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  });
+}
+
+Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                                  const std::string& what) {
+  // Device-local memory the host can write (resizable BAR, unified memory, lavapipe) saves the
+  // staging copy, but only where its heap holds the buffer with room to spare: the small 256 MiB
+  // BAR window of a discrete GPU without resizable BAR is left to the driver.
+  Result<Buffer> direct = allocateBuffer(context, size, usage, what, [&](const VkMemoryRequirements& needs) -> Result<uint32_t> {
+    constexpr VkMemoryPropertyFlags kWanted = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
+    for (uint32_t i = 0; i < context.memory.memoryTypeCount; ++i) {
+      const VkMemoryType& type = context.memory.memoryTypes[i];
+      if (!(needs.memoryTypeBits & (1u << i)) || (type.propertyFlags & kWanted) != kWanted) continue;
+      if (context.memory.memoryHeaps[type.heapIndex].size / 4 >= needs.size) return i;
+    }
+    return Error{"no large host-visible device-local heap", ExitCode::kNoDevice};
+  });
+  if (direct) return direct;
+  return createBuffer(context, size, usage, false, what);
 }
 
 void destroyBuffer(const VulkanContext& context, Buffer& buffer) {
@@ -96,29 +129,92 @@ Status submitOnce(const VulkanContext& context, const std::function<void(VkComma
   return okStatus();
 }
 
-Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size,
-                    const std::function<void(void* dst, VkDeviceSize offset, VkDeviceSize bytes)>& fill,
-                    VkDeviceSize staging_limit) {
-  assert(size <= target.size);
+namespace {
+
+// Calls fill on pieces of [offset, offset + bytes) from every core, each piece a multiple of
+// `grain` (the last one excepted) and about 1 MiB: the pieces are disjoint, so the bytes written
+// do not depend on the thread count.
+void fillInParallel(const UploadFill& fill, void* dst, VkDeviceSize offset, VkDeviceSize bytes, VkDeviceSize grain) {
+  const VkDeviceSize piece = std::max<VkDeviceSize>(grain, (VkDeviceSize{1} << 20) / grain * grain);
+  const size_t pieces = static_cast<size_t>((bytes + piece - 1) / piece);
+  parallelFor(pieces, pieces == 1 ? 1 : 0, [&](size_t k, unsigned) {
+    const VkDeviceSize at = k * piece;
+    fill(static_cast<uint8_t*>(dst) + at, offset + at, std::min(piece, bytes - at));
+  });
+}
+
+}  // namespace
+
+Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
+                    VkDeviceSize grain, VkDeviceSize staging_limit) {
+  assert(size <= target.size && grain > 0);
   if (target.mapped) {
-    fill(target.mapped, 0, size);
+    fillInParallel(fill, target.mapped, 0, size, grain);
     return flushBuffer(context, target);
   }
-  VkDeviceSize piece = std::min(size, staging_limit);
-  Result<Buffer> staging = createBuffer(context, piece, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "staging");
-  if (!staging) return staging.error();
-  Status status = okStatus();
-  for (VkDeviceSize offset = 0; offset < size && status; offset += piece) {
-    VkDeviceSize bytes = std::min(piece, size - offset);
-    fill(staging->mapped, offset, bytes);
-    status = flushBuffer(context, *staging);
-    if (!status) break;
-    status = submitOnce(context, [&](VkCommandBuffer commands) {
+  // Two staging buffers: the cores fill one while the GPU copies out of the other.
+  const VkDeviceSize piece = std::min(size, std::max(grain, staging_limit / grain * grain));
+  const size_t slots = size > piece ? 2 : 1;
+  struct Slot {
+    Buffer staging;
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    bool busy = false;
+  };
+  std::vector<Slot> slot(slots);
+  auto cleanup = [&]() {
+    for (Slot& s : slot) {
+      if (s.busy) vkWaitForFences(context.device, 1, &s.fence, VK_TRUE, UINT64_MAX);
+      if (s.fence) vkDestroyFence(context.device, s.fence, nullptr);
+      if (s.commands) vkFreeCommandBuffers(context.device, context.command_pool, 1, &s.commands);
+      destroyBuffer(context, s.staging);
+    }
+  };
+  auto run = [&]() -> Status {
+    for (Slot& s : slot) {
+      Result<Buffer> staging = createBuffer(context, piece, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "staging");
+      if (!staging) return staging.error();
+      s.staging = *staging;
+      VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+      allocate.commandPool = context.command_pool;
+      allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+      allocate.commandBufferCount = 1;
+      VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &s.commands));
+      VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+      VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &s.fence));
+    }
+    size_t k = 0;
+    for (VkDeviceSize offset = 0; offset < size; offset += piece, ++k) {
+      Slot& s = slot[k % slots];
+      if (s.busy) {
+        VK_TRY(vkWaitForFences(context.device, 1, &s.fence, VK_TRUE, UINT64_MAX));
+        VK_TRY(vkResetFences(context.device, 1, &s.fence));
+        s.busy = false;
+      }
+      const VkDeviceSize bytes = std::min(piece, size - offset);
+      fillInParallel(fill, s.staging.mapped, offset, bytes, grain);
+      if (Status status = flushBuffer(context, s.staging); !status) return status;
+      VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+      begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+      VK_TRY(vkBeginCommandBuffer(s.commands, &begin));
       VkBufferCopy copy{0, offset, bytes};
-      vkCmdCopyBuffer(commands, staging->buffer, target.buffer, 1, &copy);
-    });
-  }
-  destroyBuffer(context, *staging);
+      vkCmdCopyBuffer(s.commands, s.staging.buffer, target.buffer, 1, &copy);
+      VK_TRY(vkEndCommandBuffer(s.commands));
+      VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+      submit.commandBufferCount = 1;
+      submit.pCommandBuffers = &s.commands;
+      VK_TRY(vkQueueSubmit(context.queue, 1, &submit, s.fence));
+      s.busy = true;
+    }
+    for (Slot& s : slot) {
+      if (!s.busy) continue;
+      VK_TRY(vkWaitForFences(context.device, 1, &s.fence, VK_TRUE, UINT64_MAX));
+      s.busy = false;
+    }
+    return okStatus();
+  };
+  Status status = run();
+  cleanup();
   return status;
 }
 

@@ -28,13 +28,21 @@ Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
 // Records with `record` into a fresh primary command buffer, submits it, waits.
 Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record);
 
+// Device-local memory for data the host uploads once: host-visible too (mapped, written in place)
+// where the device has such a heap large enough, else plain device-local (filled via staging).
+Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                                  const std::string& what);
+
+// fill(dst, offset, bytes) writes bytes [offset, offset + bytes) of a buffer's contents to dst.
+// uploadBuffer calls it from several threads at once on disjoint pieces.
+using UploadFill = std::function<void(void* dst, VkDeviceSize offset, VkDeviceSize bytes)>;
+
 // Fills `size` bytes at the start of `target` (usage must include TRANSFER_DST) through `fill`,
-// writing into mapped memory directly when the target is host-visible, else through a staging
-// buffer of at most `staging_limit` bytes, in pieces; `fill(dst, offset, bytes)` writes
-// bytes [offset, offset + bytes) of the contents.
-Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size,
-                    const std::function<void(void* dst, VkDeviceSize offset, VkDeviceSize bytes)>& fill,
-                    VkDeviceSize staging_limit = 64u << 20);
+// on every core, in pieces that are multiples of `grain` bytes (a whole element): into mapped
+// memory directly when the target is host-visible, else through two staging buffers of at most
+// `staging_limit` bytes, one filled while the GPU copies out of the other.
+Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
+                    VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20);
 
 struct GpuImage {
   VkImage image = VK_NULL_HANDLE;

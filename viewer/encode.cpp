@@ -6,6 +6,9 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
+
+#include "core/parallel.h"
 
 namespace dpoint {
 namespace {
@@ -18,7 +21,7 @@ constexpr ModeInfo kModes[] = {
     {PrecisionMode::kRte, "rte", 24, true, true},
     {PrecisionMode::kDf64, "df64", 24, true, true},
     {PrecisionMode::kNative, "native", 24, true, false},
-    {PrecisionMode::kBatch, "batch", 12, true, false},
+    {PrecisionMode::kBatch, "batch", 8, true, false},
 };
 static_assert(std::size(kModes) == kModeCount);
 
@@ -53,7 +56,7 @@ double powerOfTwoAbove(double d) {
 std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame& frame) {
   const size_t batches = (points.size() + kBatchSize - 1) / kBatchSize;
   std::vector<BatchFrame> frames(batches);
-  for (size_t b = 0; b < batches; ++b) {
+  parallelFor(batches, 0, [&](size_t b, unsigned) {
     const size_t first = b * kBatchSize, last = std::min(points.size(), first + kBatchSize);
     const Box box = boundingBox(points.positions, first, last);
     // min/2 + max/2 cannot overflow where (min + max)/2 could; scaling by 2^exponent is exact.
@@ -66,17 +69,17 @@ std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame
       largest = std::max({largest, std::fabs(offset.x), std::fabs(offset.y), std::fabs(offset.z)});
     }
     frames[b] = {origin, powerOfTwoAbove(largest)};
-  }
+  });
   return frames;
 }
 
-// projection · rotation · translate(origin − eye) · extent, in the scene frame.
+// projection · rotation · translate(origin − eye) · extent · 2^−20, in the scene frame.
 glm::dmat4 batchMatrix(const SceneFrame& frame, const BatchFrame& b) {
   glm::dmat4 m = frame.projection_rotation;
   const glm::dvec3 relative = b.origin - frame.eye;  // both in the scene frame
   glm::dvec4 translation = m[3];
   for (int c = 0; c < 3; ++c) translation += m[c] * relative[c];
-  for (int c = 0; c < 3; ++c) m[c] *= b.extent;  // a power of two: exact
+  for (int c = 0; c < 3; ++c) m[c] *= b.extent / kBatchSteps;  // powers of two: exact
   m[3] = translation;
   return m;
 }
@@ -87,25 +90,41 @@ Error beyondFloat(PrecisionMode mode, size_t index, int axis, double value, cons
                ExitCode::kBadInput};
 }
 
-Status checkPositions(const ModeEncoding& e, const PointSet& points) {
+// The first problem of point i, if it has one.
+std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& points, size_t i) {
   const ModeInfo& info = modeInfo(e.mode);
   const bool floats = e.mode != PrecisionMode::kNative && e.mode != PrecisionMode::kBatch;
-  for (size_t i = 0; i < points.size(); ++i) {
-    for (int axis = 0; axis < 3; ++axis) {
-      const double value = points.positions[i][axis];
-      const double in_frame = scaleBy(value, e.frame);
-      if (floats && !fitsFloat(in_frame)) {
-        std::string how = info.scene_frame
-            ? " (" + shortest(in_frame) + " view sizes from the origin)" : std::string();
-        return beyondFloat(e.mode, i, axis, value, how);
-      }
-      if (!std::isfinite(in_frame)) {
-        return Error{"point " + std::to_string(i) + ": " + axisName(axis) + " = " + shortest(value) +
-                         " overflows double when scaled to the view (" + shortest(in_frame) + ")",
-                     ExitCode::kBadInput};
-      }
+  for (int axis = 0; axis < 3; ++axis) {
+    const double value = points.positions[i][axis];
+    const double in_frame = scaleBy(value, e.frame);
+    if (floats && !fitsFloat(in_frame)) {
+      std::string how = info.scene_frame
+          ? " (" + shortest(in_frame) + " view sizes from the origin)" : std::string();
+      return beyondFloat(e.mode, i, axis, value, how);
+    }
+    if (!std::isfinite(in_frame)) {
+      return Error{"point " + std::to_string(i) + ": " + axisName(axis) + " = " + shortest(value) +
+                       " overflows double when scaled to the view (" + shortest(in_frame) + ")",
+                   ExitCode::kBadInput};
     }
   }
+  return std::nullopt;
+}
+
+// Every position checked on every core; the error names the first bad point whatever the thread count.
+Status checkPositions(const ModeEncoding& e, const PointSet& points) {
+  constexpr size_t kBlock = 1 << 16;
+  const size_t blocks = (points.size() + kBlock - 1) / kBlock;
+  std::vector<size_t> first_bad(blocks, SIZE_MAX);
+  parallelFor(blocks, 0, [&](size_t b, unsigned) {
+    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i)
+      if (positionProblem(e, points, i)) {
+        first_bad[b] = i;
+        return;
+      }
+  });
+  for (size_t i : first_bad)
+    if (i != SIZE_MAX) return *positionProblem(e, points, i);
   return okStatus();
 }
 
@@ -133,10 +152,40 @@ uint32_t encodeColor(const glm::vec3& color) {
 }
 
 std::vector<uint32_t> encodeColors(const PointSet& points) {
-  if (!points.hasColors()) return std::vector<uint32_t>(points.size(), 0xffffffffu);
   std::vector<uint32_t> out(points.size());
-  for (size_t i = 0; i < points.size(); ++i) out[i] = encodeColor(points.colors[i]);
+  encodeColors(points, 0, points.size(), out.data());
   return out;
+}
+
+void encodeColors(const PointSet& points, size_t first, size_t count, uint32_t* out) {
+  assert(first + count <= points.size());
+  if (!points.hasColors()) {
+    std::fill(out, out + count, 0xffffffffu);
+    return;
+  }
+  for (size_t i = 0; i < count; ++i) out[i] = encodeColor(points.colors[first + i]);
+}
+
+uint64_t packBatchOffset(const glm::dvec3& t) {
+  constexpr double kLargest = kBatchSteps - 1.0;
+  constexpr uint64_t kMask = (uint64_t{1} << kBatchOffsetBits) - 1;
+  uint64_t word = 0;
+  for (int a = 0; a < 3; ++a) {
+    // t·2^20 is exact; nearbyint rounds it half to even; t = 1 is the one value clamped.
+    const double q = std::clamp(std::nearbyint(t[a] * kBatchSteps), -kBatchSteps, kLargest);
+    word |= (static_cast<uint64_t>(static_cast<int64_t>(q)) & kMask) << (kBatchOffsetBits * a);
+  }
+  return word;
+}
+
+glm::ivec3 unpackBatchOffset(uint64_t word) {
+  glm::ivec3 q;
+  for (int a = 0; a < 3; ++a) {
+    // Shift the field to the top, then arithmetic-shift back: the sign extends.
+    const auto field = static_cast<int64_t>(word << (64 - kBatchOffsetBits * (a + 1)));
+    q[a] = static_cast<int>(field >> (64 - kBatchOffsetBits));
+  }
+  return q;
 }
 
 FloatPair splitDouble(double d) {
@@ -223,14 +272,15 @@ void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first
           for (int a = 0; a < 3; ++a) d[3 * i + a] = scaleBy(p[i][a], frame);
       }
       break;
-    case PrecisionMode::kBatch:
+    case PrecisionMode::kBatch: {
+      auto* words = static_cast<uint64_t*>(out);
       for (size_t i = 0; i < count; ++i) {
         const BatchFrame& batch = e.batches[(first + i) / kBatchSize];
         // p·scale − origin rounds once in double; the division by a power of two is exact.
-        const glm::dvec3 offset = (scaleBy(p[i], frame) - batch.origin) / batch.extent;
-        for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(offset[a]);
+        words[i] = packBatchOffset((scaleBy(p[i], frame) - batch.origin) / batch.extent);
       }
       break;
+    }
   }
 }
 

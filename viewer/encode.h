@@ -9,9 +9,11 @@
 //   df64    hi, lo floats (24)          double-float MVP (two-sum, split two-prod), splitter at run time
 //   native  double xyz (24)             p − eye in double, then projection·rotation in double; the clip
 //                                       position is cast to float at the end
-//   batch   float offsets (12)          per batch of 4096 points: a double origin and power-of-two scale,
-//                                       offsets normalized to [−1, 1], a float matrix built in double
-// Every mode adds 4 bytes of RGBA8 colour.
+//   batch   integer offsets (8)         per batch of 4096 points: a double origin and power-of-two
+//                                       extent; each offset coordinate a 21-bit integer (2^−20 of the
+//                                       extent per step), three in one 64-bit word; a float matrix built
+//                                       in double maps them to clip space
+// Every mode adds 4 bytes of RGBA8 colour (the compute backend reads it only in the resolve).
 //
 // The scene frame (DESIGN §4): every mode but fp32 and split (the study's absolute baselines) sees
 // positions multiplied by 2^exponent, chosen so the view's size is in [1, 2). Scaling by a power
@@ -28,6 +30,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
 
 #include "core/point_set.h"
 #include "core/result.h"
@@ -66,6 +69,8 @@ inline constexpr uint32_t kBatchSize = 4096;
 // UNORM, so the byte goes to the PNG unchanged. Points without colour are white.
 uint32_t encodeColor(const glm::vec3& color);
 std::vector<uint32_t> encodeColors(const PointSet& points);
+// Colours of points [first, first + count) to `out`.
+void encodeColors(const PointSet& points, size_t first, size_t count, uint32_t* out);
 
 // The float hi part and the float remainder: hi = fl32(d), lo = fl32(d − hi). d − hi is exact in
 // double, so hi + lo carries 48 bits of d when d is in float's normal range.
@@ -93,8 +98,16 @@ inline glm::dvec3 scaleBy(const glm::dvec3& p, const SceneFrame& frame) {
   return {scaleBy(p.x, frame), scaleBy(p.y, frame), scaleBy(p.z, frame)};
 }
 
-// Batch mode: offsets = (p·scale − origin) / extent in the scene frame, each within [−1, 1];
-// extent is a power of two, so the division is exact.
+// Batch mode: t = (p·scale − origin) / extent in the scene frame, each within [−1, 1] (extent is a
+// power of two, so the division is exact), stored as q = round(t·2^20) clamped to
+// [−2^20, 2^20 − 1]: within one step (2^−20 of the extent) of t, half a step but at t = 1.
+inline constexpr int kBatchOffsetBits = 21;
+inline constexpr double kBatchSteps = 0x1p20;  // integer steps per extent
+// Packs q (x in bits 0–20, y in 21–41, z in 42–62, two's complement) as shaders/project.glsl
+// unpacks it; unpackBatchOffset is the inverse, for tests.
+uint64_t packBatchOffset(const glm::dvec3& t);
+glm::ivec3 unpackBatchOffset(uint64_t word);
+
 struct BatchFrame {
   glm::dvec3 origin{0.0};  // centre of the batch's box, in the scene frame
   double extent = 1.0;     // power of two ≥ every |p·scale − origin| of the batch (1 if all equal)
@@ -105,8 +118,8 @@ struct ModeEncoding {
   PrecisionMode mode = PrecisionMode::kNative;
   SceneFrame frame;
   std::vector<BatchFrame> batches;  // batch mode only
-  // Batch mode, one per batch, in double: projection · rotation · translate(origin − eye) · extent,
-  // all in the scene frame. The GPU gets them cast to float (batchMatrices); the error bound
+  // Batch mode, one per batch, in double: projection · rotation · translate(origin − eye) ·
+  // extent · 2^−20, all in the scene frame: it takes the integer offsets to clip space. The GPU gets them cast to float (batchMatrices); the error bound
   // uses them as they are.
   std::vector<glm::dmat4> batch_matrices;
 };

@@ -73,12 +73,14 @@ Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescript
   return layout;
 }
 
-Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe) {
+// Specialization constants of the splat (ignored by the resolve): 0 kProbe, 1 kEarlyDepth.
+Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
+                                   bool early_depth) {
   Result<VkShaderModule> module = createShaderModule(context, code.code, code.bytes);
   if (!module) return module.error();
-  VkBool32 probe_value = probe ? VK_TRUE : VK_FALSE;
-  VkSpecializationMapEntry entry{0, 0, sizeof(VkBool32)};
-  VkSpecializationInfo specialization{1, &entry, sizeof(probe_value), &probe_value};
+  const VkBool32 values[2] = {probe ? VK_TRUE : VK_FALSE, early_depth ? VK_TRUE : VK_FALSE};
+  const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(VkBool32)}, {1, sizeof(VkBool32), sizeof(VkBool32)}};
+  VkSpecializationInfo specialization{2, entries, sizeof(values), values};
   VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -172,8 +174,8 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
   if (!p.pulls_positions) bindings.push_back({0, positionBytes(mode), VK_VERTEX_INPUT_RATE_VERTEX});
   bindings.push_back({1, 4, VK_VERTEX_INPUT_RATE_VERTEX});
   switch (mode) {
-    case PrecisionMode::kFp32:
-    case PrecisionMode::kBatch: attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}); break;
+    case PrecisionMode::kFp32: attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}); break;
+    case PrecisionMode::kBatch: attributes.push_back({0, 0, VK_FORMAT_R32G32_UINT, 0}); break;
     case PrecisionMode::kSplit:
     case PrecisionMode::kRte:
     case PrecisionMode::kDf64:
@@ -294,7 +296,8 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
   return p;
 }
 
-Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe) {
+Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
+                                                bool early_depth) {
   ComputePipelines p;
   auto fail = [&](const Error& error) -> Result<ComputePipelines> {
     destroyComputePipelines(context, p);
@@ -317,15 +320,15 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
   Result<VkPipelineLayout> resolve_layout = pipelineLayout(context, p.resolve_set, sizeof(ResolvePush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!resolve_layout) return fail(resolve_layout.error());
   p.resolve_layout = *resolve_layout;
-  Result<VkPipeline> splat = computePipeline(context, splatShader(mode), p.splat_layout, false);
+  Result<VkPipeline> splat = computePipeline(context, splatShader(mode), p.splat_layout, false, early_depth);
   if (!splat) return fail(splat.error());
   p.splat = *splat;
   if (with_probe) {
-    Result<VkPipeline> probe = computePipeline(context, splatShader(mode), p.splat_layout, true);
+    Result<VkPipeline> probe = computePipeline(context, splatShader(mode), p.splat_layout, true, early_depth);
     if (!probe) return fail(probe.error());
     p.probe = *probe;
   }
-  Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout, false);
+  Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout, false, false);
   if (!resolve) return fail(resolve.error());
   p.resolve = *resolve;
   return p;

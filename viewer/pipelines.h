@@ -53,7 +53,9 @@ struct ResolvePush {
   uint32_t pixels = 0;
   uint32_t background = 0;
 };
-Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe);
+// `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
+Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
+                                                bool early_depth = true);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
 // Creates a shader module from SPIR-V words.

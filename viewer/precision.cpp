@@ -163,15 +163,16 @@ Vec4 nativeError(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
   return out;
 }
 
-// batch: the offset (p' − origin) / extent rounds once in double and once to float; the batch
-// matrix, built in double (its translation's rounding is precomputed per batch), is applied in float.
+// batch: the offset (p' − origin) / extent rounds once in double, then to an integer step (half a
+// step, one at the clamped edge t = 1), which a float holds exactly; the batch matrix, built in
+// double (its translation's rounding is precomputed per batch), is applied in float.
 Vec4 batchError(const Setup& s, const glm::dvec3& ps, size_t index) {
   const size_t b = index / kBatchSize;
   const BatchFrame& frame = s.batch.batches[b];
-  const glm::dvec3 offset = (ps - frame.origin) / frame.extent;
+  const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kBatchSteps;
   glm::dvec3 dv;
-  for (int a = 0; a < 3; ++a) dv[a] = storedFloatError(offset[a]) + 2.0 * kUd * std::fabs(offset[a]);
-  Vec4 out = floatAffine(s.batch.batch_matrices[b], offset, dv);
+  for (int a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * std::fabs(steps[a]);
+  Vec4 out = floatAffine(s.batch.batch_matrices[b], steps, dv);
   for (size_t r = 0; r < 4; ++r) out[r] += s.batch_translation_error[b][r];
   return out;
 }

@@ -120,20 +120,19 @@ void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeli
 
 Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& points, const RenderOptions& options,
                     const ModeEncoding& encoding, bool pulled, size_t per_chunk) {
-  std::vector<uint32_t> colors = encodeColors(points);
   const uint32_t stride = positionBytes(options.mode);
   const bool compute = options.backend == Backend::kCompute;
   VkBufferUsageFlags position_usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
       (pulled || compute ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  // RGBA8 colours [first, first + count) in a buffer of their own: one per chunk for the raster
-  // backend's vertex input, one for the whole set for the compute resolve.
+  // RGBA8 colours [first, first + count), encoded straight into the upload: in a buffer per chunk
+  // for the raster backend's vertex input, one for the whole set for the compute resolve.
   auto upload_colors = [&](Buffer& out, size_t first, size_t count, VkBufferUsageFlags usage, const std::string& what) {
-    Result<Buffer> buffer = createBuffer(context, count * 4, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, what);
+    Result<Buffer> buffer = createUploadTarget(context, count * 4, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
     if (!buffer) return Status(buffer.error());
     out = *buffer;
     return uploadBuffer(context, out, count * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-      std::memcpy(dst, colors.data() + first + offset / 4, bytes);
-    });
+      encodeColors(points, first + offset / 4, bytes / 4, static_cast<uint32_t*>(dst));
+    }, 4);
   };
   if (compute) {
     if (Status status = upload_colors(r.all_colors, 0, points.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "colours"); !status)
@@ -144,15 +143,13 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
     chunk.first = first;
     chunk.count = std::min(per_chunk, points.size() - first);
     std::string what = "points " + std::to_string(first) + ".." + std::to_string(first + chunk.count - 1);
-    Result<Buffer> positions = createBuffer(context, chunk.count * stride, position_usage, false, what + " positions");
+    Result<Buffer> positions = createUploadTarget(context, chunk.count * stride, position_usage, what + " positions");
     if (!positions) return positions.error();
     chunk.positions = *positions;
-    // Staging pieces hold whole points.
-    VkDeviceSize piece = (VkDeviceSize{64} << 20) / stride * stride;
     Status status = uploadBuffer(context, chunk.positions, chunk.count * stride,
         [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
           encodePositions(encoding, points, chunk.first + offset / stride, bytes / stride, dst);
-        }, piece);
+        }, stride);
     if (!status) return status;
     if (!compute) {
       status = upload_colors(chunk.colors, chunk.first, chunk.count, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, what + " colours");
@@ -374,7 +371,7 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
                  (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
   Resources r(context);
   if (compute) {
-    Result<ComputePipelines> pipelines = createComputePipelines(context, options.mode, options.probe);
+    Result<ComputePipelines> pipelines = createComputePipelines(context, options.mode, options.probe, options.early_depth);
     if (!pipelines) return pipelines.error();
     r.compute = *pipelines;
   } else {

@@ -35,6 +35,9 @@ struct RenderOptions {
   uint32_t frames = 1;  // timed frames after warm-up (≥ 1)
   bool probe = false;   // also store clip positions (DESIGN §5)
   NativePath native_path = NativePath::kAuto;  // auto: R64G64B64 vertex input where listed, else pull
+  // Compute backend: skip the atomic when the pixel's key already wins (same picture; tests turn
+  // it off to compare with the plain path).
+  bool early_depth = true;
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
   uint64_t max_chunk_points = 0;
