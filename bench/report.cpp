@@ -76,6 +76,16 @@ std::string sweepName(Sweep sweep) {
   return sweep == Sweep::kDeepZoom ? "deep zoom (view width)" : sweep == Sweep::kOffset ? "offset" : "";
 }
 
+// The bound divides by read_write_gb_per_s; bound_uses says so for a reader of the file alone.
+std::string copyBandwidthJson(const std::optional<CopyBandwidth>& copy) {
+  if (!copy) return "null";
+  return "{\"read_write_gb_per_s\": " + num(copy->read_write_gb_per_s) + ", \"copy_gb_per_s\": " +
+         num(copy->copy_gb_per_s) + ", \"copy_bytes\": " + std::to_string(copy->bytes) + ", \"copies\": " +
+         std::to_string(copy->copies) + ", \"copy_ms_median\": " + num(copy->copy_ms_median) + ", \"timer\": " +
+         jsonString(copy->gpu_timestamps ? "gpu timestamps" : "host wall time") +
+         ", \"bound_uses\": \"read_write_gb_per_s\"}";
+}
+
 std::string rowJson(const BenchRun& run, const BenchRow& r) {
   const BenchCase& c = *r.bench_case;
   const DeviceFacts& d = run.device;
@@ -94,6 +104,10 @@ std::string rowJson(const BenchRun& run, const BenchRow& r) {
   s += ", \"frame_ms_median\": " + num(r.frame_ms_median) + ", \"e2e_ms\": " + num(r.e2e_ms) +
        ", \"upload_ms\": " + num(r.upload_ms) + ", \"readback_ms\": " + num(r.readback_ms) +
        ",\n     \"points_per_s\": " + num(r.points_per_s) + ", \"bytes_per_point\": " + std::to_string(r.bytes_per_point) +
+       ", \"splat_bytes_per_point\": " + std::to_string(r.splat_bytes_per_point) +
+       ", \"bytes_per_frame\": " + (r.bytes_per_frame ? std::to_string(*r.bytes_per_frame) : std::string("null")) +
+       ",\n     \"bandwidth_bound_ms\": " + optNum(r.bandwidth_bound_ms) +
+       ", \"bandwidth_fraction\": " + optNum(r.bandwidth_fraction) +
        ", \"predicted_bound_px\": " + num(r.predicted_bound_px) + ", \"float_floor_px\": " + num(r.float_floor_px);
   s += ",\n     \"error_px\": " + (r.error_max_px ? "{\"max\": " + num(*r.error_max_px) + ", \"p99\": " + optNum(r.error_p99_px) +
                                                      ", \"rms\": " + optNum(r.error_rms_px) + "}"
@@ -134,6 +148,7 @@ std::string resultsJson(const BenchRun& run, const ReportContext& context, const
        ", \"driver\": " + jsonString(d.driver_name + " " + d.driver_info) +
        ", \"driver_version\": " + jsonString(formatDriverVersion(d.vendor_id, d.driver_version)) +
        ", \"api_version\": " + jsonString(formatApiVersion(d.api_version)) + "},\n";
+  s += "  \"copy_bandwidth\": " + copyBandwidthJson(run.copy_bandwidth) + ",\n";
   s += "  \"seconds\": " + num(run.seconds) + ",\n  \"rows\": [\n";
   for (size_t i = 0; i < run.rows.size(); ++i) s += rowJson(run, run.rows[i]) + (i + 1 < run.rows.size() ? ",\n" : "\n");
   s += "  ],\n  \"check_failures\": [";

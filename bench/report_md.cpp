@@ -35,11 +35,15 @@ std::string fpsText(double fps) {
 
 std::string msText(double ms) { return ms >= 100 ? withCommas(static_cast<uint64_t>(std::llround(ms))) : g3(ms); }
 
+std::string percentText(const std::optional<double>& fraction) { return fraction ? g3(100.0 * *fraction) + "%" : "–"; }
+
 std::string fpsCell(const BenchRow* row) {
   if (!row) return "–";
   if (!row->skipped.empty()) return "did not run";
   const double ms = frameMs(*row);
-  return fpsText(1000.0 / ms) + " fps (" + msText(ms) + " ms" + (row->gpu_ms_median ? ")" : ", host)");
+  std::string cell = fpsText(1000.0 / ms) + " fps (" + msText(ms) + " ms" + (row->gpu_ms_median ? "" : ", host");
+  if (row->bandwidth_fraction) cell += ", " + percentText(row->bandwidth_fraction) + " of bound";
+  return cell + ")";
 }
 
 std::string errorCell(const BenchRow* row) {
@@ -70,7 +74,8 @@ std::string modeHeader(bool with_bytes) {
   for (PrecisionMode mode : kAllModes) {
     h += ' ';
     h += modeText(mode);
-    if (with_bytes) h += " (" + std::to_string(bytesPerPoint(mode)) + " B/pt)";
+    if (with_bytes)
+      h += " (" + std::to_string(positionBytes(mode)) + " B/pt splat, " + std::to_string(bytesPerPoint(mode)) + " total)";
     h += " |";
   }
   return h;
@@ -165,6 +170,9 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   std::string s = "# dpoint bench: speed against error\n\n";
   s += "- Device: **" + d.name + "** (" + d.type + "), driver " + d.driver_name + " " + d.driver_info + " (" +
        formatDriverVersion(d.vendor_id, d.driver_version) + "), Vulkan " + formatApiVersion(d.api_version) + "\n";
+  s += run.copy_bandwidth ? "- Copy bandwidth: **" + copyBandwidthText(*run.copy_bandwidth) +
+                                "**; *% of bound* divides by the read+write rate\n"
+                          : std::string("- Copy bandwidth: not measured (--no-copy-bandwidth): no bandwidth bound\n");
   s += "- Command: `" + context.command + "` (dpoint " + context.version + ", " + context.date + "; whole run " +
        withCommas(static_cast<uint64_t>(std::llround(run.seconds))) + " s)\n";
   s += "- Speed: GPU timestamps around the draw (raster) or the splat and resolve passes (compute), median of the timed "
@@ -184,7 +192,11 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   if (!speed.empty()) {
     s += "\n## Speed\n\nFrames per second from the median GPU time. The study's figures were measured on an NVIDIA RTX "
          "3090 with 48 B/pt (dvec3 position + dvec3 colour), at its own resolution; we have its figures for two "
-         "datasets only.\n";
+         "datasets only. Headers give the bytes per point the splat pass (raster: the vertex fetch) reads for "
+         "positions, and in total with the colour. *% of bound* (compute backend): the time the frame's bytes take at "
+         "the copy bandwidth, against the GPU time; the bytes are points × splat B/pt + pixels × 20 B (clear, read "
+         "and resolve the 8 B keys, write the picture) + 4 B of colour per covered pixel, every point taken to cover a "
+         "pixel of its own (bench/bandwidth.h).\n";
     for (Backend backend : backendsOf(run)) {
       s += "\n### " + backendText(backend) + " backend\n\n| dataset | points | resolution | study, RTX 3090 (48 B/pt) |" +
            modeHeader(true) + "\n| --- | --- | --- | --- |" + modeRule() + "\n";
@@ -231,17 +243,18 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
     for (const CheckFailure& f : failures) s += "| " + f.case_name + " | " + f.backend + " | " + f.mode + " | " + f.what + " |\n";
   }
   s += "\n## Every run\n\n| suite | case | backend | mode | points | GPU ms (median / p95) | e2e ms | points/s | B/pt | "
-       "bound px | max px | p99 px | rms px | off ≥ 0.5 px | lost | pixels differing |\n"
-       "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+       "B/pt (splat) | % of bound | bound px | max px | p99 px | rms px | off ≥ 0.5 px | lost | pixels differing |\n"
+       "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const BenchRow& r : run.rows) {
     s += "| " + std::string(suiteName(r.bench_case->suite)) + " | " + r.bench_case->name + " | " + backendText(r.backend) +
          " | " + modeText(r.mode) + " | " + withCommas(r.points) + " | ";
     if (!r.skipped.empty()) {
-      s += "did not run: " + r.skipped + " | | | | | | | | | | |\n";
+      s += "did not run: " + r.skipped + " | | | | | | | | | | | | |\n";
       continue;
     }
     s += (r.gpu_ms_median ? g3(*r.gpu_ms_median) + " / " + g3(r.gpu_ms_p95.value_or(0)) : "–") + " | " + g3(r.e2e_ms) +
          " | " + g3(r.points_per_s) + " | " + std::to_string(r.bytes_per_point) + " | " +
+         std::to_string(r.splat_bytes_per_point) + " | " + percentText(r.bandwidth_fraction) + " | " +
          (std::isfinite(r.predicted_bound_px) ? g3(r.predicted_bound_px) : "unbounded") + " | " +
          (r.error_max_px ? g3(*r.error_max_px) + " | " + g3(r.error_p99_px.value_or(0)) + " | " + g3(r.error_rms_px.value_or(0))
                          : "all lost | – | –") +

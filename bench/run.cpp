@@ -1,6 +1,7 @@
 #include "bench/run.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -174,6 +175,20 @@ std::string montageCaption(const BenchRow& row) {
 
 }  // namespace
 
+void setBandwidthBound(BenchRow& row, const CopyBandwidth* copy) {
+  assert(row.bench_case);
+  const FrameTraffic traffic =
+      frameTraffic(row.backend, row.mode, row.points, row.bench_case->width, row.bench_case->height);
+  row.splat_bytes_per_point = traffic.splat_bytes_per_point;
+  row.bytes_per_frame = traffic.bytes_per_frame;
+  row.bandwidth_bound_ms.reset();
+  row.bandwidth_fraction.reset();
+  if (!copy || !row.bytes_per_frame) return;
+  row.bandwidth_bound_ms = bandwidthBoundMs(*row.bytes_per_frame, copy->read_write_gb_per_s);
+  if (row.skipped.empty() && row.gpu_ms_median && *row.gpu_ms_median > 0.0)
+    row.bandwidth_fraction = *row.bandwidth_bound_ms / *row.gpu_ms_median;
+}
+
 Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   BenchRun run;
@@ -188,6 +203,13 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
 
   Result<SelfTest> self_test = runPrecisionSelfTest(context);
   if (!self_test) return self_test.error();
+  if (options.measure_copy_bandwidth) {
+    Result<CopyBandwidth> copy = measureCopyBandwidth(context, options.copy);
+    if (!copy) return copy.error();
+    run.copy_bandwidth = *copy;
+    if (options.log) options.log("copy bandwidth: " + copyBandwidthText(*copy));
+  }
+  const CopyBandwidth* copy = run.copy_bandwidth ? &*run.copy_bandwidth : nullptr;
   const size_t total = run.cases.size() * options.backends.size() * kModeCount;
   size_t done = 0;
   for (const BenchCase& c : run.cases) {
@@ -224,6 +246,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
           shot.caption = montageCaption(row);
           run.montage->modes.push_back(std::move(shot));
         }
+        setBandwidthBound(row, copy);
         ++done;
         if (options.log) {
           std::string line = '[' + std::to_string(done) + '/' + std::to_string(total) + "] " + std::string(suiteName(c.suite)) +
@@ -231,6 +254,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
           if (!row.skipped.empty()) line += "skipped (" + row.skipped + ")";
           else {
             line += row.gpu_ms_median ? g3(*row.gpu_ms_median) + " ms" : g3(row.frame_ms_median) + " ms (host)";
+            if (row.bandwidth_fraction) line += " (" + g3(100.0 * *row.bandwidth_fraction) + "% of the bandwidth bound)";
             line += row.error_max_px ? ", max error " + g3(*row.error_max_px) + " px" : ", every point lost";
           }
           options.log(line);

@@ -3,7 +3,8 @@
 // then every mode on every backend is drawn twice: timed, by a fresh `dpoint render --json` process
 // (GPU timestamps, median of `frames` after warm-up, no probe: what a user's run gets), and probed,
 // in this process (clip positions of every point against the reference). One row per (case,
-// backend, mode).
+// backend, mode). Before the first case, the device's copy bandwidth is measured once
+// (bench/bandwidth.h) for each row's bandwidth bound.
 //
 // Why a process per timed draw: on the H100 (driver 580.159), once one process had drawn and
 // probed a 10M-point set, every later draw of 10M points in that process ran 4–6× slower (0.18 ms
@@ -18,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bandwidth.h"
 #include "bench/suites.h"
 #include "viewer/context.h"
 #include "viewer/encode.h"
@@ -37,6 +39,14 @@ struct BenchRow {
   double e2e_ms = 0.0;        // upload + one frame (median) + readback, as `dpoint render --json`
   double points_per_s = 0.0;  // from the GPU median (else the host frame median)
   uint32_t bytes_per_point = 0;
+  // Bandwidth (bench/bandwidth.h, setBandwidthBound): position bytes per point the splat pass (or
+  // the vertex fetch) reads; compute backend only, the bytes a frame must move, the time that takes
+  // at the run's read+write copy bandwidth, and bound / GPU median (1: as fast as the memory
+  // allows). Empty where the backend has no byte count, the bandwidth or the GPU time was not
+  // measured, or the row did not run.
+  uint32_t splat_bytes_per_point = 0;
+  std::optional<uint64_t> bytes_per_frame;
+  std::optional<double> bandwidth_bound_ms, bandwidth_fraction;
   // Error: the bound predicted before drawing (+inf: unbounded) and what the probe measured.
   double predicted_bound_px = 0.0;
   double float_floor_px = 0.0;
@@ -69,6 +79,9 @@ struct BenchOptions {
   std::string cache_dir;
   std::string device = "auto";  // passed to every `dpoint render`; the context given must be that device
   bool validate = false;        // --validate for every `dpoint render`
+  // The copy bandwidth, measured once at the start; false: not measured (no bound, no fraction).
+  bool measure_copy_bandwidth = true;
+  CopyBandwidthOptions copy;
   // Runs `dpoint ARGS` (this executable) to its end; fails naming the command and its exit code.
   std::function<Status(const std::vector<std::string>& args)> run_dpoint;
   // One line per step for the user (progress); may be empty.
@@ -80,11 +93,16 @@ struct BenchRun {
   std::vector<BenchRow> rows;
   std::optional<MontageCapture> montage;
   DeviceFacts device;
+  std::optional<CopyBandwidth> copy_bandwidth;  // empty: not measured
   double seconds = 0.0;  // wall time of the whole run
 };
 
-// Fails on a dataset that cannot be made or read; a mode the device cannot run or a draw that fails
-// becomes a skipped row naming why.
+// Fills the row's bandwidth fields (above) from its case, mode, backend and GPU time, and `copy`
+// (null: not measured). Needs row.bench_case.
+void setBandwidthBound(BenchRow& row, const CopyBandwidth* copy);
+
+// Fails on a dataset that cannot be made or read, or a copy bandwidth that cannot be measured; a
+// mode the device cannot run or a draw that fails becomes a skipped row naming why.
 Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& options);
 
 }  // namespace dpoint

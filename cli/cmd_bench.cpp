@@ -3,6 +3,7 @@
 // as report.md, results.json, speed_vs_error.svg, breakdown.svg and montage.png.
 // dpoint bench io FILE: times reading (and optionally writing) a file inside one process, for
 // the I/O benchmark in bench/ (which also times the whole process from outside).
+// dpoint bench copy: only the device's copy bandwidth, the figure the report's bandwidth bound uses.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -21,6 +22,7 @@
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "converters/point_io.h"
+#include "core/memory.h"
 #include "core/progress.h"
 
 namespace dpoint {
@@ -66,7 +68,17 @@ struct BenchReportOptions {
   std::string suite = "ci", out = "bench-out", cache = "bench-cache", device = "auto", backend = "both";
   std::vector<std::string> sizes;
   uint32_t frames = 20, warmup = 2;
-  bool validate = false, no_error = false;
+  bool validate = false, no_error = false, no_copy_bandwidth = false;
+  std::string copy_bytes = "auto";
+  uint32_t copy_repeats = 10;
+  CommonOptions common;
+};
+
+struct BenchCopyOptions {
+  std::string device = "auto";
+  std::string copy_bytes = "auto";
+  uint32_t copy_repeats = 10;
+  bool validate = false;
   CommonOptions common;
 };
 
@@ -101,6 +113,11 @@ Status runDpoint(const std::vector<std::string>& args, unsigned threads) {
                code == static_cast<int>(ExitCode::kResourceLimit) ? ExitCode::kResourceLimit : ExitCode::kBadInput};
 }
 
+// --copy-bytes: auto (0: the device's default) or a size such as 64M or 1GiB.
+Result<uint64_t> parseCopyBytes(const std::string& text) {
+  return text == "auto" ? Result<uint64_t>(uint64_t{0}) : parseMemorySize("--copy-bytes", text);
+}
+
 std::string utcNow() {
   std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -119,7 +136,20 @@ std::string commandLine(const BenchReportOptions& o) {
     for (size_t i = 0; i < o.sizes.size(); ++i) s += (i ? "," : "") + o.sizes[i];
   }
   if (o.no_error) s += " --no-error";
+  if (o.no_copy_bandwidth) s += " --no-copy-bandwidth";
+  else {
+    if (o.copy_bytes != "auto") s += " --copy-bytes " + o.copy_bytes;
+    if (o.copy_repeats != 10) s += " --copy-repeats " + std::to_string(o.copy_repeats);
+  }
   return s + " --out " + o.out + " --cache " + o.cache;
+}
+
+// Validation messages fail the run, after everything else was reported.
+int failOnValidationMessages(const VulkanContext& context) {
+  const std::vector<std::string>& messages = context.validationMessages();
+  if (messages.empty()) return 0;
+  for (const std::string& m : messages) std::fprintf(stderr, "dpoint: %s\n", m.c_str());
+  return reportError(Error{std::to_string(messages.size()) + " Vulkan validation message(s)", ExitCode::kNoDevice});
 }
 
 int runBenchReport(const BenchReportOptions& o) {
@@ -155,6 +185,11 @@ int runBenchReport(const BenchReportOptions& o) {
   const unsigned threads = o.common.threads;
   options.device = o.device;
   options.validate = o.validate;
+  options.measure_copy_bandwidth = !o.no_copy_bandwidth;
+  Result<uint64_t> copy_bytes = parseCopyBytes(o.copy_bytes);
+  if (!copy_bytes) return reportError(copy_bytes.error());
+  options.copy.bytes = *copy_bytes;
+  options.copy.copies = o.copy_repeats;
   options.run_dpoint = [threads](const std::vector<std::string>& args) { return runDpoint(args, threads); };
   std::FILE* sink = progressSink(o.common.quiet);
   if (sink) options.log = [sink](const std::string& line) { std::fprintf(sink, "bench: %s\n", line.c_str()); };
@@ -174,12 +209,18 @@ int runBenchReport(const BenchReportOptions& o) {
               run->device.name.c_str(), run->seconds);
   for (const std::string& path : *written) std::printf("wrote %s\n", path.c_str());
   if (!failures.empty()) std::fprintf(stderr, "dpoint: warning: %zu check(s) failed; see report.md\n", failures.size());
-  const std::vector<std::string>& messages = (*context)->validationMessages();
-  if (!messages.empty()) {
-    for (const std::string& m : messages) std::fprintf(stderr, "dpoint: %s\n", m.c_str());
-    return reportError(Error{std::to_string(messages.size()) + " Vulkan validation message(s)", ExitCode::kNoDevice});
-  }
-  return 0;
+  return failOnValidationMessages(**context);
+}
+
+int runBenchCopy(const BenchCopyOptions& o) {
+  Result<uint64_t> bytes = parseCopyBytes(o.copy_bytes);
+  if (!bytes) return reportError(bytes.error());
+  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
+  if (!context) return reportError(context.error());
+  Result<CopyBandwidth> copy = measureCopyBandwidth(**context, CopyBandwidthOptions{*bytes, o.copy_repeats, 1});
+  if (!copy) return reportError(copy.error());
+  std::printf("%s: copy bandwidth %s\n", (*context)->facts.name.c_str(), copyBandwidthText(*copy).c_str());
+  return failOnValidationMessages(**context);
 }
 
 }  // namespace
@@ -193,7 +234,7 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
       "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the study's\n"
       "datasets at 1920x1080, its RTX 3090 figures beside ours), hard (DESIGN's hard cases: offset and\n"
       "deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
-      "`dpoint bench io FILE` times reading a file instead.");
+      "`dpoint bench io FILE` times reading a file instead; `dpoint bench copy` measures only the copy bandwidth.");
   bench->require_subcommand(0, 1);
   auto r = std::make_shared<BenchReportOptions>();
   bench->add_option("--suite", r->suite, "ci, paper, hard or all")->default_val("ci");
@@ -207,6 +248,14 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   bench->add_option("--sizes", r->sizes, "paper suite: only these of the study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
   bench->add_flag("--no-error", r->no_error, "Time only: skip the probe draws and the exact reference (no error columns)");
   bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");
+  bench->add_flag("--no-copy-bandwidth", r->no_copy_bandwidth,
+                  "Skip measuring the copy bandwidth (no bandwidth bound or % of bound in the report)");
+  const char* copy_bytes_help =
+      "Bytes per timed vkCmdCopyBuffer, e.g. 64M or 1G; auto: 1 GiB on a GPU, 256 MiB on a CPU device (capped by "
+      "the device's allocation limit and a quarter of its memory)";
+  const char* copy_repeats_help = "Timed copies (the median is reported), after one untimed";
+  bench->add_option("--copy-bytes", r->copy_bytes, copy_bytes_help)->default_val("auto");
+  bench->add_option("--copy-repeats", r->copy_repeats, copy_repeats_help)->check(CLI::Range(1u, 1000u))->default_val(10);
   addCommonOptions(*bench, r->common);
   auto o = std::make_shared<BenchIoOptions>();
   CLI::App* io = bench->add_subcommand("io", "Time reading a point file (and writing it with --write)");
@@ -215,8 +264,17 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   io->add_option("--decimals", o->decimals, "CSV output: fixed digits after the point")->check(CLI::Range(0, 100));
   addCommonOptions(*io, o->common);
   io->callback([o, &run] { run = [o] { return runBenchIo(*o); }; });
-  bench->callback([bench, io, r, &run] {
-    if (!io->parsed()) run = [r] { return runBenchReport(*r); };
+  auto c = std::make_shared<BenchCopyOptions>();
+  CLI::App* copy = bench->add_subcommand(
+      "copy", "Measure only the device's copy bandwidth (device-local to device-local vkCmdCopyBuffer, GPU timestamps)");
+  copy->add_option("--device", c->device, "auto, cpu, or an index from `dpoint devices`")->default_val("auto");
+  copy->add_option("--copy-bytes", c->copy_bytes, copy_bytes_help)->default_val("auto");
+  copy->add_option("--copy-repeats", c->copy_repeats, copy_repeats_help)->check(CLI::Range(1u, 1000u))->default_val(10);
+  copy->add_flag("--validate", c->validate, "Enable the Khronos validation layer; any message fails the run");
+  addCommonOptions(*copy, c->common);
+  copy->callback([c, &run] { run = [c] { return runBenchCopy(*c); }; });
+  bench->callback([bench, io, copy, r, &run] {
+    if (!io->parsed() && !copy->parsed()) run = [r] { return runBenchReport(*r); };
   });
 }
 

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <set>
 
+#include "bench/bandwidth.h"
 #include "bench/report.h"
+#include "bench/run.h"
 #include "bench/suites.h"
 
 namespace dpoint {
@@ -93,6 +95,106 @@ TEST(BenchReport, resultsJsonWritesNullForWhatWasNotMeasured) {
   EXPECT_NE(json.find("\"gpu_ms\": null"), std::string::npos) << "no timestamps: no GPU time";
   EXPECT_EQ(json.find("inf"), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
+}
+
+// A 1000×500 frame of 100 points on the compute backend at 100 GB/s read+write: every byte is
+// counted by hand from the passes in viewer/render_compute.cpp.
+TEST(BenchReport, bandwidthBoundCountsEveryPassOfAComputeFrame) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  run.cases.front().width = 1000;
+  run.cases.front().height = 500;
+  CopyBandwidth copy;
+  copy.read_write_gb_per_s = 100.0;
+  for (BenchRow& row : run.rows) {
+    row.gpu_ms_median = 0.5;
+    setBandwidthBound(row, &copy);
+    const uint64_t positions = 100ull * modeInfo(row.mode).position_bytes;
+    const uint64_t per_pixel = 500000ull * (8 + 8 + 4);  // clear and read the keys, write the picture
+    const uint64_t colors = 100ull * 4;                    // 100 points cover at most 100 pixels
+    EXPECT_EQ(row.splat_bytes_per_point, modeInfo(row.mode).position_bytes) << modeName(row.mode);
+    ASSERT_TRUE(row.bytes_per_frame && row.bandwidth_bound_ms && row.bandwidth_fraction) << modeName(row.mode);
+    EXPECT_EQ(*row.bytes_per_frame, positions + per_pixel + colors) << modeName(row.mode);
+    const double bound_ms = static_cast<double>(positions + per_pixel + colors) / 100e9 * 1e3;
+    EXPECT_NEAR(*row.bandwidth_bound_ms, bound_ms, bound_ms * 1e-12) << modeName(row.mode);
+    EXPECT_NEAR(*row.bandwidth_fraction, bound_ms / 0.5, bound_ms * 1e-12) << modeName(row.mode);
+  }
+  // Modes differ only in the position bytes, read from the mode's row.
+  EXPECT_EQ(*run.rows[modeIndex(PrecisionMode::kNative)].bytes_per_frame - *run.rows[modeIndex(PrecisionMode::kFp32)].bytes_per_frame,
+            100ull * (positionBytes(PrecisionMode::kNative) - positionBytes(PrecisionMode::kFp32)));
+}
+
+TEST(BenchReport, bandwidthBoundCountsEveryPixelOnceWhenPointsOutnumberThem) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  run.cases.front().width = 10;
+  run.cases.front().height = 10;
+  BenchRow& row = run.rows.front();
+  row.points = 1000;
+  setBandwidthBound(row, nullptr);
+  ASSERT_TRUE(row.bytes_per_frame);
+  EXPECT_EQ(*row.bytes_per_frame, 1000ull * positionBytes(row.mode) + 100ull * (8 + 8 + 4 + 4));
+  EXPECT_FALSE(row.bandwidth_bound_ms) << "no copy bandwidth: no bound";
+  EXPECT_FALSE(row.bandwidth_fraction);
+}
+
+TEST(BenchReport, bandwidthBoundLeavesRasterSkippedAndUntimedRowsWithoutAFraction) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  CopyBandwidth copy;
+  copy.read_write_gb_per_s = 100.0;
+  BenchRow& raster = run.rows[0];
+  raster.backend = Backend::kRaster;
+  setBandwidthBound(raster, &copy);
+  EXPECT_EQ(raster.splat_bytes_per_point, positionBytes(raster.mode));
+  EXPECT_FALSE(raster.bytes_per_frame || raster.bandwidth_bound_ms || raster.bandwidth_fraction);
+  BenchRow& skipped = run.rows[1];
+  skipped.skipped = "not on this device";
+  setBandwidthBound(skipped, &copy);
+  EXPECT_TRUE(skipped.bandwidth_bound_ms) << "the bound is the model's, measured or not";
+  EXPECT_FALSE(skipped.bandwidth_fraction);
+  BenchRow& untimed = run.rows[2];
+  untimed.gpu_ms_median.reset();
+  setBandwidthBound(untimed, &copy);
+  EXPECT_TRUE(untimed.bandwidth_bound_ms);
+  EXPECT_FALSE(untimed.bandwidth_fraction) << "no GPU time: no fraction";
+}
+
+TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  run.cases.front().width = run.cases.front().height = 100;
+  CopyBandwidth copy;
+  copy.bytes = 64ull << 20;
+  copy.copies = 5;
+  copy.copy_ms_median = 2.0;
+  copy.copy_gb_per_s = 33.554432;
+  copy.read_write_gb_per_s = 67.108864;
+  run.copy_bandwidth = copy;
+  for (BenchRow& row : run.rows) setBandwidthBound(row, &copy);
+  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(json.find("\"copy_bandwidth\": {\"read_write_gb_per_s\": 67.108864, \"copy_gb_per_s\": 33.554432, "
+                      "\"copy_bytes\": 67108864, \"copies\": 5"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"bound_uses\": \"read_write_gb_per_s\""), std::string::npos);
+  const BenchRow& fp32 = run.rows[modeIndex(PrecisionMode::kFp32)];
+  EXPECT_NE(json.find("\"splat_bytes_per_point\": " + std::to_string(positionBytes(PrecisionMode::kFp32)) +
+                      ", \"bytes_per_frame\": " + std::to_string(*fp32.bytes_per_frame)),
+            std::string::npos);
+  EXPECT_EQ(json.find("\"bandwidth_fraction\": null"), std::string::npos);
+  const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(report.find("Copy bandwidth: **67.1 GB/s read+write, 33.6 GB/s copied"), std::string::npos) << report;
+}
+
+TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  for (BenchRow& row : run.rows) setBandwidthBound(row, nullptr);
+  run.rows[0].backend = Backend::kRaster;
+  setBandwidthBound(run.rows[0], nullptr);
+  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(json.find("\"copy_bandwidth\": null"), std::string::npos);
+  EXPECT_NE(json.find("\"bytes_per_frame\": null"), std::string::npos) << "raster: no frame bytes";
+  EXPECT_NE(json.find("\"bandwidth_bound_ms\": null, \"bandwidth_fraction\": null"), std::string::npos);
+  EXPECT_EQ(json.find("\"bandwidth_fraction\": 0"), std::string::npos);
+  const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(report.find("Copy bandwidth: not measured"), std::string::npos);
 }
 
 TEST(BenchSuites, paperSuiteHoldsTheStudysDatasetsWithItsFigures) {

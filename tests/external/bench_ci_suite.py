@@ -16,7 +16,8 @@ from common import check, dpoint, scratch
 exe = sys.argv[1]
 MODES = ["fp32", "split", "rte", "df64", "native", "batch"]
 FIELDS = ["suite", "dataset", "points", "mode", "backend", "device", "driver", "resolution", "gpu_ms", "e2e_ms",
-          "points_per_s", "bytes_per_point", "predicted_bound_px", "error_px", "share_off_half_px", "points_lost",
+          "points_per_s", "bytes_per_point", "splat_bytes_per_point", "bytes_per_frame", "bandwidth_bound_ms",
+          "bandwidth_fraction", "predicted_bound_px", "error_px", "share_off_half_px", "points_lost",
           "pixels_differing"]
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -58,7 +59,7 @@ def check_svg(path, series_per_panel, panels):
 with scratch() as d:
     out, cache = os.path.join(d, "out"), os.path.join(d, "cache")
     dpoint(exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1", "--validate",
-           "--quiet")
+           "--copy-bytes", "64M", "--copy-repeats", "5", "--quiet")
     for name in ["report.md", "results.json", "speed_vs_error.svg", "breakdown.svg", "montage.png"]:
         check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} missing or empty")
     with open(os.path.join(out, "results.json")) as f:
@@ -67,6 +68,38 @@ with scratch() as d:
     cases = sorted({r["case"] for r in rows})
     check(len(rows) == len(cases) * 2 * len(MODES), f"{len(rows)} rows for {len(cases)} cases")
     check(results["check_failures"] == [], f"the report's own checks failed: {results['check_failures']}")
+    # The copy bandwidth: measured once, as asked, and positive both ways (read+write is twice the copy rate).
+    copy = results["copy_bandwidth"]
+    check(copy is not None, "no copy_bandwidth in results.json")
+    check(copy["copy_bytes"] == 64 << 20 and copy["copies"] == 5, f"copy_bandwidth {copy}")
+    check(copy["copy_gb_per_s"] > 0 and math.isclose(copy["read_write_gb_per_s"], 2 * copy["copy_gb_per_s"]),
+          f"copy_bandwidth {copy}")
+    check(copy["bound_uses"] == "read_write_gb_per_s", f"copy_bandwidth {copy}")
+    # Splat bytes per point are the mode's position bytes: the two fixed layouts here, and batch's
+    # (its encoding may change) the same in every row and 4 B under its bytes_per_point (colour).
+    splat_bytes = {"fp32": 12, "split": 24, "rte": 24, "df64": 24, "native": 24}
+    batch_bytes = {r["splat_bytes_per_point"] for r in rows if r["mode"] == "batch"}
+    check(len(batch_bytes) == 1, f"batch splat bytes differ between rows: {batch_bytes}")
+    splat_bytes["batch"] = batch_bytes.pop()
+    for r in rows:
+        name = f"{r['case']} {r['backend']} {r['mode']}"
+        check(r["splat_bytes_per_point"] == splat_bytes[r["mode"]],
+              f"{name}: splat_bytes_per_point {r['splat_bytes_per_point']}, expected {splat_bytes[r['mode']]}")
+        check(r["bytes_per_point"] == r["splat_bytes_per_point"] + 4, f"{name}: bytes_per_point {r['bytes_per_point']}")
+        if r["backend"] == "compute":
+            w, h = map(int, r["resolution"].split("x"))
+            pixels = w * h
+            frame = r["points"] * r["splat_bytes_per_point"] + pixels * 20 + min(r["points"], pixels) * 4
+            check(r["bytes_per_frame"] == frame, f"{name}: bytes_per_frame {r['bytes_per_frame']}, expected {frame}")
+            bound = frame / (copy["read_write_gb_per_s"] * 1e6)
+            check(math.isclose(r["bandwidth_bound_ms"], bound, rel_tol=1e-9), f"{name}: bound {r['bandwidth_bound_ms']} ms")
+            check(r["bandwidth_fraction"] is not None and r["bandwidth_fraction"] > 0,
+                  f"{name}: bandwidth_fraction {r['bandwidth_fraction']}")
+            if r["gpu_ms"] is not None:
+                check(math.isclose(r["bandwidth_fraction"], bound / r["gpu_ms"]["median"], rel_tol=1e-9),
+                      f"{name}: bandwidth_fraction {r['bandwidth_fraction']} is not bound / GPU median")
+        else:
+            check(r["bytes_per_frame"] is None and r["bandwidth_fraction"] is None, f"{name}: raster has a bound")
     groups_by = {}
     for r in rows:
         for field in FIELDS:
@@ -108,4 +141,5 @@ with scratch() as d:
     for case in cases:
         check(f"| {case} |" in report, f"report.md has no row for {case}")
     check("## Checks" in report and "All passed" in report, "report.md lacks its checks")
+    check("- Copy bandwidth: **" in report and "% of bound" in report, "report.md lacks the copy bandwidth or % of bound")
 print(f"bench ci suite: {len(rows)} rows checked")

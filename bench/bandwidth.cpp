@@ -1,0 +1,160 @@
+#include "bench/bandwidth.h"
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cstdio>
+#include <vector>
+
+#include "core/memory.h"
+#include "viewer/buffers.h"
+
+namespace dpoint {
+namespace {
+
+// Everything the measurement creates, released on every path out.
+struct CopyScratch {
+  const VulkanContext& context;
+  Buffer source, target;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  ~CopyScratch() {
+    if (queries) vkDestroyQueryPool(context.device, queries, nullptr);
+    destroyBuffer(context, target);
+    destroyBuffer(context, source);
+  }
+};
+
+// Earlier transfers (the fill, the previous copy, in this or an earlier submission) before the next
+// copy reads the source and writes the target again.
+// (The structs here start from {} and get their sType after: the bench library, unlike viewer/,
+// keeps -Wmissing-field-initializers, which `= {VK_STRUCTURE_TYPE_...}` trips.)
+void transferBarrier(VkCommandBuffer commands) {
+  VkMemoryBarrier barrier{};
+  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &barrier, 0,
+                       nullptr, 0, nullptr);
+}
+
+double median(std::vector<double> v) {
+  assert(!v.empty());
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+uint64_t defaultCopyBytes(const VulkanContext& context) {
+  uint64_t bytes = context.facts.type == "cpu" ? 256ull << 20 : 1ull << 30;
+  if (context.facts.max_memory_allocation) bytes = std::min(bytes, context.facts.max_memory_allocation);
+  uint64_t heap = 0;
+  for (uint32_t h = 0; h < context.memory.memoryHeapCount; ++h)
+    if (context.memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      heap = std::max<uint64_t>(heap, context.memory.memoryHeaps[h].size);
+  if (heap) bytes = std::min(bytes, heap / 4);
+  const uint64_t mib = 1ull << 20;
+  return bytes >= mib ? bytes / mib * mib : bytes;
+}
+
+Result<CopyBandwidth> measureCopyBandwidth(const VulkanContext& context, const CopyBandwidthOptions& options) {
+  assert(options.copies >= 1);
+  const uint64_t bytes = options.bytes ? options.bytes : defaultCopyBytes(context);
+  if (bytes == 0) return Error{"copy bandwidth: the device has no device-local memory to copy", ExitCode::kNoDevice};
+  if (context.facts.max_memory_allocation && bytes > context.facts.max_memory_allocation)
+    return Error{"copy bandwidth: a copy of " + formatBytes(bytes) + " is above the device's maxMemoryAllocationSize (" +
+                     formatBytes(context.facts.max_memory_allocation) + ")",
+                 ExitCode::kResourceLimit};
+  CopyScratch s{context, {}, {}, VK_NULL_HANDLE};
+  Result<Buffer> source = createBuffer(context, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                       false, "copy bandwidth source");
+  if (!source) return source.error();
+  s.source = *source;
+  Result<Buffer> target = createBuffer(context, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, "copy bandwidth target");
+  if (!target) return target.error();
+  s.target = *target;
+  const bool timestamps = context.facts.timestamp_period_ns > 0.0f;
+  if (timestamps) {
+    VkQueryPoolCreateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    info.queryCount = 2;
+    VK_TRY(vkCreateQueryPool(context.device, &info, nullptr, &s.queries));
+  }
+  // A non-zero pattern in both buffers: every page written once before anything is timed.
+  Status filled = submitOnce(context, [&](VkCommandBuffer commands) {
+    vkCmdFillBuffer(commands, s.source.buffer, 0, VK_WHOLE_SIZE, 0x5a5a5a5au);
+    vkCmdFillBuffer(commands, s.target.buffer, 0, VK_WHOLE_SIZE, 0xa5a5a5a5u);
+  });
+  if (!filled) return filled.error();
+
+  const VkBufferCopy region{0, 0, bytes};
+  std::vector<double> ms;
+  for (uint32_t i = 0; i < options.warmup + options.copies; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    Status copied = submitOnce(context, [&](VkCommandBuffer commands) {
+      transferBarrier(commands);
+      if (timestamps) {
+        vkCmdResetQueryPool(commands, s.queries, 0, 2);
+        vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
+      }
+      vkCmdCopyBuffer(commands, s.source.buffer, s.target.buffer, 1, &region);
+      if (timestamps) vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
+    });
+    if (!copied) return copied.error();
+    const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (i < options.warmup) continue;
+    if (!timestamps) {
+      ms.push_back(wall_ms);
+      continue;
+    }
+    uint64_t ticks[2] = {0, 0};
+    VK_TRY(vkGetQueryPoolResults(context.device, s.queries, 0, 2, sizeof(ticks), ticks, sizeof(uint64_t),
+                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    ms.push_back(static_cast<double>(ticks[1] - ticks[0]) * context.facts.timestamp_period_ns * 1e-6);
+  }
+  CopyBandwidth out;
+  out.bytes = bytes;
+  out.copies = options.copies;
+  out.gpu_timestamps = timestamps;
+  out.copy_ms_median = median(ms);
+  if (!(out.copy_ms_median > 0.0))
+    return Error{"copy bandwidth: a copy of " + formatBytes(bytes) + " took " + std::to_string(out.copy_ms_median) +
+                     " ms (median), no time to divide by",
+                 ExitCode::kNoDevice};
+  out.copy_gb_per_s = static_cast<double>(bytes) / (out.copy_ms_median * 1e6);
+  out.read_write_gb_per_s = 2.0 * out.copy_gb_per_s;
+  return out;
+}
+
+std::string rateText(double gb_per_s) {
+  char text[32];
+  if (gb_per_s >= 1000.0) std::snprintf(text, sizeof text, "%.3g TB/s", gb_per_s / 1000.0);
+  else std::snprintf(text, sizeof text, "%.3g GB/s", gb_per_s);
+  return text;
+}
+
+std::string copyBandwidthText(const CopyBandwidth& copy) {
+  return rateText(copy.read_write_gb_per_s) + " read+write, " + rateText(copy.copy_gb_per_s) + " copied (" +
+         formatBytes(copy.bytes) + " vkCmdCopyBuffer, median of " + std::to_string(copy.copies) + ", " +
+         (copy.gpu_timestamps ? "GPU timestamps" : "host wall time: the queue has no timestamps") + ")";
+}
+
+FrameTraffic frameTraffic(Backend backend, PrecisionMode mode, uint64_t points, uint32_t width, uint32_t height) {
+  FrameTraffic out;
+  out.splat_bytes_per_point = positionBytes(mode);
+  if (backend != Backend::kCompute) return out;
+  const uint64_t pixels = uint64_t{width} * height;
+  constexpr uint64_t kClear = 8, kKeyRead = 8, kPictureWrite = 4, kColorRead = 4;
+  out.bytes_per_frame = points * positionBytes(mode) + pixels * (kClear + kKeyRead + kPictureWrite) +
+                        std::min(points, pixels) * kColorRead;
+  return out;
+}
+
+double bandwidthBoundMs(uint64_t bytes, double read_write_gb_per_s) {
+  assert(read_write_gb_per_s > 0.0);
+  return static_cast<double>(bytes) / (read_write_gb_per_s * 1e6);
+}
+
+}  // namespace dpoint
