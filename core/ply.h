@@ -4,7 +4,12 @@
 // ones), optional red, green, blue (uchar scaled by 1/255, or float/double taken as 0..1),
 // other vertex properties skipped; an optional `face` element whose vertex_indices (or
 // vertex_index) list is fan-triangulated. Other elements are skipped. Errors name the file and
-// the header line, or the byte offset / ASCII line of the bad data.
+// the header line, or the byte offset / ASCII line of the bad data; the first bad row in the
+// file gives the error.
+//
+// Binary vertices without list properties (the usual case) are decoded in blocks on all cores,
+// each row into its preassigned index, so the result is the same for any thread count. Memory:
+// the PointSet plus one block per thread. ASCII data and faces are read on one thread.
 //
 // Writing: `double x,y,z`, colours as `uchar` (default, read by every tool) or `float`,
 // and `face` lists of three `uint` indices for meshes.
@@ -23,7 +28,8 @@ enum class PlyColorType { kUchar, kFloat };
 
 struct PlyReadOptions {
   bool allow_nonfinite = false;
-  Progress* progress = nullptr;
+  Progress* progress = nullptr;  // thread-safe advance() is called from every reading thread
+  unsigned threads = 0;          // 0: all cores (last, so that {allow_nonfinite, progress} still reads)
 };
 
 struct PlyWriteOptions {

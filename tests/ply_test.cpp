@@ -4,9 +4,11 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "test_support.h"
@@ -187,23 +189,29 @@ TEST(Ply, plyWriterHeaderIsStandard) {
   EXPECT_TRUE(contains(text, "end_header\n0 0 0 1 0 0\n1 0 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n"));
 }
 
-// Files larger than the reader's block, so rows and lines straddle refills.
-TEST(Ply, plyLargeFilesCrossBlockBoundaries) {
-  PointSet in;
-  uint64_t state = 12345;
+// Random bit patterns with uchar-exact colours: finite values from subnormal to 2.
+PointSet randomPoints(size_t n, uint64_t seed) {
+  PointSet set;
+  uint64_t state = seed;
   auto next = [&state] {
     state = state * 6364136223846793005u + 1442695040888963407u;
     return state;
   };
-  const size_t n = 400000;
   for (size_t i = 0; i < n; ++i) {
-    // ">> 2" clears the sign and the top exponent bit: finite values from subnormal to 2.
+    // ">> 2" clears the sign and the top exponent bit.
     const uint64_t bits[3] = {next() >> 2, next() >> 2, next() >> 2};
     glm::dvec3 p;
     std::memcpy(&p, bits, sizeof p);
-    in.positions.push_back(p);
-    in.colors.push_back(glm::vec3(static_cast<float>(next() % 256) / 255.0f));
+    set.positions.push_back(p);
+    set.colors.push_back(glm::vec3(static_cast<float>(next() % 256) / 255.0f));
   }
+  return set;
+}
+
+// Files larger than the reader's block, so rows and lines straddle refills.
+TEST(Ply, plyLargeFilesCrossBlockBoundaries) {
+  const size_t n = 400000;
+  PointSet in = randomPoints(n, 12345);
   for (size_t i = 0; i + 2 < n; i += 2)
     in.triangles.insert(in.triangles.end(), {uint32_t(i), uint32_t(i + 1), uint32_t(i + 2)});
   for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
@@ -212,6 +220,158 @@ TEST(Ply, plyLargeFilesCrossBlockBoundaries) {
     expectSameColors(in, out);
     EXPECT_EQ(out.triangles, in.triangles);
   }
+}
+
+// ---------------------------------------------------------------- binary vertices on several threads
+
+// The reader decodes binary vertices in blocks of 1 MiB (kVertexBlockBytes in ply_read.cpp); the
+// files below hold four or more blocks, so that several threads share them.
+constexpr size_t kManyBlocksOf27 = 200000;  // 5.4 MB of double xyz + uchar rgb rows
+
+PlyReadOptions withThreads(unsigned threads) {
+  PlyReadOptions options;
+  options.threads = threads;
+  return options;
+}
+
+TEST(Ply, plyBinaryVerticesAreTheSameForAnyThreadCount) {
+  TempDir dir;
+  const PointSet in = randomPoints(kManyBlocksOf27, 777);
+  ASSERT_TRUE(writePly(dir.file("many.ply"), in).ok());
+  for (unsigned threads : {1u, 2u, 4u, 7u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    auto r = readPly(dir.file("many.ply"), withThreads(threads));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectSamePositions(in, *r);
+    expectSameColors(in, *r);
+  }
+}
+
+// The general path (not double xyz + uchar rgb) is parallel too: float xyz around a skipped
+// property, ushort colours.
+TEST(Ply, plyBinaryMixedTypesAreTheSameForAnyThreadCount) {
+  TempDir dir;
+  Bytes b;
+  const size_t n = 250000;  // 24-byte rows: 5.7 MB
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(n) +
+      "\nproperty float y\nproperty int flags\nproperty float x\nproperty float z\n"
+      "property ushort red\nproperty ushort green\nproperty ushort blue\nproperty short pad\nend_header\n";
+  PointSet expected;
+  for (size_t i = 0; i < n; ++i) {
+    const float x = static_cast<float>(i) * 0.1f, y = -static_cast<float>(i) / 3.0f;
+    const float z = 1.0f / static_cast<float>(i + 1);
+    const auto red = static_cast<uint16_t>(i), green = static_cast<uint16_t>(i * 7), blue = static_cast<uint16_t>(~i);
+    b.add(y).add(static_cast<int32_t>(i)).add(x).add(z).add(red).add(green).add(blue).add(int16_t{-1});
+    expected.positions.push_back({x, y, z});
+    expected.colors.push_back({static_cast<float>(red) / 65535.0f, static_cast<float>(green) / 65535.0f,
+                               static_cast<float>(blue) / 65535.0f});
+  }
+  writeFile(dir.file("mixed.ply"), b.data);
+  for (unsigned threads : {1u, 4u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    auto r = readPly(dir.file("mixed.ply"), withThreads(threads));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectSamePositions(expected, *r);
+    expectSameColors(expected, *r);
+  }
+}
+
+// Blocks hold 38836 rows of 27 bytes. Two layouts of bad rows, so that neither "the first error
+// found wins" nor "the last one found wins" passes once blocks run at the same time: the earlier
+// bad row found first (start of block 1, end of block 3) and found last (end of block 1, start of
+// block 2). A second bad row in the first bad row's block must not replace it either.
+TEST(Ply, plyFirstBadVertexWinsWhateverTheThreadCount) {
+  constexpr size_t kBlock = 38836;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (auto [first, later] : {std::pair<size_t, size_t>{kBlock + 1000, 4 * kBlock - 2},
+                              std::pair<size_t, size_t>{2 * kBlock - 10, 2 * kBlock + 1}}) {
+    SCOPED_TRACE("bad rows " + std::to_string(first) + " and " + std::to_string(later));
+    TempDir dir;
+    PointSet in = randomPoints(kManyBlocksOf27, 99);
+    in.positions[first].z = inf;
+    in.positions[first + 7].y = -inf;
+    in.positions[later].x = std::numeric_limits<double>::quiet_NaN();
+    ASSERT_TRUE(writePly(dir.file("bad.ply"), in).ok());
+    const size_t header = readFile(dir.file("bad.ply")).find("end_header\n") + 11;
+    for (unsigned threads : {1u, 2u, 4u, 7u, 2u, 4u, 7u, 2u, 4u, 7u}) {  // timing varies: several tries
+      SCOPED_TRACE("threads " + std::to_string(threads));
+      auto r = readPly(dir.file("bad.ply"), withThreads(threads));
+      ASSERT_FALSE(r.ok());
+      EXPECT_TRUE(contains(r.error().message, "bad.ply: byte " + std::to_string(header + first * 27) + ": vertex " +
+                                                  std::to_string(first) + ": z is inf, not a finite number"));
+    }
+    PlyReadOptions allow = withThreads(4);
+    allow.allow_nonfinite = true;
+    auto r = readPly(dir.file("bad.ply"), allow);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectSamePositions(in, *r);
+  }
+}
+
+TEST(Ply, plyRejectsTruncatedBinaryOfManyBlocks) {
+  TempDir dir;
+  const PointSet in = randomPoints(kManyBlocksOf27, 5);
+  ASSERT_TRUE(writePly(dir.file("whole.ply"), in).ok());
+  const std::string bytes = readFile(dir.file("whole.ply"));
+  const size_t cut = bytes.size() - 3 * 27 - 5;  // inside the fourth row from the end
+  writeFile(dir.file("cut.ply"), bytes.substr(0, cut));
+  auto r = readPly(dir.file("cut.ply"), withThreads(4));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cut.ply: truncated at byte " + std::to_string(cut) +
+                                              ": header line 4 declares 200000 'vertex' rows"));
+}
+
+// An element before the vertices may hold longer lists than the size check assumes (one count
+// byte a row), so the vertex rows themselves run out: the whole rows are decoded, the cut reported.
+TEST(Ply, plyRejectsVerticesCutAfterALongList) {
+  TempDir dir;
+  const size_t n = 200000;  // 24-byte rows
+  const std::string header = "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                             "property list uchar int vertex_indices\nelement vertex " + std::to_string(n) +
+                             "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  Bytes b;
+  b.data = header;
+  b.add(uint8_t{200});
+  for (int32_t k = 0; k < 200; ++k) b.add(k);  // 801 bytes, where the size check counts 1
+  // The size check passes (801 + 24 * (n - 33) + 5 >= 1 + 24 * n); the vertex data stops 5 bytes
+  // into row n - 33 = 199967.
+  for (size_t i = 0; i + 33 < n; ++i) b.add(static_cast<double>(i)).add(1.0).add(2.0);
+  b.data += "12345";
+  auto r = readText(dir, "cut.ply", b.data, withThreads(4));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cut.ply: truncated at byte " + std::to_string(b.data.size()) +
+                                              ": expected 200000 'vertex' rows, the data ends in row 199967"));
+  // A bad row before the cut comes first in the file, so it is the error.
+  const size_t row = header.size() + 801 + 24 * 100000;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(b.data.data() + row + 8, &nan, sizeof nan);
+  auto bad = readText(dir, "cut_nan.ply", b.data, withThreads(4));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.error().message, "cut_nan.ply: byte " + std::to_string(row) + ": vertex 100000: y is nan"));
+}
+
+// Every thread reports its blocks: the progress ends at 100%, not at the share of one thread. The
+// file is larger than the 8 MiB the header read takes in (and reports) at once.
+TEST(Ply, plyProgressCountsEveryBlock) {
+  TempDir dir;
+  ASSERT_TRUE(writePly(dir.file("many.ply"), randomPoints(3 * kManyBlocksOf27, 3)).ok());
+  std::FILE* sink = std::tmpfile();
+  ASSERT_NE(sink, nullptr);
+  {
+    Progress progress(sink, "");
+    PlyReadOptions options = withThreads(4);
+    options.progress = &progress;
+    auto r = readPly(dir.file("many.ply"), options);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    progress.finish();
+  }
+  std::rewind(sink);
+  std::string text(4096, '\0');
+  text.resize(std::fread(text.data(), 1, text.size(), sink));
+  std::fclose(sink);
+  const std::string last = text.substr(text.rfind('\r') + 1);
+  EXPECT_TRUE(contains(last, "reading " + dir.file("many.ply") + ": 100.0%")) << text;
 }
 
 // ---------------------------------------------------------------- foreign files
