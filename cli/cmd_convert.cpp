@@ -6,6 +6,7 @@
 #include "converters/gltf_read.h"
 #include "converters/point_filters.h"
 #include "converters/point_io.h"
+#include "core/point_order.h"
 
 namespace dpoint {
 namespace {
@@ -22,6 +23,7 @@ struct ConvertOptions {
   bool unique = false;
   std::string color_format = "linear";
   uint64_t max_points = 0;
+  std::string order = "input";
   CommonOptions common;
 };
 
@@ -59,6 +61,8 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
 }
 
 int runConvert(const ConvertOptions& o) {
+  Result<PointOrder> order = parsePointOrder("--order", o.order);
+  if (!order) return reportError(order.error());
   Progress progress(progressSink(o.common.quiet), "convert");
   WriteOptions w;
   w.threads = o.common.threads;
@@ -68,9 +72,10 @@ int runConvert(const ConvertOptions& o) {
   w.progress = &progress;
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
   // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
-  // point set; --unique needs the whole set, so it takes the path below.
+  // point set; --unique and --order morton need the whole set, so they take the path below.
   const Result<FileFormat> out_format = formatOf(o.output);
-  if (isGltf(formatOf(o.input)) && out_format && *out_format == FileFormat::kCsv && !o.unique) {
+  if (isGltf(formatOf(o.input)) && out_format && *out_format == FileFormat::kCsv && !o.unique &&
+      *order == PointOrder::kInput) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
@@ -82,6 +87,7 @@ int runConvert(const ConvertOptions& o) {
   if (filters.drop) points->colors.clear();
   if (o.unique) dropDuplicatePositions(*points);
   if (filters.srgb8) encodeColorsSrgb8(*points);
+  reorderPoints(*points, *order, o.common.threads, &progress);
   if (Status s = writePoints(o.output, *points, w); !s) return reportError(s.error());
   return 0;
 }
@@ -117,6 +123,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--max-points", o->max_points,
                   "Refuse (exit 4) input of more than N points, before --unique; glTF is refused before allocating")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--order", o->order, std::string(kPointOrderHelp) + "; applied last, after --unique")
+      ->default_val("input");
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runConvert(*o); }; });
 }

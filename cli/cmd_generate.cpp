@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
+#include "core/point_order.h"
 #include "generators/julia.h"
 #include "generators/mandelbrot2d.h"
 #include "generators/mandelbulb.h"
@@ -26,6 +27,7 @@ struct OutputOptions {
   std::string offset;
   int decimals = -1;
   std::string max_memory;
+  std::string order = "input";
   CommonOptions common;
 };
 
@@ -38,6 +40,7 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
   cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")
       ->check(CLI::Range(0, 100));
   cmd.add_option("--max-memory", o.max_memory, "Refuse (exit 4) when the estimate is above this (default: half of RAM)");
+  cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");
   addCommonOptions(cmd, o.common);
 }
 
@@ -55,8 +58,8 @@ Result<uint64_t> memoryLimit(const OutputOptions& o) {
   return parseMemorySize("--max-memory", o.max_memory);
 }
 
-// Colours, offset and writing: the steps after any generator.
-int finish(Result<PointSet> generated, const OutputOptions& o, bool auto_noise, Progress& progress) {
+// Colours, offset, order and writing: the steps after any generator.
+int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress) {
   if (!generated) return reportError(generated.error());
   PointSet& points = *generated;
   const bool noise = o.colors == "noise" || (o.colors == "auto" && auto_noise);
@@ -75,6 +78,15 @@ int finish(Result<PointSet> generated, const OutputOptions& o, bool auto_noise, 
     if (!offset) return reportError(offset.error());
     const glm::dvec3 d((*offset)[0], (*offset)[1], (*offset)[2]);
     for (glm::dvec3& p : points.positions) p += d;
+  }
+  if (order != PointOrder::kInput) {
+    Result<uint64_t> limit = memoryLimit(o);
+    if (!limit) return reportError(limit.error());
+    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
+                            points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
+    if (Status s = checkMemory("ordering " + std::to_string(points.size()) + " points", needed, *limit); !s)
+      return reportError(s.error());
+    reorderPoints(points, order, o.common.threads, &progress);
   }
   WriteOptions w;
   w.threads = o.common.threads;
@@ -100,10 +112,12 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
     run = [o, auto_noise, generate, makeParams, name] {
       int code = 0;
       if (!outputTypeOk(o->out, code)) return code;
+      Result<PointOrder> order = parsePointOrder("--order", o->out.order);
+      if (!order) return reportError(order.error());
       Progress progress(progressSink(o->out.common.quiet), name);
       Result<Params> params = makeParams(*o, &progress);
       if (!params) return reportError(params.error());
-      return finish(generate(*params), o->out, auto_noise, progress);
+      return finish(generate(*params), o->out, *order, auto_noise, progress);
     };
   });
 }

@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
+#include "core/point_order.h"
 #include "core/progress.h"
 #include "viewer/camera.h"
 #include "viewer/context.h"
@@ -22,6 +23,7 @@ namespace {
 
 struct RenderCliOptions {
   std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
+  std::string order = "input";
   CameraCliOptions camera;
   std::string background = "0,0,0";
   bool error = false, validate = false;
@@ -82,6 +84,7 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
          "},\n";
   }
   s += "  \"backend\": " + jsonString(o.backend) + ",\n";
+  s += "  \"order\": " + jsonString(o.order) + ",\n";
   s += "  \"device\": " + jsonString(f.name) + ",\n  \"device_type\": " + jsonString(f.type) + ",\n";
   s += "  \"driver\": " + jsonString(f.driver_name + " " + f.driver_info) + ",\n";
   s += "  \"driver_version\": " + jsonString(formatDriverVersion(f.vendor_id, f.driver_version)) + ",\n";
@@ -157,6 +160,8 @@ int runRender(const RenderCliOptions& o) {
     return reportError(Error{"--mode must be auto, fp32, split, rte, df64, native or batch, got '" + o.mode + "'", ExitCode::kUsage});
   if (o.backend != "raster" && o.backend != "compute")
     return reportError(Error{"--backend must be raster or compute, got '" + o.backend + "'", ExitCode::kUsage});
+  Result<PointOrder> order = parsePointOrder("--order", o.order);
+  if (!order) return reportError(order.error());
   if (!endsWithPng(o.output) && o.output.rfind("/dev/", 0) != 0)
     return reportError(Error{"-o " + o.output + ": the picture is written as PNG; name it .png", ExitCode::kUsage});
   NativePath native_path = NativePath::kAuto;
@@ -172,6 +177,7 @@ int runRender(const RenderCliOptions& o) {
   Progress progress(progressSink(o.common.quiet), "render");
   Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress});
   if (!points) return reportError(points.error());
+  reorderPoints(*points, *order, o.common.threads, &progress);
   if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
   Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
   if (!camera) return reportError(camera.error());
@@ -274,6 +280,9 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull")
       ->default_val("auto");
   cmd->add_option("--chunk-points", o->chunk_points, "Most points per draw (0: as the device allows)")->default_val(0);
+  cmd->add_option("--order", o->order,
+                  std::string(kPointOrderHelp) + "; applied as the set is loaded, before anything else")
+      ->default_val("input");
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });
 }

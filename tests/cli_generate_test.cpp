@@ -6,6 +6,7 @@
 
 #include "core/csv.h"
 #include "core/ply.h"
+#include "core/point_order.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -99,6 +100,34 @@ TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {
     EXPECT_TRUE(readFile(dir.file(std::string(kind) + "1.ply")) == readFile(dir.file(std::string(kind) + "2.ply"))) << kind;
 }
 
+// --order morton writes the set --order input writes, reordered: the same points with their
+// colours, the same triangles over them, in the library's Morton order.
+TEST(CliGenerate, mortonOrderWritesTheSameMeshReordered) {
+  TempDir dir;
+  for (const char* order : {"input", "morton"}) {
+    test::CommandResult r = runDpoint({"generate", "sierpinski", "--level", "6", "--order", order, "--threads", "2",
+                                       "-o", dir.file(std::string(order) + ".ply")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  Result<PointSet> input = readPly(dir.file("input.ply")), morton = readPly(dir.file("morton.ply"));
+  ASSERT_TRUE(input.ok() && morton.ok());
+  ASSERT_EQ(morton->size(), input->size());
+  ASSERT_GT(input->size(), 2 * kOrderBlock);  // whole blocks to shuffle and a partial one
+  ASSERT_TRUE(input->hasColors() && input->isMesh());
+  EXPECT_FALSE(morton->positions == input->positions) << "nothing moved";
+
+  ASSERT_EQ(morton->triangles.size(), input->triangles.size());
+  for (size_t i = 0; i < input->triangles.size(); ++i) {
+    ASSERT_EQ(morton->positions[morton->triangles[i]], input->positions[input->triangles[i]]) << "corner " << i;
+    ASSERT_EQ(morton->colors[morton->triangles[i]], input->colors[input->triangles[i]]) << "corner " << i;
+  }
+  PointSet expected = *input;
+  reorderPoints(expected, PointOrder::kMorton, 1);
+  EXPECT_TRUE(morton->positions == expected.positions);
+  EXPECT_TRUE(morton->colors == expected.colors);
+  EXPECT_TRUE(morton->triangles == expected.triangles);
+}
+
 TEST(CliGenerate, badParametersNameTheFlagAndWriteNothing) {
   struct Bad {
     std::vector<std::string> args;
@@ -122,6 +151,8 @@ TEST(CliGenerate, badParametersNameTheFlagAndWriteNothing) {
       {{"menger", "--level", "5", "--max-memory", "1M"}, 4, "--max-memory"},
       {{"random2d", "--max-memory", "lots"}, 1, "--max-memory"},
       {{"mandelbulb", "--variant", "fastest"}, 1, "--variant"},
+      {{"random2d", "--order", "bogus"}, 1, "--order"},
+      {{"sierpinski", "--level", "2", "--order", "Morton"}, 1, "--order"},
       {{"spiral"}, 1, "spiral"},
   };
   for (const Bad& c : cases) {

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "core/csv.h"
+#include "core/point_order.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -242,6 +243,41 @@ TEST(Cli, convertRoundTripsCsvPlyGlb) {
   }
   EXPECT_LE(worst, 4e-6);
   EXPECT_GT(worst, 0.0);  // it did go through float
+}
+
+// --order morton on every path convert takes, the glTF-to-CSV stream included (which must then
+// build the whole set); an unknown order is a usage error that writes nothing.
+TEST(Cli, convertOrdersPointsMortonAndRefusesAnUnknownOrder) {
+  TempDir dir;
+  PointSet original;
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 9000; ++i) {
+    original.positions.emplace_back(1e8 + static_cast<double>(rng() % 100000) * 1e-8,
+                                    static_cast<double>(rng() % 1000), static_cast<double>(rng() % 7));
+    original.colors.emplace_back(static_cast<float>(i % 256) / 255.0f, 0.5f, 1.0f);
+  }
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), original).ok());
+  ASSERT_EQ(runDpoint({"convert", dir.file("a.csv"), "-o", dir.file("a.glb")}).exit_code, 0);
+  for (const char* input : {"a.csv", "a.glb"}) {
+    SCOPED_TRACE(input);
+    for (const char* order : {"input", "morton"}) {
+      test::CommandResult r = runDpoint({"convert", dir.file(input), "-o", dir.file(order + std::string(".csv")),
+                                         "--order", order});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    Result<PointSet> as_read = readCsv(dir.file("input.csv")), morton = readCsv(dir.file("morton.csv"));
+    ASSERT_TRUE(as_read.ok() && morton.ok());
+    ASSERT_EQ(as_read->size(), original.size());
+    PointSet expected = *as_read;
+    reorderPoints(expected, PointOrder::kMorton, 1);
+    EXPECT_FALSE(morton->positions == as_read->positions) << "nothing moved";
+    EXPECT_TRUE(morton->positions == expected.positions);
+    EXPECT_TRUE(morton->colors == expected.colors);
+  }
+  test::CommandResult bad = runDpoint({"convert", dir.file("a.csv"), "-o", dir.file("bad.csv"), "--order", "bogus"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--order must be input or morton, got 'bogus'"), std::string::npos) << bad.err;
+  EXPECT_FALSE(test::fileExists(dir.file("bad.csv")));
 }
 
 TEST(Cli, infoReportsFloatMergesAsJson) {
