@@ -283,6 +283,9 @@ class PlyParser {
       if (!s.ok()) return s.error();
     }
     if (Status s = checkEnd(); !s.ok()) return s.error();
+    // Ends the line here, as readCsv does: left open, it went on counting the caller's next work
+    // as reading time.
+    if (options_.progress) options_.progress->finish();
     return std::move(points_);
   }
 
