@@ -7,6 +7,7 @@
 // divides a frame's bytes (reads and writes alike) by the read + write rate, 2·B / time.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -28,8 +29,14 @@ struct CopyBandwidth {
   uint32_t copies = 0;  // timed copies the median is taken over
   double copy_ms_median = 0.0;
   double copy_gb_per_s = 0.0;        // bytes / median time (1 GB = 1e9 B): the copy rate
-  double read_write_gb_per_s = 0.0;  // 2 · bytes / median time: what the bandwidth bound divides by
+  double read_write_gb_per_s = 0.0;  // 2 · bytes / median time
+  // The same bytes copied by a compute shader (shaders/copy.comp, 16-byte loads and stores); 0 when
+  // the device could not run it.
+  double shader_copy_ms_median = 0.0;
+  double shader_read_write_gb_per_s = 0.0;
   bool gpu_timestamps = true;        // false: host wall time around each submission (the queue has none)
+  // What the bandwidth bound divides by: the faster of the two read + write rates.
+  double boundRate() const { return std::max(read_write_gb_per_s, shader_read_write_gb_per_s); }
 };
 
 // 1 GiB on a GPU; 256 MiB on a CPU device (lavapipe copies with memcpy: that is past any cache, and

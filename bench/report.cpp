@@ -76,14 +76,17 @@ std::string sweepName(Sweep sweep) {
   return sweep == Sweep::kDeepZoom ? "deep zoom (view width)" : sweep == Sweep::kOffset ? "offset" : "";
 }
 
-// The bound divides by read_write_gb_per_s; bound_uses says so for a reader of the file alone.
+// The bound divides by the faster read + write rate; bound_uses says which for a reader of the file alone.
 std::string copyBandwidthJson(const std::optional<CopyBandwidth>& copy) {
   if (!copy) return "null";
   return "{\"read_write_gb_per_s\": " + num(copy->read_write_gb_per_s) + ", \"copy_gb_per_s\": " +
          num(copy->copy_gb_per_s) + ", \"copy_bytes\": " + std::to_string(copy->bytes) + ", \"copies\": " +
          std::to_string(copy->copies) + ", \"copy_ms_median\": " + num(copy->copy_ms_median) + ", \"timer\": " +
          jsonString(copy->gpu_timestamps ? "gpu timestamps" : "host wall time") +
-         ", \"bound_uses\": \"read_write_gb_per_s\"}";
+         ", \"shader_read_write_gb_per_s\": " + num(copy->shader_read_write_gb_per_s) +
+         ", \"shader_copy_ms_median\": " + num(copy->shader_copy_ms_median) + ", \"bound_uses\": " +
+         jsonString(copy->shader_read_write_gb_per_s > copy->read_write_gb_per_s ? "shader_read_write_gb_per_s"
+                                                                                 : "read_write_gb_per_s") + "}";
 }
 
 std::string rowJson(const BenchRun& run, const BenchRow& r) {

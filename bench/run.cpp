@@ -184,7 +184,7 @@ void setBandwidthBound(BenchRow& row, const CopyBandwidth* copy) {
   row.bandwidth_bound_ms.reset();
   row.bandwidth_fraction.reset();
   if (!copy || !row.bytes_per_frame) return;
-  row.bandwidth_bound_ms = bandwidthBoundMs(*row.bytes_per_frame, copy->read_write_gb_per_s);
+  row.bandwidth_bound_ms = bandwidthBoundMs(*row.bytes_per_frame, copy->boundRate());
   if (row.skipped.empty() && row.gpu_ms_median && *row.gpu_ms_median > 0.0)
     row.bandwidth_fraction = *row.bandwidth_bound_ms / *row.gpu_ms_median;
 }

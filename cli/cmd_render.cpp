@@ -175,7 +175,7 @@ int runRender(const RenderCliOptions& o) {
   if (!background) return reportError(background.error());
 
   Progress progress(progressSink(o.common.quiet), "render");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress});
+  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
   if (!points) return reportError(points.error());
   reorderPoints(*points, *order, o.common.threads, &progress);
   if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});

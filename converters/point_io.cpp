@@ -64,7 +64,7 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
     case FileFormat::kCsv:
       return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress});
     case FileFormat::kPly:
-      return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress});
+      return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only});
     case FileFormat::kGlb:
     case FileFormat::kGltf: {
       GltfReadOptions gltf;

@@ -21,6 +21,7 @@ struct ReadOptions {
   unsigned threads = 0;
   bool allow_nonfinite = false;
   Progress* progress = nullptr;
+  bool points_only = false;  // PLY: stop after the vertex element (faces are not read)
 };
 
 struct WriteOptions {

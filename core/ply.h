@@ -30,6 +30,9 @@ struct PlyReadOptions {
   bool allow_nonfinite = false;
   Progress* progress = nullptr;  // thread-safe advance() is called from every reading thread
   unsigned threads = 0;          // 0: all cores (last, so that {allow_nonfinite, progress} still reads)
+  // The caller wants positions and colours only (a renderer): reading stops after the vertex
+  // element, so faces and any later element are neither read nor checked.
+  bool points_only = false;
 };
 
 struct PlyWriteOptions {

@@ -276,13 +276,15 @@ class PlyParser {
     if (Status s = parseHeader(); !s.ok()) return s.error();
     if (Status s = planElements(); !s.ok()) return s.error();
     if (Status s = checkSizes(); !s.ok()) return s.error();
+    bool stopped = false;
     for (const Element& e : elements_) {
       Status s = readElement(e, e.name == "vertex" ? vertex_roles_
                                 : e.name == "face" ? face_roles_
                                                    : std::vector<Role>(e.properties.size(), kSkip));
       if (!s.ok()) return s.error();
+      if ((stopped = options_.points_only && e.name == "vertex")) break;
     }
-    if (Status s = checkEnd(); !s.ok()) return s.error();
+    if (Status s = stopped ? okStatus() : checkEnd(); !s.ok()) return s.error();
     // Ends the line here, as readCsv does: left open, it went on counting the caller's next work
     // as reading time.
     if (options_.progress) options_.progress->finish();

@@ -14,6 +14,7 @@
 layout(constant_id = 0) const bool kProbe = false;
 layout(constant_id = 1) const bool kEarlyDepth = true;
 layout(local_size_x = 256) in;
+const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.h
 
 layout(std430, set = 0, binding = 3) writeonly buffer Probe { vec4 probe_clip[]; };
 layout(std430, set = 0, binding = 4) buffer Visibility { uint64_t visibility[]; };
@@ -25,9 +26,8 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { uvec2 positions
 layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
 #endif
 
-void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= pc.count) return;
+// Splats point i of this dispatch.
+void splat(uint i) {
   PointInput point;
 #if defined(MODE_SPLIT) || defined(MODE_RTE) || defined(MODE_DF64)
   uint base = 6u * i;
@@ -56,4 +56,13 @@ void main() {
   uint pixel = uint(py) * pc.width + uint(px);
   if (kEarlyDepth && visibility[pixel] >= key) return;
   atomicMax(visibility[pixel], key);
+}
+
+// A workgroup takes kPointsPerThread · 256 consecutive points; thread t splats t, t + 256, …
+void main() {
+  uint first = gl_WorkGroupID.x * (kPointsPerThread * gl_WorkGroupSize.x) + gl_LocalInvocationID.x;
+  for (uint k = 0u; k < kPointsPerThread; ++k) {
+    uint i = first + k * gl_WorkGroupSize.x;
+    if (i < pc.count) splat(i);
+  }
 }

@@ -9,7 +9,7 @@ layout(push_constant) uniform Push {
   float splitter;    // 2^12 + 1, at run time so the split cannot be folded
   float point_size;
   uint first_index;  // index of this draw's first point in the whole set (batch mode, compute)
-  uint batch_size;
+  uint batch_shift;  // log2 of the points per batch
   uint width, height, count;  // compute backend: target size, points in this dispatch
 } pc;
 
@@ -78,6 +78,6 @@ vec4 projectPoint(PointInput point, uint index) {
   return vec4(cam.projection_rotation * dvec4(relative, 1.0));
 #elif defined(MODE_BATCH)
   // Offsets are integers in the batch's box; the matrix carries origin, extent and 2^−20.
-  return batch_mvp[index / pc.batch_size] * vec4(point.position, 1.0);
+  return batch_mvp[index >> pc.batch_shift] * vec4(point.position, 1.0);
 #endif
 }

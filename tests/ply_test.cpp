@@ -687,6 +687,37 @@ TEST(Ply, plyRejectsIndexOutOfRange) {
                                                    ": face 0: vertex index 4000000000 out of range"));
 }
 
+// A renderer asks for points only: the vertices and colours come back, and reading stops before
+// the faces (a bad index there goes unseen, as the option says).
+TEST(Ply, pointsOnlyStopsAfterTheVertices) {
+  TempDir dir;
+  PointSet in;
+  in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  in.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  in.triangles = {0, 1, 2};
+  ASSERT_TRUE(writePly(dir.file("mesh.ply"), in).ok());
+  PlyReadOptions options;
+  options.points_only = true;
+  Result<PointSet> points = readPly(dir.file("mesh.ply"), options);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  EXPECT_EQ(points->positions, in.positions);
+  EXPECT_EQ(points->colors, in.colors);
+  EXPECT_TRUE(points->triangles.empty());
+  Result<PointSet> whole = readPly(dir.file("mesh.ply"));
+  ASSERT_TRUE(whole.ok());
+  EXPECT_EQ(whole->triangles, in.triangles);
+
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+  const std::string path = dir.file("bad_face.ply");
+  writeFile(path, header);
+  EXPECT_FALSE(readPly(path).ok());
+  Result<PointSet> vertices = readPly(path, options);
+  ASSERT_TRUE(vertices.ok()) << vertices.error().message;
+  EXPECT_EQ(vertices->size(), 3u);
+}
+
 TEST(Ply, plyRejectsFaceWithTwoVertices) {
   TempDir dir;
   auto r = readText(dir, "line.ply",

@@ -63,7 +63,8 @@ inline uint32_t positionBytes(PrecisionMode mode) { return modeInfo(mode).positi
 inline uint32_t bytesPerPoint(PrecisionMode mode) { return positionBytes(mode) + 4; }
 
 // Points per batch in `batch` mode: consecutive points share one double origin and scale.
-inline constexpr uint32_t kBatchSize = 4096;
+inline constexpr uint32_t kBatchShift = 12;
+inline constexpr uint32_t kBatchSize = 1u << kBatchShift;
 
 // Linear 0..1 colour → RGBA8 (R in the low byte), rounded to nearest, alpha 255. The image is
 // UNORM, so the byte goes to the PNG unchanged. Points without colour are white.

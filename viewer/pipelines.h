@@ -20,7 +20,7 @@ struct PushConstants {
   float splitter = 4097.0f;  // 2^12 + 1: Dekker's split of a 24-bit significand
   float point_size = 1.0f;
   uint32_t first_index = 0;  // index of the draw's first point in the whole set
-  uint32_t batch_size = kBatchSize;
+  uint32_t batch_shift = kBatchShift;  // log2(kBatchSize): a point's batch is index >> batch_shift
   uint32_t width = 0, height = 0, count = 0;  // compute backend
 };
 
@@ -28,6 +28,10 @@ struct PushConstants {
 // (one uint64 per pixel); the resolve pass has its own set (visibility, colours, picture).
 inline constexpr uint32_t kBindingVisibility = 4;
 inline constexpr uint32_t kComputeGroupSize = 256;  // local_size_x of both compute shaders
+// Points per splat thread (the shader's kPointsPerThread): a workgroup splats 1024 consecutive
+// points, each thread one from every 256, so every load is still coalesced.
+inline constexpr uint32_t kSplatPointsPerThread = 4;
+inline constexpr uint32_t kSplatPointsPerGroup = kComputeGroupSize * kSplatPointsPerThread;
 
 struct PointPipelines {
   VkRenderPass render_pass = VK_NULL_HANDLE;

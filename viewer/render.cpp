@@ -32,9 +32,9 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
     if (options.probe) per_point = std::max<uint64_t>(per_point, sizeof(glm::vec4));
   }
   uint64_t points = std::max<uint64_t>(1, limit / per_point);
-  // The compute backend dispatches one 256-thread group per 256 points of a chunk.
+  // The compute backend dispatches one 256-thread group per kSplatPointsPerGroup points of a chunk.
   if (options.backend == Backend::kCompute)
-    points = std::min<uint64_t>(points, uint64_t{facts.max_dispatch_groups_x} * kComputeGroupSize);
+    points = std::min<uint64_t>(points, uint64_t{facts.max_dispatch_groups_x} * kSplatPointsPerGroup);
   if (options.max_chunk_points) points = std::min(points, options.max_chunk_points);
   return static_cast<size_t>(points);
 }

@@ -89,7 +89,7 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
     push.count = static_cast<uint32_t>(chunk.count);
     vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
-    vkCmdDispatch(commands, static_cast<uint32_t>((chunk.count + kComputeGroupSize - 1) / kComputeGroupSize), 1, 1);
+    vkCmdDispatch(commands, static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup), 1, 1);
   }
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT);
