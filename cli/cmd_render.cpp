@@ -1,9 +1,14 @@
 // dpoint render IN -o OUT.png: the offscreen Vulkan preview in one precision mode, with GPU
 // timing and, with --error, the error against the exact CPU reference (DESIGN §4–6).
+#include <sys/resource.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "cli/cli_camera.h"
 #include "cli/cli_text.h"
@@ -63,8 +68,29 @@ struct Prediction {
 // Points the probe measured: visible in the reference and not lost.
 bool anyMeasured(const ErrorStats& e) { return e.points > e.lost; }
 
+// Where the command's wall time goes, step by step (the time to a picture), and its peak memory.
+class Phases {
+ public:
+  void mark(const char* name) {
+    const auto now = std::chrono::steady_clock::now();
+    list_.emplace_back(name, std::chrono::duration<double, std::milli>(now - last_).count());
+    last_ = now;
+  }
+  const std::vector<std::pair<const char*, double>>& list() const { return list_; }
+  static double peakRssMb() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // kilobytes on Linux
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  std::vector<std::pair<const char*, double>> list_;
+};
+
 std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
-                       const RenderResult& r, const Prediction& prediction, const ErrorReport* error) {
+                       const RenderResult& r, const Prediction& prediction, const ErrorReport* error,
+                       const Phases& phases) {
   const DeviceFacts& f = context.facts;
   const PrecisionMode mode = prediction.mode;
   double gpu_median = medianOf(r.gpu_ms), frame_median = medianOf(r.frame_ms);
@@ -101,6 +127,10 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   s += "  \"frame_ms\": {\"median\": " + num(frame_median) + ", \"p95\": " + num(percentileOf(r.frame_ms, 95)) + "},\n";
   s += "  \"upload_ms\": " + num(r.upload_ms) + ",\n  \"readback_ms\": " + num(r.readback_ms) + ",\n";
   s += "  \"e2e_ms\": " + num(r.upload_ms + frame_median + r.readback_ms) + ",\n";
+  s += "  \"phases_ms\": {";
+  for (size_t i = 0; i < phases.list().size(); ++i)
+    s += std::string(i ? ", " : "") + jsonString(phases.list()[i].first) + ": " + num(phases.list()[i].second);
+  s += "},\n  \"peak_rss_mb\": " + num(Phases::peakRssMb()) + ",\n";
   s += "  \"points_per_s\": " + num(static_cast<double>(points.size()) / (per_frame_ms * 1e-3)) + ",\n";
   s += "  \"bytes_per_point\": " + std::to_string(bytesPerPoint(mode)) + ",\n";
   s += "  \"chunks\": " + std::to_string(r.chunks) + ",\n";
@@ -174,19 +204,25 @@ int runRender(const RenderCliOptions& o) {
   Result<uint32_t> background = parseBackground(o.background);
   if (!background) return reportError(background.error());
 
+  Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
   Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
   if (!points) return reportError(points.error());
+  phases.mark("read");
   reorderPoints(*points, *order, o.common.threads, &progress);
+  phases.mark("order");
   if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
   Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
   if (!camera) return reportError(camera.error());
+  phases.mark("camera");
 
   Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
   if (!context) return reportError(context.error());
+  phases.mark("device");
   const Backend backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
   Result<Prediction> prediction = predict(o, **context, *points, *camera, backend);
   if (!prediction) return reportError(prediction.error());
+  phases.mark("mode");
   RenderOptions options;
   options.mode = prediction->mode;
   options.backend = backend;
@@ -199,15 +235,18 @@ int runRender(const RenderCliOptions& o) {
   options.max_chunk_points = o.chunk_points;
   Result<RenderResult> rendered = renderPoints(**context, *points, *camera, options);
   if (!rendered) return reportError(rendered.error());
+  phases.mark("render");
   std::optional<ErrorReport> error;
   if (o.error) error = measureError(*points, *camera, *rendered, options);
+  if (o.error) phases.mark("error");
 
   Status written = writePng(o.output, rendered->image);
   if (!written) return reportError(written.error());
+  phases.mark("png");
   if (!o.json.empty()) {
     Result<AtomicFile> file = AtomicFile::create(o.json);
     if (!file) return reportError(file.error());
-    Status status = file->write(jsonReport(o, **context, *points, *rendered, *prediction, error ? &*error : nullptr));
+    Status status = file->write(jsonReport(o, **context, *points, *rendered, *prediction, error ? &*error : nullptr, phases));
     if (status) status = file->commit();
     if (!status) return reportError(status.error());
   }
@@ -224,6 +263,13 @@ int runRender(const RenderCliOptions& o) {
                 r.gpu_ms.size(), percentileOf(r.gpu_ms, 95),
                 static_cast<double>(points->size()) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(mode));
   std::printf("host: upload %.1f ms, frame %.3f ms, readback %.1f ms\n", r.upload_ms, medianOf(r.frame_ms), r.readback_ms);
+  std::string steps;
+  for (const auto& [name, ms] : phases.list()) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%s%s %.1f", steps.empty() ? "" : ", ", name, ms);
+    steps += text;
+  }
+  std::printf("time to picture (ms): %s; peak memory %.0f MB\n", steps.c_str(), Phases::peakRssMb());
   if (error) {
     const ErrorStats& e = error->stats;
     std::string image_check = error->pixels_compared

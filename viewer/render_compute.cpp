@@ -15,6 +15,12 @@ Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t
                                            false, "visibility buffer");
   if (!visibility) return visibility.error();
   r.visibility = *visibility;
+  // Every key starts at 0 (nothing drawn); from then on each frame's resolve leaves them so.
+  if (Status status = submitOnce(context, [&](VkCommandBuffer commands) {
+        vkCmdFillBuffer(commands, r.visibility.buffer, 0, VK_WHOLE_SIZE, 0);
+      });
+      !status)
+    return status;
   Result<Buffer> picture = createBuffer(context, pixels * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                         false, "picture");
   if (!picture) return picture.error();
@@ -73,11 +79,9 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
     vkCmdResetQueryPool(commands, r.queries, 0, 2);
     vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r.queries, 0);
   }
-  // The previous frame's resolve read the keys; then they start again from 0 (nothing drawn).
-  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT);
-  vkCmdFillBuffer(commands, r.visibility.buffer, 0, VK_WHOLE_SIZE, 0);
-  barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+  // The keys are 0: cleared when the buffer was made, and by every earlier frame's resolve.
+  barrier(VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, splat);
   for (const Chunk& chunk : r.chunks) {
@@ -92,7 +96,7 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
     vkCmdDispatch(commands, static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup), 1, 1);
   }
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_SHADER_READ_BIT);
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve);
   ResolvePush resolve{pixels, options.background_rgba8};
   vkCmdPushConstants(commands, r.compute.resolve_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(resolve), &resolve);
