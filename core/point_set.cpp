@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <vector>
 
@@ -12,12 +13,18 @@
 namespace dpoint {
 
 bool PointSet::isPlanar() const {
-  for (const glm::dvec3& p : positions) {
-    uint64_t bits;
-    std::memcpy(&bits, &p.z, sizeof bits);
-    if (bits != 0) return false;
-  }
-  return true;
+  // Blocks on every core; a 3D set usually answers in its first block.
+  constexpr size_t kBlock = size_t{1} << 20;
+  std::atomic<bool> planar{true};
+  parallelFor((positions.size() + kBlock - 1) / kBlock, 0, [&](size_t b, unsigned) {
+    const size_t end = std::min(positions.size(), (b + 1) * kBlock);
+    for (size_t i = b * kBlock; i < end && planar.load(std::memory_order_relaxed); ++i) {
+      uint64_t bits;
+      std::memcpy(&bits, &positions[i].z, sizeof bits);
+      if (bits != 0) planar.store(false, std::memory_order_relaxed);
+    }
+  });
+  return planar.load();
 }
 
 namespace {
