@@ -51,6 +51,15 @@ TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
   EXPECT_GT(jsonNumber(json, "points_per_s"), 0.0);
   EXPECT_LT(jsonNumber(json, "max"), 0.01);
   EXPECT_NE(r.out.find("error: max"), std::string::npos) << r.out;
+  // Where the wall time went, step by step, and the peak memory (issue #11's time to a picture).
+  const size_t phases_at = json.find("\"phases_ms\": {");
+  ASSERT_NE(phases_at, std::string::npos) << json;
+  const std::string phases = json.substr(phases_at, json.find('}', phases_at) - phases_at);
+  for (const char* step : {"read", "camera", "device", "mode", "render", "error", "png"})
+    EXPECT_GE(jsonNumber(phases, step), 0.0) << step << " in " << phases;
+  EXPECT_GT(jsonNumber(phases, "render"), 0.0);
+  EXPECT_GT(jsonNumber(json, "peak_rss_mb"), 1.0);
+  EXPECT_NE(r.out.find("time to picture (ms): read "), std::string::npos) << r.out;
 }
 
 // DESIGN §7 offset, end to end: a generated fractal moved to the Earth's radius.

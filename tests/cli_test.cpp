@@ -88,6 +88,18 @@ TEST(Cli, benchRefusesUnknownSuiteBackendFramesAndSizesBeforeDrawing) {
   EXPECT_NE(sizes.err.find("16.7M"), std::string::npos) << "lists the sizes there are: " << sizes.err;
 }
 
+// The copy bandwidth alone: both copies measured and named; a bad size is refused with the flag.
+TEST(Cli, benchCopyMeasuresBothCopiesAndRefusesABadSize) {
+  test::CommandResult r = runDpoint({"bench", "copy", "--copy-bytes", "8M", "--copy-repeats", "3", "--validate"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("read+write"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("8.0 MiB vkCmdCopyBuffer, median of 3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("compute-shader copy"), std::string::npos) << r.out;
+  test::CommandResult bad = runDpoint({"bench", "copy", "--copy-bytes", "lots"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--copy-bytes"), std::string::npos) << bad.err;
+}
+
 TEST(Cli, badInputExitsTwoWithOneLineAndWritesNothing) {
   std::string garbage;
   std::mt19937 rng(11);

@@ -96,13 +96,20 @@ static Status syncMapped(const VulkanContext& context, const Buffer& buffer, boo
 Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, true); }
 static Status flushBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, false); }
 
-Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record) {
+Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context) {
   VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   allocate.commandPool = context.command_pool;
   allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   allocate.commandBufferCount = 1;
   VkCommandBuffer commands = VK_NULL_HANDLE;
   VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &commands));
+  return commands;
+}
+
+Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record) {
+  Result<VkCommandBuffer> allocated = allocateCommandBuffer(context);
+  if (!allocated) return allocated.error();
+  VkCommandBuffer commands = *allocated;
   VkFence fence = VK_NULL_HANDLE;
   auto cleanup = [&]() {
     if (fence) vkDestroyFence(context.device, fence, nullptr);
@@ -175,11 +182,9 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
       Result<Buffer> staging = createBuffer(context, piece, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "staging");
       if (!staging) return staging.error();
       s.staging = *staging;
-      VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-      allocate.commandPool = context.command_pool;
-      allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-      allocate.commandBufferCount = 1;
-      VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &s.commands));
+      Result<VkCommandBuffer> commands = allocateCommandBuffer(context);
+      if (!commands) return commands.error();
+      s.commands = *commands;
       VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
       VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &s.fence));
     }

@@ -25,6 +25,9 @@ void destroyBuffer(const VulkanContext& context, Buffer& buffer);
 // Makes device writes visible to the host for a mapped, non-coherent buffer.
 Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
 
+// A primary command buffer from the context's pool (the caller frees it).
+Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context);
+
 // Records with `record` into a fresh primary command buffer, submits it, waits.
 Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record);
 

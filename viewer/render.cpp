@@ -243,11 +243,9 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
     query_info.queryCount = 2;
     VK_TRY(vkCreateQueryPool(context.device, &query_info, nullptr, &r.queries));
   }
-  VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  allocate.commandPool = context.command_pool;
-  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  allocate.commandBufferCount = 1;
-  VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &r.frame_commands));
+  Result<VkCommandBuffer> commands = allocateCommandBuffer(context);
+  if (!commands) return commands.error();
+  r.frame_commands = *commands;
   VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   VK_TRY(vkBeginCommandBuffer(r.frame_commands, &begin));
   if (options.backend == Backend::kCompute)
