@@ -107,13 +107,6 @@ Status createShaderCopy(const VulkanContext& context, CopyScratch& s) {
   return okStatus();
 }
 
-double median(std::vector<double> v) {
-  assert(!v.empty());
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 }  // namespace
 
 uint64_t defaultCopyBytes(const VulkanContext& context) {
@@ -187,7 +180,7 @@ Result<CopyBandwidth> measureCopyBandwidth(const VulkanContext& context, const C
                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
       ms.push_back(static_cast<double>(ticks[1] - ticks[0]) * context.facts.timestamp_period_ns * 1e-6);
     }
-    return median(ms);
+    return medianOf(ms);
   };
   const VkBufferCopy region{0, 0, bytes};
   Result<double> copy_ms = time([&](VkCommandBuffer commands) {

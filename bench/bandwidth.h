@@ -36,7 +36,8 @@ struct CopyBandwidth {
   double shader_read_write_gb_per_s = 0.0;
   bool gpu_timestamps = true;        // false: host wall time around each submission (the queue has none)
   // What the bandwidth bound divides by: the faster of the two read + write rates.
-  double boundRate() const { return std::max(read_write_gb_per_s, shader_read_write_gb_per_s); }
+  bool shaderCopyFaster() const { return shader_read_write_gb_per_s > read_write_gb_per_s; }
+  double boundRate() const { return shaderCopyFaster() ? shader_read_write_gb_per_s : read_write_gb_per_s; }
 };
 
 // 1 GiB on a GPU; 256 MiB on a CPU device (lavapipe copies with memcpy: that is past any cache, and

@@ -85,8 +85,7 @@ std::string copyBandwidthJson(const std::optional<CopyBandwidth>& copy) {
          jsonString(copy->gpu_timestamps ? "gpu timestamps" : "host wall time") +
          ", \"shader_read_write_gb_per_s\": " + num(copy->shader_read_write_gb_per_s) +
          ", \"shader_copy_ms_median\": " + num(copy->shader_copy_ms_median) + ", \"bound_uses\": " +
-         jsonString(copy->shader_read_write_gb_per_s > copy->read_write_gb_per_s ? "shader_read_write_gb_per_s"
-                                                                                 : "read_write_gb_per_s") + "}";
+         jsonString(copy->shaderCopyFaster() ? "shader_read_write_gb_per_s" : "read_write_gb_per_s") + "}";
 }
 
 std::string rowJson(const BenchRun& run, const BenchRow& r) {

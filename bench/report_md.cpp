@@ -20,13 +20,6 @@ std::string withCommas(uint64_t n) {
   return out;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // Whole frames per second with thousands separated from 100 up (a reader compares magnitudes),
 // three digits below.
 std::string fpsText(double fps) {
@@ -118,7 +111,7 @@ void glanceCost(const BenchRun& run, std::string& s) {
         const BenchRow *base = rowOf(rows, PrecisionMode::kFp32), *row = rowOf(rows, mode);
         if (ran(base) && ran(row)) ratios.push_back(frameMs(*row) / frameMs(*base));
       }
-      if (!ratios.empty()) line += (line.empty() ? "" : ", ") + modeText(mode) + " " + g3(median(ratios)) + "×";
+      if (!ratios.empty()) line += (line.empty() ? "" : ", ") + modeText(mode) + " " + g3(medianOf(ratios)) + "×";
     }
     if (!line.empty())
       s += "- **Cost of precision, " + backendText(backend) + " backend**: GPU time per frame against fp32's, median over " +
@@ -131,7 +124,7 @@ void glanceCost(const BenchRun& run, std::string& s) {
       if (ran(raster[m]) && ran(compute[m])) speedups.push_back(frameMs(*raster[m]) / frameMs(*compute[m]));
   }
   if (!speedups.empty())
-    s += "- **Backends**: the compute backend draws the same picture " + g3(median(speedups)) +
+    s += "- **Backends**: the compute backend draws the same picture " + g3(medianOf(speedups)) +
          "× as fast as the raster backend (raster GPU time / compute GPU time, median over datasets and modes; from " +
          g3(*std::min_element(speedups.begin(), speedups.end())) + "× to " +
          g3(*std::max_element(speedups.begin(), speedups.end())) + "×).\n";

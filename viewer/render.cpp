@@ -212,8 +212,8 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
                                     false, "camera uniform");
   if (!ubo) return ubo.error();
   r.camera = *ubo;
-  Status status = uploadBuffer(context, r.camera, uniform.size(), [&](void* dst, VkDeviceSize, VkDeviceSize bytes) {
-    std::memcpy(dst, uniform.data(), bytes);
+  Status status = uploadBuffer(context, r.camera, uniform.size(), [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+    std::memcpy(dst, uniform.data() + offset, bytes);
   });
   if (!status) return status;
   Result<Buffer> dummy = createBuffer(context, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "unused binding");
