@@ -28,7 +28,8 @@ namespace {
 
 struct RenderCliOptions {
   std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
-  std::string order = "input";
+  std::string order = "input", shade = "auto", color = "auto";
+  double edl_strength = 1.0, edl_radius = 1.4;
   CameraCliOptions camera;
   std::string background = "0,0,0";
   bool error = false, validate = false;
@@ -149,6 +150,14 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   return s + "\n}\n";
 }
 
+// --shade auto: eye-dome lighting for a 3D view, none for a 2D set (a flat set has no depth to
+// shade) and with --error (whose image check compares plain pixels with the reference raster).
+Shading shadingFor(const RenderCliOptions& o, const Camera& camera) {
+  if (o.shade == "edl") return Shading::kEdl;
+  if (o.shade == "none" || o.error) return Shading::kNone;
+  return camera.ortho ? Shading::kNone : Shading::kEdl;
+}
+
 // --mode auto picks on the device; an explicit mode gets its bound computed for the report.
 Result<Prediction> predict(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
                            const Camera& camera, Backend backend) {
@@ -199,6 +208,12 @@ int runRender(const RenderCliOptions& o) {
   else if (o.native_path == "pull") native_path = NativePath::kPull;
   else if (o.native_path != "auto")
     return reportError(Error{"--native-path must be auto, attribute or pull, got '" + o.native_path + "'", ExitCode::kUsage});
+  if (o.shade != "auto" && o.shade != "none" && o.shade != "edl")
+    return reportError(Error{"--shade must be auto, none or edl, got '" + o.shade + "'", ExitCode::kUsage});
+  if (!(o.edl_strength > 0.0 && o.edl_strength <= 100.0))
+    return reportError(Error{"--edl-strength must be in (0, 100], got " + formatNumber(o.edl_strength, true), ExitCode::kUsage});
+  if (!(o.edl_radius >= 1.0 && o.edl_radius <= 16.0))
+    return reportError(Error{"--edl-radius must be in [1, 16] pixels, got " + formatNumber(o.edl_radius, true), ExitCode::kUsage});
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
   Result<uint32_t> background = parseBackground(o.background);
@@ -233,6 +248,8 @@ int runRender(const RenderCliOptions& o) {
   options.probe = o.error;
   options.native_path = native_path;
   options.max_chunk_points = o.chunk_points;
+  options.shading = shadingFor(o, *camera);
+  options.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
   Result<RenderResult> rendered = renderPoints(**context, *points, *camera, options);
   if (!rendered) return reportError(rendered.error());
   phases.mark("render");
@@ -274,7 +291,7 @@ int runRender(const RenderCliOptions& o) {
     const ErrorStats& e = error->stats;
     std::string image_check = error->pixels_compared
         ? std::to_string(error->pixels_differing) + " pixels differ from the reference raster"
-        : "no image check (the reference raster draws --point-size 1 only)";
+        : "no image check (the reference raster draws plain --point-size 1 pixels only)";
     if (anyMeasured(e)) {
       std::printf("error: max %.4g px, p99 %.4g px, rms %.4g px, %.4g%% of %zu visible points off by >= 0.5 px, "
                   "%zu lost; %s\n",
@@ -329,6 +346,15 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--order", o->order,
                   std::string(kPointOrderHelp) + "; applied as the set is loaded, before anything else")
       ->default_val("input");
+  cmd->add_option("--shade", o->shade,
+                  "auto|none|edl. edl: eye-dome lighting, a screen-space pass over the depth of the visible points\n"
+                  "that darkens a pixel by how far its neighbours stand in front of it, so a surface of 1-px points\n"
+                  "reads as a surface (as in Potree and CloudCompare). auto: edl for a 3D view, none for 2D sets\n"
+                  "(ortho views) and with --error; GPU timings exclude it")
+      ->default_val("auto");
+  cmd->add_option("--edl-strength", o->edl_strength, "Eye-dome darkening: exp(-strength * 300 * mean log2 depth step)")
+      ->default_val(1.0);
+  cmd->add_option("--edl-radius", o->edl_radius, "Eye-dome neighbour distance in pixels (1..16)")->default_val(1.4);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });
 }

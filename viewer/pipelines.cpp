@@ -8,6 +8,7 @@
 #include "shaders/points_rte.vert.h"
 #include "shaders/points_split.vert.h"
 #include "shaders/points.frag.h"
+#include "shaders/edl.comp.h"
 #include "shaders/points_resolve.comp.h"
 #include "shaders/splat_batch.comp.h"
 #include "shaders/splat_df64.comp.h"
@@ -73,7 +74,8 @@ Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescript
   return layout;
 }
 
-// Specialization constants of the splat (ignored by the resolve): 0 kProbe, 1 kEarlyDepth.
+// Two boolean specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
+// 0 kWriteDepth (its constant 1 is unused); the eye-dome pass has none.
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
                                    bool early_depth) {
   Result<VkShaderModule> module = createShaderModule(context, code.code, code.bytes);
@@ -95,7 +97,9 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
   return pipeline;
 }
 
-Result<VkRenderPass> createRenderPass(const VulkanContext& context) {
+// keep_depth: the depth attachment is stored and left in TRANSFER_SRC_OPTIMAL for the eye-dome
+// pass to copy; otherwise it is discarded.
+Result<VkRenderPass> createRenderPass(const VulkanContext& context, bool keep_depth) {
   VkAttachmentDescription attachments[2] = {};
   attachments[0].format = kColorFormat;
   attachments[0].samples = VK_SAMPLE_COUNT_1_BIT;
@@ -107,8 +111,8 @@ Result<VkRenderPass> createRenderPass(const VulkanContext& context) {
   attachments[0].finalLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
   attachments[1] = attachments[0];
   attachments[1].format = kDepthFormat;
-  attachments[1].storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-  attachments[1].finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+  attachments[1].storeOp = keep_depth ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  attachments[1].finalLayout = keep_depth ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
   VkAttachmentReference color_ref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
   VkAttachmentReference depth_ref{1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
   VkSubpassDescription subpass{};
@@ -129,9 +133,11 @@ Result<VkRenderPass> createRenderPass(const VulkanContext& context) {
                                   VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT;
   dependencies[1].srcSubpass = 0;
   dependencies[1].dstSubpass = VK_SUBPASS_EXTERNAL;
-  dependencies[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  dependencies[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                                 (keep_depth ? VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT : 0);
   dependencies[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
-  dependencies[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  dependencies[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+                                  (keep_depth ? VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT : 0);
   dependencies[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
   VkRenderPassCreateInfo info = {VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
   info.attachmentCount = 2;
@@ -254,14 +260,14 @@ Result<VkShaderModule> createShaderModule(const VulkanContext& context, const ui
 }
 
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
-                                            bool with_probe, uint32_t width, uint32_t height) {
+                                            bool with_probe, uint32_t width, uint32_t height, bool keep_depth) {
   PointPipelines p;
   p.pulls_positions = mode == PrecisionMode::kNative && pull;
   auto fail = [&](const Error& error) -> Result<PointPipelines> {
     destroyPointPipelines(context, p);
     return error;
   };
-  Result<VkRenderPass> render_pass = createRenderPass(context);
+  Result<VkRenderPass> render_pass = createRenderPass(context, keep_depth);
   if (!render_pass) return fail(render_pass.error());
   p.render_pass = *render_pass;
 
@@ -297,7 +303,7 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
 }
 
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth) {
+                                                bool early_depth, bool write_depth) {
   ComputePipelines p;
   auto fail = [&](const Error& error) -> Result<ComputePipelines> {
     destroyComputePipelines(context, p);
@@ -311,7 +317,7 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
       storage(kBindingPositions), storage(kBindingBatches), storage(kBindingProbe), storage(kBindingVisibility)});
   if (!splat_set) return fail(splat_set.error());
   p.splat_set = *splat_set;
-  Result<VkDescriptorSetLayout> resolve_set = storageSetLayout(context, {storage(0), storage(1), storage(2)});
+  Result<VkDescriptorSetLayout> resolve_set = storageSetLayout(context, {storage(0), storage(1), storage(2), storage(3)});
   if (!resolve_set) return fail(resolve_set.error());
   p.resolve_set = *resolve_set;
   Result<VkPipelineLayout> splat_layout = pipelineLayout(context, p.splat_set, sizeof(PushConstants), VK_SHADER_STAGE_COMPUTE_BIT);
@@ -328,7 +334,8 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
     if (!probe) return fail(probe.error());
     p.probe = *probe;
   }
-  Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout, false, false);
+  Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout,
+                                                 write_depth, false);
   if (!resolve) return fail(resolve.error());
   p.resolve = *resolve;
   return p;
@@ -342,6 +349,34 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& p) 
   for (VkDescriptorSetLayout set : {p.splat_set, p.resolve_set})
     if (set) vkDestroyDescriptorSetLayout(context.device, set, nullptr);
   p = ComputePipelines{};
+}
+
+Result<ShadePipeline> createShadePipeline(const VulkanContext& context) {
+  ShadePipeline p;
+  auto fail = [&](const Error& error) -> Result<ShadePipeline> {
+    destroyShadePipeline(context, p);
+    return error;
+  };
+  auto storage = [](uint32_t binding) {
+    return VkDescriptorSetLayoutBinding{binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  };
+  Result<VkDescriptorSetLayout> set = storageSetLayout(context, {storage(0), storage(1), storage(2)});
+  if (!set) return fail(set.error());
+  p.set_layout = *set;
+  Result<VkPipelineLayout> layout = pipelineLayout(context, p.set_layout, sizeof(EdlPush), VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!layout) return fail(layout.error());
+  p.layout = *layout;
+  Result<VkPipeline> edl = computePipeline(context, {kEdlComp, sizeof(kEdlComp)}, p.layout, false, false);
+  if (!edl) return fail(edl.error());
+  p.edl = *edl;
+  return p;
+}
+
+void destroyShadePipeline(const VulkanContext& context, ShadePipeline& p) {
+  if (p.edl) vkDestroyPipeline(context.device, p.edl, nullptr);
+  if (p.layout) vkDestroyPipelineLayout(context.device, p.layout, nullptr);
+  if (p.set_layout) vkDestroyDescriptorSetLayout(context.device, p.set_layout, nullptr);
+  p = ShadePipeline{};
 }
 
 void destroyPointPipelines(const VulkanContext& context, PointPipelines& p) {

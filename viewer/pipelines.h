@@ -42,9 +42,10 @@ struct PointPipelines {
   bool pulls_positions = false;       // native mode reads a storage buffer instead of vertex input
 };
 
-// `pull` selects vertex pulling for native mode (ignored by the other modes).
+// `pull` selects vertex pulling for native mode (ignored by the other modes). `keep_depth` stores
+// the depth attachment and leaves it ready to copy (TRANSFER_SRC_OPTIMAL) for the eye-dome pass.
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
-                                            bool with_probe, uint32_t width, uint32_t height);
+                                            bool with_probe, uint32_t width, uint32_t height, bool keep_depth = false);
 void destroyPointPipelines(const VulkanContext& context, PointPipelines& pipelines);
 
 // The compute backend (DESIGN §4): a splat pass per mode (and its probe twin) and the resolve.
@@ -58,9 +59,26 @@ struct ResolvePush {
   uint32_t background = 0;
 };
 // `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
+// `write_depth` has the resolve also write each pixel's depth (binding 3) for the eye-dome pass.
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth = true);
+                                                bool early_depth = true, bool write_depth = false);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
+
+// Eye-dome lighting (shaders/edl.comp), the same pass after either backend: reads a float depth per
+// pixel (0 = nothing drawn) and the RGBA8 picture, writes the shaded picture (bindings 0, 1, 2).
+struct ShadePipeline {
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline edl = VK_NULL_HANDLE;
+};
+struct EdlPush {
+  uint32_t width = 0, height = 0;
+  float depth_scale = 0.0f;  // perspective: (far − near) / near; 0 for ortho
+  float strength = 1.0f, radius = 1.4f;
+};
+inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/edl.comp
+Result<ShadePipeline> createShadePipeline(const VulkanContext& context);
+void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);
 
 // Creates a shader module from SPIR-V words.
 Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);

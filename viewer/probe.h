@@ -11,7 +11,7 @@ namespace dpoint {
 struct ErrorReport {
   ErrorStats stats;
   // Rendered picture vs reference raster; the reference draws size-1 points only, so with a
-  // larger point size there is no image check (pixels_compared false).
+  // larger point size or with shading there is no image check (pixels_compared false).
   bool pixels_compared = false;
   size_t pixels_differing = 0;
   Image reference;              // the reference raster

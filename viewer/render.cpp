@@ -165,13 +165,14 @@ Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& 
   return okStatus();
 }
 
-Status createTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height) {
+Status createTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool keep_depth) {
   Result<GpuImage> color = createImage(context, width, height, kColorFormat,
       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
   if (!color) return color.error();
   r.color = *color;
   Result<GpuImage> depth = createImage(context, width, height, kDepthFormat,
-      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
+      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | (keep_depth ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0),
+      VK_IMAGE_ASPECT_DEPTH_BIT);
   if (!depth) return depth.error();
   r.depth = *depth;
   VkImageView views[2] = {r.color.view, r.depth.view};
@@ -191,7 +192,8 @@ Status createTargets(const VulkanContext& context, Resources& r, uint32_t width,
 }
 
 Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
-  if (Status status = detail::createDescriptorPool(context, r, static_cast<uint32_t>(r.chunks.size()), 3); !status)
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.edl ? 1 : 0);
+  if (Status status = detail::createDescriptorPool(context, r, sets, 3); !status)
     return status;
   for (Chunk& chunk : r.chunks) {
     VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -201,7 +203,7 @@ Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled
     VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &chunk.set));
     writeDescriptors(context, r, chunk, pulled, probe);
   }
-  return okStatus();
+  return r.shade.edl ? detail::createShadeDescriptors(context, r) : okStatus();
 }
 
 Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
@@ -234,8 +236,9 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
   return okStatus();
 }
 
-Status timeFrames(const VulkanContext& context, Resources& r, const RenderOptions& options, uint32_t width,
-                  uint32_t height, RenderResult& out) {
+Status timeFrames(const VulkanContext& context, Resources& r, const RenderOptions& options, const Camera& camera,
+                  RenderResult& out) {
+  const uint32_t width = camera.width, height = camera.height;
   bool timestamps = context.facts.timestamp_period_ns > 0.0f;
   if (timestamps) {
     VkQueryPoolCreateInfo query_info = {VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
@@ -252,6 +255,8 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
     detail::recordCompute(r.frame_commands, r, r.compute.splat, options, width, height, timestamps);
   else
     recordDraws(r.frame_commands, r, r.pipelines.draw, options, width, height, timestamps);
+  if (options.shading == Shading::kEdl)
+    detail::recordShade(r.frame_commands, r, detail::edlPush(camera, options.edl), options.backend == Backend::kRaster);
   VK_TRY(vkEndCommandBuffer(r.frame_commands));
   VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
@@ -280,9 +285,10 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
 Status readPicture(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, RenderResult& out) {
   Clock::time_point start = Clock::now();
   Status status = submitOnce(context, [&](VkCommandBuffer commands) {
-    if (r.picture.buffer) {  // compute: the resolve wrote packed RGBA8 rows
+    if (const Buffer& rows = r.shaded.buffer ? r.shaded : r.picture; rows.buffer) {
+      // packed RGBA8 rows: the eye-dome pass's, or the compute resolve's
       VkBufferCopy copy{0, 0, VkDeviceSize{width} * height * 4};
-      vkCmdCopyBuffer(commands, r.picture.buffer, r.readback.buffer, 1, &copy);
+      vkCmdCopyBuffer(commands, rows.buffer, r.readback.buffer, 1, &copy);
     } else {
       VkBufferImageCopy copy{};
       copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -354,6 +360,7 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
     self_test = *ran;
   }
   const bool compute = options.backend == Backend::kCompute;
+  const bool shading = options.shading == Shading::kEdl;
   // The compute probe writes from a compute shader, which needs no vertex-stage stores.
   status = modeUsable(context, options.mode, self_test, options.probe && !compute);
   if (!status) return status.error();
@@ -369,12 +376,13 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
                  (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
   Resources r(context);
   if (compute) {
-    Result<ComputePipelines> pipelines = createComputePipelines(context, options.mode, options.probe, options.early_depth);
+    Result<ComputePipelines> pipelines =
+        createComputePipelines(context, options.mode, options.probe, options.early_depth, shading);
     if (!pipelines) return pipelines.error();
     r.compute = *pipelines;
   } else {
     Result<PointPipelines> pipelines =
-        createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height);
+        createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height, shading);
     if (!pipelines) return pipelines.error();
     r.pipelines = *pipelines;
   }
@@ -390,12 +398,14 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
 
   if (compute) {
     status = detail::createComputeTargets(context, r, camera.width, camera.height);
+    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, false);
     if (status) status = detail::createComputeDescriptors(context, r, options.probe);
   } else {
-    status = createTargets(context, r, camera.width, camera.height);
+    status = createTargets(context, r, camera.width, camera.height, shading);
+    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, true);
     if (status) status = createDescriptors(context, r, pulled, options.probe);
   }
-  if (status) status = timeFrames(context, r, options, camera.width, camera.height, out);
+  if (status) status = timeFrames(context, r, options, camera, out);
   if (status) status = readPicture(context, r, camera.width, camera.height, out);
   if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, points.size(), out);
   if (!status) return status.error();

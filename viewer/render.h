@@ -26,6 +26,15 @@ enum class NativePath { kAuto, kAttribute, kPull };
 // same projection code, same picture, size-1 points only.
 enum class Backend { kRaster, kCompute };
 
+// What is done to the picture after the points are drawn. kEdl: eye-dome lighting
+// (shaders/edl.comp), a screen-space pass over the depth of the visible points that darkens a
+// pixel by how far its neighbours stand in front of it, so a surface of 1-px points reads as one.
+enum class Shading { kNone, kEdl };
+struct EdlOptions {
+  float strength = 1.0f;  // > 0; the shade is exp(−strength · 300 · mean log2 depth step)
+  float radius = 1.4f;    // neighbour distance in pixels, ≥ 1 (1.4: the 8 nearest pixels)
+};
+
 struct RenderOptions {
   PrecisionMode mode = PrecisionMode::kNative;
   Backend backend = Backend::kRaster;
@@ -41,6 +50,9 @@ struct RenderOptions {
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
   uint64_t max_chunk_points = 0;
+  // After the frame, outside its timestamps (gpu_ms times the points alone, in every shading).
+  Shading shading = Shading::kNone;
+  EdlOptions edl;
 };
 
 struct RenderResult {

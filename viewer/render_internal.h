@@ -39,6 +39,9 @@ struct Resources {
     destroyBuffer(context, all_colors);
     destroyBuffer(context, visibility);
     destroyBuffer(context, picture);
+    destroyBuffer(context, depth_values);
+    destroyBuffer(context, shaded);
+    destroyShadePipeline(context, shade);
     destroyImage(context, color);
     destroyImage(context, depth);
     destroyPointPipelines(context, pipelines);
@@ -58,6 +61,11 @@ struct Resources {
   ComputePipelines compute;
   Buffer all_colors, visibility, picture;
   VkDescriptorSet resolve_set = VK_NULL_HANDLE;
+  // Eye-dome lighting: each pixel's depth (from the depth attachment or the resolve), the shaded
+  // picture the readback takes instead of the plain one, and (raster) `picture` holds the plain one.
+  ShadePipeline shade;
+  Buffer depth_values, shaded;
+  VkDescriptorSet shade_set = VK_NULL_HANDLE;
 };
 
 // The render's descriptor pool: `sets` sets of one uniform and `storage_per_set` storage buffers.
@@ -69,5 +77,14 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
 // Clears the visibility buffer, splats every chunk with `splat`, resolves into the picture.
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
                    uint32_t width, uint32_t height, bool timed);
+
+// Eye-dome pieces (viewer/render_shade.cpp). createShadeTargets makes the pipeline and the depth,
+// shaded (and for raster, plain picture) buffers; call before the descriptor pool is made, which
+// holds one more set for it. recordShade copies the raster attachments into buffers when
+// `raster`, then shades; the picture to read back is then `shaded`.
+Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster);
+Status createShadeDescriptors(const VulkanContext& context, Resources& r);
+EdlPush edlPush(const Camera& camera, const EdlOptions& options);
+void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& push, bool raster);
 
 }  // namespace dpoint::detail

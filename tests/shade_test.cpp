@@ -1,0 +1,120 @@
+// Eye-dome lighting (RenderOptions::shading) on real Vulkan with the validation layer on: it
+// darkens exactly the pixels that have a nearer neighbour, leaves every other pixel as the plain
+// render drew it, and gives the same picture after either backend.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "viewer/camera.h"
+#include "viewer/render.h"
+#include "render_test_support.h"
+
+namespace dpoint {
+namespace {
+
+class Shade : public VulkanRenderTest {};
+
+constexpr uint32_t kSize = 256;
+
+// Two grey squares facing the eye, dense enough (about two points a pixel each way) that neither
+// has a hole: a near one (z = 0, side 4) in front of a far one (z = −2, side 6), seen along −z.
+struct Scene {
+  PointSet points;
+  Camera camera;
+};
+
+Scene twoSquares(bool ortho) {
+  Scene scene;
+  auto square = [&](double z, double side, float grey) {
+    const int n = static_cast<int>(side / 0.01);
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        scene.points.positions.emplace_back(-0.5 * side + 0.01 * i, -0.5 * side + 0.01 * j, z);
+        scene.points.colors.emplace_back(grey);
+      }
+  };
+  square(0.0, 4.0, 0.8f);
+  square(-2.0, 6.0, 0.6f);
+  CameraSpec spec;
+  spec.width = spec.height = kSize;
+  spec.eye = glm::dvec3(0.0, 0.0, 10.0);
+  spec.target = glm::dvec3(0.0);
+  spec.up = glm::dvec3(0.0, 1.0, 0.0);
+  spec.ortho = ortho;
+  scene.camera = *makeCamera(spec, boundsOf(scene.points));
+  return scene;
+}
+
+uint32_t pixel(const Image& image, uint32_t x, uint32_t y) {
+  uint32_t value = 0;
+  std::memcpy(&value, &image.rgba[(size_t{y} * image.width + x) * 4], 4);
+  return value;
+}
+
+uint32_t red(uint32_t rgba8) { return rgba8 & 0xffu; }
+
+// The first column, going right along the middle row, where the near square ends.
+uint32_t nearSquareRightEdge(const Image& plain) {
+  const uint32_t y = kSize / 2, near_grey = pixel(plain, kSize / 2, y);
+  uint32_t x = kSize / 2;
+  while (x + 1 < kSize && pixel(plain, x + 1, y) == near_grey) ++x;
+  return x;
+}
+
+Image render(VulkanContext& context, const Scene& scene, Backend backend, Shading shading) {
+  RenderOptions options;
+  options.backend = backend;
+  options.shading = shading;
+  Result<RenderResult> r = renderPoints(context, scene.points, scene.camera, options);
+  EXPECT_TRUE(r.ok()) << r.error().message;
+  return r.ok() ? r->image : Image{};
+}
+
+TEST_P(Shade, edlDarkensOnlyPixelsWithANearerNeighbour) {
+  for (bool ortho : {false, true}) {
+    SCOPED_TRACE(ortho ? "ortho" : "perspective");
+    const Scene scene = twoSquares(ortho);
+    const Image plain = render(*context_, scene, GetParam(), Shading::kNone);
+    const Image shaded = render(*context_, scene, GetParam(), Shading::kEdl);
+    ASSERT_EQ(plain.rgba.size(), shaded.rgba.size());
+    const uint32_t y = kSize / 2, edge = nearSquareRightEdge(plain);
+    ASSERT_GT(edge, kSize / 2 + 10);
+    ASSERT_LT(edge, kSize - 20) << "the far square shows beside the near one";
+    ASSERT_NE(pixel(plain, edge + 1, y), pixel(plain, edge, y));
+    // The near square is flat and facing the eye: its depth is even, nothing is in front of it.
+    EXPECT_EQ(pixel(shaded, kSize / 2, y), pixel(plain, kSize / 2, y));
+    EXPECT_EQ(pixel(shaded, edge, y), pixel(plain, edge, y));
+    // The far square's first pixel beside the near edge has a nearer neighbour: darker.
+    EXPECT_LT(red(pixel(shaded, edge + 1, y)), red(pixel(plain, edge + 1, y)));
+    // Five pixels on, no neighbour within the radius is nearer: unchanged; so is the background.
+    EXPECT_EQ(pixel(shaded, edge + 5, y), pixel(plain, edge + 5, y));
+    EXPECT_EQ(pixel(shaded, 0, 0), pixel(plain, 0, 0));
+    // A larger radius reaches the edge from further away.
+    RenderOptions wide;
+    wide.backend = GetParam();
+    wide.shading = Shading::kEdl;
+    wide.edl.radius = 6.0f;
+    Result<RenderResult> r = renderPoints(*context_, scene.points, scene.camera, wide);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_LT(red(pixel(r->image, edge + 5, y)), red(pixel(plain, edge + 5, y)));
+  }
+}
+
+// The raster backend shades from its depth attachment, the compute backend from its visibility
+// keys: the same depth values, so the same picture.
+TEST_P(Shade, edlIsTheSameAfterEitherBackend) {
+  const Scene scene = twoSquares(false);
+  const Backend other = GetParam() == Backend::kRaster ? Backend::kCompute : Backend::kRaster;
+  const Image raster = render(*context_, scene, GetParam(), Shading::kEdl);
+  const Image compute = render(*context_, scene, other, Shading::kEdl);
+  ASSERT_EQ(raster.rgba.size(), compute.rgba.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < raster.rgba.size(); i += 4)
+    differing += std::memcmp(&raster.rgba[i], &compute.rgba[i], 4) != 0;
+  EXPECT_EQ(differing, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, Shade, ::testing::Values(Backend::kRaster, Backend::kCompute), backendName);
+
+}  // namespace
+}  // namespace dpoint
