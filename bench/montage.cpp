@@ -1,9 +1,8 @@
 // The bench report's montage: per-point error heat maps, stb_easy_font text and the layout of
 // tiles, title and colour bar in one RGBA8 image.
 //
-// The heat map's colours are viridis (van der Walt and Smith, matplotlib 1.5), taken as its
-// published 9 stops and interpolated linearly in sRGB between them: perceptually ordered from dark
-// to bright, so a larger error reads as brighter at a glance and in grey print.
+// The heat map's colours are viridis (viewer/canvas.h): perceptually ordered from dark to bright,
+// so a larger error reads as brighter at a glance and in grey print.
 #include "bench/montage.h"
 
 #include <algorithm>
@@ -13,22 +12,10 @@
 #include <cstdio>
 #include <cstring>
 
-#include <stb/stb_easy_font.h>  // a system include: its casts and unused statics stay quiet
-
 namespace dpoint {
 namespace {
 
-struct Rgb {
-  uint8_t r, g, b;
-};
-
-// viridis at t = 0, 1/8, ..., 1.
-constexpr std::array<Rgb, 9> kViridis = {{
-    {0x44, 0x01, 0x54}, {0x47, 0x2d, 0x7b}, {0x3b, 0x52, 0x8b}, {0x2c, 0x72, 0x8e}, {0x21, 0x90, 0x8c},
-    {0x27, 0xad, 0x81}, {0x5d, 0xc8, 0x63}, {0xaa, 0xdc, 0x32}, {0xfd, 0xe7, 0x25},
-}};
-
-constexpr uint32_t pack(uint32_t r, uint32_t g, uint32_t b) { return r | g << 8 | b << 16 | 0xffu << 24; }
+constexpr uint32_t pack(uint32_t r, uint32_t g, uint32_t b) { return packRgb(r, g, b); }
 
 constexpr uint32_t kLostColor = pack(255, 0, 255);
 constexpr uint32_t kBackground = pack(0x20, 0x20, 0x20);
@@ -38,90 +25,12 @@ constexpr uint32_t kCaptionColor = pack(0xb4, 0xb4, 0xb4);
 constexpr uint32_t kLegendColor = pack(0xd0, 0xd0, 0xd0);
 constexpr uint32_t kTickColor = pack(0xa0, 0xa0, 0xa0);
 
-constexpr int kLineUnits = 12;   // stb_easy_font's line step
-constexpr int kGlyphUnits = 9;   // rows a line's glyphs cover, descenders included
+constexpr int kLineUnits = kTextLineUnits;
+constexpr int kGlyphUnits = kTextGlyphUnits;
 constexpr int kCapUnits = 7;     // rows of a capital or a digit
 constexpr int kMargin = 10;      // around everything
 constexpr int kTileGap = 8;      // between tiles, and between the tile row and the colour bar
 constexpr int kPictureGap = 4;   // between a picture and its heat map
-constexpr int kMaxGlyphQuads = 64;
-
-uint32_t viridis(double t) {
-  const double u = std::clamp(t, 0.0, 1.0) * double(kViridis.size() - 1);
-  const size_t i = std::min(size_t(u), kViridis.size() - 2);
-  const double f = u - double(i);
-  const auto mix = [f](uint8_t a, uint8_t b) { return uint32_t(std::lround(double(a) + (double(b) - double(a)) * f)); };
-  const Rgb a = kViridis[i], b = kViridis[i + 1];
-  return pack(mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b));
-}
-
-void putPixel(Image& image, uint32_t x, uint32_t y, uint32_t rgba8) {
-  uint8_t* p = &image.rgba[(size_t(y) * image.width + x) * 4];
-  for (int c = 0; c < 4; ++c) p[c] = uint8_t(rgba8 >> (8 * c));
-}
-
-struct Rect {
-  int x0, y0, x1, y1;  // [x0, x1) × [y0, y1)
-};
-
-Rect whole(const Image& image) { return {0, 0, int(image.width), int(image.height)}; }
-
-void fillRect(Image& image, Rect rect, Rect clip, uint32_t rgba8) {
-  const int x0 = std::max({rect.x0, clip.x0, 0}), x1 = std::min({rect.x1, clip.x1, int(image.width)});
-  const int y0 = std::max({rect.y0, clip.y0, 0}), y1 = std::min({rect.y1, clip.y1, int(image.height)});
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) putPixel(image, uint32_t(x), uint32_t(y), rgba8);
-  }
-}
-
-Image blankImage(uint32_t width, uint32_t height, uint32_t rgba8) {
-  Image image;
-  image.width = width, image.height = height;
-  image.rgba.resize(size_t(width) * height * 4);
-  fillRect(image, whole(image), whole(image), rgba8);
-  return image;
-}
-
-void blit(Image& dst, const Image& src, int x, int y) {
-  for (uint32_t row = 0; row < src.height; ++row) {
-    std::memcpy(&dst.rgba[((size_t(y) + row) * dst.width + size_t(x)) * 4], &src.rgba[size_t(row) * src.width * 4],
-                size_t(src.width) * 4);
-  }
-}
-
-// stb's characters outside ' '..'~' would index past its glyph table.
-char printable(char c) { return c >= ' ' && c <= '~' ? c : '?'; }
-
-// One character at a time, so that a fixed buffer always holds a glyph's quads.
-int drawTextClipped(Image& image, Rect clip, int x, int y, const std::string& text, uint32_t rgba8, int scale) {
-  assert(scale >= 1);
-  int pen_x = 0, pen_y = 0, widest = 0;
-  for (const char raw : text) {
-    if (raw == '\n') {
-      pen_x = 0, pen_y += kLineUnits;
-      continue;
-    }
-    char glyph[2] = {printable(raw), 0};
-    struct Vertex {
-      float x, y, z;
-      uint8_t color[4];
-    };
-    Vertex quads[kMaxGlyphQuads * 4];
-    const int count = stb_easy_font_print(0.0f, 0.0f, glyph, nullptr, quads, int(sizeof(quads)));
-    assert(count < kMaxGlyphQuads);  // a glyph that filled the buffer may have lost quads
-    for (int q = 0; q < count; ++q) {
-      // Vertices 0 and 2 are opposite corners, on whole units.
-      const Vertex& a = quads[4 * q];
-      const Vertex& b = quads[4 * q + 2];
-      const Rect rect = {x + (pen_x + int(a.x)) * scale, y + (pen_y + int(a.y)) * scale,
-                         x + (pen_x + int(b.x)) * scale, y + (pen_y + int(b.y)) * scale};
-      fillRect(image, rect, clip, rgba8);
-    }
-    pen_x += stb_easy_font_width(glyph);
-    widest = std::max(widest, pen_x);
-  }
-  return widest * scale;
-}
 
 // The largest scale from `preferred` down to 1 at which `text` fits in `width`; 1 if none does.
 int fittingScale(const std::string& text, int preferred, int width) {
@@ -197,7 +106,7 @@ void drawColourBar(Image& image, int x, int y, int width, int bar_height, int sc
   const double log_lo = std::log10(lo_px), log_hi = std::log10(hi_px);
   for (int i = 0; i < width; ++i) {
     const uint32_t color = viridis(width > 1 ? double(i) / double(width - 1) : 0.0);
-    fillRect(image, {x + i, y, x + i + 1, y + bar_height}, whole(image), color);
+    fillRect(image, {x + i, y, x + i + 1, y + bar_height}, wholeImage(image), color);
   }
   const auto x_of = [&](double log_e) {
     return x + int(std::lround((log_e - log_lo) / (log_hi - log_lo) * double(width - 1)));
@@ -209,9 +118,9 @@ void drawColourBar(Image& image, int x, int y, int width, int bar_height, int sc
     // No decade inside the range: label its ends instead.
     char text[32];
     std::snprintf(text, sizeof(text), "%.2g", lo_px);
-    drawTextClipped(image, whole(image), x, label_y, text, kLegendColor, scale);
+    drawTextClipped(image, wholeImage(image), x, label_y, text, kLegendColor, scale);
     std::snprintf(text, sizeof(text), "%.2g", hi_px);
-    drawTextClipped(image, whole(image), x + width - textWidth(text, scale), label_y, text, kLegendColor, scale);
+    drawTextClipped(image, wholeImage(image), x + width - textWidth(text, scale), label_y, text, kLegendColor, scale);
     return;
   }
   int widest = 0;
@@ -223,11 +132,11 @@ void drawColourBar(Image& image, int x, int y, int width, int bar_height, int sc
     const int tick_x = x_of(double(k));
     const bool labelled = k % step == 0;
     const int length = labelled ? tick_length : tick_length / 2 + 1;
-    fillRect(image, {tick_x, tick_y, tick_x + 1, tick_y + length}, whole(image), kTickColor);
+    fillRect(image, {tick_x, tick_y, tick_x + 1, tick_y + length}, wholeImage(image), kTickColor);
     if (!labelled) continue;
     const std::string label = decadeLabel(k);
     const int label_x = std::clamp(tick_x - textWidth(label, scale) / 2, 0, int(image.width) - textWidth(label, scale));
-    drawTextClipped(image, whole(image), label_x, label_y, label, kLegendColor, scale);
+    drawTextClipped(image, wholeImage(image), label_x, label_y, label, kLegendColor, scale);
   }
 }
 
@@ -273,24 +182,7 @@ Image errorHeatMap(const std::vector<WindowPoint>& reference, const std::vector<
   return image;
 }
 
-int textWidth(const std::string& text, int scale) {
-  assert(scale >= 1);
-  int pen_x = 0, widest = 0;
-  for (const char raw : text) {
-    if (raw == '\n') {
-      pen_x = 0;
-      continue;
-    }
-    char glyph[2] = {printable(raw), 0};
-    pen_x += stb_easy_font_width(glyph);
-    widest = std::max(widest, pen_x);
-  }
-  return widest * scale;
-}
 
-int drawText(Image& image, int x, int y, const std::string& text, uint32_t rgba8, int scale) {
-  return drawTextClipped(image, whole(image), x, y, text, rgba8, scale);
-}
 
 Image composeMontage(const std::string& title, const std::vector<MontageTile>& tiles, double lo_px, double hi_px) {
   assert(lo_px > 0.0 && hi_px > lo_px);
@@ -352,7 +244,7 @@ Image composeMontage(const std::string& title, const std::vector<MontageTile>& t
   drawText(image, bar_x, legend_top, legend, kLegendColor, scale);
   drawColourBar(image, bar_x, bar_top, bar_w, bar_h, scale, lo_px, hi_px);
   const int swatch_x = bar_x + bar_w + swatch_gap;
-  fillRect(image, {swatch_x, bar_top, swatch_x + bar_h, bar_top + bar_h}, whole(image), kLostColor);
+  fillRect(image, {swatch_x, bar_top, swatch_x + bar_h, bar_top + bar_h}, wholeImage(image), kLostColor);
   const int lost_y = bar_top + (bar_h - kCapUnits * scale) / 2;
   drawText(image, swatch_x + bar_h + 4 * scale, lost_y, "lost", kLegendColor, scale);
   return image;

@@ -1,13 +1,14 @@
 // The bench report's montage (issue #10): one hard-case view rendered in every precision mode side
 // by side, each labelled, and under each its per-point error as a heat map with a colour bar.
 // Drawn into an RGBA8 Image (viewer/reference.h) that viewer/image.h writes as PNG. Text is
-// stb_easy_font's quads filled into the image (no font files).
+// viewer/canvas.h's.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "viewer/canvas.h"
 #include "viewer/reference.h"
 
 namespace dpoint {
@@ -40,14 +41,5 @@ struct MontageTile {
 // the same size (asserted). Text scale chosen so labels are legible at the tile width; a label or
 // caption wider than its tile breaks after a comma or a space and never runs into the next tile.
 Image composeMontage(const std::string& title, const std::vector<MontageTile>& tiles, double lo_px, double hi_px);
-
-// Draws `text` (ASCII) into `image` with its top-left corner at (x, y), each stb_easy_font unit
-// `scale` pixels, clipped to the image. Returns the width drawn in pixels: the widest line's
-// advance, the same whether or not clipping cut it (as textWidth). '\n' starts a line 12 units
-// down; other characters outside ' '..'~' are drawn as '?'. scale ≥ 1 (asserted).
-int drawText(Image& image, int x, int y, const std::string& text, uint32_t rgba8, int scale);
-
-// The width drawText returns, without drawing.
-int textWidth(const std::string& text, int scale);
 
 }  // namespace dpoint

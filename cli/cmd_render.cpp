@@ -13,11 +13,13 @@
 #include "cli/cli_camera.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
+#include "converters/point_filters.h"
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
 #include "core/point_order.h"
 #include "core/progress.h"
 #include "viewer/camera.h"
+#include "viewer/canvas.h"
 #include "viewer/context.h"
 #include "viewer/image.h"
 #include "viewer/probe.h"
@@ -28,8 +30,11 @@ namespace {
 
 struct RenderCliOptions {
   std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
-  std::string order = "input", shade = "auto", color = "auto";
+  std::string order = "input", shade = "auto";
   double edl_strength = 1.0, edl_radius = 1.4;
+  uint32_t views = 1;
+  std::string color = "auto";
+  std::string up_axis = "auto";
   CameraCliOptions camera;
   std::string background = "0,0,0";
   bool error = false, validate = false;
@@ -158,6 +163,31 @@ Shading shadingFor(const RenderCliOptions& o, const Camera& camera) {
   return camera.ortho ? Shading::kNone : Shading::kEdl;
 }
 
+// A view of --views: its label and the fit's direction (target to eye) and up.
+struct View {
+  const char* label;
+  glm::dvec3 direction, up;
+};
+
+// --up-axis auto: z for LAS (surveys are z-up), y otherwise (the generators' and glTF's up).
+bool zUp(const RenderCliOptions& o) {
+  if (o.up_axis != "auto") return o.up_axis == "z";
+  std::string tail = o.input.size() >= 4 ? o.input.substr(o.input.size() - 4) : "";
+  std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return tail == ".las";
+}
+
+// One view: the three-quarter one; four: front, side, top, three-quarter. Directions are in the
+// up axis's frame: with z up, "front" looks along +y and the oblique view sits in front, above.
+std::vector<View> viewsFor(uint32_t count, bool z_up) {
+  const View three_quarter = z_up ? View{"three-quarter", {0.6, -1.0, 0.5}, {0, 0, 1}}
+                                  : View{"three-quarter", {0.6, 0.5, 1.0}, {0, 1, 0}};
+  if (count == 1) return {three_quarter};
+  if (z_up)
+    return {{"front", {0, -1, 0}, {0, 0, 1}}, {"side", {1, 0, 0}, {0, 0, 1}}, {"top", {0, 0, 1}, {0, 1, 0}}, three_quarter};
+  return {{"front", {0, 0, 1}, {0, 1, 0}}, {"side", {1, 0, 0}, {0, 1, 0}}, {"top", {0, 1, 0}, {0, 0, -1}}, three_quarter};
+}
+
 // --mode auto picks on the device; an explicit mode gets its bound computed for the report.
 Result<Prediction> predict(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
                            const Camera& camera, Backend backend) {
@@ -194,6 +224,52 @@ void printChoice(const Prediction& p, const DeviceFacts& f, Backend backend) {
   }
 }
 
+RenderOptions renderOptions(const RenderCliOptions& o, PrecisionMode mode, Backend backend, uint32_t background,
+                            NativePath native_path, const Camera& camera) {
+  RenderOptions options;
+  options.mode = mode;
+  options.backend = backend;
+  options.point_size = static_cast<float>(o.point_size);
+  options.background_rgba8 = background;
+  options.frames = o.frames;
+  options.warmup_frames = o.warmup;
+  options.probe = o.error;
+  options.native_path = native_path;
+  options.max_chunk_points = o.chunk_points;
+  options.shading = shadingFor(o, camera);
+  options.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
+  return options;
+}
+
+// --views 4: each view rendered in its own mode (--mode auto decides per view), one labelled sheet.
+int renderViews(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
+                const std::vector<View>& views, const std::vector<Camera>& cameras, Backend backend,
+                uint32_t background, NativePath native_path) {
+  std::vector<LabelledView> sheet;
+  for (size_t i = 0; i < views.size(); ++i) {
+    Result<Prediction> prediction = predict(o, context, points, cameras[i], backend);
+    if (!prediction) return reportError(prediction.error());
+    const RenderOptions options = renderOptions(o, prediction->mode, backend, background, native_path, cameras[i]);
+    Result<RenderResult> rendered = renderPoints(context, points, cameras[i], options);
+    if (!rendered) return reportError(rendered.error());
+    const std::string mode(modeName(prediction->mode));
+    sheet.push_back({std::string(views[i].label) + " (" + mode + ")", std::move(rendered->image)});
+    std::printf("view %s: mode %s, predicted error bound %s", views[i].label, mode.c_str(),
+                formatBound(prediction->bound_px).c_str());
+    if (!rendered->gpu_ms.empty()) std::printf(", gpu %.3f ms/frame median of %zu", medianOf(rendered->gpu_ms), rendered->gpu_ms.size());
+    std::printf("\n");
+  }
+  const Image picture = composeContactSheet(sheet, 2);
+  if (Status written = writePng(o.output, picture); !written) return reportError(written.error());
+  std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), points.size(), picture.width,
+              picture.height, o.backend.c_str(), context.facts.name.c_str());
+  for (const std::string& m : context.validationMessages()) std::fprintf(stderr, "dpoint: %s\n", m.c_str());
+  if (!context.validationMessages().empty())
+    return reportError(Error{std::to_string(context.validationMessages().size()) + " Vulkan validation message(s)",
+                             ExitCode::kNoDevice});
+  return 0;
+}
+
 int runRender(const RenderCliOptions& o) {
   if (o.mode != "auto" && !parseMode(o.mode))
     return reportError(Error{"--mode must be auto, fp32, split, rte, df64, native or batch, got '" + o.mode + "'", ExitCode::kUsage});
@@ -214,8 +290,21 @@ int runRender(const RenderCliOptions& o) {
     return reportError(Error{"--edl-strength must be in (0, 100], got " + formatNumber(o.edl_strength, true), ExitCode::kUsage});
   if (!(o.edl_radius >= 1.0 && o.edl_radius <= 16.0))
     return reportError(Error{"--edl-radius must be in [1, 16] pixels, got " + formatNumber(o.edl_radius, true), ExitCode::kUsage});
+  if (o.color != "auto" && o.color != "rgb" && o.color != "elevation")
+    return reportError(Error{"--color must be auto, rgb or elevation, got '" + o.color + "'", ExitCode::kUsage});
+  if (o.views != 1 && o.views != 4) return reportError(Error{"--views must be 1 or 4, got " + std::to_string(o.views), ExitCode::kUsage});
+  if (o.up_axis != "auto" && o.up_axis != "y" && o.up_axis != "z")
+    return reportError(Error{"--up-axis must be auto, y or z, got '" + o.up_axis + "'", ExitCode::kUsage});
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
+  if (o.views == 4) {
+    if (spec->eye || spec->ortho.value_or(false))
+      return reportError(Error{"--views 4 frames each view with --fit in perspective; drop --eye/--target/--up and --ortho",
+                               ExitCode::kUsage});
+    if (o.error || !o.json.empty())
+      return reportError(Error{"--views 4 makes a contact sheet; --error and --json measure one view (use --views 1)",
+                               ExitCode::kUsage});
+  }
   Result<uint32_t> background = parseBackground(o.background);
   if (!background) return reportError(background.error());
 
@@ -224,32 +313,42 @@ int runRender(const RenderCliOptions& o) {
   Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
   if (!points) return reportError(points.error());
   phases.mark("read");
+  if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
+  if (o.color == "rgb" && !points->hasColors())
+    return reportError(Error{o.input + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput});
+  if (o.color == "elevation" || (o.color == "auto" && !points->hasColors()))
+    colorByElevation(*points, zUp(o) ? 2 : 1, o.common.threads);
   reorderPoints(*points, *order, o.common.threads, &progress);
   phases.mark("order");
-  if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
-  Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
-  if (!camera) return reportError(camera.error());
+  const Bounds bounds = boundsOf(*points);
+  if (o.views == 4 && bounds.planar)
+    return reportError(Error{o.input + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
+                             ExitCode::kUsage});
+  const bool z_up = zUp(o);
+  std::vector<View> views = viewsFor(o.views, z_up);
+  std::vector<Camera> cameras;
+  for (const View& view : views) {
+    CameraSpec view_spec = *spec;
+    // One y-up view is makeCamera's own default fit.
+    if (!spec->eye && (o.views == 4 || z_up)) view_spec.fit_direction = view.direction, view_spec.fit_up = view.up;
+    // Four views share the picture: each gets a quarter, so the sheet keeps about --width x --height.
+    if (o.views == 4) view_spec.width = std::max(1u, spec->width / 2), view_spec.height = std::max(1u, spec->height / 2);
+    Result<Camera> camera = makeCamera(view_spec, bounds);
+    if (!camera) return reportError(camera.error());
+    cameras.push_back(*camera);
+  }
   phases.mark("camera");
 
   Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
   if (!context) return reportError(context.error());
   phases.mark("device");
   const Backend backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
+  if (o.views == 4) return renderViews(o, **context, *points, views, cameras, backend, *background, native_path);
+  const Camera* camera = &cameras[0];
   Result<Prediction> prediction = predict(o, **context, *points, *camera, backend);
   if (!prediction) return reportError(prediction.error());
   phases.mark("mode");
-  RenderOptions options;
-  options.mode = prediction->mode;
-  options.backend = backend;
-  options.point_size = static_cast<float>(o.point_size);
-  options.background_rgba8 = *background;
-  options.frames = o.frames;
-  options.warmup_frames = o.warmup;
-  options.probe = o.error;
-  options.native_path = native_path;
-  options.max_chunk_points = o.chunk_points;
-  options.shading = shadingFor(o, *camera);
-  options.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
+  const RenderOptions options = renderOptions(o, prediction->mode, backend, *background, native_path, *camera);
   Result<RenderResult> rendered = renderPoints(**context, *points, *camera, options);
   if (!rendered) return reportError(rendered.error());
   phases.mark("render");
@@ -355,6 +454,17 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--edl-strength", o->edl_strength, "Eye-dome darkening: exp(-strength * 300 * mean log2 depth step)")
       ->default_val(1.0);
   cmd->add_option("--edl-radius", o->edl_radius, "Eye-dome neighbour distance in pixels (1..16)")->default_val(1.4);
+  cmd->add_option("--color", o->color,
+                  "auto|rgb|elevation. elevation: a perceptual colour map (viridis) along the up axis (--up-axis).\n"
+                  "auto: the set's colours when it has them, elevation otherwise")
+      ->default_val("auto");
+  cmd->add_option("--views", o->views,
+                  "1, or 4: one PNG of four labelled views (front, side, top, three-quarter), each framed by --fit\n"
+                  "in a quarter of --width x --height (3D sets; not with --eye, --ortho, --error or --json)")
+      ->default_val(1);
+  cmd->add_option("--up-axis", o->up_axis,
+                  "auto|y|z: the data's up for the --fit views. auto: z for LAS (surveys), y otherwise")
+      ->default_val("auto");
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });
 }

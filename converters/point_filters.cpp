@@ -1,10 +1,15 @@
 #include "converters/point_filters.h"
 
+#include <cassert>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
+
+#include "core/colormap.h"
+#include "core/parallel.h"
 
 namespace dpoint {
 namespace {
@@ -63,6 +68,22 @@ void encodeColorsSrgb8(PointSet& points) {
       const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
       colour[k] = float(std::round(255.0 * s) / 255.0);
     }
+}
+
+void colorByElevation(PointSet& points, int axis, unsigned threads) {
+  assert(points.size() > 0 && axis >= 0 && axis <= 2);
+  const Box box = boundingBox(points.positions);
+  const double low = box.min[axis], range = box.max[axis] - box.min[axis];
+  points.colors.resize(points.size());
+  constexpr size_t kBlock = size_t{1} << 16;
+  parallelFor((points.size() + kBlock - 1) / kBlock, threads, [&](size_t block, unsigned) {
+    const size_t first = block * kBlock, last = std::min(points.size(), first + kBlock);
+    for (size_t i = first; i < last; ++i) {
+      const double t = range > 0.0 ? (points.positions[i][axis] - low) / range : 0.5;
+      const uint32_t rgba = viridis(t);
+      points.colors[i] = glm::vec3(float(rgba & 0xffu), float((rgba >> 8) & 0xffu), float((rgba >> 16) & 0xffu)) / 255.0f;
+    }
+  });
 }
 
 }  // namespace dpoint

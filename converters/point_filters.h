@@ -16,4 +16,10 @@ void dropDuplicatePositions(PointSet& points);
 // display-ready values; PLY uchar output writes exactly that byte.
 void encodeColorsSrgb8(PointSet& points);
 
+// Replaces the colours by elevation: viridis (core/colormap.h) of each point's coordinate along
+// `axis` (0 x, 1 y, 2 z) from the set's lowest (dark purple) to its highest (yellow), stored as
+// the map's sRGB bytes / 255, the values the renderer shows. A flat set takes the map's middle.
+// Needs a non-empty set (asserted); runs on `threads` cores (0: all), same result on any number.
+void colorByElevation(PointSet& points, int axis, unsigned threads = 0);
+
 }  // namespace dpoint

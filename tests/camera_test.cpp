@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "viewer/reference.h"
@@ -270,6 +271,34 @@ TEST(Camera, rejectsBadOptionsNamingThem) {
   spec = {};
   spec.eye = glm::dvec3(NAN, 0, 0), spec.target = glm::dvec3(0, 0, 0), spec.up = glm::dvec3(0, 1, 0);
   expectUsageError(spec, "--eye must be finite");
+}
+
+// The four views of `dpoint render --views 4`: the fit's direction and up steer the eye; the box
+// stays framed, the eye sits along the direction from the centre, and up points up on screen.
+TEST(Camera, fitDirectionAndUpSteerTheFramedView) {
+  const Bounds bounds{{6.378e6, -2.0, 10.0}, {6.378e6 + 3.0, 1.0, 11.0}};
+  const glm::dvec3 centre = 0.5 * (bounds.min + bounds.max);
+  for (const auto& [direction, up] : std::vector<std::pair<glm::dvec3, glm::dvec3>>{
+           {{0, 0, 1}, {0, 1, 0}}, {{1, 0, 0}, {0, 1, 0}}, {{0, 1, 0}, {0, 0, -1}}, {{0.6, -1, 0.5}, {0, 0, 1}}}) {
+    CameraSpec spec;
+    spec.fit_direction = direction, spec.fit_up = up;
+    const Camera camera = make(spec, bounds);
+    expectFramed(camera, bounds, 0.3);
+    const glm::dvec3 from_centre = camera.eye - centre;
+    EXPECT_NEAR(glm::dot(from_centre / glm::length(from_centre), direction / glm::length(direction)), 1.0, 1e-9);
+    // A point above the centre (along up) lands above it on screen: smaller window y.
+    EXPECT_LT(project(camera, centre + 0.1 * up).y, project(camera, centre).y);
+  }
+  CameraSpec parallel;
+  parallel.fit_direction = glm::dvec3(0, 2, 0), parallel.fit_up = glm::dvec3(0, 1, 0);
+  expectUsageError(parallel, "the fit's up (0, 1, 0) is parallel to its direction (0, 2, 0)");
+  CameraSpec zero;
+  zero.fit_direction = glm::dvec3(0.0);
+  expectUsageError(zero, "the fit direction must be a finite non-zero vector");
+  CameraSpec with_eye;
+  with_eye.eye = glm::dvec3(0, 0, 5), with_eye.target = glm::dvec3(0.0), with_eye.up = glm::dvec3(0, 1, 0);
+  with_eye.fit_direction = glm::dvec3(1, 0, 0);
+  expectUsageError(with_eye, "cannot be combined with --eye");
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 
 #include <cstdlib>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "test_support.h"
 
@@ -130,6 +132,7 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
   TempDir dir;
   writeFile(dir.file("empty.csv"), "x,y,z\n");
   writeFile(dir.file("one.csv"), "x,y,z\n1,2,3\n");
+  writeFile(dir.file("flat.csv"), "x,y\n1,2\n3,4\n");
   struct Case {
     std::vector<std::string> args;
     int code;
@@ -148,6 +151,16 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
       {{dir.file("one.csv"), "--backend", "mesh"}, 1, "--backend"},
       {{dir.file("one.csv"), "--order", "hilbert"}, 1, "--order"},
       {{dir.file("one.csv"), "--backend", "compute", "--point-size", "2"}, 1, "--point-size"},
+      {{dir.file("one.csv"), "--shade", "soft"}, 1, "--shade"},
+      {{dir.file("one.csv"), "--edl-radius", "0.5"}, 1, "--edl-radius"},
+      {{dir.file("one.csv"), "--edl-strength", "0"}, 1, "--edl-strength"},
+      {{dir.file("one.csv"), "--color", "heat"}, 1, "--color"},
+      {{dir.file("one.csv"), "--color", "rgb"}, 2, "no colours"},
+      {{dir.file("one.csv"), "--views", "2"}, 1, "--views"},
+      {{dir.file("one.csv"), "--views", "4", "--error"}, 1, "--views 4"},
+      {{dir.file("one.csv"), "--views", "4", "--ortho"}, 1, "--views 4"},
+      {{dir.file("flat.csv"), "--views", "4"}, 1, "2D"},
+      {{dir.file("one.csv"), "--up-axis", "x"}, 1, "--up-axis"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = {"render"};
@@ -161,6 +174,44 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
   test::CommandResult jpg = runDpoint({"render", dir.file("one.csv"), "-o", dir.file("out.jpg")});
   EXPECT_EQ(jpg.exit_code, 1);
   EXPECT_NE(jpg.err.find(".png"), std::string::npos);
+}
+
+// The PNG's size from its IHDR chunk (big-endian width and height at bytes 16 and 20).
+std::pair<uint32_t, uint32_t> pngSize(const std::string& png) {
+  auto be32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(png.at(at + i));
+    return v;
+  };
+  return {be32(16), be32(20)};
+}
+
+// Readable previews (issue #13): eye-dome lighting by default for 3D, a colour map for sets
+// without colours, and a four-view contact sheet.
+TEST(CliRender, previewsShadeColourAndShowFourViews) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "33", "--quiet", "-o", dir.file("mb.ply")}).exit_code, 0);
+  auto render = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", dir.file("mb.ply"), "-o", dir.file(name), "--validate", "--width", "320",
+                                     "--height", "240", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.err;
+    return readFile(dir.file(name));
+  };
+  const std::string plain = render("none.png", {"--shade", "none"});
+  EXPECT_EQ(render("auto.png", {}), render("edl.png", {"--shade", "edl"})) << "a 3D view is shaded by default";
+  EXPECT_NE(plain, readFile(dir.file("edl.png")));
+  EXPECT_EQ(render("error.png", {"--error"}), plain) << "--error keeps the plain picture";
+  EXPECT_NE(render("elevation.png", {"--shade", "none", "--color", "elevation"}), plain);
+  EXPECT_EQ(render("rgb.png", {"--shade", "none", "--color", "rgb"}), plain) << "rgb: the set's own colours";
+  const std::string sheet = render("views.png", {"--views", "4"});
+  EXPECT_EQ(pngSize(sheet), std::make_pair(2u * 160u + 2u, 2u * 120u + 2u)) << "four quarter views, 2 px apart";
+  test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file("views.png"), "--views", "4",
+                                     "--width", "320", "--height", "240", "--backend", "compute"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* view : {"view front", "view side", "view top", "view three-quarter", "4 views"})
+    EXPECT_NE(r.out.find(view), std::string::npos) << view << " in " << r.out;
 }
 
 // --order morton changes only which of two points at the same depth on one pixel wins; a

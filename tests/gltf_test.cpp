@@ -687,6 +687,24 @@ TEST(Gltf, srgb8EncodesLinearColours) {
   EXPECT_EQ(set.colors[0], glm::vec3(0.0f, 1.0f, float(188 / 255.0)));
 }
 
+// `dpoint render --color elevation`: viridis along the chosen axis, lowest dark purple (its first
+// stop #440154), highest yellow (#fde725), whatever the thread count; a flat set in the middle.
+TEST(PointFilters, colorByElevationMapsTheAxisRangeOntoViridis) {
+  PointSet set;
+  for (int i = 0; i <= 200000; ++i) set.positions.push_back({6.378e6, 0.5 * i, -1.0});
+  PointSet other = set;
+  colorByElevation(set, 1, 1);
+  colorByElevation(other, 1, 2);
+  ASSERT_EQ(set.colors.size(), set.size());
+  EXPECT_EQ(set.colors, other.colors);
+  EXPECT_EQ(set.colors.front(), glm::vec3(0x44, 0x01, 0x54) / 255.0f);
+  EXPECT_EQ(set.colors.back(), glm::vec3(0xfd, 0xe7, 0x25) / 255.0f);
+  for (size_t i = 1; i < set.size(); i += 997) EXPECT_GE(set.colors[i].g, set.colors[i - 1].g) << i;
+  colorByElevation(set, 2);  // every z is -1
+  EXPECT_EQ(set.colors.front(), set.colors.back());
+  EXPECT_EQ(set.colors.front(), glm::vec3(0x21, 0x90, 0x8c) / 255.0f) << "the middle stop";
+}
+
 // --- The official Khronos validator --------------------------------------------------------------
 
 TEST(Gltf, glbPassesOfficialValidator) {

@@ -163,6 +163,16 @@ Status checkSpec(const CameraSpec& spec) {
     return usage("--view-center must be finite, got " + shortest(*spec.view_center));
   }
   const int given = int(spec.eye.has_value()) + int(spec.target.has_value()) + int(spec.up.has_value());
+  if (spec.fit_direction || spec.fit_up) {
+    const glm::dvec3 direction = spec.fit_direction.value_or(glm::dvec3(0.6, 0.5, 1.0));
+    const glm::dvec3 up = spec.fit_up.value_or(glm::dvec3(0.0, 1.0, 0.0));
+    if (given) return usage("a fit direction cannot be combined with --eye/--target/--up");
+    if (!isFinite(direction) || maxAbs(direction) == 0.0)
+      return usage("the fit direction must be a finite non-zero vector, got " + shortest(direction));
+    if (!isFinite(up) || maxAbs(up) == 0.0) return usage("the fit's up must be a finite non-zero vector, got " + shortest(up));
+    if (glm::length(glm::cross(safeNormalize(direction), safeNormalize(up))) < 1e-9)
+      return usage("the fit's up " + shortest(up) + " is parallel to its direction " + shortest(direction));
+  }
   if (given == 0) return okStatus();
   if (given != 3) {
     return usage(std::string("--eye, --target and --up go together; missing") + (spec.eye ? "" : " --eye") +
@@ -233,8 +243,10 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     camera.rotation = lookAtRotation({0.0, 0.0, -1.0}, up_y);
   } else {
     // Perspective fit: 2D data straight down −z, 3D data from a fixed oblique direction.
-    const glm::dvec3 direction =
-        bounds.planar ? glm::dvec3(0.0, 0.0, 1.0) : glm::normalize(glm::dvec3(0.6, 0.5, 1.0));
+    const glm::dvec3 direction = bounds.planar      ? glm::dvec3(0.0, 0.0, 1.0)
+                                 : spec.fit_direction ? safeNormalize(*spec.fit_direction)
+                                                      : glm::normalize(glm::dvec3(0.6, 0.5, 1.0));
+    const glm::dvec3 up = bounds.planar ? up_y : spec.fit_up.value_or(up_y);
     const glm::dvec3 target = spec.view_center.value_or(centre);
     double distance = 0.0;
     if (spec.view_width) {
@@ -253,7 +265,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
       return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +
                    "; the window is too small for coordinates this large");
     }
-    camera.rotation = lookAtRotation(target - camera.eye, up_y);
+    camera.rotation = lookAtRotation(target - camera.eye, up);
   }
 
   choosePlanes(camera, bounds);
