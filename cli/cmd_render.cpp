@@ -23,6 +23,7 @@
 #include "viewer/context.h"
 #include "viewer/image.h"
 #include "viewer/probe.h"
+#include "viewer/reference.h"
 #include "viewer/render.h"
 
 namespace dpoint {
@@ -38,7 +39,7 @@ struct RenderCliOptions {
   CameraCliOptions camera;
   std::string background = "0,0,0";
   bool error = false, validate = false;
-  double point_size = 1.0;
+  std::string point_size = "auto";
   uint32_t frames = 1, warmup = 1;
   uint64_t chunk_points = 0;
   CommonOptions common;
@@ -224,12 +225,37 @@ void printChoice(const Prediction& p, const DeviceFacts& f, Backend backend) {
   }
 }
 
-RenderOptions renderOptions(const RenderCliOptions& o, PrecisionMode mode, Backend backend, uint32_t background,
-                            NativePath native_path, const Camera& camera) {
+// --point-size auto: 1 px, unless the points are too few to cover the set's outline on screen:
+// then about the spacing of a quarter of them (a closed surface shows its front half, and a folded
+// one like a fractal's hides about half of that behind its own folds) over the
+// ellipse inside the bounding box's screen rectangle, rounded up, at most 4 px. Always 1 for 2D
+// (ortho) views, the compute backend (size-1 points only) and with --error (the reference raster
+// draws 1-px points).
+float pointSizeFor(const RenderCliOptions& o, const PointSet& points, const Camera& camera, Backend backend,
+                   const DeviceFacts& facts) {
+  if (o.point_size != "auto") return static_cast<float>(std::stod(o.point_size));
+  if (o.error || backend == Backend::kCompute || camera.ortho || !facts.large_points) return 1.0f;
+  const Box box = boundingBox(points.positions);
+  std::vector<glm::dvec3> corners;
+  for (int i = 0; i < 8; ++i)
+    corners.push_back({(i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z});
+  double x0 = camera.width, y0 = camera.height, x1 = 0.0, y1 = 0.0;
+  for (const WindowPoint& w : projectReference(corners, camera)) {
+    if (!w.visible) return 1.0f;  // the eye is inside or near the box: no outline to fill
+    x0 = std::min(x0, std::max(w.x, 0.0)), x1 = std::max(x1, std::min(w.x, double(camera.width)));
+    y0 = std::min(y0, std::max(w.y, 0.0)), y1 = std::max(y1, std::min(w.y, double(camera.height)));
+  }
+  const double area = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0) * 0.25 * 3.14159265358979;
+  const double spacing = std::sqrt(area / std::max(1.0, 0.25 * static_cast<double>(points.size())));
+  return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(4.0, double(facts.max_point_size))));
+}
+
+RenderOptions renderOptions(const RenderCliOptions& o, const PointSet& points, PrecisionMode mode, Backend backend,
+                            uint32_t background, NativePath native_path, const Camera& camera, const DeviceFacts& facts) {
   RenderOptions options;
   options.mode = mode;
   options.backend = backend;
-  options.point_size = static_cast<float>(o.point_size);
+  options.point_size = pointSizeFor(o, points, camera, backend, facts);
   options.background_rgba8 = background;
   options.frames = o.frames;
   options.warmup_frames = o.warmup;
@@ -249,7 +275,8 @@ int renderViews(const RenderCliOptions& o, const VulkanContext& context, const P
   for (size_t i = 0; i < views.size(); ++i) {
     Result<Prediction> prediction = predict(o, context, points, cameras[i], backend);
     if (!prediction) return reportError(prediction.error());
-    const RenderOptions options = renderOptions(o, prediction->mode, backend, background, native_path, cameras[i]);
+    const RenderOptions options =
+        renderOptions(o, points, prediction->mode, backend, background, native_path, cameras[i], context.facts);
     Result<RenderResult> rendered = renderPoints(context, points, cameras[i], options);
     if (!rendered) return reportError(rendered.error());
     const std::string mode(modeName(prediction->mode));
@@ -292,6 +319,10 @@ int runRender(const RenderCliOptions& o) {
     return reportError(Error{"--edl-radius must be in [1, 16] pixels, got " + formatNumber(o.edl_radius, true), ExitCode::kUsage});
   if (o.color != "auto" && o.color != "rgb" && o.color != "elevation")
     return reportError(Error{"--color must be auto, rgb or elevation, got '" + o.color + "'", ExitCode::kUsage});
+  if (o.point_size != "auto") {
+    Result<std::vector<double>> size = parseNumbers("--point-size", o.point_size, 1);
+    if (!size) return reportError(size.error());
+  }
   if (o.views != 1 && o.views != 4) return reportError(Error{"--views must be 1 or 4, got " + std::to_string(o.views), ExitCode::kUsage});
   if (o.up_axis != "auto" && o.up_axis != "y" && o.up_axis != "z")
     return reportError(Error{"--up-axis must be auto, y or z, got '" + o.up_axis + "'", ExitCode::kUsage});
@@ -348,7 +379,8 @@ int runRender(const RenderCliOptions& o) {
   Result<Prediction> prediction = predict(o, **context, *points, *camera, backend);
   if (!prediction) return reportError(prediction.error());
   phases.mark("mode");
-  const RenderOptions options = renderOptions(o, prediction->mode, backend, *background, native_path, *camera);
+  const RenderOptions options =
+      renderOptions(o, *points, prediction->mode, backend, *background, native_path, *camera, (*context)->facts);
   Result<RenderResult> rendered = renderPoints(**context, *points, *camera, options);
   if (!rendered) return reportError(rendered.error());
   phases.mark("render");
@@ -370,8 +402,9 @@ int runRender(const RenderCliOptions& o) {
   const DeviceFacts& f = (*context)->facts;
   const RenderResult& r = *rendered;
   const PrecisionMode mode = prediction->mode;
-  std::printf("%s: %zu points, mode %s, %s backend, %ux%u, %s (%s, driver %s)\n", o.output.c_str(), points->size(),
-              std::string(modeName(mode)).c_str(), o.backend.c_str(), o.camera.width, o.camera.height, f.name.c_str(),
+  std::printf("%s: %zu points, mode %s, %s backend, %ux%u, %g px points%s, %s (%s, driver %s)\n", o.output.c_str(),
+              points->size(), std::string(modeName(mode)).c_str(), o.backend.c_str(), o.camera.width, o.camera.height,
+              double(options.point_size), options.shading == Shading::kEdl ? ", eye-dome lighting" : "", f.name.c_str(),
               f.type.c_str(), formatDriverVersion(f.vendor_id, f.driver_version).c_str());
   printChoice(*prediction, f, backend);
   if (!r.gpu_ms.empty())
@@ -430,7 +463,10 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
                   "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)")
       ->default_val("raster");
   addCameraOptions(*cmd, o->camera);
-  cmd->add_option("--point-size", o->point_size, "Point size in pixels")->default_val(1.0);
+  cmd->add_option("--point-size", o->point_size,
+                  "Point size in pixels, or auto: 1, or larger (up to 4) when a 3D set has too few points to\n"
+                  "cover its outline at this size; 1 for 2D sets, --backend compute and --error")
+      ->default_val("auto");
   cmd->add_option("--background", o->background, "Background colour R,G,B (0..255)")->default_val("0,0,0");
   cmd->add_option("--device", o->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
       ->default_val("auto");
