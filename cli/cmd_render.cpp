@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "converters/point_filters.h"
 #include "converters/point_io.h"
+#include "core/ply.h"
 #include "core/atomic_file.h"
 #include "core/point_order.h"
 #include "core/progress.h"
@@ -31,7 +32,7 @@ namespace {
 
 struct RenderCliOptions {
   std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
-  std::string order = "input", shade = "auto";
+  std::string order = "input", shade = "auto", stream = "auto";
   double edl_strength = 1.0, edl_radius = 1.4;
   uint32_t views = 1;
   std::string color = "auto";
@@ -45,11 +46,12 @@ struct RenderCliOptions {
   CommonOptions common;
 };
 
-bool endsWithPng(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string tail = path.substr(path.size() - 4);
+// `path` ends with `extension` (lower case, with its dot), in any case.
+bool hasExtension(const std::string& path, const std::string& extension) {
+  if (path.size() < extension.size()) return false;
+  std::string tail = path.substr(path.size() - extension.size());
   std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return tail == ".png";
+  return tail == extension;
 }
 
 Result<uint32_t> parseBackground(const std::string& text) {
@@ -95,7 +97,7 @@ class Phases {
   std::vector<std::pair<const char*, double>> list_;
 };
 
-std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
+std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, size_t count,
                        const RenderResult& r, const Prediction& prediction, const ErrorReport* error,
                        const Phases& phases) {
   const DeviceFacts& f = context.facts;
@@ -122,7 +124,7 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   s += "  \"driver\": " + jsonString(f.driver_name + " " + f.driver_info) + ",\n";
   s += "  \"driver_version\": " + jsonString(formatDriverVersion(f.vendor_id, f.driver_version)) + ",\n";
   s += "  \"api_version\": " + jsonString(formatApiVersion(f.api_version)) + ",\n";
-  s += "  \"points\": " + std::to_string(points.size()) + ",\n";
+  s += "  \"points\": " + std::to_string(count) + ",\n";
   s += "  \"width\": " + std::to_string(o.camera.width) + ",\n  \"height\": " + std::to_string(o.camera.height) + ",\n";
   s += "  \"frames\": " + std::to_string(r.frame_ms.size()) + ",\n";
   if (r.gpu_ms.empty()) {
@@ -138,7 +140,7 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   for (size_t i = 0; i < phases.list().size(); ++i)
     s += std::string(i ? ", " : "") + jsonString(phases.list()[i].first) + ": " + num(phases.list()[i].second);
   s += "},\n  \"peak_rss_mb\": " + num(Phases::peakRssMb()) + ",\n";
-  s += "  \"points_per_s\": " + num(static_cast<double>(points.size()) / (per_frame_ms * 1e-3)) + ",\n";
+  s += "  \"points_per_s\": " + num(static_cast<double>(count) / (per_frame_ms * 1e-3)) + ",\n";
   s += "  \"bytes_per_point\": " + std::to_string(bytesPerPoint(mode)) + ",\n";
   s += "  \"chunks\": " + std::to_string(r.chunks) + ",\n";
   s += "  \"native_path\": " + std::string(mode != PrecisionMode::kNative ? "null" : r.pulled_positions ? "\"pull\"" : "\"attribute\"");
@@ -171,12 +173,7 @@ struct View {
 };
 
 // --up-axis auto: z for LAS (surveys are z-up), y otherwise (the generators' and glTF's up).
-bool zUp(const RenderCliOptions& o) {
-  if (o.up_axis != "auto") return o.up_axis == "z";
-  std::string tail = o.input.size() >= 4 ? o.input.substr(o.input.size() - 4) : "";
-  std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return tail == ".las";
-}
+bool zUp(const RenderCliOptions& o) { return o.up_axis == "auto" ? hasExtension(o.input, ".las") : o.up_axis == "z"; }
 
 // One view: the three-quarter one; four: front, side, top, three-quarter. Directions are in the
 // up axis's frame: with z up, "front" looks along +y and the oblique view sits in front, above.
@@ -231,11 +228,10 @@ void printChoice(const Prediction& p, const DeviceFacts& f, Backend backend) {
 // ellipse inside the bounding box's screen rectangle, rounded up, at most 4 px. Always 1 for 2D
 // (ortho) views, the compute backend (size-1 points only) and with --error (the reference raster
 // draws 1-px points).
-float pointSizeFor(const RenderCliOptions& o, const PointSet& points, const Camera& camera, Backend backend,
+float pointSizeFor(const RenderCliOptions& o, size_t count, const Bounds& box, const Camera& camera, Backend backend,
                    const DeviceFacts& facts) {
   if (o.point_size != "auto") return static_cast<float>(std::stod(o.point_size));
   if (o.error || backend == Backend::kCompute || camera.ortho || !facts.large_points) return 1.0f;
-  const Box box = boundingBox(points.positions);
   std::vector<glm::dvec3> corners;
   for (int i = 0; i < 8; ++i)
     corners.push_back({(i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z});
@@ -246,21 +242,30 @@ float pointSizeFor(const RenderCliOptions& o, const PointSet& points, const Came
     y0 = std::min(y0, std::max(w.y, 0.0)), y1 = std::max(y1, std::min(w.y, double(camera.height)));
   }
   const double area = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0) * 0.25 * 3.14159265358979;
-  const double spacing = std::sqrt(area / std::max(1.0, 0.25 * static_cast<double>(points.size())));
+  const double spacing = std::sqrt(area / std::max(1.0, 0.25 * static_cast<double>(count)));
   return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(4.0, double(facts.max_point_size))));
 }
 
-RenderOptions renderOptions(const RenderCliOptions& o, const PointSet& points, PrecisionMode mode, Backend backend,
-                            uint32_t background, NativePath native_path, const Camera& camera, const DeviceFacts& facts) {
+// What every view of one run shares: the set's size and bounds, the parsed options.
+struct RunFacts {
+  size_t count = 0;
+  Bounds bounds;
+  Backend backend = Backend::kRaster;
+  uint32_t background = 0;
+  NativePath native_path = NativePath::kAuto;
+};
+
+RenderOptions renderOptions(const RenderCliOptions& o, const RunFacts& run, PrecisionMode mode, const Camera& camera,
+                            const DeviceFacts& facts) {
   RenderOptions options;
   options.mode = mode;
-  options.backend = backend;
-  options.point_size = pointSizeFor(o, points, camera, backend, facts);
-  options.background_rgba8 = background;
+  options.backend = run.backend;
+  options.point_size = pointSizeFor(o, run.count, run.bounds, camera, run.backend, facts);
+  options.background_rgba8 = run.background;
   options.frames = o.frames;
   options.warmup_frames = o.warmup;
   options.probe = o.error;
-  options.native_path = native_path;
+  options.native_path = run.native_path;
   options.max_chunk_points = o.chunk_points;
   options.shading = shadingFor(o, camera);
   options.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
@@ -269,14 +274,12 @@ RenderOptions renderOptions(const RenderCliOptions& o, const PointSet& points, P
 
 // --views 4: each view rendered in its own mode (--mode auto decides per view), one labelled sheet.
 int renderViews(const RenderCliOptions& o, const VulkanContext& context, const PointSet& points,
-                const std::vector<View>& views, const std::vector<Camera>& cameras, Backend backend,
-                uint32_t background, NativePath native_path) {
+                const std::vector<View>& views, const std::vector<Camera>& cameras, const RunFacts& run) {
   std::vector<LabelledView> sheet;
   for (size_t i = 0; i < views.size(); ++i) {
-    Result<Prediction> prediction = predict(o, context, points, cameras[i], backend);
+    Result<Prediction> prediction = predict(o, context, points, cameras[i], run.backend);
     if (!prediction) return reportError(prediction.error());
-    const RenderOptions options =
-        renderOptions(o, points, prediction->mode, backend, background, native_path, cameras[i], context.facts);
+    const RenderOptions options = renderOptions(o, run, prediction->mode, cameras[i], context.facts);
     Result<RenderResult> rendered = renderPoints(context, points, cameras[i], options);
     if (!rendered) return reportError(rendered.error());
     const std::string mode(modeName(prediction->mode));
@@ -297,6 +300,36 @@ int renderViews(const RenderCliOptions& o, const VulkanContext& context, const P
   return 0;
 }
 
+// --stream auto draws a binary PLY of more points than this a block at a time: in memory it would
+// take 36 B a point (2.4 GB here) before the upload's own.
+constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
+
+// The bounds and planarity of a streamed set: one pass over it, a block at a time.
+Result<Bounds> streamBounds(const std::string& path, PlyVertexStream& ply, Progress& progress) {
+  Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
+  PointSet block;
+  progress.start("bounds of " + path + " (points)", ply.count());
+  for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
+    const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
+    if (Status status = ply.read(first, n, block); !status) return status.error();
+    progress.advance(n);
+    const Box box = boundingBox(block.positions);
+    bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
+    bounds.planar = bounds.planar && block.isPlanar();
+  }
+  progress.finish();
+  return bounds;
+}
+
+// A streamed set is read once, so no bound is predicted from its points: --mode auto takes native,
+// which holds to well under 0.1 px wherever the study's hard cases reach.
+Result<Prediction> streamPrediction(const RenderCliOptions& o) {
+  Prediction p;
+  p.mode = o.mode == "auto" ? PrecisionMode::kNative : *parseMode(o.mode);
+  p.bound_px = std::nan("");
+  return p;
+}
+
 int runRender(const RenderCliOptions& o) {
   if (o.mode != "auto" && !parseMode(o.mode))
     return reportError(Error{"--mode must be auto, fp32, split, rte, df64, native or batch, got '" + o.mode + "'", ExitCode::kUsage});
@@ -304,7 +337,7 @@ int runRender(const RenderCliOptions& o) {
     return reportError(Error{"--backend must be raster or compute, got '" + o.backend + "'", ExitCode::kUsage});
   Result<PointOrder> order = parsePointOrder("--order", o.order);
   if (!order) return reportError(order.error());
-  if (!endsWithPng(o.output) && o.output.rfind("/dev/", 0) != 0)
+  if (!hasExtension(o.output, ".png") && o.output.rfind("/dev/", 0) != 0)
     return reportError(Error{"-o " + o.output + ": the picture is written as PNG; name it .png", ExitCode::kUsage});
   NativePath native_path = NativePath::kAuto;
   if (o.native_path == "attribute") native_path = NativePath::kAttribute;
@@ -323,6 +356,8 @@ int runRender(const RenderCliOptions& o) {
     Result<std::vector<double>> size = parseNumbers("--point-size", o.point_size, 1);
     if (!size) return reportError(size.error());
   }
+  if (o.stream != "auto" && o.stream != "on" && o.stream != "off")
+    return reportError(Error{"--stream must be auto, on or off, got '" + o.stream + "'", ExitCode::kUsage});
   if (o.views != 1 && o.views != 4) return reportError(Error{"--views must be 1 or 4, got " + std::to_string(o.views), ExitCode::kUsage});
   if (o.up_axis != "auto" && o.up_axis != "y" && o.up_axis != "z")
     return reportError(Error{"--up-axis must be auto, y or z, got '" + o.up_axis + "'", ExitCode::kUsage});
@@ -341,21 +376,51 @@ int runRender(const RenderCliOptions& o) {
 
   Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
-  if (!points) return reportError(points.error());
-  phases.mark("read");
-  if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
-  if (o.color == "rgb" && !points->hasColors())
+  // A large binary PLY is drawn a block at a time (a set larger than memory); anything else is read whole.
+  std::unique_ptr<PlyVertexStream> ply;
+  if (o.stream != "off" && hasExtension(o.input, ".ply")) {
+    Result<std::unique_ptr<PlyVertexStream>> opened =
+        PlyVertexStream::open(o.input, PlyReadOptions{false, nullptr, o.common.threads, true});
+    if (opened && (o.stream == "on" || (*opened)->count() > kStreamAbovePoints)) ply = std::move(*opened);
+    else if (!opened && o.stream == "on") return reportError(opened.error());
+  } else if (o.stream == "on") {
+    return reportError(Error{o.input + ": --stream on reads binary PLY only", ExitCode::kUsage});
+  }
+  if (ply && (o.error || *order != PointOrder::kInput || o.views != 1))
+    return reportError(Error{o.input + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
+                             "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage});
+  std::optional<PointSet> points;
+  RunFacts run;
+  bool has_colors = false;
+  if (ply) {
+    if (ply->count() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
+    Result<Bounds> bounds = streamBounds(o.input, *ply, progress);
+    if (!bounds) return reportError(bounds.error());
+    run.count = ply->count(), run.bounds = *bounds, has_colors = ply->hasColors();
+    phases.mark("bounds");
+  } else {
+    Result<PointSet> read = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
+    if (!read) return reportError(read.error());
+    points = std::move(*read);
+    phases.mark("read");
+    if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
+    run.count = points->size(), has_colors = points->hasColors();
+  }
+  if (o.color == "rgb" && !has_colors)
     return reportError(Error{o.input + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput});
-  if (o.color == "elevation" || (o.color == "auto" && !points->hasColors()))
-    colorByElevation(*points, zUp(o) ? 2 : 1, o.common.threads);
-  reorderPoints(*points, *order, o.common.threads, &progress);
-  phases.mark("order");
-  const Bounds bounds = boundsOf(*points);
+  const bool z_up = zUp(o);
+  if (points) run.bounds = boundsOf(*points);
+  const Bounds& bounds = run.bounds;
+  // A 2D set has no elevation: without colours its points stay white.
+  const bool elevation = o.color == "elevation" || (o.color == "auto" && !has_colors && !bounds.planar);
+  if (points) {
+    if (elevation) colorByElevation(*points, z_up ? 2 : 1, o.common.threads);
+    reorderPoints(*points, *order, o.common.threads, &progress);
+    phases.mark("order");
+  }
   if (o.views == 4 && bounds.planar)
     return reportError(Error{o.input + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
                              ExitCode::kUsage});
-  const bool z_up = zUp(o);
   std::vector<View> views = viewsFor(o.views, z_up);
   std::vector<Camera> cameras;
   for (const View& view : views) {
@@ -373,15 +438,34 @@ int runRender(const RenderCliOptions& o) {
   Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
   if (!context) return reportError(context.error());
   phases.mark("device");
-  const Backend backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
-  if (o.views == 4) return renderViews(o, **context, *points, views, cameras, backend, *background, native_path);
+  run.backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
+  run.background = *background;
+  run.native_path = native_path;
+  const Backend backend = run.backend;
+  if (o.views == 4) return renderViews(o, **context, *points, views, cameras, run);
   const Camera* camera = &cameras[0];
-  Result<Prediction> prediction = predict(o, **context, *points, *camera, backend);
+  Result<Prediction> prediction = ply ? streamPrediction(o) : predict(o, **context, *points, *camera, backend);
   if (!prediction) return reportError(prediction.error());
   phases.mark("mode");
-  const RenderOptions options =
-      renderOptions(o, *points, prediction->mode, backend, *background, native_path, *camera, (*context)->facts);
-  Result<RenderResult> rendered = renderPoints(**context, *points, *camera, options);
+  const RenderOptions options = renderOptions(o, run, prediction->mode, *camera, (*context)->facts);
+  Result<RenderResult> rendered = Error{""};
+  if (ply) {
+    PointStream stream;
+    stream.count = run.count;
+    stream.has_colors = has_colors || elevation;
+    const int axis = z_up ? 2 : 1;
+    stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
+      if (Status status = ply->read(first, n, block); !status) return status;
+      if (elevation) colorByElevation(block, axis, bounds.min[axis], bounds.max[axis], o.common.threads);
+      progress.advance(n);
+      return okStatus();
+    };
+    progress.start("streaming " + o.input + " to the GPU (points)", run.count);
+    rendered = renderStream(**context, stream, *camera, options);
+    progress.finish();
+  } else {
+    rendered = renderPoints(**context, *points, *camera, options);
+  }
   if (!rendered) return reportError(rendered.error());
   phases.mark("render");
   std::optional<ErrorReport> error;
@@ -394,7 +478,7 @@ int runRender(const RenderCliOptions& o) {
   if (!o.json.empty()) {
     Result<AtomicFile> file = AtomicFile::create(o.json);
     if (!file) return reportError(file.error());
-    Status status = file->write(jsonReport(o, **context, *points, *rendered, *prediction, error ? &*error : nullptr, phases));
+    Status status = file->write(jsonReport(o, **context, run.count, *rendered, *prediction, error ? &*error : nullptr, phases));
     if (status) status = file->commit();
     if (!status) return reportError(status.error());
   }
@@ -402,15 +486,19 @@ int runRender(const RenderCliOptions& o) {
   const DeviceFacts& f = (*context)->facts;
   const RenderResult& r = *rendered;
   const PrecisionMode mode = prediction->mode;
-  std::printf("%s: %zu points, mode %s, %s backend, %ux%u, %g px points%s, %s (%s, driver %s)\n", o.output.c_str(),
-              points->size(), std::string(modeName(mode)).c_str(), o.backend.c_str(), o.camera.width, o.camera.height,
+  std::printf("%s: %zu points%s, mode %s, %s backend, %ux%u, %g px points%s, %s (%s, driver %s)\n", o.output.c_str(),
+              run.count, ply ? " (streamed)" : "", std::string(modeName(mode)).c_str(), o.backend.c_str(), o.camera.width, o.camera.height,
               double(options.point_size), options.shading == Shading::kEdl ? ", eye-dome lighting" : "", f.name.c_str(),
               f.type.c_str(), formatDriverVersion(f.vendor_id, f.driver_version).c_str());
-  printChoice(*prediction, f, backend);
+  if (ply)
+    std::printf("mode %s: no bound predicted (a streamed set is read once)%s\n", std::string(modeName(mode)).c_str(),
+                o.mode == "auto" ? "; --mode auto takes native for it" : "");
+  else
+    printChoice(*prediction, f, backend);
   if (!r.gpu_ms.empty())
     std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f), %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
                 r.gpu_ms.size(), percentileOf(r.gpu_ms, 95),
-                static_cast<double>(points->size()) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(mode));
+                static_cast<double>(run.count) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(mode));
   std::printf("host: upload %.1f ms, frame %.3f ms, readback %.1f ms\n", r.upload_ms, medianOf(r.frame_ms), r.readback_ms);
   std::string steps;
   for (const auto& [name, ms] : phases.list()) {
@@ -492,7 +580,13 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--edl-radius", o->edl_radius, "Eye-dome neighbour distance in pixels (1..16)")->default_val(1.4);
   cmd->add_option("--color", o->color,
                   "auto|rgb|elevation. elevation: a perceptual colour map (viridis) along the up axis (--up-axis).\n"
-                  "auto: the set's colours when it has them, elevation otherwise")
+                  "auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones")
+      ->default_val("auto");
+  cmd->add_option("--stream", o->stream,
+                  "auto|on|off. on: draw a binary PLY a block at a time, so a file larger than memory renders in\n"
+                  "about 1.2 GB of host memory (two blocks of 16M points); auto: for binary PLY of more than 2^26\n"
+                  "points. A streamed set gets no predicted bound (--mode auto takes native), no --error, --order\n"
+                  "or --views 4")
       ->default_val("auto");
   cmd->add_option("--views", o->views,
                   "1, or 4: one PNG of four labelled views (front, side, top, three-quarter), each framed by --fit\n"

@@ -71,9 +71,14 @@ void encodeColorsSrgb8(PointSet& points) {
 }
 
 void colorByElevation(PointSet& points, int axis, unsigned threads) {
-  assert(points.size() > 0 && axis >= 0 && axis <= 2);
+  assert(points.size() > 0);
   const Box box = boundingBox(points.positions);
-  const double low = box.min[axis], range = box.max[axis] - box.min[axis];
+  colorByElevation(points, axis, box.min[axis], box.max[axis], threads);
+}
+
+void colorByElevation(PointSet& points, int axis, double low, double high, unsigned threads) {
+  assert(axis >= 0 && axis <= 2 && low <= high);
+  const double range = high - low;
   points.colors.resize(points.size());
   constexpr size_t kBlock = size_t{1} << 16;
   parallelFor((points.size() + kBlock - 1) / kBlock, threads, [&](size_t block, unsigned) {

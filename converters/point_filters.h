@@ -21,5 +21,7 @@ void encodeColorsSrgb8(PointSet& points);
 // the map's sRGB bytes / 255, the values the renderer shows. A flat set takes the map's middle.
 // Needs a non-empty set (asserted); runs on `threads` cores (0: all), same result on any number.
 void colorByElevation(PointSet& points, int axis, unsigned threads = 0);
+// The same with the range given (low ≤ high): for a block of a larger set, coloured as the whole.
+void colorByElevation(PointSet& points, int axis, double low, double high, unsigned threads);
 
 }  // namespace dpoint

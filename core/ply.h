@@ -15,6 +15,7 @@
 // and `face` lists of three `uint` indices for meshes.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "core/point_set.h"
@@ -43,5 +44,26 @@ struct PlyWriteOptions {
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options = {});
+
+// The vertices of a binary PLY file a range at a time, for a renderer drawing a file larger than
+// memory should hold. open() reads the header with readPly's checks; an ASCII file, or one with
+// list rows before its vertices (whose offsets are unknown until read), fails naming why. read()
+// replaces `block` with vertex rows [first, first + n) (first + n ≤ count(), asserted): positions,
+// and colours when hasColors(), with readPly's values and errors (whole-file row numbers), decoded
+// on options.threads cores. Elements after the vertices are not read. read() may be called from
+// one thread at a time.
+class PlyVertexStream {
+ public:
+  static Result<std::unique_ptr<PlyVertexStream>> open(const std::string& path, const PlyReadOptions& options = {});
+  ~PlyVertexStream();
+  uint64_t count() const;
+  bool hasColors() const;
+  Status read(uint64_t first, uint64_t n, PointSet& block);
+
+ private:
+  PlyVertexStream() = default;
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace dpoint

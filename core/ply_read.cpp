@@ -291,6 +291,80 @@ class PlyParser {
     return std::move(points_);
   }
 
+  // PlyVertexStream: the header, then where the vertex rows start. Binary only, and every element
+  // before the vertices of fixed-size rows, so that row r's offset is known without reading.
+  Status openStream() {
+    if (Status s = parseHeader(); !s.ok()) return s.error();
+    if (Status s = planElements(); !s.ok()) return s.error();
+    if (Status s = checkSizes(); !s.ok()) return s.error();
+    if (ascii_) return Error{path_ + ": an ASCII PLY file cannot be streamed; convert it to binary PLY first"};
+    uint64_t offset = in_.offset();
+    for (const Element& e : elements_) {
+      const bool fixed =
+          std::none_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; });
+      if (!fixed)
+        return Error{path_ + ": element '" + e.name + "' (header line " + std::to_string(e.line) +
+                     ") has list rows before the vertices; such a file cannot be streamed"};
+      if (e.name == "vertex") {
+        stream_layout_ = vertexLayout(e, vertex_roles_);
+        stream_begin_ = offset;
+        return okStatus();
+      }
+      uint64_t row_bytes = 0;
+      for (const Property& p : e.properties) row_bytes += typeSize(p.type);
+      offset += row_bytes * e.count;  // bounded by checkSizes
+    }
+    return okStatus();  // planElements found a vertex element
+  }
+  uint64_t vertexCount() const { return vertex_count_; }
+  bool hasColors() const { return has_colors_; }
+
+  // Vertex rows [first, first + n) into `block`, in parallel blocks, with readPly's errors.
+  Status readStream(uint64_t first, uint64_t n, PointSet& block) {
+    assert(first <= vertex_count_ && n <= vertex_count_ - first);
+    const RowLayout& layout = stream_layout_;
+    block.triangles.clear();
+    block.positions.resize(static_cast<size_t>(n));
+    if (has_colors_) block.colors.resize(static_cast<size_t>(n));
+    else block.colors.clear();
+    const uint64_t block_rows = std::max<size_t>(1, kVertexBlockBytes / layout.row_bytes);
+    const size_t blocks = static_cast<size_t>((n + block_rows - 1) / block_rows);
+    std::mutex error_mutex;
+    std::optional<Error> first_error;
+    uint64_t error_row = UINT64_MAX;
+    auto fail = [&](uint64_t row, Error error) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (row < error_row) error_row = row, first_error = std::move(error);
+    };
+    const unsigned threads = resolveThreads(options_.threads);
+    std::vector<std::vector<char>> buffers(threads);
+    glm::dvec3* positions = block.positions.data();
+    glm::vec3* colors = has_colors_ ? block.colors.data() : nullptr;
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      const uint64_t from = first + b * block_rows, to = std::min(from + block_rows, first + n);
+      const uint64_t offset = stream_begin_ + from * layout.row_bytes;
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>((to - from) * layout.row_bytes));
+      Result<size_t> got = file_.readAt(offset, buffer.data(), buffer.size());
+      if (!got) return fail(from, got.error());
+      if (*got < buffer.size()) {  // the file shrank since it was opened
+        const uint64_t whole = from + *got / layout.row_bytes;
+        return fail(whole, Error{path_ + ": truncated at byte " + std::to_string(offset + *got) + ": expected " +
+                                 std::to_string(vertex_count_) + " 'vertex' rows, the data ends in row " +
+                                 std::to_string(whole)});
+      }
+      const uint64_t bad = decodeVertices(layout, buffer.data(), from, to, positions, colors, first);
+      if (bad != to) {
+        double v[kRoleCount];
+        layout.load(buffer.data() + (bad - from) * layout.row_bytes, v);
+        return fail(bad, nonfiniteError(v, bad, stream_begin_ + bad * layout.row_bytes));
+      }
+      if (options_.progress) options_.progress->advance(buffer.size());
+    });
+    if (first_error) return *first_error;
+    return okStatus();
+  }
+
  private:
   Error headerError(int line, const std::string& what) const {
     return Error{path_ + ": header line " + std::to_string(line) + ": " + what};
@@ -507,8 +581,7 @@ class PlyParser {
     }
   };
 
-  // The hot path: binary rows of one size, decoded in blocks on all cores (see the top comment).
-  Status readFixedVertices(const Element& e, const std::vector<Role>& roles) {
+  static RowLayout vertexLayout(const Element& e, const std::vector<Role>& roles) {
     RowLayout layout;
     for (size_t k = 0; k < e.properties.size(); layout.row_bytes += typeSize(e.properties[k++].type)) {
       if (roles[k] == kSkip) continue;
@@ -518,6 +591,12 @@ class PlyParser {
     }
     layout.packed = layout.packed && layout.at[kY] == layout.at[kX] + 8 && layout.at[kZ] == layout.at[kX] + 16;
     for (int k = 0; k < 256; ++k) layout.byte_color[k] = static_cast<float>(k) / 255.0f;
+    return layout;
+  }
+
+  // The hot path: binary rows of one size, decoded in blocks on all cores (see the top comment).
+  Status readFixedVertices(const Element& e, const std::vector<Role>& roles) {
+    const RowLayout layout = vertexLayout(e, roles);
 
     // checkSizes bounds the rows by the file size, but elements before this one may hold longer
     // lists than it assumed: decode the whole rows there are, then report the cut.
@@ -557,7 +636,7 @@ class PlyParser {
         const uint64_t whole = first + *got / row_bytes;
         return fail(whole, truncated(e, whole));
       }
-      const uint64_t bad = decodeVertices(layout, buffer.data(), first, last, positions, colors);
+      const uint64_t bad = decodeVertices(layout, buffer.data(), first, last, positions, colors, 0);
       if (bad != last) {
         double v[kRoleCount];
         layout.load(buffer.data() + (bad - first) * row_bytes, v);
@@ -572,26 +651,28 @@ class PlyParser {
     return okStatus();
   }
 
-  // Decodes rows [first, last) from `data` (row `first` at data[0]) into positions[row] and, when
-  // not null, colors[row]. Returns the first unacceptable row, or `last`. Runs on several threads.
+  // Decodes rows [first, last) from `data` (row `first` at data[0]) into positions[row − base] and,
+  // when not null, colors[row − base]. Returns the first unacceptable row, or `last`. Runs on
+  // several threads.
   uint64_t decodeVertices(const RowLayout& layout, const char* data, uint64_t first, uint64_t last,
-                          glm::dvec3* positions, glm::vec3* colors) const {
+                          glm::dvec3* positions, glm::vec3* colors, uint64_t base) const {
     const char* p = data;
     for (uint64_t row = first; row < last; ++row, p += layout.row_bytes) {
       double v[kRoleCount];  // local, so that stores into the point arrays cannot alias it
+      const uint64_t at = row - base;
       if (layout.packed) {
         std::memcpy(&v[kX], p + layout.at[kX], 3 * sizeof(double));
         if (!acceptable(v)) return row;
-        positions[row] = glm::dvec3(v[kX], v[kY], v[kZ]);
+        positions[at] = glm::dvec3(v[kX], v[kY], v[kZ]);
         if (colors)
-          colors[row] = glm::vec3(layout.byte_color[static_cast<uint8_t>(p[layout.at[kRed]])],
+          colors[at] = glm::vec3(layout.byte_color[static_cast<uint8_t>(p[layout.at[kRed]])],
                                   layout.byte_color[static_cast<uint8_t>(p[layout.at[kGreen]])],
                                   layout.byte_color[static_cast<uint8_t>(p[layout.at[kBlue]])]);
       } else {
         layout.load(p, v);
         if (!acceptable(v)) return row;
-        positions[row] = glm::dvec3(v[kX], v[kY], v[kZ]);
-        if (colors) colors[row] = colorOf(v);
+        positions[at] = glm::dvec3(v[kX], v[kY], v[kZ]);
+        if (colors) colors[at] = colorOf(v);
       }
     }
     return last;
@@ -742,6 +823,8 @@ class PlyParser {
   double values_[kRoleCount] = {};
   std::vector<double> polygon_;  // indices of the current face (exact in double)
   PointSet points_;
+  RowLayout stream_layout_;  // PlyVertexStream
+  uint64_t stream_begin_ = 0;
 };
 
 }  // namespace
@@ -751,6 +834,29 @@ Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options)
   if (!file.ok()) return file.error();
   PlyParser parser(*file, options);
   return parser.run();
+}
+
+struct PlyVertexStream::State {
+  State(InputFile opened, const PlyReadOptions& read) : file(std::move(opened)), options(read), parser(file, options) {}
+  InputFile file;
+  PlyReadOptions options;
+  PlyParser parser;
+};
+
+Result<std::unique_ptr<PlyVertexStream>> PlyVertexStream::open(const std::string& path, const PlyReadOptions& options) {
+  auto file = InputFile::open(path);
+  if (!file.ok()) return file.error();
+  std::unique_ptr<PlyVertexStream> stream(new PlyVertexStream);
+  stream->state_ = std::make_unique<State>(std::move(*file), options);
+  if (Status status = stream->state_->parser.openStream(); !status) return status.error();
+  return stream;
+}
+
+PlyVertexStream::~PlyVertexStream() = default;
+uint64_t PlyVertexStream::count() const { return state_->parser.vertexCount(); }
+bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
+Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {
+  return state_->parser.readStream(first, n, block);
 }
 
 }  // namespace dpoint

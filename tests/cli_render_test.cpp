@@ -223,6 +223,33 @@ TEST(CliRender, previewsShadeColourAndShowFourViews) {
     EXPECT_NE(r.out.find(view), std::string::npos) << view << " in " << r.out;
 }
 
+// A binary PLY drawn a block at a time (a file larger than memory) gives the picture the set in
+// memory gives; what needs the whole set is refused, and so is a file that cannot be streamed.
+TEST(CliRender, streamedPlyDrawsTheSamePicture) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "40", "--quiet", "-o", dir.file("mb.ply")}).exit_code, 0);
+  for (const char* backend : {"raster", "compute"}) {
+    SCOPED_TRACE(backend);
+    for (const char* stream : {"off", "on"}) {
+      test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file(stream + std::string(".png")),
+                                         "--backend", backend, "--mode", "batch", "--stream", stream, "--validate",
+                                         "--width", "256", "--height", "256", "--json", dir.file("r.json")});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_EQ(r.out.find("(streamed)") != std::string::npos, stream == std::string("on")) << r.out;
+    }
+    EXPECT_TRUE(readFile(dir.file("off.png")) == readFile(dir.file("on.png")));
+    EXPECT_NE(readFile(dir.file("r.json")).find("\"predicted_bound_px\": null"), std::string::npos);
+  }
+  ASSERT_EQ(runDpoint({"convert", dir.file("mb.ply"), "-o", dir.file("ascii.ply"), "--ply-ascii"}).exit_code, 0);
+  test::CommandResult ascii = runDpoint({"render", dir.file("ascii.ply"), "-o", dir.file("a.png"), "--stream", "on"});
+  EXPECT_EQ(ascii.exit_code, 2);
+  EXPECT_NE(ascii.err.find("an ASCII PLY file cannot be streamed"), std::string::npos) << ascii.err;
+  test::CommandResult error = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file("e.png"), "--stream", "on", "--error"});
+  EXPECT_EQ(error.exit_code, 1);
+  EXPECT_NE(error.err.find("is read once"), std::string::npos) << error.err;
+  EXPECT_FALSE(test::fileExists(dir.file("a.png")) || test::fileExists(dir.file("e.png")));
+}
+
 // --order morton changes only which of two points at the same depth on one pixel wins; a
 // marching-cubes surface has no such pairs, so the picture is the same, on both backends.
 TEST(CliRender, mortonOrderDrawsTheSamePicture) {

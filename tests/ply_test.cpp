@@ -807,5 +807,71 @@ TEST(Ply, plyFailedWriteLeavesNothing) {
   EXPECT_TRUE(dir.entries().empty());
 }
 
+// ---------------------------------------------------------------- streamed vertices
+
+// dpoint render of a file larger than memory: any range, read in any order of ranges, holds the
+// rows readPly reads, with colours, for any thread count.
+TEST(Ply, plyVertexStreamReadsAnyRangeAsReadPlyDoes) {
+  TempDir dir;
+  const PointSet in = randomPoints(kManyBlocksOf27, 11);  // with colours: 27-byte rows
+  ASSERT_TRUE(writePly(dir.file("s.ply"), in).ok());
+  auto whole = readPly(dir.file("s.ply"));
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  for (unsigned threads : {1u, 3u}) {
+    auto stream = PlyVertexStream::open(dir.file("s.ply"), withThreads(threads));
+    ASSERT_TRUE(stream.ok()) << stream.error().message;
+    EXPECT_EQ((*stream)->count(), in.size());
+    EXPECT_TRUE((*stream)->hasColors());
+    PointSet block, expected;
+    for (auto [first, n] : {std::pair<size_t, size_t>{0, 1}, {0, 100000}, {99999, 70001}, {in.size() - 3, 3},
+                            {12345, 0}}) {
+      SCOPED_TRACE(std::to_string(first) + "+" + std::to_string(n));
+      ASSERT_TRUE((*stream)->read(first, n, block).ok());
+      expected.positions.assign(whole->positions.begin() + std::ptrdiff_t(first),
+                                whole->positions.begin() + std::ptrdiff_t(first + n));
+      expected.colors.assign(whole->colors.begin() + std::ptrdiff_t(first),
+                             whole->colors.begin() + std::ptrdiff_t(first + n));
+      expectSamePositions(expected, block);
+      expectSameColors(expected, block);
+    }
+  }
+}
+
+// Its errors are readPly's, with whole-file row numbers and byte offsets.
+TEST(Ply, plyVertexStreamNamesBadRowsAndRefusesWhatCannotBeStreamed) {
+  TempDir dir;
+  PointSet in = randomPoints(kManyBlocksOf27, 12);
+  in.positions[150001].y = std::numeric_limits<double>::infinity();
+  ASSERT_TRUE(writePly(dir.file("bad.ply"), in).ok());
+  const size_t header = readFile(dir.file("bad.ply")).find("end_header\n") + 11;
+  auto stream = PlyVertexStream::open(dir.file("bad.ply"));
+  ASSERT_TRUE(stream.ok()) << stream.error().message;
+  PointSet block;
+  EXPECT_TRUE((*stream)->read(0, 150000, block).ok());
+  Status bad = (*stream)->read(150000, 10, block);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.error().message, "bad.ply: byte " + std::to_string(header + 150001 * 27) +
+                                                ": vertex 150001: y is inf, not a finite number"));
+  // ASCII rows have no fixed offsets, nor have vertices after a list element.
+  writeFile(dir.file("a.ply"), std::string(kAsciiHeader) + "1 2 3\n4 5 6\n");
+  auto ascii = PlyVertexStream::open(dir.file("a.ply"));
+  ASSERT_FALSE(ascii.ok());
+  EXPECT_TRUE(contains(ascii.error().message, "a.ply: an ASCII PLY file cannot be streamed"));
+  Bytes b;
+  b.data = "ply\nformat binary_little_endian 1.0\nelement note 1\nproperty list uchar uchar text\n"
+           "element vertex 1\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  b.add(uint8_t{1}).add(uint8_t{65}).add(1.0).add(2.0).add(3.0);
+  writeFile(dir.file("list.ply"), b.data);
+  auto listed = PlyVertexStream::open(dir.file("list.ply"));
+  ASSERT_FALSE(listed.ok());
+  EXPECT_TRUE(contains(listed.error().message, "list.ply: element 'note' (header line 3) has list rows before"));
+  // A header check of readPly's: counts beyond the file.
+  writeFile(dir.file("short.ply"), "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n"
+                                   "property double x\nproperty double y\nproperty double z\nend_header\n");
+  auto huge = PlyVertexStream::open(dir.file("short.ply"));
+  ASSERT_FALSE(huge.ok());
+  EXPECT_TRUE(contains(huge.error().message, "short.ply: truncated at byte"));
+}
+
 }  // namespace
 }  // namespace dpoint

@@ -321,6 +321,62 @@ TEST_P(Render, computeBackendRefusesLargePointsAndAgreesWithRasterOn2D) {
   EXPECT_EQ(a->image.rgba, b->image.rgba);
 }
 
+// A set streamed block by block (dpoint render of a file larger than memory) draws the picture
+// the set in memory draws, in every mode, with blocks that split it unevenly; a failing read ends
+// the render with the stream's error, and a bad point is named by its index in the whole set.
+TEST_P(Render, streamDrawsTheSamePictureAsTheSetInMemory) {
+  PointSet s = cloud(glm::dvec3(6378137.0, 0.0, 0.0), 0.01);
+  for (int copy = 0; copy < 12; ++copy)  // 12 000 points: three blocks of 4096 and a partial one
+    for (size_t i = 0; i < 1000; ++i) {
+      s.positions.push_back(s.positions[i] + glm::dvec3(0.001 * (copy + 1), 0.0, 0.0));
+      s.colors.push_back(s.colors[i]);
+    }
+  const Camera camera = lookAtCloud(s, glm::dvec3(6378137.0, 0.0, 0.0), 1.0);
+  PointStream stream;
+  stream.count = s.size();
+  stream.has_colors = true;
+  size_t reads = 0;
+  stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
+    ++reads;
+    block.positions.assign(s.positions.begin() + static_cast<std::ptrdiff_t>(first),
+                           s.positions.begin() + static_cast<std::ptrdiff_t>(first + n));
+    block.colors.assign(s.colors.begin() + static_cast<std::ptrdiff_t>(first),
+                        s.colors.begin() + static_cast<std::ptrdiff_t>(first + n));
+    return okStatus();
+  };
+  for (PrecisionMode mode : kAllModes) {
+    SCOPED_TRACE(std::string(modeName(mode)));
+    RenderOptions options;
+    options.mode = mode;
+    options.backend = GetParam();
+    options.max_chunk_points = 5000;  // batch mode rounds it down to 4096
+    Result<RenderResult> whole = renderPoints(*context_, s, camera, options);
+    ASSERT_TRUE(whole.ok()) << whole.error().message;
+    reads = 0;
+    Result<RenderResult> streamed = renderStream(*context_, stream, camera, options);
+    ASSERT_TRUE(streamed.ok()) << streamed.error().message;
+    EXPECT_EQ(reads, streamed->chunks);
+    EXPECT_GE(streamed->chunks, 3u);
+    EXPECT_TRUE(streamed->image.rgba == whole->image.rgba);
+  }
+  RenderOptions options;
+  options.backend = GetParam();
+  options.max_chunk_points = 5000;
+  PointStream failing = stream;
+  failing.read = [&](size_t first, size_t n, PointSet& block) -> Status {
+    if (first > 0) return Error{"cloud.ply: byte 1234: truncated"};
+    return stream.read(first, n, block);
+  };
+  Result<RenderResult> failed = renderStream(*context_, failing, camera, options);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().message, "cloud.ply: byte 1234: truncated");
+  s.positions[9000].y = 1e39;  // beyond float: fp32 names it
+  options.mode = PrecisionMode::kFp32;
+  failed = renderStream(*context_, stream, camera, options);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_NE(failed.error().message.find("point 9000: y"), std::string::npos) << failed.error().message;
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, Render, ::testing::Values(Backend::kRaster, Backend::kCompute), backendName);
 
 }  // namespace

@@ -153,10 +153,10 @@ void fillInParallel(const UploadFill& fill, void* dst, VkDeviceSize offset, VkDe
 }  // namespace
 
 Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
-                    VkDeviceSize grain, VkDeviceSize staging_limit) {
-  assert(size <= target.size && grain > 0);
+                    VkDeviceSize grain, VkDeviceSize staging_limit, VkDeviceSize at) {
+  assert(at <= target.size && size <= target.size - at && grain > 0);
   if (target.mapped) {
-    fillInParallel(fill, target.mapped, 0, size, grain);
+    fillInParallel(fill, static_cast<uint8_t*>(target.mapped) + at, 0, size, grain);
     return flushBuffer(context, target);
   }
   // Two staging buffers: the cores fill one while the GPU copies out of the other.
@@ -202,7 +202,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
       VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
       begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
       VK_TRY(vkBeginCommandBuffer(s.commands, &begin));
-      VkBufferCopy copy{0, offset, bytes};
+      VkBufferCopy copy{0, at + offset, bytes};
       vkCmdCopyBuffer(s.commands, s.staging.buffer, target.buffer, 1, &copy);
       VK_TRY(vkEndCommandBuffer(s.commands));
       VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};

@@ -40,12 +40,13 @@ Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize siz
 // uploadBuffer calls it from several threads at once on disjoint pieces.
 using UploadFill = std::function<void(void* dst, VkDeviceSize offset, VkDeviceSize bytes)>;
 
-// Fills `size` bytes at the start of `target` (usage must include TRANSFER_DST) through `fill`,
-// on every core, in pieces that are multiples of `grain` bytes (a whole element): into mapped
-// memory directly when the target is host-visible, else through two staging buffers of at most
-// `staging_limit` bytes, one filled while the GPU copies out of the other.
+// Fills `size` bytes of `target` from byte `at` on (usage must include TRANSFER_DST) through
+// `fill`, whose offsets count from `at`, on every core, in pieces that are multiples of `grain`
+// bytes (a whole element): into mapped memory directly when the target is host-visible, else
+// through two staging buffers of at most `staging_limit` bytes, one filled while the GPU copies
+// out of the other.
 Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
-                    VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20);
+                    VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20, VkDeviceSize at = 0);
 
 struct GpuImage {
   VkImage image = VK_NULL_HANDLE;

@@ -91,7 +91,7 @@ Error beyondFloat(PrecisionMode mode, size_t index, int axis, double value, cons
 }
 
 // The first problem of point i, if it has one.
-std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& points, size_t i) {
+std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& points, size_t i, size_t index_base) {
   const ModeInfo& info = modeInfo(e.mode);
   const bool floats = e.mode != PrecisionMode::kNative && e.mode != PrecisionMode::kBatch;
   for (int axis = 0; axis < 3; ++axis) {
@@ -100,10 +100,10 @@ std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& poin
     if (floats && !fitsFloat(in_frame)) {
       std::string how = info.scene_frame
           ? " (" + shortest(in_frame) + " view sizes from the origin)" : std::string();
-      return beyondFloat(e.mode, i, axis, value, how);
+      return beyondFloat(e.mode, index_base + i, axis, value, how);
     }
     if (!std::isfinite(in_frame)) {
-      return Error{"point " + std::to_string(i) + ": " + axisName(axis) + " = " + shortest(value) +
+      return Error{"point " + std::to_string(index_base + i) + ": " + axisName(axis) + " = " + shortest(value) +
                        " overflows double when scaled to the view (" + shortest(in_frame) + ")",
                    ExitCode::kBadInput};
     }
@@ -112,19 +112,19 @@ std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& poin
 }
 
 // Every position checked on every core; the error names the first bad point whatever the thread count.
-Status checkPositions(const ModeEncoding& e, const PointSet& points) {
+Status checkPositions(const ModeEncoding& e, const PointSet& points, size_t index_base) {
   constexpr size_t kBlock = 1 << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
   std::vector<size_t> first_bad(blocks, SIZE_MAX);
   parallelFor(blocks, 0, [&](size_t b, unsigned) {
     for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i)
-      if (positionProblem(e, points, i)) {
+      if (positionProblem(e, points, i, index_base)) {
         first_bad[b] = i;
         return;
       }
   });
   for (size_t i : first_bad)
-    if (i != SIZE_MAX) return *positionProblem(e, points, i);
+    if (i != SIZE_MAX) return *positionProblem(e, points, i, index_base);
   return okStatus();
 }
 
@@ -218,15 +218,21 @@ SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera) {
   return frame;
 }
 
-Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera) {
+ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera) {
   ModeEncoding e;
   e.mode = mode;
   e.frame = sceneFrame(mode, camera);
-  if (Status status = checkPositions(e, points); !status) return status.error();
-  if (mode != PrecisionMode::kBatch) return e;
-  e.batches = makeBatchFrames(points, e.frame);
+  return e;
+}
+
+Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
+  if (Status status = checkPositions(e, block, first_index); !status) return status;
+  if (e.mode != PrecisionMode::kBatch) return okStatus();
+  assert(first_index == e.batches.size() * kBatchSize);  // blocks in order, whole batches but the last
+  const size_t first_batch = e.batches.size();
+  for (const BatchFrame& frame : makeBatchFrames(block, e.frame)) e.batches.push_back(frame);
   e.batch_matrices.reserve(e.batches.size());
-  for (size_t b = 0; b < e.batches.size(); ++b) {
+  for (size_t b = first_batch; b < e.batches.size(); ++b) {
     const glm::dmat4& m = e.batch_matrices.emplace_back(batchMatrix(e.frame, e.batches[b]));
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) {
@@ -238,10 +244,17 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
                      ExitCode::kBadInput};
       }
   }
+  return okStatus();
+}
+
+Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera) {
+  ModeEncoding e = beginEncoding(mode, camera);
+  if (Status status = addPoints(e, points, 0); !status) return status.error();
   return e;
 }
 
-void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first, size_t count, void* out) {
+void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first, size_t count, void* out,
+                     size_t index_base) {
   assert(first + count <= points.size());
   auto* f = static_cast<float*>(out);
   const glm::dvec3* p = points.positions.data() + first;
@@ -275,7 +288,7 @@ void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first
     case PrecisionMode::kBatch: {
       auto* words = static_cast<uint64_t*>(out);
       for (size_t i = 0; i < count; ++i) {
-        const BatchFrame& batch = e.batches[(first + i) / kBatchSize];
+        const BatchFrame& batch = e.batches[(index_base + first + i) / kBatchSize];
         // p·scale − origin rounds once in double; the division by a power of two is exact.
         words[i] = packBatchOffset((scaleBy(p[i], frame) - batch.origin) / batch.extent);
       }

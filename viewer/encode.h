@@ -132,9 +132,18 @@ struct ModeEncoding {
 // are finite (readers reject the rest), and these checks keep every encoded value finite too.
 Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera);
 
-// Writes positions [first, first + count) in the mode's layout to `out`
-// (count · positionBytes(mode) bytes).
-void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_t first, size_t count, void* out);
+// The same a block at a time, for a set streamed from a file: the encoding before any point is
+// seen, then each block in order (first_index: its first point's index in the whole set; in batch
+// mode a multiple of kBatchSize), checked as prepareEncoding checks the whole set, with errors
+// naming whole-set indices, and in batch mode its batches' frames and matrices appended.
+ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera);
+Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);
+
+// Writes positions [first, first + count) of `points` in the mode's layout to `out`
+// (count · positionBytes(mode) bytes). index_base: the index of points[0] in the whole set when
+// `points` is a block of it (batch mode looks up batches by whole-set index).
+void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_t first, size_t count, void* out,
+                     size_t index_base = 0);
 
 // The mode's uniform block (std140, as declared in shaders/project.glsl); empty for batch.
 std::vector<uint8_t> cameraUniform(const ModeEncoding& encoding, const Camera& camera);

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <future>
 
 #include "viewer/buffers.h"
 #include "viewer/pipelines.h"
@@ -39,10 +41,10 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
   return static_cast<size_t>(points);
 }
 
-Status checkOptions(const VulkanContext& context, const PointSet& points, const RenderOptions& options) {
-  if (points.size() == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
-  if (points.size() > UINT32_MAX)
-    return Error{"more than 2^32 points (" + std::to_string(points.size()) + ") are not supported", ExitCode::kResourceLimit};
+Status checkOptions(const VulkanContext& context, size_t count, const RenderOptions& options) {
+  if (count == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
+  if (count > UINT32_MAX)
+    return Error{"more than 2^32 points (" + std::to_string(count) + ") are not supported", ExitCode::kResourceLimit};
   if (options.frames == 0) return Error{"--frames must be at least 1", ExitCode::kUsage};
   const DeviceFacts& f = context.facts;
   if (!(options.point_size >= 1.0f) || options.point_size > f.max_point_size)
@@ -56,8 +58,8 @@ Status checkOptions(const VulkanContext& context, const PointSet& points, const 
                    ExitCode::kNoDevice};
     if (options.point_size != 1.0f)
       return Error{"--backend compute draws points of size 1; --point-size needs --backend raster", ExitCode::kUsage};
-    if (uint64_t{4} * points.size() > f.max_storage_buffer_range)
-      return Error{"--backend compute keeps every colour in one storage buffer: " + std::to_string(points.size()) +
+    if (uint64_t{4} * count > f.max_storage_buffer_range)
+      return Error{"--backend compute keeps every colour in one storage buffer: " + std::to_string(count) +
                        " points exceed " + f.name + "'s maxStorageBufferRange; use --backend raster",
                    ExitCode::kResourceLimit};
   }
@@ -65,6 +67,18 @@ Status checkOptions(const VulkanContext& context, const PointSet& points, const 
     return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; native mode must pull positions",
                  ExitCode::kNoDevice};
   return okStatus();
+}
+
+// The device runs the mode: its features, and for emulated double the self-test.
+Status checkMode(const VulkanContext& context, const RenderOptions& options) {
+  SelfTest self_test{true, ""};
+  if (modeInfo(options.mode).needs_self_test) {
+    Result<SelfTest> ran = runPrecisionSelfTest(context);
+    if (!ran) return ran.error();
+    self_test = *ran;
+  }
+  // The compute probe writes from a compute shader, which needs no vertex-stage stores.
+  return modeUsable(context, options.mode, self_test, options.probe && options.backend == Backend::kRaster);
 }
 
 void writeDescriptors(const VulkanContext& context, const Resources& r, const Chunk& chunk, bool pulled, bool probe) {
@@ -118,43 +132,60 @@ void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeli
   vkCmdEndRenderPass(commands);
 }
 
-Status uploadPoints(const VulkanContext& context, Resources& r, const PointSet& points, const RenderOptions& options,
-                    const ModeEncoding& encoding, bool pulled, size_t per_chunk) {
+// Where a chunk's points come from: the set itself when it is in memory (offset = the chunk's
+// first index), or a block just read from a stream (offset 0). Fails with the stream's error.
+struct BlockView {
+  const PointSet* set = nullptr;
+  size_t offset = 0;
+};
+using ChunkPoints = std::function<Result<BlockView>(size_t first, size_t count)>;
+
+Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, const ChunkPoints& chunk_points,
+                    const RenderOptions& options, const ModeEncoding& encoding, bool pulled, size_t per_chunk) {
   const uint32_t stride = positionBytes(options.mode);
   const bool compute = options.backend == Backend::kCompute;
   VkBufferUsageFlags position_usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
       (pulled || compute ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  // RGBA8 colours [first, first + count), encoded straight into the upload: in a buffer per chunk
-  // for the raster backend's vertex input, one for the whole set for the compute resolve.
-  auto upload_colors = [&](Buffer& out, size_t first, size_t count, VkBufferUsageFlags usage, const std::string& what) {
-    Result<Buffer> buffer = createUploadTarget(context, count * 4, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
+  // RGBA8 colours of `count` points of `view`, encoded straight into the upload at byte `at`: in a
+  // buffer per chunk for the raster backend's vertex input, one for the whole set for the compute
+  // resolve.
+  auto upload_colors = [&](Buffer& out, BlockView view, size_t count, VkDeviceSize at) {
+    return uploadBuffer(context, out, count * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+      encodeColors(*view.set, view.offset + offset / 4, bytes / 4, static_cast<uint32_t*>(dst));
+    }, 4, VkDeviceSize{32} << 20, at);
+  };
+  auto create = [&](Buffer& out, VkDeviceSize bytes, VkBufferUsageFlags usage, const std::string& what) {
+    Result<Buffer> buffer = createUploadTarget(context, bytes, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
     if (!buffer) return Status(buffer.error());
     out = *buffer;
-    return uploadBuffer(context, out, count * 4, [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-      encodeColors(points, first + offset / 4, bytes / 4, static_cast<uint32_t*>(dst));
-    }, 4);
+    return okStatus();
   };
   if (compute) {
-    if (Status status = upload_colors(r.all_colors, 0, points.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "colours"); !status)
+    if (Status status = create(r.all_colors, total * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "colours"); !status)
       return status;
   }
-  for (size_t first = 0; first < points.size(); first += per_chunk) {
+  for (size_t first = 0; first < total; first += per_chunk) {
     Chunk& chunk = r.chunks.emplace_back();
     chunk.first = first;
-    chunk.count = std::min(per_chunk, points.size() - first);
+    chunk.count = std::min(per_chunk, total - first);
+    Result<BlockView> view = chunk_points(chunk.first, chunk.count);
+    if (!view) return view.error();
     std::string what = "points " + std::to_string(first) + ".." + std::to_string(first + chunk.count - 1);
-    Result<Buffer> positions = createUploadTarget(context, chunk.count * stride, position_usage, what + " positions");
-    if (!positions) return positions.error();
-    chunk.positions = *positions;
+    if (Status status = create(chunk.positions, chunk.count * stride, position_usage, what + " positions"); !status)
+      return status;
     Status status = uploadBuffer(context, chunk.positions, chunk.count * stride,
         [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-          encodePositions(encoding, points, chunk.first + offset / stride, bytes / stride, dst);
+          encodePositions(encoding, *view->set, view->offset + offset / stride, bytes / stride, dst,
+                          chunk.first - view->offset);
         }, stride);
     if (!status) return status;
-    if (!compute) {
-      status = upload_colors(chunk.colors, chunk.first, chunk.count, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, what + " colours");
-      if (!status) return status;
+    if (compute) {
+      status = upload_colors(r.all_colors, *view, chunk.count, VkDeviceSize{chunk.first} * 4);
+    } else {
+      status = create(chunk.colors, chunk.count * 4, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, what + " colours");
+      if (status) status = upload_colors(chunk.colors, *view, chunk.count, 0);
     }
+    if (!status) return status;
     if (options.probe) {
       Result<Buffer> probe = createBuffer(context, chunk.count * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                           true, what + " probe");
@@ -206,8 +237,7 @@ Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled
   return r.shade.edl ? detail::createShadeDescriptors(context, r) : okStatus();
 }
 
-Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
-                      const ModeEncoding& encoding) {
+Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const ModeEncoding& encoding) {
   std::vector<uint8_t> uniform = cameraUniform(encoding, camera);
   uniform.resize(std::max<size_t>(uniform.size(), 256), 0);
   Result<Buffer> ubo = createBuffer(context, uniform.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -221,6 +251,12 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
   Result<Buffer> dummy = createBuffer(context, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "unused binding");
   if (!dummy) return dummy.error();
   r.dummy = *dummy;
+  return okStatus();
+}
+
+// Batch mode's matrices, once every batch is known (a stream appends them block by block).
+Status uploadBatchMatrices(const VulkanContext& context, Resources& r, const RenderOptions& options,
+                           const ModeEncoding& encoding) {
   if (options.mode == PrecisionMode::kBatch) {
     std::vector<glm::mat4> matrices = batchMatrices(encoding);
     VkDeviceSize bytes = matrices.size() * sizeof(glm::mat4);
@@ -228,7 +264,7 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
                                           false, "batch matrices");
     if (!batches) return batches.error();
     r.batches = *batches;
-    status = uploadBuffer(context, r.batches, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize n) {
+    Status status = uploadBuffer(context, r.batches, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize n) {
       std::memcpy(dst, reinterpret_cast<const uint8_t*>(matrices.data()) + offset, n);
     });
     if (!status) return status;
@@ -336,39 +372,13 @@ Status runProbe(const VulkanContext& context, Resources& r, const RenderOptions&
   return okStatus();
 }
 
-}  // namespace
-
-Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
-                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets}};
-  VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  info.maxSets = sets;
-  info.poolSizeCount = 2;
-  info.pPoolSizes = sizes;
-  VK_TRY(vkCreateDescriptorPool(context.device, &info, nullptr, &r.descriptor_pool));
-  return okStatus();
-}
-
-Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                  const RenderOptions& options) {
-  Status status = checkOptions(context, points, options);
-  if (!status) return status.error();
-  SelfTest self_test{true, ""};
-  if (modeInfo(options.mode).needs_self_test) {
-    Result<SelfTest> ran = runPrecisionSelfTest(context);
-    if (!ran) return ran.error();
-    self_test = *ran;
-  }
+// Both entry points: `total` points, a chunk at a time from `chunk_points`; `encoding` is complete
+// for a set in memory, and for a stream grows block by block (chunk_points adds each block).
+Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, const ChunkPoints& chunk_points,
+                                  const ModeEncoding& encoding, const Camera& camera, const RenderOptions& options,
+                                  std::chrono::steady_clock::time_point upload_start, uint64_t max_chunk_points) {
   const bool compute = options.backend == Backend::kCompute;
   const bool shading = options.shading == Shading::kEdl;
-  // The compute probe writes from a compute shader, which needs no vertex-stage stores.
-  status = modeUsable(context, options.mode, self_test, options.probe && !compute);
-  if (!status) return status.error();
-
-  Clock::time_point upload_start = Clock::now();
-  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera);
-  if (!encoding) return encoding.error();
-
   // Positions come from a storage buffer in the compute backend, and for native mode on a device
   // without double vertex attributes.
   bool pulled = options.mode == PrecisionMode::kNative &&
@@ -389,11 +399,15 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
 
   RenderResult out;
   out.pulled_positions = pulled;
-  status = createUniforms(context, r, camera, options, *encoding);
-  if (status) status = uploadPoints(context, r, points, options, *encoding, pulled, chunkPoints(context.facts, options, pulled || compute));
+  RenderOptions chunking = options;
+  chunking.max_chunk_points = max_chunk_points;
+  Status status = createUniforms(context, r, camera, encoding);
+  if (status) status = uploadPoints(context, r, total, chunk_points, options, encoding, pulled,
+                                    chunkPoints(context.facts, chunking, pulled || compute));
+  if (status) status = uploadBatchMatrices(context, r, options, encoding);
   if (!status) return status.error();
   out.chunks = static_cast<uint32_t>(r.chunks.size());
-  out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * points.size();
+  out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * total;
   out.upload_ms = msSince(upload_start);
 
   if (compute) {
@@ -407,9 +421,95 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
   }
   if (status) status = timeFrames(context, r, options, camera, out);
   if (status) status = readPicture(context, r, camera.width, camera.height, out);
-  if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, points.size(), out);
+  if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, total, out);
   if (!status) return status.error();
   return out;
+}
+
+// Reads a stream's chunks in order, each while the one before is encoded and uploaded: two
+// blocks on the host, one being read, one being uploaded.
+class StreamBlocks {
+ public:
+  StreamBlocks(const PointStream& stream, ModeEncoding& encoding) : stream_(stream), encoding_(encoding) {}
+  ~StreamBlocks() {
+    if (pending_.valid()) pending_.wait();
+  }
+  Result<BlockView> get(size_t first, size_t count) {
+    const unsigned current = next_;
+    Status status = pending_.valid() && pending_first_ == first ? pending_.get() : read(first, count, current);
+    if (status) status = addPoints(encoding_, blocks_[current], first);
+    if (!status) return status.error();
+    const size_t after = first + count;
+    if (after < stream_.count) {
+      const unsigned slot = next_ = current ^ 1u;
+      pending_first_ = after;
+      pending_ = std::async(std::launch::async, [this, after, count, slot] {
+        return read(after, std::min(count, stream_.count - after), slot);
+      });
+    }
+    return BlockView{&blocks_[current], 0};
+  }
+
+ private:
+  Status read(size_t first, size_t count, unsigned slot) {
+    PointSet& block = blocks_[slot];
+    if (Status status = stream_.read(first, count, block); !status) return status;
+    if (block.size() != count || (stream_.has_colors && block.colors.size() != count))
+      return Error{"the stream gave " + std::to_string(block.size()) + " points for " + std::to_string(first) + ".." +
+                   std::to_string(first + count - 1)};
+    return okStatus();
+  }
+
+  const PointStream& stream_;
+  ModeEncoding& encoding_;
+  PointSet blocks_[2];
+  unsigned next_ = 0;
+  size_t pending_first_ = 0;
+  std::future<Status> pending_;
+};
+
+}  // namespace
+
+Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets}};
+  VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  info.maxSets = sets;
+  info.poolSizeCount = 2;
+  info.pPoolSizes = sizes;
+  VK_TRY(vkCreateDescriptorPool(context.device, &info, nullptr, &r.descriptor_pool));
+  return okStatus();
+}
+
+Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                                  const RenderOptions& options) {
+  Status status = checkOptions(context, points.size(), options);
+  if (!status) return status.error();
+  if (status = checkMode(context, options); !status) return status.error();
+  Clock::time_point upload_start = Clock::now();
+  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera);
+  if (!encoding) return encoding.error();
+  return renderChunks(context, points.size(),
+                      [&](size_t first, size_t) -> Result<BlockView> { return BlockView{&points, first}; }, *encoding,
+                      camera, options, upload_start, options.max_chunk_points);
+}
+
+Result<RenderResult> renderStream(const VulkanContext& context, const PointStream& stream, const Camera& camera,
+                                  const RenderOptions& options) {
+  assert(!options.probe && "the probe keeps every point's clip position: render the set in memory");
+  Status status = checkOptions(context, stream.count, options);
+  if (!status) return status.error();
+  if (status = checkMode(context, options); !status) return status.error();
+  Clock::time_point upload_start = Clock::now();
+  ModeEncoding encoding = beginEncoding(options.mode, camera);
+  StreamBlocks blocks(stream, encoding);
+  // Whole batches per block, so batch mode's frames line up with the chunks.
+  uint64_t limit = options.max_chunk_points ? std::min<uint64_t>(options.max_chunk_points, kStreamBlockPoints)
+                                            : kStreamBlockPoints;
+  if (options.mode == PrecisionMode::kBatch) limit = std::max<uint64_t>(kBatchSize, limit / kBatchSize * kBatchSize);
+  return renderChunks(context, stream.count,
+                      [&](size_t first, size_t count) { return blocks.get(first, count); }, encoding, camera, options,
+                      upload_start, limit);
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,

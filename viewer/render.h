@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,23 @@ struct RenderResult {
 // kNoDevice when the device cannot run the mode (see modeUsable), kResourceLimit when memory
 // runs out. The caller's context collects validation messages.
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                                  const RenderOptions& options);
+
+// A point set read a block at a time, in order: how `dpoint render` draws a file larger than the
+// host memory should hold. read(first, n, block) replaces `block` with points [first, first + n)
+// (positions, and colours when has_colors); it is called for consecutive ranges from 0 on, each
+// from one thread at a time, the next while the last is uploaded.
+struct PointStream {
+  size_t count = 0;
+  bool has_colors = false;
+  std::function<Status(size_t first, size_t n, PointSet& block)> read;
+};
+// Points per block of a stream: with two blocks on the host (36 B a point), about 1.2 GB.
+inline constexpr uint64_t kStreamBlockPoints = uint64_t{1} << 24;
+
+// renderPoints for a stream (no probe: it keeps every point's clip position). The same picture
+// and the same errors as renderPoints of the whole set; the stream's errors end it.
+Result<RenderResult> renderStream(const VulkanContext& context, const PointStream& stream, const Camera& camera,
                                   const RenderOptions& options);
 
 // --mode auto on this device (viewer/precision.h): the measured speed order of the device's
