@@ -4,7 +4,8 @@
 # `dpoint render --backend compute` per dataset, order and mode at 1920x1080: FRAMES (50) timed
 # frames after 5 warm-up, the GPU median from timestamps, e2e_ms (encode + upload + one frame +
 # readback) and the whole command's wall time. Also `dpoint bench copy` (the copy bandwidth).
-# One line per run in $OUT/speed.tsv. SETS picks the datasets (default: all of them).
+# One line per run in $OUT/speed.tsv. SETS picks the datasets (default: all but the 1e9-point
+# one), STREAM passes --stream (auto: sets above 2^26 points are streamed from the file).
 set -euo pipefail
 source bench/gpu_env.sh
 d=${BIN:-.gpu/dpoint}  # BIN: another build to compare, LABEL: its name in the table
@@ -27,7 +28,7 @@ render() {
   local name=$1 order=$2 file=$3 mode=$4 start end
   start=$(date +%s.%N)
   "$d" render "$file" --backend compute --mode "$mode" --width 1920 --height 1080 --frames "${FRAMES:-50}" \
-    --warmup 5 -q --json /tmp/r.json -o /tmp/r.png
+    --warmup 5 -q --stream "${STREAM:-auto}" --json /tmp/r.json -o /tmp/r.png
   end=$(date +%s.%N)
   printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name${LABEL:+ ($LABEL)}" "$order" "$mode" "$(value points)" "$(field gpu_ms)" \
     "$(value upload_ms)" "$(value e2e_ms)" "$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')" \
@@ -39,6 +40,7 @@ for set in ${SETS:-sierpinski mandelbulb random300m}; do
     sierpinski) args=(sierpinski --level 11 --unwelded) ;;
     mandelbulb) args=(mandelbulb --resolution 1024 --variant fast) ;;
     random300m) args=(random2d --count 300000000) ;;
+    random1g) args=(random2d --count 1000000000) ;;  # 24 GB of binary PLY
     *) echo "unknown set $set" >&2; exit 1 ;;
   esac
   for order in ${ORDERS:-input morton}; do
