@@ -12,3 +12,13 @@ for mode in fp32 native; do
   "$dpoint" render "$work/mandelbulb_earth.ply" -o "$here/mandelbulb_earth_$mode.png" --mode $mode --error \
     --width 480 --height 480 --point-size 2
 done
+
+# Readable previews (issue #13): the same Mandelbulb and a level-4 Menger sponge as plain 1-px
+# points and as `dpoint render` draws them by default (eye-dome lighting, --point-size auto),
+# and the Mandelbulb's four-view contact sheet.
+"$dpoint" generate menger --level 4 --quiet -o "$work/menger.ply"
+for set in mandelbulb_earth menger; do
+  "$dpoint" render "$work/$set.ply" -o "$here/${set}_plain.png" --shade none --point-size 1 --width 480 --height 480
+  "$dpoint" render "$work/$set.ply" -o "$here/${set}_edl.png" --width 480 --height 480
+done
+"$dpoint" render "$work/mandelbulb_earth.ply" -o "$here/mandelbulb_earth_views.png" --views 4 --width 960 --height 720
