@@ -17,6 +17,7 @@
 #include "converters/point_io.h"
 #include "core/ply.h"
 #include "core/atomic_file.h"
+#include "core/memory.h"
 #include "core/point_order.h"
 #include "core/progress.h"
 #include "viewer/camera.h"
@@ -35,7 +36,7 @@ struct RenderCliOptions {
   std::string order = "input", shade = "auto", stream = "auto";
   double edl_strength = 1.0, edl_radius = 1.4;
   uint32_t views = 1;
-  std::string color = "auto";
+  std::string color = "auto", max_device_memory;
   std::string up_axis = "auto";
   CameraCliOptions camera;
   std::string background = "0,0,0";
@@ -373,6 +374,9 @@ int runRender(const RenderCliOptions& o) {
   }
   Result<uint32_t> background = parseBackground(o.background);
   if (!background) return reportError(background.error());
+  Result<uint64_t> device_memory =
+      o.max_device_memory.empty() ? uint64_t{0} : parseMemorySize("--max-device-memory", o.max_device_memory);
+  if (!device_memory) return reportError(device_memory.error());
 
   Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
@@ -435,7 +439,8 @@ int runRender(const RenderCliOptions& o) {
   }
   phases.mark("camera");
 
-  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{o.device, o.validate});
+  Result<std::unique_ptr<VulkanContext>> context =
+      VulkanContext::create(ContextOptions{o.device, o.validate, *device_memory});
   if (!context) return reportError(context.error());
   phases.mark("device");
   run.backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
@@ -582,6 +587,8 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
                   "auto|rgb|elevation. elevation: a perceptual colour map (viridis) along the up axis (--up-axis).\n"
                   "auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones")
       ->default_val("auto");
+  cmd->add_option("--max-device-memory", o->max_device_memory,
+                  "Refuse (exit 4) to allocate more GPU memory than this, e.g. 2G (default: what the device has)");
   cmd->add_option("--stream", o->stream,
                   "auto|on|off. on: draw a binary PLY a block at a time, so a file larger than memory renders in\n"
                   "about 1.2 GB of host memory (two blocks of 16M points); auto: for binary PLY of more than 2^26\n"

@@ -1,6 +1,7 @@
 // dpoint render and dpoint devices as a user runs them (on lavapipe in CI, validation layer on).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 #include <utility>
@@ -248,6 +249,44 @@ TEST(CliRender, streamedPlyDrawsTheSamePicture) {
   EXPECT_EQ(error.exit_code, 1);
   EXPECT_NE(error.err.find("is read once"), std::string::npos) << error.err;
   EXPECT_FALSE(test::fileExists(dir.file("a.png")) || test::fileExists(dir.file("e.png")));
+}
+
+// Vulkan faults (issue #12): no driver, a device without a feature the run needs (hidden by the
+// test switch), a lost device (injected at every queue submission), and a device-memory budget
+// too small: each ends the run within its own time with one line on stderr, the exit code, and
+// no picture.
+TEST(CliRender, vulkanFaultsEndWithOneLineAndNoPicture) {
+  TempDir dir;
+  writeFile(dir.file("one.csv"), "x,y,z\n1,2,3\n4,5,6\n");
+  struct Case {
+    std::string env;
+    std::vector<std::string> args;
+    int code;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"VK_DRIVER_FILES=/nonexistent/icd.json", {}, 3, "no Vulkan driver found"},
+      {"DPOINT_TEST_VULKAN_FAULT=no-float64", {"--mode", "native"}, 3, "needs shaderFloat64"},
+      {"DPOINT_TEST_VULKAN_FAULT=no-int64-atomics", {"--backend", "compute"}, 3, "shaderBufferInt64Atomics"},
+      {"DPOINT_TEST_VULKAN_FAULT=device-lost", {}, 3, "VK_ERROR_DEVICE_LOST"},
+      {"DPOINT_TEST_VULKAN_FAULT=", {"--max-device-memory", "1M"}, 4, "--max-device-memory"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.env);
+    std::vector<std::string> argv = {"/usr/bin/env", c.env, DPOINT_EXE, "render", dir.file("one.csv"), "-o",
+                                     dir.file("out.png")};
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    test::CommandResult r = test::runCommand(argv);
+    EXPECT_EQ(r.exit_code, c.code) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(test::fileExists(dir.file("out.png")));
+  }
+  // With the feature hidden, --mode auto goes on in a mode the device still runs.
+  test::CommandResult r = test::runCommand({"/usr/bin/env", "DPOINT_TEST_VULKAN_FAULT=no-float64", DPOINT_EXE, "render",
+                                            dir.file("one.csv"), "-o", dir.file("auto.png"), "--validate"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("mode native"), std::string::npos) << r.out;
 }
 
 // --order morton changes only which of two points at the same depth on one pixel wins; a

@@ -30,6 +30,11 @@ Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, V
     vkDestroyBuffer(context.device, out.buffer, nullptr);
     return type.error();
   }
+  if (Status budget = reserveDeviceMemory(context, needs.size, what); !budget) {
+    vkDestroyBuffer(context.device, out.buffer, nullptr);
+    return budget.error();
+  }
+  out.allocated = needs.size;
   VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   allocate.allocationSize = needs.size;
   allocate.memoryTypeIndex = *type;
@@ -79,7 +84,25 @@ Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize siz
 void destroyBuffer(const VulkanContext& context, Buffer& buffer) {
   if (buffer.buffer) vkDestroyBuffer(context.device, buffer.buffer, nullptr);
   if (buffer.memory) vkFreeMemory(context.device, buffer.memory, nullptr);  // unmaps too
+  releaseDeviceMemory(context, buffer.allocated);
   buffer = Buffer{};
+}
+
+Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, const std::string& what) {
+  const uint64_t used = context.device_memory_used.fetch_add(bytes) + bytes;
+  if (context.device_memory_budget == 0 || used <= context.device_memory_budget) return okStatus();
+  context.device_memory_used.fetch_sub(bytes);
+  return Error{"device memory: " + what + " needs " + formatBytes(bytes) + " more, " + formatBytes(used) +
+                   " in all, above the budget of " + formatBytes(context.device_memory_budget) +
+                   " (--max-device-memory); try a smaller set, size or --mode with fewer bytes a point",
+               ExitCode::kResourceLimit};
+}
+
+void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes) { context.device_memory_used.fetch_sub(bytes); }
+
+VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence) {
+  if (vulkanFaults().device_lost) return VK_ERROR_DEVICE_LOST;
+  return vkQueueSubmit(context.queue, 1, &submit, fence);
 }
 
 // Host caches and device memory agree already for coherent memory; otherwise one range call.
@@ -128,7 +151,7 @@ Status submitOnce(const VulkanContext& context, const std::function<void(VkComma
     VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &commands;
-    result = vkQueueSubmit(context.queue, 1, &submit, fence);
+    result = queueSubmit(context, submit, fence);
   }
   if (result == VK_SUCCESS) result = vkWaitForFences(context.device, 1, &fence, VK_TRUE, UINT64_MAX);
   cleanup();
@@ -208,7 +231,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
       VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
       submit.commandBufferCount = 1;
       submit.pCommandBuffers = &s.commands;
-      VK_TRY(vkQueueSubmit(context.queue, 1, &submit, s.fence));
+      VK_TRY(queueSubmit(context, submit, s.fence));
       s.busy = true;
     }
     for (Slot& s : slot) {
@@ -244,6 +267,13 @@ Result<GpuImage> createImage(const VulkanContext& context, uint32_t width, uint3
     destroyImage(context, out);
     return type.error();
   }
+  if (Status budget = reserveDeviceMemory(context, needs.size, std::to_string(width) + "x" + std::to_string(height) +
+                                                                   " image");
+      !budget) {
+    destroyImage(context, out);
+    return budget.error();
+  }
+  out.allocated = needs.size;
   VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   allocate.allocationSize = needs.size;
   allocate.memoryTypeIndex = *type;
@@ -268,6 +298,7 @@ void destroyImage(const VulkanContext& context, GpuImage& image) {
   if (image.view) vkDestroyImageView(context.device, image.view, nullptr);
   if (image.image) vkDestroyImage(context.device, image.image, nullptr);
   if (image.memory) vkFreeMemory(context.device, image.memory, nullptr);
+  releaseDeviceMemory(context, image.allocated);
   image = GpuImage{};
 }
 

@@ -12,6 +12,7 @@ struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkDeviceSize size = 0;
+  VkDeviceSize allocated = 0;  // counted in the context's device_memory_used
   void* mapped = nullptr;  // set when the memory is host-visible (mapped for the buffer's life)
   bool coherent = false;
 };
@@ -24,6 +25,16 @@ void destroyBuffer(const VulkanContext& context, Buffer& buffer);
 
 // Makes device writes visible to the host for a mapped, non-coherent buffer.
 Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
+
+// vkQueueSubmit on the context's queue, or VK_ERROR_DEVICE_LOST without submitting under the
+// device-lost test switch (vulkanFaults): every submission goes through here.
+VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence);
+
+// Counts `bytes` of device memory against the context's budget (--max-device-memory) before they
+// are allocated: fails with kResourceLimit naming `what`, the size and the budget when they do
+// not fit. releaseDeviceMemory gives them back.
+Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, const std::string& what);
+void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes);
 
 // A primary command buffer from the context's pool (the caller frees it).
 Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context);
@@ -52,6 +63,7 @@ struct GpuImage {
   VkImage image = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
+  VkDeviceSize allocated = 0;  // counted in the context's device_memory_used
 };
 Result<GpuImage> createImage(const VulkanContext& context, uint32_t width, uint32_t height, VkFormat format,
                           VkImageUsageFlags usage, VkImageAspectFlags aspect);

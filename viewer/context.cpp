@@ -1,5 +1,7 @@
 #include "viewer/context.h"
 
+#include <cstdlib>
+
 #include <algorithm>
 #include <cstring>
 
@@ -53,7 +55,7 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
 
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(physical, &features);
-  facts.shader_float64 = features.shaderFloat64;
+  facts.shader_float64 = features.shaderFloat64 && !vulkanFaults().no_float64;
   facts.vertex_stores = features.vertexPipelineStoresAndAtomics;
   facts.large_points = features.largePoints;
 
@@ -62,7 +64,8 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
     VkPhysicalDeviceFeatures2 features2 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
     features2.pNext = &features12;
     vkGetPhysicalDeviceFeatures2(physical, &features2);
-    facts.int64_atomics = features.shaderInt64 && features12.shaderBufferInt64Atomics;
+    facts.int64_atomics =
+        features.shaderInt64 && features12.shaderBufferInt64Atomics && !vulkanFaults().no_int64_atomics;
   }
   if (facts.vulkan12) {
     VkPhysicalDeviceMaintenance3Properties maintenance3 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
@@ -208,9 +211,31 @@ const char* vkResultName(VkResult result) {
   }
 }
 
+const VulkanFaults& vulkanFaults() {
+  static const VulkanFaults faults = [] {
+    VulkanFaults f;
+    const char* text = std::getenv("DPOINT_TEST_VULKAN_FAULT");
+    std::string list = text ? text : "";
+    for (size_t at = 0; at <= list.size();) {
+      size_t end = list.find(',', at);
+      if (end == std::string::npos) end = list.size();
+      const std::string word = list.substr(at, end - at);
+      f.no_float64 = f.no_float64 || word == "no-float64";
+      f.no_int64_atomics = f.no_int64_atomics || word == "no-int64-atomics";
+      f.device_lost = f.device_lost || word == "device-lost";
+      at = end + 1;
+    }
+    return f;
+  }();
+  return faults;
+}
+
 Error vulkanError(const std::string& what, VkResult result) {
   bool memory = result == VK_ERROR_OUT_OF_HOST_MEMORY || result == VK_ERROR_OUT_OF_DEVICE_MEMORY;
-  std::string hint = result == VK_ERROR_INCOMPATIBLE_DRIVER ? " (no Vulkan driver found)" : "";
+  std::string hint = result == VK_ERROR_INCOMPATIBLE_DRIVER ? " (no Vulkan driver found)"
+                     : result == VK_ERROR_DEVICE_LOST
+                         ? " (the GPU was reset or its driver failed; nothing was written; try again, or --device cpu)"
+                         : "";
   return Error{what + " failed: " + vkResultName(result) + " (" + std::to_string(static_cast<int>(result)) + ")" + hint,
                memory ? ExitCode::kResourceLimit : ExitCode::kNoDevice};
 }
@@ -279,6 +304,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pool_info.queueFamilyIndex = context->facts.queue_family;
   VK_TRY(vkCreateCommandPool(context->device, &pool_info, nullptr, &context->command_pool));
+  context->device_memory_budget = options.max_device_memory;
   return context;
 }
 

@@ -3,6 +3,7 @@
 // No window, no surface.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -40,7 +41,18 @@ std::string formatDriverVersion(uint32_t vendor_id, uint32_t version);
 struct ContextOptions {
   std::string device = "auto";  // auto (a discrete GPU if any, else the best other), cpu, or an index
   bool validate = false;        // enable VK_LAYER_KHRONOS_validation and collect its messages
+  uint64_t max_device_memory = 0;  // --max-device-memory: a budget for every allocation; 0: none
 };
+
+// Test switches for the fault paths (issue #12), from the environment variable
+// DPOINT_TEST_VULKAN_FAULT, a comma-separated list: `no-float64` and `no-int64-atomics` hide the
+// feature as if the device lacked it (listDevices and create both), `device-lost` makes every
+// queue submission fail with VK_ERROR_DEVICE_LOST as a reset or crashed GPU does. Unknown words
+// are ignored. Read once per process.
+struct VulkanFaults {
+  bool no_float64 = false, no_int64_atomics = false, device_lost = false;
+};
+const VulkanFaults& vulkanFaults();
 
 class VulkanContext {
  public:
@@ -67,6 +79,9 @@ class VulkanContext {
   VkCommandPool command_pool = VK_NULL_HANDLE;
   DeviceFacts facts;
   VkPhysicalDeviceMemoryProperties memory{};
+  // Device memory allocated through viewer/buffers and the budget it must stay in (0: none).
+  uint64_t device_memory_budget = 0;
+  mutable std::atomic<uint64_t> device_memory_used{0};
 
  private:
   VulkanContext() = default;

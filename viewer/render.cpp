@@ -302,7 +302,7 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
     VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &r.frame_commands;
-    VK_TRY(vkQueueSubmit(context.queue, 1, &submit, r.fence));
+    VK_TRY(queueSubmit(context, submit, r.fence));
     VK_TRY(vkWaitForFences(context.device, 1, &r.fence, VK_TRUE, UINT64_MAX));
     double wall = msSince(start);
     VK_TRY(vkResetFences(context.device, 1, &r.fence));
