@@ -94,16 +94,7 @@ Status createShaderCopy(const VulkanContext& context, CopyScratch& s) {
   allocate.pSetLayouts = &s.set_layout;
   VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &s.set));
   VkDescriptorBufferInfo infos[2] = {{s.source.buffer, 0, VK_WHOLE_SIZE}, {s.target.buffer, 0, VK_WHOLE_SIZE}};
-  VkWriteDescriptorSet writes[2] = {};
-  for (uint32_t b = 0; b < 2; ++b) {
-    writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[b].dstSet = s.set;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(context.device, 2, writes, 0, nullptr);
+  writeBufferDescriptors(context, s.set, infos);
   return okStatus();
 }
 

@@ -1,5 +1,7 @@
 #include "viewer/pipelines.h"
 
+#include <vector>
+
 #include "shaders/points_batch.vert.h"
 #include "shaders/points_df64.vert.h"
 #include "shaders/points_fp32.vert.h"
@@ -249,6 +251,20 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
 }
 
 }  // namespace
+
+void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
+                            std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform) {
+  std::vector<VkWriteDescriptorSet> writes(infos.size());
+  for (uint32_t b = 0; b < infos.size(); ++b) {
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = b == 0 && first_is_uniform ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+}
 
 Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes) {
   VkShaderModuleCreateInfo info = {VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};

@@ -3,6 +3,8 @@
 // pipeline is the same shader with the specialization constant kProbe on (DESIGN §5).
 #pragma once
 
+#include <span>
+
 #include "viewer/context.h"
 #include "viewer/encode.h"
 
@@ -79,6 +81,11 @@ struct EdlPush {
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/edl.comp
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);
+
+// Points bindings 0, 1, … of `set` at whole buffers (`infos`, in binding order): storage buffers,
+// but binding 0 a uniform buffer when `first_is_uniform`.
+void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
+                            std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform = false);
 
 // Creates a shader module from SPIR-V words.
 Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);

@@ -89,16 +89,8 @@ void writeDescriptors(const VulkanContext& context, const Resources& r, const Ch
       r.batches.buffer ? whole(r.batches) : whole(r.dummy),
       probe ? whole(chunk.probe) : whole(r.dummy),
   };
-  VkWriteDescriptorSet writes[4];
-  for (uint32_t b = 0; b < 4; ++b) {
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = chunk.set;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = b == kBindingCamera ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(context.device, 4, writes, 0, nullptr);
+  static_assert(kBindingCamera == 0, "the camera uniform is binding 0");
+  writeBufferDescriptors(context, chunk.set, infos, true);
 }
 
 void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeline, const RenderOptions& options,

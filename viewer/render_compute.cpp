@@ -46,16 +46,7 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
     return okStatus();
   };
   auto write = [&](VkDescriptorSet set, const std::vector<VkDescriptorBufferInfo>& infos, bool first_is_uniform) {
-    std::vector<VkWriteDescriptorSet> writes(infos.size());
-    for (uint32_t b = 0; b < infos.size(); ++b) {
-      writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-      writes[b].dstSet = set;
-      writes[b].dstBinding = b;
-      writes[b].descriptorCount = 1;
-      writes[b].descriptorType = b == 0 && first_is_uniform ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      writes[b].pBufferInfo = &infos[b];
-    }
-    vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+    writeBufferDescriptors(context, set, infos, first_is_uniform);
   };
   for (Chunk& chunk : r.chunks) {
     if (Status status = allocate(r.compute.splat_set, chunk.set); !status) return status;

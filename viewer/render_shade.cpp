@@ -35,16 +35,7 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
   const VkDescriptorBufferInfo infos[3] = {{r.depth_values.buffer, 0, VK_WHOLE_SIZE},
                                            {r.picture.buffer, 0, VK_WHOLE_SIZE},
                                            {r.shaded.buffer, 0, VK_WHOLE_SIZE}};
-  VkWriteDescriptorSet writes[3];
-  for (uint32_t b = 0; b < 3; ++b) {
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = r.shade_set;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(context.device, 3, writes, 0, nullptr);
+  writeBufferDescriptors(context, r.shade_set, infos);
   return okStatus();
 }
 
