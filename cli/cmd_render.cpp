@@ -453,8 +453,8 @@ int runRender(const RenderCliOptions& o) {
   if (!prediction) return reportError(prediction.error());
   phases.mark("mode");
   const RenderOptions options = renderOptions(o, run, prediction->mode, *camera, (*context)->facts);
-  Result<RenderResult> rendered = Error{""};
-  if (ply) {
+  Result<RenderResult> rendered = [&]() -> Result<RenderResult> {
+    if (!ply) return renderPoints(**context, *points, *camera, options);
     PointStream stream;
     stream.count = run.count;
     stream.has_colors = has_colors || elevation;
@@ -466,11 +466,10 @@ int runRender(const RenderCliOptions& o) {
       return okStatus();
     };
     progress.start("streaming " + o.input + " to the GPU (points)", run.count);
-    rendered = renderStream(**context, stream, *camera, options);
+    Result<RenderResult> streamed = renderStream(**context, stream, *camera, options);
     progress.finish();
-  } else {
-    rendered = renderPoints(**context, *points, *camera, options);
-  }
+    return streamed;
+  }();
   if (!rendered) return reportError(rendered.error());
   phases.mark("render");
   std::optional<ErrorReport> error;
