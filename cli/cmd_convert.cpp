@@ -108,7 +108,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
   CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply, .glb and .las");
   cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las); written whole or not at all")->required();
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las); written whole or not at all")
+      ->required();
   cmd->add_option("--decimals", o->decimals,
                   "CSV: fixed digits after the point (15 gives the seed's %.15f); default: shortest round trip")
       ->check(CLI::Range(0, 100));
@@ -136,7 +137,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::IsMember({"linear", "srgb8"}))
       ->default_val("linear");
   cmd->add_option("--max-points", o->max_points,
-                  "Refuse (exit 4) input of more than N points, before --unique; glTF and LAS are refused before allocating")
+                  "Refuse (exit 4) input of more than N points, before --unique; glTF and LAS are refused before "
+                  "allocating")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--order", o->order, std::string(kPointOrderHelp) + "; applied last, after --unique")
       ->default_val("input");

@@ -88,7 +88,7 @@ Result<LasHeader> parseHeader(const InputFile& file) {
   LasHeader hd;
   hd.version_major = static_cast<uint8_t>(h[kVersionMajorAt]);
   hd.version_minor = static_cast<uint8_t>(h[kVersionMinorAt]);
-  const std::string version = str(static_cast<uint64_t>(hd.version_major)) + "." + str(static_cast<uint64_t>(hd.version_minor));
+  const std::string version = std::to_string(hd.version_major) + "." + std::to_string(hd.version_minor);
   if (hd.version_major != 1 || hd.version_minor > 4)
     return Error{path + ": header: version " + version + " is not supported (LAS 1.0 to 1.4)"};
   const uint32_t needed = hd.version_minor >= 4 ? kHeaderSize14 : hd.version_minor == 3 ? kHeaderSize13 : kHeaderSize12;
@@ -383,7 +383,8 @@ double lasOffsetFor(double min, double scale) {
 }
 
 glm::vec3 lasClassColor(uint8_t classification) {
-  const std::array<uint8_t, 3>& c = classification < kClassColors.size() ? kClassColors[classification] : kOtherClassColor;
+  const std::array<uint8_t, 3>& c =
+      classification < kClassColors.size() ? kClassColors[classification] : kOtherClassColor;
   return glm::vec3(c[0], c[1], c[2]) / 255.0f;
 }
 
@@ -448,9 +449,11 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     }
     block_box[b] = box;
   });
-  if (const auto bad = std::min_element(block_bad.begin(), block_bad.end()); bad != block_bad.end() && *bad != SIZE_MAX) {
-    const glm::dvec3& p = points.positions[*bad];
-    return Error{path + ": point " + str(*bad) + " (" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) +
+  size_t bad = SIZE_MAX;
+  for (size_t first_bad : block_bad) bad = std::min(bad, first_bad);
+  if (bad != SIZE_MAX) {
+    const glm::dvec3& p = points.positions[bad];
+    return Error{path + ": point " + str(bad) + " (" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) +
                  ") is not finite; LAS stores finite coordinates only"};
   }
   Box box;

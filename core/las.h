@@ -18,8 +18,9 @@
 // Colours (LasReadOptions::color):
 // - RGB (formats 2, 3, 5, 7, 8, 10) as c / 65535, or as c / 255 when no channel of any point
 //   exceeds 255: such a file holds 8-bit values in the 16-bit fields (as CloudCompare assumes; a
-//   true 16-bit file that dark is shown 257 times brighter, the heuristic's known price). The values are kept as they are, not decoded from sRGB: LAS RGB are display
-//   values (orthophoto pixels), and dpoint treats PLY's uchar and CSV colours the same way; the
+//   true 16-bit file that dark is shown 257 times brighter, the heuristic's known price). The
+//   values are kept as they are, not decoded from sRGB: LAS RGB are display values (orthophoto
+//   pixels), and dpoint treats PLY's uchar and CSV colours the same way; the
 //   renderer writes a colour's value to the PNG unchanged, so a scan looks as in other viewers.
 //   writeLas stores round(c · 65535), so LAS → LAS keeps every 16-bit value (c / 65535 is
 //   correctly rounded to float, and float's 24 bits leave |c · 65535 − v| < 0.004).

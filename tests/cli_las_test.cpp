@@ -41,7 +41,9 @@ TEST(CliLas, csvToLasToCsvIsByteIdenticalOnTheScaleGrid) {
   EXPECT_EQ(readFile(dir.file("out.csv")), readFile(dir.file("in.csv")));
   // A survey's coordinates (simple.las, scale 0.01), through CSV and back into LAS at its scale.
   ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("a.csv"), "--quiet"}).exit_code, 0);
-  ASSERT_EQ(runDpoint({"convert", dir.file("a.csv"), "-o", dir.file("b.las"), "--las-scale", "0.01", "--quiet"}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"convert", dir.file("a.csv"), "-o", dir.file("b.las"), "--las-scale", "0.01", "--quiet"})
+                .exit_code,
+            0);
   ASSERT_EQ(runDpoint({"convert", dir.file("b.las"), "-o", dir.file("c.csv"), "--quiet"}).exit_code, 0);
   EXPECT_EQ(readFile(dir.file("c.csv")), readFile(dir.file("a.csv")));
 }
@@ -106,6 +108,16 @@ TEST(CliLas, maxPointsRefusesALasFileByItsHeader) {
       runDpoint({"convert", kCorpus + "simple1_4.las", "-o", dir.file("x.csv"), "--max-points", "1000"});
   EXPECT_EQ(r.exit_code, 4);
   EXPECT_NE(r.err.find("22600 points exceed --max-points 1000"), std::string::npos) << r.err;
+}
+
+TEST(CliLas, generateWritesLasAtTheDefaultMillimetreScale) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"generate", "random2d", "--count", "100", "--offset", "637000,5800000,0", "-o",
+                                     dir.file("r.las"), "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  test::CommandResult info = runDpoint({"info", dir.file("r.las"), "--quiet"});
+  EXPECT_NE(info.out.find("point format 0, 20-byte records (0 extra bytes), 100 points"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS scale:          0.001 0.001 0.001"), std::string::npos) << info.out;
 }
 
 TEST(CliLas, rendersALasFile) {

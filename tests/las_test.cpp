@@ -72,7 +72,9 @@ std::string makeLas(const LasSpec& spec) {
   put<uint32_t>(s, 96, header_size);
   s[104] = static_cast<char>(spec.format);
   put<uint16_t>(s, 105, static_cast<uint16_t>(length));
-  const int64_t legacy = spec.legacy_count >= 0 ? spec.legacy_count : (spec.minor >= 4 && spec.format >= 6 ? 0 : static_cast<int64_t>(n));
+  const int64_t records = static_cast<int64_t>(n);
+  const int64_t legacy =
+      spec.legacy_count >= 0 ? spec.legacy_count : (spec.minor >= 4 && spec.format >= 6 ? 0 : records);
   put<uint32_t>(s, 107, static_cast<uint32_t>(legacy));
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (size_t i = 0; i < n; ++i) {
@@ -89,7 +91,7 @@ std::string makeLas(const LasSpec& spec) {
     put<double>(s, 179 + 16 * k, hi[k]);
     put<double>(s, 187 + 16 * k, lo[k]);
   }
-  if (spec.minor >= 4) put<uint64_t>(s, 247, static_cast<uint64_t>(spec.count64 >= 0 ? spec.count64 : static_cast<int64_t>(n)));
+  if (spec.minor >= 4) put<uint64_t>(s, 247, static_cast<uint64_t>(spec.count64 >= 0 ? spec.count64 : records));
   for (const Record& r : spec.records) {
     std::string rec(length, '\0');
     put<int32_t>(rec, 0, r.x);
@@ -115,7 +117,10 @@ LasSpec threePoints(int minor, int format) {
   spec.scale[0] = 0.001;
   spec.offset[0] = 637000;
   spec.offset[1] = 5800000;
-  spec.records = {{12345, -2, 40000, 100, 2, 1, 2, 3}, {0, 0, 0, 7, 5, 255, 0, 9}, {-7, 2147483647, -2147483647, 0, 9, 0, 200, 0}};
+  // x, y, z, intensity, classification, red, green, blue
+  spec.records = {{12345, -2, 40000, 100, 2, 1, 2, 3},
+                  {0, 0, 0, 7, 5, 255, 0, 9},
+                  {-7, 2147483647, -2147483647, 0, 9, 0, 200, 0}};
   return spec;
 }
 
@@ -236,9 +241,11 @@ TEST(Las, rejectsEmptyFileAndBadSignature) {
 
 TEST(Las, rejectsTruncatedHeader) {
   const std::string bytes = makeLas(threePoints(2, 0));
-  EXPECT_TRUE(contains(readError(bytes.substr(0, 200)), "truncated header: the file has 200 bytes, a LAS header at least 227"));
+  EXPECT_TRUE(contains(readError(bytes.substr(0, 200)),
+                       "truncated header: the file has 200 bytes, a LAS header at least 227"));
   const std::string v14 = makeLas(threePoints(4, 6));
-  EXPECT_TRUE(contains(readError(v14.substr(0, 300)), "truncated header: the file has 300 bytes, a LAS 1.4 header 375"));
+  EXPECT_TRUE(contains(readError(v14.substr(0, 300)),
+                       "truncated header: the file has 300 bytes, a LAS 1.4 header 375"));
 }
 
 TEST(Las, rejectsCountPastFileEndBeforeAllocating) {
@@ -258,7 +265,8 @@ TEST(Las, rejectsCountPastFileEndBeforeAllocating) {
 TEST(Las, rejectsRecordLengthShorterThanTheFormat) {
   LasSpec spec = threePoints(2, 1);
   spec.record_length = 20;
-  EXPECT_TRUE(contains(readError(makeLas(spec)), "header: point record length 20 is shorter than point format 1's 28 bytes"));
+  EXPECT_TRUE(contains(readError(makeLas(spec)),
+                       "header: point record length 20 is shorter than point format 1's 28 bytes"));
 }
 
 TEST(Las, rejectsZeroOrNonFiniteScaleAndOffset) {
@@ -349,7 +357,8 @@ TEST(Las, askingForRgbOfAFormatWithoutIsAnErrorNamingTheFile) {
   options.color = LasColorSource::kRgb;
   Result<PointSet> las = readLas(kCorpus + "autzen.las", options);
   ASSERT_FALSE(las.ok());
-  EXPECT_EQ(las.error().message, kCorpus + "autzen.las: point format 1 has no RGB colours (formats 2, 3, 5, 7, 8 and 10 have)");
+  EXPECT_EQ(las.error().message,
+            kCorpus + "autzen.las: point format 1 has no RGB colours (formats 2, 3, 5, 7, 8 and 10 have)");
   options.color = LasColorSource::kNone;
   Result<PointSet> simple = readLas(kCorpus + "simple.las", options);
   ASSERT_TRUE(simple.ok()) << simple.error().message;
@@ -479,7 +488,8 @@ TEST(Las, writerRefusesPointBeyondInt32NamingTheFirst) {
   Status s = writeLas(dir.file("far.las"), set, options);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ExitCode::kBadInput);
-  EXPECT_TRUE(contains(s.error().message, "far.las: point 2: x = 3000 is 3e+09 steps of the scale 1e-06 from the offset 0"));
+  EXPECT_TRUE(contains(s.error().message,
+                       "far.las: point 2: x = 3000 is 3e+09 steps of the scale 1e-06 from the offset 0"));
   EXPECT_TRUE(dir.entries().empty());  // nothing half-written
 }
 
@@ -567,7 +577,8 @@ void expectMatches(const PointSet& ours, const Reference& ref, const std::string
   const double divisor = largest > 255 ? 65535.0 : 255.0;
   for (size_t i = 0; i < ours.colors.size(); ++i)
     for (int k = 0; k < 3; ++k)
-      ASSERT_EQ(std::lround(ours.colors[i][k] * divisor), static_cast<long>(ref.colors[i][k])) << name << " point " << i;
+      ASSERT_EQ(std::lround(ours.colors[i][k] * divisor), static_cast<long>(ref.colors[i][k]))
+          << name << " point " << i;
   std::printf("%s: %zu points, %s, %zu positions bit-identical, largest relative difference %g\n", name.c_str(),
               ours.size(), ours.colors.empty() ? "no colours" : largest > 255 ? "16-bit colours" : "8-bit colours",
               identical, worst);

@@ -43,7 +43,8 @@ TEST(PointIoLas, lasFieldsAskedOfOtherFormatsAreErrorsNamingTheFile) {
   read.las_color = LasColorSource::kIntensity;
   Result<PointSet> csv = readPoints(dir.file("a.csv"), read);
   ASSERT_FALSE(csv.ok());
-  EXPECT_EQ(csv.error().message, dir.file("a.csv") + ": colour by intensity needs a LAS file; this file has no such field");
+  EXPECT_EQ(csv.error().message,
+            dir.file("a.csv") + ": colour by intensity needs a LAS file; this file has no such field");
   read.las_color = LasColorSource::kClassification;
   EXPECT_FALSE(readPoints(dir.file("a.csv"), read).ok());
   read.las_color = LasColorSource::kRgb;
