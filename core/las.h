@@ -7,7 +7,8 @@
 // VLRs, EVLRs, waveform packets and a record's extra bytes (record length beyond the format's base
 // size) are skipped. The count is the 64-bit one of a 1.4 header (the legacy 32-bit field when the
 // 64-bit one is 0), else the legacy one. Coordinates are X·scale + offset in double, rounded
-// twice, exactly as PDAL, laspy and loaders.gl compute them, so all four give the same doubles.
+// twice, as PDAL, laspy and loaders.gl compute them (on the corpus, loaders.gl's doubles and
+// dpoint's are bit-identical).
 // Before anything is allocated the header is checked: signature, version, point format, record
 // length against the format's base size, finite non-zero scales, finite offsets and bounds, and
 // count × record length against the bytes the file holds after the offset. Compressed records
@@ -30,8 +31,8 @@
 // - Classification through lasClassColor's fixed palette.
 //
 // Writing: LAS 1.2, point format 0, or 2 when the set has colours; one scale for x, y and z; per
-// axis the first offset, of a whole number (lasOffsetFor), 0, and the minimum rounded down to a
-// multiple of the scale, under which every coordinate reads back as the same double (else the
+// axis the first of these offsets under which every coordinate reads back as the same double: a
+// whole number (lasOffsetFor), 0, the minimum rounded down to a multiple of the scale (none: the
 // whole number); return 1 of 1, classification 0, intensity 0. A point whose (coordinate − offset)
 // / scale rounds outside the 32-bit integers is an error naming the point.
 //
