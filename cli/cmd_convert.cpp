@@ -1,5 +1,5 @@
-// dpoint convert IN -o OUT: CSV, PLY and GLB in any direction, and glTF/GLB input with scene
-// selection (converters/gltf_read.h says what a glTF file turns into).
+// dpoint convert IN -o OUT: CSV, PLY, GLB and LAS in any direction, and glTF/GLB input with scene
+// selection (converters/gltf_read.h says what a glTF file turns into, core/las.h a LAS file).
 #include <memory>
 
 #include "cli/commands.h"
@@ -24,6 +24,7 @@ struct ConvertOptions {
   std::string color_format = "linear";
   uint64_t max_points = 0;
   std::string order = "input";
+  double las_scale = 0.001;
   CommonOptions common;
 };
 
@@ -52,6 +53,14 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
   }
   if (o.scene >= 0 || o.all_scenes)
     return Error{o.input + ": --scene and --all-scenes apply to .glb/.gltf input only", ExitCode::kUsage};
+  if (*format == FileFormat::kLas && o.max_points != 0) {  // the header's count, before allocating
+    Result<LasHeader> header = readLasHeader(o.input);
+    if (!header) return header.error();
+    if (header->point_count > o.max_points)
+      return Error{o.input + ": " + std::to_string(header->point_count) + " points exceed --max-points " +
+                       std::to_string(o.max_points),
+                   ExitCode::kResourceLimit};
+  }
   Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
   if (points && o.max_points != 0 && points->size() > o.max_points)
     return Error{o.input + ": " + std::to_string(points->size()) + " points exceed --max-points " +
@@ -70,6 +79,7 @@ int runConvert(const ConvertOptions& o) {
   w.ply_encoding = o.ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
   w.ply_colors = o.ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
   w.progress = &progress;
+  w.las_scale = o.las_scale;
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
   // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
   // point set; --unique and --order morton need the whole set, so they take the path below.
@@ -96,9 +106,10 @@ int runConvert(const ConvertOptions& o) {
 
 void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply and .glb");
-  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply, .glb and .las");
+  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las)")->required();
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las); written whole or not at all")
+      ->required();
   cmd->add_option("--decimals", o->decimals,
                   "CSV: fixed digits after the point (15 gives the seed's %.15f); default: shortest round trip")
       ->check(CLI::Range(0, 100));
@@ -106,6 +117,11 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--ply-colors", o->ply_colors, "PLY: colour property type")
       ->check(CLI::IsMember({"uchar", "float"}))
       ->default_val("uchar");
+  cmd->add_option("--las-scale", o->las_scale,
+                  "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "
+                  "down to a whole number); a point beyond the 32-bit integers at this step is an error (exit 2)")
+      ->default_val(0.001)
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");
   auto* scene = cmd->add_option("--scene", o->scene,
@@ -121,7 +137,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::IsMember({"linear", "srgb8"}))
       ->default_val("linear");
   cmd->add_option("--max-points", o->max_points,
-                  "Refuse (exit 4) input of more than N points, before --unique; glTF is refused before allocating")
+                  "Refuse (exit 4) input of more than N points, before --unique; glTF and LAS are refused before "
+                  "allocating")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--order", o->order, std::string(kPointOrderHelp) + "; applied last, after --unique")
       ->default_val("input");

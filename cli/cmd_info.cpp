@@ -38,11 +38,42 @@ std::string num(double v, bool json = false) { return formatNumber(v, json); }
 std::string vec(const glm::dvec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
 std::string jsonVec(const glm::dvec3& v) { return "[" + num(v.x, true) + ", " + num(v.y, true) + ", " + num(v.z, true) + "]"; }
 
-void printText(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice) {
+// A LAS file's header (core/las.h), and whether its bounds hold the points read.
+struct LasFacts {
+  LasHeader header;
+  bool bounds_hold = true;
+};
+
+void printLasText(const LasFacts& las) {
+  const LasHeader& h = las.header;
+  std::printf("LAS:                version %d.%d, point format %d, %u-byte records (%u extra bytes), %llu points\n",
+              h.version_major, h.version_minor, h.point_format, h.record_length,
+              h.record_length - lasBaseRecordLength(h.point_format), static_cast<unsigned long long>(h.point_count));
+  std::printf("LAS scale:          %s\n", vec(h.scale).c_str());
+  std::printf("LAS offset:         %s\n", vec(h.offset).c_str());
+  std::printf("LAS header bounds:  %s .. %s (%s)\n", vec(h.min).c_str(), vec(h.max).c_str(),
+              las.bounds_hold ? "hold the points" : "do not hold the points: the header is wrong, the points are used");
+  std::printf("LAS software:       %s\n", h.generating_software.c_str());
+}
+
+void printLasJson(const LasFacts& las) {
+  const LasHeader& h = las.header;
+  std::printf(",\n  \"las\": {\"version\": \"%d.%d\", \"point_format\": %d, \"record_length\": %u, \"points\": %llu,\n",
+              h.version_major, h.version_minor, h.point_format, h.record_length,
+              static_cast<unsigned long long>(h.point_count));
+  std::printf("          \"scale\": %s, \"offset\": %s,\n", jsonVec(h.scale).c_str(), jsonVec(h.offset).c_str());
+  std::printf("          \"header_min\": %s, \"header_max\": %s, \"header_bounds_hold\": %s,\n", jsonVec(h.min).c_str(),
+              jsonVec(h.max).c_str(), las.bounds_hold ? "true" : "false");
+  std::printf("          \"generating_software\": %s}", jsonString(h.generating_software).c_str());
+}
+
+void printText(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice,
+               const std::optional<LasFacts>& las) {
   std::printf("file:               %s\n", path.c_str());
   std::printf("points:             %zu\n", i.count);
   std::printf("triangles:          %zu\n", i.triangles);
   std::printf("colours:            %s\n", i.has_colors ? "yes" : "no");
+  if (las) printLasText(*las);
   std::printf("min:                %s\n", vec(i.min).c_str());
   std::printf("max:                %s\n", vec(i.max).c_str());
   std::printf("extent:             %s\n", vec(i.extent).c_str());
@@ -68,7 +99,8 @@ void printText(const std::string& path, const PointSetInfo& i, const std::option
   }
 }
 
-void printJson(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice) {
+void printJson(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice,
+               const std::optional<LasFacts>& las) {
   std::printf("{\n");
   std::printf("  \"file\": %s,\n", jsonString(path).c_str());
   std::printf("  \"points\": %zu,\n  \"triangles\": %zu,\n  \"colors\": %s,\n", i.count, i.triangles,
@@ -81,6 +113,7 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
               num(i.min_neighbor_distance, true).c_str(), i.neighbor_sample);
   std::printf("  \"float32_merged_points\": %zu,\n  \"float32_overflow\": %zu,\n  \"float32_represents\": %s",
               i.float_merged, i.float_overflow, i.floatRepresents() ? "true" : "false");
+  if (las) printLasJson(*las);
   if (advice) {
     const Camera& c = advice->camera;
     std::printf(",\n  \"view\": {\"width\": %u, \"height\": %u, \"ortho\": %s, \"points_visible\": %zu},\n", c.width,
@@ -105,14 +138,20 @@ int runInfo(const InfoOptions& o) {
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
   const PointSetInfo info = computeInfo(*points, o.sample, o.common.threads);
+  std::optional<LasFacts> las;
+  if (Result<FileFormat> format = formatOf(o.input); format && *format == FileFormat::kLas) {
+    Result<LasHeader> header = readLasHeader(o.input);
+    if (!header) return reportError(header.error());
+    las = LasFacts{*header, info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max})};
+  }
   std::optional<ViewAdvice> advice;
   if (points->size() > 0) {
     Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
     if (!camera) return reportError(camera.error());
     advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera)};
   }
-  if (o.json) printJson(o.input, info, advice);
-  else printText(o.input, info, advice);
+  if (o.json) printJson(o.input, info, advice, las);
+  else printText(o.input, info, advice, las);
   return 0;
 }
 
@@ -124,7 +163,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "info",
       "Counts, bounds, whether float32 can hold the data, and each render mode's predicted error in pixels for a\n"
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
-  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf)")->required();
+  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las)")->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
       ->default_val(10000)

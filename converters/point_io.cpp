@@ -54,13 +54,15 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".ply") return FileFormat::kPly;
   if (ext == ".glb") return FileFormat::kGlb;
   if (ext == ".gltf") return FileFormat::kGltf;
-  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb or .gltf)", ExitCode::kUsage};
+  if (ext == ".las") return FileFormat::kLas;
+  if (ext == ".laz") return FileFormat::kLaz;
+  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb, .gltf or .las)", ExitCode::kUsage};
 }
 
-Result<PointSet> readPoints(const std::string& path, const ReadOptions& options) {
-  Result<FileFormat> format = formatOf(path);
-  if (!format) return format.error();
-  switch (*format) {
+namespace {
+
+Result<PointSet> readByFormat(const std::string& path, FileFormat format, const ReadOptions& options) {
+  switch (format) {
     case FileFormat::kCsv:
       return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress});
     case FileFormat::kPly:
@@ -71,8 +73,30 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
       gltf.allow_nonfinite = options.allow_nonfinite;
       return readGltf(path, gltf);
     }
+    case FileFormat::kLas:
+      return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color});
+    case FileFormat::kLaz:
+      return lasCompressedError(path);
   }
   return Error{path + ": unreachable format"};
+}
+
+}  // namespace
+
+Result<PointSet> readPoints(const std::string& path, const ReadOptions& options) {
+  Result<FileFormat> format = formatOf(path);
+  if (!format) return format.error();
+  const bool las = *format == FileFormat::kLas || *format == FileFormat::kLaz;
+  if (!las && (options.las_color == LasColorSource::kIntensity || options.las_color == LasColorSource::kClassification))
+    return Error{path + ": colour by " +
+                 (options.las_color == LasColorSource::kIntensity ? "intensity" : "classification") +
+                 " needs a LAS file; this file has no such field"};
+  Result<PointSet> points = readByFormat(path, *format, options);
+  if (!points || las) return points;
+  if (options.las_color == LasColorSource::kRgb && !points->hasColors())
+    return Error{path + ": colour by RGB asked for, but the file has no colours"};
+  if (options.las_color == LasColorSource::kNone) points->colors.clear();
+  return points;
 }
 
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
@@ -88,6 +112,11 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return writeGlb(path, points);
     case FileFormat::kGltf:
       return Error{path + ": writing .gltf is not supported; write .glb", ExitCode::kUsage};
+    case FileFormat::kLas:
+      return writeLas(path, points, LasWriteOptions{options.las_scale, options.threads, options.progress});
+    case FileFormat::kLaz:
+      return Error{path + ": writing LAZ is not supported; write .las and compress it with laszip or PDAL",
+                   ExitCode::kUsage};
   }
   return Error{path + ": unreachable format"};
 }

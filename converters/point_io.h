@@ -1,18 +1,19 @@
-// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input), and
-// glTF/GLB to CSV streamed without a PointSet.
+// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input), .las (.laz
+// is refused by name), and glTF/GLB to CSV streamed without a PointSet.
 #pragma once
 
 #include <string>
 
 #include "converters/gltf_read.h"
 #include "core/csv.h"
+#include "core/las.h"
 #include "core/ply.h"
 #include "core/point_set.h"
 #include "core/result.h"
 
 namespace dpoint {
 
-enum class FileFormat { kCsv, kPly, kGlb, kGltf };
+enum class FileFormat { kCsv, kPly, kGlb, kGltf, kLas, kLaz };
 
 // From the extension, case-insensitive. Error names the path and the extensions accepted.
 Result<FileFormat> formatOf(const std::string& path);
@@ -22,6 +23,10 @@ struct ReadOptions {
   bool allow_nonfinite = false;
   Progress* progress = nullptr;
   bool points_only = false;  // PLY: stop after the vertex element (faces are not read)
+  // Where colours come from. LAS: core/las.h. Other formats: kAuto and kRgb take the file's
+  // colours (kRgb fails when it has none), kNone drops them; kIntensity and kClassification are
+  // errors (only LAS has those fields).
+  LasColorSource las_color = LasColorSource::kAuto;
 };
 
 struct WriteOptions {
@@ -30,6 +35,7 @@ struct WriteOptions {
   PlyEncoding ply_encoding = PlyEncoding::kBinary;
   PlyColorType ply_colors = PlyColorType::kUchar;
   Progress* progress = nullptr;
+  double las_scale = 0.001;  // LAS: the coordinate step for x, y and z (core/las.h)
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});

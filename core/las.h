@@ -1,0 +1,128 @@
+// LAS point clouds (ASPRS LAS 1.0–1.4, point data record formats 0–10): airborne and terrestrial
+// laser scans, integers with a double scale and offset per axis. Written by hand from the ASPRS
+// specifications (LAS 1.2 of 2008, LAS 1.4 R15 of 2019): Debian has no maintained LAS library.
+//
+// Reading: the public header block of any version 1.0–1.4 (227, 235 or 375 bytes, or more when a
+// writer extended it), then `count` records of `record length` bytes from the offset to point data.
+// VLRs, EVLRs, waveform packets and a record's extra bytes (record length beyond the format's base
+// size) are skipped. The count is the 64-bit one of a 1.4 header (the legacy 32-bit field when the
+// 64-bit one is 0), else the legacy one. Coordinates are X·scale + offset in double, rounded
+// twice, as PDAL, laspy and loaders.gl compute them (on the corpus, loaders.gl's doubles and
+// dpoint's are bit-identical).
+// Before anything is allocated the header is checked: signature, version, point format, record
+// length against the format's base size, finite non-zero scales, finite offsets and bounds, and
+// count × record length against the bytes the file holds after the offset. Compressed records
+// (LAZ: point format bit 7 or 6 set) are refused with a message that says how to decompress them.
+// Records are decoded in blocks on all cores, each into its preassigned index, so the result does
+// not depend on the thread count. Memory: the PointSet plus one block per thread.
+//
+// Colours (LasReadOptions::color):
+// - RGB (formats 2, 3, 5, 7, 8, 10) as c / 65535, or as c / 255 when no channel of any point
+//   exceeds 255: such a file holds 8-bit values in the 16-bit fields (as CloudCompare assumes; a
+//   true 16-bit file that dark is shown 257 times brighter, the heuristic's known price). The
+//   values are kept as they are, not decoded from sRGB: LAS RGB are display values (orthophoto
+//   pixels), and dpoint treats PLY's uchar and CSV colours the same way; the
+//   renderer writes a colour's value to the PNG unchanged, so a scan looks as in other viewers.
+//   writeLas stores round(c · 65535), so LAS → LAS keeps every 16-bit value (c / 65535 is
+//   correctly rounded to float, and float's 24 bits leave |c · 65535 − v| < 0.004).
+// - Intensity as grey, divided by the file's largest intensity: the spec asks writers to scale
+//   intensity to 16 bits, but many store the sensor's 8- or 12-bit values as they are, so a fixed
+//   divisor would leave most files black; the file's maximum gives every file full contrast.
+// - Classification through lasClassColor's fixed palette.
+//
+// Writing: LAS 1.2, point format 0, or 2 when the set has colours; one scale for x, y and z; per
+// axis the first of these offsets under which every coordinate reads back as the same double: a
+// whole number (lasOffsetFor), 0, the minimum rounded down to a multiple of the scale (none: the
+// whole number); return 1 of 1, classification 0, intensity 0. A point whose (coordinate − offset)
+// / scale rounds outside the 32-bit integers is an error naming the point.
+//
+// Exactness: a coordinate reads back as itself when it is a value some LAS reader computes,
+// X·scale + offset in double, for one of those offsets. That holds for data read from a LAS file
+// at the same scale whose offset was 0 or a whole number (CSV → LAS → CSV of such data is
+// byte-identical), and for decimal data with the scale's digits whose spread is small next to its
+// magnitude (millimetre eastings and northings over a few km: with a whole-number offset o, the
+// error of X·scale is below the distance from a 3-digit decimal to the nearest midpoint between
+// doubles). Not for decimal values near 0: no integer X gives 418.191 back through X · 0.001 (it
+// is 418.19100000000003), a property of the format's formula that every LAS writer shares.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+// What becomes PointSet::colors. kAuto: the RGB of formats that have it, else no colours.
+enum class LasColorSource { kAuto, kRgb, kIntensity, kClassification, kNone };
+
+// The public header block as the reader uses it (fields it skips are not kept).
+struct LasHeader {
+  int version_major = 1, version_minor = 2;
+  int point_format = 0;         // 0..10
+  uint32_t record_length = 0;   // bytes per point record, the format's base size and any extra bytes
+  uint32_t header_size = 0;
+  uint32_t point_offset = 0;    // offset to point data
+  uint32_t vlr_count = 0;
+  uint32_t evlr_count = 0;      // 1.4 only
+  uint64_t point_count = 0;     // the count the reader uses (see the top comment)
+  glm::dvec3 scale{1.0}, offset{0.0};
+  glm::dvec3 min{0.0}, max{0.0};  // the header's bounds as written: finite, not checked against the points
+  std::string generating_software;
+};
+
+struct LasReadOptions {
+  unsigned threads = 0;  // 0: all cores
+  Progress* progress = nullptr;
+  LasColorSource color = LasColorSource::kAuto;
+};
+
+struct LasWriteOptions {
+  double scale = 0.001;  // for x, y and z; finite and > 0
+  unsigned threads = 0;
+  Progress* progress = nullptr;
+};
+
+// Reads and checks the header only (everything the top comment lists, the file size included).
+Result<LasHeader> readLasHeader(const std::string& path);
+Result<PointSet> readLas(const std::string& path, const LasReadOptions& options = {});
+
+// Writes atomically (AtomicFile). Triangles are not stored. Fails (exit 2) on a non-finite
+// position, on a point that does not fit the 32-bit integers at options.scale, and on more than
+// 2^32 − 1 points (LAS 1.2's count); with exit 1 on a scale that is not finite and positive.
+Status writeLas(const std::string& path, const PointSet& points, const LasWriteOptions& options = {});
+
+// True when the header's bounds contain `points` (the box of the points read), each side within
+// half a scale step (writers round the bounds they store). Not a reason to refuse a file: the
+// corpus's simple1_3.las, a real file PDAL, laspy and loaders.gl all read, stores its raw integers
+// (x · 1000) as bounds. `dpoint info` reports the disagreement.
+bool lasBoundsContain(const LasHeader& header, const Box& points);
+
+// The refusal of compressed LAS, for a .laz name or a header with the LAZ bits set.
+Error lasCompressedError(const std::string& path);
+
+// Bytes of a record of point format 0..10 without extra bytes (20, 28, 26, 34, 57, 63, 30, 36, 38,
+// 59, 67); formats 2, 3, 5, 7, 8 and 10 carry RGB.
+uint32_t lasBaseRecordLength(int point_format);
+bool lasFormatHasRgb(int point_format);
+
+// The writer's first choice of offset for one axis: floor(min) for scales up to 1, floor(min /
+// scale) · scale above. A whole number is exact in double, and for the decimal scales people use
+// (0.01, 0.001) it is also a multiple of the scale; floor(min / scale) · scale itself is not a
+// double for them (0.01 · 63561985 is not), and its rounding error lands in every coordinate read
+// back: of 20000 3-digit points at UTM eastings, 765 came back one ulp off with it, none with
+// floor(min).
+double lasOffsetFor(double min, double scale);
+
+// The ASPRS standard classes (LAS 1.4 R15, table 17) as colours, for LasColorSource::kClassification:
+// 0 never classified and 1 unclassified grey, 2 ground brown, 3/4/5 low/medium/high vegetation
+// from light to dark green, 6 building brick red, 7 low point (noise) and 18 high noise magenta,
+// 9 water blue, 10 rail dark purple, 11 road surface dark grey, 13/14 wires yellow, 15 transmission
+// tower orange, 16 wire-structure connector light orange, 17 bridge deck tan, 19 overhead
+// structure cyan, 20 ignored ground pale brown, 21 snow white, 22 temporal exclusion pink;
+// reserved (8, 12, 23–63) and user-defined (64–255) classes a light grey apart from 0 and 1.
+glm::vec3 lasClassColor(uint8_t classification);
+
+}  // namespace dpoint

@@ -1,0 +1,132 @@
+// dpoint with LAS files as a user runs it (issue #13): convert, info, render, the LAZ refusal and
+// --las-scale, with exit codes, messages and files left behind.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::runDpoint;
+using test::TempDir;
+using test::writeFile;
+
+const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/las/";
+const std::string kLazRefusal = ": LAZ (compressed LAS) is not supported; decompress it with laszip or PDAL first";
+
+TEST(CliLas, convertLasToCsvWritesEveryPointWithItsColour) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("s.csv"), "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string csv = readFile(dir.file("s.csv"));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1066);
+  // The first record: X, Y, Z = 63701224, 84902831, 43166 at scale 0.01; colour 68, 77, 88 of 255.
+  EXPECT_EQ(csv.rfind("x,y,z,r,g,b\n637012.24,849028.31,431.66,0.26666668,0.3019608,0.34509805\n", 0), 0u)
+      << csv.substr(0, 120);
+}
+
+TEST(CliLas, csvToLasToCsvIsByteIdenticalOnTheScaleGrid) {
+  TempDir dir;
+  // Millimetre eastings and northings, heights of whole binary fractions.
+  writeFile(dir.file("in.csv"),
+            "x,y,z\n637012.241,5800843.145,265.125\n637999.999,5800000.001,0.5\n637500,5800500.25,-12.375\n");
+  ASSERT_EQ(runDpoint({"convert", dir.file("in.csv"), "-o", dir.file("mid.las"), "--quiet"}).exit_code, 0);
+  test::CommandResult r = runDpoint({"convert", dir.file("mid.las"), "-o", dir.file("out.csv"), "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(readFile(dir.file("out.csv")), readFile(dir.file("in.csv")));
+  // A survey's coordinates (simple.las, scale 0.01), through CSV and back into LAS at its scale.
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("a.csv"), "--quiet"}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"convert", dir.file("a.csv"), "-o", dir.file("b.las"), "--las-scale", "0.01", "--quiet"})
+                .exit_code,
+            0);
+  ASSERT_EQ(runDpoint({"convert", dir.file("b.las"), "-o", dir.file("c.csv"), "--quiet"}).exit_code, 0);
+  EXPECT_EQ(readFile(dir.file("c.csv")), readFile(dir.file("a.csv")));
+}
+
+TEST(CliLas, infoPrintsTheLasHeader) {
+  test::CommandResult r = runDpoint({"info", kCorpus + "simple1_4.las", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* line : {"points:             22600\n",
+                           "LAS:                version 1.4, point format 7, 36-byte records (0 extra bytes), 22600 points\n",
+                           "LAS scale:          1.0000000000000002e-06 1.0000000000000002e-07 0.001\n",
+                           "LAS offset:         1 1 0\n", "(hold the points)"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << " in\n" << r.out;
+  // A real file whose header bounds are its raw integers: read, and the bounds called wrong.
+  test::CommandResult wrong = runDpoint({"info", kCorpus + "simple1_3.las", "--json"});
+  ASSERT_EQ(wrong.exit_code, 0) << wrong.err;
+  for (const char* part : {"\"las\": {\"version\": \"1.3\", \"point_format\": 4, \"record_length\": 57, \"points\": 999",
+                           "\"header_bounds_hold\": false", "\"points\": 999,"})
+    EXPECT_NE(wrong.out.find(part), std::string::npos) << part << " in\n" << wrong.out;
+}
+
+TEST(CliLas, lazIsRefusedWithExitTwoAndHowToDecompress) {
+  TempDir dir;
+  const std::string laz = kCorpus + "simple.laz";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"convert", laz, "-o", dir.file("x.csv")}, {"info", laz},
+        {"render", laz, "-o", dir.file("x.png")}}) {
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 2) << args[0];
+    EXPECT_EQ(r.err, "dpoint: error: " + laz + kLazRefusal + "\n") << args[0];
+  }
+  // The same bytes under a .las name are refused by their header.
+  writeFile(dir.file("hidden.las"), readFile(laz));
+  test::CommandResult r = runDpoint({"convert", dir.file("hidden.las"), "-o", dir.file("x.csv")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("hidden.las" + kLazRefusal), std::string::npos) << r.err;
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"hidden.las"});
+}
+
+TEST(CliLas, lasScaleTooFineForTheExtentExitsTwoNamingThePoint) {
+  TempDir dir;
+  // simple.las spans 3.4 km in x; at 1e-6 m only 2147 m fit from the offset.
+  test::CommandResult r =
+      runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("fine.las"), "--las-scale", "1e-6", "--quiet"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("fine.las: point "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("beyond LAS's 32-bit integers"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--las-scale"), std::string::npos) << r.err;
+  EXPECT_TRUE(dir.entries().empty());
+  EXPECT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("x.las"), "--las-scale", "0"}).exit_code, 1);
+  EXPECT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("x.las"), "--las-scale", "-1"}).exit_code, 1);
+  // At 0.01 (the file's own scale) it fits, and the colours come along as format 2.
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("ok.las"), "--las-scale", "0.01", "--quiet"})
+                .exit_code,
+            0);
+  test::CommandResult info = runDpoint({"info", dir.file("ok.las"), "--quiet"});
+  EXPECT_NE(info.out.find("version 1.2, point format 2, 26-byte records"), std::string::npos) << info.out;
+}
+
+TEST(CliLas, maxPointsRefusesALasFileByItsHeader) {
+  TempDir dir;
+  test::CommandResult r =
+      runDpoint({"convert", kCorpus + "simple1_4.las", "-o", dir.file("x.csv"), "--max-points", "1000"});
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find("22600 points exceed --max-points 1000"), std::string::npos) << r.err;
+}
+
+TEST(CliLas, generateWritesLasAtTheDefaultMillimetreScale) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"generate", "random2d", "--count", "100", "--offset", "637000,5800000,0", "-o",
+                                     dir.file("r.las"), "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  test::CommandResult info = runDpoint({"info", dir.file("r.las"), "--quiet"});
+  EXPECT_NE(info.out.find("point format 0, 20-byte records (0 extra bytes), 100 points"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS scale:          0.001 0.001 0.001"), std::string::npos) << info.out;
+}
+
+TEST(CliLas, rendersALasFile) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"render", kCorpus + "simple.las", "-o", dir.file("s.png"), "--width", "64",
+                                     "--height", "48", "--frames", "1", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(readFile(dir.file("s.png")).substr(0, 8), "\x89PNG\r\n\x1a\n");
+}
+
+}  // namespace
+}  // namespace dpoint
