@@ -351,8 +351,10 @@ int runRender(const RenderCliOptions& o) {
     return reportError(Error{"--edl-strength must be in (0, 100], got " + formatNumber(o.edl_strength, true), ExitCode::kUsage});
   if (!(o.edl_radius >= 1.0 && o.edl_radius <= 16.0))
     return reportError(Error{"--edl-radius must be in [1, 16] pixels, got " + formatNumber(o.edl_radius, true), ExitCode::kUsage});
-  if (o.color != "auto" && o.color != "rgb" && o.color != "elevation")
-    return reportError(Error{"--color must be auto, rgb or elevation, got '" + o.color + "'", ExitCode::kUsage});
+  if (o.color != "auto" && o.color != "rgb" && o.color != "elevation" && o.color != "intensity" &&
+      o.color != "classification")
+    return reportError(Error{"--color must be auto, rgb, elevation, intensity or classification, got '" + o.color + "'",
+                             ExitCode::kUsage});
   if (o.point_size != "auto") {
     Result<std::vector<double>> size = parseNumbers("--point-size", o.point_size, 1);
     if (!size) return reportError(size.error());
@@ -390,6 +392,8 @@ int runRender(const RenderCliOptions& o) {
   } else if (o.stream == "on") {
     return reportError(Error{o.input + ": --stream on reads binary PLY only", ExitCode::kUsage});
   }
+  if (ply && (o.color == "intensity" || o.color == "classification"))
+    return reportError(Error{o.input + ": --color " + o.color + " needs LAS input", ExitCode::kBadInput});
   if (ply && (o.error || *order != PointOrder::kInput || o.views != 1))
     return reportError(Error{o.input + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
                              "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage});
@@ -403,7 +407,13 @@ int runRender(const RenderCliOptions& o) {
     run.count = ply->count(), run.bounds = *bounds, has_colors = ply->hasColors();
     phases.mark("bounds");
   } else {
-    Result<PointSet> read = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
+    ReadOptions read_options{o.common.threads, false, &progress, true};
+    // LAS fields as colours; elevation replaces whatever the file holds.
+    read_options.las_color = o.color == "intensity"        ? LasColorSource::kIntensity
+                             : o.color == "classification" ? LasColorSource::kClassification
+                             : o.color == "elevation"      ? LasColorSource::kNone
+                                                           : LasColorSource::kAuto;
+    Result<PointSet> read = readPoints(o.input, read_options);
     if (!read) return reportError(read.error());
     points = std::move(*read);
     phases.mark("read");
@@ -544,7 +554,7 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins); all but fp32\n"
       "and split work in a frame scaled to the view, so they hold at 1e-300 m as at 1 m. Each run prints the\n"
       "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.");
-  cmd->add_option("input", o->input, "Point set: .csv, .ply, .glb or .gltf")->required();
+  cmd->add_option("input", o->input, "Point set: .csv, .ply, .las, .glb or .gltf")->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required();
   cmd->add_option("--mode", o->mode,
                   "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"
@@ -583,8 +593,9 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->default_val(1.0);
   cmd->add_option("--edl-radius", o->edl_radius, "Eye-dome neighbour distance in pixels (1..16)")->default_val(1.4);
   cmd->add_option("--color", o->color,
-                  "auto|rgb|elevation. elevation: a perceptual colour map (viridis) along the up axis (--up-axis).\n"
-                  "auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones")
+                  "auto|rgb|elevation|intensity|classification. elevation: a perceptual colour map (viridis) along\n"
+                  "the up axis (--up-axis); intensity (grey) and classification (the ASPRS classes' colours): LAS\n"
+                  "only. auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones")
       ->default_val("auto");
   cmd->add_option("--max-device-memory", o->max_device_memory,
                   "Refuse (exit 4) to allocate more GPU memory than this, e.g. 2G (default: what the device has)");

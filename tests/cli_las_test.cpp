@@ -128,5 +128,48 @@ TEST(CliLas, rendersALasFile) {
   EXPECT_EQ(readFile(dir.file("s.png")).substr(0, 8), "\x89PNG\r\n\x1a\n");
 }
 
+// The renderer's colour sources for a survey: the file's RGB (auto), intensity, classification,
+// elevation; the LAS-only ones are refused by name on other formats.
+TEST(CliLas, renderColoursASurveyByEachSource) {
+  TempDir dir;
+  std::vector<std::string> pictures;
+  for (const char* color : {"auto", "intensity", "classification", "elevation"}) {
+    SCOPED_TRACE(color);
+    const std::string png = dir.file(std::string(color) + ".png");
+    test::CommandResult r = runDpoint({"render", kCorpus + "simple.las", "-o", png, "--color", color, "--validate",
+                                       "--width", "160", "--height", "120", "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    pictures.push_back(readFile(png));
+  }
+  for (size_t i = 0; i < pictures.size(); ++i)
+    for (size_t j = i + 1; j < pictures.size(); ++j) EXPECT_FALSE(pictures[i] == pictures[j]) << i << " " << j;
+  writeFile(dir.file("p.csv"), "x,y,z\n1,2,3\n");
+  test::CommandResult csv = runDpoint({"render", dir.file("p.csv"), "-o", dir.file("p.png"), "--color", "intensity"});
+  EXPECT_EQ(csv.exit_code, 2);
+  EXPECT_NE(csv.err.find("intensity"), std::string::npos) << csv.err;
+  EXPECT_FALSE(test::fileExists(dir.file("p.png")));
+}
+
+// The real-data hard case: one return of simple.las (853 km north, 0.01 m scale) in a window 1 m
+// wide seen from above: float32's 6.25 cm spacing there moves it off its pixel; native does not.
+TEST(CliLas, surveyReturnAtCentimetreScaleIsOffItsPixelInFp32Only) {
+  TempDir dir;
+  double off[2] = {-1, -1};
+  int k = 0;
+  for (const char* mode : {"fp32", "native"}) {
+    test::CommandResult r = runDpoint({"render", kCorpus + "simple.las", "-o", dir.file("r.png"), "--mode", mode,
+                                       "--error", "--ortho", "--view-center", "638435.2,853170.1", "--view-width", "1",
+                                       "--width", "256", "--height", "256", "--validate", "--json", dir.file("r.json")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string json = readFile(dir.file("r.json"));
+    EXPECT_NE(json.find("\"points_visible\": 1,"), std::string::npos) << json;
+    const size_t at = json.find("\"share_off_half_px\": ");
+    ASSERT_NE(at, std::string::npos);
+    off[k++] = std::stod(json.substr(at + 21));
+  }
+  EXPECT_EQ(off[0], 1.0) << "fp32: the return is off its pixel";
+  EXPECT_EQ(off[1], 0.0) << "native: on it";
+}
+
 }  // namespace
 }  // namespace dpoint

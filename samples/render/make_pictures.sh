@@ -22,3 +22,17 @@ for set in mandelbulb_earth menger; do
   "$dpoint" render "$work/$set.ply" -o "$here/${set}_edl.png" --width 480 --height 480
 done
 "$dpoint" render "$work/mandelbulb_earth.ply" -o "$here/mandelbulb_earth_views.png" --views 4 --width 960 --height 720
+
+# A real survey (issue #13): the corpus's simple.las (TerraScan, UTM-like coordinates at 0.01 m)
+# when ../shared sits beside the checkout: plain and with eye-dome lighting and elevation colours,
+# and the hard case: one return seen 1 m wide (2 mm a pixel) from straight above, off centre,
+# in fp32 (float's 6 cm spacing at 853 km moves it) and native (on its pixel).
+las=$here/../../../shared/corpus/las/simple.las
+if [ -f "$las" ]; then
+  "$dpoint" render "$las" -o "$here/simple_las_plain.png" --shade none --width 480 --height 480
+  "$dpoint" render "$las" -o "$here/simple_las_elevation.png" --color elevation --width 480 --height 480
+  for mode in fp32 native; do
+    "$dpoint" render "$las" -o "$here/simple_las_$mode.png" --mode $mode --error --ortho \
+      --view-center 638435.2,853170.1 --view-width 1 --width 256 --height 256 --point-size 15 --background 255,255,255
+  done
+fi
