@@ -8,7 +8,7 @@
 #include "cli/cli_camera.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
-#include "converters/point_io.h"
+#include "converters/point_inputs.h"
 #include "core/info.h"
 #include "viewer/precision.h"
 
@@ -16,7 +16,7 @@ namespace dpoint {
 namespace {
 
 struct InfoOptions {
-  std::string input;
+  std::vector<std::string> inputs;
   bool json = false;
   bool allow_nonfinite = false;
   size_t sample = 10000;
@@ -100,7 +100,7 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
 
 int runInfo(const InfoOptions& o) {
   Progress progress(progressSink(o.common.quiet || o.json), "info");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  Result<PointSet> points = readPointInputs(o.inputs, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
   if (!points) return reportError(points.error());
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
@@ -111,8 +111,9 @@ int runInfo(const InfoOptions& o) {
     if (!camera) return reportError(camera.error());
     advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera)};
   }
-  if (o.json) printJson(o.input, info, advice);
-  else printText(o.input, info, advice);
+  const std::string files = describeInputs(o.inputs);
+  if (o.json) printJson(files, info, advice);
+  else printText(files, info, advice);
   return 0;
 }
 
@@ -124,7 +125,9 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "info",
       "Counts, bounds, whether float32 can hold the data, and each render mode's predicted error in pixels for a\n"
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
-  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf)")->required();
+  cmd->add_option("input", o->inputs,
+                  "Input files (.csv, .ply, .glb, .gltf), taken as one set; the N tiles of `generate --tile` as the whole")
+      ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
       ->default_val(10000)

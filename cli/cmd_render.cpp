@@ -13,7 +13,7 @@
 #include "cli/cli_camera.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
-#include "converters/point_io.h"
+#include "converters/point_inputs.h"
 #include "core/atomic_file.h"
 #include "core/point_order.h"
 #include "core/progress.h"
@@ -27,7 +27,8 @@ namespace dpoint {
 namespace {
 
 struct RenderCliOptions {
-  std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
+  std::vector<std::string> inputs;
+  std::string output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
   std::string order = "input";
   CameraCliOptions camera;
   std::string background = "0,0,0";
@@ -206,12 +207,12 @@ int runRender(const RenderCliOptions& o) {
 
   Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
+  Result<PointSet> points = readPointInputs(o.inputs, ReadOptions{o.common.threads, false, &progress, true});
   if (!points) return reportError(points.error());
   phases.mark("read");
   reorderPoints(*points, *order, o.common.threads, &progress);
   phases.mark("order");
-  if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
+  if (points->size() == 0) return reportError(Error{describeInputs(o.inputs) + ": no points to render", ExitCode::kBadInput});
   Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
   if (!camera) return reportError(camera.error());
   phases.mark("camera");
@@ -303,7 +304,8 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins); all but fp32\n"
       "and split work in a frame scaled to the view, so they hold at 1e-300 m as at 1 m. Each run prints the\n"
       "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.");
-  cmd->add_option("input", o->input, "Point set: .csv, .ply, .glb or .gltf")->required();
+  cmd->add_option("input", o->inputs, "Point sets (.csv, .ply, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the whole")
+      ->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required();
   cmd->add_option("--mode", o->mode,
                   "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"

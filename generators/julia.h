@@ -33,11 +33,14 @@ struct JuliaParams {
   unsigned threads = 0;          // 0: all cores
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
+  EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
 };
 
 // Welded surface mesh (no colours). Errors: bad parameters name the flag and the limit (kUsage);
 // over the memory limit (kResourceLimit).
 Result<PointSet> generateJulia(const JuliaParams& params);
+// Tile `tile` of that mesh (escape_grid.h); same errors.
+Result<PointTile> generateJuliaTile(const JuliaParams& params, TileSpec tile);
 
 int juliaEscape(double x, double y, double z, const glm::dvec4& c, int max_iter);
 EscapeRowFunction juliaRow(const glm::dvec4& c);

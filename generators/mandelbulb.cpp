@@ -260,14 +260,31 @@ std::string powerText(double power) {
 }
 }  // namespace
 
-Result<PointSet> generateMandelbulb(const MandelbulbParams& params) {
+namespace {
+Status validateMandelbulb(const MandelbulbParams& params) {
   if (Status s = validateEscapeParams(params.resolution, params.max_iter, params.lo, params.hi, params.level); !s)
-    return s.error();
+    return s;
   if (!std::isfinite(params.power) || params.power < 2.0 || params.power > 64.0)
     return Error{"--power: " + powerText(params.power) + " is outside 2..64", ExitCode::kUsage};
   if (params.variant == MandelbulbVariant::kFast && params.power != 8.0)
     return Error{"--variant fast: only --power 8 has a trig-free form; use --variant seed", ExitCode::kUsage};
+  if (params.variant == MandelbulbVariant::kSeed && params.planes)
+    return Error{"--variant seed runs on the CPU only (it calls libm's acos, atan2, sin, cos and pow, which a shader "
+                 "cannot reproduce bit for bit): use --device none, or --variant fast on a device",
+                 ExitCode::kUsage};
+  return okStatus();
+}
+}  // namespace
+
+Result<PointSet> generateMandelbulb(const MandelbulbParams& params) {
+  if (Status s = validateMandelbulb(params); !s) return s.error();
   return generateEscapeSurface(escapeSurfaceParams("mandelbulb", params), mandelbulbRow(params.variant, params.power));
+}
+
+Result<PointTile> generateMandelbulbTile(const MandelbulbParams& params, TileSpec tile) {
+  if (Status s = validateMandelbulb(params); !s) return s.error();
+  return generateEscapeSurfaceTile(escapeSurfaceParams("mandelbulb", params), mandelbulbRow(params.variant, params.power),
+                                   tile);
 }
 
 }  // namespace dpoint
