@@ -16,7 +16,7 @@ namespace {
 // Off the polar axis the fast map divides by ρ^8 = (x² + y²)^4, which stays a normal double
 // while x² + y² > 1e-60. Closer to the axis the map's limit is used instead; it differs from the
 // map by |Im (z + iρ)^8| ≤ 8·r^7·ρ < 1e-27 (r ≤ 2: only such points are updated).
-constexpr double kAxisRho2 = 1e-60;
+constexpr double kAxisRho2 = kMandelbulbAxisRho2;
 
 // (re + i·im)^8 by three complex squarings.
 inline void power8(double& re, double& im) {

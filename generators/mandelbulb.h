@@ -33,6 +33,9 @@ namespace dpoint {
 
 enum class MandelbulbVariant { kSeed, kFast };
 
+// The fast variant's polar axis: at x² + y² ≤ this, φ is taken as 0 (see mandelbulb.cpp).
+constexpr double kMandelbulbAxisRho2 = 1e-60;
+
 struct MandelbulbParams {
   int resolution = 200;          // grid points per axis, 2..65536
   int max_iter = 100;            // 1..65535

@@ -18,6 +18,13 @@
 // Needs GL_ARB_gpu_shader_int64 (shaderInt64) and shaderFloat64. Inputs are positive, finite and
 // give a normal result (the callers' ranges); 0 and ±∞ pass through sqrt unchanged.
 
+// The test shader (exact_fp64_test.comp) moves the built-in guesses off by a few ulps through
+// this hook, to show the correction does not rely on a device whose sqrt and division happen to
+// be correctly rounded (lavapipe's are).
+#ifndef EXACT_FP64_GUESS
+#define EXACT_FP64_GUESS(guess) (guess)
+#endif
+
 const double kTwo52 = 4503599627370496.0lf;  // 2^52
 const double kTwo53 = 9007199254740992.0lf;  // 2^53
 
@@ -28,7 +35,7 @@ double sqrtRn(double x) {
   const int k = (e - 1) >> 1;      // ⌊(e − 1)/2⌋ (arithmetic shift)
   precise double g = ldexp(x, -2 * k);  // x·2^-2k ∈ [1, 4), exact
   const uint64_t n_low = uint64_t(g * kTwo52) << 52;  // N mod 2^64, N = g·2^104
-  precise double guess = clamp(sqrt(g), 1.0lf, 2.0lf);
+  precise double guess = clamp(EXACT_FP64_GUESS(sqrt(g)), 1.0lf, 2.0lf);
   uint64_t a = uint64_t(guess * kTwo52);  // an integer: the guess lies on the 2^-52 grid of [1, 2]
   for (int step = 0; step < 64; ++step) {
     const int64_t residual = int64_t(n_low - a * a);  // N − A², exact while |N − A²| < 2^63
@@ -45,7 +52,7 @@ double recipRn(double y) {
   precise double m = 2.0lf * f;    // y = m·2^(e−1), m ∈ [1, 2), 1/y = (1/m)·2^(1−e)
   if (m == 1.0lf) return ldexp(1.0lf, 1 - e);
   const uint64_t y_int = uint64_t(m * kTwo52);  // Y ∈ (2^52, 2^53)
-  precise double guess = clamp(1.0lf / m, 0.5lf, 1.0lf);
+  precise double guess = clamp(EXACT_FP64_GUESS(1.0lf / m), 0.5lf, 1.0lf);
   uint64_t a = uint64_t(guess * kTwo53);  // 1/m ∈ (1/2, 1): the 2^-53 grid
   for (int step = 0; step < 64; ++step) {
     const int64_t residual = int64_t(a * y_int);  // A·Y − 2^105 modulo 2^64

@@ -50,6 +50,8 @@ Spirv splatShader(PrecisionMode mode) {
   return {nullptr, 0};
 }
 
+}  // namespace
+
 Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
                                                const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
   VkDescriptorSetLayoutCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
@@ -72,6 +74,8 @@ Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescript
   VK_TRY(vkCreatePipelineLayout(context.device, &info, nullptr, &layout));
   return layout;
 }
+
+namespace {
 
 // Specialization constants of the splat (ignored by the resolve): 0 kProbe, 1 kEarlyDepth.
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,

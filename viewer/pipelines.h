@@ -62,6 +62,13 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
                                                 bool early_depth = true);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
+// A descriptor set layout of these bindings, and a pipeline layout of one set and push_bytes of
+// push constants from offset 0 for `stages`.
+Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
+                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings);
+Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
+                                        VkShaderStageFlags stages);
+
 // Creates a shader module from SPIR-V words.
 Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);
 
