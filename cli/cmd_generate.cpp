@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 
+#include "cli/cli_device.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_io.h"
@@ -209,13 +210,24 @@ struct MandelbulbOptions {
   MandelbulbParams params;
   std::string bounds = "-1.5,1.5";
   std::string variant = "seed", frame = "native";
+  GenerateDeviceOptions device;
   OutputOptions out;
 };
+constexpr const char* kSeedCpuOnly =
+    "--variant seed runs on the CPU only: it calls libm's acos, atan2, sin, cos and pow, which no shader reproduces "
+    "bit for bit (use --variant fast on a device)";
 Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* progress) {
   MandelbulbParams p = o.params;
   if (Status s = parseBounds(o.bounds, p.lo, p.hi); !s) return s.error();
   p.variant = o.variant == "fast" ? MandelbulbVariant::kFast : MandelbulbVariant::kSeed;
   p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
+  const bool seed = p.variant == MandelbulbVariant::kSeed;
+  Result<std::shared_ptr<GenerateDevice>> device =
+      GenerateDevice::open(o.device, "mandelbulb", seed ? kSeedCpuOnly : "", o.out.common.quiet);
+  if (!device) return device.error();
+  if (*device)
+    p.planes = (*device)->planes({EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2},
+                                 GridAxis{p.resolution, p.lo, p.hi});
   return withCommon(p, o.out, progress);
 }
 
@@ -225,6 +237,7 @@ struct JuliaOptions {
   std::string c = "-0.7,0.27015,0.27015,0";
   std::string bounds = "-1.5,1.5";
   std::string frame = "native";
+  GenerateDeviceOptions device;
   OutputOptions out;
 };
 Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
@@ -234,6 +247,10 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
   p.c = glm::dvec4((*c)[0], (*c)[1], (*c)[2], (*c)[3]);
   if (Status s = parseBounds(o.bounds, p.lo, p.hi); !s) return s.error();
   p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
+  Result<std::shared_ptr<GenerateDevice>> device = GenerateDevice::open(o.device, "julia", "", o.out.common.quiet);
+  if (!device) return device.error();
+  if (*device)
+    p.planes = (*device)->planes({EscapeKernel::kJulia, p.c, kJuliaEscapeSquare, 0.0}, GridAxis{p.resolution, p.lo, p.hi});
   return withCommon(p, o.out, progress);
 }
 
@@ -253,6 +270,7 @@ Result<MengerParams> mengerParams(const MengerOptions& o, Progress* progress) {
 struct Mandelbrot2dOptions {
   Mandelbrot2dParams params;
   std::string center = "-0.7436450,0.1318259";
+  GenerateDeviceOptions device;
   OutputOptions out;
 };
 Result<Mandelbrot2dParams> mandelbrot2dParams(const Mandelbrot2dOptions& o, Progress* progress) {
@@ -261,6 +279,10 @@ Result<Mandelbrot2dParams> mandelbrot2dParams(const Mandelbrot2dOptions& o, Prog
   if (!c) return c.error();
   p.center_x = (*c)[0];
   p.center_y = (*c)[1];
+  Result<std::shared_ptr<GenerateDevice>> device =
+      GenerateDevice::open(o.device, "mandelbrot2d", "", o.out.common.quiet);
+  if (!device) return device.error();
+  if (*device) p.perturbation = (*device)->perturbation();
   return withCommon(p, o.out, progress);
 }
 
@@ -301,6 +323,9 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
                                                    "fast: trig-free power-8 form")
       ->check(CLI::IsMember({"seed", "fast"}))
       ->default_val("seed");
+  addGenerateDeviceOptions(*mandelbulb, mb->device,
+                           "--variant seed always runs on the CPU (libm's trigonometry has no bit-exact shader form):\n"
+                           "auto gives it the CPU, an explicit device is an error");
   addOutputOptions(*mandelbulb, mb->out, "noise");
   registerKind(run, mb, mandelbulb, true, &generateMandelbulb, &generateMandelbulbTile, &mandelbulbParams);
 
@@ -309,6 +334,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   addEscapeGridOptions(julia, ju->params.resolution, ju->params.max_iter, ju->params.level, ju->bounds, ju->frame,
                        ju->params.grid_out, 200);
   julia->add_option("--c", ju->c, "Julia constant as 4 numbers")->default_val("-0.7,0.27015,0.27015,0");
+  addGenerateDeviceOptions(*julia, ju->device, "");
   addOutputOptions(*julia, ju->out, "noise");
   registerKind(run, ju, julia, true, &generateJulia, &generateJuliaTile, &juliaParams);
 
@@ -349,6 +375,10 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   mandelbrot2d->add_option("--width", m2->params.width, "View width")->default_val(1e-6);
   mandelbrot2d->add_option("--resolution", m2->params.resolution, "Points per side (2..65536)")->default_val(1024);
   mandelbrot2d->add_option("--max-iter", m2->params.max_iter, "Iterations before a point counts as inside")->default_val(2000);
+  addGenerateDeviceOptions(*mandelbrot2d, m2->device,
+                           "On a device: the perturbation deltas (the reference orbit stays on the CPU)");
+  mandelbrot2d->add_option("--grid-out", m2->params.grid_out,
+                           "Also write the escape counts, row-major (uint8 if max_iter <= 255, else uint16)");
   addOutputOptions(*mandelbrot2d, m2->out, "escape count");
   registerKind(run, m2, mandelbrot2d, false, &generateMandelbrot2d, &generateMandelbrot2dTile, &mandelbrot2dParams);
 }

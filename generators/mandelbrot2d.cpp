@@ -32,6 +32,7 @@
 
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "generators/escape_grid.h"
 
 namespace dpoint {
 namespace {
@@ -316,6 +317,10 @@ Status validate(const Mandelbrot2dParams& p) {
                  ExitCode::kUsage};
   if (p.max_iter < 1)
     return Error{"--max-iter must be at least 1, got " + std::to_string(p.max_iter), ExitCode::kUsage};
+  if (!p.grid_out.empty() && p.max_iter > kMaxEscapeIterations)
+    return Error{"--grid-out stores counts up to " + std::to_string(kMaxEscapeIterations) + ", but --max-iter is " +
+                     std::to_string(p.max_iter),
+                 ExitCode::kUsage};
   if (!std::isfinite(p.width) || !(p.width >= kMinWidth))
     return Error{"--width must be finite and at least 1e-300, got " + formatDouble(p.width), ExitCode::kUsage};
   const std::string center = formatDouble(p.center_x) + "," + formatDouble(p.center_y);
@@ -381,6 +386,8 @@ Result<PointSet> generateRows(const Mandelbrot2dParams& params, size_t first_row
     return s.error();
   std::vector<uint32_t> counts(rows * res);
   if (Status s = computeCounts(params, first_row, rows, counts); !s) return s.error();
+  if (!params.grid_out.empty())
+    if (Status s = writeEscapeGrid(params.grid_out, counts, params.max_iter); !s) return s.error();
   PointSet set;
   set.positions.resize(rows * res);
   set.colors.resize(rows * res);
@@ -431,7 +438,11 @@ Result<PointTile> generateMandelbrot2dTile(const Mandelbrot2dParams& params, Til
   const TileRange rows = tileRange(static_cast<uint64_t>(params.resolution), tile);
   PointTile out;
   out.tile = tile;
-  if (rows.empty()) return out;
+  if (rows.empty()) {  // more tiles than rows: no points, an empty piece of the grid file
+    if (!params.grid_out.empty())
+      if (Status s = writeEscapeGrid(params.grid_out, {}, params.max_iter); !s) return s.error();
+    return out;
+  }
   Result<PointSet> points = generateRows(params, rows.begin, rows.end - rows.begin);
   if (!points) return points.error();
   if (points->size() > UINT32_MAX)

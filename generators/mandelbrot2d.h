@@ -52,11 +52,15 @@ struct Mandelbrot2dParams {
   Progress* progress = nullptr;
   Mandelbrot2dMethod method = Mandelbrot2dMethod::kPerturbation;
   PerturbationFunction perturbation;  // perturbation deltas elsewhere (a GPU); empty: on the CPU
+  // Also write the counts there, row-major, in the escape-grid format (escape_grid.h; a tile its
+  // rows); needs max_iter ≤ kMaxEscapeIterations.
+  std::string grid_out;
 };
 
 // resolution² points in row-major order (row 0 at the lowest y), every grid point emitted; colour
 // from a cyclic palette over the escape count, black for count == max_iter. Errors: kUsage naming
-// --resolution, --max-iter, --width or --center and the limit; kResourceLimit over max_memory.
+// --resolution, --max-iter, --width, --center or --grid-out and the limit; kResourceLimit over
+// max_memory; the grid file's.
 Result<PointSet> generateMandelbrot2d(const Mandelbrot2dParams& params);
 
 // Tile `tile` (core/tile.h): rows [⌊I·res/N⌋, ⌊(I+1)·res/N⌋), same order and values. Same errors.
