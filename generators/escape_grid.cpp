@@ -103,6 +103,7 @@ class PlaneBlocks {
   }
   void release(size_t s) {
     std::lock_guard<std::mutex> lock(mutex_);
+    spare_.push_back(std::move(blocks_[s]));  // reused for a later slab: no allocator churn
     blocks_[s] = {};
     ++released_;
     changed_.notify_all();
@@ -129,7 +130,17 @@ class PlaneBlocks {
         if (stopping_) return;
       }
       const auto [first, planes] = slabs_[s];
-      std::vector<uint32_t> block(static_cast<size_t>(planes) * plane_size_);
+      std::vector<uint32_t> block;
+      {
+        // At most `ahead` blocks ever exist: taken from the spares once there are some. (Freeing
+        // and allocating 32 MiB blocks on different threads grew the heap to several times that.)
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!spare_.empty()) {
+          block = std::move(spare_.back());
+          spare_.pop_back();
+        }
+      }
+      block.resize(static_cast<size_t>(planes) * plane_size_);
       Status status = planes_(first, planes, limit_, block.data());
       std::lock_guard<std::mutex> lock(mutex_);
       if (!status) {
@@ -152,6 +163,7 @@ class PlaneBlocks {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<std::vector<uint32_t>> blocks_;
+  std::vector<std::vector<uint32_t>> spare_;  // released blocks, for reuse
   std::vector<bool> ready_;
   size_t produced_ = 0, released_ = 0;
   bool stopping_ = false;
