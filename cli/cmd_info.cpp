@@ -8,7 +8,7 @@
 #include "cli/cli_camera.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
-#include "converters/point_io.h"
+#include "converters/point_inputs.h"
 #include "core/info.h"
 #include "viewer/precision.h"
 
@@ -16,7 +16,7 @@ namespace dpoint {
 namespace {
 
 struct InfoOptions {
-  std::string input;
+  std::vector<std::string> inputs;
   bool json = false;
   bool allow_nonfinite = false;
   size_t sample = 10000;
@@ -133,14 +133,15 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
 
 int runInfo(const InfoOptions& o) {
   Progress progress(progressSink(o.common.quiet || o.json), "info");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  Result<PointSet> points = readPointInputs(o.inputs, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
   if (!points) return reportError(points.error());
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
   const PointSetInfo info = computeInfo(*points, o.sample, o.common.threads);
   std::optional<LasFacts> las;
-  if (Result<FileFormat> format = formatOf(o.input); format && *format == FileFormat::kLas) {
-    Result<LasHeader> header = readLasHeader(o.input);
+  // One LAS file: its header too.
+  if (Result<FileFormat> format = formatOf(o.inputs[0]); o.inputs.size() == 1 && format && *format == FileFormat::kLas) {
+    Result<LasHeader> header = readLasHeader(o.inputs[0]);
     if (!header) return reportError(header.error());
     las = LasFacts{*header, info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max})};
   }
@@ -150,8 +151,9 @@ int runInfo(const InfoOptions& o) {
     if (!camera) return reportError(camera.error());
     advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera)};
   }
-  if (o.json) printJson(o.input, info, advice, las);
-  else printText(o.input, info, advice, las);
+  const std::string files = describeInputs(o.inputs);
+  if (o.json) printJson(files, info, advice, las);
+  else printText(files, info, advice, las);
   return 0;
 }
 
@@ -163,7 +165,10 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "info",
       "Counts, bounds, whether float32 can hold the data, and each render mode's predicted error in pixels for a\n"
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
-  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las)")->required();
+  cmd->add_option("input", o->inputs,
+                  "Input files (.csv, .ply, .las, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
+                  "as the whole")
+      ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
       ->default_val(10000)

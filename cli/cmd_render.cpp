@@ -14,6 +14,7 @@
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_filters.h"
+#include "converters/point_inputs.h"
 #include "converters/point_io.h"
 #include "core/ply.h"
 #include "core/atomic_file.h"
@@ -32,7 +33,8 @@ namespace dpoint {
 namespace {
 
 struct RenderCliOptions {
-  std::string input, output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
+  std::vector<std::string> inputs;
+  std::string output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
   std::string order = "input", shade = "auto", stream = "auto";
   double edl_strength = 1.0, edl_radius = 1.4;
   uint32_t views = 1;
@@ -174,7 +176,10 @@ struct View {
 };
 
 // --up-axis auto: z for LAS (surveys are z-up), y otherwise (the generators' and glTF's up).
-bool zUp(const RenderCliOptions& o) { return o.up_axis == "auto" ? hasExtension(o.input, ".las") : o.up_axis == "z"; }
+bool zUp(const RenderCliOptions& o) {
+  if (o.up_axis != "auto") return o.up_axis == "z";
+  return std::all_of(o.inputs.begin(), o.inputs.end(), [](const std::string& path) { return hasExtension(path, ".las"); });
+}
 
 // One view: the three-quarter one; four: front, side, top, three-quarter. Directions are in the
 // up axis's frame: with z up, "front" looks along +y and the oblique view sits in front, above.
@@ -384,25 +389,27 @@ int runRender(const RenderCliOptions& o) {
   Progress progress(progressSink(o.common.quiet), "render");
   // A large binary PLY is drawn a block at a time (a set larger than memory); anything else is read whole.
   std::unique_ptr<PlyVertexStream> ply;
-  if (o.stream != "off" && hasExtension(o.input, ".ply")) {
+  const std::string& input = o.inputs[0];
+  const std::string inputs = describeInputs(o.inputs);
+  if (o.stream != "off" && o.inputs.size() == 1 && hasExtension(input, ".ply")) {
     Result<std::unique_ptr<PlyVertexStream>> opened =
-        PlyVertexStream::open(o.input, PlyReadOptions{false, nullptr, o.common.threads, true});
+        PlyVertexStream::open(input, PlyReadOptions{false, nullptr, o.common.threads, true});
     if (opened && (o.stream == "on" || (*opened)->count() > kStreamAbovePoints)) ply = std::move(*opened);
     else if (!opened && o.stream == "on") return reportError(opened.error());
   } else if (o.stream == "on") {
-    return reportError(Error{o.input + ": --stream on reads binary PLY only", ExitCode::kUsage});
+    return reportError(Error{inputs + ": --stream on reads one binary PLY file", ExitCode::kUsage});
   }
   if (ply && (o.color == "intensity" || o.color == "classification"))
-    return reportError(Error{o.input + ": --color " + o.color + " needs LAS input", ExitCode::kBadInput});
+    return reportError(Error{inputs + ": --color " + o.color + " needs LAS input", ExitCode::kBadInput});
   if (ply && (o.error || *order != PointOrder::kInput || o.views != 1))
-    return reportError(Error{o.input + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
+    return reportError(Error{inputs + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
                              "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage});
   std::optional<PointSet> points;
   RunFacts run;
   bool has_colors = false;
   if (ply) {
-    if (ply->count() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
-    Result<Bounds> bounds = streamBounds(o.input, *ply, progress);
+    if (ply->count() == 0) return reportError(Error{inputs + ": no points to render", ExitCode::kBadInput});
+    Result<Bounds> bounds = streamBounds(input, *ply, progress);
     if (!bounds) return reportError(bounds.error());
     run.count = ply->count(), run.bounds = *bounds, has_colors = ply->hasColors();
     phases.mark("bounds");
@@ -413,15 +420,15 @@ int runRender(const RenderCliOptions& o) {
                              : o.color == "classification" ? LasColorSource::kClassification
                              : o.color == "elevation"      ? LasColorSource::kNone
                                                            : LasColorSource::kAuto;
-    Result<PointSet> read = readPoints(o.input, read_options);
+    Result<PointSet> read = readPointInputs(o.inputs, read_options);
     if (!read) return reportError(read.error());
     points = std::move(*read);
     phases.mark("read");
-    if (points->size() == 0) return reportError(Error{o.input + ": no points to render", ExitCode::kBadInput});
+    if (points->size() == 0) return reportError(Error{inputs + ": no points to render", ExitCode::kBadInput});
     run.count = points->size(), has_colors = points->hasColors();
   }
   if (o.color == "rgb" && !has_colors)
-    return reportError(Error{o.input + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput});
+    return reportError(Error{inputs + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput});
   const bool z_up = zUp(o);
   if (points) run.bounds = boundsOf(*points);
   const Bounds& bounds = run.bounds;
@@ -433,7 +440,7 @@ int runRender(const RenderCliOptions& o) {
     phases.mark("order");
   }
   if (o.views == 4 && bounds.planar)
-    return reportError(Error{o.input + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
+    return reportError(Error{inputs + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
                              ExitCode::kUsage});
   std::vector<View> views = viewsFor(o.views, z_up);
   std::vector<Camera> cameras;
@@ -475,7 +482,7 @@ int runRender(const RenderCliOptions& o) {
       progress.advance(n);
       return okStatus();
     };
-    progress.start("streaming " + o.input + " to the GPU (points)", run.count);
+    progress.start("streaming " + input + " to the GPU (points)", run.count);
     Result<RenderResult> streamed = renderStream(**context, stream, *camera, options);
     progress.finish();
     return streamed;
@@ -554,7 +561,10 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins); all but fp32\n"
       "and split work in a frame scaled to the view, so they hold at 1e-300 m as at 1 m. Each run prints the\n"
       "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.");
-  cmd->add_option("input", o->input, "Point set: .csv, .ply, .las, .glb or .gltf")->required();
+  cmd->add_option("input", o->inputs,
+                  "Point sets (.csv, .ply, .las, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
+                  "whole. One large binary PLY is streamed (--stream)")
+      ->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required();
   cmd->add_option("--mode", o->mode,
                   "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"

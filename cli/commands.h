@@ -18,6 +18,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run);
 void addBenchCommand(CLI::App& app, RunCommand& run);
 void addRenderCommand(CLI::App& app, RunCommand& run);
 void addDevicesCommand(CLI::App& app, RunCommand& run);
+void addMergeCommand(CLI::App& app, RunCommand& run);
 
 // Prints "dpoint: error: <message>" on stderr and returns the error's exit code.
 int reportError(const Error& error);

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   RunCommand run;
   addGenerateCommand(app, run);
+  addMergeCommand(app, run);
   addConvertCommand(app, run);
   addRenderCommand(app, run);
   addInfoCommand(app, run);

@@ -5,8 +5,10 @@
 #include <cassert>
 #include <charconv>
 #include <cmath>
+#include <condition_variable>
 #include <mutex>
 #include <optional>
+#include <thread>
 
 #include "core/atomic_file.h"
 #include "core/memory.h"
@@ -36,18 +38,138 @@ uint64_t squared(int res) { return static_cast<uint64_t>(res) * static_cast<uint
 double estimatedVertices(int res) { return 0.5 * std::pow(static_cast<double>(res), 2.5); }
 
 // Slabs of `thickness` cell layers; about six per thread so the dynamic hand-out balances the
-// heavy middle slabs, at most 32 layers so a slab's mesh and grid stay small, at least 4 so the
-// plane both neighbours compute costs at most a quarter more.
+// heavy middle slabs, at most 32 layers (max_thickness) so a slab's mesh and grid stay small, at
+// least 4 so the plane both neighbours compute costs at most a quarter more.
+constexpr int kMaxSlabThickness = 32;
 struct SlabPlan {
   int thickness;
   int count;
 };
-SlabPlan planSlabs(int res, unsigned threads) {
-  const int layers = res - 1;
+SlabPlan planSlabs(int layers, unsigned threads, int max_thickness) {
   const int wanted = static_cast<int>(std::min<unsigned>(threads, 1024)) * 6;
-  const int thickness = std::clamp((layers + wanted - 1) / wanted, 4, 32);
+  const int thickness = std::clamp((layers + wanted - 1) / wanted, 4, std::max(4, max_thickness));
   return {thickness, (layers + thickness - 1) / thickness};
 }
+
+// With a plane function (a GPU), a slab's planes are computed as one block and held until the slab
+// is meshed; a block of about 32 MiB keeps the few in flight small and the dispatches large.
+constexpr uint64_t kGpuBlockBytes = uint64_t{32} << 20;
+int gpuSlabThickness(int res) {
+  const uint64_t planes = kGpuBlockBytes / (sizeof(uint32_t) * squared(res));
+  return static_cast<int>(std::clamp<uint64_t>(planes, 5, kMaxSlabThickness + 1)) - 1;
+}
+
+// The classification pass iterates to the cap: points at the cap are above the level, since
+// min(count, cap) > level exactly when count > level. The grid file needs every count.
+int classificationLimit(const EscapeSurfaceParams& p) {
+  return p.lazy && p.grid_out.empty() ? static_cast<int>(std::floor(p.level)) + 1 : p.max_iter;
+}
+
+uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share) {
+  const int res = params.axis.resolution;
+  const unsigned threads = resolveThreads(params.threads);
+  const SlabPlan plan =
+      planSlabs(res - 1, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
+  uint64_t per_worker = kWorkerBytesPerPoint * squared(res);
+  if (!params.grid_out.empty())  // a slab's planes wait for their turn to be written; twice for the stragglers
+    per_worker += 2 * static_cast<uint64_t>(plan.thickness) * squared(res) *
+                  static_cast<uint64_t>(escapeGridBytesPerCount(params.max_iter));
+  uint64_t blocks = 0;  // the plane function's blocks in flight, threads + 2 of them
+  if (params.planes)
+    blocks = (threads + 2) * static_cast<uint64_t>(plan.thickness + 1) * squared(res) * sizeof(uint32_t);
+  const double mesh = share * estimatedVertices(res) * static_cast<double>(kMeshBytesPerVertex);
+  return threads * per_worker + blocks + static_cast<uint64_t>(std::min(mesh, 1e19));
+}
+
+// The plane function's blocks, one per slab, computed in slab order on a thread of their own while
+// the workers mesh earlier slabs: at most `ahead` blocks are held (computed and not yet released),
+// so memory stays a few slabs whatever the grid. Workers take slabs in increasing order
+// (parallelFor), so the block a worker waits for is always among the next ones computed.
+class PlaneBlocks {
+ public:
+  PlaneBlocks(const EscapePlaneFunction& planes, std::vector<std::pair<int, int>> slabs, int limit, uint64_t plane_size,
+              size_t ahead)
+      : planes_(planes), slabs_(std::move(slabs)), limit_(limit), plane_size_(plane_size), ahead_(ahead),
+        blocks_(slabs_.size()), ready_(slabs_.size(), false) {
+    thread_ = std::thread([this] { produce(); });
+  }
+  ~PlaneBlocks() { stop(); }
+
+  // The counts of slab s's planes; nullptr when the plane function failed (see error()).
+  const uint32_t* wait(size_t s) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return ready_[s] || error_.has_value(); });
+    return ready_[s] ? blocks_[s].data() : nullptr;
+  }
+  void release(size_t s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    spare_.push_back(std::move(blocks_[s]));  // reused for a later slab: no allocator churn
+    blocks_[s] = {};
+    ++released_;
+    changed_.notify_all();
+  }
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+      changed_.notify_all();
+    }
+    if (thread_.joinable()) thread_.join();
+  }
+  std::optional<Error> error() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return error_;
+  }
+
+ private:
+  void produce() {
+    for (size_t s = 0; s < slabs_.size(); ++s) {
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return stopping_ || produced_ - released_ < ahead_; });
+        if (stopping_) return;
+      }
+      const auto [first, planes] = slabs_[s];
+      std::vector<uint32_t> block;
+      {
+        // At most `ahead` blocks ever exist: taken from the spares once there are some. (Freeing
+        // and allocating 32 MiB blocks on different threads grew the heap to several times that.)
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!spare_.empty()) {
+          block = std::move(spare_.back());
+          spare_.pop_back();
+        }
+      }
+      block.resize(static_cast<size_t>(planes) * plane_size_);
+      Status status = planes_(first, planes, limit_, block.data());
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!status) {
+        error_ = status.error();
+        changed_.notify_all();
+        return;
+      }
+      blocks_[s] = std::move(block);
+      ready_[s] = true;
+      ++produced_;
+      changed_.notify_all();
+    }
+  }
+
+  const EscapePlaneFunction& planes_;
+  const std::vector<std::pair<int, int>> slabs_;
+  const int limit_;
+  const uint64_t plane_size_;
+  const size_t ahead_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<std::vector<uint32_t>> blocks_;
+  std::vector<std::vector<uint32_t>> spare_;  // released blocks, for reuse
+  std::vector<bool> ready_;
+  size_t produced_ = 0, released_ = 0;
+  bool stopping_ = false;
+  std::optional<Error> error_;
+  std::thread thread_;
+};
 
 void encodePlane(const uint32_t* counts, size_t n, int bytes, uint8_t* out) {
   for (size_t i = 0; i < n; ++i) {
@@ -64,17 +186,18 @@ void encodePlane(const uint32_t* counts, size_t n, int bytes, uint8_t* out) {
 // One slab's worth of streaming: counts of the two planes in flight, finished lazily.
 class SlabField {
  public:
+  // meshes_last: the slab makes vertices on plane `last`'s in-plane edges (owns them, or copies
+  // them for a seam). block: the classification counts of planes first..last (at `cap`), computed
+  // elsewhere; nullptr: computed here by the row function.
   SlabField(const EscapeSurfaceParams& params, const std::vector<double>& values, const EscapeRowFunction& row,
-            int first, int last, bool owns_last, int grid_planes, int grid_bytes)
+            int first, int last, bool meshes_last, int grid_planes, int grid_bytes, int cap, const uint32_t* block)
       : p_(params), values_(values), row_(row), res_(params.axis.resolution), first_(first), last_(last),
-        owns_last_(owns_last), grid_planes_(grid_planes), grid_bytes_(grid_bytes) {
+        owns_last_(meshes_last), grid_planes_(grid_planes), grid_bytes_(grid_bytes), cap_(cap), block_(block) {
     const size_t plane = squared(res_);
     for (int s = 0; s < 2; ++s) {
       counts_[s].resize(plane);
       above_[s].resize(plane);
     }
-    // Points at the cap are above the level: min(count, cap) > level exactly when count > level.
-    cap_ = p_.lazy && p_.grid_out.empty() ? static_cast<int>(std::floor(p_.level)) + 1 : p_.max_iter;
     refine_ = cap_ < p_.max_iter;
     if (refine_) {
       need_.resize(plane);
@@ -89,8 +212,12 @@ class SlabField {
     std::vector<uint32_t>& c = counts_[p & 1];
     std::vector<uint8_t>& a = above_[p & 1];
     const size_t n = static_cast<size_t>(res_);
-    const double x = values_[static_cast<size_t>(p)];
-    for (size_t j = 0; j < n; ++j) row_(x, values_[j], values_.data(), n, cap_, &c[j * n]);
+    if (block_) {
+      std::copy_n(block_ + static_cast<size_t>(p - first_) * c.size(), c.size(), c.begin());
+    } else {
+      const double x = values_[static_cast<size_t>(p)];
+      for (size_t j = 0; j < n; ++j) row_(x, values_[j], values_.data(), n, cap_, &c[j * n]);
+    }
     for (size_t i = 0; i < c.size(); ++i) a[i] = static_cast<double>(c[i]) > p_.level;
     std::copy(a.begin(), a.end(), above);
     if (refine_) finishCrossings(p);
@@ -194,6 +321,7 @@ class SlabField {
   bool owns_last_;
   int grid_planes_, grid_bytes_;
   int cap_ = 0;
+  const uint32_t* block_ = nullptr;
   bool refine_ = false;
   std::vector<uint32_t> counts_[2];
   std::vector<uint8_t> above_[2];
@@ -229,23 +357,31 @@ double resolveLevel(int max_iter, double level) {
 
 int escapeGridBytesPerCount(int max_iter) { return max_iter <= 255 ? 1 : 2; }
 
-uint64_t estimateEscapeSurfaceMemory(const EscapeSurfaceParams& params) {
-  const int res = params.axis.resolution;
-  const unsigned threads = resolveThreads(params.threads);
-  const SlabPlan plan = planSlabs(res, threads);
-  uint64_t per_worker = kWorkerBytesPerPoint * squared(res);
-  if (!params.grid_out.empty())  // a slab's planes wait for their turn to be written; twice for the stragglers
-    per_worker += 2 * static_cast<uint64_t>(plan.thickness) * squared(res) *
-                  static_cast<uint64_t>(escapeGridBytesPerCount(params.max_iter));
-  const double mesh = estimatedVertices(res) * static_cast<double>(kMeshBytesPerVertex);
-  return threads * per_worker + static_cast<uint64_t>(std::min(mesh, 1e19));
-}
+uint64_t estimateEscapeSurfaceMemory(const EscapeSurfaceParams& params) { return estimateLayerMemory(params, 1.0); }
 
-Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const EscapeRowFunction& row) {
+namespace {
+
+// The vertices and triangles of cell layers [first_layer, last_layer) (planes first_layer ..
+// last_layer), in canonical order; triangle indices ≥ mesh.size() are the in-plane vertices of
+// plane last_layer, which the layers own only when it is the grid's last plane; otherwise `seam`
+// holds copies of their positions.
+struct LayerMesh {
+  PointSet mesh;
+  std::vector<glm::dvec3> seam;
+};
+
+Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowFunction& row, int first_layer,
+                             int last_layer) {
   const int res = params.axis.resolution;
   assert(res >= 2 && params.level > 0.0 && params.level < params.max_iter);
-  const std::string what = params.name + " at resolution " + std::to_string(res);
-  if (Status s = checkMemory(what, estimateEscapeSurfaceMemory(params), params.max_memory); !s) return s.error();
+  assert(0 <= first_layer && first_layer < last_layer && last_layer <= res - 1);
+  const int layers = last_layer - first_layer;
+  const double share = static_cast<double>(layers) / (res - 1);
+  const std::string what = params.name + " at resolution " + std::to_string(res) +
+                           (layers < res - 1 ? " (planes " + std::to_string(first_layer) + ".." +
+                                                   std::to_string(last_layer) + ")"
+                                             : "");
+  if (Status s = checkMemory(what, estimateLayerMemory(params, share), params.max_memory); !s) return s.error();
   const uint64_t limit = params.max_memory == 0 ? defaultMemoryLimit() : params.max_memory;
 
   std::optional<AtomicFile> grid_file;
@@ -260,11 +396,13 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
   for (int i = 0; i < res; ++i) values[static_cast<size_t>(i)] = params.axis.value(i);
 
   const unsigned threads = resolveThreads(params.threads);
-  const SlabPlan plan = planSlabs(res, threads);
-  PointSet mesh;
+  const SlabPlan plan = planSlabs(layers, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
+  LayerMesh out;
+  PointSet& mesh = out.mesh;
   // Reserving only claims address space; the pages are touched as the mesh grows, so an
   // estimate on the high side costs nothing and saves the copy of a reallocation.
-  const double reserve = std::min(1.25 * estimatedVertices(res), static_cast<double>(limit / kMeshBytesPerVertex));
+  const double reserve =
+      std::min(1.25 * share * estimatedVertices(res), static_cast<double>(limit / kMeshBytesPerVertex));
   mesh.positions.reserve(static_cast<size_t>(reserve));
   mesh.triangles.reserve(static_cast<size_t>(reserve) * 6);
 
@@ -304,6 +442,7 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
         } else {
           mesh.positions.insert(mesh.positions.end(), done.mesh.positions.begin(), done.mesh.positions.end());
           for (uint32_t id : done.mesh.triangles) mesh.triangles.push_back(static_cast<uint32_t>(offset + id));
+          if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
           if (grid_file)
             if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());
         }
@@ -313,15 +452,31 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
     }
   };
 
-  if (params.progress) params.progress->start(params.name, static_cast<uint64_t>(res - 1));
+  auto slabFirst = [&](size_t s) { return first_layer + static_cast<int>(s) * plan.thickness; };
+  auto slabLast = [&](size_t s) { return std::min(slabFirst(s) + plan.thickness, last_layer); };
+  const int cap = classificationLimit(params);
+  std::optional<PlaneBlocks> blocks;
+  if (params.planes) {
+    std::vector<std::pair<int, int>> planes;  // first plane and plane count of each slab
+    for (size_t s = 0; s < pending.size(); ++s) planes.emplace_back(slabFirst(s), slabLast(s) - slabFirst(s) + 1);
+    blocks.emplace(params.planes, std::move(planes), cap, squared(res), threads + 2);
+  }
+
+  if (params.progress) params.progress->start(params.name, static_cast<uint64_t>(layers));
   parallelFor(static_cast<size_t>(plan.count), threads, [&](size_t s, unsigned) {
-    const int first = static_cast<int>(s) * plan.thickness;
-    const int last = std::min(first + plan.thickness, res - 1);
-    const bool last_slab = last == res - 1;
+    const int first = slabFirst(s);
+    const int last = slabLast(s);
+    const bool owns_last = last == res - 1;
+    const bool seam = last == last_layer && !owns_last;
     Pending result;
+    const uint32_t* block = nullptr;
+    if (!failed && blocks) {
+      block = blocks->wait(s);
+      if (!block) failed = true;  // the plane function failed; blocks holds the error
+    }
     if (!failed) {
-      const int grid_planes = grid_file ? last - first + (last_slab ? 1 : 0) : 0;
-      SlabField field(params, values, row, first, last, last_slab, grid_planes, grid_bytes);
+      const int grid_planes = grid_file ? last - first + (owns_last ? 1 : 0) : 0;
+      SlabField field(params, values, row, first, last, owns_last || seam, grid_planes, grid_bytes, cap, block);
       McSlabCallbacks callbacks;
       callbacks.load_plane = [&](int p, uint8_t* above) { field.load(p, above); };
       callbacks.edge_vertex = [&](int p, int j, int k, int axis) { return field.vertex(p, j, k, axis); };
@@ -329,19 +484,64 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
         if (p > first && params.progress) params.progress->advance(1);
         return !failed.load(std::memory_order_relaxed);
       };
-      result.mesh = marchingCubesSlab(res, res, first, last, last_slab, callbacks);
+      result.mesh = marchingCubesSlab(res, res, first, last, owns_last, callbacks, seam);
       result.grid = field.takeGrid();
     }
+    if (block) blocks->release(s);
     std::lock_guard<std::mutex> lock(mutex);
     result.ready = true;
     pending[s] = std::move(result);
     commitReady();
   });
+  if (blocks) {
+    blocks->stop();
+    if (std::optional<Error> e = blocks->error(); e && !failure) failure = std::move(e);
+  }
   if (params.progress) params.progress->finish();
   if (failure) return *failure;
   if (grid_file)
     if (Status s = grid_file->commit(); !s) return s.error();
-  return mesh;
+  return out;
+}
+
+}  // namespace
+
+Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const EscapeRowFunction& row) {
+  Result<LayerMesh> whole = meshLayers(params, row, 0, params.axis.resolution - 1);
+  if (!whole) return whole.error();
+  assert(whole->seam.empty());
+  return std::move(whole->mesh);
+}
+
+Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, const EscapeRowFunction& row,
+                                            TileSpec tile) {
+  const uint64_t layers = static_cast<uint64_t>(params.axis.resolution - 1);
+  const TileRange range = tileRange(layers, tile);
+  PointTile out;
+  out.tile = tile;
+  if (range.empty()) {  // more tiles than cell layers: nothing to own, an empty grid piece
+    if (!params.grid_out.empty()) {
+      Result<AtomicFile> f = AtomicFile::create(params.grid_out);
+      if (!f) return f.error();
+      if (Status s = f->commit(); !s) return s.error();
+    }
+    return out;
+  }
+  Result<LayerMesh> part = meshLayers(params, row, static_cast<int>(range.begin), static_cast<int>(range.end));
+  if (!part) return part.error();
+  out.points = std::move(part->mesh);
+  out.owned = static_cast<uint32_t>(out.points.size());
+  // The seam plane's vertices open the next non-empty tile's own (canonical order: a plane's
+  // in-plane edges come first).
+  const uint32_t next = nextNonEmptyTile(layers, tile);
+  assert(part->seam.empty() || next < tile.count);
+  if (uint64_t{out.owned} + part->seam.size() > UINT32_MAX)
+    return Error{params.name + ": more than 2^32 vertices in tile " + std::to_string(tile.index), ExitCode::kResourceLimit};
+  for (size_t i = 0; i < part->seam.size(); ++i) {
+    out.points.positions.push_back(part->seam[i]);
+    out.foreign.push_back({next, static_cast<uint32_t>(i)});
+  }
+  return out;
 }
 
 Result<std::vector<uint32_t>> computeEscapeGrid(const GridAxis& axis, int max_iter, const EscapeRowFunction& row,

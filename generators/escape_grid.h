@@ -18,6 +18,15 @@
 // resolution-1024 run keeps a few 1024² planes per worker plus the mesh) and the output does not
 // depend on the thread count. --grid-out needs every count, so it turns the lazy pass off and
 // streams the planes to the file in the same order.
+//
+// Elsewhere: a plane function (a GPU, viewer/gpu_generate.h) may compute the classification pass
+// instead of the row function, a slab's planes at a time on a thread of its own, ahead of the
+// workers that mesh earlier slabs (at most threads + 2 slabs of counts held). Finishing the
+// crossings, marching cubes and writing stay here. The function must return the row function's
+// counts bit for bit, so the mesh is the same either way.
+//
+// Tiles (core/tile.h): the cell layers split into N contiguous shares; a tile meshes its own and
+// copies the in-plane vertices of its last plane, which open the next tile's own vertices.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +37,7 @@
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "core/tile.h"
 
 namespace dpoint {
 
@@ -53,6 +63,10 @@ struct GridAxis {
 using EscapeRowFunction =
     std::function<void(double x, double y, const double* zs, size_t n, int limit, uint32_t* counts)>;
 
+// Escape counts of whole x-planes: counts[(p − first)·res² + j·res + k] = min(count, limit) for
+// planes first ≤ p < first + planes, equal to the row function's. Called from one thread at a time.
+using EscapePlaneFunction = std::function<Status(int first, int planes, int limit, uint32_t* counts)>;
+
 struct EscapeSurfaceParams {
   std::string name = "fractal";  // for messages and progress
   GridAxis axis;
@@ -64,10 +78,11 @@ struct EscapeSurfaceParams {
   unsigned threads = 0;          // 0: all cores
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
+  EscapePlaneFunction planes;    // empty: the row function classifies too
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
-// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress).
+// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes).
 template <typename FractalParams>
 EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& params);
 
@@ -89,6 +104,7 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.threads = params.threads;
   surface.max_memory = params.max_memory;
   surface.progress = params.progress;
+  surface.planes = params.planes;
   return surface;
 }
 
@@ -102,6 +118,13 @@ uint64_t estimateEscapeSurfaceMemory(const EscapeSurfaceParams& params);
 // marching_cubes.h, independent of the thread count. Writes params.grid_out (whole or not at all)
 // when set. Errors: over the memory limit (kResourceLimit), grid file errors.
 Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const EscapeRowFunction& row);
+
+// Tile `tile` of the same mesh (core/tile.h): the vertices and triangles of its share of the cell
+// layers; concatenated in tile order they are generateEscapeSurface's. With grid_out, the tile's
+// planes of the grid file (its layers' first planes, and the last plane in the last tile), so the
+// pieces concatenated are the whole grid file. Same errors.
+Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, const EscapeRowFunction& row,
+                                            TileSpec tile);
 
 // The full count grid of x-planes [first_plane, first_plane + planes), layout [i][j][k]; for tests
 // and measurements (holds planes·res² counts).

@@ -26,12 +26,24 @@ EscapeRowFunction juliaRow(const glm::dvec4& c) {
   };
 }
 
-Result<PointSet> generateJulia(const JuliaParams& params) {
+namespace {
+Status validateJulia(const JuliaParams& params) {
   if (Status s = validateEscapeParams(params.resolution, params.max_iter, params.lo, params.hi, params.level); !s)
-    return s.error();
+    return s;
   for (int d = 0; d < 4; ++d)
     if (!std::isfinite(params.c[d])) return Error{"--c: every component must be finite", ExitCode::kUsage};
+  return okStatus();
+}
+}  // namespace
+
+Result<PointSet> generateJulia(const JuliaParams& params) {
+  if (Status s = validateJulia(params); !s) return s.error();
   return generateEscapeSurface(escapeSurfaceParams("julia", params), juliaRow(params.c));
+}
+
+Result<PointTile> generateJuliaTile(const JuliaParams& params, TileSpec tile) {
+  if (Status s = validateJulia(params); !s) return s.error();
+  return generateEscapeSurfaceTile(escapeSurfaceParams("julia", params), juliaRow(params.c), tile);
 }
 
 }  // namespace dpoint

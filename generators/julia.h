@@ -22,6 +22,14 @@
 
 namespace dpoint {
 
+// The escape test sqrt(s) > 2 with a correctly rounded square root holds exactly when
+// s > 4 + 2^-50, the double after 4: doubles in [4, 8) are 2^-50 apart, and sqrt(4 + 2^-50) =
+// 2 + 2^-52 − ε lies below the midpoint 2 + 2^-52 between 2 and the next double, so it rounds to 2
+// (not above 2), while sqrt(4 + 2^-49) = 2 + 2^-51 − ε rounds up. A device whose square root is
+// not correctly rounded tests s against this instead (shaders/escape.comp); tested exhaustively
+// near 4.
+constexpr double kJuliaEscapeSquare = 0x1.0000000000001p+2;
+
 struct JuliaParams {
   int resolution = 200;          // grid points per axis, 2..65536
   int max_iter = 200;            // 1..65535
@@ -33,11 +41,14 @@ struct JuliaParams {
   unsigned threads = 0;          // 0: all cores
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
+  EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
 };
 
 // Welded surface mesh (no colours). Errors: bad parameters name the flag and the limit (kUsage);
 // over the memory limit (kResourceLimit).
 Result<PointSet> generateJulia(const JuliaParams& params);
+// Tile `tile` of that mesh (escape_grid.h); same errors.
+Result<PointTile> generateJuliaTile(const JuliaParams& params, TileSpec tile);
 
 int juliaEscape(double x, double y, double z, const glm::dvec4& c, int max_iter);
 EscapeRowFunction juliaRow(const glm::dvec4& c);

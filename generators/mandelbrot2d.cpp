@@ -32,6 +32,7 @@
 
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "generators/escape_grid.h"
 
 namespace dpoint {
 namespace {
@@ -316,6 +317,10 @@ Status validate(const Mandelbrot2dParams& p) {
                  ExitCode::kUsage};
   if (p.max_iter < 1)
     return Error{"--max-iter must be at least 1, got " + std::to_string(p.max_iter), ExitCode::kUsage};
+  if (!p.grid_out.empty() && p.max_iter > kMaxEscapeIterations)
+    return Error{"--grid-out stores counts up to " + std::to_string(kMaxEscapeIterations) + ", but --max-iter is " +
+                     std::to_string(p.max_iter),
+                 ExitCode::kUsage};
   if (!std::isfinite(p.width) || !(p.width >= kMinWidth))
     return Error{"--width must be finite and at least 1e-300, got " + formatDouble(p.width), ExitCode::kUsage};
   const std::string center = formatDouble(p.center_x) + "," + formatDouble(p.center_y);
@@ -333,24 +338,34 @@ uint64_t referenceBytes(const Mandelbrot2dParams& p) {
   return 2 * (static_cast<uint64_t>(p.max_iter) + 1) * sizeof(glm::dvec2);
 }
 
-Status checkBudget(const Mandelbrot2dParams& p, uint64_t bytes_per_point) {
-  const uint64_t points = static_cast<uint64_t>(p.resolution) * static_cast<uint64_t>(p.resolution);
+// `rows` of the grid at bytes_per_point, and the reference orbits.
+Status checkBudget(const Mandelbrot2dParams& p, uint64_t rows, uint64_t bytes_per_point) {
+  const uint64_t points = rows * static_cast<uint64_t>(p.resolution);
   return checkMemory("mandelbrot2d at --resolution " + std::to_string(p.resolution) + " with --max-iter " +
                          std::to_string(p.max_iter),
                      points * bytes_per_point + referenceBytes(p), p.max_memory);
 }
 
-// Fills counts (resolution², preallocated). Each row writes only its own cells, so the result does
-// not depend on the thread count.
-void computeCounts(const Mandelbrot2dParams& p, std::vector<uint32_t>& counts) {
+// Fills counts of rows [first_row, first_row + rows) (rows·resolution, preallocated). Each row writes
+// only its own cells, so the result does not depend on the thread count.
+Status computeCounts(const Mandelbrot2dParams& p, size_t first_row, size_t rows, std::vector<uint32_t>& counts) {
   const bool perturb = p.method == Mandelbrot2dMethod::kPerturbation;
   const Reference reference = perturb ? chooseReference(p) : Reference{};
   const double spacing = pixelSpacing(p);
   const size_t res = static_cast<size_t>(p.resolution);
-  if (p.progress) p.progress->start("mandelbrot2d", static_cast<uint64_t>(res) * res);
-  parallelFor(res, p.threads, [&](size_t row, unsigned) {
+  if (perturb && p.perturbation) {  // elsewhere (a GPU), from the same δc
+    std::vector<double> dcx(res), dcy(rows);
+    for (size_t col = 0; col < res; ++col)
+      dcx[col] = pixelOffset(static_cast<int>(col), p.resolution, spacing) - reference.offset.x;
+    for (size_t row = 0; row < rows; ++row)
+      dcy[row] = pixelOffset(static_cast<int>(first_row + row), p.resolution, spacing) - reference.offset.y;
+    return p.perturbation(reference.orbit, dcx, dcy, p.max_iter, counts.data());
+  }
+  if (p.progress) p.progress->start("mandelbrot2d", static_cast<uint64_t>(res) * rows);
+  parallelFor(rows, p.threads, [&](size_t r, unsigned) {
+    const size_t row = first_row + r;
     const double offset_y = pixelOffset(static_cast<int>(row), p.resolution, spacing);
-    uint32_t* out = counts.data() + row * res;
+    uint32_t* out = counts.data() + r * res;
     for (int col = 0; col < p.resolution; ++col) {
       const double offset_x = pixelOffset(col, p.resolution, spacing);
       out[col] = perturb ? perturbedCount(reference.orbit, offset_x - reference.offset.x,
@@ -360,6 +375,34 @@ void computeCounts(const Mandelbrot2dParams& p, std::vector<uint32_t>& counts) {
     if (p.progress) p.progress->advance(res);
   });
   if (p.progress) p.progress->finish();
+  return okStatus();
+}
+
+// Rows [first_row, first_row + rows) of the grid as points.
+Result<PointSet> generateRows(const Mandelbrot2dParams& params, size_t first_row, size_t rows) {
+  if (Status s = validate(params); !s) return s.error();
+  const size_t res = static_cast<size_t>(params.resolution);
+  if (Status s = checkBudget(params, rows, sizeof(uint32_t) + sizeof(glm::dvec3) + sizeof(glm::vec3)); !s)
+    return s.error();
+  std::vector<uint32_t> counts(rows * res);
+  if (Status s = computeCounts(params, first_row, rows, counts); !s) return s.error();
+  if (!params.grid_out.empty())
+    if (Status s = writeEscapeGrid(params.grid_out, counts, params.max_iter); !s) return s.error();
+  PointSet set;
+  set.positions.resize(rows * res);
+  set.colors.resize(rows * res);
+  const double spacing = pixelSpacing(params);
+  parallelFor(rows, params.threads, [&](size_t r, unsigned) {
+    // Correctly rounded centre + offset (the offsets are exact doubles).
+    const double y = params.center_y + pixelOffset(static_cast<int>(first_row + r), params.resolution, spacing);
+    for (size_t col = 0; col < res; ++col) {
+      const size_t i = r * res + col;
+      const double x = params.center_x + pixelOffset(static_cast<int>(col), params.resolution, spacing);
+      set.positions[i] = glm::dvec3(x, y, 0.0);
+      set.colors[i] = mandelbrot2dColor(counts[i], params.max_iter);
+    }
+  });
+  return set;
 }
 
 }  // namespace
@@ -379,34 +422,35 @@ glm::vec3 mandelbrot2dColor(uint32_t count, int max_iter) {
 
 Result<std::vector<uint32_t>> mandelbrot2dCounts(const Mandelbrot2dParams& params) {
   if (Status s = validate(params); !s) return s.error();
-  if (Status s = checkBudget(params, sizeof(uint32_t)); !s) return s.error();
-  std::vector<uint32_t> counts(static_cast<size_t>(params.resolution) * static_cast<size_t>(params.resolution));
-  computeCounts(params, counts);
+  const size_t res = static_cast<size_t>(params.resolution);
+  if (Status s = checkBudget(params, res, sizeof(uint32_t)); !s) return s.error();
+  std::vector<uint32_t> counts(res * res);
+  if (Status s = computeCounts(params, 0, res, counts); !s) return s.error();
   return counts;
 }
 
 Result<PointSet> generateMandelbrot2d(const Mandelbrot2dParams& params) {
+  return generateRows(params, 0, static_cast<size_t>(std::max(params.resolution, 0)));
+}
+
+Result<PointTile> generateMandelbrot2dTile(const Mandelbrot2dParams& params, TileSpec tile) {
   if (Status s = validate(params); !s) return s.error();
-  if (Status s = checkBudget(params, sizeof(uint32_t) + sizeof(glm::dvec3) + sizeof(glm::vec3)); !s)
-    return s.error();
-  const size_t res = static_cast<size_t>(params.resolution);
-  std::vector<uint32_t> counts(res * res);
-  computeCounts(params, counts);
-  PointSet set;
-  set.positions.resize(res * res);
-  set.colors.resize(res * res);
-  const double spacing = pixelSpacing(params);
-  parallelFor(res, params.threads, [&](size_t row, unsigned) {
-    // Correctly rounded centre + offset (the offsets are exact doubles).
-    const double y = params.center_y + pixelOffset(static_cast<int>(row), params.resolution, spacing);
-    for (size_t col = 0; col < res; ++col) {
-      const size_t i = row * res + col;
-      const double x = params.center_x + pixelOffset(static_cast<int>(col), params.resolution, spacing);
-      set.positions[i] = glm::dvec3(x, y, 0.0);
-      set.colors[i] = mandelbrot2dColor(counts[i], params.max_iter);
-    }
-  });
-  return set;
+  const TileRange rows = tileRange(static_cast<uint64_t>(params.resolution), tile);
+  PointTile out;
+  out.tile = tile;
+  if (rows.empty()) {  // more tiles than rows: no points, an empty piece of the grid file
+    if (!params.grid_out.empty())
+      if (Status s = writeEscapeGrid(params.grid_out, {}, params.max_iter); !s) return s.error();
+    return out;
+  }
+  Result<PointSet> points = generateRows(params, rows.begin, rows.end - rows.begin);
+  if (!points) return points.error();
+  if (points->size() > UINT32_MAX)
+    return Error{"mandelbrot2d: tile " + std::to_string(tile.index) + " has more than 2^32 points; use more tiles",
+                 ExitCode::kResourceLimit};
+  out.owned = static_cast<uint32_t>(points->size());
+  out.points = std::move(*points);
+  return out;
 }
 
 }  // namespace dpoint

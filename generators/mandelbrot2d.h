@@ -15,11 +15,15 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
+
+#include <glm/vec2.hpp>
 
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "core/tile.h"
 
 namespace dpoint {
 
@@ -29,6 +33,13 @@ enum class Mandelbrot2dMethod {
   kPerturbation,  // high-precision reference orbit, double deltas per pixel (see the .cpp)
   kDouble,        // z_{n+1} = z_n² + fl(c) in double per pixel: for comparison only
 };
+
+// Perturbation counts computed elsewhere (a GPU, viewer/gpu_generate.h): counts[r·dcx.size() + c]
+// = the pixel count of δc = (dcx[c], dcy[r]) against `orbit` (the reference Z_0, Z_1, ...), equal to
+// the CPU's bit for bit.
+using PerturbationFunction =
+    std::function<Status(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
+                         const std::vector<double>& dcy, int max_iter, uint32_t* counts)>;
 
 struct Mandelbrot2dParams {
   double center_x = -0.7436450;
@@ -40,12 +51,20 @@ struct Mandelbrot2dParams {
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
   Mandelbrot2dMethod method = Mandelbrot2dMethod::kPerturbation;
+  PerturbationFunction perturbation;  // perturbation deltas elsewhere (a GPU); empty: on the CPU
+  // Also write the counts there, row-major, in the escape-grid format (escape_grid.h; a tile its
+  // rows); needs max_iter ≤ kMaxEscapeIterations.
+  std::string grid_out;
 };
 
 // resolution² points in row-major order (row 0 at the lowest y), every grid point emitted; colour
 // from a cyclic palette over the escape count, black for count == max_iter. Errors: kUsage naming
-// --resolution, --max-iter, --width or --center and the limit; kResourceLimit over max_memory.
+// --resolution, --max-iter, --width, --center or --grid-out and the limit; kResourceLimit over
+// max_memory; the grid file's.
 Result<PointSet> generateMandelbrot2d(const Mandelbrot2dParams& params);
+
+// Tile `tile` (core/tile.h): rows [⌊I·res/N⌋, ⌊(I+1)·res/N⌋), same order and values. Same errors.
+Result<PointTile> generateMandelbrot2dTile(const Mandelbrot2dParams& params, TileSpec tile);
 
 // The escape counts alone, row-major: counts[row * resolution + col]. Same errors.
 Result<std::vector<uint32_t>> mandelbrot2dCounts(const Mandelbrot2dParams& params);

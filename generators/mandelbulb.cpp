@@ -16,7 +16,7 @@ namespace {
 // Off the polar axis the fast map divides by ρ^8 = (x² + y²)^4, which stays a normal double
 // while x² + y² > 1e-60. Closer to the axis the map's limit is used instead; it differs from the
 // map by |Im (z + iρ)^8| ≤ 8·r^7·ρ < 1e-27 (r ≤ 2: only such points are updated).
-constexpr double kAxisRho2 = 1e-60;
+constexpr double kAxisRho2 = kMandelbulbAxisRho2;
 
 // (re + i·im)^8 by three complex squarings.
 inline void power8(double& re, double& im) {
@@ -260,14 +260,31 @@ std::string powerText(double power) {
 }
 }  // namespace
 
-Result<PointSet> generateMandelbulb(const MandelbulbParams& params) {
+namespace {
+Status validateMandelbulb(const MandelbulbParams& params) {
   if (Status s = validateEscapeParams(params.resolution, params.max_iter, params.lo, params.hi, params.level); !s)
-    return s.error();
+    return s;
   if (!std::isfinite(params.power) || params.power < 2.0 || params.power > 64.0)
     return Error{"--power: " + powerText(params.power) + " is outside 2..64", ExitCode::kUsage};
   if (params.variant == MandelbulbVariant::kFast && params.power != 8.0)
     return Error{"--variant fast: only --power 8 has a trig-free form; use --variant seed", ExitCode::kUsage};
+  if (params.variant == MandelbulbVariant::kSeed && params.planes)
+    return Error{"--variant seed runs on the CPU only (it calls libm's acos, atan2, sin, cos and pow, which a shader "
+                 "cannot reproduce bit for bit): use --device none, or --variant fast on a device",
+                 ExitCode::kUsage};
+  return okStatus();
+}
+}  // namespace
+
+Result<PointSet> generateMandelbulb(const MandelbulbParams& params) {
+  if (Status s = validateMandelbulb(params); !s) return s.error();
   return generateEscapeSurface(escapeSurfaceParams("mandelbulb", params), mandelbulbRow(params.variant, params.power));
+}
+
+Result<PointTile> generateMandelbulbTile(const MandelbulbParams& params, TileSpec tile) {
+  if (Status s = validateMandelbulb(params); !s) return s.error();
+  return generateEscapeSurfaceTile(escapeSurfaceParams("mandelbulb", params), mandelbulbRow(params.variant, params.power),
+                                   tile);
 }
 
 }  // namespace dpoint

@@ -33,6 +33,9 @@ namespace dpoint {
 
 enum class MandelbulbVariant { kSeed, kFast };
 
+// The fast variant's polar axis: at x² + y² ≤ this, φ is taken as 0 (see mandelbulb.cpp).
+constexpr double kMandelbulbAxisRho2 = 1e-60;
+
 struct MandelbulbParams {
   int resolution = 200;          // grid points per axis, 2..65536
   int max_iter = 100;            // 1..65535
@@ -45,11 +48,15 @@ struct MandelbulbParams {
   unsigned threads = 0;          // 0: all cores
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
+  EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
 };
 
 // Welded surface mesh (no colours). Errors: bad parameters name the flag and the limit (kUsage;
 // --variant fast with a power other than 8 too); over the memory limit (kResourceLimit).
 Result<PointSet> generateMandelbulb(const MandelbulbParams& params);
+// Tile `tile` of that mesh (escape_grid.h); same errors. With params.planes, variant seed is
+// refused (kUsage): its libm calls have no bit-exact shader form.
+Result<PointTile> generateMandelbulbTile(const MandelbulbParams& params, TileSpec tile);
 
 // The escape counts themselves, for tests and --grid-out.
 int mandelbulbEscapeSeed(double cx, double cy, double cz, int max_iter, double power = 8.0);

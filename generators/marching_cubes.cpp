@@ -122,7 +122,7 @@ int mcEdgeStart(int edge) {
 }
 
 McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last_plane,
-                             const McSlabCallbacks& callbacks) {
+                             const McSlabCallbacks& callbacks, bool seam_positions) {
   assert(ny >= 2 && nz >= 2 && last > first);
   const size_t plane = static_cast<size_t>(ny) * static_cast<size_t>(nz);
   const size_t row = static_cast<size_t>(nz);
@@ -147,7 +147,9 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
                                      static_cast<size_t>((c >> 1) & 1) * row + static_cast<size_t>((c >> 2) & 1)};
   }
 
-  auto numberPlane = [&](int p, bool owned) {
+  // owned: the positions go to out.positions; seam: to out.seam_positions; neither: ids only.
+  auto numberPlane = [&](int p, bool owned, bool seam) {
+    std::vector<glm::dvec3>* positions = owned ? &out.positions : seam ? &out.seam_positions : nullptr;
     const size_t s = static_cast<size_t>(p & 1);
     const uint8_t* a = above[s].data();
     uint32_t count = 0;
@@ -157,12 +159,12 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
         if (j + 1 < ny && a[pt] != a[pt + row]) {
           ids_y[s][pt] = next_id++;
           ++count;
-          if (owned) out.positions.push_back(callbacks.edge_vertex(p, j, k, 1));
+          if (positions) positions->push_back(callbacks.edge_vertex(p, j, k, 1));
         }
         if (k + 1 < nz && a[pt] != a[pt + 1]) {
           ids_z[s][pt] = next_id++;
           ++count;
-          if (owned) out.positions.push_back(callbacks.edge_vertex(p, j, k, 2));
+          if (positions) positions->push_back(callbacks.edge_vertex(p, j, k, 2));
         }
       }
     }
@@ -170,7 +172,7 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
   };
 
   callbacks.load_plane(first, above[first & 1].data());
-  out.first_plane_vertices = numberPlane(first, true);
+  out.first_plane_vertices = numberPlane(first, true, false);
   if (callbacks.plane_done && !callbacks.plane_done(first)) return out;
 
   for (int l = first; l < last; ++l) {
@@ -188,7 +190,7 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
       }
     }
     const bool owned = l + 1 < last || owns_last_plane;
-    const uint32_t plane_vertices = numberPlane(l + 1, owned);
+    const uint32_t plane_vertices = numberPlane(l + 1, owned, !owned && seam_positions && l + 1 == last);
     if (l + 1 == last) out.last_plane_vertices = plane_vertices;
 
     const uint32_t* id_planes[2][3] = {{ids_x.data(), ids_y[s0].data(), ids_z[s0].data()},

@@ -46,7 +46,8 @@ int mcEdgeStart(int edge);
 // One slab: planes first..last (last > first) of a grid of ny·nz points per x-plane (index
 // j·nz + k). The slab owns the vertices on the in-plane edges of planes first..last−1, on the x
 // edges between them, and, when owns_last_plane, those of plane `last`; otherwise plane `last`
-// belongs to the next slab, whose vertices start with them.
+// belongs to the next slab, whose vertices start with them (a slab that ends a tile may still want
+// their positions, as copies: seam_positions).
 struct McSlabCallbacks {
   // Sets above[j·nz + k] to 1 when the value at (p, j, k) is above the level, else 0.
   // Called for p = first, first + 1, ..., last in order.
@@ -64,11 +65,13 @@ struct McSlabMesh {
   std::vector<uint32_t> triangles;
   uint32_t first_plane_vertices = 0;  // crossed in-plane edges of plane `first`
   uint32_t last_plane_vertices = 0;   // crossed in-plane edges of plane `last`
+  // With seam_positions and !owns_last_plane: the positions of those last_plane_vertices, in order.
+  std::vector<glm::dvec3> seam_positions;
   bool complete = false;              // false when plane_done stopped it
 };
 
 McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last_plane,
-                             const McSlabCallbacks& callbacks);
+                             const McSlabCallbacks& callbacks, bool seam_positions = false);
 
 // Whole-field convenience: values[(i·ny + j)·nz + k] on an nx·ny·nz grid, surface of
 // {value > level}, vertex = origin + (index + t along the edge)·spacing with

@@ -150,7 +150,9 @@ bool mengerCellInSponge(uint64_t x, uint64_t y, uint64_t z) {
   return true;
 }
 
-Result<PointSet> generateMenger(const MengerParams& params) {
+namespace {
+
+Status validate(const MengerParams& params) {
   const int n = params.level;
   if (n < 0 || n > kMengerMaxLevel)
     return Error{"--level " + std::to_string(n) + " is out of range for menger (0.." +
@@ -158,30 +160,35 @@ Result<PointSet> generateMenger(const MengerParams& params) {
                  ExitCode::kUsage};
   if (!(params.size > 0.0) || !std::isfinite(params.size))
     return Error{"--size " + std::to_string(params.size) + " must be a finite number above 0", ExitCode::kUsage};
-  if (params.method == MengerMethod::kVoxel) return generateMengerVoxel(params);
+  return okStatus();
+}
 
-  const uint64_t faces = mengerFaceCount(n);
-  const uint64_t vertices = mengerVertexCount(n);
-  const std::string what = "menger level " + std::to_string(n);
-  if (Status s = checkMemory(what, vertices * sizeof(glm::dvec3) + faces * 6 * sizeof(uint32_t), params.max_memory); !s)
-    return s.error();
-  if (vertices > UINT32_MAX)
-    return Error{what + " has " + std::to_string(vertices) + " vertices, more than 32-bit triangle indices can address",
-                 ExitCode::kResourceLimit};
+// The cell slabs x ∈ [first, last) of the exact mesh: the used points of planes first ..
+// last − 1 (and of plane `last` when it is the sponge's last, side), then the faces of the slabs.
+// A face corner on plane `last` that the range does not own is index (points owned) + its rank in
+// the plane, and `seam` holds those points' positions (the whole plane, in rank order).
+struct RangeMesh {
+  PointSet mesh;
+  std::vector<glm::dvec3> seam;
+};
 
-  const Lattice lattice(n);
+Result<RangeMesh> meshRange(const MengerParams& params, const Lattice& lattice, uint32_t first, uint32_t last,
+                            const std::string& what) {
   const uint32_t side = lattice.side();
   const size_t words = lattice.words();
+  assert(first < last && last <= side);
+  const bool owns_last = last == side;
+  const size_t planes = last - first + 1;
 
-  // Pass 1: used points per plane x = i and exposed faces per cell slab x = i.
-  std::vector<uint64_t> vertex_base(side + 2, 0), face_base(side + 2, 0);
-  parallelFor(side + 1, params.threads, [&](size_t item, unsigned) {
-    const int64_t i = static_cast<int64_t>(item);
+  // Pass 1: used points per plane x = first + item and exposed faces per cell slab.
+  std::vector<uint64_t> vertex_base(planes + 1, 0), face_base(planes + 1, 0);
+  parallelFor(planes, params.threads, [&](size_t item, unsigned) {
+    const int64_t i = static_cast<int64_t>(first + item);
     Plane plane;
     plane.build(lattice, i);
     vertex_base[item + 1] = plane.total;
     uint64_t count = 0;
-    if (item < side) {
+    if (item + 1 < planes) {
       for (int64_t j = 0; j < side; ++j)
         for (size_t w = 0; w < words; ++w) {
           uint64_t exposed[6];
@@ -191,12 +198,20 @@ Result<PointSet> generateMenger(const MengerParams& params) {
     }
     face_base[item + 1] = count;
   });
-  for (size_t i = 0; i <= side; ++i) {
+  for (size_t i = 0; i < planes; ++i) {
     vertex_base[i + 1] += vertex_base[i];
     face_base[i + 1] += face_base[i];
   }
-  assert(face_base[side + 1] == faces);
-  assert(vertex_base[side + 1] == vertices);
+  const uint64_t owned = owns_last ? vertex_base[planes] : vertex_base[planes - 1];
+  const uint64_t faces = face_base[planes];
+  if (Status s = checkMemory(what, vertex_base[planes] * sizeof(glm::dvec3) + faces * 6 * sizeof(uint32_t),
+                             params.max_memory);
+      !s)
+    return s.error();
+  if (vertex_base[planes] > UINT32_MAX)
+    return Error{what + " has " + std::to_string(vertex_base[planes]) +
+                     " vertices, more than 32-bit triangle indices can address",
+                 ExitCode::kResourceLimit};
 
   // One coordinate per lattice integer, shared by every point on that plane, so faces are exactly
   // flat and welding needs no double comparison. k·size is exact when size is 1 (or a power of
@@ -205,34 +220,36 @@ Result<PointSet> generateMenger(const MengerParams& params) {
   std::vector<double> coordinate(side + 1);
   for (uint32_t k = 0; k <= side; ++k) coordinate[k] = (static_cast<double>(k) * params.size) / side;
 
-  PointSet out;
-  out.positions.resize(vertex_base[side + 1]);
-  out.triangles.resize(faces * 6);
+  RangeMesh out;
+  out.mesh.positions.resize(owned);
+  out.seam.resize(vertex_base[planes] - owned);
+  out.mesh.triangles.resize(faces * 6);
   if (params.progress) params.progress->start("menger", faces);
 
-  // Pass 2: item i writes the points of plane i and the faces of cell slab i (whose corners lie
-  // on planes i and i+1). Each worker keeps its own two planes.
+  // Pass 2: item i writes the points of plane first + i and the faces of the cell slab there
+  // (whose corners lie on that plane and the next). Each worker keeps its own two planes.
   const unsigned workers = resolveThreads(params.threads);
   std::vector<Plane> lower(workers), upper(workers);
-  parallelFor(side + 1, params.threads, [&](size_t item, unsigned worker) {
-    const int64_t i = static_cast<int64_t>(item);
+  parallelFor(planes, params.threads, [&](size_t item, unsigned worker) {
+    const int64_t i = static_cast<int64_t>(first + item);
     Plane& here = lower[worker];
     Plane& next = upper[worker];
     here.build(lattice, i);
     assert(vertex_base[item] + here.total == vertex_base[item + 1]);
-    size_t v = vertex_base[item];
+    const bool seam = item + 1 == planes && !owns_last;
+    glm::dvec3* v = seam ? out.seam.data() : out.mesh.positions.data() + vertex_base[item];
     for (uint32_t j = 0; j <= side; ++j)
       for (size_t w = 0; w < words; ++w)
         for (uint64_t bits = here.used[j * words + w]; bits != 0; bits &= bits - 1) {
           const size_t k = w * 64 + static_cast<size_t>(std::countr_zero(bits));
-          out.positions[v++] = glm::dvec3(coordinate[item], coordinate[j], coordinate[k]);
+          *v++ = glm::dvec3(coordinate[static_cast<size_t>(i)], coordinate[j], coordinate[k]);
         }
-    if (item == side) return;
+    if (item + 1 == planes) return;
 
     next.build(lattice, i + 1);
-    const Plane* planes[2] = {&here, &next};
+    const Plane* pair[2] = {&here, &next};
     const uint32_t base[2] = {static_cast<uint32_t>(vertex_base[item]), static_cast<uint32_t>(vertex_base[item + 1])};
-    uint32_t* tri = out.triangles.data() + face_base[item] * 6;
+    uint32_t* tri = out.mesh.triangles.data() + face_base[item] * 6;
     std::vector<uint64_t> exposed(6 * words);  // direction d, word w at d·words + w
     for (uint32_t j = 0; j < side; ++j) {
       for (size_t w = 0; w < words; ++w) {
@@ -247,17 +264,65 @@ Result<PointSet> generateMenger(const MengerParams& params) {
             uint32_t corner[4];
             for (int c = 0; c < 4; ++c) {
               const int* d = kQuads[dir][c];
-              corner[c] = base[d[0]] + planes[d[0]]->rank(words, j + uint32_t(d[1]), k + uint32_t(d[2]));
+              corner[c] = base[d[0]] + pair[d[0]]->rank(words, j + uint32_t(d[1]), k + uint32_t(d[2]));
             }
             *tri++ = corner[0], *tri++ = corner[1], *tri++ = corner[2];
             *tri++ = corner[0], *tri++ = corner[2], *tri++ = corner[3];
           }
         }
     }
-    assert(tri == out.triangles.data() + face_base[item + 1] * 6);
+    assert(tri == out.mesh.triangles.data() + face_base[item + 1] * 6);
     if (params.progress) params.progress->advance(face_base[item + 1] - face_base[item]);
   });
   if (params.progress) params.progress->finish();
+  return out;
+}
+
+}  // namespace
+
+Result<PointSet> generateMenger(const MengerParams& params) {
+  if (Status s = validate(params); !s) return s.error();
+  if (params.method == MengerMethod::kVoxel) return generateMengerVoxel(params);
+
+  const int n = params.level;
+  const uint64_t faces = mengerFaceCount(n);
+  const uint64_t vertices = mengerVertexCount(n);
+  const std::string what = "menger level " + std::to_string(n);
+  // Checked before the lattice is built, from the closed forms.
+  if (Status s = checkMemory(what, vertices * sizeof(glm::dvec3) + faces * 6 * sizeof(uint32_t), params.max_memory); !s)
+    return s.error();
+  if (vertices > UINT32_MAX)
+    return Error{what + " has " + std::to_string(vertices) + " vertices, more than 32-bit triangle indices can address",
+                 ExitCode::kResourceLimit};
+  const Lattice lattice(n);
+  Result<RangeMesh> whole = meshRange(params, lattice, 0, lattice.side(), what);
+  if (!whole) return whole.error();
+  assert(whole->mesh.triangles.size() == faces * 6 && whole->mesh.size() == vertices);
+  return std::move(whole->mesh);
+}
+
+Result<PointTile> generateMengerTile(const MengerParams& params, TileSpec tile) {
+  if (Status s = validate(params); !s) return s.error();
+  if (params.method == MengerMethod::kVoxel)
+    return Error{"--tile: menger --method voxel has no split; use --method exact (the default)", ExitCode::kUsage};
+  const Lattice lattice(params.level);
+  const TileRange range = tileRange(lattice.side(), tile);
+  PointTile out;
+  out.tile = tile;
+  if (range.empty()) return out;
+  const std::string what = "menger level " + std::to_string(params.level) + " tile " + std::to_string(tile.index) +
+                           "/" + std::to_string(tile.count);
+  Result<RangeMesh> part =
+      meshRange(params, lattice, static_cast<uint32_t>(range.begin), static_cast<uint32_t>(range.end), what);
+  if (!part) return part.error();
+  out.points = std::move(part->mesh);
+  out.owned = static_cast<uint32_t>(out.points.size());
+  // The seam plane's points open the next non-empty tile's own, in the same (rank) order.
+  const uint32_t next = nextNonEmptyTile(lattice.side(), tile);
+  for (size_t i = 0; i < part->seam.size(); ++i) {
+    out.points.positions.push_back(part->seam[i]);
+    out.foreign.push_back({next, static_cast<uint32_t>(i)});
+  }
   return out;
 }
 

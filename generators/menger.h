@@ -15,6 +15,7 @@
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "core/tile.h"
 
 namespace dpoint {
 
@@ -45,6 +46,11 @@ struct MengerParams {
 // Errors: level outside 0..kMengerMaxLevel or size not finite and positive (kUsage); over the
 // memory limit (kResourceLimit, checked before anything large is allocated).
 Result<PointSet> generateMenger(const MengerParams& params);
+
+// Tile `tile` (core/tile.h) of the exact mesh: the cell slabs x ∈ [⌊I·3^n/N⌋, ⌊(I+1)·3^n/N⌋), owning
+// the points of their planes but the last, which opens the next tile's. Same errors; --method
+// voxel is refused (kUsage).
+Result<PointTile> generateMengerTile(const MengerParams& params, TileSpec tile);
 
 // The voxel method: the sponge's occupancy sampled at the centres of resolution³ voxels over
 // [0, size]³ (1 inside, 0 outside, with a border of empty samples so the surface closes), meshed

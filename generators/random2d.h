@@ -12,6 +12,7 @@
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "core/tile.h"
 
 namespace dpoint {
 
@@ -24,6 +25,8 @@ struct Random2dParams {
 };
 
 Result<PointSet> generateRandom2d(const Random2dParams& params);
+// Tile `tile` (core/tile.h): points [⌊I·count/N⌋, ⌊(I+1)·count/N⌋), at most 2^32 of them.
+Result<PointTile> generateRandom2dTile(const Random2dParams& params, TileSpec tile);
 
 // Output number `index` (0-based) of splitmix64 started from `seed`.
 uint64_t splitmix64At(uint64_t seed, uint64_t index);

@@ -4,6 +4,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,40 @@ Occurrence occurrence(uint64_t t, int j, int level) {
   other |= uint64_t(j) << (2 * l);
   for (int m = 0; m < l; ++m) other |= uint64_t(i) << (2 * m);
   return {false, other, i};
+}
+
+// Owned occurrences (welded vertices) among the tetrahedra [0, t). [0, t) is a union of whole
+// subtrees: for each digit position L (most significant first) and each digit v below t's digit
+// there, the 4^L tetrahedra with t's digits above L, v at L and any digits below. In such a
+// subtree, occurrence (t', j) is decided by t''s digits below L unless they are all j: per j, the
+// lowest digit l < L that differs from j is below j for j·4^(L−1−l) of the patterns, so
+// Σ_j Σ_l j·4^(L−1−l) = 2·(4^L − 1) occurrences are owned that way (the whole tree, L = n, then
+// has 2·4^n − 2, plus its 4 outer corners: 2·4^n + 2); the 4 tetrahedra whose low digits are all
+// j are asked directly.
+uint64_t ownedBefore(uint64_t t, int level) {
+  if (t >= uint64_t{1} << (2 * level)) return 2 * (uint64_t{1} << (2 * level)) + 2;  // all of them
+  uint64_t owned = 0;
+  for (int l = level - 1; l >= 0; --l) {
+    const uint64_t digit = (t >> (2 * l)) & 3;
+    const uint64_t high = (t >> (2 * l + 2)) << (2 * l + 2);
+    for (uint64_t v = 0; v < digit; ++v) {
+      const uint64_t base = high | (v << (2 * l));
+      owned += 2 * ((uint64_t{1} << (2 * l)) - 1);
+      for (int j = 0; j < 4; ++j) {
+        uint64_t all_j = 0;
+        for (int m = 0; m < l; ++m) all_j |= uint64_t(j) << (2 * m);
+        owned += occurrence(base | all_j, j, level).owned ? 1 : 0;
+      }
+    }
+  }
+  return owned;
+}
+
+// Index, in the welded order, of the vertex that occurrence (t, j) owns.
+uint64_t ownedIndex(uint64_t t, int j, int level) {
+  uint64_t index = ownedBefore(t, level);
+  for (int k = 0; k < j; ++k) index += occurrence(t, k, level).owned ? 1 : 0;
+  return index;
 }
 
 }  // namespace
@@ -197,6 +232,135 @@ Result<PointSet> generateSierpinski(const SierpinskiParams& params) {
     }
     if (params.progress) params.progress->advance(per_chunk);
   });
+  if (params.progress) params.progress->finish();
+  return out;
+}
+
+
+Result<PointTile> generateSierpinskiTile(const SierpinskiParams& params, TileSpec tile) {
+  const int n = params.level;
+  if (n < 0 || n > kSierpinskiMaxLevel)
+    return Error{"--level " + std::to_string(n) + " is out of range for sierpinski (0.." +
+                     std::to_string(kSierpinskiMaxLevel) + ")",
+                 ExitCode::kUsage};
+  const uint64_t tetrahedra = uint64_t{1} << (2 * n);
+  const TileRange range = tileRange(tetrahedra, tile);
+  const uint64_t first = range.begin, count = range.end - range.begin;
+  const uint64_t most_vertices = params.unwelded ? 4 * count : ownedBefore(range.end, n) - ownedBefore(first, n);
+  const uint64_t bytes = most_vertices * sizeof(glm::dvec3) + count * 12 * sizeof(uint32_t);
+  if (Status s = checkMemory("sierpinski level " + std::to_string(n) + " tile " + std::to_string(tile.index) + "/" +
+                                 std::to_string(tile.count),
+                             bytes, params.max_memory);
+      !s)
+    return s.error();
+
+  PointTile out;
+  out.tile = tile;
+  PointSet& points = out.points;
+  points.triangles.resize(count * 12);
+  const Frame frame = makeFrame(n);
+  constexpr uint64_t kChunk = 4096;  // tetrahedra per work item
+  const uint64_t chunks = (count + kChunk - 1) / kChunk;
+  auto chunkEnd = [&](uint64_t c) { return std::min(first + (c + 1) * kChunk, range.end); };
+  if (params.progress) params.progress->start("sierpinski", count);
+
+  if (params.unwelded) {  // rows 4t + j, nothing shared
+    points.positions.resize(4 * count);
+    parallelFor(chunks, params.threads, [&](size_t c, unsigned) {
+      for (uint64_t t = first + c * kChunk; t < chunkEnd(c); ++t) {
+        const uint64_t local = t - first;
+        const Corners corners = cornersOf(t, n);
+        for (int j = 0; j < 4; ++j) points.positions[4 * local + uint64_t(j)] = cornerPosition(frame, corners, j);
+        for (int e = 0; e < 12; ++e)
+          points.triangles[12 * local + uint64_t(e)] = static_cast<uint32_t>(4 * local) + uint32_t(kFaces[e / 3][e % 3]);
+      }
+      if (params.progress) params.progress->advance(chunkEnd(c) - first - c * kChunk);
+    });
+    out.owned = static_cast<uint32_t>(points.size());
+    if (params.progress) params.progress->finish();
+    return out;
+  }
+
+  // Welded, as generateSierpinski but over the tile's tetrahedra: owned occurrences numbered in
+  // order, each parked at its slot's first triangle entry; every other entry reads its owner's
+  // parked index when the owner is in this tile, else names a foreign vertex (resolved after).
+  std::vector<uint64_t> chunk_base(chunks + 1, 0);
+  parallelFor(chunks, params.threads, [&](size_t c, unsigned) {
+    uint64_t owned = 0;
+    for (uint64_t t = first + c * kChunk; t < chunkEnd(c); ++t)
+      for (int j = 0; j < 4; ++j) owned += occurrence(t, j, n).owned ? 1 : 0;
+    chunk_base[c + 1] = owned;
+  });
+  for (uint64_t c = 0; c < chunks; ++c) chunk_base[c + 1] += chunk_base[c];
+  assert(chunk_base[chunks] == most_vertices);
+  points.positions.resize(most_vertices);
+  out.owned = static_cast<uint32_t>(most_vertices);
+  parallelFor(chunks, params.threads, [&](size_t c, unsigned) {
+    uint64_t next = chunk_base[c];
+    for (uint64_t t = first + c * kChunk; t < chunkEnd(c); ++t) {
+      const Corners corners = cornersOf(t, n);
+      for (int j = 0; j < 4; ++j) {
+        if (!occurrence(t, j, n).owned) continue;
+        points.positions[next] = cornerPosition(frame, corners, j);
+        points.triangles[12 * (t - first) + uint64_t(kPrimaryEntry[size_t(j)])] = static_cast<uint32_t>(next);
+        ++next;
+      }
+    }
+  });
+  struct Outside {
+    uint64_t entry;  // triangle entry to fill
+    uint64_t t;      // the owning occurrence
+    int slot;
+  };
+  std::vector<std::vector<Outside>> outside(chunks);
+  parallelFor(chunks, params.threads, [&](size_t c, unsigned) {
+    for (uint64_t t = first + c * kChunk; t < chunkEnd(c); ++t) {
+      const uint64_t local = t - first;
+      uint64_t index[4];  // the local index, or UINT64_MAX for a foreign vertex
+      for (int j = 0; j < 4; ++j) {
+        const uint64_t entry = 12 * local + uint64_t(kPrimaryEntry[size_t(j)]);
+        const Occurrence o = occurrence(t, j, n);
+        if (o.owned) {
+          index[j] = points.triangles[entry];
+        } else if (o.other_t >= first) {
+          index[j] = points.triangles[12 * (o.other_t - first) + uint64_t(kPrimaryEntry[size_t(o.other_slot)])];
+          points.triangles[entry] = static_cast<uint32_t>(index[j]);
+        } else {
+          index[j] = UINT64_MAX;
+          outside[c].push_back({entry, o.other_t, o.other_slot});
+        }
+      }
+      for (int e = 0; e < 12; ++e) {
+        const int slot = kFaces[e / 3][e % 3];
+        if (kPrimaryEntry[size_t(slot)] == e) continue;
+        if (index[slot] != UINT64_MAX) points.triangles[12 * local + uint64_t(e)] = static_cast<uint32_t>(index[slot]);
+        else outside[c].push_back({12 * local + uint64_t(e), 0, -1 - slot});  // same vertex as the slot's primary entry
+      }
+    }
+    if (params.progress) params.progress->advance(chunkEnd(c) - first - c * kChunk);
+  });
+  // Foreign vertices: a corner shared with a tetrahedron of an earlier tile (a few per tile
+  // boundary), copied once each in the order first met.
+  std::map<uint64_t, uint32_t> copies;  // owner's index in the whole set → local index
+  for (std::vector<Outside>& list : outside) {
+    for (const Outside& o : list) {
+      if (o.slot < 0) continue;
+      const uint64_t global = ownedIndex(o.t, o.slot, n);
+      auto [it, added] = copies.emplace(global, static_cast<uint32_t>(points.positions.size()));
+      if (added) {
+        const uint32_t owner = tileOfItem(tetrahedra, tile.count, o.t);
+        const uint64_t owner_first = ownedBefore(tileRange(tetrahedra, {owner, tile.count}).begin, n);
+        points.positions.push_back(cornerPosition(frame, cornersOf(o.t, n), o.slot));
+        out.foreign.push_back({owner, static_cast<uint32_t>(global - owner_first)});
+      }
+      points.triangles[o.entry] = it->second;
+    }
+    for (const Outside& o : list) {  // the other entries of the same slot, from the primary one
+      if (o.slot >= 0) continue;
+      const uint64_t local = o.entry / 12;
+      points.triangles[o.entry] = points.triangles[12 * local + uint64_t(kPrimaryEntry[size_t(-1 - o.slot)])];
+    }
+  }
   if (params.progress) params.progress->finish();
   return out;
 }

@@ -14,6 +14,7 @@
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "core/tile.h"
 
 namespace dpoint {
 
@@ -38,6 +39,11 @@ struct SierpinskiParams {
 // k-th, each counter-clockwise seen from outside.
 // Errors: level outside 0..kSierpinskiMaxLevel (kUsage), over the memory limit (kResourceLimit).
 Result<PointSet> generateSierpinski(const SierpinskiParams& params);
+
+// Tile `tile` (core/tile.h): tetrahedra [⌊I·4^n/N⌋, ⌊(I+1)·4^n/N⌋) with the vertices whose first
+// occurrence they hold (welded) or their 4 rows each (unwelded); a corner first met in an earlier
+// tile is a foreign vertex. Same errors.
+Result<PointTile> generateSierpinskiTile(const SierpinskiParams& params, TileSpec tile);
 
 // The seed's corners: (0,0,1), (√(8/9),0,−1/3), (−√(2/9),√(2/3),−1/3), (−√(2/9),−√(2/3),−1/3).
 glm::dvec3 sierpinskiCorner(int k);

@@ -225,6 +225,20 @@ TEST(Julia, gridMatchesReferenceAndIsMirrorSymmetric) {
       for (size_t k = 0; k < j; ++k) ASSERT_EQ((*grid)[(i * 41 + j) * 41 + k], (*grid)[(i * 41 + k) * 41 + j]);
 }
 
+TEST(Julia, escapeSquareThresholdEqualsTheSquareRootTest) {
+  // Every double within 2^20 ulps of 4 and of the threshold, and the threshold's neighbours.
+  for (double centre : {4.0, kJuliaEscapeSquare}) {
+    double below = centre, above = centre;
+    for (int i = 0; i < (1 << 20); ++i) {
+      below = std::nextafter(below, 0.0);
+      above = std::nextafter(above, 8.0);
+      for (double s : {below, above}) ASSERT_EQ(std::sqrt(s) > 2.0, s > kJuliaEscapeSquare) << s;
+    }
+  }
+  EXPECT_FALSE(std::sqrt(std::nextafter(4.0, 8.0)) > 2.0);
+  EXPECT_EQ(kJuliaEscapeSquare, std::nextafter(4.0, 8.0));
+}
+
 TEST(Julia, rejectsNonFiniteConstantAndBadLevel) {
   JuliaParams params;
   params.resolution = 8;

@@ -56,6 +56,7 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(physical, &features);
   facts.shader_float64 = features.shaderFloat64 && !vulkanFaults().no_float64;
+  facts.shader_int64 = features.shaderInt64;
   facts.vertex_stores = features.vertexPipelineStoresAndAtomics;
   facts.large_points = features.largePoints;
 
@@ -284,7 +285,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   enabled.shaderFloat64 = context->facts.shader_float64;
   enabled.vertexPipelineStoresAndAtomics = context->facts.vertex_stores;
   enabled.largePoints = context->facts.large_points;
-  enabled.shaderInt64 = context->facts.int64_atomics;
+  enabled.shaderInt64 = context->facts.shader_int64;
   VkPhysicalDeviceVulkan12Features enabled12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   enabled12.shaderBufferInt64Atomics = context->facts.int64_atomics;
   float priority = 1.0f;

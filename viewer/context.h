@@ -20,7 +20,8 @@ struct DeviceFacts {
   uint32_t vendor_id = 0, device_id = 0;
   uint32_t api_version = 0, driver_version = 0;
   std::string driver_name, driver_info;  // VkPhysicalDeviceDriverProperties
-  bool shader_float64 = false;     // native mode
+  bool shader_float64 = false;     // native mode, generation on the device
+  bool shader_int64 = false;       // generation on the device (exact fp64 rounding)
   bool vertex_stores = false;      // vertexPipelineStoresAndAtomics: the probe
   bool large_points = false;       // --point-size > 1
   bool int64_atomics = false;      // shaderInt64 + shaderBufferInt64Atomics: the compute backend

@@ -53,6 +53,8 @@ Spirv splatShader(PrecisionMode mode) {
   return {nullptr, 0};
 }
 
+}  // namespace
+
 Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
                                                const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
   VkDescriptorSetLayoutCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
@@ -75,6 +77,8 @@ Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescript
   VK_TRY(vkCreatePipelineLayout(context.device, &info, nullptr, &layout));
   return layout;
 }
+
+namespace {
 
 // Two boolean specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
 // 0 kWriteDepth (its constant 1 is unused); the eye-dome pass has none.

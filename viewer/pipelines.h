@@ -66,6 +66,13 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
                                                 bool early_depth = true, bool write_depth = false);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
+// A descriptor set layout of these bindings, and a pipeline layout of one set and push_bytes of
+// push constants from offset 0 for `stages`.
+Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
+                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings);
+Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
+                                        VkShaderStageFlags stages);
+
 // Eye-dome lighting (shaders/edl.comp), the same pass after either backend: reads a float depth per
 // pixel (0 = nothing drawn) and the RGBA8 picture, writes the shaded picture (bindings 0, 1, 2).
 struct ShadePipeline {

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Issue #14 on the GPU machine (device tool; carry .gl and .gpu as for bench/gpu_bench.sh: .gpu/
+# holds build/dpoint, build/tests/viewer_tests and the libraries dpoint links that the machine
+# lacks). Five files in $OUT (gpu.txt from gpu_env.sh):
+#   devices.txt   dpoint devices
+#   equal.txt     the device's counts against the CPU's on the NVIDIA driver, whose fp64 sqrt and
+#                 division need the exact correction: viewer_tests' GpuGenerate suite (validation
+#                 layer on), then --grid-out and output files of each kind, CPU path against
+#                 --device 0 --validate, at small odd and even resolutions
+#   generate.tsv  one line per case and path: wall time, peak RSS, output SHA-256; CPU (--device
+#                 none, all cores) against the GPU (--device 0), REPEATS (1) runs each, median
+#   tiles.tsv     TILES (8) tiles of mandelbulb res TILE_RES (2048) spread over the GPUs (tile I on
+#                 --device I mod GPUS, GPUS at a time) + dpoint merge, against the single GPU run:
+#                 wall, peak RSS and SHA-256 of the merged file
+# Env: BIN (default .gpu/dpoint), CASES (a subset of the case names below), REPEATS, TILES,
+# TILE_RES, GPUS (default: nvidia-smi's count), DATA (scratch, default /tmp/dpoint-generate).
+set -euo pipefail
+source bench/gpu_env.sh
+d=${BIN:-.gpu/dpoint}
+data=${DATA:-/tmp/dpoint-generate}
+repeats=${REPEATS:-1}
+gpus=${GPUS:-$(nvidia-smi -L | wc -l)}
+mkdir -p "$data"
+"$d" devices | tee "$out/devices.txt"
+
+# --- equality on the real driver ---
+{
+  if [ -x .gpu/viewer_tests ]; then
+    .gpu/viewer_tests --gtest_filter='GpuGenerate*' 2>&1 | tail -12
+  else
+    echo "no .gpu/viewer_tests carried: the GpuGenerate suite did not run"
+  fi
+  for kind in "mandelbulb --variant fast --max-iter 100" "julia" "mandelbrot2d --width 1e-9 --max-iter 3000"; do
+    for res in 63 64 257; do
+      # shellcheck disable=SC2086
+      "$d" generate $kind --resolution $res -q --device none --grid-out "$data/cpu.grid" -o "$data/cpu.ply"
+      # shellcheck disable=SC2086
+      "$d" generate $kind --resolution $res -q --device 0 --validate --grid-out "$data/gpu.grid" -o "$data/gpu.ply"
+      grid=$(cmp -s "$data/cpu.grid" "$data/gpu.grid" && echo equal || echo DIFFER)
+      file=$(cmp -s "$data/cpu.ply" "$data/gpu.ply" && echo equal || echo DIFFER)
+      echo "$kind --resolution $res: grid $grid, file $file"
+    done
+  done
+} 2>&1 | tee "$out/equal.txt"
+
+# timed LABEL ARGS...: one dpoint run; prints "wall_s<TAB>peak_mb<TAB>sha256" of the output $data/out.ply.
+timed() {
+  /usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" "$@" -q -o "$data/out.ply"
+  printf '%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
+    "$(sha256sum <"$data/out.ply" | cut -c1-16)"
+  rm -f "$data/out.ply"
+}
+median() { printf '%s\n' "$@" | sort -n | awk '{ a[NR] = $0 } END { print a[int((NR + 1) / 2)] }'; }
+
+results=$out/generate.tsv
+printf 'case\targs\tpath\twall_s\tpeak_mb\tsha256_16\n' >"$results"
+for name in ${CASES:-bulb1024 bulb2048 julia1024 zoom4096}; do
+  case $name in
+    bulb1024) args="mandelbulb --variant fast --resolution 1024" ;;
+    bulb2048) args="mandelbulb --variant fast --resolution 2048" ;;
+    julia1024) args="julia --resolution 1024" ;;
+    zoom4096) args="mandelbrot2d --resolution 4096 --width 1e-9 --max-iter 5000" ;;
+    *) echo "unknown case $name" >&2; exit 1 ;;
+  esac
+  for path in none 0; do
+    runs=()
+    # shellcheck disable=SC2086
+    for ((r = 0; r < repeats; ++r)); do runs+=("$(timed generate $args --device $path)"); done
+    printf '%s\t%s\t%s\t%s\n' "$name" "$args" "$([ $path = none ] && echo cpu || echo gpu)" "$(median "${runs[@]}")" |
+      tee -a "$results"
+  done
+done
+
+# --- tiles over the GPUs of the host ---
+tiles=${TILES:-8}
+args="mandelbulb --variant fast --resolution ${TILE_RES:-2048}"
+printf 'run\twall_s\tpeak_mb\tsha256_16\n' >"$out/tiles.tsv"
+# shellcheck disable=SC2086
+printf 'single process, --device 0\t%s\n' "$(timed generate $args --device 0)" | tee -a "$out/tiles.tsv"
+rm -f "$data"/part-*.ply "$data"/peak-*.txt
+start=$(date +%s.%N)
+# shellcheck disable=SC2016,SC2086
+seq 0 $((tiles - 1)) | xargs -P "$gpus" -I{} sh -c \
+  '/usr/bin/time -f %M -o "$0/peak-$1.txt" "$2" generate '"$args"' -q --device $(($1 % $3)) --tile $1/$4 -o "$0/part-$1.ply"' \
+  "$data" {} "$d" "$gpus" "$tiles"
+tiles_end=$(date +%s.%N)
+/usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" merge -q "$data"/part-*.ply -o "$data/merged.ply"
+end=$(date +%s.%N)
+peak=$(cat "$data"/peak-*.txt | sort -n | tail -1)
+printf '%s tiles on %s GPU(s)\t%.2f\t%.0f\t-\n' "$tiles" "$gpus" "$(awk -v a="$start" -v b="$tiles_end" 'BEGIN { print b - a }')" \
+  "$((peak / 1024))" | tee -a "$out/tiles.tsv"
+printf 'merge\t%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
+  "$(sha256sum <"$data/merged.ply" | cut -c1-16)" | tee -a "$out/tiles.tsv"
+printf 'tiles + merge\t%.2f\t-\t-\n' "$(awk -v a="$start" -v b="$end" 'BEGIN { print b - a }')" | tee -a "$out/tiles.tsv"
+rm -f "$data"/part-*.ply "$data/merged.ply"

@@ -1,0 +1,84 @@
+#include "cli/cli_device.h"
+
+#include <cstdio>
+
+namespace dpoint {
+
+void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options, const std::string& cpu_only_note) {
+  command
+      .add_option("--device", options.device,
+                  "Where the escape counts run: auto (a GPU with fp64 if there is one, else the CPU), none (the "
+                  "CPU),\ncpu (lavapipe) or an index from `dpoint devices`; the counts are the CPU's bit for bit. "
+                  "Marching cubes,\ncolours and writing stay on the CPU" +
+                      (cpu_only_note.empty() ? std::string() : ".\n" + cpu_only_note))
+      ->default_val("auto");
+  command.add_flag("--validate", options.validate,
+                   "With a device: enable the Khronos validation layer; any message fails the run");
+}
+
+Result<std::shared_ptr<GenerateDevice>> GenerateDevice::open(const GenerateDeviceOptions& options,
+                                                            const std::string& what, const std::string& cpu_only,
+                                                            bool quiet) {
+  const std::string& wanted = options.device;
+  if (wanted == "none") return std::shared_ptr<GenerateDevice>();
+  std::string index = wanted;
+  if (wanted == "auto") {
+    if (!cpu_only.empty()) return std::shared_ptr<GenerateDevice>();
+    Result<std::vector<DeviceFacts>> all = listDevices();
+    if (!all) return std::shared_ptr<GenerateDevice>();  // no loader or driver: the CPU
+    index.clear();
+    for (const DeviceFacts& f : *all) {
+      const bool gpu = f.type == "discrete" || f.type == "integrated" || f.type == "virtual";
+      if (gpu && f.vulkan12 && f.has_graphics_queue && gpuGenerateUsable(f)) {
+        index = std::to_string(f.index);
+        break;
+      }
+    }
+    if (index.empty()) return std::shared_ptr<GenerateDevice>();
+  } else if (!cpu_only.empty()) {
+    return Error{"--device " + wanted + ": " + cpu_only, ExitCode::kUsage};
+  }
+  std::shared_ptr<GenerateDevice> device(new GenerateDevice());
+  device->validate_ = options.validate;
+  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{index, options.validate});
+  if (!context) return context.error();
+  device->context_ = std::move(*context);
+  Result<std::unique_ptr<GpuEscape>> gpu = GpuEscape::create(*device->context_);
+  if (!gpu) return Error{"--device " + wanted + ": " + gpu.error().message, gpu.error().code};
+  device->gpu_ = std::move(*gpu);
+  if (Status s = device->checkValidation(); !s) return s.error();
+  if (!quiet) {
+    const DeviceFacts& f = device->context_->facts;
+    std::fprintf(stderr, "dpoint: %s escape counts on %s (%s, driver %s)\n", what.c_str(), f.name.c_str(),
+                 f.type.c_str(), formatDriverVersion(f.vendor_id, f.driver_version).c_str());
+  }
+  return device;
+}
+
+Status GenerateDevice::checkValidation() const {
+  if (!validate_ || context_->validationMessages().empty()) return okStatus();
+  const std::vector<std::string>& messages = context_->validationMessages();
+  return Error{std::to_string(messages.size()) + " Vulkan validation message(s), the first: " + messages.front(),
+               ExitCode::kNoDevice};
+}
+
+EscapePlaneFunction GenerateDevice::planes(const EscapeKernelParams& kernel, const GridAxis& axis) {
+  // The axis values are made at the first call, once the generator has checked the resolution.
+  auto values = std::make_shared<std::vector<double>>();
+  return [self = shared_from_this(), kernel, axis, values](int first, int count, int limit, uint32_t* counts) -> Status {
+    if (values->empty())
+      for (int i = 0; i < axis.resolution; ++i) values->push_back(axis.value(i));
+    if (Status s = self->gpu_->escapePlanes(kernel, *values, first, count, limit, counts); !s) return s;
+    return self->checkValidation();
+  };
+}
+
+PerturbationFunction GenerateDevice::perturbation() {
+  return [self = shared_from_this()](const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
+                                    const std::vector<double>& dcy, int max_iter, uint32_t* counts) -> Status {
+    if (Status s = self->gpu_->perturbation(orbit, dcx, dcy, max_iter, counts); !s) return s;
+    return self->checkValidation();
+  };
+}
+
+}  // namespace dpoint

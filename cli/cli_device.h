@@ -1,0 +1,51 @@
+// --device for the generators whose escape counts can run on a Vulkan device (issue #14):
+// mandelbulb (--variant fast), julia and mandelbrot2d. The device computes the counts
+// (viewer/gpu_generate.h); marching cubes, colours and writing stay on the CPU.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "core/result.h"
+#include "generators/escape_grid.h"
+#include "generators/mandelbrot2d.h"
+#include "viewer/context.h"
+#include "viewer/gpu_generate.h"
+
+namespace dpoint {
+
+struct GenerateDeviceOptions {
+  std::string device = "auto";
+  bool validate = false;
+};
+
+// `cpu_only_note`: which variants stay on the CPU, for the help text (may be empty).
+void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options, const std::string& cpu_only_note);
+
+// The device a generation runs its counts on; the functions it hands out hold it alive.
+class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
+ public:
+  // nullptr: the CPU. --device none: the CPU. auto: the first GPU (discrete, integrated, virtual;
+  // lavapipe is not one) with Vulkan 1.2, shaderFloat64 and shaderInt64, else the CPU; auto never
+  // fails. cpu or an index: that device, or the error (kNoDevice: no such device, or it lacks a
+  // feature). `cpu_only` (non-empty: why this kind or variant has no device form) makes auto the
+  // CPU and an explicit device a usage error naming the reason. `quiet`: no line on stderr naming
+  // the device used.
+  static Result<std::shared_ptr<GenerateDevice>> open(const GenerateDeviceOptions& options, const std::string& what,
+                                                      const std::string& cpu_only, bool quiet);
+
+  EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis);
+  PerturbationFunction perturbation();
+
+ private:
+  // With --validate: any message of the layer so far fails the run (kNoDevice), as in render.
+  Status checkValidation() const;
+
+  std::unique_ptr<VulkanContext> context_;
+  std::unique_ptr<GpuEscape> gpu_;
+  bool validate_ = false;
+};
+
+}  // namespace dpoint

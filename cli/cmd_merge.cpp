@@ -1,0 +1,75 @@
+// dpoint merge TILE... -o OUT: the parts of `dpoint generate KIND --tile I/N` welded into the file
+// one `dpoint generate KIND` writes with the same output options, byte for byte (core/tile.h).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "converters/point_io.h"
+#include "core/memory.h"
+#include "core/point_order.h"
+#include "core/tile.h"
+
+namespace dpoint {
+namespace {
+
+struct MergeOptions {
+  std::vector<std::string> inputs;
+  std::string output;
+  int decimals = -1;
+  std::string max_memory;
+  std::string order = "input";
+  CommonOptions common;
+};
+
+int runMerge(const MergeOptions& o) {
+  Result<FileFormat> format = formatOf(o.output);
+  if (!format) return reportError(format.error());
+  if (*format == FileFormat::kGltf) return reportError(Error{o.output + ": write .glb, not .gltf", ExitCode::kUsage});
+  Result<PointOrder> order = parsePointOrder("--order", o.order);
+  if (!order) return reportError(order.error());
+  uint64_t limit = 0;
+  if (!o.max_memory.empty()) {
+    Result<uint64_t> parsed = parseMemorySize("--max-memory", o.max_memory);
+    if (!parsed) return reportError(parsed.error());
+    limit = *parsed;
+  }
+  Progress progress(progressSink(o.common.quiet), "merge");
+  Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress);
+  if (!merged) return reportError(merged.error());
+  PointSet& points = *merged;
+  // From here on as `dpoint generate` finishes a whole set (cmd_generate.cpp: finish).
+  if (*order != PointOrder::kInput) {
+    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
+                            points.triangles.size() * 4 + reorderExtraBytes(points.size(), *order);
+    if (Status s = checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit); !s)
+      return reportError(s.error());
+    reorderPoints(points, *order, o.common.threads, &progress);
+  }
+  WriteOptions w;
+  w.threads = o.common.threads;
+  w.decimals = o.decimals;
+  w.progress = &progress;
+  if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
+  return 0;
+}
+
+}  // namespace
+
+void addMergeCommand(CLI::App& app, RunCommand& run) {
+  auto o = std::make_shared<MergeOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "merge",
+      "Weld the tiles of `dpoint generate KIND --tile I/N` (all N, in any order) into one file: the same bytes\n"
+      "as the single `dpoint generate KIND` with these output options, vertex order included");
+  cmd->add_option("tiles", o->inputs, "The tile parts (.ply)")->required();
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
+  cmd->add_option("--decimals", o->decimals, "CSV: fixed digits after the point (default: shortest round trip)")
+      ->check(CLI::Range(0, 100));
+  cmd->add_option("--max-memory", o->max_memory, "Refuse (exit 4) when the estimate is above this (default: half of RAM)");
+  cmd->add_option("--order", o->order, kPointOrderHelp)->default_val("input");
+  addCommonOptions(*cmd, o->common);
+  cmd->callback([o, &run] { run = [o] { return runMerge(*o); }; });
+}
+
+}  // namespace dpoint

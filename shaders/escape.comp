@@ -1,0 +1,99 @@
+#version 450
+// Escape counts of grid points for `dpoint generate` on a device (issue #14): the quaternion Julia
+// set and the trig-free power-8 Mandelbulb (generators/julia.cpp, generators/mandelbulb.cpp), one
+// thread per point, the same IEEE fp64 operations in the same order as the CPU, so the same
+// counts bit for bit: add, sub and mul round correctly in Vulkan, and nothing may be fused
+// (every double is `precise`); the square root and the reciprocal of the Mandelbulb are
+// correctly rounded by exact_fp64.glsl; Julia's test sqrt(s) > 2 is replaced by its exact
+// equivalent s > 4 + 2^-50 (the threshold comes from the CPU), which needs no square root.
+// The kind is a specialization constant.
+#extension GL_ARB_gpu_shader_int64 : require
+#extension GL_GOOGLE_include_directive : require
+#include "exact_fp64.glsl"
+
+layout(local_size_x = 256) in;
+layout(constant_id = 0) const uint kKind = 0;  // 0: Julia, 1: Mandelbulb (fast variant)
+
+layout(std430, set = 0, binding = 0) readonly buffer Axis { double values[]; };  // grid axis, res of them
+layout(std430, set = 0, binding = 1) writeonly buffer Counts { uint counts[]; };
+
+layout(push_constant) uniform Push {
+  dvec4 c;            // Julia's constant
+  double threshold;   // Julia: sqrt(s) > 2 exactly when s > threshold (the CPU passes 4 + 2^-50)
+  double axis_rho2;   // Mandelbulb: x² + y² at or below which φ = 0 (1e-60, as the CPU)
+  uint res;           // points per axis
+  uint first_row;     // rows (plane·res + j) before this dispatch's first point
+  uint count;         // points in this dispatch: whole rows, k fastest
+  uint limit;         // iterations at most
+};
+
+uint juliaCount(double x0, double y0, double z0) {
+  precise double x = x0, y = y0, z = z0, w = 0.0lf;
+  for (uint i = 0; i < limit; ++i) {
+    precise double x2 = x * x;
+    precise double rest = y * y + z * z + w * w;
+    precise double s = x2 + rest;
+    if (s > threshold) return i;
+    precise double nx = x2 - rest + c.x;
+    precise double ny = 2.0lf * x * y + c.y;
+    precise double nz = 2.0lf * x * z + c.z;
+    precise double nw = 2.0lf * x * w + c.w;
+    x = nx;
+    y = ny;
+    z = nz;
+    w = nw;
+  }
+  return limit;
+}
+
+// (re + i·im)^8 by three complex squarings.
+void power8(inout double re, inout double im) {
+  for (int s = 0; s < 3; ++s) {
+    precise double r2 = re * re - im * im;
+    precise double i2 = 2.0lf * re * im;
+    re = r2;
+    im = i2;
+  }
+}
+
+uint mandelbulbCount(double cx, double cy, double cz) {
+  precise double x = cx, y = cy, z = cz;
+  for (uint i = 0; i < limit; ++i) {
+    precise double rho2 = x * x + y * y;
+    precise double r2 = rho2 + z * z;
+    if (r2 > 4.0lf) return i;
+    precise double wr = z;
+    precise double wi = sqrtRn(rho2);
+    precise double cp = x, sp = y;
+    power8(cp, sp);
+    if (rho2 > axis_rho2) {
+      precise double q = rho2 * rho2;
+      precise double q2 = q * q;
+      precise double inv = recipRn(q2);
+      precise double ncp = cp * inv;
+      precise double nsp = sp * inv;
+      cp = ncp;
+      sp = nsp;
+    } else {
+      cp = 1.0lf;
+      sp = 0.0lf;
+    }
+    power8(wr, wi);
+    precise double nx = wi * cp + cx;
+    precise double ny = wi * sp + cy;
+    precise double nz = wr + cz;
+    x = nx;
+    y = ny;
+    z = nz;
+  }
+  return limit;
+}
+
+void main() {
+  const uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
+  if (t >= count) return;
+  const uint row = first_row + t / res;
+  const uint k = t % res;
+  const double x = values[row / res], y = values[row % res], z = values[k];
+  counts[t] = kKind == 0u ? juliaCount(x, y, z) : mandelbulbCount(x, y, z);
+}

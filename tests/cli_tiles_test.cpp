@@ -1,0 +1,176 @@
+// dpoint generate --tile and dpoint merge as a user or a scheduler runs them: the merged file is
+// the single process's, byte for byte, for every kind and output format; bad tiles are refused
+// with the flag or file named; render and info take the tiles as the whole set.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::runCommand;
+using test::runDpoint;
+using test::TempDir;
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Runs the N tiles and the merge into `out_name`, returns the merged bytes ("" on failure).
+std::string mergedTiles(const TempDir& dir, const std::vector<std::string>& kind, uint32_t count,
+                        const std::string& out_name, const std::vector<std::string>& merge_args = {}) {
+  std::vector<std::string> merge = {"merge", "-q", "-o", dir.file(out_name)};
+  for (uint32_t i = 0; i < count; ++i) {
+    const std::string part = dir.file("part-" + std::to_string(i) + ".ply");
+    test::CommandResult r = runDpoint(concat(concat({"generate"}, kind),
+                                             {"-q", "--tile", std::to_string(i) + "/" + std::to_string(count), "-o", part}));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    if (r.exit_code != 0) return "";
+    merge.push_back(part);
+  }
+  test::CommandResult r = runDpoint(concat(merge, merge_args));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? readFile(dir.file(out_name)) : "";
+}
+
+std::string whole(const TempDir& dir, const std::vector<std::string>& kind, const std::string& out_name,
+                  const std::vector<std::string>& args = {}) {
+  test::CommandResult r = runDpoint(concat(concat(concat({"generate"}, kind), {"-q", "-o", dir.file(out_name)}), args));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return readFile(dir.file(out_name));
+}
+
+TEST(CliTiles, everyKindMergesToTheSingleProcessFileByteForByte) {
+  const std::vector<std::vector<std::string>> kinds = {
+      {"mandelbulb", "--resolution", "33", "--variant", "fast"},
+      {"mandelbulb", "--resolution", "17"},
+      {"julia", "--resolution", "25", "--frame", "seed"},
+      {"menger", "--level", "2"},
+      {"sierpinski", "--level", "3"},
+      {"random2d", "--count", "999"},
+      {"mandelbrot2d", "--resolution", "31", "--max-iter", "300"},
+  };
+  for (const std::vector<std::string>& kind : kinds) {
+    for (uint32_t count : {3u, 40u}) {  // 40: more tiles than slabs, lattice planes or rows
+      SCOPED_TRACE(kind[0] + " " + kind[2] + " N=" + std::to_string(count));
+      TempDir dir;
+      const std::string expected = whole(dir, kind, "whole.ply");
+      ASSERT_FALSE(expected.empty());
+      EXPECT_TRUE(mergedTiles(dir, kind, count, "merged.ply") == expected);
+    }
+  }
+}
+
+TEST(CliTiles, mergeWritesEveryFormatAndOrderAsGenerateDoes) {
+  TempDir dir;
+  const std::vector<std::string> kind = {"julia", "--resolution", "21", "--offset", "6378137,0,0.5"};
+  for (const std::vector<std::string>& options :
+       std::vector<std::vector<std::string>>{{}, {"--decimals", "15"}, {"--order", "morton"}}) {
+    for (const char* ext : {".csv", ".glb", ".ply"}) {
+      SCOPED_TRACE(std::string(ext) + (options.empty() ? "" : " " + options[0]));
+      const std::string expected = whole(dir, kind, std::string("whole") + ext, options);
+      ASSERT_FALSE(expected.empty());
+      EXPECT_TRUE(mergedTiles(dir, kind, 5, std::string("merged") + ext, options) == expected);
+    }
+  }
+}
+
+TEST(CliTiles, badTilesAreRefusedNamingTheFlag) {
+  TempDir dir;
+  const std::string out = dir.file("t.ply");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"julia", "--tile", "5/4", "-o", out}, "--tile: '5/4' asks for tile 5, but tiles are 0..3"},
+      {{"julia", "--tile", "0/0", "-o", out}, "--tile: '0/0' asks for N outside"},
+      {{"julia", "--tile", "x", "-o", out}, "--tile: 'x' is not I/N"},
+      {{"julia", "--tile", "0/2", "-o", dir.file("t.csv")}, "a tile is written as .ply"},
+      {{"julia", "--tile", "0/2", "--order", "morton", "-o", out}, "--order morton needs the whole set"},
+      {{"menger", "--method", "voxel", "--tile", "0/2", "-o", out}, "--method voxel has no split"},
+  };
+  for (const Case& c : cases) {
+    test::CommandResult r = runDpoint(concat({"generate"}, c.args));
+    EXPECT_EQ(r.exit_code, 1) << c.message;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(CliTiles, mergeRefusesAnIncompleteOrMixedSet) {
+  TempDir dir;
+  for (int i = 0; i < 3; ++i)
+    ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "2", "-q", "--tile", std::to_string(i) + "/3", "-o",
+                         dir.file(std::to_string(i) + "-s.ply")})
+                  .exit_code,
+              0);
+  ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "3", "-q", "--tile", "1/3", "-o", dir.file("other.ply")})
+                .exit_code,
+            0);
+  test::CommandResult r = runDpoint({"merge", dir.file("0-s.ply"), dir.file("2-s.ply"), "-o", dir.file("m.ply")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("missing tile(s) 1 of 0..2"), std::string::npos) << r.err;
+  r = runDpoint({"merge", dir.file("0-s.ply"), dir.file("other.ply"), dir.file("2-s.ply"), "-o", dir.file("m.ply")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("other.ply: a tile of another run"), std::string::npos) << r.err;
+  r = runDpoint({"merge", DPOINT_SAMPLES_DIR "/earth_offset_mm.csv", "-o", dir.file("m.ply")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("not a PLY file"), std::string::npos) << r.err;
+  EXPECT_FALSE(test::fileExists(dir.file("m.ply")));
+}
+
+TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
+  TempDir dir;
+  const std::vector<std::string> kind = {"mandelbulb", "--resolution", "29"};
+  whole(dir, kind, "whole.ply");
+  std::vector<std::string> parts;
+  for (int i = 0; i < 4; ++i) {
+    parts.push_back(dir.file("part-" + std::to_string(i) + ".ply"));
+    ASSERT_EQ(runDpoint(concat(concat({"generate"}, kind), {"-q", "--tile", std::to_string(i) + "/4", "-o", parts.back()}))
+                  .exit_code,
+              0);
+  }
+  test::CommandResult one = runDpoint({"info", "--json", dir.file("whole.ply")});
+  test::CommandResult tiles = runDpoint(concat({"info", "--json"}, parts));
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  ASSERT_EQ(tiles.exit_code, 0) << tiles.err;
+  auto afterFile = [](const std::string& json) { return json.substr(json.find("\"points\"")); };
+  EXPECT_EQ(afterFile(one.out), afterFile(tiles.out));
+  EXPECT_NE(tiles.out.find("part-0.ply and 3 more"), std::string::npos);
+
+  ASSERT_EQ(runDpoint({"render", dir.file("whole.ply"), "-q", "--validate", "-o", dir.file("whole.png")}).exit_code, 0);
+  test::CommandResult r = runDpoint(concat(concat({"render", "-q", "--validate"}, parts), {"-o", dir.file("tiles.png")}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(readFile(dir.file("whole.png")) == readFile(dir.file("tiles.png")));
+  // A partial set is read file by file: its points are there, seam copies included.
+  r = runDpoint({"info", "--json", parts[0], parts[1]});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"points\": "), std::string::npos);
+}
+
+// A scheduler runs the tiles: GNU parallel (Debian `parallel`, installed by scripts/setup) runs 7
+// tiles two at a time, and the merge equals the single process.
+TEST(CliTiles, gnuParallelRunsTheTilesAndTheMergeEqualsOneProcess) {
+  TempDir dir;
+  const std::vector<std::string> kind = {"mandelbulb", "--resolution", "45", "--variant", "fast"};
+  const std::string expected = whole(dir, kind, "whole.ply");
+  std::vector<std::string> command = {"/usr/bin/parallel", "--will-cite", "--halt", "now,fail=1", "-j2", DPOINT_EXE, "generate"};
+  command = concat(command, kind);
+  command = concat(command, {"-q", "--tile", "{}/7", "-o", dir.file("part-{}.ply"), ":::", "0", "1", "2", "3", "4", "5", "6"});
+  test::CommandResult r = runCommand(command);
+  ASSERT_EQ(r.exit_code, 0) << "is GNU parallel installed (scripts/setup)? " << r.err;
+  std::vector<std::string> merge = {"merge", "-q", "-o", dir.file("merged.ply")};
+  for (int i = 6; i >= 0; --i) merge.push_back(dir.file("part-" + std::to_string(i) + ".ply"));
+  r = runDpoint(merge);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(readFile(dir.file("merged.ply")) == expected);
+}
+
+}  // namespace
+}  // namespace dpoint
