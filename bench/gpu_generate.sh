@@ -43,23 +43,26 @@ mkdir -p "$data"
   done
 } 2>&1 | tee "$out/equal.txt"
 
-# timed LABEL ARGS...: one dpoint run; prints "wall_s<TAB>peak_mb<TAB>sha256" of the output $data/out.ply.
+# timed LABEL ARGS...: one dpoint run; prints "wall_s<TAB>peak_mb<TAB>sha256<TAB>gpu_ms<TAB>gpu_points_per_s"
+# of the output $data/out.ply (the last two from the device's own line: the classification alone,
+# GPU timestamps around its dispatches; "-" on the CPU path).
 timed() {
-  /usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" "$@" -q -o "$data/out.ply"
-  printf '%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
-    "$(sha256sum <"$data/out.ply" | cut -c1-16)"
+  /usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" "$@" -o "$data/out.ply" 2>"$data/stderr.txt"
+  printf '%s\t%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
+    "$(sha256sum <"$data/out.ply" | cut -c1-16)" \
+    "$(sed -n 's/.* in \([0-9.]*\) ms of GPU time (\([0-9.e+]*\) points\/s).*/\1\t\2/p' "$data/stderr.txt" | grep . || printf -- '-\t-')"
   rm -f "$data/out.ply"
 }
 median() { printf '%s\n' "$@" | sort -n | awk '{ a[NR] = $0 } END { print a[int((NR + 1) / 2)] }'; }
 
 results=$out/generate.tsv
-printf 'case\targs\tpath\twall_s\tpeak_mb\tsha256_16\n' >"$results"
+printf 'case\targs\tpath\twall_s\tpeak_mb\tsha256_16\tgpu_ms\tgpu_points_per_s\n' >"$results"
 for name in ${CASES:-bulb1024 bulb2048 julia1024 zoom4096}; do
   case $name in
     bulb1024) args="mandelbulb --variant fast --resolution 1024" ;;
     bulb2048) args="mandelbulb --variant fast --resolution 2048" ;;
     julia1024) args="julia --resolution 1024" ;;
-    zoom4096) args="mandelbrot2d --resolution 4096 --width 1e-9 --max-iter 5000" ;;
+    zoom4096) args="mandelbrot2d --resolution 4096 --width 1e-12 --max-iter 5000" ;;
     *) echo "unknown case $name" >&2; exit 1 ;;
   esac
   for path in none 0; do
@@ -74,7 +77,7 @@ done
 # --- tiles over the GPUs of the host ---
 tiles=${TILES:-8}
 args="mandelbulb --variant fast --resolution ${TILE_RES:-2048}"
-printf 'run\twall_s\tpeak_mb\tsha256_16\n' >"$out/tiles.tsv"
+printf 'run\twall_s\tpeak_mb\tsha256_16\tgpu_ms\tgpu_points_per_s\n' >"$out/tiles.tsv"
 # shellcheck disable=SC2086
 printf 'single process, --device 0\t%s\n' "$(timed generate $args --device 0)" | tee -a "$out/tiles.tsv"
 rm -f "$data"/part-*.ply "$data"/peak-*.txt

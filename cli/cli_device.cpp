@@ -47,12 +47,20 @@ Result<std::shared_ptr<GenerateDevice>> GenerateDevice::open(const GenerateDevic
   if (!gpu) return Error{"--device " + wanted + ": " + gpu.error().message, gpu.error().code};
   device->gpu_ = std::move(*gpu);
   if (Status s = device->checkValidation(); !s) return s.error();
+  device->quiet_ = quiet;
   if (!quiet) {
     const DeviceFacts& f = device->context_->facts;
     std::fprintf(stderr, "dpoint: %s escape counts on %s (%s, driver %s)\n", what.c_str(), f.name.c_str(),
                  f.type.c_str(), formatDriverVersion(f.vendor_id, f.driver_version).c_str());
   }
   return device;
+}
+
+GenerateDevice::~GenerateDevice() {
+  if (quiet_ || !gpu_ || gpu_->pointsDone() == 0 || !(gpu_->gpuMs() > 0.0)) return;
+  std::fprintf(stderr, "dpoint: escape counts of %llu points in %.1f ms of GPU time (%.3g points/s)\n",
+               static_cast<unsigned long long>(gpu_->pointsDone()), gpu_->gpuMs(),
+               static_cast<double>(gpu_->pointsDone()) / (gpu_->gpuMs() * 1e-3));
 }
 
 Status GenerateDevice::checkValidation() const {

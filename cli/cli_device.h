@@ -38,6 +38,9 @@ class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
 
   EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis);
   PerturbationFunction perturbation();
+  // Unless quiet: a line on stderr with the points classified and the GPU time their dispatches
+  // took (the classification alone; the generator's functions hold the device until it is done).
+  ~GenerateDevice();
 
  private:
   // With --validate: any message of the layer so far fails the run (kNoDevice), as in render.
@@ -46,6 +49,7 @@ class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
   std::unique_ptr<VulkanContext> context_;
   std::unique_ptr<GpuEscape> gpu_;
   bool validate_ = false;
+  bool quiet_ = false;
 };
 
 }  // namespace dpoint

@@ -86,6 +86,12 @@ Result<std::unique_ptr<GpuEscape>> GpuEscape::create(const VulkanContext& contex
 }
 
 Status GpuEscape::init() {
+  if (context_.facts.timestamp_period_ns > 0.0f) {
+    VkQueryPoolCreateInfo query_info = {VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = 4;
+    VK_TRY(vkCreateQueryPool(context_.device, &query_info, nullptr, &queries_));
+  }
   Result<VkDescriptorSetLayout> escape_set = storageSetLayout(context_, {storage(0), storage(1)});
   if (!escape_set) return escape_set.error();
   escape_set_layout_ = *escape_set;
@@ -149,6 +155,7 @@ GpuEscape::~GpuEscape() {
   }
   for (Buffer* b : {&axis_, &orbit_, &dcx_, &dcy_}) destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);  // frees the sets
+  if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
   for (VkPipeline p : {escape_[0], escape_[1], perturbation_})
     if (p) vkDestroyPipeline(device, p, nullptr);
   for (VkPipelineLayout l : {escape_layout_, perturbation_layout_})
@@ -177,6 +184,14 @@ Status GpuEscape::finish(Slot& slot) {
   slot.points = 0;
   if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
   std::memcpy(slot.destination, slot.counts.mapped, points * sizeof(uint32_t));
+  points_done_ += points;
+  if (queries_) {
+    const uint32_t first = 2 * static_cast<uint32_t>(&slot - slots_);
+    uint64_t ticks[2] = {0, 0};
+    VK_TRY(vkGetQueryPoolResults(context_.device, queries_, first, 2, sizeof(ticks), ticks, sizeof(uint64_t),
+                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    gpu_ms_ += static_cast<double>(ticks[1] - ticks[0]) * context_.facts.timestamp_period_ns * 1e-6;
+  }
   return okStatus();
 }
 
@@ -196,6 +211,11 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_TRY(vkBeginCommandBuffer(slot.commands, &begin));
+  const uint32_t query = 2 * static_cast<uint32_t>(s);
+  if (queries_) {
+    vkCmdResetQueryPool(slot.commands, queries_, query, 2);
+    vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, query);
+  }
   vkCmdBindPipeline(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   vkCmdBindDescriptorSets(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
   vkCmdPushConstants(slot.commands, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
@@ -203,6 +223,7 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   const uint64_t groups = (points + kGroupSize - 1) / kGroupSize;
   const uint64_t x = std::min<uint64_t>(groups, std::max<uint32_t>(context_.facts.max_dispatch_groups_x, 1));
   vkCmdDispatch(slot.commands, static_cast<uint32_t>(x), static_cast<uint32_t>((groups + x - 1) / x), 1);
+  if (queries_) vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, query + 1);
   VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
   barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;

@@ -57,6 +57,11 @@ class GpuEscape {
   Status perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
                       const std::vector<double>& dcy, int max_iter, uint32_t* counts);
 
+  // The points classified so far and the GPU time their dispatches took (timestamps around each
+  // dispatch; 0 on a queue without timestamps): the classification alone, for the bench.
+  uint64_t pointsDone() const { return points_done_; }
+  double gpuMs() const { return gpu_ms_; }
+
  private:
   struct Slot {
     Buffer counts;
@@ -83,6 +88,9 @@ class GpuEscape {
   VkPipeline perturbation_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   Slot slots_[2];
+  VkQueryPool queries_ = VK_NULL_HANDLE;  // two timestamps per slot
+  uint64_t points_done_ = 0;
+  double gpu_ms_ = 0.0;
   Buffer axis_, orbit_, dcx_, dcy_;
   std::vector<double> axis_values_;  // what axis_ holds
 };
