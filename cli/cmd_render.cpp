@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
+#include "core/memory.h"
 #include "core/point_order.h"
 #include "core/progress.h"
 #include "viewer/camera.h"
@@ -35,8 +36,13 @@ struct RenderCliOptions {
   double point_size = 1.0;
   uint32_t frames = 1, warmup = 1;
   uint64_t chunk_points = 0;
+  std::string max_memory;
   CommonOptions common;
 };
+
+// Host and device bytes per pixel at most: colour and depth (or the compute backend's 64-bit key
+// and packed picture), the readback buffer, the host image and, with --error, the reference raster.
+constexpr uint64_t kPictureBytesPerPixel = 32;
 
 bool endsWithPng(const std::string& path) {
   if (path.size() < 4) return false;
@@ -203,10 +209,20 @@ int runRender(const RenderCliOptions& o) {
   if (!spec) return reportError(spec.error());
   Result<uint32_t> background = parseBackground(o.background);
   if (!background) return reportError(background.error());
+  Result<uint64_t> limit = memoryLimitOf(o.max_memory);
+  if (!limit) return reportError(limit.error());
+  // Before the input is read: --width 1000000 should not wait for a large file to load first.
+  const uint64_t pixels = uint64_t{o.camera.width} * o.camera.height;
+  if (Status s = checkMemory("a " + std::to_string(o.camera.width) + "x" + std::to_string(o.camera.height) + " picture",
+                             pixels * kPictureBytesPerPixel, *limit);
+      !s)
+    return reportError(s.error());
 
   Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, &progress, true});
+  ReadOptions read{o.common.threads, false, &progress, true};
+  read.max_memory = *limit;
+  Result<PointSet> points = readPoints(o.input, read);
   if (!points) return reportError(points.error());
   phases.mark("read");
   reorderPoints(*points, *order, o.common.threads, &progress);
@@ -329,6 +345,7 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--order", o->order,
                   std::string(kPointOrderHelp) + "; applied as the set is loaded, before anything else")
       ->default_val("input");
+  addMaxMemoryOption(*cmd, o->max_memory);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });
 }

@@ -22,6 +22,7 @@ struct ReadOptions {
   bool allow_nonfinite = false;
   Progress* progress = nullptr;
   bool points_only = false;  // PLY: stop after the vertex element (faces are not read)
+  uint64_t max_memory = 0;   // --max-memory for what is read; 0: defaultMemoryLimit() (core/memory.h)
 };
 
 struct WriteOptions {

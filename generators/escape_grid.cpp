@@ -207,9 +207,10 @@ class SlabField {
 }  // namespace
 
 Status validateEscapeParams(int resolution, int max_iter, double lo, double hi, double level) {
+  // Too large is a resource limit (exit 4), like the memory estimate it would otherwise fail.
   if (resolution < 2 || resolution > kMaxGridResolution)
     return Error{"--resolution: " + std::to_string(resolution) + " is outside 2.." + std::to_string(kMaxGridResolution),
-                 ExitCode::kUsage};
+                 resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
   if (max_iter < 1 || max_iter > kMaxEscapeIterations)
     return Error{"--max-iter: " + std::to_string(max_iter) + " is outside 1.." + std::to_string(kMaxEscapeIterations),
                  ExitCode::kUsage};

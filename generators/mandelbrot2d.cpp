@@ -310,10 +310,11 @@ Reference chooseReference(const Mandelbrot2dParams& p) {
 }
 
 Status validate(const Mandelbrot2dParams& p) {
+  // Too large is a resource limit (exit 4), like the memory estimate it would otherwise fail.
   if (p.resolution < 2 || p.resolution > kMaxResolution)
     return Error{"--resolution must be in [2, " + std::to_string(kMaxResolution) + "], got " +
                      std::to_string(p.resolution),
-                 ExitCode::kUsage};
+                 p.resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
   if (p.max_iter < 1)
     return Error{"--max-iter must be at least 1, got " + std::to_string(p.max_iter), ExitCode::kUsage};
   if (!std::isfinite(p.width) || !(p.width >= kMinWidth))

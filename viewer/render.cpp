@@ -39,7 +39,8 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
   return static_cast<size_t>(points);
 }
 
-Status checkOptions(const VulkanContext& context, const PointSet& points, const RenderOptions& options) {
+Status checkOptions(const VulkanContext& context, const PointSet& points, const Camera& camera,
+                    const RenderOptions& options) {
   if (points.size() == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
   if (points.size() > UINT32_MAX)
     return Error{"more than 2^32 points (" + std::to_string(points.size()) + ") are not supported", ExitCode::kResourceLimit};
@@ -61,6 +62,17 @@ Status checkOptions(const VulkanContext& context, const PointSet& points, const 
                        " points exceed " + f.name + "'s maxStorageBufferRange; use --backend raster",
                    ExitCode::kResourceLimit};
   }
+  // The picture's size comes from the command line: refused here rather than by a failed allocation.
+  const uint64_t width = camera.width, height = camera.height;
+  const std::string picture = "a " + std::to_string(width) + "x" + std::to_string(height) + " picture";
+  if (options.backend == Backend::kRaster && std::max(width, height) > f.max_image_dimension)
+    return Error{picture + " is larger than " + f.name + " draws (" + std::to_string(f.max_image_dimension) +
+                     " pixels a side at most)",
+                 ExitCode::kResourceLimit};
+  if (options.backend == Backend::kCompute && 8 * width * height > f.max_storage_buffer_range)
+    return Error{"--backend compute keeps a 64-bit key per pixel in one storage buffer: " + picture + " exceeds " +
+                     f.name + "'s maxStorageBufferRange of " + std::to_string(f.max_storage_buffer_range) + " bytes",
+                 ExitCode::kResourceLimit};
   if (options.mode == PrecisionMode::kNative && options.native_path == NativePath::kAttribute && !f.r64g64b64_vertex)
     return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; native mode must pull positions",
                  ExitCode::kNoDevice};
@@ -345,7 +357,7 @@ Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, 
 
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                   const RenderOptions& options) {
-  Status status = checkOptions(context, points, options);
+  Status status = checkOptions(context, points, camera, options);
   if (!status) return status.error();
   SelfTest self_test{true, ""};
   if (modeInfo(options.mode).needs_self_test) {
