@@ -5,12 +5,14 @@
 
 #include "cli/commands.h"
 #include "cli/version.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 
 namespace dpoint {
 
 int reportError(const Error& error) {
   std::fprintf(stderr, "dpoint: error: %s\n", error.message.c_str());
+  noteErrorReported();
   return static_cast<int>(error.code);
 }
 
@@ -34,10 +36,12 @@ Result<uint64_t> memoryLimitOf(const std::string& text) {
 
 int main(int argc, char** argv) {
   using namespace dpoint;
+  watchInterrupts();  // before any thread starts (core/interrupt.h)
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
                "CSV, PLY and GLB, render them offscreen with Vulkan in six precision modes, and inspect the\n"
                "precision a dataset needs.\n"
-               "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit.",
+               "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit,\n"
+               "130/143 stopped by SIGINT/SIGTERM (the output is not written).",
                "dpoint"};
   app.set_version_flag("--version", "dpoint " DPOINT_VERSION);
   app.require_subcommand(1);
@@ -55,7 +59,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
   }
   try {
-    return run ? run() : static_cast<int>(ExitCode::kUsage);
+    const int code = run ? run() : static_cast<int>(ExitCode::kUsage);
+    // A run cut short by SIGINT/SIGTERM exits 128 + signal whatever error the cut caused.
+    return code != 0 && interrupted() ? 128 + interruptSignal() : code;
   } catch (const std::bad_alloc&) {
     return reportError(Error{"out of memory", ExitCode::kResourceLimit});
   } catch (const std::exception& e) {

@@ -22,6 +22,7 @@
 
 #include "converters/gltf_accessor.h"
 #include "converters/gltf_load.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 
 namespace dpoint {
@@ -353,6 +354,7 @@ class SceneReader {
   }
 
   Status readPrimitive(const tinygltf::Primitive& primitive, const std::string& pointer, const glm::dmat4& world) {
+    if (interrupted()) return interruptedError();  // a scene may place a mesh many times over
     if (primitive.mode < 0 || primitive.mode > 6)
       return fail(pointer + "/mode: " + std::to_string(primitive.mode) + " is not a glTF primitive mode (0-6)");
     const auto position_it = primitive.attributes.find("POSITION");

@@ -8,6 +8,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "core/interrupt.h"
+
 namespace dpoint {
 
 Result<InputFile> InputFile::open(const std::string& path) {
@@ -33,6 +35,8 @@ InputFile::~InputFile() {
 }
 
 Result<size_t> InputFile::readAt(uint64_t offset, void* data, size_t size) const {
+  // Every reader comes through here: an interrupted run stops reading (core/interrupt.h).
+  if (interrupted()) return interruptedError();
   if (memory_) {
     if (offset >= size_) return size_t{0};
     const size_t n = static_cast<size_t>(std::min<uint64_t>(size, size_ - offset));

@@ -32,7 +32,8 @@ class InputFile {
   // True for fromMemory: there is no folder beside it to read other files from.
   bool inMemory() const { return memory_ != nullptr; }
   // Reads up to `size` bytes at `offset` (pread, safe from several threads). Returns bytes read,
-  // fewer only at the end of the file; an I/O error is an Error naming the file.
+  // fewer only at the end of the file; an I/O error is an Error naming the file, and so is an
+  // interrupt (interruptedError, core/interrupt.h).
   Result<size_t> readAt(uint64_t offset, void* data, size_t size) const;
 
  private:

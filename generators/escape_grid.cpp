@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/atomic_file.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "generators/marching_cubes.h"
@@ -328,6 +329,8 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
       callbacks.edge_vertex = [&](int p, int j, int k, int axis) { return field.vertex(p, j, k, axis); };
       callbacks.plane_done = [&](int p) {
         if (p > first && params.progress) params.progress->advance(1);
+        // An interrupt stops every slab at its next plane; nothing more is committed.
+        if (interrupted()) failed = true;
         return !failed.load(std::memory_order_relaxed);
       };
       result.mesh = marchingCubesSlab(res, res, first, last, last_slab, callbacks);
@@ -339,6 +342,7 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
     commitReady();
   });
   if (params.progress) params.progress->finish();
+  if (interrupted()) return interruptedError();
   if (failure) return *failure;
   if (grid_file)
     if (Status s = grid_file->commit(); !s) return s.error();

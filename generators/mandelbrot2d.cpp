@@ -30,6 +30,7 @@
 
 #include <glm/vec2.hpp>
 
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 
@@ -350,6 +351,7 @@ void computeCounts(const Mandelbrot2dParams& p, std::vector<uint32_t>& counts) {
   const size_t res = static_cast<size_t>(p.resolution);
   if (p.progress) p.progress->start("mandelbrot2d", static_cast<uint64_t>(res) * res);
   parallelFor(res, p.threads, [&](size_t row, unsigned) {
+    if (interrupted()) return;  // the caller returns interruptedError()
     const double offset_y = pixelOffset(static_cast<int>(row), p.resolution, spacing);
     uint32_t* out = counts.data() + row * res;
     for (int col = 0; col < p.resolution; ++col) {
@@ -383,6 +385,7 @@ Result<std::vector<uint32_t>> mandelbrot2dCounts(const Mandelbrot2dParams& param
   if (Status s = checkBudget(params, sizeof(uint32_t)); !s) return s.error();
   std::vector<uint32_t> counts(static_cast<size_t>(params.resolution) * static_cast<size_t>(params.resolution));
   computeCounts(params, counts);
+  if (interrupted()) return interruptedError();
   return counts;
 }
 
@@ -393,6 +396,7 @@ Result<PointSet> generateMandelbrot2d(const Mandelbrot2dParams& params) {
   const size_t res = static_cast<size_t>(params.resolution);
   std::vector<uint32_t> counts(res * res);
   computeCounts(params, counts);
+  if (interrupted()) return interruptedError();
   PointSet set;
   set.positions.resize(res * res);
   set.colors.resize(res * res);

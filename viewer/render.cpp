@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/interrupt.h"
 #include "viewer/buffers.h"
 #include "viewer/pipelines.h"
 #include "viewer/render_internal.h"
@@ -269,6 +270,7 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
   VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
 
   for (uint32_t frame = 0; frame < options.warmup_frames + options.frames; ++frame) {
+    if (interrupted()) return interruptedError();  // between frames: the GPU is idle here
     Clock::time_point start = Clock::now();
     VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
