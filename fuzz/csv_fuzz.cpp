@@ -8,6 +8,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const InputFile input = InputFile::fromMemory("fuzz.csv", fuzz::bytesOf(data, size));
   CsvReadOptions options;
   options.threads = 1;
+  options.max_memory = fuzz::kMaxMemory;
   fuzz::checkOutcome(readCsv(input, options), input.path());
   return 0;
 }

@@ -13,6 +13,11 @@
 
 namespace dpoint::fuzz {
 
+// --max-memory for every target: far under libFuzzer's 2 GB (-rss_limit_mb), so that what the
+// readers allow themselves is never an out-of-memory finding, and what they must refuse is
+// refused at this limit (exit 4) like a user's --max-memory.
+constexpr uint64_t kMaxMemory = uint64_t{512} << 20;
+
 // Readers used by `dpoint convert` get bytes as a file named `name`: only this name may start
 // their messages.
 inline std::string_view bytesOf(const uint8_t* data, size_t size) {

@@ -39,6 +39,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   GltfReadOptions options;
   // What a user bounds with --max-points; here it keeps each input's work small and bounded.
   options.max_points = 1 << 20;
+  options.max_memory = fuzz::kMaxMemory;
   Result<PointSet> built = readGltf(input, options);
   fuzz::checkOutcome(built, input.path());
 

@@ -9,6 +9,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const InputFile input = InputFile::fromMemory("fuzz.ply", fuzz::bytesOf(data, size));
   PlyReadOptions options;
   options.threads = 1;
+  options.max_memory = fuzz::kMaxMemory;
   Result<PointSet> whole = readPly(input, options);
   fuzz::checkOutcome(whole, input.path());
   options.points_only = true;
