@@ -12,6 +12,7 @@
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
 #include "core/input_file.h"
+#include "core/interrupt.h"
 #include "core/text.h"
 #include "viewer/precision.h"
 #include "viewer/probe.h"
@@ -213,6 +214,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
   const size_t total = run.cases.size() * options.backends.size() * kModeCount;
   size_t done = 0;
   for (const BenchCase& c : run.cases) {
+    if (interrupted()) return interruptedError();
     Result<Prepared> prepared = prepare(c, options);
     if (!prepared) return prepared.error();
     const Prepared& p = *prepared;
@@ -221,6 +223,8 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
     if (wants_montage) run.montage = MontageCapture{&c, montage_backend, p.reference, {}};
     for (Backend backend : options.backends) {
       for (size_t m = 0; m < kModeCount; ++m) {
+        // A run that failed because of the interrupt would otherwise be recorded as skipped.
+        if (interrupted()) return interruptedError();
         BenchRow row;
         row.bench_case = &c;
         row.points = p.points.size();

@@ -11,8 +11,10 @@
 #include <cstring>
 #include <fcntl.h>
 #include <unistd.h>
+#include <csignal>
 #include <ctime>
 #include <memory>
+#include <string_view>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -22,6 +24,7 @@
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "converters/point_io.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/progress.h"
 
@@ -99,14 +102,38 @@ Status runDpoint(const std::vector<std::string>& args, unsigned threads) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  // The child starts with no signal blocked (ours are, for the interrupt watcher), and dies with
+  // us: it gets SIGTERM if the bench is killed (core/interrupt.h, kParentPidVariable).
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
+  std::vector<std::string> environment = {std::string(kParentPidVariable) + "=" + std::to_string(getpid())};
+  for (char** e = environ; *e; ++e)
+    if (std::string_view(*e).rfind(std::string(kParentPidVariable) + "=", 0) != 0) environment.emplace_back(*e);
+  std::vector<char*> c_environment;
+  for (std::string& e : environment) c_environment.push_back(e.data());
+  c_environment.push_back(nullptr);
+  if (interrupted()) return interruptedError();
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, c_argv.data(), environ);
+  const int spawned = posix_spawn(&pid, "/proc/self/exe", &actions, &attributes, c_argv.data(), c_environment.data());
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
   if (spawned != 0) return Error{"cannot run " + command + ": " + std::strerror(spawned), ExitCode::kBadInput};
+  // An interrupt is forwarded to the child, which stops and exits 130/143 like any dpoint run.
+  registerChildProcess(pid);
+  if (interrupted()) ::kill(pid, interruptSignal());  // came before the registration
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return Error{"waiting for " + command + ": " + std::strerror(errno), ExitCode::kBadInput};
+    if (errno != EINTR) {
+      unregisterChildProcess(pid);
+      return Error{"waiting for " + command + ": " + std::strerror(errno), ExitCode::kBadInput};
+    }
   }
+  unregisterChildProcess(pid);
+  if (interrupted()) return interruptedError();
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return okStatus();
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return Error{command + " failed (exit " + std::to_string(code) + ")",

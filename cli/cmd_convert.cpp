@@ -6,6 +6,7 @@
 #include "converters/gltf_read.h"
 #include "converters/point_filters.h"
 #include "converters/point_io.h"
+#include "core/memory.h"
 #include "core/point_order.h"
 
 namespace dpoint {
@@ -25,11 +26,14 @@ struct ConvertOptions {
   uint64_t max_points = 0;
   std::string order = "input";
   double las_scale = 0.001;
+  std::string max_memory;
+  uint64_t memory_limit = 0;  // max_memory parsed
   CommonOptions common;
 };
 
 GltfReadOptions gltfOptions(const ConvertOptions& o) {
   GltfReadOptions g;
+  g.max_memory = o.memory_limit;
   g.scene = o.scene;
   g.all_scenes = o.all_scenes;
   g.allow_nonfinite = o.allow_nonfinite;
@@ -61,7 +65,9 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
                        std::to_string(o.max_points),
                    ExitCode::kResourceLimit};
   }
-  Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
+  r.max_memory = o.memory_limit;
+  Result<PointSet> points = readPoints(o.input, r);
   if (points && o.max_points != 0 && points->size() > o.max_points)
     return Error{o.input + ": " + std::to_string(points->size()) + " points exceed --max-points " +
                      std::to_string(o.max_points),
@@ -69,9 +75,12 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
   return points;
 }
 
-int runConvert(const ConvertOptions& o) {
+int runConvert(ConvertOptions& o) {
   Result<PointOrder> order = parsePointOrder("--order", o.order);
   if (!order) return reportError(order.error());
+  Result<uint64_t> limit = memoryLimitOf(o.max_memory);
+  if (!limit) return reportError(limit.error());
+  o.memory_limit = *limit;
   Progress progress(progressSink(o.common.quiet), "convert");
   WriteOptions w;
   w.threads = o.common.threads;
@@ -97,6 +106,12 @@ int runConvert(const ConvertOptions& o) {
   if (filters.drop) points->colors.clear();
   if (o.unique) dropDuplicatePositions(*points);
   if (filters.srgb8) encodeColorsSrgb8(*points);
+  if (*order != PointOrder::kInput) {
+    const uint64_t needed = points->size() * (sizeof(glm::dvec3) + (points->hasColors() ? sizeof(glm::vec3) : 0)) +
+                            points->triangles.size() * 4 + reorderExtraBytes(points->size(), *order);
+    if (Status s = checkMemory("ordering " + std::to_string(points->size()) + " points", needed, o.memory_limit); !s)
+      return reportError(s.error());
+  }
   reorderPoints(*points, *order, o.common.threads, &progress);
   if (Status s = writePoints(o.output, *points, w); !s) return reportError(s.error());
   return 0;
@@ -142,6 +157,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--order", o->order, std::string(kPointOrderHelp) + "; applied last, after --unique")
       ->default_val("input");
+  addMaxMemoryOption(*cmd, o->max_memory);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runConvert(*o); }; });
 }

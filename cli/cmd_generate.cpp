@@ -45,7 +45,7 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
   cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
   cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")
       ->check(CLI::Range(0, 100));
-  cmd.add_option("--max-memory", o.max_memory, "Refuse (exit 4) when the estimate is above this (default: half of RAM)");
+  addMaxMemoryOption(cmd, o.max_memory);
   cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");
   cmd.add_option("--tile", o.tile,
                  "I/N: compute only tile I (from 0) of N of the set, into a .ply part that `dpoint merge` welds with\n"
@@ -62,10 +62,7 @@ Status parseBounds(const std::string& text, double& lo, double& hi) {
   return okStatus();
 }
 
-Result<uint64_t> memoryLimit(const OutputOptions& o) {
-  if (o.max_memory.empty()) return uint64_t{0};
-  return parseMemorySize("--max-memory", o.max_memory);
-}
+Result<uint64_t> memoryLimit(const OutputOptions& o) { return memoryLimitOf(o.max_memory); }
 
 // Colours and offset: the steps after any generator that act point by point (a tile applies them
 // to its own points and copies alike).

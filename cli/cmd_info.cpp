@@ -21,6 +21,7 @@ struct InfoOptions {
   bool allow_nonfinite = false;
   size_t sample = 10000;
   CameraCliOptions camera;
+  std::string max_memory;
   CommonOptions common;
 };
 
@@ -133,7 +134,11 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
 
 int runInfo(const InfoOptions& o) {
   Progress progress(progressSink(o.common.quiet || o.json), "info");
-  Result<PointSet> points = readPointInputs(o.inputs, ReadOptions{o.common.threads, o.allow_nonfinite, &progress});
+  Result<uint64_t> limit = memoryLimitOf(o.max_memory);
+  if (!limit) return reportError(limit.error());
+  ReadOptions read{o.common.threads, o.allow_nonfinite, &progress};
+  read.max_memory = *limit;
+  Result<PointSet> points = readPointInputs(o.inputs, read);
   if (!points) return reportError(points.error());
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
@@ -175,6 +180,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::Range(size_t{1}, size_t{100000000}));
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   addCameraOptions(*cmd, o->camera);
+  addMaxMemoryOption(*cmd, o->max_memory);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runInfo(*o); }; });
 }

@@ -18,6 +18,7 @@
 #include "converters/point_io.h"
 #include "core/ply.h"
 #include "core/atomic_file.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/point_order.h"
 #include "core/progress.h"
@@ -46,8 +47,13 @@ struct RenderCliOptions {
   std::string point_size = "auto";
   uint32_t frames = 1, warmup = 1;
   uint64_t chunk_points = 0;
+  std::string max_memory;
   CommonOptions common;
 };
+
+// Host and device bytes per pixel at most: colour and depth (or the compute backend's 64-bit key
+// and packed picture), the readback buffer, the host image and, with --error, the reference raster.
+constexpr uint64_t kPictureBytesPerPixel = 32;
 
 // `path` ends with `extension` (lower case, with its dot), in any case.
 bool hasExtension(const std::string& path, const std::string& extension) {
@@ -317,6 +323,7 @@ Result<Bounds> streamBounds(const std::string& path, PlyVertexStream& ply, Progr
   progress.start("bounds of " + path + " (points)", ply.count());
   for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
     const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
+    if (interrupted()) return interruptedError();
     if (Status status = ply.read(first, n, block); !status) return status.error();
     progress.advance(n);
     const Box box = boundingBox(block.positions);
@@ -385,6 +392,15 @@ int runRender(const RenderCliOptions& o) {
       o.max_device_memory.empty() ? uint64_t{0} : parseMemorySize("--max-device-memory", o.max_device_memory);
   if (!device_memory) return reportError(device_memory.error());
 
+  Result<uint64_t> limit = memoryLimitOf(o.max_memory);
+  if (!limit) return reportError(limit.error());
+  // Before the input is read: --width 1000000 should not wait for a large file to load first.
+  const uint64_t pixels = uint64_t{o.camera.width} * o.camera.height;
+  if (Status s = checkMemory("a " + std::to_string(o.camera.width) + "x" + std::to_string(o.camera.height) + " picture",
+                             pixels * kPictureBytesPerPixel, *limit);
+      !s)
+    return reportError(s.error());
+
   Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
   // A large binary PLY is drawn a block at a time (a set larger than memory); anything else is read whole.
@@ -415,6 +431,7 @@ int runRender(const RenderCliOptions& o) {
     phases.mark("bounds");
   } else {
     ReadOptions read_options{o.common.threads, false, &progress, true};
+    read_options.max_memory = *limit;
     // LAS fields as colours; elevation replaces whatever the file holds.
     read_options.las_color = o.color == "intensity"        ? LasColorSource::kIntensity
                              : o.color == "classification" ? LasColorSource::kClassification
@@ -622,6 +639,7 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--up-axis", o->up_axis,
                   "auto|y|z: the data's up for the --fit views. auto: z for LAS (surveys), y otherwise")
       ->default_val("auto");
+  addMaxMemoryOption(*cmd, o->max_memory);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });
 }

@@ -30,4 +30,9 @@ struct CommonOptions {
 };
 void addCommonOptions(CLI::App& command, CommonOptions& options);
 
+// --max-memory SIZE for commands that size memory from their input or options; `text` stays
+// empty when it is not given. memoryLimitOf: 0 (the default, half of RAM) or the bytes.
+void addMaxMemoryOption(CLI::App& command, std::string& text);
+Result<uint64_t> memoryLimitOf(const std::string& text);
+
 }  // namespace dpoint

@@ -5,11 +5,14 @@
 
 #include "cli/commands.h"
 #include "cli/version.h"
+#include "core/interrupt.h"
+#include "core/memory.h"
 
 namespace dpoint {
 
 int reportError(const Error& error) {
   std::fprintf(stderr, "dpoint: error: %s\n", error.message.c_str());
+  noteErrorReported();
   return static_cast<int>(error.code);
 }
 
@@ -18,14 +21,27 @@ void addCommonOptions(CLI::App& command, CommonOptions& options) {
   command.add_flag("--quiet,-q", options.quiet, "No progress output");
 }
 
+void addMaxMemoryOption(CLI::App& command, std::string& text) {
+  command.add_option("--max-memory", text,
+                     "Refuse (exit 4) work whose memory, estimated before allocating, is above this, e.g. 512M, 8G "
+                     "(default: half of RAM)");
+}
+
+Result<uint64_t> memoryLimitOf(const std::string& text) {
+  if (text.empty()) return uint64_t{0};
+  return parseMemorySize("--max-memory", text);
+}
+
 }  // namespace dpoint
 
 int main(int argc, char** argv) {
   using namespace dpoint;
+  watchInterrupts();  // before any thread starts (core/interrupt.h)
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
                "CSV, PLY and GLB, render them offscreen with Vulkan in six precision modes, and inspect the\n"
                "precision a dataset needs.\n"
-               "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit.",
+               "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit,\n"
+               "130/143 stopped by SIGINT/SIGTERM (the output is not written).",
                "dpoint"};
   app.set_version_flag("--version", "dpoint " DPOINT_VERSION);
   app.require_subcommand(1);
@@ -44,7 +60,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
   }
   try {
-    return run ? run() : static_cast<int>(ExitCode::kUsage);
+    const int code = run ? run() : static_cast<int>(ExitCode::kUsage);
+    // A run cut short by SIGINT/SIGTERM exits 128 + signal whatever error the cut caused.
+    return code != 0 && interrupted() ? 128 + interruptSignal() : code;
   } catch (const std::bad_alloc&) {
     return reportError(Error{"out of memory", ExitCode::kResourceLimit});
   } catch (const std::exception& e) {

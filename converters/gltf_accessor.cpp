@@ -110,8 +110,8 @@ Result<AccessorDecoder::Span> AccessorDecoder::locate(const std::string& pointer
     const size_t n = count == 0 ? 0 : count - 1;
     if (n == 0 || stride <= (std::numeric_limits<size_t>::max() - byte_offset - extent) / n)
       sum = std::to_string(byte_offset + stride * n + extent);
-    return fail_at("byteOffset + stride*(count-1) + " + std::to_string(extent) + " = " + sum +
-                   " exceeds " + view_name + " length " + std::to_string(length));
+    return fail_at("count " + std::to_string(count) + ": byteOffset + stride*(count-1) + " + std::to_string(extent) +
+                   " = " + sum + " exceeds " + view_name + " length " + std::to_string(length));
   }
   return Span{data.data() + view.byteOffset + byte_offset, stride};
 }

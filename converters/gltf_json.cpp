@@ -28,7 +28,7 @@ void JsonValue::set(const std::string& key, JsonValue value) {
     *member = std::move(value);
     return;
   }
-  members.emplace_back(key, std::move(value));
+  members.push_back(JsonMember{key, std::move(value)});
 }
 
 bool JsonValue::erase(std::string_view key) {
@@ -130,7 +130,7 @@ class JsonParser {
       skipSpace();
       if (pos_ >= text_.size() || text_[pos_] != ':') return fail("expected ':'");
       ++pos_;
-      out.members.emplace_back(std::move(key), JsonValue{});
+      out.members.push_back(JsonMember{std::move(key), JsonValue{}});
       if (!parseValue(out.members.back().second, depth)) return false;
       skipSpace();
       if (pos_ < text_.size() && text_[pos_] == ',') { ++pos_; continue; }

@@ -17,6 +17,8 @@
 
 namespace dpoint {
 
+struct JsonMember;
+
 struct JsonValue {
   enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject };
   Kind kind = Kind::kNull;
@@ -25,8 +27,8 @@ struct JsonValue {
   bool is_integer = false;  // number written without fraction or exponent and fits int64
   int64_t integer = 0;      // valid when is_integer
   std::string text;         // kString: decoded UTF-8
-  std::vector<JsonValue> items;                              // kArray
-  std::vector<std::pair<std::string, JsonValue>> members;    // kObject, in file order
+  std::vector<JsonValue> items;     // kArray
+  std::vector<JsonMember> members;  // kObject, in file order
 
   // Member of an object by key; nullptr when absent or when this is not an object.
   const JsonValue* find(std::string_view key) const;
@@ -38,6 +40,13 @@ struct JsonValue {
 
   static JsonValue integerValue(int64_t v);
   static JsonValue stringValue(const std::string& text);
+};
+
+// An object member. A struct rather than std::pair: clang with libstdc++ cannot instantiate
+// std::pair<std::string, JsonValue> inside JsonValue's own definition (the fuzz build uses clang).
+struct JsonMember {
+  std::string first;  // the key
+  JsonValue second;   // the value
 };
 
 // Parses one JSON document. Nesting deeper than max_depth arrays/objects is an error, so the

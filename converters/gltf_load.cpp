@@ -15,6 +15,7 @@
 #include "converters/gltf_json.h"
 #include "converters/gltf_meshopt.h"
 #include "core/input_file.h"
+#include "core/memory.h"
 
 namespace dpoint {
 namespace {
@@ -253,9 +254,12 @@ struct FolderJail {
   std::string base;                  // the folder string handed to tinygltf as its base dir
   std::filesystem::path canonical;   // the folder with links resolved
   uint64_t max_bytes = 0;
+  uint64_t memory_left = 0;          // --max-memory left for external files, all of them together
+  bool in_memory = false;            // the model came from memory: it has no folder, nothing is read
 };
 
 bool allowed(const std::string& file, const FolderJail& jail) {
+  if (jail.in_memory) return false;
   if (file.size() <= jail.base.size() + 1 || file.compare(0, jail.base.size(), jail.base) != 0 ||
       file[jail.base.size()] != '/')
     return false;  // not JoinPath(base, name): the cwd fallback or an absolute name
@@ -277,7 +281,7 @@ bool jailedFileExists(const std::string& file, void* user) {
 std::string noExpansion(const std::string& file, void*) { return file; }
 
 bool jailedReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
-  const auto& jail = *static_cast<const FolderJail*>(user);
+  auto& jail = *static_cast<FolderJail*>(user);
   const auto refuse = [&](const std::string& why) {
     if (err) *err += "'" + file + "' " + why;
     return false;
@@ -286,6 +290,9 @@ bool jailedReadWholeFile(std::vector<unsigned char>* out, std::string* err, cons
   Result<InputFile> input = InputFile::open(file);
   if (!input) return refuse(input.error().message);
   if (input->size() > jail.max_bytes) return refuse("is larger than the size limit");
+  if (input->size() > jail.memory_left)
+    return refuse("is larger (" + std::to_string(input->size()) + " bytes) than the memory left under --max-memory");
+  jail.memory_left -= input->size();
   out->resize(size_t(input->size()));
   Result<size_t> got = input->readAt(0, out->data(), out->size());
   if (!got || *got != out->size()) return refuse("could not be read whole");
@@ -351,17 +358,21 @@ std::optional<BinHandOver> standInForBin(JsonValue& document, const GlbLayout& g
   return out;
 }
 
-Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
-  Result<InputFile> input = InputFile::open(path);
-  if (!input) return input.error();
-  if (input->size() == 0) return Error{path + ": file is empty"};
-  if (input->size() > max_file_bytes)
-    return Error{path + ": " + std::to_string(input->size()) + " bytes exceeds the glTF input limit of " +
+Result<tinygltf::Model> load(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory) {
+  const std::string& path = input.path();
+  if (input.size() == 0) return Error{path + ": file is empty"};
+  if (input.size() > max_file_bytes)
+    return Error{path + ": " + std::to_string(input.size()) + " bytes exceeds the glTF input limit of " +
                      std::to_string(max_file_bytes) + " bytes",
                  ExitCode::kResourceLimit};
-  std::vector<unsigned char> bytes(size_t(input->size()));
+  // The model holds the file; what is decoded from it (external files, meshopt views, Draco
+  // primitives) shares what is left under --max-memory, each checked before it is allocated.
+  if (Status s = checkMemory(path + ": loading " + std::to_string(input.size()) + " bytes", input.size(), max_memory); !s)
+    return s.error();
+  const uint64_t memory_left = max_memory - input.size();
+  std::vector<unsigned char> bytes(size_t(input.size()));
   std::vector<unsigned char> tinygltf_input;  // the GLB tinygltf parses when the BIN chunk is handed over
-  Result<size_t> got = input->readAt(0, bytes.data(), bytes.size());
+  Result<size_t> got = input.readAt(0, bytes.data(), bytes.size());
   if (!got) return got.error();
   if (*got != bytes.size()) return Error{path + ": the file shrank while being read"};
 
@@ -422,10 +433,14 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
 
   std::error_code ec;
   FolderJail jail;
-  jail.base = std::filesystem::absolute(path, ec).parent_path().string();
-  if (!ec) jail.canonical = std::filesystem::weakly_canonical(jail.base, ec);
-  if (ec) return Error{path + ": cannot resolve its folder: " + ec.message()};
+  jail.in_memory = input.inMemory();
+  if (!jail.in_memory) {
+    jail.base = std::filesystem::absolute(path, ec).parent_path().string();
+    if (!ec) jail.canonical = std::filesystem::weakly_canonical(jail.base, ec);
+    if (ec) return Error{path + ": cannot resolve its folder: " + ec.message()};
+  }
   jail.max_bytes = max_file_bytes;
+  jail.memory_left = memory_left;
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&jailedFileExists, &noExpansion, &jailedReadWholeFile, &refuseWrite, &jail});
   loader.SetImageLoader(&skipImage, nullptr);
@@ -444,9 +459,11 @@ Result<tinygltf::Model> load(const std::string& path, uint64_t max_file_bytes) {
     bytes.resize(hand_over->byte_length);
     model.buffers[0].data = std::move(bytes);
   }
-  // Decoded here so every reader of the model sees plain views; the input cap bounds the output.
-  if (Status s = decodeMeshoptViews(path, model, max_file_bytes); !s) return s.error();
-  if (Status s = decodeDracoPrimitives(path, model, draco_indices, max_file_bytes); !s) return s.error();
+  // Decoded here so every reader of the model sees plain views; the input cap and what is left of
+  // the memory limit bound the output.
+  const uint64_t decoded_limit = std::min(max_file_bytes, jail.memory_left);
+  if (Status s = decodeMeshoptViews(path, model, decoded_limit); !s) return s.error();
+  if (Status s = decodeDracoPrimitives(path, model, draco_indices, decoded_limit); !s) return s.error();
   return model;
 }
 
@@ -466,10 +483,11 @@ bool gltfRequiredExtensionSupported(const std::string& name) {
   return false;
 }
 
-Result<tinygltf::Model> loadGltfModel(const std::string& path, uint64_t max_file_bytes) {
+Result<tinygltf::Model> loadGltfModel(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory) {
   // tinygltf throws (std::bad_alloc on huge byteLength, nlohmann exceptions); none may escape.
+  const std::string& path = input.path();
   try {
-    return load(path, max_file_bytes);
+    return load(input, max_file_bytes, max_memory == 0 ? defaultMemoryLimit() : max_memory);
   } catch (const std::bad_alloc&) {
     return Error{path + ": out of memory while loading", ExitCode::kResourceLimit};
   } catch (const std::exception& e) {

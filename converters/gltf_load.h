@@ -13,6 +13,7 @@
 #include <string>
 
 #include "converters/gltf_read.h"  // kGltfDefaultMaxFileBytes
+#include "core/input_file.h"
 #include "core/result.h"
 
 namespace dpoint {
@@ -20,9 +21,12 @@ namespace dpoint {
 // Deeper nesting than any real glTF (the schema itself nests about 8 levels).
 constexpr int kGltfMaxJsonDepth = 64;
 
-// Errors are one line: "PATH: /json/pointer: what". Files (and external buffers) larger than
-// max_file_bytes fail with ExitCode::kResourceLimit. Never throws.
-Result<tinygltf::Model> loadGltfModel(const std::string& path, uint64_t max_file_bytes);
+// Errors are one line: "PATH: /json/pointer: what" (PATH: input.path()). Files (and external
+// buffers) larger than max_file_bytes fail with ExitCode::kResourceLimit, and so does a model
+// whose file, external buffers and decoded meshopt and Draco data together pass max_memory
+// (0: defaultMemoryLimit()), checked before each is allocated. External files are read from the
+// input's folder; an input in memory has none, so its external URIs fail. Never throws.
+Result<tinygltf::Model> loadGltfModel(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory);
 
 // Extensions listed in extensionsRequired that we accept: those we decode (KHR_mesh_quantization,
 // EXT_meshopt_compression, KHR_draco_mesh_compression, EXT_mesh_gpu_instancing) and those that do

@@ -22,6 +22,8 @@
 
 #include "converters/gltf_accessor.h"
 #include "converters/gltf_load.h"
+#include "core/interrupt.h"
+#include "core/memory.h"
 
 namespace dpoint {
 namespace {
@@ -79,7 +81,11 @@ struct Uncoloured {
 class SceneReader {
  public:
   SceneReader(const std::string& path, const tinygltf::Model& model, const GltfReadOptions& options)
-      : path_(path), model_(model), options_(options), decoder_(path, model, kMaxUnbackedValues) {}
+      : path_(path),
+        model_(model),
+        options_(options),
+        memory_limit_(options.max_memory ? options.max_memory : defaultMemoryLimit()),
+        decoder_(path, model, std::min<uint64_t>(kMaxUnbackedValues, memory_limit_ / sizeof(double))) {}
 
   Result<PointSet> read() {
     pass_ = Pass::kBuild;
@@ -254,6 +260,11 @@ class SceneReader {
       return fail(pointer + ": " + std::to_string(*count) + " instances exceed --max-points " +
                       std::to_string(options_.max_points),
                   ExitCode::kResourceLimit);
+    // 128 bytes of matrix per instance, from as little as 3 bytes of TRANSLATION.
+    if (Status s = checkMemory(path_ + ": " + pointer + ": " + std::to_string(*count) + " instances",
+                               *count * sizeof(glm::dmat4), memory_limit_);
+        !s)
+      return s.error();
     std::vector<glm::dmat4> placements;
     placements.reserve(*count);
     for (size_t e = 0; e < *count; ++e) {
@@ -343,6 +354,7 @@ class SceneReader {
   }
 
   Status readPrimitive(const tinygltf::Primitive& primitive, const std::string& pointer, const glm::dmat4& world) {
+    if (interrupted()) return interruptedError();  // a scene may place a mesh many times over
     if (primitive.mode < 0 || primitive.mode > 6)
       return fail(pointer + "/mode: " + std::to_string(primitive.mode) + " is not a glTF primitive mode (0-6)");
     const auto position_it = primitive.attributes.find("POSITION");
@@ -375,7 +387,11 @@ class SceneReader {
     emitted_total_ += emitted;
     if (pass_ == Pass::kEmit) return emitPrimitive(primitive, pointer, *positions, remap, world);
 
-    if (pass_ == Pass::kBuild) reserveMore(out_.positions, emitted);
+    if (pass_ == Pass::kBuild) {
+      // A mesh placed by many nodes or instances multiplies the set without more file.
+      if (Status s = checkSetMemory(emitted_total_, out_.triangles.size()); !s) return s;
+      reserveMore(out_.positions, emitted);
+    }
     for (size_t e = 0; e < count; ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
       const glm::dvec3 w = placeVertex(*positions, world, e);
@@ -406,10 +422,13 @@ class SceneReader {
     };
     // Spec §3.7.2.1; a trailing incomplete triangle is not drawn (the validator warns, no error).
     // Reserved up front: growth by doubling briefly holds 1.5 times a large mesh's triangle list.
+    size_t added = 0;
     if (primitive.mode == TINYGLTF_MODE_TRIANGLES)
-      reserveMore(out_.triangles, n / 3 * 3);
+      added = n / 3 * 3;
     else if ((primitive.mode == TINYGLTF_MODE_TRIANGLE_STRIP || primitive.mode == TINYGLTF_MODE_TRIANGLE_FAN) && n >= 3)
-      reserveMore(out_.triangles, 3 * (n - 2));
+      added = 3 * (n - 2);
+    if (Status s = checkSetMemory(emitted_total_, out_.triangles.size() + added); !s) return s;
+    reserveMore(out_.triangles, added);
     if (primitive.mode == TINYGLTF_MODE_TRIANGLES) {
       for (size_t i = 0; i + 3 <= n; i += 3) triangle(i, i + 1, i + 2);
     } else if (primitive.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
@@ -499,6 +518,16 @@ class SceneReader {
     return okStatus();
   }
 
+  // The build pass's point set at `points` points (colours counted: any later primitive may bring
+  // them) and `indices` triangle indices, against --max-memory.
+  Status checkSetMemory(size_t points, size_t indices) const {
+    const uint64_t bytes = uint64_t(points) * (sizeof(glm::dvec3) + sizeof(glm::vec3)) + uint64_t(indices) * sizeof(uint32_t);
+    if (bytes <= memory_limit_) return okStatus();
+    return checkMemory(path_ + ": the scene's " + std::to_string(points) + " points and " + std::to_string(indices / 3) +
+                           " triangles",
+                       bytes, memory_limit_);
+  }
+
   Status flushBlock() {
     Status s = sink_->points(block_);
     block_.positions.clear();
@@ -509,6 +538,7 @@ class SceneReader {
   const std::string& path_;
   const tinygltf::Model& model_;
   const GltfReadOptions& options_;
+  uint64_t memory_limit_;  // --max-memory, resolved
   AccessorDecoder decoder_;
   Pass pass_ = Pass::kBuild;
   size_t emitted_total_ = 0;  // points placed so far in this pass
@@ -524,8 +554,15 @@ class SceneReader {
 }  // namespace
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options) {
+  Result<InputFile> input = InputFile::open(path);
+  if (!input) return input.error();
+  return readGltf(*input, options);
+}
+
+Result<PointSet> readGltf(const InputFile& input, const GltfReadOptions& options) {
+  const std::string& path = input.path();
   try {
-    Result<tinygltf::Model> model = loadGltfModel(path, options.max_file_bytes);
+    Result<tinygltf::Model> model = loadGltfModel(input, options.max_file_bytes, options.max_memory);
     if (!model) return model.error();
     return SceneReader(path, *model, options).read();
   } catch (const std::bad_alloc&) {
@@ -534,8 +571,15 @@ Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& option
 }
 
 Status streamGltf(const std::string& path, const GltfReadOptions& options, GltfPointSink& sink) {
+  Result<InputFile> input = InputFile::open(path);
+  if (!input) return input.error();
+  return streamGltf(*input, options, sink);
+}
+
+Status streamGltf(const InputFile& input, const GltfReadOptions& options, GltfPointSink& sink) {
+  const std::string& path = input.path();
   try {
-    Result<tinygltf::Model> model = loadGltfModel(path, options.max_file_bytes);
+    Result<tinygltf::Model> model = loadGltfModel(input, options.max_file_bytes, options.max_memory);
     if (!model) return model.error();
     return SceneReader(path, *model, options).stream(sink);
   } catch (const std::bad_alloc&) {
@@ -544,8 +588,10 @@ Status streamGltf(const std::string& path, const GltfReadOptions& options, GltfP
 }
 
 Result<std::vector<double>> readGltfAccessor(const std::string& path, int index) {
+  Result<InputFile> input = InputFile::open(path);
+  if (!input) return input.error();
   try {
-    Result<tinygltf::Model> model = loadGltfModel(path, kGltfDefaultMaxFileBytes);
+    Result<tinygltf::Model> model = loadGltfModel(*input, kGltfDefaultMaxFileBytes, 0);
     if (!model) return model.error();
     AccessorDecoder decoder(path, *model, kMaxUnbackedValues);
     Result<AccessorElements> elements = decoder.open(index);

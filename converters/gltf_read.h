@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "core/input_file.h"
 #include "core/point_set.h"
 #include "core/result.h"
 
@@ -38,10 +39,15 @@ struct GltfReadOptions {
   bool allow_nonfinite = false;
   uint64_t max_points = 0;   // 0: no limit; else more points is kResourceLimit, checked before allocating
   uint64_t max_file_bytes = kGltfDefaultMaxFileBytes;  // the file and each external buffer
+  // Bytes for the model, what is decoded from it and the point set (--max-memory), each part
+  // checked before it is allocated; over it is kResourceLimit. 0: defaultMemoryLimit().
+  uint64_t max_memory = 0;
   bool triangles = true;     // false: points only (CSV output stores no triangles; saves 12 B/triangle)
 };
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});
+// The same from an opened file or from bytes in memory (InputFile::fromMemory: external URIs fail).
+Result<PointSet> readGltf(const InputFile& input, const GltfReadOptions& options = {});
 
 // What readGltf's set would be, found by streamGltf's first walk without keeping points.
 struct GltfSummary {
@@ -70,6 +76,7 @@ constexpr size_t kGltfStreamBlockPoints = size_t(1) << 16;
 // points to the sink. Memory: the model, one primitive's vertex map, one block. Triangles are not
 // produced (options.triangles is ignored).
 Status streamGltf(const std::string& path, const GltfReadOptions& options, GltfPointSink& sink);
+Status streamGltf(const InputFile& input, const GltfReadOptions& options, GltfPointSink& sink);
 
 // Every component of accessor `index` decoded as the spec defines it (normalisation and sparse
 // substitution applied), element after element. For tests and tools that check the decoder.

@@ -64,13 +64,15 @@ namespace {
 Result<PointSet> readByFormat(const std::string& path, FileFormat format, const ReadOptions& options) {
   switch (format) {
     case FileFormat::kCsv:
-      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress});
+      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory});
     case FileFormat::kPly:
-      return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only});
+      return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
+                                          options.max_memory});
     case FileFormat::kGlb:
     case FileFormat::kGltf: {
       GltfReadOptions gltf;
       gltf.allow_nonfinite = options.allow_nonfinite;
+      gltf.max_memory = options.max_memory;
       return readGltf(path, gltf);
     }
     case FileFormat::kLas:

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "core/interrupt.h"
+
 namespace dpoint {
 namespace {
 
@@ -43,11 +45,15 @@ AtomicFile::AtomicFile(AtomicFile&& other) noexcept
 
 AtomicFile::~AtomicFile() {
   if (fd_ >= 0) ::close(fd_);
-  if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
+  if (!committed_ && !temp_path_.empty()) {
+    ::unlink(temp_path_.c_str());
+    unregisterTemporaryFile(temp_path_);
+  }
 }
 
 Result<AtomicFile> AtomicFile::create(const std::string& path) {
   if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
+  if (interrupted()) return interruptedError();
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {
     if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
@@ -73,6 +79,7 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
   std::string temp = path + ".dpoint-XXXXXX";
   fd = ::mkstemp(temp.data());
   if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
+  registerTemporaryFile(temp);  // removed by the interrupt watcher if it must end the process
   ::fchmod(fd, 0644);
   return AtomicFile(path, temp, fd, false);
 }
@@ -99,6 +106,8 @@ Status AtomicFile::flush() {
 
 Status AtomicFile::write(const void* data, size_t size) {
   assert(fd_ >= 0 && !committed_);
+  // Every writer comes through here: an interrupted run stops writing and its output is discarded.
+  if (interrupted()) return interruptedError();
   if (buffer_.size() + size > kBufferSize) {
     if (Status s = flush(); !s) return s;
   }
@@ -109,6 +118,7 @@ Status AtomicFile::write(const void* data, size_t size) {
 
 Status AtomicFile::commit() {
   assert(fd_ >= 0 && !committed_);
+  if (interrupted()) return interruptedError();
   if (Status s = flush(); !s) return s;
   if (direct_) {
     ::close(fd_);
@@ -122,9 +132,12 @@ Status AtomicFile::commit() {
     // linkat alone would fail on an existing target).
     named = path_ + ".dpoint-" + std::to_string(::getpid());
     ::unlink(named.c_str());
+    registerTemporaryFile(named);
     const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
-    if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, named.c_str(), AT_SYMLINK_FOLLOW) != 0)
+    if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, named.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      unregisterTemporaryFile(named);
       return ioError("cannot create", named, errno);
+    }
     temp_path_ = named;
   }
   if (::close(fd_) != 0) {
@@ -134,6 +147,7 @@ Status AtomicFile::commit() {
   fd_ = -1;
   if (::rename(named.c_str(), path_.c_str()) != 0) return ioError("cannot rename into", path_, errno);
   committed_ = true;
+  unregisterTemporaryFile(named);
   temp_path_.clear();
   return okStatus();
 }

@@ -5,6 +5,10 @@
 // commit) or a killed one (SIGKILL: the kernel frees the unnamed inode) leaves nothing behind.
 // Where the file system lacks O_TMPFILE, a named temporary beside the target is used and removed
 // on failure. Targets that are not regular files (/dev/null, a pipe) are written directly.
+// SIGINT/SIGTERM (core/interrupt.h): create, write and commit fail once interrupted, and named
+// temporaries are registered so that a forced exit removes them too. SIGKILL can leave a named
+// temporary (PATH.dpoint-XXXXXX without O_TMPFILE, or PATH.dpoint-PID in the instant between
+// commit's link and rename), never a file at PATH.
 #pragma once
 
 #include <string>

@@ -3,7 +3,8 @@
 // Reading: LF or CRLF line ends, an optional UTF-8 BOM, spaces or tabs around fields, blank lines
 // skipped. Numbers are parsed correctly rounded (fast_float): positions to double, colours to
 // float. The file is read in blocks on all cores; every row goes to its preassigned index, so the
-// result is the same for any thread count. Memory: the PointSet plus one block per thread.
+// result is the same for any thread count. Memory: the PointSet plus one block per thread; the
+// set's size (from the line count) is checked against max_memory before it is allocated.
 // Errors name the file, line, column and the bad text; the first error by line wins.
 //
 // Writing: doubles in shortest round-trip form (std::to_chars), or with `decimals` fixed digits
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "core/input_file.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -27,6 +29,7 @@ struct CsvReadOptions {
   unsigned threads = 0;          // 0: all cores
   bool allow_nonfinite = false;  // accept nan/inf values instead of rejecting them
   Progress* progress = nullptr;
+  uint64_t max_memory = 0;       // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
 };
 
 struct CsvWriteOptions {
@@ -36,6 +39,8 @@ struct CsvWriteOptions {
 };
 
 Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options = {});
+// The same from an opened file, or from bytes in memory (InputFile::fromMemory).
+Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = {});
 
 // Writes atomically (AtomicFile). Header `x,y` when the set is planar (every z is +0.0),
 // else `x,y,z`; `,r,g,b` when it has colours. Triangles are not stored in CSV.

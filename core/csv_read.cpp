@@ -16,6 +16,7 @@
 
 #include "core/csv.h"
 #include "core/input_file.h"
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
 
@@ -257,7 +258,11 @@ Result<Header> readHeader(const InputFile& file) {
 Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options) {
   Result<InputFile> opened = InputFile::open(path);
   if (!opened) return opened.error();
-  const InputFile& file = *opened;
+  return readCsv(*opened, options);
+}
+
+Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
+  const std::string& path = file.path();
   if (file.size() == 0) return Error{path + ": empty file"};
   Result<Header> header_result = readHeader(file);
   if (!header_result) return header_result.error();
@@ -275,9 +280,10 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options)
     std::vector<std::vector<char>> buffers(threads);
     parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
       std::vector<char>& buffer = buffers[worker];
-      buffer.resize(kBlockSize);
       uint64_t offset = begin + b * kBlockSize;
-      Result<size_t> got = file.readAt(offset, buffer.data(), static_cast<size_t>(std::min<uint64_t>(kBlockSize, size - offset)));
+      // The block's own length: a small file costs a small buffer, not a zeroed 8 MiB one.
+      buffer.resize(static_cast<size_t>(std::min<uint64_t>(kBlockSize, size - offset)));
+      Result<size_t> got = file.readAt(offset, buffer.data(), buffer.size());
       if (!got) {
         io_errors[b] = got.error();
         return;
@@ -296,6 +302,11 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options)
   const uint64_t lines = newlines[blocks] + (last_byte != '\n' ? 1 : 0);
 
   const Layout layout = header.layout;
+  // Every line may be a row: a file of short lines (or of blank ones) asks for 24-36 bytes of
+  // point set per 2-4 bytes of file, so the arrays are checked before they are made.
+  const uint64_t row_bytes = sizeof(glm::dvec3) + (hasColorColumns(layout) ? sizeof(glm::vec3) : 0);
+  if (Status s = checkMemory(path + ": " + std::to_string(lines) + " lines", lines * row_bytes, options.max_memory); !s)
+    return s.error();
   PointSet points;
   points.positions.resize(lines);
   if (hasColorColumns(layout)) points.colors.resize(lines);

@@ -4,8 +4,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+
+#include "core/interrupt.h"
 
 namespace dpoint {
 
@@ -21,11 +24,25 @@ Result<InputFile> InputFile::open(const std::string& path) {
   return InputFile(path, fd, S_ISREG(st.st_mode) ? static_cast<uint64_t>(st.st_size) : 0);
 }
 
+InputFile InputFile::fromMemory(std::string name, std::string_view bytes) {
+  // A non-null pointer even for no bytes: inMemory() tells the two kinds apart.
+  static const char kEmpty = 0;
+  return InputFile(std::move(name), -1, bytes.size(), bytes.empty() ? &kEmpty : bytes.data());
+}
+
 InputFile::~InputFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
 Result<size_t> InputFile::readAt(uint64_t offset, void* data, size_t size) const {
+  // Every reader comes through here: an interrupted run stops reading (core/interrupt.h).
+  if (interrupted()) return interruptedError();
+  if (memory_) {
+    if (offset >= size_) return size_t{0};
+    const size_t n = static_cast<size_t>(std::min<uint64_t>(size, size_ - offset));
+    std::memcpy(data, memory_ + offset, n);
+    return n;
+  }
   size_t total = 0;
   char* out = static_cast<char*>(data);
   while (total < size) {

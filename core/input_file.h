@@ -1,8 +1,10 @@
 // Opening an input file with the checks every reader needs: exists, is a regular file, readable.
+// Readers take an InputFile, so the same code reads a file or bytes in memory (the fuzz targets).
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "core/result.h"
 
@@ -13,8 +15,12 @@ class InputFile {
   // Fails with a message naming the path when it does not exist, is a folder or cannot be read.
   // An empty file is not an error here; readers decide what empty means.
   static Result<InputFile> open(const std::string& path);
+  // `bytes` read as if they were a file named `name` (which names it in errors); no file is
+  // opened. The bytes must outlive the InputFile.
+  static InputFile fromMemory(std::string name, std::string_view bytes);
 
-  InputFile(InputFile&& other) noexcept : path_(std::move(other.path_)), fd_(other.fd_), size_(other.size_) {
+  InputFile(InputFile&& other) noexcept
+      : path_(std::move(other.path_)), fd_(other.fd_), size_(other.size_), memory_(other.memory_) {
     other.fd_ = -1;
   }
   InputFile(const InputFile&) = delete;
@@ -23,15 +29,20 @@ class InputFile {
 
   const std::string& path() const { return path_; }
   uint64_t size() const { return size_; }
+  // True for fromMemory: there is no folder beside it to read other files from.
+  bool inMemory() const { return memory_ != nullptr; }
   // Reads up to `size` bytes at `offset` (pread, safe from several threads). Returns bytes read,
-  // fewer only at the end of the file; an I/O error is an Error naming the file.
+  // fewer only at the end of the file; an I/O error is an Error naming the file, and so is an
+  // interrupt (interruptedError, core/interrupt.h).
   Result<size_t> readAt(uint64_t offset, void* data, size_t size) const;
 
  private:
-  InputFile(std::string path, int fd, uint64_t size) : path_(std::move(path)), fd_(fd), size_(size) {}
+  InputFile(std::string path, int fd, uint64_t size, const char* memory = nullptr)
+      : path_(std::move(path)), fd_(fd), size_(size), memory_(memory) {}
   std::string path_;
   int fd_ = -1;
   uint64_t size_ = 0;
+  const char* memory_ = nullptr;  // fromMemory: the bytes (fd_ is -1)
 };
 
 }  // namespace dpoint

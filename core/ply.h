@@ -9,7 +9,9 @@
 //
 // Binary vertices without list properties (the usual case) are decoded in blocks on all cores,
 // each row into its preassigned index, so the result is the same for any thread count. Memory:
-// the PointSet plus one block per thread. ASCII data and faces are read on one thread.
+// the PointSet plus one block per thread. ASCII data and faces are read on one thread. The
+// header's counts are checked against the data that follows it and against max_memory before
+// anything is allocated, and the triangles of the faces against max_memory as they are made.
 //
 // Writing: `double x,y,z`, colours as `uchar` (default, read by every tool) or `float`,
 // and `face` lists of three `uint` indices for meshes.
@@ -18,6 +20,7 @@
 #include <memory>
 #include <string>
 
+#include "core/input_file.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -34,6 +37,7 @@ struct PlyReadOptions {
   // The caller wants positions and colours only (a renderer): reading stops after the vertex
   // element, so faces and any later element are neither read nor checked.
   bool points_only = false;
+  uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
 };
 
 struct PlyWriteOptions {
@@ -43,6 +47,8 @@ struct PlyWriteOptions {
 };
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});
+// The same from an opened file, or from bytes in memory (InputFile::fromMemory).
+Result<PointSet> readPly(const InputFile& file, const PlyReadOptions& options = {});
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options = {});
 
 // The vertices of a binary PLY file a range at a time, for a renderer drawing a file larger than

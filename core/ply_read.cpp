@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "core/input_file.h"
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
 
@@ -524,7 +525,11 @@ class PlyParser {
                      "' rows, needing at least " + (overflow ? "2^64" : std::to_string(needed)) +
                      " bytes of data, but only " + std::to_string(data_bytes) + " follow the header"};
     }
-    return okStatus();
+    // What the data bounds may still be more than memory: 24-36 bytes of point set per vertex
+    // from as little as 3 bytes of file.
+    memory_limit_ = options_.max_memory ? options_.max_memory : defaultMemoryLimit();
+    vertex_bytes_ = vertex_count_ * (sizeof(glm::dvec3) + (has_colors_ ? sizeof(glm::vec3) : 0));
+    return checkMemory(path_ + ": " + std::to_string(vertex_count_) + " vertices", vertex_bytes_, memory_limit_);
   }
 
   Status readElement(const Element& e, const std::vector<Role>& roles) {
@@ -551,7 +556,8 @@ class PlyParser {
       for (size_t k = 0; k < e.properties.size(); ++k)
         if (roles[k] == kIndices && !ascii_)
           min_face = typeSize(e.properties[k].count_type) + 3 * typeSize(e.properties[k].type);
-      points_.triangles.reserve(3 * std::min(e.count, in_.remaining() / min_face));
+      const uint64_t room = (memory_limit_ - vertex_bytes_) / (3 * sizeof(uint32_t));  // checkSizes: ≥ 0
+      points_.triangles.reserve(3 * std::min({e.count, in_.remaining() / min_face, room}));
     }
     for (uint64_t row = 0; row < e.count; ++row) {
       uint64_t where = 0;
@@ -787,6 +793,12 @@ class PlyParser {
         return dataError(where, "face " + std::to_string(row) + ": vertex index " +
                                     std::to_string(static_cast<int64_t>(index)) + " out of range (the file has " +
                                     std::to_string(vertex_count_) + " vertices)");
+    // A face of n indices (1 byte each, at least) becomes 3(n - 2) of 4 bytes: checked as it grows.
+    const uint64_t triangle_bytes = (points_.triangles.size() + 3 * (polygon_.size() - 2)) * sizeof(uint32_t);
+    if (vertex_bytes_ + triangle_bytes > memory_limit_)
+      return checkMemory(path_ + ": face " + std::to_string(row) + ": the faces' triangles",
+                         vertex_bytes_ + triangle_bytes, memory_limit_)
+          .error();
     for (size_t i = 1; i + 1 < polygon_.size(); ++i)
       for (double index : {polygon_[0], polygon_[i], polygon_[i + 1]})
         points_.triangles.push_back(static_cast<uint32_t>(index));
@@ -819,6 +831,8 @@ class PlyParser {
   bool has_colors_ = false;
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;
+  uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)
+  uint64_t vertex_bytes_ = 0;  // what the vertices take in the point set
   uint64_t line_no_ = 0;  // the last line read (header, then ASCII data)
   double values_[kRoleCount] = {};
   std::vector<double> polygon_;  // indices of the current face (exact in double)
@@ -832,7 +846,11 @@ class PlyParser {
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options) {
   auto file = InputFile::open(path);
   if (!file.ok()) return file.error();
-  PlyParser parser(*file, options);
+  return readPly(*file, options);
+}
+
+Result<PointSet> readPly(const InputFile& file, const PlyReadOptions& options) {
+  PlyParser parser(file, options);
   return parser.run();
 }
 

@@ -15,6 +15,8 @@ enum class ExitCode : int {
   kBadInput = 2,
   kNoDevice = 3,
   kResourceLimit = 4,
+  kInterrupted = 130,  // SIGINT (128 + 2), as shells report it
+  kTerminated = 143,   // SIGTERM (128 + 15)
 };
 
 struct Error {

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "core/atomic_file.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "generators/marching_cubes.h"
@@ -335,9 +336,10 @@ class SlabField {
 }  // namespace
 
 Status validateEscapeParams(int resolution, int max_iter, double lo, double hi, double level) {
+  // Too large is a resource limit (exit 4), like the memory estimate it would otherwise fail.
   if (resolution < 2 || resolution > kMaxGridResolution)
     return Error{"--resolution: " + std::to_string(resolution) + " is outside 2.." + std::to_string(kMaxGridResolution),
-                 ExitCode::kUsage};
+                 resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
   if (max_iter < 1 || max_iter > kMaxEscapeIterations)
     return Error{"--max-iter: " + std::to_string(max_iter) + " is outside 1.." + std::to_string(kMaxEscapeIterations),
                  ExitCode::kUsage};
@@ -482,6 +484,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       callbacks.edge_vertex = [&](int p, int j, int k, int axis) { return field.vertex(p, j, k, axis); };
       callbacks.plane_done = [&](int p) {
         if (p > first && params.progress) params.progress->advance(1);
+        // An interrupt stops every slab at its next plane; nothing more is committed.
+        if (interrupted()) failed = true;
         return !failed.load(std::memory_order_relaxed);
       };
       result.mesh = marchingCubesSlab(res, res, first, last, owns_last, callbacks, seam);
@@ -498,6 +502,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     if (std::optional<Error> e = blocks->error(); e && !failure) failure = std::move(e);
   }
   if (params.progress) params.progress->finish();
+  if (interrupted()) return interruptedError();
   if (failure) return *failure;
   if (grid_file)
     if (Status s = grid_file->commit(); !s) return s.error();

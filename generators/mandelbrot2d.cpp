@@ -30,6 +30,7 @@
 
 #include <glm/vec2.hpp>
 
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "generators/escape_grid.h"
@@ -311,10 +312,11 @@ Reference chooseReference(const Mandelbrot2dParams& p) {
 }
 
 Status validate(const Mandelbrot2dParams& p) {
+  // Too large is a resource limit (exit 4), like the memory estimate it would otherwise fail.
   if (p.resolution < 2 || p.resolution > kMaxResolution)
     return Error{"--resolution must be in [2, " + std::to_string(kMaxResolution) + "], got " +
                      std::to_string(p.resolution),
-                 ExitCode::kUsage};
+                 p.resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
   if (p.max_iter < 1)
     return Error{"--max-iter must be at least 1, got " + std::to_string(p.max_iter), ExitCode::kUsage};
   if (!p.grid_out.empty() && p.max_iter > kMaxEscapeIterations)
@@ -363,6 +365,7 @@ Status computeCounts(const Mandelbrot2dParams& p, size_t first_row, size_t rows,
   }
   if (p.progress) p.progress->start("mandelbrot2d", static_cast<uint64_t>(res) * rows);
   parallelFor(rows, p.threads, [&](size_t r, unsigned) {
+    if (interrupted()) return;  // computeCounts returns interruptedError()
     const size_t row = first_row + r;
     const double offset_y = pixelOffset(static_cast<int>(row), p.resolution, spacing);
     uint32_t* out = counts.data() + r * res;
@@ -375,6 +378,7 @@ Status computeCounts(const Mandelbrot2dParams& p, size_t first_row, size_t rows,
     if (p.progress) p.progress->advance(res);
   });
   if (p.progress) p.progress->finish();
+  if (interrupted()) return interruptedError();
   return okStatus();
 }
 

@@ -127,7 +127,7 @@ TEST(GltfInstancing, rejectsShortAccessor) {
   // TRANSLATION claiming more elements than its view holds: the accessor bounds check.
   expectReadError(replaced(instancedGltf(), R"({"bufferView": 1, "componentType": 5126, "count": 3,)",
                            R"({"bufferView": 1, "componentType": 5126, "count": 4,)"),
-                  {"/accessors/1: byteOffset + stride*(count-1) + 12 = 48 exceeds bufferView 1 length 36"});
+                  {"/accessors/1: count 4: byteOffset + stride*(count-1) + 12 = 48 exceeds bufferView 1 length 36"});
 }
 
 TEST(GltfInstancing, rejectsWrongTypes) {

@@ -300,7 +300,7 @@ TEST(Gltf, gltfRejectsAccessorPastBuffer) {
   // Four positions in a 36-byte view that holds three.
   expectReadError(replaced(fixtureGltf(), R"("componentType": 5126, "count": 3)",
                            R"("componentType": 5126, "count": 4)"),
-                  {"/accessors/0: byteOffset + stride*(count-1) + 12 = 48 exceeds bufferView 0 length 36"});
+                  {"/accessors/0: count 4: byteOffset + stride*(count-1) + 12 = 48 exceeds bufferView 0 length 36"});
   // A stride that walks out of the view.
   expectReadError(replaced(fixtureGltf(), R"("byteOffset": 0, "byteLength": 36})",
                            R"("byteOffset": 0, "byteLength": 36, "byteStride": 16})"),

@@ -27,6 +27,7 @@ struct DeviceFacts {
   bool int64_atomics = false;      // shaderInt64 + shaderBufferInt64Atomics: the compute backend
   bool r64g64b64_vertex = false;   // native mode reads double vertex attributes (else pulls)
   uint64_t max_storage_buffer_range = 0, max_memory_allocation = 0;
+  uint32_t max_image_dimension = 0;  // maxImageDimension2D: the raster backend's largest picture side
   float max_point_size = 1.0f;
   uint32_t max_dispatch_groups_x = 0;  // maxComputeWorkGroupCount[0]: caps a compute chunk
   float timestamp_period_ns = 0.0f;  // 0: no timestamps on the graphics queue

@@ -7,6 +7,7 @@
 #include <functional>
 #include <future>
 
+#include "core/interrupt.h"
 #include "viewer/buffers.h"
 #include "viewer/pipelines.h"
 #include "viewer/render_internal.h"
@@ -41,7 +42,7 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
   return static_cast<size_t>(points);
 }
 
-Status checkOptions(const VulkanContext& context, size_t count, const RenderOptions& options) {
+Status checkOptions(const VulkanContext& context, size_t count, const Camera& camera, const RenderOptions& options) {
   if (count == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
   if (count > UINT32_MAX)
     return Error{"more than 2^32 points (" + std::to_string(count) + ") are not supported", ExitCode::kResourceLimit};
@@ -63,6 +64,17 @@ Status checkOptions(const VulkanContext& context, size_t count, const RenderOpti
                        " points exceed " + f.name + "'s maxStorageBufferRange; use --backend raster",
                    ExitCode::kResourceLimit};
   }
+  // The picture's size comes from the command line: refused here rather than by a failed allocation.
+  const uint64_t width = camera.width, height = camera.height;
+  const std::string picture = "a " + std::to_string(width) + "x" + std::to_string(height) + " picture";
+  if (options.backend == Backend::kRaster && std::max(width, height) > f.max_image_dimension)
+    return Error{picture + " is larger than " + f.name + " draws (" + std::to_string(f.max_image_dimension) +
+                     " pixels a side at most)",
+                 ExitCode::kResourceLimit};
+  if (options.backend == Backend::kCompute && 8 * width * height > f.max_storage_buffer_range)
+    return Error{"--backend compute keeps a 64-bit key per pixel in one storage buffer: " + picture + " exceeds " +
+                     f.name + "'s maxStorageBufferRange of " + std::to_string(f.max_storage_buffer_range) + " bytes",
+                 ExitCode::kResourceLimit};
   if (options.mode == PrecisionMode::kNative && options.native_path == NativePath::kAttribute && !f.r64g64b64_vertex)
     return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; native mode must pull positions",
                  ExitCode::kNoDevice};
@@ -290,6 +302,7 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
   VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
 
   for (uint32_t frame = 0; frame < options.warmup_frames + options.frames; ++frame) {
+    if (interrupted()) return interruptedError();  // between frames: the GPU is idle here
     Clock::time_point start = Clock::now();
     VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
@@ -427,6 +440,7 @@ class StreamBlocks {
     if (pending_.valid()) pending_.wait();
   }
   Result<BlockView> get(size_t first, size_t count) {
+    if (interrupted()) return interruptedError();  // between blocks: SIGINT ends a long stream
     const unsigned current = next_;
     Status status = pending_.valid() && pending_first_ == first ? pending_.get() : read(first, count, current);
     if (status) status = addPoints(encoding_, blocks_[current], first);
@@ -475,7 +489,7 @@ Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, 
 
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                   const RenderOptions& options) {
-  Status status = checkOptions(context, points.size(), options);
+  Status status = checkOptions(context, points.size(), camera, options);
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();
@@ -489,7 +503,7 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
 Result<RenderResult> renderStream(const VulkanContext& context, const PointStream& stream, const Camera& camera,
                                   const RenderOptions& options) {
   assert(!options.probe && "the probe keeps every point's clip position: render the set in memory");
-  Status status = checkOptions(context, stream.count, options);
+  Status status = checkOptions(context, stream.count, camera, options);
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();

@@ -1,0 +1,14 @@
+// libFuzzer target `csv`: the CSV reader `dpoint convert IN.csv` runs (core/csv.h), given the
+// input's bytes as a file (InputFile::fromMemory). One thread: inputs are far smaller than a block.
+#include "core/csv.h"
+#include "fuzz/fuzz_support.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace dpoint;
+  const InputFile input = InputFile::fromMemory("fuzz.csv", fuzz::bytesOf(data, size));
+  CsvReadOptions options;
+  options.threads = 1;
+  options.max_memory = fuzz::kMaxMemory;
+  fuzz::checkOutcome(readCsv(input, options), input.path());
+  return 0;
+}

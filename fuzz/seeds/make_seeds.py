@@ -1,0 +1,182 @@
+#!/usr/bin/env python3
+"""Writes the hand-made fuzz seeds in fuzz/seeds/{csv,ply,gltf}/ (committed; rerun to remake them).
+
+Small files, each reaching a path of a reader the other seeds (samples/, ../shared/corpus/,
+assimp-testmodels) may miss. The Draco and meshopt seeds are made from gltf/quantized.glb's
+float twin by gltf-transform (.tools/, scripts/setup) and gltfpack when they are installed.
+"""
+import base64, json, os, struct, subprocess, sys
+
+here = os.path.dirname(os.path.abspath(__file__))
+top = os.path.dirname(os.path.dirname(here))
+
+
+def write(sub, name, data):
+    path = os.path.join(here, sub, name)
+    with open(path, "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+    return path
+
+
+# ---- CSV: every layout, every accepted spelling, and the edge values ----
+write("csv", "xyz.csv", "x,y,z\n1,2,3\n-4.5,6e10,-0\n")
+write("csv", "xyzrgb_crlf_bom.csv", "\ufeffx,y,z,r,g,b\r\n1,2,3,0.5,0.25,1\r\n4,5,6,0,0,0\r\n")
+write("csv", "xy_noheader.csv", "0.1,0.2\n  +3 , -4\t\n\n5,6")
+write("csv", "xyrgb.csv", "x,y,r,g,b\n1,2,0.1,0.2,0.3\n")
+write("csv", "extremes.csv", "x,y,z\n1.7976931348623157e308,4.9e-324,-2.2250738585072014e-308\n"
+      "123456789012345678901234567890,0.000000000000000000001,1e-400\n")
+write("csv", "nonfinite.csv", "x,y,z\nnan,inf,-inf\n")
+
+# ---- PLY: ASCII and binary, every property type, lists, faces, other elements ----
+def ply_header(fmt, elements):
+    lines = ["ply", "format %s 1.0" % fmt, "comment fuzz seed"]
+    for name, count, props in elements:
+        lines.append("element %s %d" % (name, count))
+        lines += ["property " + p for p in props]
+    return "\n".join(lines + ["end_header"]) + "\n"
+
+tetra = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+faces = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
+write("ply", "ascii_faces.ply",
+      ply_header("ascii", [("vertex", 4, ["float x", "float y", "float z", "uchar red", "uchar green", "uchar blue"]),
+                           ("face", 4, ["list uchar int vertex_indices"])]) +
+      "".join("%g %g %g %d 0 255\n" % (p + (i * 60,)) for i, p in enumerate(tetra)) +
+      "".join("3 %d %d %d\n" % f for f in faces))
+write("ply", "ascii_quad_extra_element.ply",
+      ply_header("ascii", [("vertex", 4, ["double x", "double y", "double z", "float nx"]),
+                           ("face", 1, ["list uchar uint vertex_index"]),
+                           ("edge", 1, ["int vertex1", "int vertex2"])]) +
+      "0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n4 0 1 2 3\n0 1\n")
+body = b"".join(struct.pack("<3dBBB", *p, 10, 20, 30) for p in tetra)
+body += b"".join(struct.pack("<B3I", 3, *f) for f in faces)
+write("ply", "binary_double_uchar_faces.ply",
+      ply_header("binary_little_endian", [("vertex", 4, ["double x", "double y", "double z", "uchar red",
+                                                         "uchar green", "uchar blue"]),
+                                          ("face", 4, ["list uchar uint vertex_indices"])]).encode() + body)
+body = b"".join(struct.pack("<hhhfHHH", int(p[0]), int(p[1]), int(p[2]), 0.5, 1, 2, 65535) for p in tetra)
+write("ply", "binary_short_ushort.ply",
+      ply_header("binary_little_endian", [("vertex", 4, ["short x", "short y", "short z", "float confidence",
+                                                         "ushort red", "ushort green", "ushort blue"])]).encode() + body)
+body = b"".join(struct.pack("<B", 2) + struct.pack("<2f", 0.5, 0.5) + struct.pack("<3f", *p) for p in tetra)
+write("ply", "binary_vertex_with_list.ply",
+      ply_header("binary_little_endian", [("vertex", 4, ["list uchar float uv", "float x", "float y",
+                                                         "float z"])]).encode() + body)
+write("ply", "empty_vertices.ply", ply_header("ascii", [("vertex", 0, ["float x", "float y", "float z"])]))
+
+# ---- glTF: each accessor form and extension the walker decodes ----
+def data_uri(b):
+    return "data:application/octet-stream;base64," + base64.b64encode(b).decode()
+
+def glb(doc, binary):
+    js = json.dumps(doc, separators=(",", ":")).encode()
+    js += b" " * ((4 - len(js) % 4) % 4)
+    binary += b"\0" * ((4 - len(binary) % 4) % 4)
+    chunks = struct.pack("<II", len(js), 0x4E4F534A) + js
+    if binary:
+        chunks += struct.pack("<II", len(binary), 0x004E4942) + binary
+    return struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks
+
+# Points with unorm8 colours in a data: URI, under a node with T, R, S.
+pos = b"".join(struct.pack("<3f", *p) for p in tetra)
+col = bytes([255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 9, 9, 9, 255])
+points = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0, "translation": [6378137.0, 0, 0], "rotation": [0, 0.7071068, 0, 0.7071068], "scale": [2, 2, 2]}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "mode": 0}]}],
+    "buffers": [{"byteLength": len(pos) + len(col), "uri": data_uri(pos + col)}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(pos)},
+                    {"buffer": 0, "byteOffset": len(pos), "byteLength": len(col)}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                  {"bufferView": 1, "componentType": 5121, "normalized": True, "count": 4, "type": "VEC4"}],
+}
+write("gltf", "points_unorm8_colors.gltf", json.dumps(points, indent=1))
+
+# Sparse accessor over no bufferView, substituted by a second one over zeros, strip and fan modes.
+idx = struct.pack("<2H", 1, 3)
+vals = struct.pack("<6f", 5, 5, 5, -1, -2, -3)
+strip = struct.pack("<6B", 0, 1, 2, 3, 0, 1)
+buf = idx + vals + strip
+sparse = {
+    "asset": {"version": "2.0"}, "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 10, 20, 30, 1]},
+              {"mesh": 1, "children": [2]}, {"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 5, "material": 0}]},
+               {"primitives": [{"attributes": {"POSITION": 0}, "mode": 6}, {"attributes": {"POSITION": 0}, "mode": 1}]}],
+    "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1]}}],
+    "buffers": [{"byteLength": len(buf), "uri": data_uri(buf)}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(idx)},
+                    {"buffer": 0, "byteOffset": len(idx), "byteLength": len(vals)},
+                    {"buffer": 0, "byteOffset": len(idx) + len(vals), "byteLength": len(strip)}],
+    "accessors": [{"componentType": 5126, "count": 4, "type": "VEC3",
+                   "sparse": {"count": 2, "indices": {"bufferView": 0, "componentType": 5123},
+                              "values": {"bufferView": 1}}},
+                  {"bufferView": 2, "componentType": 5121, "count": 6, "type": "SCALAR"}],
+}
+write("gltf", "sparse_strip_fan_lines.gltf", json.dumps(sparse, indent=1))
+
+# KHR_mesh_quantization: normalized short positions (stride 8), unorm16 colours, uint16 indices,
+# placed twice by EXT_mesh_gpu_instancing (float translation, normalized-short rotation).
+qpos = b"".join(struct.pack("<3hh", int(p[0] * 32767), int(p[1] * 32767), int(p[2] * 32767), 0) for p in tetra)
+qcol = b"".join(struct.pack("<3H", 65535, i * 20000, 0) for i in range(4))
+qidx = b"".join(struct.pack("<3H", *f) for f in faces)
+inst_t = struct.pack("<6f", 0, 0, 0, 100, 0, 0)
+inst_r = struct.pack("<8h", 0, 0, 0, 32767, 0, 23170, 0, 23170)
+binary = qpos + qcol + qidx + inst_t + inst_r
+offsets = [0]
+for part in (qpos, qcol, qidx, inst_t):
+    offsets.append(offsets[-1] + len(part))
+quant = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "extensionsUsed": ["KHR_mesh_quantization", "EXT_mesh_gpu_instancing"],
+    "extensionsRequired": ["KHR_mesh_quantization"],
+    "nodes": [{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 3, "ROTATION": 4}}}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}]}],
+    "buffers": [{"byteLength": len(binary)}],
+    "bufferViews": [{"buffer": 0, "byteOffset": offsets[0], "byteLength": len(qpos), "byteStride": 8},
+                    {"buffer": 0, "byteOffset": offsets[1], "byteLength": len(qcol)},
+                    {"buffer": 0, "byteOffset": offsets[2], "byteLength": len(qidx)},
+                    {"buffer": 0, "byteOffset": offsets[3], "byteLength": len(inst_t)},
+                    {"buffer": 0, "byteOffset": offsets[4], "byteLength": len(inst_r)}],
+    "accessors": [{"bufferView": 0, "componentType": 5122, "normalized": True, "count": 4, "type": "VEC3"},
+                  {"bufferView": 1, "componentType": 5123, "normalized": True, "count": 4, "type": "VEC3"},
+                  {"bufferView": 2, "componentType": 5123, "count": 12, "type": "SCALAR"},
+                  {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"},
+                  {"bufferView": 4, "componentType": 5122, "normalized": True, "count": 2, "type": "VEC4"}],
+}
+write("gltf", "quantized_instanced.glb", glb(quant, binary))
+
+# A float triangle mesh, the source of the compressed seeds (not a seed itself).
+fpos = b"".join(struct.pack("<3f", *p) for p in tetra)
+fidx = b"".join(struct.pack("<3I", *f) for f in faces)
+mesh = {
+    "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}]}],
+    "buffers": [{"byteLength": len(fpos) * 2 + len(fidx)}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(fpos)},
+                    {"buffer": 0, "byteOffset": len(fpos), "byteLength": len(fpos)},
+                    {"buffer": 0, "byteOffset": 2 * len(fpos), "byteLength": len(fidx)}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+                  {"bufferView": 2, "componentType": 5125, "count": 12, "type": "SCALAR"}],
+}
+source = os.path.join(os.environ.get("TMPDIR", "/tmp"), "dpoint-fuzz-seed-mesh.glb")
+with open(source, "wb") as f:
+    f.write(glb(mesh, fpos + fpos + fidx))
+
+tool = os.path.join(top, ".tools", "node_modules", ".bin", "gltf-transform")
+made = []
+def run(command, name, options=()):
+    """command + [output] + options; a missing tool leaves the seed out, with a note."""
+    out = os.path.join(here, "gltf", name)
+    try:
+        subprocess.run(list(command) + [out] + list(options), check=True, capture_output=True)
+        made.append(name)
+    except (OSError, subprocess.CalledProcessError) as e:
+        print("make_seeds: could not make %s: %s" % (name, e), file=sys.stderr)
+if os.path.exists(tool):
+    run([tool, "draco", source], "draco_edgebreaker.glb")
+    run([tool, "draco", source], "draco_sequential.glb", ["--method", "sequential", "--quantize-position", "0"])
+run(["gltfpack", "-c", "-i", source, "-o"], "meshopt.glb")
+run(["gltfpack", "-cc", "-noq", "-i", source, "-o"], "meshopt_filters_fallback.glb")
+os.remove(source)
+print("make_seeds: wrote the csv, ply and gltf seeds (compressed: %s)" % (", ".join(made) or "none"))
