@@ -171,6 +171,12 @@ std::string_view nextToken(std::string_view& rest) {
 
 bool isBlank(std::string_view s) { return nextToken(s).empty(); }
 
+// Element and property names go into messages as they are; a control byte in one would break the
+// one-line rule, and no PLY writer makes such a name.
+bool hasControlByte(std::string_view s) {
+  return std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
+
 // A window onto the file, refilled in big blocks.
 class ByteReader {
  public:
@@ -343,6 +349,7 @@ class PlyParser {
         auto r = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
         if (r.ec != std::errc() || r.ptr != w[2].data() + w[2].size())
           return headerError(line_no, "bad element count " + quote(w[2]));
+        if (hasControlByte(w[1])) return headerError(line_no, "element name " + quote(w[1]) + " has a control character");
         e.name = w[1];
         e.line = line_no;
         for (const Element& other : elements_)
@@ -364,6 +371,8 @@ class PlyParser {
         }
         if (prop.is_list && !isInteger(prop.count_type))
           return headerError(line_no, "list count type " + quote(w[2]) + " is not an integer type");
+        if (hasControlByte(w.back()))
+          return headerError(line_no, "property name " + quote(w.back()) + " has a control character");
         prop.name = w.back();
         for (const Property& other : elements_.back().properties)
           if (other.name == prop.name) return headerError(line_no, "second property " + quote(prop.name));
