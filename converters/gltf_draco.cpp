@@ -19,6 +19,7 @@
 #include <memory>
 
 #include "converters/gltf_accessor.h"
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -44,11 +45,7 @@ std::string dracoTypeName(draco::DataType type) {
   return i >= 0 && i < int(std::size(kNames)) ? kNames[i] : "type " + std::to_string(i);
 }
 
-std::string oneLine(std::string text) {
-  for (char& c : text)
-    if (c == '\n' || c == '\r') c = ' ';
-  return text.empty() ? "no reason given" : text;
-}
+std::string oneLine(const std::string& text) { return oneLineText(text, "no reason given"); }
 
 class PrimitiveDecoder {
  public:
@@ -72,7 +69,8 @@ class PrimitiveDecoder {
       Result<size_t> id = integer(attribute_ids, name.c_str(), "/attributes/");
       if (!id) return id.error();
       if (!primitive().attributes.count(name))
-        return fail("/attributes/" + name, "is not an attribute of the primitive (the extension's must be a subset)");
+        return fail("/attributes/" + printableExcerpt(name),
+                    "is not an attribute of the primitive (the extension's must be a subset)");
       listed.emplace_back(name, uint32_t(*id));
     }
     const int mode = primitive().mode;
@@ -136,7 +134,7 @@ class PrimitiveDecoder {
     // Every listed id must exist, also for attributes we do not read: a wrong id is a broken file.
     for (const auto& [name, id] : listed)
       if (!mesh.GetAttributeByUniqueId(id))
-        return fail("/attributes/" + name, "Draco attribute id " + std::to_string(id) + " is not in the decoded data (" +
+        return fail("/attributes/" + printableExcerpt(name), "Draco attribute id " + std::to_string(id) + " is not in the decoded data (" +
                                                std::to_string(mesh.num_attributes()) + " attributes)");
     std::vector<std::pair<std::string, int>> replaced;
     for (const Target& t : targets) {
@@ -177,11 +175,12 @@ class PrimitiveDecoder {
   }
 
   Result<size_t> integer(const tinygltf::Value& object, const char* key, const std::string& prefix = "/") const {
-    if (!object.Has(key)) return fail(prefix + key, "missing");
+    // key may be an attribute name from the file: quoted printably.
+    if (!object.Has(key)) return fail(prefix + printableExcerpt(key), "missing");
     const tinygltf::Value& v = object.Get(key);
     const double d = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
     if (!(d >= 0) || d > 2147483647.0 || d != std::floor(d))
-      return fail(prefix + key, "must be an integer from 0 to 2147483647");
+      return fail(prefix + printableExcerpt(key), "must be an integer from 0 to 2147483647");
     return size_t(d);
   }
 

@@ -16,6 +16,7 @@
 #include "converters/gltf_meshopt.h"
 #include "core/input_file.h"
 #include "core/memory.h"
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -130,7 +131,7 @@ class FieldChecker {
 std::optional<Error> checkUri(const std::string& path, const std::string& pointer, const std::string& uri) {
   if (uri.rfind("data:", 0) == 0) return std::nullopt;
   const auto fail = [&](const std::string& why) {
-    return Error{path + ": " + pointer + ": '" + uri + "' " + why};
+    return Error{path + ": " + pointer + ": '" + printableExcerpt(uri) + "' " + why};
   };
   if (uri.empty() || uri == "." || uri == "..") return fail("is not a file name");
   if (uri.find(':') != std::string::npos) return fail("is not a relative file name (only data: URIs and files beside the model)");
@@ -148,10 +149,10 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
   if (!version || version->kind != JsonValue::Kind::kString)
     return Error{path + ": /asset/version: missing; not a glTF 2.0 file (glTF 1.0 is not supported)"};
   if (version->text.rfind("2.", 0) != 0)
-    return Error{path + ": /asset/version: '" + version->text + "' is not supported; only glTF 2.x"};
+    return Error{path + ": /asset/version: '" + printableExcerpt(version->text) + "' is not supported; only glTF 2.x"};
   if (const JsonValue* min = asset->find("minVersion"); min && min->kind == JsonValue::Kind::kString &&
                                                           min->text != "2.0")
-    return Error{path + ": /asset/minVersion: '" + min->text + "' is newer than glTF 2.0"};
+    return Error{path + ": /asset/minVersion: '" + printableExcerpt(min->text) + "' is newer than glTF 2.0"};
 
   if (const JsonValue* required = root.find("extensionsRequired")) {
     if (required->kind != JsonValue::Kind::kArray) return Error{path + ": /extensionsRequired: must be an array"};
@@ -159,7 +160,7 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
       const JsonValue& name = required->items[i];
       if (name.kind != JsonValue::Kind::kString) return Error{path + ": " + pointerTo("/extensionsRequired", i) + ": must be a string"};
       if (!gltfRequiredExtensionSupported(name.text))
-        return Error{path + ": " + pointerTo("/extensionsRequired", i) + ": requires extension " + name.text +
+        return Error{path + ": " + pointerTo("/extensionsRequired", i) + ": requires extension " + printableExcerpt(name.text) +
                      ", which dpoint does not decode"};
     }
   }
@@ -177,7 +178,7 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
     const JsonValue* instancing = extensions ? extensions->find("EXT_mesh_gpu_instancing") : nullptr;
     if (const JsonValue* attributes = instancing ? instancing->find("attributes") : nullptr)
       for (const auto& [name, value] : attributes->members)
-        check.integer(&value, at + "/extensions/EXT_mesh_gpu_instancing/attributes/" + name, kMaxIndex);
+        check.integer(&value, at + "/extensions/EXT_mesh_gpu_instancing/attributes/" + printableExcerpt(name), kMaxIndex);
   }
   const auto& meshes = *check.objects(root, "meshes");
   for (size_t m = 0; m < meshes.size(); ++m) {
@@ -188,14 +189,16 @@ std::optional<Error> checkDocument(const std::string& path, const JsonValue& roo
       const std::string at = pointerTo(pointerTo("/meshes", m) + "/primitives", p);
       for (const char* key : {"indices", "material", "mode"}) check.index(primitive, key, at);
       if (const JsonValue* attributes = primitive.find("attributes"))
-        for (const auto& [name, value] : attributes->members) check.integer(&value, at + "/attributes/" + name, kMaxIndex);
+        for (const auto& [name, value] : attributes->members)
+          check.integer(&value, at + "/attributes/" + printableExcerpt(name), kMaxIndex);
       // tinygltf keeps extension numbers in int, wrapping larger ones.
       const JsonValue* extensions = primitive.find("extensions");
       if (const JsonValue* draco = extensions ? extensions->find("KHR_draco_mesh_compression") : nullptr) {
         const std::string ext_at = at + "/extensions/KHR_draco_mesh_compression";
         check.index(*draco, "bufferView", ext_at);
         if (const JsonValue* ids = draco->find("attributes"))
-          for (const auto& [name, value] : ids->members) check.integer(&value, ext_at + "/attributes/" + name, kMaxIndex);
+          for (const auto& [name, value] : ids->members)
+            check.integer(&value, ext_at + "/attributes/" + printableExcerpt(name), kMaxIndex);
       }
     }
   }
@@ -283,7 +286,7 @@ std::string noExpansion(const std::string& file, void*) { return file; }
 bool jailedReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
   auto& jail = *static_cast<FolderJail*>(user);
   const auto refuse = [&](const std::string& why) {
-    if (err) *err += "'" + file + "' " + why;
+    if (err) err->append("'").append(printableExcerpt(file)).append("' ").append(why);
     return false;
   };
   if (!allowed(file, jail)) return refuse("is not a regular file inside the model's folder");
@@ -310,11 +313,7 @@ bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int
   return true;
 }
 
-std::string oneLine(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  std::replace(text.begin(), text.end(), '\n', ';');
-  return text.empty() ? "tinygltf gave no reason" : text;
-}
+std::string oneLine(const std::string& text) { return oneLineText(text, "tinygltf gave no reason"); }
 
 struct BinHandOver {
   size_t bin_offset = 0;        // of the BIN chunk's data in the file

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <vector>
 
+#include "core/text.h"
+
 namespace dpoint {
 namespace {
 
@@ -42,12 +44,12 @@ class ViewDecoder {
       if (*stride != 2 && *stride != 4) return fail("/byteStride", std::to_string(*stride) + " is not 2 or 4 (mode " + mode + ")");
       if (mode == "TRIANGLES" && *count % 3 != 0)
         return fail("/count", std::to_string(*count) + " is not a multiple of 3 (mode TRIANGLES)");
-      if (filter != "NONE") return fail("/filter", "'" + filter + "' is only allowed with mode ATTRIBUTES");
+      if (filter != "NONE") return fail("/filter", quotedExcerpt(filter) + " is only allowed with mode ATTRIBUTES");
     } else {
-      return fail("/mode", "'" + mode + "' is not ATTRIBUTES, TRIANGLES or INDICES");
+      return fail("/mode", quotedExcerpt(mode) + " is not ATTRIBUTES, TRIANGLES or INDICES");
     }
     if (filter != "NONE" && filter != "OCTAHEDRAL" && filter != "QUATERNION" && filter != "EXPONENTIAL")
-      return fail("/filter", "'" + filter + "' is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL");
+      return fail("/filter", quotedExcerpt(filter) + " is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL");
     // EXPONENTIAL needs a multiple of 4, which ATTRIBUTES already guarantees.
     if ((filter == "OCTAHEDRAL" && *stride != 4 && *stride != 8) || (filter == "QUATERNION" && *stride != 8))
       return fail("/byteStride", std::to_string(*stride) + " is not allowed with filter " + filter);

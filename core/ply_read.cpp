@@ -21,6 +21,7 @@
 #include <atomic>
 #include <bit>
 #include <cassert>
+#include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -170,6 +171,12 @@ std::string_view nextToken(std::string_view& rest) {
 }
 
 bool isBlank(std::string_view s) { return nextToken(s).empty(); }
+
+// Element and property names go into messages as they are; a control byte in one would break the
+// one-line rule, and no PLY writer makes such a name.
+bool hasControlByte(std::string_view s) {
+  return std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
 
 // A window onto the file, refilled in big blocks.
 class ByteReader {
@@ -417,6 +424,7 @@ class PlyParser {
         auto r = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
         if (r.ec != std::errc() || r.ptr != w[2].data() + w[2].size())
           return headerError(line_no, "bad element count " + quote(w[2]));
+        if (hasControlByte(w[1])) return headerError(line_no, "element name " + quote(w[1]) + " has a control character");
         e.name = w[1];
         e.line = line_no;
         for (const Element& other : elements_)
@@ -438,6 +446,8 @@ class PlyParser {
         }
         if (prop.is_list && !isInteger(prop.count_type))
           return headerError(line_no, "list count type " + quote(w[2]) + " is not an integer type");
+        if (hasControlByte(w.back()))
+          return headerError(line_no, "property name " + quote(w.back()) + " has a control character");
         prop.name = w.back();
         for (const Property& other : elements_.back().properties)
           if (other.name == prop.name) return headerError(line_no, "second property " + quote(prop.name));
@@ -668,7 +678,7 @@ class PlyParser {
       const uint64_t at = row - base;
       if (layout.packed) {
         std::memcpy(&v[kX], p + layout.at[kX], 3 * sizeof(double));
-        if (!acceptable(v)) return row;
+        if (!positionAcceptable(v)) return row;  // uchar colours always are
         positions[at] = glm::dvec3(v[kX], v[kY], v[kZ]);
         if (colors)
           colors[at] = glm::vec3(layout.byte_color[static_cast<uint8_t>(p[layout.at[kRed]])],
@@ -676,7 +686,7 @@ class PlyParser {
                                   layout.byte_color[static_cast<uint8_t>(p[layout.at[kBlue]])]);
       } else {
         layout.load(p, v);
-        if (!acceptable(v)) return row;
+        if (!positionAcceptable(v) || (colors && !colourAcceptable(v))) return row;
         positions[at] = glm::dvec3(v[kX], v[kY], v[kZ]);
         if (colors) colors[at] = colorOf(v);
       }
@@ -759,23 +769,38 @@ class PlyParser {
     return okStatus();
   }
 
-  // Appends the vertex, or returns false for a non-finite position that is not allowed; no Status
-  // here, it is per row.
-  bool acceptable(const double* v) const {
+  // Per row, so no Status: a position must be finite unless allowed, and so must a colour (the
+  // renderer turns colours into bytes; the CSV reader refuses them alike). A double colour must
+  // also fit a float: converting one that does not is undefined.
+  bool positionAcceptable(const double* v) const {
     return options_.allow_nonfinite || (std::isfinite(v[kX]) && std::isfinite(v[kY]) && std::isfinite(v[kZ]));
+  }
+  bool colourChannelAcceptable(double c) const {
+    return std::isfinite(c) ? std::fabs(c) <= double(FLT_MAX) : options_.allow_nonfinite;
+  }
+  bool colourAcceptable(const double* v) const {
+    return colourChannelAcceptable(v[kRed]) && colourChannelAcceptable(v[kGreen]) && colourChannelAcceptable(v[kBlue]);
   }
   glm::vec3 colorOf(const double* v) const {
     return glm::vec3(static_cast<float>(v[kRed]) / divisor_[kRed], static_cast<float>(v[kGreen]) / divisor_[kGreen],
                      static_cast<float>(v[kBlue]) / divisor_[kBlue]);
   }
   bool storeVertex(const double* v) {
-    if (!acceptable(v)) return false;
+    if (!positionAcceptable(v) || (has_colors_ && !colourAcceptable(v))) return false;
     points_.positions.emplace_back(v[kX], v[kY], v[kZ]);
     if (has_colors_) points_.colors.push_back(colorOf(v));
     return true;
   }
 
+  // Why row `row` was not acceptable: the first bad position axis, else the first bad colour.
   Error nonfiniteError(const double* v, uint64_t row, uint64_t where) const {
+    if (positionAcceptable(v)) {
+      static constexpr const char* kChannel[] = {"red", "green", "blue"};
+      int c = kRed;
+      while (c < kBlue && colourChannelAcceptable(v[c])) ++c;
+      return dataError(where, "vertex " + std::to_string(row) + ": " + kChannel[c - kRed] + " is " + numberText(v[c]) +
+                                  (std::isfinite(v[c]) ? ", out of float range" : ", not a finite number"));
+    }
     const double x = v[kX], y = v[kY], z = v[kZ];
     const char axis = std::isfinite(x) ? (std::isfinite(y) ? 'z' : 'y') : 'x';
     const double bad = axis == 'x' ? x : axis == 'y' ? y : z;

@@ -27,6 +27,38 @@ inline std::string printableExcerpt(std::string_view text) {
   return out;
 }
 
+// printableExcerpt in single quotes. (Built by appending: GCC 12 warns falsely on "'" + string,
+// bug 105651.)
+inline std::string quotedExcerpt(std::string_view text) {
+  std::string out = "'";
+  out += printableExcerpt(text);
+  out += '\'';
+  return out;
+}
+
+// A library's own message (tinygltf's, libdraco's) as part of a one-line error: trailing blanks
+// dropped, line ends become "; ", other control bytes \xNN. Not shortened. `empty` when nothing is left.
+inline std::string oneLineText(std::string_view text, std::string_view empty) {
+  static const char kHex[] = "0123456789abcdef";
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.remove_suffix(1);
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == '\n') {
+      out += "; ";
+    } else if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') {
+      continue;
+    } else if (c < 0x20 || c == 0x7f) {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out.empty() ? std::string(empty) : out;
+}
+
 // Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
 std::string formatNumber(double v, bool json = false);
 // A JSON string literal: quotes, with '"', '\\' and control characters escaped.

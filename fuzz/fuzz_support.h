@@ -29,11 +29,13 @@ inline std::string_view bytesOf(const uint8_t* data, size_t size) {
   std::abort();
 }
 
-// One line, naming the input, with the exit code of bad input or of a resource limit.
+// One printable line (bytes from the input quoted as \xNN), naming the input, with the exit code of
+// bad input or of a resource limit.
 inline void checkError(const Error& error, const std::string& name) {
   const std::string& m = error.message;
   if (m.empty()) broken("an error has a message", "empty");
-  if (m.find('\n') != std::string::npos || m.find('\r') != std::string::npos) broken("an error is one line", m);
+  for (char c : m)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) broken("an error is one printable line", m);
   if (m.rfind(name, 0) != 0) broken("an error names the input first", m);
   if (error.code != ExitCode::kBadInput && error.code != ExitCode::kResourceLimit)
     broken("an error exits 2 or 4", std::to_string(static_cast<int>(error.code)) + ": " + m);

@@ -3,7 +3,9 @@
 // ExitCode::kResourceLimit with one line naming the file, the count and --max-memory.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -155,6 +157,27 @@ TEST(Limits, gltfFileBeyondMaxMemoryIsRefusedBeforeLoading) {
   GltfReadOptions options;
   options.max_memory = 1000;
   expectLimit(readGltf(dir.file("a.gltf"), options), dir.file("a.gltf"), {"loading"});
+}
+
+// tests/corpus/ (its README): hostile inputs, fuzz findings among them, each refused with one
+// printable line naming the file (bytes from the file quoted as \xNN), exit 2 or 4.
+TEST(Limits, corpusInputsFailWithOneLineNamingTheFile) {
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(DPOINT_TESTS_DIR "/corpus")) {
+    if (!entry.is_regular_file() || entry.path().filename() == "README.md") continue;
+    const std::string path = entry.path().string();
+    SCOPED_TRACE(path);
+    ++files;
+    Result<PointSet> read = readPoints(path);
+    ASSERT_FALSE(read.ok()) << "read " << read->size() << " points";
+    const Error& e = read.error();
+    EXPECT_TRUE(e.code == ExitCode::kBadInput || e.code == ExitCode::kResourceLimit) << int(e.code) << " " << e.message;
+    EXPECT_EQ(e.message.rfind(path + ":", 0), 0u) << e.message;  // "PATH: " or "PATH:LINE: "
+    EXPECT_TRUE(std::none_of(e.message.begin(), e.message.end(),
+                             [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+        << e.message;
+  }
+  EXPECT_GE(files, 11u);
 }
 
 }  // namespace

@@ -489,6 +489,38 @@ TEST(Ply, plyAcceptsNanWhenAllowed) {
 
 // ---------------------------------------------------------------- failures
 
+// A fuzz finding (tests/corpus/ply/fuzz_float_colour_nan.ply): NaN float colours were read as they
+// were, and the renderer turns colours into bytes. Colours now follow positions: finite unless
+// allowed, and a double colour must fit a float. Binary (multithreaded and serial) and ASCII alike.
+TEST(Ply, plyRejectsNonFiniteColoursAndDoubleColoursPastFloat) {
+  TempDir dir;
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
+                             "property double z\nproperty float red\nproperty double green\nproperty float blue\n"
+                             "end_header\n";
+  auto nan = readText(dir, "nan.ply", header + "0 0 0 0.5 0.5 0.5\n1 1 1 nan 0 0\n");
+  ASSERT_FALSE(nan.ok());
+  EXPECT_NE(nan.error().message.find("line 12: vertex 1: red is nan, not a finite number"), std::string::npos)
+      << nan.error().message;
+  auto huge = readText(dir, "huge.ply", header + "0 0 0 0.5 1e300 0.5\n1 1 1 0 0 0\n");
+  ASSERT_FALSE(huge.ok());
+  EXPECT_NE(huge.error().message.find("vertex 0: green is 1e+300, out of float range"), std::string::npos)
+      << huge.error().message;
+  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                       "property float z\nproperty float red\nproperty float green\nproperty float blue\nend_header\n";
+  const float row[6] = {0, 0, 0, 0.5f, std::numeric_limits<float>::infinity(), 0};
+  binary.append(reinterpret_cast<const char*>(row), sizeof row);
+  auto inf = readText(dir, "inf.ply", binary);
+  ASSERT_FALSE(inf.ok());
+  EXPECT_NE(inf.error().message.find("vertex 0: green is inf, not a finite number"), std::string::npos)
+      << inf.error().message;
+  PlyReadOptions allow;
+  allow.allow_nonfinite = true;
+  auto allowed = readText(dir, "nan.ply", header + "0 0 0 0.5 0.5 0.5\n1 1 1 nan 0 0\n", allow);
+  ASSERT_TRUE(allowed.ok()) << allowed.error().message;
+  EXPECT_TRUE(std::isnan(allowed->colors[1].r));
+  EXPECT_FALSE(readText(dir, "huge.ply", header + "0 0 0 0.5 1e300 0.5\n1 1 1 0 0 0\n", allow).ok());
+}
+
 TEST(Ply, plyRejectsMissingFile) {
   TempDir dir;
   auto r = readPly(dir.file("nope.ply"));
