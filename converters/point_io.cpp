@@ -76,7 +76,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
       return readGltf(path, gltf);
     }
     case FileFormat::kLas:
-      return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color});
+      return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color, options.max_memory});
     case FileFormat::kLaz:
       return lasCompressedError(path);
   }

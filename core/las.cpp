@@ -18,6 +18,7 @@
 
 #include "core/atomic_file.h"
 #include "core/input_file.h"
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
 
@@ -409,7 +410,12 @@ Result<LasHeader> readLasHeader(const std::string& path) {
 Result<PointSet> readLas(const std::string& path, const LasReadOptions& options) {
   Result<InputFile> file = InputFile::open(path);
   if (!file) return file.error();
-  Result<LasHeader> header = parseHeader(*file);
+  return readLas(*file, options);
+}
+
+Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
+  const std::string& path = file.path();
+  Result<LasHeader> header = parseHeader(file);
   if (!header) return header.error();
   const bool rgb = lasFormatHasRgb(header->point_format);
   LasColorSource source = options.color;
@@ -417,7 +423,13 @@ Result<PointSet> readLas(const std::string& path, const LasReadOptions& options)
   if (source == LasColorSource::kRgb && !rgb)
     return Error{path + ": point format " + str(static_cast<uint64_t>(header->point_format)) +
                  " has no RGB colours (formats 2, 3, 5, 7, 8 and 10 have)"};
-  LasReader reader(*file, *header, source, options);
+  // The count is bounded by the file size already; the point set must also fit --max-memory.
+  const uint64_t point_bytes = sizeof(glm::dvec3) + (source == LasColorSource::kNone ? 0 : sizeof(glm::vec3));
+  if (Status fits = checkMemory(path + ": " + str(header->point_count) + " points", header->point_count * point_bytes,
+                                options.max_memory);
+      !fits)
+    return fits.error();
+  LasReader reader(file, *header, source, options);
   return reader.run();
 }
 

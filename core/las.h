@@ -49,6 +49,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/input_file.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -77,6 +78,7 @@ struct LasReadOptions {
   unsigned threads = 0;  // 0: all cores
   Progress* progress = nullptr;
   LasColorSource color = LasColorSource::kAuto;
+  uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
 };
 
 struct LasWriteOptions {
@@ -88,6 +90,8 @@ struct LasWriteOptions {
 // Reads and checks the header only (everything the top comment lists, the file size included).
 Result<LasHeader> readLasHeader(const std::string& path);
 Result<PointSet> readLas(const std::string& path, const LasReadOptions& options = {});
+// The same from an open file (the fuzz target reads bytes as a file, InputFile::fromMemory).
+Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options = {});
 
 // Writes atomically (AtomicFile). Triangles are not stored. Fails (exit 2) on a non-finite
 // position, on a point that does not fit the 32-bit integers at options.scale, and on more than

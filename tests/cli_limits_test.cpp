@@ -83,5 +83,16 @@ TEST(CliLimits, maxMemoryBoundsConvertRenderAndInfo) {
   EXPECT_EQ(test::runDpoint({"convert", dir.file("a.csv"), "-o", dir.file("b.ply"), "--max-memory", "lots"}).exit_code, 1);
 }
 
+// The LAS reader's point set (1,065 points of simple.las: 38 KB with colours) obeys the limit too.
+TEST(CliLimits, maxMemoryBoundsTheLasReader) {
+  TempDir dir;
+  const std::string las = std::string(DPOINT_CORPUS_DIR) + "/las/simple.las";
+  test::CommandResult r = test::runDpoint({"convert", las, "-o", dir.file("out.csv"), "--max-memory", "20K"});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("1065 points"), std::string::npos) << r.err;
+  EXPECT_FALSE(test::fileExists(dir.file("out.csv")));
+  EXPECT_EQ(test::runDpoint({"convert", las, "-o", dir.file("out.csv"), "--max-memory", "64K"}).exit_code, 0);
+}
+
 }  // namespace
 }  // namespace dpoint

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the hand-made fuzz seeds in fuzz/seeds/{csv,ply,gltf}/ (committed; rerun to remake them).
+"""Writes the hand-made fuzz seeds in fuzz/seeds/{csv,ply,gltf,las}/ (committed; rerun to remake them).
 
 Small files, each reaching a path of a reader the other seeds (samples/, ../shared/corpus/,
 assimp-testmodels) may miss. The Draco and meshopt seeds are made from gltf/quantized.glb's
@@ -26,6 +26,63 @@ write("csv", "xyrgb.csv", "x,y,r,g,b\n1,2,0.1,0.2,0.3\n")
 write("csv", "extremes.csv", "x,y,z\n1.7976931348623157e308,4.9e-324,-2.2250738585072014e-308\n"
       "123456789012345678901234567890,0.000000000000000000001,1e-400\n")
 write("csv", "nonfinite.csv", "x,y,z\nnan,inf,-inf\n")
+
+# ---- LAS: every header size, a point format of each record layout, VLRs, EVLRs, extra bytes ----
+LAS_BASE = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67]
+LAS_RGB_AT = [0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30]
+
+def las(minor, fmt, points, extra=0, vlrs=0, evlrs=0, colours=None):
+    """A LAS 1.minor file of point format fmt: `points` are integer (X, Y, Z), scale 0.01, offset
+    (500000, 4000000, 100) (UTM-like); `extra` bytes after each record; `vlrs` VLRs of 8 bytes
+    of payload before the points, `evlrs` EVLRs after them (1.4)."""
+    header_size = {0: 227, 1: 227, 2: 227, 3: 235, 4: 375}[minor]
+    vlr = b"".join(struct.pack("<H16sHH32s", 0, b"dpoint_seed", 1000 + i, 8, b"seed vlr") + b"\x01" * 8
+                   for i in range(vlrs))
+    length = LAS_BASE[fmt] + extra
+    records = b""
+    for k, (x, y, z) in enumerate(points):
+        r = bytearray(length)
+        struct.pack_into("<iiiH", r, 0, x, y, z, 1000 * (k + 1))
+        if fmt >= 6:
+            r[14] = 0x11           # return 1 of 1
+            r[16] = 2 + k % 5      # classification
+        else:
+            r[14] = 0x09
+            r[15] = 2 + k % 5
+        if colours:
+            struct.pack_into("<3H", r, LAS_RGB_AT[fmt], *colours[k % len(colours)])
+        records += bytes(r)
+    offset = header_size + len(vlr)
+    h = bytearray(header_size)
+    h[0:4] = b"LASF"
+    h[24], h[25] = 1, minor
+    h[26:58] = b"dpoint fuzz seed".ljust(32, b"\0")
+    h[58:90] = b"make_seeds.py".ljust(32, b"\0")
+    struct.pack_into("<HIIBHI", h, 94, header_size, offset, vlrs, fmt, length, len(points) if fmt < 6 else 0)
+    scale, origin = (0.01, 0.01, 0.01), (500000.0, 4000000.0, 100.0)
+    struct.pack_into("<3d3d", h, 131, *scale, *origin)
+    xs = [[p[a] * scale[a] + origin[a] for p in points] for a in range(3)]
+    for a in range(3):
+        struct.pack_into("<2d", h, 179 + 16 * a, max(xs[a], default=0.0), min(xs[a], default=0.0))
+    evlr = b"".join(struct.pack("<H16sHQ32s", 0, b"dpoint_seed", 2000 + i, 4, b"seed evlr") + b"\x02" * 4
+                    for i in range(evlrs))
+    if minor == 4:
+        start = offset + len(records)
+        struct.pack_into("<QQIQ", h, 227, 0, start if evlrs else 0, evlrs, len(points))
+    return bytes(h) + vlr + records + evlr
+
+grid = [(x * 100, y * 100, (x + y) * 10) for x in range(3) for y in range(3)]
+write("las", "v1_0_format0.las", las(0, 0, grid[:4]))
+write("las", "v1_2_format1_vlr.las", las(2, 1, grid, vlrs=2))
+write("las", "v1_2_format2_8bit_colours.las", las(2, 2, grid, colours=[(255, 0, 0), (0, 128, 255)]))
+write("las", "v1_3_format3_16bit_colours.las", las(3, 3, grid, colours=[(65535, 0, 30000)]))
+write("las", "v1_3_format4_extra.las", las(3, 4, grid[:2], extra=3))
+write("las", "v1_4_format6_evlr.las", las(4, 6, grid, vlrs=1, evlrs=1))
+write("las", "v1_4_format7_extra.las", las(4, 7, grid, extra=5, colours=[(1, 2, 3), (300, 200, 100)]))
+write("las", "v1_4_format10.las", las(4, 10, grid[:3], colours=[(40000, 20000, 0)]))
+one = las(2, 0, grid[:1])
+write("las", "laz_flag.las", one[:104] + bytes([0x80]) + one[105:])  # format 0 with LAZ's bit 7
+write("las", "empty_v1_2.las", las(2, 0, []))
 
 # ---- PLY: ASCII and binary, every property type, lists, faces, other elements ----
 def ply_header(fmt, elements):
@@ -179,4 +236,4 @@ if os.path.exists(tool):
 run(["gltfpack", "-c", "-i", source, "-o"], "meshopt.glb")
 run(["gltfpack", "-cc", "-noq", "-i", source, "-o"], "meshopt_filters_fallback.glb")
 os.remove(source)
-print("make_seeds: wrote the csv, ply and gltf seeds (compressed: %s)" % (", ".join(made) or "none"))
+print("make_seeds: wrote the csv, ply, gltf and las seeds (compressed: %s)" % (", ".join(made) or "none"))
