@@ -8,11 +8,12 @@
 #                 layer on), then --grid-out and output files of each kind, CPU path against
 #                 --device 0 --validate, at small odd and even resolutions
 #   generate.tsv  one line per case and path: wall time, peak RSS, output SHA-256; CPU (--device
-#                 none, all cores) against the GPU (--device 0), REPEATS (1) runs each, median
-#   tiles.tsv     TILES (8) tiles of mandelbulb res TILE_RES (2048) spread over the GPUs (tile I on
-#                 --device I mod GPUS, GPUS at a time) + dpoint merge, against the single GPU run:
-#                 wall, peak RSS and SHA-256 of the merged file
-# Env: BIN (default .gpu/dpoint), CASES (a subset of the case names below), REPEATS, TILES,
+#                 none, all cores) against the GPU (--device 0) at --counts capped and full
+#                 (PATHS), REPEATS (1) runs each, median
+#   tiles.tsv     TILES (8; 0: none) tiles of mandelbulb res TILE_RES (2048) spread over the GPUs
+#                 (tile I on --device I mod GPUS, GPUS at a time) + dpoint merge, then the single
+#                 GPU run (SINGLE=0: not): wall, peak RSS and SHA-256 of the merged file, its counts
+# Env: BIN (default .gpu/dpoint), CASES (a subset of the case names below), PATHS, REPEATS, TILES (0: none),
 # TILE_RES, GPUS (default: nvidia-smi's count), DATA (scratch, default /tmp/dpoint-generate).
 set -euo pipefail
 source bench/gpu_env.sh
@@ -23,8 +24,8 @@ gpus=${GPUS:-$(nvidia-smi -L | wc -l)}
 mkdir -p "$data"
 "$d" devices | tee "$out/devices.txt"
 
-# --- equality on the real driver ---
-{
+# --- equality on the real driver (EQUAL=0 skips it) ---
+[ "${EQUAL:-1}" = 0 ] || {
   if [ -x .gpu/viewer_tests ]; then
     .gpu/viewer_tests --gtest_filter='GpuGenerate*' 2>&1 | tail -12
   else
@@ -57,7 +58,7 @@ median() { printf '%s\n' "$@" | sort -n | awk '{ a[NR] = $0 } END { print a[int(
 
 results=$out/generate.tsv
 printf 'case\targs\tpath\twall_s\tpeak_mb\tsha256_16\tgpu_ms\tgpu_points_per_s\n' >"$results"
-for name in ${CASES:-bulb1024 bulb2048 julia1024 zoom4096}; do
+for name in ${CASES-bulb1024 bulb2048 julia1024 zoom4096}; do  # CASES= (empty): none
   case $name in
     bulb1024) args="mandelbulb --variant fast --resolution 1024" ;;
     bulb2048) args="mandelbulb --variant fast --resolution 2048" ;;
@@ -65,21 +66,28 @@ for name in ${CASES:-bulb1024 bulb2048 julia1024 zoom4096}; do
     zoom4096) args="mandelbrot2d --resolution 4096 --width 1e-12 --max-iter 5000" ;;
     *) echo "unknown case $name" >&2; exit 1 ;;
   esac
-  for path in none 0; do
+  # none: the CPU path; DEVICE:COUNTS: the GPU at that --counts (capped: the classification stops
+  # past the level and the CPU finishes the points near the surface; full: every count on the GPU).
+  for path in ${PATHS:-none 0:capped 0:full}; do
+    device=${path%%:*} counts=${path#*:}
+    extra=(--counts "$counts") label="gpu $counts"
+    [ "$device" = none ] && extra=() label=cpu
+    if [[ $args == mandelbrot2d* ]] && [ "$device" != none ]; then  # no --counts: one GPU run
+      [ "$counts" = capped ] || continue
+      extra=() label=gpu
+    fi
     runs=()
     # shellcheck disable=SC2086
-    for ((r = 0; r < repeats; ++r)); do runs+=("$(timed generate $args --device $path)"); done
-    printf '%s\t%s\t%s\t%s\n' "$name" "$args" "$([ $path = none ] && echo cpu || echo gpu)" "$(median "${runs[@]}")" |
-      tee -a "$results"
+    for ((r = 0; r < repeats; ++r)); do runs+=("$(timed generate $args --device $device "${extra[@]}")"); done
+    printf '%s\t%s\t%s\t%s\n' "$name" "$args" "$label" "$(median "${runs[@]}")" | tee -a "$results"
   done
 done
 
 # --- tiles over the GPUs of the host ---
+[ "${TILES:-8}" = 0 ] && exit 0
 tiles=${TILES:-8}
 args="mandelbulb --variant fast --resolution ${TILE_RES:-2048}"
 printf 'run\twall_s\tpeak_mb\tsha256_16\tgpu_ms\tgpu_points_per_s\n' >"$out/tiles.tsv"
-# shellcheck disable=SC2086
-printf 'single process, --device 0\t%s\n' "$(timed generate $args --device 0)" | tee -a "$out/tiles.tsv"
 rm -f "$data"/part-*.ply "$data"/peak-*.txt
 start=$(date +%s.%N)
 # shellcheck disable=SC2016,SC2086
@@ -95,4 +103,12 @@ printf '%s tiles on %s GPU(s)\t%.2f\t%.0f\t-\n' "$tiles" "$gpus" "$(awk -v a="$s
 printf 'merge\t%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
   "$(sha256sum <"$data/merged.ply" | cut -c1-16)" | tee -a "$out/tiles.tsv"
 printf 'tiles + merge\t%.2f\t-\t-\n' "$(awk -v a="$start" -v b="$end" 'BEGIN { print b - a }')" | tee -a "$out/tiles.tsv"
+# The merged file's size and counts, from its header.
+printf '# merged: %s bytes; %s\n' "$(stat -c %s "$data/merged.ply")" \
+  "$(head -c 1000 "$data/merged.ply" | grep -a '^element' | tr '\n' ' ')" | tee -a "$out/tiles.tsv"
 rm -f "$data"/part-*.ply "$data/merged.ply"
+# The same grid in one process on one GPU, for the wall time and the checksum (SINGLE=0 skips it).
+if [ "${SINGLE:-1}" != 0 ]; then
+  # shellcheck disable=SC2086
+  printf 'single process, --device 0\t%s\n' "$(timed generate $args --device 0)" | tee -a "$out/tiles.tsv"
+fi

@@ -16,6 +16,22 @@ void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options,
                    "With a device: enable the Khronos validation layer; any message fails the run");
 }
 
+void addEscapeCountsOption(CLI::App& command, GenerateDeviceOptions& options) {
+  command
+      .add_option("--counts", options.counts,
+                  "How far the classification iterates: capped (just past the level; the points near the surface\n"
+                  "are then finished to --max-iter on the CPU), full (every point to --max-iter), auto (full on\n"
+                  "a GPU, capped on the CPU and on lavapipe). The output is the same bit for bit")
+      ->check(CLI::IsMember({"auto", "capped", "full"}))
+      ->default_val("auto");
+}
+
+bool fullCounts(const GenerateDeviceOptions& options, const GenerateDevice* device) {
+  return options.counts == "full" || (options.counts == "auto" && device && device->isGpu());
+}
+
+bool GenerateDevice::isGpu() const { return context_->facts.type != "cpu"; }
+
 Result<std::shared_ptr<GenerateDevice>> GenerateDevice::open(const GenerateDeviceOptions& options,
                                                             const std::string& what, const std::string& cpu_only,
                                                             bool quiet) {
@@ -58,9 +74,11 @@ Result<std::shared_ptr<GenerateDevice>> GenerateDevice::open(const GenerateDevic
 
 GenerateDevice::~GenerateDevice() {
   if (quiet_ || !gpu_ || gpu_->pointsDone() == 0 || !(gpu_->gpuMs() > 0.0)) return;
-  std::fprintf(stderr, "dpoint: escape counts of %llu points in %.1f ms of GPU time (%.3g points/s)\n",
+  std::fprintf(stderr,
+               "dpoint: escape counts of %llu points in %.1f ms of GPU time (%.3g points/s); the host waited %.0f ms "
+               "for them and copied them out in %.0f ms\n",
                static_cast<unsigned long long>(gpu_->pointsDone()), gpu_->gpuMs(),
-               static_cast<double>(gpu_->pointsDone()) / (gpu_->gpuMs() * 1e-3));
+               static_cast<double>(gpu_->pointsDone()) / (gpu_->gpuMs() * 1e-3), gpu_->waitMs(), gpu_->copyMs());
 }
 
 Status GenerateDevice::checkValidation() const {

@@ -19,10 +19,18 @@ namespace dpoint {
 struct GenerateDeviceOptions {
   std::string device = "auto";
   bool validate = false;
+  std::string counts = "auto";  // auto|capped|full (escape-grid kinds only)
 };
 
 // `cpu_only_note`: which variants stay on the CPU, for the help text (may be empty).
 void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options, const std::string& cpu_only_note);
+
+// --counts for the escape-grid kinds (mandelbulb, julia): how far the classification iterates.
+void addEscapeCountsOption(CLI::App& command, GenerateDeviceOptions& options);
+class GenerateDevice;
+// Whether the classification runs every count to max_iter: `full`, or `auto` on a GPU (on the
+// H100 the GPU's extra iterations cost less than the CPU's finishing; on lavapipe, a CPU, more).
+bool fullCounts(const GenerateDeviceOptions& options, const GenerateDevice* device);
 
 // The device a generation runs its counts on; the functions it hands out hold it alive.
 class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
@@ -37,6 +45,8 @@ class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
                                                       const std::string& cpu_only, bool quiet);
 
   EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis);
+  // A GPU, not a CPU device such as lavapipe.
+  bool isGpu() const;
   PerturbationFunction perturbation();
   // Unless quiet: a line on stderr with the points classified and the GPU time their dispatches
   // took (the classification alone; the generator's functions hold the device until it is done).

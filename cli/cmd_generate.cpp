@@ -2,6 +2,8 @@
 // Parsing and reporting only; every generator is a library function.
 #include <algorithm>
 #include <charconv>
+#include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -86,11 +88,35 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
   return okStatus();
 }
 
-// Colours, offset, order and writing: the steps after any generator.
-int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress) {
+// Seconds since `start`, and since the last call (the phases of the time line).
+class PhaseClock {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return s;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+std::string seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", s);
+  return text;
+}
+
+// Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of
+// where the time went (generation counted from `clock`'s start, before the parameters).
+int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
+           PhaseClock& clock) {
   if (!generated) return reportError(generated.error());
+  const double generate_s = clock.lap();
   PointSet& points = *generated;
   if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
+  const double colours_s = clock.lap();
   if (order != PointOrder::kInput) {
     Result<uint64_t> limit = memoryLimit(o);
     if (!limit) return reportError(limit.error());
@@ -100,11 +126,16 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
       return reportError(s.error());
     reorderPoints(points, order, o.common.threads, &progress);
   }
+  const double order_s = clock.lap();
   WriteOptions w;
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
   if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
+  if (!o.common.quiet)
+    std::fprintf(stderr, "time (s): generate %s, colours and offset %s, order %s, write %s; %zu points, %zu triangles\n",
+                 seconds(generate_s).c_str(), seconds(colours_s).c_str(), seconds(order_s).c_str(),
+                 seconds(clock.lap()).c_str(), points.size(), points.triangles.size() / 3);
   return 0;
 }
 
@@ -121,7 +152,7 @@ int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_no
 // CLI11 prints them (given or default), less those that only say where and how to run or write.
 std::string tileSignature(const CLI::App& cmd) {
   static const std::vector<std::string> kIgnored = {"output", "tile", "threads", "quiet", "grid-out", "device",
-                                                    "max-memory", "decimals", "order", "validate", "help"};
+                                                    "max-memory", "decimals", "order", "validate", "counts", "help"};
   std::istringstream lines(cmd.config_to_str(true, false));
   std::string line, signature = cmd.get_name();
   while (std::getline(lines, line)) {
@@ -171,11 +202,12 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
         if (!spec) return reportError(spec.error());
         tile = *spec;
       }
+      PhaseClock clock;
       Progress progress(progressSink(o->out.common.quiet), name);
       Result<Params> params = makeParams(*o, &progress);
       if (!params) return reportError(params.error());
       if (tile) return finishTile(generate_tile(*params, *tile), o->out, auto_noise, signature, progress);
-      return finish(generate(*params), o->out, *order, auto_noise, progress);
+      return finish(generate(*params), o->out, *order, auto_noise, progress, clock);
     };
   });
 }
@@ -225,6 +257,7 @@ Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* 
   if (*device)
     p.planes = (*device)->planes({EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2},
                                  GridAxis{p.resolution, p.lo, p.hi});
+  p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);
 }
 
@@ -248,6 +281,7 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
   if (!device) return device.error();
   if (*device)
     p.planes = (*device)->planes({EscapeKernel::kJulia, p.c, kJuliaEscapeSquare, 0.0}, GridAxis{p.resolution, p.lo, p.hi});
+  p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);
 }
 
@@ -323,6 +357,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   addGenerateDeviceOptions(*mandelbulb, mb->device,
                            "--variant seed always runs on the CPU (libm's trigonometry has no bit-exact shader form):\n"
                            "auto gives it the CPU, an explicit device is an error");
+  addEscapeCountsOption(*mandelbulb, mb->device);
   addOutputOptions(*mandelbulb, mb->out, "noise");
   registerKind(run, mb, mandelbulb, true, &generateMandelbulb, &generateMandelbulbTile, &mandelbulbParams);
 
@@ -332,6 +367,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
                        ju->params.grid_out, 200);
   julia->add_option("--c", ju->c, "Julia constant as 4 numbers")->default_val("-0.7,0.27015,0.27015,0");
   addGenerateDeviceOptions(*julia, ju->device, "");
+  addEscapeCountsOption(*julia, ju->device);
   addOutputOptions(*julia, ju->out, "noise");
   registerKind(run, ju, julia, true, &generateJulia, &generateJuliaTile, &juliaParams);
 

@@ -53,8 +53,10 @@ SlabPlan planSlabs(int layers, unsigned threads, int max_thickness) {
 }
 
 // With a plane function (a GPU), a slab's planes are computed as one block and held until the slab
-// is meshed; a block of about 32 MiB keeps the few in flight small and the dispatches large.
-constexpr uint64_t kGpuBlockBytes = uint64_t{32} << 20;
+// is meshed; a block of about 128 MiB keeps the few in flight small and the dispatches large. Each
+// block recomputes the plane it shares with the next: at res 2048 (16 MiB a plane) 8-plane blocks
+// repeat 1 plane in 8, where 32 MiB blocks (4 layers, the least) repeated 1 in 5.
+constexpr uint64_t kGpuBlockBytes = uint64_t{128} << 20;
 int gpuSlabThickness(int res) {
   const uint64_t planes = kGpuBlockBytes / (sizeof(uint32_t) * squared(res));
   return static_cast<int>(std::clamp<uint64_t>(planes, 5, kMaxSlabThickness + 1)) - 1;
@@ -324,12 +326,27 @@ class SlabField {
   int cap_ = 0;
   const uint32_t* block_ = nullptr;
   bool refine_ = false;
-  std::vector<uint32_t> counts_[2];
-  std::vector<uint8_t> above_[2];
-  std::vector<uint8_t> need_;
-  std::vector<double> row_z_;
-  std::vector<size_t> row_k_;
-  std::vector<uint32_t> row_counts_;
+  // The planes in flight and the row buffers, kept by the thread from slab to slab (fresh ones
+  // cost a page fault per 4 KiB: at res 2048 that was most of the meshing's time). load() writes
+  // a plane's counts and flags whole, and finishCrossings every need_ entry, before any is read.
+  struct Scratch {
+    std::vector<uint32_t> counts[2];
+    std::vector<uint8_t> above[2];
+    std::vector<uint8_t> need;
+    std::vector<double> row_z;
+    std::vector<size_t> row_k;
+    std::vector<uint32_t> row_counts;
+  };
+  static Scratch& scratch() {
+    thread_local Scratch s;
+    return s;
+  }
+  std::vector<uint32_t> (&counts_)[2] = scratch().counts;
+  std::vector<uint8_t> (&above_)[2] = scratch().above;
+  std::vector<uint8_t>& need_ = scratch().need;
+  std::vector<double>& row_z_ = scratch().row_z;
+  std::vector<size_t>& row_k_ = scratch().row_k;
+  std::vector<uint32_t>& row_counts_ = scratch().row_counts;
   std::vector<uint8_t> grid_;
 };
 
@@ -443,7 +460,10 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                      ExitCode::kResourceLimit});
         } else {
           mesh.positions.insert(mesh.positions.end(), done.mesh.positions.begin(), done.mesh.positions.end());
-          for (uint32_t id : done.mesh.triangles) mesh.triangles.push_back(static_cast<uint32_t>(offset + id));
+          const size_t at = mesh.triangles.size();
+          mesh.triangles.resize(at + done.mesh.triangles.size());
+          std::transform(done.mesh.triangles.begin(), done.mesh.triangles.end(), mesh.triangles.begin() + at,
+                         [offset](uint32_t id) { return static_cast<uint32_t>(offset + id); });
           if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
           if (grid_file)
             if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());

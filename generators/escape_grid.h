@@ -99,7 +99,7 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.max_iter = params.max_iter;
   surface.level = resolveLevel(params.max_iter, params.level);
   surface.frame = params.frame;
-  surface.lazy = params.grid_out.empty();
+  surface.lazy = params.grid_out.empty() && !params.full_counts;
   surface.grid_out = params.grid_out;
   surface.threads = params.threads;
   surface.max_memory = params.max_memory;

@@ -49,6 +49,7 @@ struct MandelbulbParams {
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
+  bool full_counts = false;      // every count to max_iter, not capped above the level (escape_grid.h)
 };
 
 // Welded surface mesh (no colours). Errors: bad parameters name the flag and the limit (kUsage;

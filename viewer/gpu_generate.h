@@ -61,6 +61,10 @@ class GpuEscape {
   // dispatch; 0 on a queue without timestamps): the classification alone, for the bench.
   uint64_t pointsDone() const { return points_done_; }
   double gpuMs() const { return gpu_ms_; }
+  // Host milliseconds spent waiting for dispatches to finish, and copying their counts out of the
+  // mapped buffers (on several threads): where the thread feeding the generator spends its time.
+  double waitMs() const { return wait_ms_; }
+  double copyMs() const { return copy_ms_; }
 
  private:
   struct Slot {
@@ -91,6 +95,7 @@ class GpuEscape {
   VkQueryPool queries_ = VK_NULL_HANDLE;  // two timestamps per slot
   uint64_t points_done_ = 0;
   double gpu_ms_ = 0.0;
+  double wait_ms_ = 0.0, copy_ms_ = 0.0;
   Buffer axis_, orbit_, dcx_, dcy_;
   std::vector<double> axis_values_;  // what axis_ holds
 };
