@@ -317,7 +317,7 @@ int renderViews(const RenderCliOptions& o, const VulkanContext& context, const P
 constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
-Result<Bounds> streamBounds(const std::string& path, PlyVertexStream& ply, Progress& progress) {
+Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress) {
   Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
   PointSet block;
   progress.start("bounds of " + path + " (points)", ply.count());
@@ -403,17 +403,18 @@ int runRender(const RenderCliOptions& o) {
 
   Phases phases;
   Progress progress(progressSink(o.common.quiet), "render");
-  // A large binary PLY is drawn a block at a time (a set larger than memory); anything else is read whole.
-  std::unique_ptr<PlyVertexStream> ply;
-  const std::string& input = o.inputs[0];
+  // Large binary PLY input (one file, or tiles) is drawn a block at a time (a set larger than
+  // memory); anything else is read whole.
+  std::unique_ptr<PointInputStream> ply;
   const std::string inputs = describeInputs(o.inputs);
-  if (o.stream != "off" && o.inputs.size() == 1 && hasExtension(input, ".ply")) {
-    Result<std::unique_ptr<PlyVertexStream>> opened =
-        PlyVertexStream::open(input, PlyReadOptions{false, nullptr, o.common.threads, true});
+  const bool all_ply = std::all_of(o.inputs.begin(), o.inputs.end(),
+                                   [](const std::string& path) { return hasExtension(path, ".ply"); });
+  if (o.stream != "off" && all_ply) {
+    Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(o.inputs, o.common.threads);
     if (opened && (o.stream == "on" || (*opened)->count() > kStreamAbovePoints)) ply = std::move(*opened);
     else if (!opened && o.stream == "on") return reportError(opened.error());
   } else if (o.stream == "on") {
-    return reportError(Error{inputs + ": --stream on reads one binary PLY file", ExitCode::kUsage});
+    return reportError(Error{inputs + ": --stream on reads binary PLY files", ExitCode::kUsage});
   }
   if (ply && (o.color == "intensity" || o.color == "classification"))
     return reportError(Error{inputs + ": --color " + o.color + " needs LAS input", ExitCode::kBadInput});
@@ -425,7 +426,7 @@ int runRender(const RenderCliOptions& o) {
   bool has_colors = false;
   if (ply) {
     if (ply->count() == 0) return reportError(Error{inputs + ": no points to render", ExitCode::kBadInput});
-    Result<Bounds> bounds = streamBounds(input, *ply, progress);
+    Result<Bounds> bounds = streamBounds(inputs, *ply, progress);
     if (!bounds) return reportError(bounds.error());
     run.count = ply->count(), run.bounds = *bounds, has_colors = ply->hasColors();
     phases.mark("bounds");
@@ -499,7 +500,7 @@ int runRender(const RenderCliOptions& o) {
       progress.advance(n);
       return okStatus();
     };
-    progress.start("streaming " + input + " to the GPU (points)", run.count);
+    progress.start("streaming " + inputs + " to the GPU (points)", run.count);
     Result<RenderResult> streamed = renderStream(**context, stream, *camera, options);
     progress.finish();
     return streamed;
@@ -580,7 +581,7 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.");
   cmd->add_option("input", o->inputs,
                   "Point sets (.csv, .ply, .las, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
-                  "whole. One large binary PLY is streamed (--stream)")
+                  "whole. Large binary PLY input is streamed (--stream)")
       ->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required();
   cmd->add_option("--mode", o->mode,
@@ -627,9 +628,9 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--max-device-memory", o->max_device_memory,
                   "Refuse (exit 4) to allocate more GPU memory than this, e.g. 2G (default: what the device has)");
   cmd->add_option("--stream", o->stream,
-                  "auto|on|off. on: draw a binary PLY a block at a time, so a file larger than memory renders in\n"
-                  "about 1.2 GB of host memory (two blocks of 16M points); auto: for binary PLY of more than 2^26\n"
-                  "points. A streamed set gets no predicted bound (--mode auto takes native), no --error, --order\n"
+                  "auto|on|off. on: draw binary PLY input (a file, or tiles) a block at a time, so a set larger\n"
+                  "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for binary\n"
+                  "PLY input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes native), no --error, --order\n"
                   "or --views 4")
       ->default_val("auto");
   cmd->add_option("--views", o->views,

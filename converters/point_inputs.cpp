@@ -1,14 +1,15 @@
 #include "converters/point_inputs.h"
 
 #include <algorithm>
+#include <cassert>
 
+#include "core/ply.h"
 #include "core/tile.h"
 
 namespace dpoint {
-namespace {
 
 // Every path a tile of the same count, each index once.
-bool completeTileSet(const std::vector<std::string>& paths) {
+bool isCompleteTileSet(const std::vector<std::string>& paths) {
   std::vector<bool> seen;
   for (const std::string& path : paths) {
     if (!isTileFile(path)) return false;
@@ -21,11 +22,9 @@ bool completeTileSet(const std::vector<std::string>& paths) {
   return std::all_of(seen.begin(), seen.end(), [](bool s) { return s; }) && seen.size() == paths.size();
 }
 
-}  // namespace
-
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
   if (paths.size() == 1) return readPoints(paths[0], options);
-  if (completeTileSet(paths)) {
+  if (isCompleteTileSet(paths)) {
     Result<PointSet> whole = mergeTiles(paths, 0, options.progress);
     if (whole && options.points_only) whole->triangles.clear();
     return whole;
@@ -52,6 +51,67 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     out.positions.insert(out.positions.end(), part->positions.begin(), part->positions.end());
   }
   return out;
+}
+
+struct PointInputStream::Part {
+  std::unique_ptr<PlyVertexStream> ply;
+  uint64_t first = 0;  // the part's first point in the stream
+  uint64_t count = 0;  // points it streams (a tile: its owned vertices)
+};
+
+PointInputStream::~PointInputStream() = default;
+
+Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
+                                                                 unsigned threads) {
+  std::unique_ptr<PointInputStream> stream(new PointInputStream());
+  std::vector<std::pair<std::string, uint64_t>> files;  // path, points to stream (all: UINT64_MAX)
+  if (paths.size() > 1 && isCompleteTileSet(paths)) {
+    files.resize(paths.size());
+    for (const std::string& path : paths) {
+      Result<TileHeader> h = readTileHeader(path);
+      if (!h) return h.error();
+      files[h->tile.index] = {path, h->owned};
+    }
+  } else {
+    for (const std::string& path : paths) files.emplace_back(path, UINT64_MAX);
+  }
+  for (const auto& [path, owned] : files) {
+    Result<std::unique_ptr<PlyVertexStream>> ply =
+        PlyVertexStream::open(path, PlyReadOptions{false, nullptr, threads, true});
+    if (!ply) return ply.error();
+    Part part;
+    part.count = std::min(owned, (*ply)->count());
+    part.first = stream->count_;
+    stream->count_ += part.count;
+    if (part.count > 0) stream->has_colors_ = stream->has_colors_ || (*ply)->hasColors();
+    part.ply = std::move(*ply);
+    stream->parts_.push_back(std::move(part));
+  }
+  return stream;
+}
+
+Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
+  assert(first <= count_ && n <= count_ - first);
+  if (parts_.size() == 1) {  // straight into the block
+    if (Status s = parts_[0].ply->read(first, n, block); !s) return s;
+    if (has_colors_ && !block.hasColors()) block.colors.assign(block.size(), glm::vec3(1.0f));
+    return okStatus();
+  }
+  block.triangles.clear();
+  block.positions.resize(static_cast<size_t>(n));
+  block.colors.resize(has_colors_ ? static_cast<size_t>(n) : 0);
+  const uint64_t end = first + n;
+  for (Part& part : parts_) {
+    const uint64_t from = std::max(first, part.first), to = std::min(end, part.first + part.count);
+    if (from >= to) continue;
+    if (Status s = part.ply->read(from - part.first, to - from, scratch_); !s) return s;
+    const size_t at = static_cast<size_t>(from - first);
+    std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
+    if (!has_colors_) continue;
+    if (scratch_.hasColors()) std::copy(scratch_.colors.begin(), scratch_.colors.end(), block.colors.begin() + at);
+    else std::fill_n(block.colors.begin() + at, scratch_.size(), glm::vec3(1.0f));
+  }
+  return okStatus();
 }
 
 std::string describeInputs(const std::vector<std::string>& paths) {

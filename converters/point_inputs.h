@@ -2,6 +2,7 @@
 // inputs, e.g. the tiles of `dpoint generate --tile`).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,33 @@ namespace dpoint {
 // the colour the renderer gives a set without colours. One path is readPoints(path). Errors are
 // the files' own, naming the file.
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options = {});
+
+// True when the paths are the tiles of one run, all N of them, each once (core/tile.h).
+bool isCompleteTileSet(const std::vector<std::string>& paths);
+
+// One or several binary PLY files as one stream of points (render's --stream): the points
+// readPointInputs(paths) gives, in its order, a block at a time (positions and colours, no
+// triangles). A complete tile set streams each tile's owned vertices in tile order (the merged
+// set, each seam vertex once); other files stream whole, one after another. Colours as in
+// readPointInputs: white for the files without in a mix. Only the headers are read by open();
+// errors (ASCII PLY, another format, a bad header) name the file.
+class PointInputStream {
+ public:
+  static Result<std::unique_ptr<PointInputStream>> open(const std::vector<std::string>& paths, unsigned threads);
+  ~PointInputStream();
+  uint64_t count() const { return count_; }
+  bool hasColors() const { return has_colors_; }
+  // Points [first, first + n) into `block` (resized to n).
+  Status read(uint64_t first, uint64_t n, PointSet& block);
+
+ private:
+  PointInputStream() = default;
+  struct Part;
+  std::vector<Part> parts_;  // in stream order
+  uint64_t count_ = 0;
+  bool has_colors_ = false;
+  PointSet scratch_;
+};
 
 // "a.ply" for one path, "a.ply and 3 more" for several: for messages and reports.
 std::string describeInputs(const std::vector<std::string>& paths);
