@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "converters/point_inputs.h"
 #include "core/info.h"
+#include "core/interrupt.h"
 #include "viewer/precision.h"
 
 namespace dpoint {
@@ -22,8 +23,11 @@ struct InfoOptions {
   size_t sample = 10000;
   CameraCliOptions camera;
   std::string max_memory;
+  std::string stream = "auto";
   CommonOptions common;
 };
+
+constexpr uint64_t kStreamBlockPoints = uint64_t{1} << 24;  // as render's
 
 // Every mode's predicted error for one view (viewer/precision.h), as advice.
 struct ViewAdvice {
@@ -68,8 +72,9 @@ void printLasJson(const LasFacts& las) {
   std::printf("          \"generating_software\": %s}", jsonString(h.generating_software).c_str());
 }
 
+// `merged`: whether float_merged was computed (not for a streamed set).
 void printText(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice,
-               const std::optional<LasFacts>& las) {
+               const std::optional<LasFacts>& las, bool merged) {
   std::printf("file:               %s\n", path.c_str());
   std::printf("points:             %zu\n", i.count);
   std::printf("triangles:          %zu\n", i.triangles);
@@ -82,14 +87,21 @@ void printText(const std::string& path, const PointSetInfo& i, const std::option
   std::printf("float32 spacing:    %s (at the largest |coordinate|)\n", num(i.float_spacing).c_str());
   std::printf("nearest neighbour:  %s (smallest non-zero, %zu points sampled)\n",
               num(i.min_neighbor_distance).c_str(), i.neighbor_sample);
-  if (i.floatRepresents()) {
-    std::printf("float32 enough:     yes (no two distinct points merge)\n");
-  } else if (i.float_overflow > 0) {
+  if (i.float_overflow > 0) {
     std::printf("float32 enough:     no (%zu coordinates beyond float range)\n", i.float_overflow);
+  } else if (!merged) {
+    std::printf("float32 enough:     not decided: a streamed set is read a block at a time, and finding the points\n"
+                "                    float32 merges needs all of them at once (--stream off)\n");
+  } else if (i.floatRepresents()) {
+    std::printf("float32 enough:     yes (no two distinct points merge)\n");
   } else {
     std::printf("float32 enough:     no (%zu distinct points merge with another)\n", i.float_merged);
   }
-  if (!advice) return;
+  if (!advice) {
+    if (!merged && i.count > 0)
+      std::printf("error bound by mode: not predicted for a streamed set (as in render; --stream off)\n");
+    return;
+  }
   std::printf("error bound by mode, for the view (%s, %zu points visible; float floor %s):\n",
               viewName(advice->camera).c_str(), advice->bounds.visible, formatBound(advice->bounds.float_floor_px).c_str());
   for (PrecisionMode mode : kAllModes) {
@@ -101,7 +113,7 @@ void printText(const std::string& path, const PointSetInfo& i, const std::option
 }
 
 void printJson(const std::string& path, const PointSetInfo& i, const std::optional<ViewAdvice>& advice,
-               const std::optional<LasFacts>& las) {
+               const std::optional<LasFacts>& las, bool merged) {
   std::printf("{\n");
   std::printf("  \"file\": %s,\n", jsonString(path).c_str());
   std::printf("  \"points\": %zu,\n  \"triangles\": %zu,\n  \"colors\": %s,\n", i.count, i.triangles,
@@ -112,8 +124,11 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
               num(i.float_spacing, true).c_str());
   std::printf("  \"min_neighbor_distance\": %s,\n  \"neighbor_sample\": %zu,\n",
               num(i.min_neighbor_distance, true).c_str(), i.neighbor_sample);
-  std::printf("  \"float32_merged_points\": %zu,\n  \"float32_overflow\": %zu,\n  \"float32_represents\": %s",
-              i.float_merged, i.float_overflow, i.floatRepresents() ? "true" : "false");
+  // A streamed set: merged points not counted (null), and float32 undecided unless it overflows.
+  const std::string represents = i.float_overflow > 0 ? "false" : !merged ? "null" : i.floatRepresents() ? "true" : "false";
+  std::printf("  \"streamed\": %s,\n", merged ? "false" : "true");
+  std::printf("  \"float32_merged_points\": %s,\n  \"float32_overflow\": %zu,\n  \"float32_represents\": %s",
+              merged ? std::to_string(i.float_merged).c_str() : "null", i.float_overflow, represents.c_str());
   if (las) printLasJson(*las);
   if (advice) {
     const Camera& c = advice->camera;
@@ -132,16 +147,38 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
   std::printf("\n}\n");
 }
 
+// Large binary PLY input (one file, or tiles) a block at a time: what computeStreamedInfo gives.
+int runStreamedInfo(const InfoOptions& o, PointInputStream& stream, Progress& progress) {
+  progress.start("reading " + describeInputs(o.inputs) + " twice (points)", 2 * stream.count());
+  const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
+    if (interrupted()) return interruptedError();
+    if (Status s = stream.read(first, n, block); !s) return s;
+    progress.advance(n);
+    return okStatus();
+  };
+  Result<StreamedInfo> info = computeStreamedInfo(stream.count(), stream.hasColors(), stream.faceCount(), read,
+                                                  kStreamBlockPoints, o.sample, o.common.threads);
+  if (!info) return reportError(info.error());
+  progress.finish();
+  const std::string files = describeInputs(o.inputs);
+  if (o.json) printJson(files, info->info, std::nullopt, std::nullopt, false);
+  else printText(files, info->info, std::nullopt, std::nullopt, false);
+  return 0;
+}
+
 int runInfo(const InfoOptions& o) {
   Progress progress(progressSink(o.common.quiet || o.json), "info");
   Result<uint64_t> limit = memoryLimitOf(o.max_memory);
   if (!limit) return reportError(limit.error());
+  Result<CameraSpec> spec = cameraSpec(o.camera);
+  if (!spec) return reportError(spec.error());
+  Result<std::unique_ptr<PointInputStream>> stream = openPointStream(o.inputs, o.stream, o.common.threads);
+  if (!stream) return reportError(stream.error());
+  if (*stream) return runStreamedInfo(o, **stream, progress);
   ReadOptions read{o.common.threads, o.allow_nonfinite, &progress};
   read.max_memory = *limit;
   Result<PointSet> points = readPointInputs(o.inputs, read);
   if (!points) return reportError(points.error());
-  Result<CameraSpec> spec = cameraSpec(o.camera);
-  if (!spec) return reportError(spec.error());
   const PointSetInfo info = computeInfo(*points, o.sample, o.common.threads);
   std::optional<LasFacts> las;
   // One LAS file: its header too.
@@ -157,8 +194,8 @@ int runInfo(const InfoOptions& o) {
     advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera)};
   }
   const std::string files = describeInputs(o.inputs);
-  if (o.json) printJson(files, info, advice, las);
-  else printText(files, info, advice, las);
+  if (o.json) printJson(files, info, advice, las, true);
+  else printText(files, info, advice, las, true);
   return 0;
 }
 
@@ -172,7 +209,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
   cmd->add_option("input", o->inputs,
                   "Input files (.csv, .ply, .las, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
-                  "as the whole")
+                  "as the whole. Large binary PLY input is streamed (--stream)")
       ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
@@ -181,6 +218,12 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   addCameraOptions(*cmd, o->camera);
   addMaxMemoryOption(*cmd, o->max_memory);
+  cmd->add_option("--stream", o->stream,
+                  "auto|on|off. on: read binary PLY input (a file, or tiles) a block at a time, twice, so a set\n"
+                  "larger than memory is described in about 1.2 GB (no float32 merge count and no error bounds:\n"
+                  "they need every point at once); auto: for binary PLY input of more than 2^26 points")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->default_val("auto");
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runInfo(*o); }; });
 }

@@ -312,10 +312,6 @@ int renderViews(const RenderCliOptions& o, const VulkanContext& context, const P
   return 0;
 }
 
-// --stream auto draws a binary PLY of more points than this a block at a time: in memory it would
-// take 36 B a point (2.4 GB here) before the upload's own.
-constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
-
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
 Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress) {
   Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
@@ -405,17 +401,10 @@ int runRender(const RenderCliOptions& o) {
   Progress progress(progressSink(o.common.quiet), "render");
   // Large binary PLY input (one file, or tiles) is drawn a block at a time (a set larger than
   // memory); anything else is read whole.
-  std::unique_ptr<PointInputStream> ply;
   const std::string inputs = describeInputs(o.inputs);
-  const bool all_ply = std::all_of(o.inputs.begin(), o.inputs.end(),
-                                   [](const std::string& path) { return hasExtension(path, ".ply"); });
-  if (o.stream != "off" && all_ply) {
-    Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(o.inputs, o.common.threads);
-    if (opened && (o.stream == "on" || (*opened)->count() > kStreamAbovePoints)) ply = std::move(*opened);
-    else if (!opened && o.stream == "on") return reportError(opened.error());
-  } else if (o.stream == "on") {
-    return reportError(Error{inputs + ": --stream on reads binary PLY files", ExitCode::kUsage});
-  }
+  Result<std::unique_ptr<PointInputStream>> opened = openPointStream(o.inputs, o.stream, o.common.threads);
+  if (!opened) return reportError(opened.error());
+  std::unique_ptr<PointInputStream> ply = std::move(*opened);
   if (ply && (o.color == "intensity" || o.color == "classification"))
     return reportError(Error{inputs + ": --color " + o.color + " needs LAS input", ExitCode::kBadInput});
   if (ply && (o.error || *order != PointOrder::kInput || o.views != 1))
@@ -626,12 +615,13 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
                   "only. auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones")
       ->default_val("auto");
   cmd->add_option("--max-device-memory", o->max_device_memory,
-                  "Refuse (exit 4) to allocate more GPU memory than this, e.g. 2G (default: what the device has)");
+                  "Refuse (exit 3, a Vulkan fault) to allocate more GPU memory than this, e.g. 2G (default: what the\n"
+                  "device has)");
   cmd->add_option("--stream", o->stream,
                   "auto|on|off. on: draw binary PLY input (a file, or tiles) a block at a time, so a set larger\n"
                   "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for binary\n"
-                  "PLY input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes native), no --error, --order\n"
-                  "or --views 4")
+                  "PLY input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes\n"
+                  "native), no --error, --order or --views 4")
       ->default_val("auto");
   cmd->add_option("--views", o->views,
                   "1, or 4: one PNG of four labelled views (front, side, top, three-quarter), each framed by --fit\n"

@@ -84,6 +84,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     part.first = stream->count_;
     stream->count_ += part.count;
     if (part.count > 0) stream->has_colors_ = stream->has_colors_ || (*ply)->hasColors();
+    stream->faces_ += (*ply)->faceCount();
     part.ply = std::move(*ply);
     stream->parts_.push_back(std::move(part));
   }
@@ -112,6 +113,26 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     else std::fill_n(block.colors.begin() + at, scratch_.size(), glm::vec3(1.0f));
   }
   return okStatus();
+}
+
+Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
+                                                          const std::string& stream, unsigned threads) {
+  const bool all_ply = std::all_of(paths.begin(), paths.end(), [](const std::string& path) {
+    Result<FileFormat> format = formatOf(path);
+    return format && *format == FileFormat::kPly;
+  });
+  if (stream == "off") return std::unique_ptr<PointInputStream>();
+  if (!all_ply) {
+    if (stream == "on") return Error{describeInputs(paths) + ": --stream on reads binary PLY files", ExitCode::kUsage};
+    return std::unique_ptr<PointInputStream>();
+  }
+  Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(paths, threads);
+  if (!opened) {
+    if (stream == "on") return opened.error();
+    return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong
+  }
+  if (stream == "on" || (*opened)->count() > kStreamAbovePoints) return opened;
+  return std::unique_ptr<PointInputStream>();
 }
 
 std::string describeInputs(const std::vector<std::string>& paths) {

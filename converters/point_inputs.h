@@ -36,6 +36,9 @@ class PointInputStream {
   ~PointInputStream();
   uint64_t count() const { return count_; }
   bool hasColors() const { return has_colors_; }
+  // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
+  // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
+  uint64_t faceCount() const { return faces_; }
   // Points [first, first + n) into `block` (resized to n).
   Status read(uint64_t first, uint64_t n, PointSet& block);
 
@@ -43,10 +46,19 @@ class PointInputStream {
   PointInputStream() = default;
   struct Part;
   std::vector<Part> parts_;  // in stream order
-  uint64_t count_ = 0;
+  uint64_t count_ = 0, faces_ = 0;
   bool has_colors_ = false;
   PointSet scratch_;
 };
+
+// --stream auto|on|off of render and info: the stream when `stream` is "on", or "auto" and the
+// paths are binary PLY files of more than kStreamAbovePoints points together; nullptr when the
+// set is to be read whole. With "on", input that cannot be streamed is an error (an ASCII PLY, a
+// bad header: the reader's; another format: kUsage). In memory such a set would take 36 B a point
+// (2.4 GB at 2^26) before the upload's own.
+inline constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
+Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
+                                                          const std::string& stream, unsigned threads);
 
 // "a.ply" for one path, "a.ply and 3 more" for several: for messages and reports.
 std::string describeInputs(const std::vector<std::string>& paths);

@@ -104,6 +104,29 @@ size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
   return merged;
 }
 
+// Bounds and float overflow of `positions` into `info` (min and max already set to a point).
+void addBounds(PointSetInfo& info, const std::vector<glm::dvec3>& positions) {
+  for (const glm::dvec3& p : positions) {
+    info.min = glm::min(info.min, p);
+    info.max = glm::max(info.max, p);
+    for (int k = 0; k < 3; ++k) {
+      if (std::fabs(p[k]) > static_cast<double>(FLT_MAX)) ++info.float_overflow;
+    }
+  }
+}
+
+// Extent, largest magnitude and float32's spacing there, from the bounds.
+void finishBounds(PointSetInfo& info) {
+  info.extent = info.max - info.min;
+  info.max_abs = std::max({std::fabs(info.min.x), std::fabs(info.min.y), std::fabs(info.min.z),
+                           std::fabs(info.max.x), std::fabs(info.max.y), std::fabs(info.max.z)});
+  // The spacing of float32 at max_abs: the gap above the float nearest to it.
+  const float f = static_cast<float>(info.max_abs);
+  info.float_spacing = std::isfinite(f)
+      ? static_cast<double>(std::nextafter(f, std::numeric_limits<float>::infinity())) - static_cast<double>(f)
+      : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
 PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigned threads) {
@@ -114,21 +137,8 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   if (points.positions.empty()) return info;
 
   info.min = info.max = points.positions[0];
-  for (const glm::dvec3& p : points.positions) {
-    info.min = glm::min(info.min, p);
-    info.max = glm::max(info.max, p);
-    for (int k = 0; k < 3; ++k) {
-      if (std::fabs(p[k]) > static_cast<double>(FLT_MAX)) ++info.float_overflow;
-    }
-  }
-  info.extent = info.max - info.min;
-  info.max_abs = std::max({std::fabs(info.min.x), std::fabs(info.min.y), std::fabs(info.min.z),
-                           std::fabs(info.max.x), std::fabs(info.max.y), std::fabs(info.max.z)});
-  // The spacing of float32 at max_abs: the gap above the float nearest to it.
-  const float f = static_cast<float>(info.max_abs);
-  info.float_spacing = std::isfinite(f)
-      ? static_cast<double>(std::nextafter(f, std::numeric_limits<float>::infinity())) - static_cast<double>(f)
-      : std::numeric_limits<double>::infinity();
+  addBounds(info, points.positions);
+  finishBounds(info);
 
   // The merge count needs 32-bit indices; larger sets are beyond the renderer anyway.
   if (info.float_overflow == 0 && points.size() <= UINT32_MAX) info.float_merged = countFloatMerges(points.positions);
@@ -145,6 +155,45 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
     info.neighbor_sample = sample;
   }
   return info;
+}
+
+Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64_t triangles, const BlockReader& read,
+                                         uint64_t block_points, size_t neighbor_sample, unsigned threads) {
+  StreamedInfo out;
+  PointSetInfo& info = out.info;
+  info.count = static_cast<size_t>(count);
+  info.triangles = static_cast<size_t>(triangles);
+  info.has_colors = has_colors;
+  if (count == 0) return out;
+  // The sample computeInfo takes: every step-th point from the first.
+  const uint64_t sample = std::min<uint64_t>(count, std::max<size_t>(neighbor_sample, 1));
+  const uint64_t step = count / sample;
+  std::vector<glm::dvec3> sampled;
+  sampled.reserve(static_cast<size_t>(sample));
+  PointSet block;
+  for (uint64_t first = 0; first < count; first += block_points) {
+    const uint64_t n = std::min(block_points, count - first);
+    if (Status s = read(first, n, block); !s) return s.error();
+    if (first == 0) info.min = info.max = block.positions[0];
+    addBounds(info, block.positions);
+    // Sample indices k·step in [first, first + n), k < sample.
+    for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k)
+      sampled.push_back(block.positions[static_cast<size_t>(k * step - first)]);
+  }
+  finishBounds(info);
+  if (count < 2) return out;
+  std::vector<double> nearest(sampled.size(), std::numeric_limits<double>::infinity());
+  for (uint64_t first = 0; first < count; first += block_points) {
+    const uint64_t n = std::min(block_points, count - first);
+    if (Status s = read(first, n, block); !s) return s.error();
+    const KdTree tree(std::move(block.positions));
+    parallelFor(sampled.size(), threads,
+                [&](size_t k, unsigned) { nearest[k] = std::min(nearest[k], tree.nearestNonzero(sampled[k])); });
+  }
+  const double smallest = *std::min_element(nearest.begin(), nearest.end());
+  info.min_neighbor_distance = std::isfinite(smallest) ? smallest : 0.0;
+  info.neighbor_sample = sampled.size();
+  return out;
 }
 
 }  // namespace dpoint

@@ -64,6 +64,7 @@ class PlyVertexStream {
   ~PlyVertexStream();
   uint64_t count() const;
   bool hasColors() const;
+  uint64_t faceCount() const;  // the header's `face` rows (0 without the element)
   Status read(uint64_t first, uint64_t n, PointSet& block);
 
  private:

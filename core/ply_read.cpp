@@ -326,6 +326,11 @@ class PlyParser {
   }
   uint64_t vertexCount() const { return vertex_count_; }
   bool hasColors() const { return has_colors_; }
+  uint64_t faceCount() const {
+    for (const Element& e : elements_)
+      if (e.name == "face") return e.count;
+    return 0;
+  }
 
   // Vertex rows [first, first + n) into `block`, in parallel blocks, with readPly's errors.
   Status readStream(uint64_t first, uint64_t n, PointSet& block) {
@@ -898,6 +903,7 @@ Result<std::unique_ptr<PlyVertexStream>> PlyVertexStream::open(const std::string
 PlyVertexStream::~PlyVertexStream() = default;
 uint64_t PlyVertexStream::count() const { return state_->parser.vertexCount(); }
 bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
+uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
 Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {
   return state_->parser.readStream(first, n, block);
 }

@@ -269,7 +269,7 @@ TEST(CliRender, vulkanFaultsEndWithOneLineAndNoPicture) {
       {"DPOINT_TEST_VULKAN_FAULT=no-float64", {"--mode", "native"}, 3, "needs shaderFloat64"},
       {"DPOINT_TEST_VULKAN_FAULT=no-int64-atomics", {"--backend", "compute"}, 3, "shaderBufferInt64Atomics"},
       {"DPOINT_TEST_VULKAN_FAULT=device-lost", {}, 3, "VK_ERROR_DEVICE_LOST"},
-      {"DPOINT_TEST_VULKAN_FAULT=", {"--max-device-memory", "1M"}, 4, "--max-device-memory"},
+      {"DPOINT_TEST_VULKAN_FAULT=", {"--max-device-memory", "1M"}, 3, "--max-device-memory"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.env);

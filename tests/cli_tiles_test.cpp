@@ -143,6 +143,21 @@ TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
   auto afterFile = [](const std::string& json) { return json.substr(json.find("\"points\"")); };
   EXPECT_EQ(afterFile(one.out), afterFile(tiles.out));
   EXPECT_NE(tiles.out.find("part-0.ply and 3 more"), std::string::npos);
+  // Streamed (as tiles larger than memory are): the same counts, bounds and nearest neighbour; the
+  // float32 merge count and the error bounds, which need every point at once, are left out.
+  test::CommandResult streamed = runDpoint(concat({"info", "--json", "--stream", "on"}, parts));
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+  for (const char* key : {"\"points\"", "\"triangles\"", "\"colors\"", "\"min\"", "\"max\"",
+                          "\"min_neighbor_distance\"", "\"neighbor_sample\""}) {
+    auto line = [&](const std::string& json) {
+      const size_t at = json.find(key);
+      return json.substr(at, json.find('\n', at) - at);
+    };
+    ASSERT_NE(streamed.out.find(key), std::string::npos) << key;
+    EXPECT_EQ(line(one.out), line(streamed.out));
+  }
+  EXPECT_NE(streamed.out.find("\"float32_merged_points\": null"), std::string::npos) << streamed.out;
+  EXPECT_EQ(streamed.out.find("error_bound_px"), std::string::npos) << streamed.out;
 
   ASSERT_EQ(runDpoint({"render", dir.file("whole.ply"), "-q", "--validate", "-o", dir.file("whole.png")}).exit_code, 0);
   test::CommandResult r = runDpoint(concat(concat({"render", "-q", "--validate"}, parts), {"-o", dir.file("tiles.png")}));

@@ -53,6 +53,46 @@ TEST(Info, overflowBeyondFloatRange) {
   EXPECT_TRUE(std::isinf(i.float_spacing));
 }
 
+// A set read a block at a time (info --stream) gives computeInfo's facts: bounds, overflow and the
+// sampled nearest neighbour, whose nearest point may lie in another block; blocks of 7 points and
+// samples that do not divide the count test the sample's indices across block edges.
+TEST(Info, streamedInfoEqualsTheWholeSetsWhateverTheBlocks) {
+  PointSet s;
+  for (int k = 0; k < 1000; ++k) s.positions.emplace_back(std::cos(k) * 1e3, std::sin(k) * 1e3, 6.378e6 + k * 0.25);
+  s.positions.emplace_back(s.positions[10].x + 1e-6, s.positions[10].y, s.positions[10].z);  // a close pair
+  s.positions.emplace_back(1e39, 0.0, 0.0);
+  for (size_t sample : {size_t{1}, size_t{7}, size_t{333}, size_t{5000}}) {
+    for (uint64_t block : {uint64_t{1}, uint64_t{7}, uint64_t{1002}, uint64_t{4096}}) {
+      SCOPED_TRACE(std::to_string(sample) + " sampled, blocks of " + std::to_string(block));
+      const PointSetInfo whole = computeInfo(s, sample);
+      uint64_t reads = 0;
+      const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+        ++reads;
+        out.positions.assign(s.positions.begin() + static_cast<long>(first),
+                             s.positions.begin() + static_cast<long>(first + n));
+        return okStatus();
+      };
+      Result<StreamedInfo> streamed = computeStreamedInfo(s.size(), false, 0, read, block, sample);
+      ASSERT_TRUE(streamed.ok());
+      const PointSetInfo& i = streamed->info;
+      EXPECT_FALSE(streamed->merged_computed);
+      EXPECT_EQ(i.count, whole.count);
+      EXPECT_EQ(i.min, whole.min);
+      EXPECT_EQ(i.max, whole.max);
+      EXPECT_EQ(i.max_abs, whole.max_abs);
+      EXPECT_EQ(i.float_overflow, whole.float_overflow);
+      EXPECT_EQ(i.neighbor_sample, whole.neighbor_sample);
+      EXPECT_EQ(i.min_neighbor_distance, whole.min_neighbor_distance);
+      EXPECT_EQ(reads, 2 * ((s.size() + block - 1) / block));  // two passes
+    }
+  }
+  // A read error ends it.
+  const BlockReader failing = [](uint64_t, uint64_t, PointSet&) -> Status { return Error{"x.ply: truncated"}; };
+  Result<StreamedInfo> failed = computeStreamedInfo(10, false, 0, failing, 4);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().message, "x.ply: truncated");
+}
+
 TEST(Info, emptySetHasZeroCount) {
   const PointSetInfo i = computeInfo(PointSet{});
   EXPECT_EQ(i.count, 0u);

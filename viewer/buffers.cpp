@@ -95,7 +95,7 @@ Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, con
   return Error{"device memory: " + what + " needs " + formatBytes(bytes) + " more, " + formatBytes(used) +
                    " in all, above the budget of " + formatBytes(context.device_memory_budget) +
                    " (--max-device-memory); try a smaller set, size or --mode with fewer bytes a point",
-               ExitCode::kResourceLimit};
+               ExitCode::kNoDevice};  // a Vulkan fault like a lost device (issue #12): exit 3
 }
 
 void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes) { context.device_memory_used.fetch_sub(bytes); }

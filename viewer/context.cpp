@@ -233,7 +233,9 @@ const VulkanFaults& vulkanFaults() {
 }
 
 Error vulkanError(const std::string& what, VkResult result) {
-  bool memory = result == VK_ERROR_OUT_OF_HOST_MEMORY || result == VK_ERROR_OUT_OF_DEVICE_MEMORY;
+  // Host memory is a resource limit (exit 4) like --max-memory; the device's is a Vulkan fault
+  // (exit 3), as a budget past --max-device-memory is.
+  const bool memory = result == VK_ERROR_OUT_OF_HOST_MEMORY;
   std::string hint = result == VK_ERROR_INCOMPATIBLE_DRIVER ? " (no Vulkan driver found)"
                      : result == VK_ERROR_DEVICE_LOST
                          ? " (the GPU was reset or its driver failed; nothing was written; try again, or --device cpu)"
