@@ -43,16 +43,6 @@ double cpuSeconds(pid_t pid) {
   return static_cast<double>(utime + stime) / static_cast<double>(::sysconf(_SC_CLK_TCK));
 }
 
-// Bytes the process has written so far (/proc/PID/io wchar).
-uint64_t bytesWritten(pid_t pid) {
-  std::ifstream io("/proc/" + std::to_string(pid) + "/io");
-  std::string key;
-  uint64_t value = 0;
-  while (io >> key >> value)
-    if (key == "wchar:") return value;
-  return 0;
-}
-
 // A dpoint run in the background; stderr goes to a file in `dir`.
 class BackgroundRun {
  public:
@@ -240,7 +230,7 @@ TEST(CliInterrupt, sigkillLeavesNoOutputFile) {
     BackgroundRun process(dir, args);
     // convert: once it writes its output; the others once they have worked a while.
     const bool going = std::string(run.name) == "convert"
-                           ? process.waitUntil([&] { return bytesWritten(process.pid()) > (4u << 20); })
+                           ? process.waitUntil([&] { return test::bytesWrittenBy(process.pid()) > (4u << 20); })
                            : process.waitForCpu(0.3);
     ASSERT_TRUE(going) << process.err();
     const int status = process.stop(SIGKILL);

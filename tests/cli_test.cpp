@@ -184,16 +184,6 @@ TEST(Cli, random2dRefusesOverMemoryLimitWithExitFour) {
   EXPECT_TRUE(dir.entries().empty());
 }
 
-// Bytes the process has written so far (/proc/PID/io wchar).
-uint64_t bytesWrittenBy(pid_t pid) {
-  std::ifstream io("/proc/" + std::to_string(pid) + "/io");
-  std::string key;
-  uint64_t value = 0;
-  while (io >> key >> value)
-    if (key == "wchar:") return value;
-  return 0;
-}
-
 TEST(Cli, sigkillWhileWritingLeavesNoFile) {
   TempDir dir;
   const std::string out = dir.file("big.csv");
@@ -207,7 +197,7 @@ TEST(Cli, sigkillWhileWritingLeavesNoFile) {
   // Wait until 20 MB of the ~1.6 GB file are written, then kill.
   bool writing = false;
   for (int i = 0; i < 3000 && !writing; ++i) {
-    writing = bytesWrittenBy(pid) > (20u << 20);
+    writing = test::bytesWrittenBy(pid) > (20u << 20);
     if (!writing) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ::kill(pid, SIGKILL);

@@ -22,16 +22,12 @@
 namespace dpoint {
 namespace {
 
+using test::contains;
 using test::readFile;
 using test::TempDir;
 using test::writeFile;
 
 const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/las/";
-
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
-}
 
 // --- Files built byte by byte (LAS 1.4 R15 tables 3, 7–17) ---------------------------------------
 

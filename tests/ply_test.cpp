@@ -16,15 +16,10 @@
 namespace dpoint {
 namespace {
 
+using test::contains;
 using test::readFile;
 using test::TempDir;
 using test::writeFile;
-
-// A failure prints the whole message, so a wrong wording is easy to see.
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
-}
 
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }

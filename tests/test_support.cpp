@@ -83,4 +83,13 @@ CommandResult runDpoint(const std::vector<std::string>& args) {
   return runCommand(argv);
 }
 
+uint64_t bytesWrittenBy(int pid) {
+  std::ifstream io("/proc/" + std::to_string(pid) + "/io");
+  std::string key;
+  uint64_t value = 0;
+  while (io >> key >> value)
+    if (key == "wchar:") return value;
+  return 0;
+}
+
 }  // namespace dpoint::test

@@ -1,6 +1,9 @@
 // Helpers shared by the test suites: scratch folders, whole-file I/O, running the dpoint binary.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -37,5 +40,13 @@ struct CommandResult {
 CommandResult runCommand(const std::vector<std::string>& argv);
 // Runs build/dpoint with the arguments.
 CommandResult runDpoint(const std::vector<std::string>& args);
+// EXPECT_TRUE(test::contains(message, "part")): a failure prints the whole text.
+inline ::testing::AssertionResult contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
+}
+
+// Bytes process `pid` has written so far (/proc/PID/io wchar); 0 once it is gone.
+uint64_t bytesWrittenBy(int pid);
 
 }  // namespace dpoint::test

@@ -13,14 +13,10 @@
 namespace dpoint {
 namespace {
 
+using test::contains;
 using test::readFile;
 using test::TempDir;
 using test::writeFile;
-
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
-}
 
 TEST(Tile, rangesPartitionTheItemsEvenWithMoreTilesThanItems) {
   for (uint64_t items : {0ull, 1ull, 5ull, 7ull, 1000ull}) {
