@@ -22,11 +22,13 @@ using test::TempDir;
 // Bit for bit (NaN-proof); memcmp is never given an empty vector's null data (UBSan).
 void expectSameBits(const PointSet& a, const PointSet& b) {
   ASSERT_EQ(a.size(), b.size());
-  if (a.size() > 0)
+  if (a.size() > 0) {
     EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), a.size() * sizeof(glm::dvec3)), 0);
+  }
   ASSERT_EQ(a.colors.size(), b.colors.size());
-  if (!a.colors.empty())
+  if (!a.colors.empty()) {
     EXPECT_EQ(std::memcmp(a.colors.data(), b.colors.data(), a.colors.size() * sizeof(glm::vec3)), 0);
+  }
   EXPECT_TRUE(a.triangles == b.triangles);
 }
 
