@@ -13,6 +13,8 @@
 #   tiles.tsv     TILES (8; 0: none) tiles of mandelbulb res TILE_RES (2048) spread over the GPUs
 #                 (tile I on --device I mod GPUS, GPUS at a time) + dpoint merge, then the single
 #                 GPU run (SINGLE=0: not): wall, peak RSS and SHA-256 of the merged file, its counts
+#                 (MERGE=0: no merge); then info and render of the parts, streamed (tiles-info.txt,
+#                 tiles-render.txt, tiles.png)
 # Env: BIN (default .gpu/dpoint), CASES (a subset of the case names below), PATHS, REPEATS, TILES (0: none),
 # TILE_RES, GPUS (default: nvidia-smi's count), DATA (scratch, default /tmp/dpoint-generate).
 set -euo pipefail
@@ -95,17 +97,31 @@ seq 0 $((tiles - 1)) | xargs -P "$gpus" -I{} sh -c \
   '/usr/bin/time -f %M -o "$0/peak-$1.txt" "$2" generate '"$args"' -q --device $(($1 % $3)) --tile $1/$4 -o "$0/part-$1.ply"' \
   "$data" {} "$d" "$gpus" "$tiles"
 tiles_end=$(date +%s.%N)
-/usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" merge -q "$data"/part-*.ply -o "$data/merged.ply"
-end=$(date +%s.%N)
 peak=$(cat "$data"/peak-*.txt | sort -n | tail -1)
 printf '%s tiles on %s GPU(s)\t%.2f\t%.0f\t-\n' "$tiles" "$gpus" "$(awk -v a="$start" -v b="$tiles_end" 'BEGIN { print b - a }')" \
   "$((peak / 1024))" | tee -a "$out/tiles.tsv"
-printf 'merge\t%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
-  "$(sha256sum <"$data/merged.ply" | cut -c1-16)" | tee -a "$out/tiles.tsv"
-printf 'tiles + merge\t%.2f\t-\t-\n' "$(awk -v a="$start" -v b="$end" 'BEGIN { print b - a }')" | tee -a "$out/tiles.tsv"
-# The merged file's size and counts, from its header.
-printf '# merged: %s bytes; %s\n' "$(stat -c %s "$data/merged.ply")" \
-  "$(head -c 1000 "$data/merged.ply" | grep -a '^element' | tr '\n' ' ')" | tee -a "$out/tiles.tsv"
+printf '# parts: %s bytes in all\n' "$(cat "$data"/part-*.ply | wc -c)" | tee -a "$out/tiles.tsv"
+# MERGE=0: no merged file (at res 4096 the parts and the merged file do not both fit the 64 GB
+# disk); the parts are described and drawn as the whole set instead, streamed.
+if [ "${MERGE:-1}" != 0 ]; then
+  /usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" merge -q "$data"/part-*.ply -o "$data/merged.ply"
+  end=$(date +%s.%N)
+  printf 'merge\t%s\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" \
+    "$(sha256sum <"$data/merged.ply" | cut -c1-16)" | tee -a "$out/tiles.tsv"
+  printf 'tiles + merge\t%.2f\t-\t-\n' "$(awk -v a="$start" -v b="$end" 'BEGIN { print b - a }')" | tee -a "$out/tiles.tsv"
+  # The merged file's size and counts, from its header.
+  printf '# merged: %s bytes; %s\n' "$(stat -c %s "$data/merged.ply")" \
+    "$(head -c 1000 "$data/merged.ply" | grep -a '^element' | tr '\n' ' ')" | tee -a "$out/tiles.tsv"
+fi
+# The tiles as one set, streamed: dpoint info (counts, bounds) and a picture (compute, native).
+timeout 300 /usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" info --stream on "$data"/part-*.ply \
+  >"$out/tiles-info.txt" || echo "info did not finish in 300 s" >"$data/time.txt"
+printf 'info --stream on (the tiles)\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" |
+  tee -a "$out/tiles.tsv"
+/usr/bin/time -f "%e %M" -o "$data/time.txt" "$d" render --stream on --backend compute --mode native --device 0 \
+  --width 1920 --height 1080 "$data"/part-*.ply -o "$out/tiles.png" >"$out/tiles-render.txt"
+printf 'render --stream on (the tiles)\t%s\n' "$(awk '{ printf "%s\t%.0f", $1, $2 / 1024 }' "$data/time.txt")" |
+  tee -a "$out/tiles.tsv"
 rm -f "$data"/part-*.ply "$data/merged.ply"
 # The same grid in one process on one GPU, for the wall time and the checksum (SINGLE=0 skips it).
 if [ "${SINGLE:-1}" != 0 ]; then
