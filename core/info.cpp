@@ -4,6 +4,8 @@
 #include <cfloat>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <span>
 #include <numeric>
 
 #include <glm/common.hpp>
@@ -13,19 +15,28 @@
 namespace dpoint {
 namespace {
 
-// A k-d tree laid out in place: the median of each range sits at its middle, split along the
-// axis of largest extent, which is recorded at the median's index. Leaves are small ranges.
+// A k-d tree laid out in place in the points it is given (reordered, not owned): the median of
+// each range sits at its middle, split along the axis of largest extent, which is recorded at the
+// median's index. Leaves are small ranges.
 class KdTree {
  public:
-  explicit KdTree(std::vector<glm::dvec3> points) : pts_(std::move(points)), axis_(pts_.size(), 0) {
+  explicit KdTree(std::span<glm::dvec3> points) : pts_(points), axis_(pts_.size(), 0) {
+    if (pts_.empty()) return;
+    min_ = max_ = pts_[0];
+    for (const glm::dvec3& p : pts_) {
+      min_ = glm::min(min_, p);
+      max_ = glm::max(max_, p);
+    }
     build(0, pts_.size());
   }
 
-  // Smallest distance > 0 from q to a point of the tree (infinity if none).
-  double nearestNonzero(const glm::dvec3& q) const {
-    double best = std::numeric_limits<double>::infinity();
-    search(0, pts_.size(), q, best);
-    return std::sqrt(best);
+  // Lowers best2 to the smallest squared distance > 0 from q to a point of the tree, if smaller.
+  // The tree's box is tested first: a far tree costs a few comparisons.
+  void nearestNonzero(const glm::dvec3& q, double& best2) const {
+    if (pts_.empty()) return;
+    const glm::dvec3 outside = glm::max(glm::dvec3(0.0), glm::max(min_ - q, q - max_));
+    if (outside.x * outside.x + outside.y * outside.y + outside.z * outside.z > best2) return;
+    search(0, pts_.size(), q, best2);
   }
 
  private:
@@ -74,9 +85,44 @@ class KdTree {
     }
   }
 
-  std::vector<glm::dvec3> pts_;
+  std::span<glm::dvec3> pts_;
   std::vector<uint8_t> axis_;
+  glm::dvec3 min_{0.0}, max_{0.0};
 };
+
+// Points in one k-d tree of a Forest: small enough that a set's trees build in parallel, large
+// enough that the box tests stay few.
+constexpr size_t kTreePoints = size_t{1} << 20;
+
+// k-d trees over consecutive ranges of a set of points (reordered within each range), built in
+// parallel; the smallest distance over the trees is the one over the set, whatever the ranges.
+class Forest {
+ public:
+  Forest(std::vector<glm::dvec3>& points, unsigned threads) {
+    const size_t n = points.size();
+    trees_.resize((n + kTreePoints - 1) / kTreePoints);
+    parallelFor(trees_.size(), threads, [&](size_t t, unsigned) {
+      const size_t first = t * kTreePoints;
+      trees_[t] = std::make_unique<KdTree>(std::span(points).subspan(first, std::min(kTreePoints, n - first)));
+    });
+  }
+
+  // Lowers each best2[k] to the smallest squared distance > 0 from queries[k] to the points.
+  void nearestNonzero(const std::vector<glm::dvec3>& queries, std::vector<double>& best2, unsigned threads) const {
+    parallelFor(queries.size(), threads, [&](size_t k, unsigned) {
+      for (const std::unique_ptr<KdTree>& tree : trees_) tree->nearestNonzero(queries[k], best2[k]);
+    });
+  }
+
+ private:
+  std::vector<std::unique_ptr<KdTree>> trees_;
+};
+
+// The smallest of the sampled nearest distances (best2: squared), 0 when none is finite.
+double smallestDistance(const std::vector<double>& best2) {
+  const double smallest = *std::min_element(best2.begin(), best2.end());
+  return std::isfinite(smallest) ? std::sqrt(smallest) : 0.0;
+}
 
 // Counts distinct points that float32 rounding merges with another distinct point.
 size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
@@ -146,12 +192,13 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   const size_t n = points.size();
   const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
   if (n >= 2) {
-    const KdTree tree(points.positions);
     const size_t step = n / sample;
-    std::vector<double> nearest(sample, std::numeric_limits<double>::infinity());
-    parallelFor(sample, threads, [&](size_t k, unsigned) { nearest[k] = tree.nearestNonzero(points.positions[k * step]); });
-    const double smallest = *std::min_element(nearest.begin(), nearest.end());
-    info.min_neighbor_distance = std::isfinite(smallest) ? smallest : 0.0;
+    std::vector<glm::dvec3> sampled(sample);
+    for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step];
+    std::vector<double> best2(sample, std::numeric_limits<double>::infinity());
+    std::vector<glm::dvec3> scratch = points.positions;  // the trees reorder it
+    Forest(scratch, threads).nearestNonzero(sampled, best2, threads);
+    info.min_neighbor_distance = smallestDistance(best2);
     info.neighbor_sample = sample;
   }
   return info;
@@ -182,16 +229,13 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   }
   finishBounds(info);
   if (count < 2) return out;
-  std::vector<double> nearest(sampled.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> best2(sampled.size(), std::numeric_limits<double>::infinity());
   for (uint64_t first = 0; first < count; first += block_points) {
     const uint64_t n = std::min(block_points, count - first);
     if (Status s = read(first, n, block); !s) return s.error();
-    const KdTree tree(std::move(block.positions));
-    parallelFor(sampled.size(), threads,
-                [&](size_t k, unsigned) { nearest[k] = std::min(nearest[k], tree.nearestNonzero(sampled[k])); });
+    Forest(block.positions, threads).nearestNonzero(sampled, best2, threads);
   }
-  const double smallest = *std::min_element(nearest.begin(), nearest.end());
-  info.min_neighbor_distance = std::isfinite(smallest) ? smallest : 0.0;
+  info.min_neighbor_distance = smallestDistance(best2);
   info.neighbor_sample = sampled.size();
   return out;
 }

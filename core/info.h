@@ -31,9 +31,10 @@ struct PointSetInfo {
 
 // What computeInfo gives, for a set read a block at a time (`dpoint info` on input larger than
 // memory): `read(first, n, block)` fills `block` with points [first, first + n). Two passes: the
-// counts, bounds and the sample, then the sample's nearest neighbours block by block (a k-d tree
-// of each block; the smallest distance over the blocks is the one over the set). float_merged,
-// which needs every point at once, is not computed (merged_computed false). Errors are read's.
+// counts, bounds and the sample, then the sample's nearest neighbours block by block (k-d trees of
+// 2^20 points built in parallel; the smallest distance over the trees is the one over the set).
+// float_merged, which needs every point at once, is not computed (merged_computed false). Errors
+// are read's.
 struct StreamedInfo {
   PointSetInfo info;
   bool merged_computed = false;
@@ -42,7 +43,8 @@ using BlockReader = std::function<Status(uint64_t first, uint64_t n, PointSet& b
 Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64_t triangles, const BlockReader& read,
                                          uint64_t block_points, size_t neighbor_sample = 10000, unsigned threads = 0);
 
-// Deterministic: the sample is every k-th point. `threads` 0 means all cores.
+// Deterministic: the sample is every k-th point, its nearest neighbours exact (k-d trees of 2^20
+// points, built in parallel). `threads` 0 means all cores.
 // Cost: O(n log n) time, about 40 bytes per point of scratch memory.
 PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample = 10000, unsigned threads = 0);
 
