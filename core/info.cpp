@@ -6,6 +6,8 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <tuple>
+#include <utility>
 #include <numeric>
 
 #include <glm/common.hpp>
@@ -15,40 +17,43 @@
 namespace dpoint {
 namespace {
 
-// A k-d tree laid out in place in the points it is given (reordered, not owned): the median of
-// each range sits at its middle, split along the axis of largest extent, which is recorded at the
-// median's index. Leaves are small ranges.
+// Squared distance from q to the box [lo, hi] (0 inside it).
+double boxDistance2(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& q) {
+  const glm::dvec3 outside = glm::max(glm::dvec3(0.0), glm::max(lo - q, q - hi));
+  return outside.x * outside.x + outside.y * outside.y + outside.z * outside.z;
+}
+
+// Bounds of points (not empty).
+std::pair<glm::dvec3, glm::dvec3> boxOf(std::span<const glm::dvec3> points) {
+  glm::dvec3 lo = points[0], hi = points[0];
+  for (const glm::dvec3& p : points) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  return {lo, hi};
+}
+
+// A k-d tree laid out in place in the points it is given (reordered, not owned; not empty): the
+// median of each range sits at its middle, split along the axis of largest extent, which is
+// recorded at the median's index. Leaves are small ranges.
 class KdTree {
  public:
   explicit KdTree(std::span<glm::dvec3> points) : pts_(points), axis_(pts_.size(), 0) {
-    if (pts_.empty()) return;
-    min_ = max_ = pts_[0];
-    for (const glm::dvec3& p : pts_) {
-      min_ = glm::min(min_, p);
-      max_ = glm::max(max_, p);
-    }
+    std::tie(min_, max_) = boxOf(pts_);
     build(0, pts_.size());
   }
 
+  double boxDistance2(const glm::dvec3& q) const { return dpoint::boxDistance2(min_, max_, q); }
+
   // Lowers best2 to the smallest squared distance > 0 from q to a point of the tree, if smaller.
-  // The tree's box is tested first: a far tree costs a few comparisons.
-  void nearestNonzero(const glm::dvec3& q, double& best2) const {
-    if (pts_.empty()) return;
-    const glm::dvec3 outside = glm::max(glm::dvec3(0.0), glm::max(min_ - q, q - max_));
-    if (outside.x * outside.x + outside.y * outside.y + outside.z * outside.z > best2) return;
-    search(0, pts_.size(), q, best2);
-  }
+  void nearestNonzero(const glm::dvec3& q, double& best2) const { search(0, pts_.size(), q, best2); }
 
  private:
   static constexpr size_t kLeaf = 8;
 
   void build(size_t lo, size_t hi) {
     if (hi - lo <= kLeaf) return;
-    glm::dvec3 mn = pts_[lo], mx = pts_[lo];
-    for (size_t i = lo + 1; i < hi; ++i) {
-      mn = glm::min(mn, pts_[i]);
-      mx = glm::max(mx, pts_[i]);
-    }
+    const auto [mn, mx] = boxOf(pts_.subspan(lo, hi - lo));
     const glm::dvec3 size = mx - mn;
     const int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
     const size_t mid = lo + (hi - lo) / 2;
@@ -94,23 +99,35 @@ class KdTree {
 // enough that the box tests stay few.
 constexpr size_t kTreePoints = size_t{1} << 20;
 
+// Points on each side of a sampled point, in file order, that give the first bound on its nearest
+// distance in a streamed set.
+constexpr size_t kFileNeighbors = 8;
+
 // k-d trees over consecutive ranges of a set of points (reordered within each range), built in
 // parallel; the smallest distance over the trees is the one over the set, whatever the ranges.
 class Forest {
  public:
-  Forest(std::vector<glm::dvec3>& points, unsigned threads) {
+  Forest(std::span<glm::dvec3> points, unsigned threads) {
     const size_t n = points.size();
     trees_.resize((n + kTreePoints - 1) / kTreePoints);
     parallelFor(trees_.size(), threads, [&](size_t t, unsigned) {
       const size_t first = t * kTreePoints;
-      trees_[t] = std::make_unique<KdTree>(std::span(points).subspan(first, std::min(kTreePoints, n - first)));
+      trees_[t] = std::make_unique<KdTree>(points.subspan(first, std::min(kTreePoints, n - first)));
     });
   }
 
-  // Lowers each best2[k] to the smallest squared distance > 0 from queries[k] to the points.
-  void nearestNonzero(const std::vector<glm::dvec3>& queries, std::vector<double>& best2, unsigned threads) const {
+  // Lowers each best2[k] to the smallest squared distance > 0 from queries[k] to the points. The
+  // trees are searched nearest box first, and only while their box is within the best distance:
+  // a query far from a tree (a thin slab of a file in slab order) would visit much of it.
+  void nearestNonzero(std::span<const glm::dvec3> queries, std::span<double> best2, unsigned threads) const {
     parallelFor(queries.size(), threads, [&](size_t k, unsigned) {
-      for (const std::unique_ptr<KdTree>& tree : trees_) tree->nearestNonzero(queries[k], best2[k]);
+      std::vector<std::pair<double, size_t>> order(trees_.size());
+      for (size_t t = 0; t < trees_.size(); ++t) order[t] = {trees_[t]->boxDistance2(queries[k]), t};
+      std::sort(order.begin(), order.end());
+      for (const auto& [distance2, t] : order) {
+        if (distance2 > best2[k]) break;
+        trees_[t]->nearestNonzero(queries[k], best2[k]);
+      }
     });
   }
 
@@ -215,25 +232,53 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   // The sample computeInfo takes: every step-th point from the first.
   const uint64_t sample = std::min<uint64_t>(count, std::max<size_t>(neighbor_sample, 1));
   const uint64_t step = count / sample;
+  // Pass 1: bounds, the sample, and for each sampled point a first bound on its nearest distance:
+  // the points beside it in the file (near in space when the file is in slab or Morton order).
   std::vector<glm::dvec3> sampled;
   sampled.reserve(static_cast<size_t>(sample));
+  std::vector<double> best2;
+  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes;  // of each block
   PointSet block;
   for (uint64_t first = 0; first < count; first += block_points) {
     const uint64_t n = std::min(block_points, count - first);
     if (Status s = read(first, n, block); !s) return s.error();
     if (first == 0) info.min = info.max = block.positions[0];
     addBounds(info, block.positions);
+    boxes.push_back(boxOf(block.positions));
     // Sample indices k·step in [first, first + n), k < sample.
-    for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k)
-      sampled.push_back(block.positions[static_cast<size_t>(k * step - first)]);
+    for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k) {
+      const size_t at = static_cast<size_t>(k * step - first);
+      sampled.push_back(block.positions[at]);
+      double bound2 = std::numeric_limits<double>::infinity();
+      for (size_t j = at - std::min<size_t>(at, kFileNeighbors); j <= std::min<size_t>(at + kFileNeighbors, n - 1); ++j) {
+        const glm::dvec3 d = block.positions[j] - sampled.back();
+        const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (d2 > 0.0 && d2 < bound2) bound2 = d2;
+      }
+      best2.push_back(bound2);
+    }
   }
   finishBounds(info);
   if (count < 2) return out;
-  std::vector<double> best2(sampled.size(), std::numeric_limits<double>::infinity());
-  for (uint64_t first = 0; first < count; first += block_points) {
-    const uint64_t n = std::min(block_points, count - first);
-    if (Status s = read(first, n, block); !s) return s.error();
-    Forest(block.positions, threads).nearestNonzero(sampled, best2, threads);
+  // Pass 2: each block whose box lies within some sampled point's bound, against those points.
+  std::vector<size_t> near;
+  std::vector<glm::dvec3> queries;
+  std::vector<double> query_best2;
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    near.clear();
+    for (size_t k = 0; k < sampled.size(); ++k)
+      if (boxDistance2(boxes[b].first, boxes[b].second, sampled[k]) <= best2[k]) near.push_back(k);
+    if (near.empty()) continue;
+    const uint64_t first = b * block_points;
+    if (Status s = read(first, std::min(block_points, count - first), block); !s) return s.error();
+    queries.resize(near.size());
+    query_best2.resize(near.size());
+    for (size_t j = 0; j < near.size(); ++j) {
+      queries[j] = sampled[near[j]];
+      query_best2[j] = best2[near[j]];
+    }
+    Forest(block.positions, threads).nearestNonzero(queries, query_best2, threads);
+    for (size_t j = 0; j < near.size(); ++j) best2[near[j]] = query_best2[j];
   }
   info.min_neighbor_distance = smallestDistance(best2);
   info.neighbor_sample = sampled.size();

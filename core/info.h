@@ -31,10 +31,11 @@ struct PointSetInfo {
 
 // What computeInfo gives, for a set read a block at a time (`dpoint info` on input larger than
 // memory): `read(first, n, block)` fills `block` with points [first, first + n). Two passes: the
-// counts, bounds and the sample, then the sample's nearest neighbours block by block (k-d trees of
-// 2^20 points built in parallel; the smallest distance over the trees is the one over the set).
-// float_merged, which needs every point at once, is not computed (merged_computed false). Errors
-// are read's.
+// counts, bounds, the sample and a first bound on each sampled point's nearest distance (the
+// points beside it in the file); then the blocks whose box lies within some sampled point's bound,
+// read again (k-d trees of 2^20 points built in parallel, searched nearest first; the smallest
+// distance over the trees is the one over the set). float_merged, which needs every point at
+// once, is not computed (merged_computed false). Errors are read's.
 struct StreamedInfo {
   PointSetInfo info;
   bool merged_computed = false;

@@ -83,7 +83,10 @@ TEST(Info, streamedInfoEqualsTheWholeSetsWhateverTheBlocks) {
       EXPECT_EQ(i.float_overflow, whole.float_overflow);
       EXPECT_EQ(i.neighbor_sample, whole.neighbor_sample);
       EXPECT_EQ(i.min_neighbor_distance, whole.min_neighbor_distance);
-      EXPECT_EQ(reads, 2 * ((s.size() + block - 1) / block));  // two passes
+      // Every block once, then again only those near another block's samples.
+      const uint64_t blocks = (s.size() + block - 1) / block;
+      EXPECT_GE(reads, blocks);
+      EXPECT_LE(reads, 2 * blocks);
     }
   }
   // A read error ends it.
