@@ -106,7 +106,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     const uint64_t from = std::max(first, part.first), to = std::min(end, part.first + part.count);
     if (from >= to) continue;
     if (Status s = part.ply->read(from - part.first, to - from, scratch_); !s) return s;
-    const size_t at = static_cast<size_t>(from - first);
+    const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
     if (!has_colors_) continue;
     if (scratch_.hasColors()) std::copy(scratch_.colors.begin(), scratch_.colors.end(), block.colors.begin() + at);

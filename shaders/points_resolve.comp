@@ -20,7 +20,7 @@ void main() {
   uint p = gl_GlobalInvocationID.x;
   if (p >= pc.pixels) return;
   uint64_t key = visibility[p];
-  visibility[p] = 0ul;
+  if (key != 0ul) visibility[p] = 0ul;  // most of a picture is often background: no write there
   picture[p] = key == 0ul ? pc.background : colors[~uint(key & 0xffffffffu)];
   if (kWriteDepth) depth[p] = uintBitsToFloat(uint(key >> 32));
 }
