@@ -8,7 +8,6 @@
 #include <span>
 #include <tuple>
 #include <utility>
-#include <numeric>
 
 #include <glm/common.hpp>
 
@@ -17,10 +16,12 @@
 namespace dpoint {
 namespace {
 
-// Squared distance from q to the box [lo, hi] (0 inside it).
+// Squared distance from q to the box [lo, hi] (0 inside it, and where a non-finite coordinate
+// makes it undefined: such a box is never passed over, and the sort by distance stays ordered).
 double boxDistance2(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& q) {
   const glm::dvec3 outside = glm::max(glm::dvec3(0.0), glm::max(lo - q, q - hi));
-  return outside.x * outside.x + outside.y * outside.y + outside.z * outside.z;
+  const double d2 = outside.x * outside.x + outside.y * outside.y + outside.z * outside.z;
+  return std::isnan(d2) ? 0.0 : d2;
 }
 
 // Bounds of points (not empty).
@@ -33,20 +34,31 @@ std::pair<glm::dvec3, glm::dvec3> boxOf(std::span<const glm::dvec3> points) {
   return {lo, hi};
 }
 
-// A k-d tree laid out in place in the points it is given (reordered, not owned; not empty): the
-// median of each range sits at its middle, split along the axis of largest extent, which is
-// recorded at the median's index. Leaves are small ranges.
+// A k-d tree laid out in place in the points it is given (reordered, not owned): the median of
+// each range sits at its middle, split along the axis of largest extent, which is recorded at the
+// median's index. Leaves are small ranges. Points with a non-finite coordinate are left out (no
+// distance to them counts, and they would break the median's ordering).
 class KdTree {
  public:
-  explicit KdTree(std::span<glm::dvec3> points) : pts_(points), axis_(pts_.size(), 0) {
+  explicit KdTree(std::span<glm::dvec3> points) {
+    const auto finite = std::partition(points.begin(), points.end(), [](const glm::dvec3& p) {
+      return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    });
+    pts_ = points.first(static_cast<size_t>(finite - points.begin()));
+    axis_.assign(pts_.size(), 0);
+    if (pts_.empty()) return;
     std::tie(min_, max_) = boxOf(pts_);
     build(0, pts_.size());
   }
 
-  double boxDistance2(const glm::dvec3& q) const { return dpoint::boxDistance2(min_, max_, q); }
+  double boxDistance2(const glm::dvec3& q) const {
+    return pts_.empty() ? std::numeric_limits<double>::infinity() : dpoint::boxDistance2(min_, max_, q);
+  }
 
   // Lowers best2 to the smallest squared distance > 0 from q to a point of the tree, if smaller.
-  void nearestNonzero(const glm::dvec3& q, double& best2) const { search(0, pts_.size(), q, best2); }
+  void nearestNonzero(const glm::dvec3& q, double& best2) const {
+    if (!pts_.empty()) search(0, pts_.size(), q, best2);
+  }
 
  private:
   static constexpr size_t kLeaf = 8;
@@ -141,10 +153,15 @@ double smallestDistance(const std::vector<double>& best2) {
   return std::isfinite(smallest) ? std::sqrt(smallest) : 0.0;
 }
 
-// Counts distinct points that float32 rounding merges with another distinct point.
+// Counts distinct points that float32 rounding merges with another distinct point (of the finite
+// ones: a NaN would break the sort's ordering).
 size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
-  std::vector<uint32_t> order(positions.size());
-  std::iota(order.begin(), order.end(), 0u);
+  std::vector<uint32_t> order;
+  order.reserve(positions.size());
+  for (uint32_t i = 0; i < positions.size(); ++i) {
+    const glm::dvec3& p = positions[i];
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) order.push_back(i);
+  }
   auto as_float = [&](uint32_t i) { return glm::vec3(positions[i]); };
   auto less_float = [](const glm::vec3& a, const glm::vec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;

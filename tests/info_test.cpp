@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "core/info.h"
 
@@ -94,6 +95,34 @@ TEST(Info, streamedInfoEqualsTheWholeSetsWhateverTheBlocks) {
   Result<StreamedInfo> failed = computeStreamedInfo(10, false, 0, failing, 4);
   ASSERT_FALSE(failed.ok());
   EXPECT_EQ(failed.error().message, "x.ply: truncated");
+}
+
+// Non-finite points (read with --allow-nonfinite) take no part in the nearest distance, whole or
+// streamed, and do not upset the trees' ordering.
+TEST(Info, nonFinitePointsAreLeftOutOfTheNearestDistance) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  PointSet s;
+  for (int k = 0; k < 300; ++k) {
+    s.positions.emplace_back(k * 2.0, 0.0, 0.0);
+    if (k % 7 == 0) s.positions.emplace_back(nan, k, 0.0);
+    if (k % 11 == 0) s.positions.emplace_back(0.0, -inf, k);
+  }
+  s.positions.emplace_back(101.5, 0.0, 0.0);  // 1.5 from 100, 0.5 from 102
+  const PointSetInfo whole = computeInfo(s, s.size());
+  EXPECT_EQ(whole.min_neighbor_distance, 0.5);
+  EXPECT_EQ(whole.float_merged, 0u);
+  const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+    out.positions.assign(s.positions.begin() + static_cast<long>(first), s.positions.begin() + static_cast<long>(first + n));
+    return okStatus();
+  };
+  Result<StreamedInfo> streamed = computeStreamedInfo(s.size(), false, 0, read, 13, s.size());
+  ASSERT_TRUE(streamed.ok());
+  EXPECT_EQ(streamed->info.min_neighbor_distance, 0.5);
+  // Without infinities the float32 merge count runs, over the finite points: 1 + 1e-12 merges.
+  PointSet merged;
+  for (int k = 0; k < 50; ++k) merged.positions.emplace_back(k % 5 == 0 ? nan : k, 0.0, 0.0);
+  merged.positions.emplace_back(1.0 + 1e-12, 0.0, 0.0);
+  EXPECT_EQ(computeInfo(merged).float_merged, 1u);
 }
 
 TEST(Info, emptySetHasZeroCount) {
