@@ -5,7 +5,8 @@
 # frames after 5 warm-up, the GPU median from timestamps, e2e_ms (encode + upload + one frame +
 # readback) and the whole command's wall time. Also `dpoint bench copy` (the copy bandwidth).
 # One line per run in $OUT/speed.tsv. SETS picks the datasets (default: all but the 1e9-point
-# one), STREAM passes --stream (auto: sets above 2^26 points are streamed from the file).
+# one), STREAM passes --stream (auto: sets above 2^26 points are streamed from the file), EXTRA more
+# render arguments (e.g. a camera that sees nothing: the frame's floor).
 set -euo pipefail
 source bench/gpu_env.sh
 d=${BIN:-.gpu/dpoint}  # BIN: another build to compare, LABEL: its name in the table
@@ -21,18 +22,19 @@ gen() {
 }
 
 results=$out/speed.tsv
-[ -s "$results" ] || printf 'dataset\torder\tmode\tpoints\tgpu_ms_median\tgpu_ms_p95\tupload_ms\te2e_ms\twall_s\tpeak_rss_mb\n' >"$results"
+[ -s "$results" ] || printf 'dataset\torder\tmode\tpoints\tgpu_ms_median\tgpu_ms_p95\tupload_ms\te2e_ms\twall_s\tpeak_rss_mb\tgpu_ms_min\n' >"$results"
 field() { sed -n "s/.*\"$1\": {\"median\": \([^,]*\), \"p95\": \([^,]*\),.*/\1\t\2/p" /tmp/r.json; }
+minimum() { sed -n "s/.*\"$1\": {.*\"min\": \([^,}]*\).*/\1/p" /tmp/r.json; }
 value() { sed -n "s/.*\"$1\": \([^,}]*\).*/\1/p" /tmp/r.json | head -1; }
 render() {
   local name=$1 order=$2 file=$3 mode=$4 start end
   start=$(date +%s.%N)
   "$d" render "$file" --backend compute --mode "$mode" --width 1920 --height 1080 --frames "${FRAMES:-50}" \
-    --warmup 5 -q --stream "${STREAM:-auto}" --json /tmp/r.json -o /tmp/r.png
+    --warmup 5 -q --stream "${STREAM:-auto}" --json /tmp/r.json -o /tmp/r.png ${EXTRA:-}
   end=$(date +%s.%N)
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name${LABEL:+ ($LABEL)}" "$order" "$mode" "$(value points)" "$(field gpu_ms)" \
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name${LABEL:+ ($LABEL)}" "$order" "$mode" "$(value points)" "$(field gpu_ms)" \
     "$(value upload_ms)" "$(value e2e_ms)" "$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')" \
-    "$(value peak_rss_mb)" | tee -a "$results"
+    "$(value peak_rss_mb)" "$(minimum gpu_ms)" | tee -a "$results"
 }
 
 for set in ${SETS:-sierpinski mandelbulb random300m}; do

@@ -140,6 +140,20 @@ TEST(Encode, batchOffsetsAreNormalizedToTheirBatchBox) {
       << "the extent and the step are folded into the matrix";
 }
 
+// shaders/project.glsl turns a 21-bit field into a float without an int-to-float conversion: the
+// field with its sign bit flipped, placed in the significand of 1.5·2^23, less 13631488. The same
+// float arithmetic here gives exactly float(q) for every field the encoder writes.
+TEST(Encode, batchOffsetFieldsBecomeExactFloatsWithoutAConversion) {
+  for (int q = -(1 << 20); q < (1 << 20); ++q) {
+    const uint32_t field = static_cast<uint32_t>(q) & 0x1FFFFFu;
+    const uint32_t bits = 0x4B400000u | (field ^ 0x100000u);
+    float biased;
+    std::memcpy(&biased, &bits, sizeof biased);
+    const float value = biased - 13631488.0f;
+    if (value != static_cast<float>(q)) FAIL() << "field of " << q << " gives " << value;
+  }
+}
+
 // The 21-bit fields hold every step from −2^20 to 2^20 − 1 and round half to even; t = 1 (the box's
 // edge, where the extent is exactly the largest offset) clamps one step short.
 TEST(Encode, batchOffsetsPackThreeSignedTwentyOneBitIntegers) {

@@ -39,6 +39,9 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
   if (options.backend == Backend::kCompute)
     points = std::min<uint64_t>(points, uint64_t{facts.max_dispatch_groups_x} * kSplatPointsPerGroup);
   if (options.max_chunk_points) points = std::min(points, options.max_chunk_points);
+  // The compute splat of batch mode reads points in pairs that must share a batch: chunks start
+  // at even points.
+  if (options.mode == PrecisionMode::kBatch) points = std::max<uint64_t>(2, points & ~uint64_t{1});
   return static_cast<size_t>(points);
 }
 
