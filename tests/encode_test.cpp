@@ -1,6 +1,7 @@
 // Per-mode encodings (viewer/encode.h): what each precision mode sends to the GPU.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -138,6 +139,26 @@ TEST(Encode, batchOffsetsAreNormalizedToTheirBatchBox) {
   const glm::dmat4& m = e.batch_matrices[1];
   EXPECT_EQ(m[0][0], camera.projection[0][0] * e.batches[1].extent / kBatchSteps)
       << "the extent and the step are folded into the matrix";
+}
+
+// The encoders round without libm calls; they must round as lround (colours) and nearbyint
+// (batch offsets) do, at and around every tie.
+TEST(Encode, colourAndOffsetRoundingMatchLroundAndNearbyint) {
+  for (int k = 0; k <= 256; ++k) {
+    float v = std::min(1.0f, (static_cast<float>(k) - 0.5f) / 255.0f);
+    for (int step = 0; step < 64 && v >= 0.0f; ++step, v = std::nextafter(v, 0.0f)) {
+      for (float c : {v, std::nextafter(v, 2.0f)}) {
+        const uint32_t expected = 0xff000000u | static_cast<uint32_t>(std::lround(std::min(c, 1.0f) * 255.0f));
+        EXPECT_EQ(encodeColor(glm::vec3(c, 0.0f, 0.0f)) & 0xff0000ffu, expected) << c;
+      }
+    }
+  }
+  const double step = 1.0 / kBatchSteps;
+  for (double t : {0.5 * step, 1.5 * step, 2.5 * step, -0.5 * step, -1.5 * step, 0.49999999999 * step,
+                   (1 << 19) * step + 0.5 * step, -0.75 + 0.5 * step, 0.999 + 0.5 * step, 0.3, -0.7}) {
+    const int expected = static_cast<int>(std::nearbyint(t * kBatchSteps));
+    EXPECT_EQ(unpackBatchOffset(packBatchOffset({t, -t, t})), glm::ivec3(expected, -expected, expected)) << t;
+  }
 }
 
 // shaders/project.glsl turns a 21-bit field into a float without an int-to-float conversion: the
