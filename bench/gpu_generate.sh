@@ -65,6 +65,7 @@ for name in ${CASES-bulb1024 bulb2048 julia1024 zoom4096}; do  # CASES= (empty):
     bulb1024) args="mandelbulb --variant fast --resolution 1024" ;;
     bulb2048) args="mandelbulb --variant fast --resolution 2048" ;;
     julia1024) args="julia --resolution 1024" ;;
+    julia2048) args="julia --resolution 2048" ;;
     zoom4096) args="mandelbrot2d --resolution 4096 --width 1e-12 --max-iter 5000" ;;
     *) echo "unknown case $name" >&2; exit 1 ;;
   esac
