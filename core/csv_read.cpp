@@ -308,8 +308,8 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   if (Status s = checkMemory(path + ": " + std::to_string(lines) + " lines", lines * row_bytes, options.max_memory); !s)
     return s.error();
   PointSet points;
-  points.positions.resize(lines);
-  if (hasColorColumns(layout)) points.colors.resize(lines);
+  resizePrefaulted(points.positions, static_cast<size_t>(lines), threads);
+  if (hasColorColumns(layout)) resizePrefaulted(points.colors, static_cast<size_t>(lines), threads);
 
   // Pass 2: parse. The first error by line number wins, whatever the thread count.
   const LineParser parser(path, layout, options.allow_nonfinite);

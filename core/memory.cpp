@@ -1,9 +1,13 @@
 #include "core/memory.h"
 
+#include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+
+#include "core/parallel.h"
 
 namespace dpoint {
 
@@ -47,6 +51,22 @@ Status checkMemory(const std::string& what, uint64_t needed, uint64_t limit) {
   return Error{what + " needs about " + formatBytes(needed) + ", more than the limit of " + formatBytes(limit) +
                    " (--max-memory)",
                ExitCode::kResourceLimit};
+}
+
+void prefaultForWrite(void* data, size_t bytes, unsigned threads) {
+#ifdef MADV_POPULATE_WRITE
+  constexpr uintptr_t kChunk = uintptr_t{8} << 20;  // a multiple of every page size
+  const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + page - 1) & ~(page - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(data) + bytes;
+  if (end > begin + kChunk)
+    parallelFor((end - begin + kChunk - 1) / kChunk, threads, [&](size_t chunk, unsigned) {
+      const uintptr_t first = begin + chunk * kChunk;
+      (void)madvise(reinterpret_cast<void*>(first), std::min(kChunk, end - first), MADV_POPULATE_WRITE);
+    });
+#else
+  (void)data, (void)bytes, (void)threads;
+#endif
 }
 
 }  // namespace dpoint

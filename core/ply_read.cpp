@@ -14,8 +14,6 @@
 #include "core/ply.h"
 
 #include <fast_float/fast_float.h>
-#include <sys/mman.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -123,30 +121,6 @@ bool parseAscii(Type t, std::string_view token, double& out) {
   if (v < kMin[static_cast<int>(t)] || v > kMax[static_cast<int>(t)]) return false;
   out = static_cast<double>(v);
   return true;
-}
-
-// Resizes an empty `v` to n zeroed elements, its pages faulted in on all cores first. Faulting in
-// fresh pages is most of the cost of a big resize (on the 2-core test VM, 0.27 s of the 0.48 s a
-// 16.7M-point read took with a plain resize) and resize takes it on one thread;
-// MADV_POPULATE_WRITE on the reserved storage takes it on every core and changes no byte. It is
-// only a hint: where the kernel lacks it (before Linux 5.14) madvise fails and resize faults the
-// pages itself, with the same result.
-template <typename T>
-void resizePrefaulted(std::vector<T>& v, size_t n, unsigned threads) {
-  assert(v.empty());
-  v.reserve(n);
-#ifdef MADV_POPULATE_WRITE
-  constexpr uintptr_t kChunk = uintptr_t{8} << 20;  // a multiple of every page size
-  const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(v.data()) + page - 1) & ~(page - 1);
-  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + n);
-  if (end > begin + kChunk)
-    parallelFor((end - begin + kChunk - 1) / kChunk, threads, [&](size_t chunk, unsigned) {
-      const uintptr_t first = begin + chunk * kChunk;
-      (void)madvise(reinterpret_cast<void*>(first), std::min(kChunk, end - first), MADV_POPULATE_WRITE);
-    });
-#endif
-  v.resize(n);
 }
 
 std::string quote(std::string_view text) { return "'" + printableExcerpt(text) + "'"; }
