@@ -168,12 +168,14 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   return s + "\n}\n";
 }
 
-// --shade auto: eye-dome lighting for a 3D view, none for a 2D set (a flat set has no depth to
-// shade) and with --error (whose image check compares plain pixels with the reference raster).
-Shading shadingFor(const RenderCliOptions& o, const Camera& camera) {
+// --shade auto: eye-dome lighting for a 3D set, none for a 2D one (every z is 0) and with --error
+// (whose image check compares plain pixels with the reference raster). It keys on the data, not
+// the camera: a survey seen from above with --ortho still has the relief EDL brings out, and a
+// flat set seen in perspective has no relief, only the depth ramp of a tilted plane.
+Shading shadingFor(const RenderCliOptions& o, const Bounds& bounds) {
   if (o.shade == "edl") return Shading::kEdl;
   if (o.shade == "none" || o.error) return Shading::kNone;
-  return camera.ortho ? Shading::kNone : Shading::kEdl;
+  return bounds.planar ? Shading::kNone : Shading::kEdl;
 }
 
 // A view of --views: its label and the fit's direction (target to eye) and up.
@@ -280,7 +282,7 @@ RenderOptions renderOptions(const RenderCliOptions& o, const RunFacts& run, Prec
   options.probe = o.error;
   options.native_path = run.native_path;
   options.max_chunk_points = o.chunk_points;
-  options.shading = shadingFor(o, camera);
+  options.shading = shadingFor(o, run.bounds);
   options.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
   return options;
 }
@@ -609,8 +611,8 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--shade", o->shade,
                   "auto|none|edl. edl: eye-dome lighting, a screen-space pass over the depth of the visible points\n"
                   "that darkens a pixel by how far its neighbours stand in front of it, so a surface of 1-px points\n"
-                  "reads as a surface (as in Potree and CloudCompare). auto: edl for a 3D view, none for 2D sets\n"
-                  "(ortho views) and with --error; GPU timings exclude it")
+                  "reads as a surface (as in Potree and CloudCompare). auto: edl for 3D sets, none for 2D sets\n"
+                  "(every z is 0) and with --error, whatever the camera (--ortho, --eye); GPU timings exclude it")
       ->default_val("auto");
   cmd->add_option("--edl-strength", o->edl_strength, "Eye-dome darkening: exp(-strength * 300 * mean log2 depth step)")
       ->default_val(1.0);

@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
+#include "converters/point_io.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -28,6 +31,44 @@ TEST(CliLas, convertLasToCsvWritesEveryPointWithItsColour) {
   // The first record: X, Y, Z = 63701224, 84902831, 43166 at scale 0.01; colour 68, 77, 88 of 255.
   EXPECT_EQ(csv.rfind("x,y,z,r,g,b\n637012.24,849028.31,431.66,0.26666668,0.3019608,0.34509805\n", 0), 0u)
       << csv.substr(0, 120);
+}
+
+// LAS to PLY and to GLB as a user converts, read back. PLY stores double x, y, z: every position
+// comes back bit for bit. GLB stores float32 offsets from the bounding box's centre (the node's
+// translation, a double): each coordinate comes back within float's half-ulp of its offset (2^-24
+// of at most half the box) plus the one double rounding of adding the centre back (2^-53 of it).
+TEST(CliLas, convertLasToPlyAndGlbKeepsEveryPosition) {
+  for (const char* name : {"simple1_4.las", "simple.las"}) {  // 16-bit and 8-bit colours; 1e-6 m and UTM-like
+    SCOPED_TRACE(name);
+    TempDir dir;
+    Result<PointSet> las = readPoints(kCorpus + name);
+    ASSERT_TRUE(las.ok()) << las.error().message;
+    for (const char* output : {"out.ply", "out.glb"}) {
+      test::CommandResult r = runDpoint({"convert", kCorpus + name, "-o", dir.file(output), "--quiet"});
+      ASSERT_EQ(r.exit_code, 0) << output << ": " << r.err;
+    }
+    Result<PointSet> ply = readPoints(dir.file("out.ply"));
+    ASSERT_TRUE(ply.ok()) << ply.error().message;
+    EXPECT_EQ(ply->positions, las->positions);
+    EXPECT_EQ(ply->hasColors(), las->hasColors());
+
+    Result<PointSet> glb = readPoints(dir.file("out.glb"));
+    ASSERT_TRUE(glb.ok()) << glb.error().message;
+    ASSERT_EQ(glb->size(), las->size());
+    const Box box = boundingBox(las->positions);
+    const glm::dvec3 half = 0.5 * (box.max - box.min);
+    double worst = 0.0;  // in units of the bound
+    for (size_t i = 0; i < las->size(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const double want = las->positions[i][k], got = glb->positions[i][k];
+        const double bound = 0x1p-24 * half[k] * (1.0 + 0x1p-20) + 0x1p-53 * std::fabs(want);
+        ASSERT_LE(std::fabs(got - want), bound) << "point " << i << " axis " << k;
+        worst = std::max(worst, std::fabs(got - want) / bound);
+      }
+    }
+    EXPECT_EQ(glb->colors, las->colors) << "float32 colours keep the LAS colours' floats";
+    std::printf("%s: GLB positions within %.3g of the bound\n", name, worst);
+  }
 }
 
 TEST(CliLas, csvToLasToCsvIsByteIdenticalOnTheScaleGrid) {

@@ -257,5 +257,41 @@ TEST(Montage, montageOfSixTilesShowsTitleLabelsPicturesAndColourBar) {
   EXPECT_GT(countColor(montage, kViridisHigh), 0u);
 }
 
+// dpoint render --views 4's sheet: each view's label is drawn, pixel for pixel as drawText draws it,
+// on a dark strip over its picture's top-left corner; the rest of each picture and the 2-px gaps
+// between them are untouched.
+TEST(Montage, contactSheetDrawsEachLabelOnAStripOverItsPicture) {
+  const uint32_t strip = rgba(0x10, 0x10, 0x10), label = rgba(0xf2, 0xf2, 0xf2), gap = rgba(0x20, 0x20, 0x20);
+  const uint32_t w = 120, h = 80;
+  std::vector<LabelledView> views = {{"front (fp32)", filled(w, h, rgba(200, 0, 0))},
+                                     {"side (native)", filled(w, h, rgba(0, 200, 0))},
+                                     {"top (df64)", filled(w, h, rgba(0, 0, 200))},
+                                     {"three-quarter (rte)", filled(w, h, rgba(200, 200, 0))}};
+  const Image sheet = composeContactSheet(views, 2);
+  ASSERT_EQ(sheet.width, 2 * w + 2);
+  ASSERT_EQ(sheet.height, 2 * h + 2);
+  for (size_t i = 0; i < views.size(); ++i) {
+    SCOPED_TRACE(views[i].label);
+    // Pictures under 400 px wide get scale-1 text, 3 px in from the corner and the strip's edges.
+    Image glyphs = filled(w, h, kBlack);
+    drawText(glyphs, 3, 3, views[i].label, label, 1);
+    const uint32_t strip_w = uint32_t(textWidth(views[i].label, 1)) + 6, strip_h = kTextGlyphUnits + 6;
+    const uint32_t x0 = uint32_t(i % 2) * (w + 2), y0 = uint32_t(i / 2) * (h + 2);
+    size_t label_pixels = 0;
+    for (uint32_t y = 0; y < h; ++y) {
+      for (uint32_t x = 0; x < w; ++x) {
+        const uint32_t want = pixel(glyphs, x, y) == label     ? label
+                              : x < strip_w && y < strip_h ? strip
+                                                            : pixel(views[i].picture, x, y);
+        ASSERT_EQ(pixel(sheet, x0 + x, y0 + y), want) << x << "," << y;
+        label_pixels += want == label;
+      }
+    }
+    EXPECT_GT(label_pixels, views[i].label.size()) << "several pixels a glyph";
+  }
+  for (uint32_t y = 0; y < sheet.height; ++y) EXPECT_EQ(pixel(sheet, w, y), gap) << y;
+  for (uint32_t x = 0; x < sheet.width; ++x) EXPECT_EQ(pixel(sheet, x, h + 1), gap) << x;
+}
+
 }  // namespace
 }  // namespace dpoint

@@ -25,8 +25,8 @@ done
 
 # A real survey (issue #13): the corpus's simple.las (TerraScan, UTM-like coordinates at 0.01 m)
 # when ../shared sits beside the checkout: plain and with eye-dome lighting and elevation colours,
-# and the hard case: one return seen 1 m wide (2 mm a pixel) from straight above, off centre,
-# in fp32 (float's 6 cm spacing at 853 km moves it) and native (on its pixel).
+# and the hard case: one return seen 1 m wide (3.9 mm a pixel: 1 m over 256 px) from straight
+# above, off centre, in fp32 (float's 6 cm spacing at 853 km moves it) and native (on its pixel).
 las=$here/../../../shared/corpus/las/simple.las
 if [ -f "$las" ]; then
   "$dpoint" render "$las" -o "$here/simple_las_plain.png" --shade none --width 480 --height 480
