@@ -249,7 +249,9 @@ VKAPI_ATTR VkBool32 VKAPI_CALL VulkanContext::onMessage(VkDebugUtilsMessageSever
                                                        const VkDebugUtilsMessengerCallbackDataEXT* data, void* self) {
   std::string line = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "validation error: " : "validation warning: ";
   line += data && data->pMessage ? data->pMessage : "(no message)";
-  static_cast<VulkanContext*>(self)->messages_.push_back(std::move(line));
+  auto* context = static_cast<VulkanContext*>(self);
+  std::lock_guard<std::mutex> lock(context->messages_mutex_);
+  context->messages_.push_back(std::move(line));
   return VK_FALSE;
 }
 

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -72,7 +73,10 @@ class VulkanContext {
 
   // Validation messages (warnings and errors) seen so far, one line each.
   const std::vector<std::string>& validationMessages() const { return messages_; }
-  void clearValidationMessages() { messages_.clear(); }
+  void clearValidationMessages() {
+    std::lock_guard<std::mutex> lock(messages_mutex_);
+    messages_.clear();
+  }
 
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
@@ -92,6 +96,7 @@ class VulkanContext {
                                                  const VkDebugUtilsMessengerCallbackDataEXT* data, void* self);
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   std::vector<std::string> messages_;
+  std::mutex messages_mutex_;  // the layer may call back from two threads (render makes pipelines beside the upload)
 };
 
 // Every physical device the loader reports, with its facts (creates and destroys an instance).
