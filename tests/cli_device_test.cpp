@@ -101,8 +101,9 @@ TEST(CliGenerateDevice, seedVariantAndMissingDevicesAreRefused) {
   EXPECT_NE(r.err.find("--grid-out stores counts up to 65535"), std::string::npos) << r.err;
 }
 
-// Vulkan faults (issue #12) with the test switch: a device without shaderFloat64 and a device lost
-// at a submission each end the run with exit 3 and one line naming the problem, well before a generous bound (no hang), and
+// Vulkan faults (issue #12) with the test switch: a device without shaderFloat64, a device lost at
+// a submission, and one lost at the first fence wait after a submission went through each end the
+// run with exit 3 and one line naming the problem, well before a generous bound (no hang), and
 // leave nothing (no output, no temporary) in the folder.
 TEST(CliGenerateDevice, vulkanFaultsEndWithOneLineAndNoOutput) {
   struct Case {
@@ -112,6 +113,7 @@ TEST(CliGenerateDevice, vulkanFaultsEndWithOneLineAndNoOutput) {
   const std::vector<Case> cases = {
       {"no-float64", "lacks shaderFloat64, which generation on the device needs"},
       {"device-lost", "VK_ERROR_DEVICE_LOST"},
+      {"device-lost-wait", "VK_ERROR_DEVICE_LOST"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.fault);
@@ -140,14 +142,14 @@ TEST(CliGenerateDevice, vulkanFaultsEndWithOneLineAndNoOutput) {
 }
 
 // The bench's device work starts with its own submissions (the precision self-test, the copy
-// bandwidth): a device lost at a submission ends `bench` and `bench copy` with
+// bandwidth): a device lost at a submission or at a fence wait ends `bench` and `bench copy` with
 // exit 3 and one line, before any dataset, cache folder or report is made.
 TEST(CliGenerateDevice, benchEndsWithOneLineAndNothingWrittenOnALostDevice) {
   const std::vector<std::vector<std::string>> commands = {
       {"bench", "--device", "cpu", "-q", "--out", "report", "--cache", "cache"},
       {"bench", "copy", "--device", "cpu", "--copy-bytes", "1M", "--copy-repeats", "1"},
   };
-  for (const char* fault : {"device-lost"}) {
+  for (const char* fault : {"device-lost", "device-lost-wait"}) {
     for (const std::vector<std::string>& command : commands) {
       SCOPED_TRACE(std::string(fault) + (command[1] == "copy" ? " bench copy" : " bench"));
       TempDir dir;

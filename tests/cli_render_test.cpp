@@ -253,8 +253,8 @@ TEST(CliRender, streamedPlyDrawsTheSamePicture) {
 }
 
 // Vulkan faults (issue #12): no driver, a device without a feature the run needs (hidden by the
-// test switch), a lost device (injected at every queue submission), and a device-memory budget
-// too small: each ends the run
+// test switch), a lost device (injected at every queue submission, or at the first fence wait
+// after a submission that went through), and a device-memory budget too small: each ends the run
 // with one line on stderr and the exit code, well before a generous bound (no hang), and leaves
 // neither the picture nor the --json report.
 TEST(CliRender, vulkanFaultsEndWithOneLineAndNoPicture) {
@@ -271,6 +271,7 @@ TEST(CliRender, vulkanFaultsEndWithOneLineAndNoPicture) {
       {"DPOINT_TEST_VULKAN_FAULT=no-float64", {"--mode", "native"}, 3, "needs shaderFloat64"},
       {"DPOINT_TEST_VULKAN_FAULT=no-int64-atomics", {"--backend", "compute"}, 3, "shaderBufferInt64Atomics"},
       {"DPOINT_TEST_VULKAN_FAULT=device-lost", {}, 3, "VK_ERROR_DEVICE_LOST"},
+      {"DPOINT_TEST_VULKAN_FAULT=device-lost-wait", {}, 3, "VK_ERROR_DEVICE_LOST"},
       {"DPOINT_TEST_VULKAN_FAULT=", {"--max-device-memory", "1M"}, 3, "--max-device-memory"},
   };
   for (const Case& c : cases) {
