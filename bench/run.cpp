@@ -198,10 +198,6 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
     for (BenchCase& c : suiteCases(suite))
       if (keptBySizes(c, options.sizes)) run.cases.push_back(std::move(c));
   }
-  std::error_code ec;
-  std::filesystem::create_directories(options.cache_dir, ec);
-  if (ec) return Error{"cannot create the dataset cache " + options.cache_dir + ": " + ec.message(), ExitCode::kBadInput};
-
   Result<SelfTest> self_test = runPrecisionSelfTest(context);
   if (!self_test) return self_test.error();
   if (options.measure_copy_bandwidth) {
@@ -211,6 +207,11 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
     if (options.log) options.log("copy bandwidth: " + copyBandwidthText(*copy));
   }
   const CopyBandwidth* copy = run.copy_bandwidth ? &*run.copy_bandwidth : nullptr;
+  // Made only once the device has passed its first submissions: a bench that fails there (no
+  // feature, a lost device) leaves nothing behind.
+  std::error_code ec;
+  std::filesystem::create_directories(options.cache_dir, ec);
+  if (ec) return Error{"cannot create the dataset cache " + options.cache_dir + ": " + ec.message(), ExitCode::kBadInput};
   const size_t total = run.cases.size() * options.backends.size() * kModeCount;
   size_t done = 0;
   for (const BenchCase& c : run.cases) {

@@ -1,8 +1,11 @@
 // dpoint generate --device as a user runs it, on lavapipe here (--device cpu) with the validation
 // layer: each kind's grid (--grid-out) and output file equal the CPU path's at small odd and even
-// resolutions, whole and in tiles; the seed variant and missing devices are refused with exit codes.
+// resolutions, whole and in tiles; the seed variant and missing devices are refused with exit codes;
+// Vulkan faults (the DPOINT_TEST_VULKAN_FAULT switch) end generate and bench cleanly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -96,6 +99,71 @@ TEST(CliGenerateDevice, seedVariantAndMissingDevicesAreRefused) {
                  dir.file("g"), "-o", dir.file("m.csv")});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("--grid-out stores counts up to 65535"), std::string::npos) << r.err;
+}
+
+// Vulkan faults (issue #12) with the test switch: a device without shaderFloat64, a device lost at
+// a submission, and one lost at the first fence wait after a submission went through each end the
+// run with exit 3 and one line naming the problem, well before a generous bound (no hang), and
+// leave nothing (no output, no temporary) in the folder.
+TEST(CliGenerateDevice, vulkanFaultsEndWithOneLineAndNoOutput) {
+  struct Case {
+    const char* fault;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"no-float64", "lacks shaderFloat64, which generation on the device needs"},
+      {"device-lost", "VK_ERROR_DEVICE_LOST"},
+      {"device-lost-wait", "VK_ERROR_DEVICE_LOST"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.fault);
+    TempDir dir;
+    test::CommandResult r = test::runCommand(
+        {"/usr/bin/env", std::string("DPOINT_TEST_VULKAN_FAULT=") + c.fault, DPOINT_EXE, "generate", "mandelbulb",
+         "--variant", "fast", "--resolution", "16", "--device", "cpu", "-q", "-o", dir.file("X.ply")},
+        std::chrono::seconds(60));
+    ASSERT_FALSE(r.timed_out);
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    EXPECT_TRUE(test::contains(r.err, c.message));
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(dir.entries().empty());
+  }
+  // Generation on the device uses no 64-bit atomics: with them hidden it runs, to the same file.
+  TempDir dir;
+  const std::vector<std::string> args = {DPOINT_EXE, "generate", "mandelbulb", "--variant", "fast", "--resolution",
+                                         "16", "--device", "cpu", "-q", "-o"};
+  test::CommandResult plain = test::runCommand(concat(concat({"/usr/bin/env", "DPOINT_TEST_VULKAN_FAULT="}, args),
+                                                      {dir.file("plain.ply")}));
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  test::CommandResult hidden = test::runCommand(
+      concat(concat({"/usr/bin/env", "DPOINT_TEST_VULKAN_FAULT=no-int64-atomics"}, args), {dir.file("hidden.ply")}));
+  ASSERT_EQ(hidden.exit_code, 0) << hidden.err;
+  EXPECT_TRUE(readFile(dir.file("plain.ply")) == readFile(dir.file("hidden.ply")));
+}
+
+// The bench's device work starts with its own submissions (the precision self-test, the copy
+// bandwidth): a device lost at a submission or at a fence wait ends `bench` and `bench copy` with
+// exit 3 and one line, before any dataset, cache folder or report is made.
+TEST(CliGenerateDevice, benchEndsWithOneLineAndNothingWrittenOnALostDevice) {
+  const std::vector<std::vector<std::string>> commands = {
+      {"bench", "--device", "cpu", "-q", "--out", "report", "--cache", "cache"},
+      {"bench", "copy", "--device", "cpu", "--copy-bytes", "1M", "--copy-repeats", "1"},
+  };
+  for (const char* fault : {"device-lost", "device-lost-wait"}) {
+    for (const std::vector<std::string>& command : commands) {
+      SCOPED_TRACE(std::string(fault) + (command[1] == "copy" ? " bench copy" : " bench"));
+      TempDir dir;
+      std::vector<std::string> argv = {"/usr/bin/env", std::string("DPOINT_TEST_VULKAN_FAULT=") + fault, DPOINT_EXE};
+      for (const std::string& a : command)
+        argv.push_back(a == "report" || a == "cache" ? dir.file(a) : a);
+      test::CommandResult r = test::runCommand(argv, std::chrono::seconds(60));
+      ASSERT_FALSE(r.timed_out);
+      EXPECT_EQ(r.exit_code, 3) << r.err;
+      EXPECT_TRUE(test::contains(r.err, "VK_ERROR_DEVICE_LOST"));
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_TRUE(dir.entries().empty());
+    }
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "test_support.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace dpoint::test {
 
@@ -50,7 +52,7 @@ void writeFile(const std::string& path, const std::string& bytes) {
 
 bool fileExists(const std::string& path) { return std::filesystem::exists(path); }
 
-CommandResult runCommand(const std::vector<std::string>& argv) {
+CommandResult runCommand(const std::vector<std::string>& argv, std::chrono::seconds limit) {
   TempDir dir;
   const std::string out_path = dir.file("out"), err_path = dir.file("err");
   pid_t pid = ::fork();
@@ -69,8 +71,21 @@ CommandResult runCommand(const std::vector<std::string>& argv) {
     ::_exit(127);
   }
   int status = 0;
-  ::waitpid(pid, &status, 0);
   CommandResult r;
+  if (limit.count() == 0) {
+    ::waitpid(pid, &status, 0);
+  } else {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (::waitpid(pid, &status, WNOHANG) != pid) {
+      if (std::chrono::steady_clock::now() >= end) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        r.timed_out = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = readFile(out_path);
   r.err = readFile(err_path);

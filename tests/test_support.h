@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -33,11 +34,14 @@ bool fileExists(const std::string& path);
 
 struct CommandResult {
   int exit_code = -1;  // -1 when killed by a signal
+  bool timed_out = false;  // killed (SIGKILL) for running past runCommand's limit
   std::string out;
   std::string err;
 };
-// Runs argv[0] with the arguments (no shell), capturing stdout and stderr.
-CommandResult runCommand(const std::vector<std::string>& argv);
+// Runs argv[0] with the arguments (no shell), capturing stdout and stderr. With a non-zero
+// `limit`, a run still going after it is killed and marked timed_out: a bound for "does not
+// hang", generous so that it never measures speed (tests assert no timings).
+CommandResult runCommand(const std::vector<std::string>& argv, std::chrono::seconds limit = std::chrono::seconds(0));
 // Runs build/dpoint with the arguments.
 CommandResult runDpoint(const std::vector<std::string>& args);
 // EXPECT_TRUE(test::contains(message, "part")): a failure prints the whole text.

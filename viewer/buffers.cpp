@@ -101,8 +101,15 @@ Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, con
 void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes) { context.device_memory_used.fetch_sub(bytes); }
 
 VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence) {
-  if (vulkanFaults().device_lost) return VK_ERROR_DEVICE_LOST;
+  if (vulkanFaults().device_lost || context.injected_loss) return VK_ERROR_DEVICE_LOST;
   return vkQueueSubmit(context.queue, 1, &submit, fence);
+}
+
+VkResult waitForFence(const VulkanContext& context, VkFence fence) {
+  const VkResult result = vkWaitForFences(context.device, 1, &fence, VK_TRUE, UINT64_MAX);
+  if (result != VK_SUCCESS || !vulkanFaults().device_lost_wait) return result;
+  context.injected_loss = true;
+  return VK_ERROR_DEVICE_LOST;
 }
 
 // Host caches and device memory agree already for coherent memory; otherwise one range call.
@@ -153,7 +160,7 @@ Status submitOnce(const VulkanContext& context, const std::function<void(VkComma
     submit.pCommandBuffers = &commands;
     result = queueSubmit(context, submit, fence);
   }
-  if (result == VK_SUCCESS) result = vkWaitForFences(context.device, 1, &fence, VK_TRUE, UINT64_MAX);
+  if (result == VK_SUCCESS) result = waitForFence(context, fence);
   cleanup();
   if (result != VK_SUCCESS) return vulkanError("one-shot command submission", result);
   return okStatus();
@@ -194,7 +201,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
   std::vector<Slot> slot(slots);
   auto cleanup = [&]() {
     for (Slot& s : slot) {
-      if (s.busy) vkWaitForFences(context.device, 1, &s.fence, VK_TRUE, UINT64_MAX);
+      if (s.busy) waitForFence(context, s.fence);
       if (s.fence) vkDestroyFence(context.device, s.fence, nullptr);
       if (s.commands) vkFreeCommandBuffers(context.device, context.command_pool, 1, &s.commands);
       destroyBuffer(context, s.staging);
@@ -215,7 +222,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
     for (VkDeviceSize offset = 0; offset < size; offset += piece, ++k) {
       Slot& s = slot[k % slots];
       if (s.busy) {
-        VK_TRY(vkWaitForFences(context.device, 1, &s.fence, VK_TRUE, UINT64_MAX));
+        VK_TRY(waitForFence(context, s.fence));
         VK_TRY(vkResetFences(context.device, 1, &s.fence));
         s.busy = false;
       }
@@ -236,7 +243,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
     }
     for (Slot& s : slot) {
       if (!s.busy) continue;
-      VK_TRY(vkWaitForFences(context.device, 1, &s.fence, VK_TRUE, UINT64_MAX));
+      VK_TRY(waitForFence(context, s.fence));
       s.busy = false;
     }
     return okStatus();

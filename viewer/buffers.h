@@ -27,8 +27,15 @@ void destroyBuffer(const VulkanContext& context, Buffer& buffer);
 Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
 
 // vkQueueSubmit on the context's queue, or VK_ERROR_DEVICE_LOST without submitting under the
-// device-lost test switch (vulkanFaults): every submission goes through here.
+// device-lost test switch (vulkanFaults) or once device-lost-wait has fired: every submission
+// goes through here.
 VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence);
+
+// vkWaitForFences on one fence, without a timeout. Under the device-lost-wait test switch the wait
+// still happens (so no work is in flight when the caller frees what it used) and then reports
+// VK_ERROR_DEVICE_LOST, and so does every later wait and submission: every fence wait goes
+// through here.
+VkResult waitForFence(const VulkanContext& context, VkFence fence);
 
 // Counts `bytes` of device memory against the context's budget (--max-device-memory) before they
 // are allocated: fails with kResourceLimit naming `what`, the size and the budget when they do

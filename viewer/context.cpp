@@ -225,6 +225,7 @@ const VulkanFaults& vulkanFaults() {
       f.no_float64 = f.no_float64 || word == "no-float64";
       f.no_int64_atomics = f.no_int64_atomics || word == "no-int64-atomics";
       f.device_lost = f.device_lost || word == "device-lost";
+      f.device_lost_wait = f.device_lost_wait || word == "device-lost-wait";
       at = end + 1;
     }
     return f;

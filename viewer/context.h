@@ -50,10 +50,12 @@ struct ContextOptions {
 // Test switches for the fault paths (issue #12), from the environment variable
 // DPOINT_TEST_VULKAN_FAULT, a comma-separated list: `no-float64` and `no-int64-atomics` hide the
 // feature as if the device lacked it (listDevices and create both), `device-lost` makes every
-// queue submission fail with VK_ERROR_DEVICE_LOST as a reset or crashed GPU does. Unknown words
-// are ignored. Read once per process.
+// queue submission fail with VK_ERROR_DEVICE_LOST as a reset or crashed GPU does, and
+// `device-lost-wait` lets submissions through but makes the first fence wait report
+// VK_ERROR_DEVICE_LOST, the way a GPU that hangs mid-work is usually seen (buffers.h,
+// waitForFence). Unknown words are ignored. Read once per process.
 struct VulkanFaults {
-  bool no_float64 = false, no_int64_atomics = false, device_lost = false;
+  bool no_float64 = false, no_int64_atomics = false, device_lost = false, device_lost_wait = false;
 };
 const VulkanFaults& vulkanFaults();
 
@@ -88,6 +90,9 @@ class VulkanContext {
   // Device memory allocated through viewer/buffers and the budget it must stay in (0: none).
   uint64_t device_memory_budget = 0;
   mutable std::atomic<uint64_t> device_memory_used{0};
+  // Set once the device-lost-wait test switch has reported a loss: from then on the device stays
+  // lost for every submission and wait, as a real lost device does.
+  mutable std::atomic<bool> injected_loss{false};
 
  private:
   VulkanContext() = default;

@@ -150,7 +150,7 @@ Status GpuEscape::init() {
 GpuEscape::~GpuEscape() {
   const VkDevice device = context_.device;
   for (Slot& slot : slots_) {
-    if (slot.points) vkWaitForFences(device, 1, &slot.fence, VK_TRUE, UINT64_MAX);
+    if (slot.points) waitForFence(context_, slot.fence);
     if (slot.fence) vkDestroyFence(device, slot.fence, nullptr);
     if (slot.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &slot.commands);
     destroyBuffer(context_, slot.counts);
@@ -182,7 +182,7 @@ Status GpuEscape::upload(Buffer& target, const void* data, size_t bytes, const s
 Status GpuEscape::finish(Slot& slot) {
   if (!slot.points) return okStatus();
   const auto start = std::chrono::steady_clock::now();
-  VK_TRY(vkWaitForFences(context_.device, 1, &slot.fence, VK_TRUE, UINT64_MAX));
+  VK_TRY(waitForFence(context_, slot.fence));
   const auto waited = std::chrono::steady_clock::now();
   const uint64_t points = slot.points;
   slot.points = 0;

@@ -311,7 +311,7 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &r.frame_commands;
     VK_TRY(queueSubmit(context, submit, r.fence));
-    VK_TRY(vkWaitForFences(context.device, 1, &r.fence, VK_TRUE, UINT64_MAX));
+    VK_TRY(waitForFence(context, r.fence));
     double wall = msSince(start);
     VK_TRY(vkResetFences(context.device, 1, &r.fence));
     if (frame < options.warmup_frames) continue;
