@@ -15,8 +15,10 @@ done
 
 # Readable previews (issue #13): the same Mandelbulb and a level-4 Menger sponge as plain 1-px
 # points and as `dpoint render` draws them by default (eye-dome lighting, --point-size auto),
-# and the Mandelbulb's four-view contact sheet.
-"$dpoint" generate menger --level 4 --quiet -o "$work/menger.ply"
+# and the Mandelbulb's four-view contact sheet. The sponge is the voxel method's surface (res 243,
+# one voxel per smallest cube): the exact method's vertices sit only on the lattice, where a
+# hole's back wall lines up with its front face and the holes do not show.
+"$dpoint" generate menger --level 4 --method voxel --resolution 243 --quiet -o "$work/menger.ply"
 for set in mandelbulb_earth menger; do
   "$dpoint" render "$work/$set.ply" -o "$here/${set}_plain.png" --shade none --point-size 1 --width 480 --height 480
   "$dpoint" render "$work/$set.ply" -o "$here/${set}_edl.png" --width 480 --height 480
