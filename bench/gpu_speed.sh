@@ -43,6 +43,7 @@ for set in ${SETS:-sierpinski mandelbulb random300m}; do
     mandelbulb) args=(mandelbulb --resolution 1024 --variant fast) ;;
     random300m) args=(random2d --count 300000000) ;;
     random1g) args=(random2d --count 1000000000) ;;  # 24 GB of binary PLY
+    menger) args=(menger --method voxel --level 4 --resolution 482) ;;  # 11.9M, the bench's largest Menger
     *) echo "unknown set $set" >&2; exit 1 ;;
   esac
   for order in ${ORDERS:-input morton}; do
