@@ -4,8 +4,8 @@
 # `dpoint render --backend compute` per dataset, order and mode at 1920x1080: FRAMES (50) timed
 # frames after 5 warm-up, the GPU median from timestamps, e2e_ms (encode + upload + one frame +
 # readback) and the whole command's wall time. Also `dpoint bench copy` (the copy bandwidth).
-# One line per run in $OUT/speed.tsv. SETS picks the datasets (default: all but the 1e9-point
-# one), STREAM passes --stream (auto: sets above 2^26 points are streamed from the file), EXTRA more
+# One line per run in $OUT/speed.tsv. SETS picks the datasets (default: sierpinski mandelbulb
+# random300m; also menger, random1g), STREAM passes --stream (auto: sets above 2^26 points are streamed from the file), EXTRA more
 # render arguments (e.g. a camera that sees nothing: the frame's floor).
 set -euo pipefail
 source bench/gpu_env.sh
