@@ -142,6 +142,10 @@ std::string jsonReport(const RenderCliOptions& o, const VulkanContext& context, 
   } else {
     s += "  \"gpu_ms\": {\"median\": " + num(gpu_median) + ", \"p95\": " + num(percentileOf(r.gpu_ms, 95)) +
          ", \"min\": " + num(*std::min_element(r.gpu_ms.begin(), r.gpu_ms.end())) + "},\n";
+    // Every timed frame in order: a slow start (the first frames after a large upload) shows here.
+    s += "  \"gpu_ms_each\": [";
+    for (size_t i = 0; i < r.gpu_ms.size(); ++i) s += (i ? ", " : "") + num(r.gpu_ms[i]);
+    s += "],\n";
   }
   s += "  \"frame_ms\": {\"median\": " + num(frame_median) + ", \"p95\": " + num(percentileOf(r.frame_ms, 95)) + "},\n";
   s += "  \"upload_ms\": " + num(r.upload_ms) + ",\n  \"readback_ms\": " + num(r.readback_ms) + ",\n";

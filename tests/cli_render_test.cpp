@@ -53,6 +53,11 @@ TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
   EXPECT_EQ(jsonNumber(json, "bytes_per_point"), 28.0);
   EXPECT_EQ(jsonNumber(json, "width"), 320.0);
   EXPECT_GT(jsonNumber(json, "points_per_s"), 0.0);
+  // Every timed frame, in order: three numbers for --frames 3.
+  const size_t each_at = json.find("\"gpu_ms_each\": [");
+  ASSERT_NE(each_at, std::string::npos) << json;
+  const std::string each = json.substr(each_at, json.find(']', each_at) - each_at);
+  EXPECT_EQ(std::count(each.begin(), each.end(), ','), 2) << each;
   EXPECT_LT(jsonNumber(json, "max"), 0.01);
   EXPECT_NE(r.out.find("error: max"), std::string::npos) << r.out;
   // Where the wall time went, step by step, and the peak memory (issue #11's time to a picture).
