@@ -16,12 +16,8 @@ namespace {
 
 using test::readFile;
 using test::runDpoint;
+using test::concat;
 using test::TempDir;
-
-std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
-}
 
 TEST(CliGenerateDevice, gridAndOutputOnTheDeviceEqualTheCpuPathsForEachKind) {
   const std::vector<std::vector<std::string>> kinds = {

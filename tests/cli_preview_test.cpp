@@ -16,6 +16,7 @@
 namespace dpoint {
 namespace {
 
+using test::concat;
 using test::readFile;
 using test::runDpoint;
 using test::TempDir;
@@ -86,16 +87,12 @@ TEST(CliPreview, threeDimensionalSetSeenOrthographicallyIsShaded) {
   TempDir dir;
   const std::string mb = mandelbulb(dir);
   const std::vector<std::string> ortho = {"--ortho", "--point-size", "1"};
-  auto with = [&](std::vector<std::string> extra) {
-    extra.insert(extra.end(), ortho.begin(), ortho.end());
-    return extra;
-  };
   // Binary PNGs compared with ==, so a failure does not print them.
-  const std::string plain = render(dir, mb, "none.png", with({"--shade", "none"}));
-  const std::string edl = render(dir, mb, "edl.png", with({"--shade", "edl"}));
+  const std::string plain = render(dir, mb, "none.png", concat({"--shade", "none"}, ortho));
+  const std::string edl = render(dir, mb, "edl.png", concat({"--shade", "edl"}, ortho));
   ASSERT_FALSE(edl == plain) << "EDL must show on this view for the test to mean anything";
   EXPECT_TRUE(render(dir, mb, "auto.png", ortho) == edl) << "--ortho on a 3D set: --shade auto is edl";
-  EXPECT_TRUE(render(dir, mb, "error.png", with({"--error"})) == plain) << "--error draws plain pixels";
+  EXPECT_TRUE(render(dir, mb, "error.png", concat({"--error"}, ortho)) == plain) << "--error draws plain pixels";
 }
 
 // A 2D set (every z = 0) is drawn plain by default: from the default view straight down and from
@@ -107,12 +104,8 @@ TEST(CliPreview, twoDimensionalSetIsPlainByDefaultFromAnyEye) {
   const std::string flat = dir.file("flat.csv");
   EXPECT_TRUE(render(dir, flat, "auto.png", {}) == render(dir, flat, "none.png", {"--shade", "none"}));
   const std::vector<std::string> eye = {"--eye", "0.5,-1.2,1.0", "--target", "0.5,0.5,0", "--up", "0,0,1"};
-  auto with = [&](std::vector<std::string> extra) {
-    extra.insert(extra.end(), eye.begin(), eye.end());
-    return extra;
-  };
-  const std::string plain = render(dir, flat, "eye_none.png", with({"--shade", "none"}));
-  ASSERT_FALSE(render(dir, flat, "eye_edl.png", with({"--shade", "edl"})) == plain)
+  const std::string plain = render(dir, flat, "eye_none.png", concat({"--shade", "none"}, eye));
+  ASSERT_FALSE(render(dir, flat, "eye_edl.png", concat({"--shade", "edl"}, eye)) == plain)
       << "EDL must show on this view for the test to mean anything";
   EXPECT_TRUE(render(dir, flat, "eye_auto.png", eye) == plain) << "a 2D set from an oblique eye: --shade auto is none";
 }
@@ -123,11 +116,7 @@ TEST(CliPreview, threeDimensionalSetWithoutColoursDefaultsToElevation) {
   writeFile(dir.file("bare.csv"), paraboloid(false));
   writeFile(dir.file("white.csv"), paraboloid(true));
   const std::vector<std::string> plain = {"--shade", "none", "--point-size", "1"};
-  auto with = [&](std::vector<std::string> extra) {
-    extra.insert(extra.end(), plain.begin(), plain.end());
-    return extra;
-  };
-  const std::string elevation = render(dir, dir.file("bare.csv"), "elevation.png", with({"--color", "elevation"}));
+  const std::string elevation = render(dir, dir.file("bare.csv"), "elevation.png", concat({"--color", "elevation"}, plain));
   EXPECT_TRUE(render(dir, dir.file("bare.csv"), "auto.png", plain) == elevation);
   EXPECT_FALSE(render(dir, dir.file("white.csv"), "white.png", plain) == elevation) << "elevation is not white";
 }

@@ -14,12 +14,8 @@ namespace {
 using test::readFile;
 using test::runCommand;
 using test::runDpoint;
+using test::concat;
 using test::TempDir;
-
-std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
-}
 
 // Runs the N tiles and the merge into `out_name`, returns the merged bytes ("" on failure).
 std::string mergedTiles(const TempDir& dir, const std::vector<std::string>& kind, uint32_t count,

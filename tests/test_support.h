@@ -50,6 +50,12 @@ inline ::testing::AssertionResult contains(const std::string& text, const std::s
   return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
 }
 
+// The arguments of `a` followed by those of `b`: one command line built from shared pieces.
+inline std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 // Bytes process `pid` has written so far (/proc/PID/io wchar); 0 once it is gone.
 uint64_t bytesWrittenBy(int pid);
 
