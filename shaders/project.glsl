@@ -26,9 +26,9 @@ layout(std140, set = 0, binding = 0) uniform CameraBlock { dmat4 projection_rota
 layout(std430, set = 0, binding = 2) readonly buffer Batches { mat4 batch_mvp[]; };
 // A point's offset in its batch (viewer/encode.h): three 21-bit two's-complement integers in one
 // 64-bit word, x in bits 0–20, y in 21–41, z in 42–62; each is exact as a float.
-// A field f becomes a float without an int-to-float conversion (a quarter-rate instruction on
-// NVIDIA, and the batch splat's limit there): f ^ 2^20 is n + 2^20 in [0, 2^21), which placed in
-// the significand of 1.5·2^23 gives the float 1.5·2^23 + 2^20 + n exactly; subtracting
+// A field f becomes a float without an int-to-float conversion (lavapipe's batch splat 5% faster;
+// no change on the H100, whose splat waits on memory): f ^ 2^20 is n + 2^20 in [0, 2^21), which
+// placed in the significand of 1.5·2^23 gives the float 1.5·2^23 + 2^20 + n exactly; subtracting
 // 1.5·2^23 + 2^20 = 13631488 (the same binade) is exact too, so the result is n, as float(n) is.
 float offsetField(uint f) {
   precise float n = uintBitsToFloat(0x4B400000u | ((f & 0x1FFFFFu) ^ 0x100000u)) - 13631488.0;
