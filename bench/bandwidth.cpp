@@ -9,7 +9,7 @@
 
 #include "core/memory.h"
 #include "shaders/copy.comp.h"
-#include "viewer/buffers.h"
+#include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
 
 namespace dpoint {
@@ -50,7 +50,7 @@ void accessBarrier(VkCommandBuffer commands) {
   vkCmdPipelineBarrier(commands, kStages, kStages, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
 
-// shaders/copy.comp bound to the scratch buffers: layout, pipeline and descriptor set.
+// shaders/bench/copy.comp bound to the scratch buffers: layout, pipeline and descriptor set.
 Status createShaderCopy(const VulkanContext& context, CopyScratch& s) {
   VkDescriptorSetLayoutBinding bindings[2] = {
       {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},

@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-#include "viewer/context.h"
+#include "vulkan/context.h"
 #include "viewer/encode.h"
 #include "viewer/render.h"
 
@@ -30,7 +30,7 @@ struct CopyBandwidth {
   double copy_ms_median = 0.0;
   double copy_gb_per_s = 0.0;        // bytes / median time (1 GB = 1e9 B): the copy rate
   double read_write_gb_per_s = 0.0;  // 2 · bytes / median time
-  // The same bytes copied by a compute shader (shaders/copy.comp, 16-byte loads and stores); 0 when
+  // The same bytes copied by a compute shader (shaders/bench/copy.comp, 16-byte loads and stores); 0 when
   // the device could not run it.
   double shader_copy_ms_median = 0.0;
   double shader_read_write_gb_per_s = 0.0;
@@ -63,7 +63,7 @@ struct FrameTraffic {
   std::optional<uint64_t> bytes_per_frame;  // compute backend only
 };
 
-// The compute backend (viewer/render_compute.cpp, shaders/points_splat.comp and
+// The compute backend (viewer/render_compute.cpp, shaders/render/points_splat.comp and
 // points_resolve.comp), at point size 1:
 //   points · positionBytes(mode)           the splat pass reads positions only
 //   + pixels · (8 + 8 + 4)                 clear the 8 B key per pixel, read it in the resolve, write

@@ -1,7 +1,7 @@
 // The bench report's montage: per-point error heat maps, stb_easy_font text and the layout of
 // tiles, title and colour bar in one RGBA8 image.
 //
-// The heat map's colours are viridis (viewer/canvas.h): perceptually ordered from dark to bright,
+// The heat map's colours are viridis (image/canvas.h): perceptually ordered from dark to bright,
 // so a larger error reads as brighter at a glance and in grey print.
 #include "bench/montage.h"
 

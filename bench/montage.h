@@ -1,14 +1,14 @@
 // The bench report's montage (issue #10): one hard-case view rendered in every precision mode side
 // by side, each labelled, and under each its per-point error as a heat map with a colour bar.
-// Drawn into an RGBA8 Image (viewer/reference.h) that viewer/image.h writes as PNG. Text is
-// viewer/canvas.h's.
+// Drawn into an RGBA8 Image (viewer/reference.h) that image/image.h writes as PNG. Text is
+// image/canvas.h's.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "viewer/canvas.h"
+#include "image/canvas.h"
 #include "viewer/reference.h"
 
 namespace dpoint {

@@ -6,7 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/text.h"
-#include "viewer/image.h"
+#include "image/image.h"
 #include "bench/report_internal.h"
 
 namespace dpoint {

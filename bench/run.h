@@ -21,7 +21,7 @@
 
 #include "bench/bandwidth.h"
 #include "bench/suites.h"
-#include "viewer/context.h"
+#include "vulkan/context.h"
 #include "viewer/encode.h"
 #include "viewer/render.h"
 

@@ -1,6 +1,6 @@
 // --device for the generators whose escape counts can run on a Vulkan device (issue #14):
 // mandelbulb (--variant fast), julia and mandelbrot2d. The device computes the counts
-// (viewer/gpu_generate.h); marching cubes, colours and writing stay on the CPU.
+// (generators/gpu_generate.h); marching cubes, colours and writing stay on the CPU.
 #pragma once
 
 #include <memory>
@@ -11,8 +11,8 @@
 #include "core/result.h"
 #include "generators/escape_grid.h"
 #include "generators/mandelbrot2d.h"
-#include "viewer/context.h"
-#include "viewer/gpu_generate.h"
+#include "vulkan/context.h"
+#include "generators/gpu_generate.h"
 
 namespace dpoint {
 

@@ -1,13 +1,13 @@
 // dpoint convert IN -o OUT: CSV, PLY, GLB and LAS in any direction, and glTF/GLB input with scene
-// selection (converters/gltf_read.h says what a glTF file turns into, core/las.h a LAS file).
+// selection (converters/gltf_read.h says what a glTF file turns into, converters/las.h a LAS file).
 #include <memory>
 
 #include "cli/commands.h"
 #include "converters/gltf_read.h"
-#include "converters/point_filters.h"
+#include "ops/point_filters.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
-#include "core/point_order.h"
+#include "ops/point_order.h"
 
 namespace dpoint {
 namespace {

@@ -6,7 +6,7 @@
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "core/memory.h"
-#include "viewer/context.h"
+#include "vulkan/context.h"
 #include "viewer/selftest.h"
 
 namespace dpoint {

@@ -9,7 +9,7 @@
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "converters/point_inputs.h"
-#include "core/info.h"
+#include "ops/info.h"
 #include "core/interrupt.h"
 #include "viewer/precision.h"
 
@@ -43,7 +43,7 @@ std::string num(double v, bool json = false) { return formatNumber(v, json); }
 std::string vec(const glm::dvec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
 std::string jsonVec(const glm::dvec3& v) { return "[" + num(v.x, true) + ", " + num(v.y, true) + ", " + num(v.z, true) + "]"; }
 
-// A LAS file's header (core/las.h), and whether its bounds hold the points read.
+// A LAS file's header (converters/las.h), and whether its bounds hold the points read.
 struct LasFacts {
   LasHeader header;
   bool bounds_hold = true;

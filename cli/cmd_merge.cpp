@@ -1,5 +1,5 @@
 // dpoint merge TILE... -o OUT: the parts of `dpoint generate KIND --tile I/N` welded into the file
-// one `dpoint generate KIND` writes with the same output options, byte for byte (core/tile.h).
+// one `dpoint generate KIND` writes with the same output options, byte for byte (converters/tile_file.h).
 #include <memory>
 #include <string>
 #include <vector>
@@ -7,8 +7,8 @@
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
-#include "core/point_order.h"
-#include "core/tile.h"
+#include "ops/point_order.h"
+#include "converters/tile_file.h"
 
 namespace dpoint {
 namespace {

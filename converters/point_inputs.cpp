@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cassert>
 
-#include "core/ply.h"
-#include "core/tile.h"
+#include "converters/ply.h"
+#include "converters/tile_file.h"
 
 namespace dpoint {
 

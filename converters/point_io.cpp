@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "converters/gltf_write.h"
-#include "converters/point_filters.h"
+#include "ops/point_filters.h"
 
 namespace dpoint {
 namespace {

@@ -5,9 +5,9 @@
 #include <string>
 
 #include "converters/gltf_read.h"
-#include "core/csv.h"
-#include "core/las.h"
-#include "core/ply.h"
+#include "converters/csv.h"
+#include "converters/las.h"
+#include "converters/ply.h"
 #include "core/point_set.h"
 #include "core/result.h"
 
@@ -36,7 +36,7 @@ struct WriteOptions {
   PlyEncoding ply_encoding = PlyEncoding::kBinary;
   PlyColorType ply_colors = PlyColorType::kUchar;
   Progress* progress = nullptr;
-  double las_scale = 0.001;  // LAS: the coordinate step for x, y and z (core/las.h)
+  double las_scale = 0.001;  // LAS: the coordinate step for x, y and z (converters/las.h)
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});

@@ -2,6 +2,7 @@
 // shortest round-trip form, JSON strings. Shared by the readers, the CLI and the bench report.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -57,6 +58,17 @@ inline std::string oneLineText(std::string_view text, std::string_view empty) {
     }
   }
   return out.empty() ? std::string(empty) : out;
+}
+
+// Decimal digits only (at most 19, so no overflow), no sign, no spaces: false otherwise.
+inline bool parseDecimalU64(std::string_view text, uint64_t& value) {
+  if (text.empty() || text.size() > 19) return false;
+  value = 0;
+  for (char c : text) {
+    if (c < '0' || c > '9') return false;
+    value = value * 10 + static_cast<uint64_t>(c - '0');
+  }
+  return true;
 }
 
 // Shortest round-trip text; JSON has no infinity, so non-finite values become null there.

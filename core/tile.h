@@ -1,6 +1,7 @@
 // Tiles: one dataset computed as N independent parts (`dpoint generate KIND --tile I/N`) on any
 // scheduler, and welded back into the file a single process writes, byte for byte
-// (`dpoint merge`).
+// (`dpoint merge`). This is the model: which share of the work a tile owns, and what a tile holds.
+// The part file and the merge are converters/tile_file.h.
 //
 // Every generator numbers its vertices in one canonical order that does not depend on how the work
 // is cut (the slabs of marching_cubes.h, the lattice planes of menger.h, the tetrahedra of
@@ -12,13 +13,6 @@
 // vertices). Merging is thus concatenation with an index offset per tile, no geometric search: the
 // weld is by identity, and the copies only serve to check it (a copy must equal its owner's vertex
 // bit for bit, colour included).
-//
-// The file of a tile is a binary little-endian PLY any reader takes as a mesh (owned vertices, then
-// the copies; faces index into both): `double x, y, z`, optional `float red, green, blue` (float so
-// that the colours come back exactly), `face` lists of 3 `uint`, and an element `dpoint_foreign` of
-// `uint tile, uint index` rows, one per copy. Header comments carry `dpoint-tile I/N`,
-// `dpoint-tile-owned COUNT` and `dpoint-tile-of SIGNATURE` (the generator and every option that
-// shapes the data, so that parts of different runs are never welded together).
 #pragma once
 
 #include <cstdint>
@@ -68,33 +62,5 @@ struct PointTile {
   uint32_t owned = 0;
   std::vector<TileVertexRef> foreign;
 };
-
-// Writes the tile file (atomically). `signature`: one line of text, no newline.
-Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature,
-                 Progress* progress = nullptr);
-
-// What a tile file's header says.
-struct TileHeader {
-  TileSpec tile;
-  uint32_t owned = 0;
-  std::string signature;
-  uint64_t vertices = 0, faces = 0, foreign = 0;
-  bool colors = false;
-};
-
-// True when the file starts like a tile file (a PLY whose header has a `dpoint-tile` comment);
-// reads the header only.
-bool isTileFile(const std::string& path);
-// Errors (kBadInput) name the file and the header line or the byte offset.
-Result<TileHeader> readTileHeader(const std::string& path);
-Result<PointTile> readTile(const std::string& path);
-
-// The whole set from all N tiles of one run, in any order of `paths`: owned vertices of tile 0, 1,
-// ... concatenated, triangles with their indices offset, every copy of a foreign vertex checked
-// against its owner. Errors (kBadInput) name the file: a missing, repeated or extra tile, tiles of
-// different runs (signatures) or counts, a reference past its owner's vertices, a copy that differs
-// from its owner; kResourceLimit past 2^32 vertices or over `max_memory` (0: half of RAM).
-Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory = 0,
-                            Progress* progress = nullptr);
 
 }  // namespace dpoint

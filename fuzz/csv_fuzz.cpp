@@ -1,6 +1,6 @@
-// libFuzzer target `csv`: the CSV reader `dpoint convert IN.csv` runs (core/csv.h), given the
+// libFuzzer target `csv`: the CSV reader `dpoint convert IN.csv` runs (converters/csv.h), given the
 // input's bytes as a file (InputFile::fromMemory). One thread: inputs are far smaller than a block.
-#include "core/csv.h"
+#include "converters/csv.h"
 #include "fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,10 +1,10 @@
-// libFuzzer target `las`: the LAS reader `dpoint convert IN.las` runs (core/las.h: LAS 1.0-1.4,
+// libFuzzer target `las`: the LAS reader `dpoint convert IN.las` runs (converters/las.h: LAS 1.0-1.4,
 // point formats 0-10, VLRs and EVLRs skipped), given the input's bytes as a file
 // (InputFile::fromMemory), once with colours as the file has them and once by classification
 // (`render --color classification`), which must agree on the positions.
 #include <cstring>
 
-#include "core/las.h"
+#include "converters/las.h"
 #include "fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,9 +1,9 @@
-// libFuzzer target `ply`: the PLY reader `dpoint convert IN.ply` runs (core/ply.h: ASCII and
+// libFuzzer target `ply`: the PLY reader `dpoint convert IN.ply` runs (converters/ply.h: ASCII and
 // binary, vertices and faces), given the input's bytes as a file (InputFile::fromMemory), then
 // again as `dpoint render` reads it (points only, so it stops after the vertices).
 #include <cstring>
 
-#include "core/ply.h"
+#include "converters/ply.h"
 #include "fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

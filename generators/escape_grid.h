@@ -19,7 +19,7 @@
 // depend on the thread count. --grid-out needs every count, so it turns the lazy pass off and
 // streams the planes to the file in the same order.
 //
-// Elsewhere: a plane function (a GPU, viewer/gpu_generate.h) may compute the classification pass
+// Elsewhere: a plane function (a GPU, generators/gpu_generate.h) may compute the classification pass
 // instead of the row function, a slab's planes at a time on a thread of its own, ahead of the
 // workers that mesh earlier slabs (at most threads + 2 slabs of counts held). Finishing the
 // crossings, marching cubes and writing stay here. The function must return the row function's

@@ -26,7 +26,7 @@ namespace dpoint {
 // s > 4 + 2^-50, the double after 4: doubles in [4, 8) are 2^-50 apart, and sqrt(4 + 2^-50) =
 // 2 + 2^-52 − ε lies below the midpoint 2 + 2^-52 between 2 and the next double, so it rounds to 2
 // (not above 2), while sqrt(4 + 2^-49) = 2 + 2^-51 − ε rounds up. A device whose square root is
-// not correctly rounded tests s against this instead (shaders/escape.comp); tested exhaustively
+// not correctly rounded tests s against this instead (shaders/generate/escape.comp); tested exhaustively
 // near 4.
 constexpr double kJuliaEscapeSquare = 0x1.0000000000001p+2;
 

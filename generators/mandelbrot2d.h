@@ -34,7 +34,7 @@ enum class Mandelbrot2dMethod {
   kDouble,        // z_{n+1} = z_n² + fl(c) in double per pixel: for comparison only
 };
 
-// Perturbation counts computed elsewhere (a GPU, viewer/gpu_generate.h): counts[r·dcx.size() + c]
+// Perturbation counts computed elsewhere (a GPU, generators/gpu_generate.h): counts[r·dcx.size() + c]
 // = the pixel count of δc = (dcx[c], dcy[r]) against `orbit` (the reference Z_0, Z_1, ...), equal to
 // the CPU's bit for bit.
 using PerturbationFunction =

@@ -198,7 +198,7 @@ glm::ivec3 unpackBatchOffset(uint64_t word) {
 FloatPair splitDouble(double d) {
   // GCC 12's SLP vectorizer folds (double)(float)d back to d when it packs two of these side by
   // side (seen at -O2: `subpd %xmm0, %xmm0`), which zeroes every lo part; the volatile read of
-  // hi keeps the rounding. encodeRoundTripKeepsLowParts (tests/encode_test.cpp) guards it.
+  // hi keeps the rounding. encodeRoundTripKeepsLowParts (tests/viewer/encode_test.cpp) guards it.
   volatile float hi = static_cast<float>(d);
   float hi_value = hi;
   float lo = static_cast<float>(d - static_cast<double>(hi_value));  // d − hi is exact in double

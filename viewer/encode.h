@@ -104,7 +104,7 @@ inline glm::dvec3 scaleBy(const glm::dvec3& p, const SceneFrame& frame) {
 // [−2^20, 2^20 − 1]: within one step (2^−20 of the extent) of t, half a step but at t = 1.
 inline constexpr int kBatchOffsetBits = 21;
 inline constexpr double kBatchSteps = 0x1p20;  // integer steps per extent
-// Packs q (x in bits 0–20, y in 21–41, z in 42–62, two's complement) as shaders/project.glsl
+// Packs q (x in bits 0–20, y in 21–41, z in 42–62, two's complement) as shaders/render/project.glsl
 // unpacks it; unpackBatchOffset is the inverse, for tests.
 uint64_t packBatchOffset(const glm::dvec3& t);
 glm::ivec3 unpackBatchOffset(uint64_t word);
@@ -145,7 +145,7 @@ Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_ind
 void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_t first, size_t count, void* out,
                      size_t index_base = 0);
 
-// The mode's uniform block (std140, as declared in shaders/project.glsl); empty for batch.
+// The mode's uniform block (std140, as declared in shaders/render/project.glsl); empty for batch.
 std::vector<uint8_t> cameraUniform(const ModeEncoding& encoding, const Camera& camera);
 
 // Batch mode: encoding.batch_matrices cast to float, as the GPU gets them.

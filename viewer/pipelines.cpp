@@ -53,33 +53,6 @@ Spirv splatShader(PrecisionMode mode) {
   return {nullptr, 0};
 }
 
-}  // namespace
-
-Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
-                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
-  VkDescriptorSetLayoutCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  info.bindingCount = static_cast<uint32_t>(bindings.size());
-  info.pBindings = bindings.data();
-  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
-  VK_TRY(vkCreateDescriptorSetLayout(context.device, &info, nullptr, &layout));
-  return layout;
-}
-
-Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
-                                        VkShaderStageFlags stages) {
-  VkPushConstantRange push{stages, 0, push_bytes};
-  VkPipelineLayoutCreateInfo info = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  info.setLayoutCount = 1;
-  info.pSetLayouts = &set;
-  info.pushConstantRangeCount = 1;
-  info.pPushConstantRanges = &push;
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  VK_TRY(vkCreatePipelineLayout(context.device, &info, nullptr, &layout));
-  return layout;
-}
-
-namespace {
-
 // Two boolean specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
 // 0 kWriteDepth (its constant 1 is unused); the eye-dome pass has none.
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
@@ -255,29 +228,6 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
 }
 
 }  // namespace
-
-void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
-                            std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform) {
-  std::vector<VkWriteDescriptorSet> writes(infos.size());
-  for (uint32_t b = 0; b < infos.size(); ++b) {
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = set;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = b == 0 && first_is_uniform ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
-}
-
-Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes) {
-  VkShaderModuleCreateInfo info = {VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  info.codeSize = bytes;
-  info.pCode = code;
-  VkShaderModule module = VK_NULL_HANDLE;
-  VK_TRY(vkCreateShaderModule(context.device, &info, nullptr, &module));
-  return module;
-}
 
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
                                             bool with_probe, uint32_t width, uint32_t height, bool keep_depth) {

@@ -1,11 +1,12 @@
-// The graphics pipeline of the raster backend: render pass (RGBA8 colour + D32 depth, reversed Z),
+// The pipelines of the renderer. The raster backend: render pass (RGBA8 colour + D32 depth, reversed Z),
 // and one pipeline per precision mode, built from the SPIR-V compiled at build time. The probe
 // pipeline is the same shader with the specialization constant kProbe on (DESIGN §5).
 #pragma once
 
 #include <span>
 
-#include "viewer/context.h"
+#include "vulkan/context.h"
+#include "vulkan/shader.h"
 #include "viewer/encode.h"
 
 namespace dpoint {
@@ -13,11 +14,12 @@ namespace dpoint {
 inline constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
-// Descriptor bindings shared by every mode (shaders/points.vert): 0 camera uniform,
-// 1 double positions (native mode pulling), 2 batch matrices, 3 probe output.
+// Descriptor bindings shared by every mode (shaders/render/project.glsl): 0 camera uniform,
+// 1 positions (the compute backend's in every mode; the raster backend's only for native mode
+// pulling doubles from a storage buffer), 2 batch matrices, 3 probe output.
 inline constexpr uint32_t kBindingCamera = 0, kBindingPositions = 1, kBindingBatches = 2, kBindingProbe = 3;
 
-// Push constants of shaders/project.glsl (both backends).
+// Push constants of shaders/render/project.glsl (both backends).
 struct PushConstants {
   float splitter = 4097.0f;  // 2^12 + 1: Dekker's split of a 24-bit significand
   float point_size = 1.0f;
@@ -66,14 +68,7 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
                                                 bool early_depth = true, bool write_depth = false);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
-// A descriptor set layout of these bindings, and a pipeline layout of one set and push_bytes of
-// push constants from offset 0 for `stages`.
-Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
-                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings);
-Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
-                                        VkShaderStageFlags stages);
-
-// Eye-dome lighting (shaders/edl.comp), the same pass after either backend: reads a float depth per
+// Eye-dome lighting (shaders/render/edl.comp), the same pass after either backend: reads a float depth per
 // pixel (0 = nothing drawn) and the RGBA8 picture, writes the shaded picture (bindings 0, 1, 2).
 struct ShadePipeline {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
@@ -85,16 +80,8 @@ struct EdlPush {
   float depth_scale = 0.0f;  // perspective: (far − near) / near; 0 for ortho
   float strength = 1.0f, radius = 1.4f;
 };
-inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/edl.comp
+inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/render/edl.comp
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);
-
-// Points bindings 0, 1, … of `set` at whole buffers (`infos`, in binding order): storage buffers,
-// but binding 0 a uniform buffer when `first_is_uniform`.
-void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
-                            std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform = false);
-
-// Creates a shader module from SPIR-V words.
-Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);
 
 }  // namespace dpoint

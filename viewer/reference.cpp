@@ -146,19 +146,4 @@ Image rasterReference(const std::vector<WindowPoint>& window, const std::vector<
   }
   return image;
 }
-
-size_t countDifferingPixels(const Image& a, const Image& b) {
-  assert(a.width == b.width && a.height == b.height);
-  assert(a.rgba.size() == size_t(a.width) * a.height * 4 && b.rgba.size() == a.rgba.size());
-  size_t differing = 0;
-  for (size_t pixel = 0; pixel < a.rgba.size() / 4; ++pixel) {
-    if (!std::equal(a.rgba.begin() + static_cast<ptrdiff_t>(pixel * 4),
-                    a.rgba.begin() + static_cast<ptrdiff_t>(pixel * 4 + 4),
-                    b.rgba.begin() + static_cast<ptrdiff_t>(pixel * 4))) {
-      ++differing;
-    }
-  }
-  return differing;
-}
-
 }  // namespace dpoint

@@ -8,6 +8,7 @@
 #include <glm/vec4.hpp>
 
 #include "core/point_set.h"
+#include "image/image.h"
 #include "viewer/camera.h"
 
 namespace dpoint {
@@ -51,14 +52,7 @@ ErrorStats compareToReference(const std::vector<WindowPoint>& reference, const s
 // cleared to 0 would drop it; makeCamera's far plane keeps every box point above depth 0).
 // `colors_rgba8` holds one colour per point, packed as encodeColor in viewer/encode.h packs it:
 // R in the low byte (bytes in memory R, G, B, A on a little-endian host); `background_rgba8` too.
-struct Image {
-  uint32_t width = 0, height = 0;
-  std::vector<uint8_t> rgba;  // width · height · 4
-};
 Image rasterReference(const std::vector<WindowPoint>& window, const std::vector<uint32_t>& colors_rgba8,
                       uint32_t width, uint32_t height, uint32_t background_rgba8);
-
-// Pixels whose RGBA differs between two images of the same size (asserts equal sizes).
-size_t countDifferingPixels(const Image& a, const Image& b);
 
 }  // namespace dpoint

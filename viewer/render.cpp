@@ -8,7 +8,7 @@
 #include <future>
 
 #include "core/interrupt.h"
-#include "viewer/buffers.h"
+#include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
 #include "viewer/render_internal.h"
 #include "viewer/selftest.h"

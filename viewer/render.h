@@ -13,7 +13,7 @@
 
 #include "core/point_set.h"
 #include "viewer/camera.h"
-#include "viewer/context.h"
+#include "vulkan/context.h"
 #include "viewer/encode.h"
 #include "viewer/precision.h"
 #include "viewer/reference.h"
@@ -28,7 +28,7 @@ enum class NativePath { kAuto, kAttribute, kPull };
 enum class Backend { kRaster, kCompute };
 
 // What is done to the picture after the points are drawn. kEdl: eye-dome lighting
-// (shaders/edl.comp), a screen-space pass over the depth of the visible points that darkens a
+// (shaders/render/edl.comp), a screen-space pass over the depth of the visible points that darkens a
 // pixel by how far its neighbours stand in front of it, so a surface of 1-px points reads as one.
 enum class Shading { kNone, kEdl };
 struct EdlOptions {

@@ -1,5 +1,5 @@
 // The compute backend (DESIGN §4): one thread per point projects it with the mode's code
-// (shaders/project.glsl, the same as the raster vertex shader) and keeps the nearest point per
+// (shaders/render/project.glsl, the same as the raster vertex shader) and keeps the nearest point per
 // pixel with a 64-bit atomicMax into a visibility buffer; a resolve pass per pixel then fetches
 // the winner's colour. No rasterizer, no depth attachment: on GPUs whose graphics front end is
 // small next to their compute (H100/H200 run graphics on two TPCs) this is the fast path.

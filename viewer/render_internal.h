@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "viewer/buffers.h"
+#include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
 #include "viewer/render.h"
 

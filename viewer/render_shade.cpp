@@ -1,6 +1,6 @@
 // Eye-dome lighting after either backend (RenderOptions::shading): the raster backend's colour
 // and depth attachments are copied into buffers, the compute backend's resolve writes them
-// there itself; then one pass (shaders/edl.comp) writes the shaded picture that is read back.
+// there itself; then one pass (shaders/render/edl.comp) writes the shaded picture that is read back.
 #include "viewer/render_internal.h"
 
 namespace dpoint::detail {

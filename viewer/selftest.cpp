@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "viewer/buffers.h"
+#include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
 
 #include "shaders/selftest.comp.h"

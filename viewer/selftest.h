@@ -1,12 +1,12 @@
 // Start-up self-test of the emulated-double building blocks (DESIGN §4): a compute shader runs
-// two-sum, split two-prod and a double-float add from shaders/df64.glsl on inputs read from a
+// two-sum, split two-prod and a double-float add from shaders/render/df64.glsl on inputs read from a
 // buffer. A compiler that reassociates or fuses despite `precise` returns zero low parts; rte and
 // df64 are then unusable on that device, and saying so beats drawing a wrong picture.
 #pragma once
 
 #include <string>
 
-#include "viewer/context.h"
+#include "vulkan/context.h"
 #include "viewer/encode.h"
 
 namespace dpoint {

@@ -1,0 +1,414 @@
+// CSV reader: two passes over fixed-size blocks, both on all cores.
+//
+// Pass 1 counts line ends per block, so every line's number (and so its row index) is known
+// before parsing. Pass 2 parses each block's lines straight into the final, exactly sized
+// arrays. A line belongs to the block in which it starts; a block reads past its end to finish
+// its last line. Results therefore never depend on the thread count, and peak memory is the
+// PointSet plus one block buffer per thread (no growth by doubling, no copy at the end).
+#include <fast_float/fast_float.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <optional>
+
+#include "converters/csv.h"
+#include "core/input_file.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+#include "core/text.h"
+
+namespace dpoint {
+namespace {
+
+constexpr size_t kBlockSize = 8u << 20;
+// Longest line accepted: a row of six fixed-format DBL_MAX values fits in about 2 KB; anything far
+// longer is not a point row (and would otherwise make a block read unbounded).
+constexpr size_t kMaxLineLength = 64u << 10;
+
+// The value is the column count. 2D files written with colours have `x,y,r,g,b` (the writer's
+// planar form), so that layout is read too.
+enum class Layout { kXy = 2, kXyz = 3, kXyRgb = 5, kXyzRgb = 6 };
+int positionColumns(Layout layout) { return layout == Layout::kXy || layout == Layout::kXyRgb ? 2 : 3; }
+bool hasColorColumns(Layout layout) { return layout == Layout::kXyRgb || layout == Layout::kXyzRgb; }
+const char* layoutText(Layout layout) {
+  switch (layout) {
+    case Layout::kXy: return "x,y";
+    case Layout::kXyz: return "x,y,z";
+    case Layout::kXyRgb: return "x,y,r,g,b";
+    case Layout::kXyzRgb: return "x,y,z,r,g,b";
+  }
+  return "";
+}
+
+bool isBlank(char c) { return c == ' ' || c == '\t'; }
+
+std::string excerpt(const char* begin, const char* end) {
+  return printableExcerpt(std::string_view(begin, static_cast<size_t>(end - begin)));
+}
+
+// True when the decimal mantissa in [begin, end) has a non-zero digit: a value that parses to
+// zero from such text has underflowed.
+bool hasNonzeroMantissa(const char* begin, const char* end) {
+  for (const char* p = begin; p < end; ++p) {
+    if (*p == 'e' || *p == 'E') return false;
+    if (*p >= '1' && *p <= '9') return true;
+  }
+  return false;
+}
+
+bool looksLikeInfinityText(const char* begin, const char* end) {
+  if (begin < end && (*begin == '-' || *begin == '+')) ++begin;
+  return end - begin >= 3 && (begin[0] == 'i' || begin[0] == 'I');
+}
+
+struct LineError {
+  uint64_t line = 0;  // 1-based
+  std::string message;
+};
+
+class LineParser {
+ public:
+  LineParser(const std::string& path, Layout layout, bool allow_nonfinite)
+      : path_(path), layout_(layout), columns_(static_cast<int>(layout)), position_columns_(positionColumns(layout)),
+        allow_nonfinite_(allow_nonfinite) {}
+
+  // Parses one line (without its line end, '\r' already removed). Returns false on error.
+  bool parse(const char* begin, const char* end, uint64_t line, glm::dvec3& position, glm::vec3& color,
+             LineError& error) const {
+    const char* p = begin;
+    double values[3] = {0.0, 0.0, 0.0};
+    float colors[3] = {0.0f, 0.0f, 0.0f};
+    int column = 0;
+    while (true) {
+      while (p < end && isBlank(*p)) ++p;
+      const char* number_begin = p;
+      const char* field_end = static_cast<const char*>(std::memchr(p, ',', static_cast<size_t>(end - p)));
+      if (!field_end) field_end = end;
+      ++column;
+      if (column > columns_) {
+        error = {line, lineText(line) + countMessage(begin, end)};
+        return false;
+      }
+      const char* number_end = field_end;
+      while (number_end > number_begin && isBlank(number_end[-1])) --number_end;
+      if (number_begin == number_end) {
+        error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
+        return false;
+      }
+      bool ok = column <= position_columns_
+                    ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
+                    : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error);
+      if (!ok) return false;
+      p = field_end;
+      if (p == end) break;
+      ++p;  // the comma
+    }
+    if (column != columns_) {
+      error = {line, lineText(line) + countMessage(begin, end)};
+      return false;
+    }
+    position = glm::dvec3(values[0], values[1], values[2]);
+    color = glm::vec3(colors[0], colors[1], colors[2]);
+    return true;
+  }
+
+ private:
+  std::string lineText(uint64_t line) const { return path_ + ":" + std::to_string(line) + ": "; }
+
+  std::string countMessage(const char* begin, const char* end) const {
+    size_t commas = static_cast<size_t>(std::count(begin, end, ','));
+    return std::to_string(commas + 1) + " columns, expected " + std::to_string(columns_) + " (" + layoutText(layout_) + ")";
+  }
+
+  template <typename T>
+  bool parseNumber(const char* begin, const char* end, T& value, uint64_t line, int column,
+                   LineError& error) const {
+    const char* start = begin;
+    // fast_float follows std::from_chars and refuses a leading '+'; CSV writers emit it.
+    if (end - start >= 2 && *start == '+' && start[1] != '-' && start[1] != '+') ++start;
+    auto result = fast_float::from_chars(start, end, value);
+    // The message is built only on failure: this runs for every number of the file.
+    auto fail = [&](const std::string& why) {
+      error = {line, lineText(line) + "column " + std::to_string(column) + ": '" + excerpt(begin, end) + "' " + why};
+      return false;
+    };
+    const char* type = sizeof(T) == 8 ? "double" : "float";
+    if (result.ec != std::errc() || result.ptr != end) return fail("is not a number");
+    if (std::isinf(value) && !looksLikeInfinityText(begin, end)) return fail(std::string("is out of ") + type + " range");
+    if (value == T(0) && hasNonzeroMantissa(begin, end))
+      return fail(std::string("is out of ") + type + " range (underflows to zero)");
+    if (!allow_nonfinite_ && !std::isfinite(value))
+      return fail("is not a finite number (--allow-nonfinite accepts it)");
+    return true;
+  }
+
+  const std::string& path_;
+  Layout layout_;
+  int columns_;
+  int position_columns_;
+  bool allow_nonfinite_;
+};
+
+// Splits the first line into trimmed, lower-case fields.
+std::vector<std::string> splitHeader(std::string_view line) {
+  std::vector<std::string> fields;
+  size_t start = 0;
+  while (true) {
+    size_t comma = line.find(',', start);
+    std::string_view field = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    while (!field.empty() && isBlank(field.front())) field.remove_prefix(1);
+    while (!field.empty() && isBlank(field.back())) field.remove_suffix(1);
+    std::string lower(field);
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    fields.push_back(std::move(lower));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return fields;
+}
+
+// A first field that starts with a letter (other than nan/inf) marks a header line.
+bool isHeaderLine(const std::vector<std::string>& fields) {
+  const std::string& first = fields.front();
+  if (first.empty() || !std::isalpha(static_cast<unsigned char>(first[0]))) return false;
+  return first.rfind("nan", 0) != 0 && first.rfind("inf", 0) != 0;
+}
+
+Result<Layout> layoutFromHeader(const std::string& path, const std::vector<std::string>& fields,
+                                uint64_t line, std::string_view text) {
+  std::string joined;
+  for (const std::string& f : fields) joined += (joined.empty() ? "" : ",") + f;
+  for (Layout layout : {Layout::kXy, Layout::kXyz, Layout::kXyRgb, Layout::kXyzRgb})
+    if (joined == layoutText(layout)) return layout;
+  return Error{path + ":" + std::to_string(line) + ": header '" + excerpt(text.data(), text.data() + text.size()) +
+               "' is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b"};
+}
+
+Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line) {
+  if (columns == 2) return Layout::kXy;
+  if (columns == 3) return Layout::kXyz;
+  if (columns == 5) return Layout::kXyRgb;
+  if (columns == 6) return Layout::kXyzRgb;
+  return Error{path + ":" + std::to_string(line) + ": " + std::to_string(columns) +
+               " columns without a header; expected 2 (x,y), 3 (x,y,z), 5 (x,y,r,g,b) or 6 (x,y,z,r,g,b)"};
+}
+
+struct Header {
+  Layout layout = Layout::kXyz;
+  uint64_t data_offset = 0;     // byte where the first data line (or blank lines) start
+  uint64_t first_data_line = 0; // 0-based line index at data_offset
+};
+
+// Finds the layout from the first non-blank line, skipping a UTF-8 BOM.
+Result<Header> readHeader(const InputFile& file) {
+  std::string head(std::min<uint64_t>(file.size(), kMaxLineLength + 4), '\0');
+  Result<size_t> got = file.readAt(0, head.data(), head.size());
+  if (!got) return got.error();
+  head.resize(*got);
+  size_t pos = head.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  uint64_t line = 0;
+  while (true) {
+    if (pos >= head.size()) {
+      if (head.size() == file.size()) return Error{file.path() + ": no data rows"};
+      return Error{file.path() + ":" + std::to_string(line + 1) + ": line longer than " +
+                   std::to_string(kMaxLineLength) + " bytes"};
+    }
+    size_t nl = head.find('\n', pos);
+    if (nl == std::string::npos) {
+      if (head.size() < file.size())
+        return Error{file.path() + ":" + std::to_string(line + 1) + ": line longer than " +
+                     std::to_string(kMaxLineLength) + " bytes"};
+      nl = head.size();
+    }
+    std::string_view text(head.data() + pos, nl - pos);
+    if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
+    if (text.find_first_not_of(" \t") == std::string_view::npos) {  // blank line before any data
+      pos = nl + 1;
+      ++line;
+      continue;
+    }
+    if (text.find('\0') != std::string_view::npos)
+      return Error{file.path() + ":" + std::to_string(line + 1) + ": binary data, not CSV text ('" +
+                   excerpt(text.data(), text.data() + text.size()) + "')"};
+    std::vector<std::string> fields = splitHeader(text);
+    Header header;
+    if (isHeaderLine(fields)) {
+      Result<Layout> layout = layoutFromHeader(file.path(), fields, line + 1, text);
+      if (!layout) return layout.error();
+      header.layout = *layout;
+      header.data_offset = nl + 1;
+      header.first_data_line = line + 1;
+      if (header.data_offset >= file.size()) return Error{file.path() + ": header only, no data rows"};
+    } else {
+      Result<Layout> layout = layoutFromColumns(file.path(), fields.size(), line + 1);
+      if (!layout) return layout.error();
+      header.layout = *layout;
+      header.data_offset = pos;
+      header.first_data_line = line;
+    }
+    return header;
+  }
+}
+
+}  // namespace
+
+Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options) {
+  Result<InputFile> opened = InputFile::open(path);
+  if (!opened) return opened.error();
+  return readCsv(*opened, options);
+}
+
+Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
+  const std::string& path = file.path();
+  if (file.size() == 0) return Error{path + ": empty file"};
+  Result<Header> header_result = readHeader(file);
+  if (!header_result) return header_result.error();
+  const Header header = *header_result;
+
+  const uint64_t begin = header.data_offset, size = file.size();
+  const size_t blocks = static_cast<size_t>((size - begin + kBlockSize - 1) / kBlockSize);
+  const unsigned threads = resolveThreads(options.threads);
+  if (options.progress) options.progress->start("reading " + path, 2 * (size - begin));
+
+  // Pass 1: line ends per block.
+  std::vector<uint64_t> newlines(blocks + 1, 0);
+  std::vector<std::optional<Error>> io_errors(blocks);
+  {
+    std::vector<std::vector<char>> buffers(threads);
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      std::vector<char>& buffer = buffers[worker];
+      uint64_t offset = begin + b * kBlockSize;
+      // The block's own length: a small file costs a small buffer, not a zeroed 8 MiB one.
+      buffer.resize(static_cast<size_t>(std::min<uint64_t>(kBlockSize, size - offset)));
+      Result<size_t> got = file.readAt(offset, buffer.data(), buffer.size());
+      if (!got) {
+        io_errors[b] = got.error();
+        return;
+      }
+      newlines[b + 1] = static_cast<uint64_t>(std::count(buffer.data(), buffer.data() + *got, '\n'));
+      if (options.progress) options.progress->advance(*got);
+    });
+  }
+  for (const auto& e : io_errors)
+    if (e) return *e;
+  for (size_t b = 0; b < blocks; ++b) newlines[b + 1] += newlines[b];
+
+  // Lines from the data offset on: every newline ends one, plus a last line without a newline.
+  char last_byte = 0;
+  if (Result<size_t> got = file.readAt(size - 1, &last_byte, 1); !got) return got.error();
+  const uint64_t lines = newlines[blocks] + (last_byte != '\n' ? 1 : 0);
+
+  const Layout layout = header.layout;
+  // Every line may be a row: a file of short lines (or of blank ones) asks for 24-36 bytes of
+  // point set per 2-4 bytes of file, so the arrays are checked before they are made.
+  const uint64_t row_bytes = sizeof(glm::dvec3) + (hasColorColumns(layout) ? sizeof(glm::vec3) : 0);
+  if (Status s = checkMemory(path + ": " + std::to_string(lines) + " lines", lines * row_bytes, options.max_memory); !s)
+    return s.error();
+  PointSet points;
+  resizePrefaulted(points.positions, static_cast<size_t>(lines), threads);
+  if (hasColorColumns(layout)) resizePrefaulted(points.colors, static_cast<size_t>(lines), threads);
+
+  // Pass 2: parse. The first error by line number wins, whatever the thread count.
+  const LineParser parser(path, layout, options.allow_nonfinite);
+  const bool has_colors = hasColorColumns(layout);
+  std::mutex error_mutex;
+  std::optional<LineError> first_error;
+  std::atomic<uint64_t> error_line{UINT64_MAX};
+  std::vector<std::vector<uint64_t>> blank_rows(blocks);
+  std::vector<std::vector<char>> buffers(threads);
+  parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+    const uint64_t block_start = begin + b * kBlockSize;
+    const uint64_t block_end = std::min<uint64_t>(block_start + kBlockSize, size);
+    uint64_t row = newlines[b];  // line index (relative to the data start) of the line at block_start
+    if (header.first_data_line + row + 1 > error_line.load()) return;
+    // Read one byte before (to know whether a line starts at block_start) and enough after.
+    const uint64_t read_start = block_start == begin ? block_start : block_start - 1;
+    const uint64_t read_end = std::min<uint64_t>(block_end + kMaxLineLength + 1, size);
+    std::vector<char>& buffer = buffers[worker];
+    buffer.resize(static_cast<size_t>(read_end - read_start));
+    Result<size_t> got = file.readAt(read_start, buffer.data(), buffer.size());
+    auto fail = [&](LineError e) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!first_error || e.line < first_error->line) {
+        error_line = e.line;
+        first_error = std::move(e);
+      }
+    };
+    if (!got) {
+      fail({header.first_data_line + row + 1, got.error().message});
+      return;
+    }
+    const char* data = buffer.data();
+    const char* stop = data + (block_end - read_start);  // lines must start before this
+    const char* end = data + *got;
+    const char* p = data;
+    if (read_start != block_start) {
+      ++p;
+      if (data[0] != '\n') {  // the line at block_start began in the previous block
+        const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(stop - p)));
+        if (!nl) return;  // no line starts in this block
+        p = nl + 1;
+        ++row;
+      }
+    }
+    LineError error;
+    glm::vec3 scratch_color;
+    while (p < stop) {
+      const uint64_t line_number = header.first_data_line + row + 1;
+      const size_t window = static_cast<size_t>(std::min<ptrdiff_t>(end - p, static_cast<ptrdiff_t>(kMaxLineLength) + 1));
+      const char* nl = static_cast<const char*>(std::memchr(p, '\n', window));
+      const char* line_end = nl ? nl : end;
+      if (static_cast<size_t>(line_end - p) > kMaxLineLength) {
+        fail({line_number, path + ":" + std::to_string(line_number) + ": line longer than " +
+                               std::to_string(kMaxLineLength) + " bytes"});
+        return;
+      }
+      const char* text_end = line_end;
+      if (text_end > p && text_end[-1] == '\r') --text_end;
+      const char* first = p;
+      while (first < text_end && isBlank(*first)) ++first;
+      if (first == text_end) {
+        blank_rows[b].push_back(row);
+      } else if (!parser.parse(p, text_end, line_number, points.positions[row],
+                               has_colors ? points.colors[row] : scratch_color, error)) {
+        fail(std::move(error));
+        return;
+      }
+      ++row;
+      if (!nl) break;
+      p = nl + 1;
+    }
+    if (options.progress) options.progress->advance(block_end - block_start);
+  });
+  if (first_error) return Error{first_error->message};
+
+  // Blank lines left holes; close them (rare, so a single ordered pass is fine).
+  size_t holes = 0;
+  for (const auto& rows : blank_rows) holes += rows.size();
+  if (holes > 0) {
+    std::vector<uint64_t> all;
+    all.reserve(holes);
+    for (const auto& rows : blank_rows) all.insert(all.end(), rows.begin(), rows.end());
+    size_t out = 0, next_hole = 0;
+    for (size_t i = 0; i < points.positions.size(); ++i) {
+      if (next_hole < all.size() && all[next_hole] == i) {
+        ++next_hole;
+        continue;
+      }
+      points.positions[out] = points.positions[i];
+      if (!points.colors.empty()) points.colors[out] = points.colors[i];
+      ++out;
+    }
+    // No shrink_to_fit: it would copy the whole set to give back a few slots.
+    points.positions.resize(out);
+    if (!points.colors.empty()) points.colors.resize(out);
+  }
+  if (points.positions.empty()) return Error{path + ": no data rows"};
+  if (options.progress) options.progress->finish();
+  return points;
+}
+
+}  // namespace dpoint

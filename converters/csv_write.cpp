@@ -1,0 +1,188 @@
+// CSV writer (CsvRowWriter, and writeCsv on top of it): rows are formatted in chunks on all
+// cores and written in order.
+//
+// Shortest round-trip output is std::to_chars(double) (Ryu in libstdc++): the fewest digits that
+// parse back to the same double, so CSV -> PointSet -> CSV is byte- and bit-identical.
+// Fixed output is formatFixed (core/fixed_format.h): printf("%.*f") rounding, exactly, as glibc
+// does: the exact binary value rounded half to even. Colours are floats: shortest float form, or their exact double
+// value in fixed form (as the seed printed its double colours with %.15f).
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+
+#include "core/atomic_file.h"
+#include "converters/csv.h"
+#include "core/fixed_format.h"
+#include "core/parallel.h"
+
+namespace dpoint {
+namespace {
+
+constexpr size_t kRowsPerChunk = 1u << 16;
+constexpr int kMaxDecimals = 100;
+// DBL_MAX in fixed form has 309 integer digits; plus sign, point, decimals and a separator.
+constexpr size_t kMaxFieldChars = fixedFormatMaxChars(kMaxDecimals) + 1;
+
+class RowFormatter {
+ public:
+  RowFormatter(CsvLayout layout, int decimals) : decimals_(decimals), planar_(layout.planar), colors_(layout.colors) {}
+
+  std::string header() const {
+    std::string h = planar_ ? "x,y" : "x,y,z";
+    if (colors_) h += ",r,g,b";
+    return h + "\n";
+  }
+
+  // Formats `count` rows into out (replacing its content); colors is read only with a colour layout.
+  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count, std::string& out) const {
+    const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u);
+    const size_t row_max = fields * kMaxFieldChars;
+    // Start from the shortest-form size and grow only for long fixed-form rows.
+    if (out.size() < count * fields * 24 + row_max) out.resize(count * fields * 24 + row_max);
+    size_t used = 0;
+    for (size_t i = 0; i < count; ++i) {
+      if (out.size() - used < row_max) out.resize(2 * out.size());
+      char* p = out.data() + used;
+      char* const limit = out.data() + out.size();
+      const glm::dvec3& v = positions[i];
+      p = number(p, limit, v.x);
+      *p++ = ',';
+      p = number(p, limit, v.y);
+      if (!planar_) {
+        *p++ = ',';
+        p = number(p, limit, v.z);
+      }
+      if (colors_) {
+        const glm::vec3& c = colors[i];
+        for (int k = 0; k < 3; ++k) {
+          *p++ = ',';
+          p = color(p, limit, c[k]);
+        }
+      }
+      *p++ = '\n';
+      used = static_cast<size_t>(p - out.data());
+    }
+    out.resize(used);
+  }
+
+ private:
+  char* number(char* p, char* limit, double v) const {
+    if (decimals_ >= 0 && std::isfinite(v)) return formatFixed(p, v, decimals_);
+    std::to_chars_result r = decimals_ < 0 ? std::to_chars(p, limit, v)
+                                           : std::to_chars(p, limit, v, std::chars_format::fixed, decimals_);
+    assert(r.ec == std::errc());
+    return r.ptr;
+  }
+  char* color(char* p, char* limit, float v) const {
+    if (decimals_ >= 0) return number(p, limit, static_cast<double>(v));
+    std::to_chars_result r = std::to_chars(p, limit, v);
+    assert(r.ec == std::errc());
+    return r.ptr;
+  }
+
+  int decimals_;
+  bool planar_;
+  bool colors_;
+};
+
+Status checkDecimals(int decimals) {
+  if (decimals > kMaxDecimals)
+    return Error{"--decimals " + std::to_string(decimals) + " is above the limit of " + std::to_string(kMaxDecimals),
+                 ExitCode::kUsage};
+  return okStatus();
+}
+
+}  // namespace
+
+Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout layout,
+                                          const CsvWriteOptions& options, uint64_t rows) {
+  if (Status s = checkDecimals(options.decimals); !s) return s.error();
+  Result<AtomicFile> file = AtomicFile::create(path);
+  if (!file) return file.error();
+  CsvRowWriter writer(std::move(*file), layout, options);
+  if (Status s = writer.file_.write(RowFormatter(layout, options.decimals).header()); !s) return s.error();
+  if (options.progress) options.progress->start("writing " + path, rows);
+  return writer;
+}
+
+CsvRowWriter::CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOptions& options)
+    : file_(std::move(file)),
+      layout_(layout),
+      decimals_(options.decimals),
+      threads_(resolveThreads(options.threads)),
+      progress_(options.progress) {
+  // Chunks are formatted a batch at a time (a few per thread) and written in order, so memory
+  // stays at a few megabytes per thread whatever the number of rows.
+  texts_.resize(std::max<size_t>(1, 2 * size_t(threads_)));
+  batch_rows_ = texts_.size() * kRowsPerChunk;
+}
+
+Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count) {
+  assert(count <= batch_rows_);
+  const RowFormatter formatter(layout_, decimals_);
+  const size_t chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
+  parallelFor(chunks, threads_, [&](size_t k, unsigned) {
+    const size_t begin = k * kRowsPerChunk;
+    formatter.format(positions + begin, colors ? colors + begin : nullptr,
+                     std::min(count, begin + kRowsPerChunk) - begin, texts_[k]);
+  });
+  for (size_t k = 0; k < chunks; ++k) {
+    if (Status s = file_.write(texts_[k]); !s) return s;
+  }
+  if (progress_) progress_->advance(count);
+  return okStatus();
+}
+
+Status CsvRowWriter::append(std::span<const glm::dvec3> positions, std::span<const glm::vec3> colors) {
+  assert(colors.size() == (layout_.colors ? positions.size() : 0));
+  const size_t n = positions.size();
+  const auto colorsAt = [&](size_t at) { return layout_.colors ? colors.data() + at : nullptr; };
+  size_t at = 0;
+  // Rows held from earlier calls are topped up to a full batch first: batches stay full (all
+  // cores busy) however small the caller's blocks are.
+  if (!pending_positions_.empty()) {
+    at = std::min(n, batch_rows_ - pending_positions_.size());
+    pending_positions_.insert(pending_positions_.end(), positions.begin(), positions.begin() + std::ptrdiff_t(at));
+    if (layout_.colors)
+      pending_colors_.insert(pending_colors_.end(), colors.begin(), colors.begin() + std::ptrdiff_t(at));
+    if (pending_positions_.size() < batch_rows_) return okStatus();
+    if (Status s = flushPending(); !s) return s;
+  }
+  // Whole batches straight from the caller's arrays (writeCsv's one call copies nothing but its tail).
+  for (; n - at >= batch_rows_; at += batch_rows_)
+    if (Status s = writeBatch(positions.data() + at, colorsAt(at), batch_rows_); !s) return s;
+  pending_positions_.assign(positions.begin() + std::ptrdiff_t(at), positions.end());
+  if (layout_.colors) pending_colors_.assign(colors.begin() + std::ptrdiff_t(at), colors.end());
+  return okStatus();
+}
+
+Status CsvRowWriter::flushPending() {
+  if (pending_positions_.empty()) return okStatus();
+  Status s = writeBatch(pending_positions_.data(), layout_.colors ? pending_colors_.data() : nullptr,
+                        pending_positions_.size());
+  pending_positions_.clear();
+  pending_colors_.clear();
+  return s;
+}
+
+Status CsvRowWriter::commit() {
+  if (Status s = flushPending(); !s) return s;
+  if (progress_) progress_->finish();
+  return file_.commit();
+}
+
+Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
+  if (Status s = checkDecimals(options.decimals); !s) return s;
+  if (!points.colors.empty() && points.colors.size() != points.positions.size())
+    return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
+                 std::to_string(points.positions.size()) + " points"};
+  Result<CsvRowWriter> writer =
+      CsvRowWriter::create(path, CsvLayout{points.isPlanar(), points.hasColors()}, options, points.size());
+  if (!writer) return writer.error();
+  if (Status s = writer->append(points.positions, points.colors); !s) return s;
+  return writer->commit();
+}
+
+}  // namespace dpoint

@@ -1,0 +1,541 @@
+// LAS reading and writing (converters/las.h says what and why). Field offsets follow the public header
+// block and point record tables of LAS 1.4 R15; the 1.0–1.3 headers are prefixes of the 1.4 one.
+// Only little-endian hosts: fields are copied out of the bytes with memcpy.
+#include "converters/las.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include <glm/common.hpp>
+
+#include "core/atomic_file.h"
+#include "core/input_file.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+#include "core/text.h"
+
+namespace dpoint {
+
+static_assert(std::endian::native == std::endian::little, "LAS fields are little-endian, copied as they are");
+
+namespace {
+
+// Public header block: byte offsets of the fields used here.
+constexpr size_t kVersionMajorAt = 24, kVersionMinorAt = 25, kSystemIdAt = 26, kSoftwareAt = 58;
+constexpr size_t kHeaderSizeAt = 94, kPointOffsetAt = 96, kVlrCountAt = 100, kFormatAt = 104;
+constexpr size_t kRecordLengthAt = 105, kLegacyCountAt = 107, kLegacyByReturnAt = 111;
+constexpr size_t kScaleAt = 131, kOffsetAt = 155, kBoundsAt = 179;  // bounds: max x, min x, max y, ...
+constexpr size_t kEvlrCountAt = 243, kCountAt = 247;                 // LAS 1.4
+// Header sizes: 1.0–1.2, 1.3 (adds the waveform packet start), 1.4 (EVLRs, 64-bit counts).
+constexpr uint32_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
+
+// Point records: base sizes and where red sits (green and blue follow; 0: no RGB). Intensity is
+// at byte 12 in every format; classification is the low five bits of byte 15 in formats 0–5 (the
+// top three are the synthetic, key-point and withheld flags) and all of byte 16 in formats 6–10.
+constexpr std::array<uint32_t, 11> kBaseLength = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+constexpr std::array<uint32_t, 11> kRgbAt = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
+constexpr size_t kIntensityAt = 12;
+
+// Records are read and decoded in blocks of about this many bytes, one per task: large enough that
+// a pread and a task hand-out cost nothing, small enough that every core stays busy to the end.
+constexpr size_t kBlockBytes = size_t{1} << 20;
+// The writer encodes this many points per task.
+constexpr size_t kWriteBlockPoints = size_t{1} << 15;
+
+constexpr char kAxis[3] = {'x', 'y', 'z'};
+
+template <typename T>
+T load(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+template <typename T>
+void store(char* p, T v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+std::string num(double v) { return formatNumber(v); }
+std::string str(uint64_t v) { return std::to_string(v); }
+
+// A fixed-size text field up to its first NUL, made printable.
+std::string textField(const char* p, size_t size) {
+  return printableExcerpt(std::string_view(p, strnlen(p, size)));
+}
+
+Result<LasHeader> parseHeader(const InputFile& file) {
+  const std::string& path = file.path();
+  char h[kHeaderSize14] = {};
+  Result<size_t> got = file.readAt(0, h, sizeof h);
+  if (!got) return got.error();
+  if (*got == 0) return Error{path + ": empty file, not a LAS file"};
+  if (*got < 4 || std::memcmp(h, "LASF", 4) != 0)
+    return Error{path + ": not a LAS file (it does not start with 'LASF')"};
+  const auto truncatedHeader = [&](uint32_t needed, const std::string& what) {
+    return Error{path + ": truncated header: the file has " + str(file.size()) + " bytes, " + what + " " +
+                 str(needed)};
+  };
+  if (*got < kHeaderSize12) return truncatedHeader(kHeaderSize12, "a LAS header at least");
+
+  LasHeader hd;
+  hd.version_major = static_cast<uint8_t>(h[kVersionMajorAt]);
+  hd.version_minor = static_cast<uint8_t>(h[kVersionMinorAt]);
+  const std::string version = std::to_string(hd.version_major) + "." + std::to_string(hd.version_minor);
+  if (hd.version_major != 1 || hd.version_minor > 4)
+    return Error{path + ": header: version " + version + " is not supported (LAS 1.0 to 1.4)"};
+  const uint32_t needed = hd.version_minor >= 4 ? kHeaderSize14 : hd.version_minor == 3 ? kHeaderSize13 : kHeaderSize12;
+  if (*got < needed) return truncatedHeader(needed, "a LAS " + version + " header");
+  hd.header_size = load<uint16_t>(h + kHeaderSizeAt);
+  if (hd.header_size < needed)
+    return Error{path + ": header: header size " + str(hd.header_size) + " is smaller than LAS " + version + "'s " +
+                 str(needed) + " bytes"};
+  hd.generating_software = textField(h + kSoftwareAt, 32);
+
+  const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
+  if (raw_format & 0xC0) return lasCompressedError(path);  // LAZ marks its records with bit 7 (old: 6)
+  hd.point_format = raw_format;
+  if (hd.point_format > 10)
+    return Error{path + ": header: point data format " + str(raw_format) + " is not one of LAS's formats 0 to 10"};
+  hd.record_length = load<uint16_t>(h + kRecordLengthAt);
+  const uint32_t base = lasBaseRecordLength(hd.point_format);
+  if (hd.record_length < base)
+    return Error{path + ": header: point record length " + str(hd.record_length) + " is shorter than point format " +
+                 str(raw_format) + "'s " + str(base) + " bytes"};
+  hd.point_offset = load<uint32_t>(h + kPointOffsetAt);
+  hd.vlr_count = load<uint32_t>(h + kVlrCountAt);
+  if (hd.point_offset < hd.header_size)
+    return Error{path + ": header: offset to point data " + str(hd.point_offset) + " lies inside the " +
+                 str(hd.header_size) + "-byte header"};
+
+  for (int k = 0; k < 3; ++k) {
+    const std::string axis(1, kAxis[k]);
+    const double scale = load<double>(h + kScaleAt + 8 * k), offset = load<double>(h + kOffsetAt + 8 * k);
+    const double max = load<double>(h + kBoundsAt + 16 * k), min = load<double>(h + kBoundsAt + 16 * k + 8);
+    if (!std::isfinite(scale) || scale == 0.0)
+      return Error{path + ": header: " + axis + " scale " + num(scale) + " is not a finite, non-zero number"};
+    if (!std::isfinite(offset))
+      return Error{path + ": header: " + axis + " offset " + num(offset) + " is not a finite number"};
+    if (!std::isfinite(min) || !std::isfinite(max))
+      return Error{path + ": header: " + axis + " bounds " + num(min) + " .. " + num(max) + " are not finite numbers"};
+    // Every stored integer is within ±2^31, so this bound makes every coordinate finite.
+    if (!std::isfinite(std::fabs(scale) * 2147483648.0 + std::fabs(offset)))
+      return Error{path + ": header: " + axis + " scale " + num(scale) + " and offset " + num(offset) +
+                   " give coordinates beyond double's range"};
+    hd.scale[k] = scale;
+    hd.offset[k] = offset;
+    hd.min[k] = min;
+    hd.max[k] = max;
+  }
+
+  const uint32_t legacy = load<uint32_t>(h + kLegacyCountAt);
+  hd.point_count = legacy;
+  if (hd.version_minor >= 4) {
+    hd.evlr_count = load<uint32_t>(h + kEvlrCountAt);
+    const uint64_t count = load<uint64_t>(h + kCountAt);
+    if (count != 0 && legacy != 0 && count != legacy)
+      return Error{path + ": header: legacy point count " + str(legacy) + " disagrees with the 64-bit count " +
+                   str(count)};
+    if (count != 0) hd.point_count = count;
+  }
+  if (hd.point_offset > file.size())
+    return Error{path + ": truncated: the offset to point data " + str(hd.point_offset) + " is past the end of the " +
+                 str(file.size()) + "-byte file"};
+  const uint64_t available = file.size() - hd.point_offset;
+  if (hd.point_count > available / hd.record_length)
+    return Error{path + ": truncated: the header declares " + str(hd.point_count) + " points of " +
+                 str(hd.record_length) + " bytes from byte " + str(hd.point_offset) + ", but only " + str(available) +
+                 " bytes follow (room for " + str(available / hd.record_length) + " points)"};
+  return hd;
+}
+
+constexpr std::array<std::array<uint8_t, 3>, 23> kClassColors = {{
+    {128, 128, 128},  // 0 created, never classified
+    {160, 160, 160},  // 1 unclassified
+    {139, 90, 43},    // 2 ground
+    {144, 238, 144},  // 3 low vegetation
+    {60, 179, 60},    // 4 medium vegetation
+    {0, 100, 0},      // 5 high vegetation
+    {178, 34, 34},    // 6 building
+    {255, 0, 255},    // 7 low point (noise)
+    {200, 200, 200},  // 8 reserved (model key-point before 1.4)
+    {30, 100, 255},   // 9 water
+    {100, 50, 130},   // 10 rail
+    {64, 64, 64},     // 11 road surface
+    {200, 200, 200},  // 12 reserved (overlap before 1.4)
+    {255, 215, 0},    // 13 wire, guard (shield)
+    {255, 255, 0},    // 14 wire, conductor (phase)
+    {255, 140, 0},    // 15 transmission tower
+    {255, 190, 120},  // 16 wire-structure connector (insulator)
+    {210, 180, 140},  // 17 bridge deck
+    {200, 0, 200},    // 18 high noise
+    {0, 200, 200},    // 19 overhead structure
+    {205, 170, 125},  // 20 ignored ground
+    {255, 255, 255},  // 21 snow
+    {255, 160, 200},  // 22 temporal exclusion
+}};
+constexpr std::array<uint8_t, 3> kOtherClassColor = {200, 200, 200};
+
+// Decodes the point records into a PointSet (see the top of las.h for the colour rules).
+class LasReader {
+ public:
+  LasReader(const InputFile& file, const LasHeader& header, LasColorSource source, const LasReadOptions& options)
+      : file_(file), h_(header), source_(source), options_(options) {
+    rgb_at_ = kRgbAt[static_cast<size_t>(h_.point_format)];
+    class_at_ = h_.point_format >= 6 ? 16 : 15;
+    class_mask_ = h_.point_format >= 6 ? 0xFF : 0x1F;
+    for (size_t c = 0; c < palette_.size(); ++c) palette_[c] = lasClassColor(static_cast<uint8_t>(c));
+  }
+
+  Result<PointSet> run() {
+    const size_t count = static_cast<size_t>(h_.point_count);  // bounded by the file size
+    const size_t length = h_.record_length;
+    if (options_.progress) options_.progress->start("reading " + file_.path(), count * length);
+    PointSet points;
+    points.positions.resize(count);
+    if (source_ != LasColorSource::kNone) points.colors.resize(count);
+    const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
+    const size_t blocks = (count + block_points - 1) / block_points;
+    const unsigned threads = resolveThreads(options_.threads);
+    std::vector<uint16_t> block_max(blocks, 0);  // the largest colour channel or intensity per block
+    std::vector<std::vector<char>> buffers(threads);
+    std::mutex error_mutex;
+    std::optional<Error> first_error;
+    size_t error_block = SIZE_MAX;
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      const size_t first = b * block_points, last = std::min(first + block_points, count);
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize((last - first) * length);
+      const uint64_t at = h_.point_offset + uint64_t{first} * length;
+      Result<size_t> got = file_.readAt(at, buffer.data(), buffer.size());
+      if (!got || *got < buffer.size()) {  // an I/O error, or the file shrank since it was opened
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (b < error_block) {
+          error_block = b;
+          first_error = got ? Error{file_.path() + ": truncated: the file ends in point " +
+                                    str(first + *got / length) + " of " + str(count)}
+                            : got.error();
+        }
+        return;
+      }
+      block_max[b] = decode(buffer.data(), first, last, points);
+      if (options_.progress) options_.progress->advance(buffer.size());
+    });
+    if (first_error) return *first_error;
+    uint16_t largest = 0;
+    for (uint16_t m : block_max) largest = std::max(largest, m);
+    normalize(points, largest, threads);
+    if (options_.progress) options_.progress->finish();
+    return points;
+  }
+
+ private:
+  // Records [first, last) from `data` into the point set; returns the largest raw colour channel
+  // (kRgb) or intensity (kIntensity) seen, 0 for the other sources.
+  uint16_t decode(const char* data, size_t first, size_t last, PointSet& points) const {
+    const glm::dvec3 scale = h_.scale, offset = h_.offset;
+    glm::dvec3* positions = points.positions.data();
+    glm::vec3* colors = points.colors.data();
+    uint16_t largest = 0;
+    const char* p = data;
+    for (size_t i = first; i < last; ++i, p += h_.record_length) {
+      // X·scale + offset, two roundings, as PDAL, laspy and loaders.gl compute it (no FMA: the
+      // project builds with -ffp-contract=off).
+      positions[i] = glm::dvec3(static_cast<double>(load<int32_t>(p)) * scale.x + offset.x,
+                                static_cast<double>(load<int32_t>(p + 4)) * scale.y + offset.y,
+                                static_cast<double>(load<int32_t>(p + 8)) * scale.z + offset.z);
+      switch (source_) {
+        case LasColorSource::kRgb: {
+          const uint16_t r = load<uint16_t>(p + rgb_at_), g = load<uint16_t>(p + rgb_at_ + 2),
+                         b = load<uint16_t>(p + rgb_at_ + 4);
+          largest = std::max({largest, r, g, b});
+          colors[i] = glm::vec3(r, g, b);  // raw for now; normalize() divides
+          break;
+        }
+        case LasColorSource::kIntensity: {
+          const uint16_t v = load<uint16_t>(p + kIntensityAt);
+          largest = std::max(largest, v);
+          colors[i] = glm::vec3(v);
+          break;
+        }
+        case LasColorSource::kClassification:
+          colors[i] = palette_[static_cast<uint8_t>(p[class_at_]) & class_mask_];
+          break;
+        case LasColorSource::kAuto:
+        case LasColorSource::kNone:
+          break;
+      }
+    }
+    return largest;
+  }
+
+  // Turns the raw colours or intensities into 0..1: a float division of an exact integer, so each
+  // channel is the correctly rounded quotient.
+  void normalize(PointSet& points, uint16_t largest, unsigned threads) const {
+    float divisor = 0.0f;
+    if (source_ == LasColorSource::kRgb) divisor = largest > 255 ? 65535.0f : 255.0f;
+    if (source_ == LasColorSource::kIntensity) divisor = static_cast<float>(largest);
+    if (divisor == 0.0f) return;  // no colours, a palette, or every intensity 0 (already black)
+    const size_t chunk = size_t{1} << 16;
+    parallelFor((points.colors.size() + chunk - 1) / chunk, threads, [&](size_t c, unsigned) {
+      const size_t end = std::min(points.colors.size(), (c + 1) * chunk);
+      for (size_t i = c * chunk; i < end; ++i) points.colors[i] /= divisor;
+    });
+  }
+
+  const InputFile& file_;
+  const LasHeader& h_;
+  LasColorSource source_;
+  const LasReadOptions& options_;
+  size_t rgb_at_ = 0, class_at_ = 15;
+  uint8_t class_mask_ = 0x1F;
+  std::array<glm::vec3, 256> palette_;
+};
+
+// One axis of the writer: offset, and the integer a coordinate is stored as.
+double quantize(double x, double offset, double scale) { return std::round((x - offset) / scale); }
+bool fitsInt32(double q) { return q >= -2147483648.0 && q <= 2147483647.0; }
+
+// True when every coordinate on axis k reads back as itself (X·scale + offset, as a reader computes
+// it) when stored under `offset`. Stops at the first that does not.
+bool readsBackExactly(const std::vector<glm::dvec3>& positions, int k, double offset, double scale, unsigned threads) {
+  std::atomic<bool> miss{false};
+  const size_t n = positions.size();
+  parallelFor((n + kWriteBlockPoints - 1) / kWriteBlockPoints, threads, [&](size_t b, unsigned) {
+    const size_t last = std::min(n, (b + 1) * kWriteBlockPoints);
+    for (size_t i = b * kWriteBlockPoints; i < last && !miss.load(std::memory_order_relaxed); ++i)
+      if (quantize(positions[i][k], offset, scale) * scale + offset != positions[i][k]) miss = true;
+  });
+  return !miss;
+}
+
+// The offset of axis k: the first of lasOffsetFor (a whole number: decimal data at large
+// coordinates reads back exactly), 0 (data read from the many files whose offset is 0, as PDAL
+// writes them by default) and floor(min / scale) · scale under which the extremes fit the 32-bit
+// integers and every coordinate reads back as the same double; lasOffsetFor when none does.
+// Measured on simple.las (scale 0.01, offset 0) written at 0.01: x, y, z offsets of 0 read every
+// point back; the whole-number offsets missed 111, 137 and 164 of 1065, the rounded multiples 315,
+// 459 and 430.
+double chooseOffset(const std::vector<glm::dvec3>& positions, int k, double min, double max, double scale,
+                    unsigned threads) {
+  const double first = lasOffsetFor(min, scale);
+  for (double offset : {first, 0.0, std::floor(min / scale) * scale}) {
+    if (!fitsInt32(quantize(min, offset, scale)) || !fitsInt32(quantize(max, offset, scale))) continue;
+    if (readsBackExactly(positions, k, offset, scale, threads)) return offset;
+  }
+  return first;
+}
+
+// Colours leave as round(clamp(c, 0, 1) · 65535), NaN as 0; c · 65535 is exact in double (24 + 16
+// significant bits), so adding 0.5 and truncating rounds half up without a libm call.
+uint16_t colorWord(float c) {
+  if (!(c > 0.0f)) return 0;
+  return static_cast<uint16_t>(std::min(static_cast<double>(c), 1.0) * 65535.0 + 0.5);
+}
+
+// The 227-byte LAS 1.2 header. Creation day and year are 0 ("not given") so that the same points
+// give the same bytes on any day.
+std::array<char, kHeaderSize12> writerHeader(int format, uint32_t record_length, uint32_t count, double scale,
+                                             const glm::dvec3& offset, const glm::dvec3& min, const glm::dvec3& max) {
+  std::array<char, kHeaderSize12> h{};
+  std::memcpy(h.data(), "LASF", 4);
+  h[kVersionMajorAt] = 1;
+  h[kVersionMinorAt] = 2;
+  std::memcpy(h.data() + kSystemIdAt, "OTHER", 5);
+  std::memcpy(h.data() + kSoftwareAt, "dpoint", 6);
+  store<uint16_t>(h.data() + kHeaderSizeAt, kHeaderSize12);
+  store<uint32_t>(h.data() + kPointOffsetAt, kHeaderSize12);
+  h[kFormatAt] = static_cast<char>(format);
+  store<uint16_t>(h.data() + kRecordLengthAt, static_cast<uint16_t>(record_length));
+  store<uint32_t>(h.data() + kLegacyCountAt, count);
+  store<uint32_t>(h.data() + kLegacyByReturnAt, count);  // every point is return 1 of 1
+  for (int k = 0; k < 3; ++k) {
+    store<double>(h.data() + kScaleAt + 8 * k, scale);
+    store<double>(h.data() + kOffsetAt + 8 * k, offset[k]);
+    store<double>(h.data() + kBoundsAt + 16 * k, max[k]);
+    store<double>(h.data() + kBoundsAt + 16 * k + 8, min[k]);
+  }
+  return h;
+}
+
+}  // namespace
+
+uint32_t lasBaseRecordLength(int point_format) {
+  assert(point_format >= 0 && point_format <= 10);
+  return kBaseLength[static_cast<size_t>(point_format)];
+}
+
+bool lasFormatHasRgb(int point_format) {
+  assert(point_format >= 0 && point_format <= 10);
+  return kRgbAt[static_cast<size_t>(point_format)] != 0;
+}
+
+double lasOffsetFor(double min, double scale) {
+  assert(std::isfinite(min) && scale > 0);
+  return scale <= 1.0 ? std::floor(min) : std::floor(min / scale) * scale;
+}
+
+glm::vec3 lasClassColor(uint8_t classification) {
+  const std::array<uint8_t, 3>& c =
+      classification < kClassColors.size() ? kClassColors[classification] : kOtherClassColor;
+  return glm::vec3(c[0], c[1], c[2]) / 255.0f;
+}
+
+bool lasBoundsContain(const LasHeader& header, const Box& points) {
+  for (int k = 0; k < 3; ++k) {
+    const double slack = std::fabs(header.scale[k]) / 2;
+    if (points.min[k] < header.min[k] - slack || points.max[k] > header.max[k] + slack) return false;
+  }
+  return true;
+}
+
+Error lasCompressedError(const std::string& path) {
+  return Error{path + ": LAZ (compressed LAS) is not supported; decompress it with laszip or PDAL first"};
+}
+
+Result<LasHeader> readLasHeader(const std::string& path) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  return parseHeader(*file);
+}
+
+Result<PointSet> readLas(const std::string& path, const LasReadOptions& options) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  return readLas(*file, options);
+}
+
+Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
+  const std::string& path = file.path();
+  Result<LasHeader> header = parseHeader(file);
+  if (!header) return header.error();
+  const bool rgb = lasFormatHasRgb(header->point_format);
+  LasColorSource source = options.color;
+  if (source == LasColorSource::kAuto) source = rgb ? LasColorSource::kRgb : LasColorSource::kNone;
+  if (source == LasColorSource::kRgb && !rgb)
+    return Error{path + ": point format " + str(static_cast<uint64_t>(header->point_format)) +
+                 " has no RGB colours (formats 2, 3, 5, 7, 8 and 10 have)"};
+  // The count is bounded by the file size already; the point set must also fit --max-memory.
+  const uint64_t point_bytes = sizeof(glm::dvec3) + (source == LasColorSource::kNone ? 0 : sizeof(glm::vec3));
+  if (Status fits = checkMemory(path + ": " + str(header->point_count) + " points", header->point_count * point_bytes,
+                                options.max_memory);
+      !fits)
+    return fits.error();
+  LasReader reader(file, *header, source, options);
+  return reader.run();
+}
+
+Status writeLas(const std::string& path, const PointSet& points, const LasWriteOptions& options) {
+  const double scale = options.scale;
+  if (!std::isfinite(scale) || !(scale > 0.0))
+    return Error{path + ": LAS scale " + num(scale) + " is not a finite number > 0", ExitCode::kUsage};
+  const size_t n = points.size();
+  if (n > UINT32_MAX)
+    return Error{path + ": " + str(n) + " points exceed LAS 1.2's 32-bit point count (4294967295)"};
+  assert(points.colors.empty() || points.colors.size() == n);
+  const unsigned threads = resolveThreads(options.threads);
+  const size_t blocks = (n + kWriteBlockPoints - 1) / kWriteBlockPoints;
+
+  // The bounding box, and the first non-finite point (each block stops at its own first one).
+  std::vector<Box> block_box(blocks);
+  std::vector<size_t> block_bad(blocks, SIZE_MAX);
+  parallelFor(blocks, threads, [&](size_t b, unsigned) {
+    const size_t first = b * kWriteBlockPoints, last = std::min(n, first + kWriteBlockPoints);
+    Box box{points.positions[first], points.positions[first]};
+    for (size_t i = first; i < last; ++i) {
+      const glm::dvec3& p = points.positions[i];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        block_bad[b] = i;
+        return;
+      }
+      box.min = glm::min(box.min, p);
+      box.max = glm::max(box.max, p);
+    }
+    block_box[b] = box;
+  });
+  size_t bad = SIZE_MAX;
+  for (size_t first_bad : block_bad) bad = std::min(bad, first_bad);
+  if (bad != SIZE_MAX) {
+    const glm::dvec3& p = points.positions[bad];
+    return Error{path + ": point " + str(bad) + " (" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) +
+                 ") is not finite; LAS stores finite coordinates only"};
+  }
+  Box box;
+  for (size_t b = 0; b < blocks; ++b) {
+    box.min = b == 0 ? block_box[b].min : glm::min(box.min, block_box[b].min);
+    box.max = b == 0 ? block_box[b].max : glm::max(box.max, block_box[b].max);
+  }
+
+  // Quantization is monotonic (a subtraction, a division by a positive number and a rounding, each
+  // correctly rounded), so the box's corners hold the extreme integers: when they fit, all do, and
+  // their decoded values are the exact bounds a reader finds.
+  glm::dvec3 offset(0.0), q_min(0.0), q_max(0.0);
+  for (int k = 0; k < 3; ++k) {
+    offset[k] = chooseOffset(points.positions, k, box.min[k], box.max[k], scale, threads);
+    q_min[k] = quantize(box.min[k], offset[k], scale);
+    q_max[k] = quantize(box.max[k], offset[k], scale);
+  }
+  const bool fits = fitsInt32(q_min.x) && fitsInt32(q_min.y) && fitsInt32(q_min.z) && fitsInt32(q_max.x) &&
+                    fitsInt32(q_max.y) && fitsInt32(q_max.z);
+  for (size_t i = 0; !fits && i < n; ++i) {  // names the first point that does not fit
+    for (int k = 0; k < 3; ++k) {
+      const double q = quantize(points.positions[i][k], offset[k], scale);
+      if (!fitsInt32(q))
+        return Error{path + ": point " + str(i) + ": " + kAxis[k] + " = " + num(points.positions[i][k]) + " is " +
+                     num(q) + " steps of the scale " + num(scale) + " from the offset " + num(offset[k]) +
+                     ", beyond LAS's 32-bit integers (±2147483647); use a larger scale (--las-scale)"};
+    }
+  }
+  assert(fits);
+  glm::dvec3 bound_min(0.0), bound_max(0.0);
+  for (int k = 0; k < 3; ++k) {  // what a reader computes for the extreme integers
+    bound_min[k] = n == 0 ? 0.0 : q_min[k] * scale + offset[k];
+    bound_max[k] = n == 0 ? 0.0 : q_max[k] * scale + offset[k];
+  }
+
+  const bool colors = points.hasColors();
+  const int format = colors ? 2 : 0;
+  const uint32_t length = lasBaseRecordLength(format);
+  Result<AtomicFile> file = AtomicFile::create(path);
+  if (!file) return file.error();
+  if (options.progress) options.progress->start("writing " + path, n);
+  const auto header = writerHeader(format, length, static_cast<uint32_t>(n), scale, offset, bound_min, bound_max);
+  if (Status s = file->write(header.data(), header.size()); !s) return s;
+
+  // Blocks are encoded on all cores a batch at a time, then written in order.
+  std::vector<std::vector<char>> encoded(static_cast<size_t>(threads) * 4);
+  for (size_t batch = 0; batch < blocks; batch += encoded.size()) {
+    const size_t batch_blocks = std::min(encoded.size(), blocks - batch);
+    parallelFor(batch_blocks, threads, [&](size_t j, unsigned) {
+      const size_t first = (batch + j) * kWriteBlockPoints, last = std::min(n, first + kWriteBlockPoints);
+      std::vector<char>& out = encoded[j];
+      out.assign((last - first) * length, 0);
+      char* r = out.data();
+      for (size_t i = first; i < last; ++i, r += length) {
+        const glm::dvec3& p = points.positions[i];
+        for (int k = 0; k < 3; ++k)
+          store<int32_t>(r + 4 * k, static_cast<int32_t>(quantize(p[k], offset[k], scale)));
+        r[14] = 0x09;  // return number 1 (bits 0–2) of 1 (bits 3–5)
+        if (colors)
+          for (int c = 0; c < 3; ++c) store<uint16_t>(r + 20 + 2 * c, colorWord(points.colors[i][c]));
+      }
+    });
+    for (size_t j = 0; j < batch_blocks; ++j) {
+      if (Status s = file->write(encoded[j].data(), encoded[j].size()); !s) return s;
+      if (options.progress) options.progress->advance(encoded[j].size() / length);
+    }
+  }
+  if (Status s = file->commit(); !s) return s;
+  if (options.progress) options.progress->finish();
+  return okStatus();
+}
+
+}  // namespace dpoint

@@ -1,0 +1,885 @@
+// PLY reading (writing is in ply_write.cpp). Format: Greg Turk, "The PLY Polygon File Format" (1994), as written
+// by rply, Open3D, MeshLab and PCL. Only little-endian hosts: binary rows are read and written
+// with memcpy.
+//
+// The header and every element are read in file order through one ByteReader, except the one
+// that matters for speed: a binary `vertex` element without list properties. Its rows all have
+// one size, so row i is at a known offset and goes to positions[i]: blocks of rows are read
+// (pread, one buffer per thread) and decoded on all cores straight into the exactly sized arrays.
+// The result therefore never depends on the thread count, and the first bad row in file order
+// gives the error (a block stops at its own first bad row; blocks after a known bad row are not
+// decoded; the lowest row wins). Memory: the PointSet plus one block per thread. ASCII data,
+// faces and vertices with lists stay serial: ASCII rows have no known offsets (the CSV reader's
+// two passes would be needed), and meshes are small next to the point sets this reader is timed on.
+#include "converters/ply.h"
+
+#include <fast_float/fast_float.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cassert>
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <mutex>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "core/input_file.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+#include "core/text.h"
+
+namespace dpoint {
+
+static_assert(std::endian::native == std::endian::little, "binary PLY rows are copied as they are");
+static_assert(sizeof(glm::dvec3) == 24 && sizeof(glm::vec3) == 12, "glm vectors must be packed");
+
+namespace {
+
+// Reads are in blocks this large: big enough that pread overhead vanishes, small enough that a
+// multi-GB file is never held whole.
+constexpr size_t kBlockBytes = size_t{8} << 20;
+// Binary vertex rows are decoded in blocks of about this many bytes, one per task: large enough
+// that a pread and a task hand-out per block cost nothing, small enough that a block is still in
+// cache when it is decoded and that the last blocks keep every core busy.
+constexpr size_t kVertexBlockBytes = size_t{1} << 20;
+constexpr size_t kMaxHeaderLine = size_t{64} << 10;
+constexpr size_t kMaxAsciiLine = size_t{64} << 20;
+
+enum class Type : uint8_t { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+struct TypeInfo {
+  std::string_view name;
+  Type type;
+};
+constexpr TypeInfo kTypeNames[] = {
+    {"char", Type::kInt8},   {"uchar", Type::kUint8},   {"short", Type::kInt16},     {"ushort", Type::kUint16},
+    {"int", Type::kInt32},   {"uint", Type::kUint32},   {"float", Type::kFloat32},   {"double", Type::kFloat64},
+    {"int8", Type::kInt8},   {"uint8", Type::kUint8},   {"int16", Type::kInt16},     {"uint16", Type::kUint16},
+    {"int32", Type::kInt32}, {"uint32", Type::kUint32}, {"float32", Type::kFloat32}, {"float64", Type::kFloat64},
+};
+
+size_t typeSize(Type t) {
+  constexpr size_t kSizes[] = {1, 1, 2, 2, 4, 4, 4, 8};
+  return kSizes[static_cast<int>(t)];
+}
+std::string_view typeName(Type t) { return kTypeNames[static_cast<int>(t)].name; }
+bool isInteger(Type t) { return t < Type::kFloat32; }
+
+template <typename T>
+T loadRaw(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Every PLY scalar is exact in a double (integers are at most 32 bits).
+inline double loadValue(Type t, const char* p) {
+  switch (t) {
+    case Type::kInt8: return loadRaw<int8_t>(p);
+    case Type::kUint8: return loadRaw<uint8_t>(p);
+    case Type::kInt16: return loadRaw<int16_t>(p);
+    case Type::kUint16: return loadRaw<uint16_t>(p);
+    case Type::kInt32: return loadRaw<int32_t>(p);
+    case Type::kUint32: return loadRaw<uint32_t>(p);
+    case Type::kFloat32: return loadRaw<float>(p);
+    case Type::kFloat64: return loadRaw<double>(p);
+  }
+  return 0;
+}
+
+// Parses one ASCII token as a value of type `t`. float32 is parsed straight to float so that the
+// value equals what a binary file would hold (no double rounding through double).
+bool parseAscii(Type t, std::string_view token, double& out) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  // printf("%+g") writers emit a '+', which from_chars does not take.
+  if (first != last && *first == '+') {
+    ++first;
+    if (first != last && *first == '-') return false;
+  }
+  if (t == Type::kFloat32) {
+    float f = 0;
+    auto r = fast_float::from_chars(first, last, f);
+    out = f;
+    return r.ec == std::errc() && r.ptr == last;
+  }
+  if (t == Type::kFloat64) {
+    auto r = fast_float::from_chars(first, last, out);
+    return r.ec == std::errc() && r.ptr == last;
+  }
+  int64_t v = 0;
+  auto r = std::from_chars(first, last, v);
+  if (r.ec != std::errc() || r.ptr != last) return false;
+  constexpr int64_t kMin[] = {INT8_MIN, 0, INT16_MIN, 0, INT32_MIN, 0};
+  constexpr int64_t kMax[] = {INT8_MAX, UINT8_MAX, INT16_MAX, UINT16_MAX, INT32_MAX, UINT32_MAX};
+  if (v < kMin[static_cast<int>(t)] || v > kMax[static_cast<int>(t)]) return false;
+  out = static_cast<double>(v);
+  return true;
+}
+
+std::string quote(std::string_view text) { return "'" + printableExcerpt(text) + "'"; }
+
+std::string numberText(double v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+// Takes the next whitespace-separated token off the front of `rest`; empty at the end. A plain
+// loop: find_first_of calls memchr per character, which was a third of the ASCII read time.
+std::string_view nextToken(std::string_view& rest) {
+  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  size_t begin = 0;
+  while (begin < rest.size() && space(rest[begin])) ++begin;
+  size_t end = begin;
+  while (end < rest.size() && !space(rest[end])) ++end;
+  std::string_view token = rest.substr(begin, end - begin);
+  rest.remove_prefix(end);
+  return token;
+}
+
+bool isBlank(std::string_view s) { return nextToken(s).empty(); }
+
+// Element and property names go into messages as they are; a control byte in one would break the
+// one-line rule, and no PLY writer makes such a name.
+bool hasControlByte(std::string_view s) {
+  return std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
+
+// A window onto the file, refilled in big blocks.
+class ByteReader {
+ public:
+  enum class Line { kLine, kEnd, kTooLong };
+
+  ByteReader(const InputFile& file, Progress* progress)
+      : file_(file), progress_(progress), buf_(std::min<uint64_t>(kBlockBytes, file.size() + 1)) {}
+
+  uint64_t offset() const { return start_ + pos_; }
+  // The file offset just past the bytes read so far (each reported once to the progress).
+  uint64_t readEnd() const { return start_ + end_; }
+  uint64_t remaining() const { return file_.size() > offset() ? file_.size() - offset() : 0; }
+  size_t available() const { return end_ - pos_; }
+  const char* data() const { return buf_.data() + pos_; }
+  void consume(size_t n) { pos_ += n; }
+
+  // Makes `n` bytes available unless the file ends first; returns how many are.
+  Result<size_t> require(size_t n) {
+    if (available() >= n) return available();
+    return refill(n);
+  }
+
+  // The caller has checked that `n` bytes remain.
+  void skip(uint64_t n) {
+    if (n <= available()) return consume(static_cast<size_t>(n));
+    start_ = start_ + end_ + (n - available());
+    pos_ = end_ = 0;
+  }
+
+  // The next line without its "\n" or "\r\n".
+  Result<Line> nextLine(std::string_view& line, size_t max_bytes) {
+    size_t scanned = 0;
+    bool at_end = false;
+    for (;;) {
+      const size_t avail = available();
+      const void* nl = std::memchr(data() + scanned, '\n', avail - scanned);
+      if (nl || (at_end && avail > 0)) {  // a newline, or the last line of the file lacks one
+        size_t len = nl ? static_cast<size_t>(static_cast<const char*>(nl) - data()) : avail;
+        if (len > max_bytes) return Line::kTooLong;
+        line = std::string_view(data(), len);
+        consume(nl ? len + 1 : len);
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        return Line::kLine;
+      }
+      if (avail > max_bytes) return Line::kTooLong;
+      if (at_end) return Line::kEnd;
+      scanned = avail;
+      auto got = refill(avail + 1);
+      if (!got.ok()) return got.error();
+      at_end = available() == avail;
+    }
+  }
+
+ private:
+  Result<size_t> refill(size_t n) {
+    size_t keep = available();
+    std::memmove(buf_.data(), data(), keep);
+    start_ += pos_;
+    pos_ = 0;
+    end_ = keep;
+    if (buf_.size() < n) buf_.resize(std::max(n, 2 * buf_.size()));
+    while (end_ < n) {
+      auto got = file_.readAt(start_ + end_, buf_.data() + end_, buf_.size() - end_);
+      if (!got.ok()) return got.error();
+      if (*got == 0) break;
+      end_ += *got;
+      if (progress_) progress_->advance(*got);
+    }
+    return end_;
+  }
+
+  const InputFile& file_;
+  Progress* progress_;
+  std::vector<char> buf_;
+  uint64_t start_ = 0;  // file offset of buf_[0]
+  size_t pos_ = 0, end_ = 0;
+};
+
+struct Property {
+  std::string name;
+  Type type = Type::kFloat64;  // the scalar type, or the item type of a list
+  bool is_list = false;
+  Type count_type = Type::kUint8;
+  int line = 0;
+};
+
+struct Element {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<Property> properties;
+  int line = 0;
+};
+
+// What a property feeds; values land in `double values[kRoleCount]` indexed by role.
+enum Role : uint8_t { kSkip, kX, kY, kZ, kRed, kGreen, kBlue, kIndices, kRoleCount };
+
+class PlyParser {
+ public:
+  PlyParser(const InputFile& file, const PlyReadOptions& options)
+      : file_(file), path_(file.path()), options_(options), in_(file, options.progress) {}
+
+  Result<PointSet> run() {
+    if (options_.progress) options_.progress->start("reading " + path_, file_.size());
+    if (Status s = parseHeader(); !s.ok()) return s.error();
+    if (Status s = planElements(); !s.ok()) return s.error();
+    if (Status s = checkSizes(); !s.ok()) return s.error();
+    bool stopped = false;
+    for (const Element& e : elements_) {
+      Status s = readElement(e, e.name == "vertex" ? vertex_roles_
+                                : e.name == "face" ? face_roles_
+                                                   : std::vector<Role>(e.properties.size(), kSkip));
+      if (!s.ok()) return s.error();
+      if ((stopped = options_.points_only && e.name == "vertex")) break;
+    }
+    if (Status s = stopped ? okStatus() : checkEnd(); !s.ok()) return s.error();
+    // Ends the line here, as readCsv does: left open, it went on counting the caller's next work
+    // as reading time.
+    if (options_.progress) options_.progress->finish();
+    return std::move(points_);
+  }
+
+  // PlyVertexStream: the header, then where the vertex rows start. Binary only, and every element
+  // before the vertices of fixed-size rows, so that row r's offset is known without reading.
+  Status openStream() {
+    if (Status s = parseHeader(); !s.ok()) return s.error();
+    if (Status s = planElements(); !s.ok()) return s.error();
+    if (Status s = checkSizes(); !s.ok()) return s.error();
+    if (ascii_) return Error{path_ + ": an ASCII PLY file cannot be streamed; convert it to binary PLY first"};
+    uint64_t offset = in_.offset();
+    for (const Element& e : elements_) {
+      const bool fixed =
+          std::none_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; });
+      if (!fixed)
+        return Error{path_ + ": element '" + e.name + "' (header line " + std::to_string(e.line) +
+                     ") has list rows before the vertices; such a file cannot be streamed"};
+      if (e.name == "vertex") {
+        stream_layout_ = vertexLayout(e, vertex_roles_);
+        stream_begin_ = offset;
+        return okStatus();
+      }
+      uint64_t row_bytes = 0;
+      for (const Property& p : e.properties) row_bytes += typeSize(p.type);
+      offset += row_bytes * e.count;  // bounded by checkSizes
+    }
+    return okStatus();  // planElements found a vertex element
+  }
+  uint64_t vertexCount() const { return vertex_count_; }
+  bool hasColors() const { return has_colors_; }
+  uint64_t faceCount() const {
+    for (const Element& e : elements_)
+      if (e.name == "face") return e.count;
+    return 0;
+  }
+
+  // Vertex rows [first, first + n) into `block`, in parallel blocks, with readPly's errors.
+  Status readStream(uint64_t first, uint64_t n, PointSet& block) {
+    assert(first <= vertex_count_ && n <= vertex_count_ - first);
+    const RowLayout& layout = stream_layout_;
+    block.triangles.clear();
+    block.positions.resize(static_cast<size_t>(n));
+    if (has_colors_) block.colors.resize(static_cast<size_t>(n));
+    else block.colors.clear();
+    const uint64_t block_rows = std::max<size_t>(1, kVertexBlockBytes / layout.row_bytes);
+    const size_t blocks = static_cast<size_t>((n + block_rows - 1) / block_rows);
+    std::mutex error_mutex;
+    std::optional<Error> first_error;
+    uint64_t error_row = UINT64_MAX;
+    auto fail = [&](uint64_t row, Error error) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (row < error_row) error_row = row, first_error = std::move(error);
+    };
+    const unsigned threads = resolveThreads(options_.threads);
+    std::vector<std::vector<char>> buffers(threads);
+    glm::dvec3* positions = block.positions.data();
+    glm::vec3* colors = has_colors_ ? block.colors.data() : nullptr;
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      const uint64_t from = first + b * block_rows, to = std::min(from + block_rows, first + n);
+      const uint64_t offset = stream_begin_ + from * layout.row_bytes;
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>((to - from) * layout.row_bytes));
+      Result<size_t> got = file_.readAt(offset, buffer.data(), buffer.size());
+      if (!got) return fail(from, got.error());
+      if (*got < buffer.size()) {  // the file shrank since it was opened
+        const uint64_t whole = from + *got / layout.row_bytes;
+        return fail(whole, Error{path_ + ": truncated at byte " + std::to_string(offset + *got) + ": expected " +
+                                 std::to_string(vertex_count_) + " 'vertex' rows, the data ends in row " +
+                                 std::to_string(whole)});
+      }
+      const uint64_t bad = decodeVertices(layout, buffer.data(), from, to, positions, colors, first);
+      if (bad != to) {
+        double v[kRoleCount];
+        layout.load(buffer.data() + (bad - from) * layout.row_bytes, v);
+        return fail(bad, nonfiniteError(v, bad, stream_begin_ + bad * layout.row_bytes));
+      }
+      if (options_.progress) options_.progress->advance(buffer.size());
+    });
+    if (first_error) return *first_error;
+    return okStatus();
+  }
+
+ private:
+  Error headerError(int line, const std::string& what) const {
+    return Error{path_ + ": header line " + std::to_string(line) + ": " + what};
+  }
+  // `where` is the 1-based line for ASCII, the byte offset for binary.
+  Error dataError(uint64_t where, const std::string& what) const {
+    return Error{path_ + (ascii_ ? ": line " : ": byte ") + std::to_string(where) + ": " + what};
+  }
+  Error truncated(const Element& e, uint64_t row) const {
+    return Error{path_ + ": truncated at byte " + std::to_string(file_.size()) + ": expected " +
+                 std::to_string(e.count) + " '" + e.name + "' rows, the data ends in row " + std::to_string(row)};
+  }
+
+  Status parseHeader() {
+    auto first = in_.require(4);
+    if (!first.ok()) return first.error();
+    if (*first == 0) return Error{path_ + ": empty file, not a PLY file"};
+    const char* p = in_.data();
+    if (*first < 3 || std::memcmp(p, "ply", 3) != 0 || (*first > 3 && p[3] != '\n' && p[3] != '\r'))
+      return Error{path_ + ": not a PLY file (it does not start with a 'ply' line)"};
+    bool have_format = false;
+    for (int line_no = 1;; ++line_no) {
+      std::string_view line;
+      auto got = in_.nextLine(line, kMaxHeaderLine);
+      if (!got.ok()) return got.error();
+      if (*got == ByteReader::Line::kEnd) return headerError(line_no, "the file ends before 'end_header'");
+      if (*got == ByteReader::Line::kTooLong) return headerError(line_no, "line too long (no 'end_header'?)");
+      line_no_ = static_cast<uint64_t>(line_no);
+      std::vector<std::string_view> w;
+      for (auto rest = line, t = nextToken(rest); !t.empty(); t = nextToken(rest)) w.push_back(t);
+      if (line_no == 1) continue;  // the magic, checked above
+      if (w.empty()) return headerError(line_no, "empty line");
+      const std::string_view key = w[0];
+      if (key == "comment" || key == "obj_info") continue;
+      if (key == "end_header") break;
+      if (key == "format") {
+        if (w.size() != 3) return headerError(line_no, "expected 'format ENCODING 1.0', found " + quote(line));
+        if (w[1] == "ascii")
+          ascii_ = true;
+        else if (w[1] == "binary_big_endian")
+          return headerError(line_no, "format binary_big_endian is unsupported (only ascii and binary_little_endian)");
+        else if (w[1] != "binary_little_endian")
+          return headerError(line_no, "unknown format " + quote(w[1]));
+        if (w[2] != "1.0") return headerError(line_no, "unsupported format version " + quote(w[2]));
+        have_format = true;
+      } else if (key == "element") {
+        Element e;
+        if (w.size() != 3) return headerError(line_no, "expected 'element NAME COUNT', found " + quote(line));
+        auto r = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
+        if (r.ec != std::errc() || r.ptr != w[2].data() + w[2].size())
+          return headerError(line_no, "bad element count " + quote(w[2]));
+        if (hasControlByte(w[1])) return headerError(line_no, "element name " + quote(w[1]) + " has a control character");
+        e.name = w[1];
+        e.line = line_no;
+        for (const Element& other : elements_)
+          if (other.name == e.name) return headerError(line_no, "second element " + quote(e.name));
+        elements_.push_back(std::move(e));
+      } else if (key == "property") {
+        if (elements_.empty()) return headerError(line_no, "property before any element");
+        Property prop;
+        prop.line = line_no;
+        prop.is_list = w.size() > 1 && w[1] == "list";
+        if (w.size() != (prop.is_list ? 5u : 3u))
+          return headerError(
+              line_no, "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME', found " + quote(line));
+        for (size_t k = prop.is_list ? 2 : 1; k + 1 < w.size(); ++k) {
+          auto it = std::find_if(std::begin(kTypeNames), std::end(kTypeNames),
+                                 [&](const TypeInfo& t) { return t.name == w[k]; });
+          if (it == std::end(kTypeNames)) return headerError(line_no, "unsupported property type " + quote(w[k]));
+          (k == 2 && prop.is_list ? prop.count_type : prop.type) = it->type;
+        }
+        if (prop.is_list && !isInteger(prop.count_type))
+          return headerError(line_no, "list count type " + quote(w[2]) + " is not an integer type");
+        if (hasControlByte(w.back()))
+          return headerError(line_no, "property name " + quote(w.back()) + " has a control character");
+        prop.name = w.back();
+        for (const Property& other : elements_.back().properties)
+          if (other.name == prop.name) return headerError(line_no, "second property " + quote(prop.name));
+        elements_.back().properties.push_back(std::move(prop));
+      } else {
+        return headerError(line_no, "unknown header keyword " + quote(key));
+      }
+    }
+    if (!have_format) return headerError(static_cast<int>(line_no_), "the header has no 'format' line");
+    return okStatus();
+  }
+
+  // Gives each vertex and face property its role and checks the types they need.
+  Status planElements() {
+    const Element* vertex = nullptr;
+    for (const Element& e : elements_) {
+      if (e.name == "vertex") vertex = &e;
+      if (e.name == "vertex") vertex_roles_.assign(e.properties.size(), kSkip);
+      if (e.name == "face") face_roles_.assign(e.properties.size(), kSkip);
+    }
+    if (!vertex) return Error{path_ + ": the header declares no 'vertex' element"};
+    int found[kRoleCount] = {};
+    constexpr std::string_view kNames[] = {"", "x", "y", "z", "red", "green", "blue"};
+    for (size_t k = 0; k < vertex->properties.size(); ++k) {
+      const Property& p = vertex->properties[k];
+      for (int role = kX; role <= kBlue; ++role) {
+        if (p.name != kNames[role]) continue;
+        if (p.is_list) return headerError(p.line, "vertex property '" + p.name + "' is a list, not a number");
+        if (role >= kRed) {
+          if (p.type == Type::kUint8)
+            divisor_[role] = 255.0f;
+          else if (p.type == Type::kUint16)
+            divisor_[role] = 65535.0f;
+          else if (isInteger(p.type))
+            return headerError(p.line, "unsupported colour type '" + std::string(typeName(p.type)) + "' for '" +
+                                           p.name + "' (uchar, ushort, float or double)");
+        }
+        vertex_roles_[k] = static_cast<Role>(role);
+        found[role] = p.line;
+      }
+    }
+    for (int role = kX; role <= kZ; ++role)
+      if (!found[role])
+        return headerError(vertex->line, "element 'vertex' has no '" + std::string(kNames[role]) + "' property");
+    has_colors_ = found[kRed] || found[kGreen] || found[kBlue];
+    if (has_colors_ && !(found[kRed] && found[kGreen] && found[kBlue]))
+      return headerError(std::max({found[kRed], found[kGreen], found[kBlue]}),
+                         "vertex colours need all of red, green and blue");
+    for (const Element& e : elements_) {
+      if (e.name != "face") continue;
+      for (size_t k = 0; k < e.properties.size(); ++k) {
+        const Property& p = e.properties[k];
+        if (p.name != "vertex_indices" && p.name != "vertex_index") continue;
+        if (!p.is_list) return headerError(p.line, "face property '" + p.name + "' is not a list");
+        if (!isInteger(p.type))
+          return headerError(p.line, "face index type '" + std::string(typeName(p.type)) + "' is not an integer type");
+        if (std::count(face_roles_.begin(), face_roles_.end(), kIndices))
+          return headerError(p.line, "face has both vertex_indices and vertex_index");
+        face_roles_[k] = kIndices;
+      }
+      if (e.count && !std::count(face_roles_.begin(), face_roles_.end(), kIndices))
+        return headerError(e.line, "element 'face' has no vertex_indices list");
+      if (e.count && vertex->count > UINT32_MAX)
+        return headerError(e.line, "a mesh may have at most 2^32 - 1 vertices");
+    }
+    vertex_count_ = vertex->count;
+    return okStatus();
+  }
+
+  // A hostile header must not make us allocate: every row needs some bytes, so the counts are
+  // bounded by the data that follows the header.
+  Status checkSizes() {
+    const uint64_t data_bytes = in_.remaining();
+    uint64_t needed = 0;
+    for (const Element& e : elements_) {
+      uint64_t row = 0;
+      for (const Property& p : e.properties)  // an ASCII value is at least one character and a separator
+        row += ascii_ ? 2 : typeSize(p.is_list ? p.count_type : p.type);
+      uint64_t bytes = 0;
+      const bool overflow =
+          __builtin_mul_overflow(row, e.count, &bytes) || __builtin_add_overflow(needed, bytes, &needed);
+      if (overflow || needed > data_bytes + (ascii_ ? 1 : 0))  // the last ASCII line may lack its newline
+        return Error{path_ + ": truncated at byte " + std::to_string(file_.size()) + ": header line " +
+                     std::to_string(e.line) + " declares " + std::to_string(e.count) + " '" + e.name +
+                     "' rows, needing at least " + (overflow ? "2^64" : std::to_string(needed)) +
+                     " bytes of data, but only " + std::to_string(data_bytes) + " follow the header"};
+    }
+    // What the data bounds may still be more than memory: 24-36 bytes of point set per vertex
+    // from as little as 3 bytes of file.
+    memory_limit_ = options_.max_memory ? options_.max_memory : defaultMemoryLimit();
+    vertex_bytes_ = vertex_count_ * (sizeof(glm::dvec3) + (has_colors_ ? sizeof(glm::vec3) : 0));
+    return checkMemory(path_ + ": " + std::to_string(vertex_count_) + " vertices", vertex_bytes_, memory_limit_);
+  }
+
+  Status readElement(const Element& e, const std::vector<Role>& roles) {
+    if (e.properties.empty() || e.count == 0) return okStatus();
+    const bool is_vertex = e.name == "vertex";
+    const bool fixed =
+        std::none_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; });
+    if (!ascii_ && fixed && !is_vertex && e.name != "face") {  // skipped whole, without reading it
+      uint64_t row_bytes = 0;
+      for (const Property& p : e.properties) row_bytes += typeSize(p.type);
+      if (row_bytes * e.count > in_.remaining())
+        return truncated(e, in_.remaining() / row_bytes);  // bounded by checkSizes
+      in_.skip(row_bytes * e.count);
+      return okStatus();
+    }
+    if (!ascii_ && fixed && is_vertex) return readFixedVertices(e, roles);
+    if (is_vertex) {
+      // reserve, not resize: each page is touched once, by the parsed value (bounded by checkSizes).
+      points_.positions.reserve(e.count);
+      if (has_colors_) points_.colors.reserve(e.count);
+    } else if (e.name == "face") {
+      // A face is at least a count and three indices; fewer is an error found while reading.
+      uint64_t min_face = 8;
+      for (size_t k = 0; k < e.properties.size(); ++k)
+        if (roles[k] == kIndices && !ascii_)
+          min_face = typeSize(e.properties[k].count_type) + 3 * typeSize(e.properties[k].type);
+      const uint64_t room = (memory_limit_ - vertex_bytes_) / (3 * sizeof(uint32_t));  // checkSizes: ≥ 0
+      points_.triangles.reserve(3 * std::min({e.count, in_.remaining() / min_face, room}));
+    }
+    for (uint64_t row = 0; row < e.count; ++row) {
+      uint64_t where = 0;
+      Status s = ascii_ ? readAsciiRow(e, roles, row, where) : readBinaryRow(e, roles, row, where);
+      if (!s.ok()) return s;
+      if (is_vertex && !storeVertex(values_)) return nonfiniteError(values_, row, where);
+      if (e.name == "face") s = finishFace(row, where);
+      if (!s.ok()) return s;
+    }
+    return okStatus();
+  }
+
+  // Where a binary vertex row keeps its values.
+  struct RowLayout {
+    struct Field {
+      size_t offset;
+      Type type;
+      Role role;
+    };
+    std::vector<Field> fields;
+    size_t row_bytes = 0, at[kRoleCount] = {};
+    bool packed = true;     // adjacent double x, y, z and uchar colours: what dpoint and most tools write
+    float byte_color[256];  // k / 255.0f, the same rounding as colorOf
+
+    void load(const char* row, double* v) const {
+      for (const Field& f : fields) v[f.role] = loadValue(f.type, row + f.offset);
+    }
+  };
+
+  static RowLayout vertexLayout(const Element& e, const std::vector<Role>& roles) {
+    RowLayout layout;
+    for (size_t k = 0; k < e.properties.size(); layout.row_bytes += typeSize(e.properties[k++].type)) {
+      if (roles[k] == kSkip) continue;
+      layout.fields.push_back({layout.row_bytes, e.properties[k].type, roles[k]});
+      layout.at[roles[k]] = layout.row_bytes;
+      layout.packed = layout.packed && e.properties[k].type == (roles[k] <= kZ ? Type::kFloat64 : Type::kUint8);
+    }
+    layout.packed = layout.packed && layout.at[kY] == layout.at[kX] + 8 && layout.at[kZ] == layout.at[kX] + 16;
+    for (int k = 0; k < 256; ++k) layout.byte_color[k] = static_cast<float>(k) / 255.0f;
+    return layout;
+  }
+
+  // The hot path: binary rows of one size, decoded in blocks on all cores (see the top comment).
+  Status readFixedVertices(const Element& e, const std::vector<Role>& roles) {
+    const RowLayout layout = vertexLayout(e, roles);
+
+    // checkSizes bounds the rows by the file size, but elements before this one may hold longer
+    // lists than it assumed: decode the whole rows there are, then report the cut.
+    const size_t row_bytes = layout.row_bytes;
+    const uint64_t begin = in_.offset();
+    const uint64_t rows = std::min<uint64_t>(e.count, in_.remaining() / row_bytes);
+    const uint64_t block_rows = std::max<size_t>(1, kVertexBlockBytes / row_bytes);
+    const size_t blocks = static_cast<size_t>((rows + block_rows - 1) / block_rows);
+    const unsigned threads = resolveThreads(options_.threads);
+    const uint64_t reported = in_.readEnd();  // bytes before this offset are already in the progress
+    // Sized, not reserved: every block writes its own slots.
+    resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
+    if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
+
+    std::mutex error_mutex;
+    std::optional<Error> first_error;
+    std::atomic<uint64_t> error_row{UINT64_MAX};
+    auto fail = [&](uint64_t row, Error error) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (row < error_row.load()) {
+        error_row = row;
+        first_error = std::move(error);
+      }
+    };
+    glm::dvec3* positions = points_.positions.data();
+    glm::vec3* colors = has_colors_ ? points_.colors.data() : nullptr;
+    std::vector<std::vector<char>> buffers(threads);
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      const uint64_t first = b * block_rows, last = std::min(first + block_rows, rows);
+      if (first > error_row.load()) return;  // cannot hold the first error
+      const uint64_t offset = begin + first * row_bytes;
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>((last - first) * row_bytes));
+      Result<size_t> got = file_.readAt(offset, buffer.data(), buffer.size());
+      if (!got) return fail(first, got.error());
+      if (*got < buffer.size()) {  // the file shrank since it was opened
+        const uint64_t whole = first + *got / row_bytes;
+        return fail(whole, truncated(e, whole));
+      }
+      const uint64_t bad = decodeVertices(layout, buffer.data(), first, last, positions, colors, 0);
+      if (bad != last) {
+        double v[kRoleCount];
+        layout.load(buffer.data() + (bad - first) * row_bytes, v);
+        return fail(bad, nonfiniteError(v, bad, begin + bad * row_bytes));
+      }
+      const uint64_t end = offset + buffer.size();
+      if (options_.progress) options_.progress->advance(end - std::clamp(reported, offset, end));
+    });
+    if (first_error) return *first_error;
+    if (rows < e.count) return truncated(e, rows);
+    in_.skip(rows * row_bytes);
+    return okStatus();
+  }
+
+  // Decodes rows [first, last) from `data` (row `first` at data[0]) into positions[row − base] and,
+  // when not null, colors[row − base]. Returns the first unacceptable row, or `last`. Runs on
+  // several threads.
+  uint64_t decodeVertices(const RowLayout& layout, const char* data, uint64_t first, uint64_t last,
+                          glm::dvec3* positions, glm::vec3* colors, uint64_t base) const {
+    const char* p = data;
+    for (uint64_t row = first; row < last; ++row, p += layout.row_bytes) {
+      double v[kRoleCount];  // local, so that stores into the point arrays cannot alias it
+      const uint64_t at = row - base;
+      if (layout.packed) {
+        std::memcpy(&v[kX], p + layout.at[kX], 3 * sizeof(double));
+        if (!positionAcceptable(v)) return row;  // uchar colours always are
+        positions[at] = glm::dvec3(v[kX], v[kY], v[kZ]);
+        if (colors)
+          colors[at] = glm::vec3(layout.byte_color[static_cast<uint8_t>(p[layout.at[kRed]])],
+                                  layout.byte_color[static_cast<uint8_t>(p[layout.at[kGreen]])],
+                                  layout.byte_color[static_cast<uint8_t>(p[layout.at[kBlue]])]);
+      } else {
+        layout.load(p, v);
+        if (!positionAcceptable(v) || (colors && !colourAcceptable(v))) return row;
+        positions[at] = glm::dvec3(v[kX], v[kY], v[kZ]);
+        if (colors) colors[at] = colorOf(v);
+      }
+    }
+    return last;
+  }
+
+  Status readBinaryRow(const Element& e, const std::vector<Role>& roles, uint64_t row, uint64_t& where) {
+    where = in_.offset();
+    polygon_.clear();
+    for (size_t k = 0; k < e.properties.size(); ++k) {
+      const Property& p = e.properties[k];
+      const size_t size = typeSize(p.is_list ? p.count_type : p.type);
+      auto avail = in_.require(size);
+      if (!avail.ok()) return avail.error();
+      if (*avail < size) return truncated(e, row);
+      const double value = loadValue(p.is_list ? p.count_type : p.type, in_.data());
+      in_.consume(size);
+      if (!p.is_list) {
+        values_[roles[k]] = value;
+        continue;
+      }
+      if (value < 0) return dataError(where, e.name + " " + std::to_string(row) + ": negative list length");
+      const uint64_t bytes = static_cast<uint64_t>(value) * typeSize(p.type);
+      if (bytes > in_.remaining()) return truncated(e, row);
+      if (roles[k] != kIndices) {
+        in_.skip(bytes);
+        continue;
+      }
+      auto got = in_.require(static_cast<size_t>(bytes));
+      if (!got.ok()) return got.error();
+      for (const char* q = in_.data(); q != in_.data() + bytes; q += typeSize(p.type))
+        polygon_.push_back(loadValue(p.type, q));
+      in_.consume(static_cast<size_t>(bytes));
+    }
+    return okStatus();
+  }
+
+  Status readAsciiRow(const Element& e, const std::vector<Role>& roles, uint64_t row, uint64_t& where) {
+    std::string_view line;
+    do {
+      auto got = in_.nextLine(line, kMaxAsciiLine);
+      if (!got.ok()) return got.error();
+      ++line_no_;
+      if (*got == ByteReader::Line::kTooLong) return dataError(line_no_, "line too long");
+      if (*got == ByteReader::Line::kEnd)
+        return Error{path_ + ": line " + std::to_string(line_no_) + ": the file ends after " + std::to_string(row) +
+                     " of " + std::to_string(e.count) + " '" + e.name + "' rows"};
+    } while (isBlank(line));
+    where = line_no_;
+    polygon_.clear();
+    std::string_view rest = line;
+    auto parse = [&](const Property& p, Type t, double& out) -> Status {
+      std::string_view token = nextToken(rest);
+      if (token.empty())
+        return dataError(where, e.name + " " + std::to_string(row) + ": missing value for '" + p.name + "'");
+      if (!parseAscii(t, token, out))
+        return dataError(where, e.name + " " + std::to_string(row) + ": '" + p.name + "': " + quote(token) +
+                                    " is not a valid " + std::string(typeName(t)));
+      return okStatus();
+    };
+    for (size_t k = 0; k < e.properties.size(); ++k) {
+      const Property& p = e.properties[k];
+      double value = 0;
+      if (Status s = parse(p, p.is_list ? p.count_type : p.type, value); !s.ok()) return s;
+      if (!p.is_list) {
+        values_[roles[k]] = value;
+        continue;
+      }
+      if (value < 0) return dataError(where, e.name + " " + std::to_string(row) + ": negative list length");
+      for (double i = 0; i < value; ++i) {
+        double item = 0;
+        if (Status s = parse(p, p.type, item); !s.ok()) return s;
+        if (roles[k] == kIndices) polygon_.push_back(item);
+      }
+    }
+    if (std::string_view extra = nextToken(rest); !extra.empty())
+      return dataError(where,
+                       e.name + " " + std::to_string(row) + ": more values than the header declares, " + quote(extra));
+    return okStatus();
+  }
+
+  // Per row, so no Status: a position must be finite unless allowed, and so must a colour (the
+  // renderer turns colours into bytes; the CSV reader refuses them alike). A double colour must
+  // also fit a float: converting one that does not is undefined.
+  bool positionAcceptable(const double* v) const {
+    return options_.allow_nonfinite || (std::isfinite(v[kX]) && std::isfinite(v[kY]) && std::isfinite(v[kZ]));
+  }
+  bool colourChannelAcceptable(double c) const {
+    return std::isfinite(c) ? std::fabs(c) <= double(FLT_MAX) : options_.allow_nonfinite;
+  }
+  bool colourAcceptable(const double* v) const {
+    return colourChannelAcceptable(v[kRed]) && colourChannelAcceptable(v[kGreen]) && colourChannelAcceptable(v[kBlue]);
+  }
+  glm::vec3 colorOf(const double* v) const {
+    return glm::vec3(static_cast<float>(v[kRed]) / divisor_[kRed], static_cast<float>(v[kGreen]) / divisor_[kGreen],
+                     static_cast<float>(v[kBlue]) / divisor_[kBlue]);
+  }
+  bool storeVertex(const double* v) {
+    if (!positionAcceptable(v) || (has_colors_ && !colourAcceptable(v))) return false;
+    points_.positions.emplace_back(v[kX], v[kY], v[kZ]);
+    if (has_colors_) points_.colors.push_back(colorOf(v));
+    return true;
+  }
+
+  // Why row `row` was not acceptable: the first bad position axis, else the first bad colour.
+  Error nonfiniteError(const double* v, uint64_t row, uint64_t where) const {
+    if (positionAcceptable(v)) {
+      static constexpr const char* kChannel[] = {"red", "green", "blue"};
+      int c = kRed;
+      while (c < kBlue && colourChannelAcceptable(v[c])) ++c;
+      return dataError(where, "vertex " + std::to_string(row) + ": " + kChannel[c - kRed] + " is " + numberText(v[c]) +
+                                  (std::isfinite(v[c]) ? ", out of float range" : ", not a finite number"));
+    }
+    const double x = v[kX], y = v[kY], z = v[kZ];
+    const char axis = std::isfinite(x) ? (std::isfinite(y) ? 'z' : 'y') : 'x';
+    const double bad = axis == 'x' ? x : axis == 'y' ? y : z;
+    return dataError(
+        where, "vertex " + std::to_string(row) + ": " + axis + " is " + numberText(bad) + ", not a finite number");
+  }
+
+  // Fan triangulation (v0, vi, vi+1): exact for the convex polygons PLY writers emit.
+  Status finishFace(uint64_t row, uint64_t where) {
+    if (polygon_.size() < 3)
+      return dataError(where, "face " + std::to_string(row) + " has " + std::to_string(polygon_.size()) +
+                                  " vertices; a face needs at least 3");
+    for (double index : polygon_)
+      if (index < 0 || index >= static_cast<double>(vertex_count_))
+        return dataError(where, "face " + std::to_string(row) + ": vertex index " +
+                                    std::to_string(static_cast<int64_t>(index)) + " out of range (the file has " +
+                                    std::to_string(vertex_count_) + " vertices)");
+    // A face of n indices (1 byte each, at least) becomes 3(n - 2) of 4 bytes: checked as it grows.
+    const uint64_t triangle_bytes = (points_.triangles.size() + 3 * (polygon_.size() - 2)) * sizeof(uint32_t);
+    if (vertex_bytes_ + triangle_bytes > memory_limit_)
+      return checkMemory(path_ + ": face " + std::to_string(row) + ": the faces' triangles",
+                         vertex_bytes_ + triangle_bytes, memory_limit_)
+          .error();
+    for (size_t i = 1; i + 1 < polygon_.size(); ++i)
+      for (double index : {polygon_[0], polygon_[i], polygon_[i + 1]})
+        points_.triangles.push_back(static_cast<uint32_t>(index));
+    return okStatus();
+  }
+
+  Status checkEnd() {
+    if (!ascii_) {
+      if (in_.remaining() == 0) return okStatus();
+      return dataError(in_.offset(), std::to_string(in_.remaining()) + " bytes of data after the last element");
+    }
+    for (;;) {
+      std::string_view line;
+      auto got = in_.nextLine(line, kMaxAsciiLine);
+      if (!got.ok()) return got.error();
+      if (*got == ByteReader::Line::kEnd) return okStatus();
+      ++line_no_;
+      if (*got == ByteReader::Line::kTooLong || !isBlank(line))
+        return dataError(line_no_, "data after the last element (the header's counts are too small?)");
+    }
+  }
+
+  const InputFile& file_;
+  const std::string& path_;
+  const PlyReadOptions& options_;
+  ByteReader in_;
+  bool ascii_ = false;
+  std::vector<Element> elements_;
+  std::vector<Role> vertex_roles_, face_roles_;
+  bool has_colors_ = false;
+  float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
+  uint64_t vertex_count_ = 0;
+  uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)
+  uint64_t vertex_bytes_ = 0;  // what the vertices take in the point set
+  uint64_t line_no_ = 0;  // the last line read (header, then ASCII data)
+  double values_[kRoleCount] = {};
+  std::vector<double> polygon_;  // indices of the current face (exact in double)
+  PointSet points_;
+  RowLayout stream_layout_;  // PlyVertexStream
+  uint64_t stream_begin_ = 0;
+};
+
+}  // namespace
+
+Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options) {
+  auto file = InputFile::open(path);
+  if (!file.ok()) return file.error();
+  return readPly(*file, options);
+}
+
+Result<PointSet> readPly(const InputFile& file, const PlyReadOptions& options) {
+  PlyParser parser(file, options);
+  return parser.run();
+}
+
+struct PlyVertexStream::State {
+  State(InputFile opened, const PlyReadOptions& read) : file(std::move(opened)), options(read), parser(file, options) {}
+  InputFile file;
+  PlyReadOptions options;
+  PlyParser parser;
+};
+
+Result<std::unique_ptr<PlyVertexStream>> PlyVertexStream::open(const std::string& path, const PlyReadOptions& options) {
+  auto file = InputFile::open(path);
+  if (!file.ok()) return file.error();
+  std::unique_ptr<PlyVertexStream> stream(new PlyVertexStream);
+  stream->state_ = std::make_unique<State>(std::move(*file), options);
+  if (Status status = stream->state_->parser.openStream(); !status) return status.error();
+  return stream;
+}
+
+PlyVertexStream::~PlyVertexStream() = default;
+uint64_t PlyVertexStream::count() const { return state_->parser.vertexCount(); }
+bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
+uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
+Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {
+  return state_->parser.readStream(first, n, block);
+}
+
+}  // namespace dpoint

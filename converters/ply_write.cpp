@@ -1,0 +1,141 @@
+// PLY writing: `double x,y,z`, uchar or float colours, `face` lists of three uint indices.
+// Rows are assembled into 1 MB chunks, then handed to AtomicFile.
+#include <algorithm>
+#include <charconv>
+#include <cstring>
+#include <string_view>
+#include <vector>
+
+#include "core/atomic_file.h"
+#include "converters/ply.h"
+
+namespace dpoint {
+
+namespace {
+
+constexpr size_t kWriteChunk = size_t{1} << 20;
+
+// Colours leave as bytes: lround(clamp(c, 0, 1) * 255), NaN as 0. c * 255 is exact in double (24 + 8
+// significant bits), so adding 0.5 is exact too and truncation rounds half away from zero like
+// lround, without its libm call.
+uint8_t colorByte(float c) {
+  if (!(c > 0.0f)) return 0;
+  return static_cast<uint8_t>(std::min(static_cast<double>(c), 1.0) * 255.0 + 0.5);
+}
+
+class ChunkWriter {
+ public:
+  ChunkWriter(AtomicFile& file, Progress* progress) : file_(file), progress_(progress), buf_(kWriteChunk + 4096) {}
+  void append(const void* data, size_t size) {
+    if (used_ + size > buf_.size()) buf_.resize(used_ + size);
+    std::memcpy(buf_.data() + used_, data, size);
+    used_ += size;
+  }
+  void append(std::string_view text) { append(text.data(), text.size()); }
+  // Ends a row; writes out a full chunk.
+  Status endRow() {
+    ++rows_;
+    return used_ >= kWriteChunk ? flush() : okStatus();
+  }
+  Status flush() {
+    Status s = file_.write(buf_.data(), used_);
+    used_ = 0;
+    if (progress_) progress_->advance(rows_);
+    rows_ = 0;
+    return s;
+  }
+
+ private:
+  AtomicFile& file_;
+  Progress* progress_;
+  std::vector<char> buf_;
+  size_t used_ = 0;
+  uint64_t rows_ = 0;
+};
+
+template <typename T>
+void appendNumber(ChunkWriter& out, T value, char separator) {
+  char text[40];
+  auto r = std::to_chars(text, text + sizeof text - 1, value);  // shortest round-trip form
+  *r.ptr = separator;
+  out.append(text, static_cast<size_t>(r.ptr + 1 - text));
+}
+
+}  // namespace
+
+Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
+  const size_t n = points.size();
+  if (points.hasColors() && points.colors.size() != n)
+    return Error{"cannot write '" + path + "': " + std::to_string(points.colors.size()) + " colours for " +
+                 std::to_string(n) + " points"};
+  if (points.triangles.size() % 3 != 0)
+    return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
+  for (uint32_t index : points.triangles)
+    if (index >= n)
+      return Error{"cannot write '" + path + "': triangle index " + std::to_string(index) + " out of range (" +
+                   std::to_string(n) + " points)"};
+  auto file = AtomicFile::create(path);
+  if (!file.ok()) return file.error();
+  const bool ascii = options.encoding == PlyEncoding::kAscii;
+  const bool float_colors = options.color_type == PlyColorType::kFloat;
+  const size_t faces = points.triangles.size() / 3;
+
+  std::string header = std::string("ply\nformat ") + (ascii ? "ascii" : "binary_little_endian") +
+                       " 1.0\ncomment written by dpoint\nelement vertex " + std::to_string(n) +
+                       "\nproperty double x\nproperty double y\nproperty double z\n";
+  if (points.hasColors())
+    for (const char* c : {"red", "green", "blue"})
+      header += std::string("property ") + (float_colors ? "float " : "uchar ") + c + "\n";
+  if (faces) header += "element face " + std::to_string(faces) + "\nproperty list uchar uint vertex_indices\n";
+  header += "end_header\n";
+
+  if (options.progress) options.progress->start("writing " + path, n + faces);
+  ChunkWriter out(*file, options.progress);
+  out.append(header);
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec3& p = points.positions[i];
+    if (ascii) {
+      appendNumber(out, p.x, ' ');
+      appendNumber(out, p.y, ' ');
+      appendNumber(out, p.z, points.hasColors() ? ' ' : '\n');
+      if (points.hasColors()) {
+        const glm::vec3& c = points.colors[i];
+        for (int k = 0; k < 3; ++k) {
+          const char sep = k == 2 ? '\n' : ' ';
+          if (float_colors)
+            appendNumber(out, c[k], sep);
+          else
+            appendNumber(out, static_cast<unsigned>(colorByte(c[k])), sep);
+        }
+      }
+    } else {
+      out.append(&p, sizeof p);
+      if (points.hasColors()) {
+        const glm::vec3& c = points.colors[i];
+        if (float_colors) {
+          out.append(&c, sizeof c);
+        } else {
+          const uint8_t rgb[3] = {colorByte(c.r), colorByte(c.g), colorByte(c.b)};
+          out.append(rgb, sizeof rgb);
+        }
+      }
+    }
+    if (Status s = out.endRow(); !s.ok()) return s;
+  }
+  for (size_t f = 0; f < faces; ++f) {
+    const uint32_t* t = &points.triangles[3 * f];
+    if (ascii) {
+      out.append("3 ");
+      for (int k = 0; k < 3; ++k) appendNumber(out, t[k], k == 2 ? '\n' : ' ');
+    } else {
+      const uint8_t three = 3;
+      out.append(&three, 1);
+      out.append(t, 3 * sizeof(uint32_t));
+    }
+    if (Status s = out.endRow(); !s.ok()) return s;
+  }
+  if (Status s = out.flush(); !s.ok()) return s;
+  return file->commit();
+}
+
+}  // namespace dpoint

@@ -1,0 +1,323 @@
+#include "generators/gpu_generate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+
+#include "core/parallel.h"
+#include "vulkan/shader.h"
+
+#include "shaders/escape.comp.h"
+#include "shaders/perturbation.comp.h"
+
+namespace dpoint {
+namespace {
+
+constexpr uint32_t kGroupSize = 256;  // local_size_x of both shaders
+
+// Push constants of shaders/generate/escape.comp (std430 offsets: dvec4 at 0, doubles at 32 and 40).
+struct EscapePush {
+  double c[4];
+  double threshold;
+  double axis_rho2;
+  uint32_t res, first_row, count, limit;
+};
+static_assert(sizeof(EscapePush) == 64);
+
+// Push constants of shaders/perturbation.comp.
+struct PerturbationPush {
+  uint32_t cols, first_row, count, max_iter, last;
+};
+
+VkDescriptorSetLayoutBinding storage(uint32_t binding) {
+  return {binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+}
+
+Result<VkPipeline> createPipeline(const VulkanContext& context, const uint32_t* code, size_t bytes,
+                                  VkPipelineLayout layout, const uint32_t* kind) {
+  Result<VkShaderModule> module = createShaderModule(context, code, bytes);
+  if (!module) return module.error();
+  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
+  const VkSpecializationInfo specialization{1, &entry, sizeof(uint32_t), kind};
+  VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = *module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = kind ? &specialization : nullptr;
+  info.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkResult result = vkCreateComputePipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(context.device, *module, nullptr);
+  if (result != VK_SUCCESS) return vulkanError("creating a generation pipeline", result);
+  return pipeline;
+}
+
+void writeSet(const VulkanContext& context, VkDescriptorSet set, const std::vector<const Buffer*>& buffers) {
+  std::vector<VkDescriptorBufferInfo> infos;
+  for (const Buffer* b : buffers) infos.push_back({b->buffer, 0, VK_WHOLE_SIZE});
+  std::vector<VkWriteDescriptorSet> writes;
+  for (uint32_t i = 0; i < infos.size(); ++i) {
+    VkWriteDescriptorSet write = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    write.dstSet = set;
+    write.dstBinding = i;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    write.pBufferInfo = &infos[i];
+    writes.push_back(write);
+  }
+  vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+}
+
+}  // namespace
+
+Status gpuGenerateUsable(const DeviceFacts& facts) {
+  if (!facts.shader_float64)
+    return Error{facts.name + " lacks shaderFloat64, which generation on the device needs", ExitCode::kNoDevice};
+  if (!facts.shader_int64)
+    return Error{facts.name + " lacks shaderInt64, which the exact fp64 rounding on the device needs",
+                 ExitCode::kNoDevice};
+  return okStatus();
+}
+
+Result<std::unique_ptr<GpuEscape>> GpuEscape::create(const VulkanContext& context) {
+  if (Status s = gpuGenerateUsable(context.facts); !s) return s.error();
+  std::unique_ptr<GpuEscape> gpu(new GpuEscape(context));
+  if (Status s = gpu->init(); !s) return s.error();
+  return gpu;
+}
+
+Status GpuEscape::init() {
+  if (context_.facts.timestamp_period_ns > 0.0f) {
+    VkQueryPoolCreateInfo query_info = {VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = 4;
+    VK_TRY(vkCreateQueryPool(context_.device, &query_info, nullptr, &queries_));
+  }
+  Result<VkDescriptorSetLayout> escape_set = storageSetLayout(context_, {storage(0), storage(1)});
+  if (!escape_set) return escape_set.error();
+  escape_set_layout_ = *escape_set;
+  Result<VkDescriptorSetLayout> perturbation_set =
+      storageSetLayout(context_, {storage(0), storage(1), storage(2), storage(3)});
+  if (!perturbation_set) return perturbation_set.error();
+  perturbation_set_layout_ = *perturbation_set;
+  Result<VkPipelineLayout> escape_layout =
+      pipelineLayout(context_, escape_set_layout_, sizeof(EscapePush), VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!escape_layout) return escape_layout.error();
+  escape_layout_ = *escape_layout;
+  Result<VkPipelineLayout> perturbation_layout =
+      pipelineLayout(context_, perturbation_set_layout_, sizeof(PerturbationPush), VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!perturbation_layout) return perturbation_layout.error();
+  perturbation_layout_ = *perturbation_layout;
+  for (uint32_t kind = 0; kind < 2; ++kind) {
+    Result<VkPipeline> p = createPipeline(context_, kEscapeComp, sizeof(kEscapeComp), escape_layout_, &kind);
+    if (!p) return p.error();
+    escape_[kind] = *p;
+  }
+  Result<VkPipeline> p = createPipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_, nullptr);
+  if (!p) return p.error();
+  perturbation_ = *p;
+
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 12};
+  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 4;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &pool_size;
+  VK_TRY(vkCreateDescriptorPool(context_.device, &pool_info, nullptr, &pool_));
+  for (Slot& slot : slots_) {
+    Result<Buffer> counts = createBuffer(context_, kGpuChunkPoints * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                         true, "escape counts");
+    if (!counts) return counts.error();
+    slot.counts = *counts;
+    const VkDescriptorSetLayout layouts[2] = {escape_set_layout_, perturbation_set_layout_};
+    VkDescriptorSet sets[2] = {};
+    VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    allocate.descriptorPool = pool_;
+    allocate.descriptorSetCount = 2;
+    allocate.pSetLayouts = layouts;
+    VK_TRY(vkAllocateDescriptorSets(context_.device, &allocate, sets));
+    slot.escape_set = sets[0];
+    slot.perturbation_set = sets[1];
+    Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
+    if (!commands) return commands.error();
+    slot.commands = *commands;
+    VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &slot.fence));
+  }
+  return okStatus();
+}
+
+GpuEscape::~GpuEscape() {
+  const VkDevice device = context_.device;
+  for (Slot& slot : slots_) {
+    if (slot.points) waitForFence(context_, slot.fence);
+    if (slot.fence) vkDestroyFence(device, slot.fence, nullptr);
+    if (slot.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &slot.commands);
+    destroyBuffer(context_, slot.counts);
+  }
+  for (Buffer* b : {&axis_, &orbit_, &dcx_, &dcy_}) destroyBuffer(context_, *b);
+  if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);  // frees the sets
+  if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
+  for (VkPipeline p : {escape_[0], escape_[1], perturbation_})
+    if (p) vkDestroyPipeline(device, p, nullptr);
+  for (VkPipelineLayout l : {escape_layout_, perturbation_layout_})
+    if (l) vkDestroyPipelineLayout(device, l, nullptr);
+  for (VkDescriptorSetLayout l : {escape_set_layout_, perturbation_set_layout_})
+    if (l) vkDestroyDescriptorSetLayout(device, l, nullptr);
+}
+
+Status GpuEscape::upload(Buffer& target, const void* data, size_t bytes, const std::string& what) {
+  if (target.size < bytes) {
+    destroyBuffer(context_, target);
+    Result<Buffer> created = createUploadTarget(context_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                                     VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
+    if (!created) return created.error();
+    target = *created;
+  }
+  return uploadBuffer(context_, target, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize size) {
+    std::memcpy(dst, static_cast<const uint8_t*>(data) + offset, size);
+  });
+}
+
+Status GpuEscape::finish(Slot& slot) {
+  if (!slot.points) return okStatus();
+  const auto start = std::chrono::steady_clock::now();
+  VK_TRY(waitForFence(context_, slot.fence));
+  const auto waited = std::chrono::steady_clock::now();
+  const uint64_t points = slot.points;
+  slot.points = 0;
+  if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
+  // 32 MiB from mapped memory: one thread copies at a fraction of the host's bandwidth, and this
+  // copy is on the critical path of the thread that feeds the meshing workers.
+  const uint8_t* from = static_cast<const uint8_t*>(slot.counts.mapped);
+  uint8_t* to = reinterpret_cast<uint8_t*>(slot.destination);
+  const uint64_t bytes = points * sizeof(uint32_t);
+  constexpr uint64_t kPiece = uint64_t{4} << 20;
+  parallelFor((bytes + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
+    const uint64_t at = i * kPiece;
+    std::memcpy(to + at, from + at, std::min(kPiece, bytes - at));
+  });
+  const auto copied = std::chrono::steady_clock::now();
+  wait_ms_ += std::chrono::duration<double, std::milli>(waited - start).count();
+  copy_ms_ += std::chrono::duration<double, std::milli>(copied - waited).count();
+  points_done_ += points;
+  if (queries_) {
+    const uint32_t first = 2 * static_cast<uint32_t>(&slot - slots_);
+    uint64_t ticks[2] = {0, 0};
+    VK_TRY(vkGetQueryPoolResults(context_.device, queries_, first, 2, sizeof(ticks), ticks, sizeof(uint64_t),
+                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    gpu_ms_ += static_cast<double>(ticks[1] - ticks[0]) * context_.facts.timestamp_period_ns * 1e-6;
+  }
+  return okStatus();
+}
+
+Status GpuEscape::finishAll() {
+  Status status = okStatus();
+  for (Slot& slot : slots_)
+    if (Status s = finish(slot); !s && status) status = s;
+  return status;
+}
+
+Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
+                           uint32_t push_bytes, uint64_t points, uint32_t* destination) {
+  assert(points > 0 && points <= kGpuChunkPoints);
+  Slot& slot = slots_[s];
+  if (Status st = finish(slot); !st) return st;
+  VK_TRY(vkResetFences(context_.device, 1, &slot.fence));
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_TRY(vkBeginCommandBuffer(slot.commands, &begin));
+  const uint32_t query = 2 * static_cast<uint32_t>(s);
+  if (queries_) {
+    vkCmdResetQueryPool(slot.commands, queries_, query, 2);
+    vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, query);
+  }
+  vkCmdBindPipeline(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  vkCmdBindDescriptorSets(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+  vkCmdPushConstants(slot.commands, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
+  // Groups in two dimensions, x at most the device's limit; the shaders skip points past count.
+  const uint64_t groups = (points + kGroupSize - 1) / kGroupSize;
+  const uint64_t x = std::min<uint64_t>(groups, std::max<uint32_t>(context_.facts.max_dispatch_groups_x, 1));
+  vkCmdDispatch(slot.commands, static_cast<uint32_t>(x), static_cast<uint32_t>((groups + x - 1) / x), 1);
+  if (queries_) vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, query + 1);
+  VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(slot.commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
+                       nullptr, 0, nullptr);
+  VK_TRY(vkEndCommandBuffer(slot.commands));
+  VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &slot.commands;
+  VK_TRY(queueSubmit(context_, submit, slot.fence));
+  slot.points = points;
+  slot.destination = destination;
+  return okStatus();
+}
+
+Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first,
+                               int planes, int limit, uint32_t* counts) {
+  const uint64_t res = axis.size();
+  assert(res >= 2 && first >= 0 && planes > 0 && static_cast<uint64_t>(first + planes) <= res && limit >= 0);
+  if (Status s = finishAll(); !s) return s;
+  if (axis != axis_values_) {
+    if (Status s = upload(axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
+    axis_values_ = axis;
+    for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
+  }
+  EscapePush push{};
+  for (int d = 0; d < 4; ++d) push.c[d] = kernel.c[d];
+  push.threshold = kernel.julia_threshold;
+  push.axis_rho2 = kernel.axis_rho2;
+  push.res = static_cast<uint32_t>(res);
+  push.limit = static_cast<uint32_t>(limit);
+  // Rows (plane·res + j) go out in chunks of whole rows; the row index stays below res² ≤ 2^32.
+  const uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuChunkPoints / res);
+  const uint64_t first_row = static_cast<uint64_t>(first) * res, end_row = first_row + static_cast<uint64_t>(planes) * res;
+  const VkPipeline pipeline = escape_[static_cast<uint32_t>(kernel.kernel)];
+  size_t s = 0;
+  for (uint64_t row = first_row; row < end_row; row += rows_per_chunk, s ^= 1) {
+    const uint64_t rows = std::min(rows_per_chunk, end_row - row);
+    push.first_row = static_cast<uint32_t>(row);
+    push.count = static_cast<uint32_t>(rows * res);
+    if (Status st = dispatch(s, pipeline, escape_layout_, slots_[s].escape_set, &push, sizeof push, rows * res,
+                             counts + (row - first_row) * res);
+        !st) {
+      (void)finishAll();
+      return st;
+    }
+  }
+  return finishAll();
+}
+
+Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
+                               const std::vector<double>& dcy, int max_iter, uint32_t* counts) {
+  assert(orbit.size() >= 2 && !dcx.empty() && max_iter >= 0);
+  if (dcy.empty()) return okStatus();
+  if (Status s = finishAll(); !s) return s;
+  if (Status s = upload(orbit_, orbit.data(), orbit.size() * sizeof(glm::dvec2), "reference orbit"); !s) return s;
+  if (Status s = upload(dcx_, dcx.data(), dcx.size() * sizeof(double), "pixel offsets"); !s) return s;
+  if (Status s = upload(dcy_, dcy.data(), dcy.size() * sizeof(double), "row offsets"); !s) return s;
+  for (Slot& slot : slots_) writeSet(context_, slot.perturbation_set, {&orbit_, &dcx_, &dcy_, &slot.counts});
+  const uint64_t cols = dcx.size();
+  PerturbationPush push{};
+  push.cols = static_cast<uint32_t>(cols);
+  push.max_iter = static_cast<uint32_t>(max_iter);
+  push.last = static_cast<uint32_t>(orbit.size() - 1);
+  const uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuChunkPoints / cols);
+  size_t s = 0;
+  for (uint64_t row = 0; row < dcy.size(); row += rows_per_chunk, s ^= 1) {
+    const uint64_t rows = std::min<uint64_t>(rows_per_chunk, dcy.size() - row);
+    push.first_row = static_cast<uint32_t>(row);
+    push.count = static_cast<uint32_t>(rows * cols);
+    if (Status st = dispatch(s, perturbation_, perturbation_layout_, slots_[s].perturbation_set, &push, sizeof push,
+                             rows * cols, counts + row * cols);
+        !st) {
+      (void)finishAll();
+      return st;
+    }
+  }
+  return finishAll();
+}
+
+}  // namespace dpoint

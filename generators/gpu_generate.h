@@ -1,0 +1,103 @@
+// Escape counts on a Vulkan device for `dpoint generate` (issue #14): the classification of the
+// Julia and fast Mandelbulb grids (shaders/generate/escape.comp) and mandelbrot2d's perturbation deltas
+// (shaders/generate/perturbation.comp), in fp64, equal to the CPU's counts bit for bit (the shaders say
+// why). The generators see plain functions (generators/escape_grid.h EscapePlaneFunction,
+// generators/mandelbrot2d.h PerturbationFunction), so they stay free of Vulkan; cli/ wraps these
+// calls into them.
+//
+// Work goes out in dispatches of at most kGpuChunkPoints points (whole rows), two in flight: the
+// device computes one while the host copies the other's counts out of mapped memory. Inputs the
+// shaders read on every iteration (axis values, the reference orbit) live in device-local memory.
+// One thread at a time may call a GpuEscape (it records on the context's one queue and pool).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+#include "vulkan/context.h"
+#include "vulkan/buffers.h"
+
+namespace dpoint {
+
+enum class EscapeKernel : uint32_t { kJulia = 0, kMandelbulbFast = 1 };
+
+// What a kernel needs beyond the points; the constants are the CPU code's (generators/julia.h,
+// generators/mandelbulb.h), passed in so that they are written down once.
+struct EscapeKernelParams {
+  EscapeKernel kernel = EscapeKernel::kJulia;
+  glm::dvec4 c{0.0};             // Julia's constant
+  double julia_threshold = 0.0;  // Julia: escaped when x² + (y² + z² + w²) > this
+  double axis_rho2 = 0.0;        // Mandelbulb: x² + y² at or below which φ is taken as 0
+};
+
+inline constexpr uint64_t kGpuChunkPoints = uint64_t{1} << 23;  // 32 MiB of counts per dispatch
+
+// Whether the device can run the kernels: shaderFloat64 and shaderInt64 (the exact rounding).
+// kNoDevice naming the device and what it lacks.
+Status gpuGenerateUsable(const DeviceFacts& facts);
+
+class GpuEscape {
+ public:
+  static Result<std::unique_ptr<GpuEscape>> create(const VulkanContext& context);
+  ~GpuEscape();
+  GpuEscape(const GpuEscape&) = delete;
+  GpuEscape& operator=(const GpuEscape&) = delete;
+
+  // counts[(p − first)·res² + j·res + k] = min(count, limit) for the points (axis[p], axis[j],
+  // axis[k]) of planes first ≤ p < first + planes, res = axis.size().
+  Status escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
+                      int limit, uint32_t* counts);
+
+  // counts[r·dcx.size() + col]: mandelbrot2d's perturbed count of δc = (dcx[col], dcy[r]) against
+  // `orbit` (generators/mandelbrot2d.cpp).
+  Status perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
+                      const std::vector<double>& dcy, int max_iter, uint32_t* counts);
+
+  // The points classified so far and the GPU time their dispatches took (timestamps around each
+  // dispatch; 0 on a queue without timestamps): the classification alone, for the bench.
+  uint64_t pointsDone() const { return points_done_; }
+  double gpuMs() const { return gpu_ms_; }
+  // Host milliseconds spent waiting for dispatches to finish, and copying their counts out of the
+  // mapped buffers (on several threads): where the thread feeding the generator spends its time.
+  double waitMs() const { return wait_ms_; }
+  double copyMs() const { return copy_ms_; }
+
+ private:
+  struct Slot {
+    Buffer counts;
+    VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    uint32_t* destination = nullptr;  // where the counts of the dispatch in flight go
+    uint64_t points = 0;              // 0: idle
+  };
+
+  explicit GpuEscape(const VulkanContext& context) : context_(context) {}
+  Status init();
+  Status upload(Buffer& target, const void* data, size_t bytes, const std::string& what);
+  // Records and submits one dispatch into slot `s`, after finishing what the slot had in flight.
+  Status dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
+                  uint32_t push_bytes, uint64_t points, uint32_t* destination);
+  Status finish(Slot& slot);  // waits for the slot's dispatch and copies its counts out
+  Status finishAll();
+
+  const VulkanContext& context_;
+  VkDescriptorSetLayout escape_set_layout_ = VK_NULL_HANDLE, perturbation_set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout escape_layout_ = VK_NULL_HANDLE, perturbation_layout_ = VK_NULL_HANDLE;
+  VkPipeline escape_[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};  // by EscapeKernel
+  VkPipeline perturbation_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  Slot slots_[2];
+  VkQueryPool queries_ = VK_NULL_HANDLE;  // two timestamps per slot
+  uint64_t points_done_ = 0;
+  double gpu_ms_ = 0.0;
+  double wait_ms_ = 0.0, copy_ms_ = 0.0;
+  Buffer axis_, orbit_, dcx_, dcy_;
+  std::vector<double> axis_values_;  // what axis_ holds
+};
+
+}  // namespace dpoint

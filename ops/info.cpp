@@ -1,0 +1,305 @@
+#include "ops/info.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <span>
+#include <tuple>
+#include <utility>
+
+#include <glm/common.hpp>
+
+#include "core/parallel.h"
+
+namespace dpoint {
+namespace {
+
+// Squared distance from q to the box [lo, hi] (0 inside it, and where a non-finite coordinate
+// makes it undefined: such a box is never passed over, and the sort by distance stays ordered).
+double boxDistance2(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& q) {
+  const glm::dvec3 outside = glm::max(glm::dvec3(0.0), glm::max(lo - q, q - hi));
+  const double d2 = outside.x * outside.x + outside.y * outside.y + outside.z * outside.z;
+  return std::isnan(d2) ? 0.0 : d2;
+}
+
+// Bounds of points (not empty).
+std::pair<glm::dvec3, glm::dvec3> boxOf(std::span<const glm::dvec3> points) {
+  glm::dvec3 lo = points[0], hi = points[0];
+  for (const glm::dvec3& p : points) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  return {lo, hi};
+}
+
+// A k-d tree laid out in place in the points it is given (reordered, not owned): the median of
+// each range sits at its middle, split along the axis of largest extent, which is recorded at the
+// median's index. Leaves are small ranges. Points with a non-finite coordinate are left out (no
+// distance to them counts, and they would break the median's ordering).
+class KdTree {
+ public:
+  explicit KdTree(std::span<glm::dvec3> points) {
+    const auto finite = std::partition(points.begin(), points.end(), [](const glm::dvec3& p) {
+      return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    });
+    pts_ = points.first(static_cast<size_t>(finite - points.begin()));
+    axis_.assign(pts_.size(), 0);
+    if (pts_.empty()) return;
+    std::tie(min_, max_) = boxOf(pts_);
+    build(0, pts_.size());
+  }
+
+  double boxDistance2(const glm::dvec3& q) const {
+    return pts_.empty() ? std::numeric_limits<double>::infinity() : dpoint::boxDistance2(min_, max_, q);
+  }
+
+  // Lowers best2 to the smallest squared distance > 0 from q to a point of the tree, if smaller.
+  void nearestNonzero(const glm::dvec3& q, double& best2) const {
+    if (!pts_.empty()) search(0, pts_.size(), q, best2);
+  }
+
+ private:
+  static constexpr size_t kLeaf = 8;
+
+  void build(size_t lo, size_t hi) {
+    if (hi - lo <= kLeaf) return;
+    const auto [mn, mx] = boxOf(pts_.subspan(lo, hi - lo));
+    const glm::dvec3 size = mx - mn;
+    const int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
+    const size_t mid = lo + (hi - lo) / 2;
+    std::nth_element(pts_.begin() + static_cast<ptrdiff_t>(lo), pts_.begin() + static_cast<ptrdiff_t>(mid),
+                     pts_.begin() + static_cast<ptrdiff_t>(hi),
+                     [axis](const glm::dvec3& a, const glm::dvec3& b) { return a[axis] < b[axis]; });
+    axis_[mid] = static_cast<uint8_t>(axis);
+    build(lo, mid);
+    build(mid + 1, hi);
+  }
+
+  void visit(const glm::dvec3& p, const glm::dvec3& q, double& best) const {
+    const glm::dvec3 d = p - q;
+    const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+    if (d2 > 0.0 && d2 < best) best = d2;
+  }
+
+  void search(size_t lo, size_t hi, const glm::dvec3& q, double& best) const {
+    if (hi - lo <= kLeaf) {
+      for (size_t i = lo; i < hi; ++i) visit(pts_[i], q, best);
+      return;
+    }
+    const size_t mid = lo + (hi - lo) / 2;
+    const int axis = axis_[mid];
+    visit(pts_[mid], q, best);
+    const double diff = q[axis] - pts_[mid][axis];
+    // Points left of mid are <= the median along the axis, points right of it >= it.
+    if (diff <= 0.0) {
+      search(lo, mid, q, best);
+      if (diff * diff <= best) search(mid + 1, hi, q, best);
+    } else {
+      search(mid + 1, hi, q, best);
+      if (diff * diff <= best) search(lo, mid, q, best);
+    }
+  }
+
+  std::span<glm::dvec3> pts_;
+  std::vector<uint8_t> axis_;
+  glm::dvec3 min_{0.0}, max_{0.0};
+};
+
+// Points in one k-d tree of a Forest: small enough that a set's trees build in parallel, large
+// enough that the box tests stay few.
+constexpr size_t kTreePoints = size_t{1} << 20;
+
+// Points on each side of a sampled point, in file order, that give the first bound on its nearest
+// distance in a streamed set.
+constexpr size_t kFileNeighbors = 8;
+
+// k-d trees over consecutive ranges of a set of points (reordered within each range), built in
+// parallel; the smallest distance over the trees is the one over the set, whatever the ranges.
+class Forest {
+ public:
+  Forest(std::span<glm::dvec3> points, unsigned threads) {
+    const size_t n = points.size();
+    trees_.resize((n + kTreePoints - 1) / kTreePoints);
+    parallelFor(trees_.size(), threads, [&](size_t t, unsigned) {
+      const size_t first = t * kTreePoints;
+      trees_[t] = std::make_unique<KdTree>(points.subspan(first, std::min(kTreePoints, n - first)));
+    });
+  }
+
+  // Lowers each best2[k] to the smallest squared distance > 0 from queries[k] to the points. The
+  // trees are searched nearest box first, and only while their box is within the best distance:
+  // a query far from a tree (a thin slab of a file in slab order) would visit much of it.
+  void nearestNonzero(std::span<const glm::dvec3> queries, std::span<double> best2, unsigned threads) const {
+    parallelFor(queries.size(), threads, [&](size_t k, unsigned) {
+      std::vector<std::pair<double, size_t>> order(trees_.size());
+      for (size_t t = 0; t < trees_.size(); ++t) order[t] = {trees_[t]->boxDistance2(queries[k]), t};
+      std::sort(order.begin(), order.end());
+      for (const auto& [distance2, t] : order) {
+        if (distance2 > best2[k]) break;
+        trees_[t]->nearestNonzero(queries[k], best2[k]);
+      }
+    });
+  }
+
+ private:
+  std::vector<std::unique_ptr<KdTree>> trees_;
+};
+
+// The smallest of the sampled nearest distances (best2: squared), 0 when none is finite.
+double smallestDistance(const std::vector<double>& best2) {
+  const double smallest = *std::min_element(best2.begin(), best2.end());
+  return std::isfinite(smallest) ? std::sqrt(smallest) : 0.0;
+}
+
+// Counts distinct points that float32 rounding merges with another distinct point (of the finite
+// ones: a NaN would break the sort's ordering).
+size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
+  std::vector<uint32_t> order;
+  order.reserve(positions.size());
+  for (uint32_t i = 0; i < positions.size(); ++i) {
+    const glm::dvec3& p = positions[i];
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) order.push_back(i);
+  }
+  auto as_float = [&](uint32_t i) { return glm::vec3(positions[i]); };
+  auto less_float = [](const glm::vec3& a, const glm::vec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  auto less_double = [](const glm::dvec3& a, const glm::dvec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    glm::vec3 fa = as_float(a), fb = as_float(b);
+    if (less_float(fa, fb)) return true;
+    if (less_float(fb, fa)) return false;
+    return less_double(positions[a], positions[b]);
+  });
+  // Within a run of equal floats, every change of the double value is one more merged point.
+  size_t merged = 0;
+  for (size_t k = 1; k < order.size(); ++k) {
+    const uint32_t a = order[k - 1], b = order[k];
+    if (as_float(a) == as_float(b) && positions[a] != positions[b]) ++merged;
+  }
+  return merged;
+}
+
+// Bounds and float overflow of `positions` into `info` (min and max already set to a point).
+void addBounds(PointSetInfo& info, const std::vector<glm::dvec3>& positions) {
+  for (const glm::dvec3& p : positions) {
+    info.min = glm::min(info.min, p);
+    info.max = glm::max(info.max, p);
+    for (int k = 0; k < 3; ++k) {
+      if (std::fabs(p[k]) > static_cast<double>(FLT_MAX)) ++info.float_overflow;
+    }
+  }
+}
+
+// Extent, largest magnitude and float32's spacing there, from the bounds.
+void finishBounds(PointSetInfo& info) {
+  info.extent = info.max - info.min;
+  info.max_abs = std::max({std::fabs(info.min.x), std::fabs(info.min.y), std::fabs(info.min.z),
+                           std::fabs(info.max.x), std::fabs(info.max.y), std::fabs(info.max.z)});
+  // The spacing of float32 at max_abs: the gap above the float nearest to it.
+  const float f = static_cast<float>(info.max_abs);
+  info.float_spacing = std::isfinite(f)
+      ? static_cast<double>(std::nextafter(f, std::numeric_limits<float>::infinity())) - static_cast<double>(f)
+      : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigned threads) {
+  PointSetInfo info;
+  info.count = points.size();
+  info.triangles = points.triangles.size() / 3;
+  info.has_colors = points.hasColors();
+  if (points.positions.empty()) return info;
+
+  info.min = info.max = points.positions[0];
+  addBounds(info, points.positions);
+  finishBounds(info);
+
+  // The merge count needs 32-bit indices; larger sets are beyond the renderer anyway.
+  if (info.float_overflow == 0 && points.size() <= UINT32_MAX) info.float_merged = countFloatMerges(points.positions);
+
+  const size_t n = points.size();
+  const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
+  if (n >= 2) {
+    const size_t step = n / sample;
+    std::vector<glm::dvec3> sampled(sample);
+    for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step];
+    std::vector<double> best2(sample, std::numeric_limits<double>::infinity());
+    std::vector<glm::dvec3> scratch = points.positions;  // the trees reorder it
+    Forest(scratch, threads).nearestNonzero(sampled, best2, threads);
+    info.min_neighbor_distance = smallestDistance(best2);
+    info.neighbor_sample = sample;
+  }
+  return info;
+}
+
+Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64_t triangles, const BlockReader& read,
+                                         uint64_t block_points, size_t neighbor_sample, unsigned threads) {
+  StreamedInfo out;
+  PointSetInfo& info = out.info;
+  info.count = static_cast<size_t>(count);
+  info.triangles = static_cast<size_t>(triangles);
+  info.has_colors = has_colors;
+  if (count == 0) return out;
+  // The sample computeInfo takes: every step-th point from the first.
+  const uint64_t sample = std::min<uint64_t>(count, std::max<size_t>(neighbor_sample, 1));
+  const uint64_t step = count / sample;
+  // Pass 1: bounds, the sample, and for each sampled point a first bound on its nearest distance:
+  // the points beside it in the file (near in space when the file is in slab or Morton order).
+  std::vector<glm::dvec3> sampled;
+  sampled.reserve(static_cast<size_t>(sample));
+  std::vector<double> best2;
+  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes;  // of each block
+  PointSet block;
+  for (uint64_t first = 0; first < count; first += block_points) {
+    const uint64_t n = std::min(block_points, count - first);
+    if (Status s = read(first, n, block); !s) return s.error();
+    if (first == 0) info.min = info.max = block.positions[0];
+    addBounds(info, block.positions);
+    boxes.push_back(boxOf(block.positions));
+    // Sample indices k·step in [first, first + n), k < sample.
+    for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k) {
+      const size_t at = static_cast<size_t>(k * step - first);
+      sampled.push_back(block.positions[at]);
+      double bound2 = std::numeric_limits<double>::infinity();
+      for (size_t j = at - std::min<size_t>(at, kFileNeighbors); j <= std::min<size_t>(at + kFileNeighbors, n - 1); ++j) {
+        const glm::dvec3 d = block.positions[j] - sampled.back();
+        const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (d2 > 0.0 && d2 < bound2) bound2 = d2;
+      }
+      best2.push_back(bound2);
+    }
+  }
+  finishBounds(info);
+  if (count < 2) return out;
+  // Pass 2: each block whose box lies within some sampled point's bound, against those points.
+  std::vector<size_t> near;
+  std::vector<glm::dvec3> queries;
+  std::vector<double> query_best2;
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    near.clear();
+    for (size_t k = 0; k < sampled.size(); ++k)
+      if (boxDistance2(boxes[b].first, boxes[b].second, sampled[k]) <= best2[k]) near.push_back(k);
+    if (near.empty()) continue;
+    const uint64_t first = b * block_points;
+    if (Status s = read(first, std::min(block_points, count - first), block); !s) return s.error();
+    queries.resize(near.size());
+    query_best2.resize(near.size());
+    for (size_t j = 0; j < near.size(); ++j) {
+      queries[j] = sampled[near[j]];
+      query_best2[j] = best2[near[j]];
+    }
+    Forest(block.positions, threads).nearestNonzero(queries, query_best2, threads);
+    for (size_t j = 0; j < near.size(); ++j) best2[near[j]] = query_best2[j];
+  }
+  info.min_neighbor_distance = smallestDistance(best2);
+  info.neighbor_sample = sampled.size();
+  return out;
+}
+
+}  // namespace dpoint

@@ -1,0 +1,172 @@
+// dpoint generate as a user runs it: every kind writes what it says, bad parameters exit 1 or 4
+// with the flag named, and nothing is written then.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "converters/csv.h"
+#include "converters/ply.h"
+#include "ops/point_order.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::runDpoint;
+using test::TempDir;
+
+TEST(CliGenerate, everyKindWritesAMeshOrPointSet) {
+  struct Kind {
+    std::vector<std::string> args;
+    size_t vertices;   // 0: only check > 0
+    size_t triangles;  // 0: a point set
+  };
+  const std::vector<Kind> kinds = {
+      {{"mandelbulb", "--resolution", "64", "--frame", "seed"}, 13112, 1},
+      {{"julia", "--resolution", "64", "--frame", "seed"}, 3844, 1},
+      {{"menger", "--level", "2"}, 0, 2 * (2 * 400 + 4 * 64)},
+      {{"menger", "--level", "2", "--method", "voxel", "--resolution", "27"}, 0, 1},
+      {{"sierpinski", "--level", "3"}, 2 * 64 + 2, 4 * 64},
+      {{"sierpinski", "--level", "3", "--unwelded"}, 4 * 64, 4 * 64},  // 4^(n+1) rows
+      {{"mandelbrot2d", "--resolution", "32", "--max-iter", "300"}, 32 * 32, 0},
+      {{"random2d", "--count", "500"}, 500, 0},
+  };
+  for (const Kind& k : kinds) {
+    SCOPED_TRACE(k.args[0]);
+    TempDir dir;
+    std::vector<std::string> args = {"generate"};
+    args.insert(args.end(), k.args.begin(), k.args.end());
+    args.insert(args.end(), {"-o", dir.file("out.ply")});
+    test::CommandResult r = runDpoint(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    Result<PointSet> points = readPly(dir.file("out.ply"));
+    ASSERT_TRUE(points.ok()) << points.error().message;
+    EXPECT_GT(points->size(), 0u);
+    if (k.vertices) {
+      EXPECT_EQ(points->size(), k.vertices);
+    }
+    if (k.triangles > 1) {
+      EXPECT_EQ(points->triangles.size() / 3, k.triangles);
+    } else if (k.triangles == 1) {
+      EXPECT_GT(points->triangles.size(), 0u);
+    } else {
+      EXPECT_TRUE(points->triangles.empty());
+    }
+    EXPECT_EQ(points->hasColors(), k.args[0] != "random2d");
+  }
+}
+
+TEST(CliGenerate, gridOutOfTheSeedVariantEqualsTheReference) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"generate", "mandelbulb", "--resolution", "64", "--variant", "seed", "--grid-out",
+                                     dir.file("grid.u8"), "-o", dir.file("m.csv"), "--colors", "none"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(readFile(dir.file("grid.u8")) == readFile(DPOINT_REFERENCE_DIR "/mandelbulb_r64_i100_escape.u8"));
+  r = runDpoint({"generate", "julia", "--resolution", "64", "--grid-out", dir.file("j.u8"), "-o", dir.file("j.csv")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(readFile(dir.file("j.u8")) == readFile(DPOINT_REFERENCE_DIR "/julia_r64_i200_escape.u8"));
+}
+
+TEST(CliGenerate, offsetTranslatesExactlyAndKeepsColours) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "2", "-o", dir.file("a.csv")}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "2", "--offset", "6378137,-1e8,0.5", "-o", dir.file("b.csv")})
+                .exit_code,
+            0);
+  Result<PointSet> a = readCsv(dir.file("a.csv")), b = readCsv(dir.file("b.csv"));
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->size(), b->size());
+  for (size_t i = 0; i < a->size(); ++i) {
+    EXPECT_EQ(b->positions[i], a->positions[i] + glm::dvec3(6378137.0, -1e8, 0.5));
+    EXPECT_EQ(b->colors[i], a->colors[i]);  // colours come from the untranslated fractal
+  }
+}
+
+TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {
+  TempDir dir;
+  for (const char* threads : {"1", "2"}) {
+    for (const std::vector<std::string>& kind :
+         {std::vector<std::string>{"mandelbulb", "--resolution", "48", "--variant", "fast"},
+          std::vector<std::string>{"mandelbrot2d", "--resolution", "48", "--width", "1e-9"},
+          std::vector<std::string>{"menger", "--level", "3"}}) {
+      std::vector<std::string> args = {"generate"};
+      args.insert(args.end(), kind.begin(), kind.end());
+      args.insert(args.end(), {"--threads", threads, "-o", dir.file(kind[0] + threads + ".ply")});
+      ASSERT_EQ(runDpoint(args).exit_code, 0);
+    }
+  }
+  for (const char* kind : {"mandelbulb", "mandelbrot2d", "menger"})
+    EXPECT_TRUE(readFile(dir.file(std::string(kind) + "1.ply")) == readFile(dir.file(std::string(kind) + "2.ply"))) << kind;
+}
+
+// --order morton writes the set --order input writes, reordered: the same points with their
+// colours, the same triangles over them, in the library's Morton order.
+TEST(CliGenerate, mortonOrderWritesTheSameMeshReordered) {
+  TempDir dir;
+  for (const char* order : {"input", "morton"}) {
+    test::CommandResult r = runDpoint({"generate", "sierpinski", "--level", "6", "--order", order, "--threads", "2",
+                                       "-o", dir.file(std::string(order) + ".ply")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  Result<PointSet> input = readPly(dir.file("input.ply")), morton = readPly(dir.file("morton.ply"));
+  ASSERT_TRUE(input.ok() && morton.ok());
+  ASSERT_EQ(morton->size(), input->size());
+  ASSERT_GT(input->size(), 2 * kOrderBlock);  // whole blocks to shuffle and a partial one
+  ASSERT_TRUE(input->hasColors() && input->isMesh());
+  EXPECT_FALSE(morton->positions == input->positions) << "nothing moved";
+
+  ASSERT_EQ(morton->triangles.size(), input->triangles.size());
+  for (size_t i = 0; i < input->triangles.size(); ++i) {
+    ASSERT_EQ(morton->positions[morton->triangles[i]], input->positions[input->triangles[i]]) << "corner " << i;
+    ASSERT_EQ(morton->colors[morton->triangles[i]], input->colors[input->triangles[i]]) << "corner " << i;
+  }
+  PointSet expected = *input;
+  reorderPoints(expected, PointOrder::kMorton, 1);
+  EXPECT_TRUE(morton->positions == expected.positions);
+  EXPECT_TRUE(morton->colors == expected.colors);
+  EXPECT_TRUE(morton->triangles == expected.triangles);
+}
+
+TEST(CliGenerate, badParametersNameTheFlagAndWriteNothing) {
+  struct Bad {
+    std::vector<std::string> args;
+    int exit_code;
+    std::string expected;
+  };
+  const std::vector<Bad> cases = {
+      {{"mandelbulb", "--resolution", "1"}, 1, "--resolution"},
+      {{"mandelbulb", "--resolution", "70000"}, 4, "--resolution"},
+      {{"mandelbulb", "--max-iter", "0"}, 1, "--max-iter"},
+      {{"mandelbulb", "--resolution", "16", "--level", "100"}, 1, "--level"},
+      {{"mandelbulb", "--resolution", "16", "--level", "-3"}, 1, "--level"},
+      {{"mandelbulb", "--bounds", "1,oops"}, 1, "--bounds"},
+      {{"julia", "--c", "1,2,3"}, 1, "--c"},
+      {{"julia", "--c", "nan,0,0,0"}, 1, "--c"},
+      {{"mandelbrot2d", "--center", "0.3"}, 1, "--center"},
+      {{"mandelbrot2d", "--width", "0"}, 1, "--width"},
+      {{"sierpinski", "--level", "13"}, 1, "--level"},
+      {{"sierpinski", "--offset", "1,2"}, 1, "--offset"},
+      {{"menger", "--level", "8"}, 4, "--max-memory"},
+      {{"menger", "--level", "5", "--max-memory", "1M"}, 4, "--max-memory"},
+      {{"random2d", "--max-memory", "lots"}, 1, "--max-memory"},
+      {{"mandelbulb", "--variant", "fastest"}, 1, "--variant"},
+      {{"random2d", "--order", "bogus"}, 1, "--order"},
+      {{"sierpinski", "--level", "2", "--order", "Morton"}, 1, "--order"},
+      {{"spiral"}, 1, "spiral"},
+  };
+  for (const Bad& c : cases) {
+    SCOPED_TRACE(c.args[0] + " " + (c.args.size() > 1 ? c.args[1] : ""));
+    TempDir dir;
+    std::vector<std::string> args = {"generate"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    args.insert(args.end(), {"-o", dir.file("out.csv")});
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, c.exit_code) << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    EXPECT_TRUE(dir.entries().empty());
+  }
+}
+
+}  // namespace
+}  // namespace dpoint

@@ -1,0 +1,384 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <charconv>
+#include <iterator>
+#include <random>
+#include <span>
+
+#include "converters/csv.h"
+#include "core/fixed_format.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::TempDir;
+using test::writeFile;
+
+uint64_t bitsOf(double v) {
+  uint64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+// 1M doubles: random bit patterns (every exponent, subnormals included) and the hard values.
+std::vector<double> hardDoubles(size_t count) {
+  std::vector<double> v = {0.0, -0.0, DBL_MAX, -DBL_MAX, DBL_MIN, -DBL_MIN, DBL_TRUE_MIN, -DBL_TRUE_MIN,
+                           1e-300, -1e-300, 0.1, -0.1, 0.30000000000000004, 1.2345678901234567,
+                           9007199254740993.0, 4.9406564584124654e-324, 2.2250738585072009e-308,
+                           1.7976931348623157e308, 6378137.123456789, 123456789.12345679, 1.0 / 3.0};
+  std::mt19937_64 rng(20261122);
+  while (v.size() < count) {
+    uint64_t bits = rng();
+    double d;
+    std::memcpy(&d, &bits, sizeof d);
+    if (!std::isfinite(d)) continue;
+    switch (v.size() % 4) {
+      case 0: v.push_back(d); break;                                                   // any exponent
+      case 1: v.push_back(std::ldexp(static_cast<double>(bits >> 11), -1074)); break;  // subnormal range
+      case 2: v.push_back(std::ldexp(static_cast<double>(bits >> 11), -53) * 1e7); break;  // 17 digits
+      default: v.push_back(static_cast<double>(static_cast<int64_t>(bits)) * 1e-9); break;
+    }
+  }
+  return v;
+}
+
+PointSet setFromDoubles(const std::vector<double>& values, bool colors) {
+  PointSet s;
+  for (size_t i = 0; i + 2 < values.size(); i += 3) s.positions.emplace_back(values[i], values[i + 1], values[i + 2]);
+  if (colors) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (size_t i = 0; i < s.positions.size(); ++i) s.colors.emplace_back(unit(rng), unit(rng), unit(rng));
+  }
+  return s;
+}
+
+void expectBitIdentical(const PointSet& a, const PointSet& b) {
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  ASSERT_EQ(a.colors.size(), b.colors.size());
+  for (size_t i = 0; i < a.positions.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(bitsOf(a.positions[i][k]), bitsOf(b.positions[i][k])) << "row " << i << " column " << k;
+    }
+  }
+  for (size_t i = 0; i < a.colors.size(); ++i) ASSERT_EQ(a.colors[i], b.colors[i]) << "row " << i;
+}
+
+TEST(Csv, roundTripIsBitExactAndByteIdentical) {
+  TempDir dir;
+  const PointSet original = setFromDoubles(hardDoubles(1000002), true);
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), original).ok());
+  Result<PointSet> read = readCsv(dir.file("a.csv"));
+  ASSERT_TRUE(read.ok()) << read.error().message;
+  expectBitIdentical(original, *read);
+  ASSERT_TRUE(writeCsv(dir.file("b.csv"), *read).ok());
+  EXPECT_TRUE(readFile(dir.file("a.csv")) == readFile(dir.file("b.csv")));
+}
+
+TEST(Csv, readIsIdenticalForAnyThreadCount) {
+  TempDir dir;
+  // About 50 MB: several 8 MB blocks, with lines crossing block boundaries.
+  const PointSet original = setFromDoubles(hardDoubles(2400000), true);
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), original, CsvWriteOptions{-1, 2, nullptr}).ok());
+  Result<PointSet> one = readCsv(dir.file("a.csv"), CsvReadOptions{1, false, nullptr});
+  Result<PointSet> two = readCsv(dir.file("a.csv"), CsvReadOptions{2, false, nullptr});
+  Result<PointSet> five = readCsv(dir.file("a.csv"), CsvReadOptions{5, false, nullptr});
+  ASSERT_TRUE(one.ok() && two.ok() && five.ok());
+  expectBitIdentical(*one, *two);
+  expectBitIdentical(*one, *five);
+  expectBitIdentical(original, *one);
+  ASSERT_TRUE(writeCsv(dir.file("b.csv"), original, CsvWriteOptions{-1, 1, nullptr}).ok());
+  EXPECT_TRUE(readFile(dir.file("a.csv")) == readFile(dir.file("b.csv")));
+}
+
+// The fixture was made once with python3: '%.15f' % v for each value of the input file (see
+// samples/fixtures/README.md). glibc printf rounds the same way (exact value, ties to even).
+TEST(Csv, decimals15MatchesPythonPercentFormat) {
+  TempDir dir;
+  Result<PointSet> values = readCsv(DPOINT_SAMPLES_DIR "/fixtures/decimals15_input.csv");
+  ASSERT_TRUE(values.ok()) << values.error().message;
+  ASSERT_TRUE(writeCsv(dir.file("out.csv"), *values, CsvWriteOptions{15, 0, nullptr}).ok());
+  EXPECT_TRUE(readFile(dir.file("out.csv")) == readFile(DPOINT_SAMPLES_DIR "/fixtures/decimals15_expected.csv"));
+}
+
+TEST(Csv, acceptsHeaderVariantsCrlfBomSpacesAndBlankLines) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "\xEF\xBB\xBF X , Y ,z\r\n 1.5 ,\t-2, +3\r\n\r\n4,5e-1,6\r\n");
+  Result<PointSet> a = readCsv(dir.file("a.csv"));
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_EQ(a->size(), 2u);
+  EXPECT_EQ(a->positions[0], glm::dvec3(1.5, -2, 3));
+  EXPECT_EQ(a->positions[1], glm::dvec3(4, 0.5, 6));
+  EXPECT_FALSE(a->hasColors());
+
+  writeFile(dir.file("b.csv"), "x,y\n1,2\n3,4");  // 2D, no final newline
+  Result<PointSet> b = readCsv(dir.file("b.csv"));
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  ASSERT_EQ(b->size(), 2u);
+  EXPECT_EQ(b->positions[1], glm::dvec3(3, 4, 0));
+  EXPECT_TRUE(b->isPlanar());
+
+  writeFile(dir.file("c.csv"), "1,2,3,0.5,0.25,1\n-1,-2,-3,0,0,0\n");  // headerless, by column count
+  Result<PointSet> c = readCsv(dir.file("c.csv"));
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  ASSERT_EQ(c->colors.size(), 2u);
+  EXPECT_EQ(c->colors[0], glm::vec3(0.5f, 0.25f, 1.0f));
+
+  writeFile(dir.file("d.csv"), "1,2\n");
+  Result<PointSet> d = readCsv(dir.file("d.csv"));
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d->positions[0], glm::dvec3(1, 2, 0));
+}
+
+TEST(Csv, writesPlanarSetsAsXy) {
+  TempDir dir;
+  PointSet s;
+  s.positions = {{1, 2, 0}, {3, 4, 0}};
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), s).ok());
+  EXPECT_EQ(readFile(dir.file("a.csv")), "x,y\n1,2\n3,4\n");
+  s.positions[1].z = -0.0;  // not +0: the z column is kept so the sign survives
+  ASSERT_TRUE(writeCsv(dir.file("b.csv"), s).ok());
+  EXPECT_EQ(readFile(dir.file("b.csv")), "x,y,z\n1,2,0\n3,4,-0\n");
+}
+
+// 2D sets with colours are written `x,y,r,g,b` and must read back (the mandelbrot2d output).
+TEST(Csv, planarColouredSetsRoundTripAsXyRgb) {
+  TempDir dir;
+  PointSet s;
+  s.positions = {{-0.7436450000001, 0.1318259, 0}, {3, 4, 0}};
+  s.colors = {{0.25f, 0.5f, 1.0f}, {0.0f, 0.125f, 0.75f}};
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), s).ok());
+  EXPECT_EQ(readFile(dir.file("a.csv")).substr(0, 10), "x,y,r,g,b\n");
+  Result<PointSet> back = readCsv(dir.file("a.csv"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->positions, s.positions);
+  EXPECT_EQ(back->colors, s.colors);
+  EXPECT_TRUE(back->isPlanar());
+  writeFile(dir.file("b.csv"), "1,2,0.5,0.5,0.5\n3,4,0,0,1\n");  // no header: five columns
+  Result<PointSet> headless = readCsv(dir.file("b.csv"));
+  ASSERT_TRUE(headless.ok()) << headless.error().message;
+  EXPECT_EQ(headless->colors[1], glm::vec3(0, 0, 1));
+}
+
+// A failing read returns an Error whose message contains every expected part.
+void expectReadError(const std::string& path, const std::vector<std::string>& parts, bool allow_nonfinite = false) {
+  Result<PointSet> r = readCsv(path, CsvReadOptions{0, allow_nonfinite, nullptr});
+  ASSERT_FALSE(r.ok()) << path << " was accepted";
+  EXPECT_EQ(r.error().code, ExitCode::kBadInput);
+  for (const std::string& part : parts)
+    EXPECT_NE(r.error().message.find(part), std::string::npos) << "'" << r.error().message << "' lacks '" << part << "'";
+  EXPECT_EQ(r.error().message.find('\n'), std::string::npos) << "message is not one line";
+}
+
+TEST(Csv, rejectsMissingFileFolderEmptyAndHeaderOnly) {
+  TempDir dir;
+  expectReadError(dir.file("missing.csv"), {"missing.csv", "not found"});
+  expectReadError(dir.path(), {dir.path(), "folder"});
+  writeFile(dir.file("empty.csv"), "");
+  expectReadError(dir.file("empty.csv"), {"empty.csv", "empty file"});
+  writeFile(dir.file("header.csv"), "x,y,z\n");
+  expectReadError(dir.file("header.csv"), {"header.csv", "header only"});
+  writeFile(dir.file("bad_header.csv"), "x,y,w\n1,2,3\n");
+  expectReadError(dir.file("bad_header.csv"), {"bad_header.csv:1:", "'x,y,w'"});
+}
+
+TEST(Csv, rejectsWrongColumnCountOnLineK) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "x,y,z\n1,2,3\n4,5,6\n7,8\n");
+  expectReadError(dir.file("a.csv"), {"a.csv:4:", "2 columns, expected 3"});
+  writeFile(dir.file("b.csv"), "1,2,3\n4,5,6,7\n");
+  expectReadError(dir.file("b.csv"), {"b.csv:2:", "4 columns, expected 3"});
+  writeFile(dir.file("c.csv"), "1,2,3,4\n");
+  expectReadError(dir.file("c.csv"), {"c.csv:1:", "4 columns without a header"});
+  writeFile(dir.file("d.csv"), "x,y,z\n1,,3\n");
+  expectReadError(dir.file("d.csv"), {"d.csv:2:", "column 2", "empty field"});
+}
+
+TEST(Csv, rejectsNonNumericTextWithLineAndColumn) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "x,y,z\n1,2,3\n1,2abc,3\n");
+  expectReadError(dir.file("a.csv"), {"a.csv:3:", "column 2", "'2abc'", "not a number"});
+  writeFile(dir.file("b.csv"), "x,y,z\n1,2,3\n1,2,hello world\n");
+  expectReadError(dir.file("b.csv"), {"b.csv:3:", "column 3", "'hello world'"});
+}
+
+TEST(Csv, rejectsNonFiniteUnlessAllowed) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "x,y,z\n1,2,3\n4,nan,6\n");
+  expectReadError(dir.file("a.csv"), {"a.csv:3:", "column 2", "'nan'", "not a finite number"});
+  writeFile(dir.file("b.csv"), "x,y,z\n1,2,-inf\n");
+  expectReadError(dir.file("b.csv"), {"b.csv:2:", "column 3", "'-inf'"});
+  Result<PointSet> allowed = readCsv(dir.file("a.csv"), CsvReadOptions{0, true, nullptr});
+  ASSERT_TRUE(allowed.ok());
+  EXPECT_TRUE(std::isnan(allowed->positions[1].y));
+}
+
+TEST(Csv, rejectsNumbersOutOfDoubleRange) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "x,y,z\n1,2,3\n1e309,2,3\n");
+  expectReadError(dir.file("a.csv"), {"a.csv:3:", "column 1", "'1e309'", "out of double range"});
+  writeFile(dir.file("b.csv"), "x,y,z\n1,-2e-400,3\n");
+  expectReadError(dir.file("b.csv"), {"b.csv:2:", "column 2", "'-2e-400'", "underflows"});
+  writeFile(dir.file("c.csv"), "x,y,z,r,g,b\n1,2,3,1e39,0,0\n");
+  expectReadError(dir.file("c.csv"), {"c.csv:2:", "column 4", "out of float range"});
+  // The smallest subnormal is in range, and so is zero written with an exponent.
+  writeFile(dir.file("d.csv"), "x,y,z\n4.9406564584124654e-324,0e-999,0.0\n");
+  EXPECT_TRUE(readCsv(dir.file("d.csv")).ok());
+}
+
+TEST(Csv, rejectsOneMegabyteLine) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "x,y,z\n1,2,3\n" + std::string(1 << 20, '7') + ",1,2\n4,5,6\n");
+  expectReadError(dir.file("a.csv"), {"a.csv:3:", "line longer than"});
+  writeFile(dir.file("b.csv"), std::string(1 << 20, ' ') + "\n");
+  expectReadError(dir.file("b.csv"), {"b.csv:1:", "line longer than"});
+}
+
+TEST(Csv, rejectsBinaryGarbage) {
+  TempDir dir;
+  std::string garbage;
+  std::mt19937 rng(3);
+  for (int i = 0; i < 4096; ++i) garbage += static_cast<char>(rng() & 0xff);
+  garbage[5] = '\0';
+  garbage[100] = '\n';
+  writeFile(dir.file("a.csv"), garbage);
+  Result<PointSet> r = readCsv(dir.file("a.csv"));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("a.csv:1:"), std::string::npos) << r.error().message;
+  writeFile(dir.file("b.csv"), "1,2,3\n\x01\x02\x03\xff,2,3\n");
+  expectReadError(dir.file("b.csv"), {"b.csv:2:", "column 1", "\\x01\\x02\\x03\\xff", "not a number"});
+}
+
+TEST(Csv, reportsTheFirstBadLineWhateverTheThreadCount) {
+  TempDir dir;
+  std::string text = "x,y,z\n";
+  for (int i = 0; i < 800000; ++i) text += "1.25,2.5,3.75\n";  // ~11 MB: two blocks
+  text += "bad,1,1\n";
+  for (int i = 0; i < 10; ++i) text += "1,2,3\n";
+  text += "alsobad,1,1\n";
+  writeFile(dir.file("a.csv"), text);
+  for (unsigned threads : {1u, 2u, 4u}) {
+    Result<PointSet> r = readCsv(dir.file("a.csv"), CsvReadOptions{threads, false, nullptr});
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("a.csv:800002: column 1: 'bad'"), std::string::npos) << r.error().message;
+  }
+}
+
+TEST(Csv, failedWriteLeavesNothing) {
+  TempDir dir;
+  PointSet s;
+  s.positions = {{1, 2, 3}};
+  Status missing = writeCsv(dir.file("no/such/folder/a.csv"), s);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("does not exist"), std::string::npos) << missing.error().message;
+  Status proc = writeCsv("/proc/dpoint-test.csv", s);  // read-only even for root
+  ASSERT_FALSE(proc.ok());
+  EXPECT_NE(proc.error().message.find("/proc"), std::string::npos) << proc.error().message;
+  EXPECT_TRUE(dir.entries().empty());
+  // Overwriting an existing file replaces it whole.
+  writeFile(dir.file("a.csv"), "old");
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), s).ok());
+  EXPECT_EQ(readFile(dir.file("a.csv")), "x,y,z\n1,2,3\n");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"a.csv"});
+}
+
+// Rows appended in uneven pieces (empty ones, one row, more than a batch) give writeCsv's bytes
+// for every layout, thread count and --decimals.
+TEST(Csv, rowWriterInPiecesEqualsWriteCsv) {
+  TempDir dir;
+  PointSet set = setFromDoubles(hardDoubles(3 * 300001), true);
+  PointSet planar = set;
+  for (glm::dvec3& p : planar.positions) p.z = 0.0;
+  const size_t pieces[] = {0, 1, 65535, 0, 2, 300000, 7};
+  for (const PointSet* source : {&set, &planar})
+    for (const bool colours : {true, false})
+      for (const int decimals : {-1, 15})
+        for (const unsigned threads : {1u, 2u}) {
+          PointSet whole = *source;
+          if (!colours) whole.colors.clear();
+          const CsvWriteOptions options{decimals, threads, nullptr};
+          ASSERT_TRUE(writeCsv(dir.file("whole.csv"), whole, options));
+          Result<CsvRowWriter> writer =
+              CsvRowWriter::create(dir.file("rows.csv"), CsvLayout{whole.isPlanar(), colours}, options);
+          ASSERT_TRUE(writer) << writer.error().message;
+          size_t at = 0;
+          for (size_t k = 0; at < whole.size(); k = (k + 1) % std::size(pieces)) {
+            const size_t n = std::min(pieces[k], whole.size() - at);
+            const std::span<const glm::vec3> c =
+                colours ? std::span<const glm::vec3>(whole.colors).subspan(at, n) : std::span<const glm::vec3>();
+            ASSERT_TRUE(writer->append(std::span<const glm::dvec3>(whole.positions).subspan(at, n), c));
+            at += n;
+          }
+          ASSERT_TRUE(writer->commit());
+          EXPECT_TRUE(readFile(dir.file("rows.csv")) == readFile(dir.file("whole.csv")))
+              << "planar " << whole.isPlanar() << " colours " << colours << " decimals " << decimals << " threads "
+              << threads;
+        }
+}
+
+TEST(Csv, rowWriterWithoutCommitLeavesNothing) {
+  TempDir dir;
+  PointSet set = setFromDoubles(hardDoubles(3 * 200000), false);
+  {
+    // One thread: batches of 2 chunks (131072 rows), so megabytes reach the file before the end.
+    Result<CsvRowWriter> writer = CsvRowWriter::create(dir.file("a.csv"), CsvLayout{}, CsvWriteOptions{-1, 1, nullptr});
+    ASSERT_TRUE(writer) << writer.error().message;
+    ASSERT_TRUE(writer->append(set.positions, {}));
+  }
+  EXPECT_TRUE(dir.entries().empty());
+  Result<CsvRowWriter> bad = CsvRowWriter::create(dir.file("a.csv"), CsvLayout{}, CsvWriteOptions{101, 0, nullptr});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ExitCode::kUsage);
+  EXPECT_NE(bad.error().message.find("--decimals 101"), std::string::npos) << bad.error().message;
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+}  // namespace
+}  // namespace dpoint
+
+namespace dpoint {
+namespace {
+
+// formatFixed must agree with glibc printf("%.*f") and std::to_chars' fixed form everywhere.
+TEST(FixedFormat, matchesGlibcPrintfAndToCharsOnRandomAndTieValues) {
+  std::mt19937_64 rng(99);
+  char a[512], b[512];
+  char c[512];
+  auto check = [&](double v, int decimals) {
+    char* end_a = formatFixed(a, v, decimals);
+    auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::fixed, decimals);
+    ASSERT_EQ(std::string(a, end_a), std::string(b, r.ptr)) << "decimals " << decimals;
+    // And glibc's printf itself, the behaviour --decimals promises.
+    std::snprintf(c, sizeof c, "%.*f", decimals, v);
+    ASSERT_EQ(std::string(a, end_a), std::string(c)) << "decimals " << decimals;
+  };
+  for (int i = 0; i < 300000; ++i) {
+    const uint64_t bits = rng();
+    double v;
+    std::memcpy(&v, &bits, sizeof v);
+    if (!std::isfinite(v)) continue;
+    const int decimals = static_cast<int>(rng() % 30);
+    check(v, decimals);
+    check(std::ldexp(static_cast<double>(bits >> 11), -static_cast<int>(rng() % 80)), decimals);  // moderate
+    check(static_cast<double>(static_cast<int64_t>(bits >> 40)) * 0.001, 15);
+  }
+  for (int k = 1; k < 80; ++k) {  // exact ties at every position
+    for (int decimals = 0; decimals < 30; ++decimals) {
+      check(std::ldexp(1.0, -k), decimals);
+      check(-3.0 * std::ldexp(1.0, -k), decimals);
+      check(2.5 + std::ldexp(1.0, -k), decimals);
+    }
+  }
+  for (double v : {0.0, -0.0, DBL_MAX, -DBL_MAX, DBL_TRUE_MIN, 1e23, 9.5, 0.5, 1.5, -0.5, 1e-7})
+    for (int decimals : {0, 1, 15, 27, 28, 60, 100}) check(v, decimals);
+}
+
+}  // namespace
+}  // namespace dpoint

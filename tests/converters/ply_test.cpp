@@ -1,0 +1,904 @@
+#include "converters/ply.h"
+
+#include <gtest/gtest.h>
+
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::contains;
+using test::readFile;
+using test::TempDir;
+using test::writeFile;
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Positions that break a careless writer: signed zeros, subnormals, the extremes, non-representable decimals.
+PointSet awkwardPoints() {
+  const double values[] = {0.0,          -0.0,           std::numeric_limits<double>::denorm_min(),
+                           -DBL_MIN / 3, DBL_MIN,        DBL_MAX,
+                           -DBL_MAX,     1e-300,         0.1,
+                           1.0 / 3.0,    6.378e6 + 1e-9, -123456789.125,
+                           1e300};
+  PointSet set;
+  const size_t n = std::size(values);
+  for (size_t i = 0; i < n; ++i) set.positions.push_back({values[i], values[(i + 1) % n], values[(i + 5) % n]});
+  return set;
+}
+
+void expectSamePositions(const PointSet& a, const PointSet& b) {
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  for (size_t i = 0; i < a.positions.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_TRUE(sameBits(a.positions[i][k], b.positions[i][k]))
+          << "point " << i << " axis " << k << ": " << a.positions[i][k] << " vs " << b.positions[i][k];
+}
+
+void expectSameColors(const PointSet& a, const PointSet& b) {
+  ASSERT_EQ(a.colors.size(), b.colors.size());
+  for (size_t i = 0; i < a.colors.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_TRUE(sameBits(a.colors[i][k], b.colors[i][k]))
+          << "colour " << i << " channel " << k << ": " << a.colors[i][k] << " vs " << b.colors[i][k];
+}
+
+PointSet roundTrip(const PointSet& in, PlyEncoding encoding, PlyColorType color_type = PlyColorType::kUchar) {
+  TempDir dir;
+  const std::string path = dir.file("round.ply");
+  PlyWriteOptions options;
+  options.encoding = encoding;
+  options.color_type = color_type;
+  Status w = writePly(path, in, options);
+  EXPECT_TRUE(w.ok()) << w.error().message;
+  auto r = readPly(path);
+  EXPECT_TRUE(r.ok()) << r.error().message;
+  return r.ok() ? std::move(r).value() : PointSet{};
+}
+
+// Little-endian bytes for hand-built binary files.
+struct Bytes {
+  std::string data;
+  template <typename T>
+  Bytes& add(T value) {
+    data.append(reinterpret_cast<const char*>(&value), sizeof value);
+    return *this;
+  }
+};
+
+Result<PointSet> readText(const TempDir& dir, const std::string& name, const std::string& bytes,
+                          const PlyReadOptions& options = {}) {
+  writeFile(dir.file(name), bytes);
+  return readPly(dir.file(name), options);
+}
+
+const char kAsciiHeader[] =
+    "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+
+// ---------------------------------------------------------------- round trips
+
+TEST(Ply, plyBinaryRoundTripIsBitExact) {
+  PointSet in = awkwardPoints();
+  expectSamePositions(in, roundTrip(in, PlyEncoding::kBinary));
+}
+
+TEST(Ply, plyAsciiRoundTripIsBitExact) {
+  PointSet in = awkwardPoints();
+  expectSamePositions(in, roundTrip(in, PlyEncoding::kAscii));
+}
+
+TEST(Ply, plyUcharColorsRoundTripAsBytes) {
+  PointSet in;
+  for (int k = 0; k < 256; ++k) {
+    in.positions.push_back({k, -k, 0.5 * k});
+    in.colors.push_back({static_cast<float>(k) / 255.0f, static_cast<float>(255 - k) / 255.0f,
+                         static_cast<float>((k * 7) % 256) / 255.0f});
+  }
+  for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+    PointSet out = roundTrip(in, encoding, PlyColorType::kUchar);
+    expectSamePositions(in, out);
+    expectSameColors(in, out);
+  }
+}
+
+TEST(Ply, plyUcharColorsAreRoundedAndClamped) {
+  PointSet in;
+  in.positions.assign(4, {0, 0, 0});
+  in.colors = {{-0.5f, 2.0f, 0.5f},
+               {std::numeric_limits<float>::quiet_NaN(), 1.0f, 0.0f},
+               {0.499f / 255, 1.501f / 255, 254.6f / 255},
+               {0, 0, 0}};
+  PointSet out = roundTrip(in, PlyEncoding::kBinary, PlyColorType::kUchar);
+  ASSERT_EQ(out.colors.size(), 4u);
+  EXPECT_EQ(out.colors[0], glm::vec3(0.0f, 1.0f, 128.0f / 255.0f));
+  EXPECT_EQ(out.colors[1], glm::vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(out.colors[2], glm::vec3(0.0f, 2.0f / 255.0f, 1.0f));
+}
+
+TEST(Ply, plyFloatColorsRoundTripExactly) {
+  PointSet in;
+  const float values[] = {0.0f, 1.0f, 0.1f, 1.0f / 3.0f, 1e-45f, 0.999999f, 0.5f, 2.0f};
+  for (size_t i = 0; i < std::size(values); ++i) {
+    in.positions.push_back({static_cast<double>(i), 0.0, 0.0});
+    in.colors.push_back({values[i], values[(i + 1) % std::size(values)], values[(i + 3) % std::size(values)]});
+  }
+  for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+    PointSet out = roundTrip(in, encoding, PlyColorType::kFloat);
+    expectSamePositions(in, out);
+    expectSameColors(in, out);
+  }
+}
+
+TEST(Ply, plyMeshRoundTripKeepsTriangles) {
+  PointSet in;
+  in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  in.triangles = {0, 1, 2, 0, 3, 1, 3, 2, 1};
+  for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+    PointSet out = roundTrip(in, encoding);
+    expectSamePositions(in, out);
+    EXPECT_EQ(out.triangles, in.triangles);
+    EXPECT_TRUE(out.colors.empty());
+  }
+}
+
+TEST(Ply, plyEmptyPointSetRoundTrips) {
+  for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+    PointSet out = roundTrip(PointSet{}, encoding);
+    EXPECT_EQ(out.size(), 0u);
+  }
+}
+
+TEST(Ply, plyWriterHeaderIsStandard) {
+  TempDir dir;
+  PointSet in;
+  in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  in.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  in.triangles = {0, 1, 2};
+  ASSERT_TRUE(writePly(dir.file("a.ply"), in).ok());
+  const std::string bytes = readFile(dir.file("a.ply"));
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment written by dpoint\nelement vertex 3\n"
+      "property double x\nproperty double y\nproperty double z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "element face 1\nproperty list uchar uint vertex_indices\nend_header\n";
+  EXPECT_EQ(bytes.substr(0, header.size()), header);
+  EXPECT_EQ(bytes.size(), header.size() + 3 * 27 + 13);
+
+  PlyWriteOptions ascii;
+  ascii.encoding = PlyEncoding::kAscii;
+  ascii.color_type = PlyColorType::kFloat;
+  ASSERT_TRUE(writePly(dir.file("b.ply"), in, ascii).ok());
+  const std::string text = readFile(dir.file("b.ply"));
+  EXPECT_TRUE(contains(text, "format ascii 1.0\n"));
+  EXPECT_TRUE(contains(text, "property float red\n"));
+  EXPECT_TRUE(contains(text, "end_header\n0 0 0 1 0 0\n1 0 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n"));
+}
+
+// Random bit patterns with uchar-exact colours: finite values from subnormal to 2.
+PointSet randomPoints(size_t n, uint64_t seed) {
+  PointSet set;
+  uint64_t state = seed;
+  auto next = [&state] {
+    state = state * 6364136223846793005u + 1442695040888963407u;
+    return state;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    // ">> 2" clears the sign and the top exponent bit.
+    const uint64_t bits[3] = {next() >> 2, next() >> 2, next() >> 2};
+    glm::dvec3 p;
+    std::memcpy(&p, bits, sizeof p);
+    set.positions.push_back(p);
+    set.colors.push_back(glm::vec3(static_cast<float>(next() % 256) / 255.0f));
+  }
+  return set;
+}
+
+// Files larger than the reader's block, so rows and lines straddle refills.
+TEST(Ply, plyLargeFilesCrossBlockBoundaries) {
+  const size_t n = 400000;
+  PointSet in = randomPoints(n, 12345);
+  for (size_t i = 0; i + 2 < n; i += 2)
+    in.triangles.insert(in.triangles.end(), {uint32_t(i), uint32_t(i + 1), uint32_t(i + 2)});
+  for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+    PointSet out = roundTrip(in, encoding);
+    expectSamePositions(in, out);
+    expectSameColors(in, out);
+    EXPECT_EQ(out.triangles, in.triangles);
+  }
+}
+
+// ---------------------------------------------------------------- binary vertices on several threads
+
+// The reader decodes binary vertices in blocks of 1 MiB (kVertexBlockBytes in ply_read.cpp); the
+// files below hold four or more blocks, so that several threads share them.
+constexpr size_t kManyBlocksOf27 = 200000;  // 5.4 MB of double xyz + uchar rgb rows
+
+PlyReadOptions withThreads(unsigned threads) {
+  PlyReadOptions options;
+  options.threads = threads;
+  return options;
+}
+
+TEST(Ply, plyBinaryVerticesAreTheSameForAnyThreadCount) {
+  TempDir dir;
+  const PointSet in = randomPoints(kManyBlocksOf27, 777);
+  ASSERT_TRUE(writePly(dir.file("many.ply"), in).ok());
+  for (unsigned threads : {1u, 2u, 4u, 7u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    auto r = readPly(dir.file("many.ply"), withThreads(threads));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectSamePositions(in, *r);
+    expectSameColors(in, *r);
+  }
+}
+
+// The general path (not double xyz + uchar rgb) is parallel too: float xyz around a skipped
+// property, ushort colours.
+TEST(Ply, plyBinaryMixedTypesAreTheSameForAnyThreadCount) {
+  TempDir dir;
+  Bytes b;
+  const size_t n = 250000;  // 24-byte rows: 5.7 MB
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(n) +
+      "\nproperty float y\nproperty int flags\nproperty float x\nproperty float z\n"
+      "property ushort red\nproperty ushort green\nproperty ushort blue\nproperty short pad\nend_header\n";
+  PointSet expected;
+  for (size_t i = 0; i < n; ++i) {
+    const float x = static_cast<float>(i) * 0.1f, y = -static_cast<float>(i) / 3.0f;
+    const float z = 1.0f / static_cast<float>(i + 1);
+    const auto red = static_cast<uint16_t>(i), green = static_cast<uint16_t>(i * 7), blue = static_cast<uint16_t>(~i);
+    b.add(y).add(static_cast<int32_t>(i)).add(x).add(z).add(red).add(green).add(blue).add(int16_t{-1});
+    expected.positions.push_back({x, y, z});
+    expected.colors.push_back({static_cast<float>(red) / 65535.0f, static_cast<float>(green) / 65535.0f,
+                               static_cast<float>(blue) / 65535.0f});
+  }
+  writeFile(dir.file("mixed.ply"), b.data);
+  for (unsigned threads : {1u, 4u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    auto r = readPly(dir.file("mixed.ply"), withThreads(threads));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectSamePositions(expected, *r);
+    expectSameColors(expected, *r);
+  }
+}
+
+// Blocks hold 38836 rows of 27 bytes. Two layouts of bad rows, so that neither "the first error
+// found wins" nor "the last one found wins" passes once blocks run at the same time: the earlier
+// bad row found first (start of block 1, end of block 3) and found last (end of block 1, start of
+// block 2). A second bad row in the first bad row's block must not replace it either.
+TEST(Ply, plyFirstBadVertexWinsWhateverTheThreadCount) {
+  constexpr size_t kBlock = 38836;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (auto [first, later] : {std::pair<size_t, size_t>{kBlock + 1000, 4 * kBlock - 2},
+                              std::pair<size_t, size_t>{2 * kBlock - 10, 2 * kBlock + 1}}) {
+    SCOPED_TRACE("bad rows " + std::to_string(first) + " and " + std::to_string(later));
+    TempDir dir;
+    PointSet in = randomPoints(kManyBlocksOf27, 99);
+    in.positions[first].z = inf;
+    in.positions[first + 7].y = -inf;
+    in.positions[later].x = std::numeric_limits<double>::quiet_NaN();
+    ASSERT_TRUE(writePly(dir.file("bad.ply"), in).ok());
+    const size_t header = readFile(dir.file("bad.ply")).find("end_header\n") + 11;
+    for (unsigned threads : {1u, 2u, 4u, 7u, 2u, 4u, 7u, 2u, 4u, 7u}) {  // timing varies: several tries
+      SCOPED_TRACE("threads " + std::to_string(threads));
+      auto r = readPly(dir.file("bad.ply"), withThreads(threads));
+      ASSERT_FALSE(r.ok());
+      EXPECT_TRUE(contains(r.error().message, "bad.ply: byte " + std::to_string(header + first * 27) + ": vertex " +
+                                                  std::to_string(first) + ": z is inf, not a finite number"));
+    }
+    PlyReadOptions allow = withThreads(4);
+    allow.allow_nonfinite = true;
+    auto r = readPly(dir.file("bad.ply"), allow);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    expectSamePositions(in, *r);
+  }
+}
+
+TEST(Ply, plyRejectsTruncatedBinaryOfManyBlocks) {
+  TempDir dir;
+  const PointSet in = randomPoints(kManyBlocksOf27, 5);
+  ASSERT_TRUE(writePly(dir.file("whole.ply"), in).ok());
+  const std::string bytes = readFile(dir.file("whole.ply"));
+  const size_t cut = bytes.size() - 3 * 27 - 5;  // inside the fourth row from the end
+  writeFile(dir.file("cut.ply"), bytes.substr(0, cut));
+  auto r = readPly(dir.file("cut.ply"), withThreads(4));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cut.ply: truncated at byte " + std::to_string(cut) +
+                                              ": header line 4 declares 200000 'vertex' rows"));
+}
+
+// An element before the vertices may hold longer lists than the size check assumes (one count
+// byte a row), so the vertex rows themselves run out: the whole rows are decoded, the cut reported.
+TEST(Ply, plyRejectsVerticesCutAfterALongList) {
+  TempDir dir;
+  const size_t n = 200000;  // 24-byte rows
+  const std::string header = "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+                             "property list uchar int vertex_indices\nelement vertex " + std::to_string(n) +
+                             "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  Bytes b;
+  b.data = header;
+  b.add(uint8_t{200});
+  for (int32_t k = 0; k < 200; ++k) b.add(k);  // 801 bytes, where the size check counts 1
+  // The size check passes (801 + 24 * (n - 33) + 5 >= 1 + 24 * n); the vertex data stops 5 bytes
+  // into row n - 33 = 199967.
+  for (size_t i = 0; i + 33 < n; ++i) b.add(static_cast<double>(i)).add(1.0).add(2.0);
+  b.data += "12345";
+  auto r = readText(dir, "cut.ply", b.data, withThreads(4));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cut.ply: truncated at byte " + std::to_string(b.data.size()) +
+                                              ": expected 200000 'vertex' rows, the data ends in row 199967"));
+  // A bad row before the cut comes first in the file, so it is the error.
+  const size_t row = header.size() + 801 + 24 * 100000;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(b.data.data() + row + 8, &nan, sizeof nan);
+  auto bad = readText(dir, "cut_nan.ply", b.data, withThreads(4));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.error().message, "cut_nan.ply: byte " + std::to_string(row) + ": vertex 100000: y is nan"));
+}
+
+// Every thread reports its blocks: the progress ends at 100%, not at the share of one thread. The
+// file is larger than the 8 MiB the header read takes in (and reports) at once.
+TEST(Ply, plyProgressCountsEveryBlock) {
+  TempDir dir;
+  ASSERT_TRUE(writePly(dir.file("many.ply"), randomPoints(3 * kManyBlocksOf27, 3)).ok());
+  std::FILE* sink = std::tmpfile();
+  ASSERT_NE(sink, nullptr);
+  {
+    Progress progress(sink, "");
+    PlyReadOptions options = withThreads(4);
+    options.progress = &progress;
+    auto r = readPly(dir.file("many.ply"), options);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    progress.finish();
+  }
+  std::rewind(sink);
+  std::string text(4096, '\0');
+  text.resize(std::fread(text.data(), 1, text.size(), sink));
+  std::fclose(sink);
+  const std::string last = text.substr(text.rfind('\r') + 1);
+  EXPECT_TRUE(contains(last, "reading " + dir.file("many.ply") + ": 100.0%")) << text;
+}
+
+// ---------------------------------------------------------------- foreign files
+
+TEST(Ply, plyQuadFaceIsFanTriangulated) {
+  TempDir dir;
+  auto r = readText(dir, "quad.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 2\nproperty list uchar int vertex_index\nend_header\n"
+                    "0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 2 2\n4 0 1 2 3\n5 4 3 2 1 0\n");
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(r->triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 4, 3, 2, 4, 2, 1, 4, 1, 0}));
+
+  Bytes b;
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+      "property double z\nelement face 1\nproperty list int ushort vertex_indices\nend_header\n";
+  for (int i = 0; i < 4; ++i) b.add(double(i)).add(0.0).add(0.0);
+  b.add(int32_t{4}).add(uint16_t{3}).add(uint16_t{2}).add(uint16_t{1}).add(uint16_t{0});
+  auto binary = readText(dir, "quad_bin.ply", b.data);
+  ASSERT_TRUE(binary.ok()) << binary.error().message;
+  EXPECT_EQ(binary->triangles, (std::vector<uint32_t>{3, 2, 1, 3, 1, 0}));
+}
+
+TEST(Ply, plyReadsFloatXyz) {
+  TempDir dir;
+  Bytes b;
+  b.data =
+      "ply\nformat binary_little_endian 1.0\ncomment from a float writer\nelement vertex 2\n"
+      "property float32 x\nproperty float32 y\nproperty float32 z\nend_header\n";
+  b.add(0.1f).add(-2.5f).add(1e30f).add(0.0f).add(-0.0f).add(3.0f);
+  auto r = readText(dir, "float.ply", b.data);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_EQ(r->size(), 2u);
+  EXPECT_TRUE(sameBits(r->positions[0].x, static_cast<double>(0.1f)));
+  EXPECT_EQ(r->positions[0].z, static_cast<double>(1e30f));
+  EXPECT_TRUE(sameBits(r->positions[1].y, -0.0));
+  EXPECT_FALSE(r->hasColors());
+
+  // An ASCII float property means the float nearest the text, as a binary file would hold.
+  auto a = readText(dir, "float.txt.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                    "property float z\nend_header\n0.1 +2 -1e-3\n");
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  EXPECT_TRUE(sameBits(a->positions[0].x, static_cast<double>(0.1f)));
+  EXPECT_EQ(a->positions[0].y, 2.0);
+  EXPECT_TRUE(sameBits(a->positions[0].z, static_cast<double>(-1e-3f)));
+}
+
+TEST(Ply, plyReadsAsciiWithExtraPropertiesAndElements) {
+  TempDir dir;
+  auto r = readText(dir, "extra.ply",
+                    "ply\r\nformat ascii 1.0\r\ncomment hand written\r\nobj_info scanner 3\r\n"
+                    "element camera 1\r\nproperty float view_px\r\nproperty list uchar float params\r\n"
+                    "element vertex 3\r\nproperty int confidence\r\nproperty double x\r\nproperty double y\r\n"
+                    "property double z\r\nproperty float nx\r\nproperty uchar red\r\nproperty uchar green\r\n"
+                    "property uchar blue\r\nproperty uchar alpha\r\nproperty list uchar int tags\r\n"
+                    "element edge 2\r\nproperty int vertex1\r\nproperty int vertex2\r\nend_header\r\n"
+                    "0.5 3 1 2 3\r\n"
+                    "7 1.5 -2.5 1e-300 0.1 255 0 51 128 2 4 5\r\n"
+                    "\t-1  0  0.1  +3 0 0 255 0 255 0\r\n"
+                    "\r\n"
+                    "9 1 2 3 nan 1 2 3 4 1 99\r\n"
+                    "0 1\r\n1 2\r\n\r\n");
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_EQ(r->size(), 3u);
+  EXPECT_EQ(r->positions[0], glm::dvec3(1.5, -2.5, 1e-300));
+  EXPECT_EQ(r->positions[1], glm::dvec3(0.0, 0.1, 3.0));
+  EXPECT_EQ(r->positions[2], glm::dvec3(1, 2, 3));
+  ASSERT_TRUE(r->hasColors());
+  EXPECT_EQ(r->colors[0], glm::vec3(1.0f, 0.0f, 51.0f / 255.0f));
+  EXPECT_EQ(r->colors[1], glm::vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(r->colors[2], glm::vec3(1.0f / 255.0f, 2.0f / 255.0f, 3.0f / 255.0f));
+  EXPECT_TRUE(r->triangles.empty());
+}
+
+TEST(Ply, plyReadsBinaryWithExtraPropertiesAndElements) {
+  TempDir dir;
+  Bytes b;
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement material 2\nproperty list uint double weights\n"
+      "property short id\nelement vertex 2\nproperty uint8 flags\nproperty float64 x\n"
+      "property list ushort int neighbours\nproperty int16 y\nproperty int32 z\nproperty ushort red\n"
+      "property float green\nproperty double blue\nelement face 1\nproperty uchar kind\n"
+      "property list uchar uint vertex_indices\nproperty list uchar float uv\nelement tail 3\n"
+      "property char c\nend_header\n";
+  b.add(uint32_t{2}).add(1.0).add(2.0).add(int16_t{7});
+  b.add(uint32_t{0}).add(int16_t{8});
+  b.add(uint8_t{1}).add(0.25).add(uint16_t{2}).add(int32_t{5}).add(int32_t{6}).add(int16_t{-3}).add(int32_t{7});
+  b.add(uint16_t{65535}).add(0.5f).add(0.125);
+  b.add(uint8_t{2}).add(-1e10).add(uint16_t{0}).add(int16_t{32767}).add(int32_t{-8});
+  b.add(uint16_t{0}).add(2.0f).add(-1.0);
+  b.add(uint8_t{9}).add(uint8_t{3}).add(uint32_t{1}).add(uint32_t{0}).add(uint32_t{1});
+  b.add(uint8_t{2}).add(0.0f).add(1.0f);
+  b.add(int8_t{1}).add(int8_t{2}).add(int8_t{3});
+  auto r = readText(dir, "extra.ply", b.data);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_EQ(r->size(), 2u);
+  EXPECT_EQ(r->positions[0], glm::dvec3(0.25, -3, 7));
+  EXPECT_EQ(r->positions[1], glm::dvec3(-1e10, 32767, -8));
+  EXPECT_EQ(r->colors[0], glm::vec3(1.0f, 0.5f, 0.125f));
+  EXPECT_EQ(r->colors[1], glm::vec3(0.0f, 2.0f, -1.0f));  // float colours are taken as they are
+  EXPECT_EQ(r->triangles, (std::vector<uint32_t>{1, 0, 1}));
+}
+
+TEST(Ply, plyAcceptsNanWhenAllowed) {
+  TempDir dir;
+  PlyReadOptions allow;
+  allow.allow_nonfinite = true;
+  auto r = readText(dir, "nan.ply", std::string(kAsciiHeader) + "1 nan 2\n-inf 0 inf\n", allow);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_TRUE(std::isnan(r->positions[0].y));
+  EXPECT_EQ(r->positions[1].x, -std::numeric_limits<double>::infinity());
+}
+
+// ---------------------------------------------------------------- failures
+
+// A fuzz finding (tests/corpus/ply/fuzz_float_colour_nan.ply): NaN float colours were read as they
+// were, and the renderer turns colours into bytes. Colours now follow positions: finite unless
+// allowed, and a double colour must fit a float. Binary (multithreaded and serial) and ASCII alike.
+TEST(Ply, plyRejectsNonFiniteColoursAndDoubleColoursPastFloat) {
+  TempDir dir;
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
+                             "property double z\nproperty float red\nproperty double green\nproperty float blue\n"
+                             "end_header\n";
+  auto nan = readText(dir, "nan.ply", header + "0 0 0 0.5 0.5 0.5\n1 1 1 nan 0 0\n");
+  ASSERT_FALSE(nan.ok());
+  EXPECT_NE(nan.error().message.find("line 12: vertex 1: red is nan, not a finite number"), std::string::npos)
+      << nan.error().message;
+  auto huge = readText(dir, "huge.ply", header + "0 0 0 0.5 1e300 0.5\n1 1 1 0 0 0\n");
+  ASSERT_FALSE(huge.ok());
+  EXPECT_NE(huge.error().message.find("vertex 0: green is 1e+300, out of float range"), std::string::npos)
+      << huge.error().message;
+  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                       "property float z\nproperty float red\nproperty float green\nproperty float blue\nend_header\n";
+  const float row[6] = {0, 0, 0, 0.5f, std::numeric_limits<float>::infinity(), 0};
+  binary.append(reinterpret_cast<const char*>(row), sizeof row);
+  auto inf = readText(dir, "inf.ply", binary);
+  ASSERT_FALSE(inf.ok());
+  EXPECT_NE(inf.error().message.find("vertex 0: green is inf, not a finite number"), std::string::npos)
+      << inf.error().message;
+  PlyReadOptions allow;
+  allow.allow_nonfinite = true;
+  auto allowed = readText(dir, "nan.ply", header + "0 0 0 0.5 0.5 0.5\n1 1 1 nan 0 0\n", allow);
+  ASSERT_TRUE(allowed.ok()) << allowed.error().message;
+  EXPECT_TRUE(std::isnan(allowed->colors[1].r));
+  EXPECT_FALSE(readText(dir, "huge.ply", header + "0 0 0 0.5 1e300 0.5\n1 1 1 0 0 0\n", allow).ok());
+}
+
+TEST(Ply, plyRejectsMissingFile) {
+  TempDir dir;
+  auto r = readPly(dir.file("nope.ply"));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "nope.ply"));
+  EXPECT_TRUE(contains(r.error().message, "not found"));
+}
+
+TEST(Ply, plyRejectsFolder) {
+  TempDir dir;
+  auto r = readPly(dir.path());
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, dir.path()));
+  EXPECT_TRUE(contains(r.error().message, "folder"));
+}
+
+TEST(Ply, plyRejectsEmptyFile) {
+  TempDir dir;
+  auto r = readText(dir, "empty.ply", "");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "empty.ply: empty file"));
+}
+
+TEST(Ply, plyRejectsMissingMagic) {
+  TempDir dir;
+  auto r = readText(dir, "csv.ply", "x,y,z\n1,2,3\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "csv.ply: not a PLY file"));
+  auto g = readText(dir, "garbage.ply",
+                    std::string("\x7f"
+                                "ELF\0\0\0\x01\x02",
+                                9) +
+                        std::string(100000, '\xff'));
+  ASSERT_FALSE(g.ok());
+  EXPECT_TRUE(contains(g.error().message, "garbage.ply: not a PLY file"));
+  auto p = readText(dir, "plyx.ply", "plyfoo\nformat ascii 1.0\n");
+  ASSERT_FALSE(p.ok());
+  EXPECT_TRUE(contains(p.error().message, "plyx.ply: not a PLY file"));
+}
+
+TEST(Ply, plyRejectsMissingEndHeader) {
+  TempDir dir;
+  auto r = readText(dir, "cut.ply", "ply\nformat ascii 1.0\nelement vertex 1\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cut.ply: header line 4: the file ends before 'end_header'"));
+}
+
+TEST(Ply, plyRejectsBigEndian) {
+  TempDir dir;
+  auto r = readText(dir, "big.ply", "ply\nformat binary_big_endian 1.0\nelement vertex 0\nend_header\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "big.ply: header line 2:"));
+  EXPECT_TRUE(contains(r.error().message, "binary_big_endian is unsupported"));
+}
+
+TEST(Ply, plyRejectsUnknownHeaderKeyword) {
+  TempDir dir;
+  auto r = readText(dir, "kw.ply", "ply\nformat ascii 1.0\nelemnt vertex 1\nend_header\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "kw.ply: header line 3: unknown header keyword 'elemnt'"));
+}
+
+TEST(Ply, plyRejectsUnsupportedPropertyType) {
+  TempDir dir;
+  auto r = readText(dir, "cloud.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty float128 y\n"
+                    "property double z\nend_header\n1 2 3\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cloud.ply: header line 5: unsupported property type 'float128'"));
+  auto list = readText(dir, "list.ply",
+                       "ply\nformat ascii 1.0\nelement vertex 0\nproperty double x\nproperty double y\n"
+                       "property double z\nelement face 0\nproperty list float int vertex_indices\nend_header\n");
+  ASSERT_FALSE(list.ok());
+  EXPECT_TRUE(contains(list.error().message, "list.ply: header line 8: list count type 'float'"));
+}
+
+TEST(Ply, plyRejectsMissingX) {
+  TempDir dir;
+  auto r = readText(dir, "nox.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty double y\nproperty double z\n"
+                    "end_header\n1 2\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "nox.ply: header line 3: element 'vertex' has no 'x' property"));
+  auto none =
+      readText(dir, "novertex.ply", "ply\nformat ascii 1.0\nelement point 1\nproperty double x\nend_header\n1\n");
+  ASSERT_FALSE(none.ok());
+  EXPECT_TRUE(contains(none.error().message, "novertex.ply: the header declares no 'vertex' element"));
+}
+
+TEST(Ply, plyRejectsPartialColors) {
+  TempDir dir;
+  auto r = readText(dir, "rg.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+                    "property double z\nproperty uchar red\nproperty uchar green\nend_header\n1 2 3 4 5\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "rg.ply: header line 8: vertex colours need all of red, green and blue"));
+}
+
+TEST(Ply, plyRejectsTruncatedBinary) {
+  TempDir dir;
+  PointSet in = awkwardPoints();
+  in.colors.assign(in.size(), glm::vec3(0.5f));
+  ASSERT_TRUE(writePly(dir.file("whole.ply"), in).ok());
+  const std::string bytes = readFile(dir.file("whole.ply"));
+  // Cut inside the fifth vertex (27 bytes a row).
+  const size_t header = bytes.find("end_header\n") + 11;
+  const size_t cut = header + 4 * 27 + 10;
+  auto r = readText(dir, "cut.ply", bytes.substr(0, cut));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "cut.ply: truncated at byte " + std::to_string(cut)));
+  EXPECT_TRUE(contains(r.error().message,
+                       "header line 4 declares 13 'vertex' rows, needing at least 351 bytes of data, but only 118"));
+}
+
+TEST(Ply, plyRejectsTruncatedFaceList) {
+  TempDir dir;
+  PointSet in;
+  in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  in.triangles = {0, 1, 2, 2, 1, 0};
+  ASSERT_TRUE(writePly(dir.file("mesh.ply"), in).ok());
+  const std::string bytes = readFile(dir.file("mesh.ply"));
+  auto r = readText(dir, "mesh_cut.ply", bytes.substr(0, bytes.size() - 2));
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "mesh_cut.ply: truncated at byte " + std::to_string(bytes.size() - 2)));
+  EXPECT_TRUE(contains(r.error().message, "'face' rows, the data ends in row 1"));
+}
+
+TEST(Ply, plyRejectsTruncatedAscii) {
+  TempDir dir;
+  auto r = readText(dir, "short.ply", std::string(kAsciiHeader) + "1.5 2.5 3.5\n4 5\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "short.ply: line 9: vertex 1: missing value for 'z'"));
+  auto lines = readText(dir, "lines.ply", std::string(kAsciiHeader) + "1 2 3\n\n\n\n\n\n\n\n");
+  ASSERT_FALSE(lines.ok());
+  EXPECT_TRUE(contains(lines.error().message, "lines.ply: line"));
+  EXPECT_TRUE(contains(lines.error().message, "the file ends after 1 of 2 'vertex' rows"));
+}
+
+TEST(Ply, plyRejectsMalformedAsciiNumber) {
+  TempDir dir;
+  auto r = readText(dir, "bad.ply", std::string(kAsciiHeader) + "1 2 3\n4 5,0 6\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "bad.ply: line 9: vertex 1: 'y': '5,0' is not a valid double"));
+  auto range = readText(dir, "range.ply",
+                        "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+                        "property double z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                        "end_header\n1 2 3 0 256 0\n");
+  ASSERT_FALSE(range.ok());
+  EXPECT_TRUE(contains(range.error().message, "range.ply: line 11: vertex 0: 'green': '256' is not a valid uchar"));
+  auto extra = readText(dir, "extra.ply", std::string(kAsciiHeader) + "1 2 3 4\n5 6 7\n");
+  ASSERT_FALSE(extra.ok());
+  EXPECT_TRUE(
+      contains(extra.error().message, "extra.ply: line 8: vertex 0: more values than the header declares, '4'"));
+}
+
+TEST(Ply, plyRejectsDataAfterLastElement) {
+  TempDir dir;
+  auto r = readText(dir, "more.ply", std::string(kAsciiHeader) + "1 2 3\n4 5 6\n7 8 9\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "more.ply: line 10: data after the last element"));
+  Bytes b;
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n";
+  const size_t end = b.data.size() + 12;
+  b.add(1.0f).add(2.0f).add(3.0f).add(4.0f);
+  auto binary = readText(dir, "more_bin.ply", b.data);
+  ASSERT_FALSE(binary.ok());
+  EXPECT_TRUE(
+      contains(binary.error().message, "more_bin.ply: byte " + std::to_string(end) + ": 4 bytes of data after"));
+}
+
+TEST(Ply, plyRejectsIndexOutOfRange) {
+  TempDir dir;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  auto r = readText(dir, "mesh.ply", header + "3 0 1 2\n3 0 1 3\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(
+      contains(r.error().message, "mesh.ply: line 14: face 1: vertex index 3 out of range (the file has 3 vertices)"));
+  auto negative = readText(dir, "neg.ply", header + "3 0 -1 2\n3 0 1 2\n");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_TRUE(contains(negative.error().message, "neg.ply: line 13: face 0: vertex index -1 out of range"));
+
+  Bytes b;
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+      "property double z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n";
+  b.add(0.0).add(0.0).add(0.0);
+  const size_t face_at = b.data.size();
+  b.add(uint8_t{3}).add(uint32_t{0}).add(uint32_t{0}).add(uint32_t{4000000000u});
+  auto binary = readText(dir, "mesh_bin.ply", b.data);
+  ASSERT_FALSE(binary.ok());
+  EXPECT_TRUE(contains(binary.error().message, "mesh_bin.ply: byte " + std::to_string(face_at) +
+                                                   ": face 0: vertex index 4000000000 out of range"));
+}
+
+// A renderer asks for points only: the vertices and colours come back, and reading stops before
+// the faces (a bad index there goes unseen, as the option says).
+TEST(Ply, pointsOnlyStopsAfterTheVertices) {
+  TempDir dir;
+  PointSet in;
+  in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  in.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  in.triangles = {0, 1, 2};
+  ASSERT_TRUE(writePly(dir.file("mesh.ply"), in).ok());
+  PlyReadOptions options;
+  options.points_only = true;
+  Result<PointSet> points = readPly(dir.file("mesh.ply"), options);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  EXPECT_EQ(points->positions, in.positions);
+  EXPECT_EQ(points->colors, in.colors);
+  EXPECT_TRUE(points->triangles.empty());
+  Result<PointSet> whole = readPly(dir.file("mesh.ply"));
+  ASSERT_TRUE(whole.ok());
+  EXPECT_EQ(whole->triangles, in.triangles);
+
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+  const std::string path = dir.file("bad_face.ply");
+  writeFile(path, header);
+  EXPECT_FALSE(readPly(path).ok());
+  Result<PointSet> vertices = readPly(path, options);
+  ASSERT_TRUE(vertices.ok()) << vertices.error().message;
+  EXPECT_EQ(vertices->size(), 3u);
+}
+
+TEST(Ply, plyRejectsFaceWithTwoVertices) {
+  TempDir dir;
+  auto r = readText(dir, "line.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\n"
+                    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n2 0 1\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "line.ply: line 12: face 0 has 2 vertices; a face needs at least 3"));
+}
+
+TEST(Ply, plyRejectsNanWithLine) {
+  TempDir dir;
+  auto r = readText(dir, "nan.ply", std::string(kAsciiHeader) + "1 2 3\n4 nan 6\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "nan.ply: line 9: vertex 1: y is nan, not a finite number"));
+  auto overflow = readText(dir, "big.ply", std::string(kAsciiHeader) + "1e400 2 3\n4 5 6\n");
+  ASSERT_FALSE(overflow.ok());
+  EXPECT_TRUE(contains(overflow.error().message, "big.ply: line 8: vertex 0: x is inf"));
+}
+
+TEST(Ply, plyRejectsNonfiniteBinaryWithOffset) {
+  TempDir dir;
+  PointSet in;
+  in.positions = {{1, 2, 3}, {4, 5, -std::numeric_limits<double>::infinity()}};
+  ASSERT_TRUE(writePly(dir.file("inf.ply"), in).ok());
+  auto r = readPly(dir.file("inf.ply"));
+  ASSERT_FALSE(r.ok());
+  const size_t row = readFile(dir.file("inf.ply")).find("end_header\n") + 11 + 24;
+  EXPECT_TRUE(contains(r.error().message, "inf.ply: byte " + std::to_string(row) + ": vertex 1: z is -inf"));
+  PlyReadOptions allow;
+  allow.allow_nonfinite = true;
+  auto ok = readPly(dir.file("inf.ply"), allow);
+  ASSERT_TRUE(ok.ok()) << ok.error().message;
+  EXPECT_TRUE(std::isinf(ok->positions[1].z));
+
+  // Float rows take the general path, which must check as well.
+  Bytes b;
+  b.data =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n";
+  const size_t third = b.data.size() + 24;
+  b.add(1.0f).add(2.0f).add(3.0f).add(4.0f).add(5.0f).add(6.0f);
+  b.add(std::numeric_limits<float>::quiet_NaN()).add(0.0f).add(0.0f);
+  auto f = readText(dir, "nan_float.ply", b.data);
+  ASSERT_FALSE(f.ok());
+  EXPECT_TRUE(contains(f.error().message, "nan_float.ply: byte " + std::to_string(third) + ": vertex 2: x is nan"));
+}
+
+TEST(Ply, plyRejectsHugeElementCountWithoutAllocating) {
+  TempDir dir;
+  // Reserving these rows would need ~10^19 bytes: the check against the file size must come first.
+  const std::string huge =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000000000\nproperty double x\n"
+      "property double y\nproperty double z\nend_header\n0123456789";
+  auto r = readText(dir, "huge.ply", huge);
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "huge.ply: truncated at byte " + std::to_string(huge.size()) +
+                                              ": header line 3 declares 1000000000000000000 'vertex' rows, "
+                                              "needing at least 2^64 bytes of data, but only 10 follow"));
+  const std::string many_faces =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+      "property double z\nelement face 18446744073709551615\nproperty list uchar int vertex_indices\n"
+      "end_header\n1 2 3\n3 0 0 0\n";
+  auto faces = readText(dir, "faces.ply", many_faces);
+  ASSERT_FALSE(faces.ok());
+  EXPECT_TRUE(contains(faces.error().message, "faces.ply: truncated at byte " + std::to_string(many_faces.size()) +
+                                                  ": header line 7 declares 18446744073709551615 'face' rows"));
+  auto overflow =
+      readText(dir, "count.ply", "ply\nformat ascii 1.0\nelement vertex 99999999999999999999\nend_header\n");
+  ASSERT_FALSE(overflow.ok());
+  EXPECT_TRUE(contains(overflow.error().message, "count.ply: header line 3: bad element count '99999999999999999999'"));
+}
+
+TEST(Ply, plyFailedWriteLeavesNothing) {
+  TempDir dir;
+  PointSet in = awkwardPoints();
+  const std::string path = dir.file("missing/out.ply");
+  Status s = writePly(path, in);
+  ASSERT_FALSE(s.ok());
+  EXPECT_TRUE(contains(s.error().message, path));
+  EXPECT_TRUE(dir.entries().empty());
+
+  in.triangles = {0, 1, 99};
+  Status bad = writePly(dir.file("bad.ply"), in);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.error().message, "bad.ply"));
+  EXPECT_TRUE(contains(bad.error().message, "triangle index 99 out of range"));
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+// ---------------------------------------------------------------- streamed vertices
+
+// dpoint render of a file larger than memory: any range, read in any order of ranges, holds the
+// rows readPly reads, with colours, for any thread count.
+TEST(Ply, plyVertexStreamReadsAnyRangeAsReadPlyDoes) {
+  TempDir dir;
+  const PointSet in = randomPoints(kManyBlocksOf27, 11);  // with colours: 27-byte rows
+  ASSERT_TRUE(writePly(dir.file("s.ply"), in).ok());
+  auto whole = readPly(dir.file("s.ply"));
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  for (unsigned threads : {1u, 3u}) {
+    auto stream = PlyVertexStream::open(dir.file("s.ply"), withThreads(threads));
+    ASSERT_TRUE(stream.ok()) << stream.error().message;
+    EXPECT_EQ((*stream)->count(), in.size());
+    EXPECT_TRUE((*stream)->hasColors());
+    PointSet block, expected;
+    for (auto [first, n] : {std::pair<size_t, size_t>{0, 1}, {0, 100000}, {99999, 70001}, {in.size() - 3, 3},
+                            {12345, 0}}) {
+      SCOPED_TRACE(std::to_string(first) + "+" + std::to_string(n));
+      ASSERT_TRUE((*stream)->read(first, n, block).ok());
+      expected.positions.assign(whole->positions.begin() + std::ptrdiff_t(first),
+                                whole->positions.begin() + std::ptrdiff_t(first + n));
+      expected.colors.assign(whole->colors.begin() + std::ptrdiff_t(first),
+                             whole->colors.begin() + std::ptrdiff_t(first + n));
+      expectSamePositions(expected, block);
+      expectSameColors(expected, block);
+    }
+  }
+}
+
+// Its errors are readPly's, with whole-file row numbers and byte offsets.
+TEST(Ply, plyVertexStreamNamesBadRowsAndRefusesWhatCannotBeStreamed) {
+  TempDir dir;
+  PointSet in = randomPoints(kManyBlocksOf27, 12);
+  in.positions[150001].y = std::numeric_limits<double>::infinity();
+  ASSERT_TRUE(writePly(dir.file("bad.ply"), in).ok());
+  const size_t header = readFile(dir.file("bad.ply")).find("end_header\n") + 11;
+  auto stream = PlyVertexStream::open(dir.file("bad.ply"));
+  ASSERT_TRUE(stream.ok()) << stream.error().message;
+  PointSet block;
+  EXPECT_TRUE((*stream)->read(0, 150000, block).ok());
+  Status bad = (*stream)->read(150000, 10, block);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.error().message, "bad.ply: byte " + std::to_string(header + 150001 * 27) +
+                                                ": vertex 150001: y is inf, not a finite number"));
+  // ASCII rows have no fixed offsets, nor have vertices after a list element.
+  writeFile(dir.file("a.ply"), std::string(kAsciiHeader) + "1 2 3\n4 5 6\n");
+  auto ascii = PlyVertexStream::open(dir.file("a.ply"));
+  ASSERT_FALSE(ascii.ok());
+  EXPECT_TRUE(contains(ascii.error().message, "a.ply: an ASCII PLY file cannot be streamed"));
+  Bytes b;
+  b.data = "ply\nformat binary_little_endian 1.0\nelement note 1\nproperty list uchar uchar text\n"
+           "element vertex 1\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  b.add(uint8_t{1}).add(uint8_t{65}).add(1.0).add(2.0).add(3.0);
+  writeFile(dir.file("list.ply"), b.data);
+  auto listed = PlyVertexStream::open(dir.file("list.ply"));
+  ASSERT_FALSE(listed.ok());
+  EXPECT_TRUE(contains(listed.error().message, "list.ply: element 'note' (header line 3) has list rows before"));
+  // A header check of readPly's: counts beyond the file.
+  writeFile(dir.file("short.ply"), "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n"
+                                   "property double x\nproperty double y\nproperty double z\nend_header\n");
+  auto huge = PlyVertexStream::open(dir.file("short.ply"));
+  ASSERT_FALSE(huge.ok());
+  EXPECT_TRUE(contains(huge.error().message, "short.ply: truncated at byte"));
+}
+
+}  // namespace
+}  // namespace dpoint

@@ -1,0 +1,84 @@
+// LAS through converters/point_io: .las and .laz by name, and the colour sources a caller can ask
+// of any input (converters/las.h has the LAS reader's own tests).
+#include <gtest/gtest.h>
+
+#include "converters/point_io.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::TempDir;
+using test::writeFile;
+
+const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/las/";
+
+TEST(PointIoLas, lasAndLazAreKnownByTheirExtension) {
+  EXPECT_EQ(*formatOf("scan.LAS"), FileFormat::kLas);
+  EXPECT_EQ(*formatOf("scan.laz"), FileFormat::kLaz);
+  Result<PointSet> las = readPoints(kCorpus + "simple.las");
+  ASSERT_TRUE(las.ok()) << las.error().message;
+  EXPECT_EQ(las->size(), 1065u);
+}
+
+TEST(PointIoLas, lazIsRefusedByNameWithExitTwo) {
+  Result<PointSet> laz = readPoints(kCorpus + "simple.laz");
+  ASSERT_FALSE(laz.ok());
+  EXPECT_EQ(laz.error().message,
+            kCorpus + "simple.laz: LAZ (compressed LAS) is not supported; decompress it with laszip or PDAL first");
+  EXPECT_EQ(laz.error().code, ExitCode::kBadInput);
+  TempDir dir;
+  PointSet one;
+  one.positions = {{1, 2, 3}};
+  Status write = writePoints(dir.file("out.laz"), one);
+  ASSERT_FALSE(write.ok());
+  EXPECT_NE(write.error().message.find("writing LAZ is not supported; write .las"), std::string::npos);
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+TEST(PointIoLas, lasFieldsAskedOfOtherFormatsAreErrorsNamingTheFile) {
+  TempDir dir;
+  writeFile(dir.file("a.csv"), "x,y,z\n1,2,3\n");
+  ReadOptions read;
+  read.las_color = LasColorSource::kIntensity;
+  Result<PointSet> csv = readPoints(dir.file("a.csv"), read);
+  ASSERT_FALSE(csv.ok());
+  EXPECT_EQ(csv.error().message,
+            dir.file("a.csv") + ": colour by intensity needs a LAS file; this file has no such field");
+  read.las_color = LasColorSource::kClassification;
+  EXPECT_FALSE(readPoints(dir.file("a.csv"), read).ok());
+  read.las_color = LasColorSource::kRgb;
+  csv = readPoints(dir.file("a.csv"), read);
+  ASSERT_FALSE(csv.ok());
+  EXPECT_EQ(csv.error().message, dir.file("a.csv") + ": colour by RGB asked for, but the file has no colours");
+}
+
+TEST(PointIoLas, noneDropsColoursOfAnyFormat) {
+  TempDir dir;
+  writeFile(dir.file("c.csv"), "x,y,z,r,g,b\n1,2,3,0.5,0.5,0.5\n");
+  ReadOptions read;
+  read.las_color = LasColorSource::kNone;
+  for (const std::string& path : {dir.file("c.csv"), kCorpus + "simple.las"}) {
+    Result<PointSet> points = readPoints(path, read);
+    ASSERT_TRUE(points.ok()) << points.error().message;
+    EXPECT_FALSE(points->hasColors()) << path;
+  }
+}
+
+TEST(PointIoLas, writePointsStoresLasAtTheAskedScale) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0.5, 0.25, 0.125}, {2, 3, 4}};
+  WriteOptions write;
+  write.las_scale = 0.125;
+  ASSERT_TRUE(writePoints(dir.file("s.las"), set, write).ok());
+  Result<LasHeader> header = readLasHeader(dir.file("s.las"));
+  ASSERT_TRUE(header.ok()) << header.error().message;
+  EXPECT_EQ(header->scale, glm::dvec3(0.125));
+  Result<PointSet> back = readPoints(dir.file("s.las"));
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->positions, set.positions);
+}
+
+}  // namespace
+}  // namespace dpoint

@@ -1,0 +1,273 @@
+// Escape counts on the Vulkan device (generators/gpu_generate.h) equal the CPU's bit for bit: the
+// exact fp64 square root and reciprocal, the Julia and fast Mandelbulb grids at small odd and even
+// resolutions, the meshes made from them, and mandelbrot2d's perturbation counts at every depth.
+// On lavapipe here, with the validation layer on (any message fails the test).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+
+#include "generators/julia.h"
+#include "generators/mandelbrot2d.h"
+#include "generators/mandelbulb.h"
+#include "vulkan/buffers.h"
+#include "generators/gpu_generate.h"
+#include "vulkan/shader.h"
+
+#include "shaders/exact_fp64_test.comp.h"
+
+namespace dpoint {
+namespace {
+
+class GpuGenerate : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    Result<std::unique_ptr<VulkanContext>> created = VulkanContext::create(ContextOptions{"auto", true});
+    if (!created) {
+      setup_error_ = created.error().message;
+      return;
+    }
+    context_ = std::move(*created);
+    Result<std::unique_ptr<GpuEscape>> gpu = GpuEscape::create(*context_);
+    if (gpu) gpu_ = std::move(*gpu);
+    else setup_error_ = gpu.error().message;
+  }
+  static void TearDownTestSuite() {
+    gpu_.reset();
+    context_.reset();
+  }
+  void SetUp() override {
+    ASSERT_TRUE(gpu_) << setup_error_;
+    context_->clearValidationMessages();
+  }
+  void TearDown() override {
+    if (!context_) return;
+    for (const std::string& m : context_->validationMessages()) ADD_FAILURE() << m;
+  }
+
+  static EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis) {
+    std::vector<double> values(static_cast<size_t>(axis.resolution));
+    for (int i = 0; i < axis.resolution; ++i) values[static_cast<size_t>(i)] = axis.value(i);
+    return [kernel, values](int first, int count, int limit, uint32_t* counts) {
+      return gpu_->escapePlanes(kernel, values, first, count, limit, counts);
+    };
+  }
+  static EscapeKernelParams julia(const glm::dvec4& c) {
+    return {EscapeKernel::kJulia, c, kJuliaEscapeSquare, 0.0};
+  }
+  static EscapeKernelParams mandelbulb() {
+    return {EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2};
+  }
+
+  // The device's planes [first, first + count) against computeEscapeGrid's.
+  static void expectSameGrid(const EscapeKernelParams& kernel, const EscapeRowFunction& row, const GridAxis& axis,
+                             int limit, int first, int count) {
+    SCOPED_TRACE("res " + std::to_string(axis.resolution) + ", limit " + std::to_string(limit) + ", planes " +
+                 std::to_string(first) + "+" + std::to_string(count));
+    Result<std::vector<uint32_t>> cpu = computeEscapeGrid(axis, limit, row, 0, first, count);
+    ASSERT_TRUE(cpu.ok());
+    std::vector<uint32_t> gpu(cpu->size(), 0xdeadbeef);
+    Status s = planes(kernel, axis)(first, count, limit, gpu.data());
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    size_t differ = 0;
+    for (size_t i = 0; i < gpu.size(); ++i) differ += gpu[i] != (*cpu)[i];
+    EXPECT_EQ(differ, 0u) << "of " << gpu.size();
+  }
+
+  static inline std::unique_ptr<VulkanContext> context_;
+  static inline std::unique_ptr<GpuEscape> gpu_;
+  static inline std::string setup_error_;
+};
+
+// Runs shaders/generate/exact_fp64_test.comp on `inputs`: (sqrtRn, recipRn) of each, the first guesses moved
+// `skew` ulps.
+std::vector<double> runExactShader(const VulkanContext& context, const std::vector<double>& inputs, int32_t skew) {
+  const size_t n = inputs.size();
+  const VkDeviceSize bytes = 3 * n * sizeof(double);
+  Result<Buffer> data = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "test data");
+  EXPECT_TRUE(data.ok());
+  if (!data) return {};
+  std::memcpy(data->mapped, inputs.data(), n * sizeof(double));
+  VkMappedMemoryRange range = {VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+  range.memory = data->memory;
+  range.size = VK_WHOLE_SIZE;
+  if (!data->coherent) vkFlushMappedMemoryRanges(context.device, 1, &range);
+  VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  Result<VkDescriptorSetLayout> set_layout = storageSetLayout(context, {binding});
+  Result<VkPipelineLayout> layout = pipelineLayout(context, *set_layout, sizeof(uint32_t), VK_SHADER_STAGE_COMPUTE_BIT);
+  Result<VkShaderModule> module = createShaderModule(context, kExactFp64TestComp, sizeof(kExactFp64TestComp));
+  EXPECT_TRUE(set_layout.ok() && layout.ok() && module.ok());
+  VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = *module;
+  info.stage.pName = "main";
+  const VkSpecializationMapEntry entry{0, 0, sizeof skew};
+  const VkSpecializationInfo specialization{1, &entry, sizeof skew, &skew};
+  info.stage.pSpecializationInfo = &specialization;
+  info.layout = *layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  EXPECT_EQ(vkCreateComputePipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline), VK_SUCCESS);
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
+  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &pool_size;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  EXPECT_EQ(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &pool), VK_SUCCESS);
+  VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  allocate.descriptorPool = pool;
+  allocate.descriptorSetCount = 1;
+  allocate.pSetLayouts = &*set_layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  EXPECT_EQ(vkAllocateDescriptorSets(context.device, &allocate, &set), VK_SUCCESS);
+  VkDescriptorBufferInfo buffer_info{data->buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet write = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  write.dstSet = set;
+  write.descriptorCount = 1;
+  write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  write.pBufferInfo = &buffer_info;
+  vkUpdateDescriptorSets(context.device, 1, &write, 0, nullptr);
+  const uint32_t count = static_cast<uint32_t>(n);
+  Status run = submitOnce(context, [&](VkCommandBuffer commands) {
+    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, *layout, 0, 1, &set, 0, nullptr);
+    vkCmdPushConstants(commands, *layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof count, &count);
+    vkCmdDispatch(commands, (count + 63) / 64, 1, 1);
+    VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
+                         nullptr, 0, nullptr);
+  });
+  EXPECT_TRUE(run.ok());
+  EXPECT_TRUE(invalidateBuffer(context, *data).ok());
+  std::vector<double> out(2 * n);
+  std::memcpy(out.data(), static_cast<const double*>(data->mapped) + n, 2 * n * sizeof(double));
+  vkDestroyDescriptorPool(context.device, pool, nullptr);
+  vkDestroyPipeline(context.device, pipeline, nullptr);
+  vkDestroyShaderModule(context.device, *module, nullptr);
+  vkDestroyPipelineLayout(context.device, *layout, nullptr);
+  vkDestroyDescriptorSetLayout(context.device, *set_layout, nullptr);
+  destroyBuffer(context, *data);
+  return out;
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST_F(GpuGenerate, exactSquareRootAndReciprocalEqualTheCpus) {
+  std::mt19937_64 random(14);
+  std::uniform_real_distribution<double> unit(1.0, 2.0);
+  std::uniform_int_distribution<int> exponent(-1000, 1000);
+  std::vector<double> inputs = {1.0, 2.0, 4.0, 0.25, 3.0, 0.5, 1e-60, 1e-240, 256.0, std::nextafter(4.0, 8.0),
+                                std::nextafter(1.0, 0.0), std::nextafter(1.0, 2.0), std::nextafter(2.0, 0.0)};
+  for (int i = 0; i < 20000; ++i) inputs.push_back(std::ldexp(unit(random), exponent(random)));
+  // Near-ties: squares and reciprocals of the midpoints between neighbouring doubles, and their
+  // neighbours, where a result off by one ulp would show.
+  for (int i = 0; i < 20000; ++i) {
+    const double r = unit(random);
+    const long double mid = static_cast<long double>(r) + 0x1p-53L;
+    const double square = static_cast<double>(mid * mid), inverse = static_cast<double>(1.0L / mid);
+    for (double x : {square, inverse})
+      for (double d : {std::nextafter(x, 0.0), x, std::nextafter(x, 8.0)}) inputs.push_back(d);
+  }
+  for (int32_t skew : {0, 1, 4, 40}) {  // lavapipe's own guesses are already right: skewed ones are not
+    SCOPED_TRACE("guesses " + std::to_string(skew) + " ulps off");
+    const std::vector<double> out = runExactShader(*context_, inputs, skew);
+    ASSERT_EQ(out.size(), 2 * inputs.size());
+    size_t sqrt_differ = 0, recip_differ = 0;
+    for (size_t i = 0; i < inputs.size(); ++i) {
+      const double x = inputs[i];
+      if (!sameBits(out[2 * i], std::sqrt(x)) && sqrt_differ++ < 5)
+        ADD_FAILURE() << "sqrt(" << x << "): " << out[2 * i] << " vs " << std::sqrt(x);
+      if (!sameBits(out[2 * i + 1], 1.0 / x) && recip_differ++ < 5)
+        ADD_FAILURE() << "1/" << x << ": " << out[2 * i + 1] << " vs " << 1.0 / x;
+    }
+    EXPECT_EQ(sqrt_differ, 0u);
+    EXPECT_EQ(recip_differ, 0u);
+  }
+}
+
+TEST_F(GpuGenerate, juliaGridEqualsTheCpusAtOddAndEvenResolutions) {
+  const glm::dvec4 c(-0.7, 0.27015, 0.27015, 0.0);
+  for (int res : {17, 31, 40}) {
+    const GridAxis axis{res, -1.5, 1.5};
+    expectSameGrid(julia(c), juliaRow(c), axis, 200, 0, res);
+    expectSameGrid(julia(c), juliaRow(c), axis, 51, 3, 5);  // the classification cap, some planes
+  }
+  const glm::dvec4 other(0.3, -0.5, 0.1, 0.2);
+  expectSameGrid(julia(other), juliaRow(other), GridAxis{23, -1.2, 1.3}, 300, 0, 23);
+}
+
+TEST_F(GpuGenerate, fastMandelbulbGridEqualsTheCpusAtOddAndEvenResolutions) {
+  const EscapeRowFunction row = mandelbulbRow(MandelbulbVariant::kFast, 8.0);
+  for (int res : {21, 33, 40}) {  // odd: the origin and the polar axis are sampled
+    const GridAxis axis{res, -1.5, 1.5};
+    expectSameGrid(mandelbulb(), row, axis, 100, 0, res);
+    expectSameGrid(mandelbulb(), row, axis, 26, 5, 7);
+  }
+  expectSameGrid(mandelbulb(), row, GridAxis{25, -0.4, 0.6}, 400, 0, 25);
+}
+
+TEST_F(GpuGenerate, meshesFromDevicePlanesEqualTheCpuMeshes) {
+  MandelbulbParams bulb;
+  bulb.resolution = 45;
+  bulb.variant = MandelbulbVariant::kFast;
+  Result<PointSet> cpu = generateMandelbulb(bulb);
+  bulb.planes = planes(mandelbulb(), GridAxis{45, -1.5, 1.5});
+  Result<PointSet> gpu = generateMandelbulb(bulb);
+  ASSERT_TRUE(cpu.ok() && gpu.ok()) << (gpu.ok() ? "" : gpu.error().message);
+  ASSERT_EQ(cpu->size(), gpu->size());
+  EXPECT_EQ(std::memcmp(cpu->positions.data(), gpu->positions.data(), cpu->size() * sizeof(glm::dvec3)), 0);
+  EXPECT_TRUE(cpu->triangles == gpu->triangles);
+
+  JuliaParams julia_params;
+  julia_params.resolution = 38;
+  Result<PointSet> julia_cpu = generateJulia(julia_params);
+  julia_params.planes = planes(julia(julia_params.c), GridAxis{38, -1.5, 1.5});
+  Result<PointTile> tile = generateJuliaTile(julia_params, {1, 3});
+  JuliaParams on_cpu;
+  on_cpu.resolution = 38;
+  Result<PointTile> tile_cpu = generateJuliaTile(on_cpu, {1, 3});
+  ASSERT_TRUE(julia_cpu.ok() && tile.ok() && tile_cpu.ok());
+  EXPECT_EQ(std::memcmp(tile->points.positions.data(), tile_cpu->points.positions.data(),
+                        tile->points.size() * sizeof(glm::dvec3)),
+            0);
+  EXPECT_TRUE(tile->points.triangles == tile_cpu->points.triangles);
+
+  bulb.variant = MandelbulbVariant::kSeed;  // libm's trigonometry: no device form
+  Result<PointSet> refused = generateMandelbulb(bulb);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, ExitCode::kUsage);
+  EXPECT_NE(refused.error().message.find("--variant seed runs on the CPU only"), std::string::npos);
+}
+
+TEST_F(GpuGenerate, mandelbrot2dPerturbationCountsEqualTheCpusAtEveryDepth) {
+  for (double width : {3.0, 1e-3, 1e-6, 1e-9, 1e-12}) {
+    for (int res : {31, 32}) {
+      SCOPED_TRACE("width " + std::to_string(width) + ", res " + std::to_string(res));
+      Mandelbrot2dParams params;
+      params.width = width;
+      params.resolution = res;
+      params.max_iter = 1500;
+      Result<std::vector<uint32_t>> cpu = mandelbrot2dCounts(params);
+      params.perturbation = [](const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
+                               const std::vector<double>& dcy, int max_iter, uint32_t* counts) {
+        return gpu_->perturbation(orbit, dcx, dcy, max_iter, counts);
+      };
+      Result<std::vector<uint32_t>> gpu = mandelbrot2dCounts(params);
+      ASSERT_TRUE(cpu.ok() && gpu.ok()) << (gpu.ok() ? "" : gpu.error().message);
+      EXPECT_TRUE(*cpu == *gpu);
+      Result<PointTile> tile = generateMandelbrot2dTile(params, {2, 5});
+      ASSERT_TRUE(tile.ok());
+      const size_t first = static_cast<size_t>(2 * res / 5) * static_cast<size_t>(res);
+      for (size_t i = 0; i < tile->points.size(); ++i)
+        ASSERT_EQ(tile->points.colors[i], mandelbrot2dColor((*cpu)[first + i], params.max_iter)) << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dpoint

@@ -1,0 +1,135 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "ops/info.h"
+
+namespace dpoint {
+namespace {
+
+TEST(Info, boundsExtentAndFloatSpacing) {
+  PointSet s;
+  s.positions = {{-1, 2, 3}, {4, -5, 0.5}, {0, 0, -6378137.0}};
+  const PointSetInfo i = computeInfo(s);
+  EXPECT_EQ(i.count, 3u);
+  EXPECT_EQ(i.min, glm::dvec3(-1, -5, -6378137.0));
+  EXPECT_EQ(i.max, glm::dvec3(4, 2, 3));
+  EXPECT_EQ(i.extent, glm::dvec3(5, 7, 6378140.0));
+  EXPECT_EQ(i.max_abs, 6378137.0);
+  EXPECT_EQ(i.float_spacing, 0.5);  // floats in [2^22, 2^23) are 0.5 apart
+  EXPECT_TRUE(i.floatRepresents());
+}
+
+TEST(Info, detectsPointsThatFloatMerges) {
+  // Millimetre spacing at the Earth's radius: float32 steps there are 0.5 m.
+  PointSet s;
+  for (int k = 0; k < 100; ++k) s.positions.emplace_back(6.378e6 + 0.001 * k, 0.0, 0.0);
+  s.positions.emplace_back(6.378e6, 0.0, 0.0);  // an exact duplicate is not a merge
+  const PointSetInfo i = computeInfo(s);
+  EXPECT_FALSE(i.floatRepresents());
+  EXPECT_GE(i.float_merged, 90u);
+  EXPECT_NEAR(i.min_neighbor_distance, 0.001, 1e-9);
+  // The same cloud near the origin is fine in float.
+  for (glm::dvec3& p : s.positions) p.x -= 6.378e6;
+  EXPECT_TRUE(computeInfo(s).floatRepresents());
+}
+
+TEST(Info, nearestNeighbourSkipsDuplicatesAndFindsTinySpacing) {
+  PointSet s;
+  for (int k = 0; k < 5000; ++k) s.positions.emplace_back(std::cos(k) * 10.0, std::sin(k) * 10.0, k * 1e-3);
+  s.positions.push_back(s.positions[0]);  // a duplicate: distance 0 does not count
+  s.positions.emplace_back(0.0, 0.0, 0.0);
+  s.positions.emplace_back(1e-40, 0.0, 0.0);  // float32 has no normal number this small
+  const PointSetInfo i = computeInfo(s, s.size());
+  EXPECT_EQ(i.min_neighbor_distance, 1e-40);
+}
+
+TEST(Info, overflowBeyondFloatRange) {
+  PointSet s;
+  s.positions = {{1e39, 0, 0}, {0, 0, 0}};
+  const PointSetInfo i = computeInfo(s);
+  EXPECT_EQ(i.float_overflow, 1u);
+  EXPECT_FALSE(i.floatRepresents());
+  EXPECT_TRUE(std::isinf(i.float_spacing));
+}
+
+// A set read a block at a time (info --stream) gives computeInfo's facts: bounds, overflow and the
+// sampled nearest neighbour, whose nearest point may lie in another block; blocks of 7 points and
+// samples that do not divide the count test the sample's indices across block edges.
+TEST(Info, streamedInfoEqualsTheWholeSetsWhateverTheBlocks) {
+  PointSet s;
+  for (int k = 0; k < 1000; ++k) s.positions.emplace_back(std::cos(k) * 1e3, std::sin(k) * 1e3, 6.378e6 + k * 0.25);
+  s.positions.emplace_back(s.positions[10].x + 1e-6, s.positions[10].y, s.positions[10].z);  // a close pair
+  s.positions.emplace_back(1e39, 0.0, 0.0);
+  for (size_t sample : {size_t{1}, size_t{7}, size_t{333}, size_t{5000}}) {
+    for (uint64_t block : {uint64_t{1}, uint64_t{7}, uint64_t{1002}, uint64_t{4096}}) {
+      SCOPED_TRACE(std::to_string(sample) + " sampled, blocks of " + std::to_string(block));
+      const PointSetInfo whole = computeInfo(s, sample);
+      uint64_t reads = 0;
+      const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+        ++reads;
+        out.positions.assign(s.positions.begin() + static_cast<long>(first),
+                             s.positions.begin() + static_cast<long>(first + n));
+        return okStatus();
+      };
+      Result<StreamedInfo> streamed = computeStreamedInfo(s.size(), false, 0, read, block, sample);
+      ASSERT_TRUE(streamed.ok());
+      const PointSetInfo& i = streamed->info;
+      EXPECT_FALSE(streamed->merged_computed);
+      EXPECT_EQ(i.count, whole.count);
+      EXPECT_EQ(i.min, whole.min);
+      EXPECT_EQ(i.max, whole.max);
+      EXPECT_EQ(i.max_abs, whole.max_abs);
+      EXPECT_EQ(i.float_overflow, whole.float_overflow);
+      EXPECT_EQ(i.neighbor_sample, whole.neighbor_sample);
+      EXPECT_EQ(i.min_neighbor_distance, whole.min_neighbor_distance);
+      // Every block once, then again only those near another block's samples.
+      const uint64_t blocks = (s.size() + block - 1) / block;
+      EXPECT_GE(reads, blocks);
+      EXPECT_LE(reads, 2 * blocks);
+    }
+  }
+  // A read error ends it.
+  const BlockReader failing = [](uint64_t, uint64_t, PointSet&) -> Status { return Error{"x.ply: truncated"}; };
+  Result<StreamedInfo> failed = computeStreamedInfo(10, false, 0, failing, 4);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().message, "x.ply: truncated");
+}
+
+// Non-finite points (read with --allow-nonfinite) take no part in the nearest distance, whole or
+// streamed, and do not upset the trees' ordering.
+TEST(Info, nonFinitePointsAreLeftOutOfTheNearestDistance) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  PointSet s;
+  for (int k = 0; k < 300; ++k) {
+    s.positions.emplace_back(k * 2.0, 0.0, 0.0);
+    if (k % 7 == 0) s.positions.emplace_back(nan, k, 0.0);
+    if (k % 11 == 0) s.positions.emplace_back(0.0, -inf, k);
+  }
+  s.positions.emplace_back(101.5, 0.0, 0.0);  // 1.5 from 100, 0.5 from 102
+  const PointSetInfo whole = computeInfo(s, s.size());
+  EXPECT_EQ(whole.min_neighbor_distance, 0.5);
+  EXPECT_EQ(whole.float_merged, 0u);
+  const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+    out.positions.assign(s.positions.begin() + static_cast<long>(first), s.positions.begin() + static_cast<long>(first + n));
+    return okStatus();
+  };
+  Result<StreamedInfo> streamed = computeStreamedInfo(s.size(), false, 0, read, 13, s.size());
+  ASSERT_TRUE(streamed.ok());
+  EXPECT_EQ(streamed->info.min_neighbor_distance, 0.5);
+  // Without infinities the float32 merge count runs, over the finite points: 1 + 1e-12 merges.
+  PointSet merged;
+  for (int k = 0; k < 50; ++k) merged.positions.emplace_back(k % 5 == 0 ? nan : k, 0.0, 0.0);
+  merged.positions.emplace_back(1.0 + 1e-12, 0.0, 0.0);
+  EXPECT_EQ(computeInfo(merged).float_merged, 1u);
+}
+
+TEST(Info, emptySetHasZeroCount) {
+  const PointSetInfo i = computeInfo(PointSet{});
+  EXPECT_EQ(i.count, 0u);
+  EXPECT_EQ(i.neighbor_sample, 0u);
+}
+
+}  // namespace
+}  // namespace dpoint

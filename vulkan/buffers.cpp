@@ -1,0 +1,312 @@
+#include "vulkan/buffers.h"
+
+#include <algorithm>
+
+#include "core/memory.h"
+#include "core/parallel.h"
+
+namespace dpoint {
+
+namespace {
+
+// A buffer of `size` bytes bound to memory of the type `pick` chooses from the buffer's allowed
+// types (mapped for the buffer's life when host-visible).
+Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                              const std::string& what,
+                              const std::function<Result<uint32_t>(const VkMemoryRequirements&)>& pick) {
+  assert(size > 0);
+  Buffer out;
+  out.size = size;
+  VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkResult result = vkCreateBuffer(context.device, &info, nullptr, &out.buffer);
+  if (result != VK_SUCCESS) return vulkanError("vkCreateBuffer (" + what + ", " + formatBytes(size) + ")", result);
+  VkMemoryRequirements needs{};
+  vkGetBufferMemoryRequirements(context.device, out.buffer, &needs);
+  Result<uint32_t> type = pick(needs);
+  if (!type) {
+    vkDestroyBuffer(context.device, out.buffer, nullptr);
+    return type.error();
+  }
+  if (Status budget = reserveDeviceMemory(context, needs.size, what); !budget) {
+    vkDestroyBuffer(context.device, out.buffer, nullptr);
+    return budget.error();
+  }
+  out.allocated = needs.size;
+  VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  allocate.allocationSize = needs.size;
+  allocate.memoryTypeIndex = *type;
+  result = vkAllocateMemory(context.device, &allocate, nullptr, &out.memory);
+  if (result == VK_SUCCESS) result = vkBindBufferMemory(context.device, out.buffer, out.memory, 0);
+  VkMemoryPropertyFlags flags = context.memory.memoryTypes[*type].propertyFlags;
+  if (result == VK_SUCCESS && (flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+    out.coherent = (flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    result = vkMapMemory(context.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+  }
+  if (result != VK_SUCCESS) {
+    destroyBuffer(context, out);
+    return vulkanError("allocating " + formatBytes(size) + " for " + what, result);
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                            bool host_visible, const std::string& what) {
+  return allocateBuffer(context, size, usage, what, [&](const VkMemoryRequirements& needs) {
+    return host_visible
+        ? context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+        : context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  });
+}
+
+Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                                  const std::string& what) {
+  // Device-local memory the host can write (resizable BAR, unified memory, lavapipe) saves the
+  // staging copy, but only where its heap holds the buffer with room to spare: the small 256 MiB
+  // BAR window of a discrete GPU without resizable BAR is left to the driver.
+  Result<Buffer> direct = allocateBuffer(context, size, usage, what, [&](const VkMemoryRequirements& needs) -> Result<uint32_t> {
+    constexpr VkMemoryPropertyFlags kWanted = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
+    for (uint32_t i = 0; i < context.memory.memoryTypeCount; ++i) {
+      const VkMemoryType& type = context.memory.memoryTypes[i];
+      if (!(needs.memoryTypeBits & (1u << i)) || (type.propertyFlags & kWanted) != kWanted) continue;
+      if (context.memory.memoryHeaps[type.heapIndex].size / 4 >= needs.size) return i;
+    }
+    return Error{"no large host-visible device-local heap", ExitCode::kNoDevice};
+  });
+  if (direct) return direct;
+  return createBuffer(context, size, usage, false, what);
+}
+
+void destroyBuffer(const VulkanContext& context, Buffer& buffer) {
+  if (buffer.buffer) vkDestroyBuffer(context.device, buffer.buffer, nullptr);
+  if (buffer.memory) vkFreeMemory(context.device, buffer.memory, nullptr);  // unmaps too
+  releaseDeviceMemory(context, buffer.allocated);
+  buffer = Buffer{};
+}
+
+Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, const std::string& what) {
+  const uint64_t used = context.device_memory_used.fetch_add(bytes) + bytes;
+  if (context.device_memory_budget == 0 || used <= context.device_memory_budget) return okStatus();
+  context.device_memory_used.fetch_sub(bytes);
+  return Error{"device memory: " + what + " needs " + formatBytes(bytes) + " more, " + formatBytes(used) +
+                   " in all, above the budget of " + formatBytes(context.device_memory_budget) +
+                   " (--max-device-memory); try a smaller set, size or --mode with fewer bytes a point",
+               ExitCode::kNoDevice};  // a Vulkan fault like a lost device (issue #12): exit 3
+}
+
+void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes) { context.device_memory_used.fetch_sub(bytes); }
+
+VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence) {
+  if (vulkanFaults().device_lost || context.injected_loss) return VK_ERROR_DEVICE_LOST;
+  return vkQueueSubmit(context.queue, 1, &submit, fence);
+}
+
+VkResult waitForFence(const VulkanContext& context, VkFence fence) {
+  const VkResult result = vkWaitForFences(context.device, 1, &fence, VK_TRUE, UINT64_MAX);
+  if (result != VK_SUCCESS || !vulkanFaults().device_lost_wait) return result;
+  context.injected_loss = true;
+  return VK_ERROR_DEVICE_LOST;
+}
+
+// Host caches and device memory agree already for coherent memory; otherwise one range call.
+static Status syncMapped(const VulkanContext& context, const Buffer& buffer, bool device_to_host) {
+  if (buffer.coherent || !buffer.mapped) return okStatus();
+  VkMappedMemoryRange range = {VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+  range.memory = buffer.memory;
+  range.size = VK_WHOLE_SIZE;
+  if (device_to_host) VK_TRY(vkInvalidateMappedMemoryRanges(context.device, 1, &range));
+  else VK_TRY(vkFlushMappedMemoryRanges(context.device, 1, &range));
+  return okStatus();
+}
+
+Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, true); }
+static Status flushBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, false); }
+
+Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context) {
+  VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  allocate.commandPool = context.command_pool;
+  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  allocate.commandBufferCount = 1;
+  VkCommandBuffer commands = VK_NULL_HANDLE;
+  VK_TRY(vkAllocateCommandBuffers(context.device, &allocate, &commands));
+  return commands;
+}
+
+Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record) {
+  Result<VkCommandBuffer> allocated = allocateCommandBuffer(context);
+  if (!allocated) return allocated.error();
+  VkCommandBuffer commands = *allocated;
+  VkFence fence = VK_NULL_HANDLE;
+  auto cleanup = [&]() {
+    if (fence) vkDestroyFence(context.device, fence, nullptr);
+    vkFreeCommandBuffers(context.device, context.command_pool, 1, &commands);
+  };
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VkResult result = vkBeginCommandBuffer(commands, &begin);
+  if (result == VK_SUCCESS) {
+    record(commands);
+    result = vkEndCommandBuffer(commands);
+  }
+  VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  if (result == VK_SUCCESS) result = vkCreateFence(context.device, &fence_info, nullptr, &fence);
+  if (result == VK_SUCCESS) {
+    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &commands;
+    result = queueSubmit(context, submit, fence);
+  }
+  if (result == VK_SUCCESS) result = waitForFence(context, fence);
+  cleanup();
+  if (result != VK_SUCCESS) return vulkanError("one-shot command submission", result);
+  return okStatus();
+}
+
+namespace {
+
+// Calls fill on pieces of [offset, offset + bytes) from every core, each piece a multiple of
+// `grain` (the last one excepted) and about 1 MiB: the pieces are disjoint, so the bytes written
+// do not depend on the thread count.
+void fillInParallel(const UploadFill& fill, void* dst, VkDeviceSize offset, VkDeviceSize bytes, VkDeviceSize grain) {
+  const VkDeviceSize piece = std::max<VkDeviceSize>(grain, (VkDeviceSize{1} << 20) / grain * grain);
+  const size_t pieces = static_cast<size_t>((bytes + piece - 1) / piece);
+  parallelFor(pieces, pieces == 1 ? 1 : 0, [&](size_t k, unsigned) {
+    const VkDeviceSize at = k * piece;
+    fill(static_cast<uint8_t*>(dst) + at, offset + at, std::min(piece, bytes - at));
+  });
+}
+
+}  // namespace
+
+Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
+                    VkDeviceSize grain, VkDeviceSize staging_limit, VkDeviceSize at) {
+  assert(at <= target.size && size <= target.size - at && grain > 0);
+  if (target.mapped) {
+    fillInParallel(fill, static_cast<uint8_t*>(target.mapped) + at, 0, size, grain);
+    return flushBuffer(context, target);
+  }
+  // Two staging buffers: the cores fill one while the GPU copies out of the other.
+  const VkDeviceSize piece = std::min(size, std::max(grain, staging_limit / grain * grain));
+  const size_t slots = size > piece ? 2 : 1;
+  struct Slot {
+    Buffer staging;
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    bool busy = false;
+  };
+  std::vector<Slot> slot(slots);
+  auto cleanup = [&]() {
+    for (Slot& s : slot) {
+      if (s.busy) waitForFence(context, s.fence);
+      if (s.fence) vkDestroyFence(context.device, s.fence, nullptr);
+      if (s.commands) vkFreeCommandBuffers(context.device, context.command_pool, 1, &s.commands);
+      destroyBuffer(context, s.staging);
+    }
+  };
+  auto run = [&]() -> Status {
+    for (Slot& s : slot) {
+      Result<Buffer> staging = createBuffer(context, piece, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "staging");
+      if (!staging) return staging.error();
+      s.staging = *staging;
+      Result<VkCommandBuffer> commands = allocateCommandBuffer(context);
+      if (!commands) return commands.error();
+      s.commands = *commands;
+      VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+      VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &s.fence));
+    }
+    size_t k = 0;
+    for (VkDeviceSize offset = 0; offset < size; offset += piece, ++k) {
+      Slot& s = slot[k % slots];
+      if (s.busy) {
+        VK_TRY(waitForFence(context, s.fence));
+        VK_TRY(vkResetFences(context.device, 1, &s.fence));
+        s.busy = false;
+      }
+      const VkDeviceSize bytes = std::min(piece, size - offset);
+      fillInParallel(fill, s.staging.mapped, offset, bytes, grain);
+      if (Status status = flushBuffer(context, s.staging); !status) return status;
+      VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+      begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+      VK_TRY(vkBeginCommandBuffer(s.commands, &begin));
+      VkBufferCopy copy{0, at + offset, bytes};
+      vkCmdCopyBuffer(s.commands, s.staging.buffer, target.buffer, 1, &copy);
+      VK_TRY(vkEndCommandBuffer(s.commands));
+      VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+      submit.commandBufferCount = 1;
+      submit.pCommandBuffers = &s.commands;
+      VK_TRY(queueSubmit(context, submit, s.fence));
+      s.busy = true;
+    }
+    for (Slot& s : slot) {
+      if (!s.busy) continue;
+      VK_TRY(waitForFence(context, s.fence));
+      s.busy = false;
+    }
+    return okStatus();
+  };
+  Status status = run();
+  cleanup();
+  return status;
+}
+
+Result<GpuImage> createImage(const VulkanContext& context, uint32_t width, uint32_t height, VkFormat format,
+                             VkImageUsageFlags usage, VkImageAspectFlags aspect) {
+  GpuImage out;
+  VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = VK_IMAGE_TYPE_2D;
+  info.format = format;
+  info.extent = {width, height, 1};
+  info.mipLevels = 1;
+  info.arrayLayers = 1;
+  info.samples = VK_SAMPLE_COUNT_1_BIT;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = usage;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VK_TRY(vkCreateImage(context.device, &info, nullptr, &out.image));
+  VkMemoryRequirements needs{};
+  vkGetImageMemoryRequirements(context.device, out.image, &needs);
+  Result<uint32_t> type = context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  if (!type) {
+    destroyImage(context, out);
+    return type.error();
+  }
+  if (Status budget = reserveDeviceMemory(context, needs.size, std::to_string(width) + "x" + std::to_string(height) +
+                                                                   " image");
+      !budget) {
+    destroyImage(context, out);
+    return budget.error();
+  }
+  out.allocated = needs.size;
+  VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  allocate.allocationSize = needs.size;
+  allocate.memoryTypeIndex = *type;
+  VkResult result = vkAllocateMemory(context.device, &allocate, nullptr, &out.memory);
+  if (result == VK_SUCCESS) result = vkBindImageMemory(context.device, out.image, out.memory, 0);
+  if (result == VK_SUCCESS) {
+    VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    view.image = out.image;
+    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.format = format;
+    view.subresourceRange = {aspect, 0, 1, 0, 1};
+    result = vkCreateImageView(context.device, &view, nullptr, &out.view);
+  }
+  if (result != VK_SUCCESS) {
+    destroyImage(context, out);
+    return vulkanError("creating a " + std::to_string(width) + "x" + std::to_string(height) + " image", result);
+  }
+  return out;
+}
+
+void destroyImage(const VulkanContext& context, GpuImage& image) {
+  if (image.view) vkDestroyImageView(context.device, image.view, nullptr);
+  if (image.image) vkDestroyImage(context.device, image.image, nullptr);
+  if (image.memory) vkFreeMemory(context.device, image.memory, nullptr);
+  releaseDeviceMemory(context, image.allocated);
+  image = GpuImage{};
+}
+
+}  // namespace dpoint

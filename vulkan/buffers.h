@@ -1,0 +1,79 @@
+// Buffers and images as plain structs with create/destroy pairs (one allocation each: a render
+// holds a handful of them, so a sub-allocator would buy nothing), and one-shot command submission.
+#pragma once
+
+#include <functional>
+
+#include "vulkan/context.h"
+
+namespace dpoint {
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  VkDeviceSize allocated = 0;  // counted in the context's device_memory_used
+  void* mapped = nullptr;  // set when the memory is host-visible (mapped for the buffer's life)
+  bool coherent = false;
+};
+
+// Device-local when `host_visible` is false (filled through uploadBuffer), else host-visible
+// and mapped (cached preferred, for readback). Fails naming `what` and the size.
+Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                            bool host_visible, const std::string& what);
+void destroyBuffer(const VulkanContext& context, Buffer& buffer);
+
+// Makes device writes visible to the host for a mapped, non-coherent buffer.
+Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
+
+// vkQueueSubmit on the context's queue, or VK_ERROR_DEVICE_LOST without submitting under the
+// device-lost test switch (vulkanFaults) or once device-lost-wait has fired: every submission
+// goes through here.
+VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence);
+
+// vkWaitForFences on one fence, without a timeout. Under the device-lost-wait test switch the wait
+// still happens (so no work is in flight when the caller frees what it used) and then reports
+// VK_ERROR_DEVICE_LOST, and so does every later wait and submission: every fence wait goes
+// through here.
+VkResult waitForFence(const VulkanContext& context, VkFence fence);
+
+// Counts `bytes` of device memory against the context's budget (--max-device-memory) before they
+// are allocated: fails with kResourceLimit naming `what`, the size and the budget when they do
+// not fit. releaseDeviceMemory gives them back.
+Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, const std::string& what);
+void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes);
+
+// A primary command buffer from the context's pool (the caller frees it).
+Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context);
+
+// Records with `record` into a fresh primary command buffer, submits it, waits.
+Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record);
+
+// Device-local memory for data the host uploads once: host-visible too (mapped, written in place)
+// where the device has such a heap large enough, else plain device-local (filled via staging).
+Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                                  const std::string& what);
+
+// fill(dst, offset, bytes) writes bytes [offset, offset + bytes) of a buffer's contents to dst.
+// uploadBuffer calls it from several threads at once on disjoint pieces.
+using UploadFill = std::function<void(void* dst, VkDeviceSize offset, VkDeviceSize bytes)>;
+
+// Fills `size` bytes of `target` from byte `at` on (usage must include TRANSFER_DST) through
+// `fill`, whose offsets count from `at`, on every core, in pieces that are multiples of `grain`
+// bytes (a whole element): into mapped memory directly when the target is host-visible, else
+// through two staging buffers of at most `staging_limit` bytes, one filled while the GPU copies
+// out of the other.
+Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
+                    VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20, VkDeviceSize at = 0);
+
+struct GpuImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkDeviceSize allocated = 0;  // counted in the context's device_memory_used
+};
+Result<GpuImage> createImage(const VulkanContext& context, uint32_t width, uint32_t height, VkFormat format,
+                          VkImageUsageFlags usage, VkImageAspectFlags aspect);
+void destroyImage(const VulkanContext& context, GpuImage& image);
+
+}  // namespace dpoint

@@ -1,0 +1,51 @@
+#include "vulkan/shader.h"
+
+namespace dpoint {
+
+Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes) {
+  VkShaderModuleCreateInfo info = {VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  info.codeSize = bytes;
+  info.pCode = code;
+  VkShaderModule module = VK_NULL_HANDLE;
+  VK_TRY(vkCreateShaderModule(context.device, &info, nullptr, &module));
+  return module;
+}
+
+Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
+                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
+  VkDescriptorSetLayoutCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  info.bindingCount = static_cast<uint32_t>(bindings.size());
+  info.pBindings = bindings.data();
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  VK_TRY(vkCreateDescriptorSetLayout(context.device, &info, nullptr, &layout));
+  return layout;
+}
+
+Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
+                                        VkShaderStageFlags stages) {
+  VkPushConstantRange push{stages, 0, push_bytes};
+  VkPipelineLayoutCreateInfo info = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  info.setLayoutCount = 1;
+  info.pSetLayouts = &set;
+  info.pushConstantRangeCount = 1;
+  info.pPushConstantRanges = &push;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VK_TRY(vkCreatePipelineLayout(context.device, &info, nullptr, &layout));
+  return layout;
+}
+
+void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
+                            std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform) {
+  std::vector<VkWriteDescriptorSet> writes(infos.size());
+  for (uint32_t b = 0; b < infos.size(); ++b) {
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = b == 0 && first_is_uniform ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+}
+
+}  // namespace dpoint

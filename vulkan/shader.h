@@ -1,0 +1,31 @@
+// Shader modules, descriptor-set and pipeline layouts, and descriptor writes: the pieces of a
+// pipeline that the renderer (viewer/pipelines.h), the GPU generators (generators/gpu_generate.h)
+// and the bench's copy kernel build the same way. Every VkResult is checked (VK_TRY).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/result.h"
+#include "vulkan/context.h"
+
+namespace dpoint {
+
+// Creates a shader module from SPIR-V words.
+Result<VkShaderModule> createShaderModule(const VulkanContext& context, const uint32_t* code, size_t bytes);
+
+// A descriptor set layout of these bindings, and a pipeline layout of one set and push_bytes of
+// push constants from offset 0 for `stages`.
+Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
+                                               const std::vector<VkDescriptorSetLayoutBinding>& bindings);
+Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
+                                        VkShaderStageFlags stages);
+
+// Points bindings 0, 1, … of `set` at whole buffers (`infos`, in binding order): storage buffers,
+// but binding 0 a uniform buffer when `first_is_uniform`.
+void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
+                            std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform = false);
+
+}  // namespace dpoint
