@@ -31,7 +31,7 @@ BenchCase fitCase(BenchSuite suite, std::string family, std::string name, std::s
   return c;
 }
 
-// The study's datasets as README's table makes them, with the figures the study published for them
+// The study's datasets as docs/datasets.md's table makes them, with the figures the study published for them
 // on an RTX 3090 (issue #5: 16.7M points native 330 fps, emulated 115 fps; 10M 2D points 218 fps).
 std::vector<BenchCase> paperCases() {
   const BenchSuite p = BenchSuite::kPaper;

@@ -9,7 +9,7 @@
 # PARTS=ratio or PARTS=tiles runs one of the two (default both).
 set -euo pipefail
 bin=${1:-build/dpoint}
-out=${2:-bench/results/generate-lavapipe}
+out=${2:-bench/results/$(date +%F)/generate-lavapipe}
 work=${WORK:-/tmp/dpoint-generate-bench}
 repeats=${REPEATS:-3}
 mkdir -p "$out" "$work"

@@ -1,4 +1,4 @@
-# Sourced by the bench/gpu_*.sh scripts on the GPU machine (device tool: NVIDIA H100/H200,
+# Sourced by the bench/scripts/gpu_*.sh scripts on the GPU machine (device tool: NVIDIA H100/H200,
 # Ubuntu 24.04, no package registry): unpacks the carried Vulkan loader and validation layer
 # (.gl/, Debian packages), points the loader at NVIDIA's driver and the dynamic linker at the
 # carried libraries (.gpu/lib), and names the output folder.

@@ -3,12 +3,12 @@
 # backends and every mode in one run, so compute and raster compare as ratios of the same machine
 # state. One fresh `dpoint render` per set, mode and backend: compute FRAMES (20) frames after 3
 # warm-up, raster RFRAMES (5) after 1 (a raster frame takes about a second here); the GPU median
-# from timestamps. Rows go to OUT (default bench/results/lavapipe/speed-DATE.tsv).
+# from timestamps. Rows go to OUT (default bench/results/DATE/lavapipe/speed-DATE.tsv).
 #   bench/scripts/lavapipe_speed.sh [BIN]      (BIN: default build/dpoint; SETS, MODES, ORDERS to narrow)
 set -euo pipefail
 bin=${1:-build/dpoint}
 data=${DATA:-/tmp/dpoint-lavapipe}
-out=${OUT:-bench/results/lavapipe/speed-$(date +%F).tsv}
+out=${OUT:-bench/results/$(date +%F)/lavapipe/speed-$(date +%F).tsv}
 mkdir -p "$data" "$(dirname "$out")"
 [ -s "$out" ] || printf 'dataset\torder\tmode\tbackend\tpoints\tgpu_ms_median\tgpu_ms_p95\tframes\n' >"$out"
 value() { python3 -c "import json,sys; d=json.load(open('$data/r.json')); print(d['points'], d['gpu_ms']['median'], d['gpu_ms']['p95'], sep='\t')"; }

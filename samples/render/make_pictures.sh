@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Remakes the README's pictures: the Mandelbulb (res 200) moved to the Earth's radius, framed
+# Remakes the pictures of README.md and docs/rendering.md: the Mandelbulb (res 200) moved to the Earth's radius, framed
 # by --fit, in fp32 (float's 0.5 m spacing at 6.4e6 m shows as a lattice) and native fp64.
 # Usage: samples/render/make_pictures.sh build/dpoint
 set -euo pipefail

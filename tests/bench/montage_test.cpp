@@ -6,43 +6,23 @@
 #include <string>
 #include <vector>
 
+#include "image/picture_checks.h"
+
 namespace dpoint {
 namespace {
 
-constexpr double kLo = 1e-6, kHi = 100.0;
+using test::countColor;
+using test::filled;
+using test::pixel;
+using test::rgba;
 
-uint32_t rgba(uint32_t r, uint32_t g, uint32_t b) { return r | g << 8 | b << 16 | 0xffu << 24; }
+constexpr double kLo = 1e-6, kHi = 100.0;
 
 const uint32_t kBlack = rgba(0, 0, 0);
 const uint32_t kMagenta = rgba(255, 0, 255);
 const uint32_t kViridisLow = rgba(0x44, 0x01, 0x54);
 const uint32_t kViridisHigh = rgba(0xfd, 0xe7, 0x25);
 const uint32_t kMontageBackground = rgba(0x20, 0x20, 0x20);
-
-uint32_t pixel(const Image& image, uint32_t x, uint32_t y) {
-  const uint8_t* p = &image.rgba[(size_t(y) * image.width + x) * 4];
-  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-
-Image filled(uint32_t width, uint32_t height, uint32_t color) {
-  Image image;
-  image.width = width, image.height = height;
-  image.rgba.resize(size_t(width) * height * 4);
-  for (uint32_t y = 0; y < height; ++y) {
-    for (uint32_t x = 0; x < width; ++x) {
-      for (int c = 0; c < 4; ++c) image.rgba[(size_t(y) * width + x) * 4 + size_t(c)] = uint8_t(color >> (8 * c));
-    }
-  }
-  return image;
-}
-
-size_t countColor(const Image& image, uint32_t color) {
-  size_t count = 0;
-  for (uint32_t y = 0; y < image.height; ++y) {
-    for (uint32_t x = 0; x < image.width; ++x) count += pixel(image, x, y) == color;
-  }
-  return count;
-}
 
 WindowPoint at(double x, double y) { return {x, y, 0.5, true}; }
 
@@ -110,50 +90,6 @@ TEST(Montage, heatMapSkipsInvisiblePoints) {
   const Image heat = errorHeatMap({hidden, at(5.5, 1.5), at(1.5, 9.0), at(0.0, 1.0)}, {NAN, NAN, NAN, NAN}, 4, 4,
                                   kLo, kHi);
   EXPECT_EQ(countColor(heat, kBlack), 16u);
-}
-
-TEST(Montage, drawTextMarksPixelsAndClipsAtEdges) {
-  const uint32_t white = rgba(255, 255, 255);
-  Image image = filled(40, 20, kBlack);
-  const int width = drawText(image, 2, 3, "Hi", white, 1);
-  EXPECT_EQ(width, textWidth("Hi", 1));
-  const size_t marked = countColor(image, white);
-  EXPECT_GT(marked, 10u);
-  for (uint32_t y = 0; y < image.height; ++y) {
-    for (uint32_t x = 0; x < image.width; ++x) {
-      if (pixel(image, x, y) != white) continue;
-      EXPECT_GE(x, 2u);
-      EXPECT_LT(x, 2u + uint32_t(width));
-      EXPECT_GE(y, 3u);
-      EXPECT_LT(y, 3u + 12u);
-    }
-  }
-  // Twice the scale, four times the pixels.
-  Image doubled = filled(80, 40, kBlack);
-  EXPECT_EQ(drawText(doubled, 4, 6, "Hi", white, 2), 2 * width);
-  EXPECT_EQ(countColor(doubled, white), 4 * marked);
-
-  // Across every edge: only what lies inside is drawn, and the width is the text's, not the cut.
-  Image small = filled(6, 6, kBlack);
-  EXPECT_EQ(drawText(small, -5, -4, "WWW", white, 2), textWidth("WWW", 2));
-  EXPECT_GT(countColor(small, white), 0u);
-  EXPECT_LT(countColor(small, white), 36u);
-  Image outside = filled(6, 6, kBlack);
-  drawText(outside, 7, 0, "W", white, 1);
-  drawText(outside, 0, -30, "W", white, 1);
-  drawText(outside, -100, 0, "W", white, 1);
-  EXPECT_EQ(countColor(outside, kBlack), 36u);
-}
-
-TEST(Montage, textWidthTakesTheWidestLineAndDrawsUnprintableAsQuestionMark) {
-  EXPECT_EQ(textWidth("ab\nabcd", 1), textWidth("abcd", 1));
-  EXPECT_EQ(textWidth("abcd", 3), 3 * textWidth("abcd", 1));
-  EXPECT_EQ(textWidth("", 1), 0);
-  EXPECT_EQ(textWidth("a\tb", 1), textWidth("a?b", 1));
-  Image tab = filled(30, 12, kBlack), question = filled(30, 12, kBlack);
-  drawText(tab, 0, 0, "\t\x80", rgba(255, 255, 255), 1);
-  drawText(question, 0, 0, "??", rgba(255, 255, 255), 1);
-  EXPECT_EQ(tab.rgba, question.rgba);
 }
 
 // Tile i: a picture of one flat colour, and a heat map of one point at a mid-range error.
@@ -255,42 +191,6 @@ TEST(Montage, montageOfSixTilesShowsTitleLabelsPicturesAndColourBar) {
   EXPECT_GT(countColor(montage, kMagenta), 0u);
   EXPECT_GT(countColor(montage, kViridisLow), 0u);
   EXPECT_GT(countColor(montage, kViridisHigh), 0u);
-}
-
-// dpoint render --views 4's sheet: each view's label is drawn, pixel for pixel as drawText draws it,
-// on a dark strip over its picture's top-left corner; the rest of each picture and the 2-px gaps
-// between them are untouched.
-TEST(Montage, contactSheetDrawsEachLabelOnAStripOverItsPicture) {
-  const uint32_t strip = rgba(0x10, 0x10, 0x10), label = rgba(0xf2, 0xf2, 0xf2), gap = rgba(0x20, 0x20, 0x20);
-  const uint32_t w = 120, h = 80;
-  std::vector<LabelledView> views = {{"front (fp32)", filled(w, h, rgba(200, 0, 0))},
-                                     {"side (native)", filled(w, h, rgba(0, 200, 0))},
-                                     {"top (df64)", filled(w, h, rgba(0, 0, 200))},
-                                     {"three-quarter (rte)", filled(w, h, rgba(200, 200, 0))}};
-  const Image sheet = composeContactSheet(views, 2);
-  ASSERT_EQ(sheet.width, 2 * w + 2);
-  ASSERT_EQ(sheet.height, 2 * h + 2);
-  for (size_t i = 0; i < views.size(); ++i) {
-    SCOPED_TRACE(views[i].label);
-    // Pictures under 400 px wide get scale-1 text, 3 px in from the corner and the strip's edges.
-    Image glyphs = filled(w, h, kBlack);
-    drawText(glyphs, 3, 3, views[i].label, label, 1);
-    const uint32_t strip_w = uint32_t(textWidth(views[i].label, 1)) + 6, strip_h = kTextGlyphUnits + 6;
-    const uint32_t x0 = uint32_t(i % 2) * (w + 2), y0 = uint32_t(i / 2) * (h + 2);
-    size_t label_pixels = 0;
-    for (uint32_t y = 0; y < h; ++y) {
-      for (uint32_t x = 0; x < w; ++x) {
-        const uint32_t want = pixel(glyphs, x, y) == label     ? label
-                              : x < strip_w && y < strip_h ? strip
-                                                            : pixel(views[i].picture, x, y);
-        ASSERT_EQ(pixel(sheet, x0 + x, y0 + y), want) << x << "," << y;
-        label_pixels += want == label;
-      }
-    }
-    EXPECT_GT(label_pixels, views[i].label.size()) << "several pixels a glyph";
-  }
-  for (uint32_t y = 0; y < sheet.height; ++y) EXPECT_EQ(pixel(sheet, w, y), gap) << y;
-  for (uint32_t x = 0; x < sheet.width; ++x) EXPECT_EQ(pixel(sheet, x, h + 1), gap) << x;
 }
 
 }  // namespace

@@ -7,16 +7,9 @@
 #include <vector>
 
 #include "test_support.h"
-#include "image/image.h"
-
-#define STB_IMAGE_STATIC
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb/stb_image.h>
 
 namespace dpoint {
 namespace {
-
-using test::TempDir;
 
 WindowPoint at(double x, double y, double depth = 0.5) { return {x, y, depth, true}; }
 
@@ -145,56 +138,6 @@ TEST(Reference, rasterTieKeepsTheLowerIndex) {
   // A first point at depth exactly 0 is drawn, and an equal depth does not replace it.
   EXPECT_EQ(pixelAt(image, 0, 0)[0], 0xaa);
   EXPECT_EQ(pixelAt(image, 1, 0)[0], 0xcc);
-}
-
-TEST(Reference, countDifferingPixelsCountsPixelsNotBytes) {
-  Image a{3, 2, std::vector<uint8_t>(24, 7)};
-  Image b = a;
-  EXPECT_EQ(countDifferingPixels(a, b), 0u);
-  b.rgba[0] = 1, b.rgba[3] = 1;  // two bytes of pixel 0
-  b.rgba[23] = 1;                // alpha of the last pixel
-  EXPECT_EQ(countDifferingPixels(a, b), 2u);
-}
-
-Image testImage() {
-  Image image{5, 3, {}};
-  for (uint32_t i = 0; i < 5 * 3 * 4; ++i) image.rgba.push_back(static_cast<uint8_t>(i * 37 + 11));
-  return image;
-}
-
-TEST(Image, writePngRoundTripsEveryByte) {
-  TempDir dir;
-  const Image image = testImage();
-  const std::string path = dir.file("out.png");
-  const Status status = writePng(path, image);
-  ASSERT_TRUE(status.ok()) << status.error().message;
-  int width = 0, height = 0, channels = 0;
-  unsigned char* pixels = stbi_load(path.c_str(), &width, &height, &channels, 4);
-  ASSERT_NE(pixels, nullptr) << stbi_failure_reason();
-  EXPECT_EQ(width, 5);
-  EXPECT_EQ(height, 3);
-  EXPECT_EQ(channels, 4);
-  EXPECT_EQ(std::vector<uint8_t>(pixels, pixels + image.rgba.size()), image.rgba);
-  stbi_image_free(pixels);
-  EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.png"});
-}
-
-TEST(Image, writePngFailureNamesThePathAndLeavesNothing) {
-  TempDir dir;
-  const std::string missing = dir.file("no-such-folder/out.png");
-  const Status status = writePng(missing, testImage());
-  ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.error().message.find(missing), std::string::npos) << status.error().message;
-  EXPECT_TRUE(dir.entries().empty());
-  const Status folder = writePng(dir.path(), testImage());
-  ASSERT_FALSE(folder.ok());
-  EXPECT_NE(folder.error().message.find(dir.path()), std::string::npos) << folder.error().message;
-  EXPECT_TRUE(dir.entries().empty());
-  // An empty image is refused before anything is created.
-  const Status empty = writePng(dir.file("empty.png"), Image{});
-  ASSERT_FALSE(empty.ok());
-  EXPECT_NE(empty.error().message.find("empty.png"), std::string::npos);
-  EXPECT_TRUE(dir.entries().empty());
 }
 
 }  // namespace
