@@ -11,10 +11,7 @@
 namespace dpoint {
 namespace {
 
-using test::countColor;
-using test::filled;
-using test::pixel;
-using test::rgba;
+using namespace test;  // the pixel checks of image/picture_checks.h
 
 constexpr double kLo = 1e-6, kHi = 100.0;
 

@@ -17,11 +17,7 @@
 namespace dpoint {
 namespace {
 
-using test::countColor;
-using test::filled;
-using test::pixel;
-using test::rgba;
-using test::TempDir;
+using namespace test;  // the pixel checks of image/picture_checks.h
 
 const uint32_t kBlack = rgba(0, 0, 0);
 
