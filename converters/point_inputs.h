@@ -13,7 +13,7 @@
 namespace dpoint {
 
 // The files one after another, as one set: points concatenated in the order given, triangles
-// offset to their file's first point. Tiles of one run, all N of them (core/tile.h), are welded as
+// offset to their file's first point. Tiles of one run, all N of them (converters/tile_file.h), are welded as
 // `dpoint merge` welds them, so the set is the whole one, each seam vertex once; any other mix of
 // files is read file by file (a tile then brings its copies of seam vertices too). Colours: kept
 // when every file with points has them, none when none has; in a mix, the files without get white,
@@ -21,7 +21,7 @@ namespace dpoint {
 // the files' own, naming the file.
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options = {});
 
-// True when the paths are the tiles of one run, all N of them, each once (core/tile.h).
+// True when the paths are the tiles of one run, all N of them, each once (converters/tile_file.h).
 bool isCompleteTileSet(const std::vector<std::string>& paths);
 
 // One or several binary PLY files as one stream of points (render's --stream): the points

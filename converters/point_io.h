@@ -24,7 +24,7 @@ struct ReadOptions {
   Progress* progress = nullptr;
   bool points_only = false;  // PLY: stop after the vertex element (faces are not read)
   uint64_t max_memory = 0;   // --max-memory for what is read; 0: defaultMemoryLimit() (core/memory.h)
-  // Where colours come from. LAS: core/las.h. Other formats: kAuto and kRgb take the file's
+  // Where colours come from. LAS: converters/las.h. Other formats: kAuto and kRgb take the file's
   // colours (kRgb fails when it has none), kNone drops them; kIntensity and kClassification are
   // errors (only LAS has those fields).
   LasColorSource las_color = LasColorSource::kAuto;

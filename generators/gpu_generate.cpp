@@ -24,7 +24,7 @@ struct EscapePush {
 };
 static_assert(sizeof(EscapePush) == 64);
 
-// Push constants of shaders/perturbation.comp.
+// Push constants of shaders/generate/perturbation.comp.
 struct PerturbationPush {
   uint32_t cols, first_row, count, max_iter, last;
 };

@@ -1,4 +1,4 @@
-// Drawing into an RGBA8 Image (viewer/reference.h): rectangles, copies, stb_easy_font text (no
+// Drawing into an RGBA8 Image (image/image.h): rectangles, copies, stb_easy_font text (no
 // font files), and the contact sheet of `dpoint render --views`. Shared by
 // the bench report's montage and the renderer's CLI.
 #pragma once

@@ -1,5 +1,5 @@
-// Post-processing of a read point set for `dpoint convert`: dropping duplicate positions and
-// re-encoding colours. Pure functions on a PointSet; they never fail.
+// Post-processing of a read point set, for `dpoint convert` and `dpoint render`: dropping
+// duplicate positions and re-encoding colours. Pure functions on a PointSet; they never fail.
 #pragma once
 
 #include "core/point_set.h"

@@ -87,7 +87,7 @@ class VulkanContext {
   VkCommandPool command_pool = VK_NULL_HANDLE;
   DeviceFacts facts;
   VkPhysicalDeviceMemoryProperties memory{};
-  // Device memory allocated through viewer/buffers and the budget it must stay in (0: none).
+  // Device memory allocated through vulkan/buffers and the budget it must stay in (0: none).
   uint64_t device_memory_budget = 0;
   mutable std::atomic<uint64_t> device_memory_used{0};
   // Set once the device-lost-wait test switch has reported a loss: from then on the device stays
