@@ -1,59 +1,23 @@
 // dpoint generate KIND -o OUT: the datasets of the study (DESIGN §8).
-// Parsing and reporting only; every generator is a library function.
-#include <algorithm>
-#include <charconv>
-#include <chrono>
-#include <cstdio>
-#include <cmath>
+// Parsing and reporting only; every generator is a library function, and what is done to its
+// points after it is cli/cli_generate_output.h over generators/generate.h.
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include "cli/cli_device.h"
+#include "cli/cli_generate_output.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
-#include "converters/point_io.h"
-#include "core/memory.h"
-#include "ops/point_order.h"
-#include "converters/tile_file.h"
+#include "generators/generate.h"
 #include "generators/julia.h"
 #include "generators/mandelbrot2d.h"
 #include "generators/mandelbulb.h"
 #include "generators/menger.h"
-#include "generators/perlin.h"
 #include "generators/random2d.h"
 #include "generators/sierpinski.h"
 
 namespace dpoint {
 namespace {
-
-// Options every generator shares: where the output goes and what is done to it after generation.
-struct OutputOptions {
-  std::string output;
-  std::string tile;  // "I/N": write tile I of N (core/tile.h) instead of the whole set
-  std::string colors = "auto";
-  std::string offset;
-  int decimals = -1;
-  std::string max_memory;
-  std::string order = "input";
-  CommonOptions common;
-};
-
-void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
-  cmd.add_option("-o,--output", o.output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
-  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (the seed's pnoise3), none")
-      ->check(CLI::IsMember({"auto", "noise", "none"}))
-      ->default_val("auto");
-  cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
-  cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")
-      ->check(CLI::Range(0, 100));
-  addMaxMemoryOption(cmd, o.max_memory);
-  cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");
-  cmd.add_option("--tile", o.tile,
-                 "I/N: compute only tile I (from 0) of N of the set, into a .ply part that `dpoint merge` welds with\n"
-                 "the others into the file one process writes, byte for byte (--order then goes to merge)");
-  addCommonOptions(cmd, o.common);
-}
 
 // "a,b,c" → exactly `count` finite doubles; the error names the flag and the text.
 Status parseBounds(const std::string& text, double& lo, double& hi) {
@@ -64,133 +28,13 @@ Status parseBounds(const std::string& text, double& lo, double& hi) {
   return okStatus();
 }
 
-Result<uint64_t> memoryLimit(const OutputOptions& o) { return memoryLimitOf(o.max_memory); }
-
-// Colours and offset: the steps after any generator that act point by point (a tile applies them
-// to its own points and copies alike).
-Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise) {
-  const bool noise = o.colors == "noise" || (o.colors == "auto" && auto_noise);
-  if (o.colors == "none") points.colors.clear();
-  if (noise) {
-    Result<uint64_t> limit = memoryLimit(o);
-    if (!limit) return limit.error();
-    // The generators' own estimates cover positions and triangles; colours come on top.
-    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + sizeof(glm::vec3)) + points.triangles.size() * 4;
-    if (Status s = checkMemory("colouring " + std::to_string(points.size()) + " points", needed, *limit); !s) return s;
-    colorByNoise(points, o.common.threads);  // on the fractal's own coordinates, before the offset
-  }
-  if (!o.offset.empty()) {
-    Result<std::vector<double>> offset = parseNumbers("--offset", o.offset, 3);
-    if (!offset) return offset.error();
-    const glm::dvec3 d((*offset)[0], (*offset)[1], (*offset)[2]);
-    for (glm::dvec3& p : points.positions) p += d;
-  }
-  return okStatus();
-}
-
-// Seconds since `start`, and since the last call (the phases of the time line).
-class PhaseClock {
- public:
-  double lap() {
-    const auto now = std::chrono::steady_clock::now();
-    const double s = std::chrono::duration<double>(now - last_).count();
-    last_ = now;
-    return s;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-std::string seconds(double s) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2f", s);
-  return text;
-}
-
-// Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of
-// where the time went (generation counted from `clock`'s start, before the parameters).
-int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
-           PhaseClock& clock) {
-  if (!generated) return reportError(generated.error());
-  const double generate_s = clock.lap();
-  PointSet& points = *generated;
-  if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
-  const double colours_s = clock.lap();
-  if (order != PointOrder::kInput) {
-    Result<uint64_t> limit = memoryLimit(o);
-    if (!limit) return reportError(limit.error());
-    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
-                            points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
-    if (Status s = checkMemory("ordering " + std::to_string(points.size()) + " points", needed, *limit); !s)
-      return reportError(s.error());
-    reorderPoints(points, order, o.common.threads, &progress);
-  }
-  const double order_s = clock.lap();
-  WriteOptions w;
-  w.threads = o.common.threads;
-  w.decimals = o.decimals;
-  w.progress = &progress;
-  if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
-  if (!o.common.quiet)
-    std::fprintf(stderr, "time (s): generate %s, colours and offset %s, order %s, write %s; %zu points, %zu triangles\n",
-                 seconds(generate_s).c_str(), seconds(colours_s).c_str(), seconds(order_s).c_str(),
-                 seconds(clock.lap()).c_str(), points.size(), points.triangles.size() / 3);
-  return 0;
-}
-
-// A tile: colours and offset on its points, then its part file.
-int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_noise, const std::string& signature,
-               Progress& progress) {
-  if (!generated) return reportError(generated.error());
-  if (Status s = colorAndOffset(generated->points, o, auto_noise); !s) return reportError(s.error());
-  if (Status s = writeTile(o.output, *generated, signature, &progress); !s) return reportError(s.error());
-  return 0;
-}
-
-// What makes two runs' tiles one dataset: the kind and every option that shapes the points, as
-// CLI11 prints them (given or default), less those that only say where and how to run or write.
-std::string tileSignature(const CLI::App& cmd) {
-  static const std::vector<std::string> kIgnored = {"output", "tile", "threads", "quiet", "grid-out", "device",
-                                                    "max-memory", "decimals", "order", "validate", "counts", "help"};
-  std::istringstream lines(cmd.config_to_str(true, false));
-  std::string line, signature = cmd.get_name();
-  while (std::getline(lines, line)) {
-    const std::string name = line.substr(0, line.find('='));
-    if (line.empty() || std::find(kIgnored.begin(), kIgnored.end(), name) != kIgnored.end()) continue;
-    signature += " " + line;
-  }
-  return signature;
-}
-
-// --tile checks before any work: a .ply part, and no --order (which needs the whole set).
-Result<TileSpec> tileOptions(const OutputOptions& o) {
-  Result<TileSpec> tile = parseTileSpec("--tile", o.tile);
-  if (!tile) return tile.error();
-  Result<FileFormat> format = formatOf(o.output);
-  if (!format || *format != FileFormat::kPly)
-    return Error{"--tile: -o " + o.output + ": a tile is written as .ply (dpoint merge makes the .ply, .csv or .glb)",
-                 ExitCode::kUsage};
-  if (o.order != "input")
-    return Error{"--tile: --order " + o.order + " needs the whole set; give it to dpoint merge", ExitCode::kUsage};
-  return tile;
-}
-
-// Checks the output path's extension before any work, so a typo does not cost a long run.
-bool outputTypeOk(const OutputOptions& o, int& code) {
-  Result<FileFormat> format = formatOf(o.output);
-  if (format && *format != FileFormat::kGltf) return true;
-  code = reportError(format ? Error{o.output + ": write .glb, not .gltf", ExitCode::kUsage} : format.error());
-  return false;
-}
-
 template <typename Params, typename Options>
 void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* cmd, bool auto_noise,
                   Result<PointSet> (*generate)(const Params&),
                   Result<PointTile> (*generate_tile)(const Params&, TileSpec),
                   Result<Params> (*makeParams)(const Options&, Progress*)) {
   cmd->callback([o, &run, cmd, auto_noise, generate, generate_tile, makeParams, name = cmd->get_name()] {
-    const std::string signature = o->out.tile.empty() ? std::string() : tileSignature(*cmd);
+    const std::string signature = o->out.tile.empty() ? std::string() : tileSignature(name, cmd->config_to_str(true, false));
     run = [o, auto_noise, generate, generate_tile, makeParams, name, signature] {
       int code = 0;
       if (!outputTypeOk(o->out, code)) return code;

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <new>
 
+#include "cli/cli_check.h"
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "core/interrupt.h"
@@ -55,6 +56,8 @@ int main(int argc, char** argv) {
   addBenchCommand(app, run);
   try {
     app.parse(argc, argv);
+  } catch (const UsageError& e) {  // a value one of dpoint's own validators refused (cli_check.h)
+    return reportError(Error{e.what(), ExitCode::kUsage});
   } catch (const CLI::ParseError& e) {
     int code = app.exit(e);  // prints help, version or the usage error
     return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);

@@ -1,0 +1,48 @@
+#include "cli/cli_check.h"
+
+#include <algorithm>
+
+#include "core/text.h"
+
+namespace dpoint {
+
+CLI::Validator check(std::function<std::string(const std::string& value)> problem) {
+  // Empty description: nothing added to the option's line in --help.
+  return CLI::Validator(
+      [problem = std::move(problem)](std::string& value) -> std::string {
+        const std::string message = problem(value);
+        if (!message.empty()) throw UsageError(message);
+        return std::string();
+      },
+      "");
+}
+
+CLI::Validator checkStatus(std::function<Status(const std::string& value)> problem) {
+  return check([problem = std::move(problem)](const std::string& value) {
+    Status status = problem(value);
+    return status ? std::string() : status.error().message;
+  });
+}
+
+CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed) {
+  std::string list;
+  for (size_t i = 0; i < allowed.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
+  return check([flag, allowed = std::move(allowed), list](const std::string& value) {
+    if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return std::string();
+    return flag + " must be " + list + ", got '" + value + "'";
+  });
+}
+
+CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open_low, const std::string& unit) {
+  const std::string range = (open_low ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) + "]" +
+                            (unit.empty() ? "" : " " + unit);
+  return check([flag, lo, hi, open_low, range](const std::string& value) {
+    double v = 0.0;
+    if (!CLI::detail::lexical_cast(value, v)) return std::string();  // CLI11's conversion error follows
+    if ((open_low ? v > lo : v >= lo) && v <= hi) return std::string();
+    return flag + " must be in " + range + ", got " + formatNumber(v, true);
+  });
+}
+
+}  // namespace dpoint

@@ -1,0 +1,40 @@
+// CLI11 validators whose refusal is dpoint's own usage error: "dpoint: error: MESSAGE", exit 1,
+// the message naming the flag as the commands' checks always have (main.cpp prints it). CLI11's
+// own validators (CLI::Range, CLI::IsMember) word their refusals their own way and add their
+// allowed values to --help; these add nothing to --help.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "core/result.h"
+
+namespace dpoint {
+
+// Thrown by a check() validator; main.cpp reports it as reportError does.
+class UsageError : public CLI::ParseError {
+ public:
+  explicit UsageError(const std::string& message)
+      : CLI::ParseError("UsageError", message, static_cast<int>(ExitCode::kUsage)) {}
+};
+
+// A validator from `problem`: the empty string accepts the value, anything else is the message.
+CLI::Validator check(std::function<std::string(const std::string& value)> problem);
+// The same from a Status-returning check (its message; its code is kUsage for every such check).
+CLI::Validator checkStatus(std::function<Status(const std::string& value)> problem);
+// A Result's error, or ok.
+template <typename T>
+Status statusOf(const Result<T>& result) {
+  return result ? okStatus() : Status(result.error());
+}
+
+// One of `allowed`, else "FLAG must be A, B or C, got 'VALUE'".
+CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed);
+// A number CLI11 reads as double in [lo, hi] (or (lo, hi] with `open_low`), else
+// "FLAG must be in RANGE UNIT, got VALUE" (the value in shortest form). Text that is no number is
+// left to CLI11's conversion.
+CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open_low, const std::string& unit);
+
+}  // namespace dpoint

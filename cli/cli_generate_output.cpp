@@ -1,0 +1,114 @@
+#include "cli/cli_generate_output.h"
+
+#include <cstdio>
+
+#include "cli/cli_text.h"
+#include "converters/point_io.h"
+#include "converters/tile_file.h"
+#include "core/memory.h"
+#include "generators/generate.h"
+
+namespace dpoint {
+namespace {
+
+// Colours and offset (generators/generate.h): the steps after any generator that act point by point.
+Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise) {
+  Result<uint64_t> limit = memoryLimit(o);
+  if (!limit) return limit.error();
+  const PointColors colors = o.colors == "noise" ? PointColors::kNoise : o.colors == "none" ? PointColors::kNone : PointColors::kAuto;
+  if (Status s = colorGenerated(points, PointColoring{colors, auto_noise, o.common.threads, *limit}); !s) return s;
+  if (o.offset.empty()) return okStatus();
+  Result<glm::dvec3> offset = parseVec3("--offset", o.offset);
+  if (!offset) return offset.error();
+  offsetPoints(points, *offset);
+  return okStatus();
+}
+
+}  // namespace
+
+void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
+  cmd.add_option("-o,--output", o.output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
+  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (the seed's pnoise3), none")
+      ->check(CLI::IsMember({"auto", "noise", "none"}))
+      ->default_val("auto");
+  cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
+  cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")
+      ->check(CLI::Range(0, 100));
+  addMaxMemoryOption(cmd, o.max_memory);
+  cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");
+  cmd.add_option("--tile", o.tile,
+                 "I/N: compute only tile I (from 0) of N of the set, into a .ply part that `dpoint merge` welds with\n"
+                 "the others into the file one process writes, byte for byte (--order then goes to merge)");
+  addCommonOptions(cmd, o.common);
+}
+
+Result<uint64_t> memoryLimit(const OutputOptions& o) { return memoryLimitOf(o.max_memory); }
+
+double PhaseClock::lap() {
+  const auto now = std::chrono::steady_clock::now();
+  const double s = std::chrono::duration<double>(now - last_).count();
+  last_ = now;
+  return s;
+}
+
+// Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of
+// where the time went (generation counted from `clock`'s start, before the parameters).
+int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
+           PhaseClock& clock) {
+  if (!generated) return reportError(generated.error());
+  const double generate_s = clock.lap();
+  PointSet& points = *generated;
+  if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
+  const double colours_s = clock.lap();
+  if (order != PointOrder::kInput) {
+    Result<uint64_t> limit = memoryLimit(o);
+    if (!limit) return reportError(limit.error());
+    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
+                            points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
+    if (Status s = checkMemory("ordering " + std::to_string(points.size()) + " points", needed, *limit); !s)
+      return reportError(s.error());
+    reorderPoints(points, order, o.common.threads, &progress);
+  }
+  const double order_s = clock.lap();
+  WriteOptions w;
+  w.threads = o.common.threads;
+  w.decimals = o.decimals;
+  w.progress = &progress;
+  if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
+  if (!o.common.quiet)
+    std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles\n",
+                 generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3);
+  return 0;
+}
+
+// A tile: colours and offset on its points, then its part file.
+int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_noise, const std::string& signature,
+               Progress& progress) {
+  if (!generated) return reportError(generated.error());
+  if (Status s = colorAndOffset(generated->points, o, auto_noise); !s) return reportError(s.error());
+  if (Status s = writeTile(o.output, *generated, signature, &progress); !s) return reportError(s.error());
+  return 0;
+}
+
+// --tile checks before any work: a .ply part, and no --order (which needs the whole set).
+Result<TileSpec> tileOptions(const OutputOptions& o) {
+  Result<TileSpec> tile = parseTileSpec("--tile", o.tile);
+  if (!tile) return tile.error();
+  Result<FileFormat> format = formatOf(o.output);
+  if (!format || *format != FileFormat::kPly)
+    return Error{"--tile: -o " + o.output + ": a tile is written as .ply (dpoint merge makes the .ply, .csv or .glb)",
+                 ExitCode::kUsage};
+  if (o.order != "input")
+    return Error{"--tile: --order " + o.order + " needs the whole set; give it to dpoint merge", ExitCode::kUsage};
+  return tile;
+}
+
+// Checks the output path's extension before any work, so a typo does not cost a long run.
+bool outputTypeOk(const OutputOptions& o, int& code) {
+  Result<FileFormat> format = formatOf(o.output);
+  if (format && *format != FileFormat::kGltf) return true;
+  code = reportError(format ? Error{o.output + ": write .glb, not .gltf", ExitCode::kUsage} : format.error());
+  return false;
+}
+
+}  // namespace dpoint

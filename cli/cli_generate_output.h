@@ -1,0 +1,58 @@
+// The output half of `dpoint generate`, shared by every kind: the options that say where the
+// points go and what is done to them after the generator (colours, offset, order), the checks made
+// before any work, and the steps after it (writing the set, or a tile's part file).
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/commands.h"
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+#include "core/tile.h"
+#include "ops/point_order.h"
+
+namespace dpoint {
+
+// Options every generator shares: where the output goes and what is done to it after generation.
+struct OutputOptions {
+  std::string output;
+  std::string tile;  // "I/N": write tile I of N (core/tile.h) instead of the whole set
+  std::string colors = "auto";
+  std::string offset;
+  int decimals = -1;
+  std::string max_memory;
+  std::string order = "input";
+  CommonOptions common;
+};
+
+// `auto_colors`: what --colors auto gives for the kind, for the help text.
+void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors);
+// --max-memory as bytes (0: half of RAM).
+Result<uint64_t> memoryLimit(const OutputOptions& o);
+
+// Seconds since the last call (the phases of the time line).
+class PhaseClock {
+ public:
+  double lap();
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// Checks the output path's extension before any work, so a typo does not cost a long run.
+bool outputTypeOk(const OutputOptions& o, int& code);
+// --tile checks before any work: a .ply part, and no --order (which needs the whole set).
+Result<TileSpec> tileOptions(const OutputOptions& o);
+// Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of
+// where the time went (generation counted from `clock`'s start, before the parameters).
+int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
+           PhaseClock& clock);
+// A tile: colours and offset on its points, then its part file.
+int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_noise, const std::string& signature,
+               Progress& progress);
+
+}  // namespace dpoint

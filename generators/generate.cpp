@@ -1,0 +1,41 @@
+#include "generators/generate.h"
+
+#include <algorithm>
+#include <sstream>
+#include <vector>
+
+#include "core/memory.h"
+#include "generators/perlin.h"
+
+namespace dpoint {
+
+Status colorGenerated(PointSet& points, const PointColoring& coloring) {
+  const bool noise = coloring.colors == PointColors::kNoise || (coloring.colors == PointColors::kAuto && coloring.auto_noise);
+  if (coloring.colors == PointColors::kNone) points.colors.clear();
+  if (!noise) return okStatus();
+  // The generators' own estimates cover positions and triangles; colours come on top.
+  const uint64_t needed = points.size() * (sizeof(glm::dvec3) + sizeof(glm::vec3)) + points.triangles.size() * 4;
+  if (Status s = checkMemory("colouring " + std::to_string(points.size()) + " points", needed, coloring.max_memory); !s)
+    return s;
+  colorByNoise(points, coloring.threads);
+  return okStatus();
+}
+
+void offsetPoints(PointSet& points, const glm::dvec3& offset) {
+  for (glm::dvec3& p : points.positions) p += offset;
+}
+
+std::string tileSignature(const std::string& kind, const std::string& option_lines) {
+  static const std::vector<std::string> kIgnored = {"output", "tile", "threads", "quiet", "grid-out", "device",
+                                                    "max-memory", "decimals", "order", "validate", "counts", "help"};
+  std::istringstream lines(option_lines);
+  std::string line, signature = kind;
+  while (std::getline(lines, line)) {
+    const std::string name = line.substr(0, line.find('='));
+    if (line.empty() || std::find(kIgnored.begin(), kIgnored.end(), name) != kIgnored.end()) continue;
+    signature += " " + line;
+  }
+  return signature;
+}
+
+}  // namespace dpoint

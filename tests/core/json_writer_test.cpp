@@ -1,0 +1,38 @@
+// The JSON writer the render report is built with (core/json_writer.h).
+#include "core/json_writer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace dpoint {
+namespace {
+
+TEST(JsonWriter, keepsTheOrderEscapesStringsAndWritesNumbersShortest) {
+  JsonObject inner;
+  inner.add("b", JsonValue::integer(2)).add("a", JsonValue::boolean(false));
+  JsonObject o;
+  o.add("z \"quoted\"\n", JsonValue::string("back\\slash\ttab"));
+  o.add("n", JsonValue::number(0.1)).add("inf", JsonValue::number(HUGE_VAL)).add("nan", JsonValue::number(std::nan("")));
+  o.add("list", JsonValue::numbers(std::vector<double>{1.0, 2.5, 1e-300})).add("empty", JsonValue::numbers({}));
+  o.add("inner", inner).add("none", JsonValue::null()).add("nothing", JsonObject());
+  EXPECT_EQ(o.block(),
+            "{\n"
+            "  \"z \\\"quoted\\\"\\u000a\": \"back\\\\slash\\u0009tab\",\n"
+            "  \"n\": 0.1,\n"
+            "  \"inf\": null,\n"
+            "  \"nan\": null,\n"
+            "  \"list\": [1, 2.5, 1e-300],\n"
+            "  \"empty\": [],\n"
+            "  \"inner\": {\"b\": 2, \"a\": false},\n"
+            "  \"none\": null,\n"
+            "  \"nothing\": {}\n"
+            "}\n");
+  EXPECT_EQ(inner.line(), "{\"b\": 2, \"a\": false}");
+  EXPECT_EQ(JsonValue::integer(18446744073709551615ull).text(), "18446744073709551615");
+}
+
+}  // namespace
+}  // namespace dpoint

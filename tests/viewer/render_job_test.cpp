@@ -1,0 +1,140 @@
+// The render policies and the report a front end gets from viewer/render_job.h. No device: these
+// are the pure parts.
+#include "viewer/render_job.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+
+namespace dpoint {
+namespace {
+
+Bounds cube() { return Bounds{glm::dvec3(-1.0), glm::dvec3(1.0), false}; }
+
+DeviceFacts bigPoints() {
+  DeviceFacts facts;
+  facts.large_points = true;
+  facts.max_point_size = 64.0f;
+  return facts;
+}
+
+Camera cameraFor(const RenderRequest& request, const Bounds& bounds) {
+  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(1, zUpFor(request)), bounds);
+  EXPECT_TRUE(cameras.ok());
+  return cameras.ok() ? cameras->front() : Camera{};
+}
+
+TEST(RenderJob, pointSizeGrowsOnlyForSparse3dSetsOnTheRasterBackend) {
+  RenderRequest request;
+  const Camera camera = cameraFor(request, cube());
+  EXPECT_EQ(pointSizeFor(request, 100, cube(), camera, bigPoints()), 4.0f) << "a few points: at most 4 px";
+  EXPECT_EQ(pointSizeFor(request, 100000000, cube(), camera, bigPoints()), 1.0f) << "dense: 1 px";
+  const float middle = pointSizeFor(request, 1000000, cube(), camera, bigPoints());
+  EXPECT_GT(middle, 1.0f);
+  EXPECT_LT(middle, 4.0f);
+  DeviceFacts small = bigPoints();
+  small.max_point_size = 2.0f;
+  EXPECT_EQ(pointSizeFor(request, 100, cube(), camera, small), 2.0f) << "never above the device's largest";
+  small.large_points = false;
+  EXPECT_EQ(pointSizeFor(request, 100, cube(), camera, small), 1.0f);
+  for (auto change : {+[](RenderRequest& r) { r.error = true; }, +[](RenderRequest& r) { r.backend = Backend::kCompute; }}) {
+    RenderRequest other = request;
+    change(other);
+    EXPECT_EQ(pointSizeFor(other, 100, cube(), camera, bigPoints()), 1.0f);
+  }
+  RenderRequest ortho = request;
+  ortho.camera.ortho = true;
+  EXPECT_EQ(pointSizeFor(ortho, 100, cube(), cameraFor(ortho, cube()), bigPoints()), 1.0f);
+  request.point_size = 2.5;
+  EXPECT_EQ(pointSizeFor(request, 100000000, cube(), camera, bigPoints()), 2.5f) << "asked for: kept";
+}
+
+TEST(RenderJob, viewsAndTheirCameras) {
+  std::vector<RenderView> one = viewsFor(1, false);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_STREQ(one[0].label, "three-quarter");
+  std::vector<RenderView> four = viewsFor(4, true);
+  ASSERT_EQ(four.size(), 4u);
+  EXPECT_STREQ(four[0].label, "front");
+  EXPECT_EQ(four[0].direction, glm::dvec3(0, -1, 0)) << "z up: front looks along +y";
+  EXPECT_EQ(four[2].up, glm::dvec3(0, 1, 0)) << "z up: the top view's up is y";
+  EXPECT_EQ(viewsFor(4, false)[2].up, glm::dvec3(0, 0, -1));
+
+  RenderRequest request;
+  request.views = 4;
+  request.camera.width = 401, request.camera.height = 300;
+  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(4, false), cube());
+  ASSERT_TRUE(cameras.ok());
+  ASSERT_EQ(cameras->size(), 4u);
+  for (const Camera& c : *cameras) EXPECT_EQ(std::make_pair(c.width, c.height), std::make_pair(200u, 150u));
+  EXPECT_NE((*cameras)[0].eye, (*cameras)[1].eye);
+}
+
+TEST(RenderJob, upAxisShadingAndRequestChecks) {
+  RenderRequest request;
+  request.inputs = {"a.LAS", "b.las"};
+  EXPECT_TRUE(zUpFor(request));
+  request.inputs.push_back("c.ply");
+  EXPECT_FALSE(zUpFor(request));
+  request.up_axis = UpAxis::kZ;
+  EXPECT_TRUE(zUpFor(request));
+
+  Bounds flat = cube();
+  flat.planar = true;
+  EXPECT_EQ(shadingFor(request, cube()), Shading::kEdl);
+  EXPECT_EQ(shadingFor(request, flat), Shading::kNone);
+  request.shading = Shading::kEdl;
+  EXPECT_EQ(shadingFor(request, flat), Shading::kEdl);
+  request.shading.reset();
+  request.error = true;
+  EXPECT_EQ(shadingFor(request, cube()), Shading::kNone) << "--error compares plain pixels";
+
+  EXPECT_TRUE(checkPictureOutput("a.PNG").ok());
+  EXPECT_TRUE(checkPictureOutput("/dev/null").ok());
+  EXPECT_EQ(checkPictureOutput("a.jpg").error().message, "-o a.jpg: the picture is written as PNG; name it .png");
+  EXPECT_EQ(checkModeName("emulated").error().message,
+            "--mode must be auto, fp32, split, rte, df64, native or batch, got 'emulated'");
+  EXPECT_TRUE(checkModeName("auto").ok() && checkModeName("df64").ok());
+  RenderRequest sheet;
+  sheet.views = 4;
+  EXPECT_TRUE(checkRenderRequest(sheet).ok());
+  sheet.report = true;
+  EXPECT_EQ(checkRenderRequest(sheet).error().code, ExitCode::kUsage);
+  sheet.views = 2;
+  EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views must be 1 or 4, got 2");
+}
+
+TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
+  RenderRequest request;
+  request.mode = "fp32";
+  request.camera.width = 64, request.camera.height = 48;
+  RenderOutcome outcome;
+  outcome.points = 10;
+  outcome.device.name = "dev \"1\"";
+  outcome.device.type = "cpu";
+  outcome.prediction.mode = *parseMode("fp32");
+  outcome.prediction.bound_px = std::nan("");
+  outcome.result.frame_ms = {2.0, 4.0};
+  outcome.result.chunks = 1;
+  outcome.phases.mark("read");
+  outcome.error = ErrorReport{};
+  outcome.error->stats.points = 3;
+  outcome.error->stats.lost = 3;
+  const std::string json = renderReportJson(request, outcome);
+  EXPECT_EQ(json.rfind("{\n  \"mode\": \"fp32\",\n  \"mode_requested\": \"fp32\",\n  \"predicted_bound_px\": null,\n"
+                       "  \"backend\": \"raster\",\n  \"order\": \"input\",\n  \"device\": \"dev \\\"1\\\"\",\n", 0),
+            0u)
+      << json;
+  for (const char* line : {"  \"width\": 64,\n  \"height\": 48,\n  \"frames\": 2,\n  \"gpu_ms\": null,\n",
+                           "  \"frame_ms\": {\"median\": 3, \"p95\": 4},\n", "\"phases_ms\": {\"read\": ",
+                           "  \"native_path\": null,\n  \"error_px\": null,\n",
+                           "  \"points_visible\": 3,\n  \"points_lost\": 3,\n  \"pixels_differing\": null\n}\n"})
+    EXPECT_NE(json.find(line), std::string::npos) << line << " in\n" << json;
+  EXPECT_EQ(json.find("\"auto\""), std::string::npos) << "no choice made: no auto member";
+}
+
+}  // namespace
+}  // namespace dpoint

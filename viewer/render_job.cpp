@@ -1,0 +1,464 @@
+#include "viewer/render_job.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cmath>
+#include <future>
+#include <memory>
+
+#include "converters/point_inputs.h"
+#include "converters/point_io.h"
+#include "core/interrupt.h"
+#include "core/json_writer.h"
+#include "core/memory.h"
+#include "image/canvas.h"
+#include "ops/point_filters.h"
+#include "viewer/reference.h"
+
+namespace dpoint {
+namespace {
+
+// `path` ends with `extension` (lower case, with its dot), in any case.
+bool hasExtension(const std::string& path, const std::string& extension) {
+  if (path.size() < extension.size()) return false;
+  std::string tail = path.substr(path.size() - extension.size());
+  std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return tail == extension;
+}
+
+// The input as the run draws it: in memory, or a stream read a block at a time (a binary PLY
+// larger than memory), with what every view shares.
+struct LoadedSet {
+  std::string inputs;  // describeInputs: for messages
+  std::optional<PointSet> points;
+  std::unique_ptr<PointInputStream> stream;
+  size_t count = 0;
+  Bounds bounds;
+  bool has_colors = false;
+  bool elevation = false;  // coloured by elevation along the up axis (a stream: block by block)
+  bool z_up = false;
+};
+
+// The bounds and planarity of a streamed set: one pass over it, a block at a time.
+Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress) {
+  Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
+  PointSet block;
+  progress.start("bounds of " + path + " (points)", ply.count());
+  for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
+    const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
+    if (interrupted()) return interruptedError();
+    if (Status status = ply.read(first, n, block); !status) return status.error();
+    progress.advance(n);
+    const Box box = boundingBox(block.positions);
+    bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
+    bounds.planar = bounds.planar && block.isPlanar();
+  }
+  progress.finish();
+  return bounds;
+}
+
+LasColorSource lasColorOf(RenderColor color) {
+  // LAS fields as colours; elevation replaces whatever the file holds.
+  switch (color) {
+    case RenderColor::kIntensity: return LasColorSource::kIntensity;
+    case RenderColor::kClassification: return LasColorSource::kClassification;
+    case RenderColor::kElevation: return LasColorSource::kNone;
+    default: return LasColorSource::kAuto;
+  }
+}
+
+// Opens the input as a stream (large binary PLY) or reads it whole; its bounds, colours and order.
+Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
+  LoadedSet set;
+  set.inputs = describeInputs(request.inputs);
+  const std::string& inputs = set.inputs;
+  Result<std::unique_ptr<PointInputStream>> opened = openPointStream(request.inputs, request.stream, request.threads);
+  if (!opened) return opened.error();
+  set.stream = std::move(*opened);
+  PointInputStream* ply = set.stream.get();
+  if (ply && (request.color == RenderColor::kIntensity || request.color == RenderColor::kClassification))
+    return Error{inputs + ": --color " + renderColorName(request.color) + " needs LAS input", ExitCode::kBadInput};
+  if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
+    return Error{inputs + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
+                 "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
+  if (ply) {
+    if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
+    Result<Bounds> bounds = streamBounds(inputs, *ply, progress);
+    if (!bounds) return bounds.error();
+    set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
+    phases.mark("bounds");
+  } else {
+    ReadOptions read_options{request.threads, false, &progress, true};
+    read_options.max_memory = request.max_memory;
+    read_options.las_color = lasColorOf(request.color);
+    Result<PointSet> read = readPointInputs(request.inputs, read_options);
+    if (!read) return read.error();
+    set.points = std::move(*read);
+    phases.mark("read");
+    if (set.points->size() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
+    set.count = set.points->size(), set.has_colors = set.points->hasColors();
+  }
+  if (request.color == RenderColor::kRgb && !set.has_colors)
+    return Error{inputs + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput};
+  set.z_up = zUpFor(request);
+  if (set.points) set.bounds = boundsOf(*set.points);
+  // A 2D set has no elevation: without colours its points stay white.
+  set.elevation = request.color == RenderColor::kElevation ||
+                  (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar);
+  if (set.points) {
+    if (set.elevation) colorByElevation(*set.points, set.z_up ? 2 : 1, request.threads);
+    reorderPoints(*set.points, request.order, request.threads, &progress);
+    phases.mark("order");
+  }
+  return set;
+}
+
+// --mode auto picks on the device; an explicit mode gets its bound computed for the report.
+Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanContext& context, const PointSet& points,
+                                   const Camera& camera) {
+  ModePrediction p;
+  if (request.mode != "auto") {
+    p.mode = *parseMode(request.mode);
+    const PrecisionMode one[] = {p.mode};
+    p.bound_px = predictErrorBounds(points, camera, one).px[modeIndex(p.mode)];
+    return p;
+  }
+  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, request.backend, request.error);
+  if (!choice) return choice.error();
+  p.mode = choice->mode;
+  p.bound_px = choice->bound_px;
+  p.choice = std::move(*choice);
+  return p;
+}
+
+// A streamed set is read once, so no bound is predicted from its points: --mode auto takes native,
+// which holds to well under 0.1 px wherever the study's hard cases reach.
+ModePrediction streamedModePrediction(const RenderRequest& request) {
+  ModePrediction p;
+  // TODO(modes): the mode auto takes for a streamed set, from the table.
+  p.mode = request.mode == "auto" ? PrecisionMode::kNative : *parseMode(request.mode);
+  p.bound_px = std::nan("");
+  return p;
+}
+
+RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& set, PrecisionMode mode,
+                               const Camera& camera, const DeviceFacts& facts) {
+  RenderOptions options;
+  options.mode = mode;
+  options.backend = request.backend;
+  options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts);
+  options.background_rgba8 = request.background_rgba8;
+  options.frames = request.frames;
+  options.warmup_frames = request.warmup;
+  options.probe = request.error;
+  options.native_path = request.native_path;
+  options.max_chunk_points = request.chunk_points;
+  options.shading = shadingFor(request, set.bounds);
+  options.edl = request.edl;
+  return options;
+}
+
+// --views 4: each view rendered in its own mode (--mode auto decides per view), one labelled sheet.
+Status renderSheet(const RenderRequest& request, const VulkanContext& context, const LoadedSet& set,
+                   const std::vector<RenderView>& views, const std::vector<Camera>& cameras, RenderOutcome& outcome,
+                   const std::function<void(const SheetView&)>& view_done) {
+  std::vector<LabelledView> sheet;
+  for (size_t i = 0; i < views.size(); ++i) {
+    Result<ModePrediction> prediction = predictMode(request, context, *set.points, cameras[i]);
+    if (!prediction) return prediction.error();
+    const RenderOptions options = renderOptionsFor(request, set, prediction->mode, cameras[i], context.facts);
+    Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options);
+    if (!rendered) return rendered.error();
+    const std::string mode(modeName(prediction->mode));
+    sheet.push_back({std::string(views[i].label) + " (" + mode + ")", std::move(rendered->image)});
+    outcome.views.push_back({views[i].label, std::move(*prediction), std::move(rendered->gpu_ms)});
+    if (view_done) view_done(outcome.views.back());
+  }
+  outcome.image = composeContactSheet(sheet, 2);
+  return okStatus();
+}
+
+// One view, the set in memory or streamed: the render and, with --error, the error measured.
+Status renderOne(const RenderRequest& request, const VulkanContext& context, const LoadedSet& set,
+                 const Camera& camera, RenderOutcome& outcome, Progress& progress) {
+  Result<ModePrediction> prediction =
+      set.stream ? streamedModePrediction(request) : predictMode(request, context, *set.points, camera);
+  if (!prediction) return prediction.error();
+  outcome.prediction = std::move(*prediction);
+  outcome.phases.mark("mode");
+  const RenderOptions options = renderOptionsFor(request, set, outcome.prediction.mode, camera, context.facts);
+  outcome.point_size = options.point_size;
+  outcome.shading = options.shading;
+  Result<RenderResult> rendered = [&]() -> Result<RenderResult> {
+    if (!set.stream) return renderPoints(context, *set.points, camera, options);
+    PointStream stream;
+    stream.count = set.count;
+    stream.has_colors = set.has_colors || set.elevation;
+    const int axis = set.z_up ? 2 : 1;
+    stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
+      if (Status status = set.stream->read(first, n, block); !status) return status;
+      if (set.elevation) colorByElevation(block, axis, set.bounds.min[axis], set.bounds.max[axis], request.threads);
+      progress.advance(n);
+      return okStatus();
+    };
+    progress.start("streaming " + set.inputs + " to the GPU (points)", set.count);
+    Result<RenderResult> streamed = renderStream(context, stream, camera, options);
+    progress.finish();
+    return streamed;
+  }();
+  if (!rendered) return rendered.error();
+  outcome.phases.mark("render");
+  if (request.error) {
+    outcome.error = measureError(*set.points, camera, *rendered, options);
+    outcome.phases.mark("error");
+  }
+  outcome.image = std::move(rendered->image);
+  outcome.result = std::move(*rendered);
+  return okStatus();
+}
+
+}  // namespace
+
+std::optional<RenderColor> parseRenderColor(std::string_view name) {
+  for (RenderColor c : {RenderColor::kAuto, RenderColor::kRgb, RenderColor::kElevation, RenderColor::kIntensity,
+                        RenderColor::kClassification})
+    if (name == renderColorName(c)) return c;
+  return std::nullopt;
+}
+
+const char* renderColorName(RenderColor color) {
+  switch (color) {
+    case RenderColor::kRgb: return "rgb";
+    case RenderColor::kElevation: return "elevation";
+    case RenderColor::kIntensity: return "intensity";
+    case RenderColor::kClassification: return "classification";
+    default: return "auto";
+  }
+}
+
+const char* backendName(Backend backend) { return backend == Backend::kCompute ? "compute" : "raster"; }
+
+Status checkPictureOutput(const std::string& path) {
+  if (!hasExtension(path, ".png") && path.rfind("/dev/", 0) != 0)
+    return Error{"-o " + path + ": the picture is written as PNG; name it .png", ExitCode::kUsage};
+  return okStatus();
+}
+
+Status checkModeName(const std::string& mode) {
+  if (mode == "auto" || parseMode(mode)) return okStatus();
+  std::string names = "auto";
+  for (size_t i = 0; i < kModeCount; ++i) names += (i + 1 == kModeCount ? " or " : ", ") + std::string(modeName(kAllModes[i]));
+  return Error{"--mode must be " + names + ", got '" + mode + "'", ExitCode::kUsage};
+}
+
+Status checkViewCount(uint32_t views) {
+  if (views == 1 || views == 4) return okStatus();
+  return Error{"--views must be 1 or 4, got " + std::to_string(views), ExitCode::kUsage};
+}
+
+Status checkRenderRequest(const RenderRequest& request) {
+  if (Status s = checkModeName(request.mode); !s) return s;
+  if (Status s = checkViewCount(request.views); !s) return s;
+  if (request.views == 4) {
+    if (request.camera.eye || request.camera.ortho.value_or(false))
+      return Error{"--views 4 frames each view with --fit in perspective; drop --eye/--target/--up and --ortho",
+                   ExitCode::kUsage};
+    if (request.error || request.report)
+      return Error{"--views 4 makes a contact sheet; --error and --json measure one view (use --views 1)",
+                   ExitCode::kUsage};
+  }
+  return okStatus();
+}
+
+void RenderPhases::mark(const char* name) {
+  const auto now = std::chrono::steady_clock::now();
+  list_.emplace_back(name, std::chrono::duration<double, std::milli>(now - last_).count());
+  last_ = now;
+}
+
+double peakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // kilobytes on Linux
+}
+
+std::vector<RenderView> viewsFor(uint32_t count, bool z_up) {
+  const RenderView three_quarter = z_up ? RenderView{"three-quarter", {0.6, -1.0, 0.5}, {0, 0, 1}}
+                                        : RenderView{"three-quarter", {0.6, 0.5, 1.0}, {0, 1, 0}};
+  if (count == 1) return {three_quarter};
+  if (z_up)
+    return {{"front", {0, -1, 0}, {0, 0, 1}}, {"side", {1, 0, 0}, {0, 0, 1}}, {"top", {0, 0, 1}, {0, 1, 0}}, three_quarter};
+  return {{"front", {0, 0, 1}, {0, 1, 0}}, {"side", {1, 0, 0}, {0, 1, 0}}, {"top", {0, 1, 0}, {0, 0, -1}}, three_quarter};
+}
+
+bool zUpFor(const RenderRequest& request) {
+  if (request.up_axis != UpAxis::kAuto) return request.up_axis == UpAxis::kZ;
+  return std::all_of(request.inputs.begin(), request.inputs.end(),
+                     [](const std::string& path) { return hasExtension(path, ".las"); });
+}
+
+Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std::vector<RenderView>& views,
+                                        const Bounds& bounds) {
+  const CameraSpec& spec = request.camera;
+  const bool z_up = zUpFor(request);
+  std::vector<Camera> cameras;
+  for (const RenderView& view : views) {
+    CameraSpec view_spec = spec;
+    // One y-up view is makeCamera's own default fit.
+    if (!spec.eye && (views.size() == 4 || z_up)) view_spec.fit_direction = view.direction, view_spec.fit_up = view.up;
+    // Four views share the picture: each gets a quarter, so the sheet keeps about width x height.
+    if (views.size() == 4) view_spec.width = std::max(1u, spec.width / 2), view_spec.height = std::max(1u, spec.height / 2);
+    Result<Camera> camera = makeCamera(view_spec, bounds);
+    if (!camera) return camera.error();
+    cameras.push_back(*camera);
+  }
+  return cameras;
+}
+
+// It keys on the data, not the camera: a survey seen from above with --ortho still has the relief
+// EDL brings out, and a flat set seen in perspective has no relief, only the depth ramp of a
+// tilted plane. With --error the image check compares plain pixels with the reference raster.
+Shading shadingFor(const RenderRequest& request, const Bounds& bounds) {
+  if (request.shading) return *request.shading;
+  if (request.error) return Shading::kNone;
+  return bounds.planar ? Shading::kNone : Shading::kEdl;
+}
+
+// The spacing of a quarter of the points (a closed surface shows its front half, and a folded one
+// like a fractal's hides about half of that behind its own folds) over the ellipse inside the
+// bounding box's screen rectangle, rounded up, at most 4 px. Always 1 for 2D (ortho) views, the
+// compute backend (size-1 points only) and with --error (the reference raster draws 1-px points).
+float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box, const Camera& camera,
+                   const DeviceFacts& facts) {
+  if (request.point_size) return static_cast<float>(*request.point_size);
+  if (request.error || request.backend == Backend::kCompute || camera.ortho || !facts.large_points) return 1.0f;
+  std::vector<glm::dvec3> corners;
+  for (int i = 0; i < 8; ++i)
+    corners.push_back({(i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z});
+  double x0 = camera.width, y0 = camera.height, x1 = 0.0, y1 = 0.0;
+  for (const WindowPoint& w : projectReference(corners, camera)) {
+    if (!w.visible) return 1.0f;  // the eye is inside or near the box: no outline to fill
+    x0 = std::min(x0, std::max(w.x, 0.0)), x1 = std::max(x1, std::min(w.x, double(camera.width)));
+    y0 = std::min(y0, std::max(w.y, 0.0)), y1 = std::max(y1, std::min(w.y, double(camera.height)));
+  }
+  const double area = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0) * 0.25 * 3.14159265358979;
+  const double spacing = std::sqrt(area / std::max(1.0, 0.25 * static_cast<double>(count)));
+  return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(4.0, double(facts.max_point_size))));
+}
+
+Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progress,
+                                   const std::function<void(const SheetView&)>& view_done) {
+  if (Status s = checkRenderRequest(request); !s) return s.error();
+  // Before the input is read: a 1000000-pixel-wide picture should not wait for a large file to load first.
+  const CameraSpec& spec = request.camera;
+  const uint64_t pixels = uint64_t{spec.width} * spec.height;
+  if (Status s = checkMemory("a " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " picture",
+                             pixels * kPictureBytesPerPixel, request.max_memory);
+      !s)
+    return s.error();
+
+  RenderOutcome outcome;
+  // The Vulkan device is made while the input is read: creating it takes 150 ms or more on the
+  // NVIDIA driver, a good part of a 16.7M-point render's second. Its errors wait until the input
+  // has been read, so a bad file is still reported first.
+  std::future<Result<std::unique_ptr<VulkanContext>>> device_made = std::async(std::launch::async, [&request] {
+    return VulkanContext::create(ContextOptions{request.device, request.validate, request.max_device_memory});
+  });
+  Result<LoadedSet> set = loadInput(request, progress, outcome.phases);
+  if (!set) return set.error();
+  outcome.points = set->count;
+  outcome.streamed = set->stream != nullptr;
+  if (request.views == 4 && set->bounds.planar)
+    return Error{set->inputs + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
+                 ExitCode::kUsage};
+  const std::vector<RenderView> views = viewsFor(request.views, set->z_up);
+  Result<std::vector<Camera>> cameras = viewCameras(request, views, set->bounds);
+  if (!cameras) return cameras.error();
+  outcome.phases.mark("camera");
+
+  if (Result<std::unique_ptr<VulkanContext>> made = device_made.get(); made)
+    outcome.context = std::move(*made);
+  else
+    return made.error();
+  outcome.phases.mark("device");  // what is left of making it once the input is in
+  const VulkanContext& context = *outcome.context;
+  outcome.device = context.facts;
+  Status rendered = views.size() == 4 ? renderSheet(request, context, *set, views, *cameras, outcome, view_done)
+                                      : renderOne(request, context, *set, cameras->front(), outcome, progress);
+  if (!rendered) return rendered.error();
+  outcome.validation_messages = context.validationMessages();
+  return outcome;
+}
+
+Status writeRenderPicture(const std::string& path, RenderOutcome& outcome) {
+  if (Status written = writePng(path, outcome.image); !written) return written;
+  outcome.phases.mark("png");
+  return okStatus();
+}
+
+std::string renderReportJson(const RenderRequest& request, const RenderOutcome& outcome) {
+  const DeviceFacts& f = outcome.device;
+  const RenderResult& r = outcome.result;
+  const PrecisionMode mode = outcome.prediction.mode;
+  const double gpu_median = medianOf(r.gpu_ms), frame_median = medianOf(r.frame_ms);
+  const double per_frame_ms = r.gpu_ms.empty() ? frame_median : gpu_median;
+  using V = JsonValue;
+  JsonObject o;
+  o.add("mode", V::string(modeName(mode))).add("mode_requested", V::string(request.mode));
+  o.add("predicted_bound_px", V::number(outcome.prediction.bound_px));
+  if (const std::optional<ModeChoice>& c = outcome.prediction.choice) {
+    JsonObject choice;
+    choice.add("enough", V::boolean(c->enough)).add("limit_px", V::number(kAutoBoundPx));
+    choice.add("device_class", V::string(deviceClassName(deviceClassOf(f.type))));
+    if (c->runner_up)
+      choice.add("runner_up", JsonObject()
+                                  .add("mode", V::string(modeName(*c->runner_up)))
+                                  .add("predicted_bound_px", V::number(c->runner_up_bound_px)));
+    else
+      choice.add("runner_up", V::null());
+    o.add("auto", choice);
+  }
+  o.add("backend", V::string(backendName(request.backend))).add("order", V::string(pointOrderName(request.order)));
+  o.add("device", V::string(f.name)).add("device_type", V::string(f.type));
+  o.add("driver", V::string(f.driver_name + " " + f.driver_info));
+  o.add("driver_version", V::string(formatDriverVersion(f.vendor_id, f.driver_version)));
+  o.add("api_version", V::string(formatApiVersion(f.api_version)));
+  o.add("points", V::integer(outcome.points));
+  o.add("width", V::integer(request.camera.width)).add("height", V::integer(request.camera.height));
+  o.add("frames", V::integer(r.frame_ms.size()));
+  if (r.gpu_ms.empty()) {
+    o.add("gpu_ms", V::null());
+  } else {
+    o.add("gpu_ms", JsonObject()
+                        .add("median", V::number(gpu_median))
+                        .add("p95", V::number(percentileOf(r.gpu_ms, 95)))
+                        .add("min", V::number(*std::min_element(r.gpu_ms.begin(), r.gpu_ms.end()))));
+    // Every timed frame in order: a slow start (the first frames after a large upload) shows here.
+    o.add("gpu_ms_each", V::numbers(r.gpu_ms));
+  }
+  o.add("frame_ms", JsonObject().add("median", V::number(frame_median)).add("p95", V::number(percentileOf(r.frame_ms, 95))));
+  o.add("upload_ms", V::number(r.upload_ms)).add("readback_ms", V::number(r.readback_ms));
+  o.add("e2e_ms", V::number(r.upload_ms + frame_median + r.readback_ms));
+  JsonObject phases;
+  for (const auto& [name, ms] : outcome.phases.list()) phases.add(name, V::number(ms));
+  o.add("phases_ms", phases).add("peak_rss_mb", V::number(peakRssMb()));
+  o.add("points_per_s", V::number(static_cast<double>(outcome.points) / (per_frame_ms * 1e-3)));
+  o.add("bytes_per_point", V::integer(bytesPerPoint(mode))).add("chunks", V::integer(r.chunks));
+  // TODO(modes): whether the mode has a native path to report, from the table.
+  o.add("native_path", mode != PrecisionMode::kNative ? V::null() : V::string(r.pulled_positions ? "pull" : "attribute"));
+  if (const std::optional<ErrorReport>& error = outcome.error) {
+    const ErrorStats& e = error->stats;
+    o.add("error_px", anyMeasured(e) ? V::object(JsonObject()
+                                                     .add("max", V::number(e.max_px))
+                                                     .add("p99", V::number(e.p99_px))
+                                                     .add("rms", V::number(e.rms_px)))
+                                     : V::null());
+    o.add("share_off_half_px", V::number(e.share_off_half_px));
+    o.add("points_visible", V::integer(e.points)).add("points_lost", V::integer(e.lost));
+    o.add("pixels_differing", error->pixels_compared ? V::integer(error->pixels_differing) : V::null());
+  }
+  return o.block();
+}
+
+}  // namespace dpoint

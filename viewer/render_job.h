@@ -1,0 +1,166 @@
+// One `dpoint render` run as a library call. A front end (the CLI, a Python module) fills a
+// RenderRequest with what the user asked, calls runRenderJob and gets back a RenderOutcome: the
+// picture and the facts to print or report (renderReportJson: the JSON of render's --json). The
+// policies live here so that every front end gives the same answer: the point size, the views of
+// a contact sheet and their cameras, the shading, the up axis, the colouring, the streaming of a
+// large PLY (its bounds in one pass) and the mode (--mode auto's choice, or the bound of the mode
+// asked for). Nothing here prints; progress goes to the caller's Progress.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/progress.h"
+#include "core/result.h"
+#include "image/image.h"
+#include "ops/point_order.h"
+#include "viewer/camera.h"
+#include "viewer/precision.h"
+#include "viewer/probe.h"
+#include "viewer/render.h"
+#include "vulkan/context.h"
+
+namespace dpoint {
+
+// --color: where the points' colours come from.
+enum class RenderColor { kAuto, kRgb, kElevation, kIntensity, kClassification };
+std::optional<RenderColor> parseRenderColor(std::string_view name);
+const char* renderColorName(RenderColor color);
+
+// --up-axis: the data's up for the fitted views. auto: z for LAS input (surveys), y otherwise.
+enum class UpAxis { kAuto, kY, kZ };
+
+const char* backendName(Backend backend);  // "raster", "compute"
+
+// What the user asked for, as plain values (the CLI's options, parsed).
+struct RenderRequest {
+  std::vector<std::string> inputs;   // drawn as one (point_inputs.h)
+  std::string mode = "auto";         // a mode name (modeName) or "auto"
+  Backend backend = Backend::kRaster;
+  std::string device = "auto";       // ContextOptions::device
+  bool validate = false;             // the Khronos validation layer; messages come back in the outcome
+  uint64_t max_device_memory = 0;    // 0: what the device has
+  CameraSpec camera;                 // the picture's size and the user's camera
+  std::optional<double> point_size;  // pixels; none: pointSizeFor's choice
+  uint32_t background_rgba8 = 0xff000000u;
+  std::optional<Shading> shading;    // none: shadingFor's choice
+  EdlOptions edl;
+  RenderColor color = RenderColor::kAuto;
+  UpAxis up_axis = UpAxis::kAuto;
+  PointOrder order = PointOrder::kInput;
+  uint32_t views = 1;                // 1, or 4: a contact sheet of four labelled views
+  bool error = false;                // measure the error against the exact CPU reference
+  bool report = false;               // a report (renderReportJson) is wanted: one view only
+  uint32_t frames = 1, warmup = 1;
+  uint64_t chunk_points = 0;         // most points per draw; 0: as the device allows
+  NativePath native_path = NativePath::kAuto;
+  std::string stream = "auto";       // auto|on|off (openPointStream)
+  uint64_t max_memory = 0;           // host memory limit in bytes; 0: half of RAM
+  unsigned threads = 0;
+};
+
+// -o: the picture is written as PNG (a .png name, or a device such as /dev/null). kUsage.
+Status checkPictureOutput(const std::string& path);
+// --mode: auto or a mode name (kUsage, listing them).
+Status checkModeName(const std::string& mode);
+// --views: 1 or 4 (kUsage).
+Status checkViewCount(uint32_t views);
+// The request's combinations: --views 1 or 4, and 4 only with the fitted perspective camera and
+// without --error or a report; a known mode name. kUsage, naming the flags.
+Status checkRenderRequest(const RenderRequest& request);
+
+// Host and device bytes per pixel at most: colour and depth (or the compute backend's 64-bit key
+// and packed picture), the readback buffer, the host image and, with --error, the reference raster.
+inline constexpr uint64_t kPictureBytesPerPixel = 32;
+
+// Where a run's wall time goes, step by step (the time to a picture).
+class RenderPhases {
+ public:
+  void mark(const char* name);
+  const std::vector<std::pair<const char*, double>>& list() const { return list_; }  // milliseconds
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  std::vector<std::pair<const char*, double>> list_;
+};
+// The process's peak resident memory so far, in MB.
+double peakRssMb();
+
+// What the run predicted for its mode: the bound, and with --mode auto the choice made.
+struct ModePrediction {
+  PrecisionMode mode = PrecisionMode::kNative;
+  double bound_px = 0.0;             // NaN for a streamed set (none predicted)
+  std::optional<ModeChoice> choice;  // --mode auto
+};
+
+// A view of a contact sheet: its label and the fit's direction (target to eye) and up.
+struct RenderView {
+  const char* label;
+  glm::dvec3 direction, up;
+};
+// One view: the three-quarter one; four: front, side, top, three-quarter. Directions are in the
+// up axis's frame: with z up, "front" looks along +y and the oblique view sits in front, above.
+std::vector<RenderView> viewsFor(uint32_t count, bool z_up);
+// The up axis the request's views use (UpAxis::kAuto: z when every input is .las).
+bool zUpFor(const RenderRequest& request);
+// The camera of each view: the request's own for one y-up view, else fitted along the view's
+// direction; four views get a quarter of the picture each.
+Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std::vector<RenderView>& views,
+                                        const Bounds& bounds);
+
+// Shading auto: eye-dome lighting for a 3D set, none for a 2D one and with --error.
+Shading shadingFor(const RenderRequest& request, const Bounds& bounds);
+// Point size auto: 1 px, or up to 4 px when a 3D set has too few points to cover its outline.
+float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box, const Camera& camera,
+                   const DeviceFacts& facts);
+
+// Points the probe measured: visible in the reference and not lost. With none, there is no error
+// to report (null, never a perfect 0).
+inline bool anyMeasured(const ErrorStats& e) { return e.points > e.lost; }
+
+// One rendered view of a contact sheet (--views 4).
+struct SheetView {
+  std::string label;
+  ModePrediction prediction;
+  std::vector<double> gpu_ms;
+};
+
+struct RenderOutcome {
+  Image image;                 // the picture (the contact sheet with four views)
+  // The device it ran on, kept open for the caller: destroyed with the outcome, after the
+  // picture is written (its teardown is no part of the run's phases).
+  std::unique_ptr<VulkanContext> context;
+  size_t points = 0;
+  bool streamed = false;       // drawn a block at a time (no prediction, no --error)
+  DeviceFacts device;
+  std::vector<std::string> validation_messages;  // with `validate`: any fails the run
+  // One view:
+  ModePrediction prediction;
+  float point_size = 1.0f;
+  Shading shading = Shading::kNone;
+  RenderResult result;         // timings and counts (its image moved to `image`)
+  std::optional<ErrorReport> error;
+  RenderPhases phases;
+  // Four views:
+  std::vector<SheetView> views;
+};
+
+// Runs the request: checks it, reads (or streams) the input, makes the device, picks the mode and
+// the views, renders, measures the error. `view_done` (may be empty) hears of each view of a
+// contact sheet as it is drawn. The picture is not written: writeRenderPicture does it.
+Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progress,
+                                   const std::function<void(const SheetView&)>& view_done = {});
+
+// Writes the outcome's picture as PNG and counts the time as the phase "png".
+Status writeRenderPicture(const std::string& path, RenderOutcome& outcome);
+
+// The JSON report of one view (render's --json), with the peak memory at the time of the call.
+std::string renderReportJson(const RenderRequest& request, const RenderOutcome& outcome);
+
+}  // namespace dpoint
