@@ -17,15 +17,19 @@
 //
 // Adding a mode:
 //   1. its enumerator at the end of PrecisionMode below (kAllModes lists them; rows are in this order);
-//   2. its row in kModes in viewer/modes.cpp, with the functions the row points at beside it: the
-//      position encoder, the uniform builder (std140, as project.glsl declares it) and the
-//      per-point error bound (viewer/bound_terms.h has the shared terms), plus its speed ranks;
-//   3. its arithmetic in shaders/render/project.glsl under a MODE_… define, and its two (or three)
-//      dpoint_shader lines in CMakeLists.txt (raster vertex, compute splat; a pull variant where
-//      the raster path may read positions from a storage buffer), whose headers the row includes.
-// Nothing else names a mode: the CLI's --mode, `dpoint devices`, the bench's columns, the
-// pipelines, the encoder and --mode auto all walk this table. tests/viewer/modes_test.cpp checks
-// that the row's bytes match what its encoder writes and that every speed order holds it.
+//   2. its row at the end of kModes in viewer/modes.cpp, with the functions the row points at
+//      beside it: the position encoder, the uniform builder (std140, as project.glsl declares it)
+//      and the per-point error bound (bound::worstOf<itsBound>; the shared terms are in
+//      viewer/bound_terms.h, and a per-camera term no mode has yet goes in bound::Setup there),
+//      plus its speed ranks (kNoRank until measured);
+//   3. its arithmetic in shaders/render/project.glsl under a MODE_… define, and its dpoint_shader
+//      lines in CMakeLists.txt (raster vertex, compute splat; a pull variant where the raster path
+//      may read positions from a storage buffer), whose headers modes.cpp includes for the row.
+// Nothing else switches on a mode: --mode's names and help, `dpoint devices`, `dpoint info`, the
+// bench's columns and charts, the pipelines, the encoder and --mode auto all walk this table.
+// (bench/report.cpp's checks name the modes whose relations they check: split equals fp32, native
+// meets the float floor.) tests/viewer/modes_test.cpp checks each row against its encoder, its
+// uniform block, its layout and the speed orders.
 #pragma once
 
 #include <cstddef>
