@@ -4,7 +4,6 @@
 #include "viewer/precision.h"
 
 #include <algorithm>
-#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <optional>
