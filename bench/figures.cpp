@@ -2,6 +2,7 @@
 // mode along the sweeps with its predicted bound, and the montage of one hard view in every mode.
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 
 #include "bench/montage.h"
 #include "bench/report.h"
@@ -12,10 +13,13 @@ namespace {
 
 using namespace report;
 
-// Okabe–Ito colours (distinguishable with the common colour-vision deficiencies), one per mode.
-const char* const kModeColors[kModeCount] = {"#E69F00", "#CC79A7", "#56B4E9", "#009E73", "#0072B2", "#D55E00"};
-const Marker kModeMarkers[kModeCount] = {Marker::kCircle, Marker::kCross,  Marker::kTriangle,
-                                         Marker::kDiamond, Marker::kSquare, Marker::kStar};
+// Okabe–Ito colours (distinguishable with the common colour-vision deficiencies) and markers, taken
+// by the mode's place in the table (viewer/modes.h), so a new mode gets the next pair unasked.
+const char* const kPalette[] = {"#E69F00", "#CC79A7", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#F0E442", "#000000"};
+const Marker kMarkers[] = {Marker::kCircle, Marker::kCross, Marker::kTriangle, Marker::kDiamond,
+                           Marker::kSquare, Marker::kStar,  Marker::kPlus,     Marker::kTriangleDown};
+const char* modeColor(size_t m) { return kPalette[m % std::size(kPalette)]; }
+Marker modeMarker(size_t m) { return kMarkers[m % std::size(kMarkers)]; }
 const char* backendColor(Backend backend) { return backend == Backend::kCompute ? "#0072B2" : "#E69F00"; }
 
 ChartPoint errorPoint(double x, const BenchRow& row) {
@@ -55,7 +59,7 @@ Chart speedVsErrorChart(const BenchRun& run) {
         ChartSeries series;
         series.name = modeText(kAllModes[m]) + " " + backendText(backend);
         series.color = backendColor(backend);
-        series.marker = kModeMarkers[m];
+        series.marker = modeMarker(m);
         for (const BenchRow& row : run.rows) {
           if (row.bench_case->family != family || row.backend != backend || row.mode != kAllModes[m] || !ran(&row)) continue;
           series.points.push_back(errorPoint(frameMs(row), row));
@@ -71,7 +75,7 @@ Chart speedVsErrorChart(const BenchRun& run) {
     }
     chart.panels.push_back(std::move(panel));
   }
-  for (size_t m = 0; m < kModeCount; ++m) chart.legend.push_back({modeText(kAllModes[m]), "#444444", kModeMarkers[m]});
+  for (size_t m = 0; m < kModeCount; ++m) chart.legend.push_back({modeText(kAllModes[m]), "#444444", modeMarker(m)});
   for (Backend backend : backends) chart.legend.push_back({backendText(backend) + " backend", backendColor(backend), Marker::kSquare});
   chart.legend.push_back({"0.5 px (wrong pixel)", "#C00000", Marker::kNone, true, true});
   chart.legend.push_back({"float floor: 2^-24 of half the view", "#666666", Marker::kNone, true, true});
@@ -98,8 +102,8 @@ std::optional<Chart> breakdownChart(const BenchRun& run) {
       ChartSeries measured, bound;
       measured.name = modeText(kAllModes[m]) + " measured";
       bound.name = modeText(kAllModes[m]) + " bound";
-      measured.color = bound.color = kModeColors[m];
-      measured.marker = kModeMarkers[m];
+      measured.color = bound.color = modeColor(m);
+      measured.marker = modeMarker(m);
       bound.marker = Marker::kNone;
       measured.line = bound.line = true;
       bound.dashed = true;
@@ -121,7 +125,7 @@ std::optional<Chart> breakdownChart(const BenchRun& run) {
     chart.panels.push_back(std::move(panel));
   }
   if (chart.panels.empty()) return std::nullopt;
-  for (size_t m = 0; m < kModeCount; ++m) chart.legend.push_back({modeText(kAllModes[m]), kModeColors[m], kModeMarkers[m], true});
+  for (size_t m = 0; m < kModeCount; ++m) chart.legend.push_back({modeText(kAllModes[m]), modeColor(m), modeMarker(m), true});
   chart.legend.push_back({"measured max error", "#444444", Marker::kNone, true, false});
   chart.legend.push_back({"predicted bound", "#444444", Marker::kNone, true, true});
   return chart;

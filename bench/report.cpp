@@ -51,7 +51,8 @@ void checkGroup(const BenchCase& c, Backend backend, const ModeRows& rows, std::
   }
   // Where fp32 is off by more than a pixel, every double-precision mode must do better.
   if (ran(fp32) && (!fp32->error_max_px || *fp32->error_max_px > 1.0)) {
-    for (PrecisionMode mode : {PrecisionMode::kRte, PrecisionMode::kDf64, PrecisionMode::kNative, PrecisionMode::kBatch}) {
+    for (PrecisionMode mode : kAllModes) {
+      if (!modeInfo(mode).scene_frame) continue;  // the study's absolute baselines, fp32 and split
       const BenchRow* row = rowOf(rows, mode);
       if (!ran(row) || !fp32->error_max_px) continue;
       if (!row->error_max_px || *row->error_max_px > *fp32->error_max_px)

@@ -1,4 +1,4 @@
-// Text helpers shared by the subcommands: option values in, numbers and JSON out.
+// Text helpers shared by the subcommands: option values in, numbers and JSON out, help text laid out.
 #pragma once
 
 #include <string>
@@ -19,5 +19,10 @@ inline Result<std::vector<double>> parseNumbers(const std::string& flag, const s
   return parseNumbers(flag, text, count, count);
 }
 Result<glm::dvec3> parseVec3(const std::string& flag, const std::string& text);
+
+// Help text as the subcommands lay it out: words greedily on lines of at most `width` characters
+// (a longer word stands alone on its line), joined by '\n', no trailing newline.
+inline constexpr size_t kHelpWidth = 102;
+std::string wrapText(const std::string& text, size_t width);
 
 }  // namespace dpoint

@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/memory.h"
 #include "core/progress.h"
+#include "viewer/modes.h"
 #include "viewer/render_job.h"
 
 namespace dpoint {
@@ -196,26 +197,34 @@ int runRender(const RenderCliOptions& o) {
   return validationResult(*outcome);
 }
 
+// `dpoint render --help`'s description; its list of modes comes from the mode table.
+std::string renderDescription() {
+  std::string absolute;  // the modes that work on absolute coordinates: the study's baselines
+  for (PrecisionMode mode : kAllModes) {
+    if (modeInfo(mode).scene_frame) continue;
+    absolute += (absolute.empty() ? "" : " and ") + std::string(modeName(mode));
+  }
+  return "Offscreen Vulkan point renderer: draws IN in one precision mode, writes a PNG, times the GPU, and with\n"
+         "--error measures the mode against the exact CPU reference. Works without a GPU (Mesa lavapipe).\n" +
+         wrapText("Modes: " + modeListHelp() + "; all but " + absolute +
+                      " work in a frame scaled to the view, so they hold at 1e-300 m as at 1 m. Each run prints the "
+                      "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.",
+                  kHelpWidth);
+}
+
 }  // namespace
 
 void addRenderCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<RenderCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render",
-      "Offscreen Vulkan point renderer: draws IN in one precision mode, writes a PNG, times the GPU, and with\n"
-      "--error measures the mode against the exact CPU reference. Works without a GPU (Mesa lavapipe).\n"
-      "Modes: fp32 (float positions), split (the study's hi+lo, no better than fp32), rte (relative to eye),\n"
-      "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins); all but fp32\n"
-      "and split work in a frame scaled to the view, so they hold at 1e-300 m as at 1 m. Each run prints the\n"
-      "mode's predicted error bound in pixels; `dpoint info IN` prints every mode's for a view.");
+      renderDescription());
   cmd->add_option("input", o->inputs,
                   "Point sets (.csv, .ply, .las, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
                   "whole. Large binary PLY input is streamed (--stream)")
       ->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required()->check(checkStatus(checkPictureOutput));
-  cmd->add_option("--mode", o->mode,
-                  "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"
-                  "order) whose predicted error bound is <= 0.1 px for this view; native when none is")
+  cmd->add_option("--mode", o->mode, modeOptionHelp())
       ->check(checkStatus(checkModeName))
       ->default_val("auto");
   cmd->add_option("--backend", o->backend,

@@ -4,7 +4,6 @@
 #include <cassert>
 #include <charconv>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <optional>
 
@@ -14,16 +13,6 @@ namespace dpoint {
 namespace {
 
 constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
-
-constexpr ModeInfo kModes[] = {
-    {PrecisionMode::kFp32, "fp32", 12, false, false},
-    {PrecisionMode::kSplit, "split", 24, false, false},
-    {PrecisionMode::kRte, "rte", 24, true, true},
-    {PrecisionMode::kDf64, "df64", 24, true, true},
-    {PrecisionMode::kNative, "native", 24, true, false},
-    {PrecisionMode::kBatch, "batch", 8, true, false},
-};
-static_assert(std::size(kModes) == kModeCount);
 
 std::string shortest(double v) {
   char text[32];
@@ -37,13 +26,6 @@ const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z";
 // under FLT_MAX to keep the test simple and safe.
 bool fitsFloat(double d) { return std::fabs(d) <= kFloatMax; }
 
-
-template <typename Value>
-void appendBytes(std::vector<uint8_t>& out, const Value& v) {
-  size_t at = out.size();
-  out.resize(at + sizeof(Value));
-  std::memcpy(out.data() + at, &v, sizeof(Value));
-}
 
 // The smallest power of two ≥ d (d ≥ 0); 1 for 0.
 double powerOfTwoAbove(double d) {
@@ -93,7 +75,7 @@ Error beyondFloat(PrecisionMode mode, size_t index, int axis, double value, cons
 // The first problem of point i, if it has one.
 std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& points, size_t i, size_t index_base) {
   const ModeInfo& info = modeInfo(e.mode);
-  const bool floats = e.mode != PrecisionMode::kNative && e.mode != PrecisionMode::kBatch;
+  const bool floats = info.layout.element == PositionElement::kFloat32;  // each coordinate stored as float(s)
   for (int axis = 0; axis < 3; ++axis) {
     const double value = points.positions[i][axis];
     const double in_frame = scaleBy(value, e.frame);
@@ -129,18 +111,6 @@ Status checkPositions(const ModeEncoding& e, const PointSet& points, size_t inde
 }
 
 }  // namespace
-
-const ModeInfo& modeInfo(PrecisionMode mode) {
-  const ModeInfo& info = kModes[modeIndex(mode)];
-  assert(info.mode == mode);
-  return info;
-}
-
-std::optional<PrecisionMode> parseMode(std::string_view name) {
-  for (const ModeInfo& info : kModes)
-    if (info.name == name) return info.mode;
-  return std::nullopt;
-}
 
 uint32_t encodeColor(const glm::vec3& color) {
   uint32_t packed = 0xff000000u;
@@ -206,10 +176,17 @@ FloatPair splitDouble(double d) {
 }
 
 SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera) {
+  if (modeInfo(mode).scene_frame) return sceneFrame(camera);
   SceneFrame frame;
   frame.eye = camera.eye;
   frame.projection_rotation = camera.projection * camera.rotation;
-  if (!modeInfo(mode).scene_frame) return frame;
+  return frame;
+}
+
+SceneFrame sceneFrame(const Camera& camera) {
+  SceneFrame frame;
+  frame.eye = camera.eye;
+  frame.projection_rotation = camera.projection * camera.rotation;
   // The view's size: the window for ortho; for perspective the far plane, which bounds every
   // eye-relative distance of a visible point (the projection is already scaled by 1/far).
   double size = camera.far_plane;
@@ -234,7 +211,7 @@ ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera) {
 
 Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
   if (Status status = checkPositions(e, block, first_index); !status) return status;
-  if (e.mode != PrecisionMode::kBatch) return okStatus();
+  if (modeInfo(e.mode).batch_points == 0) return okStatus();
   assert(first_index == e.batches.size() * kBatchSize);  // blocks in order, whole batches but the last
   const size_t first_batch = e.batches.size();
   for (const BatchFrame& frame : makeBatchFrames(block, e.frame)) e.batches.push_back(frame);
@@ -263,89 +240,11 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
 void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first, size_t count, void* out,
                      size_t index_base) {
   assert(first + count <= points.size());
-  auto* f = static_cast<float*>(out);
-  const glm::dvec3* p = points.positions.data() + first;
-  const SceneFrame& frame = e.frame;
-  switch (e.mode) {
-    case PrecisionMode::kFp32:
-      for (size_t i = 0; i < count; ++i)
-        for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(p[i][a]);
-      break;
-    case PrecisionMode::kSplit:
-    case PrecisionMode::kRte:
-    case PrecisionMode::kDf64:
-      // Interleaved per point: hi.xyz then lo.xyz (one 24-byte vertex binding).
-      for (size_t i = 0; i < count; ++i) {
-        for (int a = 0; a < 3; ++a) {
-          FloatPair pair = splitDouble(scaleBy(p[i][a], frame));
-          f[6 * i + a] = pair.hi;
-          f[6 * i + 3 + a] = pair.lo;
-        }
-      }
-      break;
-    case PrecisionMode::kNative:
-      if (frame.exponent == 0) {
-        std::memcpy(out, p, count * sizeof(glm::dvec3));
-      } else {
-        auto* d = static_cast<double*>(out);
-        for (size_t i = 0; i < count; ++i)
-          for (int a = 0; a < 3; ++a) d[3 * i + a] = scaleBy(p[i][a], frame);
-      }
-      break;
-    case PrecisionMode::kBatch: {
-      auto* words = static_cast<uint64_t*>(out);
-      for (size_t i = 0; i < count; ++i) {
-        const BatchFrame& batch = e.batches[(index_base + first + i) / kBatchSize];
-        // p·scale − origin rounds once in double; the division by a power of two is exact.
-        words[i] = packBatchOffset((scaleBy(p[i], frame) - batch.origin) / batch.extent);
-      }
-      break;
-    }
-  }
+  modeInfo(e.mode).encode(e, points.positions.data() + first, count, out, index_base + first);
 }
 
 std::vector<uint8_t> cameraUniform(const ModeEncoding& e, const Camera& camera) {
-  std::vector<uint8_t> out;
-  const SceneFrame& frame = e.frame;
-  switch (e.mode) {
-    case PrecisionMode::kFp32:
-    case PrecisionMode::kSplit: appendBytes(out, glm::mat4(camera.viewProjection())); break;
-    case PrecisionMode::kRte: {
-      // The translation is done in the shader against the eye's hi/lo parts, so the matrix
-      // holds only projection · rotation and never sees a large number.
-      appendBytes(out, glm::mat4(frame.projection_rotation));
-      float eye[8] = {};  // vec4 eye_hi, vec4 eye_lo (std140)
-      for (int a = 0; a < 3; ++a) {
-        FloatPair pair = splitDouble(frame.eye[a]);
-        eye[a] = pair.hi;
-        eye[4 + a] = pair.lo;
-      }
-      appendBytes(out, eye);
-      break;
-    }
-    case PrecisionMode::kDf64: {
-      glm::dmat4 translate(1.0);
-      translate[3] = glm::dvec4(-frame.eye, 1.0);
-      const glm::dmat4 mvp = frame.projection_rotation * translate;
-      glm::mat4 hi(0.0f), lo(0.0f);
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-          FloatPair pair = splitDouble(mvp[c][r]);
-          hi[c][r] = pair.hi;
-          lo[c][r] = pair.lo;
-        }
-      appendBytes(out, hi);
-      appendBytes(out, lo);
-      break;
-    }
-    case PrecisionMode::kNative:
-      // dmat4 projection_rotation, dvec4 eye (std140): the shader subtracts the eye first.
-      appendBytes(out, frame.projection_rotation);
-      appendBytes(out, glm::dvec4(frame.eye, 0.0));
-      break;
-    case PrecisionMode::kBatch: break;
-  }
-  return out;
+  return modeInfo(e.mode).uniform(e, camera);
 }
 
 std::vector<glm::mat4> batchMatrices(const ModeEncoding& e) {

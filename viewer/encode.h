@@ -1,19 +1,7 @@
 // What each precision mode sends to the GPU (DESIGN §4): the per-point position encoding, the
-// colour, and the camera uniforms, all derived from the same double Camera.
-//
-//   mode    per point (bytes)           shader arithmetic
-//   fp32    float xyz (12)              float MVP on absolute coordinates
-//   split   hi, lo floats (24)          the study's mvp·(hi + lo): the sum rounds back to hi
-//   rte     hi, lo floats (24)          (hi − eye_hi) + (lo − eye_lo) under `precise`, then a float
-//                                       projection·rotation with no translation
-//   df64    hi, lo floats (24)          double-float MVP (two-sum, split two-prod), splitter at run time
-//   native  double xyz (24)             p − eye in double, then projection·rotation in double; the clip
-//                                       position is cast to float at the end
-//   batch   integer offsets (8)         per batch of 4096 points: a double origin and power-of-two
-//                                       extent; each offset coordinate a 21-bit integer (2^−20 of the
-//                                       extent per step), three in one 64-bit word; a float matrix built
-//                                       in double maps them to clip space
-// Every mode adds 4 bytes of RGBA8 colour (the compute backend reads it only in the resolve).
+// colour, and the camera uniforms, all derived from the same double Camera. The modes themselves
+// (their layouts, encoders and uniform blocks) are rows of viewer/modes.h; this file holds what
+// they share and the entry points that dispatch to the row.
 //
 // The scene frame (DESIGN §4): every mode but fp32 and split (the study's absolute baselines) sees
 // positions multiplied by 2^exponent, chosen so the view's size is in [1, 2). Scaling by a power
@@ -35,32 +23,9 @@
 #include "core/point_set.h"
 #include "core/result.h"
 #include "viewer/camera.h"
+#include "viewer/modes.h"
 
 namespace dpoint {
-
-enum class PrecisionMode { kFp32, kSplit, kRte, kDf64, kNative, kBatch };
-inline constexpr PrecisionMode kAllModes[] = {PrecisionMode::kFp32, PrecisionMode::kSplit,
-                                              PrecisionMode::kRte,  PrecisionMode::kDf64,
-                                              PrecisionMode::kNative, PrecisionMode::kBatch};
-inline constexpr size_t kModeCount = std::size(kAllModes);
-
-// One row per mode: the facts every part of the renderer asks about.
-struct ModeInfo {
-  PrecisionMode mode;
-  std::string_view name;
-  uint32_t position_bytes;  // per point, colour not included
-  bool scene_frame;         // works in the scaled scene frame (all but the absolute baselines)
-  bool needs_self_test;     // emulated double: unusable where the compiler folds low parts away
-};
-const ModeInfo& modeInfo(PrecisionMode mode);
-inline size_t modeIndex(PrecisionMode mode) { return static_cast<size_t>(mode); }
-
-inline std::string_view modeName(PrecisionMode mode) { return modeInfo(mode).name; }
-std::optional<PrecisionMode> parseMode(std::string_view name);
-
-// Bytes of position data per point (colour not included).
-inline uint32_t positionBytes(PrecisionMode mode) { return modeInfo(mode).position_bytes; }
-inline uint32_t bytesPerPoint(PrecisionMode mode) { return positionBytes(mode) + 4; }
 
 // Points per batch in `batch` mode: consecutive points share one double origin and scale.
 inline constexpr uint32_t kBatchShift = 12;
@@ -89,6 +54,8 @@ struct SceneFrame {
   glm::dmat4 projection_rotation{1.0};  // projection · rotation · 2^−exponent (x, y, z columns)
 };
 SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera);
+// The scaled scene frame of the camera, whatever the mode (what every scene_frame mode gets).
+SceneFrame sceneFrame(const Camera& camera);
 
 // x · 2^exponent, correctly rounded (exact unless it over- or underflows): a multiplication by the
 // power of two where that is a normal double, ldexp beyond.
@@ -116,9 +83,9 @@ struct BatchFrame {
 
 // Everything the encoders and uniform builders need for one mode, one camera and one set.
 struct ModeEncoding {
-  PrecisionMode mode = PrecisionMode::kNative;
+  PrecisionMode mode = kFallbackMode;
   SceneFrame frame;
-  std::vector<BatchFrame> batches;  // batch mode only
+  std::vector<BatchFrame> batches;  // per-batch modes (ModeInfo::batch_points) only
   // Batch mode, one per batch, in double: projection · rotation · translate(origin − eye) ·
   // extent · 2^−20, all in the scene frame: it takes the integer offsets to clip space. The GPU gets them cast to float (batchMatrices); the error bound
   // uses them as they are.
@@ -140,12 +107,14 @@ ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera);
 Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);
 
 // Writes positions [first, first + count) of `points` in the mode's layout to `out`
-// (count · positionBytes(mode) bytes). index_base: the index of points[0] in the whole set when
-// `points` is a block of it (batch mode looks up batches by whole-set index).
+// (count · positionBytes(mode) bytes), with the mode's encoder (ModeInfo::encode). index_base: the
+// index of points[0] in the whole set when `points` is a block of it (batch mode looks up batches
+// by whole-set index).
 void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_t first, size_t count, void* out,
                      size_t index_base = 0);
 
-// The mode's uniform block (std140, as declared in shaders/render/project.glsl); empty for batch.
+// The mode's uniform block (std140, as declared in shaders/render/project.glsl; ModeInfo::uniform);
+// empty for batch.
 std::vector<uint8_t> cameraUniform(const ModeEncoding& encoding, const Camera& camera);
 
 // Batch mode: encoding.batch_matrices cast to float, as the GPU gets them.

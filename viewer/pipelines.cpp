@@ -2,55 +2,17 @@
 
 #include <vector>
 
-#include "shaders/points_batch.vert.h"
-#include "shaders/points_df64.vert.h"
-#include "shaders/points_fp32.vert.h"
-#include "shaders/points_native_attr.vert.h"
-#include "shaders/points_native_pull.vert.h"
-#include "shaders/points_rte.vert.h"
-#include "shaders/points_split.vert.h"
 #include "shaders/points.frag.h"
 #include "shaders/edl.comp.h"
 #include "shaders/points_resolve.comp.h"
-#include "shaders/splat_batch.comp.h"
-#include "shaders/splat_df64.comp.h"
-#include "shaders/splat_fp32.comp.h"
-#include "shaders/splat_native.comp.h"
-#include "shaders/splat_rte.comp.h"
-#include "shaders/splat_split.comp.h"
 
 namespace dpoint {
 namespace {
 
-struct Spirv {
-  const uint32_t* code;
-  size_t bytes;
-};
-
+// The raster vertex shader of the mode: the pull variant where asked for and the mode has one.
 Spirv vertexShader(PrecisionMode mode, bool pull) {
-  switch (mode) {
-    case PrecisionMode::kFp32: return {kPointsFp32Vert, sizeof(kPointsFp32Vert)};
-    case PrecisionMode::kSplit: return {kPointsSplitVert, sizeof(kPointsSplitVert)};
-    case PrecisionMode::kRte: return {kPointsRteVert, sizeof(kPointsRteVert)};
-    case PrecisionMode::kDf64: return {kPointsDf64Vert, sizeof(kPointsDf64Vert)};
-    case PrecisionMode::kNative:
-      return pull ? Spirv{kPointsNativePullVert, sizeof(kPointsNativePullVert)}
-                  : Spirv{kPointsNativeAttrVert, sizeof(kPointsNativeAttrVert)};
-    case PrecisionMode::kBatch: return {kPointsBatchVert, sizeof(kPointsBatchVert)};
-  }
-  return {nullptr, 0};
-}
-
-Spirv splatShader(PrecisionMode mode) {
-  switch (mode) {
-    case PrecisionMode::kFp32: return {kSplatFp32Comp, sizeof(kSplatFp32Comp)};
-    case PrecisionMode::kSplit: return {kSplatSplitComp, sizeof(kSplatSplitComp)};
-    case PrecisionMode::kRte: return {kSplatRteComp, sizeof(kSplatRteComp)};
-    case PrecisionMode::kDf64: return {kSplatDf64Comp, sizeof(kSplatDf64Comp)};
-    case PrecisionMode::kNative: return {kSplatNativeComp, sizeof(kSplatNativeComp)};
-    case PrecisionMode::kBatch: return {kSplatBatchComp, sizeof(kSplatBatchComp)};
-  }
-  return {nullptr, 0};
+  const ModeShaders& shaders = modeInfo(mode).shaders;
+  return pull && shaders.vertex_pull.code ? shaders.vertex_pull : shaders.vertex;
 }
 
 // Two boolean specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
@@ -158,18 +120,10 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
   std::vector<VkVertexInputAttributeDescription> attributes;
   if (!p.pulls_positions) bindings.push_back({0, positionBytes(mode), VK_VERTEX_INPUT_RATE_VERTEX});
   bindings.push_back({1, 4, VK_VERTEX_INPUT_RATE_VERTEX});
-  switch (mode) {
-    case PrecisionMode::kFp32: attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}); break;
-    case PrecisionMode::kBatch: attributes.push_back({0, 0, VK_FORMAT_R32G32_UINT, 0}); break;
-    case PrecisionMode::kSplit:
-    case PrecisionMode::kRte:
-    case PrecisionMode::kDf64:
-      attributes.push_back({0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0});
-      attributes.push_back({1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12});
-      break;
-    case PrecisionMode::kNative:
-      if (!p.pulls_positions) attributes.push_back({0, 0, VK_FORMAT_R64G64B64_SFLOAT, 0});
-      break;
+  if (!p.pulls_positions) {
+    const ModeShaders& shaders = modeInfo(mode).shaders;
+    for (uint32_t a = 0; a < shaders.attribute_count; ++a)
+      attributes.push_back({shaders.attributes[a].location, 0, shaders.attributes[a].format, shaders.attributes[a].offset});
   }
   attributes.push_back({2, 1, VK_FORMAT_R8G8B8A8_UNORM, 0});
   VkPipelineVertexInputStateCreateInfo vertex_input = {VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
@@ -232,7 +186,7 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
                                             bool with_probe, uint32_t width, uint32_t height, bool keep_depth) {
   PointPipelines p;
-  p.pulls_positions = mode == PrecisionMode::kNative && pull;
+  p.pulls_positions = pull && modeInfo(mode).shaders.vertex_pull.code != nullptr;
   auto fail = [&](const Error& error) -> Result<PointPipelines> {
     destroyPointPipelines(context, p);
     return error;
@@ -296,11 +250,11 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
   Result<VkPipelineLayout> resolve_layout = pipelineLayout(context, p.resolve_set, sizeof(ResolvePush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!resolve_layout) return fail(resolve_layout.error());
   p.resolve_layout = *resolve_layout;
-  Result<VkPipeline> splat = computePipeline(context, splatShader(mode), p.splat_layout, false, early_depth);
+  Result<VkPipeline> splat = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, false, early_depth);
   if (!splat) return fail(splat.error());
   p.splat = *splat;
   if (with_probe) {
-    Result<VkPipeline> probe = computePipeline(context, splatShader(mode), p.splat_layout, true, early_depth);
+    Result<VkPipeline> probe = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, true, early_depth);
     if (!probe) return fail(probe.error());
     p.probe = *probe;
   }

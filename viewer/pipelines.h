@@ -1,5 +1,6 @@
 // The pipelines of the renderer. The raster backend: render pass (RGBA8 colour + D32 depth, reversed Z),
-// and one pipeline per precision mode, built from the SPIR-V compiled at build time. The probe
+// and one pipeline per precision mode, built from the SPIR-V compiled at build time (each mode's
+// variants and vertex attributes are in its row, viewer/modes.h). The probe
 // pipeline is the same shader with the specialization constant kProbe on (DESIGN §5).
 #pragma once
 
@@ -43,10 +44,10 @@ struct PointPipelines {
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline draw = VK_NULL_HANDLE;
   VkPipeline probe = VK_NULL_HANDLE;  // only when asked for
-  bool pulls_positions = false;       // native mode reads a storage buffer instead of vertex input
+  bool pulls_positions = false;       // the mode reads a storage buffer instead of vertex input
 };
 
-// `pull` selects vertex pulling for native mode (ignored by the other modes). `keep_depth` stores
+// `pull` selects vertex pulling for a mode with a pull variant (native; ignored by the others). `keep_depth` stores
 // the depth attachment and leaves it ready to copy (TRANSFER_SRC_OPTIMAL) for the eye-dome pass.
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
                                             bool with_probe, uint32_t width, uint32_t height, bool keep_depth = false);

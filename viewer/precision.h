@@ -41,20 +41,8 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
 // --mode auto (DESIGN §4): the fastest mode on this kind of device whose bound is ≤ kAutoBoundPx.
 inline constexpr double kAutoBoundPx = 0.1;
 
-// Devices whose measured speed order `auto` knows: lavapipe (a CPU) and GPUs. The order for GPUs
-// was measured on an NVIDIA H100 (bench/results/render-h100-2026-11-22.md, 1M–16.7M points); for
-// lavapipe on this project's 2-core machine (render-lavapipe-2026-11-22.md).
-enum class DeviceClass { kCpu, kGpu };
-std::string_view deviceClassName(DeviceClass device_class);
-// From DeviceFacts::type ("cpu" for lavapipe).
-inline DeviceClass deviceClassOf(std::string_view device_type) {
-  return device_type == "cpu" ? DeviceClass::kCpu : DeviceClass::kGpu;
-}
-// Fastest first; `split` never appears (fp32's bound at a higher cost). raster: graphics pipeline.
-std::span<const PrecisionMode> measuredSpeedOrder(DeviceClass device_class, bool compute_backend);
-
 struct ModeChoice {
-  PrecisionMode mode = PrecisionMode::kNative;
+  PrecisionMode mode = kFallbackMode;
   double bound_px = 0.0;
   bool enough = false;  // bound_px ≤ kAutoBoundPx
   std::optional<PrecisionMode> runner_up;  // the next mode in speed order within the bound

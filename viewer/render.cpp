@@ -40,8 +40,9 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
     points = std::min<uint64_t>(points, uint64_t{facts.max_dispatch_groups_x} * kSplatPointsPerGroup);
   if (options.max_chunk_points) points = std::min(points, options.max_chunk_points);
   // The compute splat of batch mode reads points in pairs that must share a batch: chunks start
-  // at even points.
-  if (options.mode == PrecisionMode::kBatch) points = std::max<uint64_t>(2, points & ~uint64_t{1});
+  // at even points (ModeInfo::chunk_multiple).
+  if (const uint64_t multiple = modeInfo(options.mode).chunk_multiple; multiple > 1)
+    points = std::max<uint64_t>(multiple, points / multiple * multiple);
   return static_cast<size_t>(points);
 }
 
@@ -78,8 +79,10 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
     return Error{"--backend compute keeps a 64-bit key per pixel in one storage buffer: " + picture + " exceeds " +
                      f.name + "'s maxStorageBufferRange of " + std::to_string(f.max_storage_buffer_range) + " bytes",
                  ExitCode::kResourceLimit};
-  if (options.mode == PrecisionMode::kNative && options.native_path == NativePath::kAttribute && !f.r64g64b64_vertex)
-    return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; native mode must pull positions",
+  const ModeInfo& mode = modeInfo(options.mode);
+  if (mode.attribute_needs_r64_vertex && options.native_path == NativePath::kAttribute && !f.r64g64b64_vertex)
+    return Error{f.name + " does not list R64G64B64_SFLOAT as a vertex format; " + std::string(mode.name) +
+                     " mode must pull positions",
                  ExitCode::kNoDevice};
   return okStatus();
 }
@@ -264,7 +267,7 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
 // Batch mode's matrices, once every batch is known (a stream appends them block by block).
 Status uploadBatchMatrices(const VulkanContext& context, Resources& r, const RenderOptions& options,
                            const ModeEncoding& encoding) {
-  if (options.mode == PrecisionMode::kBatch) {
+  if (modeInfo(options.mode).batch_points) {
     std::vector<glm::mat4> matrices = batchMatrices(encoding);
     VkDeviceSize bytes = matrices.size() * sizeof(glm::mat4);
     Result<Buffer> batches = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -389,7 +392,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   const bool shading = options.shading == Shading::kEdl;
   // Positions come from a storage buffer in the compute backend, and for native mode on a device
   // without double vertex attributes.
-  bool pulled = options.mode == PrecisionMode::kNative &&
+  bool pulled = modeInfo(options.mode).shaders.vertex_pull.code != nullptr &&
                 (compute || options.native_path == NativePath::kPull ||
                  (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
   Resources r(context);
@@ -523,7 +526,7 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
   // Whole batches per block, so batch mode's frames line up with the chunks.
   uint64_t limit = options.max_chunk_points ? std::min<uint64_t>(options.max_chunk_points, kStreamBlockPoints)
                                             : kStreamBlockPoints;
-  if (options.mode == PrecisionMode::kBatch) limit = std::max<uint64_t>(kBatchSize, limit / kBatchSize * kBatchSize);
+  if (const uint64_t batch = modeInfo(options.mode).batch_points) limit = std::max<uint64_t>(batch, limit / batch * batch);
   return renderChunks(context, stream.count,
                       [&](size_t first, size_t count) { return blocks.get(first, count); }, encoding, camera, options,
                       upload_start, limit);

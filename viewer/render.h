@@ -37,7 +37,7 @@ struct EdlOptions {
 };
 
 struct RenderOptions {
-  PrecisionMode mode = PrecisionMode::kNative;
+  PrecisionMode mode = kFallbackMode;
   Backend backend = Backend::kRaster;
   float point_size = 1.0f;
   uint32_t background_rgba8 = 0xff000000u;  // opaque black, R in the low byte

@@ -132,12 +132,11 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   return p;
 }
 
-// A streamed set is read once, so no bound is predicted from its points: --mode auto takes native,
-// which holds to well under 0.1 px wherever the study's hard cases reach.
+// A streamed set is read once, so no bound is predicted from its points: --mode auto takes the
+// fallback mode (native), which holds to well under 0.1 px wherever the study's hard cases reach.
 ModePrediction streamedModePrediction(const RenderRequest& request) {
   ModePrediction p;
-  // TODO(modes): the mode auto takes for a streamed set, from the table.
-  p.mode = request.mode == "auto" ? PrecisionMode::kNative : *parseMode(request.mode);
+  p.mode = request.mode == "auto" ? kFallbackMode : *parseMode(request.mode);
   p.bound_px = std::nan("");
   return p;
 }
@@ -247,9 +246,7 @@ Status checkPictureOutput(const std::string& path) {
 
 Status checkModeName(const std::string& mode) {
   if (mode == "auto" || parseMode(mode)) return okStatus();
-  std::string names = "auto";
-  for (size_t i = 0; i < kModeCount; ++i) names += (i + 1 == kModeCount ? " or " : ", ") + std::string(modeName(kAllModes[i]));
-  return Error{"--mode must be " + names + ", got '" + mode + "'", ExitCode::kUsage};
+  return Error{"--mode must be " + modeOptionChoices() + ", got '" + mode + "'", ExitCode::kUsage};
 }
 
 Status checkViewCount(uint32_t views) {
@@ -445,8 +442,9 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   o.add("phases_ms", phases).add("peak_rss_mb", V::number(peakRssMb()));
   o.add("points_per_s", V::number(static_cast<double>(outcome.points) / (per_frame_ms * 1e-3)));
   o.add("bytes_per_point", V::integer(bytesPerPoint(mode))).add("chunks", V::integer(r.chunks));
-  // TODO(modes): whether the mode has a native path to report, from the table.
-  o.add("native_path", mode != PrecisionMode::kNative ? V::null() : V::string(r.pulled_positions ? "pull" : "attribute"));
+  // Only a mode with two raster paths (vertex input or pulling from a storage buffer) says which ran.
+  const bool two_paths = modeInfo(mode).shaders.vertex_pull.code != nullptr;
+  o.add("native_path", !two_paths ? V::null() : V::string(r.pulled_positions ? "pull" : "attribute"));
   if (const std::optional<ErrorReport>& error = outcome.error) {
     const ErrorStats& e = error->stats;
     o.add("error_px", anyMeasured(e) ? V::object(JsonObject()

@@ -94,7 +94,7 @@ double peakRssMb();
 
 // What the run predicted for its mode: the bound, and with --mode auto the choice made.
 struct ModePrediction {
-  PrecisionMode mode = PrecisionMode::kNative;
+  PrecisionMode mode = kFallbackMode;
   double bound_px = 0.0;             // NaN for a streamed set (none predicted)
   std::optional<ModeChoice> choice;  // --mode auto
 };

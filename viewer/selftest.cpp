@@ -108,10 +108,11 @@ Result<SelfTest> runPrecisionSelfTest(const VulkanContext& context) {
 
 Status modeUsable(const VulkanContext& context, PrecisionMode mode, const SelfTest& self_test, bool probe) {
   const DeviceFacts& f = context.facts;
-  std::string name(modeName(mode));
-  if (mode == PrecisionMode::kNative && !f.shader_float64)
-    return Error{"--mode native needs shaderFloat64, which " + f.name + " lacks", ExitCode::kNoDevice};
-  if (modeInfo(mode).needs_self_test && !self_test.low_parts_survive)
+  const ModeInfo& info = modeInfo(mode);
+  std::string name(info.name);
+  if (info.needs_shader_float64 && !f.shader_float64)
+    return Error{"--mode " + name + " needs shaderFloat64, which " + f.name + " lacks", ExitCode::kNoDevice};
+  if (info.needs_self_test && !self_test.low_parts_survive)
     return Error{"--mode " + name + " is unusable on " + f.name +
                      ": its shader compiler folds away the low parts of exact sums despite `precise` (self-test: " +
                      self_test.detail + ")",

@@ -18,9 +18,9 @@ struct SelfTest {
 
 Result<SelfTest> runPrecisionSelfTest(const VulkanContext& context);
 
-// Whether `mode` can run on the context's device, with the reason when not (kNoDevice):
-// native needs shaderFloat64; rte and df64 need the self-test to pass; the probe needs
-// vertexPipelineStoresAndAtomics.
+// Whether `mode` can run on the context's device, with the reason when not (kNoDevice): the
+// device feature its row needs (native: shaderFloat64); emulated double (rte, df64) needs the
+// self-test to pass; the probe needs vertexPipelineStoresAndAtomics.
 Status modeUsable(const VulkanContext& context, PrecisionMode mode, const SelfTest& self_test, bool probe);
 
 }  // namespace dpoint

@@ -1,0 +1,163 @@
+// The precision modes' table (viewer/modes.h): each row agrees with itself, with what its
+// encoder and uniform builder write, and with the CLI text and measured orders built from it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <set>
+#include <vector>
+
+#include "viewer/encode.h"
+#include "viewer/modes.h"
+
+namespace dpoint {
+namespace {
+
+Camera orthoCamera(const glm::dvec3& centre, double width) {
+  CameraSpec spec;
+  spec.width = spec.height = 64;
+  spec.view_center = centre;
+  spec.view_width = width;
+  PointSet s;
+  s.positions = {centre};
+  Result<Camera> camera = makeCamera(spec, boundsOf(s));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
+TEST(Modes, rowsAreInEnumOrderAndNamesParseBack) {
+  std::set<std::string_view> names;
+  for (size_t i = 0; i < kModeCount; ++i) {
+    const PrecisionMode mode = kAllModes[i];
+    const ModeInfo& info = modeInfo(mode);
+    EXPECT_EQ(info.mode, mode);
+    EXPECT_EQ(modeIndex(mode), i);
+    EXPECT_EQ(parseMode(info.name), mode) << info.name;
+    EXPECT_FALSE(info.help.empty()) << info.name;
+    EXPECT_EQ(info.help.find('\n'), std::string_view::npos) << info.name << ": help is one line";
+    names.insert(info.name);
+  }
+  EXPECT_EQ(names.size(), kModeCount) << "names are unique";
+  EXPECT_FALSE(parseMode("auto").has_value()) << "auto is a choice, not a mode";
+  EXPECT_FALSE(parseMode("FP32").has_value());
+}
+
+TEST(Modes, layoutAccountsForEveryPositionByte) {
+  for (PrecisionMode mode : kAllModes) {
+    const ModeInfo& info = modeInfo(mode);
+    const PositionLayout& layout = info.layout;
+    EXPECT_EQ(layout.elements * layout.element_bytes, info.position_bytes) << info.name;
+    const uint32_t size = layout.element == PositionElement::kFloat32 ? 4 : 8;
+    EXPECT_EQ(layout.element_bytes, size) << info.name;
+    EXPECT_EQ(bytesPerPoint(mode), info.position_bytes + 4) << info.name;
+  }
+}
+
+// The encoder writes exactly position_bytes per point: all of the last point's bytes are its own
+// (some differ from the fill), and not one byte past them.
+TEST(Modes, encoderWritesExactlyTheRowsBytesPerPoint) {
+  PointSet s;
+  for (int i = 0; i < 5; ++i) s.positions.push_back({0.1 + 0.01 * i, -0.2 + 0.03 * i, 0.3 - 0.02 * i});
+  const Camera camera = orthoCamera({0.1, -0.2, 0.3}, 2.0);
+  for (PrecisionMode mode : kAllModes) {
+    const ModeInfo& info = modeInfo(mode);
+    Result<ModeEncoding> e = prepareEncoding(mode, s, camera);
+    ASSERT_TRUE(e.ok()) << info.name << ": " << e.error().message;
+    constexpr uint8_t kFill = 0xa5;
+    const size_t used = s.size() * info.position_bytes;
+    std::vector<uint8_t> out(used + 64, kFill);
+    encodePositions(*e, s, 0, s.size(), out.data());
+    EXPECT_TRUE(std::all_of(out.begin() + static_cast<std::ptrdiff_t>(used), out.end(),
+                            [](uint8_t b) { return b == kFill; }))
+        << info.name << " writes past " << info.position_bytes << " bytes a point";
+    EXPECT_FALSE(std::all_of(out.begin() + static_cast<std::ptrdiff_t>(used - info.position_bytes),
+                             out.begin() + static_cast<std::ptrdiff_t>(used), [](uint8_t b) { return b == kFill; }))
+        << info.name << " leaves its last point unwritten";
+  }
+}
+
+// The uniform blocks as shaders/render/project.glsl declares them (std140).
+TEST(Modes, uniformSizesMatchTheShaderBlocks) {
+  PointSet s;
+  s.positions = {{1.0, 2.0, 3.0}};
+  const Camera camera = orthoCamera({1.0, 2.0, 3.0}, 2.0);
+  const size_t expected[] = {
+      64,              // fp32: mat4 mvp
+      64,              // split: mat4 mvp
+      64 + 2 * 16,     // rte: mat4 projection·rotation, vec4 eye_hi, vec4 eye_lo
+      2 * 64,          // df64: mat4 hi, mat4 lo
+      128 + 32,        // native: dmat4 projection·rotation, dvec4 eye
+      0,               // batch: matrices in a storage buffer
+  };
+  static_assert(std::size(expected) == kModeCount);
+  for (size_t i = 0; i < kModeCount; ++i) {
+    Result<ModeEncoding> e = prepareEncoding(kAllModes[i], s, camera);
+    ASSERT_TRUE(e.ok());
+    EXPECT_EQ(cameraUniform(*e, camera).size(), expected[i]) << modeName(kAllModes[i]);
+  }
+}
+
+TEST(Modes, shaderVariantsAndAttributesFitTheLayout) {
+  for (PrecisionMode mode : kAllModes) {
+    const ModeInfo& info = modeInfo(mode);
+    const ModeShaders& shaders = info.shaders;
+    EXPECT_TRUE(shaders.vertex.code && shaders.vertex.bytes % 4 == 0 && shaders.vertex.bytes > 0) << info.name;
+    EXPECT_TRUE(shaders.splat.code && shaders.splat.bytes % 4 == 0 && shaders.splat.bytes > 0) << info.name;
+    EXPECT_NE(shaders.vertex.code, shaders.splat.code) << info.name;
+    ASSERT_GE(shaders.attribute_count, 1u) << info.name;
+    ASSERT_LE(shaders.attribute_count, 2u) << info.name;
+    for (uint32_t a = 0; a < shaders.attribute_count; ++a) {
+      EXPECT_NE(shaders.attributes[a].format, VK_FORMAT_UNDEFINED) << info.name;
+      EXPECT_LT(shaders.attributes[a].offset, info.position_bytes) << info.name;
+      EXPECT_EQ(shaders.attributes[a].offset % info.layout.element_bytes, 0u) << info.name;
+    }
+    // A mode whose attribute path needs double vertex input has the pull path to fall back on.
+    if (info.attribute_needs_r64_vertex) {
+      EXPECT_NE(shaders.vertex_pull.code, nullptr) << info.name;
+    }
+    if (info.needs_shader_float64) {
+      EXPECT_EQ(info.layout.element, PositionElement::kFloat64) << info.name;
+    }
+    EXPECT_GE(info.chunk_multiple, 1u) << info.name;
+    if (info.batch_points) {
+      EXPECT_EQ(info.batch_points % info.chunk_multiple, 0u) << info.name;
+    }
+  }
+}
+
+// Every speed order holds every mode but split exactly once, and is the order measured
+// (bench/results/render-h100-2026-11-22.md, render-lavapipe-2026-11-22.md).
+TEST(Modes, speedOrdersHoldEveryModeButSplitOnce) {
+  using M = PrecisionMode;
+  const std::vector<M> gpu_compute = {M::kFp32, M::kBatch, M::kRte, M::kNative, M::kDf64};
+  const std::vector<M> gpu_raster = {M::kFp32, M::kBatch, M::kNative, M::kRte, M::kDf64};
+  const std::vector<M> cpu = {M::kFp32, M::kNative, M::kRte, M::kBatch, M::kDf64};
+  for (DeviceClass device : {DeviceClass::kCpu, DeviceClass::kGpu})
+    for (bool compute : {false, true}) {
+      const std::span<const PrecisionMode> order = measuredSpeedOrder(device, compute);
+      SCOPED_TRACE(std::string(deviceClassName(device)) + (compute ? " compute" : " raster"));
+      EXPECT_EQ(order.size(), kModeCount - 1);
+      for (PrecisionMode mode : kAllModes)
+        EXPECT_EQ(std::count(order.begin(), order.end(), mode), mode == M::kSplit ? 0 : 1) << modeName(mode);
+      const std::vector<M>& expected = device == DeviceClass::kCpu ? cpu : compute ? gpu_compute : gpu_raster;
+      EXPECT_EQ(std::vector<M>(order.begin(), order.end()), expected);
+    }
+  EXPECT_EQ(deviceClassOf("cpu"), DeviceClass::kCpu);
+  EXPECT_EQ(deviceClassOf("discrete-gpu"), DeviceClass::kGpu);
+}
+
+// The CLI text built from the table is the text `dpoint render --help` printed before the table.
+TEST(Modes, modeOptionTextComesFromTheTable) {
+  EXPECT_EQ(modeOptionNames(), (std::vector<std::string>{"auto", "fp32", "split", "rte", "df64", "native", "batch"}));
+  EXPECT_EQ(modeOptionChoices(), "auto, fp32, split, rte, df64, native or batch");
+  EXPECT_EQ(modeOptionHelp(),
+            "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"
+            "order) whose predicted error bound is <= 0.1 px for this view; native when none is");
+  EXPECT_EQ(modeListHelp(),
+            "fp32 (float positions), split (the study's hi+lo, no better than fp32), rte (relative to eye), "
+            "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins)");
+  EXPECT_EQ(modeName(kFallbackMode), "native");
+}
+
+}  // namespace
+}  // namespace dpoint

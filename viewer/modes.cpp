@@ -1,0 +1,370 @@
+// The precision modes' table (viewer/modes.h): per mode, the functions its row points at (the
+// position encoder, the uniform builder, the per-point error bound) and the row itself. The
+// arithmetic each function does is bit-exact work that tests pin: the encoders against the shaders'
+// unpacking (shaders/render/project.glsl), the bounds against the probe's measured error.
+#include "viewer/modes.h"
+
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "viewer/bound_terms.h"
+#include "viewer/camera.h"
+#include "viewer/encode.h"
+#include "viewer/precision.h"
+
+#include "shaders/points_batch.vert.h"
+#include "shaders/points_df64.vert.h"
+#include "shaders/points_fp32.vert.h"
+#include "shaders/points_native_attr.vert.h"
+#include "shaders/points_native_pull.vert.h"
+#include "shaders/points_rte.vert.h"
+#include "shaders/points_split.vert.h"
+#include "shaders/splat_batch.comp.h"
+#include "shaders/splat_df64.comp.h"
+#include "shaders/splat_fp32.comp.h"
+#include "shaders/splat_native.comp.h"
+#include "shaders/splat_rte.comp.h"
+#include "shaders/splat_split.comp.h"
+
+namespace dpoint {
+namespace {
+
+using namespace bound;
+
+#define DPOINT_SPIRV(words) Spirv{words, sizeof(words)}
+
+template <typename Value>
+void appendBytes(std::vector<uint8_t>& out, const Value& v) {
+  size_t at = out.size();
+  out.resize(at + sizeof(Value));
+  std::memcpy(out.data() + at, &v, sizeof(Value));
+}
+
+// ---- encoders: positions as the shaders read them --------------------------------------------
+
+void encodeFloats(const ModeEncoding&, const glm::dvec3* p, size_t count, void* out, size_t) {
+  auto* f = static_cast<float*>(out);
+  for (size_t i = 0; i < count; ++i)
+    for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(p[i][a]);
+}
+
+void encodeFloatPairs(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t) {
+  auto* f = static_cast<float*>(out);
+  const SceneFrame& frame = e.frame;
+  // Interleaved per point: hi.xyz then lo.xyz (one 24-byte vertex binding).
+  for (size_t i = 0; i < count; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      FloatPair pair = splitDouble(scaleBy(p[i][a], frame));
+      f[6 * i + a] = pair.hi;
+      f[6 * i + 3 + a] = pair.lo;
+    }
+  }
+}
+
+void encodeDoubles(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t) {
+  const SceneFrame& frame = e.frame;
+  if (frame.exponent == 0) {
+    std::memcpy(out, p, count * sizeof(glm::dvec3));
+  } else {
+    auto* d = static_cast<double*>(out);
+    for (size_t i = 0; i < count; ++i)
+      for (int a = 0; a < 3; ++a) d[3 * i + a] = scaleBy(p[i][a], frame);
+  }
+}
+
+void encodeBatchOffsets(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t first_index) {
+  const SceneFrame& frame = e.frame;
+  auto* words = static_cast<uint64_t*>(out);
+  for (size_t i = 0; i < count; ++i) {
+    const BatchFrame& batch = e.batches[(first_index + i) / kBatchSize];
+    // p·scale − origin rounds once in double; the division by a power of two is exact.
+    words[i] = packBatchOffset((scaleBy(p[i], frame) - batch.origin) / batch.extent);
+  }
+}
+
+// ---- uniform blocks (std140, as shaders/render/project.glsl declares them) --------------------
+
+std::vector<uint8_t> worldMatrixUniform(const ModeEncoding&, const Camera& camera) {
+  std::vector<uint8_t> out;
+  appendBytes(out, glm::mat4(camera.viewProjection()));
+  return out;
+}
+
+std::vector<uint8_t> rteUniform(const ModeEncoding& e, const Camera&) {
+  std::vector<uint8_t> out;
+  const SceneFrame& frame = e.frame;
+  // The translation is done in the shader against the eye's hi/lo parts, so the matrix
+  // holds only projection · rotation and never sees a large number.
+  appendBytes(out, glm::mat4(frame.projection_rotation));
+  float eye[8] = {};  // vec4 eye_hi, vec4 eye_lo (std140)
+  for (int a = 0; a < 3; ++a) {
+    FloatPair pair = splitDouble(frame.eye[a]);
+    eye[a] = pair.hi;
+    eye[4 + a] = pair.lo;
+  }
+  appendBytes(out, eye);
+  return out;
+}
+
+std::vector<uint8_t> df64Uniform(const ModeEncoding& e, const Camera&) {
+  std::vector<uint8_t> out;
+  const SceneFrame& frame = e.frame;
+  glm::dmat4 translate(1.0);
+  translate[3] = glm::dvec4(-frame.eye, 1.0);
+  const glm::dmat4 mvp = frame.projection_rotation * translate;
+  glm::mat4 hi(0.0f), lo(0.0f);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) {
+      FloatPair pair = splitDouble(mvp[c][r]);
+      hi[c][r] = pair.hi;
+      lo[c][r] = pair.lo;
+    }
+  appendBytes(out, hi);
+  appendBytes(out, lo);
+  return out;
+}
+
+std::vector<uint8_t> nativeUniform(const ModeEncoding& e, const Camera&) {
+  std::vector<uint8_t> out;
+  const SceneFrame& frame = e.frame;
+  // dmat4 projection_rotation, dvec4 eye (std140): the shader subtracts the eye first.
+  appendBytes(out, frame.projection_rotation);
+  appendBytes(out, glm::dvec4(frame.eye, 0.0));
+  return out;
+}
+
+// Batch mode's matrices go in a storage buffer (batchMatrices), one per batch: no uniform block.
+std::vector<uint8_t> noUniform(const ModeEncoding&, const Camera&) { return {}; }
+
+// ---- error bounds: each mode's arithmetic, step by step (notation in viewer/bound_terms.h) ------
+
+Vec4 fp32Error(const Setup& s, const glm::dvec3& p, bool split) {
+  glm::dvec3 dv;
+  for (int a = 0; a < 3; ++a) {
+    // split: hi + lo in float is within u·|p| of p, plus hi's and lo's flushes.
+    dv[a] = split ? 1.01 * kU * std::fabs(p[a]) + 2.0 * kFloatMin : storedFloatError(p[a]);
+  }
+  return floatAffine(s.world_mvp, p, dv);
+}
+
+// rte: d_hi = hi_p − hi_e (exact when Sterbenz applies: checked, not assumed), d_lo = lo_p − lo_e
+// (u), their sum (u), and the hi/lo representations themselves (u·|lo| each).
+Vec4 rteError(const Setup& s, const glm::dvec3& ps) {
+  glm::dvec3 v, dv;
+  for (int a = 0; a < 3; ++a) {
+    const FloatPair pp = splitDouble(ps[a]);
+    const FloatPair& pe = s.eye_split[static_cast<size_t>(a)];
+    const double dh = double(pp.hi) - double(pe.hi);
+    double ddh = double(static_cast<float>(dh)) == dh ? 0.0 : kU * std::fabs(dh);
+    if (dh != 0.0 && std::fabs(dh) < kFloatMin) ddh += kFloatMin;
+    const double dl = double(pp.lo) - double(pe.lo);
+    const double ddl = kU * std::fabs(dl) + 3.0 * kFloatMin;
+    const double dsum = kU * (std::fabs(dh) + std::fabs(dl)) * (1.0 + kU) + kFloatMin;
+    const double representation = kU * (std::fabs(double(pp.lo)) + std::fabs(double(pe.lo))) * (1.0 + kU) + 2.0 * kFloatMin;
+    v[a] = dh + dl;
+    dv[a] = ddh + ddl + dsum + representation;
+  }
+  return floatAffine(s.frame.projection_rotation, v, dv);
+}
+
+// df64: each hi/lo pair holds its value to u² (point and matrix: 2u² per product); dfMul drops
+// lo·lo and rounds the cross terms and their sum (≤ 8u² of the product); each of the three dfAdds
+// is off by ≤ 3u² of its operands (≤ 9u² of Σ|terms| in all); the final hi part rounds to u.
+Vec4 df64Error(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
+  for (int a = 0; a < 3; ++a)
+    if (!(std::fabs(ps[a]) <= kDekkerMax)) return kUnbounded;
+  Vec4 out;
+  for (int r = 0; r < 4; ++r) {
+    double terms = std::fabs(s.df64_mvp[3][r]);
+    for (int c = 0; c < 3; ++c) terms += std::fabs(s.df64_mvp[c][r] * ps[c]);
+    if (!(terms <= 0.5 * kFloatMax)) return kUnbounded;
+    const size_t row = static_cast<size_t>(r);
+    out[row] = (20.0 * kU2 + 4.0 * kUd) * terms + kU * std::fabs(clip[row]) * (1.0 + kU) + 32.0 * kFloatMin;
+  }
+  return out;
+}
+
+// native: p' − e' in double (ud), projection·rotation in double (γ_4 in ud), cast to float (u).
+Vec4 nativeError(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
+  const glm::dvec3 d = ps - s.frame.eye;
+  const glm::dmat4& m = s.frame.projection_rotation;
+  Vec4 out;
+  for (int r = 0; r < 4; ++r) {
+    if (const std::optional<double> constant = constantRowError(m, r)) {
+      out[static_cast<size_t>(r)] = *constant;
+      continue;
+    }
+    double sum = std::fabs(m[3][r]), input = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const double dd = kUd * std::fabs(d[c]);
+      sum += std::fabs(m[c][r]) * (std::fabs(d[c]) + dd);
+      input += std::fabs(m[c][r]) * dd;
+    }
+    const size_t row = static_cast<size_t>(r);
+    const double in_double = input + (gamma(4, kUd) + 4.0 * kUd) * sum + 8.0 * DBL_MIN;
+    out[row] = in_double + kU * (std::fabs(clip[row]) + in_double) + kFloatMin;
+  }
+  return out;
+}
+
+// batch: the offset (p' − origin) / extent rounds once in double, then to an integer step (half a
+// step, one at the clamped edge t = 1), which a float holds exactly; the batch matrix, built in
+// double (its translation's rounding is precomputed per batch), is applied in float.
+Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
+  const size_t b = index / kBatchSize;
+  const BatchFrame& frame = own.encoding.batches[b];
+  const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kBatchSteps;
+  glm::dvec3 dv;
+  for (int a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * std::fabs(steps[a]);
+  Vec4 out = floatAffine(own.encoding.batch_matrices[b], steps, dv);
+  for (size_t r = 0; r < 4; ++r) out[r] += own.batch_translation_error[b][r];
+  return out;
+}
+
+// df64's split constant times a matrix entry must stay finite (Dekker's split past 8e34).
+bool df64MatrixOverflows(const Setup& s) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!(std::fabs(s.df64_mvp[c][r]) <= kDekkerMax)) return true;
+  return false;
+}
+
+// The per-point bounds with one signature, for bound::worstOf.
+Vec4 fp32Bound(const Setup& s, const ModeState&, const glm::dvec3& p, const Projected&, size_t) {
+  return fp32Error(s, p, false);
+}
+Vec4 splitBound(const Setup& s, const ModeState&, const glm::dvec3& p, const Projected&, size_t) {
+  return fp32Error(s, p, true);
+}
+Vec4 rteBound(const Setup& s, const ModeState&, const glm::dvec3&, const Projected& q, size_t) {
+  return rteError(s, q.ps);
+}
+Vec4 df64Bound(const Setup& s, const ModeState&, const glm::dvec3&, const Projected& q, size_t) {
+  return df64Error(s, q.ps, q.clip);
+}
+Vec4 nativeBound(const Setup& s, const ModeState&, const glm::dvec3&, const Projected& q, size_t) {
+  return nativeError(s, q.ps, q.clip);
+}
+Vec4 batchBound(const Setup&, const ModeState& own, const glm::dvec3&, const Projected& q, size_t i) {
+  return batchError(own, q.ps, i);
+}
+
+// ---- the table -----------------------------------------------------------------------------------
+
+constexpr PositionLayout kFloatXyz{PositionElement::kFloat32, 3, 4, "float x, y, z"};
+constexpr PositionLayout kFloatPairs{PositionElement::kFloat32, 6, 4, "float hi.xyz then lo.xyz (hi = fl32(p), lo = fl32(p - hi))"};
+constexpr PositionLayout kDoubleXyz{PositionElement::kFloat64, 3, 8, "double x, y, z"};
+constexpr PositionLayout kBatchWord{PositionElement::kUint64, 1, 8,
+                                    "21-bit offsets x, y, z from the batch's origin in one 64-bit word"};
+
+constexpr PositionAttribute kFloatAttribute{0, VK_FORMAT_R32G32B32_SFLOAT, 0};
+constexpr PositionAttribute kLoAttribute{1, VK_FORMAT_R32G32B32_SFLOAT, 12};
+constexpr PositionAttribute kNone{};
+
+// Speed ranks, [DeviceClass][compute backend], from the measured orders:
+// - GPU compute (H100, ms/frame × fp32 at 16.7M points: batch 1.01, rte 1.09, native 1.10, df64
+//   1.16): fp32, batch, rte, native, df64.
+// - GPU raster: bound by the point rasterizer (all modes within 2% at 10M), so fewest bytes first:
+//   fp32, batch, native, rte, df64.
+// - lavapipe compute at 1M and 10M (native 0.92–1.06, rte 1.17–1.28, batch 1.23–1.42, df64
+//   1.28–1.49); raster within noise of each other, so the same order: fp32, native, rte, batch, df64.
+// split has none: it computes exactly what fp32 does, at twice the bytes.
+//                                {{cpu raster, cpu compute}, {gpu raster, gpu compute}}
+constexpr ModeInfo kModes[] = {
+    {PrecisionMode::kFp32, "fp32", "float positions", 12, kFloatXyz, false, false, false, false, 0, 1,
+     {DPOINT_SPIRV(kPointsFp32Vert), {}, DPOINT_SPIRV(kSplatFp32Comp), {kFloatAttribute, kNone}, 1},
+     encodeFloats, worldMatrixUniform, worstOf<fp32Bound>, nullptr, {{0, 0}, {0, 0}}},
+    {PrecisionMode::kSplit, "split", "the study's hi+lo, no better than fp32", 24, kFloatPairs, false, false, false,
+     false, 0, 1,
+     {DPOINT_SPIRV(kPointsSplitVert), {}, DPOINT_SPIRV(kSplatSplitComp), {kFloatAttribute, kLoAttribute}, 2},
+     encodeFloatPairs, worldMatrixUniform, worstOf<splitBound>, nullptr, {{kNoRank, kNoRank}, {kNoRank, kNoRank}}},
+    {PrecisionMode::kRte, "rte", "relative to eye", 24, kFloatPairs, true, true, false, false, 0, 1,
+     {DPOINT_SPIRV(kPointsRteVert), {}, DPOINT_SPIRV(kSplatRteComp), {kFloatAttribute, kLoAttribute}, 2},
+     encodeFloatPairs, rteUniform, worstOf<rteBound>, nullptr, {{2, 2}, {3, 2}}},
+    {PrecisionMode::kDf64, "df64", "double-float arithmetic", 24, kFloatPairs, true, true, false, false, 0, 1,
+     {DPOINT_SPIRV(kPointsDf64Vert), {}, DPOINT_SPIRV(kSplatDf64Comp), {kFloatAttribute, kLoAttribute}, 2},
+     encodeFloatPairs, df64Uniform, worstOf<df64Bound>, df64MatrixOverflows, {{4, 4}, {4, 4}}},
+    {PrecisionMode::kNative, "native", "fp64 shaders", 24, kDoubleXyz, true, false, true, true, 0, 1,
+     {DPOINT_SPIRV(kPointsNativeAttrVert), DPOINT_SPIRV(kPointsNativePullVert), DPOINT_SPIRV(kSplatNativeComp),
+      {{0, VK_FORMAT_R64G64B64_SFLOAT, 0}, kNone}, 1},
+     encodeDoubles, nativeUniform, worstOf<nativeBound>, nullptr, {{1, 1}, {2, 3}}},
+    // The compute splat reads points in pairs that must share a batch: chunks start at even points.
+    {PrecisionMode::kBatch, "batch", "per-batch double origins", 8, kBatchWord, true, false, false, false, kBatchSize, 2,
+     {DPOINT_SPIRV(kPointsBatchVert), {}, DPOINT_SPIRV(kSplatBatchComp), {{0, VK_FORMAT_R32G32_UINT, 0}, kNone}, 1},
+     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{3, 3}, {1, 1}}},
+};
+static_assert(std::size(kModes) == kModeCount);
+
+#undef DPOINT_SPIRV
+
+}  // namespace
+
+const ModeInfo& modeInfo(PrecisionMode mode) {
+  const ModeInfo& info = kModes[modeIndex(mode)];
+  assert(info.mode == mode);
+  return info;
+}
+
+std::optional<PrecisionMode> parseMode(std::string_view name) {
+  for (const ModeInfo& info : kModes)
+    if (info.name == name) return info.mode;
+  return std::nullopt;
+}
+
+std::string_view deviceClassName(DeviceClass device_class) {
+  return device_class == DeviceClass::kCpu ? "lavapipe (CPU)" : "GPU (measured on an NVIDIA H100)";
+}
+
+std::span<const PrecisionMode> measuredSpeedOrder(DeviceClass device_class, bool compute_backend) {
+  using Order = std::vector<PrecisionMode>;
+  static const std::array<std::array<Order, 2>, kDeviceClassCount> kOrders = [] {
+    std::array<std::array<Order, 2>, kDeviceClassCount> orders;
+    for (size_t d = 0; d < kDeviceClassCount; ++d)
+      for (size_t b = 0; b < 2; ++b) {
+        for (int rank = 0; rank < static_cast<int>(kModeCount); ++rank)
+          for (const ModeInfo& info : kModes)
+            if (info.speed_rank[d][b] == rank) orders[d][b].push_back(info.mode);
+      }
+    return orders;
+  }();
+  return kOrders[static_cast<size_t>(device_class)][compute_backend ? 1 : 0];
+}
+
+std::vector<std::string> modeOptionNames() {
+  std::vector<std::string> names{"auto"};
+  for (const ModeInfo& info : kModes) names.emplace_back(info.name);
+  return names;
+}
+
+std::string modeOptionChoices() {
+  std::string text = "auto";
+  for (size_t i = 0; i < kModeCount; ++i) {
+    text.append(i + 1 < kModeCount ? ", " : " or ");
+    text.append(kModes[i].name);
+  }
+  return text;
+}
+
+std::string modeOptionHelp() {
+  std::string text = "auto";
+  for (const ModeInfo& info : kModes) text.append("|").append(info.name);
+  char bound[32];
+  std::snprintf(bound, sizeof bound, "%g", kAutoBoundPx);
+  text.append(". auto: the fastest mode on this kind of device (measured\norder) whose predicted error bound is <= ");
+  text.append(bound).append(" px for this view; ").append(modeName(kFallbackMode)).append(" when none is");
+  return text;
+}
+
+std::string modeListHelp() {
+  std::string text;
+  for (const ModeInfo& info : kModes) {
+    if (!text.empty()) text.append(", ");
+    text.append(info.name).append(" (").append(info.help).append(")");
+  }
+  return text;
+}
+
+}  // namespace dpoint
