@@ -31,6 +31,12 @@ TEST(CliRender, helpNamesEveryModeAndOption) {
   for (const char* word : {"auto", "fp32", "split", "rte", "df64", "native", "batch", "--view-center", "--error",
                            "--validate", "--frames", "--device", "lavapipe", "0.1 px"})
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
+  // The mode list comes from the mode table, laid out on lines of at most 102 characters.
+  EXPECT_NE(help.out.find("Modes: fp32 (float positions), split (the study's hi+lo, no better than fp32), rte "
+                          "(relative to eye),\ndf64 (double-float arithmetic), native (fp64 shaders), batch "
+                          "(per-batch double origins); all but fp32\nand split work in a frame scaled to the view"),
+            std::string::npos)
+      << help.out;
   EXPECT_EQ(runDpoint({"devices", "--help"}).exit_code, 0);
 }
 
