@@ -34,6 +34,12 @@ CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed) 
   });
 }
 
+CLI::Option* addChoiceOption(CLI::App& command, const std::string& flag, std::string& value, const std::string& help,
+                             std::vector<std::string> allowed) {
+  const std::string first = allowed.front();
+  return command.add_option(flag, value, help)->check(oneOf(flag, std::move(allowed)))->default_val(first);
+}
+
 CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open_low, const std::string& unit) {
   const std::string range = (open_low ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) + "]" +
                             (unit.empty() ? "" : " " + unit);

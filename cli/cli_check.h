@@ -32,6 +32,9 @@ Status statusOf(const Result<T>& result) {
 
 // One of `allowed`, else "FLAG must be A, B or C, got 'VALUE'".
 CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed);
+// An option that takes one of `allowed` (checked by oneOf), the first of them by default.
+CLI::Option* addChoiceOption(CLI::App& command, const std::string& flag, std::string& value, const std::string& help,
+                             std::vector<std::string> allowed);
 // A number CLI11 reads as double in [lo, hi] (or (lo, hi] with `open_low`), else
 // "FLAG must be in RANGE UNIT, got VALUE" (the value in shortest form). Text that is no number is
 // left to CLI11's conversion.

@@ -227,11 +227,10 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--mode", o->mode, modeOptionHelp())
       ->check(checkStatus(checkModeName))
       ->default_val("auto");
-  cmd->add_option("--backend", o->backend,
+  addChoiceOption(*cmd, "--backend", o->backend,
                   "raster (graphics pipeline, POINT_LIST, the study's design) or compute (a thread per point,\n"
-                  "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)")
-      ->check(oneOf("--backend", {"raster", "compute"}))
-      ->default_val("raster");
+                  "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)",
+                  {"raster", "compute"});
   addCameraOptions(*cmd, o->camera);
   cmd->add_option("--point-size", o->point_size,
                   "Point size in pixels, or auto: 1, or larger (up to 4) when a 3D set has too few points to\n"
@@ -248,43 +247,39 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_flag("--error", o->error, "Run the probe and the exact CPU reference; report the error in pixels");
   cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file");
   cmd->add_flag("--validate", o->validate, "Enable the Khronos validation layer; any message fails the run");
-  cmd->add_option("--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull")
-      ->check(oneOf("--native-path", {"auto", "attribute", "pull"}))
-      ->default_val("auto");
+  addChoiceOption(*cmd, "--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull",
+                  {"auto", "attribute", "pull"});
   cmd->add_option("--chunk-points", o->chunk_points, "Most points per draw (0: as the device allows)")->default_val(0);
   cmd->add_option("--order", o->order,
                   std::string(kPointOrderHelp) + "; applied as the set is loaded, before anything else")
       ->check(checkStatus([](const std::string& v) { return statusOf(parsePointOrder("--order", v)); }))
       ->default_val("input");
-  cmd->add_option("--shade", o->shade,
+  addChoiceOption(*cmd, "--shade", o->shade,
                   "auto|none|edl. edl: eye-dome lighting, a screen-space pass over the depth of the visible points\n"
                   "that darkens a pixel by how far its neighbours stand in front of it, so a surface of 1-px points\n"
                   "reads as a surface (as in Potree and CloudCompare). auto: edl for 3D sets, none for 2D sets\n"
-                  "(every z is 0) and with --error, whatever the camera (--ortho, --eye); GPU timings exclude it")
-      ->check(oneOf("--shade", {"auto", "none", "edl"}))
-      ->default_val("auto");
+                  "(every z is 0) and with --error, whatever the camera (--ortho, --eye); GPU timings exclude it",
+                  {"auto", "none", "edl"});
   cmd->add_option("--edl-strength", o->edl_strength, "Eye-dome darkening: exp(-strength * 300 * mean log2 depth step)")
       ->check(numberIn("--edl-strength", 0.0, 100.0, true, ""))
       ->default_val(1.0);
   cmd->add_option("--edl-radius", o->edl_radius, "Eye-dome neighbour distance in pixels (1..16)")
       ->check(numberIn("--edl-radius", 1.0, 16.0, false, "pixels"))
       ->default_val(1.4);
-  cmd->add_option("--color", o->color,
+  addChoiceOption(*cmd, "--color", o->color,
                   "auto|rgb|elevation|intensity|classification. elevation: a perceptual colour map (viridis) along\n"
                   "the up axis (--up-axis); intensity (grey) and classification (the ASPRS classes' colours): LAS\n"
-                  "only. auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones")
-      ->check(oneOf("--color", {"auto", "rgb", "elevation", "intensity", "classification"}))
-      ->default_val("auto");
+                  "only. auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones",
+                  {"auto", "rgb", "elevation", "intensity", "classification"});
   cmd->add_option("--max-device-memory", o->max_device_memory,
                   "Refuse (exit 3, a Vulkan fault) to allocate more GPU memory than this, e.g. 2G (default: what the\n"
                   "device has)");
-  cmd->add_option("--stream", o->stream,
+  addChoiceOption(*cmd, "--stream", o->stream,
                   "auto|on|off. on: draw binary PLY input (a file, or tiles) a block at a time, so a set larger\n"
                   "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for binary\n"
                   "PLY input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes\n"
-                  "native), no --error, --order or --views 4")
-      ->check(oneOf("--stream", {"auto", "on", "off"}))
-      ->default_val("auto");
+                  "native), no --error, --order or --views 4",
+                  {"auto", "on", "off"});
   cmd->add_option("--views", o->views,
                   "1, or 4: one PNG of four labelled views (front, side, top, three-quarter), each framed by --fit\n"
                   "in a quarter of --width x --height (3D sets; not with --eye, --ortho, --error or --json)")
@@ -294,10 +289,9 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
                                                                              : std::string();
       }))
       ->default_val(1);
-  cmd->add_option("--up-axis", o->up_axis,
-                  "auto|y|z: the data's up for the --fit views. auto: z for LAS (surveys), y otherwise")
-      ->check(oneOf("--up-axis", {"auto", "y", "z"}))
-      ->default_val("auto");
+  addChoiceOption(*cmd, "--up-axis", o->up_axis,
+                  "auto|y|z: the data's up for the --fit views. auto: z for LAS (surveys), y otherwise",
+                  {"auto", "y", "z"});
   addMaxMemoryOption(*cmd, o->max_memory);
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });

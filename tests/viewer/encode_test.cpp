@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "viewer/encode.h"
+#include "viewer/ortho_camera.h"
 
 namespace dpoint {
 namespace {
@@ -19,22 +20,6 @@ TEST(Encode, modeNamesRoundTripAndBytesPerPointMatchDesign) {
     EXPECT_EQ(bytesPerPoint(mode), expected[i++]) << modeName(mode);
   }
   EXPECT_FALSE(parseMode("emulated").has_value());
-}
-
-// hi + lo carries d to 48 bits, and lo is the exact float remainder. Done over arrays because the
-// bug this guards against (GCC 12 folding (double)(float)d back to d) appears only when the
-// compiler vectorizes several splits together.
-// A camera looking down −z at `centre` through an orthographic window `width` wide.
-Camera orthoCamera(const glm::dvec3& centre, double width) {
-  CameraSpec spec;
-  spec.width = spec.height = 64;
-  spec.view_center = centre;
-  spec.view_width = width;
-  PointSet s;
-  s.positions = {centre};
-  Result<Camera> camera = makeCamera(spec, boundsOf(s));
-  EXPECT_TRUE(camera.ok()) << camera.error().message;
-  return *camera;
 }
 
 ModeEncoding encoding(PrecisionMode mode, const PointSet& s, const Camera& camera) {

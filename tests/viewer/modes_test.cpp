@@ -8,22 +8,11 @@
 #include <vector>
 
 #include "viewer/encode.h"
+#include "viewer/ortho_camera.h"
 #include "viewer/modes.h"
 
 namespace dpoint {
 namespace {
-
-Camera orthoCamera(const glm::dvec3& centre, double width) {
-  CameraSpec spec;
-  spec.width = spec.height = 64;
-  spec.view_center = centre;
-  spec.view_width = width;
-  PointSet s;
-  s.positions = {centre};
-  Result<Camera> camera = makeCamera(spec, boundsOf(s));
-  EXPECT_TRUE(camera.ok()) << camera.error().message;
-  return *camera;
-}
 
 TEST(Modes, rowsAreInEnumOrderAndNamesParseBack) {
   std::set<std::string_view> names;

@@ -1,0 +1,26 @@
+// The camera the encoding and mode-table tests share: orthographic, 64×64 pixels, `width` across,
+// centred on `centre` (the fit of a one-point set, so the depth range is the default one).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <glm/vec3.hpp>
+
+#include "core/point_set.h"
+#include "viewer/camera.h"
+
+namespace dpoint {
+
+inline Camera orthoCamera(const glm::dvec3& centre, double width) {
+  CameraSpec spec;
+  spec.width = spec.height = 64;
+  spec.view_center = centre;
+  spec.view_width = width;
+  PointSet s;
+  s.positions = {centre};
+  Result<Camera> camera = makeCamera(spec, boundsOf(s));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
+}  // namespace dpoint
