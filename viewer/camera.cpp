@@ -13,7 +13,10 @@
 #include <numbers>
 #include <string>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
+
+#include "core/parallel.h"
 
 namespace dpoint {
 namespace {
@@ -27,10 +30,15 @@ constexpr double kNearMargin = 0.99;
 // about 2^-24 relative precision everywhere, so a large far/near ratio costs nothing, but near
 // must stay positive when the eye is inside the box (points behind it are simply outside).
 constexpr double kNearFloor = 1e-6;
-// The smallest extent a framing uses, relative to the largest coordinate: a box of one point (or
-// narrower than a few ulps) at 6.4e6 still gets an eye far enough from the target that
-// eye − target is many ulps long and the view direction is accurate (to ~1e-6).
+// The extent a degenerate box (one point, all points equal) is framed as, relative to the largest
+// coordinate: the point at 6.4e6 still gets an eye far enough from it that eye − target is many
+// ulps long and the view direction is accurate (to ~1e-6). Boxes of any other size are framed as
+// they are: the fit takes its view direction from the spec, not from the rounded eye − target.
 constexpr double kMinRelativeExtent = 1e-10;
+// Rounds of the perspective fit's correction for the eye's rounding (see fitPerspective).
+constexpr int kFitRounds = 4;
+// The outline's grid: rows along x on kOutlineGrid² cells over y, z (OutlineBuilder).
+constexpr int kOutlineGrid = 64;
 
 std::string shortest(double value) {
   char buffer[32];
@@ -68,6 +76,8 @@ double minHalfExtent(const glm::dvec3& position) {
   return relative > 0.0 ? relative : 1.0;
 }
 
+bool isDegenerate(const Bounds& bounds) { return bounds.min == bounds.max; }
+
 Error usage(std::string message) { return Error{std::move(message), ExitCode::kUsage}; }
 
 // World → eye rotation: rows are right, up and −forward (the eye looks down its −z).
@@ -92,6 +102,66 @@ std::array<glm::dvec3, 8> corners(const Bounds& bounds) {
                                    (i & 4) ? bounds.max.z : bounds.min.z};
   }
   return out;
+}
+
+// The points the fit frames: the outline when there is one, else the box's corners.
+std::vector<glm::dvec3> framedPoints(const Bounds& bounds) {
+  if (!bounds.outline.empty()) return bounds.outline;
+  const std::array<glm::dvec3, 8> box = corners(bounds);
+  return {box.begin(), box.end()};
+}
+
+// The perspective fit: the eye's distance from `target` along `direction` (unit), for a camera
+// with `rotation`. Every framed point p must lie inside the frustum shrunk by kFitMargin: with
+// q = p − eye in eye space, |q.x| ≤ depth·tan_x and |q.y| ≤ depth·tan_y (depth = −q.z). For an eye
+// at target + d·direction this is linear in d: d ≥ z + max(|x|/tan_x, |y|/tan_y), where x, y, z are
+// p − target along right, up and direction, so the smallest such d frames the projected extent
+// exactly (not the bounding sphere, which leaves a box's projection 55–80% of the picture).
+// Perspective makes that extent lopsided (the near side looks larger), so when `recentre` the
+// target moves sideways to the middle of the projected extent, a few rounds, and d is found again.
+// The eye is then rounded to doubles: on a box a few ulps wide that moves it sideways by a share
+// of the box, so the condition is checked again from the rounded eye and d grows by what is
+// missing (a few rounds; each misses by at most the rounding). d is at least kFitMargin times the
+// farthest point's distance from the target, so the eye is outside the data and every depth > 0.
+double fitPerspective(const std::vector<glm::dvec3>& points, glm::dvec3& target, const glm::dvec3& direction,
+                      const glm::dmat4& rotation, double tan_x, double tan_y, bool recentre) {
+  const glm::dvec3 right(rotation[0][0], rotation[1][0], rotation[2][0]);
+  const glm::dvec3 up(rotation[0][1], rotation[1][1], rotation[2][1]);
+  const auto closedForm = [&](const glm::dvec3& t) {
+    double d = 0.0, reach = 0.0;
+    for (const glm::dvec3& p : points) {
+      const glm::dvec3 q = p - t;
+      const double need = std::max(std::abs(glm::dot(q, right)) / tan_x, std::abs(glm::dot(q, up)) / tan_y);
+      d = std::max(d, glm::dot(q, direction) + need);
+      reach = std::max(reach, safeLength(q));
+    }
+    return std::max(d, kFitMargin * reach);
+  };
+  double distance = closedForm(target);
+  for (int round = 0; recentre && round < kFitRounds; ++round) {
+    double lo_x = HUGE_VAL, hi_x = -HUGE_VAL, lo_y = HUGE_VAL, hi_y = -HUGE_VAL;
+    for (const glm::dvec3& p : points) {  // each point's direction from the eye, in tangent units
+      const glm::dvec3 q = p - target;
+      const double depth = distance - glm::dot(q, direction);
+      const double x = glm::dot(q, right) / depth, y = glm::dot(q, up) / depth;
+      lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
+    }
+    // The middle ray meets the target's plane (depth = distance) this far off the target.
+    target += (0.5 * (lo_x + hi_x) * distance) * right + (0.5 * (lo_y + hi_y) * distance) * up;
+    distance = closedForm(target);
+  }
+  for (int round = 0; round < kFitRounds; ++round) {
+    const glm::dvec3 eye = target + distance * direction;
+    double missing = 0.0;
+    for (const glm::dvec3& p : points) {
+      const glm::dvec3 q = p - eye;
+      const double need = std::max(std::abs(glm::dot(q, right)) / tan_x, std::abs(glm::dot(q, up)) / tan_y);
+      missing = std::max(missing, need + glm::dot(q, direction));  // need − depth
+    }
+    if (!(missing > 0.0)) break;
+    distance += 2.0 * missing;
+  }
+  return distance;
 }
 
 // Near and far planes enclosing the box. Depth along the view axis is linear, so its extremes over
@@ -146,6 +216,14 @@ glm::dmat4 orthoProjection(double view_width, double view_height, double near_pl
   p[3][2] = far_plane / (far_plane - near_plane);
   p[3][3] = 1.0;
   return p;
+}
+
+// An ortho fit's window width: `fitted` unless the box projects to nothing (a degenerate box, or a
+// segment along the view axis), where it is the degenerate floor or the box's largest side.
+double fitWidth(double fitted, const Bounds& bounds) {
+  if (fitted > 0.0) return fitted;
+  return isDegenerate(bounds) ? 2.0 * minHalfExtent(0.5 * (bounds.min + bounds.max))
+                              : kFitMargin * maxAbs(bounds.max - bounds.min);
 }
 
 Status checkSpec(const CameraSpec& spec) {
@@ -230,15 +308,13 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
         half_x = std::max(half_x, std::abs(e.x));
         half_y = std::max(half_y, std::abs(e.y));
       }
-      view_width = spec.view_width.value_or(
-          std::max(2.0 * kFitMargin * std::max(half_x, half_y * aspect), 2.0 * minHalfExtent(centre)));
+      view_width = spec.view_width.value_or(fitWidth(2.0 * kFitMargin * std::max(half_x, half_y * aspect), bounds));
     }
   } else if (camera.ortho) {
     // Straight down −z; the eye's x, y are the window centre, its height only sets the depth slab.
-    const double fit_width = std::max(kFitMargin * std::max(extent.x, extent.y * aspect), 2.0 * minHalfExtent(centre));
-    view_width = spec.view_width.value_or(fit_width);
+    view_width = spec.view_width.value_or(fitWidth(kFitMargin * std::max(extent.x, extent.y * aspect), bounds));
     const glm::dvec3 window = spec.view_center.value_or(centre);
-    const double height = std::max({extent.z, view_width, 2.0 * minHalfExtent(centre)});
+    const double height = std::max({extent.z, view_width, isDegenerate(bounds) ? 2.0 * minHalfExtent(centre) : 0.0});
     camera.eye = {window.x, window.y, bounds.max.z + height};
     camera.rotation = lookAtRotation({0.0, 0.0, -1.0}, up_y);
   } else {
@@ -247,25 +323,32 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
                                  : spec.fit_direction ? safeNormalize(*spec.fit_direction)
                                                       : glm::normalize(glm::dvec3(0.6, 0.5, 1.0));
     const glm::dvec3 up = bounds.planar ? up_y : spec.fit_up.value_or(up_y);
-    const glm::dvec3 target = spec.view_center.value_or(centre);
+    glm::dvec3 target = spec.view_center.value_or(centre);
+    // From the direction asked for, not from the rounded eye − target, which is only a few ulps
+    // long when the box is.
+    camera.rotation = lookAtRotation(-direction, up);
     double distance = 0.0;
     if (spec.view_width) {
       distance = 0.5 * *spec.view_width / std::tan(half_fov_x);  // the window is view_width wide at target
+    } else if (!isDegenerate(bounds)) {
+      distance = fitPerspective(framedPoints(bounds), target, direction, camera.rotation,
+                                std::tan(half_fov_x) / kFitMargin, std::tan(half_fov) / kFitMargin,
+                                !spec.view_center);
     } else if (bounds.planar) {
-      // The rectangle lies in a plane facing the eye: fit its half-sizes to the two half-angles.
-      const double half_x = std::max(0.5 * extent.x, minHalfExtent(centre));
-      distance = kFitMargin * std::max(half_x / std::tan(half_fov_x), 0.5 * extent.y / std::tan(half_fov));
+      // One point: framed as a square 2e-10 of its coordinates wide (kMinRelativeExtent).
+      distance = kFitMargin * minHalfExtent(centre) / std::tan(half_fov_x);
     } else {
-      // The bounding sphere fits the narrower of the two half-angles.
-      const double radius = std::max(0.5 * safeLength(extent), minHalfExtent(centre));
-      distance = kFitMargin * radius / std::sin(std::min(half_fov, half_fov_x));
+      // One point: framed as a sphere of radius 1e-10 of its coordinates (kMinRelativeExtent).
+      distance = kFitMargin * minHalfExtent(centre) / std::sin(std::min(half_fov, half_fov_x));
     }
     camera.eye = target + distance * direction;
     if (camera.eye == target) {
       return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +
                    "; the window is too small for coordinates this large");
     }
-    camera.rotation = lookAtRotation(target - camera.eye, up);
+    // One point stays exactly at the picture's centre: its eye is far enough (kMinRelativeExtent)
+    // for the rounded eye − target to give an accurate direction.
+    if (isDegenerate(bounds) && !spec.view_width) camera.rotation = lookAtRotation(target - camera.eye, up);
   }
 
   choosePlanes(camera, bounds);
@@ -280,7 +363,65 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
 
 Bounds boundsOf(const PointSet& points) {
   const Box box = boundingBox(points.positions);
-  return Bounds{box.min, box.max, points.isPlanar()};
+  return Bounds{box.min, box.max, points.isPlanar(), {}};
+}
+
+// The boxes of the points of each row along x (a row: one cell of a kOutlineGrid² grid over the
+// box's y, z), made of the points' own coordinates, so their corners hold every point whatever
+// the rounding of the cell index. Their hull is the set's, widened by at most one cell (1/64 of the
+// box) across the rows. min and max do not depend on the order, so blocks in any order and any
+// number of threads give the same outline.
+OutlineBuilder::OutlineBuilder(const Bounds& bounds)
+    : min_(bounds.min), rows_(bounds.planar || isDegenerate(bounds) ? 0 : size_t{kOutlineGrid} * kOutlineGrid) {
+  const glm::dvec3 extent = bounds.max - bounds.min;
+  per_y_ = extent.y > 0.0 ? kOutlineGrid / extent.y : 0.0;  // cells per unit (0 along a flat axis: one cell)
+  per_z_ = extent.z > 0.0 ? kOutlineGrid / extent.z : 0.0;
+}
+
+void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
+  if (rows_.empty()) return;
+  const auto cellOf = [](double offset, double per) {
+    const double cell = std::floor(offset * per);  // offset ≥ 0 inside the box; clamped for the rest
+    return static_cast<size_t>(std::clamp(cell, 0.0, double(kOutlineGrid - 1)));
+  };
+  constexpr size_t kBlock = size_t{1} << 18;
+  const size_t blocks = (positions.size() + kBlock - 1) / kBlock;
+  std::vector<std::vector<RowBox>> partial(blocks);
+  parallelFor(blocks, 0, [&](size_t b, unsigned) {
+    std::vector<RowBox>& rows = partial[b];
+    rows.resize(rows_.size());
+    const size_t end = std::min(positions.size(), (b + 1) * kBlock);
+    for (size_t i = b * kBlock; i < end; ++i) {
+      const glm::dvec3& p = positions[i];
+      RowBox& row = rows[cellOf(p.y - min_.y, per_y_) * kOutlineGrid + cellOf(p.z - min_.z, per_z_)];
+      row.min = glm::min(row.min, p);
+      row.max = glm::max(row.max, p);
+    }
+  });
+  for (const std::vector<RowBox>& rows : partial) {
+    for (size_t cell = 0; cell < rows_.size(); ++cell) {
+      rows_[cell].min = glm::min(rows_[cell].min, rows[cell].min);
+      rows_[cell].max = glm::max(rows_[cell].max, rows[cell].max);
+    }
+  }
+}
+
+std::vector<glm::dvec3> OutlineBuilder::finish() const {
+  std::vector<glm::dvec3> outline;
+  for (const RowBox& row : rows_) {
+    if (!(row.min.x <= row.max.x)) continue;  // no point in this row
+    const std::array<glm::dvec3, 8> box_corners = corners(Bounds{row.min, row.max, false, {}});
+    outline.insert(outline.end(), box_corners.begin(), box_corners.end());
+  }
+  return outline;
+}
+
+Bounds boundsWithOutline(const PointSet& points) {
+  Bounds bounds = boundsOf(points);
+  OutlineBuilder builder(bounds);
+  builder.add(points.positions);
+  bounds.outline = builder.finish();
+  return bounds;
 }
 
 }  // namespace dpoint

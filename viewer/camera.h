@@ -8,8 +8,10 @@
 // so pixel (i, j) covers [i, i+1) × [j, j+1) and its centre is (i + 0.5, j + 0.5).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
@@ -60,20 +62,49 @@ struct Camera {
 struct Bounds {
   glm::dvec3 min{0.0}, max{0.0};
   bool planar = false;  // every z is 0
+  // Points whose convex hull holds every point of the set, so that the fit frames the data and
+  // not the empty corners of its box (a Mandelbulb's box corners project ~1.3x wider than the
+  // bulb). OutlineBuilder makes it; empty: the fit frames the box's eight corners.
+  std::vector<glm::dvec3> outline;
 };
 
 // Builds the camera. Fails (kUsage, naming the option) on a zero-size viewport, eye == target,
 // up parallel to the view direction, fov outside (0, 180), a non-positive or non-finite view
 // width, non-finite vectors, and the combinations refused above. Bounds must be finite with
-// min ≤ max (asserted). Degenerate bounds (one point, all points equal) still give a usable
-// camera: the framing never uses a box smaller than 1e-10 of the largest coordinate (or 1 at the
-// origin). Near and far planes enclose the bounding box as seen from the eye: with the box wholly
+// min ≤ max (asserted). The fit frames the projected extent of the outline (or of the box's
+// corners) so that it spans 1/1.02 of the picture along its limiting side, however small the box
+// is against its coordinates: a deep zoom 1e-15 wide at 0.74 (a few ulps) fills the picture.
+// Only degenerate bounds (min == max: one point, all points equal) get a floor: a box 1e-10 of
+// the largest coordinate (or 1 at the origin) around the point. Near and far planes enclose the bounding box as seen from the eye: with the box wholly
 // in front of the eye, every box point has depth in (0, 1]. Perspective near > 0: a box around
 // the eye gets near = far·1e-6, and points nearer than that or behind the eye are outside the view
 // volume. Ortho near may be < 0 (the slab then reaches behind the eye and holds the whole box).
 Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds);
 
-// The bounding box of a non-empty set, and whether it is 2D (PointSet::isPlanar).
+// The bounding box of a non-empty set and whether it is 2D (PointSet::isPlanar); no outline.
 Bounds boundsOf(const PointSet& points);
+
+// The outline of a 3D set whose box is known (a second pass over a streamed set, block by block):
+// the corners of the boxes of the points in each row along x of a 64×64 grid over the box's y, z
+// (at most 8·64² points). Blocks may come in any order and size, on any number of threads: the
+// outline is the same. Empty for 2D and degenerate boxes (their box is their extent). Every added
+// point must lie in the box given.
+class OutlineBuilder {
+ public:
+  explicit OutlineBuilder(const Bounds& bounds);
+  void add(const std::vector<glm::dvec3>& positions);
+  std::vector<glm::dvec3> finish() const;
+
+ private:
+  struct RowBox {
+    glm::dvec3 min{HUGE_VAL}, max{-HUGE_VAL};
+  };
+  glm::dvec3 min_;
+  double per_y_ = 0.0, per_z_ = 0.0;
+  std::vector<RowBox> rows_;
+};
+
+// boundsOf with the outline, in memory.
+Bounds boundsWithOutline(const PointSet& points);
 
 }  // namespace dpoint

@@ -4,11 +4,19 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <unistd.h>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "converters/point_io.h"
+#include "core/progress.h"
+#include "generators/mandelbrot2d.h"
+#include "generators/mandelbulb.h"
 #include "viewer/reference.h"
+#include "viewer/render_job.h"
 
 namespace dpoint {
 namespace {
@@ -284,8 +292,12 @@ TEST(Camera, fitDirectionAndUpSteerTheFramedView) {
     spec.fit_direction = direction, spec.fit_up = up;
     const Camera camera = make(spec, bounds);
     expectFramed(camera, bounds, 0.3);
+    // The eye looks back along the direction (the fit centres the box's lopsided perspective
+    // projection, so the eye need not sit exactly on the line through the box's centre).
+    const glm::dvec3 backward(camera.rotation[0][2], camera.rotation[1][2], camera.rotation[2][2]);
+    EXPECT_NEAR(glm::dot(backward, direction / glm::length(direction)), 1.0, 1e-12);
     const glm::dvec3 from_centre = camera.eye - centre;
-    EXPECT_NEAR(glm::dot(from_centre / glm::length(from_centre), direction / glm::length(direction)), 1.0, 1e-9);
+    EXPECT_GT(glm::dot(from_centre / glm::length(from_centre), direction / glm::length(direction)), 0.95);
     // A point above the centre (along up) lands above it on screen: smaller window y.
     EXPECT_LT(project(camera, centre + 0.1 * up).y, project(camera, centre).y);
   }
@@ -299,6 +311,101 @@ TEST(Camera, fitDirectionAndUpSteerTheFramedView) {
   with_eye.eye = glm::dvec3(0, 0, 5), with_eye.target = glm::dvec3(0.0), with_eye.up = glm::dvec3(0, 1, 0);
   with_eye.fit_direction = glm::dvec3(1, 0, 0);
   expectUsageError(with_eye, "cannot be combined with --eye");
+}
+
+
+// The fit frames a box however small it is against its coordinates: a deep zoom 1e-15 wide at
+// 0.74 is a few ulps of double, and it still fills the picture (it was a 2-px square under the old
+// 1e-10 relative floor), ortho and perspective, planar and 3D.
+TEST(Camera, fitFillsThePictureAtEveryScale) {
+  const glm::dvec3 c(-0.7436450, 0.1318259, 0.0);
+  for (double width : {1e-6, 1e-12, 1e-15}) {
+    for (bool planar : {true, false}) {
+      for (bool ortho : {true, false}) {
+        SCOPED_TRACE(std::to_string(width) + (planar ? " planar" : " 3D") + (ortho ? " ortho" : " perspective"));
+        const glm::dvec3 half(width / 2, width / 2, planar ? 0.0 : width / 2);
+        const Bounds bounds{c - half, c + half, planar};
+        CameraSpec spec;
+        spec.ortho = ortho;
+        const Camera camera = make(spec, bounds);
+        expectFramed(camera, bounds, 0.85);
+      }
+    }
+  }
+}
+
+// The fit of a set with an outline frames the points, not the box's empty corners: a Mandelbulb
+// (its box corners project ~1.4x wider than it) spans ≥ 85% of the smaller side, every point
+// inside the picture. With the box alone it spans ~72%.
+TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
+  MandelbulbParams params;
+  params.resolution = 64;
+  Result<PointSet> bulb = generateMandelbulb(params);
+  ASSERT_TRUE(bulb.ok()) << bulb.error().message;
+  const Bounds outlined = boundsWithOutline(*bulb);
+  ASSERT_FALSE(outlined.outline.empty());
+  for (const auto& [width, height] : std::vector<std::pair<uint32_t, uint32_t>>{{1024, 768}, {480, 640}}) {
+    CameraSpec spec;
+    spec.width = width, spec.height = height;
+    const auto span = [&](const Bounds& bounds) {
+      const Camera camera = make(spec, bounds);
+      double lo_x = HUGE_VAL, hi_x = -HUGE_VAL, lo_y = HUGE_VAL, hi_y = -HUGE_VAL;
+      for (const WindowPoint& w : projectReference(bulb->positions, camera)) {
+        EXPECT_TRUE(w.visible);
+        lo_x = std::min(lo_x, w.x), hi_x = std::max(hi_x, w.x), lo_y = std::min(lo_y, w.y), hi_y = std::max(hi_y, w.y);
+      }
+      return std::max(hi_x - lo_x, hi_y - lo_y) / std::min(width, height);
+    };
+    EXPECT_GE(span(outlined), 0.85);
+    EXPECT_LT(span(boundsOf(*bulb)), 0.8) << "the box alone frames its corners";
+  }
+  // Blocks in any order give the same outline.
+  OutlineBuilder builder(outlined);
+  const size_t half = bulb->size() / 2;
+  builder.add(std::vector<glm::dvec3>(bulb->positions.begin() + long(half), bulb->positions.end()));
+  builder.add(std::vector<glm::dvec3>(bulb->positions.begin(), bulb->positions.begin() + long(half)));
+  EXPECT_EQ(builder.finish(), outlined.outline);
+}
+
+// The drawn pixels' bounding box as a share of the picture's smaller side (background magenta, so
+// the set's black points count as drawn).
+double drawnSpan(const Image& image, uint32_t background) {
+  uint32_t lo_x = image.width, hi_x = 0, lo_y = image.height, hi_y = 0;
+  for (uint32_t y = 0; y < image.height; ++y) {
+    for (uint32_t x = 0; x < image.width; ++x) {
+      const uint8_t* p = &image.rgba[(size_t(y) * image.width + x) * 4];
+      const uint32_t rgba = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+      if (rgba == background) continue;
+      lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
+    }
+  }
+  if (hi_x < lo_x) return 0.0;
+  return double(std::max(hi_x - lo_x + 1, hi_y - lo_y + 1)) / std::min(image.width, image.height);
+}
+
+// Real deep zooms drawn by the default render job on the device: each fills the picture (the
+// 1e-12 one was a 7-px square, the 1e-15 one 2 px).
+TEST(Camera, defaultRenderOfDeepZoomsFillsThePicture) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("dpoint-camera-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (double width : {1e-6, 1e-12, 1e-15}) {
+    SCOPED_TRACE(width);
+    Mandelbrot2dParams params;
+    params.resolution = 256, params.width = width;
+    Result<PointSet> set = generateMandelbrot2d(params);
+    ASSERT_TRUE(set.ok()) << set.error().message;
+    const std::string path = (dir / "deep.ply").string();
+    ASSERT_TRUE(writePoints(path, *set).ok());
+    RenderRequest request;
+    request.inputs = {path};
+    request.background_rgba8 = 0xffff00ffu;
+    Progress progress;
+    Result<RenderOutcome> outcome = runRenderJob(request, progress);
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message;
+    EXPECT_GE(drawnSpan(outcome->image, request.background_rgba8), 0.85);
+    EXPECT_LE(drawnSpan(outcome->image, request.background_rgba8), 1.0);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
