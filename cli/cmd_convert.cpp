@@ -1,5 +1,6 @@
 // dpoint convert IN -o OUT: CSV, PLY, GLB and LAS in any direction, and glTF/GLB input with scene
 // selection (converters/gltf_read.h says what a glTF file turns into, converters/las.h a LAS file).
+#include <cstdio>
 #include <memory>
 
 #include "cli/commands.h"
@@ -67,7 +68,10 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
   }
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
+  std::vector<std::string> notices;
+  r.notices = &notices;
   Result<PointSet> points = readPoints(o.input, r);
+  for (const std::string& notice : notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   if (points && o.max_points != 0 && points->size() > o.max_points)
     return Error{o.input + ": " + std::to_string(points->size()) + " points exceed --max-points " +
                      std::to_string(o.max_points),
@@ -98,11 +102,16 @@ int runConvert(ConvertOptions& o) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
+  // LAS → CSV: values at the file's step (849087.70 at 0.01 is "849087.7"), unless --decimals.
+  if (o.decimals < 0 && out_format && *out_format == FileFormat::kCsv && formatOf(o.input) &&
+      *formatOf(o.input) == FileFormat::kLas) {
+    Result<LasHeader> header = readLasHeader(o.input);
+    if (!header) return reportError(header.error());
+    w.decimals = lasStepDecimals(*header);
+    w.decimals_at_scale = w.decimals >= 0;
+  }
   Result<PointSet> points = readInput(o, progress);
   if (!points) return reportError(points.error());
-  // Named here rather than by the writer, which only knows the output: the input is what is empty
-  // (a glTF file whose scene places no mesh, a CSV with a header only).
-  if (points->positions.empty()) return reportError(Error{o.input + ": no points to convert"});
   if (filters.drop) points->colors.clear();
   if (o.unique) dropDuplicatePositions(*points);
   if (filters.srgb8) encodeColorsSrgb8(*points);
@@ -126,7 +135,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las); written whole or not at all")
       ->required();
   cmd->add_option("--decimals", o->decimals,
-                  "CSV: fixed digits after the point (15 gives the seed's %.15f); default: shortest round trip")
+                  "CSV: fixed digits after the point (15 gives the seed's %.15f); default: shortest round trip, "
+                  "or for LAS input the file's step (scale 0.01: at most 2 digits, trailing zeros dropped)")
       ->check(CLI::Range(0, 100));
   cmd->add_flag("--ply-ascii", o->ply_ascii, "PLY: write ASCII instead of binary little-endian");
   cmd->add_option("--ply-colors", o->ply_colors, "PLY: colour property type")

@@ -1,7 +1,11 @@
 // CSV point files: `x,y,z,r,g,b`, `x,y,z`, `x,y,r,g,b` or `x,y` (z = 0), with or without a header.
 //
 // Reading: LF or CRLF line ends, an optional UTF-8 BOM, spaces or tabs around fields, blank lines
-// skipped. Numbers are parsed correctly rounded (fast_float): positions to double, colours to
+// skipped. Fields are separated by commas, or (when the first line has no comma) by runs of spaces
+// and tabs, as CloudCompare's ASCII export writes them; its `//X,Y,Z` header is read too. A header
+// may name further columns after x,y,z or x,y,z,r,g,b (`x,y,z,intensity`): they are skipped, and a
+// notice says so. A header with no rows after it is an empty set; a file without a header needs a
+// row. PointSet::z_axis says whether the file had a z column. Numbers are parsed correctly rounded (fast_float): positions to double, colours to
 // float. The file is read in blocks on all cores; every row goes to its preassigned index, so the
 // result is the same for any thread count. Memory: the PointSet plus one block per thread; the
 // set's size (from the line count) is checked against max_memory before it is allocated.
@@ -30,23 +34,29 @@ struct CsvReadOptions {
   bool allow_nonfinite = false;  // accept nan/inf values instead of rejecting them
   Progress* progress = nullptr;
   uint64_t max_memory = 0;       // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
+  // When not null, gets one line per thing read past (a header's further columns, ignored).
+  std::vector<std::string>* notices = nullptr;
 };
 
 struct CsvWriteOptions {
   int decimals = -1;  // < 0: shortest round trip; else fixed digits after the point (0..40)
   unsigned threads = 0;
   Progress* progress = nullptr;
+  // decimals is the input's coordinate step (LAS, lasStepDecimals): positions are written with
+  // `decimals` digits and their trailing zeros trimmed (849087.70 → "849087.7"), colours in
+  // shortest form. Ignored when decimals < 0.
+  bool at_scale = false;
 };
 
 Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options = {});
 // The same from an opened file, or from bytes in memory (InputFile::fromMemory).
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = {});
 
-// Writes atomically (AtomicFile). Header `x,y` when the set is planar (every z is +0.0),
-// else `x,y,z`; `,r,g,b` when it has colours. Triangles are not stored in CSV.
+// Writes atomically (AtomicFile). Header `x,y` when the set has no z (PointSet::hasZ: a 2D
+// source, or a set made in memory whose every z is +0.0), else `x,y,z`; `,r,g,b` when it has colours. Triangles are not stored in CSV.
 Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options = {});
 
-// The columns: `x,y` (planar: z is not written) or `x,y,z`, then `,r,g,b` when colors.
+// The columns: `x,y` (planar: the set has no z, which is not written) or `x,y,z`, then `,r,g,b` when colors.
 struct CsvLayout {
   bool planar = false;
   bool colors = false;
@@ -78,6 +88,7 @@ class CsvRowWriter {
   AtomicFile file_;
   CsvLayout layout_;
   int decimals_;
+  bool at_scale_;
   unsigned threads_;
   Progress* progress_;
   size_t batch_rows_;  // rows formatted in one parallel batch

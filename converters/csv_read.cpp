@@ -28,20 +28,22 @@ constexpr size_t kBlockSize = 8u << 20;
 // longer is not a point row (and would otherwise make a block read unbounded).
 constexpr size_t kMaxLineLength = 64u << 10;
 
-// The value is the column count. 2D files written with colours have `x,y,r,g,b` (the writer's
-// planar form), so that layout is read too.
-enum class Layout { kXy = 2, kXyz = 3, kXyRgb = 5, kXyzRgb = 6 };
-int positionColumns(Layout layout) { return layout == Layout::kXy || layout == Layout::kXyRgb ? 2 : 3; }
-bool hasColorColumns(Layout layout) { return layout == Layout::kXyRgb || layout == Layout::kXyzRgb; }
-const char* layoutText(Layout layout) {
-  switch (layout) {
-    case Layout::kXy: return "x,y";
-    case Layout::kXyz: return "x,y,z";
-    case Layout::kXyRgb: return "x,y,r,g,b";
-    case Layout::kXyzRgb: return "x,y,z,r,g,b";
-  }
-  return "";
-}
+// The known layouts. 2D files written with colours have `x,y,r,g,b` (the writer's planar form),
+// so that layout is read too.
+enum class Known { kXy, kXyz, kXyRgb, kXyzRgb };
+constexpr const char* kKnownText[] = {"x,y", "x,y,z", "x,y,r,g,b", "x,y,z,r,g,b"};
+
+// What a row holds: one of the known layouts in its first columns, then, with a header only, any
+// number of further columns that are read past and not kept (`x,y,z,intensity`). Fields are
+// separated by commas, or by runs of spaces and tabs (CloudCompare's ASCII export).
+struct Layout {
+  Known known = Known::kXyz;
+  int columns = 3;  // every row has exactly this many fields
+  bool whitespace = false;
+  std::string text;  // the header's names, or the known layout's, for messages
+};
+int positionColumns(Known known) { return known == Known::kXy || known == Known::kXyRgb ? 2 : 3; }
+bool hasColorColumns(const Layout& layout) { return layout.known == Known::kXyRgb || layout.known == Known::kXyzRgb; }
 
 bool isBlank(char c) { return c == ' ' || c == '\t'; }
 
@@ -71,9 +73,9 @@ struct LineError {
 
 class LineParser {
  public:
-  LineParser(const std::string& path, Layout layout, bool allow_nonfinite)
-      : path_(path), layout_(layout), columns_(static_cast<int>(layout)), position_columns_(positionColumns(layout)),
-        allow_nonfinite_(allow_nonfinite) {}
+  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite)
+      : path_(path), layout_(layout), position_columns_(positionColumns(layout.known)),
+        kept_columns_(position_columns_ + (hasColorColumns(layout) ? 3 : 0)), allow_nonfinite_(allow_nonfinite) {}
 
   // Parses one line (without its line end, '\r' already removed). Returns false on error.
   bool parse(const char* begin, const char* end, uint64_t line, glm::dvec3& position, glm::vec3& color,
@@ -84,11 +86,11 @@ class LineParser {
     int column = 0;
     while (true) {
       while (p < end && isBlank(*p)) ++p;
+      if (layout_.whitespace && p == end) break;  // trailing blanks end the row
       const char* number_begin = p;
-      const char* field_end = static_cast<const char*>(std::memchr(p, ',', static_cast<size_t>(end - p)));
-      if (!field_end) field_end = end;
+      const char* field_end = layout_.whitespace ? std::find_if(p, end, isBlank) : nextComma(p, end);
       ++column;
-      if (column > columns_) {
+      if (column > layout_.columns) {
         error = {line, lineText(line) + countMessage(begin, end)};
         return false;
       }
@@ -98,15 +100,16 @@ class LineParser {
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
       }
-      bool ok = column <= position_columns_
-                    ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
-                    : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error);
+      bool ok = column > kept_columns_ ||  // a column the header names beyond the known ones: not kept
+                (column <= position_columns_
+                     ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
+                     : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error));
       if (!ok) return false;
       p = field_end;
       if (p == end) break;
-      ++p;  // the comma
+      if (!layout_.whitespace) ++p;  // the comma
     }
-    if (column != columns_) {
+    if (column != layout_.columns) {
       error = {line, lineText(line) + countMessage(begin, end)};
       return false;
     }
@@ -116,11 +119,26 @@ class LineParser {
   }
 
  private:
+  static const char* nextComma(const char* p, const char* end) {
+    const char* comma = static_cast<const char*>(std::memchr(p, ',', static_cast<size_t>(end - p)));
+    return comma ? comma : end;
+  }
+
   std::string lineText(uint64_t line) const { return path_ + ":" + std::to_string(line) + ": "; }
 
   std::string countMessage(const char* begin, const char* end) const {
-    size_t commas = static_cast<size_t>(std::count(begin, end, ','));
-    return std::to_string(commas + 1) + " columns, expected " + std::to_string(columns_) + " (" + layoutText(layout_) + ")";
+    size_t fields = 0;
+    if (layout_.whitespace) {
+      for (const char* p = begin; p < end;) {
+        p = std::find_if_not(p, end, isBlank);
+        if (p == end) break;
+        ++fields;
+        p = std::find_if(p, end, isBlank);
+      }
+    } else {
+      fields = static_cast<size_t>(std::count(begin, end, ',')) + 1;
+    }
+    return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + layout_.text + ")";
   }
 
   template <typename T>
@@ -146,60 +164,92 @@ class LineParser {
   }
 
   const std::string& path_;
-  Layout layout_;
-  int columns_;
+  const Layout& layout_;
   int position_columns_;
+  int kept_columns_;  // position and colour columns; the header's further columns are skipped
   bool allow_nonfinite_;
 };
 
-// Splits the first line into trimmed, lower-case fields.
+// Splits the first line into trimmed, lower-case fields: at commas when it has one, else at runs
+// of spaces and tabs.
 std::vector<std::string> splitHeader(std::string_view line) {
   std::vector<std::string> fields;
-  size_t start = 0;
-  while (true) {
-    size_t comma = line.find(',', start);
-    std::string_view field = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+  auto add = [&](std::string_view field) {
     while (!field.empty() && isBlank(field.front())) field.remove_prefix(1);
     while (!field.empty() && isBlank(field.back())) field.remove_suffix(1);
     std::string lower(field);
     for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     fields.push_back(std::move(lower));
+  };
+  if (line.find(',') == std::string_view::npos) {
+    for (size_t start = line.find_first_not_of(" \t"); start != std::string_view::npos;) {
+      const size_t stop = line.find_first_of(" \t", start);
+      add(line.substr(start, stop == std::string_view::npos ? stop : stop - start));
+      start = stop == std::string_view::npos ? stop : line.find_first_not_of(" \t", stop);
+    }
+    return fields;
+  }
+  size_t start = 0;
+  while (true) {
+    size_t comma = line.find(',', start);
+    add(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
   return fields;
 }
 
-// A first field that starts with a letter (other than nan/inf) marks a header line.
+// A first field that starts with a letter (other than nan/inf) marks a header line; so does
+// CloudCompare's `//X,Y,Z`.
 bool isHeaderLine(const std::vector<std::string>& fields) {
   const std::string& first = fields.front();
+  if (first.rfind("//", 0) == 0) return true;
   if (first.empty() || !std::isalpha(static_cast<unsigned char>(first[0]))) return false;
   return first.rfind("nan", 0) != 0 && first.rfind("inf", 0) != 0;
 }
 
-Result<Layout> layoutFromHeader(const std::string& path, const std::vector<std::string>& fields,
-                                uint64_t line, std::string_view text) {
+// A header names one of the known layouts, then, after x,y,z or x,y,z,r,g,b, optionally further
+// columns whose names are none of x, y, z, r, g, b (so `x,y,z,r,g` stays an error rather than
+// x,y,z and two extras).
+Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string> fields, uint64_t line,
+                                std::string_view text, bool whitespace) {
+  if (fields.front().rfind("//", 0) == 0) fields.front().erase(0, 2);
+  auto known_name = [](const std::string& f) {
+    return f == "x" || f == "y" || f == "z" || f == "r" || f == "g" || f == "b";
+  };
   std::string joined;
   for (const std::string& f : fields) joined += (joined.empty() ? "" : ",") + f;
-  for (Layout layout : {Layout::kXy, Layout::kXyz, Layout::kXyRgb, Layout::kXyzRgb})
-    if (joined == layoutText(layout)) return layout;
+  for (Known known : {Known::kXyzRgb, Known::kXyRgb, Known::kXyz, Known::kXy}) {
+    const std::string_view prefix = kKnownText[static_cast<int>(known)];
+    const size_t count = static_cast<size_t>(std::count(prefix.begin(), prefix.end(), ',')) + 1;
+    if (fields.size() < count || joined.compare(0, prefix.size(), prefix) != 0) continue;
+    if (joined.size() > prefix.size() && joined[prefix.size()] != ',') continue;
+    // Further columns only after z: `x,y,w` is more likely a misspelt z than a 2D set with an extra.
+    if (fields.size() > count && (known == Known::kXy || known == Known::kXyRgb)) break;
+    if (std::any_of(fields.begin() + std::ptrdiff_t(count), fields.end(), known_name)) break;
+    return Layout{known, static_cast<int>(fields.size()), whitespace, joined};
+  }
   return Error{path + ":" + std::to_string(line) + ": header '" + excerpt(text.data(), text.data() + text.size()) +
-               "' is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b"};
+               "' is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b (further columns may follow)"};
 }
 
-Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line) {
-  if (columns == 2) return Layout::kXy;
-  if (columns == 3) return Layout::kXyz;
-  if (columns == 5) return Layout::kXyRgb;
-  if (columns == 6) return Layout::kXyzRgb;
+Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line, bool whitespace) {
+  auto layout = [&](Known known) {
+    return Layout{known, static_cast<int>(columns), whitespace, kKnownText[static_cast<int>(known)]};
+  };
+  if (columns == 2) return layout(Known::kXy);
+  if (columns == 3) return layout(Known::kXyz);
+  if (columns == 5) return layout(Known::kXyRgb);
+  if (columns == 6) return layout(Known::kXyzRgb);
   return Error{path + ":" + std::to_string(line) + ": " + std::to_string(columns) +
                " columns without a header; expected 2 (x,y), 3 (x,y,z), 5 (x,y,r,g,b) or 6 (x,y,z,r,g,b)"};
 }
 
 struct Header {
-  Layout layout = Layout::kXyz;
+  Layout layout;
   uint64_t data_offset = 0;     // byte where the first data line (or blank lines) start
   uint64_t first_data_line = 0; // 0-based line index at data_offset
+  bool named = false;           // the first line is a header: with no rows after it, the set is empty
 };
 
 // Finds the layout from the first non-blank line, skipping a UTF-8 BOM.
@@ -234,16 +284,17 @@ Result<Header> readHeader(const InputFile& file) {
       return Error{file.path() + ":" + std::to_string(line + 1) + ": binary data, not CSV text ('" +
                    excerpt(text.data(), text.data() + text.size()) + "')"};
     std::vector<std::string> fields = splitHeader(text);
+    const bool whitespace = text.find(',') == std::string_view::npos;
     Header header;
     if (isHeaderLine(fields)) {
-      Result<Layout> layout = layoutFromHeader(file.path(), fields, line + 1, text);
+      Result<Layout> layout = layoutFromHeader(file.path(), std::move(fields), line + 1, text, whitespace);
       if (!layout) return layout.error();
       header.layout = *layout;
-      header.data_offset = nl + 1;
+      header.data_offset = std::min<uint64_t>(nl + 1, file.size());  // a header only: an empty set
       header.first_data_line = line + 1;
-      if (header.data_offset >= file.size()) return Error{file.path() + ": header only, no data rows"};
+      header.named = true;
     } else {
-      Result<Layout> layout = layoutFromColumns(file.path(), fields.size(), line + 1);
+      Result<Layout> layout = layoutFromColumns(file.path(), fields.size(), line + 1, whitespace);
       if (!layout) return layout.error();
       header.layout = *layout;
       header.data_offset = pos;
@@ -267,6 +318,13 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   Result<Header> header_result = readHeader(file);
   if (!header_result) return header_result.error();
   const Header header = *header_result;
+  const Layout& layout = header.layout;
+  if (layout.columns > positionColumns(layout.known) + (hasColorColumns(layout) ? 3 : 0) && options.notices)
+    options.notices->push_back(path + ": columns after " + kKnownText[static_cast<int>(layout.known)] +
+                               " ignored (header '" + layout.text + "')");
+  PointSet points;
+  points.z_axis = positionColumns(layout.known) == 3 ? ZAxis::kPresent : ZAxis::kAbsent;
+  if (header.data_offset >= file.size()) return points;  // a header and nothing after it
 
   const uint64_t begin = header.data_offset, size = file.size();
   const size_t blocks = static_cast<size_t>((size - begin + kBlockSize - 1) / kBlockSize);
@@ -301,13 +359,11 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   if (Result<size_t> got = file.readAt(size - 1, &last_byte, 1); !got) return got.error();
   const uint64_t lines = newlines[blocks] + (last_byte != '\n' ? 1 : 0);
 
-  const Layout layout = header.layout;
   // Every line may be a row: a file of short lines (or of blank ones) asks for 24-36 bytes of
   // point set per 2-4 bytes of file, so the arrays are checked before they are made.
   const uint64_t row_bytes = sizeof(glm::dvec3) + (hasColorColumns(layout) ? sizeof(glm::vec3) : 0);
   if (Status s = checkMemory(path + ": " + std::to_string(lines) + " lines", lines * row_bytes, options.max_memory); !s)
     return s.error();
-  PointSet points;
   resizePrefaulted(points.positions, static_cast<size_t>(lines), threads);
   if (hasColorColumns(layout)) resizePrefaulted(points.colors, static_cast<size_t>(lines), threads);
 
@@ -406,7 +462,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     points.positions.resize(out);
     if (!points.colors.empty()) points.colors.resize(out);
   }
-  if (points.positions.empty()) return Error{path + ": no data rows"};
+  if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
   if (options.progress) options.progress->finish();
   return points;
 }

@@ -27,7 +27,8 @@ constexpr size_t kMaxFieldChars = fixedFormatMaxChars(kMaxDecimals) + 1;
 
 class RowFormatter {
  public:
-  RowFormatter(CsvLayout layout, int decimals) : decimals_(decimals), planar_(layout.planar), colors_(layout.colors) {}
+  RowFormatter(CsvLayout layout, int decimals, bool at_scale)
+      : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors) {}
 
   std::string header() const {
     std::string h = planar_ ? "x,y" : "x,y,z";
@@ -69,6 +70,13 @@ class RowFormatter {
 
  private:
   char* number(char* p, char* limit, double v) const {
+    if (at_scale_ && std::isfinite(v)) {
+      // The value at the file's step: "849087.70" is written "849087.7", "12.00" "12".
+      char* end = formatFixed(p, v, decimals_);
+      if (decimals_ == 0) return end;
+      while (end[-1] == '0') --end;
+      return end[-1] == '.' ? end - 1 : end;
+    }
     if (decimals_ >= 0 && std::isfinite(v)) return formatFixed(p, v, decimals_);
     std::to_chars_result r = decimals_ < 0 ? std::to_chars(p, limit, v)
                                            : std::to_chars(p, limit, v, std::chars_format::fixed, decimals_);
@@ -76,13 +84,14 @@ class RowFormatter {
     return r.ptr;
   }
   char* color(char* p, char* limit, float v) const {
-    if (decimals_ >= 0) return number(p, limit, static_cast<double>(v));
+    if (decimals_ >= 0 && !at_scale_) return number(p, limit, static_cast<double>(v));
     std::to_chars_result r = std::to_chars(p, limit, v);
     assert(r.ec == std::errc());
     return r.ptr;
   }
 
   int decimals_;
+  bool at_scale_;  // CsvWriteOptions::at_scale
   bool planar_;
   bool colors_;
 };
@@ -102,7 +111,7 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
   CsvRowWriter writer(std::move(*file), layout, options);
-  if (Status s = writer.file_.write(RowFormatter(layout, options.decimals).header()); !s) return s.error();
+  if (Status s = writer.file_.write(RowFormatter(layout, options.decimals, options.at_scale).header()); !s) return s.error();
   if (options.progress) options.progress->start("writing " + path, rows);
   return writer;
 }
@@ -111,6 +120,7 @@ CsvRowWriter::CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOpti
     : file_(std::move(file)),
       layout_(layout),
       decimals_(options.decimals),
+      at_scale_(options.at_scale),
       threads_(resolveThreads(options.threads)),
       progress_(options.progress) {
   // Chunks are formatted a batch at a time (a few per thread) and written in order, so memory
@@ -121,7 +131,7 @@ CsvRowWriter::CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOpti
 
 Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count) {
   assert(count <= batch_rows_);
-  const RowFormatter formatter(layout_, decimals_);
+  const RowFormatter formatter(layout_, decimals_, at_scale_);
   const size_t chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
   parallelFor(chunks, threads_, [&](size_t k, unsigned) {
     const size_t begin = k * kRowsPerChunk;
@@ -179,7 +189,7 @@ Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteO
     return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(points.positions.size()) + " points"};
   Result<CsvRowWriter> writer =
-      CsvRowWriter::create(path, CsvLayout{points.isPlanar(), points.hasColors()}, options, points.size());
+      CsvRowWriter::create(path, CsvLayout{!points.hasZ(), points.hasColors()}, options, points.size());
   if (!writer) return writer.error();
   if (Status s = writer->append(points.positions, points.colors); !s) return s;
   return writer->commit();

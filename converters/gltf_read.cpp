@@ -56,12 +56,6 @@ bool allFinite(const std::vector<double>& values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
-bool isPositiveZero(double v) {
-  uint64_t bits;
-  std::memcpy(&bits, &v, sizeof bits);
-  return bits == 0;
-}
-
 // Vertex e of a POSITION accessor in world space.
 glm::dvec3 placeVertex(const AccessorElements& positions, const glm::dmat4& world, size_t e) {
   return glm::dvec3(world * glm::dvec4(positions.value(e, 0), positions.value(e, 1), positions.value(e, 2), 1.0));
@@ -90,6 +84,7 @@ class SceneReader {
   Result<PointSet> read() {
     pass_ = Pass::kBuild;
     if (Status s = walkScenes(); !s) return s.error();
+    out_.z_axis = ZAxis::kPresent;  // glTF positions are VEC3, whatever their values
     if (any_colour_) {
       out_.colors.resize(out_.positions.size());
       for (const Uncoloured& u : uncoloured_)
@@ -101,7 +96,7 @@ class SceneReader {
   Status stream(GltfPointSink& sink) {
     pass_ = Pass::kCheck;
     if (Status s = walkScenes(); !s) return s;
-    if (Status s = sink.begin(GltfSummary{emitted_total_, any_colour_, planar_}); !s) return s;
+    if (Status s = sink.begin(GltfSummary{emitted_total_, any_colour_}); !s) return s;
     pass_ = Pass::kEmit;
     sink_ = &sink;
     emitted_total_ = 0;
@@ -401,10 +396,7 @@ class SceneReader {
         return decoder_.fail(position_index, "POSITION element " + std::to_string(e) + " is not finite" +
                                                  (local_finite ? " in world space" : ""));
       }
-      if (pass_ == Pass::kBuild)
-        out_.positions.push_back(w);
-      else
-        planar_ = planar_ && isPositiveZero(w.z);
+      if (pass_ == Pass::kBuild) out_.positions.push_back(w);
     }
     if (Status s = readColours(primitive, pointer, remap, count, begin, begin + emitted); !s) return s;
 
@@ -460,6 +452,9 @@ class SceneReader {
     if (colour_it == primitive.attributes.end()) {
       Result<glm::vec3> fill = materialColour(primitive, pointer);
       if (!fill) return fill.error();
+      // A material's base colour other than the default white is the primitive's colour, kept
+      // even when no primitive has COLOR_0 (a CAD model coloured by materials only).
+      if (*fill != glm::vec3(1.0f)) any_colour_ = true;
       if (pass_ == Pass::kBuild) uncoloured_.push_back({emitted_begin, emitted_end, *fill});
       return okStatus();
     }
@@ -546,7 +541,6 @@ class SceneReader {
   std::vector<bool> on_path_, visited_;
   std::vector<Uncoloured> uncoloured_;
   bool any_colour_ = false;  // kept from the checking pass into the emitting pass
-  bool planar_ = true;       // checking pass: every z so far is +0.0
   GltfPointSink* sink_ = nullptr;
   PointSet block_;  // emitting pass: points not yet handed to sink_
 };

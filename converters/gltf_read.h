@@ -11,8 +11,8 @@
 //   vertex some index names, once, in vertex order. Triangle modes keep their triangles
 //   (TRIANGLE_STRIP and TRIANGLE_FAN become triangle lists); points and lines are points.
 // - Colours (linear 0..1) when any primitive has COLOR_0 (float, unorm8 or unorm16, VEC3/VEC4,
-//   alpha dropped); primitives without COLOR_0 then take their material's baseColorFactor rgb
-//   (white without a material).
+//   alpha dropped) or a material whose baseColorFactor rgb is not white; primitives without
+//   COLOR_0 then take their material's baseColorFactor rgb (white without a material).
 // - Required extensions: KHR_mesh_quantization, EXT_meshopt_compression (gltf_meshopt.h),
 //   KHR_draco_mesh_compression (gltf_draco.h) and EXT_mesh_gpu_instancing are decoded;
 //   shading-only ones are accepted; any other is refused by name.
@@ -52,8 +52,7 @@ Result<PointSet> readGltf(const InputFile& input, const GltfReadOptions& options
 // What readGltf's set would be, found by streamGltf's first walk without keeping points.
 struct GltfSummary {
   uint64_t points = 0;
-  bool colors = false;  // some primitive has COLOR_0 (then every point has a colour)
-  bool planar = true;   // every world-space z is +0.0 (PointSet::isPlanar)
+  bool colors = false;  // some primitive has COLOR_0 or a non-white material colour (then every point has a colour)
 };
 
 // Receives streamGltf's points: begin() once, after the checking walk, then points() with

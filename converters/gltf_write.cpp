@@ -57,7 +57,10 @@ struct Layout {
 
 Result<Layout> planLayout(const PointSet& points) {
   const size_t n = points.size();
-  if (n == 0) return Error{"nothing to write: the point set is empty"};
+  // glTF requires accessor.count >= 1 (and buffer.byteLength >= 1): an empty set has no valid GLB.
+  if (n == 0)
+    return Error{"cannot write GLB: the point set is empty, and a glTF accessor must hold at least one element; "
+                 "write .csv, .ply or .las, which hold an empty set"};
   if (points.hasColors() && points.colors.size() != n)
     return Error{"cannot write GLB: " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(n) + " points"};

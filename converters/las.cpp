@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <charconv>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -200,6 +201,8 @@ class LasReader {
     const size_t length = h_.record_length;
     if (options_.progress) options_.progress->start("reading " + file_.path(), count * length);
     PointSet points;
+    points.z_axis = ZAxis::kPresent;  // every record has Z, whatever its values
+    points.z_up = true;               // LAS is z-up (elevation)
     points.positions.resize(count);
     if (source_ != LasColorSource::kNone) points.colors.resize(count);
     const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
@@ -536,6 +539,26 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   if (Status s = file->commit(); !s) return s;
   if (options.progress) options.progress->finish();
   return okStatus();
+}
+
+namespace {
+
+// Digits after the point in v's shortest round-trip decimal form.
+int shortestDecimals(double v) {
+  char text[400];
+  const std::to_chars_result r = std::to_chars(text, text + sizeof text, v, std::chars_format::fixed);
+  assert(r.ec == std::errc());
+  const char* point = std::find(text, r.ptr, '.');
+  return point == r.ptr ? 0 : static_cast<int>(r.ptr - point - 1);
+}
+
+}  // namespace
+
+int lasStepDecimals(const LasHeader& header) {
+  int decimals = 0;
+  for (int k = 0; k < 3; ++k)
+    decimals = std::max({decimals, shortestDecimals(header.scale[k]), shortestDecimals(header.offset[k])});
+  return decimals > 17 ? -1 : decimals;
 }
 
 }  // namespace dpoint

@@ -104,6 +104,14 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
 // (x · 1000) as bounds. `dpoint info` reports the disagreement.
 bool lasBoundsContain(const LasHeader& header, const Box& points);
 
+// The digits after the point that the file's coordinates have: the most any axis's scale or offset
+// needs in its shortest decimal form (0.01 and 638000 → 2; 0.001 and 0.5 → 3), or −1 when one needs
+// more than 17 (a scale like 1/3, not a decimal step). X·scale + offset is an exact decimal with
+// that many digits; the double a reader computes is within a few ulps of it, so printing with
+// these digits gives the decimal back (849087.70 at scale 0.01, where the double's shortest form
+// is 849087.7000000001) as long as an ulp of the value stays below half a step (|v| < 2^52 ·
+// step, 4.5e13 at 0.01). `convert` writes LAS → CSV this way unless --decimals asks otherwise.
+int lasStepDecimals(const LasHeader& header);
 // The refusal of compressed LAS, for a .laz name or a header with the LAZ bits set.
 Error lasCompressedError(const std::string& path);
 

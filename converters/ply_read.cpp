@@ -385,6 +385,11 @@ class PlyParser {
       if (line_no == 1) continue;  // the magic, checked above
       if (w.empty()) return headerError(line_no, "empty line");
       const std::string_view key = w[0];
+      if (key == "comment" && w.size() >= 3 && w[1] == "dpoint:") {
+        // The facts dpoint writes (ply_write.cpp): a 2D source, and z up.
+        if (w[2] == "2D") points_.z_axis = ZAxis::kAbsent;
+        if (w.size() == 5 && w[2] == "up" && w[3] == "axis" && w[4] == "z") points_.z_up = true;
+      }
       if (key == "comment" || key == "obj_info") continue;
       if (key == "end_header") break;
       if (key == "format") {
@@ -468,7 +473,10 @@ class PlyParser {
         found[role] = p.line;
       }
     }
-    for (int role = kX; role <= kZ; ++role)
+    // x and y are needed; without z the file is 2D (z = 0).
+    if (!found[kZ]) points_.z_axis = ZAxis::kAbsent;
+    else if (points_.z_axis == ZAxis::kUnknown) points_.z_axis = ZAxis::kPresent;
+    for (int role = kX; role <= kY; ++role)
       if (!found[role])
         return headerError(vertex->line, "element 'vertex' has no '" + std::string(kNames[role]) + "' property");
     has_colors_ = found[kRed] || found[kGreen] || found[kBlue];
@@ -572,6 +580,7 @@ class PlyParser {
     float byte_color[256];  // k / 255.0f, the same rounding as colorOf
 
     void load(const char* row, double* v) const {
+      v[kZ] = 0.0;  // a 2D file has no z property
       for (const Field& f : fields) v[f.role] = loadValue(f.type, row + f.offset);
     }
   };

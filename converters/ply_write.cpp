@@ -23,6 +23,16 @@ uint8_t colorByte(float c) {
   return static_cast<uint8_t>(std::min(static_cast<double>(c), 1.0) * 255.0 + 0.5);
 }
 
+// Header comments for the facts of the source that the values cannot tell (ply_read.cpp reads
+// them back): a 2D source (its z are 0 but not a coordinate), and z as the up axis (LAS). Sets made
+// in memory have neither, and their headers are as before.
+std::string sourceFacts(const PointSet& points) {
+  std::string facts;
+  if (points.z_axis == ZAxis::kAbsent) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
+  if (points.z_up) facts += "comment dpoint: up axis z\n";
+  return facts;
+}
+
 class ChunkWriter {
  public:
   ChunkWriter(AtomicFile& file, Progress* progress) : file_(file), progress_(progress), buf_(kWriteChunk + 4096) {}
@@ -81,7 +91,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   const size_t faces = points.triangles.size() / 3;
 
   std::string header = std::string("ply\nformat ") + (ascii ? "ascii" : "binary_little_endian") +
-                       " 1.0\ncomment written by dpoint\nelement vertex " + std::to_string(n) +
+                       " 1.0\ncomment written by dpoint\n" + sourceFacts(points) + "element vertex " + std::to_string(n) +
                        "\nproperty double x\nproperty double y\nproperty double z\n";
   if (points.hasColors())
     for (const char* c : {"red", "green", "blue"})

@@ -15,13 +15,13 @@ namespace {
 // and a refused input leaves no output behind, as with readGltf then writeCsv.
 class CsvPointSink final : public GltfPointSink {
  public:
-  CsvPointSink(const std::string& input, const std::string& output, const ColorFilters& filters,
+  CsvPointSink(const std::string& output, const ColorFilters& filters,
                const WriteOptions& options)
-      : input_(input), output_(output), filters_(filters), options_(options) {}
+      : output_(output), filters_(filters), options_(options) {}
 
   Status begin(const GltfSummary& summary) override {
-    if (summary.points == 0) return Error{input_ + ": no points to convert"};
-    const CsvLayout layout{summary.planar, summary.colors && !filters_.drop};
+    // glTF positions always have z (PointSet::z_axis), and a scene placing no points is an empty set.
+    const CsvLayout layout{false, summary.colors && !filters_.drop};
     Result<CsvRowWriter> writer = CsvRowWriter::create(
         output_, layout, CsvWriteOptions{options_.decimals, options_.threads, options_.progress}, summary.points);
     if (!writer) return writer.error();
@@ -38,7 +38,6 @@ class CsvPointSink final : public GltfPointSink {
   Status commit() { return writer_->commit(); }
 
  private:
-  const std::string& input_;
   const std::string& output_;
   const ColorFilters& filters_;
   const WriteOptions& options_;
@@ -64,7 +63,8 @@ namespace {
 Result<PointSet> readByFormat(const std::string& path, FileFormat format, const ReadOptions& options) {
   switch (format) {
     case FileFormat::kCsv:
-      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory});
+      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory,
+                                          options.notices});
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
                                           options.max_memory});
@@ -104,13 +104,15 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
-  if (points.positions.empty()) return Error{path + ": nothing to write: the point set is empty"};
   switch (*format) {
     case FileFormat::kCsv:
-      return writeCsv(path, points, CsvWriteOptions{options.decimals, options.threads, options.progress});
+      return writeCsv(path, points,
+                      CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale});
     case FileFormat::kPly:
       return writePly(path, points, PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress});
     case FileFormat::kGlb:
+      if (points.positions.empty())  // named here: writeGlb's message does not know the path
+        return Error{path + ": " + writeGlb(path, points).error().message};
       return writeGlb(path, points);
     case FileFormat::kGltf:
       return Error{path + ": writing .gltf is not supported; write .glb", ExitCode::kUsage};
@@ -125,7 +127,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
 
 Status convertGltfToCsv(const std::string& input, const GltfReadOptions& read, const ColorFilters& filters,
                         const std::string& output, const WriteOptions& options) {
-  CsvPointSink sink(input, output, filters, options);
+  CsvPointSink sink(output, filters, options);
   if (Status s = streamGltf(input, read, sink); !s) return s;
   return sink.commit();
 }

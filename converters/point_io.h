@@ -28,11 +28,14 @@ struct ReadOptions {
   // colours (kRgb fails when it has none), kNone drops them; kIntensity and kClassification are
   // errors (only LAS has those fields).
   LasColorSource las_color = LasColorSource::kAuto;
+  // When not null, gets one line per thing the reader read past (a CSV header's further columns).
+  std::vector<std::string>* notices = nullptr;
 };
 
 struct WriteOptions {
   unsigned threads = 0;
   int decimals = -1;  // CSV only
+  bool decimals_at_scale = false;  // CSV: decimals is the input's step (CsvWriteOptions::at_scale)
   PlyEncoding ply_encoding = PlyEncoding::kBinary;
   PlyColorType ply_colors = PlyColorType::kUchar;
   Progress* progress = nullptr;
@@ -40,6 +43,8 @@ struct WriteOptions {
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});
+// An empty set is written as an empty file of the format (a CSV header, a PLY or LAS of 0 points);
+// GLB cannot hold one (glTF accessors have at least one element), and says so.
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options = {});
 
 // What `dpoint convert` does to colours between reading and writing.
@@ -51,8 +56,8 @@ struct ColorFilters {
 // glTF/GLB input to a CSV file written block by block as the scene is walked (streamGltf):
 // memory is the loaded model plus a few blocks of rows, however many points the scene places.
 // The file is byte-identical to readGltf(input, read), then the filters, then writePoints(output);
-// the errors are the same and come in the same order: the input's, then "INPUT: no points to
-// convert", then the output's. On any error, nothing is left at `output`. options.ply_* are unused.
+// the errors are the same and come in the same order: the input's, then the output's; a scene
+// that places no points gives a CSV with a header only. On any error, nothing is left at `output`. options.ply_* are unused.
 Status convertGltfToCsv(const std::string& input, const GltfReadOptions& read, const ColorFilters& filters,
                         const std::string& output, const WriteOptions& options = {});
 

@@ -9,16 +9,30 @@
 
 namespace dpoint {
 
+// Whether a set has a z coordinate, as a fact of its source rather than of its values.
+enum class ZAxis : uint8_t {
+  kUnknown,  // made in memory (a generator, a tile): the values decide (isPlanar)
+  kPresent,  // read from a format or file with z (LAS, glTF, a 3-column CSV, a PLY with z)
+  kAbsent,   // read from genuinely 2D input (a 2-column CSV, a PLY without z): every z is 0
+};
+
 struct PointSet {
   std::vector<glm::dvec3> positions;  // always double
   std::vector<glm::vec3> colors;      // empty, or one linear 0..1 colour per point
   std::vector<uint32_t> triangles;    // empty for point sets; 3 vertex indices per triangle
 
+  // Facts of the source that the values cannot tell, set by the readers and kept by the filters.
+  ZAxis z_axis = ZAxis::kUnknown;
+  bool z_up = false;  // the source says z is up (LAS, or a PLY or CSV dpoint wrote from one)
+
   size_t size() const { return positions.size(); }
   bool hasColors() const { return !colors.empty(); }
   bool isMesh() const { return !triangles.empty(); }
-  // True when every z is +0.0 (bit pattern zero): the set is 2D and CSV writes `x,y`.
+  // True when every z is +0.0 (bit pattern zero). The renderer draws such a set as 2D.
   bool isPlanar() const;
+  // Whether writers write z: as z_axis says, or (kUnknown) when not isPlanar(). A LAS file whose
+  // z are all 0 still has z; a 2-column CSV has none.
+  bool hasZ() const { return z_axis == ZAxis::kUnknown ? !isPlanar() : z_axis == ZAxis::kPresent; }
 };
 
 // Smallest and largest coordinates of positions [first, last); asserts first < last.

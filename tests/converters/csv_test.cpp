@@ -177,14 +177,14 @@ void expectReadError(const std::string& path, const std::vector<std::string>& pa
   EXPECT_EQ(r.error().message.find('\n'), std::string::npos) << "message is not one line";
 }
 
-TEST(Csv, rejectsMissingFileFolderEmptyAndHeaderOnly) {
+TEST(Csv, rejectsMissingFileFolderAndEmptyFile) {
   TempDir dir;
   expectReadError(dir.file("missing.csv"), {"missing.csv", "not found"});
   expectReadError(dir.path(), {dir.path(), "folder"});
   writeFile(dir.file("empty.csv"), "");
   expectReadError(dir.file("empty.csv"), {"empty.csv", "empty file"});
-  writeFile(dir.file("header.csv"), "x,y,z\n");
-  expectReadError(dir.file("header.csv"), {"header.csv", "header only"});
+  writeFile(dir.file("blank.csv"), "\n  \n");
+  expectReadError(dir.file("blank.csv"), {"blank.csv", "no data rows"});
   writeFile(dir.file("bad_header.csv"), "x,y,w\n1,2,3\n");
   expectReadError(dir.file("bad_header.csv"), {"bad_header.csv:1:", "'x,y,w'"});
 }

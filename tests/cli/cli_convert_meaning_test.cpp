@@ -1,0 +1,237 @@
+// `dpoint convert` keeps what the data means (issue #24, item 5): z when the input has one, empty
+// inputs as empty outputs, material colours, CSV extra columns and whitespace, LAS values at the
+// file's step, z-up from LAS. Real files, exit codes, messages by content, bytes.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+
+#include "converters/csv.h"
+#include "converters/las.h"
+#include "converters/ply.h"
+#include "test_config.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::runDpoint;
+using test::TempDir;
+using test::writeFile;
+
+const std::string kLas = std::string(DPOINT_CORPUS_DIR) + "/las/";
+const std::string kEngine = "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+
+std::string firstLine(const std::string& text) { return text.substr(0, text.find('\n') + 1); }
+
+void expectConverts(const std::vector<std::string>& args) {
+  test::CommandResult r = runDpoint(test::concat({"convert"}, args));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+}
+
+// simple.las with every Z set to 0 (the same header, records rewritten), and with no points.
+void writeFlatLas(const std::string& path) {
+  std::string bytes = readFile(kLas + "simple.las");
+  uint32_t offset, length, count;
+  std::memcpy(&offset, bytes.data() + 96, 4);
+  std::memcpy(&length, bytes.data() + 105, 2);
+  length &= 0xffff;
+  std::memcpy(&count, bytes.data() + 107, 4);
+  for (uint32_t i = 0; i < count; ++i) std::memset(bytes.data() + offset + size_t(i) * length + 8, 0, 4);
+  writeFile(path, bytes);
+}
+void writeEmptyLas(const std::string& path) {
+  std::string bytes = readFile(kLas + "simple.las");
+  uint32_t offset;
+  std::memcpy(&offset, bytes.data() + 96, 4);
+  bytes.resize(offset);
+  std::memset(bytes.data() + 107, 0, 4 + 5 * 4);  // legacy count and counts by return
+  writeFile(path, bytes);
+}
+
+TEST(CliConvertMeaning, lasWhoseZAreAllZeroKeepsItsZColumn) {
+  TempDir dir;
+  writeFlatLas(dir.file("flat.las"));
+  expectConverts({dir.file("flat.las"), "-o", dir.file("flat.csv")});
+  const std::string csv = readFile(dir.file("flat.csv"));
+  EXPECT_EQ(firstLine(csv), "x,y,z,r,g,b\n");
+  EXPECT_TRUE(test::contains(csv, "\n637012.24,849028.31,0,"));
+  // And through PLY: the PLY has z, so its CSV too.
+  expectConverts({dir.file("flat.las"), "-o", dir.file("flat.ply")});
+  expectConverts({dir.file("flat.ply"), "-o", dir.file("flat_ply.csv")});
+  EXPECT_EQ(firstLine(readFile(dir.file("flat_ply.csv"))), "x,y,z,r,g,b\n");
+}
+
+TEST(CliConvertMeaning, threeColumnCsvAtZeroStaysThreeColumnsAndTwoColumnsStayTwo) {
+  TempDir dir;
+  writeFile(dir.file("xyz.csv"), "x,y,z\n1.5,2,0\n3,4,0\n");
+  expectConverts({dir.file("xyz.csv"), "-o", dir.file("xyz_out.csv")});
+  EXPECT_EQ(readFile(dir.file("xyz_out.csv")), "x,y,z\n1.5,2,0\n3,4,0\n");
+  // Genuinely 2D: CSV → PLY → CSV comes back as x,y (the PLY says so in a header comment).
+  writeFile(dir.file("xy.csv"), "x,y\n1.5,2\n3,4\n");
+  expectConverts({dir.file("xy.csv"), "-o", dir.file("xy.ply")});
+  EXPECT_TRUE(test::contains(readFile(dir.file("xy.ply")), "\ncomment dpoint: 2D (the source has x,y only; z is 0)\n"));
+  expectConverts({dir.file("xy.ply"), "-o", dir.file("xy_out.csv")});
+  EXPECT_EQ(readFile(dir.file("xy_out.csv")), "x,y\n1.5,2\n3,4\n");
+  // GLB positions have z: 2D input through GLB comes back with a z column of zeros.
+  expectConverts({dir.file("xy.csv"), "-o", dir.file("xy.glb")});
+  expectConverts({dir.file("xy.glb"), "-o", dir.file("xy_glb.csv")});
+  EXPECT_EQ(firstLine(readFile(dir.file("xy_glb.csv"))), "x,y,z\n");
+}
+
+TEST(CliConvertMeaning, plyWithoutZIsTwoDimensional) {
+  TempDir dir;
+  writeFile(dir.file("xy.ply"),
+            "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty float y\nend_header\n1 2\n3.25 4\n");
+  expectConverts({dir.file("xy.ply"), "-o", dir.file("xy.csv")});
+  EXPECT_EQ(readFile(dir.file("xy.csv")), "x,y\n1,2\n3.25,4\n");
+  // A PLY without y is still refused, with its message.
+  writeFile(dir.file("x.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nend_header\n1\n");
+  test::CommandResult r = runDpoint({"convert", dir.file("x.ply"), "-o", dir.file("x.csv")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(test::contains(r.err, "element 'vertex' has no 'y' property"));
+  EXPECT_FALSE(test::fileExists(dir.file("x.csv")));
+}
+
+TEST(CliConvertMeaning, emptyLasConvertsToEmptyCsvPlyAndLasAndGlbSaysWhyNot) {
+  TempDir dir;
+  writeEmptyLas(dir.file("empty.las"));
+  expectConverts({dir.file("empty.las"), "-o", dir.file("empty.csv")});
+  EXPECT_EQ(readFile(dir.file("empty.csv")), "x,y,z\n");
+  expectConverts({dir.file("empty.las"), "-o", dir.file("empty.ply")});
+  const std::string ply = readFile(dir.file("empty.ply"));
+  EXPECT_TRUE(test::contains(ply, "\nelement vertex 0\n"));
+  EXPECT_EQ(ply.substr(ply.size() - 11), "end_header\n");  // no vertex bytes
+  expectConverts({dir.file("empty.las"), "-o", dir.file("empty_out.las")});
+  Result<LasHeader> header = readLasHeader(dir.file("empty_out.las"));
+  ASSERT_TRUE(header) << header.error().message;
+  EXPECT_EQ(header->point_count, 0u);
+  // Each empty output reads back as an empty set, and converts again.
+  for (const char* name : {"empty.csv", "empty.ply", "empty_out.las"}) {
+    expectConverts({dir.file(name), "-o", dir.file(std::string("again_") + name + ".csv")});
+    EXPECT_EQ(readFile(dir.file(std::string("again_") + name + ".csv")), "x,y,z\n") << name;
+  }
+  test::CommandResult r = runDpoint({"convert", dir.file("empty.las"), "-o", dir.file("empty.glb")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(test::contains(r.err, "empty.glb: cannot write GLB: the point set is empty"));
+  EXPECT_TRUE(test::contains(r.err, "write .csv, .ply or .las"));
+  EXPECT_FALSE(test::fileExists(dir.file("empty.glb")));
+}
+
+TEST(CliConvertMeaning, csvHeaderOnlyIsAnEmptySetAndAnEmptyFileStillFails) {
+  TempDir dir;
+  writeFile(dir.file("header.csv"), "x,y\r\n");
+  expectConverts({dir.file("header.csv"), "-o", dir.file("header.ply")});
+  EXPECT_TRUE(test::contains(readFile(dir.file("header.ply")), "\nelement vertex 0\n"));
+  expectConverts({dir.file("header.ply"), "-o", dir.file("header_out.csv")});
+  EXPECT_EQ(readFile(dir.file("header_out.csv")), "x,y\n");
+  writeFile(dir.file("empty.csv"), "");
+  test::CommandResult r = runDpoint({"convert", dir.file("empty.csv"), "-o", dir.file("out.ply")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(test::contains(r.err, "empty.csv: empty file"));
+}
+
+TEST(CliConvertMeaning, materialBaseColoursBecomePointColours) {
+  // 2CylinderEngine has no COLOR_0 anywhere: its parts are coloured by materials only.
+  TempDir dir;
+  expectConverts({kEngine, "-o", dir.file("engine.csv")});
+  const std::string csv = readFile(dir.file("engine.csv"));
+  EXPECT_EQ(firstLine(csv), "x,y,z,r,g,b\n");
+  EXPECT_TRUE(test::contains(csv, ",0,0,0.85\n"));  // a material's baseColorFactor
+  // --no-colors still drops them; a GLB dpoint wrote without colours gains none.
+  expectConverts({kEngine, "-o", dir.file("plain.csv"), "--no-colors"});
+  EXPECT_EQ(firstLine(readFile(dir.file("plain.csv"))), "x,y,z\n");
+  writeFile(dir.file("p.csv"), "x,y,z\n1,2,3\n");
+  expectConverts({dir.file("p.csv"), "-o", dir.file("p.glb")});
+  expectConverts({dir.file("p.glb"), "-o", dir.file("p_out.csv")});
+  EXPECT_EQ(readFile(dir.file("p_out.csv")), "x,y,z\n1,2,3\n");
+}
+
+TEST(CliConvertMeaning, csvExtraColumnsAreIgnoredWithOneNotice) {
+  TempDir dir;
+  writeFile(dir.file("i.csv"), "x,y,z,intensity\n1,2,3,40\n4,5,6,41\n");
+  test::CommandResult r = runDpoint({"convert", dir.file("i.csv"), "-o", dir.file("i_out.csv")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(readFile(dir.file("i_out.csv")), "x,y,z\n1,2,3\n4,5,6\n");
+  EXPECT_EQ(r.err, "dpoint: note: " + dir.file("i.csv") + ": columns after x,y,z ignored (header 'x,y,z,intensity')\n");
+  // Colours then extras.
+  writeFile(dir.file("c.csv"), "x,y,z,r,g,b,a,t\n1,2,3,0.5,0.25,1,9,9\n");
+  expectConverts({dir.file("c.csv"), "-o", dir.file("c_out.csv")});
+  EXPECT_EQ(readFile(dir.file("c_out.csv")), "x,y,z,r,g,b\n1,2,3,0.5,0.25,1\n");
+  // Existing rejections keep their messages: a row of the wrong length, a bad header, 4 columns
+  // without a header (what they are is unknown), a partial colour set.
+  const std::vector<std::pair<std::string, std::vector<std::string>>> bad = {
+      {"x,y,z,intensity\n1,2,3\n", {":2:", "3 columns, expected 4 (x,y,z,intensity)"}},
+      {"x,y,w\n1,2,3\n", {":1:", "header 'x,y,w' is not one of"}},
+      {"1,2,3,4\n", {":1:", "4 columns without a header"}},
+      {"x,y,z,r,g\n1,2,3,4,5\n", {":1:", "header 'x,y,z,r,g' is not one of"}},
+      {"x,y,z\n1,two,3\n", {":2:", "column 2", "'two' is not a number"}},
+  };
+  for (size_t k = 0; k < bad.size(); ++k) {
+    const std::string name = "bad" + std::to_string(k) + ".csv";
+    writeFile(dir.file(name), bad[k].first);
+    test::CommandResult b = runDpoint({"convert", dir.file(name), "-o", dir.file(name + ".ply")});
+    EXPECT_EQ(b.exit_code, 2) << name;
+    for (const std::string& part : bad[k].second) EXPECT_TRUE(test::contains(b.err, part)) << name;
+    EXPECT_FALSE(test::fileExists(dir.file(name + ".ply")));
+  }
+}
+
+TEST(CliConvertMeaning, whitespaceSeparatedCsvAsCloudCompareWritesIt) {
+  TempDir dir;
+  // Space-separated with CloudCompare's `//X Y Z` header, tab-separated without one, runs of blanks.
+  writeFile(dir.file("cc.csv"), "//X Y Z R G B\n1.5 2 3 0.5 0.25 1\n-4  5\t6 0 0 0 \n");
+  expectConverts({dir.file("cc.csv"), "-o", dir.file("cc_out.csv")});
+  EXPECT_EQ(readFile(dir.file("cc_out.csv")), "x,y,z,r,g,b\n1.5,2,3,0.5,0.25,1\n-4,5,6,0,0,0\n");
+  writeFile(dir.file("tab.csv"), "1\t2\t3\n4\t5\t6\n");
+  expectConverts({dir.file("tab.csv"), "-o", dir.file("tab_out.csv")});
+  EXPECT_EQ(readFile(dir.file("tab_out.csv")), "x,y,z\n1,2,3\n4,5,6\n");
+  writeFile(dir.file("xy.txt.csv"), "x y\n1 2\n");
+  expectConverts({dir.file("xy.txt.csv"), "-o", dir.file("xy_out.csv")});
+  EXPECT_EQ(readFile(dir.file("xy_out.csv")), "x,y\n1,2\n");
+  // A row of the wrong length names its line and the layout.
+  writeFile(dir.file("short.csv"), "1 2 3\n4 5\n");
+  test::CommandResult r = runDpoint({"convert", dir.file("short.csv"), "-o", dir.file("short.ply")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(test::contains(r.err, "short.csv:2: 2 columns, expected 3 (x,y,z)"));
+}
+
+TEST(CliConvertMeaning, lasToCsvWritesValuesAtTheFilesStep) {
+  TempDir dir;
+  expectConverts({kLas + "simple.las", "-o", dir.file("s.csv")});
+  const std::string csv = readFile(dir.file("s.csv"));
+  // 849087.70 at scale 0.01: the double X·0.01 is 849087.7000000001, written as the file means it.
+  EXPECT_TRUE(test::contains(csv, "\n636896.33,849087.7,446.39,"));
+  EXPECT_FALSE(test::contains(csv, "849087.7000000001"));
+  // Every value read back is the LAS reader's double to within half a step, and LAS at the same
+  // scale gives the same integers: CSV → LAS at 0.01 → CSV is byte-identical.
+  expectConverts({dir.file("s.csv"), "-o", dir.file("s.las"), "--las-scale", "0.01"});
+  expectConverts({dir.file("s.las"), "-o", dir.file("s2.csv")});
+  EXPECT_TRUE(readFile(dir.file("s2.csv")) == csv);
+  // --decimals overrides: fixed digits, zeros kept, colours too.
+  expectConverts({kLas + "simple.las", "-o", dir.file("d.csv"), "--decimals", "3"});
+  EXPECT_TRUE(test::contains(readFile(dir.file("d.csv")), "\n636896.330,849087.700,446.390,"));
+  // Other inputs keep the shortest round trip.
+  writeFile(dir.file("p.csv"), "x,y,z\n849087.7000000001,1,2\n");
+  expectConverts({dir.file("p.csv"), "-o", dir.file("p_out.csv")});
+  EXPECT_EQ(readFile(dir.file("p_out.csv")), "x,y,z\n849087.7000000001,1,2\n");
+}
+
+TEST(CliConvertMeaning, plyWrittenFromLasRecordsZUp) {
+  TempDir dir;
+  expectConverts({kLas + "simple.las", "-o", dir.file("s.ply")});
+  EXPECT_TRUE(test::contains(readFile(dir.file("s.ply")), "\ncomment dpoint: up axis z\n"));
+  Result<PointSet> set = readPly(dir.file("s.ply"));
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_TRUE(set->z_up);
+  // Kept through PLY → PLY; a PLY from CSV has no such comment.
+  expectConverts({dir.file("s.ply"), "-o", dir.file("s2.ply")});
+  EXPECT_TRUE(test::contains(readFile(dir.file("s2.ply")), "\ncomment dpoint: up axis z\n"));
+  writeFile(dir.file("p.csv"), "x,y,z\n1,2,3\n");
+  expectConverts({dir.file("p.csv"), "-o", dir.file("p.ply")});
+  EXPECT_FALSE(test::contains(readFile(dir.file("p.ply")), "up axis"));
+}
+
+}  // namespace
+}  // namespace dpoint
