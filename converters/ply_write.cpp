@@ -24,11 +24,12 @@ uint8_t colorByte(float c) {
 }
 
 // Header comments for the facts of the source that the values cannot tell (ply_read.cpp reads
-// them back): a 2D source (its z are 0 but not a coordinate), and z as the up axis (LAS). Sets made
-// in memory have neither, and their headers are as before.
+// them back): a 2D set (its z are 0 but not a coordinate: read from 2D input, or made in memory with
+// every z 0, as random2d and mandelbrot2d make theirs), and z as the up axis (LAS). Without the first,
+// a 2D set written as PLY would come back as a 3D one and convert to a 3-column CSV.
 std::string sourceFacts(const PointSet& points) {
   std::string facts;
-  if (points.z_axis == ZAxis::kAbsent) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
+  if (!points.hasZ()) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
   if (points.z_up) facts += "comment dpoint: up axis z\n";
   return facts;
 }

@@ -94,6 +94,19 @@ TEST(CliConvertMeaning, plyWithoutZIsTwoDimensional) {
   EXPECT_FALSE(test::fileExists(dir.file("x.csv")));
 }
 
+// A 2D generator's PLY says it is 2D, so it converts back to x,y as the CSV the generator writes;
+// a 3D generator's PLY does not say so.
+TEST(CliConvertMeaning, generated2dPlyConvertsToTwoColumns) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "50", "-q", "-o", dir.file("r.ply")}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "50", "-q", "-o", dir.file("r.csv")}).exit_code, 0);
+  EXPECT_TRUE(test::contains(readFile(dir.file("r.ply")), "comment dpoint: 2D"));
+  expectConverts({dir.file("r.ply"), "-o", dir.file("back.csv")});
+  EXPECT_EQ(readFile(dir.file("back.csv")), readFile(dir.file("r.csv")));
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "1", "-q", "-o", dir.file("m.ply")}).exit_code, 0);
+  EXPECT_FALSE(test::contains(readFile(dir.file("m.ply")), "comment dpoint: 2D"));
+}
+
 TEST(CliConvertMeaning, emptyLasConvertsToEmptyCsvPlyAndLasAndGlbSaysWhyNot) {
   TempDir dir;
   writeEmptyLas(dir.file("empty.las"));
