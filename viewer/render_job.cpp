@@ -174,7 +174,7 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     outcome.views.push_back({views[i].label, std::move(*prediction), std::move(rendered->gpu_ms)});
     if (view_done) view_done(outcome.views.back());
   }
-  outcome.image = composeContactSheet(sheet, 2);
+  outcome.image = composeContactSheet(sheet, 2, request.camera.width, request.camera.height);
   return okStatus();
 }
 
@@ -264,6 +264,11 @@ Status checkRenderRequest(const RenderRequest& request) {
     if (request.error || request.report)
       return Error{"--views 4 makes a contact sheet; --error and --json measure one view (use --views 1)",
                    ExitCode::kUsage};
+    const uint32_t least = 2 + kContactSheetGap;  // two 1-px views and the line between them
+    if (request.camera.width < least || request.camera.height < least)
+      return Error{"--views 4 needs --width and --height of at least " + std::to_string(least) + " px, got " +
+                       std::to_string(request.camera.width) + "x" + std::to_string(request.camera.height),
+                   ExitCode::kUsage};
   }
   return okStatus();
 }
@@ -304,8 +309,10 @@ Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std:
     CameraSpec view_spec = spec;
     // One y-up view is makeCamera's own default fit.
     if (!spec.eye && (views.size() == 4 || z_up)) view_spec.fit_direction = view.direction, view_spec.fit_up = view.up;
-    // Four views share the picture: each gets a quarter, so the sheet keeps about width x height.
-    if (views.size() == 4) view_spec.width = std::max(1u, spec.width / 2), view_spec.height = std::max(1u, spec.height / 2);
+    // Four views share the picture: each gets a quarter less the lines between them, so the sheet
+    // is exactly width x height (composeContactSheet).
+    if (views.size() == 4)
+      view_spec.width = contactSheetCell(spec.width, 2), view_spec.height = contactSheetCell(spec.height, 2);
     Result<Camera> camera = makeCamera(view_spec, bounds);
     if (!camera) return camera.error();
     cameras.push_back(*camera);

@@ -228,7 +228,7 @@ TEST(CliRender, previewsShadeColourAndShowFourViews) {
   EXPECT_EQ(sized.out.find(", 1 px points"), std::string::npos) << sized.out;
   EXPECT_FALSE(readFile(dir.file("sized.png")) == plain);
   const std::string sheet = render("views.png", {"--views", "4"});
-  EXPECT_EQ(pngSize(sheet), std::make_pair(2u * 160u + 2u, 2u * 120u + 2u)) << "four quarter views, 2 px apart";
+  EXPECT_EQ(pngSize(sheet), std::make_pair(320u, 240u)) << "four 159 x 119 views and 2-px lines: the size asked for";
   test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file("views.png"), "--views", "4",
                                      "--width", "320", "--height", "240", "--backend", "compute"});
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -69,7 +69,8 @@ TEST(RenderJob, viewsAndTheirCameras) {
   Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(4, false), cube());
   ASSERT_TRUE(cameras.ok());
   ASSERT_EQ(cameras->size(), 4u);
-  for (const Camera& c : *cameras) EXPECT_EQ(std::make_pair(c.width, c.height), std::make_pair(200u, 150u));
+  // A quarter less the 2-px lines, rounded down: the sheet is 401 x 300 (the odd pixel goes to a line).
+  for (const Camera& c : *cameras) EXPECT_EQ(std::make_pair(c.width, c.height), std::make_pair(199u, 149u));
   EXPECT_NE((*cameras)[0].eye, (*cameras)[1].eye);
 }
 
@@ -103,6 +104,9 @@ TEST(RenderJob, upAxisShadingAndRequestChecks) {
   EXPECT_TRUE(checkRenderRequest(sheet).ok());
   sheet.report = true;
   EXPECT_EQ(checkRenderRequest(sheet).error().code, ExitCode::kUsage);
+  sheet.report = false;
+  sheet.camera.width = 3;
+  EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views 4 needs --width and --height of at least 4 px, got 3x768");
   sheet.views = 2;
   EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views must be 1 or 4, got 2");
 }
