@@ -7,6 +7,7 @@
 
 #include "cli/cli_camera.h"
 #include "cli/cli_check.h"
+#include "cli/cli_suggest.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "core/atomic_file.h"
@@ -47,6 +48,15 @@ Result<uint32_t> parseBackground(const std::string& text) {
     packed |= static_cast<uint32_t>(v) << (8 * c);
   }
   return packed;
+}
+
+// --mode: the library's check, and the nearest name when the value is a typo.
+Status checkModeOption(const std::string& value) {
+  Status status = checkModeName(value);
+  if (status) return status;
+  std::vector<std::string> names = {"auto"};
+  for (PrecisionMode mode : kAllModes) names.emplace_back(modeName(mode));
+  return Error{status.error().message + didYouMean(value, names), ExitCode::kUsage};
 }
 
 Result<double> parsePointSize(const std::string& text) {
@@ -225,7 +235,7 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required()->check(checkStatus(checkPictureOutput));
   cmd->add_option("--mode", o->mode, modeOptionHelp())
-      ->check(checkStatus(checkModeName))
+      ->check(checkStatus(checkModeOption))
       ->default_val("auto");
   addChoiceOption(*cmd, "--backend", o->backend,
                   "raster (graphics pipeline, POINT_LIST, the study's design) or compute (a thread per point,\n"
