@@ -21,6 +21,8 @@
 
 #include "bench/report.h"
 #include "bench/run.h"
+#include "cli/cli_check.h"
+#include "cli/cli_output.h"
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "converters/point_io.h"
@@ -265,7 +267,9 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   bench->require_subcommand(0, 1);
   auto r = std::make_shared<BenchReportOptions>();
   bench->add_option("--suite", r->suite, "ci, paper, hard or all")->default_val("ci");
-  bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")->default_val("bench-out");
+  bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")
+      ->check(checkStatus([](const std::string& v) { return checkOutputFolder("--out", v); }))
+      ->default_val("bench-out");
   bench->add_option("--cache", r->cache, "Folder the datasets are made in and reused from")->default_val("bench-cache");
   bench->add_option("--device", r->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
       ->default_val("auto");
@@ -287,7 +291,7 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<BenchIoOptions>();
   CLI::App* io = bench->add_subcommand("io", "Time reading a point file (and writing it with --write)");
   io->add_option("input", o->input, "Input file")->required();
-  io->add_option("--write", o->write, "Also write the set to this file and time it");
+  io->add_option("--write", o->write, "Also write the set to this file and time it")->check(checkStatus(checkPointOutput));
   io->add_option("--decimals", o->decimals, "CSV output: fixed digits after the point")->check(CLI::Range(0, 100));
   addCommonOptions(*io, o->common);
   io->callback([o, &run] { run = [o] { return runBenchIo(*o); }; });

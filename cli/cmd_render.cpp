@@ -255,7 +255,8 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--frames", o->frames, "Timed frames after warm-up (the median is reported)")->default_val(1);
   cmd->add_option("--warmup", o->warmup, "Untimed frames first")->default_val(1);
   cmd->add_flag("--error", o->error, "Run the probe and the exact CPU reference; report the error in pixels");
-  cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file");
+  cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file")
+      ->check(checkStatus(AtomicFile::checkTarget));
   cmd->add_flag("--validate", o->validate, "Enable the Khronos validation layer; any message fails the run");
   addChoiceOption(*cmd, "--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull",
                   {"auto", "attribute", "pull"});

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   using namespace dpoint;
   watchInterrupts();  // before any thread starts (core/interrupt.h)
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
-               "CSV, PLY and GLB, render them offscreen with Vulkan in six precision modes, and inspect the\n"
+               "CSV, PLY, GLB and LAS, render them offscreen with Vulkan in six precision modes, and inspect the\n"
                "precision a dataset needs.\n"
                "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit,\n"
                "130/143 stopped by SIGINT/SIGTERM (the output is not written).",

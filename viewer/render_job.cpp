@@ -9,6 +9,7 @@
 
 #include "converters/point_inputs.h"
 #include "converters/point_io.h"
+#include "core/atomic_file.h"
 #include "core/interrupt.h"
 #include "core/json_writer.h"
 #include "core/memory.h"
@@ -239,6 +240,7 @@ const char* renderColorName(RenderColor color) {
 const char* backendName(Backend backend) { return backend == Backend::kCompute ? "compute" : "raster"; }
 
 Status checkPictureOutput(const std::string& path) {
+  if (Status s = AtomicFile::checkTarget(path); !s) return s;  // where it goes, before any work
   if (!hasExtension(path, ".png") && path.rfind("/dev/", 0) != 0)
     return Error{"-o " + path + ": the picture is written as PNG; name it .png", ExitCode::kUsage};
   return okStatus();

@@ -65,7 +65,8 @@ struct RenderRequest {
   unsigned threads = 0;
 };
 
-// -o: the picture is written as PNG (a .png name, or a device such as /dev/null). kUsage.
+// -o: a place the picture can be written (AtomicFile::checkTarget's errors), as PNG (a .png name,
+// or a device such as /dev/null; kUsage).
 Status checkPictureOutput(const std::string& path);
 // --mode: auto or a mode name (kUsage, listing them).
 Status checkModeName(const std::string& mode);

@@ -13,6 +13,7 @@
 namespace dpoint {
 namespace {
 
+using test::concat;
 using test::contains;
 using test::readFile;
 using test::runDpoint;
@@ -114,6 +115,66 @@ TEST(CliHelp, fourViewSheetIsTheSizeAskedFor) {
   EXPECT_EQ(tiny.exit_code, 1);
   EXPECT_TRUE(contains(tiny.err, "--views 4 needs --width and --height of at least 4 px, got 3x600")) << tiny.err;
   EXPECT_FALSE(test::fileExists(dir.file("tiny.png")));
+}
+
+
+// A bad -o ends the run with one line naming the path, exit 1, before any work: a generation
+// that would take minutes (a 2000^3 grid) ends at once, an input that does not exist is not
+// reached, and nothing is written. The same for merge, render's --json and bench's --out.
+TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
+  TempDir dir;
+  writeFile(dir.file("file.txt"), "x");
+  const std::vector<std::string> slow = {"generate", "mandelbulb", "--resolution", "2000", "-o"};
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {concat(slow, {dir.file("missing/x.ply")}),
+       "cannot write '" + dir.file("missing/x.ply") + "': folder '" + dir.file("missing") + "' does not exist"},
+      {concat(slow, {dir.path()}), "cannot write '" + dir.path() + "': it is a folder"},
+      {concat(slow, {dir.file("x.txt")}), dir.file("x.txt") + ": unknown file type '.txt' (write .csv, .ply, .glb or .las)"},
+      {concat(slow, {dir.file("x.gltf")}), dir.file("x.gltf") + ": .gltf is read, not written; write .glb"},
+      {concat(slow, {dir.file("x.laz")}), "writing LAZ is not supported"},
+      {concat(slow, {"/sys/dpoint-test.ply"}), "'/sys/dpoint-test.ply': Permission denied"},  // even for root
+      {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
+      {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("x.gltf")}, ".gltf is read, not written"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.file("missing/x.png")}, "folder '" + dir.file("missing") + "' does not exist"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.path()}, "it is a folder"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.file("x.jpg")}, "name it .png"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.file("x.png"), "--json", dir.file("missing/r.json")},
+       "folder '" + dir.file("missing") + "' does not exist"},
+      {{"bench", "--out", dir.file("file.txt"), "--cache", dir.file("cache")}, "--out " + dir.file("file.txt") + ": is a file, not a folder"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args[0] + " " + c.args.back());
+    test::CommandResult r = test::runCommand(concat({DPOINT_EXE}, c.args), std::chrono::seconds(20));
+    ASSERT_FALSE(r.timed_out) << "the work started";
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_TRUE(contains(r.err, "dpoint: error: ")) << r.err;
+    EXPECT_TRUE(contains(r.err, c.message)) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{"file.txt"}) << "nothing written";
+  }
+}
+
+// One list of output formats: every format the -o help of generate and merge lists is written,
+// and the top-level help names the same four.
+TEST(CliHelp, everyListedOutputFormatIsWritten) {
+  for (const char* command : {"merge", "convert"}) {
+    test::CommandResult help = runDpoint({command, "--help"});
+    EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las)")) << command;
+  }
+  test::CommandResult help = runDpoint({"generate", "random2d", "--help"});
+  EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las)")) << help.out;
+  EXPECT_FALSE(contains(help.out, ".gltf"));
+  EXPECT_TRUE(contains(runDpoint({"--help"}).out, "CSV, PLY, GLB and LAS"));
+  TempDir dir;
+  for (const char* ext : {"csv", "ply", "glb", "las"}) {
+    test::CommandResult r = runDpoint({"generate", "random2d", "-n", "10", "-q", "-o", dir.file(std::string("p.") + ext)});
+    EXPECT_EQ(r.exit_code, 0) << ext << ": " << r.err;
+    EXPECT_TRUE(test::fileExists(dir.file(std::string("p.") + ext))) << ext;
+  }
 }
 
 }  // namespace
