@@ -115,11 +115,22 @@ void printChoice(const ModePrediction& p, const DeviceFacts& f, Backend backend)
   std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the fastest within %g px on %s, %s backend\n",
               std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(), kAutoBoundPx,
               std::string(deviceClassName(deviceClassOf(f.type))).c_str(), backendName(backend));
-  if (!c.enough) {
-    std::fprintf(stderr, "dpoint: warning: no mode this device runs stays within %g px for this view; %s is the most "
-                 "accurate here (bound %s)\n", kAutoBoundPx, std::string(modeName(c.mode)).c_str(),
-                 formatBound(c.bound_px).c_str());
+  // Why each faster mode was passed over (its warning, with none enough, is in outcome.warnings).
+  std::string passed;
+  for (const ModeChoice::Rejected& r : c.rejected) {
+    const std::string why = std::isnan(r.bound_px)
+                                ? "not usable here" + (r.reason.empty() ? std::string() : ": " + r.reason)
+                                : std::isinf(r.bound_px) ? std::string("unbounded error")
+                                                         : "bound " + formatBound(r.bound_px) + " > " +
+                                                               formatNumber(kAutoBoundPx) + " px";
+    passed += (passed.empty() ? "" : "; ") + std::string(modeName(r.mode)) + " (" + why + ")";
   }
+  if (!passed.empty()) std::printf("mode auto: faster modes passed over: %s\n", passed.c_str());
+}
+
+// The outcome's warnings, one line each on stderr.
+void printWarnings(const RenderOutcome& outcome) {
+  for (const std::string& w : outcome.warnings) std::fprintf(stderr, "dpoint: warning: %s\n", w.c_str());
 }
 
 void printError(const ErrorReport& error) {
@@ -199,11 +210,13 @@ int runRender(const RenderCliOptions& o) {
   if (request->views == 4) {
     std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), outcome->points,
                 outcome->image.width, outcome->image.height, backendName(request->backend), outcome->device.name.c_str());
+    printWarnings(*outcome);
     return validationResult(*outcome);
   }
   if (!o.json.empty())
     if (Status s = writeReport(o.json, *request, *outcome); !s) return reportError(s.error());
   printOutcome(*request, o.output, *outcome);
+  printWarnings(*outcome);
   return validationResult(*outcome);
 }
 
@@ -238,7 +251,7 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->check(checkStatus(checkModeOption))
       ->default_val("auto");
   addChoiceOption(*cmd, "--backend", o->backend,
-                  "raster (graphics pipeline, POINT_LIST, the study's design) or compute (a thread per point,\n"
+                  "raster (graphics pipeline, POINT_LIST, the float-vs-double Vulkan study's design) or compute (a thread\nper point, "
                   "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)",
                   {"raster", "compute"});
   addCameraOptions(*cmd, o->camera);
