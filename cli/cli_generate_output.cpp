@@ -30,7 +30,7 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
 
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
   cmd.add_option("-o,--output", o.output, pointOutputHelp())->required()->check(checkStatus(checkPointOutput));
-  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (the seed's pnoise3), none")
+  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (Perlin pnoise3, as the original study's Python generator coloured its points), none")
       ->check(CLI::IsMember({"auto", "noise", "none"}))
       ->default_val("auto");
   cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");

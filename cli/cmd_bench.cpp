@@ -260,9 +260,9 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
       "The speed-against-error report: every precision mode on both backends over a suite of datasets, timed\n"
       "(GPU timestamps) and measured against the exact reference. Writes report.md, results.json,\n"
       "speed_vs_error.svg, breakdown.svg and montage.png into --out. Datasets are made once with\n"
-      "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the study's\n"
-      "datasets at 1920x1080, its RTX 3090 figures beside ours), hard (DESIGN's hard cases: offset and\n"
-      "deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
+      "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the\n"
+      "float-vs-double Vulkan study's datasets at 1920x1080, its RTX 3090 figures beside ours), hard (offset\n"
+      "and deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
       "`dpoint bench io FILE` times reading a file instead; `dpoint bench copy` measures only the copy bandwidth.");
   bench->require_subcommand(0, 1);
   auto r = std::make_shared<BenchReportOptions>();
@@ -276,7 +276,7 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   bench->add_option("--backend", r->backend, "raster, compute or both")->default_val("both");
   bench->add_option("--frames", r->frames, "Timed frames per run (the median is reported)")->default_val(20);
   bench->add_option("--warmup", r->warmup, "Untimed frames first")->default_val(2);
-  bench->add_option("--sizes", r->sizes, "paper suite: only these of the study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
+  bench->add_option("--sizes", r->sizes, "paper suite: only these of the float-vs-double Vulkan study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
   bench->add_flag("--no-error", r->no_error, "Time only: skip the probe draws and the exact reference (no error columns)");
   bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");
   bench->add_flag("--no-copy-bandwidth", r->no_copy_bandwidth,
