@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cli/cli_suggest.h"
 #include "core/text.h"
 
 namespace dpoint {
@@ -30,7 +31,7 @@ CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed) 
     list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
   return check([flag, allowed = std::move(allowed), list](const std::string& value) {
     if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return std::string();
-    return flag + " must be " + list + ", got '" + value + "'";
+    return flag + " must be " + list + ", got '" + value + "'" + didYouMean(value, allowed);
   });
 }
 

@@ -30,7 +30,8 @@ Status statusOf(const Result<T>& result) {
   return result ? okStatus() : Status(result.error());
 }
 
-// One of `allowed`, else "FLAG must be A, B or C, got 'VALUE'".
+// One of `allowed`, else "FLAG must be A, B or C, got 'VALUE'", and "; did you mean 'B'?" when
+// VALUE is near one of them (cli_suggest.h).
 CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed);
 // An option that takes one of `allowed` (checked by oneOf), the first of them by default.
 CLI::Option* addChoiceOption(CLI::App& command, const std::string& flag, std::string& value, const std::string& help,

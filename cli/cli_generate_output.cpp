@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "cli/cli_check.h"
+#include "cli/cli_output.h"
 #include "cli/cli_text.h"
 #include "converters/point_io.h"
 #include "converters/tile_file.h"
@@ -27,8 +29,8 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
 }  // namespace
 
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
-  cmd.add_option("-o,--output", o.output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
-  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (the seed's pnoise3), none")
+  cmd.add_option("-o,--output", o.output, pointOutputHelp())->required()->check(checkStatus(checkPointOutput));
+  cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (Perlin pnoise3, as the original study's Python generator coloured its points), none")
       ->check(CLI::IsMember({"auto", "noise", "none"}))
       ->default_val("auto");
   cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
@@ -101,14 +103,6 @@ Result<TileSpec> tileOptions(const OutputOptions& o) {
   if (o.order != "input")
     return Error{"--tile: --order " + o.order + " needs the whole set; give it to dpoint merge", ExitCode::kUsage};
   return tile;
-}
-
-// Checks the output path's extension before any work, so a typo does not cost a long run.
-bool outputTypeOk(const OutputOptions& o, int& code) {
-  Result<FileFormat> format = formatOf(o.output);
-  if (format && *format != FileFormat::kGltf) return true;
-  code = reportError(format ? Error{o.output + ": write .glb, not .gltf", ExitCode::kUsage} : format.error());
-  return false;
 }
 
 }  // namespace dpoint

@@ -29,7 +29,8 @@ struct OutputOptions {
   CommonOptions common;
 };
 
-// `auto_colors`: what --colors auto gives for the kind, for the help text.
+// `auto_colors`: what --colors auto gives for the kind, for the help text. -o is checked as it is
+// parsed (cli_output.h: a written format, a folder it can be written into), before any work.
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors);
 // --max-memory as bytes (0: half of RAM).
 Result<uint64_t> memoryLimit(const OutputOptions& o);
@@ -43,8 +44,6 @@ class PhaseClock {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-// Checks the output path's extension before any work, so a typo does not cost a long run.
-bool outputTypeOk(const OutputOptions& o, int& code);
 // --tile checks before any work: a .ply part, and no --order (which needs the whole set).
 Result<TileSpec> tileOptions(const OutputOptions& o);
 // Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of

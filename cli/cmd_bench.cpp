@@ -21,6 +21,8 @@
 
 #include "bench/report.h"
 #include "bench/run.h"
+#include "cli/cli_check.h"
+#include "cli/cli_output.h"
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "converters/point_io.h"
@@ -258,21 +260,23 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
       "The speed-against-error report: every precision mode on both backends over a suite of datasets, timed\n"
       "(GPU timestamps) and measured against the exact reference. Writes report.md, results.json,\n"
       "speed_vs_error.svg, breakdown.svg and montage.png into --out. Datasets are made once with\n"
-      "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the study's\n"
-      "datasets at 1920x1080, its RTX 3090 figures beside ours), hard (DESIGN's hard cases: offset and\n"
-      "deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
+      "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the\n"
+      "float-vs-double Vulkan study's datasets at 1920x1080, its RTX 3090 figures beside ours), hard (offset\n"
+      "and deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
       "`dpoint bench io FILE` times reading a file instead; `dpoint bench copy` measures only the copy bandwidth.");
   bench->require_subcommand(0, 1);
   auto r = std::make_shared<BenchReportOptions>();
   bench->add_option("--suite", r->suite, "ci, paper, hard or all")->default_val("ci");
-  bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")->default_val("bench-out");
+  bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")
+      ->check(checkStatus([](const std::string& v) { return checkOutputFolder("--out", v); }))
+      ->default_val("bench-out");
   bench->add_option("--cache", r->cache, "Folder the datasets are made in and reused from")->default_val("bench-cache");
   bench->add_option("--device", r->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
       ->default_val("auto");
   bench->add_option("--backend", r->backend, "raster, compute or both")->default_val("both");
   bench->add_option("--frames", r->frames, "Timed frames per run (the median is reported)")->default_val(20);
   bench->add_option("--warmup", r->warmup, "Untimed frames first")->default_val(2);
-  bench->add_option("--sizes", r->sizes, "paper suite: only these of the study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
+  bench->add_option("--sizes", r->sizes, "paper suite: only these of the float-vs-double Vulkan study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
   bench->add_flag("--no-error", r->no_error, "Time only: skip the probe draws and the exact reference (no error columns)");
   bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");
   bench->add_flag("--no-copy-bandwidth", r->no_copy_bandwidth,
@@ -287,7 +291,7 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<BenchIoOptions>();
   CLI::App* io = bench->add_subcommand("io", "Time reading a point file (and writing it with --write)");
   io->add_option("input", o->input, "Input file")->required();
-  io->add_option("--write", o->write, "Also write the set to this file and time it");
+  io->add_option("--write", o->write, "Also write the set to this file and time it")->check(checkStatus(checkPointOutput));
   io->add_option("--decimals", o->decimals, "CSV output: fixed digits after the point")->check(CLI::Range(0, 100));
   addCommonOptions(*io, o->common);
   io->callback([o, &run] { run = [o] { return runBenchIo(*o); }; });

@@ -36,8 +36,6 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
   cmd->callback([o, &run, cmd, auto_noise, generate, generate_tile, makeParams, name = cmd->get_name()] {
     const std::string signature = o->out.tile.empty() ? std::string() : tileSignature(name, cmd->config_to_str(true, false));
     run = [o, auto_noise, generate, generate_tile, makeParams, name, signature] {
-      int code = 0;
-      if (!outputTypeOk(o->out, code)) return code;
       Result<PointOrder> order = parsePointOrder("--order", o->out.order);
       if (!order) return reportError(order.error());
       std::optional<TileSpec> tile;
@@ -168,7 +166,7 @@ void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double&
   cmd->add_option("--level", level, "Surface level on the escape-count field (default: max_iter/4)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--bounds", bounds, "Grid range LO,HI on every axis")->default_val("-1.5,1.5");
-  cmd->add_option("--frame", frame, "Coordinates: native (the fractal's own) or seed (grid corner at 0, like skimage)")
+  cmd->add_option("--frame", frame, "Coordinates: native (the fractal's own) or seed (grid corner at 0, as the original study's Python generator had it from skimage)")
       ->check(CLI::IsMember({"native", "seed"}))
       ->default_val("native");
   cmd->add_option("--grid-out", grid_out, "Also write the raw escape-count grid (uint8 if max_iter <= 255, else uint16)");
@@ -177,7 +175,7 @@ void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double&
 }  // namespace
 
 void addGenerateCommand(CLI::App& app, RunCommand& run) {
-  CLI::App* generate = app.add_subcommand("generate", "Generate a dataset of the study");
+  CLI::App* generate = app.add_subcommand("generate", "Generate a dataset: the fractal and random sets of the float-vs-double Vulkan study (README)");
   // Optional for CLI11, so that an unknown kind is reported by name ("not expected: spiral")
   // rather than as "a subcommand is required"; no kind at all gets the list here.
   generate->require_subcommand(0, 1);
@@ -194,7 +192,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   addEscapeGridOptions(mandelbulb, mb->params.resolution, mb->params.max_iter, mb->params.level, mb->bounds, mb->frame,
                        mb->params.grid_out, 100);
   mandelbulb->add_option("--power", mb->params.power, "Exponent of the Mandelbulb map")->default_val(8);
-  mandelbulb->add_option("--variant", mb->variant, "seed: the study's trigonometric escape function, bit for bit; "
+  mandelbulb->add_option("--variant", mb->variant, "seed: the original study's Python generator's trigonometric escape function, bit for bit; "
                                                    "fast: trig-free power-8 form")
       ->check(CLI::IsMember({"seed", "fast"}))
       ->default_val("seed");
@@ -206,7 +204,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   registerKind(run, mb, mandelbulb, true, &generateMandelbulb, &generateMandelbulbTile, &mandelbulbParams);
 
   auto ju = std::make_shared<JuliaOptions>();
-  CLI::App* julia = generate->add_subcommand("julia", "Quaternion Julia set surface (the seed's iteration, k = 0 slice)");
+  CLI::App* julia = generate->add_subcommand("julia", "Quaternion Julia set surface (the original study's Python iteration, k = 0 slice)");
   addEscapeGridOptions(julia, ju->params.resolution, ju->params.max_iter, ju->params.level, ju->bounds, ju->frame,
                        ju->params.grid_out, 200);
   julia->add_option("--c", ju->c, "Julia constant as 4 numbers")->default_val("-0.7,0.27015,0.27015,0");
@@ -220,7 +218,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   menger->add_option("--level", me->params.level, "Subdivision level (0..8)")->default_val(4);
   menger->add_option("--size", me->params.size, "Edge length of the sponge")->default_val(1.0);
   menger->add_option("--method", me->method, "exact: the exposed faces of the lattice cubes; voxel: sampled grid + "
-                                             "marching cubes, as the seed did")
+                                             "marching cubes, as the original study's Python generator did")
       ->check(CLI::IsMember({"exact", "voxel"}))
       ->default_val("exact");
   menger->add_option("--resolution", me->params.resolution, "Voxel method: samples per axis (2..4096)")->default_val(200);
@@ -228,9 +226,9 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   registerKind(run, me, menger, true, &generateMenger, &generateMengerTile, &mengerParams);
 
   auto si = std::make_shared<PlainOptions<SierpinskiParams>>();
-  CLI::App* sierpinski = generate->add_subcommand("sierpinski", "Sierpinski tetrahedron: 4^n tetrahedra from the seed's corners");
+  CLI::App* sierpinski = generate->add_subcommand("sierpinski", "Sierpinski tetrahedron: 4^n tetrahedra from the original study's Python generator's corners");
   sierpinski->add_option("--level", si->params.level, "Subdivision level (0..12)")->default_val(9);
-  sierpinski->add_flag("--unwelded", si->params.unwelded, "The seed's 4^(n+1) rows instead of the 2*4^n+2 distinct vertices");
+  sierpinski->add_flag("--unwelded", si->params.unwelded, "The original study's Python generator's 4^(n+1) rows instead of the 2*4^n+2 distinct vertices");
   addOutputOptions(*sierpinski, si->out, "noise");
   registerKind(run, si, sierpinski, true, &generateSierpinski, &generateSierpinskiTile,
                &plainParams<SierpinskiParams>);

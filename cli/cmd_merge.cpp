@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "cli/cli_check.h"
+#include "cli/cli_output.h"
 #include "cli/commands.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
@@ -23,9 +25,6 @@ struct MergeOptions {
 };
 
 int runMerge(const MergeOptions& o) {
-  Result<FileFormat> format = formatOf(o.output);
-  if (!format) return reportError(format.error());
-  if (*format == FileFormat::kGltf) return reportError(Error{o.output + ": write .glb, not .gltf", ExitCode::kUsage});
   Result<PointOrder> order = parsePointOrder("--order", o.order);
   if (!order) return reportError(order.error());
   uint64_t limit = 0;
@@ -63,7 +62,7 @@ void addMergeCommand(CLI::App& app, RunCommand& run) {
       "Weld the tiles of `dpoint generate KIND --tile I/N` (all N, in any order) into one file: the same bytes\n"
       "as the single `dpoint generate KIND` with these output options, vertex order included");
   cmd->add_option("tiles", o->inputs, "The tile parts (.ply)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb); written whole or not at all")->required();
+  cmd->add_option("-o,--output", o->output, pointOutputHelp())->required()->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals, "CSV: fixed digits after the point (default: shortest round trip)")
       ->check(CLI::Range(0, 100));
   cmd->add_option("--max-memory", o->max_memory, "Refuse (exit 4) when the estimate is above this (default: half of RAM)");

@@ -7,6 +7,7 @@
 
 #include "cli/cli_camera.h"
 #include "cli/cli_check.h"
+#include "cli/cli_suggest.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
 #include "core/atomic_file.h"
@@ -47,6 +48,15 @@ Result<uint32_t> parseBackground(const std::string& text) {
     packed |= static_cast<uint32_t>(v) << (8 * c);
   }
   return packed;
+}
+
+// --mode: the library's check, and the nearest name when the value is a typo.
+Status checkModeOption(const std::string& value) {
+  Status status = checkModeName(value);
+  if (status) return status;
+  std::vector<std::string> names = {"auto"};
+  for (PrecisionMode mode : kAllModes) names.emplace_back(modeName(mode));
+  return Error{status.error().message + didYouMean(value, names), ExitCode::kUsage};
 }
 
 Result<double> parsePointSize(const std::string& text) {
@@ -105,11 +115,22 @@ void printChoice(const ModePrediction& p, const DeviceFacts& f, Backend backend)
   std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the fastest within %g px on %s, %s backend\n",
               std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(), kAutoBoundPx,
               std::string(deviceClassName(deviceClassOf(f.type))).c_str(), backendName(backend));
-  if (!c.enough) {
-    std::fprintf(stderr, "dpoint: warning: no mode this device runs stays within %g px for this view; %s is the most "
-                 "accurate here (bound %s)\n", kAutoBoundPx, std::string(modeName(c.mode)).c_str(),
-                 formatBound(c.bound_px).c_str());
+  // Why each faster mode was passed over (its warning, with none enough, is in outcome.warnings).
+  std::string passed;
+  for (const ModeChoice::Rejected& r : c.rejected) {
+    const std::string why = std::isnan(r.bound_px)
+                                ? "not usable here" + (r.reason.empty() ? std::string() : ": " + r.reason)
+                                : std::isinf(r.bound_px) ? std::string("unbounded error")
+                                                         : "bound " + formatBound(r.bound_px) + " > " +
+                                                               formatNumber(kAutoBoundPx) + " px";
+    passed += (passed.empty() ? "" : "; ") + std::string(modeName(r.mode)) + " (" + why + ")";
   }
+  if (!passed.empty()) std::printf("mode auto: faster modes passed over: %s\n", passed.c_str());
+}
+
+// The outcome's warnings, one line each on stderr.
+void printWarnings(const RenderOutcome& outcome) {
+  for (const std::string& w : outcome.warnings) std::fprintf(stderr, "dpoint: warning: %s\n", w.c_str());
 }
 
 void printError(const ErrorReport& error) {
@@ -189,11 +210,13 @@ int runRender(const RenderCliOptions& o) {
   if (request->views == 4) {
     std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), outcome->points,
                 outcome->image.width, outcome->image.height, backendName(request->backend), outcome->device.name.c_str());
+    printWarnings(*outcome);
     return validationResult(*outcome);
   }
   if (!o.json.empty())
     if (Status s = writeReport(o.json, *request, *outcome); !s) return reportError(s.error());
   printOutcome(*request, o.output, *outcome);
+  printWarnings(*outcome);
   return validationResult(*outcome);
 }
 
@@ -225,10 +248,10 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->required();
   cmd->add_option("-o,--output", o->output, "PNG to write")->required()->check(checkStatus(checkPictureOutput));
   cmd->add_option("--mode", o->mode, modeOptionHelp())
-      ->check(checkStatus(checkModeName))
+      ->check(checkStatus(checkModeOption))
       ->default_val("auto");
   addChoiceOption(*cmd, "--backend", o->backend,
-                  "raster (graphics pipeline, POINT_LIST, the study's design) or compute (a thread per point,\n"
+                  "raster (graphics pipeline, POINT_LIST, the float-vs-double Vulkan study's design) or compute (a thread\nper point, "
                   "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)",
                   {"raster", "compute"});
   addCameraOptions(*cmd, o->camera);
@@ -245,7 +268,8 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--frames", o->frames, "Timed frames after warm-up (the median is reported)")->default_val(1);
   cmd->add_option("--warmup", o->warmup, "Untimed frames first")->default_val(1);
   cmd->add_flag("--error", o->error, "Run the probe and the exact CPU reference; report the error in pixels");
-  cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file");
+  cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file")
+      ->check(checkStatus(AtomicFile::checkTarget));
   cmd->add_flag("--validate", o->validate, "Enable the Khronos validation layer; any message fails the run");
   addChoiceOption(*cmd, "--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull",
                   {"auto", "attribute", "pull"});

@@ -4,6 +4,7 @@
 #include <new>
 
 #include "cli/cli_check.h"
+#include "cli/cli_suggest.h"
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "core/interrupt.h"
@@ -39,7 +40,7 @@ int main(int argc, char** argv) {
   using namespace dpoint;
   watchInterrupts();  // before any thread starts (core/interrupt.h)
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
-               "CSV, PLY and GLB, render them offscreen with Vulkan in six precision modes, and inspect the\n"
+               "CSV, PLY, GLB and LAS, render them offscreen with Vulkan in six precision modes, and inspect the\n"
                "precision a dataset needs.\n"
                "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit,\n"
                "130/143 stopped by SIGINT/SIGTERM (the output is not written).",
@@ -54,11 +55,25 @@ int main(int argc, char** argv) {
   addInfoCommand(app, run);
   addDevicesCommand(app, run);
   addBenchCommand(app, run);
+  // `dpoint` alone: the command list, as a usage error (exit 1), like `git` alone.
+  if (argc < 2) {
+    std::printf("%s", app.help().c_str());
+    return static_cast<int>(ExitCode::kUsage);
+  }
+  // A mistyped command or kind is named with the nearest one, before CLI11 calls it a missing
+  // subcommand or an unexpected argument.
+  if (std::optional<std::string> unknown = unknownCommandMessage(app, argc, argv))
+    return reportError(Error{*unknown, ExitCode::kUsage});
   try {
     app.parse(argc, argv);
   } catch (const UsageError& e) {  // a value one of dpoint's own validators refused (cli_check.h)
     return reportError(Error{e.what(), ExitCode::kUsage});
   } catch (const CLI::ParseError& e) {
+    // An unknown option is what went wrong whatever CLI11 calls it ("not expected", "a subcommand
+    // is required"): it is named with the nearest known one.
+    if (e.get_exit_code() != 0)
+      if (std::optional<std::string> unknown = unknownOptionMessage(app, argc, argv))
+        return reportError(Error{*unknown, ExitCode::kUsage});
     int code = app.exit(e);  // prints help, version or the usage error
     return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
   }

@@ -51,6 +51,49 @@ AtomicFile::~AtomicFile() {
   }
 }
 
+namespace {
+
+// The target's folder exists and is a folder (create's first checks on a regular or new target).
+Status checkFolder(const std::string& path, const std::string& folder) {
+  struct stat folder_st {};
+  if (::stat(folder.c_str(), &folder_st) != 0)
+    return Error{"cannot write '" + path + "': folder '" + folder + "' does not exist"};
+  if (!S_ISDIR(folder_st.st_mode))
+    return Error{"cannot write '" + path + "': '" + folder + "' is not a folder"};
+  return okStatus();
+}
+
+}  // namespace
+
+Status AtomicFile::checkTarget(const std::string& path) {
+  if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
+    if (!S_ISREG(st.st_mode)) {
+      int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+      if (fd < 0) return ioError("cannot open", path, errno);
+      ::close(fd);
+      return okStatus();
+    }
+  }
+  const std::string folder = folderOf(path);
+  if (Status s = checkFolder(path, folder); !s) return s;
+  int fd = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  if (fd >= 0) {
+    ::close(fd);
+    return okStatus();
+  }
+  if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
+    return ioError("cannot write into folder", folder, errno);
+  std::string temp = path + ".dpoint-XXXXXX";
+  fd = ::mkstemp(temp.data());
+  if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
+  ::close(fd);
+  ::unlink(temp.c_str());
+  return okStatus();
+}
+
 Result<AtomicFile> AtomicFile::create(const std::string& path) {
   if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
   if (interrupted()) return interruptedError();
@@ -64,11 +107,7 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
     }
   }
   const std::string folder = folderOf(path);
-  struct stat folder_st {};
-  if (::stat(folder.c_str(), &folder_st) != 0)
-    return Error{"cannot write '" + path + "': folder '" + folder + "' does not exist"};
-  if (!S_ISDIR(folder_st.st_mode))
-    return Error{"cannot write '" + path + "': '" + folder + "' is not a folder"};
+  if (Status s = checkFolder(path, folder); !s) return s.error();
 
   int fd = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
   if (fd >= 0) return AtomicFile(path, "", fd, false);

@@ -24,6 +24,11 @@ class AtomicFile {
   // Opens the temporary file. Fails (with a message naming the path) when the folder does not
   // exist, is not writable, or the target is a folder.
   static Result<AtomicFile> create(const std::string& path);
+  // What create checks, without leaving anything behind: the same errors (and exit codes) create
+  // would give for `path`, found before any work. The folder's writability is tried the way create
+  // writes (an unnamed temporary, or a named one removed at once), so a read-only file system or a
+  // folder root cannot write into fails here as it would there.
+  static Status checkTarget(const std::string& path);
 
   AtomicFile(AtomicFile&& other) noexcept;
   AtomicFile& operator=(AtomicFile&&) = delete;

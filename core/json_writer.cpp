@@ -21,6 +21,12 @@ JsonValue JsonValue::numbers(std::span<const double> values) {
 
 JsonValue JsonValue::object(const JsonObject& object) { return JsonValue(object.line()); }
 
+JsonValue JsonValue::array(std::span<const JsonValue> values) {
+  std::string text = "[";
+  for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + values[i].text();
+  return JsonValue(text + "]");
+}
+
 JsonObject& JsonObject::add(std::string_view key, const JsonValue& value) {
   members_.emplace_back(jsonString(std::string(key)), value.text());
   return *this;

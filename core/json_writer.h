@@ -24,6 +24,7 @@ class JsonValue {
   static JsonValue null();
   static JsonValue numbers(std::span<const double> values);  // [1, 2.5] on one line
   static JsonValue object(const JsonObject& object);         // {"a": 1, "b": 2} on one line
+  static JsonValue array(std::span<const JsonValue> values); // ["a", {"b": 2}] on one line
   const std::string& text() const { return text_; }
 
  private:

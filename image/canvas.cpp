@@ -97,18 +97,32 @@ int textWidth(const std::string& text, int scale) {
 
 Image composeContactSheet(const std::vector<LabelledView>& views, uint32_t columns) {
   assert(!views.empty() && columns >= 1);
-  constexpr int kGap = 2;
+  const uint32_t w = views[0].picture.width, h = views[0].picture.height;
+  const uint32_t used_columns = std::min<uint32_t>(columns, uint32_t(views.size()));
+  const uint32_t rows = (uint32_t(views.size()) + used_columns - 1) / used_columns;
+  return composeContactSheet(views, columns, used_columns * w + (used_columns - 1) * kContactSheetGap,
+                             rows * h + (rows - 1) * kContactSheetGap);
+}
+
+Image composeContactSheet(const std::vector<LabelledView>& views, uint32_t columns, uint32_t width, uint32_t height) {
+  assert(!views.empty() && columns >= 1);
   constexpr uint32_t kGapColor = packRgb(0x20, 0x20, 0x20), kStripColor = packRgb(0x10, 0x10, 0x10);
   constexpr uint32_t kLabelColor = packRgb(0xf2, 0xf2, 0xf2);
   const uint32_t w = views[0].picture.width, h = views[0].picture.height;
   columns = std::min<uint32_t>(columns, uint32_t(views.size()));
   const uint32_t rows = (uint32_t(views.size()) + columns - 1) / columns;
-  Image sheet = blankImage(columns * w + (columns - 1) * kGap, rows * h + (rows - 1) * kGap, kGapColor);
+  assert(width >= columns * w && height >= rows * h);
+  // The lines take the pixels the pictures leave: cell i starts after i pictures and i lines, the
+  // line pixels shared out in order (floor), so the last cell ends at the sheet's edge.
+  const auto start = [](uint32_t i, uint32_t cells, uint32_t cell, uint32_t total) {
+    return cells == 1 ? 0 : int(i * cell + (i * (total - cells * cell)) / (cells - 1));
+  };
+  Image sheet = blankImage(width, height, kGapColor);
   const int scale = w >= 400 ? 2 : 1;
   for (size_t i = 0; i < views.size(); ++i) {
     const Image& picture = views[i].picture;
     assert(picture.width == w && picture.height == h);
-    const int x = int(i % columns) * int(w + kGap), y = int(i / columns) * int(h + kGap);
+    const int x = start(uint32_t(i % columns), columns, w, width), y = start(uint32_t(i / columns), rows, h, height);
     blit(sheet, picture, x, y);
     const Rect tile = {x, y, x + int(w), y + int(h)};
     const int pad = 3 * scale;

@@ -48,5 +48,17 @@ struct LabelledView {
 // top-left corner, separated by 2-pixel dark lines. Every picture must have the same size
 // (asserted); views must not be empty and columns ≥ 1 (asserted).
 Image composeContactSheet(const std::vector<LabelledView>& views, uint32_t columns);
+// The same sheet at exactly `width` x `height`: the dark lines between the pictures take what the
+// pictures leave (at least 2 px when the pictures are contactSheetCell's size), so a sheet is the
+// size the user asked for. The pictures must fit (asserted).
+Image composeContactSheet(const std::vector<LabelledView>& views, uint32_t columns, uint32_t width, uint32_t height);
+inline constexpr uint32_t kContactSheetGap = 2;
+// The size of each of `cells` pictures side by side in `total` pixels with 2-px lines between them
+// (a pixel the cells cannot share evenly goes to the lines); 1 at least. The pictures and their
+// lines fit in `total` when total >= cells + (cells - 1) * kContactSheetGap.
+inline uint32_t contactSheetCell(uint32_t total, uint32_t cells) {
+  const uint32_t gaps = (cells - 1) * kContactSheetGap;
+  return total > gaps + cells ? (total - gaps) / cells : 1u;
+}
 
 }  // namespace dpoint

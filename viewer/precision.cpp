@@ -116,6 +116,13 @@ ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<co
     }
     return choice.bounds.px[i];
   };
+  // Each mode ahead of the choice: unusable, or usable with a bound over the limit (computed above).
+  auto noteRejected = [&] {
+    for (PrecisionMode mode : order) {
+      if (mode == choice.mode) break;
+      choice.rejected.push_back({mode, usable(mode) ? bound(mode) : std::nan(""), std::string()});
+    }
+  };
   for (PrecisionMode mode : order) {
     if (!usable(mode) || !(bound(mode) <= kAutoBoundPx)) continue;
     if (!choice.enough) {
@@ -125,10 +132,14 @@ ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<co
     } else {
       choice.runner_up = mode;
       choice.runner_up_bound_px = bound(mode);
+      noteRejected();
       return choice;
     }
   }
-  if (choice.enough) return choice;
+  if (choice.enough) {
+    noteRejected();
+    return choice;
+  }
   std::optional<PrecisionMode> best;
   for (PrecisionMode mode : order) {
     if (!usable(mode)) continue;
@@ -136,6 +147,7 @@ ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<co
   }
   choice.mode = best.value_or(kFallbackMode);
   choice.bound_px = bound(choice.mode);
+  noteRejected();
   return choice;
 }
 

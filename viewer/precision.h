@@ -16,6 +16,8 @@
 #pragma once
 
 #include <array>
+#include <string>
+#include <vector>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -48,6 +50,15 @@ struct ModeChoice {
   std::optional<PrecisionMode> runner_up;  // the next mode in speed order within the bound
   double runner_up_bound_px = 0.0;
   ErrorBounds bounds;  // every mode the choice looked at
+  // The modes ahead of the choice in speed order and why each was passed over: its bound over
+  // kAutoBoundPx, or (bound_px NaN) the device cannot run it, `reason` saying why when the caller
+  // knows (chooseModeOnDevice fills it in).
+  struct Rejected {
+    PrecisionMode mode;
+    double bound_px;
+    std::string reason;
+  };
+  std::vector<Rejected> rejected;
 };
 
 // Walks the speed order, skipping modes `usable` refuses, and takes the first whose bound is

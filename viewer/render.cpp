@@ -538,7 +538,10 @@ Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointS
   if (!self_test) return self_test.error();
   const bool compute = backend == Backend::kCompute;
   auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
-  return chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable);
+  ModeChoice choice = chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable);
+  for (ModeChoice::Rejected& r : choice.rejected)
+    if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
+  return choice;
 }
 
 double medianOf(std::vector<double> values) {

@@ -9,9 +9,11 @@
 
 #include "converters/point_inputs.h"
 #include "converters/point_io.h"
+#include "core/atomic_file.h"
 #include "core/interrupt.h"
 #include "core/json_writer.h"
 #include "core/memory.h"
+#include "core/text.h"
 #include "image/canvas.h"
 #include "ops/point_filters.h"
 #include "viewer/reference.h"
@@ -122,6 +124,11 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
     p.mode = *parseMode(request.mode);
     const PrecisionMode one[] = {p.mode};
     p.bound_px = predictErrorBounds(points, camera, one).px[modeIndex(p.mode)];
+    if (!(p.bound_px <= kWrongBoundPx)) {  // a wrong picture: name the mode auto would take
+      Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, request.backend, request.error);
+      if (!choice) return choice.error();
+      p.warning = predictionWarning(request, p, choice->mode);
+    }
     return p;
   }
   Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, request.backend, request.error);
@@ -129,6 +136,7 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   p.mode = choice->mode;
   p.bound_px = choice->bound_px;
   p.choice = std::move(*choice);
+  p.warning = predictionWarning(request, p, std::nullopt);
   return p;
 }
 
@@ -170,11 +178,15 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options);
     if (!rendered) return rendered.error();
     const std::string mode(modeName(prediction->mode));
+    const std::string label = "view " + std::string(views[i].label) + ": ";
+    if (!prediction->warning.empty()) outcome.warnings.push_back(label + prediction->warning);
+    if (std::string cover = coverWarning(drawnShare(rendered->image, request.background_rgba8)); !cover.empty())
+      outcome.warnings.push_back(label + cover);
     sheet.push_back({std::string(views[i].label) + " (" + mode + ")", std::move(rendered->image)});
     outcome.views.push_back({views[i].label, std::move(*prediction), std::move(rendered->gpu_ms)});
     if (view_done) view_done(outcome.views.back());
   }
-  outcome.image = composeContactSheet(sheet, 2);
+  outcome.image = composeContactSheet(sheet, 2, request.camera.width, request.camera.height);
   return okStatus();
 }
 
@@ -185,6 +197,7 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
       set.stream ? streamedModePrediction(request) : predictMode(request, context, *set.points, camera);
   if (!prediction) return prediction.error();
   outcome.prediction = std::move(*prediction);
+  if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
   outcome.phases.mark("mode");
   const RenderOptions options = renderOptionsFor(request, set, outcome.prediction.mode, camera, context.facts);
   outcome.point_size = options.point_size;
@@ -212,6 +225,8 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
     outcome.error = measureError(*set.points, camera, *rendered, options);
     outcome.phases.mark("error");
   }
+  outcome.drawn_share = drawnShare(rendered->image, request.background_rgba8);
+  if (std::string cover = coverWarning(outcome.drawn_share); !cover.empty()) outcome.warnings.push_back(cover);
   outcome.image = std::move(rendered->image);
   outcome.result = std::move(*rendered);
   return okStatus();
@@ -236,9 +251,51 @@ const char* renderColorName(RenderColor color) {
   }
 }
 
+std::string predictionWarning(const RenderRequest& request, const ModePrediction& prediction,
+                              std::optional<PrecisionMode> auto_mode) {
+  const std::string mode(modeName(prediction.mode));
+  if (const std::optional<ModeChoice>& c = prediction.choice) {
+    if (c->enough) return std::string();
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", kAutoBoundPx);
+    return std::string("no mode this device runs stays within ") + limit + " px for this view; " + mode +
+           " is the most accurate here (bound " + formatBound(prediction.bound_px) + ")";
+  }
+  if (request.mode == "auto" || prediction.bound_px <= kWrongBoundPx) return std::string();
+  const std::string bound = std::isfinite(prediction.bound_px) ? "up to " + formatBound(prediction.bound_px)
+                                                               : std::string("unbounded");
+  return "--mode " + mode + ": predicted error " + bound + " (> " + formatNumber(kWrongBoundPx) +
+         " px): the picture is wrong here" +
+         (auto_mode ? "; --mode auto picks " + std::string(modeName(*auto_mode)) : std::string());
+}
+
+double drawnShare(const Image& image, uint32_t background_rgba8) {
+  const size_t pixels = size_t(image.width) * image.height;
+  if (pixels == 0) return 0.0;
+  size_t drawn = 0;
+  for (size_t i = 0; i < pixels; ++i) {
+    const uint8_t* p = &image.rgba[4 * i];
+    const uint32_t rgb = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+    drawn += rgb != (background_rgba8 & 0xffffffu);
+  }
+  return double(drawn) / double(pixels);
+}
+
+std::string coverWarning(double drawn_share) {
+  if (drawn_share == 0.0)
+    return "the picture shows nothing: no point was drawn in the view (frame the data with --view-center and "
+           "--view-width, or --eye and --target)";
+  if (!(drawn_share < kPoorCoverShare)) return std::string();
+  char share[32];
+  std::snprintf(share, sizeof share, "%.2g%%", 100.0 * drawn_share);
+  return std::string("the data covers ") + share + " of the picture (under 1%): frame it closer with --view-center "
+         "and --view-width, or --eye and --target";
+}
+
 const char* backendName(Backend backend) { return backend == Backend::kCompute ? "compute" : "raster"; }
 
 Status checkPictureOutput(const std::string& path) {
+  if (Status s = AtomicFile::checkTarget(path); !s) return s;  // where it goes, before any work
   if (!hasExtension(path, ".png") && path.rfind("/dev/", 0) != 0)
     return Error{"-o " + path + ": the picture is written as PNG; name it .png", ExitCode::kUsage};
   return okStatus();
@@ -263,6 +320,11 @@ Status checkRenderRequest(const RenderRequest& request) {
                    ExitCode::kUsage};
     if (request.error || request.report)
       return Error{"--views 4 makes a contact sheet; --error and --json measure one view (use --views 1)",
+                   ExitCode::kUsage};
+    const uint32_t least = 2 + kContactSheetGap;  // two 1-px views and the line between them
+    if (request.camera.width < least || request.camera.height < least)
+      return Error{"--views 4 needs --width and --height of at least " + std::to_string(least) + " px, got " +
+                       std::to_string(request.camera.width) + "x" + std::to_string(request.camera.height),
                    ExitCode::kUsage};
   }
   return okStatus();
@@ -304,8 +366,10 @@ Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std:
     CameraSpec view_spec = spec;
     // One y-up view is makeCamera's own default fit.
     if (!spec.eye && (views.size() == 4 || z_up)) view_spec.fit_direction = view.direction, view_spec.fit_up = view.up;
-    // Four views share the picture: each gets a quarter, so the sheet keeps about width x height.
-    if (views.size() == 4) view_spec.width = std::max(1u, spec.width / 2), view_spec.height = std::max(1u, spec.height / 2);
+    // Four views share the picture: each gets a quarter less the lines between them, so the sheet
+    // is exactly width x height (composeContactSheet).
+    if (views.size() == 4)
+      view_spec.width = contactSheetCell(spec.width, 2), view_spec.height = contactSheetCell(spec.height, 2);
     Result<Camera> camera = makeCamera(view_spec, bounds);
     if (!camera) return camera.error();
     cameras.push_back(*camera);
@@ -414,6 +478,15 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
                                   .add("predicted_bound_px", V::number(c->runner_up_bound_px)));
     else
       choice.add("runner_up", V::null());
+    std::vector<V> rejected;
+    for (const ModeChoice::Rejected& passed : c->rejected) {
+      JsonObject one;
+      one.add("mode", V::string(modeName(passed.mode))).add("predicted_bound_px", V::number(passed.bound_px));
+      one.add("usable", V::boolean(!std::isnan(passed.bound_px)));
+      if (!passed.reason.empty()) one.add("reason", V::string(passed.reason));
+      rejected.push_back(V::object(one));
+    }
+    choice.add("rejected", V::array(rejected));
     o.add("auto", choice);
   }
   o.add("backend", V::string(backendName(request.backend))).add("order", V::string(pointOrderName(request.order)));
@@ -456,6 +529,10 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
     o.add("points_visible", V::integer(e.points)).add("points_lost", V::integer(e.lost));
     o.add("pixels_differing", error->pixels_compared ? V::integer(error->pixels_differing) : V::null());
   }
+  o.add("drawn_share", V::number(outcome.drawn_share));
+  std::vector<V> warnings;
+  for (const std::string& w : outcome.warnings) warnings.push_back(V::string(w));
+  o.add("warnings", V::array(warnings));
   return o.block();
 }
 

@@ -65,7 +65,8 @@ struct RenderRequest {
   unsigned threads = 0;
 };
 
-// -o: the picture is written as PNG (a .png name, or a device such as /dev/null). kUsage.
+// -o: a place the picture can be written (AtomicFile::checkTarget's errors), as PNG (a .png name,
+// or a device such as /dev/null; kUsage).
 Status checkPictureOutput(const std::string& path);
 // --mode: auto or a mode name (kUsage, listing them).
 Status checkModeName(const std::string& mode);
@@ -97,7 +98,23 @@ struct ModePrediction {
   PrecisionMode mode = kFallbackMode;
   double bound_px = 0.0;             // NaN for a streamed set (none predicted)
   std::optional<ModeChoice> choice;  // --mode auto
+  std::string warning;               // the picture is likely wrong in this mode (predictionWarning); or empty
 };
+
+// Over this predicted bound a forced --mode draws a wrong picture (points half a pixel or more off),
+// and the run says so; --mode auto itself holds to kAutoBoundPx.
+inline constexpr double kWrongBoundPx = 0.5;
+// Under this share of its pixels drawn, a picture shows the data as a speck, and the run says so.
+inline constexpr double kPoorCoverShare = 0.01;
+
+// The warning of a prediction: a forced mode whose bound is over kWrongBoundPx (naming the mode
+// --mode auto picks, `auto_mode`), or --mode auto with no mode within kAutoBoundPx; else empty.
+std::string predictionWarning(const RenderRequest& request, const ModePrediction& prediction,
+                              std::optional<PrecisionMode> auto_mode);
+// The share of the picture's pixels whose colour is not the background's (RGB compared).
+double drawnShare(const Image& image, uint32_t background_rgba8);
+// The warning of a picture that shows nothing (share 0) or a speck (under kPoorCoverShare); else empty.
+std::string coverWarning(double drawn_share);
 
 // A view of a contact sheet: its label and the fit's direction (target to eye) and up.
 struct RenderView {
@@ -140,6 +157,11 @@ struct RenderOutcome {
   bool streamed = false;       // drawn a block at a time (no prediction, no --error)
   DeviceFacts device;
   std::vector<std::string> validation_messages;  // with `validate`: any fails the run
+  // What makes the picture wrong or poor, one line each (no "warning:" prefix): a forced mode
+  // whose bound is over kWrongBoundPx, --mode auto with no mode within its limit, a picture drawn
+  // on under 1% of its pixels or on none ("view LABEL: " first for a view of a sheet).
+  std::vector<std::string> warnings;
+  double drawn_share = std::nan("");  // one view: the share of pixels drawn (drawnShare)
   // One view:
   ModePrediction prediction;
   float point_size = 1.0f;

@@ -3,10 +3,16 @@
 #include <cstdlib>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 
 namespace dpoint {
 namespace {
+
+// Whether the device of the last context created is a CPU (lavapipe): a lost device's hint then
+// does not send the user to --device cpu, which is what failed. One process uses one device at a
+// time, and vulkanError has no context to ask.
+std::atomic<bool> g_device_is_cpu{false};
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
@@ -239,7 +245,9 @@ Error vulkanError(const std::string& what, VkResult result) {
   const bool memory = result == VK_ERROR_OUT_OF_HOST_MEMORY;
   std::string hint = result == VK_ERROR_INCOMPATIBLE_DRIVER ? " (no Vulkan driver found)"
                      : result == VK_ERROR_DEVICE_LOST
-                         ? " (the GPU was reset or its driver failed; nothing was written; try again, or --device cpu)"
+                         ? (g_device_is_cpu ? " (the CPU device's driver failed; nothing was written; try again)"
+                                            : " (the GPU was reset or its driver failed; nothing was written; try again, or "
+                                              "--device cpu)")
                          : "";
   return Error{what + " failed: " + vkResultName(result) + " (" + std::to_string(static_cast<int>(result)) + ")" + hint,
                memory ? ExitCode::kResourceLimit : ExitCode::kNoDevice};
@@ -284,6 +292,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   if (!chosen) return chosen.error();
   context->physical = (*devices)[*chosen];
   context->facts = all[*chosen];
+  g_device_is_cpu = context->facts.type == "cpu";
   vkGetPhysicalDeviceMemoryProperties(context->physical, &context->memory);
 
   // Enable only what the modes use and the device has; each mode checks its own needs.

@@ -152,15 +152,15 @@ TEST(CliPreview, edlStrengthDarkensMoreAsItGrows) {
 TEST(CliPreview, fourViewSheetLabelsEachViewOverItsPicture) {
   TempDir dir;
   const std::string mb = mandelbulb(dir);
-  // --views 4 at 322 x 242 gives four 161 x 121 views; the single view is drawn at that size.
+  // --views 4 at 322 x 242 gives four 160 x 120 views and 2-px lines; the single view is drawn at that size.
   const Pixels sheet = decodePng(render(dir, mb, "views.png", {"--views", "4"}, 322, 242));
-  const Pixels alone = decodePng(render(dir, mb, "alone.png", {}, 161, 121));
-  ASSERT_EQ(sheet.width, 2 * 161 + 2);
-  ASSERT_EQ(sheet.height, 2 * 121 + 2);
+  const Pixels alone = decodePng(render(dir, mb, "alone.png", {}, 160, 120));
+  ASSERT_EQ(sheet.width, 322) << "the size asked for";
+  ASSERT_EQ(sheet.height, 242);
   const uint32_t strip = 0xff101010u, label = 0xfff2f2f2u;
   // Every quarter: a dark strip at its top-left corner with light glyphs on it.
   for (int quarter = 0; quarter < 4; ++quarter) {
-    const int x0 = (quarter % 2) * (161 + 2), y0 = (quarter / 2) * (121 + 2);
+    const int x0 = (quarter % 2) * (160 + 2), y0 = (quarter / 2) * (120 + 2);
     size_t strip_pixels = 0, label_pixels = 0;
     for (int y = y0; y < y0 + 15; ++y) {
       for (int x = x0; x < x0 + 40; ++x) {
@@ -172,11 +172,11 @@ TEST(CliPreview, fourViewSheetLabelsEachViewOverItsPicture) {
     EXPECT_GT(label_pixels, 20u) << "quarter " << quarter;
   }
   // The three-quarter view: what differs from the view alone is the label, on its strip.
-  const int x0 = 161 + 2, y0 = 121 + 2;
+  const int x0 = 160 + 2, y0 = 120 + 2;
   int right = 0, bottom = 0;
   size_t label_pixels = 0;
-  for (int y = 0; y < 121; ++y) {
-    for (int x = 0; x < 161; ++x) {
+  for (int y = 0; y < 120; ++y) {
+    for (int x = 0; x < 160; ++x) {
       const uint32_t got = sheet.at(x0 + x, y0 + y);
       if (got == alone.at(x, y)) continue;
       EXPECT_TRUE(got == strip || got == label) << x << "," << y;

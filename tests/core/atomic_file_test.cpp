@@ -41,6 +41,22 @@ TEST(AtomicFile, rejectsMissingFolderAndFolderTarget) {
   EXPECT_NE(folder.error().message.find("is a folder"), std::string::npos);
 }
 
+// checkTarget finds what create would refuse, with create's message, and leaves nothing behind.
+TEST(AtomicFile, checkTargetRefusesWhatCreateRefusesAndWritesNothing) {
+  TempDir dir;
+  for (const std::string& path : {dir.file("nope/out.txt"), dir.path(), std::string("/sys/dpoint-test.txt")}) {
+    SCOPED_TRACE(path);
+    Status checked = AtomicFile::checkTarget(path);
+    Result<AtomicFile> created = AtomicFile::create(path);
+    ASSERT_FALSE(checked.ok());
+    ASSERT_FALSE(created.ok());
+    EXPECT_EQ(checked.error().message, created.error().message);
+  }
+  EXPECT_TRUE(AtomicFile::checkTarget(dir.file("new.txt")).ok());
+  EXPECT_TRUE(AtomicFile::checkTarget("/dev/null").ok());
+  EXPECT_TRUE(dir.entries().empty());
+}
+
 TEST(AtomicFile, writesDevicesDirectly) {
   Result<AtomicFile> f = AtomicFile::create("/dev/null");
   ASSERT_TRUE(f.ok());

@@ -151,5 +151,28 @@ TEST(Canvas, contactSheetDrawsEachLabelOnAStripOverItsPicture) {
   for (uint32_t x = 0; x < sheet.width; ++x) EXPECT_EQ(pixel(sheet, x, h + 1), gap) << x;
 }
 
+
+// A sheet asked for at a size is that size: the lines take the pixels the pictures leave, so an
+// odd width or height widens one line, and each picture sits whole at its place.
+TEST(Canvas, contactSheetAtASizeIsThatSizeAndKeepsEveryPicture) {
+  const uint32_t gap = rgba(0x20, 0x20, 0x20);
+  EXPECT_EQ(contactSheetCell(800, 2), 399u);
+  EXPECT_EQ(contactSheetCell(801, 2), 399u);
+  EXPECT_EQ(contactSheetCell(4, 2), 1u);
+  const uint32_t w = contactSheetCell(81, 2), h = contactSheetCell(60, 2);
+  std::vector<LabelledView> views;
+  for (int i = 0; i < 4; ++i) views.push_back({"", filled(w, h, rgba(uint8_t(50 * (i + 1)), 0, 0))});
+  const Image sheet = composeContactSheet(views, 2, 81, 60);
+  ASSERT_EQ(sheet.width, 81u);
+  ASSERT_EQ(sheet.height, 60u);
+  for (int i = 0; i < 4; ++i) {
+    const uint32_t x0 = (i % 2) ? 81 - w : 0, y0 = (i / 2) ? 60 - h : 0;  // the last cell ends at the edge
+    EXPECT_EQ(pixel(sheet, x0 + w / 2, y0 + h / 2), rgba(uint8_t(50 * (i + 1)), 0, 0)) << i;
+    EXPECT_EQ(pixel(sheet, x0 + w - 1, y0 + h - 1), rgba(uint8_t(50 * (i + 1)), 0, 0)) << i;
+  }
+  for (uint32_t x = w; x < 81 - w; ++x) EXPECT_EQ(pixel(sheet, x, 0), gap) << "a 3-px line: " << x;
+  EXPECT_EQ(81 - 2 * w, 3u);
+}
+
 }  // namespace
 }  // namespace dpoint

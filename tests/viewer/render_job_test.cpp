@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
+
+#include "test_support.h"
 
 
 namespace dpoint {
@@ -69,7 +72,8 @@ TEST(RenderJob, viewsAndTheirCameras) {
   Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(4, false), cube());
   ASSERT_TRUE(cameras.ok());
   ASSERT_EQ(cameras->size(), 4u);
-  for (const Camera& c : *cameras) EXPECT_EQ(std::make_pair(c.width, c.height), std::make_pair(200u, 150u));
+  // A quarter less the 2-px lines, rounded down: the sheet is 401 x 300 (the odd pixel goes to a line).
+  for (const Camera& c : *cameras) EXPECT_EQ(std::make_pair(c.width, c.height), std::make_pair(199u, 149u));
   EXPECT_NE((*cameras)[0].eye, (*cameras)[1].eye);
 }
 
@@ -103,6 +107,9 @@ TEST(RenderJob, upAxisShadingAndRequestChecks) {
   EXPECT_TRUE(checkRenderRequest(sheet).ok());
   sheet.report = true;
   EXPECT_EQ(checkRenderRequest(sheet).error().code, ExitCode::kUsage);
+  sheet.report = false;
+  sheet.camera.width = 3;
+  EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views 4 needs --width and --height of at least 4 px, got 3x768");
   sheet.views = 2;
   EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views must be 1 or 4, got 2");
 }
@@ -131,9 +138,60 @@ TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
   for (const char* line : {"  \"width\": 64,\n  \"height\": 48,\n  \"frames\": 2,\n  \"gpu_ms\": null,\n",
                            "  \"frame_ms\": {\"median\": 3, \"p95\": 4},\n", "\"phases_ms\": {\"read\": ",
                            "  \"native_path\": null,\n  \"error_px\": null,\n",
-                           "  \"points_visible\": 3,\n  \"points_lost\": 3,\n  \"pixels_differing\": null\n}\n"})
+                           "  \"points_visible\": 3,\n  \"points_lost\": 3,\n  \"pixels_differing\": null,\n"
+                           "  \"drawn_share\": null,\n  \"warnings\": []\n}\n"})
     EXPECT_NE(json.find(line), std::string::npos) << line << " in\n" << json;
   EXPECT_EQ(json.find("\"auto\""), std::string::npos) << "no choice made: no auto member";
+}
+
+// The warnings are data: a forced mode over 0.5 px names its bound and auto's pick; auto with no
+// mode within 0.1 px says which is the most accurate; a picture drawn on under 1% of its pixels,
+// or on none, says so. The report lists them, and auto's rejected modes with their bounds.
+TEST(RenderJob, warningsSayWhenThePictureIsWrongOrPoor) {
+  RenderRequest request;
+  request.mode = "fp32";
+  ModePrediction forced;
+  forced.mode = *parseMode("fp32");
+  forced.bound_px = 136.0;
+  EXPECT_EQ(predictionWarning(request, forced, parseMode("native")),
+            "--mode fp32: predicted error up to 1.4e+02 px (> 0.5 px): the picture is wrong here; --mode auto picks native");
+  forced.bound_px = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(predictionWarning(request, forced, parseMode("rte")),
+            "--mode fp32: predicted error unbounded (> 0.5 px): the picture is wrong here; --mode auto picks rte");
+  forced.bound_px = 0.5;
+  EXPECT_EQ(predictionWarning(request, forced, std::nullopt), "") << "0.5 px itself is not wrong";
+  request.mode = "auto";
+  ModePrediction chosen;
+  chosen.mode = *parseMode("native");
+  chosen.bound_px = 0.3;
+  chosen.choice = ModeChoice{};
+  chosen.choice->enough = false;
+  EXPECT_EQ(predictionWarning(request, chosen, std::nullopt),
+            "no mode this device runs stays within 0.1 px for this view; native is the most accurate here (bound 0.3 px)");
+  chosen.choice->enough = true;
+  EXPECT_EQ(predictionWarning(request, chosen, std::nullopt), "");
+
+  Image image{10, 10, std::vector<uint8_t>(400, 0)};
+  for (size_t i = 0; i < 100; ++i) image.rgba[4 * i + 3] = 255;
+  EXPECT_EQ(drawnShare(image, 0xff000000u), 0.0);
+  EXPECT_TRUE(coverWarning(0.0).starts_with("the picture shows nothing: no point was drawn in the view"));
+  image.rgba[4 * 55] = 200;
+  EXPECT_EQ(drawnShare(image, 0xff000000u), 0.01);
+  EXPECT_EQ(drawnShare(image, 0xff0000c8u), 0.99) << "the background is what is not drawn";
+  EXPECT_EQ(coverWarning(0.01), "") << "1% itself is enough";
+  EXPECT_TRUE(coverWarning(0.005).starts_with("the data covers 0.5% of the picture (under 1%)")) << coverWarning(0.005);
+
+  RenderOutcome outcome;
+  outcome.device.type = "cpu";
+  outcome.prediction = chosen;
+  outcome.prediction.choice->rejected = {{*parseMode("fp32"), 3.5, ""}, {*parseMode("rte"), std::nan(""), "needs X"}};
+  outcome.warnings = {"a \"quoted\" warning", "two"};
+  outcome.drawn_share = 0.25;
+  const std::string json = renderReportJson(request, outcome);
+  EXPECT_TRUE(test::contains(json, "\"rejected\": [{\"mode\": \"fp32\", \"predicted_bound_px\": 3.5, \"usable\": true}, "
+                                   "{\"mode\": \"rte\", \"predicted_bound_px\": null, \"usable\": false, \"reason\": \"needs X\"}]}"))
+      << json;
+  EXPECT_TRUE(test::contains(json, "  \"drawn_share\": 0.25,\n  \"warnings\": [\"a \\\"quoted\\\" warning\", \"two\"]\n}\n")) << json;
 }
 
 }  // namespace

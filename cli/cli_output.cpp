@@ -1,0 +1,42 @@
+#include "cli/cli_output.h"
+
+#include <sys/stat.h>
+
+#include <filesystem>
+
+#include "converters/point_io.h"
+#include "core/atomic_file.h"
+
+namespace dpoint {
+
+std::string pointOutputHelp() { return "Output file (.csv, .ply, .glb, .las); written whole or not at all"; }
+
+Status checkPointOutput(const std::string& path) {
+  if (Status s = AtomicFile::checkTarget(path); !s) return s;  // first: a folder is no file of any type
+  Result<FileFormat> format = formatOf(path);
+  if (!format) {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    return Error{path + ": unknown file type '" + ext + "' (write " + kPointOutputFormats + ")", ExitCode::kUsage};
+  }
+  if (*format == FileFormat::kGltf)
+    return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .las)", ExitCode::kUsage};
+  if (*format == FileFormat::kLaz)
+    return Error{path + ": writing LAZ is not supported; write .las and compress it with laszip or PDAL",
+                 ExitCode::kUsage};
+  return okStatus();
+}
+
+Status checkOutputFolder(const std::string& flag, const std::string& path) {
+  std::filesystem::path at = path.empty() ? std::filesystem::path(".") : std::filesystem::path(path);
+  struct stat st {};
+  if (::stat(at.c_str(), &st) == 0 && !S_ISDIR(st.st_mode))
+    return Error{flag + " " + path + ": is a file, not a folder", ExitCode::kUsage};
+  // The nearest folder that exists is where the first folder will be made (or the files written).
+  while (::stat(at.c_str(), &st) != 0 && at.has_parent_path() && at.parent_path() != at) at = at.parent_path();
+  if (::stat(at.c_str(), &st) != 0) at = ".";
+  if (Status s = AtomicFile::checkTarget((at / "dpoint-check").string()); !s)
+    return Error{flag + " " + path + ": " + s.error().message, s.error().code};
+  return okStatus();
+}
+
+}  // namespace dpoint

@@ -1,0 +1,27 @@
+// Where the commands write, checked as the options are parsed, before any work (issue #24): a
+// long generation or read no longer ends in "cannot write". One list of the formats a point set
+// is written as, for every help text and error.
+#pragma once
+
+#include <string>
+
+#include "core/result.h"
+
+namespace dpoint {
+
+// The formats a point set is written as (.gltf is read only, .laz not at all), as help and errors
+// list them.
+inline constexpr const char* kPointOutputFormats = ".csv, .ply, .glb or .las";
+// "Output file (.csv, .ply, .glb, .las); written whole or not at all": the -o help of the commands
+// that write a point set.
+std::string pointOutputHelp();
+
+// -o of a point set: a place it can be written (AtomicFile::checkTarget: a missing folder, a folder
+// given as the file, a folder that cannot be written into), then a written format ("PATH: unknown
+// file type '.txt' (write .csv, .ply, .glb or .las)"). As validators, both are usage errors (exit 1).
+Status checkPointOutput(const std::string& path);
+// An output folder that is created when missing (bench --out): not a file, and the nearest folder
+// that exists can be written into. `flag` names the option in the message.
+Status checkOutputFolder(const std::string& flag, const std::string& path);
+
+}  // namespace dpoint

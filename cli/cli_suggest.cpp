@@ -1,0 +1,124 @@
+#include "cli/cli_suggest.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace dpoint {
+namespace {
+
+std::string withoutDashes(const std::string& word) { return word.substr(std::min(word.find_first_not_of('-'), word.size())); }
+
+std::string listed(const std::vector<std::string>& words) {
+  std::string list;
+  for (const std::string& w : words) list += (list.empty() ? "" : ", ") + w;
+  return list;
+}
+
+std::vector<std::string> subcommandNames(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+  return names;
+}
+
+std::vector<std::string> optionNames(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::Option* option : app.get_options()) {
+    for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+    for (const std::string& name : option->get_snames()) names.push_back("-" + name);
+  }
+  return names;
+}
+
+const CLI::App* findSubcommand(const CLI::App& app, const std::string& name) {
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (sub->check_name(name)) return sub;
+  return nullptr;
+}
+
+// A word that stands where an option would: "-x", "--name" or "--name=value", not a negative number.
+bool looksLikeOption(const std::string& word) {
+  if (word.size() < 2 || word[0] != '-' || word == "--") return false;
+  return !(std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.');
+}
+
+// What a command is called in messages: "render", "generate mandelbulb".
+std::string commandPath(const CLI::App& app) {
+  std::string path;
+  for (const CLI::App* at = &app; at != nullptr && at->get_parent() != nullptr; at = at->get_parent())
+    path = at->get_name() + (path.empty() ? "" : " " + path);
+  return path;
+}
+
+}  // namespace
+
+size_t editDistance(const std::string& a, const std::string& b) {
+  // Rows i-2, i-1 and i of the usual table; d[i][j] the distance of a's first i and b's first j.
+  std::vector<size_t> before(b.size() + 1), previous(b.size() + 1), current(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        current[j] = std::min(current[j], before[j - 2] + 1);
+    }
+    before.swap(previous);
+    previous.swap(current);
+  }
+  return previous[b.size()];
+}
+
+std::optional<std::string> closestMatch(const std::string& word, const std::vector<std::string>& candidates) {
+  const std::string bare = withoutDashes(word);
+  std::optional<std::string> best;
+  size_t best_distance = 3;
+  for (const std::string& candidate : candidates) {
+    const size_t d = editDistance(bare, withoutDashes(candidate));
+    if (d < best_distance && d < bare.size()) best = candidate, best_distance = d;
+  }
+  if (best || bare.size() < 3) return best;
+  for (const std::string& candidate : candidates)
+    if (withoutDashes(candidate).starts_with(bare)) return candidate;
+  return std::nullopt;
+}
+
+std::string didYouMean(const std::string& word, const std::vector<std::string>& candidates) {
+  std::optional<std::string> match = closestMatch(word, candidates);
+  return match ? "; did you mean '" + *match + "'?" : std::string();
+}
+
+std::optional<std::string> unknownCommandMessage(const CLI::App& app, int argc, const char* const* argv) {
+  const CLI::App* at = &app;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    const std::vector<std::string> names = subcommandNames(*at);
+    if (names.empty() || word.starts_with("-")) return std::nullopt;
+    if (const CLI::App* sub = findSubcommand(*at, word)) {
+      at = sub;
+      continue;
+    }
+    const bool top = at == &app;
+    return (top ? std::string("unknown command '") : commandPath(*at) + ": unknown kind '") + word + "'" +
+           didYouMean(word, names) + " (" + (top ? "commands: " : "kinds: ") + listed(names) + ")";
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> unknownOptionMessage(const CLI::App& app, int argc, const char* const* argv) {
+  const CLI::App* chosen = &app;
+  while (!chosen->get_subcommands().empty()) chosen = chosen->get_subcommands().front();
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (!looksLikeOption(word)) continue;
+    const std::string name = word.substr(0, word.find('='));
+    if (chosen->get_option_no_throw(name) != nullptr) continue;
+    const std::string path = commandPath(*chosen);
+    return (path.empty() ? std::string() : path + ": ") + "unknown option '" + name + "'" +
+           didYouMean(name, optionNames(*chosen)) + " (`dpoint " + (path.empty() ? "" : path + " ") +
+           "--help` lists them)";
+  }
+  return std::nullopt;
+}
+
+}  // namespace dpoint

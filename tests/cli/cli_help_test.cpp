@@ -1,0 +1,181 @@
+// A CLI that helps (issue #24): a mistyped command, kind, option or value is named with the nearest
+// known one; `dpoint` alone lists the commands; -o is checked before any work; the sizes asked for
+// are the sizes written; one list of output formats.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "cli/cli_suggest.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::concat;
+using test::contains;
+using test::readFile;
+using test::runDpoint;
+using test::TempDir;
+using test::writeFile;
+
+std::pair<uint32_t, uint32_t> pngSize(const std::string& png) {
+  auto be32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(png.at(at + i));
+    return v;
+  };
+  return {be32(16), be32(20)};
+}
+
+size_t lines(const std::string& text) { return size_t(std::count(text.begin(), text.end(), '\n')); }
+
+TEST(CliSuggest, editDistanceCountsASwapOfNeighboursAsOne) {
+  EXPECT_EQ(editDistance("", "abc"), 3u);
+  EXPECT_EQ(editDistance("render", "render"), 0u);
+  EXPECT_EQ(editDistance("rendr", "render"), 1u);
+  EXPECT_EQ(editDistance("mandlebulb", "mandelbulb"), 1u) << "le/el is one swap";
+  EXPECT_EQ(editDistance("colour", "color"), 1u);
+  EXPECT_EQ(editDistance("kitten", "sitting"), 3u);
+}
+
+TEST(CliSuggest, closestMatchTakesTheNearestOrAPrefixAndNothingFarOff) {
+  const std::vector<std::string> modes = {"auto", "fp32", "split", "rte", "df64", "native", "batch"};
+  EXPECT_EQ(closestMatch("natve", modes), "native");
+  EXPECT_EQ(closestMatch("df46", modes), "df64");
+  EXPECT_EQ(closestMatch("nat", modes), "native") << "a prefix of 3 characters";
+  EXPECT_EQ(closestMatch("zzzzzz", modes), std::nullopt);
+  EXPECT_EQ(closestMatch("x", modes), std::nullopt) << "a one-letter word is not corrected";
+  EXPECT_EQ(closestMatch("--colour", {"--color", "--background"}), "--color");
+  EXPECT_EQ(didYouMean("rendr", {"generate", "render"}), "; did you mean 'render'?");
+  EXPECT_EQ(didYouMean("qqqq", {"generate", "render"}), "");
+}
+
+// Each mistake ends with one line naming the mistyped word and the nearest known one, exit 1.
+TEST(CliHelp, mistypedWordsGetOneLineWithTheNearestKnownOne) {
+  TempDir dir;
+  writeFile(dir.file("one.csv"), "x,y,z\n1,2,3\n4,5,6\n");
+  struct Case {
+    std::vector<std::string> args;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {{"rendr"}, "unknown command 'rendr'; did you mean 'render'? (commands: generate, merge, convert, render"},
+      {{"generate", "mandlebulb", "-o", dir.file("t.ply")},
+       "generate: unknown kind 'mandlebulb'; did you mean 'mandelbulb'? (kinds: mandelbulb, julia"},
+      {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--mode", "natve"},
+       "--mode must be auto, fp32, split, rte, df64, native or batch, got 'natve'; did you mean 'native'?"},
+      {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--colour", "rgb"},
+       "render: unknown option '--colour'; did you mean '--color'?"},
+      {{"generate", "random2d", "--colour", "none", "-o", dir.file("t.ply")},
+       "generate random2d: unknown option '--colour'; did you mean '--colors'?"},
+      {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--backend", "computee"},
+       "--backend must be raster or compute, got 'computee'; did you mean 'compute'?"},
+      {{"--bogus"}, "unknown option '--bogus'"},
+      {{"frobnicate"}, "unknown command 'frobnicate' (commands: generate,"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args[0] + " " + (c.args.size() > 1 ? c.args[1] : ""));
+    test::CommandResult r = runDpoint(c.args);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_TRUE(contains(r.err, std::string("dpoint: error: ") + c.message)) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_EQ(r.out, "");
+  }
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"one.csv"}) << "nothing written";
+}
+
+// `dpoint` alone prints the top-level help (the command list) and exits 1, a usage error.
+TEST(CliHelp, dpointAloneListsTheCommandsAndExitsOne) {
+  test::CommandResult bare = runDpoint({});
+  EXPECT_EQ(bare.exit_code, 1);
+  test::CommandResult help = runDpoint({"--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_EQ(bare.out, help.out) << "the same text as --help";
+  for (const char* command : {"generate", "merge", "convert", "render", "info", "devices", "bench"})
+    EXPECT_TRUE(contains(bare.out, std::string("\n  ") + command)) << command;
+}
+
+// --views 4 --width 800 --height 600 writes 800 x 600 (it wrote 802 x 602, the 2-px lines added),
+// and an odd size is kept too; a sheet too small for four views and their lines is refused.
+TEST(CliHelp, fourViewSheetIsTheSizeAskedFor) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "24", "-q", "-o", dir.file("mb.ply")}).exit_code, 0);
+  for (const auto& [w, h] : std::vector<std::pair<uint32_t, uint32_t>>{{800, 600}, {321, 241}}) {
+    const std::string out = dir.file("v" + std::to_string(w) + ".png");
+    test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", out, "--views", "4", "--width",
+                                       std::to_string(w), "--height", std::to_string(h), "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(pngSize(readFile(out)), std::make_pair(w, h));
+    EXPECT_TRUE(contains(r.out, std::to_string(w) + "x" + std::to_string(h))) << r.out;
+  }
+  test::CommandResult tiny = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file("tiny.png"), "--views", "4",
+                                        "--width", "3", "--height", "600"});
+  EXPECT_EQ(tiny.exit_code, 1);
+  EXPECT_TRUE(contains(tiny.err, "--views 4 needs --width and --height of at least 4 px, got 3x600")) << tiny.err;
+  EXPECT_FALSE(test::fileExists(dir.file("tiny.png")));
+}
+
+
+// A bad -o ends the run with one line naming the path, exit 1, before any work: a generation
+// that would take minutes (a 2000^3 grid) ends at once, an input that does not exist is not
+// reached, and nothing is written. The same for merge, render's --json and bench's --out.
+TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
+  TempDir dir;
+  writeFile(dir.file("file.txt"), "x");
+  const std::vector<std::string> slow = {"generate", "mandelbulb", "--resolution", "2000", "-o"};
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {concat(slow, {dir.file("missing/x.ply")}),
+       "cannot write '" + dir.file("missing/x.ply") + "': folder '" + dir.file("missing") + "' does not exist"},
+      {concat(slow, {dir.path()}), "cannot write '" + dir.path() + "': it is a folder"},
+      {concat(slow, {dir.file("x.txt")}), dir.file("x.txt") + ": unknown file type '.txt' (write .csv, .ply, .glb or .las)"},
+      {concat(slow, {dir.file("x.gltf")}), dir.file("x.gltf") + ": .gltf is read, not written; write .glb"},
+      {concat(slow, {dir.file("x.laz")}), "writing LAZ is not supported"},
+      {concat(slow, {"/sys/dpoint-test.ply"}), "'/sys/dpoint-test.ply': Permission denied"},  // even for root
+      {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
+      {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("x.gltf")}, ".gltf is read, not written"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.file("missing/x.png")}, "folder '" + dir.file("missing") + "' does not exist"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.path()}, "it is a folder"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.file("x.jpg")}, "name it .png"},
+      {{"render", dir.file("no-such-input.ply"), "-o", dir.file("x.png"), "--json", dir.file("missing/r.json")},
+       "folder '" + dir.file("missing") + "' does not exist"},
+      {{"bench", "--out", dir.file("file.txt"), "--cache", dir.file("cache")}, "--out " + dir.file("file.txt") + ": is a file, not a folder"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args[0] + " " + c.args.back());
+    test::CommandResult r = test::runCommand(concat({DPOINT_EXE}, c.args), std::chrono::seconds(20));
+    ASSERT_FALSE(r.timed_out) << "the work started";
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_TRUE(contains(r.err, "dpoint: error: ")) << r.err;
+    EXPECT_TRUE(contains(r.err, c.message)) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_EQ(dir.entries(), std::vector<std::string>{"file.txt"}) << "nothing written";
+  }
+}
+
+// One list of output formats: every format the -o help of generate and merge lists is written,
+// and the top-level help names the same four.
+TEST(CliHelp, everyListedOutputFormatIsWritten) {
+  for (const char* command : {"merge", "convert"}) {
+    test::CommandResult help = runDpoint({command, "--help"});
+    EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las)")) << command;
+  }
+  test::CommandResult help = runDpoint({"generate", "random2d", "--help"});
+  EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las)")) << help.out;
+  EXPECT_FALSE(contains(help.out, ".gltf"));
+  EXPECT_TRUE(contains(runDpoint({"--help"}).out, "CSV, PLY, GLB and LAS"));
+  TempDir dir;
+  for (const char* ext : {"csv", "ply", "glb", "las"}) {
+    test::CommandResult r = runDpoint({"generate", "random2d", "-n", "10", "-q", "-o", dir.file(std::string("p.") + ext)});
+    EXPECT_EQ(r.exit_code, 0) << ext << ": " << r.err;
+    EXPECT_TRUE(test::fileExists(dir.file(std::string("p.") + ext))) << ext;
+  }
+}
+
+}  // namespace
+}  // namespace dpoint
