@@ -60,6 +60,31 @@ Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Prog
   return bounds;
 }
 
+// A perspective fit of a 3D set frames its outline (viewer/camera.h); the ortho fit and a camera the
+// user placed do not need it, so a streamed set is read a second time only when it is used.
+bool needsOutline(const RenderRequest& request, const Bounds& bounds) {
+  const CameraSpec& spec = request.camera;
+  return !bounds.planar && !spec.eye && !spec.ortho.value_or(false);
+}
+
+// The outline of a streamed set (the same as boundsWithOutline gives the set in memory, whatever the
+// block size): a second pass, a block at a time.
+Result<std::vector<glm::dvec3>> streamOutline(const std::string& path, PointInputStream& ply, const Bounds& bounds,
+                                              Progress& progress) {
+  OutlineBuilder builder(bounds);
+  PointSet block;
+  progress.start("outline of " + path + " (points)", ply.count());
+  for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
+    const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
+    if (interrupted()) return interruptedError();
+    if (Status status = ply.read(first, n, block); !status) return status.error();
+    progress.advance(n);
+    builder.add(block.positions);
+  }
+  progress.finish();
+  return builder.finish();
+}
+
 LasColorSource lasColorOf(RenderColor color) {
   // LAS fields as colours; elevation replaces whatever the file holds.
   switch (color) {
@@ -89,6 +114,11 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
     Result<Bounds> bounds = streamBounds(inputs, *ply, progress);
     if (!bounds) return bounds.error();
     set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
+    if (needsOutline(request, set.bounds)) {
+      Result<std::vector<glm::dvec3>> outline = streamOutline(inputs, *ply, set.bounds, progress);
+      if (!outline) return outline.error();
+      set.bounds.outline = std::move(*outline);
+    }
     phases.mark("bounds");
   } else {
     ReadOptions read_options{request.threads, false, &progress, true};
@@ -103,8 +133,9 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   }
   if (request.color == RenderColor::kRgb && !set.has_colors)
     return Error{inputs + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput};
-  set.z_up = zUpFor(request);
-  if (set.points) set.bounds = boundsOf(*set.points);
+  set.z_up = zUpFor(request, set.points && set.points->z_up);
+  // The outline lets a perspective fit frame the data rather than its box's empty corners.
+  if (set.points) set.bounds = boundsWithOutline(*set.points);
   // A 2D set has no elevation: without colours its points stay white.
   set.elevation = request.color == RenderColor::kElevation ||
                   (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar);
@@ -351,16 +382,15 @@ std::vector<RenderView> viewsFor(uint32_t count, bool z_up) {
   return {{"front", {0, 0, 1}, {0, 1, 0}}, {"side", {1, 0, 0}, {0, 1, 0}}, {"top", {0, 1, 0}, {0, 0, -1}}, three_quarter};
 }
 
-bool zUpFor(const RenderRequest& request) {
+bool zUpFor(const RenderRequest& request, bool data_z_up) {
   if (request.up_axis != UpAxis::kAuto) return request.up_axis == UpAxis::kZ;
-  return std::all_of(request.inputs.begin(), request.inputs.end(),
+  return data_z_up || std::all_of(request.inputs.begin(), request.inputs.end(),
                      [](const std::string& path) { return hasExtension(path, ".las"); });
 }
 
 Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std::vector<RenderView>& views,
-                                        const Bounds& bounds) {
+                                        const Bounds& bounds, bool z_up) {
   const CameraSpec& spec = request.camera;
-  const bool z_up = zUpFor(request);
   std::vector<Camera> cameras;
   for (const RenderView& view : views) {
     CameraSpec view_spec = spec;
@@ -394,12 +424,16 @@ float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box
                    const DeviceFacts& facts) {
   if (request.point_size) return static_cast<float>(*request.point_size);
   if (request.error || request.backend == Backend::kCompute || camera.ortho || !facts.large_points) return 1.0f;
-  std::vector<glm::dvec3> corners;
-  for (int i = 0; i < 8; ++i)
-    corners.push_back({(i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z});
+  // The data's outline when the fit framed it (every one of its points is inside the picture), else
+  // the box's corners.
+  std::vector<glm::dvec3> corners = box.outline;
+  if (corners.empty()) {
+    for (int i = 0; i < 8; ++i)
+      corners.push_back({(i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z});
+  }
   double x0 = camera.width, y0 = camera.height, x1 = 0.0, y1 = 0.0;
   for (const WindowPoint& w : projectReference(corners, camera)) {
-    if (!w.visible) return 1.0f;  // the eye is inside or near the box: no outline to fill
+    if (!w.visible) return 1.0f;  // the eye is inside or near the data: no outline to fill
     x0 = std::min(x0, std::max(w.x, 0.0)), x1 = std::max(x1, std::min(w.x, double(camera.width)));
     y0 = std::min(y0, std::max(w.y, 0.0)), y1 = std::max(y1, std::min(w.y, double(camera.height)));
   }
@@ -434,7 +468,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
     return Error{set->inputs + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
                  ExitCode::kUsage};
   const std::vector<RenderView> views = viewsFor(request.views, set->z_up);
-  Result<std::vector<Camera>> cameras = viewCameras(request, views, set->bounds);
+  Result<std::vector<Camera>> cameras = viewCameras(request, views, set->bounds, set->z_up);
   if (!cameras) return cameras.error();
   outcome.phases.mark("camera");
 

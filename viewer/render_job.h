@@ -124,12 +124,13 @@ struct RenderView {
 // One view: the three-quarter one; four: front, side, top, three-quarter. Directions are in the
 // up axis's frame: with z up, "front" looks along +y and the oblique view sits in front, above.
 std::vector<RenderView> viewsFor(uint32_t count, bool z_up);
-// The up axis the request's views use (UpAxis::kAuto: z when every input is .las).
-bool zUpFor(const RenderRequest& request);
+// The up axis the request's views use (UpAxis::kAuto: z when every input is .las, or when the data
+// records z up: PointSet::z_up, a PLY written from LAS).
+bool zUpFor(const RenderRequest& request, bool data_z_up = false);
 // The camera of each view: the request's own for one y-up view, else fitted along the view's
 // direction; four views get a quarter of the picture each.
 Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std::vector<RenderView>& views,
-                                        const Bounds& bounds);
+                                        const Bounds& bounds, bool z_up);
 
 // Shading auto: eye-dome lighting for a 3D set, none for a 2D one and with --error.
 Shading shadingFor(const RenderRequest& request, const Bounds& bounds);

@@ -408,5 +408,36 @@ TEST(Camera, defaultRenderOfDeepZoomsFillsThePicture) {
   std::filesystem::remove_all(dir);
 }
 
+// The default render of a 3D set frames the data's outline, not its box: a Mandelbulb fills the
+// picture's height (its box's corners alone give ~72%), in memory and streamed alike.
+TEST(Camera, defaultRenderOfAMandelbulbFillsThePictureInMemoryAndStreamed) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("dpoint-bulb-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  MandelbulbParams params;
+  params.resolution = 64;
+  Result<PointSet> bulb = generateMandelbulb(params);
+  ASSERT_TRUE(bulb.ok()) << bulb.error().message;
+  const std::string path = (dir / "bulb.ply").string();
+  ASSERT_TRUE(writePoints(path, *bulb).ok());
+  std::vector<Image> pictures;
+  for (const char* stream : {"off", "on"}) {
+    SCOPED_TRACE(stream);
+    RenderRequest request;
+    request.inputs = {path};
+    request.stream = stream;
+    request.mode = "batch";  // a streamed set gets no prediction: auto would pick another mode
+    request.background_rgba8 = 0xffff00ffu;
+    Progress progress;
+    Result<RenderOutcome> outcome = runRenderJob(request, progress);
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message;
+    EXPECT_EQ(outcome->streamed, stream == std::string("on"));
+    EXPECT_GE(drawnSpan(outcome->image, request.background_rgba8), 0.85);
+    EXPECT_LE(drawnSpan(outcome->image, request.background_rgba8), 1.0);
+    pictures.push_back(outcome->image);
+  }
+  EXPECT_EQ(pictures[0].rgba, pictures[1].rgba);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace dpoint

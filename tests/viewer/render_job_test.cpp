@@ -25,7 +25,7 @@ DeviceFacts bigPoints() {
 }
 
 Camera cameraFor(const RenderRequest& request, const Bounds& bounds) {
-  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(1, zUpFor(request)), bounds);
+  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(1, zUpFor(request)), bounds, zUpFor(request));
   EXPECT_TRUE(cameras.ok());
   return cameras.ok() ? cameras->front() : Camera{};
 }
@@ -69,7 +69,7 @@ TEST(RenderJob, viewsAndTheirCameras) {
   RenderRequest request;
   request.views = 4;
   request.camera.width = 401, request.camera.height = 300;
-  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(4, false), cube());
+  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(4, false), cube(), false);
   ASSERT_TRUE(cameras.ok());
   ASSERT_EQ(cameras->size(), 4u);
   // A quarter less the 2-px lines, rounded down: the sheet is 401 x 300 (the odd pixel goes to a line).
@@ -83,8 +83,11 @@ TEST(RenderJob, upAxisShadingAndRequestChecks) {
   EXPECT_TRUE(zUpFor(request));
   request.inputs.push_back("c.ply");
   EXPECT_FALSE(zUpFor(request));
+  EXPECT_TRUE(zUpFor(request, true));  // the data records z up (a PLY written from LAS)
   request.up_axis = UpAxis::kZ;
   EXPECT_TRUE(zUpFor(request));
+  request.up_axis = UpAxis::kY;
+  EXPECT_FALSE(zUpFor(request, true));
 
   Bounds flat = cube();
   flat.planar = true;
