@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli/cli_check.h"
+#include "cli/cli_output.h"
 #include "cli/commands.h"
 #include "converters/gltf_read.h"
 #include "ops/point_filters.h"
@@ -133,9 +135,10 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply, .glb and .las");
   cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las)")->required();
   cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las); written whole or not at all")
-      ->required();
+      ->required()
+      ->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals,
-                  "CSV: fixed digits after the point (15 gives the seed's %.15f); default: shortest round trip, "
+                  "CSV: fixed digits after the point (15 gives the %.15f of the original study's Python generator); default: shortest round trip, "
                   "or for LAS input the file's step (scale 0.01: at most 2 digits, trailing zeros dropped)")
       ->check(CLI::Range(0, 100));
   cmd->add_flag("--ply-ascii", o->ply_ascii, "PLY: write ASCII instead of binary little-endian");

@@ -139,6 +139,8 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
       {concat(slow, {"/sys/dpoint-test.ply"}), "'/sys/dpoint-test.ply': Permission denied"},  // even for root
       {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
       {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("x.gltf")}, ".gltf is read, not written"},
+      {{"convert", dir.file("no-such-input.csv"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
+      {{"convert", dir.file("no-such-input.csv"), "-o", dir.file("x.gltf")}, ".gltf is read, not written"},
       {{"render", dir.file("no-such-input.ply"), "-o", dir.file("missing/x.png")}, "folder '" + dir.file("missing") + "' does not exist"},
       {{"render", dir.file("no-such-input.ply"), "-o", dir.path()}, "it is a folder"},
       {{"render", dir.file("no-such-input.ply"), "-o", dir.file("x.jpg")}, "name it .png"},

@@ -150,11 +150,12 @@ TEST(Cli, allowNonfiniteAcceptsNan) {
 TEST(Cli, unwritableOutputGivesClearErrorAndNoFile) {
   TempDir dir;
   writeFile(dir.file("in.csv"), "x,y,z\n1,2,3\n");
+  // -o is checked as it is parsed, before the input is read: a usage error, as for every command.
   test::CommandResult missing = runDpoint({"convert", dir.file("in.csv"), "-o", dir.file("no/where/out.csv")});
-  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("does not exist"), std::string::npos) << missing.err;
   test::CommandResult proc = runDpoint({"convert", dir.file("in.csv"), "-o", "/proc/dpoint-out.csv"});
-  EXPECT_EQ(proc.exit_code, 2);
+  EXPECT_EQ(proc.exit_code, 1);
   EXPECT_NE(proc.err.find("/proc"), std::string::npos) << proc.err;
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"in.csv"});
 }
