@@ -186,13 +186,14 @@ TEST(GltfCorpus, assimpBrokenModelsAreRefusedAndGoodOnesConvert) {
     Result<PointSet> set = readGltf(file);
     EXPECT_FALSE(set) << file;
   }
+  TempDir dir;
   test::CommandResult r = test::runDpoint({"convert", kAssimpDir + "/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb",
-                                           "-o", "/dev/null/never.csv"});
+                                           "-o", dir.file("never.csv")});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(dir.entries().empty()) << "nothing written";
   // A valid file whose scene places no mesh: an empty set, so a CSV with its header only (issue #24).
   const std::string no_scene = kAssimpDir + "/TestNoRootNode/NoScene.gltf";
-  TempDir dir;
   r = test::runDpoint({"convert", no_scene, "-o", dir.file("out.csv")});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(test::readFile(dir.file("out.csv")), "x,y,z\n");
