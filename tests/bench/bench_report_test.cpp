@@ -10,6 +10,7 @@
 #include "bench/report.h"
 #include "bench/run.h"
 #include "bench/suites.h"
+#include "test_support.h"
 
 namespace dpoint {
 namespace {
@@ -195,6 +196,111 @@ TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
   EXPECT_EQ(json.find("\"bandwidth_fraction\": 0"), std::string::npos);
   const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
   EXPECT_NE(report.find("Copy bandwidth: not measured"), std::string::npos);
+}
+
+// Frame times of one row: median, fastest frame, p95.
+struct Frames {
+  double median, min, p95;
+};
+
+// Speed datasets (not hard cases), one compute row per mode: fp32 and native timed as given, the
+// other modes as fp32.
+BenchRun speedRun(const std::vector<std::pair<Frames, Frames>>& fp32_native) {
+  BenchRun run;
+  run.cases.reserve(fp32_native.size() + 1);  // rows point into cases: room for one more, added by a test
+  for (size_t i = 0; i < fp32_native.size(); ++i) {
+    BenchCase c;
+    c.name = "set " + std::to_string(i);
+    c.family = "2D random";
+    run.cases.push_back(c);
+  }
+  for (size_t i = 0; i < fp32_native.size(); ++i) {
+    for (PrecisionMode mode : kAllModes) {
+      BenchRow row;
+      row.bench_case = &run.cases[i];
+      row.mode = mode;
+      row.backend = Backend::kCompute;
+      row.points = 10000;
+      const Frames f = mode == PrecisionMode::kNative ? fp32_native[i].second : fp32_native[i].first;
+      row.gpu_ms_median = f.median, row.gpu_ms_min = f.min, row.gpu_ms_p95 = f.p95;
+      run.rows.push_back(row);
+    }
+  }
+  return run;
+}
+
+std::string markdownOf(const BenchRun& run) {
+  return reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+}
+
+TEST(BenchReport, ratioWithinTheFramesSpreadIsNotCalledFaster) {
+  // lavapipe's 10K-point frames (bench/results/2026-11-23/lavapipe): native's median 0.75× of fp32's,
+  // but each spans the other's median.
+  const BenchRun run = speedRun({{{2.16, 0.98, 3.18}, {1.62, 0.84, 2.72}}, {{2.0, 1.0, 3.0}, {1.8, 0.9, 2.9}}});
+  const std::string report = markdownOf(run);
+  EXPECT_NE(report.find("native ≈ fp32 (within noise: median 0.8"), std::string::npos) << report;
+  EXPECT_EQ(report.find("native 0."), std::string::npos) << report;
+  EXPECT_NE(report.find("*≈ (within noise)*"), std::string::npos) << "the rule is stated";
+}
+
+TEST(BenchReport, ratioBeyondTheFramesSpreadKeepsItsNumber) {
+  // The H100's Sierpinski 16.7M, compute: native 1.13× of fp32, spans 1-2% wide and apart.
+  const BenchRun run = speedRun({{{0.1625, 0.1589, 0.1643}, {0.1834, 0.1814, 0.185}},
+                                 {{0.1625, 0.1589, 0.1643}, {0.1834, 0.1814, 0.185}}});
+  const std::string report = markdownOf(run);
+  EXPECT_NE(report.find("native 1.13× (0 of 2 faster, 2 slower beyond noise)"), std::string::npos) << report;
+  EXPECT_EQ(report.find("native ≈"), std::string::npos);
+}
+
+TEST(BenchReport, ratioIsCalledOnlyWhenMostDatasetsAgreeBeyondNoise) {
+  // One of three datasets clearly faster, two overlapping: the median is not a speed-up.
+  const BenchRun run = speedRun({{{1.0, 0.99, 1.01}, {0.5, 0.49, 0.51}},
+                                 {{1.0, 0.8, 1.2}, {0.9, 0.7, 1.1}},
+                                 {{1.0, 0.8, 1.2}, {0.95, 0.75, 1.15}}});
+  EXPECT_NE(markdownOf(run).find("native ≈ fp32 (within noise: median 0.9×, 1 of 3 faster, 0 slower beyond noise)"),
+            std::string::npos)
+      << markdownOf(run);
+}
+
+TEST(BenchReport, hostFrameTimesHaveNoSpreadAndAreNeverCalledFaster) {
+  BenchRun run = speedRun({{{1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}}});
+  for (BenchRow& row : run.rows) {
+    row.frame_ms_median = *row.gpu_ms_median;
+    row.gpu_ms_median.reset(), row.gpu_ms_min.reset(), row.gpu_ms_p95.reset();
+  }
+  EXPECT_NE(markdownOf(run).find("native ≈ fp32"), std::string::npos) << markdownOf(run);
+}
+
+TEST(BenchReport, reportCitesNothingOutsideTheRepository) {
+  // Speed cases, a hard case and a failed check: every section of report.md is written.
+  BenchRun run = speedRun({{{1.0, 0.9, 1.1}, {1.2, 1.15, 1.3}}});
+  BenchRun hard = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  ASSERT_GT(run.cases.capacity(), run.cases.size()) << "rows point into cases";
+  run.cases.push_back(hard.cases.front());
+  run.cases.back().sweep = Sweep::kOffset;
+  run.cases.back().sweep_x = 1e6;
+  for (BenchRow row : hard.rows) {
+    row.bench_case = &run.cases.back();
+    run.rows.push_back(row);
+  }
+  const std::vector<CheckFailure> failures = checkRun(run);
+  ASSERT_FALSE(failures.empty()) << "split differs from fp32";
+  test::TempDir dir;
+  Result<std::vector<std::string>> written =
+      writeReport(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, failures, dir.path());
+  ASSERT_TRUE(written) << written.error().message;
+  size_t text_files = 0;
+  for (const std::string& path : *written) {
+    if (path.ends_with(".png")) continue;
+    ++text_files;
+    const std::string text = test::readFile(path);
+    for (const char* outside : {"DESIGN", "../", "shared/", "/work/", "/tmp/"})
+      EXPECT_EQ(text.find(outside), std::string::npos) << path << " names " << outside;
+  }
+  EXPECT_GE(text_files, 3u) << "results.json, report.md, speed_vs_error.svg";
+  const std::string report = test::readFile(dir.file("report.md"));
+  EXPECT_NE(report.find("## Hard cases"), std::string::npos);
+  EXPECT_NE(report.find("docs/precision.md"), std::string::npos) << "the checks cite the repository's own page";
 }
 
 TEST(BenchSuites, paperSuiteHoldsTheStudysDatasetsWithItsFigures) {
