@@ -3,6 +3,8 @@
 // hold the datasets and sweeps the issue lists. The real runs are in external/bench_ci_suite.py.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -309,14 +311,68 @@ TEST(BenchSuites, paperSuiteHoldsTheStudysDatasetsWithItsFigures) {
   for (const BenchCase& c : paper) labels.push_back(c.size_label);
   EXPECT_EQ(labels, (std::vector<std::string>{"10K", "100K", "1M", "10M", "200K", "2M", "200K", "1.85M", "5M", "11.9M",
                                               "1M", "16.7M", "1.4M"}));
-  size_t with_figures = 0;
   for (const BenchCase& c : paper) {
     EXPECT_EQ(c.width, 1920u);
     EXPECT_EQ(c.height, 1080u);
     EXPECT_FALSE(c.hard);
-    with_figures += c.study.has_value();
   }
-  EXPECT_EQ(with_figures, 2u) << "the study's 10M 2D and 16.7M Sierpinski figures";
+}
+
+// The study's Tables 2 and 3 as printed (Sözen, "Double-Precision Floating-Point Data Visualizations
+// Using Vulkan API"), typed again from the paper so a slip in bench/suites.cpp shows: case, then
+// emulated ms and fps (Table 2), native ms and fps (Table 3).
+const std::vector<std::array<std::string, 5>> kStudyRows = {
+    {"Mandelbulb 200K", "9.71", "729", "11.87", "842"},     {"Menger 200K", "12.9", "703", "14.88", "804"},
+    {"Sierpinski 1M", "32.19", "745", "35.26", "789"},      {"Julia 1.4M", "35.26", "717", "39.26", "802"},
+    {"Menger 1.85M", "36.69", "612", "31.12.16", "763"},    {"Mandelbulb 2M", "53.19", "687", "42.68", "854"},
+    {"Menger 5M", "239.73", "698", "189.25", "802"},        {"Menger 11.9M", "499.12", "468", "471.29", "593"},
+    {"Sierpinski 16.7M", "722.89", "115", "695.76", "330"},
+};
+
+TEST(BenchSuites, paperSuiteCarriesEveryRowOfTheStudysTablesTwoAndThree) {
+  const std::vector<BenchCase> paper = suiteCases(BenchSuite::kPaper);
+  for (const auto& [name, emulated_ms, emulated_fps, native_ms, native_fps] : kStudyRows) {
+    auto it = std::find_if(paper.begin(), paper.end(), [&](const BenchCase& c) { return c.name == name; });
+    ASSERT_NE(it, paper.end()) << name;
+    ASSERT_TRUE(it->study) << name;
+    EXPECT_EQ(it->study->emulated.rendering_time_ms, emulated_ms) << name;
+    EXPECT_EQ(it->study->emulated.fps, emulated_fps) << name;
+    EXPECT_EQ(it->study->native.rendering_time_ms, native_ms) << name;
+    EXPECT_EQ(it->study->native.fps, native_fps) << name;
+  }
+  size_t with_figures = 0;
+  for (const BenchCase& c : paper) with_figures += c.study.has_value();
+  EXPECT_EQ(with_figures, kStudyRows.size() + 1) << "and the 10M 2D set's caption";
+}
+
+TEST(BenchReport, everyPaperRowShowsBothColumnsOfBothStudyTables) {
+  BenchRun run;
+  run.cases = suiteCases(BenchSuite::kPaper);
+  for (const BenchCase& c : run.cases) {
+    for (PrecisionMode mode : kAllModes) {
+      BenchRow row;
+      row.bench_case = &c;
+      row.mode = mode;
+      row.backend = Backend::kCompute;
+      row.points = 1000000;
+      row.gpu_ms_median = row.gpu_ms_min = row.gpu_ms_p95 = 1.0;
+      run.rows.push_back(row);
+    }
+  }
+  const std::string report = markdownOf(run);
+  for (const auto& [name, emulated_ms, emulated_fps, native_ms, native_fps] : kStudyRows) {
+    const size_t at = report.find("| " + name + " |");
+    ASSERT_NE(at, std::string::npos) << name;
+    const std::string line = report.substr(at, report.find('\n', at) - at);
+    EXPECT_NE(line.find("| " + emulated_ms + " ms, " + emulated_fps + " fps | " + native_ms + " ms, " + native_fps +
+                        " fps |"),
+              std::string::npos)
+        << line;
+  }
+  EXPECT_NE(report.find("| 2D random 10M |"), std::string::npos);
+  EXPECT_NE(report.find("| –, 218 fps (figure caption) |"), std::string::npos) << report;
+  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(json.find("\"native\": {\"rendering_time_ms\": \"31.12.16\", \"fps\": \"763\"}"), std::string::npos);
 }
 
 TEST(BenchSuites, hardSuiteSweepsEveryDecade) {
