@@ -282,13 +282,13 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
       }
     }
   }
-  s += "\n## Checks\n\nWhat each mode's arithmetic predicts (docs/precision.md): ";
+  s += "\n## Checks\n\nWhat each mode's arithmetic predicts (docs/precision.md).\n\n";
   if (failures.empty()) {
-    s += "all passed: every measured error is within its predicted bound; split equals fp32; native is the most "
+    s += "All passed: every measured error is within its predicted bound; split equals fp32; native is the most "
          "accurate mode within one float floor; where fp32 is off by more than a pixel, rte, df64, native and batch "
          "all do better.\n";
   } else {
-    s += std::to_string(failures.size()) + " failed.\n\n| case | backend | mode | what |\n| --- | --- | --- | --- |\n";
+    s += std::to_string(failures.size()) + " failed:\n\n| case | backend | mode | what |\n| --- | --- | --- | --- |\n";
     for (const CheckFailure& f : failures) s += "| " + f.case_name + " | " + f.backend + " | " + f.mode + " | " + f.what + " |\n";
   }
   s += "\n## Every run\n\n| suite | case | backend | mode | points | GPU ms (median / p95) | e2e ms | points/s | B/pt | "
