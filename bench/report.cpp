@@ -122,8 +122,14 @@ std::string rowJson(const BenchRun& run, const BenchRow& r) {
                                                        : "{\"kind\": " + jsonString(sweepName(c.sweep)) + ", \"x\": " +
                                                              num(c.sweep_x) + "}");
   if (c.study) {
-    s += ", \"study_rtx3090_fps\": {\"native\": " + optNum(c.study->native_fps) + ", \"emulated\": " +
-         optNum(c.study->emulated_fps) + ", \"mode_not_stated\": " + optNum(c.study->unspecified_fps) + "}";
+    // Text as the paper prints it (one cell is "31.12.16"), null where it prints nothing.
+    const auto cell = [](const std::string& text) { return text.empty() ? std::string("null") : jsonString(text); };
+    const auto cells = [&](const StudyCells& row) {
+      return row.empty() ? std::string("null")
+                         : "{\"rendering_time_ms\": " + cell(row.rendering_time_ms) + ", \"fps\": " + cell(row.fps) + "}";
+    };
+    s += ",\n     \"study_rtx3090\": {\"source\": " + jsonString(c.study->source) +
+         ", \"emulated\": " + cells(c.study->emulated) + ", \"native\": " + cells(c.study->native) + "}";
   }
   return s + "}";
 }

@@ -19,7 +19,7 @@ struct ReportContext {
   std::string version;  // dpoint's
 };
 
-// A broken expectation of DESIGN §4–5: a measured error above its predicted bound, split not equal
+// A broken expectation of the modes' arithmetic (docs/precision.md): a measured error above its predicted bound, split not equal
 // to fp32, native not the most accurate (within one float floor), or a mode no better than fp32
 // where fp32 is off by more than a pixel.
 struct CheckFailure {

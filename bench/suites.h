@@ -1,4 +1,4 @@
-// What `dpoint bench` runs (issue #10, DESIGN §5–7): the suites as lists of cases. A case is one
+// What `dpoint bench` runs (issue #10; docs/performance.md): the suites as lists of cases. A case is one
 // dataset, made by `dpoint generate` with the arguments given here (or written out literally for the
 // degenerate sets no generator makes), seen from one view at one resolution. Every case is run in
 // every precision mode on every backend asked for; each run is timed and measured against the
@@ -6,7 +6,7 @@
 //
 //   ci     small sets of every family and small versions of the hard cases: minutes on lavapipe
 //   paper  the study's datasets at its sizes, 1920×1080, with its RTX 3090 figures beside ours
-//   hard   DESIGN §7: the offset sweep 1e0 … 1e8 (and the Earth's radius), the deep-zoom sweep
+//   hard   docs/precision.md, the hard cases: the offset sweep 1e0 … 1e8 (and the Earth's radius), the deep-zoom sweep
 //          1e-1 … 1e-15, tiny (1e-40, 1e-300), the Mandelbulb through its origin, degenerate sets
 #pragma once
 
@@ -37,10 +37,20 @@ struct BenchView {
   double window_width = 0.0;
 };
 
-// The study's RTX 3090 figures for a dataset (frames per second at its resolution), where the
-// study gives them; `unspecified` when it does not say which of its two paths it measured.
+// One row of the study's tables for one precision path, both columns as the paper prints them
+// (text, not numbers: one cell reads "31.12.16"); empty where it prints nothing.
+struct StudyCells {
+  std::string rendering_time_ms;  // "Rendering Time": the paper does not say what it covers
+  std::string fps;                // "Frame Rate": the column to compare our per-frame time with
+  bool empty() const { return rendering_time_ms.empty() && fps.empty(); }
+};
+
+// The study's RTX 3090 figures for a dataset: Table 2 (emulated double, its float hi/lo split) and
+// Table 3 (native double), or, for the 10M 2D set, the native frame rate a figure caption gives.
 struct StudyFigures {
-  std::optional<double> native_fps, emulated_fps, unspecified_fps;
+  StudyCells emulated;  // Table 2
+  StudyCells native;    // Table 3
+  std::string source;   // "Tables 2 and 3", "figure caption"
 };
 
 // The sweeps breakdown.svg draws: x is the view width (deep zoom) or the offset.
@@ -58,7 +68,7 @@ struct BenchCase {
   Sweep sweep = Sweep::kNone;
   double sweep_x = 0.0;
   std::optional<StudyFigures> study;
-  bool hard = false;     // one of DESIGN §7's hard cases (reported by error), not a speed dataset
+  bool hard = false;     // one of the hard cases (docs/precision.md) (reported by error), not a speed dataset
   bool montage = false;  // the view montage.png shows in every mode
 };
 

@@ -4,15 +4,21 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 
 #include <stb/stb_easy_font.h>  // a system include: its casts and unused statics stay quiet
 
 namespace dpoint {
 namespace {
 
-
-
 constexpr int kMaxGlyphQuads = 64;
+
+// stb_easy_font's 0 is a 4-unit oval with a 2-unit slash in its middle rows (#.## over ##.#),
+// which at the montage's sizes fills the middle as 8's waist does: the numbers on the error scale
+// read 8 for 0. This one is drawn instead: one unit wider (5 of the 6 units stb advances, so text
+// widths do not change), its slash running corner to corner through an open middle, and its sides
+// unbroken where 8 pinches in. '#': a unit drawn; rows from the top, as stb's glyphs start.
+constexpr const char* kZeroRows[] = {".###.", "#...#", "#..##", "#.#.#", "##..#", "#...#", ".###."};
 
 // stb's characters outside ' '..'~' would index past its glyph table.
 char printable(char c) { return c >= ' ' && c <= '~' ? c : '?'; }
@@ -58,6 +64,18 @@ int drawTextClipped(Image& image, Rect clip, int x, int y, const std::string& te
       continue;
     }
     char glyph[2] = {printable(raw), 0};
+    if (glyph[0] == '0') {
+      for (int row = 0; row < int(std::size(kZeroRows)); ++row) {
+        for (int col = 0; kZeroRows[row][col]; ++col) {
+          if (kZeroRows[row][col] != '#') continue;
+          const int ux = x + (pen_x + col) * scale, uy = y + (pen_y + row) * scale;
+          fillRect(image, {ux, uy, ux + scale, uy + scale}, clip, rgba8);
+        }
+      }
+      pen_x += stb_easy_font_width(glyph);
+      widest = std::max(widest, pen_x);
+      continue;
+    }
     struct Vertex {
       float x, y, z;
       uint8_t color[4];

@@ -3,6 +3,8 @@
 // hold the datasets and sweeps the issue lists. The real runs are in external/bench_ci_suite.py.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -10,6 +12,7 @@
 #include "bench/report.h"
 #include "bench/run.h"
 #include "bench/suites.h"
+#include "test_support.h"
 
 namespace dpoint {
 namespace {
@@ -197,20 +200,179 @@ TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
   EXPECT_NE(report.find("Copy bandwidth: not measured"), std::string::npos);
 }
 
+// Frame times of one row: median, fastest frame, p95.
+struct Frames {
+  double median, min, p95;
+};
+
+// Speed datasets (not hard cases), one compute row per mode: fp32 and native timed as given, the
+// other modes as fp32.
+BenchRun speedRun(const std::vector<std::pair<Frames, Frames>>& fp32_native) {
+  BenchRun run;
+  run.cases.reserve(fp32_native.size() + 1);  // rows point into cases: room for one more, added by a test
+  for (size_t i = 0; i < fp32_native.size(); ++i) {
+    BenchCase c;
+    c.name = "set " + std::to_string(i);
+    c.family = "2D random";
+    run.cases.push_back(c);
+  }
+  for (size_t i = 0; i < fp32_native.size(); ++i) {
+    for (PrecisionMode mode : kAllModes) {
+      BenchRow row;
+      row.bench_case = &run.cases[i];
+      row.mode = mode;
+      row.backend = Backend::kCompute;
+      row.points = 10000;
+      const Frames f = mode == PrecisionMode::kNative ? fp32_native[i].second : fp32_native[i].first;
+      row.gpu_ms_median = f.median, row.gpu_ms_min = f.min, row.gpu_ms_p95 = f.p95;
+      run.rows.push_back(row);
+    }
+  }
+  return run;
+}
+
+std::string markdownOf(const BenchRun& run) {
+  return reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+}
+
+TEST(BenchReport, ratioWithinTheFramesSpreadIsNotCalledFaster) {
+  // lavapipe's 10K-point frames (bench/results/2026-11-23/lavapipe): native's median 0.75× of fp32's,
+  // but each spans the other's median.
+  const BenchRun run = speedRun({{{2.16, 0.98, 3.18}, {1.62, 0.84, 2.72}}, {{2.0, 1.0, 3.0}, {1.8, 0.9, 2.9}}});
+  const std::string report = markdownOf(run);
+  EXPECT_NE(report.find("native ≈ fp32 (within noise: median 0.8"), std::string::npos) << report;
+  EXPECT_EQ(report.find("native 0."), std::string::npos) << report;
+  EXPECT_NE(report.find("*≈ (within noise)*"), std::string::npos) << "the rule is stated";
+}
+
+TEST(BenchReport, ratioBeyondTheFramesSpreadKeepsItsNumber) {
+  // The H100's Sierpinski 16.7M, compute: native 1.13× of fp32, spans 1-2% wide and apart.
+  const BenchRun run = speedRun({{{0.1625, 0.1589, 0.1643}, {0.1834, 0.1814, 0.185}},
+                                 {{0.1625, 0.1589, 0.1643}, {0.1834, 0.1814, 0.185}}});
+  const std::string report = markdownOf(run);
+  EXPECT_NE(report.find("native 1.13× (0 of 2 faster, 2 slower beyond noise)"), std::string::npos) << report;
+  EXPECT_EQ(report.find("native ≈"), std::string::npos);
+}
+
+TEST(BenchReport, ratioIsCalledOnlyWhenMostDatasetsAgreeBeyondNoise) {
+  // One of three datasets clearly faster, two overlapping: the median is not a speed-up.
+  const BenchRun run = speedRun({{{1.0, 0.99, 1.01}, {0.5, 0.49, 0.51}},
+                                 {{1.0, 0.8, 1.2}, {0.9, 0.7, 1.1}},
+                                 {{1.0, 0.8, 1.2}, {0.95, 0.75, 1.15}}});
+  EXPECT_NE(markdownOf(run).find("native ≈ fp32 (within noise: median 0.9×, 1 of 3 faster, 0 slower beyond noise)"),
+            std::string::npos)
+      << markdownOf(run);
+}
+
+TEST(BenchReport, hostFrameTimesHaveNoSpreadAndAreNeverCalledFaster) {
+  BenchRun run = speedRun({{{1.0, 1.0, 1.0}, {0.5, 0.5, 0.5}}});
+  for (BenchRow& row : run.rows) {
+    row.frame_ms_median = *row.gpu_ms_median;
+    row.gpu_ms_median.reset(), row.gpu_ms_min.reset(), row.gpu_ms_p95.reset();
+  }
+  EXPECT_NE(markdownOf(run).find("native ≈ fp32"), std::string::npos) << markdownOf(run);
+}
+
+TEST(BenchReport, reportCitesNothingOutsideTheRepository) {
+  // Speed cases, a hard case and a failed check: every section of report.md is written.
+  BenchRun run = speedRun({{{1.0, 0.9, 1.1}, {1.2, 1.15, 1.3}}});
+  BenchRun hard = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  ASSERT_GT(run.cases.capacity(), run.cases.size()) << "rows point into cases";
+  run.cases.push_back(hard.cases.front());
+  run.cases.back().sweep = Sweep::kOffset;
+  run.cases.back().sweep_x = 1e6;
+  for (BenchRow row : hard.rows) {
+    row.bench_case = &run.cases.back();
+    run.rows.push_back(row);
+  }
+  const std::vector<CheckFailure> failures = checkRun(run);
+  ASSERT_FALSE(failures.empty()) << "split differs from fp32";
+  test::TempDir dir;
+  Result<std::vector<std::string>> written =
+      writeReport(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, failures, dir.path());
+  ASSERT_TRUE(written) << written.error().message;
+  size_t text_files = 0;
+  for (const std::string& path : *written) {
+    if (path.ends_with(".png")) continue;
+    ++text_files;
+    const std::string text = test::readFile(path);
+    for (const char* outside : {"DESIGN", "../", "shared/", "/work/", "/tmp/"})
+      EXPECT_EQ(text.find(outside), std::string::npos) << path << " names " << outside;
+  }
+  EXPECT_GE(text_files, 3u) << "results.json, report.md, speed_vs_error.svg";
+  const std::string report = test::readFile(dir.file("report.md"));
+  EXPECT_NE(report.find("## Hard cases"), std::string::npos);
+  EXPECT_NE(report.find("docs/precision.md"), std::string::npos) << "the checks cite the repository's own page";
+}
+
 TEST(BenchSuites, paperSuiteHoldsTheStudysDatasetsWithItsFigures) {
   const std::vector<BenchCase> paper = suiteCases(BenchSuite::kPaper);
   std::vector<std::string> labels;
   for (const BenchCase& c : paper) labels.push_back(c.size_label);
   EXPECT_EQ(labels, (std::vector<std::string>{"10K", "100K", "1M", "10M", "200K", "2M", "200K", "1.85M", "5M", "11.9M",
                                               "1M", "16.7M", "1.4M"}));
-  size_t with_figures = 0;
   for (const BenchCase& c : paper) {
     EXPECT_EQ(c.width, 1920u);
     EXPECT_EQ(c.height, 1080u);
     EXPECT_FALSE(c.hard);
-    with_figures += c.study.has_value();
   }
-  EXPECT_EQ(with_figures, 2u) << "the study's 10M 2D and 16.7M Sierpinski figures";
+}
+
+// The study's Tables 2 and 3 as printed (Sözen, "Double-Precision Floating-Point Data Visualizations
+// Using Vulkan API"), typed again from the paper so a slip in bench/suites.cpp shows: case, then
+// emulated ms and fps (Table 2), native ms and fps (Table 3).
+const std::vector<std::array<std::string, 5>> kStudyRows = {
+    {"Mandelbulb 200K", "9.71", "729", "11.87", "842"},     {"Menger 200K", "12.9", "703", "14.88", "804"},
+    {"Sierpinski 1M", "32.19", "745", "35.26", "789"},      {"Julia 1.4M", "35.26", "717", "39.26", "802"},
+    {"Menger 1.85M", "36.69", "612", "31.12.16", "763"},    {"Mandelbulb 2M", "53.19", "687", "42.68", "854"},
+    {"Menger 5M", "239.73", "698", "189.25", "802"},        {"Menger 11.9M", "499.12", "468", "471.29", "593"},
+    {"Sierpinski 16.7M", "722.89", "115", "695.76", "330"},
+};
+
+TEST(BenchSuites, paperSuiteCarriesEveryRowOfTheStudysTablesTwoAndThree) {
+  const std::vector<BenchCase> paper = suiteCases(BenchSuite::kPaper);
+  for (const auto& [name, emulated_ms, emulated_fps, native_ms, native_fps] : kStudyRows) {
+    auto it = std::find_if(paper.begin(), paper.end(), [&](const BenchCase& c) { return c.name == name; });
+    ASSERT_NE(it, paper.end()) << name;
+    ASSERT_TRUE(it->study) << name;
+    EXPECT_EQ(it->study->emulated.rendering_time_ms, emulated_ms) << name;
+    EXPECT_EQ(it->study->emulated.fps, emulated_fps) << name;
+    EXPECT_EQ(it->study->native.rendering_time_ms, native_ms) << name;
+    EXPECT_EQ(it->study->native.fps, native_fps) << name;
+  }
+  size_t with_figures = 0;
+  for (const BenchCase& c : paper) with_figures += c.study.has_value();
+  EXPECT_EQ(with_figures, kStudyRows.size() + 1) << "and the 10M 2D set's caption";
+}
+
+TEST(BenchReport, everyPaperRowShowsBothColumnsOfBothStudyTables) {
+  BenchRun run;
+  run.cases = suiteCases(BenchSuite::kPaper);
+  for (const BenchCase& c : run.cases) {
+    for (PrecisionMode mode : kAllModes) {
+      BenchRow row;
+      row.bench_case = &c;
+      row.mode = mode;
+      row.backend = Backend::kCompute;
+      row.points = 1000000;
+      row.gpu_ms_median = row.gpu_ms_min = row.gpu_ms_p95 = 1.0;
+      run.rows.push_back(row);
+    }
+  }
+  const std::string report = markdownOf(run);
+  for (const auto& [name, emulated_ms, emulated_fps, native_ms, native_fps] : kStudyRows) {
+    const size_t at = report.find("| " + name + " |");
+    ASSERT_NE(at, std::string::npos) << name;
+    const std::string line = report.substr(at, report.find('\n', at) - at);
+    EXPECT_NE(line.find("| " + emulated_ms + " ms, " + emulated_fps + " fps | " + native_ms + " ms, " + native_fps +
+                        " fps |"),
+              std::string::npos)
+        << line;
+  }
+  EXPECT_NE(report.find("| 2D random 10M |"), std::string::npos);
+  EXPECT_NE(report.find("| –, 218 fps (figure caption) |"), std::string::npos) << report;
+  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(json.find("\"native\": {\"rendering_time_ms\": \"31.12.16\", \"fps\": \"763\"}"), std::string::npos);
 }
 
 TEST(BenchSuites, hardSuiteSweepsEveryDecade) {

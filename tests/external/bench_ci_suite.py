@@ -141,5 +141,7 @@ with scratch() as d:
     for case in cases:
         check(f"| {case} |" in report, f"report.md has no row for {case}")
     check("## Checks" in report and "All passed" in report, "report.md lacks its checks")
+    for outside in ("DESIGN", "../", "shared/"):
+        check(outside not in report, f"report.md names {outside!r}, outside the repository")
     check("- Copy bandwidth: **" in report and "% of bound" in report, "report.md lacks the copy bandwidth or % of bound")
 print(f"bench ci suite: {len(rows)} rows checked")

@@ -104,6 +104,34 @@ TEST(Canvas, drawTextMarksPixelsAndClipsAtEdges) {
   EXPECT_EQ(countColor(outside, kBlack), 36u);
 }
 
+// Which units of a 6×7 cell one character lights at scale 1, row by row ('#': lit).
+std::vector<std::string> glyphRows(char c) {
+  const uint32_t white = rgba(255, 255, 255);
+  Image image = filled(6, 7, kBlack);
+  drawText(image, 0, 0, std::string(1, c), white, 1);
+  std::vector<std::string> rows(7, std::string(6, '.'));
+  for (uint32_t y = 0; y < 7; ++y)
+    for (uint32_t x = 0; x < 6; ++x)
+      if (pixel(image, x, y) == white) rows[y][x] = '#';
+  return rows;
+}
+
+TEST(Canvas, zeroDiffersFromEightInItsSidesAndMiddle) {
+  // stb_easy_font's own 0 differs from its 8 in 4 units, all in the middle: it read as 8.
+  const std::vector<std::string> zero = glyphRows('0'), eight = glyphRows('8');
+  size_t differing = 0;
+  for (size_t y = 0; y < 7; ++y)
+    for (size_t x = 0; x < 6; ++x) differing += zero[y][x] != eight[y][x];
+  EXPECT_GE(differing, 10u) << ::testing::PrintToString(zero) << " against " << ::testing::PrintToString(eight);
+  // Its sides run unbroken from the second row to the sixth, where 8 pinches in at its waist.
+  for (size_t y = 1; y <= 5; ++y) EXPECT_EQ(zero[y][0], '#') << "row " << y;
+  EXPECT_EQ(eight[3][0], '.');
+  // Still the same advance, so labels keep their widths.
+  EXPECT_EQ(textWidth("0", 1), textWidth("8", 1));
+  // And not the letter O, which has no slash through its middle.
+  EXPECT_NE(zero, glyphRows('O'));
+}
+
 TEST(Canvas, textWidthTakesTheWidestLineAndDrawsUnprintableAsQuestionMark) {
   EXPECT_EQ(textWidth("ab\nabcd", 1), textWidth("abcd", 1));
   EXPECT_EQ(textWidth("abcd", 3), 3 * textWidth("abcd", 1));
