@@ -1,6 +1,8 @@
 #include "cli/cli_generate_output.h"
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "cli/cli_check.h"
 #include "cli/cli_output.h"
@@ -76,7 +78,10 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
+  std::vector<std::string> write_notices;
+  w.notices = &write_notices;
   if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
+  for (const std::string& notice : write_notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   if (!o.common.quiet)
     std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles\n",
                  generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3);

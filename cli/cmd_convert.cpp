@@ -124,7 +124,10 @@ int runConvert(ConvertOptions& o) {
       return reportError(s.error());
   }
   reorderPoints(*points, *order, o.common.threads, &progress);
+  std::vector<std::string> write_notices;
+  w.notices = &write_notices;
   if (Status s = writePoints(o.output, *points, w); !s) return reportError(s.error());
+  for (const std::string& notice : write_notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // dpoint merge TILE... -o OUT: the parts of `dpoint generate KIND --tile I/N` welded into the file
 // one `dpoint generate KIND` writes with the same output options, byte for byte (converters/tile_file.h).
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,7 +50,10 @@ int runMerge(const MergeOptions& o) {
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
+  std::vector<std::string> write_notices;
+  w.notices = &write_notices;
   if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
+  for (const std::string& notice : write_notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   return 0;
 }
 

@@ -22,6 +22,7 @@
 
 #include "converters/gltf_accessor.h"
 #include "converters/gltf_load.h"
+#include "converters/gltf_position.h"
 #include "core/interrupt.h"
 #include "core/memory.h"
 
@@ -56,9 +57,23 @@ bool allFinite(const std::vector<double>& values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
-// Vertex e of a POSITION accessor in world space.
-glm::dvec3 placeVertex(const AccessorElements& positions, const glm::dmat4& world, size_t e) {
-  return glm::dvec3(world * glm::dvec4(positions.value(e, 0), positions.value(e, 1), positions.value(e, 2), 1.0));
+// A primitive's positions: POSITION and, in a file dpoint wrote, the float32 residuals that make
+// them exact (gltf_position.h). Files without _POSITION_LOW are read exactly as before.
+struct PositionParts {
+  AccessorElements hi;
+  std::optional<AccessorElements> mid, lo;
+
+  glm::dvec3 local(size_t e) const {
+    if (!mid) return glm::dvec3(hi.value(e, 0), hi.value(e, 1), hi.value(e, 2));
+    glm::dvec3 v;
+    for (int k = 0; k < 3; ++k) v[k] = joinGltfPositionParts(hi.value(e, k), mid->value(e, k), lo ? lo->value(e, k) : 0.0);
+    return v;
+  }
+};
+
+// Vertex e in world space.
+glm::dvec3 placeVertex(const PositionParts& positions, const glm::dmat4& world, size_t e) {
+  return placeGltfVertex(world, positions.local(e));
 }
 
 // Linear colour (spec §3.7.2.1); alpha is dropped.
@@ -321,6 +336,51 @@ class SceneReader {
     return okStatus();
   }
 
+  // POSITION checked (VEC3; float or, with KHR_mesh_quantization, (u)byte or (u)short), and
+  // dpoint's residual attributes when present: float VEC3 of POSITION's count, POSITION float.
+  Result<PositionParts> openPositions(const tinygltf::Primitive& primitive, int position_index,
+                                      const std::string& pointer) const {
+    Result<AccessorElements> hi = decoder_.open(position_index);
+    if (!hi) return hi.error();
+    const int ct = hi->componentType();
+    // KHR_mesh_quantization admits (u)byte and (u)short, normalized or not; core glTF only float.
+    if (hi->components() != 3 || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      return decoder_.fail(position_index, "POSITION must be VEC3 of float, (u)byte or (u)short, not " +
+                                               std::to_string(hi->components()) + " components of type " +
+                                               std::to_string(ct));
+    PositionParts parts{std::move(*hi), std::nullopt, std::nullopt};
+    const auto low_it = primitive.attributes.find(kGltfPositionLow);
+    const auto low2_it = primitive.attributes.find(kGltfPositionLow2);
+    if (low_it == primitive.attributes.end()) {
+      if (low2_it != primitive.attributes.end())
+        return fail(pointer + "/attributes/" + kGltfPositionLow2 + ": present without " + kGltfPositionLow);
+      return parts;
+    }
+    if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT || parts.hi.normalized())
+      return decoder_.fail(position_index, std::string("POSITION must be float when ") + kGltfPositionLow +
+                                               " is present, not componentType " + std::to_string(ct));
+    const auto openResidual = [&](const char* name, int index) -> Result<AccessorElements> {
+      Result<AccessorElements> residual = decoder_.open(index);
+      if (!residual) return residual.error();
+      if (residual->components() != 3 || residual->componentType() != TINYGLTF_COMPONENT_TYPE_FLOAT ||
+          residual->normalized())
+        return decoder_.fail(index, std::string(name) + " must be VEC3 of float, like POSITION");
+      if (residual->count() != parts.hi.count())
+        return decoder_.fail(index, std::string(name) + " count " + std::to_string(residual->count()) +
+                                        " differs from POSITION count " + std::to_string(parts.hi.count()));
+      return residual;
+    };
+    Result<AccessorElements> mid = openResidual(kGltfPositionLow, low_it->second);
+    if (!mid) return mid.error();
+    parts.mid = std::move(*mid);
+    if (low2_it != primitive.attributes.end()) {
+      Result<AccessorElements> lo = openResidual(kGltfPositionLow2, low2_it->second);
+      if (!lo) return lo.error();
+      parts.lo = std::move(*lo);
+    }
+    return parts;
+  }
+
   // The primitive's index accessor, checked (unsigned SCALAR, each element < vertex_count), with
   // the vertices it names marked in `remap` (sized vertex_count, kUnused elsewhere); nullopt when
   // the primitive is not indexed. The elements are read again for triangles rather than kept as
@@ -355,15 +415,9 @@ class SceneReader {
     const auto position_it = primitive.attributes.find("POSITION");
     if (position_it == primitive.attributes.end()) return okStatus();  // nothing to place
     const int position_index = position_it->second;
-    Result<AccessorElements> positions = decoder_.open(position_index);
+    Result<PositionParts> positions = openPositions(primitive, position_index, pointer);
     if (!positions) return positions.error();
-    const int ct = positions->componentType();
-    // KHR_mesh_quantization admits (u)byte and (u)short, normalized or not; core glTF only float.
-    if (positions->components() != 3 || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-      return decoder_.fail(position_index, "POSITION must be VEC3 of float, (u)byte or (u)short, not " +
-                                               std::to_string(positions->components()) + " components of type " +
-                                               std::to_string(ct));
-    const size_t count = positions->count();
+    const size_t count = positions->hi.count();
 
     // Which vertices the primitive references, renumbered in vertex order.
     std::vector<uint32_t> remap;
@@ -391,8 +445,8 @@ class SceneReader {
       if (!remap.empty() && remap[e] == kUnused) continue;
       const glm::dvec3 w = placeVertex(*positions, world, e);
       if (!options_.allow_nonfinite && (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))) {
-        const bool local_finite =
-            std::isfinite(positions->value(e, 0) + positions->value(e, 1) + positions->value(e, 2));
+        const glm::dvec3 local = positions->local(e);
+        const bool local_finite = std::isfinite(local.x + local.y + local.z);
         return decoder_.fail(position_index, "POSITION element " + std::to_string(e) + " is not finite" +
                                                  (local_finite ? " in world space" : ""));
       }
@@ -488,7 +542,7 @@ class SceneReader {
   // The emitting pass: the primitive's points (and colours, when the checking pass found any) in
   // the build pass's order. The checking pass made every check on the same data, so none fails.
   Status emitPrimitive(const tinygltf::Primitive& primitive, const std::string& pointer,
-                       const AccessorElements& positions, const std::vector<uint32_t>& remap, const glm::dmat4& world) {
+                       const PositionParts& positions, const std::vector<uint32_t>& remap, const glm::dmat4& world) {
     std::optional<AccessorElements> colours;
     glm::vec3 fill(1.0f);
     if (any_colour_) {
@@ -503,7 +557,7 @@ class SceneReader {
         fill = *material;
       }
     }
-    for (size_t e = 0; e < positions.count(); ++e) {
+    for (size_t e = 0; e < positions.hi.count(); ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
       block_.positions.push_back(placeVertex(positions, world, e));
       if (any_colour_) block_.colors.push_back(colours ? vertexColour(*colours, e) : fill);

@@ -7,6 +7,9 @@
 //   A mesh used by several nodes is emitted once per node, and once per instance of a node with
 //   EXT_mesh_gpu_instancing (node world matrix · instance T·R·S). Skins are ignored (bind pose:
 //   the node transform applies); morph targets are ignored.
+// - A primitive with dpoint's _POSITION_LOW (and _POSITION_LOW2) float VEC3 residuals of its
+//   float POSITION has local positions (POSITION + LOW) + LOW2 in double, exact for files dpoint
+//   wrote (gltf_position.h); other files are read from POSITION alone.
 // - Per primitive, the vertices it references: all of POSITION when not indexed, else each
 //   vertex some index names, once, in vertex order. Triangle modes keep their triangles
 //   (TRIANGLE_STRIP and TRIANGLE_FAN become triangle lists); points and lines are points.

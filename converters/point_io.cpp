@@ -113,7 +113,17 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     case FileFormat::kGlb:
       if (points.positions.empty())  // named here: writeGlb's message does not know the path
         return Error{path + ": " + writeGlb(path, points).error().message};
-      return writeGlb(path, points);
+    {
+      GlbWriteReport report;
+      if (Status s = writeGlb(path, points, &report); !s) return s;
+      if (report.inexact_points != 0 && options.notices)
+        options.notices->push_back(
+            path + ": " + std::to_string(report.inexact_points) + " of " + std::to_string(points.size()) +
+            " points will not read back bit-exactly (their offsets on one axis span more than float32's exponent "
+            "range, or a coordinate is -0.0); they are within float precision of the extent. Write .ply or .csv "
+            "to keep every double");
+      return okStatus();
+    }
     case FileFormat::kGltf:
       return Error{path + ": writing .gltf is not supported; write .glb", ExitCode::kUsage};
     case FileFormat::kLas:

@@ -40,6 +40,9 @@ struct WriteOptions {
   PlyColorType ply_colors = PlyColorType::kUchar;
   Progress* progress = nullptr;
   double las_scale = 0.001;  // LAS: the coordinate step for x, y and z (converters/las.h)
+  // When not null, gets one line per thing the file cannot hold as given (GLB: points that will
+  // not read back bit-exactly).
+  std::vector<std::string>* notices = nullptr;
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});

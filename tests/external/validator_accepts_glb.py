@@ -1,7 +1,9 @@
 """The official Khronos glTF validator (npm gltf-validator) finds 0 errors and 0 warnings in the
-GLB files dpoint writes: point sets (POINTS) and meshes (TRIANGLES)."""
+GLB files dpoint writes: point sets (POINTS) and meshes (TRIANGLES), with the exact-position
+attributes _POSITION_LOW and _POSITION_LOW2 and, for data beyond float32's range, a node scale."""
 import json
 import os
+import struct
 import subprocess
 import sys
 
@@ -29,6 +31,23 @@ with scratch() as d:
     write_mesh_ply(os.path.join(d, "mesh.ply"))
     files["mesh"] = os.path.join(d, "mesh.glb")
     dpoint(exe, "convert", os.path.join(d, "mesh.ply"), "-o", files["mesh"])
+    tiny = os.path.join(d, "tiny.csv")
+    with open(tiny, "w") as f:
+        f.write("x,y,z\n")
+        for i in range(100):
+            f.write(f"{(i - 50) * 1.25e-301!r},{1e-300 + i * 3e-317!r},{i * 1e290!r}\n")
+    files["tiny and huge points"] = os.path.join(d, "tiny.glb")
+    dpoint(exe, "convert", tiny, "-o", files["tiny and huge points"])
+    attributes = {}
+    for name, path in files.items():
+        with open(path, "rb") as f:
+            data = f.read()
+        (json_length,) = struct.unpack_from("<I", data, 12)
+        gltf = json.loads(data[20:20 + json_length])
+        attributes[name] = set(gltf["meshes"][0]["primitives"][0]["attributes"])
+        check("_POSITION_LOW" in attributes[name], f"{name}: no _POSITION_LOW: {attributes[name]}")
+    check("_POSITION_LOW2" in attributes["points"], "random2d needs the third part, and it is missing")
+    check("scale" in gltf["nodes"][0], "the 1e-300 set has no node scale")
     for name, path in files.items():
         out = subprocess.run(["node", "-e", script, validator, path], capture_output=True, text=True)
         check(out.returncode == 0, f"validator failed on {name}: {out.stderr}")
@@ -36,4 +55,5 @@ with scratch() as d:
         report = json.dumps(issues["messages"])[:2000]
         check(issues["numErrors"] == 0, f"{name}: {issues['numErrors']} errors: {report}")
         check(issues["numWarnings"] == 0, f"{name}: {issues['numWarnings']} warnings: {report}")
-        print(f"{name}: 0 errors, 0 warnings, {issues['numInfos']} infos, {issues['numHints']} hints")
+        print(f"{name} ({', '.join(sorted(attributes[name]))}): 0 errors, 0 warnings, "
+              f"{issues['numInfos']} infos, {issues['numHints']} hints")
