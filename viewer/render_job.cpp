@@ -424,14 +424,17 @@ Shading shadingFor(const RenderRequest& request, const Bounds& bounds) {
   return bounds.planar ? Shading::kNone : Shading::kEdl;
 }
 
-// The spacing of a quarter of the points (a closed surface shows its front half, and a folded one
-// like a fractal's hides about half of that behind its own folds) over the ellipse inside the
-// bounding box's screen rectangle, rounded up, at most 4 px. Always 1 for 2D (ortho) views and with
-// --error (the reference raster draws 1-px points); the same on both backends.
+// The points' spacing on screen, rounded up: a 3D set's quarter of its points (a closed surface
+// shows its front half, and a folded one like a fractal's hides about half of that behind its own
+// folds) over the ellipse inside the bounding box's screen rectangle, at most 4 px; a 2D set's
+// points (a grid, all of them visible) over the rectangle itself, at most 8 px, so that a grid
+// drawn larger than its resolution closes without a screen-door pattern (a 256² mandelbrot2d at
+// 768 px: 3 px). Always 1 with --error (the reference raster draws 1-px points) and for a 3D set
+// seen in ortho; the same on both backends.
 float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box, const Camera& camera,
                    const DeviceFacts& facts) {
   if (request.point_size) return static_cast<float>(*request.point_size);
-  if (request.error || camera.ortho) return 1.0f;
+  if (request.error || (camera.ortho && !box.planar)) return 1.0f;
   if (request.backend.value_or(Backend::kRaster) == Backend::kRaster && !facts.large_points) return 1.0f;
   // The data's outline when the fit framed it (every one of its points is inside the picture), else
   // the box's corners.
@@ -446,9 +449,12 @@ float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box
     x0 = std::min(x0, std::max(w.x, 0.0)), x1 = std::max(x1, std::min(w.x, double(camera.width)));
     y0 = std::min(y0, std::max(w.y, 0.0)), y1 = std::max(y1, std::min(w.y, double(camera.height)));
   }
-  const double area = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0) * 0.25 * 3.14159265358979;
-  const double spacing = std::sqrt(area / std::max(1.0, 0.25 * static_cast<double>(count)));
-  return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(4.0, double(facts.max_point_size))));
+  const double rectangle = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0);
+  const double area = box.planar ? rectangle : rectangle * 0.25 * 3.14159265358979;
+  const double shown = box.planar ? static_cast<double>(count) : 0.25 * static_cast<double>(count);
+  const double spacing = std::sqrt(area / std::max(1.0, shown));
+  const double most = box.planar ? 8.0 : 4.0;
+  return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(most, double(facts.max_point_size))));
 }
 
 Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progress,
