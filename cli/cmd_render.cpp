@@ -21,7 +21,7 @@ namespace {
 
 struct RenderCliOptions {
   std::vector<std::string> inputs;
-  std::string output, mode = "auto", backend = "raster", device = "auto", json, native_path = "auto";
+  std::string output, mode = "auto", backend = "auto", device = "auto", json, native_path = "auto";
   std::string order = "input", shade = "auto", stream = "auto";
   double edl_strength = 1.0, edl_radius = 1.4;
   uint32_t views = 1;
@@ -72,7 +72,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   RenderRequest request;
   request.inputs = o.inputs;
   request.mode = o.mode;
-  request.backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
+  if (o.backend != "auto") request.backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
   request.device = o.device;
   request.validate = o.validate;
   request.camera = *spec;
@@ -154,14 +154,14 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
   const PrecisionMode mode = outcome.prediction.mode;
   std::printf("%s: %zu points%s, mode %s, %s backend, %ux%u, %g px points%s, %s (%s, driver %s)\n", output.c_str(),
               outcome.points, outcome.streamed ? " (streamed)" : "", std::string(modeName(mode)).c_str(),
-              backendName(request.backend), request.camera.width, request.camera.height, double(outcome.point_size),
+              backendName(outcome.backend), request.camera.width, request.camera.height, double(outcome.point_size),
               outcome.shading == Shading::kEdl ? ", eye-dome lighting" : "", f.name.c_str(), f.type.c_str(),
               formatDriverVersion(f.vendor_id, f.driver_version).c_str());
   if (outcome.streamed)
     std::printf("mode %s: no bound predicted (a streamed set is read once)%s\n", std::string(modeName(mode)).c_str(),
                 request.mode == "auto" ? "; --mode auto takes native for it" : "");
   else
-    printChoice(outcome.prediction, f, request.backend);
+    printChoice(outcome.prediction, f, outcome.backend);
   if (!r.gpu_ms.empty())
     std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f), %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
                 r.gpu_ms.size(), percentileOf(r.gpu_ms, 95),
@@ -209,7 +209,7 @@ int runRender(const RenderCliOptions& o) {
   if (Status written = writeRenderPicture(o.output, *outcome); !written) return reportError(written.error());
   if (request->views == 4) {
     std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), outcome->points,
-                outcome->image.width, outcome->image.height, backendName(request->backend), outcome->device.name.c_str());
+                outcome->image.width, outcome->image.height, backendName(outcome->backend), outcome->device.name.c_str());
     printWarnings(*outcome);
     return validationResult(*outcome);
   }
@@ -251,13 +251,14 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->check(checkStatus(checkModeOption))
       ->default_val("auto");
   addChoiceOption(*cmd, "--backend", o->backend,
-                  "raster (graphics pipeline, POINT_LIST, the float-vs-double Vulkan study's design) or compute (a thread\nper point, "
-                  "64-bit atomic depth test; the fast path on GPUs with a small graphics front end)",
-                  {"raster", "compute"});
+                  "auto (compute where the device runs it, else raster), raster (graphics pipeline, POINT_LIST, the\n"
+                  "float-vs-double Vulkan study's design) or compute (a thread per point, 64-bit atomic depth test; the\n"
+                  "fast path on lavapipe and on GPUs with a small graphics front end). Both draw the same picture",
+                  {"auto", "raster", "compute"});
   addCameraOptions(*cmd, o->camera);
   cmd->add_option("--point-size", o->point_size,
                   "Point size in pixels, or auto: 1, or larger (up to 4) when a 3D set has too few points to\n"
-                  "cover its outline at this size; 1 for 2D sets, --backend compute and --error")
+                  "cover its outline at this size; 1 for 2D sets and --error")
       ->check(checkStatus([](const std::string& v) { return v == "auto" ? okStatus() : statusOf(parsePointSize(v)); }))
       ->default_val("auto");
   cmd->add_option("--background", o->background, "Background colour R,G,B (0..255)")

@@ -55,14 +55,12 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
   if (!(options.point_size >= 1.0f) || options.point_size > f.max_point_size)
     return Error{"--point-size must be in [1, " + std::to_string(f.max_point_size) + "] on " + f.name,
                  ExitCode::kUsage};
-  if (options.point_size != 1.0f && !f.large_points)
+  if (options.backend == Backend::kRaster && options.point_size != 1.0f && !f.large_points)
     return Error{"--point-size above 1 needs the largePoints feature, which " + f.name + " lacks", ExitCode::kNoDevice};
   if (options.backend == Backend::kCompute) {
     if (!f.int64_atomics)
       return Error{"--backend compute needs shaderInt64 and shaderBufferInt64Atomics, which " + f.name + " lacks",
                    ExitCode::kNoDevice};
-    if (options.point_size != 1.0f)
-      return Error{"--backend compute draws points of size 1; --point-size needs --backend raster", ExitCode::kUsage};
     if (uint64_t{4} * count > f.max_storage_buffer_range)
       return Error{"--backend compute keeps every colour in one storage buffer: " + std::to_string(count) +
                        " points exceed " + f.name + "'s maxStorageBufferRange; use --backend raster",

@@ -156,13 +156,13 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
     const PrecisionMode one[] = {p.mode};
     p.bound_px = predictErrorBounds(points, camera, one).px[modeIndex(p.mode)];
     if (!(p.bound_px <= kWrongBoundPx)) {  // a wrong picture: name the mode auto would take
-      Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, request.backend, request.error);
+      Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error);
       if (!choice) return choice.error();
       p.warning = predictionWarning(request, p, choice->mode);
     }
     return p;
   }
-  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, request.backend, request.error);
+  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error);
   if (!choice) return choice.error();
   p.mode = choice->mode;
   p.bound_px = choice->bound_px;
@@ -184,7 +184,7 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
                                const Camera& camera, const DeviceFacts& facts) {
   RenderOptions options;
   options.mode = mode;
-  options.backend = request.backend;
+  options.backend = *request.backend;
   options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts);
   options.background_rgba8 = request.background_rgba8;
   options.frames = request.frames;
@@ -407,6 +407,14 @@ Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std:
   return cameras;
 }
 
+Backend backendFor(const RenderRequest& request, size_t count, uint32_t width, uint32_t height, const DeviceFacts& facts) {
+  if (request.backend) return *request.backend;
+  // The limits renderPoints checks for compute (viewer/render.cpp's checkOptions).
+  const bool fits = uint64_t{4} * count <= facts.max_storage_buffer_range &&
+                    uint64_t{8} * width * height <= facts.max_storage_buffer_range;
+  return facts.int64_atomics && fits ? Backend::kCompute : Backend::kRaster;
+}
+
 // It keys on the data, not the camera: a survey seen from above with --ortho still has the relief
 // EDL brings out, and a flat set seen in perspective has no relief, only the depth ramp of a
 // tilted plane. With --error the image check compares plain pixels with the reference raster.
@@ -416,14 +424,18 @@ Shading shadingFor(const RenderRequest& request, const Bounds& bounds) {
   return bounds.planar ? Shading::kNone : Shading::kEdl;
 }
 
-// The spacing of a quarter of the points (a closed surface shows its front half, and a folded one
-// like a fractal's hides about half of that behind its own folds) over the ellipse inside the
-// bounding box's screen rectangle, rounded up, at most 4 px. Always 1 for 2D (ortho) views, the
-// compute backend (size-1 points only) and with --error (the reference raster draws 1-px points).
+// The points' spacing on screen, rounded up: a 3D set's quarter of its points (a closed surface
+// shows its front half, and a folded one like a fractal's hides about half of that behind its own
+// folds) over the ellipse inside the bounding box's screen rectangle, at most 4 px; a 2D set's
+// points (a grid, all of them visible) over the rectangle itself, at most 8 px, so that a grid
+// drawn larger than its resolution closes without a screen-door pattern (a 256² mandelbrot2d at
+// 768 px: 3 px). Always 1 with --error (the reference raster draws 1-px points) and for a 3D set
+// seen in ortho; the same on both backends.
 float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box, const Camera& camera,
                    const DeviceFacts& facts) {
   if (request.point_size) return static_cast<float>(*request.point_size);
-  if (request.error || request.backend == Backend::kCompute || camera.ortho || !facts.large_points) return 1.0f;
+  if (request.error || (camera.ortho && !box.planar)) return 1.0f;
+  if (request.backend.value_or(Backend::kRaster) == Backend::kRaster && !facts.large_points) return 1.0f;
   // The data's outline when the fit framed it (every one of its points is inside the picture), else
   // the box's corners.
   std::vector<glm::dvec3> corners = box.outline;
@@ -437,9 +449,12 @@ float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box
     x0 = std::min(x0, std::max(w.x, 0.0)), x1 = std::max(x1, std::min(w.x, double(camera.width)));
     y0 = std::min(y0, std::max(w.y, 0.0)), y1 = std::max(y1, std::min(w.y, double(camera.height)));
   }
-  const double area = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0) * 0.25 * 3.14159265358979;
-  const double spacing = std::sqrt(area / std::max(1.0, 0.25 * static_cast<double>(count)));
-  return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(4.0, double(facts.max_point_size))));
+  const double rectangle = std::max(0.0, x1 - x0) * std::max(0.0, y1 - y0);
+  const double area = box.planar ? rectangle : rectangle * 0.25 * 3.14159265358979;
+  const double shown = box.planar ? static_cast<double>(count) : 0.25 * static_cast<double>(count);
+  const double spacing = std::sqrt(area / std::max(1.0, shown));
+  const double most = box.planar ? 8.0 : 4.0;
+  return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(most, double(facts.max_point_size))));
 }
 
 Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progress,
@@ -479,8 +494,11 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   outcome.phases.mark("device");  // what is left of making it once the input is in
   const VulkanContext& context = *outcome.context;
   outcome.device = context.facts;
-  Status rendered = views.size() == 4 ? renderSheet(request, context, *set, views, *cameras, outcome, view_done)
-                                      : renderOne(request, context, *set, cameras->front(), outcome, progress);
+  outcome.backend = backendFor(request, set->count, spec.width, spec.height, context.facts);
+  RenderRequest resolved = request;  // the policies below see the backend that runs
+  resolved.backend = outcome.backend;
+  Status rendered = views.size() == 4 ? renderSheet(resolved, context, *set, views, *cameras, outcome, view_done)
+                                      : renderOne(resolved, context, *set, cameras->front(), outcome, progress);
   if (!rendered) return rendered.error();
   outcome.validation_messages = context.validationMessages();
   return outcome;
@@ -523,7 +541,7 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
     choice.add("rejected", V::array(rejected));
     o.add("auto", choice);
   }
-  o.add("backend", V::string(backendName(request.backend))).add("order", V::string(pointOrderName(request.order)));
+  o.add("backend", V::string(backendName(outcome.backend))).add("order", V::string(pointOrderName(request.order)));
   o.add("device", V::string(f.name)).add("device_type", V::string(f.type));
   o.add("driver", V::string(f.driver_name + " " + f.driver_info));
   o.add("driver_version", V::string(formatDriverVersion(f.vendor_id, f.driver_version)));

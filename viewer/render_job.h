@@ -42,7 +42,7 @@ const char* backendName(Backend backend);  // "raster", "compute"
 struct RenderRequest {
   std::vector<std::string> inputs;   // drawn as one (point_inputs.h)
   std::string mode = "auto";         // a mode name (modeName) or "auto"
-  Backend backend = Backend::kRaster;
+  std::optional<Backend> backend;    // none: auto (backendFor)
   std::string device = "auto";       // ContextOptions::device
   bool validate = false;             // the Khronos validation layer; messages come back in the outcome
   uint64_t max_device_memory = 0;    // 0: what the device has
@@ -132,6 +132,12 @@ bool zUpFor(const RenderRequest& request, bool data_z_up = false);
 Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std::vector<RenderView>& views,
                                         const Bounds& bounds, bool z_up);
 
+// Backend auto: compute wherever the device runs it for this set and picture (64-bit atomics, the
+// colours and the per-pixel keys each in one storage buffer), else raster. Compute draws the same
+// picture (points of every size: shaders/render/points_splat.comp) and is the faster on lavapipe and
+// on GPUs with a small graphics front end.
+Backend backendFor(const RenderRequest& request, size_t count, uint32_t width, uint32_t height, const DeviceFacts& facts);
+
 // Shading auto: eye-dome lighting for a 3D set, none for a 2D one and with --error.
 Shading shadingFor(const RenderRequest& request, const Bounds& bounds);
 // Point size auto: 1 px, or up to 4 px when a 3D set has too few points to cover its outline.
@@ -157,6 +163,7 @@ struct RenderOutcome {
   size_t points = 0;
   bool streamed = false;       // drawn a block at a time (no prediction, no --error)
   DeviceFacts device;
+  Backend backend = Backend::kRaster;  // the one that ran (backendFor with --backend auto)
   std::vector<std::string> validation_messages;  // with `validate`: any fails the run
   // What makes the picture wrong or poor, one line each (no "warning:" prefix): a forced mode
   // whose bound is over kWrongBoundPx, --mode auto with no mode within its limit, a picture drawn

@@ -1,7 +1,7 @@
 #version 450
 // Compute backend, pass 1 (DESIGN §4): one thread per point projects it with the same code as the
 // raster path (project.glsl), finds its pixel as the rasterizer would (top-left rule for a size-1
-// point) and keeps the nearest point per pixel with a 64-bit atomicMax of
+// point; a larger one covers its square) and keeps the nearest point per pixel with a 64-bit atomicMax of
 // (depth bits << 32 | ~index): reversed Z, so the greater depth wins, and on a tie the lower
 // index, as the raster depth test GREATER keeps the point drawn first. Only positions are read here
 // (colours are fetched per pixel by the resolve), and a point whose key cannot beat the pixel's
@@ -56,12 +56,29 @@ void splat(uint i, vec4 clip) {
   float depth = clip.z / clip.w;
   float x = (clip.x / clip.w * 0.5 + 0.5) * float(pc.width);
   float y = (clip.y / clip.w * 0.5 + 0.5) * float(pc.height);
-  int px = int(ceil(x)) - 1, py = int(ceil(y)) - 1;
-  if (px < 0 || py < 0 || px >= int(pc.width) || py >= int(pc.height)) return;
   uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
-  uint pixel = uint(py) * pc.width + uint(px);
-  if (kEarlyDepth && visibility[pixel] >= key) return;
-  atomicMax(visibility[pixel], key);
+  if (pc.point_size == 1.0) {
+    int px = int(ceil(x)) - 1, py = int(ceil(y)) - 1;
+    if (px < 0 || py < 0 || px >= int(pc.width) || py >= int(pc.height)) return;
+    uint pixel = uint(py) * pc.width + uint(px);
+    if (kEarlyDepth && visibility[pixel] >= key) return;
+    atomicMax(visibility[pixel], key);
+    return;
+  }
+  // A larger point is the rasterizer's square: the pixels whose centres lie in [x − s/2, x + s/2) ×
+  // [y − s/2, y + s/2), each tested at the point's one depth, as the raster depth test does, so the
+  // depth test stays exact (a key per pixel) and the picture is the raster one. Clipped by its centre
+  // (above), then to the picture. s² atomics a point at most: the sizes pointSizeFor picks are small
+  // where the points are many, and kEarlyDepth skips most of them on a closed surface.
+  float half_size = 0.5 * pc.point_size;
+  int x0 = max(int(ceil(x - half_size - 0.5)), 0), x1 = min(int(ceil(x + half_size - 0.5)) - 1, int(pc.width) - 1);
+  int y0 = max(int(ceil(y - half_size - 0.5)), 0), y1 = min(int(ceil(y + half_size - 0.5)) - 1, int(pc.height) - 1);
+  for (int py = y0; py <= y1; ++py)
+    for (int px = x0; px <= x1; ++px) {
+      uint pixel = uint(py) * pc.width + uint(px);
+      if (kEarlyDepth && visibility[pixel] >= key) continue;
+      atomicMax(visibility[pixel], key);
+    }
 }
 
 // A workgroup takes kPointsPerThread · 256 consecutive points. Thread t splats t, t + 256, …, in

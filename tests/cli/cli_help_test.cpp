@@ -71,7 +71,7 @@ TEST(CliHelp, mistypedWordsGetOneLineWithTheNearestKnownOne) {
       {{"generate", "random2d", "--colour", "none", "-o", dir.file("t.ply")},
        "generate random2d: unknown option '--colour'; did you mean '--colors'?"},
       {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--backend", "computee"},
-       "--backend must be raster or compute, got 'computee'; did you mean 'compute'?"},
+       "--backend must be auto, raster or compute, got 'computee'; did you mean 'compute'?"},
       {{"--bogus"}, "unknown option '--bogus'"},
       {{"frobnicate"}, "unknown command 'frobnicate' (commands: generate,"},
   };

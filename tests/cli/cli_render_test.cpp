@@ -165,7 +165,6 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
       {{dir.file("one.csv"), "--device", "7"}, 3, "--device 7"},
       {{dir.file("one.csv"), "--backend", "mesh"}, 1, "--backend"},
       {{dir.file("one.csv"), "--order", "hilbert"}, 1, "--order"},
-      {{dir.file("one.csv"), "--backend", "compute", "--point-size", "2"}, 1, "--point-size"},
       {{dir.file("one.csv"), "--shade", "soft"}, 1, "--shade"},
       {{dir.file("one.csv"), "--edl-radius", "0.5"}, 1, "--edl-radius"},
       {{dir.file("one.csv"), "--edl-strength", "0"}, 1, "--edl-strength"},

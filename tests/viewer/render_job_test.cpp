@@ -30,7 +30,7 @@ Camera cameraFor(const RenderRequest& request, const Bounds& bounds) {
   return cameras.ok() ? cameras->front() : Camera{};
 }
 
-TEST(RenderJob, pointSizeGrowsOnlyForSparse3dSetsOnTheRasterBackend) {
+TEST(RenderJob, pointSizeGrowsOnlyForSparse3dSets) {
   RenderRequest request;
   const Camera camera = cameraFor(request, cube());
   EXPECT_EQ(pointSizeFor(request, 100, cube(), camera, bigPoints()), 4.0f) << "a few points: at most 4 px";
@@ -43,16 +43,33 @@ TEST(RenderJob, pointSizeGrowsOnlyForSparse3dSetsOnTheRasterBackend) {
   EXPECT_EQ(pointSizeFor(request, 100, cube(), camera, small), 2.0f) << "never above the device's largest";
   small.large_points = false;
   EXPECT_EQ(pointSizeFor(request, 100, cube(), camera, small), 1.0f);
-  for (auto change : {+[](RenderRequest& r) { r.error = true; }, +[](RenderRequest& r) { r.backend = Backend::kCompute; }}) {
-    RenderRequest other = request;
-    change(other);
-    EXPECT_EQ(pointSizeFor(other, 100, cube(), camera, bigPoints()), 1.0f);
-  }
+  RenderRequest error = request;
+  error.error = true;
+  EXPECT_EQ(pointSizeFor(error, 100, cube(), camera, bigPoints()), 1.0f) << "--error: the reference's 1-px points";
+  RenderRequest compute = request;
+  compute.backend = Backend::kCompute;
+  EXPECT_EQ(pointSizeFor(compute, 100, cube(), camera, small), 2.0f) << "compute draws squares without largePoints";
+  EXPECT_EQ(pointSizeFor(compute, 1000000, cube(), camera, bigPoints()), middle) << "the same size on both backends";
   RenderRequest ortho = request;
   ortho.camera.ortho = true;
   EXPECT_EQ(pointSizeFor(ortho, 100, cube(), cameraFor(ortho, cube()), bigPoints()), 1.0f);
   request.point_size = 2.5;
   EXPECT_EQ(pointSizeFor(request, 100000000, cube(), camera, bigPoints()), 2.5f) << "asked for: kept";
+}
+
+TEST(RenderJob, backendAutoIsComputeWhereTheDeviceRunsIt) {
+  DeviceFacts facts;
+  facts.int64_atomics = true;
+  facts.max_storage_buffer_range = uint64_t{1} << 27;  // 128 MiB
+  RenderRequest request;
+  EXPECT_EQ(backendFor(request, 1000, 1024, 768, facts), Backend::kCompute);
+  EXPECT_EQ(backendFor(request, uint64_t{1} << 26, 1024, 768, facts), Backend::kRaster) << "colours over the range";
+  EXPECT_EQ(backendFor(request, 1000, 8192, 8192, facts), Backend::kRaster) << "keys over the range";
+  request.backend = Backend::kRaster;
+  EXPECT_EQ(backendFor(request, 1000, 1024, 768, facts), Backend::kRaster) << "asked for: kept";
+  request.backend.reset();
+  facts.int64_atomics = false;
+  EXPECT_EQ(backendFor(request, 1000, 1024, 768, facts), Backend::kRaster);
 }
 
 TEST(RenderJob, viewsAndTheirCameras) {

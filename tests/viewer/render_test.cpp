@@ -1,5 +1,6 @@
 // The renderer on real Vulkan (Mesa lavapipe in CI) with the Khronos validation layer on: every
 // test fails on any validation message. The hard cases are DESIGN §7's, at small sizes.
+#include <cstdio>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -264,7 +265,6 @@ TEST_P(Render, absoluteFloatModesRefuseCoordinatesBeyondFloatRange) {
 }
 
 TEST_P(Render, pointSizeCoversASquareAndTheBackgroundFillsTheRest) {
-  if (GetParam() == Backend::kCompute) GTEST_SKIP() << "the compute backend draws size-1 points (tested below)";
   PointSet s;
   s.positions = {{0, 0, 0}, {1, 1, 0}, {2, 2, 0}};
   s.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
@@ -274,6 +274,7 @@ TEST_P(Render, pointSizeCoversASquareAndTheBackgroundFillsTheRest) {
   spec.view_width = 20.0;  // the points land 3.25 px apart on the diagonal, the middle one on a pixel centre
   Camera camera = *makeCamera(spec, boundsOf(s));
   RenderOptions options;
+  options.backend = GetParam();
   options.point_size = 3.0f;
   options.background_rgba8 = 0xff332211u;
   Result<RenderResult> r = renderPoints(*context_, s, camera, options);
@@ -301,28 +302,34 @@ TEST_P(Render, timedFramesReportGpuTimestamps) {
   EXPECT_EQ(r->gpu_bytes, s.size() * 28u);
 }
 
-TEST_P(Render, computeBackendRefusesLargePointsAndAgreesWithRasterOn2D) {
+// The compute backend draws the raster picture at every point size: each pixel of a point's square
+// is depth-tested at the point's depth, ties to the point drawn first. Pixel for pixel on a 2D grid with
+// a point per pixel centre; on a 3D cloud whose points overlap at arbitrary sub-pixel positions, all
+// but under 1% of the lit pixels.
+TEST_P(Render, computeAgreesWithRasterAtPointSizes1To3) {
   if (GetParam() == Backend::kRaster) GTEST_SKIP() << "compares the compute backend against raster";
-  PointSet s;
-  s.positions = {{0, 0, 0}};
-  Camera camera = *makeCamera(CameraSpec{}, boundsOf(s));
-  RenderOptions large;
-  large.backend = Backend::kCompute;
-  large.point_size = 2.0f;
-  Result<RenderResult> refused = renderPoints(*context_, s, camera, large);
-  ASSERT_FALSE(refused.ok());
-  EXPECT_NE(refused.error().message.find("--point-size"), std::string::npos) << refused.error().message;
-  // A 2D grid with one point per pixel centre: no depth ties, no pixel edges, so both backends
-  // must draw the very same picture.
+  const PointSet cube = cloud(glm::dvec3(0.0), 1.0);
+  const Camera near = lookAtCloud(cube, glm::dvec3(0.0), 40.0);
   const DeepZoom zoom = deepZoom(1e-6, 64, 300);
   ASSERT_FALSE(zoom.grid.positions.empty());
-  RenderOptions raster, compute;
-  raster.mode = compute.mode = PrecisionMode::kDf64;
-  compute.backend = Backend::kCompute;
-  Result<RenderResult> a = renderPoints(*context_, zoom.grid, zoom.camera, raster);
-  Result<RenderResult> b = renderPoints(*context_, zoom.grid, zoom.camera, compute);
-  ASSERT_TRUE(a.ok() && b.ok());
-  EXPECT_EQ(a->image.rgba, b->image.rgba);
+  for (float size : {1.0f, 2.0f, 3.0f}) {
+    for (const auto& [points, camera] : {std::pair{&cube, &near}, std::pair{&zoom.grid, &zoom.camera}}) {
+      RenderOptions raster, compute;
+      raster.mode = compute.mode = PrecisionMode::kDf64;
+      raster.point_size = compute.point_size = size;
+      compute.backend = Backend::kCompute;
+      Result<RenderResult> a = renderPoints(*context_, *points, *camera, raster);
+      Result<RenderResult> b = renderPoints(*context_, *points, *camera, compute);
+      ASSERT_TRUE(a.ok() && b.ok());
+      const size_t lit = litPixels(a->image, raster.background_rgba8), differing = countDifferingPixels(a->image, b->image);
+      EXPECT_GT(lit, 0u);
+      std::printf("%g px, %zu points: %zu of %zu lit pixels differ\n", double(size), points->size(), differing, lit);
+      // The grid is exact. In the cloud a few points lie within lavapipe's sub-pixel snapping (1/256 px)
+      // of a pixel edge or tie in depth to float rounding: the same at size 1 as before larger points.
+      if (points == &zoom.grid) EXPECT_EQ(differing, 0u) << size << " px";
+      else EXPECT_LE(differing, lit / 100) << size << " px";
+    }
+  }
 }
 
 // A set streamed block by block (dpoint render of a file larger than memory) draws the picture
