@@ -211,7 +211,9 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     const std::string mode(modeName(prediction->mode));
     const std::string label = "view " + std::string(views[i].label) + ": ";
     if (!prediction->warning.empty()) outcome.warnings.push_back(label + prediction->warning);
-    if (std::string cover = coverWarning(drawnShare(rendered->image, request.background_rgba8)); !cover.empty())
+    if (std::string cover = coverWarning(drawnShare(rendered->image, request.background_rgba8),
+                                         drawnSpan(rendered->image, request.background_rgba8));
+        !cover.empty())
       outcome.warnings.push_back(label + cover);
     sheet.push_back({std::string(views[i].label) + " (" + mode + ")", std::move(rendered->image)});
     outcome.views.push_back({views[i].label, std::move(*prediction), std::move(rendered->gpu_ms)});
@@ -257,7 +259,8 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
     outcome.phases.mark("error");
   }
   outcome.drawn_share = drawnShare(rendered->image, request.background_rgba8);
-  if (std::string cover = coverWarning(outcome.drawn_share); !cover.empty()) outcome.warnings.push_back(cover);
+  const double span = drawnSpan(rendered->image, request.background_rgba8);
+  if (std::string cover = coverWarning(outcome.drawn_share, span); !cover.empty()) outcome.warnings.push_back(cover);
   outcome.image = std::move(rendered->image);
   outcome.result = std::move(*rendered);
   return okStatus();
@@ -312,13 +315,29 @@ double drawnShare(const Image& image, uint32_t background_rgba8) {
   return double(drawn) / double(pixels);
 }
 
-std::string coverWarning(double drawn_share) {
+double drawnSpan(const Image& image, uint32_t background_rgba8) {
+  uint32_t x0 = image.width, y0 = image.height, x1 = 0, y1 = 0;
+  for (uint32_t y = 0; y < image.height; ++y) {
+    for (uint32_t x = 0; x < image.width; ++x) {
+      const uint8_t* p = &image.rgba[4 * (size_t(y) * image.width + x)];
+      if ((uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16) == (background_rgba8 & 0xffffffu)) continue;
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+  }
+  if (x0 > x1) return 0.0;
+  return double(std::max(x1 - x0 + 1, y1 - y0 + 1)) / double(std::max(1u, std::min(image.width, image.height)));
+}
+
+std::string coverWarning(double drawn_share, double drawn_span) {
   if (drawn_share == 0.0)
     return "the picture shows nothing: no point was drawn in the view (frame the data with --view-center and "
            "--view-width, or --eye and --target)";
   if (!(drawn_share < kPoorCoverShare)) return std::string();
   char share[32];
   std::snprintf(share, sizeof share, "%.2g%%", 100.0 * drawn_share);
+  if (drawn_span >= 0.5)
+    return std::string("the data covers ") + share + " of the picture (under 1%): it spans the picture, but its "
+           "points are sparse at this size; larger points (--point-size N) show more";
   return std::string("the data covers ") + share + " of the picture (under 1%): frame it closer with --view-center "
          "and --view-width, or --eye and --target";
 }

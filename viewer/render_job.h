@@ -113,8 +113,13 @@ std::string predictionWarning(const RenderRequest& request, const ModePrediction
                               std::optional<PrecisionMode> auto_mode);
 // The share of the picture's pixels whose colour is not the background's (RGB compared).
 double drawnShare(const Image& image, uint32_t background_rgba8);
-// The warning of a picture that shows nothing (share 0) or a speck (under kPoorCoverShare); else empty.
-std::string coverWarning(double drawn_share);
+// How far the drawn pixels reach: the larger of their bounding box's width and height over the
+// picture's smaller side (0 when nothing is drawn).
+double drawnSpan(const Image& image, uint32_t background_rgba8);
+// The warning of a picture that shows nothing (share 0) or under kPoorCoverShare of it; else empty.
+// A speck (drawn_span under a half) asks for a closer frame; data that spans the picture but whose
+// points are sparse at this size asks for larger points instead.
+std::string coverWarning(double drawn_share, double drawn_span = 0.0);
 
 // A view of a contact sheet: its label and the fit's direction (target to eye) and up.
 struct RenderView {

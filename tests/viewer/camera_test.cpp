@@ -367,21 +367,8 @@ TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
   EXPECT_EQ(builder.finish(), outlined.outline);
 }
 
-// The drawn pixels' bounding box as a share of the picture's smaller side (background magenta, so
-// the set's black points count as drawn).
-double drawnSpan(const Image& image, uint32_t background) {
-  uint32_t lo_x = image.width, hi_x = 0, lo_y = image.height, hi_y = 0;
-  for (uint32_t y = 0; y < image.height; ++y) {
-    for (uint32_t x = 0; x < image.width; ++x) {
-      const uint8_t* p = &image.rgba[(size_t(y) * image.width + x) * 4];
-      const uint32_t rgba = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-      if (rgba == background) continue;
-      lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
-    }
-  }
-  if (hi_x < lo_x) return 0.0;
-  return double(std::max(hi_x - lo_x + 1, hi_y - lo_y + 1)) / std::min(image.width, image.height);
-}
+// drawnSpan (viewer/render_job.h) measures the pictures: the background is magenta, so the set's
+// black points count as drawn.
 
 // Real deep zooms drawn by the default render job on the device: each fills the picture (the
 // 1e-12 one was a 7-px square, the 1e-15 one 2 px).

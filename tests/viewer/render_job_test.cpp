@@ -200,6 +200,10 @@ TEST(RenderJob, warningsSayWhenThePictureIsWrongOrPoor) {
   EXPECT_EQ(drawnShare(image, 0xff0000c8u), 0.99) << "the background is what is not drawn";
   EXPECT_EQ(coverWarning(0.01), "") << "1% itself is enough";
   EXPECT_TRUE(coverWarning(0.005).starts_with("the data covers 0.5% of the picture (under 1%)")) << coverWarning(0.005);
+  EXPECT_TRUE(coverWarning(0.005, 0.2).ends_with("frame it closer with --view-center and --view-width, or --eye and --target"));
+  // Sparse points that span the picture ask for larger points, not a closer frame.
+  EXPECT_TRUE(coverWarning(0.005, 0.9).ends_with("larger points (--point-size N) show more")) << coverWarning(0.005, 0.9);
+  EXPECT_EQ(drawnSpan(image, 0xff000000u), 0.1) << "drawn pixels reach 10% of the smaller side";
 
   RenderOutcome outcome;
   outcome.device.type = "cpu";
