@@ -67,10 +67,7 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   if (order != PointOrder::kInput) {
     Result<uint64_t> limit = memoryLimit(o);
     if (!limit) return reportError(limit.error());
-    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
-                            points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
-    if (Status s = checkMemory("ordering " + std::to_string(points.size()) + " points", needed, *limit); !s)
-      return reportError(s.error());
+    if (Status s = checkReorderMemory(points, order, *limit); !s) return reportError(s.error());
     reorderPoints(points, order, o.common.threads, &progress);
   }
   const double order_s = clock.lap();
@@ -78,10 +75,7 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
-  std::vector<std::string> write_notices;
-  w.notices = &write_notices;
-  if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
-  for (const std::string& notice : write_notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
+  if (Status s = writePointsWithNotes(o.output, points, w); !s) return reportError(s.error());
   if (!o.common.quiet)
     std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles\n",
                  generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3);

@@ -2,7 +2,9 @@
 
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "converters/point_io.h"
 #include "core/atomic_file.h"
@@ -36,6 +38,14 @@ Status checkOutputFolder(const std::string& flag, const std::string& path) {
   if (::stat(at.c_str(), &st) != 0) at = ".";
   if (Status s = AtomicFile::checkTarget((at / "dpoint-check").string()); !s)
     return Error{flag + " " + path + ": " + s.error().message, s.error().code};
+  return okStatus();
+}
+
+Status writePointsWithNotes(const std::string& path, const PointSet& points, WriteOptions options) {
+  std::vector<std::string> notices;
+  options.notices = &notices;
+  if (Status s = writePoints(path, points, options); !s) return s;
+  for (const std::string& notice : notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   return okStatus();
 }
 

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "converters/point_io.h"
 #include "core/result.h"
 
 namespace dpoint {
@@ -23,5 +24,8 @@ Status checkPointOutput(const std::string& path);
 // An output folder that is created when missing (bench --out): not a file, and the nearest folder
 // that exists can be written into. `flag` names the option in the message.
 Status checkOutputFolder(const std::string& flag, const std::string& path);
+
+// writePoints, then each notice the writer gave ("dpoint: note: …" on stderr).
+Status writePointsWithNotes(const std::string& path, const PointSet& points, WriteOptions options);
 
 }  // namespace dpoint

@@ -117,17 +117,9 @@ int runConvert(ConvertOptions& o) {
   if (filters.drop) points->colors.clear();
   if (o.unique) dropDuplicatePositions(*points);
   if (filters.srgb8) encodeColorsSrgb8(*points);
-  if (*order != PointOrder::kInput) {
-    const uint64_t needed = points->size() * (sizeof(glm::dvec3) + (points->hasColors() ? sizeof(glm::vec3) : 0)) +
-                            points->triangles.size() * 4 + reorderExtraBytes(points->size(), *order);
-    if (Status s = checkMemory("ordering " + std::to_string(points->size()) + " points", needed, o.memory_limit); !s)
-      return reportError(s.error());
-  }
+  if (Status s = checkReorderMemory(*points, *order, o.memory_limit); !s) return reportError(s.error());
   reorderPoints(*points, *order, o.common.threads, &progress);
-  std::vector<std::string> write_notices;
-  w.notices = &write_notices;
-  if (Status s = writePoints(o.output, *points, w); !s) return reportError(s.error());
-  for (const std::string& notice : write_notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
+  if (Status s = writePointsWithNotes(o.output, *points, w); !s) return reportError(s.error());
   return 0;
 }
 

@@ -38,22 +38,14 @@ int runMerge(const MergeOptions& o) {
   Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress);
   if (!merged) return reportError(merged.error());
   PointSet& points = *merged;
-  // From here on as `dpoint generate` finishes a whole set (cmd_generate.cpp: finish).
-  if (*order != PointOrder::kInput) {
-    const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
-                            points.triangles.size() * 4 + reorderExtraBytes(points.size(), *order);
-    if (Status s = checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit); !s)
-      return reportError(s.error());
-    reorderPoints(points, *order, o.common.threads, &progress);
-  }
+  // From here on as `dpoint generate` finishes a whole set (cli_generate_output.cpp: finish).
+  if (Status s = checkReorderMemory(points, *order, limit); !s) return reportError(s.error());
+  reorderPoints(points, *order, o.common.threads, &progress);
   WriteOptions w;
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
-  std::vector<std::string> write_notices;
-  w.notices = &write_notices;
-  if (Status s = writePoints(o.output, points, w); !s) return reportError(s.error());
-  for (const std::string& notice : write_notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
+  if (Status s = writePointsWithNotes(o.output, points, w); !s) return reportError(s.error());
   return 0;
 }
 

@@ -63,19 +63,28 @@ Status checkFolder(const std::string& path, const std::string& folder) {
   return okStatus();
 }
 
+// A path that exists already: a folder is refused; a device or a pipe (not a regular file) is
+// opened for writing as it is (special_fd; -1 when the path is absent or a regular file, which is
+// replaced by rename).
+Status openIfSpecial(const std::string& path, int& special_fd) {
+  special_fd = -1;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return okStatus();
+  if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
+  special_fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (special_fd < 0) return ioError("cannot open", path, errno);
+  return okStatus();
+}
+
 }  // namespace
 
 Status AtomicFile::checkTarget(const std::string& path) {
   if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
-  struct stat st {};
-  if (::stat(path.c_str(), &st) == 0) {
-    if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
-    if (!S_ISREG(st.st_mode)) {
-      int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-      if (fd < 0) return ioError("cannot open", path, errno);
-      ::close(fd);
-      return okStatus();
-    }
+  int special = -1;
+  if (Status s = openIfSpecial(path, special); !s) return s;
+  if (special >= 0) {
+    ::close(special);
+    return okStatus();
   }
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s;
@@ -97,15 +106,9 @@ Status AtomicFile::checkTarget(const std::string& path) {
 Result<AtomicFile> AtomicFile::create(const std::string& path) {
   if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
   if (interrupted()) return interruptedError();
-  struct stat st {};
-  if (::stat(path.c_str(), &st) == 0) {
-    if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
-    if (!S_ISREG(st.st_mode)) {
-      int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-      if (fd < 0) return ioError("cannot open", path, errno);
-      return AtomicFile(path, "", fd, true);
-    }
-  }
+  int special = -1;
+  if (Status s = openIfSpecial(path, special); !s) return s.error();
+  if (special >= 0) return AtomicFile(path, "", special, true);
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s.error();
 

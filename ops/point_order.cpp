@@ -31,6 +31,7 @@
 #include <random>
 #include <type_traits>
 
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
@@ -287,6 +288,13 @@ const char* pointOrderName(PointOrder order) { return order == PointOrder::kMort
 
 uint64_t reorderExtraBytes(size_t points, PointOrder order) {
   return order == PointOrder::kMorton ? uint64_t{28} * points : 0;
+}
+
+Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit) {
+  if (order == PointOrder::kInput) return okStatus();
+  const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
+                          points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
+  return checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit);
 }
 
 MortonFrame mortonFrame(const std::vector<glm::dvec3>& positions, unsigned threads) {

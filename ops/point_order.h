@@ -53,6 +53,9 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads = 0, Pro
 // the sort's code and index arrays and their scratch copies; then 4 for the sorted indices and
 // 24 for one gathered copy of the positions), 0 for kInput.
 uint64_t reorderExtraBytes(size_t points, PointOrder order);
+// Refuses (kResourceLimit, "ordering N points needs …", core/memory.h) an order whose peak — the
+// set's positions, colours and triangles plus reorderExtraBytes — is over `limit` (0: half of RAM).
+Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit);
 
 // The frame Morton codes are taken in: the box of the finite coordinates, kept as halves
 // (min/2 and (max - min)/2 computed as max/2 - min/2) so that no extent overflows, however far

@@ -107,4 +107,13 @@ uint64_t bytesWrittenBy(int pid) {
   return 0;
 }
 
+std::pair<uint32_t, uint32_t> pngSize(const std::string& png) {
+  auto be32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(png.at(at + i));
+    return v;
+  };
+  return {be32(16), be32(20)};
+}
+
 }  // namespace dpoint::test

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/point_set.h"
@@ -58,5 +59,8 @@ inline std::vector<std::string> concat(std::vector<std::string> a, const std::ve
 
 // Bytes process `pid` has written so far (/proc/PID/io wchar); 0 once it is gone.
 uint64_t bytesWrittenBy(int pid);
+
+// A PNG's width and height, from its IHDR chunk (big-endian, at bytes 16 and 20).
+std::pair<uint32_t, uint32_t> pngSize(const std::string& png);
 
 }  // namespace dpoint::test

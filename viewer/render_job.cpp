@@ -43,20 +43,30 @@ struct LoadedSet {
 };
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
-Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress) {
-  Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
+// One pass over a streamed set, a block at a time, showing `what` as progress.
+Status forEachBlock(PointInputStream& ply, Progress& progress, const std::string& what,
+                    const std::function<void(const PointSet& block)>& visit) {
   PointSet block;
-  progress.start("bounds of " + path + " (points)", ply.count());
+  progress.start(what, ply.count());
   for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
     const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
     if (interrupted()) return interruptedError();
-    if (Status status = ply.read(first, n, block); !status) return status.error();
+    if (Status status = ply.read(first, n, block); !status) return status;
     progress.advance(n);
+    visit(block);
+  }
+  progress.finish();
+  return okStatus();
+}
+
+Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress) {
+  Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
+  Status status = forEachBlock(ply, progress, "bounds of " + path + " (points)", [&](const PointSet& block) {
     const Box box = boundingBox(block.positions);
     bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
     bounds.planar = bounds.planar && block.isPlanar();
-  }
-  progress.finish();
+  });
+  if (!status) return status.error();
   return bounds;
 }
 
@@ -72,16 +82,9 @@ bool needsOutline(const RenderRequest& request, const Bounds& bounds) {
 Result<std::vector<glm::dvec3>> streamOutline(const std::string& path, PointInputStream& ply, const Bounds& bounds,
                                               Progress& progress) {
   OutlineBuilder builder(bounds);
-  PointSet block;
-  progress.start("outline of " + path + " (points)", ply.count());
-  for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
-    const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
-    if (interrupted()) return interruptedError();
-    if (Status status = ply.read(first, n, block); !status) return status.error();
-    progress.advance(n);
-    builder.add(block.positions);
-  }
-  progress.finish();
+  Status status = forEachBlock(ply, progress, "outline of " + path + " (points)",
+                               [&](const PointSet& block) { builder.add(block.positions); });
+  if (!status) return status.error();
   return builder.finish();
 }
 

@@ -15,10 +15,7 @@
 namespace dpoint {
 namespace {
 
-using test::readFile;
-using test::runDpoint;
-using test::TempDir;
-using test::writeFile;
+using namespace test;  // readFile, runDpoint, TempDir, writeFile
 
 const std::string kLas = std::string(DPOINT_CORPUS_DIR) + "/las/";
 const std::string kEngine = "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";

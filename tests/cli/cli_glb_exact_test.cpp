@@ -10,10 +10,7 @@
 namespace dpoint {
 namespace {
 
-using test::readFile;
-using test::runDpoint;
-using test::TempDir;
-using test::writeFile;
+using namespace test;  // readFile, runDpoint, TempDir, writeFile
 
 // `csv` converted to CSV directly and through GLB: the same bytes, and no notice.
 void expectGlbRoundTripIdentical(const TempDir& dir, const std::string& csv) {

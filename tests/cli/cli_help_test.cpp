@@ -20,15 +20,6 @@ using test::runDpoint;
 using test::TempDir;
 using test::writeFile;
 
-std::pair<uint32_t, uint32_t> pngSize(const std::string& png) {
-  auto be32 = [&](size_t at) {
-    uint32_t v = 0;
-    for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(png.at(at + i));
-    return v;
-  };
-  return {be32(16), be32(20)};
-}
-
 size_t lines(const std::string& text) { return size_t(std::count(text.begin(), text.end(), '\n')); }
 
 TEST(CliSuggest, editDistanceCountsASwapOfNeighboursAsOne) {
@@ -107,7 +98,7 @@ TEST(CliHelp, fourViewSheetIsTheSizeAskedFor) {
     test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", out, "--views", "4", "--width",
                                        std::to_string(w), "--height", std::to_string(h), "-q"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(pngSize(readFile(out)), std::make_pair(w, h));
+    EXPECT_EQ(test::pngSize(readFile(out)), std::make_pair(w, h));
     EXPECT_TRUE(contains(r.out, std::to_string(w) + "x" + std::to_string(h))) << r.out;
   }
   test::CommandResult tiny = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file("tiny.png"), "--views", "4",
@@ -116,7 +107,6 @@ TEST(CliHelp, fourViewSheetIsTheSizeAskedFor) {
   EXPECT_TRUE(contains(tiny.err, "--views 4 needs --width and --height of at least 4 px, got 3x600")) << tiny.err;
   EXPECT_FALSE(test::fileExists(dir.file("tiny.png")));
 }
-
 
 // A bad -o ends the run with one line naming the path, exit 1, before any work: a generation
 // that would take minutes (a 2000^3 grid) ends at once, an input that does not exist is not

@@ -190,16 +190,6 @@ TEST(CliRender, badInputAndOptionsFailWithoutWritingAnything) {
   EXPECT_NE(jpg.err.find(".png"), std::string::npos);
 }
 
-// The PNG's size from its IHDR chunk (big-endian width and height at bytes 16 and 20).
-std::pair<uint32_t, uint32_t> pngSize(const std::string& png) {
-  auto be32 = [&](size_t at) {
-    uint32_t v = 0;
-    for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(png.at(at + i));
-    return v;
-  };
-  return {be32(16), be32(20)};
-}
-
 // Readable previews (issue #13): eye-dome lighting by default for 3D, a colour map for sets
 // without colours, and a four-view contact sheet.
 TEST(CliRender, previewsShadeColourAndShowFourViews) {
@@ -229,7 +219,7 @@ TEST(CliRender, previewsShadeColourAndShowFourViews) {
   EXPECT_EQ(sized.out.find(", 1 px points"), std::string::npos) << sized.out;
   EXPECT_FALSE(readFile(dir.file("sized.png")) == plain);
   const std::string sheet = render("views.png", {"--views", "4"});
-  EXPECT_EQ(pngSize(sheet), std::make_pair(320u, 240u)) << "four 159 x 119 views and 2-px lines: the size asked for";
+  EXPECT_EQ(test::pngSize(sheet), std::make_pair(320u, 240u)) << "four 159 x 119 views and 2-px lines: the size asked for";
   test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", dir.file("views.png"), "--views", "4",
                                      "--width", "320", "--height", "240", "--backend", "compute"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
