@@ -73,7 +73,9 @@ Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
   std::vector<std::string> notices;
   r.notices = &notices;
   Result<PointSet> points = readPoints(o.input, r);
-  for (const std::string& notice : notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
+  // Notes about a file that was read; a refused file gets its one error line only.
+  if (points)
+    for (const std::string& notice : notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   if (points && o.max_points != 0 && points->size() > o.max_points)
     return Error{o.input + ": " + std::to_string(points->size()) + " points exceed --max-points " +
                      std::to_string(o.max_points),

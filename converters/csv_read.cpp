@@ -138,7 +138,7 @@ class LineParser {
     } else {
       fields = static_cast<size_t>(std::count(begin, end, ',')) + 1;
     }
-    return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + layout_.text + ")";
+    return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + printableExcerpt(layout_.text) + ")";
   }
 
   template <typename T>
@@ -321,7 +321,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   const Layout& layout = header.layout;
   if (layout.columns > positionColumns(layout.known) + (hasColorColumns(layout) ? 3 : 0) && options.notices)
     options.notices->push_back(path + ": columns after " + kKnownText[static_cast<int>(layout.known)] +
-                               " ignored (header '" + layout.text + "')");
+                               " ignored (header " + quotedExcerpt(layout.text) + ")");
   PointSet points;
   points.z_axis = positionColumns(layout.known) == 3 ? ZAxis::kPresent : ZAxis::kAbsent;
   if (header.data_offset >= file.size()) return points;  // a header and nothing after it
