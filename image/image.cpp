@@ -86,4 +86,21 @@ size_t countDifferingPixels(const Image& a, const Image& b) {
   return differing;
 }
 
+DrawnPixels drawnPixels(const Image& image, uint32_t background_rgba8) {
+  DrawnPixels d;
+  d.pixels = size_t(image.width) * image.height;
+  d.min_side = std::min(image.width, image.height);
+  d.x0 = image.width, d.y0 = image.height;
+  const uint32_t background = background_rgba8 & 0xffffffu;
+  for (uint32_t y = 0; y < image.height; ++y) {
+    for (uint32_t x = 0; x < image.width; ++x) {
+      const uint8_t* p = &image.rgba[4 * (size_t(y) * image.width + x)];
+      if ((uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16) == background) continue;
+      ++d.count;
+      d.x0 = std::min(d.x0, x), d.x1 = std::max(d.x1, x), d.y0 = std::min(d.y0, y), d.y1 = std::max(d.y1, y);
+    }
+  }
+  return d;
+}
+
 }  // namespace dpoint

@@ -214,9 +214,8 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     const std::string mode(modeName(prediction->mode));
     const std::string label = "view " + std::string(views[i].label) + ": ";
     if (!prediction->warning.empty()) outcome.warnings.push_back(label + prediction->warning);
-    if (std::string cover = coverWarning(drawnShare(rendered->image, request.background_rgba8),
-                                         drawnSpan(rendered->image, request.background_rgba8));
-        !cover.empty())
+    const DrawnPixels drawn = drawnPixels(rendered->image, request.background_rgba8);
+    if (std::string cover = coverWarning(drawn.share(), drawn.span()); !cover.empty())
       outcome.warnings.push_back(label + cover);
     sheet.push_back({std::string(views[i].label) + " (" + mode + ")", std::move(rendered->image)});
     outcome.views.push_back({views[i].label, std::move(*prediction), std::move(rendered->gpu_ms)});
@@ -261,9 +260,9 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
     outcome.error = measureError(*set.points, camera, *rendered, options);
     outcome.phases.mark("error");
   }
-  outcome.drawn_share = drawnShare(rendered->image, request.background_rgba8);
-  const double span = drawnSpan(rendered->image, request.background_rgba8);
-  if (std::string cover = coverWarning(outcome.drawn_share, span); !cover.empty()) outcome.warnings.push_back(cover);
+  const DrawnPixels drawn = drawnPixels(rendered->image, request.background_rgba8);
+  outcome.drawn_share = drawn.share();
+  if (std::string cover = coverWarning(drawn.share(), drawn.span()); !cover.empty()) outcome.warnings.push_back(cover);
   outcome.image = std::move(rendered->image);
   outcome.result = std::move(*rendered);
   return okStatus();
@@ -304,31 +303,6 @@ std::string predictionWarning(const RenderRequest& request, const ModePrediction
   return "--mode " + mode + ": predicted error " + bound + " (> " + formatNumber(kWrongBoundPx) +
          " px): the picture is wrong here" +
          (auto_mode ? "; --mode auto picks " + std::string(modeName(*auto_mode)) : std::string());
-}
-
-double drawnShare(const Image& image, uint32_t background_rgba8) {
-  const size_t pixels = size_t(image.width) * image.height;
-  if (pixels == 0) return 0.0;
-  size_t drawn = 0;
-  for (size_t i = 0; i < pixels; ++i) {
-    const uint8_t* p = &image.rgba[4 * i];
-    const uint32_t rgb = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
-    drawn += rgb != (background_rgba8 & 0xffffffu);
-  }
-  return double(drawn) / double(pixels);
-}
-
-double drawnSpan(const Image& image, uint32_t background_rgba8) {
-  uint32_t x0 = image.width, y0 = image.height, x1 = 0, y1 = 0;
-  for (uint32_t y = 0; y < image.height; ++y) {
-    for (uint32_t x = 0; x < image.width; ++x) {
-      const uint8_t* p = &image.rgba[4 * (size_t(y) * image.width + x)];
-      if ((uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16) == (background_rgba8 & 0xffffffu)) continue;
-      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-    }
-  }
-  if (x0 > x1) return 0.0;
-  return double(std::max(x1 - x0 + 1, y1 - y0 + 1)) / double(std::max(1u, std::min(image.width, image.height)));
 }
 
 std::string coverWarning(double drawn_share, double drawn_span) {

@@ -111,12 +111,8 @@ inline constexpr double kPoorCoverShare = 0.01;
 // --mode auto picks, `auto_mode`), or --mode auto with no mode within kAutoBoundPx; else empty.
 std::string predictionWarning(const RenderRequest& request, const ModePrediction& prediction,
                               std::optional<PrecisionMode> auto_mode);
-// The share of the picture's pixels whose colour is not the background's (RGB compared).
-double drawnShare(const Image& image, uint32_t background_rgba8);
-// How far the drawn pixels reach: the larger of their bounding box's width and height over the
-// picture's smaller side (0 when nothing is drawn).
-double drawnSpan(const Image& image, uint32_t background_rgba8);
 // The warning of a picture that shows nothing (share 0) or under kPoorCoverShare of it; else empty.
+// drawn_share and drawn_span are DrawnPixels' share() and span() (image/image.h).
 // A speck (drawn_span under a half) asks for a closer frame; data that spans the picture but whose
 // points are sparse at this size asks for larger points instead.
 std::string coverWarning(double drawn_share, double drawn_span = 0.0);
@@ -174,7 +170,7 @@ struct RenderOutcome {
   // whose bound is over kWrongBoundPx, --mode auto with no mode within its limit, a picture drawn
   // on under 1% of its pixels or on none ("view LABEL: " first for a view of a sheet).
   std::vector<std::string> warnings;
-  double drawn_share = std::nan("");  // one view: the share of pixels drawn (drawnShare)
+  double drawn_share = std::nan("");  // one view: the share of pixels drawn (DrawnPixels::share)
   // One view:
   ModePrediction prediction;
   float point_size = 1.0f;

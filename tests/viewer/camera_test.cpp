@@ -367,9 +367,6 @@ TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
   EXPECT_EQ(builder.finish(), outlined.outline);
 }
 
-// drawnSpan (viewer/render_job.h) measures the pictures: the background is magenta, so the set's
-// black points count as drawn.
-
 // Real deep zooms drawn by the default render job on the device: each fills the picture (the
 // 1e-12 one was a 7-px square, the 1e-15 one 2 px).
 TEST(Camera, defaultRenderOfDeepZoomsFillsThePicture) {
@@ -389,8 +386,8 @@ TEST(Camera, defaultRenderOfDeepZoomsFillsThePicture) {
     Progress progress;
     Result<RenderOutcome> outcome = runRenderJob(request, progress);
     ASSERT_TRUE(outcome.ok()) << outcome.error().message;
-    EXPECT_GE(drawnSpan(outcome->image, request.background_rgba8), 0.85);
-    EXPECT_LE(drawnSpan(outcome->image, request.background_rgba8), 1.0);
+    EXPECT_GE(drawnPixels(outcome->image, request.background_rgba8).span(), 0.85);
+    EXPECT_LE(drawnPixels(outcome->image, request.background_rgba8).span(), 1.0);
   }
   std::filesystem::remove_all(dir);
 }
@@ -418,8 +415,8 @@ TEST(Camera, defaultRenderOfAMandelbulbFillsThePictureInMemoryAndStreamed) {
     Result<RenderOutcome> outcome = runRenderJob(request, progress);
     ASSERT_TRUE(outcome.ok()) << outcome.error().message;
     EXPECT_EQ(outcome->streamed, stream == std::string("on"));
-    EXPECT_GE(drawnSpan(outcome->image, request.background_rgba8), 0.85);
-    EXPECT_LE(drawnSpan(outcome->image, request.background_rgba8), 1.0);
+    EXPECT_GE(drawnPixels(outcome->image, request.background_rgba8).span(), 0.85);
+    EXPECT_LE(drawnPixels(outcome->image, request.background_rgba8).span(), 1.0);
     pictures.push_back(outcome->image);
   }
   EXPECT_EQ(pictures[0].rgba, pictures[1].rgba);

@@ -193,17 +193,17 @@ TEST(RenderJob, warningsSayWhenThePictureIsWrongOrPoor) {
 
   Image image{10, 10, std::vector<uint8_t>(400, 0)};
   for (size_t i = 0; i < 100; ++i) image.rgba[4 * i + 3] = 255;
-  EXPECT_EQ(drawnShare(image, 0xff000000u), 0.0);
+  EXPECT_EQ(drawnPixels(image, 0xff000000u).share(), 0.0);
   EXPECT_TRUE(coverWarning(0.0).starts_with("the picture shows nothing: no point was drawn in the view"));
   image.rgba[4 * 55] = 200;
-  EXPECT_EQ(drawnShare(image, 0xff000000u), 0.01);
-  EXPECT_EQ(drawnShare(image, 0xff0000c8u), 0.99) << "the background is what is not drawn";
+  EXPECT_EQ(drawnPixels(image, 0xff000000u).share(), 0.01);
+  EXPECT_EQ(drawnPixels(image, 0xff0000c8u).share(), 0.99) << "the background is what is not drawn";
   EXPECT_EQ(coverWarning(0.01), "") << "1% itself is enough";
   EXPECT_TRUE(coverWarning(0.005).starts_with("the data covers 0.5% of the picture (under 1%)")) << coverWarning(0.005);
   EXPECT_TRUE(coverWarning(0.005, 0.2).ends_with("frame it closer with --view-center and --view-width, or --eye and --target"));
   // Sparse points that span the picture ask for larger points, not a closer frame.
   EXPECT_TRUE(coverWarning(0.005, 0.9).ends_with("larger points (--point-size N) show more")) << coverWarning(0.005, 0.9);
-  EXPECT_EQ(drawnSpan(image, 0xff000000u), 0.1) << "drawn pixels reach 10% of the smaller side";
+  EXPECT_EQ(drawnPixels(image, 0xff000000u).span(), 0.1) << "drawn pixels reach 10% of the smaller side";
 
   RenderOutcome outcome;
   outcome.device.type = "cpu";
