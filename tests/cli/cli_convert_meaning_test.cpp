@@ -27,6 +27,14 @@ void expectConverts(const std::vector<std::string>& args) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
 }
 
+// `text` written as dir/NAME and converted to dir/OUT (a .csv): OUT's text ("" when convert failed).
+std::string convertedCsv(const TempDir& dir, const std::string& name, const std::string& text, const std::string& out) {
+  writeFile(dir.file(name), text);
+  test::CommandResult r = runDpoint({"convert", dir.file(name), "-o", dir.file(out)});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? readFile(dir.file(out)) : std::string();
+}
+
 // simple.las with every Z set to 0 (the same header, records rewritten), and with no points.
 void writeFlatLas(const std::string& path) {
   std::string bytes = readFile(kLas + "simple.las");
@@ -62,9 +70,7 @@ TEST(CliConvertMeaning, lasWhoseZAreAllZeroKeepsItsZColumn) {
 
 TEST(CliConvertMeaning, threeColumnCsvAtZeroStaysThreeColumnsAndTwoColumnsStayTwo) {
   TempDir dir;
-  writeFile(dir.file("xyz.csv"), "x,y,z\n1.5,2,0\n3,4,0\n");
-  expectConverts({dir.file("xyz.csv"), "-o", dir.file("xyz_out.csv")});
-  EXPECT_EQ(readFile(dir.file("xyz_out.csv")), "x,y,z\n1.5,2,0\n3,4,0\n");
+  EXPECT_EQ(convertedCsv(dir, "xyz.csv", "x,y,z\n1.5,2,0\n3,4,0\n", "xyz_out.csv"), "x,y,z\n1.5,2,0\n3,4,0\n");
   // Genuinely 2D: CSV → PLY → CSV comes back as x,y (the PLY says so in a header comment).
   writeFile(dir.file("xy.csv"), "x,y\n1.5,2\n3,4\n");
   expectConverts({dir.file("xy.csv"), "-o", dir.file("xy.ply")});
@@ -166,9 +172,8 @@ TEST(CliConvertMeaning, csvExtraColumnsAreIgnoredWithOneNotice) {
   EXPECT_EQ(readFile(dir.file("i_out.csv")), "x,y,z\n1,2,3\n4,5,6\n");
   EXPECT_EQ(r.err, "dpoint: note: " + dir.file("i.csv") + ": columns after x,y,z ignored (header 'x,y,z,intensity')\n");
   // Colours then extras.
-  writeFile(dir.file("c.csv"), "x,y,z,r,g,b,a,t\n1,2,3,0.5,0.25,1,9,9\n");
-  expectConverts({dir.file("c.csv"), "-o", dir.file("c_out.csv")});
-  EXPECT_EQ(readFile(dir.file("c_out.csv")), "x,y,z,r,g,b\n1,2,3,0.5,0.25,1\n");
+  EXPECT_EQ(convertedCsv(dir, "c.csv", "x,y,z,r,g,b,a,t\n1,2,3,0.5,0.25,1,9,9\n", "c_out.csv"),
+            "x,y,z,r,g,b\n1,2,3,0.5,0.25,1\n");
   // Existing rejections keep their messages: a row of the wrong length, a bad header, 4 columns
   // without a header (what they are is unknown), a partial colour set.
   const std::vector<std::pair<std::string, std::vector<std::string>>> bad = {
@@ -191,15 +196,10 @@ TEST(CliConvertMeaning, csvExtraColumnsAreIgnoredWithOneNotice) {
 TEST(CliConvertMeaning, whitespaceSeparatedCsvAsCloudCompareWritesIt) {
   TempDir dir;
   // Space-separated with CloudCompare's `//X Y Z` header, tab-separated without one, runs of blanks.
-  writeFile(dir.file("cc.csv"), "//X Y Z R G B\n1.5 2 3 0.5 0.25 1\n-4  5\t6 0 0 0 \n");
-  expectConverts({dir.file("cc.csv"), "-o", dir.file("cc_out.csv")});
-  EXPECT_EQ(readFile(dir.file("cc_out.csv")), "x,y,z,r,g,b\n1.5,2,3,0.5,0.25,1\n-4,5,6,0,0,0\n");
-  writeFile(dir.file("tab.csv"), "1\t2\t3\n4\t5\t6\n");
-  expectConverts({dir.file("tab.csv"), "-o", dir.file("tab_out.csv")});
-  EXPECT_EQ(readFile(dir.file("tab_out.csv")), "x,y,z\n1,2,3\n4,5,6\n");
-  writeFile(dir.file("xy.txt.csv"), "x y\n1 2\n");
-  expectConverts({dir.file("xy.txt.csv"), "-o", dir.file("xy_out.csv")});
-  EXPECT_EQ(readFile(dir.file("xy_out.csv")), "x,y\n1,2\n");
+  EXPECT_EQ(convertedCsv(dir, "cc.csv", "//X Y Z R G B\n1.5 2 3 0.5 0.25 1\n-4  5\t6 0 0 0 \n", "cc_out.csv"),
+            "x,y,z,r,g,b\n1.5,2,3,0.5,0.25,1\n-4,5,6,0,0,0\n");
+  EXPECT_EQ(convertedCsv(dir, "tab.csv", "1\t2\t3\n4\t5\t6\n", "tab_out.csv"), "x,y,z\n1,2,3\n4,5,6\n");
+  EXPECT_EQ(convertedCsv(dir, "xy.txt.csv", "x y\n1 2\n", "xy_out.csv"), "x,y\n1,2\n");
   // A row of the wrong length names its line and the layout.
   writeFile(dir.file("short.csv"), "1 2 3\n4 5\n");
   test::CommandResult r = runDpoint({"convert", dir.file("short.csv"), "-o", dir.file("short.ply")});
@@ -223,9 +223,7 @@ TEST(CliConvertMeaning, lasToCsvWritesValuesAtTheFilesStep) {
   expectConverts({kLas + "simple.las", "-o", dir.file("d.csv"), "--decimals", "3"});
   EXPECT_TRUE(test::contains(readFile(dir.file("d.csv")), "\n636896.330,849087.700,446.390,"));
   // Other inputs keep the shortest round trip.
-  writeFile(dir.file("p.csv"), "x,y,z\n849087.7000000001,1,2\n");
-  expectConverts({dir.file("p.csv"), "-o", dir.file("p_out.csv")});
-  EXPECT_EQ(readFile(dir.file("p_out.csv")), "x,y,z\n849087.7000000001,1,2\n");
+  EXPECT_EQ(convertedCsv(dir, "p.csv", "x,y,z\n849087.7000000001,1,2\n", "p_out.csv"), "x,y,z\n849087.7000000001,1,2\n");
 }
 
 TEST(CliConvertMeaning, plyWrittenFromLasRecordsZUp) {
