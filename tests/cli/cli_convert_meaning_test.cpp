@@ -223,7 +223,8 @@ TEST(CliConvertMeaning, lasToCsvWritesValuesAtTheFilesStep) {
   expectConverts({kLas + "simple.las", "-o", dir.file("d.csv"), "--decimals", "3"});
   EXPECT_TRUE(test::contains(readFile(dir.file("d.csv")), "\n636896.330,849087.700,446.390,"));
   // Other inputs keep the shortest round trip.
-  EXPECT_EQ(convertedCsv(dir, "p.csv", "x,y,z\n849087.7000000001,1,2\n", "p_out.csv"), "x,y,z\n849087.7000000001,1,2\n");
+  EXPECT_EQ(convertedCsv(dir, "p.csv", "x,y,z\n849087.7000000001,1,2\n", "p_out.csv"),
+            "x,y,z\n849087.7000000001,1,2\n");
 }
 
 TEST(CliConvertMeaning, plyWrittenFromLasRecordsZUp) {
