@@ -31,7 +31,8 @@ struct RenderCliOptions {
   std::string background = "0,0,0";
   bool error = false, validate = false;
   std::string point_size = "auto";
-  uint32_t frames = 1, warmup = 1;
+  uint32_t frames = 1;
+  std::optional<uint32_t> warmup;  // none: 0 for one frame (the picture alone), else 1
   uint64_t chunk_points = 0;
   std::string max_memory;
   CommonOptions common;
@@ -86,7 +87,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.views = o.views;
   request.error = o.error;
   request.report = !o.json.empty();
-  request.frames = o.frames, request.warmup = o.warmup;
+  request.frames = o.frames, request.warmup = o.warmup.value_or(o.frames > 1 ? 1 : 0);
   request.chunk_points = o.chunk_points;
   request.native_path = o.native_path == "attribute" ? NativePath::kAttribute
                         : o.native_path == "pull"    ? NativePath::kPull
@@ -163,8 +164,8 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
   else
     printChoice(outcome.prediction, f, outcome.backend);
   if (!r.gpu_ms.empty())
-    std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f), %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
-                r.gpu_ms.size(), percentileOf(r.gpu_ms, 95),
+    std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f)%s, %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
+                r.gpu_ms.size(), percentileOf(r.gpu_ms, 95), request.warmup == 0 ? ", no warm-up" : "",
                 static_cast<double>(outcome.points) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(mode));
   std::printf("host: upload %.1f ms, frame %.3f ms, readback %.1f ms\n", r.upload_ms, medianOf(r.frame_ms), r.readback_ms);
   std::string steps;
@@ -257,8 +258,9 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
                   {"auto", "raster", "compute"});
   addCameraOptions(*cmd, o->camera);
   cmd->add_option("--point-size", o->point_size,
-                  "Point size in pixels, or auto: 1, or larger (up to 4) when a 3D set has too few points to\n"
-                  "cover its outline at this size; 1 for 2D sets and --error")
+                  "Point size in pixels, or auto: from how far apart the points lie on screen (sampled), up to 8;\n"
+                  "a 2D grid's spacing, so it shows no gaps, and about 2/3 of a 3D set's, whose remaining gaps the\n"
+                  "shading closes; 1 with --error")
       ->check(checkStatus([](const std::string& v) { return v == "auto" ? okStatus() : statusOf(parsePointSize(v)); }))
       ->default_val("auto");
   cmd->add_option("--background", o->background, "Background colour R,G,B (0..255)")
@@ -267,7 +269,10 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--device", o->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
       ->default_val("auto");
   cmd->add_option("--frames", o->frames, "Timed frames after warm-up (the median is reported)")->default_val(1);
-  cmd->add_option("--warmup", o->warmup, "Untimed frames first")->default_val(1);
+  cmd->add_option("--warmup", o->warmup,
+                  "Untimed frames first. auto: none for a single frame (the picture comes sooner; its time includes the\n"
+                  "first use of the shaders), 1 with --frames above 1")
+      ->default_str("auto");
   cmd->add_flag("--error", o->error, "Run the probe and the exact CPU reference; report the error in pixels");
   cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file")
       ->check(checkStatus(AtomicFile::checkTarget));
@@ -280,10 +285,12 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->check(checkStatus([](const std::string& v) { return statusOf(parsePointOrder("--order", v)); }))
       ->default_val("input");
   addChoiceOption(*cmd, "--shade", o->shade,
-                  "auto|none|edl. edl: eye-dome lighting, a screen-space pass over the depth of the visible points\n"
-                  "that darkens a pixel by how far its neighbours stand in front of it, so a surface of 1-px points\n"
-                  "reads as a surface (as in Potree and CloudCompare). auto: edl for 3D sets, none for 2D sets\n"
-                  "(every z is 0) and with --error, whatever the camera (--ortho, --eye); GPU timings exclude it",
+                  "auto|none|edl. edl: screen-space passes over the depth of the visible points: gaps between the\n"
+                  "front points (and the back surfaces seen through them) are filled from the points around them,\n"
+                  "then eye-dome lighting darkens a pixel by how far its neighbours stand in front of it, so a\n"
+                  "surface of points reads as a surface (as in Potree and CloudCompare). auto: edl for 3D sets,\n"
+                  "none for 2D sets (every z is 0) and with --error, whatever the camera (--ortho, --eye); GPU\n"
+                  "timings exclude it",
                   {"auto", "none", "edl"});
   cmd->add_option("--edl-strength", o->edl_strength, "Eye-dome darkening: exp(-strength * 300 * mean log2 depth step)")
       ->check(numberIn("--edl-strength", 0.0, 100.0, true, ""))

@@ -1,9 +1,13 @@
 #include "viewer/pipelines.h"
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "shaders/points.frag.h"
 #include "shaders/edl.comp.h"
+#include "shaders/fill.comp.h"
+#include "shaders/smooth.comp.h"
 #include "shaders/points_resolve.comp.h"
 
 namespace dpoint {
@@ -15,14 +19,14 @@ Spirv vertexShader(PrecisionMode mode, bool pull) {
   return pull && shaders.vertex_pull.code ? shaders.vertex_pull : shaders.vertex;
 }
 
-// Two boolean specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
-// 0 kWriteDepth (its constant 1 is unused); the eye-dome pass has none.
-Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
-                                   bool early_depth) {
+// Two 32-bit specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
+// 0 kWriteDepth (its constant 1 is unused), the shading passes' radii (fill.comp's 0, smooth.comp's 0).
+Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, uint32_t constant0,
+                                   uint32_t constant1) {
   Result<VkShaderModule> module = createShaderModule(context, code.code, code.bytes);
   if (!module) return module.error();
-  const VkBool32 values[2] = {probe ? VK_TRUE : VK_FALSE, early_depth ? VK_TRUE : VK_FALSE};
-  const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(VkBool32)}, {1, sizeof(VkBool32), sizeof(VkBool32)}};
+  const uint32_t values[2] = {constant0, constant1};
+  const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
   VkSpecializationInfo specialization{2, entries, sizeof(values), values};
   VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
@@ -36,6 +40,11 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
   vkDestroyShaderModule(context.device, *module, nullptr);
   if (result != VK_SUCCESS) return vulkanError("creating a compute pipeline", result);
   return pipeline;
+}
+
+Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
+                                   bool early_depth) {
+  return computePipeline(context, code, layout, probe ? VK_TRUE : VK_FALSE, early_depth ? VK_TRUE : VK_FALSE);
 }
 
 // keep_depth: the depth attachment is stored and left in TRANSFER_SRC_OPTIMAL for the eye-dome
@@ -275,7 +284,12 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& p) 
   p = ComputePipelines{};
 }
 
-Result<ShadePipeline> createShadePipeline(const VulkanContext& context) {
+ShadeRadii shadeRadii(float point_size) {
+  const int size = static_cast<int>(std::ceil(std::clamp(point_size, 1.0f, 64.0f)));
+  return {(size + 1) / 2 + 1, size - 1};
+}
+
+Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii) {
   ShadePipeline p;
   auto fail = [&](const Error& error) -> Result<ShadePipeline> {
     destroyShadePipeline(context, p);
@@ -284,7 +298,8 @@ Result<ShadePipeline> createShadePipeline(const VulkanContext& context) {
   auto storage = [](uint32_t binding) {
     return VkDescriptorSetLayoutBinding{binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   };
-  Result<VkDescriptorSetLayout> set = storageSetLayout(context, {storage(0), storage(1), storage(2)});
+  Result<VkDescriptorSetLayout> set = storageSetLayout(
+      context, {storage(0), storage(1), storage(2), storage(3), storage(4), storage(5), storage(6)});
   if (!set) return fail(set.error());
   p.set_layout = *set;
   Result<VkPipelineLayout> layout = pipelineLayout(context, p.set_layout, sizeof(EdlPush), VK_SHADER_STAGE_COMPUTE_BIT);
@@ -293,11 +308,21 @@ Result<ShadePipeline> createShadePipeline(const VulkanContext& context) {
   Result<VkPipeline> edl = computePipeline(context, {kEdlComp, sizeof(kEdlComp)}, p.layout, false, false);
   if (!edl) return fail(edl.error());
   p.edl = *edl;
+  Result<VkPipeline> fill =
+      computePipeline(context, {kFillComp, sizeof(kFillComp)}, p.layout, uint32_t(radii.fill), uint32_t{0});
+  if (!fill) return fail(fill.error());
+  p.fill = *fill;
+  Result<VkPipeline> smooth =
+      computePipeline(context, {kSmoothComp, sizeof(kSmoothComp)}, p.layout, uint32_t(radii.smooth), uint32_t{0});
+  if (!smooth) return fail(smooth.error());
+  p.smooth = *smooth;
   return p;
 }
 
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& p) {
   if (p.edl) vkDestroyPipeline(context.device, p.edl, nullptr);
+  if (p.fill) vkDestroyPipeline(context.device, p.fill, nullptr);
+  if (p.smooth) vkDestroyPipeline(context.device, p.smooth, nullptr);
   if (p.layout) vkDestroyPipelineLayout(context.device, p.layout, nullptr);
   if (p.set_layout) vkDestroyDescriptorSetLayout(context.device, p.set_layout, nullptr);
   p = ShadePipeline{};

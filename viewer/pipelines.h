@@ -74,15 +74,25 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pip
 struct ShadePipeline {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline edl = VK_NULL_HANDLE;
+  VkPipeline fill = VK_NULL_HANDLE, smooth = VK_NULL_HANDLE, edl = VK_NULL_HANDLE;
 };
 struct EdlPush {
   uint32_t width = 0, height = 0;
   float depth_scale = 0.0f;  // perspective: (far − near) / near; 0 for ortho
   float strength = 1.0f, radius = 1.4f;
+  float fill_threshold = 0.0f;  // how much nearer (log2 eye distance) a surrounding pixel must be
+  uint32_t axis = 0;            // smooth.comp's pass: 0 rows, 1 columns
 };
+inline constexpr uint32_t kShadeBindings = 7;  // shaders/render/shade_common.glsl
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/render/edl.comp
-Result<ShadePipeline> createShadePipeline(const VulkanContext& context);
+// The shading passes' radii for a point size (compiled into fill.comp and smooth.comp): the
+// filling searches half a point and a pixel each way, the depth is averaged over a square a pixel
+// narrower than two points.
+struct ShadeRadii {
+  int fill = 1, smooth = 0;
+};
+ShadeRadii shadeRadii(float point_size);
+Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);
 
 }  // namespace dpoint

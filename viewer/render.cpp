@@ -300,7 +300,7 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
   else
     recordDraws(r.frame_commands, r, r.pipelines.draw, options, width, height, timestamps);
   if (options.shading == Shading::kEdl)
-    detail::recordShade(r.frame_commands, r, detail::edlPush(camera, options.edl), options.backend == Backend::kRaster);
+    detail::recordShade(r.frame_commands, r, detail::edlPush(camera, options.edl, options.point_size), options.backend == Backend::kRaster);
   VK_TRY(vkEndCommandBuffer(r.frame_commands));
   VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
@@ -429,11 +429,11 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
 
   if (compute) {
     status = detail::createComputeTargets(context, r, camera.width, camera.height);
-    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, false);
+    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, false, options.point_size);
     if (status) status = detail::createComputeDescriptors(context, r, options.probe);
   } else {
     status = createTargets(context, r, camera.width, camera.height, shading);
-    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, true);
+    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, true, options.point_size);
     if (status) status = createDescriptors(context, r, pulled, options.probe);
   }
   if (status) status = timeFrames(context, r, options, camera, out);
@@ -490,7 +490,7 @@ class StreamBlocks {
 
 Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
   VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
-                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets}};
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets + (r.shade.edl ? kShadeBindings : 0)}};
   VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   info.maxSets = sets;
   info.poolSizeCount = 2;

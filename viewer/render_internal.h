@@ -41,6 +41,10 @@ struct Resources {
     destroyBuffer(context, picture);
     destroyBuffer(context, depth_values);
     destroyBuffer(context, shaded);
+    destroyBuffer(context, filled_log);
+    destroyBuffer(context, filled_picture);
+    destroyBuffer(context, partial);
+    destroyBuffer(context, smoothed);
     destroyShadePipeline(context, shade);
     destroyImage(context, color);
     destroyImage(context, depth);
@@ -64,7 +68,7 @@ struct Resources {
   // Eye-dome lighting: each pixel's depth (from the depth attachment or the resolve), the shaded
   // picture the readback takes instead of the plain one, and (raster) `picture` holds the plain one.
   ShadePipeline shade;
-  Buffer depth_values, shaded;
+  Buffer depth_values, shaded, filled_log, filled_picture, partial, smoothed;
   VkDescriptorSet shade_set = VK_NULL_HANDLE;
 };
 
@@ -82,9 +86,10 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
 // shaded (and for raster, plain picture) buffers; call before the descriptor pool is made, which
 // holds one more set for it. recordShade copies the raster attachments into buffers when
 // `raster`, then shades; the picture to read back is then `shaded`.
-Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster);
+Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster,
+                          float point_size);
 Status createShadeDescriptors(const VulkanContext& context, Resources& r);
-EdlPush edlPush(const Camera& camera, const EdlOptions& options);
+EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_size);
 void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& push, bool raster);
 
 }  // namespace dpoint::detail

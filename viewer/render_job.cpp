@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <future>
 #include <memory>
 
@@ -31,6 +33,12 @@ bool hasExtension(const std::string& path, const std::string& extension) {
 
 // The input as the run draws it: in memory, or a stream read a block at a time (a binary PLY
 // larger than memory), with what every view shares.
+// Points sampled for their nearest neighbour's distance (the default point size): enough for a
+// steady median, few enough that the search costs ~10 ms on 1.55M points.
+constexpr size_t kSpacingSamples = 512;
+// A 3D set's point size as a share of its projected spacing (pointSizeFor).
+constexpr double kSurfaceShare = 0.65;
+
 struct LoadedSet {
   std::string inputs;  // describeInputs: for messages
   std::optional<PointSet> points;
@@ -40,6 +48,7 @@ struct LoadedSet {
   bool has_colors = false;
   bool elevation = false;  // coloured by elevation along the up axis (a stream: block by block)
   bool z_up = false;
+  std::vector<SpacingSample> spacing;  // for the default point size
 };
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
@@ -59,12 +68,14 @@ Status forEachBlock(PointInputStream& ply, Progress& progress, const std::string
   return okStatus();
 }
 
-Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress) {
+Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress,
+                            SpacingSampler& sampler) {
   Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
   Status status = forEachBlock(ply, progress, "bounds of " + path + " (points)", [&](const PointSet& block) {
     const Box box = boundingBox(block.positions);
     bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
     bounds.planar = bounds.planar && block.isPlanar();
+    sampler.add(block.positions);
   });
   if (!status) return status.error();
   return bounds;
@@ -77,15 +88,26 @@ bool needsOutline(const RenderRequest& request, const Bounds& bounds) {
   return !bounds.planar && !spec.eye && !spec.ortho.value_or(false);
 }
 
-// The outline of a streamed set (the same as boundsWithOutline gives the set in memory, whatever the
-// block size): a second pass, a block at a time.
-Result<std::vector<glm::dvec3>> streamOutline(const std::string& path, PointInputStream& ply, const Bounds& bounds,
-                                              Progress& progress) {
-  OutlineBuilder builder(bounds);
-  Status status = forEachBlock(ply, progress, "outline of " + path + " (points)",
-                               [&](const PointSet& block) { builder.add(block.positions); });
-  if (!status) return status.error();
-  return builder.finish();
+// Whether the default point size is wanted, which samples the set's spacing.
+bool needsSpacing(const RenderRequest& request) { return !request.point_size && !request.error; }
+
+// The outline and the spacing samples of a streamed set, as needed (the same as the set in memory
+// gets, whatever the block size and order): a second pass, a block at a time.
+Status streamOutlineAndSpacing(const RenderRequest& request, const std::string& path, PointInputStream& ply,
+                               std::vector<glm::dvec3> samples, LoadedSet& set, Progress& progress) {
+  const bool outline = needsOutline(request, set.bounds), spacing = needsSpacing(request);
+  if (!outline && !spacing) return okStatus();
+  OutlineBuilder builder(set.bounds);
+  SpacingSearch search(Box{set.bounds.min, set.bounds.max}, set.count, std::move(samples), request.threads);
+  const std::string what = std::string(outline ? "outline" : "spacing") + " of " + path + " (points)";
+  Status status = forEachBlock(ply, progress, what, [&](const PointSet& block) {
+    if (outline) builder.add(block.positions);
+    if (spacing) search.add(block.positions);
+  });
+  if (!status) return status;
+  if (outline) set.bounds.outline = builder.finish();
+  if (spacing) set.spacing = search.finish();
+  return okStatus();
 }
 
 LasColorSource lasColorOf(RenderColor color) {
@@ -114,14 +136,11 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
                  "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
   if (ply) {
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
-    Result<Bounds> bounds = streamBounds(inputs, *ply, progress);
+    SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
+    Result<Bounds> bounds = streamBounds(inputs, *ply, progress, sampler);
     if (!bounds) return bounds.error();
     set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
-    if (needsOutline(request, set.bounds)) {
-      Result<std::vector<glm::dvec3>> outline = streamOutline(inputs, *ply, set.bounds, progress);
-      if (!outline) return outline.error();
-      set.bounds.outline = std::move(*outline);
-    }
+    if (Status s = streamOutlineAndSpacing(request, inputs, *ply, sampler.finish(), set, progress); !s) return s.error();
     phases.mark("bounds");
   } else {
     ReadOptions read_options{request.threads, false, &progress, true};
@@ -139,6 +158,10 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   set.z_up = zUpFor(request, set.points && set.points->z_up);
   // The outline lets a perspective fit frame the data rather than its box's empty corners.
   if (set.points) set.bounds = boundsWithOutline(*set.points);
+  if (set.points && needsSpacing(request)) {
+    set.spacing = sampleSpacing(set.points->positions, Box{set.bounds.min, set.bounds.max}, kSpacingSamples, request.threads);
+    phases.mark("spacing");
+  }
   // A 2D set has no elevation: without colours its points stay white.
   set.elevation = request.color == RenderColor::kElevation ||
                   (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar);
@@ -188,7 +211,7 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   RenderOptions options;
   options.mode = mode;
   options.backend = *request.backend;
-  options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts);
+  options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts, set.spacing);
   options.background_rgba8 = request.background_rgba8;
   options.frames = request.frames;
   options.warmup_frames = request.warmup;
@@ -420,18 +443,48 @@ Shading shadingFor(const RenderRequest& request, const Bounds& bounds) {
   return bounds.planar ? Shading::kNone : Shading::kEdl;
 }
 
-// The points' spacing on screen, rounded up: a 3D set's quarter of its points (a closed surface
-// shows its front half, and a folded one like a fractal's hides about half of that behind its own
-// folds) over the ellipse inside the bounding box's screen rectangle, at most 4 px; a 2D set's
-// points (a grid, all of them visible) over the rectangle itself, at most 8 px, so that a grid
-// drawn larger than its resolution closes without a screen-door pattern (a 256² mandelbrot2d at
-// 768 px: 3 px). Always 1 with --error (the reference raster draws 1-px points) and for a 3D set
-// seen in ortho; the same on both backends.
+// The median of the sampled spacings (ops/point_spacing.h), each projected at its point's depth
+// as a distance across the picture; none when no sampled point is in view.
+std::optional<double> projectedSpacing(std::span<const SpacingSample> spacing, const Camera& camera) {
+  if (spacing.empty()) return std::nullopt;
+  // The picture's x axis in world directions: the first row of the rotation.
+  const glm::dvec3 across(camera.rotation[0][0], camera.rotation[1][0], camera.rotation[2][0]);
+  std::vector<glm::dvec3> ends;
+  ends.reserve(2 * spacing.size());
+  for (const SpacingSample& s : spacing) {
+    ends.push_back(s.position);
+    ends.push_back(s.position + s.distance * across);
+  }
+  const std::vector<WindowPoint> windows = projectReference(ends, camera);
+  std::vector<double> pixels;
+  for (size_t k = 0; k + 1 < windows.size(); k += 2) {
+    const WindowPoint &a = windows[k], &b = windows[k + 1];
+    if (a.visible && b.visible) pixels.push_back(std::hypot(b.x - a.x, b.y - a.y));
+  }
+  if (pixels.empty()) return std::nullopt;
+  std::nth_element(pixels.begin(), pixels.begin() + std::ptrdiff_t(pixels.size() / 2), pixels.end());
+  return pixels[pixels.size() / 2];
+}
+
+// With the set's spacing samples: the projected spacing rounded up for a 2D set (a grid drawn
+// larger than its resolution closes without a screen-door pattern: a 256² mandelbrot2d at 768 px,
+// 3 px); kSurfaceShare of it for a 3D set, whose gaps the hole filling before eye-dome lighting
+// closes (shaders/render/fill.comp; a Mandelbulb of 226K points, 4 px, of 1.55M, 2 px; the
+// default Menger sponge, 5 px, its holes open). At most 8 px. Without samples (a streamed set), the
+// count over the outline: a 3D set's quarter of its points (a closed surface shows its front half,
+// and a folded one hides about half of that behind its folds) over the ellipse inside the box's
+// screen rectangle, at most 4 px, and 1 px in ortho; a 2D set's points over the rectangle, at most
+// 8 px. Always 1 with --error (the reference raster draws 1-px points); the same on both backends.
 float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box, const Camera& camera,
-                   const DeviceFacts& facts) {
+                   const DeviceFacts& facts, std::span<const SpacingSample> samples) {
   if (request.point_size) return static_cast<float>(*request.point_size);
-  if (request.error || (camera.ortho && !box.planar)) return 1.0f;
+  if (request.error) return 1.0f;
   if (request.backend.value_or(Backend::kRaster) == Backend::kRaster && !facts.large_points) return 1.0f;
+  if (std::optional<double> spacing = projectedSpacing(samples, camera)) {
+    const double size = box.planar ? *spacing : kSurfaceShare * *spacing;
+    return static_cast<float>(std::clamp(std::ceil(size), 1.0, std::min(8.0, double(facts.max_point_size))));
+  }
+  if (camera.ortho && !box.planar) return 1.0f;
   // The data's outline when the fit framed it (every one of its points is inside the picture), else
   // the box's corners.
   std::vector<glm::dvec3> corners = box.outline;

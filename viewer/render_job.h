@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "core/result.h"
 #include "image/image.h"
 #include "ops/point_order.h"
+#include "ops/point_spacing.h"
 #include "viewer/camera.h"
 #include "viewer/precision.h"
 #include "viewer/probe.h"
@@ -141,9 +143,10 @@ Backend backendFor(const RenderRequest& request, size_t count, uint32_t width, u
 
 // Shading auto: eye-dome lighting for a 3D set, none for a 2D one and with --error.
 Shading shadingFor(const RenderRequest& request, const Bounds& bounds);
-// Point size auto: 1 px, or up to 4 px when a 3D set has too few points to cover its outline.
+// Point size auto: from the spacing of the points on screen (`spacing`: the set's samples,
+// sampleSpacing), or for a streamed set (no samples) from the count over the outline; 1 with --error.
 float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box, const Camera& camera,
-                   const DeviceFacts& facts);
+                   const DeviceFacts& facts, std::span<const SpacingSample> spacing = {});
 
 // Points the probe measured: visible in the reference and not lost. With none, there is no error
 // to report (null, never a perfect 0).

@@ -1,12 +1,17 @@
-// Eye-dome lighting after either backend (RenderOptions::shading): the raster backend's colour
-// and depth attachments are copied into buffers, the compute backend's resolve writes them
-// there itself; then one pass (shaders/render/edl.comp) writes the shaded picture that is read back.
+// Shading after either backend (RenderOptions::shading): the raster backend's colour and depth
+// attachments are copied into buffers, the compute backend's resolve writes them there itself;
+// then four passes (shaders/render/shade_common.glsl names them: hole filling, the depth smoothed
+// along rows and columns, eye-dome lighting) write the shaded picture that is read back.
+#include <algorithm>
+#include <cmath>
+
 #include "viewer/render_internal.h"
 
 namespace dpoint::detail {
 
-Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster) {
-  Result<ShadePipeline> pipeline = createShadePipeline(context);
+Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster,
+                          float point_size) {
+  Result<ShadePipeline> pipeline = createShadePipeline(context, shadeRadii(point_size));
   if (!pipeline) return pipeline.error();
   r.shade = *pipeline;
   const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
@@ -23,6 +28,19 @@ Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t w
                                        false, "shaded picture");
   if (!shaded) return shaded.error();
   r.shaded = *shaded;
+  struct Between {
+    Buffer* buffer;
+    VkDeviceSize bytes;
+    const char* what;
+  };
+  for (const Between& b : {Between{&r.filled_log, bytes, "log distance after hole filling"},
+                           Between{&r.filled_picture, bytes, "picture after hole filling"},
+                           Between{&r.partial, 2 * bytes, "row sums of the log distance"},
+                           Between{&r.smoothed, bytes, "smoothed log distance"}}) {
+    Result<Buffer> buffer = createBuffer(context, b.bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, b.what);
+    if (!buffer) return buffer.error();
+    *b.buffer = *buffer;
+  }
   return okStatus();
 }
 
@@ -32,14 +50,16 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
   allocate.descriptorSetCount = 1;
   allocate.pSetLayouts = &r.shade.set_layout;
   VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &r.shade_set));
-  const VkDescriptorBufferInfo infos[3] = {{r.depth_values.buffer, 0, VK_WHOLE_SIZE},
-                                           {r.picture.buffer, 0, VK_WHOLE_SIZE},
-                                           {r.shaded.buffer, 0, VK_WHOLE_SIZE}};
+  const VkDescriptorBufferInfo infos[kShadeBindings] = {
+      {r.depth_values.buffer, 0, VK_WHOLE_SIZE}, {r.picture.buffer, 0, VK_WHOLE_SIZE},
+      {r.shaded.buffer, 0, VK_WHOLE_SIZE},       {r.filled_log.buffer, 0, VK_WHOLE_SIZE},
+      {r.filled_picture.buffer, 0, VK_WHOLE_SIZE}, {r.partial.buffer, 0, VK_WHOLE_SIZE},
+      {r.smoothed.buffer, 0, VK_WHOLE_SIZE}};
   writeBufferDescriptors(context, r.shade_set, infos);
   return okStatus();
 }
 
-EdlPush edlPush(const Camera& camera, const EdlOptions& options) {
+EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_size) {
   EdlPush push;
   push.width = camera.width;
   push.height = camera.height;
@@ -49,6 +69,14 @@ EdlPush edlPush(const Camera& camera, const EdlOptions& options) {
                                   : static_cast<float>((camera.far_plane - camera.near_plane) / camera.near_plane);
   push.strength = options.strength;
   push.radius = options.radius;
+  // Hole filling's threshold: the change in log2 eye distance over its radius across a surface at
+  // 72° to the view (slope 3), so the steps within one surface never count as standing in front.
+  // A pixel spans 2 / (focal · height) of the distance in perspective (focal = P[1][1] / P[2][3])
+  // and 2 · P[2][2] / (|P[1][1]| · height) of the depth range in ortho.
+  const glm::dmat4& p = camera.projection;
+  const double pixel = camera.ortho ? 2.0 * p[2][2] / (std::abs(p[1][1]) * camera.height)
+                                    : 2.0 * p[2][3] / (p[1][1] * camera.height);
+  push.fill_threshold = static_cast<float>(3.0 * shadeRadii(point_size).fill * pixel / std::log(2.0));
   return push;
 }
 
@@ -72,11 +100,27 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
     barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
   }
-  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.edl);
-  vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.layout, 0, 1, &r.shade_set, 0, nullptr);
-  vkCmdDispatch(commands, (push.width + kShadeGroupSize - 1) / kShadeGroupSize,
-                (push.height + kShadeGroupSize - 1) / kShadeGroupSize, 1);
+  const uint32_t groups_x = (push.width + kShadeGroupSize - 1) / kShadeGroupSize;
+  const uint32_t groups_y = (push.height + kShadeGroupSize - 1) / kShadeGroupSize;
+  auto pass = [&](VkPipeline pipeline, uint32_t axis) {
+    EdlPush p = push;
+    p.axis = axis;
+    vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(p), &p);
+    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdDispatch(commands, groups_x, groups_y, 1);
+  };
+  const auto between = [&] {
+    barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+            VK_ACCESS_SHADER_READ_BIT);
+  };
+  pass(r.shade.fill, 0);
+  between();
+  pass(r.shade.smooth, 0);
+  between();
+  pass(r.shade.smooth, 1);
+  between();
+  pass(r.shade.edl, 0);
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
           VK_ACCESS_TRANSFER_READ_BIT);
 }

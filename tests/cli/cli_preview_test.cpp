@@ -122,12 +122,13 @@ TEST(CliPreview, threeDimensionalSetWithoutColoursDefaultsToElevation) {
 }
 
 // --edl-strength scales the darkening: every pixel is as dark or darker as the strength grows,
-// and some strictly. 0 (no darkening, the picture of --shade none) is refused as a usage error.
+// and some strictly (the hole filling before it is the same at every strength). 0 (no darkening)
+// is refused as a usage error.
 TEST(CliPreview, edlStrengthDarkensMoreAsItGrows) {
   TempDir dir;
   const std::string mb = mandelbulb(dir);
-  std::vector<Pixels> pictures;  // none, then strengths 0.25, 1 (the default), 4
-  pictures.push_back(decodePng(render(dir, mb, "none.png", {"--shade", "none", "--point-size", "1"})));
+  std::vector<Pixels> pictures;  // strengths 0.01, 0.25, 1 (the default), 4
+  pictures.push_back(decodePng(render(dir, mb, "faint.png", {"--edl-strength", "0.01", "--point-size", "1"})));
   pictures.push_back(decodePng(render(dir, mb, "weak.png", {"--edl-strength", "0.25", "--point-size", "1"})));
   pictures.push_back(decodePng(render(dir, mb, "default.png", {"--point-size", "1"})));
   pictures.push_back(decodePng(render(dir, mb, "strong.png", {"--edl-strength", "4", "--point-size", "1"})));

@@ -1,15 +1,21 @@
 // The default picture of issue #24's cases on the device (lavapipe in CI, the validation layer on):
-// a Mandelbulb's vertices read as a closed surface and a 2D grid shows no gaps. A gap is a
-// background pixel that a 7×7 closing of the drawn pixels covers (picture_metrics.h); the issue
-// asks for at most 2% of the closed area.
+// a Mandelbulb's vertices read as a closed surface, the Menger sponge's too with its holes open,
+// and a 2D grid shows no gaps. A gap is a background pixel that a 7×7 closing of the drawn pixels
+// covers (picture_metrics.h); the issue asks for at most 2% of the closed area (5% for the sponge)
+// and a span of at least 85% of the picture's smaller side. The hole filling itself
+// (shaders/render/fill.comp) is pinned on planes: it closes the gaps between points and hides a
+// back surface seen through them, and leaves a hole wider than the points' spacing open.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
 #include "converters/point_io.h"
 #include "generators/mandelbrot2d.h"
 #include "generators/mandelbulb.h"
+#include "generators/menger.h"
 #include "picture_metrics.h"
 #include "test_support.h"
 #include "viewer/render_job.h"
@@ -21,14 +27,19 @@ struct Rendered {
   test::ClosingGap gap;
   std::string backend;
   float point_size = 0.0f;
+  Image image;
+  // The picture's RGB at (x, y), R in the low byte.
+  uint32_t rgb(uint32_t x, uint32_t y) const {
+    const uint8_t* p = &image.rgba[4 * (size_t(y) * image.width + x)];
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+  }
 };
 
 // `dpoint render FILE -o out.png` with every default, on the set written as PLY.
-Rendered renderDefault(const PointSet& points, const std::string& name) {
+Rendered renderDefault(const PointSet& points, const std::string& name, RenderRequest request = {}) {
   test::TempDir dir;
   const std::string path = dir.file(name + ".ply");
   EXPECT_TRUE(writePoints(path, points).ok());
-  RenderRequest request;
   request.inputs = {path};
   request.validate = true;
   Progress progress;
@@ -37,7 +48,7 @@ Rendered renderDefault(const PointSet& points, const std::string& name) {
   if (!outcome.ok()) return {};
   for (const std::string& m : outcome->validation_messages) ADD_FAILURE() << m;
   Rendered r{test::closingGap(outcome->image, request.background_rgba8), backendName(outcome->backend),
-             outcome->point_size};
+             outcome->point_size, outcome->image};
   std::printf("%s: %g px points, %s backend, gaps %.2f%% of the closed area (%zu of %zu px), span %ux%u of %ux%u\n",
               name.c_str(), double(r.point_size), r.backend.c_str(), 100.0 * r.gap.share, r.gap.gaps, r.gap.closed,
               r.gap.span_x, r.gap.span_y, outcome->image.width, outcome->image.height);
@@ -53,16 +64,87 @@ PointSet mandelbrot2d(double width) {
   return points.ok() ? std::move(*points) : PointSet{};
 }
 
+double span(const Rendered& r) {
+  return double(std::max(r.gap.span_x, r.gap.span_y)) / double(std::min(r.image.width, r.image.height));
+}
+
+// 226K points (res 200, 4 px) and 1.55M (res 420, 2 px): before the hole filling, 35% and 21%.
 TEST(RenderFill, defaultMandelbulbReadsAsAClosedSurface) {
-  MandelbulbParams params;
-  params.resolution = 200;
-  Result<PointSet> points = generateMandelbulb(params);
+  for (int resolution : {200, 420}) {
+    MandelbulbParams params;
+    params.resolution = resolution;
+    Result<PointSet> points = generateMandelbulb(params);
+    ASSERT_TRUE(points.ok());
+    const Rendered r = renderDefault(*points, "mandelbulb" + std::to_string(resolution));
+    EXPECT_LE(r.gap.share, 0.02) << "res " << resolution;
+    EXPECT_GE(span(r), 0.85) << "res " << resolution;
+    EXPECT_EQ(r.backend, "compute");
+  }
+}
+
+// Level 4, exact (the default): its faces closed (the points are the small cubes' corners, 6 px
+// apart), its holes open: a hole is wider than the filling reaches (see the plane's below).
+TEST(RenderFill, defaultMengerSpongeReadsAsAClosedSurface) {
+  Result<PointSet> points = generateMenger(MengerParams{});
   ASSERT_TRUE(points.ok());
-  const Rendered r = renderDefault(*points, "mandelbulb200");
-  // Not yet at 2%: 35% of the closed area, most of it pixels eye-dome lighting turns black at the
-  // squares' depth steps (7.7% without shading at 3 px; 2.5% at 4 px, 1.0% at 5 px). Printed above.
-  EXPECT_LE(r.gap.share, 0.40);
-  EXPECT_EQ(r.backend, "compute");
+  const Rendered r = renderDefault(*points, "menger");
+  EXPECT_LE(r.gap.share, 0.05);
+  EXPECT_GE(span(r), 0.85);
+}
+
+// A plane of red points (100 × 100, 1/100 apart; tilted by 0.001 in z so the set is 3D and gets
+// the shading) with a square hole of 20 × 20 spacings at its centre, seen from straight above.
+PointSet planeWithHole(double z, glm::vec3 color, bool hole) {
+  PointSet plane;
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 100; ++j) {
+      const double x = (i + 0.5) / 100.0, y = (j + 0.5) / 100.0;
+      if (hole && std::abs(x - 0.5) < 0.1 && std::abs(y - 0.5) < 0.1) continue;
+      plane.positions.push_back({x, y, z + 0.001 * x});
+      plane.colors.push_back(color);
+    }
+  return plane;
+}
+
+RenderRequest fromAbove(double height) {
+  RenderRequest request;
+  request.camera.width = request.camera.height = 400;
+  request.camera.eye = glm::dvec3(0.5, 0.5, height);
+  request.camera.target = glm::dvec3(0.5, 0.5, 0.0);
+  request.camera.up = glm::dvec3(0.0, 1.0, 0.0);
+  return request;
+}
+
+TEST(RenderFill, fillingClosesGapsAndLeavesHolesOpen) {
+  const Rendered r = renderDefault(planeWithHole(0.0, {1, 0, 0}, true), "holed", fromAbove(1.5));
+  // The hole's centre (the picture's) shows the background; the plane around it has no gaps.
+  EXPECT_EQ(r.rgb(200, 200), 0u);
+  size_t red = 0, plane_pixels = 0;
+  for (uint32_t y = 0; y < 400; ++y)
+    for (uint32_t x = 0; x < 400; ++x) {
+      // Pixels well inside the plane and well outside the hole (the plane spans ~x 75..325 here).
+      const bool in_plane = x > 100 && x < 300 && y > 100 && y < 300;
+      const bool near_hole = x > 160 && x < 240 && y > 160 && y < 240;
+      if (!in_plane || near_hole) continue;
+      ++plane_pixels;
+      red += (r.rgb(x, y) & 0xffu) > 0 && (r.rgb(x, y) >> 8) == 0;
+    }
+  EXPECT_EQ(red, plane_pixels) << "every pixel of the plane is drawn (red, shaded or not)";
+  EXPECT_GT(r.point_size, 1.0f);
+}
+
+// Two such planes without the hole, red 0.1 above blue: the blue one, seen through the gaps
+// between the red one's points, is hidden where the red one lies.
+TEST(RenderFill, fillingHidesTheBackSurfaceSeenThroughTheGaps) {
+  PointSet both = planeWithHole(0.1, {1, 0, 0}, false);
+  const PointSet back = planeWithHole(0.0, {0, 0, 1}, false);
+  both.positions.insert(both.positions.end(), back.positions.begin(), back.positions.end());
+  both.colors.insert(both.colors.end(), back.colors.begin(), back.colors.end());
+  const Rendered r = renderDefault(both, "two-planes", fromAbove(1.5));
+  size_t blue = 0;
+  for (uint32_t y = 120; y < 280; ++y)
+    for (uint32_t x = 120; x < 280; ++x) blue += (r.rgb(x, y) >> 16) > 0;
+  EXPECT_EQ(blue, 0u) << "of 160 x 160 pixels inside the front plane";
 }
 
 TEST(RenderFill, defaultMandelbrot2dGridHasNoGaps) {

@@ -1,0 +1,188 @@
+#include "ops/point_spacing.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include <glm/glm.hpp>
+
+#include "core/parallel.h"
+
+namespace dpoint {
+namespace {
+
+constexpr int kCellBits = 21;  // cell coordinates per axis, packed three to a 64-bit key
+constexpr int64_t kMaxCell = (int64_t{1} << kCellBits) - 1;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+uint64_t mix(uint64_t x) {  // splitmix64's finalizer
+  x ^= x >> 30, x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27, x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+uint64_t positionHash(const glm::dvec3& p) {
+  uint64_t h = 0;
+  for (int k = 0; k < 3; ++k) h = mix(h ^ std::bit_cast<uint64_t>(p[k] + 0.0));  // + 0.0: -0 hashes as 0
+  return h;
+}
+
+size_t tableIndex(uint64_t key, size_t size) { return size_t(mix(key)) & (size - 1); }
+
+}  // namespace
+
+namespace {
+
+using Entry = std::pair<uint64_t, glm::dvec3>;
+
+// Keeps `heap` (a max-heap on the hash) at the `wanted` smallest distinct entries.
+void offer(std::vector<Entry>& heap, size_t wanted, uint64_t h, const glm::dvec3& p) {
+  auto less = [](const Entry& a, const Entry& b) { return a.first < b.first; };
+  if (heap.size() == wanted && !(h < heap.front().first)) return;
+  if (std::any_of(heap.begin(), heap.end(), [&](const Entry& e) { return e.first == h && e.second == p; })) return;
+  if (heap.size() == wanted) {
+    std::pop_heap(heap.begin(), heap.end(), less);
+    heap.pop_back();
+  }
+  heap.push_back({h, p});
+  std::push_heap(heap.begin(), heap.end(), less);
+}
+
+}  // namespace
+
+void SpacingSampler::add(std::span<const glm::dvec3> points) {
+  if (wanted_ == 0) return;
+  // Blocks in parallel, each keeping its own smallest, then those offered here: the same entries
+  // as one pass over the points.
+  constexpr size_t kBlock = size_t{1} << 16;
+  const size_t blocks = (points.size() + kBlock - 1) / kBlock;
+  std::vector<std::vector<Entry>> kept(blocks);
+  parallelFor(blocks, threads_, [&](size_t b, unsigned) {
+    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i)
+      offer(kept[b], wanted_, positionHash(points[i]), points[i]);
+  });
+  for (const std::vector<Entry>& block : kept)
+    for (const Entry& e : block) offer(heap_, wanted_, e.first, e.second);
+}
+
+std::vector<glm::dvec3> SpacingSampler::finish() const {
+  std::vector<std::pair<uint64_t, glm::dvec3>> sorted = heap_;
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<glm::dvec3> out;
+  for (const auto& e : sorted) out.push_back(e.second);
+  return out;
+}
+
+SpacingSearch::SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dvec3> samples, unsigned threads)
+    : samples_(std::move(samples)), threads_(resolveThreads(threads)), origin_(box.min) {
+  const glm::dvec3 extent = box.max - box.min;
+  const double largest = std::max({extent.x, extent.y, extent.z});
+  const double n = double(std::max<uint64_t>(count, 1));
+  const double volume = extent.x * extent.y * extent.z;
+  const double face = std::max({extent.x * extent.y, extent.y * extent.z, extent.x * extent.z});
+  cell_ = 2.0 * std::max({std::cbrt(volume / n), std::sqrt(face / n), largest / double(kMaxCell)});
+  if (!(cell_ > 0.0) || !std::isfinite(cell_)) samples_.clear();  // all points equal, or not finite
+  inverse_cell_ = 1.0 / cell_;
+
+  // The 27 cells around each sample, each listing the samples it is next to.
+  size_t capacity = 16;
+  while (capacity < 2 * 27 * samples_.size()) capacity *= 2;
+  keys_.assign(capacity, 0);
+  slots_.assign(capacity, 0);
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;  // (slot, sample)
+  uint32_t slot_count = 0;
+  for (uint32_t s = 0; s < samples_.size(); ++s) {
+    glm::i64vec3 c;
+    for (int k = 0; k < 3; ++k)
+      c[k] = std::clamp<int64_t>(static_cast<int64_t>((samples_[s][k] - origin_[k]) * inverse_cell_), 0, kMaxCell);
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const glm::i64vec3 q = c + glm::i64vec3(dx, dy, dz);
+          if (glm::any(glm::lessThan(q, glm::i64vec3(0))) || glm::any(glm::greaterThan(q, glm::i64vec3(kMaxCell))))
+            continue;
+          const uint64_t key = uint64_t(q.x) | uint64_t(q.y) << kCellBits | uint64_t(q.z) << (2 * kCellBits);
+          size_t at = tableIndex(key, capacity);
+          while (keys_[at] != 0 && keys_[at] != key + 1) at = (at + 1) & (capacity - 1);
+          if (keys_[at] == 0) keys_[at] = key + 1, slots_[at] = slot_count++;
+          pairs.push_back({slots_[at], s});
+        }
+  }
+  slot_start_.assign(size_t{slot_count} + 1, 0);
+  for (const auto& [slot, s] : pairs) ++slot_start_[slot + 1];
+  for (size_t k = 1; k < slot_start_.size(); ++k) slot_start_[k] += slot_start_[k - 1];
+  slot_samples_.resize(pairs.size());
+  std::vector<uint32_t> fill(slot_start_.begin(), slot_start_.end() - 1);
+  for (const auto& [slot, s] : pairs) slot_samples_[fill[slot]++] = s;
+  Best none;
+  none.fill(kInf);
+  best_.assign(threads_, std::vector<Best>(samples_.size(), none));
+}
+
+uint64_t SpacingSearch::cellKey(const glm::dvec3& p) const {
+  uint64_t key = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double c = (p[k] - origin_[k]) * inverse_cell_;
+    if (!(c >= 0.0) || c > double(kMaxCell)) return UINT64_MAX;  // outside the box (or NaN): no sample's cell
+    key |= uint64_t(c) << (k * kCellBits);
+  }
+  return key;
+}
+
+uint32_t SpacingSearch::findSlot(uint64_t key) const {
+  if (key == UINT64_MAX) return UINT32_MAX;
+  for (size_t at = tableIndex(key, keys_.size());; at = (at + 1) & (keys_.size() - 1)) {
+    if (keys_[at] == key + 1) return slots_[at];
+    if (keys_[at] == 0) return UINT32_MAX;
+  }
+}
+
+void SpacingSearch::add(std::span<const glm::dvec3> points) {
+  if (samples_.empty()) return;
+  constexpr size_t kBlock = size_t{1} << 16;
+  const size_t blocks = (points.size() + kBlock - 1) / kBlock;
+  parallelFor(blocks, threads_, [&](size_t b, unsigned worker) {
+    std::vector<Best>& best = best_[worker];
+    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
+      const uint32_t slot = findSlot(cellKey(points[i]));
+      if (slot == UINT32_MAX) continue;
+      for (uint32_t k = slot_start_[slot]; k < slot_start_[slot + 1]; ++k) {
+        const uint32_t s = slot_samples_[k];
+        const glm::dvec3 d = points[i] - samples_[s];
+        const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        Best& b2 = best[s];
+        if (!(d2 > 0.0) || d2 >= b2.back()) continue;
+        size_t at = kSpacingNeighbors - 1;
+        for (; at > 0 && b2[at - 1] > d2; --at) b2[at] = b2[at - 1];
+        b2[at] = d2;
+      }
+    }
+  });
+}
+
+std::vector<SpacingSample> SpacingSearch::finish() const {
+  std::vector<SpacingSample> out;
+  for (size_t s = 0; s < samples_.size(); ++s) {
+    // Each point was seen by one worker: the smallest of the workers' lists together.
+    std::vector<double> all;
+    for (const std::vector<Best>& worker : best_) all.insert(all.end(), worker[s].begin(), worker[s].end());
+    std::nth_element(all.begin(), all.begin() + (kSpacingNeighbors - 1), all.end());
+    const double distance = std::sqrt(all[kSpacingNeighbors - 1]);
+    if (distance <= cell_) out.push_back({samples_[s], distance});
+  }
+  if (2 * out.size() < samples_.size()) out.clear();
+  return out;
+}
+
+std::vector<SpacingSample> sampleSpacing(const std::vector<glm::dvec3>& positions, const Box& box, size_t samples,
+                                         unsigned threads) {
+  if (positions.size() < 2 || samples == 0) return {};
+  SpacingSampler sampler(samples, threads);
+  sampler.add(positions);
+  SpacingSearch search(box, positions.size(), sampler.finish(), threads);
+  search.add(positions);
+  return search.finish();
+}
+
+}  // namespace dpoint

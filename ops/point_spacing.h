@@ -1,0 +1,74 @@
+// How far apart a set's points lie: for sampled points, the distance to their kSpacingNeighbors-th
+// nearest neighbour, fast enough to run before every render (the default point size follows it,
+// viewer/render_job). Two passes over the points, each in any order and in blocks, so a set
+// streamed from a file a block at a time gets the same samples and distances as the set in memory.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/point_set.h"
+
+namespace dpoint {
+
+// The 4th nearest: on a surface or a grid, the spacing of its points, where the nearest alone
+// finds the near-duplicates a mesh's vertices have.
+inline constexpr size_t kSpacingNeighbors = 4;
+
+struct SpacingSample {
+  glm::dvec3 position{0.0};  // the sampled point
+  double distance = 0.0;     // to its kSpacingNeighbors-th nearest point at another position
+};
+
+// Pass 1: the `samples` distinct positions with the smallest hash of their coordinates' bits: a
+// spread over the set that depends on the points, not on their order or on how they are split.
+class SpacingSampler {
+ public:
+  explicit SpacingSampler(size_t samples, unsigned threads = 0) : wanted_(samples), threads_(threads) {}
+  void add(std::span<const glm::dvec3> points);
+  std::vector<glm::dvec3> finish() const;  // ordered by hash
+
+ private:
+  size_t wanted_;
+  unsigned threads_;
+  std::vector<std::pair<uint64_t, glm::dvec3>> heap_;  // max-heap on the hash
+};
+
+// Pass 2: each sample's distance, on a uniform grid over `box` (the set's bounding box) whose cell
+// is twice the spacing `count` points would have filling the box's volume or its largest face;
+// only the cells next to a sample's are kept, and any point within a cell of a sample lies in them,
+// so a distance up to a cell is exact. finish() gives the samples whose distance is within a cell,
+// or none when that is fewer than half of them (points far sparser than their box suggests).
+class SpacingSearch {
+ public:
+  SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dvec3> samples, unsigned threads = 0);
+  void add(std::span<const glm::dvec3> points);
+  std::vector<SpacingSample> finish() const;
+
+ private:
+  using Best = std::array<double, kSpacingNeighbors>;  // squared distances, ascending
+  uint64_t cellKey(const glm::dvec3& p) const;
+  uint32_t findSlot(uint64_t key) const;
+
+  std::vector<glm::dvec3> samples_;
+  unsigned threads_;
+  glm::dvec3 origin_{0.0};
+  double cell_ = 0.0, inverse_cell_ = 0.0;
+  std::vector<uint64_t> keys_;              // open addressing: cell key + 1, 0 = empty
+  std::vector<uint32_t> slots_;             // the slot of keys_[i]
+  std::vector<uint32_t> slot_start_;        // slot s lists samples slot_samples_[start[s], start[s + 1])
+  std::vector<uint32_t> slot_samples_;
+  std::vector<std::vector<Best>> best_;     // per worker, per sample
+};
+
+// Both passes over a set in memory: up to `samples` samples. Empty when the set has fewer than 2
+// distinct positions or SpacingSearch finds too few. About 10 ms for 1.55M points on 2 cores.
+std::vector<SpacingSample> sampleSpacing(const std::vector<glm::dvec3>& positions, const Box& box, size_t samples,
+                                         unsigned threads = 0);
+
+}  // namespace dpoint

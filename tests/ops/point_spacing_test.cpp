@@ -1,0 +1,77 @@
+// Sampled spacing (ops/point_spacing.h): the distances are the exact 4th-nearest on a grid, the
+// samples depend on the points and not on their order or on how they are split into blocks, and
+// a set too sparse for its box (or with one distinct position) gives none.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "ops/point_spacing.h"
+
+namespace dpoint {
+namespace {
+
+// n × n points `step` apart in the z = 0 plane (z = 0.001·x when `tilt`, so the set is 3D).
+std::vector<glm::dvec3> grid(int n, double step, bool tilt = false) {
+  std::vector<glm::dvec3> points;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) points.push_back({i * step, j * step, tilt ? 0.001 * i * step : 0.0});
+  return points;
+}
+
+TEST(PointSpacing, aGridsSpacingIsItsStep) {
+  for (bool tilt : {false, true}) {
+    const std::vector<glm::dvec3> points = grid(200, 0.25, tilt);
+    const std::vector<SpacingSample> samples = sampleSpacing(points, boundingBox(points), 256);
+    ASSERT_GE(samples.size(), 200u) << "tilt " << tilt;  // edge points too: their 4th nearest is a step away
+    size_t at_step = 0;
+    for (const SpacingSample& s : samples) at_step += std::abs(s.distance - 0.25) < 1e-3;
+    EXPECT_GT(at_step, samples.size() * 9 / 10) << "tilt " << tilt;
+  }
+}
+
+TEST(PointSpacing, samplesDoNotDependOnOrderOrBlocks) {
+  std::vector<glm::dvec3> points = grid(120, 1.0);
+  std::mt19937 random(7);
+  for (glm::dvec3& p : points) p.z = std::uniform_real_distribution<double>(0.0, 0.5)(random);
+  const Box box = boundingBox(points);
+  const std::vector<SpacingSample> whole = sampleSpacing(points, box, 300, 1);
+  std::vector<glm::dvec3> shuffled = points;
+  std::shuffle(shuffled.begin(), shuffled.end(), random);
+  // Two passes in blocks of 1000, as a streamed file is read, on two threads.
+  SpacingSampler sampler(300, 2);
+  for (size_t first = 0; first < shuffled.size(); first += 1000)
+    sampler.add(std::span(shuffled).subspan(first, std::min<size_t>(1000, shuffled.size() - first)));
+  SpacingSearch search(box, shuffled.size(), sampler.finish(), 2);
+  for (size_t first = 0; first < shuffled.size(); first += 1000)
+    search.add(std::span(shuffled).subspan(first, std::min<size_t>(1000, shuffled.size() - first)));
+  const std::vector<SpacingSample> blocks = search.finish();
+  ASSERT_EQ(whole.size(), blocks.size());
+  ASSERT_GT(whole.size(), 150u);
+  for (size_t k = 0; k < whole.size(); ++k) {
+    EXPECT_EQ(whole[k].position, blocks[k].position) << k;
+    EXPECT_EQ(whole[k].distance, blocks[k].distance) << k;
+  }
+}
+
+TEST(PointSpacing, copiesOfAPointAreNotItsNeighbours) {
+  std::vector<glm::dvec3> points = grid(50, 2.0);
+  const std::vector<glm::dvec3> copies = points;
+  points.insert(points.end(), copies.begin(), copies.end());  // every point twice
+  const std::vector<SpacingSample> samples = sampleSpacing(points, boundingBox(points), 64);
+  ASSERT_FALSE(samples.empty());
+  for (const SpacingSample& s : samples) EXPECT_GE(s.distance, 2.0 - 1e-9);
+}
+
+TEST(PointSpacing, noSamplesWithoutTwoPositionsOrForAFewFarClusters) {
+  EXPECT_TRUE(sampleSpacing(std::vector<glm::dvec3>(10, glm::dvec3(1, 2, 3)), Box{{1, 2, 3}, {1, 2, 3}}, 8).empty());
+  EXPECT_TRUE(sampleSpacing({glm::dvec3(0.0)}, Box{}, 8).empty());
+  // Two points at opposite corners of a huge box with 1000 copies each: the 4th nearest distinct
+  // position is the other corner, far beyond a cell.
+  std::vector<glm::dvec3> far;
+  for (int i = 0; i < 4; ++i) far.push_back({0, 0, 0}), far.push_back({1e6, 1e6, 1e6});
+  EXPECT_TRUE(sampleSpacing(far, boundingBox(far), 8).empty());
+}
+
+}  // namespace
+}  // namespace dpoint
