@@ -94,16 +94,22 @@ std::optional<Error> positionProblem(const ModeEncoding& e, const PointSet& poin
 }
 
 // Every position checked on every core; the error names the first bad point whatever the thread count.
+// The test positionProblem makes, without building its message: a coordinate in the mode's frame
+// is finite and, where the mode stores floats, within float range.
 Status checkPositions(const ModeEncoding& e, const PointSet& points, size_t index_base) {
   constexpr size_t kBlock = 1 << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
   std::vector<size_t> first_bad(blocks, SIZE_MAX);
+  const double limit = modeInfo(e.mode).layout.element == PositionElement::kFloat32 ? kFloatMax : HUGE_VAL;
   parallelFor(blocks, 0, [&](size_t b, unsigned) {
-    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i)
-      if (positionProblem(e, points, i, index_base)) {
-        first_bad[b] = i;
-        return;
-      }
+    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
+      const glm::dvec3 in_frame = scaleBy(points.positions[i], e.frame);
+      for (int axis = 0; axis < 3; ++axis)
+        if (!std::isfinite(in_frame[axis]) || !(std::fabs(in_frame[axis]) <= limit)) {
+          first_bad[b] = i;
+          return;
+        }
+    }
   });
   for (size_t i : first_bad)
     if (i != SIZE_MAX) return *positionProblem(e, points, i, index_base);
