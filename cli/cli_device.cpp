@@ -101,8 +101,9 @@ EscapePlaneFunction GenerateDevice::planes(const EscapeKernelParams& kernel, con
 
 PerturbationFunction GenerateDevice::perturbation() {
   return [self = shared_from_this()](const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
-                                    const std::vector<double>& dcy, int max_iter, uint32_t* counts) -> Status {
-    if (Status s = self->gpu_->perturbation(orbit, dcx, dcy, max_iter, counts); !s) return s;
+                                    const std::vector<double>& dcy, int max_iter, uint32_t* counts,
+                                    EscapeTail* tails) -> Status {
+    if (Status s = self->gpu_->perturbation(orbit, dcx, dcy, max_iter, counts, tails); !s) return s;
     return self->checkValidation();
   };
 }

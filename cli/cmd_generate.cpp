@@ -1,9 +1,12 @@
 // dpoint generate KIND -o OUT: the datasets of the study (DESIGN §8).
 // Parsing and reporting only; every generator is a library function, and what is done to its
 // points after it is cli/cli_generate_output.h over generators/generate.h.
+#include <charconv>
+#include <cstdio>
 #include <memory>
 #include <optional>
 
+#include "cli/cli_check.h"
 #include "cli/cli_device.h"
 #include "cli/cli_generate_output.h"
 #include "cli/cli_text.h"
@@ -143,15 +146,44 @@ Result<MengerParams> mengerParams(const MengerOptions& o, Progress* progress) {
 struct Mandelbrot2dOptions {
   Mandelbrot2dParams params;
   std::string center = "-0.7436450,0.1318259";
+  std::string max_iter = "auto";
   GenerateDeviceOptions device;
   OutputOptions out;
 };
+
+// --max-iter of mandelbrot2d: a whole number ≥ 1, or auto (empty).
+Result<std::optional<int>> parseMaxIter(const std::string& text) {
+  if (text == "auto") return std::optional<int>();
+  int value = 0;
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (error != std::errc() || stop != end || value < 1)
+    return Error{"--max-iter must be a whole number from 1 to 2147483647, or auto, got '" + text + "'",
+                 ExitCode::kUsage};
+  return std::optional<int>(value);
+}
+
+constexpr const char* kMaxIterAutoHelp =
+    "Iterations before a point counts as inside: a whole number, or auto (the default): max(2000, 50*d^2) with\n"
+    "d = log10(4 / width), the zoom depth (2000 down to width 1.9e-6, 2179 at 1e-6, 7941 at 1e-12,\n"
+    "12171 at 1e-15); generate says which it chose";
+
 Result<Mandelbrot2dParams> mandelbrot2dParams(const Mandelbrot2dOptions& o, Progress* progress) {
   Mandelbrot2dParams p = o.params;
   Result<std::vector<double>> c = parseNumbers("--center", o.center, 2);
   if (!c) return c.error();
   p.center_x = (*c)[0];
   p.center_y = (*c)[1];
+  Result<std::optional<int>> max_iter = parseMaxIter(o.max_iter);
+  if (!max_iter) return max_iter.error();
+  p.max_iter = *max_iter;
+  if (!p.max_iter) {
+    Result<int> chosen = mandelbrot2dMaxIter(p);  // also checks the other parameters
+    if (!chosen) return chosen.error();
+    if (!o.out.common.quiet)
+      std::fprintf(stderr, "dpoint: mandelbrot2d --max-iter auto: %d at --width %s\n", *chosen,
+                   formatNumber(p.width).c_str());
+  }
   Result<std::shared_ptr<GenerateDevice>> device =
       GenerateDevice::open(o.device, "mandelbrot2d", "", o.out.common.quiet);
   if (!device) return device.error();
@@ -245,16 +277,18 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
 
   auto m2 = std::make_shared<Mandelbrot2dOptions>();
   CLI::App* mandelbrot2d = generate->add_subcommand(
-      "mandelbrot2d", "2D Mandelbrot deep zoom: a resolution^2 grid coloured by escape count (perturbation when deep)");
+      "mandelbrot2d", "2D Mandelbrot deep zoom: a resolution^2 grid coloured by smooth escape count (perturbation)");
   mandelbrot2d->add_option("--center", m2->center, "View centre X,Y")->default_val("-0.7436450,0.1318259");
   mandelbrot2d->add_option("--width", m2->params.width, "View width")->default_val(1e-6);
   mandelbrot2d->add_option("--resolution", m2->params.resolution, "Points per side (2..65536)")->default_val(1024);
-  mandelbrot2d->add_option("--max-iter", m2->params.max_iter, "Iterations before a point counts as inside")->default_val(2000);
+  mandelbrot2d->add_option("--max-iter", m2->max_iter, kMaxIterAutoHelp)
+      ->check(checkStatus([](const std::string& text) { return statusOf(parseMaxIter(text)); }))
+      ->default_val("auto");
   addGenerateDeviceOptions(*mandelbrot2d, m2->device,
                            "On a device: the perturbation deltas (the reference orbit stays on the CPU)");
   mandelbrot2d->add_option("--grid-out", m2->params.grid_out,
                            "Also write the escape counts, row-major (uint8 if max_iter <= 255, else uint16)");
-  addOutputOptions(*mandelbrot2d, m2->out, "escape count");
+  addOutputOptions(*mandelbrot2d, m2->out, "smooth escape count, histogram-equalised over the view");
   registerKind(run, m2, mandelbrot2d, false, &generateMandelbrot2d, &generateMandelbrot2dTile, &mandelbrot2dParams);
 }
 

@@ -24,10 +24,12 @@ struct EscapePush {
 };
 static_assert(sizeof(EscapePush) == 64);
 
-// Push constants of shaders/generate/perturbation.comp.
+// Push constants of shaders/generate/perturbation.comp (std430: the double at 0, then the uints).
 struct PerturbationPush {
-  uint32_t cols, first_row, count, max_iter, last;
+  double tail_radius2;
+  uint32_t cols, first_row, count, max_iter, last, tail_steps;
 };
+static_assert(sizeof(PerturbationPush) == 32);
 
 VkDescriptorSetLayoutBinding storage(uint32_t binding) {
   return {binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
@@ -51,6 +53,17 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const uint32_t* 
   vkDestroyShaderModule(context.device, *module, nullptr);
   if (result != VK_SUCCESS) return vulkanError("creating a generation pipeline", result);
   return pipeline;
+}
+
+// Copies `bytes` out of mapped memory on several threads: one thread copies at a fraction of the
+// host's bandwidth, and this copy is on the critical path of the thread that feeds the meshing
+// workers.
+void copyOut(void* to, const void* from, uint64_t bytes) {
+  constexpr uint64_t kPiece = uint64_t{4} << 20;
+  parallelFor((bytes + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
+    const uint64_t at = i * kPiece;
+    std::memcpy(static_cast<uint8_t*>(to) + at, static_cast<const uint8_t*>(from) + at, std::min(kPiece, bytes - at));
+  });
 }
 
 void writeSet(const VulkanContext& context, VkDescriptorSet set, const std::vector<const Buffer*>& buffers) {
@@ -98,7 +111,7 @@ Status GpuEscape::init() {
   if (!escape_set) return escape_set.error();
   escape_set_layout_ = *escape_set;
   Result<VkDescriptorSetLayout> perturbation_set =
-      storageSetLayout(context_, {storage(0), storage(1), storage(2), storage(3)});
+      storageSetLayout(context_, {storage(0), storage(1), storage(2), storage(3), storage(4)});
   if (!perturbation_set) return perturbation_set.error();
   perturbation_set_layout_ = *perturbation_set;
   Result<VkPipelineLayout> escape_layout =
@@ -118,7 +131,7 @@ Status GpuEscape::init() {
   if (!p) return p.error();
   perturbation_ = *p;
 
-  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 12};
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 14};  // per slot: 2 + 5
   VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 4;
   pool_info.poolSizeCount = 1;
@@ -154,6 +167,7 @@ GpuEscape::~GpuEscape() {
     if (slot.fence) vkDestroyFence(device, slot.fence, nullptr);
     if (slot.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &slot.commands);
     destroyBuffer(context_, slot.counts);
+    destroyBuffer(context_, slot.tails);
   }
   for (Buffer* b : {&axis_, &orbit_, &dcx_, &dcy_}) destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);  // frees the sets
@@ -187,16 +201,11 @@ Status GpuEscape::finish(Slot& slot) {
   const uint64_t points = slot.points;
   slot.points = 0;
   if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
-  // 32 MiB from mapped memory: one thread copies at a fraction of the host's bandwidth, and this
-  // copy is on the critical path of the thread that feeds the meshing workers.
-  const uint8_t* from = static_cast<const uint8_t*>(slot.counts.mapped);
-  uint8_t* to = reinterpret_cast<uint8_t*>(slot.destination);
-  const uint64_t bytes = points * sizeof(uint32_t);
-  constexpr uint64_t kPiece = uint64_t{4} << 20;
-  parallelFor((bytes + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
-    const uint64_t at = i * kPiece;
-    std::memcpy(to + at, from + at, std::min(kPiece, bytes - at));
-  });
+  copyOut(slot.destination, slot.counts.mapped, points * sizeof(uint32_t));
+  if (slot.tail_destination) {
+    if (Status s = invalidateBuffer(context_, slot.tails); !s) return s;
+    copyOut(slot.tail_destination, slot.tails.mapped, points * sizeof(EscapeTail));
+  }
   const auto copied = std::chrono::steady_clock::now();
   wait_ms_ += std::chrono::duration<double, std::milli>(waited - start).count();
   copy_ms_ += std::chrono::duration<double, std::milli>(copied - waited).count();
@@ -219,8 +228,9 @@ Status GpuEscape::finishAll() {
 }
 
 Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
-                           uint32_t push_bytes, uint64_t points, uint32_t* destination) {
-  assert(points > 0 && points <= kGpuChunkPoints);
+                           uint32_t push_bytes, uint64_t points, uint32_t* destination,
+                           EscapeTail* tail_destination) {
+  assert(points > 0 && points <= (tail_destination ? kGpuPerturbationChunkPoints : kGpuChunkPoints));
   Slot& slot = slots_[s];
   if (Status st = finish(slot); !st) return st;
   VK_TRY(vkResetFences(context_.device, 1, &slot.fence));
@@ -252,6 +262,7 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   VK_TRY(queueSubmit(context_, submit, slot.fence));
   slot.points = points;
   slot.destination = destination;
+  slot.tail_destination = tail_destination;
   return okStatus();
 }
 
@@ -281,7 +292,7 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * res);
     if (Status st = dispatch(s, pipeline, escape_layout_, slots_[s].escape_set, &push, sizeof push, rows * res,
-                             counts + (row - first_row) * res);
+                             counts + (row - first_row) * res, nullptr);
         !st) {
       (void)finishAll();
       return st;
@@ -291,27 +302,37 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
 }
 
 Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
-                               const std::vector<double>& dcy, int max_iter, uint32_t* counts) {
+                               const std::vector<double>& dcy, int max_iter, uint32_t* counts, EscapeTail* tails) {
   assert(orbit.size() >= 2 && !dcx.empty() && max_iter >= 0);
   if (dcy.empty()) return okStatus();
   if (Status s = finishAll(); !s) return s;
+  for (Slot& slot : slots_) {
+    if (slot.tails.buffer) continue;
+    Result<Buffer> created = createBuffer(context_, kGpuPerturbationChunkPoints * sizeof(EscapeTail),
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "escape tails");
+    if (!created) return created.error();
+    slot.tails = *created;
+  }
   if (Status s = upload(orbit_, orbit.data(), orbit.size() * sizeof(glm::dvec2), "reference orbit"); !s) return s;
   if (Status s = upload(dcx_, dcx.data(), dcx.size() * sizeof(double), "pixel offsets"); !s) return s;
   if (Status s = upload(dcy_, dcy.data(), dcy.size() * sizeof(double), "row offsets"); !s) return s;
-  for (Slot& slot : slots_) writeSet(context_, slot.perturbation_set, {&orbit_, &dcx_, &dcy_, &slot.counts});
+  for (Slot& slot : slots_)
+    writeSet(context_, slot.perturbation_set, {&orbit_, &dcx_, &dcy_, &slot.counts, &slot.tails});
   const uint64_t cols = dcx.size();
   PerturbationPush push{};
+  push.tail_radius2 = kTailRadius2;
   push.cols = static_cast<uint32_t>(cols);
   push.max_iter = static_cast<uint32_t>(max_iter);
   push.last = static_cast<uint32_t>(orbit.size() - 1);
-  const uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuChunkPoints / cols);
+  push.tail_steps = kMaxTailSteps;
+  const uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuPerturbationChunkPoints / cols);
   size_t s = 0;
   for (uint64_t row = 0; row < dcy.size(); row += rows_per_chunk, s ^= 1) {
     const uint64_t rows = std::min<uint64_t>(rows_per_chunk, dcy.size() - row);
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * cols);
     if (Status st = dispatch(s, perturbation_, perturbation_layout_, slots_[s].perturbation_set, &push, sizeof push,
-                             rows * cols, counts + row * cols);
+                             rows * cols, counts + row * cols, tails + row * cols);
         !st) {
       (void)finishAll();
       return st;

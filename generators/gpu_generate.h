@@ -18,6 +18,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "generators/mandelbrot2d.h"
 #include "vulkan/context.h"
 #include "vulkan/buffers.h"
 
@@ -35,6 +36,9 @@ struct EscapeKernelParams {
 };
 
 inline constexpr uint64_t kGpuChunkPoints = uint64_t{1} << 23;  // 32 MiB of counts per dispatch
+// mandelbrot2d's dispatches also return 16-byte escape tails: a quarter as many points, so that its
+// tail buffers (made at the first such call) add 2 × 32 MiB.
+inline constexpr uint64_t kGpuPerturbationChunkPoints = kGpuChunkPoints / 4;
 
 // Whether the device can run the kernels: shaderFloat64 and shaderInt64 (the exact rounding).
 // kNoDevice naming the device and what it lacks.
@@ -52,10 +56,10 @@ class GpuEscape {
   Status escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
                       int limit, uint32_t* counts);
 
-  // counts[r·dcx.size() + col]: mandelbrot2d's perturbed count of δc = (dcx[col], dcy[r]) against
-  // `orbit` (generators/mandelbrot2d.cpp).
+  // counts[r·dcx.size() + col] and tails[...]: mandelbrot2d's perturbed count of δc = (dcx[col],
+  // dcy[r]) against `orbit` and its escape tail (generators/mandelbrot2d.cpp).
   Status perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
-                      const std::vector<double>& dcy, int max_iter, uint32_t* counts);
+                      const std::vector<double>& dcy, int max_iter, uint32_t* counts, EscapeTail* tails);
 
   // The points classified so far and the GPU time their dispatches took (timestamps around each
   // dispatch; 0 on a queue without timestamps): the classification alone, for the bench.
@@ -69,11 +73,13 @@ class GpuEscape {
  private:
   struct Slot {
     Buffer counts;
+    Buffer tails;  // mandelbrot2d's escape tails; made at the first perturbation call
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
-    uint32_t* destination = nullptr;  // where the counts of the dispatch in flight go
-    uint64_t points = 0;              // 0: idle
+    uint32_t* destination = nullptr;         // where the counts of the dispatch in flight go
+    EscapeTail* tail_destination = nullptr;  // where its tails go (a perturbation dispatch), or null
+    uint64_t points = 0;                     // 0: idle
   };
 
   explicit GpuEscape(const VulkanContext& context) : context_(context) {}
@@ -81,8 +87,8 @@ class GpuEscape {
   Status upload(Buffer& target, const void* data, size_t bytes, const std::string& what);
   // Records and submits one dispatch into slot `s`, after finishing what the slot had in flight.
   Status dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
-                  uint32_t push_bytes, uint64_t points, uint32_t* destination);
-  Status finish(Slot& slot);  // waits for the slot's dispatch and copies its counts out
+                  uint32_t push_bytes, uint64_t points, uint32_t* destination, EscapeTail* tail_destination);
+  Status finish(Slot& slot);  // waits for the slot's dispatch and copies its counts (and tails) out
   Status finishAll();
 
   const VulkanContext& context_;

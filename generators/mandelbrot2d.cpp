@@ -19,11 +19,21 @@
 // image like moving the reference point by about 2^-p. p ≥ 64 + log2(1 / pixel spacing) keeps that
 // under 2^-64 of a pixel at every depth: 120 fraction bits down to spacings of 2^-56, 1080 at the
 // deepest allowed. (Double-double's 106 bits would fall short of this rule below spacings of 2^-42.)
+//
+// Colouring (issue #24):
+// - The smooth ("normalised") iteration count: for |z_j| large, log|z_{j+1}| ≈ 2·log|z_j|, so
+//   j − log2(log|z_j|) tends to a continuous function of c (Douady–Hubbard potential, G(c) =
+//   lim 2^-j·log|z_j|); Linas Vepstas, "Renormalizing the Mandelbrot escape" (1997). The bailout
+//   |z|² > 4 that defines the count is too small a radius for it, hence the tail to 2^64.
+// - Histogram equalisation of the smooth count (as in fractal renderers since Kalles Fraktaler):
+//   at depth most points share a count band, and a palette over counts shows one colour (97.5% of
+//   the default 1e-12 view did); the empirical distribution spreads the palette over what is there.
 #include "generators/mandelbrot2d.h"
 
 #include <algorithm>
 #include <array>
 #include <cassert>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -33,6 +43,7 @@
 #include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "core/text.h"
 #include "generators/escape_grid.h"
 
 namespace dpoint {
@@ -44,12 +55,38 @@ constexpr double kMinWidth = 1e-300;
 // infinite δc against an infinite reference point would make NaN orbits that never escape).
 constexpr double kMaxExtent = 1e300;
 
-constexpr uint32_t kPalettePeriod = 64;  // counts per colour cycle
 constexpr int kPaletteStops = 5;
 constexpr float kPalette[kPaletteStops][3] = {
     {0.02f, 0.05f, 0.35f}, {0.10f, 0.45f, 0.85f}, {0.95f, 0.97f, 0.90f},
     {0.95f, 0.60f, 0.05f}, {0.30f, 0.05f, 0.10f},
 };
+
+constexpr int kMinAutoIter = 2000;  // --max-iter auto's floor: the old default
+
+// log2(x) for finite x > 0 from frexp (exact), +, −, × and ÷ only, so the same bits on every machine
+// and libm: colours and --max-iter auto must not depend on the math library. x = m·2^e with m in
+// [√½, √2); ln m = 2·atanh(s), s = (m − 1)/(m + 1), |s| ≤ 0.1716, whose series to s^25 leaves a
+// truncation under 1e-20 (the rounding of the sum, a few 1e-16 relative, dominates).
+double portableLog2(double x) {
+  assert(x > 0.0 && x <= DBL_MAX);
+  int e = 0;
+  double m = std::frexp(x, &e);  // [0.5, 1)
+  constexpr double kSqrtHalf = 0.70710678118654752440;
+  if (m < kSqrtHalf) {
+    m *= 2.0;  // exact
+    --e;
+  }
+  // 1 / (2k + 1), k = 0..12, rounded to nearest as the compiler folds them (as the FPU would).
+  static constexpr double kInverseOdd[13] = {1.0,      1.0 / 3,  1.0 / 5,  1.0 / 7,  1.0 / 9,
+                                             1.0 / 11, 1.0 / 13, 1.0 / 15, 1.0 / 17, 1.0 / 19,
+                                             1.0 / 21, 1.0 / 23, 1.0 / 25};
+  const double s = (m - 1.0) / (m + 1.0);
+  const double s2 = s * s;
+  double series = 0.0;  // Σ s^(2k) / (2k + 1), by Horner
+  for (int k = 12; k >= 0; --k) series = series * s2 + kInverseOdd[k];
+  constexpr double kInvLn2 = 1.44269504088896340736;  // 1 / ln 2
+  return static_cast<double>(e) + 2.0 * s * series * kInvLn2;
+}
 
 std::string formatDouble(double value) {
   char text[32];
@@ -188,7 +225,7 @@ void twoSum(double a, double b, double& sum, double& error) {
 // Z_max_iter. c = centre + offset exactly (up to 2^-p). Always holds Z_0 and Z_1.
 std::vector<glm::dvec2> referenceOrbit(glm::dvec2 center, glm::dvec2 offset, int max_iter, double spacing) {
   std::vector<glm::dvec2> orbit;
-  orbit.reserve(static_cast<size_t>(max_iter) + 1);
+  orbit.reserve(std::min<size_t>(static_cast<size_t>(max_iter) + 1, size_t{1} << 16));  // auto may be millions
   orbit.emplace_back(0.0, 0.0);
   glm::dvec2 sum, error;
   twoSum(center.x, offset.x, sum.x, error.x);
@@ -213,44 +250,84 @@ std::vector<glm::dvec2> referenceOrbit(glm::dvec2 center, glm::dvec2 offset, int
   return orbit;
 }
 
-uint32_t doubleCount(double cx, double cy, int max_iter) {
+uint32_t doubleCount(double cx, double cy, int max_iter, EscapeTail& tail) {
   double x = 0.0, y = 0.0;
   for (int n = 0; n < max_iter; ++n) {
     const double next_x = x * x - y * y + cx;
     y = 2.0 * x * y + cy;
     x = next_x;
-    if (x * x + y * y > 4.0) return static_cast<uint32_t>(n);
+    double z2 = x * x + y * y;
+    if (z2 > 4.0) {
+      uint32_t steps = 0;
+      for (; z2 <= kTailRadius2 && steps < kMaxTailSteps; ++steps) {
+        const double tail_x = x * x - y * y + cx;
+        y = 2.0 * x * y + cy;
+        x = tail_x;
+        z2 = x * x + y * y;
+      }
+      tail = {z2, steps, 0};
+      return static_cast<uint32_t>(n);
+    }
   }
+  tail = {};
   return static_cast<uint32_t>(max_iter);
 }
 
-// The pixel's orbit is z_n = Z_m + δ (m = n until the first rebase).
-uint32_t perturbedCount(const std::vector<glm::dvec2>& orbit, double dcx, double dcy, int max_iter) {
+// One perturbation step, δ ← (2·Z_m + δ)·δ + δc: 2·Z·δ + δ² as one complex product.
+inline void perturbationStep(glm::dvec2 reference, double dcx, double dcy, double& dx, double& dy) {
+  const double tx = 2.0 * reference.x + dx;
+  const double ty = 2.0 * reference.y + dy;
+  const double next_dx = tx * dx - ty * dy + dcx;
+  dy = tx * dy + ty * dx + dcy;
+  dx = next_dx;
+}
+
+// The pixel's orbit is z_n = Z_m + δ (m = n until the first rebase). Past the escape the tail goes
+// on with the same steps: the rebase test the loop skipped at the escape comes first.
+uint32_t perturbedCount(const std::vector<glm::dvec2>& orbit, double dcx, double dcy, int max_iter, EscapeTail& tail) {
   const size_t last = orbit.size() - 1;
   size_t m = 0;
   double dx = 0.0, dy = 0.0;
   for (int n = 0; n < max_iter; ++n) {
-    // δ ← (2·Z_m + δ)·δ + δc: 2·Z·δ + δ² as one complex product.
-    const double tx = 2.0 * orbit[m].x + dx;
-    const double ty = 2.0 * orbit[m].y + dy;
-    const double next_dx = tx * dx - ty * dy + dcx;
-    dy = tx * dy + ty * dx + dcy;
-    dx = next_dx;
+    perturbationStep(orbit[m], dcx, dcy, dx, dy);
     ++m;
-    const double zx = orbit[m].x + dx;
-    const double zy = orbit[m].y + dy;
-    const double z2 = zx * zx + zy * zy;
-    if (z2 > 4.0) return static_cast<uint32_t>(n);
+    double zx = orbit[m].x + dx;
+    double zy = orbit[m].y + dy;
+    double z2 = zx * zx + zy * zy;
+    if (z2 > 4.0) {
+      uint32_t steps = 0;
+      for (; z2 <= kTailRadius2 && steps < kMaxTailSteps; ++steps) {
+        if (z2 < dx * dx + dy * dy || m == last) {
+          dx = zx;
+          dy = zy;
+          m = 0;
+        }
+        perturbationStep(orbit[m], dcx, dcy, dx, dy);
+        ++m;
+        zx = orbit[m].x + dx;
+        zy = orbit[m].y + dy;
+        z2 = zx * zx + zy * zy;
+      }
+      tail = {z2, steps, 0};
+      return static_cast<uint32_t>(n);
+    }
     if (z2 < dx * dx + dy * dy || m == last) {  // rebase onto Z_0 = 0
       dx = zx;
       dy = zy;
       m = 0;
     }
   }
+  tail = {};
   return static_cast<uint32_t>(max_iter);
 }
 
 double pixelSpacing(const Mandelbrot2dParams& p) { return p.width / p.resolution; }
+
+// The max_iter of parameters resolved by resolveParams.
+int iterations(const Mandelbrot2dParams& p) {
+  assert(p.max_iter);
+  return *p.max_iter;
+}
 
 // Offset of pixel `index` from the centre: the half-integer factor is exact, so one rounding.
 double pixelOffset(int index, int resolution, double spacing) { return (index + 0.5 - resolution / 2.0) * spacing; }
@@ -273,7 +350,8 @@ Reference chooseReference(const Mandelbrot2dParams& p) {
   const double spacing = pixelSpacing(p);
   const glm::dvec2 center(p.center_x, p.center_y);
   Reference best;
-  best.orbit = referenceOrbit(center, best.offset, p.max_iter, spacing);
+  const int max_iter = iterations(p);
+  best.orbit = referenceOrbit(center, best.offset, max_iter, spacing);
   const size_t probes = static_cast<size_t>(std::min(kProbeGrid, p.resolution));
   const auto probePixel = [&](size_t k) {  // evenly spread pixel indices
     return static_cast<int>((2 * k + 1) * static_cast<size_t>(p.resolution) / (2 * probes));
@@ -281,12 +359,13 @@ Reference chooseReference(const Mandelbrot2dParams& p) {
   std::vector<uint32_t> counts(probes * probes);
   for (int round = 0; round < kReferenceRounds; ++round) {
     const size_t length = best.orbit.size() - 1;  // the reference's last index
-    if (length >= static_cast<size_t>(p.max_iter)) break;
+    if (length >= static_cast<size_t>(max_iter)) break;
     parallelFor(probes, p.threads, [&](size_t i, unsigned) {
       const double dcy = pixelOffset(probePixel(i), p.resolution, spacing) - best.offset.y;
+      EscapeTail tail;
       for (size_t j = 0; j < probes; ++j) {
         const double dcx = pixelOffset(probePixel(j), p.resolution, spacing) - best.offset.x;
-        counts[i * probes + j] = perturbedCount(best.orbit, dcx, dcy, p.max_iter);
+        counts[i * probes + j] = perturbedCount(best.orbit, dcx, dcy, max_iter, tail);
       }
     });
     size_t pick = 0;
@@ -304,7 +383,7 @@ Reference chooseReference(const Mandelbrot2dParams& p) {
     Reference next;
     next.offset = glm::dvec2(pixelOffset(probePixel(pick % probes), p.resolution, spacing),
                              pixelOffset(probePixel(pick / probes), p.resolution, spacing));
-    next.orbit = referenceOrbit(center, next.offset, p.max_iter, spacing);
+    next.orbit = referenceOrbit(center, next.offset, max_iter, spacing);
     if (next.orbit.size() <= best.orbit.size()) break;
     best = std::move(next);
   }
@@ -317,12 +396,8 @@ Status validate(const Mandelbrot2dParams& p) {
     return Error{"--resolution must be in [2, " + std::to_string(kMaxResolution) + "], got " +
                      std::to_string(p.resolution),
                  p.resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
-  if (p.max_iter < 1)
-    return Error{"--max-iter must be at least 1, got " + std::to_string(p.max_iter), ExitCode::kUsage};
-  if (!p.grid_out.empty() && p.max_iter > kMaxEscapeIterations)
-    return Error{"--grid-out stores counts up to " + std::to_string(kMaxEscapeIterations) + ", but --max-iter is " +
-                     std::to_string(p.max_iter),
-                 ExitCode::kUsage};
+  if (p.max_iter && *p.max_iter < 1)
+    return Error{"--max-iter must be at least 1, got " + std::to_string(*p.max_iter), ExitCode::kUsage};
   if (!std::isfinite(p.width) || !(p.width >= kMinWidth))
     return Error{"--width must be finite and at least 1e-300, got " + formatDouble(p.width), ExitCode::kUsage};
   const std::string center = formatDouble(p.center_x) + "," + formatDouble(p.center_y);
@@ -331,79 +406,164 @@ Status validate(const Mandelbrot2dParams& p) {
   if (std::max(std::abs(p.center_x), std::abs(p.center_y)) + p.width > kMaxExtent)
     return Error{"--width " + formatDouble(p.width) + " around --center " + center + " reaches past ±1e300",
                  ExitCode::kUsage};
+  const int max_iter = p.max_iter ? *p.max_iter : autoMaxIter(p.width);
+  if (!p.grid_out.empty() && max_iter > kMaxEscapeIterations)
+    return Error{"--grid-out stores counts up to " + std::to_string(kMaxEscapeIterations) + ", but --max-iter is " +
+                     (p.max_iter ? std::to_string(max_iter)
+                                 : "auto, " + std::to_string(max_iter) + " at --width " + formatNumber(p.width) +
+                                       " (give a --max-iter)"),
+                 ExitCode::kUsage};
   return okStatus();
+}
+
+// Checked parameters with max_iter resolved (auto: autoMaxIter).
+Result<Mandelbrot2dParams> resolveParams(const Mandelbrot2dParams& params) {
+  if (Status s = validate(params); !s) return s.error();
+  Mandelbrot2dParams p = params;
+  if (!p.max_iter) p.max_iter = autoMaxIter(p.width);
+  return p;
 }
 
 // Two reference orbits live at once while the reference is chosen.
 uint64_t referenceBytes(const Mandelbrot2dParams& p) {
   if (p.method == Mandelbrot2dMethod::kDouble) return 0;
-  return 2 * (static_cast<uint64_t>(p.max_iter) + 1) * sizeof(glm::dvec2);
+  return 2 * (static_cast<uint64_t>(iterations(p)) + 1) * sizeof(glm::dvec2);
 }
 
-// `rows` of the grid at bytes_per_point, and the reference orbits.
+// The pre-pass: its grid, escapes and sorted smooth counts.
+uint64_t prepassBytes() {
+  return static_cast<uint64_t>(kPrepassResolution) * kPrepassResolution *
+         (sizeof(uint32_t) + sizeof(EscapeTail) + sizeof(double));
+}
+
+// `rows` of the grid at bytes_per_point, the reference orbits and the pre-pass.
 Status checkBudget(const Mandelbrot2dParams& p, uint64_t rows, uint64_t bytes_per_point) {
   const uint64_t points = rows * static_cast<uint64_t>(p.resolution);
   return checkMemory("mandelbrot2d at --resolution " + std::to_string(p.resolution) + " with --max-iter " +
-                         std::to_string(p.max_iter),
-                     points * bytes_per_point + referenceBytes(p), p.max_memory);
+                         std::to_string(iterations(p)),
+                     points * bytes_per_point + referenceBytes(p) + prepassBytes(), p.max_memory);
 }
 
-// Fills counts of rows [first_row, first_row + rows) (rows·resolution, preallocated). Each row writes
-// only its own cells, so the result does not depend on the thread count.
-Status computeCounts(const Mandelbrot2dParams& p, size_t first_row, size_t rows, std::vector<uint32_t>& counts) {
+// A square grid over the view: the output's (resolution, width / resolution) or the pre-pass's.
+struct Grid {
+  int resolution;
+  double spacing;
+};
+
+// Escapes of rows [first_row, first_row + rows) of `grid` into counts and tails (rows·resolution
+// each, preallocated). Each row writes only its own cells, so the result does not depend on the
+// thread count. `progress` may be null.
+Status computeEscapes(const Mandelbrot2dParams& p, const Reference& reference, Grid grid, size_t first_row, size_t rows,
+                      uint32_t* counts, EscapeTail* tails, Progress* progress) {
   const bool perturb = p.method == Mandelbrot2dMethod::kPerturbation;
-  const Reference reference = perturb ? chooseReference(p) : Reference{};
-  const double spacing = pixelSpacing(p);
-  const size_t res = static_cast<size_t>(p.resolution);
+  const int max_iter = iterations(p);
+  const size_t res = static_cast<size_t>(grid.resolution);
   if (perturb && p.perturbation) {  // elsewhere (a GPU), from the same δc
     std::vector<double> dcx(res), dcy(rows);
     for (size_t col = 0; col < res; ++col)
-      dcx[col] = pixelOffset(static_cast<int>(col), p.resolution, spacing) - reference.offset.x;
+      dcx[col] = pixelOffset(static_cast<int>(col), grid.resolution, grid.spacing) - reference.offset.x;
     for (size_t row = 0; row < rows; ++row)
-      dcy[row] = pixelOffset(static_cast<int>(first_row + row), p.resolution, spacing) - reference.offset.y;
-    return p.perturbation(reference.orbit, dcx, dcy, p.max_iter, counts.data());
+      dcy[row] = pixelOffset(static_cast<int>(first_row + row), grid.resolution, grid.spacing) - reference.offset.y;
+    return p.perturbation(reference.orbit, dcx, dcy, max_iter, counts, tails);
   }
-  if (p.progress) p.progress->start("mandelbrot2d", static_cast<uint64_t>(res) * rows);
+  if (progress) progress->start("mandelbrot2d", static_cast<uint64_t>(res) * rows);
   parallelFor(rows, p.threads, [&](size_t r, unsigned) {
-    if (interrupted()) return;  // computeCounts returns interruptedError()
+    if (interrupted()) return;  // computeEscapes returns interruptedError()
     const size_t row = first_row + r;
-    const double offset_y = pixelOffset(static_cast<int>(row), p.resolution, spacing);
-    uint32_t* out = counts.data() + r * res;
-    for (int col = 0; col < p.resolution; ++col) {
-      const double offset_x = pixelOffset(col, p.resolution, spacing);
+    const double offset_y = pixelOffset(static_cast<int>(row), grid.resolution, grid.spacing);
+    uint32_t* out = counts + r * res;
+    EscapeTail* tail = tails + r * res;
+    for (int col = 0; col < grid.resolution; ++col) {
+      const double offset_x = pixelOffset(col, grid.resolution, grid.spacing);
       out[col] = perturb ? perturbedCount(reference.orbit, offset_x - reference.offset.x,
-                                          offset_y - reference.offset.y, p.max_iter)
-                         : doubleCount(p.center_x + offset_x, p.center_y + offset_y, p.max_iter);
+                                          offset_y - reference.offset.y, max_iter, tail[col])
+                         : doubleCount(p.center_x + offset_x, p.center_y + offset_y, max_iter, tail[col]);
     }
-    if (p.progress) p.progress->advance(res);
+    if (progress) progress->advance(res);
   });
-  if (p.progress) p.progress->finish();
+  if (progress) progress->finish();
   if (interrupted()) return interruptedError();
   return okStatus();
 }
 
+Reference referenceFor(const Mandelbrot2dParams& p) {
+  return p.method == Mandelbrot2dMethod::kPerturbation ? chooseReference(p) : Reference{};
+}
+
+// The smooth counts of the escaped points among `counts`, sorted: the empirical distribution the
+// colours follow.
+std::vector<double> sortedSmoothCounts(const std::vector<uint32_t>& counts, const std::vector<EscapeTail>& tails,
+                                       int max_iter) {
+  std::vector<double> smooth;
+  smooth.reserve(counts.size());
+  for (size_t i = 0; i < counts.size(); ++i)
+    if (counts[i] < static_cast<uint32_t>(max_iter)) smooth.push_back(mandelbrot2dSmoothCount(counts[i], tails[i]));
+  std::sort(smooth.begin(), smooth.end());
+  return smooth;
+}
+
+// The pre-pass over the whole view: a kPrepassResolution² grid (the output grid itself when that is
+// no larger), against the output's reference.
+Result<std::vector<double>> prepassDistribution(const Mandelbrot2dParams& p, const Reference& reference) {
+  const int res = std::min(kPrepassResolution, p.resolution);
+  const Grid grid{res, p.width / res};
+  const size_t points = static_cast<size_t>(res) * static_cast<size_t>(res);
+  std::vector<uint32_t> counts(points);
+  std::vector<EscapeTail> tails(points);
+  if (Status s = computeEscapes(p, reference, grid, 0, static_cast<size_t>(res), counts.data(), tails.data(), nullptr);
+      !s)
+    return s.error();
+  return sortedSmoothCounts(counts, tails, iterations(p));
+}
+
+// The share of `sorted` below ν, linear between neighbouring values: 0 at or below the lowest, 1 at
+// or above the highest. Basic operations only (the same bits everywhere).
+double distributionAt(const std::vector<double>& sorted, double nu) {
+  if (sorted.empty() || nu <= sorted.front()) return 0.0;
+  if (nu >= sorted.back()) return 1.0;
+  // sorted[k] ≤ ν < sorted[k + 1], so the two differ.
+  const size_t k = static_cast<size_t>(std::upper_bound(sorted.begin(), sorted.end(), nu) - sorted.begin()) - 1;
+  const double within = (nu - sorted[k]) / (sorted[k + 1] - sorted[k]);
+  return (static_cast<double>(k) + within) / static_cast<double>(sorted.size() - 1);
+}
+
 // Rows [first_row, first_row + rows) of the grid as points.
 Result<PointSet> generateRows(const Mandelbrot2dParams& params, size_t first_row, size_t rows) {
-  if (Status s = validate(params); !s) return s.error();
-  const size_t res = static_cast<size_t>(params.resolution);
-  if (Status s = checkBudget(params, rows, sizeof(uint32_t) + sizeof(glm::dvec3) + sizeof(glm::vec3)); !s)
+  Result<Mandelbrot2dParams> resolved = resolveParams(params);
+  if (!resolved) return resolved.error();
+  const Mandelbrot2dParams& p = *resolved;
+  const int max_iter = iterations(p);
+  const size_t res = static_cast<size_t>(p.resolution);
+  if (Status s = checkBudget(p, rows, sizeof(uint32_t) + sizeof(EscapeTail) + sizeof(glm::dvec3) + sizeof(glm::vec3));
+      !s)
     return s.error();
+  const Reference reference = referenceFor(p);
   std::vector<uint32_t> counts(rows * res);
-  if (Status s = computeCounts(params, first_row, rows, counts); !s) return s.error();
-  if (!params.grid_out.empty())
-    if (Status s = writeEscapeGrid(params.grid_out, counts, params.max_iter); !s) return s.error();
+  std::vector<EscapeTail> tails(rows * res);
+  const Grid grid{p.resolution, pixelSpacing(p)};
+  if (Status s = computeEscapes(p, reference, grid, first_row, rows, counts.data(), tails.data(), p.progress); !s)
+    return s.error();
+  if (!p.grid_out.empty())
+    if (Status s = writeEscapeGrid(p.grid_out, counts, max_iter); !s) return s.error();
+  // The whole grid no larger than the pre-pass is the pre-pass: the same δc, the same escapes.
+  Result<std::vector<double>> distribution = p.resolution <= kPrepassResolution && rows == res
+                                                 ? sortedSmoothCounts(counts, tails, max_iter)
+                                                 : prepassDistribution(p, reference);
+  if (!distribution) return distribution.error();
   PointSet set;
   set.positions.resize(rows * res);
   set.colors.resize(rows * res);
-  const double spacing = pixelSpacing(params);
-  parallelFor(rows, params.threads, [&](size_t r, unsigned) {
+  parallelFor(rows, p.threads, [&](size_t r, unsigned) {
     // Correctly rounded centre + offset (the offsets are exact doubles).
-    const double y = params.center_y + pixelOffset(static_cast<int>(first_row + r), params.resolution, spacing);
+    const double y = p.center_y + pixelOffset(static_cast<int>(first_row + r), p.resolution, grid.spacing);
     for (size_t col = 0; col < res; ++col) {
       const size_t i = r * res + col;
-      const double x = params.center_x + pixelOffset(static_cast<int>(col), params.resolution, spacing);
+      const double x = p.center_x + pixelOffset(static_cast<int>(col), p.resolution, grid.spacing);
       set.positions[i] = glm::dvec3(x, y, 0.0);
-      set.colors[i] = mandelbrot2dColor(counts[i], params.max_iter);
+      set.colors[i] = counts[i] >= static_cast<uint32_t>(max_iter)
+                          ? glm::vec3(0.0f)
+                          : mandelbrot2dPalette(static_cast<float>(
+                                distributionAt(*distribution, mandelbrot2dSmoothCount(counts[i], tails[i]))));
     }
   });
   return set;
@@ -411,26 +571,60 @@ Result<PointSet> generateRows(const Mandelbrot2dParams& params, size_t first_row
 
 }  // namespace
 
-glm::vec3 mandelbrot2dColor(uint32_t count, int max_iter) {
-  if (max_iter <= 0 || count >= static_cast<uint32_t>(max_iter)) return glm::vec3(0.0f);
-  // Cyclic and piecewise linear, stop i at phase i / kPaletteStops; float arithmetic only, so the
-  // colours do not depend on the math library.
-  const float phase =
-      static_cast<float>(count % kPalettePeriod) * (static_cast<float>(kPaletteStops) / kPalettePeriod);
-  const int stop = static_cast<int>(phase);
+int autoMaxIter(double width) {
+  assert(width > 0.0 && width <= DBL_MAX);
+  const double depth = portableLog2(std::min(4.0 / width, DBL_MAX)) / portableLog2(10.0);
+  const double iter = 50.0 * depth * depth;
+  if (!(iter > kMinAutoIter)) return kMinAutoIter;  // also a width above 4 (negative depth)
+  return static_cast<int>(iter + 0.5);  // d ≤ 309 even for DBL_MAX / 4: at most 4.8 million
+}
+
+Result<int> mandelbrot2dMaxIter(const Mandelbrot2dParams& params) {
+  Result<Mandelbrot2dParams> p = resolveParams(params);
+  if (!p) return p.error();
+  return iterations(*p);
+}
+
+double mandelbrot2dSmoothCount(uint32_t count, const EscapeTail& tail) {
+  // Past DBL_MAX (a view far outside, where |z_1|² = |c|² overflows) the last double stands in. An
+  // escaped orbit only grows (|z| > 2 ≥ |c|, or z_1 = c), but the clamp at 4 keeps log2(log2) finite
+  // should rounding ever take a tail's last step back under the bailout.
+  const double z2 = std::clamp(tail.z2, 4.0, DBL_MAX);
+  const double j = static_cast<double>(count) + 1.0 + static_cast<double>(tail.steps);
+  return j + 1.0 - portableLog2(portableLog2(z2));
+}
+
+glm::vec3 mandelbrot2dPalette(float f) {
+  // Piecewise linear through the stops, stop i at f = i / (kPaletteStops − 1); float arithmetic
+  // only, so the colours do not depend on the math library.
+  const float phase = std::clamp(f, 0.0f, 1.0f) * static_cast<float>(kPaletteStops - 1);
+  const int stop = std::min(static_cast<int>(phase), kPaletteStops - 2);
   const float t = phase - static_cast<float>(stop);
   const float* a = kPalette[stop];
-  const float* b = kPalette[(stop + 1) % kPaletteStops];
+  const float* b = kPalette[stop + 1];
   return glm::vec3(a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t);
 }
 
+Result<Mandelbrot2dEscapes> mandelbrot2dEscapes(const Mandelbrot2dParams& params) {
+  Result<Mandelbrot2dParams> resolved = resolveParams(params);
+  if (!resolved) return resolved.error();
+  const Mandelbrot2dParams& p = *resolved;
+  const size_t res = static_cast<size_t>(p.resolution);
+  if (Status s = checkBudget(p, res, sizeof(uint32_t) + sizeof(EscapeTail)); !s) return s.error();
+  Mandelbrot2dEscapes escapes;
+  escapes.counts.resize(res * res);
+  escapes.tails.resize(res * res);
+  if (Status s = computeEscapes(p, referenceFor(p), Grid{p.resolution, pixelSpacing(p)}, 0, res, escapes.counts.data(),
+                                escapes.tails.data(), p.progress);
+      !s)
+    return s.error();
+  return escapes;
+}
+
 Result<std::vector<uint32_t>> mandelbrot2dCounts(const Mandelbrot2dParams& params) {
-  if (Status s = validate(params); !s) return s.error();
-  const size_t res = static_cast<size_t>(params.resolution);
-  if (Status s = checkBudget(params, res, sizeof(uint32_t)); !s) return s.error();
-  std::vector<uint32_t> counts(res * res);
-  if (Status s = computeCounts(params, 0, res, counts); !s) return s.error();
-  return counts;
+  Result<Mandelbrot2dEscapes> escapes = mandelbrot2dEscapes(params);
+  if (!escapes) return escapes.error();
+  return std::move(escapes->counts);
 }
 
 Result<PointSet> generateMandelbrot2d(const Mandelbrot2dParams& params) {
@@ -438,13 +632,14 @@ Result<PointSet> generateMandelbrot2d(const Mandelbrot2dParams& params) {
 }
 
 Result<PointTile> generateMandelbrot2dTile(const Mandelbrot2dParams& params, TileSpec tile) {
-  if (Status s = validate(params); !s) return s.error();
+  Result<Mandelbrot2dParams> resolved = resolveParams(params);
+  if (!resolved) return resolved.error();
   const TileRange rows = tileRange(static_cast<uint64_t>(params.resolution), tile);
   PointTile out;
   out.tile = tile;
   if (rows.empty()) {  // more tiles than rows: no points, an empty piece of the grid file
     if (!params.grid_out.empty())
-      if (Status s = writeEscapeGrid(params.grid_out, {}, params.max_iter); !s) return s.error();
+      if (Status s = writeEscapeGrid(params.grid_out, {}, iterations(*resolved)); !s) return s.error();
     return out;
   }
   Result<PointSet> points = generateRows(params, rows.begin, rows.end - rows.begin);

@@ -12,6 +12,7 @@
 namespace dpoint {
 namespace {
 
+using test::concat;
 using test::readFile;
 using test::runDpoint;
 using test::TempDir;
@@ -145,6 +146,12 @@ TEST(CliGenerate, badParametersNameTheFlagAndWriteNothing) {
       {{"julia", "--c", "nan,0,0,0"}, 1, "--c"},
       {{"mandelbrot2d", "--center", "0.3"}, 1, "--center"},
       {{"mandelbrot2d", "--width", "0"}, 1, "--width"},
+      {{"mandelbrot2d", "--max-iter", "0"}, 1, "--max-iter must be a whole number from 1"},
+      {{"mandelbrot2d", "--max-iter", "abc"}, 1, "--max-iter must be a whole number from 1 to 2147483647, or auto, got 'abc'"},
+      {{"mandelbrot2d", "--max-iter", "2.5"}, 1, "--max-iter"},
+      {{"mandelbrot2d", "--max-iter", "-3"}, 1, "--max-iter"},
+      {{"mandelbrot2d", "--max-iter", "99999999999"}, 1, "--max-iter"},
+      {{"mandelbrot2d", "--max-iter", "Auto"}, 1, "--max-iter"},
       {{"sierpinski", "--level", "13"}, 1, "--level"},
       {{"sierpinski", "--offset", "1,2"}, 1, "--offset"},
       {{"menger", "--level", "8"}, 4, "--max-memory"},
@@ -166,6 +173,29 @@ TEST(CliGenerate, badParametersNameTheFlagAndWriteNothing) {
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
     EXPECT_TRUE(dir.entries().empty());
   }
+}
+
+// --max-iter of mandelbrot2d takes a whole number or auto (the default), and generate says what
+// auto chose; the help says how it is chosen.
+TEST(CliGenerate, mandelbrot2dMaxIterAutoIsTheDefaultAndNamesItsValue) {
+  TempDir dir;
+  const std::vector<std::string> base = {"generate", "mandelbrot2d", "--resolution", "16", "--width", "1e-12"};
+  test::CommandResult r = runDpoint(concat(base, {"-o", dir.file("default.ply")}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("dpoint: mandelbrot2d --max-iter auto: 7941 at --width 1e-12"), std::string::npos) << r.err;
+  r = runDpoint(concat(base, {"--max-iter", "auto", "-o", dir.file("auto.ply")}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(readFile(dir.file("default.ply")) == readFile(dir.file("auto.ply")));
+  r = runDpoint(concat(base, {"--max-iter", "7941", "-o", dir.file("explicit.ply")}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("--max-iter auto"), std::string::npos) << r.err;
+  EXPECT_TRUE(readFile(dir.file("default.ply")) == readFile(dir.file("explicit.ply")));
+  r = runDpoint(concat(base, {"--max-iter", "500", "-q", "-o", dir.file("500.ply")}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  r = runDpoint({"generate", "mandelbrot2d", "--help"});
+  EXPECT_NE(r.out.find("max(2000, 50*d^2)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("d = log10(4 / width)"), std::string::npos) << r.out;
 }
 
 }  // namespace

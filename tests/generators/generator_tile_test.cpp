@@ -132,5 +132,21 @@ TEST(GeneratorTiles, pointSetTilesMergeToTheWholeSet) {
     expectTilesMakeWhole(*grid, n, [&](TileSpec t) { return generateMandelbrot2dTile(zoom, t); });
 }
 
+TEST(GeneratorTiles, mandelbrot2dTilesShareTheWholeViewsColours) {
+  // Above the pre-pass's resolution (kPrepassResolution), with auto max_iter: every tile maps its
+  // points through the distribution of the whole view, so the colours are the whole set's.
+  for (double width : {1e-6, 1e-12}) {
+    SCOPED_TRACE(width);
+    Mandelbrot2dParams zoom;
+    zoom.width = width;
+    zoom.resolution = kPrepassResolution + 23;
+    if (width == 1e-6) zoom.max_iter = 500;  // the inside costs max_iter per point
+    Result<PointSet> grid = generateMandelbrot2d(zoom);
+    ASSERT_TRUE(grid.ok());
+    for (uint32_t n : {3u, 7u})
+      expectTilesMakeWhole(*grid, n, [&](TileSpec t) { return generateMandelbrot2dTile(zoom, t); });
+  }
+}
+
 }  // namespace
 }  // namespace dpoint

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 #include <mpfr.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <thread>
 #include <utility>
 
@@ -50,7 +52,7 @@ void mpfrRows(const Mandelbrot2dParams& p, int row_begin, int row_end, std::vect
     for (int col = 0; col < p.resolution; ++col) {
       counts[static_cast<size_t>(row) * static_cast<size_t>(p.resolution) + static_cast<size_t>(col)] =
           mpfrCount(p.center_x, (col + 0.5 - p.resolution / 2.0) * spacing, p.center_y,
-                    (row + 0.5 - p.resolution / 2.0) * spacing, p.max_iter);
+                    (row + 0.5 - p.resolution / 2.0) * spacing, *p.max_iter);
     }
   }
   mpfr_free_cache();
@@ -77,7 +79,7 @@ struct Agreement {
   double plain_double = 0.0;
 };
 
-// Shares of a 64² grid (max_iter 2000, the default) whose counts equal the exact ones, for both
+// Shares of a 64² grid (max_iter 2000, the old default) whose counts equal the exact ones, for both
 // methods. The exact grid costs up to a second on two cores.
 Agreement compareWithMpfr(double center_x, double center_y, double width) {
   Mandelbrot2dParams p;
@@ -85,6 +87,7 @@ Agreement compareWithMpfr(double center_x, double center_y, double width) {
   p.center_y = center_y;
   p.width = width;
   p.resolution = 64;
+  p.max_iter = 2000;
   const std::vector<uint32_t> exact = mpfrCounts(p);
   Result<std::vector<uint32_t>> perturbed = mandelbrot2dCounts(p);
   p.method = Mandelbrot2dMethod::kDouble;
@@ -184,9 +187,10 @@ TEST(Mandelbrot2d, deepestWidthKeepsTheCentresCount) {
   Mandelbrot2dParams p;
   p.width = 1e-300;
   p.resolution = 16;
+  p.max_iter = 2000;
   Result<std::vector<uint32_t>> counts = mandelbrot2dCounts(p);
   ASSERT_TRUE(counts.ok());
-  const uint32_t centre = mpfrCount(p.center_x, 0.0, p.center_y, 0.0, p.max_iter);
+  const uint32_t centre = mpfrCount(p.center_x, 0.0, p.center_y, 0.0, *p.max_iter);
   EXPECT_EQ(centre, 421u);
   EXPECT_EQ(*counts, std::vector<uint32_t>(256, centre));
 }
@@ -252,20 +256,158 @@ TEST(Mandelbrot2d, gridIsCentredRowMajorAndCorrectlyRounded) {
   EXPECT_NEAR(last.x - first.x, 15 * spacing, 2e-16);
 }
 
-TEST(Mandelbrot2d, insideIsBlackAndColoursAreInRange) {
-  EXPECT_EQ(mandelbrot2dColor(100, 100), glm::vec3(0.0f));
-  for (uint32_t count = 0; count < 200; ++count) {
-    const glm::vec3 c = mandelbrot2dColor(count, 1000);
+TEST(Mandelbrot2d, paletteIsInRangeSmoothAndSpansItsStops) {
+  for (int i = 0; i <= 1000; ++i) {
+    const float f = static_cast<float>(i) / 1000.0f;
+    const glm::vec3 c = mandelbrot2dPalette(f);
     for (int k = 0; k < 3; ++k) {
       EXPECT_GE(c[k], 0.0f);
       EXPECT_LE(c[k], 1.0f);
     }
-    EXPECT_GT(c.r + c.g + c.b, 0.0f) << count;
+    EXPECT_GT(c.r + c.g + c.b, 0.0f) << f;  // only points inside are black
+    // Nearby positions get nearby colours (piecewise linear: at most 4 stops' steps per unit).
+    const glm::vec3 d = mandelbrot2dPalette(std::min(1.0f, f + 0.001f)) - c;
+    EXPECT_LT(std::abs(d.r) + std::abs(d.g) + std::abs(d.b), 0.02f) << f;
   }
-  // Neighbouring counts get nearby colours (a smooth palette).
-  for (uint32_t count = 0; count < 200; ++count) {
-    const glm::vec3 d = mandelbrot2dColor(count + 1, 1000) - mandelbrot2dColor(count, 1000);
-    EXPECT_LT(std::abs(d.r) + std::abs(d.g) + std::abs(d.b), 0.5f) << count;
+  // From dark blue to dark red, not cyclic: the ends differ.
+  EXPECT_EQ(mandelbrot2dPalette(0.0f), glm::vec3(0.02f, 0.05f, 0.35f));
+  const glm::vec3 top = mandelbrot2dPalette(1.0f);
+  EXPECT_NEAR(top.r, 0.30f, 1e-6f);
+  EXPECT_NEAR(top.g, 0.05f, 1e-6f);
+  EXPECT_NEAR(top.b, 0.10f, 1e-6f);
+  EXPECT_EQ(mandelbrot2dPalette(-1.0f), mandelbrot2dPalette(0.0f));
+  EXPECT_EQ(mandelbrot2dPalette(2.0f), mandelbrot2dPalette(1.0f));
+}
+
+TEST(Mandelbrot2d, insideIsBlackAndOutsideIsNot) {
+  Mandelbrot2dParams p;
+  p.resolution = 64;
+  p.max_iter = 300;
+  Result<Mandelbrot2dEscapes> escapes = mandelbrot2dEscapes(p);
+  Result<PointSet> set = generateMandelbrot2d(p);
+  ASSERT_TRUE(escapes.ok() && set.ok());
+  size_t inside = 0;
+  for (size_t i = 0; i < set->size(); ++i) {
+    const glm::vec3 c = set->colors[i];
+    if (escapes->counts[i] == 300u) {
+      ++inside;
+      EXPECT_EQ(c, glm::vec3(0.0f)) << i;
+      EXPECT_EQ(escapes->tails[i].z2, 0.0);
+    } else {
+      EXPECT_GT(c.r + c.g + c.b, 0.0f) << i;
+      EXPECT_GT(escapes->tails[i].z2, kTailRadius2) << i;  // the tails all reach the radius here
+    }
+  }
+  EXPECT_GT(inside, 100u);
+}
+
+TEST(Mandelbrot2d, autoMaxIterGrowsWithDepthFromTheOldDefault) {
+  // Never below the old default 2000 at shallow widths; 2000 exactly down to 1.9e-6.
+  for (double width : {1e3, 4.0, 3.0, 1.0, 1e-3, 1.9e-6})
+    EXPECT_EQ(autoMaxIter(width), 2000) << width;
+  // max(2000, 50·d²), d = log10(4 / width): the values the header and --help name.
+  EXPECT_EQ(autoMaxIter(1e-6), 2179);
+  EXPECT_EQ(autoMaxIter(1e-9), 4610);
+  EXPECT_EQ(autoMaxIter(1e-12), 7941);
+  EXPECT_EQ(autoMaxIter(1e-15), 12171);
+  EXPECT_NEAR(autoMaxIter(1e-300), 4518081, 1);
+  int previous = 0;
+  for (double width = 4.0; width >= 1e-300; width /= 10.0) {
+    const int iter = autoMaxIter(width);
+    EXPECT_GE(iter, previous) << width;
+    if (width < 1e-6) {
+      EXPECT_GT(iter, previous) << width;
+    }
+    previous = iter;
+  }
+  // Where 4 / width overflows (subnormal widths, below what a generation accepts) it stays finite.
+  EXPECT_GT(autoMaxIter(1e-320), 4700000);
+  EXPECT_LT(autoMaxIter(1e-320), 4800000);
+}
+
+TEST(Mandelbrot2d, maxIterResolvesAutoAndChecksTheRest) {
+  Mandelbrot2dParams p;
+  p.width = 1e-12;
+  EXPECT_FALSE(p.max_iter.has_value()) << "auto is the default";
+  Result<int> chosen = mandelbrot2dMaxIter(p);
+  ASSERT_TRUE(chosen.ok());
+  EXPECT_EQ(*chosen, autoMaxIter(1e-12));
+  p.max_iter = 500;
+  EXPECT_EQ(*mandelbrot2dMaxIter(p), 500);
+  p.max_iter = 0;
+  EXPECT_NE(mandelbrot2dMaxIter(p).error().message.find("--max-iter"), std::string::npos);
+  p.max_iter.reset();
+  p.width = 0.0;
+  EXPECT_NE(mandelbrot2dMaxIter(p).error().message.find("--width"), std::string::npos);
+  // --grid-out holds counts up to 65535: auto past that (width 1e-37: 70k) is an error naming both.
+  p.width = 1e-37;
+  p.grid_out = "unused.grid";
+  Result<int> refused = mandelbrot2dMaxIter(p);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("--max-iter is auto, " + std::to_string(autoMaxIter(1e-37))),
+            std::string::npos)
+      << refused.error().message;
+}
+
+TEST(Mandelbrot2d, smoothCountIsContinuousAcrossCountBands) {
+  // The default view at 1e-12 holds the 420/421 boundary: along each row the count jumps by one
+  // where ν moves by a pixel's share of the view.
+  Mandelbrot2dParams p;
+  p.width = 1e-12;
+  p.resolution = 128;
+  Result<Mandelbrot2dEscapes> e = mandelbrot2dEscapes(p);
+  ASSERT_TRUE(e.ok());
+  size_t jumps = 0;
+  double largest_step = 0.0, lowest = 1e9, highest = -1e9;
+  for (size_t row = 0; row < 128; ++row) {
+    for (size_t col = 0; col + 1 < 128; ++col) {
+      const size_t i = row * 128 + col;
+      ASSERT_LT(e->counts[i], 7941u);
+      const double nu = mandelbrot2dSmoothCount(e->counts[i], e->tails[i]);
+      const double next = mandelbrot2dSmoothCount(e->counts[i + 1], e->tails[i + 1]);
+      jumps += e->counts[i] != e->counts[i + 1];
+      largest_step = std::max(largest_step, std::abs(next - nu));
+      lowest = std::min(lowest, nu - e->counts[i]);
+      highest = std::max(highest, nu - e->counts[i]);
+    }
+  }
+  std::printf("[ mandelbrot2d ] 1e-12: %zu count jumps along rows, largest step of nu %.3g, nu - count in [%.3f, %.3f]\n",
+              jumps, largest_step, lowest, highest);
+  EXPECT_GT(jumps, 20u);
+  EXPECT_LT(largest_step, 0.02);  // the count itself jumps by 1
+  EXPECT_GT(lowest, 0.0);
+  EXPECT_LT(highest, 1.5);
+}
+
+// The share of the most common colour and the number of distinct colours (as the PLY writes them,
+// 8 bits per channel).
+std::pair<double, size_t> colourSpread(const PointSet& set) {
+  std::map<uint32_t, size_t> histogram;
+  for (const glm::vec3& c : set.colors) {
+    uint32_t key = 0;
+    for (int k = 0; k < 3; ++k) key = key << 8 | static_cast<uint32_t>(std::lround(c[k] * 255.0f));
+    ++histogram[key];
+  }
+  size_t most = 0;
+  for (const auto& [key, count] : histogram) most = std::max(most, count);
+  return {static_cast<double>(most) / static_cast<double>(set.size()), histogram.size()};
+}
+
+TEST(Mandelbrot2d, deepZoomsAtTheDefaultCentreAreNotOneColour) {
+  // Issue #24: at 1e-12 the counts are 420 and 421 only, and the old palette over the count gave
+  // 97.5% of the points one colour; at 1e-15 every count is 421 (100%). The smooth count, spread
+  // by its distribution, uses the whole palette.
+  for (double width : {1e-12, 1e-15}) {
+    Mandelbrot2dParams p;
+    p.width = width;
+    p.resolution = 256;
+    Result<PointSet> set = generateMandelbrot2d(p);
+    ASSERT_TRUE(set.ok());
+    const auto [most, distinct] = colourSpread(*set);
+    std::printf("[ mandelbrot2d ] width %g: most common colour %.2f%% of the points, %zu colours\n", width,
+                100.0 * most, distinct);
+    EXPECT_LT(most, 0.05) << width;
+    EXPECT_GT(distinct, 500u) << width;
   }
 }
 
