@@ -106,6 +106,8 @@ SpacingSearch::SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dv
           size_t at = tableIndex(key, capacity);
           while (keys_[at] != 0 && keys_[at] != key + 1) at = (at + 1) & (capacity - 1);
           if (keys_[at] == 0) keys_[at] = key + 1, slots_[at] = slot_count++;
+          const uint64_t bit = (mix(key) >> 40) & (kFilterBits - 1);
+          filter_[bit >> 6] |= uint64_t{1} << (bit & 63);
           pairs.push_back({slots_[at], s});
         }
   }
@@ -132,6 +134,8 @@ uint64_t SpacingSearch::cellKey(const glm::dvec3& p) const {
 
 uint32_t SpacingSearch::findSlot(uint64_t key) const {
   if (key == UINT64_MAX) return UINT32_MAX;
+  const uint64_t bit = (mix(key) >> 40) & (kFilterBits - 1);
+  if (!(filter_[bit >> 6] >> (bit & 63) & 1)) return UINT32_MAX;  // most points: no kept cell, one L1 read
   for (size_t at = tableIndex(key, keys_.size());; at = (at + 1) & (keys_.size() - 1)) {
     if (keys_[at] == key + 1) return slots_[at];
     if (keys_[at] == 0) return UINT32_MAX;

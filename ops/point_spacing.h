@@ -59,6 +59,8 @@ class SpacingSearch {
   unsigned threads_;
   glm::dvec3 origin_{0.0};
   double cell_ = 0.0, inverse_cell_ = 0.0;
+  static constexpr size_t kFilterBits = size_t{1} << 16;
+  std::array<uint64_t, kFilterBits / 64> filter_{};  // a bit per hash of the kept cells' keys
   std::vector<uint64_t> keys_;              // open addressing: cell key + 1, 0 = empty
   std::vector<uint32_t> slots_;             // the slot of keys_[i]
   std::vector<uint32_t> slot_start_;        // slot s lists samples slot_samples_[start[s], start[s + 1])

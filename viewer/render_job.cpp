@@ -597,6 +597,8 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   o.add("api_version", V::string(formatApiVersion(f.api_version)));
   o.add("points", V::integer(outcome.points));
   o.add("width", V::integer(request.camera.width)).add("height", V::integer(request.camera.height));
+  o.add("point_size", V::number(outcome.point_size));
+  o.add("shading", V::string(outcome.shading == Shading::kEdl ? "edl" : "none"));
   o.add("frames", V::integer(r.frame_ms.size()));
   if (r.gpu_ms.empty()) {
     o.add("gpu_ms", V::null());

@@ -38,3 +38,27 @@ if [ -f "$las" ]; then
       --view-center 638435.2,853170.1 --view-width 1 --width 256 --height 256 --point-size 15 --background 255,255,255
   done
 fi
+
+# The first picture (issue #24): `dpoint render FILE -o OUT.png` with every default but the size
+# (640x480), beside Open3D's default capture of the same file where Open3D is there
+# (bench/scripts/open3d_capture.py: python3-open3d for /usr/bin/python3 and Xvfb): the Mandelbulb
+# (res 200) and the default Menger sponge (level 4, exact); a LAS survey (the corpus's simple.las,
+# 1,065 returns over 3.4 x 4.6 km, when ../shared sits beside the checkout); a deep zoom 1e-12 wide
+# (mandelbrot2d's --max-iter auto and equalized colours, at a centre on the set's boundary: at the
+# default centre a view this deep holds no boundary, only a smooth ramp of escape counts).
+first=$here/first
+mkdir -p "$first"
+"$dpoint" generate mandelbulb --resolution 200 --quiet -o "$work/mandelbulb.ply"
+"$dpoint" generate menger --quiet -o "$work/menger_exact.ply"
+"$dpoint" generate mandelbrot2d --width 1e-12 --center=-0.7436450004729,0.131825899748 --quiet -o "$work/deep.ply"
+survey=$here/../../../shared/corpus/las/simple.las
+for set in mandelbulb menger_exact deep; do
+  "$dpoint" render "$work/$set.ply" -o "$first/$set.png" --width 640 --height 480 --quiet
+done
+if [ -f "$survey" ]; then "$dpoint" render "$survey" -o "$first/survey.png" --width 640 --height 480 --quiet; fi
+if /usr/bin/python3 -c "import open3d" 2>/dev/null && command -v Xvfb >/dev/null; then
+  for set in mandelbulb menger_exact; do
+    /usr/bin/python3 "$here/../../bench/scripts/open3d_capture.py" "$work/$set.ply" "$first/$set.open3d.png" \
+      --width 640 --height 480 >/dev/null
+  done
+fi
