@@ -147,7 +147,7 @@ Vec4 fp32Error(const Setup& s, const glm::dvec3& p, bool split) {
     // split: hi + lo in float is within u·|p| of p, plus hi's and lo's flushes.
     dv[a] = split ? 1.01 * kU * std::fabs(p[a]) + 2.0 * kFloatMin : storedFloatError(p[a]);
   }
-  return floatAffine(s.world_mvp, p, dv);
+  return floatAffine(s.world_rows, p, dv);
 }
 
 // rte: d_hi = hi_p − hi_e (exact when Sterbenz applies: checked, not assumed), d_lo = lo_p − lo_e
@@ -167,7 +167,7 @@ Vec4 rteError(const Setup& s, const glm::dvec3& ps) {
     v[a] = dh + dl;
     dv[a] = ddh + ddl + dsum + representation;
   }
-  return floatAffine(s.frame.projection_rotation, v, dv);
+  return floatAffine(s.projection_rows, v, dv);
 }
 
 // df64: each hi/lo pair holds its value to u² (point and matrix: 2u² per product); dfMul drops
@@ -190,24 +190,16 @@ Vec4 df64Error(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
 // native: p' − e' in double (ud), projection·rotation in double (γ_4 in ud), cast to float (u).
 Vec4 nativeError(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
   const glm::dvec3 d = ps - s.frame.eye;
-  const glm::dmat4& m = s.frame.projection_rotation;
-  Vec4 out;
-  for (int r = 0; r < 4; ++r) {
-    if (const std::optional<double> constant = constantRowError(m, r)) {
-      out[static_cast<size_t>(r)] = *constant;
-      continue;
-    }
-    double sum = std::fabs(m[3][r]), input = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double dd = kUd * std::fabs(d[c]);
-      sum += std::fabs(m[c][r]) * (std::fabs(d[c]) + dd);
-      input += std::fabs(m[c][r]) * dd;
-    }
-    const size_t row = static_cast<size_t>(r);
-    const double in_double = input + (gamma(4, kUd) + 4.0 * kUd) * sum + 8.0 * DBL_MIN;
-    out[row] = in_double + kU * (std::fabs(clip[row]) + in_double) + kFloatMin;
+  const FloatRows& m = s.projection_rows;  // |entries| and constant rows, per camera
+  Rows sum = m.magnitude[3], input = splat(0.0);
+  for (int c = 0; c < 3; ++c) {
+    const double dd = kUd * std::fabs(d[c]);
+    sum = sum + m.magnitude[c] * splat(std::fabs(d[c]) + dd);
+    input = input + m.magnitude[c] * splat(dd);
   }
-  return out;
+  const Rows in_double = input + splat(gamma(4, kUd) + 4.0 * kUd) * sum + splat(8.0 * DBL_MIN);
+  const Rows out = in_double + splat(kU) * (absOf(rowsOf(clip)) + in_double) + splat(kFloatMin);
+  return vec4Of(select(m.constant, m.constant_error, out));
 }
 
 // batch: the offset (p' − origin) / extent rounds once in double, then to an integer step (half a
@@ -219,7 +211,7 @@ Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
   const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kBatchSteps;
   glm::dvec3 dv;
   for (int a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * std::fabs(steps[a]);
-  Vec4 out = floatAffine(own.encoding.batch_matrices[b], steps, dv);
+  Vec4 out = floatAffine(own.batch_rows[b], steps, dv);
   for (size_t r = 0; r < 4; ++r) out[r] += own.batch_translation_error[b][r];
   return out;
 }

@@ -74,7 +74,7 @@ struct PointSet;      // core/point_set.h
 namespace bound {     // viewer/bound_terms.h
 struct Setup;
 struct ModeState;
-struct Worst;
+struct SeenPoint;
 }  // namespace bound
 
 // What the position buffer holds per point: `elements` values of one type, each `element_bytes`
@@ -112,10 +112,10 @@ using PositionEncoder = void (*)(const ModeEncoding& encoding, const glm::dvec3*
                                  size_t first_index);
 // The mode's uniform block (std140, as declared in shaders/render/project.glsl); empty when it has none.
 using UniformBuilder = std::vector<uint8_t> (*)(const ModeEncoding& encoding, const Camera& camera);
-// The largest squared per-point error bound in pixels over points [first, end) (viewer/precision.h
-// explains the analysis; viewer/bound_terms.h holds the shared terms).
-using BoundFunction = bound::Worst (*)(const bound::Setup& setup, const bound::ModeState& own, const PointSet& points,
-                                       size_t first, size_t end, const Camera& camera);
+// The largest squared per-point error bound in pixels over the points of a block the camera sees
+// (viewer/precision.h explains the analysis; viewer/bound_terms.h holds the shared terms).
+using BoundFunction = double (*)(const bound::Setup& setup, const bound::ModeState& own, const PointSet& points,
+                                 std::span<const bound::SeenPoint> seen, const Camera& camera);
 // Whether the mode's arithmetic overflows for this camera whatever the points (nullptr: never).
 using BoundRefusal = bool (*)(const bound::Setup& setup);
 
