@@ -19,7 +19,8 @@
 //   1. its enumerator at the end of PrecisionMode below (kAllModes lists them; rows are in this order);
 //   2. its row at the end of kModes in viewer/modes.cpp, with the functions the row points at
 //      beside it: the position encoder, the uniform builder (std140, as project.glsl declares it)
-//      and the per-point error bound (bound::worstOf<itsBound>; the shared terms are in
+//      and the per-point error bound (bound::worstOf<itsBound>, or bound::worstOfPairs<ItsBound>
+//      for a bound written for one point or two in lanes; the shared terms are in
 //      viewer/bound_terms.h, and a per-camera term no mode has yet goes in bound::Setup there),
 //      plus its speed ranks (kNoRank until measured);
 //   3. its arithmetic in shaders/render/project.glsl under a MODE_… define, and its dpoint_shader

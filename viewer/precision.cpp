@@ -129,7 +129,7 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
       size_t count = 0;
       for (size_t i = block, block_end = std::min(end, block + kBlock); i < block_end; ++i) {
         const glm::dvec3& p = points.positions[i];
-        seen[count] = {i, project(s, p)};
+        seen[count] = {i, project(s.frame, p)};
         for (size_t c = 0; c < check_count; ++c)
           chunk_beyond[c] |= !withinLimit(check_scene_frame[c] ? seen[count].q.ps : p, check_limit[c]);
         count += seen[count].q.visible;
