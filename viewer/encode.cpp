@@ -100,7 +100,7 @@ Status checkPositions(const ModeEncoding& e, const PointSet& points, size_t inde
   constexpr size_t kBlock = 1 << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
   std::vector<size_t> first_bad(blocks, SIZE_MAX);
-  const double limit = modeInfo(e.mode).layout.element == PositionElement::kFloat32 ? kFloatMax : HUGE_VAL;
+  const double limit = positionLimit(e.mode);
   parallelFor(blocks, 0, [&](size_t b, unsigned) {
     for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
       const glm::dvec3 in_frame = scaleBy(points.positions[i], e.frame);
@@ -206,6 +206,10 @@ SceneFrame sceneFrame(const Camera& camera) {
     for (int r = 0; r < 4; ++r)
       frame.projection_rotation[c][r] = std::ldexp(frame.projection_rotation[c][r], -frame.exponent);
   return frame;
+}
+
+double positionLimit(PrecisionMode mode) {
+  return modeInfo(mode).layout.element == PositionElement::kFloat32 ? kFloatMax : std::numeric_limits<double>::max();
 }
 
 ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera) {

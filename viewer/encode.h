@@ -92,6 +92,10 @@ struct ModeEncoding {
   std::vector<glm::dmat4> batch_matrices;
 };
 
+// The largest |coordinate| in its frame that the mode's encoding holds: FLT_MAX where it stores
+// floats, DBL_MAX else. addPoints refuses a point with a coordinate beyond it (or NaN).
+double positionLimit(PrecisionMode mode);
+
 // Builds the encoding. Fails (kBadInput, naming the point, the coordinate and the way out) when
 // the mode cannot hold the set: a coordinate beyond float range in fp32/split, or beyond it in the
 // scene frame in rte/df64 (a point ~1e38 view sizes from the origin); a batch whose origin is so

@@ -141,22 +141,23 @@ std::vector<uint8_t> noUniform(const ModeEncoding&, const Camera&) { return {}; 
 
 // ---- error bounds: each mode's arithmetic, step by step (notation in viewer/bound_terms.h) ------
 
-Vec4 fp32Error(const Setup& s, const glm::dvec3& p, bool split) {
-  glm::dvec3 dv;
-  for (int a = 0; a < 3; ++a) {
+template <class T>
+inline Clip<T> fp32Error(const Setup& s, const Coords<T>& p, bool split) {
+  Coords<T> dv;
+  for (size_t a = 0; a < 3; ++a) {
     // split: hi + lo in float is within u·|p| of p, plus hi's and lo's flushes.
-    dv[a] = split ? 1.01 * kU * std::fabs(p[a]) + 2.0 * kFloatMin : storedFloatError(p[a]);
+    dv[a] = split ? 1.01 * kU * absOf(p[a]) + 2.0 * kFloatMin : storedFloatError(p[a]);
   }
-  return floatAffine(s.world_mvp, p, dv);
+  return floatAffine(s.world_rows, p, dv);
 }
 
 // rte: d_hi = hi_p − hi_e (exact when Sterbenz applies: checked, not assumed), d_lo = lo_p − lo_e
 // (u), their sum (u), and the hi/lo representations themselves (u·|lo| each).
 Vec4 rteError(const Setup& s, const glm::dvec3& ps) {
-  glm::dvec3 v, dv;
-  for (int a = 0; a < 3; ++a) {
-    const FloatPair pp = splitDouble(ps[a]);
-    const FloatPair& pe = s.eye_split[static_cast<size_t>(a)];
+  Coords<double> v, dv;
+  for (size_t a = 0; a < 3; ++a) {
+    const FloatPair pp = splitDouble(ps[static_cast<glm::length_t>(a)]);
+    const FloatPair& pe = s.eye_split[a];
     const double dh = double(pp.hi) - double(pe.hi);
     double ddh = double(static_cast<float>(dh)) == dh ? 0.0 : kU * std::fabs(dh);
     if (dh != 0.0 && std::fabs(dh) < kFloatMin) ddh += kFloatMin;
@@ -167,7 +168,7 @@ Vec4 rteError(const Setup& s, const glm::dvec3& ps) {
     v[a] = dh + dl;
     dv[a] = ddh + ddl + dsum + representation;
   }
-  return floatAffine(s.frame.projection_rotation, v, dv);
+  return floatAffine(s.projection_rows, v, dv);
 }
 
 // df64: each hi/lo pair holds its value to u² (point and matrix: 2u² per product); dfMul drops
@@ -188,24 +189,25 @@ Vec4 df64Error(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
 }
 
 // native: p' − e' in double (ud), projection·rotation in double (γ_4 in ud), cast to float (u).
-Vec4 nativeError(const Setup& s, const glm::dvec3& ps, const Vec4& clip) {
-  const glm::dvec3 d = ps - s.frame.eye;
-  const glm::dmat4& m = s.frame.projection_rotation;
-  Vec4 out;
-  for (int r = 0; r < 4; ++r) {
-    if (const std::optional<double> constant = constantRowError(m, r)) {
-      out[static_cast<size_t>(r)] = *constant;
+template <class T>
+inline Clip<T> nativeError(const Setup& s, const Coords<T>& ps, const Clip<T>& clip) {
+  Coords<T> d;
+  for (size_t c = 0; c < 3; ++c) d[c] = ps[c] - s.frame.eye[static_cast<glm::length_t>(c)];
+  const FloatRows& m = s.projection_rows;  // |entries| and constant rows, per camera
+  Clip<T> out;
+  for (size_t r = 0; r < 4; ++r) {
+    if (m.constant[r]) {
+      out[r] = broadcast<T>(m.constant_error[r]);
       continue;
     }
-    double sum = std::fabs(m[3][r]), input = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double dd = kUd * std::fabs(d[c]);
-      sum += std::fabs(m[c][r]) * (std::fabs(d[c]) + dd);
-      input += std::fabs(m[c][r]) * dd;
+    T sum = broadcast<T>(m.magnitude[3][r]), input = broadcast<T>(0.0);
+    for (size_t c = 0; c < 3; ++c) {
+      const T dd = kUd * absOf(d[c]);
+      sum = sum + m.magnitude[c][r] * (absOf(d[c]) + dd);
+      input = input + m.magnitude[c][r] * dd;
     }
-    const size_t row = static_cast<size_t>(r);
-    const double in_double = input + (gamma(4, kUd) + 4.0 * kUd) * sum + 8.0 * DBL_MIN;
-    out[row] = in_double + kU * (std::fabs(clip[row]) + in_double) + kFloatMin;
+    const T in_double = input + (gamma(4, kUd) + 4.0 * kUd) * sum + 8.0 * DBL_MIN;
+    out[r] = in_double + kU * (absOf(clip[r]) + in_double) + kFloatMin;
   }
   return out;
 }
@@ -217,9 +219,9 @@ Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
   const size_t b = index / kBatchSize;
   const BatchFrame& frame = own.encoding.batches[b];
   const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kBatchSteps;
-  glm::dvec3 dv;
-  for (int a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * std::fabs(steps[a]);
-  Vec4 out = floatAffine(own.encoding.batch_matrices[b], steps, dv);
+  Coords<double> dv;
+  for (size_t a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * std::fabs(steps[static_cast<glm::length_t>(a)]);
+  Vec4 out = floatAffine(own.batch_rows[b], coordsOf(steps), dv);
   for (size_t r = 0; r < 4; ++r) out[r] += own.batch_translation_error[b][r];
   return out;
 }
@@ -232,21 +234,31 @@ bool df64MatrixOverflows(const Setup& s) {
   return false;
 }
 
-// The per-point bounds with one signature, for bound::worstOf.
-Vec4 fp32Bound(const Setup& s, const ModeState&, const glm::dvec3& p, const Projected&, size_t) {
-  return fp32Error(s, p, false);
-}
-Vec4 splitBound(const Setup& s, const ModeState&, const glm::dvec3& p, const Projected&, size_t) {
-  return fp32Error(s, p, true);
-}
+// The per-point bounds for bound::worstOf (one point at a time) and bound::worstOfPairs (one point
+// or two, T = double or Lanes).
+struct Fp32Bound {
+  template <class T>
+  static Clip<T> error(const Setup& s, const ModeState&, const PointIn<T>& in) {
+    return fp32Error(s, in.p, false);
+  }
+};
+struct SplitBound {
+  template <class T>
+  static Clip<T> error(const Setup& s, const ModeState&, const PointIn<T>& in) {
+    return fp32Error(s, in.p, true);
+  }
+};
+struct NativeBound {
+  template <class T>
+  static Clip<T> error(const Setup& s, const ModeState&, const PointIn<T>& in) {
+    return nativeError(s, in.ps, in.clip);
+  }
+};
 Vec4 rteBound(const Setup& s, const ModeState&, const glm::dvec3&, const Projected& q, size_t) {
   return rteError(s, q.ps);
 }
 Vec4 df64Bound(const Setup& s, const ModeState&, const glm::dvec3&, const Projected& q, size_t) {
   return df64Error(s, q.ps, q.clip);
-}
-Vec4 nativeBound(const Setup& s, const ModeState&, const glm::dvec3&, const Projected& q, size_t) {
-  return nativeError(s, q.ps, q.clip);
 }
 Vec4 batchBound(const Setup&, const ModeState& own, const glm::dvec3&, const Projected& q, size_t i) {
   return batchError(own, q.ps, i);
@@ -276,11 +288,11 @@ constexpr PositionAttribute kNone{};
 constexpr ModeInfo kModes[] = {
     {PrecisionMode::kFp32, "fp32", "float positions", 12, kFloatXyz, false, false, false, false, 0, 1,
      {DPOINT_SPIRV(kPointsFp32Vert), {}, DPOINT_SPIRV(kSplatFp32Comp), {kFloatAttribute, kNone}, 1},
-     encodeFloats, worldMatrixUniform, worstOf<fp32Bound>, nullptr, {{0, 0}, {0, 0}}},
+     encodeFloats, worldMatrixUniform, worstOfPairs<Fp32Bound>, nullptr, {{0, 0}, {0, 0}}},
     {PrecisionMode::kSplit, "split", "the study's hi+lo, no better than fp32", 24, kFloatPairs, false, false, false,
      false, 0, 1,
      {DPOINT_SPIRV(kPointsSplitVert), {}, DPOINT_SPIRV(kSplatSplitComp), {kFloatAttribute, kLoAttribute}, 2},
-     encodeFloatPairs, worldMatrixUniform, worstOf<splitBound>, nullptr, {{kNoRank, kNoRank}, {kNoRank, kNoRank}}},
+     encodeFloatPairs, worldMatrixUniform, worstOfPairs<SplitBound>, nullptr, {{kNoRank, kNoRank}, {kNoRank, kNoRank}}},
     {PrecisionMode::kRte, "rte", "relative to eye", 24, kFloatPairs, true, true, false, false, 0, 1,
      {DPOINT_SPIRV(kPointsRteVert), {}, DPOINT_SPIRV(kSplatRteComp), {kFloatAttribute, kLoAttribute}, 2},
      encodeFloatPairs, rteUniform, worstOf<rteBound>, nullptr, {{2, 2}, {3, 2}}},
@@ -290,7 +302,7 @@ constexpr ModeInfo kModes[] = {
     {PrecisionMode::kNative, "native", "fp64 shaders", 24, kDoubleXyz, true, false, true, true, 0, 1,
      {DPOINT_SPIRV(kPointsNativeAttrVert), DPOINT_SPIRV(kPointsNativePullVert), DPOINT_SPIRV(kSplatNativeComp),
       {{0, VK_FORMAT_R64G64B64_SFLOAT, 0}, kNone}, 1},
-     encodeDoubles, nativeUniform, worstOf<nativeBound>, nullptr, {{1, 1}, {2, 3}}},
+     encodeDoubles, nativeUniform, worstOfPairs<NativeBound>, nullptr, {{1, 1}, {2, 3}}},
     // The compute splat reads points in pairs that must share a batch: chunks start at even points.
     {PrecisionMode::kBatch, "batch", "per-batch double origins", 8, kBatchWord, true, false, false, false, kBatchSize, 2,
      {DPOINT_SPIRV(kPointsBatchVert), {}, DPOINT_SPIRV(kSplatBatchComp), {{0, VK_FORMAT_R32G32_UINT, 0}, kNone}, 1},

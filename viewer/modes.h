@@ -19,7 +19,8 @@
 //   1. its enumerator at the end of PrecisionMode below (kAllModes lists them; rows are in this order);
 //   2. its row at the end of kModes in viewer/modes.cpp, with the functions the row points at
 //      beside it: the position encoder, the uniform builder (std140, as project.glsl declares it)
-//      and the per-point error bound (bound::worstOf<itsBound>; the shared terms are in
+//      and the per-point error bound (bound::worstOf<itsBound>, or bound::worstOfPairs<ItsBound>
+//      for a bound written for one point or two in lanes; the shared terms are in
 //      viewer/bound_terms.h, and a per-camera term no mode has yet goes in bound::Setup there),
 //      plus its speed ranks (kNoRank until measured);
 //   3. its arithmetic in shaders/render/project.glsl under a MODE_… define, and its dpoint_shader
@@ -74,7 +75,7 @@ struct PointSet;      // core/point_set.h
 namespace bound {     // viewer/bound_terms.h
 struct Setup;
 struct ModeState;
-struct Worst;
+struct SeenPoint;
 }  // namespace bound
 
 // What the position buffer holds per point: `elements` values of one type, each `element_bytes`
@@ -112,10 +113,10 @@ using PositionEncoder = void (*)(const ModeEncoding& encoding, const glm::dvec3*
                                  size_t first_index);
 // The mode's uniform block (std140, as declared in shaders/render/project.glsl); empty when it has none.
 using UniformBuilder = std::vector<uint8_t> (*)(const ModeEncoding& encoding, const Camera& camera);
-// The largest squared per-point error bound in pixels over points [first, end) (viewer/precision.h
-// explains the analysis; viewer/bound_terms.h holds the shared terms).
-using BoundFunction = bound::Worst (*)(const bound::Setup& setup, const bound::ModeState& own, const PointSet& points,
-                                       size_t first, size_t end, const Camera& camera);
+// The largest squared per-point error bound in pixels over the points of a block the camera sees
+// (viewer/precision.h explains the analysis; viewer/bound_terms.h holds the shared terms).
+using BoundFunction = double (*)(const bound::Setup& setup, const bound::ModeState& own, const PointSet& points,
+                                 std::span<const bound::SeenPoint> seen, const Camera& camera);
 // Whether the mode's arithmetic overflows for this camera whatever the points (nullptr: never).
 using BoundRefusal = bool (*)(const bound::Setup& setup);
 

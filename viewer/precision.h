@@ -63,7 +63,8 @@ struct ModeChoice {
 
 // Walks the speed order, skipping modes `usable` refuses, and takes the first whose bound is
 // ≤ kAutoBoundPx; when none is, takes native if usable (else the usable mode with the smallest
-// bound) with enough = false. Bounds are computed only for the modes it looks at.
+// bound) with enough = false. Bounds are computed only for the modes it looks at, those it is sure
+// to look at together in one pass (the next two usable modes before its choice, one after it).
 ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> order,
                       const std::function<bool(PrecisionMode)>& usable);
 

@@ -6,7 +6,9 @@
 // points off their pixel: run the binary with --gtest_filter='*Precision*' to read the table.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 #include <set>
@@ -276,6 +278,70 @@ TEST_P(Precision, degenerateSetsStayWithinTheBounds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Precision, ::testing::Values(Backend::kRaster, Backend::kCompute), backendName);
+
+// --- The pass itself: modes bounded together, two points at a time -----------------------------
+
+// Bounds computed together in one pass (fp32, split and native two points at a time, an odd point
+// alone) are each mode's bound from a pass of its own, to the bit: an odd count of points, far
+// from the origin, at 1e-300 (subnormal floats) and under an ortho camera (a constant w row).
+TEST(PrecisionPass, modesBoundedTogetherGetTheirOwnPassesBoundsToTheBit) {
+  const glm::dvec3 centre(6.378e6, 0.5, -3.0);
+  PointSet odd = cloud(centre, 1e-3);
+  odd.positions.pop_back();
+  odd.colors.pop_back();
+  PointSet tiny = odd;
+  for (glm::dvec3& p : tiny.positions) p *= 1e-300;
+  CameraSpec ortho_spec;
+  ortho_spec.ortho = true;
+  const Result<Camera> ortho = makeCamera(ortho_spec, boundsOf(odd));
+  ASSERT_TRUE(ortho.ok()) << ortho.error().message;
+  const std::pair<const PointSet*, Camera> cases[] = {
+      {&odd, lookAtCloud(odd, centre, 1.0)}, {&tiny, lookAtCloud(tiny, centre * 1e-300, 1e-300)}, {&odd, *ortho}};
+  for (const auto& [points, camera] : cases) {
+    const ErrorBounds together = predictErrorBounds(*points, camera);
+    EXPECT_EQ(together.visible, points->size());
+    for (PrecisionMode mode : kAllModes) {
+      const ErrorBounds alone = predictErrorBounds(*points, camera, std::array{mode});
+      const size_t m = modeIndex(mode);
+      EXPECT_EQ(std::bit_cast<uint64_t>(together.px[m]), std::bit_cast<uint64_t>(alone.px[m])) << modeName(mode);
+      EXPECT_EQ(together.visible, alone.visible) << modeName(mode);
+    }
+  }
+}
+
+// A coordinate beyond float range, checked in the pass for the modes without batch frames: the
+// float modes (fp32, split; rte and df64, whose scene frame is the world's at this size) are
+// unbounded, native is not.
+TEST(PrecisionPass, aPointBeyondFloatRangeLeavesTheFloatModesUnbounded) {
+  PointSet s = cloud(glm::dvec3(0.0), 1e-3);
+  const Camera camera = lookAtCloud(s, glm::dvec3(0.0), 1.0);
+  s.positions.emplace_back(1e39, 0.0, 0.0);  // past the far plane
+  s.colors.emplace_back(1.0f, 1.0f, 1.0f);
+  const ErrorBounds bounds = predictErrorBounds(s, camera);
+  EXPECT_EQ(bounds.visible, s.size() - 1);
+  for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kSplit, PrecisionMode::kRte, PrecisionMode::kDf64})
+    EXPECT_TRUE(std::isinf(bounds.px[modeIndex(mode)])) << modeName(mode);
+  EXPECT_LE(bounds.px[modeIndex(PrecisionMode::kNative)], 2.0 * bounds.float_floor_px);
+}
+
+// --mode auto bounds only what its walk looks at: fp32 and its runner-up where fp32 is within the
+// limit; where fp32 is not, native and the mode after it as well, never the modes past those.
+TEST(PrecisionPass, chooseModeBoundsOnlyTheModesItLooksAt) {
+  const auto all = [](PrecisionMode) { return true; };
+  const std::span<const PrecisionMode> order = measuredSpeedOrder(DeviceClass::kCpu, true);
+  ASSERT_GE(order.size(), 4u);
+  const glm::dvec3 near(1.0, 2.0, 3.0), far(6.378e6, 0.5, -3.0);
+  for (const glm::dvec3& centre : {near, far}) {
+    const PointSet s = cloud(centre, 1e-3);
+    const ModeChoice choice = chooseMode(s, lookAtCloud(s, centre, 1.0), order, all);
+    const bool fp32_enough = choice.mode == order[0];
+    const size_t looked_at = fp32_enough ? 2 : 3;
+    EXPECT_EQ(fp32_enough, centre == near);
+    for (size_t k = 0; k < order.size(); ++k)
+      EXPECT_EQ(choice.bounds.computed[modeIndex(order[k])], k < looked_at) << modeName(order[k]);
+    EXPECT_EQ(choice.runner_up, order[looked_at - 1]);
+  }
+}
 
 }  // namespace
 }  // namespace dpoint
