@@ -36,11 +36,12 @@ namespace {
 
 using Entry = std::pair<uint64_t, glm::dvec3>;
 
-// Keeps `heap` (a max-heap on the hash) at the `wanted` smallest distinct entries.
+// Keeps `heap` (a max-heap on the hash) at the `wanted` smallest entries, copies of a position
+// counted each time (finish() keeps one): the same entries whatever the order they come in, as
+// copies share a hash and only equal hashes can tie.
 void offer(std::vector<Entry>& heap, size_t wanted, uint64_t h, const glm::dvec3& p) {
   auto less = [](const Entry& a, const Entry& b) { return a.first < b.first; };
   if (heap.size() == wanted && !(h < heap.front().first)) return;
-  if (std::any_of(heap.begin(), heap.end(), [&](const Entry& e) { return e.first == h && e.second == p; })) return;
   if (heap.size() == wanted) {
     std::pop_heap(heap.begin(), heap.end(), less);
     heap.pop_back();
@@ -70,7 +71,9 @@ std::vector<glm::dvec3> SpacingSampler::finish() const {
   std::vector<std::pair<uint64_t, glm::dvec3>> sorted = heap_;
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<glm::dvec3> out;
-  for (const auto& e : sorted) out.push_back(e.second);
+  for (size_t k = 0; k < sorted.size(); ++k)
+    if (k == 0 || sorted[k].first != sorted[k - 1].first || sorted[k].second != sorted[k - 1].second)
+      out.push_back(sorted[k].second);
   return out;
 }
 

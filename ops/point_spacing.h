@@ -25,8 +25,9 @@ struct SpacingSample {
   double distance = 0.0;     // to its kSpacingNeighbors-th nearest point at another position
 };
 
-// Pass 1: the `samples` distinct positions with the smallest hash of their coordinates' bits: a
-// spread over the set that depends on the points, not on their order or on how they are split.
+// Pass 1: the positions with the `samples` smallest hashes of their coordinates' bits (a position
+// given twice counts twice, and is sampled once): a spread over the set that depends on the points,
+// not on their order or on how they are split.
 class SpacingSampler {
  public:
   explicit SpacingSampler(size_t samples, unsigned threads = 0) : wanted_(samples), threads_(threads) {}
