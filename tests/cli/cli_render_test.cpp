@@ -78,6 +78,27 @@ TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
 }
 
 // DESIGN §7 offset, end to end: a generated fractal moved to the Earth's radius.
+// --warmup auto (the default): a single picture is drawn once (no warm-up frame, said beside its
+// time); with --frames above 1 one frame is drawn untimed first, and --warmup N is kept.
+TEST(CliRender, warmupAutoDrawsASinglePictureOnce) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "24", "--quiet", "-o", dir.file("mb.ply")}).exit_code, 0);
+  auto gpuLine = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", dir.file("mb.ply"), "-o", dir.file("mb.png"), "--width", "64", "--height", "48"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const size_t at = r.out.find("gpu: ");
+    return at == std::string::npos ? std::string() : r.out.substr(at, r.out.find('\n', at) - at);
+  };
+  EXPECT_NE(gpuLine({}).find("median of 1 (p95"), std::string::npos);
+  EXPECT_NE(gpuLine({}).find(", no warm-up,"), std::string::npos) << gpuLine({});
+  EXPECT_EQ(gpuLine({"--frames", "3"}).find("no warm-up"), std::string::npos);
+  EXPECT_EQ(gpuLine({"--warmup", "2"}).find("no warm-up"), std::string::npos);
+  EXPECT_NE(gpuLine({"--frames", "3", "--warmup", "0"}).find("median of 3 (p95"), std::string::npos);
+  EXPECT_NE(gpuLine({"--frames", "3", "--warmup", "0"}).find("no warm-up"), std::string::npos);
+}
+
 TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {
   TempDir dir;
   ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "33", "--offset", "6378137,0,0", "--quiet", "-o",

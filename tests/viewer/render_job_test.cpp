@@ -146,6 +146,8 @@ TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
   outcome.prediction.bound_px = std::nan("");
   outcome.result.frame_ms = {2.0, 4.0};
   outcome.result.chunks = 1;
+  outcome.point_size = 2.5f;
+  outcome.shading = Shading::kEdl;
   outcome.phases.mark("read");
   outcome.error = ErrorReport{};
   outcome.error->stats.points = 3;
@@ -155,7 +157,8 @@ TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
                        "  \"backend\": \"raster\",\n  \"order\": \"input\",\n  \"device\": \"dev \\\"1\\\"\",\n", 0),
             0u)
       << json;
-  for (const char* line : {"  \"width\": 64,\n  \"height\": 48,\n  \"frames\": 2,\n  \"gpu_ms\": null,\n",
+  for (const char* line : {"  \"width\": 64,\n  \"height\": 48,\n  \"point_size\": 2.5,\n  \"shading\": \"edl\",\n"
+                           "  \"frames\": 2,\n  \"gpu_ms\": null,\n",
                            "  \"frame_ms\": {\"median\": 3, \"p95\": 4},\n", "\"phases_ms\": {\"read\": ",
                            "  \"native_path\": null,\n  \"error_px\": null,\n",
                            "  \"points_visible\": 3,\n  \"points_lost\": 3,\n  \"pixels_differing\": null,\n"
