@@ -305,9 +305,9 @@ ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse) {
 
 int ShadeRadii::margin() const {
   const int reach = std::max(edl_axis, edl_diagonal);
-  // smooth_edl.comp reads a window of reach + smooth around each block of kShadeBlock² pixels,
-  // the last block's reaching kShadeBlock − 1 pixels past the picture.
-  return std::max({fill, fused ? int{kShadeBlock} - 1 + smooth + reach : std::max(smooth, reach)});
+  // smooth_edl.comp reads reach + smooth pixels around each strip, the last strips reaching up to
+  // kShadeStripHeight − 1 pixels past the picture.
+  return std::max({fill, fused ? int{kShadeStripHeight} - 1 + smooth + reach : std::max(smooth, reach)});
 }
 
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii) {

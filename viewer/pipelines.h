@@ -92,7 +92,8 @@ struct EdlPush {
 };
 inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
 inline constexpr uint32_t kShadeBindings = 8;  // shaders/render/shade_common.glsl
-inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/render/shade_common.glsl
+inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
+inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
 // The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):
 // the filling searches half a point and a pixel each way, the depth is averaged over a square a
 // pixel narrower than two points, the eye-dome neighbours lie on a circle of the radius.
@@ -105,7 +106,7 @@ struct ShadeRadii {
   int margin() const;  // of the log-distance buffers (EdlPush::margin)
 };
 inline constexpr int kMaxFusedSmooth = 7, kMaxFusedReach = 2;
-inline constexpr uint32_t kShadeBlock = 4;  // pixels each way a smooth_edl.comp invocation shades
+inline constexpr uint32_t kShadeStripWidth = 8, kShadeStripHeight = 32;  // pixels a smooth_edl.comp invocation shades
 ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse);
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);

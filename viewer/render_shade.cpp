@@ -140,31 +140,31 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
             VK_ACCESS_SHADER_READ_BIT);
   }
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.layout, 0, 1, &r.shade_set, 0, nullptr);
-  // A pass whose invocations each shade `block`² pixels.
-  auto pass = [&](VkPipeline pipeline, uint32_t axis, uint32_t block) {
+  // A pass of `group`² invocations a workgroup, each shading block_x × block_y pixels.
+  auto pass = [&](VkPipeline pipeline, uint32_t axis, uint32_t group, uint32_t block_x, uint32_t block_y) {
     EdlPush p = push;
     p.axis = axis;
     vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(p), &p);
     vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    const uint32_t pixels = kShadeGroupSize * block;
-    vkCmdDispatch(commands, (push.width + pixels - 1) / pixels, (push.height + pixels - 1) / pixels, 1);
+    const uint32_t across = group * block_x, down = group * block_y;
+    vkCmdDispatch(commands, (push.width + across - 1) / across, (push.height + down - 1) / down, 1);
   };
   const auto between = [&] {
     barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
   };
-  pass(r.shade.log, 0, 1);
+  pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
   between();
-  pass(r.shade.fill, 0, 1);
+  pass(r.shade.fill, 0, kShadeGroupSize, 1, 1);
   between();
   if (r.shade.smooth_edl) {
-    pass(r.shade.smooth_edl, 0, kShadeBlock);
+    pass(r.shade.smooth_edl, 0, kShadeStripGroupSize, kShadeStripWidth, kShadeStripHeight);
   } else {
-    pass(r.shade.smooth, 0, 1);
+    pass(r.shade.smooth, 0, kShadeGroupSize, 1, 1);
     between();
-    pass(r.shade.smooth, 1, 1);
+    pass(r.shade.smooth, 1, kShadeGroupSize, 1, 1);
     between();
-    pass(r.shade.edl, 0, 1);
+    pass(r.shade.edl, 0, kShadeGroupSize, 1, 1);
   }
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
           VK_ACCESS_TRANSFER_READ_BIT);

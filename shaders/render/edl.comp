@@ -13,6 +13,8 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "shade_common.glsl"
 
+layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
+
 layout(set = 0, binding = 5, r32ui) uniform readonly uimageBuffer filled_picture;
 layout(set = 0, binding = 7, r32f) uniform readonly imageBuffer smoothed;
 layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer shaded;

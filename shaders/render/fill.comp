@@ -14,6 +14,8 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "shade_common.glsl"
 
+layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
+
 layout(set = 0, binding = 1, r32ui) uniform readonly uimageBuffer picture;
 layout(set = 0, binding = 3, r32f) uniform readonly imageBuffer log_distance;
 layout(set = 0, binding = 4, r32f) uniform writeonly imageBuffer filled_log;

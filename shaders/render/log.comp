@@ -5,6 +5,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shade_common.glsl"
 
+layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
+
 layout(set = 0, binding = 0, r32f) uniform readonly imageBuffer depth;
 layout(set = 0, binding = 3, r32f) uniform writeonly imageBuffer log_distance;
 

@@ -11,7 +11,6 @@
 // 0, 1, 2 and 5 are the picture's rows; 3, 4, 6 and 7 have a margin of pc.margin pixels all
 // round, set once to kEmpty (6: no sum) and never written, so neighbours are read at fixed
 // offsets without a test for the picture's edge.
-layout(local_size_x = 16, local_size_y = 16) in;
 layout(push_constant) uniform Push {
   uint width;
   uint height;

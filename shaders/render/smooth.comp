@@ -9,6 +9,8 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "shade_common.glsl"
 
+layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
+
 layout(set = 0, binding = 4, r32f) uniform readonly imageBuffer filled_log;
 layout(set = 0, binding = 6, rg32f) uniform imageBuffer partial;  // (sum, count) along a row
 layout(set = 0, binding = 7, r32f) uniform writeonly imageBuffer smoothed;
