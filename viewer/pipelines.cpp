@@ -8,7 +8,6 @@
 #include "shaders/points.frag.h"
 #include "shaders/edl.comp.h"
 #include "shaders/fill.comp.h"
-#include "shaders/fill_strip.comp.h"
 #include "shaders/log.comp.h"
 #include "shaders/smooth.comp.h"
 #include "shaders/smooth_edl.comp.h"
@@ -300,17 +299,15 @@ ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse) {
   // rounded them before: along the axes and along the diagonals.
   radii.edl_axis = static_cast<int>(std::round(edl_radius));
   radii.edl_diagonal = static_cast<int>(std::round(edl_radius * 0.70710678f));
-  radii.fused = fuse && radii.fill <= kMaxStripFill && radii.smooth <= kMaxFusedSmooth &&
-                std::max(radii.edl_axis, radii.edl_diagonal) <= kMaxFusedReach;
+  radii.fused = fuse && radii.smooth <= kMaxFusedSmooth && std::max(radii.edl_axis, radii.edl_diagonal) <= kMaxFusedReach;
   return radii;
 }
 
 int ShadeRadii::margin() const {
   const int reach = std::max(edl_axis, edl_diagonal);
-  // The strips of fill.comp (FILL_STRIP) and smooth_edl.comp read fill and reach + smooth pixels
-  // around them, the last strips reaching up to kShadeStripHeight − 1 pixels past the picture.
-  if (fused) return int{kShadeStripHeight} - 1 + std::max(fill, smooth + reach);
-  return std::max({fill, smooth, reach});
+  // smooth_edl.comp reads reach + smooth pixels around each strip, the last strips reaching up to
+  // kShadeStripHeight − 1 pixels past the picture.
+  return std::max({fill, fused ? int{kShadeStripHeight} - 1 + smooth + reach : std::max(smooth, reach)});
 }
 
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii) {
@@ -335,9 +332,7 @@ Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRad
   };
   const auto u = [](int v) { return static_cast<uint32_t>(v); };
   for (const Stage& stage :
-       {Stage{radii.fused ? nullptr : &p.log, {kLogComp, sizeof(kLogComp)}, {}},
-        Stage{&p.fill, radii.fused ? Spirv{kFillStripComp, sizeof(kFillStripComp)} : Spirv{kFillComp, sizeof(kFillComp)},
-              {u(radii.fill)}},
+       {Stage{&p.log, {kLogComp, sizeof(kLogComp)}, {}}, Stage{&p.fill, {kFillComp, sizeof(kFillComp)}, {u(radii.fill)}},
         Stage{radii.fused ? &p.smooth_edl : &p.smooth, radii.fused ? Spirv{kSmoothEdlComp, sizeof(kSmoothEdlComp)}
                                                                        : Spirv{kSmoothComp, sizeof(kSmoothComp)},
               {u(radii.smooth), u(radii.edl_axis), u(radii.edl_diagonal)}},

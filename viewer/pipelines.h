@@ -75,9 +75,8 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pip
 struct ShadePipeline {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  // ShadeRadii::fused: fill (its strip variant) and smooth_edl; otherwise log, fill, smooth twice
-  // and edl.
   VkPipeline log = VK_NULL_HANDLE, fill = VK_NULL_HANDLE;
+  // Then either smooth_edl (ShadeRadii::fused) or smooth twice and edl.
   VkPipeline smooth_edl = VK_NULL_HANDLE, smooth = VK_NULL_HANDLE, edl = VK_NULL_HANDLE;
 };
 struct EdlPush {
@@ -94,22 +93,20 @@ struct EdlPush {
 inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
 inline constexpr uint32_t kShadeBindings = 8;  // shaders/render/shade_common.glsl
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
-inline constexpr uint32_t kShadeStripGroupSize = 8;  // fill.comp (FILL_STRIP) and smooth_edl.comp
+inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
 // The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):
 // the filling searches half a point and a pixel each way, the depth is averaged over a square a
 // pixel narrower than two points, the eye-dome neighbours lie on a circle of the radius.
 struct ShadeRadii {
   int fill = 1, smooth = 0;
   int edl_axis = 1, edl_diagonal = 1;  // the eye-dome neighbours' offsets along the axes and the diagonals
-  // Hole filling in strips (fill.comp's FILL_STRIP, which takes the log distances itself),
-  // smoothing and eye-dome lighting in one pass (smooth_edl.comp), each keeping the rows it reads
-  // in registers: where asked, for the radii of point sizes up to 8 px and eye-dome radii under
-  // 2.5 px.
+  // Smoothing and eye-dome lighting in one pass (smooth_edl.comp), which holds its window in
+  // registers: where asked, for the radii of point sizes up to 8 px and eye-dome radii under 2.5 px.
   bool fused = false;
   int margin() const;  // of the log-distance buffers (EdlPush::margin)
 };
-inline constexpr int kMaxStripFill = 5, kMaxFusedSmooth = 7, kMaxFusedReach = 2;
-inline constexpr uint32_t kShadeStripWidth = 8, kShadeStripHeight = 32;  // pixels a strip invocation shades
+inline constexpr int kMaxFusedSmooth = 7, kMaxFusedReach = 2;
+inline constexpr uint32_t kShadeStripWidth = 8, kShadeStripHeight = 32;  // pixels a smooth_edl.comp invocation shades
 ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse);
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);

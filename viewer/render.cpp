@@ -239,7 +239,7 @@ Status createTargets(const VulkanContext& context, Resources& r, uint32_t width,
 }
 
 Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.fill ? 1 : 0);
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.log ? 1 : 0);
   if (Status status = detail::createDescriptorPool(context, r, sets, 3); !status)
     return status;
   for (Chunk& chunk : r.chunks) {
@@ -250,7 +250,7 @@ Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled
     VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &chunk.set));
     writeDescriptors(context, r, chunk, pulled, probe);
   }
-  return r.shade.fill ? detail::createShadeDescriptors(context, r) : okStatus();
+  return r.shade.log ? detail::createShadeDescriptors(context, r) : okStatus();
 }
 
 Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const ModeEncoding& encoding) {
@@ -502,7 +502,7 @@ Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, 
                                    {VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, kShadeBindings}};
   VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   info.maxSets = sets;
-  info.poolSizeCount = r.shade.fill ? 3 : 2;
+  info.poolSizeCount = r.shade.log ? 3 : 2;
   info.pPoolSizes = sizes;
   VK_TRY(vkCreateDescriptorPool(context.device, &info, nullptr, &r.descriptor_pool));
   return okStatus();

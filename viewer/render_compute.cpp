@@ -37,7 +37,7 @@ Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t
 Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe) {
   // One splat set per chunk (camera, positions, batches, probe, visibility), the resolve set
   // (visibility, colours, picture, depth) and with eye-dome lighting its set.
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.fill ? 1 : 0);
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.log ? 1 : 0);
   if (Status status = createDescriptorPool(context, r, sets, 4); !status) return status;
   auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
   auto allocate = [&](VkDescriptorSetLayout layout, VkDescriptorSet& set) -> Status {
@@ -59,7 +59,7 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   if (Status status = allocate(r.compute.resolve_set, r.resolve_set); !status) return status;
   write(r.resolve_set, {whole(r.visibility), whole(r.all_colors), whole(r.picture),
                         r.depth_values.buffer ? whole(r.depth_values) : whole(r.dummy)}, false);
-  return r.shade.fill ? createShadeDescriptors(context, r) : okStatus();
+  return r.shade.log ? createShadeDescriptors(context, r) : okStatus();
 }
 
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,

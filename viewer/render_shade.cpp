@@ -1,15 +1,13 @@
 // Shading after either backend (RenderOptions::shading): the raster backend's colour and depth
 // attachments are copied into buffers, the compute backend's resolve writes them there itself;
-// then the passes of shaders/render/shade_common.glsl write the shaded picture that is read back:
-// where the radii are small (ShadeRadii::fused, the defaults) hole filling in strips, then depth
-// smoothing and eye-dome lighting in one pass; otherwise the log distances, hole filling, the
-// depth smoothed along rows and then columns, and eye-dome lighting, one pass each.
+// then the passes of shaders/render/shade_common.glsl (log distance, hole filling, the depth
+// smoothed along rows and columns, eye-dome lighting; the last three in one pass where the radii
+// are small, ShadeRadii::fused) write the shaded picture that is read back.
 //
-// On lavapipe each pass over 786K pixels costs several ms before it reads anything, a
-// storage-buffer load is a loop over the SIMD lanes, a log2 costs more than a load, and llvmpipe
-// runs every branch of every lane: hence few passes, texel buffers, one log2 a pixel, margins
-// instead of edge tests, and strips whose invocations share what they read in registers
-// (docs/rendering.md has the timings).
+// On lavapipe, where the shading costs most next to the points, each pass costs about as much
+// for being a pass over 786K pixels as for its loads: hence one log2 a pixel, margins instead of
+// edge tests, texel buffers instead of storage buffers, and the fused last pass (1024x768
+// Mandelbulb at 2 px: 55 ms of shading before, 15 ms after, on 2 cores).
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -41,7 +39,7 @@ Status createShadeTargets(const VulkanContext& context, Resources& r, const Came
   for (const Target& t : {Target{&r.depth_values, bytes, in_usage, "depth per pixel"},
                           Target{raster ? &r.picture : nullptr, bytes, in_usage, "picture before shading"},
                           Target{&r.shaded, bytes, texel | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "shaded picture"},
-                          Target{radii.fused ? nullptr : &r.log_distance, padded, margin, "log distance"},
+                          Target{&r.log_distance, padded, margin, "log distance"},
                           Target{&r.filled_log, padded, margin, "log distance after hole filling"},
                           Target{&r.filled_picture, bytes, texel, "picture after hole filling"},
                           // Only between the separate passes of smooth.comp and edl.comp.
@@ -67,17 +65,15 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
   allocate.descriptorSetCount = 1;
   allocate.pSetLayouts = &r.shade.set_layout;
   VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &r.shade_set));
-  // In binding order (shaders/render/shade_common.glsl): one texel a pixel. The strip passes
-  // (ShadeRadii::fused) make no log distances before the filling, no row sums and no means:
-  // their bindings, which those passes never read, show the filled log distances.
-  const Buffer& log_distance = r.log_distance.buffer ? r.log_distance : r.filled_log;
-  const Buffer& partial = r.partial.buffer ? r.partial : r.filled_log;
-  const Buffer& smoothed = r.smoothed.buffer ? r.smoothed : r.filled_log;
+  // In binding order (shaders/render/shade_common.glsl): one texel a pixel. The fused pass makes
+  // no row sums or means: their bindings, which it never reads, show the log distances.
+  const Buffer& partial = r.partial.buffer ? r.partial : r.log_distance;
+  const Buffer& smoothed = r.smoothed.buffer ? r.smoothed : r.log_distance;
   const struct {
     const Buffer& buffer;
     VkFormat format;
   } views[kShadeBindings] = {{r.depth_values, VK_FORMAT_R32_SFLOAT}, {r.picture, VK_FORMAT_R32_UINT},
-                             {r.shaded, VK_FORMAT_R32_UINT},        {log_distance, VK_FORMAT_R32_SFLOAT},
+                             {r.shaded, VK_FORMAT_R32_UINT},        {r.log_distance, VK_FORMAT_R32_SFLOAT},
                              {r.filled_log, VK_FORMAT_R32_SFLOAT},  {r.filled_picture, VK_FORMAT_R32_UINT},
                              {partial, VK_FORMAT_R32G32_SFLOAT},    {smoothed, VK_FORMAT_R32_SFLOAT}};
   VkWriteDescriptorSet writes[kShadeBindings];
@@ -157,14 +153,9 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
     barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
   };
-  if (r.shade.log) {
-    pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
-    between();
-  }
-  if (r.shade.smooth_edl)
-    pass(r.shade.fill, 0, kShadeStripGroupSize, kShadeStripWidth, kShadeStripHeight);
-  else
-    pass(r.shade.fill, 0, kShadeGroupSize, 1, 1);
+  pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
+  between();
+  pass(r.shade.fill, 0, kShadeGroupSize, 1, 1);
   between();
   if (r.shade.smooth_edl) {
     pass(r.shade.smooth_edl, 0, kShadeStripGroupSize, kShadeStripWidth, kShadeStripHeight);

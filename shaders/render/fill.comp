@@ -10,56 +10,21 @@
 // first such pixel each way that lies on the nearest surface found; every other pixel is copied.
 // Gaps narrower than the radius close; the background beside a silhouette (surface on one side
 // only) and holes wider than the radius (a Menger sponge's) stay open.
-//
-// Two variants of one search (viewer/pipelines.cpp picks one, ShadeRadii::fused): by default each
-// invocation one pixel, reading its 8·kFillRadius neighbours; with FILL_STRIP (radii up to
-// kMaxFill) each walks down a strip of kBlock × kStrip pixels, keeping the 2·kFillRadius + 1 rows
-// of log distances and colours around the row it fills in registers, so that each is read once
-// rather than by every pixel that searches it (on lavapipe the loads are most of the cost).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "shade_common.glsl"
 
-layout(set = 0, binding = 0, r32f) uniform readonly imageBuffer depth;
+layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
+
 layout(set = 0, binding = 1, r32ui) uniform readonly uimageBuffer picture;
 layout(set = 0, binding = 3, r32f) uniform readonly imageBuffer log_distance;
 layout(set = 0, binding = 4, r32f) uniform writeonly imageBuffer filled_log;
 layout(set = 0, binding = 5, r32ui) uniform writeonly uimageBuffer filled_picture;
 
-// Pixels searched each way (ShadeRadii::fill): a constant, so the search unrolls.
+// Pixels searched each way (viewer/pipelines.h's shadeRadii): a constant, so the search unrolls.
 layout(constant_id = 0) const int kFillRadius = 2;
 const ivec2 kDirections[8] = ivec2[8](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1), ivec2(-1, 0),
                                       ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
-
-// The filling of a pixel whose log distance is `here` and colour `own`, from the first pixel each
-// way that stands in front by more than the threshold (seen_log[k], kEmpty where none; its colour
-// seen_color[k]): stores its log distance (padded index) and colour (picture index).
-void fillPixel(int padded, int i, float here, uint own, float seen_log[8], uint seen_color[8]) {
-  float nearest = kEmpty;
-  [[unroll]] for (int k = 0; k < 8; ++k) nearest = min(nearest, seen_log[k]);
-  int pairs = 0;
-  [[unroll]] for (int k = 0; k < 4; ++k) pairs += (seen_log[k] < kEmpty && seen_log[k + 4] < kEmpty) ? 1 : 0;
-  // The hole takes the nearest surface around it (a pixel with nothing drawn may see the front
-  // surface one way and a back one another): the pixels within the threshold of the nearest.
-  vec3 color_sum = vec3(0.0);
-  float log_sum = 0.0;
-  int covered = 0;
-  [[unroll]] for (int k = 0; k < 8; ++k) {
-    vec3 color = unpackUnorm4x8(seen_color[k]).rgb;
-    bool near = seen_log[k] <= nearest + pc.fill_threshold;
-    color_sum += near ? color : vec3(0.0);
-    log_sum += near ? seen_log[k] : 0.0;
-    covered += near ? 1 : 0;
-  }
-  // Not surrounded (a silhouette's background, a hole wider than the radius, a surface): copied.
-  bool filled = pairs >= 2;
-  imageStore(filled_log, padded, vec4(filled ? log_sum / float(covered) : here));
-  imageStore(filled_picture, i, uvec4(filled ? packUnorm4x8(vec4(color_sum / float(covered), 1.0)) : own));
-}
-
-#ifndef FILL_STRIP
-
-layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -71,6 +36,7 @@ void main() {
   float limit = here - pc.fill_threshold;
   float seen_log[8];
   int seen_index[8];
+  float nearest = kEmpty;
   // llvmpipe runs every branch of every lane, so every step below is paid for every pixel: no
   // early exits; one colour load a direction, at the index found.
   [[unroll]] for (int k = 0; k < 8; ++k) {
@@ -85,64 +51,24 @@ void main() {
       seen_log[k] = hit ? l : seen_log[k];
       seen_index[k] = hit ? i + t * (kDirections[k].y * int(pc.width) + kDirections[k].x) : seen_index[k];
     }
+    nearest = min(nearest, seen_log[k]);
   }
-  uint seen_color[8];
-  [[unroll]] for (int k = 0; k < 8; ++k) seen_color[k] = imageLoad(picture, seen_index[k]).r;
-  fillPixel(padded, i, here, imageLoad(picture, i).r, seen_log, seen_color);
-}
-
-#else
-
-// Fewer invocations than pixels by kBlock · kStrip: small groups, so the picture still makes
-// enough of them to keep every core (or a GPU's multiprocessors) busy.
-layout(local_size_x = 8, local_size_y = 8) in;  // kShadeStripGroupSize
-const int kMaxFill = 5;                    // viewer/pipelines.h's kMaxStripFill
-const int kBlock = 8, kStrip = 32;         // pixels across and down a strip (kShadeStripWidth, _Height)
-const int kLine = kBlock + 2 * kFillRadius, kMaxLine = kBlock + 2 * kMaxFill;
-const int kRows = 2 * kFillRadius + 1;
-
-void main() {
-  ivec2 origin = ivec2(gl_GlobalInvocationID.xy) * ivec2(kBlock, kStrip);
-  if (!inside(origin)) return;
-  // The padded buffers' margin covers the rows and columns a strip past the picture's edge reads.
-  float logs[2 * kMaxFill + 1][kMaxLine];  // of the last kRows rows read, the newest last
-  uint colors[2 * kMaxFill + 1][kMaxLine];
-  [[dont_unroll]] for (int row = 0; row < kStrip + 2 * kFillRadius; ++row) {
-    [[unroll]] for (int y = 0; y + 1 < kRows; ++y) {
-      logs[y] = logs[y + 1];
-      colors[y] = colors[y + 1];
-    }
-    [[unroll]] for (int x = 0; x < kLine; ++x) {
-      // The log distance from the depth here (log.comp's pass, which this variant does without),
-      // kEmpty past the picture's edge, where the colour read is therefore never taken.
-      ivec2 q = origin + ivec2(x, row) - ivec2(kFillRadius);
-      int j = pixelIndex(clamp(q, ivec2(0), ivec2(pc.width, pc.height) - 1));
-      logs[kRows - 1][x] = inside(q) ? logDistance(imageLoad(depth, j).r) : kEmpty;
-      colors[kRows - 1][x] = imageLoad(picture, j).r;
-    }
-    // Fill the row centred in the rows kept, once they are all real rows (the first
-    // 2·kFillRadius rows read only fill the registers).
-    ivec2 p = origin + ivec2(0, row - 2 * kFillRadius);
-    if (p.y < origin.y) continue;
-    [[unroll]] for (int x = 0; x < kBlock; ++x, ++p.x) {
-      float here = logs[kFillRadius][x + kFillRadius];
-      float limit = here - pc.fill_threshold;  // as in the variant above
-      float seen_log[8];
-      uint seen_color[8];
-      [[unroll]] for (int k = 0; k < 8; ++k) {
-        seen_log[k] = kEmpty;
-        seen_color[k] = 0u;
-        [[unroll]] for (int u = 0; u < kFillRadius; ++u) {
-          ivec2 q = ivec2(x + kFillRadius, kFillRadius) + (kFillRadius - u) * kDirections[k];
-          bool hit = logs[q.y][q.x] < limit;
-          seen_log[k] = hit ? logs[q.y][q.x] : seen_log[k];
-          seen_color[k] = hit ? colors[q.y][q.x] : seen_color[k];
-        }
-      }
-      if (inside(p))
-        fillPixel(paddedIndex(p), pixelIndex(p), here, colors[kFillRadius][x + kFillRadius], seen_log, seen_color);
-    }
+  int pairs = 0;
+  [[unroll]] for (int k = 0; k < 4; ++k) pairs += (seen_log[k] < kEmpty && seen_log[k + 4] < kEmpty) ? 1 : 0;
+  // The hole takes the nearest surface around it (a pixel with nothing drawn may see the front
+  // surface one way and a back one another): the pixels within the threshold of the nearest.
+  vec3 color_sum = vec3(0.0);
+  float log_sum = 0.0;
+  int covered = 0;
+  [[unroll]] for (int k = 0; k < 8; ++k) {
+    vec3 color = unpackUnorm4x8(imageLoad(picture, seen_index[k]).r).rgb;
+    bool near = seen_log[k] <= nearest + pc.fill_threshold;
+    color_sum += near ? color : vec3(0.0);
+    log_sum += near ? seen_log[k] : 0.0;
+    covered += near ? 1 : 0;
   }
+  // Not surrounded (a silhouette's background, a hole wider than the radius, a surface): copied.
+  bool filled = pairs >= 2;
+  imageStore(filled_log, padded, vec4(filled ? log_sum / float(covered) : here));
+  imageStore(filled_picture, i, uvec4(filled ? packUnorm4x8(vec4(color_sum / float(covered), 1.0)) : imageLoad(picture, i).r));
 }
-
-#endif

@@ -33,11 +33,3 @@ int pixelIndex(ivec2 q) { return q.y * int(pc.width) + q.x; }
 int paddedIndex(ivec2 q) { return (q.y + int(pc.margin)) * int(pc.padded_width) + q.x + int(pc.margin); }
 // The index step to a neighbour `d` away in the padded buffers (the same for every pixel).
 int paddedStep(ivec2 d) { return d.y * int(pc.padded_width) + d.x; }
-
-// log2 of the eye distance at depth d up to a constant (only differences are used), kEmpty where
-// nothing is drawn (d = 0). Ortho's distance is taken from one depth range behind the far plane,
-// so it stays positive: 1 + (1 − depth).
-float logDistance(float d) {
-  float l = pc.depth_scale > 0.0 ? -log2(1.0 + d * pc.depth_scale) : log2(2.0 - d);
-  return d > 0.0 ? l : kEmpty;
-}
