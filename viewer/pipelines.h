@@ -106,7 +106,7 @@ struct ShadeRadii {
   int margin() const;  // of the log-distance buffers (EdlPush::margin)
 };
 inline constexpr int kMaxFusedSmooth = 7, kMaxFusedReach = 2;
-inline constexpr uint32_t kShadeStripWidth = 8, kShadeStripHeight = 32;  // pixels a smooth_edl.comp invocation shades
+inline constexpr uint32_t kShadeStripWidth = 4, kShadeStripHeight = 32;  // pixels a smooth_edl.comp invocation shades
 ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse);
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);

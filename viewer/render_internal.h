@@ -87,9 +87,9 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
                    uint32_t width, uint32_t height, bool timed);
 
-// Shading pieces (viewer/render_shade.cpp). createShadeTargets makes the pipelines and the depth,
-// shaded (and for raster, plain picture) buffers and those between the passes, margins set; call
-// before the descriptor pool is made, which holds one more set for it. recordShade copies the raster attachments into buffers when
+// Shading pieces (viewer/render_shade.cpp). createShadeTargets makes the depth, shaded (and for
+// raster, plain picture) buffers and those between the passes, margins set, once r.shade is made
+// (createShadePipeline); call before the descriptor pool is made, which holds one more set for it. recordShade copies the raster attachments into buffers when
 // `raster`, then shades; the picture to read back is then `shaded`.
 Status createShadeTargets(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
                           bool raster);

@@ -4,10 +4,11 @@
 // smoothed along rows and columns, eye-dome lighting; the last three in one pass where the radii
 // are small, ShadeRadii::fused) write the shaded picture that is read back.
 //
-// On lavapipe, where the shading costs most next to the points, each pass costs about as much
-// for being a pass over 786K pixels as for its loads: hence one log2 a pixel, margins instead of
-// edge tests, texel buffers instead of storage buffers, and the fused last pass (1024x768
-// Mandelbulb at 2 px: 55 ms of shading before, 15 ms after, on 2 cores).
+// On lavapipe each pass over 786K pixels costs several ms before it reads anything, a
+// storage-buffer load is a loop over the SIMD lanes, a log2 costs more than a load, llvmpipe runs
+// every branch of every lane, and making a pipeline lowers and optimizes its shader anew: hence
+// few passes, texel buffers, one log2 a pixel, margins instead of edge tests, and shaders small
+// enough to make quickly (docs/rendering.md has the timings).
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -19,9 +20,6 @@ namespace dpoint::detail {
 Status createShadeTargets(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
                           bool raster) {
   const ShadeRadii radii = shadeRadii(options.point_size, options.edl.radius, options.edl.fuse);
-  Result<ShadePipeline> pipeline = createShadePipeline(context, radii);
-  if (!pipeline) return pipeline.error();
-  r.shade = *pipeline;
   const EdlPush push = edlPush(camera, options.edl, options.point_size);
   const VkDeviceSize bytes = VkDeviceSize{push.width} * push.height * 4;
   const VkDeviceSize padded = VkDeviceSize{push.padded_width} * (push.height + 2 * push.margin) * 4;
