@@ -244,7 +244,7 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
 }
 
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth, bool write_depth) {
+                                                bool early_depth, bool write_log) {
   ComputePipelines p;
   auto fail = [&](const Error& error) -> Result<ComputePipelines> {
     destroyComputePipelines(context, p);
@@ -276,7 +276,7 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
     p.probe = *probe;
   }
   Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout,
-                                                 write_depth, false);
+                                                 write_log, false);
   if (!resolve) return fail(resolve.error());
   p.resolve = *resolve;
   return p;

@@ -62,11 +62,15 @@ struct ComputePipelines {
 struct ResolvePush {
   uint32_t pixels = 0;
   uint32_t background = 0;
+  // With write_log: where the log distances go (EdlPush's width, padded_width, margin) and the
+  // depth's scale.
+  uint32_t width = 0, padded_width = 0, margin = 0;
+  float depth_scale = 0.0f;
 };
 // `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
-// `write_depth` has the resolve also write each pixel's depth (binding 3) for the eye-dome pass.
+// `write_log` has the resolve also write each pixel's log distance (binding 3) for the shading.
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth = true, bool write_depth = false);
+                                                bool early_depth = true, bool write_log = false);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
 // Shading after either backend (shaders/render/shade_common.glsl): reads a float depth per pixel
@@ -91,7 +95,7 @@ struct EdlPush {
   uint32_t axis = 0;            // smooth.comp's pass: 0 rows, 1 columns
 };
 inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
-inline constexpr uint32_t kShadeBindings = 8;  // shaders/render/shade_common.glsl
+inline constexpr uint32_t kShadeBindings = 7;  // shaders/render/shade_common.glsl
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
 inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
 // The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):

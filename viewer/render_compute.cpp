@@ -58,7 +58,7 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   }
   if (Status status = allocate(r.compute.resolve_set, r.resolve_set); !status) return status;
   write(r.resolve_set, {whole(r.visibility), whole(r.all_colors), whole(r.picture),
-                        r.depth_values.buffer ? whole(r.depth_values) : whole(r.dummy)}, false);
+                        r.log_distance.buffer ? whole(r.log_distance) : whole(r.dummy)}, false);
   return r.shade.log ? createShadeDescriptors(context, r) : okStatus();
 }
 
@@ -94,7 +94,8 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve);
-  ResolvePush resolve{pixels, options.background_rgba8};
+  ResolvePush resolve{pixels, options.background_rgba8, r.shade_push.width, r.shade_push.padded_width,
+                      r.shade_push.margin, r.shade_push.depth_scale};
   vkCmdPushConstants(commands, r.compute.resolve_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(resolve), &resolve);
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve_layout, 0, 1, &r.resolve_set, 0, nullptr);
   vkCmdDispatch(commands, (pixels + kComputeGroupSize - 1) / kComputeGroupSize, 1, 1);

@@ -45,7 +45,6 @@ struct Resources {
     destroyBuffer(context, shaded);
     destroyBuffer(context, log_distance);
     destroyBuffer(context, filled_log);
-    destroyBuffer(context, filled_picture);
     destroyBuffer(context, partial);
     destroyBuffer(context, smoothed);
     destroyShadePipeline(context, shade);
@@ -72,7 +71,8 @@ struct Resources {
   // readback takes instead of the plain one, and (raster) `picture` holds the plain one; the
   // buffers between the passes, and a texel-buffer view of each (in binding order).
   ShadePipeline shade;
-  Buffer depth_values, shaded, log_distance, filled_log, filled_picture, partial, smoothed;
+  EdlPush shade_push;  // also where the compute backend's resolve writes the log distances
+  Buffer depth_values, shaded, log_distance, filled_log, partial, smoothed;
   VkBufferView shade_views[kShadeBindings] = {};
   VkDescriptorSet shade_set = VK_NULL_HANDLE;
 };

@@ -21,25 +21,25 @@ Status createShadeTargets(const VulkanContext& context, Resources& r, const Came
                           bool raster) {
   const ShadeRadii radii = shadeRadii(options.point_size, options.edl.radius, options.edl.fuse);
   const EdlPush push = edlPush(camera, options.edl, options.point_size);
+  r.shade_push = push;
   const VkDeviceSize bytes = VkDeviceSize{push.width} * push.height * 4;
   const VkDeviceSize padded = VkDeviceSize{push.padded_width} * (push.height + 2 * push.margin) * 4;
   const VkBufferUsageFlags texel = VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
   const VkBufferUsageFlags margin = texel | VK_BUFFER_USAGE_TRANSFER_DST_BIT;  // filled once below
-  // The compute backend's resolve writes the depth as a storage buffer and makes the picture;
-  // the raster backend's attachments are copied into both.
-  const VkBufferUsageFlags in_usage = texel | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  // The raster backend's attachments are copied into the depth and the picture; the compute
+  // backend makes the picture and its resolve writes the log distances as a storage buffer.
+  const VkBufferUsageFlags in_usage = texel | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   struct Target {
     Buffer* buffer;
     VkDeviceSize bytes;
     VkBufferUsageFlags usage;
     const char* what;
   };
-  for (const Target& t : {Target{&r.depth_values, bytes, in_usage, "depth per pixel"},
+  for (const Target& t : {Target{raster ? &r.depth_values : nullptr, bytes, in_usage, "depth per pixel"},
                           Target{raster ? &r.picture : nullptr, bytes, in_usage, "picture before shading"},
                           Target{&r.shaded, bytes, texel | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "shaded picture"},
-                          Target{&r.log_distance, padded, margin, "log distance"},
+                          Target{&r.log_distance, padded, margin | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "log distance"},
                           Target{&r.filled_log, padded, margin, "log distance after hole filling"},
-                          Target{&r.filled_picture, bytes, texel, "picture after hole filling"},
                           // Only between the separate passes of smooth.comp and edl.comp.
                           Target{radii.fused ? nullptr : &r.partial, 2 * padded, margin, "row sums of the log distance"},
                           Target{radii.fused ? nullptr : &r.smoothed, padded, margin, "smoothed log distance"}}) {
@@ -63,17 +63,19 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
   allocate.descriptorSetCount = 1;
   allocate.pSetLayouts = &r.shade.set_layout;
   VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &r.shade_set));
-  // In binding order (shaders/render/shade_common.glsl): one texel a pixel. The fused pass makes
-  // no row sums or means: their bindings, which it never reads, show the log distances.
+  // In binding order (shaders/render/shade_common.glsl): one texel a pixel. After the compute
+  // backend there is no depth to read, and the fused pass makes no row sums or means: their
+  // bindings, which no pass then reads, show the log distances.
+  const Buffer& depth = r.depth_values.buffer ? r.depth_values : r.log_distance;
   const Buffer& partial = r.partial.buffer ? r.partial : r.log_distance;
   const Buffer& smoothed = r.smoothed.buffer ? r.smoothed : r.log_distance;
   const struct {
     const Buffer& buffer;
     VkFormat format;
-  } views[kShadeBindings] = {{r.depth_values, VK_FORMAT_R32_SFLOAT}, {r.picture, VK_FORMAT_R32_UINT},
+  } views[kShadeBindings] = {{depth, VK_FORMAT_R32_SFLOAT},           {r.picture, VK_FORMAT_R32_UINT},
                              {r.shaded, VK_FORMAT_R32_UINT},        {r.log_distance, VK_FORMAT_R32_SFLOAT},
-                             {r.filled_log, VK_FORMAT_R32_SFLOAT},  {r.filled_picture, VK_FORMAT_R32_UINT},
-                             {partial, VK_FORMAT_R32G32_SFLOAT},    {smoothed, VK_FORMAT_R32_SFLOAT}};
+                             {r.filled_log, VK_FORMAT_R32_SFLOAT},  {partial, VK_FORMAT_R32G32_SFLOAT},
+                             {smoothed, VK_FORMAT_R32_SFLOAT}};
   VkWriteDescriptorSet writes[kShadeBindings];
   for (uint32_t b = 0; b < kShadeBindings; ++b) {
     VkBufferViewCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
@@ -151,8 +153,10 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
     barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
   };
-  pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
-  between();
+  if (raster) {  // the compute backend's resolve wrote the log distances
+    pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
+    between();
+  }
   pass(r.shade.fill, 0, kShadeGroupSize, 1, 1);
   between();
   if (r.shade.smooth_edl) {

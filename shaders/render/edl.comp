@@ -15,9 +15,9 @@
 
 layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
 
-layout(set = 0, binding = 5, r32ui) uniform readonly uimageBuffer filled_picture;
-layout(set = 0, binding = 7, r32f) uniform readonly imageBuffer smoothed;
-layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer shaded;
+
+layout(set = 0, binding = 6, r32f) uniform readonly imageBuffer smoothed;
+layout(set = 0, binding = 2, r32ui) uniform uimageBuffer shaded;  // the filled picture, shaded in place
 
 const float kFloor = 0.25;
 
@@ -35,7 +35,7 @@ void main() {
     sum += l < kEmpty ? max(0.0, here - l) : 0.0;
   }
   float shade = max(exp(-pc.strength * 300.0 * sum / 8.0), kFloor);
-  uint color = imageLoad(filled_picture, i).r;
+  uint color = imageLoad(shaded, i).r;
   vec4 rgba = unpackUnorm4x8(color);
   imageStore(shaded, i, uvec4(here < kEmpty ? packUnorm4x8(vec4(rgba.rgb * shade, rgba.a)) : color));
 }

@@ -19,7 +19,7 @@ layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
 layout(set = 0, binding = 1, r32ui) uniform readonly uimageBuffer picture;
 layout(set = 0, binding = 3, r32f) uniform readonly imageBuffer log_distance;
 layout(set = 0, binding = 4, r32f) uniform writeonly imageBuffer filled_log;
-layout(set = 0, binding = 5, r32ui) uniform writeonly uimageBuffer filled_picture;
+layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer filled_picture;  // shaded later, in place
 
 // Pixels searched each way (viewer/pipelines.h's shadeRadii): a constant, so the search unrolls.
 layout(constant_id = 0) const int kFillRadius = 2;

@@ -4,13 +4,13 @@
 // third of the cost of a storage-buffer load, which llvmpipe makes one lane at a time. Bindings:
 //   0 depth (float, 0 = nothing drawn), 1 picture (RGBA8 as a uint): what the backend drew;
 //   3 log distance (kEmpty where nothing is drawn);
-//   4 log distance, 5 picture: after hole filling;
-//   6 (sum, count) of the log distances along each row's window, 7 their mean over the square
-//     (kEmpty where nothing is drawn);
-//   2 the shaded picture that is read back.
-// 0, 1, 2 and 5 are the picture's rows; 3, 4, 6 and 7 have a margin of pc.margin pixels all
-// round, set once to kEmpty (6: no sum) and never written, so neighbours are read at fixed
-// offsets without a test for the picture's edge.
+//   4 log distance, 2 picture: after hole filling; 2 is then shaded where it is (each pixel by
+//     the invocation that reads it) and read back;
+//   5 (sum, count) of the log distances along each row's window, 6 their mean over the square
+//     (kEmpty where nothing is drawn).
+// 0, 1 and 2 are the picture's rows; 3, 4, 5 and 6 have a margin of pc.margin pixels all round,
+// set once to kEmpty (5: no sum) and never written, so neighbours are read at fixed offsets
+// without a test for the picture's edge.
 layout(push_constant) uniform Push {
   uint width;
   uint height;
@@ -26,7 +26,7 @@ layout(push_constant) uniform Push {
   uint axis;             // smooth.comp: 0 rows, 1 columns
 } pc;
 
-const float kEmpty = 3.0e38;  // the log distance of a pixel with nothing drawn
+#include "log_distance.glsl"
 
 bool inside(ivec2 q) { return q.x >= 0 && q.y >= 0 && q.x < int(pc.width) && q.y < int(pc.height); }
 int pixelIndex(ivec2 q) { return q.y * int(pc.width) + q.x; }

@@ -12,8 +12,8 @@
 layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
 
 layout(set = 0, binding = 4, r32f) uniform readonly imageBuffer filled_log;
-layout(set = 0, binding = 6, rg32f) uniform imageBuffer partial;  // (sum, count) along a row
-layout(set = 0, binding = 7, r32f) uniform writeonly imageBuffer smoothed;
+layout(set = 0, binding = 5, rg32f) uniform imageBuffer partial;  // (sum, count) along a row
+layout(set = 0, binding = 6, r32f) uniform writeonly imageBuffer smoothed;
 
 // Half-width of the square, pixels (viewer/pipelines.h's shadeRadii): a constant, so the sum unrolls.
 layout(constant_id = 0) const int kSmoothRadius = 1;

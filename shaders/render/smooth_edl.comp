@@ -20,8 +20,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;  // kShadeStripGroupSize
 
 layout(set = 0, binding = 4, r32f) uniform readonly imageBuffer filled_log;
-layout(set = 0, binding = 5, r32ui) uniform readonly uimageBuffer filled_picture;
-layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer shaded;
+layout(set = 0, binding = 2, r32ui) uniform uimageBuffer shaded;  // the filled picture, shaded in place
 
 // Compiled in (viewer/pipelines.cpp), so every array index below is a constant and the arrays
 // live in registers: the smoothing's half-width and the eye-dome neighbours' offsets along the
@@ -83,7 +82,7 @@ void main() {
       }
       float shade = max(exp(-pc.strength * 300.0 * sum / 8.0), kFloor);
       int i = pixelIndex(inside(p) ? p : origin);  // a strip past the picture's edge stores nothing there
-      uint color = imageLoad(filled_picture, i).r;
+      uint color = imageLoad(shaded, i).r;
       vec4 rgba = unpackUnorm4x8(color);
       if (inside(p)) imageStore(shaded, i, uvec4(here < kEmpty ? packUnorm4x8(vec4(rgba.rgb * shade, rgba.a)) : color));
     }
