@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "shaders/points.frag.h"
 #include "shaders/edl.comp.h"
 #include "shaders/fill.comp.h"
+#include "shaders/log.comp.h"
 #include "shaders/smooth.comp.h"
+#include "shaders/smooth_edl.comp.h"
 #include "shaders/points_resolve.comp.h"
 
 namespace dpoint {
@@ -19,15 +24,17 @@ Spirv vertexShader(PrecisionMode mode, bool pull) {
   return pull && shaders.vertex_pull.code ? shaders.vertex_pull : shaders.vertex;
 }
 
-// Two 32-bit specialization constants: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
-// 0 kWriteDepth (its constant 1 is unused), the shading passes' radii (fill.comp's 0, smooth.comp's 0).
-Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, uint32_t constant0,
-                                   uint32_t constant1) {
+// 32-bit specialization constants 0, 1, …: the splat's 0 kProbe and 1 kEarlyDepth, the resolve's
+// 0 kWriteDepth, the shading passes' radii (fill.comp's 0, smooth.comp's 0, smooth_edl.comp's 0-2).
+Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout,
+                                   std::span<const uint32_t> constants) {
   Result<VkShaderModule> module = createShaderModule(context, code.code, code.bytes);
   if (!module) return module.error();
-  const uint32_t values[2] = {constant0, constant1};
-  const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
-  VkSpecializationInfo specialization{2, entries, sizeof(values), values};
+  std::vector<VkSpecializationMapEntry> entries;
+  for (uint32_t c = 0; c < constants.size(); ++c)
+    entries.push_back({c, static_cast<uint32_t>(c * sizeof(uint32_t)), sizeof(uint32_t)});
+  VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
+                                      constants.size_bytes(), constants.data()};
   VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -44,7 +51,8 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
 
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
                                    bool early_depth) {
-  return computePipeline(context, code, layout, probe ? VK_TRUE : VK_FALSE, early_depth ? VK_TRUE : VK_FALSE);
+  const uint32_t constants[2] = {probe ? VK_TRUE : VK_FALSE, early_depth ? VK_TRUE : VK_FALSE};
+  return computePipeline(context, code, layout, constants);
 }
 
 // keep_depth: the depth attachment is stored and left in TRANSFER_SRC_OPTIMAL for the eye-dome
@@ -236,7 +244,7 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
 }
 
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth, bool write_depth) {
+                                                bool early_depth, bool write_log) {
   ComputePipelines p;
   auto fail = [&](const Error& error) -> Result<ComputePipelines> {
     destroyComputePipelines(context, p);
@@ -268,7 +276,7 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
     p.probe = *probe;
   }
   Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout,
-                                                 write_depth, false);
+                                                 write_log, false);
   if (!resolve) return fail(resolve.error());
   p.resolve = *resolve;
   return p;
@@ -284,9 +292,24 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& p) 
   p = ComputePipelines{};
 }
 
-ShadeRadii shadeRadii(float point_size) {
+ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse) {
   const int size = static_cast<int>(std::ceil(std::clamp(point_size, 1.0f, 64.0f)));
-  return {(size + 1) / 2 + 1, size - 1};
+  ShadeRadii radii;
+  radii.fill = (size + 1) / 2 + 1;
+  radii.smooth = size - 1;
+  // The 8 neighbours on a circle of the radius, to the nearest pixel, in float as the shader
+  // rounded them before: along the axes and along the diagonals.
+  radii.edl_axis = static_cast<int>(std::round(edl_radius));
+  radii.edl_diagonal = static_cast<int>(std::round(edl_radius * 0.70710678f));
+  radii.fused = fuse && radii.smooth <= kMaxFusedSmooth && std::max(radii.edl_axis, radii.edl_diagonal) <= kMaxFusedReach;
+  return radii;
+}
+
+int ShadeRadii::margin() const {
+  const int reach = std::max(edl_axis, edl_diagonal);
+  // smooth_edl.comp reads reach + smooth pixels around each strip, the last strips reaching up to
+  // kShadeStripHeight − 1 pixels past the picture.
+  return std::max({fill, fused ? int{kShadeStripHeight} - 1 + smooth + reach : std::max(smooth, reach)});
 }
 
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii) {
@@ -295,33 +318,54 @@ Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRad
     destroyShadePipeline(context, p);
     return error;
   };
-  auto storage = [](uint32_t binding) {
-    return VkDescriptorSetLayoutBinding{binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  };
-  Result<VkDescriptorSetLayout> set = storageSetLayout(
-      context, {storage(0), storage(1), storage(2), storage(3), storage(4), storage(5), storage(6)});
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  for (uint32_t b = 0; b < kShadeBindings; ++b)
+    bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  Result<VkDescriptorSetLayout> set = storageSetLayout(context, bindings);
   if (!set) return fail(set.error());
   p.set_layout = *set;
   Result<VkPipelineLayout> layout = pipelineLayout(context, p.set_layout, sizeof(EdlPush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!layout) return fail(layout.error());
   p.layout = *layout;
-  Result<VkPipeline> edl = computePipeline(context, {kEdlComp, sizeof(kEdlComp)}, p.layout, false, false);
-  if (!edl) return fail(edl.error());
-  p.edl = *edl;
-  Result<VkPipeline> fill =
-      computePipeline(context, {kFillComp, sizeof(kFillComp)}, p.layout, uint32_t(radii.fill), uint32_t{0});
-  if (!fill) return fail(fill.error());
-  p.fill = *fill;
-  Result<VkPipeline> smooth =
-      computePipeline(context, {kSmoothComp, sizeof(kSmoothComp)}, p.layout, uint32_t(radii.smooth), uint32_t{0});
-  if (!smooth) return fail(smooth.error());
-  p.smooth = *smooth;
+  struct Stage {
+    VkPipeline* pipeline;
+    Spirv code;
+    std::vector<uint32_t> constants;
+  };
+  const auto u = [](int v) { return static_cast<uint32_t>(v); };
+  const Stage stages[] = {
+      {&p.log, {kLogComp, sizeof(kLogComp)}, {}},
+      {&p.fill, {kFillComp, sizeof(kFillComp)}, {u(radii.fill)}},
+      {radii.fused ? &p.smooth_edl : &p.smooth,
+       radii.fused ? Spirv{kSmoothEdlComp, sizeof(kSmoothEdlComp)} : Spirv{kSmoothComp, sizeof(kSmoothComp)},
+       {u(radii.smooth), u(radii.edl_axis), u(radii.edl_diagonal)}},
+      {radii.fused ? nullptr : &p.edl, {kEdlComp, sizeof(kEdlComp)}, {}}};
+  // Each on a thread of its own: lavapipe lowers and optimizes a shader's NIR whenever a pipeline
+  // is made (only the machine code is cached on disk), 3-4 ms for fill.comp and 7-16 ms for
+  // smooth_edl.comp, which the threads spread over the cores.
+  std::vector<std::future<Result<VkPipeline>>> made;
+  for (const Stage& stage : stages)
+    if (stage.pipeline)
+      made.push_back(std::async(std::launch::async, [&context, &stage, layout = p.layout] {
+        return computePipeline(context, stage.code, layout, stage.constants);
+      }));
+  std::optional<Error> failed;
+  size_t next = 0;
+  for (const Stage& stage : stages) {
+    if (!stage.pipeline) continue;
+    Result<VkPipeline> pipeline = made[next++].get();
+    if (pipeline) *stage.pipeline = *pipeline;
+    else if (!failed) failed = pipeline.error();
+  }
+  if (failed) return fail(*failed);
   return p;
 }
 
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& p) {
   if (p.edl) vkDestroyPipeline(context.device, p.edl, nullptr);
+  if (p.log) vkDestroyPipeline(context.device, p.log, nullptr);
   if (p.fill) vkDestroyPipeline(context.device, p.fill, nullptr);
+  if (p.smooth_edl) vkDestroyPipeline(context.device, p.smooth_edl, nullptr);
   if (p.smooth) vkDestroyPipeline(context.device, p.smooth, nullptr);
   if (p.layout) vkDestroyPipelineLayout(context.device, p.layout, nullptr);
   if (p.set_layout) vkDestroyDescriptorSetLayout(context.device, p.set_layout, nullptr);

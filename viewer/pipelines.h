@@ -62,36 +62,56 @@ struct ComputePipelines {
 struct ResolvePush {
   uint32_t pixels = 0;
   uint32_t background = 0;
+  // With write_log: where the log distances go (EdlPush's width, padded_width, margin) and the
+  // depth's scale.
+  uint32_t width = 0, padded_width = 0, margin = 0;
+  float depth_scale = 0.0f;
 };
 // `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
-// `write_depth` has the resolve also write each pixel's depth (binding 3) for the eye-dome pass.
+// `write_log` has the resolve also write each pixel's log distance (binding 3) for the shading.
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth = true, bool write_depth = false);
+                                                bool early_depth = true, bool write_log = false);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
-// Eye-dome lighting (shaders/render/edl.comp), the same pass after either backend: reads a float depth per
-// pixel (0 = nothing drawn) and the RGBA8 picture, writes the shaded picture (bindings 0, 1, 2).
+// Shading after either backend (shaders/render/shade_common.glsl): reads a float depth per pixel
+// (0 = nothing drawn) and the RGBA8 picture, writes the shaded picture (bindings 0, 1, 2); every
+// binding is a storage texel buffer.
 struct ShadePipeline {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline fill = VK_NULL_HANDLE, smooth = VK_NULL_HANDLE, edl = VK_NULL_HANDLE;
+  VkPipeline log = VK_NULL_HANDLE, fill = VK_NULL_HANDLE;
+  // Then either smooth_edl (ShadeRadii::fused) or smooth twice and edl.
+  VkPipeline smooth_edl = VK_NULL_HANDLE, smooth = VK_NULL_HANDLE, edl = VK_NULL_HANDLE;
 };
 struct EdlPush {
   uint32_t width = 0, height = 0;
+  // The log-distance buffers hold the picture inside a margin of `margin` pixels all round (no
+  // point drawn there), so that no pass tests whether a neighbour is inside the picture.
+  uint32_t padded_width = 0, margin = 0;
   float depth_scale = 0.0f;  // perspective: (far − near) / near; 0 for ortho
-  float strength = 1.0f, radius = 1.4f;
+  float strength = 1.0f;
+  int32_t edl_axis = 1, edl_diagonal = 1;  // the eye-dome neighbours' offsets (ShadeRadii)
   float fill_threshold = 0.0f;  // how much nearer (log2 eye distance) a surrounding pixel must be
   uint32_t axis = 0;            // smooth.comp's pass: 0 rows, 1 columns
 };
+inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
 inline constexpr uint32_t kShadeBindings = 7;  // shaders/render/shade_common.glsl
-inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of shaders/render/edl.comp
-// The shading passes' radii for a point size (compiled into fill.comp and smooth.comp): the
-// filling searches half a point and a pixel each way, the depth is averaged over a square a pixel
-// narrower than two points.
+inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
+inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
+// The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):
+// the filling searches half a point and a pixel each way, the depth is averaged over a square a
+// pixel narrower than two points, the eye-dome neighbours lie on a circle of the radius.
 struct ShadeRadii {
   int fill = 1, smooth = 0;
+  int edl_axis = 1, edl_diagonal = 1;  // the eye-dome neighbours' offsets along the axes and the diagonals
+  // Smoothing and eye-dome lighting in one pass (smooth_edl.comp), which holds its window in
+  // registers: where asked, for the radii of point sizes up to 8 px and eye-dome radii under 2.5 px.
+  bool fused = false;
+  int margin() const;  // of the log-distance buffers (EdlPush::margin)
 };
-ShadeRadii shadeRadii(float point_size);
+inline constexpr int kMaxFusedSmooth = 7, kMaxFusedReach = 2;
+inline constexpr uint32_t kShadeStripWidth = 4, kShadeStripHeight = 32;  // pixels a smooth_edl.comp invocation shades
+ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse);
 Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRadii radii);
 void destroyShadePipeline(const VulkanContext& context, ShadePipeline& pipeline);
 

@@ -73,6 +73,14 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
     return Error{picture + " is larger than " + f.name + " draws (" + std::to_string(f.max_image_dimension) +
                      " pixels a side at most)",
                  ExitCode::kResourceLimit};
+  if (options.shading == Shading::kEdl) {
+    const uint64_t margin = static_cast<uint64_t>(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
+    if ((width + 2 * margin) * (height + 2 * margin) > f.max_texel_buffer_elements)
+      return Error{"shading reads " + picture + " with a margin of " + std::to_string(margin) +
+                       " pixels as texel buffers: more than " + f.name + "'s maxTexelBufferElements of " +
+                       std::to_string(f.max_texel_buffer_elements) + "; use --shade none",
+                   ExitCode::kResourceLimit};
+  }
   if (options.backend == Backend::kCompute && 8 * width * height > f.max_storage_buffer_range)
     return Error{"--backend compute keeps a 64-bit key per pixel in one storage buffer: " + picture + " exceeds " +
                      f.name + "'s maxStorageBufferRange of " + std::to_string(f.max_storage_buffer_range) + " bytes",
@@ -231,7 +239,7 @@ Status createTargets(const VulkanContext& context, Resources& r, uint32_t width,
 }
 
 Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.edl ? 1 : 0);
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.log ? 1 : 0);
   if (Status status = detail::createDescriptorPool(context, r, sets, 3); !status)
     return status;
   for (Chunk& chunk : r.chunks) {
@@ -242,7 +250,7 @@ Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled
     VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &chunk.set));
     writeDescriptors(context, r, chunk, pulled, probe);
   }
-  return r.shade.edl ? detail::createShadeDescriptors(context, r) : okStatus();
+  return r.shade.log ? detail::createShadeDescriptors(context, r) : okStatus();
 }
 
 Status createUniforms(const VulkanContext& context, Resources& r, const Camera& camera, const ModeEncoding& encoding) {
@@ -411,6 +419,15 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
     }
     return okStatus();
   });
+  // And the shading's beside them: on lavapipe making them takes as long as uploading 1.5M points.
+  std::future<Status> shade_made = std::async(std::launch::async, [&]() -> Status {
+    if (!shading) return okStatus();
+    Result<ShadePipeline> pipeline =
+        createShadePipeline(context, shadeRadii(options.point_size, options.edl.radius, options.edl.fuse));
+    if (!pipeline) return pipeline.error();
+    r.shade = *pipeline;
+    return okStatus();
+  });
 
   RenderResult out;
   out.pulled_positions = pulled;
@@ -421,19 +438,21 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
                                     chunkPoints(context.facts, chunking, pulled || compute));
   if (status) status = uploadBatchMatrices(context, r, options, encoding);
   Status made = pipelines_made.get();
+  Status shade = shade_made.get();
   if (!status) return status.error();
   if (!made) return made.error();
+  if (!shade) return shade.error();
   out.chunks = static_cast<uint32_t>(r.chunks.size());
   out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * total;
   out.upload_ms = msSince(upload_start);
 
   if (compute) {
     status = detail::createComputeTargets(context, r, camera.width, camera.height);
-    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, false, options.point_size);
+    if (status && shading) status = detail::createShadeTargets(context, r, camera, options, false);
     if (status) status = detail::createComputeDescriptors(context, r, options.probe);
   } else {
     status = createTargets(context, r, camera.width, camera.height, shading);
-    if (status && shading) status = detail::createShadeTargets(context, r, camera.width, camera.height, true, options.point_size);
+    if (status && shading) status = detail::createShadeTargets(context, r, camera, options, true);
     if (status) status = createDescriptors(context, r, pulled, options.probe);
   }
   if (status) status = timeFrames(context, r, options, camera, out);
@@ -489,11 +508,12 @@ class StreamBlocks {
 }  // namespace
 
 Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
-                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets + (r.shade.edl ? kShadeBindings : 0)}};
+  VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, kShadeBindings}};
   VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   info.maxSets = sets;
-  info.poolSizeCount = 2;
+  info.poolSizeCount = r.shade.log ? 3 : 2;
   info.pPoolSizes = sizes;
   VK_TRY(vkCreateDescriptorPool(context.device, &info, nullptr, &r.descriptor_pool));
   return okStatus();

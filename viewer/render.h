@@ -34,6 +34,9 @@ enum class Shading { kNone, kEdl };
 struct EdlOptions {
   float strength = 1.0f;  // > 0; the shade is exp(−strength · 300 · mean log2 depth step)
   float radius = 1.4f;    // neighbour distance in pixels, ≥ 1 (1.4: the 8 nearest pixels)
+  // Depth smoothing and eye-dome lighting in one pass where the radii allow (ShadeRadii::fused;
+  // the same picture: tests turn it off to compare with the separate passes).
+  bool fuse = true;
 };
 
 struct RenderOptions {

@@ -21,7 +21,10 @@ Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t
       });
       !status)
     return status;
-  Result<Buffer> picture = createBuffer(context, pixels * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+  // Also a storage texel buffer: the shading passes read it as one.
+  Result<Buffer> picture = createBuffer(context, pixels * 4,
+                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT |
+                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                         false, "picture");
   if (!picture) return picture.error();
   r.picture = *picture;
@@ -34,7 +37,7 @@ Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t
 Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe) {
   // One splat set per chunk (camera, positions, batches, probe, visibility), the resolve set
   // (visibility, colours, picture, depth) and with eye-dome lighting its set.
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.edl ? 1 : 0);
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.log ? 1 : 0);
   if (Status status = createDescriptorPool(context, r, sets, 4); !status) return status;
   auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
   auto allocate = [&](VkDescriptorSetLayout layout, VkDescriptorSet& set) -> Status {
@@ -55,8 +58,8 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   }
   if (Status status = allocate(r.compute.resolve_set, r.resolve_set); !status) return status;
   write(r.resolve_set, {whole(r.visibility), whole(r.all_colors), whole(r.picture),
-                        r.depth_values.buffer ? whole(r.depth_values) : whole(r.dummy)}, false);
-  return r.shade.edl ? createShadeDescriptors(context, r) : okStatus();
+                        r.log_distance.buffer ? whole(r.log_distance) : whole(r.dummy)}, false);
+  return r.shade.log ? createShadeDescriptors(context, r) : okStatus();
 }
 
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
@@ -91,7 +94,8 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve);
-  ResolvePush resolve{pixels, options.background_rgba8};
+  ResolvePush resolve{pixels, options.background_rgba8, r.shade_push.width, r.shade_push.padded_width,
+                      r.shade_push.margin, r.shade_push.depth_scale};
   vkCmdPushConstants(commands, r.compute.resolve_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(resolve), &resolve);
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.resolve_layout, 0, 1, &r.resolve_set, 0, nullptr);
   vkCmdDispatch(commands, (pixels + kComputeGroupSize - 1) / kComputeGroupSize, 1, 1);

@@ -39,10 +39,12 @@ struct Resources {
     destroyBuffer(context, all_colors);
     destroyBuffer(context, visibility);
     destroyBuffer(context, picture);
+    for (VkBufferView view : shade_views)
+      if (view) vkDestroyBufferView(device, view, nullptr);
     destroyBuffer(context, depth_values);
     destroyBuffer(context, shaded);
+    destroyBuffer(context, log_distance);
     destroyBuffer(context, filled_log);
-    destroyBuffer(context, filled_picture);
     destroyBuffer(context, partial);
     destroyBuffer(context, smoothed);
     destroyShadePipeline(context, shade);
@@ -65,10 +67,13 @@ struct Resources {
   ComputePipelines compute;
   Buffer all_colors, visibility, picture;
   VkDescriptorSet resolve_set = VK_NULL_HANDLE;
-  // Eye-dome lighting: each pixel's depth (from the depth attachment or the resolve), the shaded
-  // picture the readback takes instead of the plain one, and (raster) `picture` holds the plain one.
+  // Shading: each pixel's depth (from the depth attachment or the resolve), the shaded picture the
+  // readback takes instead of the plain one, and (raster) `picture` holds the plain one; the
+  // buffers between the passes, and a texel-buffer view of each (in binding order).
   ShadePipeline shade;
-  Buffer depth_values, shaded, filled_log, filled_picture, partial, smoothed;
+  EdlPush shade_push;  // also where the compute backend's resolve writes the log distances
+  Buffer depth_values, shaded, log_distance, filled_log, partial, smoothed;
+  VkBufferView shade_views[kShadeBindings] = {};
   VkDescriptorSet shade_set = VK_NULL_HANDLE;
 };
 
@@ -82,12 +87,12 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
                    uint32_t width, uint32_t height, bool timed);
 
-// Eye-dome pieces (viewer/render_shade.cpp). createShadeTargets makes the pipeline and the depth,
-// shaded (and for raster, plain picture) buffers; call before the descriptor pool is made, which
-// holds one more set for it. recordShade copies the raster attachments into buffers when
+// Shading pieces (viewer/render_shade.cpp). createShadeTargets makes the depth, shaded (and for
+// raster, plain picture) buffers and those between the passes, margins set, once r.shade is made
+// (createShadePipeline); call before the descriptor pool is made, which holds one more set for it. recordShade copies the raster attachments into buffers when
 // `raster`, then shades; the picture to read back is then `shaded`.
-Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster,
-                          float point_size);
+Status createShadeTargets(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
+                          bool raster);
 Status createShadeDescriptors(const VulkanContext& context, Resources& r);
 EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_size);
 void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& push, bool raster);

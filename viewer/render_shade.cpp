@@ -1,47 +1,60 @@
 // Shading after either backend (RenderOptions::shading): the raster backend's colour and depth
 // attachments are copied into buffers, the compute backend's resolve writes them there itself;
-// then four passes (shaders/render/shade_common.glsl names them: hole filling, the depth smoothed
-// along rows and columns, eye-dome lighting) write the shaded picture that is read back.
+// then the passes of shaders/render/shade_common.glsl (log distance, hole filling, the depth
+// smoothed along rows and columns, eye-dome lighting; the last three in one pass where the radii
+// are small, ShadeRadii::fused) write the shaded picture that is read back.
+//
+// On lavapipe each pass over 786K pixels costs several ms before it reads anything, a
+// storage-buffer load is a loop over the SIMD lanes, a log2 costs more than a load, llvmpipe runs
+// every branch of every lane, and making a pipeline lowers and optimizes its shader anew: hence
+// few passes, texel buffers, one log2 a pixel, margins instead of edge tests, and shaders small
+// enough to make quickly (docs/rendering.md has the timings).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "viewer/render_internal.h"
 
 namespace dpoint::detail {
 
-Status createShadeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, bool raster,
-                          float point_size) {
-  Result<ShadePipeline> pipeline = createShadePipeline(context, shadeRadii(point_size));
-  if (!pipeline) return pipeline.error();
-  r.shade = *pipeline;
-  const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
-  const VkBufferUsageFlags in_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  Result<Buffer> depth = createBuffer(context, bytes, in_usage, false, "depth per pixel");
-  if (!depth) return depth.error();
-  r.depth_values = *depth;
-  if (raster) {
-    Result<Buffer> picture = createBuffer(context, bytes, in_usage, false, "picture before shading");
-    if (!picture) return picture.error();
-    r.picture = *picture;
-  }
-  Result<Buffer> shaded = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                       false, "shaded picture");
-  if (!shaded) return shaded.error();
-  r.shaded = *shaded;
-  struct Between {
+Status createShadeTargets(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
+                          bool raster) {
+  const ShadeRadii radii = shadeRadii(options.point_size, options.edl.radius, options.edl.fuse);
+  const EdlPush push = edlPush(camera, options.edl, options.point_size);
+  r.shade_push = push;
+  const VkDeviceSize bytes = VkDeviceSize{push.width} * push.height * 4;
+  const VkDeviceSize padded = VkDeviceSize{push.padded_width} * (push.height + 2 * push.margin) * 4;
+  const VkBufferUsageFlags texel = VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
+  const VkBufferUsageFlags margin = texel | VK_BUFFER_USAGE_TRANSFER_DST_BIT;  // filled once below
+  // The raster backend's attachments are copied into the depth and the picture; the compute
+  // backend makes the picture and its resolve writes the log distances as a storage buffer.
+  const VkBufferUsageFlags in_usage = texel | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  struct Target {
     Buffer* buffer;
     VkDeviceSize bytes;
+    VkBufferUsageFlags usage;
     const char* what;
   };
-  for (const Between& b : {Between{&r.filled_log, bytes, "log distance after hole filling"},
-                           Between{&r.filled_picture, bytes, "picture after hole filling"},
-                           Between{&r.partial, 2 * bytes, "row sums of the log distance"},
-                           Between{&r.smoothed, bytes, "smoothed log distance"}}) {
-    Result<Buffer> buffer = createBuffer(context, b.bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, b.what);
+  for (const Target& t : {Target{raster ? &r.depth_values : nullptr, bytes, in_usage, "depth per pixel"},
+                          Target{raster ? &r.picture : nullptr, bytes, in_usage, "picture before shading"},
+                          Target{&r.shaded, bytes, texel | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "shaded picture"},
+                          Target{&r.log_distance, padded, margin | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "log distance"},
+                          Target{&r.filled_log, padded, margin, "log distance after hole filling"},
+                          // Only between the separate passes of smooth.comp and edl.comp.
+                          Target{radii.fused ? nullptr : &r.partial, 2 * padded, margin, "row sums of the log distance"},
+                          Target{radii.fused ? nullptr : &r.smoothed, padded, margin, "smoothed log distance"}}) {
+    if (!t.buffer) continue;
+    Result<Buffer> buffer = createBuffer(context, t.bytes, t.usage, false, t.what);
     if (!buffer) return buffer.error();
-    *b.buffer = *buffer;
+    *t.buffer = *buffer;
   }
-  return okStatus();
+  // The margins, once: the passes write only the picture's pixels.
+  const uint32_t empty = std::bit_cast<uint32_t>(kShadeEmpty);
+  return submitOnce(context, [&](VkCommandBuffer commands) {
+    for (const Buffer* b : {&r.log_distance, &r.filled_log, &r.smoothed})
+      if (b->buffer) vkCmdFillBuffer(commands, b->buffer, 0, VK_WHOLE_SIZE, empty);
+    if (r.partial.buffer) vkCmdFillBuffer(commands, r.partial.buffer, 0, VK_WHOLE_SIZE, 0);  // (sum, count) = (0, 0)
+  });
 }
 
 Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
@@ -50,12 +63,34 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
   allocate.descriptorSetCount = 1;
   allocate.pSetLayouts = &r.shade.set_layout;
   VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &r.shade_set));
-  const VkDescriptorBufferInfo infos[kShadeBindings] = {
-      {r.depth_values.buffer, 0, VK_WHOLE_SIZE}, {r.picture.buffer, 0, VK_WHOLE_SIZE},
-      {r.shaded.buffer, 0, VK_WHOLE_SIZE},       {r.filled_log.buffer, 0, VK_WHOLE_SIZE},
-      {r.filled_picture.buffer, 0, VK_WHOLE_SIZE}, {r.partial.buffer, 0, VK_WHOLE_SIZE},
-      {r.smoothed.buffer, 0, VK_WHOLE_SIZE}};
-  writeBufferDescriptors(context, r.shade_set, infos);
+  // In binding order (shaders/render/shade_common.glsl): one texel a pixel. After the compute
+  // backend there is no depth to read, and the fused pass makes no row sums or means: their
+  // bindings, which no pass then reads, show the log distances.
+  const Buffer& depth = r.depth_values.buffer ? r.depth_values : r.log_distance;
+  const Buffer& partial = r.partial.buffer ? r.partial : r.log_distance;
+  const Buffer& smoothed = r.smoothed.buffer ? r.smoothed : r.log_distance;
+  const struct {
+    const Buffer& buffer;
+    VkFormat format;
+  } views[kShadeBindings] = {{depth, VK_FORMAT_R32_SFLOAT},           {r.picture, VK_FORMAT_R32_UINT},
+                             {r.shaded, VK_FORMAT_R32_UINT},        {r.log_distance, VK_FORMAT_R32_SFLOAT},
+                             {r.filled_log, VK_FORMAT_R32_SFLOAT},  {partial, VK_FORMAT_R32G32_SFLOAT},
+                             {smoothed, VK_FORMAT_R32_SFLOAT}};
+  VkWriteDescriptorSet writes[kShadeBindings];
+  for (uint32_t b = 0; b < kShadeBindings; ++b) {
+    VkBufferViewCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+    info.buffer = views[b].buffer.buffer;
+    info.format = views[b].format;
+    info.range = VK_WHOLE_SIZE;
+    VK_TRY(vkCreateBufferView(context.device, &info, nullptr, &r.shade_views[b]));
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = r.shade_set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
+    writes[b].pTexelBufferView = &r.shade_views[b];
+  }
+  vkUpdateDescriptorSets(context.device, kShadeBindings, writes, 0, nullptr);
   return okStatus();
 }
 
@@ -68,7 +103,11 @@ EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_siz
   push.depth_scale = camera.ortho ? 0.0f
                                   : static_cast<float>((camera.far_plane - camera.near_plane) / camera.near_plane);
   push.strength = options.strength;
-  push.radius = options.radius;
+  const ShadeRadii radii = shadeRadii(point_size, options.radius, options.fuse);
+  push.edl_axis = radii.edl_axis;
+  push.edl_diagonal = radii.edl_diagonal;
+  push.margin = static_cast<uint32_t>(radii.margin());
+  push.padded_width = camera.width + 2 * push.margin;
   // Hole filling's threshold: the change in log2 eye distance over its radius across a surface at
   // 72° to the view (slope 3), so the steps within one surface never count as standing in front.
   // A pixel spans 2 / (focal · height) of the distance in perspective (focal = P[1][1] / P[2][3])
@@ -76,7 +115,7 @@ EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_siz
   const glm::dmat4& p = camera.projection;
   const double pixel = camera.ortho ? 2.0 * p[2][2] / (std::abs(p[1][1]) * camera.height)
                                     : 2.0 * p[2][3] / (p[1][1] * camera.height);
-  push.fill_threshold = static_cast<float>(3.0 * shadeRadii(point_size).fill * pixel / std::log(2.0));
+  push.fill_threshold = static_cast<float>(3.0 * radii.fill * pixel / std::log(2.0));
   return push;
 }
 
@@ -101,26 +140,34 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
             VK_ACCESS_SHADER_READ_BIT);
   }
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.layout, 0, 1, &r.shade_set, 0, nullptr);
-  const uint32_t groups_x = (push.width + kShadeGroupSize - 1) / kShadeGroupSize;
-  const uint32_t groups_y = (push.height + kShadeGroupSize - 1) / kShadeGroupSize;
-  auto pass = [&](VkPipeline pipeline, uint32_t axis) {
+  // A pass of `group`² invocations a workgroup, each shading block_x × block_y pixels.
+  auto pass = [&](VkPipeline pipeline, uint32_t axis, uint32_t group, uint32_t block_x, uint32_t block_y) {
     EdlPush p = push;
     p.axis = axis;
     vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(p), &p);
     vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdDispatch(commands, groups_x, groups_y, 1);
+    const uint32_t across = group * block_x, down = group * block_y;
+    vkCmdDispatch(commands, (push.width + across - 1) / across, (push.height + down - 1) / down, 1);
   };
   const auto between = [&] {
     barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
   };
-  pass(r.shade.fill, 0);
+  if (raster) {  // the compute backend's resolve wrote the log distances
+    pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
+    between();
+  }
+  pass(r.shade.fill, 0, kShadeGroupSize, 1, 1);
   between();
-  pass(r.shade.smooth, 0);
-  between();
-  pass(r.shade.smooth, 1);
-  between();
-  pass(r.shade.edl, 0);
+  if (r.shade.smooth_edl) {
+    pass(r.shade.smooth_edl, 0, kShadeStripGroupSize, kShadeStripWidth, kShadeStripHeight);
+  } else {
+    pass(r.shade.smooth, 0, kShadeGroupSize, 1, 1);
+    between();
+    pass(r.shade.smooth, 1, kShadeGroupSize, 1, 1);
+    between();
+    pass(r.shade.edl, 0, kShadeGroupSize, 1, 1);
+  }
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
           VK_ACCESS_TRANSFER_READ_BIT);
 }

@@ -57,6 +57,7 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
   facts.driver_version = basic.driverVersion;
   facts.max_storage_buffer_range = basic.limits.maxStorageBufferRange;
   facts.max_image_dimension = basic.limits.maxImageDimension2D;
+  facts.max_texel_buffer_elements = basic.limits.maxTexelBufferElements;
   facts.max_point_size = basic.limits.pointSizeRange[1];
   facts.max_dispatch_groups_x = basic.limits.maxComputeWorkGroupCount[0];
 

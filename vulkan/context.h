@@ -29,6 +29,7 @@ struct DeviceFacts {
   bool r64g64b64_vertex = false;   // native mode reads double vertex attributes (else pulls)
   uint64_t max_storage_buffer_range = 0, max_memory_allocation = 0;
   uint32_t max_image_dimension = 0;  // maxImageDimension2D: the raster backend's largest picture side
+  uint32_t max_texel_buffer_elements = 0;  // maxTexelBufferElements: the shading's buffers (pixels)
   float max_point_size = 1.0f;
   uint32_t max_dispatch_groups_x = 0;  // maxComputeWorkGroupCount[0]: caps a compute chunk
   float timestamp_period_ns = 0.0f;  // 0: no timestamps on the graphics queue

@@ -1,5 +1,5 @@
 #version 450
-// Shading pass 1, hole filling: a screen-space visibility test after Pintus, Gobbetti and Agus
+// Shading pass 2, hole filling: a screen-space visibility test after Pintus, Gobbetti and Agus
 // ("Real-time rendering of massive unstructured raw point clouds using screen-space operators",
 // 2011), reduced to 8 directions. A pixel that shows nothing, or a point far behind the surface
 // around it (a back surface seen through the gaps between the front surface's points), is a hole
@@ -7,17 +7,19 @@
 // drawn pixel within kFillRadius stands nearer than it by more than `fill_threshold`: a crack
 // between two rows of points is open along its length, and the crossing of two cracks along both
 // of theirs, but each is closed across. A hole takes the mean colour and log distance of the
-// first such pixel each way that lies on the nearest surface found; every other pixel is copied. Gaps narrower than the radius close;
-// the background beside a silhouette (surface on one side only) and holes wider than the radius
-// (a Menger sponge's) stay open.
+// first such pixel each way that lies on the nearest surface found; every other pixel is copied.
+// Gaps narrower than the radius close; the background beside a silhouette (surface on one side
+// only) and holes wider than the radius (a Menger sponge's) stay open.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "shade_common.glsl"
 
-layout(std430, set = 0, binding = 0) readonly buffer Depth { float depth[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Picture { uint picture[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer Filled { float filled_log[]; };
-layout(std430, set = 0, binding = 4) writeonly buffer FilledPicture { uint filled_picture[]; };
+layout(local_size_x = 16, local_size_y = 16) in;  // kShadeGroupSize
+
+layout(set = 0, binding = 1, r32ui) uniform readonly uimageBuffer picture;
+layout(set = 0, binding = 3, r32f) uniform readonly imageBuffer log_distance;
+layout(set = 0, binding = 4, r32f) uniform writeonly imageBuffer filled_log;
+layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer filled_picture;  // shaded later, in place
 
 // Pixels searched each way (viewer/pipelines.h's shadeRadii): a constant, so the search unrolls.
 layout(constant_id = 0) const int kFillRadius = 2;
@@ -27,62 +29,46 @@ const ivec2 kDirections[8] = ivec2[8](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ive
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (!inside(p)) return;
-  uint i = pixelIndex(p);
-  float d = depth[i];
-  float here = d > 0.0 ? logDistance(d) : kEmpty;
+  int i = pixelIndex(p), padded = paddedIndex(p);
+  float here = imageLoad(log_distance, padded).r;
+  // A pixel stands in front by more than the threshold when its log distance is under this; where
+  // nothing is drawn it is kEmpty (kEmpty less the threshold rounds to kEmpty): any drawn pixel.
   float limit = here - pc.fill_threshold;
-  // A pixel stands in front by more than the threshold when its depth is over this (depth grows
-  // nearer the eye): one exp2 a pixel instead of a log2 a pixel searched.
-  float front_depth = d > 0.0 ? depthAt(limit) : 0.0;
-  bool seen[8];
   float seen_log[8];
-  uint seen_color[8];
+  int seen_index[8];
   float nearest = kEmpty;
+  // llvmpipe runs every branch of every lane, so every step below is paid for every pixel: no
+  // early exits; one colour load a direction, at the index found.
   [[unroll]] for (int k = 0; k < 8; ++k) {
-    // The first pixel this way that stands in front by more than the threshold.
-    seen[k] = false;
+    // The first pixel this way that stands in front by more than the threshold (from the far end:
+    // the nearest hit wins). Counting up: Mesa 22's NIR unrolls no loop that counts down.
     seen_log[k] = kEmpty;
-    seen_color[k] = 0u;
-    // Unrolled (no loop to branch on): the nearest hit wins.
-    uint hit = 0xffffffffu;
-    float hit_depth = 0.0;
-    [[unroll]] for (int t = kFillRadius; t >= 1; --t) {
-      ivec2 q = p + t * kDirections[k];
-      if (inside(q)) {
-        uint j = pixelIndex(q);
-        float e = depth[j];
-        if (e > front_depth) {
-          hit = j;
-          hit_depth = e;
-        }
-      }
+    seen_index[k] = i;
+    [[unroll]] for (int u = 0; u < kFillRadius; ++u) {
+      int t = kFillRadius - u;
+      float l = imageLoad(log_distance, padded + t * paddedStep(kDirections[k])).r;
+      bool hit = l < limit;  // never in the margin: kEmpty is not under any limit
+      seen_log[k] = hit ? l : seen_log[k];
+      seen_index[k] = hit ? i + t * (kDirections[k].y * int(pc.width) + kDirections[k].x) : seen_index[k];
     }
-    if (hit != 0xffffffffu) {
-      seen[k] = true;
-      seen_log[k] = logDistance(hit_depth);
-      seen_color[k] = picture[hit];
-      nearest = min(nearest, seen_log[k]);
-    }
+    nearest = min(nearest, seen_log[k]);
   }
   int pairs = 0;
-  [[unroll]] for (int k = 0; k < 4; ++k) pairs += (seen[k] && seen[k + 4]) ? 1 : 0;
-  if (pairs < 2) {  // not surrounded: a silhouette's background, a hole wider than the radius, a surface
-    filled_log[i] = here;
-    filled_picture[i] = picture[i];
-    return;
-  }
+  [[unroll]] for (int k = 0; k < 4; ++k) pairs += (seen_log[k] < kEmpty && seen_log[k + 4] < kEmpty) ? 1 : 0;
   // The hole takes the nearest surface around it (a pixel with nothing drawn may see the front
   // surface one way and a back one another): the pixels within the threshold of the nearest.
   vec3 color_sum = vec3(0.0);
   float log_sum = 0.0;
   int covered = 0;
   [[unroll]] for (int k = 0; k < 8; ++k) {
-    if (seen_log[k] <= nearest + pc.fill_threshold) {
-      color_sum += unpackUnorm4x8(seen_color[k]).rgb;
-      log_sum += seen_log[k];
-      ++covered;
-    }
+    vec3 color = unpackUnorm4x8(imageLoad(picture, seen_index[k]).r).rgb;
+    bool near = seen_log[k] <= nearest + pc.fill_threshold;
+    color_sum += near ? color : vec3(0.0);
+    log_sum += near ? seen_log[k] : 0.0;
+    covered += near ? 1 : 0;
   }
-  filled_log[i] = log_sum / float(covered);
-  filled_picture[i] = packUnorm4x8(vec4(color_sum / float(covered), 1.0));
+  // Not surrounded (a silhouette's background, a hole wider than the radius, a surface): copied.
+  bool filled = pairs >= 2;
+  imageStore(filled_log, padded, vec4(filled ? log_sum / float(covered) : here));
+  imageStore(filled_picture, i, uvec4(filled ? packUnorm4x8(vec4(color_sum / float(covered), 1.0)) : imageLoad(picture, i).r));
 }
