@@ -46,6 +46,15 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
   return static_cast<size_t>(points);
 }
 
+}  // namespace
+
+bool shadingFits(const DeviceFacts& f, uint32_t width, uint32_t height, const RenderOptions& options) {
+  const uint64_t margin = static_cast<uint64_t>(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
+  return (uint64_t{width} + 2 * margin) * (uint64_t{height} + 2 * margin) <= f.max_texel_buffer_elements;
+}
+
+namespace {
+
 Status checkOptions(const VulkanContext& context, size_t count, const Camera& camera, const RenderOptions& options) {
   if (count == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
   if (count > UINT32_MAX)
@@ -75,7 +84,7 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
                  ExitCode::kResourceLimit};
   if (options.shading == Shading::kEdl) {
     const uint64_t margin = static_cast<uint64_t>(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
-    if ((width + 2 * margin) * (height + 2 * margin) > f.max_texel_buffer_elements)
+    if (!shadingFits(f, camera.width, camera.height, options))
       return Error{"shading reads " + picture + " with a margin of " + std::to_string(margin) +
                        " pixels as texel buffers: more than " + f.name + "'s maxTexelBufferElements of " +
                        std::to_string(f.max_texel_buffer_elements) + "; use --shade none",

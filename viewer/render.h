@@ -74,6 +74,10 @@ struct RenderResult {
 // Fails with kBadInput when the set is empty or a position does not fit the mode's encoding,
 // kNoDevice when the device cannot run the mode (see modeUsable), kResourceLimit when memory
 // runs out. The caller's context collects validation messages.
+// Whether the shading passes' texel buffers (the picture and a margin) fit the device's
+// maxTexelBufferElements; renderPoints refuses --shade edl where they do not.
+bool shadingFits(const DeviceFacts& facts, uint32_t width, uint32_t height, const RenderOptions& options);
+
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                   const RenderOptions& options);
 

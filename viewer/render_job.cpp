@@ -206,8 +206,10 @@ ModePrediction streamedModePrediction(const RenderRequest& request) {
   return p;
 }
 
+// Shading auto on a picture too large for the shading passes' buffers draws it plain, with a
+// warning in `warnings`.
 RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& set, PrecisionMode mode,
-                               const Camera& camera, const DeviceFacts& facts) {
+                               const Camera& camera, const DeviceFacts& facts, std::vector<std::string>& warnings) {
   RenderOptions options;
   options.mode = mode;
   options.backend = *request.backend;
@@ -220,6 +222,12 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   options.max_chunk_points = request.chunk_points;
   options.shading = shadingFor(request, set.bounds);
   options.edl = request.edl;
+  if (!request.shading && options.shading == Shading::kEdl && !shadingFits(facts, camera.width, camera.height, options)) {
+    options.shading = Shading::kNone;
+    warnings.push_back("a " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                       " picture is more than " + facts.name + " shades (maxTexelBufferElements " +
+                       std::to_string(facts.max_texel_buffer_elements) + "): drawn without shading");
+  }
   return options;
 }
 
@@ -231,7 +239,10 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
   for (size_t i = 0; i < views.size(); ++i) {
     Result<ModePrediction> prediction = predictMode(request, context, *set.points, cameras[i]);
     if (!prediction) return prediction.error();
-    const RenderOptions options = renderOptionsFor(request, set, prediction->mode, cameras[i], context.facts);
+    std::vector<std::string> shading_warnings;
+    const RenderOptions options =
+        renderOptionsFor(request, set, prediction->mode, cameras[i], context.facts, shading_warnings);
+    for (const std::string& w : shading_warnings) outcome.warnings.push_back("view " + std::string(views[i].label) + ": " + w);
     Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options);
     if (!rendered) return rendered.error();
     const std::string mode(modeName(prediction->mode));
@@ -257,7 +268,8 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   outcome.prediction = std::move(*prediction);
   if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
   outcome.phases.mark("mode");
-  const RenderOptions options = renderOptionsFor(request, set, outcome.prediction.mode, camera, context.facts);
+  const RenderOptions options =
+      renderOptionsFor(request, set, outcome.prediction.mode, camera, context.facts, outcome.warnings);
   outcome.point_size = options.point_size;
   outcome.shading = options.shading;
   Result<RenderResult> rendered = [&]() -> Result<RenderResult> {

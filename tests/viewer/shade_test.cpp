@@ -8,6 +8,7 @@
 #include <string>
 
 #include "viewer/camera.h"
+#include "viewer/pipelines.h"
 #include "viewer/render.h"
 #include "render_test_support.h"
 
@@ -165,6 +166,28 @@ TEST_P(Shade, fusedSmoothingAndEdlGiveTheSeparatePassesPicture) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Shade, ::testing::Values(Backend::kRaster, Backend::kCompute), backendName);
+
+}  // namespace
+}  // namespace dpoint
+
+namespace dpoint {
+namespace {
+
+// The shading's texel buffers hold the picture and a margin: a picture that would pass the
+// device's maxTexelBufferElements does not fit (render_job then draws it plain, with a warning).
+TEST(ShadeLimits, shadingFitsCountsThePictureAndItsMargin) {
+  DeviceFacts facts;
+  facts.max_texel_buffer_elements = 10000;
+  RenderOptions options;
+  options.shading = Shading::kEdl;
+  options.point_size = 1.0f;
+  const uint32_t margin = uint32_t(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
+  ASSERT_GT(margin, 0u);
+  const uint32_t side = 100 - 2 * margin;  // with its margins, 100 x 100 = the limit
+  EXPECT_TRUE(shadingFits(facts, side, side, options));
+  EXPECT_FALSE(shadingFits(facts, side + 1, side, options));
+  EXPECT_FALSE(shadingFits(facts, 100, 100, options)) << "the picture alone at the limit, its margins over";
+}
 
 }  // namespace
 }  // namespace dpoint
