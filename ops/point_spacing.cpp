@@ -22,10 +22,10 @@ uint64_t mix(uint64_t x) {  // splitmix64's finalizer
   return x ^ (x >> 31);
 }
 
+// One mix of the three coordinates' bits, rotated apart (+ 0.0: -0 hashes as 0).
 uint64_t positionHash(const glm::dvec3& p) {
-  uint64_t h = 0;
-  for (int k = 0; k < 3; ++k) h = mix(h ^ std::bit_cast<uint64_t>(p[k] + 0.0));  // + 0.0: -0 hashes as 0
-  return h;
+  return mix(std::bit_cast<uint64_t>(p.x + 0.0) ^ std::rotl(std::bit_cast<uint64_t>(p.y + 0.0), 21) ^
+             std::rotl(std::bit_cast<uint64_t>(p.z + 0.0), 42));
 }
 
 size_t tableIndex(uint64_t key, size_t size) { return size_t(mix(key)) & (size - 1); }
