@@ -17,7 +17,7 @@ mkdir -p "$data"
 
 results=$out/first_picture.tsv
 printf 'set\twhat\tpoint_size\tshade\tpoints\tgpu_ms_median\tframe_ms_median\twall_s\n' >"$results"
-value() { sed -n "s/.*\"$1\": \([^,}]*\).*/\1/p" /tmp/r.json | head -1; }
+value() { sed -n "s/.*\"$1\": \([^,}]*\).*/\1/p" /tmp/r.json | head -1 | tr -d '"'; }
 median() { sed -n "s/.*\"$1\": {\"median\": \([^,]*\),.*/\1/p" /tmp/r.json | head -1; }
 for set in mb420 mb1024; do
   "$d" render "$data/$set.ply" -o /tmp/r.png -q >/dev/null  # the file in the page cache, the shader cache filled
