@@ -55,6 +55,10 @@ Rendered renderDefault(const PointSet& points, const std::string& name, RenderRe
   return r;
 }
 
+double span(const Rendered& r) {
+  return double(std::max(r.gap.span_x, r.gap.span_y)) / double(std::min(r.image.width, r.image.height));
+}
+
 PointSet mandelbrot2d(double width) {
   Mandelbrot2dParams params;
   params.width = width;
@@ -62,10 +66,6 @@ PointSet mandelbrot2d(double width) {
   Result<PointSet> points = generateMandelbrot2d(params);
   EXPECT_TRUE(points.ok());
   return points.ok() ? std::move(*points) : PointSet{};
-}
-
-double span(const Rendered& r) {
-  return double(std::max(r.gap.span_x, r.gap.span_y)) / double(std::min(r.image.width, r.image.height));
 }
 
 // 226K points (res 200, 4 px) and 1.55M (res 420, 2 px): before the hole filling, 35% and 21%.
@@ -148,9 +148,10 @@ TEST(RenderFill, fillingHidesTheBackSurfaceSeenThroughTheGaps) {
 }
 
 TEST(RenderFill, defaultMandelbrot2dGridHasNoGaps) {
-  for (double width : {1e-6, 1e-12}) {
+  for (double width : {1e-6, 1e-12, 1e-15}) {
     const Rendered r = renderDefault(mandelbrot2d(width), "mandelbrot2d-256-" + std::to_string(width));
     EXPECT_LE(r.gap.share, 0.02) << "width " << width;
+    EXPECT_GE(span(r), 0.85) << "width " << width;
     EXPECT_EQ(r.point_size, 3.0f) << "256 points over 756 px";
     EXPECT_EQ(r.backend, "compute");
   }
