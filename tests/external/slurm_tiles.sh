@@ -72,10 +72,12 @@ sinfo -h -o %T | grep -q idle || { echo "the cluster did not come up within a mi
 echo "cluster up after $(awk -v a="$started" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }') s"
 
 export DPOINT=$dpoint PARTS=$work/parts OUTPUT=$work/merged.ply
-export KIND_ARGS="mandelbulb --resolution 41 --variant fast"
-# Each tile's escape counts on Vulkan device (task mod 1) = 0: lavapipe here, the same counts.
-export DEVICE=task GPUS=1
-merge_job=$("$examples/submit.sh" 5 -D "$work")
+# TILES, GPUS and KIND_ARGS may be given (bench/scripts/gpu_slurm.sh: one tile per GPU of a host).
+export KIND_ARGS=${KIND_ARGS:-"mandelbulb --resolution 41 --variant fast"}
+tiles=${TILES:-5}
+# Each tile's escape counts on Vulkan device (task mod GPUS): with 1, device 0 (lavapipe here).
+export DEVICE=task GPUS=${GPUS:-1}
+merge_job=$("$examples/submit.sh" "$tiles" -D "$work")
 for _ in $(seq 1 120); do
   [ -z "$(squeue -h 2>/dev/null)" ] && break
   sleep 1
@@ -87,4 +89,4 @@ if ! cmp "$work/whole.ply" "$work/merged.ply"; then
   cat "$work"/dpoint-*.log
   exit 1
 fi
-echo "5 tiles through Slurm (merge job $merge_job): merged file equals the single process's"
+echo "$tiles tiles through Slurm (merge job $merge_job, done $(awk -v a="$started" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }') s after the cluster started): merged file equals the single process's"
