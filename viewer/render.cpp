@@ -46,14 +46,9 @@ size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool 
   return static_cast<size_t>(points);
 }
 
-}  // namespace
-
-bool shadingFits(const DeviceFacts& f, uint32_t width, uint32_t height, const RenderOptions& options) {
-  const uint64_t margin = static_cast<uint64_t>(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
-  return (uint64_t{width} + 2 * margin) * (uint64_t{height} + 2 * margin) <= f.max_texel_buffer_elements;
+uint64_t shadingMargin(const RenderOptions& options) {
+  return static_cast<uint64_t>(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
 }
-
-namespace {
 
 Status checkOptions(const VulkanContext& context, size_t count, const Camera& camera, const RenderOptions& options) {
   if (count == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
@@ -82,14 +77,11 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
     return Error{picture + " is larger than " + f.name + " draws (" + std::to_string(f.max_image_dimension) +
                      " pixels a side at most)",
                  ExitCode::kResourceLimit};
-  if (options.shading == Shading::kEdl) {
-    const uint64_t margin = static_cast<uint64_t>(shadeRadii(options.point_size, options.edl.radius, options.edl.fuse).margin());
-    if (!shadingFits(f, camera.width, camera.height, options))
-      return Error{"shading reads " + picture + " with a margin of " + std::to_string(margin) +
-                       " pixels as texel buffers: more than " + f.name + "'s maxTexelBufferElements of " +
-                       std::to_string(f.max_texel_buffer_elements) + "; use --shade none",
-                   ExitCode::kResourceLimit};
-  }
+  if (options.shading == Shading::kEdl && !shadingFits(f, camera.width, camera.height, options))
+    return Error{"shading reads " + picture + " with a margin of " + std::to_string(shadingMargin(options)) +
+                     " pixels as texel buffers: more than " + f.name + "'s maxTexelBufferElements of " +
+                     std::to_string(f.max_texel_buffer_elements) + "; use --shade none",
+                 ExitCode::kResourceLimit};
   if (options.backend == Backend::kCompute && 8 * width * height > f.max_storage_buffer_range)
     return Error{"--backend compute keeps a 64-bit key per pixel in one storage buffer: " + picture + " exceeds " +
                      f.name + "'s maxStorageBufferRange of " + std::to_string(f.max_storage_buffer_range) + " bytes",
@@ -515,6 +507,11 @@ class StreamBlocks {
 };
 
 }  // namespace
+
+bool shadingFits(const DeviceFacts& f, uint32_t width, uint32_t height, const RenderOptions& options) {
+  const uint64_t margin = shadingMargin(options);
+  return (uint64_t{width} + 2 * margin) * (uint64_t{height} + 2 * margin) <= f.max_texel_buffer_elements;
+}
 
 Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
   VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
