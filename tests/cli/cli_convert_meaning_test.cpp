@@ -35,6 +35,16 @@ std::string convertedCsv(const TempDir& dir, const std::string& name, const std:
   return r.exit_code == 0 ? readFile(dir.file(out)) : std::string();
 }
 
+// `text` written as dir/NAME and converted to dir/NAME.ply: refused with exit 2 and nothing written;
+// convert's stderr.
+std::string refusedCsv(const TempDir& dir, const std::string& name, const std::string& text) {
+  writeFile(dir.file(name), text);
+  const test::CommandResult r = runDpoint({"convert", dir.file(name), "-o", dir.file(name + ".ply")});
+  EXPECT_EQ(r.exit_code, 2) << name;
+  EXPECT_FALSE(test::fileExists(dir.file(name + ".ply"))) << name;
+  return r.err;
+}
+
 // simple.las with every Z set to 0 (the same header, records rewritten), and with no points.
 void writeFlatLas(const std::string& path) {
   std::string bytes = readFile(kLas + "simple.las");
@@ -142,10 +152,7 @@ TEST(CliConvertMeaning, csvHeaderOnlyIsAnEmptySetAndAnEmptyFileStillFails) {
   EXPECT_TRUE(test::contains(readFile(dir.file("header.ply")), "\nelement vertex 0\n"));
   expectConverts({dir.file("header.ply"), "-o", dir.file("header_out.csv")});
   EXPECT_EQ(readFile(dir.file("header_out.csv")), "x,y\n");
-  writeFile(dir.file("empty.csv"), "");
-  test::CommandResult r = runDpoint({"convert", dir.file("empty.csv"), "-o", dir.file("out.ply")});
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(test::contains(r.err, "empty.csv: empty file"));
+  EXPECT_TRUE(test::contains(refusedCsv(dir, "empty.csv", ""), "empty.csv: empty file"));
 }
 
 TEST(CliConvertMeaning, materialBaseColoursBecomePointColours) {
@@ -185,11 +192,8 @@ TEST(CliConvertMeaning, csvExtraColumnsAreIgnoredWithOneNotice) {
   };
   for (size_t k = 0; k < bad.size(); ++k) {
     const std::string name = "bad" + std::to_string(k) + ".csv";
-    writeFile(dir.file(name), bad[k].first);
-    test::CommandResult b = runDpoint({"convert", dir.file(name), "-o", dir.file(name + ".ply")});
-    EXPECT_EQ(b.exit_code, 2) << name;
-    for (const std::string& part : bad[k].second) EXPECT_TRUE(test::contains(b.err, part)) << name;
-    EXPECT_FALSE(test::fileExists(dir.file(name + ".ply")));
+    const std::string err = refusedCsv(dir, name, bad[k].first);
+    for (const std::string& part : bad[k].second) EXPECT_TRUE(test::contains(err, part)) << name;
   }
 }
 
@@ -201,10 +205,7 @@ TEST(CliConvertMeaning, whitespaceSeparatedCsvAsCloudCompareWritesIt) {
   EXPECT_EQ(convertedCsv(dir, "tab.csv", "1\t2\t3\n4\t5\t6\n", "tab_out.csv"), "x,y,z\n1,2,3\n4,5,6\n");
   EXPECT_EQ(convertedCsv(dir, "xy.txt.csv", "x y\n1 2\n", "xy_out.csv"), "x,y\n1,2\n");
   // A row of the wrong length names its line and the layout.
-  writeFile(dir.file("short.csv"), "1 2 3\n4 5\n");
-  test::CommandResult r = runDpoint({"convert", dir.file("short.csv"), "-o", dir.file("short.ply")});
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(test::contains(r.err, "short.csv:2: 2 columns, expected 3 (x,y,z)"));
+  EXPECT_TRUE(test::contains(refusedCsv(dir, "short.csv", "1 2 3\n4 5\n"), "short.csv:2: 2 columns, expected 3 (x,y,z)"));
 }
 
 TEST(CliConvertMeaning, lasToCsvWritesValuesAtTheFilesStep) {
