@@ -2,6 +2,8 @@
 
 #include "cli/cli_text.h"
 
+#include <cmath>
+
 namespace dpoint {
 
 void addCameraOptions(CLI::App& cmd, CameraCliOptions& o) {
@@ -15,6 +17,21 @@ void addCameraOptions(CLI::App& cmd, CameraCliOptions& o) {
   cmd.add_flag("--ortho", o.ortho, "Orthographic projection (the default for 2D data, z = 0)");
   cmd.add_option("--view-center", o.view_center, "Orthographic window centre X,Y[,Z]");
   cmd.add_option("--view-width", o.view_width, "Orthographic window width (height follows the aspect)");
+  cmd.add_option("--tolerance", o.tolerance,
+                 "adaptive mode: the error in pixels its per-batch choice of tiers keeps within, where 30 bits can")
+      ->check([](const std::string& v) {
+        Result<double> px = parseTolerance(v);
+        return px ? std::string() : px.error().message;
+      })
+      ->default_val("0.05");
+}
+
+Result<double> parseTolerance(const std::string& text) {
+  Result<std::vector<double>> px = parseNumbers("--tolerance", text, 1);
+  if (!px) return px.error();
+  if (!((*px)[0] > 0.0) || !std::isfinite((*px)[0]))
+    return Error{"--tolerance must be a number of pixels above 0, not " + text, ExitCode::kUsage};
+  return (*px)[0];
 }
 
 Result<CameraSpec> cameraSpec(const CameraCliOptions& o) {

@@ -16,7 +16,11 @@ struct CameraCliOptions {
   std::string eye, target, up, view_center;
   bool fit = false, ortho = false;
   double fov = 45.0, view_width = 0.0;
+  // Not the camera's, but the view's precision target both commands predict for: adaptive mode's.
+  std::string tolerance = "0.05";
 };
+// --tolerance: a finite number of pixels > 0 (kUsage, naming the flag).
+Result<double> parseTolerance(const std::string& text);
 
 void addCameraOptions(CLI::App& command, CameraCliOptions& options);
 

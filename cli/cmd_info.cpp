@@ -108,7 +108,7 @@ void printText(const std::string& path, const PointSetInfo& i, const std::option
     const double px = advice->bounds.px[modeIndex(mode)];
     const char* verdict = px <= kAutoBoundPx ? "within --mode auto's 0.1 px" : px < 0.5 ? "under half a pixel"
                                                                             : "points leave their pixel";
-    std::printf("  %-7s %-12s %s\n", std::string(modeName(mode)).c_str(), formatBound(px).c_str(), verdict);
+    std::printf("  %-8s %-12s %s\n", std::string(modeName(mode)).c_str(), formatBound(px).c_str(), verdict);
   }
 }
 
@@ -191,7 +191,7 @@ int runInfo(const InfoOptions& o) {
   if (points->size() > 0) {
     Result<Camera> camera = makeCamera(*spec, boundsOf(*points));
     if (!camera) return reportError(camera.error());
-    advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera)};
+    advice = ViewAdvice{*camera, predictErrorBounds(*points, *camera, {}, *parseTolerance(o.camera.tolerance))};
   }
   const std::string files = describeInputs(o.inputs);
   if (o.json) printJson(files, info, advice, las, true);

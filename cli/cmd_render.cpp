@@ -77,6 +77,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.device = o.device;
   request.validate = o.validate;
   request.camera = *spec;
+  request.tolerance_px = *parseTolerance(o.camera.tolerance);
   if (o.point_size != "auto") request.point_size = *parsePointSize(o.point_size);
   request.background_rgba8 = *parseBackground(o.background);
   if (o.shade != "auto") request.shading = o.shade == "edl" ? Shading::kEdl : Shading::kNone;

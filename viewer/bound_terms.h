@@ -167,6 +167,19 @@ T storedFloatError(T x) {
   return pick(a < kFloatMin, a, kU * a);
 }
 
+// The double rounding of a batch matrix's translation (projection · rotation · (origin − eye) plus
+// the projection's own translation, each a few ud of its terms), per row.
+inline Vec4 batchTranslationError(const SceneFrame& frame, const glm::dvec3& origin) {
+  const glm::dvec3 relative = origin - frame.eye;
+  Vec4 error{};
+  for (int r = 0; r < 4; ++r) {
+    double sum = std::fabs(frame.projection_rotation[3][r]);
+    for (int c = 0; c < 3; ++c) sum += std::fabs(frame.projection_rotation[c][r] * relative[c]);
+    error[static_cast<size_t>(r)] = 4.0 * kUd * sum;
+  }
+  return error;
+}
+
 // What every mode's bound reads: the camera in the scene frame and its derived matrices, computed
 // once per pass (precision.cpp, makeSetup).
 struct Setup {

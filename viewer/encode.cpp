@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/parallel.h"
+#include "viewer/batch_plan.h"
 
 namespace dpoint {
 namespace {
@@ -55,13 +56,13 @@ std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame
   return frames;
 }
 
-// projection · rotation · translate(origin − eye) · extent · 2^−20, in the scene frame.
-glm::dmat4 batchMatrix(const SceneFrame& frame, const BatchFrame& b) {
+// projection · rotation · translate(origin − eye) · extent / steps, in the scene frame.
+glm::dmat4 batchMatrix(const SceneFrame& frame, const BatchFrame& b, double steps) {
   glm::dmat4 m = frame.projection_rotation;
   const glm::dvec3 relative = b.origin - frame.eye;  // both in the scene frame
   glm::dvec4 translation = m[3];
   for (int c = 0; c < 3; ++c) translation += m[c] * relative[c];
-  for (int c = 0; c < 3; ++c) m[c] *= b.extent / kBatchSteps;  // powers of two: exact
+  for (int c = 0; c < 3; ++c) m[c] *= b.extent / steps;  // powers of two: exact
   m[3] = translation;
   return m;
 }
@@ -171,6 +172,25 @@ glm::ivec3 unpackBatchOffset(uint64_t word) {
   return q;
 }
 
+uint32_t quantizeAdaptive(double t) {
+  // As packBatchOffset: t·2^29 is exact, the sum rounds it half to even, t = 1 is clamped.
+  constexpr double kRound = 0x1.8p52;
+  const double q = std::clamp((t * kAdaptiveSteps + kRound) - kRound, -kAdaptiveSteps, kAdaptiveSteps - 1.0);
+  return static_cast<uint32_t>(static_cast<int32_t>(q) + (int32_t{1} << 29));
+}
+
+int32_t adaptiveRebuilt(uint32_t q, uint32_t tiers) {
+  const uint32_t dropped = kAdaptiveTierBits * (kAdaptiveTiers - tiers);
+  const uint32_t rebuilt = dropped == 0 ? q : ((q >> dropped) << dropped) | (1u << (dropped - 1));
+  return static_cast<int32_t>(rebuilt) - (int32_t{1} << 29);
+}
+
+double adaptiveStepError(uint32_t tiers) {
+  const uint32_t dropped = kAdaptiveTierBits * (kAdaptiveTiers - tiers);
+  const double half_cell = dropped == 0 ? 0.0 : std::ldexp(1.0, static_cast<int>(dropped) - 1);
+  return half_cell + 1.0 + 0x1p-20;
+}
+
 FloatPair splitDouble(double d) {
   // GCC 12's SLP vectorizer folds (double)(float)d back to d when it packs two of these side by
   // side (seen at -O2: `subpd %xmm0, %xmm0`), which zeroes every lo part; the volatile read of
@@ -212,10 +232,13 @@ double positionLimit(PrecisionMode mode) {
   return modeInfo(mode).layout.element == PositionElement::kFloat32 ? kFloatMax : std::numeric_limits<double>::max();
 }
 
-ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera) {
+ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tolerance_px) {
   ModeEncoding e;
   e.mode = mode;
   e.frame = sceneFrame(mode, camera);
+  e.tolerance_px = tolerance_px;
+  e.width = camera.width;
+  e.height = camera.height;
   return e;
 }
 
@@ -226,8 +249,9 @@ Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
   const size_t first_batch = e.batches.size();
   for (const BatchFrame& frame : makeBatchFrames(block, e.frame)) e.batches.push_back(frame);
   e.batch_matrices.reserve(e.batches.size());
+  const double steps = modeInfo(e.mode).batch_steps;
   for (size_t b = first_batch; b < e.batches.size(); ++b) {
-    const glm::dmat4& m = e.batch_matrices.emplace_back(batchMatrix(e.frame, e.batches[b]));
+    const glm::dmat4& m = e.batch_matrices.emplace_back(batchMatrix(e.frame, e.batches[b], steps));
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) {
         if (fitsFloat(m[c][r])) continue;
@@ -238,19 +262,21 @@ Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
                      ExitCode::kBadInput};
       }
   }
+  planBatches(e, first_batch);
   return okStatus();
 }
 
-Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera) {
-  ModeEncoding e = beginEncoding(mode, camera);
+Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera,
+                                     double tolerance_px) {
+  ModeEncoding e = beginEncoding(mode, camera, tolerance_px);
   if (Status status = addPoints(e, points, 0); !status) return status.error();
   return e;
 }
 
 void encodePositions(const ModeEncoding& e, const PointSet& points, size_t first, size_t count, void* out,
-                     size_t index_base) {
+                     size_t index_base, uint32_t plane) {
   assert(first + count <= points.size());
-  modeInfo(e.mode).encode(e, points.positions.data() + first, count, out, index_base + first);
+  modeInfo(e.mode).encode(e, points.positions.data() + first, count, out, index_base + first, plane);
 }
 
 std::vector<uint8_t> cameraUniform(const ModeEncoding& e, const Camera& camera) {

@@ -81,15 +81,47 @@ struct BatchFrame {
   double extent = 1.0;     // power of two ≥ every |p·scale − origin| of the batch (1 if all equal)
 };
 
+// Adaptive mode (issue #25): t as in batch mode, stored as q = round(t·2^29) + 2^29 clamped to
+// [0, 2^30 − 1], 30 bits per axis, split into three tiers of 10 bits (coarse: bits 29–20,
+// medium: 19–10, fine: 9–0). A tier's word holds x | y << 10 | z << 20; a chunk's positions are
+// three planes of such words (viewer/modes.h, PositionLayout::planes), so loading k tiers reads
+// 4·k bytes a point. With k tiers loaded the shader rebuilds q as the centre of the cell the
+// loaded bits name (k = 3: q itself) and maps q − 2^29 to clip space with the batch matrix.
+inline constexpr int kAdaptiveBits = 30, kAdaptiveTierBits = 10;
+inline constexpr uint32_t kAdaptiveTiers = 3;
+inline constexpr double kAdaptiveSteps = 0x1p29;  // integer steps per extent
+// The tolerance adaptive mode chooses its tiers for (--tolerance), in window pixels.
+inline constexpr double kDefaultTolerancePx = 0.05;
+// q of one coordinate t in [−1, 1] (t = 1 is the one value clamped).
+uint32_t quantizeAdaptive(double t);
+// The word of tier `tier` (0 coarse, 1 medium, 2 fine) of a point's three q.
+inline uint32_t adaptiveTierWord(const glm::uvec3& q, uint32_t tier) {
+  const uint32_t shift = kAdaptiveTierBits * (kAdaptiveTiers - 1 - tier);
+  return ((q.x >> shift) & 1023u) | ((q.y >> shift) & 1023u) << 10 | ((q.z >> shift) & 1023u) << 20;
+}
+// q rebuilt from its `tiers` loaded tiers as project.glsl rebuilds it, minus 2^29 (what the batch
+// matrix multiplies), for tests.
+int32_t adaptiveRebuilt(uint32_t q, uint32_t tiers);
+// The largest distance in steps between the stored value rebuilt from `tiers` tiers and t·2^29
+// (before the float conversion): half a cell of the bits not loaded, half a step of rounding, one
+// step at the clamped edge t = 1, and t's own rounding.
+double adaptiveStepError(uint32_t tiers);
+
 // Everything the encoders and uniform builders need for one mode, one camera and one set.
 struct ModeEncoding {
   PrecisionMode mode = kFallbackMode;
   SceneFrame frame;
   std::vector<BatchFrame> batches;  // per-batch modes (ModeInfo::batch_points) only
-  // Batch mode, one per batch, in double: projection · rotation · translate(origin − eye) ·
-  // extent · 2^−20, all in the scene frame: it takes the integer offsets to clip space. The GPU gets them cast to float (batchMatrices); the error bound
-  // uses them as they are.
+  // Per-batch modes, one per batch, in double: projection · rotation · translate(origin − eye) ·
+  // extent / steps (2^20 in batch mode, 2^29 in adaptive), all in the scene frame: it takes the
+  // integer offsets to clip space. The GPU gets them cast to float (batchMatrices); the error
+  // bound uses them as they are.
   std::vector<glm::dmat4> batch_matrices;
+  // Per batch, for this camera (viewer/batch_plan.h): 0 where its box shows no point (the compute
+  // backend skips it), else the tiers adaptive mode loads (1 to 3; batch mode: 1).
+  std::vector<uint8_t> batch_plan;
+  double tolerance_px = kDefaultTolerancePx;  // adaptive mode's tier choice
+  uint32_t width = 0, height = 0;             // the camera's picture, for the tier choice
 };
 
 // The largest |coordinate| in its frame that the mode's encoding holds: FLT_MAX where it stores
@@ -101,21 +133,22 @@ double positionLimit(PrecisionMode mode);
 // scene frame in rte/df64 (a point ~1e38 view sizes from the origin); a batch whose origin is so
 // far from the eye that its float matrix overflows. NaN and infinity never reach the GPU: inputs
 // are finite (readers reject the rest), and these checks keep every encoded value finite too.
-Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera);
+Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera,
+                                     double tolerance_px = kDefaultTolerancePx);
 
 // The same a block at a time, for a set streamed from a file: the encoding before any point is
 // seen, then each block in order (first_index: its first point's index in the whole set; in batch
 // mode a multiple of kBatchSize), checked as prepareEncoding checks the whole set, with errors
 // naming whole-set indices, and in batch mode its batches' frames and matrices appended.
-ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera);
+ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tolerance_px = kDefaultTolerancePx);
 Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);
 
 // Writes positions [first, first + count) of `points` in the mode's layout to `out`
-// (count · positionBytes(mode) bytes), with the mode's encoder (ModeInfo::encode). index_base: the
-// index of points[0] in the whole set when `points` is a block of it (batch mode looks up batches
-// by whole-set index).
+// (count · positionBytes(mode) bytes; a planar layout: count words of plane `plane`), with the
+// mode's encoder (ModeInfo::encode). index_base: the index of points[0] in the whole set when
+// `points` is a block of it (batch modes look up batches by whole-set index).
 void encodePositions(const ModeEncoding& encoding, const PointSet& points, size_t first, size_t count, void* out,
-                     size_t index_base = 0);
+                     size_t index_base = 0, uint32_t plane = 0);
 
 // The mode's uniform block (std140, as declared in shaders/render/project.glsl; ModeInfo::uniform);
 // empty for batch.

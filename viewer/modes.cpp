@@ -15,6 +15,7 @@
 #include "viewer/encode.h"
 #include "viewer/precision.h"
 
+#include "shaders/points_adaptive.vert.h"
 #include "shaders/points_batch.vert.h"
 #include "shaders/points_df64.vert.h"
 #include "shaders/points_fp32.vert.h"
@@ -22,6 +23,7 @@
 #include "shaders/points_native_pull.vert.h"
 #include "shaders/points_rte.vert.h"
 #include "shaders/points_split.vert.h"
+#include "shaders/splat_adaptive.comp.h"
 #include "shaders/splat_batch.comp.h"
 #include "shaders/splat_df64.comp.h"
 #include "shaders/splat_fp32.comp.h"
@@ -45,13 +47,13 @@ void appendBytes(std::vector<uint8_t>& out, const Value& v) {
 
 // ---- encoders: positions as the shaders read them --------------------------------------------
 
-void encodeFloats(const ModeEncoding&, const glm::dvec3* p, size_t count, void* out, size_t) {
+void encodeFloats(const ModeEncoding&, const glm::dvec3* p, size_t count, void* out, size_t, uint32_t) {
   auto* f = static_cast<float*>(out);
   for (size_t i = 0; i < count; ++i)
     for (int a = 0; a < 3; ++a) f[3 * i + a] = static_cast<float>(p[i][a]);
 }
 
-void encodeFloatPairs(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t) {
+void encodeFloatPairs(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t, uint32_t) {
   auto* f = static_cast<float*>(out);
   const SceneFrame& frame = e.frame;
   // Interleaved per point: hi.xyz then lo.xyz (one 24-byte vertex binding).
@@ -64,7 +66,7 @@ void encodeFloatPairs(const ModeEncoding& e, const glm::dvec3* p, size_t count, 
   }
 }
 
-void encodeDoubles(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t) {
+void encodeDoubles(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t, uint32_t) {
   const SceneFrame& frame = e.frame;
   if (frame.exponent == 0) {
     std::memcpy(out, p, count * sizeof(glm::dvec3));
@@ -75,13 +77,28 @@ void encodeDoubles(const ModeEncoding& e, const glm::dvec3* p, size_t count, voi
   }
 }
 
-void encodeBatchOffsets(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t first_index) {
+void encodeBatchOffsets(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t first_index,
+                        uint32_t) {
   const SceneFrame& frame = e.frame;
   auto* words = static_cast<uint64_t*>(out);
   for (size_t i = 0; i < count; ++i) {
     const BatchFrame& batch = e.batches[(first_index + i) / kBatchSize];
     // p·scale − origin rounds once in double; the division by a power of two is exact.
     words[i] = packBatchOffset((scaleBy(p[i], frame) - batch.origin) / batch.extent);
+  }
+}
+
+// One plane of adaptive mode's tier words: the point's 30-bit q per axis (viewer/encode.h), then the
+// plane's 10 bits of each.
+void encodeAdaptiveTier(const ModeEncoding& e, const glm::dvec3* p, size_t count, void* out, size_t first_index,
+                        uint32_t plane) {
+  const SceneFrame& frame = e.frame;
+  auto* words = static_cast<uint32_t*>(out);
+  for (size_t i = 0; i < count; ++i) {
+    const BatchFrame& batch = e.batches[(first_index + i) / kBatchSize];
+    const glm::dvec3 t = (scaleBy(p[i], frame) - batch.origin) / batch.extent;  // one rounding, then exact
+    const glm::uvec3 q(quantizeAdaptive(t.x), quantizeAdaptive(t.y), quantizeAdaptive(t.z));
+    words[i] = adaptiveTierWord(q, plane);
   }
 }
 
@@ -226,6 +243,26 @@ Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
   return out;
 }
 
+// adaptive: as batch, with the step error of the tiers the point's batch loads (viewer/encode.h,
+// adaptiveStepError) and, with all three, the rounding of the 30-bit integer to float (2u·|q|: SPIR-V leaves the direction open; with
+// fewer tiers the rebuilt integer has at most 21 significant bits and converts exactly).
+Vec4 adaptiveError(const ModeState& own, const glm::dvec3& ps, size_t index) {
+  const size_t b = index / kBatchSize;
+  const uint32_t tiers = own.encoding.batch_plan[b];
+  if (tiers == 0) return kUnbounded;  // never: a culled batch's box holds no visible point
+  const BatchFrame& frame = own.encoding.batches[b];
+  const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kAdaptiveSteps;
+  const double step_error = adaptiveStepError(tiers);
+  Coords<double> dv;
+  for (size_t a = 0; a < 3; ++a) {
+    const double s = std::fabs(steps[static_cast<glm::length_t>(a)]);
+    dv[a] = step_error + 2.0 * kUd * s + (tiers == kAdaptiveTiers ? 2.0 * kU * (s + step_error) : 0.0);
+  }
+  Vec4 out = floatAffine(own.batch_rows[b], coordsOf(steps), dv);
+  for (size_t r = 0; r < 4; ++r) out[r] += own.batch_translation_error[b][r];
+  return out;
+}
+
 // df64's split constant times a matrix entry must stay finite (Dekker's split past 8e34).
 bool df64MatrixOverflows(const Setup& s) {
   for (int c = 0; c < 4; ++c)
@@ -263,6 +300,9 @@ Vec4 df64Bound(const Setup& s, const ModeState&, const glm::dvec3&, const Projec
 Vec4 batchBound(const Setup&, const ModeState& own, const glm::dvec3&, const Projected& q, size_t i) {
   return batchError(own, q.ps, i);
 }
+Vec4 adaptiveBound(const Setup&, const ModeState& own, const glm::dvec3&, const Projected& q, size_t i) {
+  return adaptiveError(own, q.ps, i);
+}
 
 // ---- the table -----------------------------------------------------------------------------------
 
@@ -271,6 +311,9 @@ constexpr PositionLayout kFloatPairs{PositionElement::kFloat32, 6, 4, "float hi.
 constexpr PositionLayout kDoubleXyz{PositionElement::kFloat64, 3, 8, "double x, y, z"};
 constexpr PositionLayout kBatchWord{PositionElement::kUint64, 1, 8,
                                     "21-bit offsets x, y, z from the batch's origin in one 64-bit word"};
+
+constexpr PositionLayout kTierWords{PositionElement::kUint32, 3, 4,
+                                    "three planes of tier words, 10 bits of x | y << 10 | z << 20 each", 3};
 
 constexpr PositionAttribute kFloatAttribute{0, VK_FORMAT_R32G32B32_SFLOAT, 0};
 constexpr PositionAttribute kLoAttribute{1, VK_FORMAT_R32G32B32_SFLOAT, 12};
@@ -306,7 +349,14 @@ constexpr ModeInfo kModes[] = {
     // The compute splat reads points in pairs that must share a batch: chunks start at even points.
     {PrecisionMode::kBatch, "batch", "per-batch double origins", 8, kBatchWord, true, false, false, false, kBatchSize, 2,
      {DPOINT_SPIRV(kPointsBatchVert), {}, DPOINT_SPIRV(kSplatBatchComp), {{0, VK_FORMAT_R32G32_UINT, 0}, kNone}, 1},
-     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{3, 3}, {1, 1}}},
+     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{3, 3}, {1, 1}}, kBatchSteps},
+    // Pulls its tier words in both backends (no attributes); chunks hold whole batches, so each
+    // 1024-point workgroup of the compute splat lies in one batch and loads 16 bytes a thread.
+    {PrecisionMode::kAdaptive, "adaptive", "per-batch tiers of 10 bits, as few as --tolerance allows", 12,
+     kTierWords, true, false, false, false, kBatchSize, kBatchSize,
+     {DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kSplatAdaptiveComp),
+      {kNone, kNone}, 0},
+     encodeAdaptiveTier, noUniform, worstOf<adaptiveBound>, nullptr, {{5, 5}, {5, 5}}, kAdaptiveSteps, kAdaptiveTiers},
 };
 static_assert(std::size(kModes) == kModeCount);
 

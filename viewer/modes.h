@@ -13,6 +13,10 @@
 //                                       extent; each offset coordinate a 21-bit integer (2^−20 of the
 //                                       extent per step), three in one 64-bit word; a float matrix built
 //                                       in double maps them to clip space
+//   adaptive  tier words (4, 8 or 12)   as batch, with 30-bit offsets (2^−29 of the extent) split into
+//                                       three planes of 10 bits an axis; per frame and batch, the
+//                                       fewest tiers whose bound is within --tolerance are loaded
+//                                       (viewer/batch_plan.h), and batches outside the view are skipped
 // Every mode adds 4 bytes of RGBA8 colour (the compute backend reads it only in the resolve).
 //
 // Adding a mode:
@@ -47,10 +51,11 @@
 
 namespace dpoint {
 
-enum class PrecisionMode { kFp32, kSplit, kRte, kDf64, kNative, kBatch };
+enum class PrecisionMode { kFp32, kSplit, kRte, kDf64, kNative, kBatch, kAdaptive };
 inline constexpr PrecisionMode kAllModes[] = {PrecisionMode::kFp32, PrecisionMode::kSplit,
                                               PrecisionMode::kRte,  PrecisionMode::kDf64,
-                                              PrecisionMode::kNative, PrecisionMode::kBatch};
+                                              PrecisionMode::kNative, PrecisionMode::kBatch,
+                                              PrecisionMode::kAdaptive};
 inline constexpr size_t kModeCount = std::size(kAllModes);
 inline size_t modeIndex(PrecisionMode mode) { return static_cast<size_t>(mode); }
 
@@ -80,13 +85,18 @@ struct SeenPoint;
 
 // What the position buffer holds per point: `elements` values of one type, each `element_bytes`
 // long and aligned (the buffer's alignment too).
-enum class PositionElement { kFloat32, kFloat64, kUint64 };
+enum class PositionElement { kFloat32, kFloat64, kUint32, kUint64 };
 struct PositionLayout {
   PositionElement element;
   uint32_t elements;
   uint32_t element_bytes;
   std::string_view what;  // e.g. "hi.xyz, lo.xyz floats", interleaved per point
+  // 1: the elements interleaved per point. More: each element in a plane of its own, one after the
+  // other in a chunk's buffer, each starting at a multiple of 16 bytes (planeStride).
+  uint32_t planes = 1;
 };
+// Elements of one plane of a chunk of `count` points: count rounded up to 4 (16-byte loads).
+inline size_t planeStride(size_t count) { return (count + 3) & ~size_t{3}; }
 
 // SPIR-V words compiled at build time (a header in the build tree per variant).
 struct Spirv {
@@ -108,9 +118,10 @@ struct ModeShaders {
 };
 
 // Writes `count` positions, p[0 .. count), in the mode's layout to `out` (count · position_bytes
-// bytes). first_index: the whole-set index of p[0] (per-batch modes look their batch up by it).
+// bytes; a planar layout: the `count` elements of plane `plane`). first_index: the whole-set index
+// of p[0] (per-batch modes look their batch up by it).
 using PositionEncoder = void (*)(const ModeEncoding& encoding, const glm::dvec3* p, size_t count, void* out,
-                                 size_t first_index);
+                                 size_t first_index, uint32_t plane);
 // The mode's uniform block (std140, as declared in shaders/render/project.glsl); empty when it has none.
 using UniformBuilder = std::vector<uint8_t> (*)(const ModeEncoding& encoding, const Camera& camera);
 // The largest squared per-point error bound in pixels over the points of a block the camera sees
@@ -144,6 +155,8 @@ struct ModeInfo {
   BoundFunction bound;
   BoundRefusal bound_refuses;
   SpeedRanks speed_rank;
+  double batch_steps = 0.0;  // per-batch modes: integer steps per batch extent (the offsets' resolution)
+  uint32_t tiers = 0;        // adaptive: the tiers a batch may load (planes of the layout); 0: all, always
 };
 const ModeInfo& modeInfo(PrecisionMode mode);
 
@@ -152,6 +165,12 @@ std::optional<PrecisionMode> parseMode(std::string_view name);
 
 // Bytes of position data per point (colour not included), and with the RGBA8 colour.
 inline uint32_t positionBytes(PrecisionMode mode) { return modeInfo(mode).position_bytes; }
+// Bytes of a chunk of `count` points' position buffer (planes padded to 16 bytes).
+inline size_t positionBufferBytes(PrecisionMode mode, size_t count) {
+  const PositionLayout& layout = modeInfo(mode).layout;
+  return layout.planes == 1 ? count * modeInfo(mode).position_bytes
+                            : layout.planes * planeStride(count) * layout.element_bytes;
+}
 inline uint32_t bytesPerPoint(PrecisionMode mode) { return positionBytes(mode) + 4; }
 
 // Fastest first; modes without a rank (split: fp32's bound at a higher cost) never appear.
@@ -159,7 +178,7 @@ inline uint32_t bytesPerPoint(PrecisionMode mode) { return positionBytes(mode) +
 std::span<const PrecisionMode> measuredSpeedOrder(DeviceClass device_class, bool compute_backend);
 
 // `dpoint render --mode`: the values it takes ("auto" then every mode's name), the text an error
-// lists them with ("auto, fp32, split, rte, df64, native or batch"), and its --help text.
+// lists them with ("auto, fp32, split, rte, df64, native, batch or adaptive"), and its --help text.
 std::vector<std::string> modeOptionNames();
 std::string modeOptionChoices();
 std::string modeOptionHelp();

@@ -212,14 +212,18 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
   if (!render_pass) return fail(render_pass.error());
   p.render_pass = *render_pass;
 
-  VkDescriptorSetLayoutBinding bindings[4] = {
+  // Binding 4 is the compute backend's visibility buffer: unused here, kept so the bindings run
+  // 0 to 5 as in the compute set (descriptors are written in binding order).
+  VkDescriptorSetLayoutBinding bindings[6] = {
       {kBindingCamera, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
       {kBindingPositions, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
       {kBindingBatches, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
       {kBindingProbe, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+      {kBindingVisibility, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+      {kBindingBatchPlan, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
   };
   VkDescriptorSetLayoutCreateInfo set_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  set_info.bindingCount = 4;
+  set_info.bindingCount = 6;
   set_info.pBindings = bindings;
   VkResult result = vkCreateDescriptorSetLayout(context.device, &set_info, nullptr, &p.set_layout);
   if (result != VK_SUCCESS) return fail(vulkanError("vkCreateDescriptorSetLayout", result));
@@ -255,7 +259,8 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
   };
   Result<VkDescriptorSetLayout> splat_set = storageSetLayout(context, {
       {kBindingCamera, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-      storage(kBindingPositions), storage(kBindingBatches), storage(kBindingProbe), storage(kBindingVisibility)});
+      storage(kBindingPositions), storage(kBindingBatches), storage(kBindingProbe), storage(kBindingVisibility),
+      storage(kBindingBatchPlan)});
   if (!splat_set) return fail(splat_set.error());
   p.splat_set = *splat_set;
   Result<VkDescriptorSetLayout> resolve_set = storageSetLayout(context, {storage(0), storage(1), storage(2), storage(3)});

@@ -16,9 +16,11 @@ inline constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
 // Descriptor bindings shared by every mode (shaders/render/project.glsl): 0 camera uniform,
-// 1 positions (the compute backend's in every mode; the raster backend's only for native mode
-// pulling doubles from a storage buffer), 2 batch matrices, 3 probe output.
-inline constexpr uint32_t kBindingCamera = 0, kBindingPositions = 1, kBindingBatches = 2, kBindingProbe = 3;
+// 1 positions (the compute backend's in every mode; the raster backend's for the modes that pull
+// them from a storage buffer), 2 batch matrices, 3 probe output, 5 the batch plan (per-batch modes:
+// the raster backend's tiers per batch, the compute backend's list of batches to splat).
+inline constexpr uint32_t kBindingCamera = 0, kBindingPositions = 1, kBindingBatches = 2, kBindingProbe = 3,
+                          kBindingBatchPlan = 5;
 
 // Push constants of shaders/render/project.glsl (both backends).
 struct PushConstants {
@@ -26,7 +28,9 @@ struct PushConstants {
   float point_size = 1.0f;
   uint32_t first_index = 0;  // index of the draw's first point in the whole set
   uint32_t batch_shift = kBatchShift;  // log2(kBatchSize): a point's batch is index >> batch_shift
-  uint32_t width = 0, height = 0, count = 0;  // compute backend
+  uint32_t width = 0, height = 0;  // compute backend
+  uint32_t count = 0;       // points in the chunk
+  uint32_t list_first = 0;  // compute backend, per-batch modes: the chunk's first batch-list entry
 };
 
 // Descriptor bindings of the compute backend beyond the shared four: 4 the visibility buffer

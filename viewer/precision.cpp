@@ -49,7 +49,7 @@ inline bool withinLimit(const glm::dvec3& v, double limit) {
   return std::fabs(v.x) <= limit && std::fabs(v.y) <= limit && std::fabs(v.z) <= limit;
 }
 
-Pass makePass(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes) {
+Pass makePass(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes, double tolerance_px) {
   Pass pass;
   Setup& s = pass.setup;
   s.frame = sceneFrame(camera);
@@ -69,7 +69,7 @@ Pass makePass(const PointSet& points, const Camera& camera, std::span<const Prec
       addPositionCheck(pass.checks, mode);
       continue;
     }
-    Result<ModeEncoding> encoding = prepareEncoding(mode, points, camera);
+    Result<ModeEncoding> encoding = prepareEncoding(mode, points, camera, tolerance_px);
     if (!encoding) {
       s.unbounded[i] = true;  // the mode refuses the set: nothing reaches the picture
       continue;
@@ -81,16 +81,8 @@ Pass makePass(const PointSet& points, const Camera& camera, std::span<const Prec
     if (refuses && refuses(s)) s.unbounded[modeIndex(mode)] = true;
   }
   for (ModeState& own : pass.own) {
-    for (size_t b = 0; b < own.encoding.batches.size(); ++b) {
-      const glm::dvec3 relative = own.encoding.batches[b].origin - s.frame.eye;
-      Vec4 error{};
-      for (int r = 0; r < 4; ++r) {
-        double sum = std::fabs(s.frame.projection_rotation[3][r]);
-        for (int c = 0; c < 3; ++c) sum += std::fabs(s.frame.projection_rotation[c][r] * relative[c]);
-        error[static_cast<size_t>(r)] = 4.0 * kUd * sum;
-      }
-      own.batch_translation_error.push_back(error);
-    }
+    for (const BatchFrame& batch : own.encoding.batches)
+      own.batch_translation_error.push_back(batchTranslationError(s.frame, batch.origin));
     for (const glm::dmat4& m : own.encoding.batch_matrices) own.batch_rows.push_back(floatRows(m));
   }
   return pass;
@@ -98,8 +90,9 @@ Pass makePass(const PointSet& points, const Camera& camera, std::span<const Prec
 
 }  // namespace
 
-ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes) {
-  const Pass pass = makePass(points, camera, modes);
+ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes,
+                               double tolerance_px) {
+  const Pass pass = makePass(points, camera, modes, tolerance_px);
   const Setup& s = pass.setup;
   std::vector<size_t> bounded;  // the wanted modes whose bounds the points decide
   for (size_t m = 0; m < kModeCount; ++m)
@@ -164,12 +157,12 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
 }
 
 ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> order,
-                      const std::function<bool(PrecisionMode)>& usable) {
+                      const std::function<bool(PrecisionMode)>& usable, double tolerance_px) {
   ModeChoice choice;
   // One pass over the points for all of `modes`: a point is read and projected once, whichever
   // modes are bounded (each mode's bound is the same to the bit as from a pass of its own).
   auto compute = [&](std::span<const PrecisionMode> modes) {
-    const ErrorBounds b = predictErrorBounds(points, camera, modes);
+    const ErrorBounds b = predictErrorBounds(points, camera, modes, tolerance_px);
     for (PrecisionMode mode : modes) {
       choice.bounds.px[modeIndex(mode)] = b.px[modeIndex(mode)];
       choice.bounds.computed[modeIndex(mode)] = true;

@@ -38,7 +38,9 @@ struct ErrorBounds {
 };
 
 // Bounds of the modes in `modes` (all when empty). One pass over the points per call, on all cores.
-ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes = {});
+// tolerance_px: adaptive mode's (its tier choice, viewer/batch_plan.h, which its bound follows).
+ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes = {},
+                               double tolerance_px = kDefaultTolerancePx);
 
 // --mode auto (DESIGN §4): the fastest mode on this kind of device whose bound is ≤ kAutoBoundPx.
 inline constexpr double kAutoBoundPx = 0.1;
@@ -66,7 +68,7 @@ struct ModeChoice {
 // bound) with enough = false. Bounds are computed only for the modes it looks at, those it is sure
 // to look at together in one pass (the next two usable modes before its choice, one after it).
 ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> order,
-                      const std::function<bool(PrecisionMode)>& usable);
+                      const std::function<bool(PrecisionMode)>& usable, double tolerance_px = kDefaultTolerancePx);
 
 // "1.5e-05 px", "unbounded" for +inf.
 std::string formatBound(double px);

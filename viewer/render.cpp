@@ -29,6 +29,7 @@ double msSince(Clock::time_point start) {
 size_t chunkPoints(const DeviceFacts& facts, const RenderOptions& options, bool pulled) {
   uint64_t limit = uint64_t{1} << 30;
   if (facts.max_memory_allocation) limit = std::min(limit, facts.max_memory_allocation);
+  limit -= 64;  // a planar layout pads each plane to 16 bytes
   uint64_t per_point = std::max<uint64_t>(positionBytes(options.mode), 4);
   if (pulled || options.probe) {
     limit = std::min(limit, facts.max_storage_buffer_range);
@@ -108,11 +109,13 @@ Status checkMode(const VulkanContext& context, const RenderOptions& options) {
 
 void writeDescriptors(const VulkanContext& context, const Resources& r, const Chunk& chunk, bool pulled, bool probe) {
   auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
-  VkDescriptorBufferInfo infos[4] = {
+  VkDescriptorBufferInfo infos[6] = {
       whole(r.camera),
       pulled ? whole(chunk.positions) : whole(r.dummy),
       r.batches.buffer ? whole(r.batches) : whole(r.dummy),
       probe ? whole(chunk.probe) : whole(r.dummy),
+      whole(r.dummy),  // the compute backend's visibility
+      r.batch_plan.buffer ? whole(r.batch_plan) : whole(r.dummy),
   };
   static_assert(kBindingCamera == 0, "the camera uniform is binding 0");
   writeBufferDescriptors(context, chunk.set, infos, true);
@@ -138,6 +141,7 @@ void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeli
     PushConstants push;
     push.point_size = options.point_size;
     push.first_index = static_cast<uint32_t>(chunk.first);
+    push.count = static_cast<uint32_t>(chunk.count);
     vkCmdPushConstants(commands, r.pipelines.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, r.pipelines.layout, 0, 1, &chunk.set, 0, nullptr);
     VkDeviceSize offset = 0;
@@ -160,6 +164,7 @@ using ChunkPoints = std::function<Result<BlockView>(size_t first, size_t count)>
 Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, const ChunkPoints& chunk_points,
                     const RenderOptions& options, const ModeEncoding& encoding, bool pulled, size_t per_chunk) {
   const uint32_t stride = positionBytes(options.mode);
+  const PositionLayout& layout = modeInfo(options.mode).layout;
   const bool compute = options.backend == Backend::kCompute;
   VkBufferUsageFlags position_usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
       (pulled || compute ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
@@ -188,13 +193,27 @@ Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, co
     Result<BlockView> view = chunk_points(chunk.first, chunk.count);
     if (!view) return view.error();
     std::string what = "points " + std::to_string(first) + ".." + std::to_string(first + chunk.count - 1);
-    if (Status status = create(chunk.positions, chunk.count * stride, position_usage, what + " positions"); !status)
+    if (Status status = create(chunk.positions, positionBufferBytes(options.mode, chunk.count), position_usage,
+                               what + " positions");
+        !status)
       return status;
-    Status status = uploadBuffer(context, chunk.positions, chunk.count * stride,
-        [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-          encodePositions(encoding, *view->set, view->offset + offset / stride, bytes / stride, dst,
-                          chunk.first - view->offset);
-        }, stride);
+    Status status = okStatus();
+    if (layout.planes == 1) {
+      status = uploadBuffer(context, chunk.positions, chunk.count * stride,
+          [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+            encodePositions(encoding, *view->set, view->offset + offset / stride, bytes / stride, dst,
+                            chunk.first - view->offset);
+          }, stride);
+    }
+    // A planar layout: each plane's elements of the chunk's points, one plane after another.
+    const VkDeviceSize element = layout.element_bytes, plane_bytes = planeStride(chunk.count) * element;
+    for (uint32_t plane = 0; plane < layout.planes && layout.planes > 1 && status; ++plane) {
+      status = uploadBuffer(context, chunk.positions, chunk.count * element,
+          [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
+            encodePositions(encoding, *view->set, view->offset + offset / element, bytes / element, dst,
+                            chunk.first - view->offset, plane);
+          }, element, VkDeviceSize{32} << 20, plane * plane_bytes);
+    }
     if (!status) return status;
     if (compute) {
       status = upload_colors(r.all_colors, *view, chunk.count, VkDeviceSize{chunk.first} * 4);
@@ -241,7 +260,7 @@ Status createTargets(const VulkanContext& context, Resources& r, uint32_t width,
 
 Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
   const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.log ? 1 : 0);
-  if (Status status = detail::createDescriptorPool(context, r, sets, 3); !status)
+  if (Status status = detail::createDescriptorPool(context, r, sets, 5); !status)
     return status;
   for (Chunk& chunk : r.chunks) {
     VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -271,22 +290,45 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
   return okStatus();
 }
 
-// Batch mode's matrices, once every batch is known (a stream appends them block by block).
+// What the plan's buffer holds (binding 5): for the raster backend the tiers of every batch (0:
+// culled), for the compute backend each chunk's list of the batches it overlaps that the plan
+// keeps, batch | tiers << 30 (setting the chunks' list_first and list_count).
+std::vector<uint32_t> batchPlanWords(Resources& r, const ModeEncoding& encoding, bool compute) {
+  std::vector<uint32_t> words;
+  if (!compute) {
+    words.assign(encoding.batch_plan.begin(), encoding.batch_plan.end());
+    return words;
+  }
+  for (detail::Chunk& chunk : r.chunks) {
+    chunk.list_first = static_cast<uint32_t>(words.size());
+    const size_t first = chunk.first / kBatchSize, last = (chunk.first + chunk.count - 1) / kBatchSize;
+    for (size_t b = first; b <= last; ++b)
+      if (const uint32_t tiers = encoding.batch_plan[b]) words.push_back(static_cast<uint32_t>(b) | tiers << 30);
+    chunk.list_count = static_cast<uint32_t>(words.size()) - chunk.list_first;
+  }
+  return words;
+}
+
+// The per-batch modes' matrices and plan, once every batch is known (a stream appends them block
+// by block).
 Status uploadBatchMatrices(const VulkanContext& context, Resources& r, const RenderOptions& options,
                            const ModeEncoding& encoding) {
-  if (modeInfo(options.mode).batch_points) {
-    std::vector<glm::mat4> matrices = batchMatrices(encoding);
-    VkDeviceSize bytes = matrices.size() * sizeof(glm::mat4);
-    Result<Buffer> batches = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                          false, "batch matrices");
-    if (!batches) return batches.error();
-    r.batches = *batches;
-    Status status = uploadBuffer(context, r.batches, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize n) {
-      std::memcpy(dst, reinterpret_cast<const uint8_t*>(matrices.data()) + offset, n);
+  if (!modeInfo(options.mode).batch_points) return okStatus();
+  auto upload = [&](Buffer& out, const void* data, VkDeviceSize bytes, const std::string& what) -> Status {
+    Result<Buffer> buffer = createBuffer(context, std::max<VkDeviceSize>(bytes, 16),
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, what);
+    if (!buffer) return buffer.error();
+    out = *buffer;
+    if (bytes == 0) return okStatus();
+    return uploadBuffer(context, out, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize n) {
+      std::memcpy(dst, static_cast<const uint8_t*>(data) + offset, n);
     });
-    if (!status) return status;
-  }
-  return okStatus();
+  };
+  const std::vector<glm::mat4> matrices = batchMatrices(encoding);
+  if (Status status = upload(r.batches, matrices.data(), matrices.size() * sizeof(glm::mat4), "batch matrices"); !status)
+    return status;
+  const std::vector<uint32_t> plan = batchPlanWords(r, encoding, options.backend == Backend::kCompute);
+  return upload(r.batch_plan, plan.data(), plan.size() * sizeof(uint32_t), "batch plan");
 }
 
 Status timeFrames(const VulkanContext& context, Resources& r, const RenderOptions& options, const Camera& camera,
@@ -397,10 +439,11 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
                                   std::chrono::steady_clock::time_point upload_start, uint64_t max_chunk_points) {
   const bool compute = options.backend == Backend::kCompute;
   const bool shading = options.shading == Shading::kEdl;
-  // Positions come from a storage buffer in the compute backend, and for native mode on a device
-  // without double vertex attributes.
-  bool pulled = modeInfo(options.mode).shaders.vertex_pull.code != nullptr &&
-                (compute || options.native_path == NativePath::kPull ||
+  // Positions come from a storage buffer in the compute backend, for native mode on a device
+  // without double vertex attributes, and always for a mode with no vertex attributes (adaptive).
+  const ModeShaders& shaders = modeInfo(options.mode).shaders;
+  bool pulled = shaders.vertex_pull.code != nullptr &&
+                (compute || shaders.attribute_count == 0 || options.native_path == NativePath::kPull ||
                  (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
   Resources r(context);
   // The driver compiles the pipelines while the points are encoded and uploaded: on NVIDIA's a
@@ -445,6 +488,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   if (!shade) return shade.error();
   out.chunks = static_cast<uint32_t>(r.chunks.size());
   out.gpu_bytes = uint64_t{bytesPerPoint(options.mode)} * total;
+  if (modeInfo(options.mode).batch_points) out.batch_plan = batchPlanStats(encoding, total);
   out.upload_ms = msSince(upload_start);
 
   if (compute) {
@@ -531,7 +575,7 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();
-  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera);
+  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera, options.tolerance_px);
   if (!encoding) return encoding.error();
   return renderChunks(context, points.size(),
                       [&](size_t first, size_t) -> Result<BlockView> { return BlockView{&points, first}; }, *encoding,
@@ -545,7 +589,7 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();
-  ModeEncoding encoding = beginEncoding(options.mode, camera);
+  ModeEncoding encoding = beginEncoding(options.mode, camera, options.tolerance_px);
   StreamBlocks blocks(stream, encoding);
   // Whole batches per block, so batch mode's frames line up with the chunks.
   uint64_t limit = options.max_chunk_points ? std::min<uint64_t>(options.max_chunk_points, kStreamBlockPoints)
@@ -557,12 +601,13 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                      Backend backend, bool probe) {
+                                      Backend backend, bool probe, double tolerance_px) {
   Result<SelfTest> self_test = runPrecisionSelfTest(context);
   if (!self_test) return self_test.error();
   const bool compute = backend == Backend::kCompute;
   auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
-  ModeChoice choice = chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable);
+  ModeChoice choice =
+      chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable, tolerance_px);
   for (ModeChoice::Rejected& r : choice.rejected)
     if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
   return choice;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "core/point_set.h"
 #include "viewer/camera.h"
 #include "vulkan/context.h"
+#include "viewer/batch_plan.h"
 #include "viewer/encode.h"
 #include "viewer/precision.h"
 #include "viewer/reference.h"
@@ -54,6 +56,8 @@ struct RenderOptions {
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
   uint64_t max_chunk_points = 0;
+  // Adaptive mode: the error in window pixels its tier choice keeps within (--tolerance).
+  double tolerance_px = kDefaultTolerancePx;
   // After the frame, outside its timestamps (gpu_ms times the points alone, in every shading).
   Shading shading = Shading::kNone;
   EdlOptions edl;
@@ -69,6 +73,8 @@ struct RenderResult {
   uint32_t chunks = 0;
   bool pulled_positions = false;   // native mode read positions from a storage buffer
   uint64_t gpu_bytes = 0;          // point data on the GPU (positions + colours)
+  // Per-batch modes: what the frame's plan loads (batches culled, at each tier, bytes per point).
+  std::optional<BatchPlanStats> batch_plan;
 };
 
 // Fails with kBadInput when the set is empty or a position does not fit the mode's encoding,
@@ -102,7 +108,7 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 // class and backend, restricted to the modes the device runs (features, the emulation
 // self-test, and with `probe` the probe's needs).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                      Backend backend, bool probe);
+                                      Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx);
 
 // Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
 double medianOf(std::vector<double> values);

@@ -38,7 +38,7 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   // One splat set per chunk (camera, positions, batches, probe, visibility), the resolve set
   // (visibility, colours, picture, depth) and with eye-dome lighting its set.
   const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.log ? 1 : 0);
-  if (Status status = createDescriptorPool(context, r, sets, 4); !status) return status;
+  if (Status status = createDescriptorPool(context, r, sets, 5); !status) return status;
   auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
   auto allocate = [&](VkDescriptorSetLayout layout, VkDescriptorSet& set) -> Status {
     VkDescriptorSetAllocateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -54,7 +54,8 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   for (Chunk& chunk : r.chunks) {
     if (Status status = allocate(r.compute.splat_set, chunk.set); !status) return status;
     write(chunk.set, {whole(r.camera), whole(chunk.positions), r.batches.buffer ? whole(r.batches) : whole(r.dummy),
-                      probe ? whole(chunk.probe) : whole(r.dummy), whole(r.visibility)}, true);
+                      probe ? whole(chunk.probe) : whole(r.dummy), whole(r.visibility),
+                      r.batch_plan.buffer ? whole(r.batch_plan) : whole(r.dummy)}, true);
   }
   if (Status status = allocate(r.compute.resolve_set, r.resolve_set); !status) return status;
   write(r.resolve_set, {whole(r.visibility), whole(r.all_colors), whole(r.picture),
@@ -80,16 +81,22 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
           VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, splat);
+  const bool listed = modeInfo(options.mode).batch_points != 0;  // splats the plan's batch list
+  static_assert(kBatchSize % kSplatPointsPerGroup == 0, "a splat workgroup lies in one batch");
   for (const Chunk& chunk : r.chunks) {
+    const uint32_t groups = listed ? chunk.list_count * (kBatchSize / kSplatPointsPerGroup)
+                                   : static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup);
+    if (groups == 0) continue;  // every batch of the chunk culled
     PushConstants push;
     push.point_size = options.point_size;
     push.first_index = static_cast<uint32_t>(chunk.first);
     push.width = width;
     push.height = height;
     push.count = static_cast<uint32_t>(chunk.count);
+    push.list_first = chunk.list_first;
     vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
-    vkCmdDispatch(commands, static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup), 1, 1);
+    vkCmdDispatch(commands, groups, 1, 1);
   }
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);

@@ -12,6 +12,9 @@ namespace dpoint::detail {
 
 struct Chunk {
   size_t first = 0, count = 0;
+  // Compute backend, per-batch modes: the chunk's entries of the batch list (batches it overlaps
+  // that the plan did not cull).
+  uint32_t list_first = 0, list_count = 0;
   Buffer positions, colors, probe;
   VkDescriptorSet set = VK_NULL_HANDLE;
 };
@@ -34,6 +37,7 @@ struct Resources {
     }
     destroyBuffer(context, camera);
     destroyBuffer(context, batches);
+    destroyBuffer(context, batch_plan);
     destroyBuffer(context, dummy);
     destroyBuffer(context, readback);
     destroyBuffer(context, all_colors);
@@ -55,7 +59,7 @@ struct Resources {
   }
   const VulkanContext& context;
   PointPipelines pipelines;
-  Buffer camera, batches, dummy, readback;
+  Buffer camera, batches, batch_plan, dummy, readback;
   GpuImage color, depth;
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;

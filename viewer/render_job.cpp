@@ -180,15 +180,15 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   if (request.mode != "auto") {
     p.mode = *parseMode(request.mode);
     const PrecisionMode one[] = {p.mode};
-    p.bound_px = predictErrorBounds(points, camera, one).px[modeIndex(p.mode)];
+    p.bound_px = predictErrorBounds(points, camera, one, request.tolerance_px).px[modeIndex(p.mode)];
     if (!(p.bound_px <= kWrongBoundPx)) {  // a wrong picture: name the mode auto would take
-      Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error);
+      Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error, request.tolerance_px);
       if (!choice) return choice.error();
       p.warning = predictionWarning(request, p, choice->mode);
     }
     return p;
   }
-  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error);
+  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error, request.tolerance_px);
   if (!choice) return choice.error();
   p.mode = choice->mode;
   p.bound_px = choice->bound_px;
@@ -217,6 +217,7 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   options.background_rgba8 = request.background_rgba8;
   options.frames = request.frames;
   options.warmup_frames = request.warmup;
+  options.tolerance_px = request.tolerance_px;
   options.probe = request.error;
   options.native_path = request.native_path;
   options.max_chunk_points = request.chunk_points;
@@ -630,6 +631,23 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   o.add("phases_ms", phases).add("peak_rss_mb", V::number(peakRssMb()));
   o.add("points_per_s", V::number(static_cast<double>(outcome.points) / (per_frame_ms * 1e-3)));
   o.add("bytes_per_point", V::integer(bytesPerPoint(mode))).add("chunks", V::integer(r.chunks));
+  // The per-batch modes' plan for this view: what the frame loaded (position bytes per point of
+  // the whole set; colours are read per pixel by the resolve), the batches it culled and, in
+  // adaptive mode, the share of batches at each tier count and the tolerance it chose them for.
+  if (const std::optional<BatchPlanStats>& plan = r.batch_plan) {
+    const double batches = static_cast<double>(std::max<size_t>(plan->batches, 1));
+    JsonObject p;
+    p.add("batches", V::integer(plan->batches)).add("culled", V::integer(plan->culled));
+    p.add("loaded_bytes_per_point", V::number(plan->bytes_per_point));
+    if (modeInfo(mode).tiers) {
+      std::vector<double> shares;
+      for (size_t count : plan->at_tiers) shares.push_back(static_cast<double>(count) / batches);
+      p.add("tier_share", V::numbers(shares)).add("tolerance_px", V::number(request.tolerance_px));
+    }
+    o.add("batch_plan", p);
+  } else {
+    o.add("batch_plan", V::null());
+  }
   // Only a mode with two raster paths (vertex input or pulling from a storage buffer) says which ran.
   const bool two_paths = modeInfo(mode).shaders.vertex_pull.code != nullptr;
   o.add("native_path", !two_paths ? V::null() : V::string(r.pulled_positions ? "pull" : "attribute"));

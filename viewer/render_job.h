@@ -60,6 +60,7 @@ struct RenderRequest {
   bool error = false;                // measure the error against the exact CPU reference
   bool report = false;               // a report (renderReportJson) is wanted: one view only
   uint32_t frames = 1, warmup = 1;
+  double tolerance_px = kDefaultTolerancePx;  // adaptive mode's tier choice (--tolerance)
   uint64_t chunk_points = 0;         // most points per draw; 0: as the device allows
   NativePath native_path = NativePath::kAuto;
   std::string stream = "auto";       // auto|on|off (openPointStream)

@@ -24,11 +24,22 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { double position
 // The same buffer seen as single points and as pairs of points (16-byte loads).
 layout(std430, set = 0, binding = 1) readonly buffer Positions { uvec2 positions[]; };
 layout(std430, set = 0, binding = 1) readonly buffer PositionPairs { uvec4 position_pairs[]; };
+#elif defined(MODE_ADAPTIVE)
+// Three planes of tier words (viewer/modes.h, planeStride), seen as words and as 16-byte groups.
+layout(std430, set = 0, binding = 1) readonly buffer Positions { uint words[]; };
+layout(std430, set = 0, binding = 1) readonly buffer PositionQuads { uvec4 word_quads[]; };
 #else
 layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
 #endif
 
-#if !defined(MODE_BATCH)
+#if defined(MODE_BATCH) || defined(MODE_ADAPTIVE)
+// The batches of this frame's plan (viewer/batch_plan.h) that can show a point, this chunk's from
+// list_first on: batch index | tiers << 30. A workgroup splats a quarter of one listed batch, so a
+// culled batch is never dispatched and costs nothing.
+layout(std430, set = 0, binding = 5) readonly buffer BatchList { uint batch_list[]; };
+#endif
+
+#if !defined(MODE_BATCH) && !defined(MODE_ADAPTIVE)
 // Clip position of point i of this dispatch (batch mode: main, with the thread's matrix).
 vec4 clipOf(uint i) {
   PointInput point;
@@ -86,21 +97,54 @@ void splat(uint i, vec4 clip) {
 // keeps as many bytes in flight as fp32 mode does (batch 16.7M points on the H100: 0.120 ms with
 // 8-byte loads, 0.095 ms with 16-byte ones). Every load is coalesced either way.
 void main() {
+#if defined(MODE_BATCH) || defined(MODE_ADAPTIVE)
+  // This workgroup's batch and quarter of it; its first point relative to the chunk (negative
+  // where a test's small chunks start inside a batch). The matrix is loaded once for all of a
+  // thread's points: 64 B of matrix for every 8 B point had made batch mode slower than fp32.
+  const uint kGroupShift = 10u;  // log2(kPointsPerThread · 256)
+  uint entry = batch_list[pc.list_first + (gl_WorkGroupID.x >> (pc.batch_shift - kGroupShift))];
+  uint batch = entry & 0x3FFFFFFFu;
+  uint part = gl_WorkGroupID.x & ((1u << (pc.batch_shift - kGroupShift)) - 1u);
+  int group_first = int((batch << pc.batch_shift) + (part << kGroupShift)) - int(pc.first_index);
+  mat4 matrix = batch_mvp[batch];
+#else
   uint group_first = gl_WorkGroupID.x * (kPointsPerThread * gl_WorkGroupSize.x);
-#if defined(MODE_BATCH)
-  // A thread's points nearly always share one batch (4096 points; chunks are cut at whole batches
-  // outside tests), so its matrix is loaded again only when the batch changes: 64 B of matrix for
-  // every 8 B point had made batch mode slower than fp32 on lavapipe and no faster on the H100.
-  uint batch = 0xffffffffu;
-  mat4 matrix;
-  for (uint k = 0u; k < kPointsPerThread / 2u; ++k) {
-    uint i = group_first + 2u * (gl_LocalInvocationID.x + k * gl_WorkGroupSize.x);
-    if (i >= pc.count) break;
-    uint index = pc.first_index + i;
-    if (index >> pc.batch_shift != batch) {
-      batch = index >> pc.batch_shift;
-      matrix = batch_mvp[batch];
+#endif
+#if defined(MODE_ADAPTIVE)
+  // Chunks hold whole batches, so group_first ≥ 0 and a multiple of 4: thread t splats points
+  // 4t .. 4t + 3 of the group with one 16-byte load per tier loaded (its batch's plan).
+  uint tiers = entry >> 30;
+  uint stride = (pc.count + 3u) & ~3u;
+  uint i = uint(group_first) + 4u * gl_LocalInvocationID.x;
+  if (i >= pc.count) return;
+  if (i + 3u < pc.count) {
+    uvec4 coarse = word_quads[i >> 2];
+    vec3 offsets[4];
+    if (tiers == 1u) {
+      for (int n = 0; n < 4; ++n) offsets[n] = rebuildTiers1(coarse[n]);
+    } else if (tiers == 2u) {
+      uvec4 medium = word_quads[(stride + i) >> 2];
+      for (int n = 0; n < 4; ++n) offsets[n] = rebuildTiers2(coarse[n], medium[n]);
+    } else {
+      uvec4 medium = word_quads[(stride + i) >> 2];
+      uvec4 fine = word_quads[(2u * stride + i) >> 2];
+      for (int n = 0; n < 4; ++n) offsets[n] = rebuildTiers3(coarse[n], medium[n], fine[n]);
     }
+    for (uint n = 0u; n < 4u; ++n) splat(i + n, projectBatchOffset(offsets[n], matrix));
+  } else {  // the chunk's last points: a 16-byte load would read past them
+    for (uint j = i; j < pc.count; ++j) {
+      vec3 offset = tiers == 1u ? rebuildTiers1(words[j])
+                  : tiers == 2u ? rebuildTiers2(words[j], words[stride + j])
+                                : rebuildTiers3(words[j], words[stride + j], words[2u * stride + j]);
+      splat(j, projectBatchOffset(offset, matrix));
+    }
+  }
+#elif defined(MODE_BATCH)
+  for (uint k = 0u; k < kPointsPerThread / 2u; ++k) {
+    int first = group_first + int(2u * (gl_LocalInvocationID.x + k * gl_WorkGroupSize.x));
+    if (first < 0) continue;
+    uint i = uint(first);
+    if (i >= pc.count) break;
     if (i + 1u < pc.count) {
       uvec4 pair = position_pairs[i >> 1];
       // index is even (chunks start at even points in batch mode: viewer/render.cpp's chunkPoints),

@@ -3,14 +3,15 @@
 // Every mode but fp32 and split works in the scene frame (viewer/encode.h): positions, eye and
 // matrices arrive scaled by a power of two so no intermediate leaves float's range.
 // The mode is a define: MODE_FP32, MODE_SPLIT, MODE_RTE, MODE_DF64, MODE_NATIVE_ATTR,
-// MODE_NATIVE_PULL (native reading a storage buffer) or MODE_BATCH.
+// MODE_NATIVE_PULL (native reading a storage buffer), MODE_BATCH or MODE_ADAPTIVE.
 
 layout(push_constant) uniform Push {
   float splitter;    // 2^12 + 1, at run time so the split cannot be folded
   float point_size;
   uint first_index;  // index of this draw's first point in the whole set (batch mode, compute)
   uint batch_shift;  // log2 of the points per batch
-  uint width, height, count;  // compute backend: target size, points in this dispatch
+  uint width, height, count;  // compute backend: target size; points in this chunk (both backends)
+  uint list_first;  // compute backend, per-batch modes: this chunk's first entry of the batch list
 } pc;
 
 #if defined(MODE_FP32) || defined(MODE_SPLIT)
@@ -22,7 +23,7 @@ layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 projection_rotat
 layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 mvp_hi; mat4 mvp_lo; } cam;
 #elif defined(MODE_NATIVE_ATTR) || defined(MODE_NATIVE_PULL)
 layout(std140, set = 0, binding = 0) uniform CameraBlock { dmat4 projection_rotation; dvec4 eye; } cam;
-#elif defined(MODE_BATCH)
+#elif defined(MODE_BATCH) || defined(MODE_ADAPTIVE)
 layout(std430, set = 0, binding = 2) readonly buffer Batches { mat4 batch_mvp[]; };
 // A point's offset in its batch (viewer/encode.h): three 21-bit two's-complement integers in one
 // 64-bit word, x in bits 0–20, y in 21–41, z in 42–62; each is exact as a float.
@@ -40,12 +41,27 @@ vec3 unpackOffset(uvec2 word) {
 // Offsets are integers in the batch's box; the matrix carries origin, extent and 2^−20. The
 // compute splat calls this directly with a matrix it loads once for all of a thread's points.
 vec4 projectBatchOffset(vec3 offset, mat4 batch) { return batch * vec4(offset, 1.0); }
+#if defined(MODE_ADAPTIVE)
+// Adaptive mode (viewer/encode.h): a tier word holds 10 bits of x | y << 10 | z << 20 of the 30-bit
+// q = round(t·2^29) + 2^29. With fewer than three tiers loaded, q is rebuilt as the centre of the
+// cell its loaded bits name; the batch matrix takes q − 2^29 (in steps of 2^−29 of the extent) to
+// clip space. One or two tiers give at most 21 significant bits, which convert to float exactly.
+uvec3 tierFields(uint word) { return uvec3(word, word >> 10, word >> 20) & 1023u; }
+vec3 adaptiveOffset(uvec3 q) { return vec3(ivec3(q) - (1 << 29)); }
+vec3 rebuildTiers1(uint coarse) { return adaptiveOffset((tierFields(coarse) << 20) | (1u << 19)); }
+vec3 rebuildTiers2(uint coarse, uint medium) {
+  return adaptiveOffset((tierFields(coarse) << 20) | (tierFields(medium) << 10) | (1u << 9));
+}
+vec3 rebuildTiers3(uint coarse, uint medium, uint fine) {
+  return adaptiveOffset((tierFields(coarse) << 20) | (tierFields(medium) << 10) | tierFields(fine));
+}
+#endif
 #else
 #error "no MODE_* defined"
 #endif
 
 // What one point carries, per mode.
-#if defined(MODE_FP32) || defined(MODE_BATCH)
+#if defined(MODE_FP32) || defined(MODE_BATCH) || defined(MODE_ADAPTIVE)
 struct PointInput { vec3 position; };
 #elif defined(MODE_SPLIT) || defined(MODE_RTE) || defined(MODE_DF64)
 struct PointInput { vec3 hi; vec3 lo; };
@@ -84,7 +100,7 @@ vec4 projectPoint(PointInput point, uint index) {
   // final clip position is rounded to float.
   dvec3 relative = point.position - cam.eye.xyz;
   return vec4(cam.projection_rotation * dvec4(relative, 1.0));
-#elif defined(MODE_BATCH)
+#elif defined(MODE_BATCH) || defined(MODE_ADAPTIVE)
   return projectBatchOffset(point.position, batch_mvp[index >> pc.batch_shift]);
 #endif
 }

@@ -55,41 +55,41 @@ std::vector<std::string> failedModes(const BenchRun& run) {
 
 TEST(BenchReport, checksPassARunThatBehavesAsDesignSays) {
   // fp32 far off, every double mode near the float floor, native best.
-  BenchRun run = madeUpRun({30, 30, 2e-5, 3e-5, 1e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5});
+  BenchRun run = madeUpRun({30, 30, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
   EXPECT_TRUE(checkRun(run).empty());
 }
 
 TEST(BenchReport, checksCatchAnErrorAboveItsBound) {
-  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-4, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-4, 3e-5, 1e-5, 2e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
   EXPECT_EQ(failedModes(run), std::vector<std::string>{"rte"});
 }
 
 TEST(BenchReport, checksCatchEveryPointLostUnderASmallBound) {
-  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-5, kLost, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 0.01, 2e-5, 5e-5});
+  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-5, kLost, 1e-5, 2e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 0.01, 2e-5, 5e-5, 5e-5});
   const std::vector<std::string> failed = failedModes(run);
   EXPECT_EQ(std::set<std::string>(failed.begin(), failed.end()), std::set<std::string>{"df64"});
 }
 
 TEST(BenchReport, checksCatchSplitDifferingFromFp32) {
-  BenchRun run = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  BenchRun run = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
   EXPECT_EQ(failedModes(run), std::vector<std::string>{"split"});
 }
 
 TEST(BenchReport, checksCatchNativeBeatenByMoreThanOneFloatFloor) {
-  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-5, 3e-5, 5e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 1e-4, 5e-5});
+  BenchRun run = madeUpRun({1e-4, 1e-4, 2e-5, 3e-5, 5e-5, 2e-5, 5e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 1e-4, 5e-5, 5e-5});
   EXPECT_EQ(failedModes(run), (std::vector<std::string>{"native", "native", "native"}));
   // Within one floor (1e-5) of the best is no failure.
-  BenchRun close = madeUpRun({1e-4, 1e-4, 2e-5, 3e-5, 2.5e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 1e-4, 5e-5});
+  BenchRun close = madeUpRun({1e-4, 1e-4, 2e-5, 3e-5, 2.5e-5, 2e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 1e-4, 5e-5, 5e-5});
   EXPECT_TRUE(checkRun(close).empty());
 }
 
 TEST(BenchReport, checksCatchADoubleModeNoBetterThanFp32WhereFp32IsOff) {
-  BenchRun run = madeUpRun({3, 3, 2e-5, 4, 1e-5, 2e-5}, {kInf, kInf, 1e-4, kInf, 2e-5, 5e-5});
+  BenchRun run = madeUpRun({3, 3, 2e-5, 4, 1e-5, 2e-5, 2e-5}, {kInf, kInf, 1e-4, kInf, 2e-5, 5e-5, 5e-5});
   EXPECT_EQ(failedModes(run), std::vector<std::string>{"df64"});
 }
 
 TEST(BenchReport, resultsJsonWritesNullForWhatWasNotMeasured) {
-  BenchRun run = madeUpRun({kLost, kLost, 2e-5, 3e-5, 1e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5});
+  BenchRun run = madeUpRun({kLost, kLost, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
   run.rows[2].gpu_ms_median.reset();
   const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, checkRun(run));
   EXPECT_NE(json.find("\"mode\": \"fp32\""), std::string::npos);
@@ -103,7 +103,7 @@ TEST(BenchReport, resultsJsonWritesNullForWhatWasNotMeasured) {
 // A 1000×500 frame of 100 points on the compute backend at 100 GB/s read+write: every byte is
 // counted by hand from the passes in viewer/render_compute.cpp.
 TEST(BenchReport, bandwidthBoundCountsEveryPassOfAComputeFrame) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
   run.cases.front().width = 1000;
   run.cases.front().height = 500;
   CopyBandwidth copy;
@@ -127,7 +127,7 @@ TEST(BenchReport, bandwidthBoundCountsEveryPassOfAComputeFrame) {
 }
 
 TEST(BenchReport, bandwidthBoundCountsEveryPixelOnceWhenPointsOutnumberThem) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
   run.cases.front().width = 10;
   run.cases.front().height = 10;
   BenchRow& row = run.rows.front();
@@ -140,7 +140,7 @@ TEST(BenchReport, bandwidthBoundCountsEveryPixelOnceWhenPointsOutnumberThem) {
 }
 
 TEST(BenchReport, bandwidthBoundLeavesRasterSkippedAndUntimedRowsWithoutAFraction) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
   CopyBandwidth copy;
   copy.read_write_gb_per_s = 100.0;
   BenchRow& raster = run.rows[0];
@@ -161,7 +161,7 @@ TEST(BenchReport, bandwidthBoundLeavesRasterSkippedAndUntimedRowsWithoutAFractio
 }
 
 TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
   run.cases.front().width = run.cases.front().height = 100;
   CopyBandwidth copy;
   copy.bytes = 64ull << 20;
@@ -187,7 +187,7 @@ TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
 }
 
 TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1});
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
   for (BenchRow& row : run.rows) setBandwidthBound(row, nullptr);
   run.rows[0].backend = Backend::kRaster;
   setBandwidthBound(run.rows[0], nullptr);
@@ -276,7 +276,7 @@ TEST(BenchReport, hostFrameTimesHaveNoSpreadAndAreNeverCalledFaster) {
 TEST(BenchReport, reportCitesNothingOutsideTheRepository) {
   // Speed cases, a hard case and a failed check: every section of report.md is written.
   BenchRun run = speedRun({{{1.0, 0.9, 1.1}, {1.2, 1.15, 1.3}}});
-  BenchRun hard = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5});
+  BenchRun hard = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
   ASSERT_GT(run.cases.capacity(), run.cases.size()) << "rows point into cases";
   run.cases.push_back(hard.cases.front());
   run.cases.back().sweep = Sweep::kOffset;

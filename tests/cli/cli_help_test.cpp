@@ -56,7 +56,7 @@ TEST(CliHelp, mistypedWordsGetOneLineWithTheNearestKnownOne) {
       {{"generate", "mandlebulb", "-o", dir.file("t.ply")},
        "generate: unknown kind 'mandlebulb'; did you mean 'mandelbulb'? (kinds: mandelbulb, julia"},
       {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--mode", "natve"},
-       "--mode must be auto, fp32, split, rte, df64, native or batch, got 'natve'; did you mean 'native'?"},
+       "--mode must be auto, fp32, split, rte, df64, native, batch or adaptive, got 'natve'; did you mean 'native'?"},
       {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--colour", "rgb"},
        "render: unknown option '--colour'; did you mean '--color'?"},
       {{"generate", "random2d", "--colour", "none", "-o", dir.file("t.ply")},

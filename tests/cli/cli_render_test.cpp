@@ -28,13 +28,14 @@ double jsonNumber(const std::string& json, const std::string& key) {
 TEST(CliRender, helpNamesEveryModeAndOption) {
   test::CommandResult help = runDpoint({"render", "--help"});
   EXPECT_EQ(help.exit_code, 0);
-  for (const char* word : {"auto", "fp32", "split", "rte", "df64", "native", "batch", "--view-center", "--error",
-                           "--validate", "--frames", "--device", "lavapipe", "0.1 px"})
+  for (const char* word : {"auto", "fp32", "split", "rte", "df64", "native", "batch", "adaptive", "--tolerance",
+                           "--view-center", "--error", "--validate", "--frames", "--device", "lavapipe", "0.1 px"})
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   // The mode list comes from the mode table, laid out on lines of at most 102 characters.
   EXPECT_NE(help.out.find("Modes: fp32 (float positions), split (the study's hi+lo, no better than fp32), rte "
                           "(relative to eye),\ndf64 (double-float arithmetic), native (fp64 shaders), batch "
-                          "(per-batch double origins); all but fp32\nand split work in a frame scaled to the view"),
+                          "(per-batch double origins), adaptive\n(per-batch tiers of 10 bits, as few as --tolerance "
+                          "allows); all but fp32 and split work in a frame\nscaled to the view"),
             std::string::npos)
       << help.out;
   EXPECT_EQ(runDpoint({"devices", "--help"}).exit_code, 0);

@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 from common import check, dpoint, scratch
 
 exe = sys.argv[1]
-MODES = ["fp32", "split", "rte", "df64", "native", "batch"]
+MODES = ["fp32", "split", "rte", "df64", "native", "batch", "adaptive"]
 FIELDS = ["suite", "dataset", "points", "mode", "backend", "device", "driver", "resolution", "gpu_ms", "e2e_ms",
           "points_per_s", "bytes_per_point", "splat_bytes_per_point", "bytes_per_frame", "bandwidth_bound_ms",
           "bandwidth_fraction", "predicted_bound_px", "error_px", "share_off_half_px", "points_lost",

@@ -12,8 +12,9 @@ namespace dpoint {
 namespace {
 
 TEST(Encode, modeNamesRoundTripAndBytesPerPointMatchDesign) {
-  // DESIGN §4 plus 4 bytes of RGBA8, but batch: 3×21-bit integer offsets in 8 bytes (issue #11).
-  const uint32_t expected[] = {16, 28, 28, 28, 28, 12};
+  // DESIGN §4 plus 4 bytes of RGBA8, but batch: 3×21-bit integer offsets in 8 bytes (issue #11),
+  // and adaptive: three 4-byte tiers of 3×10 bits, of which a frame loads 1 to 3 (issue #25).
+  const uint32_t expected[] = {16, 28, 28, 28, 28, 12, 16};
   int i = 0;
   for (PrecisionMode mode : kAllModes) {
     EXPECT_EQ(parseMode(modeName(mode)), mode);

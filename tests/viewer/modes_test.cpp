@@ -36,7 +36,8 @@ TEST(Modes, layoutAccountsForEveryPositionByte) {
     const ModeInfo& info = modeInfo(mode);
     const PositionLayout& layout = info.layout;
     EXPECT_EQ(layout.elements * layout.element_bytes, info.position_bytes) << info.name;
-    const uint32_t size = layout.element == PositionElement::kFloat32 ? 4 : 8;
+    const bool four = layout.element == PositionElement::kFloat32 || layout.element == PositionElement::kUint32;
+    const uint32_t size = four ? 4 : 8;
     EXPECT_EQ(layout.element_bytes, size) << info.name;
     EXPECT_EQ(bytesPerPoint(mode), info.position_bytes + 4) << info.name;
   }
@@ -53,15 +54,22 @@ TEST(Modes, encoderWritesExactlyTheRowsBytesPerPoint) {
     Result<ModeEncoding> e = prepareEncoding(mode, s, camera);
     ASSERT_TRUE(e.ok()) << info.name << ": " << e.error().message;
     constexpr uint8_t kFill = 0xa5;
-    const size_t used = s.size() * info.position_bytes;
-    std::vector<uint8_t> out(used + 64, kFill);
-    encodePositions(*e, s, 0, s.size(), out.data());
-    EXPECT_TRUE(std::all_of(out.begin() + static_cast<std::ptrdiff_t>(used), out.end(),
-                            [](uint8_t b) { return b == kFill; }))
-        << info.name << " writes past " << info.position_bytes << " bytes a point";
-    EXPECT_FALSE(std::all_of(out.begin() + static_cast<std::ptrdiff_t>(used - info.position_bytes),
-                             out.begin() + static_cast<std::ptrdiff_t>(used), [](uint8_t b) { return b == kFill; }))
-        << info.name << " leaves its last point unwritten";
+    // A planar layout writes one plane at a time: element_bytes a point each.
+    const size_t point_bytes = info.layout.planes == 1 ? info.position_bytes : info.layout.element_bytes;
+    for (uint32_t plane = 0; plane < info.layout.planes; ++plane) {
+      const size_t used = s.size() * point_bytes;
+      std::vector<uint8_t> out(used + 64, kFill);
+      encodePositions(*e, s, 0, s.size(), out.data(), 0, plane);
+      EXPECT_TRUE(std::all_of(out.begin() + static_cast<std::ptrdiff_t>(used), out.end(),
+                              [](uint8_t b) { return b == kFill; }))
+          << info.name << " writes past " << point_bytes << " bytes a point";
+      EXPECT_FALSE(std::all_of(out.begin() + static_cast<std::ptrdiff_t>(used - point_bytes),
+                               out.begin() + static_cast<std::ptrdiff_t>(used), [](uint8_t b) { return b == kFill; }))
+          << info.name << " leaves its last point unwritten";
+    }
+    EXPECT_EQ(positionBufferBytes(mode, 5), info.layout.planes == 1 ? 5 * info.position_bytes
+                                                                    : info.layout.planes * 8 * info.layout.element_bytes)
+        << info.name << ": planes start at 16-byte multiples";
   }
 }
 
@@ -77,6 +85,7 @@ TEST(Modes, uniformSizesMatchTheShaderBlocks) {
       2 * 64,          // df64: mat4 hi, mat4 lo
       128 + 32,        // native: dmat4 projection·rotation, dvec4 eye
       0,               // batch: matrices in a storage buffer
+      0,               // adaptive: the same
   };
   static_assert(std::size(expected) == kModeCount);
   for (size_t i = 0; i < kModeCount; ++i) {
@@ -93,7 +102,10 @@ TEST(Modes, shaderVariantsAndAttributesFitTheLayout) {
     EXPECT_TRUE(shaders.vertex.code && shaders.vertex.bytes % 4 == 0 && shaders.vertex.bytes > 0) << info.name;
     EXPECT_TRUE(shaders.splat.code && shaders.splat.bytes % 4 == 0 && shaders.splat.bytes > 0) << info.name;
     EXPECT_NE(shaders.vertex.code, shaders.splat.code) << info.name;
-    ASSERT_GE(shaders.attribute_count, 1u) << info.name;
+    // A mode without vertex attributes pulls its positions in both backends.
+    if (shaders.attribute_count == 0) {
+      EXPECT_EQ(shaders.vertex.code, shaders.vertex_pull.code) << info.name;
+    }
     ASSERT_LE(shaders.attribute_count, 2u) << info.name;
     for (uint32_t a = 0; a < shaders.attribute_count; ++a) {
       EXPECT_NE(shaders.attributes[a].format, VK_FORMAT_UNDEFINED) << info.name;
@@ -118,9 +130,9 @@ TEST(Modes, shaderVariantsAndAttributesFitTheLayout) {
 // (bench/results/render-h100-2026-11-22.md, render-lavapipe-2026-11-22.md).
 TEST(Modes, speedOrdersHoldEveryModeButSplitOnce) {
   using M = PrecisionMode;
-  const std::vector<M> gpu_compute = {M::kFp32, M::kBatch, M::kRte, M::kNative, M::kDf64};
-  const std::vector<M> gpu_raster = {M::kFp32, M::kBatch, M::kNative, M::kRte, M::kDf64};
-  const std::vector<M> cpu = {M::kFp32, M::kNative, M::kRte, M::kBatch, M::kDf64};
+  const std::vector<M> gpu_compute = {M::kFp32, M::kBatch, M::kRte, M::kNative, M::kDf64, M::kAdaptive};
+  const std::vector<M> gpu_raster = {M::kFp32, M::kBatch, M::kNative, M::kRte, M::kDf64, M::kAdaptive};
+  const std::vector<M> cpu = {M::kFp32, M::kNative, M::kRte, M::kBatch, M::kDf64, M::kAdaptive};
   for (DeviceClass device : {DeviceClass::kCpu, DeviceClass::kGpu})
     for (bool compute : {false, true}) {
       const std::span<const PrecisionMode> order = measuredSpeedOrder(device, compute);
@@ -137,14 +149,16 @@ TEST(Modes, speedOrdersHoldEveryModeButSplitOnce) {
 
 // The CLI text built from the table is the text `dpoint render --help` printed before the table.
 TEST(Modes, modeOptionTextComesFromTheTable) {
-  EXPECT_EQ(modeOptionNames(), (std::vector<std::string>{"auto", "fp32", "split", "rte", "df64", "native", "batch"}));
-  EXPECT_EQ(modeOptionChoices(), "auto, fp32, split, rte, df64, native or batch");
+  EXPECT_EQ(modeOptionNames(),
+            (std::vector<std::string>{"auto", "fp32", "split", "rte", "df64", "native", "batch", "adaptive"}));
+  EXPECT_EQ(modeOptionChoices(), "auto, fp32, split, rte, df64, native, batch or adaptive");
   EXPECT_EQ(modeOptionHelp(),
-            "auto|fp32|split|rte|df64|native|batch. auto: the fastest mode on this kind of device (measured\n"
+            "auto|fp32|split|rte|df64|native|batch|adaptive. auto: the fastest mode on this kind of device (measured\n"
             "order) whose predicted error bound is <= 0.1 px for this view; native when none is");
   EXPECT_EQ(modeListHelp(),
             "fp32 (float positions), split (the study's hi+lo, no better than fp32), rte (relative to eye), "
-            "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins)");
+            "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins), "
+            "adaptive (per-batch tiers of 10 bits, as few as --tolerance allows)");
   EXPECT_EQ(modeName(kFallbackMode), "native");
 }
 

@@ -120,7 +120,7 @@ TEST(RenderJob, upAxisShadingAndRequestChecks) {
   EXPECT_TRUE(checkPictureOutput("/dev/null").ok());
   EXPECT_EQ(checkPictureOutput("a.jpg").error().message, "-o a.jpg: the picture is written as PNG; name it .png");
   EXPECT_EQ(checkModeName("emulated").error().message,
-            "--mode must be auto, fp32, split, rte, df64, native or batch, got 'emulated'");
+            "--mode must be auto, fp32, split, rte, df64, native, batch or adaptive, got 'emulated'");
   EXPECT_TRUE(checkModeName("auto").ok() && checkModeName("df64").ok());
   RenderRequest sheet;
   sheet.views = 4;

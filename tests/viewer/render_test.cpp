@@ -35,6 +35,10 @@ TEST_P(Render, validationLayerReportsMisuse) {
   context_->clearValidationMessages();
 }
 
+// What the double modes hold to on the DESIGN §7 offset and scale cases: 0.01 px, but adaptive,
+// which loads as few tiers as keep it within its tolerance (0.05 px) and no closer.
+double heldWithin(PrecisionMode mode) { return mode == PrecisionMode::kAdaptive ? kDefaultTolerancePx : 0.01; }
+
 TEST_P(Render, selfTestKeepsTheLowPartsOnThisDevice) {
   Result<SelfTest> t = runPrecisionSelfTest(*context_);
   ASSERT_TRUE(t.ok()) << t.error().message;
@@ -56,7 +60,7 @@ TEST_P(Render, earthRadiusOffsetSeparatesTheFloatModesFromTheDoubleOnes) {
       EXPECT_GT(e.share_off_half_px, 0.5) << modeName(mode);
     } else {
       EXPECT_EQ(e.lost, 0u) << modeName(mode);
-      EXPECT_LE(e.max_px, 0.01) << modeName(mode);
+      EXPECT_LE(e.max_px, heldWithin(mode)) << modeName(mode);
       EXPECT_EQ(e.share_off_half_px, 0.0) << modeName(mode);
     }
   }
@@ -74,7 +78,7 @@ TEST_P(Render, offset1e8HoldsForEveryDoubleMode) {
       EXPECT_GT(e.share_off_half_px, 0.5) << modeName(mode);
     } else {
       EXPECT_EQ(e.lost, 0u) << modeName(mode);
-      EXPECT_LE(e.max_px, 0.01) << modeName(mode) << " rms " << e.rms_px;
+      EXPECT_LE(e.max_px, heldWithin(mode)) << modeName(mode) << " rms " << e.rms_px;
     }
   }
 }
@@ -94,7 +98,7 @@ TEST_P(Render, tinyScaleNearTheOriginHoldsInEverySceneFrameMode) {
     RecordProperty(std::string(modeName(mode)) + "_max_px", std::to_string(e.max_px));
     if (!modeInfo(mode).scene_frame) continue;
     EXPECT_EQ(e.lost, 0u) << modeName(mode);
-    EXPECT_LE(e.max_px, 0.01) << modeName(mode) << " rms " << e.rms_px;
+    EXPECT_LE(e.max_px, heldWithin(mode)) << modeName(mode) << " rms " << e.rms_px;
   }
 }
 
@@ -208,7 +212,9 @@ TEST_P(Render, chunkedDrawsGiveTheSamePictureAndProbe) {
       RenderOptions chunked;
       chunked.max_chunk_points = chunk;
       Measured parts = measure(s, camera, mode, chunked);
-      EXPECT_EQ(parts.render.chunks, 4u) << modeName(mode) << " " << chunk;
+      // adaptive's chunks hold whole batches (its splat loads 16 bytes of 4 points): one here.
+      const uint32_t chunks = modeInfo(mode).chunk_multiple == kBatchSize ? 1u : 4u;
+      EXPECT_EQ(parts.render.chunks, chunks) << modeName(mode) << " " << chunk;
       EXPECT_EQ(whole.render.image.rgba, parts.render.image.rgba) << modeName(mode) << " " << chunk;
       EXPECT_EQ(0, std::memcmp(whole.render.probe_clip.data(), parts.render.probe_clip.data(),
                                s.size() * sizeof(glm::vec4))) << modeName(mode) << " " << chunk;
