@@ -109,7 +109,7 @@ BatchPlanStats batchPlanStats(const ModeEncoding& e, size_t points) {
   double bytes = 0.0;
   for (size_t b = 0; b < e.batch_plan.size(); ++b) {
     const uint8_t plan = e.batch_plan[b];
-    const size_t in_batch = std::min<size_t>(kBatchSize, points - std::min(points, b * kBatchSize));
+    const size_t in_batch = std::min(e.batchSize(), points - std::min(points, b * e.batchSize()));
     if (plan == 0) {
       ++stats.culled;
       continue;

@@ -1,6 +1,7 @@
 #include "viewer/encode.h"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <charconv>
 #include <cmath>
@@ -36,11 +37,11 @@ double powerOfTwoAbove(double d) {
   return mantissa == 0.5 ? d : std::ldexp(1.0, exponent);
 }
 
-std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame& frame) {
-  const size_t batches = (points.size() + kBatchSize - 1) / kBatchSize;
+std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame& frame, size_t batch_size) {
+  const size_t batches = (points.size() + batch_size - 1) / batch_size;
   std::vector<BatchFrame> frames(batches);
   parallelFor(batches, 0, [&](size_t b, unsigned) {
-    const size_t first = b * kBatchSize, last = std::min(points.size(), first + kBatchSize);
+    const size_t first = b * batch_size, last = std::min(points.size(), first + batch_size);
     const Box box = boundingBox(points.positions, first, last);
     // min/2 + max/2 cannot overflow where (min + max)/2 could; scaling by 2^exponent is exact.
     const glm::dvec3 origin = scaleBy(box.min * 0.5 + box.max * 0.5, frame);
@@ -239,15 +240,16 @@ ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tole
   e.tolerance_px = tolerance_px;
   e.width = camera.width;
   e.height = camera.height;
+  if (const uint32_t batch = modeInfo(mode).batch_points) e.batch_shift = static_cast<uint32_t>(std::countr_zero(batch));
   return e;
 }
 
 Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
   if (Status status = checkPositions(e, block, first_index); !status) return status;
   if (modeInfo(e.mode).batch_points == 0) return okStatus();
-  assert(first_index == e.batches.size() * kBatchSize);  // blocks in order, whole batches but the last
+  assert(first_index == e.batches.size() * e.batchSize());  // blocks in order, whole batches but the last
   const size_t first_batch = e.batches.size();
-  for (const BatchFrame& frame : makeBatchFrames(block, e.frame)) e.batches.push_back(frame);
+  for (const BatchFrame& frame : makeBatchFrames(block, e.frame, e.batchSize())) e.batches.push_back(frame);
   e.batch_matrices.reserve(e.batches.size());
   const double steps = modeInfo(e.mode).batch_steps;
   for (size_t b = first_batch; b < e.batches.size(); ++b) {
@@ -255,7 +257,7 @@ Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) {
         if (fitsFloat(m[c][r])) continue;
-        const size_t first = b * kBatchSize;
+        const size_t first = b * e.batchSize();
         return Error{"batch " + std::to_string(b) + " (points " + std::to_string(first) + "..): its origin is " +
                          shortest(glm::length(e.batches[b].origin - e.frame.eye)) +
                          " view sizes from the eye, and its float matrix overflows; use --mode native",

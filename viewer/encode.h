@@ -30,6 +30,10 @@ namespace dpoint {
 // Points per batch in `batch` mode: consecutive points share one double origin and scale.
 inline constexpr uint32_t kBatchShift = 12;
 inline constexpr uint32_t kBatchSize = 1u << kBatchShift;
+// And in `adaptive` mode: a quarter as many, so a batch's box is about half as wide on screen and
+// its points need fewer tiers; one batch is one workgroup of the compute splat.
+inline constexpr uint32_t kAdaptiveBatchShift = 10;
+inline constexpr uint32_t kAdaptiveBatchSize = 1u << kAdaptiveBatchShift;
 
 // Linear 0..1 colour → RGBA8 (R in the low byte), rounded to nearest, alpha 255. The image is
 // UNORM, so the byte goes to the PNG unchanged. Points without colour are white.
@@ -122,6 +126,9 @@ struct ModeEncoding {
   std::vector<uint8_t> batch_plan;
   double tolerance_px = kDefaultTolerancePx;  // adaptive mode's tier choice
   uint32_t width = 0, height = 0;             // the camera's picture, for the tier choice
+  uint32_t batch_shift = 0;                   // log2 of the mode's points per batch (ModeInfo::batch_points)
+  size_t batchOf(size_t index) const { return index >> batch_shift; }
+  size_t batchSize() const { return size_t{1} << batch_shift; }
 };
 
 // The largest |coordinate| in its frame that the mode's encoding holds: FLT_MAX where it stores
@@ -138,7 +145,7 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
 
 // The same a block at a time, for a set streamed from a file: the encoding before any point is
 // seen, then each block in order (first_index: its first point's index in the whole set; in batch
-// mode a multiple of kBatchSize), checked as prepareEncoding checks the whole set, with errors
+// per-batch modes a multiple of the batch size), checked as prepareEncoding checks the whole set, with errors
 // naming whole-set indices, and in batch mode its batches' frames and matrices appended.
 ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tolerance_px = kDefaultTolerancePx);
 Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);

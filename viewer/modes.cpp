@@ -82,7 +82,7 @@ void encodeBatchOffsets(const ModeEncoding& e, const glm::dvec3* p, size_t count
   const SceneFrame& frame = e.frame;
   auto* words = static_cast<uint64_t*>(out);
   for (size_t i = 0; i < count; ++i) {
-    const BatchFrame& batch = e.batches[(first_index + i) / kBatchSize];
+    const BatchFrame& batch = e.batches[e.batchOf(first_index + i)];
     // p·scale − origin rounds once in double; the division by a power of two is exact.
     words[i] = packBatchOffset((scaleBy(p[i], frame) - batch.origin) / batch.extent);
   }
@@ -95,7 +95,7 @@ void encodeAdaptiveTier(const ModeEncoding& e, const glm::dvec3* p, size_t count
   const SceneFrame& frame = e.frame;
   auto* words = static_cast<uint32_t*>(out);
   for (size_t i = 0; i < count; ++i) {
-    const BatchFrame& batch = e.batches[(first_index + i) / kBatchSize];
+    const BatchFrame& batch = e.batches[e.batchOf(first_index + i)];
     const glm::dvec3 t = (scaleBy(p[i], frame) - batch.origin) / batch.extent;  // one rounding, then exact
     const glm::uvec3 q(quantizeAdaptive(t.x), quantizeAdaptive(t.y), quantizeAdaptive(t.z));
     words[i] = adaptiveTierWord(q, plane);
@@ -233,7 +233,7 @@ inline Clip<T> nativeError(const Setup& s, const Coords<T>& ps, const Clip<T>& c
 // step, one at the clamped edge t = 1), which a float holds exactly; the batch matrix, built in
 // double (its translation's rounding is precomputed per batch), is applied in float.
 Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
-  const size_t b = index / kBatchSize;
+  const size_t b = own.encoding.batchOf(index);
   const BatchFrame& frame = own.encoding.batches[b];
   const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kBatchSteps;
   Coords<double> dv;
@@ -247,7 +247,7 @@ Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
 // adaptiveStepError) and, with all three, the rounding of the 30-bit integer to float (2u·|q|: SPIR-V leaves the direction open; with
 // fewer tiers the rebuilt integer has at most 21 significant bits and converts exactly).
 Vec4 adaptiveError(const ModeState& own, const glm::dvec3& ps, size_t index) {
-  const size_t b = index / kBatchSize;
+  const size_t b = own.encoding.batchOf(index);
   const uint32_t tiers = own.encoding.batch_plan[b];
   if (tiers == 0) return kUnbounded;  // never: a culled batch's box holds no visible point
   const BatchFrame& frame = own.encoding.batches[b];
@@ -353,7 +353,7 @@ constexpr ModeInfo kModes[] = {
     // Pulls its tier words in both backends (no attributes); chunks hold whole batches, so each
     // 1024-point workgroup of the compute splat lies in one batch and loads 16 bytes a thread.
     {PrecisionMode::kAdaptive, "adaptive", "per-batch tiers of 10 bits, as few as --tolerance allows", 12,
-     kTierWords, true, false, false, false, kBatchSize, kBatchSize,
+     kTierWords, true, false, false, false, kAdaptiveBatchSize, kAdaptiveBatchSize,
      {DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kSplatAdaptiveComp),
       {kNone, kNone}, 0},
      encodeAdaptiveTier, noUniform, worstOf<adaptiveBound>, nullptr, {{5, 5}, {5, 5}}, kAdaptiveSteps, kAdaptiveTiers},

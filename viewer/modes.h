@@ -163,6 +163,13 @@ const ModeInfo& modeInfo(PrecisionMode mode);
 inline std::string_view modeName(PrecisionMode mode) { return modeInfo(mode).name; }
 std::optional<PrecisionMode> parseMode(std::string_view name);
 
+// log2 of the points per batch of a per-batch mode (0 for the others).
+inline uint32_t batchShift(PrecisionMode mode) {
+  uint32_t shift = 0;
+  for (uint32_t n = modeInfo(mode).batch_points; n > 1; n >>= 1) ++shift;
+  return shift;
+}
+
 // Bytes of position data per point (colour not included), and with the RGBA8 colour.
 inline uint32_t positionBytes(PrecisionMode mode) { return modeInfo(mode).position_bytes; }
 // Bytes of a chunk of `count` points' position buffer (planes padded to 16 bytes).

@@ -27,7 +27,7 @@ struct PushConstants {
   float splitter = 4097.0f;  // 2^12 + 1: Dekker's split of a 24-bit significand
   float point_size = 1.0f;
   uint32_t first_index = 0;  // index of the draw's first point in the whole set
-  uint32_t batch_shift = kBatchShift;  // log2(kBatchSize): a point's batch is index >> batch_shift
+  uint32_t batch_shift = kBatchShift;  // batchShift(mode): a point's batch is index >> batch_shift
   uint32_t width = 0, height = 0;  // compute backend
   uint32_t count = 0;       // points in the chunk
   uint32_t list_first = 0;  // compute backend, per-batch modes: the chunk's first batch-list entry

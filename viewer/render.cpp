@@ -142,6 +142,7 @@ void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeli
     push.point_size = options.point_size;
     push.first_index = static_cast<uint32_t>(chunk.first);
     push.count = static_cast<uint32_t>(chunk.count);
+    push.batch_shift = batchShift(options.mode);
     vkCmdPushConstants(commands, r.pipelines.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, r.pipelines.layout, 0, 1, &chunk.set, 0, nullptr);
     VkDeviceSize offset = 0;
@@ -301,7 +302,7 @@ std::vector<uint32_t> batchPlanWords(Resources& r, const ModeEncoding& encoding,
   }
   for (detail::Chunk& chunk : r.chunks) {
     chunk.list_first = static_cast<uint32_t>(words.size());
-    const size_t first = chunk.first / kBatchSize, last = (chunk.first + chunk.count - 1) / kBatchSize;
+    const size_t first = encoding.batchOf(chunk.first), last = encoding.batchOf(chunk.first + chunk.count - 1);
     for (size_t b = first; b <= last; ++b)
       if (const uint32_t tiers = encoding.batch_plan[b]) words.push_back(static_cast<uint32_t>(b) | tiers << 30);
     chunk.list_count = static_cast<uint32_t>(words.size()) - chunk.list_first;

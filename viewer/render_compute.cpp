@@ -81,10 +81,11 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
           VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, splat);
-  const bool listed = modeInfo(options.mode).batch_points != 0;  // splats the plan's batch list
-  static_assert(kBatchSize % kSplatPointsPerGroup == 0, "a splat workgroup lies in one batch");
+  const uint32_t batch_points = modeInfo(options.mode).batch_points;  // splats the plan's batch list
+  static_assert(kBatchSize % kSplatPointsPerGroup == 0 && kAdaptiveBatchSize % kSplatPointsPerGroup == 0,
+                "a splat workgroup lies in one batch");
   for (const Chunk& chunk : r.chunks) {
-    const uint32_t groups = listed ? chunk.list_count * (kBatchSize / kSplatPointsPerGroup)
+    const uint32_t groups = batch_points ? chunk.list_count * (batch_points / kSplatPointsPerGroup)
                                    : static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup);
     if (groups == 0) continue;  // every batch of the chunk culled
     PushConstants push;
@@ -94,6 +95,7 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
     push.height = height;
     push.count = static_cast<uint32_t>(chunk.count);
     push.list_first = chunk.list_first;
+    push.batch_shift = batchShift(options.mode);
     vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
     vkCmdDispatch(commands, groups, 1, 1);

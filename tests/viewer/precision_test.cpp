@@ -27,12 +27,16 @@ class Precision : public VulkanRenderTest {
     double bound = 0.0;
     ErrorStats stats;
     size_t pixels_differing = 0;
+    size_t near_edge = 0;  // points the reference sees within `bound` px of the picture's edge
   };
   // Renders in `mode` with the probe, and prints and returns bound and measurement.
   Row run(const char* label, const PointSet& points, const Camera& camera, PrecisionMode mode,
           const ErrorBounds& bounds, Image* image = nullptr) {
     Measured m = measure(points, camera, mode);
-    Row row{bounds.px[modeIndex(mode)], m.error.stats, m.error.pixels_differing};
+    Row row{bounds.px[modeIndex(mode)], m.error.stats, m.error.pixels_differing, 0};
+    for (const WindowPoint& w : projectReference(points.positions, camera))
+      row.near_edge += w.visible && (w.x <= row.bound || w.y <= row.bound || w.x > camera.width - row.bound ||
+                                     w.y > camera.height - row.bound);
     std::printf("precision: %-34s %-7s %-6s bound %-12s measured max %-10.3g lost %zu/%zu, off >= 0.5 px %.4g%%\n",
                 label, GetParam() == Backend::kRaster ? "raster" : "compute", std::string(modeName(mode)).c_str(),
                 formatBound(row.bound).c_str(), row.stats.max_px, row.stats.lost, row.stats.points,
@@ -40,13 +44,17 @@ class Precision : public VulkanRenderTest {
     if (image) *image = std::move(m.render.image);
     return row;
   }
-  // The bound holds: no measured error above it, and under half a pixel no point lost or moved.
+  // The bound holds: no measured error above it, and under half a pixel no point lost or moved,
+  // but one the reference puts within the bound of the picture's edge, which an error within the
+  // bound may take out of the view (the 1e-15 deep zoom's grid collapses onto a few doubles, some
+  // exactly on the edge: adaptive's 0.03 px takes them out, native's 1e-6 px happens not to).
   void expectWithinBound(const char* label, PrecisionMode mode, const Row& row) {
     if (!std::isfinite(row.bound)) return;
     EXPECT_LE(row.stats.max_px, row.bound) << label << " " << modeName(mode);
     if (row.bound < 0.5) {
-      EXPECT_EQ(row.stats.lost, 0u) << label << " " << modeName(mode);
-      EXPECT_EQ(row.stats.share_off_half_px, 0.0) << label << " " << modeName(mode);
+      EXPECT_LE(row.stats.lost, row.near_edge) << label << " " << modeName(mode);
+      EXPECT_LE(row.stats.share_off_half_px * static_cast<double>(row.stats.points), static_cast<double>(row.near_edge))
+          << label << " " << modeName(mode);
     }
   }
   void everyModeWithinItsBound(const char* label, const PointSet& points, const Camera& camera) {
