@@ -31,6 +31,7 @@ struct PushConstants {
   uint32_t width = 0, height = 0;  // compute backend
   uint32_t count = 0;       // points in the chunk
   uint32_t list_first = 0;  // compute backend, per-batch modes: the chunk's first batch-list entry
+  uint32_t listed = 0;      // 1: this chunk's workgroups take their batches from the list
 };
 
 // Descriptor bindings of the compute backend beyond the shared four: 4 the visibility buffer

@@ -291,18 +291,21 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
   return okStatus();
 }
 
-// What the plan's buffer holds (binding 5): for the raster backend the tiers of every batch (0:
-// culled), for the compute backend each chunk's list of the batches it overlaps that the plan
-// keeps, batch | tiers << 30 (setting the chunks' list_first and list_count).
+// What the plan's buffer holds (binding 5): the tiers of every batch (0: culled), then for the
+// compute backend, for each chunk that culls a batch or starts inside one (tests' small chunks),
+// the list of the batches it overlaps that the plan keeps, batch | tiers << 30 (setting the
+// chunk's list_first and list_count). A chunk without a list is splatted whole, a workgroup per
+// 1024 points in order: no load of the list stands before its points' loads.
 std::vector<uint32_t> batchPlanWords(Resources& r, const ModeEncoding& encoding, bool compute) {
-  std::vector<uint32_t> words;
-  if (!compute) {
-    words.assign(encoding.batch_plan.begin(), encoding.batch_plan.end());
-    return words;
-  }
+  std::vector<uint32_t> words(encoding.batch_plan.begin(), encoding.batch_plan.end());
+  if (!compute) return words;
   for (detail::Chunk& chunk : r.chunks) {
-    chunk.list_first = static_cast<uint32_t>(words.size());
     const size_t first = encoding.batchOf(chunk.first), last = encoding.batchOf(chunk.first + chunk.count - 1);
+    bool whole = chunk.first % encoding.batchSize() == 0;
+    for (size_t b = first; b <= last && whole; ++b) whole = encoding.batch_plan[b] != 0;
+    chunk.listed = !whole;
+    if (whole) continue;
+    chunk.list_first = static_cast<uint32_t>(words.size());
     for (size_t b = first; b <= last; ++b)
       if (const uint32_t tiers = encoding.batch_plan[b]) words.push_back(static_cast<uint32_t>(b) | tiers << 30);
     chunk.list_count = static_cast<uint32_t>(words.size()) - chunk.list_first;

@@ -85,8 +85,8 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
   static_assert(kBatchSize % kSplatPointsPerGroup == 0 && kAdaptiveBatchSize % kSplatPointsPerGroup == 0,
                 "a splat workgroup lies in one batch");
   for (const Chunk& chunk : r.chunks) {
-    const uint32_t groups = batch_points ? chunk.list_count * (batch_points / kSplatPointsPerGroup)
-                                   : static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup);
+    const uint32_t groups = chunk.listed ? chunk.list_count * (batch_points / kSplatPointsPerGroup)
+                                         : static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup);
     if (groups == 0) continue;  // every batch of the chunk culled
     PushConstants push;
     push.point_size = options.point_size;
@@ -95,6 +95,7 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
     push.height = height;
     push.count = static_cast<uint32_t>(chunk.count);
     push.list_first = chunk.list_first;
+    push.listed = chunk.listed ? 1u : 0u;
     push.batch_shift = batchShift(options.mode);
     vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);

@@ -14,6 +14,7 @@ struct Chunk {
   size_t first = 0, count = 0;
   // Compute backend, per-batch modes: the chunk's entries of the batch list (batches it overlaps
   // that the plan did not cull).
+  bool listed = false;  // false: every batch of the chunk splatted, in order (no list)
   uint32_t list_first = 0, list_count = 0;
   Buffer positions, colors, probe;
   VkDescriptorSet set = VK_NULL_HANDLE;

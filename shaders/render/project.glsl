@@ -12,6 +12,7 @@ layout(push_constant) uniform Push {
   uint batch_shift;  // log2 of the points per batch
   uint width, height, count;  // compute backend: target size; points in this chunk (both backends)
   uint list_first;  // compute backend, per-batch modes: this chunk's first entry of the batch list
+  uint listed;      // 1: workgroups take their batches from the list; 0: the chunk's batches in order
 } pc;
 
 #if defined(MODE_FP32) || defined(MODE_SPLIT)
