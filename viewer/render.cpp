@@ -224,8 +224,9 @@ Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, co
     }
     if (!status) return status;
     if (options.probe) {
-      Result<Buffer> probe = createBuffer(context, chunk.count * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                          true, what + " probe");
+      Result<Buffer> probe = createBuffer(context, chunk.count * sizeof(glm::vec4),
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
+                                          what + " probe");
       if (!probe) return probe.error();
       chunk.probe = *probe;
     }
@@ -416,6 +417,15 @@ Status runProbe(const VulkanContext& context, Resources& r, const RenderOptions&
                 uint32_t height, size_t count, RenderResult& out) {
   Status status = submitOnce(context, [&](VkCommandBuffer commands) {
     const bool compute = options.backend == Backend::kCompute;
+    // Zeros first: a point no splat reads (its batch culled) keeps a clip position of 0, which no
+    // view holds (w = 0).
+    for (const Chunk& chunk : r.chunks) vkCmdFillBuffer(commands, chunk.probe.buffer, 0, VK_WHOLE_SIZE, 0);
+    VkMemoryBarrier cleared = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    cleared.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    cleared.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_VERTEX_SHADER_BIT, 0, 1,
+                         &cleared, 0, nullptr, 0, nullptr);
     if (compute)
       detail::recordCompute(commands, r, r.compute.probe, options, width, height, false);
     else

@@ -44,10 +44,16 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
   vkGetPhysicalDeviceProperties(physical, &basic);
   facts.vulkan12 = basic.apiVersion >= VK_API_VERSION_1_2;
   if (facts.vulkan12) {
+    VkPhysicalDeviceSubgroupProperties subgroup = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    driver.pNext = &subgroup;
     properties.pNext = &driver;
     vkGetPhysicalDeviceProperties2(physical, &properties);
     facts.driver_name = driver.driverName;
     facts.driver_info = driver.driverInfo;
+    constexpr VkSubgroupFeatureFlags kMerge =
+        VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_VOTE_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+    facts.subgroup_merge = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                           (subgroup.supportedOperations & kMerge) == kMerge;
   }
   facts.name = basic.deviceName;
   facts.type = deviceTypeName(basic.deviceType);

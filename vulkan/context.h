@@ -27,6 +27,7 @@ struct DeviceFacts {
   bool large_points = false;       // --point-size > 1
   bool int64_atomics = false;      // shaderInt64 + shaderBufferInt64Atomics: the compute backend
   bool r64g64b64_vertex = false;   // native mode reads double vertex attributes (else pulls)
+  bool subgroup_merge = false;     // subgroup vote and arithmetic in compute shaders: the splat merges lanes on one pixel
   uint64_t max_storage_buffer_range = 0, max_memory_allocation = 0;
   uint32_t max_image_dimension = 0;  // maxImageDimension2D: the raster backend's largest picture side
   uint32_t max_texel_buffer_elements = 0;  // maxTexelBufferElements: the shading's buffers (pixels)
