@@ -6,7 +6,7 @@
 # every mode's predicted bound come from the render's JSON. The SM and memory clocks are sampled
 # every 200 ms while it runs ($OUT/clocks.csv). SETS: sierpinski mandelbulb (16.7M), random1g (1e9,
 # streamed from a 24 GB PLY; also its 1% view); MODES, BACKENDS as below. One line per run in
-# $OUT/adaptive.tsv.
+# $OUT/adaptive.tsv. BIN: another build, LABEL: its name in the table.
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 d=${BIN:-.gpu/dpoint}
@@ -24,11 +24,12 @@ row() {  # name view backend mode wall: fields of /tmp/r.json
   /usr/bin/python3 - "$@" <<'PY' | tee -a "$results"
 import json, sys
 name, view, backend, mode, wall = sys.argv[1:6]
+label = sys.argv[6] if len(sys.argv) > 6 else ""
 j = json.load(open("/tmp/r.json"))
 g = j["gpu_ms"] or {}
 p = j.get("batch_plan") or {}
 share = ",".join(f"{s:.3f}" for s in p.get("tier_share", []))
-print("\t".join(str(v) for v in [name, view, backend, mode, j["points"], g.get("median"), g.get("p95"), g.get("min"),
+print("\t".join(str(v) for v in [name + (f" ({label})" if label else ""), view, backend, mode, j["points"], g.get("median"), g.get("p95"), g.get("min"),
       p.get("loaded_bytes_per_point", j["bytes_per_point"] - 4), share, p.get("culled", ""), p.get("batches", ""),
       j["predicted_bound_px"], round(j["phases_ms"].get("mode", 0), 1), round(j["upload_ms"], 1), wall]))
 PY
@@ -40,7 +41,8 @@ render() {  # name view file backend mode [render args...]
   "$d" render "$file" --backend "$backend" --mode "$mode" --width 1920 --height 1080 --frames "${FRAMES:-50}" \
     --warmup "${WARMUP:-5}" -q --stream "${STREAM:-auto}" --shade none --json /tmp/r.json -o /tmp/r.png "$@"
   end=$(date +%s.%N)
-  row "$name" "$view" "$backend" "$mode" "$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')"
+  row "$name" "$view" "$backend" "$mode" "$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')" "${LABEL:-}"
+  cp /tmp/r.json "$out/last.json"
 }
 
 for set in ${SETS:-sierpinski mandelbulb}; do
