@@ -668,11 +668,6 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   o.add("point_size", V::number(outcome.point_size));
   o.add("shading", V::string(outcome.shading == Shading::kEdl ? "edl" : "none"));
   o.add("frames", V::integer(r.frame_ms.size()));
-  // The warm-up that ran before them: untimed frames and their wall time, and what was asked.
-  o.add("warmup", JsonObject()
-                      .add("frames", V::integer(r.warmup_frames))
-                      .add("ms", V::number(r.warmup_ms))
-                      .add("requested", V::string(warmupText(request.warmup))));
   if (r.gpu_ms.empty()) {
     o.add("gpu_ms", V::null());
   } else {
@@ -684,6 +679,14 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
     o.add("gpu_ms_each", V::numbers(r.gpu_ms));
   }
   o.add("frame_ms", JsonObject().add("median", V::number(frame_median)).add("p95", V::number(percentileOf(r.frame_ms, 95))));
+  // The warm-up that ran before the timed frames: untimed frames and their wall time, and the time
+  // it was to last at least (--warmup by time, or auto with several frames; null: a count).
+  RenderOptions warmup;
+  setWarmup(request.warmup, request.frames, warmup);
+  o.add("warmup", JsonObject()
+                      .add("frames", V::integer(r.warmup_frames))
+                      .add("ms", V::number(r.warmup_ms))
+                      .add("until_ms", warmup.warmup_ms > 0.0 ? V::number(warmup.warmup_ms) : V::null()));
   o.add("upload_ms", V::number(r.upload_ms)).add("readback_ms", V::number(r.readback_ms));
   o.add("e2e_ms", V::number(r.upload_ms + frame_median + r.readback_ms));
   JsonObject phases;
