@@ -238,7 +238,8 @@ FrameTraffic frameTraffic(Backend backend, PrecisionMode mode, uint64_t points, 
   if (backend != Backend::kCompute || !position_bytes) return out;
   const uint64_t pixels = uint64_t{width} * height;
   constexpr uint64_t kClear = 8, kKeyRead = 8, kPictureWrite = 4, kColorRead = 4;
-  out.bytes_per_frame = *position_bytes + pixels * (kClear + kKeyRead + kPictureWrite) + std::min(points, pixels) * kColorRead;
+  out.bytes_per_frame =
+      *position_bytes + pixels * (kClear + kKeyRead + kPictureWrite) + std::min(points, pixels) * kColorRead;
   return out;
 }
 

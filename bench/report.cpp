@@ -114,6 +114,9 @@ std::string rowJson(const BenchRun& run, const BenchRow& r) {
                                            : std::string("null"));
   s += ", \"frame_ms_median\": " + num(r.frame_ms_median) + ", \"e2e_ms\": " + num(r.e2e_ms) +
        ", \"upload_ms\": " + num(r.upload_ms) + ", \"readback_ms\": " + num(r.readback_ms) +
+       ", \"warmup\": " + (r.skipped.empty() ? "{\"frames\": " + std::to_string(r.warmup_frames) + ", \"ms\": " +
+                                                   num(r.warmup_ms) + "}"
+                                             : std::string("null")) +
        ",\n     \"points_per_s\": " + num(r.points_per_s) + ", \"bytes_per_point\": " + std::to_string(r.bytes_per_point) +
        ", \"splat_bytes_per_point\": " + std::to_string(r.splat_bytes_per_point) +
        ", \"loaded_bytes_per_point\": " + optNum(r.loaded_bytes_per_point) + ", \"culled_share\": " + optNum(r.culled_share) +

@@ -257,7 +257,8 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   s += "- Command: `" + context.command + "` (dpoint " + context.version + ", " + context.date + "; whole run " +
        withCommas(static_cast<uint64_t>(std::llround(run.seconds))) + " s)\n";
   s += "- Speed: GPU timestamps around the draw (raster) or the splat and resolve passes (compute), median of the timed "
-       "frames after warm-up; p95, min and the end-to-end time (upload, one frame, readback) are in results.json. "
+       "frames after warm-up (untimed frames, as `--warmup` in the command says; each row's count and time are in "
+       "results.json); p95, min and the end-to-end time (upload, one frame, readback) are in results.json. "
        "Absolute times count on a GPU; on lavapipe (a CPU) compare modes as ratios.\n";
   s += "- Error: each point's window position from the probe (the same shader storing its clip position) against the "
        "exact one (long double, same camera), in pixels; a mode's *bound* is predicted before drawing from its "

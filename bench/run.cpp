@@ -130,7 +130,7 @@ Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& optio
                                    "--mode", std::string(modeName(row.mode)), "--backend",
                                    report::backendText(row.backend), "--device", options.device,
                                    "--frames", std::to_string(std::max<uint32_t>(options.frames, 1)), "--warmup",
-                                   std::to_string(options.warmup), "--json", json_path, "--quiet"};
+                                   warmupText(options.warmup), "--json", json_path, "--quiet"};
   for (const std::string& flag : cameraFlags(p.spec)) args.push_back(flag);
   if (options.validate) args.push_back("--validate");
   if (Status ran = options.run_dpoint(args); !ran) return ran;
@@ -151,6 +151,10 @@ Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& optio
   row.readback_ms = numberAt(*json, "readback_ms");
   row.e2e_ms = numberAt(*json, "e2e_ms");
   row.points_per_s = numberAt(*json, "points_per_s");
+  if (const JsonValue* warmup = json->find("warmup"); warmup && warmup->kind == JsonValue::Kind::kObject) {
+    row.warmup_frames = static_cast<uint32_t>(numberAt(*warmup, "frames"));
+    row.warmup_ms = numberAt(*warmup, "ms");
+  }
   return readPlan(*json, json_path, row);
 }
 

@@ -25,6 +25,7 @@
 #include "vulkan/context.h"
 #include "viewer/encode.h"
 #include "viewer/render.h"
+#include "viewer/render_job.h"
 
 namespace dpoint {
 
@@ -39,6 +40,8 @@ struct BenchRow {
   double frame_ms_median = 0.0, upload_ms = 0.0, readback_ms = 0.0;
   double e2e_ms = 0.0;        // upload + one frame (median) + readback, as `dpoint render --json`
   double points_per_s = 0.0;  // from the GPU median (else the host frame median)
+  uint32_t warmup_frames = 0;  // untimed frames the timed draw ran first, and their wall time
+  double warmup_ms = 0.0;
   uint32_t bytes_per_point = 0;
   // The per-batch modes' plan for the case's view (viewer/batch_plan.h), as the timed draw reported
   // it (`batch_plan` of its --json): position bytes it loads per point of the whole set (a culled
@@ -84,7 +87,9 @@ struct BenchOptions {
   std::vector<BenchSuite> suites;
   std::vector<Backend> backends;
   std::vector<std::string> sizes;  // paper cases kept by size label (case-insensitive); empty: all
-  uint32_t frames = 20, warmup = 2;
+  uint32_t frames = 20;
+  // Each timed draw's `dpoint render --warmup`: by time, as a GPU's clocks need (render_job.h).
+  WarmupRequest warmup{WarmupRequest::Kind::kTime, 0, kAutoWarmupMs};
   bool measure_error = true;  // false: timed draws only; error columns stay empty
   std::string cache_dir;
   std::string device = "auto";  // passed to every `dpoint render`; the context given must be that device

@@ -223,6 +223,8 @@ TEST(BenchReport, reportShowsThePlansLoadedBytesAndAdaptivesTiers) {
   adaptive.plan_bytes_per_point = 4.5;
   adaptive.culled_share = 0.5;
   adaptive.tier_share = std::array<double, kAdaptiveTiers>{0.25, 0.125, 0.125};
+  adaptive.warmup_frames = 7;
+  adaptive.warmup_ms = 301.5;
   for (BenchRow& row : run.rows) setBandwidthBound(row, nullptr);
   const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
   EXPECT_NE(json.find("\"loaded_bytes_per_point\": 6, \"culled_share\": 0.25, \"tier_share\": null"), std::string::npos)
@@ -230,6 +232,7 @@ TEST(BenchReport, reportShowsThePlansLoadedBytesAndAdaptivesTiers) {
   EXPECT_NE(json.find("\"loaded_bytes_per_point\": 4.5, \"culled_share\": 0.5, \"tier_share\": [0.25, 0.125, 0.125]"),
             std::string::npos)
       << json;
+  EXPECT_NE(json.find("\"warmup\": {\"frames\": 7, \"ms\": 301.5}"), std::string::npos) << json;
   const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
   EXPECT_NE(report.find("; 6 B/pt loaded)"), std::string::npos) << report;
   EXPECT_NE(report.find("; 4.5 B/pt loaded, tiers 25/12.5/12.5%)"), std::string::npos) << report;
@@ -281,6 +284,23 @@ TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
   EXPECT_EQ(json.find("\"bandwidth_fraction\": 0"), std::string::npos);
   const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
   EXPECT_NE(report.find("Copy bandwidth: not measured"), std::string::npos);
+}
+
+// The bench hands its --warmup to every timed `dpoint render` as text: each request reads back
+// the same, durations in ms without an exponent; the default warms up by time.
+TEST(BenchRun, warmupPassesToRenderAsTextThatReadsBackTheSame) {
+  EXPECT_EQ(warmupText(BenchOptions{}.warmup), "300ms");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"auto", "auto"}, {"0", "0"},           {"2", "2"},         {"300ms", "300ms"},     {"0.5s", "500ms"},
+      {"1.5ms", "1.5ms"}, {"0.001ms", "0.001ms"}, {"60s", "60000ms"}, {"0.1s", "100ms"}, {"0.0123s", "12.3ms"}};
+  for (const auto& [given, text] : cases) {
+    const Result<WarmupRequest> parsed = parseWarmup("--warmup", given);
+    ASSERT_TRUE(parsed) << given << ": " << parsed.error().message;
+    EXPECT_EQ(warmupText(*parsed), text) << given;
+    const Result<WarmupRequest> again = parseWarmup("--warmup", warmupText(*parsed));
+    ASSERT_TRUE(again) << text;
+    EXPECT_TRUE(again->kind == parsed->kind && again->frames == parsed->frames && again->ms == parsed->ms) << given;
+  }
 }
 
 // Frame times of one row: median, fastest frame, p95.

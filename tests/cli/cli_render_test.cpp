@@ -142,7 +142,7 @@ TEST(CliRender, warmupRefusesWhatIsNeitherACountNorADuration) {
   TempDir dir;
   writeFile(dir.file("p.csv"), "x,y,z\n0,0,0\n1,1,1\n");
   for (const char* bad : {"1.5", "0ms", "0s", "10us", "fast", "-1", "", "3 ms", "1e3ms", "4294967296", "61s", "ms", "0.0001ms"}) {
-    for (const char* command : {"render"}) {
+    for (const char* command : {"render", "bench"}) {
       std::vector<std::string> args = {command, "--warmup", bad};
       if (std::string(command) == "render") args.insert(args.begin() + 1, {dir.file("p.csv"), "-o", dir.file("p.png")});
       else args.insert(args.end(), {"--out", dir.file("out"), "--cache", dir.file("cache")});
@@ -156,6 +156,7 @@ TEST(CliRender, warmupRefusesWhatIsNeitherACountNorADuration) {
   }
   const test::CommandResult help = runDpoint({"render", "--help"});
   EXPECT_NE(help.out.find("a duration (300ms, 0.5s)"), std::string::npos) << help.out;
+  EXPECT_NE(runDpoint({"bench", "--help"}).out.find("300ms"), std::string::npos);
 }
 
 TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {

@@ -16,7 +16,7 @@ from common import check, dpoint, scratch
 exe = sys.argv[1]
 MODES = ["fp32", "split", "rte", "df64", "native", "batch", "adaptive"]
 FIELDS = ["suite", "dataset", "points", "mode", "backend", "device", "driver", "resolution", "gpu_ms", "e2e_ms",
-          "points_per_s", "bytes_per_point", "splat_bytes_per_point", "loaded_bytes_per_point",
+          "points_per_s", "warmup", "bytes_per_point", "splat_bytes_per_point", "loaded_bytes_per_point",
           "culled_share", "tier_share", "bytes_per_frame", "bandwidth_bound_ms",
           "bandwidth_fraction", "predicted_bound_px", "error_px", "share_off_half_px", "points_lost",
           "pixels_differing"]
@@ -59,7 +59,7 @@ def check_svg(path, series_per_panel, panels):
 
 with scratch() as d:
     out, cache = os.path.join(d, "out"), os.path.join(d, "cache")
-    dpoint(exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1", "--validate",
+    dpoint(exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1ms", "--validate",
            "--copy-bytes", "64M", "--copy-repeats", "5", "--quiet")
     for name in ["report.md", "results.json", "speed_vs_error.svg", "breakdown.svg", "montage.png"]:
         check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} missing or empty")
@@ -90,6 +90,9 @@ with scratch() as d:
         check(r["splat_bytes_per_point"] == splat_bytes[r["mode"]],
               f"{name}: splat_bytes_per_point {r['splat_bytes_per_point']}, expected {splat_bytes[r['mode']]}")
         check(r["bytes_per_point"] == r["splat_bytes_per_point"] + 4, f"{name}: bytes_per_point {r['bytes_per_point']}")
+        # The warm-up each timed draw ran (--warmup 1ms: by time, at least one frame).
+        check(r["warmup"] is not None and r["warmup"]["frames"] >= 1 and r["warmup"]["ms"] >= 0,
+              f"{name}: warmup {r['warmup']}")
         # Loaded bytes: the layout's for a fixed mode; a per-batch mode's plan for the view (culled
         # batches load nothing; adaptive 4 B a tier), batch's raster path every point's 8 B.
         loaded, culled, tiers = r["loaded_bytes_per_point"], r["culled_share"], r["tier_share"]
@@ -176,5 +179,6 @@ with scratch() as d:
     for outside in ("DESIGN", "../", "shared/"):
         check(outside not in report, f"report.md names {outside!r}, outside the repository")
     check("- Copy bandwidth: **" in report and "% of bound" in report, "report.md lacks the copy bandwidth or % of bound")
-    check("B/pt loaded, tiers " in report, "report.md lacks adaptive's loaded bytes and tiers")
+    check("B/pt loaded, tiers " in report and "--warmup 1ms" in report,
+          "report.md lacks adaptive's loaded bytes and tiers, or the warm-up asked")
 print(f"bench ci suite: {len(rows)} rows checked")
