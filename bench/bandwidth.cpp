@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <vector>
@@ -218,14 +219,27 @@ std::string copyBandwidthText(const CopyBandwidth& copy) {
          "); compute-shader copy " + rateText(copy.shader_read_write_gb_per_s) + " read+write";
 }
 
-FrameTraffic frameTraffic(Backend backend, PrecisionMode mode, uint64_t points, uint32_t width, uint32_t height) {
+FrameTraffic frameTraffic(Backend backend, PrecisionMode mode, uint64_t points, uint32_t width, uint32_t height,
+                          std::optional<double> plan_bytes_per_point) {
+  const ModeInfo& info = modeInfo(mode);
   FrameTraffic out;
-  out.splat_bytes_per_point = positionBytes(mode);
-  if (backend != Backend::kCompute) return out;
+  out.splat_bytes_per_point = info.position_bytes;
+  const bool follows_plan = info.batch_points && (backend == Backend::kCompute || info.shaders.attribute_count == 0);
+  // A whole layout per point is counted in integers; a plan's bytes per point is its whole-set
+  // total (a multiple of 4) divided by the points, which the rounding gives back.
+  std::optional<uint64_t> position_bytes;
+  if (!follows_plan) {
+    out.loaded_bytes_per_point = info.position_bytes;
+    position_bytes = points * info.position_bytes;
+  } else if (plan_bytes_per_point) {
+    out.loaded_bytes_per_point = *plan_bytes_per_point;
+    position_bytes = static_cast<uint64_t>(std::llround(static_cast<double>(points) * *plan_bytes_per_point));
+  }
+  if (backend != Backend::kCompute || !position_bytes) return out;
   const uint64_t pixels = uint64_t{width} * height;
   constexpr uint64_t kClear = 8, kKeyRead = 8, kPictureWrite = 4, kColorRead = 4;
-  out.bytes_per_frame = points * positionBytes(mode) + pixels * (kClear + kKeyRead + kPictureWrite) +
-                        std::min(points, pixels) * kColorRead;
+  out.bytes_per_frame =
+      *position_bytes + pixels * (kClear + kKeyRead + kPictureWrite) + std::min(points, pixels) * kColorRead;
   return out;
 }
 

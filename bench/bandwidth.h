@@ -59,23 +59,35 @@ std::string rateText(double gb_per_s);
 
 // Bytes that one frame must move between the device's memory and its cores.
 struct FrameTraffic {
-  uint32_t splat_bytes_per_point = 0;      // what the splat (compute) or vertex fetch reads per point for positions
+  uint32_t splat_bytes_per_point = 0;  // the mode's position bytes: what is read for a point loaded whole
+  // Position bytes the frame reads per point of the set: splat_bytes_per_point, but for a
+  // per-batch mode that follows its plan (below) the plan's; empty where that plan is not known.
+  std::optional<double> loaded_bytes_per_point;
   std::optional<uint64_t> bytes_per_frame;  // compute backend only
 };
 
 // The compute backend (viewer/render_compute.cpp, shaders/render/points_splat.comp and
 // points_resolve.comp), at point size 1:
-//   points · positionBytes(mode)           the splat pass reads positions only
+//   points · loaded_bytes_per_point        the splat pass reads positions only
 //   + pixels · (8 + 8 + 4)                 clear the 8 B key per pixel, read it in the resolve, write
 //                                          the 4 B picture
 //   + min(points, pixels) · 4              the resolve reads the winner's colour per covered pixel;
 //                                          coverage is not measured, so every point is taken to win
 //                                          a pixel of its own, at most every pixel (an upper bound)
+// Positions: the per-batch modes (batch, adaptive) read what their per-camera plan loads
+// (viewer/batch_plan.h), `plan_bytes_per_point` (BatchPlanStats::bytes_per_point: no byte of a culled
+// batch, which the splat never dispatches; adaptive 4, 8 or 12 B a point by the tiers its batch
+// loads); every other mode its whole layout, positionBytes(mode), for every point. The raster path
+// follows the plan only where its vertex shader pulls positions (adaptive: a culled batch's points
+// are sent behind the eye unread); batch's vertex input fetches every point's 8 B whatever the plan.
+// A plan's own reads (one 4 B word per drawn batch, and its 4096 points share one batch matrix) are
+// under 0.02 B a point and not counted.
 // The 8 B atomicMax per visible point is not counted: it lands on the keys the clear and the
 // resolve already count, in the last-level cache on a GPU (a 1920×1080 frame's keys are 16.6 MB).
 // The raster backend gets splat bytes but no frame bytes: its colour and depth attachments go
 // through compressed, cached render targets whose traffic is no byte count we can write down.
-FrameTraffic frameTraffic(Backend backend, PrecisionMode mode, uint64_t points, uint32_t width, uint32_t height);
+FrameTraffic frameTraffic(Backend backend, PrecisionMode mode, uint64_t points, uint32_t width, uint32_t height,
+                          std::optional<double> plan_bytes_per_point = std::nullopt);
 
 // Milliseconds that moving `bytes` takes at `read_write_gb_per_s` (> 0).
 double bandwidthBoundMs(uint64_t bytes, double read_write_gb_per_s);

@@ -66,6 +66,14 @@ void checkGroup(const BenchCase& c, Backend backend, const ModeRows& rows, std::
 std::string num(double v) { return formatNumber(v, true); }
 std::string optNum(const std::optional<double>& v) { return v ? num(*v) : "null"; }
 
+// Adaptive's share of batches at 1, 2 and 3 tiers; null for the other modes.
+std::string tierShareJson(const std::optional<std::array<double, kAdaptiveTiers>>& shares) {
+  if (!shares) return "null";
+  std::string s;
+  for (double share : *shares) s += (s.empty() ? "[" : ", ") + num(share);
+  return s + "]";
+}
+
 std::string generateCommand(const BenchCase& c) {
   if (c.generate.empty()) return "";
   std::string s = "dpoint generate";
@@ -106,8 +114,13 @@ std::string rowJson(const BenchRun& run, const BenchRow& r) {
                                            : std::string("null"));
   s += ", \"frame_ms_median\": " + num(r.frame_ms_median) + ", \"e2e_ms\": " + num(r.e2e_ms) +
        ", \"upload_ms\": " + num(r.upload_ms) + ", \"readback_ms\": " + num(r.readback_ms) +
+       ", \"warmup\": " + (r.skipped.empty() ? "{\"frames\": " + std::to_string(r.warmup_frames) + ", \"ms\": " +
+                                                   num(r.warmup_ms) + "}"
+                                             : std::string("null")) +
        ",\n     \"points_per_s\": " + num(r.points_per_s) + ", \"bytes_per_point\": " + std::to_string(r.bytes_per_point) +
        ", \"splat_bytes_per_point\": " + std::to_string(r.splat_bytes_per_point) +
+       ", \"loaded_bytes_per_point\": " + optNum(r.loaded_bytes_per_point) + ", \"culled_share\": " + optNum(r.culled_share) +
+       ", \"tier_share\": " + tierShareJson(r.tier_share) +
        ", \"bytes_per_frame\": " + (r.bytes_per_frame ? std::to_string(*r.bytes_per_frame) : std::string("null")) +
        ",\n     \"bandwidth_bound_ms\": " + optNum(r.bandwidth_bound_ms) +
        ", \"bandwidth_fraction\": " + optNum(r.bandwidth_fraction) +

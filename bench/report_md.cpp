@@ -30,13 +30,48 @@ std::string msText(double ms) { return ms >= 100 ? withCommas(static_cast<uint64
 
 std::string percentText(const std::optional<double>& fraction) { return fraction ? g3(100.0 * *fraction) + "%" : "–"; }
 
+// Adaptive's share of batches at 1, 2 and 3 tiers: "tiers 80/15/5%".
+std::string tiersText(const std::array<double, kAdaptiveTiers>& shares) {
+  std::string text = "tiers ";
+  for (size_t t = 0; t < shares.size(); ++t) text += (t ? "/" : "") + g3(100.0 * shares[t]);
+  return text + "%";
+}
+
+// What a per-batch mode's frame loaded (its plan for the view): "4.8 B/pt loaded, tiers 80/15/5%".
+std::string loadedText(const BenchRow& row) {
+  if (!modeInfo(row.mode).batch_points || !row.loaded_bytes_per_point) return "";
+  std::string text = g3(*row.loaded_bytes_per_point) + " B/pt loaded";
+  if (row.tier_share) text += ", " + tiersText(*row.tier_share);
+  return text;
+}
+
 std::string fpsCell(const BenchRow* row) {
   if (!row) return "–";
   if (!row->skipped.empty()) return "did not run";
   const double ms = frameMs(*row);
   std::string cell = fpsText(1000.0 / ms) + " fps (" + msText(ms) + " ms" + (row->gpu_ms_median ? "" : ", host");
   if (row->bandwidth_fraction) cell += ", " + percentText(row->bandwidth_fraction) + " of bound";
+  if (const std::string loaded = loadedText(*row); !loaded.empty()) cell += "; " + loaded;
   return cell + ")";
+}
+
+// The per-batch modes' plan in the table of every run: the share of batches culled, and adaptive's
+// share at each tier count.
+std::string planCell(const BenchRow& row) {
+  if (!row.culled_share) return "–";
+  std::string cell = g3(100.0 * *row.culled_share) + "% culled";
+  if (row.tier_share) cell += ", " + tiersText(*row.tier_share);
+  return cell;
+}
+
+// "rte, df64, native, batch and adaptive": the modes checked against fp32 where it is off.
+std::string sceneFrameModes() {
+  std::vector<std::string> names;
+  for (PrecisionMode mode : kAllModes)
+    if (modeInfo(mode).scene_frame) names.push_back(modeText(mode));
+  std::string text;
+  for (size_t i = 0; i < names.size(); ++i) text += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return text;
 }
 
 std::string errorCell(const BenchRow* row) {
@@ -66,8 +101,10 @@ std::string modeHeader(bool with_bytes) {
   for (PrecisionMode mode : kAllModes) {
     h += ' ';
     h += modeText(mode);
+    // A per-batch mode loads at most its layout's bytes: its plan culls and (adaptive) picks tiers.
     if (with_bytes)
-      h += " (" + std::to_string(positionBytes(mode)) + " B/pt splat, " + std::to_string(bytesPerPoint(mode)) + " total)";
+      h += std::string(" (") + (modeInfo(mode).batch_points ? "≤ " : "") + std::to_string(positionBytes(mode)) +
+           " B/pt splat, " + std::to_string(bytesPerPoint(mode)) + " total)";
     h += " |";
   }
   return h;
@@ -220,7 +257,8 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   s += "- Command: `" + context.command + "` (dpoint " + context.version + ", " + context.date + "; whole run " +
        withCommas(static_cast<uint64_t>(std::llround(run.seconds))) + " s)\n";
   s += "- Speed: GPU timestamps around the draw (raster) or the splat and resolve passes (compute), median of the timed "
-       "frames after warm-up; p95, min and the end-to-end time (upload, one frame, readback) are in results.json. "
+       "frames after warm-up (untimed frames, as `--warmup` in the command says; each row's count and time are in "
+       "results.json); p95, min and the end-to-end time (upload, one frame, readback) are in results.json. "
        "Absolute times count on a GPU; on lavapipe (a CPU) compare modes as ratios.\n";
   s += "- Error: each point's window position from the probe (the same shader storing its clip position) against the "
        "exact one (long double, same camera), in pixels; a mode's *bound* is predicted before drawing from its "
@@ -240,10 +278,13 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
          "are shown as printed, though they disagree with each other (695.76 ms is not 330 fps) and the paper does "
          "not say what its rendering time covers: compare our frame rate with its fps only. For the 2D sets it prints "
          "one figure, in a caption. Headers give the bytes per point the splat pass (raster: the vertex fetch) reads for "
-         "positions, and in total with the colour. *% of bound* (compute backend): the time the frame's bytes take at "
-         "the copy bandwidth, against the GPU time; the bytes are points × splat B/pt + pixels × 20 B (clear, read "
-         "and resolve the 8 B keys, write the picture) + 4 B of colour per covered pixel, every point taken to cover a "
-         "pixel of its own (bench/bandwidth.h).\n";
+         "positions, and in total with the colour. The per-batch modes (batch, adaptive) load less: per view, their "
+         "plan skips batches outside it and adaptive loads 1, 2 or 3 tiers of 4 B per batch, the fewest its tolerance "
+         "allows; their cells give the position bytes the frame loaded per point of the set and adaptive's share of "
+         "batches at each tier count (batch's raster path fetches every point's 8 B). *% of bound* (compute "
+         "backend): the time the frame's bytes take at the copy bandwidth, against the GPU time; the bytes are "
+         "points × loaded B/pt + pixels × 20 B (clear, read and resolve the 8 B keys, write the picture) + 4 B of "
+         "colour per covered pixel, every point taken to cover a pixel of its own (bench/bandwidth.h).\n";
     for (Backend backend : backendsOf(run)) {
       s += "\n### " + backendText(backend) + " backend\n\n| dataset | points | resolution | "
            "study, RTX 3090 (48 B/pt), emulated (Table 2): time, frame rate | study, native (Table 3): time, frame rate |" +
@@ -285,25 +326,29 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   s += "\n## Checks\n\nWhat each mode's arithmetic predicts (docs/precision.md).\n\n";
   if (failures.empty()) {
     s += "All passed: every measured error is within its predicted bound; split equals fp32; native is the most "
-         "accurate mode within one float floor; where fp32 is off by more than a pixel, rte, df64, native and batch "
-         "all do better.\n";
+         "accurate mode within one float floor; where fp32 is off by more than a pixel, " + sceneFrameModes() +
+         " all do better.\n";
   } else {
     s += std::to_string(failures.size()) + " failed:\n\n| case | backend | mode | what |\n| --- | --- | --- | --- |\n";
     for (const CheckFailure& f : failures) s += "| " + f.case_name + " | " + f.backend + " | " + f.mode + " | " + f.what + " |\n";
   }
   s += "\n## Every run\n\n| suite | case | backend | mode | points | GPU ms (median / p95) | e2e ms | points/s | B/pt | "
-       "B/pt (splat) | % of bound | bound px | max px | p99 px | rms px | off ≥ 0.5 px | lost | pixels differing |\n"
-       "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+       "B/pt (splat) | B/pt loaded | plan | % of bound | bound px | max px | p99 px | rms px | off ≥ 0.5 px | lost | "
+       "pixels differing |\n"
+       "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- "
+       "| --- |\n";
   for (const BenchRow& r : run.rows) {
     s += "| " + std::string(suiteName(r.bench_case->suite)) + " | " + r.bench_case->name + " | " + backendText(r.backend) +
          " | " + modeText(r.mode) + " | " + withCommas(r.points) + " | ";
     if (!r.skipped.empty()) {
-      s += "did not run: " + r.skipped + " | | | | | | | | | | | | |\n";
+      s += "did not run: " + r.skipped + " | | | | | | | | | | | | | | |\n";
       continue;
     }
     s += (r.gpu_ms_median ? g3(*r.gpu_ms_median) + " / " + g3(r.gpu_ms_p95.value_or(0)) : "–") + " | " + g3(r.e2e_ms) +
          " | " + g3(r.points_per_s) + " | " + std::to_string(r.bytes_per_point) + " | " +
-         std::to_string(r.splat_bytes_per_point) + " | " + percentText(r.bandwidth_fraction) + " | " +
+         std::to_string(r.splat_bytes_per_point) + " | " +
+         (r.loaded_bytes_per_point ? g3(*r.loaded_bytes_per_point) : "–") + " | " + planCell(r) + " | " +
+         percentText(r.bandwidth_fraction) + " | " +
          (std::isfinite(r.predicted_bound_px) ? g3(r.predicted_bound_px) : "unbounded") + " | " +
          (r.error_max_px ? g3(*r.error_max_px) + " | " + g3(r.error_p99_px.value_or(0)) + " | " + g3(r.error_rms_px.value_or(0))
                          : "all lost | – | –") +

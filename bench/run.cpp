@@ -102,6 +102,27 @@ double numberAt(const JsonValue& object, std::string_view key) {
   return v && v->kind == JsonValue::Kind::kNumber ? v->number : 0.0;
 }
 
+// A per-batch mode's plan from the timed draw's report (its `batch_plan`); other modes have none.
+Status readPlan(const JsonValue& json, const std::string& json_path, BenchRow& row) {
+  if (!modeInfo(row.mode).batch_points) return okStatus();
+  const JsonValue* plan = json.find("batch_plan");
+  const JsonValue* loaded = plan ? plan->find("loaded_bytes_per_point") : nullptr;
+  const JsonValue* batches = plan ? plan->find("batches") : nullptr;
+  if (!loaded || loaded->kind != JsonValue::Kind::kNumber || !batches || batches->kind != JsonValue::Kind::kNumber)
+    return Error{json_path + ": " + std::string(modeName(row.mode)) + " mode's report has no batch_plan", ExitCode::kBadInput};
+  row.plan_bytes_per_point = loaded->number;
+  row.culled_share = batches->number > 0 ? numberAt(*plan, "culled") / batches->number : 0.0;
+  if (!modeInfo(row.mode).tiers) return okStatus();
+  const JsonValue* shares = plan->find("tier_share");
+  if (!shares || shares->kind != JsonValue::Kind::kArray || shares->items.size() != kAdaptiveTiers)
+    return Error{json_path + ": adaptive mode's batch_plan has no tier_share of " + std::to_string(kAdaptiveTiers),
+                 ExitCode::kBadInput};
+  std::array<double, kAdaptiveTiers> tiers{};
+  for (size_t t = 0; t < kAdaptiveTiers; ++t) tiers[t] = shares->items[t].number;
+  row.tier_share = tiers;
+  return okStatus();
+}
+
 // The timed draw: a fresh `dpoint render` process without the probe, exactly what a user runs.
 Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& options, BenchRow& row) {
   const std::string json_path = cachePath(options, "timed-draw.json");
@@ -109,7 +130,7 @@ Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& optio
                                    "--mode", std::string(modeName(row.mode)), "--backend",
                                    report::backendText(row.backend), "--device", options.device,
                                    "--frames", std::to_string(std::max<uint32_t>(options.frames, 1)), "--warmup",
-                                   std::to_string(options.warmup), "--json", json_path, "--quiet"};
+                                   warmupText(options.warmup), "--json", json_path, "--quiet"};
   for (const std::string& flag : cameraFlags(p.spec)) args.push_back(flag);
   if (options.validate) args.push_back("--validate");
   if (Status ran = options.run_dpoint(args); !ran) return ran;
@@ -130,7 +151,11 @@ Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& optio
   row.readback_ms = numberAt(*json, "readback_ms");
   row.e2e_ms = numberAt(*json, "e2e_ms");
   row.points_per_s = numberAt(*json, "points_per_s");
-  return okStatus();
+  if (const JsonValue* warmup = json->find("warmup"); warmup && warmup->kind == JsonValue::Kind::kObject) {
+    row.warmup_frames = static_cast<uint32_t>(numberAt(*warmup, "frames"));
+    row.warmup_ms = numberAt(*warmup, "ms");
+  }
+  return readPlan(*json, json_path, row);
 }
 
 // The probed draw: every point's clip position against the exact reference, and the picture
@@ -178,9 +203,10 @@ std::string montageCaption(const BenchRow& row) {
 
 void setBandwidthBound(BenchRow& row, const CopyBandwidth* copy) {
   assert(row.bench_case);
-  const FrameTraffic traffic =
-      frameTraffic(row.backend, row.mode, row.points, row.bench_case->width, row.bench_case->height);
+  const FrameTraffic traffic = frameTraffic(row.backend, row.mode, row.points, row.bench_case->width,
+                                            row.bench_case->height, row.plan_bytes_per_point);
   row.splat_bytes_per_point = traffic.splat_bytes_per_point;
+  row.loaded_bytes_per_point = traffic.loaded_bytes_per_point;
   row.bytes_per_frame = traffic.bytes_per_frame;
   row.bandwidth_bound_ms.reset();
   row.bandwidth_fraction.reset();
@@ -260,6 +286,7 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
           else {
             line += row.gpu_ms_median ? g3(*row.gpu_ms_median) + " ms" : g3(row.frame_ms_median) + " ms (host)";
             if (row.bandwidth_fraction) line += " (" + g3(100.0 * *row.bandwidth_fraction) + "% of the bandwidth bound)";
+            if (row.plan_bytes_per_point) line += ", " + g3(*row.loaded_bytes_per_point) + " B/pt loaded";
             line += row.error_max_px ? ", max error " + g3(*row.error_max_px) + " px" : ", every point lost";
           }
           options.log(line);

@@ -13,6 +13,7 @@
 // frames and will meet it), the bench times what `dpoint render` times.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -24,6 +25,7 @@
 #include "vulkan/context.h"
 #include "viewer/encode.h"
 #include "viewer/render.h"
+#include "viewer/render_job.h"
 
 namespace dpoint {
 
@@ -38,13 +40,24 @@ struct BenchRow {
   double frame_ms_median = 0.0, upload_ms = 0.0, readback_ms = 0.0;
   double e2e_ms = 0.0;        // upload + one frame (median) + readback, as `dpoint render --json`
   double points_per_s = 0.0;  // from the GPU median (else the host frame median)
+  uint32_t warmup_frames = 0;  // untimed frames the timed draw ran first, and their wall time
+  double warmup_ms = 0.0;
   uint32_t bytes_per_point = 0;
-  // Bandwidth (bench/bandwidth.h, setBandwidthBound): position bytes per point the splat pass (or
-  // the vertex fetch) reads; compute backend only, the bytes a frame must move, the time that takes
-  // at the run's read+write copy bandwidth, and bound / GPU median (1: as fast as the memory
-  // allows). Empty where the backend has no byte count, the bandwidth or the GPU time was not
-  // measured, or the row did not run.
+  // The per-batch modes' plan for the case's view (viewer/batch_plan.h), as the timed draw reported
+  // it (`batch_plan` of its --json): position bytes it loads per point of the whole set (a culled
+  // batch's points 0; adaptive: 4 B per tier loaded), the share of batches culled, and adaptive's
+  // share of batches at 1, 2 and 3 tiers. Empty for the other modes and where the draw did not run.
+  std::optional<double> plan_bytes_per_point, culled_share;
+  std::optional<std::array<double, kAdaptiveTiers>> tier_share;
+  // Bandwidth (bench/bandwidth.h, setBandwidthBound): position bytes per point of the mode's layout
+  // (what the splat pass or the vertex fetch reads for a point it loads whole); those the frame
+  // loaded per point of the set (the layout's, but for the per-batch modes' plan: FrameTraffic);
+  // compute backend only, the bytes a frame must move, the time that takes at the run's read+write
+  // copy bandwidth, and bound / GPU median (1: as fast as the memory allows). Empty where the
+  // backend has no byte count, the plan, the bandwidth or the GPU time was not measured, or the row
+  // did not run.
   uint32_t splat_bytes_per_point = 0;
+  std::optional<double> loaded_bytes_per_point;
   std::optional<uint64_t> bytes_per_frame;
   std::optional<double> bandwidth_bound_ms, bandwidth_fraction;
   // Error: the bound predicted before drawing (+inf: unbounded) and what the probe measured.
@@ -74,7 +87,9 @@ struct BenchOptions {
   std::vector<BenchSuite> suites;
   std::vector<Backend> backends;
   std::vector<std::string> sizes;  // paper cases kept by size label (case-insensitive); empty: all
-  uint32_t frames = 20, warmup = 2;
+  uint32_t frames = 20;
+  // Each timed draw's `dpoint render --warmup`: by time, as a GPU's clocks need (render_job.h).
+  WarmupRequest warmup{WarmupRequest::Kind::kTime, 0, kAutoWarmupMs};
   bool measure_error = true;  // false: timed draws only; error columns stay empty
   std::string cache_dir;
   std::string device = "auto";  // passed to every `dpoint render`; the context given must be that device
@@ -97,8 +112,8 @@ struct BenchRun {
   double seconds = 0.0;  // wall time of the whole run
 };
 
-// Fills the row's bandwidth fields (above) from its case, mode, backend and GPU time, and `copy`
-// (null: not measured). Needs row.bench_case.
+// Fills the row's bandwidth fields (above) from its case, mode, backend, plan and GPU time, and
+// `copy` (null: not measured). Needs row.bench_case.
 void setBandwidthBound(BenchRow& row, const CopyBandwidth* copy);
 
 // Fails on a dataset that cannot be made or read, or a copy bandwidth that cannot be measured; a

@@ -29,6 +29,7 @@
 #include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/progress.h"
+#include "viewer/render_job.h"
 
 namespace dpoint {
 namespace {
@@ -72,7 +73,8 @@ int runBenchIo(const BenchIoOptions& o) {
 struct BenchReportOptions {
   std::string suite = "ci", out = "bench-out", cache = "bench-cache", device = "auto", backend = "both";
   std::vector<std::string> sizes;
-  uint32_t frames = 20, warmup = 2;
+  uint32_t frames = 20;
+  std::string warmup = "300ms";  // passed to every timed `dpoint render` (parseWarmup)
   bool validate = false, no_error = false, no_copy_bandwidth = false;
   std::string copy_bytes = "auto";
   uint32_t copy_repeats = 10;
@@ -159,7 +161,7 @@ std::string utcNow() {
 // The command as a user would type it to get this run again, every setting spelled out.
 std::string commandLine(const BenchReportOptions& o) {
   std::string s = "dpoint bench --suite " + o.suite + " --backend " + o.backend + " --device " + o.device +
-                  " --frames " + std::to_string(o.frames) + " --warmup " + std::to_string(o.warmup);
+                  " --frames " + std::to_string(o.frames) + " --warmup " + o.warmup;
   if (!o.sizes.empty()) {
     s += " --sizes ";
     for (size_t i = 0; i < o.sizes.size(); ++i) s += (i ? "," : "") + o.sizes[i];
@@ -208,7 +210,7 @@ int runBenchReport(const BenchReportOptions& o) {
   }
   options.sizes = o.sizes;
   options.frames = o.frames;
-  options.warmup = o.warmup;
+  options.warmup = *parseWarmup("--warmup", o.warmup);
   options.measure_error = !o.no_error;
   options.cache_dir = o.cache;
   const unsigned threads = o.common.threads;
@@ -275,7 +277,11 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
       ->default_val("auto");
   bench->add_option("--backend", r->backend, "raster, compute or both")->default_val("both");
   bench->add_option("--frames", r->frames, "Timed frames per run (the median is reported)")->default_val(20);
-  bench->add_option("--warmup", r->warmup, "Untimed frames first")->default_val(2);
+  bench->add_option("--warmup", r->warmup,
+                    "Untimed frames before each timed draw's: a duration (300ms, 0.5s: frames until that much time has\n"
+                    "passed, at least one), a count (2), or auto (as `dpoint render`)")
+      ->check(checkStatus([](const std::string& v) { return statusOf(parseWarmup("--warmup", v)); }))
+      ->default_val("300ms");
   bench->add_option("--sizes", r->sizes, "paper suite: only these of the float-vs-double Vulkan study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
   bench->add_flag("--no-error", r->no_error, "Time only: skip the probe draws and the exact reference (no error columns)");
   bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");

@@ -32,7 +32,7 @@ struct RenderCliOptions {
   bool error = false, validate = false;
   std::string point_size = "auto";
   uint32_t frames = 1;
-  std::optional<uint32_t> warmup;  // none: 0 for one frame (the picture alone), else 1
+  std::string warmup = "auto";
   uint64_t chunk_points = 0;
   std::string max_memory;
   CommonOptions common;
@@ -88,7 +88,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.views = o.views;
   request.error = o.error;
   request.report = !o.json.empty();
-  request.frames = o.frames, request.warmup = o.warmup.value_or(o.frames > 1 ? 1 : 0);
+  request.frames = o.frames, request.warmup = *parseWarmup("--warmup", o.warmup);
   request.chunk_points = o.chunk_points;
   request.native_path = o.native_path == "attribute" ? NativePath::kAttribute
                         : o.native_path == "pull"    ? NativePath::kPull
@@ -164,9 +164,13 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
                 request.mode == "auto" ? "; --mode auto takes native for it" : "");
   else
     printChoice(outcome.prediction, f, outcome.backend);
+  char warmup[64] = ", no warm-up";
+  if (r.warmup_frames)
+    std::snprintf(warmup, sizeof warmup, " after %u warm-up frame%s in %.0f ms", r.warmup_frames,
+                  r.warmup_frames == 1 ? "" : "s", r.warmup_ms);
   if (!r.gpu_ms.empty())
     std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f)%s, %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
-                r.gpu_ms.size(), percentileOf(r.gpu_ms, 95), request.warmup == 0 ? ", no warm-up" : "",
+                r.gpu_ms.size(), percentileOf(r.gpu_ms, 95), warmup,
                 static_cast<double>(outcome.points) / (medianOf(r.gpu_ms) * 1e-3), bytesPerPoint(mode));
   std::printf("host: upload %.1f ms, frame %.3f ms, readback %.1f ms\n", r.upload_ms, medianOf(r.frame_ms), r.readback_ms);
   std::string steps;
@@ -271,9 +275,12 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->default_val("auto");
   cmd->add_option("--frames", o->frames, "Timed frames after warm-up (the median is reported)")->default_val(1);
   cmd->add_option("--warmup", o->warmup,
-                  "Untimed frames first. auto: none for a single frame (the picture comes sooner; its time includes the\n"
-                  "first use of the shaders), 1 with --frames above 1")
-      ->default_str("auto");
+                  "Untimed frames first: a count (2), or a duration (300ms, 0.5s): frames until that much time has\n"
+                  "passed, at least one. auto: none for a single frame (the picture comes sooner; its time includes\n"
+                  "the first use of the shaders), 300ms with --frames above 1 (a GPU's first frames after an upload\n"
+                  "run slower while its clocks come up)")
+      ->check(checkStatus([](const std::string& v) { return statusOf(parseWarmup("--warmup", v)); }))
+      ->default_val("auto");
   cmd->add_flag("--error", o->error, "Run the probe and the exact CPU reference; report the error in pixels");
   cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file")
       ->check(checkStatus(AtomicFile::checkTarget));

@@ -361,7 +361,8 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
   VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &r.fence));
 
-  for (uint32_t frame = 0; frame < options.warmup_frames + options.frames; ++frame) {
+  // One frame: submit, wait, and its wall time from submit to fence.
+  auto drawFrame = [&]() -> Result<double> {
     if (interrupted()) return interruptedError();  // between frames: the GPU is idle here
     Clock::time_point start = Clock::now();
     VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -371,8 +372,20 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
     VK_TRY(waitForFence(context, r.fence));
     double wall = msSince(start);
     VK_TRY(vkResetFences(context.device, 1, &r.fence));
-    if (frame < options.warmup_frames) continue;
-    out.frame_ms.push_back(wall);
+    return wall;
+  };
+  // The warm-up: a count of frames, then frames until its time has passed (RenderOptions).
+  const Clock::time_point warmup_start = Clock::now();
+  while (out.warmup_frames < options.warmup_frames ||
+         (options.warmup_ms > 0.0 && msSince(warmup_start) < options.warmup_ms)) {
+    if (Result<double> drawn = drawFrame(); !drawn) return drawn.error();
+    ++out.warmup_frames;
+  }
+  out.warmup_ms = out.warmup_frames ? msSince(warmup_start) : 0.0;
+  for (uint32_t frame = 0; frame < options.frames; ++frame) {
+    Result<double> wall = drawFrame();
+    if (!wall) return wall.error();
+    out.frame_ms.push_back(*wall);
     if (timestamps) {
       uint64_t ticks[2] = {0, 0};
       VK_TRY(vkGetQueryPoolResults(context.device, r.queries, 0, 2, sizeof(ticks), ticks, sizeof(uint64_t),

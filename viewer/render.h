@@ -46,7 +46,12 @@ struct RenderOptions {
   Backend backend = Backend::kRaster;
   float point_size = 1.0f;
   uint32_t background_rgba8 = 0xff000000u;  // opaque black, R in the low byte
+  // Warm-up: untimed frames before the timed ones, warmup_frames of them, then more until warmup_ms of
+  // wall time (submit to fence) have passed since the first began (0: none by time). By time is
+  // what a GPU needs after a long upload: its first frames run 2–4× slower in flat steps for up to
+  // ~300 ms (clock ramp suspected; docs/performance.md), whatever the frame count.
   uint32_t warmup_frames = 1;
+  double warmup_ms = 0.0;
   uint32_t frames = 1;  // timed frames after warm-up (≥ 1)
   bool probe = false;   // also store clip positions (DESIGN §5)
   NativePath native_path = NativePath::kAuto;  // auto: R64G64B64 vertex input where listed, else pull
@@ -67,6 +72,8 @@ struct RenderResult {
   Image image;                     // the last frame
   std::vector<double> gpu_ms;      // per timed frame, from timestamps; empty if the queue has none
   std::vector<double> frame_ms;    // per timed frame, submit to fence on the host
+  uint32_t warmup_frames = 0;      // untimed frames drawn first (RenderOptions' warm-up)
+  double warmup_ms = 0.0;          // their wall time, from the first submit to the last fence
   double upload_ms = 0.0;          // encode + upload of every buffer
   double readback_ms = 0.0;        // copy of the picture to the host
   std::vector<glm::vec4> probe_clip;  // with `probe`: clip position of every point, in input order

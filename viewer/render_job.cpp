@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -206,6 +207,14 @@ ModePrediction streamedModePrediction(const RenderRequest& request) {
   return p;
 }
 
+// --warmup as RenderOptions' two fields: a count of frames, or one frame and then by time.
+void setWarmup(const WarmupRequest& warmup, uint32_t frames, RenderOptions& options) {
+  using Kind = WarmupRequest::Kind;
+  const double ms = warmup.kind == Kind::kTime ? warmup.ms : warmup.kind == Kind::kAuto && frames > 1 ? kAutoWarmupMs : 0.0;
+  options.warmup_frames = warmup.kind == Kind::kFrames ? warmup.frames : ms > 0.0 ? 1 : 0;
+  options.warmup_ms = ms;
+}
+
 // Shading auto on a picture too large for the shading passes' buffers draws it plain, with a
 // warning in `warnings`.
 RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& set, PrecisionMode mode,
@@ -216,7 +225,7 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts, set.spacing);
   options.background_rgba8 = request.background_rgba8;
   options.frames = request.frames;
-  options.warmup_frames = request.warmup;
+  setWarmup(request.warmup, request.frames, options);
   options.tolerance_px = request.tolerance_px;
   options.probe = request.error;
   options.native_path = request.native_path;
@@ -372,6 +381,52 @@ Status checkModeName(const std::string& mode) {
 Status checkViewCount(uint32_t views) {
   if (views == 1 || views == 4) return okStatus();
   return Error{"--views must be 1 or 4, got " + std::to_string(views), ExitCode::kUsage};
+}
+
+Result<WarmupRequest> parseWarmup(const std::string& flag, const std::string& text) {
+  WarmupRequest out;
+  if (text == "auto") return out;
+  auto refuse = [&](const std::string& why) {
+    return Error{flag + ": '" + text + "' " + why + " (a frame count such as 2, a duration such as 300ms or 0.5s, or auto)",
+                 ExitCode::kUsage};
+  };
+  const size_t digits = text.find_first_not_of("0123456789.");
+  const std::string number = text.substr(0, digits), unit = digits == std::string::npos ? "" : text.substr(digits);
+  if (number.empty() || number.front() == '.') return refuse("is not a warm-up");
+  if (unit.empty()) {
+    // A count: whole frames only, within uint32_t.
+    if (number.find('.') != std::string::npos) return refuse("is no whole number of frames; a duration needs ms or s");
+    uint64_t frames = 0;
+    if (!parseDecimalU64(number, frames) || frames > UINT32_MAX) return refuse("is more frames than can be counted");
+    out.kind = WarmupRequest::Kind::kFrames;
+    out.frames = static_cast<uint32_t>(frames);
+    return out;
+  }
+  if (unit != "ms" && unit != "s") return refuse("has no unit it knows: ms or s");
+  char* end = nullptr;
+  const double value = std::strtod(number.c_str(), &end);
+  if (end != number.c_str() + number.size() || !std::isfinite(value)) return refuse("is not a duration");
+  out.kind = WarmupRequest::Kind::kTime;
+  out.ms = unit == "s" ? value * 1000.0 : value;
+  if (!(out.ms > 0.0)) return refuse("is no time; --warmup 0 draws no warm-up frame");
+  if (out.ms < kMinWarmupMs) return refuse("is under " + formatNumber(kMinWarmupMs) + " ms");
+  if (out.ms > kMaxWarmupMs) return refuse("is more than " + formatNumber(kMaxWarmupMs / 1000.0) + " s");
+  return out;
+}
+
+std::string warmupText(const WarmupRequest& warmup) {
+  switch (warmup.kind) {
+    case WarmupRequest::Kind::kAuto: return "auto";
+    case WarmupRequest::Kind::kFrames: return std::to_string(warmup.frames);
+    case WarmupRequest::Kind::kTime: {
+      // The shortest fixed-point text that reads back to the same double (no exponent: parseWarmup
+      // takes none); kMinWarmupMs..kMaxWarmupMs fits the buffer.
+      char text[64];
+      const std::to_chars_result r = std::to_chars(text, text + sizeof text, warmup.ms, std::chars_format::fixed);
+      return std::string(text, r.ptr) + "ms";
+    }
+  }
+  return "auto";
 }
 
 Status checkRenderRequest(const RenderRequest& request) {
@@ -624,6 +679,14 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
     o.add("gpu_ms_each", V::numbers(r.gpu_ms));
   }
   o.add("frame_ms", JsonObject().add("median", V::number(frame_median)).add("p95", V::number(percentileOf(r.frame_ms, 95))));
+  // The warm-up that ran before the timed frames: untimed frames and their wall time, and the time
+  // it was to last at least (--warmup by time, or auto with several frames; null: a count).
+  RenderOptions warmup;
+  setWarmup(request.warmup, request.frames, warmup);
+  o.add("warmup", JsonObject()
+                      .add("frames", V::integer(r.warmup_frames))
+                      .add("ms", V::number(r.warmup_ms))
+                      .add("until_ms", warmup.warmup_ms > 0.0 ? V::number(warmup.warmup_ms) : V::null()));
   o.add("upload_ms", V::number(r.upload_ms)).add("readback_ms", V::number(r.readback_ms));
   o.add("e2e_ms", V::number(r.upload_ms + frame_median + r.readback_ms));
   JsonObject phases;

@@ -40,6 +40,25 @@ enum class UpAxis { kAuto, kY, kZ };
 
 const char* backendName(Backend backend);  // "raster", "compute"
 
+// --warmup: the untimed frames before the timed ones (RenderOptions' warm-up). auto: none for a
+// single frame (the picture comes sooner), else kAutoWarmupMs by time; a count of frames ("2"); or
+// a duration ("300ms", "0.5s"): frames until that much wall time has passed, at least one.
+struct WarmupRequest {
+  enum class Kind { kAuto, kFrames, kTime };
+  Kind kind = Kind::kAuto;
+  uint32_t frames = 0;  // kFrames
+  double ms = 0.0;      // kTime: kMinWarmupMs to kMaxWarmupMs
+};
+// auto's warm-up with more than one timed frame: on the H100 the first frames after a multi-second
+// upload ran 2–4× slower in flat steps for up to ~300 ms (docs/performance.md).
+inline constexpr double kAutoWarmupMs = 300.0;
+inline constexpr double kMaxWarmupMs = 60000.0;  // a longer one is taken for a typo (300s for 300ms)
+inline constexpr double kMinWarmupMs = 0.001;    // a shorter one is no duration a frame can measure
+// "auto", a whole number, or a number with "ms" or "s". Fails (kUsage) naming `flag` and the text.
+Result<WarmupRequest> parseWarmup(const std::string& flag, const std::string& text);
+// The text parseWarmup reads back to the same request ("auto", "2", "300ms").
+std::string warmupText(const WarmupRequest& warmup);
+
 // What the user asked for, as plain values (the CLI's options, parsed).
 struct RenderRequest {
   std::vector<std::string> inputs;   // drawn as one (point_inputs.h)
@@ -59,7 +78,8 @@ struct RenderRequest {
   uint32_t views = 1;                // 1, or 4: a contact sheet of four labelled views
   bool error = false;                // measure the error against the exact CPU reference
   bool report = false;               // a report (renderReportJson) is wanted: one view only
-  uint32_t frames = 1, warmup = 1;
+  uint32_t frames = 1;
+  WarmupRequest warmup;              // --warmup (auto by default)
   double tolerance_px = kDefaultTolerancePx;  // adaptive mode's tier choice (--tolerance)
   uint64_t chunk_points = 0;         // most points per draw; 0: as the device allows
   NativePath native_path = NativePath::kAuto;

@@ -34,6 +34,11 @@ BenchRun madeUpRun(const std::array<double, kModeCount>& errors, const std::arra
     row.predicted_bound_px = bounds[m];
     row.float_floor_px = 1e-5;
     row.gpu_ms_median = row.gpu_ms_p95 = row.gpu_ms_min = 1.0;
+    if (modeInfo(row.mode).batch_points) {  // a plan that culls nothing and loads every tier
+      row.plan_bytes_per_point = modeInfo(row.mode).position_bytes;
+      row.culled_share = 0.0;
+      if (modeInfo(row.mode).tiers) row.tier_share = std::array<double, kAdaptiveTiers>{0.0, 0.0, 1.0};
+    }
     if (std::isnan(errors[m])) {
       row.points_lost = 100;
     } else {
@@ -115,6 +120,7 @@ TEST(BenchReport, bandwidthBoundCountsEveryPassOfAComputeFrame) {
     const uint64_t per_pixel = 500000ull * (8 + 8 + 4);  // clear and read the keys, write the picture
     const uint64_t colors = 100ull * 4;                    // 100 points cover at most 100 pixels
     EXPECT_EQ(row.splat_bytes_per_point, modeInfo(row.mode).position_bytes) << modeName(row.mode);
+    EXPECT_EQ(row.loaded_bytes_per_point, double(modeInfo(row.mode).position_bytes)) << modeName(row.mode);
     ASSERT_TRUE(row.bytes_per_frame && row.bandwidth_bound_ms && row.bandwidth_fraction) << modeName(row.mode);
     EXPECT_EQ(*row.bytes_per_frame, positions + per_pixel + colors) << modeName(row.mode);
     const double bound_ms = static_cast<double>(positions + per_pixel + colors) / 100e9 * 1e3;
@@ -160,6 +166,83 @@ TEST(BenchReport, bandwidthBoundLeavesRasterSkippedAndUntimedRowsWithoutAFractio
   EXPECT_FALSE(untimed.bandwidth_fraction) << "no GPU time: no fraction";
 }
 
+// The per-batch modes read what their view's plan loads: 1000 points on the compute backend,
+// batch with a quarter of its batches culled (6 B a point of the set), adaptive at 4.5 B a point
+// (tiers and culling mixed), counted in the frame's bytes and its bound; without a plan (the draw
+// did not report one) nothing is counted for them, where every other mode keeps its layout's.
+TEST(BenchReport, bandwidthBoundCountsWhatThePerBatchPlanLoaded) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
+  run.cases.front().width = 100;
+  run.cases.front().height = 100;
+  CopyBandwidth copy;
+  copy.read_write_gb_per_s = 100.0;
+  BenchRow& batch = run.rows[modeIndex(PrecisionMode::kBatch)];
+  BenchRow& adaptive = run.rows[modeIndex(PrecisionMode::kAdaptive)];
+  batch.points = adaptive.points = 1000;
+  batch.plan_bytes_per_point = 6.0;
+  adaptive.plan_bytes_per_point = 4.5;
+  const uint64_t frame = 10000ull * (8 + 8 + 4) + 1000ull * 4;  // keys, picture, 1000 colours
+  setBandwidthBound(batch, &copy);
+  setBandwidthBound(adaptive, &copy);
+  EXPECT_EQ(batch.splat_bytes_per_point, 8u) << "the layout's bytes stay";
+  EXPECT_EQ(batch.loaded_bytes_per_point, 6.0);
+  ASSERT_TRUE(batch.bytes_per_frame && adaptive.bytes_per_frame && adaptive.bandwidth_bound_ms);
+  EXPECT_EQ(*batch.bytes_per_frame, 6000 + frame);
+  EXPECT_EQ(adaptive.splat_bytes_per_point, positionBytes(PrecisionMode::kAdaptive));
+  EXPECT_EQ(adaptive.loaded_bytes_per_point, 4.5);
+  EXPECT_EQ(*adaptive.bytes_per_frame, 4500 + frame);
+  EXPECT_NEAR(*adaptive.bandwidth_bound_ms, double(4500 + frame) / 100e9 * 1e3, 1e-15);
+  // The raster path: adaptive pulls its tier words, so it follows the plan; batch's vertex input
+  // fetches every point's 8 B.
+  batch.backend = adaptive.backend = Backend::kRaster;
+  setBandwidthBound(batch, &copy);
+  setBandwidthBound(adaptive, &copy);
+  EXPECT_EQ(batch.loaded_bytes_per_point, 8.0);
+  EXPECT_EQ(adaptive.loaded_bytes_per_point, 4.5);
+  EXPECT_FALSE(batch.bytes_per_frame || adaptive.bytes_per_frame) << "raster: no frame bytes";
+  // No plan reported: no loaded bytes, no frame bytes, no bound; fp32 is not affected.
+  adaptive.backend = Backend::kCompute;
+  adaptive.plan_bytes_per_point.reset();
+  setBandwidthBound(adaptive, &copy);
+  EXPECT_FALSE(adaptive.loaded_bytes_per_point || adaptive.bytes_per_frame || adaptive.bandwidth_bound_ms);
+  BenchRow& fp32 = run.rows[modeIndex(PrecisionMode::kFp32)];
+  setBandwidthBound(fp32, &copy);
+  EXPECT_EQ(fp32.loaded_bytes_per_point, 12.0);
+}
+
+// results.json and report.md show what a per-batch row loaded: its bytes per point, the share of
+// batches culled and adaptive's share at each tier count; other modes' plan fields are null.
+TEST(BenchReport, reportShowsThePlansLoadedBytesAndAdaptivesTiers) {
+  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
+  run.cases.front().hard = false;
+  run.cases.front().width = run.cases.front().height = 100;
+  BenchRow& batch = run.rows[modeIndex(PrecisionMode::kBatch)];
+  BenchRow& adaptive = run.rows[modeIndex(PrecisionMode::kAdaptive)];
+  batch.plan_bytes_per_point = 6.0;
+  batch.culled_share = 0.25;
+  adaptive.plan_bytes_per_point = 4.5;
+  adaptive.culled_share = 0.5;
+  adaptive.tier_share = std::array<double, kAdaptiveTiers>{0.25, 0.125, 0.125};
+  adaptive.warmup_frames = 7;
+  adaptive.warmup_ms = 301.5;
+  for (BenchRow& row : run.rows) setBandwidthBound(row, nullptr);
+  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(json.find("\"loaded_bytes_per_point\": 6, \"culled_share\": 0.25, \"tier_share\": null"), std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"loaded_bytes_per_point\": 4.5, \"culled_share\": 0.5, \"tier_share\": [0.25, 0.125, 0.125]"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"warmup\": {\"frames\": 7, \"ms\": 301.5}"), std::string::npos) << json;
+  const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  EXPECT_NE(report.find("; 6 B/pt loaded)"), std::string::npos) << report;
+  EXPECT_NE(report.find("; 4.5 B/pt loaded, tiers 25/12.5/12.5%)"), std::string::npos) << report;
+  EXPECT_NE(report.find(" | 4.5 | 50% culled, tiers 25/12.5/12.5% | "), std::string::npos) << report;
+  EXPECT_NE(report.find(" | 6 | 25% culled | "), std::string::npos) << report;
+  EXPECT_NE(report.find("batch (≤ 8 B/pt splat, 12 total)"), std::string::npos) << report;
+  EXPECT_NE(report.find(" | 12 | – | "), std::string::npos) << "fp32: its layout's bytes, no plan";
+  EXPECT_NE(report.find("rte, df64, native, batch and adaptive all do better"), std::string::npos) << report;
+}
+
 TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
   BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
   run.cases.front().width = run.cases.front().height = 100;
@@ -179,8 +262,11 @@ TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
   EXPECT_NE(json.find("\"bound_uses\": \"read_write_gb_per_s\""), std::string::npos);
   const BenchRow& fp32 = run.rows[modeIndex(PrecisionMode::kFp32)];
   EXPECT_NE(json.find("\"splat_bytes_per_point\": " + std::to_string(positionBytes(PrecisionMode::kFp32)) +
-                      ", \"bytes_per_frame\": " + std::to_string(*fp32.bytes_per_frame)),
-            std::string::npos);
+                      ", \"loaded_bytes_per_point\": " + std::to_string(positionBytes(PrecisionMode::kFp32)) +
+                      ", \"culled_share\": null, \"tier_share\": null, \"bytes_per_frame\": " +
+                      std::to_string(*fp32.bytes_per_frame)),
+            std::string::npos)
+      << json;
   EXPECT_EQ(json.find("\"bandwidth_fraction\": null"), std::string::npos);
   const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
   EXPECT_NE(report.find("Copy bandwidth: **67.1 GB/s read+write, 33.6 GB/s copied"), std::string::npos) << report;
@@ -198,6 +284,23 @@ TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
   EXPECT_EQ(json.find("\"bandwidth_fraction\": 0"), std::string::npos);
   const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
   EXPECT_NE(report.find("Copy bandwidth: not measured"), std::string::npos);
+}
+
+// The bench hands its --warmup to every timed `dpoint render` as text: each request reads back
+// the same, durations in ms without an exponent; the default warms up by time.
+TEST(BenchRun, warmupPassesToRenderAsTextThatReadsBackTheSame) {
+  EXPECT_EQ(warmupText(BenchOptions{}.warmup), "300ms");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"auto", "auto"}, {"0", "0"},           {"2", "2"},         {"300ms", "300ms"},     {"0.5s", "500ms"},
+      {"1.5ms", "1.5ms"}, {"0.001ms", "0.001ms"}, {"60s", "60000ms"}, {"0.1s", "100ms"}, {"0.0123s", "12.3ms"}};
+  for (const auto& [given, text] : cases) {
+    const Result<WarmupRequest> parsed = parseWarmup("--warmup", given);
+    ASSERT_TRUE(parsed) << given << ": " << parsed.error().message;
+    EXPECT_EQ(warmupText(*parsed), text) << given;
+    const Result<WarmupRequest> again = parseWarmup("--warmup", warmupText(*parsed));
+    ASSERT_TRUE(again) << text;
+    EXPECT_TRUE(again->kind == parsed->kind && again->frames == parsed->frames && again->ms == parsed->ms) << given;
+  }
 }
 
 // Frame times of one row: median, fastest frame, p95.

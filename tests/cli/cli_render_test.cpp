@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -80,7 +81,8 @@ TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
 
 // DESIGN §7 offset, end to end: a generated fractal moved to the Earth's radius.
 // --warmup auto (the default): a single picture is drawn once (no warm-up frame, said beside its
-// time); with --frames above 1 one frame is drawn untimed first, and --warmup N is kept.
+// time); with --frames above 1 frames are drawn untimed by time first (at least one), and --warmup N
+// is kept. No assertion on how long anything took: only the counts the run reports.
 TEST(CliRender, warmupAutoDrawsASinglePictureOnce) {
   TempDir dir;
   ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "24", "--quiet", "-o", dir.file("mb.ply")}).exit_code, 0);
@@ -95,9 +97,66 @@ TEST(CliRender, warmupAutoDrawsASinglePictureOnce) {
   EXPECT_NE(gpuLine({}).find("median of 1 (p95"), std::string::npos);
   EXPECT_NE(gpuLine({}).find(", no warm-up,"), std::string::npos) << gpuLine({});
   EXPECT_EQ(gpuLine({"--frames", "3"}).find("no warm-up"), std::string::npos);
-  EXPECT_EQ(gpuLine({"--warmup", "2"}).find("no warm-up"), std::string::npos);
+  EXPECT_NE(gpuLine({"--warmup", "2"}).find(" after 2 warm-up frames in "), std::string::npos) << gpuLine({"--warmup", "2"});
   EXPECT_NE(gpuLine({"--frames", "3", "--warmup", "0"}).find("median of 3 (p95"), std::string::npos);
   EXPECT_NE(gpuLine({"--frames", "3", "--warmup", "0"}).find("no warm-up"), std::string::npos);
+}
+
+// The JSON's "warmup": the untimed frames that ran, their wall time and the time asked (null for a
+// count), for a count, a duration in ms or s, and auto with several frames (by time: at least one).
+TEST(CliRender, warmupByTimeOrCountIsReportedInTheJson) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "16", "--quiet", "-o", dir.file("mb.ply")}).exit_code, 0);
+  auto warmupOf = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", dir.file("mb.ply"), "-o", dir.file("mb.png"), "--width", "32",
+                                     "--height", "24", "--quiet", "--json", dir.file("mb.json")};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const std::string json = readFile(dir.file("mb.json"));
+    const size_t at = json.find("\"warmup\": {");
+    return at == std::string::npos ? std::string() : json.substr(at, json.find('}', at) - at + 1);
+  };
+  const std::string single = warmupOf({});
+  EXPECT_EQ(jsonNumber(single, "frames"), 0.0) << single;
+  EXPECT_EQ(jsonNumber(single, "ms"), 0.0) << single;
+  EXPECT_NE(single.find("\"until_ms\": null"), std::string::npos) << single;
+  const std::string by_auto = warmupOf({"--frames", "2"});
+  EXPECT_GE(jsonNumber(by_auto, "frames"), 1.0) << by_auto;
+  EXPECT_GT(jsonNumber(by_auto, "ms"), 0.0) << by_auto;
+  EXPECT_EQ(jsonNumber(by_auto, "until_ms"), 300.0) << by_auto;
+  const std::string counted = warmupOf({"--warmup", "3"});
+  EXPECT_EQ(jsonNumber(counted, "frames"), 3.0) << counted;
+  EXPECT_NE(counted.find("\"until_ms\": null"), std::string::npos) << counted;
+  const std::string timed = warmupOf({"--warmup", "0.02s"});
+  EXPECT_GE(jsonNumber(timed, "frames"), 1.0) << timed;
+  EXPECT_EQ(jsonNumber(timed, "until_ms"), 20.0) << timed;
+  const std::string in_ms = warmupOf({"--warmup", "1.5ms", "--frames", "2"});
+  EXPECT_GE(jsonNumber(in_ms, "frames"), 1.0) << in_ms;
+  EXPECT_EQ(jsonNumber(in_ms, "until_ms"), 1.5) << in_ms;
+}
+
+// A value that is no count, no duration and not auto is a usage error naming the flag and the
+// value, before anything is read or written; --help says what it takes.
+TEST(CliRender, warmupRefusesWhatIsNeitherACountNorADuration) {
+  TempDir dir;
+  writeFile(dir.file("p.csv"), "x,y,z\n0,0,0\n1,1,1\n");
+  for (const char* bad : {"1.5", "0ms", "0s", "10us", "fast", "-1", "", "3 ms", "1e3ms", "4294967296", "61s", "ms", "0.0001ms"}) {
+    for (const char* command : {"render", "bench"}) {
+      std::vector<std::string> args = {command, "--warmup", bad};
+      if (std::string(command) == "render") args.insert(args.begin() + 1, {dir.file("p.csv"), "-o", dir.file("p.png")});
+      else args.insert(args.end(), {"--out", dir.file("out"), "--cache", dir.file("cache")});
+      const test::CommandResult r = runDpoint(args);
+      EXPECT_EQ(r.exit_code, 1) << command << " --warmup '" << bad << "': " << r.err;
+      EXPECT_NE(r.err.find(std::string("--warmup: '") + bad + "'"), std::string::npos) << r.err;
+      EXPECT_FALSE(std::filesystem::exists(dir.file("p.png")) || std::filesystem::exists(dir.file("out")) ||
+                   std::filesystem::exists(dir.file("cache")))
+          << command << " --warmup '" << bad << "' wrote something";
+    }
+  }
+  const test::CommandResult help = runDpoint({"render", "--help"});
+  EXPECT_NE(help.out.find("a duration (300ms, 0.5s)"), std::string::npos) << help.out;
+  EXPECT_NE(runDpoint({"bench", "--help"}).out.find("300ms"), std::string::npos);
 }
 
 TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {

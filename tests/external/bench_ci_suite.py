@@ -16,7 +16,8 @@ from common import check, dpoint, scratch
 exe = sys.argv[1]
 MODES = ["fp32", "split", "rte", "df64", "native", "batch", "adaptive"]
 FIELDS = ["suite", "dataset", "points", "mode", "backend", "device", "driver", "resolution", "gpu_ms", "e2e_ms",
-          "points_per_s", "bytes_per_point", "splat_bytes_per_point", "bytes_per_frame", "bandwidth_bound_ms",
+          "points_per_s", "warmup", "bytes_per_point", "splat_bytes_per_point", "loaded_bytes_per_point",
+          "culled_share", "tier_share", "bytes_per_frame", "bandwidth_bound_ms",
           "bandwidth_fraction", "predicted_bound_px", "error_px", "share_off_half_px", "points_lost",
           "pixels_differing"]
 SVG = "{http://www.w3.org/2000/svg}"
@@ -58,7 +59,7 @@ def check_svg(path, series_per_panel, panels):
 
 with scratch() as d:
     out, cache = os.path.join(d, "out"), os.path.join(d, "cache")
-    dpoint(exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1", "--validate",
+    dpoint(exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1ms", "--validate",
            "--copy-bytes", "64M", "--copy-repeats", "5", "--quiet")
     for name in ["report.md", "results.json", "speed_vs_error.svg", "breakdown.svg", "montage.png"]:
         check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} missing or empty")
@@ -75,21 +76,49 @@ with scratch() as d:
     check(copy["copy_gb_per_s"] > 0 and math.isclose(copy["read_write_gb_per_s"], 2 * copy["copy_gb_per_s"]),
           f"copy_bandwidth {copy}")
     check(copy["bound_uses"] == "read_write_gb_per_s", f"copy_bandwidth {copy}")
-    # Splat bytes per point are the mode's position bytes: the two fixed layouts here, and batch's
-    # (its encoding may change) the same in every row and 4 B under its bytes_per_point (colour).
+    # Splat bytes per point are the mode's layout: the fixed layouts here, and the per-batch modes'
+    # (their encodings may change) the same in every row and 4 B under bytes_per_point (colour).
     splat_bytes = {"fp32": 12, "split": 24, "rte": 24, "df64": 24, "native": 24}
-    batch_bytes = {r["splat_bytes_per_point"] for r in rows if r["mode"] == "batch"}
-    check(len(batch_bytes) == 1, f"batch splat bytes differ between rows: {batch_bytes}")
-    splat_bytes["batch"] = batch_bytes.pop()
+    for mode in ("batch", "adaptive"):
+        found = {r["splat_bytes_per_point"] for r in rows if r["mode"] == mode}
+        check(len(found) == 1, f"{mode} splat bytes differ between rows: {found}")
+        splat_bytes[mode] = found.pop()
+    check(splat_bytes["batch"] <= 8, f"batch stores {splat_bytes['batch']} B a point")
+    check(splat_bytes["adaptive"] == 12, f"adaptive stores {splat_bytes['adaptive']} B a point, not 3 tiers of 4")
     for r in rows:
         name = f"{r['case']} {r['backend']} {r['mode']}"
         check(r["splat_bytes_per_point"] == splat_bytes[r["mode"]],
               f"{name}: splat_bytes_per_point {r['splat_bytes_per_point']}, expected {splat_bytes[r['mode']]}")
         check(r["bytes_per_point"] == r["splat_bytes_per_point"] + 4, f"{name}: bytes_per_point {r['bytes_per_point']}")
+        # The warm-up each timed draw ran (--warmup 1ms: by time, at least one frame).
+        check(r["warmup"] is not None and r["warmup"]["frames"] >= 1 and r["warmup"]["ms"] >= 0,
+              f"{name}: warmup {r['warmup']}")
+        # Loaded bytes: the layout's for a fixed mode; a per-batch mode's plan for the view (culled
+        # batches load nothing; adaptive 4 B a tier), batch's raster path every point's 8 B.
+        loaded, culled, tiers = r["loaded_bytes_per_point"], r["culled_share"], r["tier_share"]
+        if r["mode"] not in ("batch", "adaptive"):
+            check(loaded == r["splat_bytes_per_point"] and culled is None and tiers is None,
+                  f"{name}: loaded {loaded}, culled {culled}, tiers {tiers}")
+        else:
+            check(loaded is not None and 0 <= loaded <= r["splat_bytes_per_point"], f"{name}: loaded {loaded} B/pt")
+            check(culled is not None and 0 <= culled <= 1, f"{name}: culled share {culled}")
+            if culled == 0 or (r["mode"] == "batch" and r["backend"] == "raster"):
+                low = 4 if r["mode"] == "adaptive" else r["splat_bytes_per_point"]
+                check(low <= loaded, f"{name}: {loaded} B/pt loaded with no batch culled")
+            if r["mode"] == "batch":
+                check(tiers is None, f"{name}: batch has tier shares {tiers}")
+                if culled == 0 or r["backend"] == "raster":
+                    check(loaded == r["splat_bytes_per_point"], f"{name}: batch loaded {loaded} B/pt, culling none")
+            else:
+                check(tiers is not None and len(tiers) == 3 and all(0 <= t <= 1 for t in tiers), f"{name}: tiers {tiers}")
+                check(math.isclose(sum(tiers) + culled, 1, abs_tol=1e-12), f"{name}: tiers {tiers} + culled {culled}")
+                if culled == 0:  # every point loads 4 B per tier of its batch: between the fewest and the most tiers
+                    used = [4 * (t + 1) for t in range(3) if tiers[t] > 0]
+                    check(min(used) <= loaded <= max(used), f"{name}: {loaded} B/pt from tiers {tiers}")
         if r["backend"] == "compute":
             w, h = map(int, r["resolution"].split("x"))
             pixels = w * h
-            frame = r["points"] * r["splat_bytes_per_point"] + pixels * 20 + min(r["points"], pixels) * 4
+            frame = round(r["points"] * loaded) + pixels * 20 + min(r["points"], pixels) * 4
             check(r["bytes_per_frame"] == frame, f"{name}: bytes_per_frame {r['bytes_per_frame']}, expected {frame}")
             bound = frame / (copy["read_write_gb_per_s"] * 1e6)
             check(math.isclose(r["bandwidth_bound_ms"], bound, rel_tol=1e-9), f"{name}: bound {r['bandwidth_bound_ms']} ms")
@@ -100,6 +129,12 @@ with scratch() as d:
                       f"{name}: bandwidth_fraction {r['bandwidth_fraction']} is not bound / GPU median")
         else:
             check(r["bytes_per_frame"] is None and r["bandwidth_fraction"] is None, f"{name}: raster has a bound")
+    # The plan is the view's: both backends of a case load the same (batch's raster path aside).
+    for r in rows:
+        if r["mode"] == "adaptive" and r["backend"] == "raster":
+            twin = [c for c in rows if c["case"] == r["case"] and c["mode"] == "adaptive" and c["backend"] == "compute"]
+            check(len(twin) == 1 and twin[0]["loaded_bytes_per_point"] == r["loaded_bytes_per_point"]
+                  and twin[0]["tier_share"] == r["tier_share"], f"{r['case']}: adaptive's plan differs by backend")
     groups_by = {}
     for r in rows:
         for field in FIELDS:
@@ -123,7 +158,7 @@ with scratch() as d:
         best = min(max_err(by_mode[m]) for m in MODES)
         check(max_err(by_mode["native"]) <= best + floor, f"{case} {backend}: native {max_err(by_mode['native'])} > {best}")
         if max_err(by_mode["fp32"]) > 1.0:
-            for m in ["rte", "df64", "native", "batch"]:
+            for m in ["rte", "df64", "native", "batch", "adaptive"]:
                 check(max_err(by_mode[m]) <= max_err(by_mode["fp32"]), f"{case} {backend}: {m} no better than fp32")
     # The sweeps the breakdown draws are all there, each step in every mode.
     zoom = {r["sweep"]["x"] for r in rows if r["sweep"] and r["sweep"]["kind"].startswith("deep zoom")}
@@ -144,4 +179,6 @@ with scratch() as d:
     for outside in ("DESIGN", "../", "shared/"):
         check(outside not in report, f"report.md names {outside!r}, outside the repository")
     check("- Copy bandwidth: **" in report and "% of bound" in report, "report.md lacks the copy bandwidth or % of bound")
+    check("B/pt loaded, tiers " in report and "--warmup 1ms" in report,
+          "report.md lacks adaptive's loaded bytes and tiers, or the warm-up asked")
 print(f"bench ci suite: {len(rows)} rows checked")
