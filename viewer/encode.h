@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -142,6 +143,11 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
 // naming whole-set indices, and in batch mode its batches' frames and matrices appended.
 ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tolerance_px = kDefaultTolerancePx);
 Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);
+// Per-batch modes, for a set known only by the bounding box of each batch (boxes[k]: the points of
+// the next batch, encoding.batches.size() + k, as viewer/precision.h's BatchBoxes keeps them): the
+// frames, matrices and plan addPoints makes of the points themselves, to the bit (a batch's frame
+// depends on its points only through their box), after the same checks, the errors naming the batch.
+Status addBoxes(ModeEncoding& encoding, std::span<const Box> boxes);
 
 // Writes positions [first, first + count) of `points` in the mode's layout to `out`
 // (count · positionBytes(mode) bytes; a planar layout: count words of plane `plane`), with the
