@@ -159,11 +159,9 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
               backendName(outcome.backend), request.camera.width, request.camera.height, double(outcome.point_size),
               outcome.shading == Shading::kEdl ? ", eye-dome lighting" : "", f.name.c_str(), f.type.c_str(),
               formatDriverVersion(f.vendor_id, f.driver_version).c_str());
-  if (outcome.streamed)
-    std::printf("mode %s: no bound predicted (a streamed set is read once)%s\n", std::string(modeName(mode)).c_str(),
-                request.mode == "auto" ? "; --mode auto takes native for it" : "");
-  else
-    printChoice(outcome.prediction, f, outcome.backend);
+  printChoice(outcome.prediction, f, outcome.backend);
+  if (outcome.prediction.from_boxes)
+    std::printf("mode bounds: predicted from the bounding box of each 4096-point batch (a streamed set is read once)\n");
   if (!r.gpu_ms.empty())
     std::printf("gpu: %.3f ms/frame median of %zu (p95 %.3f)%s, %.3g points/s, %u B/pt\n", medianOf(r.gpu_ms),
                 r.gpu_ms.size(), percentileOf(r.gpu_ms, 95), request.warmup == 0 ? ", no warm-up" : "",

@@ -550,6 +550,18 @@ class StreamBlocks {
   std::future<Status> pending_;
 };
 
+// --mode auto's walk in the device's speed order over the modes it runs, on bounds_of's bounds.
+Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend, bool probe, const BoundsOf& bounds_of) {
+  Result<SelfTest> self_test = runPrecisionSelfTest(context);
+  if (!self_test) return self_test.error();
+  const bool compute = backend == Backend::kCompute;
+  auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
+  ModeChoice choice = chooseMode(measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable, bounds_of);
+  for (ModeChoice::Rejected& r : choice.rejected)
+    if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
+  return choice;
+}
+
 }  // namespace
 
 bool shadingFits(const DeviceFacts& f, uint32_t width, uint32_t height, const RenderOptions& options) {
@@ -602,15 +614,16 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                       Backend backend, bool probe, double tolerance_px) {
-  Result<SelfTest> self_test = runPrecisionSelfTest(context);
-  if (!self_test) return self_test.error();
-  const bool compute = backend == Backend::kCompute;
-  auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
-  ModeChoice choice =
-      chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable, tolerance_px);
-  for (ModeChoice::Rejected& r : choice.rejected)
-    if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
-  return choice;
+  return chooseOnDevice(context, backend, probe, [&](std::span<const PrecisionMode> modes) {
+    return predictErrorBounds(points, camera, modes, tolerance_px);
+  });
+}
+
+Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
+                                      Backend backend, double tolerance_px) {
+  return chooseOnDevice(context, backend, false, [&](std::span<const PrecisionMode> modes) {
+    return predictBoxBounds(boxes, camera, modes, tolerance_px);
+  });
 }
 
 double medianOf(std::vector<double> values) {

@@ -109,6 +109,9 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 // self-test, and with `probe` the probe's needs).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                       Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx);
+// The same for a streamed set, from the boxes of its batches (predictBoxBounds; no probe).
+Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
+                                      Backend backend, double tolerance_px = kDefaultTolerancePx);
 
 // Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
 double medianOf(std::vector<double> values);
