@@ -38,6 +38,7 @@ struct Pass {
   Setup setup;
   std::array<ModeState, kModeCount> own;
   std::vector<PositionCheck> checks;
+  std::array<bool, kModeCount> refused{};  // the mode's encoding refuses the set
 };
 
 void addPositionCheck(std::vector<PositionCheck>& checks, PrecisionMode mode) {
@@ -95,6 +96,7 @@ Pass makePass(const PointSet& points, const Camera& camera, std::span<const Prec
     Result<ModeEncoding> encoding = prepareEncoding(mode, points, camera, tolerance_px);
     if (!encoding) {
       s.unbounded[i] = true;  // the mode refuses the set: nothing reaches the picture
+      pass.refused[i] = true;
       continue;
     }
     pass.own[i].encoding = std::move(*encoding);
@@ -434,7 +436,7 @@ bool boundPiece(const BoxPass& pass, glm::dvec3 lo, glm::dvec3 hi, const Coords<
 
 ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes,
                                double tolerance_px) {
-  const Pass pass = makePass(points, camera, modes, tolerance_px);
+  Pass pass = makePass(points, camera, modes, tolerance_px);
   const Setup& s = pass.setup;
   std::vector<size_t> bounded;  // the wanted modes whose bounds the points decide
   for (size_t m = 0; m < kModeCount; ++m)
@@ -493,6 +495,10 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
     out.computed[m] = s.wanted[m];
     // Nothing of a refused mode reaches the picture; with no point in view every bound is 0.
     if ((s.unbounded[m] || beyond_limit[m]) && out.visible > 0) out.px[m] = kInf;
+    // The encoding renderPoints would make: built here (per-batch modes), or the frame alone with
+    // every position checked as prepareEncoding checks them (the pass's checks are its test).
+    if (s.wanted[m] && !pass.refused[m] && !beyond_limit[m])
+      out.encodings[m] = std::make_shared<const ModeEncoding>(std::move(pass.own[m].encoding));
   }
   out.float_floor_px = kU * 0.5 * std::max(camera.width, camera.height);
   return out;
@@ -583,10 +589,11 @@ ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<
   // One pass for all of `modes`: a point (or box) is read and projected once, whichever modes are
   // bounded (each mode's bound is the same to the bit as from a pass of its own).
   auto compute = [&](std::span<const PrecisionMode> modes) {
-    const ErrorBounds b = bounds_of(modes);
+    ErrorBounds b = bounds_of(modes);
     for (PrecisionMode mode : modes) {
       choice.bounds.px[modeIndex(mode)] = b.px[modeIndex(mode)];
       choice.bounds.computed[modeIndex(mode)] = true;
+      choice.bounds.encodings[modeIndex(mode)] = std::move(b.encodings[modeIndex(mode)]);
     }
     choice.bounds.visible = b.visible;
     choice.bounds.float_floor_px = b.float_floor_px;

@@ -22,6 +22,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -41,6 +42,10 @@ struct ErrorBounds {
   size_t visible = 0;
   double float_floor_px = 0.0;              // 2^-24 · max(width, height) / 2
   bool from_boxes = false;                  // predictBoxBounds: each batch's box stood for its points
+  // Per computed mode, its encoding for this camera and tolerance (prepareEncoding's), where the
+  // pass built it (per-batch modes) or checked every point against it (the others): renderPoints
+  // takes it rather than building it again. Null where the mode refuses the set, and from boxes.
+  std::array<std::shared_ptr<const ModeEncoding>, kModeCount> encodings;
 };
 
 // Bounds of the modes in `modes` (all when empty). One pass over the points per call, on all cores.
@@ -90,6 +95,8 @@ struct ModeChoice {
     std::string reason;
   };
   std::vector<Rejected> rejected;
+  // The chosen mode's encoding from the bounds (ErrorBounds::encodings), for renderPoints; or null.
+  std::shared_ptr<const ModeEncoding> encoding() const { return bounds.encodings[modeIndex(mode)]; }
 };
 
 // What the walk asks for: the bounds of some modes, in one pass (predictErrorBounds or

@@ -1,11 +1,13 @@
 #include "viewer/render.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <functional>
 #include <future>
+#include <optional>
 
 #include "core/interrupt.h"
 #include "vulkan/buffers.h"
@@ -582,15 +584,25 @@ Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, 
 }
 
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                  const RenderOptions& options) {
+                                  const RenderOptions& options, const ModeEncoding* prepared) {
   Status status = checkOptions(context, points.size(), camera, options);
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();
-  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera, options.tolerance_px);
-  if (!encoding) return encoding.error();
+  std::optional<Result<ModeEncoding>> made;
+  if (!prepared) {
+    made = prepareEncoding(options.mode, points, camera, options.tolerance_px);
+    if (!*made) return made->error();
+    prepared = &**made;
+  }
+  // The prediction's encoding is this render's: the same mode, camera and tolerance.
+  assert(prepared->mode == options.mode && prepared->tolerance_px == options.tolerance_px);
+  assert(prepared->width == camera.width && prepared->height == camera.height);
+  assert(prepared->frame.eye == sceneFrame(options.mode, camera).eye);
+  assert(prepared->batches.size() ==
+         (modeInfo(options.mode).batch_points ? (points.size() + kBatchSize - 1) / kBatchSize : 0));
   return renderChunks(context, points.size(),
-                      [&](size_t first, size_t) -> Result<BlockView> { return BlockView{&points, first}; }, *encoding,
+                      [&](size_t first, size_t) -> Result<BlockView> { return BlockView{&points, first}; }, *prepared,
                       camera, options, upload_start, options.max_chunk_points);
 }
 

@@ -192,9 +192,10 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   if (request.mode != "auto") {
     p.mode = *parseMode(request.mode);
     const PrecisionMode one[] = {p.mode};
-    const ErrorBounds bounds = set.points ? predictErrorBounds(*set.points, camera, one, tolerance)
-                                          : predictBoxBounds(set.boxes, camera, one, tolerance);
+    ErrorBounds bounds = set.points ? predictErrorBounds(*set.points, camera, one, tolerance)
+                                    : predictBoxBounds(set.boxes, camera, one, tolerance);
     p.bound_px = bounds.px[modeIndex(p.mode)];
+    p.encoding = std::move(bounds.encodings[modeIndex(p.mode)]);
     if (!(p.bound_px <= kWrongBoundPx)) {  // a wrong picture: name the mode auto would take
       Result<ModeChoice> choice = choose();
       if (!choice) return choice.error();
@@ -206,6 +207,7 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   if (!choice) return choice.error();
   p.mode = choice->mode;
   p.bound_px = choice->bound_px;
+  p.encoding = choice->encoding();
   p.choice = std::move(*choice);
   p.warning = predictionWarning(request, p, std::nullopt);
   return p;
@@ -249,7 +251,7 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     const RenderOptions options =
         renderOptionsFor(request, set, prediction->mode, cameras[i], context.facts, shading_warnings);
     for (const std::string& w : shading_warnings) outcome.warnings.push_back("view " + std::string(views[i].label) + ": " + w);
-    Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options);
+    Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options, prediction->encoding.get());
     if (!rendered) return rendered.error();
     const std::string mode(modeName(prediction->mode));
     const std::string label = "view " + std::string(views[i].label) + ": ";
@@ -278,7 +280,7 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   outcome.point_size = options.point_size;
   outcome.shading = options.shading;
   Result<RenderResult> rendered = [&]() -> Result<RenderResult> {
-    if (!set.stream) return renderPoints(context, *set.points, camera, options);
+    if (!set.stream) return renderPoints(context, *set.points, camera, options, outcome.prediction.encoding.get());
     PointStream stream;
     stream.count = set.count;
     stream.has_colors = set.has_colors || set.elevation;

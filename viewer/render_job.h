@@ -105,6 +105,9 @@ struct ModePrediction {
   bool from_boxes = false;
   std::optional<ModeChoice> choice;  // --mode auto
   std::string warning;               // the picture is likely wrong in this mode (predictionWarning); or empty
+  // The mode's encoding, made for the bound (same camera and tolerance), which renderPoints takes
+  // rather than making it again; null: none was made (a streamed set, or the mode refuses the set).
+  std::shared_ptr<const ModeEncoding> encoding;
 };
 
 // Over this predicted bound a forced --mode draws a wrong picture (points half a pixel or more off),

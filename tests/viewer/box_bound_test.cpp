@@ -1,4 +1,5 @@
-// Bounds from batch boxes (issue #25's --mode auto on a streamed set). A streamed set is known before it is drawn only by the bounding box of each
+// Bounds from batch boxes (issue #25's --mode auto on a streamed set) and the prediction's encoding
+// handed to the render. A streamed set is known before it is drawn only by the bounding box of each
 // 4096-point batch: predictBoxBounds must bound every point's own bound (predictErrorBounds) for
 // every mode, and a streamed render's --mode auto must pick a mode whose measured error (the same
 // set drawn in memory with --error) stays within the bound it reported.
@@ -119,6 +120,7 @@ TEST(BoxBounds, boundEveryPointsBoundInEveryMode) {
       std::printf("box bound: %-28s %-8s points %-10s boxes %s\n", c.label.c_str(), std::string(modeName(mode)).c_str(),
                   formatBound(points.px[m]).c_str(), formatBound(boxes.px[m]).c_str());
       EXPECT_GE(boxes.px[m], points.px[m]) << modeName(mode);
+      EXPECT_EQ(boxes.encodings[m], nullptr) << "no encoding from boxes";
     }
   }
 }
@@ -197,6 +199,41 @@ TEST(BoxBounds, aCoordinateBeyondWhatAModeHoldsLeavesItUnbounded) {
     EXPECT_TRUE(std::isinf(boxes.px[modeIndex(mode)])) << modeName(mode);
   EXPECT_TRUE(std::isfinite(boxes.px[modeIndex(PrecisionMode::kNative)]));
 }
+
+// --- on a device --------------------------------------------------------------------------------
+
+class PreparedEncoding : public VulkanRenderTest {};
+
+// The encoding made for the bound, handed to renderPoints, draws what renderPoints draws when it
+// makes its own: for --mode auto's choice and for each mode's own bound.
+TEST_P(PreparedEncoding, drawsThePictureRenderPointsMakesAlone) {
+  const glm::dvec3 earth(6378137.0, -2345678.9, 1234.5);
+  const PointSet s = randomCube(earth, 10.0, 20000, true);
+  const Camera camera = lookAt(earth + glm::dvec3(20, 15, 12), earth, s, 160, 120);
+  Result<ModeChoice> choice = chooseModeOnDevice(*context_, s, camera, GetParam(), false);
+  ASSERT_TRUE(choice.ok()) << choice.error().message;
+  ASSERT_NE(choice->encoding(), nullptr) << modeName(choice->mode);
+  const ErrorBounds all = predictErrorBounds(s, camera);
+  for (PrecisionMode mode : kAllModes) {
+    SCOPED_TRACE(std::string(modeName(mode)));
+    const std::shared_ptr<const ModeEncoding>& prepared = all.encodings[modeIndex(mode)];
+    ASSERT_NE(prepared, nullptr);
+    RenderOptions options;
+    options.mode = mode;
+    options.backend = GetParam();
+    Result<RenderResult> made = renderPoints(*context_, s, camera, options);
+    if (!made.ok()) {  // only a mode this device does not run
+      EXPECT_EQ(made.error().code, ExitCode::kNoDevice) << made.error().message;
+      continue;
+    }
+    Result<RenderResult> given = renderPoints(*context_, s, camera, options, prepared.get());
+    ASSERT_TRUE(given.ok()) << given.error().message;
+    EXPECT_TRUE(made->image.rgba == given->image.rgba);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, PreparedEncoding, ::testing::Values(Backend::kRaster, Backend::kCompute),
+                         [](const ::testing::TestParamInfo<Backend>& param) { return backendName(param); });
 
 // --- a streamed render's --mode auto ---------------------------------------------------------------
 
