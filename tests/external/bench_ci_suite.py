@@ -77,7 +77,8 @@ with scratch() as d:
     check(copy["bound_uses"] == "read_write_gb_per_s", f"copy_bandwidth {copy}")
     # Splat bytes per point are the mode's position bytes: the two fixed layouts here, and batch's
     # (its encoding may change) the same in every row and 4 B under its bytes_per_point (colour).
-    splat_bytes = {"fp32": 12, "split": 24, "rte": 24, "df64": 24, "native": 24}
+    # adaptive: its three 4-byte tier planes, as the bench counts a frame's bytes (positionBytes).
+    splat_bytes = {"fp32": 12, "split": 24, "rte": 24, "df64": 24, "native": 24, "adaptive": 12}
     batch_bytes = {r["splat_bytes_per_point"] for r in rows if r["mode"] == "batch"}
     check(len(batch_bytes) == 1, f"batch splat bytes differ between rows: {batch_bytes}")
     splat_bytes["batch"] = batch_bytes.pop()
