@@ -97,13 +97,14 @@ void printText(const std::string& path, const PointSetInfo& i, const std::option
   } else {
     std::printf("float32 enough:     no (%zu distinct points merge with another)\n", i.float_merged);
   }
-  if (!advice) {
-    if (!merged && i.count > 0)
-      std::printf("error bound by mode: not predicted for a streamed set (as in render; --stream off)\n");
-    return;
-  }
-  std::printf("error bound by mode, for the view (%s, %zu points visible; float floor %s):\n",
-              viewName(advice->camera).c_str(), advice->bounds.visible, formatBound(advice->bounds.float_floor_px).c_str());
+  if (!advice) return;
+  if (advice->bounds.from_boxes)
+    std::printf("error bound by mode, for the view (%s, at most %zu points visible; float floor %s), from the box of\n"
+                "                    each 4096-point batch (a streamed set; its points give bounds no larger):\n",
+                viewName(advice->camera).c_str(), advice->bounds.visible, formatBound(advice->bounds.float_floor_px).c_str());
+  else
+    std::printf("error bound by mode, for the view (%s, %zu points visible; float floor %s):\n",
+                viewName(advice->camera).c_str(), advice->bounds.visible, formatBound(advice->bounds.float_floor_px).c_str());
   for (PrecisionMode mode : kAllModes) {
     const double px = advice->bounds.px[modeIndex(mode)];
     const char* verdict = px <= kAutoBoundPx ? "within --mode auto's 0.1 px" : px < 0.5 ? "under half a pixel"
@@ -134,7 +135,8 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
     const Camera& c = advice->camera;
     std::printf(",\n  \"view\": {\"width\": %u, \"height\": %u, \"ortho\": %s, \"points_visible\": %zu},\n", c.width,
                 c.height, c.ortho ? "true" : "false", advice->bounds.visible);
-    std::printf("  \"float_floor_px\": %s,\n  \"error_bound_px\": {", num(advice->bounds.float_floor_px, true).c_str());
+    std::printf("  \"float_floor_px\": %s,\n  \"error_bound_from\": \"%s\",\n  \"error_bound_px\": {",
+                num(advice->bounds.float_floor_px, true).c_str(), advice->bounds.from_boxes ? "batch_boxes" : "points");
     const char* separator = "";
     for (PrecisionMode mode : kAllModes) {  // null: unbounded (the mode may lose points)
       const double px = advice->bounds.px[modeIndex(mode)];
@@ -147,12 +149,16 @@ void printJson(const std::string& path, const PointSetInfo& i, const std::option
   std::printf("\n}\n");
 }
 
-// Large binary PLY input (one file, or tiles) a block at a time: what computeStreamedInfo gives.
-int runStreamedInfo(const InfoOptions& o, PointInputStream& stream, Progress& progress) {
+// Large binary PLY input (one file, or tiles) a block at a time: what computeStreamedInfo gives,
+// and each mode's bound from the box of every batch, kept as the first pass reads the blocks in
+// order (predictBoxBounds, as render predicts a streamed set's).
+int runStreamedInfo(const InfoOptions& o, const CameraSpec& spec, PointInputStream& stream, Progress& progress) {
   progress.start("reading " + describeInputs(o.inputs) + " twice (points)", 2 * stream.count());
+  BatchBoxes boxes;
   const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
     if (interrupted()) return interruptedError();
     if (Status s = stream.read(first, n, block); !s) return s;
+    if (first == boxes.count && n > 0) addBatchBoxes(boxes, block.positions);
     progress.advance(n);
     return okStatus();
   };
@@ -160,9 +166,22 @@ int runStreamedInfo(const InfoOptions& o, PointInputStream& stream, Progress& pr
                                                   kStreamBlockPoints, o.sample, o.common.threads);
   if (!info) return reportError(info.error());
   progress.finish();
+  std::optional<ViewAdvice> advice;
+  if (boxes.count > 0) {
+    // boundsOf's box and planarity, from the batches' boxes.
+    Bounds bounds;
+    bounds.min = boxes.boxes[0].min, bounds.max = boxes.boxes[0].max, bounds.planar = true;
+    for (const Box& box : boxes.boxes) {
+      bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
+      bounds.planar = bounds.planar && box.min.z == 0.0 && box.max.z == 0.0;
+    }
+    Result<Camera> camera = makeCamera(spec, bounds);
+    if (!camera) return reportError(camera.error());
+    advice = ViewAdvice{*camera, predictBoxBounds(boxes, *camera, {}, *parseTolerance(o.camera.tolerance))};
+  }
   const std::string files = describeInputs(o.inputs);
-  if (o.json) printJson(files, info->info, std::nullopt, std::nullopt, false);
-  else printText(files, info->info, std::nullopt, std::nullopt, false);
+  if (o.json) printJson(files, info->info, advice, std::nullopt, false);
+  else printText(files, info->info, advice, std::nullopt, false);
   return 0;
 }
 
@@ -174,7 +193,7 @@ int runInfo(const InfoOptions& o) {
   if (!spec) return reportError(spec.error());
   Result<std::unique_ptr<PointInputStream>> stream = openPointStream(o.inputs, o.stream, o.common.threads);
   if (!stream) return reportError(stream.error());
-  if (*stream) return runStreamedInfo(o, **stream, progress);
+  if (*stream) return runStreamedInfo(o, *spec, **stream, progress);
   ReadOptions read{o.common.threads, o.allow_nonfinite, &progress};
   read.max_memory = *limit;
   Result<PointSet> points = readPointInputs(o.inputs, read);
@@ -220,8 +239,9 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,
                   "auto|on|off. on: read binary PLY input (a file, or tiles) a block at a time, twice, so a set\n"
-                  "larger than memory is described in about 1.2 GB (no float32 merge count and no error bounds:\n"
-                  "they need every point at once); auto: for binary PLY input of more than 2^26 points")
+                  "larger than memory is described in about 1.2 GB (no float32 merge count, which needs every point\n"
+                  "at once, and error bounds from the box of each 4096-point batch); auto: for binary PLY input of\n"
+                  "more than 2^26 points")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->default_val("auto");
   addCommonOptions(*cmd, o->common);

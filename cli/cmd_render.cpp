@@ -159,11 +159,9 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
               backendName(outcome.backend), request.camera.width, request.camera.height, double(outcome.point_size),
               outcome.shading == Shading::kEdl ? ", eye-dome lighting" : "", f.name.c_str(), f.type.c_str(),
               formatDriverVersion(f.vendor_id, f.driver_version).c_str());
-  if (outcome.streamed)
-    std::printf("mode %s: no bound predicted (a streamed set is read once)%s\n", std::string(modeName(mode)).c_str(),
-                request.mode == "auto" ? "; --mode auto takes native for it" : "");
-  else
-    printChoice(outcome.prediction, f, outcome.backend);
+  printChoice(outcome.prediction, f, outcome.backend);
+  if (outcome.prediction.from_boxes)
+    std::printf("mode bounds: predicted from the bounding box of each batch (a streamed set is read once)\n");
   char warmup[64] = ", no warm-up";
   if (r.warmup_frames)
     std::snprintf(warmup, sizeof warmup, " after %u warm-up frame%s in %.0f ms", r.warmup_frames,

@@ -37,22 +37,26 @@ double powerOfTwoAbove(double d) {
   return mantissa == 0.5 ? d : std::ldexp(1.0, exponent);
 }
 
+// A batch's frame from the box of its points: the origin at its centre, the extent the power of
+// two at or above the largest |p·scale − origin| of a coordinate as computed (rounded), which
+// bounds every stored offset within [−1, 1] whatever the rounding of the centre. Scaling and the
+// rounded subtraction are monotone, so that largest is at the box's min or max on some axis, and
+// those are coordinates of its points: the frame of the box is the frame of the points, to the bit.
+BatchFrame batchFrameOf(const Box& box, const SceneFrame& frame) {
+  // min/2 + max/2 cannot overflow where (min + max)/2 could; scaling by 2^exponent is exact.
+  const glm::dvec3 origin = scaleBy(box.min * 0.5 + box.max * 0.5, frame);
+  const glm::dvec3 low = scaleBy(box.min, frame) - origin, high = scaleBy(box.max, frame) - origin;
+  double largest = 0.0;
+  for (int a = 0; a < 3; ++a) largest = std::max({largest, std::fabs(low[a]), std::fabs(high[a])});
+  return {origin, powerOfTwoAbove(largest)};
+}
+
 std::vector<BatchFrame> makeBatchFrames(const PointSet& points, const SceneFrame& frame, size_t batch_size) {
   const size_t batches = (points.size() + batch_size - 1) / batch_size;
   std::vector<BatchFrame> frames(batches);
   parallelFor(batches, 0, [&](size_t b, unsigned) {
     const size_t first = b * batch_size, last = std::min(points.size(), first + batch_size);
-    const Box box = boundingBox(points.positions, first, last);
-    // min/2 + max/2 cannot overflow where (min + max)/2 could; scaling by 2^exponent is exact.
-    const glm::dvec3 origin = scaleBy(box.min * 0.5 + box.max * 0.5, frame);
-    // The extent bounds the offsets as they are computed (p·scale − origin, rounded), so every
-    // stored offset is within [−1, 1] whatever the rounding of the box centre.
-    double largest = 0.0;
-    for (size_t i = first; i < last; ++i) {
-      const glm::dvec3 offset = scaleBy(points.positions[i], frame) - origin;
-      largest = std::max({largest, std::fabs(offset.x), std::fabs(offset.y), std::fabs(offset.z)});
-    }
-    frames[b] = {origin, powerOfTwoAbove(largest)};
+    frames[b] = batchFrameOf(boundingBox(points.positions, first, last), frame);
   });
   return frames;
 }
@@ -66,6 +70,28 @@ glm::dmat4 batchMatrix(const SceneFrame& frame, const BatchFrame& b, double step
   for (int c = 0; c < 3; ++c) m[c] *= b.extent / steps;  // powers of two: exact
   m[3] = translation;
   return m;
+}
+
+// Appends batches with these frames: their matrices (each checked to fit float) and their plan.
+Status appendBatches(ModeEncoding& e, const std::vector<BatchFrame>& frames) {
+  const size_t first_batch = e.batches.size();
+  e.batches.insert(e.batches.end(), frames.begin(), frames.end());
+  e.batch_matrices.reserve(e.batches.size());
+  const double steps = modeInfo(e.mode).batch_steps;
+  for (size_t b = first_batch; b < e.batches.size(); ++b) {
+    const glm::dmat4& m = e.batch_matrices.emplace_back(batchMatrix(e.frame, e.batches[b], steps));
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) {
+        if (fitsFloat(m[c][r])) continue;
+        const size_t first = b * e.batchSize();
+        return Error{"batch " + std::to_string(b) + " (points " + std::to_string(first) + "..): its origin is " +
+                         shortest(glm::length(e.batches[b].origin - e.frame.eye)) +
+                         " view sizes from the eye, and its float matrix overflows; use --mode native",
+                     ExitCode::kBadInput};
+      }
+  }
+  planBatches(e, first_batch);
+  return okStatus();
 }
 
 Error beyondFloat(PrecisionMode mode, size_t index, int axis, double value, const std::string& how) {
@@ -248,24 +274,38 @@ Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
   if (Status status = checkPositions(e, block, first_index); !status) return status;
   if (modeInfo(e.mode).batch_points == 0) return okStatus();
   assert(first_index == e.batches.size() * e.batchSize());  // blocks in order, whole batches but the last
-  const size_t first_batch = e.batches.size();
-  for (const BatchFrame& frame : makeBatchFrames(block, e.frame, e.batchSize())) e.batches.push_back(frame);
-  e.batch_matrices.reserve(e.batches.size());
-  const double steps = modeInfo(e.mode).batch_steps;
-  for (size_t b = first_batch; b < e.batches.size(); ++b) {
-    const glm::dmat4& m = e.batch_matrices.emplace_back(batchMatrix(e.frame, e.batches[b], steps));
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) {
-        if (fitsFloat(m[c][r])) continue;
-        const size_t first = b * e.batchSize();
-        return Error{"batch " + std::to_string(b) + " (points " + std::to_string(first) + "..): its origin is " +
-                         shortest(glm::length(e.batches[b].origin - e.frame.eye)) +
-                         " view sizes from the eye, and its float matrix overflows; use --mode native",
+  return appendBatches(e, makeBatchFrames(block, e.frame, e.batchSize()));
+}
+
+Status addBoxes(ModeEncoding& e, std::span<const Box> boxes) {
+  assert(modeInfo(e.mode).batch_points != 0);
+  // checkPositions' test on the boxes: a coordinate's magnitude in the frame is largest at the
+  // box's min or max of its axis, which are coordinates of the batch's points.
+  const double limit = positionLimit(e.mode);
+  for (size_t k = 0; k < boxes.size(); ++k)
+    for (const glm::dvec3& corner : {boxes[k].min, boxes[k].max})
+      for (int axis = 0; axis < 3; ++axis) {
+        const double in_frame = scaleBy(corner[axis], e.frame);
+        if (std::isfinite(in_frame) && std::fabs(in_frame) <= limit) continue;
+        const size_t b = e.batches.size() + k / (e.batchSize() / kBoxPoints);
+        return Error{"batch " + std::to_string(b) + " (points " + std::to_string(b * e.batchSize()) + "..): " +
+                         axisName(axis) + " = " + shortest(corner[axis]) + " is beyond what mode " +
+                         std::string(modeName(e.mode)) + " holds when scaled to the view (" + shortest(in_frame) + ")",
                      ExitCode::kBadInput};
       }
-  }
-  planBatches(e, first_batch);
-  return okStatus();
+  // The boxes are of kBoxPoints points; a batch of the mode is the union of batchSize() / kBoxPoints
+  // of them (its min and max are its points' as well).
+  const size_t per = e.batchSize() / kBoxPoints;
+  std::vector<BatchFrame> frames((boxes.size() + per - 1) / per);
+  parallelFor(frames.size(), 0, [&](size_t k, unsigned) {
+    Box box = boxes[k * per];
+    for (size_t j = k * per + 1; j < std::min(boxes.size(), (k + 1) * per); ++j) {
+      box.min = glm::min(box.min, boxes[j].min);
+      box.max = glm::max(box.max, boxes[j].max);
+    }
+    frames[k] = batchFrameOf(box, e.frame);
+  });
+  return appendBatches(e, frames);
 }
 
 Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points, const Camera& camera,

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -149,6 +150,13 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
 // naming whole-set indices, and in batch mode its batches' frames and matrices appended.
 ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tolerance_px = kDefaultTolerancePx);
 Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);
+// Per-batch modes, for a set known only by the bounding box of every kBoxPoints consecutive points
+// (boxes[k]: points k·kBoxPoints on from the next batch, as viewer/precision.h's BatchBoxes keeps
+// them; a batch is the union of batchSize() / kBoxPoints of them): the frames, matrices and plan
+// addPoints makes of the points themselves, to the bit (a batch's frame depends on its points only
+// through their box), after the same checks, the errors naming the batch.
+inline constexpr uint32_t kBoxPoints = kAdaptiveBatchSize;  // the smallest batch of any mode
+Status addBoxes(ModeEncoding& encoding, std::span<const Box> boxes);
 
 // Writes positions [first, first + count) of `points` in the mode's layout to `out`
 // (count · positionBytes(mode) bytes; a planar layout: count words of plane `plane`), with the

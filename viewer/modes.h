@@ -60,7 +60,7 @@ inline constexpr size_t kModeCount = std::size(kAllModes);
 inline size_t modeIndex(PrecisionMode mode) { return static_cast<size_t>(mode); }
 
 // The mode that holds everywhere double can: --mode auto's choice when no mode is within its
-// bound (and for a streamed set, which gets no bound), and the default of every options struct.
+// bound, and the default of every options struct.
 inline constexpr PrecisionMode kFallbackMode = PrecisionMode::kNative;
 
 // Devices whose measured speed order `auto` knows: lavapipe (a CPU) and GPUs. The order for GPUs

@@ -13,16 +13,20 @@
 //
 // The floor every mode meets is the float rounding of the final clip position: about 2^-24 of the
 // viewport's half-size in pixels.
+//
+// A set streamed from a file is known before it is drawn only by the box of every 1024 points
+// (BatchBoxes, as many as adaptive mode's batch; batch mode's are unions of four); predictBoxBounds bounds every point such a box may hold, so --mode auto
+// chooses for it as for a set in memory (docs/precision.md says why the box bound is an upper bound).
 #pragma once
 
 #include <array>
-#include <string>
-#include <vector>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/point_set.h"
 #include "viewer/camera.h"
@@ -33,14 +37,44 @@ namespace dpoint {
 struct ErrorBounds {
   std::array<double, kModeCount> px{};      // by modeIndex; +inf: unbounded; only `computed` ones are set
   std::array<bool, kModeCount> computed{};
-  size_t visible = 0;                       // points inside the view volume (0: every bound is 0)
+  // Points inside the view volume (0: every bound is 0). From boxes (predictBoxBounds): the points
+  // of every box that may hold a visible point, no fewer than are visible.
+  size_t visible = 0;
   double float_floor_px = 0.0;              // 2^-24 · max(width, height) / 2
+  bool from_boxes = false;                  // predictBoxBounds: each batch's box stood for its points
+  // Per computed mode, its encoding for this camera and tolerance (prepareEncoding's), where the
+  // pass built it (per-batch modes) or checked every point against it (the others): renderPoints
+  // takes it rather than building it again. Null where the mode refuses the set, and from boxes.
+  std::array<std::shared_ptr<const ModeEncoding>, kModeCount> encodings;
 };
 
 // Bounds of the modes in `modes` (all when empty). One pass over the points per call, on all cores.
 // tolerance_px: adaptive mode's (its tier choice, viewer/batch_plan.h, which its bound follows).
 ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> modes = {},
                                double tolerance_px = kDefaultTolerancePx);
+
+// A set read a block at a time (a streamed PLY), summarised in the pass that finds its bounds: the
+// double bounding box of every kBoxPoints (1024) consecutive points, whose unions are the batches
+// of the per-batch modes. 1e9 points: 977k boxes, 47 MB.
+struct BatchBoxes {
+  size_t count = 0;        // points summarised
+  std::vector<Box> boxes;  // boxes[b]: of points [b·kBoxPoints, min(count, (b + 1)·kBoxPoints))
+};
+// Adds the next points of the set, [boxes.count, boxes.count + positions.size()) (non-empty); every
+// call but the last adds whole batches. On all cores.
+void addBatchBoxes(BatchBoxes& boxes, const std::vector<glm::dvec3>& positions);
+
+// predictErrorBounds for a set known by its batch boxes: per mode a guaranteed upper bound of the
+// per-point bound of every point each box may hold. The clip position is affine in the point, so
+// over a box each row's extremes are at corners; each mode's terms are taken with every input at
+// its largest over the box (|p|, |p − eye|, the batch offsets: the terms only grow with them), and
+// the pixel distance at the box's largest |x|, |y| a visible point may have and its least w, which
+// in perspective is no less than the near plane's (points nearer are not drawn). A box that may
+// hold no visible point adds nothing. The per-batch modes' frames, matrices and plan are those
+// renderStream makes of the points (encode.h, addBoxes: to the bit); adaptive's bound for a batch is
+// also at most that of the tiers its plan chose (adaptiveBoxBoundPx).
+ErrorBounds predictBoxBounds(const BatchBoxes& boxes, const Camera& camera, std::span<const PrecisionMode> modes = {},
+                             double tolerance_px = kDefaultTolerancePx);
 
 // --mode auto (DESIGN §4): the fastest mode on this kind of device whose bound is ≤ kAutoBoundPx.
 inline constexpr double kAutoBoundPx = 0.1;
@@ -61,12 +95,21 @@ struct ModeChoice {
     std::string reason;
   };
   std::vector<Rejected> rejected;
+  // The chosen mode's encoding from the bounds (ErrorBounds::encodings), for renderPoints; or null.
+  std::shared_ptr<const ModeEncoding> encoding() const { return bounds.encodings[modeIndex(mode)]; }
 };
+
+// What the walk asks for: the bounds of some modes, in one pass (predictErrorBounds or
+// predictBoxBounds with the set, the camera and the tolerance bound in).
+using BoundsOf = std::function<ErrorBounds(std::span<const PrecisionMode> modes)>;
 
 // Walks the speed order, skipping modes `usable` refuses, and takes the first whose bound is
 // ≤ kAutoBoundPx; when none is, takes native if usable (else the usable mode with the smallest
 // bound) with enough = false. Bounds are computed only for the modes it looks at, those it is sure
 // to look at together in one pass (the next two usable modes before its choice, one after it).
+ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<bool(PrecisionMode)>& usable,
+                      const BoundsOf& bounds_of);
+// The walk on the bounds of the points themselves (predictErrorBounds).
 ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> order,
                       const std::function<bool(PrecisionMode)>& usable, double tolerance_px = kDefaultTolerancePx);
 

@@ -1,11 +1,13 @@
 #include "viewer/render.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <functional>
 #include <future>
+#include <optional>
 
 #include "core/interrupt.h"
 #include "vulkan/buffers.h"
@@ -577,6 +579,18 @@ class StreamBlocks {
   std::future<Status> pending_;
 };
 
+// --mode auto's walk in the device's speed order over the modes it runs, on bounds_of's bounds.
+Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend, bool probe, const BoundsOf& bounds_of) {
+  Result<SelfTest> self_test = runPrecisionSelfTest(context);
+  if (!self_test) return self_test.error();
+  const bool compute = backend == Backend::kCompute;
+  auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
+  ModeChoice choice = chooseMode(measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable, bounds_of);
+  for (ModeChoice::Rejected& r : choice.rejected)
+    if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
+  return choice;
+}
+
 }  // namespace
 
 bool shadingFits(const DeviceFacts& f, uint32_t width, uint32_t height, const RenderOptions& options) {
@@ -597,15 +611,25 @@ Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, 
 }
 
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                  const RenderOptions& options) {
+                                  const RenderOptions& options, const ModeEncoding* prepared) {
   Status status = checkOptions(context, points.size(), camera, options);
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();
-  Result<ModeEncoding> encoding = prepareEncoding(options.mode, points, camera, options.tolerance_px);
-  if (!encoding) return encoding.error();
+  std::optional<Result<ModeEncoding>> made;
+  if (!prepared) {
+    made = prepareEncoding(options.mode, points, camera, options.tolerance_px);
+    if (!*made) return made->error();
+    prepared = &**made;
+  }
+  // The prediction's encoding is this render's: the same mode, camera and tolerance.
+  assert(prepared->mode == options.mode && prepared->tolerance_px == options.tolerance_px);
+  assert(prepared->width == camera.width && prepared->height == camera.height);
+  assert(prepared->frame.eye == sceneFrame(options.mode, camera).eye);
+  assert(prepared->batches.size() ==
+         (modeInfo(options.mode).batch_points ? (points.size() + prepared->batchSize() - 1) / prepared->batchSize() : 0));
   return renderChunks(context, points.size(),
-                      [&](size_t first, size_t) -> Result<BlockView> { return BlockView{&points, first}; }, *encoding,
+                      [&](size_t first, size_t) -> Result<BlockView> { return BlockView{&points, first}; }, *prepared,
                       camera, options, upload_start, options.max_chunk_points);
 }
 
@@ -629,15 +653,16 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                       Backend backend, bool probe, double tolerance_px) {
-  Result<SelfTest> self_test = runPrecisionSelfTest(context);
-  if (!self_test) return self_test.error();
-  const bool compute = backend == Backend::kCompute;
-  auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
-  ModeChoice choice =
-      chooseMode(points, camera, measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable, tolerance_px);
-  for (ModeChoice::Rejected& r : choice.rejected)
-    if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
-  return choice;
+  return chooseOnDevice(context, backend, probe, [&](std::span<const PrecisionMode> modes) {
+    return predictErrorBounds(points, camera, modes, tolerance_px);
+  });
+}
+
+Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
+                                      Backend backend, double tolerance_px) {
+  return chooseOnDevice(context, backend, false, [&](std::span<const PrecisionMode> modes) {
+    return predictBoxBounds(boxes, camera, modes, tolerance_px);
+  });
 }
 
 double medianOf(std::vector<double> values) {

@@ -91,8 +91,10 @@ struct RenderResult {
 // maxTexelBufferElements; renderPoints refuses --shade edl where they do not.
 bool shadingFits(const DeviceFacts& facts, uint32_t width, uint32_t height, const RenderOptions& options);
 
+// prepared: the mode's encoding for this set, camera and options.tolerance_px, made while its bound
+// was predicted (ErrorBounds::encodings, ModeChoice::encoding()); null: made here.
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                  const RenderOptions& options);
+                                  const RenderOptions& options, const ModeEncoding* prepared = nullptr);
 
 // A point set read a block at a time, in order: how `dpoint render` draws a file larger than the
 // host memory should hold. read(first, n, block) replaces `block` with points [first, first + n)
@@ -116,6 +118,9 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 // self-test, and with `probe` the probe's needs).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                       Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx);
+// The same for a streamed set, from the boxes of its batches (predictBoxBounds; no probe).
+Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
+                                      Backend backend, double tolerance_px = kDefaultTolerancePx);
 
 // Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
 double medianOf(std::vector<double> values);

@@ -50,6 +50,7 @@ struct LoadedSet {
   bool elevation = false;  // coloured by elevation along the up axis (a stream: block by block)
   bool z_up = false;
   std::vector<SpacingSample> spacing;  // for the default point size
+  BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
 };
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
@@ -69,12 +70,16 @@ Status forEachBlock(PointInputStream& ply, Progress& progress, const std::string
   return okStatus();
 }
 
+// The bounds, and the box of every batch (the mode's bound is predicted from those once the camera
+// is known: predictBoxBounds).
 Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress,
-                            SpacingSampler& sampler) {
+                            SpacingSampler& sampler, BatchBoxes& boxes) {
   Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
   Status status = forEachBlock(ply, progress, "bounds of " + path + " (points)", [&](const PointSet& block) {
-    const Box box = boundingBox(block.positions);
-    bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
+    const size_t first = boxes.boxes.size();
+    addBatchBoxes(boxes, block.positions);
+    for (size_t b = first; b < boxes.boxes.size(); ++b)
+      bounds.min = glm::min(bounds.min, boxes.boxes[b].min), bounds.max = glm::max(bounds.max, boxes.boxes[b].max);
     bounds.planar = bounds.planar && block.isPlanar();
     sampler.add(block.positions);
   });
@@ -138,7 +143,7 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   if (ply) {
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
     SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
-    Result<Bounds> bounds = streamBounds(inputs, *ply, progress, sampler);
+    Result<Bounds> bounds = streamBounds(inputs, *ply, progress, sampler, set.boxes);
     if (!bounds) return bounds.error();
     set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
     if (Status s = streamOutlineAndSpacing(request, inputs, *ply, sampler.finish(), set, progress); !s) return s.error();
@@ -174,36 +179,38 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   return set;
 }
 
-// --mode auto picks on the device; an explicit mode gets its bound computed for the report.
-Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanContext& context, const PointSet& points,
+// --mode auto picks on the device; an explicit mode gets its bound computed for the report. From
+// the points of a set in memory, or the batch boxes of a streamed one (set.boxes).
+Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanContext& context, const LoadedSet& set,
                                    const Camera& camera) {
+  const double tolerance = request.tolerance_px;
+  auto choose = [&]() -> Result<ModeChoice> {
+    if (set.points) return chooseModeOnDevice(context, *set.points, camera, *request.backend, request.error, tolerance);
+    return chooseModeOnDevice(context, set.boxes, camera, *request.backend, tolerance);
+  };
   ModePrediction p;
+  p.from_boxes = !set.points;
   if (request.mode != "auto") {
     p.mode = *parseMode(request.mode);
     const PrecisionMode one[] = {p.mode};
-    p.bound_px = predictErrorBounds(points, camera, one, request.tolerance_px).px[modeIndex(p.mode)];
+    ErrorBounds bounds = set.points ? predictErrorBounds(*set.points, camera, one, tolerance)
+                                    : predictBoxBounds(set.boxes, camera, one, tolerance);
+    p.bound_px = bounds.px[modeIndex(p.mode)];
+    p.encoding = std::move(bounds.encodings[modeIndex(p.mode)]);
     if (!(p.bound_px <= kWrongBoundPx)) {  // a wrong picture: name the mode auto would take
-      Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error, request.tolerance_px);
+      Result<ModeChoice> choice = choose();
       if (!choice) return choice.error();
       p.warning = predictionWarning(request, p, choice->mode);
     }
     return p;
   }
-  Result<ModeChoice> choice = chooseModeOnDevice(context, points, camera, *request.backend, request.error, request.tolerance_px);
+  Result<ModeChoice> choice = choose();
   if (!choice) return choice.error();
   p.mode = choice->mode;
   p.bound_px = choice->bound_px;
+  p.encoding = choice->encoding();
   p.choice = std::move(*choice);
   p.warning = predictionWarning(request, p, std::nullopt);
-  return p;
-}
-
-// A streamed set is read once, so no bound is predicted from its points: --mode auto takes the
-// fallback mode (native), which holds to well under 0.1 px wherever the study's hard cases reach.
-ModePrediction streamedModePrediction(const RenderRequest& request) {
-  ModePrediction p;
-  p.mode = request.mode == "auto" ? kFallbackMode : *parseMode(request.mode);
-  p.bound_px = std::nan("");
   return p;
 }
 
@@ -247,13 +254,13 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
                    const std::function<void(const SheetView&)>& view_done) {
   std::vector<LabelledView> sheet;
   for (size_t i = 0; i < views.size(); ++i) {
-    Result<ModePrediction> prediction = predictMode(request, context, *set.points, cameras[i]);
+    Result<ModePrediction> prediction = predictMode(request, context, set, cameras[i]);
     if (!prediction) return prediction.error();
     std::vector<std::string> shading_warnings;
     const RenderOptions options =
         renderOptionsFor(request, set, prediction->mode, cameras[i], context.facts, shading_warnings);
     for (const std::string& w : shading_warnings) outcome.warnings.push_back("view " + std::string(views[i].label) + ": " + w);
-    Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options);
+    Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options, prediction->encoding.get());
     if (!rendered) return rendered.error();
     const std::string mode(modeName(prediction->mode));
     const std::string label = "view " + std::string(views[i].label) + ": ";
@@ -272,8 +279,7 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
 // One view, the set in memory or streamed: the render and, with --error, the error measured.
 Status renderOne(const RenderRequest& request, const VulkanContext& context, const LoadedSet& set,
                  const Camera& camera, RenderOutcome& outcome, Progress& progress) {
-  Result<ModePrediction> prediction =
-      set.stream ? streamedModePrediction(request) : predictMode(request, context, *set.points, camera);
+  Result<ModePrediction> prediction = predictMode(request, context, set, camera);
   if (!prediction) return prediction.error();
   outcome.prediction = std::move(*prediction);
   if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
@@ -283,7 +289,7 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   outcome.point_size = options.point_size;
   outcome.shading = options.shading;
   Result<RenderResult> rendered = [&]() -> Result<RenderResult> {
-    if (!set.stream) return renderPoints(context, *set.points, camera, options);
+    if (!set.stream) return renderPoints(context, *set.points, camera, options, outcome.prediction.encoding.get());
     PointStream stream;
     stream.count = set.count;
     stream.has_colors = set.has_colors || set.elevation;
@@ -637,6 +643,9 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   JsonObject o;
   o.add("mode", V::string(modeName(mode))).add("mode_requested", V::string(request.mode));
   o.add("predicted_bound_px", V::number(outcome.prediction.bound_px));
+  // What the bound was predicted from: every point the view shows, or (a streamed set, read once
+  // while it is drawn) the box of every 1024 points.
+  o.add("predicted_from", V::string(outcome.prediction.from_boxes ? "batch_boxes" : "points"));
   if (const std::optional<ModeChoice>& c = outcome.prediction.choice) {
     JsonObject choice;
     choice.add("enough", V::boolean(c->enough)).add("limit_px", V::number(kAutoBoundPx));

@@ -119,9 +119,15 @@ double peakRssMb();
 // What the run predicted for its mode: the bound, and with --mode auto the choice made.
 struct ModePrediction {
   PrecisionMode mode = kFallbackMode;
-  double bound_px = 0.0;             // NaN for a streamed set (none predicted)
+  double bound_px = 0.0;             // +inf: unbounded
+  // A streamed set's bound is from the boxes of its batches (predictBoxBounds), the points being read
+  // once while they are drawn: an upper bound of the one its points would give.
+  bool from_boxes = false;
   std::optional<ModeChoice> choice;  // --mode auto
   std::string warning;               // the picture is likely wrong in this mode (predictionWarning); or empty
+  // The mode's encoding, made for the bound (same camera and tolerance), which renderPoints takes
+  // rather than making it again; null: none was made (a streamed set, or the mode refuses the set).
+  std::shared_ptr<const ModeEncoding> encoding;
 };
 
 // Over this predicted bound a forced --mode draws a wrong picture (points half a pixel or more off),
@@ -186,7 +192,7 @@ struct RenderOutcome {
   // picture is written (its teardown is no part of the run's phases).
   std::unique_ptr<VulkanContext> context;
   size_t points = 0;
-  bool streamed = false;       // drawn a block at a time (no prediction, no --error)
+  bool streamed = false;       // drawn a block at a time (its bound from batch boxes, no --error)
   DeviceFacts device;
   Backend backend = Backend::kRaster;  // the one that ran (backendFor with --backend auto)
   std::vector<std::string> validation_messages;  // with `validate`: any fails the run

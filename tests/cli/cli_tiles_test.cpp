@@ -140,7 +140,8 @@ TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
   EXPECT_EQ(afterFile(one.out), afterFile(tiles.out));
   EXPECT_NE(tiles.out.find("part-0.ply and 3 more"), std::string::npos);
   // Streamed (as tiles larger than memory are): the same counts, bounds and nearest neighbour; the
-  // float32 merge count and the error bounds, which need every point at once, are left out.
+  // float32 merge count, which needs every point at once, is left out, and the error bounds come
+  // from the box of each batch.
   test::CommandResult streamed = runDpoint(concat({"info", "--json", "--stream", "on"}, parts));
   ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
   for (const char* key : {"\"points\"", "\"triangles\"", "\"colors\"", "\"min\"", "\"max\"",
@@ -153,7 +154,10 @@ TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
     EXPECT_EQ(line(one.out), line(streamed.out));
   }
   EXPECT_NE(streamed.out.find("\"float32_merged_points\": null"), std::string::npos) << streamed.out;
-  EXPECT_EQ(streamed.out.find("error_bound_px"), std::string::npos) << streamed.out;
+  EXPECT_NE(streamed.out.find("\"error_bound_from\": \"batch_boxes\",\n  \"error_bound_px\": {\"fp32\": "),
+            std::string::npos)
+      << streamed.out;
+  EXPECT_NE(one.out.find("\"error_bound_from\": \"points\""), std::string::npos) << one.out;
 
   ASSERT_EQ(runDpoint({"render", dir.file("whole.ply"), "-q", "--validate", "-o", dir.file("whole.png")}).exit_code, 0);
   test::CommandResult r = runDpoint(concat(concat({"render", "-q", "--validate"}, parts), {"-o", dir.file("tiles.png")}));

@@ -154,7 +154,7 @@ TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
   outcome.error->stats.lost = 3;
   const std::string json = renderReportJson(request, outcome);
   EXPECT_EQ(json.rfind("{\n  \"mode\": \"fp32\",\n  \"mode_requested\": \"fp32\",\n  \"predicted_bound_px\": null,\n"
-                       "  \"backend\": \"raster\",\n  \"order\": \"input\",\n  \"device\": \"dev \\\"1\\\"\",\n", 0),
+                       "  \"predicted_from\": \"points\",\n  \"backend\": \"raster\",\n  \"order\": \"input\",\n  \"device\": \"dev \\\"1\\\"\",\n", 0),
             0u)
       << json;
   for (const char* line : {"  \"width\": 64,\n  \"height\": 48,\n  \"point_size\": 2.5,\n  \"shading\": \"edl\",\n"
