@@ -319,44 +319,50 @@ constexpr PositionAttribute kFloatAttribute{0, VK_FORMAT_R32G32B32_SFLOAT, 0};
 constexpr PositionAttribute kLoAttribute{1, VK_FORMAT_R32G32B32_SFLOAT, 12};
 constexpr PositionAttribute kNone{};
 
-// Speed ranks, [DeviceClass][compute backend], from the measured orders:
-// - GPU compute (H100, ms/frame × fp32 at 16.7M points: batch 1.01, rte 1.09, native 1.10, df64
-//   1.16): fp32, batch, rte, native, df64.
-// - GPU raster: bound by the point rasterizer (all modes within 2% at 10M), so fewest bytes first:
-//   fp32, batch, native, rte, df64.
-// - lavapipe compute at 1M and 10M (native 0.92–1.06, rte 1.17–1.28, batch 1.23–1.42, df64
-//   1.28–1.49); raster within noise of each other, so the same order: fp32, native, rte, batch, df64.
+// Speed ranks, [DeviceClass][compute backend], from the orders measured with issue #25's encodings
+// (bench/results/2026-11-25/h100/adaptive-final-2026-11-25.tsv, adaptive-modes-2026-11-25.tsv;
+// lavapipe: bench/results/2026-11-25/lavapipe/speed-adaptive-2026-11-25.tsv):
+// - GPU compute (H100, 1920x1080, Morton order; ms at 16.7M Sierpinski / 16.6M Mandelbulb / 1e9
+//   2D): batch 0.114 / 0.124 / 5.38, adaptive 0.111 / 0.130 / 5.20, fp32 0.137 / 0.137 / 5.35,
+//   rte 0.186 / 0.193, native 0.185 / 0.194 / 8.23, df64 0.346 / 0.345: batch, adaptive, fp32, rte,
+//   native, df64 (batch and adaptive within 2% over the two 16.7M sets; rte and native tied, as before).
+// - GPU raster: bound by the point rasterizer (all within 0.2% at 16.7M: 19.18–19.22 ms, 19.88–20.93),
+//   ties ranked as on compute: batch, adaptive, fp32, native, rte, df64.
+// - lavapipe compute (16.7M Sierpinski, Morton): fp32 653, native 705, batch 857, rte 968, df64 986,
+//   adaptive 1046 ms. Raster: batch 4108 and adaptive 5359 ms, 2× the others (1794–2535 ms, within
+//   this machine's run-to-run spread of each other), which keep their earlier order: fp32, native,
+//   rte, df64, batch, adaptive.
 // split has none: it computes exactly what fp32 does, at twice the bytes.
 //                                {{cpu raster, cpu compute}, {gpu raster, gpu compute}}
 constexpr ModeInfo kModes[] = {
     {PrecisionMode::kFp32, "fp32", "float positions", 12, kFloatXyz, false, false, false, false, 0, 1,
      {DPOINT_SPIRV(kPointsFp32Vert), {}, DPOINT_SPIRV(kSplatFp32Comp), {kFloatAttribute, kNone}, 1},
-     encodeFloats, worldMatrixUniform, worstOfPairs<Fp32Bound>, nullptr, {{0, 0}, {0, 0}}},
+     encodeFloats, worldMatrixUniform, worstOfPairs<Fp32Bound>, nullptr, {{0, 0}, {2, 2}}},
     {PrecisionMode::kSplit, "split", "the study's hi+lo, no better than fp32", 24, kFloatPairs, false, false, false,
      false, 0, 1,
      {DPOINT_SPIRV(kPointsSplitVert), {}, DPOINT_SPIRV(kSplatSplitComp), {kFloatAttribute, kLoAttribute}, 2},
      encodeFloatPairs, worldMatrixUniform, worstOfPairs<SplitBound>, nullptr, {{kNoRank, kNoRank}, {kNoRank, kNoRank}}},
     {PrecisionMode::kRte, "rte", "relative to eye", 24, kFloatPairs, true, true, false, false, 0, 1,
      {DPOINT_SPIRV(kPointsRteVert), {}, DPOINT_SPIRV(kSplatRteComp), {kFloatAttribute, kLoAttribute}, 2},
-     encodeFloatPairs, rteUniform, worstOf<rteBound>, nullptr, {{2, 2}, {3, 2}}},
+     encodeFloatPairs, rteUniform, worstOf<rteBound>, nullptr, {{2, 3}, {4, 3}}},
     {PrecisionMode::kDf64, "df64", "double-float arithmetic", 24, kFloatPairs, true, true, false, false, 0, 1,
      {DPOINT_SPIRV(kPointsDf64Vert), {}, DPOINT_SPIRV(kSplatDf64Comp), {kFloatAttribute, kLoAttribute}, 2},
-     encodeFloatPairs, df64Uniform, worstOf<df64Bound>, df64MatrixOverflows, {{4, 4}, {4, 4}}},
+     encodeFloatPairs, df64Uniform, worstOf<df64Bound>, df64MatrixOverflows, {{3, 4}, {5, 5}}},
     {PrecisionMode::kNative, "native", "fp64 shaders", 24, kDoubleXyz, true, false, true, true, 0, 1,
      {DPOINT_SPIRV(kPointsNativeAttrVert), DPOINT_SPIRV(kPointsNativePullVert), DPOINT_SPIRV(kSplatNativeComp),
       {{0, VK_FORMAT_R64G64B64_SFLOAT, 0}, kNone}, 1},
-     encodeDoubles, nativeUniform, worstOfPairs<NativeBound>, nullptr, {{1, 1}, {2, 3}}},
+     encodeDoubles, nativeUniform, worstOfPairs<NativeBound>, nullptr, {{1, 1}, {3, 4}}},
     // The compute splat reads points in pairs that must share a batch: chunks start at even points.
     {PrecisionMode::kBatch, "batch", "per-batch double origins", 8, kBatchWord, true, false, false, false, kBatchSize, 2,
      {DPOINT_SPIRV(kPointsBatchVert), {}, DPOINT_SPIRV(kSplatBatchComp), {{0, VK_FORMAT_R32G32_UINT, 0}, kNone}, 1},
-     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{3, 3}, {1, 1}}, kBatchSteps},
+     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{4, 2}, {0, 0}}, kBatchSteps},
     // Pulls its tier words in both backends (no attributes); chunks hold whole batches, so each
     // 1024-point workgroup of the compute splat lies in one batch and loads 16 bytes a thread.
     {PrecisionMode::kAdaptive, "adaptive", "per-batch tiers of 10 bits, as few as --tolerance allows", 12,
      kTierWords, true, false, false, false, kAdaptiveBatchSize, kAdaptiveBatchSize,
      {DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kSplatAdaptiveComp),
       {kNone, kNone}, 0},
-     encodeAdaptiveTier, noUniform, worstOf<adaptiveBound>, nullptr, {{5, 5}, {5, 5}}, kAdaptiveSteps, kAdaptiveTiers},
+     encodeAdaptiveTier, noUniform, worstOf<adaptiveBound>, nullptr, {{5, 5}, {1, 1}}, kAdaptiveSteps, kAdaptiveTiers},
 };
 static_assert(std::size(kModes) == kModeCount);
 

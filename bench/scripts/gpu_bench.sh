@@ -11,4 +11,5 @@ set -euo pipefail
 source bench/scripts/gpu_env.sh
 .gpu/dpoint devices | tee "$out/devices.txt"
 mkdir -p "$out/bench"
-.gpu/dpoint bench --suite "${SUITE:-all}" --frames "${FRAMES:-20}" --out "$out/bench" --cache /tmp/dpoint-bench-cache
+.gpu/dpoint bench --suite "${SUITE:-all}" --frames "${FRAMES:-20}" --warmup "${WARMUP:-300ms}" --out "$out/bench" \
+  --cache /tmp/dpoint-bench-cache
