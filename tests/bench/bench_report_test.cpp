@@ -58,6 +58,20 @@ std::vector<std::string> failedModes(const BenchRun& run) {
   return out;
 }
 
+// A made-up compute frame of `width` × `height` pixels, every mode measured with error 1, and a
+// copy bandwidth of 100 GB/s read+write: what the bandwidth-bound tests count by hand.
+struct MadeUpFrame {
+  BenchRun run;
+  CopyBandwidth copy;
+};
+MadeUpFrame madeUpFrame(uint32_t width, uint32_t height) {
+  MadeUpFrame f{madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1}), CopyBandwidth{}};
+  f.run.cases.front().width = width;
+  f.run.cases.front().height = height;
+  f.copy.read_write_gb_per_s = 100.0;
+  return f;
+}
+
 TEST(BenchReport, checksPassARunThatBehavesAsDesignSays) {
   // fp32 far off, every double mode near the float floor, native best.
   BenchRun run = madeUpRun({30, 30, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
@@ -108,11 +122,7 @@ TEST(BenchReport, resultsJsonWritesNullForWhatWasNotMeasured) {
 // A 1000×500 frame of 100 points on the compute backend at 100 GB/s read+write: every byte is
 // counted by hand from the passes in viewer/render_compute.cpp.
 TEST(BenchReport, bandwidthBoundCountsEveryPassOfAComputeFrame) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
-  run.cases.front().width = 1000;
-  run.cases.front().height = 500;
-  CopyBandwidth copy;
-  copy.read_write_gb_per_s = 100.0;
+  auto [run, copy] = madeUpFrame(1000, 500);
   for (BenchRow& row : run.rows) {
     row.gpu_ms_median = 0.5;
     setBandwidthBound(row, &copy);
@@ -171,11 +181,7 @@ TEST(BenchReport, bandwidthBoundLeavesRasterSkippedAndUntimedRowsWithoutAFractio
 // (tiers and culling mixed), counted in the frame's bytes and its bound; without a plan (the draw
 // did not report one) nothing is counted for them, where every other mode keeps its layout's.
 TEST(BenchReport, bandwidthBoundCountsWhatThePerBatchPlanLoaded) {
-  BenchRun run = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
-  run.cases.front().width = 100;
-  run.cases.front().height = 100;
-  CopyBandwidth copy;
-  copy.read_write_gb_per_s = 100.0;
+  auto [run, copy] = madeUpFrame(100, 100);
   BenchRow& batch = run.rows[modeIndex(PrecisionMode::kBatch)];
   BenchRow& adaptive = run.rows[modeIndex(PrecisionMode::kAdaptive)];
   batch.points = adaptive.points = 1000;

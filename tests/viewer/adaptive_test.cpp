@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "ortho_camera.h"
 #include "render_test_support.h"
 #include "viewer/batch_plan.h"
 #include "viewer/precision.h"
@@ -57,13 +58,7 @@ Square square(const glm::dvec2& centre, double side, double view) {
   std::mt19937_64 random(2511);
   std::uniform_real_distribution<double> unit(-0.5, 0.5);
   for (int i = 0; i < 1024; ++i) s.points.positions.emplace_back(centre.x + side * unit(random), centre.y + side * unit(random), 0.0);
-  CameraSpec spec;
-  spec.width = spec.height = 512;
-  spec.view_center = glm::dvec3(centre, 0.0);
-  spec.view_width = view;
-  Result<Camera> camera = makeCamera(spec, boundsOf(s.points));
-  EXPECT_TRUE(camera.ok()) << camera.error().message;
-  s.camera = *camera;
+  s.camera = orthoCamera(s.points, glm::dvec3(centre, 0.0), view, 512);
   return s;
 }
 
@@ -143,14 +138,9 @@ TEST_P(Adaptive, straddlingBatchesAreDrawnAndCulledOnesAreNeverRead) {
     s.positions.emplace_back(centres[i / 1024] + ((i % 1024) + 0.5) / 1024.0 - 0.5, 0.3 * std::sin(0.01 * i), 0.0);
     s.colors.emplace_back(float(i % 7) / 7.0f, 0.5f, 1.0f);
   }
-  CameraSpec spec;
-  spec.width = spec.height = 256;
-  spec.view_center = glm::dvec3(0.0);
-  spec.view_width = 2.0;
-  Result<Camera> camera = makeCamera(spec, boundsOf(s));
-  ASSERT_TRUE(camera.ok());
+  const Camera camera = orthoCamera(s, glm::dvec3(0.0), 2.0, 256);
   for (PrecisionMode mode : {PrecisionMode::kAdaptive, PrecisionMode::kBatch}) {
-    Measured m = measure(s, *camera, mode);
+    Measured m = measure(s, camera, mode);
     ASSERT_TRUE(m.render.batch_plan.has_value());
     const BatchPlanStats& plan = *m.render.batch_plan;
     const size_t batch = modeInfo(mode).batch_points;
@@ -190,21 +180,16 @@ TEST_P(Adaptive, subgroupMergeGivesThePlainPicture) {
     s.positions.emplace_back(unit(random) - 0.5, unit(random) - 0.5, -1.0 - unit(random));
     s.colors.emplace_back(0.9f, float(i % 3) / 3.0f, 0.4f);
   }
-  CameraSpec spec;
-  spec.width = spec.height = 128;
-  spec.view_center = glm::dvec3(0.0);
-  spec.view_width = 1.28;
-  Result<Camera> camera = makeCamera(spec, boundsOf(s));
-  ASSERT_TRUE(camera.ok());
+  const Camera camera = orthoCamera(s, glm::dvec3(0.0), 1.28, 128);
   for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kAdaptive}) {
     RenderOptions options;
     options.mode = mode;
     options.backend = Backend::kCompute;
     options.early_depth = false;  // no merge: one atomic a point
-    Result<RenderResult> plain = renderPoints(*context_, s, *camera, options);
+    Result<RenderResult> plain = renderPoints(*context_, s, camera, options);
     ASSERT_TRUE(plain.ok()) << plain.error().message;
     options.early_depth = true;
-    Result<RenderResult> merged = renderPoints(*context_, s, *camera, options);
+    Result<RenderResult> merged = renderPoints(*context_, s, camera, options);
     ASSERT_TRUE(merged.ok()) << merged.error().message;
     EXPECT_EQ(merged->image.rgba, plain->image.rgba) << modeName(mode);
   }

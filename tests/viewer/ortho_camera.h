@@ -23,4 +23,15 @@ inline Camera orthoCamera(const glm::dvec3& centre, double width) {
   return *camera;
 }
 
+// The same for the set `fit` (its depth range), `side`² pixels.
+inline Camera orthoCamera(const PointSet& fit, const glm::dvec3& centre, double width, uint32_t side) {
+  CameraSpec spec;
+  spec.width = spec.height = side;
+  spec.view_center = centre;
+  spec.view_width = width;
+  Result<Camera> camera = makeCamera(spec, boundsOf(fit));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
 }  // namespace dpoint
