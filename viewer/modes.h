@@ -26,7 +26,8 @@
 //      and the per-point error bound (bound::worstOf<itsBound>, or bound::worstOfPairs<ItsBound>
 //      for a bound written for one point or two in lanes; the shared terms are in
 //      viewer/bound_terms.h, and a per-camera term no mode has yet goes in bound::Setup there),
-//      plus its speed ranks (kNoRank until measured);
+//      plus its speed ranks (kNoRank until measured), and its bound over a box of points in
+//      kBoxBounds (viewer/precision.cpp: what a streamed set is predicted from);
 //   3. its arithmetic in shaders/render/project.glsl under a MODE_… define, and its dpoint_shader
 //      lines in CMakeLists.txt (raster vertex, compute splat; a pull variant where the raster path
 //      may read positions from a storage buffer), whose headers modes.cpp includes for the row.
