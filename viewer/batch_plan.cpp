@@ -68,13 +68,9 @@ double adaptiveBoxBoundPx(const ModeEncoding& e, size_t b, uint32_t tiers) {
   const BoxClip box = boxClip(e, b);
   const double w_min = box.centre[3] - box.radius[3];
   if (!(w_min > 0.0)) return kInf;
-  const double step_error = adaptiveStepError(tiers);
   const double largest = kAdaptiveSteps;  // |steps| ≤ 2^29 in the box
-  const double dv = step_error + 2.0 * kUd * largest + (tiers == kAdaptiveTiers ? 2.0 * kU * (largest + step_error) : 0.0);
-  Clip<double> d = floatAffine(floatRows(e.batch_matrices[b]), Coords<double>{largest, largest, largest},
-                               Coords<double>{dv, dv, dv});
-  const Vec4 translation = batchTranslationError(e.frame, e.batches[b].origin);
-  for (size_t r = 0; r < 4; ++r) d[r] += translation[r];
+  const double dv = adaptiveOffsetError(tiers, largest);
+  Clip<double> d = batchMatrixError(e, b, Coords<double>{largest, largest, largest}, Coords<double>{dv, dv, dv});
   // pixelsSquared at the box's worst: the largest |x|, |y| a visible point has (≤ w) and the least w.
   const double w_max = box.centre[3] + box.radius[3];
   Clip<double> c;

@@ -180,6 +180,28 @@ inline Vec4 batchTranslationError(const SceneFrame& frame, const glm::dvec3& ori
   return error;
 }
 
+// How far a per-batch mode's stored offset, |steps| from its batch's origin (in steps), may be from
+// the exact one, in steps. batch: (p' − origin) / extent rounds once in double, then to an integer
+// step (half a step, one at the clamped edge t = 1), which a float holds exactly. adaptive with
+// `tiers` tiers loaded: the step error of those tiers (viewer/encode.h, adaptiveStepError) and, with
+// all three, the rounding of the 30-bit integer to float (2u·|q|: SPIR-V leaves the direction open;
+// with fewer tiers the rebuilt integer has at most 21 significant bits and converts exactly).
+inline double batchOffsetError(double steps) { return 1.0 + 2.0 * kUd * steps; }
+inline double adaptiveOffsetError(uint32_t tiers, double steps) {
+  const double step_error = adaptiveStepError(tiers);
+  return step_error + 2.0 * kUd * steps + (tiers == kAdaptiveTiers ? 2.0 * kU * (steps + step_error) : 0.0);
+}
+
+// Batch b's float matrix applied to offsets of at most `steps` off by at most dv, plus the double
+// rounding of its translation (both worked out here; the per-point pass keeps them per batch).
+inline Clip<double> batchMatrixError(const ModeEncoding& e, size_t b, const Coords<double>& steps,
+                                     const Coords<double>& dv) {
+  Clip<double> out = floatAffine(floatRows(e.batch_matrices[b]), steps, dv);
+  const Vec4 translation = batchTranslationError(e.frame, e.batches[b].origin);
+  for (size_t r = 0; r < 4; ++r) out[r] += translation[r];
+  return out;
+}
+
 // What every mode's bound reads: the camera in the scene frame and its derived matrices, computed
 // once per pass (precision.cpp, makeSetup).
 struct Setup {

@@ -229,35 +229,28 @@ inline Clip<T> nativeError(const Setup& s, const Coords<T>& ps, const Clip<T>& c
   return out;
 }
 
-// batch: the offset (p' − origin) / extent rounds once in double, then to an integer step (half a
-// step, one at the clamped edge t = 1), which a float holds exactly; the batch matrix, built in
-// double (its translation's rounding is precomputed per batch), is applied in float.
+// batch: the offset's error in steps (batchOffsetError); the batch matrix, built in double (its
+// translation's rounding is precomputed per batch), is applied in float.
 Vec4 batchError(const ModeState& own, const glm::dvec3& ps, size_t index) {
   const size_t b = own.encoding.batchOf(index);
   const BatchFrame& frame = own.encoding.batches[b];
   const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kBatchSteps;
   Coords<double> dv;
-  for (size_t a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * std::fabs(steps[static_cast<glm::length_t>(a)]);
+  for (size_t a = 0; a < 3; ++a) dv[a] = batchOffsetError(std::fabs(steps[static_cast<glm::length_t>(a)]));
   Vec4 out = floatAffine(own.batch_rows[b], coordsOf(steps), dv);
   for (size_t r = 0; r < 4; ++r) out[r] += own.batch_translation_error[b][r];
   return out;
 }
 
-// adaptive: as batch, with the step error of the tiers the point's batch loads (viewer/encode.h,
-// adaptiveStepError) and, with all three, the rounding of the 30-bit integer to float (2u·|q|: SPIR-V leaves the direction open; with
-// fewer tiers the rebuilt integer has at most 21 significant bits and converts exactly).
+// adaptive: as batch, with the offset error of the tiers the point's batch loads (adaptiveOffsetError).
 Vec4 adaptiveError(const ModeState& own, const glm::dvec3& ps, size_t index) {
   const size_t b = own.encoding.batchOf(index);
   const uint32_t tiers = own.encoding.batch_plan[b];
   if (tiers == 0) return kUnbounded;  // never: a culled batch's box holds no visible point
   const BatchFrame& frame = own.encoding.batches[b];
   const glm::dvec3 steps = (ps - frame.origin) / frame.extent * kAdaptiveSteps;
-  const double step_error = adaptiveStepError(tiers);
   Coords<double> dv;
-  for (size_t a = 0; a < 3; ++a) {
-    const double s = std::fabs(steps[static_cast<glm::length_t>(a)]);
-    dv[a] = step_error + 2.0 * kUd * s + (tiers == kAdaptiveTiers ? 2.0 * kU * (s + step_error) : 0.0);
-  }
+  for (size_t a = 0; a < 3; ++a) dv[a] = adaptiveOffsetError(tiers, std::fabs(steps[static_cast<glm::length_t>(a)]));
   Vec4 out = floatAffine(own.batch_rows[b], coordsOf(steps), dv);
   for (size_t r = 0; r < 4; ++r) out[r] += own.batch_translation_error[b][r];
   return out;

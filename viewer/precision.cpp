@@ -301,40 +301,29 @@ Coords<double> largestSteps(const BatchFrame& frame, const BoxTerms& t, double s
   return out;
 }
 
-// A batch's matrix applied in float to offsets of at most `steps` off by at most dv, plus the
-// double rounding of its translation (made here, per box: 244k batches' rows are not kept).
-Clip<double> batchMatrixError(const Setup& s, const ModeState& own, size_t b, const Coords<double>& steps,
-                              const Coords<double>& dv) {
-  Clip<double> out = floatAffine(floatRows(own.encoding.batch_matrices[b]), steps, dv);
-  const Vec4 translation = batchTranslationError(s.frame, own.encoding.batches[b].origin);
-  for (size_t r = 0; r < 4; ++r) out[r] += translation[r];
-  return out;
-}
-
 // b: the box's index in BatchBoxes (kBoxPoints points); its batch is the one holding them.
 size_t batchOfBox(const ModeState& own, size_t b) { return b * kBoxPoints / own.encoding.batchSize(); }
 
-double batchBox(const Setup& s, const ModeState& own, const BoxTerms& t, size_t box, const Camera& camera) {
+// The batch matrix's terms are worked out per box (batchMatrixError): 244k batches' rows are not kept.
+double batchBox(const Setup&, const ModeState& own, const BoxTerms& t, size_t box, const Camera& camera) {
   const size_t b = batchOfBox(own, box);
   const Coords<double> steps = largestSteps(own.encoding.batches[b], t, kBatchSteps);
   Coords<double> dv;
-  for (size_t a = 0; a < 3; ++a) dv[a] = 1.0 + 2.0 * kUd * steps[a];
-  return boxPixels(t, batchMatrixError(s, own, b, steps, dv), camera);
+  for (size_t a = 0; a < 3; ++a) dv[a] = batchOffsetError(steps[a]);
+  return boxPixels(t, batchMatrixError(own.encoding, b, steps, dv), camera);
 }
 
 // adaptive: the tiers its plan chose for the batch (a culled batch holds no point the view shows),
 // and no more than the plan's own box bound for them (adaptiveBoxBoundPx: the batch's whole cube).
-double adaptiveBox(const Setup& s, const ModeState& own, const BoxTerms& t, size_t box, const Camera& camera) {
+double adaptiveBox(const Setup&, const ModeState& own, const BoxTerms& t, size_t box, const Camera& camera) {
   const size_t b = batchOfBox(own, box);
   const uint32_t tiers = own.encoding.batch_plan[b];
   if (tiers == 0) return 0.0;
   const Coords<double> steps = largestSteps(own.encoding.batches[b], t, kAdaptiveSteps);
-  const double step_error = adaptiveStepError(tiers);
   Coords<double> dv;
-  for (size_t a = 0; a < 3; ++a)
-    dv[a] = step_error + 2.0 * kUd * steps[a] + (tiers == kAdaptiveTiers ? 2.0 * kU * (steps[a] + step_error) : 0.0);
+  for (size_t a = 0; a < 3; ++a) dv[a] = adaptiveOffsetError(tiers, steps[a]);
   const double plan_px = adaptiveBoxBoundPx(own.encoding, b, tiers);
-  return std::min(boxPixels(t, batchMatrixError(s, own, b, steps, dv), camera), plan_px * plan_px);
+  return std::min(boxPixels(t, batchMatrixError(own.encoding, b, steps, dv), camera), plan_px * plan_px);
 }
 
 // By modeIndex, beside the per-point bounds' rows (viewer/modes.cpp).
