@@ -1,7 +1,6 @@
 #include "viewer/encode.h"
 
 #include <algorithm>
-#include <bit>
 #include <cassert>
 #include <charconv>
 #include <cmath>
@@ -144,6 +143,15 @@ Status checkPositions(const ModeEncoding& e, const PointSet& points, size_t inde
   return okStatus();
 }
 
+// t in [−1, 1] as a whole number of steps (a power of two per extent) in [−steps, steps − 1]: t·steps
+// is exact, rounded half to even without nearbyint's libm call (adding and taking away 1.5·2^52
+// leaves an |x| ≤ 2^51 rounded to an integer in the current round-to-nearest mode; -ffp-contract=off
+// and no -ffast-math keep the two operations as written); t = 1 is the one value clamped.
+double roundToStep(double t, double steps) {
+  constexpr double kRound = 0x1.8p52;
+  return std::clamp((t * steps + kRound) - kRound, -steps, steps - 1.0);
+}
+
 }  // namespace
 
 uint32_t encodeColor(const glm::vec3& color) {
@@ -174,16 +182,10 @@ void encodeColors(const PointSet& points, size_t first, size_t count, uint32_t* 
 }
 
 uint64_t packBatchOffset(const glm::dvec3& t) {
-  constexpr double kLargest = kBatchSteps - 1.0;
   constexpr uint64_t kMask = (uint64_t{1} << kBatchOffsetBits) - 1;
   uint64_t word = 0;
-  // Rounding half to even without nearbyint's libm call: adding and taking away 1.5·2^52 leaves
-  // an |x| ≤ 2^51 rounded to an integer in the current (round-to-nearest) mode; -ffp-contract=off
-  // and no -ffast-math keep the two operations as written.
-  constexpr double kRound = 0x1.8p52;
   for (int a = 0; a < 3; ++a) {
-    // t·2^20 is exact; the sum rounds it half to even; t = 1 is the one value clamped.
-    const double q = std::clamp((t[a] * kBatchSteps + kRound) - kRound, -kBatchSteps, kLargest);
+    const double q = roundToStep(t[a], kBatchSteps);
     word |= (static_cast<uint64_t>(static_cast<int64_t>(q)) & kMask) << (kBatchOffsetBits * a);
   }
   return word;
@@ -200,10 +202,7 @@ glm::ivec3 unpackBatchOffset(uint64_t word) {
 }
 
 uint32_t quantizeAdaptive(double t) {
-  // As packBatchOffset: t·2^29 is exact, the sum rounds it half to even, t = 1 is clamped.
-  constexpr double kRound = 0x1.8p52;
-  const double q = std::clamp((t * kAdaptiveSteps + kRound) - kRound, -kAdaptiveSteps, kAdaptiveSteps - 1.0);
-  return static_cast<uint32_t>(static_cast<int32_t>(q) + (int32_t{1} << 29));
+  return static_cast<uint32_t>(static_cast<int32_t>(roundToStep(t, kAdaptiveSteps)) + (int32_t{1} << 29));
 }
 
 int32_t adaptiveRebuilt(uint32_t q, uint32_t tiers) {
@@ -266,7 +265,7 @@ ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tole
   e.tolerance_px = tolerance_px;
   e.width = camera.width;
   e.height = camera.height;
-  if (const uint32_t batch = modeInfo(mode).batch_points) e.batch_shift = static_cast<uint32_t>(std::countr_zero(batch));
+  e.batch_shift = batchShift(mode);
   return e;
 }
 

@@ -92,7 +92,7 @@ struct BatchFrame {
 // three planes of such words (viewer/modes.h, PositionLayout::planes), so loading k tiers reads
 // 4·k bytes a point. With k tiers loaded the shader rebuilds q as the centre of the cell the
 // loaded bits name (k = 3: q itself) and maps q − 2^29 to clip space with the batch matrix.
-inline constexpr int kAdaptiveBits = 30, kAdaptiveTierBits = 10;
+inline constexpr int kAdaptiveTierBits = 10;
 inline constexpr uint32_t kAdaptiveTiers = 3;
 inline constexpr double kAdaptiveSteps = 0x1p29;  // integer steps per extent
 // The tolerance adaptive mode chooses its tiers for (--tolerance), in window pixels.

@@ -38,6 +38,7 @@
 // uniform block, its layout and the speed orders.
 #pragma once
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
@@ -166,9 +167,7 @@ std::optional<PrecisionMode> parseMode(std::string_view name);
 
 // log2 of the points per batch of a per-batch mode (0 for the others).
 inline uint32_t batchShift(PrecisionMode mode) {
-  uint32_t shift = 0;
-  for (uint32_t n = modeInfo(mode).batch_points; n > 1; n >>= 1) ++shift;
-  return shift;
+  return static_cast<uint32_t>(std::bit_width(modeInfo(mode).batch_points | 1u)) - 1u;
 }
 
 // Bytes of position data per point (colour not included), and with the RGBA8 colour.
