@@ -200,17 +200,12 @@ Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, co
                                what + " positions");
         !status)
       return status;
+    // Plane by plane (one, interleaved, for every mode but adaptive): a point's bytes in a plane,
+    // `element`, are the whole point's where there is one plane.
+    const VkDeviceSize element = layout.planes == 1 ? stride : layout.element_bytes;
+    const VkDeviceSize plane_bytes = planeStride(chunk.count) * element;
     Status status = okStatus();
-    if (layout.planes == 1) {
-      status = uploadBuffer(context, chunk.positions, chunk.count * stride,
-          [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
-            encodePositions(encoding, *view->set, view->offset + offset / stride, bytes / stride, dst,
-                            chunk.first - view->offset);
-          }, stride);
-    }
-    // A planar layout: each plane's elements of the chunk's points, one plane after another.
-    const VkDeviceSize element = layout.element_bytes, plane_bytes = planeStride(chunk.count) * element;
-    for (uint32_t plane = 0; plane < layout.planes && layout.planes > 1 && status; ++plane) {
+    for (uint32_t plane = 0; plane < layout.planes && status; ++plane) {
       status = uploadBuffer(context, chunk.positions, chunk.count * element,
           [&](void* dst, VkDeviceSize offset, VkDeviceSize bytes) {
             encodePositions(encoding, *view->set, view->offset + offset / element, bytes / element, dst,
