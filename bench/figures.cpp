@@ -14,8 +14,9 @@ namespace {
 using namespace report;
 
 // Okabe–Ito colours (distinguishable with the common colour-vision deficiencies) and markers, taken
-// by the mode's place in the table (viewer/modes.h), so a new mode gets the next pair unasked.
-const char* const kPalette[] = {"#E69F00", "#CC79A7", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#F0E442", "#000000"};
+// by the mode's place in the table (viewer/modes.h), so a new mode gets the next pair unasked. Black
+// before the yellow, which barely shows on the white charts (it was adaptive's).
+const char* const kPalette[] = {"#E69F00", "#CC79A7", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#000000", "#F0E442"};
 const Marker kMarkers[] = {Marker::kCircle, Marker::kCross, Marker::kTriangle, Marker::kDiamond,
                            Marker::kSquare, Marker::kStar,  Marker::kPlus,     Marker::kTriangleDown};
 const char* modeColor(size_t m) { return kPalette[m % std::size(kPalette)]; }
