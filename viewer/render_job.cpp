@@ -42,7 +42,10 @@ constexpr double kSurfaceShare = 0.65;
 
 struct LoadedSet {
   std::string inputs;  // describeInputs: for messages
-  std::optional<PointSet> points;
+  std::optional<PointSet> owned;           // read here, or a copy of the request's set to colour or order
+  std::shared_ptr<const PointSet> shared;  // else the request's own set (RenderRequest::points)
+  // The set in memory; null: a stream.
+  const PointSet* points() const { return owned ? &*owned : shared.get(); }
   std::unique_ptr<PointInputStream> stream;
   size_t count = 0;
   Bounds bounds;
@@ -126,8 +129,18 @@ LasColorSource lasColorOf(RenderColor color) {
   }
 }
 
-// Opens the input as a stream (large binary PLY) or reads it whole; its bounds, colours and order.
-Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
+// The request's set in memory (RenderRequest::points), drawn as it is: nothing is read.
+Result<LoadedSet> takeInMemory(const RenderRequest& request) {
+  LoadedSet set;
+  set.inputs = request.inputs.empty() ? std::string("points") : describeInputs(request.inputs);
+  if (request.color == RenderColor::kIntensity || request.color == RenderColor::kClassification)
+    return Error{set.inputs + ": --color " + renderColorName(request.color) + " needs LAS input", ExitCode::kBadInput};
+  set.shared = request.points;
+  return set;
+}
+
+// Opens the input as a stream (large binary PLY) or reads it whole.
+Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
   LoadedSet set;
   set.inputs = describeInputs(request.inputs);
   const std::string& inputs = set.inputs;
@@ -148,35 +161,49 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
     set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
     if (Status s = streamOutlineAndSpacing(request, inputs, *ply, sampler.finish(), set, progress); !s) return s.error();
     phases.mark("bounds");
-  } else {
-    ReadOptions read_options{request.threads, false, &progress, true};
-    read_options.max_memory = request.max_memory;
-    read_options.las_color = lasColorOf(request.color);
-    Result<PointSet> read = readPointInputs(request.inputs, read_options);
-    if (!read) return read.error();
-    set.points = std::move(*read);
-    phases.mark("read");
-    if (set.points->size() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
-    set.count = set.points->size(), set.has_colors = set.points->hasColors();
+    return set;
+  }
+  ReadOptions read_options{request.threads, false, &progress, true};
+  read_options.max_memory = request.max_memory;
+  read_options.las_color = lasColorOf(request.color);
+  Result<PointSet> read = readPointInputs(request.inputs, read_options);
+  if (!read) return read.error();
+  set.owned = std::move(*read);
+  phases.mark("read");
+  return set;
+}
+
+// The input, read, streamed or the request's own; its bounds, colours and order.
+Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
+  Result<LoadedSet> loaded = request.points ? takeInMemory(request) : readInput(request, progress, phases);
+  if (!loaded) return loaded.error();
+  LoadedSet& set = *loaded;
+  const std::string& inputs = set.inputs;
+  if (set.points()) {
+    if (set.points()->size() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
+    set.count = set.points()->size(), set.has_colors = set.points()->hasColors();
   }
   if (request.color == RenderColor::kRgb && !set.has_colors)
     return Error{inputs + ": --color rgb: the set has no colours (try --color elevation)", ExitCode::kBadInput};
-  set.z_up = zUpFor(request, set.points && set.points->z_up);
+  set.z_up = zUpFor(request, set.points() && set.points()->z_up);
   // The outline lets a perspective fit frame the data rather than its box's empty corners.
-  if (set.points) set.bounds = boundsWithOutline(*set.points);
-  if (set.points && needsSpacing(request)) {
-    set.spacing = sampleSpacing(set.points->positions, Box{set.bounds.min, set.bounds.max}, kSpacingSamples, request.threads);
+  if (set.points()) set.bounds = boundsWithOutline(*set.points());
+  if (set.points() && needsSpacing(request)) {
+    set.spacing = sampleSpacing(set.points()->positions, Box{set.bounds.min, set.bounds.max}, kSpacingSamples, request.threads);
     phases.mark("spacing");
   }
   // A 2D set has no elevation: without colours its points stay white.
   set.elevation = request.color == RenderColor::kElevation ||
                   (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar);
-  if (set.points) {
-    if (set.elevation) colorByElevation(*set.points, set.z_up ? 2 : 1, request.threads);
-    reorderPoints(*set.points, request.order, request.threads, &progress);
+  if (set.points()) {
+    if (set.elevation || request.order != PointOrder::kInput) {
+      if (!set.owned) set.owned = *set.shared;  // the request's own set stays as it is
+      if (set.elevation) colorByElevation(*set.owned, set.z_up ? 2 : 1, request.threads);
+      reorderPoints(*set.owned, request.order, request.threads, &progress);
+    }
     phases.mark("order");
   }
-  return set;
+  return std::move(set);
 }
 
 // --mode auto picks on the device; an explicit mode gets its bound computed for the report. From
@@ -185,15 +212,15 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
                                    const Camera& camera) {
   const double tolerance = request.tolerance_px;
   auto choose = [&]() -> Result<ModeChoice> {
-    if (set.points) return chooseModeOnDevice(context, *set.points, camera, *request.backend, request.error, tolerance);
+    if (set.points()) return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance);
     return chooseModeOnDevice(context, set.boxes, camera, *request.backend, tolerance);
   };
   ModePrediction p;
-  p.from_boxes = !set.points;
+  p.from_boxes = !set.points();
   if (request.mode != "auto") {
     p.mode = *parseMode(request.mode);
     const PrecisionMode one[] = {p.mode};
-    ErrorBounds bounds = set.points ? predictErrorBounds(*set.points, camera, one, tolerance)
+    ErrorBounds bounds = set.points() ? predictErrorBounds(*set.points(), camera, one, tolerance)
                                     : predictBoxBounds(set.boxes, camera, one, tolerance);
     p.bound_px = bounds.px[modeIndex(p.mode)];
     p.encoding = std::move(bounds.encodings[modeIndex(p.mode)]);
@@ -260,7 +287,7 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     const RenderOptions options =
         renderOptionsFor(request, set, prediction->mode, cameras[i], context.facts, shading_warnings);
     for (const std::string& w : shading_warnings) outcome.warnings.push_back("view " + std::string(views[i].label) + ": " + w);
-    Result<RenderResult> rendered = renderPoints(context, *set.points, cameras[i], options, prediction->encoding.get());
+    Result<RenderResult> rendered = renderPoints(context, *set.points(), cameras[i], options, prediction->encoding.get());
     if (!rendered) return rendered.error();
     const std::string mode(modeName(prediction->mode));
     const std::string label = "view " + std::string(views[i].label) + ": ";
@@ -289,7 +316,7 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   outcome.point_size = options.point_size;
   outcome.shading = options.shading;
   Result<RenderResult> rendered = [&]() -> Result<RenderResult> {
-    if (!set.stream) return renderPoints(context, *set.points, camera, options, outcome.prediction.encoding.get());
+    if (!set.stream) return renderPoints(context, *set.points(), camera, options, outcome.prediction.encoding.get());
     PointStream stream;
     stream.count = set.count;
     stream.has_colors = set.has_colors || set.elevation;
@@ -308,7 +335,7 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   if (!rendered) return rendered.error();
   outcome.phases.mark("render");
   if (request.error) {
-    outcome.error = measureError(*set.points, camera, *rendered, options);
+    outcome.error = measureError(*set.points(), camera, *rendered, options);
     outcome.phases.mark("error");
   }
   const DrawnPixels drawn = drawnPixels(rendered->image, request.background_rgba8);
@@ -595,9 +622,13 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   // The Vulkan device is made while the input is read: creating it takes 150 ms or more on the
   // NVIDIA driver, a good part of a 16.7M-point render's second. Its errors wait until the input
   // has been read, so a bad file is still reported first.
-  std::future<Result<std::unique_ptr<VulkanContext>>> device_made = std::async(std::launch::async, [&request] {
-    return VulkanContext::create(ContextOptions{request.device, request.validate, request.max_device_memory});
-  });
+  std::future<Result<std::unique_ptr<VulkanContext>>> device_made;
+  if (request.context)
+    request.context->clearValidationMessages();
+  else
+    device_made = std::async(std::launch::async, [&request] {
+      return VulkanContext::create(ContextOptions{request.device, request.validate, request.max_device_memory});
+    });
   Result<LoadedSet> set = loadInput(request, progress, outcome.phases);
   if (!set) return set.error();
   outcome.points = set->count;
@@ -610,7 +641,9 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   if (!cameras) return cameras.error();
   outcome.phases.mark("camera");
 
-  if (Result<std::unique_ptr<VulkanContext>> made = device_made.get(); made)
+  if (request.context)
+    outcome.context = request.context;
+  else if (Result<std::unique_ptr<VulkanContext>> made = device_made.get(); made)
     outcome.context = std::move(*made);
   else
     return made.error();

@@ -62,6 +62,13 @@ std::string warmupText(const WarmupRequest& warmup);
 // What the user asked for, as plain values (the CLI's options, parsed).
 struct RenderRequest {
   std::vector<std::string> inputs;   // drawn as one (point_inputs.h)
+  // A set in memory, drawn instead of reading `inputs` (a front end's own arrays: the Python
+  // module). It is never changed: a colouring by elevation or an --order works on a copy. `inputs`
+  // then only names it in messages (empty: "points").
+  std::shared_ptr<const PointSet> points;
+  // A device made before, used instead of making one (a front end that draws many times keeps one
+  // device: the Python module's Renderer). Its validation messages are cleared first.
+  std::shared_ptr<VulkanContext> context;
   std::string mode = "auto";         // a mode name (modeName) or "auto"
   std::optional<Backend> backend;    // none: auto (backendFor)
   std::string device = "auto";       // ContextOptions::device
@@ -190,7 +197,7 @@ struct RenderOutcome {
   Image image;                 // the picture (the contact sheet with four views)
   // The device it ran on, kept open for the caller: destroyed with the outcome, after the
   // picture is written (its teardown is no part of the run's phases).
-  std::unique_ptr<VulkanContext> context;
+  std::shared_ptr<VulkanContext> context;  // the request's own, when it gave one
   size_t points = 0;
   bool streamed = false;       // drawn a block at a time (its bound from batch boxes, no --error)
   DeviceFacts device;
