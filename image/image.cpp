@@ -58,25 +58,31 @@ bool encodePng(const Image& image, std::vector<unsigned char>& out) {
 
 }  // namespace
 
-Status writePng(const std::string& path, const Image& image) {
+Result<std::vector<unsigned char>> pngBytes(const Image& image, const std::string& name) {
   assert(image.rgba.size() == size_t(image.width) * image.height * 4);
   if (image.width == 0 || image.height == 0) {
-    return Error{"cannot write '" + path + "': the image is empty (" + std::to_string(image.width) + "x" +
+    return Error{"cannot write '" + name + "': the image is empty (" + std::to_string(image.width) + "x" +
                      std::to_string(image.height) + ")",
                  ExitCode::kUsage};
   }
   // PNG sizes are 31-bit.
   if (image.width > INT_MAX / 4 || image.height > INT_MAX) {
-    return Error{"cannot write '" + path + "': " + std::to_string(image.width) + "x" +
+    return Error{"cannot write '" + name + "': " + std::to_string(image.width) + "x" +
                      std::to_string(image.height) + " is too large for PNG encoding",
                  ExitCode::kResourceLimit};
   }
   std::vector<unsigned char> png;
   png.reserve(image.rgba.size() / 4);
-  if (!encodePng(image, png)) return Error{"cannot write '" + path + "': PNG encoding failed", ExitCode::kResourceLimit};
+  if (!encodePng(image, png)) return Error{"cannot write '" + name + "': PNG encoding failed", ExitCode::kResourceLimit};
+  return png;
+}
+
+Status writePng(const std::string& path, const Image& image) {
+  Result<std::vector<unsigned char>> png = pngBytes(image, path);
+  if (!png) return png.error();
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
-  if (Status status = file->write(png.data(), png.size()); !status) return status;
+  if (Status status = file->write(png->data(), png->size()); !status) return status;
   return file->commit();
 }
 

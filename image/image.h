@@ -38,5 +38,7 @@ size_t countDifferingPixels(const Image& a, const Image& b);
 
 // Writes an RGBA8 image as PNG. Fails naming the path when it cannot be written.
 Status writePng(const std::string& path, const Image& image);
+// The PNG file writePng writes, in memory (a notebook's picture); errors name `name`.
+Result<std::vector<unsigned char>> pngBytes(const Image& image, const std::string& name);
 
 }  // namespace dpoint
