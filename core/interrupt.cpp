@@ -99,4 +99,29 @@ void unregisterChildProcess(pid_t pid) {
   g_children.erase(pid);
 }
 
+namespace {
+std::mutex g_scope_mutex;
+int g_scope_depth = 0;         // guarded by g_scope_mutex
+struct sigaction g_saved_sigint;  // the handler an outermost scope replaced
+
+void onScopedSignal(int signal) { detail::g_interrupt_signal.store(signal); }  // lock-free: async-signal-safe
+}  // namespace
+
+InterruptScope::InterruptScope() {
+  std::lock_guard<std::mutex> lock(g_scope_mutex);
+  if (g_scope_depth++ > 0) return;
+  detail::g_interrupt_signal.store(0);
+  struct sigaction action = {};
+  action.sa_handler = onScopedSignal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, &g_saved_sigint);
+}
+
+InterruptScope::~InterruptScope() {
+  std::lock_guard<std::mutex> lock(g_scope_mutex);
+  if (--g_scope_depth > 0) return;
+  ::sigaction(SIGINT, &g_saved_sigint, nullptr);
+  detail::g_interrupt_signal.store(0);
+}
+
 }  // namespace dpoint

@@ -51,6 +51,21 @@ inline Status checkInterrupted() { return interrupted() ? Status(interruptedErro
 // blocked signals. Also honours kParentPidVariable.
 void watchInterrupts();
 
+// For a front end that keeps its own signal handling (the Python module), instead of
+// watchInterrupts(): while a scope lives, SIGINT sets the flag interrupted() reads (the work stops
+// as it does in the CLI, leaving no output) in place of the process's own handler; the scope's end
+// puts that handler back and clears the flag. Scopes nest: the outermost one acts. No watcher, so
+// no forced exit: work that cannot poll (a GPU frame) ends first.
+class InterruptScope {
+ public:
+  InterruptScope();
+  ~InterruptScope();
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+  // Whether SIGINT came while this scope (or one around it) lived.
+  bool caught() const { return interrupted(); }
+};
+
 // main calls this with the error it printed, so that a forced exit does not print a second one.
 void noteErrorReported();
 
