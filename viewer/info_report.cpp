@@ -1,0 +1,225 @@
+#include "viewer/info_report.h"
+
+#include <array>
+#include <utility>
+
+#include "converters/point_io.h"
+#include "core/interrupt.h"
+#include "core/json_writer.h"
+#include "core/text.h"
+#include "viewer/modes.h"
+#include "viewer/render.h"
+
+namespace dpoint {
+namespace {
+
+// The box and planarity boundsOf gives, from the boxes of a streamed set's batches (non-empty).
+Bounds boundsOfBoxes(const BatchBoxes& boxes) {
+  Bounds bounds;
+  bounds.min = boxes.boxes[0].min, bounds.max = boxes.boxes[0].max, bounds.planar = true;
+  for (const Box& box : boxes.boxes) {
+    bounds.min = glm::min(bounds.min, box.min), bounds.max = glm::max(bounds.max, box.max);
+    bounds.planar = bounds.planar && box.min.z == 0.0 && box.max.z == 0.0;
+  }
+  return bounds;
+}
+
+std::string str(uint64_t v) { return std::to_string(v); }
+std::string num(double v) { return formatNumber(v); }
+std::string vec(const glm::dvec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
+std::string jsonVec(const glm::dvec3& v) { return JsonValue::numbers(std::array<double, 3>{v.x, v.y, v.z}).text(); }
+std::string jsonBool(bool v) { return v ? "true" : "false"; }
+
+// `text` padded with spaces to `width` characters (printf's %-Ns).
+std::string padded(std::string text, size_t width) {
+  if (text.size() < width) text.append(width - text.size(), ' ');
+  return text;
+}
+
+std::string viewName(const Camera& c) {
+  return str(c.width) + "x" + str(c.height) + (c.ortho ? " orthographic" : " perspective");
+}
+
+std::string lasText(const LasFacts& las) {
+  const LasHeader& h = las.header;
+  return "LAS:                version " + std::to_string(h.version_major) + "." + std::to_string(h.version_minor) +
+         ", point format " + std::to_string(h.point_format) + ", " + str(h.record_length) + "-byte records (" +
+         str(h.record_length - lasBaseRecordLength(h.point_format)) + " extra bytes), " + str(h.point_count) +
+         " points\n" +
+         "LAS scale:          " + vec(h.scale) + "\n" +
+         "LAS offset:         " + vec(h.offset) + "\n" +
+         "LAS header bounds:  " + vec(h.min) + " .. " + vec(h.max) + " (" +
+         (las.bounds_hold ? "hold the points" : "do not hold the points: the header is wrong, the points are used") +
+         ")\n" +
+         "LAS software:       " + h.generating_software + "\n";
+}
+
+// The "las" member, its value over four lines as `dpoint info --json` has always printed it.
+std::string lasJson(const LasFacts& las) {
+  const LasHeader& h = las.header;
+  const std::string indent = ",\n          ";
+  return ",\n  \"las\": {\"version\": \"" + std::to_string(h.version_major) + "." + std::to_string(h.version_minor) +
+         "\", \"point_format\": " + std::to_string(h.point_format) + ", \"record_length\": " + str(h.record_length) +
+         ", \"points\": " + str(h.point_count) + indent + "\"scale\": " + jsonVec(h.scale) +
+         ", \"offset\": " + jsonVec(h.offset) + indent + "\"header_min\": " + jsonVec(h.min) +
+         ", \"header_max\": " + jsonVec(h.max) + ", \"header_bounds_hold\": " + jsonBool(las.bounds_hold) + indent +
+         "\"generating_software\": " + jsonString(h.generating_software) + "}";
+}
+
+std::string floatEnoughText(const InfoReport& report) {
+  const PointSetInfo& i = report.info;
+  if (i.float_overflow > 0) return "no (" + str(i.float_overflow) + " coordinates beyond float range)";
+  if (report.streamed)
+    return "not decided: a streamed set is read a block at a time, and finding the points\n"
+           "                    float32 merges needs all of them at once (--stream off)";
+  if (i.floatRepresents()) return "yes (no two distinct points merge)";
+  return "no (" + str(i.float_merged) + " distinct points merge with another)";
+}
+
+std::string adviceText(const InfoAdvice& advice) {
+  const ErrorBounds& b = advice.bounds;
+  std::string text =
+      b.from_boxes
+          ? "error bound by mode, for the view (" + viewName(advice.camera) + ", at most " + str(b.visible) +
+                " points visible; float floor " + formatBound(b.float_floor_px) +
+                "), from the box of\n"
+                "                    each 4096-point batch (a streamed set; its points give bounds no larger):\n"
+          : "error bound by mode, for the view (" + viewName(advice.camera) + ", " + str(b.visible) +
+                " points visible; float floor " + formatBound(b.float_floor_px) + "):\n";
+  for (PrecisionMode mode : kAllModes) {
+    const double px = b.px[modeIndex(mode)];
+    const char* verdict = px <= kAutoBoundPx ? "within --mode auto's 0.1 px" : px < 0.5 ? "under half a pixel"
+                                                                            : "points leave their pixel";
+    text += "  " + padded(std::string(modeName(mode)), 8) + " " + padded(formatBound(px), 12) + " " + verdict + "\n";
+  }
+  return text;
+}
+
+std::string adviceJson(const InfoAdvice& advice) {
+  const Camera& c = advice.camera;
+  const ErrorBounds& b = advice.bounds;
+  JsonObject view;
+  view.add("width", JsonValue::integer(c.width)).add("height", JsonValue::integer(c.height));
+  view.add("ortho", JsonValue::boolean(c.ortho)).add("points_visible", JsonValue::integer(b.visible));
+  JsonObject bounds;  // null: unbounded (the mode may lose points)
+  for (PrecisionMode mode : kAllModes) bounds.add(modeName(mode), JsonValue::number(b.px[modeIndex(mode)]));
+  return ",\n  \"view\": " + view.line() + ",\n  \"float_floor_px\": " + formatNumber(b.float_floor_px, true) +
+         ",\n  \"error_bound_from\": \"" + (b.from_boxes ? "batch_boxes" : "points") +
+         "\",\n  \"error_bound_px\": " + bounds.line();
+}
+
+}  // namespace
+
+Result<InfoReport> describePoints(const PointSet& points, const std::string& name, const InfoOptions& options) {
+  InfoReport report;
+  report.name = name;
+  report.info = computeInfo(points, options.sample, options.threads);
+  if (points.size() > 0) {
+    Result<Camera> camera = makeCamera(options.camera, boundsOf(points));
+    if (!camera) return camera.error();
+    report.advice = InfoAdvice{*camera, predictErrorBounds(points, *camera, {}, options.tolerance_px)};
+  }
+  return report;
+}
+
+// Each mode's bound from the box of every batch, kept as the first pass reads the blocks in order.
+Result<InfoReport> describeStream(PointInputStream& stream, const std::string& name, const InfoOptions& options,
+                                  Progress& progress) {
+  progress.start("reading " + name + " twice (points)", 2 * stream.count());
+  BatchBoxes boxes;
+  const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
+    if (interrupted()) return interruptedError();
+    if (Status s = stream.read(first, n, block); !s) return s;
+    if (first == boxes.count && n > 0) addBatchBoxes(boxes, block.positions);
+    progress.advance(n);
+    return okStatus();
+  };
+  Result<StreamedInfo> info = computeStreamedInfo(stream.count(), stream.hasColors(), stream.faceCount(), read,
+                                                  kStreamBlockPoints, options.sample, options.threads);
+  if (!info) return info.error();
+  progress.finish();
+  InfoReport report;
+  report.name = name;
+  report.info = info->info;
+  report.streamed = true;
+  if (boxes.count > 0) {
+    Result<Camera> camera = makeCamera(options.camera, boundsOfBoxes(boxes));
+    if (!camera) return camera.error();
+    report.advice = InfoAdvice{*camera, predictBoxBounds(boxes, *camera, {}, options.tolerance_px)};
+  }
+  return report;
+}
+
+Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& options, Progress& progress) {
+  if (inputs.paths.empty()) return Error{"info: no input files", ExitCode::kUsage};
+  Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads);
+  if (!stream) return stream.error();
+  const std::string name = describeInputs(inputs.paths);
+  if (*stream) return describeStream(**stream, name, options, progress);
+  ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};
+  read.max_memory = inputs.max_memory;
+  Result<PointSet> points = readPointInputs(inputs.paths, read);
+  if (!points) return points.error();
+  std::optional<LasHeader> header;  // one LAS file: its header too
+  if (Result<FileFormat> format = formatOf(inputs.paths[0]);
+      inputs.paths.size() == 1 && format && *format == FileFormat::kLas) {
+    Result<LasHeader> las = readLasHeader(inputs.paths[0]);
+    if (!las) return las.error();
+    header = std::move(*las);
+  }
+  Result<InfoReport> report = describePoints(*points, name, options);
+  if (!report) return report;
+  if (header) {
+    const PointSetInfo& info = report->info;
+    const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
+    report->las = LasFacts{std::move(*header), bounds_hold};
+  }
+  return report;
+}
+
+std::string infoReportText(const InfoReport& report) {
+  const PointSetInfo& i = report.info;
+  std::string text = "file:               " + report.name + "\n" +
+                     "points:             " + str(i.count) + "\n" +
+                     "triangles:          " + str(i.triangles) + "\n" +
+                     "colours:            " + (i.has_colors ? "yes" : "no") + "\n";
+  if (report.las) text += lasText(*report.las);
+  text += "min:                " + vec(i.min) + "\n" +
+          "max:                " + vec(i.max) + "\n" +
+          "extent:             " + vec(i.extent) + "\n" +
+          "largest |coord|:    " + num(i.max_abs) + "\n" +
+          "float32 spacing:    " + num(i.float_spacing) + " (at the largest |coordinate|)\n" +
+          "nearest neighbour:  " + num(i.min_neighbor_distance) + " (smallest non-zero, " + str(i.neighbor_sample) +
+          " points sampled)\n" +
+          "float32 enough:     " + floatEnoughText(report) + "\n";
+  if (report.advice) text += adviceText(*report.advice);
+  return text;
+}
+
+std::string infoReportJson(const InfoReport& report) {
+  const PointSetInfo& i = report.info;
+  // A streamed set: merged points not counted (null), and float32 undecided unless it overflows.
+  const std::string represents = i.float_overflow > 0 ? "false"
+                                 : report.streamed    ? "null"
+                                                      : jsonBool(i.floatRepresents());
+  std::string json = "{\n  \"file\": " + jsonString(report.name) +
+                     ",\n  \"points\": " + str(i.count) +
+                     ",\n  \"triangles\": " + str(i.triangles) +
+                     ",\n  \"colors\": " + jsonBool(i.has_colors) +
+                     ",\n  \"min\": " + jsonVec(i.min) +
+                     ",\n  \"max\": " + jsonVec(i.max) +
+                     ",\n  \"extent\": " + jsonVec(i.extent) +
+                     ",\n  \"max_abs\": " + formatNumber(i.max_abs, true) +
+                     ",\n  \"float32_spacing\": " + formatNumber(i.float_spacing, true) +
+                     ",\n  \"min_neighbor_distance\": " + formatNumber(i.min_neighbor_distance, true) +
+                     ",\n  \"neighbor_sample\": " + str(i.neighbor_sample) +
+                     ",\n  \"streamed\": " + jsonBool(report.streamed) +
+                     ",\n  \"float32_merged_points\": " + (report.streamed ? "null" : str(i.float_merged)) +
+                     ",\n  \"float32_overflow\": " + str(i.float_overflow) +
+                     ",\n  \"float32_represents\": " + represents;
+  if (report.las) json += lasJson(*report.las);
+  if (report.advice) json += adviceJson(*report.advice);
+  return json + "\n}\n";
+}
+
+}  // namespace dpoint
