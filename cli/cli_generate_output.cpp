@@ -6,6 +6,7 @@
 
 #include "cli/cli_check.h"
 #include "cli/cli_output.h"
+#include "cli/cli_run.h"
 #include "cli/cli_text.h"
 #include "converters/point_io.h"
 #include "converters/tile_file.h"
@@ -31,7 +32,8 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
 }  // namespace
 
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
-  cmd.add_option("-o,--output", o.output, pointOutputHelp())->required()->check(checkStatus(checkPointOutput));
+  CLI::Option* output = cmd.add_option("-o,--output", o.output, pointOutputHelp())->check(checkStatus(checkPointOutput));
+  if (!capturingPoints()) output->required();
   cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (Perlin pnoise3, as the original study's Python generator coloured its points), none")
       ->check(CLI::IsMember({"auto", "noise", "none"}))
       ->default_val("auto");
@@ -55,8 +57,9 @@ double PhaseClock::lap() {
   return s;
 }
 
-// Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of
-// where the time went (generation counted from `clock`'s start, before the parameters).
+// Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any
+// generator. Unless quiet, one line of where the time went (generation counted from `clock`'s start,
+// before the parameters).
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
            PhaseClock& clock) {
   if (!generated) return reportError(generated.error());
@@ -71,6 +74,13 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
     reorderPoints(points, order, o.common.threads, &progress);
   }
   const double order_s = clock.lap();
+  if (capturingPoints()) {
+    if (!o.common.quiet)
+      std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f; %zu points, %zu triangles\n",
+                   generate_s, colours_s, order_s, points.size(), points.triangles.size() / 3);
+    capturePoints(std::move(points));
+    return 0;
+  }
   WriteOptions w;
   w.threads = o.common.threads;
   w.decimals = o.decimals;
@@ -89,6 +99,18 @@ int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_no
   if (Status s = colorAndOffset(generated->points, o, auto_noise); !s) return reportError(s.error());
   if (Status s = writeTile(o.output, *generated, signature, &progress); !s) return reportError(s.error());
   return 0;
+}
+
+Status checkHandedBack(const OutputOptions& o) {
+  if (!capturingPoints()) return okStatus();
+  const char* handed_back = "this run hands the points back to its caller instead of writing them";
+  if (!o.output.empty()) return Error{"-o " + o.output + ": " + handed_back, ExitCode::kUsage};
+  if (!o.tile.empty())
+    return Error{"--tile " + o.tile + ": a tile is a part file for dpoint merge; " + handed_back, ExitCode::kUsage};
+  if (o.decimals >= 0)
+    return Error{"--decimals " + std::to_string(o.decimals) + " says how a CSV is written; " + handed_back,
+                 ExitCode::kUsage};
+  return okStatus();
 }
 
 // --tile checks before any work: a .ply part, and no --order (which needs the whole set).

@@ -30,7 +30,8 @@ struct OutputOptions {
 };
 
 // `auto_colors`: what --colors auto gives for the kind, for the help text. -o is checked as it is
-// parsed (cli_output.h: a written format, a folder it can be written into), before any work.
+// parsed (cli_output.h: a written format, a folder it can be written into), before any work; it is
+// required unless the set is handed back to an embedding program (capturingPoints(), cli_run.h).
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors);
 // --max-memory as bytes (0: half of RAM).
 Result<uint64_t> memoryLimit(const OutputOptions& o);
@@ -44,9 +45,12 @@ class PhaseClock {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
+// When the set is handed back (capturingPoints()): -o, --tile and --decimals, which say how or
+// where it is written, are usage errors that say so. Before any work; ok when not capturing.
+Status checkHandedBack(const OutputOptions& o);
 // --tile checks before any work: a .ply part, and no --order (which needs the whole set).
 Result<TileSpec> tileOptions(const OutputOptions& o);
-// Colours, offset, order and writing: the steps after any generator. Unless quiet, one line of
+// Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any generator. Unless quiet, one line of
 // where the time went (generation counted from `clock`'s start, before the parameters).
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
            PhaseClock& clock);

@@ -105,6 +105,10 @@ std::optional<std::string> unknownCommandMessage(const CLI::App& app, int argc, 
   return std::nullopt;
 }
 
+std::string missingCommandMessage(const CLI::App& app) {
+  return "name a command (commands: " + listed(subcommandNames(app)) + ")";
+}
+
 std::optional<std::string> unknownOptionMessage(const CLI::App& app, int argc, const char* const* argv) {
   const CLI::App* chosen = &app;
   while (!chosen->get_subcommands().empty()) chosen = chosen->get_subcommands().front();

@@ -25,6 +25,8 @@ std::string didYouMean(const std::string& word, const std::vector<std::string>& 
 // line ("unknown command 'rendr'; did you mean 'render'? (commands: …)"); none when the words are
 // known (or an option comes first, which CLI11 then reports).
 std::optional<std::string> unknownCommandMessage(const CLI::App& app, int argc, const char* const* argv);
+// No command at all where one is needed: "name a command (commands: generate, merge, …)".
+std::string missingCommandMessage(const CLI::App& app);
 // After CLI11 refused extra arguments: the first word of argv that looks like an option and that
 // the chosen (sub)command does not have, as one line ("render: unknown option '--colour'; did you
 // mean '--color'? (…)"); none when no such word is found.

@@ -23,6 +23,7 @@
 #include "bench/run.h"
 #include "cli/cli_check.h"
 #include "cli/cli_output.h"
+#include "cli/cli_run.h"
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "converters/point_io.h"
@@ -91,9 +92,10 @@ struct BenchCopyOptions {
 
 extern "C" char** environ;
 
-// `dpoint ARGS` run as a child of this very executable: the bench's datasets and timed draws are
-// exactly what a user's `dpoint generate` and `dpoint render` give.
-Status runDpoint(const std::vector<std::string>& args, unsigned threads) {
+// `dpoint ARGS` run as a child process of dpointExecutable() (cli_run.h: this very executable, or
+// $DPOINT_EXECUTABLE where dpoint is embedded): the bench's datasets and timed draws are exactly
+// what a user's `dpoint generate` and `dpoint render` give.
+Status runDpointChild(const std::vector<std::string>& args, unsigned threads) {
   std::vector<std::string> argv = {"dpoint"};
   argv.insert(argv.end(), args.begin(), args.end());
   if (threads) argv.insert(argv.end(), {"--threads", std::to_string(threads)});
@@ -122,10 +124,12 @@ Status runDpoint(const std::vector<std::string>& args, unsigned threads) {
   c_environment.push_back(nullptr);
   if (interrupted()) return interruptedError();
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, "/proc/self/exe", &actions, &attributes, c_argv.data(), c_environment.data());
+  const std::string executable = dpointExecutable();
+  const int spawned = posix_spawn(&pid, executable.c_str(), &actions, &attributes, c_argv.data(), c_environment.data());
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
-  if (spawned != 0) return Error{"cannot run " + command + ": " + std::strerror(spawned), ExitCode::kBadInput};
+  if (spawned != 0)
+    return Error{"cannot run " + command + " (" + executable + "): " + std::strerror(spawned), ExitCode::kBadInput};
   // An interrupt is forwarded to the child, which stops and exits 130/143 like any dpoint run.
   registerChildProcess(pid);
   if (interrupted()) ::kill(pid, interruptSignal());  // came before the registration
@@ -221,7 +225,7 @@ int runBenchReport(const BenchReportOptions& o) {
   if (!copy_bytes) return reportError(copy_bytes.error());
   options.copy.bytes = *copy_bytes;
   options.copy.copies = o.copy_repeats;
-  options.run_dpoint = [threads](const std::vector<std::string>& args) { return runDpoint(args, threads); };
+  options.run_dpoint = [threads](const std::vector<std::string>& args) { return runDpointChild(args, threads); };
   std::FILE* sink = progressSink(o.common.quiet);
   if (sink) options.log = [sink](const std::string& line) { std::fprintf(sink, "bench: %s\n", line.c_str()); };
 
@@ -265,6 +269,8 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
       "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the\n"
       "float-vs-double Vulkan study's datasets at 1920x1080, its RTX 3090 figures beside ours), hard (offset\n"
       "and deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"
+      "Each dataset and timed draw is a child process of this executable, or of $DPOINT_EXECUTABLE when set\n"
+      "(a program that embeds dpoint, such as the Python module, points it at a built dpoint).\n"
       "`dpoint bench io FILE` times reading a file instead; `dpoint bench copy` measures only the copy bandwidth.");
   bench->require_subcommand(0, 1);
   auto r = std::make_shared<BenchReportOptions>();

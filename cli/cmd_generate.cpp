@@ -39,6 +39,7 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
   cmd->callback([o, &run, cmd, auto_noise, generate, generate_tile, makeParams, name = cmd->get_name()] {
     const std::string signature = o->out.tile.empty() ? std::string() : tileSignature(name, cmd->config_to_str(true, false));
     run = [o, auto_noise, generate, generate_tile, makeParams, name, signature] {
+      if (Status s = checkHandedBack(o->out); !s) return reportError(s.error());
       Result<PointOrder> order = parsePointOrder("--order", o->out.order);
       if (!order) return reportError(order.error());
       std::optional<TileSpec> tile;

@@ -20,7 +20,8 @@ void addRenderCommand(CLI::App& app, RunCommand& run);
 void addDevicesCommand(CLI::App& app, RunCommand& run);
 void addMergeCommand(CLI::App& app, RunCommand& run);
 
-// Prints "dpoint: error: <message>" on stderr and returns the error's exit code.
+// Prints "dpoint: error: <message>" on stderr and returns the error's exit code; inside
+// runEmbedded (cli_run.h) it prints nothing and hands the first error to the caller instead.
 int reportError(const Error& error);
 
 // Options every long-running command shares.

@@ -1,0 +1,25 @@
+// The options the subcommands share (commands.h). reportError is in cli_run.cpp, beside the
+// embedded run it answers to.
+#include "cli/commands.h"
+
+#include "core/memory.h"
+
+namespace dpoint {
+
+void addCommonOptions(CLI::App& command, CommonOptions& options) {
+  command.add_option("--threads", options.threads, "Worker threads (0: all cores)")->default_val(0);
+  command.add_flag("--quiet,-q", options.quiet, "No progress output");
+}
+
+void addMaxMemoryOption(CLI::App& command, std::string& text) {
+  command.add_option("--max-memory", text,
+                     "Refuse (exit 4) work whose memory, estimated before allocating, is above this, e.g. 512M, 8G "
+                     "(default: half of RAM)");
+}
+
+Result<uint64_t> memoryLimitOf(const std::string& text) {
+  if (text.empty()) return uint64_t{0};
+  return parseMemorySize("--max-memory", text);
+}
+
+}  // namespace dpoint
