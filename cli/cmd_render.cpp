@@ -7,6 +7,7 @@
 
 #include "cli/cli_camera.h"
 #include "cli/cli_check.h"
+#include "cli/cli_options.h"
 #include "cli/cli_suggest.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
@@ -239,18 +240,15 @@ std::string renderDescription() {
                   kHelpWidth);
 }
 
-}  // namespace
-
-void addRenderCommand(CLI::App& app, RunCommand& run) {
-  auto o = std::make_shared<RenderCliOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "render",
-      renderDescription());
-  cmd->add_option("input", o->inputs,
-                  "Point sets (.csv, .ply, .las, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
-                  "whole. Large binary PLY input is streamed (--stream)")
-      ->required();
-  cmd->add_option("-o,--output", o->output, "PNG to write")->required()->check(checkStatus(checkPictureOutput));
+// Every option of render; with `files`, the input, -o and --json too (the executable's).
+void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o, bool files) {
+  if (files) {
+    cmd->add_option("input", o->inputs,
+                    "Point sets (.csv, .ply, .las, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
+                    "whole. Large binary PLY input is streamed (--stream)")
+        ->required();
+    cmd->add_option("-o,--output", o->output, "PNG to write")->required()->check(checkStatus(checkPictureOutput));
+  }
   cmd->add_option("--mode", o->mode, modeOptionHelp())
       ->check(checkStatus(checkModeOption))
       ->default_val("auto");
@@ -280,8 +278,9 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
       ->check(checkStatus([](const std::string& v) { return statusOf(parseWarmup("--warmup", v)); }))
       ->default_val("auto");
   cmd->add_flag("--error", o->error, "Run the probe and the exact CPU reference; report the error in pixels");
-  cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file")
-      ->check(checkStatus(AtomicFile::checkTarget));
+  if (files)
+    cmd->add_option("--json", o->json, "Write the measurements as one JSON object to this file")
+        ->check(checkStatus(AtomicFile::checkTarget));
   cmd->add_flag("--validate", o->validate, "Enable the Khronos validation layer; any message fails the run");
   addChoiceOption(*cmd, "--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull",
                   {"auto", "attribute", "pull"});
@@ -332,7 +331,25 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
                   {"auto", "y", "z"});
   addMaxMemoryOption(*cmd, o->max_memory);
   addCommonOptions(*cmd, o->common);
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app, RunCommand& run) {
+  auto o = std::make_shared<RenderCliOptions>();
+  CLI::App* cmd = app.add_subcommand("render", renderDescription());
+  addRenderOptions(cmd, o, true);
   cmd->callback([o, &run]() { run = [o]() { return runRender(*o); }; });
+}
+
+Result<RenderRequest> renderRequestOf(const std::vector<std::string>& args) {
+  auto o = std::make_shared<RenderCliOptions>();
+  CLI::App app{renderDescription(), "render"};
+  addRenderOptions(&app, o, false);
+  if (Status s = parseOptions(app, args); !s) return s.error();
+  Result<RenderRequest> request = requestOf(*o);
+  if (request) request->report = true;
+  return request;
 }
 
 }  // namespace dpoint

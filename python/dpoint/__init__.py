@@ -1,0 +1,263 @@
+"""dpoint: double-precision point datasets, from Python.
+
+The same libraries as the ``dpoint`` executable, with NumPy arrays in and out:
+
+    import dpoint
+    bulb = dpoint.generate("mandelbulb", resolution=128, offset=(6.371e6, 0, 0))
+    result = dpoint.render(bulb, mode="native", error=True)
+    print(result.mode, result.predicted_bound_px, result.error_px)
+    result.save("bulb.png")
+
+Options are the CLI's, as keyword arguments: ``view_width=0.5`` is ``--view-width 0.5``, a sequence
+is a comma list (``eye=(0, 0, 5)`` is ``--eye 0,0,5``), ``True`` gives a flag and ``False`` or
+``None`` leaves the option out. They are parsed, checked and defaulted by the CLI's own parser, so
+``dpoint generate KIND --help`` and ``dpoint render --help`` document them and a bad one raises the
+CLI's message.
+
+Errors: ``dpoint.Error`` (a ``ValueError``) for bad input or options, ``MemoryError`` for
+resource limits, ``dpoint.DeviceError`` (a ``RuntimeError``) for a missing device or a Vulkan
+fault; each carries the CLI's exit code as ``exit_code``. Ctrl-C stops a long call within about a
+second with ``KeyboardInterrupt`` and leaves no output file. Long calls release the GIL.
+"""
+
+from __future__ import annotations
+
+import json as _json
+import os as _os
+import warnings as _warnings
+
+from ._dpoint import DeviceError, Error, PointSet, RenderResult, __version__  # noqa: F401
+from . import _dpoint
+
+__all__ = [
+    "DeviceError", "Error", "PointSet", "RenderResult", "Renderer", "RenderWarning", "__version__",
+    "bench", "generate", "info", "read", "render", "write",
+]
+
+
+class RenderWarning(UserWarning):
+    """A picture that is likely wrong or poor (render's warnings: a mode over half a pixel, a speck)."""
+
+
+def _value(value) -> str:
+    if isinstance(value, bool):
+        raise TypeError("a flag takes True or False only as the whole value")
+    if isinstance(value, float):
+        return repr(value)  # the shortest text that reads back to the same double
+    if isinstance(value, (str, int)):
+        return str(value)
+    if isinstance(value, _os.PathLike):
+        return _os.fspath(value)
+    try:
+        items = list(value)
+    except TypeError:
+        return str(value)
+    return ",".join(_value(float(v) if not isinstance(v, (int, float)) else v) for v in items)
+
+
+def _args(options: dict) -> list[str]:
+    """Keyword arguments as the CLI's options: view_width=0.5 is ["--view-width", "0.5"]."""
+    args = []
+    for key, value in options.items():
+        if value is None or value is False:
+            continue
+        flag = "--" + key.replace("_", "-")
+        if value is True:
+            args.append(flag)
+        else:
+            args += [flag, _value(value)]
+    return args
+
+
+def _as_points(points):
+    """(PointSet, []) for a set in memory, (None, paths) for files."""
+    if isinstance(points, PointSet):
+        return points, []
+    if isinstance(points, (str, _os.PathLike)):
+        return None, [_os.fspath(points)]
+    if isinstance(points, (list, tuple)) and points and all(isinstance(p, (str, _os.PathLike)) for p in points):
+        return None, [_os.fspath(p) for p in points]
+    if hasattr(points, "columns") and hasattr(points, "to_numpy"):  # a pandas DataFrame
+        return PointSet.from_dataframe(points), []
+    return PointSet(points), []
+
+
+def _from_dataframe(frame, *, allow_nonfinite: bool = False) -> PointSet:
+    """A PointSet from a pandas DataFrame with columns x, y[, z][, r, g, b].
+
+    r, g, b: integers 0..255 (as CSV files hold them) or floats 0..1 (linear). Without z the set is 2D.
+    """
+    columns = {str(c).lower(): c for c in frame.columns}
+    missing = [c for c in ("x", "y") if c not in columns]
+    if missing:
+        raise Error(f"DataFrame: no column {', '.join(missing)} (columns: {', '.join(map(str, frame.columns))})")
+    axes = ["x", "y"] + (["z"] if "z" in columns else [])
+    positions = frame[[columns[a] for a in axes]].to_numpy(dtype="float64")
+    colors = None
+    if all(c in columns for c in ("r", "g", "b")):
+        rgb = frame[[columns[c] for c in ("r", "g", "b")]]
+        if all(k.kind in "iu" for k in rgb.dtypes):
+            values = rgb.to_numpy()
+            if values.size and (values.min() < 0 or values.max() > 255):
+                raise Error("DataFrame: integer colours r, g, b must lie in 0..255")
+            colors = values.astype("uint8")
+        else:
+            colors = rgb.to_numpy(dtype="float32")
+    return PointSet(positions, colors, allow_nonfinite=allow_nonfinite)
+
+
+def _to_dataframe(self):
+    """The set as a pandas DataFrame: x, y, z (float64) and, with colours, r, g, b (float32, 0..1)."""
+    import pandas as pd
+
+    data = {"x": self.positions[:, 0], "y": self.positions[:, 1], "z": self.positions[:, 2]}
+    if self.colors is not None:
+        data.update(r=self.colors[:, 0], g=self.colors[:, 1], b=self.colors[:, 2])
+    return pd.DataFrame(data, copy=True)
+
+
+PointSet.from_dataframe = staticmethod(_from_dataframe)
+PointSet.to_dataframe = _to_dataframe
+RenderResult.report = property(
+    lambda self: _json.loads(self._report_json) if self._report_json else None,
+    doc="render --json's object as a dict (None for a contact sheet)")
+RenderResult._repr_png_ = lambda self: self.png()
+RenderResult.__repr__ = lambda self: (
+    f"<dpoint.RenderResult: {self.image.shape[1]}x{self.image.shape[0]}, {self.points} points, mode {self.mode}, "
+    f"{self.backend} backend, bound {self.predicted_bound_px:.3g} px>")
+
+
+def _warn(result: RenderResult) -> RenderResult:
+    for line in result.warnings:
+        _warnings.warn(line, RenderWarning, stacklevel=3)
+    return result
+
+
+class Renderer:
+    """One Vulkan device kept across renders: a loop over views or modes starts the device once.
+
+    Renderer(device="auto", validate=False, max_device_memory=None); render() takes what
+    dpoint.render takes but device, validate and max_device_memory, which are the Renderer's.
+    Use it as a context manager, or close() it, to give the device back.
+    """
+
+    def __init__(self, device: str | int = "auto", *, validate: bool = False, max_device_memory=None):
+        limit = 0
+        if max_device_memory is not None:
+            limit = max_device_memory if isinstance(max_device_memory, int) else _dpoint._memory_size(
+                "max_device_memory", str(max_device_memory))
+        self._renderer = _dpoint._Renderer(str(device), validate, limit)
+
+    @property
+    def device(self) -> str:
+        """The device's name."""
+        return self._renderer.device
+
+    def render(self, points, mode: str = "auto", *, progress: bool = False, **options) -> RenderResult:
+        for own in ("device", "validate", "max_device_memory"):
+            if own in options:
+                raise TypeError(f"Renderer.render: {own} is the Renderer's (Renderer({own}=...))")
+        return _render(points, mode, self._renderer, progress, options)
+
+    def close(self) -> None:
+        self._renderer.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _render(points, mode, renderer, progress, options) -> RenderResult:
+    if "json" in options or "output" in options or "o" in options:
+        raise TypeError("render: the picture and the report come back in the result (result.save(path), result.report)")
+    in_memory, inputs = _as_points(points)
+    args = _args({"mode": mode, **options})
+    return _warn(_dpoint._render(in_memory, inputs, args, renderer, progress))
+
+
+def render(points, mode: str = "auto", *, progress: bool = False, **options) -> RenderResult:
+    """Renders a set offscreen with Vulkan, as ``dpoint render`` does, and returns the picture.
+
+    points: a PointSet, an (N, 3) array, a pandas DataFrame, or a file path (or a list of them,
+    drawn as one). mode: auto or a precision mode (fp32, split, rte, df64, native, batch,
+    adaptive). Every other option of ``dpoint render`` is a keyword: width, height, eye, target,
+    up, fit, fov, ortho, view_center, view_width, tolerance, backend, point_size, background,
+    shade, color, order, views, error, frames, warmup, device, validate, … Each call starts a
+    Vulkan device; a Renderer keeps one across calls.
+    """
+    return _render(points, mode, None, progress, options)
+
+
+def read(path, **options) -> PointSet:
+    return _dpoint.read(_os.fspath(path), **options)
+
+
+def write(points, path, **options) -> None:
+    points, _ = _as_points(points) if not isinstance(points, PointSet) else (points, None)
+    if points is None:
+        raise TypeError("write: points must be a PointSet or an array, not a file name")
+    _dpoint.write(points, _os.fspath(path), **options)
+
+
+read.__doc__ = _dpoint.read.__doc__
+write.__doc__ = _dpoint.write.__doc__
+
+
+def generate(kind: str, *, progress: bool = False, **options) -> PointSet:
+    """Generates a dataset as ``dpoint generate KIND`` does, and returns it instead of writing it.
+
+    kind: mandelbulb, menger, sierpinski, julia, random2d, mandelbrot2d. Every option of
+    ``dpoint generate KIND`` is a keyword (``dpoint generate KIND --help`` lists them), e.g.
+    resolution=200, variant="seed", colors="noise", offset=(6.371e6, 0, 0), order="morton",
+    device="none". The points are the bytes the CLI writes: ``write(generate(k, **o), path)`` gives
+    the file ``dpoint generate k ... -o path`` gives. progress: lines on stderr.
+    """
+    if not isinstance(kind, str):
+        raise TypeError("generate: kind must be a string such as 'mandelbulb'")
+    return _dpoint._generate(kind, _args(options), progress)
+
+
+def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool = False, stream: str = "auto",
+         max_memory=None, progress: bool = False, **camera) -> dict:
+    """The facts ``dpoint info --json`` prints, as a dict: counts, bounds, whether float32 holds the
+    set, and each mode's predicted error bound in pixels for the view (error_bound_px).
+
+    points: a PointSet, an array, a DataFrame, or files. camera: render's camera options (width,
+    height, eye, target, up, fit, fov, ortho, view_center, view_width, tolerance). sample: points
+    sampled for the nearest-neighbour distance.
+    """
+    in_memory, inputs = _as_points(points)
+    limit = 0
+    if max_memory is not None:
+        limit = max_memory if isinstance(max_memory, int) else _dpoint._memory_size("max_memory", str(max_memory))
+    text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit, progress)
+    return _json.loads(text)
+
+
+def _executable() -> str:
+    """The dpoint executable bench runs its draws with: $DPOINT_EXECUTABLE, the build tree's, the
+    installed one, or the PATH's."""
+    import shutil
+
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    for candidate in (_os.environ.get("DPOINT_EXECUTABLE"), _os.path.join(here, "..", "..", "dpoint"),
+                      _os.path.join(_dpoint._install_prefix, "bin", "dpoint"), shutil.which("dpoint")):
+        if candidate and _os.path.isfile(candidate) and _os.access(candidate, _os.X_OK):
+            return _os.path.realpath(candidate)
+    raise Error("bench: no dpoint executable found (set DPOINT_EXECUTABLE)")
+
+
+def bench(suite: str = "ci", out="bench-out", *, progress: bool = True, **options) -> dict:
+    """Runs ``dpoint bench`` (the speed-against-error report) and returns its results.json as a dict.
+
+    suite: ci, paper, hard or all; out: the report's folder (report.md, results.json, charts,
+    montage). Every other option of ``dpoint bench`` is a keyword (cache, device, backend, frames,
+    warmup, sizes, no_error, validate, …). Its timed draws run the dpoint executable
+    (``DPOINT_EXECUTABLE``, else the one built or installed with this module).
+    """
+    _os.environ["DPOINT_EXECUTABLE"] = _executable()
+    _dpoint._bench(_args({"suite": suite, "out": _os.fspath(out), **options}), progress)
+    with open(_os.path.join(_os.fspath(out), "results.json"), encoding="utf-8") as f:
+        return _json.load(f)

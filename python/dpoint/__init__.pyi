@@ -1,0 +1,111 @@
+# Type stub of the dpoint package (python/dpoint/__init__.py over the extension dpoint._dpoint).
+from os import PathLike
+from typing import Any, Iterable, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+PathType = Union[str, PathLike[str]]
+Points = Union["PointSet", npt.ArrayLike, PathType, Sequence[PathType], Any]  # Any: a pandas DataFrame
+
+class Error(ValueError):
+    """Bad input or a bad option: the CLI's message."""
+    exit_code: int
+
+class DeviceError(RuntimeError):
+    """No usable Vulkan device, or a Vulkan fault."""
+    exit_code: int
+
+class RenderWarning(UserWarning): ...
+
+class PointSet:
+    def __init__(
+        self,
+        positions: npt.ArrayLike,
+        colors: npt.ArrayLike | None = None,
+        triangles: npt.ArrayLike | None = None,
+        *,
+        allow_nonfinite: bool = False,
+    ) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def colors(self) -> npt.NDArray[np.float32] | None: ...
+    @colors.setter
+    def colors(self, colors: npt.ArrayLike | None) -> None: ...
+    @property
+    def triangles(self) -> npt.NDArray[np.uint32] | None: ...
+    @triangles.setter
+    def triangles(self, triangles: npt.ArrayLike | None) -> None: ...
+    @property
+    def has_z(self) -> bool: ...
+    z_up: bool
+    def copy(self) -> PointSet: ...
+    @staticmethod
+    def from_dataframe(frame: Any, *, allow_nonfinite: bool = False) -> PointSet: ...
+    def to_dataframe(self) -> Any: ...
+
+class RenderResult:
+    @property
+    def image(self) -> npt.NDArray[np.uint8]: ...
+    mode: str
+    backend: str
+    device: str
+    points: int
+    predicted_bound_px: float
+    bound_from_boxes: bool
+    point_size: float
+    gpu_ms: list[float]
+    warnings: list[str]
+    @property
+    def error_px(self) -> dict[str, float] | None: ...
+    @property
+    def report(self) -> dict[str, Any] | None: ...
+    def png(self) -> bytes: ...
+    def save(self, path: PathType) -> None: ...
+    def _repr_png_(self) -> bytes: ...
+
+class Renderer:
+    def __init__(self, device: str | int = "auto", *, validate: bool = False, max_device_memory: int | str | None = None) -> None: ...
+    @property
+    def device(self) -> str: ...
+    def render(self, points: Points, mode: str = "auto", *, progress: bool = False, **options: Any) -> RenderResult: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> Renderer: ...
+    def __exit__(self, *exc: object) -> None: ...
+
+def read(
+    path: PathType,
+    *,
+    threads: int = 0,
+    allow_nonfinite: bool = False,
+    colors: str = "auto",
+    max_memory: int | str | None = None,
+    scene: int = -1,
+    all_scenes: bool = False,
+    max_points: int = 0,
+    progress: bool = False,
+) -> PointSet: ...
+def write(
+    points: PointSet,
+    path: PathType,
+    *,
+    decimals: int = -1,
+    ply_ascii: bool = False,
+    ply_colors: str = "uchar",
+    las_scale: float = 0.001,
+    order: str = "input",
+    no_colors: bool = False,
+    color_format: str = "linear",
+    unique: bool = False,
+    threads: int = 0,
+    max_memory: int | str | None = None,
+    progress: bool = False,
+) -> None: ...
+def generate(kind: str, *, progress: bool = False, **options: Any) -> PointSet: ...
+def info(points: Points, *, sample: int = 10000, progress: bool = False, **camera: Any) -> dict[str, Any]: ...
+def render(points: Points, mode: str = "auto", *, progress: bool = False, **options: Any) -> RenderResult: ...
+def bench(suite: str = "ci", out: PathType = "bench-out", *, progress: bool = True, **options: Any) -> dict[str, Any]: ...

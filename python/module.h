@@ -1,0 +1,72 @@
+// What the Python module's parts share (issue #26): library errors on their way to Python, and
+// long work run with the GIL released and Ctrl-C caught.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "core/interrupt.h"
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+
+namespace dpoint::python {
+
+namespace py = pybind11;
+
+// A library error, raised in Python by the translator module.cpp registers: dpoint.Error (a
+// ValueError) for bad input and usage, MemoryError for resource limits, dpoint.DeviceError (a
+// RuntimeError) for Vulkan faults, KeyboardInterrupt for an interrupt; each with the CLI's message
+// and its exit code as `exit_code`.
+struct LibraryError {
+  Error error;
+};
+[[noreturn]] inline void raise(const Error& error) { throw LibraryError{error}; }
+inline void check(const Status& status) {
+  if (!status) raise(status.error());
+}
+template <typename T>
+T take(Result<T> result) {
+  if (!result) raise(result.error());
+  return std::move(*result);
+}
+
+// Whether this is Python's main thread: the one that gets KeyboardInterrupt.
+bool isMainThread();
+
+// Runs `work` with the GIL released, so other Python threads run. In the main thread Ctrl-C
+// (SIGINT) is caught while it runs (core/interrupt.h's InterruptScope): the work stops as the
+// CLI's does, leaving no output, and KeyboardInterrupt is raised once it has.
+template <typename Work>
+auto released(Work&& work) {
+  std::optional<InterruptScope> scope;
+  if (isMainThread()) scope.emplace();
+  std::optional<decltype(work())> result;
+  {
+    py::gil_scoped_release release;
+    result.emplace(work());
+  }
+  const bool interrupted = scope && scope->caught();
+  scope.reset();
+  if (interrupted) {
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  return std::move(*result);
+}
+
+// Progress lines on stderr when asked (progress=True), else none.
+inline std::FILE* progressFile(bool progress) { return progress ? stderr : nullptr; }
+
+// The parts, each registering its functions and classes.
+void addPointSet(py::module_& m);
+void addRender(py::module_& m);
+void addCommands(py::module_& m);
+
+}  // namespace dpoint::python

@@ -1,0 +1,301 @@
+// dpoint.PointSet, dpoint.read and dpoint.write: the data model with NumPy arrays in and out.
+//
+// A PointSet owns the library's PointSet (double positions, float colours, uint32 triangles). Its
+// arrays are views of that memory, without a copy: positions (N, 3) float64, colors (N, 3) float32
+// (linear 0..1) and triangles (M, 3) uint32, each keeping the PointSet alive. Made from NumPy
+// arrays it copies them once into its own memory (the library's vectors cannot adopt NumPy's), so
+// a set made from an (N, 3) array holds the array and the copy until the caller drops the array.
+#include <cmath>
+#include <cstring>
+
+#include "converters/gltf_read.h"
+#include "converters/point_io.h"
+#include "core/memory.h"
+#include "ops/point_filters.h"
+#include "ops/point_order.h"
+#include "python/module.h"
+
+namespace dpoint::python {
+namespace {
+
+static_assert(sizeof(glm::dvec3) == 3 * sizeof(double) && sizeof(glm::vec3) == 3 * sizeof(float),
+              "PointSet's vectors are seen as (N, 3) arrays");
+
+std::string shapeText(const py::array& a) {
+  std::string text = "(";
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) text += (d ? ", " : "") + std::to_string(a.shape(d));
+  return text + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::string dtypeText(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+// `value` as an array of `columns` columns (or, with two_d, two) of a real number type, else a
+// TypeError (not numbers) or ValueError (the shape).
+py::array asTable(const py::handle& value, const char* name, bool two_d) {
+  py::array a = py::array::ensure(value);
+  if (!a) throw py::type_error(std::string(name) + ": expected an array of numbers, got " +
+                               py::str(py::type::of(value)).cast<std::string>());
+  const char kind = a.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
+    throw py::type_error(std::string(name) + ": expected real numbers, got dtype " + dtypeText(a));
+  if (a.ndim() != 2 || (a.shape(1) != 3 && !(two_d && a.shape(1) == 2)))
+    throw py::value_error(std::string(name) + ": expected shape (N, 3)" + (two_d ? " or (N, 2)" : "") + ", got " +
+                          shapeText(a));
+  return a;
+}
+
+const char* kAxisNames[] = {"x", "y", "z"};
+
+void setPositions(PointSet& set, const py::handle& value, bool allow_nonfinite) {
+  py::array table = asTable(value, "positions", true);
+  // float64 in any strides is read in place; another type is converted once.
+  auto doubles = py::array_t<double>::ensure(table);
+  if (!doubles) throw py::type_error("positions: cannot be read as float64 (dtype " + dtypeText(table) + ")");
+  const auto view = doubles.unchecked<2>();
+  const size_t n = static_cast<size_t>(view.shape(0));
+  const bool planar = view.shape(1) == 2;
+  set.positions.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const auto row = static_cast<py::ssize_t>(i);
+    glm::dvec3 p(view(row, 0), view(row, 1), planar ? 0.0 : view(row, 2));
+    if (!allow_nonfinite)
+      for (int axis = 0; axis < 3; ++axis)
+        if (!std::isfinite(p[axis]))
+          raise(Error{"positions: row " + std::to_string(i) + ", " + kAxisNames[axis] + ": " +
+                          (std::isnan(p[axis]) ? "nan" : p[axis] > 0 ? "inf" : "-inf") +
+                          " is not a finite coordinate (allow_nonfinite=True keeps it)",
+                      ExitCode::kBadInput});
+    set.positions[i] = p;
+  }
+  set.z_axis = planar ? ZAxis::kAbsent : ZAxis::kUnknown;
+}
+
+// uint8 (0..255, as a PLY's uchar colours are read: k / 255) or floats (linear 0..1).
+void setColors(PointSet& set, const py::handle& value) {
+  if (value.is_none()) {
+    set.colors.clear();
+    return;
+  }
+  py::array table = asTable(value, "colors", false);
+  if (static_cast<size_t>(table.shape(0)) != set.size())
+    throw py::value_error("colors: " + std::to_string(table.shape(0)) + " rows for " + std::to_string(set.size()) +
+                          " points");
+  const char kind = table.dtype().kind();
+  const size_t n = set.size();
+  std::vector<glm::vec3> colors(n);
+  if (kind == 'u' && table.itemsize() == 1) {
+    float byte_color[256];  // k / 255.0f, as the PLY reader rounds it
+    for (int k = 0; k < 256; ++k) byte_color[k] = static_cast<float>(k) / 255.0f;
+    const auto view = py::array_t<uint8_t>::ensure(table).unchecked<2>();
+    for (size_t i = 0; i < n; ++i)
+      for (py::ssize_t c = 0; c < 3; ++c) colors[i][static_cast<int>(c)] = byte_color[view(static_cast<py::ssize_t>(i), c)];
+  } else if (kind == 'f') {
+    const auto view = py::array_t<float>::ensure(table).unchecked<2>();
+    for (size_t i = 0; i < n; ++i)
+      for (py::ssize_t c = 0; c < 3; ++c) {
+        const float v = view(static_cast<py::ssize_t>(i), c);
+        if (!(v >= 0.0f && v <= 1.0f))
+          raise(Error{"colors: row " + std::to_string(i) + ", column " + std::to_string(c) + ": " + std::to_string(v) +
+                          " is outside 0..1 (float colours are linear 0..1; uint8 ones 0..255)",
+                      ExitCode::kBadInput});
+        colors[i][static_cast<int>(c)] = v;
+      }
+  } else {
+    throw py::type_error("colors: expected uint8 (0..255) or floats (0..1), got dtype " + dtypeText(table));
+  }
+  set.colors = std::move(colors);
+}
+
+void setTriangles(PointSet& set, const py::handle& value) {
+  if (value.is_none()) {
+    set.triangles.clear();
+    return;
+  }
+  py::array table = asTable(value, "triangles", false);
+  const char kind = table.dtype().kind();
+  if (kind != 'i' && kind != 'u') throw py::type_error("triangles: expected integers, got dtype " + dtypeText(table));
+  const auto view = py::array_t<int64_t>::ensure(table).unchecked<2>();
+  std::vector<uint32_t> triangles(static_cast<size_t>(view.shape(0)) * 3);
+  for (py::ssize_t t = 0; t < view.shape(0); ++t)
+    for (py::ssize_t c = 0; c < 3; ++c) {
+      const int64_t v = view(t, c);
+      if (v < 0 || static_cast<uint64_t>(v) >= set.size())
+        raise(Error{"triangles: row " + std::to_string(t) + ": vertex " + std::to_string(v) + " is not one of the " +
+                        std::to_string(set.size()) + " points",
+                    ExitCode::kBadInput});
+      triangles[static_cast<size_t>(t * 3 + c)] = static_cast<uint32_t>(v);
+    }
+  set.triangles = std::move(triangles);
+}
+
+// A view of `rows` × 3 values at `data`, kept alive by `owner`.
+template <typename T>
+py::array view3(const py::object& owner, const T* data, size_t rows) {
+  const auto n = static_cast<py::ssize_t>(rows);
+  if (rows == 0) return py::array_t<T>({n, py::ssize_t{3}});
+  return py::array_t<T>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(T)}, py::ssize_t{sizeof(T)}}, data, owner);
+}
+
+Result<uint64_t> memoryOption(const py::object& value) {
+  if (value.is_none()) return uint64_t{0};
+  if (py::isinstance<py::int_>(value)) return value.cast<uint64_t>();
+  return parseMemorySize("max_memory", py::str(value).cast<std::string>());
+}
+
+std::optional<LasColorSource> lasColorSource(const std::string& name) {
+  if (name == "auto") return LasColorSource::kAuto;
+  if (name == "rgb") return LasColorSource::kRgb;
+  if (name == "intensity") return LasColorSource::kIntensity;
+  if (name == "classification") return LasColorSource::kClassification;
+  if (name == "none") return LasColorSource::kNone;
+  return std::nullopt;
+}
+
+std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bool allow_nonfinite,
+                                   const std::string& colors, const py::object& max_memory, int scene, bool all_scenes,
+                                   uint64_t max_points, bool progress) {
+  const std::optional<LasColorSource> source = lasColorSource(colors);
+  if (!source)
+    raise(Error{"colors: '" + colors + "' is not one of auto, rgb, intensity, classification, none", ExitCode::kUsage});
+  const uint64_t limit = take(memoryOption(max_memory));
+  const FileFormat format = take(formatOf(path));
+  const bool gltf = format == FileFormat::kGlb || format == FileFormat::kGltf;
+  if (!gltf && (scene >= 0 || all_scenes))
+    raise(Error{path + ": scene and all_scenes apply to .glb/.gltf input only", ExitCode::kUsage});
+  return std::make_shared<PointSet>(take(released([&] {
+    Progress bar(progressFile(progress), "read");
+    Result<PointSet> read = [&]() -> Result<PointSet> {
+      if (gltf) {
+        GltfReadOptions g;
+        g.max_memory = limit, g.scene = scene, g.all_scenes = all_scenes, g.allow_nonfinite = allow_nonfinite;
+        g.max_points = max_points;
+        return readGltf(path, g);
+      }
+      ReadOptions r{threads, allow_nonfinite, &bar};
+      r.max_memory = limit;
+      r.las_color = *source;
+      return readPoints(path, r);
+    }();
+    if (read && max_points != 0 && read->size() > max_points)
+      return Result<PointSet>(Error{path + ": " + std::to_string(read->size()) + " points exceed max_points " +
+                                        std::to_string(max_points),
+                                    ExitCode::kResourceLimit});
+    return read;
+  })));
+}
+
+}  // namespace
+
+void addPointSet(py::module_& m) {
+  py::class_<PointSet, std::shared_ptr<PointSet>>(m, "PointSet", R"(Points with double-precision positions.
+
+PointSet(positions, colors=None, triangles=None, *, allow_nonfinite=False)
+
+positions: (N, 3) or (N, 2) array of real numbers (float64 kept exactly; (N, 2) means z = 0, a 2D
+set). colors: None, (N, 3) uint8 (0..255) or floats (linear 0..1). triangles: None or (M, 3)
+integer vertex indices. The arrays are copied once into the set; its attributes are views of
+that memory, without copying (writing into them changes the set).)")
+      .def(py::init([](const py::object& positions, const py::object& colors, const py::object& triangles,
+                       bool allow_nonfinite) {
+             auto set = std::make_shared<PointSet>();
+             setPositions(*set, positions, allow_nonfinite);
+             setColors(*set, colors);
+             setTriangles(*set, triangles);
+             return set;
+           }),
+           py::arg("positions"), py::arg("colors") = py::none(), py::arg("triangles") = py::none(), py::kw_only(),
+           py::arg("allow_nonfinite") = false)
+      .def("__len__", &PointSet::size)
+      .def_property_readonly(
+          "positions",
+          [](const py::object& self) {
+            const PointSet& s = self.cast<const PointSet&>();
+            return view3(self, reinterpret_cast<const double*>(s.positions.data()), s.size());
+          },
+          "(N, 3) float64 view of the positions (no copy)")
+      .def_property(
+          "colors",
+          [](const py::object& self) -> py::object {
+            const PointSet& s = self.cast<const PointSet&>();
+            if (!s.hasColors()) return py::none();
+            return view3(self, reinterpret_cast<const float*>(s.colors.data()), s.size());
+          },
+          [](PointSet& s, const py::object& colors) { setColors(s, colors); },
+          "(N, 3) float32 view of the linear 0..1 colours (no copy), or None. Set from uint8 or floats, or None")
+      .def_property(
+          "triangles",
+          [](const py::object& self) -> py::object {
+            const PointSet& s = self.cast<const PointSet&>();
+            if (!s.isMesh()) return py::none();
+            return view3(self, s.triangles.data(), s.triangles.size() / 3);
+          },
+          [](PointSet& s, const py::object& triangles) { setTriangles(s, triangles); },
+          "(M, 3) uint32 view of the triangles' vertex indices (no copy), or None")
+      .def_property_readonly("has_z", &PointSet::hasZ, "Whether writers write z (False for a 2D set)")
+      .def_readwrite("z_up", &PointSet::z_up, "The source says z is up (LAS): render's fitted views use it")
+      .def("copy", [](const PointSet& s) { return std::make_shared<PointSet>(s); }, "A deep copy")
+      .def("__repr__", [](const PointSet& s) {
+        return "<dpoint.PointSet: " + std::to_string(s.size()) + " points" + (s.hasColors() ? ", colours" : "") +
+               (s.isMesh() ? ", " + std::to_string(s.triangles.size() / 3) + " triangles" : "") +
+               (s.hasZ() ? "" : ", 2D") + ">";
+      });
+
+  m.def("_memory_size", [](const std::string& flag, const std::string& text) { return take(parseMemorySize(flag, text)); });
+
+  m.def(
+      "read",
+      [](const std::string& path, unsigned threads, bool allow_nonfinite, const std::string& colors,
+         const py::object& max_memory, int scene, bool all_scenes, uint64_t max_points, bool progress) {
+        return readFile(path, threads, allow_nonfinite, colors, max_memory, scene, all_scenes, max_points, progress);
+      },
+      py::arg("path"), py::kw_only(), py::arg("threads") = 0u, py::arg("allow_nonfinite") = false,
+      py::arg("colors") = "auto", py::arg("max_memory") = py::none(), py::arg("scene") = -1,
+      py::arg("all_scenes") = false, py::arg("max_points") = uint64_t{0}, py::arg("progress") = false,
+      R"(Reads a .csv, .ply, .las, .glb or .gltf file (by extension) as `dpoint convert` does.
+
+colors: LAS colour source (auto, rgb, intensity, classification, none); other formats take auto,
+rgb or none. scene / all_scenes: glTF scenes (as --scene, --all-scenes). max_memory: bytes or
+"8G" (default: half of RAM). max_points: refuse a larger set (MemoryError). progress: lines on
+stderr.)");
+
+  m.def(
+      "write",
+      [](const std::shared_ptr<PointSet>& points, const std::string& path, int decimals, bool ply_ascii,
+         const std::string& ply_colors, double las_scale, const std::string& order, bool no_colors,
+         const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
+        if (ply_colors != "uchar" && ply_colors != "float")
+          raise(Error{"ply_colors: '" + ply_colors + "' is not uchar or float", ExitCode::kUsage});
+        if (color_format != "linear" && color_format != "srgb8")
+          raise(Error{"color_format: '" + color_format + "' is not linear or srgb8", ExitCode::kUsage});
+        const PointOrder point_order = take(parsePointOrder("order", order));
+        const uint64_t limit = take(memoryOption(max_memory));
+        check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
+        check(released([&] {
+          Progress bar(progressFile(progress), "write");
+          WriteOptions w;
+          w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale;
+          w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
+          w.ply_colors = ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
+          const bool filtered = no_colors || unique || color_format == "srgb8" || point_order != PointOrder::kInput;
+          if (!filtered) return writePoints(path, *points, w);
+          PointSet copy = *points;  // the caller's set stays as it is
+          if (no_colors) copy.colors.clear();
+          if (unique) dropDuplicatePositions(copy);
+          if (color_format == "srgb8") encodeColorsSrgb8(copy);
+          if (Status s = checkReorderMemory(copy, point_order, limit); !s) return s;
+          reorderPoints(copy, point_order, threads, &bar);
+          return writePoints(path, copy, w);
+        }));
+      },
+      py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
+      py::arg("ply_colors") = "uchar", py::arg("las_scale") = 0.001, py::arg("order") = "input",
+      py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
+      py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
+      R"(Writes a set as .csv, .ply, .glb or .las (by extension), whole or not at all, as `dpoint convert` does.
+
+decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (uchar or float),
+las_scale (LAS coordinate step), order (input or morton), no_colors, color_format (linear or
+srgb8), unique: as convert's options; they act on a copy, never on `points`.)");
+}
+
+}  // namespace dpoint::python

@@ -1,0 +1,140 @@
+// dpoint.render and dpoint.Renderer: a render as the CLI runs it (viewer/render_job.h), from a
+// PointSet in memory or from files, with the picture as a NumPy array and the CLI's JSON report.
+// The options are render's own, parsed by its parser (cli/cli_options.h).
+#include <cmath>
+#include <memory>
+
+#include "cli/cli_options.h"
+#include "image/image.h"
+#include "python/module.h"
+#include "viewer/modes.h"
+#include "viewer/render_job.h"
+
+namespace dpoint::python {
+namespace {
+
+// What a render gives back to Python.
+struct RenderResultPy {
+  Image image;
+  std::string mode, backend, device;
+  size_t points = 0;
+  double predicted_bound_px = 0.0;
+  bool bound_from_boxes = false;
+  float point_size = 1.0f;
+  std::optional<ErrorStats> error;
+  std::vector<double> gpu_ms;
+  std::vector<std::string> warnings, validation_messages;
+  std::string report_json;  // renderReportJson: render --json's object (empty for a contact sheet)
+};
+
+// One Vulkan device kept across renders: a loop over views or modes makes it once.
+class Renderer {
+ public:
+  Renderer(const std::string& device, bool validate, uint64_t max_device_memory) {
+    context_ = take(released([&] {
+      Result<std::unique_ptr<VulkanContext>> made = VulkanContext::create(ContextOptions{device, validate, max_device_memory});
+      if (!made) return Result<std::shared_ptr<VulkanContext>>(made.error());
+      return Result<std::shared_ptr<VulkanContext>>(std::shared_ptr<VulkanContext>(std::move(*made)));
+    }));
+  }
+  const std::shared_ptr<VulkanContext>& context() const {
+    if (!context_) raise(Error{"this Renderer is closed", ExitCode::kUsage});
+    return context_;
+  }
+  void close() { context_.reset(); }
+
+ private:
+  std::shared_ptr<VulkanContext> context_;
+};
+
+RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
+                          const std::vector<std::string>& args, const Renderer* renderer, bool progress) {
+  RenderRequest request = take(renderRequestOf(args));
+  if (points)
+    request.points = points;
+  else
+    request.inputs = inputs;
+  if (renderer) request.context = renderer->context();
+  RenderOutcome outcome = take(released([&] {
+    Progress bar(progressFile(progress), "render");
+    return runRenderJob(request, bar);
+  }));
+  // As the CLI: with the validation layer on, any message fails the run.
+  if (!outcome.validation_messages.empty()) {
+    std::string text = std::to_string(outcome.validation_messages.size()) + " Vulkan validation message(s):";
+    for (const std::string& m : outcome.validation_messages) text += "\n" + m;
+    raise(Error{text, ExitCode::kNoDevice});
+  }
+  RenderResultPy r;
+  if (request.views == 1) r.report_json = renderReportJson(request, outcome);
+  r.image = std::move(outcome.image);
+  r.mode = std::string(modeName(outcome.prediction.mode));
+  r.backend = backendName(outcome.backend);
+  r.device = outcome.device.name;
+  r.points = outcome.points;
+  r.predicted_bound_px = outcome.prediction.bound_px;
+  r.bound_from_boxes = outcome.prediction.from_boxes;
+  r.point_size = outcome.point_size;
+  if (outcome.error && anyMeasured(outcome.error->stats)) r.error = outcome.error->stats;
+  r.gpu_ms = outcome.result.gpu_ms;
+  r.warnings = outcome.warnings;
+  return r;
+}
+
+}  // namespace
+
+void addRender(py::module_& m) {
+  py::class_<RenderResultPy, std::shared_ptr<RenderResultPy>>(m, "RenderResult", R"(What a render gives back.
+
+image: (H, W, 4) uint8 RGBA (a view, no copy); mode, backend, device: what ran; predicted_bound_px:
+the mode's error bound for the view (inf: unbounded); error_px: dict of max, p99, rms and more
+(render(..., error=True)), else None; gpu_ms: each timed frame; report: render --json's object;
+warnings: what makes the picture wrong or poor. save(path) writes the PNG the CLI writes; in
+Jupyter the result shows as its picture.)")
+      .def_property_readonly("image",
+                             [](const py::object& self) {
+                               const RenderResultPy& r = self.cast<const RenderResultPy&>();
+                               const auto h = static_cast<py::ssize_t>(r.image.height);
+                               const auto w = static_cast<py::ssize_t>(r.image.width);
+                               return py::array_t<uint8_t>({h, w, py::ssize_t{4}}, {w * 4, py::ssize_t{4}, py::ssize_t{1}},
+                                                           r.image.rgba.data(), self);
+                             })
+      .def_readonly("mode", &RenderResultPy::mode)
+      .def_readonly("backend", &RenderResultPy::backend)
+      .def_readonly("device", &RenderResultPy::device)
+      .def_readonly("points", &RenderResultPy::points)
+      .def_readonly("predicted_bound_px", &RenderResultPy::predicted_bound_px)
+      .def_readonly("bound_from_boxes", &RenderResultPy::bound_from_boxes)
+      .def_readonly("point_size", &RenderResultPy::point_size)
+      .def_readonly("gpu_ms", &RenderResultPy::gpu_ms)
+      .def_readonly("warnings", &RenderResultPy::warnings)
+      .def_property_readonly("error_px",
+                             [](const RenderResultPy& r) -> py::object {
+                               if (!r.error) return py::none();
+                               py::dict d;
+                               d["max"] = r.error->max_px, d["p99"] = r.error->p99_px, d["rms"] = r.error->rms_px;
+                               d["share_off_half_px"] = r.error->share_off_half_px;
+                               d["points"] = r.error->points, d["lost"] = r.error->lost;
+                               return d;
+                             })
+      .def_readonly("_report_json", &RenderResultPy::report_json)
+      .def("png", [](const RenderResultPy& r) {
+             std::vector<unsigned char> bytes = take(pngBytes(r.image, "the picture"));
+             return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+           }, "The picture as the bytes of the PNG file the CLI writes")
+      .def("save", [](const RenderResultPy& r, const std::string& path) {
+             check(checkPictureOutput(path));
+             check(writePng(path, r.image));
+           }, py::arg("path"), "Writes the picture as PNG, whole or not at all");
+
+  py::class_<Renderer, std::shared_ptr<Renderer>>(m, "_Renderer")
+      .def(py::init<const std::string&, bool, uint64_t>(), py::arg("device"), py::arg("validate"),
+           py::arg("max_device_memory"))
+      .def_property_readonly("device", [](const Renderer& r) { return r.context()->facts.name; })
+      .def("close", &Renderer::close);
+
+  m.def("_render", &renderWith, py::arg("points"), py::arg("inputs"), py::arg("args"), py::arg("renderer"),
+        py::arg("progress"));
+}
+
+}  // namespace dpoint::python
