@@ -78,7 +78,7 @@ Status createShaderCopy(const VulkanContext& context, CopyScratch& s) {
   info.stage.module = *module;
   info.stage.pName = "main";
   info.layout = s.layout;
-  VkResult result = vkCreateComputePipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &s.pipeline);
+  VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &s.pipeline);
   vkDestroyShaderModule(context.device, *module, nullptr);
   VK_TRY(result);
   VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2};

@@ -49,7 +49,7 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const uint32_t* 
   info.stage.pSpecializationInfo = kind ? &specialization : nullptr;
   info.layout = layout;
   VkPipeline pipeline = VK_NULL_HANDLE;
-  VkResult result = vkCreateComputePipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
   vkDestroyShaderModule(context.device, *module, nullptr);
   if (result != VK_SUCCESS) return vulkanError("creating a generation pipeline", result);
   return pipeline;

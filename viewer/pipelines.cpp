@@ -43,7 +43,7 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
   info.stage.pSpecializationInfo = &specialization;
   info.layout = layout;
   VkPipeline pipeline = VK_NULL_HANDLE;
-  VkResult result = vkCreateComputePipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
   vkDestroyShaderModule(context.device, *module, nullptr);
   if (result != VK_SUCCESS) return vulkanError("creating a compute pipeline", result);
   return pipeline;
@@ -191,7 +191,7 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
   info.layout = p.layout;
   info.renderPass = p.render_pass;
   VkPipeline pipeline = VK_NULL_HANDLE;
-  VkResult result = vkCreateGraphicsPipelines(context.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  VkResult result = vkCreateGraphicsPipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
   vkDestroyShaderModule(context.device, *vertex, nullptr);
   vkDestroyShaderModule(context.device, *fragment, nullptr);
   if (result != VK_SUCCESS)

@@ -327,6 +327,8 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pool_info.queueFamilyIndex = context->facts.queue_family;
   VK_TRY(vkCreateCommandPool(context->device, &pool_info, nullptr, &context->command_pool));
+  VkPipelineCacheCreateInfo cache_info = {VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+  VK_TRY(vkCreatePipelineCache(context->device, &cache_info, nullptr, &context->pipeline_cache));
   context->device_memory_budget = options.max_device_memory;
   return context;
 }
@@ -335,6 +337,7 @@ VulkanContext::~VulkanContext() {
   if (device) {
     vkDeviceWaitIdle(device);
     if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
+    if (pipeline_cache) vkDestroyPipelineCache(device, pipeline_cache, nullptr);
     vkDestroyDevice(device, nullptr);
   }
   if (messenger_) {

@@ -87,6 +87,9 @@ class VulkanContext {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
   VkCommandPool command_pool = VK_NULL_HANDLE;
+  // Every pipeline is made through it: a device kept across renders (the Python module's
+  // Renderer) compiles a pipeline it made before from the cache.
+  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
   DeviceFacts facts;
   VkPhysicalDeviceMemoryProperties memory{};
   // Device memory allocated through vulkan/buffers and the budget it must stay in (0: none).
