@@ -11,7 +11,8 @@ import dpoint
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--resolution", type=int, default=100, help="grid points per axis (the study: 100..400)")
-parser.add_argument("--out", default="", help="also write each mode's picture as OUT-MODE.png")
+parser.add_argument("--out", default="", help="also write each mode's measured picture as OUT-MODE.png (1-px "
+                    "points, as the error is measured) and the default preview as OUT-preview.png")
 args = parser.parse_args()
 
 # The study's generator, bit for bit (--variant seed), its points moved by exact double sums.
@@ -27,3 +28,5 @@ with dpoint.Renderer() as renderer:  # one Vulkan device for both renders
               f"{result.gpu_ms[0]:8.2f}")
         if args.out:
             result.save(f"{args.out}-{mode}.png")
+    if args.out:  # the picture a user looks at: point size and shading auto
+        renderer.render(bulb, "native", width=1920, height=1080).save(f"{args.out}-preview.png")
