@@ -49,7 +49,9 @@ class Renderer {
 
 RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
                           const std::vector<std::string>& args, const Renderer* renderer, bool progress) {
-  RenderRequest request = take(renderRequestOf(args));
+  Result<RenderRequest> parsed = renderRequestOf(args);
+  if (!parsed) raise(asCommandError(parsed.error(), "render", "render"));
+  RenderRequest request = std::move(*parsed);
   // renderRequestOf asks for the report (render --json's) always, which --views 4 refuses; a contact
   // sheet comes back without one (RenderResult.report is None).
   request.report = request.views == 1;
