@@ -2,8 +2,11 @@
 // PointSet in memory or from files, with the picture as a NumPy array and the CLI's JSON report.
 // The options are render's own, parsed by its parser (cli/cli_options.h).
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <mutex>
+
+#include <pybind11/stl/filesystem.h>
 
 #include "cli/cli_options.h"
 #include "image/image.h"
@@ -155,7 +158,8 @@ Jupyter the result shows as its picture.)")
              std::vector<unsigned char> bytes = take(pngBytes(r.image, "the picture"));
              return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
            }, "The picture as the bytes of the PNG file the CLI writes")
-      .def("save", [](const RenderResultPy& r, const std::string& path) {
+      .def("save", [](const RenderResultPy& r, const std::filesystem::path& file) {  // a str or os.PathLike
+             const std::string path = file.string();
              check(checkPictureOutput(path));
              check(writePng(path, r.image));
            }, py::arg("path"), "Writes the picture as PNG, whole or not at all");
