@@ -68,6 +68,9 @@ PYBIND11_MODULE(_dpoint, m) {
   g_device_error = PyErr_NewExceptionWithDoc("dpoint.DeviceError",
                                              "No usable Vulkan device, or a Vulkan fault (the CLI's exit code 3)",
                                              PyExc_RuntimeError, nullptr);
+  // The exit code of one raised without one (the package's own checks, a DataFrame's columns).
+  py::handle(g_error).attr("exit_code") = static_cast<int>(dpoint::ExitCode::kBadInput);
+  py::handle(g_device_error).attr("exit_code") = static_cast<int>(dpoint::ExitCode::kNoDevice);
   m.attr("Error") = py::handle(g_error);
   m.attr("DeviceError") = py::handle(g_device_error);
   py::register_exception_translator(translate);

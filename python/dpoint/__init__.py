@@ -147,10 +147,7 @@ class Renderer:
     """
 
     def __init__(self, device: str | int = "auto", *, validate: bool = False, max_device_memory=None):
-        limit = 0
-        if max_device_memory is not None:
-            limit = max_device_memory if isinstance(max_device_memory, int) else _dpoint._memory_size(
-                "max_device_memory", str(max_device_memory))
+        limit = _dpoint._memory_size("max_device_memory", max_device_memory)
         self._renderer = _dpoint._Renderer(str(device), validate, limit)
 
     @property
@@ -234,9 +231,7 @@ def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool
     sampled for the nearest-neighbour distance.
     """
     in_memory, inputs = _as_points(points)
-    limit = 0
-    if max_memory is not None:
-        limit = max_memory if isinstance(max_memory, int) else _dpoint._memory_size("max_memory", str(max_memory))
+    limit = _dpoint._memory_size("max_memory", max_memory)
     text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit, progress)
     return _json.loads(text)
 
