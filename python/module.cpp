@@ -6,9 +6,19 @@
 
 namespace dpoint::python {
 
-bool isMainThread() {
+bool catchesSigint() {
   py::module_ threading = py::module_::import("threading");
-  return threading.attr("current_thread")().is(threading.attr("main_thread")());
+  if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return false;
+  py::module_ signal = py::module_::import("signal");
+  py::object handler = signal.attr("getsignal")(signal.attr("SIGINT"));
+  return !handler.is_none() && !handler.equal(signal.attr("SIG_IGN")) && !handler.equal(signal.attr("SIG_DFL"));
+}
+
+void raiseInterrupt() {
+  PyErr_SetInterrupt();  // as if SIGINT came now, to the handler the scope had put aside
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  PyErr_SetNone(PyExc_KeyboardInterrupt);
+  throw py::error_already_set();
 }
 
 Error asCommandError(Error error, const std::string& parser, const std::string& command) {
