@@ -6,9 +6,31 @@
 
 namespace dpoint::python {
 
-bool isMainThread() {
+bool catchesSigint() {
   py::module_ threading = py::module_::import("threading");
-  return threading.attr("current_thread")().is(threading.attr("main_thread")());
+  if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return false;
+  py::module_ signal = py::module_::import("signal");
+  py::object handler = signal.attr("getsignal")(signal.attr("SIGINT"));
+  return !handler.is_none() && !handler.equal(signal.attr("SIG_IGN")) && !handler.equal(signal.attr("SIG_DFL"));
+}
+
+void raiseInterrupt() {
+  PyErr_SetInterrupt();  // as if SIGINT came now, to the handler the scope had put aside
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  PyErr_SetNone(PyExc_KeyboardInterrupt);
+  throw py::error_already_set();
+}
+
+Error asCommandError(Error error, const std::string& parser, const std::string& command) {
+  std::string& text = error.message;
+  const std::string own_prefix = parser + ": ";
+  const std::string unknown = "unknown option '";
+  const std::string root_hint = "(`dpoint --help` lists them)";
+  if (text.starts_with(unknown) && text.ends_with(root_hint))
+    text = command + ": " + text.substr(0, text.size() - root_hint.size()) + "(`dpoint " + command + " --help` lists them)";
+  else if (text.starts_with(own_prefix))
+    text.erase(0, own_prefix.size());
+  return error;
 }
 
 namespace {
@@ -56,6 +78,9 @@ PYBIND11_MODULE(_dpoint, m) {
   g_device_error = PyErr_NewExceptionWithDoc("dpoint.DeviceError",
                                              "No usable Vulkan device, or a Vulkan fault (the CLI's exit code 3)",
                                              PyExc_RuntimeError, nullptr);
+  // The exit code of one raised without one (the package's own checks, a DataFrame's columns).
+  py::handle(g_error).attr("exit_code") = static_cast<int>(dpoint::ExitCode::kBadInput);
+  py::handle(g_device_error).attr("exit_code") = static_cast<int>(dpoint::ExitCode::kNoDevice);
   m.attr("Error") = py::handle(g_error);
   m.attr("DeviceError") = py::handle(g_device_error);
   py::register_exception_translator(translate);

@@ -37,16 +37,33 @@ T take(Result<T> result) {
   return std::move(*result);
 }
 
-// Whether this is Python's main thread: the one that gets KeyboardInterrupt.
-bool isMainThread();
+// Whether Ctrl-C is Python's to handle here: this is the main thread (the one Python runs signal
+// handlers in) and SIGINT has a Python handler (default_int_handler's KeyboardInterrupt, or the
+// program's own); not when the process ignores SIGINT (SIG_IGN, as a background job of a script
+// does) or leaves it to the system (SIG_DFL).
+bool catchesSigint();
 
-// Runs `work` with the GIL released, so other Python threads run. In the main thread Ctrl-C
-// (SIGINT) is caught while it runs (core/interrupt.h's InterruptScope): the work stops as the
-// CLI's does, leaving no output, and KeyboardInterrupt is raised once it has.
+// After the work stopped for a SIGINT: Python's handler runs as for any SIGINT (KeyboardInterrupt,
+// or what the program's handler raises). One that returns still gets KeyboardInterrupt: the call
+// was cut short and has no result.
+[[noreturn]] void raiseInterrupt();
+
+// An error of cli_options.h's parsers (renderRequestOf, cameraRequestOf) in the words the
+// executable's `dpoint COMMAND` uses for the same option. Those parsers run an app of their own
+// named `parser` ("render", "camera") with no parent, so they prefix every CLI11 refusal with
+// "PARSER: " (the executable and runEmbedded give it bare) and name an unknown option without its
+// command ("unknown option '--x' ... (`dpoint --help` lists them)" for the executable's
+// "render: unknown option '--x' ... (`dpoint render --help` lists them)"). Other errors pass as they are.
+Error asCommandError(Error error, const std::string& parser, const std::string& command);
+
+// Runs `work` with the GIL released, so other Python threads run. Where Python handles Ctrl-C
+// (catchesSigint), SIGINT is caught while it runs (core/interrupt.h's InterruptScope): the work
+// stops as the CLI's does, leaving no output, and Python's handler runs once it has
+// (raiseInterrupt: KeyboardInterrupt by default).
 template <typename Work>
 auto released(Work&& work) {
   std::optional<InterruptScope> scope;
-  if (isMainThread()) scope.emplace();
+  if (catchesSigint()) scope.emplace();
   std::optional<decltype(work())> result;
   {
     py::gil_scoped_release release;
@@ -54,10 +71,7 @@ auto released(Work&& work) {
   }
   const bool interrupted = scope && scope->caught();
   scope.reset();
-  if (interrupted) {
-    PyErr_SetNone(PyExc_KeyboardInterrupt);
-    throw py::error_already_set();
-  }
+  if (interrupted) raiseInterrupt();
   return std::move(*result);
 }
 

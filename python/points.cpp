@@ -7,10 +7,12 @@
 // a set made from an (N, 3) array holds the array and the copy until the caller drops the array.
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "converters/gltf_read.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
+#include "core/text.h"
 #include "ops/point_filters.h"
 #include "ops/point_order.h"
 #include "python/module.h"
@@ -70,8 +72,39 @@ void setPositions(PointSet& set, const py::handle& value, bool allow_nonfinite) 
   set.z_axis = planar ? ZAxis::kAbsent : ZAxis::kUnknown;
 }
 
-// uint8 (0..255, as a PLY's uchar colours are read: k / 255) or floats (linear 0..1).
-void setColors(PointSet& set, const py::handle& value) {
+// Keeps `kept` alive as long as `owner` (a pybind11 instance, which takes weak references): the
+// patient of pybind11's own keep_alive, without an argument to hang it on.
+void keepWhileAlive(const py::handle& owner, py::object kept) {
+  py::handle patient = kept.release();  // one reference, dropped when the owner goes
+  py::cpp_function drop([patient](py::handle weakref) {
+    patient.dec_ref();
+    weakref.dec_ref();
+  });
+  py::weakref(owner, drop).release();
+}
+
+// Sets a vector that NumPy views may see. A view holds the set, not the vector's storage, so that
+// storage must never be freed while the set lives: a value that fits is copied into it (resize
+// within the capacity does not reallocate, and clear() keeps it), and a larger one gets new storage
+// while the old is handed to the set's Python object to keep. A view made before then still reads
+// memory of its own, never freed memory.
+template <typename T>
+void replaceKeepingViews(const py::handle& self, std::vector<T>& target, std::vector<T> values) {
+  if (values.size() <= target.capacity()) {
+    target.resize(values.size());
+    std::copy(values.begin(), values.end(), target.begin());
+    return;
+  }
+  if (target.capacity() > 0) {
+    auto* retired = new std::vector<T>(std::move(target));  // a move keeps the storage where it is
+    keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<T>*>(p); }));
+  }
+  target = std::move(values);
+}
+
+// uint8 (0..255, as a PLY's uchar colours are read: k / 255) or floats (linear 0..1). `self`: the
+// set's Python object when it exists (its views are kept valid), else none (a set being made).
+void setColors(PointSet& set, const py::handle& value, const py::handle& self = py::handle()) {
   if (value.is_none()) {
     set.colors.clear();
     return;
@@ -103,10 +136,13 @@ void setColors(PointSet& set, const py::handle& value) {
   } else {
     throw py::type_error("colors: expected uint8 (0..255) or floats (0..1), got dtype " + dtypeText(table));
   }
-  set.colors = std::move(colors);
+  if (self)
+    replaceKeepingViews(self, set.colors, std::move(colors));
+  else
+    set.colors = std::move(colors);
 }
 
-void setTriangles(PointSet& set, const py::handle& value) {
+void setTriangles(PointSet& set, const py::handle& value, const py::handle& self = py::handle()) {
   if (value.is_none()) {
     set.triangles.clear();
     return;
@@ -114,18 +150,26 @@ void setTriangles(PointSet& set, const py::handle& value) {
   py::array table = asTable(value, "triangles", false);
   const char kind = table.dtype().kind();
   if (kind != 'i' && kind != 'u') throw py::type_error("triangles: expected integers, got dtype " + dtypeText(table));
-  const auto view = py::array_t<int64_t>::ensure(table).unchecked<2>();
-  std::vector<uint32_t> triangles(static_cast<size_t>(view.shape(0)) * 3);
-  for (py::ssize_t t = 0; t < view.shape(0); ++t)
-    for (py::ssize_t c = 0; c < 3; ++c) {
-      const int64_t v = view(t, c);
-      if (v < 0 || static_cast<uint64_t>(v) >= set.size())
-        raise(Error{"triangles: row " + std::to_string(t) + ": vertex " + std::to_string(v) + " is not one of the " +
-                        std::to_string(set.size()) + " points",
-                    ExitCode::kBadInput});
-      triangles[static_cast<size_t>(t * 3 + c)] = static_cast<uint32_t>(v);
-    }
-  set.triangles = std::move(triangles);
+  // Read as int64, or uint64 for unsigned input (uint64 above 2^63 would wrap to a negative index).
+  auto fill = [&](auto view) {
+    std::vector<uint32_t> triangles(static_cast<size_t>(view.shape(0)) * 3);
+    for (py::ssize_t t = 0; t < view.shape(0); ++t)
+      for (py::ssize_t c = 0; c < 3; ++c) {
+        const auto v = view(t, c);
+        if (v < 0 || static_cast<uint64_t>(v) >= set.size())
+          raise(Error{"triangles: row " + std::to_string(t) + ": vertex " + std::to_string(v) + " is not one of the " +
+                          std::to_string(set.size()) + " points",
+                      ExitCode::kBadInput});
+        triangles[static_cast<size_t>(t * 3 + c)] = static_cast<uint32_t>(v);
+      }
+    return triangles;
+  };
+  std::vector<uint32_t> triangles = kind == 'u' ? fill(py::array_t<uint64_t>::ensure(table).unchecked<2>())
+                                                : fill(py::array_t<int64_t>::ensure(table).unchecked<2>());
+  if (self)
+    replaceKeepingViews(self, set.triangles, std::move(triangles));
+  else
+    set.triangles = std::move(triangles);
 }
 
 // A view of `rows` × 3 values at `data`, kept alive by `owner`.
@@ -136,10 +180,20 @@ py::array view3(const py::object& owner, const T* data, size_t rows) {
   return py::array_t<T>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(T)}, py::ssize_t{sizeof(T)}}, data, owner);
 }
 
-Result<uint64_t> memoryOption(const py::object& value) {
+// max_memory and the like: None or 0 (the default), bytes as a number, or a size as text ("8G").
+Result<uint64_t> memoryOption(const std::string& name, const py::object& value) {
   if (value.is_none()) return uint64_t{0};
-  if (py::isinstance<py::int_>(value)) return value.cast<uint64_t>();
-  return parseMemorySize("max_memory", py::str(value).cast<std::string>());
+  if (py::isinstance<py::bool_>(value) ||
+      !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) || py::isinstance<py::str>(value)))
+    throw py::type_error(name + ": expected bytes (a number) or a size such as \"8G\", got " +
+                         py::str(py::type::of(value)).cast<std::string>());
+  if (py::isinstance<py::int_>(value)) {
+    if (value.equal(py::int_(0))) return uint64_t{0};
+    if (value < py::int_(0) || value > py::int_(std::numeric_limits<uint64_t>::max()))
+      return Error{name + ": " + py::str(value).cast<std::string>() + " is not a size in bytes", ExitCode::kUsage};
+    return value.cast<uint64_t>();
+  }
+  return parseMemorySize(name, py::str(value).cast<std::string>());
 }
 
 std::optional<LasColorSource> lasColorSource(const std::string& name) {
@@ -157,7 +211,7 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
   const std::optional<LasColorSource> source = lasColorSource(colors);
   if (!source)
     raise(Error{"colors: '" + colors + "' is not one of auto, rgb, intensity, classification, none", ExitCode::kUsage});
-  const uint64_t limit = take(memoryOption(max_memory));
+  const uint64_t limit = take(memoryOption("max_memory", max_memory));
   const FileFormat format = take(formatOf(path));
   const bool gltf = format == FileFormat::kGlb || format == FileFormat::kGltf;
   if (!gltf && (scene >= 0 || all_scenes))
@@ -220,7 +274,7 @@ that memory, without copying (writing into them changes the set).)")
             if (!s.hasColors()) return py::none();
             return view3(self, reinterpret_cast<const float*>(s.colors.data()), s.size());
           },
-          [](PointSet& s, const py::object& colors) { setColors(s, colors); },
+          [](const py::object& self, const py::object& colors) { setColors(self.cast<PointSet&>(), colors, self); },
           "(N, 3) float32 view of the linear 0..1 colours (no copy), or None. Set from uint8 or floats, or None")
       .def_property(
           "triangles",
@@ -229,7 +283,9 @@ that memory, without copying (writing into them changes the set).)")
             if (!s.isMesh()) return py::none();
             return view3(self, s.triangles.data(), s.triangles.size() / 3);
           },
-          [](PointSet& s, const py::object& triangles) { setTriangles(s, triangles); },
+          [](const py::object& self, const py::object& triangles) {
+            setTriangles(self.cast<PointSet&>(), triangles, self);
+          },
           "(M, 3) uint32 view of the triangles' vertex indices (no copy), or None")
       .def_property_readonly("has_z", &PointSet::hasZ, "Whether writers write z (False for a 2D set)")
       .def_readwrite("z_up", &PointSet::z_up, "The source says z is up (LAS): render's fitted views use it")
@@ -240,7 +296,7 @@ that memory, without copying (writing into them changes the set).)")
                (s.hasZ() ? "" : ", 2D") + ">";
       });
 
-  m.def("_memory_size", [](const std::string& flag, const std::string& text) { return take(parseMemorySize(flag, text)); });
+  m.def("_memory_size", [](const std::string& name, const py::object& value) { return take(memoryOption(name, value)); });
 
   m.def(
       "read",
@@ -263,12 +319,18 @@ stderr.)");
       [](const std::shared_ptr<PointSet>& points, const std::string& path, int decimals, bool ply_ascii,
          const std::string& ply_colors, double las_scale, const std::string& order, bool no_colors,
          const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
+        // As convert's --decimals (0..100; -1 here: shortest round trip) and --las-scale (> 0), whatever the format.
+        if (decimals < -1 || decimals > 100)
+          raise(Error{"decimals: " + std::to_string(decimals) + " is not -1 (shortest round trip) or 0..100",
+                      ExitCode::kUsage});
+        if (!(std::isfinite(las_scale) && las_scale > 0.0))
+          raise(Error{"las_scale: " + formatNumber(las_scale) + " is not a finite number > 0", ExitCode::kUsage});
         if (ply_colors != "uchar" && ply_colors != "float")
           raise(Error{"ply_colors: '" + ply_colors + "' is not uchar or float", ExitCode::kUsage});
         if (color_format != "linear" && color_format != "srgb8")
           raise(Error{"color_format: '" + color_format + "' is not linear or srgb8", ExitCode::kUsage});
         const PointOrder point_order = take(parsePointOrder("order", order));
-        const uint64_t limit = take(memoryOption(max_memory));
+        const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
         check(released([&] {
           Progress bar(progressFile(progress), "write");

@@ -2,7 +2,11 @@
 // PointSet in memory or from files, with the picture as a NumPy array and the CLI's JSON report.
 // The options are render's own, parsed by its parser (cli/cli_options.h).
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <mutex>
+
+#include <pybind11/stl/filesystem.h>
 
 #include "cli/cli_options.h"
 #include "image/image.h"
@@ -27,7 +31,11 @@ struct RenderResultPy {
   std::string report_json;  // renderReportJson: render --json's object (empty for a contact sheet)
 };
 
-// One Vulkan device kept across renders: a loop over views or modes makes it once.
+// One Vulkan device kept across renders: a loop over views or modes makes it once. Its renders
+// run one at a time, also when several Python threads share it (the GIL is released while they
+// work): a Vulkan queue takes no two submissions at once, and the validation messages a render
+// reports are the context's since that render began. The lock is taken with the GIL released, so a
+// thread waiting for it holds up no other.
 class Renderer {
  public:
   Renderer(const std::string& device, bool validate, uint64_t max_device_memory) {
@@ -37,27 +45,55 @@ class Renderer {
       return Result<std::shared_ptr<VulkanContext>>(std::shared_ptr<VulkanContext>(std::move(*made)));
     }));
   }
-  const std::shared_ptr<VulkanContext>& context() const {
-    if (!context_) raise(Error{"this Renderer is closed", ExitCode::kUsage});
-    return context_;
+  // Runs `work(context)` (with the GIL released) alone on the device; a closed Renderer's error else.
+  template <typename Work>
+  auto use(Work&& work) -> decltype(work(std::shared_ptr<VulkanContext>())) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!context_) return Error{"this Renderer is closed", ExitCode::kUsage};
+    return work(context_);
   }
-  void close() { context_.reset(); }
+  std::string deviceName() {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!context_) raise(Error{"this Renderer is closed", ExitCode::kUsage});
+    return context_->facts.name;
+  }
+  void close() {
+    std::shared_ptr<VulkanContext> closing;  // destroyed after the lock, with the GIL back
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(mutex_);
+    closing = std::move(context_);
+  }
 
  private:
-  std::shared_ptr<VulkanContext> context_;
+  std::mutex mutex_;
+  std::shared_ptr<VulkanContext> context_;  // null once closed
 };
 
 RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
-                          const std::vector<std::string>& args, const Renderer* renderer, bool progress) {
-  RenderRequest request = take(renderRequestOf(args));
-  if (points)
+                          const std::vector<std::string>& args, Renderer* renderer, bool progress) {
+  Result<RenderRequest> parsed = renderRequestOf(args);
+  if (!parsed) raise(asCommandError(parsed.error(), "render", "render"));
+  RenderRequest request = std::move(*parsed);
+  // renderRequestOf asks for the report (render --json's) always, which --views 4 refuses; a contact
+  // sheet comes back without one (RenderResult.report is None).
+  request.report = request.views == 1;
+  if (points) {
     request.points = points;
-  else
+    // The up axis of a set in memory is its own (PointSet::z_up), as a file's is for the CLI. Left
+    // to auto, zUpFor would take the empty input list for "every input is .las" and fit every set
+    // in memory z-up: another view, bound and picture than `dpoint render` of the same points.
+    if (request.up_axis == UpAxis::kAuto) request.up_axis = points->z_up ? UpAxis::kZ : UpAxis::kY;
+  } else {
     request.inputs = inputs;
-  if (renderer) request.context = renderer->context();
-  RenderOutcome outcome = take(released([&] {
+  }
+  RenderOutcome outcome = take(released([&]() -> Result<RenderOutcome> {
     Progress bar(progressFile(progress), "render");
-    return runRenderJob(request, bar);
+    if (!renderer) return runRenderJob(request, bar);
+    return renderer->use([&](const std::shared_ptr<VulkanContext>& context) {
+      request.context = context;
+      return runRenderJob(request, bar);
+    });
   }));
   // As the CLI: with the validation layer on, any message fails the run.
   if (!outcome.validation_messages.empty()) {
@@ -122,7 +158,8 @@ Jupyter the result shows as its picture.)")
              std::vector<unsigned char> bytes = take(pngBytes(r.image, "the picture"));
              return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
            }, "The picture as the bytes of the PNG file the CLI writes")
-      .def("save", [](const RenderResultPy& r, const std::string& path) {
+      .def("save", [](const RenderResultPy& r, const std::filesystem::path& file) {  // a str or os.PathLike
+             const std::string path = file.string();
              check(checkPictureOutput(path));
              check(writePng(path, r.image));
            }, py::arg("path"), "Writes the picture as PNG, whole or not at all");
@@ -130,7 +167,7 @@ Jupyter the result shows as its picture.)")
   py::class_<Renderer, std::shared_ptr<Renderer>>(m, "_Renderer")
       .def(py::init<const std::string&, bool, uint64_t>(), py::arg("device"), py::arg("validate"),
            py::arg("max_device_memory"))
-      .def_property_readonly("device", [](const Renderer& r) { return r.context()->facts.name; })
+      .def_property_readonly("device", &Renderer::deviceName)
       .def("close", &Renderer::close);
 
   m.def("_render", &renderWith, py::arg("points"), py::arg("inputs"), py::arg("args"), py::arg("renderer"),

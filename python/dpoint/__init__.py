@@ -23,6 +23,7 @@ second with ``KeyboardInterrupt`` and leaves no output file. Long calls release 
 from __future__ import annotations
 
 import json as _json
+import numbers as _numbers
 import os as _os
 import warnings as _warnings
 
@@ -42,17 +43,20 @@ class RenderWarning(UserWarning):
 def _value(value) -> str:
     if isinstance(value, bool):
         raise TypeError("a flag takes True or False only as the whole value")
-    if isinstance(value, float):
-        return repr(value)  # the shortest text that reads back to the same double
-    if isinstance(value, (str, int)):
-        return str(value)
+    if isinstance(value, str):
+        return value
+    # float() and int() first: a subclass's repr is its own (NumPy 2 gives "np.float64(0.5)").
+    if isinstance(value, _numbers.Integral):
+        return str(int(value))
+    if isinstance(value, _numbers.Real):
+        return repr(float(value))  # the shortest text that reads back to the same double
     if isinstance(value, _os.PathLike):
         return _os.fspath(value)
     try:
         items = list(value)
     except TypeError:
         return str(value)
-    return ",".join(_value(float(v) if not isinstance(v, (int, float)) else v) for v in items)
+    return ",".join(_value(v if isinstance(v, _numbers.Real) else float(v)) for v in items)
 
 
 def _args(options: dict) -> list[str]:
@@ -128,8 +132,9 @@ RenderResult.__repr__ = lambda self: (
 
 
 def _warn(result: RenderResult) -> RenderResult:
+    # Shown at the caller's line: _warn <- _render <- render or Renderer.render <- the caller.
     for line in result.warnings:
-        _warnings.warn(line, RenderWarning, stacklevel=3)
+        _warnings.warn(line, RenderWarning, stacklevel=4)
     return result
 
 
@@ -142,10 +147,7 @@ class Renderer:
     """
 
     def __init__(self, device: str | int = "auto", *, validate: bool = False, max_device_memory=None):
-        limit = 0
-        if max_device_memory is not None:
-            limit = max_device_memory if isinstance(max_device_memory, int) else _dpoint._memory_size(
-                "max_device_memory", str(max_device_memory))
+        limit = _dpoint._memory_size("max_device_memory", max_device_memory)
         self._renderer = _dpoint._Renderer(str(device), validate, limit)
 
     @property
@@ -229,9 +231,7 @@ def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool
     sampled for the nearest-neighbour distance.
     """
     in_memory, inputs = _as_points(points)
-    limit = 0
-    if max_memory is not None:
-        limit = max_memory if isinstance(max_memory, int) else _dpoint._memory_size("max_memory", str(max_memory))
+    limit = _dpoint._memory_size("max_memory", max_memory)
     text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit, progress)
     return _json.loads(text)
 

@@ -90,7 +90,7 @@ def read(
     progress: bool = False,
 ) -> PointSet: ...
 def write(
-    points: PointSet,
+    points: PointSet | npt.ArrayLike | Any,  # Any: a pandas DataFrame
     path: PathType,
     *,
     decimals: int = -1,
@@ -106,6 +106,16 @@ def write(
     progress: bool = False,
 ) -> None: ...
 def generate(kind: str, *, progress: bool = False, **options: Any) -> PointSet: ...
-def info(points: Points, *, sample: int = 10000, progress: bool = False, **camera: Any) -> dict[str, Any]: ...
+def info(
+    points: Points,
+    *,
+    sample: int = 10000,
+    threads: int = 0,
+    allow_nonfinite: bool = False,
+    stream: str = "auto",
+    max_memory: int | str | None = None,
+    progress: bool = False,
+    **camera: Any,
+) -> dict[str, Any]: ...
 def render(points: Points, mode: str = "auto", *, progress: bool = False, **options: Any) -> RenderResult: ...
 def bench(suite: str = "ci", out: PathType = "bench-out", *, progress: bool = True, **options: Any) -> dict[str, Any]: ...

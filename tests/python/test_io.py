@@ -1,0 +1,200 @@
+"""dpoint.read and dpoint.write: every format round-trips, every option writes the bytes `dpoint
+convert` writes with the same option, and the limits and refusals are convert's."""
+import numpy as np
+import pytest
+
+import dpoint
+from conftest import cli, options_as_flags
+
+FORMATS = ["csv", "ply", "glb", "las"]
+
+
+@pytest.fixture
+def source(tmp_path, rng):
+    """A set with colours, a duplicate point and far-off coordinates, as a PLY file and as read."""
+    positions = rng.normal(size=(300, 3)) * 1e4 + np.array([6378137.0, -1e5, 2e3])
+    positions[7] = positions[3]  # for unique
+    s = dpoint.PointSet(positions, rng.integers(0, 256, (300, 3), dtype=np.uint8))
+    path = tmp_path / "source.ply"
+    dpoint.write(s, path)
+    return path, dpoint.read(path)
+
+
+@pytest.mark.parametrize("ext", ["csv", "ply", "glb"])
+def test_write_then_read_is_bit_exact(tmp_path, ext, cloud):
+    s, positions, colors = cloud
+    dpoint.write(s, tmp_path / f"c.{ext}")
+    back = dpoint.read(tmp_path / f"c.{ext}")
+    assert back.positions.tobytes() == positions.tobytes()
+    assert np.array_equal(back.colors, s.colors)
+
+
+def test_las_holds_positions_to_its_scale(tmp_path, cloud):
+    s, positions, _ = cloud
+    dpoint.write(s, tmp_path / "c.las", las_scale=0.01)
+    back = dpoint.read(tmp_path / "c.las")
+    assert np.abs(back.positions - positions).max() <= 0.005 + 1e-9
+    assert np.array_equal(back.colors, s.colors)
+    assert back.z_up  # the LAS reader says z is up
+
+
+def test_las_round_trip_is_exact_on_its_grid(tmp_path, rng):
+    positions = rng.integers(-10**6, 10**6, size=(100, 3)) * 0.25 + 6378137.0  # multiples of the scale
+    dpoint.write(dpoint.PointSet(positions), tmp_path / "g.las", las_scale=0.25)
+    assert np.array_equal(dpoint.read(tmp_path / "g.las").positions, positions)
+
+
+@pytest.mark.parametrize("ext", ["ply", "glb"])
+def test_a_mesh_keeps_its_triangles(tmp_path, ext):
+    mesh = dpoint.generate("menger", level=1, colors="none")
+    dpoint.write(mesh, tmp_path / f"m.{ext}")
+    back = dpoint.read(tmp_path / f"m.{ext}")
+    assert np.array_equal(back.triangles, mesh.triangles) and np.array_equal(back.positions, mesh.positions)
+
+
+def test_a_2d_set_is_written_without_z(tmp_path):
+    dpoint.write(dpoint.PointSet(np.array([[1.0, 2.0], [3.0, 4.0]])), tmp_path / "flat.csv")
+    assert (tmp_path / "flat.csv").read_text().splitlines() == ["x,y", "1,2", "3,4"]
+    assert not dpoint.read(tmp_path / "flat.csv").has_z
+
+
+# Each write option against convert's: the same bytes.
+WRITE_OPTIONS = [
+    ("csv", {}),
+    ("csv", dict(decimals=3)),
+    ("csv", dict(decimals=0)),
+    ("csv", dict(no_colors=True)),
+    ("csv", dict(color_format="srgb8")),
+    ("ply", {}),
+    ("ply", dict(ply_ascii=True)),
+    ("ply", dict(ply_colors="float")),
+    ("ply", dict(ply_ascii=True, ply_colors="float")),
+    ("ply", dict(order="morton")),
+    ("ply", dict(unique=True)),
+    ("ply", dict(unique=True, order="morton", no_colors=True)),
+    ("glb", {}),
+    ("glb", dict(no_colors=True)),
+    ("las", {}),
+    ("las", dict(las_scale=0.01)),
+    ("las", dict(las_scale=0.5, order="morton")),
+]
+
+
+@pytest.mark.parametrize("ext, options", WRITE_OPTIONS, ids=[f"{e}-{'-'.join(o) or 'default'}" for e, o in WRITE_OPTIONS])
+def test_write_options_give_converts_bytes(tmp_path, source, ext, options):
+    path, points = source
+    dpoint.write(points, tmp_path / f"py.{ext}", **options)
+    cli("convert", path, "-o", tmp_path / f"cli.{ext}", "--quiet", *options_as_flags(options))
+    assert (tmp_path / f"py.{ext}").read_bytes() == (tmp_path / f"cli.{ext}").read_bytes()
+
+
+def test_write_options_do_what_they_say(tmp_path, source):
+    _, points = source
+    dpoint.write(points, tmp_path / "a.ply", ply_ascii=True, ply_colors="float")
+    header = (tmp_path / "a.ply").read_bytes().split(b"end_header")[0].decode()
+    assert "format ascii 1.0" in header and "property float red" in header
+    dpoint.write(points, tmp_path / "d.csv", decimals=2)
+    first = (tmp_path / "d.csv").read_text().splitlines()[1].split(",")
+    assert all(len(v.split(".")[1]) == 2 for v in first[:3])
+    dpoint.write(points, tmp_path / "u.ply", unique=True, no_colors=True)
+    unique = dpoint.read(tmp_path / "u.ply")
+    assert len(unique) == len(points) - 1 and unique.colors is None
+    dpoint.write(points, tmp_path / "o.ply", order="morton")
+    ordered = dpoint.read(tmp_path / "o.ply").positions
+    assert not np.array_equal(ordered, points.positions)
+    assert np.array_equal(np.sort(ordered, axis=0), np.sort(points.positions, axis=0))
+    # The options act on a copy: the caller's set is as it was.
+    assert len(points) == 300 and points.colors is not None
+
+
+@pytest.mark.parametrize("options, words", [
+    (dict(decimals=101), "decimals: 101 is not -1 (shortest round trip) or 0..100"),
+    (dict(decimals=-2), "decimals: -2 is not -1"),
+    (dict(las_scale=0.0), "las_scale: 0 is not a finite number > 0"),
+    (dict(las_scale=-1.0), "las_scale: -1 is not a finite number > 0"),
+    (dict(las_scale=float("nan")), "las_scale: nan is not a finite number > 0"),
+    (dict(order="hilbert"), "order must be input or morton, got 'hilbert'"),
+    (dict(ply_colors="half"), "ply_colors: 'half' is not uchar or float"),
+    (dict(color_format="srgb"), "color_format: 'srgb' is not linear or srgb8"),
+    (dict(max_memory="lots"), "max_memory: 'lots' is not a size"),
+    (dict(max_memory=-1), "max_memory: -1 is not a size in bytes"),
+])
+def test_write_refuses_bad_options_and_writes_nothing(tmp_path, cloud, options, words):
+    s, _, _ = cloud
+    with pytest.raises(dpoint.Error) as raised:
+        dpoint.write(s, tmp_path / "out.csv", **options)
+    assert words in str(raised.value)
+    assert raised.value.exit_code == 1
+    assert not (tmp_path / "out.csv").exists()
+
+
+def test_write_refuses_a_non_size_type(tmp_path, cloud):
+    with pytest.raises(TypeError, match="max_memory: expected bytes"):
+        dpoint.write(cloud[0], tmp_path / "out.csv", max_memory=[1])
+
+
+def test_write_of_a_file_name_is_a_type_error(tmp_path):
+    with pytest.raises(TypeError, match="write: points must be a PointSet or an array"):
+        dpoint.write("in.ply", tmp_path / "out.ply")
+
+
+def test_unknown_extension_and_missing_folder(tmp_path, cloud):
+    s, _, _ = cloud
+    with pytest.raises(dpoint.Error, match=r"unknown file type '\.xyz'"):
+        dpoint.write(s, tmp_path / "out.xyz")
+    with pytest.raises(dpoint.Error, match="folder .* does not exist"):
+        dpoint.write(s, tmp_path / "no" / "out.ply")
+    with pytest.raises(dpoint.Error, match=r"unknown file type '\.xyz'"):
+        dpoint.read(tmp_path / "in.xyz")
+
+
+def test_read_of_a_missing_file_names_it(tmp_path):
+    missing = tmp_path / "missing.ply"
+    with pytest.raises(dpoint.Error) as raised:
+        dpoint.read(missing)
+    assert str(raised.value) == f"{missing}: file not found"
+    assert raised.value.exit_code == 2
+    assert isinstance(raised.value, ValueError)
+
+
+def test_read_options(tmp_path, source):
+    path, points = source
+    assert dpoint.read(path, colors="none").colors is None
+    assert np.array_equal(dpoint.read(path, colors="rgb").colors, points.colors)
+    assert len(dpoint.read(path, max_points=300)) == 300
+    with pytest.raises(MemoryError, match="300 points exceed max_points 299"):
+        dpoint.read(path, max_points=299)
+    with pytest.raises(dpoint.Error, match="colour by intensity needs a LAS file"):
+        dpoint.read(path, colors="intensity")
+    with pytest.raises(dpoint.Error, match="colors: 'rainbow' is not one of auto, rgb"):
+        dpoint.read(path, colors="rainbow")
+    with pytest.raises(dpoint.Error, match="scene and all_scenes apply to .glb/.gltf input only"):
+        dpoint.read(path, scene=0)
+    dpoint.write(points, tmp_path / "s.glb")
+    assert np.array_equal(dpoint.read(tmp_path / "s.glb", scene=0).positions, points.positions)
+    assert np.array_equal(dpoint.read(tmp_path / "s.glb", all_scenes=True).positions, points.positions)
+
+
+def test_read_non_finite_only_when_allowed(tmp_path):
+    (tmp_path / "nan.csv").write_text("x,y,z\n0,0,0\n1,nan,2\n")
+    with pytest.raises(dpoint.Error, match="nan.csv:3: column 2: 'nan' is not a finite number"):
+        dpoint.read(tmp_path / "nan.csv")
+    assert np.isnan(dpoint.read(tmp_path / "nan.csv", allow_nonfinite=True).positions[1, 1])
+
+
+def test_read_beyond_max_memory_is_a_memory_error(tmp_path, source):
+    path, _ = source
+    with pytest.raises(MemoryError) as raised:
+        dpoint.read(path, max_memory="1K")
+    assert "more than the limit of 1024 bytes" in str(raised.value)
+    assert raised.value.exit_code == 4
+    # convert says the same of the same file
+    done = cli("convert", path, "-o", path.with_suffix(".csv"), "--max-memory", "1K", check=False)
+    assert done.returncode == 4 and str(raised.value) in done.stderr
+
+
+def test_write_beyond_max_memory_is_a_memory_error(tmp_path, source):
+    _, points = source
+    with pytest.raises(MemoryError, match="ordering 300 points needs about"):
+        dpoint.write(points, tmp_path / "o.ply", order="morton", max_memory=1000)
+    assert not (tmp_path / "o.ply").exists()

@@ -1,0 +1,304 @@
+"""dpoint.PointSet: made from NumPy arrays and DataFrames, its arrays views of its own memory, and
+clear errors (never a crash) for arrays it cannot take."""
+import gc
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import dpoint
+
+
+def test_from_positions_keeps_every_double(rng):
+    positions = rng.normal(size=(100, 3)) * 1e7
+    positions[0] = [6378137.000000001, -5e-324, 1.7976931348623157e308]
+    s = dpoint.PointSet(positions)
+    assert len(s) == 100
+    assert s.positions.dtype == np.float64 and s.positions.shape == (100, 3)
+    assert s.positions.tobytes() == positions.tobytes()  # bit for bit, -0.0 and subnormals included
+    assert s.colors is None and s.triangles is None
+    assert s.has_z
+
+
+def test_from_two_columns_is_a_2d_set():
+    s = dpoint.PointSet(np.array([[1.5, 2.5], [3.5, -4.5]]))
+    assert s.positions.tolist() == [[1.5, 2.5, 0.0], [3.5, -4.5, 0.0]]
+    assert not s.has_z
+    assert "2D" in repr(s)
+
+
+def test_other_real_dtypes_are_converted():
+    s = dpoint.PointSet(np.arange(12, dtype=np.int32).reshape(4, 3))
+    assert s.positions.dtype == np.float64
+    assert s.positions.tolist() == np.arange(12.0).reshape(4, 3).tolist()
+    f32 = np.array([[0.1, 0.2, 0.3]], dtype=np.float32)
+    assert dpoint.PointSet(f32).positions.tolist() == f32.astype(np.float64).tolist()
+
+
+def test_uint8_colours_read_as_the_ply_reader_reads_them(rng):
+    colors = rng.integers(0, 256, size=(50, 3), dtype=np.uint8)
+    colors[0] = [0, 128, 255]
+    s = dpoint.PointSet(rng.random((50, 3)), colors)
+    assert s.colors.dtype == np.float32 and s.colors.shape == (50, 3)
+    assert np.array_equal(s.colors, colors.astype(np.float32) / np.float32(255))
+    assert s.colors[0].tolist() == [0.0, np.float32(128) / np.float32(255), 1.0]
+
+
+def test_float_colours_are_kept_as_linear_0_to_1(rng):
+    colors = rng.random((50, 3))
+    s = dpoint.PointSet(rng.random((50, 3)), colors)
+    assert np.array_equal(s.colors, colors.astype(np.float32))
+
+
+def test_triangles(rng):
+    s = dpoint.PointSet(rng.random((4, 3)), None, [[0, 1, 2], [1, 2, 3]])
+    assert s.triangles.dtype == np.uint32
+    assert s.triangles.tolist() == [[0, 1, 2], [1, 2, 3]]
+    assert "2 triangles" in repr(s)
+    s.triangles = None
+    assert s.triangles is None
+
+
+def test_views_share_the_sets_memory(rng):
+    s = dpoint.PointSet(rng.random((10, 3)), rng.integers(0, 256, (10, 3), dtype=np.uint8), [[0, 1, 2]])
+    for name in ("positions", "colors", "triangles"):
+        a, b = getattr(s, name), getattr(s, name)
+        assert np.shares_memory(a, b), name
+        assert a.flags.writeable, name
+    s.positions[3] = [7.0, 8.0, 9.0]
+    assert s.positions[3].tolist() == [7.0, 8.0, 9.0]
+    s.colors[3] = 0.5
+    assert s.colors[3].tolist() == [0.5, 0.5, 0.5]
+
+
+def test_a_view_keeps_the_set_alive(rng):
+    positions = rng.random((1000, 3))
+    view = dpoint.PointSet(positions).positions
+    gc.collect()
+    np.ones(10**6)  # reuse freed memory, if the set was freed
+    assert np.array_equal(view, positions)
+
+
+def test_writing_through_positions_changes_what_write_and_render_see(tmp_path, rng):
+    original = rng.random((300, 3))
+    s = dpoint.PointSet(original)
+    s.positions[0] = [1e6, 2e6, 3e6]
+    dpoint.write(s, tmp_path / "moved.ply")
+    assert dpoint.read(tmp_path / "moved.ply").positions[0].tolist() == [1e6, 2e6, 3e6]
+    assert dpoint.info(s)["max"] == [1e6, 2e6, 3e6]
+
+    s.positions[0] = original[0]
+    view = dict(width=64, height=48, point_size=3, validate=True)
+    before = dpoint.render(s, **view).image.copy()
+    s.positions[:, 1] *= 0.5  # squash in place
+    after = dpoint.render(s, **view).image
+    expected = original.copy()
+    expected[:, 1] *= 0.5
+    assert np.array_equal(after, dpoint.render(dpoint.PointSet(expected), **view).image)
+    assert not np.array_equal(after, before)
+
+
+def test_setting_colours_or_triangles_leaves_earlier_views_valid(rng):
+    """A view taken before a set's colours or triangles are replaced still reads valid memory
+    (no use after free): an equal-size value is copied into the same storage, a larger one gets
+    new storage while the old is kept."""
+    s = dpoint.PointSet(rng.random((6, 3)), np.zeros((6, 3), np.uint8), [[0, 1, 2]])
+    colors, triangles = s.colors, s.triangles
+    s.colors = np.ones((6, 3), np.float32)
+    assert np.shares_memory(colors, s.colors) and colors.tolist() == [[1.0] * 3] * 6
+    s.triangles = np.array([[3, 4, 5]] * 5000)
+    s.colors = None
+    np.ones(10**6)  # reuse freed memory, if the old storage was freed
+    assert triangles.tolist() == [[0, 1, 2]]
+    assert s.triangles.shape == (5000, 3) and s.colors is None
+    del s
+    gc.collect()
+    assert triangles.tolist() == [[0, 1, 2]]
+
+
+def test_non_contiguous_and_read_only_arrays_give_the_same_set(rng):
+    base = rng.random((20, 3))
+    colors = rng.integers(0, 256, (20, 3), dtype=np.uint8)
+    expected = dpoint.PointSet(base[::2].copy(), colors[::2].copy())
+    strided = dpoint.PointSet(base[::2], colors[::2])
+    assert np.array_equal(strided.positions, expected.positions) and np.array_equal(strided.colors, expected.colors)
+
+    fortran = dpoint.PointSet(np.asfortranarray(base), np.asfortranarray(colors), np.asfortranarray([[0, 1, 2]]))
+    assert np.array_equal(fortran.positions, base) and fortran.triangles.tolist() == [[0, 1, 2]]
+
+    read_only, read_only_colors = base.copy(), colors.copy()
+    read_only.flags.writeable = read_only_colors.flags.writeable = False
+    frozen = dpoint.PointSet(read_only, read_only_colors)
+    assert np.array_equal(frozen.positions, base) and np.array_equal(frozen.colors, expected_colors(colors))
+    frozen.positions[0] = 1.0  # the set's own copy is writable
+
+    big_endian = dpoint.PointSet(base.astype(">f8"))
+    assert np.array_equal(big_endian.positions, base)
+    reversed_rows = dpoint.PointSet(base[::-1])
+    assert np.array_equal(reversed_rows.positions, base[::-1])
+
+
+def expected_colors(uint8_colors):
+    return uint8_colors.astype(np.float32) / np.float32(255)
+
+
+def test_a_plain_list_is_taken():
+    assert dpoint.PointSet([[1, 2, 3], [4, 5, 6]]).positions.tolist() == [[1, 2, 3], [4, 5, 6]]
+
+
+@pytest.mark.parametrize("positions, error, words", [
+    (np.zeros((3, 3), dtype=object), TypeError, "positions: expected real numbers, got dtype object"),
+    (np.zeros((3, 3), dtype=complex), TypeError, "got dtype complex128"),
+    (np.array([["a", "b", "c"]]), TypeError, "got dtype <U1"),
+    (np.zeros((3, 3)).view([("a", "f8"), ("b", "f8"), ("c", "f8")]), TypeError, "expected real numbers"),
+    ("not an array", TypeError, "positions: expected real numbers"),
+    (None, TypeError, "positions"),
+    (np.zeros(3), ValueError, "positions: expected shape (N, 3) or (N, 2), got (3,)"),
+    (np.zeros((3, 4)), ValueError, "got (3, 4)"),
+    (np.zeros((3, 1)), ValueError, "got (3, 1)"),
+    (np.zeros((2, 3, 1)), ValueError, "got (2, 3, 1)"),
+])
+def test_positions_it_cannot_take(positions, error, words):
+    with pytest.raises(error) as raised:
+        dpoint.PointSet(positions)
+    assert words in str(raised.value)
+    assert not isinstance(raised.value, dpoint.Error)  # a programming error, not bad data
+
+
+@pytest.mark.parametrize("colors, error, words", [
+    (np.zeros((9, 3), np.uint8), ValueError, "colors: 9 rows for 10 points"),
+    (np.zeros((10, 4), np.uint8), ValueError, "colors: expected shape (N, 3), got (10, 4)"),
+    (np.zeros(30, np.uint8), ValueError, "got (30,)"),
+    (np.zeros((10, 3), np.int64), TypeError, "colors: expected uint8 (0..255) or floats (0..1), got dtype int64"),
+    (np.zeros((10, 3), complex), TypeError, "complex128"),
+    (np.zeros((10, 3), object), TypeError, "object"),
+])
+def test_colours_it_cannot_take(rng, colors, error, words):
+    with pytest.raises(error) as raised:
+        dpoint.PointSet(rng.random((10, 3)), colors)
+    assert words in str(raised.value)
+
+
+@pytest.mark.parametrize("value, shown", [(1.5, "1.500000"), (-0.25, "-0.250000"), (np.nan, "nan"), (np.inf, "inf")])
+def test_float_colours_outside_0_to_1_are_bad_data(rng, value, shown):
+    colors = np.full((10, 3), 0.5)
+    colors[7, 2] = value
+    with pytest.raises(dpoint.Error) as raised:
+        dpoint.PointSet(rng.random((10, 3)), colors)
+    assert str(raised.value).startswith(f"colors: row 7, column 2: {shown} is outside 0..1")
+    assert raised.value.exit_code == 2
+
+
+@pytest.mark.parametrize("triangles, error, words", [
+    ([[0, 1, 10]], dpoint.Error, "triangles: row 0: vertex 10 is not one of the 10 points"),
+    ([[0, 1, 2], [0, -1, 2]], dpoint.Error, "triangles: row 1: vertex -1 is not one of the 10 points"),
+    (np.array([[0, 1, 2**63 + 1]], np.uint64), dpoint.Error, "vertex 9223372036854775809 is not one of"),
+    (np.array([[0.0, 1.0, 2.0]]), TypeError, "triangles: expected integers, got dtype float64"),
+    (np.array([[0, 1]]), ValueError, "triangles: expected shape (N, 3), got (1, 2)"),
+])
+def test_triangles_it_cannot_take(rng, triangles, error, words):
+    with pytest.raises(error) as raised:
+        dpoint.PointSet(rng.random((10, 3)), None, triangles)
+    assert words in str(raised.value)
+
+
+def test_a_failed_setter_leaves_the_set_as_it_was(rng):
+    s = dpoint.PointSet(rng.random((10, 3)), np.zeros((10, 3), np.uint8), [[0, 1, 2]])
+    with pytest.raises(ValueError):
+        s.colors = np.zeros((3, 3), np.uint8)
+    with pytest.raises(dpoint.Error):
+        s.triangles = [[0, 1, 99]]
+    assert s.colors.tolist() == [[0.0] * 3] * 10 and s.triangles.tolist() == [[0, 1, 2]]
+
+
+@pytest.mark.parametrize("row, axis, value, shown", [(0, 2, np.nan, "nan"), (3, 1, -np.inf, "-inf"), (5, 0, np.inf, "inf")])
+def test_non_finite_positions_name_row_and_axis(row, axis, value, shown):
+    positions = np.zeros((6, 3))
+    positions[row, axis] = value
+    with pytest.raises(dpoint.Error) as raised:
+        dpoint.PointSet(positions)
+    assert str(raised.value) == (f"positions: row {row}, {'xyz'[axis]}: {shown} is not a finite coordinate "
+                                 "(allow_nonfinite=True keeps it)")
+    kept = dpoint.PointSet(positions, allow_nonfinite=True)
+    assert kept.positions[row, axis] == value or (np.isnan(value) and np.isnan(kept.positions[row, axis]))
+
+
+def test_an_empty_set(tmp_path):
+    s = dpoint.PointSet(np.zeros((0, 3)))
+    assert len(s) == 0 and s.positions.shape == (0, 3) and s.colors is None
+    with pytest.raises(dpoint.Error, match="no points to render"):
+        dpoint.render(s, validate=True)
+    for ext in ("csv", "ply"):
+        dpoint.write(s, tmp_path / f"empty.{ext}")
+        assert len(dpoint.read(tmp_path / f"empty.{ext}")) == 0
+    with pytest.raises(dpoint.Error, match="the point set is empty"):
+        dpoint.write(s, tmp_path / "empty.glb")
+    assert not (tmp_path / "empty.glb").exists()
+    assert dpoint.info(s)["points"] == 0
+
+
+def test_copy_is_deep(rng):
+    s = dpoint.PointSet(rng.random((5, 3)))
+    c = s.copy()
+    c.positions[0] = 42.0
+    assert s.positions[0].tolist() != [42.0] * 3
+    assert not np.shares_memory(s.positions, c.positions)
+
+
+def test_from_dataframe_with_integer_colours(rng):
+    frame = pd.DataFrame({"X": rng.random(20), "Y": rng.random(20), "Z": rng.random(20),
+                          "R": rng.integers(0, 256, 20), "G": rng.integers(0, 256, 20), "B": rng.integers(0, 256, 20)})
+    s = dpoint.PointSet.from_dataframe(frame)
+    assert np.array_equal(s.positions, frame[["X", "Y", "Z"]].to_numpy())
+    assert np.array_equal(s.colors, expected_colors(frame[["R", "G", "B"]].to_numpy().astype(np.uint8)))
+
+
+def test_from_dataframe_with_float_colours_and_without_z(rng):
+    frame = pd.DataFrame({"x": rng.random(20), "y": rng.random(20), "r": rng.random(20), "g": rng.random(20),
+                          "b": rng.random(20)})
+    s = dpoint.PointSet.from_dataframe(frame)
+    assert not s.has_z
+    assert np.array_equal(s.colors, frame[["r", "g", "b"]].to_numpy().astype(np.float32))
+
+
+def test_to_dataframe_and_back(rng):
+    s = dpoint.PointSet(rng.random((20, 3)), rng.integers(0, 256, (20, 3), dtype=np.uint8))
+    frame = s.to_dataframe()
+    assert list(frame.columns) == ["x", "y", "z", "r", "g", "b"]
+    assert frame.x.dtype == np.float64 and frame.r.dtype == np.float32
+    assert np.array_equal(frame[["x", "y", "z"]].to_numpy(), s.positions)
+    frame.loc[0, "x"] = 99.0  # a copy: the set stays
+    assert s.positions[0, 0] != 99.0
+    back = dpoint.PointSet.from_dataframe(s.to_dataframe())
+    assert np.array_equal(back.positions, s.positions) and np.array_equal(back.colors, s.colors)
+    assert list(dpoint.PointSet(rng.random((3, 3))).to_dataframe().columns) == ["x", "y", "z"]
+
+
+def test_a_csv_pandas_reads_makes_the_set_dpoint_reads(tmp_path, rng):
+    s = dpoint.PointSet(rng.normal(size=(100, 3)) * 1e6, rng.integers(0, 256, (100, 3), dtype=np.uint8))
+    dpoint.write(s, tmp_path / "p.csv")
+    via_pandas = dpoint.PointSet.from_dataframe(pd.read_csv(tmp_path / "p.csv", float_precision="round_trip"))
+    via_dpoint = dpoint.read(tmp_path / "p.csv")
+    assert np.array_equal(via_pandas.positions, via_dpoint.positions)
+    assert np.array_equal(via_pandas.positions, s.positions)
+
+
+@pytest.mark.parametrize("frame, words", [
+    (pd.DataFrame({"x": [1.0], "z": [2.0]}), "DataFrame: no column y (columns: x, z)"),
+    (pd.DataFrame({0: [1.0], 1: [2.0]}), "DataFrame: no column x, y"),
+    (pd.DataFrame({"x": [1.0], "y": [2.0], "r": [300], "g": [0], "b": [0]}), "r, g, b must lie in 0..255"),
+    (pd.DataFrame({"x": [np.nan], "y": [2.0]}), "positions: row 0, x: nan is not a finite coordinate"),
+])
+def test_dataframes_it_cannot_take(frame, words):
+    with pytest.raises(dpoint.Error) as raised:
+        dpoint.PointSet.from_dataframe(frame)
+    assert words in str(raised.value)
+    assert raised.value.exit_code == 2
+
+
+def test_a_dataframe_goes_wherever_points_go(tmp_path, rng):
+    frame = pd.DataFrame({"x": rng.random(30), "y": rng.random(30), "z": rng.random(30)})
+    dpoint.write(frame, tmp_path / "f.ply")
+    assert np.array_equal(dpoint.read(tmp_path / "f.ply").positions, frame.to_numpy())
+    assert dpoint.info(frame)["points"] == 30
+    assert dpoint.render(frame, width=32, height=32, validate=True).points == 30
