@@ -6,25 +6,25 @@
 
 namespace dpoint {
 
-Status parseOptions(CLI::App& app, const std::vector<std::string>& args) {
-  std::vector<const char*> argv = {app.get_name().c_str()};
+Status parseOptions(CLI::App& dpoint, const std::string& command, const std::vector<std::string>& args) {
+  std::vector<const char*> argv = {"dpoint", command.c_str()};
   for (const std::string& a : args) argv.push_back(a.c_str());
   const int argc = static_cast<int>(argv.size());
   try {
-    app.parse(argc, argv.data());
-  } catch (const CLI::ParseError& e) {
-    if (std::optional<std::string> unknown = unknownOptionMessage(app, argc, argv.data()))
+    dpoint.parse(argc, argv.data());
+  } catch (const CLI::ParseError& e) {  // as the executable reports it (cli_run.cpp)
+    if (std::optional<std::string> unknown = unknownOptionMessage(dpoint, argc, argv.data()))
       return Error{*unknown, ExitCode::kUsage};
-    return Error{app.get_name() + ": " + e.what(), ExitCode::kUsage};
+    return Error{e.what(), ExitCode::kUsage};
   }
   return okStatus();
 }
 
 Result<CameraRequest> cameraRequestOf(const std::vector<std::string>& args) {
-  CLI::App app{"the camera options of render and info", "camera"};
+  CLI::App dpoint{"", "dpoint"};
   CameraCliOptions o;
-  addCameraOptions(app, o);
-  if (Status s = parseOptions(app, args); !s) return s.error();
+  addCameraOptions(*dpoint.add_subcommand("info"), o);
+  if (Status s = parseOptions(dpoint, "info", args); !s) return s.error();
   Result<CameraSpec> spec = cameraSpec(o);
   if (!spec) return spec.error();
   return CameraRequest{*spec, *parseTolerance(o.tolerance)};

@@ -14,15 +14,16 @@
 
 namespace dpoint {
 
-// Parses `args` (options only, as on the command line) with `app`; CLI11's refusals and dpoint's own
-// validators' come back as kUsage errors naming the option, with the nearest known option for an
-// unknown one.
-Status parseOptions(CLI::App& app, const std::vector<std::string>& args);
+// Parses `dpoint COMMAND ARGS` (ARGS: options only, as on the command line) with `dpoint`, an app
+// holding COMMAND as a subcommand; CLI11's refusals and dpoint's own validators' come back as the
+// executable words them (kUsage, naming the option; the nearest known option for an unknown one).
+Status parseOptions(CLI::App& dpoint, const std::string& command, const std::vector<std::string>& args);
 
-// `dpoint render`'s options less the input, -o and --json: the request they make (report on).
+// `dpoint render`'s options less the input, -o and --json: the request they make (with the report
+// for one view: render --json's).
 Result<RenderRequest> renderRequestOf(const std::vector<std::string>& args);
 
-// The camera options render and info share (--width … --tolerance).
+// The camera options render and info share (--width … --tolerance), as info's.
 struct CameraRequest {
   CameraSpec spec;
   double tolerance_px = 0.0;

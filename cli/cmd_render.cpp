@@ -344,11 +344,11 @@ void addRenderCommand(CLI::App& app, RunCommand& run) {
 
 Result<RenderRequest> renderRequestOf(const std::vector<std::string>& args) {
   auto o = std::make_shared<RenderCliOptions>();
-  CLI::App app{renderDescription(), "render"};
-  addRenderOptions(&app, o, false);
-  if (Status s = parseOptions(app, args); !s) return s.error();
+  CLI::App dpoint{"", "dpoint"};
+  addRenderOptions(dpoint.add_subcommand("render", renderDescription()), o, false);
+  if (Status s = parseOptions(dpoint, "render", args); !s) return s.error();
   Result<RenderRequest> request = requestOf(*o);
-  if (request) request->report = true;
+  if (request) request->report = request->views == 1;  // a contact sheet has none
   return request;
 }
 

@@ -43,9 +43,7 @@ void addCommands(py::module_& m) {
       [](const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
          const std::vector<std::string>& camera_args, size_t sample, unsigned threads, bool allow_nonfinite,
          const std::string& stream, uint64_t max_memory, bool progress) {
-        Result<CameraRequest> parsed = cameraRequestOf(camera_args);
-        if (!parsed) raise(asCommandError(parsed.error(), "camera", "info"));
-        const CameraRequest camera = *parsed;
+        const CameraRequest camera = take(cameraRequestOf(camera_args));
         if (stream != "auto" && stream != "on" && stream != "off")
           raise(Error{"--stream: " + stream + " not in {auto,on,off}", ExitCode::kUsage});  // info's CLI11 check
         if (sample < 1 || sample > 100000000)

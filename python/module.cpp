@@ -21,18 +21,6 @@ void raiseInterrupt() {
   throw py::error_already_set();
 }
 
-Error asCommandError(Error error, const std::string& parser, const std::string& command) {
-  std::string& text = error.message;
-  const std::string own_prefix = parser + ": ";
-  const std::string unknown = "unknown option '";
-  const std::string root_hint = "(`dpoint --help` lists them)";
-  if (text.starts_with(unknown) && text.ends_with(root_hint))
-    text = command + ": " + text.substr(0, text.size() - root_hint.size()) + "(`dpoint " + command + " --help` lists them)";
-  else if (text.starts_with(own_prefix))
-    text.erase(0, own_prefix.size());
-  return error;
-}
-
 namespace {
 
 PyObject* g_error = nullptr;         // dpoint.Error (ValueError)

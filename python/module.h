@@ -48,14 +48,6 @@ bool catchesSigint();
 // was cut short and has no result.
 [[noreturn]] void raiseInterrupt();
 
-// An error of cli_options.h's parsers (renderRequestOf, cameraRequestOf) in the words the
-// executable's `dpoint COMMAND` uses for the same option. Those parsers run an app of their own
-// named `parser` ("render", "camera") with no parent, so they prefix every CLI11 refusal with
-// "PARSER: " (the executable and runEmbedded give it bare) and name an unknown option without its
-// command ("unknown option '--x' ... (`dpoint --help` lists them)" for the executable's
-// "render: unknown option '--x' ... (`dpoint render --help` lists them)"). Other errors pass as they are.
-Error asCommandError(Error error, const std::string& parser, const std::string& command);
-
 // Runs `work` with the GIL released, so other Python threads run. Where Python handles Ctrl-C
 // (catchesSigint), SIGINT is caught while it runs (core/interrupt.h's InterruptScope): the work
 // stops as the CLI's does, leaving no output, and Python's handler runs once it has

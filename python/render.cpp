@@ -72,18 +72,9 @@ class Renderer {
 
 RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
                           const std::vector<std::string>& args, Renderer* renderer, bool progress) {
-  Result<RenderRequest> parsed = renderRequestOf(args);
-  if (!parsed) raise(asCommandError(parsed.error(), "render", "render"));
-  RenderRequest request = std::move(*parsed);
-  // renderRequestOf asks for the report (render --json's) always, which --views 4 refuses; a contact
-  // sheet comes back without one (RenderResult.report is None).
-  request.report = request.views == 1;
+  RenderRequest request = take(renderRequestOf(args));
   if (points) {
     request.points = points;
-    // The up axis of a set in memory is its own (PointSet::z_up), as a file's is for the CLI. Left
-    // to auto, zUpFor would take the empty input list for "every input is .las" and fit every set
-    // in memory z-up: another view, bound and picture than `dpoint render` of the same points.
-    if (request.up_axis == UpAxis::kAuto) request.up_axis = points->z_up ? UpAxis::kZ : UpAxis::kY;
   } else {
     request.inputs = inputs;
   }
