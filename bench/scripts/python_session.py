@@ -8,12 +8,15 @@ In one process: the dataset is generated (dpoint.generate, in memory), then
   fresh:    3 renders with dpoint.render (a device each);
   probed:   one render with error=True (the probe and the exact reference), then RENDERS more
             with the same Renderer, as the bench's process did.
+  views:    10 views of the set (one frame each, the whole call timed) with one Renderer, then
+            with dpoint.render (a device each).
 One JSON line per render: phase, index, GPU median/min/p95 of its frames, wall time of the call.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/scripts/python_session.py --kind sierpinski --level 11
 """
 import argparse
 import json
+import math
 import statistics
 import sys
 import time
@@ -69,4 +72,16 @@ if args.probe_points:
             t = time.perf_counter()
             r = renderer.render(points, args.mode, **options)
             row("after_probe", i, r, time.perf_counter() - t)
+# Ten views, each a whole call of one frame: a Renderer's device against a device per call.
+eyes = [(0.24 + 3.0 * math.cos(a), 1.5, 0.33 + 3.0 * math.sin(a)) for a in (2 * math.pi * k / 10 for k in range(10))]
+view = dict(width=args.width, height=args.height, target=(0.24, 0.0, 0.33), up=(0, 1, 0), order=args.order)
+with dpoint.Renderer() as renderer:
+    for i, eye in enumerate(eyes):
+        t = time.perf_counter()
+        r = renderer.render(points, args.mode, eye=eye, **view)
+        row("views_renderer", i, r, time.perf_counter() - t)
+for i, eye in enumerate(eyes):
+    t = time.perf_counter()
+    r = dpoint.render(points, args.mode, eye=eye, **view)
+    row("views_render", i, r, time.perf_counter() - t)
 sys.stdout.flush()

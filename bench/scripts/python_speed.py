@@ -3,10 +3,11 @@
 
   render   the whole call `dpoint.render(PointSet(array, colours), ...)` on N points from NumPy,
            against the same render through the CLI from a file (`dpoint render F.ply -o X.png`,
-           the process's wall time: start, read, device, render, PNG) and against Open3D's
-           offscreen capture of the same arrays (the legacy Visualizer, in this process: arrays to
-           a PointCloud, add_geometry, capture_screen_float_buffer, to uint8; its window is made
-           once, before the timing); median of --runs each, interleaved;
+           the process's wall time: start, read, device, render, PNG), interleaved, and against
+           Open3D's offscreen capture of the same arrays (the legacy Visualizer in a Python process
+           of its own, as Open3D in this one slowed dpoint's 10M call by a third: arrays to a
+           PointCloud, add_geometry, capture_screen_float_buffer, to uint8; its window is made once,
+           before the timing); median of --runs each;
   reuse    a Renderer reused over 10 views of the 1M set against 10 separate dpoint.render calls;
   memory   the peak resident memory a PointSet adds over the (N, 3) float64 array it is made from
            (a child process each: a fresh peak).
@@ -83,6 +84,26 @@ class Open3D:
             self.xvfb.terminate()
 
 
+def open3d_child(positions_npy, colors_npy, runs):
+    """The --open3d-child mode: one warm capture, then `runs` timed ones, as JSON on stdout."""
+    positions, colors = np.load(positions_npy), np.load(colors_npy)
+    o3d = Open3D()
+    o3d.time(positions, colors)
+    times = [o3d.time(positions, colors) for _ in range(runs)]
+    print(json.dumps(times), flush=True)
+    o3d.close()
+    os._exit(0)  # Open3D 0.16's GLFW teardown reports a lost X connection at interpreter exit
+
+
+def time_open3d(tmp, positions, colors, runs):
+    files = [os.path.join(tmp, "positions.npy"), os.path.join(tmp, "colors.npy")]
+    np.save(files[0], positions)
+    np.save(files[1], colors)
+    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--open3d-child", *files, str(runs)],
+                         check=True, capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
 def peak_memory(n):
     """MB of peak RSS: after the array, and after the PointSet made from it (a fresh child)."""
     # VmHWM, not ru_maxrss: the latter keeps the parent's peak across fork and exec.
@@ -106,10 +127,11 @@ def main():
     parser.add_argument("--sizes", default="1000000,10000000")
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--no-open3d", action="store_true")
+    if len(sys.argv) == 5 and sys.argv[1] == "--open3d-child":
+        open3d_child(sys.argv[2], sys.argv[3], int(sys.argv[4]))
     args = parser.parse_args()
     exe = os.path.abspath(args.dpoint)
     report = dict(device=dpoint.Renderer().device, width=W, height=H, runs=args.runs, render=[], memory=[])
-    o3d = None if args.no_open3d else Open3D()
     with tempfile.TemporaryDirectory() as tmp:
         for n in (int(s) for s in args.sizes.split(",")):
             positions, colors = dataset(n)
@@ -117,18 +139,16 @@ def main():
             dpoint.write(dpoint.PointSet(positions, colors), path)
             png = os.path.join(tmp, "cli.png")
             time_module(positions, colors), time_cli(exe, path, png)  # warm: page cache, shader caches
-            if o3d:
-                o3d.time(positions, colors)
             rows = dict(module=[], cli=[], open3d=[])
             for _ in range(args.runs):
                 rows["module"].append(time_module(positions, colors))
                 rows["cli"].append(time_cli(exe, path, png))
-                if o3d:
-                    rows["open3d"].append(o3d.time(positions, colors))
+            if not args.no_open3d:
+                rows["open3d"] = time_open3d(tmp, positions, colors, args.runs)
             entry = dict(points=n, **{f"{k}_s": v for k, v in rows.items() if v},
                          **{f"{k}_median_s": statistics.median(v) for k, v in rows.items() if v})
             entry["module_over_cli"] = entry["module_median_s"] / entry["cli_median_s"]
-            if o3d:
+            if rows["open3d"]:
                 entry["module_over_open3d"] = entry["module_median_s"] / entry["open3d_median_s"]
             print(json.dumps(entry), flush=True)
             report["render"].append(entry)
@@ -153,10 +173,6 @@ def main():
             print(json.dumps(report["memory"][-1]), flush=True)
     with open(args.out, "w", encoding="utf-8") as f:
         json.dump(report, f, indent=1)
-    if o3d:
-        o3d.close()
-    sys.stdout.flush()
-    os._exit(0)  # Open3D 0.16's GLFW teardown reports a lost X connection at interpreter exit
 
 
 if __name__ == "__main__":

@@ -249,7 +249,7 @@ def _executable() -> str:
     raise Error("bench: no dpoint executable found (set DPOINT_EXECUTABLE)")
 
 
-def bench(suite: str = "ci", out="bench-out", *, progress: bool = True, **options) -> dict:
+def bench(suite: str = "ci", out="bench-out", *, progress: bool = False, **options) -> dict:
     """Runs ``dpoint bench`` (the speed-against-error report) and returns its results.json as a dict.
 
     suite: ci, paper, hard or all; out: the report's folder (report.md, results.json, charts,

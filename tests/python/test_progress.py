@@ -1,4 +1,4 @@
-"""progress=False (the default but for bench) prints nothing, on stderr or stdout; progress=True may."""
+"""progress=False (the default) prints nothing, on stderr or stdout; progress=True may."""
 import numpy as np
 
 import dpoint
