@@ -249,7 +249,7 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
 }
 
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth, bool write_log) {
+                                                bool early_depth, bool write_log, bool subgroup_merge) {
   ComputePipelines p;
   auto fail = [&](const Error& error) -> Result<ComputePipelines> {
     destroyComputePipelines(context, p);
@@ -275,7 +275,7 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
   p.resolve_layout = *resolve_layout;
   // The subgroup merge only where early depth is on (the plain path the tests compare with keeps
   // an atomic per point).
-  const bool merge = early_depth && context.facts.subgroup_merge;
+  const bool merge = early_depth && subgroup_merge && context.facts.subgroup_merge;
   Result<VkPipeline> splat = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, false, early_depth, merge);
   if (!splat) return fail(splat.error());
   p.splat = *splat;

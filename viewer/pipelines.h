@@ -73,9 +73,12 @@ struct ResolvePush {
   float depth_scale = 0.0f;
 };
 // `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
-// `write_log` has the resolve also write each pixel's log distance (binding 3) for the shading.
+// `subgroup_merge` (with early_depth, on a device that has it: DeviceFacts::subgroup_merge) has the
+// lanes of a subgroup on one pixel test and write once. `write_log` has the resolve also write each
+// pixel's log distance (binding 3) for the shading.
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth = true, bool write_log = false);
+                                                bool early_depth = true, bool write_log = false,
+                                                bool subgroup_merge = true);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
 // Shading after either backend (shaders/render/shade_common.glsl): reads a float depth per pixel

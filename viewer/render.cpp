@@ -476,7 +476,8 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   std::future<Status> pipelines_made = std::async(std::launch::async, [&]() -> Status {
     if (compute) {
       Result<ComputePipelines> pipelines =
-          createComputePipelines(context, options.mode, options.probe, options.early_depth, shading);
+          createComputePipelines(context, options.mode, options.probe, options.early_depth, shading,
+                                 options.subgroup_merge.value_or(context.facts.type != "cpu"));
       if (!pipelines) return pipelines.error();
       r.compute = *pipelines;
     } else {

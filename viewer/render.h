@@ -58,6 +58,10 @@ struct RenderOptions {
   // Compute backend: skip the atomic when the pixel's key already wins (same picture; tests turn
   // it off to compare with the plain path).
   bool early_depth = true;
+  // Compute backend: the subgroup merge (points_splat.comp; same picture). None: where it pays,
+  // on GPUs; not on a CPU device, where lavapipe's 16.7M-point frame took 11% longer with it
+  // (bench/results/2026-11-25/lavapipe/native-ab-2026-11-25.tsv). Tests force it on.
+  std::optional<bool> subgroup_merge;
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
   uint64_t max_chunk_points = 0;
