@@ -7,7 +7,6 @@
 #include "cli/cli_output.h"
 #include "cli/commands.h"
 #include "converters/gltf_read.h"
-#include "ops/point_filters.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
 #include "ops/point_order.h"
@@ -116,11 +115,8 @@ int runConvert(ConvertOptions& o) {
   }
   Result<PointSet> points = readInput(o, progress);
   if (!points) return reportError(points.error());
-  if (filters.drop) points->colors.clear();
-  if (o.unique) dropDuplicatePositions(*points);
-  if (filters.srgb8) encodeColorsSrgb8(*points);
-  if (Status s = checkReorderMemory(*points, *order, o.memory_limit); !s) return reportError(s.error());
-  reorderPoints(*points, *order, o.common.threads, &progress);
+  if (Status s = filterPoints(*points, filters, o.unique, *order, o.memory_limit, o.common.threads, &progress); !s)
+    return reportError(s.error());
   if (Status s = writePointsWithNotes(o.output, *points, w); !s) return reportError(s.error());
   return 0;
 }

@@ -135,6 +135,16 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
   return Error{path + ": unreachable format"};
 }
 
+Status filterPoints(PointSet& points, const ColorFilters& colors, bool unique, PointOrder order, uint64_t memory_limit,
+                    unsigned threads, Progress* progress) {
+  if (colors.drop) points.colors.clear();
+  if (unique) dropDuplicatePositions(points);
+  if (colors.srgb8) encodeColorsSrgb8(points);
+  if (Status s = checkReorderMemory(points, order, memory_limit); !s) return s;
+  reorderPoints(points, order, threads, progress);
+  return okStatus();
+}
+
 Status convertGltfToCsv(const std::string& input, const GltfReadOptions& read, const ColorFilters& filters,
                         const std::string& output, const WriteOptions& options) {
   CsvPointSink sink(output, filters, options);

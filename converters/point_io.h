@@ -10,6 +10,7 @@
 #include "converters/ply.h"
 #include "core/point_set.h"
 #include "core/result.h"
+#include "ops/point_order.h"
 
 namespace dpoint {
 
@@ -55,6 +56,12 @@ struct ColorFilters {
   bool drop = false;   // --no-colors
   bool srgb8 = false;  // --color-format srgb8: encodeColorsSrgb8 (point_filters.h)
 };
+
+// What `dpoint convert` does to a set between reading and writing, in its order: `colors.drop`,
+// --unique (drop duplicate positions), `colors.srgb8`, then `order` (its memory checked against
+// `memory_limit` first: kResourceLimit). The Python module's write does the same on a copy.
+Status filterPoints(PointSet& points, const ColorFilters& colors, bool unique, PointOrder order, uint64_t memory_limit,
+                    unsigned threads, Progress* progress);
 
 // glTF/GLB input to a CSV file written block by block as the scene is walked (streamGltf):
 // memory is the loaded model plus a few blocks of rows, however many points the scene places.

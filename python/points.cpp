@@ -13,7 +13,6 @@
 #include "converters/point_io.h"
 #include "core/memory.h"
 #include "core/text.h"
-#include "ops/point_filters.h"
 #include "ops/point_order.h"
 #include "python/module.h"
 
@@ -338,14 +337,11 @@ stderr.)");
           w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale;
           w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
           w.ply_colors = ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
-          const bool filtered = no_colors || unique || color_format == "srgb8" || point_order != PointOrder::kInput;
-          if (!filtered) return writePoints(path, *points, w);
+          const ColorFilters colors{no_colors, color_format == "srgb8"};
+          if (!colors.drop && !colors.srgb8 && !unique && point_order == PointOrder::kInput)
+            return writePoints(path, *points, w);
           PointSet copy = *points;  // the caller's set stays as it is
-          if (no_colors) copy.colors.clear();
-          if (unique) dropDuplicatePositions(copy);
-          if (color_format == "srgb8") encodeColorsSrgb8(copy);
-          if (Status s = checkReorderMemory(copy, point_order, limit); !s) return s;
-          reorderPoints(copy, point_order, threads, &bar);
+          if (Status s = filterPoints(copy, colors, unique, point_order, limit, threads, &bar); !s) return s;
           return writePoints(path, copy, w);
         }));
       },

@@ -27,7 +27,7 @@ struct RenderResultPy {
   float point_size = 1.0f;
   std::optional<ErrorStats> error;
   std::vector<double> gpu_ms;
-  std::vector<std::string> warnings, validation_messages;
+  std::vector<std::string> warnings;
   std::string report_json;  // renderReportJson: render --json's object (empty for a contact sheet)
 };
 

@@ -129,12 +129,18 @@ LasColorSource lasColorOf(RenderColor color) {
   }
 }
 
+// --color intensity and classification come from the LAS reader: a set it did not read (one in
+// memory, a stream) has neither.
+Status checkNotLasColor(const std::string& inputs, RenderColor color) {
+  if (color != RenderColor::kIntensity && color != RenderColor::kClassification) return okStatus();
+  return Error{inputs + ": --color " + renderColorName(color) + " needs LAS input", ExitCode::kBadInput};
+}
+
 // The request's set in memory (RenderRequest::points), drawn as it is: nothing is read.
 Result<LoadedSet> takeInMemory(const RenderRequest& request) {
   LoadedSet set;
   set.inputs = request.inputs.empty() ? std::string("points") : describeInputs(request.inputs);
-  if (request.color == RenderColor::kIntensity || request.color == RenderColor::kClassification)
-    return Error{set.inputs + ": --color " + renderColorName(request.color) + " needs LAS input", ExitCode::kBadInput};
+  if (Status s = checkNotLasColor(set.inputs, request.color); !s) return s.error();
   set.shared = request.points;
   return set;
 }
@@ -148,8 +154,8 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (!opened) return opened.error();
   set.stream = std::move(*opened);
   PointInputStream* ply = set.stream.get();
-  if (ply && (request.color == RenderColor::kIntensity || request.color == RenderColor::kClassification))
-    return Error{inputs + ": --color " + renderColorName(request.color) + " needs LAS input", ExitCode::kBadInput};
+  if (ply)
+    if (Status s = checkNotLasColor(inputs, request.color); !s) return s.error();
   if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
     return Error{inputs + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
                  "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
