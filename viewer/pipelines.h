@@ -74,11 +74,12 @@ struct ResolvePush {
 };
 // `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
 // `subgroup_merge` (with early_depth, on a device that has it: DeviceFacts::subgroup_merge) has the
-// lanes of a subgroup on one pixel test and write once. `write_log` has the resolve also write each
+// lanes of a subgroup on one pixel test and write once; `pair_merge` (with early_depth; batch and
+// adaptive modes) two consecutive points on one pixel. `write_log` has the resolve also write each
 // pixel's log distance (binding 3) for the shading.
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
                                                 bool early_depth = true, bool write_log = false,
-                                                bool subgroup_merge = true);
+                                                bool subgroup_merge = true, bool pair_merge = true);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
 // Shading after either backend (shaders/render/shade_common.glsl): reads a float depth per pixel

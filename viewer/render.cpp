@@ -477,7 +477,8 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
     if (compute) {
       Result<ComputePipelines> pipelines =
           createComputePipelines(context, options.mode, options.probe, options.early_depth, shading,
-                                 options.subgroup_merge.value_or(context.facts.type != "cpu"));
+                                 options.subgroup_merge.value_or(context.facts.type != "cpu"),
+                                 options.pair_merge.value_or(context.facts.type != "cpu"));
       if (!pipelines) return pipelines.error();
       r.compute = *pipelines;
     } else {

@@ -62,6 +62,11 @@ struct RenderOptions {
   // on GPUs; not on a CPU device, where lavapipe's 16.7M-point frame took 11% longer with it
   // (bench/results/2026-11-25/lavapipe/native-ab-2026-11-25.tsv). Tests force it on.
   std::optional<bool> subgroup_merge;
+  // Compute backend, batch and adaptive modes: two consecutive points of a thread on one pixel test
+  // and write one key (points_splat.comp's splatPair; same picture). None: on GPUs (H100, 1e9
+  // points: adaptive 5.21 -> 4.45 ms, batch 5.42 -> 4.80; bench/results/2026-11-26/h100/), not on
+  // a CPU device, where lavapipe's 16.7M-point frames took 4-8% longer with it. Tests force it on.
+  std::optional<bool> pair_merge;
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
   uint64_t max_chunk_points = 0;

@@ -18,6 +18,8 @@ layout(constant_id = 0) const bool kProbe = false;
 layout(constant_id = 1) const bool kEarlyDepth = true;
 // The device has subgroup vote and arithmetic in compute shaders (DeviceFacts::subgroup_merge).
 layout(constant_id = 2) const bool kSubgroupMerge = false;
+// Batch and adaptive modes keep one key for two consecutive points on one pixel (splatPair).
+layout(constant_id = 3) const bool kPairMerge = false;
 layout(local_size_x = 256) in;
 const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.h
 
@@ -107,6 +109,46 @@ void splat(uint i, vec4 clip) {
     }
 }
 
+// Point i of this dispatch at `clip` as a size-1 point: its pixel and key; false where it lies
+// outside the view volume or the picture. The same tests and arithmetic as splat's.
+bool pixelKey(uint i, vec4 clip, out uint pixel, out uint64_t key) {
+  uint index = pc.first_index + i;
+  if (kProbe) probe_clip[i] = clip;
+  pixel = 0u;
+  key = 0ul;
+  if (!(clip.w > 0.0) || abs(clip.x) > clip.w || abs(clip.y) > clip.w || clip.z < 0.0 || clip.z > clip.w) return false;
+  float depth = clip.z / clip.w;
+  float x = (clip.x / clip.w * 0.5 + 0.5) * float(pc.width);
+  float y = (clip.y / clip.w * 0.5 + 0.5) * float(pc.height);
+  int px = int(ceil(x)) - 1, py = int(ceil(y)) - 1;
+  if (px < 0 || py < 0 || px >= int(pc.width) || py >= int(pc.height)) return false;
+  pixel = uint(py) * pc.width + uint(px);
+  key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
+  return true;
+}
+
+// Points i and i + 1, consecutive in the set. With kPairMerge, where both land on one pixel (a
+// dense set in Morton order: 16.7M points put tens on a pixel, 1e9 about 500) only the larger of
+// their keys is tested and written: the key the two would have left, with one load and one atomic
+// for both. (pixelKey repeats splat's arithmetic rather than splat calling it: on the H200 the
+// shared form made the batch and adaptive frames 20-30% slower, bench/results/2026-11-26/.)
+void splatPair(uint i, vec4 a, vec4 b) {
+  if (!kPairMerge || pc.point_size != 1.0) {
+    splat(i, a);
+    splat(i + 1u, b);
+    return;
+  }
+  uint pixel_a, pixel_b;
+  uint64_t key_a, key_b;
+  bool in_a = pixelKey(i, a, pixel_a, key_a), in_b = pixelKey(i + 1u, b, pixel_b, key_b);
+  if (in_a && in_b && pixel_a == pixel_b) {
+    key_a = max(key_a, key_b);
+    in_b = false;
+  }
+  if (in_a && !(kEarlyDepth && visibility[pixel_a] >= key_a)) atomicMax(visibility[pixel_a], key_a);
+  if (in_b && !(kEarlyDepth && visibility[pixel_b] >= key_b)) atomicMax(visibility[pixel_b], key_b);
+}
+
 // A workgroup takes kPointsPerThread · 256 consecutive points. Thread t splats t, t + 256, …, in
 // batch mode the pairs 2t, 2t + 1 and 512 + 2t, 513 + 2t: one 16-byte load a pair, so a thread
 // keeps as many bytes in flight as fp32 mode does (batch 16.7M points on the H100: 0.120 ms with
@@ -163,8 +205,7 @@ void main() {
         a = rebuildTiers3(coarse.x, medium.x, fine.x);
         b = rebuildTiers3(coarse.y, medium.y, fine.y);
       }
-      splat(i, projectBatchOffset(a, matrix));
-      splat(i + 1u, projectBatchOffset(b, matrix));
+      splatPair(i, projectBatchOffset(a, matrix), projectBatchOffset(b, matrix));
     } else {  // the chunk's last point of an odd count: a pair would read past it
       vec3 offset = tiers == 1u ? rebuildTiers1(words[i])
                   : tiers == 2u ? rebuildTiers2(words[i], words[stride + i])
@@ -182,8 +223,7 @@ void main() {
       uvec4 pair = position_pairs[i >> 1];
       // index is even (chunks start at even points in batch mode: viewer/render.cpp's chunkPoints),
       // so index + 1 lies in the same batch.
-      splat(i, projectBatchOffset(unpackOffset(pair.xy), matrix));
-      splat(i + 1u, projectBatchOffset(unpackOffset(pair.zw), matrix));
+      splatPair(i, projectBatchOffset(unpackOffset(pair.xy), matrix), projectBatchOffset(unpackOffset(pair.zw), matrix));
     } else {  // the last point of an odd count: a pair would read past the buffer
       splat(i, projectBatchOffset(unpackOffset(positions[i]), matrix));
     }

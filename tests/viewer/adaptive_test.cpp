@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "ortho_camera.h"
 #include "render_test_support.h"
@@ -160,6 +161,20 @@ TEST_P(Adaptive, straddlingBatchesAreDrawnAndCulledOnesAreNeverRead) {
   }
 }
 
+// Orthographic, straight down −z, 128 × 128 pixels 0.01 wide around the origin: points at one x, y
+// share a pixel whatever their z (the orthoCamera helpers leave 3D sets to the oblique
+// perspective fit).
+Camera topDownCamera(const PointSet& s) {
+  CameraSpec spec;
+  spec.width = spec.height = 128;
+  spec.ortho = true;
+  spec.view_center = glm::dvec3(0.0);
+  spec.view_width = 1.28;
+  Result<Camera> camera = makeCamera(spec, boundsOf(s));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
 // The splat merges the lanes of a subgroup that land on one pixel (DeviceFacts::subgroup_merge):
 // 20,000 points in runs on a 3 × 3 patch of pixels at many depths, and a spread of others, give the
 // picture every point's own atomic gives.
@@ -180,7 +195,7 @@ TEST_P(Adaptive, subgroupMergeGivesThePlainPicture) {
     s.positions.emplace_back(unit(random) - 0.5, unit(random) - 0.5, -1.0 - unit(random));
     s.colors.emplace_back(0.9f, float(i % 3) / 3.0f, 0.4f);
   }
-  const Camera camera = orthoCamera(s, glm::dvec3(0.0), 1.28, 128);
+  const Camera camera = topDownCamera(s);
   for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kAdaptive}) {
     RenderOptions options;
     options.mode = mode;
@@ -193,6 +208,57 @@ TEST_P(Adaptive, subgroupMergeGivesThePlainPicture) {
     Result<RenderResult> merged = renderPoints(*context_, s, camera, options);
     ASSERT_TRUE(merged.ok()) << merged.error().message;
     EXPECT_EQ(merged->image.rgba, plain->image.rgba) << modeName(mode);
+  }
+}
+
+// Batch and adaptive modes' splat keeps one key for two consecutive points on one pixel
+// (RenderOptions::pair_merge): runs of points on a 3 × 3 patch of pixels at many depths (runs of
+// even and odd length, so pairs start on either point of a run; the nearer point of a pair either
+// first or second), a spread of others, and points alternating in and out of the view give the
+// picture every point's own atomic gives.
+TEST_P(Adaptive, pairMergeGivesThePlainPicture) {
+  if (GetParam() != Backend::kCompute) GTEST_SKIP() << "the merge is the compute splat's";
+  PointSet s;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int run = 0, i = 0; run < 27; ++run) {
+    // In every other run the odd points lie nearer, in the others the even ones, so wherever the
+    // camera looks from, some pixels' nearest points are the second of their pair.
+    const int pixel = run % 9;
+    for (int k = 0; k < 700 + run; ++k, ++i) {
+      const double z = ((i + run) % 2 ? 0.3 : -0.3) + 0.05 * unit(random);
+      s.positions.emplace_back(0.01 * (pixel % 3), 0.01 * (pixel / 3), z);
+      s.colors.emplace_back(float(i % 11) / 11.0f, float(i % 5) / 5.0f, 0.2f);
+    }
+  }
+  for (int i = 0; i < 20000; ++i) {
+    s.positions.emplace_back(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5);
+    s.colors.emplace_back(0.9f, float(i % 3) / 3.0f, 0.4f);
+  }
+  for (int i = 0; i < 2000; ++i) {  // every other point outside the view, the others on one pixel
+    const double outside = (i % 2) ? 5.0 : 0.0;
+    s.positions.emplace_back(0.3 + outside, 0.3, unit(random) - 0.5);
+    s.colors.emplace_back(0.1f, 0.8f, float(i % 7) / 7.0f);
+  }
+  const Camera camera = topDownCamera(s);
+  for (PrecisionMode mode : {PrecisionMode::kBatch, PrecisionMode::kAdaptive}) {
+    RenderOptions options;
+    options.mode = mode;
+    options.backend = Backend::kCompute;
+    options.early_depth = false;  // no merge: one atomic a point
+    Result<RenderResult> plain = renderPoints(*context_, s, camera, options);
+    ASSERT_TRUE(plain.ok()) << plain.error().message;
+    options.early_depth = true;
+    options.pair_merge = true;  // lavapipe (a CPU) leaves it off by default
+    options.subgroup_merge = false;
+    Result<RenderResult> merged = renderPoints(*context_, s, camera, options);
+    ASSERT_TRUE(merged.ok()) << merged.error().message;
+    EXPECT_EQ(merged->image.rgba, plain->image.rgba) << modeName(mode);
+    // Not an empty picture: the spread and the runs are drawn (background: opaque black).
+    size_t lit = 0;
+    const std::vector<uint8_t>& rgba = merged->image.rgba;
+    for (size_t p = 0; p + 3 < rgba.size(); p += 4) lit += (rgba[p] | rgba[p + 1] | rgba[p + 2]) != 0 ? 1 : 0;
+    EXPECT_GT(lit, 1000u) << modeName(mode);
   }
 }
 
