@@ -314,11 +314,13 @@ constexpr PositionAttribute kNone{};
 
 // Speed ranks, [DeviceClass][compute backend], from the orders measured with issue #25's encodings
 // (bench/results/2026-11-25/h100/adaptive-final-2026-11-25.tsv, adaptive-modes-2026-11-25.tsv;
-// lavapipe: bench/results/2026-11-25/lavapipe/speed-adaptive-2026-11-25.tsv):
+// with the pair merge bench/results/2026-11-26/h100/pair-merge/pair-merge.tsv; lavapipe:
+// bench/results/2026-11-25/lavapipe/speed-adaptive-2026-11-25.tsv):
 // - GPU compute (H100, 1920x1080, Morton order; ms at 16.7M Sierpinski / 16.6M Mandelbulb / 1e9
-//   2D): batch 0.114 / 0.124 / 5.38, adaptive 0.111 / 0.130 / 5.20, fp32 0.137 / 0.137 / 5.35,
-//   rte 0.186 / 0.193, native 0.185 / 0.194 / 8.23, df64 0.346 / 0.345: batch, adaptive, fp32, rte,
-//   native, df64 (batch and adaptive within 2% over the two 16.7M sets; rte and native tied, as before).
+//   2D, after the pair merge): adaptive 0.1065 / 0.1261 / 4.45, batch 0.1102 / 0.1217 / 4.80,
+//   fp32 0.137 / 0.137 / 5.36, rte 0.186 / 0.193, native 0.185 / 0.194 / 8.25, df64 0.346 / 0.345:
+//   adaptive, batch, fp32, rte, native, df64 (adaptive faster on two sets of three, 2.5% over the
+//   three; rte and native tied, as before).
 // - GPU raster: bound by the point rasterizer (all within 0.2% at 16.7M: 19.18–19.22 ms, 19.88–20.93),
 //   ties ranked as on compute: batch, adaptive, fp32, native, rte, df64.
 // - lavapipe compute (16.7M Sierpinski, Morton): fp32 653, native 705, batch 857, rte 968, df64 986,
@@ -348,14 +350,14 @@ constexpr ModeInfo kModes[] = {
     // The compute splat reads points in pairs that must share a batch: chunks start at even points.
     {PrecisionMode::kBatch, "batch", "per-batch double origins", 8, kBatchWord, true, false, false, false, kBatchSize, 2,
      {DPOINT_SPIRV(kPointsBatchVert), {}, DPOINT_SPIRV(kSplatBatchComp), {{0, VK_FORMAT_R32G32_UINT, 0}, kNone}, 1},
-     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{4, 2}, {0, 0}}, kBatchSteps},
+     encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{4, 2}, {0, 1}}, kBatchSteps},
     // Pulls its tier words in both backends (no attributes); chunks hold whole batches, so each
     // 1024-point workgroup of the compute splat lies in one batch and loads 16 bytes a thread.
     {PrecisionMode::kAdaptive, "adaptive", "per-batch tiers of 10 bits, as few as --tolerance allows", 12,
      kTierWords, true, false, false, false, kAdaptiveBatchSize, kAdaptiveBatchSize,
      {DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kSplatAdaptiveComp),
       {kNone, kNone}, 0},
-     encodeAdaptiveTier, noUniform, worstOf<adaptiveBound>, nullptr, {{5, 5}, {1, 1}}, kAdaptiveSteps, kAdaptiveTiers},
+     encodeAdaptiveTier, noUniform, worstOf<adaptiveBound>, nullptr, {{5, 5}, {1, 0}}, kAdaptiveSteps, kAdaptiveTiers},
 };
 static_assert(std::size(kModes) == kModeCount);
 

@@ -130,7 +130,7 @@ TEST(Modes, shaderVariantsAndAttributesFitTheLayout) {
 // viewer/modes.cpp names the runs).
 TEST(Modes, speedOrdersHoldEveryModeButSplitOnce) {
   using M = PrecisionMode;
-  const std::vector<M> gpu_compute = {M::kBatch, M::kAdaptive, M::kFp32, M::kRte, M::kNative, M::kDf64};
+  const std::vector<M> gpu_compute = {M::kAdaptive, M::kBatch, M::kFp32, M::kRte, M::kNative, M::kDf64};
   const std::vector<M> gpu_raster = {M::kBatch, M::kAdaptive, M::kFp32, M::kNative, M::kRte, M::kDf64};
   const std::vector<M> cpu_compute = {M::kFp32, M::kNative, M::kBatch, M::kRte, M::kDf64, M::kAdaptive};
   const std::vector<M> cpu_raster = {M::kFp32, M::kNative, M::kRte, M::kDf64, M::kBatch, M::kAdaptive};
