@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
@@ -92,6 +93,31 @@ struct BenchCopyOptions {
 
 extern "C" char** environ;
 
+// An unlinked file for a child's stderr (closed on exec, so the child holds it only as its fd 2);
+// -1 where the temporary folder takes no O_TMPFILE, and the child then writes to ours.
+int openChildErrors() {
+  const char* folder = std::getenv("TMPDIR");
+  return ::open(folder && *folder ? folder : "/tmp", O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+}
+
+// The last `limit` bytes a child wrote to its stderr, each line indented by two spaces.
+std::string childErrors(int fd, size_t limit = 4096) {
+  struct stat info{};
+  if (fd < 0 || ::fstat(fd, &info) != 0 || info.st_size <= 0) return {};
+  const off_t from = info.st_size > static_cast<off_t>(limit) ? info.st_size - static_cast<off_t>(limit) : 0;
+  std::string text(static_cast<size_t>(info.st_size - from), '\0');
+  const ssize_t got = ::pread(fd, text.data(), text.size(), from);
+  text.resize(got > 0 ? static_cast<size_t>(got) : 0);
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  std::string indented;
+  for (size_t start = 0; start < text.size();) {
+    const size_t end = std::min(text.find('\n', start), text.size());
+    indented += "\n  " + text.substr(start, end - start);
+    start = end + 1;
+  }
+  return indented;
+}
+
 // `dpoint ARGS` run as a child process of dpointExecutable() (cli_run.h: this very executable, or
 // $DPOINT_EXECUTABLE where dpoint is embedded): the bench's datasets and timed draws are exactly
 // what a user's `dpoint generate` and `dpoint render` give.
@@ -104,10 +130,20 @@ Status runDpointChild(const std::vector<std::string>& args, unsigned threads) {
   c_argv.push_back(nullptr);
   std::string command;
   for (size_t i = 0; i + 1 < c_argv.size(); ++i) command += (i ? " " : "") + argv[i];
-  // The child's report goes nowhere (the bench reads its --json); its errors reach our stderr.
+  // The child's report goes nowhere (the bench reads its --json). Its stderr is kept aside: the
+  // warnings of a run that succeeds are the bench's own cases (fp32 unbounded on a hard case, a
+  // set that covers little of the picture) and would bury the bench's progress; a run that fails
+  // has them in the bench's error.
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  struct ErrorsFile {
+    int fd = openChildErrors();
+    ~ErrorsFile() {
+      if (fd >= 0) ::close(fd);
+    }
+  } errors;
+  if (errors.fd >= 0) posix_spawn_file_actions_adddup2(&actions, errors.fd, STDERR_FILENO);
   // The child starts with no signal blocked (ours are, for the interrupt watcher), and dies with
   // us: it gets SIGTERM if the bench is killed (core/interrupt.h, kParentPidVariable).
   posix_spawnattr_t attributes;
@@ -144,7 +180,7 @@ Status runDpointChild(const std::vector<std::string>& args, unsigned threads) {
   if (interrupted()) return interruptedError();
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return okStatus();
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return Error{command + " failed (exit " + std::to_string(code) + ")",
+  return Error{command + " failed (exit " + std::to_string(code) + ")" + childErrors(errors.fd),
                code == static_cast<int>(ExitCode::kResourceLimit) ? ExitCode::kResourceLimit : ExitCode::kBadInput};
 }
 

@@ -11,7 +11,7 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
-from common import check, dpoint, scratch
+from common import check, scratch
 
 exe = sys.argv[1]
 MODES = ["fp32", "split", "rte", "df64", "native", "batch", "adaptive"]
@@ -58,9 +58,28 @@ def check_svg(path, series_per_panel, panels):
 
 
 with scratch() as d:
+    # A child run that fails: the bench stops with its error, the child's own stderr quoted in it,
+    # and writes no report.
+    fake = os.path.join(d, "fake-dpoint")
+    with open(fake, "w") as f:
+        f.write("#!/bin/sh\necho \"dpoint: error: the child's own message ($1)\" >&2\nexit 2\n")
+    os.chmod(fake, 0o755)
+    failed = subprocess.run([exe, "bench", "--suite", "ci", "--out", os.path.join(d, "failed"), "--cache",
+                             os.path.join(d, "failed-cache"), "--quiet"], capture_output=True, text=True,
+                            env={**os.environ, "DPOINT_EXECUTABLE": fake})
+    check(failed.returncode == 2, f"a failing child: bench exited {failed.returncode}")
+    check("failed (exit 2)" in failed.stderr and "\n  dpoint: error: the child's own message (generate)" in failed.stderr,
+          f"a failing child: the bench's error lacks the child's message: {failed.stderr!r}")
+    check(not os.path.exists(os.path.join(d, "failed", "report.md")), "a failing child: report.md written")
+
+with scratch() as d:
     out, cache = os.path.join(d, "out"), os.path.join(d, "cache")
-    dpoint(exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1ms", "--validate",
-           "--copy-bytes", "64M", "--copy-repeats", "5", "--quiet")
+    ran = subprocess.run([exe, "bench", "--suite", "ci", "--out", out, "--cache", cache, "--frames", "3", "--warmup", "1ms",
+                          "--validate", "--copy-bytes", "64M", "--copy-repeats", "5", "--quiet"], capture_output=True, text=True)
+    check(ran.returncode == 0, f"dpoint bench failed ({ran.returncode}): {ran.stderr}")
+    # Quiet and every check passed: nothing on stderr, the runs' own warnings (fp32 unbounded on the
+    # hard cases, sets that cover little of the picture) included.
+    check(ran.stderr == "", f"dpoint bench --quiet wrote to stderr:\n{ran.stderr[:2000]}")
     for name in ["report.md", "results.json", "speed_vs_error.svg", "breakdown.svg", "montage.png"]:
         check(os.path.getsize(os.path.join(out, name)) > 0, f"{name} missing or empty")
     with open(os.path.join(out, "results.json")) as f:
