@@ -20,12 +20,7 @@ Status checkPointOutput(const std::string& path) {
     const std::string ext = std::filesystem::path(path).extension().string();
     return Error{path + ": unknown file type '" + ext + "' (write " + kPointOutputFormats + ")", ExitCode::kUsage};
   }
-  if (*format == FileFormat::kGltf)
-    return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .las)", ExitCode::kUsage};
-  if (*format == FileFormat::kLaz)
-    return Error{path + ": writing LAZ is not supported; write .las and compress it with laszip or PDAL",
-                 ExitCode::kUsage};
-  return okStatus();
+  return checkWrittenFormat(path, *format);
 }
 
 Status checkOutputFolder(const std::string& flag, const std::string& path) {

@@ -58,6 +58,15 @@ Result<FileFormat> formatOf(const std::string& path) {
   return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb, .gltf or .las)", ExitCode::kUsage};
 }
 
+Status checkWrittenFormat(const std::string& path, FileFormat format) {
+  if (format == FileFormat::kGltf)
+    return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .las)", ExitCode::kUsage};
+  if (format == FileFormat::kLaz)
+    return Error{path + ": writing LAZ is not supported; write .las and compress it with laszip or PDAL",
+                 ExitCode::kUsage};
+  return okStatus();
+}
+
 namespace {
 
 Result<PointSet> readByFormat(const std::string& path, FileFormat format, const ReadOptions& options) {
@@ -125,12 +134,10 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return okStatus();
     }
     case FileFormat::kGltf:
-      return Error{path + ": writing .gltf is not supported; write .glb", ExitCode::kUsage};
+    case FileFormat::kLaz:
+      return checkWrittenFormat(path, *format);
     case FileFormat::kLas:
       return writeLas(path, points, LasWriteOptions{options.las_scale, options.threads, options.progress});
-    case FileFormat::kLaz:
-      return Error{path + ": writing LAZ is not supported; write .las and compress it with laszip or PDAL",
-                   ExitCode::kUsage};
   }
   return Error{path + ": unreachable format"};
 }

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import dpoint
-from conftest import cli, options_as_flags
+from conftest import cli, cli_error, options_as_flags
 
 FORMATS = ["csv", "ply", "glb", "las"]
 
@@ -126,6 +126,18 @@ def test_write_refuses_bad_options_and_writes_nothing(tmp_path, cloud, options, 
     assert words in str(raised.value)
     assert raised.value.exit_code == 1
     assert not (tmp_path / "out.csv").exists()
+
+
+@pytest.mark.parametrize("ext", ["gltf", "laz"])
+def test_write_refuses_a_read_only_format_as_convert_does(tmp_path, source, ext):
+    path, s = source
+    target = tmp_path / f"out.{ext}"
+    with pytest.raises(dpoint.Error) as raised:
+        dpoint.write(s, target)
+    message, code = cli_error("convert", path, "-o", target)
+    assert message == str(raised.value)
+    assert raised.value.exit_code == code
+    assert not target.exists()
 
 
 def test_write_refuses_a_non_size_type(tmp_path, cloud):
