@@ -47,38 +47,19 @@ bool isGltf(const Result<FileFormat>& format) {
   return format && (*format == FileFormat::kGlb || *format == FileFormat::kGltf);
 }
 
-Result<PointSet> readInput(const ConvertOptions& o, Progress& progress) {
-  Result<FileFormat> format = formatOf(o.input);
-  if (!format) return format.error();
-  if (isGltf(format)) {
-    GltfReadOptions g = gltfOptions(o);
-    // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
-    Result<FileFormat> out_format = formatOf(o.output);
-    g.triangles = !out_format || *out_format != FileFormat::kCsv;
-    return readGltf(o.input, g);
-  }
-  if (o.scene >= 0 || o.all_scenes)
-    return Error{o.input + ": --scene and --all-scenes apply to .glb/.gltf input only", ExitCode::kUsage};
-  if (*format == FileFormat::kLas && o.max_points != 0) {  // the header's count, before allocating
-    Result<LasHeader> header = readLasHeader(o.input);
-    if (!header) return header.error();
-    if (header->point_count > o.max_points)
-      return Error{o.input + ": " + std::to_string(header->point_count) + " points exceed --max-points " +
-                       std::to_string(o.max_points),
-                   ExitCode::kResourceLimit};
-  }
+Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
+  GltfReadOptions g = gltfOptions(o);
+  // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
+  Result<FileFormat> out_format = formatOf(o.output);
+  g.triangles = !out_format || *out_format != FileFormat::kCsv;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
   std::vector<std::string> notices;
   r.notices = &notices;
-  Result<PointSet> points = readPoints(o.input, r);
+  Result<PointSet> points = readInput(o.input, r, g);
   // Notes about a file that was read; a refused file gets its one error line only.
   if (points)
     for (const std::string& notice : notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
-  if (points && o.max_points != 0 && points->size() > o.max_points)
-    return Error{o.input + ": " + std::to_string(points->size()) + " points exceed --max-points " +
-                     std::to_string(o.max_points),
-                 ExitCode::kResourceLimit};
   return points;
 }
 
@@ -113,7 +94,7 @@ int runConvert(ConvertOptions& o) {
     w.decimals = lasStepDecimals(*header);
     w.decimals_at_scale = w.decimals >= 0;
   }
-  Result<PointSet> points = readInput(o, progress);
+  Result<PointSet> points = readConvertInput(o, progress);
   if (!points) return reportError(points.error());
   if (Status s = filterPoints(*points, filters, o.unique, *order, o.memory_limit, o.common.threads, &progress); !s)
     return reportError(s.error());

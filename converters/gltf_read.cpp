@@ -267,7 +267,7 @@ class SceneReader {
     }
     if (!count) return fail(pointer + "/attributes: has none of TRANSLATION, ROTATION, SCALE");
     if (options_.max_points != 0 && *count > options_.max_points)
-      return fail(pointer + ": " + std::to_string(*count) + " instances exceed --max-points " +
+      return fail(pointer + ": " + std::to_string(*count) + " instances exceed " + options_.max_points_name + " " +
                       std::to_string(options_.max_points),
                   ExitCode::kResourceLimit);
     // 128 bytes of matrix per instance, from as little as 3 bytes of TRANSLATION.
@@ -431,7 +431,8 @@ class SceneReader {
     }
     const size_t begin = emitted_total_;  // in the build pass, out_.positions.size()
     if (options_.max_points != 0 && emitted > options_.max_points - std::min<uint64_t>(begin, options_.max_points))
-      return fail("more than --max-points " + std::to_string(options_.max_points) + " points", ExitCode::kResourceLimit);
+      return fail("more than " + options_.max_points_name + " " + std::to_string(options_.max_points) + " points",
+                  ExitCode::kResourceLimit);
     if (emitted > size_t(kUnused) - begin) return fail("more than 2^32-1 vertices", ExitCode::kResourceLimit);
     emitted_total_ += emitted;
     if (pass_ == Pass::kEmit) return emitPrimitive(primitive, pointer, *positions, remap, world);

@@ -41,6 +41,7 @@ struct GltfReadOptions {
   bool all_scenes = false;   // every scene in order; a node in several scenes is emitted per scene
   bool allow_nonfinite = false;
   uint64_t max_points = 0;   // 0: no limit; else more points is kResourceLimit, checked before allocating
+  std::string max_points_name = "--max-points";  // how the caller names max_points in messages
   uint64_t max_file_bytes = kGltfDefaultMaxFileBytes;  // the file and each external buffer
   // Bytes for the model, what is decoded from it and the point set (--max-memory), each part
   // checked before it is allocated; over it is kResourceLimit. 0: defaultMemoryLimit().

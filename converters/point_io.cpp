@@ -110,6 +110,33 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
   return points;
 }
 
+Result<PointSet> readInput(const std::string& path, const ReadOptions& read, GltfReadOptions gltf,
+                           const InputOptionNames& names) {
+  Result<FileFormat> format = formatOf(path);
+  if (!format) return format.error();
+  if (*format == FileFormat::kGlb || *format == FileFormat::kGltf) {
+    gltf.max_memory = read.max_memory;
+    gltf.allow_nonfinite = read.allow_nonfinite;
+    gltf.max_points_name = names.max_points;
+    return readGltf(path, gltf);
+  }
+  if (gltf.scene >= 0 || gltf.all_scenes)
+    return Error{path + ": " + names.scenes + " apply to .glb/.gltf input only", ExitCode::kUsage};
+  auto tooMany = [&](uint64_t count) {
+    return Error{path + ": " + std::to_string(count) + " points exceed " + names.max_points + " " +
+                     std::to_string(gltf.max_points),
+                 ExitCode::kResourceLimit};
+  };
+  if (*format == FileFormat::kLas && gltf.max_points != 0) {  // the header's count, before allocating
+    Result<LasHeader> header = readLasHeader(path);
+    if (!header) return header.error();
+    if (header->point_count > gltf.max_points) return tooMany(header->point_count);
+  }
+  Result<PointSet> points = readPoints(path, read);
+  if (points && gltf.max_points != 0 && points->size() > gltf.max_points) return tooMany(points->size());
+  return points;
+}
+
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();

@@ -50,6 +50,18 @@ struct WriteOptions {
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});
+
+// How a caller names readInput's options in its messages: the CLI's flags, the module's keywords.
+struct InputOptionNames {
+  std::string scenes = "--scene and --all-scenes";
+  std::string max_points = "--max-points";
+};
+// An input as `dpoint convert` and the module's read take it: .glb/.gltf through readGltf(gltf)
+// (with read's max_memory and allow_nonfinite), every other format through readPoints(read), where
+// a scene choice is a usage error; more points than gltf.max_points (0: no limit) is
+// kResourceLimit, a LAS file's count taken from its header before anything is allocated.
+Result<PointSet> readInput(const std::string& path, const ReadOptions& read, GltfReadOptions gltf,
+                           const InputOptionNames& names = {});
 // An empty set is written as an empty file of the format (a CSV header, a PLY or LAS of 0 points);
 // GLB cannot hold one (glTF accessors have at least one element), and says so.
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options = {});

@@ -211,29 +211,14 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
   if (!source)
     raise(Error{"colors: '" + colors + "' is not one of auto, rgb, intensity, classification, none", ExitCode::kUsage});
   const uint64_t limit = take(memoryOption("max_memory", max_memory));
-  const FileFormat format = take(formatOf(path));
-  const bool gltf = format == FileFormat::kGlb || format == FileFormat::kGltf;
-  if (!gltf && (scene >= 0 || all_scenes))
-    raise(Error{path + ": scene and all_scenes apply to .glb/.gltf input only", ExitCode::kUsage});
+  GltfReadOptions g;
+  g.scene = scene, g.all_scenes = all_scenes, g.max_points = max_points;
   return std::make_shared<PointSet>(take(released([&] {
     Progress bar(progressFile(progress), "read");
-    Result<PointSet> read = [&]() -> Result<PointSet> {
-      if (gltf) {
-        GltfReadOptions g;
-        g.max_memory = limit, g.scene = scene, g.all_scenes = all_scenes, g.allow_nonfinite = allow_nonfinite;
-        g.max_points = max_points;
-        return readGltf(path, g);
-      }
-      ReadOptions r{threads, allow_nonfinite, &bar};
-      r.max_memory = limit;
-      r.las_color = *source;
-      return readPoints(path, r);
-    }();
-    if (read && max_points != 0 && read->size() > max_points)
-      return Result<PointSet>(Error{path + ": " + std::to_string(read->size()) + " points exceed max_points " +
-                                        std::to_string(max_points),
-                                    ExitCode::kResourceLimit});
-    return read;
+    ReadOptions r{threads, allow_nonfinite, &bar};
+    r.max_memory = limit;
+    r.las_color = *source;
+    return readInput(path, r, g, InputOptionNames{"scene and all_scenes", "max_points"});
   })));
 }
 

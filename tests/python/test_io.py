@@ -185,6 +185,15 @@ def test_read_options(tmp_path, source):
     dpoint.write(points, tmp_path / "s.glb")
     assert np.array_equal(dpoint.read(tmp_path / "s.glb", scene=0).positions, points.positions)
     assert np.array_equal(dpoint.read(tmp_path / "s.glb", all_scenes=True).positions, points.positions)
+    # max_points as convert's --max-points, named as the keyword, in every format: a glTF's count and
+    # a LAS file's header are refused before the points are read.
+    dpoint.write(points, tmp_path / "s.las")
+    for ext in ("glb", "las", "csv"):
+        if ext == "csv":
+            dpoint.write(points, tmp_path / "s.csv")
+        with pytest.raises(MemoryError, match=r"exceed max_points 299|than max_points 299"):
+            dpoint.read(tmp_path / f"s.{ext}", max_points=299)
+        assert len(dpoint.read(tmp_path / f"s.{ext}", max_points=300)) == 300
 
 
 def test_read_non_finite_only_when_allowed(tmp_path):
