@@ -43,10 +43,6 @@ GltfReadOptions gltfOptions(const ConvertOptions& o) {
   return g;
 }
 
-bool isGltf(const Result<FileFormat>& format) {
-  return format && (*format == FileFormat::kGlb || *format == FileFormat::kGltf);
-}
-
 Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   GltfReadOptions g = gltfOptions(o);
   // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
@@ -80,15 +76,14 @@ int runConvert(ConvertOptions& o) {
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
   // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
   // point set; --unique and --order morton need the whole set, so they take the path below.
-  const Result<FileFormat> out_format = formatOf(o.output);
-  if (isGltf(formatOf(o.input)) && out_format && *out_format == FileFormat::kCsv && !o.unique &&
-      *order == PointOrder::kInput) {
+  const Result<FileFormat> in_format = formatOf(o.input), out_format = formatOf(o.output);
+  const bool to_csv = out_format && *out_format == FileFormat::kCsv;
+  if (in_format && isGltf(*in_format) && to_csv && !o.unique && *order == PointOrder::kInput) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
   // LAS → CSV: values at the file's step (849087.70 at 0.01 is "849087.7"), unless --decimals.
-  if (o.decimals < 0 && out_format && *out_format == FileFormat::kCsv && formatOf(o.input) &&
-      *formatOf(o.input) == FileFormat::kLas) {
+  if (o.decimals < 0 && to_csv && in_format && *in_format == FileFormat::kLas) {
     Result<LasHeader> header = readLasHeader(o.input);
     if (!header) return reportError(header.error());
     w.decimals = lasStepDecimals(*header);

@@ -114,7 +114,7 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
                            const InputOptionNames& names) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
-  if (*format == FileFormat::kGlb || *format == FileFormat::kGltf) {
+  if (isGltf(*format)) {
     gltf.max_memory = read.max_memory;
     gltf.allow_nonfinite = read.allow_nonfinite;
     gltf.max_points_name = names.max_points;

@@ -18,6 +18,7 @@ enum class FileFormat { kCsv, kPly, kGlb, kGltf, kLas, kLaz };
 
 // From the extension, case-insensitive. Error names the path and the extensions accepted.
 Result<FileFormat> formatOf(const std::string& path);
+inline bool isGltf(FileFormat format) { return format == FileFormat::kGlb || format == FileFormat::kGltf; }
 // The error for a format that is read but not written (.gltf, LAZ), with what to write instead;
 // ok for the others. writePoints and the CLI's output check both give it.
 Status checkWrittenFormat(const std::string& path, FileFormat format);

@@ -322,7 +322,8 @@ constexpr PositionAttribute kNone{};
 //   adaptive, batch, fp32, rte, native, df64 (adaptive faster on two sets of three, 2.5% over the
 //   three; rte and native tied, as before).
 // - GPU raster: bound by the point rasterizer (all within 0.2% at 16.7M: 19.18–19.22 ms, 19.88–20.93),
-//   ties ranked as on compute: batch, adaptive, fp32, native, rte, df64.
+//   ties ranked as compute was before the pair merge (a compute splat's only): batch, adaptive, fp32,
+//   native, rte, df64.
 // - lavapipe compute (16.7M Sierpinski, Morton): fp32 653, native 705, batch 857, rte 968, df64 986,
 //   adaptive 1046 ms. Raster: batch 4108 and adaptive 5359 ms, 2× the others (1794–2535 ms, within
 //   this machine's run-to-run spread of each other), which keep their earlier order: fp32, native,
@@ -352,7 +353,8 @@ constexpr ModeInfo kModes[] = {
      {DPOINT_SPIRV(kPointsBatchVert), {}, DPOINT_SPIRV(kSplatBatchComp), {{0, VK_FORMAT_R32G32_UINT, 0}, kNone}, 1},
      encodeBatchOffsets, noUniform, worstOf<batchBound>, nullptr, {{4, 2}, {0, 1}}, kBatchSteps},
     // Pulls its tier words in both backends (no attributes); chunks hold whole batches, so each
-    // 1024-point workgroup of the compute splat lies in one batch and loads 16 bytes a thread.
+    // 1024-point workgroup of the compute splat lies in one batch (a thread loads pairs of points,
+    // 8 bytes a tier).
     {PrecisionMode::kAdaptive, "adaptive", "per-batch tiers of 10 bits, as few as --tolerance allows", 12,
      kTierWords, true, false, false, false, kAdaptiveBatchSize, kAdaptiveBatchSize,
      {DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kPointsAdaptiveVert), DPOINT_SPIRV(kSplatAdaptiveComp),
