@@ -26,7 +26,7 @@ struct Capture {
 };
 thread_local Capture* t_capture = nullptr;
 
-int runApp(int argc, const char* const* argv) {
+int runAppUnguarded(int argc, const char* const* argv) {
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
                "CSV, PLY, GLB and LAS, render them offscreen with Vulkan in six precision modes, and inspect the\n"
                "precision a dataset needs.\n"
@@ -68,14 +68,24 @@ int runApp(int argc, const char* const* argv) {
     int code = app.exit(e);  // prints help, version or the usage error
     return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
   }
+  const int code = run ? run() : static_cast<int>(ExitCode::kUsage);
+  // A run cut short by SIGINT/SIGTERM exits 128 + signal whatever error the cut caused.
+  return code != 0 && interrupted() ? 128 + interruptSignal() : code;
+}
+
+// The one top-level catch: nothing thrown while the app is built, parsed or run reaches main (or
+// the Python module) as an exception; each becomes the house error with its exit code.
+int runApp(int argc, const char* const* argv) {
   try {
-    const int code = run ? run() : static_cast<int>(ExitCode::kUsage);
-    // A run cut short by SIGINT/SIGTERM exits 128 + signal whatever error the cut caused.
-    return code != 0 && interrupted() ? 128 + interruptSignal() : code;
+    return runAppUnguarded(argc, argv);
   } catch (const std::bad_alloc&) {
     return reportError(Error{"out of memory", ExitCode::kResourceLimit});
+  } catch (const UsageError& e) {
+    return reportError(Error{e.what(), ExitCode::kUsage});
   } catch (const std::exception& e) {
     return reportError(Error{std::string("internal error: ") + e.what(), ExitCode::kBadInput});
+  } catch (...) {
+    return reportError(Error{"internal error: an unknown exception", ExitCode::kBadInput});
   }
 }
 

@@ -224,6 +224,9 @@ int failOnValidationMessages(const VulkanContext& context) {
 }
 
 int runBenchReport(const BenchReportOptions& o) {
+  // The default --out is checked here, when bench runs, not while the command line is built: a
+  // folder no other command writes must not stop them (CLI11 validates a default_val at once).
+  if (Status s = checkOutputFolder("--out", o.out); !s) return reportError(Error{s.error().message, ExitCode::kUsage});
   BenchOptions options;
   if (o.suite == "ci") options.suites = {BenchSuite::kCi};
   else if (o.suite == "paper") options.suites = {BenchSuite::kPaper};
@@ -313,7 +316,7 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   bench->add_option("--suite", r->suite, "ci, paper, hard or all")->default_val("ci");
   bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")
       ->check(checkStatus([](const std::string& v) { return checkOutputFolder("--out", v); }))
-      ->default_val("bench-out");
+      ->default_str("bench-out");  // shown, not validated here: the default is checked when bench runs
   bench->add_option("--cache", r->cache, "Folder the datasets are made in and reused from")->default_val("bench-cache");
   bench->add_option("--device", r->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
       ->default_val("auto");

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -87,6 +88,11 @@ CommandResult runCommand(const std::vector<std::string>& argv, std::chrono::seco
     }
   }
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  // No dpoint run may die by a signal the test did not send (an uncaught exception's abort, a
+  // crash): whatever the test then asserts about the run, the test fails here (issue #36).
+  if (WIFSIGNALED(status) && !r.timed_out)
+    ADD_FAILURE() << argv[0] << " died by signal " << WTERMSIG(status) << " (" << ::strsignal(WTERMSIG(status))
+                  << "), exit status " << 128 + WTERMSIG(status);
   r.out = readFile(out_path);
   r.err = readFile(err_path);
   return r;

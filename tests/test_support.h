@@ -41,7 +41,8 @@ struct CommandResult {
 };
 // Runs argv[0] with the arguments (no shell), capturing stdout and stderr. With a non-zero
 // `limit`, a run still going after it is killed and marked timed_out: a bound for "does not
-// hang", generous so that it never measures speed (tests assert no timings).
+// hang", generous so that it never measures speed (tests assert no timings). A run that dies by
+// any other signal fails the calling test (ADD_FAILURE): no command may abort or crash.
 CommandResult runCommand(const std::vector<std::string>& argv, std::chrono::seconds limit = std::chrono::seconds(0));
 // Runs build/dpoint with the arguments.
 CommandResult runDpoint(const std::vector<std::string>& args);

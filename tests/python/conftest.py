@@ -33,6 +33,8 @@ SMALL_GENERATE = {
 def cli(*args, check=True):
     """Runs `dpoint ARGS`; the CompletedProcess (text)."""
     done = subprocess.run([EXECUTABLE, *map(str, args)], capture_output=True, text=True)
+    # No run may die by a signal (an abort, a crash), whatever the caller expects of it.
+    assert done.returncode >= 0, f"dpoint {' '.join(map(str, args))} died by signal {-done.returncode}: {done.stderr}"
     if check and done.returncode != 0:
         raise AssertionError(f"dpoint {' '.join(map(str, args))} exited {done.returncode}: {done.stderr}")
     return done
