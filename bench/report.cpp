@@ -171,7 +171,9 @@ std::string resultsJson(const BenchRun& run, const ReportContext& context, const
        ", \"driver_version\": " + jsonString(formatDriverVersion(d.vendor_id, d.driver_version)) +
        ", \"api_version\": " + jsonString(formatApiVersion(d.api_version)) + "},\n";
   s += "  \"copy_bandwidth\": " + copyBandwidthJson(run.copy_bandwidth) + ",\n";
-  s += "  \"seconds\": " + num(run.seconds) + ",\n  \"rows\": [\n";
+  s += "  \"seconds\": " + num(run.seconds) + ",\n";
+  if (context.baseline) s += "  \"baseline\": " + baselineJson(*context.baseline) + ",\n";
+  s += "  \"rows\": [\n";
   for (size_t i = 0; i < run.rows.size(); ++i) s += rowJson(run, run.rows[i]) + (i + 1 < run.rows.size() ? ",\n" : "\n");
   s += "  ],\n  \"check_failures\": [";
   for (size_t i = 0; i < failures.size(); ++i) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/baseline.h"
 #include "bench/run.h"
 #include "bench/svg_chart.h"
 #include "viewer/reference.h"
@@ -17,6 +18,7 @@ struct ReportContext {
   std::string command;  // the command line as the user typed it
   std::string date;     // UTC, ISO 8601
   std::string version;  // dpoint's
+  std::optional<BaselineReport> baseline;  // --baseline: the run against it (bench/baseline.h)
 };
 
 // A broken expectation of the modes' arithmetic (docs/precision.md): a measured error above its predicted bound, split not equal

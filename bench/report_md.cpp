@@ -269,6 +269,10 @@ std::string reportMarkdown(const BenchRun& run, const ReportContext& context, co
   glanceBreak(run, Sweep::kDeepZoom, "zooming in (view width)", s);
   glanceBreak(run, Sweep::kOffset, "moving away from the origin (offset in m, 1 mm detail, 0.1 m away)", s);
   s += failures.empty() ? "- **Checks**: all passed (below).\n" : "- **Checks**: " + std::to_string(failures.size()) + " failed (below).\n";
+  if (context.baseline)
+    s += "- **Against the baseline**: " + std::to_string(context.baseline->slower()) + " of " +
+         std::to_string(context.baseline->rows.size()) + " rows more than 5% slower (below).\n";
+  if (context.baseline) s += "\n" + baselineMarkdown(*context.baseline);
 
   const std::vector<const BenchCase*> speed = casesWhere(run, false), hard = casesWhere(run, true);
   if (!speed.empty()) {

@@ -20,6 +20,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include "bench/baseline.h"
 #include "bench/report.h"
 #include "bench/run.h"
 #include "cli/cli_check.h"
@@ -80,6 +81,7 @@ struct BenchReportOptions {
   bool validate = false, no_error = false, no_copy_bandwidth = false;
   std::string copy_bytes = "auto";
   uint32_t copy_repeats = 10;
+  std::string baseline;  // an earlier results.json to compare with; empty: none
   CommonOptions common;
 };
 
@@ -227,6 +229,12 @@ int runBenchReport(const BenchReportOptions& o) {
   // The default --out is checked here, when bench runs, not while the command line is built: a
   // folder no other command writes must not stop them (CLI11 validates a default_val at once).
   if (Status s = checkOutputFolder("--out", o.out); !s) return reportError(Error{s.error().message, ExitCode::kUsage});
+  std::optional<Baseline> baseline;  // read before the run: a bad file fails at once, not after it
+  if (!o.baseline.empty()) {
+    Result<Baseline> read = readBaseline(o.baseline);
+    if (!read) return reportError(read.error());
+    baseline = std::move(*read);
+  }
   BenchOptions options;
   if (o.suite == "ci") options.suites = {BenchSuite::kCi};
   else if (o.suite == "paper") options.suites = {BenchSuite::kPaper};
@@ -273,8 +281,9 @@ int runBenchReport(const BenchReportOptions& o) {
   Result<BenchRun> run = runBench(**context, options);
   if (!run) return reportError(run.error());
   const std::vector<CheckFailure> failures = checkRun(*run);
-  Result<std::vector<std::string>> written =
-      writeReport(*run, ReportContext{commandLine(o), utcNow(), DPOINT_VERSION}, failures, o.out);
+  ReportContext report{commandLine(o), utcNow(), DPOINT_VERSION, std::nullopt};
+  if (baseline) report.baseline = compareToBaseline(*run, *baseline);
+  Result<std::vector<std::string>> written = writeReport(*run, report, failures, o.out);
   if (!written) return reportError(written.error());
 
   size_t skipped = 0;
@@ -283,6 +292,17 @@ int runBenchReport(const BenchReportOptions& o) {
               run->device.name.c_str(), run->seconds);
   for (const std::string& path : *written) std::printf("wrote %s\n", path.c_str());
   if (!failures.empty()) std::fprintf(stderr, "dpoint: warning: %zu check(s) failed; see report.md\n", failures.size());
+  if (report.baseline) {
+    const BaselineReport& b = *report.baseline;
+    std::printf("bench: against %s: %zu of %zu rows more than 5%% slower\n", b.path.c_str(), b.slower(), b.rows.size());
+    for (const BaselineComparison& c : b.rows)
+      if (c.slower)
+        std::fprintf(stderr, "dpoint: warning: %s %s %s: %.4g ms against the baseline's %.4g ms (%.2fx)\n",
+                     c.case_name.c_str(), c.backend.c_str(), c.mode.c_str(), c.now_ms, c.baseline_ms, c.ratio());
+    if (!b.same_device)
+      std::fprintf(stderr, "dpoint: warning: the baseline ran on %s, this run on %s\n", b.device.c_str(),
+                   run->device.name.c_str());
+  }
   return failOnValidationMessages(**context);
 }
 
@@ -328,6 +348,9 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
       ->check(checkStatus([](const std::string& v) { return statusOf(parseWarmup("--warmup", v)); }))
       ->default_val("300ms");
   bench->add_option("--sizes", r->sizes, "paper suite: only these of the float-vs-double Vulkan study's sizes, e.g. 10K,1M,16.7M")->delimiter(',');
+  bench->add_option("--baseline", r->baseline,
+                    "An earlier run's results.json (bench/results/baselines/ has one per device class): rows more\n"
+                    "than 5% slower than the same case, backend and mode there are marked in report.md and warned of");
   bench->add_flag("--no-error", r->no_error, "Time only: skip the probe draws and the exact reference (no error columns)");
   bench->add_flag("--validate", r->validate, "Enable the Khronos validation layer; any message fails the run");
   bench->add_flag("--no-copy-bandwidth", r->no_copy_bandwidth,

@@ -24,7 +24,7 @@ Spirv vertexShader(PrecisionMode mode, bool pull) {
   return pull && shaders.vertex_pull.code ? shaders.vertex_pull : shaders.vertex;
 }
 
-// 32-bit specialization constants 0, 1, …: the splat's 0 kProbe, 1 kEarlyDepth, 2 kSubgroupMerge and 3 kPairMerge, the resolve's
+// 32-bit specialization constants 0, 1, …: the splat's 0 kProbe, 1 kEarlyDepth, 2 kSubgroupMerge, 3 kPairMerge and 4 kLargePoints, the resolve's
 // 0 kWriteDepth, the shading passes' radii (fill.comp's 0, smooth.comp's 0, smooth_edl.comp's 0-2).
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout,
                                    std::span<const uint32_t> constants) {
@@ -50,9 +50,10 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
 }
 
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
-                                   bool early_depth, bool subgroup_merge = false, bool pair_merge = false) {
-  const uint32_t constants[4] = {probe ? VK_TRUE : VK_FALSE, early_depth ? VK_TRUE : VK_FALSE,
-                                 subgroup_merge ? VK_TRUE : VK_FALSE, pair_merge ? VK_TRUE : VK_FALSE};
+                                   const SplatVariant& v) {
+  const uint32_t constants[5] = {probe ? VK_TRUE : VK_FALSE, v.early_depth ? VK_TRUE : VK_FALSE,
+                                 v.subgroup_merge ? VK_TRUE : VK_FALSE, v.pair_merge ? VK_TRUE : VK_FALSE,
+                                 v.large_points ? VK_TRUE : VK_FALSE};
   return computePipeline(context, code, layout, constants);
 }
 
@@ -249,8 +250,7 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
 }
 
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth, bool write_log, bool subgroup_merge,
-                                                bool pair_merge) {
+                                                SplatVariant variant, bool write_log) {
   ComputePipelines p;
   auto fail = [&](const Error& error) -> Result<ComputePipelines> {
     destroyComputePipelines(context, p);
@@ -276,18 +276,19 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
   p.resolve_layout = *resolve_layout;
   // The merges only where early depth is on (the plain path the tests compare with keeps an
   // atomic per point).
-  const bool merge = early_depth && subgroup_merge && context.facts.subgroup_merge;
-  const bool pairs = early_depth && pair_merge;
-  Result<VkPipeline> splat = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, false, early_depth, merge, pairs);
+  variant.subgroup_merge = variant.early_depth && variant.subgroup_merge && context.facts.subgroup_merge;
+  variant.pair_merge = variant.early_depth && variant.pair_merge;
+  Result<VkPipeline> splat = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, false, variant);
   if (!splat) return fail(splat.error());
   p.splat = *splat;
   if (with_probe) {
-    Result<VkPipeline> probe = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, true, early_depth, merge, pairs);
+    Result<VkPipeline> probe = computePipeline(context, modeInfo(mode).shaders.splat, p.splat_layout, true, variant);
     if (!probe) return fail(probe.error());
     p.probe = *probe;
   }
+  const uint32_t resolve_constants[1] = {write_log ? VK_TRUE : VK_FALSE};
   Result<VkPipeline> resolve = computePipeline(context, {kPointsResolveComp, sizeof(kPointsResolveComp)}, p.resolve_layout,
-                                                 write_log, false);
+                                                 resolve_constants);
   if (!resolve) return fail(resolve.error());
   p.resolve = *resolve;
   return p;

@@ -72,14 +72,23 @@ struct ResolvePush {
   uint32_t width = 0, padded_width = 0, margin = 0;
   float depth_scale = 0.0f;
 };
-// `early_depth` off makes every visible point do its atomic (the plain path tests compare with).
-// `subgroup_merge` (with early_depth, on a device that has it: DeviceFacts::subgroup_merge) has the
-// lanes of a subgroup on one pixel test and write once; `pair_merge` (with early_depth; batch and
-// adaptive modes) two consecutive points on one pixel. `write_log` has the resolve also write each
-// pixel's log distance (binding 3) for the shading.
+// The splat's variant, fixed when its pipeline is made (specialization constants).
+struct SplatVariant {
+  // Off: every visible point does its atomic (the plain path tests compare with).
+  bool early_depth = true;
+  // With early_depth, on a device that has it (DeviceFacts::subgroup_merge): the lanes of a
+  // subgroup on one pixel test and write once.
+  bool subgroup_merge = true;
+  // With early_depth; batch and adaptive modes: two consecutive points on one pixel.
+  bool pair_merge = true;
+  // Points may be larger than a pixel; false for a render of 1-px points, whose splat then has no
+  // square loop (lavapipe: 1.4-1.6x faster, issue #38).
+  bool large_points = true;
+};
+
+// `write_log` has the resolve also write each pixel's log distance (binding 3) for the shading.
 Result<ComputePipelines> createComputePipelines(const VulkanContext& context, PrecisionMode mode, bool with_probe,
-                                                bool early_depth = true, bool write_log = false,
-                                                bool subgroup_merge = true, bool pair_merge = true);
+                                                SplatVariant variant = {}, bool write_log = false);
 void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pipelines);
 
 // Shading after either backend (shaders/render/shade_common.glsl): reads a float depth per pixel

@@ -476,9 +476,11 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   std::future<Status> pipelines_made = std::async(std::launch::async, [&]() -> Status {
     if (compute) {
       Result<ComputePipelines> pipelines =
-          createComputePipelines(context, options.mode, options.probe, options.early_depth, shading,
-                                 options.subgroup_merge.value_or(context.facts.type != "cpu"),
-                                 options.pair_merge.value_or(context.facts.type != "cpu"));
+          createComputePipelines(context, options.mode, options.probe,
+                                 SplatVariant{options.early_depth, options.subgroup_merge.value_or(context.facts.type != "cpu"),
+                                              options.pair_merge.value_or(context.facts.type != "cpu"),
+                                              options.point_size != 1.0f},
+                                 shading);
       if (!pipelines) return pipelines.error();
       r.compute = *pipelines;
     } else {

@@ -3,6 +3,8 @@
 // pixel with a 64-bit atomicMax into a visibility buffer; a resolve pass per pixel then fetches
 // the winner's colour. No rasterizer, no depth attachment: on GPUs whose graphics front end is
 // small next to their compute (H100/H200 run graphics on two TPCs) this is the fast path.
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include "viewer/render_internal.h"
@@ -63,6 +65,22 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   return r.shade.log ? createShadeDescriptors(context, r) : okStatus();
 }
 
+namespace {
+
+// A deliberately slowed build without a rebuild, for the test that `dpoint bench --baseline` flags
+// one (issue #38): DPOINT_TEST_SPLAT_REPEAT=N records every frame's splat N times. The picture is
+// the same (atomicMax of the same keys); only the frame's time grows.
+uint32_t splatRepeats() {
+  static const uint32_t repeats = [] {
+    const char* text = std::getenv("DPOINT_TEST_SPLAT_REPEAT");
+    const long n = text ? std::strtol(text, nullptr, 10) : 1;
+    return static_cast<uint32_t>(std::clamp(n, 1L, 64L));
+  }();
+  return repeats;
+}
+
+}  // namespace
+
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
                    uint32_t width, uint32_t height, bool timed) {
   auto barrier = [&](VkPipelineStageFlags src_stage, VkAccessFlags src, VkPipelineStageFlags dst_stage, VkAccessFlags dst) {
@@ -84,22 +102,24 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
   const uint32_t batch_points = modeInfo(options.mode).batch_points;  // splats the plan's batch list
   static_assert(kBatchSize % kSplatPointsPerGroup == 0 && kAdaptiveBatchSize % kSplatPointsPerGroup == 0,
                 "a splat workgroup lies in one batch");
-  for (const Chunk& chunk : r.chunks) {
-    const uint32_t groups = chunk.listed ? chunk.list_count * (batch_points / kSplatPointsPerGroup)
-                                         : static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup);
-    if (groups == 0) continue;  // every batch of the chunk culled
-    PushConstants push;
-    push.point_size = options.point_size;
-    push.first_index = static_cast<uint32_t>(chunk.first);
-    push.width = width;
-    push.height = height;
-    push.count = static_cast<uint32_t>(chunk.count);
-    push.list_first = chunk.list_first;
-    push.listed = chunk.listed ? 1u : 0u;
-    push.batch_shift = batchShift(options.mode);
-    vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
-    vkCmdDispatch(commands, groups, 1, 1);
+  for (uint32_t repeat = 0; repeat < splatRepeats(); ++repeat) {
+    for (const Chunk& chunk : r.chunks) {
+      const uint32_t groups = chunk.listed ? chunk.list_count * (batch_points / kSplatPointsPerGroup)
+                                           : static_cast<uint32_t>((chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup);
+      if (groups == 0) continue;  // every batch of the chunk culled
+      PushConstants push;
+      push.point_size = options.point_size;
+      push.first_index = static_cast<uint32_t>(chunk.first);
+      push.width = width;
+      push.height = height;
+      push.count = static_cast<uint32_t>(chunk.count);
+      push.list_first = chunk.list_first;
+      push.listed = chunk.listed ? 1u : 0u;
+      push.batch_shift = batchShift(options.mode);
+      vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+      vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
+      vkCmdDispatch(commands, groups, 1, 1);
+    }
   }
   barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);

@@ -20,6 +20,9 @@ layout(constant_id = 1) const bool kEarlyDepth = true;
 layout(constant_id = 2) const bool kSubgroupMerge = false;
 // Batch and adaptive modes keep one key for two consecutive points on one pixel (splatPair).
 layout(constant_id = 3) const bool kPairMerge = false;
+// Points larger than one pixel may be drawn (pc.point_size); false compiles their loop away. The
+// loop's mere presence, never taken, had made lavapipe's 1-px frames 1.4-1.6x slower (issue #38).
+layout(constant_id = 4) const bool kLargePoints = true;
 layout(local_size_x = 256) in;
 const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.h
 
@@ -74,10 +77,10 @@ void splat(uint i, vec4 clip) {
   float depth = clip.z / clip.w;
   float x = (clip.x / clip.w * 0.5 + 0.5) * float(pc.width);
   float y = (clip.y / clip.w * 0.5 + 0.5) * float(pc.height);
-  uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
-  if (pc.point_size == 1.0) {
+  if (!kLargePoints || pc.point_size == 1.0) {
     int px = int(ceil(x)) - 1, py = int(ceil(y)) - 1;
     if (px < 0 || py < 0 || px >= int(pc.width) || py >= int(pc.height)) return;
+    uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
     uint pixel = uint(py) * pc.width + uint(px);
     // Where every active lane of the subgroup lands on one pixel (dense sets in Morton order: 1e9
     // points put about 500 on a pixel), one lane tests and writes the largest key of them: the
@@ -98,6 +101,7 @@ void splat(uint i, vec4 clip) {
   // depth test stays exact (a key per pixel) and the picture is the raster one. Clipped by its centre
   // (above), then to the picture. s² atomics a point at most: the sizes pointSizeFor picks are small
   // where the points are many, and kEarlyDepth skips most of them on a closed surface.
+  uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);
   float half_size = 0.5 * pc.point_size;
   int x0 = max(int(ceil(x - half_size - 0.5)), 0), x1 = min(int(ceil(x + half_size - 0.5)) - 1, int(pc.width) - 1);
   int y0 = max(int(ceil(y - half_size - 0.5)), 0), y1 = min(int(ceil(y + half_size - 0.5)) - 1, int(pc.height) - 1);
@@ -215,10 +219,9 @@ void main() {
   }
 #elif defined(MODE_BATCH)
   for (uint k = 0u; k < kPointsPerThread / 2u; ++k) {
-    int first = group_first + int(2u * (gl_LocalInvocationID.x + k * gl_WorkGroupSize.x));
-    if (first < 0) continue;
-    uint i = uint(first);
-    if (i >= pc.count) break;
+    // A point before the chunk (group_first < 0) wraps to a large i and is skipped like one past it.
+    uint i = uint(group_first + int(2u * (gl_LocalInvocationID.x + k * gl_WorkGroupSize.x)));
+    if (i >= pc.count) continue;
     if (i + 1u < pc.count) {
       uvec4 pair = position_pairs[i >> 1];
       // index is even (chunks start at even points in batch mode: viewer/render.cpp's chunkPoints),

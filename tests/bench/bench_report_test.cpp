@@ -17,6 +17,8 @@
 namespace dpoint {
 namespace {
 
+ReportContext testContext() { return ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0", std::nullopt}; }
+
 // One case, one backend, every mode measured with `errors` (NaN: every point lost) and `bounds`.
 BenchRun madeUpRun(const std::array<double, kModeCount>& errors, const std::array<double, kModeCount>& bounds) {
   BenchRun run;
@@ -110,7 +112,7 @@ TEST(BenchReport, checksCatchADoubleModeNoBetterThanFp32WhereFp32IsOff) {
 TEST(BenchReport, resultsJsonWritesNullForWhatWasNotMeasured) {
   BenchRun run = madeUpRun({kLost, kLost, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {kInf, kInf, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
   run.rows[2].gpu_ms_median.reset();
-  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, checkRun(run));
+  const std::string json = resultsJson(run, testContext(), checkRun(run));
   EXPECT_NE(json.find("\"mode\": \"fp32\""), std::string::npos);
   EXPECT_NE(json.find("\"predicted_bound_px\": null"), std::string::npos) << "an unbounded mode has no number";
   EXPECT_NE(json.find("\"error_px\": null"), std::string::npos) << "every point lost: no error";
@@ -232,14 +234,14 @@ TEST(BenchReport, reportShowsThePlansLoadedBytesAndAdaptivesTiers) {
   adaptive.warmup_frames = 7;
   adaptive.warmup_ms = 301.5;
   for (BenchRow& row : run.rows) setBandwidthBound(row, nullptr);
-  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string json = resultsJson(run, testContext(), {});
   EXPECT_NE(json.find("\"loaded_bytes_per_point\": 6, \"culled_share\": 0.25, \"tier_share\": null"), std::string::npos)
       << json;
   EXPECT_NE(json.find("\"loaded_bytes_per_point\": 4.5, \"culled_share\": 0.5, \"tier_share\": [0.25, 0.125, 0.125]"),
             std::string::npos)
       << json;
   EXPECT_NE(json.find("\"warmup\": {\"frames\": 7, \"ms\": 301.5}"), std::string::npos) << json;
-  const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string report = reportMarkdown(run, testContext(), {});
   EXPECT_NE(report.find("; 6 B/pt loaded)"), std::string::npos) << report;
   EXPECT_NE(report.find("; 4.5 B/pt loaded, tiers 25/12.5/12.5%)"), std::string::npos) << report;
   EXPECT_NE(report.find(" | 4.5 | 50% culled, tiers 25/12.5/12.5% | "), std::string::npos) << report;
@@ -260,7 +262,7 @@ TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
   copy.read_write_gb_per_s = 67.108864;
   run.copy_bandwidth = copy;
   for (BenchRow& row : run.rows) setBandwidthBound(row, &copy);
-  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string json = resultsJson(run, testContext(), {});
   EXPECT_NE(json.find("\"copy_bandwidth\": {\"read_write_gb_per_s\": 67.108864, \"copy_gb_per_s\": 33.554432, "
                       "\"copy_bytes\": 67108864, \"copies\": 5"),
             std::string::npos)
@@ -274,7 +276,7 @@ TEST(BenchReport, resultsJsonCarriesTheCopyBandwidthAndEachRowsBound) {
             std::string::npos)
       << json;
   EXPECT_EQ(json.find("\"bandwidth_fraction\": null"), std::string::npos);
-  const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string report = reportMarkdown(run, testContext(), {});
   EXPECT_NE(report.find("Copy bandwidth: **67.1 GB/s read+write, 33.6 GB/s copied"), std::string::npos) << report;
 }
 
@@ -283,12 +285,12 @@ TEST(BenchReport, resultsJsonWritesNullBandwidthWhenNotMeasured) {
   for (BenchRow& row : run.rows) setBandwidthBound(row, nullptr);
   run.rows[0].backend = Backend::kRaster;
   setBandwidthBound(run.rows[0], nullptr);
-  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string json = resultsJson(run, testContext(), {});
   EXPECT_NE(json.find("\"copy_bandwidth\": null"), std::string::npos);
   EXPECT_NE(json.find("\"bytes_per_frame\": null"), std::string::npos) << "raster: no frame bytes";
   EXPECT_NE(json.find("\"bandwidth_bound_ms\": null, \"bandwidth_fraction\": null"), std::string::npos);
   EXPECT_EQ(json.find("\"bandwidth_fraction\": 0"), std::string::npos);
-  const std::string report = reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string report = reportMarkdown(run, testContext(), {});
   EXPECT_NE(report.find("Copy bandwidth: not measured"), std::string::npos);
 }
 
@@ -341,7 +343,7 @@ BenchRun speedRun(const std::vector<std::pair<Frames, Frames>>& fp32_native) {
 }
 
 std::string markdownOf(const BenchRun& run) {
-  return reportMarkdown(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  return reportMarkdown(run, testContext(), {});
 }
 
 TEST(BenchReport, ratioWithinTheFramesSpreadIsNotCalledFaster) {
@@ -398,7 +400,7 @@ TEST(BenchReport, reportCitesNothingOutsideTheRepository) {
   ASSERT_FALSE(failures.empty()) << "split differs from fp32";
   test::TempDir dir;
   Result<std::vector<std::string>> written =
-      writeReport(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, failures, dir.path());
+      writeReport(run, testContext(), failures, dir.path());
   ASSERT_TRUE(written) << written.error().message;
   size_t text_files = 0;
   for (const std::string& path : *written) {
@@ -480,7 +482,7 @@ TEST(BenchReport, everyPaperRowShowsBothColumnsOfBothStudyTables) {
   }
   EXPECT_NE(report.find("| 2D random 10M |"), std::string::npos);
   EXPECT_NE(report.find("| –, 218 fps (figure caption) |"), std::string::npos) << report;
-  const std::string json = resultsJson(run, ReportContext{"dpoint bench", "2026-11-23T00:00:00Z", "0"}, {});
+  const std::string json = resultsJson(run, testContext(), {});
   EXPECT_NE(json.find("\"native\": {\"rendering_time_ms\": \"31.12.16\", \"fps\": \"763\"}"), std::string::npos);
 }
 
@@ -530,6 +532,46 @@ TEST(BenchSuites, nearViewLooksAtTheBoxCentreFromTheGivenDistance) {
   ASSERT_TRUE(spec.eye && spec.target && spec.up);
   EXPECT_EQ(*spec.target, glm::dvec3(6378138.0, 0.0, 1.0));
   EXPECT_EQ(*spec.eye, glm::dvec3(6378138.2, 0.4, 3.0));
+}
+
+// --baseline (issue #38): a run read back from its own results.json is its baseline; a row more
+// than 5% slower than there is marked, one 5% slower or less is not, and both reports say so.
+TEST(BenchBaseline, aRowMoreThanFivePercentSlowerIsMarked) {
+  test::TempDir dir;
+  BenchRun before = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
+  test::writeFile(dir.file("results.json"), resultsJson(before, testContext(), {}));
+  Result<Baseline> baseline = readBaseline(dir.file("results.json"));
+  ASSERT_TRUE(baseline) << baseline.error().message;
+  EXPECT_EQ(baseline->rows.size(), kModeCount);
+
+  BenchRun after = madeUpRun({1, 1, 1, 1, 1, 1, 1}, {kInf, kInf, 1, 1, 1, 1, 1});
+  after.rows[0].gpu_ms_median = 1.06;  // fp32: 6% slower
+  after.rows[1].gpu_ms_median = 1.05;  // split: 5%, within the tolerance
+  after.rows[2].gpu_ms_median = 0.5;   // rte: faster
+  const BaselineReport report = compareToBaseline(after, *baseline);
+  ASSERT_EQ(report.rows.size(), kModeCount);
+  EXPECT_EQ(report.slower(), 1u);
+  EXPECT_TRUE(report.rows[0].slower);
+  EXPECT_FALSE(report.rows[1].slower);
+  EXPECT_TRUE(report.same_device);
+
+  ReportContext context = testContext();
+  context.baseline = report;
+  EXPECT_TRUE(test::contains(reportMarkdown(after, context, {}), "1 more than 5% slower"));
+  EXPECT_TRUE(test::contains(reportMarkdown(after, context, {}), "| made up | compute | fp32 | 1.0000 | 1.0600 | 1.060 | **slower** |"));
+  const std::string json = resultsJson(after, context, {});
+  EXPECT_TRUE(test::contains(json, "\"slower\": 1,"));
+  EXPECT_TRUE(test::contains(json, "\"mode\": \"fp32\", \"baseline_ms\": 1, \"gpu_ms\": 1.06"));
+}
+
+TEST(BenchBaseline, aFileThatIsNoResultsJsonIsRefusedByName) {
+  test::TempDir dir;
+  test::writeFile(dir.file("other.json"), "{\"asset\": {}}");
+  Result<Baseline> baseline = readBaseline(dir.file("other.json"));
+  ASSERT_FALSE(baseline);
+  EXPECT_TRUE(test::contains(baseline.error().message, "other.json: not a dpoint bench results.json: no \"rows\" array"));
+  EXPECT_EQ(baseline.error().code, ExitCode::kBadInput);
+  EXPECT_FALSE(readBaseline(dir.file("missing.json")));
 }
 
 }  // namespace
