@@ -11,5 +11,9 @@ set -euo pipefail
 source bench/scripts/gpu_env.sh
 .gpu/dpoint devices | tee "$out/devices.txt"
 mkdir -p "$out/bench"
+# BASELINE (h100 or h200): compare with bench/results/baselines/$BASELINE.json where it exists
+# (issue #38: rows more than 5% slower are marked); a run without one can become it.
+baseline=()
+[ -f "bench/results/baselines/${BASELINE:-h100}.json" ] && baseline=(--baseline "bench/results/baselines/${BASELINE:-h100}.json")
 .gpu/dpoint bench --suite "${SUITE:-all}" --frames "${FRAMES:-20}" --warmup "${WARMUP:-300ms}" --out "$out/bench" \
-  --cache /tmp/dpoint-bench-cache
+  --cache /tmp/dpoint-bench-cache "${baseline[@]}"

@@ -10,6 +10,10 @@ bin=${1:-build/dpoint}
 data=${DATA:-/tmp/dpoint-lavapipe}
 out=${OUT:-bench/results/$(date +%F)/lavapipe/speed-$(date +%F).tsv}
 mkdir -p "$data" "$(dirname "$out")"
+# First the regression check (issue #38): the paper suite's 1M sets against the recorded lavapipe
+# baseline; rows more than 5% slower are warned of and marked in its report.md.
+"$bin" bench --suite paper --sizes 1M --frames 10 --baseline bench/results/baselines/lavapipe.json \
+  --out "$(dirname "$out")/bench-vs-baseline" --cache "$data/bench-cache" -q
 [ -s "$out" ] || printf 'dataset\torder\tmode\tbackend\tpoints\tgpu_ms_median\tgpu_ms_p95\tframes\n' >"$out"
 value() { python3 -c "import json,sys; d=json.load(open('$data/r.json')); print(d['points'], d['gpu_ms']['median'], d['gpu_ms']['p95'], sep='\t')"; }
 for set in ${SETS:-sierpinski mandelbulb}; do
