@@ -27,7 +27,7 @@ struct ConvertOptions {
   std::string color_format = "linear";
   uint64_t max_points = 0;
   std::string order = "input";
-  double las_scale = 0.001;
+  double las_scale = 0.0;  // 0: the input LAS file's, else 0.001
   std::string max_memory;
   uint64_t memory_limit = 0;  // max_memory parsed
   CommonOptions common;
@@ -116,8 +116,9 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->default_val("uchar");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "
-                  "down to a whole number); a point beyond the 32-bit integers at this step is an error (exit 2)")
-      ->default_val(0.001)
+                  "down to a whole number); a point beyond the 32-bit integers at this step is an error (exit 2). "
+                  "Default: a LAS input's own scale and offset (the same point records), else 0.001")
+      ->default_str("auto")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");

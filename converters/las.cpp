@@ -17,6 +17,7 @@
 
 #include <glm/common.hpp>
 
+#include "converters/las_fields.h"
 #include "core/atomic_file.h"
 #include "core/input_file.h"
 #include "core/memory.h"
@@ -34,7 +35,8 @@ constexpr size_t kVersionMajorAt = 24, kVersionMinorAt = 25, kSystemIdAt = 26, k
 constexpr size_t kHeaderSizeAt = 94, kPointOffsetAt = 96, kVlrCountAt = 100, kFormatAt = 104;
 constexpr size_t kRecordLengthAt = 105, kLegacyCountAt = 107, kLegacyByReturnAt = 111;
 constexpr size_t kScaleAt = 131, kOffsetAt = 155, kBoundsAt = 179;  // bounds: max x, min x, max y, ...
-constexpr size_t kEvlrCountAt = 243, kCountAt = 247;                 // LAS 1.4
+constexpr size_t kEvlrStartAt = 235, kEvlrCountAt = 243, kCountAt = 247;  // LAS 1.4
+constexpr size_t kVlrHeaderBytes = 54, kEvlrHeaderBytes = 60;
 // Header sizes: 1.0–1.2, 1.3 (adds the waveform packet start), 1.4 (EVLRs, 64-bit counts).
 constexpr uint32_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
 
@@ -100,6 +102,8 @@ Result<LasHeader> parseHeader(const InputFile& file) {
     return Error{path + ": header: header size " + str(hd.header_size) + " is smaller than LAS " + version + "'s " +
                  str(needed) + " bytes"};
   hd.generating_software = textField(h + kSoftwareAt, 32);
+  hd.file_source_id = load<uint16_t>(h + 4);
+  hd.global_encoding = load<uint16_t>(h + 6);
 
   const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
   if (raw_format & 0xC0) return lasCompressedError(path);  // LAZ marks its records with bit 7 (old: 6)
@@ -188,11 +192,14 @@ constexpr std::array<uint8_t, 3> kOtherClassColor = {200, 200, 200};
 // Decodes the point records into a PointSet (see the top of las.h for the colour rules).
 class LasReader {
  public:
-  LasReader(const InputFile& file, const LasHeader& header, LasColorSource source, const LasReadOptions& options)
-      : file_(file), h_(header), source_(source), options_(options) {
+  LasReader(const InputFile& file, const LasHeader& header, LasColorSource source, const LasReadOptions& options,
+            std::vector<LasExtraField> extra)
+      : file_(file), h_(header), source_(source), options_(options), fields_(lasFields(header.point_format)),
+        extra_(std::move(extra)) {
     rgb_at_ = kRgbAt[static_cast<size_t>(h_.point_format)];
     class_at_ = h_.point_format >= 6 ? 16 : 15;
     class_mask_ = h_.point_format >= 6 ? 0xFF : 0x1F;
+    extra_at_ = lasBaseRecordLength(h_.point_format);
     for (size_t c = 0; c < palette_.size(); ++c) palette_[c] = lasClassColor(static_cast<uint8_t>(c));
   }
 
@@ -205,6 +212,12 @@ class LasReader {
     points.z_up = true;               // LAS is z-up (elevation)
     points.positions.resize(count);
     if (source_ != LasColorSource::kNone) points.colors.resize(count);
+    // Every field of the record, and each extra byte field, as a dimension (core/dimensions.h).
+    for (const LasField& f : fields_) points.dimensions.add(f.name, f.type, count);
+    for (const LasExtraField& f : extra_) points.dimensions.add(f.name, f.type, count);
+    columns_.clear();  // pointers once every column is in place (adding one may move the others)
+    for (const LasField& f : fields_) columns_.push_back(points.dimensions.find(f.name));
+    for (const LasExtraField& f : extra_) columns_.push_back(points.dimensions.find(f.name));
     const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
     const size_t blocks = (count + block_points - 1) / block_points;
     const unsigned threads = resolveThreads(options_.threads);
@@ -236,6 +249,7 @@ class LasReader {
     uint16_t largest = 0;
     for (uint16_t m : block_max) largest = std::max(largest, m);
     normalize(points, largest, threads);
+    if (source_ == LasColorSource::kRgb) points.color_full_scale = largest > 255 ? 65535 : 255;
     if (options_.progress) options_.progress->finish();
     return points;
   }
@@ -255,6 +269,7 @@ class LasReader {
       positions[i] = glm::dvec3(static_cast<double>(load<int32_t>(p)) * scale.x + offset.x,
                                 static_cast<double>(load<int32_t>(p + 4)) * scale.y + offset.y,
                                 static_cast<double>(load<int32_t>(p + 8)) * scale.z + offset.z);
+      decodeFields(p, i);
       switch (source_) {
         case LasColorSource::kRgb: {
           const uint16_t r = load<uint16_t>(p + rgb_at_), g = load<uint16_t>(p + rgb_at_ + 2),
@@ -294,10 +309,33 @@ class LasReader {
     });
   }
 
+  // The record's fields and extra bytes into point i's dimensions, as stored (bit fields shifted down).
+  void decodeFields(const char* record, size_t i) const {
+    for (size_t k = 0; k < fields_.size(); ++k) {
+      const LasField& f = fields_[k];
+      Dimension& d = *columns_[k];
+      if (f.bits) {
+        d.set<uint8_t>(i, static_cast<uint8_t>((static_cast<uint8_t>(record[f.offset]) >> f.shift) & ((1u << f.bits) - 1)));
+      } else {
+        const size_t w = dimTypeSize(f.type);
+        std::memcpy(d.bytes.data() + i * w, record + f.offset, w);
+      }
+    }
+    for (size_t k = 0; k < extra_.size(); ++k) {
+      Dimension& d = *columns_[fields_.size() + k];
+      const size_t w = dimTypeSize(d.type);
+      std::memcpy(d.bytes.data() + i * w, record + extra_at_ + extra_[k].offset, w);
+    }
+  }
+
   const InputFile& file_;
   const LasHeader& h_;
   LasColorSource source_;
   const LasReadOptions& options_;
+  const std::vector<LasField>& fields_;
+  std::vector<LasExtraField> extra_;
+  std::vector<Dimension*> columns_;  // fields_ then extra_, into the point set being read
+  uint32_t extra_at_ = 0;
   size_t rgb_at_ = 0, class_at_ = 15;
   uint8_t class_mask_ = 0x1F;
   std::array<glm::vec3, 256> palette_;
@@ -337,37 +375,222 @@ double chooseOffset(const std::vector<glm::dvec3>& positions, int k, double min,
   return first;
 }
 
-// Colours leave as round(clamp(c, 0, 1) · 65535), NaN as 0; c · 65535 is exact in double (24 + 16
+// Colours leave as round(clamp(c, 0, 1) · full), NaN as 0, where full is 65535 or, for colours
+// read as 8-bit (PointSet::color_full_scale), 255: c · full is exact in double (24 + 16
 // significant bits), so adding 0.5 and truncating rounds half up without a libm call.
-uint16_t colorWord(float c) {
+uint16_t colorWord(float c, double full) {
   if (!(c > 0.0f)) return 0;
-  return static_cast<uint16_t>(std::min(static_cast<double>(c), 1.0) * 65535.0 + 0.5);
+  return static_cast<uint16_t>(std::min(static_cast<double>(c), 1.0) * full + 0.5);
 }
 
-// The 227-byte LAS 1.2 header. Creation day and year are 0 ("not given") so that the same points
-// give the same bytes on any day.
-std::array<char, kHeaderSize12> writerHeader(int format, uint32_t record_length, uint32_t count, double scale,
-                                             const glm::dvec3& offset, const glm::dvec3& min, const glm::dvec3& max) {
-  std::array<char, kHeaderSize12> h{};
+// What the writer puts in a file beside the records.
+struct WriterLayout {
+  int format = 0, version_minor = 2;
+  uint32_t record_length = 0, base_length = 0;
+  std::vector<LasExtraField> extra;  // dimensions kept as extra bytes, after the base record
+  std::vector<LasVlr> vlrs, evlrs;
+  uint16_t global_encoding = 0, file_source_id = 0;
+};
+
+// The LAS 1.2 (227-byte) or 1.4 (375-byte) header. Creation day and year are 0 ("not given") so
+// that the same points give the same bytes on any day.
+std::string writerHeader(const WriterLayout& l, uint64_t count, const std::array<uint64_t, 15>& by_return,
+                         const glm::dvec3& scale, const glm::dvec3& offset, const glm::dvec3& min,
+                         const glm::dvec3& max, uint32_t point_offset, uint64_t evlr_start) {
+  const bool v14 = l.version_minor >= 4;
+  std::string h(v14 ? kHeaderSize14 : kHeaderSize12, '\0');
   std::memcpy(h.data(), "LASF", 4);
+  store<uint16_t>(h.data() + 4, l.file_source_id);
+  store<uint16_t>(h.data() + 6, l.global_encoding);
   h[kVersionMajorAt] = 1;
-  h[kVersionMinorAt] = 2;
+  h[kVersionMinorAt] = static_cast<char>(l.version_minor);
   std::memcpy(h.data() + kSystemIdAt, "OTHER", 5);
   std::memcpy(h.data() + kSoftwareAt, "dpoint", 6);
-  store<uint16_t>(h.data() + kHeaderSizeAt, kHeaderSize12);
-  store<uint32_t>(h.data() + kPointOffsetAt, kHeaderSize12);
-  h[kFormatAt] = static_cast<char>(format);
-  store<uint16_t>(h.data() + kRecordLengthAt, static_cast<uint16_t>(record_length));
-  store<uint32_t>(h.data() + kLegacyCountAt, count);
-  store<uint32_t>(h.data() + kLegacyByReturnAt, count);  // every point is return 1 of 1
+  store<uint16_t>(h.data() + kHeaderSizeAt, static_cast<uint16_t>(h.size()));
+  store<uint32_t>(h.data() + kPointOffsetAt, point_offset);
+  store<uint32_t>(h.data() + kVlrCountAt, static_cast<uint32_t>(l.vlrs.size()));
+  h[kFormatAt] = static_cast<char>(l.format);
+  store<uint16_t>(h.data() + kRecordLengthAt, static_cast<uint16_t>(l.record_length));
+  // The legacy counts: 0 where they cannot hold the truth (formats 6-10, more than 2^32 - 1 points).
+  const bool legacy = l.format < 6 && count <= UINT32_MAX;
+  store<uint32_t>(h.data() + kLegacyCountAt, legacy ? static_cast<uint32_t>(count) : 0u);
+  for (int r = 0; r < 5; ++r)
+    store<uint32_t>(h.data() + kLegacyByReturnAt + 4 * r, legacy ? static_cast<uint32_t>(by_return[r]) : 0u);
   for (int k = 0; k < 3; ++k) {
-    store<double>(h.data() + kScaleAt + 8 * k, scale);
+    store<double>(h.data() + kScaleAt + 8 * k, scale[k]);
     store<double>(h.data() + kOffsetAt + 8 * k, offset[k]);
     store<double>(h.data() + kBoundsAt + 16 * k, max[k]);
     store<double>(h.data() + kBoundsAt + 16 * k + 8, min[k]);
   }
+  if (v14) {
+    store<uint64_t>(h.data() + kEvlrStartAt, l.evlrs.empty() ? 0 : evlr_start);
+    store<uint32_t>(h.data() + kEvlrCountAt, static_cast<uint32_t>(l.evlrs.size()));
+    store<uint64_t>(h.data() + kCountAt, count);
+    for (int r = 0; r < 15; ++r) store<uint64_t>(h.data() + kCountAt + 8 + 8 * r, by_return[r]);
+  }
   return h;
 }
+
+// A VLR (54-byte header) or EVLR (60) with its data.
+std::string vlrBytes(const LasVlr& vlr, bool extended) {
+  std::string out(extended ? kEvlrHeaderBytes : kVlrHeaderBytes, '\0');
+  std::memcpy(out.data() + 2, vlr.user_id.data(), std::min<size_t>(vlr.user_id.size(), 16));
+  store<uint16_t>(out.data() + 18, vlr.record_id);
+  if (extended) store<uint64_t>(out.data() + 20, vlr.data.size());
+  else store<uint16_t>(out.data() + 20, static_cast<uint16_t>(vlr.data.size()));
+  std::memcpy(out.data() + (extended ? 28 : 22), vlr.description.data(), std::min<size_t>(vlr.description.size(), 32));
+  return out + vlr.data;
+}
+
+// The value v stored as `type` at p: rounded and clamped into an integer type's range.
+void storeValue(char* p, DimType type, double v) {
+  auto whole = [&](double lo, double hi) { return std::isnan(v) ? 0.0 : std::clamp(std::round(v), lo, hi); };
+  switch (type) {
+    case DimType::kU8: store<uint8_t>(p, static_cast<uint8_t>(whole(0, 255))); break;
+    case DimType::kI8: store<int8_t>(p, static_cast<int8_t>(whole(-128, 127))); break;
+    case DimType::kU16: store<uint16_t>(p, static_cast<uint16_t>(whole(0, 65535))); break;
+    case DimType::kI16: store<int16_t>(p, static_cast<int16_t>(whole(-32768, 32767))); break;
+    case DimType::kU32: store<uint32_t>(p, static_cast<uint32_t>(whole(0, 4294967295.0))); break;
+    case DimType::kI32: store<int32_t>(p, static_cast<int32_t>(whole(-2147483648.0, 2147483647.0))); break;
+    case DimType::kU64: store<uint64_t>(p, static_cast<uint64_t>(whole(0, 18446744073709549568.0))); break;
+    case DimType::kI64: store<int64_t>(p, static_cast<int64_t>(whole(-9223372036854775808.0, 9223372036854774784.0))); break;
+    case DimType::kF32: store<float>(p, static_cast<float>(v)); break;
+    case DimType::kF64: store<double>(p, v); break;
+  }
+}
+
+// Which format, extra bytes, version and records the writer uses for `points` (las_fields.h).
+Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n) {
+  WriterLayout l;
+  const LasSource* source = points.las ? &*points.las : nullptr;
+  l.format = lasFormatFor(points, source ? source->point_format : -1);
+  l.base_length = lasBaseRecordLength(l.format);
+  const std::vector<LasField>& fields = lasFields(l.format);
+  const auto isField = [&](const std::string& name) {
+    return std::any_of(fields.begin(), fields.end(), [&](const LasField& f) { return name == f.name; });
+  };
+  uint32_t at = 0;
+  for (const Dimension& d : points.dimensions.all()) {
+    if (isField(d.name)) continue;
+    // The other family's scan angle fills this format's, unless the set has that one too.
+    const char* counterpart = d.name == dim::kScanAngle ? dim::kScanAngleRank : d.name == dim::kScanAngleRank ? dim::kScanAngle : nullptr;
+    if (counterpart && isField(counterpart) && !points.dimensions.find(counterpart)) continue;
+    l.extra.push_back({d.name.substr(0, 32), d.type, at});
+    at += static_cast<uint32_t>(dimTypeSize(d.type));
+  }
+  l.record_length = l.base_length + at;
+  if (l.record_length > 65535)
+    return Error{path + ": " + str(points.dimensions.count()) + " dimensions make a " + str(l.record_length) +
+                 "-byte record, beyond LAS's 65535"};
+  const bool v14 = l.format >= 6 || (source && source->version_minor >= 4) || n > UINT32_MAX;
+  l.version_minor = v14 ? 4 : 2;
+  // Bit 0: GPS time is adjusted standard time; bit 4 (1.4): the coordinate system is WKT.
+  l.global_encoding = source ? static_cast<uint16_t>(source->global_encoding & (v14 ? 0x11 : 0x01)) : 0;
+  l.file_source_id = source ? source->file_source_id : 0;
+  if (source)
+    for (const LasVlr& vlr : source->vlrs) {
+      if (vlr.extended && v14) l.evlrs.push_back(vlr);
+      else if (vlr.data.size() <= 65535) l.vlrs.push_back(vlr);
+    }
+  if (!l.extra.empty()) l.vlrs.push_back(lasExtraBytesVlr(l.extra));
+  return l;
+}
+
+// Encodes point i of a set into a record of the layout's format.
+class RecordEncoder {
+ public:
+  RecordEncoder(const PointSet& points, const WriterLayout& l, const glm::dvec3& offset, const glm::dvec3& scale)
+      : points_(points), offset_(offset), scale_(scale) {
+    for (const LasField& f : lasFields(l.format)) {
+      Slot slot{f.name, f.type, f.offset, f.shift, f.bits, points.dimensions.find(f.name), Convert::kNone};
+      if (!slot.source && std::strcmp(f.name, dim::kScanAngleRank) == 0) {
+        slot.source = points.dimensions.find(dim::kScanAngle);
+        slot.convert = Convert::kAngleToRank;
+      } else if (!slot.source && std::strcmp(f.name, dim::kScanAngle) == 0) {
+        slot.source = points.dimensions.find(dim::kScanAngleRank);
+        slot.convert = Convert::kRankToAngle;
+      }
+      // A set without returns was one return a pulse: 1 of 1, as LAS readers expect.
+      slot.missing = std::strcmp(f.name, dim::kReturnNumber) == 0 || std::strcmp(f.name, dim::kNumberOfReturns) == 0 ? 1 : 0;
+      slots_.push_back(slot);
+    }
+    for (const LasExtraField& e : l.extra)
+      slots_.push_back({nullptr, e.type, l.base_length + e.offset, 0, 0, findExtra(e), Convert::kNone});
+    rgb_at_ = points.hasColors() ? lasRgbOffset(l.format) : 0;
+    color_scale_ = points.color_full_scale == 255 ? 255.0 : 65535.0;
+    return_number_ = points.dimensions.find(dim::kReturnNumber);
+    returns_ = l.format >= 6 ? 15 : 5;
+  }
+
+  void encode(size_t i, char* r) const {
+    const glm::dvec3& p = points_.positions[i];
+    for (int k = 0; k < 3; ++k) store<int32_t>(r + 4 * k, static_cast<int32_t>(quantize(p[k], offset_[k], scale_[k])));
+    for (const Slot& s : slots_) {
+      if (s.bits) {
+        const uint32_t v = s.source ? static_cast<uint32_t>(std::clamp(s.source->value(i), 0.0, 255.0)) : s.missing;
+        r[s.offset] = static_cast<char>(static_cast<uint8_t>(r[s.offset]) | ((v & ((1u << s.bits) - 1)) << s.shift));
+      } else if (!s.source) {
+        if (s.missing) storeValue(r + s.offset, s.type, s.missing);
+      } else if (s.convert == Convert::kAngleToRank) {
+        storeValue(r + s.offset, s.type, std::clamp(s.source->value(i) * 0.006, -90.0, 90.0));
+      } else if (s.convert == Convert::kRankToAngle) {
+        storeValue(r + s.offset, s.type, s.source->value(i) / 0.006);
+      } else if (s.source->type == s.type) {
+        const size_t w = dimTypeSize(s.type);
+        std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
+      } else {
+        storeValue(r + s.offset, s.type, s.source->value(i));
+      }
+    }
+    if (rgb_at_)
+      for (int c = 0; c < 3; ++c) store<uint16_t>(r + rgb_at_ + 2 * c, colorWord(points_.colors[i][c], color_scale_));
+  }
+
+  // Points by return number 1..15 (1..5 in formats 0-5), for the header.
+  std::array<uint64_t, 15> countByReturn(unsigned threads) const {
+    std::array<uint64_t, 15> counts{};
+    const size_t n = points_.size();
+    if (!return_number_) {
+      counts[0] = n;
+      return counts;
+    }
+    const size_t blocks = (n + kWriteBlockPoints - 1) / kWriteBlockPoints;
+    std::vector<std::array<uint64_t, 16>> partial(blocks);
+    parallelFor(blocks, threads, [&](size_t b, unsigned) {
+      partial[b] = {};
+      for (size_t i = b * kWriteBlockPoints, end = std::min(n, i + kWriteBlockPoints); i < end; ++i)
+        ++partial[b][static_cast<size_t>(std::clamp(return_number_->value(i), 0.0, 15.0))];
+    });
+    for (const auto& part : partial)
+      for (size_t r = 1; r <= returns_; ++r) counts[r - 1] += part[r];
+    return counts;
+  }
+
+ private:
+  enum class Convert { kNone, kAngleToRank, kRankToAngle };
+  struct Slot {
+    const char* name;
+    DimType type;
+    uint32_t offset;
+    uint8_t shift, bits;
+    const Dimension* source;
+    Convert convert;
+    uint32_t missing = 0;  // the value where the set lacks the dimension
+  };
+  const Dimension* findExtra(const LasExtraField& e) const {
+    for (const Dimension& d : points_.dimensions.all())
+      if (d.name.substr(0, 32) == e.name) return &d;
+    return nullptr;
+  }
+
+  const PointSet& points_;
+  glm::dvec3 offset_, scale_;
+  std::vector<Slot> slots_;
+  uint32_t rgb_at_ = 0;
+  double color_scale_ = 65535.0;
+  const Dimension* return_number_ = nullptr;
+  size_t returns_ = 5;
+};
 
 }  // namespace
 
@@ -416,6 +639,55 @@ Result<PointSet> readLas(const std::string& path, const LasReadOptions& options)
   return readLas(*file, options);
 }
 
+namespace {
+
+
+// The VLRs between the header and the points, and a 1.4 file's EVLRs after them. A list that runs
+// past its room ends the list (the points are still read, as before VLRs were kept).
+std::vector<LasVlr> readVlrs(const InputFile& file, const LasHeader& h) {
+  std::vector<LasVlr> out;
+  uint64_t at = h.header_size;
+  for (uint32_t k = 0; k < h.vlr_count && at + kVlrHeaderBytes <= h.point_offset; ++k) {
+    char v[kVlrHeaderBytes];
+    Result<size_t> got = file.readAt(at, v, sizeof v);
+    if (!got || *got < sizeof v) break;
+    LasVlr vlr{textField(v + 2, 16), load<uint16_t>(v + 18), textField(v + 22, 32), {}, false};
+    const uint16_t length = load<uint16_t>(v + 20);
+    if (at + kVlrHeaderBytes + length > h.point_offset) break;
+    vlr.data.resize(length);
+    got = file.readAt(at + kVlrHeaderBytes, vlr.data.data(), length);
+    if (!got || *got < length) break;
+    out.push_back(std::move(vlr));
+    at += kVlrHeaderBytes + length;
+  }
+  if (h.version_minor < 4 || h.evlr_count == 0) return out;
+  char start[8];
+  Result<size_t> got = file.readAt(kEvlrStartAt, start, sizeof start);
+  if (!got || *got < sizeof start) return out;
+  at = load<uint64_t>(start);
+  for (uint32_t k = 0; k < h.evlr_count && at >= h.point_offset && file.size() >= kEvlrHeaderBytes &&
+                      at <= file.size() - kEvlrHeaderBytes;
+       ++k) {
+    char v[kEvlrHeaderBytes];
+    got = file.readAt(at, v, sizeof v);
+    if (!got || *got < sizeof v) break;
+    LasVlr vlr{textField(v + 2, 16), load<uint16_t>(v + 18), textField(v + 28, 32), {}, true};
+    const uint64_t length = load<uint64_t>(v + 20);
+    if (length > file.size() - at - kEvlrHeaderBytes || length > (uint64_t{1} << 30)) break;
+    vlr.data.resize(static_cast<size_t>(length));
+    got = file.readAt(at + kEvlrHeaderBytes, vlr.data.data(), vlr.data.size());
+    if (!got || *got < vlr.data.size()) break;
+    out.push_back(std::move(vlr));
+    at += kEvlrHeaderBytes + length;
+  }
+  return out;
+}
+
+bool isCrsRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Projection"; }
+bool isExtraBytesRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Spec" && vlr.record_id == 4; }
+
+}  // namespace
+
 Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   const std::string& path = file.path();
   Result<LasHeader> header = parseHeader(file);
@@ -426,23 +698,48 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   if (source == LasColorSource::kRgb && !rgb)
     return Error{path + ": point format " + str(static_cast<uint64_t>(header->point_format)) +
                  " has no RGB colours (formats 2, 3, 5, 7, 8 and 10 have)"};
+  // The records' fields and extra bytes become dimensions; the coordinate system's records are
+  // kept for the LAS writer.
+  const std::vector<LasVlr> vlrs = readVlrs(file, *header);
+  const LasVlr* extra_vlr = nullptr;
+  for (const LasVlr& vlr : vlrs)
+    if (isExtraBytesRecord(vlr)) extra_vlr = &vlr;
+  const uint32_t extra_bytes = header->record_length - lasBaseRecordLength(header->point_format);
+  Result<std::vector<LasExtraField>> extra = lasExtraFields(extra_vlr, extra_bytes, lasFields(header->point_format));
+  if (!extra) extra = lasExtraFields(nullptr, extra_bytes, lasFields(header->point_format));  // bytes as they are
   // The count is bounded by the file size already; the point set must also fit --max-memory.
-  const uint64_t point_bytes = sizeof(glm::dvec3) + (source == LasColorSource::kNone ? 0 : sizeof(glm::vec3));
+  uint64_t point_bytes = sizeof(glm::dvec3) + (source == LasColorSource::kNone ? 0 : sizeof(glm::vec3));
+  for (const LasField& f : lasFields(header->point_format)) point_bytes += dimTypeSize(f.type);
+  for (const LasExtraField& f : *extra) point_bytes += dimTypeSize(f.type);
   if (Status fits = checkMemory(path + ": " + str(header->point_count) + " points", header->point_count * point_bytes,
                                 options.max_memory);
       !fits)
     return fits.error();
-  LasReader reader(file, *header, source, options);
-  return reader.run();
+  LasReader reader(file, *header, source, options, std::move(*extra));
+  Result<PointSet> points = reader.run();
+  if (!points) return points;
+  LasSource las;
+  las.version_minor = header->version_minor;
+  las.point_format = header->point_format;
+  las.scale = header->scale;
+  las.offset = header->offset;
+  las.global_encoding = header->global_encoding;
+  las.file_source_id = header->file_source_id;
+  for (const LasVlr& vlr : vlrs)
+    if (isCrsRecord(vlr)) las.vlrs.push_back(vlr);
+  points->las = std::move(las);
+  return points;
 }
 
 Status writeLas(const std::string& path, const PointSet& points, const LasWriteOptions& options) {
-  const double scale = options.scale;
-  if (!std::isfinite(scale) || !(scale > 0.0))
-    return Error{path + ": LAS scale " + num(scale) + " is not a finite number > 0", ExitCode::kUsage};
+  // The scale: as asked, else the source LAS file's per axis, else 0.001.
+  if (options.scale != 0.0 && !(std::isfinite(options.scale) && options.scale > 0.0))
+    return Error{path + ": LAS scale " + num(options.scale) + " is not a finite number > 0", ExitCode::kUsage};
+  const bool keep_frame = options.scale == 0.0 && points.las;
+  const glm::dvec3 scale = options.scale > 0.0 ? glm::dvec3(options.scale)
+                           : keep_frame       ? glm::abs(points.las->scale)
+                                              : glm::dvec3(0.001);
   const size_t n = points.size();
-  if (n > UINT32_MAX)
-    return Error{path + ": " + str(n) + " points exceed LAS 1.2's 32-bit point count (4294967295)"};
   assert(points.colors.empty() || points.colors.size() == n);
   const unsigned threads = resolveThreads(options.threads);
   const size_t blocks = (n + kWriteBlockPoints - 1) / kWriteBlockPoints;
@@ -480,38 +777,49 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   // Quantization is monotonic (a subtraction, a division by a positive number and a rounding, each
   // correctly rounded), so the box's corners hold the extreme integers: when they fit, all do, and
   // their decoded values are the exact bounds a reader finds.
+  // The source's offset where its integers still hold every point (LAS → LAS: the same records).
   glm::dvec3 offset(0.0), q_min(0.0), q_max(0.0);
   for (int k = 0; k < 3; ++k) {
-    offset[k] = chooseOffset(points.positions, k, box.min[k], box.max[k], scale, threads);
-    q_min[k] = quantize(box.min[k], offset[k], scale);
-    q_max[k] = quantize(box.max[k], offset[k], scale);
+    const double kept = keep_frame ? points.las->offset[k] : 0.0;
+    const bool fits_kept = keep_frame && fitsInt32(quantize(box.min[k], kept, scale[k])) &&
+                           fitsInt32(quantize(box.max[k], kept, scale[k]));
+    offset[k] = fits_kept ? kept : chooseOffset(points.positions, k, box.min[k], box.max[k], scale[k], threads);
+    q_min[k] = quantize(box.min[k], offset[k], scale[k]);
+    q_max[k] = quantize(box.max[k], offset[k], scale[k]);
   }
   const bool fits = fitsInt32(q_min.x) && fitsInt32(q_min.y) && fitsInt32(q_min.z) && fitsInt32(q_max.x) &&
                     fitsInt32(q_max.y) && fitsInt32(q_max.z);
   for (size_t i = 0; !fits && i < n; ++i) {  // names the first point that does not fit
     for (int k = 0; k < 3; ++k) {
-      const double q = quantize(points.positions[i][k], offset[k], scale);
+      const double q = quantize(points.positions[i][k], offset[k], scale[k]);
       if (!fitsInt32(q))
         return Error{path + ": point " + str(i) + ": " + kAxis[k] + " = " + num(points.positions[i][k]) + " is " +
-                     num(q) + " steps of the scale " + num(scale) + " from the offset " + num(offset[k]) +
+                     num(q) + " steps of the scale " + num(scale[k]) + " from the offset " + num(offset[k]) +
                      ", beyond LAS's 32-bit integers (±2147483647); use a larger scale (--las-scale)"};
     }
   }
   assert(fits);
   glm::dvec3 bound_min(0.0), bound_max(0.0);
   for (int k = 0; k < 3; ++k) {  // what a reader computes for the extreme integers
-    bound_min[k] = n == 0 ? 0.0 : q_min[k] * scale + offset[k];
-    bound_max[k] = n == 0 ? 0.0 : q_max[k] * scale + offset[k];
+    bound_min[k] = n == 0 ? 0.0 : q_min[k] * scale[k] + offset[k];
+    bound_max[k] = n == 0 ? 0.0 : q_max[k] * scale[k] + offset[k];
   }
 
-  const bool colors = points.hasColors();
-  const int format = colors ? 2 : 0;
-  const uint32_t length = lasBaseRecordLength(format);
+  Result<WriterLayout> layout = writerLayout(path, points, n);
+  if (!layout) return layout.error();
+  const WriterLayout& l = *layout;
+  const RecordEncoder encoder(points, l, offset, scale);
+  std::string vlr_bytes;
+  for (const LasVlr& vlr : l.vlrs) vlr_bytes += vlrBytes(vlr, false);
+  const uint32_t point_offset = static_cast<uint32_t>((l.version_minor >= 4 ? kHeaderSize14 : kHeaderSize12) + vlr_bytes.size());
+  const uint64_t evlr_start = point_offset + uint64_t{n} * l.record_length;
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
   if (options.progress) options.progress->start("writing " + path, n);
-  const auto header = writerHeader(format, length, static_cast<uint32_t>(n), scale, offset, bound_min, bound_max);
+  const std::string header = writerHeader(l, n, encoder.countByReturn(threads), scale, offset, bound_min, bound_max,
+                                          point_offset, evlr_start);
   if (Status s = file->write(header.data(), header.size()); !s) return s;
+  if (Status s = file->write(vlr_bytes.data(), vlr_bytes.size()); !s) return s;
 
   // Blocks are encoded on all cores a batch at a time, then written in order.
   std::vector<std::vector<char>> encoded(static_cast<size_t>(threads) * 4);
@@ -520,21 +828,18 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     parallelFor(batch_blocks, threads, [&](size_t j, unsigned) {
       const size_t first = (batch + j) * kWriteBlockPoints, last = std::min(n, first + kWriteBlockPoints);
       std::vector<char>& out = encoded[j];
-      out.assign((last - first) * length, 0);
+      out.assign((last - first) * l.record_length, 0);
       char* r = out.data();
-      for (size_t i = first; i < last; ++i, r += length) {
-        const glm::dvec3& p = points.positions[i];
-        for (int k = 0; k < 3; ++k)
-          store<int32_t>(r + 4 * k, static_cast<int32_t>(quantize(p[k], offset[k], scale)));
-        r[14] = 0x09;  // return number 1 (bits 0–2) of 1 (bits 3–5)
-        if (colors)
-          for (int c = 0; c < 3; ++c) store<uint16_t>(r + 20 + 2 * c, colorWord(points.colors[i][c]));
-      }
+      for (size_t i = first; i < last; ++i, r += l.record_length) encoder.encode(i, r);
     });
     for (size_t j = 0; j < batch_blocks; ++j) {
       if (Status s = file->write(encoded[j].data(), encoded[j].size()); !s) return s;
-      if (options.progress) options.progress->advance(encoded[j].size() / length);
+      if (options.progress) options.progress->advance(encoded[j].size() / l.record_length);
     }
+  }
+  for (const LasVlr& evlr : l.evlrs) {
+    const std::string bytes = vlrBytes(evlr, true);
+    if (Status s = file->write(bytes.data(), bytes.size()); !s) return s;
   }
   if (Status s = file->commit(); !s) return s;
   if (options.progress) options.progress->finish();

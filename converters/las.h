@@ -30,11 +30,16 @@
 //   divisor would leave most files black; the file's maximum gives every file full contrast.
 // - Classification through lasClassColor's fixed palette.
 //
-// Writing: LAS 1.2, point format 0, or 2 when the set has colours; one scale for x, y and z; per
-// axis the first of these offsets under which every coordinate reads back as the same double: a
-// whole number (lasOffsetFor), 0, the minimum rounded down to a multiple of the scale (none: the
-// whole number); return 1 of 1, classification 0, intensity 0. A point whose (coordinate − offset)
-// / scale rounds outside the 32-bit integers is an error naming the point.
+// Writing: every dimension a point format holds is written in its field (las_fields.h), the others
+// as extra bytes with their names and types (the extra bytes VLR). The format is the source's
+// (PointSet::las) when it holds everything the set carries, else the smallest that does: 0-3 in
+// LAS 1.2, 6-8 in LAS 1.4 where a field or value needs them. A LAS source also gives its scale,
+// offset, version and coordinate system records, so LAS → LAS writes the same point records.
+// Otherwise one scale for x, y and z and per axis the first of these offsets under which every
+// coordinate reads back as the same double: a whole number (lasOffsetFor), 0, the minimum rounded
+// down to a multiple of the scale (none: the whole number). A set without returns is written as
+// return 1 of 1. A point whose (coordinate − offset) / scale rounds outside the 32-bit integers is
+// an error naming the point.
 //
 // Exactness: a coordinate reads back as itself when it is a value some LAS reader computes,
 // X·scale + offset in double, for one of those offsets. That holds for data read from a LAS file
@@ -72,6 +77,7 @@ struct LasHeader {
   glm::dvec3 scale{1.0}, offset{0.0};
   glm::dvec3 min{0.0}, max{0.0};  // the header's bounds as written: finite, not checked against the points
   std::string generating_software;
+  uint16_t file_source_id = 0, global_encoding = 0;
 };
 
 struct LasReadOptions {
@@ -82,7 +88,9 @@ struct LasReadOptions {
 };
 
 struct LasWriteOptions {
-  double scale = 0.001;  // for x, y and z; finite and > 0
+  // The coordinate step for x, y and z, finite and > 0; 0: the source LAS file's (PointSet::las)
+  // per axis, with its offset where every point fits it, else 0.001.
+  double scale = 0.0;
   unsigned threads = 0;
   Progress* progress = nullptr;
 };
@@ -94,8 +102,8 @@ Result<PointSet> readLas(const std::string& path, const LasReadOptions& options 
 Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options = {});
 
 // Writes atomically (AtomicFile). Triangles are not stored. Fails (exit 2) on a non-finite
-// position, on a point that does not fit the 32-bit integers at options.scale, and on more than
-// 2^32 − 1 points (LAS 1.2's count); with exit 1 on a scale that is not finite and positive.
+// position and on a point that does not fit the 32-bit integers at the scale; with exit 1 on a
+// scale that is not finite and positive. More than 2^32 − 1 points are written as LAS 1.4.
 Status writeLas(const std::string& path, const PointSet& points, const LasWriteOptions& options = {});
 
 // True when the header's bounds contain `points` (the box of the points read), each side within

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstring>
 
 #include "converters/ply.h"
 #include "converters/tile_file.h"
@@ -48,7 +49,19 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     } else if (any_colors) {
       out.colors.resize(out.size() + part->size(), glm::vec3(1.0f));
     }
+    // Dimensions: the union of the parts', 0 where a part lacks one; a name of two types keeps the
+    // first part's type (values converted).
+    for (const Dimension& d : part->dimensions.all()) {
+      Dimension* column = out.dimensions.find(d.name);
+      if (!column) column = &out.dimensions.add(d.name, d.type, out.size());
+      const size_t at = out.size();
+      column->resize(at + part->size());
+      if (column->type == d.type) std::memcpy(column->bytes.data() + at * dimTypeSize(d.type), d.bytes.data(), d.bytes.size());
+      else for (size_t i = 0; i < part->size(); ++i) column->setValue(at + i, d.value(i));
+    }
     out.positions.insert(out.positions.end(), part->positions.begin(), part->positions.end());
+    out.dimensions.resize(out.size());
+    if (!out.las) out.las = part->las;  // the first LAS part's frame and coordinate system
   }
   return out;
 }

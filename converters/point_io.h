@@ -44,7 +44,7 @@ struct WriteOptions {
   PlyEncoding ply_encoding = PlyEncoding::kBinary;
   PlyColorType ply_colors = PlyColorType::kUchar;
   Progress* progress = nullptr;
-  double las_scale = 0.001;  // LAS: the coordinate step for x, y and z (converters/las.h)
+  double las_scale = 0.0;  // LAS: the coordinate step for x, y and z; 0: the source's, else 0.001 (converters/las.h)
   // When not null, gets one line per thing the file cannot hold as given (GLB: points that will
   // not read back bit-exactly).
   std::vector<std::string>* notices = nullptr;

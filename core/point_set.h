@@ -3,9 +3,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
+
+#include "core/dimensions.h"
 
 namespace dpoint {
 
@@ -16,10 +20,37 @@ enum class ZAxis : uint8_t {
   kAbsent,   // read from genuinely 2D input (a 2-column CSV, a PLY without z): every z is 0
 };
 
+// A variable length record of a LAS file (VLR, or EVLR when `extended`), kept as its bytes.
+struct LasVlr {
+  std::string user_id;  // up to 16 bytes
+  uint16_t record_id = 0;
+  std::string description;  // up to 32 bytes
+  std::string data;
+  bool extended = false;
+};
+
+// What a LAS file said beside its points, so that LAS → LAS writes the same point records (the
+// same format, scale and offset) and keeps the records the writer can vouch for (the CRS).
+struct LasSource {
+  int version_minor = 2;
+  int point_format = 0;
+  glm::dvec3 scale{0.001}, offset{0.0};
+  uint16_t global_encoding = 0;  // bit 4: the CRS is WKT (LAS 1.4)
+  uint16_t file_source_id = 0;
+  std::vector<LasVlr> vlrs;  // the coordinate system's (LASF_Projection); extra bytes are described anew
+};
+
 struct PointSet {
   std::vector<glm::dvec3> positions;  // always double
   std::vector<glm::vec3> colors;      // empty, or one linear 0..1 colour per point
   std::vector<uint32_t> triangles;    // empty for point sets; 3 vertex indices per triangle
+  // Per-point attributes (core/dimensions.h): each column has size() values or the set has none.
+  Dimensions dimensions;
+  // The integer full scale the colours were read from (255, 65535), 0 when they came as floats or
+  // were made here: a writer of integer colours scales by it, so 8-bit colours stay 8-bit.
+  uint16_t color_full_scale = 0;
+  // Set by the LAS reader, kept by the filters, used by the LAS writer.
+  std::optional<LasSource> las;
 
   // Facts of the source that the values cannot tell, set by the readers and kept by the filters.
   ZAxis z_axis = ZAxis::kUnknown;

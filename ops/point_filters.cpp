@@ -45,10 +45,12 @@ void dropDuplicatePositions(PointSet& points) {
     if (!inserted) continue;
     points.positions[kept] = points.positions[i];
     if (points.hasColors()) points.colors[kept] = points.colors[i];
+    for (Dimension& d : points.dimensions.all()) d.copyFrom(kept, d, i);  // the first point's attributes
     ++kept;
   }
   points.positions.resize(kept);
   if (points.hasColors()) points.colors.resize(kept);
+  points.dimensions.resize(kept);
   size_t t = 0;
   for (size_t i = 0; i + 3 <= points.triangles.size(); i += 3) {
     const uint32_t a = remap[points.triangles[i]], b = remap[points.triangles[i + 1]], c = remap[points.triangles[i + 2]];

@@ -259,9 +259,8 @@ inline size_t sourceBlock(const std::vector<uint32_t>& blocks, size_t b) { retur
 // values[i] becomes values[source of i]: gathered into the scratch, then copied back (both over
 // all threads), so the set keeps its own storage.
 template <typename T>
-void gather(std::vector<T>& values, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
+void gather(T* values, size_t n, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
             unsigned threads, Progress* progress) {
-  const size_t n = values.size();
   const size_t block_count = (n + kOrderBlock - 1) / kOrderBlock;
   T* out = scratch.array<T>(0, n);
   parallelFor(block_count, threads, [&](size_t b, unsigned) {
@@ -272,8 +271,26 @@ void gather(std::vector<T>& values, const uint32_t* sorted, const std::vector<ui
   });
   parallelFor(block_count, threads, [&](size_t b, unsigned) {
     const size_t first = b * kOrderBlock;
-    std::copy(out + first, out + first + std::min(kOrderBlock, n - first), values.data() + first);
+    std::copy(out + first, out + first + std::min(kOrderBlock, n - first), values + first);
   });
+}
+
+template <typename T>
+void gather(std::vector<T>& values, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
+            unsigned threads, Progress* progress) {
+  gather(values.data(), values.size(), sorted, blocks, scratch, threads, progress);
+}
+
+// A dimension's column, moved as values of its width (core/dimensions.h).
+void gatherDimension(Dimension& d, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
+                     unsigned threads) {
+  const size_t n = d.size();
+  switch (dimTypeSize(d.type)) {
+    case 1: gather(reinterpret_cast<uint8_t*>(d.bytes.data()), n, sorted, blocks, scratch, threads, nullptr); break;
+    case 2: gather(reinterpret_cast<uint16_t*>(d.bytes.data()), n, sorted, blocks, scratch, threads, nullptr); break;
+    case 4: gather(reinterpret_cast<uint32_t*>(d.bytes.data()), n, sorted, blocks, scratch, threads, nullptr); break;
+    default: gather(reinterpret_cast<uint64_t*>(d.bytes.data()), n, sorted, blocks, scratch, threads, nullptr); break;
+  }
 }
 
 }  // namespace
@@ -292,7 +309,8 @@ uint64_t reorderExtraBytes(size_t points, PointOrder order) {
 
 Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit) {
   if (order == PointOrder::kInput) return okStatus();
-  const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0)) +
+  const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0) +
+                                           points.dimensions.bytesPerPoint()) +
                           points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
   return checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit);
 }
@@ -386,6 +404,7 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
   const std::vector<uint32_t> blocks = shuffledBlocks(n / kOrderBlock);
   gather(points.positions, sorted, blocks, scratch, threads, progress);
   if (points.hasColors()) gather(points.colors, sorted, blocks, scratch, threads, nullptr);
+  for (Dimension& d : points.dimensions.all()) gatherDimension(d, sorted, blocks, scratch, threads);
   if (points.isMesh()) {
     uint32_t* rank = scratch.array<uint32_t>(0, n);  // new place of each old point
     parallelFor((n + kOrderBlock - 1) / kOrderBlock, threads, [&](size_t b, unsigned) {

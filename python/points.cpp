@@ -301,14 +301,14 @@ stderr.)");
   m.def(
       "write",
       [](const std::shared_ptr<PointSet>& points, const std::string& path, int decimals, bool ply_ascii,
-         const std::string& ply_colors, double las_scale, const std::string& order, bool no_colors,
+         const std::string& ply_colors, std::optional<double> las_scale, const std::string& order, bool no_colors,
          const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
         // As convert's --decimals (0..100; -1 here: shortest round trip) and --las-scale (> 0), whatever the format.
         if (decimals < -1 || decimals > 100)
           raise(Error{"decimals: " + std::to_string(decimals) + " is not -1 (shortest round trip) or 0..100",
                       ExitCode::kUsage});
-        if (!(std::isfinite(las_scale) && las_scale > 0.0))
-          raise(Error{"las_scale: " + formatNumber(las_scale) + " is not a finite number > 0", ExitCode::kUsage});
+        if (las_scale && !(std::isfinite(*las_scale) && *las_scale > 0.0))
+          raise(Error{"las_scale: " + formatNumber(*las_scale) + " is not a finite number > 0", ExitCode::kUsage});
         if (ply_colors != "uchar" && ply_colors != "float")
           raise(Error{"ply_colors: '" + ply_colors + "' is not uchar or float", ExitCode::kUsage});
         if (color_format != "linear" && color_format != "srgb8")
@@ -319,7 +319,7 @@ stderr.)");
         check(released([&] {
           Progress bar(progressFile(progress), "write");
           WriteOptions w;
-          w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale;
+          w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale.value_or(0.0);
           w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
           w.ply_colors = ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
           const ColorFilters colors{no_colors, color_format == "srgb8"};
@@ -331,13 +331,13 @@ stderr.)");
         }));
       },
       py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
-      py::arg("ply_colors") = "uchar", py::arg("las_scale") = 0.001, py::arg("order") = "input",
+      py::arg("ply_colors") = "uchar", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
       R"(Writes a set as .csv, .ply, .glb or .las (by extension), whole or not at all, as `dpoint convert` does.
 
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (uchar or float),
-las_scale (LAS coordinate step), order (input or morton), no_colors, color_format (linear or
+las_scale (LAS coordinate step; None: a LAS source's own, else 0.001), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");
 }
 

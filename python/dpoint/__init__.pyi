@@ -1,6 +1,6 @@
 # Type stub of the dpoint package (python/dpoint/__init__.py over the extension dpoint._dpoint).
 from os import PathLike
-from typing import Any, Iterable, Sequence, Union
+from typing import Any, Iterable, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -96,7 +96,7 @@ def write(
     decimals: int = -1,
     ply_ascii: bool = False,
     ply_colors: str = "uchar",
-    las_scale: float = 0.001,
+    las_scale: Optional[float] = None,
     order: str = "input",
     no_colors: bool = False,
     color_format: str = "linear",

@@ -135,12 +135,12 @@ TEST(CliLas, lasScaleTooFineForTheExtentExitsTwoNamingThePoint) {
   EXPECT_TRUE(dir.entries().empty());
   EXPECT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("x.las"), "--las-scale", "0"}).exit_code, 1);
   EXPECT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("x.las"), "--las-scale", "-1"}).exit_code, 1);
-  // At 0.01 (the file's own scale) it fits, and the colours come along as format 2.
+  // At 0.01 (the file's own scale) it fits, and every field comes along: format 3, as the input.
   ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("ok.las"), "--las-scale", "0.01", "--quiet"})
                 .exit_code,
             0);
   test::CommandResult info = runDpoint({"info", dir.file("ok.las"), "--quiet"});
-  EXPECT_NE(info.out.find("version 1.2, point format 2, 26-byte records"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("version 1.2, point format 3, 34-byte records"), std::string::npos) << info.out;
 }
 
 TEST(CliLas, maxPointsRefusesALasFileByItsHeader) {

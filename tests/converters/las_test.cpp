@@ -554,11 +554,11 @@ TEST(Las, writerRefusesNonFinitePointsAndBadScale) {
   EXPECT_TRUE(contains(s.error().message, "nan.las: point 1 (1, nan, 0) is not finite"));
   set.positions.pop_back();
   LasWriteOptions options;
-  options.scale = 0;
-  s = writeLas(dir.file("zero.las"), set, options);
+  options.scale = -1;  // 0 is "automatic" (the source's, else 0.001)
+  s = writeLas(dir.file("negative.las"), set, options);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ExitCode::kUsage);
-  EXPECT_TRUE(contains(s.error().message, "LAS scale 0 is not a finite number > 0"));
+  EXPECT_TRUE(contains(s.error().message, "LAS scale -1 is not a finite number > 0"));
   EXPECT_TRUE(dir.entries().empty());
 }
 

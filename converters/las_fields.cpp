@@ -1,0 +1,193 @@
+#include "converters/las_fields.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstring>
+#include <optional>
+
+namespace dpoint {
+namespace {
+
+using T = DimType;
+
+// Fields common to formats 0-5 (table 7), then each format's additions.
+std::vector<LasField> legacyFields(bool gps, uint32_t wave_at) {
+  std::vector<LasField> f = {
+      {dim::kIntensity, T::kU16, 12},
+      {dim::kReturnNumber, T::kU8, 14, 0, 3},
+      {dim::kNumberOfReturns, T::kU8, 14, 3, 3},
+      {dim::kScanDirection, T::kU8, 14, 6, 1},
+      {dim::kEdgeOfFlightLine, T::kU8, 14, 7, 1},
+      {dim::kClassification, T::kU8, 15, 0, 5},
+      {dim::kSynthetic, T::kU8, 15, 5, 1},
+      {dim::kKeyPoint, T::kU8, 15, 6, 1},
+      {dim::kWithheld, T::kU8, 15, 7, 1},
+      {dim::kScanAngleRank, T::kI8, 16},
+      {dim::kUserData, T::kU8, 17},
+      {dim::kPointSourceId, T::kU16, 18},
+  };
+  if (gps) f.push_back({dim::kGpsTime, T::kF64, 20});
+  if (wave_at) {
+    for (const LasField& w : std::initializer_list<LasField>{
+             {dim::kWavePacketIndex, T::kU8, 0}, {dim::kWaveByteOffset, T::kU64, 1}, {dim::kWavePacketSize, T::kU32, 9},
+             {dim::kWaveReturnLocation, T::kF32, 13}, {dim::kWaveXt, T::kF32, 17}, {dim::kWaveYt, T::kF32, 21},
+             {dim::kWaveZt, T::kF32, 25}})
+      f.push_back({w.name, w.type, wave_at + w.offset});
+  }
+  return f;
+}
+
+// Formats 6-10 (table 12), then NIR and the waveform fields where the format has them.
+std::vector<LasField> modernFields(uint32_t nir_at, uint32_t wave_at) {
+  std::vector<LasField> f = {
+      {dim::kIntensity, T::kU16, 12},
+      {dim::kReturnNumber, T::kU8, 14, 0, 4},
+      {dim::kNumberOfReturns, T::kU8, 14, 4, 4},
+      {dim::kSynthetic, T::kU8, 15, 0, 1},
+      {dim::kKeyPoint, T::kU8, 15, 1, 1},
+      {dim::kWithheld, T::kU8, 15, 2, 1},
+      {dim::kOverlap, T::kU8, 15, 3, 1},
+      {dim::kScannerChannel, T::kU8, 15, 4, 2},
+      {dim::kScanDirection, T::kU8, 15, 6, 1},
+      {dim::kEdgeOfFlightLine, T::kU8, 15, 7, 1},
+      {dim::kClassification, T::kU8, 16},
+      {dim::kUserData, T::kU8, 17},
+      {dim::kScanAngle, T::kI16, 18},
+      {dim::kPointSourceId, T::kU16, 20},
+      {dim::kGpsTime, T::kF64, 22},
+  };
+  if (nir_at) f.push_back({dim::kNir, T::kU16, nir_at});
+  if (wave_at) {
+    std::vector<LasField> w = legacyFields(false, wave_at);
+    f.insert(f.end(), w.end() - 7, w.end());
+  }
+  return f;
+}
+
+const std::array<std::vector<LasField>, 11>& allFields() {
+  static const std::array<std::vector<LasField>, 11> fields = {
+      legacyFields(false, 0), legacyFields(true, 0),  legacyFields(false, 0), legacyFields(true, 0),
+      legacyFields(true, 28), legacyFields(true, 34), modernFields(0, 0),     modernFields(0, 0),
+      modernFields(36, 0),    modernFields(0, 30),    modernFields(36, 38)};
+  return fields;
+}
+
+constexpr std::array<uint32_t, 11> kRgbAt = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
+constexpr size_t kDescriptorBytes = 192;
+
+bool hasField(int format, const std::string& name) {
+  const std::vector<LasField>& fields = lasFields(format);
+  return std::any_of(fields.begin(), fields.end(), [&](const LasField& f) { return name == f.name; });
+}
+
+// The largest value of a dimension (0 when absent or empty).
+double largest(const PointSet& points, const char* name) {
+  const Dimension* d = points.dimensions.find(name);
+  double m = 0.0;
+  if (d)
+    for (size_t i = 0; i < d->size(); ++i) m = std::max(m, d->value(i));
+  return m;
+}
+
+// Whether format `f` holds every LAS field and value of the set.
+bool holds(const PointSet& points, int f) {
+  if (points.hasColors() && !kRgbAt[static_cast<size_t>(f)]) return false;
+  for (const Dimension& d : points.dimensions.all()) {
+    const KnownDimension* known = findKnownDimension(d.name);
+    if (!known || !known->las_field) continue;  // extra bytes in any format
+    const bool scan_angle = d.name == dim::kScanAngle || d.name == dim::kScanAngleRank;
+    if (!scan_angle && !hasField(f, d.name)) return false;
+  }
+  if (f < 6) {  // the narrower legacy fields
+    if (largest(points, dim::kClassification) > 31 || largest(points, dim::kReturnNumber) > 7 ||
+        largest(points, dim::kNumberOfReturns) > 7)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+const std::vector<LasField>& lasFields(int point_format) { return allFields().at(static_cast<size_t>(point_format)); }
+
+uint32_t lasRgbOffset(int point_format) { return kRgbAt.at(static_cast<size_t>(point_format)); }
+
+Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t extra, const std::vector<LasField>& base) {
+  std::vector<LasExtraField> out;
+  std::vector<bool> described(extra, false);
+  auto taken = [&](const std::string& name) {
+    return std::any_of(base.begin(), base.end(), [&](const LasField& f) { return name == f.name; }) ||
+           std::any_of(out.begin(), out.end(), [&](const LasExtraField& f) { return f.name == name; }) ||
+           name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue";
+  };
+  auto unique = [&](std::string name) {
+    if (!taken(name)) return name;
+    for (int n = 2;; ++n)
+      if (!taken(name + "_" + std::to_string(n))) return name + "_" + std::to_string(n);
+  };
+  uint32_t at = 0;
+  if (vlr) {
+    if (vlr->data.size() % kDescriptorBytes != 0)
+      return Error{"extra bytes VLR: " + std::to_string(vlr->data.size()) + " bytes are not whole 192-byte descriptors"};
+    for (size_t k = 0; k * kDescriptorBytes < vlr->data.size(); ++k) {
+      const char* d = vlr->data.data() + k * kDescriptorBytes;
+      const uint8_t data_type = static_cast<uint8_t>(d[2]), options = static_cast<uint8_t>(d[3]);
+      std::string name(d + 4, strnlen(d + 4, 32));
+      // Types 1-10 are one value; 11-20 and 21-30 (deprecated) two and three of them, kept as
+      // NAME_0, NAME_1, …; 0 is `options` undocumented bytes.
+      uint32_t size = 0, elements = 0;
+      std::optional<DimType> type;
+      if (data_type == 0) {
+        size = options;
+      } else if (data_type <= 30) {
+        type = static_cast<DimType>((data_type - 1) % 10);
+        elements = data_type <= 10 ? 1 : data_type <= 20 ? 2 : 3;
+        size = static_cast<uint32_t>(dimTypeSize(*type)) * elements;
+      } else {
+        return Error{"extra bytes descriptor " + std::to_string(k) + " ('" + name + "'): data type " +
+                     std::to_string(data_type) + " is not one of LAS's 0 to 30"};
+      }
+      if (at + size > extra)
+        return Error{"extra bytes descriptor " + std::to_string(k) + " ('" + name + "'): its " + std::to_string(size) +
+                     " bytes at " + std::to_string(at) + " pass the record's " + std::to_string(extra) + " extra bytes"};
+      for (char& c : name)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) c = '_';
+      if (name.empty()) name = "extra";
+      if (type) {
+        const uint32_t width = static_cast<uint32_t>(dimTypeSize(*type));
+        for (uint32_t e = 0; e < elements; ++e)
+          out.push_back({unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width});
+        std::fill(described.begin() + at, described.begin() + at + size, true);
+      }
+      at += size;
+    }
+  }
+  for (uint32_t b = 0; b < extra; ++b)
+    if (!described[b]) out.push_back({unique("extra_byte_" + std::to_string(b)), DimType::kU8, b});
+  std::sort(out.begin(), out.end(), [](const LasExtraField& a, const LasExtraField& b) { return a.offset < b.offset; });
+  return out;
+}
+
+LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields) {
+  LasVlr vlr;
+  vlr.user_id = "LASF_Spec";
+  vlr.record_id = 4;
+  vlr.description = "dpoint dimensions";
+  vlr.data.assign(fields.size() * kDescriptorBytes, '\0');
+  for (size_t k = 0; k < fields.size(); ++k) {
+    char* d = vlr.data.data() + k * kDescriptorBytes;
+    d[2] = static_cast<char>(static_cast<uint8_t>(fields[k].type) + 1);
+    std::memcpy(d + 4, fields[k].name.data(), std::min<size_t>(fields[k].name.size(), 32));
+  }
+  return vlr;
+}
+
+int lasFormatFor(const PointSet& points, int preferred) {
+  if (preferred >= 0 && preferred <= 10 && holds(points, preferred)) return preferred;
+  for (int f : {0, 1, 2, 3, 6, 7, 8, 4, 5, 9, 10})
+    if (holds(points, f)) return f;
+  return 10;
+}
+
+}  // namespace dpoint

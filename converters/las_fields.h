@@ -1,0 +1,53 @@
+// Where each field of a LAS point record sits (LAS 1.4 R15, tables 7-16 and 27-35), for the
+// reader that turns records into dimensions (core/dimensions.h) and the writer that turns them back:
+// one table, so the two cannot disagree. Formats 0-5 pack return numbers, flags and a 5-bit class
+// into bytes 14-15 and keep an 8-bit scan angle rank; formats 6-10 have 4-bit returns, an 8-bit
+// class and a 16-bit scan angle. The extra bytes VLR (LASF_Spec, record 4) names and types the
+// bytes a record holds beyond its format's base.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/dimensions.h"
+#include "core/point_set.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+// One field of a record: the dimension it fills, at byte `offset`; a bit field when `bits` > 0
+// (bits [shift, shift + bits) of the byte at offset, into a uint8 dimension).
+struct LasField {
+  const char* name;
+  DimType type;
+  uint32_t offset;
+  uint8_t shift = 0, bits = 0;
+};
+
+// The fields of point format 0..10 besides X, Y, Z (bytes 0-11) and RGB (colours, not dimensions).
+const std::vector<LasField>& lasFields(int point_format);
+// Where RGB starts in a record of the format, 0 when it has none; NIR is a field (format 8, 10).
+uint32_t lasRgbOffset(int point_format);
+
+// A dimension kept in a record's extra bytes: its name, type and byte offset after the base record.
+struct LasExtraField {
+  std::string name;
+  DimType type;
+  uint32_t offset;
+};
+
+// The extra bytes of a record of `extra` bytes as the VLR `vlr` (null: none) describes them. Bytes
+// it leaves undescribed (or the whole of them without a VLR) become uint8 dimensions named
+// extra_byte_N (N: the byte's offset after the base record). A name that is already taken (a LAS
+// field, a repeated name) gets the suffix _2, _3, …. Errors name the descriptor.
+Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t extra, const std::vector<LasField>& base);
+// The extra bytes VLR describing `fields` (LAS 1.4 R15 table 24: 192 bytes a field).
+LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields);
+
+// The point format that holds what `points` carries: `preferred` (the source's) when it holds every
+// LAS field the set has, its colours and the values of its fields; else the smallest of formats
+// 0-3 or, where a field or value needs LAS 1.4's, 6-8 (waveform fields: 4, 5, 9 or 10).
+int lasFormatFor(const PointSet& points, int preferred);
+
+}  // namespace dpoint

@@ -1,0 +1,155 @@
+#include "core/dimensions.h"
+
+#include <algorithm>
+#include <array>
+
+namespace dpoint {
+namespace {
+
+struct TypeRow {
+  DimType type;
+  size_t size;
+  const char* name;
+  const char* ply;
+  bool is_float, is_signed;
+};
+constexpr std::array<TypeRow, kDimTypeCount> kTypes = {{
+    {DimType::kU8, 1, "uint8", "uchar", false, false},
+    {DimType::kI8, 1, "int8", "char", false, true},
+    {DimType::kU16, 2, "uint16", "ushort", false, false},
+    {DimType::kI16, 2, "int16", "short", false, true},
+    {DimType::kU32, 4, "uint32", "uint", false, false},
+    {DimType::kI32, 4, "int32", "int", false, true},
+    {DimType::kU64, 8, "uint64", nullptr, false, false},
+    {DimType::kI64, 8, "int64", nullptr, false, true},
+    {DimType::kF32, 4, "float32", "float", true, true},
+    {DimType::kF64, 8, "float64", "double", true, true},
+}};
+
+const TypeRow& row(DimType type) { return kTypes[static_cast<size_t>(type)]; }
+
+// The one table of dimensions dpoint knows (issue #34). Types are LAS's where LAS has the field;
+// LAS 1.4 point formats 6-10 hold the wider ones (4-bit return numbers, 8-bit classes, a 16-bit
+// scan angle in steps of 0.006 degrees), and formats 0-5 their narrower forms, which the writer
+// checks before it narrows.
+constexpr KnownDimension kKnown[] = {
+    {dim::kIntensity, DimType::kU16, "intensity", "_INTENSITY", "pulse return magnitude"},
+    {dim::kReturnNumber, DimType::kU8, "return number", "_RETURN_NUMBER", "return of its pulse, from 1"},
+    {dim::kNumberOfReturns, DimType::kU8, "number of returns", "_NUMBER_OF_RETURNS", "returns of its pulse"},
+    {dim::kScanDirection, DimType::kU8, "scan direction flag", "_SCAN_DIRECTION", "1: the mirror moved +"},
+    {dim::kEdgeOfFlightLine, DimType::kU8, "edge of flight line", "_EDGE_OF_FLIGHT_LINE", "1: the scan line's last point"},
+    {dim::kClassification, DimType::kU8, "classification", "_CLASSIFICATION", "ASPRS class (2 ground, 6 building, ...)"},
+    {dim::kSynthetic, DimType::kU8, "synthetic flag", "_SYNTHETIC", "made by other means than the scan"},
+    {dim::kKeyPoint, DimType::kU8, "key-point flag", "_KEY_POINT", "a model key point"},
+    {dim::kWithheld, DimType::kU8, "withheld flag", "_WITHHELD", "to be left out of processing"},
+    {dim::kOverlap, DimType::kU8, "overlap flag", "_OVERLAP", "in the overlap of two flight lines (LAS 1.4)"},
+    {dim::kScannerChannel, DimType::kU8, "scanner channel", "_SCANNER_CHANNEL", "channel of a multi-channel scanner (LAS 1.4)"},
+    {dim::kScanAngleRank, DimType::kI8, "scan angle rank", "_SCAN_ANGLE_RANK", "scan angle in whole degrees (formats 0-5)"},
+    {dim::kScanAngle, DimType::kI16, "scan angle", "_SCAN_ANGLE", "scan angle in steps of 0.006 degrees (formats 6-10)"},
+    {dim::kUserData, DimType::kU8, "user data", "_USER_DATA", "free for the user"},
+    {dim::kPointSourceId, DimType::kU16, "point source id", "_POINT_SOURCE_ID", "flight line or source file"},
+    {dim::kGpsTime, DimType::kF64, "GPS time", "_GPS_TIME", "time of the pulse"},
+    {dim::kNir, DimType::kU16, "NIR", "_NIR", "near infrared"},
+    {dim::kWavePacketIndex, DimType::kU8, "wave packet descriptor index", "_WAVE_PACKET_INDEX", "waveform: its descriptor"},
+    {dim::kWaveByteOffset, DimType::kU64, "byte offset to waveform data", "_WAVE_BYTE_OFFSET", "waveform: where it starts"},
+    {dim::kWavePacketSize, DimType::kU32, "waveform packet size", "_WAVE_PACKET_SIZE", "waveform: its bytes"},
+    {dim::kWaveReturnLocation, DimType::kF32, "return point waveform location", "_WAVE_RETURN_LOCATION", "waveform: ps of the return"},
+    {dim::kWaveXt, DimType::kF32, "X(t)", "_WAVE_XT", "waveform: x of the parametric line"},
+    {dim::kWaveYt, DimType::kF32, "Y(t)", "_WAVE_YT", "waveform: y of the parametric line"},
+    {dim::kWaveZt, DimType::kF32, "Z(t)", "_WAVE_ZT", "waveform: z of the parametric line"},
+    {dim::kNormalX, DimType::kF32, nullptr, "NORMAL", "normal x"},
+    {dim::kNormalY, DimType::kF32, nullptr, "NORMAL", "normal y"},
+    {dim::kNormalZ, DimType::kF32, nullptr, "NORMAL", "normal z"},
+};
+
+}  // namespace
+
+size_t dimTypeSize(DimType type) { return row(type).size; }
+const char* dimTypeName(DimType type) { return row(type).name; }
+bool dimTypeIsFloat(DimType type) { return row(type).is_float; }
+bool dimTypeIsSigned(DimType type) { return row(type).is_signed; }
+const char* plyTypeName(DimType type) { return row(type).ply; }
+
+std::optional<DimType> parseDimType(std::string_view name) {
+  for (const TypeRow& r : kTypes)
+    if (name == r.name || (r.ply && name == r.ply)) return r.type;
+  return std::nullopt;
+}
+
+double Dimension::value(size_t i) const {
+  switch (type) {
+    case DimType::kU8: return get<uint8_t>(i);
+    case DimType::kI8: return get<int8_t>(i);
+    case DimType::kU16: return get<uint16_t>(i);
+    case DimType::kI16: return get<int16_t>(i);
+    case DimType::kU32: return get<uint32_t>(i);
+    case DimType::kI32: return get<int32_t>(i);
+    case DimType::kU64: return static_cast<double>(get<uint64_t>(i));
+    case DimType::kI64: return static_cast<double>(get<int64_t>(i));
+    case DimType::kF32: return get<float>(i);
+    case DimType::kF64: return get<double>(i);
+  }
+  return 0.0;
+}
+
+void Dimension::setValue(size_t i, double v) {
+  switch (type) {
+    case DimType::kU8: set(i, static_cast<uint8_t>(v)); break;
+    case DimType::kI8: set(i, static_cast<int8_t>(v)); break;
+    case DimType::kU16: set(i, static_cast<uint16_t>(v)); break;
+    case DimType::kI16: set(i, static_cast<int16_t>(v)); break;
+    case DimType::kU32: set(i, static_cast<uint32_t>(v)); break;
+    case DimType::kI32: set(i, static_cast<int32_t>(v)); break;
+    case DimType::kU64: set(i, static_cast<uint64_t>(v)); break;
+    case DimType::kI64: set(i, static_cast<int64_t>(v)); break;
+    case DimType::kF32: set(i, static_cast<float>(v)); break;
+    case DimType::kF64: set(i, v); break;
+  }
+}
+
+std::span<const KnownDimension> knownDimensions() { return kKnown; }
+
+const KnownDimension* findKnownDimension(std::string_view name) {
+  for (const KnownDimension& k : kKnown)
+    if (name == k.name) return &k;
+  return nullptr;
+}
+
+const Dimension* Dimensions::find(std::string_view name) const {
+  for (const Dimension& d : columns_)
+    if (d.name == name) return &d;
+  return nullptr;
+}
+
+Dimension* Dimensions::find(std::string_view name) {
+  for (Dimension& d : columns_)
+    if (d.name == name) return &d;
+  return nullptr;
+}
+
+Dimension& Dimensions::add(const std::string& name, DimType type, size_t points) {
+  if (Dimension* d = find(name)) {
+    assert(d->type == type);
+    return *d;
+  }
+  return columns_.emplace_back(name, type, points);
+}
+
+bool Dimensions::remove(std::string_view name) {
+  const auto it = std::find_if(columns_.begin(), columns_.end(), [&](const Dimension& d) { return d.name == name; });
+  if (it == columns_.end()) return false;
+  columns_.erase(it);
+  return true;
+}
+
+void Dimensions::resize(size_t points) {
+  for (Dimension& d : columns_) d.resize(points);
+}
+
+size_t Dimensions::bytesPerPoint() const {
+  size_t n = 0;
+  for (const Dimension& d : columns_) n += dimTypeSize(d.type);
+  return n;
+}
+
+}  // namespace dpoint

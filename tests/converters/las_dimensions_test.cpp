@@ -1,0 +1,167 @@
+// Point attributes kept whole (issue #34): every field of a LAS record becomes a dimension, extra
+// bytes their declared types, and LAS → LAS writes the same point records byte for byte; the
+// filters carry the dimensions with their points.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "converters/las.h"
+#include "core/dimensions.h"
+#include "ops/point_filters.h"
+#include "ops/point_order.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::readFile;
+using test::TempDir;
+
+template <typename T>
+T at(const std::string& bytes, size_t offset) {
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof v);
+  return v;
+}
+
+// The point records of a LAS file, its format and record length, read straight from the bytes.
+struct Records {
+  int format = 0;
+  uint16_t length = 0;
+  uint64_t count = 0;
+  std::string bytes;
+};
+Records recordsOf(const std::string& path) {
+  const std::string file = readFile(path);
+  Records r;
+  const uint32_t offset = at<uint32_t>(file, 96);
+  r.format = static_cast<uint8_t>(file[104]);
+  r.length = at<uint16_t>(file, 105);
+  r.count = at<uint32_t>(file, 107);
+  if (file[25] >= 4 && at<uint64_t>(file, 247) != 0) r.count = at<uint64_t>(file, 247);
+  r.bytes = file.substr(offset, r.count * r.length);
+  return r;
+}
+
+std::vector<std::string> corpusLasFiles() {
+  std::vector<std::string> files;
+  for (const char* folder : {"/las/", "/laz/"})
+    for (const auto& e : std::filesystem::directory_iterator(std::string(DPOINT_CORPUS_DIR) + folder))
+      if (e.path().extension() == ".las") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(LasDimensions, lasToLasWritesTheSamePointRecordsForEveryCorpusFile) {
+  const std::vector<std::string> files = corpusLasFiles();
+  ASSERT_GE(files.size(), 20u) << "the corpus LAS files are missing";
+  TempDir dir;
+  for (const std::string& path : files) {
+    Result<PointSet> points = readLas(path);
+    ASSERT_TRUE(points) << points.error().message;
+    const std::string out = dir.file(std::filesystem::path(path).filename());
+    ASSERT_TRUE(writeLas(out, *points)) << path;
+    const Records in = recordsOf(path), written = recordsOf(out);
+    EXPECT_EQ(written.format, in.format) << path;
+    EXPECT_EQ(written.length, in.length) << path;
+    EXPECT_EQ(written.count, in.count) << path;
+    EXPECT_TRUE(written.bytes == in.bytes) << path << ": the point records differ";
+  }
+}
+
+TEST(LasDimensions, everyFieldOfARecordIsADimensionWithItsValue) {
+  Result<PointSet> points = readLas(std::string(DPOINT_CORPUS_DIR) + "/las/simple.las");
+  ASSERT_TRUE(points);
+  const Records raw = recordsOf(std::string(DPOINT_CORPUS_DIR) + "/las/simple.las");
+  const Dimensions& d = points->dimensions;
+  ASSERT_TRUE(d.find(dim::kIntensity) && d.find(dim::kClassification) && d.find(dim::kGpsTime));
+  for (size_t i = 0; i < points->size(); i += 97) {
+    const size_t r = i * raw.length;
+    EXPECT_EQ(d.find(dim::kIntensity)->get<uint16_t>(i), at<uint16_t>(raw.bytes, r + 12));
+    EXPECT_EQ(d.find(dim::kReturnNumber)->get<uint8_t>(i), static_cast<uint8_t>(raw.bytes[r + 14]) & 7);
+    EXPECT_EQ(d.find(dim::kNumberOfReturns)->get<uint8_t>(i), (static_cast<uint8_t>(raw.bytes[r + 14]) >> 3) & 7);
+    EXPECT_EQ(d.find(dim::kClassification)->get<uint8_t>(i), static_cast<uint8_t>(raw.bytes[r + 15]) & 31);
+    EXPECT_EQ(d.find(dim::kScanAngleRank)->get<int8_t>(i), static_cast<int8_t>(raw.bytes[r + 16]));
+    EXPECT_EQ(d.find(dim::kPointSourceId)->get<uint16_t>(i), at<uint16_t>(raw.bytes, r + 18));
+    EXPECT_EQ(d.find(dim::kGpsTime)->get<double>(i), at<double>(raw.bytes, r + 20));
+  }
+  // The issue's first point: intensity 143, class 1.
+  EXPECT_EQ(d.find(dim::kIntensity)->get<uint16_t>(0), 143);
+  EXPECT_EQ(d.find(dim::kClassification)->get<uint8_t>(0), 1);
+  ASSERT_TRUE(points->las);
+  EXPECT_EQ(points->las->point_format, 3);
+  EXPECT_EQ(points->las->scale, glm::dvec3(0.01));
+}
+
+TEST(LasDimensions, extraBytesBecomeDimensionsOfTheirDeclaredTypes) {
+  Result<PointSet> points = readLas(std::string(DPOINT_CORPUS_DIR) + "/las/extrabytes.las");
+  ASSERT_TRUE(points);
+  // The file's VLR: Colors (3 × uint16, deprecated array), Reserved (undocumented), Flags
+  // (2 × int8), Intensity (uint32), Time (uint64).
+  const Dimensions& d = points->dimensions;
+  ASSERT_TRUE(d.find("Colors_0") && d.find("Colors_2") && d.find("Flags_1") && d.find("Intensity") && d.find("Time"));
+  EXPECT_EQ(d.find("Colors_1")->type, DimType::kU16);
+  EXPECT_EQ(d.find("Flags_0")->type, DimType::kI8);
+  EXPECT_EQ(d.find("Intensity")->type, DimType::kU32);
+  EXPECT_EQ(d.find("Time")->type, DimType::kU64);
+  EXPECT_TRUE(d.find(dim::kIntensity)) << "the LAS field keeps its own name beside the extra bytes' Intensity";
+}
+
+TEST(LasDimensions, aSetWithoutLasSourceGetsTheSmallestFormatThatHoldsIt) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 2, 3}, {4, 5, 6}};
+  set.dimensions.add(dim::kClassification, DimType::kU8, 3).set<uint8_t>(1, 6);
+  set.dimensions.add("temperature", DimType::kF32, 3).set<float>(2, 21.5f);
+  ASSERT_TRUE(writeLas(dir.file("a.las"), set));
+  EXPECT_EQ(recordsOf(dir.file("a.las")).format, 0);
+  Result<PointSet> back = readLas(dir.file("a.las"));
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->dimensions.find(dim::kClassification)->get<uint8_t>(1), 6);
+  ASSERT_TRUE(back->dimensions.find("temperature"));
+  EXPECT_EQ(back->dimensions.find("temperature")->get<float>(2), 21.5f);
+  EXPECT_EQ(back->dimensions.find(dim::kReturnNumber)->get<uint8_t>(0), 1) << "return 1 of 1";
+
+  // A class above 31 needs LAS 1.4's 8-bit field: format 6.
+  set.dimensions.find(dim::kClassification)->set<uint8_t>(0, 64);
+  set.dimensions.add(dim::kGpsTime, DimType::kF64, 3).set<double>(0, 12.25);
+  ASSERT_TRUE(writeLas(dir.file("b.las"), set));
+  EXPECT_EQ(recordsOf(dir.file("b.las")).format, 6);
+  back = readLas(dir.file("b.las"));
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->dimensions.find(dim::kClassification)->get<uint8_t>(0), 64);
+  EXPECT_EQ(back->dimensions.find(dim::kGpsTime)->get<double>(0), 12.25);
+}
+
+TEST(LasDimensions, mortonOrderAndUniqueCarryEachPointsAttributes) {
+  PointSet set;
+  Dimension& id = set.dimensions.add("id", DimType::kU32, 0);
+  for (uint32_t i = 0; i < 5000; ++i) {
+    set.positions.push_back({double((i * 7919) % 5000), double((i * 104729) % 4999), double(i % 13)});
+    id.resize(i + 1);
+    id.set<uint32_t>(i, i);
+  }
+  const std::vector<glm::dvec3> before = set.positions;
+  reorderPoints(set, PointOrder::kMorton, 2);
+  ASSERT_EQ(set.dimensions.find("id")->size(), 5000u);
+  bool moved = false;
+  for (size_t i = 0; i < set.size(); ++i) {
+    const uint32_t was = set.dimensions.find("id")->get<uint32_t>(i);
+    EXPECT_EQ(set.positions[i], before[was]);
+    moved |= was != i;
+  }
+  EXPECT_TRUE(moved);
+  set.positions.push_back(set.positions[10]);  // a duplicate: unique keeps the first point's id
+  set.dimensions.resize(set.size());
+  set.dimensions.find("id")->set<uint32_t>(set.size() - 1, 99999);
+  dropDuplicatePositions(set);
+  EXPECT_EQ(set.size(), 5000u);
+  EXPECT_EQ(set.dimensions.find("id")->size(), 5000u);
+  EXPECT_NE(set.dimensions.find("id")->get<uint32_t>(10), 99999u);
+}
+
+}  // namespace
+}  // namespace dpoint
