@@ -383,6 +383,49 @@ uint16_t colorWord(float c, double full) {
   return static_cast<uint16_t>(std::min(static_cast<double>(c), 1.0) * full + 0.5);
 }
 
+// Distinct positions minus distinct integer triples at this scale and offset: how many points
+// would read back on top of another. Two sorts, 12 + 24 bytes a point for the time of the count.
+uint64_t mergedPoints(const std::vector<glm::dvec3>& positions, const glm::dvec3& scale, const glm::dvec3& offset) {
+  std::vector<std::array<double, 3>> exact(positions.size());
+  std::vector<std::array<int64_t, 3>> stored(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      exact[i][static_cast<size_t>(k)] = positions[i][k];
+      stored[i][static_cast<size_t>(k)] = static_cast<int64_t>(quantize(positions[i][k], offset[k], scale[k]));
+    }
+  std::sort(exact.begin(), exact.end());
+  std::sort(stored.begin(), stored.end());
+  const uint64_t distinct = static_cast<uint64_t>(std::unique(exact.begin(), exact.end()) - exact.begin());
+  const uint64_t kept = static_cast<uint64_t>(std::unique(stored.begin(), stored.end()) - stored.begin());
+  return distinct - kept;
+}
+
+// Whether every coordinate of the box fits the 32-bit integers at `scale` from the offset the
+// writer would choose (lasOffsetFor rounds the minimum down by less than one unit).
+bool extentFits(const Box& box, double scale) {
+  for (int k = 0; k < 3; ++k) {
+    const double offset = lasOffsetFor(box.min[k], scale);
+    if (!fitsInt32(quantize(box.min[k], offset, scale)) || !fitsInt32(quantize(box.max[k], offset, scale))) return false;
+  }
+  return true;
+}
+
+// The scale of a set without a LAS source or an asked one (las.h: the first decimal step that keeps
+// distinct points apart and fits the extent).
+double chooseScale(const std::vector<glm::dvec3>& positions, const Box& box) {
+  double scale = 0.001;
+  while (!extentFits(box, scale) && scale < 1e300) scale *= 10.0;
+  if (positions.size() < 2) return scale;
+  for (double finer = scale; finer >= 1e-12; finer /= 10.0) {
+    if (!extentFits(box, finer)) break;
+    scale = finer;
+    glm::dvec3 offset;
+    for (int k = 0; k < 3; ++k) offset[k] = lasOffsetFor(box.min[k], finer);
+    if (mergedPoints(positions, glm::dvec3(finer), offset) == 0) break;
+  }
+  return scale;
+}
+
 // What the writer puts in a file beside the records.
 struct WriterLayout {
   int format = 0, version_minor = 2;
@@ -736,9 +779,9 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   if (options.scale != 0.0 && !(std::isfinite(options.scale) && options.scale > 0.0))
     return Error{path + ": LAS scale " + num(options.scale) + " is not a finite number > 0", ExitCode::kUsage};
   const bool keep_frame = options.scale == 0.0 && points.las;
-  const glm::dvec3 scale = options.scale > 0.0 ? glm::dvec3(options.scale)
-                           : keep_frame       ? glm::abs(points.las->scale)
-                                              : glm::dvec3(0.001);
+  glm::dvec3 scale = options.scale > 0.0 ? glm::dvec3(options.scale)
+                     : keep_frame       ? glm::abs(points.las->scale)
+                                        : glm::dvec3(0.001);  // chosen from the data below
   const size_t n = points.size();
   assert(points.colors.empty() || points.colors.size() == n);
   const unsigned threads = resolveThreads(options.threads);
@@ -777,6 +820,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   // Quantization is monotonic (a subtraction, a division by a positive number and a rounding, each
   // correctly rounded), so the box's corners hold the extreme integers: when they fit, all do, and
   // their decoded values are the exact bounds a reader finds.
+  if (options.scale == 0.0 && !keep_frame && n > 0) scale = glm::dvec3(chooseScale(points.positions, box));
   // The source's offset where its integers still hold every point (LAS → LAS: the same records).
   glm::dvec3 offset(0.0), q_min(0.0), q_max(0.0);
   for (int k = 0; k < 3; ++k) {
@@ -805,6 +849,10 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     bound_max[k] = n == 0 ? 0.0 : q_max[k] * scale[k] + offset[k];
   }
 
+  if (options.report) {
+    options.report->scale = scale;
+    options.report->merged_points = mergedPoints(points.positions, scale, offset);
+  }
   Result<WriterLayout> layout = writerLayout(path, points, n);
   if (!layout) return layout.error();
   const WriterLayout& l = *layout;

@@ -35,7 +35,10 @@
 // (PointSet::las) when it holds everything the set carries, else the smallest that does: 0-3 in
 // LAS 1.2, 6-8 in LAS 1.4 where a field or value needs them. A LAS source also gives its scale,
 // offset, version and coordinate system records, so LAS → LAS writes the same point records.
-// Otherwise one scale for x, y and z and per axis the first of these offsets under which every
+// Otherwise one scale for x, y and z: the first of 0.001, 0.0001, … 1e-12 under which no two
+// distinct points share their integers while the extent still fits the 32-bit integers (coarser
+// than 0.001 only where the extent does not fit at it); where none keeps them apart, the finest
+// that fits, and the report counts the points that merge. Per axis the first of these offsets under which every
 // coordinate reads back as the same double: a whole number (lasOffsetFor), 0, the minimum rounded
 // down to a multiple of the scale (none: the whole number). A set without returns is written as
 // return 1 of 1. A point whose (coordinate − offset) / scale rounds outside the 32-bit integers is
@@ -87,12 +90,20 @@ struct LasReadOptions {
   uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
 };
 
+// What writeLas chose and what the file cannot hold as given.
+struct LasWriteReport {
+  glm::dvec3 scale{0.0};
+  // Distinct positions that share their integers at that scale with another: they read back as one.
+  uint64_t merged_points = 0;
+};
+
 struct LasWriteOptions {
   // The coordinate step for x, y and z, finite and > 0; 0: the source LAS file's (PointSet::las)
   // per axis, with its offset where every point fits it, else 0.001.
   double scale = 0.0;
   unsigned threads = 0;
   Progress* progress = nullptr;
+  LasWriteReport* report = nullptr;  // filled when not null
 };
 
 // Reads and checks the header only (everything the top comment lists, the file size included).

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "converters/gltf_write.h"
+#include "core/text.h"
 #include "ops/point_filters.h"
 
 namespace dpoint {
@@ -163,8 +164,19 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     case FileFormat::kGltf:
     case FileFormat::kLaz:
       return checkWrittenFormat(path, *format);
-    case FileFormat::kLas:
-      return writeLas(path, points, LasWriteOptions{options.las_scale, options.threads, options.progress});
+    case FileFormat::kLas: {
+      LasWriteReport report;
+      if (Status s = writeLas(path, points, LasWriteOptions{options.las_scale, options.threads, options.progress, &report});
+          !s)
+        return s;
+      if (report.merged_points != 0 && options.notices)
+        options.notices->push_back(path + ": " + std::to_string(report.merged_points) + " of " +
+                                   std::to_string(points.size()) + " points share their integers with another at the LAS scale " +
+                                   formatNumber(report.scale.x) + " and read back merged" +
+                                   (options.las_scale > 0.0 ? " (a finer --las-scale keeps them apart where the extent fits)"
+                                                            : " (no decimal scale down to 1e-12 keeps them apart within LAS's 32-bit range)"));
+      return okStatus();
+    }
   }
   return Error{path + ": unreachable format"};
 }

@@ -1,6 +1,7 @@
 #include "viewer/info_report.h"
 
 #include <array>
+#include <limits>
 #include <utility>
 
 #include "converters/point_io.h"
@@ -114,6 +115,15 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
   InfoReport report;
   report.name = name;
   report.info = computeInfo(points, options.sample, options.threads);
+  for (const Dimension& d : points.dimensions.all()) {
+    DimensionRange range{d.name, d.type, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    for (size_t i = 0; i < d.size(); ++i) {
+      const double v = d.value(i);
+      if (v < range.min) range.min = v;
+      if (v > range.max) range.max = v;
+    }
+    report.dimensions.push_back(range);
+  }
   if (points.size() > 0) {
     Result<Camera> camera = makeCamera(options.camera, boundsOf(points));
     if (!camera) return camera.error();
@@ -177,12 +187,49 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   return report;
 }
 
+namespace {
+
+std::string dimensionsJson(const std::vector<DimensionRange>& dimensions) {
+  std::string json = "[";
+  for (size_t k = 0; k < dimensions.size(); ++k) {
+    const DimensionRange& d = dimensions[k];
+    const bool any = d.min <= d.max;
+    if (k) json += ", ";
+    json += "{\"name\": ";
+    json += jsonString(d.name);
+    json += ", \"type\": ";
+    json += jsonString(dimTypeName(d.type));
+    json += ", \"min\": ";
+    json += any ? formatNumber(d.min, true) : std::string("null");
+    json += ", \"max\": ";
+    json += any ? formatNumber(d.max, true) : std::string("null");
+    json += "}";
+  }
+  return json + "]";
+}
+
+}  // namespace
+
 std::string infoReportText(const InfoReport& report) {
   const PointSetInfo& i = report.info;
   std::string text = "file:               " + report.name + "\n" +
                      "points:             " + str(i.count) + "\n" +
                      "triangles:          " + str(i.triangles) + "\n" +
                      "colours:            " + (i.has_colors ? "yes" : "no") + "\n";
+  for (const DimensionRange& d : report.dimensions) {
+    text += "dimension:          ";
+    text += d.name;
+    text += " (";
+    text += dimTypeName(d.type);
+    text += ")";
+    if (d.min <= d.max) {
+      text += ' ';
+      text += num(d.min);
+      text += " .. ";
+      text += num(d.max);
+    }
+    text += "\n";
+  }
   if (report.las) text += lasText(*report.las);
   text += "min:                " + vec(i.min) + "\n" +
           "max:                " + vec(i.max) + "\n" +
@@ -206,6 +253,7 @@ std::string infoReportJson(const InfoReport& report) {
                      ",\n  \"points\": " + str(i.count) +
                      ",\n  \"triangles\": " + str(i.triangles) +
                      ",\n  \"colors\": " + jsonBool(i.has_colors) +
+                     ",\n  \"dimensions\": " + dimensionsJson(report.dimensions) +
                      ",\n  \"min\": " + jsonVec(i.min) +
                      ",\n  \"max\": " + jsonVec(i.max) +
                      ",\n  \"extent\": " + jsonVec(i.extent) +

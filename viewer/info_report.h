@@ -44,9 +44,17 @@ struct LasFacts {
   bool bounds_hold = true;
 };
 
+// A dimension of the set (core/dimensions.h) and its range; min > max where the set is empty.
+struct DimensionRange {
+  std::string name;
+  DimType type = DimType::kF64;
+  double min = 0.0, max = 0.0;
+};
+
 struct InfoReport {
   std::string name;                  // the set's name in the report ("file"): the caller's
   PointSetInfo info;
+  std::vector<DimensionRange> dimensions;  // a set in memory's; a streamed set lists none
   // Read a block at a time: float32's merged points, which need every point at once, are not
   // counted (info.float_merged stays 0, the JSON says null) and the bounds are from boxes.
   bool streamed = false;

@@ -22,6 +22,53 @@ using test::writeFile;
 const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/las/";
 const std::string kLazRefusal = ": LAZ (compressed LAS) is not supported; decompress it with laszip or PDAL first";
 
+size_t distinctPositions(std::vector<glm::dvec3> p) {
+  std::sort(p.begin(), p.end(), [](const glm::dvec3& a, const glm::dvec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  });
+  return static_cast<size_t>(std::unique(p.begin(), p.end()) - p.begin());
+}
+
+// Issue #34: LAS writing never merges distinct points silently. Without a LAS source or
+// --las-scale, the scale is chosen so that they stay apart; an asked scale that merges says how many.
+TEST(CliLas, lasOutputKeepsDistinctPointsApartOrSaysHowManyMerge) {
+  TempDir dir;
+  // A level-3 Menger sponge 1 mm wide at 1 km: 15,232 points 37 µm apart (8 positions at 0.001).
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "3", "--size", "0.001", "--offset", "1000,0,0", "-o",
+                       dir.file("m3.ply"), "--quiet"}).exit_code, 0);
+  test::CommandResult r = runDpoint({"convert", dir.file("m3.ply"), "-o", dir.file("m3.las")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("merged"), std::string::npos) << r.err;
+  Result<PointSet> ply = readPoints(dir.file("m3.ply")), las = readPoints(dir.file("m3.las"));
+  ASSERT_TRUE(ply && las);
+  EXPECT_EQ(distinctPositions(las->positions), distinctPositions(ply->positions));
+  for (size_t i = 0; i < ply->size(); i += 101)  // within half the scale (1e-5)
+    for (int k = 0; k < 3; ++k) EXPECT_LE(std::fabs(las->positions[i][k] - ply->positions[i][k]), 0.5e-5);
+  // At an asked 0.001 they merge, and the note counts them.
+  r = runDpoint({"convert", dir.file("m3.ply"), "-o", dir.file("coarse.las"), "--las-scale", "0.001"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  las = readPoints(dir.file("coarse.las"));
+  ASSERT_TRUE(las);
+  const size_t merged = distinctPositions(ply->positions) - distinctPositions(las->positions);
+  EXPECT_GT(merged, 0u);
+  EXPECT_TRUE(test::contains(r.err, "coarse.las: " + std::to_string(merged) + " of 15232 points share their integers"));
+  // generate -o .las takes the same path.
+  r = runDpoint({"generate", "menger", "--level", "3", "--size", "0.001", "--offset", "1000,0,0", "-o", dir.file("g.las"), "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  las = readPoints(dir.file("g.las"));
+  ASSERT_TRUE(las);
+  EXPECT_EQ(distinctPositions(las->positions), distinctPositions(ply->positions));
+}
+
+TEST(CliLas, aMandelbulbKeepsEveryDistinctPointThroughLas) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "200", "-o", dir.file("bulb.ply"), "--quiet"}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"convert", dir.file("bulb.ply"), "-o", dir.file("bulb.las"), "--quiet"}).exit_code, 0);
+  Result<PointSet> ply = readPoints(dir.file("bulb.ply")), las = readPoints(dir.file("bulb.las"));
+  ASSERT_TRUE(ply && las);
+  EXPECT_EQ(distinctPositions(las->positions), distinctPositions(ply->positions));
+}
+
 TEST(CliLas, convertLasToCsvWritesEveryPointWithItsColour) {
   TempDir dir;
   test::CommandResult r = runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("s.csv"), "--quiet"});
