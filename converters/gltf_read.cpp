@@ -89,6 +89,13 @@ struct Uncoloured {
 
 class SceneReader {
  public:
+  // dpoint's writer marks a 2D set's asset (gltf_write.cpp).
+  static bool saysFlat(const tinygltf::Model& model) {
+    const tinygltf::Value& dpoint = model.asset.extras.Get("dpoint");
+    return model.asset.generator == "dpoint" && dpoint.IsObject() && dpoint.Get("2d").IsBool() &&
+           dpoint.Get("2d").Get<bool>();
+  }
+
   SceneReader(const std::string& path, const tinygltf::Model& model, const GltfReadOptions& options)
       : path_(path),
         model_(model),
@@ -99,7 +106,11 @@ class SceneReader {
   Result<PointSet> read() {
     pass_ = Pass::kBuild;
     if (Status s = walkScenes(); !s) return s.error();
-    out_.z_axis = ZAxis::kPresent;  // glTF positions are VEC3, whatever their values
+    // glTF positions are VEC3, whatever their values; a set dpoint wrote as 2D says so in the
+    // asset's extras (gltf_write.cpp), and its z are 0.
+    const bool flat = saysFlat(model_) && std::all_of(out_.positions.begin(), out_.positions.end(),
+                                                      [](const glm::dvec3& p) { return p.z == 0.0; });
+    out_.z_axis = flat ? ZAxis::kAbsent : ZAxis::kPresent;
     if (any_colour_) {
       out_.colors.resize(out_.positions.size());
       for (const Uncoloured& u : uncoloured_)
@@ -111,7 +122,7 @@ class SceneReader {
   Status stream(GltfPointSink& sink) {
     pass_ = Pass::kCheck;
     if (Status s = walkScenes(); !s) return s;
-    if (Status s = sink.begin(GltfSummary{emitted_total_, any_colour_}); !s) return s;
+    if (Status s = sink.begin(GltfSummary{emitted_total_, any_colour_, saysFlat(model_)}); !s) return s;
     pass_ = Pass::kEmit;
     sink_ = &sink;
     emitted_total_ = 0;

@@ -57,6 +57,7 @@ Result<PointSet> readGltf(const InputFile& input, const GltfReadOptions& options
 struct GltfSummary {
   uint64_t points = 0;
   bool colors = false;  // some primitive has COLOR_0 or a non-white material colour (then every point has a colour)
+  bool flat = false;    // the asset says dpoint wrote it from a 2D set (gltfSaysFlat): its z are 0
 };
 
 // Receives streamGltf's points: begin() once, after the checking walk, then points() with

@@ -251,6 +251,15 @@ tinygltf::Model describe(const PointSet& points, const Layout& layout) {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "dpoint";
+  // A 2D set (z not a coordinate: read from x,y input, or made with every z 0) says so, as the PLY
+  // writer's comment does: glTF positions are VEC3, so without it x,y → GLB → CSV came back x,y,z.
+  if (!points.hasZ()) {
+    tinygltf::Value::Object dpoint;
+    dpoint["2d"] = tinygltf::Value(true);
+    tinygltf::Value::Object extras;
+    extras["dpoint"] = tinygltf::Value(dpoint);
+    model.asset.extras = tinygltf::Value(extras);
+  }
 
   tinygltf::Primitive primitive;
   size_t offset = 0;

@@ -21,8 +21,10 @@ class CsvPointSink final : public GltfPointSink {
       : output_(output), filters_(filters), options_(options) {}
 
   Status begin(const GltfSummary& summary) override {
-    // glTF positions always have z (PointSet::z_axis), and a scene placing no points is an empty set.
-    const CsvLayout layout{false, summary.colors && !filters_.drop};
+    // glTF positions have z (PointSet::z_axis) unless dpoint wrote the file from a 2D set; a scene
+    // placing no points is an empty set.
+    flat_ = summary.flat;
+    const CsvLayout layout{flat_, summary.colors && !filters_.drop};
     Result<CsvRowWriter> writer = CsvRowWriter::create(
         output_, layout, CsvWriteOptions{options_.decimals, options_.threads, options_.progress}, summary.points);
     if (!writer) return writer.error();
@@ -31,6 +33,11 @@ class CsvPointSink final : public GltfPointSink {
   }
 
   Status points(PointSet& block) override {
+    if (flat_)  // a file that says 2D but has a z would lose it in x,y columns
+      for (size_t i = 0; i < block.size(); ++i)
+        if (block.positions[i].z != 0.0)
+          return Error{"a glTF marked 2D by dpoint has a point with z = " + formatNumber(block.positions[i].z) +
+                       "; not written as x,y"};
     if (filters_.drop) block.colors.clear();
     if (filters_.srgb8) encodeColorsSrgb8(block);
     return writer_->append(block.positions, block.colors);
@@ -43,6 +50,7 @@ class CsvPointSink final : public GltfPointSink {
   const ColorFilters& filters_;
   const WriteOptions& options_;
   std::optional<CsvRowWriter> writer_;
+  bool flat_ = false;  // x,y columns: the file said 2D
 };
 
 }  // namespace

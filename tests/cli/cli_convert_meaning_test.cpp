@@ -87,10 +87,10 @@ TEST(CliConvertMeaning, threeColumnCsvAtZeroStaysThreeColumnsAndTwoColumnsStayTw
   EXPECT_TRUE(test::contains(readFile(dir.file("xy.ply")), "\ncomment dpoint: 2D (the source has x,y only; z is 0)\n"));
   expectConverts({dir.file("xy.ply"), "-o", dir.file("xy_out.csv")});
   EXPECT_EQ(readFile(dir.file("xy_out.csv")), "x,y\n1.5,2\n3,4\n");
-  // GLB positions have z: 2D input through GLB comes back with a z column of zeros.
+  // GLB positions have z, but dpoint's GLB of a 2D set says it is one (issue #34): x,y again.
   expectConverts({dir.file("xy.csv"), "-o", dir.file("xy.glb")});
   expectConverts({dir.file("xy.glb"), "-o", dir.file("xy_glb.csv")});
-  EXPECT_EQ(firstLine(readFile(dir.file("xy_glb.csv"))), "x,y,z\n");
+  EXPECT_EQ(readFile(dir.file("xy_glb.csv")), "x,y\n1.5,2\n3,4\n");
 }
 
 TEST(CliConvertMeaning, plyWithoutZIsTwoDimensional) {
@@ -118,6 +118,23 @@ TEST(CliConvertMeaning, generated2dPlyConvertsToTwoColumns) {
   EXPECT_EQ(readFile(dir.file("back.csv")), readFile(dir.file("r.csv")));
   ASSERT_EQ(runDpoint({"generate", "menger", "--level", "1", "-q", "-o", dir.file("m.ply")}).exit_code, 0);
   EXPECT_FALSE(test::contains(readFile(dir.file("m.ply")), "comment dpoint: 2D"));
+}
+
+// Issue #34: a 2D set stays 2D through GLB (the asset's extras say so), on the streamed glTF → CSV
+// path and through a set in memory (GLB → PLY → CSV); a 3D set's GLB carries no such mark.
+TEST(CliConvertMeaning, a2dSetStays2dThroughGlb) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "50", "-q", "-o", dir.file("r.csv")}).exit_code, 0);
+  expectConverts({dir.file("r.csv"), "-o", dir.file("r.glb")});
+  expectConverts({dir.file("r.glb"), "-o", dir.file("streamed.csv")});
+  EXPECT_EQ(readFile(dir.file("streamed.csv")), readFile(dir.file("r.csv")));
+  expectConverts({dir.file("r.glb"), "-o", dir.file("r.ply")});
+  expectConverts({dir.file("r.ply"), "-o", dir.file("held.csv")});
+  EXPECT_EQ(readFile(dir.file("held.csv")), readFile(dir.file("r.csv")));
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "1", "-q", "-o", dir.file("m.glb")}).exit_code, 0);
+  EXPECT_FALSE(test::contains(readFile(dir.file("m.glb")), "\"2d\""));
+  expectConverts({dir.file("m.glb"), "-o", dir.file("m.csv")});
+  EXPECT_EQ(readFile(dir.file("m.csv")).substr(0, 6), "x,y,z,");
 }
 
 TEST(CliConvertMeaning, emptyLasConvertsToEmptyCsvPlyAndLasAndGlbSaysWhyNot) {
