@@ -213,11 +213,11 @@ class LasReader {
     points.positions.resize(count);
     if (source_ != LasColorSource::kNone) points.colors.resize(count);
     // Every field of the record, and each extra byte field, as a dimension (core/dimensions.h).
-    for (const LasField& f : fields_) points.dimensions.add(f.name, f.type, count);
-    for (const LasExtraField& f : extra_) points.dimensions.add(f.name, f.type, count);
+    // (lasExtraFields made every name unique.)
+    for (const LasField& f : fields_) points.dimensions.append(f.name, f.type, count);
+    for (const LasExtraField& f : extra_) points.dimensions.append(f.name, f.type, count);
     columns_.clear();  // pointers once every column is in place (adding one may move the others)
-    for (const LasField& f : fields_) columns_.push_back(points.dimensions.find(f.name));
-    for (const LasExtraField& f : extra_) columns_.push_back(points.dimensions.find(f.name));
+    for (Dimension& d : points.dimensions.all()) columns_.push_back(&d);
     const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
     const size_t blocks = (count + block_points - 1) / block_points;
     const unsigned threads = resolveThreads(options_.threads);
@@ -457,7 +457,7 @@ std::string writerHeader(const WriterLayout& l, uint64_t count, const std::array
   // The legacy counts: 0 where they cannot hold the truth (formats 6-10, more than 2^32 - 1 points).
   const bool legacy = l.format < 6 && count <= UINT32_MAX;
   store<uint32_t>(h.data() + kLegacyCountAt, legacy ? static_cast<uint32_t>(count) : 0u);
-  for (int r = 0; r < 5; ++r)
+  for (size_t r = 0; r < 5; ++r)
     store<uint32_t>(h.data() + kLegacyByReturnAt + 4 * r, legacy ? static_cast<uint32_t>(by_return[r]) : 0u);
   for (int k = 0; k < 3; ++k) {
     store<double>(h.data() + kScaleAt + 8 * k, scale[k]);
@@ -469,7 +469,7 @@ std::string writerHeader(const WriterLayout& l, uint64_t count, const std::array
     store<uint64_t>(h.data() + kEvlrStartAt, l.evlrs.empty() ? 0 : evlr_start);
     store<uint32_t>(h.data() + kEvlrCountAt, static_cast<uint32_t>(l.evlrs.size()));
     store<uint64_t>(h.data() + kCountAt, count);
-    for (int r = 0; r < 15; ++r) store<uint64_t>(h.data() + kCountAt + 8 + 8 * r, by_return[r]);
+    for (size_t r = 0; r < 15; ++r) store<uint64_t>(h.data() + kCountAt + 8 + 8 * r, by_return[r]);
   }
   return h;
 }
@@ -518,7 +518,7 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
     // The other family's scan angle fills this format's, unless the set has that one too.
     const char* counterpart = d.name == dim::kScanAngle ? dim::kScanAngleRank : d.name == dim::kScanAngleRank ? dim::kScanAngle : nullptr;
     if (counterpart && isField(counterpart) && !points.dimensions.find(counterpart)) continue;
-    l.extra.push_back({d.name.substr(0, 32), d.type, at});
+    l.extra.push_back({d.name.substr(0, 32), d.type, at, static_cast<size_t>(&d - points.dimensions.all().data())});
     at += static_cast<uint32_t>(dimTypeSize(d.type));
   }
   l.record_length = l.base_length + at;
@@ -558,7 +558,8 @@ class RecordEncoder {
       slots_.push_back(slot);
     }
     for (const LasExtraField& e : l.extra)
-      slots_.push_back({nullptr, e.type, l.base_length + e.offset, 0, 0, findExtra(e), Convert::kNone});
+      slots_.push_back({nullptr, e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
+                        Convert::kNone});
     rgb_at_ = points.hasColors() ? lasRgbOffset(l.format) : 0;
     color_scale_ = points.color_full_scale == 255 ? 255.0 : 65535.0;
     return_number_ = points.dimensions.find(dim::kReturnNumber);
@@ -620,11 +621,6 @@ class RecordEncoder {
     Convert convert;
     uint32_t missing = 0;  // the value where the set lacks the dimension
   };
-  const Dimension* findExtra(const LasExtraField& e) const {
-    for (const Dimension& d : points_.dimensions.all())
-      if (d.name.substr(0, 32) == e.name) return &d;
-    return nullptr;
-  }
 
   const PointSet& points_;
   glm::dvec3 offset_, scale_;

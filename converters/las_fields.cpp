@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstring>
 #include <optional>
+#include <unordered_set>
 
 namespace dpoint {
 namespace {
@@ -116,15 +117,19 @@ uint32_t lasRgbOffset(int point_format) { return kRgbAt.at(static_cast<size_t>(p
 Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t extra, const std::vector<LasField>& base) {
   std::vector<LasExtraField> out;
   std::vector<bool> described(extra, false);
-  auto taken = [&](const std::string& name) {
-    return std::any_of(base.begin(), base.end(), [&](const LasField& f) { return name == f.name; }) ||
-           std::any_of(out.begin(), out.end(), [&](const LasExtraField& f) { return f.name == name; }) ||
-           name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue";
-  };
-  auto unique = [&](std::string name) {
-    if (!taken(name)) return name;
-    for (int n = 2;; ++n)
-      if (!taken(name + "_" + std::to_string(n))) return name + "_" + std::to_string(n);
+  // Names in use, in a set: a record may carry 65,000 extra bytes (the fuzz target found one whose
+  // pairwise name checks took seconds).
+  std::unordered_set<std::string> taken = {"x", "y", "z", "red", "green", "blue"};
+  for (const LasField& f : base) taken.insert(f.name);
+  auto unique = [&](const std::string& name) {
+    std::string candidate = name;
+    for (int n = 2; taken.count(candidate); ++n) {
+      candidate = name;
+      candidate += '_';
+      candidate += std::to_string(n);
+    }
+    taken.insert(candidate);
+    return candidate;
   };
   uint32_t at = 0;
   if (vlr) {
@@ -157,14 +162,14 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
       if (type) {
         const uint32_t width = static_cast<uint32_t>(dimTypeSize(*type));
         for (uint32_t e = 0; e < elements; ++e)
-          out.push_back({unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width});
+          out.push_back({unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width, 0});
         std::fill(described.begin() + at, described.begin() + at + size, true);
       }
       at += size;
     }
   }
   for (uint32_t b = 0; b < extra; ++b)
-    if (!described[b]) out.push_back({unique("extra_byte_" + std::to_string(b)), DimType::kU8, b});
+    if (!described[b]) out.push_back({unique("extra_byte_" + std::to_string(b)), DimType::kU8, b, 0});
   std::sort(out.begin(), out.end(), [](const LasExtraField& a, const LasExtraField& b) { return a.offset < b.offset; });
   return out;
 }

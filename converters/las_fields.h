@@ -35,6 +35,7 @@ struct LasExtraField {
   std::string name;
   DimType type;
   uint32_t offset;
+  size_t dimension = 0;  // the writer's: its index in the set's dimensions
 };
 
 // The extra bytes of a record of `extra` bytes as the VLR `vlr` (null: none) describes them. Bytes

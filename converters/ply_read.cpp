@@ -27,6 +27,7 @@
 #include <mutex>
 #include <optional>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "core/input_file.h"
@@ -246,7 +247,15 @@ struct Element {
 };
 
 // What a property feeds; values land in `double values[kRoleCount]` indexed by role.
-enum Role : uint8_t { kSkip, kX, kY, kZ, kRed, kGreen, kBlue, kIndices, kRoleCount };
+// kAttribute: a vertex property kept as a dimension (core/dimensions.h); its value goes to
+// attribute_row_ instead (the slot in values_ is scratch).
+enum Role : uint8_t { kSkip, kX, kY, kZ, kRed, kGreen, kBlue, kIndices, kAttribute, kRoleCount };
+
+DimType dimTypeOf(Type t) {
+  constexpr DimType kTypes[] = {DimType::kI8,  DimType::kU8,  DimType::kI16, DimType::kU16,
+                                DimType::kI32, DimType::kU32, DimType::kF32, DimType::kF64};
+  return kTypes[static_cast<int>(t)];
+}
 
 class PlyParser {
  public:
@@ -389,6 +398,25 @@ class PlyParser {
         // The facts dpoint writes (ply_write.cpp): a 2D source, and z up.
         if (w[2] == "2D") points_.z_axis = ZAxis::kAbsent;
         if (w.size() == 5 && w[2] == "up" && w[3] == "axis" && w[4] == "z") points_.z_up = true;
+        // A set read from LAS: its point format, version, scale and offset, so that LAS → PLY → LAS
+        // writes the same coordinates in the same format. Ignored unless all of it parses.
+        if (w.size() == 12 && w[2] == "las" && w[3] == "frame") {
+          LasSource las;
+          double v[8];
+          bool ok = true;
+          for (size_t k = 0; k < 8; ++k) {
+            const std::string_view t = w[4 + k];
+            ok = ok && std::from_chars(t.data(), t.data() + t.size(), v[k]).ec == std::errc() && std::isfinite(v[k]);
+          }
+          if (ok && v[0] >= 0 && v[0] <= 10 && v[0] == std::floor(v[0]) && v[1] >= 0 && v[1] <= 4 && v[2] > 0 &&
+              v[3] > 0 && v[4] > 0) {
+            las.point_format = static_cast<int>(v[0]);
+            las.version_minor = static_cast<int>(v[1]);
+            las.scale = glm::dvec3(v[2], v[3], v[4]);
+            las.offset = glm::dvec3(v[5], v[6], v[7]);
+            points_.las = las;
+          }
+        }
       }
       if (key == "comment" || key == "obj_info") continue;
       if (key == "end_header") break;
@@ -473,6 +501,18 @@ class PlyParser {
         found[role] = p.line;
       }
     }
+    // Every other number of a vertex is a dimension of its own type, in the header's order (a
+    // repeated name keeps its first property; a set of names, as a header may list thousands).
+    std::unordered_set<std::string> named;
+    for (size_t k = 0; k < vertex->properties.size(); ++k) {
+      const Property& p = vertex->properties[k];
+      if (vertex_roles_[k] != kSkip || p.is_list || !named.insert(p.name).second) continue;
+      vertex_roles_[k] = kAttribute;
+      attribute_of_.resize(vertex->properties.size(), SIZE_MAX);
+      attribute_of_[k] = points_.dimensions.count();
+      points_.dimensions.append(p.name, dimTypeOf(p.type), 0);
+    }
+    attribute_row_.assign(points_.dimensions.count(), 0.0);
     // x and y are needed; without z the file is 2D (z = 0).
     if (!found[kZ]) points_.z_axis = ZAxis::kAbsent;
     else if (points_.z_axis == ZAxis::kUnknown) points_.z_axis = ZAxis::kPresent;
@@ -525,7 +565,8 @@ class PlyParser {
     // What the data bounds may still be more than memory: 24-36 bytes of point set per vertex
     // from as little as 3 bytes of file.
     memory_limit_ = options_.max_memory ? options_.max_memory : defaultMemoryLimit();
-    vertex_bytes_ = vertex_count_ * (sizeof(glm::dvec3) + (has_colors_ ? sizeof(glm::vec3) : 0));
+    vertex_bytes_ = vertex_count_ * (sizeof(glm::dvec3) + (has_colors_ ? sizeof(glm::vec3) : 0) +
+                                     points_.dimensions.bytesPerPoint());
     return checkMemory(path_ + ": " + std::to_string(vertex_count_) + " vertices", vertex_bytes_, memory_limit_);
   }
 
@@ -575,6 +616,10 @@ class PlyParser {
       Role role;
     };
     std::vector<Field> fields;
+    struct Attribute {
+      size_t offset, bytes, dimension;
+    };
+    std::vector<Attribute> attributes;  // copied as they are into their dimension's column
     size_t row_bytes = 0, at[kRoleCount] = {};
     bool packed = true;     // adjacent double x, y, z and uchar colours: what dpoint and most tools write
     float byte_color[256];  // k / 255.0f, the same rounding as colorOf
@@ -585,10 +630,14 @@ class PlyParser {
     }
   };
 
-  static RowLayout vertexLayout(const Element& e, const std::vector<Role>& roles) {
+  RowLayout vertexLayout(const Element& e, const std::vector<Role>& roles) const {
     RowLayout layout;
     for (size_t k = 0; k < e.properties.size(); layout.row_bytes += typeSize(e.properties[k++].type)) {
       if (roles[k] == kSkip) continue;
+      if (roles[k] == kAttribute) {
+        layout.attributes.push_back({layout.row_bytes, typeSize(e.properties[k].type), attribute_of_[k]});
+        continue;
+      }
       layout.fields.push_back({layout.row_bytes, e.properties[k].type, roles[k]});
       layout.at[roles[k]] = layout.row_bytes;
       layout.packed = layout.packed && e.properties[k].type == (roles[k] <= kZ ? Type::kFloat64 : Type::kUint8);
@@ -614,6 +663,9 @@ class PlyParser {
     // Sized, not reserved: every block writes its own slots.
     resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
     if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
+    points_.dimensions.resize(static_cast<size_t>(rows));
+    std::vector<uint8_t*> columns;
+    for (Dimension& d : points_.dimensions.all()) columns.push_back(d.bytes.data());
 
     std::mutex error_mutex;
     std::optional<Error> first_error;
@@ -640,7 +692,7 @@ class PlyParser {
         const uint64_t whole = first + *got / row_bytes;
         return fail(whole, truncated(e, whole));
       }
-      const uint64_t bad = decodeVertices(layout, buffer.data(), first, last, positions, colors, 0);
+      const uint64_t bad = decodeVertices(layout, buffer.data(), first, last, positions, colors, 0, columns.data());
       if (bad != last) {
         double v[kRoleCount];
         layout.load(buffer.data() + (bad - first) * row_bytes, v);
@@ -659,11 +711,15 @@ class PlyParser {
   // when not null, colors[row − base]. Returns the first unacceptable row, or `last`. Runs on
   // several threads.
   uint64_t decodeVertices(const RowLayout& layout, const char* data, uint64_t first, uint64_t last,
-                          glm::dvec3* positions, glm::vec3* colors, uint64_t base) const {
+                          glm::dvec3* positions, glm::vec3* colors, uint64_t base,
+                          uint8_t* const* columns = nullptr) const {
     const char* p = data;
     for (uint64_t row = first; row < last; ++row, p += layout.row_bytes) {
       double v[kRoleCount];  // local, so that stores into the point arrays cannot alias it
       const uint64_t at = row - base;
+      if (columns)
+        for (const RowLayout::Attribute& a : layout.attributes)
+          std::memcpy(columns[a.dimension] + at * a.bytes, p + a.offset, a.bytes);
       if (layout.packed) {
         std::memcpy(&v[kX], p + layout.at[kX], 3 * sizeof(double));
         if (!positionAcceptable(v)) return row;  // uchar colours always are
@@ -695,6 +751,7 @@ class PlyParser {
       in_.consume(size);
       if (!p.is_list) {
         values_[roles[k]] = value;
+        if (roles[k] == kAttribute) attribute_row_[attribute_of_[k]] = value;
         continue;
       }
       if (value < 0) return dataError(where, e.name + " " + std::to_string(row) + ": negative list length");
@@ -742,6 +799,7 @@ class PlyParser {
       if (Status s = parse(p, p.is_list ? p.count_type : p.type, value); !s.ok()) return s;
       if (!p.is_list) {
         values_[roles[k]] = value;
+        if (roles[k] == kAttribute) attribute_row_[attribute_of_[k]] = value;
         continue;
       }
       if (value < 0) return dataError(where, e.name + " " + std::to_string(row) + ": negative list length");
@@ -777,6 +835,12 @@ class PlyParser {
     if (!positionAcceptable(v) || (has_colors_ && !colourAcceptable(v))) return false;
     points_.positions.emplace_back(v[kX], v[kY], v[kZ]);
     if (has_colors_) points_.colors.push_back(colorOf(v));
+    const size_t row = points_.positions.size() - 1;
+    for (size_t a = 0; a < attribute_row_.size(); ++a) {
+      Dimension& d = points_.dimensions.all()[a];
+      d.resize(row + 1);
+      d.setValue(row, attribute_row_[a]);
+    }
     return true;
   }
 
@@ -848,6 +912,8 @@ class PlyParser {
   uint64_t vertex_bytes_ = 0;  // what the vertices take in the point set
   uint64_t line_no_ = 0;  // the last line read (header, then ASCII data)
   double values_[kRoleCount] = {};
+  std::vector<size_t> attribute_of_;  // per vertex property: its dimension's index (kAttribute only)
+  std::vector<double> attribute_row_;  // the dimensions' values of the row being read (ASCII, lists)
   std::vector<double> polygon_;  // indices of the current face (exact in double)
   PointSet points_;
   RowLayout stream_layout_;  // PlyVertexStream

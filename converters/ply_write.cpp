@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "core/text.h"
 #include "converters/ply.h"
 
 namespace dpoint {
@@ -31,6 +32,19 @@ std::string sourceFacts(const PointSet& points) {
   std::string facts;
   if (!points.hasZ()) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
   if (points.z_up) facts += "comment dpoint: up axis z\n";
+  if (points.las) {  // ply_read.cpp reads it back, so that LAS → PLY → LAS keeps its coordinates
+    const LasSource& l = *points.las;
+    facts += "comment dpoint: las frame ";
+    facts += std::to_string(l.point_format);
+    facts += ' ';
+    facts += std::to_string(l.version_minor);
+    for (const glm::dvec3* v : {&l.scale, &l.offset})
+      for (int k = 0; k < 3; ++k) {
+        facts += ' ';
+        facts += formatNumber((*v)[k]);
+      }
+    facts += '\n';
+  }
   return facts;
 }
 
@@ -72,6 +86,17 @@ void appendNumber(ChunkWriter& out, T value, char separator) {
   out.append(text, static_cast<size_t>(r.ptr + 1 - text));
 }
 
+// Value i of a dimension in ASCII: integers as integers, floats in shortest round-trip form.
+void appendDimension(ChunkWriter& out, const Dimension& d, size_t i, char separator) {
+  switch (d.type) {
+    case DimType::kF32: appendNumber(out, d.get<float>(i), separator); break;
+    case DimType::kF64: appendNumber(out, d.get<double>(i), separator); break;
+    case DimType::kU64: appendNumber(out, d.get<uint64_t>(i), separator); break;
+    case DimType::kI64: appendNumber(out, d.get<int64_t>(i), separator); break;
+    default: appendNumber(out, static_cast<int64_t>(d.value(i)), separator); break;
+  }
+}
+
 }  // namespace
 
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
@@ -97,6 +122,16 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   if (points.hasColors())
     for (const char* c : {"red", "green", "blue"})
       header += std::string("property ") + (float_colors ? "float " : "uchar ") + c + "\n";
+  // Dimensions as properties of their own type; PLY has no 64-bit integers, so those go as double
+  // (exact below 2^53).
+  for (const Dimension& d : points.dimensions.all()) {
+    const char* type = plyTypeName(d.type);
+    header += "property ";
+    header += type ? type : "double";
+    header += ' ';
+    header += d.name;
+    header += '\n';
+  }
   if (faces) header += "element face " + std::to_string(faces) + "\nproperty list uchar uint vertex_indices\n";
   header += "end_header\n";
 
@@ -105,20 +140,23 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   out.append(header);
   for (size_t i = 0; i < n; ++i) {
     const glm::dvec3& p = points.positions[i];
+    const bool attributes = !points.dimensions.empty();
     if (ascii) {
       appendNumber(out, p.x, ' ');
       appendNumber(out, p.y, ' ');
-      appendNumber(out, p.z, points.hasColors() ? ' ' : '\n');
+      appendNumber(out, p.z, points.hasColors() || attributes ? ' ' : '\n');
       if (points.hasColors()) {
         const glm::vec3& c = points.colors[i];
         for (int k = 0; k < 3; ++k) {
-          const char sep = k == 2 ? '\n' : ' ';
+          const char sep = k == 2 && !attributes ? '\n' : ' ';
           if (float_colors)
             appendNumber(out, c[k], sep);
           else
             appendNumber(out, static_cast<unsigned>(colorByte(c[k])), sep);
         }
       }
+      const std::vector<Dimension>& dims = points.dimensions.all();
+      for (size_t k = 0; k < dims.size(); ++k) appendDimension(out, dims[k], i, k + 1 == dims.size() ? '\n' : ' ');
     } else {
       out.append(&p, sizeof p);
       if (points.hasColors()) {
@@ -128,6 +166,15 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
         } else {
           const uint8_t rgb[3] = {colorByte(c.r), colorByte(c.g), colorByte(c.b)};
           out.append(rgb, sizeof rgb);
+        }
+      }
+      for (const Dimension& d : points.dimensions.all()) {
+        if (plyTypeName(d.type)) {
+          const size_t w = dimTypeSize(d.type);
+          out.append(d.bytes.data() + i * w, w);
+        } else {
+          const double v = d.value(i);
+          out.append(&v, sizeof v);
         }
       }
     }

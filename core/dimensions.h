@@ -126,6 +126,10 @@ class Dimensions {
   Dimension* find(std::string_view name);
   // The column `name`, added with `points` zero values when missing (its type must then match).
   Dimension& add(const std::string& name, DimType type, size_t points);
+  // A new column whose name the caller knows is not taken (no search: readers adding many).
+  Dimension& append(const std::string& name, DimType type, size_t points) {
+    return columns_.emplace_back(name, type, points);
+  }
   bool remove(std::string_view name);
   // Every column resized to `points` (new values 0).
   void resize(size_t points);

@@ -170,9 +170,12 @@ TEST(GltfStream, csvEqualsInMemoryWithInstancingMixedColoursAndScenes) {
 }
 
 TEST(GltfStream, zColumnKeptEvenWhenEveryZIsZero) {
-  // glTF positions have z: a set at z = 0 keeps its z column (issue #24: the values do not decide).
+  // glTF positions have z: a 3D set at z = 0 keeps its z column (issue #24: the values do not
+  // decide). (A set dpoint writes as 2D says so in the asset and comes back x,y: issue #34.)
   TempDir dir;
-  ASSERT_TRUE(writeGlb(dir.file("planar.glb"), cloud(300, true, true)));
+  PointSet planar = cloud(300, true, true);
+  planar.z_axis = ZAxis::kPresent;
+  ASSERT_TRUE(writeGlb(dir.file("planar.glb"), planar));
   ASSERT_TRUE(convertGltfToCsv(dir.file("planar.glb"), {}, {}, dir.file("planar.csv")));
   EXPECT_EQ(test::readFile(dir.file("planar.csv")).substr(0, 12), "x,y,z,r,g,b\n");
   expectSameOutputForAllCases(dir.file("planar.glb"), "planar.glb");
