@@ -91,8 +91,13 @@ double largest(const PointSet& points, const char* name) {
   return m;
 }
 
+// The largest class and return numbers of a set: what formats 0-5's narrower fields must hold.
+struct Widest {
+  double classification = 0.0, returns = 0.0;
+};
+
 // Whether format `f` holds every LAS field and value of the set.
-bool holds(const PointSet& points, int f) {
+bool holds(const PointSet& points, const Widest& widest, int f) {
   if (points.hasColors() && !kRgbAt[static_cast<size_t>(f)]) return false;
   for (const Dimension& d : points.dimensions.all()) {
     const KnownDimension* known = findKnownDimension(d.name);
@@ -100,12 +105,7 @@ bool holds(const PointSet& points, int f) {
     const bool scan_angle = d.name == dim::kScanAngle || d.name == dim::kScanAngleRank;
     if (!scan_angle && !hasField(f, d.name)) return false;
   }
-  if (f < 6) {  // the narrower legacy fields
-    if (largest(points, dim::kClassification) > 31 || largest(points, dim::kReturnNumber) > 7 ||
-        largest(points, dim::kNumberOfReturns) > 7)
-      return false;
-  }
-  return true;
+  return f >= 6 || (widest.classification <= 31 && widest.returns <= 7);  // the narrower legacy fields
 }
 
 }  // namespace
@@ -189,9 +189,11 @@ LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields) {
 }
 
 int lasFormatFor(const PointSet& points, int preferred) {
-  if (preferred >= 0 && preferred <= 10 && holds(points, preferred)) return preferred;
+  const Widest widest{largest(points, dim::kClassification),
+                      std::max(largest(points, dim::kReturnNumber), largest(points, dim::kNumberOfReturns))};
+  if (preferred >= 0 && preferred <= 10 && holds(points, widest, preferred)) return preferred;
   for (int f : {0, 1, 2, 3, 6, 7, 8, 4, 5, 9, 10})
-    if (holds(points, f)) return f;
+    if (holds(points, widest, f)) return f;
   return 10;
 }
 
