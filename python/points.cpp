@@ -271,6 +271,23 @@ that memory, without copying (writing into them changes the set).)")
             setTriangles(self.cast<PointSet&>(), triangles, self);
           },
           "(M, 3) uint32 view of the triangles' vertex indices (no copy), or None")
+      .def_property_readonly(
+          "attributes",
+          [](const py::object& self) {
+            // One NumPy view per dimension (core/dimensions.h), in its own dtype, no copy.
+            const PointSet& s = self.cast<const PointSet&>();
+            py::dict out;
+            for (const Dimension& d : s.dimensions.all()) {
+              const py::dtype dtype(dimTypeName(d.type));
+              const std::vector<py::ssize_t> shape = {static_cast<py::ssize_t>(d.size())};
+              const std::vector<py::ssize_t> strides = {static_cast<py::ssize_t>(dimTypeSize(d.type))};
+              out[py::str(d.name)] = d.size() == 0 ? py::array(dtype, shape, strides)
+                                                   : py::array(dtype, shape, strides, d.bytes.data(), self);
+            }
+            return out;
+          },
+          "The per-point attributes (intensity, classification, GPS time, a LAS file's extra bytes, a PLY's\n"
+          "other properties): a dict of name to a 1-D NumPy view in the attribute's own dtype (no copy)")
       .def_property_readonly("has_z", &PointSet::hasZ, "Whether writers write z (False for a 2D set)")
       .def_readwrite("z_up", &PointSet::z_up, "The source says z is up (LAS): render's fitted views use it")
       .def("copy", [](const PointSet& s) { return std::make_shared<PointSet>(s); }, "A deep copy")
