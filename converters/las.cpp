@@ -40,11 +40,10 @@ constexpr size_t kVlrHeaderBytes = 54, kEvlrHeaderBytes = 60;
 // Header sizes: 1.0–1.2, 1.3 (adds the waveform packet start), 1.4 (EVLRs, 64-bit counts).
 constexpr uint32_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
 
-// Point records: base sizes and where red sits (green and blue follow; 0: no RGB). Intensity is
+// Point records: base sizes (where red sits is lasRgbOffset, las_fields.h). Intensity is
 // at byte 12 in every format; classification is the low five bits of byte 15 in formats 0–5 (the
 // top three are the synthetic, key-point and withheld flags) and all of byte 16 in formats 6–10.
 constexpr std::array<uint32_t, 11> kBaseLength = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-constexpr std::array<uint32_t, 11> kRgbAt = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
 constexpr size_t kIntensityAt = 12;
 
 // Records are read and decoded in blocks of about this many bytes, one per task: large enough that
@@ -196,7 +195,7 @@ class LasReader {
             std::vector<LasExtraField> extra)
       : file_(file), h_(header), source_(source), options_(options), fields_(lasFields(header.point_format)),
         extra_(std::move(extra)) {
-    rgb_at_ = kRgbAt[static_cast<size_t>(h_.point_format)];
+    rgb_at_ = lasRgbOffset(h_.point_format);
     class_at_ = h_.point_format >= 6 ? 16 : 15;
     class_mask_ = h_.point_format >= 6 ? 0xFF : 0x1F;
     extra_at_ = lasBaseRecordLength(h_.point_format);
@@ -545,7 +544,7 @@ class RecordEncoder {
   RecordEncoder(const PointSet& points, const WriterLayout& l, const glm::dvec3& offset, const glm::dvec3& scale)
       : points_(points), offset_(offset), scale_(scale) {
     for (const LasField& f : lasFields(l.format)) {
-      Slot slot{f.name, f.type, f.offset, f.shift, f.bits, points.dimensions.find(f.name), Convert::kNone};
+      Slot slot{f.type, f.offset, f.shift, f.bits, points.dimensions.find(f.name), Convert::kNone};
       if (!slot.source && std::strcmp(f.name, dim::kScanAngleRank) == 0) {
         slot.source = points.dimensions.find(dim::kScanAngle);
         slot.convert = Convert::kAngleToRank;
@@ -558,7 +557,7 @@ class RecordEncoder {
       slots_.push_back(slot);
     }
     for (const LasExtraField& e : l.extra)
-      slots_.push_back({nullptr, e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
+      slots_.push_back({e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
                         Convert::kNone});
     rgb_at_ = points.hasColors() ? lasRgbOffset(l.format) : 0;
     color_scale_ = points.color_full_scale == 255 ? 255.0 : 65535.0;
@@ -613,7 +612,6 @@ class RecordEncoder {
  private:
   enum class Convert { kNone, kAngleToRank, kRankToAngle };
   struct Slot {
-    const char* name;
     DimType type;
     uint32_t offset;
     uint8_t shift, bits;
@@ -640,7 +638,7 @@ uint32_t lasBaseRecordLength(int point_format) {
 
 bool lasFormatHasRgb(int point_format) {
   assert(point_format >= 0 && point_format <= 10);
-  return kRgbAt[static_cast<size_t>(point_format)] != 0;
+  return lasRgbOffset(point_format) != 0;
 }
 
 double lasOffsetFor(double min, double scale) {
