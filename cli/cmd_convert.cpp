@@ -27,7 +27,8 @@ struct ConvertOptions {
   std::string color_format = "linear";
   uint64_t max_points = 0;
   std::string order = "input";
-  double las_scale = 0.0;  // 0: the input LAS file's, else 0.001
+  double las_scale = 0.0;  // 0: the input LAS file's, else chosen from the data
+  DimensionChoice dimensions;  // --keep, --drop
   std::string max_memory;
   uint64_t memory_limit = 0;  // max_memory parsed
   CommonOptions common;
@@ -78,7 +79,8 @@ int runConvert(ConvertOptions& o) {
   // point set; --unique and --order morton need the whole set, so they take the path below.
   const Result<FileFormat> in_format = formatOf(o.input), out_format = formatOf(o.output);
   const bool to_csv = out_format && *out_format == FileFormat::kCsv;
-  if (in_format && isGltf(*in_format) && to_csv && !o.unique && *order == PointOrder::kInput) {
+  const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
+  if (in_format && isGltf(*in_format) && to_csv && !o.unique && *order == PointOrder::kInput && !choose_dimensions) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
@@ -91,6 +93,7 @@ int runConvert(ConvertOptions& o) {
   }
   Result<PointSet> points = readConvertInput(o, progress);
   if (!points) return reportError(points.error());
+  if (Status s = selectDimensions(*points, o.dimensions, o.input); !s) return reportError(s.error());
   if (Status s = filterPoints(*points, filters, o.unique, *order, o.memory_limit, o.common.threads, &progress); !s)
     return reportError(s.error());
   if (Status s = writePointsWithNotes(o.output, *points, w); !s) return reportError(s.error());
@@ -122,6 +125,9 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");
+  cmd->add_option("--keep", o->dimensions.keep,
+                  "Keep only these dimensions (comma-separated names, as `dpoint info` lists them; none: no dimension)");
+  cmd->add_option("--drop", o->dimensions.drop, "Drop these dimensions (comma-separated names; all: every one)");
   auto* scene = cmd->add_option("--scene", o->scene,
                                 "glTF: walk scene N instead of the default scene (else scene 0)")
                     ->check(CLI::NonNegativeNumber);

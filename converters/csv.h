@@ -53,13 +53,17 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options 
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = {});
 
 // Writes atomically (AtomicFile). Header `x,y` when the set has no z (PointSet::hasZ: a 2D
-// source, or a set made in memory whose every z is +0.0), else `x,y,z`; `,r,g,b` when it has colours. Triangles are not stored in CSV.
+// source, or a set made in memory whose every z is +0.0), else `x,y,z`; `,r,g,b` when it has
+// colours; then a column per dimension (integers as integers, floats in the shortest form of their
+// width). Triangles are not stored in CSV.
 Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options = {});
 
-// The columns: `x,y` (planar: the set has no z, which is not written) or `x,y,z`, then `,r,g,b` when colors.
+// The columns: `x,y` (planar: the set has no z, which is not written) or `x,y,z`, then `,r,g,b` when
+// colors, then one column per dimension, named as the dimension.
 struct CsvLayout {
   bool planar = false;
   bool colors = false;
+  std::vector<std::string> dimensions;  // names; rows with dimensions are written by appendSet
 };
 
 // Rows appended in any number of calls give the same bytes as one writeCsv of all of them with
@@ -77,12 +81,15 @@ class CsvRowWriter {
   // colors: one per position when the layout has colours, else empty. Positions of a planar
   // layout must have z == +0.0 (z is not written).
   Status append(std::span<const glm::dvec3> positions, std::span<const glm::vec3> colors);
+  // Every row of `points` (the layout's columns; before any append): what writeCsv writes.
+  Status appendSet(const PointSet& points);
   // Writes the rows still held and moves the file into place.
   Status commit();
 
  private:
   CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOptions& options);
-  Status writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count);
+  Status writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count,
+                    const std::vector<Dimension>* dims = nullptr, size_t first = 0);
   Status flushPending();  // writes the rows held back for a whole batch
 
   AtomicFile file_;

@@ -34,13 +34,14 @@ enum class Known { kXy, kXyz, kXyRgb, kXyzRgb };
 constexpr const char* kKnownText[] = {"x,y", "x,y,z", "x,y,r,g,b", "x,y,z,r,g,b"};
 
 // What a row holds: one of the known layouts in its first columns, then, with a header only, any
-// number of further columns that are read past and not kept (`x,y,z,intensity`). Fields are
-// separated by commas, or by runs of spaces and tabs (CloudCompare's ASCII export).
+// number of further columns, each a dimension (`x,y,z,intensity`). Fields are separated by
+// commas, or by runs of spaces and tabs (CloudCompare's ASCII export).
 struct Layout {
   Known known = Known::kXyz;
   int columns = 3;  // every row has exactly this many fields
   bool whitespace = false;
   std::string text;  // the header's names, or the known layout's, for messages
+  std::vector<std::string> dimensions;  // the further columns' names, as the header spells them
 };
 int positionColumns(Known known) { return known == Known::kXy || known == Known::kXyRgb ? 2 : 3; }
 bool hasColorColumns(const Layout& layout) { return layout.known == Known::kXyRgb || layout.known == Known::kXyzRgb; }
@@ -73,13 +74,17 @@ struct LineError {
 
 class LineParser {
  public:
-  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite)
+  // dimensions: one column of doubles per further column of the layout; those with `as_float`
+  // set are parsed as float (a float32 dimension written in its shortest form reads back exactly).
+  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite, std::vector<double*> dimensions,
+             std::vector<bool> as_float)
       : path_(path), layout_(layout), position_columns_(positionColumns(layout.known)),
-        kept_columns_(position_columns_ + (hasColorColumns(layout) ? 3 : 0)), allow_nonfinite_(allow_nonfinite) {}
+        kept_columns_(position_columns_ + (hasColorColumns(layout) ? 3 : 0)), allow_nonfinite_(allow_nonfinite),
+        dimensions_(std::move(dimensions)), as_float_(std::move(as_float)) {}
 
-  // Parses one line (without its line end, '\r' already removed). Returns false on error.
-  bool parse(const char* begin, const char* end, uint64_t line, glm::dvec3& position, glm::vec3& color,
-             LineError& error) const {
+  // Parses one line (without its line end, '\r' already removed) of row `row`. Returns false on error.
+  bool parse(const char* begin, const char* end, uint64_t line, uint64_t row, glm::dvec3& position,
+             glm::vec3& color, LineError& error) const {
     const char* p = begin;
     double values[3] = {0.0, 0.0, 0.0};
     float colors[3] = {0.0f, 0.0f, 0.0f};
@@ -100,10 +105,12 @@ class LineParser {
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
       }
-      bool ok = column > kept_columns_ ||  // a column the header names beyond the known ones: not kept
-                (column <= position_columns_
-                     ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
-                     : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error));
+      bool ok = column > kept_columns_
+                    ? parseDimension(number_begin, number_end, static_cast<size_t>(column - kept_columns_ - 1), row,
+                                     line, column, error)
+                : column <= position_columns_
+                    ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
+                    : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error);
       if (!ok) return false;
       p = field_end;
       if (p == end) break;
@@ -141,6 +148,17 @@ class LineParser {
     return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + printableExcerpt(layout_.text) + ")";
   }
 
+  bool parseDimension(const char* begin, const char* end, size_t k, uint64_t row, uint64_t line, int column,
+                      LineError& error) const {
+    if (as_float_[k]) {
+      float f = 0.0f;
+      if (!parseNumber(begin, end, f, line, column, error)) return false;
+      dimensions_[k][row] = f;
+      return true;
+    }
+    return parseNumber(begin, end, dimensions_[k][row], line, column, error);
+  }
+
   template <typename T>
   bool parseNumber(const char* begin, const char* end, T& value, uint64_t line, int column,
                    LineError& error) const {
@@ -158,8 +176,10 @@ class LineParser {
     if (std::isinf(value) && !looksLikeInfinityText(begin, end)) return fail(std::string("is out of ") + type + " range");
     if (value == T(0) && hasNonzeroMantissa(begin, end))
       return fail(std::string("is out of ") + type + " range (underflows to zero)");
-    if (!allow_nonfinite_ && !std::isfinite(value))
+    if (!allow_nonfinite_ && !std::isfinite(value)) {
+      if (column > kept_columns_ && std::isnan(value)) return true;  // an attribute may be NaN (a missing GPS time)
       return fail("is not a finite number (--allow-nonfinite accepts it)");
+    }
     return true;
   }
 
@@ -168,17 +188,20 @@ class LineParser {
   int position_columns_;
   int kept_columns_;  // position and colour columns; the header's further columns are skipped
   bool allow_nonfinite_;
+  std::vector<double*> dimensions_;
+  std::vector<bool> as_float_;
 };
 
-// Splits the first line into trimmed, lower-case fields: at commas when it has one, else at runs
-// of spaces and tabs.
-std::vector<std::string> splitHeader(std::string_view line) {
+// Splits the first line into trimmed fields, lower case unless `spelled`: at commas when it has
+// one, else at runs of spaces and tabs.
+std::vector<std::string> splitHeader(std::string_view line, bool spelled = false) {
   std::vector<std::string> fields;
   auto add = [&](std::string_view field) {
     while (!field.empty() && isBlank(field.front())) field.remove_prefix(1);
     while (!field.empty() && isBlank(field.back())) field.remove_suffix(1);
     std::string lower(field);
-    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!spelled)
+      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     fields.push_back(std::move(lower));
   };
   if (line.find(',') == std::string_view::npos) {
@@ -211,8 +234,9 @@ bool isHeaderLine(const std::vector<std::string>& fields) {
 // A header names one of the known layouts, then, after x,y,z or x,y,z,r,g,b, optionally further
 // columns whose names are none of x, y, z, r, g, b (so `x,y,z,r,g` stays an error rather than
 // x,y,z and two extras).
-Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string> fields, uint64_t line,
-                                std::string_view text, bool whitespace) {
+Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string> fields,
+                                std::vector<std::string> spelled, uint64_t line, std::string_view text,
+                                bool whitespace) {
   if (fields.front().rfind("//", 0) == 0) fields.front().erase(0, 2);
   auto known_name = [](const std::string& f) {
     return f == "x" || f == "y" || f == "z" || f == "r" || f == "g" || f == "b";
@@ -227,7 +251,17 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
     // Further columns only after z: `x,y,w` is more likely a misspelt z than a 2D set with an extra.
     if (fields.size() > count && (known == Known::kXy || known == Known::kXyRgb)) break;
     if (std::any_of(fields.begin() + std::ptrdiff_t(count), fields.end(), known_name)) break;
-    return Layout{known, static_cast<int>(fields.size()), whitespace, joined};
+    Layout layout{known, static_cast<int>(fields.size()), whitespace, joined, {}};
+    for (size_t k = count; k < spelled.size(); ++k) {
+      const std::string& name = spelled[k];
+      if (name.empty())
+        return Error{path + ":" + std::to_string(line) + ": column " + std::to_string(k + 1) + " has no name"};
+      if (std::find(layout.dimensions.begin(), layout.dimensions.end(), name) != layout.dimensions.end())
+        return Error{path + ":" + std::to_string(line) + ": column " + std::to_string(k + 1) + " '" +
+                     printableExcerpt(name) + "' is named twice"};
+      layout.dimensions.push_back(name);
+    }
+    return layout;
   }
   return Error{path + ":" + std::to_string(line) + ": header '" + excerpt(text.data(), text.data() + text.size()) +
                "' is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b (further columns may follow)"};
@@ -235,7 +269,7 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
 
 Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line, bool whitespace) {
   auto layout = [&](Known known) {
-    return Layout{known, static_cast<int>(columns), whitespace, kKnownText[static_cast<int>(known)]};
+    return Layout{known, static_cast<int>(columns), whitespace, kKnownText[static_cast<int>(known)], {}};
   };
   if (columns == 2) return layout(Known::kXy);
   if (columns == 3) return layout(Known::kXyz);
@@ -287,7 +321,8 @@ Result<Header> readHeader(const InputFile& file) {
     const bool whitespace = text.find(',') == std::string_view::npos;
     Header header;
     if (isHeaderLine(fields)) {
-      Result<Layout> layout = layoutFromHeader(file.path(), std::move(fields), line + 1, text, whitespace);
+      Result<Layout> layout =
+          layoutFromHeader(file.path(), std::move(fields), splitHeader(text, true), line + 1, text, whitespace);
       if (!layout) return layout.error();
       header.layout = *layout;
       header.data_offset = std::min<uint64_t>(nl + 1, file.size());  // a header only: an empty set
@@ -301,6 +336,29 @@ Result<Header> readHeader(const InputFile& file) {
       header.first_data_line = line;
     }
     return header;
+  }
+}
+
+// A column named as a known dimension (core/dimensions.h) takes its type when every value fits it
+// exactly (an intensity of whole numbers 0-65535 becomes uint16); any other stays double.
+void narrowDimensions(Dimensions& dimensions, unsigned threads) {
+  for (Dimension& d : dimensions.all()) {
+    const KnownDimension* known = findKnownDimension(d.name);
+    if (!known || known->type == DimType::kF64) continue;
+    Dimension narrow(d.name, known->type, d.size());
+    std::atomic<bool> fits{true};
+    const size_t n = d.size(), block = 1u << 16;
+    parallelFor((n + block - 1) / block, threads, [&](size_t b, unsigned) {
+      for (size_t i = b * block; i < std::min(n, (b + 1) * block) && fits.load(std::memory_order_relaxed); ++i) {
+        const double v = d.get<double>(i);
+        if (!dimensionHolds(known->type, v)) {
+          fits = false;
+          return;
+        }
+        narrow.setValue(i, v);
+      }
+    });
+    if (fits) d = std::move(narrow);
   }
 }
 
@@ -319,12 +377,15 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   if (!header_result) return header_result.error();
   const Header header = *header_result;
   const Layout& layout = header.layout;
-  if (layout.columns > positionColumns(layout.known) + (hasColorColumns(layout) ? 3 : 0) && options.notices)
-    options.notices->push_back(path + ": columns after " + kKnownText[static_cast<int>(layout.known)] +
-                               " ignored (header " + quotedExcerpt(layout.text) + ")");
   PointSet points;
   points.z_axis = positionColumns(layout.known) == 3 ? ZAxis::kPresent : ZAxis::kAbsent;
-  if (header.data_offset >= file.size()) return points;  // a header and nothing after it
+  if (header.data_offset >= file.size()) {  // a header and nothing after it
+    for (const std::string& name : layout.dimensions) {
+      const KnownDimension* known = findKnownDimension(name);
+      points.dimensions.append(name, known ? known->type : DimType::kF64, 0);
+    }
+    return points;
+  }
 
   const uint64_t begin = header.data_offset, size = file.size();
   const size_t blocks = static_cast<size_t>((size - begin + kBlockSize - 1) / kBlockSize);
@@ -361,14 +422,25 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
 
   // Every line may be a row: a file of short lines (or of blank ones) asks for 24-36 bytes of
   // point set per 2-4 bytes of file, so the arrays are checked before they are made.
-  const uint64_t row_bytes = sizeof(glm::dvec3) + (hasColorColumns(layout) ? sizeof(glm::vec3) : 0);
+  const uint64_t row_bytes =
+      sizeof(glm::dvec3) + (hasColorColumns(layout) ? sizeof(glm::vec3) : 0) + sizeof(double) * layout.dimensions.size();
   if (Status s = checkMemory(path + ": " + std::to_string(lines) + " lines", lines * row_bytes, options.max_memory); !s)
     return s.error();
   resizePrefaulted(points.positions, static_cast<size_t>(lines), threads);
   if (hasColorColumns(layout)) resizePrefaulted(points.colors, static_cast<size_t>(lines), threads);
+  // Further columns are read as doubles (floats for a known float32 dimension), then narrowed to
+  // their known type where every value fits it (narrowDimensions).
+  std::vector<double*> columns;
+  std::vector<bool> as_float;
+  for (const std::string& name : layout.dimensions) {
+    Dimension& d = points.dimensions.append(name, DimType::kF64, static_cast<size_t>(lines));
+    columns.push_back(reinterpret_cast<double*>(d.bytes.data()));
+    const KnownDimension* known = findKnownDimension(name);
+    as_float.push_back(known && known->type == DimType::kF32);
+  }
 
   // Pass 2: parse. The first error by line number wins, whatever the thread count.
-  const LineParser parser(path, layout, options.allow_nonfinite);
+  const LineParser parser(path, layout, options.allow_nonfinite, columns, as_float);
   const bool has_colors = hasColorColumns(layout);
   std::mutex error_mutex;
   std::optional<LineError> first_error;
@@ -428,7 +500,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
       while (first < text_end && isBlank(*first)) ++first;
       if (first == text_end) {
         blank_rows[b].push_back(row);
-      } else if (!parser.parse(p, text_end, line_number, points.positions[row],
+      } else if (!parser.parse(p, text_end, line_number, row, points.positions[row],
                                has_colors ? points.colors[row] : scratch_color, error)) {
         fail(std::move(error));
         return;
@@ -456,12 +528,15 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
       }
       points.positions[out] = points.positions[i];
       if (!points.colors.empty()) points.colors[out] = points.colors[i];
+      for (Dimension& d : points.dimensions.all()) d.copyFrom(out, d, i);
       ++out;
     }
     // No shrink_to_fit: it would copy the whole set to give back a few slots.
     points.positions.resize(out);
     if (!points.colors.empty()) points.colors.resize(out);
+    points.dimensions.resize(out);
   }
+  narrowDimensions(points.dimensions, threads);
   if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
   if (options.progress) options.progress->finish();
   return points;

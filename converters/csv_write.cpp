@@ -25,20 +25,42 @@ constexpr int kMaxDecimals = 100;
 // DBL_MAX in fixed form has 309 integer digits; plus sign, point, decimals and a separator.
 constexpr size_t kMaxFieldChars = fixedFormatMaxChars(kMaxDecimals) + 1;
 
+// Value i of a dimension: integers as integers, floats in shortest round-trip form of their own
+// width (a float32 intensity is written "0.1", which reads back as the same float).
+char* dimensionValue(char* p, char* limit, const Dimension& d, size_t i) {
+  std::to_chars_result r{};
+  switch (d.type) {
+    case DimType::kF32: r = std::to_chars(p, limit, d.get<float>(i)); break;
+    case DimType::kF64: r = std::to_chars(p, limit, d.get<double>(i)); break;
+    case DimType::kU64: r = std::to_chars(p, limit, d.get<uint64_t>(i)); break;
+    case DimType::kI64: r = std::to_chars(p, limit, d.get<int64_t>(i)); break;
+    default: r = std::to_chars(p, limit, static_cast<int64_t>(d.value(i))); break;
+  }
+  assert(r.ec == std::errc());
+  return r.ptr;
+}
+
 class RowFormatter {
  public:
-  RowFormatter(CsvLayout layout, int decimals, bool at_scale)
-      : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors) {}
+  RowFormatter(const CsvLayout& layout, int decimals, bool at_scale)
+      : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors),
+        dimension_names_(layout.dimensions) {}
 
   std::string header() const {
     std::string h = planar_ ? "x,y" : "x,y,z";
     if (colors_) h += ",r,g,b";
+    for (const std::string& name : dimension_names_) {
+      h += ',';
+      h += name;
+    }
     return h + "\n";
   }
 
   // Formats `count` rows into out (replacing its content); colors is read only with a colour layout.
-  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count, std::string& out) const {
-    const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u);
+  // dims (one per name of the layout, or null without any) are read at rows first … first + count.
+  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count, std::string& out,
+              const std::vector<Dimension>* dims = nullptr, size_t first = 0) const {
+    const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u) + (dims ? dims->size() : 0u);
     const size_t row_max = fields * kMaxFieldChars;
     // Start from the shortest-form size and grow only for long fixed-form rows.
     if (out.size() < count * fields * 24 + row_max) out.resize(count * fields * 24 + row_max);
@@ -62,6 +84,11 @@ class RowFormatter {
           p = color(p, limit, c[k]);
         }
       }
+      if (dims)
+        for (const Dimension& d : *dims) {
+          *p++ = ',';
+          p = dimensionValue(p, limit, d, first + i);
+        }
       *p++ = '\n';
       used = static_cast<size_t>(p - out.data());
     }
@@ -94,6 +121,7 @@ class RowFormatter {
   bool at_scale_;  // CsvWriteOptions::at_scale
   bool planar_;
   bool colors_;
+  const std::vector<std::string>& dimension_names_;
 };
 
 Status checkDecimals(int decimals) {
@@ -129,14 +157,15 @@ CsvRowWriter::CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOpti
   batch_rows_ = texts_.size() * kRowsPerChunk;
 }
 
-Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count) {
+Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count,
+                                const std::vector<Dimension>* dims, size_t first) {
   assert(count <= batch_rows_);
   const RowFormatter formatter(layout_, decimals_, at_scale_);
   const size_t chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
   parallelFor(chunks, threads_, [&](size_t k, unsigned) {
     const size_t begin = k * kRowsPerChunk;
     formatter.format(positions + begin, colors ? colors + begin : nullptr,
-                     std::min(count, begin + kRowsPerChunk) - begin, texts_[k]);
+                     std::min(count, begin + kRowsPerChunk) - begin, texts_[k], dims, first + begin);
   });
   for (size_t k = 0; k < chunks; ++k) {
     if (Status s = file_.write(texts_[k]); !s) return s;
@@ -147,6 +176,7 @@ Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* co
 
 Status CsvRowWriter::append(std::span<const glm::dvec3> positions, std::span<const glm::vec3> colors) {
   assert(colors.size() == (layout_.colors ? positions.size() : 0));
+  assert(layout_.dimensions.empty());  // rows with dimensions come whole, through appendSet
   const size_t n = positions.size();
   const auto colorsAt = [&](size_t at) { return layout_.colors ? colors.data() + at : nullptr; };
   size_t at = 0;
@@ -160,7 +190,7 @@ Status CsvRowWriter::append(std::span<const glm::dvec3> positions, std::span<con
     if (pending_positions_.size() < batch_rows_) return okStatus();
     if (Status s = flushPending(); !s) return s;
   }
-  // Whole batches straight from the caller's arrays (writeCsv's one call copies nothing but its tail).
+  // Whole batches straight from the caller's arrays.
   for (; n - at >= batch_rows_; at += batch_rows_)
     if (Status s = writeBatch(positions.data() + at, colorsAt(at), batch_rows_); !s) return s;
   pending_positions_.assign(positions.begin() + std::ptrdiff_t(at), positions.end());
@@ -177,6 +207,17 @@ Status CsvRowWriter::flushPending() {
   return s;
 }
 
+Status CsvRowWriter::appendSet(const PointSet& points) {
+  assert(pending_positions_.empty() && points.dimensions.count() == layout_.dimensions.size());
+  const std::vector<Dimension>& dims = points.dimensions.all();
+  for (size_t at = 0; at < points.size(); at += batch_rows_)
+    if (Status s = writeBatch(points.positions.data() + at, layout_.colors ? points.colors.data() + at : nullptr,
+                              std::min(batch_rows_, points.size() - at), &dims, at);
+        !s)
+      return s;
+  return okStatus();
+}
+
 Status CsvRowWriter::commit() {
   if (Status s = flushPending(); !s) return s;
   if (progress_) progress_->finish();
@@ -188,10 +229,11 @@ Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteO
   if (!points.colors.empty() && points.colors.size() != points.positions.size())
     return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(points.positions.size()) + " points"};
-  Result<CsvRowWriter> writer =
-      CsvRowWriter::create(path, CsvLayout{!points.hasZ(), points.hasColors()}, options, points.size());
+  CsvLayout layout{!points.hasZ(), points.hasColors(), {}};
+  for (const Dimension& d : points.dimensions.all()) layout.dimensions.push_back(d.name);
+  Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
   if (!writer) return writer.error();
-  if (Status s = writer->append(points.positions, points.colors); !s) return s;
+  if (Status s = writer->appendSet(points); !s) return s;
   return writer->commit();
 }
 

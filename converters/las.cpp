@@ -359,19 +359,23 @@ bool readsBackExactly(const std::vector<glm::dvec3>& positions, int k, double of
 
 // The offset of axis k: the first of lasOffsetFor (a whole number: decimal data at large
 // coordinates reads back exactly), 0 (data read from the many files whose offset is 0, as PDAL
-// writes them by default) and floor(min / scale) · scale under which the extremes fit the 32-bit
-// integers and every coordinate reads back as the same double; lasOffsetFor when none does.
+// writes them by default), floor(min / scale) · scale and the middle of the extent as a whole
+// number (an extent of nearly 2^32 steps) under which the extremes fit the 32-bit integers and
+// every coordinate reads back as the same double; else the first of them under which the
+// extremes fit; else lasOffsetFor.
 // Measured on simple.las (scale 0.01, offset 0) written at 0.01: x, y, z offsets of 0 read every
 // point back; the whole-number offsets missed 111, 137 and 164 of 1065, the rounded multiples 315,
 // 459 and 430.
 double chooseOffset(const std::vector<glm::dvec3>& positions, int k, double min, double max, double scale,
                     unsigned threads) {
   const double first = lasOffsetFor(min, scale);
-  for (double offset : {first, 0.0, std::floor(min / scale) * scale}) {
+  std::optional<double> fitting;
+  for (double offset : {first, 0.0, std::floor(min / scale) * scale, lasOffsetFor(min / 2 + max / 2, scale)}) {
     if (!fitsInt32(quantize(min, offset, scale)) || !fitsInt32(quantize(max, offset, scale))) continue;
     if (readsBackExactly(positions, k, offset, scale, threads)) return offset;
+    if (!fitting) fitting = offset;
   }
-  return first;
+  return fitting.value_or(first);
 }
 
 // Colours leave as round(clamp(c, 0, 1) · full), NaN as 0, where full is 65535 or, for colours
@@ -399,30 +403,50 @@ uint64_t mergedPoints(const std::vector<glm::dvec3>& positions, const glm::dvec3
   return distinct - kept;
 }
 
-// Whether every coordinate of the box fits the 32-bit integers at `scale` from the offset the
-// writer would choose (lasOffsetFor rounds the minimum down by less than one unit).
-bool extentFits(const Box& box, double scale) {
-  for (int k = 0; k < 3; ++k) {
-    const double offset = lasOffsetFor(box.min[k], scale);
-    if (!fitsInt32(quantize(box.min[k], offset, scale)) || !fitsInt32(quantize(box.max[k], offset, scale))) return false;
-  }
-  return true;
+// Whether axis k's extent fits the 32-bit integers at `scale` from the offset the writer would
+// choose (lasOffsetFor rounds the minimum down by less than one unit).
+bool extentFits(double min, double max, double scale) {
+  for (double offset : {lasOffsetFor(min, scale), lasOffsetFor(min / 2 + max / 2, scale)})
+    if (fitsInt32(quantize(min, offset, scale)) && fitsInt32(quantize(max, offset, scale))) return true;
+  return false;
 }
 
-// The scale of a set without a LAS source or an asked one (las.h: the first decimal step that keeps
-// distinct points apart and fits the extent).
-double chooseScale(const std::vector<glm::dvec3>& positions, const Box& box) {
-  double scale = 0.001;
-  while (!extentFits(box, scale) && scale < 1e300) scale *= 10.0;
-  if (positions.size() < 2) return scale;
-  for (double finer = scale; finer >= 1e-12; finer /= 10.0) {
-    if (!extentFits(box, finer)) break;
-    scale = finer;
-    glm::dvec3 offset;
-    for (int k = 0; k < 3; ++k) offset[k] = lasOffsetFor(box.min[k], finer);
-    if (mergedPoints(positions, glm::dvec3(finer), offset) == 0) break;
+// True when every coordinate on axis k reads back within two units in the last place of itself
+// (or of the offset, where that is larger): the decimal digits it has are all kept. Stops at the
+// first that does not.
+bool readsBackClosely(const std::vector<glm::dvec3>& positions, int k, double offset, double scale, unsigned threads) {
+  std::atomic<bool> miss{false};
+  const size_t n = positions.size();
+  const double offset_ulp = std::nextafter(std::abs(offset), HUGE_VAL) - std::abs(offset);
+  parallelFor((n + kWriteBlockPoints - 1) / kWriteBlockPoints, threads, [&](size_t b, unsigned) {
+    const size_t last = std::min(n, (b + 1) * kWriteBlockPoints);
+    for (size_t i = b * kWriteBlockPoints; i < last && !miss.load(std::memory_order_relaxed); ++i) {
+      const double x = positions[i][k], back = quantize(x, offset, scale) * scale + offset;
+      const double ulp = std::max(std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x), offset_ulp);
+      if (!(std::abs(back - x) <= 2.0 * ulp)) miss = true;
+    }
+  });
+  return !miss;
+}
+
+// The decimal steps the writer chooses from, coarse to fine (literals: 1/10/10… drifts from them).
+constexpr double kDecimalSteps[] = {1.0,  0.1,  0.01, 0.001, 1e-4,  1e-5, 1e-6,
+                                    1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
+
+// The scale of axis k of a set without a LAS source or an asked one (las.h): the coarsest decimal
+// step at which every coordinate keeps its digits (the data's own step: 0.01 for centimetre
+// data), else the finest at which the extent fits the 32-bit integers.
+double chooseAxisScale(const std::vector<glm::dvec3>& positions, int k, double min, double max, unsigned threads) {
+  double coarse = 1.0;
+  while (!extentFits(min, max, coarse) && coarse < 1e300) coarse *= 10.0;
+  if (coarse > 1.0 || positions.empty()) return coarse;  // a wider extent than 2^31 units: no finer step fits
+  double finest = coarse;
+  for (double step : kDecimalSteps) {
+    if (!extentFits(min, max, step)) break;
+    finest = step;
+    if (readsBackClosely(positions, k, chooseOffset(positions, k, min, max, step, threads), step, threads)) return step;
   }
-  return scale;
+  return finest;
 }
 
 // What the writer puts in a file beside the records.
@@ -814,7 +838,8 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   // Quantization is monotonic (a subtraction, a division by a positive number and a rounding, each
   // correctly rounded), so the box's corners hold the extreme integers: when they fit, all do, and
   // their decoded values are the exact bounds a reader finds.
-  if (options.scale == 0.0 && !keep_frame && n > 0) scale = glm::dvec3(chooseScale(points.positions, box));
+  if (options.scale == 0.0 && !keep_frame && n > 0)
+    for (int k = 0; k < 3; ++k) scale[k] = chooseAxisScale(points.positions, k, box.min[k], box.max[k], threads);
   // The source's offset where its integers still hold every point (LAS → LAS: the same records).
   glm::dvec3 offset(0.0), q_min(0.0), q_max(0.0);
   for (int k = 0; k < 3; ++k) {
@@ -845,7 +870,10 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
 
   if (options.report) {
     options.report->scale = scale;
-    options.report->merged_points = mergedPoints(points.positions, scale, offset);
+    // Points that read back as themselves cannot merge: the count's two sorts only run otherwise.
+    bool exact = true;
+    for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
+    options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset);
   }
   Result<WriterLayout> layout = writerLayout(path, points, n);
   if (!layout) return layout.error();

@@ -24,7 +24,7 @@ class CsvPointSink final : public GltfPointSink {
     // glTF positions have z (PointSet::z_axis) unless dpoint wrote the file from a 2D set; a scene
     // placing no points is an empty set.
     flat_ = summary.flat;
-    const CsvLayout layout{flat_, summary.colors && !filters_.drop};
+    const CsvLayout layout{flat_, summary.colors && !filters_.drop, {}};
     Result<CsvRowWriter> writer = CsvRowWriter::create(
         output_, layout, CsvWriteOptions{options_.decimals, options_.threads, options_.progress}, summary.points);
     if (!writer) return writer.error();
@@ -177,16 +177,76 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       if (Status s = writeLas(path, points, LasWriteOptions{options.las_scale, options.threads, options.progress, &report});
           !s)
         return s;
-      if (report.merged_points != 0 && options.notices)
-        options.notices->push_back(path + ": " + std::to_string(report.merged_points) + " of " +
-                                   std::to_string(points.size()) + " points share their integers with another at the LAS scale " +
-                                   formatNumber(report.scale.x) + " and read back merged" +
-                                   (options.las_scale > 0.0 ? " (a finer --las-scale keeps them apart where the extent fits)"
-                                                            : " (no decimal scale down to 1e-12 keeps them apart within LAS's 32-bit range)"));
+      if (report.merged_points != 0 && options.notices) {
+        const glm::dvec3& sc = report.scale;
+        std::string scale = formatNumber(sc.x);
+        if (sc.x != sc.y || sc.y != sc.z) {
+          scale = '(' + scale;
+          for (double v : {sc.y, sc.z}) {
+            scale += ", ";
+            scale += formatNumber(v);
+          }
+          scale += ')';
+        }
+        std::string note = path;
+        note += ": ";
+        note += std::to_string(report.merged_points);
+        note += " of ";
+        note += std::to_string(points.size());
+        note += " points share their integers with another at the LAS scale " + scale;
+        note += options.las_scale > 0.0 ? " and read back merged (a finer --las-scale keeps them apart where the extent fits)"
+                                        : " and read back merged (no finer decimal scale fits the extent in LAS's 32-bit integers)";
+        options.notices->push_back(std::move(note));
+      }
       return okStatus();
     }
   }
   return Error{path + ": unreachable format"};
+}
+
+Status selectDimensions(PointSet& points, const DimensionChoice& choice, const std::string& what) {
+  const auto names = [](const std::string& list) {
+    std::vector<std::string> out;
+    for (size_t start = 0; start <= list.size();) {
+      size_t comma = list.find(',', start);
+      if (comma == std::string::npos) comma = list.size();
+      if (comma > start) out.push_back(list.substr(start, comma - start));
+      start = comma + 1;
+    }
+    return out;
+  };
+  const auto check = [&](const std::string& option, const std::vector<std::string>& asked) -> Status {
+    for (const std::string& name : asked) {
+      if (points.dimensions.find(name)) continue;
+      std::string has;
+      for (const Dimension& d : points.dimensions.all()) {
+        has += has.empty() ? "" : ", ";
+        has += d.name;
+      }
+      return Error{option + " " + name + ": " + what + " has no dimension '" + name + "' (" +
+                       (has.empty() ? std::string("it has none") : "it has " + has) + ")",
+                   ExitCode::kUsage};
+    }
+    return okStatus();
+  };
+  if (choice.keep && *choice.keep != "none") {
+    const std::vector<std::string> keep = names(*choice.keep);
+    if (Status s = check("--keep", keep); !s) return s;
+    Dimensions kept;
+    for (const std::string& name : keep)
+      if (!kept.find(name)) kept.all().push_back(std::move(*points.dimensions.find(name)));
+    points.dimensions = std::move(kept);
+  } else if (choice.keep) {
+    points.dimensions = Dimensions();
+  }
+  if (choice.drop == "all") {
+    points.dimensions = Dimensions();
+  } else {
+    const std::vector<std::string> drop = names(choice.drop);
+    if (Status s = check("--drop", drop); !s) return s;
+    for (const std::string& name : drop) points.dimensions.remove(name);
+  }
+  return okStatus();
 }
 
 Status filterPoints(PointSet& points, const ColorFilters& colors, bool unique, PointOrder order, uint64_t memory_limit,

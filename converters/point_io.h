@@ -2,6 +2,7 @@
 // is refused by name), and glTF/GLB to CSV streamed without a PointSet.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "converters/gltf_read.h"
@@ -72,6 +73,15 @@ struct ColorFilters {
   bool drop = false;   // --no-colors
   bool srgb8 = false;  // --color-format srgb8: encodeColorsSrgb8 (point_filters.h)
 };
+
+// Convert's --keep and --drop: comma-separated dimension names (core/dimensions.h). `keep` given:
+// only those stay (`none`: no dimension); then those in `drop` go (`all`: every one). A name the
+// set does not have is a usage error that lists the names it has (`what` names the input).
+struct DimensionChoice {
+  std::optional<std::string> keep;
+  std::string drop;
+};
+Status selectDimensions(PointSet& points, const DimensionChoice& choice, const std::string& what);
 
 // What `dpoint convert` does to a set between reading and writing, in its order: `colors.drop`,
 // --unique (drop duplicate positions), `colors.srgb8`, then `order` (its memory checked against

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 
 namespace dpoint {
 namespace {
@@ -92,17 +94,53 @@ double Dimension::value(size_t i) const {
   return 0.0;
 }
 
+namespace {
+// v truncated and clamped to T's range (a plain cast of an out-of-range double is undefined).
+template <typename T>
+T saturate(double v) {
+  if (!(v == v)) return T(0);
+  constexpr double lo = static_cast<double>(std::numeric_limits<T>::min());
+  // 2^64 and 2^63 are doubles; T's max is not, for 64-bit T.
+  constexpr double hi_excl = static_cast<double>(std::numeric_limits<T>::max() / 2 + 1) * 2.0;
+  if (v <= lo) return std::numeric_limits<T>::min();
+  if (v >= hi_excl) return std::numeric_limits<T>::max();
+  return static_cast<T>(v);
+}
+
+template <typename T>
+bool holdsInteger(double v) {
+  return v == std::trunc(v) && v >= static_cast<double>(std::numeric_limits<T>::min()) &&
+         v < static_cast<double>(std::numeric_limits<T>::max() / 2 + 1) * 2.0;
+}
+}  // namespace
+
+bool dimensionHolds(DimType type, double v) {
+  switch (type) {
+    case DimType::kU8: return holdsInteger<uint8_t>(v);
+    case DimType::kI8: return holdsInteger<int8_t>(v);
+    case DimType::kU16: return holdsInteger<uint16_t>(v);
+    case DimType::kI16: return holdsInteger<int16_t>(v);
+    case DimType::kU32: return holdsInteger<uint32_t>(v);
+    case DimType::kI32: return holdsInteger<int32_t>(v);
+    case DimType::kU64: return holdsInteger<uint64_t>(v);
+    case DimType::kI64: return holdsInteger<int64_t>(v);
+    case DimType::kF32: return std::isnan(v) || static_cast<double>(static_cast<float>(v)) == v;
+    case DimType::kF64: return true;
+  }
+  return false;
+}
+
 void Dimension::setValue(size_t i, double v) {
   switch (type) {
-    case DimType::kU8: set(i, static_cast<uint8_t>(v)); break;
-    case DimType::kI8: set(i, static_cast<int8_t>(v)); break;
-    case DimType::kU16: set(i, static_cast<uint16_t>(v)); break;
-    case DimType::kI16: set(i, static_cast<int16_t>(v)); break;
-    case DimType::kU32: set(i, static_cast<uint32_t>(v)); break;
-    case DimType::kI32: set(i, static_cast<int32_t>(v)); break;
-    case DimType::kU64: set(i, static_cast<uint64_t>(v)); break;
-    case DimType::kI64: set(i, static_cast<int64_t>(v)); break;
-    case DimType::kF32: set(i, static_cast<float>(v)); break;
+    case DimType::kU8: set(i, saturate<uint8_t>(v)); break;
+    case DimType::kI8: set(i, saturate<int8_t>(v)); break;
+    case DimType::kU16: set(i, saturate<uint16_t>(v)); break;
+    case DimType::kI16: set(i, saturate<int16_t>(v)); break;
+    case DimType::kU32: set(i, saturate<uint32_t>(v)); break;
+    case DimType::kI32: set(i, saturate<int32_t>(v)); break;
+    case DimType::kU64: set(i, saturate<uint64_t>(v)); break;
+    case DimType::kI64: set(i, saturate<int64_t>(v)); break;
+    case DimType::kF32: set(i, static_cast<float>(v)); break;  // beyond float's range: ±inf, defined
     case DimType::kF64: set(i, v); break;
   }
 }

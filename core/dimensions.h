@@ -32,6 +32,9 @@ bool dimTypeIsSigned(DimType type);
 // PLY's type names: uchar, char, ushort, short, uint, int, (none), (none), float, double; nullptr for
 // the 64-bit integers, which PLY cannot store.
 const char* plyTypeName(DimType type);
+// Whether `v` is exactly a value of the type (a whole number in its range; for float32, a float;
+// NaN for the float types only).
+bool dimensionHolds(DimType type, double v);
 // The type of a name as `dimTypeName` or PLY (uint8/uchar, int16/short, float64/double, …).
 std::optional<DimType> parseDimType(std::string_view name);
 
@@ -49,7 +52,8 @@ struct Dimension {
   void resize(size_t count) { bytes.resize(count * dimTypeSize(type)); }
   // The value of point i as a double (exact for every type but 64-bit integers beyond 2^53).
   double value(size_t i) const;
-  // Sets point i from a double, converted as a C++ cast would (the caller checks the range).
+  // Sets point i from a double: rounded toward zero and clamped to an integer type's range (NaN as
+  // 0), rounded to nearest for float32. Exact when dimensionHolds(type, v).
   void setValue(size_t i, double v);
   // Typed access; T must be the type's C++ type.
   template <typename T>

@@ -30,6 +30,8 @@ class TempDir {
 };
 
 std::string readFile(const std::string& path);
+// The first line of `text` with its line end (all of it when it has none).
+inline std::string firstLine(const std::string& text) { return text.substr(0, text.find('\n') + 1); }
 void writeFile(const std::string& path, const std::string& bytes);
 bool fileExists(const std::string& path);
 

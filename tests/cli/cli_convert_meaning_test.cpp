@@ -20,8 +20,6 @@ using namespace test;  // readFile, runDpoint, TempDir, writeFile
 const std::string kLas = std::string(DPOINT_CORPUS_DIR) + "/las/";
 const std::string kEngine = "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
 
-std::string firstLine(const std::string& text) { return text.substr(0, text.find('\n') + 1); }
-
 void expectConverts(const std::vector<std::string>& args) {
   test::CommandResult r = runDpoint(test::concat({"convert"}, args));
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -70,12 +68,16 @@ TEST(CliConvertMeaning, lasWhoseZAreAllZeroKeepsItsZColumn) {
   writeFlatLas(dir.file("flat.las"));
   expectConverts({dir.file("flat.las"), "-o", dir.file("flat.csv")});
   const std::string csv = readFile(dir.file("flat.csv"));
-  EXPECT_EQ(firstLine(csv), "x,y,z,r,g,b\n");
+  // Point format 3's fields follow the colours (issue #34).
+  const std::string header = "x,y,z,r,g,b,intensity,return_number,number_of_returns,scan_direction,"
+                             "edge_of_flight_line,classification,synthetic,key_point,withheld,scan_angle_rank,"
+                             "user_data,point_source_id,gps_time\n";
+  EXPECT_EQ(firstLine(csv), header);
   EXPECT_TRUE(test::contains(csv, "\n637012.24,849028.31,0,"));
   // And through PLY: the PLY has z, so its CSV too.
   expectConverts({dir.file("flat.las"), "-o", dir.file("flat.ply")});
   expectConverts({dir.file("flat.ply"), "-o", dir.file("flat_ply.csv")});
-  EXPECT_EQ(firstLine(readFile(dir.file("flat_ply.csv"))), "x,y,z,r,g,b\n");
+  EXPECT_EQ(firstLine(readFile(dir.file("flat_ply.csv"))), header);
 }
 
 TEST(CliConvertMeaning, threeColumnCsvAtZeroStaysThreeColumnsAndTwoColumnsStayTwo) {
@@ -141,7 +143,11 @@ TEST(CliConvertMeaning, emptyLasConvertsToEmptyCsvPlyAndLasAndGlbSaysWhyNot) {
   TempDir dir;
   writeEmptyLas(dir.file("empty.las"));
   expectConverts({dir.file("empty.las"), "-o", dir.file("empty.csv")});
-  EXPECT_EQ(readFile(dir.file("empty.csv")), "x,y,z\n");
+  // No points, and still the columns of the file's point format (1).
+  const std::string columns = "x,y,z,intensity,return_number,number_of_returns,scan_direction,"
+                              "edge_of_flight_line,classification,synthetic,key_point,withheld,scan_angle_rank,"
+                              "user_data,point_source_id,gps_time\n";
+  EXPECT_EQ(readFile(dir.file("empty.csv")), columns);
   expectConverts({dir.file("empty.las"), "-o", dir.file("empty.ply")});
   const std::string ply = readFile(dir.file("empty.ply"));
   EXPECT_TRUE(test::contains(ply, "\nelement vertex 0\n"));
@@ -153,7 +159,7 @@ TEST(CliConvertMeaning, emptyLasConvertsToEmptyCsvPlyAndLasAndGlbSaysWhyNot) {
   // Each empty output reads back as an empty set, and converts again.
   for (const char* name : {"empty.csv", "empty.ply", "empty_out.las"}) {
     expectConverts({dir.file(name), "-o", dir.file(std::string("again_") + name + ".csv")});
-    EXPECT_EQ(readFile(dir.file(std::string("again_") + name + ".csv")), "x,y,z\n") << name;
+    EXPECT_EQ(readFile(dir.file(std::string("again_") + name + ".csv")), columns) << name;
   }
   test::CommandResult r = runDpoint({"convert", dir.file("empty.las"), "-o", dir.file("empty.glb")});
   EXPECT_EQ(r.exit_code, 2);
@@ -188,16 +194,16 @@ TEST(CliConvertMeaning, materialBaseColoursBecomePointColours) {
   EXPECT_EQ(readFile(dir.file("p_out.csv")), "x,y,z\n1,2,3\n");
 }
 
-TEST(CliConvertMeaning, csvExtraColumnsAreIgnoredWithOneNotice) {
+TEST(CliConvertMeaning, csvFurtherColumnsAreDimensionsKeptInOrder) {
   TempDir dir;
   writeFile(dir.file("i.csv"), "x,y,z,intensity\n1,2,3,40\n4,5,6,41\n");
   test::CommandResult r = runDpoint({"convert", dir.file("i.csv"), "-o", dir.file("i_out.csv")});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(readFile(dir.file("i_out.csv")), "x,y,z\n1,2,3\n4,5,6\n");
-  EXPECT_EQ(r.err, "dpoint: note: " + dir.file("i.csv") + ": columns after x,y,z ignored (header 'x,y,z,intensity')\n");
-  // Colours then extras.
-  EXPECT_EQ(convertedCsv(dir, "c.csv", "x,y,z,r,g,b,a,t\n1,2,3,0.5,0.25,1,9,9\n", "c_out.csv"),
-            "x,y,z,r,g,b\n1,2,3,0.5,0.25,1\n");
+  EXPECT_EQ(readFile(dir.file("i_out.csv")), "x,y,z,intensity\n1,2,3,40\n4,5,6,41\n");
+  EXPECT_EQ(r.err, "");
+  // Colours then dimensions; a name keeps its spelling, a float its digits.
+  EXPECT_EQ(convertedCsv(dir, "c.csv", "x,y,z,r,g,b,Amp,t\n1,2,3,0.5,0.25,1,9,0.1\n", "c_out.csv"),
+            "x,y,z,r,g,b,Amp,t\n1,2,3,0.5,0.25,1,9,0.1\n");
   // Existing rejections keep their messages: a row of the wrong length, a bad header, 4 columns
   // without a header (what they are is unknown), a partial colour set.
   const std::vector<std::pair<std::string, std::vector<std::string>>> bad = {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 namespace dpoint {
 namespace {
 
+using test::firstLine;
 using test::readFile;
 using test::runDpoint;
 using test::TempDir;
@@ -76,8 +78,33 @@ TEST(CliLas, convertLasToCsvWritesEveryPointWithItsColour) {
   const std::string csv = readFile(dir.file("s.csv"));
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1066);
   // The first record: X, Y, Z = 63701224, 84902831, 43166 at scale 0.01; colour 68, 77, 88 of 255.
-  EXPECT_EQ(csv.rfind("x,y,z,r,g,b\n637012.24,849028.31,431.66,0.26666668,0.3019608,0.34509805\n", 0), 0u)
-      << csv.substr(0, 120);
+  // Then every field of point format 1: intensity 143, return 1 of 1, scan direction 1, class 1,
+  // scan angle -9, user data 132, point source 7326, GPS time 245380.78254962614.
+  EXPECT_EQ(csv.rfind("x,y,z,r,g,b,intensity,return_number,number_of_returns,scan_direction,edge_of_flight_line,"
+                      "classification,synthetic,key_point,withheld,scan_angle_rank,user_data,point_source_id,gps_time\n"
+                      "637012.24,849028.31,431.66,0.26666668,0.3019608,0.34509805,143,1,1,1,0,1,0,0,0,-9,132,7326,"
+                      "245380.78254962614\n",
+                      0),
+            0u)
+      << csv.substr(0, 400);
+  // --keep chooses the dimensions, in its order; --drop all leaves the coordinates and colours.
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("k.csv"), "-q", "--keep",
+                       "classification,intensity"})
+                .exit_code,
+            0);
+  EXPECT_EQ(firstLine(readFile(dir.file("k.csv"))), "x,y,z,r,g,b,classification,intensity\n");
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("d.csv"), "-q", "--drop", "all"}).exit_code, 0);
+  EXPECT_EQ(firstLine(readFile(dir.file("d.csv"))), "x,y,z,r,g,b\n");
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("n.csv"), "-q", "--keep", "none", "--no-colors"})
+                .exit_code,
+            0);
+  EXPECT_EQ(firstLine(readFile(dir.file("n.csv"))), "x,y,z\n");
+  // A name the file lacks is a usage error that lists what it has; nothing is written.
+  test::CommandResult bad = runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("bad.csv"), "--drop", "nir"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_TRUE(test::contains(bad.err, "--drop nir: " + kCorpus + "simple.las has no dimension 'nir' (it has intensity, "))
+      << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.csv")));
 }
 
 // LAS to PLY and to GLB as a user converts, read back. PLY stores double x, y, z: every position
@@ -124,7 +151,9 @@ TEST(CliLas, csvToLasToCsvIsByteIdenticalOnTheScaleGrid) {
   writeFile(dir.file("in.csv"),
             "x,y,z\n637012.241,5800843.145,265.125\n637999.999,5800000.001,0.5\n637500,5800500.25,-12.375\n");
   ASSERT_EQ(runDpoint({"convert", dir.file("in.csv"), "-o", dir.file("mid.las"), "--quiet"}).exit_code, 0);
-  test::CommandResult r = runDpoint({"convert", dir.file("mid.las"), "-o", dir.file("out.csv"), "--quiet"});
+  // The LAS file's fields (all 0 here) are dropped: only the coordinates are compared.
+  test::CommandResult r =
+      runDpoint({"convert", dir.file("mid.las"), "-o", dir.file("out.csv"), "--quiet", "--drop", "all"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(readFile(dir.file("out.csv")), readFile(dir.file("in.csv")));
   // A survey's coordinates (simple.las, scale 0.01), through CSV and back into LAS at its scale.
@@ -198,14 +227,17 @@ TEST(CliLas, maxPointsRefusesALasFileByItsHeader) {
   EXPECT_NE(r.err.find("22600 points exceed --max-points 1000"), std::string::npos) << r.err;
 }
 
-TEST(CliLas, generateWritesLasAtTheDefaultMillimetreScale) {
+// random2d's coordinates are arbitrary doubles: no decimal step keeps their digits, so x and y get
+// the finest that fits their extent (about 2 units from a whole-number offset: 1e-9), and z, all
+// 0, the coarsest (1).
+TEST(CliLas, generateWritesLasAtTheFinestScaleItsExtentFits) {
   TempDir dir;
   test::CommandResult r = runDpoint({"generate", "random2d", "--count", "100", "--offset", "637000,5800000,0", "-o",
                                      dir.file("r.las"), "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   test::CommandResult info = runDpoint({"info", dir.file("r.las"), "--quiet"});
   EXPECT_NE(info.out.find("point format 0, 20-byte records (0 extra bytes), 100 points"), std::string::npos) << info.out;
-  EXPECT_NE(info.out.find("LAS scale:          0.001 0.001 0.001"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS scale:          1e-09 1e-09 1\n"), std::string::npos) << info.out;
 }
 
 TEST(CliLas, rendersALasFile) {

@@ -306,7 +306,7 @@ TEST(Csv, rowWriterInPiecesEqualsWriteCsv) {
           const CsvWriteOptions options{decimals, threads, nullptr};
           ASSERT_TRUE(writeCsv(dir.file("whole.csv"), whole, options));
           Result<CsvRowWriter> writer =
-              CsvRowWriter::create(dir.file("rows.csv"), CsvLayout{whole.isPlanar(), colours}, options);
+              CsvRowWriter::create(dir.file("rows.csv"), CsvLayout{whole.isPlanar(), colours, {}}, options);
           ASSERT_TRUE(writer) << writer.error().message;
           size_t at = 0;
           for (size_t k = 0; at < whole.size(); k = (k + 1) % std::size(pieces)) {

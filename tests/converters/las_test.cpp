@@ -487,6 +487,8 @@ TEST(Las, csvToLasToCsvIsExactForDecimalEastingsAndNorthings) {
   Result<PointSet> mid = readLas(dir.file("mid.las"));
   ASSERT_TRUE(mid.ok()) << mid.error().message;
   EXPECT_EQ(mid->positions, in->positions);
+  // A LAS file carries every field of its format (here all 0): only the coordinates are compared.
+  mid->dimensions = Dimensions();
   ASSERT_TRUE(writeCsv(dir.file("out.csv"), *mid).ok());
   // LAS has z (issue #24): the CSV written from it keeps its z column, here all 0.
   PointSet in3d = *in;
@@ -534,9 +536,9 @@ TEST(Las, lasToLasKeepsEveryPointAndSixteenBitColour) {
 TEST(Las, writerRefusesPointBeyondInt32NamingTheFirst) {
   TempDir dir;
   PointSet set;
-  set.positions = {{0, 0, 0}, {1000, 0, 0}, {3000, 0, 0}, {4000, 0, 0}};
+  set.positions = {{0, 0, 0}, {1000, 0, 0}, {3000, 0, 0}, {5000, 0, 0}};
   LasWriteOptions options;
-  options.scale = 1e-6;  // 2147.48 m at most from the offset
+  options.scale = 1e-6;  // 2147.48 m at most from the offset: no offset holds 5 km
   Status s = writeLas(dir.file("far.las"), set, options);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ExitCode::kBadInput);

@@ -48,4 +48,21 @@ with scratch() as d:
         want = [float("%.15f" % v) for v in r]
         got = [frame.x[i], frame.y[i], frame.z[i]]
         check(got == want, f"row {i}: --decimals 15 gave {got}, '%.15f' gives {want}")
+    # A survey's fields after x,y,z,r,g,b (issue #34): pandas reads them as numbers, integers as integers.
+    las = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "corpus", "las",
+                       "simple.las")
+    fields = os.path.join(d, "fields.csv")
+    dpoint(exe, "convert", las, "-o", fields)
+    frame = pandas.read_csv(fields, float_precision="round_trip")
+    want = ["x", "y", "z", "r", "g", "b", "intensity", "return_number", "number_of_returns", "scan_direction",
+            "edge_of_flight_line", "classification", "synthetic", "key_point", "withheld", "scan_angle_rank",
+            "user_data", "point_source_id", "gps_time"]
+    check(list(frame.columns) == want, f"LAS fields: columns {list(frame.columns)}")
+    check(len(frame) == 1065, f"LAS fields: {len(frame)} rows")
+    first = frame.iloc[0]
+    check((first.intensity, first.classification, first.scan_angle_rank, first.point_source_id) == (143, 1, -9, 7326),
+          f"LAS fields: first row {first.to_dict()}")
+    check(str(frame.classification.dtype).startswith("int"), f"classification read as {frame.classification.dtype}")
+    check(first.gps_time == 245380.78254962614, f"gps time {first.gps_time!r}")
+    check(sorted(frame.classification.unique().tolist()) == [1, 2], f"classes {frame.classification.unique()}")
 print(f"pandas {pandas.__version__} read {len(rows)} rows with the same values")
