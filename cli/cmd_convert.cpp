@@ -120,7 +120,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "
                   "down to a whole number); a point beyond the 32-bit integers at this step is an error (exit 2). "
-                  "Default: a LAS input's own scale and offset (the same point records), else 0.001")
+                  "Default: a LAS input's own scale and offset (the same point records), else per axis the "
+                  "data's own decimal step (0.01 for centimetres), else the finest the extent fits")
       ->default_str("auto")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");

@@ -3,8 +3,8 @@
 // Reading: LF or CRLF line ends, an optional UTF-8 BOM, spaces or tabs around fields, blank lines
 // skipped. Fields are separated by commas, or (when the first line has no comma) by runs of spaces
 // and tabs, as CloudCompare's ASCII export writes them; its `//X,Y,Z` header is read too. A header
-// may name further columns after x,y,z or x,y,z,r,g,b (`x,y,z,intensity`): they are skipped, and a
-// notice says so. A header with no rows after it is an empty set; a file without a header needs a
+// may name further columns after x,y,z or x,y,z,r,g,b (`x,y,z,intensity`): each is a dimension
+// (double, or its known type where every value fits it; NaN allowed). A header with no rows after it is an empty set; a file without a header needs a
 // row. PointSet::z_axis says whether the file had a z column. Numbers are parsed correctly rounded (fast_float): positions to double, colours to
 // float. The file is read in blocks on all cores; every row goes to its preassigned index, so the
 // result is the same for any thread count. Memory: the PointSet plus one block per thread; the
@@ -34,8 +34,6 @@ struct CsvReadOptions {
   bool allow_nonfinite = false;  // accept nan/inf values instead of rejecting them
   Progress* progress = nullptr;
   uint64_t max_memory = 0;       // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
-  // When not null, gets one line per thing read past (a header's further columns, ignored).
-  std::vector<std::string>* notices = nullptr;
 };
 
 struct CsvWriteOptions {

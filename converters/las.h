@@ -35,10 +35,11 @@
 // (PointSet::las) when it holds everything the set carries, else the smallest that does: 0-3 in
 // LAS 1.2, 6-8 in LAS 1.4 where a field or value needs them. A LAS source also gives its scale,
 // offset, version and coordinate system records, so LAS → LAS writes the same point records.
-// Otherwise one scale for x, y and z: the first of 0.001, 0.0001, … 1e-12 under which no two
-// distinct points share their integers while the extent still fits the 32-bit integers (coarser
-// than 0.001 only where the extent does not fit at it); where none keeps them apart, the finest
-// that fits, and the report counts the points that merge. Per axis the first of these offsets under which every
+// Otherwise a scale per axis: the coarsest of 1, 0.1, … 1e-12 at which every coordinate reads back
+// within two units in its last place (the data's own decimal step: 0.01 for centimetres), else
+// the finest at which the extent fits the 32-bit integers (coarser than 1 only where even 1 does
+// not fit). Points that do not read back bit for bit are counted where they merge (the report).
+// Per axis the first of these offsets under which every
 // coordinate reads back as the same double: a whole number (lasOffsetFor), 0, the minimum rounded
 // down to a multiple of the scale (none: the whole number). A set without returns is written as
 // return 1 of 1. A point whose (coordinate − offset) / scale rounds outside the 32-bit integers is
@@ -99,7 +100,7 @@ struct LasWriteReport {
 
 struct LasWriteOptions {
   // The coordinate step for x, y and z, finite and > 0; 0: the source LAS file's (PointSet::las)
-  // per axis, with its offset where every point fits it, else 0.001.
+  // per axis, with its offset where every point fits it, else chosen from the data (above).
   double scale = 0.0;
   unsigned threads = 0;
   Progress* progress = nullptr;

@@ -81,8 +81,7 @@ namespace {
 Result<PointSet> readByFormat(const std::string& path, FileFormat format, const ReadOptions& options) {
   switch (format) {
     case FileFormat::kCsv:
-      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory,
-                                          options.notices});
+      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory});
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
                                           options.max_memory});

@@ -354,7 +354,7 @@ stderr.)");
       R"(Writes a set as .csv, .ply, .glb or .las (by extension), whole or not at all, as `dpoint convert` does.
 
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (uchar or float),
-las_scale (LAS coordinate step; None: a LAS source's own, else 0.001), order (input or morton), no_colors, color_format (linear or
+las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");
 }
 
