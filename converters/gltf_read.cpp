@@ -21,6 +21,7 @@
 #include <string_view>
 
 #include "converters/gltf_accessor.h"
+#include "converters/gltf_dimensions.h"
 #include "converters/gltf_load.h"
 #include "converters/gltf_position.h"
 #include "core/interrupt.h"
@@ -81,6 +82,52 @@ glm::vec3 vertexColour(const AccessorElements& colours, size_t e) {
   return glm::vec3(float(colours.value(e, 0)), float(colours.value(e, 1)), float(colours.value(e, 2)));
 }
 
+// A dimension the file's primitives carry (gltf_dimensions.h): its attribute, name and type.
+struct GltfDimension {
+  std::string attribute, name;
+  DimType type;
+};
+
+// The type a SCALAR accessor of this component type holds, for an attribute without dpoint's extras.
+std::optional<DimType> scalarType(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return DimType::kU8;
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return DimType::kI8;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return DimType::kU16;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return DimType::kI16;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return DimType::kU32;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return DimType::kF32;
+    default: return std::nullopt;
+  }
+}
+
+// How one primitive's accessor fills a dimension: as stored, or (`raw`) from its unsigned shorts.
+struct DimensionSource {
+  size_t column;  // in the set's dimensions
+  AccessorElements elements;
+  bool raw;
+  DimType stored;  // the accessor's own type, converted where the set's column differs
+
+  void store(Dimension& d, size_t at, size_t e) const {
+    if (raw) {
+      uint8_t bytes[8] = {};
+      for (int k = 0; k < elements.components(); ++k) {
+        const uint16_t word = static_cast<uint16_t>(elements.value(e, k));
+        std::memcpy(bytes + 2 * k, &word, 2);
+      }
+      if (stored == d.type) {
+        std::memcpy(d.bytes.data() + at * dimTypeSize(d.type), bytes, dimTypeSize(d.type));
+        return;
+      }
+      Dimension one("", stored, 1);
+      std::memcpy(one.bytes.data(), bytes, dimTypeSize(stored));
+      d.setValue(at, one.value(0));
+      return;
+    }
+    d.setValue(at, elements.value(e, 0));  // a byte, short, u32 or float: exact in double
+  }
+};
+
 // A primitive without COLOR_0; it gets its material colour if any other primitive has colours.
 struct Uncoloured {
   size_t begin = 0, end = 0;
@@ -101,11 +148,14 @@ class SceneReader {
         model_(model),
         options_(options),
         memory_limit_(options.max_memory ? options.max_memory : defaultMemoryLimit()),
-        decoder_(path, model, std::min<uint64_t>(kMaxUnbackedValues, memory_limit_ / sizeof(double))) {}
+        decoder_(path, model, std::min<uint64_t>(kMaxUnbackedValues, memory_limit_ / sizeof(double))),
+        dimensions_(findDimensions(model)) {}
 
   Result<PointSet> read() {
     pass_ = Pass::kBuild;
+    for (const GltfDimension& d : dimensions_) out_.dimensions.append(d.name, d.type, 0);
     if (Status s = walkScenes(); !s) return s.error();
+    out_.dimensions.resize(out_.positions.size());  // 0 for the points of primitives without one
     // glTF positions are VEC3, whatever their values; a set dpoint wrote as 2D says so in the
     // asset's extras (gltf_write.cpp), and its z are 0.
     const bool flat = saysFlat(model_) && std::all_of(out_.positions.begin(), out_.positions.end(),
@@ -122,18 +172,93 @@ class SceneReader {
   Status stream(GltfPointSink& sink) {
     pass_ = Pass::kCheck;
     if (Status s = walkScenes(); !s) return s;
-    if (Status s = sink.begin(GltfSummary{emitted_total_, any_colour_, saysFlat(model_)}); !s) return s;
+    GltfSummary summary{emitted_total_, any_colour_, saysFlat(model_), {}};
+    for (const GltfDimension& d : dimensions_) summary.dimensions.emplace_back(d.name, d.type);
+    if (Status s = sink.begin(summary); !s) return s;
     pass_ = Pass::kEmit;
     sink_ = &sink;
     emitted_total_ = 0;
     block_.positions.reserve(kGltfStreamBlockPoints);
     if (any_colour_) block_.colors.reserve(kGltfStreamBlockPoints);
+    for (const GltfDimension& d : dimensions_) block_.dimensions.append(d.name, d.type, kGltfStreamBlockPoints);
     if (Status s = walkScenes(); !s) return s;
     return block_.positions.empty() ? okStatus() : flushBlock();
   }
 
  private:
   enum class Pass { kBuild, kCheck, kEmit };
+
+  // The application-specific SCALAR attributes of every primitive (dpoint's position residuals
+  // aside), each once, by name, in the order of their first accessors (the order dpoint wrote
+  // them in); a name stored in two types is read as float64.
+  static std::vector<GltfDimension> findDimensions(const tinygltf::Model& model) {
+    std::vector<GltfDimension> found;
+    std::vector<int> first_accessor;
+    for (const tinygltf::Mesh& mesh : model.meshes)
+      for (const tinygltf::Primitive& primitive : mesh.primitives)
+        for (const auto& [attribute, index] : primitive.attributes) {
+          std::optional<GltfDimension> d = describe(model, attribute, index);
+          if (!d) continue;
+          auto same = std::find_if(found.begin(), found.end(), [&](const GltfDimension& f) { return f.name == d->name; });
+          if (same == found.end()) {
+            found.push_back(*d);
+            first_accessor.push_back(index);
+          } else {
+            if (same->type != d->type) same->type = DimType::kF64;
+            int& first = first_accessor[size_t(same - found.begin())];
+            first = std::min(first, index);
+          }
+        }
+    std::vector<size_t> order(found.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return first_accessor[a] < first_accessor[b]; });
+    std::vector<GltfDimension> sorted;
+    for (size_t i : order) sorted.push_back(std::move(found[i]));
+    return sorted;
+  }
+
+  // The dimension an attribute holds, if it is one (gltf_dimensions.h); the accessor is checked
+  // when a primitive is read.
+  static std::optional<GltfDimension> describe(const tinygltf::Model& model, const std::string& attribute, int index) {
+    if (attribute.size() < 2 || attribute[0] != '_' || attribute == kGltfPositionLow || attribute == kGltfPositionLow2)
+      return std::nullopt;
+    if (index < 0 || size_t(index) >= model.accessors.size()) return std::nullopt;
+    const tinygltf::Accessor& a = model.accessors[size_t(index)];
+    const tinygltf::Value& facts = a.extras.Get("dpoint");
+    std::string name;
+    for (const KnownDimension& k : knownDimensions())
+      if (attribute == k.gltf_attribute) name = k.name;
+    if (name.empty()) name = gltfDimensionName(attribute);
+    if (facts.IsObject() && facts.Get("name").IsString()) name = facts.Get("name").Get<std::string>();
+    if (facts.IsObject() && facts.Get("type").IsString()) {
+      const std::optional<DimType> type = parseDimType(facts.Get("type").Get<std::string>());
+      if (type && dimTypeSize(*type) >= 4 && a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+          a.type == (dimTypeSize(*type) == 4 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC4) && !a.normalized)
+        return GltfDimension{attribute, name, *type};
+    }
+    const std::optional<DimType> type = scalarType(a.componentType);
+    if (!type || a.type != TINYGLTF_TYPE_SCALAR || a.normalized) return std::nullopt;
+    return GltfDimension{attribute, name, *type};
+  }
+
+  // The sources of a primitive's dimensions, checked: one per attribute that is one, of
+  // POSITION's count.
+  Result<std::vector<DimensionSource>> openDimensions(const tinygltf::Primitive& primitive, size_t count) const {
+    std::vector<DimensionSource> sources;
+    for (const auto& [attribute, index] : primitive.attributes) {
+      const std::optional<GltfDimension> d = describe(model_, attribute, index);
+      if (!d) continue;
+      Result<AccessorElements> elements = decoder_.open(index);
+      if (!elements) return elements.error();
+      if (elements->count() != count)
+        return decoder_.fail(index, attribute + " count " + std::to_string(elements->count()) +
+                                        " differs from POSITION count " + std::to_string(count));
+      size_t column = 0;
+      while (dimensions_[column].name != d->name) ++column;
+      sources.push_back({column, std::move(*elements), elements->components() > 1, d->type});
+    }
+    return sources;
+  }
 
   Status walkScenes() {
     if (Status s = checkParents(); !s) return s;
@@ -465,6 +590,16 @@ class SceneReader {
       if (pass_ == Pass::kBuild) out_.positions.push_back(w);
     }
     if (Status s = readColours(primitive, pointer, remap, count, begin, begin + emitted); !s) return s;
+    Result<std::vector<DimensionSource>> sources = openDimensions(primitive, count);
+    if (!sources) return sources.error();
+    if (pass_ == Pass::kBuild && !dimensions_.empty()) {
+      out_.dimensions.resize(begin + emitted);
+      for (const DimensionSource& source : *sources) {
+        Dimension& d = out_.dimensions.all()[source.column];
+        for (size_t e = 0; e < count; ++e)
+          if (remap.empty() || remap[e] != kUnused) source.store(d, begin + (remap.empty() ? e : remap[e]), e);
+      }
+    }
 
     // Triangles in the output numbering; points and lines add none.
     if (pass_ != Pass::kBuild || !options_.triangles) return okStatus();
@@ -569,8 +704,16 @@ class SceneReader {
         fill = *material;
       }
     }
+    Result<std::vector<DimensionSource>> sources = openDimensions(primitive, positions.hi.count());
+    if (!sources) return sources.error();
+    std::vector<bool> has(dimensions_.size(), false);
+    for (const DimensionSource& source : *sources) has[source.column] = true;
     for (size_t e = 0; e < positions.hi.count(); ++e) {
       if (!remap.empty() && remap[e] == kUnused) continue;
+      const size_t at = block_.positions.size();
+      for (size_t c = 0; c < dimensions_.size(); ++c)
+        if (!has[c]) block_.dimensions.all()[c].setValue(at, 0.0);
+      for (const DimensionSource& source : *sources) source.store(block_.dimensions.all()[source.column], at, e);
       block_.positions.push_back(placeVertex(positions, world, e));
       if (any_colour_) block_.colors.push_back(colours ? vertexColour(*colours, e) : fill);
       if (block_.positions.size() == kGltfStreamBlockPoints)
@@ -590,9 +733,11 @@ class SceneReader {
   }
 
   Status flushBlock() {
+    block_.dimensions.resize(block_.positions.size());
     Status s = sink_->points(block_);
     block_.positions.clear();
     block_.colors.clear();
+    block_.dimensions.resize(kGltfStreamBlockPoints);
     return s;
   }
 
@@ -607,6 +752,7 @@ class SceneReader {
   std::vector<bool> on_path_, visited_;
   std::vector<Uncoloured> uncoloured_;
   bool any_colour_ = false;  // kept from the checking pass into the emitting pass
+  std::vector<GltfDimension> dimensions_;  // findDimensions: the set's columns, in this order
   GltfPointSink* sink_ = nullptr;
   PointSet block_;  // emitting pass: points not yet handed to sink_
 };

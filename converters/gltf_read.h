@@ -58,6 +58,8 @@ struct GltfSummary {
   uint64_t points = 0;
   bool colors = false;  // some primitive has COLOR_0 or a non-white material colour (then every point has a colour)
   bool flat = false;    // the asset says dpoint wrote it from a 2D set (gltfSaysFlat): its z are 0
+  // The dimensions every block carries (gltf_dimensions.h), in their order: name and type.
+  std::vector<std::pair<std::string, DimType>> dimensions;
 };
 
 // Receives streamGltf's points: begin() once, after the checking walk, then points() with

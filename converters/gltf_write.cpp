@@ -26,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include "converters/gltf_dimensions.h"
 #include "converters/gltf_position.h"
 #include "core/atomic_file.h"
 
@@ -125,6 +126,7 @@ struct Layout {
   size_t positions_bytes = 0;  // each of POSITION, _POSITION_LOW and (if low2) _POSITION_LOW2
   size_t colors_bytes = 0;
   size_t indices_bytes = 0;
+  size_t dimensions_bytes = 0;  // every dimension's view (gltf_dimensions.h), each a multiple of 4
   size_t bin_bytes = 0;  // all views, each 4-byte aligned
 
   glm::dvec3 invScale() const {
@@ -219,8 +221,9 @@ Result<Layout> planLayout(const PointSet& points) {
   layout.positions_bytes = n * sizeof(glm::vec3);
   layout.colors_bytes = points.hasColors() ? n * sizeof(glm::vec3) : 0;
   layout.indices_bytes = points.triangles.size() * sizeof(uint32_t);
+  for (const Dimension& d : points.dimensions.all()) layout.dimensions_bytes += n * gltfDimensionForm(d.type).stride;
   layout.bin_bytes = padTo4(layout.positions_bytes) * (layout.low2 ? 3 : 2) + padTo4(layout.colors_bytes) +
-                     padTo4(layout.indices_bytes);
+                     layout.dimensions_bytes + padTo4(layout.indices_bytes);
   return layout;
 }
 
@@ -291,6 +294,29 @@ tinygltf::Model describe(const PointSet& points, const Layout& layout) {
     primitive.attributes["COLOR_0"] = addAccessor(model, color_view, TINYGLTF_COMPONENT_TYPE_FLOAT,
                                                   TINYGLTF_TYPE_VEC3, points.size());
   }
+  // Each dimension as an application-specific attribute (gltf_dimensions.h), before the indices.
+  for (const Dimension& d : points.dimensions.all()) {
+    const GltfDimensionForm form = gltfDimensionForm(d.type);
+    const size_t bytes = points.size() * form.stride;
+    const int view = addView(model, offset, bytes, TINYGLTF_TARGET_ARRAY_BUFFER);
+    offset += bytes;
+    if (dimTypeSize(d.type) < 4) model.bufferViews[size_t(view)].byteStride = 4;
+    const int accessor = addAccessor(model, view, form.component_type, form.type, points.size());
+    const KnownDimension* known = findKnownDimension(d.name);
+    // Names that differ only in case (a LAS extra byte "Intensity" beside the field) get a suffix.
+    const std::string base = known ? known->gltf_attribute : gltfAttributeName(d.name);
+    std::string attribute = base;
+    for (int k = 2; primitive.attributes.count(attribute); ++k) attribute = base + "_" + std::to_string(k);
+    tinygltf::Value::Object facts;
+    if (form.raw) facts["type"] = tinygltf::Value(std::string(dimTypeName(d.type)));
+    if (gltfDimensionName(attribute) != d.name) facts["name"] = tinygltf::Value(d.name);
+    if (!facts.empty()) {
+      tinygltf::Value::Object extras;
+      extras["dpoint"] = tinygltf::Value(facts);
+      model.accessors[size_t(accessor)].extras = tinygltf::Value(extras);
+    }
+    primitive.attributes[attribute] = accessor;
+  }
   if (points.isMesh()) {
     const int index_view =
         addView(model, offset, layout.indices_bytes, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
@@ -357,6 +383,21 @@ Status writeBin(AtomicFile& file, const PointSet& points, const Layout& layout) 
   // Colours and indices are already float32 VEC3 / uint32 little-endian in memory.
   if (points.hasColors()) {
     if (Status s = file.write(points.colors.data(), layout.colors_bytes); !s) return s;
+  }
+  // Dimensions: 1- and 2-byte values padded to 4 bytes each, wider ones as their bytes.
+  std::vector<char> padded;
+  for (const Dimension& d : points.dimensions.all()) {
+    const size_t width = dimTypeSize(d.type);
+    if (width >= 4) {
+      if (Status s = file.write(d.bytes.data(), d.bytes.size()); !s) return s;
+      continue;
+    }
+    for (size_t begin = 0; begin < points.size(); begin += kPositionBlock) {
+      const size_t end = std::min(points.size(), begin + kPositionBlock);
+      padded.assign((end - begin) * 4, 0);
+      for (size_t i = begin; i < end; ++i) std::memcpy(padded.data() + (i - begin) * 4, d.bytes.data() + i * width, width);
+      if (Status s = file.write(padded.data(), padded.size()); !s) return s;
+    }
   }
   if (points.isMesh()) {
     if (Status s = file.write(points.triangles.data(), layout.indices_bytes); !s) return s;

@@ -24,7 +24,8 @@ class CsvPointSink final : public GltfPointSink {
     // glTF positions have z (PointSet::z_axis) unless dpoint wrote the file from a 2D set; a scene
     // placing no points is an empty set.
     flat_ = summary.flat;
-    const CsvLayout layout{flat_, summary.colors && !filters_.drop, {}};
+    CsvLayout layout{flat_, summary.colors && !filters_.drop, {}};
+    for (const auto& [name, type] : summary.dimensions) layout.dimensions.push_back(name);
     Result<CsvRowWriter> writer = CsvRowWriter::create(
         output_, layout, CsvWriteOptions{options_.decimals, options_.threads, options_.progress}, summary.points);
     if (!writer) return writer.error();
@@ -40,7 +41,8 @@ class CsvPointSink final : public GltfPointSink {
                        "; not written as x,y"};
     if (filters_.drop) block.colors.clear();
     if (filters_.srgb8) encodeColorsSrgb8(block);
-    return writer_->append(block.positions, block.colors);
+    // A block with dimensions is written whole (a partial batch of rows; appendSet).
+    return block.dimensions.empty() ? writer_->append(block.positions, block.colors) : writer_->appendSet(block);
   }
 
   Status commit() { return writer_->commit(); }

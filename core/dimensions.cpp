@@ -59,9 +59,9 @@ constexpr KnownDimension kKnown[] = {
     {dim::kWaveXt, DimType::kF32, "X(t)", "_WAVE_XT", "waveform: x of the parametric line"},
     {dim::kWaveYt, DimType::kF32, "Y(t)", "_WAVE_YT", "waveform: y of the parametric line"},
     {dim::kWaveZt, DimType::kF32, "Z(t)", "_WAVE_ZT", "waveform: z of the parametric line"},
-    {dim::kNormalX, DimType::kF32, nullptr, "NORMAL", "normal x"},
-    {dim::kNormalY, DimType::kF32, nullptr, "NORMAL", "normal y"},
-    {dim::kNormalZ, DimType::kF32, nullptr, "NORMAL", "normal z"},
+    {dim::kNormalX, DimType::kF32, nullptr, "_NX", "normal x"},
+    {dim::kNormalY, DimType::kF32, nullptr, "_NY", "normal y"},
+    {dim::kNormalZ, DimType::kF32, nullptr, "_NZ", "normal z"},
 };
 
 }  // namespace

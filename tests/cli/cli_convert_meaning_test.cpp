@@ -139,6 +139,23 @@ TEST(CliConvertMeaning, a2dSetStays2dThroughGlb) {
   EXPECT_EQ(readFile(dir.file("m.csv")).substr(0, 6), "x,y,z,");
 }
 
+// A survey's fields through GLB: the streamed glTF → CSV (no point set held) writes the same bytes
+// as the held path through PLY.
+TEST(CliConvertMeaning, dimensionsComeThroughGlbStreamedOrHeld) {
+  TempDir dir;
+  expectConverts({kLas + "extrabytes.las", "-o", dir.file("e.glb")});
+  expectConverts({dir.file("e.glb"), "-o", dir.file("streamed.csv")});
+  expectConverts({dir.file("e.glb"), "-o", dir.file("e.ply")});
+  expectConverts({dir.file("e.ply"), "-o", dir.file("held.csv")});
+  const std::string streamed = readFile(dir.file("streamed.csv"));
+  EXPECT_TRUE(test::contains(firstLine(streamed), ",gps_time,Colors_0,"));
+  EXPECT_TRUE(test::contains(firstLine(streamed), ",Intensity,Time\n"));
+  EXPECT_TRUE(streamed == readFile(dir.file("held.csv")));
+  // --keep on a glTF input takes the held path and keeps the one asked for.
+  expectConverts({dir.file("e.glb"), "-o", dir.file("k.csv"), "--keep", "Time"});
+  EXPECT_EQ(firstLine(readFile(dir.file("k.csv"))), "x,y,z,r,g,b,Time\n");
+}
+
 TEST(CliConvertMeaning, emptyLasConvertsToEmptyCsvPlyAndLasAndGlbSaysWhyNot) {
   TempDir dir;
   writeEmptyLas(dir.file("empty.las"));

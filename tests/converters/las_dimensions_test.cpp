@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "converters/csv.h"
+#include "converters/gltf_dimensions.h"
+#include "converters/gltf_read.h"
+#include "converters/gltf_write.h"
 #include "converters/las.h"
 #include "converters/ply.h"
 #include "core/dimensions.h"
@@ -144,6 +147,36 @@ TEST(LasDimensions, lasToCsvToLasKeepsEveryFieldOfEveryCorpusFile) {
       EXPECT_EQ(csv->dimensions.find(d.name)->type, d.type) << what << " " << d.name;
     }
   }
+}
+
+// GLB: each dimension an application-specific attribute (gltf_dimensions.h), read back in its type.
+TEST(LasDimensions, lasToGlbToLasKeepsEveryFieldOfEveryCorpusFile) {
+  TempDir dir;
+  for (const std::string& path : corpusLasFiles()) {
+    Result<PointSet> las = readLas(path);
+    ASSERT_TRUE(las);
+    if (las->size() == 0) continue;  // GLB cannot hold an empty set (tested in the CLI tests)
+    const std::string what = path + " (GLB)";
+    ASSERT_TRUE(writeGlb(dir.file("p.glb"), *las)) << what;
+    Result<PointSet> glb = readGltf(dir.file("p.glb"));
+    ASSERT_TRUE(glb) << glb.error().message;
+    expectSameDimensions(*las, *glb, what);
+    ASSERT_EQ(glb->dimensions.count(), las->dimensions.count()) << what;
+    for (size_t k = 0; k < las->dimensions.count(); ++k) {
+      EXPECT_EQ(glb->dimensions.all()[k].name, las->dimensions.all()[k].name) << what;
+      EXPECT_EQ(glb->dimensions.all()[k].type, las->dimensions.all()[k].type) << what;
+      EXPECT_TRUE(glb->dimensions.all()[k].bytes == las->dimensions.all()[k].bytes) << what << ": bits differ";
+    }
+    ASSERT_TRUE(writeLas(dir.file("back.las"), *glb)) << what;
+    Result<PointSet> back = readLas(dir.file("back.las"));
+    ASSERT_TRUE(back);
+    expectSameDimensions(*las, *back, what + " -> LAS");
+    expectSameLasIntegers(*las, *back, *las->las, what + " -> LAS");
+  }
+}
+
+TEST(LasDimensions, theKnownGltfAttributesAreTheNamesInUpperCase) {
+  for (const KnownDimension& k : knownDimensions()) EXPECT_EQ(gltfAttributeName(k.name), k.gltf_attribute) << k.name;
 }
 
 TEST(LasDimensions, everyFieldOfARecordIsADimensionWithItsValue) {

@@ -38,6 +38,12 @@ with scratch() as d:
             f.write(f"{(i - 50) * 1.25e-301!r},{1e-300 + i * 3e-317!r},{i * 1e290!r}\n")
     files["tiny and huge points"] = os.path.join(d, "tiny.glb")
     dpoint(exe, "convert", tiny, "-o", files["tiny and huge points"])
+    # Every LAS field and extra byte as an application-specific attribute (issue #34): bytes and
+    # shorts padded to 4, float32 as FLOAT, wider types as their bytes in unsigned shorts.
+    corpus = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "corpus")
+    for las in ("las/extrabytes.las", "laz/rand1_6.las", "las/1_4_w_evlr.las"):
+        files[las] = os.path.join(d, os.path.basename(las) + ".glb")
+        dpoint(exe, "convert", os.path.join(corpus, las), "-o", files[las])
     attributes = {}
     for name, path in files.items():
         with open(path, "rb") as f:
@@ -47,6 +53,11 @@ with scratch() as d:
         attributes[name] = set(gltf["meshes"][0]["primitives"][0]["attributes"])
         check("_POSITION_LOW" in attributes[name], f"{name}: no _POSITION_LOW: {attributes[name]}")
     check("_POSITION_LOW2" in attributes["points"], "random2d needs the third part, and it is missing")
+    check({"_INTENSITY", "_CLASSIFICATION", "_GPS_TIME"} <= attributes["laz/rand1_6.las"],
+          f"rand1_6: {attributes['laz/rand1_6.las']}")
+    with open(files["tiny and huge points"], "rb") as f:
+        data = f.read()
+    gltf = json.loads(data[20:20 + struct.unpack_from("<I", data, 12)[0]])
     check("scale" in gltf["nodes"][0], "the 1e-300 set has no node scale")
     for name, path in files.items():
         out = subprocess.run(["node", "-e", script, validator, path], capture_output=True, text=True)
