@@ -141,6 +141,53 @@ void setColors(PointSet& set, const py::handle& value, const py::handle& self = 
     set.colors = std::move(colors);
 }
 
+// The dimension type of a NumPy dtype: its integer and float types, bool as uint8.
+DimType dimTypeOf(const py::array& array, const std::string& name) {
+  const char kind = array.dtype().kind();
+  const size_t size = static_cast<size_t>(array.itemsize());
+  if (kind == 'b') return DimType::kU8;
+  for (size_t t = 0; t < kDimTypeCount; ++t) {
+    const DimType type = static_cast<DimType>(t);
+    if (dimTypeSize(type) == size && (kind == 'f') == dimTypeIsFloat(type) &&
+        (kind == 'f' || (kind == 'i') == dimTypeIsSigned(type)) && (kind == 'f' || kind == 'i' || kind == 'u'))
+      return type;
+  }
+  throw py::type_error("attribute '" + name + "': dtype " + dtypeText(array) +
+                       " is not an integer, float or bool type");
+}
+
+// Sets (adds or replaces) a dimension from a 1-D array of one value per point, in the array's own
+// dtype. Views of a replaced column keep memory of their own (replaceKeepingViews).
+void setAttribute(const py::handle& self, PointSet& set, const std::string& name, const py::handle& value) {
+  if (name.empty()) throw py::value_error("attribute: the name is empty");
+  for (const char* taken : {"x", "y", "z", "r", "g", "b"})
+    if (name == taken) throw py::value_error("attribute '" + name + "': a coordinate or colour, not an attribute");
+  py::array array = py::array::ensure(value);
+  if (!array) throw py::type_error("attribute '" + name + "': not an array");
+  if (array.ndim() != 1 || static_cast<size_t>(array.shape(0)) != set.size())
+    throw py::value_error("attribute '" + name + "': expected " + std::to_string(set.size()) +
+                          " values (one per point) in one dimension");
+  const DimType type = dimTypeOf(array, name);
+  py::array contiguous = py::array::ensure(array, py::array::c_style | py::array::forcecast);
+  std::vector<uint8_t> bytes(set.size() * dimTypeSize(type));
+  if (!bytes.empty()) std::memcpy(bytes.data(), contiguous.data(), bytes.size());
+  Dimension* d = set.dimensions.find(name);
+  if (!d) {
+    set.dimensions.append(name, type, 0).bytes = std::move(bytes);
+    return;
+  }
+  if (d->type != type) {
+    if (d->bytes.capacity() > 0) {
+      auto* retired = new std::vector<uint8_t>(std::move(d->bytes));
+      keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<uint8_t>*>(p); }));
+    }
+    d->type = type;
+    d->bytes = std::move(bytes);
+    return;
+  }
+  replaceKeepingViews(self, d->bytes, std::move(bytes));
+}
+
 void setTriangles(PointSet& set, const py::handle& value, const py::handle& self = py::handle()) {
   if (value.is_none()) {
     set.triangles.clear();
@@ -288,6 +335,28 @@ that memory, without copying (writing into them changes the set).)")
           },
           "The per-point attributes (intensity, classification, GPS time, a LAS file's extra bytes, a PLY's\n"
           "other properties): a dict of name to a 1-D NumPy view in the attribute's own dtype (no copy)")
+      .def(
+          "set_attribute",
+          [](const py::object& self, const std::string& name, const py::object& values) {
+            setAttribute(self, self.cast<PointSet&>(), name, values);
+          },
+          py::arg("name"), py::arg("values"),
+          "Adds or replaces attribute `name` from a 1-D array of one value per point, kept in its dtype\n"
+          "(integers, float32/64; bool as uint8). Writers write it as a LAS field (a known name such as\n"
+          "intensity or classification) or extra bytes, a PLY property, a CSV column, a GLB attribute")
+      .def(
+          "remove_attribute",
+          [](const py::object& self, const std::string& name) {
+            PointSet& s = self.cast<PointSet&>();
+            Dimension* d = s.dimensions.find(name);
+            if (!d) throw py::key_error(name);
+            if (d->bytes.capacity() > 0) {  // views of it stay valid
+              auto* retired = new std::vector<uint8_t>(std::move(d->bytes));
+              keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<uint8_t>*>(p); }));
+            }
+            s.dimensions.remove(name);
+          },
+          py::arg("name"), "Removes attribute `name` (KeyError when the set has none of that name)")
       .def_property_readonly("has_z", &PointSet::hasZ, "Whether writers write z (False for a 2D set)")
       .def_readwrite("z_up", &PointSet::z_up, "The source says z is up (LAS): render's fitted views use it")
       .def("copy", [](const PointSet& s) { return std::make_shared<PointSet>(s); }, "A deep copy")

@@ -87,9 +87,10 @@ def _as_points(points):
 
 
 def _from_dataframe(frame, *, allow_nonfinite: bool = False) -> PointSet:
-    """A PointSet from a pandas DataFrame with columns x, y[, z][, r, g, b].
+    """A PointSet from a pandas DataFrame with columns x, y[, z][, r, g, b] and any others.
 
     r, g, b: integers 0..255 (as CSV files hold them) or floats 0..1 (linear). Without z the set is 2D.
+    Every other column is an attribute in its dtype (integers, floats, bool), as to_dataframe gives them.
     """
     columns = {str(c).lower(): c for c in frame.columns}
     missing = [c for c in ("x", "y") if c not in columns]
@@ -107,16 +108,30 @@ def _from_dataframe(frame, *, allow_nonfinite: bool = False) -> PointSet:
             colors = values.astype("uint8")
         else:
             colors = rgb.to_numpy(dtype="float32")
-    return PointSet(positions, colors, allow_nonfinite=allow_nonfinite)
+    points = PointSet(positions, colors, allow_nonfinite=allow_nonfinite)
+    used = set(axes) | ({"r", "g", "b"} if colors is not None else set())
+    for column in frame.columns:
+        if str(column).lower() in used:
+            continue
+        values = frame[column].to_numpy()
+        if values.dtype.kind not in "biuf":
+            raise Error(f"DataFrame: column {column!r} is {values.dtype}, not numbers: "
+                        "an attribute holds integers, floats or bools")
+        points.set_attribute(str(column), values)
+    return points
 
 
 def _to_dataframe(self):
-    """The set as a pandas DataFrame: x, y, z (float64) and, with colours, r, g, b (float32, 0..1)."""
+    """The set as a pandas DataFrame: x, y, z (float64; no z for a 2D set), with colours r, g, b
+    (float32, 0..1), then one column per attribute in its own dtype. The values are copied."""
     import pandas as pd
 
-    data = {"x": self.positions[:, 0], "y": self.positions[:, 1], "z": self.positions[:, 2]}
+    data = {"x": self.positions[:, 0], "y": self.positions[:, 1]}
+    if self.has_z:
+        data["z"] = self.positions[:, 2]
     if self.colors is not None:
         data.update(r=self.colors[:, 0], g=self.colors[:, 1], b=self.colors[:, 2])
+    data.update(self.attributes)
     return pd.DataFrame(data, copy=True)
 
 

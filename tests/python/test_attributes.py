@@ -45,3 +45,64 @@ def test_attributes_are_views_whose_changes_are_written(tmp_path):
     dpoint.write(s, tmp_path / "b.las")
     assert (dpoint.read(tmp_path / "b.las").attributes["classification"] == 6).all()
     assert dpoint.PointSet(np.zeros((2, 3))).attributes == {}
+
+
+def same_values(a, b):
+    """Equal value for value, NaN equal to NaN (rand1_6.las has NaN GPS times)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype.kind == "f" or b.dtype.kind == "f":
+        return np.array_equal(a.astype("float64"), b.astype("float64"), equal_nan=True)
+    return np.array_equal(a, b)
+
+
+def test_las_to_dataframe_to_las_keeps_every_field(tmp_path):
+    for path in sorted((CORPUS / "las").glob("*.las")) + sorted((CORPUS / "laz").glob("*.las")):
+        s = dpoint.read(path)
+        frame = s.to_dataframe()
+        assert list(frame.columns)[:3] == ["x", "y", "z"], path.name
+        for name, values in s.attributes.items():
+            assert frame[name].dtype == values.dtype, (path.name, name)
+        t = dpoint.PointSet.from_dataframe(frame)
+        assert t.attributes.keys() == s.attributes.keys(), path.name
+        dpoint.write(t, tmp_path / "back.las")
+        back = dpoint.read(tmp_path / "back.las")
+        for name, values in s.attributes.items():
+            assert same_values(back.attributes[name], values), (path.name, name)
+        # The coordinates are the same integers of the file's own frame (the frame itself stays
+        # with the file: a DataFrame has no place for it).
+        header = pathlib.Path(path).read_bytes()
+        scale = np.array(struct.unpack_from("<3d", header, 131))
+        offset = np.array(struct.unpack_from("<3d", header, 155))
+        assert np.array_equal(np.rint((back.positions - offset) / scale), np.rint((s.positions - offset) / scale)), path.name
+
+
+def test_set_and_remove_attribute(tmp_path):
+    s = dpoint.PointSet(np.array([[0.0, 0, 0], [1, 2, 3]]))
+    s.set_attribute("classification", np.array([2, 6], dtype=np.uint8))
+    s.set_attribute("Amplitude", np.array([1.5, -2.25], dtype=np.float32))
+    s.set_attribute("ok", np.array([True, False]))
+    assert s.attributes["ok"].dtype == np.uint8
+    view = s.attributes["classification"]
+    s.set_attribute("classification", np.array([9, 9], dtype=np.uint8))
+    assert list(view) == [9, 9]  # same dtype: written in place, the view sees it
+    s.set_attribute("classification", np.array([1, 2], dtype=np.int64))
+    assert s.attributes["classification"].dtype == np.int64 and list(view) == [9, 9]  # the old view stays readable
+    dpoint.write(s, tmp_path / "a.las")
+    back = dpoint.read(tmp_path / "a.las")
+    assert list(back.attributes["classification"]) == [1, 2]
+    assert list(back.attributes["Amplitude"]) == [1.5, -2.25]
+    s.remove_attribute("ok")
+    assert "ok" not in s.attributes
+    for bad, error in [(("x", [1, 2]), ValueError), (("a", [1, 2, 3]), ValueError), (("a", ["p", "q"]), TypeError)]:
+        try:
+            s.set_attribute(*bad)
+        except error:
+            pass
+        else:
+            raise AssertionError(f"set_attribute{bad} was accepted")
+    try:
+        s.remove_attribute("missing")
+    except KeyError:
+        pass
+    else:
+        raise AssertionError("remove_attribute('missing') was accepted")
