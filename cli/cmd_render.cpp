@@ -83,7 +83,8 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.background_rgba8 = *parseBackground(o.background);
   if (o.shade != "auto") request.shading = o.shade == "edl" ? Shading::kEdl : Shading::kNone;
   request.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
-  request.color = *parseRenderColor(o.color);
+  request.color = parseRenderColor(o.color);
+  request.color_attribute = o.color;
   request.up_axis = o.up_axis == "z" ? UpAxis::kZ : o.up_axis == "y" ? UpAxis::kY : UpAxis::kAuto;
   request.order = *parsePointOrder("--order", o.order);
   request.views = o.views;
@@ -303,11 +304,14 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
   cmd->add_option("--edl-radius", o->edl_radius, "Eye-dome neighbour distance in pixels (1..16)")
       ->check(numberIn("--edl-radius", 1.0, 16.0, false, "pixels"))
       ->default_val(1.4);
-  addChoiceOption(*cmd, "--color", o->color,
-                  "auto|rgb|elevation|intensity|classification. elevation: a perceptual colour map (viridis) along\n"
-                  "the up axis (--up-axis); intensity (grey) and classification (the ASPRS classes' colours): LAS\n"
-                  "only. auto: the set's colours when it has them, else elevation for 3D sets and white for 2D ones",
-                  {"auto", "rgb", "elevation", "intensity", "classification"});
+  cmd->add_option("--color", o->color,
+                  "auto|rgb|elevation|NAME. elevation: a perceptual colour map (viridis) along the up axis\n"
+                  "(--up-axis). NAME: any dimension of the set (`dpoint info` lists them: intensity, classification,\n"
+                  "gps_time, a PLY property or CSV column), with a legend in the top-right corner: classification in\n"
+                  "the ASPRS classes' colours, another integer of at most 12 values one colour each, anything else\n"
+                  "viridis from its 1st to its 99th percentile. auto: the set's colours when it has them, else\n"
+                  "elevation for 3D sets and white for 2D ones")
+      ->default_val("auto");
   cmd->add_option("--max-device-memory", o->max_device_memory,
                   "Refuse (exit 3, a Vulkan fault) to allocate more GPU memory than this, e.g. 2G (default: what the\n"
                   "device has)");

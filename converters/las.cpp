@@ -23,6 +23,7 @@
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
+#include "ops/colormap.h"
 
 namespace dpoint {
 
@@ -161,32 +162,6 @@ Result<LasHeader> parseHeader(const InputFile& file) {
   return hd;
 }
 
-constexpr std::array<std::array<uint8_t, 3>, 23> kClassColors = {{
-    {128, 128, 128},  // 0 created, never classified
-    {160, 160, 160},  // 1 unclassified
-    {139, 90, 43},    // 2 ground
-    {144, 238, 144},  // 3 low vegetation
-    {60, 179, 60},    // 4 medium vegetation
-    {0, 100, 0},      // 5 high vegetation
-    {178, 34, 34},    // 6 building
-    {255, 0, 255},    // 7 low point (noise)
-    {200, 200, 200},  // 8 reserved (model key-point before 1.4)
-    {30, 100, 255},   // 9 water
-    {100, 50, 130},   // 10 rail
-    {64, 64, 64},     // 11 road surface
-    {200, 200, 200},  // 12 reserved (overlap before 1.4)
-    {255, 215, 0},    // 13 wire, guard (shield)
-    {255, 255, 0},    // 14 wire, conductor (phase)
-    {255, 140, 0},    // 15 transmission tower
-    {255, 190, 120},  // 16 wire-structure connector (insulator)
-    {210, 180, 140},  // 17 bridge deck
-    {200, 0, 200},    // 18 high noise
-    {0, 200, 200},    // 19 overhead structure
-    {205, 170, 125},  // 20 ignored ground
-    {255, 255, 255},  // 21 snow
-    {255, 160, 200},  // 22 temporal exclusion
-}};
-constexpr std::array<uint8_t, 3> kOtherClassColor = {200, 200, 200};
 
 // Decodes the point records into a PointSet (see the top of las.h for the colour rules).
 class LasReader {
@@ -671,9 +646,8 @@ double lasOffsetFor(double min, double scale) {
 }
 
 glm::vec3 lasClassColor(uint8_t classification) {
-  const std::array<uint8_t, 3>& c =
-      classification < kClassColors.size() ? kClassColors[classification] : kOtherClassColor;
-  return glm::vec3(c[0], c[1], c[2]) / 255.0f;
+  const uint32_t c = asprsClassColor(classification);
+  return glm::vec3(float(c & 0xffu), float((c >> 8) & 0xffu), float((c >> 16) & 0xffu)) / 255.0f;
 }
 
 bool lasBoundsContain(const LasHeader& header, const Box& points) {

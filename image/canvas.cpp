@@ -151,4 +151,36 @@ Image composeContactSheet(const std::vector<LabelledView>& views, uint32_t colum
   return sheet;
 }
 
+void drawLegend(Image& image, const AttributeColoring& plan) {
+  constexpr uint32_t kBoxColor = packRgb(0x10, 0x10, 0x10), kTextColor = packRgb(0xf2, 0xf2, 0xf2);
+  const int scale = image.width >= 800 ? 2 : 1;
+  const int pad = 4 * scale, line = kTextLineUnits * scale, swatch = kTextGlyphUnits * scale;
+  const std::vector<LegendLine> lines = legendLines(plan);
+  const bool ramp = plan.kind == AttributeColoring::Kind::kRamp;
+  const int bar = ramp ? 6 * line : 0;  // the ramp's height between its two labels
+  int width = textWidth(plan.name, scale);
+  for (const LegendLine& l : lines) width = std::max(width, swatch + pad + textWidth(l.label, scale));
+  const int height = line * (1 + int(lines.size())) + bar;
+  const Rect all = wholeImage(image);
+  const int x0 = int(image.width) - width - 3 * pad, y0 = pad;
+  const Rect box = {x0, y0, x0 + width + 2 * pad, y0 + height + 2 * pad};
+  fillRect(image, box, all, kBoxColor);
+  int y = y0 + pad;
+  const int x = x0 + pad;
+  drawTextClipped(image, box, x, y, plan.name, kTextColor, scale);
+  y += line;
+  for (size_t k = 0; k < lines.size(); ++k) {
+    if (ramp && k == 1) {  // the bar between p99 (above) and p1 (below)
+      for (int row = 0; row < bar; ++row) {
+        const double t = 1.0 - (double(row) + 0.5) / double(bar);
+        fillRect(image, {x, y + row, x + swatch, y + row + 1}, box, plan.colorOf(plan.low + t * (plan.high - plan.low)));
+      }
+      y += bar;
+    }
+    fillRect(image, {x, y, x + swatch, y + swatch}, box, lines[k].rgba8);
+    drawTextClipped(image, box, x + swatch + pad, y, lines[k].label, kTextColor, scale);
+    y += line;
+  }
+}
+
 }  // namespace dpoint

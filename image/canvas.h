@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "ops/attribute_colors.h"
 #include "ops/colormap.h"
 #include "image/image.h"
 
@@ -60,5 +61,12 @@ inline uint32_t contactSheetCell(uint32_t total, uint32_t cells) {
   const uint32_t gaps = (cells - 1) * kContactSheetGap;
   return total > gaps + cells ? (total - gaps) / cells : 1u;
 }
+
+// The legend of a picture coloured by a dimension (`render --color NAME`), on a dark box in the
+// top-right corner: the dimension's name, then a swatch and a label per category (legendLines), or
+// for a ramp a bar from its p99 colour at the top to its p1 colour at the bottom between the two
+// values. Text is twice as large on pictures 800 px wide or more; a picture too small for the box
+// gets what fits (clipped).
+void drawLegend(Image& image, const AttributeColoring& plan);
 
 }  // namespace dpoint

@@ -18,6 +18,7 @@
 #include "core/memory.h"
 #include "core/text.h"
 #include "image/canvas.h"
+#include "ops/attribute_colors.h"
 #include "ops/point_filters.h"
 #include "viewer/reference.h"
 
@@ -51,6 +52,7 @@ struct LoadedSet {
   Bounds bounds;
   bool has_colors = false;
   bool elevation = false;  // coloured by elevation along the up axis (a stream: block by block)
+  std::optional<AttributeColoring> coloring;  // coloured by a dimension (--color NAME): the legend's plan
   bool z_up = false;
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
@@ -119,28 +121,28 @@ Status streamOutlineAndSpacing(const RenderRequest& request, const std::string& 
   return okStatus();
 }
 
+// The LAS colours to read: none where a colour map replaces them.
 LasColorSource lasColorOf(RenderColor color) {
-  // LAS fields as colours; elevation replaces whatever the file holds.
-  switch (color) {
-    case RenderColor::kIntensity: return LasColorSource::kIntensity;
-    case RenderColor::kClassification: return LasColorSource::kClassification;
-    case RenderColor::kElevation: return LasColorSource::kNone;
-    default: return LasColorSource::kAuto;
-  }
+  return color == RenderColor::kElevation || color == RenderColor::kAttribute ? LasColorSource::kNone
+                                                                              : LasColorSource::kAuto;
 }
 
-// --color intensity and classification come from the LAS reader: a set it did not read (one in
-// memory, a stream) has neither.
-Status checkNotLasColor(const std::string& inputs, RenderColor color) {
-  if (color != RenderColor::kIntensity && color != RenderColor::kClassification) return okStatus();
-  return Error{inputs + ": --color " + renderColorName(color) + " needs LAS input", ExitCode::kBadInput};
+// --color NAME of a set without that dimension: a usage error listing those it has.
+Error noSuchAttribute(const std::string& inputs, const std::string& name, const Dimensions& dimensions) {
+  std::string has;
+  for (const Dimension& d : dimensions.all()) {
+    has += has.empty() ? "" : ", ";
+    has += d.name;
+  }
+  std::string message = "--color " + name + ": " + inputs + " has no dimension '" + name + "' (";
+  message += has.empty() ? std::string("it has none; --color takes auto, rgb, elevation or a dimension)") : "it has " + has + ")";
+  return Error{std::move(message), ExitCode::kUsage};
 }
 
 // The request's set in memory (RenderRequest::points), drawn as it is: nothing is read.
 Result<LoadedSet> takeInMemory(const RenderRequest& request) {
   LoadedSet set;
   set.inputs = request.inputs.empty() ? std::string("points") : describeInputs(request.inputs);
-  if (Status s = checkNotLasColor(set.inputs, request.color); !s) return s.error();
   set.shared = request.points;
   return set;
 }
@@ -154,8 +156,10 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (!opened) return opened.error();
   set.stream = std::move(*opened);
   PointInputStream* ply = set.stream.get();
-  if (ply)
-    if (Status s = checkNotLasColor(inputs, request.color); !s) return s.error();
+  if (ply && request.color == RenderColor::kAttribute)
+    return Error{inputs + ": --color " + request.color_attribute + ": a streamed set (" + std::to_string(ply->count()) +
+                     " points) is coloured by elevation or its own colours; a dimension needs it in memory (--stream off)",
+                 ExitCode::kUsage};
   if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
     return Error{inputs + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
                  "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
@@ -201,10 +205,23 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   // A 2D set has no elevation: without colours its points stay white.
   set.elevation = request.color == RenderColor::kElevation ||
                   (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar);
+  if (request.color == RenderColor::kAttribute && set.points()) {
+    const Dimension* d = set.points()->dimensions.find(request.color_attribute);
+    if (!d) return noSuchAttribute(inputs, request.color_attribute, set.points()->dimensions);
+    set.coloring = planAttributeColoring(*d, request.threads);
+    set.has_colors = true;
+  }
   if (set.points()) {
-    if (set.elevation || request.order != PointOrder::kInput) {
+    if (set.elevation || set.coloring || request.order != PointOrder::kInput) {
       if (!set.owned) set.owned = *set.shared;  // the request's own set stays as it is
       if (set.elevation) colorByElevation(*set.owned, set.z_up ? 2 : 1, request.threads);
+      if (set.coloring) {
+        PointSet& s = *set.owned;
+        s.colors.resize(s.size());
+        colorByAttribute(*s.dimensions.find(request.color_attribute), 0, s.size(), *set.coloring, s.colors.data(),
+                         request.threads);
+        phases.mark("colour");
+      }
       reorderPoints(*set.owned, request.order, request.threads, &progress);
     }
     phases.mark("order");
@@ -306,6 +323,7 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     if (view_done) view_done(outcome.views.back());
   }
   outcome.image = composeContactSheet(sheet, 2, request.camera.width, request.camera.height);
+  if (set.coloring) drawLegend(outcome.image, *set.coloring);
   return okStatus();
 }
 
@@ -348,27 +366,18 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   outcome.drawn_share = drawn.share();
   if (std::string cover = coverWarning(drawn.share(), drawn.span()); !cover.empty()) outcome.warnings.push_back(cover);
   outcome.image = std::move(rendered->image);
+  if (set.coloring) drawLegend(outcome.image, *set.coloring);
   outcome.result = std::move(*rendered);
   return okStatus();
 }
 
 }  // namespace
 
-std::optional<RenderColor> parseRenderColor(std::string_view name) {
-  for (RenderColor c : {RenderColor::kAuto, RenderColor::kRgb, RenderColor::kElevation, RenderColor::kIntensity,
-                        RenderColor::kClassification})
-    if (name == renderColorName(c)) return c;
-  return std::nullopt;
-}
-
-const char* renderColorName(RenderColor color) {
-  switch (color) {
-    case RenderColor::kRgb: return "rgb";
-    case RenderColor::kElevation: return "elevation";
-    case RenderColor::kIntensity: return "intensity";
-    case RenderColor::kClassification: return "classification";
-    default: return "auto";
-  }
+RenderColor parseRenderColor(std::string_view name) {
+  if (name == "auto") return RenderColor::kAuto;
+  if (name == "rgb") return RenderColor::kRgb;
+  if (name == "elevation") return RenderColor::kElevation;
+  return RenderColor::kAttribute;
 }
 
 std::string predictionWarning(const RenderRequest& request, const ModePrediction& prediction,

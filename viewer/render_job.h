@@ -30,10 +30,11 @@
 
 namespace dpoint {
 
-// --color: where the points' colours come from.
-enum class RenderColor { kAuto, kRgb, kElevation, kIntensity, kClassification };
-std::optional<RenderColor> parseRenderColor(std::string_view name);
-const char* renderColorName(RenderColor color);
+// --color: where the points' colours come from: the set's own, a map of the elevation, or a map of
+// one of its dimensions (RenderRequest::color_attribute; ops/attribute_colors.h) with a legend.
+enum class RenderColor { kAuto, kRgb, kElevation, kAttribute };
+// auto, rgb, elevation, or any other name: a dimension (kAttribute).
+RenderColor parseRenderColor(std::string_view name);
 
 // --up-axis: the data's up for the fitted views. auto: z for LAS input (surveys), y otherwise.
 enum class UpAxis { kAuto, kY, kZ };
@@ -80,6 +81,7 @@ struct RenderRequest {
   std::optional<Shading> shading;    // none: shadingFor's choice
   EdlOptions edl;
   RenderColor color = RenderColor::kAuto;
+  std::string color_attribute;       // kAttribute: the dimension's name
   UpAxis up_axis = UpAxis::kAuto;
   PointOrder order = PointOrder::kInput;
   uint32_t views = 1;                // 1, or 4: a contact sheet of four labelled views

@@ -263,12 +263,19 @@ TEST(CliLas, renderColoursASurveyByEachSource) {
   }
   for (size_t i = 0; i < pictures.size(); ++i)
     for (size_t j = i + 1; j < pictures.size(); ++j) EXPECT_FALSE(pictures[i] == pictures[j]) << i << " " << j;
-  writeFile(dir.file("p.csv"), "x,y,z\n1,2,3\n");
-  test::CommandResult csv = runDpoint({"render", dir.file("p.csv"), "-o", dir.file("p.png"), "--color", "intensity"});
-  EXPECT_EQ(csv.exit_code, 2);
-  EXPECT_NE(csv.err.find("intensity"), std::string::npos) << csv.err;
+  // Any dimension colours, from any format; a name the set lacks is refused with those it has.
+  writeFile(dir.file("p.csv"), "x,y,z,temperature\n1,2,3,20.5\n2,3,4,21\n");
+  test::CommandResult csv =
+      runDpoint({"render", dir.file("p.csv"), "-o", dir.file("t.png"), "--color", "temperature", "--quiet"});
+  EXPECT_EQ(csv.exit_code, 0) << csv.err;
+  csv = runDpoint({"render", dir.file("p.csv"), "-o", dir.file("p.png"), "--color", "intensity"});
+  EXPECT_EQ(csv.exit_code, 1);
+  EXPECT_NE(csv.err.find("--color intensity: " + dir.file("p.csv") + " has no dimension 'intensity' (it has temperature)"),
+            std::string::npos)
+      << csv.err;
   EXPECT_FALSE(test::fileExists(dir.file("p.png")));
 }
+
 
 // The real-data hard case: one return of simple.las (853 km north, 0.01 m scale) in a window 1 m
 // wide seen from above: float32's 6.25 cm spacing there moves it off its pixel; native does not.

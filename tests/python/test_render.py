@@ -1,6 +1,7 @@
 """dpoint.render and dpoint.Renderer: the picture and the report `dpoint render` gives for the same
 points and options, under the Khronos validation layer (validate=True: any message raises)."""
 import json
+import pathlib
 import threading
 import time
 import warnings
@@ -10,6 +11,8 @@ import pytest
 
 import dpoint
 from conftest import cli, cli_error, options_as_flags
+
+CORPUS = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
 
 # The report's timings and memory, which differ from run to run; every other key must match.
 TIMED = {"gpu_ms", "gpu_ms_each", "frame_ms", "upload_ms", "readback_ms", "e2e_ms", "phases_ms", "peak_rss_mb",
@@ -277,9 +280,34 @@ def test_no_such_device_is_a_device_error(tmp_path, cloud):
 def test_bad_data_for_render(tmp_path, rng):
     with pytest.raises(dpoint.Error, match="--color rgb: the set has no colours"):
         dpoint.render(dpoint.PointSet(rng.random((5, 3))), color="rgb")
-    with pytest.raises(dpoint.Error, match="--color intensity needs LAS input"):
+    with pytest.raises(dpoint.Error, match="--color intensity: points has no dimension 'intensity' \\(it has none"):
         dpoint.render(dpoint.PointSet(rng.random((5, 3))), color="intensity")
     with pytest.raises(dpoint.Error, match="file not found"):
         dpoint.render(tmp_path / "gone.ply")
     with pytest.raises(MemoryError, match="picture"):
         dpoint.render(dpoint.PointSet(rng.random((5, 3))), width=4096, height=4096, max_memory="1M")
+
+
+def _pixels(image, rgb):
+    """How many pixels of an (H, W, 4) uint8 picture have this RGB."""
+    return int(np.all(image[:, :, :3] == np.array(rgb, dtype=np.uint8), axis=2).sum())
+
+
+def test_render_by_any_attribute_draws_its_legend():
+    """render --color NAME (issue #34): a survey by class in the ASPRS colours, by intensity in viridis
+    over its 1st-99th percentile, each with a legend box in the top-right corner; and a set's own
+    attribute made in Python."""
+    survey = CORPUS / "laz" / "autzen_trim.las"
+    by_class = dpoint.render(survey, color="classification", width=600, height=400, shade="none", validate=True)
+    by_intensity = dpoint.render(survey, color="intensity", width=600, height=400, shade="none", validate=True)
+    for picture in (by_class.image, by_intensity.image):
+        corner = picture[:40, 300:]
+        assert _pixels(corner, (0x10, 0x10, 0x10)) > 100  # the legend's dark box
+    assert _pixels(by_class.image, (139, 90, 43)) > 1000  # ground, in points and its swatch
+    assert _pixels(by_class.image, (160, 160, 160)) > 1000  # unclassified
+    assert _pixels(by_intensity.image, (0xfd, 0xe7, 0x25)) > 50  # viridis' top: the brightest 1% and the bar
+    s = dpoint.PointSet(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 1]]))
+    s.set_attribute("temperature", np.array([10.0, 20, 30, 40]))
+    one = dpoint.render(s, color="temperature", width=200, height=150, point_size=15)
+    assert _pixels(one.image, (0x10, 0x10, 0x10)) > 50
+    assert "temperature" in s.attributes and s.colors is None  # the caller's set stays as it was
