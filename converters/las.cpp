@@ -353,14 +353,6 @@ double chooseOffset(const std::vector<glm::dvec3>& positions, int k, double min,
   return fitting.value_or(first);
 }
 
-// Colours leave as round(clamp(c, 0, 1) · full), NaN as 0, where full is 65535 or, for colours
-// read as 8-bit (PointSet::color_full_scale), 255: c · full is exact in double (24 + 16
-// significant bits), so adding 0.5 and truncating rounds half up without a libm call.
-uint16_t colorWord(float c, double full) {
-  if (!(c > 0.0f)) return 0;
-  return static_cast<uint16_t>(std::min(static_cast<double>(c), 1.0) * full + 0.5);
-}
-
 // Distinct positions minus distinct integer triples at this scale and offset: how many points
 // would read back on top of another. Two sorts, 12 + 24 bytes a point for the time of the count.
 uint64_t mergedPoints(const std::vector<glm::dvec3>& positions, const glm::dvec3& scale, const glm::dvec3& offset) {
@@ -585,7 +577,7 @@ class RecordEncoder {
       }
     }
     if (rgb_at_)
-      for (int c = 0; c < 3; ++c) store<uint16_t>(r + rgb_at_ + 2 * c, colorWord(points_.colors[i][c], color_scale_));
+      for (int c = 0; c < 3; ++c) store<uint16_t>(r + rgb_at_ + 2 * c, colorInteger(points_.colors[i][c], color_scale_));
   }
 
   // Points by return number 1..15 (1..5 in formats 0-5), for the header.

@@ -520,6 +520,12 @@ class PlyParser {
       if (!found[role])
         return headerError(vertex->line, "element 'vertex' has no '" + std::string(kNames[role]) + "' property");
     has_colors_ = found[kRed] || found[kGreen] || found[kBlue];
+    // Integer colours keep their width (PointSet::color_full_scale): 16-bit colours stay 16-bit, and
+    // a LAS file's 8-bit ones (its frame in a comment) go back to LAS as 8-bit values; other 8-bit
+    // colours are written to LAS at 16 bits, as the LAS specification asks.
+    if (has_colors_ && divisor_[kRed] == divisor_[kGreen] && divisor_[kGreen] == divisor_[kBlue] &&
+        (divisor_[kRed] == 65535.0f || (divisor_[kRed] == 255.0f && points_.las)))
+      points_.color_full_scale = static_cast<uint16_t>(divisor_[kRed]);
     if (has_colors_ && !(found[kRed] && found[kGreen] && found[kBlue]))
       return headerError(std::max({found[kRed], found[kGreen], found[kBlue]}),
                          "vertex colours need all of red, green and blue");

@@ -16,13 +16,10 @@ namespace {
 
 constexpr size_t kWriteChunk = size_t{1} << 20;
 
-// Colours leave as bytes: lround(clamp(c, 0, 1) * 255), NaN as 0. c * 255 is exact in double (24 + 8
-// significant bits), so adding 0.5 is exact too and truncation rounds half away from zero like
-// lround, without its libm call.
-uint8_t colorByte(float c) {
-  if (!(c > 0.0f)) return 0;
-  return static_cast<uint8_t>(std::min(static_cast<double>(c), 1.0) * 255.0 + 0.5);
-}
+// Colours leave as bytes (colorInteger of 255), or as 16-bit words for colours read so
+// (PointSet::color_full_scale 65535: LAS).
+uint8_t colorByte(float c) { return static_cast<uint8_t>(colorInteger(c, 255.0)); }
+uint16_t colorWord(float c) { return colorInteger(c, 65535.0); }
 
 // Header comments for the facts of the source that the values cannot tell (ply_read.cpp reads
 // them back): a 2D set (its z are 0 but not a coordinate: read from 2D input, or made in memory with
@@ -114,6 +111,8 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   if (!file.ok()) return file.error();
   const bool ascii = options.encoding == PlyEncoding::kAscii;
   const bool float_colors = options.color_type == PlyColorType::kFloat;
+  // Integer colours as wide as they were read: 16-bit LAS colours as ushort, others as uchar.
+  const bool word_colors = !float_colors && points.color_full_scale == 65535;
   const size_t faces = points.triangles.size() / 3;
 
   std::string header = std::string("ply\nformat ") + (ascii ? "ascii" : "binary_little_endian") +
@@ -121,7 +120,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
                        "\nproperty double x\nproperty double y\nproperty double z\n";
   if (points.hasColors())
     for (const char* c : {"red", "green", "blue"})
-      header += std::string("property ") + (float_colors ? "float " : "uchar ") + c + "\n";
+      header += std::string("property ") + (float_colors ? "float " : word_colors ? "ushort " : "uchar ") + c + "\n";
   // Dimensions as properties of their own type; PLY has no 64-bit integers, so those go as double
   // (exact below 2^53).
   for (const Dimension& d : points.dimensions.all()) {
@@ -151,6 +150,8 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
           const char sep = k == 2 && !attributes ? '\n' : ' ';
           if (float_colors)
             appendNumber(out, c[k], sep);
+          else if (word_colors)
+            appendNumber(out, static_cast<unsigned>(colorWord(c[k])), sep);
           else
             appendNumber(out, static_cast<unsigned>(colorByte(c[k])), sep);
         }
@@ -163,6 +164,9 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
         const glm::vec3& c = points.colors[i];
         if (float_colors) {
           out.append(&c, sizeof c);
+        } else if (word_colors) {
+          const uint16_t rgb[3] = {colorWord(c.r), colorWord(c.g), colorWord(c.b)};
+          out.append(rgb, sizeof rgb);
         } else {
           const uint8_t rgb[3] = {colorByte(c.r), colorByte(c.g), colorByte(c.b)};
           out.append(rgb, sizeof rgb);

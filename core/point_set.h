@@ -66,6 +66,14 @@ struct PointSet {
   bool hasZ() const { return z_axis == ZAxis::kUnknown ? !isPlanar() : z_axis == ZAxis::kPresent; }
 };
 
+// A colour channel as an integer of `full` (255, 65535): round(clamp(c, 0, 1) · full), NaN as 0.
+// c · full is exact in double (24 + 16 significant bits), so adding 0.5 and truncating rounds half
+// up without a libm call.
+inline uint16_t colorInteger(float c, double full) {
+  if (!(c > 0.0f)) return 0;
+  return static_cast<uint16_t>((c < 1.0f ? static_cast<double>(c) : 1.0) * full + 0.5);
+}
+
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {
   glm::dvec3 min{0.0}, max{0.0};

@@ -109,6 +109,11 @@ TEST(LasDimensions, lasToPlyToLasKeepsEveryFieldOfEveryCorpusFile) {
       ASSERT_TRUE(back);
       expectSameDimensions(*las, *back, what + " -> LAS");
       EXPECT_EQ(back->positions, las->positions) << what;
+      // The colours as the file stored them (16-bit words, or a file's 8-bit values).
+      EXPECT_EQ(back->colors, las->colors) << what;
+      EXPECT_EQ(back->color_full_scale, las->color_full_scale) << what;
+      // (Not always the same record bytes: PLY has no 64-bit integers, so a uint64 extra byte comes
+      // back as a double of the same value, and ASCII PLY writes every NaN as "nan".)
     }
   }
 }
@@ -141,6 +146,8 @@ TEST(LasDimensions, lasToCsvToLasKeepsEveryFieldOfEveryCorpusFile) {
     ASSERT_TRUE(back);
     expectSameDimensions(*las, *back, what + " -> LAS");
     expectSameLasIntegers(*las, *back, *las->las, what + " -> LAS");
+    // The colours' values (a file's 8-bit colours come back at 16 bits, the same fraction).
+    EXPECT_EQ(back->colors, las->colors) << what;
     // Known dimensions come back in their own types: a class is a byte again.
     for (const Dimension& d : las->dimensions.all()) {
       if (!findKnownDimension(d.name)) continue;
@@ -172,6 +179,7 @@ TEST(LasDimensions, lasToGlbToLasKeepsEveryFieldOfEveryCorpusFile) {
     ASSERT_TRUE(back);
     expectSameDimensions(*las, *back, what + " -> LAS");
     expectSameLasIntegers(*las, *back, *las->las, what + " -> LAS");
+    EXPECT_EQ(back->colors, las->colors) << what;
   }
 }
 
