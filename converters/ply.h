@@ -65,6 +65,10 @@ class PlyVertexStream {
   uint64_t count() const;
   bool hasColors() const;
   uint64_t faceCount() const;  // the header's `face` rows (0 without the element)
+  // The vertex properties that are dimensions, as empty columns (names and types).
+  const Dimensions& dimensions() const;
+  // From now on read() also fills these of dimensions() (by index) into the block; none by default.
+  void streamDimensions(std::vector<size_t> which);
   Status read(uint64_t first, uint64_t n, PointSet& block);
 
  private:

@@ -309,6 +309,10 @@ class PlyParser {
   }
   uint64_t vertexCount() const { return vertex_count_; }
   bool hasColors() const { return has_colors_; }
+  // The vertex properties that are dimensions (empty columns: names and types).
+  const Dimensions& dimensions() const { return points_.dimensions; }
+  // readStream fills these dimensions (indices into dimensions()) of each block too.
+  void streamDimensions(std::vector<size_t> which) { streamed_dimensions_ = std::move(which); }
   uint64_t faceCount() const {
     for (const Element& e : elements_)
       if (e.name == "face") return e.count;
@@ -358,6 +362,26 @@ class PlyParser {
       if (options_.progress) options_.progress->advance(buffer.size());
     });
     if (first_error) return *first_error;
+    // The chosen dimensions, copied as stored (little-endian, as the host) from each row.
+    block.dimensions = Dimensions();
+    for (size_t which : streamed_dimensions_) {
+      const Dimension& like = points_.dimensions.all()[which];
+      Dimension& d = block.dimensions.append(like.name, like.type, static_cast<size_t>(n));
+      const auto at = std::find_if(layout.attributes.begin(), layout.attributes.end(),
+                                   [&](const RowLayout::Attribute& a) { return a.dimension == which; });
+      assert(at != layout.attributes.end());
+      std::vector<char> rows;
+      for (uint64_t from = first; from < first + n; from += block_rows) {
+        const uint64_t to = std::min(from + block_rows, first + n);
+        rows.resize(static_cast<size_t>((to - from) * layout.row_bytes));
+        Result<size_t> got = file_.readAt(stream_begin_ + from * layout.row_bytes, rows.data(), rows.size());
+        if (!got) return got.error();
+        if (*got < rows.size()) return Error{path_ + ": truncated while reading '" + like.name + "'"};
+        for (uint64_t r = from; r < to; ++r)
+          std::memcpy(d.bytes.data() + (r - first) * at->bytes, rows.data() + (r - from) * layout.row_bytes + at->offset,
+                      at->bytes);
+      }
+    }
     return okStatus();
   }
 
@@ -923,6 +947,7 @@ class PlyParser {
   std::vector<double> polygon_;  // indices of the current face (exact in double)
   PointSet points_;
   RowLayout stream_layout_;  // PlyVertexStream
+  std::vector<size_t> streamed_dimensions_;  // PlyVertexStream: the dimensions each block gets
   uint64_t stream_begin_ = 0;
 };
 
@@ -959,6 +984,8 @@ PlyVertexStream::~PlyVertexStream() = default;
 uint64_t PlyVertexStream::count() const { return state_->parser.vertexCount(); }
 bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
 uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
+const Dimensions& PlyVertexStream::dimensions() const { return state_->parser.dimensions(); }
+void PlyVertexStream::streamDimensions(std::vector<size_t> which) { state_->parser.streamDimensions(std::move(which)); }
 Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {
   return state_->parser.readStream(first, n, block);
 }

@@ -104,6 +104,20 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
   return stream;
 }
 
+const Dimensions& PointInputStream::dimensions() const { return parts_.front().ply->dimensions(); }
+
+Status PointInputStream::streamDimension(const std::string& name) {
+  for (const Part& part : parts_) {
+    const std::vector<Dimension>& all = part.ply->dimensions().all();
+    const auto it = std::find_if(all.begin(), all.end(), [&](const Dimension& d) { return d.name == name; });
+    if (it == all.end()) return Error{"dimension '" + name + "' is not in every file streamed", ExitCode::kUsage};
+    part.ply->streamDimensions({static_cast<size_t>(it - all.begin())});
+    if (!streamed_) streamed_.emplace(name, it->type);
+    else if (streamed_->type != it->type) streamed_->type = DimType::kF64;
+  }
+  return okStatus();
+}
+
 Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   assert(first <= count_ && n <= count_ - first);
   if (parts_.size() == 1) {  // straight into the block
@@ -114,6 +128,8 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   block.triangles.clear();
   block.positions.resize(static_cast<size_t>(n));
   block.colors.resize(has_colors_ ? static_cast<size_t>(n) : 0);
+  block.dimensions = Dimensions();
+  Dimension* streamed = streamed_ ? &block.dimensions.append(streamed_->name, streamed_->type, n) : nullptr;
   const uint64_t end = first + n;
   for (Part& part : parts_) {
     const uint64_t from = std::max(first, part.first), to = std::min(end, part.first + part.count);
@@ -121,6 +137,10 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     if (Status s = part.ply->read(from - part.first, to - from, scratch_); !s) return s;
     const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
+    if (streamed) {
+      const Dimension& d = scratch_.dimensions.all().front();
+      for (size_t i = 0; i < scratch_.size(); ++i) streamed->setValue(static_cast<size_t>(at) + i, d.value(i));
+    }
     if (!has_colors_) continue;
     if (scratch_.hasColors()) std::copy(scratch_.colors.begin(), scratch_.colors.end(), block.colors.begin() + at);
     else std::fill_n(block.colors.begin() + at, scratch_.size(), glm::vec3(1.0f));

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,11 @@ class PointInputStream {
   // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
   // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
   uint64_t faceCount() const { return faces_; }
+  // The first file's dimensions (PLY vertex properties), as empty columns.
+  const Dimensions& dimensions() const;
+  // From now on read() also gives each block dimension `name` (float64 where the files' types
+  // differ). Every file must have it: else an error naming the file (kUsage).
+  Status streamDimension(const std::string& name);
   // Points [first, first + n) into `block` (resized to n).
   Status read(uint64_t first, uint64_t n, PointSet& block);
 
@@ -48,6 +54,7 @@ class PointInputStream {
   std::vector<Part> parts_;  // in stream order
   uint64_t count_ = 0, faces_ = 0;
   bool has_colors_ = false;
+  std::optional<Dimension> streamed_;  // streamDimension's name and type, no values
   PointSet scratch_;
 };
 

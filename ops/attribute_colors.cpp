@@ -15,19 +15,6 @@ std::string numberText(double v) {
   return text;
 }
 
-// The distinct values of the sample, ascending; empty when there are more than `limit`.
-std::vector<double> distinctValues(const std::vector<double>& values, size_t limit) {
-  std::vector<double> found;
-  for (double v : values) {
-    if (std::isnan(v)) continue;
-    const auto at = std::lower_bound(found.begin(), found.end(), v);
-    if (at != found.end() && *at == v) continue;
-    if (found.size() == limit) return {};
-    found.insert(at, v);
-  }
-  return found;
-}
-
 }  // namespace
 
 uint32_t AttributeColoring::colorOf(double value) const {
@@ -43,24 +30,42 @@ uint32_t AttributeColoring::colorOf(double value) const {
   return viridis((value - low) / (high - low));
 }
 
-AttributeColoring planAttributeColoring(const std::string& name, DimType type, std::vector<double> sample,
-                                        uint64_t points) {
-  AttributeColoring plan;
-  plan.name = name;
-  plan.points = points;
-  if (name == dim::kClassification) {
+AttributeSampler::AttributeSampler(std::string name, DimType type, uint64_t points)
+    : stride_(std::max<uint64_t>(1, points / kPercentileSamples)) {
+  plan_.name = std::move(name);
+  plan_.points = points;
+  limit_ = plan_.name == dim::kClassification ? 256 : dimTypeIsFloat(type) ? 0 : kMaxCategories;
+}
+
+void AttributeSampler::add(const Dimension& piece) {
+  for (size_t i = 0; i < piece.size(); ++i, ++seen_) {
+    const double v = piece.value(i);
+    if (seen_ % stride_ == 0) sample_.push_back(v);
+    if (overflow_ || limit_ == 0 || std::isnan(v)) continue;
+    const auto at = std::lower_bound(distinct_.begin(), distinct_.end(), v);
+    if (at != distinct_.end() && *at == v) continue;
+    if (distinct_.size() == limit_) {
+      overflow_ = true;
+      distinct_.clear();
+      continue;
+    }
+    distinct_.insert(at, v);
+  }
+}
+
+AttributeColoring AttributeSampler::finish() {
+  AttributeColoring plan = std::move(plan_);
+  if (plan.name == dim::kClassification) {  // a class value is a byte: never more than 256
     plan.kind = AttributeColoring::Kind::kClasses;
-    plan.values = distinctValues(sample, 256);
+    plan.values = std::move(distinct_);
     return plan;
   }
-  if (!dimTypeIsFloat(type)) {
-    std::vector<double> distinct = distinctValues(sample, kMaxCategories);
-    if (!distinct.empty()) {
-      plan.kind = AttributeColoring::Kind::kCategories;
-      plan.values = std::move(distinct);
-      return plan;
-    }
+  if (limit_ > 0 && !overflow_ && !distinct_.empty()) {
+    plan.kind = AttributeColoring::Kind::kCategories;
+    plan.values = std::move(distinct_);
+    return plan;
   }
+  std::vector<double>& sample = sample_;
   sample.erase(std::remove_if(sample.begin(), sample.end(), [](double v) { return std::isnan(v); }), sample.end());
   plan.kind = AttributeColoring::Kind::kRamp;
   if (sample.empty()) return plan;
@@ -79,27 +84,10 @@ AttributeColoring planAttributeColoring(const std::string& name, DimType type, s
   return plan;
 }
 
-AttributeColoring planAttributeColoring(const Dimension& d, unsigned threads) {
-  const size_t n = d.size();
-  // Categories need every value; a ramp's percentiles a strided sample.
-  const bool whole = d.name == dim::kClassification || !dimTypeIsFloat(d.type);
-  const size_t stride = whole ? 1 : std::max<size_t>(1, n / kPercentileSamples);
-  std::vector<double> sample((n + stride - 1) / stride);
-  constexpr size_t kBlock = size_t{1} << 16;
-  parallelFor((sample.size() + kBlock - 1) / kBlock, threads, [&](size_t b, unsigned) {
-    for (size_t k = b * kBlock; k < std::min(sample.size(), (b + 1) * kBlock); ++k) sample[k] = d.value(k * stride);
-  });
-  if (whole && d.name != dim::kClassification) {
-    // Many distinct integers: a ramp from a strided sample, as for floats.
-    std::vector<double> distinct = distinctValues(sample, kMaxCategories);
-    if (distinct.empty() && n > kPercentileSamples) {
-      const size_t s = n / kPercentileSamples;
-      std::vector<double> strided;
-      for (size_t i = 0; i < n; i += s) strided.push_back(sample[i]);
-      sample = std::move(strided);
-    }
-  }
-  return planAttributeColoring(d.name, d.type, std::move(sample), n);
+AttributeColoring planAttributeColoring(const Dimension& d) {
+  AttributeSampler sampler(d.name, d.type, d.size());
+  sampler.add(d);
+  return sampler.finish();
 }
 
 void colorByAttribute(const Dimension& d, size_t first, size_t count, const AttributeColoring& plan, glm::vec3* colors,

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -32,12 +33,27 @@ struct AttributeColoring {
   uint32_t colorOf(double value) const;  // packRgb
 };
 
+// Makes the plan from a column seen in consecutive pieces (a streamed set's blocks, or one whole
+// column): every value for the categories (up to their limit), a strided sample for the ramp.
+class AttributeSampler {
+ public:
+  // `points`: the column's length, which sets the sample's stride.
+  AttributeSampler(std::string name, DimType type, uint64_t points);
+  // The next values of the column, in order.
+  void add(const Dimension& piece);
+  AttributeColoring finish();
+
+ private:
+  AttributeColoring plan_;
+  size_t limit_;                 // categories at most (256 for classes); 0: not categories
+  bool overflow_ = false;        // more distinct values than limit_
+  std::vector<double> distinct_;  // ascending
+  uint64_t stride_, seen_ = 0;
+  std::vector<double> sample_;
+};
+
 // The plan for a whole column (its NaN ignored; a column of NaN only ramps over [0, 1]).
-AttributeColoring planAttributeColoring(const Dimension& d, unsigned threads = 0);
-// The same from a sample of a column's values (a streamed set): distinct values are those of the
-// sample, which a caller that saw every value passes whole.
-AttributeColoring planAttributeColoring(const std::string& name, DimType type, std::vector<double> sample,
-                                        uint64_t points);
+AttributeColoring planAttributeColoring(const Dimension& d);
 
 // colors[i] = the plan's colour of d's value at first + i, for count points (linear 0..1 bytes / 255,
 // as colorByElevation writes them).

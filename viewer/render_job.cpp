@@ -156,10 +156,8 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (!opened) return opened.error();
   set.stream = std::move(*opened);
   PointInputStream* ply = set.stream.get();
-  if (ply && request.color == RenderColor::kAttribute)
-    return Error{inputs + ": --color " + request.color_attribute + ": a streamed set (" + std::to_string(ply->count()) +
-                     " points) is coloured by elevation or its own colours; a dimension needs it in memory (--stream off)",
-                 ExitCode::kUsage};
+  if (ply && request.color == RenderColor::kAttribute && !ply->dimensions().find(request.color_attribute))
+    return noSuchAttribute(inputs, request.color_attribute, ply->dimensions());
   if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
     return Error{inputs + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
                  "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
@@ -171,6 +169,17 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
     if (Status s = streamOutlineAndSpacing(request, inputs, *ply, sampler.finish(), set, progress); !s) return s.error();
     phases.mark("bounds");
+    if (request.color == RenderColor::kAttribute) {  // one more pass: the dimension's classes or percentiles
+      const std::string& name = request.color_attribute;
+      if (Status s = ply->streamDimension(name); !s) return Error{inputs + ": --color " + name + ": " + s.error().message, ExitCode::kUsage};
+      AttributeSampler values(name, ply->dimensions().find(name)->type, ply->count());
+      Status s = forEachBlock(*ply, progress, "values of " + name + " in " + inputs + " (points)",
+                              [&](const PointSet& block) { values.add(block.dimensions.all().front()); });
+      if (!s) return s.error();
+      set.coloring = values.finish();
+      set.has_colors = true;
+      phases.mark("colour");
+    }
     return set;
   }
   ReadOptions read_options{request.threads, false, &progress, true};
@@ -208,7 +217,7 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   if (request.color == RenderColor::kAttribute && set.points()) {
     const Dimension* d = set.points()->dimensions.find(request.color_attribute);
     if (!d) return noSuchAttribute(inputs, request.color_attribute, set.points()->dimensions);
-    set.coloring = planAttributeColoring(*d, request.threads);
+    set.coloring = planAttributeColoring(*d);
     set.has_colors = true;
   }
   if (set.points()) {
@@ -348,6 +357,11 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
     stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
       if (Status status = set.stream->read(first, n, block); !status) return status;
       if (set.elevation) colorByElevation(block, axis, set.bounds.min[axis], set.bounds.max[axis], request.threads);
+      if (set.coloring) {
+        block.colors.resize(block.size());
+        colorByAttribute(block.dimensions.all().front(), 0, block.size(), *set.coloring, block.colors.data(),
+                         request.threads);
+      }
       progress.advance(n);
       return okStatus();
     };

@@ -293,7 +293,7 @@ def _pixels(image, rgb):
     return int(np.all(image[:, :, :3] == np.array(rgb, dtype=np.uint8), axis=2).sum())
 
 
-def test_render_by_any_attribute_draws_its_legend():
+def test_render_by_any_attribute_draws_its_legend(tmp_path):
     """render --color NAME (issue #34): a survey by class in the ASPRS colours, by intensity in viridis
     over its 1st-99th percentile, each with a legend box in the top-right corner; and a set's own
     attribute made in Python."""
@@ -311,3 +311,11 @@ def test_render_by_any_attribute_draws_its_legend():
     one = dpoint.render(s, color="temperature", width=200, height=150, point_size=15)
     assert _pixels(one.image, (0x10, 0x10, 0x10)) > 50
     assert "temperature" in s.attributes and s.colors is None  # the caller's set stays as it was
+    # Streamed (a binary PLY read a block at a time): the same classes and legend.
+    dpoint.write(dpoint.read(survey), tmp_path / "survey.ply")
+    streamed = dpoint.render(tmp_path / "survey.ply", color="classification", stream="on", width=600, height=400,
+                             shade="none", validate=True)
+    assert _pixels(streamed.image[:40, 300:], (0x10, 0x10, 0x10)) > 100
+    assert _pixels(streamed.image, (139, 90, 43)) > 1000
+    with pytest.raises(dpoint.Error, match="--color nope: .*survey.ply has no dimension 'nope' \\(it has intensity, "):
+        dpoint.render(tmp_path / "survey.ply", color="nope", stream="on")
