@@ -29,10 +29,23 @@ CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed) 
   std::string list;
   for (size_t i = 0; i < allowed.size(); ++i)
     list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
-  return check([flag, allowed = std::move(allowed), list](const std::string& value) {
-    if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return std::string();
-    return flag + " must be " + list + ", got '" + value + "'" + didYouMean(value, allowed);
-  });
+  const auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  return CLI::Validator(
+      [flag, allowed = std::move(allowed), list, lower](std::string& value) -> std::string {
+        if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return std::string();
+        // Another case of exactly one choice is that choice (EDL, Z).
+        const std::string folded = lower(value);
+        const auto same = [&](const std::string& a) { return lower(a) == folded; };
+        if (std::count_if(allowed.begin(), allowed.end(), same) == 1) {
+          value = *std::find_if(allowed.begin(), allowed.end(), same);
+          return std::string();
+        }
+        throw UsageError(flag + " " + value + ": must be " + list + didYouMean(value, allowed));
+      },
+      "");
 }
 
 CLI::Option* addChoiceOption(CLI::App& command, const std::string& flag, std::string& value, const std::string& help,
@@ -48,7 +61,7 @@ CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open
     double v = 0.0;
     if (!CLI::detail::lexical_cast(value, v)) return std::string();  // CLI11's conversion error follows
     if ((open_low ? v > lo : v >= lo) && v <= hi) return std::string();
-    return flag + " must be in " + range + ", got " + formatNumber(v, true);
+    return flag + " " + formatNumber(v) + ": must be in " + range;
   });
 }
 

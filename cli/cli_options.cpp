@@ -15,7 +15,7 @@ Status parseOptions(CLI::App& dpoint, const std::string& command, const std::vec
   } catch (const CLI::ParseError& e) {  // as the executable reports it (cli_run.cpp)
     if (std::optional<std::string> unknown = unknownOptionMessage(dpoint, argc, argv.data()))
       return Error{*unknown, ExitCode::kUsage};
-    return Error{e.what(), ExitCode::kUsage};
+    return Error{usageMessage(e, dpoint, argc, argv.data()), ExitCode::kUsage};
   }
   return okStatus();
 }

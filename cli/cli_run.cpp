@@ -3,9 +3,11 @@
 #include "cli/cli_run.h"
 
 #include <cassert>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <new>
+#include <regex>
 #include <utility>
 
 #include "cli/cli_check.h"
@@ -26,7 +28,23 @@ struct Capture {
 };
 thread_local Capture* t_capture = nullptr;
 
-int runAppUnguarded(int argc, const char* const* argv) {
+// A word that is a whole number in exponent form ("1e6", "2.5e3") as its digits ("1000000"), so
+// that a count takes what a size does; any other word (1e-9, a path, 1e3,0,0) is left as it is.
+// Below 2^53 the digits are the same number for an option of any type.
+std::string wholeNumberWord(const std::string& word) {
+  static const std::regex kExponent(R"(^\+?[0-9]+(\.[0-9]+)?[eE]\+?[0-9]+$)");
+  if (!std::regex_match(word, kExponent)) return word;
+  const double v = std::strtod(word.c_str(), nullptr);
+  if (!(v < 9007199254740992.0) || v != std::floor(v)) return word;
+  return std::to_string(static_cast<uint64_t>(v));
+}
+
+int runAppUnguarded(int argc, const char* const* argv_in) {
+  std::vector<std::string> words(argv_in, argv_in + argc);
+  for (size_t i = 1; i < words.size(); ++i) words[i] = wholeNumberWord(words[i]);
+  std::vector<const char*> argv_words;
+  for (const std::string& w : words) argv_words.push_back(w.c_str());
+  const char* const* argv = argv_words.data();
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
                "CSV, PLY, GLB and LAS, render them offscreen with Vulkan in six precision modes, and inspect the\n"
                "precision a dataset needs.\n"
@@ -63,7 +81,7 @@ int runAppUnguarded(int argc, const char* const* argv) {
       // is required"): it is named with the nearest known one.
       if (std::optional<std::string> unknown = unknownOptionMessage(app, argc, argv))
         return reportError(Error{*unknown, ExitCode::kUsage});
-      if (t_capture) return reportError(Error{e.what(), ExitCode::kUsage});  // what app.exit would print
+      return reportError(Error{usageMessage(e, app, argc, argv), ExitCode::kUsage});
     }
     int code = app.exit(e);  // prints help, version or the usage error
     return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);

@@ -1,5 +1,7 @@
 #include "cli/cli_suggest.h"
 
+#include <regex>
+
 #include <algorithm>
 #include <cctype>
 
@@ -123,6 +125,66 @@ std::optional<std::string> unknownOptionMessage(const CLI::App& app, int argc, c
            "--help` lists them)";
   }
   return std::nullopt;
+}
+
+namespace {
+
+// The (sub)command the words name: "render", "generate menger", or "" for dpoint itself.
+std::string commandPath(const CLI::App& app, int argc, const char* const* argv) {
+  std::string path;
+  const CLI::App* at = &app;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') continue;
+    const CLI::App* next = nullptr;
+    for (const CLI::App* sub : at->get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->get_name() == word) next = sub;
+    if (!next) break;
+    at = next;
+    path += (path.empty() ? "" : " ") + word;
+  }
+  return path;
+}
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ' || s.back() == '.')) s.pop_back();
+  return s;
+}
+
+}  // namespace
+
+std::string usageMessage(const CLI::ParseError& error, const CLI::App& app, int argc, const char* const* argv) {
+  const std::string command = commandPath(app, argc, argv);
+  const std::string help = " (dpoint " + (command.empty() ? std::string() : command + " ") + "--help)";
+  const std::string what = trimmed(error.what());
+  std::smatch m;
+  // IsMember: "--method: voxl not in {exact,voxel}".
+  static const std::regex kNotIn(R"(^(-[-\w]+): (.*) not in \{(.*)\}$)");
+  if (std::regex_match(what, m, kNotIn)) {
+    std::vector<std::string> allowed;
+    std::string list;
+    for (size_t start = 0; start <= m[3].str().size();) {
+      size_t comma = m[3].str().find(',', start);
+      if (comma == std::string::npos) comma = m[3].str().size();
+      allowed.push_back(m[3].str().substr(start, comma - start));
+      start = comma + 1;
+    }
+    for (size_t i = 0; i < allowed.size(); ++i) list += (i == 0 ? "" : ", ") + allowed[i];
+    return m[1].str() + " " + m[2].str() + ": not one of " + list + didYouMean(m[2].str(), allowed) + help;
+  }
+  // Range: "--count: Value 1e6 not in range 1 to 1099511627776".
+  static const std::regex kRange(R"(^(-[-\w]+): Value (.*) not in range (.*) to (.*)$)");
+  if (std::regex_match(what, m, kRange))
+    return m[1].str() + " " + m[2].str() + ": must be a number from " + m[3].str() + " to " + m[4].str() + help;
+  // Conversion: "Could not convert: --width = -100".
+  static const std::regex kConvert(R"(^Could not convert: (-[-\w]+) = (.*)$)");
+  if (std::regex_match(what, m, kConvert))
+    return m[1].str() + " " + m[2].str() + ": not a valid value for " + m[1].str() + help;
+  // Required: "--output is required".
+  static const std::regex kRequired(R"(^(-[-\w]+) is required$)");
+  if (std::regex_match(what, m, kRequired))
+    return (command.empty() ? std::string() : command + ": ") + m[1].str() + " is required" + help;
+  return what;  // dpoint's own validators' messages (cli_check.h) and shapes not known here
 }
 
 }  // namespace dpoint

@@ -32,4 +32,10 @@ std::string missingCommandMessage(const CLI::App& app);
 // mean '--color'? (…)"); none when no such word is found.
 std::optional<std::string> unknownOptionMessage(const CLI::App& app, int argc, const char* const* argv);
 
+// A usage error CLI11 found, in dpoint's voice (issue #36): "--method voxl: not one of exact,
+// voxel; did you mean 'voxel'?", "--count 1e6: must be from 1 to 1099511627776",
+// "--width -100: not a valid value", "render: --output is required", each ending "(dpoint CMD
+// --help)"; any other text (dpoint's own validators', which are in this voice already) as it is.
+std::string usageMessage(const CLI::ParseError& error, const CLI::App& app, int argc, const char* const* argv);
+
 }  // namespace dpoint

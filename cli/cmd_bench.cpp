@@ -240,7 +240,7 @@ int runBenchReport(const BenchReportOptions& o) {
   else if (o.suite == "paper") options.suites = {BenchSuite::kPaper};
   else if (o.suite == "hard") options.suites = {BenchSuite::kHard};
   else if (o.suite == "all") options.suites = {BenchSuite::kPaper, BenchSuite::kHard};
-  else return reportError(Error{"--suite must be ci, paper, hard or all, got '" + o.suite + "'", ExitCode::kUsage});
+  else return reportError(Error{"--suite " + o.suite + ": must be ci, paper, hard or all", ExitCode::kUsage});
   if (o.backend == "raster") options.backends = {Backend::kRaster};
   else if (o.backend == "compute") options.backends = {Backend::kCompute};
   else if (o.backend == "both") options.backends = {Backend::kRaster, Backend::kCompute};

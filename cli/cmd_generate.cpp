@@ -159,8 +159,7 @@ Result<std::optional<int>> parseMaxIter(const std::string& text) {
   const char* end = text.data() + text.size();
   const auto [stop, error] = std::from_chars(text.data(), end, value);
   if (error != std::errc() || stop != end || value < 1)
-    return Error{"--max-iter must be a whole number from 1 to 2147483647, or auto, got '" + text + "'",
-                 ExitCode::kUsage};
+    return Error{"--max-iter " + text + ": must be a whole number from 1 to 2147483647, or auto", ExitCode::kUsage};
   return std::optional<int>(value);
 }
 

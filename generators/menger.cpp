@@ -9,6 +9,7 @@
 
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -159,7 +160,7 @@ Status validate(const MengerParams& params) {
                      std::to_string(kMengerMaxLevel) + ")",
                  ExitCode::kUsage};
   if (!(params.size > 0.0) || !std::isfinite(params.size))
-    return Error{"--size " + std::to_string(params.size) + " must be a finite number above 0", ExitCode::kUsage};
+    return Error{"--size " + formatNumber(params.size) + ": must be a finite number above 0", ExitCode::kUsage};
   return okStatus();
 }
 

@@ -298,7 +298,7 @@ void gatherDimension(Dimension& d, const uint32_t* sorted, const std::vector<uin
 Result<PointOrder> parsePointOrder(const std::string& flag, const std::string& text) {
   if (text == "input") return PointOrder::kInput;
   if (text == "morton") return PointOrder::kMorton;
-  return Error{flag + " must be input or morton, got '" + text + "'", ExitCode::kUsage};
+  return Error{flag + " " + text + ": must be input or morton", ExitCode::kUsage};
 }
 
 const char* pointOrderName(PointOrder order) { return order == PointOrder::kMorton ? "morton" : "input"; }

@@ -45,7 +45,8 @@ void addCommands(py::module_& m) {
          const std::string& stream, uint64_t max_memory, bool progress) {
         const CameraRequest camera = take(cameraRequestOf(camera_args));
         if (stream != "auto" && stream != "on" && stream != "off")
-          raise(Error{"--stream: " + stream + " not in {auto,on,off}", ExitCode::kUsage});  // info's CLI11 check
+          raise(Error{"--stream " + stream + ": not one of auto, on, off (dpoint info --help)",
+                      ExitCode::kUsage});  // as the CLI says it (cli_suggest.h usageMessage)
         if (sample < 1 || sample > 100000000)
           raise(Error{"sample: " + std::to_string(sample) + " is not in 1..100000000", ExitCode::kUsage});
         InfoOptions options{camera.spec, sample, camera.tolerance_px, threads};

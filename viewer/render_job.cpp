@@ -437,12 +437,12 @@ Status checkPictureOutput(const std::string& path) {
 
 Status checkModeName(const std::string& mode) {
   if (mode == "auto" || parseMode(mode)) return okStatus();
-  return Error{"--mode must be " + modeOptionChoices() + ", got '" + mode + "'", ExitCode::kUsage};
+  return Error{"--mode " + mode + ": must be " + modeOptionChoices(), ExitCode::kUsage};
 }
 
 Status checkViewCount(uint32_t views) {
   if (views == 1 || views == 4) return okStatus();
-  return Error{"--views must be 1 or 4, got " + std::to_string(views), ExitCode::kUsage};
+  return Error{"--views " + std::to_string(views) + ": must be 1 or 4", ExitCode::kUsage};
 }
 
 Result<WarmupRequest> parseWarmup(const std::string& flag, const std::string& text) {

@@ -56,13 +56,13 @@ TEST(CliHelp, mistypedWordsGetOneLineWithTheNearestKnownOne) {
       {{"generate", "mandlebulb", "-o", dir.file("t.ply")},
        "generate: unknown kind 'mandlebulb'; did you mean 'mandelbulb'? (kinds: mandelbulb, julia"},
       {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--mode", "natve"},
-       "--mode must be auto, fp32, split, rte, df64, native, batch or adaptive, got 'natve'; did you mean 'native'?"},
+       "--mode natve: must be auto, fp32, split, rte, df64, native, batch or adaptive; did you mean 'native'?"},
       {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--colour", "rgb"},
        "render: unknown option '--colour'; did you mean '--color'?"},
       {{"generate", "random2d", "--colour", "none", "-o", dir.file("t.ply")},
        "generate random2d: unknown option '--colour'; did you mean '--colors'?"},
       {{"render", dir.file("one.csv"), "-o", dir.file("t.png"), "--backend", "computee"},
-       "--backend must be auto, raster or compute, got 'computee'; did you mean 'compute'?"},
+       "--backend computee: must be auto, raster or compute; did you mean 'compute'?"},
       {{"--bogus"}, "unknown option '--bogus'"},
       {{"frobnicate"}, "unknown command 'frobnicate' (commands: generate,"},
   };
@@ -167,6 +167,59 @@ TEST(CliHelp, everyListedOutputFormatIsWritten) {
     EXPECT_EQ(r.exit_code, 0) << ext << ": " << r.err;
     EXPECT_TRUE(test::fileExists(dir.file(std::string("p.") + ext))) << ext;
   }
+}
+
+// One voice for usage errors (issue #36 item 2): every bad invocation is one line "dpoint: error:
+// FLAG VALUE: what is accepted", exit 1, nothing written; a closed set's value gets "did you mean"
+// and its other case is taken; a whole number may be written 1e6.
+TEST(CliVoice, badInvocationsSpeakOneVoice) {
+  TempDir dir;
+  test::writeFile(dir.file("one.csv"), "x,y,z\n1,2,3\n");
+  const std::string in = dir.file("one.csv"), png = dir.file("o.png"), ply = dir.file("o.ply");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"generate", "menger", "--method", "voxl", "-o", ply},
+       "--method voxl: not one of exact, voxel; did you mean 'voxel'? (dpoint generate menger --help)"},
+      {{"render", in, "-o", png, "--width", "-100"}, "--width -100: not a valid value for --width (dpoint render --help)"},
+      {{"convert", in}, "convert: --output is required (dpoint convert --help)"},
+      {{"render", in, "-o", png, "--up-axis", "q"}, "--up-axis q: must be auto, y or z"},
+      {{"render", in, "-o", png, "--shade", "edll"}, "--shade edll: must be auto, none or edl; did you mean 'edl'?"},
+      {{"generate", "menger", "--size", "-1", "-o", ply}, "--size -1: must be a finite number above 0"},
+      {{"render", in, "-o", png, "--edl-strength", "500"}, "--edl-strength 500: must be in (0, 100]"},
+      {{"render", in, "-o", png, "--mode", "emulated"}, "--mode emulated: must be auto, fp32, split, rte, df64"},
+      {{"render", in, "-o", png, "--views", "2"}, "--views 2: must be 1 or 4"},
+      {{"render", in, "-o", png, "--order", "hilbert"}, "--order hilbert: must be input or morton"},
+      {{"convert", in, "-o", ply, "--order", "hilbert"}, "--order hilbert: must be input or morton"},
+      {{"bench", "--suite", "nightly"}, "--suite nightly: must be ci, paper, hard or all"},
+      {{"render", in, "-o", png, "--device", "gpu"}, "--device gpu: must be auto, cpu or a device index"},
+      {{"generate", "mandelbrot2d", "--max-iter", "abc", "-o", ply},
+       "--max-iter abc: must be a whole number from 1 to 2147483647, or auto"},
+      {{"convert", in, "-o", ply, "--keep", "intensity"}, "--keep intensity: " + in + " has no dimension 'intensity'"},
+      {{"render", in, "-o", png, "--color", "intensity"}, "--color intensity: " + in + " has no dimension 'intensity'"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args[0] + " " + c.args[1] + " " + c.args[2]);
+    test::CommandResult r = runDpoint(c.args);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_TRUE(contains(r.err, "dpoint: error: " + c.message)) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+  }
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"one.csv"}) << "nothing written";
+}
+
+TEST(CliVoice, closedSetsTakeAnotherCaseAndCountsTakeExponentForm) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"generate", "random2d", "--count", "1e3", "-o", dir.file("r.csv"), "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(std::count(test::readFile(dir.file("r.csv")).begin(), test::readFile(dir.file("r.csv")).end(), '\n'), 1001);
+  r = runDpoint({"generate", "menger", "--method", "VOXEL", "--level", "1", "-o", dir.file("m.ply"), "-q"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  // 1e-3 is not a whole number: a count refuses it.
+  r = runDpoint({"generate", "random2d", "--count", "1e-3", "-o", dir.file("x.csv")});
+  EXPECT_EQ(r.exit_code, 1);
 }
 
 }  // namespace

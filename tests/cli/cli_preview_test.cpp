@@ -143,7 +143,7 @@ TEST(CliPreview, edlStrengthDarkensMoreAsItGrows) {
   }
   const test::CommandResult zero = runDpoint({"render", mb, "-o", dir.file("zero.png"), "--edl-strength", "0"});
   EXPECT_EQ(zero.exit_code, 1);
-  EXPECT_TRUE(test::contains(zero.err, "--edl-strength must be in (0, 100], got 0"));
+  EXPECT_TRUE(test::contains(zero.err, "--edl-strength 0: must be in (0, 100]"));
   EXPECT_FALSE(test::fileExists(dir.file("zero.png")));
 }
 

@@ -113,7 +113,7 @@ def test_write_options_do_what_they_say(tmp_path, source):
     (dict(las_scale=0.0), "las_scale: 0 is not a finite number > 0"),
     (dict(las_scale=-1.0), "las_scale: -1 is not a finite number > 0"),
     (dict(las_scale=float("nan")), "las_scale: nan is not a finite number > 0"),
-    (dict(order="hilbert"), "order must be input or morton, got 'hilbert'"),
+    (dict(order="hilbert"), "order hilbert: must be input or morton"),
     (dict(ply_colors="half"), "ply_colors: 'half' is not uchar or float"),
     (dict(color_format="srgb"), "color_format: 'srgb' is not linear or srgb8"),
     (dict(max_memory="lots"), "max_memory: 'lots' is not a size"),

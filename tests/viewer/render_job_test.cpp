@@ -120,7 +120,7 @@ TEST(RenderJob, upAxisShadingAndRequestChecks) {
   EXPECT_TRUE(checkPictureOutput("/dev/null").ok());
   EXPECT_EQ(checkPictureOutput("a.jpg").error().message, "-o a.jpg: the picture is written as PNG; name it .png");
   EXPECT_EQ(checkModeName("emulated").error().message,
-            "--mode must be auto, fp32, split, rte, df64, native, batch or adaptive, got 'emulated'");
+            "--mode emulated: must be auto, fp32, split, rte, df64, native, batch or adaptive");
   EXPECT_TRUE(checkModeName("auto").ok() && checkModeName("df64").ok());
   RenderRequest sheet;
   sheet.views = 4;
@@ -131,7 +131,7 @@ TEST(RenderJob, upAxisShadingAndRequestChecks) {
   sheet.camera.width = 3;
   EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views 4 needs --width and --height of at least 4 px, got 3x768");
   sheet.views = 2;
-  EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views must be 1 or 4, got 2");
+  EXPECT_EQ(checkRenderRequest(sheet).error().message, "--views 2: must be 1 or 4");
 }
 
 TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
