@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "cli/cli_check.h"
+
 namespace dpoint {
 
 void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options, const std::string& cpu_only_note) {
@@ -22,7 +24,7 @@ void addEscapeCountsOption(CLI::App& command, GenerateDeviceOptions& options) {
                   "How far the classification iterates: capped (just past the level; the points near the surface\n"
                   "are then finished to --max-iter on the CPU), full (every point to --max-iter), auto (full on\n"
                   "a GPU, capped on the CPU and on lavapipe). The output is the same bit for bit")
-      ->check(CLI::IsMember({"auto", "capped", "full"}))
+      ->check(oneOf("--counts", {"auto", "capped", "full"}))
       ->default_val("auto");
 }
 

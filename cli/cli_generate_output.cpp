@@ -35,7 +35,7 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
   CLI::Option* output = cmd.add_option("-o,--output", o.output, pointOutputHelp())->check(checkStatus(checkPointOutput));
   if (!capturingPoints()) output->required();
   cmd.add_option("--colors", o.colors, "Colours: auto (" + auto_colors + "), noise (Perlin pnoise3, as the original study's Python generator coloured its points), none")
-      ->check(CLI::IsMember({"auto", "noise", "none"}))
+      ->check(oneOf("--colors", {"auto", "noise", "none"}))
       ->default_val("auto");
   cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
   cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")

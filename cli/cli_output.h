@@ -10,7 +10,7 @@
 
 namespace dpoint {
 
-// The formats a point set is written as (.gltf is read only, .laz not at all), as help and errors
+// The formats a point set is written as (.gltf and .laz are read only), as help and errors
 // list them.
 inline constexpr const char* kPointOutputFormats = ".csv, .ply, .glb or .las";
 // "Output file (.csv, .ply, .glb, .las); written whole or not at all": the -o help of the commands

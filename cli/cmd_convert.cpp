@@ -84,8 +84,8 @@ int runConvert(ConvertOptions& o) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
-  // LAS → CSV: values at the file's step (849087.70 at 0.01 is "849087.7"), unless --decimals.
-  if (o.decimals < 0 && to_csv && in_format && *in_format == FileFormat::kLas) {
+  // LAS (or LAZ) → CSV: values at the file's step (849087.70 at 0.01 is "849087.7"), unless --decimals.
+  if (o.decimals < 0 && to_csv && in_format && (*in_format == FileFormat::kLas || *in_format == FileFormat::kLaz)) {
     Result<LasHeader> header = readLasHeader(o.input);
     if (!header) return reportError(header.error());
     w.decimals = lasStepDecimals(*header);
@@ -104,8 +104,8 @@ int runConvert(ConvertOptions& o) {
 
 void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply, .glb and .las");
-  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las)")->required();
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply, .glb and .las (and from .laz)");
+  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las, .laz)")->required();
   cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las); written whole or not at all")
       ->required()
       ->check(checkStatus(checkPointOutput));
@@ -115,7 +115,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::Range(0, 100));
   cmd->add_flag("--ply-ascii", o->ply_ascii, "PLY: write ASCII instead of binary little-endian");
   cmd->add_option("--ply-colors", o->ply_colors, "PLY: colour property type")
-      ->check(CLI::IsMember({"uchar", "float"}))
+      ->check(oneOf("--ply-colors", {"uchar", "float"}))
       ->default_val("uchar");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "
@@ -139,7 +139,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--color-format", o->color_format,
                   "linear: colours as read (linear 0..1; glTF primitives without COLOR_0 take their material's "
                   "baseColorFactor); srgb8: each channel sRGB-encoded and rounded to 8 bits, written as k/255")
-      ->check(CLI::IsMember({"linear", "srgb8"}))
+      ->check(oneOf("--color-format", {"linear", "srgb8"}))
       ->default_val("linear");
   cmd->add_option("--max-points", o->max_points,
                   "Refuse (exit 4) input of more than N points, before --unique; glTF and LAS are refused before "

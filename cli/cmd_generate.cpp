@@ -199,7 +199,7 @@ void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double&
       ->check(CLI::PositiveNumber);
   cmd->add_option("--bounds", bounds, "Grid range LO,HI on every axis")->default_val("-1.5,1.5");
   cmd->add_option("--frame", frame, "Coordinates: native (the fractal's own) or seed (grid corner at 0, as the original study's Python generator had it from skimage)")
-      ->check(CLI::IsMember({"native", "seed"}))
+      ->check(oneOf("--frame", {"native", "seed"}))
       ->default_val("native");
   cmd->add_option("--grid-out", grid_out, "Also write the raw escape-count grid (uint8 if max_iter <= 255, else uint16)");
 }
@@ -226,7 +226,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   mandelbulb->add_option("--power", mb->params.power, "Exponent of the Mandelbulb map")->default_val(8);
   mandelbulb->add_option("--variant", mb->variant, "seed: the original study's Python generator's trigonometric escape function, bit for bit; "
                                                    "fast: trig-free power-8 form")
-      ->check(CLI::IsMember({"seed", "fast"}))
+      ->check(oneOf("--variant", {"seed", "fast"}))
       ->default_val("seed");
   addGenerateDeviceOptions(*mandelbulb, mb->device,
                            "--variant seed always runs on the CPU (libm's trigonometry has no bit-exact shader form):\n"
@@ -251,7 +251,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   menger->add_option("--size", me->params.size, "Edge length of the sponge")->default_val(1.0);
   menger->add_option("--method", me->method, "exact: the exposed faces of the lattice cubes; voxel: sampled grid + "
                                              "marching cubes, as the original study's Python generator did")
-      ->check(CLI::IsMember({"exact", "voxel"}))
+      ->check(oneOf("--method", {"exact", "voxel"}))
       ->default_val("exact");
   menger->add_option("--resolution", me->params.resolution, "Voxel method: samples per axis (2..4096)")->default_val(200);
   addOutputOptions(*menger, me->out, "noise");

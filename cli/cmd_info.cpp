@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "cli/cli_camera.h"
+#include "cli/cli_check.h"
 #include "cli/commands.h"
 #include "viewer/info_report.h"
 
@@ -44,7 +45,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "Counts, bounds, whether float32 can hold the data, and each render mode's predicted error in pixels for a\n"
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
   cmd->add_option("input", o->inputs,
-                  "Input files (.csv, .ply, .las, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
+                  "Input files (.csv, .ply, .las, .laz, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
                   "as the whole. Large binary PLY input is streamed (--stream)")
       ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
@@ -59,7 +60,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
                   "larger than memory is described in about 1.2 GB (no float32 merge count, which needs every point\n"
                   "at once, and error bounds from the box of each 4096-point batch); auto: for binary PLY input of\n"
                   "more than 2^26 points")
-      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->check(oneOf("--stream", {"auto", "on", "off"}))
       ->default_val("auto");
   addCommonOptions(*cmd, o->common);
   cmd->callback([o, &run] { run = [o] { return runInfo(*o); }; });

@@ -18,6 +18,7 @@
 #include <glm/common.hpp>
 
 #include "converters/las_fields.h"
+#include "converters/laz_decode.h"
 #include "core/atomic_file.h"
 #include "core/input_file.h"
 #include "core/memory.h"
@@ -106,8 +107,8 @@ Result<LasHeader> parseHeader(const InputFile& file) {
   hd.global_encoding = load<uint16_t>(h + 6);
 
   const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
-  if (raw_format & 0xC0) return lasCompressedError(path);  // LAZ marks its records with bit 7 (old: 6)
-  hd.point_format = raw_format;
+  hd.compressed = (raw_format & 0xC0) != 0;  // LAZ marks its records with bit 7 (old writers: 6)
+  hd.point_format = raw_format & 0x3F;
   if (hd.point_format > 10)
     return Error{path + ": header: point data format " + str(raw_format) + " is not one of LAS's formats 0 to 10"};
   hd.record_length = load<uint16_t>(h + kRecordLengthAt);
@@ -155,7 +156,7 @@ Result<LasHeader> parseHeader(const InputFile& file) {
     return Error{path + ": truncated: the offset to point data " + str(hd.point_offset) + " is past the end of the " +
                  str(file.size()) + "-byte file"};
   const uint64_t available = file.size() - hd.point_offset;
-  if (hd.point_count > available / hd.record_length)
+  if (!hd.compressed && hd.point_count > available / hd.record_length)
     return Error{path + ": truncated: the header declares " + str(hd.point_count) + " points of " +
                  str(hd.record_length) + " bytes from byte " + str(hd.point_offset) + ", but only " + str(available) +
                  " bytes follow (room for " + str(available / hd.record_length) + " points)"};
@@ -650,9 +651,6 @@ bool lasBoundsContain(const LasHeader& header, const Box& points) {
   return true;
 }
 
-Error lasCompressedError(const std::string& path) {
-  return Error{path + ": LAZ (compressed LAS) is not supported; decompress it with laszip or PDAL first"};
-}
 
 Result<LasHeader> readLasHeader(const std::string& path) {
   Result<InputFile> file = InputFile::open(path);
@@ -742,7 +740,21 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
                                 options.max_memory);
       !fits)
     return fits.error();
-  LasReader reader(file, *header, source, options, std::move(*extra));
+  // LAZ: the records decoded (on all cores) into memory after the header and VLRs, and read from
+  // there as from a LAS file.
+  std::string decoded;
+  std::optional<InputFile> records;
+  LasHeader plain = *header;
+  if (header->compressed) {
+    Result<std::string> bytes = decodeLaz(file, options.threads, options.max_memory);
+    if (!bytes) return bytes.error();
+    decoded.resize(header->point_offset);
+    if (Result<size_t> got = file.readAt(0, decoded.data(), decoded.size()); !got) return got.error();
+    decoded += *bytes;
+    records.emplace(InputFile::fromMemory(path, decoded));
+    plain.compressed = false;
+  }
+  LasReader reader(records ? *records : file, plain, source, options, std::move(*extra));
   Result<PointSet> points = reader.run();
   if (!points) return points;
   LasSource las;

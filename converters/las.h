@@ -12,7 +12,8 @@
 // Before anything is allocated the header is checked: signature, version, point format, record
 // length against the format's base size, finite non-zero scales, finite offsets and bounds, and
 // count × record length against the bytes the file holds after the offset. Compressed records
-// (LAZ: point format bit 7 or 6 set) are refused with a message that says how to decompress them.
+// (LAZ: point format bit 7 or 6 set) are decoded first (converters/laz_decode.h: point formats
+// 0–3; others refused by name) into memory after the header and VLRs, then read as a LAS file's.
 // Records are decoded in blocks on all cores, each into its preassigned index, so the result does
 // not depend on the thread count. Memory: the PointSet plus one block per thread.
 //
@@ -82,6 +83,7 @@ struct LasHeader {
   glm::dvec3 min{0.0}, max{0.0};  // the header's bounds as written: finite, not checked against the points
   std::string generating_software;
   uint16_t file_source_id = 0, global_encoding = 0;
+  bool compressed = false;  // LAZ: the records are LASzip-compressed (converters/laz_decode.h)
 };
 
 struct LasReadOptions {
@@ -132,8 +134,6 @@ bool lasBoundsContain(const LasHeader& header, const Box& points);
 // is 849087.7000000001) as long as an ulp of the value stays below half a step (|v| < 2^52 ·
 // step, 4.5e13 at 0.01). `convert` writes LAS → CSV this way unless --decimals asks otherwise.
 int lasStepDecimals(const LasHeader& header);
-// The refusal of compressed LAS, for a .laz name or a header with the LAZ bits set.
-Error lasCompressedError(const std::string& path);
 
 // Bytes of a record of point format 0..10 without extra bytes (20, 28, 26, 34, 57, 63, 30, 36, 38,
 // 59, 67); formats 2, 3, 5, 7, 8 and 10 carry RGB.

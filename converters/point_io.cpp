@@ -66,14 +66,14 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".gltf") return FileFormat::kGltf;
   if (ext == ".las") return FileFormat::kLas;
   if (ext == ".laz") return FileFormat::kLaz;
-  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb, .gltf or .las)", ExitCode::kUsage};
+  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb, .gltf, .las or .laz)", ExitCode::kUsage};
 }
 
 Status checkWrittenFormat(const std::string& path, FileFormat format) {
   if (format == FileFormat::kGltf)
     return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .las)", ExitCode::kUsage};
   if (format == FileFormat::kLaz)
-    return Error{path + ": writing LAZ is not supported; write .las and compress it with laszip or PDAL",
+    return Error{path + ": writing LAZ is not supported yet; write .las (dpoint reads .laz)",
                  ExitCode::kUsage};
   return okStatus();
 }
@@ -95,9 +95,8 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
       return readGltf(path, gltf);
     }
     case FileFormat::kLas:
+    case FileFormat::kLaz:  // the LAS reader decodes LAZ (converters/laz_decode.h)
       return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color, options.max_memory});
-    case FileFormat::kLaz:
-      return lasCompressedError(path);
   }
   return Error{path + ": unreachable format"};
 }

@@ -1,5 +1,5 @@
-// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input), .las (.laz
-// is refused by name), and glTF/GLB to CSV streamed without a PointSet.
+// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input), .las (and
+// .laz input: converters/laz_decode.h), and glTF/GLB to CSV streamed without a PointSet.
 #pragma once
 
 #include <optional>

@@ -45,8 +45,7 @@ void addCommands(py::module_& m) {
          const std::string& stream, uint64_t max_memory, bool progress) {
         const CameraRequest camera = take(cameraRequestOf(camera_args));
         if (stream != "auto" && stream != "on" && stream != "off")
-          raise(Error{"--stream " + stream + ": not one of auto, on, off (dpoint info --help)",
-                      ExitCode::kUsage});  // as the CLI says it (cli_suggest.h usageMessage)
+          raise(Error{"--stream " + stream + ": must be auto, on or off", ExitCode::kUsage});  // as the CLI's oneOf
         if (sample < 1 || sample > 100000000)
           raise(Error{"sample: " + std::to_string(sample) + " is not in 1..100000000", ExitCode::kUsage});
         InfoOptions options{camera.spec, sample, camera.tolerance_px, threads};

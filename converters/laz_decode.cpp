@@ -1,0 +1,792 @@
+// LAZ decoding (converters/laz_decode.h says what and whence): the laszip VLR, the chunk table, the
+// version-2 item decoders and the file-level decode. Only little-endian hosts: fields are copied
+// out of the bytes with memcpy, as in las.cpp.
+#include "converters/laz_decode.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "converters/laz_codec.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+
+namespace dpoint {
+
+static_assert(std::endian::native == std::endian::little, "LAZ fields are little-endian, copied as they are");
+
+namespace {
+
+template <typename T>
+T load(const void* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+template <typename T>
+void store(void* p, T v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+std::string str(uint64_t v) { return std::to_string(v); }
+
+// LASzip's item type names (laszip.hpp), for messages.
+std::string itemName(uint16_t type) {
+  // Types 0..14 as LASzip enumerates them (of the first six only BYTE is ever written).
+  static const char* const kNames[] = {"BYTE", "SHORT", "INT", "LONG", "FLOAT", "DOUBLE", "POINT10", "GPSTIME11",
+                                       "RGB12", "WAVEPACKET13", "POINT14", "RGB14", "RGBNIR14", "WAVEPACKET14",
+                                       "BYTE14"};
+  return type < std::size(kNames) ? kNames[type] : "unknown";
+}
+
+std::string itemList(const std::vector<LazItem>& items) {
+  std::string out;
+  for (const LazItem& item : items) {
+    if (!out.empty()) out += ", ";
+    out += itemName(item.type);
+    if (item.type == kLazByte) {  // appended: GCC 12 warns falsely on "(" + string (bug 105651)
+      out += '(';
+      out += str(item.size);
+      out += ')';
+    }
+  }
+  return out.empty() ? "none" : out;
+}
+
+// --- The laszip VLR --------------------------------------------------------------------------------
+
+constexpr size_t kVlrFixedBytes = 34;  // up to and with the item count
+constexpr size_t kVlrItemBytes = 6;
+constexpr uint16_t kCompressorPointwise = 1, kCompressorChunked = 2, kCompressorLayered = 3;
+
+// The four decoded item types, their sizes (0: any) and the version decoded.
+struct ItemSupport {
+  uint16_t type;
+  uint16_t size;
+};
+constexpr ItemSupport kDecoded[] = {{kLazPoint10, 20}, {kLazGpsTime11, 8}, {kLazRgb12, 6}, {kLazByte, 0}};
+constexpr uint16_t kDecodedVersion = 2;
+
+// --- Item decoders, version 2 ----------------------------------------------------------------------
+//
+// Each starts from the chunk's first (raw) item and then decodes one item per point in place of
+// the last one. A decoder lives for one chunk: LASzip resets every model and state at a chunk's
+// start, which a fresh decoder is.
+
+class ItemDecoder {
+ public:
+  virtual ~ItemDecoder() = default;
+  virtual void decode(LazDecoder& decoder, uint8_t* item) = 0;
+};
+
+// LASzip's StreamingMedian5: not the median of the last five values but a sorted window of five
+// that drops its largest value (in "high" mode) or its smallest (in "low" mode) for each new one,
+// inserted in order; the mode turns to high when the new value falls below the old middle (or
+// equals it, from low). Its middle predicts the next x or y difference. (LASzip writes the same as
+// a tree of branches; this form gives the same window for every sequence.)
+class Median5 {
+ public:
+  int32_t get() const { return v_[2]; }
+  void add(int32_t x) {
+    const bool next_high = x < v_[2] || (!high_ && x == v_[2]);
+    if (!high_) std::copy(v_.begin() + 1, v_.end(), v_.begin());
+    size_t i = 4;
+    for (; i > 0 && v_[i - 1] > x; --i) v_[i] = v_[i - 1];
+    v_[i] = x;
+    high_ = next_high;
+  }
+
+ private:
+  std::array<int32_t, 5> v_{};
+  bool high_ = true;
+};
+
+// Contexts from the return number r and the number of returns n (laszip_common_v2.hpp): kReturnMap
+// [n][r] picks one of 16 histories of x/y differences and intensities, kReturnLevel[n][r] one of
+// 8 heights. Both fill the entries that well-formed files never use (r > n, r or n = 0) too.
+constexpr uint8_t kReturnMap[8][8] = {
+    {15, 14, 13, 12, 11, 10, 9, 8},   {14, 0, 1, 3, 6, 10, 10, 9},    {13, 1, 2, 4, 7, 11, 11, 10},
+    {12, 3, 4, 5, 8, 12, 12, 11},     {11, 6, 7, 8, 9, 13, 13, 12},   {10, 10, 11, 12, 13, 14, 14, 13},
+    {9, 10, 11, 12, 13, 14, 15, 14},  {8, 9, 10, 11, 12, 13, 14, 15}};
+constexpr uint8_t kReturnLevel[8][8] = {
+    {0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 1, 2, 3, 4, 5, 6}, {2, 1, 0, 1, 2, 3, 4, 5}, {3, 2, 1, 0, 1, 2, 3, 4},
+    {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2}, {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
+
+// The 20 bytes formats 0–5 share: x, y, z (i32), intensity (u16), the return byte (return number
+// bits 0–2, number of returns 3–5, scan direction 6, edge of flight line 7), classification,
+// scan angle rank, user data (u8 each), point source ID (u16).
+class Point10Decoder final : public ItemDecoder {
+ public:
+  explicit Point10Decoder(const uint8_t* first) {
+    x_ = load<int32_t>(first);
+    y_ = load<int32_t>(first + 4);
+    z_ = load<int32_t>(first + 8);
+    // intensity_ stays 0: LASzip predicts the second point's intensity from 0, not the first's.
+    returns_ = first[14];
+    classification_ = first[15];
+    scan_angle_ = first[16];
+    user_data_ = first[17];
+    source_id_ = load<uint16_t>(first + 18);
+  }
+
+  void decode(LazDecoder& d, uint8_t* item) override {
+    // Bits 5..0: the return byte, intensity, classification, scan angle, user data and point
+    // source ID changed.
+    const uint32_t changed = d.decodeSymbol(changed_model_);
+    if (changed & 32) returns_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(returns_models_[returns_])));
+    const uint32_t r = returns_ & 7u, n = (returns_ >> 3) & 7u;
+    const uint32_t m = kReturnMap[n][r], l = kReturnLevel[n][r];
+    // LASzip sets the intensity only when some value changed; when none did, the point's return
+    // byte is the last one's, so m is too, and the last intensity is last_intensity_[m] already.
+    if (changed & 16) {
+      last_intensity_[m] = static_cast<uint16_t>(
+          intensity_decoder_.decode(d, last_intensity_[m], m < 3 ? m : 3));
+    }
+    intensity_ = last_intensity_[m];
+    if (changed & 8)
+      classification_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(class_models_[classification_])));
+    if (changed & 4) {
+      const uint32_t delta = d.decodeSymbol(scan_angle_models_[(returns_ >> 6) & 1u]);
+      scan_angle_ = static_cast<uint8_t>(delta + scan_angle_);  // mod 256
+    }
+    if (changed & 2) user_data_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(user_models_[user_data_])));
+    if (changed & 1) source_id_ = static_cast<uint16_t>(source_id_decoder_.decode(d, source_id_));
+
+    // x and y: the difference from the last point, predicted by the median of its history; y's and
+    // z's contexts grow with the magnitude classes (k) of the corrections before them. Sums wrap
+    // as the encoder's 32-bit ones did.
+    const uint32_t single = n == 1 ? 1 : 0;
+    const int32_t dx = dx_decoder_.decode(d, dx_history_[m].get(), single);
+    x_ = static_cast<int32_t>(static_cast<uint32_t>(x_) + static_cast<uint32_t>(dx));
+    dx_history_[m].add(dx);
+    uint32_t k = dx_decoder_.k();
+    const int32_t dy = dy_decoder_.decode(d, dy_history_[m].get(), single + (k < 20 ? k & ~1u : 20));
+    y_ = static_cast<int32_t>(static_cast<uint32_t>(y_) + static_cast<uint32_t>(dy));
+    dy_history_[m].add(dy);
+    k = (dx_decoder_.k() + dy_decoder_.k()) / 2;
+    z_ = z_decoder_.decode(d, last_height_[l], single + (k < 18 ? k & ~1u : 18));
+    last_height_[l] = z_;
+
+    store(item, x_);
+    store(item + 4, y_);
+    store(item + 8, z_);
+    store(item + 12, intensity_);
+    item[14] = returns_;
+    item[15] = classification_;
+    item[16] = scan_angle_;
+    item[17] = user_data_;
+    store(item + 18, source_id_);
+  }
+
+ private:
+  // The return byte, classification and user data are each coded with a model per previous
+  // value, created when first needed (most files use a few of the 256).
+  using LazyModels = std::array<std::unique_ptr<LazSymbolModel>, 256>;
+  static LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& slot) {
+    if (!slot) slot = std::make_unique<LazSymbolModel>(256);
+    return *slot;
+  }
+
+  int32_t x_ = 0, y_ = 0, z_ = 0;
+  uint16_t intensity_ = 0, source_id_ = 0;
+  uint8_t returns_ = 0, classification_ = 0, scan_angle_ = 0, user_data_ = 0;
+  std::array<uint16_t, 16> last_intensity_{};
+  std::array<int32_t, 8> last_height_{};
+  std::array<Median5, 16> dx_history_, dy_history_;
+
+  LazSymbolModel changed_model_{64};
+  LazyModels returns_models_, class_models_, user_models_;
+  std::array<LazSymbolModel, 2> scan_angle_models_{LazSymbolModel(256), LazSymbolModel(256)};  // by scan direction
+  LazIntegerDecoder intensity_decoder_{16, 4};
+  LazIntegerDecoder source_id_decoder_{16, 1};
+  LazIntegerDecoder dx_decoder_{32, 2};
+  LazIntegerDecoder dy_decoder_{32, 22};
+  LazIntegerDecoder z_decoder_{32, 20};
+};
+
+// GPS time (a double) as its 64-bit pattern. Up to four sequences (interleaved flight lines) are
+// followed at once, each with its last time and last integer difference; a point either repeats,
+// steps by a multiple of the last difference (the multiplier a symbol, the remainder an integer),
+// switches to another sequence, or starts a new one with a full 64-bit value.
+class GpsTimeDecoder final : public ItemDecoder {
+ public:
+  explicit GpsTimeDecoder(const uint8_t* first) { time_[0] = load<uint64_t>(first); }
+
+  void decode(LazDecoder& d, uint8_t* item) override {
+    // A switch to another sequence decodes the point again in that one (LASzip recurses). Valid
+    // data switches at most once per point; corrupt data may switch on, but every symbol uses up
+    // some of the code, so the decoder runs past its bytes and the loop ends.
+    while (d.ok()) {
+      if (diff_[last_] == 0) {
+        const uint32_t s = d.decodeSymbol(zero_diff_model_);
+        if (s == 1) {  // a difference that fits 32 bits
+          diff_[last_] = time_decoder_.decode(d, 0, 0);
+          time_[last_] += static_cast<uint64_t>(static_cast<int64_t>(diff_[last_]));
+          extreme_[last_] = 0;
+        } else if (s == 2) {
+          startSequence(d);
+        } else if (s > 2) {
+          last_ = (last_ + s - 2) & 3u;
+          continue;
+        }
+        break;  // s == 0: unchanged
+      }
+      const uint32_t s = d.decodeSymbol(multi_model_);
+      if (s == 1) {
+        time_[last_] += widen(time_decoder_.decode(d, diff_[last_], 1));
+        extreme_[last_] = 0;
+      } else if (s < kUnchanged) {
+        time_[last_] += widen(multipleDifference(d, s));
+      } else if (s == kFull) {
+        startSequence(d);
+      } else if (s > kFull) {
+        last_ = (last_ + s - kFull) & 3u;
+        continue;
+      }
+      break;  // s == kUnchanged
+    }
+    store(item, time_[last_]);
+  }
+
+ private:
+  // Symbols of the multiplier model: 0 (a difference unrelated to the last), 1..499 (that many
+  // times the last), 500 (500 or more times), 501..510 (−1..−10 times, −10 meaning −10 or less),
+  // then unchanged, a new sequence, and switches by 1, 2 and 3 sequences.
+  static constexpr uint32_t kMulti = 500;
+  static constexpr int32_t kMultiMinus = -10;
+  static constexpr uint32_t kUnchanged = kMulti - kMultiMinus + 1;  // 511
+  static constexpr uint32_t kFull = kUnchanged + 1;                 // 512
+  static constexpr uint32_t kMultiSymbols = kFull + 4;              // 516
+
+  static uint64_t widen(int32_t v) { return static_cast<uint64_t>(static_cast<int64_t>(v)); }
+  // multiple · last difference with the encoder's 32-bit wrap-around.
+  int32_t times(int32_t multiple) const {
+    return static_cast<int32_t>(static_cast<uint32_t>(multiple) * static_cast<uint32_t>(diff_[last_]));
+  }
+  // A difference counted among the extreme multipliers (0, ≥ 500, ≤ −10): after four in a row it
+  // becomes the sequence's difference.
+  void countExtreme(int32_t difference) {
+    if (++extreme_[last_] > 3) {
+      diff_[last_] = difference;
+      extreme_[last_] = 0;
+    }
+  }
+
+  int32_t multipleDifference(LazDecoder& d, uint32_t s) {
+    if (s == 0) {
+      const int32_t difference = time_decoder_.decode(d, 0, 7);
+      countExtreme(difference);
+      return difference;
+    }
+    if (s < kMulti) return time_decoder_.decode(d, times(static_cast<int32_t>(s)), s < 10 ? 2 : 3);
+    if (s == kMulti) {
+      const int32_t difference = time_decoder_.decode(d, times(static_cast<int32_t>(kMulti)), 4);
+      countExtreme(difference);
+      return difference;
+    }
+    const int32_t multiple = static_cast<int32_t>(kMulti) - static_cast<int32_t>(s);  // −1..−10
+    if (multiple > kMultiMinus) return time_decoder_.decode(d, times(multiple), 5);
+    const int32_t difference = time_decoder_.decode(d, times(kMultiMinus), 6);
+    countExtreme(difference);
+    return difference;
+  }
+
+  // A new sequence: the high 32 bits predicted by the current sequence's, the low 32 raw.
+  void startSequence(LazDecoder& d) {
+    const int32_t high = time_decoder_.decode(d, static_cast<int32_t>(time_[last_] >> 32), 8);
+    next_ = (next_ + 1) & 3u;
+    time_[next_] = (static_cast<uint64_t>(static_cast<uint32_t>(high)) << 32) | d.readInt();
+    last_ = next_;
+    diff_[last_] = 0;
+    extreme_[last_] = 0;
+  }
+
+  std::array<uint64_t, 4> time_{};
+  std::array<int32_t, 4> diff_{};
+  std::array<int32_t, 4> extreme_{};
+  uint32_t last_ = 0, next_ = 0;
+  LazSymbolModel multi_model_{kMultiSymbols};
+  LazSymbolModel zero_diff_model_{6};  // unchanged, 32-bit difference, new sequence, 3 switches
+  LazIntegerDecoder time_decoder_{32, 9};
+};
+
+// Red, green, blue (u16 each). Which of the six bytes changed is one symbol (bit 6: green and blue
+// differ from red at all); red's bytes are coded against the last red, green's and blue's against
+// the last value moved by red's change (blue's by the mean of red's and green's), clamped to a
+// byte. All byte sums are mod 256.
+class RgbDecoder final : public ItemDecoder {
+ public:
+  explicit RgbDecoder(const uint8_t* first) {
+    for (int c = 0; c < 3; ++c) last_[c] = load<uint16_t>(first + 2 * c);
+  }
+
+  void decode(LazDecoder& d, uint8_t* item) override {
+    const uint32_t used = d.decodeSymbol(used_model_);
+    const int red_lo = (used & 1) ? byteSum(d.decodeSymbol(byte_models_[0]), lo(last_[0])) : lo(last_[0]);
+    const int red_hi = (used & 2) ? byteSum(d.decodeSymbol(byte_models_[1]), hi(last_[0])) : hi(last_[0]);
+    int green_lo = red_lo, green_hi = red_hi, blue_lo = red_lo, blue_hi = red_hi;
+    if (used & 64) {
+      int change = red_lo - lo(last_[0]);
+      green_lo = (used & 4) ? byteSum(d.decodeSymbol(byte_models_[2]), clampByte(change + lo(last_[1])))
+                            : lo(last_[1]);
+      if (used & 16) {
+        change = (change + green_lo - lo(last_[1])) / 2;  // truncated toward zero, as LASzip's
+        blue_lo = byteSum(d.decodeSymbol(byte_models_[4]), clampByte(change + lo(last_[2])));
+      } else {
+        blue_lo = lo(last_[2]);
+      }
+      change = red_hi - hi(last_[0]);
+      green_hi = (used & 8) ? byteSum(d.decodeSymbol(byte_models_[3]), clampByte(change + hi(last_[1])))
+                            : hi(last_[1]);
+      if (used & 32) {
+        change = (change + green_hi - hi(last_[1])) / 2;
+        blue_hi = byteSum(d.decodeSymbol(byte_models_[5]), clampByte(change + hi(last_[2])));
+      } else {
+        blue_hi = hi(last_[2]);
+      }
+    }
+    last_[0] = static_cast<uint16_t>(red_lo | red_hi << 8);
+    last_[1] = static_cast<uint16_t>(green_lo | green_hi << 8);
+    last_[2] = static_cast<uint16_t>(blue_lo | blue_hi << 8);
+    for (int c = 0; c < 3; ++c) store(item + 2 * c, last_[c]);
+  }
+
+ private:
+  static int lo(uint16_t v) { return v & 0xFF; }
+  static int hi(uint16_t v) { return v >> 8; }
+  static int clampByte(int v) { return std::clamp(v, 0, 255); }
+  static int byteSum(uint32_t symbol, int base) {
+    return static_cast<int>((symbol + static_cast<uint32_t>(base)) & 0xFFu);
+  }
+
+  std::array<uint16_t, 3> last_{};
+  LazSymbolModel used_model_{128};
+  std::array<LazSymbolModel, 6> byte_models_{LazSymbolModel(256), LazSymbolModel(256), LazSymbolModel(256),
+                                             LazSymbolModel(256), LazSymbolModel(256), LazSymbolModel(256)};
+};
+
+// Extra bytes: each byte the last one plus a symbol of its own model, mod 256.
+class ByteDecoder final : public ItemDecoder {
+ public:
+  ByteDecoder(const uint8_t* first, size_t size) : last_(first, first + size) {
+    models_.reserve(size);
+    for (size_t i = 0; i < size; ++i) models_.emplace_back(256);
+  }
+
+  void decode(LazDecoder& d, uint8_t* item) override {
+    for (size_t i = 0; i < last_.size(); ++i) {
+      last_[i] = static_cast<uint8_t>(last_[i] + d.decodeSymbol(models_[i]));
+      item[i] = last_[i];
+    }
+  }
+
+ private:
+  std::vector<uint8_t> last_;
+  std::vector<LazSymbolModel> models_;
+};
+
+std::unique_ptr<ItemDecoder> makeItemDecoder(const LazItem& item, const uint8_t* first) {
+  switch (item.type) {
+    case kLazPoint10: return std::make_unique<Point10Decoder>(first);
+    case kLazGpsTime11: return std::make_unique<GpsTimeDecoder>(first);
+    case kLazRgb12: return std::make_unique<RgbDecoder>(first);
+    case kLazByte: return std::make_unique<ByteDecoder>(first, item.size);
+    default: break;
+  }
+  assert(false && "parseLaszipVlr refuses other item types");
+  return nullptr;
+}
+
+}  // namespace
+
+// --- The laszip VLR --------------------------------------------------------------------------------
+
+uint32_t LazInfo::recordLength() const {
+  uint32_t length = 0;
+  for (const LazItem& item : items) length += item.size;
+  return length;
+}
+
+bool LazInfo::variableChunks() const { return chunk_size == kLazVariableChunks; }
+
+Result<LazInfo> parseLaszipVlr(std::string_view data) {
+  const std::string what = "laszip VLR: ";
+  if (data.size() < kVlrFixedBytes)
+    return Error{what + str(data.size()) + " bytes, fewer than the " + str(kVlrFixedBytes) + " of its fixed fields"};
+  const char* p = data.data();
+  LazInfo info;
+  info.compressor = load<uint16_t>(p);
+  info.coder = load<uint16_t>(p + 2);
+  info.major = static_cast<uint8_t>(p[4]);
+  info.minor = static_cast<uint8_t>(p[5]);
+  info.revision = load<uint16_t>(p + 6);
+  info.options = load<uint32_t>(p + 8);
+  info.chunk_size = load<uint32_t>(p + 12);
+  // p + 16, p + 24: the number and offset of special EVLRs (unused by LASzip itself).
+  const uint16_t count = load<uint16_t>(p + 32);
+  const size_t needed = kVlrFixedBytes + kVlrItemBytes * count;
+  if (data.size() < needed)
+    return Error{what + str(data.size()) + " bytes, fewer than the " + str(needed) + " that its " + str(count) +
+                 " items need"};
+  if (info.compressor == kCompressorPointwise)
+    return Error{"LAZ compressor 1 (pointwise, without chunks) is not supported (only 2, pointwise chunked)"};
+  if (info.compressor == kCompressorLayered)
+    return Error{"LAZ compressor 3 (layered chunked, point formats 6 to 10) is not supported (only 2, pointwise "
+                 "chunked)"};
+  if (info.compressor != kCompressorChunked)
+    return Error{what + "compressor " + str(info.compressor) + " is not one of LASzip's (1 to 3)"};
+  if (info.coder != 0)
+    return Error{"LAZ coder " + str(info.coder) + " is not supported (only 0, the arithmetic coder)"};
+  if (info.chunk_size == 0) return Error{what + "chunk size 0"};
+  if (count == 0) return Error{what + "no items"};
+  for (uint16_t i = 0; i < count; ++i) {
+    const char* q = p + kVlrFixedBytes + kVlrItemBytes * i;
+    LazItem item{load<uint16_t>(q), load<uint16_t>(q + 2), load<uint16_t>(q + 4)};
+    const std::string name = "LAZ item type " + str(item.type) + " (" + itemName(item.type) + ")";
+    const ItemSupport* support = nullptr;
+    for (const ItemSupport& s : kDecoded)
+      if (s.type == item.type) support = &s;
+    if (!support || item.version != kDecodedVersion)
+      return Error{name + " version " + str(item.version) +
+                   " is not supported (only version 2 of POINT10, GPSTIME11, RGB12 and BYTE: point formats 0 to 3)"};
+    if (support->size != 0 && item.size != support->size)
+      return Error{what + name + " has size " + str(item.size) + ", not " + str(support->size)};
+    if (item.size == 0) return Error{what + name + " has size 0"};
+    info.items.push_back(item);
+  }
+  return info;
+}
+
+Status checkLazItems(const LazInfo& info, int point_format, uint32_t record_length) {
+  if (point_format < 0 || point_format > 3)
+    return Error{"LAZ point format " + str(static_cast<uint64_t>(point_format)) +
+                 " is not supported (only formats 0 to 3)"};
+  static constexpr uint32_t kBase[4] = {20, 28, 26, 34};
+  const uint32_t base = kBase[point_format];
+  if (record_length < base)
+    return Error{"point record length " + str(record_length) + " is shorter than point format " +
+                 str(static_cast<uint64_t>(point_format)) + "'s " + str(base) + " bytes"};
+  std::vector<LazItem> expected = {{kLazPoint10, 20, kDecodedVersion}};
+  if (point_format == 1 || point_format == 3) expected.push_back({kLazGpsTime11, 8, kDecodedVersion});
+  if (point_format >= 2) expected.push_back({kLazRgb12, 6, kDecodedVersion});
+  if (record_length > base)
+    expected.push_back({kLazByte, static_cast<uint16_t>(record_length - base), kDecodedVersion});
+  bool same = expected.size() == info.items.size();
+  for (size_t i = 0; same && i < expected.size(); ++i)
+    same = expected[i].type == info.items[i].type && expected[i].size == info.items[i].size;
+  if (!same)
+    return Error{"the laszip VLR's items (" + itemList(info.items) + ") do not match point format " +
+                 str(static_cast<uint64_t>(point_format)) + " with " + str(record_length) + "-byte records (" +
+                 itemList(expected) + ")"};
+  return okStatus();
+}
+
+// --- One chunk -------------------------------------------------------------------------------------
+
+Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint64_t points, char* records) {
+  const size_t length = info.recordLength();
+  assert(length > 0);
+  if (points == 0) return Error{"a chunk of 0 points"};
+  if (bytes < length)
+    return Error{"the chunk's " + str(bytes) + " bytes are fewer than its first point's " + str(length) +
+                 " raw bytes"};
+  // The first point raw; the item decoders start from it.
+  std::memcpy(records, data, length);
+  std::vector<std::unique_ptr<ItemDecoder>> decoders;
+  std::vector<size_t> offsets;
+  size_t offset = 0;
+  for (const LazItem& item : info.items) {
+    decoders.push_back(makeItemDecoder(item, reinterpret_cast<const uint8_t*>(records) + offset));
+    offsets.push_back(offset);
+    offset += item.size;
+  }
+  // The code starts after the raw point, even for a chunk of one point (its encoder flushed 4 bytes).
+  LazDecoder decoder(reinterpret_cast<const uint8_t*>(data) + length, bytes - length);
+  const auto failure = [&](uint64_t point) {
+    std::string where = "point " + str(point) + " of " + str(points) + ": ";
+    if (decoder.invalid()) return Error{where + "invalid arithmetic code (corrupt data)"};
+    return Error{where + "the compressed data ends early (the decoder needs " + str(decoder.overrun()) +
+                 " bytes past the chunk's " + str(bytes) + "; truncated or corrupt)"};
+  };
+  if (!decoder.ok()) return failure(0);
+  for (uint64_t p = 1; p < points; ++p) {
+    uint8_t* record = reinterpret_cast<uint8_t*>(records) + p * length;
+    for (size_t i = 0; i < decoders.size(); ++i) decoders[i]->decode(decoder, record + offsets[i]);
+    if (!decoder.ok()) return failure(p);
+  }
+  const size_t left = bytes - length - decoder.consumed();
+  if (left != 0)
+    return Error{str(left) + " of the chunk's " + str(bytes) + " bytes are left over after its " + str(points) +
+                 " points (corrupt chunk or chunk table)"};
+  return okStatus();
+}
+
+// --- The chunk table -------------------------------------------------------------------------------
+
+Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t point_data_offset, const LazInfo& info,
+                                                uint64_t point_count) {
+  const std::string& path = file.path();
+  const uint64_t size = file.size();
+  const auto readExactly = [&](uint64_t at, void* out, size_t n, const std::string& what) -> Status {
+    if (at > size || size - at < n)
+      return Error{path + ": truncated: " + what + " (" + str(n) + " bytes at byte " + str(at) +
+                   ") is past the end of the " + str(size) + "-byte file"};
+    Result<size_t> got = file.readAt(at, out, n);
+    if (!got) return got.error();
+    if (*got != n) return Error{path + ": truncated: " + what + " ends at the file's end"};
+    return okStatus();
+  };
+  int64_t table_at = 0;
+  if (Status s = readExactly(point_data_offset, &table_at, 8, "the chunk table's offset"); !s) return s.error();
+  const uint64_t chunks_at = point_data_offset + 8;
+  if (table_at == -1) {  // written by a writer that could not seek back: at the file's end
+    if (size < chunks_at + 8)
+      return Error{path + ": truncated: no chunk table offset at the end of the " + str(size) + "-byte file"};
+    if (Status s = readExactly(size - 8, &table_at, 8, "the chunk table's offset at the file's end"); !s)
+      return s.error();
+  }
+  if (table_at >= 0 && static_cast<uint64_t>(table_at) == point_data_offset)
+    return Error{path + ": the chunk table is missing (its offset points at itself: the compressor was interrupted)"};
+  if (table_at < 0 || static_cast<uint64_t>(table_at) < chunks_at)
+    return Error{path + ": the chunk table's offset " + std::to_string(table_at) + " lies before the chunks' start " +
+                 str(chunks_at)};
+  const uint64_t table = static_cast<uint64_t>(table_at);
+  if (table > size || size - table < 8)
+    return Error{path + ": truncated: the chunk table's offset " + str(table) + " is past the end of the " + str(size) +
+                 "-byte file"};
+  uint32_t head[2] = {0, 0};
+  if (Status s = readExactly(table, head, 8, "the chunk table"); !s) return s.error();
+  if (head[0] != 0) return Error{path + ": chunk table version " + str(head[0]) + " is not 0"};
+  const uint32_t count = head[1];
+
+  // Bound the count before allocating: every chunk holds at least its raw first point and the 4
+  // bytes an encoder flushes, between the chunks' start and the table.
+  const uint64_t chunk_bytes = table - chunks_at;
+  const uint64_t length = info.recordLength();
+  if (count > chunk_bytes / (length + 4))
+    return Error{path + ": the chunk table lists " + str(count) + " chunks, more than the " + str(chunk_bytes) +
+                 " bytes before it can hold"};
+  if (!info.variableChunks()) {
+    const uint64_t needed = point_count / info.chunk_size + (point_count % info.chunk_size != 0 ? 1 : 0);
+    if (count != needed)
+      return Error{path + ": the chunk table lists " + str(count) + " chunks, but " + str(point_count) +
+                   " points in chunks of " + str(info.chunk_size) + " need " + str(needed)};
+  } else if (count > point_count) {
+    return Error{path + ": the chunk table lists " + str(count) + " chunks for " + str(point_count) + " points"};
+  }
+  std::vector<LazChunk> chunks(count);
+  if (count == 0 && point_count != 0)
+    return Error{path + ": the chunk table lists no chunks for " + str(point_count) + " points"};
+  if (count == 0) return chunks;
+
+  // The coded entries: at most 7 bytes per value (a class symbol, a corrector symbol and 24 raw
+  // bits, each symbol at most ~16 bits with LASzip's count limits) plus the decoder's 4.
+  const uint64_t values = info.variableChunks() ? 2 * uint64_t{count} : count;
+  const uint64_t coded_at = table + 8;
+  std::vector<uint8_t> coded(static_cast<size_t>(std::min<uint64_t>(size - coded_at, 8 * values + 8)));
+  if (Status s = readExactly(coded_at, coded.data(), coded.size(), "the chunk table's entries"); !s) return s.error();
+  LazDecoder decoder(coded.data(), coded.size());
+  LazIntegerDecoder entries(32, 2);
+  uint32_t last_points = 0, last_bytes = 0;
+  uint64_t offset = chunks_at, points_seen = 0;
+  for (uint32_t i = 0; i < count; ++i) {
+    LazChunk& c = chunks[i];
+    if (info.variableChunks()) {
+      last_points = static_cast<uint32_t>(entries.decode(decoder, static_cast<int32_t>(last_points), 0));
+      c.points = last_points;
+    } else {
+      c.points = i + 1 < count ? info.chunk_size : point_count - uint64_t{info.chunk_size} * (count - 1);
+    }
+    last_bytes = static_cast<uint32_t>(entries.decode(decoder, static_cast<int32_t>(last_bytes), 1));
+    c.bytes = last_bytes;
+    c.offset = offset;
+    if (!decoder.ok())
+      return Error{path + ": the chunk table is " + (decoder.invalid() ? "corrupt" : "truncated") + " (at chunk " +
+                   str(i) + " of " + str(count) + ")"};
+    if (c.points == 0) return Error{path + ": the chunk table gives chunk " + str(i) + " 0 points"};
+    if (c.bytes == 0 || c.bytes > table - offset)
+      return Error{path + ": the chunk table gives chunk " + str(i) + " " + str(c.bytes) + " bytes from byte " +
+                   str(offset) + ", past the chunk table at byte " + str(table)};
+    offset += c.bytes;
+    points_seen += c.points;
+  }
+  if (points_seen != point_count)
+    return Error{path + ": the chunk table's chunks hold " + str(points_seen) + " points, the header " +
+                 str(point_count)};
+  return chunks;
+}
+
+// --- The file --------------------------------------------------------------------------------------
+
+namespace {
+
+// Public header block: byte offsets of the fields used here (LAS 1.4 R15, table 3; 1.0–1.3 are
+// prefixes of it).
+constexpr size_t kVersionMajorAt = 24, kVersionMinorAt = 25, kHeaderSizeAt = 94, kPointOffsetAt = 96;
+constexpr size_t kVlrCountAt = 100, kFormatAt = 104, kRecordLengthAt = 105, kLegacyCountAt = 107;
+constexpr size_t kCountAt = 247;  // LAS 1.4: the 64-bit count
+constexpr uint32_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
+constexpr size_t kVlrHeaderBytes = 54;
+constexpr uint16_t kLaszipRecordId = 22204;
+
+struct LazHeader {
+  int point_format = 0;
+  uint32_t record_length = 0;
+  uint64_t point_offset = 0;
+  uint64_t point_count = 0;
+  LazInfo info;
+};
+
+Result<LazHeader> readHeader(const InputFile& file) {
+  const std::string& path = file.path();
+  char h[kHeaderSize14] = {};
+  Result<size_t> got = file.readAt(0, h, sizeof h);
+  if (!got) return got.error();
+  if (*got < 4 || std::memcmp(h, "LASF", 4) != 0)
+    return Error{path + ": not a LAS/LAZ file (it does not start with 'LASF')"};
+  const int major = static_cast<uint8_t>(h[kVersionMajorAt]), minor = static_cast<uint8_t>(h[kVersionMinorAt]);
+  const std::string version = std::to_string(major) + "." + std::to_string(minor);
+  if (major != 1 || minor > 4)
+    return Error{path + ": header: version " + version + " is not supported (LAS 1.0 to 1.4)"};
+  const uint32_t needed = minor >= 4 ? kHeaderSize14 : minor == 3 ? kHeaderSize13 : kHeaderSize12;
+  if (*got < needed)
+    return Error{path + ": truncated header: the file has " + str(file.size()) + " bytes, a LAS " + version +
+                 " header " + str(needed)};
+  const uint16_t header_size = load<uint16_t>(h + kHeaderSizeAt);
+  if (header_size < needed)
+    return Error{path + ": header: header size " + str(header_size) + " is smaller than LAS " + version + "'s " +
+                 str(needed) + " bytes"};
+  LazHeader hd;
+  const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
+  if ((raw_format & 0xC0) == 0)
+    return Error{path + ": not compressed: point data format " + str(raw_format) +
+                 " has neither bit 7 nor bit 6 set (read it as LAS)"};
+  hd.point_format = raw_format & 0x3F;
+  hd.record_length = load<uint16_t>(h + kRecordLengthAt);
+  hd.point_offset = load<uint32_t>(h + kPointOffsetAt);
+  if (hd.point_offset < header_size)
+    return Error{path + ": header: offset to point data " + str(hd.point_offset) + " lies inside the " +
+                 str(header_size) + "-byte header"};
+  const uint32_t legacy = load<uint32_t>(h + kLegacyCountAt);
+  hd.point_count = legacy;
+  if (minor >= 4) {
+    const uint64_t count = load<uint64_t>(h + kCountAt);
+    if (count != 0 && legacy != 0 && count != legacy)
+      return Error{path + ": header: legacy point count " + str(legacy) + " disagrees with the 64-bit count " +
+                   str(count)};
+    if (count != 0) hd.point_count = count;
+  }
+
+  // The VLRs lie between the header and the point data; the laszip one is among them.
+  const uint32_t vlr_count = load<uint32_t>(h + kVlrCountAt);
+  uint64_t at = header_size;
+  std::optional<LazInfo> info;
+  for (uint32_t i = 0; i < vlr_count && !info; ++i) {
+    char v[kVlrHeaderBytes];
+    if (at + kVlrHeaderBytes > hd.point_offset)
+      return Error{path + ": VLR " + str(i) + " at byte " + str(at) + " runs past the offset to point data " +
+                   str(hd.point_offset)};
+    Result<size_t> read = file.readAt(at, v, sizeof v);
+    if (!read) return read.error();
+    if (*read != sizeof v) return Error{path + ": truncated: the file ends in VLR " + str(i)};
+    const uint16_t record_id = load<uint16_t>(v + 18), bytes = load<uint16_t>(v + 20);
+    const uint64_t data_at = at + kVlrHeaderBytes;
+    if (data_at + bytes > hd.point_offset)
+      return Error{path + ": VLR " + str(i) + " (" + str(bytes) + " bytes at byte " + str(data_at) +
+                   ") runs past the offset to point data " + str(hd.point_offset)};
+    // The user ID is 16 bytes, NUL-padded.
+    if (record_id == kLaszipRecordId && std::string_view(v + 2, strnlen(v + 2, 16)) == "laszip encoded") {
+      std::string data(bytes, '\0');
+      Result<size_t> data_read = file.readAt(data_at, data.data(), bytes);
+      if (!data_read) return data_read.error();
+      if (*data_read != bytes) return Error{path + ": truncated: the file ends in the laszip VLR"};
+      Result<LazInfo> parsed = parseLaszipVlr(data);
+      if (!parsed) return Error{path + ": " + parsed.error().message};
+      info = std::move(*parsed);
+    }
+    at = data_at + bytes;
+  }
+  if (!info)
+    return Error{path + ": no laszip VLR (user ID 'laszip encoded', record 22204) among its " + str(vlr_count) +
+                 " VLRs"};
+  hd.info = std::move(*info);
+  if (Status s = checkLazItems(hd.info, hd.point_format, hd.record_length); !s)
+    return Error{path + ": " + s.error().message};
+  return hd;
+}
+
+}  // namespace
+
+Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t max_memory) {
+  const std::string& path = file.path();
+  Result<LazHeader> header = readHeader(file);
+  if (!header) return header.error();
+  const LazHeader& hd = *header;
+  Result<std::vector<LazChunk>> table = readLazChunkTable(file, hd.point_offset, hd.info, hd.point_count);
+  if (!table) return table.error();
+  const std::vector<LazChunk>& chunks = *table;
+
+  // The records and one chunk's bytes per thread.
+  const uint64_t length = hd.record_length;
+  threads = std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(std::max<size_t>(chunks.size(), 1)));
+  uint64_t largest = 0;
+  for (const LazChunk& c : chunks) largest = std::max(largest, c.bytes);
+  if (hd.point_count > (UINT64_MAX - largest * threads) / length)
+    return Error{path + ": " + str(hd.point_count) + " points of " + str(length) + " bytes overflow 64 bits",
+                 ExitCode::kResourceLimit};
+  if (Status s = checkMemory(path + ": decoding " + str(hd.point_count) + " points", hd.point_count * length +
+                             largest * threads, max_memory); !s)
+    return s.error();
+
+  std::string records(static_cast<size_t>(hd.point_count * length), '\0');
+  std::vector<uint64_t> first_point(chunks.size(), 0);
+  for (size_t i = 1; i < chunks.size(); ++i) first_point[i] = first_point[i - 1] + chunks[i - 1].points;
+  // The error reported is the first failing chunk's: chunks are handed out in order, and once one
+  // fails no later one starts, so every earlier one is decoded and its error, if any, wins.
+  std::atomic<size_t> failed{chunks.size()};
+  std::mutex mutex;
+  std::optional<Error> error;
+  std::vector<std::vector<char>> buffers(threads);
+  parallelFor(chunks.size(), threads, [&](size_t i, unsigned worker) {
+    if (i > failed.load()) return;
+    const LazChunk& c = chunks[i];
+    std::vector<char>& buffer = buffers[worker];
+    buffer.resize(static_cast<size_t>(c.bytes));
+    const std::string where = path + ": chunk " + str(i) + " of " + str(chunks.size()) + " (" + str(c.bytes) +
+                              " bytes at byte " + str(c.offset) + ", points " + str(first_point[i]) + " to " +
+                              str(first_point[i] + c.points - 1) + "): ";
+    std::optional<Error> problem;
+    Result<size_t> got = file.readAt(c.offset, buffer.data(), buffer.size());
+    if (!got) {
+      problem = got.error();
+    } else if (*got != buffer.size()) {
+      problem = Error{where + "truncated: the file ends inside the chunk"};
+    } else {
+      Status s = decodeLazChunk(hd.info, buffer.data(), buffer.size(), c.points,
+                                records.data() + first_point[i] * length);
+      if (!s) problem = Error{where + s.error().message};
+    }
+    if (!problem) return;
+    std::lock_guard<std::mutex> lock(mutex);
+    if (i < failed.load()) {
+      failed.store(i);
+      error = std::move(*problem);
+    }
+  });
+  if (error) return *error;
+  return records;
+}
+
+Result<std::string> decodeLazFile(const std::string& path, unsigned threads, uint64_t max_memory) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  return decodeLaz(*file, threads, max_memory);
+}
+
+}  // namespace dpoint

@@ -1,0 +1,111 @@
+// LAZ (LASzip-compressed LAS) decoding: the point records of a .laz file back as the uncompressed
+// LAS records, byte for byte. dpoint's own decoder, written from LASzip's sources
+// (lasreadpoint, lasreaditemcompressed_v2, laszip_common_v2, laszip.cpp's VLR; Apache 2.0) and
+// laz-perf's (readers.cpp, detail/field_*.cpp), on the entropy coder of laz_codec.h.
+//
+// The format, as relied on here:
+// - The LAS header's point data format byte has bit 7 (old writers: bit 6) set; the format is the
+//   byte & 0x3F. Record length and point counts are the uncompressed records'.
+// - A VLR "laszip encoded" / 22204 describes the coding: compressor u16, coder u16, version major
+//   u8, minor u8, revision u16, options u32, chunk size u32 (0xFFFFFFFF: variable), number and
+//   offset of special EVLRs (i64 each), item count u16, then per item type, size, version (u16).
+// - At the offset to point data, an i64: the chunk table's offset (−1: written at the file's last
+//   8 bytes). The chunks follow that i64, back to back. The table: version u32 (0), chunk count
+//   u32, then per chunk its point count (variable chunks only) and byte count, each coded with
+//   an integer decompressor (32 bits, 2 contexts) predicted from the previous chunk's.
+// - A chunk: its first point raw (the items' bytes in order), then an arithmetic code of the other
+//   points, item by item, every model reset at the chunk's start. A fixed chunk size gives every
+//   chunk that many points but the last.
+// - Item decoders, version 2: POINT10 (type 6, 20 bytes: the fields shared by formats 0–5),
+//   GPSTIME11 (7, 8 bytes), RGB12 (8, 6 bytes), BYTE (0, the extra bytes, n bytes).
+//
+// Supported: compressor 2 (pointwise chunked) with the arithmetic coder, item version 2, point
+// formats 0–3 with or without extra bytes, fixed and variable chunks, LAS 1.0–1.4 headers.
+// Refused by name: compressor 1 (unchunked) and 3 (layered, point formats 6–10), other coders,
+// item versions 1 (LASzip 1.x) and 3/4, item types of formats 4–10 (wave packets, POINT14,
+// RGB14, RGBNIR14, BYTE14), items that disagree with the header's format, and a file whose chunk
+// table is missing (its writer was interrupted; LASzip rebuilds such a table, dpoint does not).
+//
+// Hostile input: every length and offset is checked against the file before it is used, a
+// chunk's decoder reads only the chunk's bytes, and a chunk must decode its points with exactly its
+// bytes (LASzip's encoder pads its last bytes so that a decoder ends where the chunk ends), so a
+// truncated or corrupt chunk is an Error naming the chunk and the point, never a crash. A corrupt
+// chunk can still decode to wrong points that pass these checks: LAZ has no checksum.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/input_file.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+// LASzip's item types (only these four are decoded).
+enum LazItemType : uint16_t { kLazByte = 0, kLazPoint10 = 6, kLazGpsTime11 = 7, kLazRgb12 = 8 };
+
+struct LazItem {
+  uint16_t type = 0, size = 0, version = 0;
+};
+
+// The laszip VLR.
+struct LazInfo {
+  uint16_t compressor = 0, coder = 0;
+  uint8_t major = 0, minor = 0;
+  uint16_t revision = 0;
+  uint32_t options = 0;
+  uint32_t chunk_size = 0;  // kLazVariableChunks: each chunk's count is in the chunk table
+  std::vector<LazItem> items;
+
+  // Bytes of one uncompressed record: the sum of the items' sizes.
+  uint32_t recordLength() const;
+  bool variableChunks() const;
+};
+constexpr uint32_t kLazVariableChunks = 0xFFFFFFFFu;
+
+// Parses the laszip VLR's data (without its 54-byte VLR header). Fails, naming what is wrong, on
+// a short or inconsistent record and on anything this decoder does not support (top comment):
+// "LAZ item type 9 (WAVEPACKET13) version 3 is not supported (...)".
+Result<LazInfo> parseLaszipVlr(std::string_view data);
+
+// The items a LAS point format 0–3 with `record_length`-byte records needs (POINT10, GPSTIME11
+// for 1 and 3, RGB12 for 2 and 3, BYTE for extra bytes), compared with `info`'s: an Error saying
+// both lists when they differ.
+Status checkLazItems(const LazInfo& info, int point_format, uint32_t record_length);
+
+struct LazChunk {
+  uint64_t offset = 0;  // in the file
+  uint64_t bytes = 0;
+  uint64_t points = 0;
+};
+
+// Reads the i64 at `point_data_offset` and the chunk table it points to. Checks that the chunks
+// lie between the i64 and the table, that their points add up to `point_count`, and that the
+// table is neither missing, past the file's end nor corrupt. Messages start with the file's path.
+Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t point_data_offset,
+                                                const LazInfo& info, uint64_t point_count);
+
+// Decodes one chunk of `points` (≥ 1) points from [data, data + bytes) into `records`, which holds
+// points × info.recordLength() bytes: the LAS point records. Reads nothing outside the data.
+// Fails when the data ends before the points do, holds an invalid code, or has bytes left over;
+// the message names the point ("point 812 of 50000: ...") but not the file or chunk (the caller's).
+// `info` must have passed parseLaszipVlr.
+Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint64_t points, char* records);
+
+// All point records of a .laz file (LAS 1.0–1.4, point formats 0–3), count × record length bytes,
+// exactly as the uncompressed .las holds them. Parses the LAS header fields it needs (version,
+// header size, offset to point data, VLR count, point format, record length, legacy and 64-bit
+// counts), finds the laszip VLR among the VLRs, reads the chunk table and decodes the chunks on
+// `threads` threads (0: all cores), each into its own place: the result does not depend on the
+// thread count, nor does the error (the first failing chunk's). The records are allocated only
+// after every check, and only within `max_memory` (0: defaultMemoryLimit(); past it an Error with
+// ExitCode::kResourceLimit): LAZ's compression ratio has no bound, so a small file may claim many
+// points.
+Result<std::string> decodeLazFile(const std::string& path, unsigned threads = 0, uint64_t max_memory = 0);
+// The same from an open file (bytes in memory: InputFile::fromMemory).
+Result<std::string> decodeLaz(const InputFile& file, unsigned threads = 0, uint64_t max_memory = 0);
+
+}  // namespace dpoint
