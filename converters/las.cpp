@@ -20,6 +20,7 @@
 #include "converters/las_fields.h"
 #include "converters/laz_decode.h"
 #include "core/atomic_file.h"
+#include "core/bytes.h"
 #include "core/input_file.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -56,18 +57,6 @@ constexpr size_t kWriteBlockPoints = size_t{1} << 15;
 
 constexpr char kAxis[3] = {'x', 'y', 'z'};
 
-template <typename T>
-T load(const char* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-template <typename T>
-void store(char* p, T v) {
-  std::memcpy(p, &v, sizeof v);
-}
-
 std::string num(double v) { return formatNumber(v); }
 std::string str(uint64_t v) { return std::to_string(v); }
 
@@ -98,34 +87,34 @@ Result<LasHeader> parseHeader(const InputFile& file) {
     return Error{path + ": header: version " + version + " is not supported (LAS 1.0 to 1.4)"};
   const uint32_t needed = hd.version_minor >= 4 ? kHeaderSize14 : hd.version_minor == 3 ? kHeaderSize13 : kHeaderSize12;
   if (*got < needed) return truncatedHeader(needed, "a LAS " + version + " header");
-  hd.header_size = load<uint16_t>(h + kHeaderSizeAt);
+  hd.header_size = loadUnaligned<uint16_t>(h + kHeaderSizeAt);
   if (hd.header_size < needed)
     return Error{path + ": header: header size " + str(hd.header_size) + " is smaller than LAS " + version + "'s " +
                  str(needed) + " bytes"};
   hd.generating_software = textField(h + kSoftwareAt, 32);
-  hd.file_source_id = load<uint16_t>(h + 4);
-  hd.global_encoding = load<uint16_t>(h + 6);
+  hd.file_source_id = loadUnaligned<uint16_t>(h + 4);
+  hd.global_encoding = loadUnaligned<uint16_t>(h + 6);
 
   const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
   hd.compressed = (raw_format & 0xC0) != 0;  // LAZ marks its records with bit 7 (old writers: 6)
   hd.point_format = raw_format & 0x3F;
   if (hd.point_format > 10)
     return Error{path + ": header: point data format " + str(raw_format) + " is not one of LAS's formats 0 to 10"};
-  hd.record_length = load<uint16_t>(h + kRecordLengthAt);
+  hd.record_length = loadUnaligned<uint16_t>(h + kRecordLengthAt);
   const uint32_t base = lasBaseRecordLength(hd.point_format);
   if (hd.record_length < base)
     return Error{path + ": header: point record length " + str(hd.record_length) + " is shorter than point format " +
                  str(raw_format) + "'s " + str(base) + " bytes"};
-  hd.point_offset = load<uint32_t>(h + kPointOffsetAt);
-  hd.vlr_count = load<uint32_t>(h + kVlrCountAt);
+  hd.point_offset = loadUnaligned<uint32_t>(h + kPointOffsetAt);
+  hd.vlr_count = loadUnaligned<uint32_t>(h + kVlrCountAt);
   if (hd.point_offset < hd.header_size)
     return Error{path + ": header: offset to point data " + str(hd.point_offset) + " lies inside the " +
                  str(hd.header_size) + "-byte header"};
 
   for (int k = 0; k < 3; ++k) {
     const std::string axis(1, kAxis[k]);
-    const double scale = load<double>(h + kScaleAt + 8 * k), offset = load<double>(h + kOffsetAt + 8 * k);
-    const double max = load<double>(h + kBoundsAt + 16 * k), min = load<double>(h + kBoundsAt + 16 * k + 8);
+    const double scale = loadUnaligned<double>(h + kScaleAt + 8 * k), offset = loadUnaligned<double>(h + kOffsetAt + 8 * k);
+    const double max = loadUnaligned<double>(h + kBoundsAt + 16 * k), min = loadUnaligned<double>(h + kBoundsAt + 16 * k + 8);
     if (!std::isfinite(scale) || scale == 0.0)
       return Error{path + ": header: " + axis + " scale " + num(scale) + " is not a finite, non-zero number"};
     if (!std::isfinite(offset))
@@ -142,11 +131,11 @@ Result<LasHeader> parseHeader(const InputFile& file) {
     hd.max[k] = max;
   }
 
-  const uint32_t legacy = load<uint32_t>(h + kLegacyCountAt);
+  const uint32_t legacy = loadUnaligned<uint32_t>(h + kLegacyCountAt);
   hd.point_count = legacy;
   if (hd.version_minor >= 4) {
-    hd.evlr_count = load<uint32_t>(h + kEvlrCountAt);
-    const uint64_t count = load<uint64_t>(h + kCountAt);
+    hd.evlr_count = loadUnaligned<uint32_t>(h + kEvlrCountAt);
+    const uint64_t count = loadUnaligned<uint64_t>(h + kCountAt);
     if (count != 0 && legacy != 0 && count != legacy)
       return Error{path + ": header: legacy point count " + str(legacy) + " disagrees with the 64-bit count " +
                    str(count)};
@@ -241,20 +230,20 @@ class LasReader {
     for (size_t i = first; i < last; ++i, p += h_.record_length) {
       // X·scale + offset, two roundings, as PDAL, laspy and loaders.gl compute it (no FMA: the
       // project builds with -ffp-contract=off).
-      positions[i] = glm::dvec3(static_cast<double>(load<int32_t>(p)) * scale.x + offset.x,
-                                static_cast<double>(load<int32_t>(p + 4)) * scale.y + offset.y,
-                                static_cast<double>(load<int32_t>(p + 8)) * scale.z + offset.z);
+      positions[i] = glm::dvec3(static_cast<double>(loadUnaligned<int32_t>(p)) * scale.x + offset.x,
+                                static_cast<double>(loadUnaligned<int32_t>(p + 4)) * scale.y + offset.y,
+                                static_cast<double>(loadUnaligned<int32_t>(p + 8)) * scale.z + offset.z);
       decodeFields(p, i);
       switch (source_) {
         case LasColorSource::kRgb: {
-          const uint16_t r = load<uint16_t>(p + rgb_at_), g = load<uint16_t>(p + rgb_at_ + 2),
-                         b = load<uint16_t>(p + rgb_at_ + 4);
+          const uint16_t r = loadUnaligned<uint16_t>(p + rgb_at_), g = loadUnaligned<uint16_t>(p + rgb_at_ + 2),
+                         b = loadUnaligned<uint16_t>(p + rgb_at_ + 4);
           largest = std::max({largest, r, g, b});
           colors[i] = glm::vec3(r, g, b);  // raw for now; normalize() divides
           break;
         }
         case LasColorSource::kIntensity: {
-          const uint16_t v = load<uint16_t>(p + kIntensityAt);
+          const uint16_t v = loadUnaligned<uint16_t>(p + kIntensityAt);
           largest = std::max(largest, v);
           colors[i] = glm::vec3(v);
           break;
@@ -434,33 +423,33 @@ std::string writerHeader(const WriterLayout& l, uint64_t count, const std::array
   const bool v14 = l.version_minor >= 4;
   std::string h(v14 ? kHeaderSize14 : kHeaderSize12, '\0');
   std::memcpy(h.data(), "LASF", 4);
-  store<uint16_t>(h.data() + 4, l.file_source_id);
-  store<uint16_t>(h.data() + 6, l.global_encoding);
+  storeUnaligned<uint16_t>(h.data() + 4, l.file_source_id);
+  storeUnaligned<uint16_t>(h.data() + 6, l.global_encoding);
   h[kVersionMajorAt] = 1;
   h[kVersionMinorAt] = static_cast<char>(l.version_minor);
   std::memcpy(h.data() + kSystemIdAt, "OTHER", 5);
   std::memcpy(h.data() + kSoftwareAt, "dpoint", 6);
-  store<uint16_t>(h.data() + kHeaderSizeAt, static_cast<uint16_t>(h.size()));
-  store<uint32_t>(h.data() + kPointOffsetAt, point_offset);
-  store<uint32_t>(h.data() + kVlrCountAt, static_cast<uint32_t>(l.vlrs.size()));
+  storeUnaligned<uint16_t>(h.data() + kHeaderSizeAt, static_cast<uint16_t>(h.size()));
+  storeUnaligned<uint32_t>(h.data() + kPointOffsetAt, point_offset);
+  storeUnaligned<uint32_t>(h.data() + kVlrCountAt, static_cast<uint32_t>(l.vlrs.size()));
   h[kFormatAt] = static_cast<char>(l.format);
-  store<uint16_t>(h.data() + kRecordLengthAt, static_cast<uint16_t>(l.record_length));
+  storeUnaligned<uint16_t>(h.data() + kRecordLengthAt, static_cast<uint16_t>(l.record_length));
   // The legacy counts: 0 where they cannot hold the truth (formats 6-10, more than 2^32 - 1 points).
   const bool legacy = l.format < 6 && count <= UINT32_MAX;
-  store<uint32_t>(h.data() + kLegacyCountAt, legacy ? static_cast<uint32_t>(count) : 0u);
+  storeUnaligned<uint32_t>(h.data() + kLegacyCountAt, legacy ? static_cast<uint32_t>(count) : 0u);
   for (size_t r = 0; r < 5; ++r)
-    store<uint32_t>(h.data() + kLegacyByReturnAt + 4 * r, legacy ? static_cast<uint32_t>(by_return[r]) : 0u);
+    storeUnaligned<uint32_t>(h.data() + kLegacyByReturnAt + 4 * r, legacy ? static_cast<uint32_t>(by_return[r]) : 0u);
   for (int k = 0; k < 3; ++k) {
-    store<double>(h.data() + kScaleAt + 8 * k, scale[k]);
-    store<double>(h.data() + kOffsetAt + 8 * k, offset[k]);
-    store<double>(h.data() + kBoundsAt + 16 * k, max[k]);
-    store<double>(h.data() + kBoundsAt + 16 * k + 8, min[k]);
+    storeUnaligned<double>(h.data() + kScaleAt + 8 * k, scale[k]);
+    storeUnaligned<double>(h.data() + kOffsetAt + 8 * k, offset[k]);
+    storeUnaligned<double>(h.data() + kBoundsAt + 16 * k, max[k]);
+    storeUnaligned<double>(h.data() + kBoundsAt + 16 * k + 8, min[k]);
   }
   if (v14) {
-    store<uint64_t>(h.data() + kEvlrStartAt, l.evlrs.empty() ? 0 : evlr_start);
-    store<uint32_t>(h.data() + kEvlrCountAt, static_cast<uint32_t>(l.evlrs.size()));
-    store<uint64_t>(h.data() + kCountAt, count);
-    for (size_t r = 0; r < 15; ++r) store<uint64_t>(h.data() + kCountAt + 8 + 8 * r, by_return[r]);
+    storeUnaligned<uint64_t>(h.data() + kEvlrStartAt, l.evlrs.empty() ? 0 : evlr_start);
+    storeUnaligned<uint32_t>(h.data() + kEvlrCountAt, static_cast<uint32_t>(l.evlrs.size()));
+    storeUnaligned<uint64_t>(h.data() + kCountAt, count);
+    for (size_t r = 0; r < 15; ++r) storeUnaligned<uint64_t>(h.data() + kCountAt + 8 + 8 * r, by_return[r]);
   }
   return h;
 }
@@ -469,9 +458,9 @@ std::string writerHeader(const WriterLayout& l, uint64_t count, const std::array
 std::string vlrBytes(const LasVlr& vlr, bool extended) {
   std::string out(extended ? kEvlrHeaderBytes : kVlrHeaderBytes, '\0');
   std::memcpy(out.data() + 2, vlr.user_id.data(), std::min<size_t>(vlr.user_id.size(), 16));
-  store<uint16_t>(out.data() + 18, vlr.record_id);
-  if (extended) store<uint64_t>(out.data() + 20, vlr.data.size());
-  else store<uint16_t>(out.data() + 20, static_cast<uint16_t>(vlr.data.size()));
+  storeUnaligned<uint16_t>(out.data() + 18, vlr.record_id);
+  if (extended) storeUnaligned<uint64_t>(out.data() + 20, vlr.data.size());
+  else storeUnaligned<uint16_t>(out.data() + 20, static_cast<uint16_t>(vlr.data.size()));
   std::memcpy(out.data() + (extended ? 28 : 22), vlr.description.data(), std::min<size_t>(vlr.description.size(), 32));
   return out + vlr.data;
 }
@@ -480,16 +469,16 @@ std::string vlrBytes(const LasVlr& vlr, bool extended) {
 void storeValue(char* p, DimType type, double v) {
   auto whole = [&](double lo, double hi) { return std::isnan(v) ? 0.0 : std::clamp(std::round(v), lo, hi); };
   switch (type) {
-    case DimType::kU8: store<uint8_t>(p, static_cast<uint8_t>(whole(0, 255))); break;
-    case DimType::kI8: store<int8_t>(p, static_cast<int8_t>(whole(-128, 127))); break;
-    case DimType::kU16: store<uint16_t>(p, static_cast<uint16_t>(whole(0, 65535))); break;
-    case DimType::kI16: store<int16_t>(p, static_cast<int16_t>(whole(-32768, 32767))); break;
-    case DimType::kU32: store<uint32_t>(p, static_cast<uint32_t>(whole(0, 4294967295.0))); break;
-    case DimType::kI32: store<int32_t>(p, static_cast<int32_t>(whole(-2147483648.0, 2147483647.0))); break;
-    case DimType::kU64: store<uint64_t>(p, static_cast<uint64_t>(whole(0, 18446744073709549568.0))); break;
-    case DimType::kI64: store<int64_t>(p, static_cast<int64_t>(whole(-9223372036854775808.0, 9223372036854774784.0))); break;
-    case DimType::kF32: store<float>(p, static_cast<float>(v)); break;
-    case DimType::kF64: store<double>(p, v); break;
+    case DimType::kU8: storeUnaligned<uint8_t>(p, static_cast<uint8_t>(whole(0, 255))); break;
+    case DimType::kI8: storeUnaligned<int8_t>(p, static_cast<int8_t>(whole(-128, 127))); break;
+    case DimType::kU16: storeUnaligned<uint16_t>(p, static_cast<uint16_t>(whole(0, 65535))); break;
+    case DimType::kI16: storeUnaligned<int16_t>(p, static_cast<int16_t>(whole(-32768, 32767))); break;
+    case DimType::kU32: storeUnaligned<uint32_t>(p, static_cast<uint32_t>(whole(0, 4294967295.0))); break;
+    case DimType::kI32: storeUnaligned<int32_t>(p, static_cast<int32_t>(whole(-2147483648.0, 2147483647.0))); break;
+    case DimType::kU64: storeUnaligned<uint64_t>(p, static_cast<uint64_t>(whole(0, 18446744073709549568.0))); break;
+    case DimType::kI64: storeUnaligned<int64_t>(p, static_cast<int64_t>(whole(-9223372036854775808.0, 9223372036854774784.0))); break;
+    case DimType::kF32: storeUnaligned<float>(p, static_cast<float>(v)); break;
+    case DimType::kF64: storeUnaligned<double>(p, v); break;
   }
 }
 
@@ -559,7 +548,7 @@ class RecordEncoder {
 
   void encode(size_t i, char* r) const {
     const glm::dvec3& p = points_.positions[i];
-    for (int k = 0; k < 3; ++k) store<int32_t>(r + 4 * k, static_cast<int32_t>(quantize(p[k], offset_[k], scale_[k])));
+    for (int k = 0; k < 3; ++k) storeUnaligned<int32_t>(r + 4 * k, static_cast<int32_t>(quantize(p[k], offset_[k], scale_[k])));
     for (const Slot& s : slots_) {
       if (s.bits) {
         const uint32_t v = s.source ? static_cast<uint32_t>(std::clamp(s.source->value(i), 0.0, 255.0)) : s.missing;
@@ -578,7 +567,7 @@ class RecordEncoder {
       }
     }
     if (rgb_at_)
-      for (int c = 0; c < 3; ++c) store<uint16_t>(r + rgb_at_ + 2 * c, colorInteger(points_.colors[i][c], color_scale_));
+      for (int c = 0; c < 3; ++c) storeUnaligned<uint16_t>(r + rgb_at_ + 2 * c, colorInteger(points_.colors[i][c], color_scale_));
   }
 
   // Points by return number 1..15 (1..5 in formats 0-5), for the header.
@@ -676,8 +665,8 @@ std::vector<LasVlr> readVlrs(const InputFile& file, const LasHeader& h) {
     char v[kVlrHeaderBytes];
     Result<size_t> got = file.readAt(at, v, sizeof v);
     if (!got || *got < sizeof v) break;
-    LasVlr vlr{textField(v + 2, 16), load<uint16_t>(v + 18), textField(v + 22, 32), {}, false};
-    const uint16_t length = load<uint16_t>(v + 20);
+    LasVlr vlr{textField(v + 2, 16), loadUnaligned<uint16_t>(v + 18), textField(v + 22, 32), {}, false};
+    const uint16_t length = loadUnaligned<uint16_t>(v + 20);
     if (at + kVlrHeaderBytes + length > h.point_offset) break;
     vlr.data.resize(length);
     got = file.readAt(at + kVlrHeaderBytes, vlr.data.data(), length);
@@ -689,15 +678,15 @@ std::vector<LasVlr> readVlrs(const InputFile& file, const LasHeader& h) {
   char start[8];
   Result<size_t> got = file.readAt(kEvlrStartAt, start, sizeof start);
   if (!got || *got < sizeof start) return out;
-  at = load<uint64_t>(start);
+  at = loadUnaligned<uint64_t>(start);
   for (uint32_t k = 0; k < h.evlr_count && at >= h.point_offset && file.size() >= kEvlrHeaderBytes &&
                       at <= file.size() - kEvlrHeaderBytes;
        ++k) {
     char v[kEvlrHeaderBytes];
     got = file.readAt(at, v, sizeof v);
     if (!got || *got < sizeof v) break;
-    LasVlr vlr{textField(v + 2, 16), load<uint16_t>(v + 18), textField(v + 28, 32), {}, true};
-    const uint64_t length = load<uint64_t>(v + 20);
+    LasVlr vlr{textField(v + 2, 16), loadUnaligned<uint16_t>(v + 18), textField(v + 28, 32), {}, true};
+    const uint64_t length = loadUnaligned<uint64_t>(v + 20);
     if (length > file.size() - at - kEvlrHeaderBytes || length > (uint64_t{1} << 30)) break;
     vlr.data.resize(static_cast<size_t>(length));
     got = file.readAt(at + kEvlrHeaderBytes, vlr.data.data(), vlr.data.size());

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "converters/laz_codec.h"
+#include "core/bytes.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 
@@ -21,18 +22,6 @@ namespace dpoint {
 static_assert(std::endian::native == std::endian::little, "LAZ fields are little-endian, copied as they are");
 
 namespace {
-
-template <typename T>
-T load(const void* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-template <typename T>
-void store(void* p, T v) {
-  std::memcpy(p, &v, sizeof v);
-}
 
 std::string str(uint64_t v) { return std::to_string(v); }
 
@@ -124,15 +113,15 @@ constexpr uint8_t kReturnLevel[8][8] = {
 class Point10Decoder final : public ItemDecoder {
  public:
   explicit Point10Decoder(const uint8_t* first) {
-    x_ = load<int32_t>(first);
-    y_ = load<int32_t>(first + 4);
-    z_ = load<int32_t>(first + 8);
+    x_ = loadUnaligned<int32_t>(first);
+    y_ = loadUnaligned<int32_t>(first + 4);
+    z_ = loadUnaligned<int32_t>(first + 8);
     // intensity_ stays 0: LASzip predicts the second point's intensity from 0, not the first's.
     returns_ = first[14];
     classification_ = first[15];
     scan_angle_ = first[16];
     user_data_ = first[17];
-    source_id_ = load<uint16_t>(first + 18);
+    source_id_ = loadUnaligned<uint16_t>(first + 18);
   }
 
   void decode(LazDecoder& d, uint8_t* item) override {
@@ -173,15 +162,15 @@ class Point10Decoder final : public ItemDecoder {
     z_ = z_decoder_.decode(d, last_height_[l], single + (k < 18 ? k & ~1u : 18));
     last_height_[l] = z_;
 
-    store(item, x_);
-    store(item + 4, y_);
-    store(item + 8, z_);
-    store(item + 12, intensity_);
+    storeUnaligned(item, x_);
+    storeUnaligned(item + 4, y_);
+    storeUnaligned(item + 8, z_);
+    storeUnaligned(item + 12, intensity_);
     item[14] = returns_;
     item[15] = classification_;
     item[16] = scan_angle_;
     item[17] = user_data_;
-    store(item + 18, source_id_);
+    storeUnaligned(item + 18, source_id_);
   }
 
  private:
@@ -216,7 +205,7 @@ class Point10Decoder final : public ItemDecoder {
 // switches to another sequence, or starts a new one with a full 64-bit value.
 class GpsTimeDecoder final : public ItemDecoder {
  public:
-  explicit GpsTimeDecoder(const uint8_t* first) { time_[0] = load<uint64_t>(first); }
+  explicit GpsTimeDecoder(const uint8_t* first) { time_[0] = loadUnaligned<uint64_t>(first); }
 
   void decode(LazDecoder& d, uint8_t* item) override {
     // A switch to another sequence decodes the point again in that one (LASzip recurses). Valid
@@ -251,7 +240,7 @@ class GpsTimeDecoder final : public ItemDecoder {
       }
       break;  // s == kUnchanged
     }
-    store(item, time_[last_]);
+    storeUnaligned(item, time_[last_]);
   }
 
  private:
@@ -260,7 +249,7 @@ class GpsTimeDecoder final : public ItemDecoder {
   // then unchanged, a new sequence, and switches by 1, 2 and 3 sequences.
   static constexpr uint32_t kMulti = 500;
   static constexpr int32_t kMultiMinus = -10;
-  static constexpr uint32_t kUnchanged = kMulti - kMultiMinus + 1;  // 511
+  static constexpr uint32_t kUnchanged = kMulti + static_cast<uint32_t>(-kMultiMinus) + 1;  // 511
   static constexpr uint32_t kFull = kUnchanged + 1;                 // 512
   static constexpr uint32_t kMultiSymbols = kFull + 4;              // 516
 
@@ -323,7 +312,7 @@ class GpsTimeDecoder final : public ItemDecoder {
 class RgbDecoder final : public ItemDecoder {
  public:
   explicit RgbDecoder(const uint8_t* first) {
-    for (int c = 0; c < 3; ++c) last_[c] = load<uint16_t>(first + 2 * c);
+    for (size_t c = 0; c < 3; ++c) last_[c] = loadUnaligned<uint16_t>(first + 2 * c);
   }
 
   void decode(LazDecoder& d, uint8_t* item) override {
@@ -354,7 +343,7 @@ class RgbDecoder final : public ItemDecoder {
     last_[0] = static_cast<uint16_t>(red_lo | red_hi << 8);
     last_[1] = static_cast<uint16_t>(green_lo | green_hi << 8);
     last_[2] = static_cast<uint16_t>(blue_lo | blue_hi << 8);
-    for (int c = 0; c < 3; ++c) store(item + 2 * c, last_[c]);
+    for (size_t c = 0; c < 3; ++c) storeUnaligned(item + 2 * c, last_[c]);
   }
 
  private:
@@ -421,15 +410,15 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
     return Error{what + str(data.size()) + " bytes, fewer than the " + str(kVlrFixedBytes) + " of its fixed fields"};
   const char* p = data.data();
   LazInfo info;
-  info.compressor = load<uint16_t>(p);
-  info.coder = load<uint16_t>(p + 2);
+  info.compressor = loadUnaligned<uint16_t>(p);
+  info.coder = loadUnaligned<uint16_t>(p + 2);
   info.major = static_cast<uint8_t>(p[4]);
   info.minor = static_cast<uint8_t>(p[5]);
-  info.revision = load<uint16_t>(p + 6);
-  info.options = load<uint32_t>(p + 8);
-  info.chunk_size = load<uint32_t>(p + 12);
+  info.revision = loadUnaligned<uint16_t>(p + 6);
+  info.options = loadUnaligned<uint32_t>(p + 8);
+  info.chunk_size = loadUnaligned<uint32_t>(p + 12);
   // p + 16, p + 24: the number and offset of special EVLRs (unused by LASzip itself).
-  const uint16_t count = load<uint16_t>(p + 32);
+  const uint16_t count = loadUnaligned<uint16_t>(p + 32);
   const size_t needed = kVlrFixedBytes + kVlrItemBytes * count;
   if (data.size() < needed)
     return Error{what + str(data.size()) + " bytes, fewer than the " + str(needed) + " that its " + str(count) +
@@ -447,7 +436,7 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
   if (count == 0) return Error{what + "no items"};
   for (uint16_t i = 0; i < count; ++i) {
     const char* q = p + kVlrFixedBytes + kVlrItemBytes * i;
-    LazItem item{load<uint16_t>(q), load<uint16_t>(q + 2), load<uint16_t>(q + 4)};
+    LazItem item{loadUnaligned<uint16_t>(q), loadUnaligned<uint16_t>(q + 2), loadUnaligned<uint16_t>(q + 4)};
     const std::string name = "LAZ item type " + str(item.type) + " (" + itemName(item.type) + ")";
     const ItemSupport* support = nullptr;
     for (const ItemSupport& s : kDecoded)
@@ -658,7 +647,7 @@ Result<LazHeader> readHeader(const InputFile& file) {
   if (*got < needed)
     return Error{path + ": truncated header: the file has " + str(file.size()) + " bytes, a LAS " + version +
                  " header " + str(needed)};
-  const uint16_t header_size = load<uint16_t>(h + kHeaderSizeAt);
+  const uint16_t header_size = loadUnaligned<uint16_t>(h + kHeaderSizeAt);
   if (header_size < needed)
     return Error{path + ": header: header size " + str(header_size) + " is smaller than LAS " + version + "'s " +
                  str(needed) + " bytes"};
@@ -668,15 +657,15 @@ Result<LazHeader> readHeader(const InputFile& file) {
     return Error{path + ": not compressed: point data format " + str(raw_format) +
                  " has neither bit 7 nor bit 6 set (read it as LAS)"};
   hd.point_format = raw_format & 0x3F;
-  hd.record_length = load<uint16_t>(h + kRecordLengthAt);
-  hd.point_offset = load<uint32_t>(h + kPointOffsetAt);
+  hd.record_length = loadUnaligned<uint16_t>(h + kRecordLengthAt);
+  hd.point_offset = loadUnaligned<uint32_t>(h + kPointOffsetAt);
   if (hd.point_offset < header_size)
     return Error{path + ": header: offset to point data " + str(hd.point_offset) + " lies inside the " +
                  str(header_size) + "-byte header"};
-  const uint32_t legacy = load<uint32_t>(h + kLegacyCountAt);
+  const uint32_t legacy = loadUnaligned<uint32_t>(h + kLegacyCountAt);
   hd.point_count = legacy;
   if (minor >= 4) {
-    const uint64_t count = load<uint64_t>(h + kCountAt);
+    const uint64_t count = loadUnaligned<uint64_t>(h + kCountAt);
     if (count != 0 && legacy != 0 && count != legacy)
       return Error{path + ": header: legacy point count " + str(legacy) + " disagrees with the 64-bit count " +
                    str(count)};
@@ -684,7 +673,7 @@ Result<LazHeader> readHeader(const InputFile& file) {
   }
 
   // The VLRs lie between the header and the point data; the laszip one is among them.
-  const uint32_t vlr_count = load<uint32_t>(h + kVlrCountAt);
+  const uint32_t vlr_count = loadUnaligned<uint32_t>(h + kVlrCountAt);
   uint64_t at = header_size;
   std::optional<LazInfo> info;
   for (uint32_t i = 0; i < vlr_count && !info; ++i) {
@@ -695,7 +684,7 @@ Result<LazHeader> readHeader(const InputFile& file) {
     Result<size_t> read = file.readAt(at, v, sizeof v);
     if (!read) return read.error();
     if (*read != sizeof v) return Error{path + ": truncated: the file ends in VLR " + str(i)};
-    const uint16_t record_id = load<uint16_t>(v + 18), bytes = load<uint16_t>(v + 20);
+    const uint16_t record_id = loadUnaligned<uint16_t>(v + 18), bytes = loadUnaligned<uint16_t>(v + 20);
     const uint64_t data_at = at + kVlrHeaderBytes;
     if (data_at + bytes > hd.point_offset)
       return Error{path + ": VLR " + str(i) + " (" + str(bytes) + " bytes at byte " + str(data_at) +

@@ -30,6 +30,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "core/bytes.h"
 #include "core/input_file.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -72,24 +73,17 @@ size_t typeSize(Type t) {
 std::string_view typeName(Type t) { return kTypeNames[static_cast<int>(t)].name; }
 bool isInteger(Type t) { return t < Type::kFloat32; }
 
-template <typename T>
-T loadRaw(const char* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
 // Every PLY scalar is exact in a double (integers are at most 32 bits).
 inline double loadValue(Type t, const char* p) {
   switch (t) {
-    case Type::kInt8: return loadRaw<int8_t>(p);
-    case Type::kUint8: return loadRaw<uint8_t>(p);
-    case Type::kInt16: return loadRaw<int16_t>(p);
-    case Type::kUint16: return loadRaw<uint16_t>(p);
-    case Type::kInt32: return loadRaw<int32_t>(p);
-    case Type::kUint32: return loadRaw<uint32_t>(p);
-    case Type::kFloat32: return loadRaw<float>(p);
-    case Type::kFloat64: return loadRaw<double>(p);
+    case Type::kInt8: return loadUnaligned<int8_t>(p);
+    case Type::kUint8: return loadUnaligned<uint8_t>(p);
+    case Type::kInt16: return loadUnaligned<int16_t>(p);
+    case Type::kUint16: return loadUnaligned<uint16_t>(p);
+    case Type::kInt32: return loadUnaligned<int32_t>(p);
+    case Type::kUint32: return loadUnaligned<uint32_t>(p);
+    case Type::kFloat32: return loadUnaligned<float>(p);
+    case Type::kFloat64: return loadUnaligned<double>(p);
   }
   return 0;
 }
