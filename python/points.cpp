@@ -87,6 +87,16 @@ void keepWhileAlive(const py::handle& owner, py::object kept) {
 // within the capacity does not reallocate, and clear() keeps it), and a larger one gets new storage
 // while the old is handed to the set's Python object to keep. A view made before then still reads
 // memory of its own, never freed memory.
+// Hands `target`'s storage to the set's Python object to keep (views of it stay valid) and leaves
+// `target` empty.
+template <typename T>
+void retireKeepingViews(const py::handle& self, std::vector<T>& target) {
+  if (target.capacity() == 0) return;
+  auto* retired = new std::vector<T>(std::move(target));  // a move keeps the storage where it is
+  keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<T>*>(p); }));
+  target = std::vector<T>();
+}
+
 template <typename T>
 void replaceKeepingViews(const py::handle& self, std::vector<T>& target, std::vector<T> values) {
   if (values.size() <= target.capacity()) {
@@ -94,10 +104,7 @@ void replaceKeepingViews(const py::handle& self, std::vector<T>& target, std::ve
     std::copy(values.begin(), values.end(), target.begin());
     return;
   }
-  if (target.capacity() > 0) {
-    auto* retired = new std::vector<T>(std::move(target));  // a move keeps the storage where it is
-    keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<T>*>(p); }));
-  }
+  retireKeepingViews(self, target);
   target = std::move(values);
 }
 
@@ -177,10 +184,7 @@ void setAttribute(const py::handle& self, PointSet& set, const std::string& name
     return;
   }
   if (d->type != type) {
-    if (d->bytes.capacity() > 0) {
-      auto* retired = new std::vector<uint8_t>(std::move(d->bytes));
-      keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<uint8_t>*>(p); }));
-    }
+    retireKeepingViews(self, d->bytes);
     d->type = type;
     d->bytes = std::move(bytes);
     return;
@@ -350,10 +354,7 @@ that memory, without copying (writing into them changes the set).)")
             PointSet& s = self.cast<PointSet&>();
             Dimension* d = s.dimensions.find(name);
             if (!d) throw py::key_error(name);
-            if (d->bytes.capacity() > 0) {  // views of it stay valid
-              auto* retired = new std::vector<uint8_t>(std::move(d->bytes));
-              keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<uint8_t>*>(p); }));
-            }
+            retireKeepingViews(self, d->bytes);  // views of it stay valid
             s.dimensions.remove(name);
           },
           py::arg("name"), "Removes attribute `name` (KeyError when the set has none of that name)")
