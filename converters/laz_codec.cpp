@@ -11,7 +11,7 @@ constexpr uint32_t kBitLengthShift = 13;
 constexpr uint32_t kBitMaxCount = 1u << kBitLengthShift;
 constexpr uint32_t kSymbolLengthShift = 15;
 constexpr uint32_t kSymbolMaxCount = 1u << kSymbolLengthShift;
-constexpr uint32_t kMaxSymbols = 1u << 11;
+[[maybe_unused]] constexpr uint32_t kMaxSymbols = 1u << 11;  // checked by assert only
 // Models up to this many symbols are decoded by bisection alone (FastAC's choice).
 constexpr uint32_t kNoTableSymbols = 16;
 
