@@ -1,4 +1,4 @@
-// The entropy coder of LASzip, decoding side only: an arithmetic decoder over a byte range, its
+// The entropy coder of LASzip, decoding side (the encoding side, laz_encoder.h, shares the models): an arithmetic decoder over a byte range, its
 // adaptive models and the integer decompressor that LAZ's item decoders (laz_decode.h) and its
 // chunk table are built on. Written from LASzip's sources (arithmeticdecoder, arithmeticmodel,
 // integercompressor; Apache 2.0) and laz-perf's (decoder.hpp, model.hpp, decompressor.hpp), which
@@ -46,6 +46,7 @@ class LazBitModel {
 
  private:
   friend class LazDecoder;
+  friend class LazEncoder;
   void update();
   uint32_t bit_0_count_ = 1, bit_count_ = 2, bit_0_prob_ = 0;
   uint32_t update_cycle_ = 4, bits_until_update_ = 4;
@@ -65,6 +66,7 @@ class LazSymbolModel {
 
  private:
   friend class LazDecoder;
+  friend class LazEncoder;
   void update();
   uint32_t symbols_ = 0, last_symbol_ = 0;
   uint32_t total_count_ = 0, update_cycle_ = 0, symbols_until_update_ = 0;

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "converters/laz_codec.h"
+#include "converters/laz_common.h"
 #include "core/bytes.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -74,39 +75,6 @@ class ItemDecoder {
   virtual void decode(LazDecoder& decoder, uint8_t* item) = 0;
 };
 
-// LASzip's StreamingMedian5: not the median of the last five values but a sorted window of five
-// that drops its largest value (in "high" mode) or its smallest (in "low" mode) for each new one,
-// inserted in order; the mode turns to high when the new value falls below the old middle (or
-// equals it, from low). Its middle predicts the next x or y difference. (LASzip writes the same as
-// a tree of branches; this form gives the same window for every sequence.)
-class Median5 {
- public:
-  int32_t get() const { return v_[2]; }
-  void add(int32_t x) {
-    const bool next_high = x < v_[2] || (!high_ && x == v_[2]);
-    if (!high_) std::copy(v_.begin() + 1, v_.end(), v_.begin());
-    size_t i = 4;
-    for (; i > 0 && v_[i - 1] > x; --i) v_[i] = v_[i - 1];
-    v_[i] = x;
-    high_ = next_high;
-  }
-
- private:
-  std::array<int32_t, 5> v_{};
-  bool high_ = true;
-};
-
-// Contexts from the return number r and the number of returns n (laszip_common_v2.hpp): kReturnMap
-// [n][r] picks one of 16 histories of x/y differences and intensities, kReturnLevel[n][r] one of
-// 8 heights. Both fill the entries that well-formed files never use (r > n, r or n = 0) too.
-constexpr uint8_t kReturnMap[8][8] = {
-    {15, 14, 13, 12, 11, 10, 9, 8},   {14, 0, 1, 3, 6, 10, 10, 9},    {13, 1, 2, 4, 7, 11, 11, 10},
-    {12, 3, 4, 5, 8, 12, 12, 11},     {11, 6, 7, 8, 9, 13, 13, 12},   {10, 10, 11, 12, 13, 14, 14, 13},
-    {9, 10, 11, 12, 13, 14, 15, 14},  {8, 9, 10, 11, 12, 13, 14, 15}};
-constexpr uint8_t kReturnLevel[8][8] = {
-    {0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 1, 2, 3, 4, 5, 6}, {2, 1, 0, 1, 2, 3, 4, 5}, {3, 2, 1, 0, 1, 2, 3, 4},
-    {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2}, {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
-
 // The 20 bytes formats 0–5 share: x, y, z (i32), intensity (u16), the return byte (return number
 // bits 0–2, number of returns 3–5, scan direction 6, edge of flight line 7), classification,
 // scan angle rank, user data (u8 each), point source ID (u16).
@@ -130,7 +98,7 @@ class Point10Decoder final : public ItemDecoder {
     const uint32_t changed = d.decodeSymbol(changed_model_);
     if (changed & 32) returns_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(returns_models_[returns_])));
     const uint32_t r = returns_ & 7u, n = (returns_ >> 3) & 7u;
-    const uint32_t m = kReturnMap[n][r], l = kReturnLevel[n][r];
+    const uint32_t m = kLazReturnMap[n][r], l = kLazReturnLevel[n][r];
     // LASzip sets the intensity only when some value changed; when none did, the point's return
     // byte is the last one's, so m is too, and the last intensity is last_intensity_[m] already.
     if (changed & 16) {
@@ -187,7 +155,7 @@ class Point10Decoder final : public ItemDecoder {
   uint8_t returns_ = 0, classification_ = 0, scan_angle_ = 0, user_data_ = 0;
   std::array<uint16_t, 16> last_intensity_{};
   std::array<int32_t, 8> last_height_{};
-  std::array<Median5, 16> dx_history_, dy_history_;
+  std::array<LazMedian5, 16> dx_history_, dy_history_;
 
   LazSymbolModel changed_model_{64};
   LazyModels returns_models_, class_models_, user_models_;
@@ -244,14 +212,8 @@ class GpsTimeDecoder final : public ItemDecoder {
   }
 
  private:
-  // Symbols of the multiplier model: 0 (a difference unrelated to the last), 1..499 (that many
-  // times the last), 500 (500 or more times), 501..510 (−1..−10 times, −10 meaning −10 or less),
-  // then unchanged, a new sequence, and switches by 1, 2 and 3 sequences.
-  static constexpr uint32_t kMulti = 500;
-  static constexpr int32_t kMultiMinus = -10;
-  static constexpr uint32_t kUnchanged = kMulti + static_cast<uint32_t>(-kMultiMinus) + 1;  // 511
-  static constexpr uint32_t kFull = kUnchanged + 1;                 // 512
-  static constexpr uint32_t kMultiSymbols = kFull + 4;              // 516
+  static constexpr uint32_t kMulti = kLazGpsMulti, kUnchanged = kLazGpsUnchanged, kFull = kLazGpsFull;
+  static constexpr int32_t kMultiMinus = kLazGpsMultiMinus;
 
   static uint64_t widen(int32_t v) { return static_cast<uint64_t>(static_cast<int64_t>(v)); }
   // multiple · last difference with the encoder's 32-bit wrap-around.
@@ -300,7 +262,7 @@ class GpsTimeDecoder final : public ItemDecoder {
   std::array<int32_t, 4> diff_{};
   std::array<int32_t, 4> extreme_{};
   uint32_t last_ = 0, next_ = 0;
-  LazSymbolModel multi_model_{kMultiSymbols};
+  LazSymbolModel multi_model_{kLazGpsMultiSymbols};
   LazSymbolModel zero_diff_model_{6};  // unchanged, 32-bit difference, new sequence, 3 switches
   LazIntegerDecoder time_decoder_{32, 9};
 };
