@@ -19,9 +19,11 @@
 
 #include "converters/las_fields.h"
 #include "converters/laz_decode.h"
+#include "converters/laz_encode.h"
 #include "core/atomic_file.h"
 #include "core/bytes.h"
 #include "core/input_file.h"
+#include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
@@ -483,10 +485,10 @@ void storeValue(char* p, DimType type, double v) {
 }
 
 // Which format, extra bytes, version and records the writer uses for `points` (las_fields.h).
-Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n) {
+Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n, bool compress) {
   WriterLayout l;
   const LasSource* source = points.las ? &*points.las : nullptr;
-  l.format = lasFormatFor(points, source ? source->point_format : -1);
+  l.format = lasFormatFor(points, source ? source->point_format : -1, !compress);
   l.base_length = lasBaseRecordLength(l.format);
   const std::vector<LasField>& fields = lasFields(l.format);
   const auto isField = [&](const std::string& name) {
@@ -842,36 +844,80 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
     options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset);
   }
-  Result<WriterLayout> layout = writerLayout(path, points, n);
+  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress);
   if (!layout) return layout.error();
-  const WriterLayout& l = *layout;
+  WriterLayout& l = *layout;
+  std::optional<LazInfo> laz;
+  if (options.compress) {
+    Result<LazInfo> info = lazInfoForFormat(l.format, l.record_length);
+    if (!info) return Error{path + ": " + info.error().message};
+    laz = std::move(*info);
+    l.vlrs.push_back(LasVlr{"laszip encoded", 22204, "dpoint LAZ (LASzip 3.4 format)", laszipVlrData(*laz), false});
+  }
   const RecordEncoder encoder(points, l, offset, scale);
   std::string vlr_bytes;
   for (const LasVlr& vlr : l.vlrs) vlr_bytes += vlrBytes(vlr, false);
   const uint32_t point_offset = static_cast<uint32_t>((l.version_minor >= 4 ? kHeaderSize14 : kHeaderSize12) + vlr_bytes.size());
-  const uint64_t evlr_start = point_offset + uint64_t{n} * l.record_length;
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
-  if (options.progress) options.progress->start("writing " + path, n);
-  const std::string header = writerHeader(l, n, encoder.countByReturn(threads), scale, offset, bound_min, bound_max,
-                                          point_offset, evlr_start);
-  if (Status s = file->write(header.data(), header.size()); !s) return s;
-  if (Status s = file->write(vlr_bytes.data(), vlr_bytes.size()); !s) return s;
+  if (options.progress) options.progress->start((laz ? "compressing " : "writing ") + path, n);
+  const auto encodeRecords = [&](size_t first, size_t last, std::vector<char>& out) {
+    out.assign((last - first) * l.record_length, 0);
+    char* r = out.data();
+    for (size_t i = first; i < last; ++i, r += l.record_length) encoder.encode(i, r);
+  };
 
-  // Blocks are encoded on all cores a batch at a time, then written in order.
-  std::vector<std::vector<char>> encoded(static_cast<size_t>(threads) * 4);
-  for (size_t batch = 0; batch < blocks; batch += encoded.size()) {
-    const size_t batch_blocks = std::min(encoded.size(), blocks - batch);
-    parallelFor(batch_blocks, threads, [&](size_t j, unsigned) {
-      const size_t first = (batch + j) * kWriteBlockPoints, last = std::min(n, first + kWriteBlockPoints);
-      std::vector<char>& out = encoded[j];
-      out.assign((last - first) * l.record_length, 0);
-      char* r = out.data();
-      for (size_t i = first; i < last; ++i, r += l.record_length) encoder.encode(i, r);
-    });
-    for (size_t j = 0; j < batch_blocks; ++j) {
-      if (Status s = file->write(encoded[j].data(), encoded[j].size()); !s) return s;
-      if (options.progress) options.progress->advance(encoded[j].size() / l.record_length);
+  if (laz) {
+    // Chunks compressed a batch at a time on all cores, kept until every size is known.
+    const size_t chunk_count = (n + kLazChunkPoints - 1) / kLazChunkPoints;
+    std::vector<std::vector<uint8_t>> coded(chunk_count);
+    std::vector<std::vector<char>> records(threads);
+    for (size_t batch = 0; batch < chunk_count; batch += 2 * size_t{threads}) {
+      const size_t batch_chunks = std::min<size_t>(2 * size_t{threads}, chunk_count - batch);
+      parallelFor(batch_chunks, threads, [&](size_t j, unsigned worker) {
+        const size_t c = batch + j, first = c * kLazChunkPoints, last = std::min(n, first + kLazChunkPoints);
+        encodeRecords(first, last, records[worker]);
+        coded[c] = encodeLazChunk(*laz, records[worker].data(), last - first);
+      });
+      if (interrupted()) return interruptedError();
+      if (options.progress) options.progress->advance(std::min(n, (batch + batch_chunks) * kLazChunkPoints) - batch * kLazChunkPoints);
+    }
+    std::vector<LazChunk> chunks(chunk_count);
+    uint64_t at = uint64_t{point_offset} + 8;
+    for (size_t c = 0; c < chunk_count; ++c) {
+      if (coded[c].empty()) return Error{path + ": point format " + str(l.format) + " is not written as LAZ yet"};
+      chunks[c] = {at, coded[c].size(), std::min<uint64_t>(kLazChunkPoints, n - c * kLazChunkPoints)};
+      at += coded[c].size();
+    }
+    const std::string table = encodeLazChunkTable(*laz, chunks);
+    std::string header = writerHeader(l, n, encoder.countByReturn(threads), scale, offset, bound_min, bound_max,
+                                      point_offset, at + table.size());
+    header[kFormatAt] = static_cast<char>(l.format | 0x80);  // LASzip's mark of compressed records
+    char table_at[8];
+    storeUnaligned<int64_t>(table_at, static_cast<int64_t>(at));
+    for (const std::string_view piece : {std::string_view(header), std::string_view(vlr_bytes), std::string_view(table_at, 8)})
+      if (Status s = file->write(piece.data(), piece.size()); !s) return s;
+    for (const std::vector<uint8_t>& c : coded)
+      if (Status s = file->write(c.data(), c.size()); !s) return s;
+    if (Status s = file->write(table); !s) return s;
+  } else {
+    const uint64_t evlr_start = point_offset + uint64_t{n} * l.record_length;
+    const std::string header = writerHeader(l, n, encoder.countByReturn(threads), scale, offset, bound_min, bound_max,
+                                            point_offset, evlr_start);
+    if (Status s = file->write(header.data(), header.size()); !s) return s;
+    if (Status s = file->write(vlr_bytes.data(), vlr_bytes.size()); !s) return s;
+    // Blocks are encoded on all cores a batch at a time, then written in order.
+    std::vector<std::vector<char>> encoded(static_cast<size_t>(threads) * 4);
+    for (size_t batch = 0; batch < blocks; batch += encoded.size()) {
+      const size_t batch_blocks = std::min(encoded.size(), blocks - batch);
+      parallelFor(batch_blocks, threads, [&](size_t j, unsigned) {
+        const size_t first = (batch + j) * kWriteBlockPoints, last = std::min(n, first + kWriteBlockPoints);
+        encodeRecords(first, last, encoded[j]);
+      });
+      for (size_t j = 0; j < batch_blocks; ++j) {
+        if (Status s = file->write(encoded[j].data(), encoded[j].size()); !s) return s;
+        if (options.progress) options.progress->advance(encoded[j].size() / l.record_length);
+      }
     }
   }
   for (const LasVlr& evlr : l.evlrs) {

@@ -107,6 +107,10 @@ struct LasWriteOptions {
   unsigned threads = 0;
   Progress* progress = nullptr;
   LasWriteReport* report = nullptr;  // filled when not null
+  // LAZ: the records compressed as LASzip does (converters/laz_encode.h), in chunks of 50,000
+  // points compressed on all cores and held compressed until the header (which needs the EVLRs'
+  // offset) is written. Point formats 0–3 and 6–8.
+  bool compress = false;
 };
 
 // Reads and checks the header only (everything the top comment lists, the file size included).

@@ -188,11 +188,18 @@ LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields) {
   return vlr;
 }
 
-int lasFormatFor(const PointSet& points, int preferred) {
+int lasFormatFor(const PointSet& points, int preferred, bool waveforms) {
   const Widest widest{largest(points, dim::kClassification),
                       std::max(largest(points, dim::kReturnNumber), largest(points, dim::kNumberOfReturns))};
+  if (!waveforms) {
+    static constexpr int kBase[11] = {0, 1, 2, 3, 1, 3, 6, 7, 8, 6, 7};
+    if (preferred >= 0 && preferred <= 10) preferred = kBase[preferred];
+  }
   if (preferred >= 0 && preferred <= 10 && holds(points, widest, preferred)) return preferred;
-  for (int f : {0, 1, 2, 3, 6, 7, 8, 4, 5, 9, 10})
+  for (int f : {0, 1, 2, 3, 6, 7, 8})
+    if (holds(points, widest, f)) return f;
+  if (!waveforms) return preferred >= 0 && preferred <= 10 ? preferred : 8;
+  for (int f : {4, 5, 9, 10})
     if (holds(points, widest, f)) return f;
   return 10;
 }

@@ -49,6 +49,9 @@ LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields);
 // The point format that holds what `points` carries: `preferred` (the source's) when it holds every
 // LAS field the set has, its colours and the values of its fields; else the smallest of formats
 // 0-3 or, where a field or value needs LAS 1.4's, 6-8 (waveform fields: 4, 5, 9 or 10).
-int lasFormatFor(const PointSet& points, int preferred);
+// Without `waveforms` (LAZ, whose waveform items dpoint does not code) the formats 4, 5, 9 and 10
+// are never chosen: a waveform source's format becomes its base (1, 3, 6, 7), the others as above,
+// and the wave packet fields are left to the extra bytes.
+int lasFormatFor(const PointSet& points, int preferred, bool waveforms = true);
 
 }  // namespace dpoint

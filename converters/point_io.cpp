@@ -72,9 +72,6 @@ Result<FileFormat> formatOf(const std::string& path) {
 Status checkWrittenFormat(const std::string& path, FileFormat format) {
   if (format == FileFormat::kGltf)
     return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .las)", ExitCode::kUsage};
-  if (format == FileFormat::kLaz)
-    return Error{path + ": writing LAZ is not supported yet; write .las (dpoint reads .laz)",
-                 ExitCode::kUsage};
   return okStatus();
 }
 
@@ -170,12 +167,13 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return okStatus();
     }
     case FileFormat::kGltf:
-    case FileFormat::kLaz:
       return checkWrittenFormat(path, *format);
-    case FileFormat::kLas: {
+    case FileFormat::kLas:
+    case FileFormat::kLaz: {
       LasWriteReport report;
-      if (Status s = writeLas(path, points, LasWriteOptions{options.las_scale, options.threads, options.progress, &report});
-          !s)
+      LasWriteOptions las{options.las_scale, options.threads, options.progress, &report};
+      las.compress = *format == FileFormat::kLaz;
+      if (Status s = writeLas(path, points, las); !s)
         return s;
       if (report.merged_points != 0 && options.notices) {
         const glm::dvec3& sc = report.scale;

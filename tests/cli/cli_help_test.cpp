@@ -123,9 +123,8 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
       {concat(slow, {dir.file("missing/x.ply")}),
        "cannot write '" + dir.file("missing/x.ply") + "': folder '" + dir.file("missing") + "' does not exist"},
       {concat(slow, {dir.path()}), "cannot write '" + dir.path() + "': it is a folder"},
-      {concat(slow, {dir.file("x.txt")}), dir.file("x.txt") + ": unknown file type '.txt' (write .csv, .ply, .glb or .las)"},
+      {concat(slow, {dir.file("x.txt")}), dir.file("x.txt") + ": unknown file type '.txt' (write .csv, .ply, .glb, .las or .laz)"},
       {concat(slow, {dir.file("x.gltf")}), dir.file("x.gltf") + ": .gltf is read, not written; write .glb"},
-      {concat(slow, {dir.file("x.laz")}), "writing LAZ is not supported"},
       {concat(slow, {"/sys/dpoint-test.ply"}), "'/sys/dpoint-test.ply': Permission denied"},  // even for root
       {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
       {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("x.gltf")}, ".gltf is read, not written"},
