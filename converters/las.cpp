@@ -485,10 +485,12 @@ void storeValue(char* p, DimType type, double v) {
 }
 
 // Which format, extra bytes, version and records the writer uses for `points` (las_fields.h).
-Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n, bool compress) {
+Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n, bool compress,
+                                  bool las14) {
   WriterLayout l;
   const LasSource* source = points.las ? &*points.las : nullptr;
   l.format = lasFormatFor(points, source ? source->point_format : -1, !compress);
+  if (las14 && l.format < 6) l.format = l.format == 0 ? 6 : l.format == 2 ? 7 : l.format == 3 ? 7 : 6;
   l.base_length = lasBaseRecordLength(l.format);
   const std::vector<LasField>& fields = lasFields(l.format);
   const auto isField = [&](const std::string& name) {
@@ -844,7 +846,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
     options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset);
   }
-  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress);
+  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14);
   if (!layout) return layout.error();
   WriterLayout& l = *layout;
   std::optional<LazInfo> laz;
@@ -858,8 +860,21 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   std::string vlr_bytes;
   for (const LasVlr& vlr : l.vlrs) vlr_bytes += vlrBytes(vlr, false);
   const uint32_t point_offset = static_cast<uint32_t>((l.version_minor >= 4 ? kHeaderSize14 : kHeaderSize12) + vlr_bytes.size());
-  Result<AtomicFile> file = AtomicFile::create(path);
-  if (!file) return file.error();
+  // The bytes go to the file, or to options.memory (COPC reorganises a whole LAS 1.4 file).
+  std::optional<AtomicFile> file;
+  if (!options.memory) {
+    Result<AtomicFile> created = AtomicFile::create(path);
+    if (!created) return created.error();
+    file.emplace(std::move(*created));
+  }
+  const auto write = [&](const void* data, size_t size) -> Status {
+    if (!file) {
+      if (interrupted()) return interruptedError();
+      options.memory->append(static_cast<const char*>(data), size);
+      return okStatus();
+    }
+    return file->write(data, size);
+  };
   if (options.progress) options.progress->start((laz ? "compressing " : "writing ") + path, n);
   const auto encodeRecords = [&](size_t first, size_t last, std::vector<char>& out) {
     out.assign((last - first) * l.record_length, 0);
@@ -896,16 +911,16 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     char table_at[8];
     storeUnaligned<int64_t>(table_at, static_cast<int64_t>(at));
     for (const std::string_view piece : {std::string_view(header), std::string_view(vlr_bytes), std::string_view(table_at, 8)})
-      if (Status s = file->write(piece.data(), piece.size()); !s) return s;
+      if (Status s = write(piece.data(), piece.size()); !s) return s;
     for (const std::vector<uint8_t>& c : coded)
-      if (Status s = file->write(c.data(), c.size()); !s) return s;
-    if (Status s = file->write(table); !s) return s;
+      if (Status s = write(c.data(), c.size()); !s) return s;
+    if (Status s = write(table.data(), table.size()); !s) return s;
   } else {
     const uint64_t evlr_start = point_offset + uint64_t{n} * l.record_length;
     const std::string header = writerHeader(l, n, encoder.countByReturn(threads), scale, offset, bound_min, bound_max,
                                             point_offset, evlr_start);
-    if (Status s = file->write(header.data(), header.size()); !s) return s;
-    if (Status s = file->write(vlr_bytes.data(), vlr_bytes.size()); !s) return s;
+    if (Status s = write(header.data(), header.size()); !s) return s;
+    if (Status s = write(vlr_bytes.data(), vlr_bytes.size()); !s) return s;
     // Blocks are encoded on all cores a batch at a time, then written in order.
     std::vector<std::vector<char>> encoded(static_cast<size_t>(threads) * 4);
     for (size_t batch = 0; batch < blocks; batch += encoded.size()) {
@@ -915,16 +930,17 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
         encodeRecords(first, last, encoded[j]);
       });
       for (size_t j = 0; j < batch_blocks; ++j) {
-        if (Status s = file->write(encoded[j].data(), encoded[j].size()); !s) return s;
+        if (Status s = write(encoded[j].data(), encoded[j].size()); !s) return s;
         if (options.progress) options.progress->advance(encoded[j].size() / l.record_length);
       }
     }
   }
   for (const LasVlr& evlr : l.evlrs) {
     const std::string bytes = vlrBytes(evlr, true);
-    if (Status s = file->write(bytes.data(), bytes.size()); !s) return s;
+    if (Status s = write(bytes.data(), bytes.size()); !s) return s;
   }
-  if (Status s = file->commit(); !s) return s;
+  if (file)
+    if (Status s = file->commit(); !s) return s;
   if (options.progress) options.progress->finish();
   return okStatus();
 }

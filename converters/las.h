@@ -111,6 +111,12 @@ struct LasWriteOptions {
   // points compressed on all cores and held compressed until the header (which needs the EVLRs'
   // offset) is written. Point formats 0–3 and 6–8.
   bool compress = false;
+  // Point formats 6–8 (LAS 1.4) whatever the set needs: 0 and 1 become 6, 2 and 3 become 7
+  // (COPC's formats; a format 4/5 source with compress is written as 6 or 7 too).
+  bool las14 = false;
+  // When set, the file's bytes are appended here and nothing is written at `path` (which names the
+  // output in messages).
+  std::string* memory = nullptr;
 };
 
 // Reads and checks the header only (everything the top comment lists, the file size included).

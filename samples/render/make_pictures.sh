@@ -56,6 +56,12 @@ for set in mandelbulb menger_exact deep; do
   "$dpoint" render "$work/$set.ply" -o "$first/$set.png" --width 640 --height 480 --quiet
 done
 if [ -f "$survey" ]; then "$dpoint" render "$survey" -o "$first/survey.png" --width 640 --height 480 --quiet; fi
+# A LAZ survey (issue #35): laz-perf's autzen_trim.laz (110,000 returns, LASzip-compressed) by
+# classification, with the ASPRS colours and their legend.
+laz=$here/../../../shared/corpus/laz/autzen_trim.laz
+if [ -f "$laz" ]; then
+  "$dpoint" render "$laz" --color classification -o "$first/survey_laz_classes.png" --width 640 --height 480 --quiet
+fi
 if /usr/bin/python3 -c "import open3d" 2>/dev/null && command -v Xvfb >/dev/null; then
   for set in mandelbulb menger_exact; do
     /usr/bin/python3 "$here/../../bench/scripts/open3d_capture.py" "$work/$set.ply" "$first/$set.open3d.png" \
