@@ -14,6 +14,7 @@
 
 #include "converters/laz_codec.h"
 #include "converters/laz_common.h"
+#include "converters/laz_layered.h"
 #include "core/bytes.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -35,12 +36,15 @@ std::string itemName(uint16_t type) {
   return type < std::size(kNames) ? kNames[type] : "unknown";
 }
 
+// LAS 1.4's item types (formats 6–10), decoded by laz_layered.cpp.
+enum : uint16_t { kLazPoint14 = 10, kLazRgb14 = 11, kLazRgbNir14 = 12, kLazByte14 = 14 };
+
 std::string itemList(const std::vector<LazItem>& items) {
   std::string out;
   for (const LazItem& item : items) {
     if (!out.empty()) out += ", ";
     out += itemName(item.type);
-    if (item.type == kLazByte) {  // appended: GCC 12 warns falsely on "(" + string (bug 105651)
+    if (item.type == kLazByte || item.type == kLazByte14) {  // appended: GCC 12 warns falsely on "(" + string (bug 105651)
       out += '(';
       out += str(item.size);
       out += ')';
@@ -55,13 +59,25 @@ constexpr size_t kVlrFixedBytes = 34;  // up to and with the item count
 constexpr size_t kVlrItemBytes = 6;
 constexpr uint16_t kCompressorPointwise = 1, kCompressorChunked = 2, kCompressorLayered = 3;
 
-// The four decoded item types, their sizes (0: any) and the version decoded.
+// The decoded item types and their sizes (0: any): version 2 with compressor 2 (point formats
+// 0–3), version 3 with compressor 3 (formats 6–8; laz_layered.h).
 struct ItemSupport {
   uint16_t type;
   uint16_t size;
 };
 constexpr ItemSupport kDecoded[] = {{kLazPoint10, 20}, {kLazGpsTime11, 8}, {kLazRgb12, 6}, {kLazByte, 0}};
 constexpr uint16_t kDecodedVersion = 2;
+constexpr ItemSupport kDecodedLayered[] = {{kLazPoint14, 30}, {kLazRgb14, 6}, {kLazRgbNir14, 8}, {kLazByte14, 0}};
+constexpr uint16_t kDecodedLayeredVersion = 3;
+constexpr const char* kSupportedItems =
+    "only version 2 of POINT10, GPSTIME11, RGB12 and BYTE: point formats 0 to 3, and version 3 of POINT14, RGB14, "
+    "RGBNIR14 and BYTE14: formats 6 to 8";
+
+const ItemSupport* findSupport(const ItemSupport (&table)[4], uint16_t type) {
+  for (const ItemSupport& s : table)
+    if (s.type == type) return &s;
+  return nullptr;
+}
 
 // --- Item decoders, version 2 ----------------------------------------------------------------------
 //
@@ -386,11 +402,9 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
     return Error{what + str(data.size()) + " bytes, fewer than the " + str(needed) + " that its " + str(count) +
                  " items need"};
   if (info.compressor == kCompressorPointwise)
-    return Error{"LAZ compressor 1 (pointwise, without chunks) is not supported (only 2, pointwise chunked)"};
-  if (info.compressor == kCompressorLayered)
-    return Error{"LAZ compressor 3 (layered chunked, point formats 6 to 10) is not supported (only 2, pointwise "
-                 "chunked)"};
-  if (info.compressor != kCompressorChunked)
+    return Error{"LAZ compressor 1 (pointwise, without chunks) is not supported (only 2, pointwise chunked, and 3, "
+                 "layered chunked)"};
+  if (info.compressor != kCompressorChunked && info.compressor != kCompressorLayered)
     return Error{what + "compressor " + str(info.compressor) + " is not one of LASzip's (1 to 3)"};
   if (info.coder != 0)
     return Error{"LAZ coder " + str(info.coder) + " is not supported (only 0, the arithmetic coder)"};
@@ -400,12 +414,17 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
     const char* q = p + kVlrFixedBytes + kVlrItemBytes * i;
     LazItem item{loadUnaligned<uint16_t>(q), loadUnaligned<uint16_t>(q + 2), loadUnaligned<uint16_t>(q + 4)};
     const std::string name = "LAZ item type " + str(item.type) + " (" + itemName(item.type) + ")";
-    const ItemSupport* support = nullptr;
-    for (const ItemSupport& s : kDecoded)
-      if (s.type == item.type) support = &s;
-    if (!support || item.version != kDecodedVersion)
-      return Error{name + " version " + str(item.version) +
-                   " is not supported (only version 2 of POINT10, GPSTIME11, RGB12 and BYTE: point formats 0 to 3)"};
+    // Each compressor has its own items: LASzip codes LAS 1.4's points only in layers.
+    const bool layered = info.compressor == kCompressorLayered;
+    const ItemSupport* support = findSupport(layered ? kDecodedLayered : kDecoded, item.type);
+    const uint16_t version = layered ? kDecodedLayeredVersion : kDecodedVersion;
+    if (!support && item.version == (layered ? kDecodedVersion : kDecodedLayeredVersion) &&
+        findSupport(layered ? kDecoded : kDecodedLayered, item.type))
+      return Error{what + name + " version " + str(item.version) + " does not go with compressor " +
+                   str(info.compressor) + (layered ? " (layered chunked: version 3 of POINT14, RGB14, RGBNIR14 and BYTE14)"
+                                                   : " (pointwise chunked: version 2 of POINT10, GPSTIME11, RGB12 and BYTE)")};
+    if (!support || item.version != version)
+      return Error{name + " version " + str(item.version) + " is not supported (" + kSupportedItems + ")"};
     if (support->size != 0 && item.size != support->size)
       return Error{what + name + " has size " + str(item.size) + ", not " + str(support->size)};
     if (item.size == 0) return Error{what + name + " has size 0"};
@@ -415,19 +434,28 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
 }
 
 Status checkLazItems(const LazInfo& info, int point_format, uint32_t record_length) {
-  if (point_format < 0 || point_format > 3)
+  const bool pointwise = point_format >= 0 && point_format <= 3, layered = point_format >= 6 && point_format <= 8;
+  if (!pointwise && !layered)
     return Error{"LAZ point format " + str(static_cast<uint64_t>(point_format)) +
-                 " is not supported (only formats 0 to 3)"};
-  static constexpr uint32_t kBase[4] = {20, 28, 26, 34};
+                 " is not supported (only formats 0 to 3 and 6 to 8: 4, 5, 9 and 10 carry waveforms)"};
+  static constexpr uint32_t kBase[9] = {20, 28, 26, 34, 0, 0, 30, 36, 38};
   const uint32_t base = kBase[point_format];
   if (record_length < base)
     return Error{"point record length " + str(record_length) + " is shorter than point format " +
                  str(static_cast<uint64_t>(point_format)) + "'s " + str(base) + " bytes"};
-  std::vector<LazItem> expected = {{kLazPoint10, 20, kDecodedVersion}};
-  if (point_format == 1 || point_format == 3) expected.push_back({kLazGpsTime11, 8, kDecodedVersion});
-  if (point_format >= 2) expected.push_back({kLazRgb12, 6, kDecodedVersion});
-  if (record_length > base)
-    expected.push_back({kLazByte, static_cast<uint16_t>(record_length - base), kDecodedVersion});
+  const uint16_t extra = static_cast<uint16_t>(record_length - base);
+  std::vector<LazItem> expected;
+  if (pointwise) {
+    expected.push_back({kLazPoint10, 20, kDecodedVersion});
+    if (point_format == 1 || point_format == 3) expected.push_back({kLazGpsTime11, 8, kDecodedVersion});
+    if (point_format >= 2) expected.push_back({kLazRgb12, 6, kDecodedVersion});
+    if (extra != 0) expected.push_back({kLazByte, extra, kDecodedVersion});
+  } else {
+    expected.push_back({kLazPoint14, 30, kDecodedLayeredVersion});
+    if (point_format == 7) expected.push_back({kLazRgb14, 6, kDecodedLayeredVersion});
+    if (point_format == 8) expected.push_back({kLazRgbNir14, 8, kDecodedLayeredVersion});
+    if (extra != 0) expected.push_back({kLazByte14, extra, kDecodedLayeredVersion});
+  }
   bool same = expected.size() == info.items.size();
   for (size_t i = 0; same && i < expected.size(); ++i)
     same = expected[i].type == info.items[i].type && expected[i].size == info.items[i].size;
@@ -441,6 +469,7 @@ Status checkLazItems(const LazInfo& info, int point_format, uint32_t record_leng
 // --- One chunk -------------------------------------------------------------------------------------
 
 Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint64_t points, char* records) {
+  if (info.compressor == kCompressorLayered) return decodeLayeredChunk(info, data, bytes, points, records);
   const size_t length = info.recordLength();
   assert(length > 0);
   if (points == 0) return Error{"a chunk of 0 points"};
@@ -516,8 +545,9 @@ Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t 
   if (head[0] != 0) return Error{path + ": chunk table version " + str(head[0]) + " is not 0"};
   const uint32_t count = head[1];
 
-  // Bound the count before allocating: every chunk holds at least its raw first point and the 4
-  // bytes an encoder flushes, between the chunks' start and the table.
+  // Bound the count before allocating: every chunk holds at least its raw first point and 4 bytes
+  // more (a pointwise chunk's code ends with the 4 bytes an encoder flushes, a layered chunk has
+  // its point count and layer sizes), between the chunks' start and the table.
   const uint64_t chunk_bytes = table - chunks_at;
   const uint64_t length = info.recordLength();
   if (count > chunk_bytes / (length + 4))

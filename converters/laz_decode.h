@@ -1,7 +1,8 @@
 // LAZ (LASzip-compressed LAS) decoding: the point records of a .laz file back as the uncompressed
 // LAS records, byte for byte. dpoint's own decoder, written from LASzip's sources
 // (lasreadpoint, lasreaditemcompressed_v2, laszip_common_v2, laszip.cpp's VLR; Apache 2.0) and
-// laz-perf's (readers.cpp, detail/field_*.cpp), on the entropy coder of laz_codec.h.
+// laz-perf's (readers.cpp, detail/field_*.cpp), on the entropy coder of laz_codec.h. The layered
+// chunks of point formats 6–8 are laz_layered.h's.
 //
 // The format, as relied on here:
 // - The LAS header's point data format byte has bit 7 (old writers: bit 6) set; the format is the
@@ -13,18 +14,24 @@
 //   8 bytes). The chunks follow that i64, back to back. The table: version u32 (0), chunk count
 //   u32, then per chunk its point count (variable chunks only) and byte count, each coded with
 //   an integer decompressor (32 bits, 2 contexts) predicted from the previous chunk's.
-// - A chunk: its first point raw (the items' bytes in order), then an arithmetic code of the other
-//   points, item by item, every model reset at the chunk's start. A fixed chunk size gives every
-//   chunk that many points but the last.
+// - A chunk (compressor 2, pointwise): its first point raw (the items' bytes in order), then an
+//   arithmetic code of the other points, item by item, every model reset at the chunk's start.
+//   A layered chunk (compressor 3): the first point raw, the point count, then one code per field
+//   group (layer) and its byte count (laz_layered.h). A fixed chunk size gives every chunk that
+//   many points but the last.
 // - Item decoders, version 2: POINT10 (type 6, 20 bytes: the fields shared by formats 0–5),
-//   GPSTIME11 (7, 8 bytes), RGB12 (8, 6 bytes), BYTE (0, the extra bytes, n bytes).
+//   GPSTIME11 (7, 8 bytes), RGB12 (8, 6 bytes), BYTE (0, the extra bytes, n bytes). Version 3:
+//   POINT14 (10, 30 bytes: all of formats 6–10's first 30), RGB14 (11, 6), RGBNIR14 (12, 8),
+//   BYTE14 (14, n).
 //
-// Supported: compressor 2 (pointwise chunked) with the arithmetic coder, item version 2, point
-// formats 0–3 with or without extra bytes, fixed and variable chunks, LAS 1.0–1.4 headers.
-// Refused by name: compressor 1 (unchunked) and 3 (layered, point formats 6–10), other coders,
-// item versions 1 (LASzip 1.x) and 3/4, item types of formats 4–10 (wave packets, POINT14,
-// RGB14, RGBNIR14, BYTE14), items that disagree with the header's format, and a file whose chunk
-// table is missing (its writer was interrupted; LASzip rebuilds such a table, dpoint does not).
+// Supported, with the arithmetic coder, fixed and variable chunks and LAS 1.0–1.4 headers:
+// compressor 2 (pointwise chunked) with item version 2, point formats 0–3; compressor 3 (layered
+// chunked) with item version 3, point formats 6–8; either with or without extra bytes.
+// Refused by name: compressor 1 (unchunked), other coders, item versions 1 (LASzip 1.x) and 4
+// (LASzip 3.4's context-switch fix), each compressor's items with the other, the waveform items
+// of formats 4, 5, 9 and 10 (WAVEPACKET13, WAVEPACKET14), items that disagree with the header's
+// format, and a file whose chunk table is missing (its writer was interrupted; LASzip rebuilds
+// such a table, dpoint does not).
 //
 // Hostile input: every length and offset is checked against the file before it is used, a
 // chunk's decoder reads only the chunk's bytes, and a chunk must decode its points with exactly its
@@ -44,7 +51,8 @@
 
 namespace dpoint {
 
-// LASzip's item types (only these four are decoded).
+// LASzip's item types of point formats 0–3 (those of formats 6–8, POINT14 10, RGB14 11,
+// RGBNIR14 12 and BYTE14 14, are named where they are coded).
 enum LazItemType : uint16_t { kLazByte = 0, kLazPoint10 = 6, kLazGpsTime11 = 7, kLazRgb12 = 8 };
 
 struct LazItem {
@@ -68,12 +76,13 @@ constexpr uint32_t kLazVariableChunks = 0xFFFFFFFFu;
 
 // Parses the laszip VLR's data (without its 54-byte VLR header). Fails, naming what is wrong, on
 // a short or inconsistent record and on anything this decoder does not support (top comment):
-// "LAZ item type 9 (WAVEPACKET13) version 3 is not supported (...)".
+// "LAZ item type 9 (WAVEPACKET13) version 1 is not supported (...)".
 Result<LazInfo> parseLaszipVlr(std::string_view data);
 
-// The items a LAS point format 0–3 with `record_length`-byte records needs (POINT10, GPSTIME11
-// for 1 and 3, RGB12 for 2 and 3, BYTE for extra bytes), compared with `info`'s: an Error saying
-// both lists when they differ.
+// The items a LAS point format 0–3 or 6–8 with `record_length`-byte records needs (POINT10,
+// GPSTIME11 for 1 and 3, RGB12 for 2 and 3, BYTE for extra bytes; POINT14, RGB14 for 7, RGBNIR14
+// for 8, BYTE14 for extra bytes), compared with `info`'s: an Error saying both lists when they
+// differ, or naming the format when it is not supported.
 Status checkLazItems(const LazInfo& info, int point_format, uint32_t record_length);
 
 struct LazChunk {
@@ -89,13 +98,14 @@ Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t 
                                                 const LazInfo& info, uint64_t point_count);
 
 // Decodes one chunk of `points` (≥ 1) points from [data, data + bytes) into `records`, which holds
-// points × info.recordLength() bytes: the LAS point records. Reads nothing outside the data.
+// points × info.recordLength() bytes: the LAS point records (a layered chunk through
+// decodeLayeredChunk). Reads nothing outside the data.
 // Fails when the data ends before the points do, holds an invalid code, or has bytes left over;
 // the message names the point ("point 812 of 50000: ...") but not the file or chunk (the caller's).
 // `info` must have passed parseLaszipVlr.
 Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint64_t points, char* records);
 
-// All point records of a .laz file (LAS 1.0–1.4, point formats 0–3), count × record length bytes,
+// All point records of a .laz file (LAS 1.0–1.4, point formats 0–3 and 6–8), count × record length bytes,
 // exactly as the uncompressed .las holds them. Parses the LAS header fields it needs (version,
 // header size, offset to point data, VLR count, point format, record length, legacy and 64-bit
 // counts), finds the laszip VLR among the VLRs, reads the chunk table and decodes the chunks on
