@@ -210,18 +210,21 @@ int runRender(const RenderCliOptions& o) {
   Result<RenderRequest> request = requestOf(o);
   if (!request) return reportError(request.error());
   Progress progress(progressSink(o.common.quiet), "render");
-  Result<RenderOutcome> outcome = runRenderJob(*request, progress, printView);
+  // --quiet: no progress and no report lines; warnings and errors still go to stderr.
+  Result<RenderOutcome> outcome =
+      runRenderJob(*request, progress, o.common.quiet ? std::function<void(const SheetView&)>() : printView);
   if (!outcome) return reportError(outcome.error());
   if (Status written = writeRenderPicture(o.output, *outcome); !written) return reportError(written.error());
   if (request->views == 4) {
-    std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), outcome->points,
+    if (!o.common.quiet)
+      std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), outcome->points,
                 outcome->image.width, outcome->image.height, backendName(outcome->backend), outcome->device.name.c_str());
     printWarnings(*outcome);
     return validationResult(*outcome);
   }
   if (!o.json.empty())
     if (Status s = writeReport(o.json, *request, *outcome); !s) return reportError(s.error());
-  printOutcome(*request, o.output, *outcome);
+  if (!o.common.quiet) printOutcome(*request, o.output, *outcome);
   printWarnings(*outcome);
   return validationResult(*outcome);
 }
@@ -316,9 +319,9 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
                   "Refuse (exit 3, a Vulkan fault) to allocate more GPU memory than this, e.g. 2G (default: what the\n"
                   "device has)");
   addChoiceOption(*cmd, "--stream", o->stream,
-                  "auto|on|off. on: draw binary PLY input (a file, or tiles) a block at a time, so a set larger\n"
-                  "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for binary\n"
-                  "PLY input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes\n"
+                  "auto|on|off. on: draw binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, so a set larger\n"
+                  "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for such\n"
+                  "input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes\n"
                   "native), no --error, --order or --views 4",
                   {"auto", "on", "off"});
   cmd->add_option("--views", o->views,

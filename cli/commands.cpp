@@ -8,7 +8,7 @@ namespace dpoint {
 
 void addCommonOptions(CLI::App& command, CommonOptions& options) {
   command.add_option("--threads", options.threads, "Worker threads (0: all cores)")->default_val(0);
-  command.add_flag("--quiet,-q", options.quiet, "No progress output");
+  command.add_flag("--quiet,-q", options.quiet, "No progress or report lines (warnings and errors still print)");
 }
 
 void addMaxMemoryOption(CLI::App& command, std::string& text) {

@@ -83,6 +83,22 @@ TEST(CliRender, writesPngAndJsonWithEveryMeasurement) {
 // --warmup auto (the default): a single picture is drawn once (no warm-up frame, said beside its
 // time); with --frames above 1 frames are drawn untimed by time first (at least one), and --warmup N
 // is kept. No assertion on how long anything took: only the counts the run reports.
+TEST(CliRender, quietPrintsNothingButStillWritesThePictureAndReport) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "2", "--quiet", "-o", dir.file("m.ply")}).exit_code, 0);
+  for (const char* views : {"1", "4"}) {
+    test::CommandResult r = runDpoint({"render", dir.file("m.ply"), "-o", dir.file("m.png"), "--width", "96", "--height",
+                                       "64", "--views", views, "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "") << "--views " << views;
+    EXPECT_EQ(r.err, "") << "--views " << views;
+    EXPECT_TRUE(test::fileExists(dir.file("m.png")));
+  }
+  // Without --quiet the report is there (the same command).
+  test::CommandResult loud = runDpoint({"render", dir.file("m.ply"), "-o", dir.file("m.png"), "--width", "96", "--height", "64"});
+  EXPECT_NE(loud.out.find("time to picture"), std::string::npos) << loud.out;
+}
+
 TEST(CliRender, warmupAutoDrawsASinglePictureOnce) {
   TempDir dir;
   ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "24", "--quiet", "-o", dir.file("mb.ply")}).exit_code, 0);
