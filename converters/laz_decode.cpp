@@ -44,7 +44,8 @@ std::string itemList(const std::vector<LazItem>& items) {
   for (const LazItem& item : items) {
     if (!out.empty()) out += ", ";
     out += itemName(item.type);
-    if (item.type == kLazByte || item.type == kLazByte14) {  // appended: GCC 12 warns falsely on "(" + string (bug 105651)
+    // Appended: GCC 12 warns falsely on "(" + string (bug 105651).
+    if (item.type == kLazByte || item.type == kLazByte14) {
       out += '(';
       out += str(item.size);
       out += ')';
@@ -421,8 +422,9 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
     if (!support && item.version == (layered ? kDecodedVersion : kDecodedLayeredVersion) &&
         findSupport(layered ? kDecoded : kDecodedLayered, item.type))
       return Error{what + name + " version " + str(item.version) + " does not go with compressor " +
-                   str(info.compressor) + (layered ? " (layered chunked: version 3 of POINT14, RGB14, RGBNIR14 and BYTE14)"
-                                                   : " (pointwise chunked: version 2 of POINT10, GPSTIME11, RGB12 and BYTE)")};
+                   str(info.compressor) +
+                   (layered ? " (layered chunked: version 3 of POINT14, RGB14, RGBNIR14 and BYTE14)"
+                            : " (pointwise chunked: version 2 of POINT10, GPSTIME11, RGB12 and BYTE)")};
     if (!support || item.version != version)
       return Error{name + " version " + str(item.version) + " is not supported (" + kSupportedItems + ")"};
     if (support->size != 0 && item.size != support->size)

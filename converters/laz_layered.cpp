@@ -180,7 +180,9 @@ uint32_t changedContext(const Point14& last) {
 }
 
 // The layers of POINT14, in the chunk's order.
-enum Point14Layer : size_t { kXy, kZ, kClass, kFlags, kIntensity, kScanAngle, kUserData, kSource, kGps, kPoint14Layers };
+enum Point14Layer : size_t {
+  kXy, kZ, kClass, kFlags, kIntensity, kScanAngle, kUserData, kSource, kGps, kPoint14Layers
+};
 constexpr const char* kPoint14LayerNames[kPoint14Layers] = {
     "channel/returns/XY", "Z", "classification", "flags", "intensity", "scan angle", "user data",
     "point source ID", "GPS time"};
@@ -438,7 +440,9 @@ class ColourDecoder {
  private:
   static void decodeRgb(LazDecoder& d, std::array<uint16_t, 4>& last, ColourChannel& m) {
     const uint32_t used = d.decodeSymbol(m.rgb_used);
-    const auto next = [&](size_t model, int base) { return byteOf(static_cast<int>(d.decodeSymbol(m.rgb_diff[model])) + base); };
+    const auto next = [&](size_t model, int base) {
+      return byteOf(static_cast<int>(d.decodeSymbol(m.rgb_diff[model])) + base);
+    };
     const int red_lo = (used & 1) ? next(0, lo(last[0])) : lo(last[0]);
     const int red_hi = (used & 2) ? next(1, hi(last[0])) : hi(last[0]);
     int green_lo = red_lo, green_hi = red_hi, blue_lo = red_lo, blue_hi = red_hi;

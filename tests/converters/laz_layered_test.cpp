@@ -139,7 +139,8 @@ std::string syntheticRecords(int format, uint16_t extra, uint64_t points, uint32
     if (chance(0.03)) flags = static_cast<uint8_t>(uniform(0, 63));
     if (chance(0.05)) cls = static_cast<uint8_t>(chance(0.3) ? uniform(32, 255) : uniform(0, 9));
     if (chance(0.02)) user = static_cast<uint8_t>(uniform(0, 255));
-    if (chance(0.1)) angle = static_cast<int16_t>(chance(0.1) ? (chance(0.5) ? INT16_MIN : INT16_MAX) : uniform(-3000, 3000));
+    if (chance(0.1))
+      angle = static_cast<int16_t>(chance(0.1) ? (chance(0.5) ? INT16_MIN : INT16_MAX) : uniform(-3000, 3000));
     if (chance(0.01)) source = static_cast<uint16_t>(uniform(0, 65535));
     intensity = static_cast<uint16_t>(chance(0.3) ? intensity : uniform(0, 65535));
     // GPS time: the channel's own sequence advances; the first return of a pulse takes a new time.
@@ -502,7 +503,8 @@ TEST(LazLayered, rejectsLayerSizesThatLie) {
     std::vector<uint8_t> c = b.chunk;
     setSize(c, 0, 0);
     setSize(c, 1, sizes[0] + sizes[1]);
-    EXPECT_TRUE(contains(decodeMessage(b, c), "the chunk's channel/returns/XY layer is empty, but it holds 300 points"));
+    EXPECT_TRUE(
+        contains(decodeMessage(b, c), "the chunk's channel/returns/XY layer is empty, but it holds 300 points"));
   }
 }
 
@@ -589,7 +591,8 @@ TEST(LazLayered, itemsMustMatchFormats6To8) {
   EXPECT_TRUE(contains(extra.error().message, "(POINT14, RGB14, BYTE14(4))"));
   Status waveform = checkLazItems(*info7, 9, 59);
   ASSERT_FALSE(waveform.ok());
-  EXPECT_TRUE(contains(waveform.error().message, "LAZ point format 9 is not supported (only formats 0 to 3 and 6 to 8"));
+  EXPECT_TRUE(
+      contains(waveform.error().message, "LAZ point format 9 is not supported (only formats 0 to 3 and 6 to 8"));
 }
 
 }  // namespace
