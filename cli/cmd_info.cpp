@@ -46,7 +46,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
   cmd->add_option("input", o->inputs,
                   "Input files (.csv, .ply, .las, .laz, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
-                  "as the whole. Large binary PLY input is streamed (--stream)")
+                  "as the whole. Large binary PLY, LAS and LAZ input is streamed (--stream)")
       ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
@@ -56,9 +56,9 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   addCameraOptions(*cmd, o->camera);
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,
-                  "auto|on|off. on: read binary PLY input (a file, or tiles) a block at a time, twice, so a set\n"
+                  "auto|on|off. on: read binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, twice, so a set\n"
                   "larger than memory is described in about 1.2 GB (no float32 merge count, which needs every point\n"
-                  "at once, and error bounds from the box of each 4096-point batch); auto: for binary PLY input of\n"
+                  "at once, and error bounds from the box of each 4096-point batch); auto: for such input of\n"
                   "more than 2^26 points")
       ->check(oneOf("--stream", {"auto", "on", "off"}))
       ->default_val("auto");

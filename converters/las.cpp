@@ -763,6 +763,167 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   return points;
 }
 
+// --- The stream ------------------------------------------------------------------------------------
+
+struct LasPointStream::State {
+  InputFile file;
+  LasHeader header;
+  std::vector<LasField> fields;
+  std::vector<LasExtraField> extra;
+  Dimensions dimensions;  // fields then extra, empty
+  std::vector<size_t> streamed;
+  unsigned threads = 0;
+  float color_divisor = 0.0f;  // 0: no colours
+  // LAZ: the chunks, and the last chunks decoded (their records) for the next block.
+  std::optional<LazChunks> laz;
+  size_t cached_first = 0, cached_last = 0;  // chunks [first, last) in `cache`
+  std::string cache;
+
+  explicit State(InputFile f) : file(std::move(f)) {}
+
+  // Records [first, first + n) into `out` (n · record length bytes).
+  Status records(uint64_t first, uint64_t n, char* out) {
+    const uint64_t length = header.record_length;
+    if (!laz) {
+      Result<size_t> got = file.readAt(header.point_offset + first * length, out, static_cast<size_t>(n * length));
+      if (!got) return got.error();
+      if (*got != n * length) return Error{file.path() + ": truncated: the file ends in point " + str(first + *got / length)};
+      return okStatus();
+    }
+    const std::vector<uint64_t>& starts = laz->first_point;
+    // The chunks holding the first and the last point.
+    const auto chunkOf = [&](uint64_t point) {
+      return static_cast<size_t>(std::upper_bound(starts.begin(), starts.end(), point) - starts.begin()) - 1;
+    };
+    const size_t from = chunkOf(first), to = chunkOf(first + n - 1) + 1;
+    if (from < cached_first || to > cached_last) {
+      const uint64_t begin = starts[from], end = to < starts.size() ? starts[to] : header.point_count;
+      cache.resize(static_cast<size_t>((end - begin) * length));
+      if (Status s = decodeLazChunks(file, *laz, from, to, cache.data(), threads); !s) return s;
+      cached_first = from;
+      cached_last = to;
+    }
+    std::memcpy(out, cache.data() + (first - starts[cached_first]) * length, static_cast<size_t>(n * length));
+    return okStatus();
+  }
+};
+
+LasPointStream::LasPointStream() = default;
+LasPointStream::~LasPointStream() = default;
+
+Result<std::unique_ptr<LasPointStream>> LasPointStream::open(const std::string& path, unsigned threads) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  std::unique_ptr<LasPointStream> stream(new LasPointStream());
+  stream->state_ = std::make_unique<State>(std::move(*file));
+  State& st = *stream->state_;
+  Result<LasHeader> header = parseHeader(st.file);
+  if (!header) return header.error();
+  st.header = *header;
+  st.threads = resolveThreads(threads);
+  const std::vector<LasVlr> vlrs = readVlrs(st.file, st.header);
+  const LasVlr* extra_vlr = nullptr;
+  for (const LasVlr& vlr : vlrs)
+    if (isExtraBytesRecord(vlr)) extra_vlr = &vlr;
+  st.fields = lasFields(st.header.point_format);
+  const uint32_t extra_bytes = st.header.record_length - lasBaseRecordLength(st.header.point_format);
+  Result<std::vector<LasExtraField>> extra = lasExtraFields(extra_vlr, extra_bytes, st.fields);
+  if (!extra) extra = lasExtraFields(nullptr, extra_bytes, st.fields);
+  st.extra = std::move(*extra);
+  for (const LasField& f : st.fields) st.dimensions.append(f.name, f.type, 0);
+  for (const LasExtraField& f : st.extra) st.dimensions.append(f.name, f.type, 0);
+  if (st.header.compressed) {
+    Result<LazChunks> chunks = openLazChunks(st.file);
+    if (!chunks) return chunks.error();
+    st.laz = std::move(*chunks);
+  }
+  // The colour divisor from a sample (the class comment says which).
+  if (lasFormatHasRgb(st.header.point_format) && st.header.point_count > 0) {
+    const uint64_t count = st.header.point_count, length = st.header.record_length;
+    std::vector<std::pair<uint64_t, uint64_t>> ranges;  // first, n
+    if (st.laz) {
+      const std::vector<uint64_t>& starts = st.laz->first_point;
+      for (size_t c : {size_t{0}, starts.size() / 2, starts.size() - 1}) {
+        const uint64_t end = c + 1 < starts.size() ? starts[c + 1] : count;
+        ranges.emplace_back(starts[c], end - starts[c]);
+      }
+    } else {
+      for (uint64_t k = 0; k < 64; ++k) {
+        const uint64_t first = count * k / 64;
+        ranges.emplace_back(first, std::min<uint64_t>(64, count - first));
+      }
+    }
+    const size_t rgb_at = lasRgbOffset(st.header.point_format);
+    uint16_t largest = 0;
+    std::string buffer;
+    for (const auto& [first, n] : ranges) {
+      buffer.resize(static_cast<size_t>(n * length));
+      if (Status s = st.records(first, n, buffer.data()); !s) return s.error();
+      for (uint64_t i = 0; i < n; ++i)
+        for (size_t c = 0; c < 3; ++c)
+          largest = std::max(largest, loadUnaligned<uint16_t>(buffer.data() + i * length + rgb_at + 2 * c));
+    }
+    st.color_divisor = largest > 255 ? 65535.0f : 255.0f;
+  } else if (lasFormatHasRgb(st.header.point_format)) {
+    st.color_divisor = 65535.0f;
+  }
+  return stream;
+}
+
+const LasHeader& LasPointStream::header() const { return state_->header; }
+uint64_t LasPointStream::count() const { return state_->header.point_count; }
+bool LasPointStream::hasColors() const { return state_->color_divisor != 0.0f; }
+const Dimensions& LasPointStream::dimensions() const { return state_->dimensions; }
+void LasPointStream::streamDimensions(std::vector<size_t> which) { state_->streamed = std::move(which); }
+
+Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
+  State& st = *state_;
+  const LasHeader& h = st.header;
+  assert(first <= h.point_count && n <= h.point_count - first);
+  const size_t count = static_cast<size_t>(n), length = h.record_length;
+  std::string records(count * length, '\0');
+  if (n > 0)
+    if (Status s = st.records(first, n, records.data()); !s) return s;
+  block.triangles.clear();
+  block.z_axis = ZAxis::kPresent;
+  block.z_up = true;
+  block.positions.resize(count);
+  block.colors.resize(st.color_divisor != 0.0f ? count : 0);
+  block.dimensions = Dimensions();
+  for (size_t k : st.streamed) block.dimensions.append(st.dimensions.all()[k].name, st.dimensions.all()[k].type, count);
+  std::vector<Dimension*> columns;  // once every column is in place (appending may move the others)
+  for (Dimension& d : block.dimensions.all()) columns.push_back(&d);
+  const size_t rgb_at = lasRgbOffset(h.point_format), extra_at = lasBaseRecordLength(h.point_format);
+  const size_t chunk = size_t{1} << 15;
+  parallelFor((count + chunk - 1) / chunk, st.threads, [&](size_t c, unsigned) {
+    const size_t end = std::min(count, (c + 1) * chunk);
+    for (size_t i = c * chunk; i < end; ++i) {
+      const char* p = records.data() + i * length;
+      block.positions[i] = glm::dvec3(static_cast<double>(loadUnaligned<int32_t>(p)) * h.scale.x + h.offset.x,
+                                      static_cast<double>(loadUnaligned<int32_t>(p + 4)) * h.scale.y + h.offset.y,
+                                      static_cast<double>(loadUnaligned<int32_t>(p + 8)) * h.scale.z + h.offset.z);
+      if (st.color_divisor != 0.0f)
+        block.colors[i] = glm::vec3(loadUnaligned<uint16_t>(p + rgb_at), loadUnaligned<uint16_t>(p + rgb_at + 2),
+                                    loadUnaligned<uint16_t>(p + rgb_at + 4)) / st.color_divisor;
+      for (size_t k = 0; k < st.streamed.size(); ++k) {
+        const size_t index = st.streamed[k];
+        Dimension& d = *columns[k];
+        const size_t w = dimTypeSize(d.type);
+        if (index < st.fields.size()) {
+          const LasField& f = st.fields[index];
+          if (f.bits)
+            d.set<uint8_t>(i, static_cast<uint8_t>((static_cast<uint8_t>(p[f.offset]) >> f.shift) & ((1u << f.bits) - 1)));
+          else
+            std::memcpy(d.bytes.data() + i * w, p + f.offset, w);
+        } else {
+          std::memcpy(d.bytes.data() + i * w, p + extra_at + st.extra[index - st.fields.size()].offset, w);
+        }
+      }
+    }
+  });
+  return okStatus();
+}
+
 Status writeLas(const std::string& path, const PointSet& points, const LasWriteOptions& options) {
   // The scale: as asked, else the source LAS file's per axis, else 0.001.
   if (options.scale != 0.0 && !(std::isfinite(options.scale) && options.scale > 0.0))

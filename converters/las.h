@@ -57,7 +57,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "core/input_file.h"
 #include "core/point_set.h"
@@ -129,6 +131,32 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options = 
 // position and on a point that does not fit the 32-bit integers at the scale; with exit 1 on a
 // scale that is not finite and positive. More than 2^32 − 1 points are written as LAS 1.4.
 Status writeLas(const std::string& path, const PointSet& points, const LasWriteOptions& options = {});
+
+// A LAS or LAZ file read a block at a time (`render`/`info --stream`, converters/point_inputs.h):
+// positions, colours and the dimensions asked for, in bounded memory (LAZ: the chunks a block
+// covers are decoded, on all cores, and the last ones kept for the next block). Colours: the RGB
+// of formats that have it, divided by 255 when no channel of a sample exceeds 255 (an uncompressed
+// file: 4096 records spread over it; LAZ: its first, middle and last chunk), else by 65535: the
+// whole-file read's rule (readLas), decided before the first block, so a file whose only 16-bit
+// values lie outside the sample streams 257 times brighter than it reads whole.
+class LasPointStream {
+ public:
+  static Result<std::unique_ptr<LasPointStream>> open(const std::string& path, unsigned threads = 0);
+  ~LasPointStream();
+  const LasHeader& header() const;
+  uint64_t count() const;
+  bool hasColors() const;
+  // The record's fields and extra bytes as dimensions, as empty columns (names and types).
+  const Dimensions& dimensions() const;
+  // From now on read() also fills these of dimensions() (by index) into the block; none by default.
+  void streamDimensions(std::vector<size_t> which);
+  Status read(uint64_t first, uint64_t n, PointSet& block);
+
+ private:
+  LasPointStream();
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // True when the header's bounds contain `points` (the box of the points read), each side within
 // half a scale step (writers round the bounds they store). Not a reason to refuse a file: the

@@ -706,44 +706,44 @@ Result<LazHeader> readHeader(const InputFile& file) {
 
 }  // namespace
 
-Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t max_memory) {
-  const std::string& path = file.path();
+Result<LazChunks> openLazChunks(const InputFile& file) {
   Result<LazHeader> header = readHeader(file);
   if (!header) return header.error();
-  const LazHeader& hd = *header;
-  Result<std::vector<LazChunk>> table = readLazChunkTable(file, hd.point_offset, hd.info, hd.point_count);
+  Result<std::vector<LazChunk>> table = readLazChunkTable(file, header->point_offset, header->info, header->point_count);
   if (!table) return table.error();
-  const std::vector<LazChunk>& chunks = *table;
+  LazChunks out;
+  out.info = std::move(header->info);
+  out.chunks = std::move(*table);
+  out.record_length = header->record_length;
+  out.point_count = header->point_count;
+  out.first_point.assign(out.chunks.size(), 0);
+  for (size_t i = 1; i < out.chunks.size(); ++i) out.first_point[i] = out.first_point[i - 1] + out.chunks[i - 1].points;
+  return out;
+}
 
-  // The records and one chunk's bytes per thread.
-  const uint64_t length = hd.record_length;
-  threads = std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(std::max<size_t>(chunks.size(), 1)));
-  uint64_t largest = 0;
-  for (const LazChunk& c : chunks) largest = std::max(largest, c.bytes);
-  if (hd.point_count > (UINT64_MAX - largest * threads) / length)
-    return Error{path + ": " + str(hd.point_count) + " points of " + str(length) + " bytes overflow 64 bits",
-                 ExitCode::kResourceLimit};
-  if (Status s = checkMemory(path + ": decoding " + str(hd.point_count) + " points", hd.point_count * length +
-                             largest * threads, max_memory); !s)
-    return s.error();
-
-  std::string records(static_cast<size_t>(hd.point_count * length), '\0');
-  std::vector<uint64_t> first_point(chunks.size(), 0);
-  for (size_t i = 1; i < chunks.size(); ++i) first_point[i] = first_point[i - 1] + chunks[i - 1].points;
+Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first, size_t last, char* records,
+                       unsigned threads) {
+  assert(first <= last && last <= laz.chunks.size());
+  const std::string& path = file.path();
+  const std::vector<LazChunk>& chunks = laz.chunks;
+  const uint64_t length = laz.record_length;
+  if (first == last) return okStatus();
+  threads = std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(last - first));
   // The error reported is the first failing chunk's: chunks are handed out in order, and once one
   // fails no later one starts, so every earlier one is decoded and its error, if any, wins.
-  std::atomic<size_t> failed{chunks.size()};
+  std::atomic<size_t> failed{last};
   std::mutex mutex;
   std::optional<Error> error;
   std::vector<std::vector<char>> buffers(threads);
-  parallelFor(chunks.size(), threads, [&](size_t i, unsigned worker) {
+  parallelFor(last - first, threads, [&](size_t j, unsigned worker) {
+    const size_t i = first + j;
     if (i > failed.load()) return;
     const LazChunk& c = chunks[i];
     std::vector<char>& buffer = buffers[worker];
     buffer.resize(static_cast<size_t>(c.bytes));
     const std::string where = path + ": chunk " + str(i) + " of " + str(chunks.size()) + " (" + str(c.bytes) +
-                              " bytes at byte " + str(c.offset) + ", points " + str(first_point[i]) + " to " +
-                              str(first_point[i] + c.points - 1) + "): ";
+                              " bytes at byte " + str(c.offset) + ", points " + str(laz.first_point[i]) + " to " +
+                              str(laz.first_point[i] + c.points - 1) + "): ";
     std::optional<Error> problem;
     Result<size_t> got = file.readAt(c.offset, buffer.data(), buffer.size());
     if (!got) {
@@ -751,8 +751,8 @@ Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t 
     } else if (*got != buffer.size()) {
       problem = Error{where + "truncated: the file ends inside the chunk"};
     } else {
-      Status s = decodeLazChunk(hd.info, buffer.data(), buffer.size(), c.points,
-                                records.data() + first_point[i] * length);
+      Status s = decodeLazChunk(laz.info, buffer.data(), buffer.size(), c.points,
+                                records + (laz.first_point[i] - laz.first_point[first]) * length);
       if (!s) problem = Error{where + s.error().message};
     }
     if (!problem) return;
@@ -763,6 +763,29 @@ Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t 
     }
   });
   if (error) return *error;
+  return okStatus();
+}
+
+Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t max_memory) {
+  const std::string& path = file.path();
+  Result<LazChunks> opened = openLazChunks(file);
+  if (!opened) return opened.error();
+  const LazChunks& laz = *opened;
+  // The records and one chunk's bytes per thread.
+  const uint64_t length = laz.record_length;
+  const unsigned workers =
+      std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(std::max<size_t>(laz.chunks.size(), 1)));
+  uint64_t largest = 0;
+  for (const LazChunk& c : laz.chunks) largest = std::max(largest, c.bytes);
+  if (laz.point_count > (UINT64_MAX - largest * workers) / length)
+    return Error{path + ": " + str(laz.point_count) + " points of " + str(length) + " bytes overflow 64 bits",
+                 ExitCode::kResourceLimit};
+  if (Status s = checkMemory(path + ": decoding " + str(laz.point_count) + " points",
+                             laz.point_count * length + largest * workers, max_memory);
+      !s)
+    return s.error();
+  std::string records(static_cast<size_t>(laz.point_count * length), '\0');
+  if (Status s = decodeLazChunks(file, laz, 0, laz.chunks.size(), records.data(), workers); !s) return s.error();
   return records;
 }
 

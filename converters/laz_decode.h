@@ -105,6 +105,23 @@ Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t 
 // `info` must have passed parseLaszipVlr.
 Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint64_t points, char* records);
 
+// A LAZ file's chunks, to decode a few at a time (LasPointStream): the laszip VLR, the chunk
+// table, each chunk's first point, and the header's record length and count.
+struct LazChunks {
+  LazInfo info;
+  std::vector<LazChunk> chunks;
+  std::vector<uint64_t> first_point;  // per chunk
+  uint32_t record_length = 0;
+  uint64_t point_count = 0;
+};
+// Parses the header fields, the laszip VLR and the chunk table (readLazChunkTable's checks).
+Result<LazChunks> openLazChunks(const InputFile& file);
+// Decodes chunks [first, last) into `records` (their points × record length bytes, from chunk
+// `first`'s first point) on `threads` threads (0: all cores); the error is the first failing
+// chunk's, naming the file, the chunk, its bytes and points.
+Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first, size_t last, char* records,
+                       unsigned threads = 0);
+
 // All point records of a .laz file (LAS 1.0–1.4, point formats 0–3 and 6–8), count × record length bytes,
 // exactly as the uncompressed .las holds them. Parses the LAS header fields it needs (version,
 // header size, offset to point data, VLR count, point format, record length, legacy and 64-bit

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cstring>
 
+#include "converters/las.h"
 #include "converters/ply.h"
 #include "converters/tile_file.h"
 
@@ -66,10 +67,22 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
   return out;
 }
 
+// One file of the stream: a binary PLY or a LAS/LAZ file.
 struct PointInputStream::Part {
   std::unique_ptr<PlyVertexStream> ply;
+  std::unique_ptr<LasPointStream> las;
   uint64_t first = 0;  // the part's first point in the stream
   uint64_t count = 0;  // points it streams (a tile: its owned vertices)
+
+  uint64_t fileCount() const { return ply ? ply->count() : las->count(); }
+  bool hasColors() const { return ply ? ply->hasColors() : las->hasColors(); }
+  uint64_t faceCount() const { return ply ? ply->faceCount() : 0; }
+  const Dimensions& dimensions() const { return ply ? ply->dimensions() : las->dimensions(); }
+  void streamDimensions(std::vector<size_t> which) {
+    if (ply) ply->streamDimensions(std::move(which));
+    else las->streamDimensions(std::move(which));
+  }
+  Status read(uint64_t from, uint64_t n, PointSet& block) { return ply ? ply->read(from, n, block) : las->read(from, n, block); }
 };
 
 PointInputStream::~PointInputStream() = default;
@@ -89,29 +102,36 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     for (const std::string& path : paths) files.emplace_back(path, UINT64_MAX);
   }
   for (const auto& [path, owned] : files) {
-    Result<std::unique_ptr<PlyVertexStream>> ply =
-        PlyVertexStream::open(path, PlyReadOptions{false, nullptr, threads, true});
-    if (!ply) return ply.error();
     Part part;
-    part.count = std::min(owned, (*ply)->count());
+    Result<FileFormat> format = formatOf(path);
+    if (format && (*format == FileFormat::kLas || *format == FileFormat::kLaz)) {
+      Result<std::unique_ptr<LasPointStream>> las = LasPointStream::open(path, threads);
+      if (!las) return las.error();
+      part.las = std::move(*las);
+    } else {
+      Result<std::unique_ptr<PlyVertexStream>> ply =
+          PlyVertexStream::open(path, PlyReadOptions{false, nullptr, threads, true});
+      if (!ply) return ply.error();
+      part.ply = std::move(*ply);
+    }
+    part.count = std::min(owned, part.fileCount());
     part.first = stream->count_;
     stream->count_ += part.count;
-    if (part.count > 0) stream->has_colors_ = stream->has_colors_ || (*ply)->hasColors();
-    stream->faces_ += (*ply)->faceCount();
-    part.ply = std::move(*ply);
+    if (part.count > 0) stream->has_colors_ = stream->has_colors_ || part.hasColors();
+    stream->faces_ += part.faceCount();
     stream->parts_.push_back(std::move(part));
   }
   return stream;
 }
 
-const Dimensions& PointInputStream::dimensions() const { return parts_.front().ply->dimensions(); }
+const Dimensions& PointInputStream::dimensions() const { return parts_.front().dimensions(); }
 
 Status PointInputStream::streamDimension(const std::string& name) {
-  for (const Part& part : parts_) {
-    const std::vector<Dimension>& all = part.ply->dimensions().all();
+  for (Part& part : parts_) {
+    const std::vector<Dimension>& all = part.dimensions().all();
     const auto it = std::find_if(all.begin(), all.end(), [&](const Dimension& d) { return d.name == name; });
     if (it == all.end()) return Error{"dimension '" + name + "' is not in every file streamed", ExitCode::kUsage};
-    part.ply->streamDimensions({static_cast<size_t>(it - all.begin())});
+    part.streamDimensions({static_cast<size_t>(it - all.begin())});
     if (!streamed_) streamed_.emplace(name, it->type);
     else if (streamed_->type != it->type) streamed_->type = DimType::kF64;
   }
@@ -121,7 +141,7 @@ Status PointInputStream::streamDimension(const std::string& name) {
 Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   assert(first <= count_ && n <= count_ - first);
   if (parts_.size() == 1) {  // straight into the block
-    if (Status s = parts_[0].ply->read(first, n, block); !s) return s;
+    if (Status s = parts_[0].read(first, n, block); !s) return s;
     if (has_colors_ && !block.hasColors()) block.colors.assign(block.size(), glm::vec3(1.0f));
     return okStatus();
   }
@@ -134,7 +154,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   for (Part& part : parts_) {
     const uint64_t from = std::max(first, part.first), to = std::min(end, part.first + part.count);
     if (from >= to) continue;
-    if (Status s = part.ply->read(from - part.first, to - from, scratch_); !s) return s;
+    if (Status s = part.read(from - part.first, to - from, scratch_); !s) return s;
     const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
     if (streamed) {
@@ -150,13 +170,14 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
 
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
                                                           const std::string& stream, unsigned threads) {
-  const bool all_ply = std::all_of(paths.begin(), paths.end(), [](const std::string& path) {
+  const bool streamable = std::all_of(paths.begin(), paths.end(), [](const std::string& path) {
     Result<FileFormat> format = formatOf(path);
-    return format && *format == FileFormat::kPly;
+    return format && (*format == FileFormat::kPly || *format == FileFormat::kLas || *format == FileFormat::kLaz);
   });
   if (stream == "off") return std::unique_ptr<PointInputStream>();
-  if (!all_ply) {
-    if (stream == "on") return Error{describeInputs(paths) + ": --stream on reads binary PLY files", ExitCode::kUsage};
+  if (!streamable) {
+    if (stream == "on")
+      return Error{describeInputs(paths) + ": --stream on reads binary PLY, LAS and LAZ files", ExitCode::kUsage};
     return std::unique_ptr<PointInputStream>();
   }
   Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(paths, threads);

@@ -25,7 +25,7 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
 // True when the paths are the tiles of one run, all N of them, each once (converters/tile_file.h).
 bool isCompleteTileSet(const std::vector<std::string>& paths);
 
-// One or several binary PLY files as one stream of points (render's --stream): the points
+// One or several binary PLY, LAS or LAZ files as one stream of points (render's --stream): the points
 // readPointInputs(paths) gives, in its order, a block at a time (positions and colours, no
 // triangles). A complete tile set streams each tile's owned vertices in tile order (the merged
 // set, each seam vertex once); other files stream whole, one after another. Colours as in
@@ -59,7 +59,7 @@ class PointInputStream {
 };
 
 // --stream auto|on|off of render and info: the stream when `stream` is "on", or "auto" and the
-// paths are binary PLY files of more than kStreamAbovePoints points together; nullptr when the
+// paths are binary PLY, LAS or LAZ files of more than kStreamAbovePoints points together; nullptr when the
 // set is to be read whole. With "on", input that cannot be streamed is an error (an ASCII PLY, a
 // bad header: the reader's; another format: kUsage). In memory such a set would take 36 B a point
 // (2.4 GB at 2^26) before the upload's own.

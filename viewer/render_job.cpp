@@ -534,7 +534,7 @@ std::vector<RenderView> viewsFor(uint32_t count, bool z_up) {
 bool zUpFor(const RenderRequest& request, bool data_z_up) {
   if (request.up_axis != UpAxis::kAuto) return request.up_axis == UpAxis::kZ;
   return data_z_up || (!request.points && !request.inputs.empty() && std::all_of(request.inputs.begin(), request.inputs.end(), [](
-                                                         const std::string& path) { return hasExtension(path, ".las"); }));
+                                                         const std::string& path) { return hasExtension(path, ".las") || hasExtension(path, ".laz"); }));
 }
 
 Result<std::vector<Camera>> viewCameras(const RenderRequest& request, const std::vector<RenderView>& views,

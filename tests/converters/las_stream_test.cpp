@@ -1,0 +1,90 @@
+// LasPointStream (converters/las.h): LAS and LAZ files read a block at a time, as `render` and
+// `info --stream` read them, give what readLas gives whole: every position, colour and streamed
+// dimension, for every corpus file, in blocks that do not line up with LAZ's chunks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "converters/las.h"
+#include "converters/point_inputs.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+std::vector<std::string> corpusFiles() {
+  std::vector<std::string> files;
+  for (const char* folder : {"/las", "/laz"})
+    for (const auto& entry : std::filesystem::directory_iterator(std::string(DPOINT_CORPUS_DIR) + folder)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext == ".las" || ext == ".laz") files.push_back(entry.path().string());
+    }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(LasStream, everyCorpusFileStreamsAsItReadsWhole) {
+  const std::vector<std::string> files = corpusFiles();
+  ASSERT_GE(files.size(), 20u);
+  size_t laz = 0;
+  for (const std::string& path : files) {
+    SCOPED_TRACE(path);
+    Result<PointSet> whole = readLas(path);
+    ASSERT_TRUE(whole) << whole.error().message;
+    Result<std::unique_ptr<LasPointStream>> opened = LasPointStream::open(path, 2);
+    ASSERT_TRUE(opened) << opened.error().message;
+    LasPointStream& stream = **opened;
+    laz += stream.header().compressed ? 1 : 0;
+    ASSERT_EQ(stream.count(), whole->size());
+    EXPECT_EQ(stream.hasColors(), whole->hasColors());
+    ASSERT_EQ(stream.dimensions().count(), whole->dimensions.count());
+    std::vector<size_t> all;
+    for (size_t k = 0; k < stream.dimensions().count(); ++k) all.push_back(k);
+    stream.streamDimensions(all);
+    PointSet block;
+    const uint64_t step = 7777;  // across LAZ's 50,000-point chunks
+    for (uint64_t first = 0; first < stream.count(); first += step) {
+      const uint64_t n = std::min(step, stream.count() - first);
+      ASSERT_TRUE(stream.read(first, n, block).ok());
+      ASSERT_EQ(block.size(), n);
+      for (uint64_t i = 0; i < n; ++i) {
+        ASSERT_EQ(block.positions[i], whole->positions[first + i]) << "point " << first + i;
+        if (whole->hasColors()) {
+          ASSERT_EQ(block.colors[i], whole->colors[first + i]) << "point " << first + i;
+        }
+      }
+      for (size_t k = 0; k < all.size(); ++k) {
+        const Dimension& got = block.dimensions.all()[k];
+        const Dimension& want = whole->dimensions.all()[k];
+        ASSERT_EQ(got.name, want.name);
+        const size_t w = dimTypeSize(want.type);
+        ASSERT_TRUE(std::equal(got.bytes.begin(), got.bytes.end(), want.bytes.begin() + static_cast<ptrdiff_t>(first * w),
+                               want.bytes.begin() + static_cast<ptrdiff_t>((first + n) * w)))
+            << want.name;
+      }
+    }
+  }
+  EXPECT_GE(laz, 10u);
+}
+
+TEST(LasStream, renderAndInfoStreamLazAndLas) {
+  const std::string laz = std::string(DPOINT_CORPUS_DIR) + "/laz/autzen_trim.laz";
+  Result<std::unique_ptr<PointInputStream>> on = openPointStream({laz}, "on", 2);
+  ASSERT_TRUE(on) << on.error().message;
+  ASSERT_TRUE(*on);
+  EXPECT_EQ((*on)->count(), 110000u);
+  ASSERT_TRUE((*on)->streamDimension("classification").ok());
+  PointSet block;
+  ASSERT_TRUE((*on)->read(49990, 20, block).ok());  // across the first chunk's end
+  ASSERT_EQ(block.dimensions.count(), 1u);
+  // auto streams only sets larger than kStreamAbovePoints.
+  Result<std::unique_ptr<PointInputStream>> automatic = openPointStream({laz}, "auto", 2);
+  ASSERT_TRUE(automatic);
+  EXPECT_FALSE(*automatic);
+}
+
+}  // namespace
+}  // namespace dpoint
