@@ -90,6 +90,9 @@ class ItemDecoder {
  public:
   virtual ~ItemDecoder() = default;
   virtual void decode(LazDecoder& decoder, uint8_t* item) = 0;
+  // True once the item's code held something no encoder writes that the arithmetic decoder cannot
+  // see (GPS time's second sequence switch within one point).
+  virtual bool corrupt() const { return false; }
 };
 
 // The 20 bytes formats 0–5 share: x, y, z (i32), intensity (u16), the return byte (return number
@@ -193,10 +196,15 @@ class GpsTimeDecoder final : public ItemDecoder {
   explicit GpsTimeDecoder(const uint8_t* first) { time_[0] = loadUnaligned<uint64_t>(first); }
 
   void decode(LazDecoder& d, uint8_t* item) override {
-    // A switch to another sequence decodes the point again in that one (LASzip recurses). Valid
-    // data switches at most once per point; corrupt data may switch on, but every symbol uses up
-    // some of the code, so the decoder runs past its bytes and the loop ends.
-    while (d.ok()) {
+    // A switch to another sequence decodes the point again in that one (LASzip recurses). An
+    // encoder switches at most once per point (to a sequence where the difference fits 32 bits,
+    // then codes it there), so a second switch is corrupt data: refusing it bounds the loop, which
+    // crafted data could otherwise spin for billions of cheap symbols.
+    for (int pass = 0;; ++pass) {
+      if (pass == 2 || !d.ok()) {
+        corrupt_ = pass == 2;
+        break;
+      }
       if (diff_[last_] == 0) {
         const uint32_t s = d.decodeSymbol(zero_diff_model_);
         if (s == 1) {  // a difference that fits 32 bits
@@ -227,6 +235,7 @@ class GpsTimeDecoder final : public ItemDecoder {
     }
     storeUnaligned(item, time_[last_]);
   }
+  bool corrupt() const override { return corrupt_; }
 
  private:
   static constexpr uint32_t kMulti = kLazGpsMulti, kUnchanged = kLazGpsUnchanged, kFull = kLazGpsFull;
@@ -279,6 +288,7 @@ class GpsTimeDecoder final : public ItemDecoder {
   std::array<int32_t, 4> diff_{};
   std::array<int32_t, 4> extreme_{};
   uint32_t last_ = 0, next_ = 0;
+  bool corrupt_ = false;
   LazSymbolModel multi_model_{kLazGpsMultiSymbols};
   LazSymbolModel zero_diff_model_{6};  // unchanged, 32-bit difference, new sequence, 3 switches
   LazIntegerDecoder time_decoder_{32, 9};
@@ -499,7 +509,11 @@ Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint6
   if (!decoder.ok()) return failure(0);
   for (uint64_t p = 1; p < points; ++p) {
     uint8_t* record = reinterpret_cast<uint8_t*>(records) + p * length;
-    for (size_t i = 0; i < decoders.size(); ++i) decoders[i]->decode(decoder, record + offsets[i]);
+    for (size_t i = 0; i < decoders.size(); ++i) {
+      decoders[i]->decode(decoder, record + offsets[i]);
+      if (decoders[i]->corrupt())
+        return Error{"point " + str(p) + " of " + str(points) + ": the GPS time switches time sequence twice (corrupt data)"};
+    }
     if (!decoder.ok()) return failure(p);
   }
   const size_t left = bytes - length - decoder.consumed();

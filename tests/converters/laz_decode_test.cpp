@@ -232,7 +232,24 @@ TEST(LazDecode, rejectsCorruptChunk) {
   ASSERT_FALSE(records.ok());
   EXPECT_TRUE(contains(records.error().message,
                        "broken.laz: chunk 0 of 1 (17191 bytes at byte 1321, points 0 to 1064): point "));
-  EXPECT_TRUE(contains(records.error().message, "the compressed data ends early"));
+  // This flip makes the GPS time switch sequence twice in point 3, which no encoder writes.
+  EXPECT_TRUE(contains(records.error().message, "point 3 of 1065: the GPS time switches time sequence twice"));
+}
+
+TEST(LazDecode, gpsTimeSwitchingOnAndOnIsCorruptNotALongLoop) {
+  // Every byte of a chunk's code after its raw first point set to each value in turn: whatever it
+  // decodes to, the decode ends (an error or points), and never hangs on sequence switches.
+  const std::string base = readFile(kLaz + "point-time.las.laz");
+  const Layout l = layoutOf(base);
+  size_t corrupt = 0;
+  for (size_t at = 0; at < 64; ++at)
+    for (int value : {0x00, 0xFF, 0x80, 0x7F}) {
+      std::string file = base;
+      file[l.point_offset + 8 + 28 + at] = static_cast<char>(value);
+      Result<std::string> records = decodeBytes(file);
+      if (!records.ok()) ++corrupt;
+    }
+  EXPECT_GT(corrupt, 0u);
 }
 
 TEST(LazDecode, reportsTheFirstCorruptChunkWhateverTheThreads) {
