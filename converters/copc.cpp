@@ -1,0 +1,913 @@
+// COPC write and selective read (converters/copc.h says what and whence). Writing: parse the LAS
+// 1.4 input, measure it (bounds, returns, GPS times), quantize every point to 32 bits per axis of
+// the cube, thin level by level into the octree, compress one LAZ chunk per node on all cores, then
+// lay out header, VLRs, chunks, chunk table and hierarchy pages. Reading: header, info and laszip
+// VLRs, the hierarchy pages a query needs, and the chunks of the nodes it selects.
+#include "converters/copc.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <optional>
+#include <set>
+
+#include "converters/laz_encode.h"
+#include "core/bytes.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+
+namespace dpoint {
+
+static_assert(std::endian::native == std::endian::little, "LAS fields are little-endian, copied as they are");
+
+namespace {
+
+std::string str(uint64_t v) { return std::to_string(v); }
+
+// LAS 1.4 R15 header offsets (table 3).
+constexpr size_t kGlobalEncodingAt = 6, kVersionMajorAt = 24, kVersionMinorAt = 25, kHeaderSizeAt = 94;
+constexpr size_t kPointOffsetAt = 96, kVlrCountAt = 100, kFormatAt = 104, kRecordLengthAt = 105;
+constexpr size_t kLegacyCountAt = 107, kLegacyByReturnAt = 111, kScaleAt = 131, kOffsetAt = 155;
+constexpr size_t kMaxXAt = 179, kWaveformAt = 227, kEvlrStartAt = 235, kEvlrCountAt = 243, kCountAt = 247;
+constexpr size_t kByReturnAt = 255;
+constexpr size_t kHeader14 = 375, kVlrHeaderBytes = 54, kEvlrHeaderBytes = 60;
+constexpr size_t kInfoBytes = 160, kEntryBytes = 32;
+constexpr uint16_t kWktBit = 1u << 4;
+constexpr uint16_t kInfoRecord = 1, kHierarchyRecord = 1000, kLaszipRecord = 22204;
+
+// A VLR's or EVLR's user ID: 16 bytes, NUL-padded.
+std::string_view userId(const char* header) { return {header + 2, strnlen(header + 2, 16)}; }
+
+std::string vlrHeader(const char* user, uint16_t record, uint16_t length, const char* description) {
+  std::string h(kVlrHeaderBytes, '\0');
+  std::memcpy(h.data() + 2, user, std::min<size_t>(16, std::strlen(user)));
+  storeUnaligned<uint16_t>(h.data() + 18, record);
+  storeUnaligned<uint16_t>(h.data() + 20, length);
+  std::memcpy(h.data() + 22, description, std::min<size_t>(32, std::strlen(description)));
+  return h;
+}
+
+std::string evlrHeader(const char* user, uint16_t record, uint64_t length, const char* description) {
+  std::string h(kEvlrHeaderBytes, '\0');
+  std::memcpy(h.data() + 2, user, std::min<size_t>(16, std::strlen(user)));
+  storeUnaligned<uint16_t>(h.data() + 18, record);
+  storeUnaligned<uint64_t>(h.data() + 20, length);
+  std::memcpy(h.data() + 28, description, std::min<size_t>(32, std::strlen(description)));
+  return h;
+}
+
+// --- The input -------------------------------------------------------------------------------------
+
+struct LasInput {
+  std::string_view header;  // the first 375 bytes
+  int format = 0;
+  uint16_t record_length = 0;
+  uint64_t count = 0;
+  const char* records = nullptr;
+  std::vector<std::string_view> vlrs, evlrs;  // kept ones, header and data
+  double scale[3] = {1, 1, 1}, offset[3] = {0, 0, 0};
+};
+
+Result<LasInput> parseLas14(std::string_view las) {
+  if (las.size() < kHeader14 || las.substr(0, 4) != "LASF")
+    return Error{"not a LAS 1.4 file (no 'LASF' header of 375 bytes)"};
+  const char* h = las.data();
+  const int major = static_cast<uint8_t>(h[kVersionMajorAt]), minor = static_cast<uint8_t>(h[kVersionMinorAt]);
+  const uint16_t header_size = loadUnaligned<uint16_t>(h + kHeaderSizeAt);
+  if (major != 1 || minor != 4 || header_size < kHeader14)
+    return Error{"COPC is written from LAS 1.4 (a 375-byte header); this is LAS " + std::to_string(major) + "." +
+                 std::to_string(minor) + " with a " + str(header_size) + "-byte header"};
+  LasInput in;
+  in.header = las.substr(0, kHeader14);
+  const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
+  if (raw_format & 0xC0) return Error{"the records are compressed already (point format byte " + str(raw_format) + ")"};
+  in.format = raw_format;
+  if (in.format < 6 || in.format > 8)
+    return Error{"COPC holds point formats 6 to 8 only, not " + str(raw_format)};
+  in.record_length = loadUnaligned<uint16_t>(h + kRecordLengthAt);
+  const uint64_t point_offset = loadUnaligned<uint32_t>(h + kPointOffsetAt);
+  in.count = loadUnaligned<uint64_t>(h + kCountAt);
+  if (in.count == 0) in.count = loadUnaligned<uint32_t>(h + kLegacyCountAt);
+  if (point_offset < header_size || point_offset > las.size())
+    return Error{"header: the offset to point data " + str(point_offset) + " is outside the " + str(las.size()) +
+                 "-byte file"};
+  if (in.record_length == 0 || in.count > (las.size() - point_offset) / in.record_length)
+    return Error{str(in.count) + " records of " + str(in.record_length) + " bytes run past the file's end"};
+  if (in.count > UINT32_MAX) return Error{str(in.count) + " points: dpoint's COPC writer takes at most 2^32 - 1"};
+  in.records = h + point_offset;
+  for (size_t a = 0; a < 3; ++a) {
+    in.scale[a] = loadUnaligned<double>(h + kScaleAt + 8 * a);
+    in.offset[a] = loadUnaligned<double>(h + kOffsetAt + 8 * a);
+    if (!std::isfinite(in.scale[a]) || in.scale[a] == 0 || !std::isfinite(in.offset[a]))
+      return Error{"header: scale " + std::to_string(in.scale[a]) + " or offset " + std::to_string(in.offset[a]) +
+                   " of axis " + "XYZ"[a] + " is 0 or not finite"};
+  }
+
+  // VLRs and EVLRs but laszip's and COPC's own (a COPC input's are rewritten).
+  const auto kept = [](const char* header) { return userId(header) != "copc" && userId(header) != "laszip encoded"; };
+  size_t at = header_size;
+  const uint32_t vlr_count = loadUnaligned<uint32_t>(h + kVlrCountAt);
+  for (uint32_t i = 0; i < vlr_count; ++i) {
+    if (point_offset - at < kVlrHeaderBytes ||
+        point_offset - at - kVlrHeaderBytes < loadUnaligned<uint16_t>(h + at + 20))
+      return Error{"VLR " + str(i) + " at byte " + str(at) + " runs past the offset to point data " + str(point_offset)};
+    const size_t bytes = kVlrHeaderBytes + loadUnaligned<uint16_t>(h + at + 20);
+    if (kept(h + at)) in.vlrs.push_back(las.substr(at, bytes));
+    at += bytes;
+  }
+  uint64_t evlr_at = loadUnaligned<uint64_t>(h + kEvlrStartAt);
+  const uint32_t evlr_count = loadUnaligned<uint32_t>(h + kEvlrCountAt);
+  if (evlr_count != 0 && evlr_at < point_offset + in.count * in.record_length)
+    return Error{"header: the EVLRs' start " + str(evlr_at) + " lies inside the point records"};
+  for (uint32_t i = 0; i < evlr_count; ++i) {
+    if (evlr_at > las.size() || las.size() - evlr_at < kEvlrHeaderBytes ||
+        las.size() - evlr_at - kEvlrHeaderBytes < loadUnaligned<uint64_t>(h + evlr_at + 20))
+      return Error{"EVLR " + str(i) + " at byte " + str(evlr_at) + " runs past the file's end"};
+    const uint64_t bytes = kEvlrHeaderBytes + loadUnaligned<uint64_t>(h + evlr_at + 20);
+    if (kept(h + evlr_at)) in.evlrs.push_back(las.substr(evlr_at, bytes));
+    evlr_at += bytes;
+  }
+  return in;
+}
+
+// What the header says of the records: bounds (as integers), points by return, GPS times.
+struct RecordStats {
+  int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  uint64_t by_return[15] = {};
+  double gps_min = std::numeric_limits<double>::infinity(), gps_max = -std::numeric_limits<double>::infinity();
+
+  void merge(const RecordStats& o) {
+    for (size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], o.lo[a]), hi[a] = std::max(hi[a], o.hi[a]);
+    for (size_t r = 0; r < 15; ++r) by_return[r] += o.by_return[r];
+    gps_min = std::min(gps_min, o.gps_min);
+    gps_max = std::max(gps_max, o.gps_max);
+  }
+};
+
+RecordStats measure(const LasInput& in, unsigned threads) {
+  constexpr uint64_t kBlock = 1 << 16;
+  std::vector<RecordStats> blocks(static_cast<size_t>((in.count + kBlock - 1) / kBlock));
+  parallelFor(blocks.size(), threads, [&](size_t b, unsigned) {
+    RecordStats& s = blocks[b];
+    const uint64_t end = std::min(in.count, (b + 1) * kBlock);
+    for (uint64_t i = b * kBlock; i < end; ++i) {
+      const char* r = in.records + i * in.record_length;
+      for (size_t a = 0; a < 3; ++a) {
+        const int32_t v = loadUnaligned<int32_t>(r + 4 * a);
+        s.lo[a] = std::min(s.lo[a], v);
+        s.hi[a] = std::max(s.hi[a], v);
+      }
+      const unsigned ret = static_cast<uint8_t>(r[14]) & 0x0Fu;  // formats 6-10: return number, bits 0-3
+      if (ret != 0) ++s.by_return[ret - 1];
+      const double t = loadUnaligned<double>(r + 22);
+      // NaN times stay out of the range (min/max with NaN would depend on the order).
+      if (t < s.gps_min) s.gps_min = t;
+      if (t > s.gps_max) s.gps_max = t;
+    }
+  });
+  RecordStats all;
+  for (const RecordStats& s : blocks) all.merge(s);
+  return all;
+}
+
+// --- The octree ------------------------------------------------------------------------------------
+
+struct Node {
+  CopcKey key;
+  std::vector<uint32_t> points;  // input record indices, ascending
+  std::array<int32_t, 8> children = {-1, -1, -1, -1, -1, -1, -1, -1};
+  uint32_t subtree = 1;  // nodes in the subtree, this one included
+};
+
+// Each point's position in the cube as 32-bit fixed point per axis: node (level d) = q >> (32 − d).
+struct Quantized {
+  std::vector<uint32_t> q[3];
+};
+
+// The top 21 bits of each axis interleaved (z y x, from the top): the Morton curve's order.
+uint64_t mortonKey(const Quantized& qz, uint32_t p) {
+  const auto spread = [](uint64_t v) {  // 21 bits to every third of 63
+    v &= 0x1FFFFF;
+    v = (v | v << 32) & 0x1F00000000FFFFu;
+    v = (v | v << 16) & 0x1F0000FF0000FFu;
+    v = (v | v << 8) & 0x100F00F00F00F00Fu;
+    v = (v | v << 4) & 0x10C30C30C30C30C3u;
+    v = (v | v << 2) & 0x1249249249249249u;
+    return v;
+  };
+  return spread(qz.q[0][p] >> 11) | spread(qz.q[1][p] >> 11) << 1 | spread(qz.q[2][p] >> 11) << 2;
+}
+
+// What LAZ's coding of a node's records in this order costs, roughly: the bits of each difference
+// of x, y and z from the point before, and of each GPS time step (of the times' bit patterns) from
+// the step before, as LAZ predicts a time from the last step. Enough to tell an order whose
+// neighbours are near in space and time from one whose are not.
+uint64_t orderCost(const char* records, uint16_t length, const std::vector<uint32_t>& order) {
+  const auto bits = [](uint64_t a, uint64_t b) { return static_cast<uint64_t>(std::bit_width(a > b ? a - b : b - a)); };
+  uint64_t total = 0, last_step = 0;
+  for (size_t i = 1; i < order.size(); ++i) {
+    const char* a = records + uint64_t{order[i - 1]} * length;
+    const char* b = records + uint64_t{order[i]} * length;
+    for (size_t k = 0; k < 3; ++k) {
+      // Offset by 2^31: the int32 values as uint32, whose differences have the same magnitudes.
+      total += bits(loadUnaligned<uint32_t>(a + 4 * k) ^ 0x80000000u, loadUnaligned<uint32_t>(b + 4 * k) ^ 0x80000000u);
+    }
+    const uint64_t step = loadUnaligned<uint64_t>(b + 22) - loadUnaligned<uint64_t>(a + 22);
+    total += bits(step, last_step);
+    last_step = step;
+  }
+  return total;
+}
+
+// A node's points in the order that codes smaller: the input's (a scanner's order keeps neighbours
+// in space and time together; its leaves keep runs of it) or, where that order is scattered (a
+// generator's, a shuffled file's), along the Morton curve. The choice depends on the data alone.
+void chooseOrder(const Quantized& qz, const char* records, uint16_t length, std::vector<uint32_t>& points,
+                 std::vector<std::pair<uint64_t, uint32_t>>& keys, std::vector<uint32_t>& morton) {
+  keys.resize(points.size());
+  for (size_t i = 0; i < points.size(); ++i) keys[i] = {mortonKey(qz, points[i]), points[i]};
+  std::sort(keys.begin(), keys.end());
+  morton.resize(points.size());
+  for (size_t i = 0; i < points.size(); ++i) morton[i] = keys[i].second;
+  if (orderCost(records, length, morton) < orderCost(records, length, points)) points.swap(morton);
+}
+
+// The hash that picks a cell's point: SplitMix64's finalizer of index and seed (any point of a cell
+// is equally likely to be kept; ties, which a 32-bit hash has, go to the smaller index).
+uint64_t priority(uint32_t index, uint64_t seed) {
+  uint64_t z = index + seed * 0x9E3779B97F4A7C15u + 0x9E3779B97F4A7C15u;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9u;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBu;
+  z ^= z >> 31;
+  return (z & 0xFFFFFFFF00000000u) | index;
+}
+
+// Open addressing from a cell to the smallest priority offered for it.
+class CellTable {
+ public:
+  void reset(size_t cells) {
+    slots_.assign(std::bit_ceil(std::max<size_t>(16, 2 * cells)), Slot{});
+    mask_ = slots_.size() - 1;
+  }
+  void offer(uint32_t cell, uint64_t key) {
+    for (size_t i = (cell * 0x9E3779B1u) & mask_;; i = (i + 1) & mask_) {
+      Slot& s = slots_[i];
+      if (s.cell == cell + 1) {
+        s.key = std::min(s.key, key);
+        return;
+      }
+      if (s.cell == 0) {
+        s = {cell + 1, key};
+        return;
+      }
+    }
+  }
+  void winners(std::vector<uint64_t>& out) const {
+    out.clear();
+    for (const Slot& s : slots_)
+      if (s.cell != 0) out.push_back(s.key);
+  }
+
+ private:
+  struct Slot {
+    uint32_t cell = 0;  // cell + 1; 0: free
+    uint64_t key = 0;
+  };
+  std::vector<Slot> slots_;
+  size_t mask_ = 0;
+};
+
+struct Range {
+  uint32_t begin = 0, end = 0;
+};
+
+struct Scratch {
+  CellTable table;
+  std::vector<uint64_t> winners;
+};
+
+// Thins one node at `level` reached by the points cur[r.begin, r.end) (ascending): fills `kept`
+// and writes the others to next[r.begin, …) grouped by child octant, each group ascending.
+void thinNode(const Quantized& qz, int level, const CopcWriteOptions& o, Range r, const uint32_t* cur, uint32_t* next,
+              uint8_t* taken, Scratch& scratch, std::vector<uint32_t>& kept, std::array<Range, 8>& children) {
+  const uint32_t n = r.end - r.begin;
+  const uint32_t* in = cur + r.begin;
+  const uint32_t *qx = qz.q[0].data(), *qy = qz.q[1].data(), *qz_ = qz.q[2].data();
+  bool leaf = n <= o.max_points_per_node || level >= 32 - o.grid_levels;
+  if (!leaf) {  // points that all quantize alike never part: one leaf holds them
+    leaf = true;
+    for (uint32_t i = 1; i < n && leaf; ++i)
+      leaf = qx[in[i]] == qx[in[0]] && qy[in[i]] == qy[in[0]] && qz_[in[i]] == qz_[in[0]];
+  }
+  if (leaf) {
+    kept.assign(in, in + n);
+    return;
+  }
+  const int g = o.grid_levels;
+  const int shift = 32 - level - g;
+  const uint32_t mask = (1u << g) - 1;
+  scratch.table.reset(std::min<size_t>(n, size_t{1} << (3 * g)));
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t p = in[i];
+    const uint32_t cell = ((qx[p] >> shift) & mask) | (((qy[p] >> shift) & mask) << g) |
+                          (((qz_[p] >> shift) & mask) << (2 * g));
+    scratch.table.offer(cell, priority(p, o.seed));
+  }
+  std::vector<uint64_t>& winners = scratch.winners;
+  scratch.table.winners(winners);
+  if (winners.size() > o.max_points_per_node) {
+    std::nth_element(winners.begin(), winners.begin() + o.max_points_per_node, winners.end());
+    winners.resize(o.max_points_per_node);
+  }
+  for (uint64_t k : winners) taken[static_cast<uint32_t>(k)] = 1;
+
+  const int bit = 31 - level;
+  const auto octant = [&](uint32_t p) {
+    return ((qx[p] >> bit) & 1u) | (((qy[p] >> bit) & 1u) << 1) | (((qz_[p] >> bit) & 1u) << 2);
+  };
+  kept.clear();
+  kept.reserve(winners.size());
+  std::array<uint32_t, 8> count{};
+  for (uint32_t i = 0; i < n; ++i) {
+    if (taken[in[i]]) kept.push_back(in[i]);
+    else ++count[octant(in[i])];
+  }
+  std::array<uint32_t, 8> at{};
+  uint32_t start = r.begin;
+  for (size_t c = 0; c < 8; ++c) {
+    children[c] = {start, start + count[c]};
+    at[c] = start;
+    start += count[c];
+  }
+  for (uint32_t i = 0; i < n; ++i)
+    if (!taken[in[i]]) next[at[octant(in[i])]++] = in[i];
+}
+
+// The octree, level by level (nodes of a level in parent order, then octant order): the nodes of a
+// level are thinned in parallel, each only touching its own range, so the tree is the same for any
+// thread count.
+std::vector<Node> buildOctree(const Quantized& qz, uint32_t count, const CopcWriteOptions& o, unsigned threads) {
+  std::vector<Node> nodes(1);
+  std::vector<uint32_t> cur(count), next(count);
+  for (uint32_t i = 0; i < count; ++i) cur[i] = i;
+  std::vector<uint8_t> taken(count, 0);
+  std::vector<std::pair<size_t, Range>> level = {{0, Range{0, count}}};
+  std::vector<Scratch> scratch(threads);
+  for (int depth = 0; !level.empty(); ++depth) {
+    std::vector<std::array<Range, 8>> children(level.size());
+    parallelFor(level.size(), threads, [&](size_t i, unsigned worker) {
+      thinNode(qz, depth, o, level[i].second, cur.data(), next.data(), taken.data(), scratch[worker],
+               nodes[level[i].first].points, children[i]);
+    });
+    std::vector<std::pair<size_t, Range>> below;
+    for (size_t i = 0; i < level.size(); ++i) {
+      for (size_t c = 0; c < 8; ++c) {
+        const Range r = children[i][c];
+        if (r.end == r.begin) continue;
+        const CopcKey& k = nodes[level[i].first].key;
+        Node child;
+        child.key = {k.level + 1, 2 * k.x + static_cast<int32_t>(c & 1), 2 * k.y + static_cast<int32_t>((c >> 1) & 1),
+                     2 * k.z + static_cast<int32_t>(c >> 2)};
+        nodes[level[i].first].children[c] = static_cast<int32_t>(nodes.size());
+        below.emplace_back(nodes.size(), r);
+        nodes.push_back(std::move(child));
+      }
+    }
+    level = std::move(below);
+    std::swap(cur, next);
+  }
+  for (size_t i = nodes.size(); i-- > 0;)
+    for (int32_t c : nodes[i].children)
+      if (c >= 0) nodes[i].subtree += nodes[static_cast<size_t>(c)].subtree;
+  return nodes;
+}
+
+// --- Hierarchy pages -------------------------------------------------------------------------------
+
+struct PageEntry {
+  size_t node;
+  int64_t page;  // ≥ 0: the entry points at that child page (count −1)
+};
+
+// PDAL's paging: a page holds its root and the subtree below it, except that a node `page_levels`
+// below the root whose subtree has more than `page_min_nodes` nodes gets a page of its own.
+class Pager {
+ public:
+  Pager(const std::vector<Node>& nodes, const CopcWriteOptions& o) : nodes_(nodes), o_(o) {}
+  std::vector<std::vector<PageEntry>> pages;
+
+  size_t addPage(size_t root) {
+    const size_t id = pages.size();
+    pages.emplace_back();
+    pages[id].push_back({root, -1});
+    addChildren(root, nodes_[root].key.level + o_.page_levels, id);
+    return id;
+  }
+
+ private:
+  void addChildren(size_t parent, int stop, size_t page) {
+    for (int32_t c : nodes_[parent].children) {
+      if (c < 0) continue;
+      const size_t child = static_cast<size_t>(c);
+      if (o_.page_levels == 0 || nodes_[child].key.level != stop || nodes_[child].subtree <= o_.page_min_nodes) {
+        pages[page].push_back({child, -1});
+        addChildren(child, stop, page);
+      } else {
+        const size_t child_page = addPage(child);
+        pages[page].push_back({child, static_cast<int64_t>(child_page)});
+      }
+    }
+  }
+  const std::vector<Node>& nodes_;
+  const CopcWriteOptions& o_;
+};
+
+void putEntry(std::string& out, const CopcKey& key, uint64_t offset, int32_t bytes, int32_t points) {
+  char e[kEntryBytes];
+  storeUnaligned<int32_t>(e, key.level);
+  storeUnaligned<int32_t>(e + 4, key.x);
+  storeUnaligned<int32_t>(e + 8, key.y);
+  storeUnaligned<int32_t>(e + 12, key.z);
+  storeUnaligned<uint64_t>(e + 16, offset);
+  storeUnaligned<int32_t>(e + 24, bytes);
+  storeUnaligned<int32_t>(e + 28, points);
+  out.append(e, kEntryBytes);
+}
+
+}  // namespace
+
+std::string copcKeyName(const CopcKey& key) {
+  return std::to_string(key.level) + "-" + std::to_string(key.x) + "-" + std::to_string(key.y) + "-" +
+         std::to_string(key.z);
+}
+
+CopcBox copcNodeCube(const CopcInfo& info, const CopcKey& key) {
+  const double size = std::ldexp(2 * info.halfsize, -key.level);
+  const int32_t cell[3] = {key.x, key.y, key.z};
+  CopcBox box;
+  for (size_t a = 0; a < 3; ++a) {
+    const double lo = info.center[a] - info.halfsize;
+    box.min[a] = lo + cell[a] * size;
+    box.max[a] = lo + (cell[a] + 1.0) * size;
+  }
+  return box;
+}
+
+// --- Writing ---------------------------------------------------------------------------------------
+
+Result<std::string> copcFromLasBytes(std::string_view las14, const CopcWriteOptions& options) {
+  if (options.max_points_per_node == 0 || options.max_points_per_node > INT32_MAX)
+    return Error{"COPC: max points per node " + str(options.max_points_per_node) + " is not between 1 and 2^31 - 1"};
+  if (options.grid_levels < 1 || options.grid_levels > 10)
+    return Error{"COPC: grid levels " + std::to_string(options.grid_levels) + " is not between 1 and 10"};
+  if (options.page_levels < 0) return Error{"COPC: page levels " + std::to_string(options.page_levels) + " is negative"};
+  Result<LasInput> parsed = parseLas14(las14);
+  if (!parsed) return parsed.error();
+  const LasInput& in = *parsed;
+  const unsigned threads = resolveThreads(options.threads);
+  const uint32_t count = static_cast<uint32_t>(in.count);
+  const RecordStats stats = measure(in, threads);
+
+  // The cube: its edge the bounds' largest extent (a point or none: one scale step, so that the
+  // spacing is positive), its corner the bounds' minimum. Not centred on the bounds as PDAL does:
+  // a short axis (a survey's heights) then starts at a node face instead of straddling the cube's
+  // middle, which every level splits, so its points fill half as many nodes.
+  double lo[3], hi[3];
+  CopcInfo info;
+  for (size_t a = 0; a < 3; ++a) {
+    const double u = count ? stats.lo[a] * in.scale[a] + in.offset[a] : 0;
+    const double v = count ? stats.hi[a] * in.scale[a] + in.offset[a] : 0;
+    lo[a] = std::min(u, v);  // a negative scale swaps them
+    hi[a] = std::max(u, v);
+    info.halfsize = std::max(info.halfsize, (hi[a] - lo[a]) / 2);
+  }
+  if (!(info.halfsize > 0))
+    info.halfsize = std::max({std::abs(in.scale[0]), std::abs(in.scale[1]), std::abs(in.scale[2])}) / 2;
+  for (size_t a = 0; a < 3; ++a) info.center[a] = lo[a] + info.halfsize;
+  info.spacing = 2 * info.halfsize / static_cast<double>(1u << options.grid_levels);
+  if (count != 0 && stats.gps_min <= stats.gps_max) {
+    info.gpstime_minimum = stats.gps_min;
+    info.gpstime_maximum = stats.gps_max;
+  }
+
+  // Fixed point: t = (x − cube min) / edge in [0, 1], q = ⌊t·2^32⌋ clamped; rounding moves a point
+  // across a cell face by ~1e-16 of the cube at most, far inside the half scale step readers allow.
+  Quantized qz;
+  for (size_t a = 0; a < 3; ++a) qz.q[a].resize(count);
+  parallelFor((count + 65535) / 65536, threads, [&](size_t b, unsigned) {
+    const uint32_t end = static_cast<uint32_t>(std::min<uint64_t>(count, (b + 1) * 65536));
+    for (uint32_t i = static_cast<uint32_t>(b * 65536); i < end; ++i) {
+      const char* r = in.records + uint64_t{i} * in.record_length;
+      for (size_t a = 0; a < 3; ++a) {
+        const double x = loadUnaligned<int32_t>(r + 4 * a) * in.scale[a] + in.offset[a];
+        const double t = (x - (info.center[a] - info.halfsize)) / (2 * info.halfsize) * 4294967296.0;
+        qz.q[a][i] = t <= 0 ? 0u : t >= 4294967295.0 ? 4294967295u : static_cast<uint32_t>(t);
+      }
+    }
+  });
+  std::vector<Node> nodes;
+  if (count != 0) {
+    nodes = buildOctree(qz, count, options, threads);
+  } else {
+    nodes.resize(1);  // the root, empty
+  }
+
+  // One chunk per node, compressed in parallel.
+  Result<LazInfo> laz = lazInfoForFormat(in.format, in.record_length, kLazVariableChunks);
+  if (!laz) return laz.error();
+  std::vector<std::vector<uint8_t>> coded(nodes.size());
+  std::vector<std::string> gathered(threads);
+  std::vector<std::vector<std::pair<uint64_t, uint32_t>>> keys(threads);
+  std::vector<std::vector<uint32_t>> morton(threads);
+  parallelFor(nodes.size(), threads, [&](size_t i, unsigned worker) {
+    std::vector<uint32_t>& points = nodes[i].points;
+    if (points.empty()) return;
+    chooseOrder(qz, in.records, in.record_length, points, keys[worker], morton[worker]);
+    std::string& buffer = gathered[worker];
+    buffer.resize(points.size() * in.record_length);
+    for (size_t k = 0; k < points.size(); ++k)
+      std::memcpy(buffer.data() + k * in.record_length, in.records + uint64_t{points[k]} * in.record_length,
+                  in.record_length);
+    coded[i] = encodeLazChunk(*laz, buffer.data(), points.size());
+  });
+
+  // Layout: header, info VLR, the kept VLRs, the laszip VLR, the chunk table's offset, the chunks,
+  // the chunk table, the hierarchy EVLR, the kept EVLRs.
+  std::string vlrs = vlrHeader("copc", kInfoRecord, kInfoBytes, "COPC info");
+  const size_t info_at = kHeader14 + vlrs.size();
+  vlrs.append(kInfoBytes, '\0');
+  for (std::string_view v : in.vlrs) vlrs += v;
+  const std::string laz_data = laszipVlrData(*laz);
+  vlrs += vlrHeader("laszip encoded", kLaszipRecord, static_cast<uint16_t>(laz_data.size()), "dpoint COPC (LASzip 3.4)");
+  vlrs += laz_data;
+  const uint64_t point_offset = kHeader14 + vlrs.size();
+  if (point_offset > UINT32_MAX) return Error{"COPC: the VLRs outgrow the 32-bit offset to point data"};
+  std::vector<LazChunk> chunks;
+  std::vector<uint64_t> chunk_at(nodes.size(), 0);
+  uint64_t at = point_offset + 8;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].points.empty()) continue;
+    if (nodes[i].points.size() > INT32_MAX || coded[i].size() > INT32_MAX)
+      return Error{"COPC: node " + copcKeyName(nodes[i].key) + " holds " + str(nodes[i].points.size()) +
+                   " points in " + str(coded[i].size()) + " bytes, past the hierarchy's 32-bit fields"};
+    chunk_at[i] = at;
+    chunks.push_back({at, coded[i].size(), nodes[i].points.size()});
+    at += coded[i].size();
+  }
+  const uint64_t table_at = at;
+  const std::string table = encodeLazChunkTable(*laz, chunks);
+  const uint64_t evlr_at = table_at + table.size();
+
+  Pager pager(nodes, options);
+  pager.addPage(0);
+  const uint64_t pages_at = evlr_at + kEvlrHeaderBytes;
+  std::vector<uint64_t> page_at(pager.pages.size());
+  uint64_t page_end = pages_at;
+  for (size_t p = 0; p < pager.pages.size(); ++p) {
+    page_at[p] = page_end;
+    page_end += kEntryBytes * pager.pages[p].size();
+  }
+  std::string hierarchy = evlrHeader("copc", kHierarchyRecord, page_end - pages_at, "EPT hierarchy");
+  for (const std::vector<PageEntry>& page : pager.pages) {
+    for (const PageEntry& e : page) {
+      const Node& node = nodes[e.node];
+      if (e.page >= 0) {
+        const size_t p = static_cast<size_t>(e.page);
+        putEntry(hierarchy, node.key, page_at[p], static_cast<int32_t>(kEntryBytes * pager.pages[p].size()), -1);
+      } else {
+        putEntry(hierarchy, node.key, chunk_at[e.node], static_cast<int32_t>(coded[e.node].size()),
+                 static_cast<int32_t>(node.points.size()));
+      }
+    }
+  }
+  info.root_hier_offset = pages_at;
+  info.root_hier_size = kEntryBytes * pager.pages[0].size();
+
+  std::string out(in.header);
+  char* h = out.data();
+  storeUnaligned<uint16_t>(h + kGlobalEncodingAt, loadUnaligned<uint16_t>(h + kGlobalEncodingAt) | kWktBit);
+  storeUnaligned<uint16_t>(h + kHeaderSizeAt, static_cast<uint16_t>(kHeader14));
+  storeUnaligned<uint32_t>(h + kPointOffsetAt, static_cast<uint32_t>(point_offset));
+  storeUnaligned<uint32_t>(h + kVlrCountAt, static_cast<uint32_t>(in.vlrs.size() + 2));
+  h[kFormatAt] = static_cast<char>(in.format | 0x80);
+  storeUnaligned<uint32_t>(h + kLegacyCountAt, 0);
+  for (size_t r = 0; r < 5; ++r) storeUnaligned<uint32_t>(h + kLegacyByReturnAt + 4 * r, 0);
+  for (size_t a = 0; a < 3; ++a) {
+    storeUnaligned<double>(h + kMaxXAt + 16 * a, hi[a]);
+    storeUnaligned<double>(h + kMaxXAt + 16 * a + 8, lo[a]);
+  }
+  storeUnaligned<uint64_t>(h + kWaveformAt, 0);
+  storeUnaligned<uint64_t>(h + kEvlrStartAt, evlr_at);
+  storeUnaligned<uint32_t>(h + kEvlrCountAt, static_cast<uint32_t>(in.evlrs.size() + 1));
+  storeUnaligned<uint64_t>(h + kCountAt, in.count);
+  for (size_t r = 0; r < 15; ++r) storeUnaligned<uint64_t>(h + kByReturnAt + 8 * r, stats.by_return[r]);
+
+  char* v = vlrs.data() + (info_at - kHeader14);
+  for (size_t a = 0; a < 3; ++a) storeUnaligned<double>(v + 8 * a, info.center[a]);
+  storeUnaligned<double>(v + 24, info.halfsize);
+  storeUnaligned<double>(v + 32, info.spacing);
+  storeUnaligned<uint64_t>(v + 40, info.root_hier_offset);
+  storeUnaligned<uint64_t>(v + 48, info.root_hier_size);
+  storeUnaligned<double>(v + 56, info.gpstime_minimum);
+  storeUnaligned<double>(v + 64, info.gpstime_maximum);
+
+  uint64_t evlr_bytes = 0;
+  for (std::string_view e : in.evlrs) evlr_bytes += e.size();
+  out.reserve(static_cast<size_t>(page_end + evlr_bytes));
+  out += vlrs;
+  char table_offset[8];
+  storeUnaligned<int64_t>(table_offset, static_cast<int64_t>(table_at));
+  out.append(table_offset, 8);
+  for (const std::vector<uint8_t>& c : coded) out.append(reinterpret_cast<const char*>(c.data()), c.size());
+  out += table;
+  out += hierarchy;
+  for (std::string_view e : in.evlrs) out += e;
+  assert(out.size() == page_end + evlr_bytes);
+  return out;
+}
+
+// --- Reading ---------------------------------------------------------------------------------------
+
+namespace {
+
+// The bytes [at, at + n) of the file, or an Error saying what was cut short.
+Status readExactly(const InputFile& file, uint64_t at, void* out, size_t n, const std::string& what) {
+  if (at > file.size() || file.size() - at < n)
+    return Error{file.path() + ": truncated: " + what + " (" + str(n) + " bytes at byte " + str(at) +
+                 ") runs past the end of the " + str(file.size()) + "-byte file"};
+  Result<size_t> got = file.readAt(at, out, n);
+  if (!got) return got.error();
+  if (*got != n) return Error{file.path() + ": truncated: " + what + " ends at the file's end"};
+  return okStatus();
+}
+
+Result<CopcHeader> readHeader(const InputFile& file, uint64_t& bytes_read) {
+  const std::string& path = file.path();
+  char h[kHeader14 + kVlrHeaderBytes + kInfoBytes];
+  if (Status s = readExactly(file, 0, h, sizeof h, "the header and COPC info VLR"); !s) return s.error();
+  bytes_read += sizeof h;
+  if (std::memcmp(h, "LASF", 4) != 0) return Error{path + ": not a LAS/LAZ file (it does not start with 'LASF')"};
+  if (h[kVersionMajorAt] != 1 || h[kVersionMinorAt] != 4)
+    return Error{path + ": not COPC: LAS " + std::to_string(h[kVersionMajorAt]) + "." +
+                 std::to_string(h[kVersionMinorAt]) + ", COPC is LAS 1.4"};
+  const char* vlr = h + kHeader14;
+  if (loadUnaligned<uint16_t>(h + kHeaderSizeAt) != kHeader14 || userId(vlr) != "copc" ||
+      loadUnaligned<uint16_t>(vlr + 18) != kInfoRecord)
+    return Error{path + ": not COPC: no info VLR (user 'copc', record 1) at byte 375"};
+  if (loadUnaligned<uint16_t>(vlr + 20) != kInfoBytes)
+    return Error{path + ": COPC info VLR: " + str(loadUnaligned<uint16_t>(vlr + 20)) + " bytes, not 160"};
+  CopcHeader hd;
+  const uint8_t raw_format = static_cast<uint8_t>(h[kFormatAt]);
+  hd.point_format = raw_format & 0x3F;
+  if ((raw_format & 0x80) == 0 || hd.point_format < 6 || hd.point_format > 8)
+    return Error{path + ": COPC: point format byte " + str(raw_format) + " is not a compressed format 6, 7 or 8"};
+  hd.record_length = loadUnaligned<uint16_t>(h + kRecordLengthAt);
+  hd.point_data_offset = loadUnaligned<uint32_t>(h + kPointOffsetAt);
+  hd.point_count = loadUnaligned<uint64_t>(h + kCountAt);
+  if (hd.point_count == 0) hd.point_count = loadUnaligned<uint32_t>(h + kLegacyCountAt);
+  for (size_t a = 0; a < 3; ++a) {
+    hd.scale[a] = loadUnaligned<double>(h + kScaleAt + 8 * a);
+    hd.offset[a] = loadUnaligned<double>(h + kOffsetAt + 8 * a);
+  }
+  const char* d = vlr + kVlrHeaderBytes;
+  CopcInfo& info = hd.info;
+  for (size_t a = 0; a < 3; ++a) info.center[a] = loadUnaligned<double>(d + 8 * a);
+  info.halfsize = loadUnaligned<double>(d + 24);
+  info.spacing = loadUnaligned<double>(d + 32);
+  info.root_hier_offset = loadUnaligned<uint64_t>(d + 40);
+  info.root_hier_size = loadUnaligned<uint64_t>(d + 48);
+  info.gpstime_minimum = loadUnaligned<double>(d + 56);
+  info.gpstime_maximum = loadUnaligned<double>(d + 64);
+  const auto finite = [](double x) { return std::isfinite(x); };
+  if (!finite(info.center[0]) || !finite(info.center[1]) || !finite(info.center[2]) || !finite(info.halfsize) ||
+      !(info.halfsize > 0) || !finite(info.spacing) || !(info.spacing > 0))
+    return Error{path + ": COPC info VLR: the cube (half size " + std::to_string(info.halfsize) + ") or spacing (" +
+                 std::to_string(info.spacing) + ") is not positive and finite"};
+  if (info.root_hier_size == 0 || info.root_hier_size % kEntryBytes != 0 ||
+      info.root_hier_offset > file.size() || file.size() - info.root_hier_offset < info.root_hier_size)
+    return Error{path + ": COPC info VLR: the root hierarchy page (" + str(info.root_hier_size) + " bytes at byte " +
+                 str(info.root_hier_offset) + ") is not a whole number of 32-byte entries within the " +
+                 str(file.size()) + "-byte file"};
+
+  // The laszip VLR, among the VLRs after the info VLR.
+  const uint32_t vlr_count = loadUnaligned<uint32_t>(h + kVlrCountAt);
+  uint64_t at = kHeader14 + kVlrHeaderBytes + kInfoBytes;
+  bool found = false;
+  for (uint32_t i = 1; i < vlr_count && !found; ++i) {
+    char v[kVlrHeaderBytes];
+    if (at + kVlrHeaderBytes > hd.point_data_offset)
+      return Error{path + ": VLR " + str(i) + " at byte " + str(at) + " runs past the offset to point data " +
+                   str(hd.point_data_offset)};
+    if (Status s = readExactly(file, at, v, sizeof v, "VLR " + str(i)); !s) return s.error();
+    bytes_read += sizeof v;
+    const uint16_t bytes = loadUnaligned<uint16_t>(v + 20);
+    if (at + kVlrHeaderBytes + bytes > hd.point_data_offset)
+      return Error{path + ": VLR " + str(i) + " (" + str(bytes) + " bytes at byte " + str(at + kVlrHeaderBytes) +
+                   ") runs past the offset to point data " + str(hd.point_data_offset)};
+    if (loadUnaligned<uint16_t>(v + 18) == kLaszipRecord && userId(v) == "laszip encoded") {
+      std::string data(bytes, '\0');
+      if (Status s = readExactly(file, at + kVlrHeaderBytes, data.data(), bytes, "the laszip VLR"); !s)
+        return s.error();
+      bytes_read += bytes;
+      Result<LazInfo> laz = parseLaszipVlr(data);
+      if (!laz) return Error{path + ": " + laz.error().message};
+      hd.laz = std::move(*laz);
+      found = true;
+    }
+    at += kVlrHeaderBytes + bytes;
+  }
+  if (!found) return Error{path + ": COPC: no laszip VLR (user 'laszip encoded', record 22204)"};
+  if (Status s = checkLazItems(hd.laz, hd.point_format, hd.record_length); !s)
+    return Error{path + ": " + s.error().message};
+  return hd;
+}
+
+// The deepest level a query reads: the first whose spacing is at most the resolution.
+int deepestLevel(double spacing, double resolution) {
+  if (!(resolution > 0)) return INT32_MAX;
+  int level = 0;
+  for (double s = spacing; s > resolution && level < 64; s /= 2) ++level;
+  return level;
+}
+
+bool meets(const CopcBox& a, const CopcBox& b) {
+  for (size_t i = 0; i < 3; ++i)
+    if (!(a.min[i] <= b.max[i] && a.max[i] >= b.min[i])) return false;
+  return true;
+}
+
+bool everything(const CopcQuery& q) {
+  if (q.resolution > 0) return false;
+  for (size_t a = 0; a < 3; ++a)
+    if (q.box.min[a] != -std::numeric_limits<double>::infinity() ||
+        q.box.max[a] != std::numeric_limits<double>::infinity())
+      return false;
+  return true;
+}
+
+}  // namespace
+
+bool isCopc(const InputFile& file) {
+  char h[kHeader14 + kVlrHeaderBytes];
+  Result<size_t> got = file.readAt(0, h, sizeof h);
+  if (!got || *got != sizeof h) return false;
+  return std::memcmp(h, "LASF", 4) == 0 && userId(h + kHeader14) == "copc" &&
+         loadUnaligned<uint16_t>(h + kHeader14 + 18) == kInfoRecord;
+}
+
+Result<CopcHeader> readCopcHeader(const InputFile& file) {
+  uint64_t bytes = 0;
+  return readHeader(file, bytes);
+}
+
+Result<std::vector<CopcNode>> readCopcNodes(const InputFile& file, const CopcHeader& header, const CopcQuery& query,
+                                            uint64_t* bytes_read) {
+  const std::string& path = file.path();
+  const int deepest = deepestLevel(header.info.spacing, query.resolution);
+  struct Pending {
+    uint64_t offset, size;
+    std::string name;  // for messages
+  };
+  std::vector<Pending> queue = {{header.info.root_hier_offset, header.info.root_hier_size, "the root page"}};
+  std::set<uint64_t> seen;
+  uint64_t page_bytes = 0;
+  std::vector<CopcNode> nodes;
+  std::string page;
+  for (size_t next = 0; next < queue.size(); ++next) {
+    const Pending pending = queue[next];
+    const std::string where = path + ": hierarchy: " + pending.name + " (" + str(pending.size) + " bytes at byte " +
+                              str(pending.offset) + ")";
+    if (!seen.insert(pending.offset).second) return Error{where + " is read a second time (the pages form a cycle)"};
+    page_bytes += pending.size;
+    if (page_bytes > file.size())
+      return Error{where + ": the pages read add up to " + str(page_bytes) + " bytes, more than the file's " +
+                   str(file.size()) + " (pages overlap)"};
+    page.resize(static_cast<size_t>(pending.size));
+    if (Status s = readExactly(file, pending.offset, page.data(), page.size(), pending.name + " of the hierarchy"); !s)
+      return s.error();
+    for (size_t j = 0; j < page.size() / kEntryBytes; ++j) {
+      const char* e = page.data() + j * kEntryBytes;
+      CopcNode node;
+      node.key = {loadUnaligned<int32_t>(e), loadUnaligned<int32_t>(e + 4), loadUnaligned<int32_t>(e + 8),
+                  loadUnaligned<int32_t>(e + 12)};
+      node.offset = loadUnaligned<uint64_t>(e + 16);
+      node.bytes = loadUnaligned<int32_t>(e + 24);
+      node.points = loadUnaligned<int32_t>(e + 28);
+      const std::string entry = where + ", entry " + str(j) + " (node " + copcKeyName(node.key) + "): ";
+      const CopcKey& k = node.key;
+      if (k.level < 0 && node.points == 0 && node.offset == 0 && node.bytes == 0) continue;  // an unused slot
+      const int64_t cells = k.level >= 0 && k.level <= 30 ? int64_t{1} << k.level : 0;
+      if (cells == 0 || k.x < 0 || k.y < 0 || k.z < 0 || k.x >= cells || k.y >= cells || k.z >= cells)
+        return Error{entry + "not a node of an octree (levels 0 to 30, cells 0 to 2^level - 1)"};
+      if (node.points < -1) return Error{entry + "point count " + std::to_string(node.points) + " is below -1"};
+      if (node.points == -1) {
+        if (node.bytes <= 0 || node.bytes % static_cast<int32_t>(kEntryBytes) != 0 || node.offset > file.size() ||
+            file.size() - node.offset < static_cast<uint64_t>(node.bytes))
+          return Error{entry + "its child page (" + std::to_string(node.bytes) + " bytes at byte " + str(node.offset) +
+                       ") is not a whole number of 32-byte entries within the " + str(file.size()) + "-byte file"};
+      } else if (node.points > 0) {
+        if (node.bytes <= 0 || node.offset < header.point_data_offset + 8 || node.offset > file.size() ||
+            file.size() - node.offset < static_cast<uint64_t>(node.bytes))
+          return Error{entry + "its chunk (" + std::to_string(node.bytes) + " bytes at byte " + str(node.offset) +
+                       ") is not within the point data (bytes " + str(header.point_data_offset + 8) + " to " +
+                       str(file.size()) + ")"};
+      }
+      if (k.level > deepest || !meets(copcNodeCube(header.info, k), query.box)) continue;
+      if (node.points == -1) {
+        queue.push_back({node.offset, static_cast<uint64_t>(node.bytes), "the page of node " + copcKeyName(k)});
+      } else {
+        nodes.push_back(node);
+      }
+    }
+  }
+  std::sort(nodes.begin(), nodes.end(), [](const CopcNode& a, const CopcNode& b) { return a.key < b.key; });
+  for (size_t i = 1; i < nodes.size(); ++i)
+    if (nodes[i].key == nodes[i - 1].key)
+      return Error{path + ": hierarchy: node " + copcKeyName(nodes[i].key) + " has two entries"};
+  if (everything(query)) {
+    uint64_t total = 0;
+    for (const CopcNode& n : nodes) total += static_cast<uint64_t>(std::max(n.points, 0));
+    if (total != header.point_count)
+      return Error{path + ": hierarchy: the nodes hold " + str(total) + " points, the header says " +
+                   str(header.point_count)};
+  }
+  if (bytes_read) *bytes_read = page_bytes;
+  return nodes;
+}
+
+Result<std::string> readCopcRecords(const InputFile& file, const CopcQuery& query, CopcNodeRead* stats) {
+  const std::string& path = file.path();
+  uint64_t bytes_read = 0;
+  Result<CopcHeader> header = readHeader(file, bytes_read);
+  if (!header) return header.error();
+  const CopcHeader& hd = *header;
+  uint64_t page_bytes = 0;
+  Result<std::vector<CopcNode>> selected = readCopcNodes(file, hd, query, &page_bytes);
+  if (!selected) return selected.error();
+  bytes_read += page_bytes;
+  std::vector<CopcNode> nodes;
+  for (const CopcNode& n : *selected)
+    if (n.points > 0) nodes.push_back(n);
+
+  // Each node's place in the records, and the memory they take.
+  const uint64_t length = hd.record_length;
+  std::vector<uint64_t> first(nodes.size() + 1, 0);
+  uint64_t largest = 0;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    first[i + 1] = first[i] + static_cast<uint64_t>(nodes[i].points);
+    largest = std::max(largest, static_cast<uint64_t>(nodes[i].bytes));
+  }
+  const uint64_t total = first.back();
+  const unsigned threads =
+      std::min<unsigned>(resolveThreads(query.threads), static_cast<unsigned>(std::max<size_t>(nodes.size(), 1)));
+  if (Status s = checkMemory(path + ": reading " + str(total) + " points of " + str(nodes.size()) + " COPC nodes",
+                             total * length + largest * threads, query.max_memory);
+      !s)
+    return s.error();
+  std::string records(static_cast<size_t>(total * length), '\0');
+
+  // The first failing node's error, whatever the thread count (as decodeLaz does).
+  std::atomic<size_t> failed{nodes.size()};
+  std::mutex mutex;
+  std::optional<Error> error;
+  std::vector<std::vector<char>> buffers(threads);
+  parallelFor(nodes.size(), threads, [&](size_t i, unsigned worker) {
+    if (i > failed.load()) return;
+    const CopcNode& n = nodes[i];
+    std::vector<char>& buffer = buffers[worker];
+    buffer.resize(static_cast<size_t>(n.bytes));
+    const std::string where = path + ": node " + copcKeyName(n.key) + " (" + std::to_string(n.points) + " points, " +
+                              std::to_string(n.bytes) + " bytes at byte " + str(n.offset) + "): ";
+    std::optional<Error> problem;
+    Result<size_t> got = file.readAt(n.offset, buffer.data(), buffer.size());
+    if (!got) {
+      problem = got.error();
+    } else if (*got != buffer.size()) {
+      problem = Error{where + "truncated: the file ends inside the chunk"};
+    } else if (Status s = decodeLazChunk(hd.laz, buffer.data(), buffer.size(), static_cast<uint64_t>(n.points),
+                                         records.data() + first[i] * length);
+               !s) {
+      problem = Error{where + s.error().message};
+    }
+    if (!problem) return;
+    std::lock_guard<std::mutex> lock(mutex);
+    if (i < failed.load()) {
+      failed.store(i);
+      error = std::move(*problem);
+    }
+  });
+  if (error) return *error;
+  if (stats) {
+    stats->points = total;
+    stats->nodes = nodes.size();
+    stats->bytes = bytes_read;
+    for (const CopcNode& n : nodes) stats->bytes += static_cast<uint64_t>(n.bytes);
+  }
+  return records;
+}
+
+}  // namespace dpoint
