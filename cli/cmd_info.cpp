@@ -18,6 +18,8 @@ struct InfoCliOptions {
   CameraCliOptions camera;
   std::string max_memory;
   std::string stream = "auto";
+  int scene = -1;
+  bool all_scenes = false;
   CommonOptions common;
 };
 
@@ -27,7 +29,9 @@ int runInfo(const InfoCliOptions& o) {
   if (!limit) return reportError(limit.error());
   Result<CameraSpec> spec = cameraSpec(o.camera);
   if (!spec) return reportError(spec.error());
-  const InfoInputs inputs{o.inputs, o.stream, o.allow_nonfinite, *limit};
+  InfoInputs inputs{o.inputs, o.stream, o.allow_nonfinite, *limit};
+  inputs.scene = o.scene;
+  inputs.all_scenes = o.all_scenes;
   const InfoOptions options{*spec, o.sample, *parseTolerance(o.camera.tolerance), o.common.threads};
   Result<InfoReport> report = describeFiles(inputs, options, progress);
   if (!report) return reportError(report.error());
@@ -53,6 +57,10 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       ->default_val(10000)
       ->check(CLI::Range(size_t{1}, size_t{100000000}));
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
+  // The same choice of glTF scene as `dpoint convert`.
+  auto* scene = cmd->add_option("--scene", o->scene, "glTF: describe scene N instead of the default scene (else scene 0)")
+                    ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--all-scenes", o->all_scenes, "glTF: every scene, one after the other, as one set")->excludes(scene);
   addCameraOptions(*cmd, o->camera);
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,

@@ -66,6 +66,9 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".gltf") return FileFormat::kGltf;
   if (ext == ".las") return FileFormat::kLas;
   if (ext == ".laz") return FileFormat::kLaz;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return Error{path + ": is a folder, not a point file (.csv, .ply, .glb, .gltf, .las or .laz)", ExitCode::kUsage};
   return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb, .gltf, .las or .laz)", ExitCode::kUsage};
 }
 
@@ -133,7 +136,7 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
                      std::to_string(gltf.max_points),
                  ExitCode::kResourceLimit};
   };
-  if (*format == FileFormat::kLas && gltf.max_points != 0) {  // the header's count, before allocating
+  if ((*format == FileFormat::kLas || *format == FileFormat::kLaz) && gltf.max_points != 0) {  // the header's count first
     Result<LasHeader> header = readLasHeader(path);
     if (!header) return header.error();
     if (header->point_count > gltf.max_points) return tooMany(header->point_count);

@@ -353,17 +353,18 @@ class SlabField {
 }  // namespace
 
 Status validateEscapeParams(int resolution, int max_iter, double lo, double hi, double level) {
-  // Too large is a resource limit (exit 4), like the memory estimate it would otherwise fail.
+  // A fixed range: outside it is a usage error (exit 1) either way; a resolution inside it that
+  // needs more memory than there is fails the memory estimate (exit 4) later.
   if (resolution < 2 || resolution > kMaxGridResolution)
-    return Error{"--resolution: " + std::to_string(resolution) + " is outside 2.." + std::to_string(kMaxGridResolution),
-                 resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
+    return Error{"--resolution " + std::to_string(resolution) + ": must be 2.." + std::to_string(kMaxGridResolution),
+                 ExitCode::kUsage};
   if (max_iter < 1 || max_iter > kMaxEscapeIterations)
-    return Error{"--max-iter: " + std::to_string(max_iter) + " is outside 1.." + std::to_string(kMaxEscapeIterations),
+    return Error{"--max-iter " + std::to_string(max_iter) + ": must be 1.." + std::to_string(kMaxEscapeIterations),
                  ExitCode::kUsage};
   if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi))
     return Error{"--bounds: " + text(lo) + "," + text(hi) + " must be finite with LO < HI", ExitCode::kUsage};
   if (level != kDefaultLevel && !(level > 0.0 && level < static_cast<double>(max_iter)))
-    return Error{"--level: " + text(level) + " is outside the escape counts' range (0, " + std::to_string(max_iter) +
+    return Error{"--level " + text(level) + ": must lie inside the escape counts' range (0, " + std::to_string(max_iter) +
                      ") (exclusive; --max-iter is " + std::to_string(max_iter) + ")",
                  ExitCode::kUsage};
   return okStatus();

@@ -391,13 +391,13 @@ Reference chooseReference(const Mandelbrot2dParams& p) {
 }
 
 Status validate(const Mandelbrot2dParams& p) {
-  // Too large is a resource limit (exit 4), like the memory estimate it would otherwise fail.
+  // A fixed range: outside it is a usage error either way (a size inside it that needs more memory
+  // than there is fails the memory estimate, exit 4, later).
   if (p.resolution < 2 || p.resolution > kMaxResolution)
-    return Error{"--resolution must be in [2, " + std::to_string(kMaxResolution) + "], got " +
-                     std::to_string(p.resolution),
-                 p.resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
+    return Error{"--resolution " + std::to_string(p.resolution) + ": must be 2.." + std::to_string(kMaxResolution),
+                 ExitCode::kUsage};
   if (p.max_iter && *p.max_iter < 1)
-    return Error{"--max-iter must be at least 1, got " + std::to_string(*p.max_iter), ExitCode::kUsage};
+    return Error{"--max-iter " + std::to_string(*p.max_iter) + ": must be at least 1", ExitCode::kUsage};
   if (!std::isfinite(p.width) || !(p.width >= kMinWidth))
     return Error{"--width must be finite and at least 1e-300, got " + formatDouble(p.width), ExitCode::kUsage};
   const std::string center = formatDouble(p.center_x) + "," + formatDouble(p.center_y);

@@ -265,7 +265,7 @@ Status validateMandelbulb(const MandelbulbParams& params) {
   if (Status s = validateEscapeParams(params.resolution, params.max_iter, params.lo, params.hi, params.level); !s)
     return s;
   if (!std::isfinite(params.power) || params.power < 2.0 || params.power > 64.0)
-    return Error{"--power: " + powerText(params.power) + " is outside 2..64", ExitCode::kUsage};
+    return Error{"--power " + powerText(params.power) + ": must be 2..64", ExitCode::kUsage};
   if (params.variant == MandelbulbVariant::kFast && params.power != 8.0)
     return Error{"--variant fast: only --power 8 has a trig-free form; use --variant seed", ExitCode::kUsage};
   if (params.variant == MandelbulbVariant::kSeed && params.planes)

@@ -168,11 +168,17 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) return describeStream(**stream, name, options, progress);
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};
   read.max_memory = inputs.max_memory;
-  Result<PointSet> points = readPointInputs(inputs.paths, read);
+  const bool scenes = inputs.scene >= 0 || inputs.all_scenes;
+  if (scenes && inputs.paths.size() != 1)
+    return Error{name + ": --scene and --all-scenes apply to one .glb/.gltf input", ExitCode::kUsage};
+  GltfReadOptions gltf;
+  gltf.scene = inputs.scene;
+  gltf.all_scenes = inputs.all_scenes;
+  Result<PointSet> points = scenes ? readInput(inputs.paths[0], read, gltf) : readPointInputs(inputs.paths, read);
   if (!points) return points.error();
   std::optional<LasHeader> header;  // one LAS file: its header too
   if (Result<FileFormat> format = formatOf(inputs.paths[0]);
-      inputs.paths.size() == 1 && format && *format == FileFormat::kLas) {
+      inputs.paths.size() == 1 && format && (*format == FileFormat::kLas || *format == FileFormat::kLaz)) {
     Result<LasHeader> las = readLasHeader(inputs.paths[0]);
     if (!las) return las.error();
     header = std::move(*las);

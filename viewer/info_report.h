@@ -80,6 +80,8 @@ struct InfoInputs {
   std::string stream = "auto";       // auto|on|off (openPointStream)
   bool allow_nonfinite = false;      // accept nan/inf positions instead of failing
   uint64_t max_memory = 0;           // host memory limit in bytes; 0: half of RAM
+  int scene = -1;                    // glTF: the scene (-1: the default), as `convert --scene`
+  bool all_scenes = false;           // glTF: every scene (`--all-scenes`)
 };
 
 // The report of the files, named describeInputs(paths): streamed (describeStream) where

@@ -137,7 +137,7 @@ TEST(CliGenerate, badParametersNameTheFlagAndWriteNothing) {
   };
   const std::vector<Bad> cases = {
       {{"mandelbulb", "--resolution", "1"}, 1, "--resolution"},
-      {{"mandelbulb", "--resolution", "70000"}, 4, "--resolution"},
+      {{"mandelbulb", "--resolution", "70000"}, 1, "--resolution 70000: must be 2..65536"},
       {{"mandelbulb", "--max-iter", "0"}, 1, "--max-iter"},
       {{"mandelbulb", "--resolution", "16", "--level", "100"}, 1, "--level"},
       {{"mandelbulb", "--resolution", "16", "--level", "-3"}, 1, "--level"},

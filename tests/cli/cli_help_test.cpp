@@ -96,7 +96,7 @@ TEST(CliHelp, fourViewSheetIsTheSizeAskedFor) {
   for (const auto& [w, h] : std::vector<std::pair<uint32_t, uint32_t>>{{800, 600}, {321, 241}}) {
     const std::string out = dir.file("v" + std::to_string(w) + ".png");
     test::CommandResult r = runDpoint({"render", dir.file("mb.ply"), "-o", out, "--views", "4", "--width",
-                                       std::to_string(w), "--height", std::to_string(h), "-q"});
+                                       std::to_string(w), "--height", std::to_string(h)});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(test::pngSize(readFile(out)), std::make_pair(w, h));
     EXPECT_TRUE(contains(r.out, std::to_string(w) + "x" + std::to_string(h))) << r.out;
@@ -154,14 +154,14 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
 TEST(CliHelp, everyListedOutputFormatIsWritten) {
   for (const char* command : {"merge", "convert"}) {
     test::CommandResult help = runDpoint({command, "--help"});
-    EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las)")) << command;
+    EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las, .laz)")) << command;
   }
   test::CommandResult help = runDpoint({"generate", "random2d", "--help"});
-  EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las)")) << help.out;
+  EXPECT_TRUE(contains(help.out, "Output file (.csv, .ply, .glb, .las, .laz)")) << help.out;
   EXPECT_FALSE(contains(help.out, ".gltf"));
-  EXPECT_TRUE(contains(runDpoint({"--help"}).out, "CSV, PLY, GLB and LAS"));
+  EXPECT_TRUE(contains(runDpoint({"--help"}).out, "CSV, PLY, GLB, LAS and LAZ"));
   TempDir dir;
-  for (const char* ext : {"csv", "ply", "glb", "las"}) {
+  for (const char* ext : {"csv", "ply", "glb", "las", "laz"}) {
     test::CommandResult r = runDpoint({"generate", "random2d", "-n", "10", "-q", "-o", dir.file(std::string("p.") + ext)});
     EXPECT_EQ(r.exit_code, 0) << ext << ": " << r.err;
     EXPECT_TRUE(test::fileExists(dir.file(std::string("p.") + ext))) << ext;
@@ -198,6 +198,12 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
        "--max-iter abc: must be a whole number from 1 to 2147483647, or auto"},
       {{"convert", in, "-o", ply, "--keep", "intensity"}, "--keep intensity: " + in + " has no dimension 'intensity'"},
       {{"render", in, "-o", png, "--color", "intensity"}, "--color intensity: " + in + " has no dimension 'intensity'"},
+      {{"generate", "mandelbulb", "--resolution", "100000", "-o", ply}, "--resolution 100000: must be 2..65536"},
+      {{"generate", "mandelbrot2d", "--resolution", "1", "-o", ply}, "--resolution 1: must be 2.."},
+      {{"info", dir.path()}, dir.path() + ": is a folder, not a point file (.csv, .ply, .glb, .gltf, .las or .laz)"},
+      {{"convert", dir.path(), "-o", ply}, dir.path() + ": is a folder, not a point file"},
+      {{"info", in, "--scene", "1"}, in + ": --scene and --all-scenes apply to .glb/.gltf input only"},
+      {{"info", in, in, "--all-scenes"}, in + " and 1 more: --scene and --all-scenes apply to one .glb/.gltf input"},
   };
   for (const Case& c : cases) {
     std::string line;

@@ -480,7 +480,7 @@ TEST(CliRender, wrongOrPoorPicturesSaySo) {
   EXPECT_TRUE(test::contains(json, "\"warnings\": [\"--mode fp32: predicted error unbounded (> 0.5 px)")) << json;
   EXPECT_TRUE(test::contains(json, "\"mode_requested\": \"fp32\"")) << "the existing keys stay";
 
-  test::CommandResult good = render({"-q"});
+  test::CommandResult good = render({});
   EXPECT_EQ(warnings(good.err), 0u) << good.err;
   EXPECT_TRUE(test::contains(good.out, "mode auto: faster modes passed over: fp32 (unbounded error)")) << good.out;
   json = readFile(dir.file("p.json"));

@@ -251,7 +251,7 @@ TEST(Julia, rejectsNonFiniteConstantAndBadLevel) {
   params.level = 200.0;
   r = generateJulia(params);
   ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.error().message.find("--level: 200 is outside"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("--level 200: must lie inside"), std::string::npos) << r.error().message;
 }
 
 TEST(Julia, gridOutIsUint16AboveMaxIter255) {

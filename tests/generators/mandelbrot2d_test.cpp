@@ -437,7 +437,7 @@ TEST(Mandelbrot2d, rejectsBadParametersNamingTheFlag) {
     c.edit(p);
     Result<PointSet> set = generateMandelbrot2d(p);
     ASSERT_FALSE(set.ok()) << c.flag;
-    EXPECT_EQ(set.error().code, p.resolution > 65536 ? ExitCode::kResourceLimit : ExitCode::kUsage);
+    EXPECT_EQ(set.error().code, ExitCode::kUsage);
     EXPECT_NE(set.error().message.find(c.flag), std::string::npos) << set.error().message;
     EXPECT_FALSE(mandelbrot2dCounts(p).ok());
   }
