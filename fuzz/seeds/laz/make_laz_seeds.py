@@ -254,7 +254,8 @@ def convert_error(data):
 
 def assemble(b, keep, chunks, chunk_size, count, at_end):
     """A LAZ file: b's header and the VLRs `keep` accepts, the laszip VLR's chunk size set, the
-    header's count(s) set to `count`, then `chunks` [(points, bytes)] and their table."""
+    header's count(s) set to `count`, then `chunks` (Chunk: the bytes, with .points) and their
+    table (after the chunks, or at the file's end with the offset -1 before the chunks)."""
     header_size, vlrs = vlrs_of(b)
     head = bytearray(b[:header_size])
     kept = b"".join(b[at:at + size] for at, size, uid, rid in vlrs if uid == b"laszip encoded" or keep(uid, rid))
