@@ -133,14 +133,20 @@ LazIntegerDecoder::LazIntegerDecoder(uint32_t bits, uint32_t contexts, uint32_t 
   corr_min_ = corr_range_ != 0 ? -static_cast<int32_t>(corr_range_ / 2) : INT32_MIN;
   classes_.reserve(contexts);
   for (uint32_t c = 0; c < contexts; ++c) classes_.emplace_back(corr_bits_ + 1);
-  correctors_.reserve(corr_bits_);
-  for (uint32_t k = 1; k <= corr_bits_; ++k) correctors_.emplace_back(1u << (k <= bits_high_ ? k : bits_high_));
+  correctors_.resize(corr_bits_);
 }
 
 void LazIntegerDecoder::reset() {
   for (LazSymbolModel& m : classes_) m.reset();
   corrector_0_.reset();
-  for (LazSymbolModel& m : correctors_) m.reset();
+  for (std::unique_ptr<LazSymbolModel>& m : correctors_)
+    if (m) m->reset();
+}
+
+LazSymbolModel& LazIntegerDecoder::corrector(uint32_t k) {
+  std::unique_ptr<LazSymbolModel>& m = correctors_[k - 1];
+  if (!m) m = std::make_unique<LazSymbolModel>(1u << (k <= bits_high_ ? k : bits_high_));
+  return *m;
 }
 
 int32_t LazIntegerDecoder::decode(LazDecoder& decoder, int32_t prediction, uint32_t context) {
@@ -162,10 +168,10 @@ uint32_t LazIntegerDecoder::readCorrector(LazDecoder& decoder, LazSymbolModel& c
   if (k_ >= 32) return static_cast<uint32_t>(corr_min_);
   uint32_t c;
   if (k_ <= bits_high_) {
-    c = decoder.decodeSymbol(correctors_[k_ - 1]);
+    c = decoder.decodeSymbol(corrector(k_));
   } else {
     const uint32_t low_bits = k_ - bits_high_;
-    c = decoder.decodeSymbol(correctors_[k_ - 1]) << low_bits;
+    c = decoder.decodeSymbol(corrector(k_)) << low_bits;
     c |= decoder.readBits(low_bits);
   }
   // c in [0, 2^k) back to the class's two halves: [2^(k−1), 2^k) is c + 1 in [2^(k−1) + 1, 2^k],

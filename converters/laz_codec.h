@@ -34,6 +34,7 @@
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace dpoint {
@@ -207,6 +208,7 @@ class LazIntegerDecoder {
 
  private:
   uint32_t readCorrector(LazDecoder& decoder, LazSymbolModel& classes);
+  LazSymbolModel& corrector(uint32_t k);
 
   uint32_t bits_high_ = 8;
   uint32_t corr_bits_ = 0;
@@ -215,7 +217,10 @@ class LazIntegerDecoder {
   uint32_t k_ = 0;
   std::vector<LazSymbolModel> classes_;     // one per context: k, 0..corr_bits
   LazBitModel corrector_0_;                 // k = 0
-  std::vector<LazSymbolModel> correctors_;  // k = 1..corr_bits, at k − 1
+  // k = 1..corr_bits, at k − 1, each made when its class first occurs: a fresh model is the same
+  // whenever it is made, and a chunk uses few of the 32 classes (building all of them was most of
+  // a small chunk's time: COPC nodes, fuzzing).
+  std::vector<std::unique_ptr<LazSymbolModel>> correctors_;
 };
 
 }  // namespace dpoint

@@ -50,14 +50,20 @@ LazIntegerEncoder::LazIntegerEncoder(uint32_t bits, uint32_t contexts, uint32_t 
   }
   classes_.reserve(contexts);
   for (uint32_t c = 0; c < contexts; ++c) classes_.emplace_back(corr_bits_ + 1);
-  correctors_.reserve(corr_bits_);
-  for (uint32_t k = 1; k <= corr_bits_; ++k) correctors_.emplace_back(1u << (k <= bits_high_ ? k : bits_high_));
+  correctors_.resize(corr_bits_);
 }
 
 void LazIntegerEncoder::reset() {
   for (LazSymbolModel& m : classes_) m.reset();
   corrector_0_.reset();
-  for (LazSymbolModel& m : correctors_) m.reset();
+  for (std::unique_ptr<LazSymbolModel>& m : correctors_)
+    if (m) m->reset();
+}
+
+LazSymbolModel& LazIntegerEncoder::corrector(uint32_t k) {
+  std::unique_ptr<LazSymbolModel>& m = correctors_[k - 1];
+  if (!m) m = std::make_unique<LazSymbolModel>(1u << (k <= bits_high_ ? k : bits_high_));
+  return *m;
 }
 
 void LazIntegerEncoder::encode(LazEncoder& encoder, int32_t prediction, int32_t real, uint32_t context) {
@@ -88,10 +94,10 @@ void LazIntegerEncoder::writeCorrector(LazEncoder& encoder, int32_t c, LazSymbol
   // Into [0, 2^k): the negative half up by 2^k − 1, the positive half down by 1.
   const uint32_t shifted = c < 0 ? static_cast<uint32_t>(c) + ((1u << k_) - 1) : static_cast<uint32_t>(c) - 1;
   if (k_ <= bits_high_) {
-    encoder.encodeSymbol(correctors_[k_ - 1], shifted);
+    encoder.encodeSymbol(corrector(k_), shifted);
   } else {
     const uint32_t low_bits = k_ - bits_high_;
-    encoder.encodeSymbol(correctors_[k_ - 1], shifted >> low_bits);
+    encoder.encodeSymbol(corrector(k_), shifted >> low_bits);
     encoder.writeBits(low_bits, shifted & ((1u << low_bits) - 1));
   }
 }

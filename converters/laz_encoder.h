@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "converters/laz_codec.h"
@@ -113,6 +114,7 @@ class LazIntegerEncoder {
 
  private:
   void writeCorrector(LazEncoder& encoder, int32_t c, LazSymbolModel& classes);
+  LazSymbolModel& corrector(uint32_t k);
 
   uint32_t bits_high_ = 8;
   uint32_t corr_bits_ = 0;
@@ -121,7 +123,7 @@ class LazIntegerEncoder {
   uint32_t k_ = 0;
   std::vector<LazSymbolModel> classes_;
   LazBitModel corrector_0_;
-  std::vector<LazSymbolModel> correctors_;
+  std::vector<std::unique_ptr<LazSymbolModel>> correctors_;  // made on first use, as the decoder's
 };
 
 }  // namespace dpoint
