@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <optional>
 
+#include "converters/copc.h"
 #include "converters/gltf_write.h"
+#include "core/atomic_file.h"
 #include "core/text.h"
 #include "ops/point_filters.h"
 
@@ -70,6 +72,12 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (std::filesystem::is_directory(path, ec))
     return Error{path + ": is a folder, not a point file (.csv, .ply, .glb, .gltf, .las or .laz)", ExitCode::kUsage};
   return Error{path + ": unknown file type '" + ext + "' (expected .csv, .ply, .glb, .gltf, .las or .laz)", ExitCode::kUsage};
+}
+
+bool isCopcPath(const std::string& path) {
+  std::string lower = path;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return lower.size() >= 9 && lower.compare(lower.size() - 9, 9, ".copc.laz") == 0;
 }
 
 Status checkWrittenFormat(const std::string& path, FileFormat format) {
@@ -175,9 +183,25 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     case FileFormat::kLaz: {
       LasWriteReport report;
       LasWriteOptions las{options.las_scale, options.threads, options.progress, &report};
-      las.compress = *format == FileFormat::kLaz;
-      if (Status s = writeLas(path, points, las); !s)
-        return s;
+      if (isCopcPath(path)) {
+        // COPC: the LAS 1.4 file in memory (formats 6-8), then its octree of LAZ chunks.
+        std::string bytes;
+        las.las14 = true;
+        las.memory = &bytes;
+        if (Status s = writeLas(path, points, las); !s) return s;
+        CopcWriteOptions copc;
+        copc.threads = options.threads;
+        Result<std::string> file = copcFromLasBytes(bytes, copc);
+        if (!file) return Error{path + ": " + file.error().message};
+        std::string().swap(bytes);
+        Result<AtomicFile> out = AtomicFile::create(path);
+        if (!out) return out.error();
+        if (Status s = out->write(file->data(), file->size()); !s) return s;
+        if (Status s = out->commit(); !s) return s;
+      } else {
+        las.compress = *format == FileFormat::kLaz;
+        if (Status s = writeLas(path, points, las); !s) return s;
+      }
       if (report.merged_points != 0 && options.notices) {
         const glm::dvec3& sc = report.scale;
         std::string scale = formatNumber(sc.x);

@@ -22,6 +22,9 @@ Result<FileFormat> formatOf(const std::string& path);
 inline bool isGltf(FileFormat format) { return format == FileFormat::kGlb || format == FileFormat::kGltf; }
 // The error for a format that is read but not written (.gltf, LAZ), with what to write instead;
 // ok for the others. writePoints and the CLI's output check both give it.
+// True for a path ending in .copc.laz (any case): written as COPC (converters/copc.h), an octree
+// of LAZ 1.4 chunks that reads as plain LAZ too.
+bool isCopcPath(const std::string& path);
 Status checkWrittenFormat(const std::string& path, FileFormat format);
 
 struct ReadOptions {
