@@ -161,6 +161,11 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
               backendName(outcome.backend), request.camera.width, request.camera.height, double(outcome.point_size),
               outcome.shading == Shading::kEdl ? ", eye-dome lighting" : "", f.name.c_str(), f.type.c_str(),
               formatDriverVersion(f.vendor_id, f.driver_version).c_str());
+  if (const std::optional<CopcReadStats>& c = outcome.copc)
+    std::printf("copc: the view read %llu of %llu points, %llu of %llu bytes (%llu nodes)\n",
+                static_cast<unsigned long long>(c->points), static_cast<unsigned long long>(c->file_points),
+                static_cast<unsigned long long>(c->bytes), static_cast<unsigned long long>(c->file_bytes),
+                static_cast<unsigned long long>(c->nodes));
   printChoice(outcome.prediction, f, outcome.backend);
   if (outcome.prediction.from_boxes)
     std::printf("mode bounds: predicted from the bounding box of each batch (a streamed set is read once)\n");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 
@@ -78,6 +79,33 @@ bool isCopcPath(const std::string& path) {
   std::string lower = path;
   std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return lower.size() >= 9 && lower.compare(lower.size() - 9, 9, ".copc.laz") == 0;
+}
+
+Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query, const LasReadOptions& options,
+                                CopcReadStats* stats) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  Result<CopcHeader> header = readCopcHeader(*file);
+  if (!header) return header.error();
+  CopcNodeRead read;
+  Result<std::string> records = readCopcRecords(*file, query, &read);
+  if (!records) return records.error();
+  // The file's header and VLRs, uncompressed and counting these records, then the records.
+  const uint64_t count = records->size() / header->record_length;
+  std::string bytes(static_cast<size_t>(header->point_data_offset), '\0');
+  if (Result<size_t> got = file->readAt(0, bytes.data(), bytes.size()); !got) return got.error();
+  bytes[104] = static_cast<char>(static_cast<uint8_t>(bytes[104]) & 0x3F);  // not compressed
+  const uint32_t legacy = 0;
+  const uint64_t none = 0;
+  std::memcpy(bytes.data() + 107, &legacy, 4);  // formats 6-8: the legacy count is 0
+  std::memcpy(bytes.data() + 235, &none, 8);    // no EVLRs (the hierarchy stays behind)
+  std::memcpy(bytes.data() + 243, &legacy, 4);
+  std::memcpy(bytes.data() + 247, &count, 8);
+  bytes += *records;
+  std::string().swap(*records);
+  Result<PointSet> points = readLas(InputFile::fromMemory(path, bytes), options);
+  if (stats) *stats = {read.points, read.bytes, read.nodes, file->size(), header->point_count};
+  return points;
 }
 
 Status checkWrittenFormat(const std::string& path, FileFormat format) {

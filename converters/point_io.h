@@ -6,6 +6,7 @@
 #include <string>
 
 #include "converters/gltf_read.h"
+#include "converters/copc.h"
 #include "converters/csv.h"
 #include "converters/las.h"
 #include "converters/ply.h"
@@ -25,6 +26,14 @@ inline bool isGltf(FileFormat format) { return format == FileFormat::kGlb || for
 // True for a path ending in .copc.laz (any case): written as COPC (converters/copc.h), an octree
 // of LAZ 1.4 chunks that reads as plain LAZ too.
 bool isCopcPath(const std::string& path);
+// The points of the COPC nodes `query` selects (readCopcRecords), read as readLas reads a file:
+// the header and VLRs of the file with those records after them. `stats` gets the points, bytes
+// and nodes read, and `file_bytes` the file's size.
+struct CopcReadStats {
+  uint64_t points = 0, bytes = 0, nodes = 0, file_bytes = 0, file_points = 0;
+};
+Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query, const LasReadOptions& options,
+                                CopcReadStats* stats = nullptr);
 Status checkWrittenFormat(const std::string& path, FileFormat format);
 
 struct ReadOptions {

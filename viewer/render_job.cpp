@@ -56,6 +56,7 @@ struct LoadedSet {
   bool z_up = false;
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
+  std::optional<CopcReadStats> copc;   // a COPC input: what its view read
 };
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
@@ -147,11 +148,52 @@ Result<LoadedSet> takeInMemory(const RenderRequest& request) {
   return set;
 }
 
-// Opens the input as a stream (large binary PLY) or reads it whole.
+// What a COPC input's view needs (one .copc.laz, not streamed): the nodes down to the level whose
+// spacing is at most a pixel's width, and with an orthographic window (--ortho --view-center
+// --view-width) only those that meet it. Without a window, the pixel is the octree cube's edge over
+// the picture's larger side: the whole file at the picture's resolution.
+Result<CopcQuery> copcQueryFor(const RenderRequest& request, const std::string& path) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  Result<CopcHeader> header = readCopcHeader(*file);
+  if (!header) return header.error();
+  const CameraSpec& c = request.camera;
+  CopcQuery query;
+  query.threads = request.threads;
+  query.max_memory = request.max_memory;
+  double window = 2.0 * header->info.halfsize;
+  if (c.ortho.value_or(false) && c.view_width && !c.eye) {
+    window = *c.view_width;
+    if (c.view_center) {
+      const double half_w = window / 2.0, half_h = window * c.height / c.width / 2.0;
+      query.box.min[0] = c.view_center->x - half_w, query.box.max[0] = c.view_center->x + half_w;
+      query.box.min[1] = c.view_center->y - half_h, query.box.max[1] = c.view_center->y + half_h;
+    }
+  }
+  query.resolution = window / std::max(c.width, c.height);
+  return query;
+}
+
+// Opens the input as a stream (large binary PLY, LAS or LAZ), reads a COPC file's view, or reads
+// it whole.
 Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
   LoadedSet set;
   set.inputs = describeInputs(request.inputs);
   const std::string& inputs = set.inputs;
+  if (request.inputs.size() == 1 && isCopcPath(request.inputs[0]) && request.stream != "on") {
+    Result<CopcQuery> query = copcQueryFor(request, request.inputs[0]);
+    if (!query) return query.error();
+    LasReadOptions las{request.threads, &progress, lasColorOf(request.color), request.max_memory};
+    CopcReadStats stats;
+    Result<PointSet> read = readCopcPoints(request.inputs[0], *query, las, &stats);
+    if (!read) return read.error();
+    if (request.color == RenderColor::kAttribute && !read->dimensions.find(request.color_attribute))
+      return noSuchAttribute(inputs, request.color_attribute, read->dimensions);
+    set.owned = std::move(*read);
+    set.copc = stats;
+    phases.mark("read");
+    return set;
+  }
   Result<std::unique_ptr<PointInputStream>> opened = openPointStream(request.inputs, request.stream, request.threads);
   if (!opened) return opened.error();
   set.stream = std::move(*opened);
@@ -662,6 +704,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   if (!set) return set.error();
   outcome.points = set->count;
   outcome.streamed = set->stream != nullptr;
+  outcome.copc = set->copc;
   if (request.views == 4 && set->bounds.planar)
     return Error{set->inputs + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
                  ExitCode::kUsage};
@@ -708,6 +751,13 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   // What the bound was predicted from: every point the view shows, or (a streamed set, read once
   // while it is drawn) the box of every 1024 points.
   o.add("predicted_from", V::string(outcome.prediction.from_boxes ? "batch_boxes" : "points"));
+  if (const std::optional<CopcReadStats>& c = outcome.copc)  // a COPC input: what its view read
+    o.add("copc", JsonObject()
+                      .add("points_read", V::integer(c->points))
+                      .add("bytes_read", V::integer(c->bytes))
+                      .add("nodes_read", V::integer(c->nodes))
+                      .add("file_points", V::integer(c->file_points))
+                      .add("file_bytes", V::integer(c->file_bytes)));
   if (const std::optional<ModeChoice>& c = outcome.prediction.choice) {
     JsonObject choice;
     choice.add("enough", V::boolean(c->enough)).add("limit_px", V::number(kAutoBoundPx));

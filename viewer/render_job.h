@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "converters/point_io.h"
 #include "core/progress.h"
 #include "core/result.h"
 #include "image/image.h"
@@ -219,6 +220,8 @@ struct RenderOutcome {
   RenderPhases phases;
   // Four views:
   std::vector<SheetView> views;
+  // A COPC input: the points, bytes and nodes its view read (readCopcPoints).
+  std::optional<CopcReadStats> copc;
 };
 
 // Runs the request: checks it, reads (or streams) the input, makes the device, picks the mode and
