@@ -1,4 +1,5 @@
-// What LAZ's item decoders (laz_decode.cpp, laz_layered.cpp) and encoders (laz_encode.cpp) share:
+// What LAZ's item decoders (laz_decode.cpp, laz_layered_decode.cpp) and encoders (laz_encode.cpp,
+// laz_layered_encode.cpp) share:
 // LASzip's streaming median of x/y differences and the return contexts (laszip_common_v2.hpp,
 // Apache 2.0, as read; dpoint's own code).
 #pragma once

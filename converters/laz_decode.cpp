@@ -36,9 +36,6 @@ std::string itemName(uint16_t type) {
   return type < std::size(kNames) ? kNames[type] : "unknown";
 }
 
-// LAS 1.4's item types (formats 6–10), decoded by laz_layered.cpp.
-enum : uint16_t { kLazPoint14 = 10, kLazRgb14 = 11, kLazRgbNir14 = 12, kLazByte14 = 14 };
-
 std::string itemList(const std::vector<LazItem>& items) {
   std::string out;
   for (const LazItem& item : items) {

@@ -51,9 +51,21 @@
 
 namespace dpoint {
 
-// LASzip's item types of point formats 0–3 (those of formats 6–8, POINT14 10, RGB14 11,
-// RGBNIR14 12 and BYTE14 14, are named where they are coded).
-enum LazItemType : uint16_t { kLazByte = 0, kLazPoint10 = 6, kLazGpsTime11 = 7, kLazRgb12 = 8 };
+// LASzip's item types (laszip.hpp's LASitem::Type), the one list for every LAZ file: formats 0–5
+// use POINT10 [GPSTIME11] [RGB12] [WAVEPACKET13] [BYTE], formats 6–10 POINT14 [RGB14 or
+// RGBNIR14] [WAVEPACKET14] [BYTE14]. Types 1–5 (SHORT to DOUBLE) were never written.
+enum LazItemType : uint16_t {
+  kLazByte = 0,
+  kLazPoint10 = 6,
+  kLazGpsTime11 = 7,
+  kLazRgb12 = 8,
+  kLazWavePacket13 = 9,
+  kLazPoint14 = 10,
+  kLazRgb14 = 11,
+  kLazRgbNir14 = 12,
+  kLazWavePacket14 = 13,
+  kLazByte14 = 14,
+};
 
 struct LazItem {
   uint16_t type = 0, size = 0, version = 0;

@@ -28,7 +28,6 @@ std::string str(uint64_t v) { return std::to_string(v); }
 
 constexpr uint16_t kCompressorChunked = 2, kCompressorLayered = 3;
 constexpr uint16_t kItemVersion2 = 2, kItemVersion3 = 3;
-enum : uint16_t { kLazPoint14 = 10, kLazRgb14 = 11, kLazRgbNir14 = 12, kLazByte14 = 14 };
 
 // --- Item encoders, version 2 ----------------------------------------------------------------------
 
