@@ -89,6 +89,10 @@ Result<LasInput> parseLas14(std::string_view las) {
   if (in.format < 6 || in.format > 8)
     return Error{"COPC holds point formats 6 to 8 only, not " + str(raw_format)};
   in.record_length = loadUnaligned<uint16_t>(h + kRecordLengthAt);
+  static constexpr uint16_t kBase[3] = {30, 36, 38};  // formats 6, 7, 8
+  if (in.record_length < kBase[in.format - 6])
+    return Error{"point record length " + str(in.record_length) + " is shorter than point format " +
+                 str(raw_format) + "'s " + str(kBase[in.format - 6]) + " bytes"};
   const uint64_t point_offset = loadUnaligned<uint32_t>(h + kPointOffsetAt);
   in.count = loadUnaligned<uint64_t>(h + kCountAt);
   if (in.count == 0) in.count = loadUnaligned<uint32_t>(h + kLegacyCountAt);
@@ -864,6 +868,9 @@ Result<std::string> readCopcRecords(const InputFile& file, const CopcQuery& quer
   const uint64_t total = first.back();
   const unsigned threads =
       std::min<unsigned>(resolveThreads(query.threads), static_cast<unsigned>(std::max<size_t>(nodes.size(), 1)));
+  if (total > (UINT64_MAX - largest * threads) / length)  // counts of a hostile hierarchy
+    return Error{path + ": " + str(total) + " points of " + str(length) + " bytes overflow 64 bits",
+                 ExitCode::kResourceLimit};
   if (Status s = checkMemory(path + ": reading " + str(total) + " points of " + str(nodes.size()) + " COPC nodes",
                              total * length + largest * threads, query.max_memory);
       !s)

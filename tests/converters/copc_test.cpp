@@ -432,6 +432,10 @@ TEST(CopcWrite, refusesOtherFormatsVersionsAndCompressedInput) {
   std::string short_records = las14(surfaceRecords(10, 1, 10), kOrigin);
   short_records.resize(short_records.size() - 1);
   EXPECT_TRUE(test::contains(copcFromLasBytes(short_records).error().message, "run past the file's end"));
+  std::string short_length = las14(surfaceRecords(10, 1, 10), kOrigin);
+  put<uint16_t>(short_length, 105, 22);
+  EXPECT_TRUE(test::contains(copcFromLasBytes(short_length).error().message,
+                             "point record length 22 is shorter than point format 6's 30 bytes"));
   std::string zero_scale = las14(surfaceRecords(10, 1, 10), kOrigin);
   put<double>(zero_scale, 139, 0.0);
   EXPECT_TRUE(test::contains(copcFromLasBytes(zero_scale).error().message, "axis Y is 0 or not finite"));
