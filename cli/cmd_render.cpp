@@ -326,8 +326,8 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
   addChoiceOption(*cmd, "--stream", o->stream,
                   "auto|on|off. on: draw binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, so a set larger\n"
                   "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for such\n"
-                  "input of more than 2^26 points. A streamed set gets no predicted bound (--mode auto takes\n"
-                  "native), no --error, --order or --views 4",
+                  "input of more than 2^26 points. A streamed set's bound is predicted from the box of each batch\n"
+                  "(docs/precision.md); it gets no --error, --order or --views 4",
                   {"auto", "on", "off"});
   cmd->add_option("--views", o->views,
                   "1, or 4: one PNG of four labelled views (front, side, top, three-quarter), each framed by --fit\n"
