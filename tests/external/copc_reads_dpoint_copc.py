@@ -4,8 +4,8 @@ every node and checks that its points lie in its node's cube and that the counts
 header's; laz-perf reads each as plain LAZ to the header's count.
 
 The files: those the converter tests write (CONVERTERS_TESTS with DPOINT_COPC_OUT: the corpus's LAS 1.4
-files, a 300,000-point surface, a paged hierarchy, 0 and 1 point), and, once `dpoint convert` writes
-.copc.laz, the corpus's LAS 1.4 files, a fractal and a 16.7M-point set converted by dpoint (each
+files, a 300,000-point surface, a paged hierarchy, 0 and 1 point), and what `dpoint convert` and
+`generate` write as .copc.laz: the corpus's LAS 1.4 files, a fractal and 400,000 random points (each
 compared, as sorted records, with the same source converted to LAS).
 Usage: copc_reads_dpoint_copc.py DPOINT [CONVERTERS_TESTS]
 """
@@ -76,27 +76,30 @@ def from_converter_tests(tests, tmp):
 
 
 def from_dpoint(exe, tmp):
-    """COPC files `dpoint convert` writes, or None while it cannot write them."""
+    """COPC files `dpoint convert` and `dpoint generate` write, with the LAS twin of each."""
     sources = [os.path.join(CORPUS, "las", "simple1_4.las"), os.path.join(CORPUS, "laz", "rand1_6.las"),
                os.path.join(CORPUS, "las", "1_4_w_evlr.las"), os.path.join(CORPUS, "las", "test1_4.las")]
     probe_path = os.path.join(tmp, "probe.copc.laz")
     probe = subprocess.run([exe, "convert", sources[0], "-o", probe_path], capture_output=True, text=True)
-    if probe.returncode != 0:
-        print(f"SKIPPED the dpoint part: `dpoint convert X -o Y.copc.laz` fails: {probe.stderr.strip()[:300]}")
-        return None
-    if not is_copc(probe_path):
-        print("SKIPPED the dpoint part: `dpoint convert X -o Y.copc.laz` writes plain LAZ (COPC not wired yet)")
-        return None
-    menger = os.path.join(tmp, "menger.ply")
-    dpoint(exe, "generate", "menger", "--level", "4", "-o", menger)
-    big = os.path.join(tmp, "random-16.7M.ply")
-    dpoint(exe, "generate", "random2d", "--count", str(1 << 24), "--seed", "5", "-o", big)
+    check(probe.returncode == 0, f"`dpoint convert X -o Y.copc.laz` fails: {probe.stderr.strip()[:300]}")
+    check(is_copc(probe_path), "`dpoint convert X -o Y.copc.laz` did not write COPC (no info VLR at byte 375)")
+    # A fractal and 400,000 random points (several levels of nodes), written by generate itself. A
+    # LAS 1.4 source's twin is its own .las (the same records); a generated set's (its format 2
+    # becomes COPC's 7) is the COPC file converted back to .las, as dpoint reads it.
+    menger = os.path.join(tmp, "menger.copc.laz")
+    dpoint(exe, "generate", "menger", "--level", "4", "-q", "-o", menger)
+    random = os.path.join(tmp, "random.copc.laz")
+    dpoint(exe, "generate", "random2d", "--count", "400000", "--seed", "5", "-q", "-o", random)
     files = []
-    for i, source in enumerate(sources + [menger, big]):
+    for i, source in enumerate(sources):
         name = f"dpoint-{i:02d}-{os.path.basename(source).rsplit('.', 1)[0]}"
         copc, las = os.path.join(tmp, name + ".copc.laz"), os.path.join(tmp, name + ".las")
         dpoint(exe, "convert", source, "-o", copc)
         dpoint(exe, "convert", source, "-o", las)
+        files.append((copc, las))
+    for copc in (menger, random):
+        las = copc[:-len(".copc.laz")] + "-back.las"
+        dpoint(exe, "convert", copc, "-o", las)
         files.append((copc, las))
     return files
 
