@@ -1,4 +1,4 @@
-// What LAZ's item decoders (laz_decode.cpp, laz_layered_decode.cpp) and encoders (laz_encode.cpp,
+// What LAZ's item decoders (laz_decode_v2.cpp, laz_layered_decode.cpp) and encoders (laz_encode.cpp,
 // laz_layered_encode.cpp) share:
 // LASzip's streaming median of x/y differences and the return contexts (laszip_common_v2.hpp,
 // Apache 2.0, as read; dpoint's own code).

@@ -1,10 +1,10 @@
-// LAZ decoding (converters/laz_decode.h says what and whence): the laszip VLR, the chunk table, the
-// version-2 item decoders and the file-level decode. Only little-endian hosts: fields are copied
-// out of the bytes with memcpy, as in las.cpp.
+// LAZ decoding (converters/laz_decode.h says what and whence): the laszip VLR, the chunk table, one
+// chunk and the file-level decode; the item decoders are laz_decode_v1.cpp's and
+// laz_decode_v2.cpp's. Only little-endian hosts: fields are copied out of the bytes with memcpy, as
+// in las.cpp.
 #include "converters/laz_decode.h"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <bit>
 #include <cstring>
@@ -13,7 +13,7 @@
 #include <optional>
 
 #include "converters/laz_codec.h"
-#include "converters/laz_common.h"
+#include "converters/laz_item_decoder.h"
 #include "converters/laz_layered.h"
 #include "core/bytes.h"
 #include "core/memory.h"
@@ -57,19 +57,20 @@ constexpr size_t kVlrFixedBytes = 34;  // up to and with the item count
 constexpr size_t kVlrItemBytes = 6;
 constexpr uint16_t kCompressorPointwise = 1, kCompressorChunked = 2, kCompressorLayered = 3;
 
-// The decoded item types and their sizes (0: any): version 2 with compressor 2 (point formats
-// 0–3), version 3 with compressor 3 (formats 6–8; laz_layered.h).
+// The decoded item types and their sizes (0: any): versions 1 and 2 with compressors 1 and 2
+// (point formats 0–3; version 1 is LASzip 1.x's), version 3 with compressor 3 (formats 6–8;
+// laz_layered.h). LASzip codes LAS 1.4's points only in layers, and the older items never so.
 struct ItemSupport {
   uint16_t type;
   uint16_t size;
 };
-constexpr ItemSupport kDecoded[] = {{kLazPoint10, 20}, {kLazGpsTime11, 8}, {kLazRgb12, 6}, {kLazByte, 0}};
-constexpr uint16_t kDecodedVersion = 2;
+constexpr ItemSupport kDecodedPointwise[] = {{kLazPoint10, 20}, {kLazGpsTime11, 8}, {kLazRgb12, 6}, {kLazByte, 0}};
 constexpr ItemSupport kDecodedLayered[] = {{kLazPoint14, 30}, {kLazRgb14, 6}, {kLazRgbNir14, 8}, {kLazByte14, 0}};
-constexpr uint16_t kDecodedLayeredVersion = 3;
+constexpr uint16_t kLayeredVersion = 3;
+bool pointwiseVersion(uint16_t version) { return version == 1 || version == 2; }
 constexpr const char* kSupportedItems =
-    "only version 2 of POINT10, GPSTIME11, RGB12 and BYTE: point formats 0 to 3, and version 3 of POINT14, RGB14, "
-    "RGBNIR14 and BYTE14: formats 6 to 8";
+    "only versions 1 and 2 of POINT10, GPSTIME11, RGB12 and BYTE: point formats 0 to 3, and version 3 of POINT14, "
+    "RGB14, RGBNIR14 and BYTE14: formats 6 to 8";
 
 const ItemSupport* findSupport(const ItemSupport (&table)[4], uint16_t type) {
   for (const ItemSupport& s : table)
@@ -77,305 +78,10 @@ const ItemSupport* findSupport(const ItemSupport (&table)[4], uint16_t type) {
   return nullptr;
 }
 
-// --- Item decoders, version 2 ----------------------------------------------------------------------
-//
-// Each starts from the chunk's first (raw) item and then decodes one item per point in place of
-// the last one. A decoder lives for one chunk: LASzip resets every model and state at a chunk's
-// start, which a fresh decoder is.
 
-class ItemDecoder {
- public:
-  virtual ~ItemDecoder() = default;
-  virtual void decode(LazDecoder& decoder, uint8_t* item) = 0;
-  // True once the item's code held something no encoder writes that the arithmetic decoder cannot
-  // see (GPS time's second sequence switch within one point).
-  virtual bool corrupt() const { return false; }
-};
-
-// The 20 bytes formats 0–5 share: x, y, z (i32), intensity (u16), the return byte (return number
-// bits 0–2, number of returns 3–5, scan direction 6, edge of flight line 7), classification,
-// scan angle rank, user data (u8 each), point source ID (u16).
-class Point10Decoder final : public ItemDecoder {
- public:
-  explicit Point10Decoder(const uint8_t* first) {
-    x_ = loadUnaligned<int32_t>(first);
-    y_ = loadUnaligned<int32_t>(first + 4);
-    z_ = loadUnaligned<int32_t>(first + 8);
-    // intensity_ stays 0: LASzip predicts the second point's intensity from 0, not the first's.
-    returns_ = first[14];
-    classification_ = first[15];
-    scan_angle_ = first[16];
-    user_data_ = first[17];
-    source_id_ = loadUnaligned<uint16_t>(first + 18);
-  }
-
-  void decode(LazDecoder& d, uint8_t* item) override {
-    // Bits 5..0: the return byte, intensity, classification, scan angle, user data and point
-    // source ID changed.
-    const uint32_t changed = d.decodeSymbol(changed_model_);
-    if (changed & 32) returns_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(returns_models_[returns_])));
-    const uint32_t r = returns_ & 7u, n = (returns_ >> 3) & 7u;
-    const uint32_t m = kLazReturnMap[n][r], l = kLazReturnLevel[n][r];
-    // LASzip sets the intensity only when some value changed; when none did, the point's return
-    // byte is the last one's, so m is too, and the last intensity is last_intensity_[m] already.
-    if (changed & 16) {
-      last_intensity_[m] = static_cast<uint16_t>(
-          intensity_decoder_.decode(d, last_intensity_[m], m < 3 ? m : 3));
-    }
-    intensity_ = last_intensity_[m];
-    if (changed & 8)
-      classification_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(class_models_[classification_])));
-    if (changed & 4) {
-      const uint32_t delta = d.decodeSymbol(scan_angle_models_[(returns_ >> 6) & 1u]);
-      scan_angle_ = static_cast<uint8_t>(delta + scan_angle_);  // mod 256
-    }
-    if (changed & 2) user_data_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(user_models_[user_data_])));
-    if (changed & 1) source_id_ = static_cast<uint16_t>(source_id_decoder_.decode(d, source_id_));
-
-    // x and y: the difference from the last point, predicted by the median of its history; y's and
-    // z's contexts grow with the magnitude classes (k) of the corrections before them. Sums wrap
-    // as the encoder's 32-bit ones did.
-    const uint32_t single = n == 1 ? 1 : 0;
-    const int32_t dx = dx_decoder_.decode(d, dx_history_[m].get(), single);
-    x_ = static_cast<int32_t>(static_cast<uint32_t>(x_) + static_cast<uint32_t>(dx));
-    dx_history_[m].add(dx);
-    uint32_t k = dx_decoder_.k();
-    const int32_t dy = dy_decoder_.decode(d, dy_history_[m].get(), single + (k < 20 ? k & ~1u : 20));
-    y_ = static_cast<int32_t>(static_cast<uint32_t>(y_) + static_cast<uint32_t>(dy));
-    dy_history_[m].add(dy);
-    k = (dx_decoder_.k() + dy_decoder_.k()) / 2;
-    z_ = z_decoder_.decode(d, last_height_[l], single + (k < 18 ? k & ~1u : 18));
-    last_height_[l] = z_;
-
-    storeUnaligned(item, x_);
-    storeUnaligned(item + 4, y_);
-    storeUnaligned(item + 8, z_);
-    storeUnaligned(item + 12, intensity_);
-    item[14] = returns_;
-    item[15] = classification_;
-    item[16] = scan_angle_;
-    item[17] = user_data_;
-    storeUnaligned(item + 18, source_id_);
-  }
-
- private:
-  // The return byte, classification and user data are each coded with a model per previous
-  // value, created when first needed (most files use a few of the 256).
-  using LazyModels = std::array<std::unique_ptr<LazSymbolModel>, 256>;
-  static LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& slot) {
-    if (!slot) slot = std::make_unique<LazSymbolModel>(256);
-    return *slot;
-  }
-
-  int32_t x_ = 0, y_ = 0, z_ = 0;
-  uint16_t intensity_ = 0, source_id_ = 0;
-  uint8_t returns_ = 0, classification_ = 0, scan_angle_ = 0, user_data_ = 0;
-  std::array<uint16_t, 16> last_intensity_{};
-  std::array<int32_t, 8> last_height_{};
-  std::array<LazMedian5, 16> dx_history_, dy_history_;
-
-  LazSymbolModel changed_model_{64};
-  LazyModels returns_models_, class_models_, user_models_;
-  std::array<LazSymbolModel, 2> scan_angle_models_{LazSymbolModel(256), LazSymbolModel(256)};  // by scan direction
-  LazIntegerDecoder intensity_decoder_{16, 4};
-  LazIntegerDecoder source_id_decoder_{16, 1};
-  LazIntegerDecoder dx_decoder_{32, 2};
-  LazIntegerDecoder dy_decoder_{32, 22};
-  LazIntegerDecoder z_decoder_{32, 20};
-};
-
-// GPS time (a double) as its 64-bit pattern. Up to four sequences (interleaved flight lines) are
-// followed at once, each with its last time and last integer difference; a point either repeats,
-// steps by a multiple of the last difference (the multiplier a symbol, the remainder an integer),
-// switches to another sequence, or starts a new one with a full 64-bit value.
-class GpsTimeDecoder final : public ItemDecoder {
- public:
-  explicit GpsTimeDecoder(const uint8_t* first) { time_[0] = loadUnaligned<uint64_t>(first); }
-
-  void decode(LazDecoder& d, uint8_t* item) override {
-    // A switch to another sequence decodes the point again in that one (LASzip recurses). An
-    // encoder switches at most once per point (to a sequence where the difference fits 32 bits,
-    // then codes it there), so a second switch is corrupt data: refusing it bounds the loop, which
-    // crafted data could otherwise spin for billions of cheap symbols.
-    for (int pass = 0;; ++pass) {
-      if (pass == 2 || !d.ok()) {
-        corrupt_ = pass == 2;
-        break;
-      }
-      if (diff_[last_] == 0) {
-        const uint32_t s = d.decodeSymbol(zero_diff_model_);
-        if (s == 1) {  // a difference that fits 32 bits
-          diff_[last_] = time_decoder_.decode(d, 0, 0);
-          time_[last_] += static_cast<uint64_t>(static_cast<int64_t>(diff_[last_]));
-          extreme_[last_] = 0;
-        } else if (s == 2) {
-          startSequence(d);
-        } else if (s > 2) {
-          last_ = (last_ + s - 2) & 3u;
-          continue;
-        }
-        break;  // s == 0: unchanged
-      }
-      const uint32_t s = d.decodeSymbol(multi_model_);
-      if (s == 1) {
-        time_[last_] += widen(time_decoder_.decode(d, diff_[last_], 1));
-        extreme_[last_] = 0;
-      } else if (s < kUnchanged) {
-        time_[last_] += widen(multipleDifference(d, s));
-      } else if (s == kFull) {
-        startSequence(d);
-      } else if (s > kFull) {
-        last_ = (last_ + s - kFull) & 3u;
-        continue;
-      }
-      break;  // s == kUnchanged
-    }
-    storeUnaligned(item, time_[last_]);
-  }
-  bool corrupt() const override { return corrupt_; }
-
- private:
-  static constexpr uint32_t kMulti = kLazGpsMulti, kUnchanged = kLazGpsUnchanged, kFull = kLazGpsFull;
-  static constexpr int32_t kMultiMinus = kLazGpsMultiMinus;
-
-  static uint64_t widen(int32_t v) { return static_cast<uint64_t>(static_cast<int64_t>(v)); }
-  // multiple · last difference with the encoder's 32-bit wrap-around.
-  int32_t times(int32_t multiple) const {
-    return static_cast<int32_t>(static_cast<uint32_t>(multiple) * static_cast<uint32_t>(diff_[last_]));
-  }
-  // A difference counted among the extreme multipliers (0, ≥ 500, ≤ −10): after four in a row it
-  // becomes the sequence's difference.
-  void countExtreme(int32_t difference) {
-    if (++extreme_[last_] > 3) {
-      diff_[last_] = difference;
-      extreme_[last_] = 0;
-    }
-  }
-
-  int32_t multipleDifference(LazDecoder& d, uint32_t s) {
-    if (s == 0) {
-      const int32_t difference = time_decoder_.decode(d, 0, 7);
-      countExtreme(difference);
-      return difference;
-    }
-    if (s < kMulti) return time_decoder_.decode(d, times(static_cast<int32_t>(s)), s < 10 ? 2 : 3);
-    if (s == kMulti) {
-      const int32_t difference = time_decoder_.decode(d, times(static_cast<int32_t>(kMulti)), 4);
-      countExtreme(difference);
-      return difference;
-    }
-    const int32_t multiple = static_cast<int32_t>(kMulti) - static_cast<int32_t>(s);  // −1..−10
-    if (multiple > kMultiMinus) return time_decoder_.decode(d, times(multiple), 5);
-    const int32_t difference = time_decoder_.decode(d, times(kMultiMinus), 6);
-    countExtreme(difference);
-    return difference;
-  }
-
-  // A new sequence: the high 32 bits predicted by the current sequence's, the low 32 raw.
-  void startSequence(LazDecoder& d) {
-    const int32_t high = time_decoder_.decode(d, static_cast<int32_t>(time_[last_] >> 32), 8);
-    next_ = (next_ + 1) & 3u;
-    time_[next_] = (static_cast<uint64_t>(static_cast<uint32_t>(high)) << 32) | d.readInt();
-    last_ = next_;
-    diff_[last_] = 0;
-    extreme_[last_] = 0;
-  }
-
-  std::array<uint64_t, 4> time_{};
-  std::array<int32_t, 4> diff_{};
-  std::array<int32_t, 4> extreme_{};
-  uint32_t last_ = 0, next_ = 0;
-  bool corrupt_ = false;
-  LazSymbolModel multi_model_{kLazGpsMultiSymbols};
-  LazSymbolModel zero_diff_model_{6};  // unchanged, 32-bit difference, new sequence, 3 switches
-  LazIntegerDecoder time_decoder_{32, 9};
-};
-
-// Red, green, blue (u16 each). Which of the six bytes changed is one symbol (bit 6: green and blue
-// differ from red at all); red's bytes are coded against the last red, green's and blue's against
-// the last value moved by red's change (blue's by the mean of red's and green's), clamped to a
-// byte. All byte sums are mod 256.
-class RgbDecoder final : public ItemDecoder {
- public:
-  explicit RgbDecoder(const uint8_t* first) {
-    for (size_t c = 0; c < 3; ++c) last_[c] = loadUnaligned<uint16_t>(first + 2 * c);
-  }
-
-  void decode(LazDecoder& d, uint8_t* item) override {
-    const uint32_t used = d.decodeSymbol(used_model_);
-    const int red_lo = (used & 1) ? byteSum(d.decodeSymbol(byte_models_[0]), lo(last_[0])) : lo(last_[0]);
-    const int red_hi = (used & 2) ? byteSum(d.decodeSymbol(byte_models_[1]), hi(last_[0])) : hi(last_[0]);
-    int green_lo = red_lo, green_hi = red_hi, blue_lo = red_lo, blue_hi = red_hi;
-    if (used & 64) {
-      int change = red_lo - lo(last_[0]);
-      green_lo = (used & 4) ? byteSum(d.decodeSymbol(byte_models_[2]), clampByte(change + lo(last_[1])))
-                            : lo(last_[1]);
-      if (used & 16) {
-        change = (change + green_lo - lo(last_[1])) / 2;  // truncated toward zero, as LASzip's
-        blue_lo = byteSum(d.decodeSymbol(byte_models_[4]), clampByte(change + lo(last_[2])));
-      } else {
-        blue_lo = lo(last_[2]);
-      }
-      change = red_hi - hi(last_[0]);
-      green_hi = (used & 8) ? byteSum(d.decodeSymbol(byte_models_[3]), clampByte(change + hi(last_[1])))
-                            : hi(last_[1]);
-      if (used & 32) {
-        change = (change + green_hi - hi(last_[1])) / 2;
-        blue_hi = byteSum(d.decodeSymbol(byte_models_[5]), clampByte(change + hi(last_[2])));
-      } else {
-        blue_hi = hi(last_[2]);
-      }
-    }
-    last_[0] = static_cast<uint16_t>(red_lo | red_hi << 8);
-    last_[1] = static_cast<uint16_t>(green_lo | green_hi << 8);
-    last_[2] = static_cast<uint16_t>(blue_lo | blue_hi << 8);
-    for (size_t c = 0; c < 3; ++c) storeUnaligned(item + 2 * c, last_[c]);
-  }
-
- private:
-  static int lo(uint16_t v) { return v & 0xFF; }
-  static int hi(uint16_t v) { return v >> 8; }
-  static int clampByte(int v) { return std::clamp(v, 0, 255); }
-  static int byteSum(uint32_t symbol, int base) {
-    return static_cast<int>((symbol + static_cast<uint32_t>(base)) & 0xFFu);
-  }
-
-  std::array<uint16_t, 3> last_{};
-  LazSymbolModel used_model_{128};
-  std::array<LazSymbolModel, 6> byte_models_{LazSymbolModel(256), LazSymbolModel(256), LazSymbolModel(256),
-                                             LazSymbolModel(256), LazSymbolModel(256), LazSymbolModel(256)};
-};
-
-// Extra bytes: each byte the last one plus a symbol of its own model, mod 256.
-class ByteDecoder final : public ItemDecoder {
- public:
-  ByteDecoder(const uint8_t* first, size_t size) : last_(first, first + size) {
-    models_.reserve(size);
-    for (size_t i = 0; i < size; ++i) models_.emplace_back(256);
-  }
-
-  void decode(LazDecoder& d, uint8_t* item) override {
-    for (size_t i = 0; i < last_.size(); ++i) {
-      last_[i] = static_cast<uint8_t>(last_[i] + d.decodeSymbol(models_[i]));
-      item[i] = last_[i];
-    }
-  }
-
- private:
-  std::vector<uint8_t> last_;
-  std::vector<LazSymbolModel> models_;
-};
-
-std::unique_ptr<ItemDecoder> makeItemDecoder(const LazItem& item, const uint8_t* first) {
-  switch (item.type) {
-    case kLazPoint10: return std::make_unique<Point10Decoder>(first);
-    case kLazGpsTime11: return std::make_unique<GpsTimeDecoder>(first);
-    case kLazRgb12: return std::make_unique<RgbDecoder>(first);
-    case kLazByte: return std::make_unique<ByteDecoder>(first, item.size);
-    default: break;
-  }
-  assert(false && "parseLaszipVlr refuses other item types");
-  return nullptr;
+// The decoder of a pointwise item of either version.
+std::unique_ptr<LazItemDecoder> makeItemDecoder(const LazItem& item, const uint8_t* first) {
+  return item.version == 1 ? makeLazItemDecoderV1(item, first) : makeLazItemDecoderV2(item, first);
 }
 
 }  // namespace
@@ -409,30 +115,32 @@ Result<LazInfo> parseLaszipVlr(std::string_view data) {
   if (data.size() < needed)
     return Error{what + str(data.size()) + " bytes, fewer than the " + str(needed) + " that its " + str(count) +
                  " items need"};
-  if (info.compressor == kCompressorPointwise)
-    return Error{"LAZ compressor 1 (pointwise, without chunks) is not supported (only 2, pointwise chunked, and 3, "
-                 "layered chunked)"};
-  if (info.compressor != kCompressorChunked && info.compressor != kCompressorLayered)
+  if (info.compressor != kCompressorPointwise && info.compressor != kCompressorChunked &&
+      info.compressor != kCompressorLayered)
     return Error{what + "compressor " + str(info.compressor) + " is not one of LASzip's (1 to 3)"};
   if (info.coder != 0)
     return Error{"LAZ coder " + str(info.coder) + " is not supported (only 0, the arithmetic coder)"};
-  if (info.chunk_size == 0) return Error{what + "chunk size 0"};
+  // Compressor 1 has no chunks: LASzip 1.x wrote 0 or 1 here, later versions their default.
+  if (info.chunk_size == 0 && info.compressor != kCompressorPointwise) return Error{what + "chunk size 0"};
   if (count == 0) return Error{what + "no items"};
   for (uint16_t i = 0; i < count; ++i) {
     const char* q = p + kVlrFixedBytes + kVlrItemBytes * i;
     LazItem item{loadUnaligned<uint16_t>(q), loadUnaligned<uint16_t>(q + 2), loadUnaligned<uint16_t>(q + 4)};
     const std::string name = "LAZ item type " + str(item.type) + " (" + itemName(item.type) + ")";
-    // Each compressor has its own items: LASzip codes LAS 1.4's points only in layers.
+    // Each compressor has its own items (the table's comment).
     const bool layered = info.compressor == kCompressorLayered;
-    const ItemSupport* support = findSupport(layered ? kDecodedLayered : kDecoded, item.type);
-    const uint16_t version = layered ? kDecodedLayeredVersion : kDecodedVersion;
-    if (!support && item.version == (layered ? kDecodedVersion : kDecodedLayeredVersion) &&
-        findSupport(layered ? kDecoded : kDecodedLayered, item.type))
+    const auto decodedBy = [&](bool by_layers) {
+      const ItemSupport* s = findSupport(by_layers ? kDecodedLayered : kDecodedPointwise, item.type);
+      const bool version = by_layers ? item.version == kLayeredVersion : pointwiseVersion(item.version);
+      return version ? s : nullptr;
+    };
+    const ItemSupport* support = decodedBy(layered);
+    if (!support && decodedBy(!layered))
       return Error{what + name + " version " + str(item.version) + " does not go with compressor " +
                    str(info.compressor) +
                    (layered ? " (layered chunked: version 3 of POINT14, RGB14, RGBNIR14 and BYTE14)"
-                            : " (pointwise chunked: version 2 of POINT10, GPSTIME11, RGB12 and BYTE)")};
-    if (!support || item.version != version)
+                            : " (pointwise: versions 1 and 2 of POINT10, GPSTIME11, RGB12 and BYTE)")};
+    if (!support)
       return Error{name + " version " + str(item.version) + " is not supported (" + kSupportedItems + ")"};
     if (support->size != 0 && item.size != support->size)
       return Error{what + name + " has size " + str(item.size) + ", not " + str(support->size)};
@@ -455,15 +163,16 @@ Status checkLazItems(const LazInfo& info, int point_format, uint32_t record_leng
   const uint16_t extra = static_cast<uint16_t>(record_length - base);
   std::vector<LazItem> expected;
   if (pointwise) {
-    expected.push_back({kLazPoint10, 20, kDecodedVersion});
-    if (point_format == 1 || point_format == 3) expected.push_back({kLazGpsTime11, 8, kDecodedVersion});
-    if (point_format >= 2) expected.push_back({kLazRgb12, 6, kDecodedVersion});
-    if (extra != 0) expected.push_back({kLazByte, extra, kDecodedVersion});
+    // The versions are not compared (parseLaszipVlr checked them).
+    expected.push_back({kLazPoint10, 20, 0});
+    if (point_format == 1 || point_format == 3) expected.push_back({kLazGpsTime11, 8, 0});
+    if (point_format >= 2) expected.push_back({kLazRgb12, 6, 0});
+    if (extra != 0) expected.push_back({kLazByte, extra, 0});
   } else {
-    expected.push_back({kLazPoint14, 30, kDecodedLayeredVersion});
-    if (point_format == 7) expected.push_back({kLazRgb14, 6, kDecodedLayeredVersion});
-    if (point_format == 8) expected.push_back({kLazRgbNir14, 8, kDecodedLayeredVersion});
-    if (extra != 0) expected.push_back({kLazByte14, extra, kDecodedLayeredVersion});
+    expected.push_back({kLazPoint14, 30, 0});
+    if (point_format == 7) expected.push_back({kLazRgb14, 6, 0});
+    if (point_format == 8) expected.push_back({kLazRgbNir14, 8, 0});
+    if (extra != 0) expected.push_back({kLazByte14, extra, 0});
   }
   bool same = expected.size() == info.items.size();
   for (size_t i = 0; same && i < expected.size(); ++i)
@@ -487,7 +196,7 @@ Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint6
                  " raw bytes"};
   // The first point raw; the item decoders start from it.
   std::memcpy(records, data, length);
-  std::vector<std::unique_ptr<ItemDecoder>> decoders;
+  std::vector<std::unique_ptr<LazItemDecoder>> decoders;
   std::vector<size_t> offsets;
   size_t offset = 0;
   for (const LazItem& item : info.items) {
@@ -496,6 +205,7 @@ Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint6
     offset += item.size;
   }
   // The code starts after the raw point, even for a chunk of one point (its encoder flushed 4 bytes).
+  // Compressor 1's whole point data is such a chunk.
   LazDecoder decoder(reinterpret_cast<const uint8_t*>(data) + length, bytes - length);
   const auto failure = [&](uint64_t point) {
     std::string where = "point " + str(point) + " of " + str(points) + ": ";
@@ -525,6 +235,9 @@ Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint6
 Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t point_data_offset, const LazInfo& info,
                                                 uint64_t point_count) {
   const std::string& path = file.path();
+  // (Compressor 1's chunk size may be 0: it must not reach the division below.)
+  if (info.compressor == kCompressorPointwise)
+    return Error{path + ": compressor 1 has no chunk table (its point data is one code)"};
   const uint64_t size = file.size();
   const auto readExactly = [&](uint64_t at, void* out, size_t n, const std::string& what) -> Status {
     if (at > size || size - at < n)
@@ -624,6 +337,7 @@ namespace {
 // prefixes of it).
 constexpr size_t kVersionMajorAt = 24, kVersionMinorAt = 25, kHeaderSizeAt = 94, kPointOffsetAt = 96;
 constexpr size_t kVlrCountAt = 100, kFormatAt = 104, kRecordLengthAt = 105, kLegacyCountAt = 107;
+constexpr size_t kEvlrStartAt = 235, kEvlrCountAt = 243;  // LAS 1.4
 constexpr size_t kCountAt = 247;  // LAS 1.4: the 64-bit count
 constexpr uint32_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
 constexpr size_t kVlrHeaderBytes = 54;
@@ -633,6 +347,7 @@ struct LazHeader {
   int point_format = 0;
   uint32_t record_length = 0;
   uint64_t point_offset = 0;
+  uint64_t point_end = 0;  // where the point data ends: the first EVLR or the file's end
   uint64_t point_count = 0;
   LazInfo info;
 };
@@ -712,6 +427,21 @@ Result<LazHeader> readHeader(const InputFile& file) {
   hd.info = std::move(*info);
   if (Status s = checkLazItems(hd.info, hd.point_format, hd.record_length); !s)
     return Error{path + ": " + s.error().message};
+  // Compressor 1's code has no table to say where it ends: at the EVLRs of LAS 1.4, else the file's end.
+  if (hd.info.compressor == kCompressorPointwise) {
+    const uint64_t size = file.size();
+    if (hd.point_offset > size)
+      return Error{path + ": truncated: the point data starts at byte " + str(hd.point_offset) +
+                   ", past the end of the " + str(size) + "-byte file"};
+    hd.point_end = size;
+    if (minor >= 4 && loadUnaligned<uint32_t>(h + kEvlrCountAt) != 0) {
+      const uint64_t evlrs = loadUnaligned<uint64_t>(h + kEvlrStartAt);
+      if (evlrs < hd.point_offset || evlrs > size)
+        return Error{path + ": header: the first EVLR's offset " + str(evlrs) + " is not between the offset to point " +
+                     "data " + str(hd.point_offset) + " and the file's end " + str(size)};
+      hd.point_end = evlrs;
+    }
+  }
   return hd;
 }
 
@@ -720,11 +450,18 @@ Result<LazHeader> readHeader(const InputFile& file) {
 Result<LazChunks> openLazChunks(const InputFile& file) {
   Result<LazHeader> header = readHeader(file);
   if (!header) return header.error();
-  Result<std::vector<LazChunk>> table = readLazChunkTable(file, header->point_offset, header->info, header->point_count);
-  if (!table) return table.error();
   LazChunks out;
+  if (header->info.compressor == kCompressorPointwise) {
+    // No chunk table: the point data is one code, read as one chunk of every point.
+    if (header->point_count != 0)
+      out.chunks.push_back({header->point_offset, header->point_end - header->point_offset, header->point_count});
+  } else {
+    Result<std::vector<LazChunk>> table =
+        readLazChunkTable(file, header->point_offset, header->info, header->point_count);
+    if (!table) return table.error();
+    out.chunks = std::move(*table);
+  }
   out.info = std::move(header->info);
-  out.chunks = std::move(*table);
   out.record_length = header->record_length;
   out.point_count = header->point_count;
   out.first_point.assign(out.chunks.size(), 0);
@@ -752,9 +489,13 @@ Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first
     const LazChunk& c = chunks[i];
     std::vector<char>& buffer = buffers[worker];
     buffer.resize(static_cast<size_t>(c.bytes));
-    const std::string where = path + ": chunk " + str(i) + " of " + str(chunks.size()) + " (" + str(c.bytes) +
-                              " bytes at byte " + str(c.offset) + ", points " + str(laz.first_point[i]) + " to " +
-                              str(laz.first_point[i] + c.points - 1) + "): ";
+    const std::string range = "points " + str(laz.first_point[i]) + " to " + str(laz.first_point[i] + c.points - 1);
+    const std::string where =
+        laz.info.compressor == kCompressorPointwise
+            ? path + ": the point data (compressor 1: one code of " + str(c.bytes) + " bytes at byte " +
+                  str(c.offset) + ", " + range + "): "
+            : path + ": chunk " + str(i) + " of " + str(chunks.size()) + " (" + str(c.bytes) + " bytes at byte " +
+                  str(c.offset) + ", " + range + "): ";
     std::optional<Error> problem;
     Result<size_t> got = file.readAt(c.offset, buffer.data(), buffer.size());
     if (!got) {

@@ -1,8 +1,9 @@
 // LAZ (LASzip-compressed LAS) decoding: the point records of a .laz file back as the uncompressed
 // LAS records, byte for byte. dpoint's own decoder, written from LASzip's sources
-// (lasreadpoint, lasreaditemcompressed_v2, laszip_common_v2, laszip.cpp's VLR; Apache 2.0) and
-// laz-perf's (readers.cpp, detail/field_*.cpp), on the entropy coder of laz_codec.h. The layered
-// chunks of point formats 6–8 are laz_layered.h's.
+// (lasreadpoint, lasreaditemcompressed_v1 and _v2, laszip_common_v2, laszip.cpp's VLR; Apache 2.0)
+// and laz-perf's (readers.cpp, detail/field_*.cpp), on the entropy coder of laz_codec.h. The
+// layered chunks of point formats 6–8 are laz_layered.h's; the item decoders of versions 1 and 2
+// are laz_decode_v1.cpp's and laz_decode_v2.cpp's.
 //
 // The format, as relied on here:
 // - The LAS header's point data format byte has bit 7 (old writers: bit 6) set; the format is the
@@ -10,34 +11,40 @@
 // - A VLR "laszip encoded" / 22204 describes the coding: compressor u16, coder u16, version major
 //   u8, minor u8, revision u16, options u32, chunk size u32 (0xFFFFFFFF: variable), number and
 //   offset of special EVLRs (i64 each), item count u16, then per item type, size, version (u16).
-// - At the offset to point data, an i64: the chunk table's offset (−1: written at the file's last
-//   8 bytes). The chunks follow that i64, back to back. The table: version u32 (0), chunk count
-//   u32, then per chunk its point count (variable chunks only) and byte count, each coded with
-//   an integer decompressor (32 bits, 2 contexts) predicted from the previous chunk's.
+// - Compressor 1 (pointwise, LASzip 1.x's): at the offset to point data the first point raw, then
+//   one arithmetic code of all the other points, up to the file's end (LAS 1.4: its first EVLR);
+//   no chunk table. It decodes as one chunk of every point.
+// - Compressors 2 and 3: at the offset to point data, an i64: the chunk table's offset (−1: written
+//   at the file's last 8 bytes). The chunks follow that i64, back to back. The table: version u32
+//   (0), chunk count u32, then per chunk its point count (variable chunks only) and byte count,
+//   each coded with an integer decompressor (32 bits, 2 contexts) predicted from the previous
+//   chunk's.
 // - A chunk (compressor 2, pointwise): its first point raw (the items' bytes in order), then an
 //   arithmetic code of the other points, item by item, every model reset at the chunk's start.
 //   A layered chunk (compressor 3): the first point raw, the point count, then one code per field
 //   group (layer) and its byte count (laz_layered.h). A fixed chunk size gives every chunk that
 //   many points but the last.
-// - Item decoders, version 2: POINT10 (type 6, 20 bytes: the fields shared by formats 0–5),
-//   GPSTIME11 (7, 8 bytes), RGB12 (8, 6 bytes), BYTE (0, the extra bytes, n bytes). Version 3:
-//   POINT14 (10, 30 bytes: all of formats 6–10's first 30), RGB14 (11, 6), RGBNIR14 (12, 8),
-//   BYTE14 (14, n).
+// - Item decoders, versions 1 (LASzip 1.x) and 2: POINT10 (type 6, 20 bytes: the fields shared by
+//   formats 0–5), GPSTIME11 (7, 8 bytes), RGB12 (8, 6 bytes), BYTE (0, the extra bytes, n bytes).
+//   Version 3: POINT14 (10, 30 bytes: all of formats 6–10's first 30), RGB14 (11, 6), RGBNIR14
+//   (12, 8), BYTE14 (14, n).
 //
 // Supported, with the arithmetic coder, fixed and variable chunks and LAS 1.0–1.4 headers:
-// compressor 2 (pointwise chunked) with item version 2, point formats 0–3; compressor 3 (layered
-// chunked) with item version 3, point formats 6–8; either with or without extra bytes.
-// Refused by name: compressor 1 (unchunked), other coders, item versions 1 (LASzip 1.x) and 4
-// (LASzip 3.4's context-switch fix), each compressor's items with the other, the waveform items
-// of formats 4, 5, 9 and 10 (WAVEPACKET13, WAVEPACKET14), items that disagree with the header's
+// compressors 1 (pointwise) and 2 (pointwise chunked) with item versions 1 and 2, point formats
+// 0–3; compressor 3 (layered chunked) with item version 3, point formats 6–8; either with or
+// without extra bytes. Refused by name: other coders, item version 4 (LASzip 3.4's context-switch
+// fix), layered items with compressors 1 and 2 and the older items with 3, the waveform items of
+// formats 4, 5, 9 and 10 (WAVEPACKET13, WAVEPACKET14), items that disagree with the header's
 // format, and a file whose chunk table is missing (its writer was interrupted; LASzip rebuilds
 // such a table, dpoint does not).
 //
 // Hostile input: every length and offset is checked against the file before it is used, a
 // chunk's decoder reads only the chunk's bytes, and a chunk must decode its points with exactly its
-// bytes (LASzip's encoder pads its last bytes so that a decoder ends where the chunk ends), so a
-// truncated or corrupt chunk is an Error naming the chunk and the point, never a crash. A corrupt
-// chunk can still decode to wrong points that pass these checks: LAZ has no checksum.
+// bytes (LASzip's encoder pads its last bytes so that a decoder ends where the chunk ends; so does
+// compressor 1's, at the point data's end), so a truncated or corrupt chunk is an Error naming the
+// chunk and the point, never a crash. No item decoder loops on its data (version 2's GPS time
+// follows at most one sequence switch per point). A corrupt chunk can still decode to wrong points
+// that pass these checks: LAZ has no checksum.
 #pragma once
 
 #include <cstddef>
@@ -103,22 +110,24 @@ struct LazChunk {
   uint64_t points = 0;
 };
 
-// Reads the i64 at `point_data_offset` and the chunk table it points to. Checks that the chunks
-// lie between the i64 and the table, that their points add up to `point_count`, and that the
-// table is neither missing, past the file's end nor corrupt. Messages start with the file's path.
+// Reads the i64 at `point_data_offset` and the chunk table it points to (compressors 2 and 3:
+// compressor 1 has no table, an Error). Checks that the chunks lie between the i64 and the table,
+// that their points add up to `point_count`, and that the table is neither missing, past the
+// file's end nor corrupt. Messages start with the file's path.
 Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t point_data_offset,
                                                 const LazInfo& info, uint64_t point_count);
 
 // Decodes one chunk of `points` (≥ 1) points from [data, data + bytes) into `records`, which holds
 // points × info.recordLength() bytes: the LAS point records (a layered chunk through
-// decodeLayeredChunk). Reads nothing outside the data.
+// decodeLayeredChunk; compressor 1's point data is one chunk). Reads nothing outside the data.
 // Fails when the data ends before the points do, holds an invalid code, or has bytes left over;
 // the message names the point ("point 812 of 50000: ...") but not the file or chunk (the caller's).
 // `info` must have passed parseLaszipVlr.
 Status decodeLazChunk(const LazInfo& info, const char* data, size_t bytes, uint64_t points, char* records);
 
 // A LAZ file's chunks, to decode a few at a time (LasPointStream): the laszip VLR, the chunk
-// table, each chunk's first point, and the header's record length and count.
+// table, each chunk's first point, and the header's record length and count. Compressor 1's point
+// data is one chunk of every point (none when there are no points).
 struct LazChunks {
   LazInfo info;
   std::vector<LazChunk> chunks;
@@ -126,7 +135,8 @@ struct LazChunks {
   uint32_t record_length = 0;
   uint64_t point_count = 0;
 };
-// Parses the header fields, the laszip VLR and the chunk table (readLazChunkTable's checks).
+// Parses the header fields, the laszip VLR and the chunk table (readLazChunkTable's checks); for
+// compressor 1, where the point data ends.
 Result<LazChunks> openLazChunks(const InputFile& file);
 // Decodes chunks [first, last) into `records` (their points × record length bytes, from chunk
 // `first`'s first point) on `threads` threads (0: all cores); the error is the first failing

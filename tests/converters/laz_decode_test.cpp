@@ -314,13 +314,14 @@ TEST(LazDecode, rejectsBadLaszipVlr) {
   };
   EXPECT_TRUE(contains(decodeWith([&](std::string& f) { put<uint16_t>(f, l.laszip_vlr, 3); }),
                        "broken.laz: laszip VLR: LAZ item type 6 (POINT10) version 2 does not go with compressor 3"));
-  EXPECT_TRUE(contains(decodeWith([&](std::string& f) { put<uint16_t>(f, l.laszip_vlr, 1); }),
-                       "LAZ compressor 1 (pointwise, without chunks) is not supported"));
+  EXPECT_TRUE(contains(decodeWith([&](std::string& f) { put<uint16_t>(f, l.laszip_vlr, 4); }),
+                       "broken.laz: laszip VLR: compressor 4 is not one of LASzip's (1 to 3)"));
   EXPECT_TRUE(contains(decodeWith([&](std::string& f) { put<uint16_t>(f, l.laszip_vlr + 2, 1); }),
                        "LAZ coder 1 is not supported"));
   // The first item: type 6 (POINT10), size 20, version 2.
-  EXPECT_TRUE(contains(decodeWith([&](std::string& f) { put<uint16_t>(f, l.laszip_vlr + 34 + 4, 1); }),
-                       "LAZ item type 6 (POINT10) version 1 is not supported"));
+  EXPECT_TRUE(contains(decodeWith([&](std::string& f) { put<uint16_t>(f, l.laszip_vlr + 34 + 4, 4); }),
+                       "LAZ item type 6 (POINT10) version 4 is not supported (only versions 1 and 2 of POINT10, "
+                       "GPSTIME11, RGB12 and BYTE: point formats 0 to 3, and version 3 of POINT14"));
   EXPECT_TRUE(contains(decodeWith([&](std::string& f) {
                          put<uint16_t>(f, l.laszip_vlr + 34, 9);
                          put<uint16_t>(f, l.laszip_vlr + 34 + 4, 3);
