@@ -1,6 +1,6 @@
 // LAZ encoding (converters/laz_encode.h says what and whence): the version-2 item encoders, the
 // chunk and its table, the laszip VLR and a whole file. Each encoder mirrors its decoder in
-// laz_decode.cpp step for step (the same models, updated in the same order); where LASzip's
+// laz_decode_v2.cpp step for step (the same models, updated in the same order); where LASzip's
 // encoder has a choice the decoder cannot see (which of two equal sequences a GPS time joins), the
 // choice is LASzip's, so that dpoint's files come out the size LASzip's do.
 #include "converters/laz_encode.h"
@@ -37,7 +37,7 @@ class ItemEncoder {
   virtual void encode(LazEncoder& encoder, const uint8_t* item) = 0;
 };
 
-// POINT10 (laz_decode.cpp's Point10Decoder says what each field's coding is).
+// POINT10 (laz_decode_v2.cpp's Point10Decoder says what each field's coding is).
 class Point10Encoder final : public ItemEncoder {
  public:
   explicit Point10Encoder(const uint8_t* first) { std::memcpy(last_, first, sizeof last_); }
@@ -210,7 +210,7 @@ class GpsTimeEncoder final : public ItemEncoder {
   LazIntegerEncoder time_encoder_{32, 9};
 };
 
-// RGB12: which bytes changed, then each changed byte against its prediction (laz_decode.cpp's
+// RGB12: which bytes changed, then each changed byte against its prediction (laz_decode_v2.cpp's
 // RgbDecoder).
 class RgbEncoder final : public ItemEncoder {
  public:
