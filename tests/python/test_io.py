@@ -128,7 +128,7 @@ def test_write_refuses_bad_options_and_writes_nothing(tmp_path, cloud, options, 
     assert not (tmp_path / "out.csv").exists()
 
 
-@pytest.mark.parametrize("ext", ["gltf", "laz"])
+@pytest.mark.parametrize("ext", ["gltf"])
 def test_write_refuses_a_read_only_format_as_convert_does(tmp_path, source, ext):
     path, s = source
     target = tmp_path / f"out.{ext}"
@@ -138,6 +138,18 @@ def test_write_refuses_a_read_only_format_as_convert_does(tmp_path, source, ext)
     assert message == str(raised.value)
     assert raised.value.exit_code == code
     assert not target.exists()
+
+
+@pytest.mark.parametrize("ext", ["laz", "copc.laz"])
+def test_write_laz_and_copc_as_convert_does(tmp_path, source, ext):
+    """LAZ and COPC (issue #35) from the module: the bytes `dpoint convert` writes, read back whole."""
+    path, s = source
+    dpoint.write(s, tmp_path / f"py.{ext}")
+    cli("convert", path, "-o", tmp_path / f"cli.{ext}")
+    assert (tmp_path / f"py.{ext}").read_bytes() == (tmp_path / f"cli.{ext}").read_bytes()
+    back = dpoint.read(tmp_path / f"py.{ext}")
+    assert len(back) == len(s)
+    assert np.allclose(np.sort(back.positions, axis=0), np.sort(s.positions, axis=0), rtol=0, atol=1e-3)
 
 
 def test_write_refuses_a_non_size_type(tmp_path, cloud):
