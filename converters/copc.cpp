@@ -7,11 +7,9 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <mutex>
 #include <optional>
 #include <set>
 
@@ -857,15 +855,13 @@ Result<std::string> readCopcRecords(const InputFile& file, const CopcQuery& quer
   for (const CopcNode& n : *selected)
     if (n.points > 0) nodes.push_back(n);
 
-  // Each node's place in the records, and the memory they take.
+  // The memory the records take (a node's count is at most 2^31 - 1: the sum cannot overflow).
   const uint64_t length = hd.record_length;
-  std::vector<uint64_t> first(nodes.size() + 1, 0);
-  uint64_t largest = 0;
-  for (size_t i = 0; i < nodes.size(); ++i) {
-    first[i + 1] = first[i] + static_cast<uint64_t>(nodes[i].points);
-    largest = std::max(largest, static_cast<uint64_t>(nodes[i].bytes));
+  uint64_t total = 0, largest = 0;
+  for (const CopcNode& n : nodes) {
+    total += static_cast<uint64_t>(n.points);
+    largest = std::max(largest, static_cast<uint64_t>(n.bytes));
   }
-  const uint64_t total = first.back();
   const unsigned threads =
       std::min<unsigned>(resolveThreads(query.threads), static_cast<unsigned>(std::max<size_t>(nodes.size(), 1)));
   if (total > (UINT64_MAX - largest * threads) / length)  // counts of a hostile hierarchy
@@ -877,37 +873,18 @@ Result<std::string> readCopcRecords(const InputFile& file, const CopcQuery& quer
     return s.error();
   std::string records(static_cast<size_t>(total * length), '\0');
 
-  // The first failing node's error, whatever the thread count (as decodeLaz does).
-  std::atomic<size_t> failed{nodes.size()};
-  std::mutex mutex;
-  std::optional<Error> error;
-  std::vector<std::vector<char>> buffers(threads);
-  parallelFor(nodes.size(), threads, [&](size_t i, unsigned worker) {
-    if (i > failed.load()) return;
-    const CopcNode& n = nodes[i];
-    std::vector<char>& buffer = buffers[worker];
-    buffer.resize(static_cast<size_t>(n.bytes));
-    const std::string where = path + ": node " + copcKeyName(n.key) + " (" + std::to_string(n.points) + " points, " +
-                              std::to_string(n.bytes) + " bytes at byte " + str(n.offset) + "): ";
-    std::optional<Error> problem;
-    Result<size_t> got = file.readAt(n.offset, buffer.data(), buffer.size());
-    if (!got) {
-      problem = got.error();
-    } else if (*got != buffer.size()) {
-      problem = Error{where + "truncated: the file ends inside the chunk"};
-    } else if (Status s = decodeLazChunk(hd.laz, buffer.data(), buffer.size(), static_cast<uint64_t>(n.points),
-                                         records.data() + first[i] * length);
-               !s) {
-      problem = Error{where + s.error().message};
-    }
-    if (!problem) return;
-    std::lock_guard<std::mutex> lock(mutex);
-    if (i < failed.load()) {
-      failed.store(i);
-      error = std::move(*problem);
-    }
-  });
-  if (error) return *error;
+  // The nodes' chunks, decoded as decodeLaz decodes a file's (the first failing node's error).
+  std::vector<LazChunk> chunks;
+  chunks.reserve(nodes.size());
+  for (const CopcNode& n : nodes)
+    chunks.push_back({n.offset, static_cast<uint64_t>(n.bytes), static_cast<uint64_t>(n.points)});
+  if (Status s = decodeLazChunkList(file, hd.laz, chunks, hd.record_length, records.data(), threads, [&](size_t i) {
+        const CopcNode& n = nodes[i];
+        return path + ": node " + copcKeyName(n.key) + " (" + std::to_string(n.points) + " points, " +
+               std::to_string(n.bytes) + " bytes at byte " + str(n.offset) + "): ";
+      });
+      !s)
+    return s.error();
   if (stats) {
     stats->points = total;
     stats->nodes = nodes.size();

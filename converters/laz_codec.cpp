@@ -114,49 +114,49 @@ LazDecoder::LazDecoder(const uint8_t* data, size_t size) : begin_(data), next_(d
 
 // --- Integer decoder -------------------------------------------------------------------------------
 
-LazIntegerDecoder::LazIntegerDecoder(uint32_t bits, uint32_t contexts, uint32_t bits_high, uint32_t range)
-    : bits_high_(bits_high) {
+LazIntegerModels::LazIntegerModels(uint32_t bits, uint32_t contexts, uint32_t split_bits, uint32_t range)
+    : bits_high(split_bits) {
   assert(bits >= 1 && bits <= 32 && contexts >= 1 && bits_high >= 1 && bits_high <= 11);
   if (range != 0) {
     // The fewest bits that hold range − 1 (a power of two needs one bit less than its own width).
-    corr_bits_ = 0;
-    for (uint32_t r = range; r != 0; r >>= 1) ++corr_bits_;
-    if (range == (1u << (corr_bits_ - 1))) --corr_bits_;
-    corr_range_ = range;
+    corr_bits = 0;
+    for (uint32_t r = range; r != 0; r >>= 1) ++corr_bits;
+    if (range == (1u << (corr_bits - 1))) --corr_bits;
+    corr_range = range;
   } else if (bits < 32) {
-    corr_bits_ = bits;
-    corr_range_ = 1u << bits;
+    corr_bits = bits;
+    corr_range = 1u << bits;
   } else {
-    corr_bits_ = 32;
-    corr_range_ = 0;
+    corr_bits = 32;
+    corr_range = 0;
   }
-  corr_min_ = corr_range_ != 0 ? -static_cast<int32_t>(corr_range_ / 2) : INT32_MIN;
-  classes_.reserve(contexts);
-  for (uint32_t c = 0; c < contexts; ++c) classes_.emplace_back(corr_bits_ + 1);
-  correctors_.resize(corr_bits_);
+  corr_min = corr_range != 0 ? -static_cast<int32_t>(corr_range / 2) : INT32_MIN;
+  classes.reserve(contexts);
+  for (uint32_t c = 0; c < contexts; ++c) classes.emplace_back(corr_bits + 1);
+  correctors.resize(corr_bits);
 }
 
-void LazIntegerDecoder::reset() {
-  for (LazSymbolModel& m : classes_) m.reset();
-  corrector_0_.reset();
-  for (std::unique_ptr<LazSymbolModel>& m : correctors_)
+void LazIntegerModels::reset() {
+  for (LazSymbolModel& m : classes) m.reset();
+  corrector_0.reset();
+  for (std::unique_ptr<LazSymbolModel>& m : correctors)
     if (m) m->reset();
 }
 
-LazSymbolModel& LazIntegerDecoder::corrector(uint32_t k) {
-  std::unique_ptr<LazSymbolModel>& m = correctors_[k - 1];
-  if (!m) m = std::make_unique<LazSymbolModel>(1u << (k <= bits_high_ ? k : bits_high_));
+LazSymbolModel& LazIntegerModels::corrector(uint32_t k) {
+  std::unique_ptr<LazSymbolModel>& m = correctors[k - 1];
+  if (!m) m = std::make_unique<LazSymbolModel>(1u << (k <= bits_high ? k : bits_high));
   return *m;
 }
 
 int32_t LazIntegerDecoder::decode(LazDecoder& decoder, int32_t prediction, uint32_t context) {
-  assert(context < classes_.size());
+  assert(context < m_.classes.size());
   // All in unsigned arithmetic: the sum wraps as LASzip's int32 sum does on every compiler it
   // supports, without the undefined behaviour of a signed overflow.
-  uint32_t real = static_cast<uint32_t>(prediction) + readCorrector(decoder, classes_[context]);
-  if (corr_range_ != 0) {
-    if (static_cast<int32_t>(real) < 0) real += corr_range_;
-    else if (real >= corr_range_) real -= corr_range_;
+  uint32_t real = static_cast<uint32_t>(prediction) + readCorrector(decoder, m_.classes[context]);
+  if (m_.corr_range != 0) {
+    if (static_cast<int32_t>(real) < 0) real += m_.corr_range;
+    else if (real >= m_.corr_range) real -= m_.corr_range;
   }
   return static_cast<int32_t>(real);
 }
@@ -164,14 +164,14 @@ int32_t LazIntegerDecoder::decode(LazDecoder& decoder, int32_t prediction, uint3
 // The corrector as a 32-bit two's-complement pattern.
 uint32_t LazIntegerDecoder::readCorrector(LazDecoder& decoder, LazSymbolModel& classes) {
   k_ = decoder.decodeSymbol(classes);
-  if (k_ == 0) return decoder.decodeBit(corrector_0_);  // c is 0 or 1
-  if (k_ >= 32) return static_cast<uint32_t>(corr_min_);
+  if (k_ == 0) return decoder.decodeBit(m_.corrector_0);  // c is 0 or 1
+  if (k_ >= 32) return static_cast<uint32_t>(m_.corr_min);
   uint32_t c;
-  if (k_ <= bits_high_) {
-    c = decoder.decodeSymbol(corrector(k_));
+  if (k_ <= m_.bits_high) {
+    c = decoder.decodeSymbol(m_.corrector(k_));
   } else {
-    const uint32_t low_bits = k_ - bits_high_;
-    c = decoder.decodeSymbol(corrector(k_)) << low_bits;
+    const uint32_t low_bits = k_ - m_.bits_high;
+    c = decoder.decodeSymbol(m_.corrector(k_)) << low_bits;
     c |= decoder.readBits(low_bits);
   }
   // c in [0, 2^k) back to the class's two halves: [2^(k−1), 2^k) is c + 1 in [2^(k−1) + 1, 2^k],

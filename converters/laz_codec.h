@@ -31,6 +31,7 @@
 // table index in bounds, so a caller may decode on and check ok() once per point.
 #pragma once
 
+#include <array>
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
@@ -192,13 +193,50 @@ class LazDecoder {
   bool invalid_ = false;
 };
 
-// LASzip's IntegerCompressor, decompressing: values of `bits` bits (1..32) predicted in one of
-// `contexts` contexts, the corrector in the given `range` (0: 2^bits), large classes split at
-// `bits_high` bits.
+// Models keyed by a previous value, created when first needed, as LASzip creates them: most files
+// use a few of the keys. A new model starts in its reset state, so when it is created does not
+// change the code.
+template <size_t N>
+class LazKeyedModels {
+ public:
+  explicit LazKeyedModels(uint32_t symbols) : symbols_(symbols) {}
+  LazSymbolModel& operator[](size_t key) {
+    assert(key < N);
+    if (!models_[key]) models_[key] = std::make_unique<LazSymbolModel>(symbols_);
+    return *models_[key];
+  }
+
+ private:
+  uint32_t symbols_;
+  std::array<std::unique_ptr<LazSymbolModel>, N> models_;
+};
+
+// The models of LASzip's IntegerCompressor, which its compressor (laz_encoder.h) and decompressor
+// share: values of `bits` bits (1..32) predicted in one of `contexts` contexts, the corrector in the
+// given `range` (0: 2^bits), large classes split at `bits_high` bits.
+struct LazIntegerModels {
+  LazIntegerModels(uint32_t bits, uint32_t contexts, uint32_t bits_high, uint32_t range);
+  void reset();  // every model to its start state
+  // The model of class k's corrector (k = 1..corr_bits), made when the class first occurs: a
+  // fresh model is the same whenever it is made, and a chunk uses few of the 32 classes (building
+  // all of them was most of a small chunk's time: COPC nodes, fuzzing).
+  LazSymbolModel& corrector(uint32_t k);
+
+  uint32_t bits_high = 8;
+  uint32_t corr_bits = 0;
+  uint32_t corr_range = 0;  // 0: the whole 32 bits, no wrapping needed
+  int32_t corr_min = 0;
+  std::vector<LazSymbolModel> classes;  // one per context: k, 0..corr_bits
+  LazBitModel corrector_0;              // k = 0
+  std::vector<std::unique_ptr<LazSymbolModel>> correctors;  // k = 1..corr_bits, at k − 1
+};
+
+// LASzip's IntegerCompressor, decompressing (the arguments are LazIntegerModels').
 class LazIntegerDecoder {
  public:
-  explicit LazIntegerDecoder(uint32_t bits = 16, uint32_t contexts = 1, uint32_t bits_high = 8, uint32_t range = 0);
-  void reset();  // every model to its start state
+  explicit LazIntegerDecoder(uint32_t bits = 16, uint32_t contexts = 1, uint32_t bits_high = 8, uint32_t range = 0)
+      : m_(bits, contexts, bits_high, range) {}
+  void reset() { m_.reset(); }
 
   // The value coded after `prediction` in `context` (< contexts; an assert).
   int32_t decode(LazDecoder& decoder, int32_t prediction, uint32_t context = 0);
@@ -208,19 +246,9 @@ class LazIntegerDecoder {
 
  private:
   uint32_t readCorrector(LazDecoder& decoder, LazSymbolModel& classes);
-  LazSymbolModel& corrector(uint32_t k);
 
-  uint32_t bits_high_ = 8;
-  uint32_t corr_bits_ = 0;
-  uint32_t corr_range_ = 0;  // 0: the whole 32 bits, no wrapping needed
-  int32_t corr_min_ = 0;
+  LazIntegerModels m_;
   uint32_t k_ = 0;
-  std::vector<LazSymbolModel> classes_;     // one per context: k, 0..corr_bits
-  LazBitModel corrector_0_;                 // k = 0
-  // k = 1..corr_bits, at k − 1, each made when its class first occurs: a fresh model is the same
-  // whenever it is made, and a chunk uses few of the 32 classes (building all of them was most of
-  // a small chunk's time: COPC nodes, fuzzing).
-  std::vector<std::unique_ptr<LazSymbolModel>> correctors_;
 };
 
 }  // namespace dpoint

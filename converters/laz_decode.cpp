@@ -8,9 +8,11 @@
 #include <atomic>
 #include <bit>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 
 #include "converters/laz_codec.h"
 #include "converters/laz_item_decoder.h"
@@ -469,43 +471,33 @@ Result<LazChunks> openLazChunks(const InputFile& file) {
   return out;
 }
 
-Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first, size_t last, char* records,
-                       unsigned threads) {
-  assert(first <= last && last <= laz.chunks.size());
-  const std::string& path = file.path();
-  const std::vector<LazChunk>& chunks = laz.chunks;
-  const uint64_t length = laz.record_length;
-  if (first == last) return okStatus();
-  threads = std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(last - first));
+Status decodeLazChunkList(const InputFile& file, const LazInfo& info, std::span<const LazChunk> chunks,
+                          uint32_t record_length, char* records, unsigned threads,
+                          const std::function<std::string(size_t)>& where) {
+  if (chunks.empty()) return okStatus();
+  threads = std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(chunks.size()));
+  std::vector<uint64_t> at(chunks.size(), 0);  // each chunk's first record in `records`
+  for (size_t i = 1; i < chunks.size(); ++i) at[i] = at[i - 1] + chunks[i - 1].points;
   // The error reported is the first failing chunk's: chunks are handed out in order, and once one
   // fails no later one starts, so every earlier one is decoded and its error, if any, wins.
-  std::atomic<size_t> failed{last};
+  std::atomic<size_t> failed{chunks.size()};
   std::mutex mutex;
   std::optional<Error> error;
   std::vector<std::vector<char>> buffers(threads);
-  parallelFor(last - first, threads, [&](size_t j, unsigned worker) {
-    const size_t i = first + j;
+  parallelFor(chunks.size(), threads, [&](size_t i, unsigned worker) {
     if (i > failed.load()) return;
     const LazChunk& c = chunks[i];
     std::vector<char>& buffer = buffers[worker];
     buffer.resize(static_cast<size_t>(c.bytes));
-    const std::string range = "points " + str(laz.first_point[i]) + " to " + str(laz.first_point[i] + c.points - 1);
-    const std::string where =
-        laz.info.compressor == kCompressorPointwise
-            ? path + ": the point data (compressor 1: one code of " + str(c.bytes) + " bytes at byte " +
-                  str(c.offset) + ", " + range + "): "
-            : path + ": chunk " + str(i) + " of " + str(chunks.size()) + " (" + str(c.bytes) + " bytes at byte " +
-                  str(c.offset) + ", " + range + "): ";
     std::optional<Error> problem;
     Result<size_t> got = file.readAt(c.offset, buffer.data(), buffer.size());
     if (!got) {
       problem = got.error();
     } else if (*got != buffer.size()) {
-      problem = Error{where + "truncated: the file ends inside the chunk"};
-    } else {
-      Status s = decodeLazChunk(laz.info, buffer.data(), buffer.size(), c.points,
-                                records + (laz.first_point[i] - laz.first_point[first]) * length);
-      if (!s) problem = Error{where + s.error().message};
+      problem = Error{where(i) + "truncated: the file ends inside the chunk"};
+    } else if (Status s = decodeLazChunk(info, buffer.data(), buffer.size(), c.points, records + at[i] * record_length);
+               !s) {
+      problem = Error{where(i) + s.error().message};
     }
     if (!problem) return;
     std::lock_guard<std::mutex> lock(mutex);
@@ -516,6 +508,22 @@ Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first
   });
   if (error) return *error;
   return okStatus();
+}
+
+Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first, size_t last, char* records,
+                       unsigned threads) {
+  assert(first <= last && last <= laz.chunks.size());
+  const std::span<const LazChunk> chunks(laz.chunks.data() + first, last - first);
+  return decodeLazChunkList(file, laz.info, chunks, laz.record_length, records, threads, [&](size_t j) {
+    const size_t i = first + j;
+    const LazChunk& c = laz.chunks[i];
+    const std::string range = "points " + str(laz.first_point[i]) + " to " + str(laz.first_point[i] + c.points - 1);
+    if (laz.info.compressor == kCompressorPointwise)
+      return file.path() + ": the point data (compressor 1: one code of " + str(c.bytes) + " bytes at byte " +
+             str(c.offset) + ", " + range + "): ";
+    return file.path() + ": chunk " + str(i) + " of " + str(laz.chunks.size()) + " (" + str(c.bytes) +
+           " bytes at byte " + str(c.offset) + ", " + range + "): ";
+  });
 }
 
 Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t max_memory) {

@@ -49,6 +49,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -143,6 +145,13 @@ Result<LazChunks> openLazChunks(const InputFile& file);
 // chunk's, naming the file, the chunk, its bytes and points.
 Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first, size_t last, char* records,
                        unsigned threads = 0);
+// The mechanism under it, for chunks that need not follow each other in the file (COPC's nodes):
+// each chunk read and decoded on one of `threads` threads (0: all cores) into `records`, one after
+// another in the list's order. Errors start with where(i), the caller's name for chunk i (file
+// and position); the one reported is the first failing chunk's, whatever the thread count.
+Status decodeLazChunkList(const InputFile& file, const LazInfo& info, std::span<const LazChunk> chunks,
+                          uint32_t record_length, char* records, unsigned threads,
+                          const std::function<std::string(size_t)>& where);
 
 // All point records of a .laz file (LAS 1.0–1.4, point formats 0–3 and 6–8), count × record length bytes,
 // exactly as the uncompressed .las holds them. Parses the LAS header fields it needs (version,

@@ -81,11 +81,11 @@ class Point10V1Decoder final : public LazItemDecoder {
     // source ID changed (not version 2's order).
     const uint32_t changed = d.decodeSymbol(changed_model_);
     if (changed & 32) intensity_ = static_cast<uint16_t>(intensity_decoder_.decode(d, intensity_));
-    if (changed & 16) returns_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(returns_models_[returns_])));
+    if (changed & 16) returns_ = static_cast<uint8_t>(d.decodeSymbol(returns_models_[returns_]));
     if (changed & 8)
-      classification_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(class_models_[classification_])));
+      classification_ = static_cast<uint8_t>(d.decodeSymbol(class_models_[classification_]));
     if (changed & 4) scan_angle_ = static_cast<uint8_t>(scan_angle_decoder_.decode(d, scan_angle_, k < 3 ? 1u : 0u));
-    if (changed & 2) user_data_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(user_models_[user_data_])));
+    if (changed & 2) user_data_ = static_cast<uint8_t>(d.decodeSymbol(user_models_[user_data_]));
     if (changed & 1) source_id_ = static_cast<uint16_t>(source_id_decoder_.decode(d, source_id_));
 
     dx_history_[next_] = dx;
@@ -104,14 +104,6 @@ class Point10V1Decoder final : public LazItemDecoder {
   }
 
  private:
-  // A model per previous value, created when first needed (a new model is in its reset state, so
-  // when it is created does not change the code).
-  using LazyModels = std::array<std::unique_ptr<LazSymbolModel>, 256>;
-  static LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& slot) {
-    if (!slot) slot = std::make_unique<LazSymbolModel>(256);
-    return *slot;
-  }
-
   int32_t x_ = 0, y_ = 0, z_ = 0;
   uint16_t intensity_ = 0, source_id_ = 0;
   uint8_t returns_ = 0, classification_ = 0, scan_angle_ = 0, user_data_ = 0;
@@ -119,7 +111,8 @@ class Point10V1Decoder final : public LazItemDecoder {
   uint32_t next_ = 0;  // the history slot the next differences replace
 
   LazSymbolModel changed_model_{64};
-  LazyModels returns_models_, class_models_, user_models_;
+  // The return byte, classification and user data each have a model per previous value.
+  LazKeyedModels<256> returns_models_{256}, class_models_{256}, user_models_{256};
   LazIntegerDecoder dx_decoder_{32, 1};
   LazIntegerDecoder dy_decoder_{32, 20};
   LazIntegerDecoder z_decoder_{32, 20};

@@ -42,7 +42,7 @@ class Point10Decoder final : public LazItemDecoder {
     // Bits 5..0: the return byte, intensity, classification, scan angle, user data and point
     // source ID changed.
     const uint32_t changed = d.decodeSymbol(changed_model_);
-    if (changed & 32) returns_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(returns_models_[returns_])));
+    if (changed & 32) returns_ = static_cast<uint8_t>(d.decodeSymbol(returns_models_[returns_]));
     const uint32_t r = returns_ & 7u, n = (returns_ >> 3) & 7u;
     const uint32_t m = kLazReturnMap[n][r], l = kLazReturnLevel[n][r];
     // LASzip sets the intensity only when some value changed; when none did, the point's return
@@ -53,12 +53,12 @@ class Point10Decoder final : public LazItemDecoder {
     }
     intensity_ = last_intensity_[m];
     if (changed & 8)
-      classification_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(class_models_[classification_])));
+      classification_ = static_cast<uint8_t>(d.decodeSymbol(class_models_[classification_]));
     if (changed & 4) {
       const uint32_t delta = d.decodeSymbol(scan_angle_models_[(returns_ >> 6) & 1u]);
       scan_angle_ = static_cast<uint8_t>(delta + scan_angle_);  // mod 256
     }
-    if (changed & 2) user_data_ = static_cast<uint8_t>(d.decodeSymbol(lazyModel(user_models_[user_data_])));
+    if (changed & 2) user_data_ = static_cast<uint8_t>(d.decodeSymbol(user_models_[user_data_]));
     if (changed & 1) source_id_ = static_cast<uint16_t>(source_id_decoder_.decode(d, source_id_));
 
     // x and y: the difference from the last point, predicted by the median of its history; y's and
@@ -88,14 +88,6 @@ class Point10Decoder final : public LazItemDecoder {
   }
 
  private:
-  // The return byte, classification and user data are each coded with a model per previous
-  // value, created when first needed (most files use a few of the 256).
-  using LazyModels = std::array<std::unique_ptr<LazSymbolModel>, 256>;
-  static LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& slot) {
-    if (!slot) slot = std::make_unique<LazSymbolModel>(256);
-    return *slot;
-  }
-
   int32_t x_ = 0, y_ = 0, z_ = 0;
   uint16_t intensity_ = 0, source_id_ = 0;
   uint8_t returns_ = 0, classification_ = 0, scan_angle_ = 0, user_data_ = 0;
@@ -104,7 +96,8 @@ class Point10Decoder final : public LazItemDecoder {
   std::array<LazMedian5, 16> dx_history_, dy_history_;
 
   LazSymbolModel changed_model_{64};
-  LazyModels returns_models_, class_models_, user_models_;
+  // The return byte, classification and user data each have a model per previous value.
+  LazKeyedModels<256> returns_models_{256}, class_models_{256}, user_models_{256};
   std::array<LazSymbolModel, 2> scan_angle_models_{LazSymbolModel(256), LazSymbolModel(256)};  // by scan direction
   LazIntegerDecoder intensity_decoder_{16, 4};
   LazIntegerDecoder source_id_decoder_{16, 1};

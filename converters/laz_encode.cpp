@@ -52,14 +52,14 @@ class Point10Encoder final : public ItemEncoder {
                              (uint32_t{last_[15] != item[15]} << 3) | (uint32_t{last_[16] != item[16]} << 2) |
                              (uint32_t{last_[17] != item[17]} << 1) | uint32_t{last_source_id != source_id};
     e.encodeSymbol(changed_model_, changed);
-    if (changed & 32) e.encodeSymbol(lazyModel(returns_models_[last_[14]]), returns);
+    if (changed & 32) e.encodeSymbol(returns_models_[last_[14]], returns);
     if (changed & 16) {
       intensity_encoder_.encode(e, last_intensity_[m], intensity, m < 3 ? m : 3);
       last_intensity_[m] = intensity;
     }
-    if (changed & 8) e.encodeSymbol(lazyModel(class_models_[last_[15]]), item[15]);
+    if (changed & 8) e.encodeSymbol(class_models_[last_[15]], item[15]);
     if (changed & 4) e.encodeSymbol(scan_angle_models_[(returns >> 6) & 1u], static_cast<uint8_t>(item[16] - last_[16]));
-    if (changed & 2) e.encodeSymbol(lazyModel(user_models_[last_[17]]), item[17]);
+    if (changed & 2) e.encodeSymbol(user_models_[last_[17]], item[17]);
     if (changed & 1) source_id_encoder_.encode(e, last_source_id, source_id);
 
     const uint32_t single = n == 1 ? 1 : 0;
@@ -77,11 +77,6 @@ class Point10Encoder final : public ItemEncoder {
   }
 
  private:
-  using LazyModels = std::array<std::unique_ptr<LazSymbolModel>, 256>;
-  static LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& slot) {
-    if (!slot) slot = std::make_unique<LazSymbolModel>(256);
-    return *slot;
-  }
   // The coordinate at `at` minus the last one's, wrapping as LASzip's int32 difference does.
   int32_t difference(const uint8_t* item, size_t at) const {
     return static_cast<int32_t>(static_cast<uint32_t>(loadUnaligned<int32_t>(item + at)) -
@@ -94,7 +89,8 @@ class Point10Encoder final : public ItemEncoder {
   std::array<LazMedian5, 16> dx_history_, dy_history_;
 
   LazSymbolModel changed_model_{64};
-  LazyModels returns_models_, class_models_, user_models_;
+  // The return byte, classification and user data each have a model per previous value.
+  LazKeyedModels<256> returns_models_{256}, class_models_{256}, user_models_{256};
   std::array<LazSymbolModel, 2> scan_angle_models_{LazSymbolModel(256), LazSymbolModel(256)};
   LazIntegerEncoder intensity_encoder_{16, 4};
   LazIntegerEncoder source_id_encoder_{16, 1};

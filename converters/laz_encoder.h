@@ -14,7 +14,6 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "converters/laz_codec.h"
@@ -101,11 +100,13 @@ class LazEncoder {
   std::vector<uint8_t> out_;
 };
 
-// LASzip's IntegerCompressor, compressing: the arguments are LazIntegerDecoder's.
+// LASzip's IntegerCompressor, compressing: the arguments are LazIntegerDecoder's, the models
+// (LazIntegerModels) the same.
 class LazIntegerEncoder {
  public:
-  explicit LazIntegerEncoder(uint32_t bits = 16, uint32_t contexts = 1, uint32_t bits_high = 8, uint32_t range = 0);
-  void reset();
+  explicit LazIntegerEncoder(uint32_t bits = 16, uint32_t contexts = 1, uint32_t bits_high = 8, uint32_t range = 0)
+      : m_(bits, contexts, bits_high, range) {}
+  void reset() { m_.reset(); }
 
   // Codes `real` after `prediction` in `context`.
   void encode(LazEncoder& encoder, int32_t prediction, int32_t real, uint32_t context = 0);
@@ -114,16 +115,9 @@ class LazIntegerEncoder {
 
  private:
   void writeCorrector(LazEncoder& encoder, int32_t c, LazSymbolModel& classes);
-  LazSymbolModel& corrector(uint32_t k);
 
-  uint32_t bits_high_ = 8;
-  uint32_t corr_bits_ = 0;
-  uint32_t corr_range_ = 0;  // 0: the whole 32 bits
-  int32_t corr_min_ = 0, corr_max_ = 0;
+  LazIntegerModels m_;
   uint32_t k_ = 0;
-  std::vector<LazSymbolModel> classes_;
-  LazBitModel corrector_0_;
-  std::vector<std::unique_ptr<LazSymbolModel>> correctors_;  // made on first use, as the decoder's
 };
 
 }  // namespace dpoint

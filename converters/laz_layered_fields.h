@@ -94,24 +94,6 @@ inline void storePoint14(const Point14& q, uint8_t* p) {
   storeUnaligned(p + 22, q.gps);
 }
 
-// Models keyed by a previous value, created when first needed, as LASzip creates them: most
-// files use a few of the keys. A new model starts in its reset state, so when it is created does
-// not change the code.
-template <size_t N>
-class LazyModels {
- public:
-  explicit LazyModels(uint32_t symbols) : symbols_(symbols) {}
-  LazSymbolModel& operator[](size_t key) {
-    assert(key < N);
-    if (!models_[key]) models_[key] = std::make_unique<LazSymbolModel>(symbols_);
-    return *models_[key];
-  }
-
- private:
-  uint32_t symbols_;
-  std::array<std::unique_ptr<LazSymbolModel>, N> models_;
-};
-
 inline uint64_t widen(int32_t v) { return static_cast<uint64_t>(static_cast<int64_t>(v)); }
 // a · b and a + b with the 32-bit wrap-around of LASzip's int arithmetic, without signed overflow.
 inline int32_t wrapTimes(int32_t a, int32_t b) {
@@ -151,9 +133,9 @@ struct Point14Channel {
                                         LazSymbolModel(128), LazSymbolModel(128), LazSymbolModel(128),
                                         LazSymbolModel(128), LazSymbolModel(128)};
   LazSymbolModel channel_model{3};
-  LazyModels<16> returns_count{16}, return_number{16};
+  LazKeyedModels<16> returns_count{16}, return_number{16};
   LazSymbolModel return_gps_same{13};
-  LazyModels<64> classification{256}, flags{64}, user_data{256};
+  LazKeyedModels<64> classification{256}, flags{64}, user_data{256};
   LazSymbolModel gps_multi{kGpsMultiSymbols}, gps_zero_diff{kGpsZeroDiffSymbols};
   IntegerCoder dx{32, 2}, dy{32, 22}, z{32, 20}, intensity{16, 4}, scan_angle{16, 2}, source_id{16}, gps{32, 9};
 
