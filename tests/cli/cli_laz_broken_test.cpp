@@ -13,11 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
+using test::put;
 using test::readFile;
 using test::runDpoint;
 using test::TempDir;
@@ -25,27 +28,11 @@ using test::writeFile;
 
 const std::string kLaz = std::string(DPOINT_CORPUS_DIR) + "/laz/";
 
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
-
-template <typename T>
-void put(std::string& bytes, size_t offset, T v) {
-  std::memcpy(bytes.data() + offset, &v, sizeof v);
-}
-
 // Offset of the laszip VLR's data (after its 54-byte VLR header).
 size_t laszipVlr(const std::string& file) {
-  size_t p = at<uint16_t>(file, 94);
-  for (uint32_t i = 0; i < at<uint32_t>(file, 100); ++i) {
-    if (std::strncmp(file.data() + p + 2, "laszip encoded", 16) == 0) return p + 54;
-    p += 54 + at<uint16_t>(file, p + 20);
-  }
-  ADD_FAILURE() << "no laszip VLR";
-  return 0;
+  const size_t data = test::laszipVlrAt(file);
+  if (data == 0) ADD_FAILURE() << "no laszip VLR";
+  return data;
 }
 
 struct Broken {

@@ -18,29 +18,16 @@
 #include <vector>
 
 #include "converters/laz_decode.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
+using test::lasRecords;
+using test::put;
 using test::readFile;
-
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
-template <typename T>
-void put(std::string& bytes, size_t offset, T v) {
-  std::memcpy(bytes.data() + offset, &v, sizeof v);
-}
-
-std::string lasRecords(const std::string& file) {
-  uint64_t count = at<uint64_t>(file, 247);
-  if (count == 0) count = at<uint32_t>(file, 107);
-  return file.substr(at<uint32_t>(file, 96), count * at<uint16_t>(file, 105));
-}
 
 std::vector<std::string> sorted(const std::string& records, size_t length) {
   std::vector<std::string> out;

@@ -15,36 +15,19 @@
 
 #include "converters/las.h"
 #include "converters/point_io.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
 using test::contains;
+using test::lasRecords;
+using test::put;
 using test::readFile;
 
 const std::string kLaz = std::string(DPOINT_CORPUS_DIR) + "/laz/";
-
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
-
-template <typename T>
-void put(std::string& bytes, size_t offset, T v) {
-  std::memcpy(bytes.data() + offset, &v, sizeof v);
-}
-
-// The point records of an uncompressed LAS file, straight from its header's fields.
-std::string lasRecords(const std::string& file) {
-  const uint32_t offset = at<uint32_t>(file, 96);
-  const uint16_t length = at<uint16_t>(file, 105);
-  uint64_t count = at<uint32_t>(file, 107);
-  if (file[25] >= 4 && at<uint64_t>(file, 247) != 0) count = at<uint64_t>(file, 247);
-  return file.substr(offset, count * length);
-}
 
 Result<std::string> decodeBytes(const std::string& bytes, unsigned threads = 1) {
   return decodeLaz(InputFile::fromMemory("broken.laz", bytes), threads);

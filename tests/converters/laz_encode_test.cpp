@@ -14,29 +14,17 @@
 
 #include "converters/laz_codec.h"
 #include "converters/laz_encoder.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
+using test::lasRecords;
 using test::readFile;
 
 const std::string kLaz = std::string(DPOINT_CORPUS_DIR) + "/laz/";
-
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
-
-std::string lasRecords(const std::string& file) {
-  const uint32_t offset = at<uint32_t>(file, 96);
-  const uint16_t length = at<uint16_t>(file, 105);
-  uint64_t count = at<uint32_t>(file, 107);
-  if (file[25] >= 4 && at<uint64_t>(file, 247) != 0) count = at<uint64_t>(file, 247);
-  return file.substr(offset, count * length);
-}
 
 TEST(LazEncoder, decoderReadsBackBitsSymbolsRawBitsAndIntegers) {
   std::mt19937 engine(7);

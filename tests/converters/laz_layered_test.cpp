@@ -24,40 +24,23 @@
 
 #include "converters/laz_decode.h"
 #include "converters/laz_encode.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
 using test::contains;
+using test::lasRecords;
+using test::put;
 using test::readFile;
 
 const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/";
 const std::string kData = std::string(DPOINT_TESTS_DIR) + "/data/laz/";
 
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
-template <typename T>
-void put(std::string& bytes, size_t offset, T v) {
-  std::memcpy(bytes.data() + offset, &v, sizeof v);
-}
-
 int lasFormat(const std::string& file) { return static_cast<uint8_t>(file[104]) & 0x3F; }
 uint16_t lasRecordLength(const std::string& file) { return at<uint16_t>(file, 105); }
-uint64_t lasCount(const std::string& file) {
-  uint64_t count = at<uint32_t>(file, 107);
-  if (file[25] >= 4 && at<uint64_t>(file, 247) != 0) count = at<uint64_t>(file, 247);
-  return count;
-}
-// The point records of an uncompressed LAS file, straight from its header's fields.
-std::string lasRecords(const std::string& file) {
-  return file.substr(at<uint32_t>(file, 96), lasCount(file) * lasRecordLength(file));
-}
-
 // FNV-1a, 64 bits: a fingerprint of records decoded by laz-perf when the tests were written.
 uint64_t fnv1a(const std::string& bytes) {
   uint64_t h = 0xcbf29ce484222325u;

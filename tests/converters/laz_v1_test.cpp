@@ -25,45 +25,25 @@
 #include "converters/laz_encode.h"
 #include "converters/laz_encoder.h"
 #include "converters/point_io.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
 using test::contains;
+using test::lasRecords;
+using test::laszipVlrAt;
+using test::put;
 using test::readFile;
 
 const std::string kData = std::string(DPOINT_TESTS_DIR) + "/data/laz/";
 const std::string kLaszip1 = kData + "1.2-with-color.laz";  // LASzip 1.0: compressor 1, items version 1
 const std::string kTwin = kData + "1.2-with-color.las";
 
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
-template <typename T>
-void put(std::string& bytes, size_t offset, T v) {
-  std::memcpy(bytes.data() + offset, &v, sizeof v);
-}
-
-std::string lasRecords(const std::string& file) {
-  return file.substr(at<uint32_t>(file, 96), size_t{at<uint32_t>(file, 107)} * at<uint16_t>(file, 105));
-}
-
 Result<std::string> decodeBytes(const std::string& bytes, unsigned threads = 1) {
   return decodeLaz(InputFile::fromMemory("v1.laz", bytes), threads);
-}
-
-// The offset of the laszip VLR's data in a LAZ file.
-size_t laszipVlr(const std::string& file) {
-  size_t p = at<uint16_t>(file, 94);
-  for (uint32_t i = 0; i < at<uint32_t>(file, 100); ++i) {
-    if (std::strncmp(file.data() + p + 2, "laszip encoded", 16) == 0) return p + 54;
-    p += 54 + at<uint16_t>(file, p + 20);
-  }
-  return 0;
 }
 
 // --- A version-1 encoder, for these tests only -------------------------------------------------------
@@ -320,7 +300,7 @@ std::string lazFileOf(const std::string& las, const LazInfo& info, Encode encode
 
 TEST(LazV1, laszip1FileDecodesToItsUncompressedTwinByteForByte) {
   const std::string laz = readFile(kLaszip1);
-  Result<LazInfo> info = parseLaszipVlr(std::string_view(laz).substr(laszipVlr(laz), 34 + 3 * 6));
+  Result<LazInfo> info = parseLaszipVlr(std::string_view(laz).substr(laszipVlrAt(laz), 34 + 3 * 6));
   ASSERT_TRUE(info.ok()) << info.error().message;
   EXPECT_EQ(info->compressor, 1);
   EXPECT_EQ(info->major, 1);
@@ -341,7 +321,7 @@ TEST(LazV1, laszip12HeaderOfTheSameCodeDecodesTheSame) {
   // LASzip's own copy of this file (its pnacl example, 2014) differs only in its VLR: version 1.2
   // and chunk size 0, which compressor 1 does not use.
   std::string laz = readFile(kLaszip1);
-  const size_t vlr = laszipVlr(laz);
+  const size_t vlr = laszipVlrAt(laz);
   laz[vlr + 5] = 2;
   put<uint32_t>(laz, vlr + 12, 0);
   Result<std::string> records = decodeBytes(laz);
@@ -553,7 +533,7 @@ TEST(LazV1, laszipsBrokenFilesAreRefusedSayingWhy) {
                                                       "versions 1 and 2 of POINT10, GPSTIME11, RGB12 and BYTE"));
   // With its coder mended, the cut file decodes until its code runs out, then says where.
   std::string mended = readFile(kData + "broken_coder.laz");
-  put<uint16_t>(mended, laszipVlr(mended) + 2, 0);
+  put<uint16_t>(mended, laszipVlrAt(mended) + 2, 0);
   Result<std::string> records = decodeBytes(mended);
   ASSERT_FALSE(records.ok());
   EXPECT_TRUE(contains(records.error().message, "v1.laz: the point data (compressor 1: one code of 671 bytes at byte "
@@ -567,7 +547,7 @@ TEST(LazV1, laszipsOwnCutFileDecodesToPointsInsideItsBounds) {
   // the header's bounds, their GPS times (version 1's single sequence) must never go back, and the
   // return byte (format 1, LAS 1.0) must say return r of n with 1 ≤ r ≤ n.
   const std::string file = readFile(kData + "broken_coder.laz");
-  std::string vlr = file.substr(laszipVlr(file), 34 + 2 * 6);
+  std::string vlr = file.substr(laszipVlrAt(file), 34 + 2 * 6);
   put<uint16_t>(vlr, 2, 0);  // the arithmetic coder
   Result<LazInfo> info = parseLaszipVlr(vlr);
   ASSERT_TRUE(info.ok()) << info.error().message;
@@ -649,7 +629,7 @@ TEST(LazV1, corruptCodeIsAnErrorOrWrongPointsNeverACrash) {
 
 TEST(LazV1, itemsAndCompressorsThatDoNotGoTogetherAreRefused) {
   const std::string original = readFile(kLaszip1);
-  const size_t vlr = laszipVlr(original);
+  const size_t vlr = laszipVlrAt(original);
   const auto decodeWith = [&](auto change) {
     std::string file = original;
     change(file);
