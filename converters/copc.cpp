@@ -17,6 +17,7 @@
 #include "core/bytes.h"
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "ops/point_order.h"
 
 namespace dpoint {
 
@@ -192,16 +193,7 @@ struct Quantized {
 
 // The top 21 bits of each axis interleaved (z y x, from the top): the Morton curve's order.
 uint64_t mortonKey(const Quantized& qz, uint32_t p) {
-  const auto spread = [](uint64_t v) {  // 21 bits to every third of 63
-    v &= 0x1FFFFF;
-    v = (v | v << 32) & 0x1F00000000FFFFu;
-    v = (v | v << 16) & 0x1F0000FF0000FFu;
-    v = (v | v << 8) & 0x100F00F00F00F00Fu;
-    v = (v | v << 4) & 0x10C30C30C30C30C3u;
-    v = (v | v << 2) & 0x1249249249249249u;
-    return v;
-  };
-  return spread(qz.q[0][p] >> 11) | spread(qz.q[1][p] >> 11) << 1 | spread(qz.q[2][p] >> 11) << 2;
+  return mortonInterleave(qz.q[0][p] >> 11, qz.q[1][p] >> 11, qz.q[2][p] >> 11);
 }
 
 // What LAZ's coding of a node's records in this order costs, roughly: the bits of each difference

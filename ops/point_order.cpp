@@ -70,10 +70,17 @@ inline uint64_t spreadBits(uint32_t v) {
   return x;
 }
 
+}  // namespace
+
+uint64_t mortonInterleave(uint32_t x, uint32_t y, uint32_t z) {
+  return spreadBits(x) | spreadBits(y) << 1 | spreadBits(z) << 2;
+}
+
+namespace {
+
 inline uint64_t codeOf(const MortonFrame& f, const glm::dvec3& p) {
-  return spreadBits(quantize(p.x, f.half_min.x, f.half_extent.x)) |
-         spreadBits(quantize(p.y, f.half_min.y, f.half_extent.y)) << 1 |
-         spreadBits(quantize(p.z, f.half_min.z, f.half_extent.z)) << 2;
+  return mortonInterleave(quantize(p.x, f.half_min.x, f.half_extent.x), quantize(p.y, f.half_min.y, f.half_extent.y),
+                          quantize(p.z, f.half_min.z, f.half_extent.z));
 }
 
 // Uniform in [0, bound) by rejection, so the shuffle is the same on every standard library.

@@ -77,4 +77,8 @@ uint64_t mortonCode(const MortonFrame& frame, const glm::dvec3& p);
 // standard, unlike std::shuffle), so every build and machine gives the same order.
 std::vector<uint32_t> shuffledBlocks(size_t count);
 
+// The low 21 bits of x, y and z interleaved (bit k of x to bit 3k, of y to 3k + 1, of z to 3k + 2):
+// a Morton code, the order `--order morton` sorts by and COPC's writer orders a node's points by.
+uint64_t mortonInterleave(uint32_t x, uint32_t y, uint32_t z);
+
 }  // namespace dpoint
