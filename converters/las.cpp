@@ -156,6 +156,30 @@ Result<LasHeader> parseHeader(const InputFile& file) {
 
 
 // Decodes the point records into a PointSet (see the top of las.h for the colour rules).
+// A record's position: X·scale + offset per axis, two roundings, as PDAL, laspy and loaders.gl
+// compute it (no FMA: the project builds with -ffp-contract=off).
+glm::dvec3 recordPosition(const char* p, const glm::dvec3& scale, const glm::dvec3& offset) {
+  return glm::dvec3(static_cast<double>(loadUnaligned<int32_t>(p)) * scale.x + offset.x,
+                    static_cast<double>(loadUnaligned<int32_t>(p + 4)) * scale.y + offset.y,
+                    static_cast<double>(loadUnaligned<int32_t>(p + 8)) * scale.z + offset.z);
+}
+
+// Field f of `record` into point i of its dimension, as stored (a bit field shifted down).
+void copyField(const LasField& f, const char* record, Dimension& d, size_t i) {
+  if (f.bits) {
+    d.set<uint8_t>(i, static_cast<uint8_t>((static_cast<uint8_t>(record[f.offset]) >> f.shift) & ((1u << f.bits) - 1)));
+  } else {
+    const size_t w = dimTypeSize(f.type);
+    std::memcpy(d.bytes.data() + i * w, record + f.offset, w);
+  }
+}
+
+// An extra bytes field at `at` into point i of its dimension.
+void copyExtra(const char* at, Dimension& d, size_t i) {
+  const size_t w = dimTypeSize(d.type);
+  std::memcpy(d.bytes.data() + i * w, at, w);
+}
+
 class LasReader {
  public:
   LasReader(const InputFile& file, const LasHeader& header, LasColorSource source, const LasReadOptions& options,
@@ -230,11 +254,7 @@ class LasReader {
     uint16_t largest = 0;
     const char* p = data;
     for (size_t i = first; i < last; ++i, p += h_.record_length) {
-      // X·scale + offset, two roundings, as PDAL, laspy and loaders.gl compute it (no FMA: the
-      // project builds with -ffp-contract=off).
-      positions[i] = glm::dvec3(static_cast<double>(loadUnaligned<int32_t>(p)) * scale.x + offset.x,
-                                static_cast<double>(loadUnaligned<int32_t>(p + 4)) * scale.y + offset.y,
-                                static_cast<double>(loadUnaligned<int32_t>(p + 8)) * scale.z + offset.z);
+      positions[i] = recordPosition(p, scale, offset);
       decodeFields(p, i);
       switch (source_) {
         case LasColorSource::kRgb: {
@@ -277,21 +297,9 @@ class LasReader {
 
   // The record's fields and extra bytes into point i's dimensions, as stored (bit fields shifted down).
   void decodeFields(const char* record, size_t i) const {
-    for (size_t k = 0; k < fields_.size(); ++k) {
-      const LasField& f = fields_[k];
-      Dimension& d = *columns_[k];
-      if (f.bits) {
-        d.set<uint8_t>(i, static_cast<uint8_t>((static_cast<uint8_t>(record[f.offset]) >> f.shift) & ((1u << f.bits) - 1)));
-      } else {
-        const size_t w = dimTypeSize(f.type);
-        std::memcpy(d.bytes.data() + i * w, record + f.offset, w);
-      }
-    }
-    for (size_t k = 0; k < extra_.size(); ++k) {
-      Dimension& d = *columns_[fields_.size() + k];
-      const size_t w = dimTypeSize(d.type);
-      std::memcpy(d.bytes.data() + i * w, record + extra_at_ + extra_[k].offset, w);
-    }
+    for (size_t k = 0; k < fields_.size(); ++k) copyField(fields_[k], record, *columns_[k], i);
+    for (size_t k = 0; k < extra_.size(); ++k)
+      copyExtra(record + extra_at_ + extra_[k].offset, *columns_[fields_.size() + k], i);
   }
 
   const InputFile& file_;
@@ -899,25 +907,14 @@ Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
     const size_t end = std::min(count, (c + 1) * chunk);
     for (size_t i = c * chunk; i < end; ++i) {
       const char* p = records.data() + i * length;
-      block.positions[i] = glm::dvec3(static_cast<double>(loadUnaligned<int32_t>(p)) * h.scale.x + h.offset.x,
-                                      static_cast<double>(loadUnaligned<int32_t>(p + 4)) * h.scale.y + h.offset.y,
-                                      static_cast<double>(loadUnaligned<int32_t>(p + 8)) * h.scale.z + h.offset.z);
+      block.positions[i] = recordPosition(p, h.scale, h.offset);
       if (st.color_divisor != 0.0f)
         block.colors[i] = glm::vec3(loadUnaligned<uint16_t>(p + rgb_at), loadUnaligned<uint16_t>(p + rgb_at + 2),
                                     loadUnaligned<uint16_t>(p + rgb_at + 4)) / st.color_divisor;
       for (size_t k = 0; k < st.streamed.size(); ++k) {
         const size_t index = st.streamed[k];
-        Dimension& d = *columns[k];
-        const size_t w = dimTypeSize(d.type);
-        if (index < st.fields.size()) {
-          const LasField& f = st.fields[index];
-          if (f.bits)
-            d.set<uint8_t>(i, static_cast<uint8_t>((static_cast<uint8_t>(p[f.offset]) >> f.shift) & ((1u << f.bits) - 1)));
-          else
-            std::memcpy(d.bytes.data() + i * w, p + f.offset, w);
-        } else {
-          std::memcpy(d.bytes.data() + i * w, p + extra_at + st.extra[index - st.fields.size()].offset, w);
-        }
+        if (index < st.fields.size()) copyField(st.fields[index], p, *columns[k], i);
+        else copyExtra(p + extra_at + st.extra[index - st.fields.size()].offset, *columns[k], i);
       }
     }
   });
