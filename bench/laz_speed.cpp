@@ -55,12 +55,13 @@ int main(int argc, char** argv) {
       }
       out_bytes = laz->size();
     } else {
-      Result<std::string> records = decodeLaz(memory, threads);
+      // What readLas decodes into (decodeLazRecords: memory the workers touch first).
+      Result<LazRecords> records = decodeLazRecords(memory, threads);
       if (!records) {
         std::fprintf(stderr, "laz_speed: %s\n", records.error().message.c_str());
         return 2;
       }
-      out_bytes = records->size();
+      out_bytes = records->size;
     }
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }

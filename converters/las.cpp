@@ -743,16 +743,17 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
     return fits.error();
   // LAZ: the records decoded (on all cores) into memory after the header and VLRs, and read from
   // there as from a LAS file.
-  std::string decoded;
+  LazRecords decoded;
   std::optional<InputFile> records;
   LasHeader plain = *header;
   if (header->compressed) {
-    Result<std::string> bytes = decodeLaz(file, options.threads, options.max_memory);
+    Result<LazRecords> bytes = decodeLazRecords(file, options.threads, options.max_memory, header->point_offset);
     if (!bytes) return bytes.error();
-    decoded.resize(header->point_offset);
-    if (Result<size_t> got = file.readAt(0, decoded.data(), decoded.size()); !got) return got.error();
-    decoded += *bytes;
-    records.emplace(InputFile::fromMemory(path, decoded));
+    decoded = std::move(*bytes);
+    Result<size_t> got = file.readAt(0, decoded.bytes.get(), header->point_offset);
+    if (!got) return got.error();
+    if (*got != header->point_offset) return Error{path + ": the file ends before its offset to point data"};
+    records.emplace(InputFile::fromMemory(path, decoded.view()));
     plain.compressed = false;
   }
   LasReader reader(records ? *records : file, plain, source, options, std::move(*extra));

@@ -270,7 +270,9 @@ Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t 
                  "-byte file"};
   uint32_t head[2] = {0, 0};
   if (Status s = readExactly(table, head, 8, "the chunk table"); !s) return s.error();
-  if (head[0] != 0) return Error{path + ": chunk table version " + str(head[0]) + " is not 0"};
+  const std::string where = "the chunk table at byte " + str(table);
+  if (head[0] != 0)
+    return Error{path + ": " + where + ": version " + str(head[0]) + " is not 0 (a wrong offset to the table?)"};
   const uint32_t count = head[1];
 
   // Bound the count before allocating: every chunk holds at least its raw first point and 4 bytes
@@ -279,19 +281,19 @@ Result<std::vector<LazChunk>> readLazChunkTable(const InputFile& file, uint64_t 
   const uint64_t chunk_bytes = table - chunks_at;
   const uint64_t length = info.recordLength();
   if (count > chunk_bytes / (length + 4))
-    return Error{path + ": the chunk table lists " + str(count) + " chunks, more than the " + str(chunk_bytes) +
+    return Error{path + ": " + where + " lists " + str(count) + " chunks, more than the " + str(chunk_bytes) +
                  " bytes before it can hold"};
   if (!info.variableChunks()) {
     const uint64_t needed = point_count / info.chunk_size + (point_count % info.chunk_size != 0 ? 1 : 0);
     if (count != needed)
-      return Error{path + ": the chunk table lists " + str(count) + " chunks, but " + str(point_count) +
+      return Error{path + ": " + where + " lists " + str(count) + " chunks, but " + str(point_count) +
                    " points in chunks of " + str(info.chunk_size) + " need " + str(needed)};
   } else if (count > point_count) {
-    return Error{path + ": the chunk table lists " + str(count) + " chunks for " + str(point_count) + " points"};
+    return Error{path + ": " + where + " lists " + str(count) + " chunks for " + str(point_count) + " points"};
   }
   std::vector<LazChunk> chunks(count);
   if (count == 0 && point_count != 0)
-    return Error{path + ": the chunk table lists no chunks for " + str(point_count) + " points"};
+    return Error{path + ": " + where + " lists no chunks for " + str(point_count) + " points"};
   if (count == 0) return chunks;
 
   // The coded entries: at most 7 bytes per value (a class symbol, a corrector symbol and 24 raw
@@ -526,7 +528,7 @@ Status decodeLazChunks(const InputFile& file, const LazChunks& laz, size_t first
   });
 }
 
-Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t max_memory) {
+Result<LazRecords> decodeLazRecords(const InputFile& file, unsigned threads, uint64_t max_memory, size_t lead) {
   const std::string& path = file.path();
   Result<LazChunks> opened = openLazChunks(file);
   if (!opened) return opened.error();
@@ -537,16 +539,25 @@ Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t 
       std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(std::max<size_t>(laz.chunks.size(), 1)));
   uint64_t largest = 0;
   for (const LazChunk& c : laz.chunks) largest = std::max(largest, c.bytes);
-  if (laz.point_count > (UINT64_MAX - largest * workers) / length)
+  if (laz.point_count > (UINT64_MAX - lead - largest * workers) / length)
     return Error{path + ": " + str(laz.point_count) + " points of " + str(length) + " bytes overflow 64 bits",
                  ExitCode::kResourceLimit};
   if (Status s = checkMemory(path + ": decoding " + str(laz.point_count) + " points",
-                             laz.point_count * length + largest * workers, max_memory);
+                             lead + laz.point_count * length + largest * workers, max_memory);
       !s)
     return s.error();
-  std::string records(static_cast<size_t>(laz.point_count * length), '\0');
-  if (Status s = decodeLazChunks(file, laz, 0, laz.chunks.size(), records.data(), workers); !s) return s.error();
-  return records;
+  LazRecords out;
+  out.size = lead + static_cast<size_t>(laz.point_count * length);
+  out.bytes = std::make_unique_for_overwrite<char[]>(std::max<size_t>(out.size, 1));
+  if (Status s = decodeLazChunks(file, laz, 0, laz.chunks.size(), out.bytes.get() + lead, workers); !s)
+    return s.error();
+  return out;
+}
+
+Result<std::string> decodeLaz(const InputFile& file, unsigned threads, uint64_t max_memory) {
+  Result<LazRecords> records = decodeLazRecords(file, threads, max_memory);
+  if (!records) return records.error();
+  return std::string(records->view());
 }
 
 Result<std::string> decodeLazFile(const std::string& path, unsigned threads, uint64_t max_memory) {
