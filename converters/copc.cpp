@@ -735,7 +735,7 @@ bool meets(const CopcBox& a, const CopcBox& b) {
 }
 
 bool everything(const CopcQuery& q) {
-  if (q.resolution > 0) return false;
+  if (q.resolution > 0 || q.select) return false;
   for (size_t a = 0; a < 3; ++a)
     if (q.box.min[a] != -std::numeric_limits<double>::infinity() ||
         q.box.max[a] != std::numeric_limits<double>::infinity())
@@ -810,7 +810,8 @@ Result<std::vector<CopcNode>> readCopcNodes(const InputFile& file, const CopcHea
                        ") is not within the point data (bytes " + str(header.point_data_offset + 8) + " to " +
                        str(file.size()) + ")"};
       }
-      if (k.level > deepest || !meets(copcNodeCube(header.info, k), query.box)) continue;
+      const CopcBox cube = copcNodeCube(header.info, k);
+      if (k.level > deepest || !meets(cube, query.box) || (query.select && !query.select(cube, k.level))) continue;
       if (node.points == -1) {
         queue.push_back({node.offset, static_cast<uint64_t>(node.bytes), "the page of node " + copcKeyName(k)});
       } else {

@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -119,6 +120,10 @@ struct CopcNode {
 struct CopcQuery {
   CopcBox box;              // nodes whose cube meets it (everything by default)
   double resolution = 0;    // world units: levels down to the first whose spacing is ≤ it; 0: all
+  // Where set, also only the nodes it accepts (a perspective view: its frustum and a resolution
+  // that falls with the distance). It must accept a node's ancestors wherever it accepts the node
+  // (a rejected node's subtree is not read).
+  std::function<bool(const CopcBox& cube, int level)> select;
   unsigned threads = 0;     // 0: all cores
   uint64_t max_memory = 0;  // for the records; 0: defaultMemoryLimit()
 };

@@ -8,6 +8,7 @@
 #include "core/interrupt.h"
 #include "core/json_writer.h"
 #include "core/text.h"
+#include "viewer/copc_view.h"
 #include "viewer/modes.h"
 #include "viewer/render.h"
 
@@ -174,7 +175,17 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   GltfReadOptions gltf;
   gltf.scene = inputs.scene;
   gltf.all_scenes = inputs.all_scenes;
-  Result<PointSet> points = scenes ? readInput(inputs.paths[0], read, gltf) : readPointInputs(inputs.paths, read);
+  std::optional<CopcReadStats> copc;
+  Result<PointSet> points = PointSet{};
+  if (inputs.paths.size() == 1 && isCopcPath(inputs.paths[0]) && !scenes) {
+    Result<CopcQuery> query = copcQueryFor(options.camera, inputs.paths[0], options.threads, inputs.max_memory);
+    if (!query) return query.error();
+    LasReadOptions las{options.threads, &progress, LasColorSource::kAuto, inputs.max_memory};
+    copc.emplace();
+    points = readCopcPoints(inputs.paths[0], *query, las, &*copc);
+  } else {
+    points = scenes ? readInput(inputs.paths[0], read, gltf) : readPointInputs(inputs.paths, read);
+  }
   if (!points) return points.error();
   std::optional<LasHeader> header;  // one LAS file: its header too
   if (Result<FileFormat> format = formatOf(inputs.paths[0]);
@@ -185,6 +196,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   }
   Result<InfoReport> report = describePoints(*points, name, options);
   if (!report) return report;
+  report->copc = copc;
   if (header) {
     const PointSetInfo& info = report->info;
     const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
@@ -216,10 +228,20 @@ std::string dimensionsJson(const std::vector<DimensionRange>& dimensions) {
 
 }  // namespace
 
+namespace {
+
+// A COPC file read by view: the points line says the count is of the points read.
+std::string copcCount(const InfoReport& report) {
+  if (!report.copc) return "";
+  return " (read by view, of " + str(report.copc->file_points) + " in the file: COPC)";
+}
+
+}  // namespace
+
 std::string infoReportText(const InfoReport& report) {
   const PointSetInfo& i = report.info;
   std::string text = "file:               " + report.name + "\n" +
-                     "points:             " + str(i.count) + "\n" +
+                     "points:             " + str(i.count) + copcCount(report) + "\n" +
                      "triangles:          " + str(i.triangles) + "\n" +
                      "colours:            " + (i.has_colors ? "yes" : "no") + "\n";
   for (const DimensionRange& d : report.dimensions) {
@@ -236,6 +258,10 @@ std::string infoReportText(const InfoReport& report) {
     }
     text += "\n";
   }
+  if (const std::optional<CopcReadStats>& c = report.copc)
+    text += "copc:               the view read " + str(c->points) + " of " + str(c->file_points) + " points, " +
+            str(c->bytes) + " of " + str(c->file_bytes) + " bytes (" + str(c->nodes) +
+            " nodes); the facts below but the header's are of those points (--stream on reads all)\n";
   if (report.las) text += lasText(*report.las);
   text += "min:                " + vec(i.min) + "\n" +
           "max:                " + vec(i.max) + "\n" +
@@ -271,6 +297,10 @@ std::string infoReportJson(const InfoReport& report) {
                      ",\n  \"float32_merged_points\": " + (report.streamed ? "null" : str(i.float_merged)) +
                      ",\n  \"float32_overflow\": " + str(i.float_overflow) +
                      ",\n  \"float32_represents\": " + represents;
+  if (const std::optional<CopcReadStats>& c = report.copc)
+    json += ",\n  \"copc\": {\"points_read\": " + str(c->points) + ", \"bytes_read\": " + str(c->bytes) +
+            ", \"nodes_read\": " + str(c->nodes) + ", \"file_points\": " + str(c->file_points) +
+            ", \"file_bytes\": " + str(c->file_bytes) + "}";
   if (report.las) json += lasJson(*report.las);
   if (report.advice) json += adviceJson(*report.advice);
   return json + "\n}\n";

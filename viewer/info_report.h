@@ -15,6 +15,7 @@
 
 #include "converters/las.h"
 #include "converters/point_inputs.h"
+#include "converters/point_io.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -59,6 +60,9 @@ struct InfoReport {
   // counted (info.float_merged stays 0, the JSON says null) and the bounds are from boxes.
   bool streamed = false;
   std::optional<LasFacts> las;       // one LAS file only
+  // One COPC file, read by view (describeFiles): the points, bytes and nodes its view read; the
+  // facts are of those points, the LAS header's of the whole file.
+  std::optional<CopcReadStats> copc;
   std::optional<InfoAdvice> advice;  // none for an empty set
 };
 
@@ -86,6 +90,8 @@ struct InfoInputs {
 
 // The report of the files, named describeInputs(paths): streamed (describeStream) where
 // openPointStream says so, else read whole (describePoints), with the header of a single LAS file.
+// A single COPC file (not --stream on) is read by view, as render reads it (copcQueryFor with the
+// options' camera): only the octree's nodes its picture needs, at its resolution.
 // Errors are the readers' (naming the file), and those of describePoints and describeStream.
 Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& options, Progress& progress);
 

@@ -20,6 +20,7 @@
 #include "image/canvas.h"
 #include "ops/attribute_colors.h"
 #include "ops/point_filters.h"
+#include "viewer/copc_view.h"
 #include "viewer/reference.h"
 
 namespace dpoint {
@@ -148,32 +149,6 @@ Result<LoadedSet> takeInMemory(const RenderRequest& request) {
   return set;
 }
 
-// What a COPC input's view needs (one .copc.laz, not streamed): the nodes down to the level whose
-// spacing is at most a pixel's width, and with an orthographic window (--ortho --view-center
-// --view-width) only those that meet it. Without a window, the pixel is the octree cube's edge over
-// the picture's larger side: the whole file at the picture's resolution.
-Result<CopcQuery> copcQueryFor(const RenderRequest& request, const std::string& path) {
-  Result<InputFile> file = InputFile::open(path);
-  if (!file) return file.error();
-  Result<CopcHeader> header = readCopcHeader(*file);
-  if (!header) return header.error();
-  const CameraSpec& c = request.camera;
-  CopcQuery query;
-  query.threads = request.threads;
-  query.max_memory = request.max_memory;
-  double window = 2.0 * header->info.halfsize;
-  if (c.ortho.value_or(false) && c.view_width && !c.eye) {
-    window = *c.view_width;
-    if (c.view_center) {
-      const double half_w = window / 2.0, half_h = window * c.height / c.width / 2.0;
-      query.box.min[0] = c.view_center->x - half_w, query.box.max[0] = c.view_center->x + half_w;
-      query.box.min[1] = c.view_center->y - half_h, query.box.max[1] = c.view_center->y + half_h;
-    }
-  }
-  query.resolution = window / std::max(c.width, c.height);
-  return query;
-}
-
 // Opens the input as a stream (large binary PLY, LAS or LAZ), reads a COPC file's view, or reads
 // it whole.
 Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
@@ -181,7 +156,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   set.inputs = describeInputs(request.inputs);
   const std::string& inputs = set.inputs;
   if (request.inputs.size() == 1 && isCopcPath(request.inputs[0]) && request.stream != "on") {
-    Result<CopcQuery> query = copcQueryFor(request, request.inputs[0]);
+    Result<CopcQuery> query = copcQueryFor(request.camera, request.inputs[0], request.threads, request.max_memory);
     if (!query) return query.error();
     LasReadOptions las{request.threads, &progress, lasColorOf(request.color), request.max_memory};
     CopcReadStats stats;

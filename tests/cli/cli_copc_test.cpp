@@ -1,6 +1,7 @@
 // COPC through the CLI (issue #35): every writer's .copc.laz reads back as the same points, and a
 // render of a COPC file reads only the nodes its view needs: the whole file at the picture's
-// resolution by default, a few nodes for a small orthographic window; --json says how much.
+// resolution by default, a few nodes for a small orthographic window; --json says how much. info
+// reads the same nodes for the same view.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -77,6 +78,56 @@ TEST(CliCopc, aSmallWindowReadsAFewNodesAndTheReportSaysSo) {
   EXPECT_LE(number(deep, "bytes_read"), file_bytes / 2) << deep;  // 16.7M points: under 10% (bench/results)
   EXPECT_LT(number(deep, "nodes_read"), number(whole, "nodes_read") + 8) << deep;
   EXPECT_GT(number(deep, "points_read"), 0.0);
+
+  // info reads as render does: the same nodes for the same view, and says so; --stream on reads
+  // the file as plain LAZ, every point.
+  const auto info = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"info", dir.file("r.copc.laz"), "--width", "200", "--height", "200", "--json",
+                                     "--sample", "100"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return r.out;
+  };
+  const std::string described = info({});
+  EXPECT_EQ(number(described, "points_read"), number(whole, "points_read")) << described;
+  EXPECT_EQ(number(described, "points"), number(whole, "points_read")) << described;
+  EXPECT_EQ(number(described, "file_points"), 600000.0);
+  const std::string described_deep =
+      info({"--ortho", "--view-center", centre_text, "--view-width", std::to_string(extent.x / 100)});
+  EXPECT_EQ(number(described_deep, "bytes_read"), number(deep, "bytes_read")) << described_deep;
+  const std::string all = info({"--stream", "on"});
+  EXPECT_EQ(all.find("\"copc\""), std::string::npos) << all;
+  EXPECT_EQ(number(all, "points"), 600000.0);
+  test::CommandResult text = runDpoint({"info", dir.file("r.copc.laz"), "--width", "200", "--height", "200"});
+  EXPECT_TRUE(test::contains(text.out, "(read by view, of 600000 in the file: COPC)")) << text.out;
+  EXPECT_TRUE(test::contains(text.out, "copc:               the view read ")) << text.out;
+}
+
+// A perspective view of 3D data: the nodes in its frustum, each as deep as a pixel at its nearest
+// depth needs. From far away, a coarse preview; from within the set, looking along it, the near
+// nodes deep and the far ones coarse, less than the whole file at the picture's resolution.
+TEST(CliCopc, aPerspectiveViewReadsItsFrustumDeepWhereNear) {
+  TempDir dir;
+  const std::string copc = dir.file("s.copc.laz");
+  ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "9", "-q", "-o", copc}).exit_code, 0);
+  const auto render = [&](const std::vector<std::string>& view) {
+    std::vector<std::string> args = {"render", copc, "-o", dir.file("v.png"), "--width", "320", "--height", "240",
+                                     "--json", dir.file("v.json"), "-q"};
+    args.insert(args.end(), view.begin(), view.end());
+    test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return readFile(dir.file("v.json"));
+  };
+  const std::string whole = render({});
+  const std::string far = render({"--eye", "0.2,0,40", "--target", "0.2,0,0", "--up", "0,1,0"});
+  const std::string near = render({"--eye", "0.9,0,-0.3", "--target", "0.5,0,-0.33", "--up", "0,0,1"});
+  const std::string away = render({"--eye", "0.2,0,3", "--target", "0.2,0,6", "--up", "0,1,0"});
+  EXPECT_LT(number(far, "points_read"), number(whole, "points_read")) << far;
+  EXPECT_GT(number(far, "points_read"), 0.0);
+  EXPECT_LT(number(near, "bytes_read"), number(whole, "bytes_read")) << near;
+  EXPECT_GT(number(near, "nodes_read"), number(far, "nodes_read")) << near;
+  EXPECT_EQ(number(away, "nodes_read"), 1.0) << away;  // looking away from the set: the root only
 }
 
 }  // namespace
