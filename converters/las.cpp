@@ -1059,7 +1059,8 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     std::vector<LazChunk> chunks(chunk_count);
     uint64_t at = uint64_t{point_offset} + 8;
     for (size_t c = 0; c < chunk_count; ++c) {
-      if (coded[c].empty()) return Error{path + ": point format " + str(l.format) + " is not written as LAZ yet"};
+      if (coded[c].empty())
+        return Error{path + ": point format " + std::to_string(l.format) + " is not written as LAZ yet"};
       chunks[c] = {at, coded[c].size(), std::min<uint64_t>(kLazChunkPoints, n - c * kLazChunkPoints)};
       at += coded[c].size();
     }
