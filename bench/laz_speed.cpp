@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "laz_speed: %s\n", records.error().message.c_str());
         return 2;
       }
-      out_bytes = records->size;
+      out_bytes = records->bytes.size();
     }
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }

@@ -750,7 +750,7 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
     Result<LazRecords> bytes = decodeLazRecords(file, options.threads, options.max_memory, header->point_offset);
     if (!bytes) return bytes.error();
     decoded = std::move(*bytes);
-    Result<size_t> got = file.readAt(0, decoded.bytes.get(), header->point_offset);
+    Result<size_t> got = file.readAt(0, decoded.bytes.data(), header->point_offset);
     if (!got) return got.error();
     if (*got != header->point_offset) return Error{path + ": the file ends before its offset to point data"};
     records.emplace(InputFile::fromMemory(path, decoded.view()));

@@ -546,10 +546,8 @@ Result<LazRecords> decodeLazRecords(const InputFile& file, unsigned threads, uin
                              lead + laz.point_count * length + largest * workers, max_memory);
       !s)
     return s.error();
-  LazRecords out;
-  out.size = lead + static_cast<size_t>(laz.point_count * length);
-  out.bytes = std::make_unique_for_overwrite<char[]>(std::max<size_t>(out.size, 1));
-  if (Status s = decodeLazChunks(file, laz, 0, laz.chunks.size(), out.bytes.get() + lead, workers); !s)
+  LazRecords out{LargeBuffer(lead + static_cast<size_t>(laz.point_count * length))};
+  if (Status s = decodeLazChunks(file, laz, 0, laz.chunks.size(), out.bytes.data() + lead, workers); !s)
     return s.error();
   return out;
 }

@@ -50,13 +50,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/input_file.h"
+#include "core/memory.h"
 #include "core/result.h"
 
 namespace dpoint {
@@ -167,15 +167,15 @@ Result<std::string> decodeLazFile(const std::string& path, unsigned threads = 0,
 // The same from an open file (bytes in memory: InputFile::fromMemory).
 Result<std::string> decodeLaz(const InputFile& file, unsigned threads = 0, uint64_t max_memory = 0);
 
-// decodeLaz's records in memory that nothing zeroes first: each chunk's pages are first touched by
-// the worker that decodes it, so a large file pays no serial fill before the parallel decode (on
-// two cores that fill and a copy after it kept the decode at 1.55× one core's speed). `lead` bytes
+// decodeLaz's records in memory that nothing zeroes first (a LargeBuffer, 2 MiB pages where the
+// kernel gives them): each chunk's pages are first touched by the worker that decodes it, so a
+// large file pays no serial fill before the parallel decode (a zero fill and a copy after it kept
+// two cores at 1.55–1.72× one core's speed; bench/results/2026-11-28/cpu/laz_scaling.md). `lead` bytes
 // are left, unwritten, in front of the records for the caller (readLas puts the file's header and
 // VLRs there and reads the whole as a LAS file, with no copy).
 struct LazRecords {
-  std::unique_ptr<char[]> bytes;
-  size_t size = 0;  // lead + count × record length
-  std::string_view view() const { return {bytes.get(), size}; }
+  LargeBuffer bytes;  // lead + count × record length
+  std::string_view view() const { return {bytes.data(), bytes.size()}; }
 };
 Result<LazRecords> decodeLazRecords(const InputFile& file, unsigned threads = 0, uint64_t max_memory = 0,
                                     size_t lead = 0);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "core/parallel.h"
 
@@ -32,7 +33,7 @@ Result<uint64_t> parseMemorySize(const std::string& flag, const std::string& tex
   else if (unit == "M" || unit == "MiB" || unit == "MB") scale = 1024.0 * 1024.0;
   else if (unit == "G" || unit == "GiB" || unit == "GB") scale = 1024.0 * 1024.0 * 1024.0;
   if (used == 0 || scale == 0.0 || !(value > 0.0) || !std::isfinite(value) || value * scale > 1e19)
-    return Error{flag + ": '" + text + "' is not a size (examples: 512M, 8G, 1000000)", ExitCode::kUsage};
+    return Error{flag + " " + text + ": not a size (examples: 512M, 8G, 1000000)", ExitCode::kUsage};
   return static_cast<uint64_t>(value * scale);
 }
 
@@ -67,6 +68,47 @@ void prefaultForWrite(void* data, size_t bytes, unsigned threads) {
 #else
   (void)data, (void)bytes, (void)threads;
 #endif
+}
+
+LargeBuffer::LargeBuffer(size_t bytes) : size_(bytes) {
+  constexpr size_t kHuge = size_t{2} << 20;
+  if (bytes >= kHuge) {
+    const size_t length = (bytes + kHuge - 1) / kHuge * kHuge;
+    void* p = mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p != MAP_FAILED) {
+#ifdef MADV_HUGEPAGE
+      (void)madvise(p, length, MADV_HUGEPAGE);  // a hint: without it the pages are 4 KiB
+#endif
+      data_ = static_cast<char*>(p);
+      mapped_ = length;
+      return;
+    }
+  }
+  data_ = new char[std::max<size_t>(bytes, 1)];
+}
+
+LargeBuffer::LargeBuffer(LargeBuffer&& other) noexcept
+    : data_(std::exchange(other.data_, nullptr)),
+      size_(std::exchange(other.size_, 0)),
+      mapped_(std::exchange(other.mapped_, 0)) {}
+
+LargeBuffer& LargeBuffer::operator=(LargeBuffer&& other) noexcept {
+  if (this != &other) {
+    release();
+    data_ = std::exchange(other.data_, nullptr);
+    size_ = std::exchange(other.size_, 0);
+    mapped_ = std::exchange(other.mapped_, 0);
+  }
+  return *this;
+}
+
+LargeBuffer::~LargeBuffer() { release(); }
+
+void LargeBuffer::release() {
+  if (!data_) return;
+  if (mapped_) munmap(data_, mapped_);
+  else delete[] data_;
+  data_ = nullptr;
 }
 
 }  // namespace dpoint
