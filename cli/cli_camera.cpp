@@ -30,7 +30,7 @@ Result<double> parseTolerance(const std::string& text) {
   Result<std::vector<double>> px = parseNumbers("--tolerance", text, 1);
   if (!px) return px.error();
   if (!((*px)[0] > 0.0) || !std::isfinite((*px)[0]))
-    return Error{"--tolerance must be a number of pixels above 0, not " + text, ExitCode::kUsage};
+    return Error{"--tolerance " + text + ": must be a number of pixels above 0", ExitCode::kUsage};
   return (*px)[0];
 }
 

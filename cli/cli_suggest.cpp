@@ -180,10 +180,22 @@ std::string usageMessage(const CLI::ParseError& error, const CLI::App& app, int 
   static const std::regex kConvert(R"(^Could not convert: (-[-\w]+) = (.*)$)");
   if (std::regex_match(what, m, kConvert))
     return m[1].str() + " " + m[2].str() + ": not a valid value for " + m[1].str() + help;
-  // Required: "--output is required".
-  static const std::regex kRequired(R"(^(-[-\w]+) is required$)");
-  if (std::regex_match(what, m, kRequired))
-    return (command.empty() ? std::string() : command + ": ") + m[1].str() + " is required" + help;
+  const std::string prefix = command.empty() ? std::string() : command + ": ";
+  // Required: "--output is required", or a positional "tiles is required" (named in capitals, as
+  // the usage line shows it).
+  static const std::regex kRequired(R"(^(-?[-\w]+) is required$)");
+  if (std::regex_match(what, m, kRequired)) {
+    std::string name = m[1].str();
+    if (name[0] != '-')
+      for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return prefix + name + " is required" + help;
+  }
+  // A check's own message that names its option again: "--tolerance: --tolerance -1: ..." once.
+  static const std::regex kTwice(R"(^(-[-\w]+): (\1 .*)$)");
+  if (std::regex_match(what, m, kTwice)) return m[2].str();
+  // Extra words: "The following argument was not expected: extra" (or "arguments were").
+  static const std::regex kExtra(R"(^The following arguments? (?:was|were) not expected: (.*)$)");
+  if (std::regex_match(what, m, kExtra)) return prefix + "unexpected argument '" + m[1].str() + "'" + help;
   return what;  // dpoint's own validators' messages (cli_check.h) and shapes not known here
 }
 

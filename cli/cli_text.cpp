@@ -29,7 +29,7 @@ Result<std::vector<double>> parseNumbers(const std::string& flag, const std::str
   }
   std::string count = min_count == max_count ? std::to_string(min_count)
                                              : std::to_string(min_count) + " to " + std::to_string(max_count);
-  return Error{flag + ": '" + text + "' is not " + count + " comma-separated finite numbers", ExitCode::kUsage};
+  return Error{flag + " " + text + ": must be " + count + " comma-separated finite numbers", ExitCode::kUsage};
 }
 
 Result<glm::dvec3> parseVec3(const std::string& flag, const std::string& text) {

@@ -245,7 +245,7 @@ int runBenchReport(const BenchReportOptions& o) {
   else if (o.backend == "compute") options.backends = {Backend::kCompute};
   else if (o.backend == "both") options.backends = {Backend::kRaster, Backend::kCompute};
   else return reportError(Error{"--backend must be raster, compute or both, got '" + o.backend + "'", ExitCode::kUsage});
-  if (o.frames == 0) return reportError(Error{"--frames must be at least 1", ExitCode::kUsage});
+  if (o.frames == 0) return reportError(Error{"--frames 0: must be at least 1", ExitCode::kUsage});
   if (!o.sizes.empty()) {
     if (o.suite != "paper" && o.suite != "all")
       return reportError(Error{"--sizes picks datasets of the paper suite; --suite is " + o.suite, ExitCode::kUsage});

@@ -156,8 +156,7 @@ namespace {
 Status validate(const MengerParams& params) {
   const int n = params.level;
   if (n < 0 || n > kMengerMaxLevel)
-    return Error{"--level " + std::to_string(n) + " is out of range for menger (0.." +
-                     std::to_string(kMengerMaxLevel) + ")",
+    return Error{"--level " + std::to_string(n) + ": must be 0.." + std::to_string(kMengerMaxLevel) + " for menger",
                  ExitCode::kUsage};
   if (!(params.size > 0.0) || !std::isfinite(params.size))
     return Error{"--size " + formatNumber(params.size) + ": must be a finite number above 0", ExitCode::kUsage};

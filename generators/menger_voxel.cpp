@@ -18,8 +18,8 @@ Result<PointSet> generateMengerVoxel(const MengerParams& params) {
   const int n = params.level;  // level and size were checked by generateMenger
   constexpr int kMaxResolution = 4096;
   if (params.resolution < 2 || params.resolution > kMaxResolution)
-    return Error{"--resolution " + std::to_string(params.resolution) + " is out of range for the voxel method (2.." +
-                     std::to_string(kMaxResolution) + ")",
+    return Error{"--resolution " + std::to_string(params.resolution) + ": must be 2.." + std::to_string(kMaxResolution) +
+                     " for the voxel method",
                  params.resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
   const uint64_t res = static_cast<uint64_t>(params.resolution);
   const uint64_t padded = res + 2;

@@ -29,7 +29,7 @@ namespace {
 
 // Points [first, last) of the whole set.
 Result<PointSet> generateRange(const Random2dParams& params, uint64_t first, uint64_t last) {
-  if (params.count == 0) return Error{"--count must be at least 1", ExitCode::kUsage};
+  if (params.count == 0) return Error{"--count 0: must be at least 1", ExitCode::kUsage};
   const uint64_t count = last - first;
   if (Status s = checkMemory("random2d with " + std::to_string(count) + " points", count * sizeof(glm::dvec3),
                              params.max_memory);

@@ -149,8 +149,8 @@ glm::dvec3 sierpinskiCorner(int k) {
 Result<PointSet> generateSierpinski(const SierpinskiParams& params) {
   const int n = params.level;
   if (n < 0 || n > kSierpinskiMaxLevel)
-    return Error{"--level " + std::to_string(n) + " is out of range for sierpinski (0.." +
-                     std::to_string(kSierpinskiMaxLevel) + ")",
+    return Error{"--level " + std::to_string(n) + ": must be 0.." + std::to_string(kSierpinskiMaxLevel) +
+                     " for sierpinski",
                  ExitCode::kUsage};
   const uint64_t tetrahedra = uint64_t{1} << (2 * n);
   const uint64_t vertices = params.unwelded ? 4 * tetrahedra : 2 * tetrahedra + 2;
@@ -240,8 +240,8 @@ Result<PointSet> generateSierpinski(const SierpinskiParams& params) {
 Result<PointTile> generateSierpinskiTile(const SierpinskiParams& params, TileSpec tile) {
   const int n = params.level;
   if (n < 0 || n > kSierpinskiMaxLevel)
-    return Error{"--level " + std::to_string(n) + " is out of range for sierpinski (0.." +
-                     std::to_string(kSierpinskiMaxLevel) + ")",
+    return Error{"--level " + std::to_string(n) + ": must be 0.." + std::to_string(kSierpinskiMaxLevel) +
+                     " for sierpinski",
                  ExitCode::kUsage};
   const uint64_t tetrahedra = uint64_t{1} << (2 * n);
   const TileRange range = tileRange(tetrahedra, tile);

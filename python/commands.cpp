@@ -47,7 +47,7 @@ void addCommands(py::module_& m) {
         if (stream != "auto" && stream != "on" && stream != "off")
           raise(Error{"--stream " + stream + ": must be auto, on or off", ExitCode::kUsage});  // as the CLI's oneOf
         if (sample < 1 || sample > 100000000)
-          raise(Error{"sample: " + std::to_string(sample) + " is not in 1..100000000", ExitCode::kUsage});
+          raise(Error{"sample " + std::to_string(sample) + ": must be a number from 1 to 100000000", ExitCode::kUsage});
         InfoOptions options{camera.spec, sample, camera.tolerance_px, threads};
         InfoReport report = take(released([&] {
           if (points) return describePoints(*points, "points", options);

@@ -240,7 +240,7 @@ Result<uint64_t> memoryOption(const std::string& name, const py::object& value) 
   if (py::isinstance<py::int_>(value)) {
     if (value.equal(py::int_(0))) return uint64_t{0};
     if (value < py::int_(0) || value > py::int_(std::numeric_limits<uint64_t>::max()))
-      return Error{name + ": " + py::str(value).cast<std::string>() + " is not a size in bytes", ExitCode::kUsage};
+      return Error{name + " " + py::str(value).cast<std::string>() + ": not a size in bytes", ExitCode::kUsage};
     return value.cast<uint64_t>();
   }
   return parseMemorySize(name, py::str(value).cast<std::string>());
@@ -395,7 +395,7 @@ stderr.)");
           raise(Error{"decimals: " + std::to_string(decimals) + " is not -1 (shortest round trip) or 0..100",
                       ExitCode::kUsage});
         if (las_scale && !(std::isfinite(*las_scale) && *las_scale > 0.0))
-          raise(Error{"las_scale: " + formatNumber(*las_scale) + " is not a finite number > 0", ExitCode::kUsage});
+          raise(Error{"las_scale " + formatNumber(*las_scale) + ": must be a finite number above 0", ExitCode::kUsage});
         if (ply_colors != "uchar" && ply_colors != "float")
           raise(Error{"ply_colors: '" + ply_colors + "' is not uchar or float", ExitCode::kUsage});
         if (color_format != "linear" && color_format != "srgb8")

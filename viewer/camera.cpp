@@ -228,17 +228,16 @@ double fitWidth(double fitted, const Bounds& bounds) {
 
 Status checkSpec(const CameraSpec& spec) {
   if (spec.width == 0 || spec.height == 0) {
-    return usage("--width and --height must be positive, got " + std::to_string(spec.width) + "x" +
-                 std::to_string(spec.height));
+    return usage(spec.width == 0 ? "--width 0: must be at least 1" : "--height 0: must be at least 1");
   }
   if (!(spec.fov_degrees > 0.0 && spec.fov_degrees < 180.0)) {
-    return usage("--fov must be in (0, 180), got " + shortest(spec.fov_degrees));
+    return usage("--fov " + shortest(spec.fov_degrees) + ": must be in (0, 180)");
   }
   if (spec.view_width && !(std::isfinite(*spec.view_width) && *spec.view_width > 0.0)) {
-    return usage("--view-width must be positive and finite, got " + shortest(*spec.view_width));
+    return usage("--view-width " + shortest(*spec.view_width) + ": must be a finite number above 0");
   }
   if (spec.view_center && !isFinite(*spec.view_center)) {
-    return usage("--view-center must be finite, got " + shortest(*spec.view_center));
+    return usage("--view-center " + shortest(*spec.view_center) + ": must be finite");
   }
   const int given = int(spec.eye.has_value()) + int(spec.target.has_value()) + int(spec.up.has_value());
   if (spec.fit_direction || spec.fit_up) {
@@ -258,9 +257,9 @@ Status checkSpec(const CameraSpec& spec) {
   }
   if (spec.view_center) return usage("--view-center cannot be combined with --eye/--target/--up");
   const glm::dvec3 eye = *spec.eye, target = *spec.target, up = *spec.up;
-  if (!isFinite(eye)) return usage("--eye must be finite, got " + shortest(eye));
-  if (!isFinite(target)) return usage("--target must be finite, got " + shortest(target));
-  if (!isFinite(up) || maxAbs(up) == 0.0) return usage("--up must be a finite non-zero vector, got " + shortest(up));
+  if (!isFinite(eye)) return usage("--eye " + shortest(eye) + ": must be finite");
+  if (!isFinite(target)) return usage("--target " + shortest(target) + ": must be finite");
+  if (!isFinite(up) || maxAbs(up) == 0.0) return usage("--up " + shortest(up) + ": must be a finite non-zero vector");
   if (eye == target) return usage("--eye and --target are the same point " + shortest(eye));
   // Parallel when the sine of the angle between them is below 1e-9: the right vector would be noise.
   const glm::dvec3 forward = safeNormalize(target - eye);

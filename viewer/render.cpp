@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "core/interrupt.h"
+#include "core/text.h"
 #include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
 #include "viewer/render_internal.h"
@@ -57,10 +58,11 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
   if (count == 0) return Error{"nothing to render: the point set is empty", ExitCode::kBadInput};
   if (count > UINT32_MAX)
     return Error{"more than 2^32 points (" + std::to_string(count) + ") are not supported", ExitCode::kResourceLimit};
-  if (options.frames == 0) return Error{"--frames must be at least 1", ExitCode::kUsage};
+  if (options.frames == 0) return Error{"--frames 0: must be at least 1", ExitCode::kUsage};
   const DeviceFacts& f = context.facts;
   if (!(options.point_size >= 1.0f) || options.point_size > f.max_point_size)
-    return Error{"--point-size must be in [1, " + std::to_string(f.max_point_size) + "] on " + f.name,
+    return Error{"--point-size " + formatNumber(options.point_size) + ": must be 1.." + formatNumber(f.max_point_size) +
+                     " on " + f.name,
                  ExitCode::kUsage};
   if (options.backend == Backend::kRaster && options.point_size != 1.0f && !f.large_points)
     return Error{"--point-size above 1 needs the largePoints feature, which " + f.name + " lacks", ExitCode::kNoDevice};

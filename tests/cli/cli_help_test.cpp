@@ -168,16 +168,21 @@ TEST(CliHelp, everyListedOutputFormatIsWritten) {
   }
 }
 
-// One voice for usage errors (issue #36 item 2): every bad invocation is one line "dpoint: error:
-// FLAG VALUE: what is accepted", exit 1, nothing written; a closed set's value gets "did you mean"
-// and its other case is taken; a whole number may be written 1e6.
+// One voice for errors (issue #36 item 2): every bad invocation of every command is one line
+// "dpoint: error: FLAG VALUE: what is accepted" (or "FILE: what is wrong"), with the exit code of
+// its class (README: 1 usage, 2 bad input, 3 no usable device, 4 resource limit), and nothing
+// written; a closed set's value gets "did you mean" and its other case is taken; a whole number may
+// be written 1e6. tests/python/test_errors.py holds the Python module's side of the table.
 TEST(CliVoice, badInvocationsSpeakOneVoice) {
   TempDir dir;
   test::writeFile(dir.file("one.csv"), "x,y,z\n1,2,3\n");
+  test::writeFile(dir.file("bad.csv"), "x,y,z\n1,2\n");
   const std::string in = dir.file("one.csv"), png = dir.file("o.png"), ply = dir.file("o.ply");
+  const std::string bad = dir.file("bad.csv"), missing = dir.file("missing.csv");
   struct Case {
     std::vector<std::string> args;
     std::string message;
+    int code = 1;
   };
   const std::vector<Case> cases = {
       {{"generate", "menger", "--method", "voxl", "-o", ply},
@@ -204,17 +209,45 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"convert", dir.path(), "-o", ply}, dir.path() + ": is a folder, not a point file"},
       {{"info", in, "--scene", "1"}, in + ": --scene and --all-scenes apply to .glb/.gltf input only"},
       {{"info", in, in, "--all-scenes"}, in + " and 1 more: --scene and --all-scenes apply to one .glb/.gltf input"},
+      {{"generate", "menger", "--level", "99", "-o", ply}, "--level 99: must be 0..8 for menger"},
+      {{"generate", "sierpinski", "--level", "40", "-o", ply}, "--level 40: must be 0..12 for sierpinski"},
+      {{"generate", "julia", "--c", "1,2", "-o", ply}, "--c 1,2: must be 4 comma-separated finite numbers"},
+      {{"generate", "nosuch", "-o", ply}, "generate: unknown kind 'nosuch' (kinds: mandelbulb, julia, menger,"},
+      {{"generate", "random2d", "--count", "0", "-o", ply}, "--count 0: must be a number from 1 to 1099511627776"},
+      {{"merge", "-o", ply}, "merge: TILES is required (dpoint merge --help)"},
+      {{"merge", in, in}, "merge: --output is required (dpoint merge --help)"},
+      {{"convert", in, "-o", ply, "--max-memory", "12Q"}, "--max-memory 12Q: not a size (examples: 512M, 8G, 1000000)"},
+      {{"convert", in, "-o", dir.file("o.gltf")}, dir.file("o.gltf") + ": .gltf is read, not written; write .glb"},
+      {{"render", in, "-o", dir.file("o.jpg")}, "-o " + dir.file("o.jpg") + ": the picture is written as PNG; name it .png"},
+      {{"render", in, "-o", png, "--point-size", "0"}, "--point-size 0: must be 1.."},
+      {{"render", in, "-o", png, "--height", "0"}, "--height 0: must be at least 1"},
+      {{"render", in, "-o", png, "--fov", "200"}, "--fov 200: must be in (0, 180)"},
+      {{"render", in, "-o", png, "--tolerance", "-1"}, "--tolerance -1: must be a number of pixels above 0"},
+      {{"render", in, "-o", png, "--frames", "0"}, "--frames 0: must be at least 1"},
+      {{"render", in, "-o", png, "--stream", "sometimes"}, "--stream sometimes: must be auto, on or off"},
+      {{"info", in, "--view-width", "-3"}, "--view-width -3: must be a finite number above 0"},
+      {{"info", in, "--sample", "0"}, "--sample 0: must be a number from 1 to 100000000 (dpoint info --help)"},
+      {{"devices", "extra"}, "devices: unexpected argument 'extra' (dpoint devices --help)"},
+      {{"bench", "--frames", "0", "--out", dir.file("b")}, "--frames 0: must be at least 1"},
+      // The other classes: bad input (2), no usable device (3), a resource limit (4).
+      {{"convert", missing, "-o", ply}, missing + ": file not found", 2},
+      {{"info", bad}, bad + ":2: 2 columns, expected 3 (x,y,z)", 2},
+      {{"merge", in, "-o", ply}, in + ": not a PLY file (no 'ply' line at the start)", 2},
+      {{"render", in, "-o", png, "--device", "99"}, "--device 99: only ", 3},
+      {{"info", in, "--max-memory", "1"}, in + ": 1 lines needs about 24 bytes, more than the limit of 1 bytes", 4},
+      {{"render", in, "-o", png, "--max-memory", "1"}, "a 1024x768 picture needs about 24.0 MiB, more than the limit", 4},
   };
+  ASSERT_GE(cases.size(), 40u);
   for (const Case& c : cases) {
     std::string line;
     for (const std::string& a : c.args) line += a + " ";
     SCOPED_TRACE(line);
     test::CommandResult r = runDpoint(c.args);
-    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.exit_code, c.code) << r.err;
     EXPECT_TRUE(contains(r.err, "dpoint: error: " + c.message)) << r.err;
     EXPECT_EQ(lines(r.err), 1u) << r.err;
   }
-  EXPECT_EQ(dir.entries(), std::vector<std::string>{"one.csv"}) << "nothing written";
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"bad.csv", "one.csv"})) << "nothing written";
 }
 
 TEST(CliVoice, closedSetsTakeAnotherCaseAndCountsTakeExponentForm) {

@@ -16,7 +16,7 @@ def test_a_bad_option_is_the_clis_error(tmp_path):
         dpoint.bench("nightly", out=tmp_path / "out", progress=False)
     assert str(raised.value) == message == "--suite nightly: must be ci, paper, hard or all"
     assert raised.value.exit_code == code == 1
-    with pytest.raises(dpoint.Error, match="--frames must be at least 1"):
+    with pytest.raises(dpoint.Error, match="--frames 0: must be at least 1"):
         dpoint.bench(out=tmp_path / "out", frames=0, progress=False)
     assert not (tmp_path / "out").exists()
 

@@ -54,7 +54,7 @@ def test_info_options(tmp_path, cloud):
     dpoint.write(s, tmp_path / "s.ply")
     assert dpoint.info(s, sample=10)["neighbor_sample"] == 10
     assert dpoint.info(tmp_path / "s.ply", stream="on")["streamed"]
-    with pytest.raises(dpoint.Error, match="sample: 0 is not in 1..100000000"):
+    with pytest.raises(dpoint.Error, match="sample 0: must be a number from 1 to 100000000"):
         dpoint.info(s, sample=0)
     with pytest.raises(MemoryError, match="more than the limit of 1024 bytes"):
         dpoint.info(tmp_path / "s.ply", max_memory="1K")
