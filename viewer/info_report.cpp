@@ -75,6 +75,7 @@ std::string floatEnoughText(const InfoReport& report) {
     return "not decided: a streamed set is read a block at a time, and finding the points\n"
            "                    float32 merges needs all of them at once (--stream off)";
   if (i.floatRepresents()) return "yes (no two distinct points merge)";
+  if (i.float_merged == 1) return "no (1 distinct point merges with another)";
   return "no (" + str(i.float_merged) + " distinct points merge with another)";
 }
 
@@ -263,6 +264,8 @@ std::string infoReportText(const InfoReport& report) {
             str(c->bytes) + " of " + str(c->file_bytes) + " bytes (" + str(c->nodes) +
             " nodes); the facts below but the header's are of those points (--stream on reads all)\n";
   if (report.las) text += lasText(*report.las);
+  if (i.count == 0)
+    return text + "bounds:             none (no points)\n" + "float32 enough:     nothing to hold (no points)\n";
   text += "min:                " + vec(i.min) + "\n" +
           "max:                " + vec(i.max) + "\n" +
           "extent:             " + vec(i.extent) + "\n" +
@@ -286,9 +289,9 @@ std::string infoReportJson(const InfoReport& report) {
                      ",\n  \"triangles\": " + str(i.triangles) +
                      ",\n  \"colors\": " + jsonBool(i.has_colors) +
                      ",\n  \"dimensions\": " + dimensionsJson(report.dimensions) +
-                     ",\n  \"min\": " + jsonVec(i.min) +
-                     ",\n  \"max\": " + jsonVec(i.max) +
-                     ",\n  \"extent\": " + jsonVec(i.extent) +
+                     ",\n  \"min\": " + (i.count ? jsonVec(i.min) : "null") +
+                     ",\n  \"max\": " + (i.count ? jsonVec(i.max) : "null") +
+                     ",\n  \"extent\": " + (i.count ? jsonVec(i.extent) : "null") +
                      ",\n  \"max_abs\": " + formatNumber(i.max_abs, true) +
                      ",\n  \"float32_spacing\": " + formatNumber(i.float_spacing, true) +
                      ",\n  \"min_neighbor_distance\": " + formatNumber(i.min_neighbor_distance, true) +

@@ -111,6 +111,21 @@ TEST(InfoReport, emptySetHasNoAdviceAsInDpointInfo) {
   EXPECT_FALSE(report.advice.has_value());
   EXPECT_EQ(infoReportJson(report).find("\"view\""), std::string::npos);
   EXPECT_EQ(infoReportText(report).find("error bound by mode"), std::string::npos);
+  // No bounds to state: not "min: 0 0 0", and float32 has nothing to hold (issue #36).
+  EXPECT_TRUE(test::contains(infoReportText(report), "bounds:             none (no points)\n"));
+  EXPECT_TRUE(test::contains(infoReportText(report), "float32 enough:     nothing to hold (no points)\n"));
+  EXPECT_EQ(infoReportText(report).find("min:"), std::string::npos);
+  EXPECT_TRUE(test::contains(infoReportJson(report), "\"min\": null"));
+}
+
+// One point that float32 merges with another is one point, not "1 distinct points".
+TEST(InfoReport, oneMergedPointIsSingular) {
+  PointSet points;
+  points.positions = {{1.0, 0.0, 0.0}, {1.0 + 1e-12, 0.0, 0.0}, {2.0, 0.0, 0.0}};
+  Result<InfoReport> report = describePoints(points, "two.ply", InfoOptions{});
+  ASSERT_TRUE(report.ok());
+  EXPECT_EQ(report->info.float_merged, 1u);
+  EXPECT_TRUE(test::contains(infoReportText(*report), "no (1 distinct point merges with another)"));
 }
 
 // A set read a block at a time: what `dpoint info --stream on` prints (no merge count, bounds
