@@ -1,8 +1,10 @@
 // CSV point files: `x,y,z,r,g,b`, `x,y,z`, `x,y,r,g,b` or `x,y` (z = 0), with or without a header.
 //
 // Reading: LF or CRLF line ends, an optional UTF-8 BOM, spaces or tabs around fields, blank lines
-// skipped. Fields are separated by commas, or (when the first line has no comma) by runs of spaces
-// and tabs, as CloudCompare's ASCII export writes them; its `//X,Y,Z` header is read too. A header
+// skipped. The first line decides the separator: semicolons where it has one (numbers may then
+// have a decimal comma), else commas, else runs of spaces and tabs, as CloudCompare's ASCII export
+// writes them; its `//X,Y,Z` header is read too. Header names in any case, with the common names
+// of the axes (lon/lat/alt, E/N/H, easting/northing/elevation, …) and colours (red/green/blue). A header
 // may name further columns after x,y,z or x,y,z,r,g,b (`x,y,z,intensity`): each is a dimension
 // (double, or its known type where every value fits it; NaN allowed). A header with no rows after it is an empty set; a file without a header needs a
 // row. PointSet::z_axis says whether the file had a z column. Numbers are parsed correctly rounded (fast_float): positions to double, colours to

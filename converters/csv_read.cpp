@@ -40,6 +40,9 @@ struct Layout {
   Known known = Known::kXyz;
   int columns = 3;  // every row has exactly this many fields
   bool whitespace = false;
+  // Without whitespace: ',' or ';' (the European spreadsheet export), where a number may then
+  // have a decimal comma (1,5;2,25;3).
+  char separator = ',';
   std::string text;  // the header's names, or the known layout's, for messages
   std::vector<std::string> dimensions;  // the further columns' names, as the header spells them
 };
@@ -93,7 +96,7 @@ class LineParser {
       while (p < end && isBlank(*p)) ++p;
       if (layout_.whitespace && p == end) break;  // trailing blanks end the row
       const char* number_begin = p;
-      const char* field_end = layout_.whitespace ? std::find_if(p, end, isBlank) : nextComma(p, end);
+      const char* field_end = layout_.whitespace ? std::find_if(p, end, isBlank) : nextSeparator(p, end);
       ++column;
       if (column > layout_.columns) {
         error = {line, lineText(line) + countMessage(begin, end)};
@@ -114,7 +117,7 @@ class LineParser {
       if (!ok) return false;
       p = field_end;
       if (p == end) break;
-      if (!layout_.whitespace) ++p;  // the comma
+      if (!layout_.whitespace) ++p;  // the separator
     }
     if (column != layout_.columns) {
       error = {line, lineText(line) + countMessage(begin, end)};
@@ -126,9 +129,9 @@ class LineParser {
   }
 
  private:
-  static const char* nextComma(const char* p, const char* end) {
-    const char* comma = static_cast<const char*>(std::memchr(p, ',', static_cast<size_t>(end - p)));
-    return comma ? comma : end;
+  const char* nextSeparator(const char* p, const char* end) const {
+    const char* at = static_cast<const char*>(std::memchr(p, layout_.separator, static_cast<size_t>(end - p)));
+    return at ? at : end;
   }
 
   std::string lineText(uint64_t line) const { return path_ + ":" + std::to_string(line) + ": "; }
@@ -143,7 +146,7 @@ class LineParser {
         p = std::find_if(p, end, isBlank);
       }
     } else {
-      fields = static_cast<size_t>(std::count(begin, end, ',')) + 1;
+      fields = static_cast<size_t>(std::count(begin, end, layout_.separator)) + 1;
     }
     return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + printableExcerpt(layout_.text) + ")";
   }
@@ -165,7 +168,11 @@ class LineParser {
     const char* start = begin;
     // fast_float follows std::from_chars and refuses a leading '+'; CSV writers emit it.
     if (end - start >= 2 && *start == '+' && start[1] != '-' && start[1] != '+') ++start;
-    auto result = fast_float::from_chars(start, end, value);
+    // A decimal comma where fields are separated by semicolons ("1,5"): the only comma a field can hold.
+    const bool comma = layout_.separator == ';' && std::memchr(start, ',', static_cast<size_t>(end - start));
+    auto result = comma ? fast_float::from_chars_advanced(start, end, value,
+                                                          fast_float::parse_options{fast_float::chars_format::general, ','})
+                        : fast_float::from_chars(start, end, value);
     // The message is built only on failure: this runs for every number of the file.
     auto fail = [&](const std::string& why) {
       error = {line, lineText(line) + "column " + std::to_string(column) + ": '" + excerpt(begin, end) + "' " + why};
@@ -192,8 +199,15 @@ class LineParser {
   std::vector<bool> as_float_;
 };
 
-// Splits the first line into trimmed fields, lower case unless `spelled`: at commas when it has
-// one, else at runs of spaces and tabs.
+// The first line's separator: ';' where it has one (a semicolon file's numbers may hold decimal
+// commas), else ',' where it has one, else 0: runs of spaces and tabs.
+char separatorOf(std::string_view line) {
+  if (line.find(';') != std::string_view::npos) return ';';
+  return line.find(',') != std::string_view::npos ? ',' : '\0';
+}
+
+// Splits the first line into trimmed fields, lower case unless `spelled`: at its separator
+// (separatorOf), else at runs of spaces and tabs.
 std::vector<std::string> splitHeader(std::string_view line, bool spelled = false) {
   std::vector<std::string> fields;
   auto add = [&](std::string_view field) {
@@ -204,7 +218,8 @@ std::vector<std::string> splitHeader(std::string_view line, bool spelled = false
       for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     fields.push_back(std::move(lower));
   };
-  if (line.find(',') == std::string_view::npos) {
+  const char separator = separatorOf(line);
+  if (separator == '\0') {
     for (size_t start = line.find_first_not_of(" \t"); start != std::string_view::npos;) {
       const size_t stop = line.find_first_of(" \t", start);
       add(line.substr(start, stop == std::string_view::npos ? stop : stop - start));
@@ -214,10 +229,10 @@ std::vector<std::string> splitHeader(std::string_view line, bool spelled = false
   }
   size_t start = 0;
   while (true) {
-    size_t comma = line.find(',', start);
-    add(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
+    size_t at = line.find(separator, start);
+    add(line.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start));
+    if (at == std::string_view::npos) break;
+    start = at + 1;
   }
   return fields;
 }
@@ -236,8 +251,26 @@ bool isHeaderLine(const std::vector<std::string>& fields) {
 // x,y,z and two extras).
 Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string> fields,
                                 std::vector<std::string> spelled, uint64_t line, std::string_view text,
-                                bool whitespace) {
+                                char separator) {
   if (fields.front().rfind("//", 0) == 0) fields.front().erase(0, 2);
+  // The names people give the known columns (any case): geographic and surveyors' axes in the
+  // first three columns, colour words in the three after the position. Further columns keep their
+  // names (a column `h` after x,y,z stays a dimension `h`).
+  static const std::vector<std::pair<std::string_view, std::string_view>> kAxes = {
+      {"lon", "x"}, {"long", "x"}, {"longitude", "x"}, {"e", "x"}, {"east", "x"}, {"easting", "x"},
+      {"rechtswert", "x"}, {"lat", "y"}, {"latitude", "y"}, {"n", "y"}, {"north", "y"}, {"northing", "y"},
+      {"hochwert", "y"},
+      {"alt", "z"}, {"altitude", "z"}, {"h", "z"}, {"height", "z"}, {"elevation", "z"}, {"elev", "z"},
+      {"h\xc3\xb6he", "z"}, {"hoehe", "z"}};
+  static const std::vector<std::pair<std::string_view, std::string_view>> kColours = {
+      {"red", "r"}, {"green", "g"}, {"blue", "b"}};
+  for (size_t k = 0; k < fields.size() && k < 6; ++k)
+    for (const auto& [name, known] : k < 3 ? kAxes : kColours)
+      if (fields[k] == name) fields[k] = known;
+  if (fields.size() >= 5 && fields[1] == "y" && fields[2] == "red")  // x,y,red,green,blue
+    for (size_t k = 2; k < 5; ++k)
+      for (const auto& [name, known] : kColours)
+        if (fields[k] == name) fields[k] = known;
   auto known_name = [](const std::string& f) {
     return f == "x" || f == "y" || f == "z" || f == "r" || f == "g" || f == "b";
   };
@@ -251,7 +284,7 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
     // Further columns only after z: `x,y,w` is more likely a misspelt z than a 2D set with an extra.
     if (fields.size() > count && (known == Known::kXy || known == Known::kXyRgb)) break;
     if (std::any_of(fields.begin() + std::ptrdiff_t(count), fields.end(), known_name)) break;
-    Layout layout{known, static_cast<int>(fields.size()), whitespace, joined, {}};
+    Layout layout{known, static_cast<int>(fields.size()), separator == '\0', separator ? separator : ',', joined, {}};
     for (size_t k = count; k < spelled.size(); ++k) {
       const std::string& name = spelled[k];
       if (name.empty())
@@ -263,13 +296,18 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
     }
     return layout;
   }
+  const std::string split = separator == ';'   ? "split at semicolons"
+                            : separator == ',' ? "split at commas"
+                                               : "split at spaces and tabs";
   return Error{path + ":" + std::to_string(line) + ": header '" + excerpt(text.data(), text.data() + text.size()) +
-               "' is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b (further columns may follow)"};
+               "' (" + split + ") is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b, or their names " +
+               "(lon,lat,alt | E,N,H | red,green,blue); further columns may follow"};
 }
 
-Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line, bool whitespace) {
+Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line, char separator) {
   auto layout = [&](Known known) {
-    return Layout{known, static_cast<int>(columns), whitespace, kKnownText[static_cast<int>(known)], {}};
+    return Layout{known, static_cast<int>(columns), separator == '\0', separator ? separator : ',',
+                  kKnownText[static_cast<int>(known)], {}};
   };
   if (columns == 2) return layout(Known::kXy);
   if (columns == 3) return layout(Known::kXyz);
@@ -318,18 +356,18 @@ Result<Header> readHeader(const InputFile& file) {
       return Error{file.path() + ":" + std::to_string(line + 1) + ": binary data, not CSV text ('" +
                    excerpt(text.data(), text.data() + text.size()) + "')"};
     std::vector<std::string> fields = splitHeader(text);
-    const bool whitespace = text.find(',') == std::string_view::npos;
+    const char separator = separatorOf(text);
     Header header;
     if (isHeaderLine(fields)) {
       Result<Layout> layout =
-          layoutFromHeader(file.path(), std::move(fields), splitHeader(text, true), line + 1, text, whitespace);
+          layoutFromHeader(file.path(), std::move(fields), splitHeader(text, true), line + 1, text, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
       header.data_offset = std::min<uint64_t>(nl + 1, file.size());  // a header only: an empty set
       header.first_data_line = line + 1;
       header.named = true;
     } else {
-      Result<Layout> layout = layoutFromColumns(file.path(), fields.size(), line + 1, whitespace);
+      Result<Layout> layout = layoutFromColumns(file.path(), fields.size(), line + 1, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
       header.data_offset = pos;

@@ -8,15 +8,30 @@
 
 namespace dpoint {
 
-// Bad input text quoted in a one-line error message: at most 40 characters, control and
-// non-ASCII bytes written as \xNN so the message stays one printable line.
+// The length of the well-formed UTF-8 sequence of two to four bytes at text[i] (a lead byte C2-F4
+// and its continuation bytes), or 0.
+inline size_t utf8SequenceAt(std::string_view text, size_t i) {
+  const unsigned char c = static_cast<unsigned char>(text[i]);
+  const size_t n = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+  if (n == 0 || i + n > text.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return 0;
+  return n;
+}
+
+// Bad input text quoted in a one-line error message: at most 40 characters, UTF-8 letters as they
+// are (a header `Höhe` reads as Höhe), control bytes and bytes that are not UTF-8 written as \xNN
+// so the message stays one printable line.
 inline std::string printableExcerpt(std::string_view text) {
   constexpr size_t kMax = 40;
   static const char kHex[] = "0123456789abcdef";
   std::string out;
   for (size_t i = 0; i < text.size() && out.size() < kMax; ++i) {
     const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7f) {
+    if (const size_t n = c >= 0x80 ? utf8SequenceAt(text, i) : 0; n > 0) {
+      out.append(text.substr(i, n));
+      i += n - 1;
+    } else if (c >= 0x20 && c < 0x7f) {
       out += static_cast<char>(c);
     } else {
       out += "\\x";

@@ -225,9 +225,9 @@ TEST(CliConvertMeaning, csvFurtherColumnsAreDimensionsKeptInOrder) {
   // without a header (what they are is unknown), a partial colour set.
   const std::vector<std::pair<std::string, std::vector<std::string>>> bad = {
       {"x,y,z,intensity\n1,2,3\n", {":2:", "3 columns, expected 4 (x,y,z,intensity)"}},
-      {"x,y,w\n1,2,3\n", {":1:", "header 'x,y,w' is not one of"}},
+      {"x,y,w\n1,2,3\n", {":1:", "header 'x,y,w' (split at commas) is not one of"}},
       {"1,2,3,4\n", {":1:", "4 columns without a header"}},
-      {"x,y,z,r,g\n1,2,3,4,5\n", {":1:", "header 'x,y,z,r,g' is not one of"}},
+      {"x,y,z,r,g\n1,2,3,4,5\n", {":1:", "header 'x,y,z,r,g' (split at commas) is not one of"}},
       {"x,y,z\n1,two,3\n", {":2:", "column 2", "'two' is not a number"}},
   };
   for (size_t k = 0; k < bad.size(); ++k) {

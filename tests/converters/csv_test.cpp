@@ -177,6 +177,52 @@ void expectReadError(const std::string& path, const std::vector<std::string>& pa
   EXPECT_EQ(r.error().message.find('\n'), std::string::npos) << "message is not one line";
 }
 
+// Text point files as spreadsheets and survey tools write them (issue #37): each variant reads to
+// the same two points. The separator is the first line's: semicolons (then a decimal comma is
+// read), else commas, else runs of spaces and tabs; header names in any case, UTF-8, and the
+// common names of the axes and colours.
+TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
+  TempDir dir;
+  struct Variant {
+    std::string name, text;
+  };
+  const std::vector<Variant> variants = {
+      {"commas", "x,y,z\n1.5,-2.25,3\n4,5,6.125\n"},
+      {"semicolons_decimal_commas", "X;Y;Z\n1,5;-2,25;3\n4;5;6,125\n"},
+      {"semicolons_decimal_points", "x;y;z\n1.5;-2.25;3\n4;5;6.125\n"},
+      {"semicolons_no_header", "1,5;-2,25;3\r\n4;5;6,125\r\n"},
+      {"tabs", "x\ty\tz\n1.5\t-2.25\t3\n4\t5\t6.125\n"},
+      {"spaces_no_header", "1.5 -2.25 3\n  4   5 6.125  \n"},
+      {"cloudcompare", "//X,Y,Z\n1.5,-2.25,3\n4,5,6.125\n"},
+      {"lon_lat_alt", "Lon,Lat,Alt\n1.5,-2.25,3\n4,5,6.125\n"},
+      {"longitude_latitude_height", "longitude latitude height\n1.5 -2.25 3\n4 5 6.125\n"},
+      {"e_n_h", "E;N;H\n1,5;-2,25;3\n4;5;6,125\n"},
+      {"easting_northing_elevation", "Easting,Northing,Elevation\n1.5,-2.25,3\n4,5,6.125\n"},
+      {"german_utf8", "Rechtswert;Hochwert;H\xc3\xb6he\n1,5;-2,25;3\n4;5;6,125\n"},
+      {"bom_crlf_upper", "\xEF\xBB\xBFX,Y,Z\r\n1.5,-2.25,3\r\n4,5,6.125\r\n"},
+  };
+  for (const Variant& v : variants) {
+    SCOPED_TRACE(v.name);
+    writeFile(dir.file(v.name + ".csv"), v.text);
+    Result<PointSet> p = readCsv(dir.file(v.name + ".csv"));
+    ASSERT_TRUE(p.ok()) << p.error().message;
+    ASSERT_EQ(p->size(), 2u);
+    EXPECT_EQ(p->positions[0], glm::dvec3(1.5, -2.25, 3));
+    EXPECT_EQ(p->positions[1], glm::dvec3(4, 5, 6.125));
+  }
+  // Colour words and a further column keep their meaning; a column named h after the position is
+  // a dimension, not a second z.
+  writeFile(dir.file("words.csv"), "X;Y;Z;Red;Green;Blue;h\n1;2;3;0,5;0,25;1;7,5\n");
+  Result<PointSet> words = readCsv(dir.file("words.csv"));
+  ASSERT_TRUE(words.ok()) << words.error().message;
+  EXPECT_EQ(words->colors.at(0), glm::vec3(0.5f, 0.25f, 1.0f));
+  ASSERT_NE(words->dimensions.find("h"), nullptr);
+  // A header it cannot map says how it split the line, and prints UTF-8 as it is.
+  writeFile(dir.file("unknown.csv"), "Rechts;Hoch;H\xc3\xb6henlage\n1;2;3\n");
+  expectReadError(dir.file("unknown.csv"), {"unknown.csv:1: header 'Rechts;Hoch;H\xc3\xb6henlage' (split at semicolons)",
+                                            "lon,lat,alt"});
+}
+
 TEST(Csv, rejectsMissingFileFolderAndEmptyFile) {
   TempDir dir;
   expectReadError(dir.file("missing.csv"), {"missing.csv", "not found"});
