@@ -104,9 +104,9 @@ int runConvert(ConvertOptions& o) {
 
 void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv, .ply, .glb, .las and .laz");
-  cmd->add_option("input", o->input, "Input file (.csv, .ply, .glb, .gltf, .las, .laz)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .ply, .glb, .las, .laz); written whole or not at all")
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc), .ply, .glb, .las and .laz");
+  cmd->add_option("input", o->input, "Input file (.csv, .xyz, .txt, .asc, .ply, .glb, .gltf, .las, .laz)")->required();
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .ply, .glb, .las, .laz); written whole or not at all")
       ->required()
       ->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals,

@@ -49,6 +49,8 @@ struct CsvWriteOptions {
 };
 
 Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options = {});
+// The separator a written file gets: ' ' for a path ending .xyz, .txt or .asc (any case), else ','.
+char csvSeparatorFor(const std::string& path);
 // The same from an opened file, or from bytes in memory (InputFile::fromMemory).
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = {});
 
@@ -64,6 +66,9 @@ struct CsvLayout {
   bool planar = false;
   bool colors = false;
   std::vector<std::string> dimensions;  // names; rows with dimensions are written by appendSet
+  // ',' for .csv; ' ' for the text exports .xyz, .txt and .asc, whose header is then CloudCompare's
+  // comment form `//x y z` (CsvRowWriter::create sets it from the path: csvSeparatorFor).
+  char separator = ',';
 };
 
 // Rows appended in any number of calls give the same bytes as one writeCsv of all of them with

@@ -8,9 +8,11 @@
 // value in fixed form (as the seed printed its double colours with %.15f).
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 
 #include "core/atomic_file.h"
 #include "converters/csv.h"
@@ -44,13 +46,19 @@ class RowFormatter {
  public:
   RowFormatter(const CsvLayout& layout, int decimals, bool at_scale)
       : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors),
-        dimension_names_(layout.dimensions) {}
+        separator_(layout.separator), dimension_names_(layout.dimensions) {}
 
   std::string header() const {
-    std::string h = planar_ ? "x,y" : "x,y,z";
-    if (colors_) h += ",r,g,b";
+    std::vector<std::string> names = {"x", "y"};
+    if (!planar_) names.push_back("z");
+    if (colors_) names.insert(names.end(), {"r", "g", "b"});
+    std::string h = separator_ == ' ' ? "//x" : "x";  // CloudCompare's comment header for text exports
+    for (size_t k = 1; k < names.size(); ++k) {
+      h += separator_;
+      h += names[k];
+    }
     for (const std::string& name : dimension_names_) {
-      h += ',';
+      h += separator_;
       h += name;
     }
     return h + "\n";
@@ -71,22 +79,22 @@ class RowFormatter {
       char* const limit = out.data() + out.size();
       const glm::dvec3& v = positions[i];
       p = number(p, limit, v.x);
-      *p++ = ',';
+      *p++ = separator_;
       p = number(p, limit, v.y);
       if (!planar_) {
-        *p++ = ',';
+        *p++ = separator_;
         p = number(p, limit, v.z);
       }
       if (colors_) {
         const glm::vec3& c = colors[i];
         for (int k = 0; k < 3; ++k) {
-          *p++ = ',';
+          *p++ = separator_;
           p = color(p, limit, c[k]);
         }
       }
       if (dims)
         for (const Dimension& d : *dims) {
-          *p++ = ',';
+          *p++ = separator_;
           p = dimensionValue(p, limit, d, first + i);
         }
       *p++ = '\n';
@@ -121,6 +129,7 @@ class RowFormatter {
   bool at_scale_;  // CsvWriteOptions::at_scale
   bool planar_;
   bool colors_;
+  char separator_;
   const std::vector<std::string>& dimension_names_;
 };
 
@@ -138,6 +147,7 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
   if (Status s = checkDecimals(options.decimals); !s) return s.error();
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
+  layout.separator = csvSeparatorFor(path);
   CsvRowWriter writer(std::move(*file), layout, options);
   if (Status s = writer.file_.write(RowFormatter(layout, options.decimals, options.at_scale).header()); !s) return s.error();
   if (options.progress) options.progress->start("writing " + path, rows);
@@ -235,6 +245,12 @@ Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteO
   if (!writer) return writer.error();
   if (Status s = writer->appendSet(points); !s) return s;
   return writer->commit();
+}
+
+char csvSeparatorFor(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".xyz" || ext == ".txt" || ext == ".asc" ? ' ' : ',';
 }
 
 }  // namespace dpoint

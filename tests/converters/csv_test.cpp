@@ -223,6 +223,28 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
                                             "lon,lat,alt"});
 }
 
+// The text exports (.xyz, .txt, .asc) are written with spaces and CloudCompare's comment header,
+// and read back to the same doubles, colours and dimensions.
+TEST(Csv, textExportsAreWrittenWithSpacesAndReadBack) {
+  TempDir dir;
+  PointSet set = setFromDoubles({1.5, -2.25, 3, 0.1, 4, 5, 6.125, 1e-300}, true);
+  set.dimensions.add("intensity", DimType::kU16, set.size()).set<uint16_t>(1, 7);
+  for (const std::string ext : {".xyz", ".TXT", ".asc"}) {
+    SCOPED_TRACE(ext);
+    const std::string path = dir.file("p" + ext);
+    ASSERT_TRUE(writeCsv(path, set).ok());
+    const std::string text = readFile(path);
+    EXPECT_EQ(text.substr(0, text.find('\n')), "//x y z r g b intensity");
+    EXPECT_EQ(text.find(','), std::string::npos) << text;
+    Result<PointSet> back = readCsv(path);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back->positions, set.positions);
+    EXPECT_EQ(back->colors, set.colors);
+    ASSERT_NE(back->dimensions.find("intensity"), nullptr);
+    EXPECT_EQ(back->dimensions.find("intensity")->get<uint16_t>(1), 7);
+  }
+}
+
 TEST(Csv, rejectsMissingFileFolderAndEmptyFile) {
   TempDir dir;
   expectReadError(dir.file("missing.csv"), {"missing.csv", "not found"});

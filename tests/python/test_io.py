@@ -164,12 +164,12 @@ def test_write_of_a_file_name_is_a_type_error(tmp_path):
 
 def test_unknown_extension_and_missing_folder(tmp_path, cloud):
     s, _, _ = cloud
-    with pytest.raises(dpoint.Error, match=r"unknown file type '\.xyz'"):
-        dpoint.write(s, tmp_path / "out.xyz")
+    with pytest.raises(dpoint.Error, match=r"unknown file type '\.dat'"):
+        dpoint.write(s, tmp_path / "out.dat")
     with pytest.raises(dpoint.Error, match="folder .* does not exist"):
         dpoint.write(s, tmp_path / "no" / "out.ply")
-    with pytest.raises(dpoint.Error, match=r"unknown file type '\.xyz'"):
-        dpoint.read(tmp_path / "in.xyz")
+    with pytest.raises(dpoint.Error, match=r"unknown file type '\.dat'"):
+        dpoint.read(tmp_path / "in.dat")
 
 
 def test_read_of_a_missing_file_names_it(tmp_path):
@@ -231,3 +231,14 @@ def test_write_beyond_max_memory_is_a_memory_error(tmp_path, source):
     with pytest.raises(MemoryError, match="ordering 300 points needs about"):
         dpoint.write(points, tmp_path / "o.ply", order="morton", max_memory=1000)
     assert not (tmp_path / "o.ply").exists()
+
+
+def test_text_exports_write_with_spaces_and_read_back(tmp_path, cloud):
+    s, _, _ = cloud
+    for name in ("p.xyz", "p.txt", "p.asc"):
+        path = tmp_path / name
+        dpoint.write(s, path)
+        first = path.read_text().splitlines()[0]
+        assert first.startswith("//x y z"), first
+        back = dpoint.read(path)
+        assert np.array_equal(back.positions, s.positions)
