@@ -149,6 +149,7 @@ class GpsTimeV1Decoder final : public LazItemDecoder {
   static constexpr uint32_t kMultiMax = kMultiSymbols - 3;  // 509: 509 times or more
   static constexpr uint32_t kFull = kMultiSymbols - 2;      // 510
   static constexpr uint32_t kUnchanged = kMultiSymbols - 1;  // 511
+  static_assert(kUnchanged + 1 == kMultiSymbols, "the model's last symbol leaves the time unchanged");
 
   static uint64_t widen(int32_t v) { return static_cast<uint64_t>(static_cast<int64_t>(v)); }
   // A full time: two 32-bit halves, low first (LASzip's readInt64).
