@@ -46,9 +46,9 @@ TEST(Cli, usageErrorsExitOne) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("--bogus"), std::string::npos) << r.err;
   TempDir dir;
-  test::CommandResult ext = runDpoint({"generate", "random2d", "--count", "10", "-o", dir.file("a.xyz")});
+  test::CommandResult ext = runDpoint({"generate", "random2d", "--count", "10", "-o", dir.file("a.dat")});
   EXPECT_EQ(ext.exit_code, 1);
-  EXPECT_NE(ext.err.find("unknown file type '.xyz'"), std::string::npos) << ext.err;
+  EXPECT_NE(ext.err.find("unknown file type '.dat'"), std::string::npos) << ext.err;
   EXPECT_TRUE(dir.entries().empty());
 }
 
