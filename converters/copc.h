@@ -104,6 +104,7 @@ struct CopcHeader {
   uint64_t point_count = 0;
   uint64_t point_data_offset = 0;
   double scale[3] = {1, 1, 1}, offset[3] = {0, 0, 0};
+  double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};  // the header's bounds, as written
   LazInfo laz;
 };
 // Parses and checks the header, the info VLR and the laszip VLR. Errors start with the file's path.

@@ -76,6 +76,8 @@ Result<CopcHeader> readHeader(const InputFile& file, uint64_t& bytes_read) {
   for (size_t a = 0; a < 3; ++a) {
     hd.scale[a] = loadUnaligned<double>(h + kScaleAt + 8 * a);
     hd.offset[a] = loadUnaligned<double>(h + kOffsetAt + 8 * a);
+    hd.max[a] = loadUnaligned<double>(h + kMaxXAt + 16 * a);  // max x, min x, max y, min y, …
+    hd.min[a] = loadUnaligned<double>(h + kMaxXAt + 16 * a + 8);
   }
   const char* d = vlr + kVlrHeaderBytes;
   CopcInfo& info = hd.info;

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 
-#include "converters/las.h"
 #include "core/input_file.h"
 
 namespace dpoint {
@@ -60,14 +59,14 @@ Result<CopcQuery> copcQueryFor(const CameraSpec& camera, const std::string& path
   CopcQuery query;
   query.threads = threads;
   query.max_memory = max_memory;
-  Result<LasHeader> las = readLasHeader(path);
-  if (!las) return las.error();
-  const bool planar = las->min.z == 0.0 && las->max.z == 0.0;
+  const bool planar = header->min[2] == 0.0 && header->max[2] == 0.0;
   if (!c.ortho.value_or(planar) && (c.eye || c.view_center || c.view_width)) {
     // A perspective view the user placed: its camera does not depend on the points (the header's
     // box gives only its near and far planes), so the nodes are chosen for the very view drawn.
     Bounds bounds;
-    bounds.min = las->min, bounds.max = las->max, bounds.planar = planar;
+    bounds.min = {header->min[0], header->min[1], header->min[2]};
+    bounds.max = {header->max[0], header->max[1], header->max[2]};
+    bounds.planar = planar;
     Result<Camera> view = makeCamera(c, bounds);
     if (!view) return view.error();
     query.select = frustumSelect(*view, c.fov_degrees, header->info.spacing);
