@@ -254,7 +254,7 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
                                 char separator) {
   if (fields.front().rfind("//", 0) == 0) fields.front().erase(0, 2);
   // The names people give the known columns (any case): geographic and surveyors' axes in the
-  // first three columns, colour words in the three after the position. Further columns keep their
+  // first three columns, colour words in the three after the position (columns 3-5, or 2-4 in 2D). Further columns keep their
   // names (a column `h` after x,y,z stays a dimension `h`).
   static const std::vector<std::pair<std::string_view, std::string_view>> kAxes = {
       {"lon", "x"}, {"long", "x"}, {"longitude", "x"}, {"e", "x"}, {"east", "x"}, {"easting", "x"},
@@ -264,13 +264,14 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
       {"h\xc3\xb6he", "z"}, {"hoehe", "z"}};
   static const std::vector<std::pair<std::string_view, std::string_view>> kColours = {
       {"red", "r"}, {"green", "g"}, {"blue", "b"}};
-  for (size_t k = 0; k < fields.size() && k < 6; ++k)
-    for (const auto& [name, known] : k < 3 ? kAxes : kColours)
-      if (fields[k] == name) fields[k] = known;
-  if (fields.size() >= 5 && fields[1] == "y" && fields[2] == "red")  // x,y,red,green,blue
-    for (size_t k = 2; k < 5; ++k)
+  for (size_t k = 0; k < fields.size() && k < 6; ++k) {
+    if (k < 3)
+      for (const auto& [name, known] : kAxes)
+        if (fields[k] == name) fields[k] = known;
+    if (k >= 2)  // colours follow x,y (2D) or x,y,z
       for (const auto& [name, known] : kColours)
         if (fields[k] == name) fields[k] = known;
+  }
   auto known_name = [](const std::string& f) {
     return f == "x" || f == "y" || f == "z" || f == "r" || f == "g" || f == "b";
   };
