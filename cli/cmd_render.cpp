@@ -31,7 +31,7 @@ struct RenderCliOptions {
   CameraCliOptions camera;
   std::string background = "0,0,0";
   bool error = false, validate = false;
-  std::string point_size = "auto";
+  std::string point_size = "auto", point_shape = "auto";
   uint32_t frames = 1;
   std::string warmup = "auto";
   uint64_t chunk_points = 0;
@@ -80,6 +80,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.camera = *spec;
   request.tolerance_px = *parseTolerance(o.camera.tolerance);
   if (o.point_size != "auto") request.point_size = *parsePointSize(o.point_size);
+  if (o.point_shape != "auto") request.round_points = o.point_shape == "round";
   request.background_rgba8 = *parseBackground(o.background);
   if (o.shade != "auto") request.shading = o.shade == "edl" ? Shading::kEdl : Shading::kNone;
   request.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
@@ -268,11 +269,16 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
                   {"auto", "raster", "compute"});
   addCameraOptions(*cmd, o->camera);
   cmd->add_option("--point-size", o->point_size,
-                  "Point size in pixels, or auto: from how far apart the points lie on screen (sampled), up to 8;\n"
-                  "a 2D grid's spacing, so it shows no gaps, and about 2/3 of a 3D set's, whose remaining gaps the\n"
-                  "shading closes; 1 with --error")
+                  "Point size in pixels, or auto: from how far apart the points lie on screen (sampled), up to 8\n"
+                  "(more for a sparse set, up to 64); a 2D grid's spacing, so it shows no gaps, and 1.3 times a 3D\n"
+                  "set's for round points (at least 3), whose remaining gaps the shading closes; 1 with --error")
       ->check(checkStatus([](const std::string& v) { return v == "auto" ? okStatus() : statusOf(parsePointSize(v)); }))
       ->default_val("auto");
+  addChoiceOption(*cmd, "--point-shape", o->point_shape,
+                  "Points larger than a pixel: round (discs whose depth falls away to the rim, so the nearest\n"
+                  "surface wins where discs overlap and a point behind it shows no edge), square (the rasterizer's\n"
+                  "squares at one depth), or auto: round for a 3D set, square for a 2D one (a grid closes exactly)",
+                  {"auto", "round", "square"});
   cmd->add_option("--background", o->background, "Background colour R,G,B (0..255)")
       ->check(checkStatus([](const std::string& v) { return statusOf(parseBackground(v)); }))
       ->default_val("0,0,0");

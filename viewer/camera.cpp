@@ -295,6 +295,8 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
   const glm::dvec3 extent = bounds.max - bounds.min;
   const glm::dvec3 up_y(0.0, 1.0, 0.0);
   double view_width = 0.0;  // ortho only
+  // The fit's margin, widened by fit_margin_px on each side.
+  const double margin = kFitMargin * (1.0 + 2.0 * spec.fit_margin_px / double(std::min(spec.width, spec.height)));
 
   if (spec.eye) {
     camera.eye = *spec.eye;
@@ -307,11 +309,11 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
         half_x = std::max(half_x, std::abs(e.x));
         half_y = std::max(half_y, std::abs(e.y));
       }
-      view_width = spec.view_width.value_or(fitWidth(2.0 * kFitMargin * std::max(half_x, half_y * aspect), bounds));
+      view_width = spec.view_width.value_or(fitWidth(2.0 * margin * std::max(half_x, half_y * aspect), bounds));
     }
   } else if (camera.ortho) {
     // Straight down −z; the eye's x, y are the window centre, its height only sets the depth slab.
-    view_width = spec.view_width.value_or(fitWidth(kFitMargin * std::max(extent.x, extent.y * aspect), bounds));
+    view_width = spec.view_width.value_or(fitWidth(margin * std::max(extent.x, extent.y * aspect), bounds));
     const glm::dvec3 window = spec.view_center.value_or(centre);
     const double height = std::max({extent.z, view_width, isDegenerate(bounds) ? 2.0 * minHalfExtent(centre) : 0.0});
     camera.eye = {window.x, window.y, bounds.max.z + height};
@@ -331,7 +333,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
       distance = 0.5 * *spec.view_width / std::tan(half_fov_x);  // the window is view_width wide at target
     } else if (!isDegenerate(bounds)) {
       distance = fitPerspective(framedPoints(bounds), target, direction, camera.rotation,
-                                std::tan(half_fov_x) / kFitMargin, std::tan(half_fov) / kFitMargin,
+                                std::tan(half_fov_x) / margin, std::tan(half_fov) / margin,
                                 !spec.view_center);
     } else if (bounds.planar) {
       // One point: framed as a square 2e-10 of its coordinates wide (kMinRelativeExtent).

@@ -39,6 +39,8 @@ struct CameraSpec {
   std::optional<bool> ortho;  // unset: ortho for 2D data, perspective for 3D
   std::optional<glm::dvec3> view_center;
   std::optional<double> view_width;
+  // Pixels the fit leaves free on each side beyond its 1% (the radius of large points).
+  double fit_margin_px = 0.0;
   // The perspective fit of 3D data: the direction from the target to the eye and the picture's up
   // (not parallel; neither need be unit length). Unset: an oblique direction, (0.6, 0.5, 1)
   // normalized, with +y up. Not allowed with eye/target/up; ignored by ortho and for 2D data.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "shaders/points.frag.h"
+#include "shaders/points_round.frag.h"
 #include "shaders/edl.comp.h"
 #include "shaders/fill.comp.h"
 #include "shaders/log.comp.h"
@@ -51,9 +52,9 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
 
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
                                    const SplatVariant& v) {
-  const uint32_t constants[5] = {probe ? VK_TRUE : VK_FALSE, v.early_depth ? VK_TRUE : VK_FALSE,
+  const uint32_t constants[6] = {probe ? VK_TRUE : VK_FALSE, v.early_depth ? VK_TRUE : VK_FALSE,
                                  v.subgroup_merge ? VK_TRUE : VK_FALSE, v.pair_merge ? VK_TRUE : VK_FALSE,
-                                 v.large_points ? VK_TRUE : VK_FALSE};
+                                 v.large_points ? VK_TRUE : VK_FALSE, v.large_points && v.round ? VK_TRUE : VK_FALSE};
   return computePipeline(context, code, layout, constants);
 }
 
@@ -112,11 +113,14 @@ Result<VkRenderPass> createRenderPass(const VulkanContext& context, bool keep_de
 }
 
 Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipelines& p, PrecisionMode mode, bool pull,
-                                  bool probe, uint32_t width, uint32_t height) {
+                                  bool probe, uint32_t width, uint32_t height, bool round) {
   Spirv vertex_code = vertexShader(mode, pull);
   Result<VkShaderModule> vertex = createShaderModule(context, vertex_code.code, vertex_code.bytes);
   if (!vertex) return vertex.error();
-  Result<VkShaderModule> fragment = createShaderModule(context, kPointsFrag, sizeof(kPointsFrag));
+  // Round points write their depth (gl_FragDepth) in a shader of their own, so the square one keeps
+  // the early depth test.
+  Result<VkShaderModule> fragment = round ? createShaderModule(context, kPointsRoundFrag, sizeof(kPointsRoundFrag))
+                                          : createShaderModule(context, kPointsFrag, sizeof(kPointsFrag));
   if (!fragment) {
     vkDestroyShaderModule(context.device, *vertex, nullptr);
     return fragment.error();
@@ -203,7 +207,8 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const PointPipel
 }  // namespace
 
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
-                                            bool with_probe, uint32_t width, uint32_t height, bool keep_depth) {
+                                            bool with_probe, uint32_t width, uint32_t height, bool keep_depth,
+                                            bool round) {
   PointPipelines p;
   p.pulls_positions = pull && modeInfo(mode).shaders.vertex_pull.code != nullptr;
   auto fail = [&](const Error& error) -> Result<PointPipelines> {
@@ -229,7 +234,7 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
   set_info.pBindings = bindings;
   VkResult result = vkCreateDescriptorSetLayout(context.device, &set_info, nullptr, &p.set_layout);
   if (result != VK_SUCCESS) return fail(vulkanError("vkCreateDescriptorSetLayout", result));
-  VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)};
+  VkPushConstantRange push{kPointPushStages, 0, sizeof(PushConstants)};
   VkPipelineLayoutCreateInfo layout_info = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout_info.setLayoutCount = 1;
   layout_info.pSetLayouts = &p.set_layout;
@@ -238,11 +243,11 @@ Result<PointPipelines> createPointPipelines(const VulkanContext& context, Precis
   result = vkCreatePipelineLayout(context.device, &layout_info, nullptr, &p.layout);
   if (result != VK_SUCCESS) return fail(vulkanError("vkCreatePipelineLayout", result));
 
-  Result<VkPipeline> draw = createPipeline(context, p, mode, pull, false, width, height);
+  Result<VkPipeline> draw = createPipeline(context, p, mode, pull, false, width, height, round);
   if (!draw) return fail(draw.error());
   p.draw = *draw;
   if (with_probe) {
-    Result<VkPipeline> probe = createPipeline(context, p, mode, pull, true, width, height);
+    Result<VkPipeline> probe = createPipeline(context, p, mode, pull, true, width, height, round);
     if (!probe) return fail(probe.error());
     p.probe = *probe;
   }
@@ -304,8 +309,11 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& p) 
   p = ComputePipelines{};
 }
 
+// The radii follow the point size up to 8 px: larger points are a sparse set's round ones (up to
+// 64 px), which overlap and leave no staircase or gap as wide as themselves; following them made
+// the shaders' loops (unrolled) long and a 1,065-point survey's default render 2x slower on lavapipe.
 ShadeRadii shadeRadii(float point_size, float edl_radius, bool fuse) {
-  const int size = static_cast<int>(std::ceil(std::clamp(point_size, 1.0f, 64.0f)));
+  const int size = static_cast<int>(std::ceil(std::clamp(point_size, 1.0f, 8.0f)));
   ShadeRadii radii;
   radii.fill = (size + 1) / 2 + 1;
   radii.smooth = size - 1;

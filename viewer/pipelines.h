@@ -32,7 +32,12 @@ struct PushConstants {
   uint32_t count = 0;       // points in the chunk
   uint32_t list_first = 0;  // compute backend, per-batch modes: the chunk's first batch-list entry
   uint32_t listed = 0;      // 1: this chunk's workgroups take their batches from the list
+  // Round points (shaders/render/push.glsl's roundDepth; roundPointPush fills them).
+  float depth_scale = 0.0f;
+  float bulge = 0.0f;
 };
+// The raster backend's stages that read them: the fragment shader of round points too.
+inline constexpr VkShaderStageFlags kPointPushStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
 // Descriptor bindings of the compute backend beyond the shared four: 4 the visibility buffer
 // (one uint64 per pixel); the resolve pass has its own set (visibility, colours, picture).
@@ -53,9 +58,11 @@ struct PointPipelines {
 };
 
 // `pull` selects vertex pulling for a mode with a pull variant (native; ignored by the others). `keep_depth` stores
-// the depth attachment and leaves it ready to copy (TRANSFER_SRC_OPTIMAL) for the eye-dome pass.
+// the depth attachment and leaves it ready to copy (TRANSFER_SRC_OPTIMAL) for the eye-dome pass. `round`: points
+// larger than a pixel are discs (RenderOptions::round_points).
 Result<PointPipelines> createPointPipelines(const VulkanContext& context, PrecisionMode mode, bool pull,
-                                            bool with_probe, uint32_t width, uint32_t height, bool keep_depth = false);
+                                            bool with_probe, uint32_t width, uint32_t height, bool keep_depth = false,
+                                            bool round = false);
 void destroyPointPipelines(const VulkanContext& context, PointPipelines& pipelines);
 
 // The compute backend (DESIGN §4): a splat pass per mode (and its probe twin) and the resolve.
@@ -84,6 +91,8 @@ struct SplatVariant {
   // Points may be larger than a pixel; false for a render of 1-px points, whose splat then has no
   // square loop (lavapipe: 1.4-1.6x faster, issue #38).
   bool large_points = true;
+  // With large_points: discs whose depth falls away to the rim (RenderOptions::round_points).
+  bool round = false;
 };
 
 // `write_log` has the resolve also write each pixel's log distance (binding 3) for the shading.

@@ -147,7 +147,9 @@ void recordDraws(VkCommandBuffer commands, const Resources& r, VkPipeline pipeli
     push.first_index = static_cast<uint32_t>(chunk.first);
     push.count = static_cast<uint32_t>(chunk.count);
     push.batch_shift = batchShift(options.mode);
-    vkCmdPushConstants(commands, r.pipelines.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
+    push.depth_scale = r.round_depth_scale;
+    push.bulge = r.round_bulge;
+    vkCmdPushConstants(commands, r.pipelines.layout, kPointPushStages, 0, sizeof(push), &push);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, r.pipelines.layout, 0, 1, &chunk.set, 0, nullptr);
     VkDeviceSize offset = 0;
     if (!r.pipelines.pulls_positions) vkCmdBindVertexBuffers(commands, 0, 1, &chunk.positions.buffer, &offset);
@@ -481,13 +483,14 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
           createComputePipelines(context, options.mode, options.probe,
                                  SplatVariant{options.early_depth, options.subgroup_merge.value_or(context.facts.type != "cpu"),
                                               options.pair_merge.value_or(context.facts.type != "cpu"),
-                                              options.point_size != 1.0f},
+                                              options.point_size != 1.0f, options.round_points},
                                  shading);
       if (!pipelines) return pipelines.error();
       r.compute = *pipelines;
     } else {
       Result<PointPipelines> pipelines =
-          createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height, shading);
+          createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height, shading,
+                               options.round_points && options.point_size != 1.0f);
       if (!pipelines) return pipelines.error();
       r.pipelines = *pipelines;
     }
@@ -507,6 +510,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   out.pulled_positions = pulled;
   RenderOptions chunking = options;
   chunking.max_chunk_points = max_chunk_points;
+  detail::roundPointPush(camera, options, r.round_depth_scale, r.round_bulge);
   Status status = createUniforms(context, r, camera, encoding);
   if (status) status = uploadPoints(context, r, total, chunk_points, options, encoding, pulled,
                                     chunkPoints(context.facts, chunking, pulled || compute));

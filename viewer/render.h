@@ -45,6 +45,11 @@ struct RenderOptions {
   PrecisionMode mode = kFallbackMode;
   Backend backend = Backend::kRaster;
   float point_size = 1.0f;
+  // Points larger than a pixel as discs whose depth falls away to the rim, the front of a
+  // paraboloid as deep as the sphere of their radius (Potree's "paraboloid" points): of
+  // overlapping discs the nearest centre wins, so a point behind a surface never shows a square's
+  // edge through it. False: the rasterizer's squares at one depth. Both backends draw the same.
+  bool round_points = false;
   uint32_t background_rgba8 = 0xff000000u;  // opaque black, R in the low byte
   // Warm-up: untimed frames before the timed ones, warmup_frames of them, then more until warmup_ms of
   // wall time (submit to fence) have passed since the first began (0: none by time). By time is

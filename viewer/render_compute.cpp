@@ -116,6 +116,8 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
       push.list_first = chunk.list_first;
       push.listed = chunk.listed ? 1u : 0u;
       push.batch_shift = batchShift(options.mode);
+      push.depth_scale = r.round_depth_scale;
+      push.bulge = r.round_bulge;
       vkCmdPushConstants(commands, r.compute.splat_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
       vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.compute.splat_layout, 0, 1, &chunk.set, 0, nullptr);
       vkCmdDispatch(commands, groups, 1, 1);

@@ -80,6 +80,8 @@ struct Resources {
   Buffer depth_values, shaded, log_distance, filled_log, partial, smoothed;
   VkBufferView shade_views[kShadeBindings] = {};
   VkDescriptorSet shade_set = VK_NULL_HANDLE;
+  // Round points: PushConstants' depth_scale and bulge for this camera (roundPointPush).
+  float round_depth_scale = 0.0f, round_bulge = 0.0f;
 };
 
 // The render's descriptor pool: `sets` sets of one uniform and `storage_per_set` storage buffers.
@@ -100,6 +102,9 @@ Status createShadeTargets(const VulkanContext& context, Resources& r, const Came
                           bool raster);
 Status createShadeDescriptors(const VulkanContext& context, Resources& r);
 EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_size);
+// PushConstants' depth_scale and bulge: a disc of point_size pixels is the front of a paraboloid
+// as deep as the sphere of its radius at its depth (0, 0 for square points).
+void roundPointPush(const Camera& camera, const RenderOptions& options, float& depth_scale, float& bulge);
 void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& push, bool raster);
 
 }  // namespace dpoint::detail

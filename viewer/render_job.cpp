@@ -39,8 +39,18 @@ bool hasExtension(const std::string& path, const std::string& extension) {
 // Points sampled for their nearest neighbour's distance (the default point size): enough for a
 // steady median, few enough that the search costs ~10 ms on 1.55M points.
 constexpr size_t kSpacingSamples = 512;
-// A 3D set's point size as a share of its projected spacing (pointSizeFor).
-constexpr double kSurfaceShare = 0.65;
+// A 3D set's point size as a share of its projected spacing (pointSizeFor): a round point's disc
+// (inscribed in its square) a little wider than the spacing, so neighbouring discs overlap and the
+// nearest centre wins between them; a square one as wide as the spacing. At 0.65 of it (square) the
+// res-200 Mandelbulb at 1024x768 showed the points of its inner shells through the gaps as hollow
+// squares (1.9% of the surface's pixels; bench/results/2026-11-28/cpu/default_pictures.md).
+constexpr double kRoundShare = 1.3, kSquareShare = 1.0;
+// The most point pixels a default size draws, in pictures' worth: a sparse set's points grow up to
+// their spacing (a survey of 1,065 points reads as a surface), a dense set's stay at most 8 px.
+constexpr double kPointPixelBudget = 32.0;
+// The share of the picture's smaller side the fit leaves free on both sides together (camera.cpp's
+// kFitMargin, 1.02).
+constexpr double kFitMarginShare = 1.0 - 1.0 / 1.02;
 
 struct LoadedSet {
   std::string inputs;  // describeInputs: for messages
@@ -306,6 +316,8 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   options.mode = mode;
   options.backend = *request.backend;
   options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts, set.spacing);
+  // A 2D grid drawn at its spacing closes exactly with squares; discs would leave their corners open.
+  options.round_points = request.round_points.value_or(!set.bounds.planar);
   options.background_rgba8 = request.background_rgba8;
   options.frames = request.frames;
   setWarmup(request.warmup, request.frames, options);
@@ -615,9 +627,11 @@ std::optional<double> projectedSpacing(std::span<const SpacingSample> spacing, c
 
 // With the set's spacing samples: the projected spacing rounded up for a 2D set (a grid drawn
 // larger than its resolution closes without a screen-door pattern: a 256² mandelbrot2d at 768 px,
-// 3 px); kSurfaceShare of it for a 3D set, whose gaps the hole filling before eye-dome lighting
-// closes (shaders/render/fill.comp; a Mandelbulb of 226K points, 4 px, of 1.55M, 2 px; the
-// default Menger sponge, 5 px, its holes open). At most 8 px. Without samples (a streamed set), the
+// 3 px); kRoundShare (kSquareShare) of it for a 3D set, whose remaining gaps the hole filling before
+// eye-dome lighting closes (shaders/render/fill.comp; at 1024x768 a Mandelbulb of 226K points,
+// 7 px, of 1.55M, 3 px; the default Menger sponge, 8 px, its holes open). At most 8 px, or where
+// the points are few, as large as kPointPixelBudget pictures of point pixels allow (at most 64).
+// Without samples (a streamed set), the
 // count over the outline: a 3D set's quarter of its points (a closed surface shows its front half,
 // and a folded one hides about half of that behind its folds) over the ellipse inside the box's
 // screen rectangle, at most 4 px, and 1 px in ortho; a 2D set's points over the rectangle, at most
@@ -628,8 +642,15 @@ float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box
   if (request.error) return 1.0f;
   if (request.backend.value_or(Backend::kRaster) == Backend::kRaster && !facts.large_points) return 1.0f;
   if (std::optional<double> spacing = projectedSpacing(samples, camera)) {
-    const double size = box.planar ? *spacing : kSurfaceShare * *spacing;
-    return static_cast<float>(std::clamp(std::ceil(size), 1.0, std::min(8.0, double(facts.max_point_size))));
+    const bool round = request.round_points.value_or(!box.planar);
+    // A disc of 2 px is its square (every pixel centre lies within it): at least 3 px, whose
+    // corners leave out overlap the neighbours' (a 1.55M Mandelbulb at 640x480: 0.58% artefacts
+    // at 2 px, 0.16% at 3).
+    const double size = box.planar ? *spacing : round ? std::max(3.0, kRoundShare * *spacing) : kSquareShare * *spacing;
+    const double pixels = double(camera.width) * double(camera.height);
+    const double most = std::min({std::max(8.0, std::floor(std::sqrt(kPointPixelBudget * pixels / double(std::max<size_t>(count, 1))))),
+                                  64.0, double(facts.max_point_size)});
+    return static_cast<float>(std::clamp(std::ceil(size), 1.0, most));
   }
   if (camera.ortho && !box.planar) return 1.0f;
   // The data's outline when the fit framed it (every one of its points is inside the picture), else
@@ -700,6 +721,20 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   outcome.backend = backendFor(request, set->count, spec.width, spec.height, context.facts);
   RenderRequest resolved = request;  // the policies below see the backend that runs
   resolved.backend = outcome.backend;
+  // A fitted view leaves 1% of the picture free each side; where the default points are larger
+  // (a sparse set's), the fit is made again leaving their radius, so no point touches the edge.
+  if (!request.point_size && !spec.eye && !spec.view_center && !spec.view_width) {
+    double radius = 0.0, free = HUGE_VAL;
+    for (const Camera& camera : *cameras) {
+      radius = std::max(radius, 0.5 * pointSizeFor(resolved, set->count, set->bounds, camera, context.facts, set->spacing));
+      free = std::min(free, 0.5 * kFitMarginShare * std::min(camera.width, camera.height));
+    }
+    if (radius + 0.5 > free) {
+      resolved.camera.fit_margin_px = radius + 0.5;
+      cameras = viewCameras(resolved, views, set->bounds, set->z_up);
+      if (!cameras) return cameras.error();
+    }
+  }
   Status rendered = views.size() == 4 ? renderSheet(resolved, context, *set, views, *cameras, outcome, view_done)
                                       : renderOne(resolved, context, *set, cameras->front(), outcome, progress);
   if (!rendered) return rendered.error();

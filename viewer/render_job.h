@@ -78,6 +78,7 @@ struct RenderRequest {
   uint64_t max_device_memory = 0;    // 0: what the device has
   CameraSpec camera;                 // the picture's size and the user's camera
   std::optional<double> point_size;  // pixels; none: pointSizeFor's choice
+  std::optional<bool> round_points;  // RenderOptions::round_points; none: round for a 3D set
   uint32_t background_rgba8 = 0xff000000u;
   std::optional<Shading> shading;    // none: shadingFor's choice
   EdlOptions edl;

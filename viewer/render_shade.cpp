@@ -119,6 +119,18 @@ EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_siz
   return push;
 }
 
+void roundPointPush(const Camera& camera, const RenderOptions& options, float& depth_scale, float& bulge) {
+  depth_scale = bulge = 0.0f;
+  if (!options.round_points || options.point_size <= 1.0f) return;
+  // A pixel spans 2 |P[2][3]| / (|P[1][1]| · height) of the eye distance in perspective, and
+  // 2 |P[2][2]| / (|P[1][1]| · height) of the depth range in ortho (as edlPush's threshold).
+  const glm::dmat4& p = camera.projection;
+  const double pixel = 2.0 * std::abs(camera.ortho ? p[2][2] : p[2][3]) / (std::abs(p[1][1]) * camera.height);
+  depth_scale = camera.ortho ? 0.0f
+                             : static_cast<float>((camera.far_plane - camera.near_plane) / camera.near_plane);
+  bulge = static_cast<float>(0.5 * options.point_size * pixel);
+}
+
 void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& push, bool raster) {
   auto barrier = [&](VkPipelineStageFlags src_stage, VkAccessFlags src, VkPipelineStageFlags dst_stage, VkAccessFlags dst) {
     VkMemoryBarrier b = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};

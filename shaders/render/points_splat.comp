@@ -23,6 +23,9 @@ layout(constant_id = 3) const bool kPairMerge = false;
 // Points larger than one pixel may be drawn (pc.point_size); false compiles their loop away. The
 // loop's mere presence, never taken, had made lavapipe's 1-px frames 1.4-1.6x slower (issue #38).
 layout(constant_id = 4) const bool kLargePoints = true;
+// Larger points are discs whose depth falls away towards the rim (push.glsl's roundDepth), the
+// raster backend's points_round.frag; false: the rasterizer's squares at one depth.
+layout(constant_id = 5) const bool kRound = false;
 layout(local_size_x = 256) in;
 const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.h
 
@@ -96,7 +99,7 @@ void splat(uint i, vec4 clip) {
     atomicMax(visibility[pixel], key);
     return;
   }
-  // A larger point is the rasterizer's square: the pixels whose centres lie in [x − s/2, x + s/2) ×
+  // A larger point is the rasterizer's square (or, with kRound, its inscribed disc): the pixels whose centres lie in [x − s/2, x + s/2) ×
   // [y − s/2, y + s/2), each tested at the point's one depth, as the raster depth test does, so the
   // depth test stays exact (a key per pixel) and the picture is the raster one. Clipped by its centre
   // (above), then to the picture. s² atomics a point at most: the sizes pointSizeFor picks are small
@@ -105,6 +108,26 @@ void splat(uint i, vec4 clip) {
   float half_size = 0.5 * pc.point_size;
   int x0 = max(int(ceil(x - half_size - 0.5)), 0), x1 = min(int(ceil(x + half_size - 0.5)) - 1, int(pc.width) - 1);
   int y0 = max(int(ceil(y - half_size - 0.5)), 0), y1 = min(int(ceil(y + half_size - 0.5)) - 1, int(pc.height) - 1);
+  if (kRound) {
+    // A disc: the pixels whose centres lie within it, as gl_PointCoord places a pixel's centre in
+    // the square (r2 ≤ 1), each at its own depth. A row's pixels are found from the row's chord.
+    float inv_half = 1.0 / half_size, slope = roundSlope(depth);
+    for (int py = y0; py <= y1; ++py) {
+      float dy = (float(py) + 0.5 - y) * inv_half, dy2 = dy * dy;
+      if (dy2 > 1.0) continue;
+      float chord = half_size * sqrt(1.0 - dy2);
+      int row_x0 = max(x0, int(ceil(x - chord - 0.5)) - 1), row_x1 = min(x1, int(floor(x + chord - 0.5)) + 1);
+      for (int px = row_x0; px <= row_x1; ++px) {
+        float dx = (float(px) + 0.5 - x) * inv_half, r2 = dx * dx + dy2;
+        if (r2 > 1.0) continue;
+        uint64_t pixel_key = (uint64_t(floatBitsToUint(roundDepth(depth, slope, r2))) << 32) | uint64_t(~index);
+        uint pixel = uint(py) * pc.width + uint(px);
+        if (kEarlyDepth && visibility[pixel] >= pixel_key) continue;
+        atomicMax(visibility[pixel], pixel_key);
+      }
+    }
+    return;
+  }
   for (int py = y0; py <= y1; ++py)
     for (int px = x0; px <= x1; ++px) {
       uint pixel = uint(py) * pc.width + uint(px);

@@ -5,15 +5,7 @@
 // The mode is a define: MODE_FP32, MODE_SPLIT, MODE_RTE, MODE_DF64, MODE_NATIVE_ATTR,
 // MODE_NATIVE_PULL (native reading a storage buffer), MODE_BATCH or MODE_ADAPTIVE.
 
-layout(push_constant) uniform Push {
-  float splitter;    // 2^12 + 1, at run time so the split cannot be folded
-  float point_size;
-  uint first_index;  // index of this draw's first point in the whole set (batch mode, compute)
-  uint batch_shift;  // log2 of the points per batch
-  uint width, height, count;  // compute backend: target size; points in this chunk (both backends)
-  uint list_first;  // compute backend, per-batch modes: this chunk's first entry of the batch list
-  uint listed;      // 1: workgroups take their batches from the list; 0: the chunk's batches in order
-} pc;
+#include "push.glsl"
 
 #if defined(MODE_FP32) || defined(MODE_SPLIT)
 layout(std140, set = 0, binding = 0) uniform CameraBlock { mat4 mvp; } cam;

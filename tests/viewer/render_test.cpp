@@ -338,6 +338,58 @@ TEST_P(Render, computeAgreesWithRasterAtPointSizes1To3) {
   }
 }
 
+// Round points (RenderOptions::round_points) are the same discs on both backends, at one depth
+// per pixel that falls towards the rim: all but under 1% of the lit pixels agree (a pixel centre on
+// a disc's rim, lavapipe's sub-pixel snapping); and a disc is not its square: its corners are left
+// out, so a lone 9-px point lights 69 of its 81 pixels, and of two discs at one depth the nearer
+// centre wins the pixels between them (with squares, the point drawn first would take them all).
+TEST_P(Render, roundPointsAreTheSameDiscsOnBothBackends) {
+  if (GetParam() == Backend::kRaster) GTEST_SKIP() << "compares the compute backend against raster";
+  const PointSet cube = cloud(glm::dvec3(0.0), 1.0);
+  CameraSpec from_above;
+  from_above.width = from_above.height = 200;
+  from_above.ortho = true;
+  Result<Camera> ortho = makeCamera(from_above, boundsOf(cube));
+  ASSERT_TRUE(ortho.ok()) << ortho.error().message;
+  for (const Camera& camera : {lookAtCloud(cube, glm::dvec3(0.0), 40.0), *ortho}) {
+    for (float size : {5.0f, 9.0f}) {
+      RenderOptions raster, compute;
+      raster.point_size = compute.point_size = size;
+      raster.round_points = compute.round_points = true;
+      compute.backend = Backend::kCompute;
+      Result<RenderResult> a = renderPoints(*context_, cube, camera, raster);
+      Result<RenderResult> b = renderPoints(*context_, cube, camera, compute);
+      ASSERT_TRUE(a.ok() && b.ok());
+      const size_t lit = litPixels(a->image, raster.background_rgba8), differing = countDifferingPixels(a->image, b->image);
+      std::printf("round %g px, %s: %zu of %zu lit pixels differ\n", double(size), camera.ortho ? "ortho" : "perspective",
+                  differing, lit);
+      EXPECT_GT(lit, 0u);
+      EXPECT_LE(differing, lit / 100) << size << " px";
+    }
+  }
+  // A lone point at a pixel's centre (the middle of a 63-px picture): 69 pixel centres lie within
+  // 4.5 px of it.
+  PointSet lone;
+  lone.positions = {glm::dvec3(0.0, 0.0, 0.0), glm::dvec3(0.0, 0.0, 0.5)};
+  lone.colors = {glm::vec3(1.0f), glm::vec3(1.0f)};
+  CameraSpec centred;
+  centred.width = centred.height = 63;
+  centred.ortho = true;
+  centred.view_center = glm::dvec3(0.0);
+  centred.view_width = 1.0;
+  Result<Camera> camera = makeCamera(centred, boundsOf(lone));
+  ASSERT_TRUE(camera.ok()) << camera.error().message;
+  for (Backend backend : {Backend::kRaster, Backend::kCompute}) {
+    RenderOptions options;
+    options.point_size = 9.0f;
+    options.round_points = true;
+    options.backend = backend;
+    Result<RenderResult> r = renderPoints(*context_, lone, *camera, options);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(litPixels(r->image, options.background_rgba8), 69u) << (backend == Backend::kCompute ? "compute" : "raster");
+  }
+}
+
 // A set streamed block by block (dpoint render of a file larger than memory) draws the picture
 // the set in memory draws, in every mode, with blocks that split it unevenly; a failing read ends
 // the render with the stream's error, and a bad point is named by its index in the whole set.
