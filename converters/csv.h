@@ -69,6 +69,8 @@ struct CsvLayout {
   // ',' for .csv; ' ' for the text exports .xyz, .txt and .asc, whose header is then CloudCompare's
   // comment form `//x y z` (CsvRowWriter::create sets it from the path: csvSeparatorFor).
   char separator = ',';
+  // Colours as integers of this full scale (255, 65535: PointSet::color_full_scale), 0 as floats 0..1.
+  uint16_t color_full_scale = 0;
 };
 
 // Rows appended in any number of calls give the same bytes as one writeCsv of all of them with

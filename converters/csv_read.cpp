@@ -21,6 +21,32 @@
 #include "core/text.h"
 
 namespace dpoint {
+
+namespace {
+
+// Colour columns hold floats 0..1, or integers 0..255 (or 0..65535) as spreadsheets and most point
+// tools write them: where a value above 1 appears, every colour must be such an integer, and the set
+// keeps the full scale (PointSet::color_full_scale), so 255,128,0 is written back as 255,128,0.
+Status integerColors(const std::string& path, PointSet& points) {
+  float largest = 0.0f;
+  for (const glm::vec3& c : points.colors) largest = std::max({largest, c.r, c.g, c.b});
+  if (!(largest > 1.0f)) return okStatus();
+  const float full = largest > 255.0f ? 65535.0f : 255.0f;
+  for (size_t i = 0; i < points.colors.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const float v = points.colors[i][k];
+      if (!(v >= 0.0f && v <= full && v == std::floor(v)))
+        return Error{path + ": row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": " +
+                     formatNumber(v) + " among integer colours (values above 1 make every colour an integer 0.." +
+                     formatNumber(full) + "; colours as fractions are 0..1)"};
+    }
+  const float scale = 1.0f / full;
+  for (glm::vec3& c : points.colors) c *= scale;
+  points.color_full_scale = static_cast<uint16_t>(full);
+  return okStatus();
+}
+
+}  // namespace
 namespace {
 
 constexpr size_t kBlockSize = 8u << 20;
@@ -576,6 +602,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     points.dimensions.resize(out);
   }
   narrowDimensions(points.dimensions, threads);
+  if (Status s = integerColors(path, points); !s) return s.error();
   if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
   if (options.progress) options.progress->finish();
   return points;

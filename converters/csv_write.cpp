@@ -46,7 +46,7 @@ class RowFormatter {
  public:
   RowFormatter(const CsvLayout& layout, int decimals, bool at_scale)
       : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors),
-        separator_(layout.separator), dimension_names_(layout.dimensions) {}
+        separator_(layout.separator), color_full_scale_(layout.color_full_scale), dimension_names_(layout.dimensions) {}
 
   std::string header() const {
     std::vector<std::string> names = {"x", "y"};
@@ -119,6 +119,11 @@ class RowFormatter {
     return r.ptr;
   }
   char* color(char* p, char* limit, float v) const {
+    if (color_full_scale_) {  // the integers the colours were read as: 255 stays 255
+      std::to_chars_result r = std::to_chars(p, limit, colorInteger(v, color_full_scale_));
+      assert(r.ec == std::errc());
+      return r.ptr;
+    }
     if (decimals_ >= 0 && !at_scale_) return number(p, limit, static_cast<double>(v));
     std::to_chars_result r = std::to_chars(p, limit, v);
     assert(r.ec == std::errc());
@@ -130,6 +135,7 @@ class RowFormatter {
   bool planar_;
   bool colors_;
   char separator_;
+  uint16_t color_full_scale_;
   const std::vector<std::string>& dimension_names_;
 };
 
@@ -240,6 +246,9 @@ Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteO
     return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(points.positions.size()) + " points"};
   CsvLayout layout{!points.hasZ(), points.hasColors(), {}};
+  // Integers where the colours came as integers from a text file or a PLY's 16-bit ones; a LAS
+  // file's colours stay 0..1 values, as they always were in CSV.
+  layout.color_full_scale = points.las ? 0 : points.color_full_scale;
   for (const Dimension& d : points.dimensions.all()) layout.dimensions.push_back(d.name);
   Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
   if (!writer) return writer.error();

@@ -553,7 +553,9 @@ class RecordEncoder {
       slots_.push_back({e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
                         Convert::kNone});
     rgb_at_ = points.hasColors() ? lasRgbOffset(l.format) : 0;
-    color_scale_ = points.color_full_scale == 255 ? 255.0 : 65535.0;
+    // 8-bit values where the colours came from a LAS file that had them (PLY or CSV 8-bit colours
+    // are scaled to 16 bits, as the specification asks).
+    color_scale_ = points.color_full_scale == 255 && points.las ? 255.0 : 65535.0;
     return_number_ = points.dimensions.find(dim::kReturnNumber);
     returns_ = l.format >= 6 ? 15 : 5;
   }

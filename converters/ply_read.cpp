@@ -416,6 +416,8 @@ class PlyParser {
         // The facts dpoint writes (ply_write.cpp): a 2D source, and z up.
         if (w[2] == "2D") points_.z_axis = ZAxis::kAbsent;
         if (w.size() == 5 && w[2] == "up" && w[3] == "axis" && w[4] == "z") points_.z_up = true;
+        // Colours that came as integers 0..255 (a CSV's), so CSV → PLY → CSV writes them so again.
+        if (w.size() == 4 && w[2] == "colours" && w[3] == "0..255") integer_colours_ = true;
         // A set read from LAS: its point format, version, scale and offset, so that LAS → PLY → LAS
         // writes the same coordinates in the same format. Ignored unless all of it parses.
         if (w.size() == 12 && w[2] == "las" && w[3] == "frame") {
@@ -538,11 +540,12 @@ class PlyParser {
       if (!found[role])
         return headerError(vertex->line, "element 'vertex' has no '" + std::string(kNames[role]) + "' property");
     has_colors_ = found[kRed] || found[kGreen] || found[kBlue];
-    // Integer colours keep their width (PointSet::color_full_scale): 16-bit colours stay 16-bit, and
-    // a LAS file's 8-bit ones (its frame in a comment) go back to LAS as 8-bit values; other 8-bit
-    // colours are written to LAS at 16 bits, as the LAS specification asks.
+    // Integer colours keep their width (PointSet::color_full_scale): 16-bit colours stay 16-bit, a
+    // LAS file's 8-bit ones (its frame in a comment) go back to LAS as 8-bit values, and a CSV's
+    // 0..255 integers (a comment too) back to CSV as integers; other 8-bit colours are 0..1 values
+    // stored in a byte (dpoint's own), written to LAS at 16 bits, as the LAS specification asks.
     if (has_colors_ && divisor_[kRed] == divisor_[kGreen] && divisor_[kGreen] == divisor_[kBlue] &&
-        (divisor_[kRed] == 65535.0f || (divisor_[kRed] == 255.0f && points_.las)))
+        (divisor_[kRed] == 65535.0f || (divisor_[kRed] == 255.0f && (points_.las || integer_colours_))))
       points_.color_full_scale = static_cast<uint16_t>(divisor_[kRed]);
     if (has_colors_ && !(found[kRed] && found[kGreen] && found[kBlue]))
       return headerError(std::max({found[kRed], found[kGreen], found[kBlue]}),
@@ -930,6 +933,7 @@ class PlyParser {
   std::vector<Element> elements_;
   std::vector<Role> vertex_roles_, face_roles_;
   bool has_colors_ = false;
+  bool integer_colours_ = false;  // the header's `comment dpoint: colours 0..255`
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;
   uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)

@@ -29,6 +29,8 @@ std::string sourceFacts(const PointSet& points) {
   std::string facts;
   if (!points.hasZ()) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
   if (points.z_up) facts += "comment dpoint: up axis z\n";
+  // Colours read as integers 0..255 from a text file (ply_read.cpp keeps them so for CSV).
+  if (points.hasColors() && points.color_full_scale == 255 && !points.las) facts += "comment dpoint: colours 0..255\n";
   if (points.las) {  // ply_read.cpp reads it back, so that LAS → PLY → LAS keeps its coordinates
     const LasSource& l = *points.las;
     facts += "comment dpoint: las frame ";

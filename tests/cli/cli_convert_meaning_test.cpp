@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "converters/csv.h"
@@ -281,6 +282,38 @@ TEST(CliConvertMeaning, plyWrittenFromLasRecordsZUp) {
   writeFile(dir.file("p.csv"), "x,y,z\n1,2,3\n");
   expectConverts({dir.file("p.csv"), "-o", dir.file("p.ply")});
   EXPECT_FALSE(test::contains(readFile(dir.file("p.ply")), "up axis"));
+}
+
+// Colours given as 0-255 integers stay integers through CSV -> PLY -> CSV (and 16-bit ones through
+// a PLY's ushort), render as the colours they are, and a fraction among them is refused by row and column.
+TEST(CliConvertMeaning, integerColoursKeepTheirFormThroughPly) {
+  TempDir dir;
+  const std::string bytes = "x,y,z,r,g,b\n0,0,0,255,0,0\n1,0,0,128,64,32\n0,1,0.5,0,0,255\n";
+  writeFile(dir.file("a.csv"), bytes);
+  expectConverts({dir.file("a.csv"), "-o", dir.file("a.ply")});
+  expectConverts({dir.file("a.ply"), "-o", dir.file("b.csv")});
+  EXPECT_EQ(readFile(dir.file("b.csv")), bytes);
+  Result<PointSet> read = readCsv(dir.file("a.csv"));
+  ASSERT_TRUE(read.ok()) << read.error().message;
+  EXPECT_EQ(read->color_full_scale, 255);
+  EXPECT_FLOAT_EQ(read->colors[1].r, 128.0f / 255.0f);
+  const std::string words = "x,y,z,r,g,b\n0,0,0,65535,0,0\n1,0,0,256,64,32\n";
+  writeFile(dir.file("w.csv"), words);
+  expectConverts({dir.file("w.csv"), "-o", dir.file("w.ply")});
+  EXPECT_TRUE(test::contains(readFile(dir.file("w.ply")), "property ushort red"));
+  expectConverts({dir.file("w.ply"), "-o", dir.file("w2.csv")});
+  EXPECT_EQ(readFile(dir.file("w2.csv")), words);
+  // 0-1 colours stay 0-1 values.
+  const std::string fractions = "x,y,z,r,g,b\n0,0,0,1,0,0\n1,0,0,0,0.2509804,1\n";
+  writeFile(dir.file("f.csv"), fractions);
+  expectConverts({dir.file("f.csv"), "-o", dir.file("f.ply")});
+  expectConverts({dir.file("f.ply"), "-o", dir.file("f2.csv")});
+  EXPECT_EQ(readFile(dir.file("f2.csv")), fractions);
+  writeFile(dir.file("bad.csv"), "x,y,z,r,g,b\n0,0,0,255,0,0\n1,0,0,0.5,64,32\n");
+  test::CommandResult bad = runDpoint({"convert", dir.file("bad.csv"), "-o", dir.file("bad.ply")});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_TRUE(test::contains(bad.err, "bad.csv: row 2, colour column 1: 0.5 among integer colours"));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
 }
 
 }  // namespace
