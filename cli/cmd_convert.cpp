@@ -6,6 +6,7 @@
 #include "cli/cli_check.h"
 #include "cli/cli_output.h"
 #include "cli/commands.h"
+#include "converters/csv.h"
 #include "converters/gltf_read.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
@@ -80,7 +81,8 @@ int runConvert(ConvertOptions& o) {
   const Result<FileFormat> in_format = formatOf(o.input), out_format = formatOf(o.output);
   const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
-  if (in_format && isGltf(*in_format) && to_csv && !o.unique && *order == PointOrder::kInput && !choose_dimensions) {
+  if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !o.unique && *order == PointOrder::kInput &&
+      !choose_dimensions) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
@@ -104,9 +106,9 @@ int runConvert(ConvertOptions& o) {
 
 void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc), .ply, .glb, .las and .laz");
-  cmd->add_option("input", o->input, "Input file (.csv, .xyz, .txt, .asc, .ply, .glb, .gltf, .las, .laz)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .ply, .glb, .las, .laz); written whole or not at all")
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc, .pts), .ply, .glb, .las and .laz");
+  cmd->add_option("input", o->input, "Input file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las, .laz)")->required();
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .las, .laz); written whole or not at all")
       ->required()
       ->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals,

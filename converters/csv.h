@@ -51,6 +51,8 @@ struct CsvWriteOptions {
 Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options = {});
 // The separator a written file gets: ' ' for a path ending .xyz, .txt or .asc (any case), else ','.
 char csvSeparatorFor(const std::string& path);
+// A path ending .pts (any case): Leica's PTS text, read and written by the CSV code.
+bool isPtsPath(const std::string& path);
 // The same from an opened file, or from bytes in memory (InputFile::fromMemory).
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = {});
 

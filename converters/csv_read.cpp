@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <optional>
 
@@ -27,10 +28,10 @@ namespace {
 // Colour columns hold floats 0..1, or integers 0..255 (or 0..65535) as spreadsheets and most point
 // tools write them: where a value above 1 appears, every colour must be such an integer, and the set
 // keeps the full scale (PointSet::color_full_scale), so 255,128,0 is written back as 255,128,0.
-Status integerColors(const std::string& path, PointSet& points) {
+Status integerColors(const std::string& path, PointSet& points, bool always) {
   float largest = 0.0f;
   for (const glm::vec3& c : points.colors) largest = std::max({largest, c.r, c.g, c.b});
-  if (!(largest > 1.0f)) return okStatus();
+  if (!(largest > 1.0f) && !always) return okStatus();
   const float full = largest > 255.0f ? 65535.0f : 255.0f;
   for (size_t i = 0; i < points.colors.size(); ++i)
     for (int k = 0; k < 3; ++k) {
@@ -71,11 +72,26 @@ struct Layout {
   char separator = ',';
   std::string text;  // the header's names, or the known layout's, for messages
   std::vector<std::string> dimensions;  // the further columns' names, as the header spells them
+  // What each column holds (kRole*): by default the known layout's columns, then the dimensions
+  // in order; a PTS file's intensity sits between z and the colours.
+  std::vector<int> roles;
+  bool integer_colors = false;  // colours are 0-255 whatever their values (PTS)
 };
+// A column's role: 0-2 x, y, z; 3-5 r, g, b; kRoleDimension + k the k-th dimension.
+constexpr int kRoleDimension = 6;
 int positionColumns(Known known) { return known == Known::kXy || known == Known::kXyRgb ? 2 : 3; }
 bool hasColorColumns(const Layout& layout) { return layout.known == Known::kXyRgb || layout.known == Known::kXyzRgb; }
 
 bool isBlank(char c) { return c == ' ' || c == '\t'; }
+
+// The roles of the known layout's columns, then one for each dimension.
+std::vector<int> defaultRoles(Known known, size_t dimensions) {
+  std::vector<int> roles = {0, 1};
+  if (positionColumns(known) == 3) roles.push_back(2);
+  if (known == Known::kXyRgb || known == Known::kXyzRgb) roles.insert(roles.end(), {3, 4, 5});
+  for (size_t k = 0; k < dimensions; ++k) roles.push_back(kRoleDimension + static_cast<int>(k));
+  return roles;
+}
 
 std::string excerpt(const char* begin, const char* end) {
   return printableExcerpt(std::string_view(begin, static_cast<size_t>(end - begin)));
@@ -107,9 +123,8 @@ class LineParser {
   // set are parsed as float (a float32 dimension written in its shortest form reads back exactly).
   LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite, std::vector<double*> dimensions,
              std::vector<bool> as_float)
-      : path_(path), layout_(layout), position_columns_(positionColumns(layout.known)),
-        kept_columns_(position_columns_ + (hasColorColumns(layout) ? 3 : 0)), allow_nonfinite_(allow_nonfinite),
-        dimensions_(std::move(dimensions)), as_float_(std::move(as_float)) {}
+      : path_(path), layout_(layout), allow_nonfinite_(allow_nonfinite), dimensions_(std::move(dimensions)),
+        as_float_(std::move(as_float)) {}
 
   // Parses one line (without its line end, '\r' already removed) of row `row`. Returns false on error.
   bool parse(const char* begin, const char* end, uint64_t line, uint64_t row, glm::dvec3& position,
@@ -134,12 +149,12 @@ class LineParser {
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
       }
-      bool ok = column > kept_columns_
-                    ? parseDimension(number_begin, number_end, static_cast<size_t>(column - kept_columns_ - 1), row,
-                                     line, column, error)
-                : column <= position_columns_
-                    ? parseNumber(number_begin, number_end, values[column - 1], line, column, error)
-                    : parseNumber(number_begin, number_end, colors[column - position_columns_ - 1], line, column, error);
+      const int role = layout_.roles[static_cast<size_t>(column - 1)];
+      bool ok = role >= kRoleDimension
+                    ? parseDimension(number_begin, number_end, static_cast<size_t>(role - kRoleDimension), row, line,
+                                     column, error)
+                : role < 3 ? parseNumber(number_begin, number_end, values[role], line, column, error)
+                           : parseNumber(number_begin, number_end, colors[role - 3], line, column, error);
       if (!ok) return false;
       p = field_end;
       if (p == end) break;
@@ -210,7 +225,8 @@ class LineParser {
     if (value == T(0) && hasNonzeroMantissa(begin, end))
       return fail(std::string("is out of ") + type + " range (underflows to zero)");
     if (!allow_nonfinite_ && !std::isfinite(value)) {
-      if (column > kept_columns_ && std::isnan(value)) return true;  // an attribute may be NaN (a missing GPS time)
+      if (layout_.roles[static_cast<size_t>(column - 1)] >= kRoleDimension && std::isnan(value))
+        return true;  // an attribute may be NaN (a missing GPS time)
       return fail("is not a finite number (--allow-nonfinite accepts it)");
     }
     return true;
@@ -218,8 +234,6 @@ class LineParser {
 
   const std::string& path_;
   const Layout& layout_;
-  int position_columns_;
-  int kept_columns_;  // position and colour columns; the header's further columns are skipped
   bool allow_nonfinite_;
   std::vector<double*> dimensions_;
   std::vector<bool> as_float_;
@@ -311,7 +325,7 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
     // Further columns only after z: `x,y,w` is more likely a misspelt z than a 2D set with an extra.
     if (fields.size() > count && (known == Known::kXy || known == Known::kXyRgb)) break;
     if (std::any_of(fields.begin() + std::ptrdiff_t(count), fields.end(), known_name)) break;
-    Layout layout{known, static_cast<int>(fields.size()), separator == '\0', separator ? separator : ',', joined, {}};
+    Layout layout{known, static_cast<int>(fields.size()), separator == '\0', separator ? separator : ',', joined, {}, {}, false};
     for (size_t k = count; k < spelled.size(); ++k) {
       const std::string& name = spelled[k];
       if (name.empty())
@@ -321,6 +335,7 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
                      printableExcerpt(name) + "' is named twice"};
       layout.dimensions.push_back(name);
     }
+    layout.roles = defaultRoles(known, layout.dimensions.size());
     return layout;
   }
   const std::string split = separator == ';'   ? "split at semicolons"
@@ -334,7 +349,7 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
 Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line, char separator) {
   auto layout = [&](Known known) {
     return Layout{known, static_cast<int>(columns), separator == '\0', separator ? separator : ',',
-                  kKnownText[static_cast<int>(known)], {}};
+                  kKnownText[static_cast<int>(known)], {}, defaultRoles(known, 0), false};
   };
   if (columns == 2) return layout(Known::kXy);
   if (columns == 3) return layout(Known::kXyz);
@@ -342,6 +357,30 @@ Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64
   if (columns == 6) return layout(Known::kXyzRgb);
   return Error{path + ":" + std::to_string(line) + ": " + std::to_string(columns) +
                " columns without a header; expected 2 (x,y), 3 (x,y,z), 5 (x,y,r,g,b) or 6 (x,y,z,r,g,b)"};
+}
+
+// A PTS file's rows (Leica Cyclone, FARO, CloudCompare): x y z, x y z intensity, x y z r g b or
+// x y z intensity r g b, the colours 0-255.
+Result<Layout> layoutFromPtsColumns(const std::string& path, size_t columns, uint64_t line, char separator) {
+  Layout layout{Known::kXyz, static_cast<int>(columns), separator == '\0', separator ? separator : ',', "x y z", {}, {}, true};
+  if (columns == 3 || columns == 4) layout.known = Known::kXyz;
+  else if (columns == 6 || columns == 7) layout.known = Known::kXyzRgb;
+  else
+    return Error{path + ":" + std::to_string(line) + ": " + std::to_string(columns) +
+                 " columns in a PTS row; expected 3 (x y z), 4 (x y z intensity), 6 (x y z r g b) or 7 (x y z intensity r g b)"};
+  if (columns == 4 || columns == 7) layout.dimensions = {"intensity"};
+  layout.roles = columns == 3 ? std::vector<int>{0, 1, 2}
+                 : columns == 4 ? std::vector<int>{0, 1, 2, kRoleDimension}
+                 : columns == 6 ? std::vector<int>{0, 1, 2, 3, 4, 5}
+                                : std::vector<int>{0, 1, 2, kRoleDimension, 3, 4, 5};
+  layout.text = columns == 3 ? "x y z" : columns == 4 ? "x y z intensity" : columns == 6 ? "x y z r g b" : "x y z intensity r g b";
+  return layout;
+}
+
+// A line that is one whole number: a PTS file's point count.
+bool isCountLine(const std::vector<std::string>& fields) {
+  return fields.size() == 1 && !fields[0].empty() &&
+         std::all_of(fields[0].begin(), fields[0].end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 struct Header {
@@ -359,6 +398,10 @@ Result<Header> readHeader(const InputFile& file) {
   head.resize(*got);
   size_t pos = head.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
   uint64_t line = 0;
+  std::string extension = std::filesystem::path(file.path()).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool pts = extension == ".pts";
+  bool counted = false;
   while (true) {
     if (pos >= head.size()) {
       if (head.size() == file.size()) return Error{file.path() + ": no data rows"};
@@ -384,6 +427,12 @@ Result<Header> readHeader(const InputFile& file) {
                    excerpt(text.data(), text.data() + text.size()) + "')"};
     std::vector<std::string> fields = splitHeader(text);
     const char separator = separatorOf(text);
+    if (pts && !counted && isCountLine(fields)) {  // the count line before a PTS file's rows
+      counted = true;
+      pos = nl + 1;
+      ++line;
+      continue;
+    }
     Header header;
     if (isHeaderLine(fields)) {
       Result<Layout> layout =
@@ -394,7 +443,8 @@ Result<Header> readHeader(const InputFile& file) {
       header.first_data_line = line + 1;
       header.named = true;
     } else {
-      Result<Layout> layout = layoutFromColumns(file.path(), fields.size(), line + 1, separator);
+      Result<Layout> layout = pts ? layoutFromPtsColumns(file.path(), fields.size(), line + 1, separator)
+                                  : layoutFromColumns(file.path(), fields.size(), line + 1, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
       header.data_offset = pos;
@@ -602,7 +652,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     points.dimensions.resize(out);
   }
   narrowDimensions(points.dimensions, threads);
-  if (Status s = integerColors(path, points); !s) return s.error();
+  if (Status s = integerColors(path, points, layout.integer_colors); !s) return s.error();
   if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
   if (options.progress) options.progress->finish();
   return points;

@@ -240,8 +240,58 @@ Status CsvRowWriter::commit() {
   return file_.commit();
 }
 
+namespace {
+
+// PTS (Leica Cyclone, FARO, CloudCompare): the point count, then a row per point, x y z, its
+// intensity where the set has one, and r g b as 0-255 integers where it has colours. A PTS row has
+// no room for other dimensions: they are not written.
+Status writePts(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
+  auto file = AtomicFile::create(path);
+  if (!file.ok()) return file.error();
+  const Dimension* intensity = points.dimensions.find(dim::kIntensity);
+  std::string out = std::to_string(points.size()) + "\n";
+  char buffer[kMaxFieldChars + 64];
+  // As the CSV rows' numbers: shortest, or --decimals, or a LAS file's step with trailing zeros dropped.
+  auto number = [&](double v) {
+    char* end = buffer;
+    if (options.decimals >= 0 && std::isfinite(v)) {
+      end = formatFixed(buffer, v, options.decimals);
+      if (options.at_scale && options.decimals > 0) {
+        while (end[-1] == '0') --end;
+        if (end[-1] == '.') --end;
+      }
+    } else {
+      end = std::to_chars(buffer, buffer + sizeof(buffer), v).ptr;
+    }
+    out.append(buffer, end);
+  };
+  for (size_t i = 0; i < points.size(); ++i) {
+    const glm::dvec3& p = points.positions[i];
+    number(p.x), out += ' ', number(p.y), out += ' ', number(p.z);
+    if (intensity) out += ' ', out.append(buffer, dimensionValue(buffer, buffer + sizeof(buffer), *intensity, i));
+    if (points.hasColors())
+      for (int k = 0; k < 3; ++k) out += ' ', out += std::to_string(colorInteger(points.colors[i][k], 255.0));
+    out += '\n';
+    if (out.size() > (1u << 22)) {
+      if (Status s = file->write(out); !s) return s;
+      out.clear();
+    }
+  }
+  if (Status s = file->write(out); !s) return s;
+  return file->commit();
+}
+
+}  // namespace
+
+bool isPtsPath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".pts";
+}
+
 Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
   if (Status s = checkDecimals(options.decimals); !s) return s;
+  if (isPtsPath(path)) return writePts(path, points, options);
   if (!points.colors.empty() && points.colors.size() != points.positions.size())
     return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(points.positions.size()) + " points"};

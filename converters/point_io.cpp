@@ -63,7 +63,7 @@ class CsvPointSink final : public GltfPointSink {
 Result<FileFormat> formatOf(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == ".csv" || ext == ".xyz" || ext == ".txt" || ext == ".asc") return FileFormat::kCsv;
+  if (ext == ".csv" || ext == ".xyz" || ext == ".txt" || ext == ".asc" || ext == ".pts") return FileFormat::kCsv;
   if (ext == ".ply") return FileFormat::kPly;
   if (ext == ".glb") return FileFormat::kGlb;
   if (ext == ".gltf") return FileFormat::kGltf;
@@ -71,9 +71,9 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".laz") return FileFormat::kLaz;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
-    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .ply, .glb, .gltf, .las or .laz)",
+    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las or .laz)",
                  ExitCode::kUsage};
-  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .ply, .glb, .gltf, .las or .laz)",
+  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las or .laz)",
                ExitCode::kUsage};
 }
 

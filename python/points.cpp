@@ -421,7 +421,7 @@ stderr.)");
       py::arg("ply_colors") = "uchar", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
-      R"(Writes a set as .csv (.xyz, .txt, .asc), .ply, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
+      R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
 
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (uchar or float),
 las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does), order (input or morton), no_colors, color_format (linear or

@@ -184,7 +184,7 @@ void expectReadError(const std::string& path, const std::vector<std::string>& pa
 TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
   TempDir dir;
   struct Variant {
-    std::string name, text;
+    std::string name, text, extension = ".csv";
   };
   const std::vector<Variant> variants = {
       {"commas", "x,y,z\n1.5,-2.25,3\n4,5,6.125\n"},
@@ -200,16 +200,35 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
       {"easting_northing_elevation", "Easting,Northing,Elevation\n1.5,-2.25,3\n4,5,6.125\n"},
       {"german_utf8", "Rechtswert;Hochwert;H\xc3\xb6he\n1,5;-2,25;3\n4;5;6,125\n"},
       {"bom_crlf_upper", "\xEF\xBB\xBFX,Y,Z\r\n1.5,-2.25,3\r\n4,5,6.125\r\n"},
+      {"xyz_export", "//X Y Z\n1.5 -2.25 3\n4 5 6.125\n", ".xyz"},
+      {"txt_tabs", "1.5\t-2.25\t3\n4\t5\t6.125\n", ".txt"},
+      {"asc_upper_extension", "1.5 -2.25 3\n4 5 6.125\n", ".ASC"},
+      {"pts_count_line", "2\n1.5 -2.25 3\n4 5 6.125\n", ".pts"},
+      {"pts_intensity_colours", "2\r\n1.5 -2.25 3 -120 255 0 0\r\n4 5 6.125 2047 0 128 1\r\n", ".pts"},
+      {"pts_without_count", "1.5 -2.25 3 7\n4 5 6.125 8\n", ".pts"},
   };
   for (const Variant& v : variants) {
     SCOPED_TRACE(v.name);
-    writeFile(dir.file(v.name + ".csv"), v.text);
-    Result<PointSet> p = readCsv(dir.file(v.name + ".csv"));
+    writeFile(dir.file(v.name + v.extension), v.text);
+    Result<PointSet> p = readCsv(dir.file(v.name + v.extension));
     ASSERT_TRUE(p.ok()) << p.error().message;
     ASSERT_EQ(p->size(), 2u);
     EXPECT_EQ(p->positions[0], glm::dvec3(1.5, -2.25, 3));
     EXPECT_EQ(p->positions[1], glm::dvec3(4, 5, 6.125));
   }
+  // PTS: the intensity between z and the colours, the colours 0-255 whatever their values; a row of
+  // another width is refused by line.
+  Result<PointSet> pts = readCsv(dir.file("pts_intensity_colours.pts"));
+  ASSERT_TRUE(pts.ok()) << pts.error().message;
+  ASSERT_NE(pts->dimensions.find("intensity"), nullptr);
+  EXPECT_EQ(pts->dimensions.find("intensity")->value(0), -120.0);
+  EXPECT_EQ(pts->dimensions.find("intensity")->value(1), 2047.0);
+  EXPECT_EQ(pts->colors.at(1), glm::vec3(0.0f, 128.0f / 255.0f, 1.0f / 255.0f));
+  EXPECT_EQ(pts->color_full_scale, 255);
+  writeFile(dir.file("five.pts"), "2\n1 2 3 4 5\n");
+  expectReadError(dir.file("five.pts"), {"five.pts:2: 5 columns in a PTS row", "7 (x y z intensity r g b)"});
+  writeFile(dir.file("ragged.pts"), "2\n1 2 3 4\n1 2 3\n");
+  expectReadError(dir.file("ragged.pts"), {"ragged.pts:3: 3 columns, expected 4 (x y z intensity)"});
   // Colour words and a further column keep their meaning; a column named h after the position is
   // a dimension, not a second z.
   writeFile(dir.file("words.csv"), "X;Y;Z;Red;Green;Blue;h\n1;2;3;0,5;0,25;1;7,5\n");

@@ -1,5 +1,6 @@
-"""Open3D reads dpoint's PLY (points and meshes, binary and ASCII) and mesh GLB with the same
-values. (Open3D does not read POINTS primitives from glTF; validator_accepts_glb.py checks those.)"""
+"""Open3D reads dpoint's PLY (points and meshes, binary and ASCII), PTS and mesh GLB with the same
+values, and dpoint reads the PTS Open3D writes. (Open3D does not read POINTS primitives from glTF;
+validator_accepts_glb.py checks those.)"""
 import json
 import os
 import random
@@ -34,6 +35,22 @@ with scratch() as d:
         check(np.array_equal(got, want_points), f"point cloud {args}: positions differ (max {np.abs(got - want_points).max()})")
         check(np.allclose(np.asarray(cloud.colors), want_colors, atol=1e-7), f"point cloud {args}: colours differ")
 
+    # PTS both ways: dpoint's (count line, x y z r g b with 0-255 colours) read by Open3D, and
+    # Open3D's (x y z intensity r g b, ten decimals) read by dpoint as the points Open3D reads back.
+    pts = os.path.join(d, "cloud.pts")
+    dpoint(exe, "convert", src, "-o", pts)
+    cloud = o3d.io.read_point_cloud(pts)
+    check(np.array_equal(np.asarray(cloud.points), want_points), "PTS: Open3D reads other positions")
+    check(np.allclose(np.asarray(cloud.colors), want_colors, atol=1e-7), "PTS: Open3D reads other colours")
+    theirs = os.path.join(d, "open3d.pts")
+    check(o3d.io.write_point_cloud(theirs, cloud), "Open3D could not write PTS")
+    back = o3d.io.read_point_cloud(theirs)
+    ours = os.path.join(d, "open3d_pts.csv")
+    dpoint(exe, "convert", theirs, "-o", ours)
+    rows = np.loadtxt(ours, delimiter=",", skiprows=1)
+    check(np.array_equal(rows[:, 0:3], np.asarray(back.points)), "PTS: dpoint reads Open3D's file to other positions")
+    check(np.allclose(rows[:, 3:6] / 255.0, np.asarray(back.colors), atol=1e-7), "PTS: dpoint reads other colours")
+
     verts, faces = write_mesh_ply(os.path.join(d, "mesh_in.ply"))
     for args in ([], ["--ply-ascii"]):
         out = os.path.join(d, "mesh.ply")
@@ -59,4 +76,4 @@ with scratch() as d:
     err = np.abs(got - np.array(verts)).max()
     check(err <= 2e-7, f"mesh GLB: vertices off by {err}")
     check(np.array_equal(np.asarray(mesh.triangles), np.array(faces)), "mesh GLB: triangles differ")
-print("Open3D", o3d.__version__, "read dpoint's PLY points, PLY meshes and mesh GLB with the same values")
+print("Open3D", o3d.__version__, "read dpoint's PLY points, PLY meshes, PTS and mesh GLB with the same values; dpoint read Open3D's PTS")
