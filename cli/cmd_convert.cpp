@@ -21,6 +21,7 @@ struct ConvertOptions {
   bool ply_ascii = false;
   std::string ply_colors = "uchar";
   bool allow_nonfinite = false;
+  std::string columns;  // --columns x,y,z,-,intensity
   bool no_colors = false;
   int scene = -1;
   bool all_scenes = false;
@@ -45,6 +46,18 @@ GltfReadOptions gltfOptions(const ConvertOptions& o) {
   return g;
 }
 
+// --columns x,y,z,-,intensity as its names (none when not given).
+std::vector<std::string> columnNames(const std::string& text) {
+  std::vector<std::string> names;
+  if (text.empty()) return names;
+  for (size_t start = 0;;) {
+    const size_t comma = text.find(',', start);
+    names.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return names;
+    start = comma + 1;
+  }
+}
+
 Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   GltfReadOptions g = gltfOptions(o);
   // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
@@ -52,6 +65,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   g.triangles = !out_format || *out_format != FileFormat::kCsv;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
+  r.columns = columnNames(o.columns);
   std::vector<std::string> notices;
   r.notices = &notices;
   Result<PointSet> points = readInput(o.input, r, g);
@@ -82,7 +96,7 @@ int runConvert(ConvertOptions& o) {
   const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
   if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !o.unique && *order == PointOrder::kInput &&
-      !choose_dimensions) {
+      !choose_dimensions && o.columns.empty()) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
@@ -127,6 +141,9 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->default_str("auto")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
+  cmd->add_option("--columns", o->columns,
+                  "Text input: what each column holds, e.g. x,y,z,-,intensity: x, y, z, r, g, b (red, green, blue),\n"
+                  "- to skip a column, any other name a dimension; a header line is then passed over");
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");
   cmd->add_option("--keep", o->dimensions.keep,
                   "Keep only these dimensions (comma-separated names, as `dpoint info` lists them; none: no dimension)");

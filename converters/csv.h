@@ -36,6 +36,10 @@ struct CsvReadOptions {
   bool allow_nonfinite = false;  // accept nan/inf values instead of rejecting them
   Progress* progress = nullptr;
   uint64_t max_memory = 0;       // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
+  // --columns: what each column holds, instead of the header's names or the count's layout: x, y, z,
+  // r, g, b (red, green, blue), `-` to skip a column, any other name a dimension. A header line
+  // is then skipped.
+  std::vector<std::string> columns = {};
 };
 
 struct CsvWriteOptions {

@@ -77,8 +77,9 @@ struct Layout {
   std::vector<int> roles;
   bool integer_colors = false;  // colours are 0-255 whatever their values (PTS)
 };
-// A column's role: 0-2 x, y, z; 3-5 r, g, b; kRoleDimension + k the k-th dimension.
-constexpr int kRoleDimension = 6;
+// A column's role: 0-2 x, y, z; 3-5 r, g, b; kRoleDimension + k the k-th dimension; kRoleSkip
+// a column --columns says to pass over (`-`).
+constexpr int kRoleDimension = 6, kRoleSkip = -1;
 int positionColumns(Known known) { return known == Known::kXy || known == Known::kXyRgb ? 2 : 3; }
 bool hasColorColumns(const Layout& layout) { return layout.known == Known::kXyRgb || layout.known == Known::kXyzRgb; }
 
@@ -150,7 +151,8 @@ class LineParser {
         return false;
       }
       const int role = layout_.roles[static_cast<size_t>(column - 1)];
-      bool ok = role >= kRoleDimension
+      bool ok = role == kRoleSkip         ? true
+                : role >= kRoleDimension
                     ? parseDimension(number_begin, number_end, static_cast<size_t>(role - kRoleDimension), row, line,
                                      column, error)
                 : role < 3 ? parseNumber(number_begin, number_end, values[role], line, column, error)
@@ -377,6 +379,44 @@ Result<Layout> layoutFromPtsColumns(const std::string& path, size_t columns, uin
   return layout;
 }
 
+// The layout --columns names (CsvReadOptions::columns).
+Result<Layout> layoutFromNames(const std::string& path, const std::vector<std::string>& names, char separator) {
+  Layout layout{Known::kXyz, static_cast<int>(names.size()), separator == '\0', separator ? separator : ',', "", {}, {}, false};
+  int seen[6] = {0, 0, 0, 0, 0, 0};
+  for (const std::string& spelled : names) {
+    std::string name = spelled;
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (name == "red") name = "r";
+    if (name == "green") name = "g";
+    if (name == "blue") name = "b";
+    layout.text += (layout.text.empty() ? "" : ",") + spelled;
+    const size_t known = std::string_view("xyzrgb").find(name.size() == 1 ? name[0] : '?');
+    if (name == "-") {
+      layout.roles.push_back(kRoleSkip);
+    } else if (name.size() == 1 && known != std::string_view::npos) {
+      if (seen[known]++)
+        return Error{"--columns " + printableExcerpt(spelled) + ": named twice", ExitCode::kUsage};
+      layout.roles.push_back(static_cast<int>(known));
+    } else if (name.empty()) {
+      return Error{"--columns: an empty name (use - to skip a column)", ExitCode::kUsage};
+    } else {
+      if (std::find(layout.dimensions.begin(), layout.dimensions.end(), spelled) != layout.dimensions.end())
+        return Error{"--columns " + printableExcerpt(spelled) + ": named twice", ExitCode::kUsage};
+      layout.roles.push_back(kRoleDimension + static_cast<int>(layout.dimensions.size()));
+      layout.dimensions.push_back(spelled);
+    }
+  }
+  const int colours = seen[3] + seen[4] + seen[5];
+  if (!seen[0] || !seen[1])
+    return Error{"--columns " + layout.text + ": names no x or no y (x,y[,z][,r,g,b], - to skip, others are dimensions)",
+                 ExitCode::kUsage};
+  if (colours != 0 && colours != 3)
+    return Error{"--columns " + layout.text + ": colours need all of r, g and b", ExitCode::kUsage};
+  layout.known = seen[2] ? (colours ? Known::kXyzRgb : Known::kXyz) : (colours ? Known::kXyRgb : Known::kXy);
+  (void)path;
+  return layout;
+}
+
 // A line that is one whole number: a PTS file's point count.
 bool isCountLine(const std::vector<std::string>& fields) {
   return fields.size() == 1 && !fields[0].empty() &&
@@ -391,7 +431,7 @@ struct Header {
 };
 
 // Finds the layout from the first non-blank line, skipping a UTF-8 BOM.
-Result<Header> readHeader(const InputFile& file) {
+Result<Header> readHeader(const InputFile& file, const std::vector<std::string>& columns) {
   std::string head(std::min<uint64_t>(file.size(), kMaxLineLength + 4), '\0');
   Result<size_t> got = file.readAt(0, head.data(), head.size());
   if (!got) return got.error();
@@ -434,6 +474,16 @@ Result<Header> readHeader(const InputFile& file) {
       continue;
     }
     Header header;
+    if (!columns.empty()) {  // --columns: the names are given; a header line is passed over
+      Result<Layout> layout = layoutFromNames(file.path(), columns, separator);
+      if (!layout) return layout.error();
+      header.layout = *layout;
+      const bool named = isHeaderLine(fields);
+      header.data_offset = named ? std::min<uint64_t>(nl + 1, file.size()) : pos;
+      header.first_data_line = named ? line + 1 : line;
+      header.named = named;
+      return header;
+    }
     if (isHeaderLine(fields)) {
       Result<Layout> layout =
           layoutFromHeader(file.path(), std::move(fields), splitHeader(text, true), line + 1, text, separator);
@@ -488,7 +538,7 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options)
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   const std::string& path = file.path();
   if (file.size() == 0) return Error{path + ": empty file"};
-  Result<Header> header_result = readHeader(file);
+  Result<Header> header_result = readHeader(file, options.columns);
   if (!header_result) return header_result.error();
   const Header header = *header_result;
   const Layout& layout = header.layout;

@@ -119,9 +119,13 @@ Status checkWrittenFormat(const std::string& path, FileFormat format) {
 namespace {
 
 Result<PointSet> readByFormat(const std::string& path, FileFormat format, const ReadOptions& options) {
+  if (!options.columns.empty() && format != FileFormat::kCsv)
+    return Error{"--columns: " + path + " is not a text file (.csv, .xyz, .txt, .asc, .pts); its fields have their names",
+                 ExitCode::kUsage};
   switch (format) {
     case FileFormat::kCsv:
-      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory});
+      return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory,
+                                          options.columns});
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
                                           options.max_memory});

@@ -48,6 +48,8 @@ struct ReadOptions {
   LasColorSource las_color = LasColorSource::kAuto;
   // When not null, gets one line per thing the reader read past (a CSV header's further columns).
   std::vector<std::string>* notices = nullptr;
+  // Text files: what each column holds (CsvReadOptions::columns); an error for other formats.
+  std::vector<std::string> columns = {};
 };
 
 struct WriteOptions {

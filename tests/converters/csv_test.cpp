@@ -185,6 +185,7 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
   TempDir dir;
   struct Variant {
     std::string name, text, extension = ".csv";
+    std::vector<std::string> columns = {};  // --columns
   };
   const std::vector<Variant> variants = {
       {"commas", "x,y,z\n1.5,-2.25,3\n4,5,6.125\n"},
@@ -206,11 +207,15 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
       {"pts_count_line", "2\n1.5 -2.25 3\n4 5 6.125\n", ".pts"},
       {"pts_intensity_colours", "2\r\n1.5 -2.25 3 -120 255 0 0\r\n4 5 6.125 2047 0 128 1\r\n", ".pts"},
       {"pts_without_count", "1.5 -2.25 3 7\n4 5 6.125 8\n", ".pts"},
+      {"columns_skip_an_id", "id;Rechts;Hoch;Z\n7;1,5;-2,25;3\n8;4;5;6,125\n", ".csv", {"-", "x", "y", "z"}},
+      {"columns_in_another_order", "3 1.5 -2.25 0.5\n6.125 4 5 0.25\n", ".txt", {"z", "X", "y", "quality"}},
   };
   for (const Variant& v : variants) {
     SCOPED_TRACE(v.name);
     writeFile(dir.file(v.name + v.extension), v.text);
-    Result<PointSet> p = readCsv(dir.file(v.name + v.extension));
+    CsvReadOptions options;
+    options.columns = v.columns;
+    Result<PointSet> p = readCsv(dir.file(v.name + v.extension), options);
     ASSERT_TRUE(p.ok()) << p.error().message;
     ASSERT_EQ(p->size(), 2u);
     EXPECT_EQ(p->positions[0], glm::dvec3(1.5, -2.25, 3));
@@ -227,6 +232,21 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
   EXPECT_EQ(pts->color_full_scale, 255);
   writeFile(dir.file("five.pts"), "2\n1 2 3 4 5\n");
   expectReadError(dir.file("five.pts"), {"five.pts:2: 5 columns in a PTS row", "7 (x y z intensity r g b)"});
+  CsvReadOptions quality;
+  quality.columns = {"z", "x", "y", "quality"};
+  Result<PointSet> named = readCsv(dir.file("columns_in_another_order.txt"), quality);
+  ASSERT_TRUE(named.ok()) << named.error().message;
+  ASSERT_NE(named->dimensions.find("quality"), nullptr);
+  EXPECT_EQ(named->dimensions.find("quality")->value(1), 0.25);
+  // --columns that do not fit the rows, or name no y, are refused: by line, or as a usage error.
+  quality.columns = {"x", "y", "z"};
+  Result<PointSet> narrow = readCsv(dir.file("columns_in_another_order.txt"), quality);
+  ASSERT_FALSE(narrow.ok());
+  EXPECT_TRUE(test::contains(narrow.error().message, "columns_in_another_order.txt:1: 4 columns, expected 3 (x,y,z)"));
+  quality.columns = {"x", "-", "z"};
+  Result<PointSet> no_y = readCsv(dir.file("columns_in_another_order.txt"), quality);
+  ASSERT_FALSE(no_y.ok());
+  EXPECT_EQ(no_y.error().code, ExitCode::kUsage);
   writeFile(dir.file("ragged.pts"), "2\n1 2 3 4\n1 2 3\n");
   expectReadError(dir.file("ragged.pts"), {"ragged.pts:3: 3 columns, expected 4 (x y z intensity)"});
   // Colour words and a further column keep their meaning; a column named h after the position is
