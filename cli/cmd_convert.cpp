@@ -10,6 +10,7 @@
 #include "converters/gltf_read.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
+#include "core/text.h"
 #include "ops/point_order.h"
 
 namespace dpoint {
@@ -46,18 +47,6 @@ GltfReadOptions gltfOptions(const ConvertOptions& o) {
   return g;
 }
 
-// --columns x,y,z,-,intensity as its names (none when not given).
-std::vector<std::string> columnNames(const std::string& text) {
-  std::vector<std::string> names;
-  if (text.empty()) return names;
-  for (size_t start = 0;;) {
-    const size_t comma = text.find(',', start);
-    names.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) return names;
-    start = comma + 1;
-  }
-}
-
 Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   GltfReadOptions g = gltfOptions(o);
   // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
@@ -65,7 +54,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   g.triangles = !out_format || *out_format != FileFormat::kCsv;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
-  r.columns = columnNames(o.columns);
+  if (!o.columns.empty()) r.columns = splitAt(o.columns, ',');
   std::vector<std::string> notices;
   r.notices = &notices;
   Result<PointSet> points = readInput(o.input, r, g);

@@ -11,7 +11,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <mutex>
 #include <optional>
 
@@ -47,8 +46,6 @@ Status integerColors(const std::string& path, PointSet& points, bool always) {
   return okStatus();
 }
 
-}  // namespace
-namespace {
 
 constexpr size_t kBlockSize = 8u << 20;
 // Longest line accepted: a row of six fixed-format DBL_MAX values fits in about 2 KB; anything far
@@ -81,7 +78,8 @@ struct Layout {
 // a column --columns says to pass over (`-`).
 constexpr int kRoleDimension = 6, kRoleSkip = -1;
 int positionColumns(Known known) { return known == Known::kXy || known == Known::kXyRgb ? 2 : 3; }
-bool hasColorColumns(const Layout& layout) { return layout.known == Known::kXyRgb || layout.known == Known::kXyzRgb; }
+bool hasColors(Known known) { return known == Known::kXyRgb || known == Known::kXyzRgb; }
+bool hasColorColumns(const Layout& layout) { return hasColors(layout.known); }
 
 bool isBlank(char c) { return c == ' ' || c == '\t'; }
 
@@ -89,7 +87,7 @@ bool isBlank(char c) { return c == ' ' || c == '\t'; }
 std::vector<int> defaultRoles(Known known, size_t dimensions) {
   std::vector<int> roles = {0, 1};
   if (positionColumns(known) == 3) roles.push_back(2);
-  if (known == Known::kXyRgb || known == Known::kXyzRgb) roles.insert(roles.end(), {3, 4, 5});
+  if (hasColors(known)) roles.insert(roles.end(), {3, 4, 5});
   for (size_t k = 0; k < dimensions; ++k) roles.push_back(kRoleDimension + static_cast<int>(k));
   return roles;
 }
@@ -269,13 +267,7 @@ std::vector<std::string> splitHeader(std::string_view line, bool spelled = false
     }
     return fields;
   }
-  size_t start = 0;
-  while (true) {
-    size_t at = line.find(separator, start);
-    add(line.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start));
-    if (at == std::string_view::npos) break;
-    start = at + 1;
-  }
+  for (const std::string& field : splitAt(line, separator)) add(field);
   return fields;
 }
 
@@ -380,7 +372,7 @@ Result<Layout> layoutFromPtsColumns(const std::string& path, size_t columns, uin
 }
 
 // The layout --columns names (CsvReadOptions::columns).
-Result<Layout> layoutFromNames(const std::string& path, const std::vector<std::string>& names, char separator) {
+Result<Layout> layoutFromNames(const std::vector<std::string>& names, char separator) {
   Layout layout{Known::kXyz, static_cast<int>(names.size()), separator == '\0', separator ? separator : ',', "", {}, {}, false};
   int seen[6] = {0, 0, 0, 0, 0, 0};
   for (const std::string& spelled : names) {
@@ -413,7 +405,6 @@ Result<Layout> layoutFromNames(const std::string& path, const std::vector<std::s
   if (colours != 0 && colours != 3)
     return Error{"--columns " + layout.text + ": colours need all of r, g and b", ExitCode::kUsage};
   layout.known = seen[2] ? (colours ? Known::kXyzRgb : Known::kXyz) : (colours ? Known::kXyRgb : Known::kXy);
-  (void)path;
   return layout;
 }
 
@@ -438,9 +429,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
   head.resize(*got);
   size_t pos = head.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
   uint64_t line = 0;
-  std::string extension = std::filesystem::path(file.path()).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const bool pts = extension == ".pts";
+  const bool pts = isPtsPath(file.path());
   bool counted = false;
   while (true) {
     if (pos >= head.size()) {
@@ -475,7 +464,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
     }
     Header header;
     if (!columns.empty()) {  // --columns: the names are given; a header line is passed over
-      Result<Layout> layout = layoutFromNames(file.path(), columns, separator);
+      Result<Layout> layout = layoutFromNames(columns, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
       const bool named = isHeaderLine(fields);

@@ -12,12 +12,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 
 #include "core/atomic_file.h"
 #include "converters/csv.h"
 #include "core/fixed_format.h"
 #include "core/parallel.h"
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -38,6 +38,23 @@ char* dimensionValue(char* p, char* limit, const Dimension& d, size_t i) {
     case DimType::kI64: r = std::to_chars(p, limit, d.get<int64_t>(i)); break;
     default: r = std::to_chars(p, limit, static_cast<int64_t>(d.value(i))); break;
   }
+  assert(r.ec == std::errc());
+  return r.ptr;
+}
+
+// A coordinate as the rows write it: shortest round trip (decimals < 0), `decimals` fixed digits, or
+// with at_scale (decimals ≥ 0) the value at the file's step: "849087.70" is written "849087.7",
+// "12.00" "12".
+char* formatCoordinate(char* p, char* limit, double v, int decimals, bool at_scale) {
+  if (at_scale && std::isfinite(v)) {
+    char* end = formatFixed(p, v, decimals);
+    if (decimals == 0) return end;
+    while (end[-1] == '0') --end;
+    return end[-1] == '.' ? end - 1 : end;
+  }
+  if (decimals >= 0 && std::isfinite(v)) return formatFixed(p, v, decimals);
+  std::to_chars_result r = decimals < 0 ? std::to_chars(p, limit, v)
+                                        : std::to_chars(p, limit, v, std::chars_format::fixed, decimals);
   assert(r.ec == std::errc());
   return r.ptr;
 }
@@ -104,20 +121,7 @@ class RowFormatter {
   }
 
  private:
-  char* number(char* p, char* limit, double v) const {
-    if (at_scale_ && std::isfinite(v)) {
-      // The value at the file's step: "849087.70" is written "849087.7", "12.00" "12".
-      char* end = formatFixed(p, v, decimals_);
-      if (decimals_ == 0) return end;
-      while (end[-1] == '0') --end;
-      return end[-1] == '.' ? end - 1 : end;
-    }
-    if (decimals_ >= 0 && std::isfinite(v)) return formatFixed(p, v, decimals_);
-    std::to_chars_result r = decimals_ < 0 ? std::to_chars(p, limit, v)
-                                           : std::to_chars(p, limit, v, std::chars_format::fixed, decimals_);
-    assert(r.ec == std::errc());
-    return r.ptr;
-  }
+  char* number(char* p, char* limit, double v) const { return formatCoordinate(p, limit, v, decimals_, at_scale_); }
   char* color(char* p, char* limit, float v) const {
     if (color_full_scale_) {  // the integers the colours were read as: 255 stays 255
       std::to_chars_result r = std::to_chars(p, limit, colorInteger(v, color_full_scale_));
@@ -251,19 +255,9 @@ Status writePts(const std::string& path, const PointSet& points, const CsvWriteO
   const Dimension* intensity = points.dimensions.find(dim::kIntensity);
   std::string out = std::to_string(points.size()) + "\n";
   char buffer[kMaxFieldChars + 64];
-  // As the CSV rows' numbers: shortest, or --decimals, or a LAS file's step with trailing zeros dropped.
+  const bool at_scale = options.at_scale && options.decimals >= 0;
   auto number = [&](double v) {
-    char* end = buffer;
-    if (options.decimals >= 0 && std::isfinite(v)) {
-      end = formatFixed(buffer, v, options.decimals);
-      if (options.at_scale && options.decimals > 0) {
-        while (end[-1] == '0') --end;
-        if (end[-1] == '.') --end;
-      }
-    } else {
-      end = std::to_chars(buffer, buffer + sizeof(buffer), v).ptr;
-    }
-    out.append(buffer, end);
+    out.append(buffer, formatCoordinate(buffer, buffer + sizeof(buffer), v, options.decimals, at_scale));
   };
   for (size_t i = 0; i < points.size(); ++i) {
     const glm::dvec3& p = points.positions[i];
@@ -283,11 +277,7 @@ Status writePts(const std::string& path, const PointSet& points, const CsvWriteO
 
 }  // namespace
 
-bool isPtsPath(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".pts";
-}
+bool isPtsPath(const std::string& path) { return lowerExtension(path) == ".pts"; }
 
 Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
   if (Status s = checkDecimals(options.decimals); !s) return s;
@@ -307,8 +297,7 @@ Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteO
 }
 
 char csvSeparatorFor(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lowerExtension(path);
   return ext == ".xyz" || ext == ".txt" || ext == ".asc" ? ' ' : ',';
 }
 

@@ -61,8 +61,7 @@ class CsvPointSink final : public GltfPointSink {
 }  // namespace
 
 Result<FileFormat> formatOf(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   if (ext == ".csv" || ext == ".xyz" || ext == ".txt" || ext == ".asc" || ext == ".pts") return FileFormat::kCsv;
   if (ext == ".ply") return FileFormat::kPly;
   if (ext == ".glb") return FileFormat::kGlb;
@@ -264,14 +263,9 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
 }
 
 Status selectDimensions(PointSet& points, const DimensionChoice& choice, const std::string& what) {
-  const auto names = [](const std::string& list) {
-    std::vector<std::string> out;
-    for (size_t start = 0; start <= list.size();) {
-      size_t comma = list.find(',', start);
-      if (comma == std::string::npos) comma = list.size();
-      if (comma > start) out.push_back(list.substr(start, comma - start));
-      start = comma + 1;
-    }
+  const auto names = [](const std::string& list) {  // empty names (a doubled comma) are passed over
+    std::vector<std::string> out = splitAt(list, ',');
+    std::erase(out, std::string());
     return out;
   };
   const auto check = [&](const std::string& option, const std::vector<std::string>& asked) -> Status {

@@ -1,10 +1,29 @@
 #include "core/text.h"
 
+#include <filesystem>
+
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 
 namespace dpoint {
+
+std::vector<std::string> splitAt(std::string_view text, char separator) {
+  std::vector<std::string> fields;
+  for (size_t start = 0;;) {
+    const size_t at = text.find(separator, start);
+    fields.emplace_back(text.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start));
+    if (at == std::string_view::npos) return fields;
+    start = at + 1;
+  }
+}
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
 
 std::string formatNumber(double v, bool json) {
   if (json && !std::isfinite(v)) return "null";

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace dpoint {
 
@@ -85,6 +86,13 @@ inline bool parseDecimalU64(std::string_view text, uint64_t& value) {
   }
   return true;
 }
+
+// `text` split at every `separator`, empty fields kept ("a,,b": a, "", b; "": one empty field).
+std::vector<std::string> splitAt(std::string_view text, char separator);
+
+// A path's extension in lower case, with its dot (".las" for "SCAN.LAS"), "" when it has none: what
+// the readers and writers choose a format by.
+std::string lowerExtension(const std::string& path);
 
 // Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
 std::string formatNumber(double v, bool json = false);

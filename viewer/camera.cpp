@@ -21,9 +21,9 @@
 namespace dpoint {
 namespace {
 
-// Framing margins: the fit leaves 2% around the box; far sits 1% beyond the farthest corner and
-// near 1% before the nearest one, so no box point is clipped by the rounding of the planes.
-constexpr double kFitMargin = 1.02;
+// Framing margins (kFitMargin in camera.h: the fit leaves 2% around the box); far sits 1% beyond
+// the farthest corner and near 1% before the nearest one, so no box point is clipped by the
+// rounding of the planes.
 constexpr double kFarMargin = 1.01;
 constexpr double kNearMargin = 0.99;
 // A perspective near plane never closer than far · 1e-6: with reversed Z in float, depth keeps

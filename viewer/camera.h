@@ -22,6 +22,9 @@
 
 namespace dpoint {
 
+// The fit frames the data in 1 / kFitMargin of the picture: 1% of it free on each side.
+inline constexpr double kFitMargin = 1.02;
+
 struct CameraSpec {
   uint32_t width = 1024, height = 768;
   // Perspective look-at when eye, target and up are all set (orthographic if ortho is true);

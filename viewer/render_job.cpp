@@ -48,9 +48,8 @@ constexpr double kRoundShare = 1.3, kSquareShare = 1.0;
 // The most point pixels a default size draws, in pictures' worth: a sparse set's points grow up to
 // their spacing (a survey of 1,065 points reads as a surface), a dense set's stay at most 8 px.
 constexpr double kPointPixelBudget = 32.0;
-// The share of the picture's smaller side the fit leaves free on both sides together (camera.cpp's
-// kFitMargin, 1.02).
-constexpr double kFitMarginShare = 1.0 - 1.0 / 1.02;
+// The share of the picture's smaller side the fit leaves free on both sides together.
+constexpr double kFitMarginShare = 1.0 - 1.0 / kFitMargin;
 
 struct LoadedSet {
   std::string inputs;  // describeInputs: for messages

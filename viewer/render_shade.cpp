@@ -94,14 +94,28 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
   return okStatus();
 }
 
+namespace {
+
+// Reversed-Z perspective depth is n(f − t) / (t(f − n)) at eye distance t, so
+// t = f / (1 + depth · (f − n) / n): the shaders need only (f − n) / n; 0 for ortho.
+float depthScale(const Camera& camera) {
+  return camera.ortho ? 0.0f : static_cast<float>((camera.far_plane - camera.near_plane) / camera.near_plane);
+}
+
+// What one pixel spans: 2 / (focal · height) of the eye distance in perspective (focal =
+// P[1][1] / P[2][3]), 2 · P[2][2] / (|P[1][1]| · height) of the depth range in ortho.
+double pixelDepthSpan(const Camera& camera) {
+  const glm::dmat4& p = camera.projection;
+  return camera.ortho ? 2.0 * p[2][2] / (std::abs(p[1][1]) * camera.height) : 2.0 * p[2][3] / (p[1][1] * camera.height);
+}
+
+}  // namespace
+
 EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_size) {
   EdlPush push;
   push.width = camera.width;
   push.height = camera.height;
-  // Reversed-Z perspective depth is n(f − t) / (t(f − n)) at eye distance t, so
-  // t = f / (1 + depth · (f − n) / n); the shader needs only (f − n) / n.
-  push.depth_scale = camera.ortho ? 0.0f
-                                  : static_cast<float>((camera.far_plane - camera.near_plane) / camera.near_plane);
+  push.depth_scale = depthScale(camera);
   push.strength = options.strength;
   const ShadeRadii radii = shadeRadii(point_size, options.radius, options.fuse);
   push.edl_axis = radii.edl_axis;
@@ -110,25 +124,15 @@ EdlPush edlPush(const Camera& camera, const EdlOptions& options, float point_siz
   push.padded_width = camera.width + 2 * push.margin;
   // Hole filling's threshold: the change in log2 eye distance over its radius across a surface at
   // 72° to the view (slope 3), so the steps within one surface never count as standing in front.
-  // A pixel spans 2 / (focal · height) of the distance in perspective (focal = P[1][1] / P[2][3])
-  // and 2 · P[2][2] / (|P[1][1]| · height) of the depth range in ortho.
-  const glm::dmat4& p = camera.projection;
-  const double pixel = camera.ortho ? 2.0 * p[2][2] / (std::abs(p[1][1]) * camera.height)
-                                    : 2.0 * p[2][3] / (p[1][1] * camera.height);
-  push.fill_threshold = static_cast<float>(3.0 * radii.fill * pixel / std::log(2.0));
+  push.fill_threshold = static_cast<float>(3.0 * radii.fill * pixelDepthSpan(camera) / std::log(2.0));
   return push;
 }
 
 void roundPointPush(const Camera& camera, const RenderOptions& options, float& depth_scale, float& bulge) {
   depth_scale = bulge = 0.0f;
   if (!options.round_points || options.point_size <= 1.0f) return;
-  // A pixel spans 2 |P[2][3]| / (|P[1][1]| · height) of the eye distance in perspective, and
-  // 2 |P[2][2]| / (|P[1][1]| · height) of the depth range in ortho (as edlPush's threshold).
-  const glm::dmat4& p = camera.projection;
-  const double pixel = 2.0 * std::abs(camera.ortho ? p[2][2] : p[2][3]) / (std::abs(p[1][1]) * camera.height);
-  depth_scale = camera.ortho ? 0.0f
-                             : static_cast<float>((camera.far_plane - camera.near_plane) / camera.near_plane);
-  bulge = static_cast<float>(0.5 * options.point_size * pixel);
+  depth_scale = depthScale(camera);
+  bulge = static_cast<float>(0.5 * options.point_size * pixelDepthSpan(camera));
 }
 
 void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& push, bool raster) {

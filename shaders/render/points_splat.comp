@@ -99,9 +99,10 @@ void splat(uint i, vec4 clip) {
     atomicMax(visibility[pixel], key);
     return;
   }
-  // A larger point is the rasterizer's square (or, with kRound, its inscribed disc): the pixels whose centres lie in [x − s/2, x + s/2) ×
+  // A larger point is the rasterizer's square: the pixels whose centres lie in [x − s/2, x + s/2) ×
   // [y − s/2, y + s/2), each tested at the point's one depth, as the raster depth test does, so the
-  // depth test stays exact (a key per pixel) and the picture is the raster one. Clipped by its centre
+  // depth test stays exact (a key per pixel) and the picture is the raster one; with kRound, the
+  // disc inscribed in that square, each pixel at its own depth. Clipped by its centre
   // (above), then to the picture. s² atomics a point at most: the sizes pointSizeFor picks are small
   // where the points are many, and kEarlyDepth skips most of them on a closed surface.
   uint64_t key = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(~index);

@@ -161,26 +161,12 @@ TEST_P(Adaptive, straddlingBatchesAreDrawnAndCulledOnesAreNeverRead) {
   }
 }
 
-// Orthographic, straight down −z, 128 × 128 pixels 0.01 wide around the origin: points at one x, y
-// share a pixel whatever their z (the orthoCamera helpers leave 3D sets to the oblique
-// perspective fit).
-Camera topDownCamera(const PointSet& s) {
-  CameraSpec spec;
-  spec.width = spec.height = 128;
-  spec.ortho = true;
-  spec.view_center = glm::dvec3(0.0);
-  spec.view_width = 1.28;
-  Result<Camera> camera = makeCamera(spec, boundsOf(s));
-  EXPECT_TRUE(camera.ok()) << camera.error().message;
-  return *camera;
-}
-
 // `s` drawn top-down in `mode` on the compute backend twice: with early depth off (no merge, one
 // atomic a point) and with it on and `merge` applied to the options; the pictures must be the same.
 // Returns how many pixels the merged picture draws (the background is opaque black).
 size_t expectMergeKeepsThePicture(const VulkanContext& context, const PointSet& s, PrecisionMode mode,
                                   void (*merge)(RenderOptions&)) {
-  const Camera camera = topDownCamera(s);
+  const Camera camera = topDownCamera(s, 1.28, 128);  // pixels 0.01 wide
   RenderOptions options;
   options.mode = mode;
   options.backend = Backend::kCompute;

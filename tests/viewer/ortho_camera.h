@@ -34,4 +34,17 @@ inline Camera orthoCamera(const PointSet& fit, const glm::dvec3& centre, double 
   return *camera;
 }
 
+// Orthographic whatever the set (a 3D one too), straight down −z, `side`² pixels, `width` across,
+// centred on the origin: points at one x, y share a pixel whatever their z.
+inline Camera topDownCamera(const PointSet& fit, double width, uint32_t side) {
+  CameraSpec spec;
+  spec.width = spec.height = side;
+  spec.ortho = true;
+  spec.view_center = glm::dvec3(0.0);
+  spec.view_width = width;
+  Result<Camera> camera = makeCamera(spec, boundsOf(fit));
+  EXPECT_TRUE(camera.ok()) << camera.error().message;
+  return *camera;
+}
+
 }  // namespace dpoint

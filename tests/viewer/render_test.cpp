@@ -13,6 +13,7 @@
 #include "viewer/probe.h"
 #include "viewer/render.h"
 #include "viewer/selftest.h"
+#include "ortho_camera.h"
 #include "render_test_support.h"
 
 namespace dpoint {
@@ -372,19 +373,13 @@ TEST_P(Render, roundPointsAreTheSameDiscsOnBothBackends) {
   PointSet lone;
   lone.positions = {glm::dvec3(0.0, 0.0, 0.0), glm::dvec3(0.0, 0.0, 0.5)};
   lone.colors = {glm::vec3(1.0f), glm::vec3(1.0f)};
-  CameraSpec centred;
-  centred.width = centred.height = 63;
-  centred.ortho = true;
-  centred.view_center = glm::dvec3(0.0);
-  centred.view_width = 1.0;
-  Result<Camera> camera = makeCamera(centred, boundsOf(lone));
-  ASSERT_TRUE(camera.ok()) << camera.error().message;
+  const Camera camera = topDownCamera(lone, 1.0, 63);
   for (Backend backend : {Backend::kRaster, Backend::kCompute}) {
     RenderOptions options;
     options.point_size = 9.0f;
     options.round_points = true;
     options.backend = backend;
-    Result<RenderResult> r = renderPoints(*context_, lone, *camera, options);
+    Result<RenderResult> r = renderPoints(*context_, lone, camera, options);
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(litPixels(r->image, options.background_rgba8), 69u) << (backend == Backend::kCompute ? "compute" : "raster");
   }
