@@ -1,4 +1,4 @@
-// dpoint convert IN -o OUT: CSV, PLY, GLB and LAS in any direction, and glTF/GLB input with scene
+// dpoint convert IN -o OUT: text, PLY, PCD, GLB and LAS in any direction, and glTF/GLB input with scene
 // selection (converters/gltf_read.h says what a glTF file turns into, converters/las.h a LAS file).
 #include <cstdio>
 #include <memory>
@@ -21,6 +21,7 @@ struct ConvertOptions {
   int decimals = -1;
   bool ply_ascii = false;
   std::string ply_colors = "uchar";
+  std::string pcd_encoding = "binary";
   bool allow_nonfinite = false;
   std::string columns;  // --columns x,y,z,-,intensity
   bool no_colors = false;
@@ -76,6 +77,7 @@ int runConvert(ConvertOptions& o) {
   w.decimals = o.decimals;
   w.ply_encoding = o.ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
   w.ply_colors = o.ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
+  w.pcd_encoding = *parsePcdEncoding(o.pcd_encoding);  // checked by the option's validator
   w.progress = &progress;
   w.las_scale = o.las_scale;
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
@@ -109,9 +111,9 @@ int runConvert(ConvertOptions& o) {
 
 void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc, .pts), .ply, .glb, .las and .laz");
-  cmd->add_option("input", o->input, "Input file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las, .laz)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .las, .laz); written whole or not at all")
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc, .pts), .ply, .pcd, .glb, .las and .laz");
+  cmd->add_option("input", o->input, "Input file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .gltf, .las, .laz)")->required();
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz); written whole or not at all")
       ->required()
       ->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals,
@@ -122,6 +124,10 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--ply-colors", o->ply_colors, "PLY: colour property type")
       ->check(oneOf("--ply-colors", {"uchar", "float"}))
       ->default_val("uchar");
+  cmd->add_option("--pcd-encoding", o->pcd_encoding,
+                  "PCD: DATA ascii, binary (rows of the fields) or binary_compressed (LZF, the smallest)")
+      ->check(oneOf("--pcd-encoding", {"ascii", "binary", "binary_compressed"}))
+      ->default_val("binary");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "
                   "down to a whole number); a point beyond the 32-bit integers at this step is an error (exit 2). "

@@ -66,13 +66,14 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".ply") return FileFormat::kPly;
   if (ext == ".glb") return FileFormat::kGlb;
   if (ext == ".gltf") return FileFormat::kGltf;
+  if (ext == ".pcd") return FileFormat::kPcd;
   if (ext == ".las") return FileFormat::kLas;
   if (ext == ".laz") return FileFormat::kLaz;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
-    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las or .laz)",
+    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .gltf, .las or .laz)",
                  ExitCode::kUsage};
-  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las or .laz)",
+  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .gltf, .las or .laz)",
                ExitCode::kUsage};
 }
 
@@ -111,7 +112,7 @@ Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query,
 
 Status checkWrittenFormat(const std::string& path, FileFormat format) {
   if (format == FileFormat::kGltf)
-    return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .las)", ExitCode::kUsage};
+    return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .pcd, .las)", ExitCode::kUsage};
   return okStatus();
 }
 
@@ -128,6 +129,9 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
                                           options.max_memory});
+    case FileFormat::kPcd:
+      return readPcd(path, PcdReadOptions{options.allow_nonfinite, options.progress, options.threads, options.max_memory,
+                                          options.notices});
     case FileFormat::kGlb:
     case FileFormat::kGltf: {
       GltfReadOptions gltf;
@@ -196,6 +200,8 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
                       CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale});
     case FileFormat::kPly:
       return writePly(path, points, PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress});
+    case FileFormat::kPcd:
+      return writePcd(path, points, PcdWriteOptions{options.pcd_encoding, options.progress, options.notices});
     case FileFormat::kGlb:
       if (points.positions.empty())  // named here: writeGlb's message does not know the path
         return Error{path + ": " + writeGlb(path, points).error().message};

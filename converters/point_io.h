@@ -1,5 +1,5 @@
-// Reading and writing a PointSet by file extension: .csv, .ply, .glb (and .gltf input), .las (and
-// .laz input: converters/laz_decode.h), and glTF/GLB to CSV streamed without a PointSet.
+// Reading and writing a PointSet by file extension: text (.csv, .xyz, .txt, .asc, .pts), .ply, .pcd,
+// .glb (and .gltf input), .las, .laz and .copc.laz, and glTF/GLB to CSV streamed without a PointSet.
 #pragma once
 
 #include <optional>
@@ -9,6 +9,7 @@
 #include "converters/copc.h"
 #include "converters/csv.h"
 #include "converters/las.h"
+#include "converters/pcd.h"
 #include "converters/ply.h"
 #include "core/point_set.h"
 #include "core/result.h"
@@ -16,7 +17,7 @@
 
 namespace dpoint {
 
-enum class FileFormat { kCsv, kPly, kGlb, kGltf, kLas, kLaz };
+enum class FileFormat { kCsv, kPly, kPcd, kGlb, kGltf, kLas, kLaz };
 
 // From the extension, case-insensitive. Error names the path and the extensions accepted.
 Result<FileFormat> formatOf(const std::string& path);
@@ -58,6 +59,7 @@ struct WriteOptions {
   bool decimals_at_scale = false;  // CSV: decimals is the input's step (CsvWriteOptions::at_scale)
   PlyEncoding ply_encoding = PlyEncoding::kBinary;
   PlyColorType ply_colors = PlyColorType::kUchar;
+  PcdEncoding pcd_encoding = PcdEncoding::kBinary;
   Progress* progress = nullptr;
   double las_scale = 0.0;  // LAS: the coordinate step for x, y and z; 0: the source's, else 0.001 (converters/las.h)
   // When not null, gets one line per thing the file cannot hold as given (GLB: points that will

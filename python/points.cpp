@@ -378,7 +378,7 @@ that memory, without copying (writing into them changes the set).)")
       py::arg("path"), py::kw_only(), py::arg("threads") = 0u, py::arg("allow_nonfinite") = false,
       py::arg("colors") = "auto", py::arg("max_memory") = py::none(), py::arg("scene") = -1,
       py::arg("all_scenes") = false, py::arg("max_points") = uint64_t{0}, py::arg("progress") = false,
-      R"(Reads a .csv, .ply, .las, .glb or .gltf file (by extension) as `dpoint convert` does.
+      R"(Reads a .csv (or .xyz, .txt, .asc, .pts), .ply, .pcd, .las, .laz, .glb or .gltf file (by extension) as `dpoint convert` does.
 
 colors: LAS colour source (auto, rgb, intensity, classification, none); other formats take auto,
 rgb or none. scene / all_scenes: glTF scenes (as --scene, --all-scenes). max_memory: bytes or
@@ -388,7 +388,8 @@ stderr.)");
   m.def(
       "write",
       [](const std::shared_ptr<PointSet>& points, const std::string& path, int decimals, bool ply_ascii,
-         const std::string& ply_colors, std::optional<double> las_scale, const std::string& order, bool no_colors,
+         const std::string& ply_colors, const std::string& pcd_encoding, std::optional<double> las_scale,
+         const std::string& order, bool no_colors,
          const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
         // As convert's --decimals (0..100; -1 here: shortest round trip) and --las-scale (> 0), whatever the format.
         if (decimals < -1 || decimals > 100)
@@ -401,6 +402,7 @@ stderr.)");
         if (color_format != "linear" && color_format != "srgb8")
           raise(Error{"color_format: '" + color_format + "' is not linear or srgb8", ExitCode::kUsage});
         const PointOrder point_order = take(parsePointOrder("order", order));
+        const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding));
         const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
         check(released([&] {
@@ -409,6 +411,7 @@ stderr.)");
           w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale.value_or(0.0);
           w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
           w.ply_colors = ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
+          w.pcd_encoding = pcd;
           const ColorFilters colors{no_colors, color_format == "srgb8"};
           if (!colors.drop && !colors.srgb8 && !unique && point_order == PointOrder::kInput)
             return writePoints(path, *points, w);
@@ -418,12 +421,13 @@ stderr.)");
         }));
       },
       py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
-      py::arg("ply_colors") = "uchar", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
+      py::arg("ply_colors") = "uchar", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
-      R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
+      R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .pcd, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
 
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (uchar or float),
+pcd_encoding (ascii, binary or binary_compressed),
 las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");
 }

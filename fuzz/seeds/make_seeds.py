@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes the hand-made fuzz seeds in fuzz/seeds/{csv,ply,gltf,las}/ (committed; rerun to remake them).
+"""Writes the hand-made fuzz seeds in fuzz/seeds/{csv,pcd,ply,gltf,las}/ (committed; rerun to remake them;
+`make_seeds.py pcd` writes only the PCD seeds).
 
 Small files, each reaching a path of a reader the other seeds (samples/, ../shared/corpus/,
 assimp-testmodels) may miss. The Draco and meshopt seeds are made from gltf/quantized.glb's
@@ -26,6 +27,41 @@ write("csv", "xyrgb.csv", "x,y,r,g,b\n1,2,0.1,0.2,0.3\n")
 write("csv", "extremes.csv", "x,y,z\n1.7976931348623157e308,4.9e-324,-2.2250738585072014e-308\n"
       "123456789012345678901234567890,0.000000000000000000001,1e-400\n")
 write("csv", "nonfinite.csv", "x,y,z\nnan,inf,-inf\n")
+
+# ---- PCD: each encoding, PCL's header variants, an organized cloud with NaN points ----
+def lzf_literals(data, repeat_at=None):
+    """LZF as literal runs (a control byte < 32, then up to 32 bytes), with one back reference
+    (length 3 from 1 byte back) after byte `repeat_at` when given: the decoder's two paths."""
+    out = bytearray()
+    i = 0
+    while i < len(data):
+        run = data[i:i + 32]
+        out += bytes([len(run) - 1]) + run
+        i += len(run)
+    if repeat_at is not None:
+        out += bytes([(1 << 5) | 0, 0])  # length 1 + 2 = 3, offset 0 + 1: the byte before, three times
+    return bytes(out)
+
+PCD_HEAD = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
+write("pcd", "ascii_rgb.pcd", PCD_HEAD + "FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+      "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
+      "1 2 3 1.180104e-38\n-4.5 6e10 -0 4.2108e+06\nnan nan nan 0\n")
+write("pcd", "ascii_v05_rgba.pcd", "VERSION .5\r\nCOLUMNS x y z rgba intensity\r\nSIZE 4 4 4 4 2\r\nTYPE F F F U U\r\n"
+      "POINTS 2\r\nDATA ascii\r\n1 2 3 4294901760 7\r\n\r\n4\t5\t6\t0\t65535\r\n")
+rows = b""
+for i, (x, y, z) in enumerate([(0, 0, 1), (float("nan"),) * 3, (2, 0, 1), (0, 1, 5)]):
+    rows += struct.pack("<fffB", x, y, z, 255) + b"\xee\xee" + struct.pack("<hhd", -i, i, i / 3.0)
+write("pcd", "binary_organized.pcd", (PCD_HEAD + "FIELDS x y z label _ h gps\nSIZE 4 4 4 1 1 2 8\n"
+      "TYPE F F F U U I F\nCOUNT 1 1 1 1 2 2 1\nWIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA binary\n").encode() + rows)
+columns = struct.pack("<3d", 1.5, -2.5, 6378137.0) + struct.pack("<3d", 0.1, 0.2, 0.3) + \
+    struct.pack("<3d", 7, 8, 9) + struct.pack("<3I", 0x00ff0000, 0x0000ff00, 0)
+packed = lzf_literals(columns[:-3], repeat_at=len(columns) - 3)  # its last 3 zero bytes by reference
+write("pcd", "compressed.pcd", (PCD_HEAD + "FIELDS x y z rgb\nSIZE 8 8 8 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+      "WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA binary_compressed\n").encode() +
+      struct.pack("<II", len(packed), len(columns)) + packed)
+if sys.argv[1:] == ["pcd"]:
+    print("make_seeds: wrote the pcd seeds")
+    sys.exit(0)
 
 # ---- LAS: every header size, a point format of each record layout, VLRs, EVLRs, extra bytes ----
 LAS_BASE = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67]
@@ -236,4 +272,4 @@ if os.path.exists(tool):
 run(["gltfpack", "-c", "-i", source, "-o"], "meshopt.glb")
 run(["gltfpack", "-cc", "-noq", "-i", source, "-o"], "meshopt_filters_fallback.glb")
 os.remove(source)
-print("make_seeds: wrote the csv, ply, gltf and las seeds (compressed: %s)" % (", ".join(made) or "none"))
+print("make_seeds: wrote the csv, pcd, ply, gltf and las seeds (compressed: %s)" % (", ".join(made) or "none"))

@@ -100,6 +100,7 @@ def write(
     decimals: int = -1,
     ply_ascii: bool = False,
     ply_colors: str = "uchar",
+    pcd_encoding: str = "binary",
     las_scale: Optional[float] = None,
     order: str = "input",
     no_colors: bool = False,

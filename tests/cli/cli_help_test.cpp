@@ -123,7 +123,7 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
       {concat(slow, {dir.file("missing/x.ply")}),
        "cannot write '" + dir.file("missing/x.ply") + "': folder '" + dir.file("missing") + "' does not exist"},
       {concat(slow, {dir.path()}), "cannot write '" + dir.path() + "': it is a folder"},
-      {concat(slow, {dir.file("x.dat")}), dir.file("x.dat") + ": unknown file type '.dat' (write .csv, .xyz, .txt, .asc, .pts, .ply, .glb, .las or .laz)"},
+      {concat(slow, {dir.file("x.dat")}), dir.file("x.dat") + ": unknown file type '.dat' (write .csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las or .laz)"},
       {concat(slow, {dir.file("x.gltf")}), dir.file("x.gltf") + ": .gltf is read, not written; write .glb"},
       {concat(slow, {"/sys/dpoint-test.ply"}), "'/sys/dpoint-test.ply': Permission denied"},  // even for root
       {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
@@ -154,10 +154,10 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
 TEST(CliHelp, everyListedOutputFormatIsWritten) {
   for (const char* command : {"merge", "convert"}) {
     test::CommandResult help = runDpoint({command, "--help"});
-    EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .las, .laz)")) << command;
+    EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz)")) << command;
   }
   test::CommandResult help = runDpoint({"generate", "random2d", "--help"});
-  EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .las, .laz)")) << help.out;
+  EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz)")) << help.out;
   EXPECT_FALSE(contains(help.out, ".gltf"));
   EXPECT_TRUE(contains(runDpoint({"--help"}).out, "CSV, PLY, GLB, LAS and LAZ"));
   TempDir dir;
@@ -205,7 +205,7 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"render", in, "-o", png, "--color", "intensity"}, "--color intensity: " + in + " has no dimension 'intensity'"},
       {{"generate", "mandelbulb", "--resolution", "100000", "-o", ply}, "--resolution 100000: must be 2..65536"},
       {{"generate", "mandelbrot2d", "--resolution", "1", "-o", ply}, "--resolution 1: must be 2.."},
-      {{"info", dir.path()}, dir.path() + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ply, .glb, .gltf, .las or .laz)"},
+      {{"info", dir.path()}, dir.path() + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .gltf, .las or .laz)"},
       {{"convert", dir.path(), "-o", ply}, dir.path() + ": is a folder, not a point file"},
       {{"info", in, "--scene", "1"}, in + ": --scene and --all-scenes apply to .glb/.gltf input only"},
       {{"info", in, in, "--all-scenes"}, in + " and 1 more: --scene and --all-scenes apply to one .glb/.gltf input"},

@@ -72,6 +72,9 @@ WRITE_OPTIONS = [
     ("ply", dict(order="morton")),
     ("ply", dict(unique=True)),
     ("ply", dict(unique=True, order="morton", no_colors=True)),
+    ("pcd", {}),
+    ("pcd", dict(pcd_encoding="ascii")),
+    ("pcd", dict(pcd_encoding="binary_compressed", order="morton")),
     ("glb", {}),
     ("glb", dict(no_colors=True)),
     ("las", {}),
@@ -103,6 +106,12 @@ def test_write_options_do_what_they_say(tmp_path, source):
     ordered = dpoint.read(tmp_path / "o.ply").positions
     assert not np.array_equal(ordered, points.positions)
     assert np.array_equal(np.sort(ordered, axis=0), np.sort(points.positions, axis=0))
+    dpoint.write(points, tmp_path / "c.pcd", pcd_encoding="binary_compressed")
+    assert b"DATA binary_compressed\n" in (tmp_path / "c.pcd").read_bytes()[:400]
+    back = dpoint.read(tmp_path / "c.pcd")
+    assert np.array_equal(back.positions, points.positions)
+    with pytest.raises(ValueError, match="pcd_encoding|PCD encoding"):
+        dpoint.write(points, tmp_path / "x.pcd", pcd_encoding="zip")
     # The options act on a copy: the caller's set is as it was.
     assert len(points) == 300 and points.colors is not None
 

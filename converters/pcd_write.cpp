@@ -1,0 +1,262 @@
+// PCD writing (converters/pcd.h): the v0.7 header, then ASCII rows, binary rows, or the fields one
+// after another compressed with LZF (liblzf), as PCL writes binary_compressed.
+#include <lzf.h>
+
+#include <charconv>
+#include <cstring>
+#include <limits>
+
+#include "converters/pcd.h"
+#include "core/atomic_file.h"
+#include "core/bytes.h"
+#include "core/text.h"
+
+namespace dpoint {
+namespace {
+
+constexpr size_t kRowsPerWrite = size_t{1} << 14;
+
+enum class Source : uint8_t { kX, kY, kZ, kRgb, kDimension };
+
+struct OutField {
+  std::string name;
+  char type = 'F';
+  int size = 4;
+  Source source = Source::kDimension;
+  const Dimension* dimension = nullptr;
+};
+
+char pcdTypeOf(DimType type) { return dimTypeIsFloat(type) ? 'F' : dimTypeIsSigned(type) ? 'I' : 'U'; }
+
+// PCD field names are one token: a dimension's spaces become '_'.
+std::string fieldName(const std::string& name) {
+  if (name == "nx") return "normal_x";
+  if (name == "ny") return "normal_y";
+  if (name == "nz") return "normal_z";
+  std::string out = name;
+  for (char& c : out)
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') c = '_';
+  return out.empty() ? "_unnamed" : out;
+}
+
+bool exactlyFloat(double v) { return static_cast<double>(static_cast<float>(v)) == v || v != v; }
+
+class Writer {
+ public:
+  Writer(const std::string& path, const PointSet& points, const PcdWriteOptions& options)
+      : path_(path), points_(points), options_(options) {}
+
+  Status write() {
+    const size_t n = points_.size();
+    if (points_.hasColors() && points_.colors.size() != n)
+      return Error{"cannot write '" + path_ + "': " + std::to_string(points_.colors.size()) + " colours for " +
+                   std::to_string(n) + " points"};
+    if (Status s = plan(); !s) return s;
+    for (const OutField& f : fields_) row_bytes_ += static_cast<size_t>(f.size);
+    if (options_.encoding == PcdEncoding::kBinaryCompressed &&
+        static_cast<uint64_t>(n) * row_bytes_ > std::numeric_limits<uint32_t>::max() / 17 * 16)
+      return Error{"cannot write '" + path_ + "': binary_compressed holds at most 4 GiB of point data (its sizes are 32-bit); " +
+                   std::to_string(n) + " points of " + std::to_string(row_bytes_) + " bytes are more: write binary"};
+    Result<AtomicFile> file = AtomicFile::create(path_);
+    if (!file) return file.error();
+    if (Status s = file->write(header()); !s) return s;
+    if (options_.progress) options_.progress->start("writing " + path_, n);
+    Status body = options_.encoding == PcdEncoding::kAscii    ? writeAscii(*file)
+                  : options_.encoding == PcdEncoding::kBinary ? writeBinary(*file)
+                                                              : writeCompressed(*file);
+    if (!body) return body;
+    return file->commit();
+  }
+
+ private:
+  Status plan() {
+    // x y z as float when every coordinate is one, else double.
+    bool single = true;
+    for (const glm::dvec3& p : points_.positions)
+      if (!exactlyFloat(p.x) || !exactlyFloat(p.y) || !exactlyFloat(p.z)) {
+        single = false;
+        break;
+      }
+    for (int axis = 0; axis < 3; ++axis) fields_.push_back({std::string(1, static_cast<char>('x' + axis)), 'F', single ? 4 : 8, static_cast<Source>(axis), nullptr});
+    if (!single && options_.notices)
+      options_.notices->push_back(path_ + ": x, y and z written as double (PCD TYPE F SIZE 8) to keep every coordinate; "
+                                  "PCL's typed loaders such as pcl::PointXYZ want float and leave double fields at 0");
+    alpha_ = nullptr;
+    if (points_.hasColors()) {
+      const Dimension* alpha = points_.dimensions.find("alpha");
+      alpha_ = alpha && alpha->type == DimType::kU8 ? alpha : nullptr;
+      fields_.push_back({alpha_ ? "rgba" : "rgb", alpha_ ? 'U' : 'F', 4, Source::kRgb, nullptr});
+    }
+    for (const Dimension& d : points_.dimensions.all()) {
+      if (&d == alpha_) continue;
+      fields_.push_back({fieldName(d.name), pcdTypeOf(d.type), static_cast<int>(dimTypeSize(d.type)), Source::kDimension, &d});
+    }
+    for (size_t a = 0; a < fields_.size(); ++a)
+      for (size_t b = a + 1; b < fields_.size(); ++b)
+        if (fields_[a].name == fields_[b].name)
+          return Error{"cannot write '" + path_ + "': two attributes would be the PCD field '" + fields_[a].name + "'"};
+    return okStatus();
+  }
+
+  std::string header() const {
+    const size_t n = points_.size();
+    std::string h = "# .PCD v0.7 - Point Cloud Data file format\n# written by dpoint\n";
+    if (!points_.hasZ()) h += "# dpoint: 2D (the source has x,y only; z is 0)\n";
+    if (points_.z_up) h += "# dpoint: up axis z\n";
+    h += "VERSION 0.7\nFIELDS";
+    for (const OutField& f : fields_) h += ' ' + f.name;
+    h += "\nSIZE";
+    for (const OutField& f : fields_) h += ' ' + std::to_string(f.size);
+    h += "\nTYPE";
+    for (const OutField& f : fields_) h += std::string(" ") + f.type;
+    h += "\nCOUNT";
+    for (size_t k = 0; k < fields_.size(); ++k) h += " 1";
+    h += "\nWIDTH " + std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) +
+         "\nDATA " + pcdEncodingName(options_.encoding) + "\n";
+    return h;
+  }
+
+  uint32_t packed(size_t i) const {
+    const glm::vec3& c = points_.colors[i];
+    uint32_t v = (uint32_t{colorInteger(c.r, 255.0)} << 16) | (uint32_t{colorInteger(c.g, 255.0)} << 8) |
+                 colorInteger(c.b, 255.0);
+    if (alpha_) v |= uint32_t{alpha_->get<uint8_t>(i)} << 24;
+    return v;
+  }
+
+  // Field f of point i as its bytes at out.
+  void store(const OutField& f, size_t i, uint8_t* out) const {
+    switch (f.source) {
+      case Source::kX:
+      case Source::kY:
+      case Source::kZ: {
+        const double v = points_.hasZ() || f.source != Source::kZ ? points_.positions[i][static_cast<int>(f.source)] : 0.0;
+        if (f.size == 4)
+          storeUnaligned(out, static_cast<float>(v));
+        else
+          storeUnaligned(out, v);
+        break;
+      }
+      case Source::kRgb: storeUnaligned(out, packed(i)); break;
+      case Source::kDimension: {
+        const size_t w = static_cast<size_t>(f.size);
+        std::memcpy(out, f.dimension->bytes.data() + i * w, w);
+        break;
+      }
+    }
+  }
+
+  Status writeBinary(AtomicFile& file) {
+    const size_t n = points_.size();
+    std::vector<uint8_t> rows;
+    for (size_t first = 0; first < n; first += kRowsPerWrite) {
+      const size_t count = std::min(kRowsPerWrite, n - first);
+      rows.resize(count * row_bytes_);
+      uint8_t* out = rows.data();
+      for (size_t i = first; i < first + count; ++i)
+        for (const OutField& f : fields_) {
+          store(f, i, out);
+          out += f.size;
+        }
+      if (Status s = file.write(rows.data(), rows.size()); !s) return s;
+      if (options_.progress) options_.progress->advance(count);
+    }
+    return okStatus();
+  }
+
+  Status writeCompressed(AtomicFile& file) {
+    const size_t n = points_.size();
+    // The fields one after another (each field's values for every point), then LZF.
+    std::vector<uint8_t> columns(n * row_bytes_);
+    uint8_t* out = columns.data();
+    for (const OutField& f : fields_)
+      for (size_t i = 0; i < n; ++i, out += f.size) store(f, i, out);
+    std::vector<uint8_t> packed(columns.size() + columns.size() / 16 + 64);
+    unsigned int made = 0;
+    if (!columns.empty()) {
+      made = lzf_compress(columns.data(), static_cast<unsigned int>(columns.size()), packed.data(),
+                          static_cast<unsigned int>(packed.size()));
+      if (made == 0) return Error{"cannot write '" + path_ + "': LZF compression failed"};
+    }
+    uint8_t sizes[8];
+    storeUnaligned(sizes, static_cast<uint32_t>(made));
+    storeUnaligned(sizes + 4, static_cast<uint32_t>(columns.size()));
+    if (Status s = file.write(sizes, sizeof sizes); !s) return s;
+    if (Status s = file.write(packed.data(), made); !s) return s;
+    if (options_.progress) options_.progress->advance(n);
+    return okStatus();
+  }
+
+  template <typename T>
+  static void appendNumber(std::string& text, T v) {
+    char buf[40];
+    auto r = std::to_chars(buf, buf + sizeof buf, v);
+    text.append(buf, r.ptr);
+  }
+
+  Status writeAscii(AtomicFile& file) {
+    const size_t n = points_.size();
+    std::string text;
+    size_t reported = 0;
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t k = 0; k < fields_.size(); ++k) {
+        const OutField& f = fields_[k];
+        if (k) text += ' ';
+        switch (f.source) {
+          case Source::kX:
+          case Source::kY:
+          case Source::kZ: {
+            const double v = points_.hasZ() || f.source != Source::kZ ? points_.positions[i][static_cast<int>(f.source)] : 0.0;
+            if (f.size == 4)
+              appendNumber(text, static_cast<float>(v));
+            else
+              appendNumber(text, v);
+            break;
+          }
+          case Source::kRgb: {  // rgb: the float whose bits are the colour (PCL reads TYPE F so); rgba: the integer
+            const uint32_t c = packed(i);
+            if (alpha_)
+              appendNumber(text, c);
+            else
+              appendNumber(text, loadUnaligned<float>(&c));
+            break;
+          }
+          case Source::kDimension: {
+            const Dimension& d = *f.dimension;
+            switch (d.type) {
+              case DimType::kF32: appendNumber(text, d.get<float>(i)); break;
+              case DimType::kF64: appendNumber(text, d.get<double>(i)); break;
+              case DimType::kU64: appendNumber(text, d.get<uint64_t>(i)); break;
+              case DimType::kI64: appendNumber(text, d.get<int64_t>(i)); break;
+              default: appendNumber(text, static_cast<int64_t>(d.value(i))); break;
+            }
+            break;
+          }
+        }
+      }
+      text += '\n';
+      if (text.size() >= (size_t{1} << 20) || i + 1 == n) {
+        if (Status s = file.write(text); !s) return s;
+        text.clear();
+        if (options_.progress) options_.progress->advance(i + 1 - reported);
+        reported = i + 1;
+      }
+    }
+    return okStatus();
+  }
+
+  const std::string& path_;
+  const PointSet& points_;
+  const PcdWriteOptions& options_;
+  std::vector<OutField> fields_;
+  const Dimension* alpha_ = nullptr;
+  size_t row_bytes_ = 0;
+};
+
+}  // namespace
+
+Status writePcd(const std::string& path, const PointSet& points, const PcdWriteOptions& options) {
+  return Writer(path, points, options).write();
+}
+
+}  // namespace dpoint

@@ -1,0 +1,308 @@
+// PCD (converters/pcd.h): every encoding both ways, organized clouds with NaN points, PCL's header
+// variants, and errors that name the line, column or byte. pcl-tools judge the files in
+// tests/external/pcl_reads_and_writes_pcd.py.
+#include "converters/pcd.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "converters/point_io.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::contains;
+using test::readFile;
+using test::TempDir;
+using test::writeFile;
+
+constexpr PcdEncoding kEncodings[] = {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed};
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Double positions far from the origin, 8-bit colours, and dimensions of many types.
+PointSet richSet(size_t n) {
+  PointSet set;
+  for (size_t i = 0; i < n; ++i) {
+    set.positions.push_back({6378137.0 + static_cast<double>(i) * 1e-7, -1234.5 - 1.0 / (1.0 + static_cast<double>(i)),
+                             i % 7 == 0 ? -0.0 : 1e-300 * static_cast<double>(i)});
+    set.colors.push_back(glm::vec3(static_cast<float>(i % 256) / 255.0f, static_cast<float>((i * 7) % 256) / 255.0f,
+                                   static_cast<float>((i * 13) % 256) / 255.0f));
+  }
+  set.color_full_scale = 255;
+  set.z_axis = ZAxis::kPresent;
+  Dimension& intensity = set.dimensions.add("intensity", DimType::kU16, n);
+  Dimension& nx = set.dimensions.add("nx", DimType::kF32, n);
+  Dimension& gps = set.dimensions.add("gps_time", DimType::kF64, n);
+  Dimension& angle = set.dimensions.add("scan angle", DimType::kI8, n);
+  Dimension& big = set.dimensions.add("big", DimType::kU64, n);
+  Dimension& depth = set.dimensions.add("depth", DimType::kI32, n);
+  for (size_t i = 0; i < n; ++i) {
+    intensity.set<uint16_t>(i, static_cast<uint16_t>(i * 977));
+    nx.set<float>(i, i == 3 ? std::numeric_limits<float>::quiet_NaN() : 1.0f / static_cast<float>(i + 1));
+    gps.set<double>(i, 245370.41706455982 + static_cast<double>(i) / 3.0);
+    angle.set<int8_t>(i, static_cast<int8_t>(static_cast<int>(i % 181) - 90));
+    big.set<uint64_t>(i, (uint64_t{1} << 63) + i);
+    depth.set<int32_t>(i, -static_cast<int32_t>(i % 20000) * 100000);
+  }
+  return set;
+}
+
+void expectSame(const PointSet& want, const PointSet& got, const std::string& what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (size_t i = 0; i < want.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      ASSERT_TRUE(sameBits(got.positions[i][k], want.positions[i][k]))
+          << what << ": point " << i << " axis " << k << ": " << got.positions[i][k] << " vs " << want.positions[i][k];
+  ASSERT_EQ(got.colors.size(), want.colors.size()) << what;
+  for (size_t i = 0; i < want.colors.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      ASSERT_EQ(colorInteger(got.colors[i][k], 255.0), colorInteger(want.colors[i][k], 255.0)) << what << ": colour " << i;
+  ASSERT_EQ(got.dimensions.count(), want.dimensions.count()) << what;
+  for (size_t k = 0; k < want.dimensions.count(); ++k) {
+    const Dimension& w = want.dimensions.all()[k];
+    const Dimension& g = got.dimensions.all()[k];
+    EXPECT_EQ(g.name, w.name == "scan angle" ? "scan_angle" : w.name) << what;
+    EXPECT_EQ(g.type, w.type) << what << ": " << w.name;
+    EXPECT_TRUE(g.bytes == w.bytes) << what << ": the values of " << w.name << " differ";
+  }
+}
+
+TEST(Pcd, everyEncodingReadsBackTheSamePointsColoursAndDimensions) {
+  const PointSet set = richSet(70000);  // more than one decoding block
+  TempDir dir;
+  for (PcdEncoding encoding : kEncodings) {
+    const std::string path = dir.file(std::string(pcdEncodingName(encoding)) + ".pcd");
+    std::vector<std::string> notices;
+    ASSERT_TRUE(writePcd(path, set, PcdWriteOptions{encoding, nullptr, &notices}).ok());
+    const std::string bytes = readFile(path);
+    EXPECT_TRUE(contains(bytes, "FIELDS x y z rgb intensity normal_x gps_time scan_angle big depth\n"));
+    EXPECT_TRUE(contains(bytes, "SIZE 8 8 8 4 2 4 8 1 8 4\nTYPE F F F F U F F I U I\n"));
+    EXPECT_TRUE(contains(bytes, std::string("DATA ") + pcdEncodingName(encoding) + "\n"));
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_TRUE(contains(notices[0], "written as double"));
+    for (unsigned threads : {1u, 3u}) {
+      PcdReadOptions options;
+      options.threads = threads;
+      Result<PointSet> back = readPcd(path, options);
+      ASSERT_TRUE(back.ok()) << back.error().message;
+      expectSame(set, *back, pcdEncodingName(encoding));
+      EXPECT_EQ(back->color_full_scale, 255);
+      EXPECT_EQ(back->z_axis, ZAxis::kPresent);
+    }
+  }
+  // Compressed is smaller than binary on data with structure.
+  EXPECT_LT(readFile(dir.file("binary_compressed.pcd")).size(), readFile(dir.file("binary.pcd")).size());
+}
+
+TEST(Pcd, floatCoordinatesAreWrittenAsFloatFieldsAndTwoDAndUpAxisSurvive) {
+  PointSet set;
+  set.positions = {{1.5, -2.25, 0.0}, {3.0, 4.0, 0.0}};
+  set.z_axis = ZAxis::kAbsent;
+  set.z_up = true;
+  TempDir dir;
+  for (PcdEncoding encoding : kEncodings) {
+    const std::string path = dir.file("flat.pcd");
+    std::vector<std::string> notices;
+    ASSERT_TRUE(writePcd(path, set, PcdWriteOptions{encoding, nullptr, &notices}).ok());
+    EXPECT_TRUE(notices.empty());
+    const std::string bytes = readFile(path);
+    EXPECT_TRUE(contains(bytes, "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"));
+    EXPECT_TRUE(contains(bytes, "# dpoint: 2D"));
+    Result<PointSet> back = readPcd(path);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back->z_axis, ZAxis::kAbsent);
+    EXPECT_TRUE(back->z_up);
+    expectSame(set, *back, pcdEncodingName(encoding));
+  }
+}
+
+TEST(Pcd, rgbaKeepsItsAlphaAsADimension) {
+  const std::string file =
+      "VERSION .7\nFIELDS x y z rgba\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n"
+      "1 2 3 4294901760\n4 5 6 2147516416\n";  // 0xFFFF0000 (opaque red), 0x80008000 (half-transparent green)
+  TempDir dir;
+  writeFile(dir.file("a.pcd"), file);
+  Result<PointSet> set = readPcd(dir.file("a.pcd"));
+  ASSERT_TRUE(set.ok()) << set.error().message;
+  ASSERT_EQ(set->size(), 2u);
+  EXPECT_EQ(set->colors[0], glm::vec3(1, 0, 0));
+  EXPECT_EQ(set->colors[1], glm::vec3(0, 128.0f / 255.0f, 0));
+  const Dimension* alpha = set->dimensions.find("alpha");
+  ASSERT_NE(alpha, nullptr);
+  EXPECT_EQ(alpha->get<uint8_t>(0), 255);
+  EXPECT_EQ(alpha->get<uint8_t>(1), 128);
+  ASSERT_TRUE(writePcd(dir.file("b.pcd"), *set, PcdWriteOptions{PcdEncoding::kAscii}).ok());
+  const std::string back = readFile(dir.file("b.pcd"));
+  EXPECT_TRUE(contains(back, "FIELDS x y z rgba\n"));
+  EXPECT_TRUE(contains(back, "1 2 3 4294901760\n4 5 6 2147516416\n"));
+}
+
+TEST(Pcd, organizedCloudDropsItsNanPointsAndSaysHowMany) {
+  // 3 × 2, two pixels without a return; a `_` padding field, a COUNT 2 field, comments anywhere.
+  std::string file =
+      "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z _ h normal_z\nSIZE 4 4 4 1 2 4\n"
+      "TYPE F F F U U F\n# a comment\nCOUNT 1 1 1 3 2 1\nWIDTH 3\nHEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 6\n"
+      "DATA binary\n";
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float xyz[6][3] = {{0, 0, 1}, {nan, nan, nan}, {2, 0, 1}, {0, 1, 1}, {1, 1, nan}, {2, 1, 1}};
+  for (int i = 0; i < 6; ++i) {
+    char row[4 * 3 + 3 + 4 + 4];
+    std::memcpy(row, xyz[i], 12);
+    std::memset(row + 12, 0xEE, 3);
+    const uint16_t h[2] = {static_cast<uint16_t>(i), static_cast<uint16_t>(100 + i)};
+    std::memcpy(row + 15, h, 4);
+    const float nz = static_cast<float>(i) / 2;
+    std::memcpy(row + 19, &nz, 4);
+    file.append(row, sizeof row);
+  }
+  TempDir dir;
+  writeFile(dir.file("o.pcd"), file);
+  for (const std::string& name : {std::string("o.pcd"), std::string("c.pcd")}) {
+    std::vector<std::string> notices;
+    PcdReadOptions options;
+    options.notices = &notices;
+    Result<PointSet> set = readPcd(dir.file(name), options);
+    ASSERT_TRUE(set.ok()) << set.error().message;
+    ASSERT_EQ(set->size(), 4u) << name;
+    EXPECT_EQ(set->positions[1], glm::dvec3(2, 0, 1));
+    EXPECT_EQ(set->positions[3], glm::dvec3(2, 1, 1));
+    ASSERT_EQ(set->dimensions.count(), 3u);
+    EXPECT_EQ(set->dimensions.all()[0].name, "h_0");
+    EXPECT_EQ(set->dimensions.all()[1].name, "h_1");
+    EXPECT_EQ(set->dimensions.all()[2].name, "nz");
+    EXPECT_EQ(set->dimensions.all()[1].get<uint16_t>(2), 103);
+    EXPECT_EQ(set->dimensions.all()[2].get<float>(3), 2.5f);
+    if (name == "c.pcd") {
+      EXPECT_TRUE(notices.empty());
+      continue;
+    }
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_TRUE(contains(notices[0], "dropped 2 of 6 points whose x, y or z is NaN (no return)")) << notices[0];
+    // The same points written compressed (no padding) read the same.
+    ASSERT_TRUE(writePcd(dir.file("c.pcd"), *set, PcdWriteOptions{PcdEncoding::kBinaryCompressed}).ok());
+  }
+}
+
+TEST(Pcd, oldHeadersAndAsciiSpellingsRead) {
+  TempDir dir;
+  // PCD 0.5: COLUMNS, no TYPE (float), no COUNT, no WIDTH; CRLF lines, tabs, a float in an integer field.
+  writeFile(dir.file("old.pcd"),
+            "VERSION .5\r\nCOLUMNS x y z intensity\r\nSIZE 4 4 4 4\r\nPOINTS 2\r\nDATA ascii\r\n1\t2\t3\t0.5\r\n\r\n4 5 6 7\r\n");
+  Result<PointSet> old = readPcd(dir.file("old.pcd"));
+  ASSERT_TRUE(old.ok()) << old.error().message;
+  ASSERT_EQ(old->size(), 2u);
+  EXPECT_EQ(old->positions[1], glm::dvec3(4, 5, 6));
+  EXPECT_EQ(old->dimensions.find("intensity")->get<float>(0), 0.5f);
+  // x y only: a 2D set. An integer field written as "3.0".
+  // A VIEWPOINT that moves the sensor is not applied, and a note says so.
+  writeFile(dir.file("xy.pcd"),
+            "FIELDS x y label\nSIZE 8 8 4\nTYPE F F U\nWIDTH 1\nVIEWPOINT 1 2 3 1 0 0 0\nDATA ascii\n0.1 0.2 3.0\n");
+  std::vector<std::string> notices;
+  PcdReadOptions noted;
+  noted.notices = &notices;
+  Result<PointSet> xy = readPcd(dir.file("xy.pcd"), noted);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_TRUE(contains(notices[0], "VIEWPOINT 1 2 3 1 0 0 0 is not applied to the points")) << notices[0];
+  ASSERT_TRUE(xy.ok()) << xy.error().message;
+  EXPECT_EQ(xy->z_axis, ZAxis::kAbsent);
+  EXPECT_EQ(xy->positions[0], glm::dvec3(0.1, 0.2, 0));
+  EXPECT_EQ(xy->dimensions.find("label")->get<uint32_t>(0), 3u);
+  // An rgb of TYPE F in ASCII is the float whose bits are the colour, as PCL reads it.
+  writeFile(dir.file("rgb.pcd"), "FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nPOINTS 1\nDATA ascii\n0 0 0 9.1477e-41\n");
+  Result<PointSet> rgb = readPcd(dir.file("rgb.pcd"));
+  ASSERT_TRUE(rgb.ok()) << rgb.error().message;
+  EXPECT_EQ(rgb->colors[0], glm::vec3(0, 1, 0));  // 0x0000FF00
+}
+
+TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
+  TempDir dir;
+  const std::string head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\n";
+  struct Case {
+    std::string bytes, error;
+  };
+  const std::vector<Case> cases = {
+      {"", "empty file, not a PCD file"},
+      {"ply\nformat ascii 1.0\n", "not a PCD file (header line 1 starts with 'ply', not VERSION or FIELDS)"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4\n", "header line 3: SIZE has 2 values for the 3 FIELDS of line 2"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 3\n", "header line 3: field 'z': SIZE '3' is not 1, 2, 4 or 8"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\n", "header line 4: field 'z': TYPE 'Q' is not I, U or F"},
+      {"VERSION 0.7\nFIELDS x z\nSIZE 4 4\nPOINTS 1\nDATA ascii\n", "header line 2: no y field (FIELDS must name x and y)"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nPOINTS 1\nDATA ascii\n",
+       "header line 3: field 'z': TYPE F with SIZE 2 (floats are 4 or 8 bytes)"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nWIDTH 3\nHEIGHT 2\nPOINTS 5\nDATA ascii\n",
+       "header line 6: POINTS 5 is not WIDTH × HEIGHT (3 × 2)"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nSHAPE 3\n", "header line 4: unknown entry 'SHAPE'"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nPOINTS 1\nDATA zipped\n", "header line 5: DATA 'zipped' is not ascii, binary or binary_compressed"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nPOINTS 1\n", "the header ends without a DATA line"},
+      {head + "DATA ascii\n1 2 3\n4 5\n", "line 11: 2 values; the header's fields need 3"},
+      {head + "DATA ascii\n1 2 3\n4 five 6\n", "line 11, column 2 (field 'y'): 'five' is not a number"},
+      {head + "DATA ascii\n1 2 3\n", "line 10: the file ends after 1 of the 2 points the header declares"},
+      {head + "DATA ascii\n1 2 3\n4 5 6\n7 8 9\n", "line 12: more rows than the header's POINTS 2"},
+      {head + "DATA ascii\n1 2 3\n4 inf 6\n", "line 11: point 1: y is inf, not a finite number (--allow-nonfinite accepts it)"},
+      {head + "DATA binary\n" + std::string(20, '\0'), "truncated: POINTS 2 need 12 bytes each after the header (byte 97), the file has 20"},
+      {head + "DATA binary_compressed\n" + std::string(4, '\0'), "binary_compressed data starts with its two sizes (8 bytes)"},
+      {head + "DATA binary_compressed\n" + std::string("\x05\0\0\0\x18\0\0\0", 8) + std::string(5, '\xff'),
+       "the LZF data is corrupt, not the 24 the header declares"},
+      {head + "DATA binary_compressed\n" + std::string("\x05\0\0\0\x10\0\0\0", 8) + std::string(5, '\0'),
+       "the uncompressed size 16 is not POINTS × bytes per point (2 × 12)"},
+      {"VERSION 0.7\nFIELDS x y y\nSIZE 4 4 4\nPOINTS 1\nDATA ascii\n", "header line 2: field 'y' appears twice"},
+      // A fuzz finding: a field of 88,881 values once took seconds (a quadratic check of the names).
+      {"VERSION 0.7\nFIELDS x y z w\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 88881\n",
+       "header line 5: field 'w': COUNT '88881' is not 1 to 65536"},
+      {"VERSION 0.7\nFIELDS x y a a_0\nSIZE 4 4 4 4\nCOUNT 1 1 2 1\nPOINTS 1\nDATA ascii\n",
+       "header line 2: two fields give the attribute 'a_0'"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 2 1\nPOINTS 1\nDATA ascii\n",
+       "header line 5: field 'y': COUNT 2 (must be 1)"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = dir.file("bad.pcd");
+    writeFile(path, c.bytes);
+    Result<PointSet> set = readPcd(path);
+    ASSERT_FALSE(set.ok()) << c.error;
+    EXPECT_TRUE(contains(set.error().message, path + ": ")) << set.error().message;
+    EXPECT_TRUE(contains(set.error().message, c.error)) << set.error().message;
+  }
+  // A binary infinity names its byte; --allow-nonfinite keeps it.
+  std::string bytes = head + "DATA binary\n";
+  const float rows[6] = {1, 2, 3, 4, -std::numeric_limits<float>::infinity(), 6};
+  bytes.append(reinterpret_cast<const char*>(rows), sizeof rows);
+  writeFile(dir.file("inf.pcd"), bytes);
+  Result<PointSet> inf = readPcd(dir.file("inf.pcd"));
+  ASSERT_FALSE(inf.ok());
+  EXPECT_TRUE(contains(inf.error().message, "byte 109: point 1: y is -inf, not a finite number")) << inf.error().message;
+  PcdReadOptions allow;
+  allow.allow_nonfinite = true;
+  EXPECT_TRUE(readPcd(dir.file("inf.pcd"), allow).ok());
+  // A header that claims more points than memory allows is refused before allocating.
+  writeFile(dir.file("huge.pcd"), "FIELDS x y z\nSIZE 8 8 8\nPOINTS 100000000\nDATA binary_compressed\n" +
+                                      std::string("\x01\0\0\0\x00\x18\x0d\x8f", 8) + "x");
+  PcdReadOptions small;
+  small.max_memory = 1 << 20;
+  Result<PointSet> huge = readPcd(dir.file("huge.pcd"), small);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_TRUE(contains(huge.error().message, "100000000 points")) << huge.error().message;
+  EXPECT_EQ(huge.error().code, ExitCode::kResourceLimit);
+}
+
+TEST(Pcd, convertsByExtensionWithTheEncodingAsked) {
+  TempDir dir;
+  const PointSet set = richSet(10);
+  WriteOptions options;
+  options.pcd_encoding = PcdEncoding::kBinaryCompressed;
+  ASSERT_TRUE(writePoints(dir.file("x.PCD"), set, options).ok());
+  EXPECT_TRUE(contains(readFile(dir.file("x.PCD")), "DATA binary_compressed\n"));
+  Result<PointSet> back = readPoints(dir.file("x.PCD"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  expectSame(set, *back, "x.PCD");
+  EXPECT_FALSE(parsePcdEncoding("zip").ok());
+}
+
+}  // namespace
+}  // namespace dpoint
