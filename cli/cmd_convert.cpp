@@ -11,6 +11,7 @@
 #include "converters/point_io.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "ops/mesh_sample.h"
 #include "ops/point_order.h"
 
 namespace dpoint {
@@ -24,6 +25,9 @@ struct ConvertOptions {
   std::string pcd_encoding = "binary";
   bool allow_nonfinite = false;
   std::string columns;  // --columns x,y,z,-,intensity
+  uint64_t sample = 0;  // --sample N: points on the mesh's surface instead of its vertices
+  std::string sample_method = "uniform";
+  uint64_t sample_seed = 0;
   bool no_colors = false;
   int scene = -1;
   bool all_scenes = false;
@@ -52,7 +56,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   GltfReadOptions g = gltfOptions(o);
   // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
   Result<FileFormat> out_format = formatOf(o.output);
-  g.triangles = !out_format || *out_format != FileFormat::kCsv;
+  g.triangles = !out_format || *out_format != FileFormat::kCsv || o.sample != 0;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
   if (!o.columns.empty()) r.columns = splitAt(o.columns, ',');
@@ -87,7 +91,7 @@ int runConvert(ConvertOptions& o) {
   const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
   if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !o.unique && *order == PointOrder::kInput &&
-      !choose_dimensions && o.columns.empty()) {
+      !choose_dimensions && o.columns.empty() && o.sample == 0) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
@@ -100,6 +104,18 @@ int runConvert(ConvertOptions& o) {
   }
   Result<PointSet> points = readConvertInput(o, progress);
   if (!points) return reportError(points.error());
+  if (o.sample != 0) {
+    SampleOptions sample;
+    sample.count = o.sample;
+    sample.method = *parseSampleMethod(o.sample_method);  // checked by the option's validator
+    sample.seed = o.sample_seed;
+    sample.threads = o.common.threads;
+    sample.max_memory = o.memory_limit;
+    sample.progress = &progress;
+    Result<PointSet> sampled = sampleSurface(*points, sample, o.input);
+    if (!sampled) return reportError(sampled.error());
+    points = std::move(sampled);
+  }
   if (Status s = selectDimensions(*points, o.dimensions, o.input); !s) return reportError(s.error());
   if (Status s = filterPoints(*points, filters, o.unique, *order, o.memory_limit, o.common.threads, &progress); !s)
     return reportError(s.error());
@@ -139,6 +155,16 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--columns", o->columns,
                   "Text input: what each column holds, e.g. x,y,z,-,intensity: x, y, z, r, g, b (red, green, blue),\n"
                   "- to skip a column, any other name a dimension; a header line is then passed over");
+  cmd->add_option("--sample", o->sample,
+                  "Mesh input: write N points on its surface (uniform by area, colours and normals interpolated) "
+                  "instead of its vertices");
+  cmd->add_option("--sample-method", o->sample_method,
+                  "uniform: independent points, uniform by area; poisson: an even sample (weighted sample "
+                  "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk)")
+      ->check(oneOf("--sample-method", {"uniform", "poisson"}))
+      ->default_val("uniform");
+  cmd->add_option("--sample-seed", o->sample_seed, "Seed of --sample: the same seed gives the same points on any thread count")
+      ->default_val(0);
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");
   cmd->add_option("--keep", o->dimensions.keep,
                   "Keep only these dimensions (comma-separated names, as `dpoint info` lists them; none: no dimension)");

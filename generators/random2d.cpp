@@ -6,7 +6,6 @@
 namespace dpoint {
 namespace {
 
-constexpr uint64_t kGamma = 0x9E3779B97F4A7C15ull;  // splitmix64's increment (2^64 / golden ratio)
 constexpr size_t kPointsPerChunk = 1u << 16;
 
 // (u >> 11) is an integer m < 2^53; (m - 2^52) · 2^-52 lies in [-1, 1) and both steps are exact
@@ -16,16 +15,6 @@ double unitSigned(uint64_t u) {
   return static_cast<double>(m) * 0x1p-52;
 }
 
-}  // namespace
-
-uint64_t splitmix64At(uint64_t seed, uint64_t index) {
-  uint64_t z = seed + (index + 1) * kGamma;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-namespace {
 
 // Points [first, last) of the whole set.
 Result<PointSet> generateRange(const Random2dParams& params, uint64_t first, uint64_t last) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "core/point_set.h"
+#include "core/random.h"
 #include "core/progress.h"
 #include "core/result.h"
 #include "core/tile.h"
@@ -27,8 +28,5 @@ struct Random2dParams {
 Result<PointSet> generateRandom2d(const Random2dParams& params);
 // Tile `tile` (core/tile.h): points [⌊I·count/N⌋, ⌊(I+1)·count/N⌋), at most 2^32 of them.
 Result<PointTile> generateRandom2dTile(const Random2dParams& params, TileSpec tile);
-
-// Output number `index` (0-based) of splitmix64 started from `seed`.
-uint64_t splitmix64At(uint64_t seed, uint64_t index);
 
 }  // namespace dpoint

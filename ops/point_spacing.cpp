@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "core/parallel.h"
+#include "core/random.h"
 
 namespace dpoint {
 namespace {
@@ -16,11 +17,7 @@ constexpr int kCellBits = 21;  // cell coordinates per axis, packed three to a 6
 constexpr int64_t kMaxCell = (int64_t{1} << kCellBits) - 1;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-uint64_t mix(uint64_t x) {  // splitmix64's finalizer
-  x ^= x >> 30, x *= 0xbf58476d1ce4e5b9ull;
-  x ^= x >> 27, x *= 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
+uint64_t mix(uint64_t x) { return splitmixMix(x); }
 
 // One mix of the three coordinates' bits, rotated apart (+ 0.0: -0 hashes as 0).
 uint64_t positionHash(const glm::dvec3& p) {

@@ -11,6 +11,7 @@
 
 #include "converters/gltf_read.h"
 #include "converters/point_io.h"
+#include "ops/mesh_sample.h"
 #include "core/memory.h"
 #include "core/text.h"
 #include "ops/point_order.h"
@@ -368,6 +369,31 @@ that memory, without copying (writing into them changes the set).)")
       });
 
   m.def("_memory_size", [](const std::string& name, const py::object& value) { return take(memoryOption(name, value)); });
+
+  m.def(
+      "sample",
+      [](const std::shared_ptr<PointSet>& mesh, uint64_t count, const std::string& method, uint64_t seed,
+         unsigned threads, const py::object& max_memory, bool progress) {
+        SampleOptions options;
+        options.count = count;
+        options.method = take(parseSampleMethod(method));
+        options.seed = seed;
+        options.threads = threads;
+        options.max_memory = take(memoryOption("max_memory", max_memory));
+        return std::make_shared<PointSet>(take(released([&] {
+          Progress bar(progressFile(progress), "sample");
+          options.progress = &bar;
+          return sampleSurface(*mesh, options, "the mesh");
+        })));
+      },
+      py::arg("mesh"), py::arg("count"), py::kw_only(), py::arg("method") = "uniform", py::arg("seed") = uint64_t{0},
+      py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
+      R"(count points on a mesh's surface, as `dpoint convert MESH --sample N` makes them.
+
+method: uniform (independent points, uniform by area) or poisson (an even sample: weighted sample
+elimination from 5 x count uniform points, as Open3D's sample_points_poisson_disk). Colours and the
+normals (attributes nx, ny, nz) are interpolated over each triangle. The same seed gives the same
+points on any thread count. A set without triangles raises ValueError.)");
 
   m.def(
       "read",

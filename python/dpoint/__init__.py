@@ -32,7 +32,7 @@ from . import _dpoint
 
 __all__ = [
     "DeviceError", "Error", "PointSet", "RenderResult", "Renderer", "RenderWarning", "__version__",
-    "bench", "generate", "info", "read", "render", "write",
+    "bench", "generate", "info", "read", "render", "sample", "write",
 ]
 
 
@@ -218,8 +218,15 @@ def write(points, path, **options) -> None:
     _dpoint.write(points, _os.fspath(path), **options)
 
 
+def sample(mesh, count, **options) -> PointSet:
+    if isinstance(mesh, (str, _os.PathLike)):
+        mesh = _dpoint.read(_os.fspath(mesh))
+    return _dpoint.sample(mesh, count, **options)
+
+
 read.__doc__ = _dpoint.read.__doc__
 write.__doc__ = _dpoint.write.__doc__
+sample.__doc__ = _dpoint.sample.__doc__
 
 
 def generate(kind: str, *, progress: bool = False, **options) -> PointSet:

@@ -110,6 +110,16 @@ def write(
     max_memory: int | str | None = None,
     progress: bool = False,
 ) -> None: ...
+def sample(
+    mesh: PointSet | PathType,
+    count: int,
+    *,
+    method: str = "uniform",
+    seed: int = 0,
+    threads: int = 0,
+    max_memory: int | str | None = None,
+    progress: bool = False,
+) -> PointSet: ...
 def generate(kind: str, *, progress: bool = False, **options: Any) -> PointSet: ...
 def info(
     points: Points,

@@ -251,3 +251,26 @@ def test_text_exports_write_with_spaces_and_read_back(tmp_path, cloud):
         assert first.startswith("//x y z"), first
         back = dpoint.read(path)
         assert np.array_equal(back.positions, s.positions)
+
+
+BOX = "/usr/share/assimp/models/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb"
+
+
+def test_sample_gives_converts_points_on_the_surface(tmp_path):
+    mesh = dpoint.read(BOX)
+    points = dpoint.sample(mesh, 2000, seed=5)
+    assert len(points) == 2000 and points.triangles is None
+    # On the unit box's faces: one coordinate at +-0.5 for every point.
+    assert np.all(np.isclose(np.abs(points.positions).max(axis=1), 0.5, atol=1e-12))
+    normals = np.stack([points.attributes[k] for k in ("nx", "ny", "nz")], axis=1)
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-6)
+    # The same points as convert --sample, on any thread count.
+    cli("convert", BOX, "-o", tmp_path / "cli.ply", "--sample", "2000", "--sample-seed", "5", "--quiet")
+    assert np.array_equal(dpoint.read(tmp_path / "cli.ply").positions, points.positions)
+    assert np.array_equal(dpoint.sample(BOX, 2000, seed=5, threads=1).positions, points.positions)
+    poisson = dpoint.sample(mesh, 500, method="poisson")
+    assert len(poisson) == 500
+    with pytest.raises(ValueError, match="no triangles"):
+        dpoint.sample(points, 10)
+    with pytest.raises(ValueError, match="uniform or poisson"):
+        dpoint.sample(mesh, 10, method="grid")
