@@ -52,8 +52,8 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
 void addSampleOptions(CLI::App& cmd, OutputOptions& o) {
   cmd.add_option("--sample", o.sample,
                  "Write N points on the mesh's surface (uniform by area, colours and normals interpolated) instead of the mesh");
-  cmd.add_option("--sample-method", o.sample_method, "uniform, or poisson: an even sample (as Open3D's sample_points_poisson_disk)")
-      ->check(oneOf("--sample-method", {"uniform", "poisson"}))
+  cmd.add_option("--sample-method", o.sample_method, "uniform; poisson: an even sample (as Open3D's sample_points_poisson_disk); stratified: each triangle its share, spread evenly")
+      ->check(oneOf("--sample-method", {"uniform", "poisson", "stratified"}))
       ->default_val("uniform");
   cmd.add_option("--sample-seed", o.sample_seed, "Seed of --sample (the same points on any thread count)")->default_val(0);
 }

@@ -160,8 +160,9 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
                   "instead of its vertices");
   cmd->add_option("--sample-method", o->sample_method,
                   "uniform: independent points, uniform by area; poisson: an even sample (weighted sample "
-                  "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk)")
-      ->check(oneOf("--sample-method", {"uniform", "poisson"}))
+                  "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk); stratified: "
+                  "each triangle its share of the points, spread evenly in it (as fast as uniform)")
+      ->check(oneOf("--sample-method", {"uniform", "poisson", "stratified"}))
       ->default_val("uniform");
   cmd->add_option("--sample-seed", o->sample_seed, "Seed of --sample: the same seed gives the same points on any thread count")
       ->default_val(0);

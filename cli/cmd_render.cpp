@@ -31,7 +31,7 @@ struct RenderCliOptions {
   CameraCliOptions camera;
   std::string background = "0,0,0";
   bool error = false, validate = false;
-  std::string point_size = "auto", point_shape = "auto";
+  std::string point_size = "auto", point_shape = "auto", surface = "auto";
   uint32_t frames = 1;
   std::string warmup = "auto";
   uint64_t chunk_points = 0;
@@ -81,6 +81,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.tolerance_px = *parseTolerance(o.camera.tolerance);
   if (o.point_size != "auto") request.point_size = *parsePointSize(o.point_size);
   if (o.point_shape != "auto") request.round_points = o.point_shape == "round";
+  request.surface = o.surface == "on" ? SurfaceChoice::kOn : o.surface == "off" ? SurfaceChoice::kOff : SurfaceChoice::kAuto;
   request.background_rgba8 = *parseBackground(o.background);
   if (o.shade != "auto") request.shading = o.shade == "edl" ? Shading::kEdl : Shading::kNone;
   request.edl = EdlOptions{static_cast<float>(o.edl_strength), static_cast<float>(o.edl_radius)};
@@ -279,6 +280,11 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
                   "surface wins where discs overlap and a point behind it shows no edge), square (the rasterizer's\n"
                   "squares at one depth), or auto: round for a 3D set, square for a 2D one (a grid closes exactly)",
                   {"auto", "round", "square"});
+  addChoiceOption(*cmd, "--surface", o->surface,
+                  "A mesh input (glTF, or a PLY with faces): on draws points sampled on its surface, about two per\n"
+                  "pixel it covers (each triangle its share, colours and normals interpolated); off its vertices;\n"
+                  "auto: its surface when its triangles are long on screen (a CAD part, not a generated fractal)",
+                  {"auto", "on", "off"});
   cmd->add_option("--background", o->background, "Background colour R,G,B (0..255)")
       ->check(checkStatus([](const std::string& v) { return statusOf(parseBackground(v)); }))
       ->default_val("0,0,0");

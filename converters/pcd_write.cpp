@@ -44,7 +44,7 @@ bool exactlyFloat(double v) { return static_cast<double>(static_cast<float>(v)) 
 class Writer {
  public:
   Writer(const std::string& path, const PointSet& points, const PcdWriteOptions& options)
-      : path_(path), points_(points), options_(options) {}
+      : path_(path), points_(points), options_(options), has_z_(points.hasZ()) {}
 
   Status write() {
     const size_t n = points_.size();
@@ -101,7 +101,7 @@ class Writer {
   std::string header() const {
     const size_t n = points_.size();
     std::string h = "# .PCD v0.7 - Point Cloud Data file format\n# written by dpoint\n";
-    if (!points_.hasZ()) h += "# dpoint: 2D (the source has x,y only; z is 0)\n";
+    if (!has_z_) h += "# dpoint: 2D (the source has x,y only; z is 0)\n";
     if (points_.z_up) h += "# dpoint: up axis z\n";
     h += "VERSION 0.7\nFIELDS";
     for (const OutField& f : fields_) h += ' ' + f.name;
@@ -124,13 +124,18 @@ class Writer {
     return v;
   }
 
+  // x, y or z of point i (z 0 for a 2D set).
+  double coordinate(const OutField& f, size_t i) const {
+    return f.source == Source::kZ && !has_z_ ? 0.0 : points_.positions[i][static_cast<int>(f.source)];
+  }
+
   // Field f of point i as its bytes at out.
   void store(const OutField& f, size_t i, uint8_t* out) const {
     switch (f.source) {
       case Source::kX:
       case Source::kY:
       case Source::kZ: {
-        const double v = points_.hasZ() || f.source != Source::kZ ? points_.positions[i][static_cast<int>(f.source)] : 0.0;
+        const double v = coordinate(f, i);
         if (f.size == 4)
           storeUnaligned(out, static_cast<float>(v));
         else
@@ -206,7 +211,7 @@ class Writer {
           case Source::kX:
           case Source::kY:
           case Source::kZ: {
-            const double v = points_.hasZ() || f.source != Source::kZ ? points_.positions[i][static_cast<int>(f.source)] : 0.0;
+            const double v = coordinate(f, i);
             if (f.size == 4)
               appendNumber(text, static_cast<float>(v));
             else
@@ -251,6 +256,7 @@ class Writer {
   std::vector<OutField> fields_;
   const Dimension* alpha_ = nullptr;
   size_t row_bytes_ = 0;
+  bool has_z_;  // PointSet::hasZ() once: for a set made in memory it looks at every point
 };
 
 }  // namespace

@@ -104,6 +104,20 @@ class Sampler {
     return {t, s * (1.0 - r2), s * r2};
   }
 
+  // Sample i of `count`, stratified (mesh_sample.h).
+  Placement placeStratified(uint64_t i, uint64_t count) const {
+    const double shift = unitInterval(splitmix64At(options_.seed, 0));
+    const double r = (static_cast<double>(i) + shift) / static_cast<double>(count) * total_;
+    size_t t = static_cast<size_t>(std::upper_bound(sums_.begin(), sums_.end(), r) - sums_.begin());
+    if (t == sums_.size()) t = sums_.size() - 1;  // r rounded up to the total
+    while (t > 0 && sums_[t] == sums_[t - 1]) --t;  // never a triangle of no area
+    constexpr double kA1 = 0.7548776662466927, kA2 = 0.5698402909980532;  // 1/g, 1/g² (g: the plastic number)
+    const double x = static_cast<double>(i);
+    const double u1 = 0.5 + x * kA1, u2 = 0.5 + x * kA2;
+    const double s = std::sqrt(u1 - std::floor(u1)), r2 = u2 - std::floor(u2);
+    return {static_cast<uint32_t>(t), s * (1.0 - r2), s * r2};
+  }
+
   glm::dvec3 position(const Placement& p) const {
     const glm::dvec3 p0 = vertex(mesh_, p.triangle, 0);
     return p0 + p.b * (vertex(mesh_, p.triangle, 1) - p0) + p.c * (vertex(mesh_, p.triangle, 2) - p0);
@@ -117,7 +131,7 @@ class Sampler {
     parallelFor(static_cast<size_t>(blocks), options_.threads, [&](size_t b, unsigned) {
       const uint64_t first = b * kBlock, last = std::min(count, first + kBlock);
       for (uint64_t i = first; i < last; ++i) {
-        placements[i] = place(i);
+        placements[i] = options_.method == SampleMethod::kStratified ? placeStratified(i, count) : place(i);
         positions[i] = position(placements[i]);
       }
     });
@@ -337,7 +351,8 @@ std::vector<uint32_t> eliminate(const std::vector<glm::dvec3>& candidates, uint6
 Result<SampleMethod> parseSampleMethod(std::string_view text) {
   if (text == "uniform") return SampleMethod::kUniform;
   if (text == "poisson") return SampleMethod::kPoisson;
-  return Error{"--sample-method " + quotedExcerpt(text) + ": expected uniform or poisson", ExitCode::kUsage};
+  if (text == "stratified") return SampleMethod::kStratified;
+  return Error{"--sample-method " + quotedExcerpt(text) + ": expected uniform, poisson or stratified", ExitCode::kUsage};
 }
 
 double surfaceArea(const PointSet& mesh) {
@@ -347,6 +362,25 @@ double surfaceArea(const PointSet& mesh) {
     sum += 0.5 * glm::length(glm::cross(mesh.positions[mesh.triangles[t + 1]] - p0, mesh.positions[mesh.triangles[t + 2]] - p0));
   }
   return sum;
+}
+
+double medianTriangleEdge(const PointSet& mesh) {
+  std::vector<std::pair<double, double>> edges;  // longest edge, area
+  edges.reserve(mesh.triangles.size() / 3);
+  double total = 0.0;
+  for (size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
+    const glm::dvec3 a = mesh.positions[mesh.triangles[t]], b = mesh.positions[mesh.triangles[t + 1]],
+                     c = mesh.positions[mesh.triangles[t + 2]];
+    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+    if (!(area > 0.0)) continue;
+    edges.emplace_back(std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)}), area);
+    total += area;
+  }
+  std::sort(edges.begin(), edges.end());
+  double running = 0.0;
+  for (const auto& [edge, area] : edges)
+    if ((running += area) >= 0.5 * total) return edge;
+  return 0.0;
 }
 
 Result<PointSet> sampleSurface(const PointSet& mesh, const SampleOptions& options, const std::string& what) {

@@ -13,6 +13,11 @@
 // at least r_min = r_max · 0.5 · (1 − (N/M)^1.5)); the heaviest is removed and its neighbours'
 // weights lowered until N remain. Ties go to the lower index, so it is deterministic.
 //
+// Stratified: sample i lies at (i + shift) / N of the running sum of the areas (systematic
+// sampling: each triangle gets its expected count rounded up or down, the seed draws the shift), at
+// point i of the R2 sequence (Roberts 2018) in its triangle, so the samples of a large triangle
+// spread evenly. As fast as uniform and with no clumps or holes: `render` draws a mesh's surface so.
+//
 // Each sample gets the triangle's colours and normals interpolated: vertex colours when the mesh
 // has them, vertex normals (dimensions nx, ny, nz) when it has them, else the face normal. Other
 // dimensions are not carried (a vertex attribute need not mean anything between vertices).
@@ -28,9 +33,9 @@
 
 namespace dpoint {
 
-enum class SampleMethod { kUniform, kPoisson };
+enum class SampleMethod { kUniform, kPoisson, kStratified };
 
-// "uniform" or "poisson" (a usage error lists them).
+// "uniform", "poisson" or "stratified" (a usage error lists them).
 Result<SampleMethod> parseSampleMethod(std::string_view text);
 
 struct SampleOptions {
@@ -50,5 +55,9 @@ Result<PointSet> sampleSurface(const PointSet& mesh, const SampleOptions& option
 
 // The total area of the mesh's triangles (0 for a point set).
 double surfaceArea(const PointSet& mesh);
+// How coarse a mesh is where most of its surface lies: with its triangles ordered by their longest
+// edge, the longest edge of the one at half of the area (0 for a point set). A marching-cubes mesh's
+// is about its grid step; a CAD part's, whose flat faces are a few long triangles, far more.
+double medianTriangleEdge(const PointSet& mesh);
 
 }  // namespace dpoint

@@ -390,8 +390,9 @@ that memory, without copying (writing into them changes the set).)")
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
       R"(count points on a mesh's surface, as `dpoint convert MESH --sample N` makes them.
 
-method: uniform (independent points, uniform by area) or poisson (an even sample: weighted sample
-elimination from 5 x count uniform points, as Open3D's sample_points_poisson_disk). Colours and the
+method: uniform (independent points, uniform by area), poisson (an even sample: weighted sample
+elimination from 5 x count uniform points, as Open3D's sample_points_poisson_disk) or stratified
+(each triangle its share of the points, spread evenly in it). Colours and the
 normals (attributes nx, ny, nz) are interpolated over each triangle. The same seed gives the same
 points on any thread count. A set without triangles raises ValueError.)");
 

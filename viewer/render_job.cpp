@@ -19,6 +19,7 @@
 #include "core/text.h"
 #include "image/canvas.h"
 #include "ops/attribute_colors.h"
+#include "ops/mesh_sample.h"
 #include "ops/point_filters.h"
 #include "viewer/copc_view.h"
 #include "viewer/reference.h"
@@ -67,6 +68,7 @@ struct LoadedSet {
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
   std::optional<CopcReadStats> copc;   // a COPC input: what its view read
+  float min_point_px = 0.0f;           // a sampled mesh surface: the default point size at least this
 };
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
@@ -208,7 +210,18 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     }
     return set;
   }
-  ReadOptions read_options{request.threads, false, &progress, true};
+  // A mesh PLY is read with its faces when its surface may be drawn: asked for, or (auto) with few
+  // enough vertices that they may lie far apart on screen (a 16th of the pixels; its header says).
+  bool points_only = true;
+  if (request.surface != SurfaceChoice::kOff && request.inputs.size() == 1) {
+    Result<FileFormat> format = formatOf(request.inputs[0]);
+    if (format && *format == FileFormat::kPly)
+      if (Result<std::unique_ptr<PlyVertexStream>> header = PlyVertexStream::open(request.inputs[0]); header)
+        points_only = (*header)->faceCount() == 0 ||
+                      (request.surface == SurfaceChoice::kAuto &&
+                       (*header)->count() >= uint64_t{request.camera.width} * request.camera.height / 16);
+  }
+  ReadOptions read_options{request.threads, false, &progress, points_only};
   read_options.max_memory = request.max_memory;
   read_options.las_color = lasColorOf(request.color);
   Result<PointSet> read = readPointInputs(request.inputs, read_options);
@@ -216,6 +229,32 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   set.owned = std::move(*read);
   phases.mark("read");
   return set;
+}
+
+// A mesh drawn as its surface: points sampled on its triangles replace its vertices (the request's
+// own set stays as it is).
+Status sampleMeshSurface(const RenderRequest& request, LoadedSet& set, Progress& progress, RenderPhases& phases) {
+  const PointSet& mesh = *set.points();
+  if (!mesh.isMesh() || request.surface == SurfaceChoice::kOff) return okStatus();
+  const uint64_t count = meshSurfaceSamples(request.surface, mesh, request.camera.width, request.camera.height);
+  if (count == 0) return okStatus();
+  // Fewer samples than two per pixel of the surface (the cap): points as wide as 2.6 of their spacing.
+  const Box box = boundingBox(mesh.positions);
+  const double pixel = glm::length(box.max - box.min) / std::max(1u, std::max(request.camera.width, request.camera.height));
+  const double per_pixel = static_cast<double>(count) * pixel * pixel / surfaceArea(mesh);
+  if (per_pixel > 0.0) set.min_point_px = static_cast<float>(std::min(64.0, 2.6 / std::sqrt(per_pixel)));
+  SampleOptions options;
+  options.count = count;
+  options.method = SampleMethod::kStratified;  // no clumps and holes for the far side to show through
+  options.threads = request.threads;
+  options.max_memory = request.max_memory;
+  options.progress = &progress;
+  Result<PointSet> sample = sampleSurface(mesh, options, set.inputs);
+  if (!sample) return sample.error();
+  set.owned = std::move(*sample);
+  set.shared.reset();
+  phases.mark("surface");
+  return okStatus();
 }
 
 // The input, read, streamed or the request's own; its bounds, colours and order.
@@ -226,6 +265,7 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   const std::string& inputs = set.inputs;
   if (set.points()) {
     if (set.points()->size() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
+    if (Status s = sampleMeshSurface(request, set, progress, phases); !s) return s.error();
     set.count = set.points()->size(), set.has_colors = set.points()->hasColors();
   }
   if (request.color == RenderColor::kRgb && !set.has_colors)
@@ -307,6 +347,12 @@ void setWarmup(const WarmupRequest& warmup, uint32_t frames, RenderOptions& opti
   options.warmup_ms = ms;
 }
 
+// pointSizeFor's size, at least a sampled surface's floor (LoadedSet::min_point_px) unless given.
+float defaultPointSize(const RenderRequest& request, const LoadedSet& set, const Camera& camera, const DeviceFacts& facts) {
+  const float size = pointSizeFor(request, set.count, set.bounds, camera, facts, set.spacing);
+  return request.point_size ? size : std::max(size, set.min_point_px);
+}
+
 // Shading auto on a picture too large for the shading passes' buffers draws it plain, with a
 // warning in `warnings`.
 RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& set, PrecisionMode mode,
@@ -314,7 +360,7 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   RenderOptions options;
   options.mode = mode;
   options.backend = *request.backend;
-  options.point_size = pointSizeFor(request, set.count, set.bounds, camera, facts, set.spacing);
+  options.point_size = defaultPointSize(request, set, camera, facts);
   // A 2D grid drawn at its spacing closes exactly with squares; discs would leave their corners open.
   options.round_points = request.round_points.value_or(!set.bounds.planar);
   options.background_rgba8 = request.background_rgba8;
@@ -455,6 +501,24 @@ std::string coverWarning(double drawn_share, double drawn_span) {
 }
 
 const char* backendName(Backend backend) { return backend == Backend::kCompute ? "compute" : "raster"; }
+
+uint64_t meshSurfaceSamples(SurfaceChoice choice, const PointSet& mesh, uint32_t width, uint32_t height) {
+  if (choice == SurfaceChoice::kOff || !mesh.isMesh()) return 0;
+  const uint64_t pixels = uint64_t{width} * height;
+  if (choice == SurfaceChoice::kAuto && mesh.size() >= pixels) return 0;  // dense enough to draw as points
+  const Box box = boundingBox(mesh.positions);
+  // The fit's scale, about: the box's diagonal across the picture's larger side (an elongated part
+  // lies along it; the smaller side made the engine's samples 2× too sparse at 1920×1080).
+  const double pixel = glm::length(box.max - box.min) / std::max(1u, std::max(width, height));
+  if (choice == SurfaceChoice::kAuto && !(medianTriangleEdge(mesh) > kCoarseTrianglePx * pixel)) return 0;
+  const double area = surfaceArea(mesh);
+  if (!(area > 0.0)) return 0;
+  // Two per pixel: at one, uniform samples leave a few holes wider than the 3-pixel discs that EDL
+  // then outlines (the far side showed through BoxTextured's front faces).
+  const double cap = 2.0 * static_cast<double>(pixels);
+  const double wanted = pixel > 0.0 ? std::min(cap, 2.0 * area / (pixel * pixel)) : cap;
+  return static_cast<uint64_t>(std::max(1.0, std::ceil(wanted)));
+}
 
 Status checkPictureOutput(const std::string& path) {
   if (Status s = AtomicFile::checkTarget(path); !s) return s;  // where it goes, before any work
@@ -725,7 +789,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   if (!request.point_size && !spec.eye && !spec.view_center && !spec.view_width) {
     double radius = 0.0, free = HUGE_VAL;
     for (const Camera& camera : *cameras) {
-      radius = std::max(radius, 0.5 * pointSizeFor(resolved, set->count, set->bounds, camera, context.facts, set->spacing));
+      radius = std::max(radius, 0.5 * defaultPointSize(resolved, *set, camera, context.facts));
       free = std::min(free, 0.5 * kFitMarginShare * std::min(camera.width, camera.height));
     }
     if (radius + 0.5 > free) {

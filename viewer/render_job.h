@@ -61,6 +61,19 @@ Result<WarmupRequest> parseWarmup(const std::string& flag, const std::string& te
 // The text parseWarmup reads back to the same request ("auto", "2", "300ms").
 std::string warmupText(const WarmupRequest& warmup);
 
+enum class SurfaceChoice { kAuto, kOn, kOff };
+
+// How many points to sample on `mesh` drawn into a `width` × `height` picture: two per pixel of its
+// surface seen face-on at the fit's scale (the box's diagonal across the larger side), at most 2
+// per pixel of the picture. 0 for kOff, a point set, and for kAuto unless the mesh is coarse on
+// screen: fewer vertices than pixels and the area-weighted median triangle (medianTriangleEdge)
+// longer than kCoarseTrianglePx, a CAD part's flat faces, which its vertices alone leave empty.
+// A generated Mandelbulb, Julia set, Sierpinski tetrahedron or Menger sponge at its default
+// resolution (3-19 px at 640×480 to 1920×1080; a res-64 Mandelbulb 16 px at 1024×768) keeps its
+// vertices, which the hole filling closes; the 2CylinderEngine's are 31-94 px, BoxTextured's 500+.
+inline constexpr double kCoarseTrianglePx = 24.0;
+uint64_t meshSurfaceSamples(SurfaceChoice choice, const PointSet& mesh, uint32_t width, uint32_t height);
+
 // What the user asked for, as plain values (the CLI's options, parsed).
 struct RenderRequest {
   std::vector<std::string> inputs;   // drawn as one (point_inputs.h)
@@ -79,6 +92,9 @@ struct RenderRequest {
   CameraSpec camera;                 // the picture's size and the user's camera
   std::optional<double> point_size;  // pixels; none: pointSizeFor's choice
   std::optional<bool> round_points;  // RenderOptions::round_points; none: round for a 3D set
+  // A mesh input (triangles): draw points sampled on its surface (ops/mesh_sample.h). kAuto: when its
+  // vertices are sparser on screen than the picture's pixels (meshSurfaceSamples).
+  SurfaceChoice surface = SurfaceChoice::kAuto;
   uint32_t background_rgba8 = 0xff000000u;
   std::optional<Shading> shading;    // none: shadingFor's choice
   EdlOptions edl;

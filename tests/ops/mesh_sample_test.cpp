@@ -190,6 +190,36 @@ TEST(MeshSample, poissonSamplesAreEvenAndDeterministic) {
   EXPECT_EQ(std::memcmp(again->positions.data(), poisson->positions.data(), 3000 * sizeof(glm::dvec3)), 0);
 }
 
+// Stratified (render's surface): each triangle gets its expected count rounded down or up, and the
+// points lie on their triangles.
+TEST(MeshSample, stratifiedGivesEachTriangleItsShareWithinOnePoint) {
+  const PointSet engine = readMesh(kModels + "2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
+  ASSERT_FALSE(engine.triangles.empty());
+  std::vector<uint32_t> faces;
+  SampleOptions options;
+  options.count = 300000;
+  options.method = SampleMethod::kStratified;
+  options.faces = &faces;
+  Result<PointSet> sample = sampleSurface(engine, options, "engine");
+  ASSERT_TRUE(sample.ok()) << sample.error().message;
+  expectOnTriangles(engine, *sample, faces, "engine stratified");
+  const size_t triangles = engine.triangles.size() / 3;
+  std::vector<double> area(triangles);
+  double total = 0.0;
+  for (size_t t = 0; t < triangles; ++t) {
+    const glm::dvec3 a = engine.positions[engine.triangles[3 * t]];
+    area[t] = 0.5 * glm::length(glm::cross(engine.positions[engine.triangles[3 * t + 1]] - a,
+                                           engine.positions[engine.triangles[3 * t + 2]] - a));
+    total += area[t];
+  }
+  std::vector<double> count(triangles, 0.0);
+  for (uint32_t f : faces) count[f] += 1.0;
+  double worst = 0.0;
+  for (size_t t = 0; t < triangles; ++t) worst = std::max(worst, std::fabs(count[t] - area[t] / total * 300000.0));
+  EXPECT_LT(worst, 1.0 + 1e-6) << "a triangle's count is more than one point from its share";
+  EXPECT_GE(chiSquareP(engine, faces, 64), 0.01);
+}
+
 TEST(MeshSample, refusesWhatCannotBeSampled) {
   PointSet points;
   points.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};

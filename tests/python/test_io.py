@@ -272,5 +272,5 @@ def test_sample_gives_converts_points_on_the_surface(tmp_path):
     assert len(poisson) == 500
     with pytest.raises(ValueError, match="no triangles"):
         dpoint.sample(points, 10)
-    with pytest.raises(ValueError, match="uniform or poisson"):
+    with pytest.raises(ValueError, match="uniform, poisson or stratified"):
         dpoint.sample(mesh, 10, method="grid")

@@ -37,11 +37,8 @@ struct Rendered {
   }
 };
 
-// `dpoint render FILE -o out.png` with every default, on the set written as PLY.
-Rendered renderDefault(const PointSet& points, const std::string& name, RenderRequest request = {}) {
-  test::TempDir dir;
-  const std::string path = dir.file(name + ".ply");
-  EXPECT_TRUE(writePoints(path, points).ok());
+// `dpoint render FILE -o out.png` with every default.
+Rendered renderFile(const std::string& path, const std::string& name, RenderRequest request = {}) {
   request.inputs = {path};
   request.validate = true;
   Progress progress;
@@ -55,6 +52,14 @@ Rendered renderDefault(const PointSet& points, const std::string& name, RenderRe
               name.c_str(), double(r.point_size), r.backend.c_str(), 100.0 * r.gap.share, r.gap.gaps, r.gap.closed,
               r.gap.span_x, r.gap.span_y, outcome->image.width, outcome->image.height);
   return r;
+}
+
+// The same on the set written as PLY.
+Rendered renderDefault(const PointSet& points, const std::string& name, RenderRequest request = {}) {
+  test::TempDir dir;
+  const std::string path = dir.file(name + ".ply");
+  EXPECT_TRUE(writePoints(path, points).ok());
+  return renderFile(path, name, std::move(request));
 }
 
 double span(const Rendered& r) {
@@ -186,6 +191,34 @@ TEST(RenderFill, fillingHidesTheBackSurfaceSeenThroughTheGaps) {
   for (uint32_t y = 120; y < 280; ++y)
     for (uint32_t x = 120; x < 280; ++x) blue += (r.rgb(x, y) >> 16) > 0;
   EXPECT_EQ(blue, 0u) << "of 160 x 160 pixels inside the front plane";
+}
+
+// A glTF mesh whose vertices lie far apart on screen (a CAD part: BoxTextured's 24 vertices, the
+// 2CylinderEngine's flat faces of long triangles) is drawn as points sampled on its surface: closed,
+// within the picture with a margin (no drawn pixel in the outer 2-pixel frame). As vertices, the box
+// was 8 dots, two of them touching the top edge, and the engine a cloud of dots.
+TEST(RenderFill, defaultGltfMeshesReadAsClosedSurfacesWithAMargin) {
+  const std::string models = "/usr/share/assimp/models/glTF2/";
+  const std::pair<const char*, const char*> meshes[] = {
+      {"BoxTextured", "BoxTextured-glTF-Binary/BoxTextured.glb"},
+      {"2CylinderEngine", "2CylinderEngine-glTF-Binary/2CylinderEngine.glb"}};
+  for (const auto& [name, file] : meshes)
+    for (const auto& size : kSizes) {
+      RenderRequest request;
+      request.camera.width = size[0];
+      request.camera.height = size[1];
+      const std::string what = std::string(name) + " at " + std::to_string(size[0]) + "x" + std::to_string(size[1]);
+      const Rendered r = renderFile(models + file, what, request);
+      std::printf("  artefacts %.2f%% (%zu px)\n", 100.0 * r.gap.artefact_share, r.gap.artefacts);
+      EXPECT_LE(r.gap.share, 0.02) << what;
+      EXPECT_LE(r.gap.artefact_share, 0.005) << what;
+      EXPECT_GE(span(r), 0.85) << what;
+      size_t edge = 0;
+      for (uint32_t y = 0; y < r.image.height; ++y)
+        for (uint32_t x = 0; x < r.image.width; ++x)
+          if ((x < 2 || y < 2 || x + 2 >= r.image.width || y + 2 >= r.image.height) && r.rgb(x, y) != 0) ++edge;
+      EXPECT_EQ(edge, 0u) << what << ": drawn pixels at the picture's edge";
+    }
 }
 
 TEST(RenderFill, defaultMandelbrot2dGridHasNoGaps) {
