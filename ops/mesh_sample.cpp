@@ -24,7 +24,7 @@ struct Placement {
   double b = 0.0, c = 0.0;
 };
 
-glm::dvec3 vertex(const PointSet& mesh, uint32_t triangle, int k) { return mesh.positions[mesh.triangles[3 * size_t{triangle} + k]]; }
+glm::dvec3 vertex(const PointSet& mesh, uint32_t triangle, size_t k) { return mesh.positions[mesh.triangles[3 * size_t{triangle} + k]]; }
 
 class Sampler {
  public:
@@ -38,7 +38,7 @@ class Sampler {
     sums_.resize(triangles);
     double sum = 0.0;
     for (size_t t = 0; t < triangles; ++t) {
-      for (int k = 0; k < 3; ++k) {
+      for (size_t k = 0; k < 3; ++k) {
         const glm::dvec3 p = vertex(mesh_, static_cast<uint32_t>(t), k);
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
           return Error{what_ + ": triangle " + std::to_string(t) + " has a vertex that is not finite; it cannot be sampled"};
