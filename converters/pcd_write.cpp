@@ -199,45 +199,44 @@ class Writer {
     text.append(buf, r.ptr);
   }
 
+  // A field's stored bytes as ASCII, by its PCD type: integers as integers, floats in shortest
+  // round-trip form. So rgb (TYPE F) is the float whose bits are the colour, as PCL reads it, and
+  // rgba (TYPE U) the integer.
+  static void appendField(std::string& text, const OutField& f, const uint8_t* p) {
+    switch (f.type) {
+      case 'F':
+        if (f.size == 4)
+          appendNumber(text, loadUnaligned<float>(p));
+        else
+          appendNumber(text, loadUnaligned<double>(p));
+        break;
+      case 'U':
+        if (f.size == 8)
+          appendNumber(text, loadUnaligned<uint64_t>(p));
+        else
+          appendNumber(text, f.size == 1 ? uint32_t{p[0]} : f.size == 2 ? uint32_t{loadUnaligned<uint16_t>(p)} : loadUnaligned<uint32_t>(p));
+        break;
+      default:
+        if (f.size == 8)
+          appendNumber(text, loadUnaligned<int64_t>(p));
+        else
+          appendNumber(text, f.size == 1   ? int32_t{static_cast<int8_t>(p[0])}
+                             : f.size == 2 ? int32_t{loadUnaligned<int16_t>(p)}
+                                           : loadUnaligned<int32_t>(p));
+        break;
+    }
+  }
+
   Status writeAscii(AtomicFile& file) {
     const size_t n = points_.size();
     std::string text;
     size_t reported = 0;
     for (size_t i = 0; i < n; ++i) {
       for (size_t k = 0; k < fields_.size(); ++k) {
-        const OutField& f = fields_[k];
         if (k) text += ' ';
-        switch (f.source) {
-          case Source::kX:
-          case Source::kY:
-          case Source::kZ: {
-            const double v = coordinate(f, i);
-            if (f.size == 4)
-              appendNumber(text, static_cast<float>(v));
-            else
-              appendNumber(text, v);
-            break;
-          }
-          case Source::kRgb: {  // rgb: the float whose bits are the colour (PCL reads TYPE F so); rgba: the integer
-            const uint32_t c = packed(i);
-            if (alpha_)
-              appendNumber(text, c);
-            else
-              appendNumber(text, loadUnaligned<float>(&c));
-            break;
-          }
-          case Source::kDimension: {
-            const Dimension& d = *f.dimension;
-            switch (d.type) {
-              case DimType::kF32: appendNumber(text, d.get<float>(i)); break;
-              case DimType::kF64: appendNumber(text, d.get<double>(i)); break;
-              case DimType::kU64: appendNumber(text, d.get<uint64_t>(i)); break;
-              case DimType::kI64: appendNumber(text, d.get<int64_t>(i)); break;
-              default: appendNumber(text, static_cast<int64_t>(d.value(i))); break;
-            }
-            break;
-          }
-        }
+        uint8_t bytes[8];
+        store(fields_[k], i, bytes);  // the binary writers' bytes, as text
+        appendField(text, fields_[k], bytes);
       }
       text += '\n';
       if (text.size() >= (size_t{1} << 20) || i + 1 == n) {

@@ -26,6 +26,12 @@ struct Placement {
 
 glm::dvec3 vertex(const PointSet& mesh, uint32_t triangle, size_t k) { return mesh.positions[mesh.triangles[3 * size_t{triangle} + k]]; }
 
+// The area of triangle t, from its edges out of vertex 0 (the differences keep a far-off mesh exact).
+double triangleArea(const PointSet& mesh, uint32_t t) {
+  const glm::dvec3 p0 = vertex(mesh, t, 0);
+  return 0.5 * glm::length(glm::cross(vertex(mesh, t, 1) - p0, vertex(mesh, t, 2) - p0));
+}
+
 class Sampler {
  public:
   Sampler(const PointSet& mesh, const SampleOptions& options, const std::string& what)
@@ -43,9 +49,7 @@ class Sampler {
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
           return Error{what_ + ": triangle " + std::to_string(t) + " has a vertex that is not finite; it cannot be sampled"};
       }
-      const glm::dvec3 p0 = vertex(mesh_, static_cast<uint32_t>(t), 0);
-      sum += 0.5 * glm::length(glm::cross(vertex(mesh_, static_cast<uint32_t>(t), 1) - p0,
-                                          vertex(mesh_, static_cast<uint32_t>(t), 2) - p0));
+      sum += triangleArea(mesh_, static_cast<uint32_t>(t));
       sums_[t] = sum;
     }
     if (!(sum > 0.0) || !std::isfinite(sum))
@@ -357,10 +361,7 @@ Result<SampleMethod> parseSampleMethod(std::string_view text) {
 
 double surfaceArea(const PointSet& mesh) {
   double sum = 0.0;
-  for (size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
-    const glm::dvec3 p0 = mesh.positions[mesh.triangles[t]];
-    sum += 0.5 * glm::length(glm::cross(mesh.positions[mesh.triangles[t + 1]] - p0, mesh.positions[mesh.triangles[t + 2]] - p0));
-  }
+  for (size_t t = 0; t < mesh.triangles.size() / 3; ++t) sum += triangleArea(mesh, static_cast<uint32_t>(t));
   return sum;
 }
 
@@ -368,10 +369,9 @@ double medianTriangleEdge(const PointSet& mesh) {
   std::vector<std::pair<double, double>> edges;  // longest edge, area
   edges.reserve(mesh.triangles.size() / 3);
   double total = 0.0;
-  for (size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
-    const glm::dvec3 a = mesh.positions[mesh.triangles[t]], b = mesh.positions[mesh.triangles[t + 1]],
-                     c = mesh.positions[mesh.triangles[t + 2]];
-    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+  for (uint32_t t = 0; t < mesh.triangles.size() / 3; ++t) {
+    const glm::dvec3 a = vertex(mesh, t, 0), b = vertex(mesh, t, 1), c = vertex(mesh, t, 2);
+    const double area = triangleArea(mesh, t);
     if (!(area > 0.0)) continue;
     edges.emplace_back(std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)}), area);
     total += area;
