@@ -59,7 +59,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   g.triangles = !out_format || *out_format != FileFormat::kCsv || o.sample != 0;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
-  if (!o.columns.empty()) r.columns = splitAt(o.columns, ',');
+  r.columns = columnsOf(o.columns);
   std::vector<std::string> notices;
   r.notices = &notices;
   Result<PointSet> points = readInput(o.input, r, g);
@@ -152,9 +152,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->default_str("auto")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
-  cmd->add_option("--columns", o->columns,
-                  "Text input: what each column holds, e.g. x,y,z,-,intensity: x, y, z, r, g, b (red, green, blue),\n"
-                  "- to skip a column, any other name a dimension; a header line is then passed over");
+  addColumnsOption(*cmd, o->columns);
   cmd->add_option("--sample", o->sample,
                   "Mesh input: write N points on its surface (uniform by area, colours and normals interpolated) "
                   "instead of its vertices");

@@ -20,6 +20,7 @@ struct InfoCliOptions {
   std::string stream = "auto";
   int scene = -1;
   bool all_scenes = false;
+  std::string columns;
   CommonOptions common;
 };
 
@@ -32,6 +33,7 @@ int runInfo(const InfoCliOptions& o) {
   InfoInputs inputs{o.inputs, o.stream, o.allow_nonfinite, *limit};
   inputs.scene = o.scene;
   inputs.all_scenes = o.all_scenes;
+  inputs.columns = columnsOf(o.columns);
   const InfoOptions options{*spec, o.sample, *parseTolerance(o.camera.tolerance), o.common.threads};
   Result<InfoReport> report = describeFiles(inputs, options, progress);
   if (!report) return reportError(report.error());
@@ -61,6 +63,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   auto* scene = cmd->add_option("--scene", o->scene, "glTF: describe scene N instead of the default scene (else scene 0)")
                     ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--all-scenes", o->all_scenes, "glTF: every scene, one after the other, as one set")->excludes(scene);
+  addColumnsOption(*cmd, o->columns);
   addCameraOptions(*cmd, o->camera);
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,

@@ -36,6 +36,7 @@ struct RenderCliOptions {
   std::string warmup = "auto";
   uint64_t chunk_points = 0;
   std::string max_memory;
+  std::string columns;
   CommonOptions common;
 };
 
@@ -98,6 +99,7 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
                         : o.native_path == "pull"    ? NativePath::kPull
                                                      : NativePath::kAuto;
   request.stream = o.stream;
+  request.columns = columnsOf(o.columns);
   request.threads = o.common.threads;
   if (Status s = checkRenderRequest(request); !s) return s.error();
   Result<uint64_t> device_memory =
@@ -280,6 +282,7 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
                   "surface wins where discs overlap and a point behind it shows no edge), square (the rasterizer's\n"
                   "squares at one depth), or auto: round for a 3D set, square for a 2D one (a grid closes exactly)",
                   {"auto", "round", "square"});
+  addColumnsOption(*cmd, o->columns);
   addChoiceOption(*cmd, "--surface", o->surface,
                   "A mesh input (glTF, or a PLY with faces): on draws points sampled on its surface, about two per\n"
                   "pixel it covers (each triangle its share, colours and normals interpolated); off its vertices;\n"

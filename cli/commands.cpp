@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 
 #include "core/memory.h"
+#include "core/text.h"
 
 namespace dpoint {
 
@@ -15,6 +16,17 @@ void addMaxMemoryOption(CLI::App& command, std::string& text) {
   command.add_option("--max-memory", text,
                      "Refuse (exit 4) work whose memory, estimated before allocating, is above this, e.g. 512M, 8G "
                      "(default: half of RAM)");
+}
+
+void addColumnsOption(CLI::App& command, std::string& text) {
+  command.add_option("--columns", text,
+                     "Text input: what each column holds, e.g. x,y,z,-,intensity: x, y, z, r, g, b (red, green, blue),\n"
+                     "- to skip a column, any other name a dimension; a header line is then passed over");
+}
+
+std::vector<std::string> columnsOf(const std::string& text) {
+  if (text.empty()) return {};
+  return splitAt(text, ',');
 }
 
 Result<uint64_t> memoryLimitOf(const std::string& text) {

@@ -36,4 +36,9 @@ void addCommonOptions(CLI::App& command, CommonOptions& options);
 void addMaxMemoryOption(CLI::App& command, std::string& text);
 Result<uint64_t> memoryLimitOf(const std::string& text);
 
+// --columns x,y,z,-,intensity for commands that read text point files (CsvReadOptions::columns);
+// columnsOf: its names, none when it is not given.
+void addColumnsOption(CLI::App& command, std::string& text);
+std::vector<std::string> columnsOf(const std::string& text);
+
 }  // namespace dpoint

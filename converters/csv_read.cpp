@@ -350,7 +350,8 @@ Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64
   if (columns == 5) return layout(Known::kXyRgb);
   if (columns == 6) return layout(Known::kXyzRgb);
   return Error{path + ":" + std::to_string(line) + ": " + std::to_string(columns) +
-               " columns without a header; expected 2 (x,y), 3 (x,y,z), 5 (x,y,r,g,b) or 6 (x,y,z,r,g,b)"};
+               " columns without a header; expected 2 (x,y), 3 (x,y,z), 5 (x,y,r,g,b) or 6 (x,y,z,r,g,b); "
+               "--columns names each, e.g. x,y,z,intensity"};
 }
 
 // A PTS file's rows (Leica Cyclone, FARO, CloudCompare): x y z, x y z intensity, x y z r g b or

@@ -42,7 +42,7 @@ void addCommands(py::module_& m) {
       "_info",
       [](const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
          const std::vector<std::string>& camera_args, size_t sample, unsigned threads, bool allow_nonfinite,
-         const std::string& stream, uint64_t max_memory, bool progress) {
+         const std::string& stream, uint64_t max_memory, const std::vector<std::string>& columns, bool progress) {
         const CameraRequest camera = take(cameraRequestOf(camera_args));
         if (stream != "auto" && stream != "on" && stream != "off")
           raise(Error{"--stream " + stream + ": must be auto, on or off", ExitCode::kUsage});  // as the CLI's oneOf
@@ -52,12 +52,14 @@ void addCommands(py::module_& m) {
         InfoReport report = take(released([&] {
           if (points) return describePoints(*points, "points", options);
           Progress bar(progressFile(progress), "info");
-          return describeFiles(InfoInputs{inputs, stream, allow_nonfinite, max_memory}, options, bar);
+          InfoInputs files{inputs, stream, allow_nonfinite, max_memory};
+          files.columns = columns;
+          return describeFiles(files, options, bar);
         }));
         return infoReportJson(report);
       },
       py::arg("points"), py::arg("inputs"), py::arg("camera_args"), py::arg("sample"), py::arg("threads"),
-      py::arg("allow_nonfinite"), py::arg("stream"), py::arg("max_memory"), py::arg("progress"));
+      py::arg("allow_nonfinite"), py::arg("stream"), py::arg("max_memory"), py::arg("columns"), py::arg("progress"));
 
   m.def(
       "_bench",

@@ -258,7 +258,8 @@ std::optional<LasColorSource> lasColorSource(const std::string& name) {
 
 std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bool allow_nonfinite,
                                    const std::string& colors, const py::object& max_memory, int scene, bool all_scenes,
-                                   uint64_t max_points, bool progress) {
+                                   uint64_t max_points, const std::optional<std::vector<std::string>>& columns,
+                                   bool progress) {
   const std::optional<LasColorSource> source = lasColorSource(colors);
   if (!source)
     raise(Error{"colors: '" + colors + "' is not one of auto, rgb, intensity, classification, none", ExitCode::kUsage});
@@ -270,6 +271,7 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
     ReadOptions r{threads, allow_nonfinite, &bar};
     r.max_memory = limit;
     r.las_color = *source;
+    if (columns) r.columns = *columns;
     return readInput(path, r, g, InputOptionNames{"scene and all_scenes", "max_points"});
   })));
 }
@@ -399,18 +401,22 @@ points on any thread count. A set without triangles raises ValueError.)");
   m.def(
       "read",
       [](const std::string& path, unsigned threads, bool allow_nonfinite, const std::string& colors,
-         const py::object& max_memory, int scene, bool all_scenes, uint64_t max_points, bool progress) {
-        return readFile(path, threads, allow_nonfinite, colors, max_memory, scene, all_scenes, max_points, progress);
+         const py::object& max_memory, int scene, bool all_scenes, uint64_t max_points,
+         const std::optional<std::vector<std::string>>& columns, bool progress) {
+        return readFile(path, threads, allow_nonfinite, colors, max_memory, scene, all_scenes, max_points, columns,
+                        progress);
       },
       py::arg("path"), py::kw_only(), py::arg("threads") = 0u, py::arg("allow_nonfinite") = false,
       py::arg("colors") = "auto", py::arg("max_memory") = py::none(), py::arg("scene") = -1,
-      py::arg("all_scenes") = false, py::arg("max_points") = uint64_t{0}, py::arg("progress") = false,
+      py::arg("all_scenes") = false, py::arg("max_points") = uint64_t{0}, py::arg("columns") = py::none(),
+      py::arg("progress") = false,
       R"(Reads a .csv (or .xyz, .txt, .asc, .pts), .ply, .pcd, .las, .laz, .glb or .gltf file (by extension) as `dpoint convert` does.
 
 colors: LAS colour source (auto, rgb, intensity, classification, none); other formats take auto,
 rgb or none. scene / all_scenes: glTF scenes (as --scene, --all-scenes). max_memory: bytes or
-"8G" (default: half of RAM). max_points: refuse a larger set (MemoryError). progress: lines on
-stderr.)");
+"8G" (default: half of RAM). max_points: refuse a larger set (MemoryError). columns: text files,
+what each column holds, "x,y,z,-,intensity" or a list of the names (as --columns; "-" skips one).
+progress: lines on stderr.)");
 
   m.def(
       "write",

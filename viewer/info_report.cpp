@@ -170,6 +170,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) return describeStream(**stream, name, options, progress);
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};
   read.max_memory = inputs.max_memory;
+  read.columns = inputs.columns;
   const bool scenes = inputs.scene >= 0 || inputs.all_scenes;
   if (scenes && inputs.paths.size() != 1)
     return Error{name + ": --scene and --all-scenes apply to one .glb/.gltf input", ExitCode::kUsage};

@@ -86,6 +86,7 @@ struct InfoInputs {
   uint64_t max_memory = 0;           // host memory limit in bytes; 0: half of RAM
   int scene = -1;                    // glTF: the scene (-1: the default), as `convert --scene`
   bool all_scenes = false;           // glTF: every scene (`--all-scenes`)
+  std::vector<std::string> columns = {};  // text input: what each column holds (`--columns`)
 };
 
 // The report of the files, named describeInputs(paths): streamed (describeStream) where

@@ -224,6 +224,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   ReadOptions read_options{request.threads, false, &progress, points_only};
   read_options.max_memory = request.max_memory;
   read_options.las_color = lasColorOf(request.color);
+  read_options.columns = request.columns;
   Result<PointSet> read = readPointInputs(request.inputs, read_options);
   if (!read) return read.error();
   set.owned = std::move(*read);

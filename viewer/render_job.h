@@ -111,6 +111,7 @@ struct RenderRequest {
   uint64_t chunk_points = 0;         // most points per draw; 0: as the device allows
   NativePath native_path = NativePath::kAuto;
   std::string stream = "auto";       // auto|on|off (openPointStream)
+  std::vector<std::string> columns = {};  // text input: what each column holds (`--columns`)
   uint64_t max_memory = 0;           // host memory limit in bytes; 0: half of RAM
   unsigned threads = 0;
 };

@@ -56,7 +56,16 @@ def _value(value) -> str:
         items = list(value)
     except TypeError:
         return str(value)
-    return ",".join(_value(v if isinstance(v, _numbers.Real) else float(v)) for v in items)
+    return ",".join(_value(v if isinstance(v, (_numbers.Real, str)) else float(v)) for v in items)
+
+
+def _column_names(columns):
+    """columns= of read and info: "x,y,z,-,i" or ["x", "y", "z", "-", "i"] as a list of names."""
+    if columns is None:
+        return None
+    if isinstance(columns, str):
+        return columns.split(",")
+    return [str(c) for c in columns]
 
 
 def _args(options: dict) -> list[str]:
@@ -208,6 +217,8 @@ def render(points, mode: str = "auto", *, progress: bool = False, **options) -> 
 
 
 def read(path, **options) -> PointSet:
+    if "columns" in options:
+        options["columns"] = _column_names(options["columns"])
     return _dpoint.read(_os.fspath(path), **options)
 
 
@@ -244,17 +255,19 @@ def generate(kind: str, *, progress: bool = False, **options) -> PointSet:
 
 
 def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool = False, stream: str = "auto",
-         max_memory=None, progress: bool = False, **camera) -> dict:
+         max_memory=None, columns=None, progress: bool = False, **camera) -> dict:
     """The facts ``dpoint info --json`` prints, as a dict: counts, bounds, whether float32 holds the
     set, and each mode's predicted error bound in pixels for the view (error_bound_px).
 
     points: a PointSet, an array, a DataFrame, or files. camera: render's camera options (width,
     height, eye, target, up, fit, fov, ortho, view_center, view_width, tolerance). sample: points
-    sampled for the nearest-neighbour distance.
+    sampled for the nearest-neighbour distance. columns: text files, what each column holds (as
+    read's columns).
     """
     in_memory, inputs = _as_points(points)
     limit = _dpoint._memory_size("max_memory", max_memory)
-    text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit, progress)
+    text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit,
+                         _column_names(columns) or [], progress)
     return _json.loads(text)
 
 

@@ -295,6 +295,32 @@ TEST(Cli, infoReportsFloatMergesAsJson) {
   EXPECT_NE(text.out.find("float32 enough:     no"), std::string::npos) << text.out;
 }
 
+// --columns is read by info and render as by convert: a headerless file whose first column is an
+// intensity is refused without it (naming the option), and read with it.
+TEST(Cli, infoAndRenderTakeColumnsAsConvertDoes) {
+  TempDir dir;
+  writeFile(dir.file("a.xyz"), "7 1.5 2.5 3.5\n9 4.5 5.5 6.5\n8 2 3 4\n");
+  test::CommandResult plain = runDpoint({"info", dir.file("a.xyz"), "--json"});
+  EXPECT_EQ(plain.exit_code, 2);
+  EXPECT_NE(plain.err.find("a.xyz:1: 4 columns without a header"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("--columns"), std::string::npos) << plain.err;
+  test::CommandResult info = runDpoint({"info", dir.file("a.xyz"), "--columns", "intensity,x,y,z", "--json"});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("\"min\": [1.5, 2.5, 3.5]"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("{\"name\": \"intensity\", \"type\": \"uint16\", \"min\": 7, \"max\": 9}"),
+            std::string::npos)
+      << info.out;
+  test::CommandResult render = runDpoint({"render", dir.file("a.xyz"), "--columns", "intensity,x,y,z", "--color",
+                                          "intensity", "--width", "64", "--height", "48", "-o", dir.file("a.png"),
+                                          "--json", dir.file("a.json"), "-q"});
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_NE(test::readFile(dir.file("a.json")).find("\"points\": 3"), std::string::npos);
+  test::CommandResult short_row = runDpoint({"render", dir.file("a.xyz"), "--columns", "q,x,y", "-o", dir.file("b.png")});
+  EXPECT_EQ(short_row.exit_code, 2);
+  EXPECT_NE(short_row.err.find("a.xyz:1: 4 columns, expected 3 (q,x,y)"), std::string::npos) << short_row.err;
+  EXPECT_FALSE(test::fileExists(dir.file("b.png")));
+}
+
 // info prints each render mode's predicted error for a view: fp32 fails at a 1e-13 zoom of 0.74,
 // native and batch do not; the camera flags are render's.
 TEST(Cli, infoAdvisesEachModesErrorBoundForAView) {

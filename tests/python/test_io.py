@@ -274,3 +274,20 @@ def test_sample_gives_converts_points_on_the_surface(tmp_path):
         dpoint.sample(points, 10)
     with pytest.raises(ValueError, match="uniform, poisson or stratified"):
         dpoint.sample(mesh, 10, method="grid")
+
+
+def test_read_info_and_render_take_columns_as_the_cli(tmp_path):
+    path = tmp_path / "a.xyz"
+    path.write_text("7 1.5 2.5 3.5\n9 4.5 5.5 6.5\n8 2 3 4\n")
+    with pytest.raises(ValueError, match=r"a\.xyz:1: 4 columns without a header.*--columns"):
+        dpoint.read(path)
+    for columns in ("intensity,x,y,z", ["intensity", "x", "y", "z"]):
+        points = dpoint.read(path, columns=columns)
+        assert points.positions.tolist() == [[1.5, 2.5, 3.5], [4.5, 5.5, 6.5], [2.0, 3.0, 4.0]]
+        assert points.attributes["intensity"].tolist() == [7, 9, 8]
+        facts = dpoint.info(path, columns=columns)
+        assert facts["points"] == 3 and facts["min"] == [1.5, 2.5, 3.5]
+        picture = dpoint.render(path, "fp32", columns=columns, width=32, height=24)
+        assert picture.report["points"] == 3
+    with pytest.raises(ValueError, match=r"4 columns, expected 3 \(q,x,y\)"):
+        dpoint.read(path, columns=["q", "x", "y"])
