@@ -52,7 +52,8 @@ GltfReadOptions gltfOptions(const ConvertOptions& o) {
   return g;
 }
 
-Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
+// `texture`: when not null, gets a glTF mesh's base-colour textures (for --sample).
+Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress, MeshTexture* texture) {
   GltfReadOptions g = gltfOptions(o);
   // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
   Result<FileFormat> out_format = formatOf(o.output);
@@ -60,6 +61,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress) {
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
   r.columns = columnsOf(o.columns);
+  r.texture = texture;
   std::vector<std::string> notices;
   r.notices = &notices;
   Result<PointSet> points = readInput(o.input, r, g);
@@ -102,9 +104,11 @@ int runConvert(ConvertOptions& o) {
     w.decimals = lasStepDecimals(*header);
     w.decimals_at_scale = w.decimals >= 0;
   }
-  Result<PointSet> points = readConvertInput(o, progress);
+  MeshTexture texture;
+  Result<PointSet> points = readConvertInput(o, progress, o.sample != 0 ? &texture : nullptr);
   if (!points) return reportError(points.error());
   if (o.sample != 0) {
+    for (const std::string& note : texture.notes) std::fprintf(stderr, "dpoint: note: %s\n", note.c_str());
     SampleOptions sample;
     sample.count = o.sample;
     sample.method = *parseSampleMethod(o.sample_method);  // checked by the option's validator
@@ -112,6 +116,7 @@ int runConvert(ConvertOptions& o) {
     sample.threads = o.common.threads;
     sample.max_memory = o.memory_limit;
     sample.progress = &progress;
+    sample.texture = &texture;
     Result<PointSet> sampled = sampleSurface(*points, sample, o.input);
     if (!sampled) return reportError(sampled.error());
     points = std::move(sampled);
@@ -154,8 +159,8 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   addColumnsOption(*cmd, o->columns);
   cmd->add_option("--sample", o->sample,
-                  "Mesh input: write N points on its surface (uniform by area, colours and normals interpolated) "
-                  "instead of its vertices");
+                  "Mesh input: write N points on its surface (uniform by area, colours and normals interpolated, "
+                  "times a glTF base-colour texture) instead of its vertices");
   cmd->add_option("--sample-method", o->sample_method,
                   "uniform: independent points, uniform by area; poisson: an even sample (weighted sample "
                   "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk); stratified: "

@@ -259,6 +259,7 @@ struct FolderJail {
   uint64_t max_bytes = 0;
   uint64_t memory_left = 0;          // --max-memory left for external files, all of them together
   bool in_memory = false;            // the model came from memory: it has no folder, nothing is read
+  bool keep_images = false;          // keep the encoded bytes of images given by uri (keepImage)
 };
 
 bool allowed(const std::string& file, const FolderJail& jail) {
@@ -307,9 +308,19 @@ bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigne
   return false;
 }
 
-// We take points, never textures: keep image bytes undecoded (tinygltf's own decoder reads past
-// the end of an image stored in a bufferView).
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// Image bytes are never decoded here (tinygltf's own decoder reads past the end of an image stored
+// in a bufferView). When the caller wants textures, the encoded bytes of an image given by uri
+// (a data URI or a file in the model's folder) are kept in Image::image, as far as --max-memory
+// allows (else the image is left empty and its texture unused); an image in a bufferView is read
+// from its buffer afterwards (readGltfImageBytes), since tinygltf sees a stand-in of zeros here.
+bool keepImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
+               int size, void* user) {
+  auto& jail = *static_cast<FolderJail*>(user);
+  if (!jail.keep_images || image->bufferView >= 0 || bytes == nullptr || size <= 0) return true;
+  if (uint64_t(size) > jail.memory_left) return true;
+  jail.memory_left -= uint64_t(size);
+  image->image.assign(bytes, bytes + size);
+  image->as_is = true;
   return true;
 }
 
@@ -357,7 +368,7 @@ std::optional<BinHandOver> standInForBin(JsonValue& document, const GlbLayout& g
   return out;
 }
 
-Result<tinygltf::Model> load(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory) {
+Result<tinygltf::Model> load(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory, bool keep_images) {
   const std::string& path = input.path();
   if (input.size() == 0) return Error{path + ": file is empty"};
   if (input.size() > max_file_bytes)
@@ -440,9 +451,10 @@ Result<tinygltf::Model> load(const InputFile& input, uint64_t max_file_bytes, ui
   }
   jail.max_bytes = max_file_bytes;
   jail.memory_left = memory_left;
+  jail.keep_images = keep_images;
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&jailedFileExists, &noExpansion, &jailedReadWholeFile, &refuseWrite, &jail});
-  loader.SetImageLoader(&skipImage, nullptr);
+  loader.SetImageLoader(&keepImage, &jail);
   tinygltf::Model model;
   std::string err, warn;
   const std::vector<unsigned char>& input_bytes = hand_over ? tinygltf_input : bytes;
@@ -482,11 +494,12 @@ bool gltfRequiredExtensionSupported(const std::string& name) {
   return false;
 }
 
-Result<tinygltf::Model> loadGltfModel(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory) {
+Result<tinygltf::Model> loadGltfModel(const InputFile& input, uint64_t max_file_bytes, uint64_t max_memory,
+                                      bool keep_images) {
   // tinygltf throws (std::bad_alloc on huge byteLength, nlohmann exceptions); none may escape.
   const std::string& path = input.path();
   try {
-    return load(input, max_file_bytes, max_memory == 0 ? defaultMemoryLimit() : max_memory);
+    return load(input, max_file_bytes, max_memory == 0 ? defaultMemoryLimit() : max_memory, keep_images);
   } catch (const std::bad_alloc&) {
     return Error{path + ": out of memory while loading", ExitCode::kResourceLimit};
   } catch (const std::exception& e) {

@@ -24,6 +24,7 @@
 #include "converters/gltf_dimensions.h"
 #include "converters/gltf_load.h"
 #include "converters/gltf_position.h"
+#include "converters/gltf_texture.h"
 #include "core/interrupt.h"
 #include "core/memory.h"
 
@@ -149,7 +150,12 @@ class SceneReader {
         options_(options),
         memory_limit_(options.max_memory ? options.max_memory : defaultMemoryLimit()),
         decoder_(path, model, std::min<uint64_t>(kMaxUnbackedValues, memory_limit_ / sizeof(double))),
-        dimensions_(findDimensions(model)) {}
+        dimensions_(findDimensions(model)) {
+    if (options.texture && options.triangles) {
+      *options.texture = MeshTexture{};
+      textures_.emplace(path, model, memory_limit_, *options.texture);
+    }
+  }
 
   Result<PointSet> read() {
     pass_ = Pass::kBuild;
@@ -161,6 +167,10 @@ class SceneReader {
     const bool flat = saysFlat(model_) && std::all_of(out_.positions.begin(), out_.positions.end(),
                                                       [](const glm::dvec3& p) { return p.z == 0.0; });
     out_.z_axis = flat ? ZAxis::kAbsent : ZAxis::kPresent;
+    if (textures_) {
+      options_.texture->uv.resize(out_.positions.size());
+      options_.texture->triangle_image.resize(out_.triangles.size() / 3, -1);
+    }
     if (any_colour_) {
       out_.colors.resize(out_.positions.size());
       for (const Uncoloured& u : uncoloured_)
@@ -603,6 +613,12 @@ class SceneReader {
 
     // Triangles in the output numbering; points and lines add none.
     if (pass_ != Pass::kBuild || !options_.triangles) return okStatus();
+    int32_t image = -1;  // the primitive's texture, when asked for
+    if (textures_) {
+      Result<int32_t> read = readTexCoords(primitive, pointer, remap, count, begin, begin + emitted);
+      if (!read) return read.error();
+      image = *read;
+    }
     const AccessorElements* index_elements = *indices ? &**indices : nullptr;
     const size_t n = index_elements ? index_elements->count() : count;
     const auto vertex = [&](size_t i) -> uint32_t {
@@ -629,7 +645,47 @@ class SceneReader {
     } else if (primitive.mode == TINYGLTF_MODE_TRIANGLE_FAN) {
       for (size_t i = 0; i + 3 <= n; ++i) triangle(i + 1, i + 2, 0);
     }
+    if (textures_) options_.texture->triangle_image.resize(out_.triangles.size() / 3, image);
     return okStatus();
+  }
+
+  // The texture coordinates of the primitive's points [emitted_begin, emitted_end) when its
+  // material has a base-colour texture that decodes: its image in the MeshTexture, else -1.
+  Result<int32_t> readTexCoords(const tinygltf::Primitive& primitive, const std::string& pointer,
+                                const std::vector<uint32_t>& remap, size_t count, size_t emitted_begin,
+                                size_t emitted_end) {
+    MeshTexture& texture = *options_.texture;
+    texture.triangle_image.resize(out_.triangles.size() / 3, -1);  // the triangles before this primitive's
+    texture.uv.resize(emitted_end);
+    Result<GltfTextureUse> use = textures_->use(primitive, pointer);
+    if (!use) return use.error();
+    if (use->image < 0) return -1;
+    const std::string name = "TEXCOORD_" + std::to_string(use->tex_coord);
+    const auto it = primitive.attributes.find(name);
+    if (it == primitive.attributes.end()) {
+      texture.notes.push_back(path_ + ": " + pointer + " has a base-colour texture but no " + name +
+                              "; its triangles are sampled without it");
+      return -1;
+    }
+    Result<AccessorElements> uv = decoder_.open(it->second);
+    if (!uv) return uv.error();
+    const int ct = uv->componentType();
+    const bool type_ok = (ct == TINYGLTF_COMPONENT_TYPE_FLOAT && !uv->normalized()) ||
+                         ((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                          uv->normalized());
+    if (uv->components() != 2 || !type_ok)
+      return decoder_.fail(it->second, name + " must be VEC2 of float or normalized unsigned byte/short");
+    if (uv->count() != count)
+      return decoder_.fail(it->second, name + " count " + std::to_string(uv->count()) + " differs from POSITION count " +
+                                           std::to_string(count));
+    for (size_t e = 0; e < count; ++e) {
+      if (!remap.empty() && remap[e] == kUnused) continue;
+      const glm::dvec3 moved = use->transform * glm::dvec3(uv->value(e, 0), uv->value(e, 1), 1.0);
+      if (!std::isfinite(moved.x) || !std::isfinite(moved.y))
+        return decoder_.fail(it->second, name + " element " + std::to_string(e) + " is not finite");
+      texture.uv[emitted_begin + (remap.empty() ? e : remap[e])] = glm::vec2(moved);
+    }
+    return use->image;
   }
 
   // The colour of a primitive without COLOR_0: its material's base colour, white without one.
@@ -755,6 +811,7 @@ class SceneReader {
   std::vector<GltfDimension> dimensions_;  // findDimensions: the set's columns, in this order
   GltfPointSink* sink_ = nullptr;
   PointSet block_;  // emitting pass: points not yet handed to sink_
+  std::optional<GltfTextures> textures_;  // when options_.texture asks for them
 };
 
 }  // namespace
@@ -768,7 +825,8 @@ Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& option
 Result<PointSet> readGltf(const InputFile& input, const GltfReadOptions& options) {
   const std::string& path = input.path();
   try {
-    Result<tinygltf::Model> model = loadGltfModel(input, options.max_file_bytes, options.max_memory);
+    Result<tinygltf::Model> model =
+        loadGltfModel(input, options.max_file_bytes, options.max_memory, options.texture != nullptr);
     if (!model) return model.error();
     return SceneReader(path, *model, options).read();
   } catch (const std::bad_alloc&) {

@@ -16,6 +16,7 @@
 // - Colours (linear 0..1) when any primitive has COLOR_0 (float, unorm8 or unorm16, VEC3/VEC4,
 //   alpha dropped) or a material whose baseColorFactor rgb is not white; primitives without
 //   COLOR_0 then take their material's baseColorFactor rgb (white without a material).
+//   Textures are read only when asked (GltfReadOptions::texture), for sampling the surface.
 // - Required extensions: KHR_mesh_quantization, EXT_meshopt_compression (gltf_meshopt.h),
 //   KHR_draco_mesh_compression (gltf_draco.h) and EXT_mesh_gpu_instancing are decoded;
 //   shading-only ones are accepted; any other is refused by name.
@@ -30,6 +31,7 @@
 #include "core/input_file.h"
 #include "core/point_set.h"
 #include "core/result.h"
+#include "ops/mesh_texture.h"
 
 namespace dpoint {
 
@@ -47,6 +49,10 @@ struct GltfReadOptions {
   // checked before it is allocated; over it is kResourceLimit. 0: defaultMemoryLimit().
   uint64_t max_memory = 0;
   bool triangles = true;     // false: points only (CSV output stores no triangles; saves 12 B/triangle)
+  // When not null (and with triangles): receives the set's base-colour textures, for the mesh
+  // sampler (ops/mesh_texture.h): each vertex's TEXCOORD (float or normalized (u)byte/(u)short
+  // VEC2, through KHR_texture_transform) and each triangle's image, decoded (gltf_texture.h).
+  MeshTexture* texture = nullptr;
 };
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});

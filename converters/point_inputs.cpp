@@ -26,6 +26,12 @@ bool isCompleteTileSet(const std::vector<std::string>& paths) {
 
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
   if (paths.size() == 1) return readPoints(paths[0], options);
+  if (options.texture) {  // a texture is one file's: several are read without
+    *options.texture = MeshTexture{};
+    ReadOptions each = options;
+    each.texture = nullptr;
+    return readPointInputs(paths, each);
+  }
   if (isCompleteTileSet(paths)) {
     Result<PointSet> whole = mergeTiles(paths, 0, options.progress);
     if (whole && options.points_only) whole->triangles.clear();

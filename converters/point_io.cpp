@@ -137,6 +137,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
       GltfReadOptions gltf;
       gltf.allow_nonfinite = options.allow_nonfinite;
       gltf.max_memory = options.max_memory;
+      gltf.texture = options.texture;
       return readGltf(path, gltf);
     }
     case FileFormat::kLas:
@@ -149,6 +150,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
 }  // namespace
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options) {
+  if (options.texture) *options.texture = MeshTexture{};
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
   const bool las = *format == FileFormat::kLas || *format == FileFormat::kLaz;
@@ -172,6 +174,7 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
     gltf.max_memory = read.max_memory;
     gltf.allow_nonfinite = read.allow_nonfinite;
     gltf.max_points_name = names.max_points;
+    if (!gltf.texture) gltf.texture = read.texture;
     return readGltf(path, gltf);
   }
   if (gltf.scene >= 0 || gltf.all_scenes)

@@ -51,6 +51,9 @@ struct ReadOptions {
   std::vector<std::string>* notices = nullptr;
   // Text files: what each column holds (CsvReadOptions::columns); an error for other formats.
   std::vector<std::string> columns = {};
+  // glTF input: when not null, receives its base-colour textures (GltfReadOptions::texture), for
+  // sampling its surface; other formats leave it empty.
+  MeshTexture* texture = nullptr;
 };
 
 struct WriteOptions {

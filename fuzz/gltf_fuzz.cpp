@@ -2,11 +2,14 @@
 // (converters/gltf_read.h: pre-checks, tinygltf, Draco, meshopt, sparse and quantized accessors,
 // instancing), given the input's bytes as a file (InputFile::fromMemory; external URIs fail). Both
 // of convert's paths run: readGltf (to PLY or GLB) and streamGltf (to CSV), and they must agree:
-// the same points in the same order, or the same error.
+// the same points in the same order, or the same error. A third read asks for the base-colour
+// textures (converters/gltf_texture.h: images decoded by stb_image, texture coordinates, transforms),
+// as `convert --sample` does, and samples the surface with them.
 #include <cstring>
 
 #include "converters/gltf_read.h"
 #include "fuzz/fuzz_support.h"
+#include "ops/mesh_sample.h"
 
 namespace {
 
@@ -42,6 +45,30 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.max_memory = fuzz::kMaxMemory;
   Result<PointSet> built = readGltf(input, options);
   fuzz::checkOutcome(built, input.path());
+
+  // With textures: the same points, or an error (a texture's own, or a limit); what it gives fits
+  // the set, and sampling with it stays on the texture's images.
+  MeshTexture texture;
+  GltfReadOptions textured_options = options;
+  textured_options.texture = &texture;
+  Result<PointSet> textured = readGltf(input, textured_options);
+  fuzz::checkOutcome(textured, input.path());
+  if (textured && built) {
+    if (textured->positions != built->positions || textured->triangles != built->triangles)
+      fuzz::broken("a read with textures gives the same points", std::to_string(textured->size()));
+    if (texture.uv.size() != textured->size() || texture.triangle_image.size() != textured->triangles.size() / 3)
+      fuzz::broken("texture coordinates per vertex and an image per triangle", std::to_string(texture.uv.size()));
+    for (int32_t image : texture.triangle_image)
+      if (image >= int32_t(texture.images.size())) fuzz::broken("a triangle's image exists", std::to_string(image));
+    if (texture.textures() && textured->isMesh()) {
+      SampleOptions sample;
+      sample.count = 64;
+      sample.texture = &texture;
+      sample.max_memory = fuzz::kMaxMemory;
+      Result<PointSet> points = sampleSurface(*textured, sample, input.path());
+      if (points && points->colors.size() != points->size()) fuzz::broken("textured samples have colours", "");
+    }
+  }
 
   Collect sink;
   Status streamed = streamGltf(input, options, sink);

@@ -41,6 +41,12 @@ class Sampler {
     const size_t triangles = mesh_.triangles.size() / 3;
     if (triangles == 0) return Error{what_ + ": has no triangles to sample (it is a point set)", ExitCode::kUsage};
     if (options_.count == 0) return Error{"--sample 0: must be at least 1", ExitCode::kUsage};
+    if (const MeshTexture* t = options_.texture; t && t->textures()) {
+      const bool fits = t->uv.size() == mesh_.size() && t->triangle_image.size() == triangles &&
+                        std::all_of(t->triangle_image.begin(), t->triangle_image.end(),
+                                    [&](int32_t i) { return i < static_cast<int64_t>(t->images.size()); });
+      if (!fits) return Error{what_ + ": its texture coordinates do not match its vertices and triangles", ExitCode::kUsage};
+    }
     sums_.resize(triangles);
     double sum = 0.0;
     for (size_t t = 0; t < triangles; ++t) {
@@ -118,8 +124,13 @@ class Sampler {
     constexpr double kA1 = 0.7548776662466927, kA2 = 0.5698402909980532;  // 1/g, 1/g² (g: the plastic number)
     const double x = static_cast<double>(i);
     const double u1 = 0.5 + x * kA1, u2 = 0.5 + x * kA2;
-    const double s = std::sqrt(u1 - std::floor(u1)), r2 = u2 - std::floor(u2);
-    return {static_cast<uint32_t>(t), s * (1.0 - r2), s * r2};
+    // The unit square folded onto the triangle (a point past the diagonal reflected through its
+    // centre): both halves map affinely, so the pattern stays as even as R2's. (The sqrt mapping of
+    // the uniform draws squeezes it into rows near vertex 0, and the far side of a box showed
+    // through the gaps between them.) A reflected R2 point is R2's point −i: no two coincide.
+    double b = u1 - std::floor(u1), c = u2 - std::floor(u2);
+    if (b + c > 1.0) b = 1.0 - b, c = 1.0 - c;
+    return {static_cast<uint32_t>(t), b, c};
   }
 
   glm::dvec3 position(const Placement& p) const {
@@ -144,7 +155,8 @@ class Sampler {
   // Colours and normals of the kept placements, interpolated over their triangles.
   void finish(const std::vector<Placement>& placements, PointSet& out) const {
     const size_t n = placements.size();
-    const bool colors = mesh_.hasColors();
+    const MeshTexture* texture = options_.texture && options_.texture->textures() ? options_.texture : nullptr;
+    const bool vertex_colors = mesh_.hasColors(), colors = vertex_colors || texture;
     if (colors) out.colors.resize(n);
     const Dimension* vn[3] = {mesh_.dimensions.find(dim::kNormalX), mesh_.dimensions.find(dim::kNormalY),
                               mesh_.dimensions.find(dim::kNormalZ)};
@@ -165,8 +177,16 @@ class Sampler {
         const uint32_t* v = &mesh_.triangles[3 * size_t{p.triangle}];
         const double w[3] = {1.0 - p.b - p.c, p.b, p.c};
         if (colors) {
-          glm::dvec3 c(0.0);
-          for (int k = 0; k < 3; ++k) c += w[k] * glm::dvec3(mesh_.colors[v[k]]);
+          glm::dvec3 c(1.0);  // white where only the texture colours
+          if (vertex_colors) {
+            c = glm::dvec3(0.0);
+            for (int k = 0; k < 3; ++k) c += w[k] * glm::dvec3(mesh_.colors[v[k]]);
+          }
+          if (const int32_t image = texture ? texture->triangle_image[p.triangle] : -1; image >= 0) {
+            glm::dvec2 uv(0.0);
+            for (int k = 0; k < 3; ++k) uv += w[k] * glm::dvec2(texture->uv[v[k]]);
+            c *= glm::dvec3(textureColour(texture->images[static_cast<size_t>(image)], uv));
+          }
           out.colors[i] = glm::vec3(c);
         }
         glm::dvec3 nrm(0.0);
@@ -396,7 +416,8 @@ Result<PointSet> sampleSurface(const PointSet& mesh, const SampleOptions& option
   // Placements and positions of every candidate, the weights, heap and grid of Poisson's.
   const double per_candidate = poisson ? sizeof(Placement) + sizeof(glm::dvec3) + 8 + 8 + 4 * 4 + 16 + 1
                                        : sizeof(Placement) + sizeof(glm::dvec3);
-  const double per_point = sizeof(glm::dvec3) + (mesh.hasColors() ? sizeof(glm::vec3) : 0) + 3 * sizeof(float);
+  const bool colors = mesh.hasColors() || (options.texture && options.texture->textures());
+  const double per_point = sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0) + 3 * sizeof(float);
   const double bytes = drawn * per_candidate + static_cast<double>(options.count) * per_point;
   if (!(drawn < 4.0e9) || bytes > 1.8e19)
     return Error{what + ": " + std::to_string(options.count) + " samples are beyond any memory", ExitCode::kResourceLimit};

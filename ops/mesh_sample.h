@@ -15,11 +15,12 @@
 //
 // Stratified: sample i lies at (i + shift) / N of the running sum of the areas (systematic
 // sampling: each triangle gets its expected count rounded up or down, the seed draws the shift), at
-// point i of the R2 sequence (Roberts 2018) in its triangle, so the samples of a large triangle
-// spread evenly. As fast as uniform and with no clumps or holes: `render` draws a mesh's surface so.
+// point i of the R2 sequence (Roberts 2018) in the unit square folded onto its triangle (a point
+// past the diagonal reflected), so the samples of a large triangle spread evenly. As fast as uniform and with no clumps or holes: `render` draws a mesh's surface so.
 //
 // Each sample gets the triangle's colours and normals interpolated: vertex colours when the mesh
-// has them, vertex normals (dimensions nx, ny, nz) when it has them, else the face normal. Other
+// has them, times the texel of a textured triangle (SampleOptions::texture), vertex normals
+// (dimensions nx, ny, nz) when it has them, else the face normal. Other
 // dimensions are not carried (a vertex attribute need not mean anything between vertices).
 #pragma once
 
@@ -30,6 +31,7 @@
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "ops/mesh_texture.h"
 
 namespace dpoint {
 
@@ -47,6 +49,8 @@ struct SampleOptions {
   Progress* progress = nullptr;
   double poisson_factor = 5.0;  // Poisson: uniform samples drawn per point kept (Open3D's init_factor)
   std::vector<uint32_t>* faces = nullptr;  // when not null: gets the triangle of each point
+  // When not null: the mesh's base-colour textures (mesh_texture.h), multiplied into the colours.
+  const MeshTexture* texture = nullptr;
 };
 
 // The sample of `mesh`'s triangles. Errors: no triangles, no area, a non-finite vertex of a

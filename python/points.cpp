@@ -276,6 +276,39 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
   })));
 }
 
+// The samples of `mesh`, or of the file at `path` (read as convert --sample reads it, textures
+// included: their notes go to Python's warnings).
+std::shared_ptr<PointSet> sampleMesh(const PointSet* mesh, const std::string& path, uint64_t count,
+                                     const std::string& method, uint64_t seed, unsigned threads,
+                                     const py::object& max_memory, bool progress) {
+  SampleOptions options;
+  options.count = count;
+  options.method = take(parseSampleMethod(method));
+  options.seed = seed;
+  options.threads = threads;
+  options.max_memory = take(memoryOption("max_memory", max_memory));
+  MeshTexture texture;
+  std::optional<PointSet> read;
+  auto sampled = std::make_shared<PointSet>(take(released([&]() -> Result<PointSet> {
+    Progress bar(progressFile(progress), "sample");
+    options.progress = &bar;
+    if (!mesh) {
+      ReadOptions r{threads, false, &bar};
+      r.max_memory = options.max_memory;
+      r.texture = &texture;
+      Result<PointSet> file = readInput(path, r, GltfReadOptions{});
+      if (!file) return file.error();
+      read = std::move(*file);
+      mesh = &*read;
+      options.texture = &texture;
+    }
+    return sampleSurface(*mesh, options, path.empty() ? std::string("the mesh") : path);
+  })));
+  for (const std::string& note : texture.notes)
+    if (PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1) < 0) throw py::error_already_set();
+  return sampled;
+}
+
 }  // namespace
 
 void addPointSet(py::module_& m) {
@@ -376,17 +409,7 @@ that memory, without copying (writing into them changes the set).)")
       "sample",
       [](const std::shared_ptr<PointSet>& mesh, uint64_t count, const std::string& method, uint64_t seed,
          unsigned threads, const py::object& max_memory, bool progress) {
-        SampleOptions options;
-        options.count = count;
-        options.method = take(parseSampleMethod(method));
-        options.seed = seed;
-        options.threads = threads;
-        options.max_memory = take(memoryOption("max_memory", max_memory));
-        return std::make_shared<PointSet>(take(released([&] {
-          Progress bar(progressFile(progress), "sample");
-          options.progress = &bar;
-          return sampleSurface(*mesh, options, "the mesh");
-        })));
+        return sampleMesh(mesh.get(), "", count, method, seed, threads, max_memory, progress);
       },
       py::arg("mesh"), py::arg("count"), py::kw_only(), py::arg("method") = "uniform", py::arg("seed") = uint64_t{0},
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
@@ -395,8 +418,18 @@ that memory, without copying (writing into them changes the set).)")
 method: uniform (independent points, uniform by area), poisson (an even sample: weighted sample
 elimination from 5 x count uniform points, as Open3D's sample_points_poisson_disk) or stratified
 (each triangle its share of the points, spread evenly in it). Colours and the
-normals (attributes nx, ny, nz) are interpolated over each triangle. The same seed gives the same
+normals (attributes nx, ny, nz) are interpolated over each triangle; a glTF file given by its path
+is read with its base-colour textures, which colour the samples. The same seed gives the same
 points on any thread count. A set without triangles raises ValueError.)");
+  // dpoint.sample of a file: read with its base-colour textures, which then colour the samples.
+  m.def(
+      "_sample_file",
+      [](const std::string& path, uint64_t count, const std::string& method, uint64_t seed, unsigned threads,
+         const py::object& max_memory, bool progress) {
+        return sampleMesh(nullptr, path, count, method, seed, threads, max_memory, progress);
+      },
+      py::arg("path"), py::arg("count"), py::kw_only(), py::arg("method") = "uniform", py::arg("seed") = uint64_t{0},
+      py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false);
 
   m.def(
       "read",

@@ -68,7 +68,8 @@ struct LoadedSet {
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
   std::optional<CopcReadStats> copc;   // a COPC input: what its view read
-  float min_point_px = 0.0f;           // a sampled mesh surface: the default point size at least this
+  double surface_spacing = 0.0;        // a sampled mesh surface: its samples' mean spacing (world units)
+  MeshTexture texture;                 // a glTF mesh's base-colour textures, for its surface's colours
 };
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
@@ -225,6 +226,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   read_options.max_memory = request.max_memory;
   read_options.las_color = lasColorOf(request.color);
   read_options.columns = request.columns;
+  if (request.surface != SurfaceChoice::kOff && request.inputs.size() == 1) read_options.texture = &set.texture;
   Result<PointSet> read = readPointInputs(request.inputs, read_options);
   if (!read) return read.error();
   set.owned = std::move(*read);
@@ -239,17 +241,14 @@ Status sampleMeshSurface(const RenderRequest& request, LoadedSet& set, Progress&
   if (!mesh.isMesh() || request.surface == SurfaceChoice::kOff) return okStatus();
   const uint64_t count = meshSurfaceSamples(request.surface, mesh, request.camera.width, request.camera.height);
   if (count == 0) return okStatus();
-  // Fewer samples than two per pixel of the surface (the cap): points as wide as 2.6 of their spacing.
-  const Box box = boundingBox(mesh.positions);
-  const double pixel = glm::length(box.max - box.min) / std::max(1u, std::max(request.camera.width, request.camera.height));
-  const double per_pixel = static_cast<double>(count) * pixel * pixel / surfaceArea(mesh);
-  if (per_pixel > 0.0) set.min_point_px = static_cast<float>(std::min(64.0, 2.6 / std::sqrt(per_pixel)));
+  set.surface_spacing = std::sqrt(surfaceArea(mesh) / static_cast<double>(count));
   SampleOptions options;
   options.count = count;
   options.method = SampleMethod::kStratified;  // no clumps and holes for the far side to show through
   options.threads = request.threads;
   options.max_memory = request.max_memory;
   options.progress = &progress;
+  options.texture = &set.texture;
   Result<PointSet> sample = sampleSurface(mesh, options, set.inputs);
   if (!sample) return sample.error();
   set.owned = std::move(*sample);
@@ -348,10 +347,35 @@ void setWarmup(const WarmupRequest& warmup, uint32_t frames, RenderOptions& opti
   options.warmup_ms = ms;
 }
 
-// pointSizeFor's size, at least a sampled surface's floor (LoadedSet::min_point_px) unless given.
+// A sampled surface's points on screen: twice their spacing where the surface comes nearest
+// the eye, so that they close it there too (at the fit's scale, a perspective view magnifies the
+// nearest corner of a box 1.5 times: sized for the middle, the far side showed through it).
+float surfacePointPx(const LoadedSet& set, const Camera& camera) {
+  if (!(set.surface_spacing > 0.0) || !set.points()) return 0.0f;
+  const glm::dmat4 view_projection = camera.viewProjection();
+  const glm::dvec3 forward = -glm::dvec3(camera.rotation[0][2], camera.rotation[1][2], camera.rotation[2][2]);
+  const glm::dvec3 right(camera.rotation[0][0], camera.rotation[1][0], camera.rotation[2][0]);
+  // The sample nearest the eye along the view, in front of the near plane (any one for ortho).
+  glm::dvec3 nearest = set.points()->positions.front();
+  double depth = std::numeric_limits<double>::infinity();
+  if (!camera.ortho)
+    for (const glm::dvec3& p : set.points()->positions) {
+      const double d = glm::dot(p - camera.eye, forward);
+      if (d >= camera.near_plane && d < depth) depth = d, nearest = p;
+    }
+  const auto pixel = [&](const glm::dvec3& p) {
+    const glm::dvec4 clip = view_projection * glm::dvec4(p, 1.0);
+    return glm::dvec2(clip.x / clip.w * 0.5 * camera.width, clip.y / clip.w * 0.5 * camera.height);
+  };
+  const double spacing_px = glm::length(pixel(nearest + set.surface_spacing * right) - pixel(nearest));
+  if (!std::isfinite(spacing_px)) return 0.0f;
+  return static_cast<float>(std::min(64.0, 2.0 * spacing_px));
+}
+
+// pointSizeFor's size, at least a sampled surface's (surfacePointPx) unless given.
 float defaultPointSize(const RenderRequest& request, const LoadedSet& set, const Camera& camera, const DeviceFacts& facts) {
   const float size = pointSizeFor(request, set.count, set.bounds, camera, facts, set.spacing);
-  return request.point_size ? size : std::max(size, set.min_point_px);
+  return request.point_size ? size : std::max(size, surfacePointPx(set, camera));
 }
 
 // Shading auto on a picture too large for the shading passes' buffers draws it plain, with a
@@ -765,6 +789,8 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   outcome.points = set->count;
   outcome.streamed = set->stream != nullptr;
   outcome.copc = set->copc;
+  if (set->owned && !set->owned->isMesh())  // drawn as its surface: what of its texture it lacks
+    outcome.warnings.insert(outcome.warnings.end(), set->texture.notes.begin(), set->texture.notes.end());
   if (request.views == 4 && set->bounds.planar)
     return Error{set->inputs + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
                  ExitCode::kUsage};

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the hand-made fuzz seeds in fuzz/seeds/{csv,pcd,ply,gltf,las}/ (committed; rerun to remake them;
-`make_seeds.py pcd` writes only the PCD seeds).
+`make_seeds.py pcd` writes only the PCD seeds, `make_seeds.py texture` stops after gltf/textured.glb, the seeds before it rewritten as they were).
 
 Small files, each reaching a path of a reader the other seeds (samples/, ../shared/corpus/,
 assimp-testmodels) may miss. The Draco and meshopt seeds are made from gltf/quantized.glb's
@@ -168,6 +168,51 @@ def glb(doc, binary):
     if binary:
         chunks += struct.pack("<II", len(binary), 0x004E4942) + binary
     return struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks
+
+def png(width, height, rgb):
+    """An 8-bit RGB PNG of the rows in `rgb` (bytes, 3 per pixel)."""
+    import zlib
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+    rows = b"".join(b"\0" + rgb[y * width * 3:(y + 1) * width * 3] for y in range(height))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+def textured_seed():
+    """A quad whose material's base-colour texture is a 2x2 PNG in a bufferView, its TEXCOORD_0
+    normalized unsigned bytes moved by KHR_texture_transform, sampled NEAREST with MIRRORED_REPEAT:
+    the texture path of the reader (converters/gltf_texture.h) that the fuzz target runs."""
+    qpos = struct.pack("<12f", 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0)
+    quv = bytes([0, 255, 255, 255, 255, 0, 0, 0])
+    qidx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    image = png(2, 2, bytes([255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]))
+    parts = [qpos, quv, qidx, image]
+    offsets, binary = [], b""
+    for part in parts:
+        binary += b"\0" * ((4 - len(binary) % 4) % 4)
+        offsets.append(len(binary))
+        binary += part
+    doc = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "extensionsUsed": ["KHR_texture_transform"],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0.5, 1], "baseColorTexture": {
+            "index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 0.3, "scale": [3, 2]}}}}}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9728, "wrapS": 33648, "wrapT": 33071}],
+        "images": [{"bufferView": 3, "mimeType": "image/png"}],
+        "buffers": [{"byteLength": len(binary)}],
+        "bufferViews": [{"buffer": 0, "byteOffset": offsets[i], "byteLength": len(part)} for i, part in enumerate(parts)],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5121, "normalized": True, "count": 4, "type": "VEC2"},
+                      {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+    }
+    write("gltf", "textured.glb", glb(doc, binary))
+
+textured_seed()
+if sys.argv[1:] == ["texture"]:
+    print("make_seeds: wrote the textured gltf seed")
+    sys.exit(0)
 
 # Points with unorm8 colours in a data: URI, under a node with T, R, S.
 pos = b"".join(struct.pack("<3f", *p) for p in tetra)

@@ -230,8 +230,8 @@ def write(points, path, **options) -> None:
 
 
 def sample(mesh, count, **options) -> PointSet:
-    if isinstance(mesh, (str, _os.PathLike)):
-        mesh = _dpoint.read(_os.fspath(mesh))
+    if isinstance(mesh, (str, _os.PathLike)):  # read with its textures, which colour the samples
+        return _dpoint._sample_file(_os.fspath(mesh), count, **options)
     return _dpoint.sample(mesh, count, **options)
 
 

@@ -267,7 +267,13 @@ def test_sample_gives_converts_points_on_the_surface(tmp_path):
     # The same points as convert --sample, on any thread count.
     cli("convert", BOX, "-o", tmp_path / "cli.ply", "--sample", "2000", "--sample-seed", "5", "--quiet")
     assert np.array_equal(dpoint.read(tmp_path / "cli.ply").positions, points.positions)
-    assert np.array_equal(dpoint.sample(BOX, 2000, seed=5, threads=1).positions, points.positions)
+    from_file = dpoint.sample(BOX, 2000, seed=5, threads=1)
+    assert np.array_equal(from_file.positions, points.positions)
+    # A path is read with its texture, as convert --sample reads it: the logo's colours.
+    assert points.colors is None
+    written = dpoint.read(tmp_path / "cli.ply").colors  # as the PLY's 8-bit colours
+    assert np.allclose(from_file.colors, written, rtol=0, atol=0.5 / 255 + 1e-6)
+    assert len(np.unique(from_file.colors, axis=0)) > 20
     poisson = dpoint.sample(mesh, 500, method="poisson")
     assert len(poisson) == 500
     with pytest.raises(ValueError, match="no triangles"):
