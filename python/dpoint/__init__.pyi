@@ -91,6 +91,7 @@ def read(
     scene: int = -1,
     all_scenes: bool = False,
     max_points: int = 0,
+    columns: str | Sequence[str] | None = None,
     progress: bool = False,
 ) -> PointSet: ...
 def write(
@@ -129,6 +130,7 @@ def info(
     allow_nonfinite: bool = False,
     stream: str = "auto",
     max_memory: int | str | None = None,
+    columns: str | Sequence[str] | None = None,
     progress: bool = False,
     **camera: Any,
 ) -> dict[str, Any]: ...
