@@ -91,6 +91,47 @@ TEST(Mandelbulb, seedGridMatchesReferenceByteForByte) {
   EXPECT_TRUE(ours == reference);
 }
 
+// The seed's loop as it is written (mandelbulb.h), without the shortcuts mandelbulbEscapeSeed takes.
+int plainSeedEscape(double cx, double cy, double cz, int max_iter, double power) {
+  double x = cx, y = cy, z = cz;
+  for (int i = 0; i < max_iter; ++i) {
+    const double r = std::sqrt(x * x + y * y + z * z);
+    if (r > 2.0) return i;
+    if (r == 0.0) {
+      x = cx, y = cy, z = cz;
+      continue;
+    }
+    const double theta = std::acos(z / r), phi = std::atan2(y, x);
+    const double r2 = r * r, r4 = r2 * r2;
+    const double rn = power == 8.0 ? r4 * r4 : std::pow(r, power);
+    const double nt = power * theta, np = power * phi, sin_t = std::sin(nt);
+    x = rn * sin_t * std::cos(np) + cx;
+    y = rn * sin_t * std::sin(np) + cy;
+    z = rn * std::cos(nt) + cz;
+  }
+  return max_iter;
+}
+
+// The escape shortcut and the cycle detection give the plain loop's counts: on a res-61 grid of
+// the default cube (odd: the origin included), on points near the surface (a finer grid in a
+// corner of the bulb), at the lazy pass's cap and at max_iter, for powers 8 and 3. Both shortcuts
+// are taken on these points, so a wrong margin or a false cycle would show.
+TEST(Mandelbulb, seedShortcutsGiveThePlainLoopsCounts) {
+  const GridAxis coarse{61, -1.5, 1.5}, fine{41, 0.55, 0.75};
+  size_t points = 0, mismatches = 0;
+  for (const GridAxis& axis : {coarse, fine})
+    for (double power : {8.0, 3.0})
+      for (int limit : {26, 100})
+        for (int i = 0; i < axis.resolution; ++i)
+          for (int j = 0; j < axis.resolution; ++j)
+            for (int k = 0; k < axis.resolution; k += 2) {
+              const double x = axis.value(i), y = axis.value(j), z = axis.value(k);
+              ++points;
+              if (mandelbulbEscapeSeed(x, y, z, limit, power) != plainSeedEscape(x, y, z, limit, power)) ++mismatches;
+            }
+  EXPECT_EQ(mismatches, 0u) << "of " << points;
+}
+
 TEST(Mandelbulb, oddResolutionHasOriginInside) {
   EXPECT_EQ(mandelbulbEscapeSeed(0.0, 0.0, 0.0, 100), 100);
   EXPECT_EQ(mandelbulbEscapeFast(0.0, 0.0, 0.0, 100), 100);
