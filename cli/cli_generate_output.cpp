@@ -49,15 +49,6 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
   addCommonOptions(cmd, o.common);
 }
 
-void addSampleOptions(CLI::App& cmd, OutputOptions& o) {
-  cmd.add_option("--sample", o.sample,
-                 "Write N points on the mesh's surface (uniform by area, colours and normals interpolated) instead of the mesh");
-  cmd.add_option("--sample-method", o.sample_method, "uniform; poisson: an even sample (as Open3D's sample_points_poisson_disk); stratified: each triangle its share, spread evenly")
-      ->check(oneOf("--sample-method", {"uniform", "poisson", "stratified"}))
-      ->default_val("uniform");
-  cmd.add_option("--sample-seed", o.sample_seed, "Seed of --sample (the same points on any thread count)")->default_val(0);
-}
-
 Result<uint64_t> memoryLimit(const OutputOptions& o) { return memoryLimitOf(o.max_memory); }
 
 double PhaseClock::lap() {
@@ -76,16 +67,10 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   const double generate_s = clock.lap();
   PointSet& points = *generated;
   if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
-  if (o.sample != 0) {  // on the coloured, offset mesh: colours interpolate, positions are in their frame
+  if (o.sample.count != 0) {  // on the coloured, offset mesh: colours interpolate, positions are in their frame
     Result<uint64_t> limit = memoryLimit(o);
     if (!limit) return reportError(limit.error());
-    SampleOptions sample;
-    sample.count = o.sample;
-    sample.method = *parseSampleMethod(o.sample_method);  // checked by the option's validator
-    sample.seed = o.sample_seed;
-    sample.threads = o.common.threads;
-    sample.max_memory = *limit;
-    sample.progress = &progress;
+    const SampleOptions sample = sampleOptionsOf(o.sample, o.common.threads, *limit, &progress);
     Result<PointSet> sampled = sampleSurface(points, sample, "the generated mesh");
     if (!sampled) return reportError(sampled.error());
     points = std::move(*sampled);
@@ -147,7 +132,7 @@ Result<TileSpec> tileOptions(const OutputOptions& o) {
                  ExitCode::kUsage};
   if (o.order != "input")
     return Error{"--tile: --order " + o.order + " needs the whole set; give it to dpoint merge", ExitCode::kUsage};
-  if (o.sample != 0)
+  if (o.sample.count != 0)
     return Error{"--tile: --sample needs the whole mesh; sample the merged file with dpoint convert --sample", ExitCode::kUsage};
   return tile;
 }

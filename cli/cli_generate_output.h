@@ -26,9 +26,7 @@ struct OutputOptions {
   int decimals = -1;
   std::string max_memory;
   std::string order = "input";
-  uint64_t sample = 0;  // --sample N (mesh kinds): N points on the surface instead of the mesh
-  std::string sample_method = "uniform";
-  uint64_t sample_seed = 0;
+  SampleCliOptions sample;  // --sample N (mesh kinds): N points on the surface instead of the mesh
   CommonOptions common;
 };
 
@@ -36,8 +34,6 @@ struct OutputOptions {
 // parsed (cli_output.h: a written format, a folder it can be written into), before any work; it is
 // required unless the set is handed back to an embedding program (capturingPoints(), cli_run.h).
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors);
-// --sample, --sample-method, --sample-seed: for the kinds that make meshes.
-void addSampleOptions(CLI::App& cmd, OutputOptions& o);
 // --max-memory as bytes (0: half of RAM).
 Result<uint64_t> memoryLimit(const OutputOptions& o);
 

@@ -25,9 +25,7 @@ struct ConvertOptions {
   std::string pcd_encoding = "binary";
   bool allow_nonfinite = false;
   std::string columns;  // --columns x,y,z,-,intensity
-  uint64_t sample = 0;  // --sample N: points on the mesh's surface instead of its vertices
-  std::string sample_method = "uniform";
-  uint64_t sample_seed = 0;
+  SampleCliOptions sample;  // --sample N: points on the mesh's surface instead of its vertices
   bool no_colors = false;
   int scene = -1;
   bool all_scenes = false;
@@ -57,7 +55,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress, M
   GltfReadOptions g = gltfOptions(o);
   // CSV holds no triangles: not building them keeps a large mesh's index list out of memory.
   Result<FileFormat> out_format = formatOf(o.output);
-  g.triangles = !out_format || *out_format != FileFormat::kCsv || o.sample != 0;
+  g.triangles = !out_format || *out_format != FileFormat::kCsv || o.sample.count != 0;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.max_memory = o.memory_limit;
   r.columns = columnsOf(o.columns);
@@ -93,7 +91,7 @@ int runConvert(ConvertOptions& o) {
   const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
   if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !o.unique && *order == PointOrder::kInput &&
-      !choose_dimensions && o.columns.empty() && o.sample == 0) {
+      !choose_dimensions && o.columns.empty() && o.sample.count == 0) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;
   }
@@ -105,17 +103,11 @@ int runConvert(ConvertOptions& o) {
     w.decimals_at_scale = w.decimals >= 0;
   }
   MeshTexture texture;
-  Result<PointSet> points = readConvertInput(o, progress, o.sample != 0 ? &texture : nullptr);
+  Result<PointSet> points = readConvertInput(o, progress, o.sample.count != 0 ? &texture : nullptr);
   if (!points) return reportError(points.error());
-  if (o.sample != 0) {
+  if (o.sample.count != 0) {
     for (const std::string& note : texture.notes) std::fprintf(stderr, "dpoint: note: %s\n", note.c_str());
-    SampleOptions sample;
-    sample.count = o.sample;
-    sample.method = *parseSampleMethod(o.sample_method);  // checked by the option's validator
-    sample.seed = o.sample_seed;
-    sample.threads = o.common.threads;
-    sample.max_memory = o.memory_limit;
-    sample.progress = &progress;
+    SampleOptions sample = sampleOptionsOf(o.sample, o.common.threads, o.memory_limit, &progress);
     sample.texture = &texture;
     Result<PointSet> sampled = sampleSurface(*points, sample, o.input);
     if (!sampled) return reportError(sampled.error());
@@ -158,17 +150,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   addColumnsOption(*cmd, o->columns);
-  cmd->add_option("--sample", o->sample,
-                  "Mesh input: write N points on its surface (uniform by area, colours and normals interpolated, "
-                  "times a glTF base-colour texture) instead of its vertices");
-  cmd->add_option("--sample-method", o->sample_method,
-                  "uniform: independent points, uniform by area; poisson: an even sample (weighted sample "
-                  "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk); stratified: "
-                  "each triangle its share of the points, spread evenly in it (as fast as uniform)")
-      ->check(oneOf("--sample-method", {"uniform", "poisson", "stratified"}))
-      ->default_val("uniform");
-  cmd->add_option("--sample-seed", o->sample_seed, "Seed of --sample: the same seed gives the same points on any thread count")
-      ->default_val(0);
+  addSampleOptions(*cmd, o->sample);
   cmd->add_flag("--no-colors", o->no_colors, "Drop colours");
   cmd->add_option("--keep", o->dimensions.keep,
                   "Keep only these dimensions (comma-separated names, as `dpoint info` lists them; none: no dimension)");

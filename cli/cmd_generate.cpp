@@ -233,7 +233,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
                            "auto gives it the CPU, an explicit device is an error");
   addEscapeCountsOption(*mandelbulb, mb->device);
   addOutputOptions(*mandelbulb, mb->out, "noise");
-  addSampleOptions(*mandelbulb, mb->out);
+  addSampleOptions(*mandelbulb, mb->out.sample);
   registerKind(run, mb, mandelbulb, true, &generateMandelbulb, &generateMandelbulbTile, &mandelbulbParams);
 
   auto ju = std::make_shared<JuliaOptions>();
@@ -244,7 +244,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   addGenerateDeviceOptions(*julia, ju->device, "");
   addEscapeCountsOption(*julia, ju->device);
   addOutputOptions(*julia, ju->out, "noise");
-  addSampleOptions(*julia, ju->out);
+  addSampleOptions(*julia, ju->out.sample);
   registerKind(run, ju, julia, true, &generateJulia, &generateJuliaTile, &juliaParams);
 
   auto me = std::make_shared<MengerOptions>();
@@ -257,7 +257,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
       ->default_val("exact");
   menger->add_option("--resolution", me->params.resolution, "Voxel method: samples per axis (2..4096)")->default_val(200);
   addOutputOptions(*menger, me->out, "noise");
-  addSampleOptions(*menger, me->out);
+  addSampleOptions(*menger, me->out.sample);
   registerKind(run, me, menger, true, &generateMenger, &generateMengerTile, &mengerParams);
 
   auto si = std::make_shared<PlainOptions<SierpinskiParams>>();
@@ -265,7 +265,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   sierpinski->add_option("--level", si->params.level, "Subdivision level (0..12)")->default_val(9);
   sierpinski->add_flag("--unwelded", si->params.unwelded, "The original study's Python generator's 4^(n+1) rows instead of the 2*4^n+2 distinct vertices");
   addOutputOptions(*sierpinski, si->out, "noise");
-  addSampleOptions(*sierpinski, si->out);
+  addSampleOptions(*sierpinski, si->out.sample);
   registerKind(run, si, sierpinski, true, &generateSierpinski, &generateSierpinskiTile,
                &plainParams<SierpinskiParams>);
 

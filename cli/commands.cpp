@@ -2,6 +2,7 @@
 // embedded run it answers to.
 #include "cli/commands.h"
 
+#include "cli/cli_check.h"
 #include "core/memory.h"
 #include "core/text.h"
 
@@ -27,6 +28,32 @@ void addColumnsOption(CLI::App& command, std::string& text) {
 std::vector<std::string> columnsOf(const std::string& text) {
   if (text.empty()) return {};
   return splitAt(text, ',');
+}
+
+void addSampleOptions(CLI::App& command, SampleCliOptions& options) {
+  command.add_option("--sample", options.count,
+                     "Mesh: write N points on its surface (uniform by area; colours, normals and a glTF base-colour "
+                     "texture interpolated) instead of its vertices");
+  command
+      .add_option("--sample-method", options.method,
+                  "uniform: independent points, uniform by area; poisson: an even sample (weighted sample "
+                  "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk); stratified: "
+                  "each triangle its share of the points, spread evenly in it (as fast as uniform)")
+      ->check(oneOf("--sample-method", {"uniform", "poisson", "stratified"}))
+      ->default_val("uniform");
+  command.add_option("--sample-seed", options.seed, "Seed of --sample: the same seed gives the same points on any thread count")
+      ->default_val(0);
+}
+
+SampleOptions sampleOptionsOf(const SampleCliOptions& options, unsigned threads, uint64_t max_memory, Progress* progress) {
+  SampleOptions sample;
+  sample.count = options.count;
+  sample.method = *parseSampleMethod(options.method);  // checked by addSampleOptions' validator
+  sample.seed = options.seed;
+  sample.threads = threads;
+  sample.max_memory = max_memory;
+  sample.progress = progress;
+  return sample;
 }
 
 Result<uint64_t> memoryLimitOf(const std::string& text) {

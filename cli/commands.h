@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "core/result.h"
+#include "ops/mesh_sample.h"
 
 namespace dpoint {
 
@@ -40,5 +41,16 @@ Result<uint64_t> memoryLimitOf(const std::string& text);
 // columnsOf: its names, none when it is not given.
 void addColumnsOption(CLI::App& command, std::string& text);
 std::vector<std::string> columnsOf(const std::string& text);
+
+// --sample N, --sample-method, --sample-seed: points on a mesh's surface (`convert` of a mesh,
+// `generate` of a mesh kind). count 0: not asked for.
+struct SampleCliOptions {
+  uint64_t count = 0;
+  std::string method = "uniform";
+  uint64_t seed = 0;
+};
+void addSampleOptions(CLI::App& command, SampleCliOptions& options);
+// The sampler's options (the method was checked by addSampleOptions' validator).
+SampleOptions sampleOptionsOf(const SampleCliOptions& options, unsigned threads, uint64_t max_memory, Progress* progress);
 
 }  // namespace dpoint

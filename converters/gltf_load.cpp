@@ -312,7 +312,7 @@ bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigne
 // in a bufferView). When the caller wants textures, the encoded bytes of an image given by uri
 // (a data URI or a file in the model's folder) are kept in Image::image, as far as --max-memory
 // allows (else the image is left empty and its texture unused); an image in a bufferView is read
-// from its buffer afterwards (readGltfImageBytes), since tinygltf sees a stand-in of zeros here.
+// from its buffer afterwards (GltfTextures, gltf_texture.h): tinygltf sees a stand-in of zeros.
 bool keepImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
                int size, void* user) {
   auto& jail = *static_cast<FolderJail*>(user);

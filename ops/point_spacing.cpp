@@ -17,15 +17,13 @@ constexpr int kCellBits = 21;  // cell coordinates per axis, packed three to a 6
 constexpr int64_t kMaxCell = (int64_t{1} << kCellBits) - 1;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-uint64_t mix(uint64_t x) { return splitmixMix(x); }
-
 // One mix of the three coordinates' bits, rotated apart (+ 0.0: -0 hashes as 0).
 uint64_t positionHash(const glm::dvec3& p) {
-  return mix(std::bit_cast<uint64_t>(p.x + 0.0) ^ std::rotl(std::bit_cast<uint64_t>(p.y + 0.0), 21) ^
+  return splitmixMix(std::bit_cast<uint64_t>(p.x + 0.0) ^ std::rotl(std::bit_cast<uint64_t>(p.y + 0.0), 21) ^
              std::rotl(std::bit_cast<uint64_t>(p.z + 0.0), 42));
 }
 
-size_t tableIndex(uint64_t key, size_t size) { return size_t(mix(key)) & (size - 1); }
+size_t tableIndex(uint64_t key, size_t size) { return size_t(splitmixMix(key)) & (size - 1); }
 
 }  // namespace
 
@@ -106,7 +104,7 @@ SpacingSearch::SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dv
           size_t at = tableIndex(key, capacity);
           while (keys_[at] != 0 && keys_[at] != key + 1) at = (at + 1) & (capacity - 1);
           if (keys_[at] == 0) keys_[at] = key + 1, slots_[at] = slot_count++;
-          const uint64_t bit = (mix(key) >> 40) & (kFilterBits - 1);
+          const uint64_t bit = (splitmixMix(key) >> 40) & (kFilterBits - 1);
           filter_[bit >> 6] |= uint64_t{1} << (bit & 63);
           pairs.push_back({slots_[at], s});
         }
@@ -134,7 +132,7 @@ uint64_t SpacingSearch::cellKey(const glm::dvec3& p) const {
 
 uint32_t SpacingSearch::findSlot(uint64_t key) const {
   if (key == UINT64_MAX) return UINT32_MAX;
-  const uint64_t bit = (mix(key) >> 40) & (kFilterBits - 1);
+  const uint64_t bit = (splitmixMix(key) >> 40) & (kFilterBits - 1);
   if (!(filter_[bit >> 6] >> (bit & 63) & 1)) return UINT32_MAX;  // most points: no kept cell, one L1 read
   for (size_t at = tableIndex(key, keys_.size());; at = (at + 1) & (keys_.size() - 1)) {
     if (keys_[at] == key + 1) return slots_[at];

@@ -213,8 +213,9 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   }
   // A mesh PLY is read with its faces when its surface may be drawn: asked for, or (auto) with few
   // enough vertices that they may lie far apart on screen (a 16th of the pixels; its header says).
+  const bool may_sample = request.surface != SurfaceChoice::kOff && request.inputs.size() == 1;
   bool points_only = true;
-  if (request.surface != SurfaceChoice::kOff && request.inputs.size() == 1) {
+  if (may_sample) {
     Result<FileFormat> format = formatOf(request.inputs[0]);
     if (format && *format == FileFormat::kPly)
       if (Result<std::unique_ptr<PlyVertexStream>> header = PlyVertexStream::open(request.inputs[0]); header)
@@ -226,7 +227,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   read_options.max_memory = request.max_memory;
   read_options.las_color = lasColorOf(request.color);
   read_options.columns = request.columns;
-  if (request.surface != SurfaceChoice::kOff && request.inputs.size() == 1) read_options.texture = &set.texture;
+  if (may_sample) read_options.texture = &set.texture;  // a mesh's surface samples take its texture
   Result<PointSet> read = readPointInputs(request.inputs, read_options);
   if (!read) return read.error();
   set.owned = std::move(*read);
