@@ -34,13 +34,11 @@ void addSampleOptions(CLI::App& command, SampleCliOptions& options) {
   command.add_option("--sample", options.count,
                      "Mesh: write N points on its surface (uniform by area; colours, normals and a glTF base-colour "
                      "texture interpolated) instead of its vertices");
-  command
-      .add_option("--sample-method", options.method,
+  addChoiceOption(command, "--sample-method", options.method,
                   "uniform: independent points, uniform by area; poisson: an even sample (weighted sample "
                   "elimination from 5N uniform points, as Open3D's sample_points_poisson_disk); stratified: "
-                  "each triangle its share of the points, spread evenly in it (as fast as uniform)")
-      ->check(oneOf("--sample-method", {"uniform", "poisson", "stratified"}))
-      ->default_val("uniform");
+                  "each triangle its share of the points, spread evenly in it (as fast as uniform)",
+                  {"uniform", "poisson", "stratified"});
   command.add_option("--sample-seed", options.seed, "Seed of --sample: the same seed gives the same points on any thread count")
       ->default_val(0);
 }
