@@ -108,7 +108,9 @@ SpacingSearch::SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dv
           filter_[bit >> 6] |= uint64_t{1} << (bit & 63);
           pairs.push_back({slots_[at], s});
         }
+    sample_cells_.push_back(c);
   }
+  std::sort(sample_cells_.begin(), sample_cells_.end(), [](const glm::i64vec3& a, const glm::i64vec3& b) { return a.x < b.x; });
   slot_start_.assign(size_t{slot_count} + 1, 0);
   for (const auto& [slot, s] : pairs) ++slot_start_[slot + 1];
   for (size_t k = 1; k < slot_start_.size(); ++k) slot_start_[k] += slot_start_[k - 1];
@@ -138,6 +140,26 @@ uint32_t SpacingSearch::findSlot(uint64_t key) const {
     if (keys_[at] == key + 1) return slots_[at];
     if (keys_[at] == 0) return UINT32_MAX;
   }
+}
+
+bool SpacingSearch::mayUse(const Box& box) const {
+  if (samples_.empty()) return false;
+  // The cells the box spans, as cellKey finds them (monotonic in each coordinate); beyond the grid
+  // a point has no cell.
+  glm::i64vec3 lo, hi;
+  for (int k = 0; k < 3; ++k) {
+    const double a = (box.min[k] - origin_[k]) * inverse_cell_, b = (box.max[k] - origin_[k]) * inverse_cell_;
+    if (!(b >= 0.0) || !(a <= double(kMaxCell))) return false;
+    lo[k] = static_cast<int64_t>(std::max(a, 0.0));
+    hi[k] = static_cast<int64_t>(std::min(b, double(kMaxCell)));
+  }
+  // A kept cell is one of the 3³ around a sample's: the box needs its points where its cells
+  // reach within one cell of a sample's (sample_cells_, by x).
+  auto at = std::lower_bound(sample_cells_.begin(), sample_cells_.end(), lo.x - 1,
+                             [](const glm::i64vec3& c, int64_t x) { return c.x < x; });
+  for (; at != sample_cells_.end() && at->x <= hi.x + 1; ++at)
+    if (at->y >= lo.y - 1 && at->y <= hi.y + 1 && at->z >= lo.z - 1 && at->z <= hi.z + 1) return true;
+  return false;
 }
 
 void SpacingSearch::add(std::span<const glm::dvec3> points) {

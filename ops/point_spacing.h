@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include <glm/ext/vector_int3_sized.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/point_set.h"
@@ -49,6 +50,9 @@ class SpacingSearch {
  public:
   SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dvec3> samples, unsigned threads = 0);
   void add(std::span<const glm::dvec3> points);
+  // Whether a point in `box` may lie in a kept cell: false means add() would pass over every one of
+  // them, so a streamed set's batch with that box need not be read (true for a box over many cells).
+  bool mayUse(const Box& box) const;
   std::vector<SpacingSample> finish() const;
 
  private:
@@ -57,6 +61,7 @@ class SpacingSearch {
   uint32_t findSlot(uint64_t key) const;
 
   std::vector<glm::dvec3> samples_;
+  std::vector<glm::i64vec3> sample_cells_;  // each sample's cell, ordered by x (mayUse)
   unsigned threads_;
   glm::dvec3 origin_{0.0};
   double cell_ = 0.0, inverse_cell_ = 0.0;

@@ -379,12 +379,16 @@ OutlineBuilder::OutlineBuilder(const Bounds& bounds)
   per_z_ = extent.z > 0.0 ? kOutlineGrid / extent.z : 0.0;
 }
 
-void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
-  if (rows_.empty()) return;
+size_t OutlineBuilder::rowOf(const glm::dvec3& p) const {
   const auto cellOf = [](double offset, double per) {
     const double cell = std::floor(offset * per);  // offset ≥ 0 inside the box; clamped for the rest
     return static_cast<size_t>(std::clamp(cell, 0.0, double(kOutlineGrid - 1)));
   };
+  return cellOf(p.y - min_.y, per_y_) * kOutlineGrid + cellOf(p.z - min_.z, per_z_);
+}
+
+void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
+  if (rows_.empty()) return;
   constexpr size_t kBlock = size_t{1} << 18;
   const size_t blocks = (positions.size() + kBlock - 1) / kBlock;
   std::vector<std::vector<RowBox>> partial(blocks);
@@ -394,7 +398,7 @@ void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
     const size_t end = std::min(positions.size(), (b + 1) * kBlock);
     for (size_t i = b * kBlock; i < end; ++i) {
       const glm::dvec3& p = positions[i];
-      RowBox& row = rows[cellOf(p.y - min_.y, per_y_) * kOutlineGrid + cellOf(p.z - min_.z, per_z_)];
+      RowBox& row = rows[rowOf(p)];
       row.min = glm::min(row.min, p);
       row.max = glm::max(row.max, p);
     }
@@ -405,6 +409,16 @@ void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
       rows_[cell].max = glm::max(rows_[cell].max, rows[cell].max);
     }
   }
+}
+
+bool OutlineBuilder::addBox(const Box& box) {
+  if (rows_.empty()) return true;
+  // The row index is monotonic in y and in z, so corners in one row hold every point between.
+  const size_t row = rowOf(box.min);
+  if (rowOf(box.max) != row) return false;
+  rows_[row].min = glm::min(rows_[row].min, box.min);
+  rows_[row].max = glm::max(rows_[row].max, box.max);
+  return true;
 }
 
 std::vector<glm::dvec3> OutlineBuilder::finish() const {

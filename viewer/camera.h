@@ -98,9 +98,14 @@ class OutlineBuilder {
  public:
   explicit OutlineBuilder(const Bounds& bounds);
   void add(const std::vector<glm::dvec3>& positions);
+  // The points of a box that lies in one row, known by the box alone: their row's box takes its
+  // corners, as it would take the points (its min and max along each axis are points' coordinates).
+  // False, and nothing added, where the box spans rows: then its points must be added.
+  bool addBox(const Box& box);
   std::vector<glm::dvec3> finish() const;
 
  private:
+  size_t rowOf(const glm::dvec3& p) const;
   struct RowBox {
     glm::dvec3 min{HUGE_VAL}, max{-HUGE_VAL};
   };

@@ -16,6 +16,7 @@
 #include "core/interrupt.h"
 #include "core/json_writer.h"
 #include "core/memory.h"
+#include "core/parallel.h"
 #include "core/text.h"
 #include "image/canvas.h"
 #include "ops/attribute_colors.h"
@@ -67,6 +68,7 @@ struct LoadedSet {
   bool z_up = false;
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
+  uint64_t reread_points = 0;          // a stream: the points its outline and spacing read again
   std::optional<CopcReadStats> copc;   // a COPC input: what its view read
   double surface_spacing = 0.0;        // a sampled mesh surface: its samples' mean spacing (world units)
   MeshTexture texture;                 // a glTF mesh's base-colour textures, for its surface's colours
@@ -117,19 +119,48 @@ bool needsOutline(const RenderRequest& request, const Bounds& bounds) {
 bool needsSpacing(const RenderRequest& request) { return !request.point_size && !request.error; }
 
 // The outline and the spacing samples of a streamed set, as needed (the same as the set in memory
-// gets, whatever the block size and order): a second pass, a block at a time.
+// gets, whatever the block size and order): a second pass, which reads only the batches whose box
+// (set.boxes) leaves their share open: a box in one outline row gives that row its corners, and a box
+// clear of every cell the spacing search keeps holds no point it uses. A file in Morton order is
+// read again in a few places; one in scan order, whose boxes are long, all through.
 Status streamOutlineAndSpacing(const RenderRequest& request, const std::string& path, PointInputStream& ply,
                                std::vector<glm::dvec3> samples, LoadedSet& set, Progress& progress) {
   const bool outline = needsOutline(request, set.bounds), spacing = needsSpacing(request);
   if (!outline && !spacing) return okStatus();
   OutlineBuilder builder(set.bounds);
   SpacingSearch search(Box{set.bounds.min, set.bounds.max}, set.count, std::move(samples), request.threads);
-  const std::string what = std::string(outline ? "outline" : "spacing") + " of " + path + " (points)";
-  Status status = forEachBlock(ply, progress, what, [&](const PointSet& block) {
-    if (outline) builder.add(block.positions);
-    if (spacing) search.add(block.positions);
+  const std::vector<Box>& boxes = set.boxes.boxes;
+  std::vector<uint8_t> needed(boxes.size(), 0);
+  parallelFor(boxes.size(), request.threads, [&](size_t k, unsigned) {
+    needed[k] = spacing && search.mayUse(boxes[k]);
   });
-  if (!status) return status;
+  for (size_t k = 0; k < boxes.size(); ++k)  // the builder's rows are one table: one thread
+    if (outline && !builder.addBox(boxes[k])) needed[k] = 1;
+  // Runs of needed boxes, joined across short gaps (a read's fixed cost against the points skipped).
+  constexpr size_t kGapBoxes = 16;
+  std::vector<std::pair<uint64_t, uint64_t>> runs;  // points [first, end)
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    if (!needed[k]) continue;
+    const uint64_t first = uint64_t{k} * kBoxPoints, end = std::min<uint64_t>(set.count, first + kBoxPoints);
+    if (!runs.empty() && first - runs.back().second <= kGapBoxes * kBoxPoints) runs.back().second = end;
+    else runs.push_back({first, end});
+  }
+  uint64_t reread = 0;
+  for (const auto& run : runs) reread += run.second - run.first;
+  set.reread_points = reread;
+  const std::string what = std::string(outline ? "outline" : "spacing") + " of " + path + " (points read again)";
+  progress.start(what, reread);
+  PointSet block;
+  for (const auto& [from, end] : runs)
+    for (uint64_t first = from; first < end; first += kStreamBlockPoints) {
+      const uint64_t n = std::min(kStreamBlockPoints, end - first);
+      if (interrupted()) return interruptedError();
+      if (Status status = ply.read(first, n, block); !status) return status;
+      progress.advance(n);
+      if (outline) builder.add(block.positions);
+      if (spacing) search.add(block.positions);
+    }
+  progress.finish();
   if (outline) set.bounds.outline = builder.finish();
   if (spacing) set.spacing = search.finish();
   return okStatus();
@@ -789,6 +820,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   if (!set) return set.error();
   outcome.points = set->count;
   outcome.streamed = set->stream != nullptr;
+  outcome.points_read_again = set->reread_points;
   outcome.copc = set->copc;
   if (set->owned && !set->owned->isMesh())  // drawn as its surface: what of its texture it lacks
     outcome.warnings.insert(outcome.warnings.end(), set->texture.notes.begin(), set->texture.notes.end());
@@ -886,6 +918,7 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   o.add("driver_version", V::string(formatDriverVersion(f.vendor_id, f.driver_version)));
   o.add("api_version", V::string(formatApiVersion(f.api_version)));
   o.add("points", V::integer(outcome.points));
+  if (outcome.streamed) o.add("points_read_again", V::integer(outcome.points_read_again));
   o.add("width", V::integer(request.camera.width)).add("height", V::integer(request.camera.height));
   o.add("point_size", V::number(outcome.point_size));
   o.add("shading", V::string(outcome.shading == Shading::kEdl ? "edl" : "none"));

@@ -221,6 +221,7 @@ struct RenderOutcome {
   std::shared_ptr<VulkanContext> context;  // the request's own, when it gave one
   size_t points = 0;
   bool streamed = false;       // drawn a block at a time (its bound from batch boxes, no --error)
+  uint64_t points_read_again = 0;  // streamed: the points its outline and spacing read a second time
   DeviceFacts device;
   Backend backend = Backend::kRaster;  // the one that ran (backendFor with --backend auto)
   std::vector<std::string> validation_messages;  // with `validate`: any fails the run

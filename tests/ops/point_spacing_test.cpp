@@ -54,6 +54,40 @@ TEST(PointSpacing, samplesDoNotDependOnOrderOrBlocks) {
   }
 }
 
+// A streamed set's second pass reads only the batches whose box mayUse: the points of the rest lie
+// in no kept cell, so the distances are those of every point; on a set in grid order most batches
+// are passed over.
+TEST(PointSpacing, batchesClearOfTheKeptCellsChangeNothing) {
+  // A 320 × 320 grid in 32 × 32 tiles, one batch each (as Morton order keeps a batch compact).
+  std::vector<glm::dvec3> points;
+  std::mt19937 random(11);
+  for (int ti = 0; ti < 10; ++ti)
+    for (int tj = 0; tj < 10; ++tj)
+      for (int i = 0; i < 32; ++i)
+        for (int j = 0; j < 32; ++j)
+          points.push_back({(ti * 32 + i) * 0.5, (tj * 32 + j) * 0.5, std::uniform_real_distribution<double>(0.0, 0.2)(random)});
+  const Box box = boundingBox(points);
+  const std::vector<SpacingSample> whole = sampleSpacing(points, box, 16, 2);
+  SpacingSampler sampler(16, 2);
+  sampler.add(points);
+  SpacingSearch search(box, points.size(), sampler.finish(), 2);
+  size_t read = 0;
+  for (size_t first = 0; first < points.size(); first += 1024) {
+    const std::span<const glm::dvec3> batch = std::span(points).subspan(first, std::min<size_t>(1024, points.size() - first));
+    if (!search.mayUse(boundingBox(std::vector<glm::dvec3>(batch.begin(), batch.end())))) continue;
+    search.add(batch);
+    read += batch.size();
+  }
+  const std::vector<SpacingSample> selective = search.finish();
+  ASSERT_EQ(whole.size(), selective.size());
+  ASSERT_GT(whole.size(), 10u);
+  for (size_t k = 0; k < whole.size(); ++k) EXPECT_EQ(whole[k].distance, selective[k].distance) << k;
+  EXPECT_GT(read, 0u);
+  EXPECT_LT(read, points.size() / 2);
+  // A box beyond the grid, or far from every sample, needs nothing.
+  EXPECT_FALSE(search.mayUse(Box{box.max + glm::dvec3(1.0), box.max + glm::dvec3(2.0)}));
+}
+
 TEST(PointSpacing, copiesOfAPointAreNotItsNeighbours) {
   std::vector<glm::dvec3> points = grid(50, 2.0);
   const std::vector<glm::dvec3> copies = points;

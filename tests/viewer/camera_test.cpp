@@ -365,6 +365,19 @@ TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
   builder.add(std::vector<glm::dvec3>(bulb->positions.begin() + long(half), bulb->positions.end()));
   builder.add(std::vector<glm::dvec3>(bulb->positions.begin(), bulb->positions.begin() + long(half)));
   EXPECT_EQ(builder.finish(), outlined.outline);
+  // Boxes of 1024 consecutive points: one in a row is taken by its corners, the rest by their
+  // points; the outline is the same.
+  OutlineBuilder by_boxes(outlined);
+  size_t read = 0;
+  for (size_t first = 0; first < bulb->size(); first += 1024) {
+    const auto from = bulb->positions.begin() + long(first), to = from + long(std::min<size_t>(1024, bulb->size() - first));
+    const std::vector<glm::dvec3> batch(from, to);
+    if (by_boxes.addBox(boundingBox(batch))) continue;
+    by_boxes.add(batch);
+    read += batch.size();
+  }
+  EXPECT_EQ(by_boxes.finish(), outlined.outline);
+  EXPECT_GT(read, 0u);
 }
 
 // Real deep zooms drawn by the default render job on the device: each fills the picture (the
