@@ -236,16 +236,19 @@ SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera) {
 }
 
 SceneFrame sceneFrame(const Camera& camera) {
-  SceneFrame frame;
-  frame.eye = camera.eye;
-  frame.projection_rotation = camera.projection * camera.rotation;
   // The view's size: the window for ortho; for perspective the far plane, which bounds every
   // eye-relative distance of a visible point (the projection is already scaled by 1/far).
   double size = camera.far_plane;
   if (camera.ortho)
     size = std::max(2.0 / std::fabs(camera.projection[0][0]), 2.0 / std::fabs(camera.projection[1][1]));
   assert(std::isfinite(size) && size > 0.0);
-  frame.exponent = -std::ilogb(size);  // size · 2^exponent in [1, 2)
+  return sceneFrame(camera, -std::ilogb(size));  // size · 2^exponent in [1, 2)
+}
+
+SceneFrame sceneFrame(const Camera& camera, int exponent) {
+  SceneFrame frame;
+  frame.projection_rotation = camera.projection * camera.rotation;
+  frame.exponent = exponent;
   frame.scale = std::ldexp(1.0, frame.exponent);
   frame.eye = scaleBy(camera.eye, frame);
   for (int c = 0; c < 3; ++c)
@@ -274,6 +277,18 @@ Status addPoints(ModeEncoding& e, const PointSet& block, size_t first_index) {
   if (modeInfo(e.mode).batch_points == 0) return okStatus();
   assert(first_index == e.batches.size() * e.batchSize());  // blocks in order, whole batches but the last
   return appendBatches(e, makeBatchFrames(block, e.frame, e.batchSize()));
+}
+
+Status reframeEncoding(ModeEncoding& e, const Camera& camera) {
+  e.frame = modeInfo(e.mode).scene_frame ? sceneFrame(camera, e.frame.exponent) : sceneFrame(e.mode, camera);
+  e.width = camera.width;
+  e.height = camera.height;
+  std::vector<BatchFrame> frames = std::move(e.batches);
+  e.batches.clear();
+  e.batch_matrices.clear();
+  e.batch_plan.clear();
+  if (frames.empty()) return okStatus();
+  return appendBatches(e, frames);
 }
 
 Status addBoxes(ModeEncoding& e, std::span<const Box> boxes) {

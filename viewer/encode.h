@@ -61,6 +61,10 @@ struct SceneFrame {
 SceneFrame sceneFrame(PrecisionMode mode, const Camera& camera);
 // The scaled scene frame of the camera, whatever the mode (what every scene_frame mode gets).
 SceneFrame sceneFrame(const Camera& camera);
+// The same at a given exponent: every mode's arithmetic is the same scaled by a power of two (exact
+// while nothing under- or overflows), so its pixels are the same; reframeEncoding keeps the
+// exponent a stream was encoded at before its camera was known.
+SceneFrame sceneFrame(const Camera& camera, int exponent);
 
 // x · 2^exponent, correctly rounded (exact unless it over- or underflows): a multiplication by the
 // power of two where that is a normal double, ldexp beyond.
@@ -150,6 +154,12 @@ Result<ModeEncoding> prepareEncoding(PrecisionMode mode, const PointSet& points,
 // naming whole-set indices, and in batch mode its batches' frames and matrices appended.
 ModeEncoding beginEncoding(PrecisionMode mode, const Camera& camera, double tolerance_px = kDefaultTolerancePx);
 Status addPoints(ModeEncoding& encoding, const PointSet& block, size_t first_index);
+// A stream encoded in one pass before its camera was known (beginEncoding with a provisional
+// camera): the encoding for `camera`, at the exponent its points were encoded at, its batches'
+// matrices and plan made again. The per-point data stays valid: fp32's and split's are the world's,
+// the scene-frame modes' are scaled by the kept exponent, and the per-batch modes' offsets are
+// relative to a batch frame that scales with it (docs/rendering.md: one pass over a stream).
+Status reframeEncoding(ModeEncoding& encoding, const Camera& camera);
 // Per-batch modes, for a set known only by the bounding box of every kBoxPoints consecutive points
 // (boxes[k]: points k·kBoxPoints on from the next batch, as viewer/precision.h's BatchBoxes keeps
 // them; a batch is the union of batchSize() / kBoxPoints of them): the frames, matrices and plan

@@ -463,10 +463,13 @@ Status runProbe(const VulkanContext& context, Resources& r, const RenderOptions&
 // Both entry points: `total` points, a chunk at a time from `chunk_points`; `encoding` is complete
 // for a set in memory, and for a stream grows block by block (chunk_points adds each block).
 Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, const ChunkPoints& chunk_points,
-                                  const ModeEncoding& encoding, const Camera& camera, const RenderOptions& options,
-                                  std::chrono::steady_clock::time_point upload_start, uint64_t max_chunk_points) {
+                                  const ModeEncoding& encoding, const Camera& given_camera,
+                                  const RenderOptions& given_options,
+                                  std::chrono::steady_clock::time_point upload_start, uint64_t max_chunk_points,
+                                  const std::function<Status(Camera&, RenderOptions&)>* settle = nullptr) {
+  Camera camera = given_camera;
+  RenderOptions options = given_options;
   const bool compute = options.backend == Backend::kCompute;
-  const bool shading = options.shading == Shading::kEdl;
   // Positions come from a storage buffer in the compute backend, for native mode on a device
   // without double vertex attributes, and always for a mode with no vertex attributes (adaptive).
   const ModeShaders& shaders = modeInfo(options.mode).shaders;
@@ -476,47 +479,62 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   Resources r(context);
   // The driver compiles the pipelines while the points are encoded and uploaded: on NVIDIA's a
   // cold shader cache takes 50-100 ms, as long as the upload of 16.7M points. Declared after r,
-  // so an early return waits for it before r is torn down.
-  std::future<Status> pipelines_made = std::async(std::launch::async, [&]() -> Status {
-    if (compute) {
-      Result<ComputePipelines> pipelines =
-          createComputePipelines(context, options.mode, options.probe,
-                                 SplatVariant{options.early_depth, options.subgroup_merge.value_or(context.facts.type != "cpu"),
-                                              options.pair_merge.value_or(context.facts.type != "cpu"),
-                                              options.point_size != 1.0f, options.round_points},
-                                 shading);
-      if (!pipelines) return pipelines.error();
-      r.compute = *pipelines;
-    } else {
-      Result<PointPipelines> pipelines =
-          createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height, shading,
-                               options.round_points && options.point_size != 1.0f);
-      if (!pipelines) return pipelines.error();
-      r.pipelines = *pipelines;
-    }
-    return okStatus();
-  });
-  // And the shading's beside them: on lavapipe making them takes as long as uploading 1.5M points.
-  std::future<Status> shade_made = std::async(std::launch::async, [&]() -> Status {
-    if (!shading) return okStatus();
-    Result<ShadePipeline> pipeline =
-        createShadePipeline(context, shadeRadii(options.point_size, options.edl.radius, options.edl.fuse));
-    if (!pipeline) return pipeline.error();
-    r.shade = *pipeline;
-    return okStatus();
-  });
+  // so an early return waits for it before r is torn down. A stream settled after its upload
+  // (renderStreamOnce) knows its point size, and so its pipelines, only then.
+  std::future<Status> pipelines_made, shade_made;
+  auto make_pipelines = [&]() {
+    const bool shading = options.shading == Shading::kEdl;
+    pipelines_made = std::async(std::launch::async, [&, shading]() -> Status {
+      if (compute) {
+        Result<ComputePipelines> pipelines =
+            createComputePipelines(context, options.mode, options.probe,
+                                   SplatVariant{options.early_depth, options.subgroup_merge.value_or(context.facts.type != "cpu"),
+                                                options.pair_merge.value_or(context.facts.type != "cpu"),
+                                                options.point_size != 1.0f, options.round_points},
+                                   shading);
+        if (!pipelines) return pipelines.error();
+        r.compute = *pipelines;
+      } else {
+        Result<PointPipelines> pipelines =
+            createPointPipelines(context, options.mode, pulled, options.probe, camera.width, camera.height, shading,
+                                 options.round_points && options.point_size != 1.0f);
+        if (!pipelines) return pipelines.error();
+        r.pipelines = *pipelines;
+      }
+      return okStatus();
+    });
+    // And the shading's beside them: on lavapipe making them takes as long as uploading 1.5M points.
+    shade_made = std::async(std::launch::async, [&, shading]() -> Status {
+      if (!shading) return okStatus();
+      Result<ShadePipeline> pipeline =
+          createShadePipeline(context, shadeRadii(options.point_size, options.edl.radius, options.edl.fuse));
+      if (!pipeline) return pipeline.error();
+      r.shade = *pipeline;
+      return okStatus();
+    });
+  };
+  if (!settle) make_pipelines();
 
   RenderResult out;
   out.pulled_positions = pulled;
   RenderOptions chunking = options;
   chunking.max_chunk_points = max_chunk_points;
+  Status status = uploadPoints(context, r, total, chunk_points, options, encoding, pulled,
+                               chunkPoints(context.facts, chunking, pulled || compute));
+  if (status && settle) {
+    const PrecisionMode mode = options.mode;
+    const Backend backend = options.backend;
+    status = (*settle)(camera, options);
+    assert(options.mode == mode && options.backend == backend);
+    (void)mode, (void)backend;
+    if (status) make_pipelines();
+  }
+  const bool shading = options.shading == Shading::kEdl;
   detail::roundPointPush(camera, options, r.round_depth_scale, r.round_bulge);
-  Status status = createUniforms(context, r, camera, encoding);
-  if (status) status = uploadPoints(context, r, total, chunk_points, options, encoding, pulled,
-                                    chunkPoints(context.facts, chunking, pulled || compute));
+  if (status) status = createUniforms(context, r, camera, encoding);
   if (status) status = uploadBatchMatrices(context, r, options, encoding);
-  Status made = pipelines_made.get();
-  Status shade = shade_made.get();
+  Status made = pipelines_made.valid() ? pipelines_made.get() : okStatus();
+  Status shade = shade_made.valid() ? shade_made.get() : okStatus();
   if (!status) return status.error();
   if (!made) return made.error();
   if (!shade) return shade.error();
@@ -638,14 +656,18 @@ Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& 
                       camera, options, upload_start, options.max_chunk_points);
 }
 
-Result<RenderResult> renderStream(const VulkanContext& context, const PointStream& stream, const Camera& camera,
-                                  const RenderOptions& options) {
+namespace {
+
+Result<RenderResult> streamChunks(const VulkanContext& context, const PointStream& stream, const Camera& camera,
+                                  const RenderOptions& options,
+                                  const std::function<Status(Camera&, RenderOptions&)>* settle,
+                                  ModeEncoding& encoding) {
   assert(!options.probe && "the probe keeps every point's clip position: render the set in memory");
   Status status = checkOptions(context, stream.count, camera, options);
   if (!status) return status.error();
   if (status = checkMode(context, options); !status) return status.error();
   Clock::time_point upload_start = Clock::now();
-  ModeEncoding encoding = beginEncoding(options.mode, camera, options.tolerance_px);
+  encoding = beginEncoding(options.mode, camera, options.tolerance_px);
   StreamBlocks blocks(stream, encoding);
   // Whole batches per block, so batch mode's frames line up with the chunks.
   uint64_t limit = options.max_chunk_points ? std::min<uint64_t>(options.max_chunk_points, kStreamBlockPoints)
@@ -653,7 +675,25 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
   if (const uint64_t batch = modeInfo(options.mode).batch_points) limit = std::max<uint64_t>(batch, limit / batch * batch);
   return renderChunks(context, stream.count,
                       [&](size_t first, size_t count) { return blocks.get(first, count); }, encoding, camera, options,
-                      upload_start, limit);
+                      upload_start, limit, settle);
+}
+
+}  // namespace
+
+Result<RenderResult> renderStream(const VulkanContext& context, const PointStream& stream, const Camera& camera,
+                                  const RenderOptions& options) {
+  ModeEncoding encoding;
+  return streamChunks(context, stream, camera, options, nullptr, encoding);
+}
+
+Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointStream& stream, const Camera& provisional,
+                                      const RenderOptions& options, const StreamSettle& settle) {
+  ModeEncoding encoding;
+  const std::function<Status(Camera&, RenderOptions&)> reframed = [&](Camera& camera, RenderOptions& settled) {
+    if (Status status = settle.settle(camera, settled); !status) return status;
+    return reframeEncoding(encoding, camera);
+  };
+  return streamChunks(context, stream, provisional, options, &reframed, encoding);
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,

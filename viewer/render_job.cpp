@@ -69,6 +69,11 @@ struct LoadedSet {
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
   uint64_t reread_points = 0;          // a stream: the points its outline and spacing read again
+  // A stream drawn in one pass (renderOnce): its bounds, outline and spacing come with the upload,
+  // its provisional camera and mode from `preview`, whole batches spread over the file.
+  bool one_pass = false;
+  PointSet preview;
+  BatchBoxes preview_boxes;
   std::optional<CopcReadStats> copc;   // a COPC input: what its view read
   double surface_spacing = 0.0;        // a sampled mesh surface: its samples' mean spacing (world units)
   MeshTexture texture;                 // a glTF mesh's base-colour textures, for its surface's colours
@@ -192,6 +197,30 @@ Result<LoadedSet> takeInMemory(const RenderRequest& request) {
   return set;
 }
 
+// Whole batches of a stream spread evenly over it, for a one-pass render's provisional camera and
+// mode: kPreviewRuns runs of one batch-mode batch (4096 points) each, their boxes kept as batch
+// boxes (predictBoxBounds), or the whole stream when it is no larger.
+constexpr uint64_t kPreviewRuns = 64, kPreviewRunPoints = kBatchSize;
+Status readPreview(PointInputStream& stream, LoadedSet& set) {
+  const uint64_t n = stream.count(), boxes = (n + kBoxPoints - 1) / kBoxPoints;
+  const uint64_t run_boxes = kPreviewRunPoints / kBoxPoints;
+  PointSet block;
+  PointSet& preview = set.preview;
+  const auto add = [&](uint64_t first, uint64_t count) -> Status {
+    if (Status status = stream.read(first, count, block); !status) return status;
+    preview.positions.insert(preview.positions.end(), block.positions.begin(), block.positions.end());
+    preview.z_axis = block.z_axis;
+    addBatchBoxes(set.preview_boxes, block.positions);
+    return okStatus();
+  };
+  if (boxes <= kPreviewRuns * run_boxes) return add(0, n);
+  for (uint64_t k = 0; k < kPreviewRuns; ++k) {
+    const uint64_t first = k * ((boxes - run_boxes) / run_boxes) / (kPreviewRuns - 1) * kPreviewRunPoints;
+    if (Status status = add(first, std::min(kPreviewRunPoints, n - first)); !status) return status;
+  }
+  return okStatus();
+}
+
 // Opens the input as a stream (large binary PLY, LAS or LAZ), reads a COPC file's view, or reads
 // it whole.
 Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
@@ -223,6 +252,15 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
                  "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
   if (ply) {
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
+    set.count = ply->count(), set.has_colors = ply->hasColors();
+    if (request.color == RenderColor::kAuto || request.color == RenderColor::kRgb) {
+      if (Status s = readPreview(*ply, set); !s) return s.error();
+      // One pass where the colours do not wait for the bounds: the file's own, or none on a 2D
+      // set (a 3D one without colours is coloured by elevation, which needs its extent first).
+      set.one_pass = set.has_colors || request.color == RenderColor::kRgb || set.preview.isPlanar();
+      phases.mark("preview");
+      if (set.one_pass) return set;
+    }
     SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
     Result<Bounds> bounds = streamBounds(inputs, *ply, progress, sampler, set.boxes);
     if (!bounds) return bounds.error();
@@ -311,7 +349,7 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   }
   // A 2D set has no elevation: without colours its points stay white.
   set.elevation = request.color == RenderColor::kElevation ||
-                  (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar);
+                  (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar && !set.one_pass);
   if (request.color == RenderColor::kAttribute && set.points()) {
     const Dimension* d = set.points()->dimensions.find(request.color_attribute);
     if (!d) return noSuchAttribute(inputs, request.color_attribute, set.points()->dimensions);
@@ -467,6 +505,16 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
   return okStatus();
 }
 
+// What a view's picture tells, and the picture with its legend into the outcome.
+void finishView(const RenderRequest& request, const LoadedSet& set, RenderResult rendered, RenderOutcome& outcome) {
+  const DrawnPixels drawn = drawnPixels(rendered.image, request.background_rgba8);
+  outcome.drawn_share = drawn.share();
+  if (std::string cover = coverWarning(drawn.share(), drawn.span()); !cover.empty()) outcome.warnings.push_back(cover);
+  outcome.image = std::move(rendered.image);
+  if (set.coloring) drawLegend(outcome.image, *set.coloring);
+  outcome.result = std::move(rendered);
+}
+
 // One view, the set in memory or streamed: the render and, with --error, the error measured.
 Status renderOne(const RenderRequest& request, const VulkanContext& context, const LoadedSet& set,
                  const Camera& camera, RenderOutcome& outcome, Progress& progress) {
@@ -507,12 +555,98 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
     outcome.error = measureError(*set.points(), camera, *rendered, options);
     outcome.phases.mark("error");
   }
-  const DrawnPixels drawn = drawnPixels(rendered->image, request.background_rgba8);
-  outcome.drawn_share = drawn.share();
-  if (std::string cover = coverWarning(drawn.share(), drawn.span()); !cover.empty()) outcome.warnings.push_back(cover);
-  outcome.image = std::move(rendered->image);
-  if (set.coloring) drawLegend(outcome.image, *set.coloring);
-  outcome.result = std::move(*rendered);
+  finishView(request, set, std::move(*rendered), outcome);
+  return okStatus();
+}
+
+// A fitted view leaves 1% of the picture free each side; where the default points are larger (a
+// sparse set's), the fit is made again leaving their radius, so no point touches the edge.
+Result<std::vector<Camera>> refitForPoints(const RenderRequest& request, const LoadedSet& set,
+                                           const std::vector<RenderView>& views, const DeviceFacts& facts,
+                                           std::vector<Camera> cameras) {
+  const CameraSpec& spec = request.camera;
+  if (request.point_size || spec.eye || spec.view_center || spec.view_width) return cameras;
+  double radius = 0.0, free = HUGE_VAL;
+  for (const Camera& camera : cameras) {
+    radius = std::max(radius, 0.5 * defaultPointSize(request, set, camera, facts));
+    free = std::min(free, 0.5 * kFitMarginShare * std::min(camera.width, camera.height));
+  }
+  if (radius + 0.5 <= free) return cameras;
+  RenderRequest refit = request;
+  refit.camera.fit_margin_px = radius + 0.5;
+  return viewCameras(refit, views, set.bounds, set.z_up);
+}
+
+// One pass over a stream (LoadedSet::one_pass): encoded and uploaded for a provisional camera and
+// mode from its preview while its bounds, batch boxes and spacing samples are gathered; then the
+// outline and spacing (the batches they need, read again), the camera, the mode's check and the
+// options, and the frames. The error StreamSettle::kAgain where the whole set wants another mode,
+// or is 3D without colours (coloured by elevation): `set` then has its bounds and the caller reads
+// the stream the usual way.
+Status renderOnce(const RenderRequest& request, const VulkanContext& context, LoadedSet& set,
+                  const std::vector<RenderView>& views, RenderOutcome& outcome, Progress& progress) {
+  Result<std::vector<Camera>> provisional = viewCameras(request, views, boundsWithOutline(set.preview), set.z_up);
+  if (!provisional) return provisional.error();
+  PrecisionMode mode = kFallbackMode;
+  if (request.mode != "auto") {
+    mode = *parseMode(request.mode);
+  } else {
+    Result<ModeChoice> choice = chooseModeOnDevice(context, set.preview_boxes, provisional->front(), *request.backend,
+                                                   request.tolerance_px);
+    if (!choice) return choice.error();
+    mode = choice->mode;
+  }
+  std::vector<std::string> ignored;
+  const RenderOptions options = renderOptionsFor(request, set, mode, provisional->front(), context.facts, ignored);
+  set.bounds = Bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
+  SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
+  PointStream stream;
+  stream.count = set.count;
+  stream.has_colors = set.has_colors;
+  stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
+    if (Status status = set.stream->read(first, n, block); !status) return status;
+    const size_t from = set.boxes.boxes.size();
+    addBatchBoxes(set.boxes, block.positions);
+    for (size_t b = from; b < set.boxes.boxes.size(); ++b)
+      set.bounds.min = glm::min(set.bounds.min, set.boxes.boxes[b].min),
+      set.bounds.max = glm::max(set.bounds.max, set.boxes.boxes[b].max);
+    set.bounds.planar = set.bounds.planar && block.isPlanar();
+    sampler.add(block.positions);
+    progress.advance(n);
+    return okStatus();
+  };
+  StreamSettle settle;
+  settle.settle = [&](Camera& camera, RenderOptions& settled) -> Status {
+    progress.finish();
+    outcome.phases.mark("upload");
+    if (Status s = streamOutlineAndSpacing(request, set.inputs, *set.stream, sampler.finish(), set, progress); !s) return s;
+    outcome.points_read_again = set.reread_points;
+    outcome.phases.mark("reread");
+    if (!set.has_colors && request.color == RenderColor::kAuto && !set.bounds.planar) {
+      set.elevation = true;
+      return Error{StreamSettle::kAgain};
+    }
+    Result<std::vector<Camera>> cameras = viewCameras(request, views, set.bounds, set.z_up);
+    if (cameras) cameras = refitForPoints(request, set, views, context.facts, std::move(*cameras));
+    if (!cameras) return cameras.error();
+    camera = cameras->front();
+    Result<ModePrediction> prediction = predictMode(request, context, set, camera);
+    if (!prediction) return prediction.error();
+    if (prediction->mode != mode) return Error{StreamSettle::kAgain};
+    outcome.prediction = std::move(*prediction);
+    if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
+    settled = renderOptionsFor(request, set, mode, camera, context.facts, outcome.warnings);
+    outcome.point_size = settled.point_size;
+    outcome.shading = settled.shading;
+    outcome.phases.mark("mode");
+    return okStatus();
+  };
+  progress.start("streaming " + set.inputs + " to the GPU (points)", set.count);
+  Result<RenderResult> rendered = renderStreamOnce(context, stream, provisional->front(), options, settle);
+  progress.finish();
+  if (!rendered) return rendered.error();
+  outcome.phases.mark("render");
+  finishView(request, set, std::move(*rendered), outcome);
   return okStatus();
 }
 
@@ -828,9 +962,12 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
     return Error{set->inputs + ": --views 4 shows a 3D set from four sides; this set is 2D (every z is 0)",
                  ExitCode::kUsage};
   const std::vector<RenderView> views = viewsFor(request.views, set->z_up);
-  Result<std::vector<Camera>> cameras = viewCameras(request, views, set->bounds, set->z_up);
-  if (!cameras) return cameras.error();
-  outcome.phases.mark("camera");
+  Result<std::vector<Camera>> cameras = std::vector<Camera>();
+  if (!set->one_pass) {
+    cameras = viewCameras(request, views, set->bounds, set->z_up);
+    if (!cameras) return cameras.error();
+    outcome.phases.mark("camera");
+  }
 
   if (request.context)
     outcome.context = request.context;
@@ -844,20 +981,23 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   outcome.backend = backendFor(request, set->count, spec.width, spec.height, context.facts);
   RenderRequest resolved = request;  // the policies below see the backend that runs
   resolved.backend = outcome.backend;
-  // A fitted view leaves 1% of the picture free each side; where the default points are larger
-  // (a sparse set's), the fit is made again leaving their radius, so no point touches the edge.
-  if (!request.point_size && !spec.eye && !spec.view_center && !spec.view_width) {
-    double radius = 0.0, free = HUGE_VAL;
-    for (const Camera& camera : *cameras) {
-      radius = std::max(radius, 0.5 * defaultPointSize(resolved, *set, camera, context.facts));
-      free = std::min(free, 0.5 * kFitMarginShare * std::min(camera.width, camera.height));
+  if (set->one_pass) {
+    Status once = renderOnce(resolved, context, *set, views, outcome, progress);
+    if (once || once.error().message != StreamSettle::kAgain) {
+      if (!once) return once.error();
+      outcome.validation_messages = context.validationMessages();
+      return outcome;
     }
-    if (radius + 0.5 > free) {
-      resolved.camera.fit_margin_px = radius + 0.5;
-      cameras = viewCameras(resolved, views, set->bounds, set->z_up);
-      if (!cameras) return cameras.error();
-    }
+    // The points as uploaded would not do: drawn from a second read, with the bounds now known.
+    set->one_pass = false;
+    set->elevation = request.color == RenderColor::kElevation ||
+                     (request.color == RenderColor::kAuto && !set->has_colors && !set->bounds.planar);
+    outcome.read_twice = true;
+    cameras = viewCameras(request, views, set->bounds, set->z_up);
+    if (!cameras) return cameras.error();
   }
+  cameras = refitForPoints(resolved, *set, views, context.facts, std::move(*cameras));
+  if (!cameras) return cameras.error();
   Status rendered = views.size() == 4 ? renderSheet(resolved, context, *set, views, *cameras, outcome, view_done)
                                       : renderOne(resolved, context, *set, cameras->front(), outcome, progress);
   if (!rendered) return rendered.error();
@@ -918,7 +1058,10 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   o.add("driver_version", V::string(formatDriverVersion(f.vendor_id, f.driver_version)));
   o.add("api_version", V::string(formatApiVersion(f.api_version)));
   o.add("points", V::integer(outcome.points));
-  if (outcome.streamed) o.add("points_read_again", V::integer(outcome.points_read_again));
+  if (outcome.streamed) {
+    o.add("points_read_again", V::integer(outcome.points_read_again));
+    o.add("read_twice", V::boolean(outcome.read_twice));
+  }
   o.add("width", V::integer(request.camera.width)).add("height", V::integer(request.camera.height));
   o.add("point_size", V::number(outcome.point_size));
   o.add("shading", V::string(outcome.shading == Shading::kEdl ? "edl" : "none"));

@@ -222,6 +222,9 @@ struct RenderOutcome {
   size_t points = 0;
   bool streamed = false;       // drawn a block at a time (its bound from batch boxes, no --error)
   uint64_t points_read_again = 0;  // streamed: the points its outline and spacing read a second time
+  // Streamed in one pass, then read again whole: the whole set wanted another mode than its preview
+  // did, or (3D, no colours) its elevation colours.
+  bool read_twice = false;
   DeviceFacts device;
   Backend backend = Backend::kRaster;  // the one that ran (backendFor with --backend auto)
   std::vector<std::string> validation_messages;  // with `validate`: any fails the run

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "converters/ply.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -342,6 +343,9 @@ TEST(CliRender, streamedPlyDrawsTheSamePicture) {
     // Streamed, the bound is predicted from the box of each batch: no less than the points' own.
     const std::string streamed = readFile(dir.file("on.json"));
     EXPECT_TRUE(test::contains(streamed, "\"predicted_from\": \"batch_boxes\"")) << streamed;
+    // Coloured, it is drawn in one pass: encoded while its bounds are gathered.
+    EXPECT_TRUE(test::contains(streamed, "\"read_twice\": false")) << streamed;
+    EXPECT_TRUE(test::contains(streamed, "\"preview\": ")) << streamed;
     EXPECT_GE(jsonNumber(streamed, "predicted_bound_px"), jsonNumber(readFile(dir.file("off.json")), "predicted_bound_px"));
   }
   // In Morton order the second pass (outline and spacing) reads again only the batches whose box
@@ -367,6 +371,51 @@ TEST(CliRender, streamedPlyDrawsTheSamePicture) {
   EXPECT_EQ(error.exit_code, 1);
   EXPECT_NE(error.err.find("is read once"), std::string::npos) << error.err;
   EXPECT_FALSE(test::fileExists(dir.file("a.png")) || test::fileExists(dir.file("e.png")));
+}
+
+// A stream drawn in one pass is encoded for the camera and mode its preview (whole batches spread
+// over the file) suggests; where the whole set wants otherwise, it is read again, and the picture
+// is still the one the set in memory gives. 300,000 2D points near the origin; the preview passes
+// over points 28,672..32,767 (its runs are batches 0..6, 8, ...).
+TEST(CliRender, aStreamThePreviewMisjudgesIsReadAgain) {
+  TempDir dir;
+  const auto write = [&](const std::string& name, const std::function<void(size_t, glm::dvec3&)>& odd) {
+    PointSet set;
+    uint64_t state = 12345;
+    const auto next = [&] { return double((state = state * 6364136223846793005ull + 1442695040888963407ull) >> 11) * 0x1p-53; };
+    for (size_t i = 0; i < 300000; ++i) {
+      glm::dvec3 p(next(), next(), 0.0);
+      if (i >= 28672 && i < 32768) odd(i, p);
+      set.positions.push_back(p);
+    }
+    ASSERT_TRUE(writePly(dir.file(name), set).ok());
+  };
+  // One point off the plane: the preview sees a 2D set (white), the whole one is 3D, coloured by
+  // elevation once its extent is known.
+  write("lift.ply", [](size_t i, glm::dvec3& p) { p.z = i == 30000 ? 0.5 : 0.0; });
+  // A cluster 1e4 away, which the view shows: off screen in the preview, every mode's bound 0 and
+  // fp32 the fastest; float32 cannot hold the cluster at this zoom.
+  write("far.ply", [](size_t, glm::dvec3& p) { p.x += 1e4; });
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"lift.ply", {"--mode", "fp32"}},
+      {"far.ply", {"--view-center", "10000.5,0.5", "--view-width", "1"}}};
+  for (const auto& [name, extra] : cases) {
+    SCOPED_TRACE(name);
+    for (const char* stream : {"off", "on"}) {
+      std::vector<std::string> args = {"render", dir.file(name), "-o", dir.file(stream + name + ".png"), "--stream",
+                                       stream, "--width", "256", "--height", "256", "--validate", "--json",
+                                       dir.file(stream + name + ".json")};
+      args.insert(args.end(), extra.begin(), extra.end());
+      test::CommandResult r = runDpoint(args);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    const std::string on = readFile(dir.file("on" + name + ".json"));
+    EXPECT_TRUE(test::contains(on, "\"read_twice\": true")) << on;
+    EXPECT_TRUE(readFile(dir.file("off" + name + ".png")) == readFile(dir.file("on" + name + ".png")));
+    if (name == "far.ply") {
+      EXPECT_FALSE(test::contains(on, "{\n  \"mode\": \"fp32\"")) << on;  // the report's first key
+    }
+  }
 }
 
 // Vulkan faults (issue #12): no driver, a device without a feature the run needs (hidden by the
