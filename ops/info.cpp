@@ -1,15 +1,18 @@
 #include "ops/info.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cfloat>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <span>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 
 #include <glm/common.hpp>
+#include <glm/ext/vector_int3_sized.hpp>
 
 #include "core/parallel.h"
 
@@ -207,6 +210,191 @@ void finishBounds(PointSetInfo& info) {
       : std::numeric_limits<double>::infinity();
 }
 
+// Points per box of a streamed set's second pass (as many as the renderer's batch boxes).
+constexpr uint64_t kStreamBoxPoints = 1024;
+// Boxes without queries that a run of boxes read again may span.
+constexpr size_t kJoinBoxes = 16;
+
+// The sampled points' balls (radius² best2) on a grid over the set's box, for the boxes and points
+// that may hold a point nearer a sample than its bound. The grid's cell is the median box's longest
+// side, so most boxes span a cell or two along each axis. A ball is listed in the cells its box
+// spans and one more each side (a coordinate's cell is rounded; the slack covers that), or, where
+// that is many cells, with every query.
+class SampleBalls {
+ public:
+  SampleBalls(const std::vector<glm::dvec3>& samples, const std::vector<double>& best2, const glm::dvec3& min,
+              const glm::dvec3& max, const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes)
+      : samples_(samples), best2_(best2), min_(min) {
+    const glm::dvec3 extent = max - min;
+    const double largest = std::max({extent.x, extent.y, extent.z});
+    std::vector<double> sides;
+    const size_t step = std::max<size_t>(1, boxes.size() / 4096);
+    for (size_t b = 0; b < boxes.size(); b += step) {
+      const glm::dvec3 side = boxes[b].second - boxes[b].first;
+      sides.push_back(std::max({side.x, side.y, side.z}));
+    }
+    std::nth_element(sides.begin(), sides.begin() + static_cast<ptrdiff_t>(sides.size() / 2), sides.end());
+    const double median = sides.empty() ? 0.0 : sides[sides.size() / 2];
+    compact_ = median <= largest / 16.0;
+    cell_ = std::max(median, largest / kCells);
+    if (!(cell_ > 0.0) || !std::isfinite(cell_)) cell_ = 1.0;
+    for (uint32_t k = 0; k < samples.size(); ++k) {
+      const double r = std::sqrt(best2[k]);
+      glm::i64vec3 lo, hi;
+      if (!cellRange(samples[k] - r, samples[k] + r, lo, hi, 1)) {
+        everywhere_.push_back(k);
+        continue;
+      }
+      for (int64_t z = lo.z; z <= hi.z; ++z)
+        for (int64_t y = lo.y; y <= hi.y; ++y)
+          for (int64_t x = lo.x; x <= hi.x; ++x) cells_[key(x, y, z)].push_back(k);
+    }
+  }
+
+  // Whether the median box spans at most a 16th of the set (a file in some spatial order).
+  bool compact() const { return compact_; }
+
+  // The samples whose ball reaches the box [lo, hi], into `out`; false (out empty) where the box
+  // spans too many cells to look up: then each of its points is looked up (pointQueries).
+  bool near(const glm::dvec3& lo, const glm::dvec3& hi, std::vector<uint32_t>& out) const {
+    out.clear();
+    glm::i64vec3 a, b;
+    if (!cellRange(lo, hi, a, b, 0)) return false;
+    for (int64_t z = a.z; z <= b.z; ++z)
+      for (int64_t y = a.y; y <= b.y; ++y)
+        for (int64_t x = a.x; x <= b.x; ++x)
+          if (auto it = cells_.find(key(x, y, z)); it != cells_.end())
+            out.insert(out.end(), it->second.begin(), it->second.end());
+    out.insert(out.end(), everywhere_.begin(), everywhere_.end());
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    std::erase_if(out, [&](uint32_t k) { return !(boxDistance2(lo, hi, samples_[k]) <= best2_[k]); });
+    return true;
+  }
+
+  // Lowers found[k] to the smallest squared distance > 0 from sample k to the points, for the
+  // samples listed in each point's cell.
+  void pointQueries(std::span<const glm::dvec3> points, std::vector<double>& found) const {
+    for (const glm::dvec3& p : points) {
+      glm::i64vec3 c, same;
+      if (!cellRange(p, p, c, same, 0)) continue;  // not finite: no distance
+      const auto visit = [&](uint32_t k) {
+        const glm::dvec3 d = p - samples_[k];
+        const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (d2 > 0.0 && d2 < found[k]) found[k] = d2;
+      };
+      if (auto it = cells_.find(key(c.x, c.y, c.z)); it != cells_.end())
+        for (uint32_t k : it->second) visit(k);
+      for (uint32_t k : everywhere_) visit(k);
+    }
+  }
+
+ private:
+  static constexpr double kCells = double(1 << 20);  // at most, along the set's longest side
+  static constexpr int64_t kMostCells = 64;  // a box or ball over more is not looked up by cell
+  static uint64_t key(int64_t x, int64_t y, int64_t z) { return uint64_t(x) | uint64_t(y) << 21 | uint64_t(z) << 42; }
+  bool cellRange(const glm::dvec3& lo, const glm::dvec3& hi, glm::i64vec3& a, glm::i64vec3& b, int64_t slack) const {
+    int64_t cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      const double from = std::floor((lo[k] - min_[k]) / cell_), to = std::floor((hi[k] - min_[k]) / cell_);
+      if (!std::isfinite(from) || !std::isfinite(to)) return false;
+      a[k] = std::max<int64_t>(static_cast<int64_t>(std::clamp(from, 0.0, kCells)) - slack, 0);
+      b[k] = std::min<int64_t>(static_cast<int64_t>(std::clamp(to, 0.0, kCells)) + slack, int64_t(kCells));
+      cells *= b[k] - a[k] + 1;
+      if (cells > kMostCells) return false;
+    }
+    return true;
+  }
+
+  const std::vector<glm::dvec3>& samples_;
+  const std::vector<double>& best2_;
+  glm::dvec3 min_;
+  double cell_ = 1.0;
+  bool compact_ = false;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+  std::vector<uint32_t> everywhere_;
+};
+
+// Pass 2 of computeStreamedInfo on a file whose boxes are compact (Morton or slab order): the boxes
+// within some sampled point's bound are read again, each against those samples, and the boxes
+// too wide to look up point by point; every point nearer a sample than its bound lies in one.
+Status nearestByBoxes(uint64_t count, const BlockReader& read, uint64_t block_points, uint64_t box_points,
+                      const std::vector<glm::dvec3>& sampled,
+                      std::vector<double>& best2, const SampleBalls& balls, const std::vector<uint8_t>& wide,
+                      const std::vector<std::vector<uint32_t>>& near, unsigned workers, PointSet& block,
+                      uint64_t& read_again) {
+  std::vector<std::vector<double>> found(workers, std::vector<double>(sampled.size(), std::numeric_limits<double>::infinity()));
+  const auto wanted = [&](size_t b) { return wide[b] || !near[b].empty(); };
+  for (uint64_t first = 0; first < count; first += block_points) {
+    const uint64_t n = std::min(block_points, count - first);
+    const size_t to = static_cast<size_t>((first + n + box_points - 1) / box_points);
+    size_t b = static_cast<size_t>(first / box_points);
+    // Runs of wanted boxes, joined across short gaps, read a run at a time.
+    while (b < to) {
+      while (b < to && !wanted(b)) ++b;
+      if (b == to) break;
+      size_t end = b + 1;
+      for (size_t gap = 0; end < to && gap <= kJoinBoxes; ++end) gap = wanted(end) ? 0 : gap + 1;
+      while (!wanted(end - 1)) --end;
+      const uint64_t run_first = uint64_t{b} * box_points;
+      const uint64_t run_end = std::min<uint64_t>(count, uint64_t{end} * box_points);
+      if (Status s = read(run_first, run_end - run_first, block); !s) return s;
+      read_again += run_end - run_first;
+      parallelFor(end - b, workers, [&](size_t k, unsigned worker) {
+        const size_t lo = static_cast<size_t>(k * box_points), hi = std::min<size_t>(block.positions.size(), lo + box_points);
+        const std::span<const glm::dvec3> points = std::span(block.positions).subspan(lo, hi - lo);
+        std::vector<double>& mine = found[worker];
+        if (wide[b + k]) return balls.pointQueries(points, mine);
+        for (uint32_t q : near[b + k]) {
+          double smallest = mine[q];
+          for (const glm::dvec3& p : points) {
+            const glm::dvec3 d = p - sampled[q];
+            const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+            if (d2 > 0.0 && d2 < smallest) smallest = d2;
+          }
+          mine[q] = smallest;
+        }
+      });
+      b = end;
+    }
+  }
+  for (const std::vector<double>& mine : found)
+    for (size_t k = 0; k < best2.size(); ++k) best2[k] = std::min(best2[k], mine[k]);
+  return okStatus();
+}
+
+// Pass 2 on a file in no spatial order: each block whose box lies within some sampled point's
+// bound, read again whole into k-d trees (Forest), searched nearest first.
+Status nearestByBlocks(uint64_t count, const BlockReader& read, uint64_t block_points, uint64_t box_points,
+                       const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes, const std::vector<glm::dvec3>& sampled,
+                       std::vector<double>& best2, unsigned threads, PointSet& block, uint64_t& read_again) {
+  const size_t per_block = static_cast<size_t>(block_points / box_points);
+  std::vector<size_t> near;
+  std::vector<glm::dvec3> queries;
+  std::vector<double> query_best2;
+  for (uint64_t first = 0; first < count; first += block_points) {
+    const size_t from = static_cast<size_t>(first / box_points), to = std::min(boxes.size(), from + per_block);
+    glm::dvec3 lo = boxes[from].first, hi = boxes[from].second;
+    for (size_t b = from; b < to; ++b) lo = glm::min(lo, boxes[b].first), hi = glm::max(hi, boxes[b].second);
+    near.clear();
+    for (size_t k = 0; k < sampled.size(); ++k)
+      if (boxDistance2(lo, hi, sampled[k]) <= best2[k]) near.push_back(k);
+    if (near.empty()) continue;
+    const uint64_t n = std::min(block_points, count - first);
+    if (Status s = read(first, n, block); !s) return s;
+    read_again += n;
+    queries.resize(near.size());
+    query_best2.resize(near.size());
+    for (size_t j = 0; j < near.size(); ++j) {
+      queries[j] = sampled[near[j]];
+      query_best2[j] = best2[near[j]];
+    }
+    Forest(block.positions, threads).nearestNonzero(queries, query_best2, threads);
+    for (size_t j = 0; j < near.size(); ++j) best2[near[j]] = query_best2[j];
+  }
+  return okStatus();
+}
+
 }  // namespace
 
 PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigned threads) {
@@ -250,18 +438,41 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   const uint64_t sample = std::min<uint64_t>(count, std::max<size_t>(neighbor_sample, 1));
   const uint64_t step = count / sample;
   // Pass 1: bounds, the sample, and for each sampled point a first bound on its nearest distance:
-  // the points beside it in the file (near in space when the file is in slab or Morton order).
+  // the points beside it in the file (near in space when the file is in slab or Morton order);
+  // the box of every kStreamBoxPoints consecutive points, on all cores.
+  // Boxes that tile the blocks: 1024 points, or a block where blocks are not whole boxes (tests).
+  const uint64_t box_points = block_points % kStreamBoxPoints == 0 ? kStreamBoxPoints : block_points;
   std::vector<glm::dvec3> sampled;
   sampled.reserve(static_cast<size_t>(sample));
   std::vector<double> best2;
-  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes;  // of each block
+  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes;
+  boxes.reserve(static_cast<size_t>((count + box_points - 1) / box_points));
   PointSet block;
+  const unsigned workers = resolveThreads(threads);
   for (uint64_t first = 0; first < count; first += block_points) {
     const uint64_t n = std::min(block_points, count - first);
     if (Status s = read(first, n, block); !s) return s.error();
+    const size_t from = boxes.size(), added = static_cast<size_t>((n + box_points - 1) / box_points);
+    boxes.resize(from + added);
+    std::vector<size_t> overflow(workers, 0), nonfinite(workers, 0);
+    parallelFor(added, workers, [&](size_t k, unsigned worker) {
+      const size_t lo = static_cast<size_t>(k * box_points), hi = std::min<size_t>(static_cast<size_t>(n), lo + box_points);
+      boxes[from + k] = boxOf(std::span(block.positions).subspan(lo, hi - lo));
+      for (size_t i = lo; i < hi; ++i)
+        for (int a = 0; a < 3; ++a) {
+          overflow[worker] += std::fabs(block.positions[i][a]) > static_cast<double>(FLT_MAX);
+          nonfinite[worker] += !std::isfinite(block.positions[i][a]);
+        }
+    });
     if (first == 0) info.min = info.max = block.positions[0];
-    addBounds(info, block.positions);
-    boxes.push_back(boxOf(block.positions));
+    if (std::all_of(nonfinite.begin(), nonfinite.end(), [](size_t c) { return c == 0; })) {
+      // min and max of finite values in any grouping: the boxes' are the points'.
+      for (size_t k = from; k < boxes.size(); ++k)
+        info.min = glm::min(info.min, boxes[k].first), info.max = glm::max(info.max, boxes[k].second);
+      for (size_t o : overflow) info.float_overflow += o;
+    } else {
+      addBounds(info, block.positions);  // in order, as computeInfo takes them
+    }
     // Sample indices k·step in [first, first + n), k < sample.
     for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k) {
       const size_t at = static_cast<size_t>(k * step - first);
@@ -277,26 +488,18 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   }
   finishBounds(info);
   if (count < 2) return out;
-  // Pass 2: each block whose box lies within some sampled point's bound, against those points.
-  std::vector<size_t> near;
-  std::vector<glm::dvec3> queries;
-  std::vector<double> query_best2;
-  for (size_t b = 0; b < boxes.size(); ++b) {
-    near.clear();
-    for (size_t k = 0; k < sampled.size(); ++k)
-      if (boxDistance2(boxes[b].first, boxes[b].second, sampled[k]) <= best2[k]) near.push_back(k);
-    if (near.empty()) continue;
-    const uint64_t first = b * block_points;
-    if (Status s = read(first, std::min(block_points, count - first), block); !s) return s.error();
-    queries.resize(near.size());
-    query_best2.resize(near.size());
-    for (size_t j = 0; j < near.size(); ++j) {
-      queries[j] = sampled[near[j]];
-      query_best2[j] = best2[near[j]];
-    }
-    Forest(block.positions, threads).nearestNonzero(queries, query_best2, threads);
-    for (size_t j = 0; j < near.size(); ++j) best2[near[j]] = query_best2[j];
-  }
+  // Pass 2: by boxes where most are compact enough to look up; else by blocks.
+  const SampleBalls balls(sampled, best2, info.min, info.max, boxes);
+  std::vector<std::vector<uint32_t>> near(balls.compact() ? boxes.size() : 0);
+  std::vector<uint8_t> wide(near.size(), 0);
+  parallelFor(near.size(), workers, [&](size_t b, unsigned) {
+    wide[b] = !balls.near(boxes[b].first, boxes[b].second, near[b]);
+  });
+  const size_t wide_boxes = static_cast<size_t>(std::count(wide.begin(), wide.end(), uint8_t{1}));
+  Status second = balls.compact() && 4 * wide_boxes <= boxes.size()
+      ? nearestByBoxes(count, read, block_points, box_points, sampled, best2, balls, wide, near, workers, block, out.points_read_again)
+      : nearestByBlocks(count, read, block_points, box_points, boxes, sampled, best2, threads, block, out.points_read_again);
+  if (!second) return second.error();
   info.min_neighbor_distance = smallestDistance(best2);
   info.neighbor_sample = sampled.size();
   return out;

@@ -32,13 +32,17 @@ struct PointSetInfo {
 // What computeInfo gives, for a set read a block at a time (`dpoint info` on input larger than
 // memory): `read(first, n, block)` fills `block` with points [first, first + n). Two passes: the
 // counts, bounds, the sample and a first bound on each sampled point's nearest distance (the
-// points beside it in the file); then the blocks whose box lies within some sampled point's bound,
-// read again (k-d trees of 2^20 points built in parallel, searched nearest first; the smallest
-// distance over the trees is the one over the set). float_merged, which needs every point at
+// points beside it in the file), and the box of every 1024 points; then, where most of those boxes
+// are compact (a file in Morton or slab order), the boxes within some sampled point's bound, read
+// again, each against the samples it may be nearest to (a few per cent of a 1e8-point Morton file);
+// else the blocks whose box lies within some sampled point's bound, read again whole into k-d trees
+// of 2^20 points built in parallel, searched nearest first. Either way each sampled distance is
+// exact. block_points: a multiple of 1024. float_merged, which needs every point at
 // once, is not computed (merged_computed false). Errors are read's.
 struct StreamedInfo {
   PointSetInfo info;
   bool merged_computed = false;
+  uint64_t points_read_again = 0;  // by the second pass
 };
 using BlockReader = std::function<Status(uint64_t first, uint64_t n, PointSet& block)>;
 Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64_t triangles, const BlockReader& read,

@@ -137,13 +137,16 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
 // Each mode's bound from the box of every batch, kept as the first pass reads the blocks in order.
 Result<InfoReport> describeStream(PointInputStream& stream, const std::string& name, const InfoOptions& options,
                                   Progress& progress) {
-  progress.start("reading " + name + " twice (points)", 2 * stream.count());
+  // The first pass shows; the second reads again only what the nearest distances need.
+  progress.start("reading " + name + " (points)", stream.count());
   BatchBoxes boxes;
   const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
     if (interrupted()) return interruptedError();
     if (Status s = stream.read(first, n, block); !s) return s;
-    if (first == boxes.count && n > 0) addBatchBoxes(boxes, block.positions);
-    progress.advance(n);
+    if (first == boxes.count && n > 0) {
+      addBatchBoxes(boxes, block.positions);
+      progress.advance(n);
+    }
     return okStatus();
   };
   Result<StreamedInfo> info = computeStreamedInfo(stream.count(), stream.hasColors(), stream.faceCount(), read,

@@ -97,6 +97,39 @@ TEST(Info, streamedInfoEqualsTheWholeSetsWhateverTheBlocks) {
   EXPECT_EQ(failed.error().message, "x.ply: truncated");
 }
 
+// A file in a spatial order (here 32 x 32 tiles of a grid, as Morton order keeps 1024 points
+// together) reads again only the boxes near a sample; in no order, its blocks whole. Both give the
+// set's own exact distances.
+TEST(Info, streamedInfoReadsAgainOnlyTheBoxesNearASample) {
+  PointSet tiled;
+  uint64_t state = 99;
+  const auto jitter = [&] { return double((state = state * 6364136223846793005ull + 1442695040888963407ull) >> 11) * 0x1p-60; };
+  for (int ti = 0; ti < 16; ++ti)
+    for (int tj = 0; tj < 16; ++tj)
+      for (int i = 0; i < 32; ++i)
+        for (int j = 0; j < 32; ++j) tiled.positions.emplace_back((ti * 32 + i) * 0.5 + jitter(), (tj * 32 + j) * 0.5, jitter());
+  PointSet shuffled = tiled;
+  for (size_t k = shuffled.size() - 1; k > 0; --k) std::swap(shuffled.positions[k], shuffled.positions[(k * 7919) % (k + 1)]);
+  for (const PointSet* set : {&tiled, &shuffled}) {
+    SCOPED_TRACE(set == &tiled ? "tiled" : "shuffled");
+    const PointSetInfo whole = computeInfo(*set, 8);
+    const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+      out.positions.assign(set->positions.begin() + static_cast<long>(first), set->positions.begin() + static_cast<long>(first + n));
+      return okStatus();
+    };
+    Result<StreamedInfo> streamed = computeStreamedInfo(set->size(), false, 0, read, 16384, 8, 2);
+    ASSERT_TRUE(streamed.ok());
+    EXPECT_EQ(streamed->info.min_neighbor_distance, whole.min_neighbor_distance);
+    EXPECT_EQ(streamed->info.min, whole.min);
+    EXPECT_EQ(streamed->info.max, whole.max);
+    if (set == &tiled) {
+      EXPECT_LT(streamed->points_read_again, set->size() / 2);
+    } else {
+      EXPECT_EQ(streamed->points_read_again, set->size());
+    }
+  }
+}
+
 // Non-finite points (read with --allow-nonfinite) take no part in the nearest distance, whole or
 // streamed, and do not upset the trees' ordering.
 TEST(Info, nonFinitePointsAreLeftOutOfTheNearestDistance) {
