@@ -458,11 +458,13 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
     parallelFor(added, workers, [&](size_t k, unsigned worker) {
       const size_t lo = static_cast<size_t>(k * box_points), hi = std::min<size_t>(static_cast<size_t>(n), lo + box_points);
       boxes[from + k] = boxOf(std::span(block.positions).subspan(lo, hi - lo));
+      size_t over = 0, bad = 0;  // counted here: workers' adjacent counters would share a cache line
       for (size_t i = lo; i < hi; ++i)
         for (int a = 0; a < 3; ++a) {
-          overflow[worker] += std::fabs(block.positions[i][a]) > static_cast<double>(FLT_MAX);
-          nonfinite[worker] += !std::isfinite(block.positions[i][a]);
+          over += std::fabs(block.positions[i][a]) > static_cast<double>(FLT_MAX);
+          bad += !std::isfinite(block.positions[i][a]);
         }
+      overflow[worker] += over, nonfinite[worker] += bad;
     });
     if (first == 0) info.min = info.max = block.positions[0];
     if (std::all_of(nonfinite.begin(), nonfinite.end(), [](size_t c) { return c == 0; })) {
