@@ -120,9 +120,21 @@ void printChoice(const ModePrediction& p, const DeviceFacts& f, Backend backend)
   const ModeChoice& c = *p.choice;
   std::string runner_up = c.runner_up ? std::string(modeName(*c.runner_up)) + " (" + formatBound(c.runner_up_bound_px) + ")"
                                       : std::string("none within the limit");
-  std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the fastest within %g px on %s, %s backend\n",
-              std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(), kAutoBoundPx,
+  std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the %s within %g px on %s, %s backend\n",
+              std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(),
+              c.by_picture_time ? "quickest to the picture" : "fastest", kAutoBoundPx,
               std::string(deviceClassName(deviceClassOf(f.type))).c_str(), backendName(backend));
+  if (c.by_picture_time) {
+    const auto seconds = [](double ms) {
+      char text[32];
+      std::snprintf(text, sizeof text, ms < 1000.0 ? "%.3g ms" : "%.3g s", ms < 1000.0 ? ms : ms / 1000.0);
+      return std::string(text);
+    };
+    // What the modes themselves cost this picture; its point size and shading add the same to each.
+    std::printf("mode auto: predicted encoding, upload and 1-px frame: %s %s%s\n", std::string(modeName(c.mode)).c_str(),
+                seconds(c.predicted_ms).c_str(),
+                c.runner_up ? (", " + std::string(modeName(*c.runner_up)) + " " + seconds(c.runner_up_predicted_ms)).c_str() : "");
+  }
   // Why each faster mode was passed over (its warning, with none enough, is in outcome.warnings).
   std::string passed;
   for (const ModeChoice::Rejected& r : c.rejected) {

@@ -383,6 +383,45 @@ std::string_view deviceClassName(DeviceClass device_class) {
   return device_class == DeviceClass::kCpu ? "lavapipe (CPU)" : "GPU (measured on an NVIDIA H100)";
 }
 
+// bench/results/2026-11-28/mode_rates.md. Host: the one-pass read, encoding and upload of 1e9 points
+// on the device tool's H200 (16 cores: the seconds x 16 / 1e9; the read is the same for every mode).
+// Frames: bench/scripts/mode_rates.sh, lavapipe on this 2-core machine and the H200 (its raster
+// frame is the same for every mode: the point rate of its rasteriser).
+// Per mode: host core-ns a point; frame ns a point {{cpu raster, cpu compute}, {gpu raster, gpu compute}}.
+constexpr ModeCosts kModeCosts[] = {
+    /* fp32 */ {85.0, {{146.69, 24.90}, {1.1397, 0.0076}}},
+    /* split */ {97.6, {{133.62, 39.50}, {1.1397, 0.0094}}},
+    /* rte */ {95.0, {{145.55, 39.00}, {1.1397, 0.0093}}},
+    /* df64 */ {95.2, {{153.07, 65.78}, {1.1397, 0.0203}}},
+    /* native */ {87.4, {{137.82, 32.07}, {1.1397, 0.0093}}},
+    /* batch */ {101.8, {{237.70, 37.11}, {1.1397, 0.0062}}},
+    /* adaptive */ {172.3, {{295.73, 50.11}, {1.1397, 0.0061}}},
+};
+static_assert(std::size(kModeCosts) == kModeCount);
+
+const ModeCosts& modeCosts(PrecisionMode mode) { return kModeCosts[modeIndex(mode)]; }
+
+double predictedPictureMs(PrecisionMode mode, DeviceClass device_class, bool compute_backend, uint64_t points,
+                          unsigned threads, uint32_t frames) {
+  const ModeCosts& c = modeCosts(mode);
+  const double n = static_cast<double>(points);
+  const double host = n * c.host_core_ns / std::max(1u, threads);
+  const double frame = n * c.frame_ns[static_cast<size_t>(device_class)][compute_backend ? 1 : 0];
+  return (host + frame * std::max(1u, frames)) * 1e-6;
+}
+
+std::vector<PrecisionMode> autoOrder(DeviceClass device_class, bool compute_backend, uint64_t points, unsigned threads,
+                                     uint32_t frames) {
+  const std::span<const PrecisionMode> speed = measuredSpeedOrder(device_class, compute_backend);
+  std::vector<PrecisionMode> order(speed.begin(), speed.end());
+  if (frames > 1) return order;
+  std::stable_sort(order.begin(), order.end(), [&](PrecisionMode a, PrecisionMode b) {
+    return predictedPictureMs(a, device_class, compute_backend, points, threads, 1) <
+           predictedPictureMs(b, device_class, compute_backend, points, threads, 1);
+  });
+  return order;
+}
+
 std::span<const PrecisionMode> measuredSpeedOrder(DeviceClass device_class, bool compute_backend) {
   using Order = std::vector<PrecisionMode>;
   static const std::array<std::array<Order, 2>, kDeviceClassCount> kOrders = [] {

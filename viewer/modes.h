@@ -184,6 +184,25 @@ inline uint32_t bytesPerPoint(PrecisionMode mode) { return positionBytes(mode) +
 // raster: graphics pipeline.
 std::span<const PrecisionMode> measuredSpeedOrder(DeviceClass device_class, bool compute_backend);
 
+// What a picture costs each mode (issue #38 item 3), measured by bench/scripts/mode_rates.sh on the
+// 16.7M-point Sierpinski set at 1920x1080, 1-px points: the host's encoding and upload in core
+// nanoseconds a point (the median over the machines and backends measured: the same code on any
+// host), and one frame in nanoseconds a point, by [DeviceClass][compute backend].
+struct ModeCosts {
+  double host_core_ns;
+  double frame_ns[kDeviceClassCount][2];
+};
+const ModeCosts& modeCosts(PrecisionMode mode);
+// The predicted time to the picture: `points` encoded and uploaded on `threads` cores, then
+// `frames` frames (ms).
+double predictedPictureMs(PrecisionMode mode, DeviceClass device_class, bool compute_backend, uint64_t points,
+                          unsigned threads, uint32_t frames);
+// --mode auto's order: for one picture (frames 1) the modes the speed order ranks, by predicted
+// time to the picture (ties in speed order); for more frames, what they wait for is the frames:
+// measuredSpeedOrder.
+std::vector<PrecisionMode> autoOrder(DeviceClass device_class, bool compute_backend, uint64_t points, unsigned threads,
+                                     uint32_t frames);
+
 // `dpoint render --mode`: the values it takes ("auto" then every mode's name), the text an error
 // lists them with ("auto, fp32, split, rte, df64, native, batch or adaptive"), and its --help text.
 std::vector<std::string> modeOptionNames();

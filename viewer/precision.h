@@ -20,6 +20,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -85,6 +86,9 @@ struct ModeChoice {
   bool enough = false;  // bound_px ≤ kAutoBoundPx
   std::optional<PrecisionMode> runner_up;  // the next mode in speed order within the bound
   double runner_up_bound_px = 0.0;
+  // Ordered by predicted time to one picture (AutoTarget): the choice's and the runner-up's (ms).
+  bool by_picture_time = false;
+  double predicted_ms = std::nan(""), runner_up_predicted_ms = std::nan("");
   ErrorBounds bounds;  // every mode the choice looked at
   // The modes ahead of the choice in speed order and why each was passed over: its bound over
   // kAutoBoundPx, or (bound_px NaN) the device cannot run it, `reason` saying why when the caller
@@ -97,6 +101,15 @@ struct ModeChoice {
   std::vector<Rejected> rejected;
   // The chosen mode's encoding from the bounds (ErrorBounds::encodings), for renderPoints; or null.
   std::shared_ptr<const ModeEncoding> encoding() const { return bounds.encodings[modeIndex(mode)]; }
+};
+
+// What --mode auto minimises (issue #38 item 3): with `points` set and one frame, the predicted
+// time to the picture of `points` points encoded on `threads` cores (viewer/modes.h, autoOrder);
+// else, or with more frames, the frames (the measured speed order).
+struct AutoTarget {
+  uint64_t points = 0;
+  unsigned threads = 0;  // 0: all cores
+  uint32_t frames = 1;
 };
 
 // What the walk asks for: the bounds of some modes, in one pass (predictErrorBounds or

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "core/interrupt.h"
+#include "core/parallel.h"
 #include "core/text.h"
 #include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
@@ -602,13 +603,26 @@ class StreamBlocks {
   std::future<Status> pending_;
 };
 
-// --mode auto's walk in the device's speed order over the modes it runs, on bounds_of's bounds.
-Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend, bool probe, const BoundsOf& bounds_of) {
+// --mode auto's walk over the modes the device runs, on bounds_of's bounds: in the device's speed
+// order, or by predicted time to the picture (AutoTarget).
+Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend, bool probe, const BoundsOf& bounds_of,
+                                  const AutoTarget& target) {
   Result<SelfTest> self_test = runPrecisionSelfTest(context);
   if (!self_test) return self_test.error();
   const bool compute = backend == Backend::kCompute;
   auto usable = [&](PrecisionMode mode) { return modeUsable(context, mode, *self_test, probe && !compute).ok(); };
-  ModeChoice choice = chooseMode(measuredSpeedOrder(deviceClassOf(context.facts.type), compute), usable, bounds_of);
+  const DeviceClass device_class = deviceClassOf(context.facts.type);
+  const bool by_time = target.points > 0 && target.frames <= 1;
+  const unsigned threads = resolveThreads(target.threads);
+  const std::vector<PrecisionMode> order = autoOrder(device_class, compute, by_time ? target.points : 0, threads,
+                                                     by_time ? 1 : 2);
+  ModeChoice choice = chooseMode(order, usable, bounds_of);
+  if (by_time) {
+    choice.by_picture_time = true;
+    choice.predicted_ms = predictedPictureMs(choice.mode, device_class, compute, target.points, threads, 1);
+    if (choice.runner_up)
+      choice.runner_up_predicted_ms = predictedPictureMs(*choice.runner_up, device_class, compute, target.points, threads, 1);
+  }
   for (ModeChoice::Rejected& r : choice.rejected)
     if (Status why = modeUsable(context, r.mode, *self_test, probe && !compute); !why) r.reason = why.error().message;
   return choice;
@@ -697,17 +711,17 @@ Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointS
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                      Backend backend, bool probe, double tolerance_px) {
+                                      Backend backend, bool probe, double tolerance_px, const AutoTarget& target) {
   return chooseOnDevice(context, backend, probe, [&](std::span<const PrecisionMode> modes) {
     return predictErrorBounds(points, camera, modes, tolerance_px);
-  });
+  }, target);
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
-                                      Backend backend, double tolerance_px) {
+                                      Backend backend, double tolerance_px, const AutoTarget& target) {
   return chooseOnDevice(context, backend, false, [&](std::span<const PrecisionMode> modes) {
     return predictBoxBounds(boxes, camera, modes, tolerance_px);
-  });
+  }, target);
 }
 
 double medianOf(std::vector<double> values) {

@@ -141,13 +141,16 @@ Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointS
                                       const RenderOptions& options, const StreamSettle& settle);
 
 // --mode auto on this device (viewer/precision.h): the measured speed order of the device's
-// class and backend, restricted to the modes the device runs (features, the emulation
+// class and backend, or its modes by predicted time to the picture (AutoTarget), restricted to the modes the device runs (features, the emulation
 // self-test, and with `probe` the probe's needs).
+// `target`: what the walk's order minimises (AutoTarget; by default the frames).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                      Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx);
+                                      Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx,
+                                      const AutoTarget& target = {});
 // The same for a streamed set, from the boxes of its batches (predictBoxBounds; no probe).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
-                                      Backend backend, double tolerance_px = kDefaultTolerancePx);
+                                      Backend backend, double tolerance_px = kDefaultTolerancePx,
+                                      const AutoTarget& target = {});
 
 // Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
 double medianOf(std::vector<double> values);

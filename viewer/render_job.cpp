@@ -374,14 +374,25 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
   return std::move(set);
 }
 
+// What --mode auto minimises for this request: one picture's time, or its frames (--frames N).
+AutoTarget autoTargetOf(const RenderRequest& request, uint64_t points) {
+  AutoTarget target;
+  target.points = points;
+  target.threads = request.threads;
+  target.frames = request.frames;
+  return target;
+}
+
 // --mode auto picks on the device; an explicit mode gets its bound computed for the report. From
 // the points of a set in memory, or the batch boxes of a streamed one (set.boxes).
 Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanContext& context, const LoadedSet& set,
                                    const Camera& camera) {
   const double tolerance = request.tolerance_px;
   auto choose = [&]() -> Result<ModeChoice> {
-    if (set.points()) return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance);
-    return chooseModeOnDevice(context, set.boxes, camera, *request.backend, tolerance);
+    const AutoTarget target = autoTargetOf(request, set.count);
+    if (set.points())
+      return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance, target);
+    return chooseModeOnDevice(context, set.boxes, camera, *request.backend, tolerance, target);
   };
   ModePrediction p;
   p.from_boxes = !set.points();
@@ -592,7 +603,7 @@ Status renderOnce(const RenderRequest& request, const VulkanContext& context, Lo
     mode = *parseMode(request.mode);
   } else {
     Result<ModeChoice> choice = chooseModeOnDevice(context, set.preview_boxes, provisional->front(), *request.backend,
-                                                   request.tolerance_px);
+                                                   request.tolerance_px, autoTargetOf(request, set.count));
     if (!choice) return choice.error();
     mode = choice->mode;
   }
@@ -1035,11 +1046,15 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
     JsonObject choice;
     choice.add("enough", V::boolean(c->enough)).add("limit_px", V::number(kAutoBoundPx));
     choice.add("device_class", V::string(deviceClassName(deviceClassOf(f.type))));
-    if (c->runner_up)
-      choice.add("runner_up", JsonObject()
-                                  .add("mode", V::string(modeName(*c->runner_up)))
-                                  .add("predicted_bound_px", V::number(c->runner_up_bound_px)));
-    else
+    // What the order minimised: the predicted time to the picture (one frame), or the frames.
+    choice.add("ordered_by", V::string(c->by_picture_time ? "time_to_picture" : "frame"));
+    if (c->by_picture_time) choice.add("predicted_ms", V::number(c->predicted_ms));
+    if (c->runner_up) {
+      JsonObject runner_up;
+      runner_up.add("mode", V::string(modeName(*c->runner_up))).add("predicted_bound_px", V::number(c->runner_up_bound_px));
+      if (c->by_picture_time) runner_up.add("predicted_ms", V::number(c->runner_up_predicted_ms));
+      choice.add("runner_up", runner_up);
+    } else
       choice.add("runner_up", V::null());
     std::vector<V> rejected;
     for (const ModeChoice::Rejected& passed : c->rejected) {

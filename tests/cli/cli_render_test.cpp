@@ -215,7 +215,19 @@ TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
     EXPECT_LE(jsonNumber(json, "predicted_bound_px"), 0.1);
     EXPECT_LE(jsonNumber(json, "max"), jsonNumber(json, "predicted_bound_px"));
     EXPECT_EQ(jsonNumber(json, "share_off_half_px"), 0.0);
+    // One picture: the modes ordered by predicted time to it, the choice's and the runner-up's stated.
+    EXPECT_TRUE(test::contains(json, "\"ordered_by\": \"time_to_picture\"")) << json;
+    EXPECT_GT(jsonNumber(json, "predicted_ms"), 0.0) << json;
+    EXPECT_NE(r.out.find("predicted encoding, upload and 1-px frame: "), std::string::npos) << r.out;
   }
+  // Several frames: what they wait for is the frames, in the measured speed order.
+  test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--frames", "2",
+                                     "--width", "128", "--height", "128", "--json", dir.file("frames.json")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string frames = readFile(dir.file("frames.json"));
+  EXPECT_TRUE(test::contains(frames, "\"ordered_by\": \"frame\"")) << frames;
+  EXPECT_FALSE(test::contains(frames, "predicted_ms")) << frames;
+  EXPECT_EQ(r.out.find("predicted encoding"), std::string::npos) << r.out;
 }
 
 // fp32 at a 1e-40 view loses every point: there is no error to report, and the report says so

@@ -150,6 +150,33 @@ TEST(Modes, speedOrdersHoldEveryModeButSplitOnce) {
 }
 
 // The CLI text built from the table is the text `dpoint render --help` printed before the table.
+// --mode auto for one picture orders the modes by predicted time to it (issue #38 item 3): on a
+// GPU the host's encoding is nearly all of it, so a billion points put fp32 first and adaptive
+// (whose frame is the fastest) last; with more frames the frame decides, as the speed order says.
+// Every order holds the ranked modes once.
+TEST(Modes, autoOrdersOnePictureByItsPredictedTime) {
+  const std::span<const PrecisionMode> speed = measuredSpeedOrder(DeviceClass::kGpu, true);
+  ASSERT_EQ(speed.front(), PrecisionMode::kAdaptive);
+  const std::vector<PrecisionMode> picture = autoOrder(DeviceClass::kGpu, true, 1'000'000'000, 16, 1);
+  EXPECT_EQ(picture.front(), PrecisionMode::kFp32);
+  EXPECT_EQ(picture.back(), PrecisionMode::kAdaptive);
+  std::vector<PrecisionMode> sorted_picture = picture, sorted_speed(speed.begin(), speed.end());
+  std::sort(sorted_picture.begin(), sorted_picture.end());
+  std::sort(sorted_speed.begin(), sorted_speed.end());
+  EXPECT_EQ(sorted_picture, sorted_speed);
+  for (size_t k = 1; k < picture.size(); ++k)
+    EXPECT_LE(predictedPictureMs(picture[k - 1], DeviceClass::kGpu, true, 1'000'000'000, 16, 1),
+              predictedPictureMs(picture[k], DeviceClass::kGpu, true, 1'000'000'000, 16, 1));
+  const std::vector<PrecisionMode> frames = autoOrder(DeviceClass::kGpu, true, 1'000'000'000, 16, 50);
+  EXPECT_TRUE(std::equal(frames.begin(), frames.end(), speed.begin(), speed.end()));
+  // The prediction: the encoding shared by the cores, plus the frames.
+  const double one = predictedPictureMs(PrecisionMode::kFp32, DeviceClass::kCpu, true, 1'000'000, 2, 1);
+  EXPECT_GT(one, 0.0);
+  EXPECT_NEAR(predictedPictureMs(PrecisionMode::kFp32, DeviceClass::kCpu, true, 2'000'000, 2, 1), 2.0 * one, 1e-9 * one);
+  EXPECT_LT(predictedPictureMs(PrecisionMode::kFp32, DeviceClass::kCpu, true, 1'000'000, 4, 1), one);
+  EXPECT_GT(predictedPictureMs(PrecisionMode::kFp32, DeviceClass::kCpu, true, 1'000'000, 2, 3), one);
+}
+
 TEST(Modes, modeOptionTextComesFromTheTable) {
   EXPECT_EQ(modeOptionNames(),
             (std::vector<std::string>{"auto", "fp32", "split", "rte", "df64", "native", "batch", "adaptive"}));
