@@ -340,7 +340,8 @@ Status nearestByBoxes(uint64_t count, const BlockReader& read, uint64_t block_po
       const uint64_t run_end = std::min<uint64_t>(count, uint64_t{end} * box_points);
       if (Status s = read(run_first, run_end - run_first, block); !s) return s;
       read_again += run_end - run_first;
-      parallelFor(end - b, workers, [&](size_t k, unsigned worker) {
+      // A short run's few boxes cost microseconds: on one thread, not a thread start each.
+      parallelFor(end - b, end - b >= 64 ? workers : 1, [&](size_t k, unsigned worker) {
         const size_t lo = static_cast<size_t>(k * box_points), hi = std::min<size_t>(block.positions.size(), lo + box_points);
         const std::span<const glm::dvec3> points = std::span(block.positions).subspan(lo, hi - lo);
         std::vector<double>& mine = found[worker];

@@ -54,9 +54,15 @@ void SpacingSampler::add(std::span<const glm::dvec3> points) {
   constexpr size_t kBlock = size_t{1} << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
   std::vector<std::vector<Entry>> kept(blocks);
+  // Once `wanted` are kept, a hash not below the largest of them can never be kept (offer's own
+  // test): most points of a large set end at this one comparison.
+  const bool full = heap_.size() == wanted_;
+  const uint64_t limit = full ? heap_.front().first : 0;
   parallelFor(blocks, threads_, [&](size_t b, unsigned) {
-    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i)
-      offer(kept[b], wanted_, positionHash(points[i]), points[i]);
+    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
+      const uint64_t h = positionHash(points[i]);
+      if (!full || h < limit) offer(kept[b], wanted_, h, points[i]);
+    }
   });
   for (const std::vector<Entry>& block : kept)
     for (const Entry& e : block) offer(heap_, wanted_, e.first, e.second);
