@@ -457,7 +457,7 @@ std::string modeOptionHelp() {
   for (const ModeInfo& info : kModes) text.append("|").append(info.name);
   char bound[32];
   std::snprintf(bound, sizeof bound, "%g", kAutoBoundPx);
-  text.append(". auto: the fastest mode on this kind of device (measured\norder) whose predicted error bound is <= ");
+  text.append(". auto: the mode quickest to the picture on this kind of\ndevice (measured rates; with --frames N, the fastest frame) whose\npredicted error bound is <= ");
   text.append(bound).append(" px for this view; ").append(modeName(kFallbackMode)).append(" when none is");
   return text;
 }

@@ -182,8 +182,9 @@ TEST(Modes, modeOptionTextComesFromTheTable) {
             (std::vector<std::string>{"auto", "fp32", "split", "rte", "df64", "native", "batch", "adaptive"}));
   EXPECT_EQ(modeOptionChoices(), "auto, fp32, split, rte, df64, native, batch or adaptive");
   EXPECT_EQ(modeOptionHelp(),
-            "auto|fp32|split|rte|df64|native|batch|adaptive. auto: the fastest mode on this kind of device (measured\n"
-            "order) whose predicted error bound is <= 0.1 px for this view; native when none is");
+            "auto|fp32|split|rte|df64|native|batch|adaptive. auto: the mode quickest to the picture on this kind of\n"
+            "device (measured rates; with --frames N, the fastest frame) whose\n"
+            "predicted error bound is <= 0.1 px for this view; native when none is");
   EXPECT_EQ(modeListHelp(),
             "fp32 (float positions), split (the study's hi+lo, no better than fp32), rte (relative to eye), "
             "df64 (double-float arithmetic), native (fp64 shaders), batch (per-batch double origins), "
