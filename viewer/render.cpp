@@ -467,7 +467,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
                                   const ModeEncoding& encoding, const Camera& given_camera,
                                   const RenderOptions& given_options,
                                   std::chrono::steady_clock::time_point upload_start, uint64_t max_chunk_points,
-                                  const std::function<Status(Camera&, RenderOptions&)>* settle = nullptr) {
+                                  const StreamSettle* settle = nullptr) {
   Camera camera = given_camera;
   RenderOptions options = given_options;
   const bool compute = options.backend == Backend::kCompute;
@@ -614,9 +614,7 @@ Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend,
   const DeviceClass device_class = deviceClassOf(context.facts.type);
   const bool by_time = target.points > 0 && target.frames <= 1;
   const unsigned threads = resolveThreads(target.threads);
-  const std::vector<PrecisionMode> order = autoOrder(device_class, compute, by_time ? target.points : 0, threads,
-                                                     by_time ? 1 : 2);
-  ModeChoice choice = chooseMode(order, usable, bounds_of);
+  ModeChoice choice = chooseMode(autoOrder(device_class, compute, target.points, threads, target.frames), usable, bounds_of);
   if (by_time) {
     choice.by_picture_time = true;
     choice.predicted_ms = predictedPictureMs(choice.mode, device_class, compute, target.points, threads, 1);
@@ -674,8 +672,7 @@ namespace {
 
 Result<RenderResult> streamChunks(const VulkanContext& context, const PointStream& stream, const Camera& camera,
                                   const RenderOptions& options,
-                                  const std::function<Status(Camera&, RenderOptions&)>* settle,
-                                  ModeEncoding& encoding) {
+                                  const StreamSettle* settle, ModeEncoding& encoding) {
   assert(!options.probe && "the probe keeps every point's clip position: render the set in memory");
   Status status = checkOptions(context, stream.count, camera, options);
   if (!status) return status.error();
@@ -703,8 +700,8 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointStream& stream, const Camera& provisional,
                                       const RenderOptions& options, const StreamSettle& settle) {
   ModeEncoding encoding;
-  const std::function<Status(Camera&, RenderOptions&)> reframed = [&](Camera& camera, RenderOptions& settled) {
-    if (Status status = settle.settle(camera, settled); !status) return status;
+  const StreamSettle reframed = [&](Camera& camera, RenderOptions& settled) {
+    if (Status status = settle(camera, settled); !status) return status;
     return reframeEncoding(encoding, camera);
   };
   return streamChunks(context, stream, provisional, options, &reframed, encoding);

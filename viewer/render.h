@@ -130,13 +130,9 @@ Result<RenderResult> renderStream(const VulkanContext& context, const PointStrea
 // One pass over a stream whose camera is known only once every point has been read (a file
 // without bounds in its header): the points are encoded for `provisional` (its scene frame's
 // exponent is kept: reframeEncoding) and uploaded; then `settle` gives the camera and options the
-// frames are drawn with (options.mode and backend as given). settle may return StreamSettle::kAgain:
-// the points as uploaded will not do (the whole set asks for another mode or its colours), and the
-// result is that error for the caller to read the stream the usual way.
-struct StreamSettle {
-  static constexpr const char* kAgain = "the stream must be read again";
-  std::function<Status(Camera& camera, RenderOptions& options)> settle;
-};
+// frames are drawn with (options.mode and backend as given). An error from settle ends the render
+// with it (the caller's settle may so say that the points as uploaded will not do).
+using StreamSettle = std::function<Status(Camera& camera, RenderOptions& options)>;
 Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointStream& stream, const Camera& provisional,
                                       const RenderOptions& options, const StreamSettle& settle);
 

@@ -96,21 +96,33 @@ Status forEachBlock(PointInputStream& ply, Progress& progress, const std::string
   return okStatus();
 }
 
-// The bounds, and the box of every batch (the mode's bound is predicted from those once the camera
-// is known: predictBoxBounds).
+// What the bounds pass gathers of a streamed set's next block: its bounds and planarity, the box
+// of every batch (the mode's bound is predicted from those once the camera is known:
+// predictBoxBounds) and the spacing samples. `bounds` starts as noBounds().
+Bounds noBounds() { return Bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true, {}}; }
+void gatherBlock(const PointSet& block, Bounds& bounds, BatchBoxes& boxes, SpacingSampler& sampler) {
+  const size_t first = boxes.boxes.size();
+  addBatchBoxes(boxes, block.positions);
+  for (size_t b = first; b < boxes.boxes.size(); ++b)
+    bounds.min = glm::min(bounds.min, boxes.boxes[b].min), bounds.max = glm::max(bounds.max, boxes.boxes[b].max);
+  bounds.planar = bounds.planar && block.isPlanar();
+  sampler.add(block.positions);
+}
+
+// The bounds pass on its own: every block gathered.
 Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress,
                             SpacingSampler& sampler, BatchBoxes& boxes) {
-  Bounds bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
-  Status status = forEachBlock(ply, progress, "bounds of " + path + " (points)", [&](const PointSet& block) {
-    const size_t first = boxes.boxes.size();
-    addBatchBoxes(boxes, block.positions);
-    for (size_t b = first; b < boxes.boxes.size(); ++b)
-      bounds.min = glm::min(bounds.min, boxes.boxes[b].min), bounds.max = glm::max(bounds.max, boxes.boxes[b].max);
-    bounds.planar = bounds.planar && block.isPlanar();
-    sampler.add(block.positions);
-  });
+  Bounds bounds = noBounds();
+  Status status = forEachBlock(ply, progress, "bounds of " + path + " (points)",
+                               [&](const PointSet& block) { gatherBlock(block, bounds, boxes, sampler); });
   if (!status) return status.error();
   return bounds;
+}
+
+// Colours by elevation: asked for, or (auto) a 3D set without colours; a 2D set's points stay white.
+bool wantsElevation(const RenderRequest& request, bool has_colors, const Bounds& bounds) {
+  return request.color == RenderColor::kElevation ||
+         (request.color == RenderColor::kAuto && !has_colors && !bounds.planar);
 }
 
 // A perspective fit of a 3D set frames its outline (viewer/camera.h); the ortho fit and a camera the
@@ -264,7 +276,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
     Result<Bounds> bounds = streamBounds(inputs, *ply, progress, sampler, set.boxes);
     if (!bounds) return bounds.error();
-    set.count = ply->count(), set.bounds = *bounds, set.has_colors = ply->hasColors();
+    set.bounds = *bounds;
     if (Status s = streamOutlineAndSpacing(request, inputs, *ply, sampler.finish(), set, progress); !s) return s.error();
     phases.mark("bounds");
     if (request.color == RenderColor::kAttribute) {  // one more pass: the dimension's classes or percentiles
@@ -347,9 +359,8 @@ Result<LoadedSet> loadInput(const RenderRequest& request, Progress& progress, Re
     set.spacing = sampleSpacing(set.points()->positions, Box{set.bounds.min, set.bounds.max}, kSpacingSamples, request.threads);
     phases.mark("spacing");
   }
-  // A 2D set has no elevation: without colours its points stay white.
-  set.elevation = request.color == RenderColor::kElevation ||
-                  (request.color == RenderColor::kAuto && !set.has_colors && !set.bounds.planar && !set.one_pass);
+  // A stream in one pass has no bounds yet, and one whose colours need them is not read so.
+  set.elevation = !set.one_pass && wantsElevation(request, set.has_colors, set.bounds);
   if (request.color == RenderColor::kAttribute && set.points()) {
     const Dimension* d = set.points()->dimensions.find(request.color_attribute);
     if (!d) return noSuchAttribute(inputs, request.color_attribute, set.points()->dimensions);
@@ -591,10 +602,10 @@ Result<std::vector<Camera>> refitForPoints(const RenderRequest& request, const L
 // One pass over a stream (LoadedSet::one_pass): encoded and uploaded for a provisional camera and
 // mode from its preview while its bounds, batch boxes and spacing samples are gathered; then the
 // outline and spacing (the batches they need, read again), the camera, the mode's check and the
-// options, and the frames. The error StreamSettle::kAgain where the whole set wants another mode,
-// or is 3D without colours (coloured by elevation): `set` then has its bounds and the caller reads
-// the stream the usual way.
-Status renderOnce(const RenderRequest& request, const VulkanContext& context, LoadedSet& set,
+// options, and the frames. False where the whole set wants another mode, or is 3D without colours
+// (coloured by elevation): `set` then has its bounds, outline and spacing, and the caller reads the
+// stream the usual way.
+Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& context, LoadedSet& set,
                   const std::vector<RenderView>& views, RenderOutcome& outcome, Progress& progress) {
   Result<std::vector<Camera>> provisional = viewCameras(request, views, boundsWithOutline(set.preview), set.z_up);
   if (!provisional) return provisional.error();
@@ -609,41 +620,36 @@ Status renderOnce(const RenderRequest& request, const VulkanContext& context, Lo
   }
   std::vector<std::string> ignored;
   const RenderOptions options = renderOptionsFor(request, set, mode, provisional->front(), context.facts, ignored);
-  set.bounds = Bounds{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL), true};
+  set.bounds = noBounds();
   SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
   PointStream stream;
   stream.count = set.count;
   stream.has_colors = set.has_colors;
   stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
     if (Status status = set.stream->read(first, n, block); !status) return status;
-    const size_t from = set.boxes.boxes.size();
-    addBatchBoxes(set.boxes, block.positions);
-    for (size_t b = from; b < set.boxes.boxes.size(); ++b)
-      set.bounds.min = glm::min(set.bounds.min, set.boxes.boxes[b].min),
-      set.bounds.max = glm::max(set.bounds.max, set.boxes.boxes[b].max);
-    set.bounds.planar = set.bounds.planar && block.isPlanar();
-    sampler.add(block.positions);
+    gatherBlock(block, set.bounds, set.boxes, sampler);
     progress.advance(n);
     return okStatus();
   };
-  StreamSettle settle;
-  settle.settle = [&](Camera& camera, RenderOptions& settled) -> Status {
+  bool again = false;
+  const auto read_again = [&again] {
+    again = true;
+    return Status(Error{"the stream must be read again"});
+  };
+  const StreamSettle settle = [&](Camera& camera, RenderOptions& settled) -> Status {
     progress.finish();
     outcome.phases.mark("upload");
     if (Status s = streamOutlineAndSpacing(request, set.inputs, *set.stream, sampler.finish(), set, progress); !s) return s;
     outcome.points_read_again = set.reread_points;
     outcome.phases.mark("reread");
-    if (!set.has_colors && request.color == RenderColor::kAuto && !set.bounds.planar) {
-      set.elevation = true;
-      return Error{StreamSettle::kAgain};
-    }
+    if (wantsElevation(request, set.has_colors, set.bounds)) return read_again();
     Result<std::vector<Camera>> cameras = viewCameras(request, views, set.bounds, set.z_up);
     if (cameras) cameras = refitForPoints(request, set, views, context.facts, std::move(*cameras));
     if (!cameras) return cameras.error();
     camera = cameras->front();
     Result<ModePrediction> prediction = predictMode(request, context, set, camera);
     if (!prediction) return prediction.error();
-    if (prediction->mode != mode) return Error{StreamSettle::kAgain};
+    if (prediction->mode != mode) return read_again();
     outcome.prediction = std::move(*prediction);
     if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
     settled = renderOptionsFor(request, set, mode, camera, context.facts, outcome.warnings);
@@ -655,10 +661,11 @@ Status renderOnce(const RenderRequest& request, const VulkanContext& context, Lo
   progress.start("streaming " + set.inputs + " to the GPU (points)", set.count);
   Result<RenderResult> rendered = renderStreamOnce(context, stream, provisional->front(), options, settle);
   progress.finish();
+  if (again) return false;
   if (!rendered) return rendered.error();
   outcome.phases.mark("render");
   finishView(request, set, std::move(*rendered), outcome);
-  return okStatus();
+  return true;
 }
 
 }  // namespace
@@ -993,16 +1000,15 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   RenderRequest resolved = request;  // the policies below see the backend that runs
   resolved.backend = outcome.backend;
   if (set->one_pass) {
-    Status once = renderOnce(resolved, context, *set, views, outcome, progress);
-    if (once || once.error().message != StreamSettle::kAgain) {
-      if (!once) return once.error();
+    Result<bool> drawn = renderOnce(resolved, context, *set, views, outcome, progress);
+    if (!drawn) return drawn.error();
+    if (*drawn) {
       outcome.validation_messages = context.validationMessages();
       return outcome;
     }
     // The points as uploaded would not do: drawn from a second read, with the bounds now known.
     set->one_pass = false;
-    set->elevation = request.color == RenderColor::kElevation ||
-                     (request.color == RenderColor::kAuto && !set->has_colors && !set->bounds.planar);
+    set->elevation = wantsElevation(request, set->has_colors, set->bounds);
     outcome.read_twice = true;
     cameras = viewCameras(request, views, set->bounds, set->z_up);
     if (!cameras) return cameras.error();
