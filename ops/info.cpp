@@ -210,8 +210,6 @@ void finishBounds(PointSetInfo& info) {
       : std::numeric_limits<double>::infinity();
 }
 
-// Points per box of a streamed set's second pass (as many as the renderer's batch boxes).
-constexpr uint64_t kStreamBoxPoints = 1024;
 // Boxes without queries that a run of boxes read again may span.
 constexpr size_t kJoinBoxes = 16;
 
@@ -223,14 +221,14 @@ constexpr size_t kJoinBoxes = 16;
 class SampleBalls {
  public:
   SampleBalls(const std::vector<glm::dvec3>& samples, const std::vector<double>& best2, const glm::dvec3& min,
-              const glm::dvec3& max, const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes)
+              const glm::dvec3& max, const std::vector<Box>& boxes)
       : samples_(samples), best2_(best2), min_(min) {
     const glm::dvec3 extent = max - min;
     const double largest = std::max({extent.x, extent.y, extent.z});
     std::vector<double> sides;
     const size_t step = std::max<size_t>(1, boxes.size() / 4096);
     for (size_t b = 0; b < boxes.size(); b += step) {
-      const glm::dvec3 side = boxes[b].second - boxes[b].first;
+      const glm::dvec3 side = boxes[b].max - boxes[b].min;
       sides.push_back(std::max({side.x, side.y, side.z}));
     }
     std::nth_element(sides.begin(), sides.begin() + static_cast<ptrdiff_t>(sides.size() / 2), sides.end());
@@ -367,7 +365,7 @@ Status nearestByBoxes(uint64_t count, const BlockReader& read, uint64_t block_po
 // Pass 2 on a file in no spatial order: each block whose box lies within some sampled point's
 // bound, read again whole into k-d trees (Forest), searched nearest first.
 Status nearestByBlocks(uint64_t count, const BlockReader& read, uint64_t block_points, uint64_t box_points,
-                       const std::vector<std::pair<glm::dvec3, glm::dvec3>>& boxes, const std::vector<glm::dvec3>& sampled,
+                       const std::vector<Box>& boxes, const std::vector<glm::dvec3>& sampled,
                        std::vector<double>& best2, unsigned threads, PointSet& block, uint64_t& read_again) {
   const size_t per_block = static_cast<size_t>(block_points / box_points);
   std::vector<size_t> near;
@@ -375,8 +373,8 @@ Status nearestByBlocks(uint64_t count, const BlockReader& read, uint64_t block_p
   std::vector<double> query_best2;
   for (uint64_t first = 0; first < count; first += block_points) {
     const size_t from = static_cast<size_t>(first / box_points), to = std::min(boxes.size(), from + per_block);
-    glm::dvec3 lo = boxes[from].first, hi = boxes[from].second;
-    for (size_t b = from; b < to; ++b) lo = glm::min(lo, boxes[b].first), hi = glm::max(hi, boxes[b].second);
+    glm::dvec3 lo = boxes[from].min, hi = boxes[from].max;
+    for (size_t b = from; b < to; ++b) lo = glm::min(lo, boxes[b].min), hi = glm::max(hi, boxes[b].max);
     near.clear();
     for (size_t k = 0; k < sampled.size(); ++k)
       if (boxDistance2(lo, hi, sampled[k]) <= best2[k]) near.push_back(k);
@@ -440,13 +438,13 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   const uint64_t step = count / sample;
   // Pass 1: bounds, the sample, and for each sampled point a first bound on its nearest distance:
   // the points beside it in the file (near in space when the file is in slab or Morton order);
-  // the box of every kStreamBoxPoints consecutive points, on all cores.
+  // the box of every kStreamedInfoBoxPoints consecutive points, on all cores.
   // Boxes that tile the blocks: 1024 points, or a block where blocks are not whole boxes (tests).
-  const uint64_t box_points = block_points % kStreamBoxPoints == 0 ? kStreamBoxPoints : block_points;
+  const uint64_t box_points = block_points % kStreamedInfoBoxPoints == 0 ? kStreamedInfoBoxPoints : block_points;
   std::vector<glm::dvec3> sampled;
   sampled.reserve(static_cast<size_t>(sample));
   std::vector<double> best2;
-  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes;
+  std::vector<Box>& boxes = out.boxes;
   boxes.reserve(static_cast<size_t>((count + box_points - 1) / box_points));
   PointSet block;
   const unsigned workers = resolveThreads(threads);
@@ -458,7 +456,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
     std::vector<size_t> overflow(workers, 0), nonfinite(workers, 0);
     parallelFor(added, workers, [&](size_t k, unsigned worker) {
       const size_t lo = static_cast<size_t>(k * box_points), hi = std::min<size_t>(static_cast<size_t>(n), lo + box_points);
-      boxes[from + k] = boxOf(std::span(block.positions).subspan(lo, hi - lo));
+      boxes[from + k] = boundingBox(block.positions, lo, hi);
       size_t over = 0, bad = 0;  // counted here: workers' adjacent counters would share a cache line
       for (size_t i = lo; i < hi; ++i)
         for (int a = 0; a < 3; ++a) {
@@ -471,7 +469,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
     if (std::all_of(nonfinite.begin(), nonfinite.end(), [](size_t c) { return c == 0; })) {
       // min and max of finite values in any grouping: the boxes' are the points'.
       for (size_t k = from; k < boxes.size(); ++k)
-        info.min = glm::min(info.min, boxes[k].first), info.max = glm::max(info.max, boxes[k].second);
+        info.min = glm::min(info.min, boxes[k].min), info.max = glm::max(info.max, boxes[k].max);
       for (size_t o : overflow) info.float_overflow += o;
     } else {
       addBounds(info, block.positions);  // in order, as computeInfo takes them
@@ -496,7 +494,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   std::vector<std::vector<uint32_t>> near(balls.compact() ? boxes.size() : 0);
   std::vector<uint8_t> wide(near.size(), 0);
   parallelFor(near.size(), workers, [&](size_t b, unsigned) {
-    wide[b] = !balls.near(boxes[b].first, boxes[b].second, near[b]);
+    wide[b] = !balls.near(boxes[b].min, boxes[b].max, near[b]);
   });
   const size_t wide_boxes = static_cast<size_t>(std::count(wide.begin(), wide.end(), uint8_t{1}));
   Status second = balls.compact() && 4 * wide_boxes <= boxes.size()

@@ -39,10 +39,15 @@ struct PointSetInfo {
 // of 2^20 points built in parallel, searched nearest first. Either way each sampled distance is
 // exact. block_points: a multiple of 1024. float_merged, which needs every point at
 // once, is not computed (merged_computed false). Errors are read's.
+// Points per box of the first pass (as many as the renderer's batch boxes, viewer/precision.h).
+inline constexpr uint64_t kStreamedInfoBoxPoints = 1024;
 struct StreamedInfo {
   PointSetInfo info;
   bool merged_computed = false;
   uint64_t points_read_again = 0;  // by the second pass
+  // The box of every kStreamedInfoBoxPoints consecutive points, where the blocks are whole boxes
+  // (else of every block): what the renderer's bound needs of a stream, for info's advice.
+  std::vector<Box> boxes;
 };
 using BlockReader = std::function<Status(uint64_t first, uint64_t n, PointSet& block)>;
 Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64_t triangles, const BlockReader& read,

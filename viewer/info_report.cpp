@@ -139,20 +139,23 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
                                   Progress& progress) {
   // The first pass shows; the second reads again only what the nearest distances need.
   progress.start("reading " + name + " (points)", stream.count());
-  BatchBoxes boxes;
+  uint64_t first_pass = 0;
   const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
     if (interrupted()) return interruptedError();
     if (Status s = stream.read(first, n, block); !s) return s;
-    if (first == boxes.count && n > 0) {
-      addBatchBoxes(boxes, block.positions);
+    if (first == first_pass) {
+      first_pass += n;
       progress.advance(n);
     }
     return okStatus();
   };
+  static_assert(kStreamBlockPoints % kStreamedInfoBoxPoints == 0 && kStreamedInfoBoxPoints == kBoxPoints,
+                "the first pass's boxes are the batch boxes");
   Result<StreamedInfo> info = computeStreamedInfo(stream.count(), stream.hasColors(), stream.faceCount(), read,
                                                   kStreamBlockPoints, options.sample, options.threads);
   if (!info) return info.error();
   progress.finish();
+  const BatchBoxes boxes{static_cast<size_t>(stream.count()), std::move(info->boxes)};
   InfoReport report;
   report.name = name;
   report.info = info->info;
