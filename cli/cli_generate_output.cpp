@@ -106,7 +106,7 @@ int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_no
                Progress& progress) {
   if (!generated) return reportError(generated.error());
   if (Status s = colorAndOffset(generated->points, o, auto_noise); !s) return reportError(s.error());
-  if (Status s = writeTile(o.output, *generated, signature, &progress); !s) return reportError(s.error());
+  if (Status s = writeTile(o.output, *generated, signature, &progress, o.common.threads); !s) return reportError(s.error());
   return 0;
 }
 

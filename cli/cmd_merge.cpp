@@ -35,7 +35,15 @@ int runMerge(const MergeOptions& o) {
     limit = *parsed;
   }
   Progress progress(progressSink(o.common.quiet), "merge");
-  Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress);
+  // A binary PLY in the tiles' order is streamed from the parts (the same bytes, without the set
+  // in memory); other formats and orders take the whole set first.
+  const PlyWriteOptions ply{PlyEncoding::kBinary, PlyColorType::kUchar, &progress, o.common.threads};
+  Result<FileFormat> format = formatOf(o.output);
+  if (format && *format == FileFormat::kPly && *order == PointOrder::kInput && canMergeToPly(ply)) {
+    if (Status s = mergeTilesToPly(o.inputs, o.output, ply); !s) return reportError(s.error());
+    return 0;
+  }
+  Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress, o.common.threads);
   if (!merged) return reportError(merged.error());
   PointSet& points = *merged;
   // From here on as `dpoint generate` finishes a whole set (cli_generate_output.cpp: finish).

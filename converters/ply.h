@@ -44,12 +44,18 @@ struct PlyWriteOptions {
   PlyEncoding encoding = PlyEncoding::kBinary;
   PlyColorType color_type = PlyColorType::kUchar;
   Progress* progress = nullptr;
+  unsigned threads = 0;  // rows formatted on this many cores (0: all); the bytes do not depend on it
 };
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});
 // The same from an opened file, or from bytes in memory (InputFile::fromMemory).
 Result<PointSet> readPly(const InputFile& file, const PlyReadOptions& options = {});
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options = {});
+// The header writePly writes for a set with `facts`' source facts, colour scale and dimensions, but
+// these counts, colours or none and z or none: for writers of the rows from elsewhere (the streamed
+// tile merge, converters/tile_file.h), whose file must be writePly's byte for byte.
+std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
+                      const PlyWriteOptions& options);
 
 // The vertices of a binary PLY file a range at a time, for a renderer drawing a file larger than
 // memory should hold. open() reads the header with readPly's checks; an ASCII file, or one with

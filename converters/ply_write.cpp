@@ -1,5 +1,5 @@
 // PLY writing: `double x,y,z`, uchar or float colours, `face` lists of three uint indices.
-// Rows are assembled into 1 MB chunks, then handed to AtomicFile.
+// Rows are formatted in chunks of 65,536 on all cores and written in order (core/ordered_write.h).
 #include <algorithm>
 #include <charconv>
 #include <cstring>
@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "core/ordered_write.h"
 #include "core/text.h"
 #include "converters/ply.h"
 
@@ -14,7 +15,8 @@ namespace dpoint {
 
 namespace {
 
-constexpr size_t kWriteChunk = size_t{1} << 20;
+constexpr size_t kRowsPerChunk = size_t{1} << 16;  // vertex or face rows a chunk
+constexpr size_t kFaceBytes = 1 + 3 * sizeof(uint32_t);
 
 // Colours leave as bytes (colorInteger of 255), or as 16-bit words for colours read so
 // (PointSet::color_full_scale 65535: LAS).
@@ -25,12 +27,12 @@ uint16_t colorWord(float c) { return colorInteger(c, 65535.0); }
 // them back): a 2D set (its z are 0 but not a coordinate: read from 2D input, or made in memory with
 // every z 0, as random2d and mandelbrot2d make theirs), and z as the up axis (LAS). Without the first,
 // a 2D set written as PLY would come back as a 3D one and convert to a 3-column CSV.
-std::string sourceFacts(const PointSet& points) {
+std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
   std::string facts;
-  if (!points.hasZ()) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
+  if (!has_z) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
   if (points.z_up) facts += "comment dpoint: up axis z\n";
   // Colours read as integers 0..255 from a text file (ply_read.cpp keeps them so for CSV).
-  if (points.hasColors() && points.color_full_scale == 255 && !points.las) facts += "comment dpoint: colours 0..255\n";
+  if (colors && points.color_full_scale == 255 && !points.las) facts += "comment dpoint: colours 0..255\n";
   if (points.las) {  // ply_read.cpp reads it back, so that LAS → PLY → LAS keeps its coordinates
     const LasSource& l = *points.las;
     facts += "comment dpoint: las frame ";
@@ -47,38 +49,25 @@ std::string sourceFacts(const PointSet& points) {
   return facts;
 }
 
-class ChunkWriter {
+// Appends to a chunk's bytes (ASCII rows, whose length is known only once formatted).
+class ChunkText {
  public:
-  ChunkWriter(AtomicFile& file, Progress* progress) : file_(file), progress_(progress), buf_(kWriteChunk + 4096) {}
+  explicit ChunkText(std::vector<char>& bytes) : bytes_(bytes) {}
+  ~ChunkText() { bytes_.resize(used_); }
   void append(const void* data, size_t size) {
-    if (used_ + size > buf_.size()) buf_.resize(used_ + size);
-    std::memcpy(buf_.data() + used_, data, size);
+    if (used_ + size > bytes_.size()) bytes_.resize(std::max(2 * bytes_.size(), used_ + size + 4096));
+    std::memcpy(bytes_.data() + used_, data, size);
     used_ += size;
   }
   void append(std::string_view text) { append(text.data(), text.size()); }
-  // Ends a row; writes out a full chunk.
-  Status endRow() {
-    ++rows_;
-    return used_ >= kWriteChunk ? flush() : okStatus();
-  }
-  Status flush() {
-    Status s = file_.write(buf_.data(), used_);
-    used_ = 0;
-    if (progress_) progress_->advance(rows_);
-    rows_ = 0;
-    return s;
-  }
 
  private:
-  AtomicFile& file_;
-  Progress* progress_;
-  std::vector<char> buf_;
+  std::vector<char>& bytes_;
   size_t used_ = 0;
-  uint64_t rows_ = 0;
 };
 
 template <typename T>
-void appendNumber(ChunkWriter& out, T value, char separator) {
+void appendNumber(ChunkText& out, T value, char separator) {
   char text[40];
   auto r = std::to_chars(text, text + sizeof text - 1, value);  // shortest round-trip form
   *r.ptr = separator;
@@ -86,7 +75,7 @@ void appendNumber(ChunkWriter& out, T value, char separator) {
 }
 
 // Value i of a dimension in ASCII: integers as integers, floats in shortest round-trip form.
-void appendDimension(ChunkWriter& out, const Dimension& d, size_t i, char separator) {
+void appendDimension(ChunkText& out, const Dimension& d, size_t i, char separator) {
   switch (d.type) {
     case DimType::kF32: appendNumber(out, d.get<float>(i), separator); break;
     case DimType::kF64: appendNumber(out, d.get<double>(i), separator); break;
@@ -98,34 +87,20 @@ void appendDimension(ChunkWriter& out, const Dimension& d, size_t i, char separa
 
 }  // namespace
 
-Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
-  const size_t n = points.size();
-  if (points.hasColors() && points.colors.size() != n)
-    return Error{"cannot write '" + path + "': " + std::to_string(points.colors.size()) + " colours for " +
-                 std::to_string(n) + " points"};
-  if (points.triangles.size() % 3 != 0)
-    return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
-  for (uint32_t index : points.triangles)
-    if (index >= n)
-      return Error{"cannot write '" + path + "': triangle index " + std::to_string(index) + " out of range (" +
-                   std::to_string(n) + " points)"};
-  auto file = AtomicFile::create(path);
-  if (!file.ok()) return file.error();
+std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
+                      const PlyWriteOptions& options) {
   const bool ascii = options.encoding == PlyEncoding::kAscii;
   const bool float_colors = options.color_type == PlyColorType::kFloat;
-  // Integer colours as wide as they were read: 16-bit LAS colours as ushort, others as uchar.
-  const bool word_colors = !float_colors && points.color_full_scale == 65535;
-  const size_t faces = points.triangles.size() / 3;
-
+  const bool word_colors = !float_colors && facts.color_full_scale == 65535;
   std::string header = std::string("ply\nformat ") + (ascii ? "ascii" : "binary_little_endian") +
-                       " 1.0\ncomment written by dpoint\n" + sourceFacts(points) + "element vertex " + std::to_string(n) +
-                       "\nproperty double x\nproperty double y\nproperty double z\n";
-  if (points.hasColors())
+                       " 1.0\ncomment written by dpoint\n" + sourceFacts(facts, has_z, colors) + "element vertex " +
+                       std::to_string(vertices) + "\nproperty double x\nproperty double y\nproperty double z\n";
+  if (colors)
     for (const char* c : {"red", "green", "blue"})
       header += std::string("property ") + (float_colors ? "float " : word_colors ? "ushort " : "uchar ") + c + "\n";
   // Dimensions as properties of their own type; PLY has no 64-bit integers, so those go as double
   // (exact below 2^53).
-  for (const Dimension& d : points.dimensions.all()) {
+  for (const Dimension& d : facts.dimensions.all()) {
     const char* type = plyTypeName(d.type);
     header += "property ";
     header += type ? type : "double";
@@ -135,14 +110,80 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   }
   if (faces) header += "element face " + std::to_string(faces) + "\nproperty list uchar uint vertex_indices\n";
   header += "end_header\n";
+  return header;
+}
+
+Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
+  const size_t n = points.size();
+  if (points.hasColors() && points.colors.size() != n)
+    return Error{"cannot write '" + path + "': " + std::to_string(points.colors.size()) + " colours for " +
+                 std::to_string(n) + " points"};
+  if (points.triangles.size() % 3 != 0)
+    return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
+  auto file = AtomicFile::create(path);
+  if (!file.ok()) return file.error();
+  const bool ascii = options.encoding == PlyEncoding::kAscii;
+  const bool float_colors = options.color_type == PlyColorType::kFloat;
+  // Integer colours as wide as they were read: 16-bit LAS colours as ushort, others as uchar.
+  const bool word_colors = !float_colors && points.color_full_scale == 65535;
+  const size_t faces = points.triangles.size() / 3;
+
+  const std::string header = plyHeader(points, n, faces, points.hasColors(), points.hasZ(), options);
 
   if (options.progress) options.progress->start("writing " + path, n + faces);
-  ChunkWriter out(*file, options.progress);
-  out.append(header);
-  for (size_t i = 0; i < n; ++i) {
-    const glm::dvec3& p = points.positions[i];
-    const bool attributes = !points.dimensions.empty();
-    if (ascii) {
+  const std::vector<Dimension>& dims = points.dimensions.all();
+  const bool attributes = !dims.empty();
+  const size_t color_bytes = !points.hasColors() ? 0 : float_colors ? 12 : word_colors ? 6 : 3;
+  size_t vertex_bytes = sizeof(glm::dvec3) + color_bytes;
+  for (const Dimension& d : dims) vertex_bytes += plyTypeName(d.type) ? dimTypeSize(d.type) : sizeof(double);
+
+  // Chunk 0 is the header, then the vertex rows and the face rows kRowsPerChunk at a time.
+  const size_t vertex_chunks = (n + kRowsPerChunk - 1) / kRowsPerChunk;
+  const size_t face_chunks = (faces + kRowsPerChunk - 1) / kRowsPerChunk;
+  auto rowsOf = [&](size_t k) -> std::pair<size_t, size_t> {  // [begin, end) of vertices or faces
+    const size_t c = k - 1 < vertex_chunks ? k - 1 : k - 1 - vertex_chunks;
+    const size_t total = k - 1 < vertex_chunks ? n : faces;
+    return {c * kRowsPerChunk, std::min(total, (c + 1) * kRowsPerChunk)};
+  };
+  auto vertexRows = [&](size_t begin, size_t end, std::vector<char>& bytes) {
+    if (!ascii) {
+      bytes.resize((end - begin) * vertex_bytes);
+      char* row = bytes.data();
+      for (size_t i = begin; i < end; ++i) {
+        std::memcpy(row, &points.positions[i], sizeof(glm::dvec3));
+        char* at = row + sizeof(glm::dvec3);
+        if (points.hasColors()) {
+          const glm::vec3& c = points.colors[i];
+          if (float_colors) {
+            std::memcpy(at, &c, sizeof c);
+          } else if (word_colors) {
+            const uint16_t rgb[3] = {colorWord(c.r), colorWord(c.g), colorWord(c.b)};
+            std::memcpy(at, rgb, sizeof rgb);
+          } else {
+            at[0] = static_cast<char>(colorByte(c.r));
+            at[1] = static_cast<char>(colorByte(c.g));
+            at[2] = static_cast<char>(colorByte(c.b));
+          }
+          at += color_bytes;
+        }
+        for (const Dimension& d : dims) {
+          if (plyTypeName(d.type)) {
+            const size_t w = dimTypeSize(d.type);
+            std::memcpy(at, d.bytes.data() + i * w, w);
+            at += w;
+          } else {
+            const double v = d.value(i);
+            std::memcpy(at, &v, sizeof v);
+            at += sizeof v;
+          }
+        }
+        row += vertex_bytes;
+      }
+      return;
+    }
+    ChunkText out(bytes);
+    for (size_t i = begin; i < end; ++i) {
+      const glm::dvec3& p = points.positions[i];
       appendNumber(out, p.x, ' ');
       appendNumber(out, p.y, ' ');
       appendNumber(out, p.z, points.hasColors() || attributes ? ' ' : '\n');
@@ -158,47 +199,48 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
             appendNumber(out, static_cast<unsigned>(colorByte(c[k])), sep);
         }
       }
-      const std::vector<Dimension>& dims = points.dimensions.all();
       for (size_t k = 0; k < dims.size(); ++k) appendDimension(out, dims[k], i, k + 1 == dims.size() ? '\n' : ' ');
-    } else {
-      out.append(&p, sizeof p);
-      if (points.hasColors()) {
-        const glm::vec3& c = points.colors[i];
-        if (float_colors) {
-          out.append(&c, sizeof c);
-        } else if (word_colors) {
-          const uint16_t rgb[3] = {colorWord(c.r), colorWord(c.g), colorWord(c.b)};
-          out.append(rgb, sizeof rgb);
-        } else {
-          const uint8_t rgb[3] = {colorByte(c.r), colorByte(c.g), colorByte(c.b)};
-          out.append(rgb, sizeof rgb);
-        }
-      }
-      for (const Dimension& d : points.dimensions.all()) {
-        if (plyTypeName(d.type)) {
-          const size_t w = dimTypeSize(d.type);
-          out.append(d.bytes.data() + i * w, w);
-        } else {
-          const double v = d.value(i);
-          out.append(&v, sizeof v);
-        }
-      }
     }
-    if (Status s = out.endRow(); !s.ok()) return s;
-  }
-  for (size_t f = 0; f < faces; ++f) {
-    const uint32_t* t = &points.triangles[3 * f];
-    if (ascii) {
+  };
+  auto faceRows = [&](size_t begin, size_t end, std::vector<char>& bytes) -> Status {
+    for (size_t i = 3 * begin; i < 3 * end; ++i)
+      if (points.triangles[i] >= n)
+        return Error{"cannot write '" + path + "': triangle index " + std::to_string(points.triangles[i]) +
+                     " out of range (" + std::to_string(n) + " points)"};
+    if (!ascii) {
+      bytes.resize((end - begin) * kFaceBytes);
+      char* row = bytes.data();
+      for (size_t f = begin; f < end; ++f, row += kFaceBytes) {
+        row[0] = 3;
+        std::memcpy(row + 1, &points.triangles[3 * f], 3 * sizeof(uint32_t));
+      }
+      return okStatus();
+    }
+    ChunkText out(bytes);
+    for (size_t f = begin; f < end; ++f) {
       out.append("3 ");
-      for (int k = 0; k < 3; ++k) appendNumber(out, t[k], k == 2 ? '\n' : ' ');
-    } else {
-      const uint8_t three = 3;
-      out.append(&three, 1);
-      out.append(t, 3 * sizeof(uint32_t));
+      for (int k = 0; k < 3; ++k) appendNumber(out, points.triangles[3 * f + k], k == 2 ? '\n' : ' ');
     }
-    if (Status s = out.endRow(); !s.ok()) return s;
-  }
-  if (Status s = out.flush(); !s.ok()) return s;
+    return okStatus();
+  };
+  const Status written = writeChunksInOrder(
+      *file, 1 + vertex_chunks + face_chunks, options.threads,
+      [&](size_t k, std::vector<char>& bytes) -> Status {
+        if (k == 0) {
+          bytes.assign(header.begin(), header.end());
+          return okStatus();
+        }
+        const auto [begin, end] = rowsOf(k);
+        if (k - 1 < vertex_chunks) {
+          vertexRows(begin, end, bytes);
+          return okStatus();
+        }
+        return faceRows(begin, end, bytes);
+      },
+      [&](size_t k) {
+        if (k > 0 && options.progress) options.progress->advance(rowsOf(k).second - rowsOf(k).first);
+      });
+  if (!written) return written;
   return file->commit();
 }
 

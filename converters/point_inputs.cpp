@@ -33,7 +33,7 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     return readPointInputs(paths, each);
   }
   if (isCompleteTileSet(paths)) {
-    Result<PointSet> whole = mergeTiles(paths, 0, options.progress);
+    Result<PointSet> whole = mergeTiles(paths, 0, options.progress, options.threads);
     if (whole && options.points_only) whole->triangles.clear();
     return whole;
   }

@@ -202,7 +202,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return writeCsv(path, points,
                       CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale});
     case FileFormat::kPly:
-      return writePly(path, points, PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress});
+      return writePly(path, points, PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads});
     case FileFormat::kPcd:
       return writePcd(path, points, PcdWriteOptions{options.pcd_encoding, options.progress, options.notices});
     case FileFormat::kGlb:

@@ -1,6 +1,7 @@
 #include "converters/tile_file.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cerrno>
 #include <cstdio>
@@ -9,8 +10,12 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/input_file.h"
+#include "core/ordered_write.h"
+#include "core/parallel.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "converters/ply.h"
 
 namespace dpoint {
 namespace {
@@ -138,14 +143,10 @@ Result<ParsedHeader> openTile(const std::string& path, File& file) {
   return h;
 }
 
-Status readExactly(const std::string& path, std::FILE* file, void* data, size_t bytes) {
-  if (std::fread(data, 1, bytes, file) != bytes) return Error{path + ": short read: " + std::strerror(errno)};
-  return okStatus();
-}
-
 }  // namespace
 
-Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature, Progress* progress) {
+Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature, Progress* progress,
+                 unsigned threads) {
   const PointSet& p = tile.points;
   assert(tile.owned <= p.size() && p.size() - tile.owned == tile.foreign.size());
   assert(signature.find('\n') == std::string::npos);
@@ -165,32 +166,49 @@ Status writeTile(const std::string& path, const PointTile& tile, const std::stri
   if (Status s = file->write(header); !s) return s;
   if (progress) progress->start("writing " + path, p.size() + faces);
 
-  std::vector<char> block;
-  for (size_t first = 0; first < p.size(); first += kRowsPerBlock) {
-    const size_t rows = std::min(kRowsPerBlock, p.size() - first);
-    const size_t stride = sizeof(glm::dvec3) + (p.hasColors() ? sizeof(glm::vec3) : 0);
-    block.resize(rows * stride);
-    for (size_t i = 0; i < rows; ++i) {
-      std::memcpy(&block[i * stride], &p.positions[first + i], sizeof(glm::dvec3));
-      if (p.hasColors()) std::memcpy(&block[i * stride + sizeof(glm::dvec3)], &p.colors[first + i], sizeof(glm::vec3));
-    }
-    if (Status s = file->write(block.data(), block.size()); !s) return s;
-    if (progress) progress->advance(rows);
-  }
-  for (size_t first = 0; first < faces; first += kRowsPerBlock) {
-    const size_t rows = std::min(kRowsPerBlock, faces - first);
-    block.resize(rows * kFaceBytes);
-    for (size_t i = 0; i < rows; ++i) {
-      block[i * kFaceBytes] = 3;
-      std::memcpy(&block[i * kFaceBytes + 1], &p.triangles[3 * (first + i)], 3 * sizeof(uint32_t));
-    }
-    if (Status s = file->write(block.data(), block.size()); !s) return s;
-    if (progress) progress->advance(rows);
-  }
-  for (const TileVertexRef& ref : tile.foreign) {
-    const uint32_t row[2] = {ref.tile, ref.index};
-    if (Status s = file->write(row, sizeof row); !s) return s;
-  }
+  // The vertex rows, the face rows and the copies' references, kRowsPerBlock rows a chunk, made on
+  // all cores and written in order.
+  const size_t stride = sizeof(glm::dvec3) + (p.hasColors() ? sizeof(glm::vec3) : 0);
+  const size_t vertex_chunks = (p.size() + kRowsPerBlock - 1) / kRowsPerBlock;
+  const size_t face_chunks = (faces + kRowsPerBlock - 1) / kRowsPerBlock;
+  auto rowsOf = [&](size_t k) -> std::pair<size_t, size_t> {
+    const size_t c = k < vertex_chunks ? k : k - vertex_chunks;
+    const size_t total = k < vertex_chunks ? p.size() : faces;
+    return {c * kRowsPerBlock, std::min(total, (c + 1) * kRowsPerBlock)};
+  };
+  Status written = writeChunksInOrder(
+      *file, vertex_chunks + face_chunks + 1, threads,
+      [&](size_t k, std::vector<char>& block) -> Status {
+        if (k == vertex_chunks + face_chunks) {  // the references
+          block.resize(tile.foreign.size() * kForeignBytes);
+          for (size_t f = 0; f < tile.foreign.size(); ++f) {
+            const uint32_t row[2] = {tile.foreign[f].tile, tile.foreign[f].index};
+            std::memcpy(&block[f * kForeignBytes], row, sizeof row);
+          }
+          return okStatus();
+        }
+        const auto [first, end] = rowsOf(k);
+        if (k < vertex_chunks) {
+          block.resize((end - first) * stride);
+          for (size_t i = first; i < end; ++i) {
+            char* row = &block[(i - first) * stride];
+            std::memcpy(row, &p.positions[i], sizeof(glm::dvec3));
+            if (p.hasColors()) std::memcpy(row + sizeof(glm::dvec3), &p.colors[i], sizeof(glm::vec3));
+          }
+          return okStatus();
+        }
+        block.resize((end - first) * kFaceBytes);
+        for (size_t i = first; i < end; ++i) {
+          char* row = &block[(i - first) * kFaceBytes];
+          row[0] = 3;
+          std::memcpy(row + 1, &p.triangles[3 * i], 3 * sizeof(uint32_t));
+        }
+        return okStatus();
+      },
+      [&](size_t k) {
+        if (progress && k < vertex_chunks + face_chunks) progress->advance(rowsOf(k).second - rowsOf(k).first);
+      });
+  if (!written) return written;
   if (progress) progress->finish();
   return file->commit();
 }
@@ -212,73 +230,161 @@ Result<TileHeader> readTileHeader(const std::string& path) {
   return h->header;
 }
 
+namespace {
+
+// A tile opened for reading its rows from any thread: the parsed header and the file.
+struct OpenTile {
+  ParsedHeader parsed;
+  std::unique_ptr<InputFile> file;
+  uint64_t stride() const { return 3 * sizeof(double) + (parsed.header.colors ? 3 * sizeof(float) : 0); }
+  uint64_t facesAt() const { return parsed.data_offset + parsed.header.vertices * stride(); }
+  uint64_t foreignAt() const { return facesAt() + parsed.header.faces * kFaceBytes; }
+};
+
+Result<OpenTile> openForRows(const std::string& path) {
+  OpenTile t;
+  {
+    File header_file;
+    Result<ParsedHeader> parsed = openTile(path, header_file);
+    if (!parsed) return parsed.error();
+    t.parsed = std::move(*parsed);
+  }
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  t.file = std::make_unique<InputFile>(std::move(*file));
+  return t;
+}
+
+Status readBytesAt(const InputFile& file, uint64_t offset, std::vector<char>& bytes, size_t size) {
+  bytes.resize(size);
+  Result<size_t> got = file.readAt(offset, bytes.data(), size);
+  if (!got) return got.error();
+  if (*got != size)
+    return Error{file.path() + ": short read at byte " + std::to_string(offset + *got) + " (the file shrank while read)"};
+  return okStatus();
+}
+
+// Vertex rows [first, first + rows) of a tile into positions[0, rows) and, with colours, colors.
+Status readVertexRows(const OpenTile& t, uint64_t first, size_t rows, glm::dvec3* positions, glm::vec3* colors,
+                      std::vector<char>& bytes) {
+  const size_t stride = t.stride();
+  if (Status s = readBytesAt(*t.file, t.parsed.data_offset + first * stride, bytes, rows * stride); !s) return s;
+  for (size_t i = 0; i < rows; ++i) {
+    std::memcpy(&positions[i], &bytes[i * stride], sizeof(glm::dvec3));
+    if (colors) std::memcpy(&colors[i], &bytes[i * stride + sizeof(glm::dvec3)], sizeof(glm::vec3));
+  }
+  return okStatus();
+}
+
+// Face rows [first, first + rows) of a tile into out[0, 3·rows), each index through remap after
+// checking the row (three corners, each below the tile's vertex count).
+template <typename Remap>
+Status readFaceRows(const OpenTile& t, uint64_t first, size_t rows, uint32_t* out, std::vector<char>& bytes,
+                    const Remap& remap) {
+  const std::string& path = t.file->path();
+  const uint64_t vertices = t.parsed.header.vertices;
+  const uint64_t at = t.facesAt() + first * kFaceBytes;
+  if (Status s = readBytesAt(*t.file, at, bytes, rows * kFaceBytes); !s) return s;
+  for (size_t i = 0; i < rows; ++i) {
+    const char* row = &bytes[i * kFaceBytes];
+    if (row[0] != 3)
+      return Error{path + ": byte " + std::to_string(at + i * kFaceBytes) + ": face " + std::to_string(first + i) +
+                   " has " + std::to_string(static_cast<unsigned char>(row[0])) + " corners, not 3"};
+    uint32_t corner[3];
+    std::memcpy(corner, row + 1, sizeof corner);
+    for (int k = 0; k < 3; ++k) {
+      if (corner[k] >= vertices)
+        return Error{path + ": byte " + std::to_string(at + i * kFaceBytes) + ": face " + std::to_string(first + i) +
+                     " uses vertex " + std::to_string(corner[k]) + " of " + std::to_string(vertices)};
+      out[3 * i + k] = remap(corner[k]);
+    }
+  }
+  return okStatus();
+}
+
+Status readForeignRows(const OpenTile& t, std::vector<TileVertexRef>& foreign) {
+  std::vector<char> bytes;
+  const uint64_t count = t.parsed.header.foreign;
+  if (Status s = readBytesAt(*t.file, t.foreignAt(), bytes, count * kForeignBytes); !s) return s;
+  foreign.resize(count);
+  for (size_t f = 0; f < count; ++f) {
+    uint32_t row[2];
+    std::memcpy(row, &bytes[f * kForeignBytes], sizeof row);
+    foreign[f] = {row[0], row[1]};
+  }
+  return okStatus();
+}
+
+// The first error of `errors` (in item order), or ok.
+Status firstError(const std::vector<Status>& errors) {
+  for (const Status& s : errors)
+    if (!s) return s;
+  return okStatus();
+}
+
+}  // namespace
+
 Result<PointTile> readTile(const std::string& path) {
-  File file;
-  Result<ParsedHeader> parsed = openTile(path, file);
-  if (!parsed) return parsed.error();
-  const TileHeader& h = parsed->header;
+  Result<OpenTile> t = openForRows(path);
+  if (!t) return t.error();
+  const TileHeader& h = t->parsed.header;
   PointTile tile;
   tile.tile = h.tile;
   tile.owned = h.owned;
   PointSet& p = tile.points;
   p.positions.resize(h.vertices);
   if (h.colors) p.colors.resize(h.vertices);
-  const size_t stride = sizeof(glm::dvec3) + (h.colors ? sizeof(glm::vec3) : 0);
-  std::vector<char> block;
+  std::vector<char> bytes;
   for (size_t first = 0; first < h.vertices; first += kRowsPerBlock) {
     const size_t rows = std::min<size_t>(kRowsPerBlock, h.vertices - first);
-    block.resize(rows * stride);
-    if (Status s = readExactly(path, file.get(), block.data(), block.size()); !s) return s.error();
-    for (size_t i = 0; i < rows; ++i) {
-      std::memcpy(&p.positions[first + i], &block[i * stride], sizeof(glm::dvec3));
-      if (h.colors) std::memcpy(&p.colors[first + i], &block[i * stride + sizeof(glm::dvec3)], sizeof(glm::vec3));
-    }
+    if (Status s = readVertexRows(*t, first, rows, &p.positions[first], h.colors ? &p.colors[first] : nullptr, bytes); !s)
+      return s.error();
   }
-  const uint64_t faces_offset = parsed->data_offset + h.vertices * stride;
   p.triangles.resize(3 * h.faces);
   for (size_t first = 0; first < h.faces; first += kRowsPerBlock) {
     const size_t rows = std::min<size_t>(kRowsPerBlock, h.faces - first);
-    block.resize(rows * kFaceBytes);
-    if (Status s = readExactly(path, file.get(), block.data(), block.size()); !s) return s.error();
-    for (size_t i = 0; i < rows; ++i) {
-      const uint64_t offset = faces_offset + (first + i) * kFaceBytes;
-      if (block[i * kFaceBytes] != 3)
-        return Error{path + ": byte " + std::to_string(offset) + ": face " + std::to_string(first + i) + " has " +
-                     std::to_string(static_cast<unsigned char>(block[i * kFaceBytes])) + " corners, not 3"};
-      uint32_t* t = &p.triangles[3 * (first + i)];
-      std::memcpy(t, &block[i * kFaceBytes + 1], 3 * sizeof(uint32_t));
-      for (int k = 0; k < 3; ++k)
-        if (t[k] >= h.vertices)
-          return Error{path + ": byte " + std::to_string(offset) + ": face " + std::to_string(first + i) +
-                       " uses vertex " + std::to_string(t[k]) + " of " + std::to_string(h.vertices)};
-    }
+    if (Status s = readFaceRows(*t, first, rows, &p.triangles[3 * first], bytes, [](uint32_t i) { return i; }); !s)
+      return s.error();
   }
-  tile.foreign.resize(h.foreign);
-  for (TileVertexRef& ref : tile.foreign) {
-    uint32_t row[2];
-    if (Status s = readExactly(path, file.get(), row, sizeof row); !s) return s.error();
-    ref = {row[0], row[1]};
-  }
+  if (Status s = readForeignRows(*t, tile.foreign); !s) return s.error();
   return tile;
 }
 
-Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory, Progress* progress) {
+namespace {
+
+// All N tiles of one run, checked against each other and taken in tile order, with where each
+// tile's owned vertices and faces start in the whole set and its copies' owners in it.
+struct TileSet {
+  std::vector<OpenTile> opened;        // in the order of the paths
+  std::vector<const OpenTile*> tile;   // tile[t]: tile t
+  std::vector<uint64_t> base, face_base;  // count + 1 each
+  std::vector<std::vector<TileVertexRef>> foreign;
+  std::vector<std::vector<uint32_t>> global;  // global[t][f]: the whole set's index of tile t's copy f
+  bool colors = false;
+  uint32_t count() const { return static_cast<uint32_t>(tile.size()); }
+  uint64_t vertices() const { return base.back(); }
+  uint64_t faces() const { return face_base.back(); }
+  const std::string& path(uint32_t t) const { return tile[t]->file->path(); }
+};
+
+Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned threads) {
   if (paths.empty()) return Error{"merge: no tiles given", ExitCode::kUsage};
-  std::vector<TileHeader> headers;
+  TileSet set;
   for (const std::string& path : paths) {
-    Result<TileHeader> h = readTileHeader(path);
-    if (!h) return h.error();
-    headers.push_back(std::move(*h));
+    Result<OpenTile> t = openForRows(path);
+    if (!t) return t.error();
+    set.opened.push_back(std::move(*t));
   }
-  const uint32_t count = headers[0].tile.count;
+  auto headerOf = [&](size_t i) -> const TileHeader& { return set.opened[i].parsed.header; };
+  const uint32_t count = headerOf(0).tile.count;
   std::vector<int> by_index(count, -1);
   for (size_t i = 0; i < paths.size(); ++i) {
-    const TileHeader& h = headers[i];
+    const TileHeader& h = headerOf(i);
     if (h.tile.count != count)
       return Error{paths[i] + ": tile " + std::to_string(h.tile.index) + "/" + std::to_string(h.tile.count) + ", but " +
                    paths[0] + " is one of " + std::to_string(count)};
-    if (h.signature != headers[0].signature)
-      return Error{paths[i] + ": a tile of another run ('" + h.signature + "'), not of '" + headers[0].signature + "' (" +
+    if (h.signature != headerOf(0).signature)
+      return Error{paths[i] + ": a tile of another run ('" + h.signature + "'), not of '" + headerOf(0).signature + "' (" +
                    paths[0] + ")"};
     int& slot = by_index[h.tile.index];
     if (slot >= 0) return Error{paths[i] + ": tile " + std::to_string(h.tile.index) + " again (also " + paths[static_cast<size_t>(slot)] + ")"};
@@ -290,74 +396,293 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
   if (!missing.empty())
     return Error{"merge: missing tile(s) " + missing + " of 0.." + std::to_string(count - 1) + " (" +
                  std::to_string(paths.size()) + " given, from " + paths[0] + ")"};
+  set.tile.resize(count);
+  for (uint32_t t = 0; t < count; ++t) set.tile[t] = &set.opened[static_cast<size_t>(by_index[t])];
 
-  // Where each tile's owned vertices start in the whole set.
-  std::vector<uint64_t> base(count + 1, 0);
-  uint64_t faces = 0;
+  set.base.assign(count + 1, 0);
+  set.face_base.assign(count + 1, 0);
   for (uint32_t t = 0; t < count; ++t) {
-    const TileHeader& h = headers[static_cast<size_t>(by_index[t])];
-    base[t + 1] = base[t] + h.owned;
-    faces += h.faces;
+    set.base[t + 1] = set.base[t] + set.tile[t]->parsed.header.owned;
+    set.face_base[t + 1] = set.face_base[t] + set.tile[t]->parsed.header.faces;
   }
-  const uint64_t vertices = base[count];
-  if (vertices > UINT32_MAX) return Error{"merge: more than 2^32 vertices", ExitCode::kResourceLimit};
+  if (set.vertices() > UINT32_MAX) return Error{"merge: more than 2^32 vertices", ExitCode::kResourceLimit};
   // Colours or none, alike in every tile that has points (an empty one has nothing to colour).
   int coloured = -1;
   for (size_t i = 0; i < paths.size(); ++i) {
-    if (headers[i].vertices == 0) continue;
+    if (headerOf(i).vertices == 0) continue;
     if (coloured < 0) coloured = static_cast<int>(i);
-    if (headers[i].colors != headers[static_cast<size_t>(coloured)].colors)
-      return Error{paths[i] + ": " + (headers[i].colors ? "has" : "lacks") + " colours, unlike " +
+    if (headerOf(i).colors != headerOf(static_cast<size_t>(coloured)).colors)
+      return Error{paths[i] + ": " + (headerOf(i).colors ? "has" : "lacks") + " colours, unlike " +
                    paths[static_cast<size_t>(coloured)]};
   }
-  const bool colors = coloured >= 0 && headers[static_cast<size_t>(coloured)].colors;
+  set.colors = coloured >= 0 && headerOf(static_cast<size_t>(coloured)).colors;
+
+  // The references of every tile's copies, as indices in the whole set.
+  set.foreign.resize(count);
+  set.global.resize(count);
+  std::vector<Status> errors(count, okStatus());
+  parallelFor(count, threads, [&](size_t t, unsigned) {
+    std::vector<TileVertexRef>& foreign = set.foreign[t];
+    if (Status s = readForeignRows(*set.tile[t], foreign); !s) {
+      errors[t] = s;
+      return;
+    }
+    set.global[t].resize(foreign.size());
+    for (size_t f = 0; f < foreign.size(); ++f) {
+      const TileVertexRef& ref = foreign[f];
+      if (ref.tile >= count || ref.tile == t || ref.index >= set.base[ref.tile + 1] - set.base[ref.tile]) {
+        errors[t] = Error{set.path(static_cast<uint32_t>(t)) + ": foreign vertex " + std::to_string(f) + " refers to vertex " +
+                          std::to_string(ref.index) + " of tile " + std::to_string(ref.tile) + ", which does not exist"};
+        return;
+      }
+      set.global[t][f] = static_cast<uint32_t>(set.base[ref.tile] + ref.index);
+    }
+  });
+  if (Status s = firstError(errors); !s) return s.error();
+  return set;
+}
+
+Error copyDiffers(const TileSet& set, uint32_t t, uint32_t at, bool same_position) {
+  return Error{set.path(t) + ": its copy of vertex " + std::to_string(at) + " differs from the owner's " +
+               (same_position ? "colour" : "position") + " (tiles of different builds or options?)"};
+}
+
+// A work item of the merge: kRowsPerBlock vertex or face rows of one tile.
+struct RowBlock {
+  uint32_t tile;
+  bool faces;
+  uint64_t first;
+  size_t rows;
+};
+
+// The blocks of rows [0, rows) of every tile (rows(t): how many), in tile order.
+template <typename Rows>
+void addBlocks(const TileSet& set, bool faces, const Rows& rows, std::vector<RowBlock>& blocks) {
+  for (uint32_t t = 0; t < set.count(); ++t)
+    for (uint64_t first = 0; first < rows(t); first += kRowsPerBlock)
+      blocks.push_back({t, faces, first, static_cast<size_t>(std::min<uint64_t>(kRowsPerBlock, rows(t) - first))});
+}
+
+}  // namespace
+
+Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory, Progress* progress,
+                            unsigned threads) {
+  Result<TileSet> opened = openTileSet(paths, threads);
+  if (!opened) return opened.error();
+  const TileSet& set = *opened;
+  const uint32_t count = set.count();
+  const bool colors = set.colors;
+  const uint64_t vertices = set.vertices(), faces = set.faces();
   const uint64_t bytes = vertices * (sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0)) + faces * 3 * sizeof(uint32_t);
   if (Status s = checkMemory("merging " + std::to_string(count) + " tiles", bytes, max_memory); !s) return s.error();
 
+  // Every tile's rows, kRowsPerBlock at a time on all cores, straight to their places: owned
+  // vertices into the set, copies beside it (checked below), faces through the weld.
   PointSet out;
-  out.positions.reserve(vertices);
-  if (colors) out.colors.reserve(vertices);
-  out.triangles.reserve(3 * faces);
-  struct Copy {
-    uint32_t tile;  // the file holding it
-    uint64_t at;    // its owner's index in the whole set
-    glm::dvec3 position;
-    glm::vec3 color;
-  };
-  std::vector<Copy> copies;
-  if (progress) progress->start("merging", count);
+  out.positions.resize(vertices);
+  if (colors) out.colors.resize(vertices);
+  out.triangles.resize(3 * faces);
+  std::vector<std::vector<glm::dvec3>> copy_positions(count);
+  std::vector<std::vector<glm::vec3>> copy_colors(count);
   for (uint32_t t = 0; t < count; ++t) {
-    const std::string& path = paths[static_cast<size_t>(by_index[t])];
-    Result<PointTile> tile = readTile(path);
-    if (!tile) return tile.error();
-    const PointSet& p = tile->points;
-    out.positions.insert(out.positions.end(), p.positions.begin(), p.positions.begin() + tile->owned);
-    if (colors) out.colors.insert(out.colors.end(), p.colors.begin(), p.colors.begin() + tile->owned);
-    std::vector<uint64_t> global(tile->foreign.size());
-    for (size_t f = 0; f < tile->foreign.size(); ++f) {
-      const TileVertexRef& ref = tile->foreign[f];
-      if (ref.tile >= count || ref.tile == t || ref.index >= base[ref.tile + 1] - base[ref.tile])
-        return Error{path + ": foreign vertex " + std::to_string(f) + " refers to vertex " + std::to_string(ref.index) +
-                     " of tile " + std::to_string(ref.tile) + ", which does not exist"};
-      global[f] = base[ref.tile] + ref.index;
-      const size_t local = tile->owned + f;
-      copies.push_back({t, global[f], p.positions[local], colors ? p.colors[local] : glm::vec3(0.0f)});
+    copy_positions[t].resize(set.foreign[t].size());
+    if (colors) copy_colors[t].resize(set.foreign[t].size());
+  }
+  std::vector<RowBlock> blocks;
+  addBlocks(set, false, [&](uint32_t t) { return set.tile[t]->parsed.header.vertices; }, blocks);
+  addBlocks(set, true, [&](uint32_t t) { return set.tile[t]->parsed.header.faces; }, blocks);
+  if (progress) progress->start("merging " + std::to_string(count) + " tiles", vertices + faces);
+  std::vector<Status> errors(blocks.size(), okStatus());
+  const unsigned workers = resolveThreads(threads);
+  std::vector<std::vector<char>> buffers(workers);
+  parallelFor(blocks.size(), workers, [&](size_t k, unsigned worker) {
+    const RowBlock& block = blocks[k];
+    const OpenTile& t = *set.tile[block.tile];
+    const uint64_t owned = t.parsed.header.owned;
+    std::vector<char>& buffer = buffers[worker];
+    Status s = okStatus();
+    if (block.faces) {
+      const uint64_t offset = set.base[block.tile];
+      const std::vector<uint32_t>& to_global = set.global[block.tile];
+      s = readFaceRows(t, block.first, block.rows, &out.triangles[3 * (set.face_base[block.tile] + block.first)], buffer,
+                       [&](uint32_t i) { return i < owned ? static_cast<uint32_t>(offset + i) : to_global[i - owned]; });
+    } else {
+      // The rows below `owned` go into the set, the others among the copies.
+      uint64_t first = block.first;
+      size_t rows = block.rows;
+      if (first < owned) {
+        const size_t mine = static_cast<size_t>(std::min<uint64_t>(rows, owned - first));
+        const uint64_t at = set.base[block.tile] + first;
+        s = readVertexRows(t, first, mine, &out.positions[at], colors ? &out.colors[at] : nullptr, buffer);
+        first += mine;
+        rows -= mine;
+      }
+      if (s && rows > 0) {
+        const uint64_t at = first - owned;
+        s = readVertexRows(t, first, rows, &copy_positions[block.tile][at],
+                           colors ? &copy_colors[block.tile][at] : nullptr, buffer);
+      }
     }
-    for (uint32_t index : p.triangles)
-      out.triangles.push_back(static_cast<uint32_t>(index < tile->owned ? base[t] + index : global[index - tile->owned]));
-    if (progress) progress->advance(1);
-  }
+    errors[k] = s;
+    if (progress) progress->advance(block.rows);
+  });
   if (progress) progress->finish();
+  if (Status s = firstError(errors); !s) return s.error();
+
   // The weld is by identity; the copies must agree with their owners bit for bit.
-  for (const Copy& c : copies) {
-    const bool same_position = std::memcmp(&c.position, &out.positions[c.at], sizeof c.position) == 0;
-    const bool same_color = !colors || std::memcmp(&c.color, &out.colors[c.at], sizeof c.color) == 0;
-    if (!same_position || !same_color)
-      return Error{paths[static_cast<size_t>(by_index[c.tile])] + ": its copy of vertex " + std::to_string(c.at) +
-                   " differs from the owner's " + (same_position ? "colour" : "position") +
-                   " (tiles of different builds or options?)"};
-  }
+  std::vector<Status> differ(count, okStatus());
+  parallelFor(count, threads, [&](size_t t, unsigned) {
+    for (size_t f = 0; f < set.global[t].size(); ++f) {
+      const uint32_t at = set.global[t][f];
+      const bool same_position = std::memcmp(&copy_positions[t][f], &out.positions[at], sizeof(glm::dvec3)) == 0;
+      const bool same_color = !colors || std::memcmp(&copy_colors[t][f], &out.colors[at], sizeof(glm::vec3)) == 0;
+      if (!same_position || !same_color) {
+        differ[t] = copyDiffers(set, static_cast<uint32_t>(t), at, same_position);
+        return;
+      }
+    }
+  });
+  if (Status s = firstError(differ); !s) return s.error();
   return out;
+}
+
+bool canMergeToPly(const PlyWriteOptions& options) {
+  return options.encoding == PlyEncoding::kBinary && options.color_type == PlyColorType::kUchar;
+}
+
+Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options) {
+  assert(canMergeToPly(options));
+  Result<TileSet> opened = openTileSet(paths, options.threads);
+  if (!opened) return opened.error();
+  const TileSet& set = *opened;
+  const uint32_t count = set.count();
+  const bool colors = set.colors;
+  const size_t in_stride = sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0);
+  const size_t out_stride = sizeof(glm::dvec3) + (colors ? 3 : 0);
+
+  // The copies' rows as read, and per owning tile the copies of its vertices by index (then by
+  // copying tile and copy): each block of owned rows checks the copies of its rows as it goes.
+  std::vector<std::vector<char>> copy_rows(count);
+  struct Copy {
+    uint32_t index;  // among the owner's owned vertices
+    uint32_t tile;   // the tile holding the copy
+    uint32_t f;      // its copy number there
+  };
+  std::vector<std::vector<Copy>> copies_of(count);
+  {
+    std::vector<Status> errors(count, okStatus());
+    parallelFor(count, options.threads, [&](size_t t, unsigned) {
+      const OpenTile& tile = *set.tile[t];
+      errors[t] = readBytesAt(*tile.file, tile.parsed.data_offset + tile.parsed.header.owned * in_stride, copy_rows[t],
+                              set.foreign[t].size() * in_stride);
+    });
+    if (Status s = firstError(errors); !s) return s;
+    for (uint32_t t = 0; t < count; ++t)
+      for (size_t f = 0; f < set.foreign[t].size(); ++f)
+        copies_of[set.foreign[t][f].tile].push_back({set.foreign[t][f].index, t, static_cast<uint32_t>(f)});
+    parallelFor(count, options.threads, [&](size_t u, unsigned) {
+      std::sort(copies_of[u].begin(), copies_of[u].end(), [](const Copy& a, const Copy& b) {
+        return a.index != b.index ? a.index < b.index : a.tile != b.tile ? a.tile < b.tile : a.f < b.f;
+      });
+    });
+  }
+
+  std::vector<RowBlock> blocks;
+  addBlocks(set, false, [&](uint32_t t) { return set.tile[t]->parsed.header.owned; }, blocks);
+  const size_t vertex_blocks = blocks.size();
+  addBlocks(set, true, [&](uint32_t t) { return set.tile[t]->parsed.header.faces; }, blocks);
+
+  // Whether every z is +0.0 (PointSet::isPlanar): the header says so. A 3D set shows a z early.
+  std::atomic<bool> planar{true};
+  {
+    std::vector<Status> errors(vertex_blocks, okStatus());
+    const unsigned workers = resolveThreads(options.threads);
+    std::vector<std::vector<char>> buffers(workers);
+    parallelFor(vertex_blocks, workers, [&](size_t k, unsigned worker) {
+      if (!planar.load(std::memory_order_relaxed)) return;
+      const RowBlock& block = blocks[k];
+      const OpenTile& tile = *set.tile[block.tile];
+      std::vector<char>& bytes = buffers[worker];
+      if (Status s = readBytesAt(*tile.file, tile.parsed.data_offset + block.first * in_stride, bytes,
+                                 block.rows * in_stride);
+          !s) {
+        errors[k] = s;
+        return;
+      }
+      for (size_t i = 0; i < block.rows; ++i) {
+        uint64_t z;
+        std::memcpy(&z, &bytes[i * in_stride + 2 * sizeof(double)], sizeof z);
+        if (z != 0) {
+          planar.store(false, std::memory_order_relaxed);
+          return;
+        }
+      }
+    });
+    if (Status s = firstError(errors); !s) return s;
+  }
+
+  Result<AtomicFile> file = AtomicFile::create(output);
+  if (!file) return file.error();
+  const std::string header = plyHeader(PointSet{}, set.vertices(), set.faces(), colors, !planar.load(), options);
+  Progress* progress = options.progress;
+  if (progress) progress->start("merging " + std::to_string(count) + " tiles into " + output, set.vertices() + set.faces());
+
+  const Status written = writeChunksInOrder(
+      *file, 1 + blocks.size(), options.threads,
+      [&](size_t k, std::vector<char>& bytes) -> Status {
+        if (k == 0) {
+          bytes.assign(header.begin(), header.end());
+          return okStatus();
+        }
+        const RowBlock& block = blocks[k - 1];
+        const OpenTile& tile = *set.tile[block.tile];
+        if (block.faces) {  // the tile's rows, each index through the weld in place
+          const uint64_t owned = tile.parsed.header.owned;
+          const uint64_t offset = set.base[block.tile];
+          const std::vector<uint32_t>& to_global = set.global[block.tile];
+          std::vector<uint32_t> corners(3 * block.rows);
+          Status s = readFaceRows(tile, block.first, block.rows, corners.data(), bytes, [&](uint32_t i) {
+            return i < owned ? static_cast<uint32_t>(offset + i) : to_global[i - owned];
+          });
+          if (!s) return s;
+          for (size_t i = 0; i < block.rows; ++i) std::memcpy(&bytes[i * kFaceBytes + 1], &corners[3 * i], 12);
+          return okStatus();
+        }
+        thread_local std::vector<char> in;
+        if (Status s = readBytesAt(*tile.file, tile.parsed.data_offset + block.first * in_stride, in,
+                                   block.rows * in_stride);
+            !s)
+          return s;
+        // The copies of these rows, bit for bit the owner's.
+        const std::vector<Copy>& copies = copies_of[block.tile];
+        auto copy = std::lower_bound(copies.begin(), copies.end(), block.first,
+                                     [](const Copy& c, uint64_t index) { return c.index < index; });
+        for (; copy != copies.end() && copy->index < block.first + block.rows; ++copy) {
+          const char* owner = &in[(copy->index - block.first) * in_stride];
+          const char* mine = &copy_rows[copy->tile][size_t{copy->f} * in_stride];
+          const bool same_position = std::memcmp(owner, mine, sizeof(glm::dvec3)) == 0;
+          if (!same_position || std::memcmp(owner, mine, in_stride) != 0)
+            return copyDiffers(set, copy->tile, static_cast<uint32_t>(set.base[block.tile] + copy->index), same_position);
+        }
+        bytes.resize(block.rows * out_stride);
+        for (size_t i = 0; i < block.rows; ++i) {
+          const char* row = &in[i * in_stride];
+          char* to = &bytes[i * out_stride];
+          std::memcpy(to, row, sizeof(glm::dvec3));
+          if (colors) {
+            float c[3];
+            std::memcpy(c, row + sizeof(glm::dvec3), sizeof c);
+            for (int j = 0; j < 3; ++j) to[sizeof(glm::dvec3) + j] = static_cast<char>(colorInteger(c[j], 255.0));
+          }
+        }
+        return okStatus();
+      },
+      [&](size_t k) {
+        if (k > 0 && progress) progress->advance(blocks[k - 1].rows);
+      });
+  if (!written) return written;
+  if (progress) progress->finish();
+  return file->commit();
 }
 
 }  // namespace dpoint

@@ -15,12 +15,14 @@
 #include "core/progress.h"
 #include "core/result.h"
 #include "core/tile.h"
+#include "converters/ply.h"
 
 namespace dpoint {
 
-// Writes the tile file (atomically). `signature`: one line of text, no newline.
+// Writes the tile file (atomically), its rows made on `threads` cores (0: all). `signature`: one
+// line of text, no newline.
 Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature,
-                 Progress* progress = nullptr);
+                 Progress* progress = nullptr, unsigned threads = 0);
 
 // What a tile file's header says.
 struct TileHeader {
@@ -42,8 +44,15 @@ Result<PointTile> readTile(const std::string& path);
 // ... concatenated, triangles with their indices offset, every copy of a foreign vertex checked
 // against its owner. Errors (kBadInput) name the file: a missing, repeated or extra tile, tiles of
 // different runs (signatures) or counts, a reference past its owner's vertices, a copy that differs
-// from its owner; kResourceLimit past 2^32 vertices or over `max_memory` (0: half of RAM).
+// from its owner; kResourceLimit past 2^32 vertices or over `max_memory` (0: half of RAM). The
+// parts are read on `threads` cores (0: all), each block of rows straight into its place.
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory = 0,
-                            Progress* progress = nullptr);
+                            Progress* progress = nullptr, unsigned threads = 0);
+// The same merge streamed into the binary PLY file writePly would write of mergeTiles' set, byte
+// for byte, without holding the set: every tile's rows are read, welded and made into the file's
+// rows on options.threads cores and written in order, the copies checked against their owners on
+// the way. For options that canMergeToPly accepts (binary, uchar colours).
+bool canMergeToPly(const PlyWriteOptions& options);
+Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options);
 
 }  // namespace dpoint

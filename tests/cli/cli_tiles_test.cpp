@@ -121,6 +121,45 @@ TEST(CliTiles, mergeRefusesAnIncompleteOrMixedSet) {
   EXPECT_FALSE(test::fileExists(dir.file("m.ply")));
 }
 
+// A part whose copy of a vertex another part owns differs from it (one bit of a coordinate, or of a
+// colour) is refused whether the merge streams into a PLY file or takes the set in memory first.
+TEST(CliTiles, mergeRefusesACopyThatDiffersFromItsOwner) {
+  TempDir dir;
+  const std::vector<std::string> kind = {"mandelbulb", "--resolution", "17", "--variant", "fast"};
+  ASSERT_FALSE(mergedTiles(dir, kind, 2, "good.ply").empty());
+  // The part holding copies: more vertices than it owns. Its rows are 36 bytes (3 double, 3 float).
+  std::string part, bytes;
+  uint64_t owned = 0, vertices = 0;
+  for (const char* name : {"part-0.ply", "part-1.ply"}) {
+    bytes = readFile(dir.file(name));
+    const size_t at_owned = bytes.find("comment dpoint-tile-owned ");
+    const size_t at_vertices = bytes.find("element vertex ");
+    ASSERT_NE(at_owned, std::string::npos);
+    owned = std::stoull(bytes.substr(at_owned + 26));
+    vertices = std::stoull(bytes.substr(at_vertices + 15));
+    part = name;
+    if (vertices > owned) break;
+  }
+  ASSERT_GT(vertices, owned) << "no part holds a copy";
+  const size_t data = bytes.find("end_header\n") + 11;
+  ASSERT_NE(bytes.find("property float red"), std::string::npos);
+  for (size_t field : {size_t{8}, size_t{24}}) {  // the last byte of y; the first byte of red
+    SCOPED_TRACE(field == 8 ? "position" : "colour");
+    std::string bad = bytes;
+    bad[data + owned * 36 + field + (field == 8 ? 7 : 0)] ^= 1;
+    test::writeFile(dir.file(part), bad);
+    for (const char* out : {"bad.ply", "bad.csv"}) {
+      test::CommandResult r = runDpoint({"merge", "-q", dir.file("part-0.ply"), dir.file("part-1.ply"), "-o", dir.file(out)});
+      EXPECT_EQ(r.exit_code, 2) << out;
+      EXPECT_NE(r.err.find(dir.file(part) + ": its copy of vertex "), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find(std::string("differs from the owner's ") + (field == 8 ? "position" : "colour")),
+                std::string::npos)
+          << r.err;
+      EXPECT_FALSE(test::fileExists(dir.file(out)));
+    }
+  }
+}
+
 TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
   TempDir dir;
   const std::vector<std::string> kind = {"mandelbulb", "--resolution", "29"};
