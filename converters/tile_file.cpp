@@ -479,9 +479,9 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
   // Every tile's rows, kRowsPerBlock at a time on all cores, straight to their places: owned
   // vertices into the set, copies beside it (checked below), faces through the weld.
   PointSet out;
-  out.positions.resize(vertices);
-  if (colors) out.colors.resize(vertices);
-  out.triangles.resize(3 * faces);
+  resizePrefaulted(out.positions, vertices, threads);
+  if (colors) resizePrefaulted(out.colors, vertices, threads);
+  resizePrefaulted(out.triangles, 3 * faces, threads);
   std::vector<std::vector<glm::dvec3>> copy_positions(count);
   std::vector<std::vector<glm::vec3>> copy_colors(count);
   for (uint32_t t = 0; t < count; ++t) {

@@ -551,8 +551,9 @@ Result<PointSet> generateRows(const Mandelbrot2dParams& params, size_t first_row
                                                  : prepassDistribution(p, reference);
   if (!distribution) return distribution.error();
   PointSet set;
-  set.positions.resize(rows * res);
-  set.colors.resize(rows * res);
+  set.z_axis = ZAxis::kAbsent;  // x,y only
+  resizePrefaulted(set.positions, rows * res, p.threads);
+  resizePrefaulted(set.colors, rows * res, p.threads);
   parallelFor(rows, p.threads, [&](size_t r, unsigned) {
     // Correctly rounded centre + offset (the offsets are exact doubles).
     const double y = p.center_y + pixelOffset(static_cast<int>(first_row + r), p.resolution, grid.spacing);

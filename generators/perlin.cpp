@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/memory.h"
 #include "core/parallel.h"
 
 namespace dpoint {
@@ -92,7 +93,10 @@ glm::vec3 seedColor(const glm::dvec3& p) {
 
 void colorByNoise(PointSet& points, unsigned threads) {
   constexpr size_t kPointsPerChunk = size_t{1} << 14;
-  points.colors.resize(points.positions.size());
+  if (points.colors.empty())
+    resizePrefaulted(points.colors, points.positions.size(), threads);
+  else
+    points.colors.resize(points.positions.size());
   const size_t chunks = (points.positions.size() + kPointsPerChunk - 1) / kPointsPerChunk;
   parallelFor(chunks, threads, [&](size_t chunk, unsigned) {
     const size_t end = std::min(points.positions.size(), (chunk + 1) * kPointsPerChunk);

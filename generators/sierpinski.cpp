@@ -161,8 +161,8 @@ Result<PointSet> generateSierpinski(const SierpinskiParams& params) {
     return s.error();
 
   PointSet out;
-  out.positions.resize(vertices);
-  out.triangles.resize(tetrahedra * 12);
+  resizePrefaulted(out.positions, vertices, params.threads);
+  resizePrefaulted(out.triangles, tetrahedra * 12, params.threads);
   const Frame frame = makeFrame(n);
   // Work items are whole subtrees (up to 256 of them), each a contiguous range of tetrahedra.
   const int chunk_depth = std::min(n, 4);
