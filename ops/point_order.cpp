@@ -83,6 +83,48 @@ inline uint64_t codeOf(const MortonFrame& f, const glm::dvec3& p) {
                           quantize(p.z, f.half_min.z, f.half_extent.z));
 }
 
+// Bit k of the low 21 bits → bit 2k.
+inline uint64_t spreadBits2(uint32_t v) {
+  uint64_t x = v & kAxisMax;
+  x = (x | x << 16) & 0x0000ffff0000ffffull;
+  x = (x | x << 8) & 0x00ff00ff00ff00ffull;
+  x = (x | x << 4) & 0x0f0f0f0f0f0f0f0full;
+  x = (x | x << 2) & 0x3333333333333333ull;
+  x = (x | x << 1) & 0x5555555555555555ull;
+  return x;
+}
+
+// The key the sort uses: the Morton code without the bits of flat axes (no extent: every point's
+// coordinate there quantizes to 0). Those bits are 0 in every code, so dropping them keeps every
+// comparison and the order is the same; but a 2D set's codes then vary in every bit, so each
+// radix digit splits the points 2^width ways instead of a third of the digit being constant (at
+// 1e9 points the top level's ranges had all stayed above kParallelMin and were sorted one at a
+// time: 5.5 of the H200's 11 s).
+class SortCode {
+ public:
+  explicit SortCode(const MortonFrame& f) : frame_(f) {
+    for (int a = 0; a < 3; ++a)
+      if (f.half_extent[a] > 0.0) axes_[live_++] = a;
+  }
+  uint64_t operator()(const glm::dvec3& p) const {
+    switch (live_) {
+      case 3: return codeOf(frame_, p);
+      case 2: return spreadBits2(axis(p, 0)) | spreadBits2(axis(p, 1)) << 1;
+      case 1: return axis(p, 0);
+      default: return 0;
+    }
+  }
+
+ private:
+  uint32_t axis(const glm::dvec3& p, int i) const {
+    const int a = axes_[i];
+    return quantize(p[a], frame_.half_min[a], frame_.half_extent[a]);
+  }
+  MortonFrame frame_;
+  int axes_[3] = {0, 0, 0};
+  int live_ = 0;
+};
+
 // Uniform in [0, bound) by rejection, so the shuffle is the same on every standard library.
 uint64_t uniformBelow(std::mt19937_64& rng, uint64_t bound) {
   const uint64_t max = std::numeric_limits<uint64_t>::max();
@@ -383,6 +425,7 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
   if (progress) progress->start("morton order", 3 * uint64_t{n});
 
   const MortonFrame frame = mortonFrame(points.positions, threads);
+  const SortCode sort_code(frame);
   Scratch scratch(n);
   SortKeys k;
   k.code[0] = scratch.array<uint64_t>(0, n);
@@ -396,7 +439,7 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
     const glm::dvec3* p = points.positions.data();
     const size_t end = std::min(n, (c + 1) * kChunk);
     for (size_t i = c * kChunk; i < end; ++i) {
-      const uint64_t v = codeOf(frame, p[i]);
+      const uint64_t v = sort_code(p[i]);
       k.code[0][i] = v;
       k.index[0][i] = static_cast<uint32_t>(i);
       all_and &= v;

@@ -1,13 +1,12 @@
 #!/usr/bin/env bash
-# Issue #38 item 4's random2d target on the device tool's machine (carry .gpu as for gpu_merge.sh):
+# Issue #38 item 4's random2d target on the device tool's machine (carry .gl and .gpu as for gpu_merge.sh):
 # `generate random2d --count COUNT (1e9) --order morton` as a whole process, for each of ROUNDS
 # rounds each build of BUILDS in turn ("A current": .gpu/dpoint-A and .gpu/dpoint), on CORES cores
 # (taskset; default all), then dd of a file of the output's size into the same folder. One line per
 # run in $OUT/random2d.tsv: build, round, wall s, peak MB, SHA-256 (16) of the first 64 MiB, and the process's own
 # phase line (generate, colours, order, write).
 set -euo pipefail
-export LD_LIBRARY_PATH=$PWD/.gpu/lib
-out=${OUT:-/tmp/out}
+source bench/scripts/gpu_env.sh  # dpoint links the Vulkan loader, even where it uses no device
 count=${COUNT:-1000000000}
 rounds=${ROUNDS:-3}
 builds=${BUILDS:-current}

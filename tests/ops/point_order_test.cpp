@@ -238,6 +238,26 @@ TEST(PointOrder, equalCodesKeepTheirInputOrderInShortRanges) {
   }
 }
 
+// The sort keys leave out the bits of flat axes (their coordinate quantizes to 0 in every code), so
+// that a 2D set's radix digits split it evenly: the order must be the 3D codes' order all the same,
+// ties included, for a plane of each orientation and a line, also past the sizes the top level
+// sorts over all threads.
+TEST(PointOrder, flatAxesGiveTheOrderOfTheFullCodes) {
+  for (int flat : {0b100, 0b001, 0b010, 0b101}) {  // x; z; y; x and z
+    SCOPED_TRACE("flat axes " + std::to_string(flat));
+    PointSet s = randomCloud(150000, 11 + static_cast<uint64_t>(flat));
+    for (size_t i = 0; i < s.size(); ++i) {
+      for (int a = 0; a < 3; ++a)
+        if ((flat >> (2 - a)) & 1) s.positions[i][a] = a == 0 ? 0.0 : 7.5;
+      if (i % 97 == 0 && i > 0) s.positions[i] = s.positions[i - 1];  // ties, kept in input order
+    }
+    expectMortonOrderOf(s, reordered(s, 2));
+  }
+  PointSet plane = randomCloud(1300000, 5);  // > kParallelMin (2^20) points in the top-level range
+  for (glm::dvec3& p : plane.positions) p.z = 0.0;
+  expectMortonOrderOf(plane, reordered(plane, 3));
+}
+
 TEST(PointOrder, tinySetsAreSortedAndEmptyIsLeftAlone) {
   PointSet empty;
   reorderPoints(empty, PointOrder::kMorton);
