@@ -40,7 +40,7 @@ int runMerge(const MergeOptions& o) {
   const PlyWriteOptions ply{PlyEncoding::kBinary, PlyColorType::kUchar, &progress, o.common.threads};
   Result<FileFormat> format = formatOf(o.output);
   if (format && *format == FileFormat::kPly && *order == PointOrder::kInput && canMergeToPly(ply)) {
-    if (Status s = mergeTilesToPly(o.inputs, o.output, ply); !s) return reportError(s.error());
+    if (Status s = mergeTilesToPly(o.inputs, o.output, ply, limit); !s) return reportError(s.error());
     return 0;
   }
   Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress, o.common.threads);

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/ordered_write.h"
+#include "core/parallel.h"
 #include "core/text.h"
 #include "converters/ply.h"
 
@@ -120,6 +121,24 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
                  std::to_string(n) + " points"};
   if (points.triangles.size() % 3 != 0)
     return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
+  {
+    // Every index below n, checked before anything is written (on all cores: a big mesh has
+    // hundreds of millions); the first bad one is named.
+    constexpr size_t kIndicesPerItem = size_t{1} << 20;
+    const std::vector<uint32_t>& t = points.triangles;
+    std::vector<size_t> bad((t.size() + kIndicesPerItem - 1) / kIndicesPerItem, t.size());
+    parallelFor(bad.size(), options.threads, [&](size_t item, unsigned) {
+      for (size_t i = item * kIndicesPerItem, end = std::min(t.size(), i + kIndicesPerItem); i < end; ++i)
+        if (t[i] >= n) {
+          bad[item] = i;
+          return;
+        }
+    });
+    for (size_t i : bad)
+      if (i < t.size())
+        return Error{"cannot write '" + path + "': triangle index " + std::to_string(t[i]) + " out of range (" +
+                     std::to_string(n) + " points)"};
+  }
   auto file = AtomicFile::create(path);
   if (!file.ok()) return file.error();
   const bool ascii = options.encoding == PlyEncoding::kAscii;
@@ -202,11 +221,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
       for (size_t k = 0; k < dims.size(); ++k) appendDimension(out, dims[k], i, k + 1 == dims.size() ? '\n' : ' ');
     }
   };
-  auto faceRows = [&](size_t begin, size_t end, std::vector<char>& bytes) -> Status {
-    for (size_t i = 3 * begin; i < 3 * end; ++i)
-      if (points.triangles[i] >= n)
-        return Error{"cannot write '" + path + "': triangle index " + std::to_string(points.triangles[i]) +
-                     " out of range (" + std::to_string(n) + " points)"};
+  auto faceRows = [&](size_t begin, size_t end, std::vector<char>& bytes) {
     if (!ascii) {
       bytes.resize((end - begin) * kFaceBytes);
       char* row = bytes.data();
@@ -214,14 +229,13 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
         row[0] = 3;
         std::memcpy(row + 1, &points.triangles[3 * f], 3 * sizeof(uint32_t));
       }
-      return okStatus();
+      return;
     }
     ChunkText out(bytes);
     for (size_t f = begin; f < end; ++f) {
       out.append("3 ");
       for (int k = 0; k < 3; ++k) appendNumber(out, points.triangles[3 * f + k], k == 2 ? '\n' : ' ');
     }
-    return okStatus();
   };
   const Status written = writeChunksInOrder(
       *file, 1 + vertex_chunks + face_chunks, options.threads,
@@ -231,11 +245,11 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
           return okStatus();
         }
         const auto [begin, end] = rowsOf(k);
-        if (k - 1 < vertex_chunks) {
+        if (k - 1 < vertex_chunks)
           vertexRows(begin, end, bytes);
-          return okStatus();
-        }
-        return faceRows(begin, end, bytes);
+        else
+          faceRows(begin, end, bytes);
+        return okStatus();
       },
       [&](size_t k) {
         if (k > 0 && options.progress) options.progress->advance(rowsOf(k).second - rowsOf(k).first);

@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <mutex>
+#include <optional>
+#include <tuple>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -491,7 +494,9 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
   std::vector<RowBlock> blocks;
   addBlocks(set, false, [&](uint32_t t) { return set.tile[t]->parsed.header.vertices; }, blocks);
   addBlocks(set, true, [&](uint32_t t) { return set.tile[t]->parsed.header.faces; }, blocks);
-  if (progress) progress->start("merging " + std::to_string(count) + " tiles", vertices + faces);
+  uint64_t all_rows = 0;  // every tile's vertex rows (copies included) and faces
+  for (const RowBlock& block : blocks) all_rows += block.rows;
+  if (progress) progress->start("merging " + std::to_string(count) + " tiles", all_rows);
   std::vector<Status> errors(blocks.size(), okStatus());
   const unsigned workers = resolveThreads(threads);
   std::vector<std::vector<char>> buffers(workers);
@@ -550,7 +555,8 @@ bool canMergeToPly(const PlyWriteOptions& options) {
   return options.encoding == PlyEncoding::kBinary && options.color_type == PlyColorType::kUchar;
 }
 
-Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options) {
+Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options,
+                       uint64_t max_memory) {
   assert(canMergeToPly(options));
   Result<TileSet> opened = openTileSet(paths, options.threads);
   if (!opened) return opened.error();
@@ -559,6 +565,16 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
   const bool colors = set.colors;
   const size_t in_stride = sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0);
   const size_t out_stride = sizeof(glm::dvec3) + (colors ? 3 : 0);
+  {
+    // What it holds: every copy's row and references, and per thread a block read and two made.
+    uint64_t copies = 0;
+    for (uint32_t t = 0; t < count; ++t) copies += set.foreign[t].size();
+    const uint64_t threads = resolveThreads(options.threads);
+    const uint64_t bytes = copies * (in_stride + 2 * sizeof(TileVertexRef) + 3 * sizeof(uint32_t)) +
+                           threads * kRowsPerBlock * (in_stride + 2 * std::max(out_stride, kFaceBytes));
+    if (Status s = checkMemory("merging " + std::to_string(count) + " tiles into " + output, bytes, max_memory); !s)
+      return s;
+  }
 
   // The copies' rows as read, and per owning tile the copies of its vertices by index (then by
   // copying tile and copy): each block of owned rows checks the copies of its rows as it goes.
@@ -621,6 +637,13 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
     if (Status s = firstError(errors); !s) return s;
   }
 
+  struct Differ {
+    uint32_t tile, f, at;
+    bool same_position;
+  };
+  std::optional<Differ> differ;
+  std::mutex differ_mutex;
+
   Result<AtomicFile> file = AtomicFile::create(output);
   if (!file) return file.error();
   const std::string header = plyHeader(PointSet{}, set.vertices(), set.faces(), colors, !planar.load(), options);
@@ -653,7 +676,9 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
                                    block.rows * in_stride);
             !s)
           return s;
-        // The copies of these rows, bit for bit the owner's.
+        // The copies of these rows, bit for bit the owner's. A copy that differs is kept (the
+        // first by copying tile and copy, as mergeTiles reports it) and reported once every
+        // block has been read, so that a read or face error comes first, as it does there.
         const std::vector<Copy>& copies = copies_of[block.tile];
         auto copy = std::lower_bound(copies.begin(), copies.end(), block.first,
                                      [](const Copy& c, uint64_t index) { return c.index < index; });
@@ -661,8 +686,10 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
           const char* owner = &in[(copy->index - block.first) * in_stride];
           const char* mine = &copy_rows[copy->tile][size_t{copy->f} * in_stride];
           const bool same_position = std::memcmp(owner, mine, sizeof(glm::dvec3)) == 0;
-          if (!same_position || std::memcmp(owner, mine, in_stride) != 0)
-            return copyDiffers(set, copy->tile, static_cast<uint32_t>(set.base[block.tile] + copy->index), same_position);
+          if (same_position && std::memcmp(owner, mine, in_stride) == 0) continue;
+          std::lock_guard lock(differ_mutex);
+          const Differ found{copy->tile, copy->f, static_cast<uint32_t>(set.base[block.tile] + copy->index), same_position};
+          if (!differ || std::tie(found.tile, found.f) < std::tie(differ->tile, differ->f)) differ = found;
         }
         bytes.resize(block.rows * out_stride);
         for (size_t i = 0; i < block.rows; ++i) {
@@ -681,6 +708,7 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
         if (k > 0 && progress) progress->advance(blocks[k - 1].rows);
       });
   if (!written) return written;
+  if (differ) return copyDiffers(set, differ->tile, differ->at, differ->same_position);
   if (progress) progress->finish();
   return file->commit();
 }

@@ -53,6 +53,9 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
 // rows on options.threads cores and written in order, the copies checked against their owners on
 // the way. For options that canMergeToPly accepts (binary, uchar colours).
 bool canMergeToPly(const PlyWriteOptions& options);
-Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options);
+// What it holds (the copies' rows, a few blocks a thread) is checked against max_memory (0: half of
+// RAM), kResourceLimit above it.
+Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options,
+                       uint64_t max_memory = 0);
 
 }  // namespace dpoint

@@ -1,12 +1,30 @@
 #include "core/ordered_write.h"
 
 #include <condition_variable>
+#include <exception>
+#include <new>
+#include <string>
 #include <mutex>
 #include <thread>
 
 #include "core/parallel.h"
 
 namespace dpoint {
+namespace {
+
+// make(k, bytes), an exception (out of memory on a worker, where nothing would catch it) turned into
+// the error the CLI gives for one on its own thread.
+Status makeCaught(const std::function<Status(size_t, std::vector<char>&)>& make, size_t k, std::vector<char>& bytes) {
+  try {
+    return make(k, bytes);
+  } catch (const std::bad_alloc&) {
+    return Error{"out of memory", ExitCode::kResourceLimit};
+  } catch (const std::exception& e) {
+    return Error{std::string("internal error: ") + e.what(), ExitCode::kBadInput};
+  }
+}
+
+}  // namespace
 
 Status writeChunksInOrder(AtomicFile& file, size_t chunks, unsigned threads,
                           const std::function<Status(size_t chunk, std::vector<char>& bytes)>& make,
@@ -45,7 +63,7 @@ Status writeChunksInOrder(AtomicFile& file, size_t chunks, unsigned threads,
         k = next++;
       }
       Slot& slot = slots[k % window];
-      Status s = make(k, slot.bytes);
+      Status s = makeCaught(make, k, slot.bytes);
       {
         std::lock_guard lock(mutex);
         slot.status = std::move(s);

@@ -551,7 +551,6 @@ Result<PointSet> generateRows(const Mandelbrot2dParams& params, size_t first_row
                                                  : prepassDistribution(p, reference);
   if (!distribution) return distribution.error();
   PointSet set;
-  set.z_axis = ZAxis::kAbsent;  // x,y only
   resizePrefaulted(set.positions, rows * res, p.threads);
   resizePrefaulted(set.colors, rows * res, p.threads);
   parallelFor(rows, p.threads, [&](size_t r, unsigned) {

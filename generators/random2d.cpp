@@ -25,7 +25,6 @@ Result<PointSet> generateRange(const Random2dParams& params, uint64_t first, uin
       !s)
     return s.error();
   PointSet points;
-  points.z_axis = ZAxis::kAbsent;  // x,y only: writers need not scan a billion z to learn it
   resizePrefaulted(points.positions, count, params.threads);
   const size_t chunks = (count + kPointsPerChunk - 1) / kPointsPerChunk;
   if (params.progress) params.progress->start("random2d", count);

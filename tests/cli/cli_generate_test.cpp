@@ -6,6 +6,7 @@
 
 #include "converters/csv.h"
 #include "converters/ply.h"
+#include "converters/point_io.h"
 #include "ops/point_order.h"
 #include "test_support.h"
 
@@ -81,6 +82,26 @@ TEST(CliGenerate, offsetTranslatesExactlyAndKeepsColours) {
   for (size_t i = 0; i < a->size(); ++i) {
     EXPECT_EQ(b->positions[i], a->positions[i] + glm::dvec3(6378137.0, -1e8, 0.5));
     EXPECT_EQ(b->colors[i], a->colors[i]);  // colours come from the untranslated fractal
+  }
+}
+
+// A 2D kind lifted off z = 0 by --offset has a z: every format writes it (a set marked 2D by its
+// generator once lost it here).
+TEST(CliGenerate, anOffsetInZGivesA2dKindItsZ) {
+  TempDir dir;
+  for (const char* kind : {"random2d", "mandelbrot2d"}) {
+    SCOPED_TRACE(kind);
+    const std::vector<std::string> size = std::string(kind) == "random2d" ? std::vector<std::string>{"--count", "5"}
+                                                                           : std::vector<std::string>{"--resolution", "4"};
+    for (const char* ext : {".csv", ".ply"}) {
+      const std::string out = dir.file(std::string("lifted") + ext);
+      ASSERT_EQ(runDpoint(test::concat(test::concat({"generate", kind}, size), {"--offset", "0,0,5", "-q", "-o", out})).exit_code,
+                0);
+      Result<PointSet> back = readPoints(out);
+      ASSERT_TRUE(back.ok()) << back.error().message;
+      EXPECT_TRUE(back->hasZ()) << ext;
+      for (const glm::dvec3& p : back->positions) EXPECT_EQ(p.z, 5.0) << ext;
+    }
   }
 }
 

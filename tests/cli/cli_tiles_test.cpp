@@ -158,6 +158,36 @@ TEST(CliTiles, mergeRefusesACopyThatDiffersFromItsOwner) {
       EXPECT_FALSE(test::fileExists(dir.file(out)));
     }
   }
+  // With a bad face as well, both paths name the face: rows are read and checked before copies.
+  std::string bad = bytes;
+  bad[data + owned * 36] ^= 1;
+  bad[data + vertices * 36] = 4;  // the first face's corner count
+  test::writeFile(dir.file(part), bad);
+  for (const char* out : {"bad.ply", "bad.csv"}) {
+    test::CommandResult r = runDpoint({"merge", "-q", dir.file("part-0.ply"), dir.file("part-1.ply"), "-o", dir.file(out)});
+    EXPECT_EQ(r.exit_code, 2) << out;
+    EXPECT_NE(r.err.find(dir.file(part) + ": byte " + std::to_string(data + vertices * 36) + ": face 0 has 4 corners"),
+              std::string::npos)
+        << out << ": " << r.err;
+  }
+}
+
+// The streamed merge into a .ply holds a few blocks a thread and the copies: --max-memory still
+// refuses it (exit 4) below that, as it refuses the merge that holds the set.
+TEST(CliTiles, mergeKeepsToMaxMemoryWhenItStreams) {
+  TempDir dir;
+  ASSERT_FALSE(mergedTiles(dir, {"julia", "--resolution", "21"}, 2, "good.ply").empty());
+  for (const char* out : {"small.ply", "small.csv"}) {
+    test::CommandResult r =
+        runDpoint({"merge", "-q", "--max-memory", "1K", dir.file("part-0.ply"), dir.file("part-1.ply"), "-o", dir.file(out)});
+    EXPECT_EQ(r.exit_code, 4) << out << ": " << r.err;
+    EXPECT_NE(r.err.find("merging 2 tiles"), std::string::npos) << r.err;
+    EXPECT_FALSE(test::fileExists(dir.file(out)));
+  }
+  EXPECT_EQ(runDpoint({"merge", "-q", "--max-memory", "1G", dir.file("part-0.ply"), dir.file("part-1.ply"), "-o",
+                       dir.file("big.ply")})
+                .exit_code,
+            0);
 }
 
 TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
