@@ -234,7 +234,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
     ChunkText out(bytes);
     for (size_t f = begin; f < end; ++f) {
       out.append("3 ");
-      for (int k = 0; k < 3; ++k) appendNumber(out, points.triangles[3 * f + k], k == 2 ? '\n' : ' ');
+      for (size_t k = 0; k < 3; ++k) appendNumber(out, points.triangles[3 * f + k], k == 2 ? '\n' : ' ');
     }
   };
   const Status written = writeChunksInOrder(

@@ -295,7 +295,7 @@ Status readFaceRows(const OpenTile& t, uint64_t first, size_t rows, uint32_t* ou
                    " has " + std::to_string(static_cast<unsigned char>(row[0])) + " corners, not 3"};
     uint32_t corner[3];
     std::memcpy(corner, row + 1, sizeof corner);
-    for (int k = 0; k < 3; ++k) {
+    for (size_t k = 0; k < 3; ++k) {
       if (corner[k] >= vertices)
         return Error{path + ": byte " + std::to_string(at + i * kFaceBytes) + ": face " + std::to_string(first + i) +
                      " uses vertex " + std::to_string(corner[k]) + " of " + std::to_string(vertices)};
@@ -699,7 +699,7 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
           if (colors) {
             float c[3];
             std::memcpy(c, row + sizeof(glm::dvec3), sizeof c);
-            for (int j = 0; j < 3; ++j) to[sizeof(glm::dvec3) + j] = static_cast<char>(colorInteger(c[j], 255.0));
+            for (size_t j = 0; j < 3; ++j) to[sizeof(glm::dvec3) + j] = static_cast<char>(colorInteger(c[j], 255.0));
           }
         }
         return okStatus();
