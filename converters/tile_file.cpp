@@ -368,6 +368,11 @@ struct TileSet {
   uint64_t vertices() const { return base.back(); }
   uint64_t faces() const { return face_base.back(); }
   const std::string& path(uint32_t t) const { return tile[t]->file->path(); }
+  // The whole set's index of vertex i of tile t: its own, or the owner's of a copy (the weld).
+  uint32_t weld(uint32_t t, uint32_t i) const {
+    const uint64_t owned = tile[t]->parsed.header.owned;
+    return i < owned ? static_cast<uint32_t>(base[t] + i) : global[t][i - owned];
+  }
 };
 
 Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned threads) {
@@ -507,10 +512,8 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
     std::vector<char>& buffer = buffers[worker];
     Status s = okStatus();
     if (block.faces) {
-      const uint64_t offset = set.base[block.tile];
-      const std::vector<uint32_t>& to_global = set.global[block.tile];
       s = readFaceRows(t, block.first, block.rows, &out.triangles[3 * (set.face_base[block.tile] + block.first)], buffer,
-                       [&](uint32_t i) { return i < owned ? static_cast<uint32_t>(offset + i) : to_global[i - owned]; });
+                       [&](uint32_t i) { return set.weld(block.tile, i); });
     } else {
       // The rows below `owned` go into the set, the others among the copies.
       uint64_t first = block.first;
@@ -660,13 +663,9 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
         const RowBlock& block = blocks[k - 1];
         const OpenTile& tile = *set.tile[block.tile];
         if (block.faces) {  // the tile's rows, each index through the weld in place
-          const uint64_t owned = tile.parsed.header.owned;
-          const uint64_t offset = set.base[block.tile];
-          const std::vector<uint32_t>& to_global = set.global[block.tile];
           std::vector<uint32_t> corners(3 * block.rows);
-          Status s = readFaceRows(tile, block.first, block.rows, corners.data(), bytes, [&](uint32_t i) {
-            return i < owned ? static_cast<uint32_t>(offset + i) : to_global[i - owned];
-          });
+          Status s = readFaceRows(tile, block.first, block.rows, corners.data(), bytes,
+                                  [&](uint32_t i) { return set.weld(block.tile, i); });
           if (!s) return s;
           for (size_t i = 0; i < block.rows; ++i) std::memcpy(&bytes[i * kFaceBytes + 1], &corners[3 * i], 12);
           return okStatus();
