@@ -114,14 +114,15 @@ int plainSeedEscape(double cx, double cy, double cz, int max_iter, double power)
 
 // The escape shortcut and the cycle detection give the plain loop's counts: on a res-61 grid of
 // the default cube (odd: the origin included), on points near the surface (a finer grid in a
-// corner of the bulb), at the lazy pass's cap and at max_iter, for powers 8 and 3. Both shortcuts
-// are taken on these points, so a wrong margin or a false cycle would show.
+// corner of the bulb), at the lazy pass's cap, at max_iter and at caps of 1 to 4 (where the
+// interior lookahead starts at the first update), for powers 8 and 3. Every shortcut is taken on
+// these points, so a wrong margin, bound or a false cycle would show.
 TEST(Mandelbulb, seedShortcutsGiveThePlainLoopsCounts) {
   const GridAxis coarse{61, -1.5, 1.5}, fine{41, 0.55, 0.75};
   size_t points = 0, mismatches = 0;
   for (const GridAxis& axis : {coarse, fine})
     for (double power : {8.0, 3.0})
-      for (int limit : {26, 100})
+      for (int limit : {1, 2, 3, 4, 26, 100})
         for (int i = 0; i < axis.resolution; ++i)
           for (int j = 0; j < axis.resolution; ++j)
             for (int k = 0; k < axis.resolution; k += 2) {
