@@ -5,7 +5,8 @@
 # `dpoint render --json` (FRAMES frames after WARMUP, the GPU median from timestamps). Rows go to
 # OUT (default bench/results/DATE/lavapipe/ab-DATE.tsv); the last lines give each build's median
 # over the rounds.
-#   bench/scripts/lavapipe_ab.sh OLD_BIN NEW_BIN   (MODES, ROUNDS, FRAMES, BACKENDS to narrow)
+#   bench/scripts/lavapipe_ab.sh OLD_BIN NEW_BIN   (MODES, ROUNDS, FRAMES, BACKENDS to narrow;
+#   POINT_SIZE, 1 by default, for the splat of larger points: round ones, as a 3D set's default)
 set -euo pipefail
 old=$1 new=$2
 data=${DATA:-/tmp/dpoint-lavapipe}
@@ -20,7 +21,7 @@ for round in $(seq "${ROUNDS:-3}"); do
       for build in old new; do
         bin=$old
         [ $build = new ] && bin=$new
-        "$bin" render "$file" --backend "$backend" --mode "$mode" --shade none --point-size 1 --width 1920 \
+        "$bin" render "$file" --backend "$backend" --mode "$mode" --shade none --point-size "${POINT_SIZE:-1}" --width 1920 \
           --height 1080 --frames "${FRAMES:-5}" --warmup "${WARMUP:-1}" -q --json "$data/r.json" -o "$data/r.png" >/dev/null
         python3 -c "import json; d=json.load(open('$data/r.json')); print('$round\t$build\t$mode\t$backend', d['points'], d['gpu_ms']['median'], sep='\t')" | tee -a "$out"
       done

@@ -31,6 +31,12 @@ const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.
 
 layout(std430, set = 0, binding = 3) writeonly buffer Probe { vec4 probe_clip[]; };
 layout(std430, set = 0, binding = 4) buffer Visibility { uint64_t visibility[]; };
+// The same keys as words: a key's depth bits are word 2·pixel + 1. A larger point's early test
+// reads only them, and skips where the pixel's depth is greater (an equal depth does the atomic,
+// which decides by index). lavapipe gathers a load lane by lane through the stack, a 64-bit one
+// into two registers, and these loads are most of its splat of larger points (16.8M points at
+// 3 px, 1920x1080: every mode 3-9% faster; on the H200 8-18%; bench/results/2026-11-28/).
+layout(std430, set = 0, binding = 4) readonly buffer VisibilityWords { uint visibility_words[]; };
 #if defined(MODE_NATIVE_PULL)
 layout(std430, set = 0, binding = 1) readonly buffer Positions { double positions[]; };
 #elif defined(MODE_BATCH)
@@ -121,10 +127,10 @@ void splat(uint i, vec4 clip) {
       for (int px = row_x0; px <= row_x1; ++px) {
         float dx = (float(px) + 0.5 - x) * inv_half, r2 = dx * dx + dy2;
         if (r2 > 1.0) continue;
-        uint64_t pixel_key = (uint64_t(floatBitsToUint(roundDepth(depth, slope, r2))) << 32) | uint64_t(~index);
+        uint pixel_depth = floatBitsToUint(roundDepth(depth, slope, r2));
         uint pixel = uint(py) * pc.width + uint(px);
-        if (kEarlyDepth && visibility[pixel] >= pixel_key) continue;
-        atomicMax(visibility[pixel], pixel_key);
+        if (kEarlyDepth && visibility_words[2u * pixel + 1u] > pixel_depth) continue;
+        atomicMax(visibility[pixel], (uint64_t(pixel_depth) << 32) | uint64_t(~index));
       }
     }
     return;
@@ -132,7 +138,7 @@ void splat(uint i, vec4 clip) {
   for (int py = y0; py <= y1; ++py)
     for (int px = x0; px <= x1; ++px) {
       uint pixel = uint(py) * pc.width + uint(px);
-      if (kEarlyDepth && visibility[pixel] >= key) continue;
+      if (kEarlyDepth && visibility_words[2u * pixel + 1u] > uint(key >> 32)) continue;
       atomicMax(visibility[pixel], key);
     }
 }
