@@ -179,8 +179,10 @@ void splatPair(uint i, vec4 a, vec4 b) {
     key_a = max(key_a, key_b);
     in_b = false;
   }
-  if (in_a && !(kEarlyDepth && visibility[pixel_a] >= key_a)) atomicMax(visibility[pixel_a], key_a);
-  if (in_b && !(kEarlyDepth && visibility[pixel_b] >= key_b)) atomicMax(visibility[pixel_b], key_b);
+  // The depth words, as larger points test (on the H200 batch and adaptive frames 2-3% faster; on
+  // lavapipe, where the pair merge is off, the word test made 1-px frames no faster).
+  if (in_a && !(kEarlyDepth && visibility_words[2u * pixel_a + 1u] > uint(key_a >> 32))) atomicMax(visibility[pixel_a], key_a);
+  if (in_b && !(kEarlyDepth && visibility_words[2u * pixel_b + 1u] > uint(key_b >> 32))) atomicMax(visibility[pixel_b], key_b);
 }
 
 // A workgroup takes kPointsPerThread · 256 consecutive points. Thread t splats t, t + 256, …, in
