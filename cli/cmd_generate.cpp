@@ -101,7 +101,7 @@ Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* 
       GenerateDevice::open(o.device, "mandelbulb", seed ? kSeedCpuOnly : "", o.out.common.quiet);
   if (!device) return device.error();
   if (*device)
-    p.planes = (*device)->planes({EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2},
+    p.planes = (*device)->planes({EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2, kMandelbulbTrapC2},
                                  GridAxis{p.resolution, p.lo, p.hi});
   p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);

@@ -15,14 +15,15 @@ namespace {
 
 constexpr uint32_t kGroupSize = 256;  // local_size_x of both shaders
 
-// Push constants of shaders/generate/escape.comp (std430 offsets: dvec4 at 0, doubles at 32 and 40).
+// Push constants of shaders/generate/escape.comp (std430 offsets: dvec4 at 0, doubles at 32, 40, 48).
 struct EscapePush {
   double c[4];
   double threshold;
   double axis_rho2;
+  double trap_c2;
   uint32_t res, first_row, count, limit;
 };
-static_assert(sizeof(EscapePush) == 64);
+static_assert(sizeof(EscapePush) == 72);
 
 // Push constants of shaders/generate/perturbation.comp (std430: the double at 0, then the uints).
 struct PerturbationPush {
@@ -280,6 +281,7 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
   for (int d = 0; d < 4; ++d) push.c[d] = kernel.c[d];
   push.threshold = kernel.julia_threshold;
   push.axis_rho2 = kernel.axis_rho2;
+  push.trap_c2 = kernel.trap_c2;
   push.res = static_cast<uint32_t>(res);
   push.limit = static_cast<uint32_t>(limit);
   // Rows (plane·res + j) go out in chunks of whole rows; the row index stays below res² ≤ 2^32.

@@ -33,6 +33,7 @@ struct EscapeKernelParams {
   glm::dvec4 c{0.0};             // Julia's constant
   double julia_threshold = 0.0;  // Julia: escaped when x² + (y² + z² + w²) > this
   double axis_rho2 = 0.0;        // Mandelbulb: x² + y² at or below which φ is taken as 0
+  double trap_c2 = 0.0;          // Mandelbulb: |c|² at or below which the count is the limit
 };
 
 inline constexpr uint64_t kGpuChunkPoints = uint64_t{1} << 23;  // 32 MiB of counts per dispatch

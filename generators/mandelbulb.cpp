@@ -53,6 +53,10 @@ inline bool fastStep(double& x, double& y, double& z, double cx, double cy, doub
   return true;
 }
 
+// Whether c lies in the ball whose points never escape (the trap of mandelbulbEscapeSeed, for the
+// fast map: it lands within r^8 + |c| as the seed's does, its rounding as far below the margin).
+inline bool trapped(double cx, double cy, double cz) { return cx * cx + cy * cy + cz * cz <= kMandelbulbTrapC2; }
+
 #if defined(__SSE2__)
 inline void power8(__m128d& re, __m128d& im) {
   const __m128d two = _mm_set1_pd(2.0);
@@ -137,7 +141,7 @@ void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32
     _mm_store_pd(pz, zv);
     for (unsigned lane = 0; lane < 2; ++lane) {
       if (((alive >> lane) & 1u) == 0) continue;
-      if (first_steps == limit) counts[k + lane] = static_cast<uint32_t>(limit);
+      if (first_steps == limit || trapped(x0, y0, zs[k + lane])) counts[k + lane] = static_cast<uint32_t>(limit);
       else survivors.push(px[lane], py[lane], pz[lane], k + lane);
     }
   }
@@ -146,6 +150,7 @@ void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32
     int step = 0;
     while (step < first_steps && fastStep(px, py, pz, x0, y0, zs[k])) ++step;
     if (step < first_steps || first_steps == limit) counts[k] = static_cast<uint32_t>(step);
+    else if (trapped(x0, y0, zs[k])) counts[k] = static_cast<uint32_t>(limit);
     else survivors.push(px, py, pz, k);
   }
 
@@ -201,7 +206,8 @@ void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32
 }
 #else
 void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32_t* counts) {
-  for (size_t k = 0; k < n; ++k) counts[k] = static_cast<uint32_t>(mandelbulbEscapeFast(x0, y0, zs[k], limit));
+  for (size_t k = 0; k < n; ++k)
+    counts[k] = static_cast<uint32_t>(trapped(x0, y0, zs[k]) ? limit : mandelbulbEscapeFast(x0, y0, zs[k], limit));
 }
 #endif
 
@@ -224,9 +230,11 @@ void fastRow(double x0, double y0, const double* zs, size_t n, int limit, uint32
 // - Whatever the tests to come, a point inside a trap stays there. The bound map b → b^n + |c|
 //   (+ the margin) is increasing, so a radius t that it takes to one no larger is a trap: from
 //   r ≤ t every later radius is at most t < 2. b^n − b is least at t = (1/n)^(1/(n−1)) (for
-//   n = 8, 0.743, where it is −0.650), which is so a trap for every |c| under 0.650: the ball of
-//   that radius lies in the bulb, and its points (on a res-140 grid of the default cube, 47% of
-//   the interior points and 41% of all the trigonometry) take none.
+//   n = 8, 0.743, where it is −0.650), which is so a trap for every |c| under 0.650; the orbit
+//   starts at r = |c| < t, so such a point never escapes: the ball of that radius lies in the
+//   bulb, and its points (on a res-140 grid of the default cube, 47% of the interior points and
+//   41% of all the trigonometry) take none. (Where t is no trap, no radius is: b − b^n is
+//   largest at t.)
 int mandelbulbEscapeSeed(double cx, double cy, double cz, int max_iter, double power) {
   constexpr double kMargin = 1e-9;
   constexpr int kInteriorLookahead = 3;
@@ -240,11 +248,10 @@ int mandelbulbEscapeSeed(double cx, double cy, double cz, int max_iter, double p
     const double r4 = r2 * r2;
     return r4 * r4;
   };
-  // The trap radius for this c, or −1 where there is none. t needs no precision: the test below
-  // is what makes it a trap.
+  // The trap radius. It needs no precision: the test below is what makes it a trap.
   thread_local double t_power = 8.0, t_radius = 0.7429971445684742;  // 8^(−1/7)
   if (power != t_power) t_power = power, t_radius = std::pow(1.0 / power, 1.0 / (power - 1.0));
-  const double trap = t_radius <= 2.0 && power_of(t_radius) + c_norm + 2.0 * kMargin <= t_radius ? t_radius : -1.0;
+  if (power_of(t_radius) + c_norm + 2.0 * kMargin <= t_radius) return max_iter;
   // True when radius bound `bound` after the next update keeps all `tests` tests to come under 2.
   const auto stays_inside = [&](double bound, int tests) {
     for (int t = 0;; ++t) {
@@ -262,7 +269,6 @@ int mandelbulbEscapeSeed(double cx, double cy, double cz, int max_iter, double p
   for (int i = 0; i < max_iter; ++i) {
     const double r = std::sqrt(x * x + y * y + z * z);
     if (r > 2.0) return i;
-    if (r <= trap) return max_iter;
     const int tests_left = max_iter - 1 - i;  // the tests the updates from here on meet
     if (tests_left == 0) return max_iter;
     if (r == 0.0) {  // r^n · anything = 0: the next point is c (the seed divided 0/0 here)

@@ -35,6 +35,10 @@ enum class MandelbulbVariant { kSeed, kFast };
 
 // The fast variant's polar axis: at x² + y² ≤ this, φ is taken as 0 (see mandelbulb.cpp).
 constexpr double kMandelbulbAxisRho2 = 1e-60;
+// |c|² at or below which a point of the power-8 Mandelbulb never escapes (mandelbulb.cpp's trap:
+// the ball of radius t − t^8 = 0.6501…, t = 8^(−1/7), lies in the set); 0.42 leaves 0.0026 of
+// |c| for the rounding of either variant, far more than it needs.
+constexpr double kMandelbulbTrapC2 = 0.42;
 
 struct MandelbulbParams {
   int resolution = 200;          // grid points per axis, 2..65536

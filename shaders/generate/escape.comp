@@ -21,6 +21,7 @@ layout(push_constant) uniform Push {
   dvec4 c;            // Julia's constant
   double threshold;   // Julia: sqrt(s) > 2 exactly when s > threshold (the CPU passes 4 + 2^-50)
   double axis_rho2;   // Mandelbulb: x² + y² at or below which φ = 0 (1e-60, as the CPU)
+  double trap_c2;     // Mandelbulb: |c|² at or below which the point never escapes (the CPU's 0.42)
   uint res;           // points per axis
   uint first_row;     // rows (plane·res + j) before this dispatch's first point
   uint count;         // points in this dispatch: whole rows, k fastest
@@ -57,6 +58,9 @@ void power8(inout double re, inout double im) {
 }
 
 uint mandelbulbCount(double cx, double cy, double cz) {
+  // Inside the ball that traps every orbit (generators/mandelbulb.cpp): no iteration to run.
+  precise double c2 = cx * cx + cy * cy + cz * cz;
+  if (c2 <= trap_c2) return limit;
   precise double x = cx, y = cy, z = cz;
   for (uint i = 0; i < limit; ++i) {
     precise double rho2 = x * x + y * y;

@@ -58,7 +58,7 @@ class GpuGenerate : public ::testing::Test {
     return {EscapeKernel::kJulia, c, kJuliaEscapeSquare, 0.0};
   }
   static EscapeKernelParams mandelbulb() {
-    return {EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2};
+    return {EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2, kMandelbulbTrapC2};
   }
 
   // The device's planes [first, first + count) against computeEscapeGrid's.

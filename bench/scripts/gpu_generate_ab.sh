@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# An A/B of one generate on the GPU machine (device tool; carry .gl and .gpu as for
+# gpu_generate.sh: .gpu/dpoint-A the build before, .gpu/dpoint the current one). First the
+# current build's device counts against its CPU path at res 63, 64 and 257 ($OUT/equal.txt). For ROUNDS
+# (3) rounds, each build of BUILDS ("A current") in turn: `generate CASE --device 0` (CASE default
+# "mandelbulb --variant fast --resolution 2048"), then dd of a file of its size into the same
+# folder. One line per run in $OUT/generate_ab.tsv: round, build, wall s, the classification's GPU
+# ms (the device line), SHA-256 (16) of the output; the medians in $OUT/generate_ab-median.tsv.
+set -euo pipefail
+source bench/scripts/gpu_env.sh
+data=${DATA:-/tmp/dpoint-generate-ab}
+mkdir -p "$data"
+case=${CASE:-mandelbulb --variant fast --resolution 2048}
+# The current build's device counts against its CPU path (grid and file) at small odd and even
+# resolutions of CASE's kind.
+kind=${case%--resolution*}
+for res in 63 64 257; do
+  # shellcheck disable=SC2086
+  .gpu/dpoint generate $kind --resolution $res -q --device none --grid-out "$data/cpu.grid" -o "$data/cpu.ply"
+  # shellcheck disable=SC2086
+  .gpu/dpoint generate $kind --resolution $res -q --device 0 --grid-out "$data/gpu.grid" -o "$data/gpu.ply"
+  echo "$kind--resolution $res: grid $(cmp -s "$data/cpu.grid" "$data/gpu.grid" && echo equal || echo DIFFER)," \
+    "file $(cmp -s "$data/cpu.ply" "$data/gpu.ply" && echo equal || echo DIFFER)"
+done | tee "$out/equal.txt"
+rows=$out/generate_ab.tsv
+printf 'round\tbuild\twall_s\tgpu_ms\tsha256\n' >"$rows"
+for round in $(seq "${ROUNDS:-3}"); do
+  for build in ${BUILDS:-A current}; do
+    bin=.gpu/dpoint-$build
+    [ "$build" = current ] && bin=.gpu/dpoint
+    # shellcheck disable=SC2086
+    /usr/bin/time -f "%e" -o "$data/time.txt" "$bin" generate $case --device 0 -o "$data/out.ply" 2>"$data/stderr.txt"
+    gpu=$(sed -n 's/.* in \([0-9.]*\) ms of GPU time.*/\1/p' "$data/stderr.txt" | head -1)
+    printf '%s\t%s\t%s\t%s\t%s\n' "$round" "$build" "$(cat "$data/time.txt")" "${gpu:--}" \
+      "$(sha256sum <"$data/out.ply" | cut -c1-16)" | tee -a "$rows"
+    size=$(stat -c %s "$data/out.ply")
+    rm -f "$data/out.ply"
+    sync
+  done
+  s=$(date +%s%N)
+  dd if=/dev/zero of="$data/dd.bin" bs=1M count=$(( (size + 1048575) / 1048576 )) status=none
+  e=$(date +%s%N)
+  printf '%s\tdd\t%s\t-\t-\n' "$round" "$(awk -v n=$(( e - s )) 'BEGIN { printf "%.2f", n / 1e9 }')" | tee -a "$rows"
+  rm -f "$data/dd.bin"
+done
+/usr/bin/python3 - "$rows" <<'PY' | tee "$out/generate_ab-median.tsv"
+import csv, statistics, sys
+rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
+for b in dict.fromkeys(r["build"] for r in rows):
+    w = [float(r["wall_s"]) for r in rows if r["build"] == b]
+    g = [float(r["gpu_ms"]) for r in rows if r["build"] == b and r["gpu_ms"] not in ("-", "")]
+    print(f"{b}\twall {statistics.median(w):.2f} s\tgpu {statistics.median(g):.1f} ms" if g else f"{b}\twall {statistics.median(w):.2f} s")
+PY
