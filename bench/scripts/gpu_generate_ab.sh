@@ -5,7 +5,8 @@
 # (3) rounds, each build of BUILDS ("A current") in turn: `generate CASE --device 0` (CASE default
 # "mandelbulb --variant fast --resolution 2048"), then dd of a file of its size into the same
 # folder. One line per run in $OUT/generate_ab.tsv: round, build, wall s, the classification's GPU
-# ms (the device line), SHA-256 (16) of the output; the medians in $OUT/generate_ab-median.tsv.
+# ms (the device line), SHA-256 (16) of the output, and the phases generate prints (generate,
+# colours and offset, write, s); the medians in $OUT/generate_ab-median.tsv.
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 data=${DATA:-/tmp/dpoint-generate-ab}
@@ -23,7 +24,7 @@ for res in 63 64 257; do
     "file $(cmp -s "$data/cpu.ply" "$data/gpu.ply" && echo equal || echo DIFFER)"
 done | tee "$out/equal.txt"
 rows=$out/generate_ab.tsv
-printf 'round\tbuild\twall_s\tgpu_ms\tsha256\n' >"$rows"
+printf 'round\tbuild\twall_s\tgpu_ms\tsha256\tgenerate_s\tcolours_s\twrite_s\n' >"$rows"
 for round in $(seq "${ROUNDS:-3}"); do
   for build in ${BUILDS:-A current}; do
     bin=.gpu/dpoint-$build
@@ -31,8 +32,10 @@ for round in $(seq "${ROUNDS:-3}"); do
     # shellcheck disable=SC2086
     /usr/bin/time -f "%e" -o "$data/time.txt" "$bin" generate $case --device 0 -o "$data/out.ply" 2>"$data/stderr.txt"
     gpu=$(sed -n 's/.* in \([0-9.]*\) ms of GPU time.*/\1/p' "$data/stderr.txt" | head -1)
-    printf '%s\t%s\t%s\t%s\t%s\n' "$round" "$build" "$(cat "$data/time.txt")" "${gpu:--}" \
-      "$(sha256sum <"$data/out.ply" | cut -c1-16)" | tee -a "$rows"
+    phases=$(sed -n 's/^time (s): generate \([0-9.]*\), colours and offset \([0-9.]*\), .*write \([0-9.]*\);.*/\1\t\2\t\3/p' \
+      "$data/stderr.txt" | head -1)
+    printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$round" "$build" "$(cat "$data/time.txt")" "${gpu:--}" \
+      "$(sha256sum <"$data/out.ply" | cut -c1-16)" "${phases:--}" | tee -a "$rows"
     size=$(stat -c %s "$data/out.ply")
     rm -f "$data/out.ply"
     sync
@@ -40,7 +43,7 @@ for round in $(seq "${ROUNDS:-3}"); do
   s=$(date +%s%N)
   dd if=/dev/zero of="$data/dd.bin" bs=1M count=$(( (size + 1048575) / 1048576 )) status=none
   e=$(date +%s%N)
-  printf '%s\tdd\t%s\t-\t-\n' "$round" "$(awk -v n=$(( e - s )) 'BEGIN { printf "%.2f", n / 1e9 }')" | tee -a "$rows"
+  printf '%s\tdd\t%s\t-\t-\t-\t-\t-\n' "$round" "$(awk -v n=$(( e - s )) 'BEGIN { printf "%.2f", n / 1e9 }')" | tee -a "$rows"
   rm -f "$data/dd.bin"
 done
 /usr/bin/python3 - "$rows" <<'PY' | tee "$out/generate_ab-median.tsv"
@@ -49,5 +52,12 @@ rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
 for b in dict.fromkeys(r["build"] for r in rows):
     w = [float(r["wall_s"]) for r in rows if r["build"] == b]
     g = [float(r["gpu_ms"]) for r in rows if r["build"] == b and r["gpu_ms"] not in ("-", "")]
-    print(f"{b}\twall {statistics.median(w):.2f} s\tgpu {statistics.median(g):.1f} ms" if g else f"{b}\twall {statistics.median(w):.2f} s")
+    line = f"{b}\twall {statistics.median(w):.2f} s"
+    if g:
+        line += f"\tgpu {statistics.median(g):.1f} ms"
+    for phase in ("generate_s", "colours_s", "write_s"):
+        v = [float(r[phase]) for r in rows if r["build"] == b and r.get(phase) not in (None, "-", "")]
+        if v:
+            line += f"\t{phase[:-2]} {statistics.median(v):.2f} s"
+    print(line)
 PY

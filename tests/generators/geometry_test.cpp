@@ -74,6 +74,12 @@ TEST(Perlin, pnoise3IsZeroAtLatticePointsAndRepeatsEvery1024) {
   EXPECT_EQ(pnoise3(0.5f, 0.25f, 0.75f), pnoise3(1024.5f, 0.25f, 0.75f));
   EXPECT_EQ(pnoise3(-0.5f, 0.25f, 0.75f), pnoise3(1023.5f, 0.25f, 0.75f));
   EXPECT_EQ(pnoise3(0.5f, 0.25f, 0.75f), pnoise3(0.5f, 0.25f, -1023.25f));
+  // Either side of ±1024, where the cell stops being v's floor and comes from fmod.
+  EXPECT_EQ(pnoise3(0.25f, 0.25f, 0.75f), pnoise3(-1023.75f, 0.25f, 0.75f));
+  EXPECT_EQ(pnoise3(0.0f, 0.25f, 0.75f), pnoise3(1024.0f, 0.25f, 0.75f));
+  EXPECT_EQ(pnoise3(0.0f, 0.25f, 0.75f), pnoise3(-1024.0f, 0.25f, 0.75f));
+  EXPECT_EQ(pnoise3(0.25f, 0.5f, 0.75f), pnoise3(0.25f, 2048.5f, 0.75f));
+  EXPECT_EQ(pnoise3(0.25f, 0.5f, 0.75f), pnoise3(0.25f, -3071.5f, 0.75f));
   EXPECT_NE(pnoise3(0.5f, 0.25f, 0.75f), 0.0f);
 }
 
