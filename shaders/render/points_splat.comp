@@ -31,11 +31,13 @@ const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.
 
 layout(std430, set = 0, binding = 3) writeonly buffer Probe { vec4 probe_clip[]; };
 layout(std430, set = 0, binding = 4) buffer Visibility { uint64_t visibility[]; };
-// The same keys as words: a key's depth bits are word 2·pixel + 1. A larger point's early test
-// reads only them, and skips where the pixel's depth is greater (an equal depth does the atomic,
-// which decides by index). lavapipe gathers a load lane by lane through the stack, a 64-bit one
-// into two registers, and these loads are most of its splat of larger points (16.8M points at
-// 3 px, 1920x1080: every mode 3-9% faster; on the H200 8-18%; bench/results/2026-11-28/).
+// The same keys as words: a key's depth bits are word 2·pixel + 1 (a 64-bit value is stored
+// little-endian, as on every device the renderer meets: lavapipe on x86, NVIDIA). A larger
+// point's early test reads only them, and skips where the pixel's depth is greater (an equal
+// depth does the atomic, which decides by index); so does the pair merge. lavapipe gathers a
+// load lane by lane through the stack, a 64-bit one into two registers, and these loads are most
+// of its splat of larger points (16.8M points at 3 px, 1920x1080: every mode 3-9% faster; on the
+// H200 8-18%; bench/results/2026-11-28/).
 layout(std430, set = 0, binding = 4) readonly buffer VisibilityWords { uint visibility_words[]; };
 #if defined(MODE_NATIVE_PULL)
 layout(std430, set = 0, binding = 1) readonly buffer Positions { double positions[]; };
