@@ -215,18 +215,27 @@ class SlabField {
     std::vector<uint32_t>& c = counts_[p & 1];
     std::vector<uint8_t>& a = above_[p & 1];
     const size_t n = static_cast<size_t>(res_);
-    if (block_) {
-      std::copy_n(block_ + static_cast<size_t>(p - first_) * c.size(), c.size(), c.begin());
+    if (block_ && !refine_) {  // the block's counts are final: read in place (a 16 MiB copy a plane at res 2048)
+      plane_[p & 1] = block_ + static_cast<size_t>(p - first_) * c.size();
     } else {
-      const double x = values_[static_cast<size_t>(p)];
-      for (size_t j = 0; j < n; ++j) row_(x, values_[j], values_.data(), n, cap_, &c[j * n]);
+      if (block_) {
+        std::copy_n(block_ + static_cast<size_t>(p - first_) * c.size(), c.size(), c.begin());
+      } else {
+        const double x = values_[static_cast<size_t>(p)];
+        for (size_t j = 0; j < n; ++j) row_(x, values_[j], values_.data(), n, cap_, &c[j * n]);
+      }
+      plane_[p & 1] = c.data();
     }
-    for (size_t i = 0; i < c.size(); ++i) a[i] = static_cast<double>(c[i]) > p_.level;
+    // count > level is count > floor(level) for an integer count: a compare of integers, which the
+    // compiler does several at a time (the conversion to double it did one by one).
+    const uint32_t above_at = p_.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(p_.level));
+    const uint32_t* counts = plane_[p & 1];
+    for (size_t i = 0; i < c.size(); ++i) a[i] = counts[i] > above_at;
     std::copy(a.begin(), a.end(), above);
     if (refine_) finishCrossings(p);
     if (p - first_ < grid_planes_) {
       const size_t plane_bytes = c.size() * static_cast<size_t>(grid_bytes_);
-      encodePlane(c.data(), c.size(), grid_bytes_, &grid_[static_cast<size_t>(p - first_) * plane_bytes]);
+      encodePlane(counts, c.size(), grid_bytes_, &grid_[static_cast<size_t>(p - first_) * plane_bytes]);
     }
   }
 
@@ -306,8 +315,10 @@ class SlabField {
   // already exact; at the cap the point is above the level and finishCrossings has finished it.
   // Finishing here too keeps the mesh right should that selection ever miss a point.
   double count(const glm::ivec3& q) {
-    uint32_t& c = counts_[q.x & 1][static_cast<size_t>(q.y) * static_cast<size_t>(res_) + static_cast<size_t>(q.z)];
-    if ((c & kExactBit) == 0 && refine_ && c >= static_cast<uint32_t>(cap_)) {
+    const size_t pt = static_cast<size_t>(q.y) * static_cast<size_t>(res_) + static_cast<size_t>(q.z);
+    if (!refine_) return static_cast<double>(plane_[q.x & 1][pt] & ~kExactBit);
+    uint32_t& c = counts_[q.x & 1][pt];
+    if ((c & kExactBit) == 0 && c >= static_cast<uint32_t>(cap_)) {
       assert(false && "finishCrossings missed a point");
       uint32_t full = 0;
       row_(values_[static_cast<size_t>(q.x)], values_[static_cast<size_t>(q.y)], &values_[static_cast<size_t>(q.z)], 1,
@@ -326,6 +337,8 @@ class SlabField {
   int cap_ = 0;
   const uint32_t* block_ = nullptr;
   bool refine_ = false;
+  // The counts of the planes in flight, by p & 1: in block_ when it holds them final, else counts_.
+  const uint32_t* plane_[2] = {nullptr, nullptr};
   // The planes in flight and the row buffers, kept by the thread from slab to slab (fresh ones
   // cost a page fault per 4 KiB: at res 2048 that was most of the meshing's time). load() writes
   // a plane's counts and flags whole, and finishCrossings every need_ entry, before any is read.
