@@ -171,12 +171,9 @@ Result<Layout> planLayout(const PointSet& points) {
   if (points.triangles.size() % 3 != 0)
     return Error{"cannot write GLB: " + std::to_string(points.triangles.size()) +
                  " triangle indices is not a multiple of 3"};
-  for (size_t i = 0; i < points.triangles.size(); ++i) {
-    if (points.triangles[i] >= n)
-      return Error{"cannot write GLB: triangle index " + std::to_string(i) + " is " +
-                   std::to_string(points.triangles[i]) + ", but there are only " +
-                   std::to_string(n) + " points"};
-  }
+  if (const size_t i = points.firstBadTriangleIndex(); i < points.triangles.size())
+    return Error{"cannot write GLB: triangle index " + std::to_string(i) + " is " +
+                 std::to_string(points.triangles[i]) + ", but there are only " + std::to_string(n) + " points"};
 
   Layout layout;
   glm::dvec3 lo = points.positions[0], hi = points.positions[0];

@@ -8,7 +8,6 @@
 
 #include "core/atomic_file.h"
 #include "core/ordered_write.h"
-#include "core/parallel.h"
 #include "core/text.h"
 #include "converters/ply.h"
 
@@ -121,24 +120,10 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
                  std::to_string(n) + " points"};
   if (points.triangles.size() % 3 != 0)
     return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
-  {
-    // Every index below n, checked before anything is written (on all cores: a big mesh has
-    // hundreds of millions); the first bad one is named.
-    constexpr size_t kIndicesPerItem = size_t{1} << 20;
-    const std::vector<uint32_t>& t = points.triangles;
-    std::vector<size_t> bad((t.size() + kIndicesPerItem - 1) / kIndicesPerItem, t.size());
-    parallelFor(bad.size(), options.threads, [&](size_t item, unsigned) {
-      for (size_t i = item * kIndicesPerItem, end = std::min(t.size(), i + kIndicesPerItem); i < end; ++i)
-        if (t[i] >= n) {
-          bad[item] = i;
-          return;
-        }
-    });
-    for (size_t i : bad)
-      if (i < t.size())
-        return Error{"cannot write '" + path + "': triangle index " + std::to_string(t[i]) + " out of range (" +
-                     std::to_string(n) + " points)"};
-  }
+  // Every index below n, checked before anything is written; the first bad one is named.
+  if (const size_t bad = points.firstBadTriangleIndex(options.threads); bad < points.triangles.size())
+    return Error{"cannot write '" + path + "': triangle index " + std::to_string(points.triangles[bad]) +
+                 " out of range (" + std::to_string(n) + " points)"};
   auto file = AtomicFile::create(path);
   if (!file.ok()) return file.error();
   const bool ascii = options.encoding == PlyEncoding::kAscii;

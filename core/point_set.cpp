@@ -27,6 +27,22 @@ bool PointSet::isPlanar() const {
   return planar.load();
 }
 
+size_t PointSet::firstBadTriangleIndex(unsigned threads) const {
+  constexpr size_t kIndicesPerItem = size_t{1} << 20;
+  const size_t n = positions.size();
+  std::vector<size_t> bad((triangles.size() + kIndicesPerItem - 1) / kIndicesPerItem, triangles.size());
+  parallelFor(bad.size(), threads, [&](size_t item, unsigned) {
+    for (size_t i = item * kIndicesPerItem, end = std::min(triangles.size(), i + kIndicesPerItem); i < end; ++i)
+      if (triangles[i] >= n) {
+        bad[item] = i;
+        return;
+      }
+  });
+  for (size_t i : bad)
+    if (i < triangles.size()) return i;
+  return triangles.size();
+}
+
 namespace {
 
 Box serialBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {

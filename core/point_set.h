@@ -64,6 +64,9 @@ struct PointSet {
   // Whether writers write z: as z_axis says, or (kUnknown) when not isPlanar(). A LAS file whose
   // z are all 0 still has z; a 2-column CSV has none.
   bool hasZ() const { return z_axis == ZAxis::kUnknown ? !isPlanar() : z_axis == ZAxis::kPresent; }
+  // The position in `triangles` of the first index that names no point, or triangles.size() when
+  // every one does; checked on `threads` cores (0: all), as a big mesh has hundreds of millions.
+  size_t firstBadTriangleIndex(unsigned threads = 0) const;
 };
 
 // A colour channel as an integer of `full` (255, 65535): round(clamp(c, 0, 1) · full), NaN as 0.
