@@ -1,7 +1,6 @@
 // Memory limits for large outputs: estimate before allocating, refuse with a clear message.
 #pragma once
 
-#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -51,12 +50,14 @@ class LargeBuffer {
   size_t size_ = 0, mapped_ = 0;  // mapped_: the mapping's length, 0 for the heap
 };
 
-// Resizes an empty `v` to n zeroed elements, its pages faulted in on all cores first.
+// Resizes `v` to n elements, the new ones zeroed; when it is empty, its pages are faulted in on
+// all cores first (a vector that holds elements keeps them, and is resized as it is).
 template <typename T>
 void resizePrefaulted(std::vector<T>& v, size_t n, unsigned threads) {
-  assert(v.empty());
-  v.reserve(n);
-  prefaultForWrite(v.data(), n * sizeof(T), threads);
+  if (v.empty()) {
+    v.reserve(n);
+    prefaultForWrite(v.data(), n * sizeof(T), threads);
+  }
   v.resize(n);
 }
 

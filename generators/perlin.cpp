@@ -96,10 +96,7 @@ glm::vec3 seedColor(const glm::dvec3& p) {
 
 void colorByNoise(PointSet& points, unsigned threads) {
   constexpr size_t kPointsPerChunk = size_t{1} << 14;
-  if (points.colors.empty())
-    resizePrefaulted(points.colors, points.positions.size(), threads);
-  else
-    points.colors.resize(points.positions.size());
+  resizePrefaulted(points.colors, points.positions.size(), threads);
   const size_t chunks = (points.positions.size() + kPointsPerChunk - 1) / kPointsPerChunk;
   parallelFor(chunks, threads, [&](size_t chunk, unsigned) {
     const size_t end = std::min(points.positions.size(), (chunk + 1) * kPointsPerChunk);
