@@ -93,7 +93,7 @@ Status GenerateDevice::checkValidation() const {
 EscapePlaneFunction GenerateDevice::planes(const EscapeKernelParams& kernel, const GridAxis& axis) {
   // The axis values are made at the first call, once the generator has checked the resolution.
   auto values = std::make_shared<std::vector<double>>();
-  return [self = shared_from_this(), kernel, axis, values](int first, int count, int limit, uint32_t* counts) -> Status {
+  return [self = shared_from_this(), kernel, axis, values](int first, int count, int limit, uint8_t* counts) -> Status {
     if (values->empty())
       for (int i = 0; i < axis.resolution; ++i) values->push_back(axis.value(i));
     if (Status s = self->gpu_->escapePlanes(kernel, *values, first, count, limit, counts); !s) return s;

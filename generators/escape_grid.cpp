@@ -6,11 +6,14 @@
 #include <charconv>
 #include <cmath>
 #include <condition_variable>
+#include <cstring>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <thread>
 
 #include "core/atomic_file.h"
+#include "core/bytes.h"
 #include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -53,12 +56,13 @@ SlabPlan planSlabs(int layers, unsigned threads, int max_thickness) {
 }
 
 // With a plane function (a GPU), a slab's planes are computed as one block and held until the slab
-// is meshed; a block of about 128 MiB keeps the few in flight small and the dispatches large. Each
-// block recomputes the plane it shares with the next: at res 2048 (16 MiB a plane) 8-plane blocks
-// repeat 1 plane in 8, where 32 MiB blocks (4 layers, the least) repeated 1 in 5.
-constexpr uint64_t kGpuBlockBytes = uint64_t{128} << 20;
+// is meshed; a block of about 32 Mi counts (32 MiB at the usual one byte a count) keeps the few in
+// flight small and the dispatches large. Each block recomputes the plane it shares with the next:
+// at res 2048 (4 Mi counts a plane) 8-plane blocks repeat 1 plane in 8, where blocks of 4 layers
+// (the least) repeated 1 in 5.
+constexpr uint64_t kGpuBlockCounts = uint64_t{32} << 20;
 int gpuSlabThickness(int res) {
-  const uint64_t planes = kGpuBlockBytes / (sizeof(uint32_t) * squared(res));
+  const uint64_t planes = kGpuBlockCounts / squared(res);
   return static_cast<int>(std::clamp<uint64_t>(planes, 5, kMaxSlabThickness + 1)) - 1;
 }
 
@@ -79,7 +83,8 @@ uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share) {
                   static_cast<uint64_t>(escapeGridBytesPerCount(params.max_iter));
   uint64_t blocks = 0;  // the plane function's blocks in flight, threads + 2 of them
   if (params.planes)
-    blocks = (threads + 2) * static_cast<uint64_t>(plan.thickness + 1) * squared(res) * sizeof(uint32_t);
+    blocks = (threads + 2) * static_cast<uint64_t>(plan.thickness + 1) * squared(res) *
+             static_cast<uint64_t>(escapeGridBytesPerCount(classificationLimit(params)));
   const double mesh = share * estimatedVertices(res) * static_cast<double>(kMeshBytesPerVertex);
   return threads * per_worker + blocks + static_cast<uint64_t>(std::min(mesh, 1e19));
 }
@@ -90,16 +95,16 @@ uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share) {
 // (parallelFor), so the block a worker waits for is always among the next ones computed.
 class PlaneBlocks {
  public:
-  PlaneBlocks(const EscapePlaneFunction& planes, std::vector<std::pair<int, int>> slabs, int limit, uint64_t plane_size,
+  PlaneBlocks(const EscapePlaneFunction& planes, std::vector<std::pair<int, int>> slabs, int limit, uint64_t plane_bytes,
               size_t ahead)
-      : planes_(planes), slabs_(std::move(slabs)), limit_(limit), plane_size_(plane_size), ahead_(ahead),
+      : planes_(planes), slabs_(std::move(slabs)), limit_(limit), plane_bytes_(plane_bytes), ahead_(ahead),
         blocks_(slabs_.size()), ready_(slabs_.size(), false) {
     thread_ = std::thread([this] { produce(); });
   }
   ~PlaneBlocks() { stop(); }
 
   // The counts of slab s's planes; nullptr when the plane function failed (see error()).
-  const uint32_t* wait(size_t s) {
+  const uint8_t* wait(size_t s) {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [&] { return ready_[s] || error_.has_value(); });
     return ready_[s] ? blocks_[s].data() : nullptr;
@@ -133,7 +138,7 @@ class PlaneBlocks {
         if (stopping_) return;
       }
       const auto [first, planes] = slabs_[s];
-      std::vector<uint32_t> block;
+      std::vector<uint8_t> block;
       {
         // At most `ahead` blocks ever exist: taken from the spares once there are some. (Freeing
         // and allocating 32 MiB blocks on different threads grew the heap to several times that.)
@@ -143,7 +148,7 @@ class PlaneBlocks {
           spare_.pop_back();
         }
       }
-      block.resize(static_cast<size_t>(planes) * plane_size_);
+      block.resize(static_cast<size_t>(planes) * plane_bytes_);
       Status status = planes_(first, planes, limit_, block.data());
       std::lock_guard<std::mutex> lock(mutex_);
       if (!status) {
@@ -161,12 +166,12 @@ class PlaneBlocks {
   const EscapePlaneFunction& planes_;
   const std::vector<std::pair<int, int>> slabs_;
   const int limit_;
-  const uint64_t plane_size_;
+  const uint64_t plane_bytes_;
   const size_t ahead_;
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::vector<std::vector<uint32_t>> blocks_;
-  std::vector<std::vector<uint32_t>> spare_;  // released blocks, for reuse
+  std::vector<std::vector<uint8_t>> blocks_;
+  std::vector<std::vector<uint8_t>> spare_;  // released blocks, for reuse
   std::vector<bool> ready_;
   size_t produced_ = 0, released_ = 0;
   bool stopping_ = false;
@@ -174,9 +179,38 @@ class PlaneBlocks {
   std::thread thread_;
 };
 
-void encodePlane(const uint32_t* counts, size_t n, int bytes, uint8_t* out) {
+// Count i of counts stored `bytes` each: 1 or 2 (a plane function's, escapeGridBytesPerCount), or
+// 4 (the row function's uint32, whose high bit may be kExactBit).
+uint32_t countAt(const uint8_t* counts, int bytes, size_t i) {
+  switch (bytes) {
+    case 1:
+      return counts[i];
+    case 2:
+      return loadUnaligned<uint16_t>(counts + 2 * i);
+    default:
+      return loadUnaligned<uint32_t>(counts + 4 * i) & ~kExactBit;
+  }
+}
+
+// above[i] = count i > above_at, for counts of type T, compared in T (16 at a time for bytes).
+template <typename T>
+void classify(const uint8_t* counts, size_t n, uint32_t above_at, uint8_t* above) {
+  if (above_at >= std::numeric_limits<T>::max()) {  // no count of type T is above
+    std::fill_n(above, n, uint8_t{0});
+    return;
+  }
+  const T at = static_cast<T>(above_at);
+  for (size_t i = 0; i < n; ++i) above[i] = loadUnaligned<T>(counts + i * sizeof(T)) > at;
+}
+
+// n counts stored `count_bytes` each (countAt) in the grid file's `bytes` (1 or 2) each.
+void encodePlane(const uint8_t* counts, int count_bytes, size_t n, int bytes, uint8_t* out) {
+  if (count_bytes == bytes) {  // a plane function's counts are the file's encoding already
+    std::memcpy(out, counts, n * static_cast<size_t>(bytes));
+    return;
+  }
   for (size_t i = 0; i < n; ++i) {
-    const uint32_t c = counts[i] & ~kExactBit;
+    const uint32_t c = countAt(counts, count_bytes, i);
     if (bytes == 1) {
       out[i] = static_cast<uint8_t>(c);
     } else {
@@ -190,18 +224,21 @@ void encodePlane(const uint32_t* counts, size_t n, int bytes, uint8_t* out) {
 class SlabField {
  public:
   // meshes_last: the slab makes vertices on plane `last`'s in-plane edges (owns them, or copies
-  // them for a seam). block: the classification counts of planes first..last (at `cap`), computed
-  // elsewhere; nullptr: computed here by the row function.
+  // them for a seam). block: the classification counts of planes first..last (at `cap`, in
+  // escapeGridBytesPerCount(cap) bytes each), computed elsewhere; nullptr: computed here by the row
+  // function.
   SlabField(const EscapeSurfaceParams& params, const std::vector<double>& values, const EscapeRowFunction& row,
-            int first, int last, bool meshes_last, int grid_planes, int grid_bytes, int cap, const uint32_t* block)
+            int first, int last, bool meshes_last, int grid_planes, int grid_bytes, int cap, const uint8_t* block)
       : p_(params), values_(values), row_(row), res_(params.axis.resolution), first_(first), last_(last),
-        owns_last_(meshes_last), grid_planes_(grid_planes), grid_bytes_(grid_bytes), cap_(cap), block_(block) {
+        owns_last_(meshes_last), grid_planes_(grid_planes), grid_bytes_(grid_bytes), cap_(cap), block_(block),
+        block_bytes_(escapeGridBytesPerCount(cap)) {
     const size_t plane = squared(res_);
     for (int s = 0; s < 2; ++s) {
       counts_[s].resize(plane);
       above_[s].resize(plane);
     }
     refine_ = cap_ < p_.max_iter;
+    plane_bytes_ = block_ && !refine_ ? block_bytes_ : static_cast<int>(sizeof(uint32_t));
     if (refine_) {
       need_.resize(plane);
       row_z_.resize(static_cast<size_t>(res_));
@@ -215,27 +252,38 @@ class SlabField {
     std::vector<uint32_t>& c = counts_[p & 1];
     std::vector<uint8_t>& a = above_[p & 1];
     const size_t n = static_cast<size_t>(res_);
-    if (block_ && !refine_) {  // the block's counts are final: read in place (a 16 MiB copy a plane at res 2048)
-      plane_[p & 1] = block_ + static_cast<size_t>(p - first_) * c.size();
+    const size_t points = c.size();
+    const uint8_t* block = block_ ? block_ + static_cast<size_t>(p - first_) * points * block_bytes_ : nullptr;
+    if (block && !refine_) {  // the block's counts are final: read in place (a 4 MiB copy a plane at res 2048)
+      plane_[p & 1] = block;
     } else {
-      if (block_) {
-        std::copy_n(block_ + static_cast<size_t>(p - first_) * c.size(), c.size(), c.begin());
+      if (block) {
+        for (size_t i = 0; i < points; ++i) c[i] = countAt(block, block_bytes_, i);
       } else {
         const double x = values_[static_cast<size_t>(p)];
         for (size_t j = 0; j < n; ++j) row_(x, values_[j], values_.data(), n, cap_, &c[j * n]);
       }
-      plane_[p & 1] = c.data();
+      plane_[p & 1] = reinterpret_cast<const uint8_t*>(c.data());
     }
     // count > level is count > floor(level) for an integer count: a compare of integers, which the
     // compiler does several at a time (the conversion to double it did one by one).
     const uint32_t above_at = p_.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(p_.level));
-    const uint32_t* counts = plane_[p & 1];
-    for (size_t i = 0; i < c.size(); ++i) a[i] = counts[i] > above_at;
+    const uint8_t* counts = plane_[p & 1];
+    switch (plane_bytes_) {
+      case 1:
+        classify<uint8_t>(counts, points, above_at, a.data());
+        break;
+      case 2:
+        classify<uint16_t>(counts, points, above_at, a.data());
+        break;
+      default:
+        classify<uint32_t>(counts, points, above_at, a.data());
+    }
     std::copy(a.begin(), a.end(), above);
     if (refine_) finishCrossings(p);
     if (p - first_ < grid_planes_) {
-      const size_t plane_bytes = c.size() * static_cast<size_t>(grid_bytes_);
-      encodePlane(counts, c.size(), grid_bytes_, &grid_[static_cast<size_t>(p - first_) * plane_bytes]);
+      const size_t plane_bytes = points * static_cast<size_t>(grid_bytes_);
+      encodePlane(counts, plane_bytes_, points, grid_bytes_, &grid_[static_cast<size_t>(p - first_) * plane_bytes]);
     }
   }
 
@@ -316,7 +364,7 @@ class SlabField {
   // Finishing here too keeps the mesh right should that selection ever miss a point.
   double count(const glm::ivec3& q) {
     const size_t pt = static_cast<size_t>(q.y) * static_cast<size_t>(res_) + static_cast<size_t>(q.z);
-    if (!refine_) return static_cast<double>(plane_[q.x & 1][pt] & ~kExactBit);
+    if (!refine_) return static_cast<double>(countAt(plane_[q.x & 1], plane_bytes_, pt));
     uint32_t& c = counts_[q.x & 1][pt];
     if ((c & kExactBit) == 0 && c >= static_cast<uint32_t>(cap_)) {
       assert(false && "finishCrossings missed a point");
@@ -335,10 +383,13 @@ class SlabField {
   bool owns_last_;
   int grid_planes_, grid_bytes_;
   int cap_ = 0;
-  const uint32_t* block_ = nullptr;
+  const uint8_t* block_ = nullptr;
+  int block_bytes_ = 1;
   bool refine_ = false;
-  // The counts of the planes in flight, by p & 1: in block_ when it holds them final, else counts_.
-  const uint32_t* plane_[2] = {nullptr, nullptr};
+  // The counts of the planes in flight, by p & 1, plane_bytes_ each: in block_ when it holds them
+  // final, else counts_ (uint32).
+  const uint8_t* plane_[2] = {nullptr, nullptr};
+  int plane_bytes_ = 4;
   // The planes in flight and the row buffers, kept by the thread from slab to slab (fresh ones
   // cost a page fault per 4 KiB: at res 2048 that was most of the meshing's time). load() writes
   // a plane's counts and flags whole, and finishCrossings every need_ entry, before any is read.
@@ -495,7 +546,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   if (params.planes) {
     std::vector<std::pair<int, int>> planes;  // first plane and plane count of each slab
     for (size_t s = 0; s < pending.size(); ++s) planes.emplace_back(slabFirst(s), slabLast(s) - slabFirst(s) + 1);
-    blocks.emplace(params.planes, std::move(planes), cap, squared(res), threads + 2);
+    blocks.emplace(params.planes, std::move(planes), cap,
+                   squared(res) * static_cast<uint64_t>(escapeGridBytesPerCount(cap)), threads + 2);
   }
 
   if (params.progress) params.progress->start(params.name, static_cast<uint64_t>(layers));
@@ -505,7 +557,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     const bool owns_last = last == res - 1;
     const bool seam = last == last_layer && !owns_last;
     Pending result;
-    const uint32_t* block = nullptr;
+    const uint8_t* block = nullptr;
     if (!failed && blocks) {
       block = blocks->wait(s);
       if (!block) failed = true;  // the plane function failed; blocks holds the error
@@ -605,7 +657,7 @@ Status writeEscapeGrid(const std::string& path, const std::vector<uint32_t>& cou
   if (!file) return file.error();
   const int bytes = escapeGridBytesPerCount(max_iter);
   std::vector<uint8_t> encoded(counts.size() * static_cast<size_t>(bytes));
-  encodePlane(counts.data(), counts.size(), bytes, encoded.data());
+  encodePlane(reinterpret_cast<const uint8_t*>(counts.data()), sizeof(uint32_t), counts.size(), bytes, encoded.data());
   if (Status s = file->write(encoded.data(), encoded.size()); !s) return s;
   return file->commit();
 }

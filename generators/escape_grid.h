@@ -63,9 +63,11 @@ struct GridAxis {
 using EscapeRowFunction =
     std::function<void(double x, double y, const double* zs, size_t n, int limit, uint32_t* counts)>;
 
-// Escape counts of whole x-planes: counts[(p − first)·res² + j·res + k] = min(count, limit) for
-// planes first ≤ p < first + planes, equal to the row function's. Called from one thread at a time.
-using EscapePlaneFunction = std::function<Status(int first, int planes, int limit, uint32_t* counts)>;
+// Escape counts of whole x-planes: count (p − first)·res² + j·res + k = min(count, limit) for planes
+// first ≤ p < first + planes, equal to the row function's, each in escapeGridBytesPerCount(limit)
+// little-endian bytes (the grid file's encoding: one byte at the usual limits, a quarter of what
+// uint32 counts would copy out of a GPU and through the mesher). Called from one thread at a time.
+using EscapePlaneFunction = std::function<Status(int first, int planes, int limit, uint8_t* counts)>;
 
 struct EscapeSurfaceParams {
   std::string name = "fractal";  // for messages and progress

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/parallel.h"
+#include "generators/escape_grid.h"
 #include "vulkan/shader.h"
 
 #include "shaders/escape.comp.h"
@@ -21,9 +22,9 @@ struct EscapePush {
   double threshold;
   double axis_rho2;
   double trap_c2;
-  uint32_t res, first_row, count, limit;
+  uint32_t res, first_row, count, limit, bits;
 };
-static_assert(sizeof(EscapePush) == 72);
+static_assert(sizeof(EscapePush) == 80);  // 76 bytes of members, padded to the doubles' alignment
 
 // Push constants of shaders/generate/perturbation.comp (std430: the double at 0, then the uints).
 struct PerturbationPush {
@@ -36,18 +37,22 @@ VkDescriptorSetLayoutBinding storage(uint32_t binding) {
   return {binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
 }
 
+// constants: the specialization constants 0, 1, … (uint32 each), or none.
 Result<VkPipeline> createPipeline(const VulkanContext& context, const uint32_t* code, size_t bytes,
-                                  VkPipelineLayout layout, const uint32_t* kind) {
+                                  VkPipelineLayout layout, const std::vector<uint32_t>& constants) {
   Result<VkShaderModule> module = createShaderModule(context, code, bytes);
   if (!module) return module.error();
-  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-  const VkSpecializationInfo specialization{1, &entry, sizeof(uint32_t), kind};
+  std::vector<VkSpecializationMapEntry> entries;
+  for (uint32_t i = 0; i < constants.size(); ++i)
+    entries.push_back({i, i * static_cast<uint32_t>(sizeof(uint32_t)), sizeof(uint32_t)});
+  const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
+                                            constants.size() * sizeof(uint32_t), constants.data()};
   VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   info.stage.module = *module;
   info.stage.pName = "main";
-  info.stage.pSpecializationInfo = kind ? &specialization : nullptr;
+  info.stage.pSpecializationInfo = constants.empty() ? nullptr : &specialization;
   info.layout = layout;
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
@@ -64,6 +69,18 @@ void copyOut(void* to, const void* from, uint64_t bytes) {
   parallelFor((bytes + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
     const uint64_t at = i * kPiece;
     std::memcpy(static_cast<uint8_t*>(to) + at, static_cast<const uint8_t*>(from) + at, std::min(kPiece, bytes - at));
+  });
+}
+
+// The same for `points` uint32 counts narrowed to T each (lavapipe's, which it writes whole).
+template <typename T>
+void copyOutNarrowed(void* to, const void* from, uint64_t points) {
+  constexpr uint64_t kPiece = uint64_t{1} << 20;
+  parallelFor((points + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
+    const uint64_t at = i * kPiece, end = std::min(at + kPiece, points);
+    const uint32_t* source = static_cast<const uint32_t*>(from);
+    T* target = static_cast<T*>(to);
+    for (uint64_t p = at; p < end; ++p) target[p] = static_cast<T>(source[p]);
   });
 }
 
@@ -94,9 +111,10 @@ Status gpuGenerateUsable(const DeviceFacts& facts) {
   return okStatus();
 }
 
-Result<std::unique_ptr<GpuEscape>> GpuEscape::create(const VulkanContext& context) {
+Result<std::unique_ptr<GpuEscape>> GpuEscape::create(const VulkanContext& context, std::optional<bool> pack_counts) {
   if (Status s = gpuGenerateUsable(context.facts); !s) return s.error();
-  std::unique_ptr<GpuEscape> gpu(new GpuEscape(context));
+  // lavapipe writes them whole: shaders/generate/escape.comp says why.
+  std::unique_ptr<GpuEscape> gpu(new GpuEscape(context, pack_counts.value_or(context.facts.type != "cpu")));
   if (Status s = gpu->init(); !s) return s.error();
   return gpu;
 }
@@ -124,11 +142,12 @@ Status GpuEscape::init() {
   if (!perturbation_layout) return perturbation_layout.error();
   perturbation_layout_ = *perturbation_layout;
   for (uint32_t kind = 0; kind < 2; ++kind) {
-    Result<VkPipeline> p = createPipeline(context_, kEscapeComp, sizeof(kEscapeComp), escape_layout_, &kind);
+    Result<VkPipeline> p = createPipeline(context_, kEscapeComp, sizeof(kEscapeComp), escape_layout_,
+                                          {kind, packed_counts_ ? 1u : 0u});
     if (!p) return p.error();
     escape_[kind] = *p;
   }
-  Result<VkPipeline> p = createPipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_, nullptr);
+  Result<VkPipeline> p = createPipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_, {});
   if (!p) return p.error();
   perturbation_ = *p;
 
@@ -202,7 +221,9 @@ Status GpuEscape::finish(Slot& slot) {
   const uint64_t points = slot.points;
   slot.points = 0;
   if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
-  copyOut(slot.destination, slot.counts.mapped, points * sizeof(uint32_t));
+  if (slot.device_bytes == slot.count_bytes) copyOut(slot.destination, slot.counts.mapped, points * slot.count_bytes);
+  else if (slot.count_bytes == 1) copyOutNarrowed<uint8_t>(slot.destination, slot.counts.mapped, points);
+  else copyOutNarrowed<uint16_t>(slot.destination, slot.counts.mapped, points);
   if (slot.tail_destination) {
     if (Status s = invalidateBuffer(context_, slot.tails); !s) return s;
     copyOut(slot.tail_destination, slot.tails.mapped, points * sizeof(EscapeTail));
@@ -229,8 +250,8 @@ Status GpuEscape::finishAll() {
 }
 
 Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
-                           uint32_t push_bytes, uint64_t points, uint32_t* destination,
-                           EscapeTail* tail_destination) {
+                           uint32_t push_bytes, uint64_t points, void* destination, uint32_t count_bytes,
+                           uint32_t device_bytes, EscapeTail* tail_destination) {
   assert(points > 0 && points <= (tail_destination ? kGpuPerturbationChunkPoints : kGpuChunkPoints));
   Slot& slot = slots_[s];
   if (Status st = finish(slot); !st) return st;
@@ -263,12 +284,14 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   VK_TRY(queueSubmit(context_, submit, slot.fence));
   slot.points = points;
   slot.destination = destination;
+  slot.count_bytes = count_bytes;
+  slot.device_bytes = device_bytes;
   slot.tail_destination = tail_destination;
   return okStatus();
 }
 
 Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first,
-                               int planes, int limit, uint32_t* counts) {
+                               int planes, int limit, uint8_t* counts) {
   const uint64_t res = axis.size();
   assert(res >= 2 && first >= 0 && planes > 0 && static_cast<uint64_t>(first + planes) <= res && limit >= 0);
   if (Status s = finishAll(); !s) return s;
@@ -284,6 +307,11 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
   push.trap_c2 = kernel.trap_c2;
   push.res = static_cast<uint32_t>(res);
   push.limit = static_cast<uint32_t>(limit);
+  const uint32_t count_bytes = static_cast<uint32_t>(escapeGridBytesPerCount(limit));
+  // A GPU packs them (a quarter of the bytes to write and copy); lavapipe writes them whole and
+  // they are narrowed as they are copied.
+  const uint32_t device_bytes = packed_counts_ ? count_bytes : 4;
+  push.bits = 8 * device_bytes;
   // Rows (plane·res + j) go out in chunks of whole rows; the row index stays below res² ≤ 2^32.
   const uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuChunkPoints / res);
   const uint64_t first_row = static_cast<uint64_t>(first) * res, end_row = first_row + static_cast<uint64_t>(planes) * res;
@@ -294,7 +322,7 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * res);
     if (Status st = dispatch(s, pipeline, escape_layout_, slots_[s].escape_set, &push, sizeof push, rows * res,
-                             counts + (row - first_row) * res, nullptr);
+                             counts + (row - first_row) * res * count_bytes, count_bytes, device_bytes, nullptr);
         !st) {
       (void)finishAll();
       return st;
@@ -334,7 +362,7 @@ Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * cols);
     if (Status st = dispatch(s, perturbation_, perturbation_layout_, slots_[s].perturbation_set, &push, sizeof push,
-                             rows * cols, counts + row * cols, tails + row * cols);
+                             rows * cols, counts + row * cols, sizeof(uint32_t), sizeof(uint32_t), tails + row * cols);
         !st) {
       (void)finishAll();
       return st;

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -47,15 +48,21 @@ Status gpuGenerateUsable(const DeviceFacts& facts);
 
 class GpuEscape {
  public:
-  static Result<std::unique_ptr<GpuEscape>> create(const VulkanContext& context);
+  // pack_counts: whether escape.comp packs the counts (bytes a count as escapePlanes returns them)
+  // or writes uint32 that the host narrows; unset: packed on a GPU, whole on lavapipe (where the
+  // packing's barriers cost time). The counts are the same either way.
+  static Result<std::unique_ptr<GpuEscape>> create(const VulkanContext& context,
+                                                   std::optional<bool> pack_counts = std::nullopt);
   ~GpuEscape();
   GpuEscape(const GpuEscape&) = delete;
   GpuEscape& operator=(const GpuEscape&) = delete;
 
-  // counts[(p − first)·res² + j·res + k] = min(count, limit) for the points (axis[p], axis[j],
-  // axis[k]) of planes first ≤ p < first + planes, res = axis.size().
+  // Count (p − first)·res² + j·res + k = min(count, limit) for the points (axis[p], axis[j],
+  // axis[k]) of planes first ≤ p < first + planes, res = axis.size(), in
+  // escapeGridBytesPerCount(limit) little-endian bytes each (generators/escape_grid.h
+  // EscapePlaneFunction).
   Status escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
-                      int limit, uint32_t* counts);
+                      int limit, uint8_t* counts);
 
   // counts[r·dcx.size() + col] and tails[...]: mandelbrot2d's perturbed count of δc = (dcx[col],
   // dcy[r]) against `orbit` and its escape tail (generators/mandelbrot2d.cpp).
@@ -78,17 +85,20 @@ class GpuEscape {
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
-    uint32_t* destination = nullptr;         // where the counts of the dispatch in flight go
+    void* destination = nullptr;             // where the counts of the dispatch in flight go
+    uint32_t count_bytes = 4;                // and the bytes of each there
+    uint32_t device_bytes = 4;               // the bytes of each in `counts`
     EscapeTail* tail_destination = nullptr;  // where its tails go (a perturbation dispatch), or null
     uint64_t points = 0;                     // 0: idle
   };
 
-  explicit GpuEscape(const VulkanContext& context) : context_(context) {}
+  GpuEscape(const VulkanContext& context, bool pack_counts) : context_(context), packed_counts_(pack_counts) {}
   Status init();
   Status upload(Buffer& target, const void* data, size_t bytes, const std::string& what);
   // Records and submits one dispatch into slot `s`, after finishing what the slot had in flight.
   Status dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
-                  uint32_t push_bytes, uint64_t points, uint32_t* destination, EscapeTail* tail_destination);
+                  uint32_t push_bytes, uint64_t points, void* destination, uint32_t count_bytes,
+                  uint32_t device_bytes, EscapeTail* tail_destination);
   Status finish(Slot& slot);  // waits for the slot's dispatch and copies its counts (and tails) out
   Status finishAll();
 
@@ -99,6 +109,7 @@ class GpuEscape {
   VkPipeline perturbation_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   Slot slots_[2];
+  const bool packed_counts_;  // escape.comp packs the counts, else writes uint32
   VkQueryPool queries_ = VK_NULL_HANDLE;  // two timestamps per slot
   uint64_t points_done_ = 0;
   double gpu_ms_ = 0.0;

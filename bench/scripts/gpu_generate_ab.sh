@@ -6,7 +6,8 @@
 # "mandelbulb --variant fast --resolution 2048"), then dd of a file of its size into the same
 # folder. One line per run in $OUT/generate_ab.tsv: round, build, wall s, the classification's GPU
 # ms (the device line), SHA-256 (16) of the output, and the phases generate prints (generate,
-# colours and offset, write, s); the medians in $OUT/generate_ab-median.tsv.
+# colours and offset, write, s); the medians in $OUT/generate_ab-median.tsv; each build's stderr of
+# the last round in $OUT/stderr-BUILD.txt.
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 data=${DATA:-/tmp/dpoint-generate-ab}
@@ -36,6 +37,7 @@ for round in $(seq "${ROUNDS:-3}"); do
       "$data/stderr.txt" | head -1)
     printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$round" "$build" "$(cat "$data/time.txt")" "${gpu:--}" \
       "$(sha256sum <"$data/out.ply" | cut -c1-16)" "${phases:--}" | tee -a "$rows"
+    cp "$data/stderr.txt" "$out/stderr-$build.txt"  # the last round's: the device and phase lines
     size=$(stat -c %s "$data/out.ply")
     rm -f "$data/out.ply"
     sync

@@ -13,8 +13,14 @@
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint kKind = 0;  // 0: Julia, 1: Mandelbulb (fast variant)
+layout(constant_id = 1) const uint kPacked = 1;  // 1: counts of `bits` packed; 0: uint32 (lavapipe)
 
 layout(std430, set = 0, binding = 0) readonly buffer Axis { double values[]; };  // grid axis, res of them
+// The counts, `bits` (8, 16 or 32) each, packed little-endian: point t in bits
+// [(t % per)·bits, …) of word t / per, per = 32 / bits. A GPU writes a byte a count when the limit
+// is at most 255, else two (generators/escape_grid.h): a quarter of the bytes to write and copy
+// out at the usual limits. lavapipe writes 32 bits (kPacked = 0, bits = 32), which the host narrows
+// as it copies them: a shader with barriers took it a fifth more time, even where none ran.
 layout(std430, set = 0, binding = 1) writeonly buffer Counts { uint counts[]; };
 
 layout(push_constant) uniform Push {
@@ -26,7 +32,10 @@ layout(push_constant) uniform Push {
   uint first_row;     // rows (plane·res + j) before this dispatch's first point
   uint count;         // points in this dispatch: whole rows, k fastest
   uint limit;         // iterations at most
+  uint bits;          // bits a count: 8, 16 or 32
 };
+
+shared uint packed[128];  // this group's counts, packed: 256 of 16 bits at most
 
 uint juliaCount(double x0, double y0, double z0) {
   precise double x = x0, y = y0, z = z0, w = 0.0lf;
@@ -94,10 +103,26 @@ uint mandelbulbCount(double cx, double cy, double cz) {
 }
 
 void main() {
-  const uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
-  if (t >= count) return;
-  const uint row = first_row + t / res;
-  const uint k = t % res;
-  const double x = values[row / res], y = values[row % res], z = values[k];
-  counts[t] = kKind == 0u ? juliaCount(x, y, z) : mandelbulbCount(x, y, z);
+  const uint lid = gl_LocalInvocationID.x;
+  const uint base = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u;
+  const uint t = base + lid;
+  uint value = 0u;
+  if (t < count) {
+    const uint row = first_row + t / res;
+    const uint k = t % res;
+    const double x = values[row / res], y = values[row % res], z = values[k];
+    value = kKind == 0u ? juliaCount(x, y, z) : mandelbulbCount(x, y, z);
+  }
+  if (kPacked == 0u) {  // no barrier in this pipeline
+    if (t < count) counts[t] = value;
+    return;
+  }
+  // Every invocation reaches the barriers (none returned early).
+  const uint per = 32u / bits, words = 256u / per;
+  if (lid < words) packed[lid] = 0u;
+  barrier();
+  atomicOr(packed[lid / per], value << ((lid % per) * bits));
+  barrier();
+  const uint word = base / per + lid;
+  if (lid < words && word < (count + per - 1u) / per) counts[word] = packed[lid];
 }

@@ -33,13 +33,17 @@ class GpuGenerate : public ::testing::Test {
     Result<std::unique_ptr<GpuEscape>> gpu = GpuEscape::create(*context_);
     if (gpu) gpu_ = std::move(*gpu);
     else setup_error_ = gpu.error().message;
+    // lavapipe writes whole counts by default; this one packs them as a GPU does.
+    Result<std::unique_ptr<GpuEscape>> packed = GpuEscape::create(*context_, true);
+    if (packed) packed_ = std::move(*packed);
   }
   static void TearDownTestSuite() {
+    packed_.reset();
     gpu_.reset();
     context_.reset();
   }
   void SetUp() override {
-    ASSERT_TRUE(gpu_) << setup_error_;
+    ASSERT_TRUE(gpu_ && packed_) << setup_error_;
     context_->clearValidationMessages();
   }
   void TearDown() override {
@@ -47,11 +51,13 @@ class GpuGenerate : public ::testing::Test {
     for (const std::string& m : context_->validationMessages()) ADD_FAILURE() << m;
   }
 
-  static EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis) {
+  // The device's plane function: counts packed in the shader (as on a GPU) or narrowed on the host.
+  static EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis, bool packed = true) {
     std::vector<double> values(static_cast<size_t>(axis.resolution));
     for (int i = 0; i < axis.resolution; ++i) values[static_cast<size_t>(i)] = axis.value(i);
-    return [kernel, values](int first, int count, int limit, uint32_t* counts) {
-      return gpu_->escapePlanes(kernel, values, first, count, limit, counts);
+    GpuEscape* gpu = packed ? packed_.get() : gpu_.get();
+    return [kernel, values, gpu](int first, int count, int limit, uint8_t* counts) {
+      return gpu->escapePlanes(kernel, values, first, count, limit, counts);
     };
   }
   static EscapeKernelParams julia(const glm::dvec4& c) {
@@ -61,23 +67,31 @@ class GpuGenerate : public ::testing::Test {
     return {EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2, kMandelbulbTrapC2};
   }
 
-  // The device's planes [first, first + count) against computeEscapeGrid's.
+  // The device's planes [first, first + count) against computeEscapeGrid's, packed and narrowed:
+  // little-endian counts of escapeGridBytesPerCount(limit) bytes, and not a byte written past them.
   static void expectSameGrid(const EscapeKernelParams& kernel, const EscapeRowFunction& row, const GridAxis& axis,
                              int limit, int first, int count) {
-    SCOPED_TRACE("res " + std::to_string(axis.resolution) + ", limit " + std::to_string(limit) + ", planes " +
-                 std::to_string(first) + "+" + std::to_string(count));
     Result<std::vector<uint32_t>> cpu = computeEscapeGrid(axis, limit, row, 0, first, count);
     ASSERT_TRUE(cpu.ok());
-    std::vector<uint32_t> gpu(cpu->size(), 0xdeadbeef);
-    Status s = planes(kernel, axis)(first, count, limit, gpu.data());
-    ASSERT_TRUE(s.ok()) << s.error().message;
-    size_t differ = 0;
-    for (size_t i = 0; i < gpu.size(); ++i) differ += gpu[i] != (*cpu)[i];
-    EXPECT_EQ(differ, 0u) << "of " << gpu.size();
+    const size_t bytes = static_cast<size_t>(escapeGridBytesPerCount(limit));
+    for (bool packed : {true, false}) {
+      SCOPED_TRACE("res " + std::to_string(axis.resolution) + ", limit " + std::to_string(limit) + ", planes " +
+                   std::to_string(first) + "+" + std::to_string(count) + (packed ? ", packed" : ", narrowed"));
+      std::vector<uint8_t> gpu(cpu->size() * bytes + 16, 0xA5);
+      Status s = planes(kernel, axis, packed)(first, count, limit, gpu.data());
+      ASSERT_TRUE(s.ok()) << s.error().message;
+      size_t differ = 0;
+      for (size_t i = 0; i < cpu->size(); ++i) {
+        const uint32_t c = bytes == 1 ? gpu[i] : gpu[2 * i] | uint32_t{gpu[2 * i + 1]} << 8;
+        differ += c != (*cpu)[i];
+      }
+      EXPECT_EQ(differ, 0u) << "of " << cpu->size();
+      for (size_t i = cpu->size() * bytes; i < gpu.size(); ++i) EXPECT_EQ(gpu[i], 0xA5) << "byte " << i;
+    }
   }
 
   static inline std::unique_ptr<VulkanContext> context_;
-  static inline std::unique_ptr<GpuEscape> gpu_;
+  static inline std::unique_ptr<GpuEscape> gpu_, packed_;
   static inline std::string setup_error_;
 };
 
@@ -211,6 +225,12 @@ TEST_F(GpuGenerate, fastMandelbulbGridEqualsTheCpusAtOddAndEvenResolutions) {
   expectSameGrid(mandelbulb(), row, GridAxis{25, -0.4, 0.6}, 400, 0, 25);
 }
 
+bool sameMesh(const PointSet& a, const PointSet& b) {
+  return a.size() == b.size() && a.size() > 0 &&
+         std::memcmp(a.positions.data(), b.positions.data(), a.size() * sizeof(glm::dvec3)) == 0 &&
+         a.triangles == b.triangles;
+}
+
 TEST_F(GpuGenerate, meshesFromDevicePlanesEqualTheCpuMeshes) {
   MandelbulbParams bulb;
   bulb.resolution = 45;
@@ -222,6 +242,24 @@ TEST_F(GpuGenerate, meshesFromDevicePlanesEqualTheCpuMeshes) {
   ASSERT_EQ(cpu->size(), gpu->size());
   EXPECT_EQ(std::memcmp(cpu->positions.data(), gpu->positions.data(), cpu->size() * sizeof(glm::dvec3)), 0);
   EXPECT_TRUE(cpu->triangles == gpu->triangles);
+  // Every count to --max-iter on the device: the mesher reads the blocks' bytes in place.
+  bulb.full_counts = true;
+  Result<PointSet> full = generateMandelbulb(bulb);
+  ASSERT_TRUE(full.ok()) << full.error().message;
+  EXPECT_TRUE(sameMesh(*cpu, *full));
+  // Above 255 iterations a count takes two bytes: capped (widened for the CPU's finishing) and full.
+  MandelbulbParams deep;
+  deep.resolution = 33;
+  deep.variant = MandelbulbVariant::kFast;
+  deep.max_iter = 1100;  // the cap, ⌊1100/4⌋ + 1 = 276, needs two bytes too
+  Result<PointSet> deep_cpu = generateMandelbulb(deep);
+  deep.planes = planes(mandelbulb(), GridAxis{33, -1.5, 1.5});
+  Result<PointSet> deep_capped = generateMandelbulb(deep);
+  deep.full_counts = true;
+  Result<PointSet> deep_full = generateMandelbulb(deep);
+  ASSERT_TRUE(deep_cpu.ok() && deep_capped.ok() && deep_full.ok());
+  EXPECT_TRUE(sameMesh(*deep_cpu, *deep_capped));
+  EXPECT_TRUE(sameMesh(*deep_cpu, *deep_full));
 
   JuliaParams julia_params;
   julia_params.resolution = 38;
