@@ -13,6 +13,7 @@
 #include "ops/mesh_sample.h"
 #include "core/memory.h"
 #include "generators/generate.h"
+#include "generators/perlin.h"
 
 namespace dpoint {
 namespace {
@@ -28,6 +29,18 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
   if (!offset) return offset.error();
   offsetPoints(points, *offset);
   return okStatus();
+}
+
+// Whether the noise colours are made as the PLY writer formats the rows (PlyWriteOptions::colors_of)
+// rather than before: the same file, without the colours' own pass over the set or their 12 bytes
+// a point. They need a .ply written here (not handed back), noise colours, and the positions as
+// written being those coloured (no --offset after the colours, no --sample interpolating them). A
+// reorder is no obstacle: a colour is a function of its point's position.
+bool coloursAtWrite(const OutputOptions& o, bool auto_noise) {
+  const bool noise = o.colors == "noise" || (o.colors == "auto" && auto_noise);
+  Result<FileFormat> format = formatOf(o.output);
+  return noise && !capturingPoints() && format && *format == FileFormat::kPly && o.offset.empty() &&
+         o.sample.count == 0;
 }
 
 }  // namespace
@@ -66,7 +79,9 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   if (!generated) return reportError(generated.error());
   const double generate_s = clock.lap();
   PointSet& points = *generated;
-  if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
+  const bool colours_at_write = coloursAtWrite(o, auto_noise);
+  if (colours_at_write) std::vector<glm::vec3>().swap(points.colors);
+  else if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
   if (o.sample.count != 0) {  // on the coloured, offset mesh: colours interpolate, positions are in their frame
     Result<uint64_t> limit = memoryLimit(o);
     if (!limit) return reportError(limit.error());
@@ -94,10 +109,15 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
+  if (colours_at_write)
+    w.colors_of = [&points](size_t begin, size_t end, glm::vec3* colors) {
+      for (size_t i = begin; i < end; ++i) colors[i - begin] = seedColor(points.positions[i]);
+    };
   if (Status s = writePointsWithNotes(o.output, points, w); !s) return reportError(s.error());
   if (!o.common.quiet)
-    std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles\n",
-                 generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3);
+    std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles%s\n",
+                 generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3,
+                 colours_at_write ? "; the colours made as the rows were written" : "");
   return 0;
 }
 

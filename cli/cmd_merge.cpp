@@ -37,7 +37,9 @@ int runMerge(const MergeOptions& o) {
   Progress progress(progressSink(o.common.quiet), "merge");
   // A binary PLY in the tiles' order is streamed from the parts (the same bytes, without the set
   // in memory); other formats and orders take the whole set first.
-  const PlyWriteOptions ply{PlyEncoding::kBinary, PlyColorType::kUchar, &progress, o.common.threads};
+  PlyWriteOptions ply;
+  ply.progress = &progress;
+  ply.threads = o.common.threads;
   Result<FileFormat> format = formatOf(o.output);
   if (format && *format == FileFormat::kPly && *order == PointOrder::kInput && canMergeToPly(ply)) {
     if (Status s = mergeTilesToPly(o.inputs, o.output, ply, limit); !s) return reportError(s.error());

@@ -17,6 +17,7 @@
 // and `face` lists of three `uint` indices for meshes.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -40,11 +41,19 @@ struct PlyReadOptions {
   uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
 };
 
+// Colours of points [begin, end) into colors[0 .. end − begin), made on demand; called from
+// several threads at once.
+using ColorSource = std::function<void(size_t begin, size_t end, glm::vec3* colors)>;
+
 struct PlyWriteOptions {
   PlyEncoding encoding = PlyEncoding::kBinary;
   PlyColorType color_type = PlyColorType::kUchar;
   Progress* progress = nullptr;
   unsigned threads = 0;  // rows formatted on this many cores (0: all); the bytes do not depend on it
+  // Set, for a set without colours: the colours, made chunk by chunk as the rows are formatted
+  // (a generator's noise colours then take no time of their own, nor 12 bytes a point); the file
+  // is the one the set with those colours gives.
+  ColorSource colors_of;
 };
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});

@@ -1,6 +1,7 @@
 // PLY writing: `double x,y,z`, uchar or float colours, `face` lists of three uint indices.
 // Rows are formatted in chunks of 65,536 on all cores and written in order (core/ordered_write.h).
 #include <algorithm>
+#include <cassert>
 #include <charconv>
 #include <cstring>
 #include <string_view>
@@ -115,6 +116,8 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
 
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
   const size_t n = points.size();
+  assert(!(options.colors_of && points.hasColors()));
+  const bool colors = points.hasColors() || options.colors_of;
   if (points.hasColors() && points.colors.size() != n)
     return Error{"cannot write '" + path + "': " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(n) + " points"};
@@ -132,12 +135,12 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   const bool word_colors = !float_colors && points.color_full_scale == 65535;
   const size_t faces = points.triangles.size() / 3;
 
-  const std::string header = plyHeader(points, n, faces, points.hasColors(), points.hasZ(), options);
+  const std::string header = plyHeader(points, n, faces, colors, points.hasZ(), options);
 
   if (options.progress) options.progress->start("writing " + path, n + faces);
   const std::vector<Dimension>& dims = points.dimensions.all();
   const bool attributes = !dims.empty();
-  const size_t color_bytes = !points.hasColors() ? 0 : float_colors ? 12 : word_colors ? 6 : 3;
+  const size_t color_bytes = !colors ? 0 : float_colors ? 12 : word_colors ? 6 : 3;
   size_t vertex_bytes = sizeof(glm::dvec3) + color_bytes;
   for (const Dimension& d : dims) vertex_bytes += plyTypeName(d.type) ? dimTypeSize(d.type) : sizeof(double);
 
@@ -149,15 +152,24 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
     const size_t total = k - 1 < vertex_chunks ? n : faces;
     return {c * kRowsPerChunk, std::min(total, (c + 1) * kRowsPerChunk)};
   };
+  // The chunk's colours, at [i − begin]: the set's, or made now by colors_of.
+  auto chunkColors = [&](size_t begin, size_t end) -> const glm::vec3* {
+    if (!options.colors_of) return colors ? points.colors.data() + begin : nullptr;
+    thread_local std::vector<glm::vec3> made;
+    made.resize(end - begin);
+    options.colors_of(begin, end, made.data());
+    return made.data();
+  };
   auto vertexRows = [&](size_t begin, size_t end, std::vector<char>& bytes) {
+    const glm::vec3* chunk_colors = chunkColors(begin, end);
     if (!ascii) {
       bytes.resize((end - begin) * vertex_bytes);
       char* row = bytes.data();
       for (size_t i = begin; i < end; ++i) {
         std::memcpy(row, &points.positions[i], sizeof(glm::dvec3));
         char* at = row + sizeof(glm::dvec3);
-        if (points.hasColors()) {
-          const glm::vec3& c = points.colors[i];
+        if (colors) {
+          const glm::vec3& c = chunk_colors[i - begin];
           if (float_colors) {
             std::memcpy(at, &c, sizeof c);
           } else if (word_colors) {
@@ -190,9 +202,9 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
       const glm::dvec3& p = points.positions[i];
       appendNumber(out, p.x, ' ');
       appendNumber(out, p.y, ' ');
-      appendNumber(out, p.z, points.hasColors() || attributes ? ' ' : '\n');
-      if (points.hasColors()) {
-        const glm::vec3& c = points.colors[i];
+      appendNumber(out, p.z, colors || attributes ? ' ' : '\n');
+      if (colors) {
+        const glm::vec3& c = chunk_colors[i - begin];
         for (int k = 0; k < 3; ++k) {
           const char sep = k == 2 && !attributes ? '\n' : ' ';
           if (float_colors)

@@ -197,12 +197,16 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
+  if (options.colors_of && *format != FileFormat::kPly)
+    return Error{path + ": colours made as the rows are written go to a .ply only"};
   switch (*format) {
     case FileFormat::kCsv:
       return writeCsv(path, points,
                       CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale});
     case FileFormat::kPly:
-      return writePly(path, points, PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads});
+      return writePly(path, points,
+                      PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
+                                      options.colors_of});
     case FileFormat::kPcd:
       return writePcd(path, points, PcdWriteOptions{options.pcd_encoding, options.progress, options.notices});
     case FileFormat::kGlb:

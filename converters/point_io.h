@@ -68,6 +68,8 @@ struct WriteOptions {
   // When not null, gets one line per thing the file cannot hold as given (GLB: points that will
   // not read back bit-exactly).
   std::vector<std::string>* notices = nullptr;
+  // PLY only (another format is refused): colours made as the rows are (PlyWriteOptions).
+  ColorSource colors_of;
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});

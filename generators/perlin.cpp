@@ -47,14 +47,29 @@ float lerp(float t, float a, float b) { return a + t * (b - a); }
 
 float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 
+// floorf(v) for |v| < 2^31 without a call to libm (six a pnoise3 were much of the colouring's
+// time): the truncation, one less below a negative non-integer, and v's sign on a zero
+// (floorf(-0) is -0). Every float in that range takes this path exactly.
+float floorSmall(float v) {
+  const float t = static_cast<float>(static_cast<int>(v));
+  return t > v ? t - 1.0f : std::copysign(t, v);
+}
+
 // The lattice cell along one axis, wrapped like the package: floor of fmod(v, repeat) (which
-// keeps the sign of v), and the next cell as fmod(cell + 1, repeat) in float. fmod is exact, so
-// inside (−repeat, repeat), where a generated set's coordinates lie, it is v itself, and of the
-// integer cell + 1 (within ±repeat) it is the C remainder: the same cells without the two fmod
-// calls, which were most of the colouring's time (18 a colour).
-void cellIndices(float v, int& lo, int& hi) {
+// keeps the sign of v), and the next cell as fmod(cell + 1, repeat) in float; floor_v = floor(v),
+// unwrapped. fmod is exact, so inside (−repeat, repeat), where a generated set's coordinates lie,
+// it is v itself, and of the integer cell + 1 (within ±repeat) it is the C remainder: the same
+// cells without the two fmod calls, which were most of the colouring's time (18 a colour), and
+// the cell is floor(v) itself.
+void cellIndices(float v, int& lo, int& hi, float& floor_v) {
   const float repeat = static_cast<float>(kRepeat);
-  lo = static_cast<int>(std::floor(std::fabs(v) < repeat ? v : std::fmod(v, repeat)));
+  if (std::fabs(v) < repeat) {
+    floor_v = floorSmall(v);
+    lo = static_cast<int>(floor_v);
+  } else {  // and NaN
+    floor_v = std::floor(v);
+    lo = static_cast<int>(std::floor(std::fmod(v, repeat)));
+  }
   hi = (lo + 1) % kRepeat;
   lo &= 255;
   hi &= 255;
@@ -64,13 +79,14 @@ void cellIndices(float v, int& lo, int& hi) {
 
 float pnoise3(float x, float y, float z) {
   int i, ii, j, jj, k, kk;
-  cellIndices(x, i, ii);
-  cellIndices(y, j, jj);
-  cellIndices(z, k, kk);
+  float floor_x, floor_y, floor_z;
+  cellIndices(x, i, ii, floor_x);
+  cellIndices(y, j, jj, floor_y);
+  cellIndices(z, k, kk, floor_z);
   // The fractional parts come from the unwrapped coordinates, as in the package.
-  x -= std::floor(x);
-  y -= std::floor(y);
-  z -= std::floor(z);
+  x -= floor_x;
+  y -= floor_y;
+  z -= floor_z;
   const float fx = fade(x), fy = fade(y), fz = fade(z);
 
   const int a = perm(i), aa = perm(a + j), ab = perm(a + jj);

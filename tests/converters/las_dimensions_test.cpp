@@ -52,6 +52,12 @@ Records recordsOf(const std::string& path) {
   return r;
 }
 
+PlyWriteOptions plyOptions(PlyEncoding encoding) {
+  PlyWriteOptions options;
+  options.encoding = encoding;
+  return options;
+}
+
 std::vector<std::string> corpusLasFiles() {
   std::vector<std::string> files;
   for (const char* folder : {"/las/", "/laz/"})
@@ -100,7 +106,7 @@ TEST(LasDimensions, lasToPlyToLasKeepsEveryFieldOfEveryCorpusFile) {
     ASSERT_TRUE(las);
     for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
       const std::string what = path + (encoding == PlyEncoding::kAscii ? " (ASCII PLY)" : " (PLY)");
-      ASSERT_TRUE(writePly(dir.file("p.ply"), *las, PlyWriteOptions{encoding})) << what;
+      ASSERT_TRUE(writePly(dir.file("p.ply"), *las, plyOptions(encoding))) << what;
       Result<PointSet> ply = readPly(dir.file("p.ply"));
       ASSERT_TRUE(ply) << ply.error().message;
       expectSameDimensions(*las, *ply, what);

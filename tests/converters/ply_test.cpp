@@ -243,6 +243,39 @@ TEST(Ply, plyBinaryVerticesAreTheSameForAnyThreadCount) {
   }
 }
 
+// Colours made as the rows are written (PlyWriteOptions::colors_of) give the file the set with
+// those colours gives, byte for byte: binary and ASCII, uchar and float colours, a mesh, chunks of
+// rows over several threads.
+TEST(Ply, plyColoursMadeAsWrittenGiveTheSameFile) {
+  TempDir dir;
+  PointSet coloured = randomPoints(kManyBlocksOf27, 778);
+  coloured.triangles = {0, 1, 2, 2, 1, 3};
+  auto colourOf = [](const glm::dvec3& p) {
+    return glm::vec3(static_cast<float>(p.x * 0.37), 0.25f, static_cast<float>(std::fabs(p.z) * 0.61));
+  };
+  for (size_t i = 0; i < coloured.size(); ++i) coloured.colors[i] = colourOf(coloured.positions[i]);
+  PointSet bare = coloured;
+  bare.colors.clear();
+  for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+    for (PlyColorType type : {PlyColorType::kUchar, PlyColorType::kFloat}) {
+      SCOPED_TRACE(std::string(encoding == PlyEncoding::kAscii ? "ASCII" : "binary") +
+                   (type == PlyColorType::kFloat ? ", float" : ", uchar"));
+      PlyWriteOptions options;
+      options.encoding = encoding;
+      options.color_type = type;
+      options.threads = 3;
+      ASSERT_TRUE(writePly(dir.file("given.ply"), coloured, options).ok());
+      options.colors_of = [&](size_t begin, size_t end, glm::vec3* colors) {
+        for (size_t i = begin; i < end; ++i) colors[i - begin] = colourOf(bare.positions[i]);
+      };
+      ASSERT_TRUE(writePly(dir.file("made.ply"), bare, options).ok());
+      const std::string given = readFile(dir.file("given.ply"));
+      EXPECT_GT(given.size(), size_t{1} << 20);
+      EXPECT_TRUE(given == readFile(dir.file("made.ply")));
+    }
+  }
+}
+
 // The general path (not double xyz + uchar rgb) is parallel too: float xyz around a skipped
 // property, ushort colours.
 TEST(Ply, plyBinaryMixedTypesAreTheSameForAnyThreadCount) {
