@@ -70,15 +70,24 @@ void prefaultForWrite(void* data, size_t bytes, unsigned threads) {
 #endif
 }
 
+void adviseHugePages(void* data, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr uintptr_t kHuge = uintptr_t{2} << 20;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data, (void)bytes;
+#endif
+}
+
 LargeBuffer::LargeBuffer(size_t bytes) : size_(bytes) {
   constexpr size_t kHuge = size_t{2} << 20;
   if (bytes >= kHuge) {
     const size_t length = (bytes + kHuge - 1) / kHuge * kHuge;
     void* p = mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p != MAP_FAILED) {
-#ifdef MADV_HUGEPAGE
-      (void)madvise(p, length, MADV_HUGEPAGE);  // a hint: without it the pages are 4 KiB
-#endif
+      adviseHugePages(p, length);  // a hint: without it the pages are 4 KiB
       data_ = static_cast<char*>(p);
       mapped_ = length;
       return;

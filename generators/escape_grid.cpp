@@ -489,6 +489,11 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       std::min(1.25 * share * estimatedVertices(res), static_cast<double>(limit / kMeshBytesPerVertex));
   mesh.positions.reserve(static_cast<size_t>(reserve));
   mesh.triangles.reserve(static_cast<size_t>(reserve) * 6);
+  // The slabs are appended one at a time under a lock while the other workers wait for it: with
+  // 4 KiB pages the faults of that first touch took most of the appending (res-2048 Mandelbulb on
+  // 16 cores: 4.6 s of it, and the workers 41 thread-seconds waiting for the lock).
+  adviseHugePages(mesh.positions.data(), mesh.positions.capacity() * sizeof(glm::dvec3));
+  adviseHugePages(mesh.triangles.data(), mesh.triangles.capacity() * sizeof(uint32_t));
 
   struct Pending {
     bool ready = false;
@@ -525,10 +530,10 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                      ExitCode::kResourceLimit});
         } else {
           mesh.positions.insert(mesh.positions.end(), done.mesh.positions.begin(), done.mesh.positions.end());
-          const size_t at = mesh.triangles.size();
-          mesh.triangles.resize(at + done.mesh.triangles.size());
-          std::transform(done.mesh.triangles.begin(), done.mesh.triangles.end(), mesh.triangles.begin() + at,
-                         [offset](uint32_t id) { return static_cast<uint32_t>(offset + id); });
+          // Shifted in place, then copied: the mesh's new pages are written once (a resize would
+          // zero them first).
+          for (uint32_t& id : done.mesh.triangles) id = static_cast<uint32_t>(offset + id);
+          mesh.triangles.insert(mesh.triangles.end(), done.mesh.triangles.begin(), done.mesh.triangles.end());
           if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
           if (grid_file)
             if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());
