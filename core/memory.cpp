@@ -60,7 +60,7 @@ void prefaultForWrite(void* data, size_t bytes, unsigned threads) {
   const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
   const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + page - 1) & ~(page - 1);
   const uintptr_t end = reinterpret_cast<uintptr_t>(data) + bytes;
-  if (end > begin + kChunk)
+  if (end > begin)
     parallelFor((end - begin + kChunk - 1) / kChunk, threads, [&](size_t chunk, unsigned) {
       const uintptr_t first = begin + chunk * kChunk;
       (void)madvise(reinterpret_cast<void*>(first), std::min(kChunk, end - first), MADV_POPULATE_WRITE);
