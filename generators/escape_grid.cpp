@@ -183,8 +183,9 @@ class PlaneBlocks {
 // under a lock (the escape-grid mesh), so the appends copy into pages that are there: with the
 // first touch in the append, the other workers waited for the lock (res-2048 Mandelbulb on 16
 // cores: 11 thread-seconds even with 2 MiB pages). At most a sixteenth of the capacity and
-// `ahead` bytes past each end, so the memory held stays about the mesh's own. A region whose array moved is restarted at its new place; a
-// page faulted in where an array no longer is changes no byte, so no lock is held while faulting.
+// `ahead` bytes past each end, so the memory held stays about the mesh's own. A region whose
+// array moved is restarted at its new place; a page faulted in where an array no longer is
+// changes no byte, so no lock is held while faulting.
 class PrefaultAhead {
  public:
   PrefaultAhead(size_t regions, size_t ahead) : regions_(regions), ahead_(ahead) {
