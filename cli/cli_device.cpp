@@ -101,6 +101,13 @@ EscapePlaneFunction GenerateDevice::planes(const EscapeKernelParams& kernel, con
   };
 }
 
+EscapeArena GenerateDevice::arena() {
+  return [self = shared_from_this()](uint64_t bytes) -> uint8_t* {
+    Result<uint8_t*> memory = self->gpu_->arena(bytes);
+    return memory ? *memory : nullptr;
+  };
+}
+
 PerturbationFunction GenerateDevice::perturbation() {
   return [self = shared_from_this()](const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
                                     const std::vector<double>& dcy, int max_iter, uint32_t* counts,

@@ -45,6 +45,8 @@ class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
                                                       const std::string& cpu_only, bool quiet);
 
   EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis);
+  // Where planes() writes in place (GpuEscape::arena); an error gives the heap instead.
+  EscapeArena arena();
   // A GPU, not a CPU device such as lavapipe.
   bool isGpu() const;
   PerturbationFunction perturbation();

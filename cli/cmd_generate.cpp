@@ -100,9 +100,11 @@ Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* 
   Result<std::shared_ptr<GenerateDevice>> device =
       GenerateDevice::open(o.device, "mandelbulb", seed ? kSeedCpuOnly : "", o.out.common.quiet);
   if (!device) return device.error();
-  if (*device)
+  if (*device) {
     p.planes = (*device)->planes({EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2, kMandelbulbTrapC2},
                                  GridAxis{p.resolution, p.lo, p.hi});
+    p.arena = (*device)->arena();
+  }
   p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);
 }
@@ -125,8 +127,10 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
   p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
   Result<std::shared_ptr<GenerateDevice>> device = GenerateDevice::open(o.device, "julia", "", o.out.common.quiet);
   if (!device) return device.error();
-  if (*device)
+  if (*device) {
     p.planes = (*device)->planes({EscapeKernel::kJulia, p.c, kJuliaEscapeSquare, 0.0}, GridAxis{p.resolution, p.lo, p.hi});
+    p.arena = (*device)->arena();
+  }
   p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);
 }

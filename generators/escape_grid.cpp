@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -95,10 +96,15 @@ uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share) {
 // (parallelFor), so the block a worker waits for is always among the next ones computed.
 class PlaneBlocks {
  public:
-  PlaneBlocks(const EscapePlaneFunction& planes, std::vector<std::pair<int, int>> slabs, int limit, uint64_t plane_bytes,
-              size_t ahead)
+  // arena: where the blocks go when it offers memory (EscapeArena), else the heap.
+  PlaneBlocks(const EscapePlaneFunction& planes, const EscapeArena& arena, std::vector<std::pair<int, int>> slabs,
+              int limit, uint64_t plane_bytes, size_t ahead)
       : planes_(planes), slabs_(std::move(slabs)), limit_(limit), plane_bytes_(plane_bytes), ahead_(ahead),
-        blocks_(slabs_.size()), ready_(slabs_.size(), false) {
+        blocks_(slabs_.size(), nullptr), ready_(slabs_.size(), false) {
+    for (const auto& slab : slabs_)
+      block_bytes_ = std::max<uint64_t>(block_bytes_, static_cast<uint64_t>(slab.second) * plane_bytes_);
+    stride_ = (block_bytes_ + 4095) / 4096 * 4096;  // whole pages: a block's words never share one
+    if (arena) arena_ = arena(stride_ * ahead_);
     thread_ = std::thread([this] { produce(); });
   }
   ~PlaneBlocks() { stop(); }
@@ -107,12 +113,12 @@ class PlaneBlocks {
   const uint8_t* wait(size_t s) {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [&] { return ready_[s] || error_.has_value(); });
-    return ready_[s] ? blocks_[s].data() : nullptr;
+    return ready_[s] ? blocks_[s] : nullptr;
   }
   void release(size_t s) {
     std::lock_guard<std::mutex> lock(mutex_);
-    spare_.push_back(std::move(blocks_[s]));  // reused for a later slab: no allocator churn
-    blocks_[s] = {};
+    spare_.push_back(blocks_[s]);  // reused for a later slab: no allocator churn
+    blocks_[s] = nullptr;
     ++released_;
     changed_.notify_all();
   }
@@ -132,31 +138,32 @@ class PlaneBlocks {
  private:
   void produce() {
     for (size_t s = 0; s < slabs_.size(); ++s) {
+      uint8_t* block = nullptr;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [&] { return stopping_ || produced_ - released_ < ahead_; });
         if (stopping_) return;
-      }
-      const auto [first, planes] = slabs_[s];
-      std::vector<uint8_t> block;
-      {
         // At most `ahead` blocks ever exist: taken from the spares once there are some. (Freeing
         // and allocating 32 MiB blocks on different threads grew the heap to several times that.)
-        std::lock_guard<std::mutex> lock(mutex_);
         if (!spare_.empty()) {
-          block = std::move(spare_.back());
+          block = spare_.back();
           spare_.pop_back();
+        } else if (arena_) {
+          block = arena_ + created_++ * stride_;
+        } else {  // not zeroed: the plane function writes every count
+          owned_.push_back(std::make_unique_for_overwrite<uint8_t[]>(block_bytes_));
+          block = owned_.back().get();
         }
       }
-      block.resize(static_cast<size_t>(planes) * plane_bytes_);
-      Status status = planes_(first, planes, limit_, block.data());
+      const auto [first, planes] = slabs_[s];
+      Status status = planes_(first, planes, limit_, block);
       std::lock_guard<std::mutex> lock(mutex_);
       if (!status) {
         error_ = status.error();
         changed_.notify_all();
         return;
       }
-      blocks_[s] = std::move(block);
+      blocks_[s] = block;
       ready_[s] = true;
       ++produced_;
       changed_.notify_all();
@@ -168,10 +175,14 @@ class PlaneBlocks {
   const int limit_;
   const uint64_t plane_bytes_;
   const size_t ahead_;
+  uint64_t block_bytes_ = 0, stride_ = 0;  // the largest block, and the arena's step between blocks
+  uint8_t* arena_ = nullptr;
+  size_t created_ = 0;  // blocks taken from the arena
+  std::vector<std::unique_ptr<uint8_t[]>> owned_;  // the heap's blocks
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::vector<std::vector<uint8_t>> blocks_;
-  std::vector<std::vector<uint8_t>> spare_;  // released blocks, for reuse
+  std::vector<uint8_t*> blocks_;
+  std::vector<uint8_t*> spare_;  // released blocks, for reuse
   std::vector<bool> ready_;
   size_t produced_ = 0, released_ = 0;
   bool stopping_ = false;
@@ -625,7 +636,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   if (params.planes) {
     std::vector<std::pair<int, int>> planes;  // first plane and plane count of each slab
     for (size_t s = 0; s < pending.size(); ++s) planes.emplace_back(slabFirst(s), slabLast(s) - slabFirst(s) + 1);
-    blocks.emplace(params.planes, std::move(planes), cap,
+    blocks.emplace(params.planes, params.arena, std::move(planes), cap,
                    squared(res) * static_cast<uint64_t>(escapeGridBytesPerCount(cap)), threads + 2);
   }
 

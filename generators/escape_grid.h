@@ -21,7 +21,8 @@
 //
 // Elsewhere: a plane function (a GPU, generators/gpu_generate.h) may compute the classification pass
 // instead of the row function, a slab's planes at a time on a thread of its own, ahead of the
-// workers that mesh earlier slabs (at most threads + 2 slabs of counts held). Finishing the
+// workers that mesh earlier slabs (at most threads + 2 slabs of counts held, in the function's
+// arena when it offers one: a GPU then writes them where the workers read them). Finishing the
 // crossings, marching cubes and writing stay here. The function must return the row function's
 // counts bit for bit, so the mesh is the same either way.
 //
@@ -69,6 +70,11 @@ using EscapeRowFunction =
 // uint32 counts would copy out of a GPU and through the mesher). Called from one thread at a time.
 using EscapePlaneFunction = std::function<Status(int first, int planes, int limit, uint8_t* counts)>;
 
+// Memory that the plane function fills fastest, `bytes` of it, valid until the next call (a GPU's
+// mapped buffer, which its dispatches write in place: no copy out of a staging buffer); nullptr
+// when there is none. The blocks of counts are then carved from it.
+using EscapeArena = std::function<uint8_t*(uint64_t bytes)>;
+
 struct EscapeSurfaceParams {
   std::string name = "fractal";  // for messages and progress
   GridAxis axis;
@@ -81,10 +87,11 @@ struct EscapeSurfaceParams {
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // empty: the row function classifies too
+  EscapeArena arena;             // where the plane function's blocks go; empty: the heap
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
-// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes).
+// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes, arena).
 template <typename FractalParams>
 EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& params);
 
@@ -107,6 +114,7 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.max_memory = params.max_memory;
   surface.progress = params.progress;
   surface.planes = params.planes;
+  surface.arena = params.arena;
   return surface;
 }
 

@@ -22,9 +22,9 @@ struct EscapePush {
   double threshold;
   double axis_rho2;
   double trap_c2;
-  uint32_t res, first_row, count, limit, bits;
+  uint32_t res, first_row, count, limit, bits, word_offset;
 };
-static_assert(sizeof(EscapePush) == 80);  // 76 bytes of members, padded to the doubles' alignment
+static_assert(sizeof(EscapePush) == 80);
 
 // Push constants of shaders/generate/perturbation.comp (std430: the double at 0, then the uints).
 struct PerturbationPush {
@@ -151,9 +151,9 @@ Status GpuEscape::init() {
   if (!p) return p.error();
   perturbation_ = *p;
 
-  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 14};  // per slot: 2 + 5
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 18};  // per slot: 2 + 5 + 2
   VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 4;
+  pool_info.maxSets = 6;
   pool_info.poolSizeCount = 1;
   pool_info.pPoolSizes = &pool_size;
   VK_TRY(vkCreateDescriptorPool(context_.device, &pool_info, nullptr, &pool_));
@@ -162,15 +162,16 @@ Status GpuEscape::init() {
                                          true, "escape counts");
     if (!counts) return counts.error();
     slot.counts = *counts;
-    const VkDescriptorSetLayout layouts[2] = {escape_set_layout_, perturbation_set_layout_};
-    VkDescriptorSet sets[2] = {};
+    const VkDescriptorSetLayout layouts[3] = {escape_set_layout_, perturbation_set_layout_, escape_set_layout_};
+    VkDescriptorSet sets[3] = {};
     VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     allocate.descriptorPool = pool_;
-    allocate.descriptorSetCount = 2;
+    allocate.descriptorSetCount = 3;
     allocate.pSetLayouts = layouts;
     VK_TRY(vkAllocateDescriptorSets(context_.device, &allocate, sets));
     slot.escape_set = sets[0];
     slot.perturbation_set = sets[1];
+    slot.arena_set = sets[2];
     Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
     if (!commands) return commands.error();
     slot.commands = *commands;
@@ -189,7 +190,7 @@ GpuEscape::~GpuEscape() {
     destroyBuffer(context_, slot.counts);
     destroyBuffer(context_, slot.tails);
   }
-  for (Buffer* b : {&axis_, &orbit_, &dcx_, &dcy_}) destroyBuffer(context_, *b);
+  for (Buffer* b : {&axis_, &orbit_, &dcx_, &dcy_, &arena_}) destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);  // frees the sets
   if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
   for (VkPipeline p : {escape_[0], escape_[1], perturbation_})
@@ -220,10 +221,17 @@ Status GpuEscape::finish(Slot& slot) {
   const auto waited = std::chrono::steady_clock::now();
   const uint64_t points = slot.points;
   slot.points = 0;
-  if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
-  if (slot.device_bytes == slot.count_bytes) copyOut(slot.destination, slot.counts.mapped, points * slot.count_bytes);
-  else if (slot.count_bytes == 1) copyOutNarrowed<uint8_t>(slot.destination, slot.counts.mapped, points);
-  else copyOutNarrowed<uint16_t>(slot.destination, slot.counts.mapped, points);
+  if (!slot.destination) {  // written in place
+    if (Status s = invalidateBuffer(context_, arena_); !s) return s;
+  } else {
+    if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
+    if (slot.device_bytes == slot.count_bytes)
+      copyOut(slot.destination, slot.counts.mapped, points * slot.count_bytes);
+    else if (slot.count_bytes == 1)
+      copyOutNarrowed<uint8_t>(slot.destination, slot.counts.mapped, points);
+    else
+      copyOutNarrowed<uint16_t>(slot.destination, slot.counts.mapped, points);
+  }
   if (slot.tail_destination) {
     if (Status s = invalidateBuffer(context_, slot.tails); !s) return s;
     copyOut(slot.tail_destination, slot.tails.mapped, points * sizeof(EscapeTail));
@@ -299,6 +307,17 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     if (Status s = upload(axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
     axis_values_ = axis;
     for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
+    arena_sets_stale_ = true;
+  }
+  const uint32_t count_bytes = static_cast<uint32_t>(escapeGridBytesPerCount(limit));
+  // In the arena, with every row whole words (so no dispatch writes a word another one does).
+  const uint64_t total = static_cast<uint64_t>(planes) * res * res * count_bytes;
+  const uint8_t* arena = static_cast<const uint8_t*>(arena_.mapped);
+  const bool in_place = packed_counts_ && arena && counts >= arena && counts + total <= arena + arena_.size &&
+                        (counts - arena) % 4 == 0 && res * count_bytes % 4 == 0;
+  if (in_place && arena_sets_stale_) {
+    for (Slot& slot : slots_) writeSet(context_, slot.arena_set, {&axis_, &arena_});
+    arena_sets_stale_ = false;
   }
   EscapePush push{};
   for (int d = 0; d < 4; ++d) push.c[d] = kernel.c[d];
@@ -307,7 +326,6 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
   push.trap_c2 = kernel.trap_c2;
   push.res = static_cast<uint32_t>(res);
   push.limit = static_cast<uint32_t>(limit);
-  const uint32_t count_bytes = static_cast<uint32_t>(escapeGridBytesPerCount(limit));
   // A GPU packs them (a quarter of the bytes to write and copy); lavapipe writes them whole and
   // they are narrowed as they are copied.
   const uint32_t device_bytes = packed_counts_ ? count_bytes : 4;
@@ -321,14 +339,32 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     const uint64_t rows = std::min(rows_per_chunk, end_row - row);
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * res);
-    if (Status st = dispatch(s, pipeline, escape_layout_, slots_[s].escape_set, &push, sizeof push, rows * res,
-                             counts + (row - first_row) * res * count_bytes, count_bytes, device_bytes, nullptr);
+    uint8_t* destination = counts + (row - first_row) * res * count_bytes;
+    push.word_offset = in_place ? static_cast<uint32_t>((destination - arena) / 4) : 0;
+    if (Status st = dispatch(s, pipeline, escape_layout_, in_place ? slots_[s].arena_set : slots_[s].escape_set, &push,
+                             sizeof push, rows * res, in_place ? nullptr : destination, count_bytes, device_bytes,
+                             nullptr);
         !st) {
       (void)finishAll();
       return st;
     }
   }
   return finishAll();
+}
+
+Result<uint8_t*> GpuEscape::arena(uint64_t bytes) {
+  if (!packed_counts_ || bytes == 0 || bytes > context_.facts.max_storage_buffer_range ||
+      bytes / 4 > UINT32_MAX)  // word offsets are uint32
+    return static_cast<uint8_t*>(nullptr);
+  if (arena_.size < bytes) {
+    if (Status s = finishAll(); !s) return s.error();
+    destroyBuffer(context_, arena_);
+    Result<Buffer> created = createBuffer(context_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "escape count blocks");
+    if (!created) return created.error();
+    arena_ = *created;
+    arena_sets_stale_ = true;
+  }
+  return static_cast<uint8_t*>(arena_.mapped);
 }
 
 Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,

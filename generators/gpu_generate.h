@@ -6,7 +6,9 @@
 // calls into them.
 //
 // Work goes out in dispatches of at most kGpuChunkPoints points (whole rows), two in flight: the
-// device computes one while the host copies the other's counts out of mapped memory. Inputs the
+// device computes one while the host copies the other's counts out of mapped memory, or, for
+// counts bound for the arena (a host-visible buffer the generator takes its blocks from), writes
+// them there in place with nothing to copy. Inputs the
 // shaders read on every iteration (axis values, the reference orbit) live in device-local memory.
 // One thread at a time may call a GpuEscape (it records on the context's one queue and pool).
 #pragma once
@@ -61,8 +63,15 @@ class GpuEscape {
   // axis[k]) of planes first ≤ p < first + planes, res = axis.size(), in
   // escapeGridBytesPerCount(limit) little-endian bytes each (generators/escape_grid.h
   // EscapePlaneFunction).
+  // Where `counts` lies in the arena (below) and each row's bytes are whole words, the dispatches
+  // write there in place; elsewhere they are copied out of a staging buffer.
   Status escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
                       int limit, uint8_t* counts);
+
+  // `bytes` of host-visible memory that escapePlanes writes in place (generators/escape_grid.h
+  // EscapeArena), valid until the next call asks for more; nullptr where the counts are not
+  // packed (lavapipe) or one buffer cannot hold that much.
+  Result<uint8_t*> arena(uint64_t bytes);
 
   // counts[r·dcx.size() + col] and tails[...]: mandelbrot2d's perturbed count of δc = (dcx[col],
   // dcy[r]) against `orbit` and its escape tail (generators/mandelbrot2d.cpp).
@@ -83,9 +92,10 @@ class GpuEscape {
     Buffer counts;
     Buffer tails;  // mandelbrot2d's escape tails; made at the first perturbation call
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
+    VkDescriptorSet arena_set = VK_NULL_HANDLE;  // the escape kernel writing into arena_
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
-    void* destination = nullptr;             // where the counts of the dispatch in flight go
+    void* destination = nullptr;             // where the counts of the dispatch in flight go; null: in place
     uint32_t count_bytes = 4;                // and the bytes of each there
     uint32_t device_bytes = 4;               // the bytes of each in `counts`
     EscapeTail* tail_destination = nullptr;  // where its tails go (a perturbation dispatch), or null
@@ -115,6 +125,8 @@ class GpuEscape {
   double gpu_ms_ = 0.0;
   double wait_ms_ = 0.0, copy_ms_ = 0.0;
   Buffer axis_, orbit_, dcx_, dcy_;
+  Buffer arena_;
+  bool arena_sets_stale_ = true;  // the slots' arena sets do not name axis_ and arena_ yet
   std::vector<double> axis_values_;  // what axis_ holds
 };
 

@@ -53,6 +53,7 @@ struct MandelbulbParams {
   uint64_t max_memory = 0;       // bytes; 0: half of physical memory
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
+  EscapeArena arena;             // where `planes` writes fastest (escape_grid.h); empty: the heap
   bool full_counts = false;      // every count to max_iter, not capped above the level (escape_grid.h)
 };
 

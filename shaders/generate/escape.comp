@@ -33,6 +33,7 @@ layout(push_constant) uniform Push {
   uint count;         // points in this dispatch: whole rows, k fastest
   uint limit;         // iterations at most
   uint bits;          // bits a count: 8, 16 or 32
+  uint word_offset;   // the words of `counts` before this dispatch's first
 };
 
 shared uint packed[128];  // this group's counts, packed: 256 of 16 bits at most
@@ -114,7 +115,7 @@ void main() {
     value = kKind == 0u ? juliaCount(x, y, z) : mandelbulbCount(x, y, z);
   }
   if (kPacked == 0u) {  // no barrier in this pipeline
-    if (t < count) counts[t] = value;
+    if (t < count) counts[word_offset + t] = value;
     return;
   }
   // Every invocation reaches the barriers (none returned early).
@@ -124,5 +125,5 @@ void main() {
   atomicOr(packed[lid / per], value << ((lid % per) * bits));
   barrier();
   const uint word = base / per + lid;
-  if (lid < words && word < (count + per - 1u) / per) counts[word] = packed[lid];
+  if (lid < words && word < (count + per - 1u) / per) counts[word_offset + word] = packed[lid];
 }

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <span>
 
 #include "generators/julia.h"
 #include "generators/mandelbrot2d.h"
@@ -60,6 +61,13 @@ class GpuGenerate : public ::testing::Test {
       return gpu->escapePlanes(kernel, values, first, count, limit, counts);
     };
   }
+  // The packed device's arena (GpuEscape::arena), as the CLI hands it to a generator.
+  static EscapeArena arena() {
+    return [](uint64_t bytes) -> uint8_t* {
+      Result<uint8_t*> memory = packed_->arena(bytes);
+      return memory ? *memory : nullptr;
+    };
+  }
   static EscapeKernelParams julia(const glm::dvec4& c) {
     return {EscapeKernel::kJulia, c, kJuliaEscapeSquare, 0.0};
   }
@@ -67,17 +75,27 @@ class GpuGenerate : public ::testing::Test {
     return {EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2, kMandelbulbTrapC2};
   }
 
-  // The device's planes [first, first + count) against computeEscapeGrid's, packed and narrowed:
-  // little-endian counts of escapeGridBytesPerCount(limit) bytes, and not a byte written past them.
+  // The device's planes [first, first + count) against computeEscapeGrid's, packed (copied out and,
+  // into the arena, in place where the rows are whole words) and narrowed: little-endian counts of
+  // escapeGridBytesPerCount(limit) bytes, and not a byte written past them.
   static void expectSameGrid(const EscapeKernelParams& kernel, const EscapeRowFunction& row, const GridAxis& axis,
                              int limit, int first, int count) {
     Result<std::vector<uint32_t>> cpu = computeEscapeGrid(axis, limit, row, 0, first, count);
     ASSERT_TRUE(cpu.ok());
     const size_t bytes = static_cast<size_t>(escapeGridBytesPerCount(limit));
-    for (bool packed : {true, false}) {
+    for (int path = 0; path < 3; ++path) {
+      const bool packed = path != 1, in_arena = path == 2;
       SCOPED_TRACE("res " + std::to_string(axis.resolution) + ", limit " + std::to_string(limit) + ", planes " +
-                   std::to_string(first) + "+" + std::to_string(count) + (packed ? ", packed" : ", narrowed"));
-      std::vector<uint8_t> gpu(cpu->size() * bytes + 16, 0xA5);
+                   std::to_string(first) + "+" + std::to_string(count) +
+                   (in_arena ? ", arena" : packed ? ", packed" : ", narrowed"));
+      std::vector<uint8_t> heap(cpu->size() * bytes + 16, 0xA5);
+      std::span<uint8_t> gpu(heap);
+      if (in_arena) {
+        Result<uint8_t*> arena = packed_->arena(heap.size());
+        ASSERT_TRUE(arena.ok() && *arena);
+        gpu = std::span<uint8_t>(*arena, heap.size());
+        std::fill(gpu.begin(), gpu.end(), uint8_t{0xA5});
+      }
       Status s = planes(kernel, axis, packed)(first, count, limit, gpu.data());
       ASSERT_TRUE(s.ok()) << s.error().message;
       size_t differ = 0;
@@ -247,6 +265,23 @@ TEST_F(GpuGenerate, meshesFromDevicePlanesEqualTheCpuMeshes) {
   Result<PointSet> full = generateMandelbulb(bulb);
   ASSERT_TRUE(full.ok()) << full.error().message;
   EXPECT_TRUE(sameMesh(*cpu, *full));
+  // The blocks in the device's arena, written there in place (res 44: rows of whole words) or
+  // copied in (res 45), capped and full.
+  for (int res : {44, 45}) {
+    MandelbulbParams on_cpu;
+    on_cpu.resolution = res;
+    on_cpu.variant = MandelbulbVariant::kFast;
+    Result<PointSet> expected = generateMandelbulb(on_cpu);
+    MandelbulbParams in_arena = on_cpu;
+    in_arena.planes = planes(mandelbulb(), GridAxis{res, -1.5, 1.5});
+    in_arena.arena = arena();
+    for (bool full_counts : {false, true}) {
+      in_arena.full_counts = full_counts;
+      Result<PointSet> got = generateMandelbulb(in_arena);
+      ASSERT_TRUE(expected.ok() && got.ok());
+      EXPECT_TRUE(sameMesh(*expected, *got)) << "res " << res << (full_counts ? ", full" : ", capped");
+    }
+  }
   // Above 255 iterations a count takes two bytes: capped (widened for the CPU's finishing) and full.
   MandelbulbParams deep;
   deep.resolution = 33;
@@ -265,6 +300,7 @@ TEST_F(GpuGenerate, meshesFromDevicePlanesEqualTheCpuMeshes) {
   julia_params.resolution = 38;
   Result<PointSet> julia_cpu = generateJulia(julia_params);
   julia_params.planes = planes(julia(julia_params.c), GridAxis{38, -1.5, 1.5});
+  julia_params.arena = arena();
   Result<PointTile> tile = generateJuliaTile(julia_params, {1, 3});
   JuliaParams on_cpu;
   on_cpu.resolution = 38;
