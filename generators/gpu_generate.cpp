@@ -312,9 +312,9 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
   const uint32_t count_bytes = static_cast<uint32_t>(escapeGridBytesPerCount(limit));
   // In the arena, with every row whole words (so no dispatch writes a word another one does).
   const uint64_t total = static_cast<uint64_t>(planes) * res * res * count_bytes;
-  const uint8_t* arena = static_cast<const uint8_t*>(arena_.mapped);
-  const bool in_place = packed_counts_ && arena && counts >= arena && counts + total <= arena + arena_.size &&
-                        (counts - arena) % 4 == 0 && res * count_bytes % 4 == 0;
+  const uintptr_t arena = reinterpret_cast<uintptr_t>(arena_.mapped), at = reinterpret_cast<uintptr_t>(counts);
+  const bool in_place = packed_counts_ && arena != 0 && at >= arena && at - arena + total <= arena_.size &&
+                        (at - arena) % 4 == 0 && res * count_bytes % 4 == 0;
   if (in_place && arena_sets_stale_) {
     for (Slot& slot : slots_) writeSet(context_, slot.arena_set, {&axis_, &arena_});
     arena_sets_stale_ = false;
@@ -340,7 +340,7 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * res);
     uint8_t* destination = counts + (row - first_row) * res * count_bytes;
-    push.word_offset = in_place ? static_cast<uint32_t>((destination - arena) / 4) : 0;
+    push.word_offset = in_place ? static_cast<uint32_t>((reinterpret_cast<uintptr_t>(destination) - arena) / 4) : 0;
     if (Status st = dispatch(s, pipeline, escape_layout_, in_place ? slots_[s].arena_set : slots_[s].escape_set, &push,
                              sizeof push, rows * res, in_place ? nullptr : destination, count_bytes, device_bytes,
                              nullptr);
