@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <type_traits>
 
 #include "core/parallel.h"
 #include "generators/escape_grid.h"
@@ -61,26 +62,19 @@ Result<VkPipeline> createPipeline(const VulkanContext& context, const uint32_t* 
   return pipeline;
 }
 
-// Copies `bytes` out of mapped memory on several threads: one thread copies at a fraction of the
-// host's bandwidth, and this copy is on the critical path of the thread that feeds the meshing
-// workers.
-void copyOut(void* to, const void* from, uint64_t bytes) {
-  constexpr uint64_t kPiece = uint64_t{4} << 20;
-  parallelFor((bytes + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
-    const uint64_t at = i * kPiece;
-    std::memcpy(static_cast<uint8_t*>(to) + at, static_cast<const uint8_t*>(from) + at, std::min(kPiece, bytes - at));
-  });
-}
-
-// The same for `points` uint32 counts narrowed to T each (lavapipe's, which it writes whole).
-template <typename T>
-void copyOutNarrowed(void* to, const void* from, uint64_t points) {
-  constexpr uint64_t kPiece = uint64_t{1} << 20;
-  parallelFor((points + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
-    const uint64_t at = i * kPiece, end = std::min(at + kPiece, points);
-    const uint32_t* source = static_cast<const uint32_t*>(from);
-    T* target = static_cast<T*>(to);
-    for (uint64_t p = at; p < end; ++p) target[p] = static_cast<T>(source[p]);
+// Copies `count` values of type From out of mapped memory as To (the same type, or lavapipe's
+// uint32 counts narrowed) on several threads: one thread copies at a fraction of the host's
+// bandwidth, and this copy is on the critical path of the thread that feeds the meshing workers.
+template <typename To, typename From>
+void copyOut(void* to, const void* from, uint64_t count) {
+  constexpr uint64_t kPiece = (uint64_t{4} << 20) / sizeof(From);  // 4 MiB read a piece
+  parallelFor((count + kPiece - 1) / kPiece, std::min(8u, resolveThreads(0)), [&](size_t i, unsigned) {
+    const uint64_t at = i * kPiece, end = std::min(at + kPiece, count);
+    const From* source = static_cast<const From*>(from);
+    if constexpr (std::is_same_v<To, From>)
+      std::copy(source + at, source + end, static_cast<To*>(to) + at);  // a memmove
+    else
+      std::transform(source + at, source + end, static_cast<To*>(to) + at, [](From v) { return static_cast<To>(v); });
   });
 }
 
@@ -226,15 +220,15 @@ Status GpuEscape::finish(Slot& slot) {
   } else {
     if (Status s = invalidateBuffer(context_, slot.counts); !s) return s;
     if (slot.device_bytes == slot.count_bytes)
-      copyOut(slot.destination, slot.counts.mapped, points * slot.count_bytes);
+      copyOut<uint8_t, uint8_t>(slot.destination, slot.counts.mapped, points * slot.count_bytes);
     else if (slot.count_bytes == 1)
-      copyOutNarrowed<uint8_t>(slot.destination, slot.counts.mapped, points);
+      copyOut<uint8_t, uint32_t>(slot.destination, slot.counts.mapped, points);
     else
-      copyOutNarrowed<uint16_t>(slot.destination, slot.counts.mapped, points);
+      copyOut<uint16_t, uint32_t>(slot.destination, slot.counts.mapped, points);
   }
   if (slot.tail_destination) {
     if (Status s = invalidateBuffer(context_, slot.tails); !s) return s;
-    copyOut(slot.tail_destination, slot.tails.mapped, points * sizeof(EscapeTail));
+    copyOut<EscapeTail, EscapeTail>(slot.tail_destination, slot.tails.mapped, points);
   }
   const auto copied = std::chrono::steady_clock::now();
   wait_ms_ += std::chrono::duration<double, std::milli>(waited - start).count();
