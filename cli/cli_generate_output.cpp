@@ -18,12 +18,16 @@
 namespace dpoint {
 namespace {
 
+PointColors pointColorsOf(const OutputOptions& o) {
+  return o.colors == "noise" ? PointColors::kNoise : o.colors == "none" ? PointColors::kNone : PointColors::kAuto;
+}
+
 // Colours and offset (generators/generate.h): the steps after any generator that act point by point.
 Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise) {
   Result<uint64_t> limit = memoryLimit(o);
   if (!limit) return limit.error();
-  const PointColors colors = o.colors == "noise" ? PointColors::kNoise : o.colors == "none" ? PointColors::kNone : PointColors::kAuto;
-  if (Status s = colorGenerated(points, PointColoring{colors, auto_noise, o.common.threads, *limit}); !s) return s;
+  const PointColoring coloring{pointColorsOf(o), auto_noise, o.common.threads, *limit};
+  if (Status s = colorGenerated(points, coloring); !s) return s;
   if (o.offset.empty()) return okStatus();
   Result<glm::dvec3> offset = parseVec3("--offset", o.offset);
   if (!offset) return offset.error();
@@ -37,9 +41,8 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
 // written being those coloured (no --offset after the colours, no --sample interpolating them). A
 // reorder is no obstacle: a colour is a function of its point's position.
 bool coloursAtWrite(const OutputOptions& o, bool auto_noise) {
-  const bool noise = o.colors == "noise" || (o.colors == "auto" && auto_noise);
   Result<FileFormat> format = formatOf(o.output);
-  return noise && !capturingPoints() && format && *format == FileFormat::kPly && o.offset.empty() &&
+  return noiseColors(pointColorsOf(o), auto_noise) && !capturingPoints() && format && *format == FileFormat::kPly && o.offset.empty() &&
          o.sample.count == 0;
 }
 
@@ -111,7 +114,7 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   w.progress = &progress;
   if (colours_at_write)
     w.colors_of = [&points](size_t begin, size_t end, glm::vec3* colors) {
-      for (size_t i = begin; i < end; ++i) colors[i - begin] = seedColor(points.positions[i]);
+      seedColors(&points.positions[begin], end - begin, colors);
     };
   if (Status s = writePointsWithNotes(o.output, points, w); !s) return reportError(s.error());
   if (!o.common.quiet)

@@ -9,8 +9,12 @@
 
 namespace dpoint {
 
+bool noiseColors(PointColors colors, bool auto_noise) {
+  return colors == PointColors::kNoise || (colors == PointColors::kAuto && auto_noise);
+}
+
 Status colorGenerated(PointSet& points, const PointColoring& coloring) {
-  const bool noise = coloring.colors == PointColors::kNoise || (coloring.colors == PointColors::kAuto && coloring.auto_noise);
+  const bool noise = noiseColors(coloring.colors, coloring.auto_noise);
   if (coloring.colors == PointColors::kNone) points.colors.clear();
   if (!noise) return okStatus();
   // The generators' own estimates cover positions and triangles; colours come on top.

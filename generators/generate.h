@@ -16,6 +16,9 @@ namespace dpoint {
 // --colors: auto (the kind's own choice), noise (the seed's pnoise3), none.
 enum class PointColors { kAuto, kNoise, kNone };
 
+// Whether `colors` means noise for a kind whose auto is noise (auto_noise) or not.
+bool noiseColors(PointColors colors, bool auto_noise);
+
 struct PointColoring {
   PointColors colors = PointColors::kAuto;
   bool auto_noise = false;  // what auto means for the kind: noise for the 3D fractals

@@ -110,13 +110,17 @@ glm::vec3 seedColor(const glm::dvec3& p) {
   return color;
 }
 
+void seedColors(const glm::dvec3* positions, size_t n, glm::vec3* colors) {
+  for (size_t i = 0; i < n; ++i) colors[i] = seedColor(positions[i]);
+}
+
 void colorByNoise(PointSet& points, unsigned threads) {
   constexpr size_t kPointsPerChunk = size_t{1} << 14;
   resizePrefaulted(points.colors, points.positions.size(), threads);
   const size_t chunks = (points.positions.size() + kPointsPerChunk - 1) / kPointsPerChunk;
   parallelFor(chunks, threads, [&](size_t chunk, unsigned) {
-    const size_t end = std::min(points.positions.size(), (chunk + 1) * kPointsPerChunk);
-    for (size_t i = chunk * kPointsPerChunk; i < end; ++i) points.colors[i] = seedColor(points.positions[i]);
+    const size_t begin = chunk * kPointsPerChunk, end = std::min(points.positions.size(), begin + kPointsPerChunk);
+    seedColors(&points.positions[begin], end - begin, &points.colors[begin]);
   });
 }
 

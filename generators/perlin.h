@@ -10,6 +10,8 @@
 // reference/pnoise3_samples.csv for equality.
 #pragma once
 
+#include <cstddef>
+
 #include <glm/vec3.hpp>
 
 #include "core/point_set.h"
@@ -26,6 +28,8 @@ float pnoise3(float x, float y, float z);
 // to float, so here p + offset is formed in double and rounded to float once; 0.5 + 0.5·n is
 // formed in double (exact: n is a float) and rounded to float once for storage.
 glm::vec3 seedColor(const glm::dvec3& p);
+// colors[i] = seedColor(positions[i]) for i < n.
+void seedColors(const glm::dvec3* positions, size_t n, glm::vec3* colors);
 
 // Sets points.colors to seedColor of every position (replacing any colours), split over
 // `threads` (0: all cores); the result does not depend on the thread count.
