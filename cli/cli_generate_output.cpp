@@ -1,6 +1,8 @@
 #include "cli/cli_generate_output.h"
 
+#include <cassert>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -112,15 +114,65 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.progress = &progress;
-  if (colours_at_write)
-    w.colors_of = [&points](size_t begin, size_t end, glm::vec3* colors) {
-      seedColors(&points.positions[begin], end - begin, colors);
-    };
+  if (colours_at_write) w.colors_of = seedColors;
   if (Status s = writePointsWithNotes(o.output, points, w); !s) return reportError(s.error());
   if (!o.common.quiet)
     std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles%s\n",
                  generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3,
                  colours_at_write ? "; the colours made as the rows were written" : "");
+  return 0;
+}
+
+bool canFinishMade(const OutputOptions& o, bool auto_noise) {
+  Result<FileFormat> format = formatOf(o.output);
+  return !capturingPoints() && format && *format == FileFormat::kPly && o.sample.count == 0 &&
+         !(noiseColors(pointColorsOf(o), auto_noise) && !o.offset.empty());
+}
+
+int finishMade(const PointFunction& made, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
+               PhaseClock& clock) {
+  assert(canFinishMade(o, auto_noise));
+  const double generate_s = clock.lap();
+  Result<uint64_t> limit = memoryLimit(o);
+  if (!limit) return reportError(limit.error());
+  glm::dvec3 offset(0.0);
+  if (!o.offset.empty()) {
+    Result<glm::dvec3> parsed = parseVec3("--offset", o.offset);
+    if (!parsed) return reportError(parsed.error());
+    offset = *parsed;
+  }
+  // As offsetPoints adds it: one rounding a coordinate. z stays +0 (a 2D set) only where the
+  // offset's z is ±0.
+  std::function<glm::dvec3(uint64_t)> at = made.at;
+  if (offset != glm::dvec3(0.0)) at = [&made, offset](uint64_t i) { return made.at(i) + offset; };
+  PointSet facts;
+  facts.z_axis = made.z_present || offset.z != 0.0 ? ZAxis::kPresent : ZAxis::kAbsent;
+  const double colours_s = clock.lap();
+
+  WriteOptions w;
+  w.threads = o.common.threads;
+  w.progress = &progress;
+  if (noiseColors(pointColorsOf(o), auto_noise)) w.colors_of = seedColors;
+  std::optional<MortonRows> rows;
+  if (order == PointOrder::kMorton) {
+    if (Status s = checkOrderable(made.count); !s) return reportError(s.error());
+    if (Status s = checkMemory("ordering " + std::to_string(made.count) + " points", mortonRowsBytes(made.count), *limit); !s)
+      return reportError(s.error());
+    rows = mortonRows(made.count, at, o.common.threads, &progress);
+    w.positions_of = {made.count, [&rows, &at](size_t begin, size_t end, glm::dvec3* out) {
+                        for (size_t r = begin; r < end; ++r) out[r - begin] = at(rows->source(r));
+                      }};
+  } else {
+    w.positions_of = {made.count, [&at](size_t begin, size_t end, glm::dvec3* out) {
+                        for (size_t i = begin; i < end; ++i) out[i - begin] = at(i);
+                      }};
+  }
+  const double order_s = clock.lap();
+  if (Status s = writePointsWithNotes(o.output, facts, w); !s) return reportError(s.error());
+  if (!o.common.quiet)
+    std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %llu points, 0 triangles; "
+                 "the points made as the rows were written\n",
+                 generate_s, colours_s, order_s, clock.lap(), static_cast<unsigned long long>(made.count));
   return 0;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -55,6 +56,22 @@ Result<TileSpec> tileOptions(const OutputOptions& o);
 // where the time went (generation counted from `clock`'s start, before the parameters).
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
            PhaseClock& clock);
+// A set whose points are a function of their index (random2d): `count` of them, point i at at(i),
+// called from several threads at once; z_present when some z is not 0.
+struct PointFunction {
+  uint64_t count = 0;
+  std::function<glm::dvec3(uint64_t)> at;
+  bool z_present = false;
+};
+// Whether finishMade writes this output: a .ply written here (not handed back), no --sample, and
+// not noise colours with an --offset (they are made from the points before the offset, which the
+// writer's rows no longer hold).
+bool canFinishMade(const OutputOptions& o, bool auto_noise);
+// finish for a PointFunction: the same file, with no array of points held. The offset is added as
+// each point is made, the Morton order is taken as rows (ops/point_order.h's mortonRows), and the
+// PLY writer makes each chunk's positions, and noise colours, as it formats the rows.
+int finishMade(const PointFunction& points, const OutputOptions& o, PointOrder order, bool auto_noise,
+               Progress& progress, PhaseClock& clock);
 // A tile: colours and offset on its points, then its part file.
 int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_noise, const std::string& signature,
                Progress& progress);

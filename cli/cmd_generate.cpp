@@ -35,10 +35,11 @@ template <typename Params, typename Options>
 void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* cmd, bool auto_noise,
                   Result<PointSet> (*generate)(const Params&),
                   Result<PointTile> (*generate_tile)(const Params&, TileSpec),
-                  Result<Params> (*makeParams)(const Options&, Progress*)) {
-  cmd->callback([o, &run, cmd, auto_noise, generate, generate_tile, makeParams, name = cmd->get_name()] {
+                  Result<Params> (*makeParams)(const Options&, Progress*),
+                  PointFunction (*made)(const Params&) = nullptr) {
+  cmd->callback([o, &run, cmd, auto_noise, generate, generate_tile, makeParams, made, name = cmd->get_name()] {
     const std::string signature = o->out.tile.empty() ? std::string() : tileSignature(name, cmd->config_to_str(true, false));
-    run = [o, auto_noise, generate, generate_tile, makeParams, name, signature] {
+    run = [o, auto_noise, generate, generate_tile, makeParams, made, name, signature] {
       if (Status s = checkHandedBack(o->out); !s) return reportError(s.error());
       Result<PointOrder> order = parsePointOrder("--order", o->out.order);
       if (!order) return reportError(order.error());
@@ -53,6 +54,7 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
       Result<Params> params = makeParams(*o, &progress);
       if (!params) return reportError(params.error());
       if (tile) return finishTile(generate_tile(*params, *tile), o->out, auto_noise, signature, progress);
+      if (made && canFinishMade(o->out, auto_noise)) return finishMade(made(*params), o->out, *order, auto_noise, progress, clock);
       return finish(generate(*params), o->out, *order, auto_noise, progress, clock);
     };
   });
@@ -281,7 +283,11 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
       ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40));
   random2d->add_option("--seed", r->params.seed, "Seed of the generator")->default_val(1);
   addOutputOptions(*random2d, r->out, "none");
-  registerKind(run, r, random2d, false, &generateRandom2d, &generateRandom2dTile, &plainParams<Random2dParams>);
+  // Written to a .ply, its points are made as the rows are written (finishMade): no array of them.
+  registerKind(run, r, random2d, false, &generateRandom2d, &generateRandom2dTile, &plainParams<Random2dParams>,
+               +[](const Random2dParams& p) {
+                 return PointFunction{p.count, [seed = p.seed](uint64_t i) { return random2dPoint(seed, i); }};
+               });
 
   auto m2 = std::make_shared<Mandelbrot2dOptions>();
   CLI::App* mandelbrot2d = generate->add_subcommand(

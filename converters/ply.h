@@ -41,9 +41,9 @@ struct PlyReadOptions {
   uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
 };
 
-// Colours of points [begin, end) into colors[0 .. end − begin), made on demand; called from
-// several threads at once.
-using ColorSource = std::function<void(size_t begin, size_t end, glm::vec3* colors)>;
+// Colours of `count` rows whose positions are `positions` into colors[0 .. count), made on demand;
+// called from several threads at once.
+using ColorSource = std::function<void(const glm::dvec3* positions, size_t count, glm::vec3* colors)>;
 
 struct PlyWriteOptions {
   PlyEncoding encoding = PlyEncoding::kBinary;
@@ -54,6 +54,11 @@ struct PlyWriteOptions {
   // (a generator's noise colours then take no time of their own, nor 12 bytes a point); the file
   // is the one the set with those colours gives.
   ColorSource colors_of;
+  // Set, for a set that holds no points but their facts (z axis, source): positions_of.count
+  // vertex rows whose positions are made chunk by chunk as the rows are formatted (core/point_set.h);
+  // the file is the one the set holding those positions gives. The set then has no colours,
+  // triangles or dimensions (colours may come from colors_of).
+  MadePositions positions_of;
 };
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});

@@ -115,7 +115,9 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
 }
 
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
-  const size_t n = points.size();
+  const MadePositions& made = options.positions_of;
+  assert(!made || (points.positions.empty() && !points.hasColors() && !points.isMesh() && points.dimensions.empty()));
+  const size_t n = made ? made.count : points.size();
   assert(!(options.colors_of && points.hasColors()));
   const bool colors = points.hasColors() || options.colors_of;
   if (points.hasColors() && points.colors.size() != n)
@@ -152,21 +154,30 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
     const size_t total = k - 1 < vertex_chunks ? n : faces;
     return {c * kRowsPerChunk, std::min(total, (c + 1) * kRowsPerChunk)};
   };
+  // The chunk's positions, at [i − begin]: the set's, or made now by positions_of.
+  auto chunkPositions = [&](size_t begin, size_t end) -> const glm::dvec3* {
+    if (!made) return points.positions.data() + begin;
+    thread_local std::vector<glm::dvec3> chunk;
+    chunk.resize(end - begin);
+    made.make(begin, end, chunk.data());
+    return chunk.data();
+  };
   // The chunk's colours, at [i − begin]: the set's, or made now by colors_of.
-  auto chunkColors = [&](size_t begin, size_t end) -> const glm::vec3* {
+  auto chunkColors = [&](const glm::dvec3* positions, size_t begin, size_t end) -> const glm::vec3* {
     if (!options.colors_of) return colors ? points.colors.data() + begin : nullptr;
-    thread_local std::vector<glm::vec3> made;
-    made.resize(end - begin);
-    options.colors_of(begin, end, made.data());
-    return made.data();
+    thread_local std::vector<glm::vec3> chunk;
+    chunk.resize(end - begin);
+    options.colors_of(positions, end - begin, chunk.data());
+    return chunk.data();
   };
   auto vertexRows = [&](size_t begin, size_t end, std::vector<char>& bytes) {
-    const glm::vec3* chunk_colors = chunkColors(begin, end);
+    const glm::dvec3* chunk_positions = chunkPositions(begin, end);
+    const glm::vec3* chunk_colors = chunkColors(chunk_positions, begin, end);
     if (!ascii) {
       bytes.resize((end - begin) * vertex_bytes);
       char* row = bytes.data();
       for (size_t i = begin; i < end; ++i) {
-        std::memcpy(row, &points.positions[i], sizeof(glm::dvec3));
+        std::memcpy(row, &chunk_positions[i - begin], sizeof(glm::dvec3));
         char* at = row + sizeof(glm::dvec3);
         if (colors) {
           const glm::vec3& c = chunk_colors[i - begin];
@@ -199,7 +210,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
     }
     ChunkText out(bytes);
     for (size_t i = begin; i < end; ++i) {
-      const glm::dvec3& p = points.positions[i];
+      const glm::dvec3& p = chunk_positions[i - begin];
       appendNumber(out, p.x, ' ');
       appendNumber(out, p.y, ' ');
       appendNumber(out, p.z, colors || attributes ? ' ' : '\n');

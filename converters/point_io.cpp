@@ -197,8 +197,8 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
-  if (options.colors_of && *format != FileFormat::kPly)
-    return Error{path + ": colours made as the rows are written go to a .ply only"};
+  if ((options.colors_of || options.positions_of) && *format != FileFormat::kPly)
+    return Error{path + ": points made as the rows are written go to a .ply only"};
   switch (*format) {
     case FileFormat::kCsv:
       return writeCsv(path, points,
@@ -206,7 +206,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     case FileFormat::kPly:
       return writePly(path, points,
                       PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
-                                      options.colors_of});
+                                      options.colors_of, options.positions_of});
     case FileFormat::kPcd:
       return writePcd(path, points, PcdWriteOptions{options.pcd_encoding, options.progress, options.notices});
     case FileFormat::kGlb:

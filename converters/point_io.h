@@ -68,8 +68,10 @@ struct WriteOptions {
   // When not null, gets one line per thing the file cannot hold as given (GLB: points that will
   // not read back bit-exactly).
   std::vector<std::string>* notices = nullptr;
-  // PLY only (another format is refused): colours made as the rows are (PlyWriteOptions).
+  // PLY only (another format is refused): colours, or positions, made as the rows are
+  // (PlyWriteOptions); with positions_of, `points` holds only the set's facts.
   ColorSource colors_of;
+  MadePositions positions_of;
 };
 
 Result<PointSet> readPoints(const std::string& path, const ReadOptions& options = {});

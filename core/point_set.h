@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,6 +68,16 @@ struct PointSet {
   // The position in `triangles` of the first index that names no point, or triangles.size() when
   // every one does; checked on `threads` cores (0: all), as a big mesh has hundreds of millions.
   size_t firstBadTriangleIndex(unsigned threads = 0) const;
+};
+
+// Points that are not held but made on demand, `count` of them: make(begin, end, out) writes the
+// positions of points [begin, end) to out[0 .. end - begin). For a generator whose points are a
+// function of their index (random2d), so that a writer formats its rows straight from them and
+// no array of positions is ever held. Called from several threads at once.
+struct MadePositions {
+  size_t count = 0;
+  std::function<void(size_t begin, size_t end, glm::dvec3* out)> make;
+  explicit operator bool() const { return static_cast<bool>(make); }
 };
 
 // A colour channel as an integer of `full` (255, 65535): round(clamp(c, 0, 1) · full), NaN as 0.

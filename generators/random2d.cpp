@@ -8,14 +8,6 @@ namespace {
 
 constexpr size_t kPointsPerChunk = 1u << 16;
 
-// (u >> 11) is an integer m < 2^53; (m - 2^52) · 2^-52 lies in [-1, 1) and both steps are exact
-// (an integer below 2^53 in magnitude, then a power-of-two scaling).
-double unitSigned(uint64_t u) {
-  const int64_t m = static_cast<int64_t>(u >> 11) - (int64_t{1} << 52);
-  return static_cast<double>(m) * 0x1p-52;
-}
-
-
 // Points [first, last) of the whole set.
 Result<PointSet> generateRange(const Random2dParams& params, uint64_t first, uint64_t last) {
   if (params.count == 0) return Error{"--count 0: must be at least 1", ExitCode::kUsage};
@@ -30,11 +22,7 @@ Result<PointSet> generateRange(const Random2dParams& params, uint64_t first, uin
   if (params.progress) params.progress->start("random2d", count);
   parallelFor(chunks, params.threads, [&](size_t chunk, unsigned) {
     const size_t end = std::min<size_t>(count, (chunk + 1) * kPointsPerChunk);
-    for (size_t i = chunk * kPointsPerChunk; i < end; ++i) {
-      const uint64_t n = first + i;
-      points.positions[i] = glm::dvec3(unitSigned(splitmix64At(params.seed, 2 * n)),
-                                       unitSigned(splitmix64At(params.seed, 2 * n + 1)), 0.0);
-    }
+    for (size_t i = chunk * kPointsPerChunk; i < end; ++i) points.positions[i] = random2dPoint(params.seed, first + i);
     if (params.progress) params.progress->advance(end - chunk * kPointsPerChunk);
   });
   if (params.progress) params.progress->finish();

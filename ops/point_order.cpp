@@ -14,16 +14,14 @@
 // (parallel over contiguous chunks for large ranges) and narrower ones as ranges shrink, so all
 // levels below the first run in cache; ranges of 32 or fewer are insertion-sorted. Every pass is
 // a stable counting sort, so the result is the one stable order of the codes, whatever the
-// threads and chunks were. The gather then moves positions, colours and triangle indices once.
+// threads and chunks were. The gather then moves positions, colours and triangle indices once;
+// mortonRows moves nothing and hands the order back as rows instead, for points made on demand.
 #include "ops/point_order.h"
-
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <bit>
 #include <cassert>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -135,49 +133,28 @@ uint64_t uniformBelow(std::mt19937_64& rng, uint64_t bound) {
   return r % bound;
 }
 
-// All the scratch memory, one allocation of 28 bytes per point, left uninitialized (the passes
-// that first write it fault its pages in, over all threads). During the sort it holds the keys
-// twice, each pass reading one copy and writing the other:
-//   bytes [0, 8n) code[0], [8n, 16n) code[1], [16n, 20n) index[0], [24n, 28n) index[1].
-// The sorted indices end in index[1]; the first 24n bytes then take one gathered array at a time
-// (the positions, then the colours, then the triangles' renumbering), so a fresh allocation,
-// its page faults and std::vector's single-threaded zeroing are paid once, not three times.
+// Uninitialized memory for the sort's arrays, on 2 MiB pages where Linux gives them
+// (core/memory.h's LargeBuffer): the scatter and the gathers jump all over it, and with 4 KiB pages
+// their TLB misses and page faults took 15% of the time at 16.7M points. The passes that first
+// write it fault its pages in, over all threads. reorderPoints' keys take the first 20 bytes a point
+// (code[0] at 0, code[1] at 8n, index[0] at 16n); once sorted, the first 24 take one gathered array
+// at a time (the positions, then the colours, then the triangles' renumbering), so a fresh
+// allocation, its page faults and std::vector's single-threaded zeroing are paid once, not three
+// times. The sorted indices (index[1]) lie in a buffer of their own, which MortonRows keeps.
 class Scratch {
  public:
-  explicit Scratch(size_t n) : size_(28 * n) {
-    // Large scratch goes on 2 MiB pages where Linux gives them (a hint, nothing depends on it):
-    // the scatter and the gathers jump all over it, and with 4 KiB pages their TLB misses and
-    // page faults took 15% of the time at 16.7M points.
-    constexpr size_t kHugePage = size_t{1} << 21;
-    void* p = nullptr;
-    if (size_ >= 4 * kHugePage) {
-      const size_t rounded = (size_ + kHugePage - 1) / kHugePage * kHugePage;
-      p = std::aligned_alloc(kHugePage, rounded);
-#ifdef MADV_HUGEPAGE
-      if (p) ::madvise(p, rounded, MADV_HUGEPAGE);
-#endif
-    } else {
-      p = std::malloc(size_);
-    }
-    if (!p) throw std::bad_alloc();  // as std::vector would; the CLI reports it (exit 4)
-    bytes_.reset(static_cast<std::byte*>(p));
-  }
+  explicit Scratch(size_t bytes) : buffer_(bytes) {}
   // Starts the lifetime of `count` objects of type T at byte `offset` and returns the first. For
   // the trivial types used here this generates no code.
   template <typename T>
   T* array(size_t offset, size_t count) {
     static_assert(std::is_trivially_destructible_v<T>);
-    assert(offset % alignof(T) == 0 && offset + count * sizeof(T) <= size_);
-    std::uninitialized_default_construct_n(reinterpret_cast<T*>(bytes_.get() + offset), count);
-    return std::launder(reinterpret_cast<T*>(bytes_.get() + offset));
+    assert(offset % alignof(T) == 0 && offset + count * sizeof(T) <= buffer_.size());
+    std::uninitialized_default_construct_n(reinterpret_cast<T*>(buffer_.data() + offset), count);
+    return std::launder(reinterpret_cast<T*>(buffer_.data() + offset));
   }
-
  private:
-  struct Free {
-    void operator()(std::byte* p) const { std::free(p); }
-  };
-  size_t size_;
-  std::unique_ptr<std::byte[], Free> bytes_;
+  LargeBuffer buffer_;
 };
 
 struct SortKeys {
@@ -348,37 +325,35 @@ void gatherDimension(Dimension& d, const uint32_t* sorted, const std::vector<uin
   }
 }
 
-}  // namespace
+// The points' positions a chunk at a time: the set's own (HeldPositions), or made by a function of
+// the index into a buffer of the calling thread's (MadePositionsAt). chunk(begin, end) returns
+// positions [begin, end), valid until the thread's next call.
+struct HeldPositions {
+  const glm::dvec3* data;
+  const glm::dvec3* chunk(size_t begin, size_t) const { return data + begin; }
+};
+struct MadePositionsAt {
+  const std::function<glm::dvec3(uint64_t)>& at;
+  const glm::dvec3* chunk(size_t begin, size_t end) const {
+    thread_local std::vector<glm::dvec3> buffer;
+    buffer.resize(end - begin);
+    for (size_t i = begin; i < end; ++i) buffer[i - begin] = at(i);
+    return buffer.data();
+  }
+};
 
-Result<PointOrder> parsePointOrder(const std::string& flag, const std::string& text) {
-  if (text == "input") return PointOrder::kInput;
-  if (text == "morton") return PointOrder::kMorton;
-  return Error{flag + " " + text + ": must be input or morton", ExitCode::kUsage};
-}
-
-const char* pointOrderName(PointOrder order) { return order == PointOrder::kMorton ? "morton" : "input"; }
-
-uint64_t reorderExtraBytes(size_t points, PointOrder order) {
-  return order == PointOrder::kMorton ? uint64_t{28} * points : 0;
-}
-
-Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit) {
-  if (order == PointOrder::kInput) return okStatus();
-  const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0) +
-                                           points.dimensions.bytesPerPoint()) +
-                          points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
-  return checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit);
-}
-
-MortonFrame mortonFrame(const std::vector<glm::dvec3>& positions, unsigned threads) {
+template <typename Positions>
+MortonFrame frameOf(size_t n, const Positions& positions, unsigned threads) {
   const double inf = std::numeric_limits<double>::infinity();
-  const size_t chunks = (positions.size() + kChunk - 1) / kChunk;
+  const size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<glm::dvec3> lo(chunks, glm::dvec3(inf)), hi(chunks, glm::dvec3(-inf));
   parallelFor(chunks, threads, [&](size_t c, unsigned) {
     glm::dvec3 chunk_lo(inf), chunk_hi(-inf);  // locals: neighbouring chunks' entries share cache lines
-    for (size_t i = c * kChunk, end = std::min(positions.size(), i + kChunk); i < end; ++i) {
+    const size_t begin = c * kChunk, end = std::min(n, begin + kChunk);
+    const glm::dvec3* p = positions.chunk(begin, end);
+    for (size_t i = 0; i < end - begin; ++i) {
       for (int a = 0; a < 3; ++a) {
-        const double v = positions[i][a];
+        const double v = p[i][a];
         if (!std::isfinite(v)) continue;
         chunk_lo[a] = std::min(chunk_lo[a], v);
         chunk_hi[a] = std::max(chunk_hi[a], v);
@@ -405,6 +380,83 @@ MortonFrame mortonFrame(const std::vector<glm::dvec3>& positions, unsigned threa
   return frame;
 }
 
+// The indices of the n points in the stable order of their Morton codes, into `sorted`; the
+// codes and the first copy of the indices take the first 20 bytes a point of `scratch`.
+// progress advances by 2n.
+template <typename Positions>
+void sortByCode(size_t n, const Positions& positions, Scratch& scratch, uint32_t* sorted, unsigned threads,
+                Progress* progress) {
+  const MortonFrame frame = frameOf(n, positions, threads);
+  const SortCode sort_code(frame);
+  SortKeys k;
+  k.code[0] = scratch.array<uint64_t>(0, n);
+  k.code[1] = scratch.array<uint64_t>(8 * n, n);
+  k.index[0] = scratch.array<uint32_t>(16 * n, n);
+  k.index[kSorted] = sorted;
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<uint64_t> chunk_and(chunks), chunk_or(chunks);
+  parallelFor(chunks, threads, [&](size_t c, unsigned) {
+    uint64_t all_and = ~uint64_t{0}, any_or = 0;
+    const size_t begin = c * kChunk, end = std::min(n, begin + kChunk);
+    const glm::dvec3* p = positions.chunk(begin, end);
+    for (size_t i = begin; i < end; ++i) {
+      const uint64_t v = sort_code(p[i - begin]);
+      k.code[0][i] = v;
+      k.index[0][i] = static_cast<uint32_t>(i);
+      all_and &= v;
+      any_or |= v;
+    }
+    chunk_and[c] = all_and;
+    chunk_or[c] = any_or;
+    if (progress) progress->advance(end - c * kChunk);
+  });
+  uint64_t all_and = ~uint64_t{0}, any_or = 0;
+  for (size_t c = 0; c < chunks; ++c) {
+    all_and &= chunk_and[c];
+    any_or |= chunk_or[c];
+  }
+  sortRange(k, 0, n, 0, all_and ^ any_or, threads, progress);
+}
+
+uint32_t* indexArray(LargeBuffer& buffer, size_t n) {
+  std::uninitialized_default_construct_n(reinterpret_cast<uint32_t*>(buffer.data()), n);
+  return std::launder(reinterpret_cast<uint32_t*>(buffer.data()));
+}
+
+}  // namespace
+
+Result<PointOrder> parsePointOrder(const std::string& flag, const std::string& text) {
+  if (text == "input") return PointOrder::kInput;
+  if (text == "morton") return PointOrder::kMorton;
+  return Error{flag + " " + text + ": must be input or morton", ExitCode::kUsage};
+}
+
+const char* pointOrderName(PointOrder order) { return order == PointOrder::kMorton ? "morton" : "input"; }
+
+uint64_t reorderExtraBytes(size_t points, PointOrder order) {
+  return order == PointOrder::kMorton ? uint64_t{28} * points : 0;
+}
+
+Status checkOrderable(uint64_t points) {
+  if (points <= std::numeric_limits<uint32_t>::max()) return okStatus();
+  return Error{"ordering " + std::to_string(points) + " points: an order holds at most 4294967295 (2^32 - 1); "
+               "write them in input order, or in tiles",
+               ExitCode::kResourceLimit};
+}
+
+Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit) {
+  if (order == PointOrder::kInput) return okStatus();
+  if (Status s = checkOrderable(points.size()); !s) return s;
+  const uint64_t needed = points.size() * (sizeof(glm::dvec3) + (points.hasColors() ? sizeof(glm::vec3) : 0) +
+                                           points.dimensions.bytesPerPoint()) +
+                          points.triangles.size() * 4 + reorderExtraBytes(points.size(), order);
+  return checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit);
+}
+
+MortonFrame mortonFrame(const std::vector<glm::dvec3>& positions, unsigned threads) {
+  return frameOf(positions.size(), HeldPositions{positions.data()}, threads);
+}
+
 uint64_t mortonCode(const MortonFrame& frame, const glm::dvec3& p) { return codeOf(frame, p); }
 
 std::vector<uint32_t> shuffledBlocks(size_t count) {
@@ -424,39 +476,11 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
   threads = resolveThreads(threads);
   if (progress) progress->start("morton order", 3 * uint64_t{n});
 
-  const MortonFrame frame = mortonFrame(points.positions, threads);
-  const SortCode sort_code(frame);
-  Scratch scratch(n);
-  SortKeys k;
-  k.code[0] = scratch.array<uint64_t>(0, n);
-  k.code[1] = scratch.array<uint64_t>(8 * n, n);
-  k.index[0] = scratch.array<uint32_t>(16 * n, n);
-  k.index[1] = scratch.array<uint32_t>(24 * n, n);
-  const size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<uint64_t> chunk_and(chunks), chunk_or(chunks);
-  parallelFor(chunks, threads, [&](size_t c, unsigned) {
-    uint64_t all_and = ~uint64_t{0}, any_or = 0;
-    const glm::dvec3* p = points.positions.data();
-    const size_t end = std::min(n, (c + 1) * kChunk);
-    for (size_t i = c * kChunk; i < end; ++i) {
-      const uint64_t v = sort_code(p[i]);
-      k.code[0][i] = v;
-      k.index[0][i] = static_cast<uint32_t>(i);
-      all_and &= v;
-      any_or |= v;
-    }
-    chunk_and[c] = all_and;
-    chunk_or[c] = any_or;
-    if (progress) progress->advance(end - c * kChunk);
-  });
-  uint64_t all_and = ~uint64_t{0}, any_or = 0;
-  for (size_t c = 0; c < chunks; ++c) {
-    all_and &= chunk_and[c];
-    any_or |= chunk_or[c];
-  }
-  sortRange(k, 0, n, 0, all_and ^ any_or, threads, progress);
+  Scratch scratch(24 * n);
+  LargeBuffer sorted_buffer(4 * n);
+  uint32_t* sorted = indexArray(sorted_buffer, n);
+  sortByCode(n, HeldPositions{points.positions.data()}, scratch, sorted, threads, progress);
 
-  const uint32_t* sorted = k.index[kSorted];
   const std::vector<uint32_t> blocks = shuffledBlocks(n / kOrderBlock);
   gather(points.positions, sorted, blocks, scratch, threads, progress);
   if (points.hasColors()) gather(points.colors, sorted, blocks, scratch, threads, nullptr);
@@ -477,6 +501,25 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
     });
   }
   if (progress) progress->finish();
+}
+
+MortonRows mortonRows(size_t n, const std::function<glm::dvec3(uint64_t)>& at, unsigned threads, Progress* progress) {
+  assert(n <= std::numeric_limits<uint32_t>::max());
+  threads = resolveThreads(threads);
+  if (progress) progress->start("morton order", 2 * uint64_t{n});
+  MortonRows rows;
+  rows.n_ = n;
+  rows.buffer_ = LargeBuffer(4 * n);
+  uint32_t* sorted = indexArray(rows.buffer_, n);
+  rows.sorted_ = sorted;
+  if (n == 1) sorted[0] = 0;
+  if (n >= 2) {
+    Scratch scratch(20 * n);
+    sortByCode(n, MadePositionsAt{at}, scratch, sorted, threads, progress);
+  }
+  rows.blocks_ = shuffledBlocks(n / kOrderBlock);
+  if (progress) progress->finish();
+  return rows;
 }
 
 }  // namespace dpoint

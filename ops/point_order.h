@@ -7,11 +7,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "core/memory.h"
 #include "core/point_set.h"
 #include "core/result.h"
 
@@ -53,9 +55,41 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads = 0, Pro
 // the sort's code and index arrays and their scratch copies; then 4 for the sorted indices and
 // 24 for one gathered copy of the positions), 0 for kInput.
 uint64_t reorderExtraBytes(size_t points, PointOrder order);
+// Refuses (kResourceLimit) more points than an order holds: 2^32 - 1 (the indices are 32-bit).
+Status checkOrderable(uint64_t points);
 // Refuses (kResourceLimit, "ordering N points needs …", core/memory.h) an order whose peak — the
-// set's positions, colours and triangles plus reorderExtraBytes — is over `limit` (0: half of RAM).
+// set's positions, colours and triangles plus reorderExtraBytes — is over `limit` (0: half of RAM),
+// or of more points than checkOrderable allows.
 Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit);
+
+// The Morton order as rows rather than moved points: row r of the ordered set is point source(r)
+// of the set in its order before. Holds 4 bytes a point.
+class MortonRows {
+ public:
+  size_t size() const { return n_; }
+  uint32_t source(size_t r) const {
+    const size_t b = r / kOrderBlock;
+    return sorted_[(b < blocks_.size() ? blocks_[b] : b) * kOrderBlock + r % kOrderBlock];
+  }
+
+ private:
+  friend MortonRows mortonRows(size_t, const std::function<glm::dvec3(uint64_t)>&, unsigned, Progress*);
+  LargeBuffer buffer_;
+  const uint32_t* sorted_ = nullptr;  // the indices in code order, in buffer_
+  std::vector<uint32_t> blocks_;      // shuffledBlocks(n / kOrderBlock)
+  size_t n_ = 0;
+};
+
+// The order reorderPoints(kMorton) gives a set of `n` points (at most 2^32 - 1) whose point i is
+// at(i), made on demand instead of held: for a generator whose points are a function of their
+// index (random2d), the rows of a file written in that order with no array of positions. Each point
+// is made twice (for the frame, then its code), so `at` should be cheap; it is called from
+// several threads at once. The same rows for any `threads` (0: all cores). Memory at the peak:
+// mortonRowsBytes. `progress`, when given, shows the work as one step, "morton order".
+MortonRows mortonRows(size_t n, const std::function<glm::dvec3(uint64_t)>& at, unsigned threads = 0,
+                      Progress* progress = nullptr);
+// 24 bytes a point: 4 for the rows, 20 while sorting.
+inline uint64_t mortonRowsBytes(size_t n) { return uint64_t{24} * n; }
 
 // The frame Morton codes are taken in: the box of the finite coordinates, kept as halves
 // (min/2 and (max - min)/2 computed as max/2 - min/2) so that no extent overflows, however far

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "converters/csv.h"
 #include "converters/ply.h"
@@ -103,6 +104,55 @@ TEST(CliGenerate, anOffsetInZGivesA2dKindItsZ) {
       for (const glm::dvec3& p : back->positions) EXPECT_EQ(p.z, 5.0) << ext;
     }
   }
+}
+
+// random2d into a .ply makes its points as the rows are written (no array of them); the file is
+// the one the held set gives: byte for byte what `convert` writes from the held path's CSV (input
+// and Morton order), and, with an offset or noise colours, the same points and colours as the
+// held path's CSV in the same order, for 1 and 2 threads.
+TEST(CliGenerate, random2dMadeAsWrittenIsTheHeldSetsFile) {
+  TempDir dir;
+  const std::vector<std::string> base = {"generate", "random2d", "--count", "20000", "--seed", "9"};
+  ASSERT_EQ(runDpoint(test::concat(base, {"-q", "-o", dir.file("held.csv")})).exit_code, 0);
+  for (const char* order : {"input", "morton"}) {
+    SCOPED_TRACE(order);
+    ASSERT_EQ(runDpoint(test::concat(base, {"-q", "--order", order, "-o", dir.file("made.ply")})).exit_code, 0);
+    ASSERT_EQ(runDpoint({"convert", dir.file("held.csv"), "--order", order, "-q", "-o", dir.file("held.ply")}).exit_code, 0);
+    EXPECT_TRUE(readFile(dir.file("made.ply")) == readFile(dir.file("held.ply")));
+  }
+  for (const std::vector<std::string>& dress :
+       {std::vector<std::string>{"--offset", "1e9,-3,0.25"}, std::vector<std::string>{"--colors", "noise"}}) {
+    const std::vector<std::string> dressed = test::concat(test::concat(base, {"--order", "morton"}), dress);
+    ASSERT_EQ(runDpoint(test::concat(dressed, {"-q", "-o", dir.file("held.csv")})).exit_code, 0);
+    Result<PointSet> held = readPoints(dir.file("held.csv"));
+    ASSERT_TRUE(held.ok()) << held.error().message;
+    EXPECT_EQ(held->hasColors(), dress[0] == "--colors");
+    for (const char* threads : {"1", "2"}) {
+      SCOPED_TRACE(dress[0] + " " + threads);
+      test::CommandResult r = runDpoint(test::concat(dressed, {"--threads", threads, "-o", dir.file("made.ply")}));
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_NE(r.err.find("the points made as the rows were written"), std::string::npos) << r.err;
+      Result<PointSet> made = readPoints(dir.file("made.ply"));
+      ASSERT_TRUE(made.ok()) << made.error().message;
+      ASSERT_EQ(made->size(), held->size());
+      EXPECT_TRUE(made->positions == held->positions);
+      ASSERT_EQ(made->colors.size(), held->colors.size());
+      for (size_t i = 0; i < made->colors.size(); ++i)  // the CSV keeps floats, the PLY bytes
+        for (int k = 0; k < 3; ++k)
+          ASSERT_EQ(colorInteger(made->colors[i][k], 255), colorInteger(held->colors[i][k], 255)) << i;
+      EXPECT_EQ(made->hasZ(), dress[0] == "--offset");
+    }
+  }
+}
+
+// More points than an order holds: refused before any work, naming the count, nothing written.
+TEST(CliGenerate, anOrderOfMoreThan2To32PointsIsRefused) {
+  TempDir dir;
+  test::CommandResult r = runDpoint(
+      {"generate", "random2d", "--count", "4294967296", "--order", "morton", "-o", dir.file("big.ply")});
+  EXPECT_EQ(r.exit_code, static_cast<int>(ExitCode::kResourceLimit));
+  EXPECT_NE(r.err.find("4294967296 points"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("big.ply")));
 }
 
 TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {

@@ -265,13 +265,52 @@ TEST(Ply, plyColoursMadeAsWrittenGiveTheSameFile) {
       options.color_type = type;
       options.threads = 3;
       ASSERT_TRUE(writePly(dir.file("given.ply"), coloured, options).ok());
-      options.colors_of = [&](size_t begin, size_t end, glm::vec3* colors) {
-        for (size_t i = begin; i < end; ++i) colors[i - begin] = colourOf(bare.positions[i]);
+      options.colors_of = [&](const glm::dvec3* positions, size_t count, glm::vec3* colors) {
+        for (size_t i = 0; i < count; ++i) colors[i] = colourOf(positions[i]);
       };
       ASSERT_TRUE(writePly(dir.file("made.ply"), bare, options).ok());
       const std::string given = readFile(dir.file("given.ply"));
       EXPECT_GT(given.size(), size_t{1} << 20);
       EXPECT_TRUE(given == readFile(dir.file("made.ply")));
+    }
+  }
+}
+
+// Positions made as the rows are written (PlyWriteOptions::positions_of), for a set that holds
+// only its facts, give the file the set holding those positions gives, byte for byte: binary and
+// ASCII, 3D and 2D (the "z is 0" comment from the facts), with colours made too, over 3 threads.
+TEST(Ply, plyPositionsMadeAsWrittenGiveTheSameFile) {
+  TempDir dir;
+  const size_t n = 200003;  // a partial last chunk of rows
+  for (bool planar : {false, true}) {
+    auto at = [planar](size_t i) {
+      return glm::dvec3(static_cast<double>(i) * 0.5 - 7.0, -1.0 / static_cast<double>(i + 1),
+                        planar ? 0.0 : static_cast<double>(i % 7) * 1e9);
+    };
+    PointSet held;
+    for (size_t i = 0; i < n; ++i) held.positions.push_back(at(i));
+    PointSet facts;
+    facts.z_axis = planar ? ZAxis::kAbsent : ZAxis::kPresent;
+    for (PlyEncoding encoding : {PlyEncoding::kBinary, PlyEncoding::kAscii}) {
+      for (bool colours : {false, true}) {
+        SCOPED_TRACE(std::string(encoding == PlyEncoding::kAscii ? "ASCII" : "binary") + (planar ? ", 2D" : ", 3D") +
+                     (colours ? ", colours made" : ""));
+        PlyWriteOptions options;
+        options.encoding = encoding;
+        options.threads = 3;
+        if (colours)
+          options.colors_of = [](const glm::dvec3* positions, size_t count, glm::vec3* colors) {
+            for (size_t i = 0; i < count; ++i) colors[i] = glm::vec3(static_cast<float>(positions[i].y), 0.5f, 0.0f);
+          };
+        ASSERT_TRUE(writePly(dir.file("held.ply"), held, options).ok());
+        options.positions_of = {n, [&](size_t begin, size_t end, glm::dvec3* out) {
+                                  for (size_t i = begin; i < end; ++i) out[i - begin] = at(i);
+                                }};
+        ASSERT_TRUE(writePly(dir.file("made.ply"), facts, options).ok());
+        const std::string expected = readFile(dir.file("held.ply"));
+        EXPECT_EQ(expected.find("z is 0") != std::string::npos, planar);
+        EXPECT_TRUE(expected == readFile(dir.file("made.ply")));
+      }
     }
   }
 }

@@ -344,5 +344,43 @@ TEST(PointOrder, nonFiniteCoordinatesAreOrderedNotDropped) {
   expectMortonOrderOf(before, reordered(before));
 }
 
+// mortonRows, for points made from their index, gives the order reorderPoints gives the set
+// holding them: row r is the point reorderPoints puts at r, colours (which tag the input index)
+// included; for any thread count, sizes around the block, a 2D set, ties and non-finite values.
+TEST(PointOrder, mortonRowsAreTheOrderReorderPointsGives) {
+  std::vector<PointSet> sets;
+  for (size_t n : {size_t{0}, size_t{1}, size_t{2}, size_t{33}, kOrderBlock, 3 * kOrderBlock + 17})
+    sets.push_back(randomCloud(n, 20 + n));
+  PointSet flat = randomCloud(2 * kOrderBlock + 5, 12);
+  for (glm::dvec3& p : flat.positions) p.z = 0.0;
+  sets.push_back(flat);
+  PointSet odd = randomCloud(kOrderBlock + 300, 13);
+  for (size_t i = 0; i < 200; ++i) odd.positions[100 + i] = odd.positions[7];  // ties
+  odd.positions[3].x = std::numeric_limits<double>::quiet_NaN();
+  odd.positions[40].y = -std::numeric_limits<double>::infinity();
+  sets.push_back(odd);
+  for (const PointSet& set : sets) {
+    const PointSet expected = reordered(set);
+    for (unsigned threads : {1u, 3u}) {
+      SCOPED_TRACE(std::to_string(set.size()) + " points, " + std::to_string(threads) + " threads");
+      const MortonRows rows =
+          mortonRows(set.size(), [&set](uint64_t i) { return set.positions[i]; }, threads);
+      ASSERT_EQ(rows.size(), set.size());
+      for (size_t r = 0; r < set.size(); ++r) {
+        ASSERT_LT(rows.source(r), set.size());
+        ASSERT_EQ(rowOf(set, rows.source(r)), rowOf(expected, r)) << "row " << r;
+      }
+    }
+  }
+}
+
+TEST(PointOrder, moreThanAnOrderHoldsIsRefused) {
+  EXPECT_TRUE(checkOrderable(4294967295u).ok());
+  const Status refused = checkOrderable(4294967296u);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, ExitCode::kResourceLimit);
+  EXPECT_NE(refused.error().message.find("4294967296"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace dpoint
