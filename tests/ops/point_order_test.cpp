@@ -374,6 +374,23 @@ TEST(PointOrder, mortonRowsAreTheOrderReorderPointsGives) {
   }
 }
 
+// At 2^20 points and more, the sort's top level runs over all threads: mortonRows still gives the
+// rows reorderPoints gives, 3D and 2D, for 2 and 3 threads.
+TEST(PointOrder, mortonRowsOfAMillionPointsAreTheOrderReorderPointsGives) {
+  for (bool flat : {false, true}) {
+    PointSet set = randomCloud((size_t{1} << 20) + 4321, flat ? 31 : 32);
+    if (flat)
+      for (glm::dvec3& p : set.positions) p.y = 0.0;
+    const PointSet expected = reordered(set);
+    for (unsigned threads : {2u, 3u}) {
+      SCOPED_TRACE(std::string(flat ? "2D, " : "3D, ") + std::to_string(threads) + " threads");
+      const MortonRows rows = mortonRows(set.size(), [&set](uint64_t i) { return set.positions[i]; }, threads);
+      ASSERT_EQ(rows.size(), set.size());
+      for (size_t r = 0; r < set.size(); ++r) ASSERT_EQ(rowOf(set, rows.source(r)), rowOf(expected, r)) << "row " << r;
+    }
+  }
+}
+
 TEST(PointOrder, moreThanAnOrderHoldsIsRefused) {
   EXPECT_TRUE(checkOrderable(4294967295u).ok());
   const Status refused = checkOrderable(4294967296u);
