@@ -133,29 +133,24 @@ uint64_t uniformBelow(std::mt19937_64& rng, uint64_t bound) {
   return r % bound;
 }
 
-// Uninitialized memory for the sort's arrays, on 2 MiB pages where Linux gives them
-// (core/memory.h's LargeBuffer): the scatter and the gathers jump all over it, and with 4 KiB pages
-// their TLB misses and page faults took 15% of the time at 16.7M points. The passes that first
-// write it fault its pages in, over all threads. reorderPoints' keys take the first 20 bytes a point
-// (code[0] at 0, code[1] at 8n, index[0] at 16n); once sorted, the first 24 take one gathered array
-// at a time (the positions, then the colours, then the triangles' renumbering), so a fresh
-// allocation, its page faults and std::vector's single-threaded zeroing are paid once, not three
-// times. The sorted indices (index[1]) lie in a buffer of their own, which MortonRows keeps.
-class Scratch {
- public:
-  explicit Scratch(size_t bytes) : buffer_(bytes) {}
-  // Starts the lifetime of `count` objects of type T at byte `offset` and returns the first. For
-  // the trivial types used here this generates no code.
-  template <typename T>
-  T* array(size_t offset, size_t count) {
-    static_assert(std::is_trivially_destructible_v<T>);
-    assert(offset % alignof(T) == 0 && offset + count * sizeof(T) <= buffer_.size());
-    std::uninitialized_default_construct_n(reinterpret_cast<T*>(buffer_.data() + offset), count);
-    return std::launder(reinterpret_cast<T*>(buffer_.data() + offset));
-  }
- private:
-  LargeBuffer buffer_;
-};
+// The sort's arrays live in uninitialized LargeBuffers (core/memory.h: 2 MiB pages where Linux
+// gives them): the scatter and the gathers jump all over them, and with 4 KiB pages their TLB
+// misses and page faults took 15% of the time at 16.7M points. The passes that first write them
+// fault their pages in, over all threads. The scratch: reorderPoints' keys take the first 20 bytes
+// a point (code[0] at 0, code[1] at 8n, index[0] at 16n); once sorted, the first 24 take one
+// gathered array at a time (the positions, then the colours, then the triangles' renumbering), so
+// a fresh allocation, its page faults and std::vector's single-threaded zeroing are paid once, not
+// three times. The sorted indices (index[1]) lie in a buffer of their own, which MortonRows keeps.
+//
+// arrayIn starts the lifetime of `count` objects of type T at byte `offset` of `buffer` and
+// returns the first. For the trivial types used here this generates no code.
+template <typename T>
+T* arrayIn(LargeBuffer& buffer, size_t offset, size_t count) {
+  static_assert(std::is_trivially_destructible_v<T>);
+  assert(offset % alignof(T) == 0 && offset + count * sizeof(T) <= buffer.size());
+  std::uninitialized_default_construct_n(reinterpret_cast<T*>(buffer.data() + offset), count);
+  return std::launder(reinterpret_cast<T*>(buffer.data() + offset));
+}
 
 struct SortKeys {
   uint64_t* code[2];
@@ -278,19 +273,15 @@ void sortRange(SortKeys& k, size_t first, size_t last, int src, uint64_t varying
   });
 }
 
-// Where output block b comes from in the sorted sequence: a shuffled whole block, or the last
-// partial block in place.
-inline size_t sourceBlock(const std::vector<uint32_t>& blocks, size_t b) { return b < blocks.size() ? blocks[b] : b; }
-
 // values[i] becomes values[source of i]: gathered into the scratch, then copied back (both over
 // all threads), so the set keeps its own storage.
 template <typename T>
-void gather(T* values, size_t n, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
+void gather(T* values, size_t n, const uint32_t* sorted, const std::vector<uint32_t>& blocks, LargeBuffer& scratch,
             unsigned threads, Progress* progress) {
   const size_t block_count = (n + kOrderBlock - 1) / kOrderBlock;
-  T* out = scratch.array<T>(0, n);
+  T* out = arrayIn<T>(scratch, 0, n);
   parallelFor(block_count, threads, [&](size_t b, unsigned) {
-    const size_t to = b * kOrderBlock, from = sourceBlock(blocks, b) * kOrderBlock;
+    const size_t to = b * kOrderBlock, from = mortonSourceBlock(blocks, b) * kOrderBlock;
     const size_t count = std::min(kOrderBlock, n - to);
     // The reads jump over the whole set: each misses the caches, so the loads of a few dozen
     // points ahead are started early, keeping more misses in flight than the core would alone.
@@ -308,13 +299,13 @@ void gather(T* values, size_t n, const uint32_t* sorted, const std::vector<uint3
 }
 
 template <typename T>
-void gather(std::vector<T>& values, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
+void gather(std::vector<T>& values, const uint32_t* sorted, const std::vector<uint32_t>& blocks, LargeBuffer& scratch,
             unsigned threads, Progress* progress) {
   gather(values.data(), values.size(), sorted, blocks, scratch, threads, progress);
 }
 
 // A dimension's column, moved as values of its width (core/dimensions.h).
-void gatherDimension(Dimension& d, const uint32_t* sorted, const std::vector<uint32_t>& blocks, Scratch& scratch,
+void gatherDimension(Dimension& d, const uint32_t* sorted, const std::vector<uint32_t>& blocks, LargeBuffer& scratch,
                      unsigned threads) {
   const size_t n = d.size();
   switch (dimTypeSize(d.type)) {
@@ -384,14 +375,14 @@ MortonFrame frameOf(size_t n, const Positions& positions, unsigned threads) {
 // codes and the first copy of the indices take the first 20 bytes a point of `scratch`.
 // progress advances by 2n.
 template <typename Positions>
-void sortByCode(size_t n, const Positions& positions, Scratch& scratch, uint32_t* sorted, unsigned threads,
+void sortByCode(size_t n, const Positions& positions, LargeBuffer& scratch, uint32_t* sorted, unsigned threads,
                 Progress* progress) {
   const MortonFrame frame = frameOf(n, positions, threads);
   const SortCode sort_code(frame);
   SortKeys k;
-  k.code[0] = scratch.array<uint64_t>(0, n);
-  k.code[1] = scratch.array<uint64_t>(8 * n, n);
-  k.index[0] = scratch.array<uint32_t>(16 * n, n);
+  k.code[0] = arrayIn<uint64_t>(scratch, 0, n);
+  k.code[1] = arrayIn<uint64_t>(scratch, 8 * n, n);
+  k.index[0] = arrayIn<uint32_t>(scratch, 16 * n, n);
   k.index[kSorted] = sorted;
   const size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<uint64_t> chunk_and(chunks), chunk_or(chunks);
@@ -416,11 +407,6 @@ void sortByCode(size_t n, const Positions& positions, Scratch& scratch, uint32_t
     any_or |= chunk_or[c];
   }
   sortRange(k, 0, n, 0, all_and ^ any_or, threads, progress);
-}
-
-uint32_t* indexArray(LargeBuffer& buffer, size_t n) {
-  std::uninitialized_default_construct_n(reinterpret_cast<uint32_t*>(buffer.data()), n);
-  return std::launder(reinterpret_cast<uint32_t*>(buffer.data()));
 }
 
 }  // namespace
@@ -476,9 +462,9 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
   threads = resolveThreads(threads);
   if (progress) progress->start("morton order", 3 * uint64_t{n});
 
-  Scratch scratch(24 * n);
+  LargeBuffer scratch(24 * n);
   LargeBuffer sorted_buffer(4 * n);
-  uint32_t* sorted = indexArray(sorted_buffer, n);
+  uint32_t* sorted = arrayIn<uint32_t>(sorted_buffer, 0, n);
   sortByCode(n, HeldPositions{points.positions.data()}, scratch, sorted, threads, progress);
 
   const std::vector<uint32_t> blocks = shuffledBlocks(n / kOrderBlock);
@@ -486,9 +472,9 @@ void reorderPoints(PointSet& points, PointOrder order, unsigned threads, Progres
   if (points.hasColors()) gather(points.colors, sorted, blocks, scratch, threads, nullptr);
   for (Dimension& d : points.dimensions.all()) gatherDimension(d, sorted, blocks, scratch, threads);
   if (points.isMesh()) {
-    uint32_t* rank = scratch.array<uint32_t>(0, n);  // new place of each old point
+    uint32_t* rank = arrayIn<uint32_t>(scratch, 0, n);  // new place of each old point
     parallelFor((n + kOrderBlock - 1) / kOrderBlock, threads, [&](size_t b, unsigned) {
-      const size_t to = b * kOrderBlock, from = sourceBlock(blocks, b) * kOrderBlock;
+      const size_t to = b * kOrderBlock, from = mortonSourceBlock(blocks, b) * kOrderBlock;
       for (size_t i = 0, count = std::min(kOrderBlock, n - to); i < count; ++i)
         rank[sorted[from + i]] = static_cast<uint32_t>(to + i);
     });
@@ -510,11 +496,11 @@ MortonRows mortonRows(size_t n, const std::function<glm::dvec3(uint64_t)>& at, u
   MortonRows rows;
   rows.n_ = n;
   rows.buffer_ = LargeBuffer(4 * n);
-  uint32_t* sorted = indexArray(rows.buffer_, n);
+  uint32_t* sorted = arrayIn<uint32_t>(rows.buffer_, 0, n);
   rows.sorted_ = sorted;
   if (n == 1) sorted[0] = 0;
   if (n >= 2) {
-    Scratch scratch(20 * n);
+    LargeBuffer scratch(20 * n);
     sortByCode(n, MadePositionsAt{at}, scratch, sorted, threads, progress);
   }
   rows.blocks_ = shuffledBlocks(n / kOrderBlock);

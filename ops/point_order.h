@@ -62,14 +62,19 @@ Status checkOrderable(uint64_t points);
 // or of more points than checkOrderable allows.
 Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t limit);
 
+// Where output block b of the Morton order comes from in the code-sorted sequence: whole block
+// blocks[b] (blocks = shuffledBlocks), or, past them, the last partial block in place.
+inline size_t mortonSourceBlock(const std::vector<uint32_t>& blocks, size_t b) {
+  return b < blocks.size() ? blocks[b] : b;
+}
+
 // The Morton order as rows rather than moved points: row r of the ordered set is point source(r)
 // of the set in its order before. Holds 4 bytes a point.
 class MortonRows {
  public:
   size_t size() const { return n_; }
   uint32_t source(size_t r) const {
-    const size_t b = r / kOrderBlock;
-    return sorted_[(b < blocks_.size() ? blocks_[b] : b) * kOrderBlock + r % kOrderBlock];
+    return sorted_[mortonSourceBlock(blocks_, r / kOrderBlock) * kOrderBlock + r % kOrderBlock];
   }
 
  private:
