@@ -65,8 +65,10 @@ class SpacingSearch {
   unsigned threads_;
   glm::dvec3 origin_{0.0};
   double cell_ = 0.0, inverse_cell_ = 0.0;
-  static constexpr size_t kFilterBits = size_t{1} << 16;
-  std::array<uint64_t, kFilterBits / 64> filter_{};  // a bit per hash of the kept cells' keys
+  // A bit per hash of the kept cells' keys: 64 KiB, which L2 holds, so that a few percent of the
+  // points that lie in no kept cell pass it (2^16 bits let a fifth of them through to the table).
+  static constexpr size_t kFilterBits = size_t{1} << 19;
+  std::vector<uint64_t> filter_ = std::vector<uint64_t>(kFilterBits / 64, 0);
   std::vector<uint64_t> keys_;              // open addressing: cell key + 1, 0 = empty
   std::vector<uint32_t> slots_;             // the slot of keys_[i]
   std::vector<uint32_t> slot_start_;        // slot s lists samples slot_samples_[start[s], start[s + 1])

@@ -380,9 +380,13 @@ OutlineBuilder::OutlineBuilder(const Bounds& bounds)
 }
 
 size_t OutlineBuilder::rowOf(const glm::dvec3& p) const {
-  const auto cellOf = [](double offset, double per) {
-    const double cell = std::floor(offset * per);  // offset ≥ 0 inside the box; clamped for the rest
-    return static_cast<size_t>(std::clamp(cell, 0.0, double(kOutlineGrid - 1)));
+  // floor(offset · per) clamped to the grid (offset ≥ 0 inside the box), by truncation, which is
+  // the floor from 0 up: std::floor is a call to libm on the baseline x86-64 this builds for.
+  const auto cellOf = [](double offset, double per) -> size_t {
+    const double cell = offset * per;
+    if (!(cell >= 0.0)) return 0;  // below the box (or NaN)
+    if (cell >= double(kOutlineGrid - 1)) return kOutlineGrid - 1;
+    return static_cast<size_t>(static_cast<int64_t>(cell));
   };
   return cellOf(p.y - min_.y, per_y_) * kOutlineGrid + cellOf(p.z - min_.z, per_z_);
 }
@@ -391,17 +395,32 @@ void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
   if (rows_.empty()) return;
   constexpr size_t kBlock = size_t{1} << 18;
   const size_t blocks = (positions.size() + kBlock - 1) / kBlock;
-  std::vector<std::vector<RowBox>> partial(blocks);
-  parallelFor(blocks, 0, [&](size_t b, unsigned) {
-    std::vector<RowBox>& rows = partial[b];
-    rows.resize(rows_.size());
+  // A worker's rows over all its blocks. Consecutive points mostly share a row (a set's order is
+  // mostly local): a run of them is kept in registers and written to its row once, where a store
+  // and load of the row for every point made each wait for the last.
+  std::vector<std::vector<RowBox>> partial(resolveThreads(0), std::vector<RowBox>(rows_.size()));
+  parallelFor(blocks, 0, [&](size_t b, unsigned worker) {
+    std::vector<RowBox>& rows = partial[worker];
     const size_t end = std::min(positions.size(), (b + 1) * kBlock);
+    size_t run_row = SIZE_MAX;
+    RowBox run;
+    const auto flush = [&] {
+      if (run_row == SIZE_MAX) return;
+      rows[run_row].min = glm::min(rows[run_row].min, run.min);
+      rows[run_row].max = glm::max(rows[run_row].max, run.max);
+    };
     for (size_t i = b * kBlock; i < end; ++i) {
       const glm::dvec3& p = positions[i];
-      RowBox& row = rows[rowOf(p)];
-      row.min = glm::min(row.min, p);
-      row.max = glm::max(row.max, p);
+      const size_t row = rowOf(p);
+      if (row != run_row) {
+        flush();
+        run_row = row;
+        run = RowBox{};
+      }
+      run.min = glm::min(run.min, p);
+      run.max = glm::max(run.max, p);
     }
+    flush();
   });
   for (const std::vector<RowBox>& rows : partial) {
     for (size_t cell = 0; cell < rows_.size(); ++cell) {

@@ -54,6 +54,28 @@ TEST(PointSpacing, samplesDoNotDependOnOrderOrBlocks) {
   }
 }
 
+// A set of many blocks (65,536 points each) on several threads, each keeping one heap over all the
+// blocks it takes, in one call and in calls of uneven size: the samples of one thread in one call.
+TEST(PointSpacing, samplesOfManyBlocksDoNotDependOnThreads) {
+  std::vector<glm::dvec3> points(300'000);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (glm::dvec3& p : points) p = {unit(random), unit(random), unit(random)};
+  points.insert(points.end(), points.begin(), points.begin() + 70'000);  // copies, sampled once each
+  SpacingSampler one(512, 1);
+  one.add(points);
+  const std::vector<glm::dvec3> expected = one.finish();
+  ASSERT_GT(expected.size(), 256u);  // fewer than 512: a copy counts twice among the smallest
+  for (unsigned threads : {2u, 3u, 5u}) {
+    SpacingSampler together(512, threads), parts(512, threads);
+    together.add(points);
+    EXPECT_EQ(together.finish(), expected) << threads;
+    for (size_t first = 0, size = 100'000; first < points.size(); first += size, size += 37'000)
+      parts.add(std::span(points).subspan(first, std::min(size, points.size() - first)));
+    EXPECT_EQ(parts.finish(), expected) << threads;
+  }
+}
+
 // A streamed set's second pass reads only the batches whose box mayUse: the points of the rest lie
 // in no kept cell, so the distances are those of every point; on a set in grid order most batches
 // are passed over.
