@@ -118,7 +118,9 @@ void printChoice(const ModePrediction& p, const DeviceFacts& f, Backend backend)
     return;
   }
   const ModeChoice& c = *p.choice;
-  std::string runner_up = c.runner_up ? std::string(modeName(*c.runner_up)) + " (" + formatBound(c.runner_up_bound_px) + ")"
+  // A runner-up bounded over the set's box alone (no pass over the points) is given as at most that.
+  std::string runner_up = c.runner_up ? std::string(modeName(*c.runner_up)) + " (" + (c.runner_up_from_box ? "at most " : "") +
+                                            formatBound(c.runner_up_bound_px) + (c.runner_up_from_box ? ", from the box" : "") + ")"
                                       : std::string("none within the limit");
   std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the %s within %g px on %s, %s backend\n",
               std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(),

@@ -578,8 +578,20 @@ ErrorBounds predictBoxBounds(const BatchBoxes& boxes, const Camera& camera, std:
 }
 
 ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<bool(PrecisionMode)>& usable,
-                      const BoundsOf& bounds_of) {
+                      const BoundsOf& bounds_of, const BoundsOf& box_bounds_of) {
   ModeChoice choice;
+  // The box's bounds of the modes that are not per batch, asked once, when first needed.
+  std::optional<ErrorBounds> box;
+  auto boxWithin = [&](PrecisionMode mode) {
+    if (!box_bounds_of || modeInfo(mode).batch_points != 0) return false;
+    if (!box) {
+      std::vector<PrecisionMode> modes;
+      for (PrecisionMode m : order)
+        if (modeInfo(m).batch_points == 0) modes.push_back(m);
+      box = box_bounds_of(modes);
+    }
+    return box->computed[modeIndex(mode)] && box->px[modeIndex(mode)] <= kAutoBoundPx;
+  };
   // One pass for all of `modes`: a point (or box) is read and projected once, whichever modes are
   // bounded (each mode's bound is the same to the bit as from a pass of its own).
   auto compute = [&](std::span<const PrecisionMode> modes) {
@@ -600,14 +612,19 @@ ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<
   // The walk below stops at the second usable mode within the bound, so from order[k] on it looks
   // at the next `certain` usable modes whatever their bounds (2 before the choice, 1 after): those
   // are computed in one pass, and no mode the walk would not look at is computed.
+  // A mode after one the box shows within the limit can only be the runner-up: where the box shows
+  // it within the limit too, it needs no place in the pass.
   auto computeAhead = [&](size_t k, size_t certain) {
     std::vector<PrecisionMode> ahead;
+    bool sure = choice.enough;  // the choice is made, or will be at a mode before order[k]
     for (; k < order.size() && certain > 0; ++k) {
       if (!usable(order[k])) continue;
       --certain;
-      if (!choice.bounds.computed[modeIndex(order[k])]) ahead.push_back(order[k]);
+      const bool within = boxWithin(order[k]);
+      if (!choice.bounds.computed[modeIndex(order[k])] && !(sure && within)) ahead.push_back(order[k]);
+      sure = sure || within;
     }
-    compute(ahead);
+    if (!ahead.empty()) compute(ahead);
   };
   // Each mode ahead of the choice: unusable, or usable with a bound over the limit (computed above).
   auto noteRejected = [&] {
@@ -616,9 +633,14 @@ ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<
       choice.rejected.push_back({mode, usable(mode) ? bound(mode) : std::nan(""), std::string()});
     }
   };
+  std::array<bool, kModeCount> from_box{};
   for (size_t k = 0; k < order.size(); ++k) {
     const PrecisionMode mode = order[k];
     if (!usable(mode)) continue;
+    if (!choice.bounds.computed[modeIndex(mode)] && choice.enough && boxWithin(mode)) {
+      choice.bounds.px[modeIndex(mode)] = box->px[modeIndex(mode)];
+      choice.bounds.computed[modeIndex(mode)] = from_box[modeIndex(mode)] = true;
+    }
     if (!choice.bounds.computed[modeIndex(mode)]) computeAhead(k, choice.enough ? 1 : 2);
     if (!(bound(mode) <= kAutoBoundPx)) continue;
     if (!choice.enough) {
@@ -628,6 +650,7 @@ ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<
     } else {
       choice.runner_up = mode;
       choice.runner_up_bound_px = bound(mode);
+      choice.runner_up_from_box = from_box[modeIndex(mode)];
       noteRejected();
       return choice;
     }

@@ -86,6 +86,9 @@ struct ModeChoice {
   bool enough = false;  // bound_px ≤ kAutoBoundPx
   std::optional<PrecisionMode> runner_up;  // the next mode in speed order within the bound
   double runner_up_bound_px = 0.0;
+  // runner_up_bound_px is the bound over the set's box (chooseMode's box_bounds_of), which showed
+  // the runner-up within the limit without a pass over the points: no less than the points' own.
+  bool runner_up_from_box = false;
   // Ordered by predicted time to one picture (AutoTarget): the choice's and the runner-up's (ms).
   bool by_picture_time = false;
   double predicted_ms = std::nan(""), runner_up_predicted_ms = std::nan("");
@@ -120,8 +123,13 @@ using BoundsOf = std::function<ErrorBounds(std::span<const PrecisionMode> modes)
 // ≤ kAutoBoundPx; when none is, takes native if usable (else the usable mode with the smallest
 // bound) with enough = false. Bounds are computed only for the modes it looks at, those it is sure
 // to look at together in one pass (the next two usable modes before its choice, one after it).
+// box_bounds_of, where given, bounds a mode over a box that holds the set (predictBoxBounds of its
+// bounding box: no pass over the points, and no less than bounds_of's): a mode it shows within the
+// limit once the choice is sure is the runner-up without a pass of its own (runner_up_from_box).
+// The choice itself, and every mode passed over, keep bounds_of's bounds. The per-batch modes are
+// not asked of it (their encoding is of the points).
 ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<bool(PrecisionMode)>& usable,
-                      const BoundsOf& bounds_of);
+                      const BoundsOf& bounds_of, const BoundsOf& box_bounds_of = {});
 // The walk on the bounds of the points themselves (predictErrorBounds).
 ModeChoice chooseMode(const PointSet& points, const Camera& camera, std::span<const PrecisionMode> order,
                       const std::function<bool(PrecisionMode)>& usable, double tolerance_px = kDefaultTolerancePx);

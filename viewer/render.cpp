@@ -606,7 +606,7 @@ class StreamBlocks {
 // --mode auto's walk over the modes the device runs, on bounds_of's bounds: in the device's speed
 // order, or by predicted time to the picture (AutoTarget).
 Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend, bool probe, const BoundsOf& bounds_of,
-                                  const AutoTarget& target) {
+                                  const AutoTarget& target, const BoundsOf& box_bounds_of = {}) {
   Result<SelfTest> self_test = runPrecisionSelfTest(context);
   if (!self_test) return self_test.error();
   const bool compute = backend == Backend::kCompute;
@@ -614,7 +614,8 @@ Result<ModeChoice> chooseOnDevice(const VulkanContext& context, Backend backend,
   const DeviceClass device_class = deviceClassOf(context.facts.type);
   const bool by_time = target.points > 0 && target.frames <= 1;
   const unsigned threads = resolveThreads(target.threads);
-  ModeChoice choice = chooseMode(autoOrder(device_class, compute, target.points, threads, target.frames), usable, bounds_of);
+  ModeChoice choice =
+      chooseMode(autoOrder(device_class, compute, target.points, threads, target.frames), usable, bounds_of, box_bounds_of);
   if (by_time) {
     choice.by_picture_time = true;
     choice.predicted_ms = predictedPictureMs(choice.mode, device_class, compute, target.points, threads, 1);
@@ -708,10 +709,16 @@ Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointS
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
-                                      Backend backend, bool probe, double tolerance_px, const AutoTarget& target) {
+                                      Backend backend, bool probe, double tolerance_px, const AutoTarget& target,
+                                      const std::optional<Box>& box) {
+  BoundsOf box_bounds_of;
+  if (box && !probe)
+    box_bounds_of = [&](std::span<const PrecisionMode> modes) {
+      return predictBoxBounds(BatchBoxes{points.size(), {*box}}, camera, modes, tolerance_px);
+    };
   return chooseOnDevice(context, backend, probe, [&](std::span<const PrecisionMode> modes) {
     return predictErrorBounds(points, camera, modes, tolerance_px);
-  }, target);
+  }, target, box_bounds_of);
 }
 
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,

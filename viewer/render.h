@@ -139,10 +139,12 @@ Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointS
 // --mode auto on this device (viewer/precision.h): the measured speed order of the device's
 // class and backend, or its modes by predicted time to the picture (AutoTarget), restricted to the modes the device runs (features, the emulation
 // self-test, and with `probe` the probe's needs).
-// `target`: what the walk's order minimises (AutoTarget; by default the frames).
+// `target`: what the walk's order minimises (AutoTarget; by default the frames). `box`, where known,
+// holds every point: the runner-up may be bounded over it (chooseMode's box_bounds_of; not with
+// `probe`, whose report compares every bound with the error measured).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                       Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx,
-                                      const AutoTarget& target = {});
+                                      const AutoTarget& target = {}, const std::optional<Box>& box = std::nullopt);
 // The same for a streamed set, from the boxes of its batches (predictBoxBounds; no probe).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const BatchBoxes& boxes, const Camera& camera,
                                       Backend backend, double tolerance_px = kDefaultTolerancePx,

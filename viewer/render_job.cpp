@@ -402,7 +402,8 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   auto choose = [&]() -> Result<ModeChoice> {
     const AutoTarget target = autoTargetOf(request, set.count);
     if (set.points())
-      return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance, target);
+      return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance, target,
+                                Box{set.bounds.min, set.bounds.max});
     return chooseModeOnDevice(context, set.boxes, camera, *request.backend, tolerance, target);
   };
   ModePrediction p;
@@ -1058,6 +1059,8 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
     if (c->runner_up) {
       JsonObject runner_up;
       runner_up.add("mode", V::string(modeName(*c->runner_up))).add("predicted_bound_px", V::number(c->runner_up_bound_px));
+      // "box": bounded over the set's bounding box, which showed it within the limit (no pass over the points).
+      runner_up.add("predicted_from", V::string(c->runner_up_from_box ? "box" : "points"));
       if (c->by_picture_time) runner_up.add("predicted_ms", V::number(c->runner_up_predicted_ms));
       choice.add("runner_up", runner_up);
     } else

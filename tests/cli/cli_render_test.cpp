@@ -219,6 +219,19 @@ TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
     EXPECT_TRUE(test::contains(json, "\"ordered_by\": \"time_to_picture\"")) << json;
     EXPECT_GT(jsonNumber(json, "predicted_ms"), 0.0) << json;
     EXPECT_NE(r.out.find("predicted encoding, upload and 1-px frame: "), std::string::npos) << r.out;
+    // --error compares every bound with the error: the runner-up's is its points' too.
+    EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"points\", \"predicted_ms\"")) << json;
+  }
+  // Without --error, a runner-up that the set's box shows within the limit is bounded over the box,
+  // with no pass over the points of its own, and said to be.
+  {
+    test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--width", "256",
+                                       "--height", "256", "--json", dir.file("box.json")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::contains(r.out, ", from the box)")) << r.out;
+    const std::string json = readFile(dir.file("box.json"));
+    EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"box\", \"predicted_ms\"")) << json;
+    EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"points\",\n")) << "the choice's own bound: " << json;
   }
   // Several frames: what they wait for is the frames, in the measured speed order.
   test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--frames", "2",

@@ -351,5 +351,61 @@ TEST(PrecisionPass, chooseModeBoundsOnlyTheModesItLooksAt) {
   }
 }
 
+// With the set's box to ask, a mode the box shows within the limit once the choice is sure is the
+// runner-up without a pass over the points (its bound the box's, no less than the points'); the
+// choice, and every mode before it, keep the points' bounds to the bit.
+TEST(PrecisionPass, aRunnerUpWithinTheLimitOverTheBoxTakesNoPass) {
+  const auto all = [](PrecisionMode) { return true; };
+  const PrecisionMode order[] = {PrecisionMode::kFp32, PrecisionMode::kNative, PrecisionMode::kDf64};
+  const glm::dvec3 near(1.0, 2.0, 3.0), far(6.378e6, 0.5, -3.0);
+  for (const glm::dvec3& centre : {near, far}) {
+    const PointSet s = cloud(centre, 1e-3);
+    const Camera camera = lookAtCloud(s, centre, 1.0);
+    std::vector<std::vector<PrecisionMode>> passes;
+    const BoundsOf points = [&](std::span<const PrecisionMode> modes) {
+      passes.emplace_back(modes.begin(), modes.end());
+      return predictErrorBounds(s, camera, modes);
+    };
+    const BoundsOf box = [&](std::span<const PrecisionMode> modes) {
+      return predictBoxBounds(BatchBoxes{s.size(), {boundingBox(s.positions)}}, camera, modes);
+    };
+    const ModeChoice plain = chooseMode(order, all, points);
+    passes.clear();
+    const ModeChoice boxed = chooseMode(order, all, points, box);
+    SCOPED_TRACE(centre == near ? "near" : "far");
+    EXPECT_EQ(boxed.mode, plain.mode);
+    EXPECT_EQ(std::bit_cast<uint64_t>(boxed.bound_px), std::bit_cast<uint64_t>(plain.bound_px));
+    ASSERT_TRUE(boxed.runner_up && plain.runner_up);
+    EXPECT_EQ(*boxed.runner_up, *plain.runner_up);
+    EXPECT_GE(boxed.runner_up_bound_px, plain.runner_up_bound_px);
+    EXPECT_LE(boxed.runner_up_bound_px, kAutoBoundPx);
+    EXPECT_TRUE(boxed.runner_up_from_box);
+    EXPECT_FALSE(plain.runner_up_from_box);
+    // One pass, without the runner-up: fp32 alone near the origin; far from it fp32 and native,
+    // both before the choice is sure, and df64 from the box.
+    ASSERT_EQ(passes.size(), 1u);
+    const std::vector<PrecisionMode> looked_at =
+        centre == near ? std::vector{PrecisionMode::kFp32} : std::vector{PrecisionMode::kFp32, PrecisionMode::kNative};
+    EXPECT_EQ(passes[0], looked_at);
+    ASSERT_EQ(boxed.rejected.size(), plain.rejected.size());
+    for (size_t k = 0; k < plain.rejected.size(); ++k)
+      EXPECT_EQ(std::bit_cast<uint64_t>(boxed.rejected[k].bound_px), std::bit_cast<uint64_t>(plain.rejected[k].bound_px));
+  }
+  // A box that shows no mode within the limit leaves the walk as it was.
+  const PointSet s = cloud(near, 1e-3);
+  const Camera camera = lookAtCloud(s, near, 1.0);
+  const BoundsOf points = [&](std::span<const PrecisionMode> modes) { return predictErrorBounds(s, camera, modes); };
+  const BoundsOf wide = [&](std::span<const PrecisionMode> modes) {
+    ErrorBounds b;
+    for (PrecisionMode mode : modes) b.px[modeIndex(mode)] = 1.0, b.computed[modeIndex(mode)] = true;
+    return b;
+  };
+  const ModeChoice plain = chooseMode(order, all, points), boxed = chooseMode(order, all, points, wide);
+  EXPECT_FALSE(boxed.runner_up_from_box);
+  EXPECT_EQ(boxed.runner_up, plain.runner_up);
+  EXPECT_EQ(std::bit_cast<uint64_t>(boxed.runner_up_bound_px), std::bit_cast<uint64_t>(plain.runner_up_bound_px));
+  EXPECT_EQ(boxed.bounds.computed, plain.bounds.computed);
+}
+
 }  // namespace
 }  // namespace dpoint
