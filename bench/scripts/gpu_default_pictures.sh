@@ -4,7 +4,8 @@
 # default: round points, EDL) of the res-200 and res-420 Mandelbulbs and the Menger sponge at
 # 1024x768, each build one fresh process per round, alternated: the point size, the median GPU
 # frame of FRAMES (20) after the auto warm-up, and the whole process's wall time for one picture.
-# Rows in $OUT/default.tsv.   BASE=19318e9 ROUNDS=3
+# Rows in $OUT/default.tsv.   BASE=19318e9 ROUNDS=3 SETS="mb200 mb420 menger" (s11u: the 16.7M-point
+# `sierpinski --level 11 --unwelded`, as bench/scripts/local_targets.sh draws on lavapipe)
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 data=/tmp/dpoint-default
@@ -12,10 +13,11 @@ mkdir -p "$data"
 [ -s "$data/mb200.ply" ] || .gpu/dpoint generate mandelbulb --resolution 200 -q -o "$data/mb200.ply"
 [ -s "$data/mb420.ply" ] || .gpu/dpoint generate mandelbulb --resolution 420 -q -o "$data/mb420.ply"
 [ -s "$data/menger.ply" ] || .gpu/dpoint generate menger -q -o "$data/menger.ply"
+case " ${SETS:-} " in *" s11u "*) [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply" ;; esac
 rows=$out/default.tsv
 printf 'round\tdataset\tbuild\tpoint_size\tgpu_ms_median\tprocess_ms\n' >"$rows"
 for round in $(seq "${ROUNDS:-3}"); do
-  for set in mb200 mb420 menger; do
+  for set in ${SETS:-mb200 mb420 menger}; do
     for build in "${BASE:-19318e9}" current; do
       bin=.gpu/dpoint-$build
       [ "$build" = current ] && bin=.gpu/dpoint
