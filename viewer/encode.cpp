@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "core/parallel.h"
 #include "viewer/batch_plan.h"
@@ -154,16 +157,20 @@ double roundToStep(double t, double steps) {
 
 }  // namespace
 
+namespace {
+
+// lround(v · 255) of v clamped to 0..1, without lround's libm call (the upload's cost at 16.7M
+// points): the float product plus 0.5 is exact in double, so truncating it rounds half away from
+// zero as lround does. NaN never gets here: readers reject it.
+inline uint32_t colourByte(float v) {
+  const float scaled = std::min(std::max(v, 0.0f), 1.0f) * 255.0f;  // std::clamp's order: -0 stays -0
+  return static_cast<uint32_t>(static_cast<int32_t>(static_cast<double>(scaled) + 0.5));
+}
+
+}  // namespace
+
 uint32_t encodeColor(const glm::vec3& color) {
-  uint32_t packed = 0xff000000u;
-  for (int c = 0; c < 3; ++c) {
-    // lround(v · 255) without lround's libm call (the upload's cost at 16.7M points): the float
-    // product plus 0.5 is exact in double, so truncating it rounds half away from zero as lround
-    // does.
-    const float v = std::clamp(color[c], 0.0f, 1.0f) * 255.0f;  // NaN never gets here: readers reject it
-    packed |= static_cast<uint32_t>(static_cast<double>(v) + 0.5) << (8 * c);
-  }
-  return packed;
+  return 0xff000000u | colourByte(color.r) | colourByte(color.g) << 8 | colourByte(color.b) << 16;
 }
 
 std::vector<uint32_t> encodeColors(const PointSet& points) {
@@ -178,7 +185,39 @@ void encodeColors(const PointSet& points, size_t first, size_t count, uint32_t* 
     std::fill(out, out + count, 0xffffffffu);
     return;
   }
-  for (size_t i = 0; i < count; ++i) out[i] = encodeColor(points.colors[first + i]);
+  // The channels as one flat array of floats, a block at a time, so that the conversions run in
+  // SIMD lanes (a point at a time they took 7 ns a point of lavapipe's 16.7M-point upload on 2
+  // cores); then the bytes packed with the alpha.
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  constexpr size_t kBlock = 1024;
+  uint8_t bytes[3 * kBlock];
+  const float* channels = &points.colors[first].x;
+  for (size_t done = 0; done < count; done += kBlock) {
+    const size_t n = std::min(kBlock, count - done);
+    const float* in = channels + 3 * done;
+    size_t j = 0;
+#if defined(__SSE2__)
+    // colourByte of 16 channels at once, the same steps in SSE2 lanes (x86-64's baseline): a clamp,
+    // the float product, its double plus 0.5 truncated; the bytes from two saturating packs (the
+    // values lie in 0..255).
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k255 = _mm_set1_ps(255.0f);
+    const __m128d half = _mm_set1_pd(0.5);
+    const auto four = [&](const float* f) {
+      const __m128 v = _mm_mul_ps(_mm_min_ps(_mm_max_ps(_mm_loadu_ps(f), zero), one), k255);
+      const __m128i lo = _mm_cvttpd_epi32(_mm_add_pd(_mm_cvtps_pd(v), half));
+      const __m128i hi = _mm_cvttpd_epi32(_mm_add_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), half));
+      return _mm_unpacklo_epi64(lo, hi);
+    };
+    for (; j + 16 <= 3 * n; j += 16) {
+      const __m128i words = _mm_packs_epi32(four(in + j), four(in + j + 4));
+      const __m128i words2 = _mm_packs_epi32(four(in + j + 8), four(in + j + 12));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(bytes + j), _mm_packus_epi16(words, words2));
+    }
+#endif
+    for (; j < 3 * n; ++j) bytes[j] = static_cast<uint8_t>(colourByte(in[j]));
+    for (size_t i = 0; i < n; ++i)
+      out[done + i] = 0xff000000u | bytes[3 * i] | uint32_t{bytes[3 * i + 1]} << 8 | uint32_t{bytes[3 * i + 2]} << 16;
+  }
 }
 
 uint64_t packBatchOffset(const glm::dvec3& t) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 
 #include "viewer/encode.h"
 #include "viewer/ortho_camera.h"
@@ -204,6 +205,36 @@ TEST(Encode, prepareEncodingNamesThePointAndCoordinateBeyondFloat) {
   for (PrecisionMode mode : {PrecisionMode::kRte, PrecisionMode::kDf64, PrecisionMode::kBatch})
     EXPECT_TRUE(prepareEncoding(mode, s, wide).ok()) << modeName(mode);
   EXPECT_FALSE(prepareEncoding(PrecisionMode::kFp32, s, wide).ok());
+}
+
+// encodeColors converts the channels a block at a time as one flat array: every channel of every
+// point rounds as lround, across block edges, from any first point.
+TEST(Encode, encodeColorsOfManyPointsRoundEachChannelAsLround) {
+  std::vector<float> values = {-1.0f, -0.0f, 0.0f, 2.0f, 1.0f, 0.5f};
+  for (int k = 0; k <= 256; ++k) {
+    float v = std::min(1.0f, (static_cast<float>(k) - 0.5f) / 255.0f);
+    for (int step = 0; step < 4 && v >= 0.0f; ++step, v = std::nextafter(v, 0.0f))
+      values.insert(values.end(), {v, std::nextafter(v, 2.0f)});
+  }
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> unit(-0.1f, 1.1f);
+  while (values.size() < 3 * 2500) values.push_back(unit(random));
+  PointSet s;
+  for (size_t i = 0; i + 3 <= values.size(); i += 3) {
+    s.positions.emplace_back(0.0);
+    s.colors.emplace_back(values[i + 2], values[i], values[i + 1]);  // each value in each channel somewhere
+    s.positions.emplace_back(0.0);
+    s.colors.emplace_back(values[i + 1], values[i + 2], values[i]);
+  }
+  const auto byte = [](float c) { return static_cast<uint32_t>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)); };
+  for (size_t first : {size_t{0}, size_t{7}}) {
+    std::vector<uint32_t> out(s.size() - first);
+    encodeColors(s, first, out.size(), out.data());
+    for (size_t i = 0; i < out.size(); ++i) {
+      const glm::vec3& c = s.colors[first + i];
+      ASSERT_EQ(out[i], 0xff000000u | byte(c.r) | byte(c.g) << 8 | byte(c.b) << 16) << first + i;
+    }
+  }
 }
 
 TEST(Encode, coloursRoundToNearestByteWithOpaqueAlphaAndWhiteWithoutColours) {
