@@ -55,11 +55,12 @@ void SpacingSampler::add(std::span<const glm::dvec3> points) {
   // pass's time), one kept over a worker's blocks a few thousand in all.
   constexpr size_t kBlock = size_t{1} << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
-  std::vector<std::vector<Entry>> kept(resolveThreads(threads_));
+  const unsigned threads = static_cast<unsigned>(std::min<size_t>(resolveThreads(threads_), std::max<size_t>(blocks, 1)));
+  std::vector<std::vector<Entry>> kept(threads);
   // Once `wanted` are kept, a hash not below the largest of them can never be kept (offer's own
   // test, made here before the call): most points of a large set end at this one comparison.
   const uint64_t none = heap_.size() == wanted_ ? heap_.front().first : UINT64_MAX;
-  parallelFor(blocks, threads_, [&](size_t b, unsigned worker) {
+  parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
     std::vector<Entry>& heap = kept[worker];
     uint64_t limit = heap.size() == wanted_ ? std::min(none, heap.front().first) : none;
     for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
@@ -146,7 +147,7 @@ uint64_t SpacingSearch::cellKey(const glm::dvec3& p) const {
 uint32_t SpacingSearch::findSlot(uint64_t key) const {
   if (key == UINT64_MAX) return UINT32_MAX;
   const uint64_t bit = (splitmixMix(key) >> 40) & (kFilterBits - 1);
-  if (!(filter_[bit >> 6] >> (bit & 63) & 1)) return UINT32_MAX;  // most points: no kept cell, one L1 read
+  if (!(filter_[bit >> 6] >> (bit & 63) & 1)) return UINT32_MAX;  // most points: no kept cell, one L2 read
   for (size_t at = tableIndex(key, keys_.size());; at = (at + 1) & (keys_.size() - 1)) {
     if (keys_[at] == key + 1) return slots_[at];
     if (keys_[at] == 0) return UINT32_MAX;

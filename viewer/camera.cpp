@@ -398,8 +398,9 @@ void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
   // A worker's rows over all its blocks. Consecutive points mostly share a row (a set's order is
   // mostly local): a run of them is kept in registers and written to its row once, where a store
   // and load of the row for every point made each wait for the last.
-  std::vector<std::vector<RowBox>> partial(resolveThreads(0), std::vector<RowBox>(rows_.size()));
-  parallelFor(blocks, 0, [&](size_t b, unsigned worker) {
+  const unsigned threads = static_cast<unsigned>(std::min<size_t>(resolveThreads(0), std::max<size_t>(blocks, 1)));
+  std::vector<std::vector<RowBox>> partial(threads, std::vector<RowBox>(rows_.size()));
+  parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
     std::vector<RowBox>& rows = partial[worker];
     const size_t end = std::min(positions.size(), (b + 1) * kBlock);
     size_t run_row = SIZE_MAX;

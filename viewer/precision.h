@@ -92,7 +92,9 @@ struct ModeChoice {
   // Ordered by predicted time to one picture (AutoTarget): the choice's and the runner-up's (ms).
   bool by_picture_time = false;
   double predicted_ms = std::nan(""), runner_up_predicted_ms = std::nan("");
-  ErrorBounds bounds;  // every mode the choice looked at
+  // Every mode the choice looked at; the runner-up's entry is the box's bound where
+  // runner_up_from_box (and has no encoding).
+  ErrorBounds bounds;
   // The modes ahead of the choice in speed order and why each was passed over: its bound over
   // kAutoBoundPx, or (bound_px NaN) the device cannot run it, `reason` saying why when the caller
   // knows (chooseModeOnDevice fills it in).
