@@ -24,6 +24,11 @@ PointColors pointColorsOf(const OutputOptions& o) {
   return o.colors == "noise" ? PointColors::kNoise : o.colors == "none" ? PointColors::kNone : PointColors::kAuto;
 }
 
+// --offset, 0 when not given.
+Result<glm::dvec3> offsetOf(const OutputOptions& o) {
+  return o.offset.empty() ? Result<glm::dvec3>(glm::dvec3(0.0)) : parseVec3("--offset", o.offset);
+}
+
 // Colours and offset (generators/generate.h): the steps after any generator that act point by point.
 Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise) {
   Result<uint64_t> limit = memoryLimit(o);
@@ -31,21 +36,25 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
   const PointColoring coloring{pointColorsOf(o), auto_noise, o.common.threads, *limit};
   if (Status s = colorGenerated(points, coloring); !s) return s;
   if (o.offset.empty()) return okStatus();
-  Result<glm::dvec3> offset = parseVec3("--offset", o.offset);
+  Result<glm::dvec3> offset = offsetOf(o);
   if (!offset) return offset.error();
   offsetPoints(points, *offset);
   return okStatus();
 }
 
+// The set's vertices go to a .ply written here (not handed back), as they are (no --sample).
+bool plyWrittenHere(const OutputOptions& o) {
+  Result<FileFormat> format = formatOf(o.output);
+  return !capturingPoints() && format && *format == FileFormat::kPly && o.sample.count == 0;
+}
+
 // Whether the noise colours are made as the PLY writer formats the rows (PlyWriteOptions::colors_of)
 // rather than before: the same file, without the colours' own pass over the set or their 12 bytes
-// a point. They need a .ply written here (not handed back), noise colours, and the positions as
-// written being those coloured (no --offset after the colours, no --sample interpolating them). A
+// a point. They need a .ply written here (plyWrittenHere: no --sample interpolating them), noise
+// colours, and the positions as written being those coloured (no --offset after the colours). A
 // reorder is no obstacle: a colour is a function of its point's position.
 bool coloursAtWrite(const OutputOptions& o, bool auto_noise) {
-  Result<FileFormat> format = formatOf(o.output);
-  return noiseColors(pointColorsOf(o), auto_noise) && !capturingPoints() && format && *format == FileFormat::kPly && o.offset.empty() &&
-         o.sample.count == 0;
+  return noiseColors(pointColorsOf(o), auto_noise) && plyWrittenHere(o) && o.offset.empty();
 }
 
 }  // namespace
@@ -124,9 +133,7 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
 }
 
 bool canFinishMade(const OutputOptions& o, bool auto_noise) {
-  Result<FileFormat> format = formatOf(o.output);
-  return !capturingPoints() && format && *format == FileFormat::kPly && o.sample.count == 0 &&
-         !(noiseColors(pointColorsOf(o), auto_noise) && !o.offset.empty());
+  return plyWrittenHere(o) && (!noiseColors(pointColorsOf(o), auto_noise) || coloursAtWrite(o, auto_noise));
 }
 
 int finishMade(const PointFunction& made, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
@@ -135,12 +142,9 @@ int finishMade(const PointFunction& made, const OutputOptions& o, PointOrder ord
   const double generate_s = clock.lap();
   Result<uint64_t> limit = memoryLimit(o);
   if (!limit) return reportError(limit.error());
-  glm::dvec3 offset(0.0);
-  if (!o.offset.empty()) {
-    Result<glm::dvec3> parsed = parseVec3("--offset", o.offset);
-    if (!parsed) return reportError(parsed.error());
-    offset = *parsed;
-  }
+  Result<glm::dvec3> parsed = offsetOf(o);
+  if (!parsed) return reportError(parsed.error());
+  const glm::dvec3 offset = *parsed;
   // As offsetPoints adds it: one rounding a coordinate. z stays +0 (a 2D set) only where the
   // offset's z is ±0.
   std::function<glm::dvec3(uint64_t)> at = made.at;
@@ -152,21 +156,18 @@ int finishMade(const PointFunction& made, const OutputOptions& o, PointOrder ord
   WriteOptions w;
   w.threads = o.common.threads;
   w.progress = &progress;
-  if (noiseColors(pointColorsOf(o), auto_noise)) w.colors_of = seedColors;
+  if (coloursAtWrite(o, auto_noise)) w.colors_of = seedColors;
   std::optional<MortonRows> rows;
   if (order == PointOrder::kMorton) {
     if (Status s = checkOrderable(made.count); !s) return reportError(s.error());
     if (Status s = checkMemory("ordering " + std::to_string(made.count) + " points", mortonRowsBytes(made.count), *limit); !s)
       return reportError(s.error());
     rows = mortonRows(made.count, at, o.common.threads, &progress);
-    w.positions_of = {made.count, [&rows, &at](size_t begin, size_t end, glm::dvec3* out) {
-                        for (size_t r = begin; r < end; ++r) out[r - begin] = at(rows->source(r));
-                      }};
-  } else {
-    w.positions_of = {made.count, [&at](size_t begin, size_t end, glm::dvec3* out) {
-                        for (size_t i = begin; i < end; ++i) out[i - begin] = at(i);
-                      }};
   }
+  // Row r is point r, or in Morton order the point the rows name.
+  w.positions_of = {made.count, [&rows, &at](size_t begin, size_t end, glm::dvec3* out) {
+                      for (size_t r = begin; r < end; ++r) out[r - begin] = at(rows ? rows->source(r) : r);
+                    }};
   const double order_s = clock.lap();
   if (Status s = writePointsWithNotes(o.output, facts, w); !s) return reportError(s.error());
   if (!o.common.quiet)

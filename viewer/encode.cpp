@@ -155,10 +155,6 @@ double roundToStep(double t, double steps) {
   return std::clamp((t * steps + kRound) - kRound, -steps, steps - 1.0);
 }
 
-}  // namespace
-
-namespace {
-
 // lround(v · 255) of v clamped to 0..1, without lround's libm call (the upload's cost at 16.7M
 // points): the float product plus 0.5 is exact in double, so truncating it rounds half away from
 // zero as lround does. NaN never gets here: readers reject it.
