@@ -118,12 +118,14 @@ void printChoice(const ModePrediction& p, const DeviceFacts& f, Backend backend)
     return;
   }
   const ModeChoice& c = *p.choice;
-  // A runner-up bounded over the set's box alone (no pass over the points) is given as at most that.
+  // A choice or runner-up bounded over the set's box alone (no pass over the points) is given as at
+  // most that.
   std::string runner_up = c.runner_up ? std::string(modeName(*c.runner_up)) + " (" + (c.runner_up_from_box ? "at most " : "") +
                                             formatBound(c.runner_up_bound_px) + (c.runner_up_from_box ? ", from the box" : "") + ")"
                                       : std::string("none within the limit");
+  const std::string bound = c.from_box ? "at most " + formatBound(c.bound_px) + " (from the box)" : formatBound(c.bound_px);
   std::printf("mode auto: %s, predicted error bound %s; runner-up %s; the %s within %g px on %s, %s backend\n",
-              std::string(modeName(c.mode)).c_str(), formatBound(c.bound_px).c_str(), runner_up.c_str(),
+              std::string(modeName(c.mode)).c_str(), bound.c_str(), runner_up.c_str(),
               c.by_picture_time ? "quickest to the picture" : "fastest", kAutoBoundPx,
               std::string(deviceClassName(deviceClassOf(f.type))).c_str(), backendName(backend));
   if (c.by_picture_time) {

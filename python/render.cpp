@@ -100,7 +100,9 @@ RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::ve
   r.device = outcome.device.name;
   r.points = outcome.points;
   r.predicted_bound_px = outcome.prediction.bound_px;
-  r.bound_from_boxes = outcome.prediction.from_boxes;
+  // From boxes, not every point: a streamed set's batch boxes, or the box --mode auto took its
+  // choice's bound from (report["predicted_from"] says which).
+  r.bound_from_boxes = outcome.prediction.from_boxes || (outcome.prediction.choice && outcome.prediction.choice->from_box);
   r.point_size = outcome.point_size;
   if (outcome.error && anyMeasured(outcome.error->stats)) r.error = outcome.error->stats;
   r.gpu_ms = outcome.result.gpu_ms;

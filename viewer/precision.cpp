@@ -572,6 +572,11 @@ ErrorBounds predictBoxBounds(const BatchBoxes& boxes, const Camera& camera, std:
     out.px[m] = std::sqrt(out.px[m]) * (1.0 + kBoxMargin);
     out.computed[m] = s.wanted[m];
     if ((s.unbounded[m] || beyond_limit[m]) && out.visible > 0) out.px[m] = kInf;
+    // A mode that is not per batch encodes the frame alone: the boxes' position checks (every
+    // coordinate's magnitude is largest at a box's min or max) stand for the encoder's, as a
+    // point pass's checks do (predictErrorBounds).
+    if (s.wanted[m] && modeInfo(kAllModes[m]).batch_points == 0 && !s.unbounded[m] && !beyond_limit[m])
+      out.encodings[m] = std::make_shared<const ModeEncoding>(beginEncoding(kAllModes[m], camera, tolerance_px));
   }
   out.float_floor_px = kU * 0.5 * std::max(camera.width, camera.height);
   return out;
@@ -611,18 +616,15 @@ ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<
   };
   // The walk below stops at the second usable mode within the bound, so from order[k] on it looks
   // at the next `certain` usable modes whatever their bounds (2 before the choice, 1 after): those
-  // are computed in one pass, and no mode the walk would not look at is computed.
-  // A mode after one the box shows within the limit can only be the runner-up: where the box shows
-  // it within the limit too, it needs no place in the pass.
+  // are computed in one pass, and no mode the walk would not look at is computed. A mode the box
+  // shows within the limit is taken on the box's bound (as the choice or the runner-up): it needs
+  // no place in the pass.
   auto computeAhead = [&](size_t k, size_t certain) {
     std::vector<PrecisionMode> ahead;
-    bool sure = choice.enough;  // the choice is made, or will be at a mode before order[k]
     for (; k < order.size() && certain > 0; ++k) {
       if (!usable(order[k])) continue;
       --certain;
-      const bool within = boxWithin(order[k]);
-      if (!choice.bounds.computed[modeIndex(order[k])] && !(sure && within)) ahead.push_back(order[k]);
-      sure = sure || within;
+      if (!choice.bounds.computed[modeIndex(order[k])] && !boxWithin(order[k])) ahead.push_back(order[k]);
     }
     if (!ahead.empty()) compute(ahead);
   };
@@ -637,15 +639,17 @@ ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<
   for (size_t k = 0; k < order.size(); ++k) {
     const PrecisionMode mode = order[k];
     if (!usable(mode)) continue;
-    if (!choice.bounds.computed[modeIndex(mode)] && choice.enough && boxWithin(mode)) {
+    if (!choice.bounds.computed[modeIndex(mode)] && boxWithin(mode)) {
       choice.bounds.px[modeIndex(mode)] = box->px[modeIndex(mode)];
       choice.bounds.computed[modeIndex(mode)] = from_box[modeIndex(mode)] = true;
+      choice.bounds.encodings[modeIndex(mode)] = box->encodings[modeIndex(mode)];
     }
     if (!choice.bounds.computed[modeIndex(mode)]) computeAhead(k, choice.enough ? 1 : 2);
     if (!(bound(mode) <= kAutoBoundPx)) continue;
     if (!choice.enough) {
       choice.mode = mode;
       choice.bound_px = bound(mode);
+      choice.from_box = from_box[modeIndex(mode)];
       choice.enough = true;
     } else {
       choice.runner_up = mode;

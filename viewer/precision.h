@@ -84,6 +84,9 @@ struct ModeChoice {
   PrecisionMode mode = kFallbackMode;
   double bound_px = 0.0;
   bool enough = false;  // bound_px ≤ kAutoBoundPx
+  // bound_px is the bound over the set's box (chooseMode's box_bounds_of), which showed the choice
+  // within the limit without a pass over the points: no less than the points' own.
+  bool from_box = false;
   std::optional<PrecisionMode> runner_up;  // the next mode in speed order within the bound
   double runner_up_bound_px = 0.0;
   // runner_up_bound_px is the bound over the set's box (chooseMode's box_bounds_of), which showed
@@ -92,8 +95,8 @@ struct ModeChoice {
   // Ordered by predicted time to one picture (AutoTarget): the choice's and the runner-up's (ms).
   bool by_picture_time = false;
   double predicted_ms = std::nan(""), runner_up_predicted_ms = std::nan("");
-  // Every mode the choice looked at; the runner-up's entry is the box's bound where
-  // runner_up_from_box (and has no encoding).
+  // Every mode the choice looked at; the choice's and the runner-up's entries are the box's bounds
+  // where from_box and runner_up_from_box.
   ErrorBounds bounds;
   // The modes ahead of the choice in speed order and why each was passed over: its bound over
   // kAutoBoundPx, or (bound_px NaN) the device cannot run it, `reason` saying why when the caller
@@ -127,9 +130,10 @@ using BoundsOf = std::function<ErrorBounds(std::span<const PrecisionMode> modes)
 // to look at together in one pass (the next two usable modes before its choice, one after it).
 // box_bounds_of, where given, bounds a mode over a box that holds the set (predictBoxBounds of its
 // bounding box: no pass over the points, and no less than bounds_of's): a mode it shows within the
-// limit once the choice is sure is the runner-up without a pass of its own (runner_up_from_box).
-// The choice itself, and every mode passed over, keep bounds_of's bounds. The per-batch modes are
-// not asked of it (their encoding is of the points).
+// limit is the choice (from_box) or the runner-up (runner_up_from_box) without a pass of its own,
+// and with the box's encoding; the mode drawn is the same as on bounds_of's bounds alone. Every
+// mode passed over keeps bounds_of's bound. The per-batch modes are not asked of it (their
+// encoding is of the points).
 ModeChoice chooseMode(std::span<const PrecisionMode> order, const std::function<bool(PrecisionMode)>& usable,
                       const BoundsOf& bounds_of, const BoundsOf& box_bounds_of = {});
 // The walk on the bounds of the points themselves (predictErrorBounds).

@@ -1039,9 +1039,11 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   JsonObject o;
   o.add("mode", V::string(modeName(mode))).add("mode_requested", V::string(request.mode));
   o.add("predicted_bound_px", V::number(outcome.prediction.bound_px));
-  // What the bound was predicted from: every point the view shows, or (a streamed set, read once
-  // while it is drawn) the box of every 1024 points.
-  o.add("predicted_from", V::string(outcome.prediction.from_boxes ? "batch_boxes" : "points"));
+  // What the bound was predicted from: every point the view shows, the set's bounding box (--mode
+  // auto, where the box showed the mode within the limit), or (a streamed set, read once while it
+  // is drawn) the box of every 1024 points.
+  const bool from_box = outcome.prediction.choice && outcome.prediction.choice->from_box;
+  o.add("predicted_from", V::string(outcome.prediction.from_boxes ? "batch_boxes" : from_box ? "box" : "points"));
   if (const std::optional<CopcReadStats>& c = outcome.copc)  // a COPC input: what its view read
     o.add("copc", JsonObject()
                       .add("points_read", V::integer(c->points))

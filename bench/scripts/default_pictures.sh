@@ -4,6 +4,7 @@
 # numpy by picture_measures.py), then the whole `dpoint render` process at 1024x768, the two builds
 # alternated, ROUNDS runs each (median reported).
 #   bench/scripts/default_pictures.sh BASE_DPOINT NEW_DPOINT WORK [ROUNDS]
+# SETS: other sets (paths, or names made in WORK beforehand), e.g. SETS="s11u.ply mb420.ply"
 set -euo pipefail
 base=$1 new=$2 work=$3 rounds=${4:-5}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -14,7 +15,7 @@ mkdir -p "$work"
 [ -f "$work/menger.ply" ] || "$new" generate menger -o "$work/menger.ply" -q
 [ -f "$work/sier7.ply" ] || "$new" generate sierpinski --level 7 -o "$work/sier7.ply" -q
 [ -f "$work/sier9.ply" ] || "$new" generate sierpinski -o "$work/sier9.ply" -q
-sets="mb200.ply mb420.ply menger.ply sier7.ply sier9.ply $corpus/las/simple.las $corpus/laz/autzen_trim.las"
+sets=${SETS:-"mb200.ply mb420.ply menger.ply sier7.ply sier9.ply $corpus/las/simple.las $corpus/laz/autzen_trim.las"}
 echo "| set | size | build | point size | gaps | artefacts |"
 echo "| --- | --- | --- | --- | --- | --- |"
 for f in $sets; do

@@ -222,18 +222,23 @@ TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
     // --error compares every bound with the error: the runner-up's is its points' too.
     EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"points\", \"predicted_ms\"")) << json;
   }
-  // Without --error, a runner-up that the set's box shows within the limit is bounded over the box,
-  // with no pass over the points of its own, and said to be. Two threads: the order by predicted
-  // time then puts rte (bounded over a box) after native on lavapipe as on a GPU, where on 4 or more
-  // cores lavapipe's would put batch (per batch, never bounded over one box) there.
+  // Without --error, a choice and a runner-up that the set's box shows within the limit are bounded
+  // over the box, with no pass over the points of their own, and said to be; fp32, passed over,
+  // keeps its points' bound. Two threads: the order by predicted time then puts rte (bounded over a
+  // box) after native on lavapipe as on a GPU, where on 4 or more cores lavapipe's would put batch
+  // (per batch, never bounded over one box) there.
   {
     test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--width", "256",
                                        "--height", "256", "--threads", "2", "--json", dir.file("box.json")});
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::contains(r.out, "predicted error bound at most ")) << r.out;
+    EXPECT_TRUE(test::contains(r.out, " (from the box); runner-up ")) << r.out;
     EXPECT_TRUE(test::contains(r.out, ", from the box)")) << r.out;
     const std::string json = readFile(dir.file("box.json"));
     EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"box\", \"predicted_ms\"")) << json;
-    EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"points\",\n")) << "the choice's own bound: " << json;
+    EXPECT_TRUE(test::contains(json, "\"predicted_from\": \"box\",\n")) << "the choice's bound: " << json;
+    EXPECT_LE(jsonNumber(json, "predicted_bound_px"), 0.1);
+    EXPECT_TRUE(test::contains(json, "\"rejected\": [{\"mode\": \"fp32\"")) << json;
   }
   // Several frames: what they wait for is the frames, in the measured speed order.
   test::CommandResult r = runDpoint({"render", dir.file("far.ply"), "-o", dir.file("far.png"), "--frames", "2",

@@ -351,10 +351,11 @@ TEST(PrecisionPass, chooseModeBoundsOnlyTheModesItLooksAt) {
   }
 }
 
-// With the set's box to ask, a mode the box shows within the limit once the choice is sure is the
-// runner-up without a pass over the points (its bound the box's, no less than the points'); the
-// choice, and every mode before it, keep the points' bounds to the bit.
-TEST(PrecisionPass, aRunnerUpWithinTheLimitOverTheBoxTakesNoPass) {
+// With the set's box to ask, a mode the box shows within the limit is the choice or the runner-up
+// without a pass over the points (its bound the box's, no less than the points', and its encoding
+// the box's); the mode drawn is the same, and every mode passed over keeps its points' bound to
+// the bit.
+TEST(PrecisionPass, aModeWithinTheLimitOverTheBoxTakesNoPass) {
   const auto all = [](PrecisionMode) { return true; };
   const PrecisionMode order[] = {PrecisionMode::kFp32, PrecisionMode::kNative, PrecisionMode::kDf64};
   const glm::dvec3 near(1.0, 2.0, 3.0), far(6.378e6, 0.5, -3.0);
@@ -374,19 +375,32 @@ TEST(PrecisionPass, aRunnerUpWithinTheLimitOverTheBoxTakesNoPass) {
     const ModeChoice boxed = chooseMode(order, all, points, box);
     SCOPED_TRACE(centre == near ? "near" : "far");
     EXPECT_EQ(boxed.mode, plain.mode);
-    EXPECT_EQ(std::bit_cast<uint64_t>(boxed.bound_px), std::bit_cast<uint64_t>(plain.bound_px));
+    EXPECT_TRUE(boxed.from_box);
+    EXPECT_FALSE(plain.from_box);
+    EXPECT_GE(boxed.bound_px, plain.bound_px);
+    EXPECT_LE(boxed.bound_px, kAutoBoundPx);
+    // The encoding the render draws with: the one a pass over the points makes (the frame alone).
+    ASSERT_TRUE(boxed.encoding() && plain.encoding());
+    EXPECT_EQ(boxed.encoding()->mode, plain.encoding()->mode);
+    EXPECT_EQ(boxed.encoding()->frame.eye, plain.encoding()->frame.eye);
+    EXPECT_EQ(boxed.encoding()->frame.exponent, plain.encoding()->frame.exponent);
     ASSERT_TRUE(boxed.runner_up && plain.runner_up);
     EXPECT_EQ(*boxed.runner_up, *plain.runner_up);
     EXPECT_GE(boxed.runner_up_bound_px, plain.runner_up_bound_px);
     EXPECT_LE(boxed.runner_up_bound_px, kAutoBoundPx);
     EXPECT_TRUE(boxed.runner_up_from_box);
     EXPECT_FALSE(plain.runner_up_from_box);
-    // One pass, without the runner-up: fp32 alone near the origin; far from it fp32 and native,
-    // both before the choice is sure, and df64 from the box.
-    ASSERT_EQ(passes.size(), 1u);
-    const std::vector<PrecisionMode> looked_at =
-        centre == near ? std::vector{PrecisionMode::kFp32} : std::vector{PrecisionMode::kFp32, PrecisionMode::kNative};
-    EXPECT_EQ(passes[0], looked_at);
+    // Near the origin fp32 and native are within the limit over the box: no pass at all. Far from
+    // it fp32 is not (its points' bound is needed to pass it over), native and df64 are: one pass,
+    // of fp32 alone.
+    if (centre == near) {
+      EXPECT_TRUE(passes.empty());
+      EXPECT_EQ(boxed.mode, PrecisionMode::kFp32);
+    } else {
+      ASSERT_EQ(passes.size(), 1u);
+      EXPECT_EQ(passes[0], std::vector{PrecisionMode::kFp32});
+      EXPECT_EQ(boxed.mode, PrecisionMode::kNative);
+    }
     ASSERT_EQ(boxed.rejected.size(), plain.rejected.size());
     for (size_t k = 0; k < plain.rejected.size(); ++k)
       EXPECT_EQ(std::bit_cast<uint64_t>(boxed.rejected[k].bound_px), std::bit_cast<uint64_t>(plain.rejected[k].bound_px));
@@ -401,6 +415,8 @@ TEST(PrecisionPass, aRunnerUpWithinTheLimitOverTheBoxTakesNoPass) {
     return b;
   };
   const ModeChoice plain = chooseMode(order, all, points), boxed = chooseMode(order, all, points, wide);
+  EXPECT_FALSE(boxed.from_box);
+  EXPECT_EQ(std::bit_cast<uint64_t>(boxed.bound_px), std::bit_cast<uint64_t>(plain.bound_px));
   EXPECT_FALSE(boxed.runner_up_from_box);
   EXPECT_EQ(boxed.runner_up, plain.runner_up);
   EXPECT_EQ(std::bit_cast<uint64_t>(boxed.runner_up_bound_px), std::bit_cast<uint64_t>(plain.runner_up_bound_px));
