@@ -209,8 +209,10 @@ void printOutcome(const RenderRequest& request, const std::string& output, const
 }
 
 void printView(const SheetView& view) {
-  std::printf("view %s: mode %s, predicted error bound %s", view.label.c_str(),
-              std::string(modeName(view.prediction.mode)).c_str(), formatBound(view.prediction.bound_px).c_str());
+  const bool from_box = view.prediction.choice && view.prediction.choice->from_box;
+  std::printf("view %s: mode %s, predicted error bound %s%s%s", view.label.c_str(),
+              std::string(modeName(view.prediction.mode)).c_str(), from_box ? "at most " : "",
+              formatBound(view.prediction.bound_px).c_str(), from_box ? " (from the box)" : "");
   if (!view.gpu_ms.empty()) std::printf(", gpu %.3f ms/frame median of %zu", medianOf(view.gpu_ms), view.gpu_ms.size());
   std::printf("\n");
 }

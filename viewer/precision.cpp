@@ -575,7 +575,7 @@ ErrorBounds predictBoxBounds(const BatchBoxes& boxes, const Camera& camera, std:
     // A mode that is not per batch encodes the frame alone: the boxes' position checks (every
     // coordinate's magnitude is largest at a box's min or max) stand for the encoder's, as a
     // point pass's checks do (predictErrorBounds).
-    if (s.wanted[m] && modeInfo(kAllModes[m]).batch_points == 0 && !s.unbounded[m] && !beyond_limit[m])
+    if (s.wanted[m] && modeInfo(kAllModes[m]).batch_points == 0 && !beyond_limit[m])
       out.encodings[m] = std::make_shared<const ModeEncoding>(beginEncoding(kAllModes[m], camera, tolerance_px));
   }
   out.float_floor_px = kU * 0.5 * std::max(camera.width, camera.height);

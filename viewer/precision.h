@@ -44,8 +44,10 @@ struct ErrorBounds {
   double float_floor_px = 0.0;              // 2^-24 · max(width, height) / 2
   bool from_boxes = false;                  // predictBoxBounds: each batch's box stood for its points
   // Per computed mode, its encoding for this camera and tolerance (prepareEncoding's), where the
-  // pass built it (per-batch modes) or checked every point against it (the others): renderPoints
-  // takes it rather than building it again. Null where the mode refuses the set, and from boxes.
+  // pass built it (per-batch modes) or checked every point against it (the others; from boxes,
+  // every box's corners, which hold every coordinate's extremes): renderPoints takes it rather
+  // than building it again. Null where the mode refuses the set, and for the per-batch modes from
+  // boxes.
   std::array<std::shared_ptr<const ModeEncoding>, kModeCount> encodings;
 };
 
@@ -96,7 +98,8 @@ struct ModeChoice {
   bool by_picture_time = false;
   double predicted_ms = std::nan(""), runner_up_predicted_ms = std::nan("");
   // Every mode the choice looked at; the choice's and the runner-up's entries are the box's bounds
-  // where from_box and runner_up_from_box.
+  // where from_box and runner_up_from_box. visible and float_floor_px are those of the last pass
+  // over the points, and 0 where the walk made none (every mode it took came from the box).
   ErrorBounds bounds;
   // The modes ahead of the choice in speed order and why each was passed over: its bound over
   // kAutoBoundPx, or (bound_px NaN) the device cannot run it, `reason` saying why when the caller

@@ -140,8 +140,9 @@ Result<RenderResult> renderStreamOnce(const VulkanContext& context, const PointS
 // class and backend, or its modes by predicted time to the picture (AutoTarget), restricted to the modes the device runs (features, the emulation
 // self-test, and with `probe` the probe's needs).
 // `target`: what the walk's order minimises (AutoTarget; by default the frames). `box`, where known,
-// holds every point: the runner-up may be bounded over it (chooseMode's box_bounds_of; not with
-// `probe`, whose report compares every bound with the error measured).
+// holds every point (and every coordinate is finite): the choice and the runner-up may be bounded
+// over it (chooseMode's box_bounds_of; not with `probe`, whose report compares every bound with
+// the error measured).
 Result<ModeChoice> chooseModeOnDevice(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                       Backend backend, bool probe, double tolerance_px = kDefaultTolerancePx,
                                       const AutoTarget& target = {}, const std::optional<Box>& box = std::nullopt);

@@ -57,6 +57,10 @@ struct LoadedSet {
   std::string inputs;  // describeInputs: for messages
   std::optional<PointSet> owned;           // read here, or a copy of the request's set to colour or order
   std::shared_ptr<const PointSet> shared;  // else the request's own set (RenderRequest::points)
+  // The request's own set may hold a non-finite position (Python's allow_nonfinite), which its box
+  // (glm::min and max pass a NaN over) does not show: predictMode checks before it trusts the box.
+  // A set read here is finite (the readers refuse the rest).
+  bool finite_unknown = false;
   // The set in memory; null: a stream.
   const PointSet* points() const { return owned ? &*owned : shared.get(); }
   std::unique_ptr<PointInputStream> stream;
@@ -206,7 +210,25 @@ Result<LoadedSet> takeInMemory(const RenderRequest& request) {
   LoadedSet set;
   set.inputs = request.inputs.empty() ? std::string("points") : describeInputs(request.inputs);
   set.shared = request.points;
+  set.finite_unknown = true;
   return set;
+}
+
+// Whether every coordinate of the set is finite, on all cores.
+bool allPositionsFinite(const PointSet& points, unsigned threads) {
+  constexpr size_t kBlock = size_t{1} << 16;
+  const size_t blocks = (points.size() + kBlock - 1) / kBlock;
+  std::vector<char> finite(blocks, 1);
+  parallelFor(blocks, threads, [&](size_t b, unsigned) {
+    // x − x is 0 for a finite x and NaN for NaN or ±inf: a sum with no branch, in vector lanes.
+    double sum = 0.0;
+    for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
+      const glm::dvec3& p = points.positions[i];
+      sum += (p.x - p.x) + (p.y - p.y) + (p.z - p.z);
+    }
+    finite[b] = sum == 0.0;
+  });
+  return std::all_of(finite.begin(), finite.end(), [](char f) { return f != 0; });
 }
 
 // Whole batches of a stream spread evenly over it, for a one-pass render's provisional camera and
@@ -401,9 +423,13 @@ Result<ModePrediction> predictMode(const RenderRequest& request, const VulkanCon
   const double tolerance = request.tolerance_px;
   auto choose = [&]() -> Result<ModeChoice> {
     const AutoTarget target = autoTargetOf(request, set.count);
-    if (set.points())
-      return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance, target,
-                                Box{set.bounds.min, set.bounds.max});
+    if (set.points()) {
+      // The box stands for the points (their bounds and position checks) only where it holds
+      // every coordinate: not past a NaN.
+      std::optional<Box> box;
+      if (!set.finite_unknown || allPositionsFinite(*set.points(), request.threads)) box = Box{set.bounds.min, set.bounds.max};
+      return chooseModeOnDevice(context, *set.points(), camera, *request.backend, request.error, tolerance, target, box);
+    }
     return chooseModeOnDevice(context, set.boxes, camera, *request.backend, tolerance, target);
   };
   ModePrediction p;

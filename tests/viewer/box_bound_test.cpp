@@ -325,5 +325,32 @@ TEST(StreamedAuto, picksAModeWhoseMeasuredErrorStaysWithinTheBoxBound) {
   }
 }
 
+// --mode auto takes a mode the set's box shows within the limit without a pass over the points,
+// its encoding's position checks the box's. A set given in memory may hold a NaN (Python's
+// allow_nonfinite), which its box (min and max pass over a NaN) does not show: its points are
+// bounded then, and the render refuses the set naming the coordinate, as it did before the box
+// stood for them. A finite set in memory takes its mode from the box.
+TEST(BoxChoice, aSetInMemoryWithANanIsBoundedOverItsPoints) {
+  PointSet points = randomCube(glm::dvec3(1.0, 2.0, 3.0), 1.0, 5000, false);
+  RenderRequest request;
+  request.mode = "auto";
+  request.validate = true;
+  request.camera.width = 64, request.camera.height = 48;
+  request.points = std::make_shared<const PointSet>(points);
+  Progress progress;
+  Result<RenderOutcome> finite = runRenderJob(request, progress);
+  ASSERT_TRUE(finite.ok()) << finite.error().message;
+  ASSERT_TRUE(finite->prediction.choice);
+  EXPECT_TRUE(finite->prediction.choice->from_box);
+  EXPECT_LE(finite->prediction.bound_px, kAutoBoundPx);
+  EXPECT_TRUE(finite->validation_messages.empty());
+  points.positions[2500].y = std::nan("");
+  request.points = std::make_shared<const PointSet>(points);
+  Result<RenderOutcome> nan = runRenderJob(request, progress);
+  ASSERT_FALSE(nan.ok()) << "a NaN drawn as if it were not there";
+  EXPECT_EQ(nan.error().code, ExitCode::kBadInput) << nan.error().message;
+  EXPECT_TRUE(test::contains(nan.error().message, "2500")) << nan.error().message;
+}
+
 }  // namespace
 }  // namespace dpoint
