@@ -53,6 +53,44 @@ TEST(Image, writePngRoundTripsEveryByte) {
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.png"});
 }
 
+// Pictures of many pieces (the encoder deflates about 64 KiB of rows a piece, on all cores, as
+// one zlib stream): opaque (written as RGB) and with alpha, one row wider than a piece, every
+// byte back through an independent decoder (stb_image, which checks the stream's Adler-32 only
+// in part: the byte count and every pixel are checked here).
+TEST(Image, writePngOfManyPiecesRoundTripsEveryByte) {
+  TempDir dir;
+  struct Case {
+    uint32_t width, height;
+    bool opaque;
+  };
+  for (const Case& c : {Case{1024, 768, true}, Case{333, 517, false}, Case{20000, 3, true}, Case{1, 70000, false}}) {
+    SCOPED_TRACE(std::to_string(c.width) + "x" + std::to_string(c.height));
+    Image image{c.width, c.height, std::vector<uint8_t>(size_t{c.width} * c.height * 4)};
+    for (size_t i = 0; i < image.rgba.size(); ++i) {
+      const size_t pixel = i / 4, x = pixel % c.width;
+      // Runs (a render's background) beside noise, so both kinds of match and literal occur.
+      image.rgba[i] = i % 4 == 3 ? (c.opaque ? 255 : static_cast<uint8_t>(pixel * 7))
+                    : x < c.width / 2 ? static_cast<uint8_t>(x / 64)
+                                      : static_cast<uint8_t>((i * 2654435761u) >> 13);
+    }
+    const std::string path = dir.file("many.png");
+    ASSERT_TRUE(writePng(path, image).ok());
+    int width = 0, height = 0, channels = 0;
+    unsigned char* pixels = stbi_load(path.c_str(), &width, &height, &channels, 4);
+    ASSERT_NE(pixels, nullptr) << stbi_failure_reason();
+    EXPECT_EQ(uint32_t(width), c.width);
+    EXPECT_EQ(uint32_t(height), c.height);
+    EXPECT_EQ(channels, c.opaque ? 3 : 4);
+    EXPECT_TRUE(std::vector<uint8_t>(pixels, pixels + image.rgba.size()) == image.rgba);
+    stbi_image_free(pixels);
+    // The same picture gives the same bytes (the pieces do not depend on the threads).
+    Result<std::vector<unsigned char>> again = pngBytes(image, "again");
+    ASSERT_TRUE(again.ok());
+    const std::string file = readFile(path);
+    EXPECT_TRUE(std::string(again->begin(), again->end()) == file);
+  }
+}
+
 TEST(Image, writePngFailureNamesThePathAndLeavesNothing) {
   TempDir dir;
   const std::string missing = dir.file("no-such-folder/out.png");
