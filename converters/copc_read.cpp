@@ -267,8 +267,7 @@ Result<std::string> readCopcRecords(const InputFile& file, const CopcQuery& quer
     total += static_cast<uint64_t>(n.points);
     largest = std::max(largest, static_cast<uint64_t>(n.bytes));
   }
-  const unsigned threads =
-      std::min<unsigned>(resolveThreads(query.threads), static_cast<unsigned>(std::max<size_t>(nodes.size(), 1)));
+  const unsigned threads = parallelWorkers(nodes.size(), query.threads);
   if (total > (UINT64_MAX - largest * threads) / length)  // counts of a hostile hierarchy
     return Error{path + ": " + str(total) + " points of " + str(length) + " bytes overflow 64 bits",
                  ExitCode::kResourceLimit};

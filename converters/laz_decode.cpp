@@ -477,7 +477,7 @@ Status decodeLazChunkList(const InputFile& file, const LazInfo& info, std::span<
                           uint32_t record_length, char* records, unsigned threads,
                           const std::function<std::string(size_t)>& where) {
   if (chunks.empty()) return okStatus();
-  threads = std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(chunks.size()));
+  threads = parallelWorkers(chunks.size(), threads);
   std::vector<uint64_t> at(chunks.size(), 0);  // each chunk's first record in `records`
   for (size_t i = 1; i < chunks.size(); ++i) at[i] = at[i - 1] + chunks[i - 1].points;
   // The error reported is the first failing chunk's: chunks are handed out in order, and once one
@@ -535,8 +535,7 @@ Result<LazRecords> decodeLazRecords(const InputFile& file, unsigned threads, uin
   const LazChunks& laz = *opened;
   // The records and one chunk's bytes per thread.
   const uint64_t length = laz.record_length;
-  const unsigned workers =
-      std::min<unsigned>(resolveThreads(threads), static_cast<unsigned>(std::max<size_t>(laz.chunks.size(), 1)));
+  const unsigned workers = parallelWorkers(laz.chunks.size(), threads);
   uint64_t largest = 0;
   for (const LazChunk& c : laz.chunks) largest = std::max(largest, c.bytes);
   if (laz.point_count > (UINT64_MAX - lead - largest * workers) / length)

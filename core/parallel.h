@@ -17,11 +17,18 @@ inline unsigned resolveThreads(unsigned requested) {
   return n == 0 ? 1 : n;
 }
 
-// Calls fn(item, worker) for every item in [0, count) on up to `threads` threads (worker < threads).
+// The workers parallelFor(count, threads, …) runs: no more than its items (at least one). Per-worker
+// arrays are sized by it, so a small job on a many-core host does not make one for every core.
+inline unsigned parallelWorkers(size_t count, unsigned threads) {
+  threads = resolveThreads(threads);
+  return threads > count ? static_cast<unsigned>(count == 0 ? 1 : count) : threads;
+}
+
+// Calls fn(item, worker) for every item in [0, count) on parallelWorkers(count, threads) threads
+// (worker < that).
 inline void parallelFor(size_t count, unsigned threads,
                         const std::function<void(size_t item, unsigned worker)>& fn) {
-  threads = resolveThreads(threads);
-  if (threads > count) threads = static_cast<unsigned>(count == 0 ? 1 : count);
+  threads = parallelWorkers(count, threads);
   std::atomic<size_t> next{0};
   auto run = [&](unsigned worker) {
     for (size_t i = next.fetch_add(1); i < count; i = next.fetch_add(1)) fn(i, worker);

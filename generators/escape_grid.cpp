@@ -283,15 +283,6 @@ void widenCounts(const uint8_t* block, int bytes, size_t n, uint32_t* counts) {
   }
 }
 
-// Eight consecutive above-level flags (0 or 1) as one word: all 0 (kNoneAbove) or all 1 (kAllAbove)
-// where a run of the grid is on one side of the level.
-inline uint64_t flagWord(const uint8_t* p) {
-  uint64_t w;
-  std::memcpy(&w, p, sizeof w);
-  return w;
-}
-constexpr uint64_t kNoneAbove = 0, kAllAbove = 0x0101010101010101ull;
-
 // above[i] = count i > above_at, for counts of type T, compared in T (16 at a time for bytes).
 template <typename T>
 void classify(const uint8_t* counts, size_t n, uint32_t above_at, uint8_t* above) {
@@ -431,12 +422,12 @@ class SlabField {
       for (size_t k = 0; k < n; ++k) {
         const size_t pt = j * n + k;
         if (k > 0 && k + 9 <= n) {  // pt − 1 .. pt + 8 lie in the row
-          const uint64_t w = flagWord(a + pt);
-          if (w == kNoneAbove ||
-              (w == kAllAbove && (!has_previous || flagWord(prev + pt) == kAllAbove) &&
-               (!in_plane || ((j == 0 || flagWord(a + pt - n) == kAllAbove) &&
-                              (j + 1 == n || flagWord(a + pt + n) == kAllAbove) && flagWord(a + pt - 1) == kAllAbove &&
-                              flagWord(a + pt + 1) == kAllAbove)))) {
+          const uint64_t w = mcFlagWord(a + pt);
+          if (w == kMcNoneAbove ||
+              (w == kMcAllAbove && (!has_previous || mcFlagWord(prev + pt) == kMcAllAbove) &&
+               (!in_plane || ((j == 0 || mcFlagWord(a + pt - n) == kMcAllAbove) &&
+                              (j + 1 == n || mcFlagWord(a + pt + n) == kMcAllAbove) && mcFlagWord(a + pt - 1) == kMcAllAbove &&
+                              mcFlagWord(a + pt + 1) == kMcAllAbove)))) {
             k += 7;
             continue;
           }
@@ -456,7 +447,7 @@ class SlabField {
       for (size_t k = 0; k < n; ++k) {
         const size_t pt = j * n + k;
         // None of p − 1 above, or all of p above: no x edge from p − 1 crossed.
-        if (k + 8 <= n && (flagWord(prev + pt) == kNoneAbove || flagWord(a + pt) == kAllAbove)) {
+        if (k + 8 <= n && (mcFlagWord(prev + pt) == kMcNoneAbove || mcFlagWord(a + pt) == kMcAllAbove)) {
           k += 7;
           continue;
         }

@@ -2,7 +2,6 @@
 
 #include <cassert>
 #include <cstdint>
-#include <cstring>
 
 namespace dpoint {
 namespace {
@@ -123,15 +122,6 @@ int mcEdgeStart(int edge) {
   return ((r & 1) << ((axis + 1) % 3)) | ((r >> 1) << ((axis + 2) % 3));
 }
 
-namespace {
-// Eight bytes of a plane's above-level flags, for skipping runs where nothing is crossed.
-inline uint64_t word(const uint8_t* p) {
-  uint64_t w;
-  std::memcpy(&w, p, sizeof w);
-  return w;
-}
-}  // namespace
-
 McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last_plane,
                              const McSlabCallbacks& callbacks, bool seam_positions) {
   assert(ny >= 2 && nz >= 2 && last > first);
@@ -182,7 +172,7 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
       for (int k = 0; k < nz; ++k) {
         const size_t pt = static_cast<size_t>(j) * row + static_cast<size_t>(k);
         // Eight points at once where no y or z edge from them is crossed (most of the grid).
-        if (k + 8 < nz && word(a + pt) == word(a + pt + 1) && (!has_y || word(a + pt) == word(a + pt + row))) {
+        if (k + 8 < nz && mcFlagWord(a + pt) == mcFlagWord(a + pt + 1) && (!has_y || mcFlagWord(a + pt) == mcFlagWord(a + pt + row))) {
           k += 7;
           continue;
         }
@@ -213,7 +203,7 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
     for (int j = 0; j < ny; ++j) {
       for (int k = 0; k < nz; ++k) {
         const size_t pt = static_cast<size_t>(j) * row + static_cast<size_t>(k);
-        if (k + 8 <= nz && word(a0 + pt) == word(a1 + pt)) {  // no x edge crossed at these eight
+        if (k + 8 <= nz && mcFlagWord(a0 + pt) == mcFlagWord(a1 + pt)) {  // no x edge crossed at these eight
           k += 7;
           continue;
         }
@@ -235,9 +225,9 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
         // Eight cubes at once when their 18 corners are all on one side: the words at pt and
         // pt + 1 of the four rows equal one another only when all their bytes are equal.
         if (k + 9 <= nz) {
-          const uint64_t w = word(a0 + pt);
-          if (w == word(a0 + pt + 1) && w == word(a1 + pt) && w == word(a1 + pt + 1) && w == word(a0 + pt + row) &&
-              w == word(a0 + pt + row + 1) && w == word(a1 + pt + row) && w == word(a1 + pt + row + 1)) {
+          const uint64_t w = mcFlagWord(a0 + pt);
+          if (w == mcFlagWord(a0 + pt + 1) && w == mcFlagWord(a1 + pt) && w == mcFlagWord(a1 + pt + 1) && w == mcFlagWord(a0 + pt + row) &&
+              w == mcFlagWord(a0 + pt + row + 1) && w == mcFlagWord(a1 + pt + row) && w == mcFlagWord(a1 + pt + row + 1)) {
             k += 7;
             continue;
           }

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <vector>
 
@@ -40,6 +41,16 @@ struct McCase {
 };
 // mask bit c is set when corner c is above the level.
 const McCase& marchingCubesCase(unsigned mask);
+
+// Eight consecutive above-level flags (0 or 1, McSlabCallbacks::load_plane's) as one word, for
+// passing over eight points at once where a run of the grid is on one side of the level: all 0
+// (kMcNoneAbove) or all 1 (kMcAllAbove), or equal to its neighbours' words.
+inline uint64_t mcFlagWord(const uint8_t* p) {
+  uint64_t w;
+  std::memcpy(&w, p, sizeof w);
+  return w;
+}
+inline constexpr uint64_t kMcNoneAbove = 0, kMcAllAbove = 0x0101010101010101ull;
 int mcEdgeAxis(int edge);
 int mcEdgeStart(int edge);
 

@@ -55,7 +55,7 @@ void SpacingSampler::add(std::span<const glm::dvec3> points) {
   // pass's time), one kept over a worker's blocks a few thousand in all.
   constexpr size_t kBlock = size_t{1} << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
-  const unsigned threads = static_cast<unsigned>(std::min<size_t>(resolveThreads(threads_), std::max<size_t>(blocks, 1)));
+  const unsigned threads = parallelWorkers(blocks, threads_);
   std::vector<std::vector<Entry>> kept(threads);
   // Once `wanted` are kept, a hash not below the largest of them can never be kept (offer's own
   // test, made here before the call): most points of a large set end at this one comparison.

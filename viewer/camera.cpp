@@ -398,7 +398,7 @@ void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
   // A worker's rows over all its blocks. Consecutive points mostly share a row (a set's order is
   // mostly local): a run of them is kept in registers and written to its row once, where a store
   // and load of the row for every point made each wait for the last.
-  const unsigned threads = static_cast<unsigned>(std::min<size_t>(resolveThreads(0), std::max<size_t>(blocks, 1)));
+  const unsigned threads = parallelWorkers(blocks, 0);
   std::vector<std::vector<RowBox>> partial(threads, std::vector<RowBox>(rows_.size()));
   parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
     std::vector<RowBox>& rows = partial[worker];
