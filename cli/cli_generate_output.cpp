@@ -94,7 +94,7 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   const double generate_s = clock.lap();
   PointSet& points = *generated;
   const bool colours_at_write = coloursAtWrite(o, auto_noise);
-  if (colours_at_write) std::vector<glm::vec3>().swap(points.colors);
+  if (colours_at_write) ColorArray().swap(points.colors);
   else if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
   if (o.sample.count != 0) {  // on the coloured, offset mesh: colours interpolate, positions are in their frame
     Result<uint64_t> limit = memoryLimit(o);

@@ -112,7 +112,7 @@ class CsvRowWriter {
   unsigned threads_;
   Progress* progress_;
   size_t batch_rows_;  // rows formatted in one parallel batch
-  std::vector<glm::dvec3> pending_positions_;  // fewer than batch_rows_ rows from earlier calls
+  PositionArray pending_positions_;  // fewer than batch_rows_ rows from earlier calls
   std::vector<glm::vec3> pending_colors_;
   std::vector<std::string> texts_;  // one per chunk of a batch
 };

@@ -49,8 +49,8 @@ glm::dmat4 rotationMatrix(double x, double y, double z, double w) {
 
 // Room for `extra` more elements: exactly for the first (often the only, and largest) primitive,
 // then growing by half at least, so many small primitives do not copy the arrays once each.
-template <typename T>
-void reserveMore(std::vector<T>& v, size_t extra) {
+template <typename T, typename Allocator>
+void reserveMore(std::vector<T, Allocator>& v, size_t extra) {
   const size_t needed = v.size() + extra;
   if (needed > v.capacity()) v.reserve(std::max(needed, v.capacity() + v.capacity() / 2));
 }

@@ -321,7 +321,7 @@ bool fitsInt32(double q) { return q >= -2147483648.0 && q <= 2147483647.0; }
 
 // True when every coordinate on axis k reads back as itself (X·scale + offset, as a reader computes
 // it) when stored under `offset`. Stops at the first that does not.
-bool readsBackExactly(const std::vector<glm::dvec3>& positions, int k, double offset, double scale, unsigned threads) {
+bool readsBackExactly(const PositionArray& positions, int k, double offset, double scale, unsigned threads) {
   std::atomic<bool> miss{false};
   const size_t n = positions.size();
   parallelFor((n + kWriteBlockPoints - 1) / kWriteBlockPoints, threads, [&](size_t b, unsigned) {
@@ -341,7 +341,7 @@ bool readsBackExactly(const std::vector<glm::dvec3>& positions, int k, double of
 // Measured on simple.las (scale 0.01, offset 0) written at 0.01: x, y, z offsets of 0 read every
 // point back; the whole-number offsets missed 111, 137 and 164 of 1065, the rounded multiples 315,
 // 459 and 430.
-double chooseOffset(const std::vector<glm::dvec3>& positions, int k, double min, double max, double scale,
+double chooseOffset(const PositionArray& positions, int k, double min, double max, double scale,
                     unsigned threads) {
   const double first = lasOffsetFor(min, scale);
   std::optional<double> fitting;
@@ -355,7 +355,7 @@ double chooseOffset(const std::vector<glm::dvec3>& positions, int k, double min,
 
 // Distinct positions minus distinct integer triples at this scale and offset: how many points
 // would read back on top of another. Two sorts, 12 + 24 bytes a point for the time of the count.
-uint64_t mergedPoints(const std::vector<glm::dvec3>& positions, const glm::dvec3& scale, const glm::dvec3& offset) {
+uint64_t mergedPoints(const PositionArray& positions, const glm::dvec3& scale, const glm::dvec3& offset) {
   std::vector<std::array<double, 3>> exact(positions.size());
   std::vector<std::array<int64_t, 3>> stored(positions.size());
   for (size_t i = 0; i < positions.size(); ++i)
@@ -381,7 +381,7 @@ bool extentFits(double min, double max, double scale) {
 // True when every coordinate on axis k reads back within two units in the last place of itself
 // (or of the offset, where that is larger): the decimal digits it has are all kept. Stops at the
 // first that does not.
-bool readsBackClosely(const std::vector<glm::dvec3>& positions, int k, double offset, double scale, unsigned threads) {
+bool readsBackClosely(const PositionArray& positions, int k, double offset, double scale, unsigned threads) {
   std::atomic<bool> miss{false};
   const size_t n = positions.size();
   const double offset_ulp = std::nextafter(std::abs(offset), HUGE_VAL) - std::abs(offset);
@@ -403,7 +403,7 @@ constexpr double kDecimalSteps[] = {1.0,  0.1,  0.01, 0.001, 1e-4,  1e-5, 1e-6,
 // The scale of axis k of a set without a LAS source or an asked one (las.h): the coarsest decimal
 // step at which every coordinate keeps its digits (the data's own step: 0.01 for centimetre
 // data), else the finest at which the extent fits the 32-bit integers.
-double chooseAxisScale(const std::vector<glm::dvec3>& positions, int k, double min, double max, unsigned threads) {
+double chooseAxisScale(const PositionArray& positions, int k, double min, double max, unsigned threads) {
   double coarse = 1.0;
   while (!extentFits(min, max, coarse) && coarse < 1e300) coarse *= 10.0;
   if (coarse > 1.0 || positions.empty()) return coarse;  // a wider extent than 2^31 units: no finer step fits

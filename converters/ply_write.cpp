@@ -157,7 +157,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   // The chunk's positions, at [i − begin]: the set's, or made now by positions_of.
   auto chunkPositions = [&](size_t begin, size_t end) -> const glm::dvec3* {
     if (!made) return points.positions.data() + begin;
-    thread_local std::vector<glm::dvec3> chunk;
+    thread_local PositionArray chunk;
     chunk.resize(end - begin);
     made.make(begin, end, chunk.data());
     return chunk.data();

@@ -490,7 +490,7 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
   resizePrefaulted(out.positions, vertices, threads);
   if (colors) resizePrefaulted(out.colors, vertices, threads);
   resizePrefaulted(out.triangles, 3 * faces, threads);
-  std::vector<std::vector<glm::dvec3>> copy_positions(count);
+  std::vector<PositionArray> copy_positions(count);
   std::vector<std::vector<glm::vec3>> copy_colors(count);
   for (uint32_t t = 0; t < count; ++t) {
     copy_positions[t].resize(set.foreign[t].size());

@@ -45,7 +45,7 @@ size_t PointSet::firstBadTriangleIndex(unsigned threads) const {
 
 namespace {
 
-Box serialBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {
+Box serialBox(const PositionArray& positions, size_t first, size_t last) {
   Box box{positions[first], positions[first]};
   for (size_t i = first + 1; i < last; ++i) {
     box.min = glm::min(box.min, positions[i]);
@@ -56,7 +56,7 @@ Box serialBox(const std::vector<glm::dvec3>& positions, size_t first, size_t las
 
 }  // namespace
 
-Box boundingBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last) {
+Box boundingBox(const PositionArray& positions, size_t first, size_t last) {
   assert(first < last && last <= positions.size());
   // Large ranges on every core, one box per block, merged in block order (min and max do not
   // depend on the order anyway).

@@ -11,6 +11,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/dimensions.h"
+#include "core/memory.h"
 
 namespace dpoint {
 
@@ -41,9 +42,14 @@ struct LasSource {
   std::vector<LasVlr> vlrs;  // the coordinate system's (LASF_Projection); extra bytes are described anew
 };
 
+// The arrays of positions and colours. Their `resize(n)` leaves the new elements unset (no pass
+// zeroing them on one thread before the threads that fill them): write every one after it.
+using PositionArray = std::vector<glm::dvec3, DefaultInitAllocator<glm::dvec3>>;
+using ColorArray = std::vector<glm::vec3, DefaultInitAllocator<glm::vec3>>;
+
 struct PointSet {
-  std::vector<glm::dvec3> positions;  // always double
-  std::vector<glm::vec3> colors;      // empty, or one linear 0..1 colour per point
+  PositionArray positions;  // always double
+  ColorArray colors;        // empty, or one linear 0..1 colour per point
   std::vector<uint32_t> triangles;    // empty for point sets; 3 vertex indices per triangle
   // Per-point attributes (core/dimensions.h): each column has size() values or the set has none.
   Dimensions dimensions;
@@ -92,7 +98,7 @@ inline uint16_t colorInteger(float c, double full) {
 struct Box {
   glm::dvec3 min{0.0}, max{0.0};
 };
-Box boundingBox(const std::vector<glm::dvec3>& positions, size_t first, size_t last);
-inline Box boundingBox(const std::vector<glm::dvec3>& positions) { return boundingBox(positions, 0, positions.size()); }
+Box boundingBox(const PositionArray& positions, size_t first, size_t last);
+inline Box boundingBox(const PositionArray& positions) { return boundingBox(positions, 0, positions.size()); }
 
 }  // namespace dpoint

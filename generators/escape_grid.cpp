@@ -562,7 +562,7 @@ namespace {
 // holds copies of their positions.
 struct LayerMesh {
   PointSet mesh;
-  std::vector<glm::dvec3> seam;
+  PositionArray seam;
 };
 
 Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowFunction& row, int first_layer,

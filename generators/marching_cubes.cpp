@@ -163,7 +163,7 @@ McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last
 
   // owned: the positions go to out.positions; seam: to out.seam_positions; neither: ids only.
   auto numberPlane = [&](int p, bool owned, bool seam) {
-    std::vector<glm::dvec3>* positions = owned ? &out.positions : seam ? &out.seam_positions : nullptr;
+    PositionArray* positions = owned ? &out.positions : seam ? &out.seam_positions : nullptr;
     const size_t s = static_cast<size_t>(p & 1);
     const uint8_t* a = above[s].data();
     uint32_t count = 0;

@@ -71,13 +71,13 @@ struct McSlabCallbacks {
 };
 
 struct McSlabMesh {
-  std::vector<glm::dvec3> positions;  // the vertices the slab owns, in canonical order
+  PositionArray positions;  // the vertices the slab owns, in canonical order
   // 3 per triangle. An index n ≥ positions.size() is the next slab's vertex n − positions.size().
   std::vector<uint32_t> triangles;
   uint32_t first_plane_vertices = 0;  // crossed in-plane edges of plane `first`
   uint32_t last_plane_vertices = 0;   // crossed in-plane edges of plane `last`
   // With seam_positions and !owns_last_plane: the positions of those last_plane_vertices, in order.
-  std::vector<glm::dvec3> seam_positions;
+  PositionArray seam_positions;
   bool complete = false;              // false when plane_done stopped it
 };
 

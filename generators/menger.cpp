@@ -169,7 +169,7 @@ Status validate(const MengerParams& params) {
 // the plane, and `seam` holds those points' positions (the whole plane, in rank order).
 struct RangeMesh {
   PointSet mesh;
-  std::vector<glm::dvec3> seam;
+  PositionArray seam;
 };
 
 Result<RangeMesh> meshRange(const MengerParams& params, const Lattice& lattice, uint32_t first, uint32_t last,

@@ -158,7 +158,7 @@ double smallestDistance(const std::vector<double>& best2) {
 
 // Counts distinct points that float32 rounding merges with another distinct point (of the finite
 // ones: a NaN would break the sort's ordering).
-size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
+size_t countFloatMerges(const PositionArray& positions) {
   std::vector<uint32_t> order;
   order.reserve(positions.size());
   for (uint32_t i = 0; i < positions.size(); ++i) {
@@ -188,7 +188,7 @@ size_t countFloatMerges(const std::vector<glm::dvec3>& positions) {
 }
 
 // Bounds and float overflow of `positions` into `info` (min and max already set to a point).
-void addBounds(PointSetInfo& info, const std::vector<glm::dvec3>& positions) {
+void addBounds(PointSetInfo& info, const PositionArray& positions) {
   for (const glm::dvec3& p : positions) {
     info.min = glm::min(info.min, p);
     info.max = glm::max(info.max, p);
@@ -220,7 +220,7 @@ constexpr size_t kJoinBoxes = 16;
 // that is many cells, with every query.
 class SampleBalls {
  public:
-  SampleBalls(const std::vector<glm::dvec3>& samples, const std::vector<double>& best2, const glm::dvec3& min,
+  SampleBalls(const PositionArray& samples, const std::vector<double>& best2, const glm::dvec3& min,
               const glm::dvec3& max, const std::vector<Box>& boxes)
       : samples_(samples), best2_(best2), min_(min) {
     const glm::dvec3 extent = max - min;
@@ -304,7 +304,7 @@ class SampleBalls {
     return true;
   }
 
-  const std::vector<glm::dvec3>& samples_;
+  const PositionArray& samples_;
   const std::vector<double>& best2_;
   glm::dvec3 min_;
   double cell_ = 1.0;
@@ -317,7 +317,7 @@ class SampleBalls {
 // within some sampled point's bound are read again, each against those samples, and the boxes
 // too wide to look up point by point; every point nearer a sample than its bound lies in one.
 Status nearestByBoxes(uint64_t count, const BlockReader& read, uint64_t block_points, uint64_t box_points,
-                      const std::vector<glm::dvec3>& sampled,
+                      const PositionArray& sampled,
                       std::vector<double>& best2, const SampleBalls& balls, const std::vector<uint8_t>& wide,
                       const std::vector<std::vector<uint32_t>>& near, unsigned workers, PointSet& block,
                       uint64_t& read_again) {
@@ -365,11 +365,11 @@ Status nearestByBoxes(uint64_t count, const BlockReader& read, uint64_t block_po
 // Pass 2 on a file in no spatial order: each block whose box lies within some sampled point's
 // bound, read again whole into k-d trees (Forest), searched nearest first.
 Status nearestByBlocks(uint64_t count, const BlockReader& read, uint64_t block_points, uint64_t box_points,
-                       const std::vector<Box>& boxes, const std::vector<glm::dvec3>& sampled,
+                       const std::vector<Box>& boxes, const PositionArray& sampled,
                        std::vector<double>& best2, unsigned threads, PointSet& block, uint64_t& read_again) {
   const size_t per_block = static_cast<size_t>(block_points / box_points);
   std::vector<size_t> near;
-  std::vector<glm::dvec3> queries;
+  PositionArray queries;
   std::vector<double> query_best2;
   for (uint64_t first = 0; first < count; first += block_points) {
     const size_t from = static_cast<size_t>(first / box_points), to = std::min(boxes.size(), from + per_block);
@@ -414,10 +414,10 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
   if (n >= 2) {
     const size_t step = n / sample;
-    std::vector<glm::dvec3> sampled(sample);
+    PositionArray sampled(sample);
     for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step];
     std::vector<double> best2(sample, std::numeric_limits<double>::infinity());
-    std::vector<glm::dvec3> scratch = points.positions;  // the trees reorder it
+    PositionArray scratch = points.positions;  // the trees reorder it
     Forest(scratch, threads).nearestNonzero(sampled, best2, threads);
     info.min_neighbor_distance = smallestDistance(best2);
     info.neighbor_sample = sample;
@@ -441,7 +441,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   // the box of every kStreamedInfoBoxPoints consecutive points, on all cores.
   // Boxes that tile the blocks: 1024 points, or a block where blocks are not whole boxes (tests).
   const uint64_t box_points = block_points % kStreamedInfoBoxPoints == 0 ? kStreamedInfoBoxPoints : block_points;
-  std::vector<glm::dvec3> sampled;
+  PositionArray sampled;
   sampled.reserve(static_cast<size_t>(sample));
   std::vector<double> best2;
   std::vector<Box>& boxes = out.boxes;

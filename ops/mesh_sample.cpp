@@ -139,7 +139,7 @@ class Sampler {
   }
 
   // Placements [0, count) and their positions, on all cores.
-  void placeAll(uint64_t count, std::vector<Placement>& placements, std::vector<glm::dvec3>& positions) const {
+  void placeAll(uint64_t count, std::vector<Placement>& placements, PositionArray& positions) const {
     placements.resize(static_cast<size_t>(count));
     resizePrefaulted(positions, static_cast<size_t>(count), options_.threads);
     const uint64_t blocks = (count + kBlock - 1) / kBlock;
@@ -161,7 +161,7 @@ class Sampler {
     const Dimension* vn[3] = {mesh_.dimensions.find(dim::kNormalX), mesh_.dimensions.find(dim::kNormalY),
                               mesh_.dimensions.find(dim::kNormalZ)};
     const bool vertex_normals = vn[0] && vn[1] && vn[2];
-    std::vector<glm::dvec3> normals;  // the vertices' normals, read once out of their columns
+    PositionArray normals;  // the vertices' normals, read once out of their columns
     if (vertex_normals) {
       normals.resize(mesh_.size());
       for (size_t v = 0; v < mesh_.size(); ++v) normals[v] = glm::dvec3(vn[0]->value(v), vn[1]->value(v), vn[2]->value(v));
@@ -220,7 +220,7 @@ class Sampler {
 // memory); an open-addressing table maps a cell's key to its run.
 class CellGrid {
  public:
-  CellGrid(const std::vector<glm::dvec3>& points, double cell, unsigned threads) : cell_(cell) {
+  CellGrid(const PositionArray& points, double cell, unsigned threads) : cell_(cell) {
     const size_t n = points.size();
     origin_ = points.empty() ? glm::dvec3(0.0) : points[0];
     for (const glm::dvec3& p : points) origin_ = glm::min(origin_, p);
@@ -306,14 +306,14 @@ class CellGrid {
 
   double cell_;
   glm::dvec3 origin_{0.0};
-  std::vector<glm::dvec3> points_;  // in grid order
+  PositionArray points_;  // in grid order
   std::vector<uint32_t> original_;
   std::vector<Slot> table_;
   size_t mask_ = 0;
 };
 
 // The indices of the `keep` candidates left by weighted sample elimination, ascending.
-std::vector<uint32_t> eliminate(const std::vector<glm::dvec3>& candidates, uint64_t keep, double area, unsigned threads,
+std::vector<uint32_t> eliminate(const PositionArray& candidates, uint64_t keep, double area, unsigned threads,
                                 Progress* progress) {
   const size_t m = candidates.size();
   const double r_max = 2.0 * std::sqrt(area / static_cast<double>(keep) / (2.0 * std::sqrt(3.0)));
@@ -437,7 +437,7 @@ Result<PointSet> sampleSurface(const PointSet& mesh, const SampleOptions& option
   if (poisson) {
     const std::vector<uint32_t> kept = eliminate(out.positions, options.count, sampler.total(), options.threads, options.progress);
     std::vector<Placement> chosen(kept.size());
-    std::vector<glm::dvec3> positions(kept.size());
+    PositionArray positions(kept.size());
     for (size_t k = 0; k < kept.size(); ++k) {
       chosen[k] = placements[kept[k]];
       positions[k] = out.positions[kept[k]];

@@ -298,8 +298,8 @@ void gather(T* values, size_t n, const uint32_t* sorted, const std::vector<uint3
   });
 }
 
-template <typename T>
-void gather(std::vector<T>& values, const uint32_t* sorted, const std::vector<uint32_t>& blocks, LargeBuffer& scratch,
+template <typename T, typename Allocator>
+void gather(std::vector<T, Allocator>& values, const uint32_t* sorted, const std::vector<uint32_t>& blocks, LargeBuffer& scratch,
             unsigned threads, Progress* progress) {
   gather(values.data(), values.size(), sorted, blocks, scratch, threads, progress);
 }
@@ -326,7 +326,7 @@ struct HeldPositions {
 struct MadePositionsAt {
   const std::function<glm::dvec3(uint64_t)>& at;
   const glm::dvec3* chunk(size_t begin, size_t end) const {
-    thread_local std::vector<glm::dvec3> buffer;
+    thread_local PositionArray buffer;
     buffer.resize(end - begin);
     for (size_t i = begin; i < end; ++i) buffer[i - begin] = at(i);
     return buffer.data();
@@ -337,7 +337,7 @@ template <typename Positions>
 MortonFrame frameOf(size_t n, const Positions& positions, unsigned threads) {
   const double inf = std::numeric_limits<double>::infinity();
   const size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<glm::dvec3> lo(chunks, glm::dvec3(inf)), hi(chunks, glm::dvec3(-inf));
+  PositionArray lo(chunks, glm::dvec3(inf)), hi(chunks, glm::dvec3(-inf));
   parallelFor(chunks, threads, [&](size_t c, unsigned) {
     glm::dvec3 chunk_lo(inf), chunk_hi(-inf);  // locals: neighbouring chunks' entries share cache lines
     const size_t begin = c * kChunk, end = std::min(n, begin + kChunk);
@@ -439,7 +439,7 @@ Status checkReorderMemory(const PointSet& points, PointOrder order, uint64_t lim
   return checkMemory("ordering " + std::to_string(points.size()) + " points", needed, limit);
 }
 
-MortonFrame mortonFrame(const std::vector<glm::dvec3>& positions, unsigned threads) {
+MortonFrame mortonFrame(const PositionArray& positions, unsigned threads) {
   return frameOf(positions.size(), HeldPositions{positions.data()}, threads);
 }
 

@@ -103,7 +103,7 @@ struct MortonFrame {
   glm::dvec3 half_min{0.0};
   glm::dvec3 half_extent{0.0};  // 0 on a flat axis (or an axis with no finite coordinate)
 };
-MortonFrame mortonFrame(const std::vector<glm::dvec3>& positions, unsigned threads = 0);
+MortonFrame mortonFrame(const PositionArray& positions, unsigned threads = 0);
 
 // Each coordinate quantized to 21 bits within the frame (the box's minimum maps to 0, its
 // maximum to 2^21 - 1, 0 on a flat axis, NaN and -inf to 0, +inf to 2^21 - 1), the bits

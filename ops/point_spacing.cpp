@@ -74,17 +74,17 @@ void SpacingSampler::add(std::span<const glm::dvec3> points) {
     for (const Entry& e : worker) offer(heap_, wanted_, e.first, e.second);
 }
 
-std::vector<glm::dvec3> SpacingSampler::finish() const {
+PositionArray SpacingSampler::finish() const {
   std::vector<std::pair<uint64_t, glm::dvec3>> sorted = heap_;
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<glm::dvec3> out;
+  PositionArray out;
   for (size_t k = 0; k < sorted.size(); ++k)
     if (k == 0 || sorted[k].first != sorted[k - 1].first || sorted[k].second != sorted[k - 1].second)
       out.push_back(sorted[k].second);
   return out;
 }
 
-SpacingSearch::SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dvec3> samples, unsigned threads)
+SpacingSearch::SpacingSearch(const Box& box, uint64_t count, PositionArray samples, unsigned threads)
     : samples_(std::move(samples)), threads_(resolveThreads(threads)), origin_(box.min) {
   const glm::dvec3 extent = box.max - box.min;
   const double largest = std::max({extent.x, extent.y, extent.z});
@@ -211,7 +211,7 @@ std::vector<SpacingSample> SpacingSearch::finish() const {
   return out;
 }
 
-std::vector<SpacingSample> sampleSpacing(const std::vector<glm::dvec3>& positions, const Box& box, size_t samples,
+std::vector<SpacingSample> sampleSpacing(const PositionArray& positions, const Box& box, size_t samples,
                                          unsigned threads) {
   if (positions.size() < 2 || samples == 0) return {};
   SpacingSampler sampler(samples, threads);

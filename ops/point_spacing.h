@@ -33,7 +33,7 @@ class SpacingSampler {
  public:
   explicit SpacingSampler(size_t samples, unsigned threads = 0) : wanted_(samples), threads_(threads) {}
   void add(std::span<const glm::dvec3> points);
-  std::vector<glm::dvec3> finish() const;  // ordered by hash
+  PositionArray finish() const;  // ordered by hash
 
  private:
   size_t wanted_;
@@ -48,7 +48,7 @@ class SpacingSampler {
 // or none when that is fewer than half of them (points far sparser than their box suggests).
 class SpacingSearch {
  public:
-  SpacingSearch(const Box& box, uint64_t count, std::vector<glm::dvec3> samples, unsigned threads = 0);
+  SpacingSearch(const Box& box, uint64_t count, PositionArray samples, unsigned threads = 0);
   void add(std::span<const glm::dvec3> points);
   // Whether a point in `box` may lie in a kept cell: false means add() would pass over every one of
   // them, so a streamed set's batch with that box need not be read (true for a box over many cells).
@@ -60,7 +60,7 @@ class SpacingSearch {
   uint64_t cellKey(const glm::dvec3& p) const;
   uint32_t findSlot(uint64_t key) const;
 
-  std::vector<glm::dvec3> samples_;
+  PositionArray samples_;
   std::vector<glm::i64vec3> sample_cells_;  // each sample's cell, ordered by x (mayUse)
   unsigned threads_;
   glm::dvec3 origin_{0.0};
@@ -78,7 +78,7 @@ class SpacingSearch {
 
 // Both passes over a set in memory: up to `samples` samples. Empty when the set has fewer than 2
 // distinct positions or SpacingSearch finds too few. About 10 ms for 1.55M points on 2 cores.
-std::vector<SpacingSample> sampleSpacing(const std::vector<glm::dvec3>& positions, const Box& box, size_t samples,
+std::vector<SpacingSample> sampleSpacing(const PositionArray& positions, const Box& box, size_t samples,
                                          unsigned threads = 0);
 
 }  // namespace dpoint

@@ -90,16 +90,16 @@ void keepWhileAlive(const py::handle& owner, py::object kept) {
 // memory of its own, never freed memory.
 // Hands `target`'s storage to the set's Python object to keep (views of it stay valid) and leaves
 // `target` empty.
-template <typename T>
-void retireKeepingViews(const py::handle& self, std::vector<T>& target) {
+template <typename Vector>
+void retireKeepingViews(const py::handle& self, Vector& target) {
   if (target.capacity() == 0) return;
-  auto* retired = new std::vector<T>(std::move(target));  // a move keeps the storage where it is
-  keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<std::vector<T>*>(p); }));
-  target = std::vector<T>();
+  auto* retired = new Vector(std::move(target));  // a move keeps the storage where it is
+  keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<Vector*>(p); }));
+  target = Vector();
 }
 
-template <typename T>
-void replaceKeepingViews(const py::handle& self, std::vector<T>& target, std::vector<T> values) {
+template <typename Vector>
+void replaceKeepingViews(const py::handle& self, Vector& target, Vector values) {
   if (values.size() <= target.capacity()) {
     target.resize(values.size());
     std::copy(values.begin(), values.end(), target.begin());
@@ -122,7 +122,7 @@ void setColors(PointSet& set, const py::handle& value, const py::handle& self = 
                           " points");
   const char kind = table.dtype().kind();
   const size_t n = set.size();
-  std::vector<glm::vec3> colors(n);
+  ColorArray colors(n);  // every element written below
   if (kind == 'u' && table.itemsize() == 1) {
     float byte_color[256];  // k / 255.0f, as the PLY reader rounds it
     for (int k = 0; k < 256; ++k) byte_color[k] = static_cast<float>(k) / 255.0f;

@@ -105,7 +105,7 @@ std::array<glm::dvec3, 8> corners(const Bounds& bounds) {
 }
 
 // The points the fit frames: the outline when there is one, else the box's corners.
-std::vector<glm::dvec3> framedPoints(const Bounds& bounds) {
+PositionArray framedPoints(const Bounds& bounds) {
   if (!bounds.outline.empty()) return bounds.outline;
   const std::array<glm::dvec3, 8> box = corners(bounds);
   return {box.begin(), box.end()};
@@ -123,7 +123,7 @@ std::vector<glm::dvec3> framedPoints(const Bounds& bounds) {
 // of the box, so the condition is checked again from the rounded eye and d grows by what is
 // missing (a few rounds; each misses by at most the rounding). d is at least kFitMargin times the
 // farthest point's distance from the target, so the eye is outside the data and every depth > 0.
-double fitPerspective(const std::vector<glm::dvec3>& points, glm::dvec3& target, const glm::dvec3& direction,
+double fitPerspective(const PositionArray& points, glm::dvec3& target, const glm::dvec3& direction,
                       const glm::dmat4& rotation, double tan_x, double tan_y, bool recentre) {
   const glm::dvec3 right(rotation[0][0], rotation[1][0], rotation[2][0]);
   const glm::dvec3 up(rotation[0][1], rotation[1][1], rotation[2][1]);
@@ -391,7 +391,7 @@ size_t OutlineBuilder::rowOf(const glm::dvec3& p) const {
   return cellOf(p.y - min_.y, per_y_) * kOutlineGrid + cellOf(p.z - min_.z, per_z_);
 }
 
-void OutlineBuilder::add(const std::vector<glm::dvec3>& positions) {
+void OutlineBuilder::add(const PositionArray& positions) {
   if (rows_.empty()) return;
   constexpr size_t kBlock = size_t{1} << 18;
   const size_t blocks = (positions.size() + kBlock - 1) / kBlock;
@@ -441,8 +441,8 @@ bool OutlineBuilder::addBox(const Box& box) {
   return true;
 }
 
-std::vector<glm::dvec3> OutlineBuilder::finish() const {
-  std::vector<glm::dvec3> outline;
+PositionArray OutlineBuilder::finish() const {
+  PositionArray outline;
   for (const RowBox& row : rows_) {
     if (!(row.min.x <= row.max.x)) continue;  // no point in this row
     const std::array<glm::dvec3, 8> box_corners = corners(Bounds{row.min, row.max, false, {}});

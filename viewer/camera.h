@@ -70,7 +70,7 @@ struct Bounds {
   // Points whose convex hull holds every point of the set, so that the fit frames the data and
   // not the empty corners of its box (a Mandelbulb's box corners project ~1.3x wider than the
   // bulb). OutlineBuilder makes it; empty: the fit frames the box's eight corners.
-  std::vector<glm::dvec3> outline;
+  PositionArray outline;
 };
 
 // Builds the camera. Fails (kUsage, naming the option) on a zero-size viewport, eye == target,
@@ -97,12 +97,12 @@ Bounds boundsOf(const PointSet& points);
 class OutlineBuilder {
  public:
   explicit OutlineBuilder(const Bounds& bounds);
-  void add(const std::vector<glm::dvec3>& positions);
+  void add(const PositionArray& positions);
   // The points of a box that lies in one row, known by the box alone: their row's box takes its
   // corners, as it would take the points (its min and max along each axis are points' coordinates).
   // False, and nothing added, where the box spans rows: then its points must be added.
   bool addBox(const Box& box);
-  std::vector<glm::dvec3> finish() const;
+  PositionArray finish() const;
 
  private:
   size_t rowOf(const glm::dvec3& p) const;

@@ -498,7 +498,7 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
   return out;
 }
 
-void addBatchBoxes(BatchBoxes& boxes, const std::vector<glm::dvec3>& positions) {
+void addBatchBoxes(BatchBoxes& boxes, const PositionArray& positions) {
   assert(!positions.empty() && boxes.count % kBoxPoints == 0 && boxes.count == boxes.boxes.size() * kBoxPoints);
   const size_t first = boxes.boxes.size(), added = (positions.size() + kBoxPoints - 1) / kBoxPoints;
   boxes.boxes.resize(first + added);

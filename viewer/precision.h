@@ -65,7 +65,7 @@ struct BatchBoxes {
 };
 // Adds the next points of the set, [boxes.count, boxes.count + positions.size()) (non-empty); every
 // call but the last adds whole batches. On all cores.
-void addBatchBoxes(BatchBoxes& boxes, const std::vector<glm::dvec3>& positions);
+void addBatchBoxes(BatchBoxes& boxes, const PositionArray& positions);
 
 // predictErrorBounds for a set known by its batch boxes: per mode a guaranteed upper bound of the
 // per-point bound of every point each box may hold. The clip position is affine in the point, so

@@ -50,7 +50,7 @@ WindowPoint toWindow(T x, T y, T z, T w, uint32_t width, uint32_t height) {
 
 }  // namespace
 
-std::vector<WindowPoint> projectReference(const std::vector<glm::dvec3>& positions, const Camera& camera) {
+std::vector<WindowPoint> projectReference(const PositionArray& positions, const Camera& camera) {
   const MatrixL rotation = toLongDouble(camera.rotation);
   const MatrixL projection = toLongDouble(camera.projection);
   const Real eye[3] = {camera.eye.x, camera.eye.y, camera.eye.z};

@@ -23,7 +23,7 @@ struct WindowPoint {
 };
 
 // Projects with clip = projection · rotation · (p − eye), every step in long double.
-std::vector<WindowPoint> projectReference(const std::vector<glm::dvec3>& positions, const Camera& camera);
+std::vector<WindowPoint> projectReference(const PositionArray& positions, const Camera& camera);
 
 // Window position from a clip position the GPU produced (float), divided by w in double.
 // Same visibility rule as above.

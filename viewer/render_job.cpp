@@ -145,7 +145,7 @@ bool needsSpacing(const RenderRequest& request) { return !request.point_size && 
 // clear of every cell the spacing search keeps holds no point it uses. A file in Morton order is
 // read again in a few places; one in scan order, whose boxes are long, all through.
 Status streamOutlineAndSpacing(const RenderRequest& request, const std::string& path, PointInputStream& ply,
-                               std::vector<glm::dvec3> samples, LoadedSet& set, Progress& progress) {
+                               PositionArray samples, LoadedSet& set, Progress& progress) {
   const bool outline = needsOutline(request, set.bounds), spacing = needsSpacing(request);
   if (!outline && !spacing) return okStatus();
   OutlineBuilder builder(set.bounds);
@@ -907,7 +907,7 @@ std::optional<double> projectedSpacing(std::span<const SpacingSample> spacing, c
   if (spacing.empty()) return std::nullopt;
   // The picture's x axis in world directions: the first row of the rotation.
   const glm::dvec3 across(camera.rotation[0][0], camera.rotation[1][0], camera.rotation[2][0]);
-  std::vector<glm::dvec3> ends;
+  PositionArray ends;
   ends.reserve(2 * spacing.size());
   for (const SpacingSample& s : spacing) {
     ends.push_back(s.position);
@@ -954,7 +954,7 @@ float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box
   if (camera.ortho && !box.planar) return 1.0f;
   // The data's outline when the fit framed it (every one of its points is inside the picture), else
   // the box's corners.
-  std::vector<glm::dvec3> corners = box.outline;
+  PositionArray corners = box.outline;
   if (corners.empty()) {
     for (int i = 0; i < 8; ++i)
       corners.push_back({(i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z});

@@ -27,7 +27,7 @@ double number(const std::string& json, const std::string& key) {
   return std::stod(json.substr(at + key.size() + 4));
 }
 
-std::vector<glm::dvec3> sorted(std::vector<glm::dvec3> p) {
+PositionArray sorted(PositionArray p) {
   std::sort(p.begin(), p.end(), [](const glm::dvec3& a, const glm::dvec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
   });

@@ -23,7 +23,7 @@ using test::writeFile;
 
 const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/las/";
 
-size_t distinctPositions(std::vector<glm::dvec3> p) {
+size_t distinctPositions(PositionArray p) {
   std::sort(p.begin(), p.end(), [](const glm::dvec3& a, const glm::dvec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
   });

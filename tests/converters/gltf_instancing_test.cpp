@@ -84,7 +84,7 @@ TEST(GltfInstancing, eachInstanceIsAWorldSpaceCopyOfTheMesh) {
   ASSERT_EQ(set->size(), 12u);
   const glm::dvec3 mesh[3] = {{1, 2, 3}, {0, 0, 0}, {-1, 0.5, 2}};
   const auto node = [](glm::dvec3 p) { return glm::dvec3(6378000, 0, 0) + 0.5 * p; };
-  std::vector<glm::dvec3> expected;
+  PositionArray expected;
   for (const glm::dvec3& p : mesh) expected.push_back(node(p));
   for (const glm::dvec3& p : mesh) expected.push_back(node(glm::dvec3(10 - p.y, p.x, p.z)));  // 90° about z
   for (const glm::dvec3& p : mesh) expected.push_back(node(glm::dvec3(2 * p.x, 3 * p.y, 4 * p.z - 5)));

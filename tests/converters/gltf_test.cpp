@@ -267,7 +267,7 @@ TEST(Gltf, gltfNodeHierarchyComposesMatrixAndTrs) {
   TempDir dir;
   Result<PointSet> set = readText(dir, fixtureGltf());
   ASSERT_TRUE(set) << set.error().message;
-  const std::vector<glm::dvec3> expected = {
+  const PositionArray expected = {
       {6378002, 4, 6},   {6378000, 0, 0},  {6377998, 1, 4},   // node 0: M·p
       {6377996, 12, 18}, {6378000, 10, 0}, {6377999, 8, 12},  // node 1: M·T·R·S·p
   };
@@ -282,7 +282,7 @@ TEST(Gltf, gltfMissingColoursTakeMaterialColour) {
   TempDir dir;
   Result<PointSet> set = readText(dir, fixtureGltf());
   ASSERT_TRUE(set) << set.error().message;
-  const std::vector<glm::vec3> expected = {
+  const ColorArray expected = {
       {0.25f, 0.5f, 0.75f}, {0.25f, 0.5f, 0.75f}, {0.25f, 0.5f, 0.75f}, {1, 0, 0}, {0, 1, 0},
       {0.2f, 0.4f, 0.8f}};
   EXPECT_EQ(set->colors, expected);
@@ -569,7 +569,7 @@ TEST(Gltf, gltfDecodesMeshoptViewsBehindFallbackBuffer) {
   TempDir dir;
   Result<PointSet> set = readText(dir, meshoptGltf());
   ASSERT_TRUE(set) << set.error().message;
-  const std::vector<glm::dvec3> expected = {{11, 2, 3}, {10, 0, 0}, {9, 0.5, 2}};
+  const PositionArray expected = {{11, 2, 3}, {10, 0, 0}, {9, 0.5, 2}};
   EXPECT_EQ(set->positions, expected);
   EXPECT_EQ(set->triangles, (std::vector<uint32_t>{0, 1, 2}));
 }
@@ -676,8 +676,8 @@ TEST(Gltf, uniqueKeepsFirstOccurrenceAndRenumbersTriangles) {
   set.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}};
   set.triangles = {0, 1, 3, 2, 4, 3, 0, 2, 1};  // the last loses a corner: 0 and 2 merge
   dropDuplicatePositions(set);
-  EXPECT_EQ(set.positions, (std::vector<glm::dvec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
-  EXPECT_EQ(set.colors, (std::vector<glm::vec3>{{1, 0, 0}, {0, 1, 0}, {1, 1, 0}}));
+  EXPECT_EQ(set.positions, (PositionArray{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+  EXPECT_EQ(set.colors, (ColorArray{{1, 0, 0}, {0, 1, 0}, {1, 1, 0}}));
   EXPECT_EQ(set.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 1, 2}));
 }
 

@@ -293,7 +293,7 @@ TEST(LasDimensions, mortonOrderAndUniqueCarryEachPointsAttributes) {
     id.resize(i + 1);
     id.set<uint32_t>(i, i);
   }
-  const std::vector<glm::dvec3> before = set.positions;
+  const PositionArray before = set.positions;
   reorderPoints(set, PointOrder::kMorton, 2);
   ASSERT_EQ(set.dimensions.find("id")->size(), 5000u);
   bool moved = false;

@@ -381,7 +381,7 @@ TEST(Las, intensityIsGreyOverTheFileMaximum) {
   options.color = LasColorSource::kIntensity;
   Result<PointSet> points = readBytes(makeLas(threePoints(2, 0)), options);  // intensities 100, 7, 0
   ASSERT_TRUE(points.ok()) << points.error().message;
-  EXPECT_EQ(points->colors, (std::vector<glm::vec3>{glm::vec3(1.0f), glm::vec3(7.0f / 100.0f), glm::vec3(0.0f)}));
+  EXPECT_EQ(points->colors, (ColorArray{glm::vec3(1.0f), glm::vec3(7.0f / 100.0f), glm::vec3(0.0f)}));
 }
 
 TEST(Las, classificationFollowsThePaletteAndIgnoresFlagBits) {
@@ -580,7 +580,7 @@ TEST(Las, writeReadOfEmptySetGivesEmptySet) {
 
 struct Reference {
   std::string header;  // "#version=1.4 format=7 count=22600"
-  std::vector<glm::dvec3> positions;
+  PositionArray positions;
   std::vector<std::array<uint32_t, 3>> colors;  // raw 16-bit values
 };
 

@@ -107,7 +107,7 @@ TEST(Tile, mergeWeldsByIdentityInTileOrder) {
   ASSERT_TRUE(writeTile(dir.file("a.ply"), leftHalf(), "s").ok());
   Result<PointSet> merged = mergeTiles({dir.file("b.ply"), dir.file("a.ply")});  // any order
   ASSERT_TRUE(merged.ok()) << merged.error().message;
-  const std::vector<glm::dvec3> positions = {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}};
+  const PositionArray positions = {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}};
   EXPECT_TRUE(merged->positions == positions);
   EXPECT_EQ(merged->colors.size(), 6u);
   const std::vector<uint32_t> triangles = {0, 2, 1, 1, 2, 3, 2, 4, 3, 3, 4, 5};

@@ -23,11 +23,11 @@
 namespace dpoint {
 namespace {
 
-std::vector<glm::dvec3> readVertices(const std::string& path) {
+PositionArray readVertices(const std::string& path) {
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);  // header x,y,z
-  std::vector<glm::dvec3> out;
+  PositionArray out;
   while (std::getline(in, line)) {
     glm::dvec3 p;
     char comma;
@@ -38,7 +38,7 @@ std::vector<glm::dvec3> readVertices(const std::string& path) {
 }
 
 // Reference vertices with none of ours within `tolerance` (bucketed by a cell of 1e-3).
-size_t unmatchedVertices(const std::vector<glm::dvec3>& reference, const std::vector<glm::dvec3>& ours,
+size_t unmatchedVertices(const PositionArray& reference, const PositionArray& ours,
                          double tolerance) {
   constexpr double kCell = 1e-3;
   auto key = [](int64_t x, int64_t y, int64_t z) { return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791); };
@@ -321,7 +321,7 @@ TEST(MarchingCubes, matchesSkimageVerticesMandelbulb) {
   params.frame = GridFrame::kSeed;
   Result<PointSet> mesh = generateMandelbulb(params);
   ASSERT_TRUE(mesh.ok());
-  const std::vector<glm::dvec3> reference = readVertices(DPOINT_REFERENCE_DIR "/mandelbulb_r64_i100_skimage_verts.csv");
+  const PositionArray reference = readVertices(DPOINT_REFERENCE_DIR "/mandelbulb_r64_i100_skimage_verts.csv");
   ASSERT_EQ(reference.size(), 13120u);
   const size_t unmatched = unmatchedVertices(reference, mesh->positions, 1e-6);
   std::cout << "mandelbulb r64: " << mesh->positions.size() << " vertices (skimage " << reference.size() << "), "
@@ -336,7 +336,7 @@ TEST(MarchingCubes, matchesSkimageVerticesJulia) {
   params.frame = GridFrame::kSeed;
   Result<PointSet> mesh = generateJulia(params);
   ASSERT_TRUE(mesh.ok());
-  const std::vector<glm::dvec3> reference = readVertices(DPOINT_REFERENCE_DIR "/julia_r64_i200_skimage_verts.csv");
+  const PositionArray reference = readVertices(DPOINT_REFERENCE_DIR "/julia_r64_i200_skimage_verts.csv");
   ASSERT_EQ(reference.size(), 3850u);
   const size_t unmatched = unmatchedVertices(reference, mesh->positions, 1e-6);
   std::cout << "julia r64: " << mesh->positions.size() << " vertices (skimage " << reference.size() << "), "

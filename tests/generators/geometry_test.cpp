@@ -30,7 +30,7 @@ std::array<uint64_t, 3> bitsOf(const glm::dvec3& p) {
   return bits;
 }
 
-bool sameBits(const std::vector<glm::dvec3>& a, const std::vector<glm::dvec3>& b) {
+bool sameBits(const PositionArray& a, const PositionArray& b) {
   if (a.size() != b.size()) return false;
   for (size_t i = 0; i < a.size(); ++i)
     if (bitsOf(a[i]) != bitsOf(b[i])) return false;
@@ -132,7 +132,7 @@ Result<PointSet> sierpinski(int level, bool unwelded, unsigned threads = 0) {
 
 // The seed's algorithm, written independently: recursive midpoints in double, children 0..3 in
 // order, 4 rows per tetrahedron.
-void seedTetrahedra(const std::array<glm::dvec3, 4>& v, int level, std::vector<glm::dvec3>& rows) {
+void seedTetrahedra(const std::array<glm::dvec3, 4>& v, int level, PositionArray& rows) {
   if (level == 0) {
     rows.insert(rows.end(), v.begin(), v.end());
     return;
@@ -166,7 +166,7 @@ TEST(Sierpinski, cornersAreTheSeedsCorners) {
 
 TEST(Sierpinski, unweldedFollowsSeedOrder) {
   for (int level : {1, 3, 5}) {
-    std::vector<glm::dvec3> seed;
+    PositionArray seed;
     seedTetrahedra({sierpinskiCorner(0), sierpinskiCorner(1), sierpinskiCorner(2), sierpinskiCorner(3)}, level, seed);
     Result<PointSet> ours = sierpinski(level, true);
     ASSERT_TRUE(ours.ok());
@@ -203,7 +203,7 @@ TEST(Sierpinski, weldedIsUnweldedWithRepeatsDroppedBitForBit) {
     // First appearances by exact bits: shared corners must come out bit-identical, or there
     // would be more than 2·4^n + 2 of them.
     std::map<std::array<uint64_t, 3>, uint32_t> seen;
-    std::vector<glm::dvec3> distinct;
+    PositionArray distinct;
     for (const glm::dvec3& p : unwelded->positions)
       if (seen.emplace(bitsOf(p), static_cast<uint32_t>(distinct.size())).second) distinct.push_back(p);
     EXPECT_TRUE(sameBits(distinct, welded->positions)) << "level " << level;
@@ -217,7 +217,7 @@ TEST(Sierpinski, weldedIsUnweldedWithRepeatsDroppedBitForBit) {
 TEST(Sierpinski, trianglesFaceOutwardOfTheirTetrahedron) {
   Result<PointSet> mesh = sierpinski(3, true);
   ASSERT_TRUE(mesh.ok());
-  const std::vector<glm::dvec3>& p = mesh->positions;
+  const PositionArray& p = mesh->positions;
   for (size_t t = 0; t < pow4(3); ++t) {
     const glm::dvec3 centre = (p[4 * t] + p[4 * t + 1] + p[4 * t + 2] + p[4 * t + 3]) / 4.0;
     for (size_t f = 0; f < 4; ++f) {

@@ -274,8 +274,8 @@ TEST(PointOrder, tinySetsAreSortedAndEmptyIsLeftAlone) {
   two.positions = {{1, 1, 1}, {0, 0, 0}};
   two.colors = {{1, 1, 1}, {0, 0, 0}};
   reorderPoints(two, PointOrder::kMorton);
-  EXPECT_EQ(two.positions, (std::vector<glm::dvec3>{{0, 0, 0}, {1, 1, 1}}));
-  EXPECT_EQ(two.colors, (std::vector<glm::vec3>{{0, 0, 0}, {1, 1, 1}}));
+  EXPECT_EQ(two.positions, (PositionArray{{0, 0, 0}, {1, 1, 1}}));
+  EXPECT_EQ(two.colors, (ColorArray{{0, 0, 0}, {1, 1, 1}}));
 }
 
 TEST(PointOrder, identicalPointsKeepOrderWithinBlocks) {

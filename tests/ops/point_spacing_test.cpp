@@ -12,8 +12,8 @@ namespace dpoint {
 namespace {
 
 // n × n points `step` apart in the z = 0 plane (z = 0.001·x when `tilt`, so the set is 3D).
-std::vector<glm::dvec3> grid(int n, double step, bool tilt = false) {
-  std::vector<glm::dvec3> points;
+PositionArray grid(int n, double step, bool tilt = false) {
+  PositionArray points;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) points.push_back({i * step, j * step, tilt ? 0.001 * i * step : 0.0});
   return points;
@@ -21,7 +21,7 @@ std::vector<glm::dvec3> grid(int n, double step, bool tilt = false) {
 
 TEST(PointSpacing, aGridsSpacingIsItsStep) {
   for (bool tilt : {false, true}) {
-    const std::vector<glm::dvec3> points = grid(200, 0.25, tilt);
+    const PositionArray points = grid(200, 0.25, tilt);
     const std::vector<SpacingSample> samples = sampleSpacing(points, boundingBox(points), 256);
     ASSERT_GE(samples.size(), 200u) << "tilt " << tilt;  // edge points too: their 4th nearest is a step away
     size_t at_step = 0;
@@ -31,12 +31,12 @@ TEST(PointSpacing, aGridsSpacingIsItsStep) {
 }
 
 TEST(PointSpacing, samplesDoNotDependOnOrderOrBlocks) {
-  std::vector<glm::dvec3> points = grid(120, 1.0);
+  PositionArray points = grid(120, 1.0);
   std::mt19937 random(7);
   for (glm::dvec3& p : points) p.z = std::uniform_real_distribution<double>(0.0, 0.5)(random);
   const Box box = boundingBox(points);
   const std::vector<SpacingSample> whole = sampleSpacing(points, box, 300, 1);
-  std::vector<glm::dvec3> shuffled = points;
+  PositionArray shuffled = points;
   std::shuffle(shuffled.begin(), shuffled.end(), random);
   // Two passes in blocks of 1000, as a streamed file is read, on two threads.
   SpacingSampler sampler(300, 2);
@@ -57,14 +57,14 @@ TEST(PointSpacing, samplesDoNotDependOnOrderOrBlocks) {
 // A set of many blocks (65,536 points each) on several threads, each keeping one heap over all the
 // blocks it takes, in one call and in calls of uneven size: the samples of one thread in one call.
 TEST(PointSpacing, samplesOfManyBlocksDoNotDependOnThreads) {
-  std::vector<glm::dvec3> points(300'000);
+  PositionArray points(300'000);
   std::mt19937 random(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (glm::dvec3& p : points) p = {unit(random), unit(random), unit(random)};
   points.insert(points.end(), points.begin(), points.begin() + 70'000);  // copies, sampled once each
   SpacingSampler one(512, 1);
   one.add(points);
-  const std::vector<glm::dvec3> expected = one.finish();
+  const PositionArray expected = one.finish();
   ASSERT_GT(expected.size(), 256u);  // fewer than 512: a copy counts twice among the smallest
   for (unsigned threads : {2u, 3u, 5u}) {
     SpacingSampler together(512, threads), parts(512, threads);
@@ -81,7 +81,7 @@ TEST(PointSpacing, samplesOfManyBlocksDoNotDependOnThreads) {
 // are passed over.
 TEST(PointSpacing, batchesClearOfTheKeptCellsChangeNothing) {
   // A 320 × 320 grid in 32 × 32 tiles, one batch each (as Morton order keeps a batch compact).
-  std::vector<glm::dvec3> points;
+  PositionArray points;
   std::mt19937 random(11);
   for (int ti = 0; ti < 10; ++ti)
     for (int tj = 0; tj < 10; ++tj)
@@ -96,7 +96,7 @@ TEST(PointSpacing, batchesClearOfTheKeptCellsChangeNothing) {
   size_t read = 0;
   for (size_t first = 0; first < points.size(); first += 1024) {
     const std::span<const glm::dvec3> batch = std::span(points).subspan(first, std::min<size_t>(1024, points.size() - first));
-    if (!search.mayUse(boundingBox(std::vector<glm::dvec3>(batch.begin(), batch.end())))) continue;
+    if (!search.mayUse(boundingBox(PositionArray(batch.begin(), batch.end())))) continue;
     search.add(batch);
     read += batch.size();
   }
@@ -111,8 +111,8 @@ TEST(PointSpacing, batchesClearOfTheKeptCellsChangeNothing) {
 }
 
 TEST(PointSpacing, copiesOfAPointAreNotItsNeighbours) {
-  std::vector<glm::dvec3> points = grid(50, 2.0);
-  const std::vector<glm::dvec3> copies = points;
+  PositionArray points = grid(50, 2.0);
+  const PositionArray copies = points;
   points.insert(points.end(), copies.begin(), copies.end());  // every point twice
   const std::vector<SpacingSample> samples = sampleSpacing(points, boundingBox(points), 64);
   ASSERT_FALSE(samples.empty());
@@ -120,11 +120,11 @@ TEST(PointSpacing, copiesOfAPointAreNotItsNeighbours) {
 }
 
 TEST(PointSpacing, noSamplesWithoutTwoPositionsOrForAFewFarClusters) {
-  EXPECT_TRUE(sampleSpacing(std::vector<glm::dvec3>(10, glm::dvec3(1, 2, 3)), Box{{1, 2, 3}, {1, 2, 3}}, 8).empty());
+  EXPECT_TRUE(sampleSpacing(PositionArray(10, glm::dvec3(1, 2, 3)), Box{{1, 2, 3}, {1, 2, 3}}, 8).empty());
   EXPECT_TRUE(sampleSpacing({glm::dvec3(0.0)}, Box{}, 8).empty());
   // Two points at opposite corners of a huge box with 1000 copies each: the 4th nearest distinct
   // position is the other corner, far beyond a cell.
-  std::vector<glm::dvec3> far;
+  PositionArray far;
   for (int i = 0; i < 4; ++i) far.push_back({0, 0, 0}), far.push_back({1e6, 1e6, 1e6});
   EXPECT_TRUE(sampleSpacing(far, boundingBox(far), 8).empty());
 }

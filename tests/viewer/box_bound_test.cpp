@@ -52,7 +52,7 @@ BatchBoxes boxesOf(const PointSet& s, size_t block = 3 * kBatchSize) {
   BatchBoxes boxes;
   for (size_t first = 0; first < s.size(); first += block) {
     const size_t end = std::min(s.size(), first + block);
-    addBatchBoxes(boxes, std::vector<glm::dvec3>(s.positions.begin() + std::ptrdiff_t(first),
+    addBatchBoxes(boxes, PositionArray(s.positions.begin() + std::ptrdiff_t(first),
                                                  s.positions.begin() + std::ptrdiff_t(end)));
   }
   return boxes;

@@ -21,8 +21,8 @@
 namespace dpoint {
 namespace {
 
-std::vector<glm::dvec3> cornersOf(const Bounds& b) {
-  std::vector<glm::dvec3> out;
+PositionArray cornersOf(const Bounds& b) {
+  PositionArray out;
   for (int i = 0; i < 8; ++i) {
     out.push_back({(i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z});
   }
@@ -161,7 +161,7 @@ TEST(Camera, pointsBehindOrAtTheEyeAreInvisibleAndFinite) {
   const Bounds bounds{{0, 0, 0}, {1, 1, 1}};  // the eye is inside the box
   const Camera camera = make(spec, bounds);
   expectUsable(camera);
-  const std::vector<glm::dvec3> points = {*spec.eye, *spec.eye + glm::dvec3(0, 0, 0.25),
+  const PositionArray points = {*spec.eye, *spec.eye + glm::dvec3(0, 0, 0.25),
                                           *spec.eye + glm::dvec3(0.1, 0.2, 1e-3),
                                           *spec.eye + glm::dvec3(0, 0, -1e-9)};  // in front, nearer than near
   for (const WindowPoint& w : projectReference(points, camera)) {
@@ -202,7 +202,7 @@ TEST(Camera, orthoDeepZoomPutsPixelCentresAtHalfPixels) {
   const Camera camera = make(spec, bounds);
   ASSERT_TRUE(camera.ortho);
   const double pixel = view_width / 1024;
-  std::vector<glm::dvec3> points;
+  PositionArray points;
   std::vector<int> columns, rows;
   for (int k = -512; k < 512; ++k) {
     const int j = (k * 7 + 100000) % 768 - 384;  // rows spread over the whole height
@@ -362,8 +362,8 @@ TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
   // Blocks in any order give the same outline.
   OutlineBuilder builder(outlined);
   const size_t half = bulb->size() / 2;
-  builder.add(std::vector<glm::dvec3>(bulb->positions.begin() + long(half), bulb->positions.end()));
-  builder.add(std::vector<glm::dvec3>(bulb->positions.begin(), bulb->positions.begin() + long(half)));
+  builder.add(PositionArray(bulb->positions.begin() + long(half), bulb->positions.end()));
+  builder.add(PositionArray(bulb->positions.begin(), bulb->positions.begin() + long(half)));
   EXPECT_EQ(builder.finish(), outlined.outline);
   // Boxes of 1024 consecutive points: one in a row is taken by its corners, the rest by their
   // points; the outline is the same.
@@ -371,7 +371,7 @@ TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
   size_t read = 0;
   for (size_t first = 0; first < bulb->size(); first += 1024) {
     const auto from = bulb->positions.begin() + long(first), to = from + long(std::min<size_t>(1024, bulb->size() - first));
-    const std::vector<glm::dvec3> batch(from, to);
+    const PositionArray batch(from, to);
     if (by_boxes.addBox(boundingBox(batch))) continue;
     by_boxes.add(batch);
     read += batch.size();
