@@ -419,7 +419,12 @@ class Reader {
 
     PointSet points;
     const size_t count = static_cast<size_t>(n);
-    resizePrefaulted(points.positions, count, options_.threads);
+    // Rows write the coordinates they have fields for: without a z field, z is 0 from here on (the
+    // finiteness checks read it before the end), not whatever the unset memory held.
+    if (h_.has_z)
+      resizePrefaulted(points.positions, count, options_.threads);
+    else
+      points.positions.assign(count, glm::dvec3(0.0));
     if (h_.colors) points.colors.resize(count);
     for (const auto& [name, type] : h_.dimensions) points.dimensions.append(name, type, count);
     points.color_full_scale = h_.colors ? 255 : 0;
