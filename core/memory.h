@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <memory>
 #include <new>
-#include <type_traits>
 #include <string>
+#include <system_error>
+#include <thread>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -88,6 +90,36 @@ template <typename T, typename U>
 bool operator==(const DefaultInitAllocator<T>&, const DefaultInitAllocator<U>&) noexcept {
   return true;
 }
+
+// Destroys an object on a thread of its own, so that giving its memory back (the kernel unmapping
+// the hundreds of MB of a large point set: 20-50 ms on the 2-core VM, more under load) overlaps what
+// the caller does next, such as writing the picture. The destructor (or wait()) waits for it. Where
+// no thread can be started, the object is destroyed at once.
+class ReleaseInBackground {
+ public:
+  ReleaseInBackground() = default;
+  template <typename T>
+  explicit ReleaseInBackground(T&& value) {
+    auto held = std::make_unique<std::decay_t<T>>(std::forward<T>(value));
+    try {
+      thread_ = std::thread([owned = std::move(held)]() mutable { owned.reset(); });
+    } catch (const std::system_error&) {  // the object dies here, with the lambda that held it
+    }
+  }
+  ReleaseInBackground(ReleaseInBackground&& other) noexcept = default;
+  ReleaseInBackground& operator=(ReleaseInBackground&& other) noexcept {
+    wait();
+    thread_ = std::move(other.thread_);
+    return *this;
+  }
+  ~ReleaseInBackground() { wait(); }
+  void wait() {
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::thread thread_;
+};
 
 // Resizes `v` to n elements, the new ones zeroed (left as they are for a DefaultInitAllocator); when it is empty, its pages are faulted in on
 // all cores first (a vector that holds elements keeps them, and is resized as it is).

@@ -1031,6 +1031,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
     if (!drawn) return drawn.error();
     if (*drawn) {
       outcome.validation_messages = context.validationMessages();
+      outcome.read_set = ReleaseInBackground(std::move(*set));
       return outcome;
     }
     // The points as uploaded would not do: drawn from a second read, with the bounds now known.
@@ -1046,6 +1047,8 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
                                       : renderOne(resolved, context, *set, cameras->front(), outcome, progress);
   if (!rendered) return rendered.error();
   outcome.validation_messages = context.validationMessages();
+  // Giving the set's memory back (s11u.ply's 600 MB: 20-50 ms) overlaps writing the picture.
+  outcome.read_set = ReleaseInBackground(std::move(*set));
   return outcome;
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "converters/point_io.h"
+#include "core/memory.h"
 #include "core/progress.h"
 #include "core/result.h"
 #include "image/image.h"
@@ -244,6 +245,9 @@ struct RenderOutcome {
   std::vector<SheetView> views;
   // A COPC input: the points, bytes and nodes its view read (readCopcPoints).
   std::optional<CopcReadStats> copc;
+  // The set as read, destroyed on a thread of its own while the picture is written; the outcome
+  // waits for it when it is destroyed.
+  ReleaseInBackground read_set;
 };
 
 // Runs the request: checks it, reads (or streams) the input, makes the device, picks the mode and

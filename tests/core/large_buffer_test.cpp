@@ -1,7 +1,11 @@
 // LargeBuffer (core/memory.h): a mapped buffer for large outputs and the heap for small ones; both
-// hold what is written, move without copying, and release once.
+// hold what is written, move without copying, and release once. ReleaseInBackground: an object
+// destroyed on a thread of its own, waited for.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <thread>
 #include <utility>
 
 #include "core/memory.h"
@@ -29,6 +33,37 @@ TEST(LargeBuffer, holdsWhatManyThreadsWriteAndMovesWithoutCopying) {
     assigned = std::move(moved);
     EXPECT_EQ(assigned.data(), at);
   }
+}
+
+// The object is destroyed once, on another thread, and the holder's end waits for it (the
+// destructor here takes 50 ms, so a holder that did not wait would see it unfinished).
+TEST(ReleaseInBackground, destroysOnceOnAnotherThreadAndWaits) {
+  struct Slow {
+    std::atomic<int>* destroyed;
+    std::thread::id* on;
+    bool live = true;
+    Slow(std::atomic<int>* d, std::thread::id* t) : destroyed(d), on(t) {}
+    Slow(Slow&& other) noexcept : destroyed(other.destroyed), on(other.on) { other.live = false; }
+    ~Slow() {
+      if (!live) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      *on = std::this_thread::get_id();
+      ++*destroyed;
+    }
+  };
+  std::atomic<int> destroyed{0};
+  std::thread::id on;
+  {
+    ReleaseInBackground release(Slow(&destroyed, &on));
+    ReleaseInBackground moved = std::move(release);
+    ReleaseInBackground other(Slow(&destroyed, &on));
+    other = std::move(moved);  // waits for other's own object first
+    EXPECT_GE(destroyed.load(), 1);
+  }
+  EXPECT_EQ(destroyed.load(), 2);
+  EXPECT_NE(on, std::this_thread::get_id());
+  ReleaseInBackground empty;
+  empty.wait();  // nothing to wait for
 }
 
 }  // namespace
