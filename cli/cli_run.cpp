@@ -28,6 +28,9 @@ struct Capture {
 };
 thread_local Capture* t_capture = nullptr;
 
+// Set by runDpoint: the process is the executable's, and ends with this run.
+bool g_executable = false;
+
 // A word that is a whole number in exponent form ("1e6", "2.5e3") as its digits ("1000000"), so
 // that a count takes what a size does; any other word (1e-9, a path, 1e3,0,0) is left as it is.
 // Below 2^53 the digits are the same number for an option of any type.
@@ -119,7 +122,17 @@ int reportError(const Error& error) {
   return static_cast<int>(error.code);
 }
 
-int runDpoint(int argc, char** argv) { return runApp(argc, argv); }
+int runDpoint(int argc, char** argv) {
+  g_executable = true;
+  return runApp(argc, argv);
+}
+
+bool runningAsExecutable() { return g_executable && !t_capture; }
+
+void exitProcessNow(int code) {
+  std::fflush(nullptr);
+  std::_Exit(code);
+}
 
 EmbeddedRun runEmbedded(const std::vector<std::string>& args, bool capture_points) {
   std::vector<const char*> argv = {"dpoint"};

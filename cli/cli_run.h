@@ -47,6 +47,15 @@ EmbeddedRun runEmbedded(const std::vector<std::string>& args, bool capture_point
 bool capturingPoints();
 void capturePoints(PointSet points);
 
+// For the commands: whether this run is the executable's own (runDpoint, from main), so that the
+// process ends with the command. False in an embedded run, which is one call among others.
+bool runningAsExecutable();
+
+// Ends the executable's process now with `code`, stdout and stderr flushed, leaving the rest of
+// the teardown (the Vulkan device, the set's memory) to the kernel, as at any process's end. For a
+// command that has written and printed everything, and only when runningAsExecutable().
+[[noreturn]] void exitProcessNow(int code);
+
 // The executable `dpoint bench` runs for its datasets and timed draws: $DPOINT_EXECUTABLE when
 // set and not empty (a process that embeds dpoint is not itself dpoint: the Python module sets it
 // to a built `dpoint`), else /proc/self/exe, this very executable.
