@@ -249,7 +249,10 @@ int runRender(const RenderCliOptions& o) {
                 outcome->image.width, outcome->image.height, backendName(outcome->backend), outcome->device.name.c_str());
     printWarnings(*outcome);
     const int code = validationResult(*outcome);
-    if (runningAsExecutable() && !request->validate) exitProcessNow(code);  // as below
+    if (runningAsExecutable() && !request->validate) {  // as below
+      progress.finish();
+      exitProcessNow(code);
+    }
     return code;
   }
   if (!o.json.empty())
@@ -261,7 +264,10 @@ int runRender(const RenderCliOptions& o) {
   // and give back the set first: on the NVIDIA driver that teardown took 33-40 ms of a 230-300 ms
   // render (H200), work the kernel does anyway as the process ends. With --validate the layer is
   // shown every object destroyed, as the tests want.
-  if (runningAsExecutable() && !request->validate) exitProcessNow(code);
+  if (runningAsExecutable() && !request->validate) {
+    progress.finish();  // a phase a reader left open ends its line, as ~Progress would
+    exitProcessNow(code);
+  }
   return code;
 }
 

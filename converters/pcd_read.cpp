@@ -437,6 +437,7 @@ class Reader {
                      : h_.data == Data::kBinary ? readBinary(columns, n)
                                                 : readCompressed(columns, n, compressed, uncompressed);
     if (!decoded) return decoded.error();
+    if (options_.progress) options_.progress->finish();
     if (Status s = dropNanPoints(points); !s) return s.error();
     if (!h_.has_z || h_.two_d)
       for (glm::dvec3& p : points.positions) p.z = 0.0;

@@ -98,7 +98,9 @@ bool operator==(const DefaultInitAllocator<T>&, const DefaultInitAllocator<U>&) 
 class ReleaseInBackground {
  public:
   ReleaseInBackground() = default;
-  template <typename T>
+  // Takes `value` by move only (an lvalue would be copied; a holder is moved as a holder).
+  template <typename T, typename = std::enable_if_t<!std::is_lvalue_reference_v<T> &&
+                                                    !std::is_same_v<std::decay_t<T>, ReleaseInBackground>>>
   explicit ReleaseInBackground(T&& value) {
     auto held = std::make_unique<std::decay_t<T>>(std::forward<T>(value));
     try {

@@ -80,11 +80,15 @@ RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::ve
   }
   RenderOutcome outcome = take(released([&]() -> Result<RenderOutcome> {
     Progress bar(progressFile(progress), "render");
-    if (!renderer) return runRenderJob(request, bar);
-    return renderer->use([&](const std::shared_ptr<VulkanContext>& context) {
-      request.context = context;
-      return runRenderJob(request, bar);
-    });
+    Result<RenderOutcome> done = !renderer ? runRenderJob(request, bar)
+                                           : renderer->use([&](const std::shared_ptr<VulkanContext>& context) {
+                                               request.context = context;
+                                               return runRenderJob(request, bar);
+                                             });
+    // The set as read is given back on its own thread (RenderOutcome::read_set): waited for here,
+    // without the GIL, so other Python threads run meanwhile.
+    if (done) done->read_set.wait();
+    return done;
   }));
   // As the CLI: with the validation layer on, any message fails the run.
   if (!outcome.validation_messages.empty()) {

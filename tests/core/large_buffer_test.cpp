@@ -6,7 +6,9 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -40,9 +42,9 @@ TEST(LargeBuffer, holdsWhatManyThreadsWriteAndMovesWithoutCopying) {
 TEST(ReleaseInBackground, destroysOnceOnAnotherThreadAndWaits) {
   struct Slow {
     std::atomic<int>* destroyed;
-    std::thread::id* on;
+    std::atomic<std::thread::id>* on;
     bool live = true;
-    Slow(std::atomic<int>* d, std::thread::id* t) : destroyed(d), on(t) {}
+    Slow(std::atomic<int>* d, std::atomic<std::thread::id>* t) : destroyed(d), on(t) {}
     Slow(Slow&& other) noexcept : destroyed(other.destroyed), on(other.on) { other.live = false; }
     ~Slow() {
       if (!live) return;
@@ -52,7 +54,7 @@ TEST(ReleaseInBackground, destroysOnceOnAnotherThreadAndWaits) {
     }
   };
   std::atomic<int> destroyed{0};
-  std::thread::id on;
+  std::atomic<std::thread::id> on;
   {
     ReleaseInBackground release(Slow(&destroyed, &on));
     ReleaseInBackground moved = std::move(release);
@@ -61,7 +63,9 @@ TEST(ReleaseInBackground, destroysOnceOnAnotherThreadAndWaits) {
     EXPECT_GE(destroyed.load(), 1);
   }
   EXPECT_EQ(destroyed.load(), 2);
-  EXPECT_NE(on, std::this_thread::get_id());
+  static_assert(!std::is_constructible_v<ReleaseInBackground, ReleaseInBackground&>);
+  static_assert(!std::is_constructible_v<ReleaseInBackground, std::vector<int>&>);
+  EXPECT_NE(on.load(), std::this_thread::get_id());
   ReleaseInBackground empty;
   empty.wait();  // nothing to wait for
 }
