@@ -238,6 +238,17 @@ class HeaderParser {
     if (sizes_.empty()) return headerError(data_line, "the header has no SIZE line");
     if (types_.empty()) types_.assign(names_.size(), 'F');  // PCD 0.5 had no TYPE
     if (counts_.empty()) counts_.assign(names_.size(), 1);
+    // A second FIELDS (or COLUMNS) line may name more fields than the earlier SIZE, TYPE or COUNT
+    // gave values for.
+    const struct {
+      const char* key;
+      size_t values;
+      int line;
+    } given[] = {{"SIZE", sizes_.size(), size_line_}, {"TYPE", types_.size(), type_line_}, {"COUNT", counts_.size(), count_line_}};
+    for (const auto& g : given)
+      if (g.values != names_.size())
+        return headerError(g.line, std::string(g.key) + " has " + std::to_string(g.values) + " values for the " +
+                                       std::to_string(names_.size()) + " FIELDS of line " + std::to_string(fields_line_));
     // POINTS, else WIDTH × HEIGHT (HEIGHT 1 when missing).
     if (width_line_ != 0 && points_line_ != 0) {
       const uint64_t h = height_line_ != 0 ? height_ : 1;

@@ -253,6 +253,11 @@ TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
       {head + "DATA binary_compressed\n" + std::string("\x05\0\0\0\x10\0\0\0", 8) + std::string(5, '\0'),
        "the uncompressed size 16 is not POINTS × bytes per point (2 × 12)"},
       {"VERSION 0.7\nFIELDS x y y\nSIZE 4 4 4\nPOINTS 1\nDATA ascii\n", "header line 2: field 'y' appears twice"},
+      // A fuzz finding: a second field list (COLUMNS, PCD 0.5's FIELDS) longer than the COUNT line
+      // before it had the fields read past the counts.
+      {"VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nCOLUMNS x y z rgba intensity\n"
+       "SIZE 4 4 4 4 2\nTYPE F F F U U\nPOINTS 2\nDATA ascii\n1 2 3 4 7\n4 5 6 0 6\n",
+       "header line 5: COUNT has 4 values for the 5 FIELDS of line 6"},
       // A fuzz finding: a field of 88,881 values once took seconds (a quadratic check of the names).
       {"VERSION 0.7\nFIELDS x y z w\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 88881\n",
        "header line 5: field 'w': COUNT '88881' is not 1 to 65536"},
