@@ -243,32 +243,30 @@ int runRender(const RenderCliOptions& o) {
       runRenderJob(*request, progress, o.common.quiet ? std::function<void(const SheetView&)>() : printView);
   if (!outcome) return reportError(outcome.error());
   if (Status written = writeRenderPicture(o.output, *outcome); !written) return reportError(written.error());
+  // Once everything is written and printed, the executable ends here rather than destroy the
+  // device and give back the set first: on the NVIDIA driver that teardown took 33-40 ms of a
+  // 230-300 ms render (H200), work the kernel does anyway as the process ends. With --validate the
+  // layer is shown every object destroyed, as the tests want.
+  auto finished = [&] {
+    const int code = validationResult(*outcome);
+    if (runningAsExecutable() && !request->validate) {
+      progress.finish();  // a phase a reader left open ends its line, as ~Progress would
+      exitProcessNow(code);
+    }
+    return code;
+  };
   if (request->views == 4) {
     if (!o.common.quiet)
       std::printf("%s: %zu points, 4 views, %ux%u, %s backend, %s\n", o.output.c_str(), outcome->points,
                 outcome->image.width, outcome->image.height, backendName(outcome->backend), outcome->device.name.c_str());
     printWarnings(*outcome);
-    const int code = validationResult(*outcome);
-    if (runningAsExecutable() && !request->validate) {  // as below
-      progress.finish();
-      exitProcessNow(code);
-    }
-    return code;
+    return finished();
   }
   if (!o.json.empty())
     if (Status s = writeReport(o.json, *request, *outcome); !s) return reportError(s.error());
   if (!o.common.quiet) printOutcome(*request, o.output, *outcome);
   printWarnings(*outcome);
-  const int code = validationResult(*outcome);
-  // Everything is written and printed. The executable ends here rather than destroy the device
-  // and give back the set first: on the NVIDIA driver that teardown took 33-40 ms of a 230-300 ms
-  // render (H200), work the kernel does anyway as the process ends. With --validate the layer is
-  // shown every object destroyed, as the tests want.
-  if (runningAsExecutable() && !request->validate) {
-    progress.finish();  // a phase a reader left open ends its line, as ~Progress would
-    exitProcessNow(code);
-  }
-  return code;
+  return finished();
 }
 
 // `dpoint render --help`'s description; its list of modes comes from the mode table.

@@ -450,7 +450,7 @@ class Reader {
     if (!decoded) return decoded.error();
     if (options_.progress) options_.progress->finish();
     if (Status s = dropNanPoints(points); !s) return s.error();
-    if (!h_.has_z || h_.two_d)
+    if (h_.has_z && h_.two_d)  // without a z field, z is 0 already
       for (glm::dvec3& p : points.positions) p.z = 0.0;
     if (options_.notices && !h_.viewpoint.empty())
       options_.notices->push_back(path_ + ": " + h_.viewpoint +
