@@ -19,6 +19,7 @@
 // come, for writers that never hold the whole set (glTF input, converters/point_io.h).
 #pragma once
 
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -40,6 +41,8 @@ struct CsvReadOptions {
   // r, g, b (red, green, blue), `-` to skip a column, any other name a dimension. A header line
   // is then skipped.
   std::vector<std::string> columns = {};
+  // Tests: runs once the lines are counted, before they are parsed (to change the file in between).
+  std::function<void()> between_passes = {};
 };
 
 struct CsvWriteOptions {

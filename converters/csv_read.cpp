@@ -574,6 +574,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   char last_byte = 0;
   if (Result<size_t> got = file.readAt(size - 1, &last_byte, 1); !got) return got.error();
   const uint64_t lines = newlines[blocks] + (last_byte != '\n' ? 1 : 0);
+  if (options.between_passes) options.between_passes();
 
   // Every line may be a row: a file of short lines (or of blank ones) asks for 24-36 bytes of
   // point set per 2-4 bytes of file, so the arrays are checked before they are made.
@@ -627,6 +628,18 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     const char* data = buffer.data();
     const char* stop = data + (block_end - read_start);  // lines must start before this
     const char* end = data + *got;
+    // The rows were sized and numbered from pass 1's count: a file that changed since (cut short,
+    // or its lines moved) would leave rows unset or number them past the arrays, so it is refused.
+    // These bytes are the block's own; a line's row comes from its block's line ends alone.
+    const bool last_block = block_end == size;
+    if (*got != buffer.size() ||
+        static_cast<uint64_t>(std::count(data + (block_start - read_start), stop, '\n')) != newlines[b + 1] - newlines[b] ||
+        (last_block && stop[-1] != last_byte)) {
+      fail({header.first_data_line + row + 1,
+            path + ": the file changed while it was read (its lines are not the ones counted before reading "
+                   "them); read it again once it is whole"});
+      return;
+    }
     const char* p = data;
     if (read_start != block_start) {
       ++p;

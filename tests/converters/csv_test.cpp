@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <charconv>
 #include <iterator>
 #include <random>
 #include <span>
+
+#include <unistd.h>
 
 #include "converters/csv.h"
 #include "core/fixed_format.h"
@@ -375,6 +378,45 @@ TEST(Csv, reportsTheFirstBadLineWhateverTheThreadCount) {
     Result<PointSet> r = readCsv(dir.file("a.csv"), CsvReadOptions{threads, false, nullptr});
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.error().message.find("a.csv:800002: column 1: 'bad'"), std::string::npos) << r.error().message;
+  }
+}
+
+// The rows are sized and numbered from a first count of the lines: a file changed between that
+// count and the parse is refused, not read into unset or misnumbered rows; one that only grew is
+// read as it was counted.
+TEST(Csv, aFileChangedBetweenThePassesIsRefused) {
+  TempDir dir;
+  std::string text = "x,y,z\n";
+  for (int i = 0; i < 800000; ++i) text += "1.25,2.5,3.75\n";  // ~11 MB: two blocks
+  const std::string path = dir.file("a.csv");
+  auto readChanging = [&](unsigned threads, const std::function<void()>& change) {
+    writeFile(path, text);
+    CsvReadOptions options;
+    options.threads = threads;
+    options.between_passes = change;
+    return readCsv(path, options);
+  };
+  auto cut = [&] { ASSERT_EQ(::truncate(path.c_str(), static_cast<off_t>(text.size() / 2)), 0); };
+  auto joinLines = [&](size_t at) {  // the same size, one line end less
+    return [&, at] {
+      std::string changed = text;
+      changed[changed.find('\n', at)] = ' ';
+      writeFile(path, changed);
+    };
+  };
+  auto grow = [&] { writeFile(path, text + "7,8,9\n"); };
+  for (unsigned threads : {1u, 2u}) {
+    for (const auto& [what, change] : std::vector<std::pair<std::string, std::function<void()>>>{
+             {"cut", cut}, {"joined in block 0", joinLines(1000)}, {"joined in block 1", joinLines(text.size() - 1000)}}) {
+      Result<PointSet> r = readChanging(threads, change);
+      ASSERT_FALSE(r.ok()) << what << ", " << threads << " threads";
+      EXPECT_NE(r.error().message.find("a.csv: the file changed while it was read"), std::string::npos)
+          << what << ": " << r.error().message;
+    }
+    Result<PointSet> grown = readChanging(threads, grow);
+    ASSERT_TRUE(grown.ok()) << grown.error().message;
+    EXPECT_EQ(grown->size(), 800000u);
+    EXPECT_EQ(grown->positions.back(), glm::dvec3(1.25, 2.5, 3.75));
   }
 }
 
