@@ -589,7 +589,8 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   std::vector<double*> columns;
   std::vector<bool> as_float;
   for (const std::string& name : layout.dimensions) {
-    Dimension& d = points.dimensions.append(name, DimType::kF64, static_cast<size_t>(lines));
+    // Unset: a data row parses every column (or the read fails); a blank line's row is closed up below.
+    Dimension& d = points.dimensions.appendUnset(name, DimType::kF64, static_cast<size_t>(lines));
     columns.push_back(reinterpret_cast<double*>(d.bytes.data()));
     const KnownDimension* known = findKnownDimension(name);
     as_float.push_back(known && known->type == DimType::kF32);

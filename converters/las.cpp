@@ -203,9 +203,10 @@ class LasReader {
     points.positions.resize(count);
     if (source_ != LasColorSource::kNone) points.colors.resize(count);
     // Every field of the record, and each extra byte field, as a dimension (core/dimensions.h).
-    // (lasExtraFields made every name unique.)
-    for (const LasField& f : fields_) points.dimensions.append(f.name, f.type, count);
-    for (const LasExtraField& f : extra_) points.dimensions.append(f.name, f.type, count);
+    // (lasExtraFields made every name unique.) Unset: decode() writes every field of every point
+    // (the columns are a dozen, hundreds of MB at 16M points, no longer zeroed on one thread first).
+    for (const LasField& f : fields_) points.dimensions.appendUnset(f.name, f.type, count);
+    for (const LasExtraField& f : extra_) points.dimensions.appendUnset(f.name, f.type, count);
     columns_.clear();  // pointers once every column is in place (adding one may move the others)
     for (Dimension& d : points.dimensions.all()) columns_.push_back(&d);
     const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
@@ -901,7 +902,8 @@ Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
   block.positions.resize(count);
   block.colors.resize(st.color_divisor != 0.0f ? count : 0);
   block.dimensions = Dimensions();
-  for (size_t k : st.streamed) block.dimensions.append(st.dimensions.all()[k].name, st.dimensions.all()[k].type, count);
+  for (size_t k : st.streamed)  // unset: every row's field is copied below
+    block.dimensions.appendUnset(st.dimensions.all()[k].name, st.dimensions.all()[k].type, count);
   std::vector<Dimension*> columns;  // once every column is in place (appending may move the others)
   for (Dimension& d : block.dimensions.all()) columns.push_back(&d);
   const size_t rgb_at = lasRgbOffset(h.point_format), extra_at = lasBaseRecordLength(h.point_format);

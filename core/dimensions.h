@@ -18,6 +18,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/memory.h"
+
 namespace dpoint {
 
 // The numeric types a dimension may have: LAS extra bytes' types 1–10 in their order.
@@ -38,18 +40,29 @@ bool dimensionHolds(DimType type, double v);
 // The type of a name as `dimTypeName` or PLY (uint8/uchar, int16/short, float64/double, …).
 std::optional<DimType> parseDimType(std::string_view name);
 
+// A column's bytes. Their allocator leaves bytes made without a value unset (core/memory.h), so
+// that a reader which writes every value of a large column does not zero it on one thread first:
+// Dimension's constructor and resize() still give zeros; Dimensions::appendUnset does not.
+using DimensionBytes = std::vector<uint8_t, DefaultInitAllocator<uint8_t>>;
+
 // One named column: size() values of `type`, stored as their bytes in host order.
 struct Dimension {
   std::string name;
   DimType type = DimType::kF64;
-  std::vector<uint8_t> bytes;
+  DimensionBytes bytes;
+
+  // Marks the constructor that leaves the values unset, for a caller that writes every one.
+  struct Unset {};
 
   Dimension() = default;
   Dimension(std::string name_, DimType type_, size_t count = 0)
+      : name(std::move(name_)), type(type_), bytes(count * dimTypeSize(type_), uint8_t{0}) {}
+  Dimension(std::string name_, DimType type_, size_t count, Unset)
       : name(std::move(name_)), type(type_), bytes(count * dimTypeSize(type_)) {}
 
   size_t size() const { return bytes.size() / dimTypeSize(type); }
-  void resize(size_t count) { bytes.resize(count * dimTypeSize(type)); }
+  // New values are 0.
+  void resize(size_t count) { bytes.resize(count * dimTypeSize(type), uint8_t{0}); }
   // The value of point i as a double (exact for every type but 64-bit integers beyond 2^53).
   double value(size_t i) const;
   // Sets point i from a double: rounded toward zero and clamped to an integer type's range (NaN as
@@ -133,6 +146,11 @@ class Dimensions {
   // A new column whose name the caller knows is not taken (no search: readers adding many).
   Dimension& append(const std::string& name, DimType type, size_t points) {
     return columns_.emplace_back(name, type, points);
+  }
+  // The same with the `points` values unset: for a reader that writes every one before any is read
+  // (a large column is then not zeroed on one thread first).
+  Dimension& appendUnset(const std::string& name, DimType type, size_t points) {
+    return columns_.emplace_back(name, type, points, Dimension::Unset{});
   }
   bool remove(std::string_view name);
   // Every column resized to `points` (new values 0).

@@ -177,7 +177,7 @@ void setAttribute(const py::handle& self, PointSet& set, const std::string& name
                           " values (one per point) in one dimension");
   const DimType type = dimTypeOf(array, name);
   py::array contiguous = py::array::ensure(array, py::array::c_style | py::array::forcecast);
-  std::vector<uint8_t> bytes(set.size() * dimTypeSize(type));
+  DimensionBytes bytes(set.size() * dimTypeSize(type));  // unset, then every byte copied
   if (!bytes.empty()) std::memcpy(bytes.data(), contiguous.data(), bytes.size());
   Dimension* d = set.dimensions.find(name);
   if (!d) {

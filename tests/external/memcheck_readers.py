@@ -43,9 +43,11 @@ with scratch() as d:
     for name in ("xy_binary.pcd", "xy_ascii.pcd"):
         under_memcheck("convert", path(name), "-o", path(name + ".ply"))
         under_memcheck("info", path(name))
-    # CSV with blank lines between rows, in 2 and 3 columns with colours.
+    # CSV with blank lines between rows, in 2 and 3 columns with colours and attribute columns
+    # (whose values are not zeroed before the rows are parsed into them).
     with open(path("blank.csv"), "w") as f:
-        f.write("x,y,z,r,g,b\n1,2,3,10,20,30\n\n4,5,6,40,50,60\n   \n7,8,9,70,80,90\n")
+        f.write("x,y,z,r,g,b,intensity,quality\n1,2,3,10,20,30,7,0.5\n\n4,5,6,40,50,60,8,0.25\n   \n"
+                "7,8,9,70,80,90,9,0.125\n")
     with open(path("two.xyz"), "w") as f:
         f.write("1 2\n\n3 4\n5 6\n")
     under_memcheck("convert", path("blank.csv"), "-o", path("blank.ply"))
