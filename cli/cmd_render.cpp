@@ -79,7 +79,6 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   if (o.backend != "auto") request.backend = o.backend == "compute" ? Backend::kCompute : Backend::kRaster;
   request.device = o.device;
   request.validate = o.validate;
-  request.keep_gpu_objects = runningAsExecutable() && !o.validate;  // runRender ends the process, not frees them
   request.camera = *spec;
   request.tolerance_px = *parseTolerance(o.camera.tolerance);
   if (o.point_size != "auto") request.point_size = *parsePointSize(o.point_size);
@@ -245,9 +244,9 @@ int runRender(const RenderCliOptions& o) {
   if (!outcome) return reportError(outcome.error());
   if (Status written = writeRenderPicture(o.output, *outcome); !written) return reportError(written.error());
   // Once everything is written and printed, the executable ends here rather than destroy the
-  // view's GPU objects and the device and give back the set first: on the NVIDIA driver that
-  // teardown took 33-40 ms of a 230-300 ms render (H200), work the kernel does anyway as the process
-  // ends. With --validate the layer is shown every object destroyed, as the tests want.
+  // device and give back the set first: on the NVIDIA driver that teardown took 33-40 ms of a
+  // 230-300 ms render (H200), work the kernel does anyway as the process ends. With --validate the
+  // layer is shown every object destroyed, as the tests want.
   auto finished = [&] {
     const int code = validationResult(*outcome);
     if (runningAsExecutable() && !request->validate) {

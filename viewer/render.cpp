@@ -477,8 +477,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   bool pulled = shaders.vertex_pull.code != nullptr &&
                 (compute || shaders.attribute_count == 0 || options.native_path == NativePath::kPull ||
                  (options.native_path == NativePath::kAuto && !context.facts.r64g64b64_vertex));
-  const std::shared_ptr<Resources> held = std::make_shared<Resources>(context);
-  Resources& r = *held;
+  Resources r(context);
   // The driver compiles the pipelines while the points are encoded and uploaded: on NVIDIA's a
   // cold shader cache takes 50-100 ms, as long as the upload of 16.7M points. Declared after r,
   // so an early return waits for it before r is torn down. A stream settled after its upload
@@ -558,7 +557,6 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   if (status) status = readPicture(context, r, camera.width, camera.height, out);
   if (status && options.probe) status = runProbe(context, r, options, camera.width, camera.height, total, out);
   if (!status) return status.error();
-  if (options.keep_resources) out.resources = held;
   return out;
 }
 

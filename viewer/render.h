@@ -6,7 +6,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -81,10 +80,6 @@ struct RenderOptions {
   // After the frame, outside its timestamps (gpu_ms times the points alone, in every shading).
   Shading shading = Shading::kNone;
   EdlOptions edl;
-  // The render's GPU objects (the points' buffers, targets, pipelines) handed back in
-  // RenderResult::resources instead of destroyed before it returns: `dpoint render` ends the process
-  // once the picture is written, and freeing a 1e9-point stream's 16 GB took about 360 ms (H200).
-  bool keep_resources = false;
 };
 
 struct RenderResult {
@@ -101,9 +96,6 @@ struct RenderResult {
   uint64_t gpu_bytes = 0;          // point data on the GPU (positions + colours)
   // Per-batch modes: what the frame's plan loads (batches culled, at each tier, bytes per point).
   std::optional<BatchPlanStats> batch_plan;
-  // With RenderOptions::keep_resources: the GPU objects, destroyed with the last copy of this
-  // pointer, which must go before the device does.
-  std::shared_ptr<void> resources;
 };
 
 // Fails with kBadInput when the set is empty or a position does not fit the mode's encoding,

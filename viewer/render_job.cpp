@@ -504,9 +504,6 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   RenderOptions options;
   options.mode = mode;
   options.backend = *request.backend;
-  // A view's GPU objects go with the outcome (RenderOutcome::result, before its device): `dpoint
-  // render` writes the picture and then ends without freeing them (cli/cmd_render.cpp).
-  options.keep_resources = request.keep_gpu_objects;
   options.point_size = defaultPointSize(request, set, camera, facts);
   // A 2D grid drawn at its spacing closes exactly with squares; discs would leave their corners open.
   options.round_points = request.round_points.value_or(!set.bounds.planar);

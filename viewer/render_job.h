@@ -89,10 +89,6 @@ struct RenderRequest {
   std::optional<Backend> backend;    // none: auto (backendFor)
   std::string device = "auto";       // ContextOptions::device
   bool validate = false;             // the Khronos validation layer; messages come back in the outcome
-  // The view's GPU objects kept in the outcome (RenderOptions::keep_resources) rather than freed
-  // before the job returns: for a process that ends once the picture is written (`dpoint render`).
-  // Not where the device is shared (the Python module's threads): they would be freed outside its lock.
-  bool keep_gpu_objects = false;
   uint64_t max_device_memory = 0;    // 0: what the device has
   CameraSpec camera;                 // the picture's size and the user's camera
   std::optional<double> point_size;  // pixels; none: pointSizeFor's choice

@@ -132,30 +132,6 @@ TEST_P(Render, emptySetIsAClearError) {
   EXPECT_NE(r.error().message.find("empty"), std::string::npos) << r.error().message;
 }
 
-// keep_resources hands the render's GPU objects back with the result (`dpoint render` ends the
-// process without freeing them); held across another render, then freed with the result, they draw
-// the same picture and give the layer nothing to report (TearDown fails on any message).
-TEST_P(Render, keptResourcesGoWithTheResult) {
-  const PointSet s = cloud(glm::dvec3(0.0), 0.1);
-  const Camera camera = lookAtCloud(s, glm::dvec3(0.0), 3.0);
-  RenderOptions options;
-  options.backend = GetParam();
-  Result<RenderResult> plain = renderPoints(*context_, s, camera, options);
-  ASSERT_TRUE(plain.ok()) << plain.error().message;
-  EXPECT_EQ(plain->resources, nullptr);
-  options.keep_resources = true;
-  Result<RenderResult> kept = renderPoints(*context_, s, camera, options);
-  ASSERT_TRUE(kept.ok()) << kept.error().message;
-  ASSERT_NE(kept->resources, nullptr);
-  Result<RenderResult> again = renderPoints(*context_, s, camera, options);  // while the first's are held
-  ASSERT_TRUE(again.ok()) << again.error().message;
-  EXPECT_NE(again->resources, kept->resources);
-  EXPECT_EQ(kept->image.rgba, plain->image.rgba);
-  EXPECT_EQ(again->image.rgba, plain->image.rgba);
-  kept->resources.reset();
-  again->resources.reset();
-}
-
 size_t litPixels(const Image& image, uint32_t background) {
   size_t lit = 0;
   for (size_t i = 0; i < image.rgba.size(); i += 4) {
