@@ -787,6 +787,72 @@ TEST(Ply, plyRejectsIndexOutOfRange) {
                                                    ": face 0: vertex index 4000000000 out of range"));
 }
 
+// Binary triangles (a uchar count of 3, 32-bit indices) are read in parallel blocks of about 80K
+// rows, up to the first row that is another polygon or names no vertex; the rows after are read one
+// at a time as before. Over several blocks and thread counts: the same triangles, a quad's fan, and
+// each error at its row and byte.
+TEST(Ply, binaryTrianglesAreReadInBlocksUpToTheFirstOtherRow) {
+  TempDir dir;
+  static constexpr uint32_t kVertices = 1000;
+  static constexpr uint64_t kFaces = 300000;  // four blocks
+  auto file = [&](const char* index_type, uint64_t quad_row, uint64_t bad_row, int64_t bad_index,
+                  std::vector<uint32_t>& expected, size_t& faces_at) {
+    Bytes b;
+    b.data = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kVertices) +
+             "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(kFaces) +
+             "\nproperty list uchar " + index_type + " vertex_indices\nend_header\n";
+    for (uint32_t v = 0; v < kVertices; ++v) b.add(double(v)).add(0.5).add(-1.0);
+    faces_at = b.data.size();
+    expected.clear();
+    for (uint64_t r = 0; r < kFaces; ++r) {
+      const auto at = [r](uint64_t k) { return static_cast<uint32_t>((r + k) % kVertices); };
+      const uint32_t a = at(0), c = at(1), d = at(7), e = at(3);
+      if (r == quad_row) {
+        b.add(uint8_t{4}).add(a).add(c).add(d).add(e);
+        expected.insert(expected.end(), {a, c, d, a, d, e});
+      } else if (r == bad_row) {
+        b.add(uint8_t{3}).add(a).add(static_cast<uint32_t>(bad_index)).add(d);
+      } else {
+        b.add(uint8_t{3}).add(a).add(c).add(d);
+        expected.insert(expected.end(), {a, c, d});
+      }
+    }
+    return b.data;
+  };
+  std::vector<uint32_t> expected;
+  size_t faces_at = 0;
+  for (unsigned threads : {1u, 2u, 4u}) {
+    PlyReadOptions options;
+    options.threads = threads;
+    for (const char* type : {"int", "uint"}) {
+      auto plain = readText(dir, "tri.ply", file(type, UINT64_MAX, UINT64_MAX, 0, expected, faces_at), options);
+      ASSERT_TRUE(plain.ok()) << plain.error().message;
+      EXPECT_EQ(plain->triangles, expected) << type << ", " << threads << " threads";
+      auto quad = readText(dir, "quad.ply", file(type, 200000, UINT64_MAX, 0, expected, faces_at), options);
+      ASSERT_TRUE(quad.ok()) << quad.error().message;
+      EXPECT_EQ(quad->triangles.size(), 3 * (kFaces + 1));
+      EXPECT_EQ(quad->triangles, expected) << type << ", " << threads << " threads";
+      auto far = readText(dir, "far.ply", file(type, UINT64_MAX, 250000, kVertices, expected, faces_at), options);
+      ASSERT_FALSE(far.ok());
+      EXPECT_TRUE(contains(far.error().message, "far.ply: byte " + std::to_string(faces_at + 250000 * 13) +
+                                                    ": face 250000: vertex index 1000 out of range (the file has 1000 vertices)"))
+          << far.error().message;
+    }
+    auto negative = readText(dir, "neg.ply", file("int", 100, 123456, -1, expected, faces_at), options);
+    ASSERT_FALSE(negative.ok());
+    EXPECT_TRUE(contains(negative.error().message, "neg.ply: byte " + std::to_string(faces_at + 123456 * 13 + 4) +
+                                                       ": face 123456: vertex index -1 out of range"))
+        << negative.error().message;
+    std::string cut = file("uint", UINT64_MAX, UINT64_MAX, 0, expected, faces_at);
+    cut.resize(cut.size() - 5);
+    auto truncated = readText(dir, "cut.ply", cut, options);
+    ASSERT_FALSE(truncated.ok());
+    EXPECT_TRUE(contains(truncated.error().message, "cut.ply: truncated at byte " + std::to_string(cut.size()) +
+                                                        ": expected 300000 'face' rows, the data ends in row 299999"))
+        << truncated.error().message;
+  }
+}
+
 // A renderer asks for points only: the vertices and colours come back, and reading stops before
 // the faces (a bad index there goes unseen, as the option says).
 TEST(Ply, pointsOnlyStopsAfterTheVertices) {
