@@ -26,6 +26,7 @@
 #include "core/interrupt.h"
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "core/random.h"
 #include "core/text.h"
 #include "ops/colormap.h"
 
@@ -355,20 +356,79 @@ double chooseOffset(const PositionArray& positions, int k, double min, double ma
 }
 
 // Distinct positions minus distinct integer triples at this scale and offset: how many points
-// would read back on top of another. Two sorts, 12 + 24 bytes a point for the time of the count.
-uint64_t mergedPoints(const PositionArray& positions, const glm::dvec3& scale, const glm::dvec3& offset) {
-  std::vector<std::array<double, 3>> exact(positions.size());
-  std::vector<std::array<int64_t, 3>> stored(positions.size());
-  for (size_t i = 0; i < positions.size(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      exact[i][static_cast<size_t>(k)] = positions[i][k];
-      stored[i][static_cast<size_t>(k)] = static_cast<int64_t>(quantize(positions[i][k], offset[k], scale[k]));
+// would read back on top of another. Points that merge share their triple, and equal positions
+// share it too, so the points are split into buckets by a hash of their triple (on all cores) and
+// each bucket, sorted on its own, counts its distinct positions less its distinct triples. 48 bytes
+// a point for the time of the count. (Two sorts of the whole set on one thread took 30% of writing
+// a 1.55M-point LAS on 2 cores.)
+uint64_t mergedPoints(const PositionArray& positions, const glm::dvec3& scale, const glm::dvec3& offset,
+                      unsigned threads) {
+  struct Entry {
+    std::array<int64_t, 3> stored;
+    std::array<double, 3> exact;
+  };
+  const size_t n = positions.size();
+  threads = resolveThreads(threads);
+  const size_t buckets = size_t{threads} * 64;
+  const size_t chunks = std::max<size_t>(1, std::min<size_t>((n + 65535) / 65536, size_t{threads} * 8));
+  const size_t chunk_points = (n + chunks - 1) / chunks;
+  auto stored = [&](size_t i) {
+    std::array<int64_t, 3> q;
+    for (int k = 0; k < 3; ++k) q[static_cast<size_t>(k)] = static_cast<int64_t>(quantize(positions[i][k], offset[k], scale[k]));
+    return q;
+  };
+  auto bucketOf = [&](const std::array<int64_t, 3>& q) {
+    const uint64_t h = splitmixMix(static_cast<uint64_t>(q[0]) ^
+                                   splitmixMix(static_cast<uint64_t>(q[1]) ^ splitmixMix(static_cast<uint64_t>(q[2]))));
+    return static_cast<size_t>(h % buckets);
+  };
+  // at[c · buckets + b]: where chunk c's points of bucket b go (bucket-major, then chunk order).
+  std::vector<size_t> at(chunks * buckets, 0);
+  parallelFor(chunks, threads, [&](size_t c, unsigned) {
+    for (size_t i = c * chunk_points, end = std::min(n, (c + 1) * chunk_points); i < end; ++i) ++at[c * buckets + bucketOf(stored(i))];
+  });
+  std::vector<size_t> bucket_start(buckets + 1, 0);
+  size_t sum = 0;
+  for (size_t b = 0; b < buckets; ++b) {
+    bucket_start[b] = sum;
+    for (size_t c = 0; c < chunks; ++c) {
+      const size_t count = at[c * buckets + b];
+      at[c * buckets + b] = sum;
+      sum += count;
     }
-  std::sort(exact.begin(), exact.end());
-  std::sort(stored.begin(), stored.end());
-  const uint64_t distinct = static_cast<uint64_t>(std::unique(exact.begin(), exact.end()) - exact.begin());
-  const uint64_t kept = static_cast<uint64_t>(std::unique(stored.begin(), stored.end()) - stored.begin());
-  return distinct - kept;
+  }
+  bucket_start[buckets] = sum;
+  std::vector<Entry, DefaultInitAllocator<Entry>> entries(n);  // every one written by the scatter
+  parallelFor(chunks, threads, [&](size_t c, unsigned) {
+    for (size_t i = c * chunk_points, end = std::min(n, (c + 1) * chunk_points); i < end; ++i) {
+      const std::array<int64_t, 3> q = stored(i);
+      entries[at[c * buckets + bucketOf(q)]++] = {q, {positions[i].x, positions[i].y, positions[i].z}};
+    }
+  });
+  std::atomic<uint64_t> merged{0};
+  parallelFor(buckets, threads, [&](size_t b, unsigned) {
+    const auto first = entries.begin() + static_cast<ptrdiff_t>(bucket_start[b]);
+    const auto last = entries.begin() + static_cast<ptrdiff_t>(bucket_start[b + 1]);
+    // Spelled out: std::array's == on the integers went to memcmp through the PLT (a quarter of the
+    // time of a 16.8M-point write).
+    auto same = [](const std::array<int64_t, 3>& u, const std::array<int64_t, 3>& v) {
+      return u[0] == v[0] && u[1] == v[1] && u[2] == v[2];
+    };
+    std::sort(first, last, [](const Entry& x, const Entry& y) {
+      for (size_t k = 0; k < 3; ++k)
+        if (x.stored[k] != y.stored[k]) return x.stored[k] < y.stored[k];
+      for (size_t k = 0; k < 3; ++k)
+        if (x.exact[k] != y.exact[k]) return x.exact[k] < y.exact[k];
+      return false;
+    });
+    uint64_t count = 0;
+    for (auto e = first; e != last; ++e)
+      if (e != first && same(e->stored, (e - 1)->stored) &&
+          (e->exact[0] != (e - 1)->exact[0] || e->exact[1] != (e - 1)->exact[1] || e->exact[2] != (e - 1)->exact[2]))
+        ++count;
+    merged += count;
+  });
+  return merged;
 }
 
 // Whether axis k's extent fits the 32-bit integers at `scale` from the offset the writer would
@@ -1007,7 +1067,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     // Points that read back as themselves cannot merge: the count's two sorts only run otherwise.
     bool exact = true;
     for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
-    options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset);
+    options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset, threads);
   }
   Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14);
   if (!layout) return layout.error();

@@ -157,6 +157,46 @@ const CorpusFile kCorpusFiles[] = {
     {"unregistered_extra_bytes.las", 4, 6, 34, 4, false},  // extra bytes without their VLR
 };
 
+// The merged-point count of an asked scale, over many chunks and buckets and any thread count,
+// against two whole sorts: 300K points on a 0.001 grid with copies, offsets below the scale (which
+// merge) and -0 beside 0 (which is the same position).
+TEST(Las, mergedPointsAreCountedAsTwoWholeSortsCountThem) {
+  TempDir dir;
+  PointSet set;
+  std::mt19937_64 rng(20261129);
+  std::uniform_int_distribution<int> cell(0, 40);
+  std::uniform_int_distribution<int> kind(0, 9);
+  for (size_t i = 0; i < 300000; ++i) {
+    glm::dvec3 p(cell(rng) * 0.001, cell(rng) * 0.001 + 100.0, cell(rng) * 0.001 - 5.0);
+    const int k = kind(rng);
+    if (k == 0) p.x += 0.0001 * (1 + kind(rng));  // another position on the same integers
+    if (k == 1 && p.x == 0.0) p.x = -0.0;
+    set.positions.push_back(p);
+  }
+  std::vector<std::array<double, 3>> exact;
+  std::vector<std::array<int64_t, 3>> stored;
+  for (const glm::dvec3& p : set.positions) {
+    exact.push_back({p.x, p.y, p.z});
+    stored.push_back({static_cast<int64_t>(std::round(p.x / 0.001)), static_cast<int64_t>(std::round((p.y - 100.0) / 0.001)),
+                      static_cast<int64_t>(std::round((p.z + 5.0) / 0.001))});
+  }
+  std::sort(exact.begin(), exact.end());
+  std::sort(stored.begin(), stored.end());
+  const auto distinct_exact = std::unique(exact.begin(), exact.end()) - exact.begin();
+  const auto distinct_stored = std::unique(stored.begin(), stored.end()) - stored.begin();
+  const uint64_t expected = static_cast<uint64_t>(distinct_exact - distinct_stored);
+  ASSERT_GT(expected, 1000u);
+  for (unsigned threads : {1u, 2u, 4u}) {
+    LasWriteReport report;
+    LasWriteOptions options;
+    options.scale = 0.001;
+    options.threads = threads;
+    options.report = &report;
+    ASSERT_TRUE(writeLas(dir.file("m.las"), set, options).ok());
+    EXPECT_EQ(report.merged_points, expected) << threads << " threads";
+  }
+}
+
 TEST(Las, readsEveryCorpusFileWithItsCountAndFormat) {
   for (const CorpusFile& f : kCorpusFiles) {
     SCOPED_TRACE(f.name);
