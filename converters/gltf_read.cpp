@@ -11,6 +11,7 @@
 #include "converters/gltf_read.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <glm/mat4x4.hpp>
@@ -27,6 +28,7 @@
 #include "converters/gltf_texture.h"
 #include "core/interrupt.h"
 #include "core/memory.h"
+#include "core/parallel.h"
 
 namespace dpoint {
 namespace {
@@ -531,6 +533,26 @@ class SceneReader {
   // the vertices it names marked in `remap` (sized vertex_count, kUnused elsewhere); nullopt when
   // the primitive is not indexed. The elements are read again for triangles rather than kept as
   // a copy: for large meshes that copy was the size of the output's triangle list.
+  // The smallest i < n for which failing(i) holds, else n. failing runs on all cores in chunks
+  // (inline for a small primitive), is called for every i below the one returned, and must be safe
+  // to call from several threads at once: its side effects go to slots of their own.
+  template <typename Failing>
+  size_t firstFailing(size_t n, const Failing& failing) const {
+    constexpr size_t kChunk = size_t{1} << 14;
+    std::atomic<size_t> first{n};
+    parallelFor((n + kChunk - 1) / kChunk, options_.threads, [&](size_t c, unsigned) {
+      for (size_t i = c * kChunk, end = std::min(n, i + kChunk); i < end; ++i) {
+        if (i > first.load(std::memory_order_relaxed)) return;
+        if (!failing(i)) continue;
+        size_t seen = first.load();
+        while (i < seen && !first.compare_exchange_weak(seen, i)) {
+        }
+        return;
+      }
+    });
+    return first.load();
+  }
+
   Result<std::optional<AccessorElements>> readIndices(const tinygltf::Primitive& primitive, size_t vertex_count,
                                                       std::vector<uint32_t>& remap) const {
     if (primitive.indices == -1) return std::optional<AccessorElements>();  // tinygltf's "no indices"
@@ -543,14 +565,18 @@ class SceneReader {
       return decoder_.fail(primitive.indices, "indices must be unsigned byte, short or int SCALAR, not componentType " +
                                                   std::to_string(ct));
     remap.assign(vertex_count, kUnused);
-    for (size_t e = 0; e < elements->count(); ++e) {
-      const double v = elements->value(e, 0);  // an unsigned integer < 2^32, exact in double
-      if (v >= double(vertex_count))
-        return decoder_.fail(primitive.indices, "element " + std::to_string(e) + " is " +
-                                                    std::to_string(uint64_t(v)) + ", out of range for " +
-                                                    std::to_string(vertex_count) + " vertices");
-      remap[size_t(v)] = 0;
-    }
+    // On all cores; the first index out of range (by element) is the one named.
+    const AccessorElements& indices = *elements;
+    const size_t bad = firstFailing(indices.count(), [&](size_t e) {
+      const double v = indices.value(e, 0);  // an unsigned integer < 2^32, exact in double
+      if (v >= double(vertex_count)) return true;
+      std::atomic_ref<uint32_t>(remap[size_t(v)]).store(0, std::memory_order_relaxed);  // used
+      return false;
+    });
+    if (bad < indices.count())
+      return decoder_.fail(primitive.indices, "element " + std::to_string(bad) + " is " +
+                                                  std::to_string(uint64_t(indices.value(bad, 0))) + ", out of range for " +
+                                                  std::to_string(vertex_count) + " vertices");
     return std::optional<AccessorElements>(std::move(*elements));
   }
 
@@ -587,17 +613,23 @@ class SceneReader {
       // A mesh placed by many nodes or instances multiplies the set without more file.
       if (Status s = checkSetMemory(emitted_total_, out_.triangles.size()); !s) return s;
       reserveMore(out_.positions, emitted);
+      out_.positions.resize(begin + emitted);  // unset: every used vertex is placed below, or this fails
     }
-    for (size_t e = 0; e < count; ++e) {
-      if (!remap.empty() && remap[e] == kUnused) continue;
+    // On all cores, each used vertex to its slot (the remap numbers them in element order); the
+    // first that is not finite (by element) is the one named.
+    const bool build = pass_ == Pass::kBuild;
+    const size_t bad = firstFailing(count, [&](size_t e) {
+      if (!remap.empty() && remap[e] == kUnused) return false;
       const glm::dvec3 w = placeVertex(*positions, world, e);
-      if (!options_.allow_nonfinite && (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))) {
-        const glm::dvec3 local = positions->local(e);
-        const bool local_finite = std::isfinite(local.x + local.y + local.z);
-        return decoder_.fail(position_index, "POSITION element " + std::to_string(e) + " is not finite" +
-                                                 (local_finite ? " in world space" : ""));
-      }
-      if (pass_ == Pass::kBuild) out_.positions.push_back(w);
+      if (!options_.allow_nonfinite && (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z))) return true;
+      if (build) out_.positions[begin + (remap.empty() ? e : remap[e])] = w;
+      return false;
+    });
+    if (bad < count) {
+      const glm::dvec3 local = positions->local(bad);
+      const bool local_finite = std::isfinite(local.x + local.y + local.z);
+      return decoder_.fail(position_index, "POSITION element " + std::to_string(bad) + " is not finite" +
+                                               (local_finite ? " in world space" : ""));
     }
     if (Status s = readColours(primitive, pointer, remap, count, begin, begin + emitted); !s) return s;
     Result<std::vector<DimensionSource>> sources = openDimensions(primitive, count);
@@ -638,8 +670,14 @@ class SceneReader {
       added = 3 * (n - 2);
     if (Status s = checkSetMemory(emitted_total_, out_.triangles.size() + added); !s) return s;
     reserveMore(out_.triangles, added);
-    if (primitive.mode == TINYGLTF_MODE_TRIANGLES) {
-      for (size_t i = 0; i + 3 <= n; i += 3) triangle(i, i + 1, i + 2);
+    if (primitive.mode == TINYGLTF_MODE_TRIANGLES) {  // on all cores, each triangle to its slot
+      const size_t first = out_.triangles.size();
+      out_.triangles.resize(first + added);
+      uint32_t* out = out_.triangles.data() + first;
+      (void)firstFailing(added / 3, [&](size_t t) {
+        for (size_t k = 0; k < 3; ++k) out[3 * t + k] = vertex(3 * t + k);
+        return false;
+      });
     } else if (primitive.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
       for (size_t i = 0; i + 3 <= n; ++i) triangle(i, i + 1 + i % 2, i + 2 - i % 2);
     } else if (primitive.mode == TINYGLTF_MODE_TRIANGLE_FAN) {

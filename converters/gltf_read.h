@@ -53,6 +53,7 @@ struct GltfReadOptions {
   // sampler (ops/mesh_texture.h): each vertex's TEXCOORD (float or normalized (u)byte/(u)short
   // VEC2, through KHR_texture_transform) and each triangle's image, decoded (gltf_texture.h).
   MeshTexture* texture = nullptr;
+  unsigned threads = 0;      // cores for a large primitive's vertices, indices and triangles (0: all)
 };
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});

@@ -138,6 +138,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
       gltf.allow_nonfinite = options.allow_nonfinite;
       gltf.max_memory = options.max_memory;
       gltf.texture = options.texture;
+      gltf.threads = options.threads;
       return readGltf(path, gltf);
     }
     case FileFormat::kLas:
