@@ -766,17 +766,22 @@ class SceneReader {
       return decoder_.fail(index, "COLOR_0 count " + std::to_string(colours->count()) + " differs from POSITION count " +
                                       std::to_string(count));
     any_colour_ = true;
-    if (pass_ == Pass::kBuild) {
+    const bool build = pass_ == Pass::kBuild;
+    if (build) {
       out_.colors.resize(emitted_begin);  // earlier uncoloured primitives are filled at the end
       reserveMore(out_.colors, emitted_end - emitted_begin);
+      out_.colors.resize(emitted_end);  // unset: every used vertex's colour is set below, or this fails
     }
-    for (size_t e = 0; e < count; ++e) {
-      if (!remap.empty() && remap[e] == kUnused) continue;
-      const glm::vec3 c = vertexColour(*colours, e);
-      if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b))
-        return decoder_.fail(index, "COLOR_0 element " + std::to_string(e) + " is not finite");
-      if (pass_ == Pass::kBuild) out_.colors.push_back(c);
-    }
+    // On all cores, like the positions; the first colour that is not finite (by element) is named.
+    const AccessorElements& elements = *colours;
+    const size_t bad = firstFailing(count, [&](size_t e) {
+      if (!remap.empty() && remap[e] == kUnused) return false;
+      const glm::vec3 c = vertexColour(elements, e);
+      if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b)) return true;
+      if (build) out_.colors[emitted_begin + (remap.empty() ? e : remap[e])] = c;
+      return false;
+    });
+    if (bad < count) return decoder_.fail(index, "COLOR_0 element " + std::to_string(bad) + " is not finite");
     return okStatus();
   }
 

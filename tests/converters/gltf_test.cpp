@@ -258,49 +258,69 @@ std::string fixtureGltf() {
 }
 
 // A primitive larger than the reader's chunks (16,384 elements): 40,000 float positions and
-// 50,000 triangles of uint32 indices over the even vertices only (the odd ones are unused and
-// dropped), read on 1, 2 and 4 cores: the same set, and of two bad elements the first is named.
+// colours and 50,000 triangles of uint32 indices over the even vertices only (the odd ones are
+// unused and dropped), read on 1, 2 and 4 cores: the same set, and of two bad indices, positions
+// or colours the first is named (a bad colour on an unused vertex is not read).
 TEST(Gltf, aLargePrimitiveIsReadOnAllCoresWithTheFirstBadElementNamed) {
   constexpr uint32_t kVertices = 40000, kTriangles = 50000;
-  auto gltf = [&](const std::vector<float>& positions, const std::vector<uint32_t>& indices) {
-    std::vector<unsigned char> bytes(positions.size() * 4 + indices.size() * 4);
-    std::memcpy(bytes.data(), positions.data(), positions.size() * 4);
-    std::memcpy(bytes.data() + positions.size() * 4, indices.data(), indices.size() * 4);
-    const std::string p = std::to_string(positions.size() * 4), i = std::to_string(indices.size() * 4);
+  auto gltf = [&](const std::vector<float>& positions, const std::vector<float>& colours,
+                  const std::vector<uint32_t>& indices) {
+    std::vector<unsigned char> bytes;
+    auto add = [&](const void* data, size_t n) {
+      const auto* b = static_cast<const unsigned char*>(data);
+      bytes.insert(bytes.end(), b, b + n);
+    };
+    add(positions.data(), positions.size() * 4);
+    add(colours.data(), colours.size() * 4);
+    add(indices.data(), indices.size() * 4);
+    const std::string p = std::to_string(positions.size() * 4), c = std::to_string(colours.size() * 4),
+                      pc = std::to_string((positions.size() + colours.size()) * 4), i = std::to_string(indices.size() * 4);
     return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 4}]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 2}, "indices": 1, "mode": 4}]}],
   "accessors": [
     {"bufferView": 0, "componentType": 5126, "count": )" + std::to_string(kVertices) + R"(, "type": "VEC3"},
-    {"bufferView": 1, "componentType": 5125, "count": )" + std::to_string(indices.size()) + R"(, "type": "SCALAR"}],
+    {"bufferView": 2, "componentType": 5125, "count": )" + std::to_string(indices.size()) + R"(, "type": "SCALAR"},
+    {"bufferView": 1, "componentType": 5126, "count": )" + std::to_string(kVertices) + R"(, "type": "VEC3"}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": )" + p + R"(},
-                  {"buffer": 0, "byteOffset": )" + p + R"(, "byteLength": )" + i + R"(}],
+                  {"buffer": 0, "byteOffset": )" + p + R"(, "byteLength": )" + c + R"(},
+                  {"buffer": 0, "byteOffset": )" + pc + R"(, "byteLength": )" + i + R"(}],
   "buffers": [{"byteLength": )" + std::to_string(bytes.size()) + R"(, "uri": "data:application/octet-stream;base64,)" +
            base64(bytes) + R"("}]})";
   };
-  std::vector<float> positions;
-  for (uint32_t v = 0; v < kVertices; ++v) positions.insert(positions.end(), {float(v), 0.5f * float(v % 97), -2.0f});
+  std::vector<float> positions, colours;
+  for (uint32_t v = 0; v < kVertices; ++v) {
+    positions.insert(positions.end(), {float(v), 0.5f * float(v % 97), -2.0f});
+    colours.insert(colours.end(), {float(v % 11) / 10.0f, 0.25f, float(v % 5) / 4.0f});
+  }
   std::vector<uint32_t> indices;
   for (uint32_t t = 0; t < kTriangles; ++t)
     for (uint32_t k : {0u, 1u, 5u}) indices.push_back(2 * ((t + k) % (kVertices / 2)));
   PositionArray expected_positions;  // the even vertices, renumbered in order
-  for (uint32_t v = 0; v < kVertices; v += 2) expected_positions.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+  ColorArray expected_colours;
+  for (uint32_t v = 0; v < kVertices; v += 2) {
+    expected_positions.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+    expected_colours.emplace_back(colours[3 * v], colours[3 * v + 1], colours[3 * v + 2]);
+  }
   std::vector<uint32_t> expected_triangles;
   for (uint32_t i : indices) expected_triangles.push_back(i / 2);
   TempDir dir;
-  for (unsigned threads : {1u, 2u, 4u}) {
+  auto read = [&](const std::string& name, const std::string& text, unsigned threads) {
     GltfReadOptions options;
     options.threads = threads;
-    writeFile(dir.file("big.gltf"), gltf(positions, indices));
-    Result<PointSet> set = readGltf(dir.file("big.gltf"), options);
+    writeFile(dir.file(name), text);
+    return readGltf(dir.file(name), options);
+  };
+  for (unsigned threads : {1u, 2u, 4u}) {
+    Result<PointSet> set = read("big.gltf", gltf(positions, colours, indices), threads);
     ASSERT_TRUE(set.ok()) << set.error().message;
     EXPECT_EQ(set->positions, expected_positions) << threads << " threads";
+    EXPECT_EQ(set->colors, expected_colours) << threads << " threads";
     EXPECT_EQ(set->triangles, expected_triangles) << threads << " threads";
 
     std::vector<uint32_t> bad_indices = indices;
     bad_indices[140000] = kVertices + 5;
     bad_indices[30001] = kVertices;
-    writeFile(dir.file("bad.gltf"), gltf(positions, bad_indices));
-    Result<PointSet> bad = readGltf(dir.file("bad.gltf"), options);
+    Result<PointSet> bad = read("bad.gltf", gltf(positions, colours, bad_indices), threads);
     ASSERT_FALSE(bad.ok());
     EXPECT_NE(bad.error().message.find("/accessors/1: element 30001 is 40000, out of range for 40000 vertices"),
               std::string::npos) << bad.error().message;
@@ -308,11 +328,19 @@ TEST(Gltf, aLargePrimitiveIsReadOnAllCoresWithTheFirstBadElementNamed) {
     std::vector<float> nan_positions = positions;
     nan_positions[3 * 39000 + 1] = std::numeric_limits<float>::quiet_NaN();
     nan_positions[3 * 25000 + 2] = std::numeric_limits<float>::infinity();
-    writeFile(dir.file("nan.gltf"), gltf(nan_positions, indices));
-    Result<PointSet> nan = readGltf(dir.file("nan.gltf"), options);
+    Result<PointSet> nan = read("nan.gltf", gltf(nan_positions, colours, indices), threads);
     ASSERT_FALSE(nan.ok());
     EXPECT_NE(nan.error().message.find("/accessors/0: POSITION element 25000 is not finite"), std::string::npos)
         << nan.error().message;
+
+    std::vector<float> nan_colours = colours;
+    nan_colours[3 * 36000] = std::numeric_limits<float>::quiet_NaN();
+    nan_colours[3 * 33001] = std::numeric_limits<float>::quiet_NaN();  // odd: an unused vertex, not read
+    nan_colours[3 * 33002 + 2] = std::numeric_limits<float>::quiet_NaN();
+    Result<PointSet> dark = read("dark.gltf", gltf(positions, nan_colours, indices), threads);
+    ASSERT_FALSE(dark.ok());
+    EXPECT_NE(dark.error().message.find("/accessors/2: COLOR_0 element 33002 is not finite"), std::string::npos)
+        << dark.error().message;
   }
 }
 
