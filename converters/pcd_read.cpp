@@ -7,6 +7,9 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
+#include <mutex>
+#include <atomic>
 #include <unordered_set>
 
 #include <fast_float/fast_float.h>
@@ -22,7 +25,8 @@ namespace {
 
 constexpr size_t kMaxHeader = size_t{1} << 20;  // a header longer than this is not a PCD file
 constexpr uint64_t kBlock = uint64_t{1} << 16;   // points per decoded block
-constexpr size_t kAsciiChunk = size_t{4} << 20;
+constexpr size_t kAsciiChunk = size_t{4} << 20;  // bytes of ASCII data per block
+constexpr size_t kAsciiMaxLineBytes = size_t{4} << 20;
 // Values per point at most (PCL's widest descriptors, SHOT colour, have 1,344).
 constexpr size_t kMaxValues = 65536;
 
@@ -553,71 +557,170 @@ class Reader {
   }
 
   // ASCII rows, one point per non-empty line, on one thread.
+  // ASCII rows on all cores, in blocks of the data. A first pass counts each block's lines and rows
+  // (lines neither blank nor a # comment; a line belongs to the block it starts in), so that each
+  // block knows its first line's number and its first row's point; the second parses its rows into
+  // their points. Each block stops at its first error and the first by line is reported, as reading
+  // the lines in order found it.
   Status readAscii(Columns& columns, uint64_t n) {
     std::vector<std::pair<const Field*, uint32_t>> slots;  // value column → field and component
     for (const Field& f : h_.fields)
       for (uint32_t c = 0; c < f.count; ++c) slots.emplace_back(&f, c);
-    std::string buffer;
-    uint64_t offset = h_.data_offset, line = h_.lines, point = 0;
-    std::string carry;
-    std::vector<std::string_view> tokens;
-    uint8_t value[8];
-    bool end_of_file = false;
-    while (!end_of_file) {
-      buffer.resize(kAsciiChunk);
-      Result<size_t> got = file_.readAt(offset, buffer.data(), buffer.size());
-      if (!got) return got.error();
-      buffer.resize(*got);
-      offset += *got;
-      end_of_file = *got == 0;
-      std::string text = std::move(carry);
-      text += buffer;
-      size_t pos = 0;
-      while (true) {
-        size_t end = text.find('\n', pos);
-        if (end == std::string::npos) {
-          if (!end_of_file) break;
-          if (pos >= text.size()) break;
-          end = text.size();
-        }
-        const std::string_view row(text.data() + pos, end - pos);
-        pos = end + 1;
-        ++line;
-        tokens = tokensOf(row);
-        if (tokens.empty() || tokens[0][0] == '#') continue;
-        if (point == n)
-          return Error{path_ + ": line " + std::to_string(line) + ": more rows than the header's POINTS " + std::to_string(n)};
-        if (tokens.size() != slots.size())
-          return Error{path_ + ": line " + std::to_string(line) + ": " + std::to_string(tokens.size()) +
-                       " values; the header's fields need " + std::to_string(slots.size())};
-        for (size_t k = 0; k < slots.size(); ++k) {
-          const auto [field, component] = slots[k];
-          if (field->role == Role::kSkip) continue;
-          if (Status s = parseValue(*field, tokens[k], value); !s)
-            return Error{path_ + ": line " + std::to_string(line) + ", column " + std::to_string(k + 1) + " (field " +
-                         quotedExcerpt(field->name) + "): " + quotedExcerpt(tokens[k]) + " " + s.error().message};
-          if (field->role == Role::kDimension) {
-            const size_t w = static_cast<size_t>(field->size);
-            std::memcpy(columns.dimension(field->dimension + component) + point * w, value, w);
-          } else {
-            columns.store(*field, value, static_cast<size_t>(point));
-          }
-        }
-        if (const glm::dvec3& p = columns.position(static_cast<size_t>(point)); isInfinite(p))
-          if (Status s = checkFinite(p, "line " + std::to_string(line) + ": point " + std::to_string(point)); !s) return s;
-        ++point;
-        if (options_.progress && point % kBlock == 0) options_.progress->advance(kBlock);
+    const uint64_t begin = h_.data_offset, size = file_.size();
+    const size_t blocks = static_cast<size_t>((size - std::min(begin, size) + kAsciiChunk - 1) / kAsciiChunk);
+    const unsigned threads = resolveThreads(options_.threads);
+    std::vector<std::string> buffers(threads);
+    auto isBlankByte = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    // Reads block b with the byte before it and up to a longest line after it; calls line(text, k)
+    // for the k-th line starting in the block (text without its newline) until it returns false.
+    // Returns false, with `long_line` the index k, where a line does not end within kAsciiMaxLineBytes.
+    auto forEachLine = [&](size_t b, unsigned worker, const auto& line, std::optional<uint64_t>& long_line,
+                           Status& io) -> bool {
+      const uint64_t start = begin + b * kAsciiChunk, stop_at = std::min<uint64_t>(start + kAsciiChunk, size);
+      const uint64_t read_start = start == begin ? start : start - 1;
+      const uint64_t read_end = std::min<uint64_t>(stop_at + kAsciiMaxLineBytes + 1, size);
+      std::string& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>(read_end - read_start));
+      Result<size_t> got = file_.readAt(read_start, buffer.data(), buffer.size());
+      if (!got) {
+        io = got.error();
+        return false;
       }
-      carry.assign(text, std::min(pos, text.size()), std::string::npos);
+      if (*got != buffer.size()) {  // the file shrank since it was opened
+        io = Error{path_ + ": the file changed while it was read (shorter than when it was opened)"};
+        return false;
+      }
+      const char* data = buffer.data();
+      const char* stop = data + (stop_at - read_start);  // lines must start before this
+      const char* end = data + buffer.size();
+      const char* p = data;
+      if (read_start != start) {
+        ++p;
+        if (data[0] != '\n') {  // the line at `start` began in the block before
+          const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(stop - p)));
+          if (!nl) return true;  // no line starts in this block
+          p = nl + 1;
+        }
+      }
+      for (uint64_t k = 0; p < stop; ++k) {
+        const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<size_t>(end - p)));
+        if (!nl && read_end < size) {
+          long_line = k;
+          return false;
+        }
+        const char* line_end = nl ? nl : end;
+        if (!line(std::string_view(p, static_cast<size_t>(line_end - p)), k)) return false;
+        if (!nl) break;
+        p = nl + 1;
+      }
+      return true;
+    };
+    auto isRow = [&](std::string_view text) {
+      size_t i = 0;
+      while (i < text.size() && isBlankByte(text[i])) ++i;
+      return i < text.size() && text[i] != '#';
+    };
+
+    // Pass 1: lines and rows per block; a line too long stops the count there.
+    std::vector<uint64_t> lines(blocks + 1, 0), rows(blocks + 1, 0);
+    std::vector<std::optional<uint64_t>> long_line(blocks);
+    std::vector<Status> io(blocks, okStatus());
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      forEachLine(
+          b, worker,
+          [&](std::string_view text, uint64_t) {
+            ++lines[b + 1];
+            rows[b + 1] += isRow(text) ? 1 : 0;
+            return true;
+          },
+          long_line[b], io[b]);
+    });
+    for (size_t b = 0; b < blocks; ++b) {
+      if (!io[b]) return io[b];
+      lines[b + 1] += lines[b];
+      rows[b + 1] += rows[b];
     }
-    if (point < n)
-      return Error{path_ + ": line " + std::to_string(line) + ": the file ends after " + std::to_string(point) + " of the " +
-                   std::to_string(n) + " points the header declares"};
+    // Lines from a too-long one on are not read; it is the error unless one before it fails.
+    size_t last_block = blocks;
+    uint64_t long_at = UINT64_MAX;  // its line number
+    for (size_t b = 0; b < blocks && last_block == blocks; ++b)
+      if (long_line[b]) {
+        last_block = b;
+        long_at = h_.lines + lines[b] + *long_line[b] + 1;
+      }
+
+    // Pass 2: each block's rows into their points.
+    std::mutex error_mutex;
+    std::optional<std::pair<uint64_t, Error>> first_error;  // line, error
+    std::atomic<uint64_t> error_line{UINT64_MAX};
+    auto fail = [&](uint64_t line, Error e) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!first_error || line < first_error->first) {
+        error_line = line;
+        first_error = std::make_pair(line, std::move(e));
+      }
+    };
+    parallelFor(std::min(blocks, last_block + 1), threads, [&](size_t b, unsigned worker) {
+      if (h_.lines + lines[b] + 1 > error_line.load()) return;
+      std::vector<std::string_view> tokens;
+      uint8_t value[8];
+      uint64_t point = rows[b];
+      std::optional<uint64_t> unused_long;
+      Status unused_io = okStatus();
+      forEachLine(
+          b, worker,
+          [&](std::string_view text, uint64_t k) -> bool {
+            const uint64_t line = h_.lines + lines[b] + k + 1;
+            if (line >= long_at) return false;
+            if (!isRow(text)) return true;
+            tokens = tokensOf(text);
+            if (point == n) {
+              fail(line, Error{path_ + ": line " + std::to_string(line) + ": more rows than the header's POINTS " +
+                               std::to_string(n)});
+              return false;
+            }
+            if (tokens.size() != slots.size()) {
+              fail(line, Error{path_ + ": line " + std::to_string(line) + ": " + std::to_string(tokens.size()) +
+                               " values; the header's fields need " + std::to_string(slots.size())});
+              return false;
+            }
+            for (size_t t = 0; t < slots.size(); ++t) {
+              const auto [field, component] = slots[t];
+              if (field->role == Role::kSkip) continue;
+              if (Status s = parseValue(*field, tokens[t], value); !s) {
+                fail(line, Error{path_ + ": line " + std::to_string(line) + ", column " + std::to_string(t + 1) +
+                                 " (field " + quotedExcerpt(field->name) + "): " + quotedExcerpt(tokens[t]) + " " +
+                                 s.error().message});
+                return false;
+              }
+              if (field->role == Role::kDimension) {
+                const size_t w = static_cast<size_t>(field->size);
+                std::memcpy(columns.dimension(field->dimension + component) + point * w, value, w);
+              } else {
+                columns.store(*field, value, static_cast<size_t>(point));
+              }
+            }
+            if (const glm::dvec3& p = columns.position(static_cast<size_t>(point)); isInfinite(p))
+              if (Status s = checkFinite(p, "line " + std::to_string(line) + ": point " + std::to_string(point)); !s) {
+                fail(line, s.error());
+                return false;
+              }
+            ++point;
+            return true;
+          },
+          unused_long, unused_io);
+      if (options_.progress) options_.progress->advance(point - rows[b]);
+    });
+    if (first_error) return first_error->second;
+    if (long_at != UINT64_MAX)
+      return Error{path_ + ": line " + std::to_string(long_at) + ": longer than " + std::to_string(kAsciiMaxLineBytes) +
+                   " bytes"};
+    if (rows[blocks] < n)
+      return Error{path_ + ": line " + std::to_string(h_.lines + lines[blocks]) + ": the file ends after " +
+                   std::to_string(rows[blocks]) + " of the " + std::to_string(n) + " points the header declares"};
     return okStatus();
   }
 
-  // One ASCII value as the bytes of the field's type. A packed colour of TYPE F is the float whose
-  // bits are the colour (as PCL reads it); of TYPE U or I the integer.
   static Status parseValue(const Field& f, std::string_view token, uint8_t* out) {
     const char* b = token.data();
     const char* e = b + token.size();

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -219,6 +220,69 @@ TEST(Pcd, oldHeadersAndAsciiSpellingsRead) {
   Result<PointSet> rgb = readPcd(dir.file("rgb.pcd"));
   ASSERT_TRUE(rgb.ok()) << rgb.error().message;
   EXPECT_EQ(rgb->colors[0], glm::vec3(0, 1, 0));  // 0x0000FF00
+}
+
+// ASCII data is read in 4 MiB blocks on all cores: over three blocks, with blank and comment
+// lines among the rows, every thread count gives the same points, and of several bad lines in
+// different blocks the first is named with its line number, as a reading in order names it.
+TEST(Pcd, asciiRowsAreReadInBlocksWithTheFirstBadLineNamed) {
+  TempDir dir;
+  constexpr size_t kRows = 300000;  // about 10 MB
+  std::vector<std::string> lines;
+  PositionArray expected;
+  for (size_t i = 0; i < kRows; ++i) {
+    if (i % 1000 == 7) lines.push_back(i % 2000 == 7 ? "" : "# a comment");
+    const double x = 0.125 * double(i), y = -2.5 + double(i % 13), z = 1e6 + double(i % 7) * 0.25;
+    char row[96];
+    std::snprintf(row, sizeof row, "%.17g %.17g %.17g 0.75", x, y, z);
+    lines.push_back(row);
+    expected.emplace_back(x, y, z);
+  }
+  auto file = [&](size_t points, const std::vector<std::pair<size_t, std::string>>& replaced) {
+    std::vector<std::string> body = lines;
+    for (const auto& [at, text] : replaced) body[at] = text;
+    std::string text = "VERSION 0.7\nFIELDS x y z intensity\nSIZE 8 8 8 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " +
+                       std::to_string(points) + "\nHEIGHT 1\nPOINTS " + std::to_string(points) + "\nDATA ascii\n";
+    for (const std::string& l : body) text += l + "\n";
+    return text;
+  };
+  // Data line k (0-based in `lines`) is file line 9 + k + 1.
+  auto lineOf = [](size_t k) { return std::to_string(10 + k); };
+  const size_t deep = lines.size() - 1000, early = lines.size() / 2;
+  ASSERT_FALSE(lines[deep].empty() || lines[deep][0] == '#' || lines[early].empty() || lines[early][0] == '#');
+  for (unsigned threads : {1u, 2u, 4u}) {
+    PcdReadOptions options;
+    options.threads = threads;
+    auto read = [&](const std::string& text) {
+      writeFile(dir.file("a.pcd"), text);
+      return readPcd(dir.file("a.pcd"), options);
+    };
+    Result<PointSet> good = read(file(kRows, {}));
+    ASSERT_TRUE(good.ok()) << good.error().message;
+    EXPECT_EQ(good->positions, expected) << threads << " threads";
+    ASSERT_NE(good->dimensions.find("intensity"), nullptr);
+    EXPECT_EQ(good->dimensions.find("intensity")->value(kRows - 1), 0.75);
+
+    Result<PointSet> bad = read(file(kRows, {{deep, "1 2 3 4 5"}, {early, "1 five 3 4"}}));
+    ASSERT_FALSE(bad.ok());
+    EXPECT_TRUE(contains(bad.error().message, "a.pcd: line " + lineOf(early) + ", column 2 (field 'y'): 'five' is not a number"))
+        << bad.error().message;
+    Result<PointSet> count = read(file(kRows, {{deep, "1 2 3"}}));
+    ASSERT_FALSE(count.ok());
+    EXPECT_TRUE(contains(count.error().message, "a.pcd: line " + lineOf(deep) + ": 3 values; the header's fields need 4"))
+        << count.error().message;
+    Result<PointSet> more = read(file(kRows - 1, {}));
+    ASSERT_FALSE(more.ok());
+    EXPECT_TRUE(contains(more.error().message, "a.pcd: line " + lineOf(lines.size() - 1) +
+                                                   ": more rows than the header's POINTS " + std::to_string(kRows - 1)))
+        << more.error().message;
+    Result<PointSet> fewer = read(file(kRows + 5, {}));
+    ASSERT_FALSE(fewer.ok());
+    EXPECT_TRUE(contains(fewer.error().message, "a.pcd: line " + lineOf(lines.size() - 1) + ": the file ends after " +
+                                                    std::to_string(kRows) + " of the " + std::to_string(kRows + 5) +
+                                                    " points the header declares"))
+        << fewer.error().message;
+  }
 }
 
 TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
