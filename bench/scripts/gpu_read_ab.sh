@@ -9,15 +9,16 @@
 #   mesh  `mandelbulb --variant fast --resolution MESH_RES --device 0` (2048: 108M vertices, 207M
 #         triangles, 5.6 GB PLY)
 #   gltf  the same at GLTF_RES (1024: 27M vertices, a 1.18 GB GLB with COLOR_0 and uint32 indices)
+#   pcd   the las set's 16.8M points as an ASCII PCD (x y z rgb)
 # Rows in $OUT/read.tsv, medians in $OUT/read-summary.tsv.
-#   SETS="las mesh gltf" BASE=a968b90 ROUNDS=3 WRITE=1 MESH_RES=2048 GLTF_RES=1024
+#   SETS="las mesh gltf pcd" BASE=a968b90 ROUNDS=3 WRITE=1 MESH_RES=2048 GLTF_RES=1024
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 data=/tmp/dpoint-read
 mkdir -p "$data"
 rows=$out/read.tsv
 printf 'round\tset\tbuild\tread_s\tprocess_s\tpeak_kb\twrite_process_s\n' >"$rows"
-for set in ${SETS:-las mesh gltf}; do
+for set in ${SETS:-las mesh gltf pcd}; do
   case $set in
     las)
       [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
@@ -31,6 +32,10 @@ for set in ${SETS:-las mesh gltf}; do
       [ -s "$data/mb${GLTF_RES:-1024}.ply" ] ||
         .gpu/dpoint generate mandelbulb --variant fast --resolution "${GLTF_RES:-1024}" --device 0 -q -o "$data/mb${GLTF_RES:-1024}.ply"
       [ -s "$file" ] || .gpu/dpoint convert "$data/mb${GLTF_RES:-1024}.ply" -q -o "$file" ;;
+    pcd)
+      [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
+      file=$data/s11u-ascii.pcd
+      [ -s "$file" ] || .gpu/dpoint convert "$data/s11u.ply" --pcd-encoding ascii -q -o "$file" ;;
     *) echo "unknown set $set" >&2; exit 2 ;;
   esac
   ls -l "$file" | tee -a "$out/sizes.txt"
