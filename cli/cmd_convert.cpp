@@ -47,6 +47,7 @@ GltfReadOptions gltfOptions(const ConvertOptions& o) {
   g.all_scenes = o.all_scenes;
   g.allow_nonfinite = o.allow_nonfinite;
   g.max_points = o.max_points;
+  g.threads = o.common.threads;
   return g;
 }
 

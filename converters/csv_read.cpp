@@ -549,6 +549,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
 
   // Pass 1: line ends per block.
   std::vector<uint64_t> newlines(blocks + 1, 0);
+  std::vector<char> block_last(blocks, 0);  // each block's last byte, which decides where the next block's first line starts
   std::vector<std::optional<Error>> io_errors(blocks);
   {
     std::vector<std::vector<char>> buffers(threads);
@@ -563,6 +564,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
         return;
       }
       newlines[b + 1] = static_cast<uint64_t>(std::count(buffer.data(), buffer.data() + *got, '\n'));
+      if (*got > 0) block_last[b] = buffer[*got - 1];
       if (options.progress) options.progress->advance(*got);
     });
   }
@@ -571,9 +573,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   for (size_t b = 0; b < blocks; ++b) newlines[b + 1] += newlines[b];
 
   // Lines from the data offset on: every newline ends one, plus a last line without a newline.
-  char last_byte = 0;
-  if (Result<size_t> got = file.readAt(size - 1, &last_byte, 1); !got) return got.error();
-  const uint64_t lines = newlines[blocks] + (last_byte != '\n' ? 1 : 0);
+  const uint64_t lines = newlines[blocks] + (block_last.back() != '\n' ? 1 : 0);
   if (options.between_passes) options.between_passes();
 
   // Every line may be a row: a file of short lines (or of blank ones) asks for 24-36 bytes of
@@ -631,11 +631,11 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     const char* end = data + *got;
     // The rows were sized and numbered from pass 1's count: a file that changed since (cut short,
     // or its lines moved) would leave rows unset or number them past the arrays, so it is refused.
-    // These bytes are the block's own; a line's row comes from its block's line ends alone.
-    const bool last_block = block_end == size;
+    // A line's row comes from its block's line ends alone, and which block a line at a boundary
+    // belongs to from the byte before it: both as pass 1 saw them, or the block refuses the file.
     if (*got != buffer.size() ||
         static_cast<uint64_t>(std::count(data + (block_start - read_start), stop, '\n')) != newlines[b + 1] - newlines[b] ||
-        (last_block && stop[-1] != last_byte)) {
+        stop[-1] != block_last[b] || (read_start != block_start && data[0] != block_last[b - 1])) {
       fail({header.first_data_line + row + 1,
             path + ": the file changed while it was read (its lines are not the ones counted before reading "
                    "them); read it again once it is whole"});

@@ -690,10 +690,11 @@ class PlyParser {
         std::memcpy(out + 3 * r, index, sizeof index);
       }
       if (whole < last) stopAt(whole);
-      const uint64_t end = offset + *got;
-      if (options_.progress) options_.progress->advance(end - std::clamp(reported, offset, end));
     });
     const uint64_t done = stop.load();
+    // Once, for the rows taken (a block past a stop may have decoded rows the loop reads again).
+    const uint64_t end = begin + done * kRow;
+    if (options_.progress) options_.progress->advance(end - std::clamp(reported, begin, end));
     points_.triangles.resize(static_cast<size_t>(3 * done));
     in_.skip(done * kRow);
     return done;

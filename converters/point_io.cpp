@@ -174,6 +174,7 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
   if (isGltf(*format)) {
     gltf.max_memory = read.max_memory;
     gltf.allow_nonfinite = read.allow_nonfinite;
+    gltf.threads = read.threads;
     gltf.max_points_name = names.max_points;
     if (!gltf.texture) gltf.texture = read.texture;
     return readGltf(path, gltf);

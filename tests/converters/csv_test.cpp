@@ -405,9 +405,17 @@ TEST(Csv, aFileChangedBetweenThePassesIsRefused) {
     };
   };
   auto grow = [&] { writeFile(path, text + "7,8,9\n"); };
+  // As many line ends in each block, but the file's last byte no longer one of them.
+  auto moveLastLineEnd = [&] {
+    std::string changed = text;
+    changed.back() = '5';
+    changed[changed.rfind("1.25,") + 4] = '\n';
+    writeFile(path, changed);
+  };
   for (unsigned threads : {1u, 2u}) {
     for (const auto& [what, change] : std::vector<std::pair<std::string, std::function<void()>>>{
-             {"cut", cut}, {"joined in block 0", joinLines(1000)}, {"joined in block 1", joinLines(text.size() - 1000)}}) {
+             {"cut", cut}, {"joined in block 0", joinLines(1000)}, {"joined in block 1", joinLines(text.size() - 1000)},
+             {"last line end moved", moveLastLineEnd}}) {
       Result<PointSet> r = readChanging(threads, change);
       ASSERT_FALSE(r.ok()) << what << ", " << threads << " threads";
       EXPECT_NE(r.error().message.find("a.csv: the file changed while it was read"), std::string::npos)
