@@ -53,6 +53,7 @@ struct PcdWriteOptions {
   PcdEncoding encoding = PcdEncoding::kBinary;
   Progress* progress = nullptr;
   std::vector<std::string>* notices = nullptr;  // coordinates written as double
+  unsigned threads = 0;  // ASCII rows formatted on this many cores (0: all); the bytes do not depend on it
 };
 
 Result<PointSet> readPcd(const std::string& path, const PcdReadOptions& options = {});

@@ -2,13 +2,18 @@
 // after another compressed with LZF (liblzf), as PCL writes binary_compressed.
 #include <lzf.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 #include <limits>
+#include <vector>
+#include <utility>
+#include <string>
 
 #include "converters/pcd.h"
 #include "core/atomic_file.h"
 #include "core/bytes.h"
+#include "core/ordered_write.h"
 #include "core/text.h"
 
 namespace dpoint {
@@ -227,26 +232,33 @@ class Writer {
     }
   }
 
+  // Rows formatted kAsciiRowsPerChunk at a time on all cores and written in order
+  // (core/ordered_write.h): formatting the numbers was the whole cost, on one thread.
   Status writeAscii(AtomicFile& file) {
+    constexpr size_t kAsciiRowsPerChunk = size_t{1} << 15;
     const size_t n = points_.size();
-    std::string text;
-    size_t reported = 0;
-    for (size_t i = 0; i < n; ++i) {
-      for (size_t k = 0; k < fields_.size(); ++k) {
-        if (k) text += ' ';
-        uint8_t bytes[8];
-        store(fields_[k], i, bytes);  // the binary writers' bytes, as text
-        appendField(text, fields_[k], bytes);
-      }
-      text += '\n';
-      if (text.size() >= (size_t{1} << 20) || i + 1 == n) {
-        if (Status s = file.write(text); !s) return s;
-        text.clear();
-        if (options_.progress) options_.progress->advance(i + 1 - reported);
-        reported = i + 1;
-      }
-    }
-    return okStatus();
+    auto rowsOf = [&](size_t k) { return std::make_pair(k * kAsciiRowsPerChunk, std::min(n, (k + 1) * kAsciiRowsPerChunk)); };
+    return writeChunksInOrder(
+        file, (n + kAsciiRowsPerChunk - 1) / kAsciiRowsPerChunk, options_.threads,
+        [&](size_t k, std::vector<char>& bytes) -> Status {
+          thread_local std::string text;
+          text.clear();
+          const auto [first, last] = rowsOf(k);
+          for (size_t i = first; i < last; ++i) {
+            for (size_t f = 0; f < fields_.size(); ++f) {
+              if (f) text += ' ';
+              uint8_t value[8];
+              store(fields_[f], i, value);  // the binary writers' bytes, as text
+              appendField(text, fields_[f], value);
+            }
+            text += '\n';
+          }
+          bytes.assign(text.begin(), text.end());
+          return okStatus();
+        },
+        [&](size_t k) {
+          if (options_.progress) options_.progress->advance(rowsOf(k).second - rowsOf(k).first);
+        });
   }
 
   const std::string& path_;

@@ -210,7 +210,8 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
                       PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
                                       options.colors_of, options.positions_of});
     case FileFormat::kPcd:
-      return writePcd(path, points, PcdWriteOptions{options.pcd_encoding, options.progress, options.notices});
+      return writePcd(path, points,
+                      PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads});
     case FileFormat::kGlb:
       if (points.positions.empty())  // named here: writeGlb's message does not know the path
         return Error{path + ": " + writeGlb(path, points).error().message};
