@@ -9,7 +9,8 @@
 #   mesh  `mandelbulb --variant fast --resolution MESH_RES --device 0` (2048: 108M vertices, 207M
 #         triangles, 5.6 GB PLY)
 #   gltf  the same at GLTF_RES (1024: 27M vertices, a 1.18 GB GLB with COLOR_0 and uint32 indices)
-#   pcd   the las set's 16.8M points as an ASCII PCD (x y z rgb)
+#   pcd   the las set's 16.8M points as an ASCII PCD (x y z rgb); with WRITE=1 also the whole
+#         `dpoint convert s11u.ply --pcd-encoding ascii -o w.pcd`
 # Rows in $OUT/read.tsv, medians in $OUT/read-summary.tsv.
 #   SETS="las mesh gltf pcd" BASE=a968b90 ROUNDS=3 WRITE=1 MESH_RES=2048 GLTF_RES=1024
 set -euo pipefail
@@ -46,9 +47,12 @@ for set in ${SETS:-las mesh gltf pcd}; do
       [ "$build" = current ] && bin=.gpu/dpoint
       /usr/bin/time -f "%e %M" -o /tmp/read_time.txt "$bin" bench io "$file" -q >/tmp/read_io.json 2>/dev/null || true
       echo "" >/tmp/read_write.txt
-      if [ "$set" = las ] && [ "${WRITE:-0}" = 1 ]; then
-        /usr/bin/time -f "%e" -o /tmp/read_write.txt "$bin" convert "$data/s11u.ply" -o "$data/w.las" -q >/dev/null 2>&1 || true
-        rm -f "$data/w.las"
+      if [ "${WRITE:-0}" = 1 ]; then
+        case $set in
+          las) /usr/bin/time -f "%e" -o /tmp/read_write.txt "$bin" convert "$data/s11u.ply" -o "$data/w.las" -q >/dev/null 2>&1 || true ;;
+          pcd) /usr/bin/time -f "%e" -o /tmp/read_write.txt "$bin" convert "$data/s11u.ply" --pcd-encoding ascii -o "$data/w.pcd" -q >/dev/null 2>&1 || true ;;
+        esac
+        rm -f "$data/w.las" "$data/w.pcd"
       fi
       /usr/bin/python3 - "$round" "$set" "$build" <<'PY' | tee -a "$rows"
 import json, sys
