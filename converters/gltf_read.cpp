@@ -529,10 +529,6 @@ class SceneReader {
     return parts;
   }
 
-  // The primitive's index accessor, checked (unsigned SCALAR, each element < vertex_count), with
-  // the vertices it names marked in `remap` (sized vertex_count, kUnused elsewhere); nullopt when
-  // the primitive is not indexed. The elements are read again for triangles rather than kept as
-  // a copy: for large meshes that copy was the size of the output's triangle list.
   // The smallest i < n for which failing(i) holds, else n. failing runs on all cores in chunks
   // (inline for a small primitive), is called for every i below the one returned, and must be safe
   // to call from several threads at once: its side effects go to slots of their own.
@@ -544,15 +540,17 @@ class SceneReader {
       for (size_t i = c * kChunk, end = std::min(n, i + kChunk); i < end; ++i) {
         if (i > first.load(std::memory_order_relaxed)) return;
         if (!failing(i)) continue;
-        size_t seen = first.load();
-        while (i < seen && !first.compare_exchange_weak(seen, i)) {
-        }
+        lowerAtomic(first, i);
         return;
       }
     });
     return first.load();
   }
 
+  // The primitive's index accessor, checked (unsigned SCALAR, each element < vertex_count), with
+  // the vertices it names marked in `remap` (sized vertex_count, kUnused elsewhere); nullopt when
+  // the primitive is not indexed. The elements are read again for triangles rather than kept as
+  // a copy: for large meshes that copy was the size of the output's triangle list.
   Result<std::optional<AccessorElements>> readIndices(const tinygltf::Primitive& primitive, size_t vertex_count,
                                                       std::vector<uint32_t>& remap) const {
     if (primitive.indices == -1) return std::optional<AccessorElements>();  // tinygltf's "no indices"

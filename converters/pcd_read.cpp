@@ -3,13 +3,13 @@
 #include <lzf.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <optional>
 #include <mutex>
-#include <atomic>
+#include <optional>
 #include <unordered_set>
 
 #include <fast_float/fast_float.h>
@@ -26,7 +26,7 @@ namespace {
 constexpr size_t kMaxHeader = size_t{1} << 20;  // a header longer than this is not a PCD file
 constexpr uint64_t kBlock = uint64_t{1} << 16;   // points per decoded block
 constexpr size_t kAsciiChunk = size_t{4} << 20;  // bytes of ASCII data per block
-constexpr size_t kAsciiMaxLineBytes = size_t{4} << 20;
+constexpr size_t kAsciiMaxLineBytes = size_t{4} << 20;  // an ASCII line longer than this is an error
 // Values per point at most (PCL's widest descriptors, SHOT colour, have 1,344).
 constexpr size_t kMaxValues = 65536;
 
@@ -556,7 +556,6 @@ class Reader {
     return okStatus();
   }
 
-  // ASCII rows, one point per non-empty line, on one thread.
   // ASCII rows on all cores, in blocks of the data. A first pass counts each block's lines and rows
   // (lines neither blank nor a # comment; a line belongs to the block it starts in), so that each
   // block knows its first line's number and its first row's point; the second parses its rows into

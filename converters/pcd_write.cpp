@@ -6,9 +6,9 @@
 #include <charconv>
 #include <cstring>
 #include <limits>
-#include <vector>
-#include <utility>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "converters/pcd.h"
 #include "core/atomic_file.h"

@@ -625,11 +625,7 @@ class PlyParser {
       points_.triangles.reserve(3 * std::min({e.count, in_.remaining() / min_face, room}));
     }
     uint64_t first_row = 0;
-    if (!ascii_ && e.name == "face") {
-      Result<uint64_t> done = readTriangleRows(e, roles);
-      if (!done) return done.error();
-      first_row = *done;
-    }
+    if (!ascii_ && e.name == "face") first_row = readTriangleRows(e, roles);
     for (uint64_t row = first_row; row < e.count; ++row) {
       uint64_t where = 0;
       Status s = ascii_ ? readAsciiRow(e, roles, row, where) : readBinaryRow(e, roles, row, where);
@@ -647,7 +643,7 @@ class PlyParser {
   // vertex), the file's end (or a read that fails) or what --max-memory leaves for triangles. Returns
   // how many rows were done; the row-by-row loop goes on from there and reports any error at its
   // row, as it does for every row of other layouts. 207M faces took 6-10 s on one thread (H200).
-  Result<uint64_t> readTriangleRows(const Element& e, const std::vector<Role>& roles) {
+  uint64_t readTriangleRows(const Element& e, const std::vector<Role>& roles) {
     if (e.properties.size() != 1 || roles[0] != kIndices || !points_.triangles.empty()) return 0;
     const Property& p = e.properties[0];
     if (!p.is_list || typeSize(p.count_type) != 1 || (p.type != Type::kInt32 && p.type != Type::kUint32)) return 0;
@@ -664,11 +660,7 @@ class PlyParser {
     const uint64_t begin = in_.offset(), reported = in_.readEnd();
     const uint64_t block_rows = kVertexBlockBytes / kRow;
     std::atomic<uint64_t> stop{rows};  // no row from here on is taken
-    auto stopAt = [&](uint64_t row) {
-      uint64_t seen = stop.load();
-      while (row < seen && !stop.compare_exchange_weak(seen, row)) {
-      }
-    };
+    auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
     std::vector<std::vector<char>> buffers(threads);
     parallelFor(static_cast<size_t>((rows + block_rows - 1) / block_rows), threads, [&](size_t b, unsigned worker) {
       const uint64_t first = b * block_rows, last = std::min(first + block_rows, rows);

@@ -24,6 +24,15 @@ inline unsigned parallelWorkers(size_t count, unsigned threads) {
   return threads > count ? static_cast<unsigned>(count == 0 ? 1 : count) : threads;
 }
 
+// Lowers `value` to `candidate` where that is smaller (from several threads at once): the first
+// failing item of a parallel scan, whichever worker finds it.
+template <typename T>
+void lowerAtomic(std::atomic<T>& value, T candidate) {
+  T seen = value.load();
+  while (candidate < seen && !value.compare_exchange_weak(seen, candidate)) {
+  }
+}
+
 // Calls fn(item, worker) for every item in [0, count) on parallelWorkers(count, threads) threads
 // (worker < that).
 inline void parallelFor(size_t count, unsigned threads,
