@@ -88,24 +88,8 @@ double PhaseClock::lap() {
 // Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any
 // generator. Unless quiet, one line of where the time went (generation counted from `clock`'s start,
 // before the parameters).
-bool canWriteWhileMade(const OutputOptions& o, PointOrder order, bool auto_noise) {
-  return plyWrittenHere(o) && order == PointOrder::kInput && o.offset.empty() &&
-         (coloursAtWrite(o, auto_noise) || pointColorsOf(o) == PointColors::kNone);
-}
-
-std::unique_ptr<PlyMeshStream> meshStream(const OutputOptions& o, bool auto_noise, Progress& progress) {
-  assert(canWriteWhileMade(o, PointOrder::kInput, auto_noise));
-  PlyWriteOptions w;
-  w.threads = o.common.threads;
-  w.progress = &progress;
-  if (coloursAtWrite(o, auto_noise)) w.colors_of = seedColors;
-  PointSet facts;
-  facts.z_axis = ZAxis::kPresent;  // a surface in space
-  return std::make_unique<PlyMeshStream>(o.output, std::move(facts), std::move(w));
-}
-
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
-           PhaseClock& clock, PlyMeshStream* stream) {
+           PhaseClock& clock) {
   if (!generated) return reportError(generated.error());
   const double generate_s = clock.lap();
   PointSet& points = *generated;
@@ -140,13 +124,11 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   w.decimals = o.decimals;
   w.progress = &progress;
   if (colours_at_write) w.colors_of = seedColors;
-  if (Status s = stream ? stream->finish(points) : writePointsWithNotes(o.output, points, w); !s)
-    return reportError(s.error());
+  if (Status s = writePointsWithNotes(o.output, points, w); !s) return reportError(s.error());
   if (!o.common.quiet)
-    std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles%s%s\n",
+    std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles%s\n",
                  generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3,
-                 colours_at_write ? "; the colours made as the rows were written" : "",
-                 stream && stream->rowsKept() ? "; the vertex rows written while meshing" : "");
+                 colours_at_write ? "; the colours made as the rows were written" : "");
   return 0;
 }
 

@@ -5,13 +5,11 @@
 
 #include <chrono>
 #include <functional>
-#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
-#include "converters/ply.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -54,17 +52,10 @@ class PhaseClock {
 Status checkHandedBack(const OutputOptions& o);
 // --tile checks before any work: a .ply part, and no --order (which needs the whole set).
 Result<TileSpec> tileOptions(const OutputOptions& o);
-// Whether a mesh's .ply can be written while it is made (a generator's mesh sink feeding a
-// PlyMeshStream, converters/ply.h): written here, with its noise colours made at write or none, in
-// input order, no --offset.
-bool canWriteWhileMade(const OutputOptions& o, PointOrder order, bool auto_noise);
-// The stream for such an output: the file writePly would write for the set finish() is given.
-std::unique_ptr<PlyMeshStream> meshStream(const OutputOptions& o, bool auto_noise, Progress& progress);
-// Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any
-// generator; with `stream` (meshStream), the set is written through it. Unless quiet, one line of
+// Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any generator. Unless quiet, one line of
 // where the time went (generation counted from `clock`'s start, before the parameters).
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
-           PhaseClock& clock, PlyMeshStream* stream = nullptr);
+           PhaseClock& clock);
 // A set whose points are a function of their index (random2d): `count` of them, point i at at(i),
 // called from several threads at once; z_present when some z is not 0.
 struct PointFunction {

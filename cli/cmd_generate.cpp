@@ -55,16 +55,6 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
       if (!params) return reportError(params.error());
       if (tile) return finishTile(generate_tile(*params, *tile), o->out, auto_noise, signature, progress);
       if (made && canFinishMade(o->out, auto_noise)) return finishMade(made(*params), o->out, *order, auto_noise, progress, clock);
-      if constexpr (requires { params->mesh_sink; }) {
-        // A surface classified on a device: its vertex rows are written while it is meshed.
-        if (params->planes && canWriteWhileMade(o->out, *order, auto_noise)) {
-          std::unique_ptr<PlyMeshStream> stream = meshStream(o->out, auto_noise, progress);
-          PlyMeshStream* to = stream.get();
-          params->mesh_sink.estimate = [to](uint64_t vertices, uint64_t triangles) { to->start(vertices, triangles); };
-          params->mesh_sink.vertices = [to](PositionArray&& positions) { to->addVertices(std::move(positions)); };
-          return finish(generate(*params), o->out, *order, auto_noise, progress, clock, to);
-        }
-      }
       return finish(generate(*params), o->out, *order, auto_noise, progress, clock);
     };
   });

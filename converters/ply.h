@@ -71,38 +71,6 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
                       const PlyWriteOptions& options);
 
-// A binary PLY mesh written while it is made (a generator's, cli/cli_generate_output.h): its vertex
-// rows as they come, then its faces once it is whole. The header holds the counts, known only at
-// the end, so it is laid out from estimates; the rows written meanwhile stay when the real counts
-// have as many digits (the header is then as long, and written over at the end), else finish()
-// writes the whole file again, as writePly does. Either way the file is writePly's for the finished
-// set, byte for byte. Binary only; colours from options.colors_of or none; no dimensions.
-class PlyMeshStream {
- public:
-  // `facts`: a set with no points whose facts (z, source) the finished set will have.
-  PlyMeshStream(std::string path, PointSet facts, PlyWriteOptions options);
-  ~PlyMeshStream();  // discards the rows written unless finish() committed them
-  PlyMeshStream(const PlyMeshStream&) = delete;
-  PlyMeshStream& operator=(const PlyMeshStream&) = delete;
-
-  // Once, before addVertices: opens the output with a header for these estimated counts and
-  // starts writing the rows added. Declines (every row then waits for finish) when an estimate is
-  // within 5% of a power of ten, whose digits it cannot then tell, or the output is not a file.
-  void start(uint64_t vertices, uint64_t faces);
-  // The next vertex rows' positions: formatted, with their colours, on options.threads cores and
-  // written on a thread of the stream's own; returns at once. Ignored unless started.
-  void addVertices(PositionArray positions);
-  // Waits for the rows, then finishes the file for `points`, the whole set, whose first rows are
-  // the ones added: its faces and header, or the whole file again. Errors: writePly's.
-  Status finish(const PointSet& points);
-  // After finish: whether the rows written while the set was made were kept.
-  bool rowsKept() const;
-
- private:
-  struct State;
-  std::unique_ptr<State> state_;
-};
-
 // The vertices of a binary PLY file a range at a time, for a renderer drawing a file larger than
 // memory should hold. open() reads the header with readPly's checks; an ASCII file, or one with
 // list rows before its vertices (whose offsets are unknown until read), fails naming why. read()

@@ -3,18 +3,12 @@
 #include <algorithm>
 #include <cassert>
 #include <charconv>
-#include <condition_variable>
 #include <cstring>
-#include <deque>
-#include <mutex>
-#include <optional>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include "core/atomic_file.h"
 #include "core/ordered_write.h"
-#include "core/parallel.h"
 #include "core/text.h"
 #include "converters/ply.h"
 
@@ -92,77 +86,6 @@ void appendDimension(ChunkText& out, const Dimension& d, size_t i, char separato
   }
 }
 
-// A binary vertex row: x, y, z as doubles, the colours, the dimensions.
-struct BinaryRowLayout {
-  BinaryRowLayout(bool colors, bool floats, bool words, const std::vector<Dimension>& dimensions)
-      : float_colors(floats), word_colors(words), color_bytes(!colors ? 0 : floats ? 12 : words ? 6 : 3),
-        dims(dimensions) {
-    vertex_bytes = sizeof(glm::dvec3) + color_bytes;
-    for (const Dimension& d : dims) vertex_bytes += plyTypeName(d.type) ? dimTypeSize(d.type) : sizeof(double);
-  }
-  bool float_colors, word_colors;
-  size_t color_bytes, vertex_bytes;
-  const std::vector<Dimension>& dims;
-};
-
-// Rows [begin, end) into out: positions[i − begin], colors[i − begin] (when the layout has colours),
-// dimension values i.
-void binaryVertexRows(const BinaryRowLayout& layout, const glm::dvec3* positions, const glm::vec3* colors, size_t begin,
-                      size_t end, char* out) {
-  for (size_t i = begin; i < end; ++i) {
-    std::memcpy(out, &positions[i - begin], sizeof(glm::dvec3));
-    char* at = out + sizeof(glm::dvec3);
-    if (layout.color_bytes) {
-      const glm::vec3& c = colors[i - begin];
-      if (layout.float_colors) {
-        std::memcpy(at, &c, sizeof c);
-      } else if (layout.word_colors) {
-        const uint16_t rgb[3] = {colorWord(c.r), colorWord(c.g), colorWord(c.b)};
-        std::memcpy(at, rgb, sizeof rgb);
-      } else {
-        at[0] = static_cast<char>(colorByte(c.r));
-        at[1] = static_cast<char>(colorByte(c.g));
-        at[2] = static_cast<char>(colorByte(c.b));
-      }
-      at += layout.color_bytes;
-    }
-    for (const Dimension& d : layout.dims) {
-      if (plyTypeName(d.type)) {
-        const size_t w = dimTypeSize(d.type);
-        std::memcpy(at, d.bytes.data() + i * w, w);
-        at += w;
-      } else {
-        const double v = d.value(i);
-        std::memcpy(at, &v, sizeof v);
-        at += sizeof v;
-      }
-    }
-    out += layout.vertex_bytes;
-  }
-}
-
-// Binary face rows [begin, end) of `triangles` into out.
-void binaryFaceRows(const std::vector<uint32_t>& triangles, size_t begin, size_t end, char* out) {
-  for (size_t f = begin; f < end; ++f, out += kFaceBytes) {
-    out[0] = 3;
-    std::memcpy(out + 1, &triangles[3 * f], 3 * sizeof(uint32_t));
-  }
-}
-
-// What writePly checks before it writes anything: as many colours as rows, whole triangles, every
-// index below the n rows (the first bad one named).
-Status checkRows(const std::string& path, const PointSet& points, size_t n, unsigned threads) {
-  if (points.hasColors() && points.colors.size() != n)
-    return Error{"cannot write '" + path + "': " + std::to_string(points.colors.size()) + " colours for " +
-                 std::to_string(n) + " points"};
-  if (points.triangles.size() % 3 != 0)
-    return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
-  if (const size_t bad = points.firstBadTriangleIndex(threads); bad < points.triangles.size())
-    return Error{"cannot write '" + path + "': triangle index " + std::to_string(points.triangles[bad]) +
-                 " out of range (" + std::to_string(n) + " points)"};
-  return okStatus();
-}
-
 }  // namespace
 
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
@@ -197,7 +120,15 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   const size_t n = made ? made.count : points.size();
   assert(!(options.colors_of && points.hasColors()));
   const bool colors = points.hasColors() || options.colors_of;
-  if (Status s = checkRows(path, points, n, options.threads); !s) return s;
+  if (points.hasColors() && points.colors.size() != n)
+    return Error{"cannot write '" + path + "': " + std::to_string(points.colors.size()) + " colours for " +
+                 std::to_string(n) + " points"};
+  if (points.triangles.size() % 3 != 0)
+    return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
+  // Every index below n, checked before anything is written; the first bad one is named.
+  if (const size_t bad = points.firstBadTriangleIndex(options.threads); bad < points.triangles.size())
+    return Error{"cannot write '" + path + "': triangle index " + std::to_string(points.triangles[bad]) +
+                 " out of range (" + std::to_string(n) + " points)"};
   auto file = AtomicFile::create(path);
   if (!file.ok()) return file.error();
   const bool ascii = options.encoding == PlyEncoding::kAscii;
@@ -211,7 +142,9 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   if (options.progress) options.progress->start("writing " + path, n + faces);
   const std::vector<Dimension>& dims = points.dimensions.all();
   const bool attributes = !dims.empty();
-  const BinaryRowLayout layout(colors, float_colors, word_colors, dims);
+  const size_t color_bytes = !colors ? 0 : float_colors ? 12 : word_colors ? 6 : 3;
+  size_t vertex_bytes = sizeof(glm::dvec3) + color_bytes;
+  for (const Dimension& d : dims) vertex_bytes += plyTypeName(d.type) ? dimTypeSize(d.type) : sizeof(double);
 
   // Chunk 0 is the header, then the vertex rows and the face rows kRowsPerChunk at a time.
   const size_t vertex_chunks = (n + kRowsPerChunk - 1) / kRowsPerChunk;
@@ -241,8 +174,38 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
     const glm::dvec3* chunk_positions = chunkPositions(begin, end);
     const glm::vec3* chunk_colors = chunkColors(chunk_positions, begin, end);
     if (!ascii) {
-      bytes.resize((end - begin) * layout.vertex_bytes);
-      binaryVertexRows(layout, chunk_positions, chunk_colors, begin, end, bytes.data());
+      bytes.resize((end - begin) * vertex_bytes);
+      char* row = bytes.data();
+      for (size_t i = begin; i < end; ++i) {
+        std::memcpy(row, &chunk_positions[i - begin], sizeof(glm::dvec3));
+        char* at = row + sizeof(glm::dvec3);
+        if (colors) {
+          const glm::vec3& c = chunk_colors[i - begin];
+          if (float_colors) {
+            std::memcpy(at, &c, sizeof c);
+          } else if (word_colors) {
+            const uint16_t rgb[3] = {colorWord(c.r), colorWord(c.g), colorWord(c.b)};
+            std::memcpy(at, rgb, sizeof rgb);
+          } else {
+            at[0] = static_cast<char>(colorByte(c.r));
+            at[1] = static_cast<char>(colorByte(c.g));
+            at[2] = static_cast<char>(colorByte(c.b));
+          }
+          at += color_bytes;
+        }
+        for (const Dimension& d : dims) {
+          if (plyTypeName(d.type)) {
+            const size_t w = dimTypeSize(d.type);
+            std::memcpy(at, d.bytes.data() + i * w, w);
+            at += w;
+          } else {
+            const double v = d.value(i);
+            std::memcpy(at, &v, sizeof v);
+            at += sizeof v;
+          }
+        }
+        row += vertex_bytes;
+      }
       return;
     }
     ChunkText out(bytes);
@@ -269,7 +232,11 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   auto faceRows = [&](size_t begin, size_t end, std::vector<char>& bytes) {
     if (!ascii) {
       bytes.resize((end - begin) * kFaceBytes);
-      binaryFaceRows(points.triangles, begin, end, bytes.data());
+      char* row = bytes.data();
+      for (size_t f = begin; f < end; ++f, row += kFaceBytes) {
+        row[0] = 3;
+        std::memcpy(row + 1, &points.triangles[3 * f], 3 * sizeof(uint32_t));
+      }
       return;
     }
     ChunkText out(bytes);
@@ -298,162 +265,5 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   if (!written) return written;
   return file->commit();
 }
-
-struct PlyMeshStream::State {
-  std::string path;
-  PointSet facts;
-  PlyWriteOptions options;
-  std::optional<AtomicFile> file;
-  size_t header_bytes = 0;
-  uint64_t added = 0;  // rows handed to the writer
-  bool started = false, kept = false;
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::deque<PositionArray> queue;  // rows not yet written
-  bool stopping = false;            // no more rows: the writer ends once the queue is empty
-  std::optional<Error> error;       // the first write that failed (the rest are dropped)
-  std::thread writer;
-
-  BinaryRowLayout layout() const {
-    return BinaryRowLayout(static_cast<bool>(options.colors_of), false, facts.color_full_scale == 65535,
-                           facts.dimensions.all());
-  }
-  // Writes whatever rows are queued as one batch of chunks: a slab's few chunks at a time while the
-  // set is made, on a quarter of the cores (the meshing has the rest), and what is left once it is
-  // made on all of them.
-  void run() {
-    const BinaryRowLayout rows_layout = layout();
-    const unsigned all = resolveThreads(options.threads);
-    for (;;) {
-      std::vector<PositionArray> batch;
-      bool last = false;
-      {
-        std::unique_lock<std::mutex> lock(mutex);
-        changed.wait(lock, [&] { return stopping || !queue.empty(); });
-        if (queue.empty()) return;
-        for (PositionArray& rows : queue) batch.push_back(std::move(rows));
-        queue.clear();
-        last = stopping;
-        if (error) continue;
-      }
-      std::vector<std::pair<size_t, size_t>> chunks;  // (slab in the batch, first row)
-      for (size_t b = 0; b < batch.size(); ++b)
-        for (size_t begin = 0; begin < batch[b].size(); begin += kRowsPerChunk) chunks.emplace_back(b, begin);
-      const unsigned threads = last ? all : std::max(1u, all / 4);
-      Status s = writeChunksInOrder(*file, chunks.size(), threads, [&](size_t k, std::vector<char>& bytes) -> Status {
-        const PositionArray& rows = batch[chunks[k].first];
-        const size_t begin = chunks[k].second, end = std::min(rows.size(), begin + kRowsPerChunk);
-        const glm::dvec3* positions = rows.data() + begin;
-        thread_local std::vector<glm::vec3> colors;
-        if (options.colors_of) {
-          colors.resize(end - begin);
-          options.colors_of(positions, end - begin, colors.data());
-        }
-        bytes.resize((end - begin) * rows_layout.vertex_bytes);
-        binaryVertexRows(rows_layout, positions, colors.data(), 0, end - begin, bytes.data());
-        return okStatus();
-      });
-      if (!s) {
-        std::lock_guard<std::mutex> lock(mutex);
-        error = s.error();
-      }
-    }
-  }
-  void stopWriter() {
-    if (!writer.joinable()) return;
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      stopping = true;
-    }
-    changed.notify_all();
-    writer.join();
-  }
-};
-
-PlyMeshStream::PlyMeshStream(std::string path, PointSet facts, PlyWriteOptions options) : state_(new State) {
-  assert(facts.size() == 0 && facts.dimensions.empty() && !options.positions_of);
-  state_->path = std::move(path);
-  state_->facts = std::move(facts);
-  state_->options = std::move(options);
-}
-
-PlyMeshStream::~PlyMeshStream() {
-  {
-    std::lock_guard<std::mutex> lock(state_->mutex);
-    state_->queue.clear();
-  }
-  state_->stopWriter();
-}
-
-void PlyMeshStream::start(uint64_t vertices, uint64_t faces) {
-  State& st = *state_;
-  assert(!st.started);
-  // The digits of an estimate within 5% of the count.
-  auto trusted = [](uint64_t n) {
-    auto digits = [](double v) { return std::to_string(static_cast<uint64_t>(v)).size(); };
-    return digits(0.95 * static_cast<double>(n)) == digits(1.05 * static_cast<double>(n));
-  };
-  if (st.options.encoding != PlyEncoding::kBinary || st.options.color_type != PlyColorType::kUchar ||
-      !trusted(vertices) || !trusted(faces))
-    return;
-  Result<AtomicFile> file = AtomicFile::create(st.path);
-  if (!file || !file->positional()) return;  // finish's writePly gives the error, or writes the pipe
-  const std::string header =
-      plyHeader(st.facts, vertices, faces, static_cast<bool>(st.options.colors_of), st.facts.hasZ(), st.options);
-  if (!file->write(header)) return;
-  st.file.emplace(std::move(file).value());
-  st.header_bytes = header.size();
-  st.started = true;
-  st.writer = std::thread([&st] { st.run(); });
-}
-
-void PlyMeshStream::addVertices(PositionArray positions) {
-  State& st = *state_;
-  if (!st.started) return;
-  st.added += positions.size();
-  {
-    std::lock_guard<std::mutex> lock(st.mutex);
-    st.queue.push_back(std::move(positions));
-  }
-  st.changed.notify_one();
-}
-
-Status PlyMeshStream::finish(const PointSet& points) {
-  State& st = *state_;
-  st.stopWriter();
-  if (!st.started) return writePly(st.path, points, st.options);
-  if (st.error) return *st.error;
-  const size_t n = points.size(), faces = points.triangles.size() / 3;
-  const bool colors = static_cast<bool>(st.options.colors_of);
-  const std::string header = plyHeader(points, n, faces, colors, points.hasZ(), st.options);
-  if (header.size() != st.header_bytes || st.added != n || points.hasColors() || !points.dimensions.empty() ||
-      points.color_full_scale != st.facts.color_full_scale) {
-    st.file.reset();  // the counts' digits were not the estimates': the whole file again
-    return writePly(st.path, points, st.options);
-  }
-  if (Status s = checkRows(st.path, points, n, st.options.threads); !s) return s;
-  Progress* progress = st.options.progress;
-  if (progress) progress->start("writing " + st.path, faces);
-  const size_t chunks = (faces + kRowsPerChunk - 1) / kRowsPerChunk;
-  auto rowsOf = [&](size_t k) { return std::pair(k * kRowsPerChunk, std::min(faces, (k + 1) * kRowsPerChunk)); };
-  Status written = writeChunksInOrder(
-      *st.file, chunks, st.options.threads,
-      [&](size_t k, std::vector<char>& bytes) -> Status {
-        const auto [begin, end] = rowsOf(k);
-        bytes.resize((end - begin) * kFaceBytes);
-        binaryFaceRows(points.triangles, begin, end, bytes.data());
-        return okStatus();
-      },
-      [&](size_t k) {
-        if (progress) progress->advance(rowsOf(k).second - rowsOf(k).first);
-      });
-  if (!written) return written;
-  if (Status s = st.file->overwriteAt(0, header.data(), header.size()); !s) return s;
-  if (Status s = st.file->commit(); !s) return s;
-  st.kept = true;
-  return okStatus();
-}
-
-bool PlyMeshStream::rowsKept() const { return state_->kept; }
 
 }  // namespace dpoint

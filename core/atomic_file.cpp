@@ -158,24 +158,6 @@ Status AtomicFile::write(const void* data, size_t size) {
   return okStatus();
 }
 
-Status AtomicFile::overwriteAt(uint64_t offset, const void* data, size_t size) {
-  assert(fd_ >= 0 && !committed_ && !direct_ && offset + size <= bytesWritten());
-  if (interrupted()) return interruptedError();
-  if (Status s = flush(); !s) return s;
-  const char* bytes = static_cast<const char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return ioError("cannot write", path_, errno);
-    }
-    bytes += n;
-    size -= static_cast<size_t>(n);
-    offset += static_cast<uint64_t>(n);
-  }
-  return okStatus();
-}
-
 Status AtomicFile::commit() {
   assert(fd_ >= 0 && !committed_);
   if (interrupted()) return interruptedError();

@@ -38,11 +38,6 @@ class AtomicFile {
   // Buffered append. Errors (disk full) are reported here or at commit.
   Status write(const void* data, size_t size);
   Status write(std::string_view text) { return write(text.data(), text.size()); }
-  // Flushes, then writes `size` bytes at `offset` over what was written there (a header laid out
-  // before its counts were known). Only where the output is a file (positional()).
-  Status overwriteAt(uint64_t offset, const void* data, size_t size);
-  // Whether overwriteAt can be used: the output is a temporary file, not a pipe or device.
-  bool positional() const { return !direct_; }
   // Flushes, syncs nothing (page cache is enough for atomicity against crashes of the process),
   // and moves the file into place.
   Status commit();

@@ -613,16 +613,6 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                   mesh.triangles.capacity() * sizeof(uint32_t));
   };
   grew();
-  // The sink is told of the whole mesh only, and needs the plane function for its estimate (a
-  // sample of 1 layer in 32, 64 at most: 6% of the classification at res 2048).
-  EscapeMeshSink sink;
-  if (params.planes && (params.sink.estimate || params.sink.vertices)) {
-    assert(first_layer == 0 && last_layer == res - 1);
-    sink = params.sink;
-    Result<MeshCounts> estimate = escapeMeshEstimate(params, std::clamp(layers / 32, 1, 64));
-    if (!estimate) return estimate.error();
-    if (sink.estimate) sink.estimate(estimate->vertices, estimate->triangles);
-  }
 
   struct Pending {
     bool ready = false;
@@ -665,7 +655,6 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
           mesh.triangles.insert(mesh.triangles.end(), done.mesh.triangles.begin(), done.mesh.triangles.end());
           grew();
           if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
-          if (sink.vertices) sink.vertices(std::move(done.mesh.positions));
           if (grid_file)
             if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());
         }
@@ -733,59 +722,6 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
 
 }  // namespace
 
-Result<MeshCounts> escapeMeshEstimate(const EscapeSurfaceParams& params, int samples) {
-  assert(params.planes && samples >= 1);
-  const int res = params.axis.resolution;
-  const int layers = res - 1;
-  samples = std::min(samples, layers);
-  const int cap = classificationLimit(params);
-  const int bytes = escapeGridBytesPerCount(cap);
-  const size_t points = squared(res);
-  const uint32_t above_at = params.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(params.level));
-  std::vector<uint8_t> counts(2 * points * static_cast<size_t>(bytes));
-  std::vector<uint8_t> above(2 * points);
-  const unsigned threads = resolveThreads(params.threads);
-  const size_t rows = static_cast<size_t>(res);
-  MeshCounts sampled;
-  for (int s = 0; s < samples; ++s) {
-    // The middle layer of the s-th of `samples` equal shares.
-    const int layer = static_cast<int>((2 * static_cast<int64_t>(s) + 1) * layers / (2 * static_cast<int64_t>(samples)));
-    if (Status st = params.planes(layer, 2, cap, counts.data()); !st) return st.error();
-    std::atomic<uint64_t> vertices{0}, triangles{0};
-    parallelFor(rows, threads, [&](size_t j, unsigned) {
-      uint8_t* a = &above[j * rows];  // plane `layer`, row j; plane layer + 1 is `points` on
-      for (size_t q = 0; q < 2; ++q)
-        for (size_t k = 0; k < rows; ++k)
-          a[q * points + k] = countAt(counts.data(), bytes, q * points + j * rows + k) > above_at;
-    });
-    parallelFor(rows, threads, [&](size_t j, unsigned) {
-      const uint8_t* a = &above[j * rows];
-      const uint8_t* b = a + points;
-      uint64_t v = 0, t = 0;
-      for (size_t k = 0; k < rows; ++k) {
-        v += a[k] != b[k];                               // the x edge to the next plane
-        if (k + 1 < rows) v += a[k] != a[k + 1];         // the z edge
-        if (j + 1 < rows) v += a[k] != a[k + rows];      // the y edge
-        if (j + 1 < rows && k + 1 < rows) {
-          unsigned mask = 0;
-          for (unsigned c = 0; c < 8; ++c) {
-            const uint8_t* plane = c & 1 ? b : a;
-            mask |= static_cast<unsigned>(plane[k + ((c >> 1) & 1) * rows + ((c >> 2) & 1)]) << c;
-          }
-          t += marchingCubesCase(mask).triangle_count;
-        }
-      }
-      vertices += v;
-      triangles += t;
-    });
-    sampled.vertices += vertices;
-    sampled.triangles += triangles;
-  }
-  const double scale = static_cast<double>(layers) / samples;
-  return MeshCounts{static_cast<uint64_t>(std::llround(static_cast<double>(sampled.vertices) * scale)),
-                    static_cast<uint64_t>(std::llround(static_cast<double>(sampled.triangles) * scale))};
-}
-
 Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const EscapeRowFunction& row) {
   Result<LayerMesh> whole = meshLayers(params, row, 0, params.axis.resolution - 1);
   if (!whole) return whole.error();
@@ -807,9 +743,7 @@ Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, c
     }
     return out;
   }
-  EscapeSurfaceParams own = params;
-  own.sink = {};  // told of whole meshes only
-  Result<LayerMesh> part = meshLayers(own, row, static_cast<int>(range.begin), static_cast<int>(range.end));
+  Result<LayerMesh> part = meshLayers(params, row, static_cast<int>(range.begin), static_cast<int>(range.end));
   if (!part) return part.error();
   out.points = std::move(part->mesh);
   out.owned = static_cast<uint32_t>(out.points.size());

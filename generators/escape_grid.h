@@ -75,18 +75,6 @@ using EscapePlaneFunction = std::function<Status(int first, int planes, int limi
 // when there is none. The blocks of counts are then carved from it.
 using EscapeArena = std::function<uint8_t*(uint64_t bytes)>;
 
-// Told of the whole mesh as it is made, for writing it meanwhile (a PLY whose vertex rows go out
-// while the later slabs are meshed, cli/cli_generate_output.h). Only with a plane function, which
-// classifies the sample cheaply; both empty: none.
-struct EscapeMeshSink {
-  // Once, before any slab joins the mesh: the whole mesh's vertex and triangle counts estimated
-  // from a sample of its cell layers (escapeMeshEstimate); within a few percent, not exact.
-  std::function<void(uint64_t vertices, uint64_t triangles)> estimate;
-  // Each slab's vertices, in slab order, as they join the mesh: the mesh's next positions. Called
-  // under the mesh's lock (keep it short).
-  std::function<void(PositionArray&& positions)> vertices;
-};
-
 struct EscapeSurfaceParams {
   std::string name = "fractal";  // for messages and progress
   GridAxis axis;
@@ -100,12 +88,10 @@ struct EscapeSurfaceParams {
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // empty: the row function classifies too
   EscapeArena arena;             // where the plane function's blocks go; empty: the heap
-  EscapeMeshSink sink;           // generateEscapeSurface only (not a tile's)
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
-// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes, arena,
-// mesh_sink).
+// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes, arena).
 template <typename FractalParams>
 EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& params);
 
@@ -129,7 +115,6 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.progress = params.progress;
   surface.planes = params.planes;
   surface.arena = params.arena;
-  surface.sink = params.mesh_sink;
   return surface;
 }
 
@@ -150,16 +135,6 @@ Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const 
 // pieces concatenated are the whole grid file. Same errors.
 Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, const EscapeRowFunction& row,
                                             TileSpec tile);
-
-// The whole mesh's vertex and triangle counts estimated from `samples` cell layers spread evenly
-// over the grid: each layer's two planes classified by params.planes (one call each, on this
-// thread), the vertices the layer owns (the crossed edges in its first plane and those to its
-// second) and its cells' triangles counted on all cores, then scaled by layers / samples. Exact
-// when every layer is sampled. Errors: the plane function's.
-struct MeshCounts {
-  uint64_t vertices = 0, triangles = 0;
-};
-Result<MeshCounts> escapeMeshEstimate(const EscapeSurfaceParams& params, int samples);
 
 // The full count grid of x-planes [first_plane, first_plane + planes), layout [i][j][k]; for tests
 // and measurements (holds planes·res² counts).

@@ -54,7 +54,6 @@ struct MandelbulbParams {
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
   EscapeArena arena;             // where `planes` writes fastest (escape_grid.h); empty: the heap
-  EscapeMeshSink mesh_sink;      // told of the mesh as it is made (escape_grid.h); needs `planes`
   bool full_counts = false;      // every count to max_iter, not capped above the level (escape_grid.h)
 };
 

@@ -58,31 +58,6 @@ TEST(CliGenerateDevice, gridAndOutputOnTheDeviceEqualTheCpuPathsForEachKind) {
   }
 }
 
-// A surface classified on the device has its vertex rows written while it is meshed
-// (PlyMeshStream, cli/cli_generate_output.h): the CPU path's file, with and without colours. An
-// --order or --offset needs the whole set first: written after it, as before.
-TEST(CliGenerateDevice, meshWrittenWhileMeshedIsTheCpuPathsFile) {
-  TempDir dir;
-  const std::string kWhile = "the vertex rows written while meshing";
-  for (const char* colors : {"auto", "none"}) {
-    SCOPED_TRACE(colors);
-    const std::vector<std::string> base = {"generate", "julia", "--resolution", "120", "--colors", colors};
-    ASSERT_EQ(runDpoint(concat(base, {"--device", "none", "-q", "-o", dir.file("cpu.ply")})).exit_code, 0);
-    test::CommandResult gpu = runDpoint(concat(base, {"--device", "cpu", "--validate", "-o", dir.file("gpu.ply")}));
-    ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
-    EXPECT_NE(gpu.err.find(kWhile), std::string::npos) << gpu.err;
-    EXPECT_TRUE(readFile(dir.file("cpu.ply")) == readFile(dir.file("gpu.ply")));
-  }
-  for (const std::vector<std::string>& after : {std::vector<std::string>{"--order", "morton"}, {"--offset", "1e6,0,0"}}) {
-    const std::vector<std::string> base = concat({"generate", "julia", "--resolution", "60"}, after);
-    ASSERT_EQ(runDpoint(concat(base, {"--device", "none", "-q", "-o", dir.file("cpu.ply")})).exit_code, 0);
-    test::CommandResult gpu = runDpoint(concat(base, {"--device", "cpu", "-o", dir.file("gpu.ply")}));
-    ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
-    EXPECT_EQ(gpu.err.find(kWhile), std::string::npos) << gpu.err;
-    EXPECT_TRUE(readFile(dir.file("cpu.ply")) == readFile(dir.file("gpu.ply")));
-  }
-}
-
 TEST(CliGenerateDevice, tilesOnTheDeviceMergeToTheCpuFile) {
   TempDir dir;
   const std::vector<std::string> kind = {"generate", "julia", "--resolution", "27", "-q"};

@@ -2,12 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <limits>
 #include <string>
 #include <utility>
@@ -973,90 +971,6 @@ TEST(Ply, plyFailedWriteLeavesNothing) {
   EXPECT_TRUE(contains(bad.error().message, "bad.ply"));
   EXPECT_TRUE(contains(bad.error().message, "triangle index 99 out of range"));
   EXPECT_TRUE(dir.entries().empty());
-}
-
-// ---------------------------------------------------------------- a mesh written while it is made
-
-// The first byte where the file at `path` differs from `expected` (its size where one is a prefix of
-// the other), or npos: a short message where an EXPECT_EQ would print both files.
-size_t firstDifference(const std::string& path, const std::string& expected) {
-  const std::string got = readFile(path);
-  const auto [a, b] = std::mismatch(got.begin(), got.end(), expected.begin(), expected.end());
-  return a == got.end() && b == expected.end() ? std::string::npos : static_cast<size_t>(a - got.begin());
-}
-
-// A generated mesh's PLY (cli/cli_generate_output.h): the vertex rows written as slabs come, the
-// header laid out from estimated counts. Whatever the estimates, the file is writePly's.
-TEST(Ply, meshStreamWritesWritePlysFileWhateverTheEstimates) {
-  TempDir dir;
-  PointSet mesh;
-  mesh.z_axis = ZAxis::kPresent;
-  const size_t n = 300000;  // several 65,536-row chunks, cut across slabs; 149,999 faces
-  for (size_t i = 0; i < n; ++i) {
-    const double x = static_cast<double>(i);
-    mesh.positions.push_back({std::sin(0.001 * x) * 1e6, 1e-9 * x, 3.0 + 0.5 * x});
-  }
-  for (uint32_t i = 0; i + 2 < n; i += 2) mesh.triangles.insert(mesh.triangles.end(), {i, i + 1, i + 2});
-  const size_t faces = mesh.triangles.size() / 3;
-  const ColorSource colors_of = [](const glm::dvec3* p, size_t count, glm::vec3* c) {  // of the position only
-    for (size_t i = 0; i < count; ++i)
-      c[i] = glm::vec3(static_cast<float>(std::fmod(std::abs(p[i].x), 1.0)), 0.25f, static_cast<float>(std::fmod(p[i].z, 7.0) / 7.0));
-  };
-  auto stream = [&](const std::string& name, uint64_t vertices, uint64_t triangles, bool colors, bool& kept) {
-    PlyWriteOptions options;
-    options.threads = 3;
-    if (colors) options.colors_of = colors_of;
-    PointSet facts;
-    facts.z_axis = ZAxis::kPresent;
-    PlyMeshStream out(dir.file(name), std::move(facts), options);
-    out.start(vertices, triangles);
-    for (size_t first = 0, slab = 1; first < n; slab = slab * 3 + 7) {  // slabs of 1, 10, 37, ... rows
-      const size_t end = std::min(n, first + slab);
-      out.addVertices(PositionArray(mesh.positions.begin() + first, mesh.positions.begin() + end));
-      if (slab == 1) out.addVertices({});  // a slab without vertices
-      first = end;
-    }
-    Status s = out.finish(mesh);
-    kept = out.rowsKept();
-    return s;
-  };
-  for (bool colors : {true, false}) {
-    PlyWriteOptions options;
-    if (colors) options.colors_of = colors_of;
-    ASSERT_TRUE(writePly(dir.file("expected.ply"), mesh, options).ok());
-    const std::string expected = readFile(dir.file("expected.ply"));
-    bool kept = false;
-    ASSERT_TRUE(stream("exact.ply", n, faces, colors, kept).ok());
-    EXPECT_TRUE(kept);
-    EXPECT_EQ(firstDifference(dir.file("exact.ply"), expected), std::string::npos);
-    // Off by 3%: the same digits, the rows kept.
-    ASSERT_TRUE(stream("near.ply", n * 103 / 100, faces * 97 / 100, colors, kept).ok());
-    EXPECT_TRUE(kept);
-    EXPECT_EQ(firstDifference(dir.file("near.ply"), expected), std::string::npos);
-    // Other digits: the rows written meanwhile are dropped and the file written again.
-    ASSERT_TRUE(stream("other.ply", n / 10, faces, colors, kept).ok());
-    EXPECT_FALSE(kept);
-    EXPECT_EQ(firstDifference(dir.file("other.ply"), expected), std::string::npos);
-    // Too near a power of ten to trust the digits: declined, written at the end.
-    ASSERT_TRUE(stream("declined.ply", n, 99000, colors, kept).ok());
-    EXPECT_FALSE(kept);
-    EXPECT_EQ(firstDifference(dir.file("declined.ply"), expected), std::string::npos);
-  }
-  EXPECT_EQ(dir.entries().size(), 5u);  // the four and expected.ply: no temporaries
-  // Not finished (the generator failed): nothing appears.
-  {
-    PlyMeshStream out(dir.file("failed.ply"), PointSet{}, PlyWriteOptions{});
-    out.start(n, faces);
-    out.addVertices(PositionArray(mesh.positions.begin(), mesh.positions.begin() + 1000));
-  }
-  EXPECT_FALSE(std::filesystem::exists(dir.file("failed.ply")));
-  // writePly's checks, after the rows: the bad index named, nothing left.
-  mesh.triangles.back() = static_cast<uint32_t>(n + 5);
-  bool kept = true;
-  Status bad = stream("bad.ply", n, faces, true, kept);
-  ASSERT_FALSE(bad.ok());
-  EXPECT_TRUE(contains(bad.error().message, "triangle index " + std::to_string(n + 5) + " out of range"));
-  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
 }
 
 // ---------------------------------------------------------------- streamed vertices

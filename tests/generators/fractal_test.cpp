@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -419,67 +418,6 @@ TEST(MarchingCubes, identicalForAnyThreadCount) {
     ASSERT_TRUE(many.ok());
     expectSameMesh(*one, *many);
   }
-}
-
-// The row function's counts as a plane function gives them (escape_grid.h): a device's stand-in.
-EscapePlaneFunction rowPlanes(const GridAxis& axis, const EscapeRowFunction& row) {
-  return [axis, row](int first, int planes, int limit, uint8_t* counts) -> Status {
-    Result<std::vector<uint32_t>> grid = computeEscapeGrid(axis, limit, row, 1, first, planes);
-    if (!grid) return grid.error();
-    const int bytes = escapeGridBytesPerCount(limit);
-    for (size_t i = 0; i < grid->size(); ++i) {
-      const uint32_t c = (*grid)[i];
-      for (int b = 0; b < bytes; ++b) counts[i * bytes + b] = static_cast<uint8_t>(c >> (8 * b));
-    }
-    return okStatus();
-  };
-}
-
-// The PLY written while the mesh is made (PlyMeshStream) hears an estimate first, then every
-// slab's vertices, which are the mesh's in order; a tile tells it nothing.
-TEST(MarchingCubes, meshSinkHearsAnEstimateThenTheVerticesInOrder) {
-  JuliaParams params;
-  params.resolution = 40;
-  params.threads = 3;
-  Result<PointSet> plain = generateJulia(params);
-  ASSERT_TRUE(plain.ok());
-  params.planes = rowPlanes(GridAxis{params.resolution, params.lo, params.hi}, juliaRow(params.c));
-  int estimates = 0;
-  uint64_t estimated_vertices = 0;
-  PositionArray heard;
-  params.mesh_sink.estimate = [&](uint64_t vertices, uint64_t) {
-    ++estimates;
-    estimated_vertices = vertices;
-    EXPECT_TRUE(heard.empty());
-  };
-  params.mesh_sink.vertices = [&](PositionArray&& p) { heard.insert(heard.end(), p.begin(), p.end()); };
-  Result<PointSet> told = generateJulia(params);
-  ASSERT_TRUE(told.ok()) << told.error().message;
-  expectSameMesh(*plain, *told);
-  EXPECT_EQ(estimates, 1);
-  EXPECT_GT(estimated_vertices, 0u);
-  ASSERT_EQ(heard.size(), plain->size());
-  EXPECT_EQ(std::memcmp(heard.data(), plain->positions.data(), heard.size() * sizeof(glm::dvec3)), 0);
-  Result<PointTile> tile = generateJuliaTile(params, {0, 2});
-  ASSERT_TRUE(tile.ok());
-  EXPECT_EQ(estimates, 1);
-  // Every cell layer sampled, the estimate is the count; one layer in four, near it.
-  const EscapeSurfaceParams surface = escapeSurfaceParams("julia", params);
-  Result<MeshCounts> exact = escapeMeshEstimate(surface, params.resolution - 1);
-  ASSERT_TRUE(exact.ok());
-  EXPECT_EQ(exact->vertices, plain->size());
-  EXPECT_EQ(exact->triangles, plain->triangles.size() / 3);
-  MandelbulbParams bulb;
-  bulb.resolution = 97;
-  bulb.variant = MandelbulbVariant::kFast;
-  Result<PointSet> bulb_mesh = generateMandelbulb(bulb);
-  ASSERT_TRUE(bulb_mesh.ok());
-  bulb.planes = rowPlanes(GridAxis{bulb.resolution, bulb.lo, bulb.hi}, mandelbulbRow(bulb.variant, 8.0));
-  Result<MeshCounts> sampled = escapeMeshEstimate(escapeSurfaceParams("mandelbulb", bulb), 24);
-  ASSERT_TRUE(sampled.ok());
-  EXPECT_NEAR(static_cast<double>(sampled->vertices) / static_cast<double>(bulb_mesh->size()), 1.0, 0.05);
-  EXPECT_NEAR(static_cast<double>(sampled->triangles) / static_cast<double>(bulb_mesh->triangles.size() / 3), 1.0,
-              0.05);
 }
 
 TEST(MarchingCubes, meshIsConsistentlyOriented) {
