@@ -8,9 +8,11 @@
 // (pread, one buffer per thread) and decoded on all cores straight into the exactly sized arrays.
 // The result therefore never depends on the thread count, and the first bad row in file order
 // gives the error (a block stops at its own first bad row; blocks after a known bad row are not
-// decoded; the lowest row wins). Memory: the PointSet plus one block per thread. ASCII data,
-// faces and vertices with lists stay serial: ASCII rows have no known offsets (the CSV reader's
-// two passes would be needed), and meshes are small next to the point sets this reader is timed on.
+// decoded; the lowest row wins). Memory: the PointSet plus one block per thread. Binary triangle
+// faces are decoded in blocks the same way, and ASCII vertex and triangle rows in two passes over
+// 4 MiB blocks (newlines counted, then each block's lines parsed into their rows: readAsciiRows),
+// each up to the first row of another kind, from which the row-by-row loop goes on. Vertices with
+// lists and other elements stay serial.
 #include "converters/ply.h"
 
 #include <fast_float/fast_float.h>
@@ -625,7 +627,8 @@ class PlyParser {
       points_.triangles.reserve(3 * std::min({e.count, in_.remaining() / min_face, room}));
     }
     uint64_t first_row = 0;
-    if (!ascii_ && e.name == "face") first_row = readTriangleRows(e, roles);
+    if (ascii_) first_row = readAsciiRows(e, roles);
+    else if (e.name == "face") first_row = readTriangleRows(e, roles);
     for (uint64_t row = first_row; row < e.count; ++row) {
       uint64_t where = 0;
       Status s = ascii_ ? readAsciiRow(e, roles, row, where) : readBinaryRow(e, roles, row, where);
@@ -689,6 +692,164 @@ class PlyParser {
     if (options_.progress) options_.progress->advance(end - std::clamp(reported, begin, end));
     points_.triangles.resize(static_cast<size_t>(3 * done));
     in_.skip(done * kRow);
+    return done;
+  }
+
+  // ASCII rows as most tools write them, in parallel blocks: vertex rows of single values, and faces
+  // whose one property is the list of indices, three of them. The newlines of the rest of the file
+  // are counted per block on all cores, which gives each block the row of the first line that ends
+  // in it; each block then parses its lines (readAsciiRow's tokens and values) into their rows.
+  // Parsing stops at the first row that is blank, does not parse, is not acceptable, is another
+  // polygon or names no vertex, or at what --max-memory leaves for triangles. Returns how many
+  // rows were done; the row-by-row loop goes on from there and reports any error at its line.
+  uint64_t readAsciiRows(const Element& e, const std::vector<Role>& roles) {
+    const bool is_vertex = e.name == "vertex";
+    if (is_vertex) {
+      if (!points_.positions.empty() ||
+          std::any_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; }))
+        return 0;
+    } else if (e.name != "face" || e.properties.size() != 1 || roles[0] != kIndices || !e.properties[0].is_list ||
+               !points_.triangles.empty()) {
+      return 0;
+    }
+    constexpr uint64_t kBlock = uint64_t{4} << 20;
+    const uint64_t begin = in_.offset(), bytes = in_.remaining(), reported = in_.readEnd();
+    const size_t blocks = static_cast<size_t>((bytes + kBlock - 1) / kBlock);
+    if (blocks == 0) return 0;
+    const unsigned threads = resolveThreads(options_.threads);
+    std::vector<std::vector<char>> buffers(threads);
+    // Pass 1: the newlines of each block, and the offset just past its last one (0: none).
+    std::vector<uint64_t> newlines(blocks, 0), after_last(blocks, 0);
+    std::atomic<bool> unread{false};
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      const uint64_t from = begin + b * kBlock, n = std::min(kBlock, bytes - b * kBlock);
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>(n));
+      Result<size_t> got = file_.readAt(from, buffer.data(), buffer.size());
+      if (!got || *got < buffer.size()) {
+        unread = true;  // the loop reads it again and reports why
+        return;
+      }
+      const char* q = buffer.data();
+      const char* const end = q + buffer.size();
+      while (const void* nl = std::memchr(q, '\n', static_cast<size_t>(end - q))) {
+        q = static_cast<const char*>(nl) + 1;
+        ++newlines[b];
+      }
+      if (newlines[b] > 0) after_last[b] = from + static_cast<uint64_t>(q - buffer.data());
+    });
+    if (unread) return 0;
+    // Block b's lines: rows first_row[b] .. + newlines[b], from line_start[b] to after_last[b].
+    std::vector<uint64_t> first_row(blocks), line_start(blocks);
+    uint64_t lines = 0, start = begin;
+    for (size_t b = 0; b < blocks; ++b) {
+      first_row[b] = lines;
+      line_start[b] = start;
+      lines += newlines[b];
+      if (newlines[b] > 0) start = after_last[b];
+    }
+    uint64_t rows = std::min(e.count, lines);
+    if (!is_vertex)  // finishFace's memory check passes while vertex_bytes_ + 12 bytes a triangle ≤ memory_limit_
+      rows = std::min(rows, (memory_limit_ - std::min(memory_limit_, vertex_bytes_)) / (3 * sizeof(uint32_t)));
+    if (rows == 0) return 0;
+    if (is_vertex) {
+      resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
+      if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
+      points_.dimensions.resize(static_cast<size_t>(rows));
+    } else {
+      resizePrefaulted(points_.triangles, static_cast<size_t>(3 * rows), threads);
+    }
+    std::atomic<uint64_t> stop{rows};  // no row from here on is taken
+    auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
+    // One line's values into row `row`; false where the row-by-row loop must take it.
+    auto parseVertex = [&](std::string_view rest, uint64_t row) {
+      double v[kRoleCount] = {};
+      double attributes[64];
+      if (attribute_row_.size() > std::size(attributes)) return false;
+      for (size_t k = 0; k < e.properties.size(); ++k) {
+        const std::string_view token = nextToken(rest);
+        double value = 0;
+        if (token.empty() || !parseAscii(e.properties[k].type, token, value)) return false;
+        v[roles[k]] = value;
+        if (roles[k] == kAttribute) attributes[attribute_of_[k]] = value;
+      }
+      if (!nextToken(rest).empty() || !positionAcceptable(v) || (has_colors_ && !colourAcceptable(v))) return false;
+      points_.positions[row] = glm::dvec3(v[kX], v[kY], v[kZ]);
+      if (has_colors_) points_.colors[row] = colorOf(v);
+      for (size_t a = 0; a < attribute_row_.size(); ++a) points_.dimensions.all()[a].setValue(row, attributes[a]);
+      return true;
+    };
+    const Property& list = e.properties[0];
+    const double vertices = static_cast<double>(vertex_count_);
+    auto parseFace = [&](std::string_view rest, uint64_t row) {
+      double count = 0;
+      std::string_view token = nextToken(rest);
+      if (token.empty() || !parseAscii(list.count_type, token, count) || count != 3) return false;
+      for (uint64_t i = 0; i < 3; ++i) {
+        double index = 0;
+        token = nextToken(rest);
+        if (token.empty() || !parseAscii(list.type, token, index) || !(index >= 0 && index < vertices)) return false;
+        points_.triangles[3 * row + i] = static_cast<uint32_t>(index);
+      }
+      return nextToken(rest).empty();
+    };
+    // Pass 2: each block's lines. A line that began more than a block before its block's end is
+    // left to the loop (which reports one longer than kMaxAsciiLine).
+    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+      const uint64_t first = first_row[b];
+      if (newlines[b] == 0 || first >= stop.load()) return;
+      if (after_last[b] - line_start[b] > 2 * kBlock) return stopAt(first);
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>(after_last[b] - line_start[b]));
+      Result<size_t> got = file_.readAt(line_start[b], buffer.data(), buffer.size());
+      if (!got || *got < buffer.size()) return stopAt(first);
+      const char* q = buffer.data();
+      for (uint64_t row = first; row < first + newlines[b]; ++row) {
+        if (row >= stop.load(std::memory_order_relaxed)) return;
+        const char* nl = static_cast<const char*>(std::memchr(q, '\n', static_cast<size_t>(buffer.data() + buffer.size() - q)));
+        std::string_view line(q, static_cast<size_t>(nl - q));
+        q = nl + 1;
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        if (isBlank(line) || !(is_vertex ? parseVertex(line, row) : parseFace(line, row))) return stopAt(row);
+      }
+    });
+    const uint64_t done = stop.load();
+    if (done < rows) {
+      if (is_vertex) {
+        points_.positions.resize(static_cast<size_t>(done));
+        if (has_colors_) points_.colors.resize(static_cast<size_t>(done));
+        points_.dimensions.resize(static_cast<size_t>(done));
+      } else {
+        points_.triangles.resize(static_cast<size_t>(3 * done));
+      }
+    }
+    if (done == 0) return 0;
+    // The offset just past row done − 1's newline: found in its block.
+    size_t b = static_cast<size_t>(std::upper_bound(first_row.begin(), first_row.end(), done - 1) - first_row.begin()) - 1;
+    while (newlines[b] == 0) --b;
+    uint64_t end = after_last[b];
+    if (first_row[b] + newlines[b] > done) {
+      std::vector<char>& buffer = buffers[0];
+      buffer.resize(static_cast<size_t>(after_last[b] - line_start[b]));
+      Result<size_t> got = file_.readAt(line_start[b], buffer.data(), buffer.size());
+      if (!got || *got < buffer.size()) {  // read a moment ago: the file changed; the loop says so
+        if (is_vertex) {
+          points_.positions.clear();
+          points_.colors.clear();
+          points_.dimensions.resize(0);
+        } else {
+          points_.triangles.clear();
+        }
+        return 0;
+      }
+      const char* q = buffer.data();
+      for (uint64_t row = first_row[b]; row < done; ++row)
+        q = static_cast<const char*>(std::memchr(q, '\n', static_cast<size_t>(buffer.data() + buffer.size() - q))) + 1;
+      end = line_start[b] + static_cast<uint64_t>(q - buffer.data());
+    }
+    if (options_.progress) options_.progress->advance(end - std::clamp(reported, begin, end));
+    in_.skip(end - begin);
+    line_no_ += done;
     return done;
   }
 

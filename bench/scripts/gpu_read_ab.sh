@@ -11,6 +11,7 @@
 #   gltf  the same at GLTF_RES (1024: 27M vertices, a 1.18 GB GLB with COLOR_0 and uint32 indices)
 #   pcd   the las set's 16.8M points as an ASCII PCD (x y z rgb); with WRITE=1 also the whole
 #         `dpoint convert s11u.ply --pcd-encoding ascii -o w.pcd`
+#   plyascii  the gltf set's mesh as an ASCII PLY (1024: 16.6M vertices, 33M faces, 2 GB)
 # Rows in $OUT/read.tsv, medians in $OUT/read-summary.tsv.
 #   SETS="las mesh gltf pcd" BASE=a968b90 ROUNDS=3 WRITE=1 MESH_RES=2048 GLTF_RES=1024
 set -euo pipefail
@@ -37,6 +38,11 @@ for set in ${SETS:-las mesh gltf pcd}; do
       [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
       file=$data/s11u-ascii.pcd
       [ -s "$file" ] || .gpu/dpoint convert "$data/s11u.ply" --pcd-encoding ascii -q -o "$file" ;;
+    plyascii)
+      file=$data/mb${GLTF_RES:-1024}-ascii.ply
+      [ -s "$data/mb${GLTF_RES:-1024}.ply" ] ||
+        .gpu/dpoint generate mandelbulb --variant fast --resolution "${GLTF_RES:-1024}" --device 0 -q -o "$data/mb${GLTF_RES:-1024}.ply"
+      [ -s "$file" ] || .gpu/dpoint convert "$data/mb${GLTF_RES:-1024}.ply" --ply-ascii -q -o "$file" ;;
     *) echo "unknown set $set" >&2; exit 2 ;;
   esac
   ls -l "$file" | tee -a "$out/sizes.txt"

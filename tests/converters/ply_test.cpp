@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/text.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -553,6 +554,110 @@ TEST(Ply, plyAcceptsNanWhenAllowed) {
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_TRUE(std::isnan(r->positions[0].y));
   EXPECT_EQ(r->positions[1].x, -std::numeric_limits<double>::infinity());
+}
+
+// ASCII rows are parsed in 4 MiB blocks on all cores up to the first row the row-by-row loop must
+// take (a blank line, another polygon, a bad value), which goes on from there: the same points,
+// triangles and errors (at their line) on any thread count, whatever block the row falls in.
+TEST(Ply, asciiRowsAreReadInBlocksUpToTheFirstOtherRow) {
+  TempDir dir;
+  const uint64_t n = 250000, faces = n - 2;  // about 10 MB of vertex rows and 4 MB of faces
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(n) +
+                             "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\n"
+                             "property uchar green\nproperty uchar blue\nproperty float intensity\nelement face " +
+                             std::to_string(faces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  const uint64_t header_lines = 13;
+  // Row i as text, with `change` applied to vertex row i or face row i.
+  auto text = [&](const std::function<void(bool vertex, uint64_t row, std::string& line)>& change,
+                  const char* newline = "\n") {
+    std::string out = header;
+    for (uint64_t i = 0; i < n; ++i) {
+      std::string line = formatNumber(0.25 * static_cast<double>(i)) + " " + formatNumber(-static_cast<double>(i)) + " " +
+                         formatNumber(1e6 + 0.125 * static_cast<double>(i)) + " " + std::to_string(i % 256) + " " +
+                         std::to_string(i * 7 % 256) + " 3 " + formatNumber(0.5 * static_cast<double>(i));
+      change(true, i, line);
+      out += line + newline;
+    }
+    for (uint64_t f = 0; f < faces; ++f) {
+      std::string line = "3 " + std::to_string(f) + " " + std::to_string(f + 1) + " " + std::to_string(f + 2);
+      change(false, f, line);
+      out += line + newline;
+    }
+    return out;
+  };
+  auto same = [](bool, uint64_t, std::string&) {};
+  auto expectTheSet = [&](const Result<PointSet>& r, uint64_t extra_triangles) {
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ASSERT_EQ(r->size(), n);
+    ASSERT_EQ(r->triangles.size(), 3 * (faces + extra_triangles));
+    bool good = true;
+    for (uint64_t i = 0; i < n && good; ++i) {
+      const double x = static_cast<double>(i);
+      good = r->positions[i] == glm::dvec3(0.25 * x, -x, 1e6 + 0.125 * x) &&
+             r->colors[i] == glm::vec3(static_cast<float>(i % 256) / 255.0f, static_cast<float>(i * 7 % 256) / 255.0f,
+                                       3.0f / 255.0f) &&
+             r->dimensions.all()[0].value(i) == 0.5 * x;
+      EXPECT_TRUE(good) << "vertex " << i;
+    }
+    for (uint64_t f = 0; f < faces && good; ++f) {
+      good = r->triangles[3 * f] == f && r->triangles[3 * f + 1] == f + 1 && r->triangles[3 * f + 2] == f + 2;
+      EXPECT_TRUE(good) << "face " << f;
+    }
+  };
+  for (unsigned threads : {1u, 2u, 7u}) {
+    SCOPED_TRACE(threads);
+    const PlyReadOptions options = withThreads(threads);
+    expectTheSet(readText(dir, "clean.ply", text(same), options), 0);
+    expectTheSet(readText(dir, "crlf.ply", text(same, "\r\n"), options), 0);
+    // Blank lines among the rows are skipped.
+    expectTheSet(readText(dir, "blank.ply", text([](bool vertex, uint64_t row, std::string& line) {
+                                           if (row == (vertex ? 100000u : 3u)) line = " \t\n" + line;
+                                         }),
+                          options),
+                 0);
+    // A quad is fanned into two triangles; the rows after it are read as before.
+    auto quad = readText(dir, "quad.ply", text([](bool vertex, uint64_t row, std::string& line) {
+                                            if (!vertex && row == 150000) line = "4 150000 150001 150002 7";
+                                          }),
+                         options);
+    ASSERT_TRUE(quad.ok()) << quad.error().message;
+    ASSERT_EQ(quad->triangles.size(), 3 * (faces + 1));
+    EXPECT_EQ(std::vector<uint32_t>(quad->triangles.begin() + 3 * 150000, quad->triangles.begin() + 3 * 150003),
+              (std::vector<uint32_t>{150000, 150001, 150002, 150000, 150002, 7, 150001, 150002, 150003}));
+    // Errors at their line, in a later block.
+    auto bad = readText(dir, "bad.ply", text([](bool vertex, uint64_t row, std::string& line) {
+                                          if (vertex && row == 200000) line = "1 abc 2 0 0 0 0";
+                                          if (vertex && row == 210000) line = "1 2";  // after the first error: not it
+                                        }),
+                        options);
+    ASSERT_FALSE(bad.ok());
+    EXPECT_TRUE(contains(bad.error().message, "line " + std::to_string(header_lines + 200000 + 1) +
+                                                  ": vertex 200000: 'y': 'abc' is not a valid double"))
+        << bad.error().message;
+    auto nan = readText(dir, "nan.ply", text([](bool vertex, uint64_t row, std::string& line) {
+                                          if (vertex && row == 123456) line = "nan 0 0 0 0 0 0";
+                                        }),
+                        options);
+    ASSERT_FALSE(nan.ok());
+    EXPECT_TRUE(contains(nan.error().message, "line " + std::to_string(header_lines + 123456 + 1) +
+                                                  ": vertex 123456: x is nan, not a finite number"))
+        << nan.error().message;
+    auto index = readText(dir, "index.ply", text([&](bool vertex, uint64_t row, std::string& line) {
+                                              if (!vertex && row == 240000) line = "3 1 2 " + std::to_string(n + 5);
+                                            }),
+                          options);
+    ASSERT_FALSE(index.ok());
+    EXPECT_TRUE(contains(index.error().message, "line " + std::to_string(header_lines + n + 240000 + 1) +
+                                                    ": face 240000: vertex index " + std::to_string(n + 5) +
+                                                    " out of range"))
+        << index.error().message;
+    auto extra = readText(dir, "extra.ply", text([](bool vertex, uint64_t row, std::string& line) {
+                                              if (!vertex && row == 5) line += " 9";
+                                            }),
+                          options);
+    ASSERT_FALSE(extra.ok());
+    EXPECT_TRUE(contains(extra.error().message, "face 5: more values than the header declares")) << extra.error().message;
+  }
 }
 
 // ---------------------------------------------------------------- failures
