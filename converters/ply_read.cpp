@@ -8,8 +8,8 @@
 // (pread, one buffer per thread) and decoded on all cores straight into the exactly sized arrays.
 // The result therefore never depends on the thread count, and the first bad row in file order
 // gives the error (a block stops at its own first bad row; blocks after a known bad row are not
-// decoded; the lowest row wins). Memory: the PointSet plus one block per thread. Binary triangle
-// faces are decoded in blocks the same way, and ASCII vertex and triangle rows in two passes over
+// decoded; the lowest row wins). Memory: the PointSet plus one block per thread. Binary faces of
+// the first row's size are decoded in blocks the same way, and ASCII vertex and face rows in two passes over
 // 4 MiB blocks (newlines counted, then each block's lines parsed into their rows: readAsciiRows),
 // each up to the first row of another kind, from which the row-by-row loop goes on. Vertices with
 // lists and other elements stay serial.
@@ -640,28 +640,33 @@ class PlyParser {
     return okStatus();
   }
 
-  // Binary triangles as dpoint and most tools write them: the face element's one property a list
-  // of a one-byte count and 32-bit indices, so a triangle's row is 13 bytes. Rows are decoded in
-  // parallel blocks up to the first that is not such a triangle (another count, an index naming no
-  // vertex), the file's end (or a read that fails) or what --max-memory leaves for triangles. Returns
-  // how many rows were done; the row-by-row loop goes on from there and reports any error at its
-  // row, as it does for every row of other layouts. 207M faces took 6-10 s on one thread (H200).
+  // Binary faces as dpoint and most tools write them: the face element's one property a list of a
+  // one-byte count and 32-bit indices, every row with the first row's count k (3: triangles, 4:
+  // quads, ...), so a row is 1 + 4k bytes and gives k − 2 triangles (finishFace's fan). Rows are
+  // decoded in parallel blocks up to the first that has another count or an index naming no
+  // vertex, the file's end (or a read that fails) or what --max-memory leaves for triangles.
+  // Returns how many rows were done; the row-by-row loop goes on from there and reports any error
+  // at its row, as it does for every row of other layouts. 207M faces took 6-10 s on one thread (H200).
   uint64_t readTriangleRows(const Element& e, const std::vector<Role>& roles) {
     if (e.properties.size() != 1 || roles[0] != kIndices || !points_.triangles.empty()) return 0;
     const Property& p = e.properties[0];
     if (!p.is_list || typeSize(p.count_type) != 1 || (p.type != Type::kInt32 && p.type != Type::kUint32)) return 0;
-    constexpr uint64_t kRow = 1 + 3 * sizeof(uint32_t);
+    Result<size_t> first_count = in_.require(1);
+    if (!first_count || *first_count < 1) return 0;
+    const uint8_t k = static_cast<uint8_t>(in_.data()[0]);
+    if (k < 3) return 0;
+    const uint64_t kRow = 1 + uint64_t{k} * sizeof(uint32_t), per_row = k - 2u;
     // finishFace's memory check passes while vertex_bytes_ + 12 bytes a triangle ≤ memory_limit_.
     const uint64_t room = (memory_limit_ - std::min(memory_limit_, vertex_bytes_)) / (3 * sizeof(uint32_t));
-    const uint64_t rows = std::min({e.count, in_.remaining() / kRow, room});
+    const uint64_t rows = std::min({e.count, in_.remaining() / kRow, room / per_row});
     if (rows == 0) return 0;
     const unsigned threads = resolveThreads(options_.threads);
-    resizePrefaulted(points_.triangles, static_cast<size_t>(3 * rows), threads);
+    resizePrefaulted(points_.triangles, static_cast<size_t>(3 * per_row * rows), threads);
     uint32_t* out = points_.triangles.data();
     const bool is_signed = p.type == Type::kInt32;
     const uint64_t vertices = vertex_count_;
     const uint64_t begin = in_.offset(), reported = in_.readEnd();
-    const uint64_t block_rows = kVertexBlockBytes / kRow;
+    const uint64_t block_rows = std::max<uint64_t>(1, kVertexBlockBytes / kRow);
     std::atomic<uint64_t> stop{rows};  // no row from here on is taken
     auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
     std::vector<std::vector<char>> buffers(threads);
@@ -675,14 +680,23 @@ class PlyParser {
       if (!got) return stopAt(first);  // the loop reads it again and reports the error
       const uint64_t whole = first + *got / kRow;
       const char* q = buffer.data();
+      uint32_t index[255];
       for (uint64_t r = first; r < whole; ++r, q += kRow) {
-        uint32_t index[3];
-        std::memcpy(index, q + 1, sizeof index);
-        bool good = q[0] == 3;
-        for (uint32_t i : index)
-          good = good && (!is_signed || static_cast<int32_t>(i) >= 0) && i < vertices;
+        std::memcpy(index, q + 1, k * sizeof(uint32_t));
+        bool good = static_cast<uint8_t>(q[0]) == k;
+        for (unsigned i = 0; i < k; ++i)
+          good = good && (!is_signed || static_cast<int32_t>(index[i]) >= 0) && index[i] < vertices;
         if (!good) return stopAt(r);
-        std::memcpy(out + 3 * r, index, sizeof index);
+        if (k == 3) {
+          std::memcpy(out + 3 * r, index, 3 * sizeof(uint32_t));
+          continue;
+        }
+        uint32_t* t = out + 3 * per_row * r;
+        for (unsigned i = 1; i + 1 < k; ++i, t += 3) {  // finishFace's fan: (v0, vi, vi+1)
+          t[0] = index[0];
+          t[1] = index[i];
+          t[2] = index[i + 1];
+        }
       }
       if (whole < last) stopAt(whole);
     });
@@ -690,13 +704,14 @@ class PlyParser {
     // Once, for the rows taken (a block past a stop may have decoded rows the loop reads again).
     const uint64_t end = begin + done * kRow;
     if (options_.progress) options_.progress->advance(end - std::clamp(reported, begin, end));
-    points_.triangles.resize(static_cast<size_t>(3 * done));
+    points_.triangles.resize(static_cast<size_t>(3 * per_row * done));
     in_.skip(done * kRow);
     return done;
   }
 
   // ASCII rows as most tools write them, in parallel blocks: vertex rows of single values, and faces
-  // whose one property is the list of indices, three of them. The newlines of the rest of the file
+  // whose one property is the list of indices, as many in every row as in the first (fanned into
+  // triangles as finishFace does). The newlines of the rest of the file
   // are counted per block on all cores, which gives each block the row of the first line that ends
   // in it; each block then parses its lines (readAsciiRow's tokens and values) into their rows.
   // Parsing stops at the first row that is blank, does not parse, is not acceptable, is another
@@ -749,15 +764,27 @@ class PlyParser {
       if (newlines[b] > 0) start = after_last[b];
     }
     uint64_t rows = std::min(e.count, lines);
-    if (!is_vertex)  // finishFace's memory check passes while vertex_bytes_ + 12 bytes a triangle ≤ memory_limit_
-      rows = std::min(rows, (memory_limit_ - std::min(memory_limit_, vertex_bytes_)) / (3 * sizeof(uint32_t)));
+    const Property& list = e.properties[0];
+    uint64_t corners = 0;  // the faces' indices a row: the first row's
+    if (!is_vertex) {
+      std::vector<char>& buffer = buffers[0];
+      buffer.resize(static_cast<size_t>(std::min<uint64_t>(bytes, 4096)));
+      Result<size_t> got = file_.readAt(begin, buffer.data(), buffer.size());
+      if (!got) return 0;
+      std::string_view line(buffer.data(), *got);
+      double count = 0;
+      if (!parseAscii(list.count_type, nextToken(line), count) || !(count >= 3 && count <= 1024)) return 0;
+      corners = static_cast<uint64_t>(count);
+      // finishFace's memory check passes while vertex_bytes_ + 12 bytes a triangle ≤ memory_limit_.
+      rows = std::min(rows, (memory_limit_ - std::min(memory_limit_, vertex_bytes_)) / (3 * sizeof(uint32_t)) / (corners - 2));
+    }
     if (rows == 0) return 0;
     if (is_vertex) {
       resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
       if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
       points_.dimensions.resize(static_cast<size_t>(rows));
     } else {
-      resizePrefaulted(points_.triangles, static_cast<size_t>(3 * rows), threads);
+      resizePrefaulted(points_.triangles, static_cast<size_t>(3 * (corners - 2) * rows), threads);
     }
     std::atomic<uint64_t> stop{rows};  // no row from here on is taken
     auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
@@ -779,17 +806,26 @@ class PlyParser {
       for (size_t a = 0; a < attribute_row_.size(); ++a) points_.dimensions.all()[a].setValue(row, attributes[a]);
       return true;
     };
-    const Property& list = e.properties[0];
     const double vertices = static_cast<double>(vertex_count_);
     auto parseFace = [&](std::string_view rest, uint64_t row) {
       double count = 0;
       std::string_view token = nextToken(rest);
-      if (token.empty() || !parseAscii(list.count_type, token, count) || count != 3) return false;
-      for (uint64_t i = 0; i < 3; ++i) {
+      if (token.empty() || !parseAscii(list.count_type, token, count) || count != static_cast<double>(corners)) return false;
+      uint32_t* t = points_.triangles.data() + 3 * (corners - 2) * row;
+      uint32_t first = 0, previous = 0;
+      for (uint64_t i = 0; i < corners; ++i) {
         double index = 0;
         token = nextToken(rest);
         if (token.empty() || !parseAscii(list.type, token, index) || !(index >= 0 && index < vertices)) return false;
-        points_.triangles[3 * row + i] = static_cast<uint32_t>(index);
+        const uint32_t v = static_cast<uint32_t>(index);
+        if (i == 0) first = v;
+        if (i >= 2) {  // finishFace's fan: (v0, vi−1, vi)
+          t[0] = first;
+          t[1] = previous;
+          t[2] = v;
+          t += 3;
+        }
+        previous = v;
       }
       return nextToken(rest).empty();
     };
@@ -820,7 +856,7 @@ class PlyParser {
         if (has_colors_) points_.colors.resize(static_cast<size_t>(done));
         points_.dimensions.resize(static_cast<size_t>(done));
       } else {
-        points_.triangles.resize(static_cast<size_t>(3 * done));
+        points_.triangles.resize(static_cast<size_t>(3 * (corners - 2) * done));
       }
     }
     if (done == 0) return 0;

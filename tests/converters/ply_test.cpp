@@ -615,7 +615,22 @@ TEST(Ply, asciiRowsAreReadInBlocksUpToTheFirstOtherRow) {
                                          }),
                           options),
                  0);
-    // A quad is fanned into two triangles; the rows after it are read as before.
+    // A quad mesh: every row fanned into two triangles.
+    auto quads = readText(dir, "quads.ply", text([&](bool vertex, uint64_t row, std::string& line) {
+                                              if (!vertex)
+                                                line = "4 " + std::to_string(row) + " " + std::to_string(row + 1) + " " +
+                                                       std::to_string(row + 2) + " " + std::to_string((row + 3) % n);
+                                            }),
+                          options);
+    ASSERT_TRUE(quads.ok()) << quads.error().message;
+    ASSERT_EQ(quads->triangles.size(), 6 * faces);
+    bool fanned = true;
+    for (uint64_t f = 0; f < faces && fanned; ++f) {
+      const uint32_t* t = &quads->triangles[6 * f];
+      fanned = t[0] == f && t[1] == f + 1 && t[2] == f + 2 && t[3] == f && t[4] == f + 2 && t[5] == (f + 3) % n;
+      EXPECT_TRUE(fanned) << "face " << f;
+    }
+    // A quad among triangles is fanned into two; the rows after it are read as before.
     auto quad = readText(dir, "quad.ply", text([](bool vertex, uint64_t row, std::string& line) {
                                             if (!vertex && row == 150000) line = "4 150000 150001 150002 7";
                                           }),
@@ -896,6 +911,52 @@ TEST(Ply, plyRejectsIndexOutOfRange) {
 // rows, up to the first row that is another polygon or names no vertex; the rows after are read one
 // at a time as before. Over several blocks and thread counts: the same triangles, a quad's fan, and
 // each error at its row and byte.
+// Faces of another size than three, every row like the first (a quad mesh): read in blocks too,
+// each fanned as the row-by-row loop fans it, up to the first row of another size or a bad index.
+TEST(Ply, binaryQuadsAreReadInBlocksUpToTheFirstOtherRow) {
+  TempDir dir;
+  static constexpr uint32_t kVertices = 1000;
+  static constexpr uint64_t kFaces = 200000;  // four blocks of 17-byte rows
+  auto file = [&](uint64_t triangle_row, uint64_t bad_row, std::vector<uint32_t>& expected, size_t& faces_at) {
+    Bytes b;
+    b.data = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kVertices) +
+             "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(kFaces) +
+             "\nproperty list uchar uint vertex_indices\nend_header\n";
+    for (uint32_t v = 0; v < kVertices; ++v) b.add(double(v)).add(0.5).add(-1.0);
+    faces_at = b.data.size();
+    expected.clear();
+    for (uint64_t r = 0; r < kFaces; ++r) {
+      const auto at = [r](uint64_t k) { return static_cast<uint32_t>((r + k) % kVertices); };
+      const uint32_t a = at(0), c = at(1), d = at(7), e = at(3);
+      if (r == triangle_row) {
+        b.add(uint8_t{3}).add(a).add(c).add(d);
+        expected.insert(expected.end(), {a, c, d});
+      } else {
+        b.add(uint8_t{4}).add(a).add(c).add(r == bad_row ? kVertices + 2 : d).add(e);
+        expected.insert(expected.end(), {a, c, d, a, d, e});
+      }
+    }
+    return b.data;
+  };
+  std::vector<uint32_t> expected;
+  size_t faces_at = 0;
+  for (unsigned threads : {1u, 2u, 4u}) {
+    SCOPED_TRACE(threads);
+    auto quads = readText(dir, "quads.ply", file(UINT64_MAX, UINT64_MAX, expected, faces_at), withThreads(threads));
+    ASSERT_TRUE(quads.ok()) << quads.error().message;
+    EXPECT_EQ(quads->triangles.size(), 6 * kFaces);
+    EXPECT_TRUE(quads->triangles == expected);
+    auto mixed = readText(dir, "mixed.ply", file(150000, UINT64_MAX, expected, faces_at), withThreads(threads));
+    ASSERT_TRUE(mixed.ok()) << mixed.error().message;
+    EXPECT_TRUE(mixed->triangles == expected);
+    auto bad = readText(dir, "bad.ply", file(UINT64_MAX, 170000, expected, faces_at), withThreads(threads));
+    ASSERT_FALSE(bad.ok());
+    EXPECT_TRUE(contains(bad.error().message, "bad.ply: byte " + std::to_string(faces_at + 170000 * 17) +
+                                                  ": face 170000: vertex index 1002 out of range"))
+        << bad.error().message;
+  }
+}
+
 TEST(Ply, binaryTrianglesAreReadInBlocksUpToTheFirstOtherRow) {
   TempDir dir;
   static constexpr uint32_t kVertices = 1000;
