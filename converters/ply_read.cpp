@@ -782,7 +782,7 @@ class PlyParser {
     if (is_vertex) {
       resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
       if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
-      points_.dimensions.resize(static_cast<size_t>(rows));
+      points_.dimensions.resizeUnset(static_cast<size_t>(rows));  // every row's values are set below
     } else {
       resizePrefaulted(points_.triangles, static_cast<size_t>(3 * (corners - 2) * rows), threads);
     }
@@ -944,7 +944,7 @@ class PlyParser {
     // Sized, not reserved: every block writes its own slots.
     resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
     if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
-    points_.dimensions.resize(static_cast<size_t>(rows));
+    points_.dimensions.resizeUnset(static_cast<size_t>(rows));  // every row's bytes are copied in below
     std::vector<uint8_t*> columns;
     for (Dimension& d : points_.dimensions.all()) columns.push_back(d.bytes.data());
 

@@ -42,7 +42,7 @@ std::optional<DimType> parseDimType(std::string_view name);
 
 // A column's bytes. Their allocator leaves bytes made without a value unset (core/memory.h), so
 // that a reader which writes every value of a large column does not zero it on one thread first:
-// Dimension's constructor and resize() still give zeros; Dimensions::appendUnset does not.
+// Dimension's constructor and resize() still give zeros; Dimensions::appendUnset and resizeUnset do not.
 using DimensionBytes = std::vector<uint8_t, DefaultInitAllocator<uint8_t>>;
 
 // One named column: size() values of `type`, stored as their bytes in host order.
@@ -63,6 +63,8 @@ struct Dimension {
   size_t size() const { return bytes.size() / dimTypeSize(type); }
   // New values are 0.
   void resize(size_t count) { bytes.resize(count * dimTypeSize(type), uint8_t{0}); }
+  // New values unset: for a caller that writes every one before any is read.
+  void resizeUnset(size_t count) { bytes.resize(count * dimTypeSize(type)); }
   // The value of point i as a double (exact for every type but 64-bit integers beyond 2^53).
   double value(size_t i) const;
   // Sets point i from a double: rounded toward zero and clamped to an integer type's range (NaN as
@@ -155,6 +157,10 @@ class Dimensions {
   bool remove(std::string_view name);
   // Every column resized to `points` (new values 0).
   void resize(size_t points);
+  // The same with the new values unset (Dimension::resizeUnset).
+  void resizeUnset(size_t points) {
+    for (Dimension& d : columns_) d.resizeUnset(points);
+  }
   // Bytes per point of all columns.
   size_t bytesPerPoint() const;
 

@@ -73,4 +73,11 @@ with scratch() as d:
     # set without a LAS source (the merged-point count's unset entries).
     under_memcheck("convert", path("bulb.glb"), "-o", path("bulb-glb.ply"))
     under_memcheck("convert", path("bulb.ply"), "-o", path("bulb.las"))
-print("memcheck: no unset byte read or written in 21 runs")
+    # PLY with dimension columns, binary and ASCII, read whole (vertex rows and their columns placed
+    # on all cores into unset slots; ASCII faces fanned into them too) and written as LAS.
+    dpoint(exe, "convert", path("simple.ply"), "--ply-ascii", "-o", path("simple-ascii.ply"))
+    dpoint(exe, "convert", path("bulb.ply"), "--ply-ascii", "-o", path("bulb-ascii.ply"))
+    under_memcheck("convert", path("simple.ply"), "-o", path("simple-back.las"))
+    under_memcheck("convert", path("simple-ascii.ply"), "-o", path("simple-ascii-back.las"))
+    under_memcheck("convert", path("bulb-ascii.ply"), "-o", path("bulb-ascii-back.ply"))
+print("memcheck: no unset byte read or written in 24 runs")
