@@ -669,6 +669,7 @@ class PlyParser {
     const uint64_t block_rows = std::max<uint64_t>(1, kVertexBlockBytes / kRow);
     std::atomic<uint64_t> stop{rows};  // no row from here on is taken
     auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
+    std::atomic<uint64_t> advanced{0};  // bytes given to the progress
     std::vector<std::vector<char>> buffers(threads);
     parallelFor(static_cast<size_t>((rows + block_rows - 1) / block_rows), threads, [&](size_t b, unsigned worker) {
       const uint64_t first = b * block_rows, last = std::min(first + block_rows, rows);
@@ -698,12 +699,18 @@ class PlyParser {
           t[2] = index[i + 1];
         }
       }
-      if (whole < last) stopAt(whole);
+      if (whole < last) return stopAt(whole);
+      // Progress as blocks finish (one past a later stop may count rows the loop reads again: the
+      // bar then reaches 100% a moment early, never more), the rest once the rows taken are known.
+      const uint64_t from = offset, to = offset + buffer.size();
+      const uint64_t bar = to - std::clamp(reported, from, to);
+      advanced += bar;
+      if (options_.progress) options_.progress->advance(bar);
     });
     const uint64_t done = stop.load();
-    // Once, for the rows taken (a block past a stop may have decoded rows the loop reads again).
     const uint64_t end = begin + done * kRow;
-    if (options_.progress) options_.progress->advance(end - std::clamp(reported, begin, end));
+    const uint64_t taken = end - std::clamp(reported, begin, end);
+    if (options_.progress && taken > advanced) options_.progress->advance(taken - advanced);
     points_.triangles.resize(static_cast<size_t>(3 * per_row * done));
     in_.skip(done * kRow);
     return done;
@@ -788,6 +795,7 @@ class PlyParser {
     }
     std::atomic<uint64_t> stop{rows};  // no row from here on is taken
     auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
+    std::atomic<uint64_t> advanced{0};  // bytes given to the progress
     // One line's values into row `row`; false where the row-by-row loop must take it.
     auto parseVertex = [&](std::string_view rest, uint64_t row) {
       double v[kRoleCount] = {};
@@ -848,6 +856,11 @@ class PlyParser {
         if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
         if (isBlank(line) || !(is_vertex ? parseVertex(line, row) : parseFace(line, row))) return stopAt(row);
       }
+      // Progress as blocks finish (one past a later stop may count bytes the loop reads again:
+      // the bar then reaches 100% a moment early, never more).
+      const uint64_t bar = after_last[b] - std::clamp(reported, line_start[b], after_last[b]);
+      advanced += bar;
+      if (options_.progress) options_.progress->advance(bar);
     });
     const uint64_t done = stop.load();
     if (done < rows) {
@@ -883,7 +896,8 @@ class PlyParser {
         q = static_cast<const char*>(std::memchr(q, '\n', static_cast<size_t>(buffer.data() + buffer.size() - q))) + 1;
       end = line_start[b] + static_cast<uint64_t>(q - buffer.data());
     }
-    if (options_.progress) options_.progress->advance(end - std::clamp(reported, begin, end));
+    const uint64_t taken = end - std::clamp(reported, begin, end);
+    if (options_.progress && taken > advanced) options_.progress->advance(taken - advanced);
     in_.skip(end - begin);
     line_no_ += done;
     return done;
