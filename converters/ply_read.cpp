@@ -752,13 +752,11 @@ class PlyParser {
         unread = true;  // the loop reads it again and reports why
         return;
       }
-      const char* q = buffer.data();
-      const char* const end = q + buffer.size();
-      while (const void* nl = std::memchr(q, '\n', static_cast<size_t>(end - q))) {
-        q = static_cast<const char*>(nl) + 1;
-        ++newlines[b];
+      newlines[b] = static_cast<uint64_t>(std::count(buffer.begin(), buffer.end(), '\n'));  // in vector lanes
+      if (newlines[b] > 0) {
+        const void* last = memrchr(buffer.data(), '\n', buffer.size());
+        after_last[b] = from + static_cast<uint64_t>(static_cast<const char*>(last) - buffer.data()) + 1;
       }
-      if (newlines[b] > 0) after_last[b] = from + static_cast<uint64_t>(q - buffer.data());
     });
     if (unread) return 0;
     // Block b's lines: rows first_row[b] .. + newlines[b], from line_start[b] to after_last[b].
