@@ -911,6 +911,22 @@ TEST(Ply, plyRejectsIndexOutOfRange) {
 // rows, up to the first row that is another polygon or names no vertex; the rows after are read one
 // at a time as before. Over several blocks and thread counts: the same triangles, a quad's fan, and
 // each error at its row and byte.
+// A binary PLY's header for `faces` rows of uchar-counted `index_type` lists, and its `vertices`
+// rows (v, 0.5, −1): the start of the face-block tests' files.
+Bytes facesFileStart(const std::string& index_type, uint32_t vertices, uint64_t faces) {
+  Bytes b;
+  b.data = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(vertices) +
+           "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(faces) +
+           "\nproperty list uchar " + index_type + " vertex_indices\nend_header\n";
+  for (uint32_t v = 0; v < vertices; ++v) b.add(double(v)).add(0.5).add(-1.0);
+  return b;
+}
+// Face row r's four corners in those files.
+std::array<uint32_t, 4> cornersOf(uint64_t r, uint32_t vertices) {
+  const auto at = [&](uint64_t k) { return static_cast<uint32_t>((r + k) % vertices); };
+  return {at(0), at(1), at(7), at(3)};
+}
+
 // Faces of another size than three, every row like the first (a quad mesh): read in blocks too,
 // each fanned as the row-by-row loop fans it, up to the first row of another size or a bad index.
 TEST(Ply, binaryQuadsAreReadInBlocksUpToTheFirstOtherRow) {
@@ -918,16 +934,11 @@ TEST(Ply, binaryQuadsAreReadInBlocksUpToTheFirstOtherRow) {
   static constexpr uint32_t kVertices = 1000;
   static constexpr uint64_t kFaces = 200000;  // four blocks of 17-byte rows
   auto file = [&](uint64_t triangle_row, uint64_t bad_row, std::vector<uint32_t>& expected, size_t& faces_at) {
-    Bytes b;
-    b.data = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kVertices) +
-             "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(kFaces) +
-             "\nproperty list uchar uint vertex_indices\nend_header\n";
-    for (uint32_t v = 0; v < kVertices; ++v) b.add(double(v)).add(0.5).add(-1.0);
+    Bytes b = facesFileStart("uint", kVertices, kFaces);
     faces_at = b.data.size();
     expected.clear();
     for (uint64_t r = 0; r < kFaces; ++r) {
-      const auto at = [r](uint64_t k) { return static_cast<uint32_t>((r + k) % kVertices); };
-      const uint32_t a = at(0), c = at(1), d = at(7), e = at(3);
+      const auto [a, c, d, e] = cornersOf(r, kVertices);
       if (r == triangle_row) {
         b.add(uint8_t{3}).add(a).add(c).add(d);
         expected.insert(expected.end(), {a, c, d});
@@ -963,16 +974,11 @@ TEST(Ply, binaryTrianglesAreReadInBlocksUpToTheFirstOtherRow) {
   static constexpr uint64_t kFaces = 300000;  // four blocks
   auto file = [&](const char* index_type, uint64_t quad_row, uint64_t bad_row, int64_t bad_index,
                   std::vector<uint32_t>& expected, size_t& faces_at) {
-    Bytes b;
-    b.data = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kVertices) +
-             "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(kFaces) +
-             "\nproperty list uchar " + index_type + " vertex_indices\nend_header\n";
-    for (uint32_t v = 0; v < kVertices; ++v) b.add(double(v)).add(0.5).add(-1.0);
+    Bytes b = facesFileStart(index_type, kVertices, kFaces);
     faces_at = b.data.size();
     expected.clear();
     for (uint64_t r = 0; r < kFaces; ++r) {
-      const auto at = [r](uint64_t k) { return static_cast<uint32_t>((r + k) % kVertices); };
-      const uint32_t a = at(0), c = at(1), d = at(7), e = at(3);
+      const auto [a, c, d, e] = cornersOf(r, kVertices);
       if (r == quad_row) {
         b.add(uint8_t{4}).add(a).add(c).add(d).add(e);
         expected.insert(expected.end(), {a, c, d, a, d, e});
