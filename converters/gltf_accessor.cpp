@@ -15,13 +15,6 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
 
-template <typename T>
-T load(const unsigned char* p) {
-  T value;
-  std::memcpy(&value, p, sizeof(T));  // buffer data has no alignment guarantee
-  return value;
-}
-
 // Components per element and rows per column (rows == components except for matrices).
 bool shapeOf(int type, int& components, int& rows) {
   switch (type) {
@@ -33,26 +26,6 @@ bool shapeOf(int type, int& components, int& rows) {
     case TINYGLTF_TYPE_MAT3: components = 9, rows = 3; return true;
     case TINYGLTF_TYPE_MAT4: components = 16, rows = 4; return true;
     default: return false;
-  }
-}
-
-double decodeComponent(const unsigned char* p, int component_type, bool normalized) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      const double c = static_cast<int8_t>(p[0]);
-      return normalized ? std::max(c / 127.0, -1.0) : c;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      const double c = load<int16_t>(p);
-      return normalized ? std::max(c / 32767.0, -1.0) : c;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      const double c = load<uint16_t>(p);
-      return normalized ? c / 65535.0 : c;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return load<uint32_t>(p);
-    default: return load<float>(p);  // open() admitted only the types above and FLOAT
   }
 }
 
@@ -68,13 +41,6 @@ size_t gltfComponentSize(int component_type) {
     case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
     default: return 0;
   }
-}
-
-double AccessorElements::value(size_t e, int k) const {
-  if (!decoded_.empty()) return decoded_[e * size_t(components_) + size_t(k)];
-  const size_t size = gltfComponentSize(component_type_);
-  const unsigned char* p = first_ + e * stride_ + size_t(k / rows_) * column_stride_ + size_t(k % rows_) * size;
-  return decodeComponent(p, component_type_, normalized_);
 }
 
 Error AccessorDecoder::fail(int index, const std::string& what) const {
@@ -136,6 +102,8 @@ Result<AccessorElements> AccessorDecoder::open(int index) const {
   const size_t element_size = columns * out.column_stride_;
   // The last matrix column needs no padding after it (the validator's get_elements_matrix oracle).
   const size_t extent = (columns - 1) * out.column_stride_ + rows * size;
+  for (int k = 0; k < out.components_; ++k)
+    out.offsets_[size_t(k)] = size_t(k / out.rows_) * out.column_stride_ + size_t(k % out.rows_) * size;
 
   if (accessor.bufferView >= 0) {
     Result<Span> span = locate("/accessors/" + std::to_string(index), accessor.bufferView, accessor.byteOffset,
@@ -158,7 +126,7 @@ Result<AccessorElements> AccessorDecoder::open(int index) const {
         for (int k = 0; k < out.components_; ++k) {
           const unsigned char* p = out.first_ + e * out.stride_ + size_t(k / out.rows_) * out.column_stride_ +
                                    size_t(k % out.rows_) * size;
-          out.decoded_[e * size_t(out.components_) + size_t(k)] = decodeComponent(p, out.component_type_, out.normalized_);
+          out.decoded_[e * size_t(out.components_) + size_t(k)] = decodeGltfComponent(p, out.component_type_, out.normalized_);
         }
     if (accessor.sparse.isSparse) {
       if (Status s = applySparse(index, accessor, out); !s) return s.error();
@@ -195,8 +163,8 @@ Status AccessorDecoder::applySparse(int index, const tinygltf::Accessor& accesso
   for (size_t i = 0; i < n; ++i) {
     const unsigned char* p = indices->first + i * index_size;
     const size_t target = index_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? p[0]
-                          : index_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? load<uint16_t>(p)
-                                                                                 : load<uint32_t>(p);
+                          : index_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? loadGltfValue<uint16_t>(p)
+                                                                                 : loadGltfValue<uint32_t>(p);
     if (target >= out.count_)
       return Error{path_ + ": " + pointer + "/indices: element " + std::to_string(i) + " is " +
                    std::to_string(target) + ", not below the accessor count " + std::to_string(out.count_)};
@@ -207,7 +175,7 @@ Status AccessorDecoder::applySparse(int index, const tinygltf::Accessor& accesso
     const unsigned char* v = values->first + i * values->stride;
     for (int k = 0; k < out.components_; ++k)
       out.decoded_[target * size_t(out.components_) + size_t(k)] =
-          decodeComponent(v + size_t(k / out.rows_) * out.column_stride_ + size_t(k % out.rows_) * value_size,
+          decodeGltfComponent(v + size_t(k / out.rows_) * out.column_stride_ + size_t(k % out.rows_) * value_size,
                           out.component_type_, out.normalized_);
   }
   return okStatus();

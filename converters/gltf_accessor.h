@@ -5,13 +5,46 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "core/result.h"
 
 namespace dpoint {
+
+template <typename T>
+T loadGltfValue(const unsigned char* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));  // buffer data has no alignment guarantee
+  return value;
+}
+
+// The component at p as the spec defines it (AccessorElements::value); component_type is one that
+// AccessorDecoder::open admitted.
+inline double decodeGltfComponent(const unsigned char* p, int component_type, bool normalized) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      const double c = static_cast<int8_t>(p[0]);
+      return normalized ? std::max(c / 127.0, -1.0) : c;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      const double c = loadGltfValue<int16_t>(p);
+      return normalized ? std::max(c / 32767.0, -1.0) : c;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      const double c = loadGltfValue<uint16_t>(p);
+      return normalized ? c / 65535.0 : c;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return loadGltfValue<uint32_t>(p);
+    default: return loadGltfValue<float>(p);  // open() admitted only the types above and FLOAT
+  }
+}
 
 // The elements of one accessor. value(e, k) is component k of element e as the spec defines it:
 // integers as they are, or mapped to [0,1] / [-1,1] when `normalized` (glTF 2.0 §3.11,
@@ -22,8 +55,12 @@ class AccessorElements {
   int components() const { return components_; }
   int componentType() const { return component_type_; }
   bool normalized() const { return normalized_; }
-  // Requires e < count(), k < components().
-  double value(size_t e, int k) const;
+  // Requires e < count(), k < components(). Inline, with each component's offset in an element
+  // worked out by open(): it is called once per value of every vertex, colour and index.
+  double value(size_t e, int k) const {
+    if (!decoded_.empty()) return decoded_[e * size_t(components_) + size_t(k)];
+    return decodeGltfComponent(first_ + e * stride_ + offsets_[size_t(k)], component_type_, normalized_);
+  }
 
  private:
   friend class AccessorDecoder;
@@ -37,6 +74,7 @@ class AccessorElements {
   const unsigned char* first_ = nullptr;
   size_t stride_ = 0, column_stride_ = 0;
   int rows_ = 1;
+  std::array<size_t, 16> offsets_{};  // component k at (k / rows_)·column_stride_ + (k % rows_)·size
   // Used instead when the accessor is sparse or has no bufferView: count·components values.
   std::vector<double> decoded_;
 };

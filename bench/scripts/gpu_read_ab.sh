@@ -8,7 +8,8 @@
 #         merged-point count, the records)
 #   mesh  `mandelbulb --variant fast --resolution MESH_RES --device 0` (2048: 108M vertices, 207M
 #         triangles, 5.6 GB PLY)
-#   gltf  the same at GLTF_RES (1024: 27M vertices, a 1.18 GB GLB with COLOR_0 and uint32 indices)
+#   gltf  the same at GLTF_RES (1024: 27M vertices, a 1.18 GB GLB with COLOR_0 and uint32 indices);
+#         with WRITE=1 also the whole `dpoint convert mb1024.glb -o w.csv` (the streamed glTF → CSV)
 #   pcd   the las set's 16.8M points as an ASCII PCD (x y z rgb); with WRITE=1 also the whole
 #         `dpoint convert s11u.ply --pcd-encoding ascii -o w.pcd`
 #   plyascii  the gltf set's mesh as an ASCII PLY (1024: 16.6M vertices, 33M faces, 2 GB)
@@ -57,8 +58,9 @@ for set in ${SETS:-las mesh gltf pcd}; do
         case $set in
           las) /usr/bin/time -f "%e" -o /tmp/read_write.txt "$bin" convert "$data/s11u.ply" -o "$data/w.las" -q >/dev/null 2>&1 || true ;;
           pcd) /usr/bin/time -f "%e" -o /tmp/read_write.txt "$bin" convert "$data/s11u.ply" --pcd-encoding ascii -o "$data/w.pcd" -q >/dev/null 2>&1 || true ;;
+          gltf) /usr/bin/time -f "%e" -o /tmp/read_write.txt "$bin" convert "$file" -o "$data/w.csv" -q >/dev/null 2>&1 || true ;;
         esac
-        rm -f "$data/w.las" "$data/w.pcd"
+        rm -f "$data/w.las" "$data/w.pcd" "$data/w.csv"
       fi
       /usr/bin/python3 - "$round" "$set" "$build" <<'PY' | tee -a "$rows"
 import json, sys
