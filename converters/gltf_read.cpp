@@ -529,6 +529,16 @@ class SceneReader {
     return parts;
   }
 
+  // body(i) for every i < n, on all cores in chunks of 16K (one chunk, inline, for a small
+  // primitive); body must be safe to call from several threads at once.
+  template <typename Body>
+  void everyIndex(size_t n, const Body& body) const {
+    constexpr size_t kChunk = size_t{1} << 14;
+    parallelFor((n + kChunk - 1) / kChunk, options_.threads, [&](size_t c, unsigned) {
+      for (size_t i = c * kChunk, end = std::min(n, i + kChunk); i < end; ++i) body(i);
+    });
+  }
+
   // The smallest i < n for which failing(i) holds, else n. failing runs on all cores in chunks
   // (inline for a small primitive), is called for every i below the one returned, and must be safe
   // to call from several threads at once: its side effects go to slots of their own.
@@ -672,9 +682,8 @@ class SceneReader {
       const size_t first = out_.triangles.size();
       out_.triangles.resize(first + added);
       uint32_t* out = out_.triangles.data() + first;
-      (void)firstFailing(added / 3, [&](size_t t) {
+      everyIndex(added / 3, [&](size_t t) {
         for (size_t k = 0; k < 3; ++k) out[3 * t + k] = vertex(3 * t + k);
-        return false;
       });
     } else if (primitive.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
       for (size_t i = 0; i + 3 <= n; ++i) triangle(i, i + 1 + i % 2, i + 2 - i % 2);
