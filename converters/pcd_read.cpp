@@ -441,7 +441,8 @@ class Reader {
     else
       points.positions.assign(count, glm::dvec3(0.0));
     if (h_.colors) points.colors.resize(count);
-    for (const auto& [name, type] : h_.dimensions) points.dimensions.append(name, type, count);
+    // Every value of every column is stored by its row (Columns::store), so none is zeroed first.
+    for (const auto& [name, type] : h_.dimensions) points.dimensions.appendUnset(name, type, count);
     points.color_full_scale = h_.colors ? 255 : 0;
     points.z_axis = h_.has_z && !h_.two_d ? ZAxis::kPresent : ZAxis::kAbsent;
     points.z_up = h_.z_up;
