@@ -10,9 +10,9 @@
 // Binary vertices without list properties (the usual case) are decoded in blocks on all cores,
 // each row into its preassigned index, so the result is the same for any thread count. Memory:
 // the PointSet plus one block per thread. Binary faces, and ASCII vertex and face rows, are read
-// in blocks on all cores too, up to the first row of another kind (a face of another size than the
-// first, a blank or bad line), from which one thread goes on; other elements are read on one
-// thread. The
+// in blocks on all cores too, up to the first row of another kind (a binary face of another size
+// than the first, a blank or bad line), from which one thread goes on; other elements are read on
+// one thread. The
 // header's counts are checked against the data that follows it and against max_memory before
 // anything is allocated, and the triangles of the faces against max_memory as they are made.
 //

@@ -717,13 +717,13 @@ class PlyParser {
   }
 
   // ASCII rows as most tools write them, in parallel blocks: vertex rows of single values, and faces
-  // whose one property is the list of indices, as many in every row as in the first (fanned into
-  // triangles as finishFace does). The newlines of the rest of the file
-  // are counted per block on all cores, which gives each block the row of the first line that ends
-  // in it; each block then parses its lines (readAsciiRow's tokens and values) into their rows.
-  // Parsing stops at the first row that is blank, does not parse, is not acceptable, is another
-  // polygon or names no vertex, or at what --max-memory leaves for triangles. Returns how many
-  // rows were done; the row-by-row loop goes on from there and reports any error at its line.
+  // whose one property is the list of indices, of any size up to 1024 (fanned into triangles as
+  // finishFace does). The newlines of the rest of the file are counted per block on all cores,
+  // which gives each block the row of the first line that ends in it; each block then parses its
+  // lines (readAsciiRow's tokens and values) into their rows. Parsing stops at the first row that
+  // is blank, does not parse, is not acceptable or names no vertex, or at what --max-memory leaves
+  // for triangles. Returns how many rows were done; the row-by-row loop goes on from there and
+  // reports any error at its line.
   uint64_t readAsciiRows(const Element& e, const std::vector<Role>& roles) {
     const bool is_vertex = e.name == "vertex";
     if (is_vertex) {
@@ -768,107 +768,205 @@ class PlyParser {
       lines += newlines[b];
       if (newlines[b] > 0) start = after_last[b];
     }
-    uint64_t rows = std::min(e.count, lines);
-    const Property& list = e.properties[0];
-    uint64_t corners = 0;  // the faces' indices a row: the first row's
-    if (!is_vertex) {
-      std::vector<char>& buffer = buffers[0];
-      buffer.resize(static_cast<size_t>(std::min<uint64_t>(bytes, 4096)));
-      Result<size_t> got = file_.readAt(begin, buffer.data(), buffer.size());
-      if (!got) return 0;
-      std::string_view line(buffer.data(), *got);
-      double count = 0;
-      if (!parseAscii(list.count_type, nextToken(line), count) || !(count >= 3 && count <= 1024)) return 0;
-      corners = static_cast<uint64_t>(count);
-      // finishFace's memory check passes while vertex_bytes_ + 12 bytes a triangle ≤ memory_limit_.
-      rows = std::min(rows, (memory_limit_ - std::min(memory_limit_, vertex_bytes_)) / (3 * sizeof(uint32_t)) / (corners - 2));
-    }
+    const uint64_t rows = std::min(e.count, lines);
     if (rows == 0) return 0;
+    std::atomic<uint64_t> stop{rows};  // no row from here on is taken
+    auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
+    std::atomic<uint64_t> advanced{0};  // bytes given to the progress
+    // take(text, row) for block b's lines in order, until it returns false (the rows then stop
+    // there), the text is blank, or the rows reach the stop. True when every line was taken. A line
+    // that began more than a block before its block's end is left to the loop (which reports one
+    // longer than kMaxAsciiLine).
+    auto eachLine = [&](size_t b, unsigned worker, const auto& take) {
+      const uint64_t first = first_row[b];
+      if (newlines[b] == 0 || first >= stop.load()) return false;
+      if (after_last[b] - line_start[b] > 2 * kBlock) {
+        stopAt(first);
+        return false;
+      }
+      std::vector<char>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>(after_last[b] - line_start[b]));
+      Result<size_t> got = file_.readAt(line_start[b], buffer.data(), buffer.size());
+      if (!got || *got < buffer.size()) {
+        stopAt(first);
+        return false;
+      }
+      const char* q = buffer.data();
+      const char* const end = buffer.data() + buffer.size();
+      for (uint64_t row = first; row < first + newlines[b]; ++row) {
+        if (row >= stop.load(std::memory_order_relaxed)) return false;
+        const char* nl = static_cast<const char*>(std::memchr(q, '\n', static_cast<size_t>(end - q)));
+        std::string_view line(q, static_cast<size_t>(nl - q));
+        q = nl + 1;
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        if (isBlank(line) || !take(line, row)) {
+          stopAt(row);
+          return false;
+        }
+      }
+      return true;
+    };
+    // Progress as blocks finish (one past a later stop may count bytes the loop reads again: the
+    // bar then reaches 100% a moment early, never more).
+    auto blockDone = [&](size_t b) {
+      const uint64_t bar = after_last[b] - std::clamp(reported, line_start[b], after_last[b]);
+      advanced += bar;
+      if (options_.progress) options_.progress->advance(bar);
+    };
+
+    uint64_t triangles_taken = 0;  // faces: the triangles of the rows taken
     if (is_vertex) {
       resizePrefaulted(points_.positions, static_cast<size_t>(rows), threads);
       if (has_colors_) resizePrefaulted(points_.colors, static_cast<size_t>(rows), threads);
       points_.dimensions.resizeUnset(static_cast<size_t>(rows));  // every row's values are set below
-    } else {
-      resizePrefaulted(points_.triangles, static_cast<size_t>(3 * (corners - 2) * rows), threads);
-    }
-    std::atomic<uint64_t> stop{rows};  // no row from here on is taken
-    auto stopAt = [&](uint64_t row) { lowerAtomic(stop, row); };
-    std::atomic<uint64_t> advanced{0};  // bytes given to the progress
-    // One line's values into row `row`; false where the row-by-row loop must take it.
-    auto parseVertex = [&](std::string_view rest, uint64_t row) {
-      double v[kRoleCount] = {};
-      double attributes[64];
-      if (attribute_row_.size() > std::size(attributes)) return false;
-      for (size_t k = 0; k < e.properties.size(); ++k) {
-        const std::string_view token = nextToken(rest);
-        double value = 0;
-        if (token.empty() || !parseAscii(e.properties[k].type, token, value)) return false;
-        v[roles[k]] = value;
-        if (roles[k] == kAttribute) attributes[attribute_of_[k]] = value;
-      }
-      if (!nextToken(rest).empty() || !positionAcceptable(v) || (has_colors_ && !colourAcceptable(v))) return false;
-      points_.positions[row] = glm::dvec3(v[kX], v[kY], v[kZ]);
-      if (has_colors_) points_.colors[row] = colorOf(v);
-      for (size_t a = 0; a < attribute_row_.size(); ++a) points_.dimensions.all()[a].setValue(row, attributes[a]);
-      return true;
-    };
-    const double vertices = static_cast<double>(vertex_count_);
-    auto parseFace = [&](std::string_view rest, uint64_t row) {
-      double count = 0;
-      std::string_view token = nextToken(rest);
-      if (token.empty() || !parseAscii(list.count_type, token, count) || count != static_cast<double>(corners)) return false;
-      uint32_t* t = points_.triangles.data() + 3 * (corners - 2) * row;
-      uint32_t first = 0, previous = 0;
-      for (uint64_t i = 0; i < corners; ++i) {
-        double index = 0;
-        token = nextToken(rest);
-        if (token.empty() || !parseAscii(list.type, token, index) || !(index >= 0 && index < vertices)) return false;
-        const uint32_t v = static_cast<uint32_t>(index);
-        if (i == 0) first = v;
-        if (i >= 2) {  // finishFace's fan: (v0, vi−1, vi)
-          t[0] = first;
-          t[1] = previous;
-          t[2] = v;
-          t += 3;
+      // One line's values into row `row`; false where the row-by-row loop must take it.
+      auto parseVertex = [&](std::string_view rest, uint64_t row) {
+        double v[kRoleCount] = {};
+        double attributes[64];
+        if (attribute_row_.size() > std::size(attributes)) return false;
+        for (size_t k = 0; k < e.properties.size(); ++k) {
+          const std::string_view token = nextToken(rest);
+          double value = 0;
+          if (token.empty() || !parseAscii(e.properties[k].type, token, value)) return false;
+          v[roles[k]] = value;
+          if (roles[k] == kAttribute) attributes[attribute_of_[k]] = value;
         }
-        previous = v;
+        if (!nextToken(rest).empty() || !positionAcceptable(v) || (has_colors_ && !colourAcceptable(v))) return false;
+        points_.positions[row] = glm::dvec3(v[kX], v[kY], v[kZ]);
+        if (has_colors_) points_.colors[row] = colorOf(v);
+        for (size_t a = 0; a < attribute_row_.size(); ++a) points_.dimensions.all()[a].setValue(row, attributes[a]);
+        return true;
+      };
+      parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+        if (eachLine(b, worker, parseVertex)) blockDone(b);
+      });
+    } else {
+      // Faces, fanned as finishFace fans them. First every row of the first row's size (a triangle
+      // or quad mesh), each to its own slots; then, from a row of another size on, rows of any
+      // size: pass 2a counts each block's triangles from its rows' first values, which places
+      // each block's first triangle, and pass 2b parses the rows into their triangles. A row that
+      // does not parse or names no vertex stops the rows there, its block's earlier ones kept.
+      const Property& list = e.properties[0];
+      constexpr double kMaxCorners = 1024;  // larger polygons go to the loop
+      auto cornersOf = [&](std::string_view& rest, uint64_t& corners) {
+        double count = 0;
+        // A row of n indices holds at least 2n − 1 characters: a bad count claims no more memory.
+        const double most = std::min(kMaxCorners, static_cast<double>(rest.size()) / 2);
+        if (!parseAscii(list.count_type, nextToken(rest), count) || !(count >= 3 && count <= most)) return false;
+        corners = static_cast<uint64_t>(count);
+        return true;
+      };
+      const double vertices = static_cast<double>(vertex_count_);
+      // The fan of a row whose count was read, into t; false when an index is bad or a value extra.
+      auto fan = [&](std::string_view& rest, uint64_t corners, uint32_t* t) {
+        uint32_t first = 0, previous = 0;
+        for (uint64_t i = 0; i < corners; ++i) {
+          double index = 0;
+          const std::string_view token = nextToken(rest);
+          if (token.empty() || !parseAscii(list.type, token, index) || !(index >= 0 && index < vertices)) return false;
+          const uint32_t v = static_cast<uint32_t>(index);
+          if (i == 0) first = v;
+          if (i >= 2) {  // finishFace's fan: (v0, vi−1, vi)
+            t[0] = first;
+            t[1] = previous;
+            t[2] = v;
+            t += 3;
+          }
+          previous = v;
+        }
+        return nextToken(rest).empty();
+      };
+      // finishFace's memory check passes while vertex_bytes_ + 12 bytes a triangle ≤ memory_limit_;
+      // past it the rows are the loop's, which names the row.
+      const uint64_t room = (memory_limit_ - std::min(memory_limit_, vertex_bytes_)) / (3 * sizeof(uint32_t));
+      uint64_t size = 0;  // the first row's indices
+      {
+        std::vector<char>& buffer = buffers[0];
+        buffer.resize(static_cast<size_t>(std::min<uint64_t>(bytes, 4096)));
+        Result<size_t> got = file_.readAt(begin, buffer.data(), buffer.size());
+        std::string_view line(buffer.data(), got ? *got : 0);
+        line = line.substr(0, line.find('\n'));
+        if (!cornersOf(line, size)) size = 0;
       }
-      return nextToken(rest).empty();
-    };
-    // Pass 2: each block's lines. A line that began more than a block before its block's end is
-    // left to the loop (which reports one longer than kMaxAsciiLine).
-    parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
-      const uint64_t first = first_row[b];
-      if (newlines[b] == 0 || first >= stop.load()) return;
-      if (after_last[b] - line_start[b] > 2 * kBlock) return stopAt(first);
-      std::vector<char>& buffer = buffers[worker];
-      buffer.resize(static_cast<size_t>(after_last[b] - line_start[b]));
-      Result<size_t> got = file_.readAt(line_start[b], buffer.data(), buffer.size());
-      if (!got || *got < buffer.size()) return stopAt(first);
-      const char* q = buffer.data();
-      for (uint64_t row = first; row < first + newlines[b]; ++row) {
-        if (row >= stop.load(std::memory_order_relaxed)) return;
-        const char* nl = static_cast<const char*>(std::memchr(q, '\n', static_cast<size_t>(buffer.data() + buffer.size() - q)));
-        std::string_view line(q, static_cast<size_t>(nl - q));
-        q = nl + 1;
-        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-        if (isBlank(line) || !(is_vertex ? parseVertex(line, row) : parseFace(line, row))) return stopAt(row);
+      uint64_t from = 0;         // the rows before it are taken
+      bool out_of_room = false;  // the rows from `from` on would pass --max-memory
+      if (size != 0) {
+        const uint64_t per_row = size - 2, fixed_rows = std::min(rows, room / per_row);
+        stopAt(fixed_rows);
+        resizePrefaulted(points_.triangles, static_cast<size_t>(3 * per_row * fixed_rows), threads);
+        parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+          const bool whole = eachLine(b, worker, [&](std::string_view rest, uint64_t row) {
+            uint64_t corners = 0;
+            return cornersOf(rest, corners) && corners == size &&
+                   fan(rest, corners, points_.triangles.data() + 3 * per_row * row);
+          });
+          if (whole) blockDone(b);
+        });
+        from = stop.load();
+        triangles_taken = per_row * from;
+        points_.triangles.resize(static_cast<size_t>(3 * triangles_taken));
+        out_of_room = from == fixed_rows && fixed_rows < rows;
       }
-      // Progress as blocks finish (one past a later stop may count bytes the loop reads again:
-      // the bar then reaches 100% a moment early, never more).
-      const uint64_t bar = after_last[b] - std::clamp(reported, line_start[b], after_last[b]);
-      advanced += bar;
-      if (options_.progress) options_.progress->advance(bar);
-    });
+      if (from < rows && !out_of_room) {
+        stop = rows;  // the row at `from` may be of another size: the rows from it, of any size
+        auto after = [&](size_t b) { return first_row[b] + newlines[b] > from; };  // holds rows from `from` on
+        std::vector<uint64_t> block_triangles(blocks, 0);
+        parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+          if (!after(b)) return;
+          uint64_t t = 0;
+          eachLine(b, worker, [&](std::string_view rest, uint64_t row) {
+            uint64_t corners = 0;
+            if (row < from) return true;
+            if (!cornersOf(rest, corners)) return false;
+            t += corners - 2;
+            return true;
+          });
+          block_triangles[b] = t;  // of its rows from `from` on, before its stop
+        });
+        std::vector<uint64_t> first_triangle(blocks, 0);
+        uint64_t total = triangles_taken;
+        for (size_t b = 0; b < blocks && first_row[b] < stop.load(); ++b) {
+          if (!after(b)) continue;
+          first_triangle[b] = total;
+          if (total + block_triangles[b] > room) {
+            stopAt(std::max(from, first_row[b]));
+            break;
+          }
+          total += block_triangles[b];
+        }
+        if (stop.load() > from) {
+          // Grown once, its new pages faulted in on all cores (a resize alone zeroes them on one).
+          points_.triangles.reserve(static_cast<size_t>(3 * total));
+          const size_t kept = points_.triangles.size();
+          prefaultForWrite(points_.triangles.data() + kept, (static_cast<size_t>(3 * total) - kept) * sizeof(uint32_t),
+                           threads);
+          points_.triangles.resize(static_cast<size_t>(3 * total));
+          std::vector<uint64_t> placed(blocks, 0);
+          parallelFor(blocks, threads, [&](size_t b, unsigned worker) {
+            if (!after(b)) return;
+            uint32_t* t = points_.triangles.data() + 3 * first_triangle[b];
+            const bool whole = eachLine(b, worker, [&](std::string_view rest, uint64_t row) {
+              uint64_t corners = 0;
+              if (row < from) return true;
+              if (!cornersOf(rest, corners) || !fan(rest, corners, t)) return false;
+              t += 3 * (corners - 2);
+              placed[b] += corners - 2;
+              return true;
+            });
+            if (whole) blockDone(b);
+          });
+          // The rows before the stop: every block's before its block, and its block's own.
+          for (size_t b = 0; b < blocks && first_row[b] < stop.load(); ++b) triangles_taken += placed[b];
+        }
+      }
+    }
     const uint64_t done = stop.load();
-    if (done < rows) {
-      if (is_vertex) {
-        points_.positions.resize(static_cast<size_t>(done));
-        if (has_colors_) points_.colors.resize(static_cast<size_t>(done));
-        points_.dimensions.resize(static_cast<size_t>(done));
-      } else {
-        points_.triangles.resize(static_cast<size_t>(3 * (corners - 2) * done));
-      }
+    if (!is_vertex) {
+      points_.triangles.resize(static_cast<size_t>(3 * triangles_taken));
+    } else if (done < rows) {
+      points_.positions.resize(static_cast<size_t>(done));
+      if (has_colors_) points_.colors.resize(static_cast<size_t>(done));
+      points_.dimensions.resize(static_cast<size_t>(done));
     }
     if (done == 0) return 0;
     // The offset just past row done − 1's newline: found in its block.

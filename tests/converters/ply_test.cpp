@@ -630,6 +630,23 @@ TEST(Ply, asciiRowsAreReadInBlocksUpToTheFirstOtherRow) {
       fanned = t[0] == f && t[1] == f + 1 && t[2] == f + 2 && t[3] == f && t[4] == f + 2 && t[5] == (f + 3) % n;
       EXPECT_TRUE(fanned) << "face " << f;
     }
+    // Faces of mixed sizes: every seventh a pentagon, fanned into three triangles.
+    auto mixed = readText(dir, "mixed.ply", text([&](bool vertex, uint64_t row, std::string& line) {
+                                              if (!vertex && row % 7 == 0)
+                                                line = "5 " + std::to_string(row) + " " + std::to_string(row + 1) + " " +
+                                                       std::to_string(row + 2) + " " + std::to_string((row + 3) % n) +
+                                                       " " + std::to_string((row + 4) % n);
+                                            }),
+                          options);
+    ASSERT_TRUE(mixed.ok()) << mixed.error().message;
+    std::vector<uint32_t> fans;
+    for (uint32_t f = 0; f < faces; ++f) {
+      fans.insert(fans.end(), {f, f + 1, f + 2});
+      if (f % 7 == 0)
+        fans.insert(fans.end(), {f, f + 2, static_cast<uint32_t>((f + 3) % n), f, static_cast<uint32_t>((f + 3) % n),
+                                 static_cast<uint32_t>((f + 4) % n)});
+    }
+    EXPECT_TRUE(mixed->triangles == fans);
     // A quad among triangles is fanned into two; the rows after it are read as before.
     auto quad = readText(dir, "quad.ply", text([](bool vertex, uint64_t row, std::string& line) {
                                             if (!vertex && row == 150000) line = "4 150000 150001 150002 7";
