@@ -647,6 +647,21 @@ TEST(Ply, asciiRowsAreReadInBlocksUpToTheFirstOtherRow) {
                                  static_cast<uint32_t>((f + 4) % n)});
     }
     EXPECT_TRUE(mixed->triangles == fans);
+    // Past --max-memory in the middle of a block: the row that passes it named, as row by row.
+    PlyReadOptions tight = options;
+    const uint64_t vertex_bytes = n * (sizeof(glm::dvec3) + sizeof(glm::vec3) + sizeof(float));
+    tight.max_memory = vertex_bytes + 12 * 300000;  // room for 300,000 triangles
+    uint64_t passing = 0;
+    for (uint64_t f = 0, t = 0; f < faces; ++f)
+      if ((t += f % 7 == 0 ? 3 : 1) > 300000) {
+        passing = f;
+        break;
+      }
+    auto over = readText(dir, "mixed.ply", readFile(dir.file("mixed.ply")), tight);
+    ASSERT_FALSE(over.ok());
+    EXPECT_TRUE(contains(over.error().message, "mixed.ply: face " + std::to_string(passing) +
+                                                   ": the faces' triangles needs about"))
+        << over.error().message;
     // A quad among triangles is fanned into two; the rows after it are read as before.
     auto quad = readText(dir, "quad.ply", text([](bool vertex, uint64_t row, std::string& line) {
                                             if (!vertex && row == 150000) line = "4 150000 150001 150002 7";
