@@ -123,11 +123,9 @@ Result<AccessorElements> AccessorDecoder::open(int index) const {
     out.decoded_.assign(accessor.count * size_t(out.components_), 0.0);
     if (out.first_)
       for (size_t e = 0; e < out.count_; ++e)
-        for (int k = 0; k < out.components_; ++k) {
-          const unsigned char* p = out.first_ + e * out.stride_ + size_t(k / out.rows_) * out.column_stride_ +
-                                   size_t(k % out.rows_) * size;
-          out.decoded_[e * size_t(out.components_) + size_t(k)] = decodeGltfComponent(p, out.component_type_, out.normalized_);
-        }
+        for (int k = 0; k < out.components_; ++k)
+          out.decoded_[e * size_t(out.components_) + size_t(k)] = decodeGltfComponent(
+              out.first_ + e * out.stride_ + out.offsets_[size_t(k)], out.component_type_, out.normalized_);
     if (accessor.sparse.isSparse) {
       if (Status s = applySparse(index, accessor, out); !s) return s.error();
     }
@@ -175,8 +173,7 @@ Status AccessorDecoder::applySparse(int index, const tinygltf::Accessor& accesso
     const unsigned char* v = values->first + i * values->stride;
     for (int k = 0; k < out.components_; ++k)
       out.decoded_[target * size_t(out.components_) + size_t(k)] =
-          decodeGltfComponent(v + size_t(k / out.rows_) * out.column_stride_ + size_t(k % out.rows_) * value_size,
-                          out.component_type_, out.normalized_);
+          decodeGltfComponent(v + out.offsets_[size_t(k)], out.component_type_, out.normalized_);
   }
   return okStatus();
 }

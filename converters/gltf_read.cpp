@@ -529,25 +529,30 @@ class SceneReader {
     return parts;
   }
 
-  // body(i) for every i < n, on all cores in chunks of 16K (one chunk, inline, for a small
-  // primitive); body must be safe to call from several threads at once.
+  // chunk(begin, end) over [0, n) in chunks of 16K on all cores (one chunk, inline, for a small
+  // primitive); chunk must be safe to call from several threads at once.
+  template <typename Chunk>
+  void eachChunk(size_t n, const Chunk& chunk) const {
+    constexpr size_t kChunk = size_t{1} << 14;
+    parallelFor((n + kChunk - 1) / kChunk, options_.threads,
+                [&](size_t c, unsigned) { chunk(c * kChunk, std::min(n, (c + 1) * kChunk)); });
+  }
+
+  // body(i) for every i < n (eachChunk).
   template <typename Body>
   void everyIndex(size_t n, const Body& body) const {
-    constexpr size_t kChunk = size_t{1} << 14;
-    parallelFor((n + kChunk - 1) / kChunk, options_.threads, [&](size_t c, unsigned) {
-      for (size_t i = c * kChunk, end = std::min(n, i + kChunk); i < end; ++i) body(i);
+    eachChunk(n, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) body(i);
     });
   }
 
-  // The smallest i < n for which failing(i) holds, else n. failing runs on all cores in chunks
-  // (inline for a small primitive), is called for every i below the one returned, and must be safe
-  // to call from several threads at once: its side effects go to slots of their own.
+  // The smallest i < n for which failing(i) holds, else n. failing runs as eachChunk's, is called
+  // for every i below the one returned, and puts its side effects in slots of their own.
   template <typename Failing>
   size_t firstFailing(size_t n, const Failing& failing) const {
-    constexpr size_t kChunk = size_t{1} << 14;
     std::atomic<size_t> first{n};
-    parallelFor((n + kChunk - 1) / kChunk, options_.threads, [&](size_t c, unsigned) {
-      for (size_t i = c * kChunk, end = std::min(n, i + kChunk); i < end; ++i) {
+    eachChunk(n, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
         if (i > first.load(std::memory_order_relaxed)) return;
         if (!failing(i)) continue;
         lowerAtomic(first, i);
