@@ -11,7 +11,7 @@ void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options,
       .add_option("--device", options.device,
                   "Where the escape counts run: auto (a GPU with fp64 if there is one, else the CPU), none (the "
                   "CPU),\ncpu (lavapipe) or an index from `dpoint devices`; the counts are the CPU's bit for bit. "
-                  "Marching cubes,\ncolours and writing stay on the CPU" +
+                  "Marching cubes\nruns there too on a GPU (--mesh); colours and writing stay on the CPU" +
                       (cpu_only_note.empty() ? std::string() : ".\n" + cpu_only_note))
       ->default_val("auto");
   command.add_flag("--validate", options.validate,
@@ -26,10 +26,22 @@ void addEscapeCountsOption(CLI::App& command, GenerateDeviceOptions& options) {
                   "a GPU, capped on the CPU and on lavapipe). The output is the same bit for bit")
       ->check(oneOf("--counts", {"auto", "capped", "full"}))
       ->default_val("auto");
+  command
+      .add_option("--mesh", options.mesh,
+                  "Where marching cubes runs: host (the CPU's cores), device (the --device that counts; implies\n"
+                  "--counts full; counts of two bytes, past --max-iter 255, are meshed on the host), auto (device on\n"
+                  "a GPU, host on the CPU and on lavapipe). The output is the same bit for bit")
+      ->check(oneOf("--mesh", {"auto", "host", "device"}))
+      ->default_val("auto");
 }
 
 bool fullCounts(const GenerateDeviceOptions& options, const GenerateDevice* device) {
-  return options.counts == "full" || (options.counts == "auto" && device && device->isGpu());
+  return options.counts == "full" || (options.counts == "auto" && device && device->isGpu()) ||
+         meshOnDevice(options, device);
+}
+
+bool meshOnDevice(const GenerateDeviceOptions& options, const GenerateDevice* device) {
+  return device && (options.mesh == "device" || (options.mesh == "auto" && device->isGpu()));
 }
 
 bool GenerateDevice::isGpu() const { return context_->facts.type != "cpu"; }
@@ -81,6 +93,13 @@ GenerateDevice::~GenerateDevice() {
                "for them and copied them out in %.0f ms\n",
                static_cast<unsigned long long>(gpu_->pointsDone()), gpu_->gpuMs(),
                static_cast<double>(gpu_->pointsDone()) / (gpu_->gpuMs() * 1e-3), gpu_->waitMs(), gpu_->copyMs());
+  if (mesher_ && mesher_->times().total() > 0.0) {
+    const GpuMesher::Times& t = mesher_->times();
+    std::fprintf(stderr,
+                 "dpoint: marching cubes on the device in %.1f ms of GPU time (counting and scanning %.1f, vertices "
+                 "%.1f, triangles %.1f, copying them across %.1f)\n",
+                 t.total(), t.scan, t.vertices, t.triangles, t.copy);
+  }
 }
 
 Status GenerateDevice::checkValidation() const {
@@ -106,6 +125,23 @@ EscapeArena GenerateDevice::arena() {
     Result<uint8_t*> memory = self->gpu_->arena(bytes);
     return memory ? *memory : nullptr;
   };
+}
+
+EscapeSlabMesher GenerateDevice::mesher(const EscapeKernelParams& kernel) {
+  EscapeSlabMesher mesher;
+  mesher.takes = &GpuMesher::supports;
+  mesher.mesh = [self = shared_from_this(), kernel](const EscapeSlab& slab) -> Result<McSlabView> {
+    if (!self->mesher_) {
+      Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*self->context_);
+      if (!made) return made.error();
+      self->mesher_ = std::move(*made);
+    }
+    Result<McSlabView> mesh = meshSlabOnDevice(*self->gpu_, *self->mesher_, kernel, slab);
+    if (!mesh) return mesh.error();
+    if (Status s = self->checkValidation(); !s) return s.error();
+    return mesh;
+  };
+  return mesher;
 }
 
 PerturbationFunction GenerateDevice::perturbation() {

@@ -20,17 +20,21 @@ struct GenerateDeviceOptions {
   std::string device = "auto";
   bool validate = false;
   std::string counts = "auto";  // auto|capped|full (escape-grid kinds only)
+  std::string mesh = "auto";    // auto|host|device: where marching cubes runs (escape-grid kinds only)
 };
 
 // `cpu_only_note`: which variants stay on the CPU, for the help text (may be empty).
 void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options, const std::string& cpu_only_note);
 
-// --counts for the escape-grid kinds (mandelbulb, julia): how far the classification iterates.
+// --counts and --mesh for the escape-grid kinds (mandelbulb, julia): how far the classification
+// iterates, and where marching cubes runs.
 void addEscapeCountsOption(CLI::App& command, GenerateDeviceOptions& options);
 class GenerateDevice;
 // Whether the classification runs every count to max_iter: `full`, or `auto` on a GPU (on the
 // H100 the GPU's extra iterations cost less than the CPU's finishing; on lavapipe, a CPU, more).
 bool fullCounts(const GenerateDeviceOptions& options, const GenerateDevice* device);
+// Whether marching cubes runs on the device: `device` (which implies full counts), or `auto` on a GPU.
+bool meshOnDevice(const GenerateDeviceOptions& options, const GenerateDevice* device);
 
 // The device a generation runs its counts on; the functions it hands out hold it alive.
 class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
@@ -47,6 +51,9 @@ class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
   EscapePlaneFunction planes(const EscapeKernelParams& kernel, const GridAxis& axis);
   // Where planes() writes in place (GpuEscape::arena); an error gives the heap instead.
   EscapeArena arena();
+  // Marching cubes on the device (generators/gpu_mesh.h) of the slabs whose counts it makes as
+  // planes(kernel, axis) would; it takes counts of one byte (--max-iter up to 255).
+  EscapeSlabMesher mesher(const EscapeKernelParams& kernel);
   // A GPU, not a CPU device such as lavapipe.
   bool isGpu() const;
   PerturbationFunction perturbation();
@@ -60,6 +67,7 @@ class GenerateDevice : public std::enable_shared_from_this<GenerateDevice> {
 
   std::unique_ptr<VulkanContext> context_;
   std::unique_ptr<GpuEscape> gpu_;
+  std::unique_ptr<GpuMesher> mesher_;  // made at the first slab
   bool validate_ = false;
   bool quiet_ = false;
 };

@@ -103,9 +103,11 @@ Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* 
       GenerateDevice::open(o.device, "mandelbulb", seed ? kSeedCpuOnly : "", o.out.common.quiet);
   if (!device) return device.error();
   if (*device) {
-    p.planes = (*device)->planes({EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2, kMandelbulbTrapC2},
-                                 GridAxis{p.resolution, p.lo, p.hi});
+    const EscapeKernelParams kernel{EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2,
+                                    kMandelbulbTrapC2};
+    p.planes = (*device)->planes(kernel, GridAxis{p.resolution, p.lo, p.hi});
     p.arena = (*device)->arena();
+    if (meshOnDevice(o.device, device->get())) p.mesher = (*device)->mesher(kernel);
   }
   p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);
@@ -130,8 +132,10 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
   Result<std::shared_ptr<GenerateDevice>> device = GenerateDevice::open(o.device, "julia", "", o.out.common.quiet);
   if (!device) return device.error();
   if (*device) {
-    p.planes = (*device)->planes({EscapeKernel::kJulia, p.c, kJuliaEscapeSquare, 0.0}, GridAxis{p.resolution, p.lo, p.hi});
+    const EscapeKernelParams kernel{EscapeKernel::kJulia, p.c, kJuliaEscapeSquare, 0.0};
+    p.planes = (*device)->planes(kernel, GridAxis{p.resolution, p.lo, p.hi});
     p.arena = (*device)->arena();
+    if (meshOnDevice(o.device, device->get())) p.mesher = (*device)->mesher(kernel);
   }
   p.full_counts = fullCounts(o.device, device->get());
   return withCommon(p, o.out, progress);

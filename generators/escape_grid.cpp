@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <future>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -630,34 +631,45 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     failed = true;
   };
 
+  // Appends slab `index`'s mesh (marchingCubesSlab's McSlabMesh, or a view of one made elsewhere)
+  // to the mesh; false when it would pass a limit (then `fail` has the error).
+  auto appendSlab = [&](size_t index, std::span<const glm::dvec3> positions, std::span<const uint32_t> triangles,
+                        uint32_t first_plane_vertices, uint32_t last_plane_vertices) {
+    assert(index == 0 || first_plane_vertices == previous_last_plane_vertices);
+    (void)index, (void)first_plane_vertices;
+    previous_last_plane_vertices = last_plane_vertices;
+    const uint64_t offset = mesh.positions.size();
+    const uint64_t vertices = offset + positions.size() + last_plane_vertices;
+    const uint64_t bytes = vertices * sizeof(glm::dvec3) + (mesh.triangles.size() + triangles.size()) * sizeof(uint32_t);
+    if (vertices > UINT32_MAX) {
+      fail(Error{what + ": more than 2^32 vertices", ExitCode::kResourceLimit});
+      return false;
+    }
+    if (bytes > limit) {
+      fail(Error{what + ": the mesh grew past " + formatBytes(bytes) + ", more than the limit of " + formatBytes(limit) +
+                     " (--max-memory)",
+                 ExitCode::kResourceLimit});
+      return false;
+    }
+    mesh.positions.insert(mesh.positions.end(), positions.begin(), positions.end());
+    const size_t first_index = mesh.triangles.size();
+    mesh.triangles.resize(first_index + triangles.size());
+    std::transform(triangles.begin(), triangles.end(), mesh.triangles.begin() + static_cast<std::ptrdiff_t>(first_index),
+                   [offset](uint32_t id) { return static_cast<uint32_t>(offset + id); });
+    grew();
+    return true;
+  };
+
   // Appends finished slabs in slab order: the output is the same for any thread count.
   auto commitReady = [&] {
     while (next_commit < pending.size() && pending[next_commit].ready) {
       Pending& done = pending[next_commit];
-      if (!failed) {
-        assert(next_commit == 0 || done.mesh.first_plane_vertices == previous_last_plane_vertices);
-        previous_last_plane_vertices = done.mesh.last_plane_vertices;
-        const uint64_t offset = mesh.positions.size();
-        const uint64_t vertices = offset + done.mesh.positions.size() + done.mesh.last_plane_vertices;
-        const uint64_t bytes = vertices * sizeof(glm::dvec3) +
-                               (mesh.triangles.size() + done.mesh.triangles.size()) * sizeof(uint32_t);
-        if (vertices > UINT32_MAX) {
-          fail(Error{what + ": more than 2^32 vertices", ExitCode::kResourceLimit});
-        } else if (bytes > limit) {
-          fail(Error{what + ": the mesh grew past " + formatBytes(bytes) + ", more than the limit of " +
-                         formatBytes(limit) + " (--max-memory)",
-                     ExitCode::kResourceLimit});
-        } else {
-          mesh.positions.insert(mesh.positions.end(), done.mesh.positions.begin(), done.mesh.positions.end());
-          // Shifted in place, then copied: the mesh's new pages are written once (a resize would
-          // zero them first).
-          for (uint32_t& id : done.mesh.triangles) id = static_cast<uint32_t>(offset + id);
-          mesh.triangles.insert(mesh.triangles.end(), done.mesh.triangles.begin(), done.mesh.triangles.end());
-          grew();
-          if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
-          if (grid_file)
-            if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());
-        }
+      if (!failed &&
+          appendSlab(next_commit, done.mesh.positions, done.mesh.triangles, done.mesh.first_plane_vertices,
+                     done.mesh.last_plane_vertices)) {
+        if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
+        if (grid_file)
+          if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());
       }
       done = Pending{true, {}, {}};  // frees the slab
       ++next_commit;
@@ -667,8 +679,12 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   auto slabFirst = [&](size_t s) { return first_layer + static_cast<int>(s) * plan.thickness; };
   auto slabLast = [&](size_t s) { return std::min(slabFirst(s) + plan.thickness, last_layer); };
   const int cap = classificationLimit(params);
+  // Marching cubes elsewhere (a GPU) makes the slabs' counts and meshes, in slab order; else the
+  // plane function's blocks of counts feed the workers, or the workers count with the row function.
+  const bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file &&
+                         params.mesher.takes(res, plan.thickness + 1, cap);
   std::optional<PlaneBlocks> blocks;
-  if (params.planes) {
+  if (params.planes && !elsewhere) {
     std::vector<std::pair<int, int>> planes;  // first plane and plane count of each slab
     for (size_t s = 0; s < pending.size(); ++s) planes.emplace_back(slabFirst(s), slabLast(s) - slabFirst(s) + 1);
     blocks.emplace(params.planes, params.arena, std::move(planes), cap,
@@ -676,6 +692,34 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   }
 
   if (params.progress) params.progress->start(params.name, static_cast<uint64_t>(layers));
+  if (elsewhere) {
+    // Each slab's mesh is copied into the mesh on a thread of its own while the next is made.
+    std::future<void> appending;
+    for (size_t s = 0; s < pending.size(); ++s) {
+      if (interrupted()) break;
+      EscapeSlab slab;
+      slab.res = res;
+      slab.first = slabFirst(s);
+      slab.last = slabLast(s);
+      slab.owns_last_plane = slab.last == res - 1;
+      slab.seam_positions = slab.last == last_layer && !slab.owns_last_plane;
+      slab.limit = cap;
+      slab.level = params.level;
+      slab.frame = params.frame;
+      slab.values = &values;
+      slab.step = params.axis.step();
+      Result<McSlabView> view = params.mesher.mesh(slab);
+      if (appending.valid()) appending.get();
+      if (!view) fail(view.error());
+      if (failed) break;
+      appending = std::async(std::launch::async, [&, s, v = *view] {
+        if (!appendSlab(s, v.positions, v.triangles, v.first_plane_vertices, v.last_plane_vertices)) return;
+        if (s + 1 == pending.size()) out.seam.assign(v.seam_positions.begin(), v.seam_positions.end());
+        if (params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
+      });
+    }
+    if (appending.valid()) appending.get();
+  } else {
   parallelFor(static_cast<size_t>(plan.count), threads, [&](size_t s, unsigned) {
     const int first = slabFirst(s);
     const int last = slabLast(s);
@@ -708,6 +752,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     pending[s] = std::move(result);
     commitReady();
   });
+  }
   if (blocks) {
     blocks->stop();
     if (std::optional<Error> e = blocks->error(); e && !failure) failure = std::move(e);

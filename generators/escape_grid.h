@@ -32,6 +32,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,7 @@
 #include "core/progress.h"
 #include "core/result.h"
 #include "core/tile.h"
+#include "generators/marching_cubes.h"
 
 namespace dpoint {
 
@@ -75,6 +77,30 @@ using EscapePlaneFunction = std::function<Status(int first, int planes, int limi
 // when there is none. The blocks of counts are then carved from it.
 using EscapeArena = std::function<uint8_t*(uint64_t bytes)>;
 
+// A slab of the grid for a mesher elsewhere (EscapeSlabMesher), which makes its counts (the plane
+// function's, every count to max_iter) where it meshes them.
+struct EscapeSlab {
+  int res = 0;
+  int first = 0, last = 0;       // planes first..last (last > first): cell layers first..last − 1
+  bool owns_last_plane = false;  // as marchingCubesSlab's arguments
+  bool seam_positions = false;
+  int limit = 0;                 // the counts' limit: max_iter
+  double level = 0.0;
+  GridFrame frame = GridFrame::kNative;
+  const std::vector<double>* values = nullptr;  // the axis: GridAxis::value(i), i < res
+  double step = 0.0;                            // GridAxis::step()
+};
+
+// Marching cubes elsewhere (a GPU, generators/gpu_mesh.h): the counts and the mesh of a slab
+// there, the mesh marchingCubesSlab makes with this file's vertices, bit for bit. Used, in place of
+// the plane function, when `takes` the run's largest slab (planes of res² counts up to limit).
+// `mesh` is called for the slabs in order, from one thread; its view stays valid until the second
+// call after it returns (the caller copies one slab out while the next is made).
+struct EscapeSlabMesher {
+  std::function<bool(int res, int planes, int limit)> takes;
+  std::function<Result<McSlabView>(const EscapeSlab&)> mesh;
+};
+
 struct EscapeSurfaceParams {
   std::string name = "fractal";  // for messages and progress
   GridAxis axis;
@@ -88,6 +114,8 @@ struct EscapeSurfaceParams {
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // empty: the row function classifies too
   EscapeArena arena;             // where the plane function's blocks go; empty: the heap
+  // With the plane function, final counts (not lazy) and no grid_out: counts and meshes the slabs.
+  EscapeSlabMesher mesher;
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
@@ -115,6 +143,7 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.progress = params.progress;
   surface.planes = params.planes;
   surface.arena = params.arena;
+  surface.mesher = params.mesher;
   return surface;
 }
 

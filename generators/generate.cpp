@@ -31,7 +31,7 @@ void offsetPoints(PointSet& points, const glm::dvec3& offset) {
 
 std::string tileSignature(const std::string& kind, const std::string& option_lines) {
   static const std::vector<std::string> kIgnored = {"output", "tile", "threads", "quiet", "grid-out", "device",
-                                                    "max-memory", "decimals", "order", "validate", "counts", "help"};
+                                                    "max-memory", "decimals", "order", "validate", "counts", "mesh", "help"};
   std::istringstream lines(option_lines);
   std::string line, signature = kind;
   while (std::getline(lines, line)) {

@@ -94,6 +94,8 @@ void writeSet(const VulkanContext& context, VkDescriptorSet set, const std::vect
   vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
 }
 
+uint64_t squaredResolution(int res) { return static_cast<uint64_t>(res) * static_cast<uint64_t>(res); }
+
 }  // namespace
 
 Status gpuGenerateUsable(const DeviceFacts& facts) {
@@ -145,9 +147,9 @@ Status GpuEscape::init() {
   if (!p) return p.error();
   perturbation_ = *p;
 
-  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 18};  // per slot: 2 + 5 + 2
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 22};  // per slot: 2 + 5 + 2 + 2
   VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 6;
+  pool_info.maxSets = 8;
   pool_info.poolSizeCount = 1;
   pool_info.pPoolSizes = &pool_size;
   VK_TRY(vkCreateDescriptorPool(context_.device, &pool_info, nullptr, &pool_));
@@ -156,16 +158,18 @@ Status GpuEscape::init() {
                                          true, "escape counts");
     if (!counts) return counts.error();
     slot.counts = *counts;
-    const VkDescriptorSetLayout layouts[3] = {escape_set_layout_, perturbation_set_layout_, escape_set_layout_};
-    VkDescriptorSet sets[3] = {};
+    const VkDescriptorSetLayout layouts[4] = {escape_set_layout_, perturbation_set_layout_, escape_set_layout_,
+                                              escape_set_layout_};
+    VkDescriptorSet sets[4] = {};
     VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     allocate.descriptorPool = pool_;
-    allocate.descriptorSetCount = 3;
+    allocate.descriptorSetCount = 4;
     allocate.pSetLayouts = layouts;
     VK_TRY(vkAllocateDescriptorSets(context_.device, &allocate, sets));
     slot.escape_set = sets[0];
     slot.perturbation_set = sets[1];
     slot.arena_set = sets[2];
+    slot.target_set = sets[3];
     Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
     if (!commands) return commands.error();
     slot.commands = *commands;
@@ -292,17 +296,26 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   return okStatus();
 }
 
+Status GpuEscape::useAxis(const std::vector<double>& axis) {
+  if (axis == axis_values_) return okStatus();
+  if (Status s = upload(axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
+  axis_values_ = axis;
+  for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
+  arena_sets_stale_ = true;
+  target_ = VK_NULL_HANDLE;
+  return okStatus();
+}
+
+uint32_t GpuEscape::deviceBits(int limit) const {
+  return packed_counts_ ? 8 * static_cast<uint32_t>(escapeGridBytesPerCount(limit)) : 32;
+}
+
 Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first,
                                int planes, int limit, uint8_t* counts) {
   const uint64_t res = axis.size();
   assert(res >= 2 && first >= 0 && planes > 0 && static_cast<uint64_t>(first + planes) <= res && limit >= 0);
   if (Status s = finishAll(); !s) return s;
-  if (axis != axis_values_) {
-    if (Status s = upload(axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
-    axis_values_ = axis;
-    for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
-    arena_sets_stale_ = true;
-  }
+  if (Status s = useAxis(axis); !s) return s;
   const uint32_t count_bytes = static_cast<uint32_t>(escapeGridBytesPerCount(limit));
   // In the arena, with every row whole words (so no dispatch writes a word another one does).
   const uint64_t total = static_cast<uint64_t>(planes) * res * res * count_bytes;
@@ -313,6 +326,27 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     for (Slot& slot : slots_) writeSet(context_, slot.arena_set, {&axis_, &arena_});
     arena_sets_stale_ = false;
   }
+  return escapeRows(kernel, res, first, planes, limit, in_place ? Target::kArena : Target::kHost,
+                    in_place ? (at - arena) / 4 : 0, counts);
+}
+
+Status GpuEscape::escapeInto(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
+                             int limit, const Buffer& target) {
+  const uint64_t res = axis.size();
+  assert(res >= 2 && first >= 0 && planes > 0 && static_cast<uint64_t>(first + planes) <= res && limit >= 0);
+  assert(target.size * 8 >= static_cast<uint64_t>(planes) * res * res * deviceBits(limit));
+  if (Status s = finishAll(); !s) return s;
+  if (Status s = useAxis(axis); !s) return s;
+  if (target.buffer != target_) {
+    for (Slot& slot : slots_) writeSet(context_, slot.target_set, {&axis_, &target});
+    target_ = target.buffer;
+  }
+  return escapeRows(kernel, res, first, planes, limit, Target::kDevice, 0, nullptr);
+}
+
+Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int first, int planes, int limit,
+                             Target target, uint64_t word_offset, uint8_t* counts) {
+  const uint32_t count_bytes = static_cast<uint32_t>(escapeGridBytesPerCount(limit));
   EscapePush push{};
   for (int d = 0; d < 4; ++d) push.c[d] = kernel.c[d];
   push.threshold = kernel.julia_threshold;
@@ -325,7 +359,10 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
   const uint32_t device_bytes = packed_counts_ ? count_bytes : 4;
   push.bits = 8 * device_bytes;
   // Rows (plane·res + j) go out in chunks of whole rows; the row index stays below res² ≤ 2^32.
-  const uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuChunkPoints / res);
+  // Into device memory, a multiple of 4 rows a chunk: each chunk starts at a whole word whatever
+  // res is, so no two dispatches write one word.
+  uint64_t rows_per_chunk = std::max<uint64_t>(1, kGpuChunkPoints / res);
+  if (target == Target::kDevice) rows_per_chunk = std::max<uint64_t>(4, rows_per_chunk / 4 * 4);
   const uint64_t first_row = static_cast<uint64_t>(first) * res, end_row = first_row + static_cast<uint64_t>(planes) * res;
   const VkPipeline pipeline = escape_[static_cast<uint32_t>(kernel.kernel)];
   size_t s = 0;
@@ -333,11 +370,14 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
     const uint64_t rows = std::min(rows_per_chunk, end_row - row);
     push.first_row = static_cast<uint32_t>(row);
     push.count = static_cast<uint32_t>(rows * res);
-    uint8_t* destination = counts + (row - first_row) * res * count_bytes;
-    push.word_offset = in_place ? static_cast<uint32_t>((reinterpret_cast<uintptr_t>(destination) - arena) / 4) : 0;
-    if (Status st = dispatch(s, pipeline, escape_layout_, in_place ? slots_[s].arena_set : slots_[s].escape_set, &push,
-                             sizeof push, rows * res, in_place ? nullptr : destination, count_bytes, device_bytes,
-                             nullptr);
+    const uint64_t bytes_before = (row - first_row) * res * device_bytes;
+    push.word_offset = target == Target::kHost ? 0 : static_cast<uint32_t>(word_offset + bytes_before / 4);
+    const VkDescriptorSet set = target == Target::kArena  ? slots_[s].arena_set
+                                : target == Target::kDevice ? slots_[s].target_set
+                                                            : slots_[s].escape_set;
+    uint8_t* destination = target == Target::kHost ? counts + (row - first_row) * res * count_bytes : nullptr;
+    if (Status st = dispatch(s, pipeline, escape_layout_, set, &push, sizeof push, rows * res, destination, count_bytes,
+                             device_bytes, nullptr);
         !st) {
       (void)finishAll();
       return st;
@@ -353,12 +393,25 @@ Result<uint8_t*> GpuEscape::arena(uint64_t bytes) {
   if (arena_.size < bytes) {
     if (Status s = finishAll(); !s) return s.error();
     destroyBuffer(context_, arena_);
-    Result<Buffer> created = createBuffer(context_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "escape count blocks");
+    // A mesher on the device copies its slab out of it (generators/gpu_mesh.h).
+    Result<Buffer> created = createBuffer(context_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                          true, "escape count blocks");
     if (!created) return created.error();
     arena_ = *created;
     arena_sets_stale_ = true;
   }
   return static_cast<uint8_t*>(arena_.mapped);
+}
+
+Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
+                                    const EscapeSlab& slab) {
+  const int planes = slab.last - slab.first + 1;
+  assert(GpuMesher::supports(slab.res, planes, slab.limit));
+  const uint32_t bits = escape.deviceBits(slab.limit);
+  Result<const Buffer*> counts = mesher.countsBuffer(static_cast<uint64_t>(planes) * squaredResolution(slab.res) * bits / 8);
+  if (!counts) return counts.error();
+  if (Status s = escape.escapeInto(kernel, *slab.values, slab.first, planes, slab.limit, **counts); !s) return s.error();
+  return mesher.meshSlab(slab, bits);
 }
 
 Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,

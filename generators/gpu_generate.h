@@ -21,6 +21,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "generators/gpu_mesh.h"
 #include "generators/mandelbrot2d.h"
 #include "vulkan/context.h"
 #include "vulkan/buffers.h"
@@ -73,6 +74,13 @@ class GpuEscape {
   // packed (lavapipe) or one buffer cannot hold that much.
   Result<uint8_t*> arena(uint64_t bytes);
 
+  // escapePlanes's counts into device memory (`target`, from its start) and nowhere else, for a
+  // mesher on the device (generators/gpu_mesh.h), deviceBits(limit) bits each: packed as in the
+  // arena on a GPU, whole uint32 on lavapipe.
+  Status escapeInto(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
+                    int limit, const Buffer& target);
+  uint32_t deviceBits(int limit) const;
+
   // counts[r·dcx.size() + col] and tails[...]: mandelbrot2d's perturbed count of δc = (dcx[col],
   // dcy[r]) against `orbit` and its escape tail (generators/mandelbrot2d.cpp).
   Status perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,
@@ -93,6 +101,7 @@ class GpuEscape {
     Buffer tails;  // mandelbrot2d's escape tails; made at the first perturbation call
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
     VkDescriptorSet arena_set = VK_NULL_HANDLE;  // the escape kernel writing into arena_
+    VkDescriptorSet target_set = VK_NULL_HANDLE;  // and into escapeInto's target
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
     void* destination = nullptr;             // where the counts of the dispatch in flight go; null: in place
@@ -105,6 +114,12 @@ class GpuEscape {
   GpuEscape(const VulkanContext& context, bool pack_counts) : context_(context), packed_counts_(pack_counts) {}
   Status init();
   Status upload(Buffer& target, const void* data, size_t bytes, const std::string& what);
+  Status useAxis(const std::vector<double>& axis);  // uploads it where axis_ holds another
+  enum class Target { kHost, kArena, kDevice };      // where a dispatch's counts go
+  // Dispatches the rows of planes first..first + planes − 1 in chunks: copied out to `counts`
+  // (kHost), or written in place from word `word_offset` of the arena or of escapeInto's target.
+  Status escapeRows(const EscapeKernelParams& kernel, uint64_t res, int first, int planes, int limit, Target target,
+                    uint64_t word_offset, uint8_t* counts);
   // Records and submits one dispatch into slot `s`, after finishing what the slot had in flight.
   Status dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
                   uint32_t push_bytes, uint64_t points, void* destination, uint32_t count_bytes,
@@ -127,7 +142,14 @@ class GpuEscape {
   Buffer axis_, orbit_, dcx_, dcy_;
   Buffer arena_;
   bool arena_sets_stale_ = true;  // the slots' arena sets do not name axis_ and arena_ yet
+  VkBuffer target_ = VK_NULL_HANDLE;  // the buffer the slots' target sets name
   std::vector<double> axis_values_;  // what axis_ holds
 };
+
+// slab's mesh on the device: its counts by `escape` into the mesher's memory (escapeInto), then
+// marching cubes by `mesher`; nothing crosses to the host but the mesh. The slab must be one the
+// mesher takes (GpuMesher::supports). The body of an EscapeSlabMesher; one thread at a time.
+Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
+                                    const EscapeSlab& slab);
 
 }  // namespace dpoint

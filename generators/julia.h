@@ -43,6 +43,7 @@ struct JuliaParams {
   Progress* progress = nullptr;
   EscapePlaneFunction planes;    // the classification elsewhere (a GPU); empty: on the CPU
   EscapeArena arena;             // where `planes` writes fastest (escape_grid.h); empty: the heap
+  EscapeSlabMesher mesher;       // meshes the slabs of `planes` elsewhere (escape_grid.h); empty: here
   bool full_counts = false;      // every count to max_iter, not capped above the level (escape_grid.h)
 };
 

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -79,6 +80,16 @@ struct McSlabMesh {
   // With seam_positions and !owns_last_plane: the positions of those last_plane_vertices, in order.
   PositionArray seam_positions;
   bool complete = false;              // false when plane_done stopped it
+};
+
+// A slab's mesh in memory someone else owns (a GPU's mesher: generators/gpu_mesh.h): McSlabMesh's
+// arrays and counts.
+struct McSlabView {
+  std::span<const glm::dvec3> positions;
+  std::span<const uint32_t> triangles;
+  uint32_t first_plane_vertices = 0;
+  uint32_t last_plane_vertices = 0;
+  std::span<const glm::dvec3> seam_positions;
 };
 
 McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last_plane,

@@ -2,7 +2,8 @@
 # An A/B of one generate on the GPU machine (device tool; carry .gl and .gpu as for
 # gpu_generate.sh: .gpu/dpoint-A the build before, .gpu/dpoint the current one). First the
 # current build's device counts against its CPU path at res 63, 64 and 257 ($OUT/equal.txt). For ROUNDS
-# (3) rounds, each build of BUILDS ("A current") in turn: `generate CASE --device 0` (CASE default
+# (3) rounds, each build of BUILDS ("A current"; a build .gpu/dpoint-NAME may be a script that runs
+# .gpu/dpoint with other options, e.g. `--mesh host`) in turn: `generate CASE --device 0` (CASE default
 # "mandelbulb --variant fast --resolution 2048"), then dd of a file of its size into the same
 # folder. One line per run in $OUT/generate_ab.tsv: round, build, wall s, the classification's GPU
 # ms (the device line), SHA-256 (16) of the output, and the phases generate prints (generate,
@@ -21,8 +22,12 @@ for res in 63 64 257; do
   .gpu/dpoint generate $kind --resolution $res -q --device none --grid-out "$data/cpu.grid" -o "$data/cpu.ply"
   # shellcheck disable=SC2086
   .gpu/dpoint generate $kind --resolution $res -q --device 0 --grid-out "$data/gpu.grid" -o "$data/gpu.ply"
+  # Without --grid-out: marching cubes where --mesh auto puts it (the device, on a GPU).
+  # shellcheck disable=SC2086
+  .gpu/dpoint generate $kind --resolution $res -q --device 0 -o "$data/mesh.ply"
   echo "$kind--resolution $res: grid $(cmp -s "$data/cpu.grid" "$data/gpu.grid" && echo equal || echo DIFFER)," \
-    "file $(cmp -s "$data/cpu.ply" "$data/gpu.ply" && echo equal || echo DIFFER)"
+    "file $(cmp -s "$data/cpu.ply" "$data/gpu.ply" && echo equal || echo DIFFER)," \
+    "file meshed by --mesh auto $(cmp -s "$data/cpu.ply" "$data/mesh.ply" && echo equal || echo DIFFER)"
 done | tee "$out/equal.txt"
 rows=$out/generate_ab.tsv
 printf 'round\tbuild\twall_s\tgpu_ms\tsha256\tgenerate_s\tcolours_s\twrite_s\n' >"$rows"

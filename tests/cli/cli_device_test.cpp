@@ -54,6 +54,10 @@ TEST(CliGenerateDevice, gridAndOutputOnTheDeviceEqualTheCpuPathsForEachKind) {
         ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
         EXPECT_TRUE(readFile(dir.file("cpu.ply")) == readFile(dir.file("lazy.ply")));
       }
+      // Marching cubes on the device too (which runs every count to --max-iter): the same file.
+      gpu = runDpoint(concat(base, {"--device", "cpu", "--mesh", "device", "--validate", "-o", dir.file("mesh.ply")}));
+      ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
+      EXPECT_TRUE(readFile(dir.file("cpu.ply")) == readFile(dir.file("mesh.ply")));
     }
   }
 }
@@ -65,8 +69,10 @@ TEST(CliGenerateDevice, tilesOnTheDeviceMergeToTheCpuFile) {
   std::vector<std::string> merge = {"merge", "-q", "-o", dir.file("merged.ply")};
   for (int i = 0; i < 3; ++i) {
     merge.push_back(dir.file("part-" + std::to_string(i) + ".ply"));
-    test::CommandResult r =
-        runDpoint(concat(kind, {"--device", "0", "--validate", "--tile", std::to_string(i) + "/3", "-o", merge.back()}));
+    // The middle tile's marching cubes on the device: its seam copies and triangles as the host's.
+    std::vector<std::string> args = concat(kind, {"--device", "0", "--validate", "--tile", std::to_string(i) + "/3", "-o", merge.back()});
+    if (i == 1) args = concat(args, {"--mesh", "device"});
+    test::CommandResult r = runDpoint(args);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   ASSERT_EQ(runDpoint(merge).exit_code, 0);

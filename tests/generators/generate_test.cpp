@@ -38,7 +38,8 @@ TEST(Generate, offsetIsOneExactSumAPoint) {
 }
 
 TEST(Generate, tileSignatureKeepsWhatShapesThePoints) {
-  const std::string lines = "resolution=64\noutput=\"a.ply\"\ntile=\"0/2\"\nthreads=4\nmax-iter=100\n\ncolors=\"auto\"\n";
+  const std::string lines =
+      "resolution=64\noutput=\"a.ply\"\ntile=\"0/2\"\nthreads=4\nmax-iter=100\n\ncolors=\"auto\"\nmesh=\"device\"\ncounts=\"full\"\n";
   EXPECT_EQ(tileSignature("mandelbulb", lines), "mandelbulb resolution=64 max-iter=100 colors=\"auto\"");
   EXPECT_NE(tileSignature("mandelbulb", lines), tileSignature("julia", lines));
 }

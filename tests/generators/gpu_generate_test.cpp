@@ -318,6 +318,92 @@ TEST_F(GpuGenerate, meshesFromDevicePlanesEqualTheCpuMeshes) {
   EXPECT_NE(refused.error().message.find("--variant seed runs on the CPU only"), std::string::npos);
 }
 
+// Marching cubes on the device (generators/gpu_mesh.h) makes the host's mesh bit for bit: both
+// kinds, both frames, counts packed as a GPU writes them (rows of whole words at res 44, not at 45)
+// and whole (lavapipe's), whole sets and tiles (a seam's copies, the last tile's own last plane),
+// and a --level between counts; counts of two bytes are meshed on the host; a mesher's error ends
+// the run with it.
+TEST_F(GpuGenerate, marchingCubesOnTheDeviceEqualsTheHosts) {
+  Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*context_);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  GpuMesher& mesher = **made;
+  int meshed = 0;
+  auto on_device = [&](GpuEscape* escape, const EscapeKernelParams& kernel) {
+    EscapeSlabMesher m;
+    m.takes = &GpuMesher::supports;
+    m.mesh = [&, escape, kernel](const EscapeSlab& slab) {
+      ++meshed;
+      return meshSlabOnDevice(*escape, mesher, kernel, slab);
+    };
+    return m;
+  };
+  for (int res : {44, 45}) {
+    for (GridFrame frame : {GridFrame::kNative, GridFrame::kSeed}) {
+      for (bool packed : {true, false}) {
+        SCOPED_TRACE("res " + std::to_string(res) + (frame == GridFrame::kSeed ? ", seed frame" : "") +
+                     (packed ? ", packed" : ", whole"));
+        GpuEscape* escape = packed ? packed_.get() : gpu_.get();
+        MandelbulbParams bulb;
+        bulb.resolution = res;
+        bulb.variant = MandelbulbVariant::kFast;
+        bulb.frame = frame;
+        bulb.level = 9.5;
+        Result<PointSet> expected = generateMandelbulb(bulb);
+        bulb.planes = planes(mandelbulb(), GridAxis{res, -1.5, 1.5}, packed);
+        bulb.full_counts = true;
+        bulb.mesher = on_device(escape, mandelbulb());
+        meshed = 0;
+        Result<PointSet> got = generateMandelbulb(bulb);
+        ASSERT_TRUE(expected.ok() && got.ok()) << (got.ok() ? "" : got.error().message);
+        EXPECT_GT(meshed, 1);
+        EXPECT_TRUE(sameMesh(*expected, *got));
+
+        JuliaParams julia_params;
+        julia_params.resolution = res;
+        julia_params.frame = frame;
+        JuliaParams on_cpu = julia_params;
+        julia_params.planes = planes(julia(julia_params.c), GridAxis{res, -1.5, 1.5}, packed);
+        julia_params.full_counts = true;
+        julia_params.mesher = on_device(escape, julia(julia_params.c));
+        for (uint32_t index : {0u, 1u, 2u}) {
+          Result<PointTile> tile = generateJuliaTile(julia_params, {index, 3});
+          Result<PointTile> tile_cpu = generateJuliaTile(on_cpu, {index, 3});
+          ASSERT_TRUE(tile.ok() && tile_cpu.ok());
+          EXPECT_TRUE(sameMesh(tile->points, tile_cpu->points)) << "tile " << index;
+          EXPECT_EQ(tile->owned, tile_cpu->owned);
+          ASSERT_EQ(tile->foreign.size(), tile_cpu->foreign.size());
+          for (size_t i = 0; i < tile->foreign.size(); ++i)
+            EXPECT_TRUE(tile->foreign[i].tile == tile_cpu->foreign[i].tile &&
+                        tile->foreign[i].index == tile_cpu->foreign[i].index);
+        }
+      }
+    }
+  }
+  // Two-byte counts (--max-iter 300): the mesher does not take them and the host meshes the slabs.
+  MandelbulbParams deep;
+  deep.resolution = 33;
+  deep.variant = MandelbulbVariant::kFast;
+  deep.max_iter = 300;
+  Result<PointSet> deep_cpu = generateMandelbulb(deep);
+  deep.planes = planes(mandelbulb(), GridAxis{33, -1.5, 1.5});
+  deep.full_counts = true;
+  deep.mesher = on_device(packed_.get(), mandelbulb());
+  meshed = 0;
+  Result<PointSet> deep_gpu = generateMandelbulb(deep);
+  ASSERT_TRUE(deep_cpu.ok() && deep_gpu.ok());
+  EXPECT_EQ(meshed, 0);
+  EXPECT_TRUE(sameMesh(*deep_cpu, *deep_gpu));
+  // A mesher that fails: the run ends with its error.
+  deep.max_iter = 100;
+  deep.mesher.mesh = [](const EscapeSlab&) -> Result<McSlabView> {
+    return Error{"the device was lost", ExitCode::kNoDevice};
+  };
+  Result<PointSet> failed = generateMandelbulb(deep);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().code, ExitCode::kNoDevice);
+  EXPECT_EQ(failed.error().message, "the device was lost");
+}
+
 bool sameBits(const PointSet& a, const PointSet& b) {
   return a.size() == b.size() && a.colors.size() == b.colors.size() &&
          std::memcmp(a.positions.data(), b.positions.data(), a.size() * sizeof(glm::dvec3)) == 0 &&

@@ -1,0 +1,337 @@
+#include "generators/gpu_mesh.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+
+#include "vulkan/shader.h"
+
+#include "shaders/mesh_slab.comp.h"
+
+namespace dpoint {
+namespace {
+
+constexpr uint32_t kGroupElements = 1024;  // 256 invocations of 4 elements (mesh_slab.comp's kGroupElements)
+constexpr uint32_t kBindings = 12;
+// Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
+enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
+
+// Push constants of shaders/generate/mesh_slab.comp (std430: the double at 0, then the uints).
+struct MeshPush {
+  double step;
+  uint32_t n, plane, planes, first, word_offset, bits, above_at, stride, seed_frame;
+  uint32_t vertex_elements, triangle_elements, vertex_group_count, triangle_group_count, groups_x, pad;
+};
+static_assert(sizeof(MeshPush) == 72);
+
+}  // namespace
+
+bool GpuMesher::supports(int res, int planes, int limit) {
+  const uint64_t plane = static_cast<uint64_t>(res) * static_cast<uint64_t>(res);
+  return res >= 2 && planes >= 2 && limit >= 1 && escapeGridBytesPerCount(limit) == 1 &&
+         (2 * static_cast<uint64_t>(planes) - 1) * plane < (uint64_t{1} << 31);
+}
+
+Result<std::unique_ptr<GpuMesher>> GpuMesher::create(const VulkanContext& context) {
+  std::unique_ptr<GpuMesher> mesher(new GpuMesher(context));
+  if (Status s = mesher->init(); !s) return s.error();
+  return mesher;
+}
+
+Status GpuMesher::init() {
+  if (context_.facts.timestamp_period_ns > 0.0f) {
+    VkQueryPoolCreateInfo query_info = {VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = kStamps;
+    VK_TRY(vkCreateQueryPool(context_.device, &query_info, nullptr, &queries_));
+  }
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  for (uint32_t b = 0; b < kBindings; ++b)
+    bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  Result<VkDescriptorSetLayout> set_layout = storageSetLayout(context_, bindings);
+  if (!set_layout) return set_layout.error();
+  set_layout_ = *set_layout;
+  Result<VkPipelineLayout> layout = pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!layout) return layout.error();
+  layout_ = *layout;
+  Result<VkShaderModule> module = createShaderModule(context_, kMeshSlabComp, sizeof(kMeshSlabComp));
+  if (!module) return module.error();
+  for (uint32_t pass = 0; pass < 5; ++pass) {
+    const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
+    const VkSpecializationInfo specialization{1, &entry, sizeof(uint32_t), &pass};
+    VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = *module;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = &specialization;
+    info.layout = layout_;
+    const VkResult result =
+        vkCreateComputePipelines(context_.device, context_.pipeline_cache, 1, &info, nullptr, &passes_[pass]);
+    if (result != VK_SUCCESS) {
+      vkDestroyShaderModule(context_.device, *module, nullptr);
+      return vulkanError("creating a meshing pipeline", result);
+    }
+  }
+  vkDestroyShaderModule(context_.device, *module, nullptr);
+
+  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
+  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &pool_size;
+  VK_TRY(vkCreateDescriptorPool(context_.device, &pool_info, nullptr, &pool_));
+  VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  allocate.descriptorPool = pool_;
+  allocate.descriptorSetCount = 1;
+  allocate.pSetLayouts = &set_layout_;
+  VK_TRY(vkAllocateDescriptorSets(context_.device, &allocate, &set_));
+  Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
+  if (!commands) return commands.error();
+  commands_ = *commands;
+  VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &fence_));
+
+  // The case table: for mask m, 16 bytes: the triangle count, then its 3·count cube edges.
+  std::vector<uint8_t> cases(256 * 16, 0);
+  for (unsigned m = 0; m < 256; ++m) {
+    const McCase& c = marchingCubesCase(m);
+    cases[16 * m] = c.triangle_count;
+    std::copy(c.edges.begin(), c.edges.end(), cases.begin() + 16 * m + 1);
+  }
+  if (Status s = upload(cases_, cases.data(), cases.size(), "marching cubes cases"); !s) return s;
+  if (Status s = ensure(totals_, 4 * sizeof(uint32_t), true, "meshing totals"); !s) return s;
+  return okStatus();
+}
+
+GpuMesher::~GpuMesher() {
+  const VkDevice device = context_.device;
+  if (fence_) vkDestroyFence(device, fence_, nullptr);
+  if (commands_) vkFreeCommandBuffers(device, context_.command_pool, 1, &commands_);
+  for (Buffer* b : {&counts_, &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
+                    &ids_z_, &ids_x_, &positions_, &triangles_, &readback_[0], &readback_[1]})
+    destroyBuffer(context_, *b);
+  if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
+  if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
+  for (VkPipeline p : passes_)
+    if (p) vkDestroyPipeline(device, p, nullptr);
+  if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
+  if (set_layout_) vkDestroyDescriptorSetLayout(device, set_layout_, nullptr);
+}
+
+// Grows `buffer` to at least `bytes` (by half again, so a slab a little larger than the last does
+// not make a new one); its old contents are not kept.
+Status GpuMesher::ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what) {
+  bytes = std::max<uint64_t>(bytes, 16);
+  if (buffer.size >= bytes) return okStatus();
+  destroyBuffer(context_, buffer);
+  const uint64_t grown = std::max<uint64_t>(bytes, buffer.size + buffer.size / 2);
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  Result<Buffer> created = createBuffer(context_, grown, usage, host_visible, what);
+  if (!created) return created.error();
+  buffer = *created;
+  return okStatus();
+}
+
+Status GpuMesher::upload(Buffer& target, const void* data, size_t bytes, const char* what) {
+  if (target.size < bytes) {
+    destroyBuffer(context_, target);
+    Result<Buffer> created = createUploadTarget(
+        context_, std::max<size_t>(bytes, 16), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
+    if (!created) return created.error();
+    target = *created;
+  }
+  return uploadBuffer(context_, target, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize size) {
+    std::memcpy(dst, static_cast<const uint8_t*>(data) + offset, size);
+  });
+}
+
+Status GpuMesher::submit(const std::function<void(VkCommandBuffer)>& record) {
+  VK_TRY(vkResetFences(context_.device, 1, &fence_));
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_TRY(vkBeginCommandBuffer(commands_, &begin));
+  record(commands_);
+  VK_TRY(vkEndCommandBuffer(commands_));
+  VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  info.commandBufferCount = 1;
+  info.pCommandBuffers = &commands_;
+  VK_TRY(queueSubmit(context_, info, fence_));
+  VK_TRY(waitForFence(context_, fence_));
+  return okStatus();
+}
+
+void GpuMesher::stamp(VkCommandBuffer commands, uint32_t query) const {
+  if (queries_) vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, query);
+}
+
+Status GpuMesher::readStamps() {
+  if (!queries_) return okStatus();
+  uint64_t ticks[kStamps] = {};
+  VK_TRY(vkGetQueryPoolResults(context_.device, queries_, 0, kStamps, sizeof(ticks), ticks, sizeof(uint64_t),
+                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  const double ms = context_.facts.timestamp_period_ns * 1e-6;
+  times_.scan += static_cast<double>(ticks[kScanned] - ticks[kStart]) * ms;
+  times_.vertices += static_cast<double>(ticks[kVertices] - ticks[kStart2]) * ms;
+  times_.triangles += static_cast<double>(ticks[kTriangles] - ticks[kVertices]) * ms;
+  times_.copy += static_cast<double>(ticks[kCopied] - ticks[kTriangles]) * ms;
+  return okStatus();
+}
+
+Result<const Buffer*> GpuMesher::countsBuffer(uint64_t bytes) {
+  if (Status s = ensure(counts_, bytes, false, "escape counts of a slab"); !s) return s.error();
+  return &counts_;
+}
+
+Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
+  const int planes = slab.last - slab.first + 1;
+  assert(supports(slab.res, planes, slab.limit) && slab.values && slab.values->size() == static_cast<size_t>(slab.res));
+  assert(bits == 8 || bits == 32);
+  const uint64_t n = static_cast<uint64_t>(slab.res), plane = n * n;
+  assert(counts_.size * 8 >= static_cast<uint64_t>(planes) * plane * bits);
+
+  // The inputs beside the counts: the axis, and the fractions t of every pair of counts (the CPU's
+  // division).
+  if (*slab.values != axis_values_) {
+    if (Status s = upload(axis_, slab.values->data(), slab.values->size() * sizeof(double), "grid axis"); !s) return s.error();
+    axis_values_ = *slab.values;
+  }
+  const uint32_t stride = static_cast<uint32_t>(slab.limit) + 1;
+  if (!fractions_.buffer || fractions_level_ != slab.level || fractions_stride_ != stride) {
+    std::vector<double> fractions(static_cast<size_t>(stride) * stride, 0.0);
+    for (uint32_t v1 = 0; v1 < stride; ++v1)
+      for (uint32_t v2 = 0; v2 < stride; ++v2)
+        if (v1 != v2) fractions[v1 * stride + v2] = (slab.level - v1) / (static_cast<double>(v2) - v1);
+    if (Status s = upload(fractions_, fractions.data(), fractions.size() * sizeof(double), "edge fractions"); !s)
+      return s.error();
+    fractions_level_ = slab.level;
+    fractions_stride_ = stride;
+  }
+
+  MeshPush push{};
+  push.step = slab.step;
+  push.n = static_cast<uint32_t>(n);
+  push.plane = static_cast<uint32_t>(plane);
+  push.planes = static_cast<uint32_t>(planes);
+  push.first = static_cast<uint32_t>(slab.first);
+  push.word_offset = 0;
+  push.bits = bits;
+  push.above_at = slab.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(slab.level));
+  push.stride = stride;
+  push.seed_frame = slab.frame == GridFrame::kSeed ? 1u : 0u;
+  const uint64_t vertex_elements = (2 * static_cast<uint64_t>(planes) - 1) * plane;
+  const uint64_t triangle_elements = static_cast<uint64_t>(planes - 1) * plane;
+  push.vertex_elements = static_cast<uint32_t>(vertex_elements);
+  push.triangle_elements = static_cast<uint32_t>(triangle_elements);
+  push.vertex_group_count = static_cast<uint32_t>((vertex_elements + kGroupElements - 1) / kGroupElements);
+  push.triangle_group_count = static_cast<uint32_t>((triangle_elements + kGroupElements - 1) / kGroupElements);
+
+  if (Status s = ensure(vertex_groups_, push.vertex_group_count * sizeof(uint32_t), false, "meshing group counts"); !s)
+    return s.error();
+  if (Status s = ensure(triangle_groups_, push.triangle_group_count * sizeof(uint32_t), false, "meshing group counts");
+      !s)
+    return s.error();
+  if (Status s = ensure(ids_y_, planes * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
+  if (Status s = ensure(ids_z_, planes * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
+  if (Status s = ensure(ids_x_, (planes - 1) * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
+  if (Status s = ensure(positions_, 3 * sizeof(double), false, "slab vertices"); !s) return s.error();
+  if (Status s = ensure(triangles_, 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s.error();
+  auto bind = [&] {
+    const VkDescriptorBufferInfo infos[kBindings] = {
+        {counts_.buffer, 0, VK_WHOLE_SIZE},    {axis_.buffer, 0, VK_WHOLE_SIZE},
+        {fractions_.buffer, 0, VK_WHOLE_SIZE}, {cases_.buffer, 0, VK_WHOLE_SIZE},
+        {vertex_groups_.buffer, 0, VK_WHOLE_SIZE}, {triangle_groups_.buffer, 0, VK_WHOLE_SIZE},
+        {totals_.buffer, 0, VK_WHOLE_SIZE},    {ids_y_.buffer, 0, VK_WHOLE_SIZE},
+        {ids_z_.buffer, 0, VK_WHOLE_SIZE},     {ids_x_.buffer, 0, VK_WHOLE_SIZE},
+        {positions_.buffer, 0, VK_WHOLE_SIZE}, {triangles_.buffer, 0, VK_WHOLE_SIZE}};
+    writeBufferDescriptors(context_, set_, infos);
+  };
+  bind();
+
+  const uint32_t max_x = std::max<uint32_t>(context_.facts.max_dispatch_groups_x, 1);
+  auto dispatch = [&](VkCommandBuffer commands, uint32_t pass, uint32_t groups) {
+    const uint32_t x = std::min(groups, max_x);
+    push.groups_x = x;
+    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass]);
+    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+    vkCmdPushConstants(commands, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(commands, x, (groups + x - 1) / x, 1);
+  };
+  auto barrier = [](VkCommandBuffer commands, VkPipelineStageFlags dst_stage, VkAccessFlags dst) {
+    VkMemoryBarrier b = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = dst;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, dst_stage, 0,
+                         1, &b, 0, nullptr, 0, nullptr);
+  };
+  const VkAccessFlags shader_rw = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+
+  // The counts (written by GpuEscape's dispatches, submitted before) and the scans.
+  Status status = submit([&](VkCommandBuffer commands) {
+    if (queries_) vkCmdResetQueryPool(commands, queries_, 0, kStamps);
+    barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
+    stamp(commands, kStart);
+    dispatch(commands, 0, push.vertex_group_count);
+    dispatch(commands, 1, push.triangle_group_count);
+    barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
+    dispatch(commands, 2, 2);
+    stamp(commands, kScanned);
+    barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+  });
+  if (!status) return status.error();
+  if (Status s = invalidateBuffer(context_, totals_); !s) return s.error();
+  uint32_t totals[4];
+  std::memcpy(totals, totals_.mapped, sizeof totals);
+  const uint64_t vertices = totals[0], triangles = totals[1];
+
+  // The vertices and triangles into device memory, then copied across to host-visible memory by
+  // the transfer engine (a shader's scattered writes across the bus were several times slower).
+  const uint64_t position_bytes = vertices * 3 * sizeof(double), triangle_bytes = triangles * 3 * sizeof(uint32_t);
+  const uint64_t old_positions = positions_.size, old_triangles = triangles_.size;
+  if (Status s = ensure(positions_, position_bytes, false, "slab vertices"); !s) return s.error();
+  if (Status s = ensure(triangles_, triangle_bytes, false, "slab triangles"); !s) return s.error();
+  Buffer& readback = readback_[next_readback_];
+  next_readback_ ^= 1;
+  if (Status s = ensure(readback, position_bytes + triangle_bytes, true, "slab mesh for the host"); !s)
+    return s.error();
+  if (positions_.size != old_positions || triangles_.size != old_triangles) bind();
+  status = submit([&](VkCommandBuffer commands) {
+    stamp(commands, kStart2);
+    dispatch(commands, 3, push.vertex_group_count);
+    stamp(commands, kVertices);
+    barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
+    dispatch(commands, 4, push.triangle_group_count);
+    stamp(commands, kTriangles);
+    barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    if (position_bytes) {
+      const VkBufferCopy copy{0, 0, position_bytes};
+      vkCmdCopyBuffer(commands, positions_.buffer, readback.buffer, 1, &copy);
+    }
+    if (triangle_bytes) {
+      const VkBufferCopy copy{0, position_bytes, triangle_bytes};
+      vkCmdCopyBuffer(commands, triangles_.buffer, readback.buffer, 1, &copy);
+    }
+    stamp(commands, kCopied);
+    barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+  });
+  if (!status) return status.error();
+  if (Status s = readStamps(); !s) return s.error();
+  for (const Buffer* b : {&totals_, &readback})
+    if (Status s = invalidateBuffer(context_, *b); !s) return s.error();
+  std::memcpy(totals, totals_.mapped, sizeof totals);
+
+  McSlabView out;
+  out.first_plane_vertices = totals[2];
+  const uint64_t last_first = totals[3];  // the first id of the last plane's in-plane vertices
+  out.last_plane_vertices = static_cast<uint32_t>(vertices - last_first);
+  const auto* positions = static_cast<const glm::dvec3*>(readback.mapped);
+  out.positions = {positions, slab.owns_last_plane ? vertices : last_first};
+  if (!slab.owns_last_plane && slab.seam_positions) out.seam_positions = {positions + last_first, vertices - last_first};
+  out.triangles = {reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(readback.mapped) + position_bytes),
+                   3 * triangles};
+  return out;
+}
+
+}  // namespace dpoint

@@ -1,0 +1,83 @@
+// Marching cubes of escape counts on a Vulkan device (issue #38 item 4): one slab of final counts
+// (every count to the limit) in, the slab's mesh out, equal bit for bit to the one
+// marchingCubesSlab (generators/marching_cubes.h) makes on the host with the escape grid's
+// vertices (generators/escape_grid.cpp's SlabField::vertex). shaders/generate/mesh_slab.comp says
+// how: a scan over the slab's elements in canonical order numbers the vertices and the triangles.
+//
+// The counts never leave the device: GpuEscape::escapeInto writes them into the mesher's memory
+// (generators/gpu_generate.h meshSlabOnDevice). Two submissions a slab: the counts and their scan,
+// then (with the output buffers grown to the totals) the vertices and triangles, copied across to
+// host-visible memory, where the caller reads them. One thread at a
+// time may call a GpuMesher, and the same thread as the GpuEscape beside it: both record on the
+// context's one queue and pool.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/result.h"
+#include "generators/escape_grid.h"
+#include "generators/marching_cubes.h"
+#include "vulkan/buffers.h"
+#include "vulkan/context.h"
+
+namespace dpoint {
+
+class GpuMesher {
+ public:
+  static Result<std::unique_ptr<GpuMesher>> create(const VulkanContext& context);
+  ~GpuMesher();
+  GpuMesher(const GpuMesher&) = delete;
+  GpuMesher& operator=(const GpuMesher&) = delete;
+
+  // Whether meshSlab takes a slab of `planes` planes of res² counts up to `limit`: counts of one
+  // byte (the fraction table has (limit + 1)² entries) and element numbers below 2^31.
+  static bool supports(int res, int planes, int limit);
+
+  // Device memory for a slab's counts, `bytes` of them: GpuEscape::escapeInto writes them there.
+  Result<const Buffer*> countsBuffer(uint64_t bytes);
+
+  // marchingCubesSlab(res, res, slab.first, slab.last, slab.owns_last_plane, …, slab.seam_positions)
+  // with SlabField's vertices (slab.level, frame, values, step) from the slab's final counts, which
+  // countsBuffer holds, `bits` (8 or 32) each. The view is of host-visible memory that stays as it
+  // is until the second call after this one (two buffers, used in turn).
+  Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits);
+
+  // The passes' time on the device (timestamps), in ms: counting and scanning, the vertices, the
+  // triangles, and copying the mesh across to host-visible memory.
+  struct Times {
+    double scan = 0.0, vertices = 0.0, triangles = 0.0, copy = 0.0;
+    double total() const { return scan + vertices + triangles + copy; }
+  };
+  const Times& times() const { return times_; }
+
+ private:
+  explicit GpuMesher(const VulkanContext& context) : context_(context) {}
+  Status init();
+  Status ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what);
+  Status upload(Buffer& target, const void* data, size_t bytes, const char* what);
+  Status submit(const std::function<void(VkCommandBuffer)>& record);  // and waits
+  void stamp(VkCommandBuffer commands, uint32_t query) const;
+  Status readStamps();
+
+  const VulkanContext& context_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline passes_[5] = {};
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  VkCommandBuffer commands_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkQueryPool queries_ = VK_NULL_HANDLE;
+  Buffer counts_, axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
+  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_;
+  Buffer readback_[2];  // host-visible, used in turn: a slab's positions, then its triangles
+  unsigned next_readback_ = 0;
+  std::vector<double> axis_values_;       // what axis_ holds
+  double fractions_level_ = 0.0;           // the level and stride fractions_ was made for
+  uint32_t fractions_stride_ = 0;
+  Times times_;
+};
+
+}  // namespace dpoint
