@@ -302,7 +302,6 @@ Status GpuEscape::useAxis(const std::vector<double>& axis) {
   axis_values_ = axis;
   for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
   arena_sets_stale_ = true;
-  target_ = VK_NULL_HANDLE;
   return okStatus();
 }
 
@@ -337,10 +336,10 @@ Status GpuEscape::escapeInto(const EscapeKernelParams& kernel, const std::vector
   assert(target.size * 8 >= static_cast<uint64_t>(planes) * res * res * deviceBits(limit));
   if (Status s = finishAll(); !s) return s;
   if (Status s = useAxis(axis); !s) return s;
-  if (target.buffer != target_) {
-    for (Slot& slot : slots_) writeSet(context_, slot.target_set, {&axis_, &target});
-    target_ = target.buffer;
-  }
+  // Every call: a buffer made after another was destroyed may have its handle (NVIDIA's driver
+  // reuses them), so the handle cannot tell whether the sets are current; no dispatch is in flight
+  // after finishAll.
+  for (Slot& slot : slots_) writeSet(context_, slot.target_set, {&axis_, &target});
   return escapeRows(kernel, res, first, planes, limit, Target::kDevice, 0, nullptr);
 }
 

@@ -142,7 +142,6 @@ class GpuEscape {
   Buffer axis_, orbit_, dcx_, dcy_;
   Buffer arena_;
   bool arena_sets_stale_ = true;  // the slots' arena sets do not name axis_ and arena_ yet
-  VkBuffer target_ = VK_NULL_HANDLE;  // the buffer the slots' target sets name
   std::vector<double> axis_values_;  // what axis_ holds
 };
 
