@@ -632,9 +632,10 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   };
 
   // Appends slab `index`'s mesh (marchingCubesSlab's McSlabMesh, or a view of one made elsewhere)
-  // to the mesh; false when it would pass a limit (then `fail` has the error).
+  // to the mesh, copying on `copiers` threads; false when it would pass a limit (then `fail` has
+  // the error).
   auto appendSlab = [&](size_t index, std::span<const glm::dvec3> positions, std::span<const uint32_t> triangles,
-                        uint32_t first_plane_vertices, uint32_t last_plane_vertices) {
+                        uint32_t first_plane_vertices, uint32_t last_plane_vertices, unsigned copiers) {
     assert(index == 0 || first_plane_vertices == previous_last_plane_vertices);
     (void)index, (void)first_plane_vertices;
     previous_last_plane_vertices = last_plane_vertices;
@@ -651,11 +652,26 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                  ExitCode::kResourceLimit});
       return false;
     }
-    mesh.positions.insert(mesh.positions.end(), positions.begin(), positions.end());
     const size_t first_index = mesh.triangles.size();
+    mesh.positions.resize(offset + positions.size());  // not zeroed (DefaultInitAllocator)
     mesh.triangles.resize(first_index + triangles.size());
-    std::transform(triangles.begin(), triangles.end(), mesh.triangles.begin() + static_cast<std::ptrdiff_t>(first_index),
-                   [offset](uint32_t id) { return static_cast<uint32_t>(offset + id); });
+    // Pieces of 256 Ki values (2–6 MiB); the ids shifted as they are copied.
+    constexpr size_t kPiece = size_t{1} << 18;
+    const size_t position_pieces = (positions.size() + kPiece - 1) / kPiece;
+    const size_t pieces = position_pieces + (triangles.size() + kPiece - 1) / kPiece;
+    parallelFor(pieces, copiers, [&](size_t piece, unsigned) {
+      if (piece < position_pieces) {
+        const size_t at = piece * kPiece, n = std::min(kPiece, positions.size() - at);
+        std::copy_n(positions.begin() + static_cast<std::ptrdiff_t>(at), n,
+                    mesh.positions.begin() + static_cast<std::ptrdiff_t>(offset + at));
+        return;
+      }
+      const size_t at = (piece - position_pieces) * kPiece, n = std::min(kPiece, triangles.size() - at);
+      std::transform(triangles.begin() + static_cast<std::ptrdiff_t>(at),
+                     triangles.begin() + static_cast<std::ptrdiff_t>(at + n),
+                     mesh.triangles.begin() + static_cast<std::ptrdiff_t>(first_index + at),
+                     [offset](uint32_t id) { return static_cast<uint32_t>(offset + id); });
+    });
     grew();
     return true;
   };
@@ -666,7 +682,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       Pending& done = pending[next_commit];
       if (!failed &&
           appendSlab(next_commit, done.mesh.positions, done.mesh.triangles, done.mesh.first_plane_vertices,
-                     done.mesh.last_plane_vertices)) {
+                     done.mesh.last_plane_vertices, 1)) {
         if (next_commit + 1 == pending.size()) out.seam = std::move(done.mesh.seam_positions);
         if (grid_file)
           if (Status s = grid_file->write(done.grid.data(), done.grid.size()); !s) fail(s.error());
@@ -713,7 +729,9 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       if (!view) fail(view.error());
       if (failed) break;
       appending = std::async(std::launch::async, [&, s, v = *view] {
-        if (!appendSlab(s, v.positions, v.triangles, v.first_plane_vertices, v.last_plane_vertices)) return;
+        // The host's cores are free while the device meshes: the copy runs on most of them.
+        if (!appendSlab(s, v.positions, v.triangles, v.first_plane_vertices, v.last_plane_vertices,
+                        std::max(1u, std::min(8u, threads)))) return;
         if (s + 1 == pending.size()) out.seam.assign(v.seam_positions.begin(), v.seam_positions.end());
         if (params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
       });

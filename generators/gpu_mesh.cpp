@@ -12,7 +12,9 @@
 namespace dpoint {
 namespace {
 
-constexpr uint32_t kGroupElements = 1024;  // 256 invocations of 4 elements (mesh_slab.comp's kGroupElements)
+// Elements a workgroup takes: 256 invocations of 16 (mesh_slab.comp's kGroupElements). Fewer,
+// larger groups keep the one-workgroup scan of their counts (pass 2) short.
+constexpr uint32_t kGroupElements = 4096;
 constexpr uint32_t kBindings = 12;
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };

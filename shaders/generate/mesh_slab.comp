@@ -25,7 +25,7 @@
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint kPass = 0;
-const uint kRun = 4u;                 // elements an invocation: kGroupElements in generators/gpu_mesh.cpp
+const uint kRun = 16u;                // elements an invocation: kGroupElements in generators/gpu_mesh.cpp
 const uint kGroupElements = 256u * kRun;
 
 layout(std430, set = 0, binding = 0) readonly buffer Counts { uint counts[]; };
