@@ -165,7 +165,7 @@ void writeInstancedGlb(const std::string& path) {
   test::writeFile(path, glb);
 }
 
-// The four commands, each started on work that lasts many seconds. `keep`: the inputs it was given.
+// The four commands (generate twice), each started on work that lasts many seconds. `keep`: the inputs it was given.
 struct LongRun {
   const char* name;
   std::function<std::vector<std::string>(const TempDir&)> start;  // makes the inputs, returns the args
@@ -177,6 +177,11 @@ std::vector<LongRun> longRuns() {
       {"generate", [](const TempDir& d) {
          return std::vector<std::string>{"generate", "mandelbulb", "--resolution", "1200", "--threads", "1", "-o",
                                          d.file("out.ply")};
+       }, {}},
+      // Marching cubes on the device (lavapipe here): stopped between slabs.
+      {"generate --mesh device", [](const TempDir& d) {
+         return std::vector<std::string>{"generate", "julia", "--resolution", "600", "--device", "cpu", "--mesh",
+                                         "device", "-o", d.file("out.ply")};
        }, {}},
       {"convert", [](const TempDir& d) {
          writeInstancedGlb(d.file("in.glb"));
