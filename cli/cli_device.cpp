@@ -40,6 +40,14 @@ bool fullCounts(const GenerateDeviceOptions& options, const GenerateDevice* devi
          meshOnDevice(options, device);
 }
 
+Status checkMeshDevice(const GenerateDeviceOptions& options, const GenerateDevice* device) {
+  if (options.mesh != "device" || device) return okStatus();
+  return Error{"--mesh device: no device makes the counts (--device " + options.device +
+                   (options.device == "auto" ? " found no GPU with shaderFloat64 and shaderInt64, or the kind runs on the CPU" : "") +
+                   "); --device cpu runs them on lavapipe",
+               ExitCode::kUsage};
+}
+
 bool meshOnDevice(const GenerateDeviceOptions& options, const GenerateDevice* device) {
   return device && (options.mesh == "device" || (options.mesh == "auto" && device->isGpu()));
 }

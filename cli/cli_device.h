@@ -33,6 +33,9 @@ class GenerateDevice;
 // Whether the classification runs every count to max_iter: `full`, or `auto` on a GPU (on the
 // H100 the GPU's extra iterations cost less than the CPU's finishing; on lavapipe, a CPU, more).
 bool fullCounts(const GenerateDeviceOptions& options, const GenerateDevice* device);
+// --mesh device without a device to run on (--device none, or auto on a machine without a GPU):
+// a usage error naming why.
+Status checkMeshDevice(const GenerateDeviceOptions& options, const GenerateDevice* device);
 // Whether marching cubes runs on the device: `device` (which implies full counts), or `auto` on a GPU.
 bool meshOnDevice(const GenerateDeviceOptions& options, const GenerateDevice* device);
 

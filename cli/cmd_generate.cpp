@@ -102,6 +102,7 @@ Result<MandelbulbParams> mandelbulbParams(const MandelbulbOptions& o, Progress* 
   Result<std::shared_ptr<GenerateDevice>> device =
       GenerateDevice::open(o.device, "mandelbulb", seed ? kSeedCpuOnly : "", o.out.common.quiet);
   if (!device) return device.error();
+  if (Status s = checkMeshDevice(o.device, device->get()); !s) return s.error();
   if (*device) {
     const EscapeKernelParams kernel{EscapeKernel::kMandelbulbFast, glm::dvec4(0.0), 0.0, kMandelbulbAxisRho2,
                                     kMandelbulbTrapC2};
@@ -131,6 +132,7 @@ Result<JuliaParams> juliaParams(const JuliaOptions& o, Progress* progress) {
   p.frame = o.frame == "seed" ? GridFrame::kSeed : GridFrame::kNative;
   Result<std::shared_ptr<GenerateDevice>> device = GenerateDevice::open(o.device, "julia", "", o.out.common.quiet);
   if (!device) return device.error();
+  if (Status s = checkMeshDevice(o.device, device->get()); !s) return s.error();
   if (*device) {
     const EscapeKernelParams kernel{EscapeKernel::kJulia, p.c, kJuliaEscapeSquare, 0.0};
     p.planes = (*device)->planes(kernel, GridAxis{p.resolution, p.lo, p.hi});

@@ -38,30 +38,6 @@ VkDescriptorSetLayoutBinding storage(uint32_t binding) {
   return {binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
 }
 
-// constants: the specialization constants 0, 1, … (uint32 each), or none.
-Result<VkPipeline> createPipeline(const VulkanContext& context, const uint32_t* code, size_t bytes,
-                                  VkPipelineLayout layout, const std::vector<uint32_t>& constants) {
-  Result<VkShaderModule> module = createShaderModule(context, code, bytes);
-  if (!module) return module.error();
-  std::vector<VkSpecializationMapEntry> entries;
-  for (uint32_t i = 0; i < constants.size(); ++i)
-    entries.push_back({i, i * static_cast<uint32_t>(sizeof(uint32_t)), sizeof(uint32_t)});
-  const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
-                                            constants.size() * sizeof(uint32_t), constants.data()};
-  VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  info.stage.module = *module;
-  info.stage.pName = "main";
-  info.stage.pSpecializationInfo = constants.empty() ? nullptr : &specialization;
-  info.layout = layout;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
-  vkDestroyShaderModule(context.device, *module, nullptr);
-  if (result != VK_SUCCESS) return vulkanError("creating a generation pipeline", result);
-  return pipeline;
-}
-
 // Copies `count` values of type From out of mapped memory as To (the same type, or lavapipe's
 // uint32 counts narrowed) on several threads: one thread copies at a fraction of the host's
 // bandwidth, and this copy is on the critical path of the thread that feeds the meshing workers.
@@ -138,12 +114,12 @@ Status GpuEscape::init() {
   if (!perturbation_layout) return perturbation_layout.error();
   perturbation_layout_ = *perturbation_layout;
   for (uint32_t kind = 0; kind < 2; ++kind) {
-    Result<VkPipeline> p = createPipeline(context_, kEscapeComp, sizeof(kEscapeComp), escape_layout_,
-                                          {kind, packed_counts_ ? 1u : 0u});
+    const uint32_t constants[2] = {kind, packed_counts_ ? 1u : 0u};
+    Result<VkPipeline> p = createComputePipeline(context_, kEscapeComp, sizeof(kEscapeComp), escape_layout_, constants);
     if (!p) return p.error();
     escape_[kind] = *p;
   }
-  Result<VkPipeline> p = createPipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_, {});
+  Result<VkPipeline> p = createComputePipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_);
   if (!p) return p.error();
   perturbation_ = *p;
 

@@ -57,26 +57,11 @@ Status GpuMesher::init() {
   Result<VkPipelineLayout> layout = pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!layout) return layout.error();
   layout_ = *layout;
-  Result<VkShaderModule> module = createShaderModule(context_, kMeshSlabComp, sizeof(kMeshSlabComp));
-  if (!module) return module.error();
-  for (uint32_t pass = 0; pass < 5; ++pass) {
-    const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-    const VkSpecializationInfo specialization{1, &entry, sizeof(uint32_t), &pass};
-    VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    info.stage.module = *module;
-    info.stage.pName = "main";
-    info.stage.pSpecializationInfo = &specialization;
-    info.layout = layout_;
-    const VkResult result =
-        vkCreateComputePipelines(context_.device, context_.pipeline_cache, 1, &info, nullptr, &passes_[pass]);
-    if (result != VK_SUCCESS) {
-      vkDestroyShaderModule(context_.device, *module, nullptr);
-      return vulkanError("creating a meshing pipeline", result);
-    }
+  for (uint32_t pass = 0; pass < 5; ++pass) {  // kPass, specialization constant 0
+    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, {&pass, 1});
+    if (!p) return p.error();
+    passes_[pass] = *p;
   }
-  vkDestroyShaderModule(context_.device, *module, nullptr);
 
   VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
   VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};

@@ -29,25 +29,7 @@ Spirv vertexShader(PrecisionMode mode, bool pull) {
 // 0 kWriteDepth, the shading passes' radii (fill.comp's 0, smooth.comp's 0, smooth_edl.comp's 0-2).
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout,
                                    std::span<const uint32_t> constants) {
-  Result<VkShaderModule> module = createShaderModule(context, code.code, code.bytes);
-  if (!module) return module.error();
-  std::vector<VkSpecializationMapEntry> entries;
-  for (uint32_t c = 0; c < constants.size(); ++c)
-    entries.push_back({c, static_cast<uint32_t>(c * sizeof(uint32_t)), sizeof(uint32_t)});
-  VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
-                                      constants.size_bytes(), constants.data()};
-  VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  info.stage.module = *module;
-  info.stage.pName = "main";
-  info.stage.pSpecializationInfo = &specialization;
-  info.layout = layout;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
-  vkDestroyShaderModule(context.device, *module, nullptr);
-  if (result != VK_SUCCESS) return vulkanError("creating a compute pipeline", result);
-  return pipeline;
+  return createComputePipeline(context, code.code, code.bytes, layout, constants);
 }
 
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,

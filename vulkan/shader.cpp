@@ -11,6 +11,29 @@ Result<VkShaderModule> createShaderModule(const VulkanContext& context, const ui
   return module;
 }
 
+Result<VkPipeline> createComputePipeline(const VulkanContext& context, const uint32_t* code, size_t bytes,
+                                         VkPipelineLayout layout, std::span<const uint32_t> constants) {
+  Result<VkShaderModule> module = createShaderModule(context, code, bytes);
+  if (!module) return module.error();
+  std::vector<VkSpecializationMapEntry> entries;
+  for (uint32_t c = 0; c < constants.size(); ++c)
+    entries.push_back({c, static_cast<uint32_t>(c * sizeof(uint32_t)), sizeof(uint32_t)});
+  const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(),
+                                            constants.size_bytes(), constants.data()};
+  VkComputePipelineCreateInfo info = {VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = *module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = constants.empty() ? nullptr : &specialization;
+  info.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  const VkResult result = vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(context.device, *module, nullptr);
+  if (result != VK_SUCCESS) return vulkanError("creating a compute pipeline", result);
+  return pipeline;
+}
+
 Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
                                                const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
   VkDescriptorSetLayoutCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};

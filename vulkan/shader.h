@@ -23,6 +23,11 @@ Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
 Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
                                         VkShaderStageFlags stages);
 
+// A compute pipeline of the SPIR-V `code` (entry point main) with `layout`, and the 32-bit
+// specialization constants 0, 1, … given (none: the shader's defaults).
+Result<VkPipeline> createComputePipeline(const VulkanContext& context, const uint32_t* code, size_t bytes,
+                                         VkPipelineLayout layout, std::span<const uint32_t> constants = {});
+
 // Points bindings 0, 1, … of `set` at whole buffers (`infos`, in binding order): storage buffers,
 // but binding 0 a uniform buffer when `first_is_uniform`.
 void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,

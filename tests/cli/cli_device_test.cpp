@@ -90,6 +90,16 @@ TEST(CliGenerateDevice, seedVariantAndMissingDevicesAreRefused) {
   EXPECT_NE(r.err.find("--device 7: only"), std::string::npos) << r.err;
   r = runDpoint({"generate", "julia", "--resolution", "9", "--device", "gpu", "-o", dir.file("j.ply")});
   EXPECT_EQ(r.exit_code, 1);
+  // Marching cubes on a device, with none to run on.
+  for (const char* device : {"none", "auto"}) {
+    r = runDpoint({"generate", "julia", "--resolution", "9", "--device", device, "--mesh", "device", "-o", dir.file("j.ply")});
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("--mesh device: no device makes the counts (--device " + std::string(device)), std::string::npos)
+        << r.err;
+  }
+  r = runDpoint({"generate", "julia", "--resolution", "9", "--mesh", "sideways", "-o", dir.file("j.ply")});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--mesh"), std::string::npos) << r.err;
   EXPECT_TRUE(dir.entries().empty());
   // auto: the seed variant takes the CPU; with no GPU here, so does everything else.
   r = runDpoint({"generate", "mandelbulb", "--resolution", "9", "-o", dir.file("m.ply")});
