@@ -128,19 +128,21 @@ TEST(CliGenerateDevice, vulkanFaultsEndWithOneLineAndNoOutput) {
       {"device-lost-wait", "VK_ERROR_DEVICE_LOST"},
   };
   for (const Case& c : cases) {
-    SCOPED_TRACE(c.fault);
-    TempDir dir;
-    test::CommandResult r = test::runCommand(
-        {"/usr/bin/env", std::string("DPOINT_TEST_VULKAN_FAULT=") + c.fault, DPOINT_EXE, "generate", "mandelbulb",
-         "--variant", "fast", "--resolution", "16", "--device", "cpu", "-q", "-o", dir.file("X.ply")},
-        std::chrono::seconds(60));
-    ASSERT_FALSE(r.timed_out);
-    EXPECT_EQ(r.exit_code, 3) << r.err;
-    EXPECT_TRUE(test::contains(r.err, c.message));
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_TRUE(dir.entries().empty());
-    // The run is already on the CPU: the hint does not send it there.
-    EXPECT_FALSE(test::contains(r.err, "or --device cpu")) << r.err;
+    for (const char* mesh : {"host", "device"}) {  // marching cubes on the device: its submissions too
+      SCOPED_TRACE(std::string(c.fault) + ", --mesh " + mesh);
+      TempDir dir;
+      test::CommandResult r = test::runCommand(
+          {"/usr/bin/env", std::string("DPOINT_TEST_VULKAN_FAULT=") + c.fault, DPOINT_EXE, "generate", "mandelbulb",
+           "--variant", "fast", "--resolution", "16", "--device", "cpu", "--mesh", mesh, "-q", "-o", dir.file("X.ply")},
+          std::chrono::seconds(60));
+      ASSERT_FALSE(r.timed_out);
+      EXPECT_EQ(r.exit_code, 3) << r.err;
+      EXPECT_TRUE(test::contains(r.err, c.message));
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_TRUE(dir.entries().empty());
+      // The run is already on the CPU: the hint does not send it there.
+      EXPECT_FALSE(test::contains(r.err, "or --device cpu")) << r.err;
+    }
   }
   // Generation on the device uses no 64-bit atomics: with them hidden it runs, to the same file.
   TempDir dir;
