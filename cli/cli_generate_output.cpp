@@ -48,14 +48,6 @@ bool plyWrittenHere(const OutputOptions& o) {
   return !capturingPoints() && format && *format == FileFormat::kPly && o.sample.count == 0;
 }
 
-// Whether the noise colours are made as the PLY writer formats the rows (PlyWriteOptions::colors_of)
-// rather than before: the same file, without the colours' own pass over the set or their 12 bytes
-// a point. They need a .ply written here (plyWrittenHere: no --sample interpolating them), noise
-// colours, and the positions as written being those coloured (no --offset after the colours). A
-// reorder is no obstacle: a colour is a function of its point's position.
-bool coloursAtWrite(const OutputOptions& o, bool auto_noise) {
-  return noiseColors(pointColorsOf(o), auto_noise) && plyWrittenHere(o) && o.offset.empty();
-}
 
 }  // namespace
 
@@ -89,12 +81,14 @@ double PhaseClock::lap() {
 // generator. Unless quiet, one line of where the time went (generation counted from `clock`'s start,
 // before the parameters).
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
-           PhaseClock& clock) {
+           PhaseClock& clock, bool noise_made) {
   if (!generated) return reportError(generated.error());
   const double generate_s = clock.lap();
   PointSet& points = *generated;
-  const bool colours_at_write = coloursAtWrite(o, auto_noise);
+  const bool colours_made = noise_made && points.hasColors() && coloursAtWrite(o, auto_noise);
+  const bool colours_at_write = coloursAtWrite(o, auto_noise) && !colours_made;
   if (colours_at_write) ColorArray().swap(points.colors);
+  else if (colours_made) {}  // the noise's already, and no --offset (coloursAtWrite)
   else if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
   if (o.sample.count != 0) {  // on the coloured, offset mesh: colours interpolate, positions are in their frame
     Result<uint64_t> limit = memoryLimit(o);
@@ -128,8 +122,19 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   if (!o.common.quiet)
     std::fprintf(stderr, "time (s): generate %.2f, colours and offset %.2f, order %.2f, write %.2f; %zu points, %zu triangles%s\n",
                  generate_s, colours_s, order_s, clock.lap(), points.size(), points.triangles.size() / 3,
-                 colours_at_write ? "; the colours made as the rows were written" : "");
+                 colours_at_write ? "; the colours made as the rows were written"
+                 : colours_made   ? "; the colours made with the mesh on the device"
+                                  : "");
   return 0;
+}
+
+// Whether the noise colours are made as the PLY writer formats the rows (PlyWriteOptions::colors_of)
+// rather than before: the same file, without the colours' own pass over the set or their 12 bytes
+// a point. They need a .ply written here (plyWrittenHere: no --sample interpolating them), noise
+// colours, and the positions as written being those coloured (no --offset after the colours). A
+// reorder is no obstacle: a colour is a function of its point's position.
+bool coloursAtWrite(const OutputOptions& o, bool auto_noise) {
+  return noiseColors(pointColorsOf(o), auto_noise) && plyWrittenHere(o) && o.offset.empty();
 }
 
 bool canFinishMade(const OutputOptions& o, bool auto_noise) {

@@ -55,7 +55,12 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
       if (!params) return reportError(params.error());
       if (tile) return finishTile(generate_tile(*params, *tile), o->out, auto_noise, signature, progress);
       if (made && canFinishMade(o->out, auto_noise)) return finishMade(made(*params), o->out, *order, auto_noise, progress, clock);
-      return finish(generate(*params), o->out, *order, auto_noise, progress, clock);
+      bool noise_made = false;
+      if constexpr (requires { params->noise_colors; }) {
+        // Marching cubes on the device makes the colours written too, where they are the noise's.
+        noise_made = params->noise_colors = params->mesher.mesh && coloursAtWrite(o->out, auto_noise);
+      }
+      return finish(generate(*params), o->out, *order, auto_noise, progress, clock, noise_made);
     };
   });
 }

@@ -631,6 +631,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     failed = true;
   };
 
+  size_t color_bytes = 0;  // a vertex's colour, where the mesher makes the colours too
   // Appends slab `index`'s mesh (marchingCubesSlab's McSlabMesh, or a view of one made elsewhere)
   // to the mesh, copying on `copiers` threads; false when it would pass a limit (then `fail` has
   // the error).
@@ -641,7 +642,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     previous_last_plane_vertices = last_plane_vertices;
     const uint64_t offset = mesh.positions.size();
     const uint64_t vertices = offset + positions.size() + last_plane_vertices;
-    const uint64_t bytes = vertices * sizeof(glm::dvec3) + (mesh.triangles.size() + triangles.size()) * sizeof(uint32_t);
+    const uint64_t bytes = vertices * (sizeof(glm::dvec3) + color_bytes) +
+                           (mesh.triangles.size() + triangles.size()) * sizeof(uint32_t);
     if (vertices > UINT32_MAX) {
       fail(Error{what + ": more than 2^32 vertices", ExitCode::kResourceLimit});
       return false;
@@ -699,6 +701,15 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   // plane function's blocks of counts feed the workers, or the workers count with the row function.
   const bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file &&
                          params.mesher.takes(res, plan.thickness + 1, cap);
+  // The mesher's noise covers the cells of |v| < 1024 (perlin.cpp's fast path): every coordinate,
+  // plus the colours' offsets of up to 200, well inside it.
+  const double reach = params.frame == GridFrame::kSeed ? params.axis.hi - params.axis.lo
+                                                        : std::max(std::fabs(params.axis.lo), std::fabs(params.axis.hi));
+  const bool noise_elsewhere = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
+  if (noise_elsewhere) {
+    color_bytes = sizeof(glm::vec3);
+    mesh.colors.reserve(mesh.positions.capacity());
+  }
   std::optional<PlaneBlocks> blocks;
   if (params.planes && !elsewhere) {
     std::vector<std::pair<int, int>> planes;  // first plane and plane count of each slab
@@ -724,6 +735,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       slab.frame = params.frame;
       slab.values = &values;
       slab.step = params.axis.step();
+      slab.noise_colors = noise_elsewhere;
       Result<McSlabView> view = params.mesher.mesh(slab);
       if (appending.valid()) appending.get();
       if (!view) fail(view.error());
@@ -732,6 +744,10 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
         // The host's cores are free while the device meshes: the copy runs on most of them.
         if (!appendSlab(s, v.positions, v.triangles, v.first_plane_vertices, v.last_plane_vertices,
                         std::max(1u, std::min(8u, threads)))) return;
+        if (noise_elsewhere) {
+          assert(v.colors.size() >= v.positions.size());
+          mesh.colors.insert(mesh.colors.end(), v.colors.begin(), v.colors.begin() + static_cast<std::ptrdiff_t>(v.positions.size()));
+        }
         if (s + 1 == pending.size()) out.seam.assign(v.seam_positions.begin(), v.seam_positions.end());
         if (params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
       });
@@ -806,7 +822,9 @@ Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, c
     }
     return out;
   }
-  Result<LayerMesh> part = meshLayers(params, row, static_cast<int>(range.begin), static_cast<int>(range.end));
+  EscapeSurfaceParams own = params;
+  own.noise_colors = false;  // a tile's seam copies would have none: its colours are made as written
+  Result<LayerMesh> part = meshLayers(own, row, static_cast<int>(range.begin), static_cast<int>(range.end));
   if (!part) return part.error();
   out.points = std::move(part->mesh);
   out.owned = static_cast<uint32_t>(out.points.size());

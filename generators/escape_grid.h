@@ -89,6 +89,7 @@ struct EscapeSlab {
   GridFrame frame = GridFrame::kNative;
   const std::vector<double>* values = nullptr;  // the axis: GridAxis::value(i), i < res
   double step = 0.0;                            // GridAxis::step()
+  bool noise_colors = false;                    // the vertices' seedColor too (generators/perlin.h)
 };
 
 // Marching cubes elsewhere (a GPU, generators/gpu_mesh.h): the counts and the mesh of a slab
@@ -116,6 +117,10 @@ struct EscapeSurfaceParams {
   EscapeArena arena;             // where the plane function's blocks go; empty: the heap
   // With the plane function, final counts (not lazy) and no grid_out: counts and meshes the slabs.
   EscapeSlabMesher mesher;
+  // Where the mesher meshes and every coordinate lies in the noise's fast range: it makes the
+  // vertices' seed noise colours too (generators/perlin.h seedColor, bit for bit), and the mesh has
+  // them; otherwise the mesh has no colours, as without it.
+  bool noise_colors = false;
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
@@ -144,6 +149,7 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.planes = params.planes;
   surface.arena = params.arena;
   surface.mesher = params.mesher;
+  surface.noise_colors = params.noise_colors;
   return surface;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "generators/perlin.h"
 #include "vulkan/shader.h"
 
 #include "shaders/mesh_slab.comp.h"
@@ -15,7 +16,7 @@ namespace {
 // Elements a workgroup takes: 256 invocations of 16 (mesh_slab.comp's kGroupElements). Fewer,
 // larger groups keep the one-workgroup scan of their counts (pass 2) short.
 constexpr uint32_t kGroupElements = 4096;
-constexpr uint32_t kBindings = 12;
+constexpr uint32_t kBindings = 13;
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
 
@@ -57,8 +58,11 @@ Status GpuMesher::init() {
   Result<VkPipelineLayout> layout = pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!layout) return layout.error();
   layout_ = *layout;
-  for (uint32_t pass = 0; pass < 5; ++pass) {  // kPass, specialization constant 0
-    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, {&pass, 1});
+  // kPass and kNoise, specialization constants 0 and 1: passes 0–4 (pass 3 with the colours is
+  // made at the first slab that wants them: on lavapipe it takes a while to compile).
+  for (uint32_t pass = 0; pass < 5; ++pass) {
+    const uint32_t constants[2] = {pass, 0u};
+    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, constants);
     if (!p) return p.error();
     passes_[pass] = *p;
   }
@@ -80,13 +84,19 @@ Status GpuMesher::init() {
   VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &fence_));
 
-  // The case table: for mask m, 16 bytes: the triangle count, then its 3·count cube edges.
-  std::vector<uint8_t> cases(256 * 16, 0);
+  // The case table: for mask m, 16 bytes: the triangle count, then its 3·count cube edges; then
+  // the noise's permutation (a word each) and gradients (a float each).
+  std::vector<uint8_t> cases(256 * 16 + 256 * 4 + 48 * 4, 0);
   for (unsigned m = 0; m < 256; ++m) {
     const McCase& c = marchingCubesCase(m);
     cases[16 * m] = c.triangle_count;
     std::copy(c.edges.begin(), c.edges.end(), cases.begin() + 16 * m + 1);
   }
+  for (unsigned i = 0; i < 256; ++i) {
+    const uint32_t word = perlinPermutation()[i];
+    std::memcpy(&cases[256 * 16 + 4 * i], &word, 4);
+  }
+  std::memcpy(&cases[256 * 16 + 256 * 4], perlinGradients(), 48 * sizeof(float));
   if (Status s = upload(cases_, cases.data(), cases.size(), "marching cubes cases"); !s) return s;
   if (Status s = ensure(totals_, 4 * sizeof(uint32_t), true, "meshing totals"); !s) return s;
   return okStatus();
@@ -97,7 +107,7 @@ GpuMesher::~GpuMesher() {
   if (fence_) vkDestroyFence(device, fence_, nullptr);
   if (commands_) vkFreeCommandBuffers(device, context_.command_pool, 1, &commands_);
   for (Buffer* b : {&counts_, &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
-                    &ids_z_, &ids_x_, &positions_, &triangles_, &readback_[0], &readback_[1]})
+                    &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &readback_[0], &readback_[1]})
     destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
   if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
@@ -208,6 +218,12 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   push.above_at = slab.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(slab.level));
   push.stride = stride;
   push.seed_frame = slab.frame == GridFrame::kSeed ? 1u : 0u;
+  if (slab.noise_colors && !passes_[5]) {
+    const uint32_t constants[2] = {3u, 1u};
+    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, constants);
+    if (!p) return p.error();
+    passes_[5] = *p;
+  }
   const uint64_t vertex_elements = (2 * static_cast<uint64_t>(planes) - 1) * plane;
   const uint64_t triangle_elements = static_cast<uint64_t>(planes - 1) * plane;
   push.vertex_elements = static_cast<uint32_t>(vertex_elements);
@@ -225,6 +241,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   if (Status s = ensure(ids_x_, (planes - 1) * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
   if (Status s = ensure(positions_, 3 * sizeof(double), false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s.error();
+  if (Status s = ensure(colors_, 3 * sizeof(float), false, "slab colours"); !s) return s.error();
   auto bind = [&] {
     const VkDescriptorBufferInfo infos[kBindings] = {
         {counts_.buffer, 0, VK_WHOLE_SIZE},    {axis_.buffer, 0, VK_WHOLE_SIZE},
@@ -232,7 +249,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
         {vertex_groups_.buffer, 0, VK_WHOLE_SIZE}, {triangle_groups_.buffer, 0, VK_WHOLE_SIZE},
         {totals_.buffer, 0, VK_WHOLE_SIZE},    {ids_y_.buffer, 0, VK_WHOLE_SIZE},
         {ids_z_.buffer, 0, VK_WHOLE_SIZE},     {ids_x_.buffer, 0, VK_WHOLE_SIZE},
-        {positions_.buffer, 0, VK_WHOLE_SIZE}, {triangles_.buffer, 0, VK_WHOLE_SIZE}};
+        {positions_.buffer, 0, VK_WHOLE_SIZE}, {triangles_.buffer, 0, VK_WHOLE_SIZE},
+        {colors_.buffer, 0, VK_WHOLE_SIZE}};
     writeBufferDescriptors(context_, set_, infos);
   };
   bind();
@@ -275,18 +293,21 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
 
   // The vertices and triangles into device memory, then copied across to host-visible memory by
   // the transfer engine (a shader's scattered writes across the bus were several times slower).
+  // Read back as the positions, the colours (with slab.noise_colors) and the triangles.
   const uint64_t position_bytes = vertices * 3 * sizeof(double), triangle_bytes = triangles * 3 * sizeof(uint32_t);
-  const uint64_t old_positions = positions_.size, old_triangles = triangles_.size;
+  const uint64_t color_bytes = slab.noise_colors ? vertices * 3 * sizeof(float) : 0;
+  const uint64_t old_positions = positions_.size, old_triangles = triangles_.size, old_colors = colors_.size;
   if (Status s = ensure(positions_, position_bytes, false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, triangle_bytes, false, "slab triangles"); !s) return s.error();
+  if (Status s = ensure(colors_, color_bytes, false, "slab colours"); !s) return s.error();
   Buffer& readback = readback_[next_readback_];
   next_readback_ ^= 1;
-  if (Status s = ensure(readback, position_bytes + triangle_bytes, true, "slab mesh for the host"); !s)
+  if (Status s = ensure(readback, position_bytes + color_bytes + triangle_bytes, true, "slab mesh for the host"); !s)
     return s.error();
-  if (positions_.size != old_positions || triangles_.size != old_triangles) bind();
+  if (positions_.size != old_positions || triangles_.size != old_triangles || colors_.size != old_colors) bind();
   status = submit([&](VkCommandBuffer commands) {
     stamp(commands, kStart2);
-    dispatch(commands, 3, push.vertex_group_count);
+    dispatch(commands, slab.noise_colors ? 5 : 3, push.vertex_group_count);
     stamp(commands, kVertices);
     barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
     dispatch(commands, 4, push.triangle_group_count);
@@ -296,8 +317,12 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
       const VkBufferCopy copy{0, 0, position_bytes};
       vkCmdCopyBuffer(commands, positions_.buffer, readback.buffer, 1, &copy);
     }
+    if (color_bytes) {
+      const VkBufferCopy copy{0, position_bytes, color_bytes};
+      vkCmdCopyBuffer(commands, colors_.buffer, readback.buffer, 1, &copy);
+    }
     if (triangle_bytes) {
-      const VkBufferCopy copy{0, position_bytes, triangle_bytes};
+      const VkBufferCopy copy{0, position_bytes + color_bytes, triangle_bytes};
       vkCmdCopyBuffer(commands, triangles_.buffer, readback.buffer, 1, &copy);
     }
     stamp(commands, kCopied);
@@ -316,8 +341,9 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   const auto* positions = static_cast<const glm::dvec3*>(readback.mapped);
   out.positions = {positions, slab.owns_last_plane ? vertices : last_first};
   if (!slab.owns_last_plane && slab.seam_positions) out.seam_positions = {positions + last_first, vertices - last_first};
-  out.triangles = {reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(readback.mapped) + position_bytes),
-                   3 * triangles};
+  const auto* bytes = static_cast<const uint8_t*>(readback.mapped);
+  if (color_bytes) out.colors = {reinterpret_cast<const glm::vec3*>(bytes + position_bytes), vertices};
+  out.triangles = {reinterpret_cast<const uint32_t*>(bytes + position_bytes + color_bytes), 3 * triangles};
   return out;
 }
 

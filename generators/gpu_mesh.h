@@ -64,15 +64,15 @@ class GpuMesher {
   const VulkanContext& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline passes_[5] = {};
+  VkPipeline passes_[6] = {};  // mesh_slab.comp's passes 0–4, and 3 with the noise colours
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   Buffer counts_, axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
-  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_;
-  Buffer readback_[2];  // host-visible, used in turn: a slab's positions, then its triangles
+  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_;
+  Buffer readback_[2];  // host-visible, used in turn: a slab's positions, colours and triangles
   unsigned next_readback_ = 0;
   std::vector<double> axis_values_;       // what axis_ holds
   double fractions_level_ = 0.0;           // the level and stride fractions_ was made for

@@ -90,6 +90,7 @@ struct McSlabView {
   uint32_t first_plane_vertices = 0;
   uint32_t last_plane_vertices = 0;
   std::span<const glm::dvec3> seam_positions;
+  std::span<const glm::vec3> colors;  // empty, or one a position (the mesher's noise colours)
 };
 
 McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last_plane,

@@ -114,6 +114,9 @@ void seedColors(const glm::dvec3* positions, size_t n, glm::vec3* colors) {
   for (size_t i = 0; i < n; ++i) colors[i] = seedColor(positions[i]);
 }
 
+const uint8_t* perlinPermutation() { return kPermutation; }
+const float* perlinGradients() { return &kGradients[0][0]; }
+
 void colorByNoise(PointSet& points, unsigned threads) {
   constexpr size_t kPointsPerChunk = size_t{1} << 14;
   resizePrefaulted(points.colors, points.positions.size(), threads);

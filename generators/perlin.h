@@ -35,4 +35,9 @@ void seedColors(const glm::dvec3* positions, size_t n, glm::vec3* colors);
 // `threads` (0: all cores); the result does not depend on the thread count.
 void colorByNoise(PointSet& points, unsigned threads);
 
+// The noise's tables, for a device that makes seedColor too (shaders/generate/mesh_slab.comp): the
+// permutation of 0..255, and the 16 gradients, x, y, z each.
+const uint8_t* perlinPermutation();
+const float* perlinGradients();
+
 }  // namespace dpoint

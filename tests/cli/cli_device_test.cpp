@@ -62,6 +62,38 @@ TEST(CliGenerateDevice, gridAndOutputOnTheDeviceEqualTheCpuPathsForEachKind) {
   }
 }
 
+// Marching cubes on the device makes the seed noise colours with the mesh where every coordinate
+// is in the noise's fast range (not for --bounds ±800 then): the CPU path's file either way, with
+// colours or none, native or seed frame, PLY or CSV.
+TEST(CliGenerateDevice, noiseColoursMadeWithTheMeshOnTheDeviceAreTheCpus) {
+  TempDir dir;
+  struct Case {
+    std::vector<std::string> args;
+    const char* note;  // in the time line
+  };
+  const std::vector<Case> cases = {
+      {{"julia", "--resolution", "40", "-o", "X.ply"}, "; the colours made with the mesh on the device"},
+      {{"mandelbulb", "--variant", "fast", "--resolution", "41", "--frame", "seed", "-o", "X.ply"},
+       "; the colours made with the mesh on the device"},
+      {{"julia", "--resolution", "40", "--bounds", "-800,800", "-o", "X.ply"}, "; the colours made as the rows were written"},
+      {{"julia", "--resolution", "40", "--colors", "none", "-o", "X.ply"}, "triangles\n"},
+      {{"julia", "--resolution", "30", "-o", "X.csv"}, "triangles\n"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = concat({"generate"}, c.args);
+    const std::string name = args.back();
+    SCOPED_TRACE(args[1] + " " + name);
+    args.back() = dir.file("cpu-" + name);
+    test::CommandResult cpu = runDpoint(concat(args, {"--device", "none", "-q"}));
+    ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
+    args.back() = dir.file("gpu-" + name);
+    test::CommandResult gpu = runDpoint(concat(args, {"--device", "cpu", "--mesh", "device", "--validate"}));
+    ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
+    EXPECT_NE(gpu.err.find(c.note), std::string::npos) << gpu.err;
+    EXPECT_TRUE(readFile(dir.file("cpu-" + name)) == readFile(dir.file("gpu-" + name)));
+  }
+}
+
 TEST(CliGenerateDevice, tilesOnTheDeviceMergeToTheCpuFile) {
   TempDir dir;
   const std::vector<std::string> kind = {"generate", "julia", "--resolution", "27", "-q"};

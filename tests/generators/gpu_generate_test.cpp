@@ -13,6 +13,7 @@
 #include "generators/julia.h"
 #include "generators/mandelbrot2d.h"
 #include "generators/mandelbulb.h"
+#include "generators/perlin.h"
 #include "vulkan/buffers.h"
 #include "generators/gpu_generate.h"
 #include "vulkan/shader.h"
@@ -357,6 +358,16 @@ TEST_F(GpuGenerate, marchingCubesOnTheDeviceEqualsTheHosts) {
         ASSERT_TRUE(expected.ok() && got.ok()) << (got.ok() ? "" : got.error().message);
         EXPECT_GT(meshed, 1);
         EXPECT_TRUE(sameMesh(*expected, *got));
+        EXPECT_TRUE(got->colors.empty());
+        // The seed noise colours made on the device: the host's seedColor, bit for bit.
+        bulb.noise_colors = true;
+        Result<PointSet> colored = generateMandelbulb(bulb);
+        ASSERT_TRUE(colored.ok()) << colored.error().message;
+        EXPECT_TRUE(sameMesh(*expected, *colored));
+        PointSet host_colored = *expected;
+        colorByNoise(host_colored, 0);
+        ASSERT_EQ(colored->colors.size(), host_colored.colors.size());
+        EXPECT_EQ(std::memcmp(colored->colors.data(), host_colored.colors.data(), host_colored.colors.size() * sizeof(glm::vec3)), 0);
 
         JuliaParams julia_params;
         julia_params.resolution = res;
@@ -379,6 +390,19 @@ TEST_F(GpuGenerate, marchingCubesOnTheDeviceEqualsTheHosts) {
       }
     }
   }
+  // Coordinates past the noise's fast range (|v| + 200 from 1000 on): no colours from the mesher.
+  MandelbulbParams wide;
+  wide.resolution = 24;
+  wide.variant = MandelbulbVariant::kFast;
+  wide.lo = -900.0;
+  wide.hi = 900.0;
+  wide.planes = planes(mandelbulb(), GridAxis{24, -900.0, 900.0});
+  wide.full_counts = true;
+  wide.mesher = on_device(packed_.get(), mandelbulb());
+  wide.noise_colors = true;
+  Result<PointSet> wide_mesh = generateMandelbulb(wide);
+  ASSERT_TRUE(wide_mesh.ok());
+  EXPECT_TRUE(wide_mesh->colors.empty());
   // Two-byte counts (--max-iter 300): the mesher does not take them and the host meshes the slabs.
   MandelbulbParams deep;
   deep.resolution = 33;
