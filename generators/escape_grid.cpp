@@ -7,9 +7,9 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <memory>
-#include <future>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -649,8 +649,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       return false;
     }
     if (bytes > limit) {
-      fail(Error{what + ": the mesh grew past " + formatBytes(bytes) + ", more than the limit of " + formatBytes(limit) +
-                     " (--max-memory)",
+      fail(Error{what + ": the mesh grew past " + formatBytes(bytes) + ", more than the limit of " +
+                     formatBytes(limit) + " (--max-memory)",
                  ExitCode::kResourceLimit});
       return false;
     }
@@ -703,8 +703,9 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                          params.mesher.takes(res, plan.thickness + 1, cap);
   // The mesher's noise covers the cells of |v| < 1024 (perlin.cpp's fast path): every coordinate,
   // plus the colours' offsets of up to 200, well inside it.
-  const double reach = params.frame == GridFrame::kSeed ? params.axis.hi - params.axis.lo
-                                                        : std::max(std::fabs(params.axis.lo), std::fabs(params.axis.hi));
+  const double reach = params.frame == GridFrame::kSeed
+                           ? params.axis.hi - params.axis.lo
+                           : std::max(std::fabs(params.axis.lo), std::fabs(params.axis.hi));
   const bool noise_elsewhere = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
   if (noise_elsewhere) {
     color_bytes = sizeof(glm::vec3);
@@ -746,7 +747,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                         std::max(1u, std::min(8u, threads)))) return;
         if (noise_elsewhere) {
           assert(v.colors.size() >= v.positions.size());
-          mesh.colors.insert(mesh.colors.end(), v.colors.begin(), v.colors.begin() + static_cast<std::ptrdiff_t>(v.positions.size()));
+          mesh.colors.insert(mesh.colors.end(), v.colors.begin(),
+                             v.colors.begin() + static_cast<std::ptrdiff_t>(v.positions.size()));
         }
         if (s + 1 == pending.size()) out.seam.assign(v.seam_positions.begin(), v.seam_positions.end());
         if (params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
@@ -754,38 +756,38 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     }
     if (appending.valid()) appending.get();
   } else {
-  parallelFor(static_cast<size_t>(plan.count), threads, [&](size_t s, unsigned) {
-    const int first = slabFirst(s);
-    const int last = slabLast(s);
-    const bool owns_last = last == res - 1;
-    const bool seam = last == last_layer && !owns_last;
-    Pending result;
-    const uint8_t* block = nullptr;
-    if (!failed && blocks) {
-      block = blocks->wait(s);
-      if (!block) failed = true;  // the plane function failed; blocks holds the error
-    }
-    if (!failed) {
-      const int grid_planes = grid_file ? last - first + (owns_last ? 1 : 0) : 0;
-      SlabField field(params, values, row, first, last, owns_last || seam, grid_planes, grid_bytes, cap, block);
-      McSlabCallbacks callbacks;
-      callbacks.load_plane = [&](int p, uint8_t* above) { field.load(p, above); };
-      callbacks.edge_vertex = [&](int p, int j, int k, int axis) { return field.vertex(p, j, k, axis); };
-      callbacks.plane_done = [&](int p) {
-        if (p > first && params.progress) params.progress->advance(1);
-        // An interrupt stops every slab at its next plane; nothing more is committed.
-        if (interrupted()) failed = true;
-        return !failed.load(std::memory_order_relaxed);
-      };
-      result.mesh = marchingCubesSlab(res, res, first, last, owns_last, callbacks, seam);
-      result.grid = field.takeGrid();
-    }
-    if (block) blocks->release(s);
-    std::lock_guard<std::mutex> lock(mutex);
-    result.ready = true;
-    pending[s] = std::move(result);
-    commitReady();
-  });
+    parallelFor(static_cast<size_t>(plan.count), threads, [&](size_t s, unsigned) {
+      const int first = slabFirst(s);
+      const int last = slabLast(s);
+      const bool owns_last = last == res - 1;
+      const bool seam = last == last_layer && !owns_last;
+      Pending result;
+      const uint8_t* block = nullptr;
+      if (!failed && blocks) {
+        block = blocks->wait(s);
+        if (!block) failed = true;  // the plane function failed; blocks holds the error
+      }
+      if (!failed) {
+        const int grid_planes = grid_file ? last - first + (owns_last ? 1 : 0) : 0;
+        SlabField field(params, values, row, first, last, owns_last || seam, grid_planes, grid_bytes, cap, block);
+        McSlabCallbacks callbacks;
+        callbacks.load_plane = [&](int p, uint8_t* above) { field.load(p, above); };
+        callbacks.edge_vertex = [&](int p, int j, int k, int axis) { return field.vertex(p, j, k, axis); };
+        callbacks.plane_done = [&](int p) {
+          if (p > first && params.progress) params.progress->advance(1);
+          // An interrupt stops every slab at its next plane; nothing more is committed.
+          if (interrupted()) failed = true;
+          return !failed.load(std::memory_order_relaxed);
+        };
+        result.mesh = marchingCubesSlab(res, res, first, last, owns_last, callbacks, seam);
+        result.grid = field.takeGrid();
+      }
+      if (block) blocks->release(s);
+      std::lock_guard<std::mutex> lock(mutex);
+      result.ready = true;
+      pending[s] = std::move(result);
+      commitReady();
+    });
   }
   if (blocks) {
     blocks->stop();

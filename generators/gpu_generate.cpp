@@ -119,7 +119,8 @@ Status GpuEscape::init() {
     if (!p) return p.error();
     escape_[kind] = *p;
   }
-  Result<VkPipeline> p = createComputePipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_);
+  Result<VkPipeline> p =
+      createComputePipeline(context_, kPerturbationComp, sizeof(kPerturbationComp), perturbation_layout_);
   if (!p) return p.error();
   perturbation_ = *p;
 

@@ -55,7 +55,8 @@ Status GpuMesher::init() {
   Result<VkDescriptorSetLayout> set_layout = storageSetLayout(context_, bindings);
   if (!set_layout) return set_layout.error();
   set_layout_ = *set_layout;
-  Result<VkPipelineLayout> layout = pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
+  Result<VkPipelineLayout> layout =
+      pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!layout) return layout.error();
   layout_ = *layout;
   // kPass and kNoise, specialization constants 0 and 1: passes 0–4 (pass 3 with the colours is
@@ -135,8 +136,9 @@ Status GpuMesher::ensure(Buffer& buffer, uint64_t bytes, bool host_visible, cons
 Status GpuMesher::upload(Buffer& target, const void* data, size_t bytes, const char* what) {
   if (target.size < bytes) {
     destroyBuffer(context_, target);
-    Result<Buffer> created = createUploadTarget(
-        context_, std::max<size_t>(bytes, 16), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
+    Result<Buffer> created =
+        createUploadTarget(context_, std::max<size_t>(bytes, 16),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
     if (!created) return created.error();
     target = *created;
   }
@@ -192,7 +194,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   // The inputs beside the counts: the axis, and the fractions t of every pair of counts (the CPU's
   // division).
   if (*slab.values != axis_values_) {
-    if (Status s = upload(axis_, slab.values->data(), slab.values->size() * sizeof(double), "grid axis"); !s) return s.error();
+    if (Status s = upload(axis_, slab.values->data(), slab.values->size() * sizeof(double), "grid axis"); !s)
+      return s.error();
     axis_values_ = *slab.values;
   }
   const uint32_t stride = static_cast<uint32_t>(slab.limit) + 1;
@@ -340,7 +343,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   out.last_plane_vertices = static_cast<uint32_t>(vertices - last_first);
   const auto* positions = static_cast<const glm::dvec3*>(readback.mapped);
   out.positions = {positions, slab.owns_last_plane ? vertices : last_first};
-  if (!slab.owns_last_plane && slab.seam_positions) out.seam_positions = {positions + last_first, vertices - last_first};
+  if (!slab.owns_last_plane && slab.seam_positions)
+    out.seam_positions = {positions + last_first, vertices - last_first};
   const auto* bytes = static_cast<const uint8_t*>(readback.mapped);
   if (color_bytes) out.colors = {reinterpret_cast<const glm::vec3*>(bytes + position_bytes), vertices};
   out.triangles = {reinterpret_cast<const uint32_t*>(bytes + position_bytes + color_bytes), 3 * triangles};
