@@ -176,19 +176,6 @@ GpuEscape::~GpuEscape() {
     if (l) vkDestroyDescriptorSetLayout(device, l, nullptr);
 }
 
-Status GpuEscape::upload(Buffer& target, const void* data, size_t bytes, const std::string& what) {
-  if (target.size < bytes) {
-    destroyBuffer(context_, target);
-    Result<Buffer> created = createUploadTarget(context_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                                     VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
-    if (!created) return created.error();
-    target = *created;
-  }
-  return uploadBuffer(context_, target, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize size) {
-    std::memcpy(dst, static_cast<const uint8_t*>(data) + offset, size);
-  });
-}
-
 Status GpuEscape::finish(Slot& slot) {
   if (!slot.points) return okStatus();
   const auto start = std::chrono::steady_clock::now();
@@ -275,7 +262,7 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
 
 Status GpuEscape::useAxis(const std::vector<double>& axis) {
   if (axis == axis_values_) return okStatus();
-  if (Status s = upload(axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
+  if (Status s = uploadStorage(context_, axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
   axis_values_ = axis;
   for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
   arena_sets_stale_ = true;
@@ -402,9 +389,9 @@ Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::
     if (!created) return created.error();
     slot.tails = *created;
   }
-  if (Status s = upload(orbit_, orbit.data(), orbit.size() * sizeof(glm::dvec2), "reference orbit"); !s) return s;
-  if (Status s = upload(dcx_, dcx.data(), dcx.size() * sizeof(double), "pixel offsets"); !s) return s;
-  if (Status s = upload(dcy_, dcy.data(), dcy.size() * sizeof(double), "row offsets"); !s) return s;
+  if (Status s = uploadStorage(context_, orbit_, orbit.data(), orbit.size() * sizeof(glm::dvec2), "reference orbit"); !s) return s;
+  if (Status s = uploadStorage(context_, dcx_, dcx.data(), dcx.size() * sizeof(double), "pixel offsets"); !s) return s;
+  if (Status s = uploadStorage(context_, dcy_, dcy.data(), dcy.size() * sizeof(double), "row offsets"); !s) return s;
   for (Slot& slot : slots_)
     writeSet(context_, slot.perturbation_set, {&orbit_, &dcx_, &dcy_, &slot.counts, &slot.tails});
   const uint64_t cols = dcx.size();

@@ -113,7 +113,6 @@ class GpuEscape {
 
   GpuEscape(const VulkanContext& context, bool pack_counts) : context_(context), packed_counts_(pack_counts) {}
   Status init();
-  Status upload(Buffer& target, const void* data, size_t bytes, const std::string& what);
   Status useAxis(const std::vector<double>& axis);  // uploads it where axis_ holds another
   enum class Target { kHost, kArena, kDevice };      // where a dispatch's counts go
   // Dispatches the rows of planes first..first + planes − 1 in chunks: copied out to `counts`

@@ -79,11 +79,6 @@ Status GpuMesher::init() {
   allocate.descriptorSetCount = 1;
   allocate.pSetLayouts = &set_layout_;
   VK_TRY(vkAllocateDescriptorSets(context_.device, &allocate, &set_));
-  Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
-  if (!commands) return commands.error();
-  commands_ = *commands;
-  VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &fence_));
 
   // The case table: for mask m, 16 bytes: the triangle count, then its 3·count cube edges; then
   // the noise's permutation (a word each) and gradients (a float each).
@@ -98,15 +93,13 @@ Status GpuMesher::init() {
     std::memcpy(&cases[256 * 16 + 4 * i], &word, 4);
   }
   std::memcpy(&cases[256 * 16 + 256 * 4], perlinGradients(), 48 * sizeof(float));
-  if (Status s = upload(cases_, cases.data(), cases.size(), "marching cubes cases"); !s) return s;
+  if (Status s = uploadStorage(context_, cases_, cases.data(), cases.size(), "marching cubes cases"); !s) return s;
   if (Status s = ensure(totals_, 4 * sizeof(uint32_t), true, "meshing totals"); !s) return s;
   return okStatus();
 }
 
 GpuMesher::~GpuMesher() {
   const VkDevice device = context_.device;
-  if (fence_) vkDestroyFence(device, fence_, nullptr);
-  if (commands_) vkFreeCommandBuffers(device, context_.command_pool, 1, &commands_);
   for (Buffer* b : {&counts_, &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
                     &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &readback_[0], &readback_[1]})
     destroyBuffer(context_, *b);
@@ -130,35 +123,6 @@ Status GpuMesher::ensure(Buffer& buffer, uint64_t bytes, bool host_visible, cons
   Result<Buffer> created = createBuffer(context_, grown, usage, host_visible, what);
   if (!created) return created.error();
   buffer = *created;
-  return okStatus();
-}
-
-Status GpuMesher::upload(Buffer& target, const void* data, size_t bytes, const char* what) {
-  if (target.size < bytes) {
-    destroyBuffer(context_, target);
-    Result<Buffer> created =
-        createUploadTarget(context_, std::max<size_t>(bytes, 16),
-                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
-    if (!created) return created.error();
-    target = *created;
-  }
-  return uploadBuffer(context_, target, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize size) {
-    std::memcpy(dst, static_cast<const uint8_t*>(data) + offset, size);
-  });
-}
-
-Status GpuMesher::submit(const std::function<void(VkCommandBuffer)>& record) {
-  VK_TRY(vkResetFences(context_.device, 1, &fence_));
-  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VK_TRY(vkBeginCommandBuffer(commands_, &begin));
-  record(commands_);
-  VK_TRY(vkEndCommandBuffer(commands_));
-  VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  info.commandBufferCount = 1;
-  info.pCommandBuffers = &commands_;
-  VK_TRY(queueSubmit(context_, info, fence_));
-  VK_TRY(waitForFence(context_, fence_));
   return okStatus();
 }
 
@@ -194,7 +158,9 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   // The inputs beside the counts: the axis, and the fractions t of every pair of counts (the CPU's
   // division).
   if (*slab.values != axis_values_) {
-    if (Status s = upload(axis_, slab.values->data(), slab.values->size() * sizeof(double), "grid axis"); !s)
+    if (Status s =
+            uploadStorage(context_, axis_, slab.values->data(), slab.values->size() * sizeof(double), "grid axis");
+        !s)
       return s.error();
     axis_values_ = *slab.values;
   }
@@ -204,7 +170,9 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
     for (uint32_t v1 = 0; v1 < stride; ++v1)
       for (uint32_t v2 = 0; v2 < stride; ++v2)
         if (v1 != v2) fractions[v1 * stride + v2] = (slab.level - v1) / (static_cast<double>(v2) - v1);
-    if (Status s = upload(fractions_, fractions.data(), fractions.size() * sizeof(double), "edge fractions"); !s)
+    if (Status s =
+            uploadStorage(context_, fractions_, fractions.data(), fractions.size() * sizeof(double), "edge fractions");
+        !s)
       return s.error();
     fractions_level_ = slab.level;
     fractions_stride_ = stride;
@@ -277,7 +245,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   const VkAccessFlags shader_rw = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
 
   // The counts (written by GpuEscape's dispatches, submitted before) and the scans.
-  Status status = submit([&](VkCommandBuffer commands) {
+  Status status = submitOnce(context_, [&](VkCommandBuffer commands) {
     if (queries_) vkCmdResetQueryPool(commands, queries_, 0, kStamps);
     barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
     stamp(commands, kStart);
@@ -308,7 +276,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   if (Status s = ensure(readback, position_bytes + color_bytes + triangle_bytes, true, "slab mesh for the host"); !s)
     return s.error();
   if (positions_.size != old_positions || triangles_.size != old_triangles || colors_.size != old_colors) bind();
-  status = submit([&](VkCommandBuffer commands) {
+  status = submitOnce(context_, [&](VkCommandBuffer commands) {
     stamp(commands, kStart2);
     dispatch(commands, slab.noise_colors ? 5 : 3, push.vertex_group_count);
     stamp(commands, kVertices);

@@ -56,8 +56,6 @@ class GpuMesher {
   explicit GpuMesher(const VulkanContext& context) : context_(context) {}
   Status init();
   Status ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what);
-  Status upload(Buffer& target, const void* data, size_t bytes, const char* what);
-  Status submit(const std::function<void(VkCommandBuffer)>& record);  // and waits
   void stamp(VkCommandBuffer commands, uint32_t query) const;
   Status readStamps();
 
@@ -67,8 +65,6 @@ class GpuMesher {
   VkPipeline passes_[6] = {};  // mesh_slab.comp's passes 0–4, and 3 with the noise colours
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
-  VkCommandBuffer commands_ = VK_NULL_HANDLE;
-  VkFence fence_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   Buffer counts_, axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
   Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_;

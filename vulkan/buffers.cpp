@@ -1,6 +1,7 @@
 #include "vulkan/buffers.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -60,6 +61,21 @@ Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkB
     return host_visible
         ? context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
         : context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  });
+}
+
+Status uploadStorage(const VulkanContext& context, Buffer& target, const void* data, size_t bytes,
+                     const std::string& what) {
+  if (target.size < bytes) {
+    destroyBuffer(context, target);
+    Result<Buffer> created =
+        createUploadTarget(context, std::max<size_t>(bytes, 16),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, what);
+    if (!created) return created.error();
+    target = *created;
+  }
+  return uploadBuffer(context, target, bytes, [&](void* dst, VkDeviceSize offset, VkDeviceSize size) {
+    std::memcpy(dst, static_cast<const uint8_t*>(data) + offset, size);
   });
 }
 

@@ -66,6 +66,11 @@ using UploadFill = std::function<void(void* dst, VkDeviceSize offset, VkDeviceSi
 Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
                     VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20, VkDeviceSize at = 0);
 
+// Copies `bytes` from `data` into `target`, a storage buffer the device reads (createUploadTarget,
+// made anew where it is smaller, its old contents dropped); `what` names it in errors.
+Status uploadStorage(const VulkanContext& context, Buffer& target, const void* data, size_t bytes,
+                     const std::string& what);
+
 struct GpuImage {
   VkImage image = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
