@@ -48,7 +48,6 @@ bool plyWrittenHere(const OutputOptions& o) {
   return !capturingPoints() && format && *format == FileFormat::kPly && o.sample.count == 0;
 }
 
-
 }  // namespace
 
 void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_colors) {
@@ -85,11 +84,14 @@ int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order,
   if (!generated) return reportError(generated.error());
   const double generate_s = clock.lap();
   PointSet& points = *generated;
-  const bool colours_made = noise_made && points.hasColors() && coloursAtWrite(o, auto_noise);
+  // Colours made with the mesh are the noise's already, and there is no --offset (coloursAtWrite).
+  const bool colours_made = noise_made && points.hasColors();
   const bool colours_at_write = coloursAtWrite(o, auto_noise) && !colours_made;
-  if (colours_at_write) ColorArray().swap(points.colors);
-  else if (colours_made) {}  // the noise's already, and no --offset (coloursAtWrite)
-  else if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
+  if (colours_at_write) {
+    ColorArray().swap(points.colors);
+  } else if (!colours_made) {
+    if (Status s = colorAndOffset(points, o, auto_noise); !s) return reportError(s.error());
+  }
   if (o.sample.count != 0) {  // on the coloured, offset mesh: colours interpolate, positions are in their frame
     Result<uint64_t> limit = memoryLimit(o);
     if (!limit) return reportError(limit.error());

@@ -52,12 +52,13 @@ class PhaseClock {
 Status checkHandedBack(const OutputOptions& o);
 // --tile checks before any work: a .ply part, and no --order (which needs the whole set).
 Result<TileSpec> tileOptions(const OutputOptions& o);
-// Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any generator. Unless quiet, one line of
-// where the time went (generation counted from `clock`'s start, before the parameters).
 // Whether the noise colours are made as the PLY writer formats the rows (see the .cpp).
 bool coloursAtWrite(const OutputOptions& o, bool auto_noise);
+// Colours, offset, order and writing (or handing the set back, capturePoints): the steps after any generator. Unless quiet, one line of
+// where the time went (generation counted from `clock`'s start, before the parameters).
 // noise_made: the generator was asked for the seed noise colours with the mesh (a mesher on the
-// device); where the set has colours they are those, written as they are.
+// device, only where coloursAtWrite holds); where the set has colours they are those, written as
+// they are.
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
            PhaseClock& clock, bool noise_made = false);
 // A set whose points are a function of their index (random2d): `count` of them, point i at at(i),
