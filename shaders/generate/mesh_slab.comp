@@ -48,7 +48,7 @@ layout(std430, set = 0, binding = 8) buffer IdsZ { uint ids_z[]; };
 layout(std430, set = 0, binding = 9) buffer IdsX { uint ids_x[]; };  // by layer · n² + point
 layout(std430, set = 0, binding = 10) writeonly buffer Positions { double positions[]; };  // 3 a vertex
 layout(std430, set = 0, binding = 11) writeonly buffer Triangles { uint triangles[]; };     // 3 a triangle
-// With pc.noise: each vertex's seed noise colour (generators/perlin.h seedColor), 3 a vertex.
+// With kNoise: each vertex's seed noise colour (generators/perlin.h seedColor), 3 a vertex.
 layout(std430, set = 0, binding = 12) writeonly buffer Colors { float colors[]; };
 
 layout(push_constant) uniform Push {
