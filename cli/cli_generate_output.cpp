@@ -184,6 +184,41 @@ int finishMade(const PointFunction& made, const OutputOptions& o, PointOrder ord
   return 0;
 }
 
+bool canStreamRows(const OutputOptions& o, PointOrder order, bool auto_noise) {
+  return plyWrittenHere(o) && order == PointOrder::kInput && o.offset.empty() &&
+         (coloursAtWrite(o, auto_noise) || pointColorsOf(o) == PointColors::kNone);
+}
+
+Result<std::unique_ptr<PlyRowStream>> rowStream(const OutputOptions& o, bool colors, Progress& progress) {
+  return PlyRowStream::create(o.output, colors, o.common.threads, &progress);
+}
+
+EscapeRowSink rowSink(PlyRowStream& stream, bool colors) {
+  EscapeRowSink sink;
+  sink.colors = colors;
+  sink.start = [&stream](uint64_t vertices, uint64_t triangles) { return stream.start(vertices, triangles); };
+  sink.slab = [&stream](std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows) {
+    return stream.add(vertex_rows, vertices, face_rows);
+  };
+  return sink;
+}
+
+int finishRows(Result<PointSet> generated, PlyRowStream& stream, const OutputOptions& o, PhaseClock& clock) {
+  if (!generated) return reportError(generated.error());
+  assert(stream.started() && generated->size() == 0);
+  const double generate_s = clock.lap();
+  if (Status s = stream.finish(); !s) return reportError(s.error());
+  if (!o.common.quiet)
+    std::fprintf(stderr,
+                 "time (s): generate %.2f, colours and offset 0.00, order 0.00, write %.2f; %llu points, %llu triangles%s; "
+                 "the rows made on the device and written as they came%s\n",
+                 generate_s, clock.lap(), static_cast<unsigned long long>(stream.vertices()),
+                 static_cast<unsigned long long>(stream.faces()),
+                 stream.colors() ? "; the colours made with the mesh on the device" : "",
+                 stream.moved() ? " (the header's estimated counts had other digits: the vertex rows were moved)" : "");
+  return 0;
+}
+
 // A tile: colours and offset on its points, then its part file.
 int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_noise, const std::string& signature,
                Progress& progress) {

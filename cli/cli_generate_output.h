@@ -5,15 +5,18 @@
 
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "converters/ply.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
 #include "core/tile.h"
+#include "generators/escape_grid.h"
 #include "ops/point_order.h"
 
 namespace dpoint {
@@ -61,6 +64,16 @@ bool coloursAtWrite(const OutputOptions& o, bool auto_noise);
 // they are.
 int finish(Result<PointSet> generated, const OutputOptions& o, PointOrder order, bool auto_noise, Progress& progress,
            PhaseClock& clock, bool noise_made = false);
+// Whether a surface meshed on the device can go to the file as the device's PLY rows, as it is
+// made (converters/ply.h PlyRowStream): a .ply written here, in input order, no --offset, and the
+// noise colours made with the mesh (coloursAtWrite) or none.
+bool canStreamRows(const OutputOptions& o, PointOrder order, bool auto_noise);
+// The stream and the generator's sink that feeds it (generators/escape_grid.h); the stream is null
+// where the output takes no positional writes (a pipe).
+Result<std::unique_ptr<PlyRowStream>> rowStream(const OutputOptions& o, bool colors, Progress& progress);
+EscapeRowSink rowSink(PlyRowStream& stream, bool colors);
+// finish for a set whose rows went to `stream` (started): its faces and header, the time line.
+int finishRows(Result<PointSet> generated, PlyRowStream& stream, const OutputOptions& o, PhaseClock& clock);
 // A set whose points are a function of their index (random2d): `count` of them, point i at at(i),
 // called from several threads at once; z_present when some z is not 0.
 struct PointFunction {

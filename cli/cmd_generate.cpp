@@ -59,6 +59,17 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
       if constexpr (requires { params->noise_colors; }) {
         // Marching cubes on the device makes the colours written too, where they are the noise's.
         noise_made = params->noise_colors = params->mesher.mesh && coloursAtWrite(o->out, auto_noise);
+        // Meshed on the device, the surface can go to the file as it is made, as the device's rows.
+        if (params->mesher.mesh && canStreamRows(o->out, *order, auto_noise)) {
+          Result<std::unique_ptr<PlyRowStream>> stream = rowStream(o->out, noise_made, progress);
+          if (!stream) return reportError(stream.error());
+          if (*stream) {
+            params->rows = rowSink(**stream, noise_made);
+            Result<PointSet> generated = generate(*params);
+            if ((*stream)->started()) return finishRows(std::move(generated), **stream, o->out, clock);
+            return finish(std::move(generated), o->out, *order, auto_noise, progress, clock, noise_made);
+          }
+        }
       }
       return finish(generate(*params), o->out, *order, auto_noise, progress, clock, noise_made);
     };

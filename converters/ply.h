@@ -22,9 +22,13 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
+#include "core/atomic_file.h"
 #include "core/input_file.h"
+#include "core/memory.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -73,6 +77,55 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 // tile merge, converters/tile_file.h), whose file must be writePly's byte for byte.
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
                       const PlyWriteOptions& options);
+
+// A binary PLY mesh whose rows are made elsewhere and written as they come (a device's marching
+// cubes: generators/escape_grid.h EscapeRowSink): vertex rows of x, y, z as doubles and, with
+// colours, red, green, blue as bytes; face rows of the byte 3 and three uint ids. The header holds
+// the counts, known only at the end, so it is laid out from estimates and the vertex rows are
+// written after it as they come. The face rows wait in memory until the last vertex is written,
+// then follow; the real header goes over the estimated one, and where its length differs (the
+// counts' digits did) the vertex rows are moved first. The file is writePly's for the same mesh,
+// byte for byte, or nothing (a failed or abandoned stream leaves no file).
+class PlyRowStream {
+ public:
+  // Opens the output (AtomicFile); null where it is not a regular file (a pipe or a device, which
+  // take no positional writes: write the set with writePly instead).
+  static Result<std::unique_ptr<PlyRowStream>> create(const std::string& path, bool colors, unsigned threads,
+                                                      Progress* progress);
+  ~PlyRowStream();
+  PlyRowStream(const PlyRowStream&) = delete;
+  PlyRowStream& operator=(const PlyRowStream&) = delete;
+
+  // Once, before add: lays the header out for these estimated counts.
+  Status start(uint64_t vertices, uint64_t faces);
+  // The next rows: `vertices` vertex rows, written now after the ones before; the face rows, kept.
+  // From one thread at a time.
+  Status add(std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows);
+  // The face rows and the real header, then the file is committed.
+  Status finish();
+
+  bool started() const { return started_; }
+  bool colors() const { return colors_; }
+  uint64_t vertices() const { return vertices_; }
+  uint64_t faces() const { return faces_.size() / kFaceRowBytes; }
+  // After finish: whether the vertex rows were moved (the estimate had other digits).
+  bool moved() const { return moved_; }
+
+  static constexpr size_t kFaceRowBytes = 13;
+
+ private:
+  PlyRowStream(AtomicFile file, bool colors, unsigned threads, Progress* progress);
+
+  AtomicFile file_;
+  bool colors_ = false;
+  unsigned threads_ = 0;
+  Progress* progress_ = nullptr;
+  bool started_ = false, moved_ = false;
+  bool has_z_ = false;          // some vertex has a z other than +0 (PointSet::isPlanar)
+  size_t header_bytes_ = 0;     // the estimated header's length: where the vertex rows begin
+  uint64_t vertices_ = 0;
+  std::vector<uint8_t, DefaultInitAllocator<uint8_t>> faces_;
+};
 
 // The vertices of a binary PLY file a range at a time, for a renderer drawing a file larger than
 // memory should hold. open() reads the header with readPly's checks; an ASCII file, or one with

@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/ordered_write.h"
+#include "core/parallel.h"
 #include "core/text.h"
 #include "converters/ply.h"
 
@@ -264,6 +265,105 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
       });
   if (!written) return written;
   return file->commit();
+}
+
+}  // namespace dpoint
+
+namespace dpoint {
+
+Result<std::unique_ptr<PlyRowStream>> PlyRowStream::create(const std::string& path, bool colors, unsigned threads,
+                                                           Progress* progress) {
+  Result<AtomicFile> file = AtomicFile::create(path);
+  if (!file) return file.error();
+  if (!file->positional()) return std::unique_ptr<PlyRowStream>();
+  return std::unique_ptr<PlyRowStream>(new PlyRowStream(std::move(*file), colors, threads, progress));
+}
+
+PlyRowStream::PlyRowStream(AtomicFile file, bool colors, unsigned threads, Progress* progress)
+    : file_(std::move(file)), colors_(colors), threads_(threads), progress_(progress) {}
+
+PlyRowStream::~PlyRowStream() = default;
+
+namespace {
+
+// The header of a generated surface (z present, no source facts) with these counts.
+std::string rowStreamHeader(uint64_t vertices, uint64_t faces, bool colors, bool has_z) {
+  return plyHeader(PointSet(), vertices, faces, colors, has_z, PlyWriteOptions());
+}
+
+}  // namespace
+
+Status PlyRowStream::start(uint64_t vertices, uint64_t faces) {
+  assert(!started_);
+  started_ = true;
+  header_bytes_ = rowStreamHeader(vertices, faces, colors_, true).size();
+  // Address space only: the pages are touched as the rows arrive.
+  faces_.reserve(static_cast<size_t>(static_cast<double>(faces) * 1.1 * kFaceRowBytes));
+  adviseHugePages(faces_.data(), faces_.capacity());
+  return okStatus();
+}
+
+Status PlyRowStream::add(std::span<const uint8_t> vertex_rows, uint64_t vertices,
+                         std::span<const uint8_t> face_rows) {
+  assert(started_);
+  const size_t row_bytes = colors_ ? 27 : 24;
+  assert(vertex_rows.size() == vertices * row_bytes && face_rows.size() % kFaceRowBytes == 0);
+  // isPlanar's test, usually settled by the first row: a z that is not +0.
+  for (uint64_t v = 0; v < vertices && !has_z_; ++v) {
+    uint64_t z;
+    std::memcpy(&z, vertex_rows.data() + v * row_bytes + 16, sizeof z);
+    has_z_ = z != 0;
+  }
+  const size_t at = faces_.size();
+  faces_.resize(at + face_rows.size());  // not zeroed (DefaultInitAllocator)
+  // The vertex rows written on one worker while the others copy the face rows in pieces of 4 MiB.
+  constexpr size_t kPiece = size_t{4} << 20;
+  const size_t pieces = (face_rows.size() + kPiece - 1) / kPiece;
+  Status written = okStatus();
+  parallelFor(1 + pieces, std::min(8u, resolveThreads(threads_)), [&](size_t item, unsigned) {
+    if (item == 0) {
+      written = file_.writeAt(header_bytes_ + vertices_ * row_bytes, vertex_rows.data(), vertex_rows.size());
+      return;
+    }
+    const size_t from = (item - 1) * kPiece, n = std::min(kPiece, face_rows.size() - from);
+    std::memcpy(faces_.data() + at + from, face_rows.data() + from, n);
+  });
+  vertices_ += vertices;
+  return written;
+}
+
+Status PlyRowStream::finish() {
+  assert(started_);
+  const size_t row_bytes = colors_ ? 27 : 24;
+  const uint64_t vertex_bytes = vertices_ * row_bytes;
+  const std::string header = rowStreamHeader(vertices_, faces(), colors_, has_z_);
+  if (progress_) progress_->start("writing " + file_.path(), faces() + (header.size() != header_bytes_ ? vertices_ : 0));
+  // Moves the vertex rows from header_bytes_ to header.size(), a block at a time from the end that
+  // goes first, so that no block is written over before it is read.
+  if (header.size() != header_bytes_) {
+    moved_ = true;
+    constexpr uint64_t kBlock = uint64_t{64} << 20;
+    std::vector<char> block(static_cast<size_t>(std::min(kBlock, std::max<uint64_t>(vertex_bytes, 1))));
+    const bool later = header.size() > header_bytes_;
+    for (uint64_t done = 0; done < vertex_bytes;) {
+      const uint64_t n = std::min(kBlock, vertex_bytes - done);
+      const uint64_t from = later ? vertex_bytes - done - n : done;  // within the rows
+      if (Status s = file_.readAt(header_bytes_ + from, block.data(), n); !s) return s;
+      if (Status s = file_.writeAt(header.size() + from, block.data(), n); !s) return s;
+      done += n;
+      if (progress_) progress_->advance(n / row_bytes);
+    }
+  }
+  if (Status s = file_.writeAt(0, header.data(), header.size()); !s) return s;
+  constexpr size_t kBlock = size_t{64} << 20;
+  for (size_t at = 0; at < faces_.size(); at += kBlock) {
+    const size_t n = std::min(kBlock, faces_.size() - at);
+    if (Status s = file_.writeAt(header.size() + vertex_bytes + at, faces_.data() + at, n); !s) return s;
+    if (progress_) progress_->advance(n / kFaceRowBytes);
+  }
+  if (Status s = file_.resize(header.size() + vertex_bytes + faces_.size()); !s) return s;
+  if (progress_) progress_->finish();
+  return file_.commit();
 }
 
 }  // namespace dpoint

@@ -88,7 +88,7 @@ Status AtomicFile::checkTarget(const std::string& path) {
   }
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s;
-  int fd = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
   if (fd >= 0) {
     ::close(fd);
     return okStatus();
@@ -112,7 +112,7 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s.error();
 
-  int fd = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
   if (fd >= 0) return AtomicFile(path, "", fd, false);
   if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
     return ioError("cannot write into folder", folder, errno);
@@ -155,6 +155,45 @@ Status AtomicFile::write(const void* data, size_t size) {
   }
   if (size >= kBufferSize) return writeAll(static_cast<const char*>(data), size);  // no copy
   buffer_.insert(buffer_.end(), static_cast<const char*>(data), static_cast<const char*>(data) + size);
+  return okStatus();
+}
+
+Status AtomicFile::writeAt(uint64_t offset, const void* data, size_t size) {
+  assert(fd_ >= 0 && !committed_ && !direct_ && buffer_.empty());
+  if (interrupted()) return interruptedError();
+  const char* bytes = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return ioError("cannot write", path_, errno);
+    }
+    bytes += n;
+    size -= static_cast<size_t>(n);
+    offset += static_cast<uint64_t>(n);
+  }
+  return okStatus();
+}
+
+Status AtomicFile::readAt(uint64_t offset, void* data, size_t size) {
+  assert(fd_ >= 0 && !committed_ && !direct_);
+  if (interrupted()) return interruptedError();
+  char* bytes = static_cast<char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::pread(fd_, bytes, size, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n == 0 ? Error{"cannot read back '" + path_ + "': it is shorter than written"}
+                              : ioError("cannot read back", path_, errno);
+    bytes += n;
+    size -= static_cast<size_t>(n);
+    offset += static_cast<uint64_t>(n);
+  }
+  return okStatus();
+}
+
+Status AtomicFile::resize(uint64_t size) {
+  assert(fd_ >= 0 && !committed_ && !direct_ && buffer_.empty());
+  if (::ftruncate(fd_, static_cast<off_t>(size)) != 0) return ioError("cannot write", path_, errno);
   return okStatus();
 }
 

@@ -38,6 +38,13 @@ class AtomicFile {
   // Buffered append. Errors (disk full) are reported here or at commit.
   Status write(const void* data, size_t size);
   Status write(std::string_view text) { return write(text.data(), text.size()); }
+  // Positional writes and reads, where the output is a file (positional(): not a pipe or a device)
+  // and nothing is buffered: a file laid out before its sizes are known (converters/ply.h
+  // PlyRowStream). writeAt may be called from one thread while another reads or writes elsewhere.
+  bool positional() const { return !direct_; }
+  Status writeAt(uint64_t offset, const void* data, size_t size);
+  Status readAt(uint64_t offset, void* data, size_t size);
+  Status resize(uint64_t size);  // the file's length, cut or extended with zeros
   // Flushes, syncs nothing (page cache is enough for atomicity against crashes of the process),
   // and moves the file into place.
   Status commit();

@@ -593,12 +593,26 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
 
   const unsigned threads = resolveThreads(params.threads);
   const SlabPlan plan = planSlabs(layers, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
+  const int cap = classificationLimit(params);
+  // Marching cubes elsewhere (a GPU) makes the slabs' counts and meshes, in slab order; else the
+  // plane function's blocks of counts feed the workers, or the workers count with the row function.
+  const bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file &&
+                         params.mesher.takes(res, plan.thickness + 1, cap);
+  // The mesher's noise covers the cells of |v| < 1024 (perlin.cpp's fast path): every coordinate,
+  // plus the colours' offsets of up to 200, well inside it.
+  const double reach = params.frame == GridFrame::kSeed
+                           ? params.axis.hi - params.axis.lo
+                           : std::max(std::fabs(params.axis.lo), std::fabs(params.axis.hi));
+  const bool noise_elsewhere = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
+  // The whole mesh as PLY rows, written as they come, where the mesher makes all of it.
+  const bool rows = elsewhere && params.rows.slab && first_layer == 0 && last_layer == res - 1 &&
+                    (!params.rows.colors || noise_elsewhere);
   LayerMesh out;
   PointSet& mesh = out.mesh;
   // Reserving only claims address space; the pages are touched as the mesh grows, so an
   // estimate on the high side costs nothing and saves the copy of a reallocation.
   const double reserve =
-      std::min(1.25 * share * estimatedVertices(res), static_cast<double>(limit / kMeshBytesPerVertex));
+      rows ? 0.0 : std::min(1.25 * share * estimatedVertices(res), static_cast<double>(limit / kMeshBytesPerVertex));
   mesh.positions.reserve(static_cast<size_t>(reserve));
   mesh.triangles.reserve(static_cast<size_t>(reserve) * 6);
   // The slabs are appended one at a time under a lock while the other workers wait for it: with
@@ -696,17 +710,6 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
 
   auto slabFirst = [&](size_t s) { return first_layer + static_cast<int>(s) * plan.thickness; };
   auto slabLast = [&](size_t s) { return std::min(slabFirst(s) + plan.thickness, last_layer); };
-  const int cap = classificationLimit(params);
-  // Marching cubes elsewhere (a GPU) makes the slabs' counts and meshes, in slab order; else the
-  // plane function's blocks of counts feed the workers, or the workers count with the row function.
-  const bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file &&
-                         params.mesher.takes(res, plan.thickness + 1, cap);
-  // The mesher's noise covers the cells of |v| < 1024 (perlin.cpp's fast path): every coordinate,
-  // plus the colours' offsets of up to 200, well inside it.
-  const double reach = params.frame == GridFrame::kSeed
-                           ? params.axis.hi - params.axis.lo
-                           : std::max(std::fabs(params.axis.lo), std::fabs(params.axis.hi));
-  const bool noise_elsewhere = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
   if (noise_elsewhere) {
     color_bytes = sizeof(glm::vec3);
     mesh.colors.reserve(mesh.positions.capacity());
@@ -719,24 +722,79 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                    squared(res) * static_cast<uint64_t>(escapeGridBytesPerCount(cap)), threads + 2);
   }
 
+  auto slabAt = [&](int first, int last) {
+    EscapeSlab slab;
+    slab.res = res;
+    slab.first = first;
+    slab.last = last;
+    slab.owns_last_plane = slab.last == res - 1;
+    slab.seam_positions = slab.last == last_layer && !slab.owns_last_plane;
+    slab.limit = cap;
+    slab.level = params.level;
+    slab.frame = params.frame;
+    slab.values = &values;
+    slab.step = params.axis.step();
+    slab.noise_colors = noise_elsewhere;
+    return slab;
+  };
+  if (rows) {
+    // The header's counts from a sample of one cell layer in 32 (at most 32 layers), meshed as
+    // slabs of their own: about 1/32 more device time.
+    const int samples = std::min(layers, 32);
+    double sampled_vertices = 0.0, sampled_triangles = 0.0;
+    for (int i = 0; i < samples && !interrupted(); ++i) {
+      const int layer = first_layer + static_cast<int>((i + 0.5) * layers / samples);
+      EscapeSlab slab = slabAt(layer, layer + 1);
+      slab.noise_colors = false;
+      Result<McSlabView> view = params.mesher.mesh(slab);
+      if (!view) return view.error();
+      sampled_vertices += static_cast<double>(view->positions.size());
+      sampled_triangles += static_cast<double>(view->triangles.size() / 3);
+    }
+    if (interrupted()) return interruptedError();
+    const double scale = static_cast<double>(layers) / samples;
+    if (Status s = params.rows.start(static_cast<uint64_t>(std::llround(sampled_vertices * scale)),
+                                     static_cast<uint64_t>(std::llround(sampled_triangles * scale)));
+        !s)
+      return s.error();
+  }
+
   if (params.progress) params.progress->start(params.name, static_cast<uint64_t>(layers));
-  if (elsewhere) {
+  if (rows) {
+    // Each slab's rows go to the sink on a thread of their own while the next is made.
+    std::future<Status> writing;
+    uint64_t vertices = 0;
+    for (size_t s = 0; s < pending.size() && !failed; ++s) {
+      if (interrupted()) break;
+      EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
+      slab.ply_rows = true;
+      slab.vertex_base = static_cast<uint32_t>(vertices);
+      Result<McSlabView> view = params.mesher.mesh(slab);
+      if (writing.valid())
+        if (Status w = writing.get(); !w) fail(w.error());
+      if (!view) fail(view.error());
+      if (failed) break;
+      // The slab's ids are below its vertices plus the next plane's: all within uint32.
+      if (vertices + view->row_vertices + view->last_plane_vertices > UINT32_MAX) {
+        fail(Error{what + ": more than 2^32 vertices", ExitCode::kResourceLimit});
+        break;
+      }
+      const uint64_t slab_vertices = view->row_vertices;
+      vertices += slab_vertices;
+      writing = std::async(std::launch::async, [&, s, v = *view, slab_vertices] {
+        Status w = params.rows.slab(v.vertex_rows, slab_vertices, v.face_rows);
+        if (w && params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
+        return w;
+      });
+    }
+    if (writing.valid())
+      if (Status w = writing.get(); !w) fail(w.error());
+  } else if (elsewhere) {
     // Each slab's mesh is copied into the mesh on a thread of its own while the next is made.
     std::future<void> appending;
     for (size_t s = 0; s < pending.size(); ++s) {
       if (interrupted()) break;
-      EscapeSlab slab;
-      slab.res = res;
-      slab.first = slabFirst(s);
-      slab.last = slabLast(s);
-      slab.owns_last_plane = slab.last == res - 1;
-      slab.seam_positions = slab.last == last_layer && !slab.owns_last_plane;
-      slab.limit = cap;
-      slab.level = params.level;
-      slab.frame = params.frame;
-      slab.values = &values;
-      slab.step = params.axis.step();
-      slab.noise_colors = noise_elsewhere;
+      const EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
       Result<McSlabView> view = params.mesher.mesh(slab);
       if (appending.valid()) appending.get();
       if (!view) fail(view.error());

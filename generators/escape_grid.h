@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,11 @@ struct EscapeSlab {
   const std::vector<double>* values = nullptr;  // the axis: GridAxis::value(i), i < res
   double step = 0.0;                            // GridAxis::step()
   bool noise_colors = false;                    // the vertices' seedColor too (generators/perlin.h)
+  // The mesh as a binary PLY's rows (McSlabView::vertex_rows, face_rows): x, y, z as doubles, and
+  // with noise_colors red, green, blue as bytes; faces as the byte 3 and three uint ids, each the
+  // slab's own plus vertex_base. Not with seam_positions.
+  bool ply_rows = false;
+  uint32_t vertex_base = 0;
 };
 
 // Marching cubes elsewhere (a GPU, generators/gpu_mesh.h): the counts and the mesh of a slab
@@ -100,6 +106,21 @@ struct EscapeSlab {
 struct EscapeSlabMesher {
   std::function<bool(int res, int planes, int limit)> takes;
   std::function<Result<McSlabView>(const EscapeSlab&)> mesh;
+};
+
+// Where a whole surface meshed elsewhere goes as a binary PLY's rows as they are made, in place of
+// the mesh (a PlyRowStream, converters/ply.h, written while the device makes the next slab). Taken
+// only where the mesher meshes every slab, and with `colors` makes the noise colours too; then the
+// set returned is empty, and `start` has been called.
+struct EscapeRowSink {
+  bool colors = false;  // the vertex rows carry the seed noise colours (EscapeSlab::noise_colors)
+  // Once, before any slab: the whole mesh's vertices and triangles, estimated from a sample of its
+  // cell layers (within a few percent; exact when every layer is sampled).
+  std::function<Status(uint64_t vertices, uint64_t triangles)> start;
+  // Each slab's rows, in slab order, from one thread (not the mesher's); the face rows' ids are
+  // the whole mesh's.
+  std::function<Status(std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows)>
+      slab;
 };
 
 struct EscapeSurfaceParams {
@@ -121,10 +142,12 @@ struct EscapeSurfaceParams {
   // vertices' seed noise colours too (generators/perlin.h seedColor, bit for bit), and the mesh has
   // them; otherwise the mesh has no colours, as without it.
   bool noise_colors = false;
+  EscapeRowSink rows;  // generateEscapeSurface only (not a tile's); empty: the mesh is returned
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
-// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes, arena).
+// max_iter, lo, hi, level, frame, grid_out, threads, max_memory, progress, planes, arena, mesher,
+// noise_colors, rows).
 template <typename FractalParams>
 EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& params);
 
@@ -150,6 +173,7 @@ EscapeSurfaceParams escapeSurfaceParams(std::string name, const FractalParams& p
   surface.arena = params.arena;
   surface.mesher = params.mesher;
   surface.noise_colors = params.noise_colors;
+  surface.rows = params.rows;
   return surface;
 }
 

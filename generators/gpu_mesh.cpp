@@ -8,6 +8,8 @@
 #include "generators/perlin.h"
 #include "vulkan/shader.h"
 
+#include "shaders/mesh_colors.comp.h"
+#include "shaders/mesh_rows.comp.h"
 #include "shaders/mesh_slab.comp.h"
 
 namespace dpoint {
@@ -16,8 +18,11 @@ namespace {
 // Elements a workgroup takes: 256 invocations of 16 (mesh_slab.comp's kGroupElements). Fewer,
 // larger groups keep the one-workgroup scan of their counts (pass 2) short.
 constexpr uint32_t kGroupElements = 4096;
-constexpr uint32_t kBindings = 13;
+constexpr uint32_t kBindings = 15;
+constexpr uint32_t kFaceRowBytes = 13;  // the byte 3, three uint ids
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
+// passes_: mesh_slab.comp's passes 0–4, then these.
+constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7;
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
 
 // Push constants of shaders/generate/mesh_slab.comp (std430: the double at 0, then the uints).
@@ -25,8 +30,12 @@ struct MeshPush {
   double step;
   uint32_t n, plane, planes, first, word_offset, bits, above_at, stride, seed_frame;
   uint32_t vertex_elements, triangle_elements, vertex_group_count, triangle_group_count, groups_x, pad;
+  uint32_t rows, row_bytes, faces, vertex_base;
 };
-static_assert(sizeof(MeshPush) == 72);
+static_assert(sizeof(MeshPush) == 88);
+
+// Workgroups of 256 invocations of 4 rows each for `rows` rows.
+uint32_t rowGroups(uint64_t rows) { return static_cast<uint32_t>((rows + 4 * 256 - 1) / (4 * 256)); }
 
 }  // namespace
 
@@ -59,10 +68,10 @@ Status GpuMesher::init() {
       pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!layout) return layout.error();
   layout_ = *layout;
-  // kPass and kNoise, specialization constants 0 and 1: passes 0–4 (pass 3 with the colours is
-  // made at the first slab that wants them: on lavapipe it takes a while to compile).
+  // kPass, specialization constant 0: passes 0–4 (the colours' and the rows' pipelines are made at
+  // the first slab that wants them).
   for (uint32_t pass = 0; pass < 5; ++pass) {
-    const uint32_t constants[2] = {pass, 0u};
+    const uint32_t constants[1] = {pass};
     Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, constants);
     if (!p) return p.error();
     passes_[pass] = *p;
@@ -101,7 +110,8 @@ Status GpuMesher::init() {
 GpuMesher::~GpuMesher() {
   const VkDevice device = context_.device;
   for (Buffer* b : {&counts_, &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
-                    &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &readback_[0], &readback_[1]})
+                    &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_, &face_rows_, &readback_[0],
+                    &readback_[1]})
     destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
   if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
@@ -189,11 +199,21 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   push.above_at = slab.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(slab.level));
   push.stride = stride;
   push.seed_frame = slab.frame == GridFrame::kSeed ? 1u : 0u;
-  if (slab.noise_colors && !passes_[5]) {
-    const uint32_t constants[2] = {3u, 1u};
-    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, constants);
+  // Made at the first slab that wants them: mesh_colors.comp, and mesh_rows.comp's two kinds.
+  auto made = [&](unsigned index, const uint32_t* code, size_t bytes, std::span<const uint32_t> constants) -> Status {
+    if (passes_[index]) return okStatus();
+    Result<VkPipeline> p = createComputePipeline(context_, code, bytes, layout_, constants);
     if (!p) return p.error();
-    passes_[5] = *p;
+    passes_[index] = *p;
+    return okStatus();
+  };
+  if (slab.noise_colors)
+    if (Status s = made(kColorPass, kMeshColorsComp, sizeof(kMeshColorsComp), {}); !s) return s.error();
+  if (slab.ply_rows) {
+    assert(!slab.seam_positions);
+    static constexpr uint32_t kVertices[1] = {0u}, kFaces[1] = {1u};
+    if (Status s = made(kVertexRowPass, kMeshRowsComp, sizeof(kMeshRowsComp), kVertices); !s) return s.error();
+    if (Status s = made(kFaceRowPass, kMeshRowsComp, sizeof(kMeshRowsComp), kFaces); !s) return s.error();
   }
   const uint64_t vertex_elements = (2 * static_cast<uint64_t>(planes) - 1) * plane;
   const uint64_t triangle_elements = static_cast<uint64_t>(planes - 1) * plane;
@@ -213,6 +233,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   if (Status s = ensure(positions_, 3 * sizeof(double), false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s.error();
   if (Status s = ensure(colors_, 3 * sizeof(float), false, "slab colours"); !s) return s.error();
+  if (Status s = ensure(vertex_rows_, 4, false, "slab vertex rows"); !s) return s.error();
+  if (Status s = ensure(face_rows_, 4, false, "slab face rows"); !s) return s.error();
   auto bind = [&] {
     const VkDescriptorBufferInfo infos[kBindings] = {
         {counts_.buffer, 0, VK_WHOLE_SIZE},    {axis_.buffer, 0, VK_WHOLE_SIZE},
@@ -221,7 +243,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
         {totals_.buffer, 0, VK_WHOLE_SIZE},    {ids_y_.buffer, 0, VK_WHOLE_SIZE},
         {ids_z_.buffer, 0, VK_WHOLE_SIZE},     {ids_x_.buffer, 0, VK_WHOLE_SIZE},
         {positions_.buffer, 0, VK_WHOLE_SIZE}, {triangles_.buffer, 0, VK_WHOLE_SIZE},
-        {colors_.buffer, 0, VK_WHOLE_SIZE}};
+        {colors_.buffer, 0, VK_WHOLE_SIZE},    {vertex_rows_.buffer, 0, VK_WHOLE_SIZE},
+        {face_rows_.buffer, 0, VK_WHOLE_SIZE}};
     writeBufferDescriptors(context_, set_, infos);
   };
   bind();
@@ -264,25 +287,62 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
 
   // The vertices and triangles into device memory, then copied across to host-visible memory by
   // the transfer engine (a shader's scattered writes across the bus were several times slower).
-  // Read back as the positions, the colours (with slab.noise_colors) and the triangles.
+  // Read back as the positions, the colours (with slab.noise_colors) and the triangles; or, with
+  // slab.ply_rows, as the vertex rows (of every vertex made: the last plane's in-plane ones, which
+  // the next slab owns, are not known from the others until pass 3 has run) and the face rows.
   const uint64_t position_bytes = vertices * 3 * sizeof(double), triangle_bytes = triangles * 3 * sizeof(uint32_t);
   const uint64_t color_bytes = slab.noise_colors ? vertices * 3 * sizeof(float) : 0;
-  const uint64_t old_positions = positions_.size, old_triangles = triangles_.size, old_colors = colors_.size;
+  const uint64_t row_bytes = slab.noise_colors ? 27 : 24;
+  // The rows' buffers hold whole blocks of 4 rows (mesh_rows.comp writes whole words).
+  const uint64_t vertex_row_bytes = slab.ply_rows ? vertices * row_bytes : 0;
+  const uint64_t face_row_bytes = slab.ply_rows ? triangles * kFaceRowBytes : 0;
+  const uint64_t old_sizes[5] = {positions_.size, triangles_.size, colors_.size, vertex_rows_.size, face_rows_.size};
   if (Status s = ensure(positions_, position_bytes, false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, triangle_bytes, false, "slab triangles"); !s) return s.error();
   if (Status s = ensure(colors_, color_bytes, false, "slab colours"); !s) return s.error();
+  if (Status s = ensure(vertex_rows_, (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s)
+    return s.error();
+  if (Status s = ensure(face_rows_, (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s)
+    return s.error();
   Buffer& readback = readback_[next_readback_];
   next_readback_ ^= 1;
-  if (Status s = ensure(readback, position_bytes + color_bytes + triangle_bytes, true, "slab mesh for the host"); !s)
-    return s.error();
-  if (positions_.size != old_positions || triangles_.size != old_triangles || colors_.size != old_colors) bind();
+  const uint64_t readback_bytes =
+      slab.ply_rows ? vertex_row_bytes + face_row_bytes : position_bytes + color_bytes + triangle_bytes;
+  if (Status s = ensure(readback, readback_bytes, true, "slab mesh for the host"); !s) return s.error();
+  const uint64_t new_sizes[5] = {positions_.size, triangles_.size, colors_.size, vertex_rows_.size, face_rows_.size};
+  if (!std::equal(old_sizes, old_sizes + 5, new_sizes)) bind();
+  push.rows = static_cast<uint32_t>(vertices);
+  push.row_bytes = static_cast<uint32_t>(row_bytes);
+  push.faces = static_cast<uint32_t>(triangles);
+  push.vertex_base = slab.vertex_base;
   status = submitOnce(context_, [&](VkCommandBuffer commands) {
     stamp(commands, kStart2);
-    dispatch(commands, slab.noise_colors ? 5 : 3, push.vertex_group_count);
+    dispatch(commands, 3, push.vertex_group_count);
+    if (slab.noise_colors && vertices) {
+      barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
+      dispatch(commands, kColorPass, static_cast<uint32_t>((vertices + 255) / 256));
+    }
     stamp(commands, kVertices);
     barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
     dispatch(commands, 4, push.triangle_group_count);
     stamp(commands, kTriangles);
+    if (slab.ply_rows) {
+      barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
+      if (vertices) dispatch(commands, kVertexRowPass, rowGroups(vertices));
+      if (triangles) dispatch(commands, kFaceRowPass, rowGroups(triangles));
+      barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+      if (vertex_row_bytes) {
+        const VkBufferCopy copy{0, 0, vertex_row_bytes};
+        vkCmdCopyBuffer(commands, vertex_rows_.buffer, readback.buffer, 1, &copy);
+      }
+      if (face_row_bytes) {
+        const VkBufferCopy copy{0, vertex_row_bytes, face_row_bytes};
+        vkCmdCopyBuffer(commands, face_rows_.buffer, readback.buffer, 1, &copy);
+      }
+      stamp(commands, kCopied);
+      barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+      return;
+    }
     barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     if (position_bytes) {
       const VkBufferCopy copy{0, 0, position_bytes};
@@ -309,8 +369,16 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   out.first_plane_vertices = totals[2];
   const uint64_t last_first = totals[3];  // the first id of the last plane's in-plane vertices
   out.last_plane_vertices = static_cast<uint32_t>(vertices - last_first);
+  const uint64_t owned = slab.owns_last_plane ? vertices : last_first;
+  if (slab.ply_rows) {
+    const auto* rows = static_cast<const uint8_t*>(readback.mapped);
+    out.row_vertices = owned;
+    out.vertex_rows = {rows, owned * row_bytes};
+    out.face_rows = {rows + vertex_row_bytes, face_row_bytes};
+    return out;
+  }
   const auto* positions = static_cast<const glm::dvec3*>(readback.mapped);
-  out.positions = {positions, slab.owns_last_plane ? vertices : last_first};
+  out.positions = {positions, owned};
   if (!slab.owns_last_plane && slab.seam_positions)
     out.seam_positions = {positions + last_first, vertices - last_first};
   const auto* bytes = static_cast<const uint8_t*>(readback.mapped);

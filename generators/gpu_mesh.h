@@ -41,7 +41,8 @@ class GpuMesher {
   // marchingCubesSlab(res, res, slab.first, slab.last, slab.owns_last_plane, …, slab.seam_positions)
   // with SlabField's vertices (slab.level, frame, values, step) from the slab's final counts, which
   // countsBuffer holds, `bits` (8 or 32) each. The view is of host-visible memory that stays as it
-  // is until the second call after this one (two buffers, used in turn).
+  // is until the second call after this one (two buffers, used in turn). With slab.ply_rows, the
+  // view has the binary PLY rows instead (McSlabView::vertex_rows and face_rows).
   Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits);
 
   // The passes' time on the device (timestamps), in ms: counting and scanning, the vertices, the
@@ -62,12 +63,13 @@ class GpuMesher {
   const VulkanContext& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline passes_[6] = {};  // mesh_slab.comp's passes 0–4, and 3 with the noise colours
+  // mesh_slab.comp's passes 0–4, mesh_colors.comp, and mesh_rows.comp's vertex and face rows.
+  VkPipeline passes_[8] = {};
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   Buffer counts_, axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
-  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_;
+  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_, vertex_rows_, face_rows_;
   Buffer readback_[2];  // host-visible, used in turn: a slab's positions, colours and triangles
   unsigned next_readback_ = 0;
   std::vector<double> axis_values_;       // what axis_ holds

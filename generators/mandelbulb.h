@@ -56,6 +56,7 @@ struct MandelbulbParams {
   EscapeArena arena;             // where `planes` writes fastest (escape_grid.h); empty: the heap
   EscapeSlabMesher mesher;       // meshes the slabs of `planes` elsewhere (escape_grid.h); empty: here
   bool noise_colors = false;     // the mesher makes the seed noise colours too where it can (escape_grid.h)
+  EscapeRowSink rows;            // the mesh as PLY rows as it is made, where the mesher takes it (escape_grid.h)
   bool full_counts = false;      // every count to max_iter, not capped above the level (escape_grid.h)
 };
 

@@ -25,19 +25,15 @@
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint kPass = 0;
-// Pass 3 makes the vertices' seed noise colours too (a pipeline of its own: the noise's code, even
-// where not run, made lavapipe's vertex pass tens of times slower).
-layout(constant_id = 1) const bool kNoise = false;
 const uint kRun = 16u;                // elements an invocation: kGroupElements in generators/gpu_mesh.cpp
 const uint kGroupElements = 256u * kRun;
 
 layout(std430, set = 0, binding = 0) readonly buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Axis { double values[]; };    // the grid axis
 layout(std430, set = 0, binding = 2) readonly buffer Fractions { double fractions[]; };  // t by (v1, v2)
-// Case m: bytes 4m..4m+15 as words: the triangle count, then 15 cube edges (marching_cubes.h);
-// then the noise's permutation (256 words) and its 16 gradients (48 floats as words).
+// Case m: bytes 4m..4m+15 as words: the triangle count, then 15 cube edges (marching_cubes.h)
+// (then mesh_colors.comp's noise tables).
 layout(std430, set = 0, binding = 3) readonly buffer Cases { uint cases[]; };
-const uint kPermutationAt = 1024u, kGradientsAt = 1280u;
 layout(std430, set = 0, binding = 4) buffer VertexGroups { uint vertex_groups[]; };
 layout(std430, set = 0, binding = 5) buffer TriangleGroups { uint triangle_groups[]; };
 // 0: vertices, 1: triangles, 2: the first id of section 1 (plane 0's in-plane vertices),
@@ -48,8 +44,6 @@ layout(std430, set = 0, binding = 8) buffer IdsZ { uint ids_z[]; };
 layout(std430, set = 0, binding = 9) buffer IdsX { uint ids_x[]; };  // by layer · n² + point
 layout(std430, set = 0, binding = 10) writeonly buffer Positions { double positions[]; };  // 3 a vertex
 layout(std430, set = 0, binding = 11) writeonly buffer Triangles { uint triangles[]; };     // 3 a triangle
-// With kNoise: each vertex's seed noise colour (generators/perlin.h seedColor), 3 a vertex.
-layout(std430, set = 0, binding = 12) writeonly buffer Colors { float colors[]; };
 
 layout(push_constant) uniform Push {
   double step;            // the seed frame's grid step
@@ -119,76 +113,6 @@ uint exclusiveScan(uint v, out uint total) {
   return scanned[i] - v;
 }
 
-// generators/perlin.cpp's pnoise3 and seedColor, operation for operation: float add, sub and mul
-// round correctly in Vulkan, the gradients' products are exact, nothing is fused (`precise`), and
-// the conversions between double and float round to nearest. Only the cells of |v| < 1024 (the
-// host's fast path; the mesher is not asked for colours past it).
-// The permutation and the gradients live in the case buffer (a constant array indexed at run time
-// was copied into each invocation's memory on lavapipe, a thousand times slower).
-int perm(int index) { return int(cases[kPermutationAt + uint(index & 255)]); }
-float gradient(int hash, float x, float y, float z) {
-  // The package's 16 gradients: the 12 cube edge midpoints, then 4 of them again.
-  uint at = kGradientsAt + 3u * uint(hash & 15);
-  vec3 g = vec3(uintBitsToFloat(cases[at]), uintBitsToFloat(cases[at + 1u]), uintBitsToFloat(cases[at + 2u]));
-  precise float xy = x * g.x + y * g.y;
-  precise float sum = xy + z * g.z;
-  return sum;
-}
-float lerpNoise(float t, float a, float b) {
-  precise float d = b - a;
-  precise float v = a + t * d;
-  return v;
-}
-float fade(float t) {
-  precise float t3 = t * t * t;
-  precise float inner = t * (t * 6.0 - 15.0) + 10.0;
-  precise float v = t3 * inner;
-  return v;
-}
-// floorSmall: the truncation, one less below a negative non-integer, and v's sign on a zero.
-float floorSmall(float v) {
-  float t = float(int(v));
-  if (t > v) {
-    precise float below = t - 1.0;
-    return below;
-  }
-  return uintBitsToFloat((floatBitsToUint(t) & 0x7FFFFFFFu) | (floatBitsToUint(v) & 0x80000000u));
-}
-// cellIndices for |v| < 1024: hi = (lo + 1) % 1024 as C computes it, lo + 1 lying in [−1023, 1024].
-void cellIndices(float v, out int lo, out int hi, out float floor_v) {
-  floor_v = floorSmall(v);
-  lo = int(floor_v);
-  hi = lo + 1 == 1024 ? 0 : lo + 1;
-  lo &= 255;
-  hi &= 255;
-}
-float pnoise3(float x, float y, float z) {
-  int i, ii, j, jj, k, kk;
-  float floor_x, floor_y, floor_z;
-  cellIndices(x, i, ii, floor_x);
-  cellIndices(y, j, jj, floor_y);
-  cellIndices(z, k, kk, floor_z);
-  precise float fx0 = x - floor_x, fy0 = y - floor_y, fz0 = z - floor_z;
-  float fx = fade(fx0), fy = fade(fy0), fz = fade(fz0);
-  int a = perm(i), aa = perm(a + j), ab = perm(a + jj);
-  int b = perm(ii), ba = perm(b + j), bb = perm(b + jj);
-  precise float x1 = fx0 - 1.0, y1 = fy0 - 1.0, z1 = fz0 - 1.0;
-  float near_z = lerpNoise(fy, lerpNoise(fx, gradient(perm(aa + k), fx0, fy0, fz0), gradient(perm(ba + k), x1, fy0, fz0)),
-                           lerpNoise(fx, gradient(perm(ab + k), fx0, y1, fz0), gradient(perm(bb + k), x1, y1, fz0)));
-  float far_z = lerpNoise(fy, lerpNoise(fx, gradient(perm(aa + kk), fx0, fy0, z1), gradient(perm(ba + kk), x1, fy0, z1)),
-                          lerpNoise(fx, gradient(perm(ab + kk), fx0, y1, z1), gradient(perm(bb + kk), x1, y1, z1)));
-  return lerpNoise(fz, near_z, far_z);
-}
-void writeColor(uint id, dvec3 p) {
-  for (uint c = 0u; c < 3u; ++c) {
-    precise double offset = 100.0lf * double(c);
-    precise double px = p.x + offset, py = p.y + offset, pz = p.z + offset;
-    double n = double(pnoise3(float(px), float(py), float(pz)));
-    precise double color = 0.5lf + 0.5lf * n;
-    colors[3u * id + c] = float(color);
-  }
-}
-
 // generators/escape_grid.cpp's SlabField::vertex: the vertex on the edge from (first + q, j, k)
 // along `axis`.
 void writeVertex(uint id, uint q, uint point, uint axis) {
@@ -198,7 +122,6 @@ void writeVertex(uint id, uint q, uint point, uint axis) {
   uint v1 = countAt(q, point), v2 = countAt(q2, point2);
   double t = fractions[v1 * pc.stride + v2];
   uint index[3] = uint[3](pc.first + q, j, k);
-  dvec3 vertex;
   for (uint d = 0u; d < 3u; ++d) {
     uint i = index[d];
     precise double out_value;
@@ -212,9 +135,7 @@ void writeVertex(uint id, uint q, uint point, uint axis) {
       out_value = values[i];
     }
     positions[3u * id + d] = out_value;
-    vertex[d] = out_value;
   }
-  if (kNoise) writeColor(id, vertex);  // every coordinate + 200 within ±1024 (the host checks)
 }
 
 // The id of the vertex on cube edge `edge` of cell (q, point) (marching_cubes.h's mcEdgeStart).

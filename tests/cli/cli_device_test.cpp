@@ -72,11 +72,16 @@ TEST(CliGenerateDevice, noiseColoursMadeWithTheMeshOnTheDeviceAreTheCpus) {
     const char* note;  // in the time line
   };
   const std::vector<Case> cases = {
-      {{"julia", "--resolution", "40", "-o", "X.ply"}, "; the colours made with the mesh on the device"},
+      // Streamed: the device's rows written as they come (converters/ply.h PlyRowStream).
+      {{"julia", "--resolution", "40", "-o", "X.ply"},
+       "; the colours made with the mesh on the device; the rows made on the device and written as they came\n"},
       {{"mandelbulb", "--variant", "fast", "--resolution", "41", "--frame", "seed", "-o", "X.ply"},
-       "; the colours made with the mesh on the device"},
+       "; the colours made with the mesh on the device; the rows made on the device and written as they came\n"},
+      {{"julia", "--resolution", "40", "--colors", "none", "-o", "X.ply"},
+       "triangles; the rows made on the device and written as they came\n"},
+      // Not streamed: the mesh is reordered, or its colours are made on the host, or it is a CSV.
+      {{"julia", "--resolution", "40", "--order", "morton", "-o", "X.ply"}, "; the colours made with the mesh on the device\n"},
       {{"julia", "--resolution", "40", "--bounds", "-800,800", "-o", "X.ply"}, "; the colours made as the rows were written"},
-      {{"julia", "--resolution", "40", "--colors", "none", "-o", "X.ply"}, "triangles\n"},
       {{"julia", "--resolution", "30", "-o", "X.csv"}, "triangles\n"},
   };
   for (const Case& c : cases) {
@@ -89,7 +94,7 @@ TEST(CliGenerateDevice, noiseColoursMadeWithTheMeshOnTheDeviceAreTheCpus) {
     args.back() = dir.file("gpu-" + name);
     test::CommandResult gpu = runDpoint(concat(args, {"--device", "cpu", "--mesh", "device", "--validate"}));
     ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
-    EXPECT_NE(gpu.err.find(c.note), std::string::npos) << gpu.err;
+    EXPECT_NE(gpu.err.find(c.note), std::string::npos) << gpu.err << "wanted: " << c.note;
     EXPECT_TRUE(readFile(dir.file("cpu-" + name)) == readFile(dir.file("gpu-" + name)));
   }
 }

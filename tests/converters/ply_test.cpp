@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <utility>
@@ -1241,6 +1242,83 @@ TEST(Ply, plyVertexStreamNamesBadRowsAndRefusesWhatCannotBeStreamed) {
   auto huge = PlyVertexStream::open(dir.file("short.ply"));
   ASSERT_FALSE(huge.ok());
   EXPECT_TRUE(contains(huge.error().message, "short.ply: truncated at byte"));
+}
+
+
+// PlyRowStream: the rows of writePly's file fed back in uneven pieces make writePly's file again,
+// whatever counts the header was laid out for (the vertex rows are moved where the digits differ).
+TEST(Ply, rowStreamWritesWritePlysFileWhateverTheEstimate) {
+  TempDir dir;
+  for (const bool colors : {true, false}) {
+    for (const bool planar : {false, true}) {
+      PointSet mesh;
+      const size_t n = 1000;
+      for (size_t i = 0; i < n; ++i) {
+        const double t = static_cast<double>(i);
+        mesh.positions.push_back({std::sin(t) * 1e6, t * 0.1 - 3.0, planar ? 0.0 : std::cos(t) + 1e-300});
+        if (colors) mesh.colors.push_back({std::fmod(t * 0.37f, 1.3f) - 0.1f, 0.5f, 1.0f});
+      }
+      for (uint32_t f = 0; f + 2 < n; ++f)
+        for (uint32_t k : {f, f + 2, f + 1}) mesh.triangles.push_back(k);
+      ASSERT_TRUE(writePly(dir.file("want.ply"), mesh).ok());
+      const std::string want = readFile(dir.file("want.ply"));
+      const size_t header = want.find("end_header\n") + 11;
+      const size_t row_bytes = colors ? 27 : 24, faces = mesh.triangles.size() / 3;
+      ASSERT_EQ(want.size(), header + n * row_bytes + faces * PlyRowStream::kFaceRowBytes);
+      const auto* rows = reinterpret_cast<const uint8_t*>(want.data() + header);
+      const auto* face_rows = rows + n * row_bytes;
+      struct Estimate {
+        uint64_t vertices, faces;
+        bool moved;
+      };
+      for (const Estimate e : {Estimate{n, faces, false}, Estimate{1234, 567, false}, Estimate{n / 20, faces / 20, true},
+                               Estimate{n * 20, faces, true}, Estimate{0, 0, true}}) {
+        SCOPED_TRACE(std::to_string(colors) + " " + std::to_string(planar) + " " + std::to_string(e.vertices) + " " +
+                     std::to_string(e.faces));
+        std::filesystem::remove(dir.file("got.ply"));
+        Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("got.ply"), colors, 3, nullptr);
+        ASSERT_TRUE(stream.ok() && *stream);
+        ASSERT_TRUE((*stream)->start(e.vertices, e.faces).ok());
+        // Pieces of 0, 1, 300 and the rest of the vertices, with a third of the faces each.
+        size_t v = 0, f = 0;
+        for (const size_t piece : {size_t{0}, size_t{1}, size_t{300}, n - 301}) {
+          const size_t fs = piece == n - 301 ? faces - f : faces / 3;
+          ASSERT_TRUE((*stream)
+                          ->add({rows + v * row_bytes, piece * row_bytes}, piece,
+                                {face_rows + f * PlyRowStream::kFaceRowBytes, fs * PlyRowStream::kFaceRowBytes})
+                          .ok());
+          v += piece;
+          f += fs;
+        }
+        EXPECT_FALSE(std::filesystem::exists(dir.file("got.ply")));  // nothing before finish
+        ASSERT_TRUE((*stream)->finish().ok());
+        const bool moved = plyHeader(PointSet(), e.vertices, e.faces, colors, true, {}).size() !=
+                           plyHeader(PointSet(), n, faces, colors, !planar, {}).size();
+        EXPECT_EQ(moved, e.moved || planar);  // the cases are what they say
+        EXPECT_EQ((*stream)->moved(), moved);
+        EXPECT_EQ((*stream)->vertices(), n);
+        EXPECT_EQ((*stream)->faces(), faces);
+        EXPECT_TRUE(readFile(dir.file("got.ply")) == want);
+      }
+    }
+  }
+}
+
+// A stream that is not finished leaves no file.
+TEST(Ply, rowStreamAbandonedLeavesNothing) {
+  TempDir dir;
+  {
+    Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("x.ply"), false, 0, nullptr);
+    ASSERT_TRUE(stream.ok() && *stream);
+    ASSERT_TRUE((*stream)->start(10, 10).ok());
+    const std::vector<uint8_t> rows(24 * 3, 0);
+    ASSERT_TRUE((*stream)->add(rows, 3, {}).ok());
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
+  // A pipe or a device takes no positional writes: no stream.
+  Result<std::unique_ptr<PlyRowStream>> null = PlyRowStream::create("/dev/null", false, 0, nullptr);
+  ASSERT_TRUE(null.ok());
+  EXPECT_EQ(null->get(), nullptr);
 }
 
 }  // namespace
