@@ -742,6 +742,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     // slabs of their own: about 1/32 more device time.
     const int samples = std::min(layers, 32);
     double sampled_vertices = 0.0, sampled_triangles = 0.0;
+    uint64_t most_vertices = 0, most_triangles = 0, most_plane = 0;  // of a sampled layer
     for (int i = 0; i < samples && !interrupted(); ++i) {
       const int layer = first_layer + static_cast<int>((i + 0.5) * layers / samples);
       EscapeSlab slab = slabAt(layer, layer + 1);
@@ -750,6 +751,19 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       if (!view) return view.error();
       sampled_vertices += static_cast<double>(view->positions.size());
       sampled_triangles += static_cast<double>(view->triangles.size() / 3);
+      most_vertices = std::max<uint64_t>(most_vertices, view->positions.size());
+      most_triangles = std::max<uint64_t>(most_triangles, view->triangles.size() / 3);
+      most_plane = std::max<uint64_t>(most_plane, view->last_plane_vertices);
+    }
+    // The largest slab's buffers at once, a quarter over the sample's densest layers: growing them
+    // slab by slab cost 0.56 s of host-visible allocations at res 2048 on an H200.
+    if (params.mesher.reserve) {
+      const double slab_layers = 1.25 * plan.thickness;
+      if (Status s = params.mesher.reserve(
+              static_cast<uint64_t>(slab_layers * static_cast<double>(most_vertices)) + 2 * most_plane,
+              static_cast<uint64_t>(slab_layers * static_cast<double>(most_triangles)), noise_elsewhere, true);
+          !s)
+        return s.error();
     }
     if (interrupted()) return interruptedError();
     const double scale = static_cast<double>(layers) / samples;

@@ -106,6 +106,10 @@ struct EscapeSlab {
 struct EscapeSlabMesher {
   std::function<bool(int res, int planes, int limit)> takes;
   std::function<Result<McSlabView>(const EscapeSlab&)> mesh;
+  // Optional: memory for slabs of up to `vertices` vertices and `triangles` triangles made at once,
+  // with colours and as rows as EscapeSlab says (else it grows as the slabs do, which on a GPU
+  // costs a host-visible allocation on the way from one slab's passes to the next).
+  std::function<Status(uint64_t vertices, uint64_t triangles, bool colors, bool rows)> reserve;
 };
 
 // Where a whole surface meshed elsewhere goes as a binary PLY's rows as they are made, in place of

@@ -153,6 +153,24 @@ Status GpuMesher::readStamps() {
   return okStatus();
 }
 
+Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, bool rows) {
+  const uint64_t row_bytes = colors ? 27 : 24;
+  if (Status s = ensure(positions_, vertices * 3 * sizeof(double), false, "slab vertices"); !s) return s;
+  if (Status s = ensure(triangles_, triangles * 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s;
+  if (colors)
+    if (Status s = ensure(colors_, vertices * 3 * sizeof(float), false, "slab colours"); !s) return s;
+  uint64_t readback = vertices * 3 * sizeof(double) + (colors ? vertices * 3 * sizeof(float) : 0) +
+                      triangles * 3 * sizeof(uint32_t);
+  if (rows) {
+    if (Status s = ensure(vertex_rows_, (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s) return s;
+    if (Status s = ensure(face_rows_, (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s) return s;
+    readback = vertices * row_bytes + triangles * kFaceRowBytes;
+  }
+  for (Buffer& b : readback_)
+    if (Status s = ensure(b, readback, true, "slab mesh for the host"); !s) return s;
+  return okStatus();
+}
+
 Result<const Buffer*> GpuMesher::countsBuffer(uint64_t bytes) {
   if (Status s = ensure(counts_, bytes, false, "escape counts of a slab"); !s) return s.error();
   return &counts_;

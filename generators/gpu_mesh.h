@@ -45,6 +45,9 @@ class GpuMesher {
   // view has the binary PLY rows instead (McSlabView::vertex_rows and face_rows).
   Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits);
 
+  // Grows the slab buffers for slabs of up to these counts (meshSlab grows them as needed).
+  Status reserve(uint64_t vertices, uint64_t triangles, bool colors, bool rows);
+
   // The passes' time on the device (timestamps), in ms: counting and scanning, the vertices, the
   // triangles, and copying the mesh across to host-visible memory.
   struct Times {
