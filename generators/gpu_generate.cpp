@@ -346,7 +346,8 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
       return st;
     }
   }
-  return finishAll();
+  // Into device memory, the reader's own submission follows on the queue (escapeInto).
+  return target == Target::kDevice ? okStatus() : finishAll();
 }
 
 Result<uint8_t*> GpuEscape::arena(uint64_t bytes) {
@@ -374,7 +375,11 @@ Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const 
   Result<const Buffer*> counts = mesher.countsBuffer(static_cast<uint64_t>(planes) * squaredResolution(slab.res) * bits / 8);
   if (!counts) return counts.error();
   if (Status s = escape.escapeInto(kernel, *slab.values, slab.first, planes, slab.limit, **counts); !s) return s.error();
-  return mesher.meshSlab(slab, bits);
+  // The mesher's first submission waits on the device for the counts, not the host.
+  Result<McSlabView> mesh = mesher.meshSlab(slab, bits);
+  const Status settled = escape.settle();
+  if (mesh && !settled) return settled.error();
+  return mesh;
 }
 
 Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::vector<double>& dcx,

@@ -76,9 +76,13 @@ class GpuEscape {
 
   // escapePlanes's counts into device memory (`target`, from its start) and nowhere else, for a
   // mesher on the device (generators/gpu_mesh.h), deviceBits(limit) bits each: packed as in the
-  // arena on a GPU, whole uint32 on lavapipe.
+  // arena on a GPU, whole uint32 on lavapipe. Returns once the last dispatch is submitted: a
+  // submission after it on the context's queue whose barrier waits for compute writes reads the
+  // counts (no host round trip between); settle() once such a submission has finished.
   Status escapeInto(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
                     int limit, const Buffer& target);
+  // Waits for the dispatches in flight and counts their time (pointsDone, gpuMs).
+  Status settle() { return finishAll(); }
   uint32_t deviceBits(int limit) const;
 
   // counts[r·dcx.size() + col] and tails[...]: mandelbrot2d's perturbed count of δc = (dcx[col],
