@@ -337,10 +337,11 @@ Status PlyRowStream::finish() {
   const size_t row_bytes = colors_ ? 27 : 24;
   const uint64_t vertex_bytes = vertices_ * row_bytes;
   const std::string header = rowStreamHeader(vertices_, faces(), colors_, has_z_);
-  if (progress_) progress_->start("writing " + file_.path(), faces() + (header.size() != header_bytes_ ? vertices_ : 0));
+  const bool move = header.size() != header_bytes_;
+  if (progress_) progress_->start("writing " + file_.path(), faces() + (move ? vertices_ : 0));
   // Moves the vertex rows from header_bytes_ to header.size(), a block at a time from the end that
   // goes first, so that no block is written over before it is read.
-  if (header.size() != header_bytes_) {
+  if (move) {
     moved_ = true;
     constexpr uint64_t kBlock = uint64_t{64} << 20;
     std::vector<char> block(static_cast<size_t>(std::min(kBlock, std::max<uint64_t>(vertex_bytes, 1))));

@@ -348,31 +348,20 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
       barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
       if (vertices) dispatch(commands, kVertexRowPass, rowGroups(vertices));
       if (triangles) dispatch(commands, kFaceRowPass, rowGroups(triangles));
-      barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-      if (vertex_row_bytes) {
-        const VkBufferCopy copy{0, 0, vertex_row_bytes};
-        vkCmdCopyBuffer(commands, vertex_rows_.buffer, readback.buffer, 1, &copy);
-      }
-      if (face_row_bytes) {
-        const VkBufferCopy copy{0, vertex_row_bytes, face_row_bytes};
-        vkCmdCopyBuffer(commands, face_rows_.buffer, readback.buffer, 1, &copy);
-      }
-      stamp(commands, kCopied);
-      barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-      return;
     }
     barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    if (position_bytes) {
-      const VkBufferCopy copy{0, 0, position_bytes};
-      vkCmdCopyBuffer(commands, positions_.buffer, readback.buffer, 1, &copy);
-    }
-    if (color_bytes) {
-      const VkBufferCopy copy{0, position_bytes, color_bytes};
-      vkCmdCopyBuffer(commands, colors_.buffer, readback.buffer, 1, &copy);
-    }
-    if (triangle_bytes) {
-      const VkBufferCopy copy{0, position_bytes + color_bytes, triangle_bytes};
-      vkCmdCopyBuffer(commands, triangles_.buffer, readback.buffer, 1, &copy);
+    auto across = [&](const Buffer& from, uint64_t at, uint64_t bytes) {
+      if (bytes == 0) return;
+      const VkBufferCopy copy{0, at, bytes};
+      vkCmdCopyBuffer(commands, from.buffer, readback.buffer, 1, &copy);
+    };
+    if (slab.ply_rows) {
+      across(vertex_rows_, 0, vertex_row_bytes);
+      across(face_rows_, vertex_row_bytes, face_row_bytes);
+    } else {
+      across(positions_, 0, position_bytes);
+      across(colors_, position_bytes, color_bytes);
+      across(triangles_, position_bytes + color_bytes, triangle_bytes);
     }
     stamp(commands, kCopied);
     barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
