@@ -68,6 +68,18 @@ int gpuSlabThickness(int res) {
   return static_cast<int>(std::clamp<uint64_t>(planes, 5, kMaxSlabThickness + 1)) - 1;
 }
 
+// Marching cubes elsewhere (a GPU's mesher) counts and meshes a slab where it holds it, with a
+// vertex id a grid point on each axis: slabs of about 128 Mi grid points (at res 2048, 31 cell
+// layers; 66 slabs where the plane function's 7-layer blocks made 293, each with its own host round
+// trips and its first plane counted again), at least 16 of them (the last one's rows are written
+// after the device is done), of 4 to 256 layers.
+constexpr uint64_t kMeshSlabCounts = uint64_t{128} << 20;
+int meshSlabThickness(int res, int layers) {
+  const uint64_t budget = kMeshSlabCounts / squared(res);
+  const uint64_t share = (static_cast<uint64_t>(layers) + 15) / 16;
+  return static_cast<int>(std::clamp<uint64_t>(std::min(budget > 0 ? budget - 1 : 0, share), 4, 256));
+}
+
 // The classification pass iterates to the cap: points at the cap are above the level, since
 // min(count, cap) > level exactly when count > level. The grid file needs every count.
 int classificationLimit(const EscapeSurfaceParams& p) {
@@ -592,12 +604,19 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   for (int i = 0; i < res; ++i) values[static_cast<size_t>(i)] = params.axis.value(i);
 
   const unsigned threads = resolveThreads(params.threads);
-  const SlabPlan plan = planSlabs(layers, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
+  SlabPlan plan = planSlabs(layers, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
   const int cap = classificationLimit(params);
-  // Marching cubes elsewhere (a GPU) makes the slabs' counts and meshes, in slab order; else the
-  // plane function's blocks of counts feed the workers, or the workers count with the row function.
-  const bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file &&
-                         params.mesher.takes(res, plan.thickness + 1, cap);
+  // Marching cubes elsewhere (a GPU) makes the slabs' counts and meshes, in slab order, in slabs of
+  // its own thickness where it takes them; else the plane function's blocks of counts feed the
+  // workers, or the workers count with the row function.
+  bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file;
+  if (elsewhere) {
+    const int thickness = std::min(layers, meshSlabThickness(res, layers));
+    if (params.mesher.takes(res, thickness + 1, cap))
+      plan = {thickness, (layers + thickness - 1) / thickness};
+    else
+      elsewhere = params.mesher.takes(res, plan.thickness + 1, cap);
+  }
   // The mesher's noise covers the cells of |v| < 1024 (perlin.cpp's fast path): every coordinate,
   // plus the colours' offsets of up to 200, well inside it.
   const double reach = params.frame == GridFrame::kSeed
