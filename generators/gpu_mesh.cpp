@@ -22,7 +22,7 @@ constexpr uint32_t kBindings = 15;
 constexpr uint32_t kFaceRowBytes = 13;  // the byte 3, three uint ids
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
 // passes_: mesh_slab.comp's passes 0–4, then these.
-constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7;
+constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7, kColoredVertexRowPass = 8;
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
 
 // Push constants of shaders/generate/mesh_slab.comp (std430: the double at 0, then the uints).
@@ -229,8 +229,11 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
     if (Status s = made(kColorPass, kMeshColorsComp, sizeof(kMeshColorsComp), {}); !s) return s.error();
   if (slab.ply_rows) {
     assert(!slab.seam_positions);
-    static constexpr uint32_t kVertices[1] = {0u}, kFaces[1] = {1u};
-    if (Status s = made(kVertexRowPass, kMeshRowsComp, sizeof(kMeshRowsComp), kVertices); !s) return s.error();
+    // kPass and kColors of mesh_rows.comp.
+    static constexpr uint32_t kVertices[2] = {0u, 0u}, kColored[2] = {0u, 1u}, kFaces[2] = {1u, 0u};
+    const uint32_t vertex_pass = slab.noise_colors ? kColoredVertexRowPass : kVertexRowPass;
+    if (Status s = made(vertex_pass, kMeshRowsComp, sizeof(kMeshRowsComp), slab.noise_colors ? kColored : kVertices); !s)
+      return s.error();
     if (Status s = made(kFaceRowPass, kMeshRowsComp, sizeof(kMeshRowsComp), kFaces); !s) return s.error();
   }
   const uint64_t vertex_elements = (2 * static_cast<uint64_t>(planes) - 1) * plane;
@@ -346,7 +349,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
     stamp(commands, kTriangles);
     if (slab.ply_rows) {
       barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
-      if (vertices) dispatch(commands, kVertexRowPass, rowGroups(vertices));
+      if (vertices) dispatch(commands, slab.noise_colors ? kColoredVertexRowPass : kVertexRowPass, rowGroups(vertices));
       if (triangles) dispatch(commands, kFaceRowPass, rowGroups(triangles));
     }
     barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);

@@ -66,8 +66,9 @@ class GpuMesher {
   const VulkanContext& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  // mesh_slab.comp's passes 0–4, mesh_colors.comp, and mesh_rows.comp's vertex and face rows.
-  VkPipeline passes_[8] = {};
+  // mesh_slab.comp's passes 0–4, mesh_colors.comp, and mesh_rows.comp's vertex rows, face rows and
+  // vertex rows with the colours.
+  VkPipeline passes_[9] = {};
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
