@@ -135,39 +135,19 @@ EscapeArena GenerateDevice::arena() {
   };
 }
 
-namespace {
-
-// The device's mesher, made at the first call that needs it.
-Status madeMesher(std::unique_ptr<GpuMesher>& mesher, const VulkanContext& context) {
-  if (mesher) return okStatus();
-  Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(context);
-  if (!made) return made.error();
-  mesher = std::move(*made);
-  return okStatus();
-}
-
-}  // namespace
-
 EscapeSlabMesher GenerateDevice::mesher(const EscapeKernelParams& kernel) {
   EscapeSlabMesher mesher;
   mesher.takes = &GpuMesher::supports;
   mesher.mesh = [self = shared_from_this(), kernel](const EscapeSlab& slab) -> Result<McSlabView> {
-    if (Status s = madeMesher(self->mesher_, *self->context_); !s) return s.error();
+    if (!self->mesher_) {
+      Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*self->context_);
+      if (!made) return made.error();
+      self->mesher_ = std::move(*made);
+    }
     Result<McSlabView> mesh = meshSlabOnDevice(*self->gpu_, *self->mesher_, kernel, slab);
     if (!mesh) return mesh.error();
     if (Status s = self->checkValidation(); !s) return s.error();
     return mesh;
-  };
-  mesher.keeps = [self = shared_from_this()](uint64_t points, int limit) {
-    return madeMesher(self->mesher_, *self->context_).ok() &&
-           points * self->gpu_->deviceBits(limit) / 8 <= self->mesher_->residentLimit();
-  };
-  mesher.count = [self = shared_from_this(), kernel](const EscapeSlab& slab) -> Result<EscapeSlabCounts> {
-    if (Status s = madeMesher(self->mesher_, *self->context_); !s) return s.error();
-    Result<GpuMesher::SlabTotals> totals = countSlabOnDevice(*self->gpu_, *self->mesher_, kernel, slab);
-    if (!totals) return totals.error();
-    if (Status s = self->checkValidation(); !s) return s.error();
-    return EscapeSlabCounts{totals->vertices, totals->triangles, totals->last_plane_vertices};
   };
   mesher.reserve = [self = shared_from_this()](uint64_t vertices, uint64_t triangles, bool colors, bool rows) {
     // After the first mesh call, which made the mesher.

@@ -196,9 +196,7 @@ Result<std::unique_ptr<PlyRowStream>> rowStream(const OutputOptions& o, bool col
 EscapeRowSink rowSink(PlyRowStream& stream, bool colors) {
   EscapeRowSink sink;
   sink.colors = colors;
-  sink.start = [&stream](uint64_t vertices, uint64_t triangles, bool exact) {
-    return stream.start(vertices, triangles, exact);
-  };
+  sink.start = [&stream](uint64_t vertices, uint64_t triangles) { return stream.start(vertices, triangles); };
   sink.slab = [&stream](std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows) {
     return stream.add(vertex_rows, vertices, face_rows);
   };

@@ -96,11 +96,10 @@ class PlyRowStream {
   PlyRowStream(const PlyRowStream&) = delete;
   PlyRowStream& operator=(const PlyRowStream&) = delete;
 
-  // Once, before add: lays the header out for these counts, estimated, or `exact` (the face rows
-  // are then written as they come too, and finish fails unless they were the counts added).
-  Status start(uint64_t vertices, uint64_t faces, bool exact = false);
-  // The next rows: `vertices` vertex rows, written now after the ones before; the face rows, kept
-  // (or, exact, written at their place). From one thread at a time.
+  // Once, before add: lays the header out for these estimated counts.
+  Status start(uint64_t vertices, uint64_t faces);
+  // The next rows: `vertices` vertex rows, written now after the ones before; the face rows, kept.
+  // From one thread at a time.
   Status add(std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows);
   // The face rows and the real header, then the file is committed.
   Status finish();
@@ -108,7 +107,7 @@ class PlyRowStream {
   bool started() const { return started_; }
   bool colors() const { return colors_; }
   uint64_t vertices() const { return vertices_; }
-  uint64_t faces() const { return faces_written_ + faces_.size() / kFaceRowBytes; }
+  uint64_t faces() const { return faces_.size() / kFaceRowBytes; }
   // After finish: whether the vertex rows were moved (the estimate had other digits).
   bool moved() const { return moved_; }
 
@@ -121,9 +120,7 @@ class PlyRowStream {
   bool colors_ = false;
   unsigned threads_ = 0;
   Progress* progress_ = nullptr;
-  bool started_ = false, moved_ = false, exact_ = false;
-  uint64_t exact_vertices_ = 0, exact_faces_ = 0;  // exact: the counts started with
-  uint64_t faces_written_ = 0;                     // exact: the face rows written so far
+  bool started_ = false, moved_ = false;
   bool has_z_ = false;          // some vertex has a z other than +0 (PointSet::isPlanar)
   size_t header_bytes_ = 0;     // the estimated header's length: where the vertex rows begin
   uint64_t vertices_ = 0;

@@ -293,16 +293,10 @@ std::string rowStreamHeader(uint64_t vertices, uint64_t faces, bool colors, bool
 
 }  // namespace
 
-Status PlyRowStream::start(uint64_t vertices, uint64_t faces, bool exact) {
+Status PlyRowStream::start(uint64_t vertices, uint64_t faces) {
   assert(!started_);
   started_ = true;
   header_bytes_ = rowStreamHeader(vertices, faces, colors_, true).size();
-  exact_ = exact;
-  if (exact) {
-    exact_vertices_ = vertices;
-    exact_faces_ = faces;
-    return okStatus();
-  }
   // Address space only: the pages are touched as the rows arrive.
   faces_.reserve(static_cast<size_t>(static_cast<double>(faces) * 1.1 * kFaceRowBytes));
   adviseHugePages(faces_.data(), faces_.capacity());
@@ -319,19 +313,6 @@ Status PlyRowStream::add(std::span<const uint8_t> vertex_rows, uint64_t vertices
     uint64_t z;
     std::memcpy(&z, vertex_rows.data() + v * row_bytes + 16, sizeof z);
     has_z_ = z != 0;
-  }
-  if (exact_) {  // both where they belong, the vertex rows and the face rows on threads of their own
-    const uint64_t face_at = header_bytes_ + exact_vertices_ * row_bytes + faces_written_ * kFaceRowBytes;
-    if (vertices_ + vertices > exact_vertices_ || faces_written_ + face_rows.size() / kFaceRowBytes > exact_faces_)
-      return Error{"cannot write '" + file_.path() + "': more rows than were counted"};
-    Status written[2] = {okStatus(), okStatus()};
-    parallelFor(2, 2, [&](size_t item, unsigned) {
-      written[item] = item == 0 ? file_.writeAt(header_bytes_ + vertices_ * row_bytes, vertex_rows.data(), vertex_rows.size())
-                                : file_.writeAt(face_at, face_rows.data(), face_rows.size());
-    });
-    vertices_ += vertices;
-    faces_written_ += face_rows.size() / kFaceRowBytes;
-    return written[0] ? written[1] : written[0];
   }
   const size_t at = faces_.size();
   faces_.resize(at + face_rows.size());  // not zeroed (DefaultInitAllocator)
@@ -355,29 +336,23 @@ Status PlyRowStream::finish() {
   assert(started_);
   const size_t row_bytes = colors_ ? 27 : 24;
   const uint64_t vertex_bytes = vertices_ * row_bytes;
-  if (exact_ && (vertices_ != exact_vertices_ || faces_written_ != exact_faces_))
-    return Error{"cannot write '" + file_.path() + "': " + std::to_string(vertices_) + " vertices and " +
-                 std::to_string(faces_written_) + " faces made where " + std::to_string(exact_vertices_) + " and " +
-                 std::to_string(exact_faces_) + " were counted"};
   const std::string header = rowStreamHeader(vertices_, faces(), colors_, has_z_);
   const bool move = header.size() != header_bytes_;
-  // The rows written so far: the vertex rows, and, exact, the face rows after them.
-  const uint64_t written = vertex_bytes + faces_written_ * kFaceRowBytes;
-  if (progress_) progress_->start("writing " + file_.path(), faces_.size() / kFaceRowBytes + (move ? written : 0));
-  // Moves them from header_bytes_ to header.size(), a block at a time from the end that goes
-  // first, so that no block is written over before it is read.
+  if (progress_) progress_->start("writing " + file_.path(), faces() + (move ? vertices_ : 0));
+  // Moves the vertex rows from header_bytes_ to header.size(), a block at a time from the end that
+  // goes first, so that no block is written over before it is read.
   if (move) {
     moved_ = true;
     constexpr uint64_t kBlock = uint64_t{64} << 20;
-    std::vector<char> block(static_cast<size_t>(std::min(kBlock, std::max<uint64_t>(written, 1))));
+    std::vector<char> block(static_cast<size_t>(std::min(kBlock, std::max<uint64_t>(vertex_bytes, 1))));
     const bool later = header.size() > header_bytes_;
-    for (uint64_t done = 0; done < written;) {
-      const uint64_t n = std::min(kBlock, written - done);
-      const uint64_t from = later ? written - done - n : done;  // within the rows
+    for (uint64_t done = 0; done < vertex_bytes;) {
+      const uint64_t n = std::min(kBlock, vertex_bytes - done);
+      const uint64_t from = later ? vertex_bytes - done - n : done;  // within the rows
       if (Status s = file_.readAt(header_bytes_ + from, block.data(), n); !s) return s;
       if (Status s = file_.writeAt(header.size() + from, block.data(), n); !s) return s;
       done += n;
-      if (progress_) progress_->advance(n);
+      if (progress_) progress_->advance(n / row_bytes);
     }
   }
   if (Status s = file_.writeAt(0, header.data(), header.size()); !s) return s;
@@ -387,7 +362,7 @@ Status PlyRowStream::finish() {
     if (Status s = file_.writeAt(header.size() + vertex_bytes + at, faces_.data() + at, n); !s) return s;
     if (progress_) progress_->advance(n / kFaceRowBytes);
   }
-  if (Status s = file_.resize(header.size() + written + faces_.size()); !s) return s;
+  if (Status s = file_.resize(header.size() + vertex_bytes + faces_.size()); !s) return s;
   if (progress_) progress_->finish();
   return file_.commit();
 }

@@ -756,32 +756,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     slab.noise_colors = noise_elsewhere;
     return slab;
   };
-  // Where the mesher can keep the whole grid's counts, every slab is counted first: the header's
-  // counts are then exact and each slab's face rows are written as they come too.
-  uint64_t grid_points = 0;
-  for (size_t s = 0; s < pending.size(); ++s)
-    grid_points += static_cast<uint64_t>(slabLast(s) - slabFirst(s) + 1) * squared(res);
-  const bool counted = rows && params.mesher.count && params.mesher.keeps && params.mesher.keeps(grid_points, cap);
-  if (counted) {
-    uint64_t vertices = 0, triangles = 0, most_vertices = 0, most_triangles = 0;
-    if (params.progress) params.progress->start(params.name + ": counting", static_cast<uint64_t>(layers));
-    for (size_t s = 0; s < pending.size(); ++s) {
-      if (interrupted()) return interruptedError();
-      const EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
-      Result<EscapeSlabCounts> c = params.mesher.count(slab);
-      if (!c) return c.error();
-      vertices += c->vertices - (slab.owns_last_plane ? 0 : c->last_plane_vertices);
-      triangles += c->triangles;
-      most_vertices = std::max(most_vertices, c->vertices);
-      most_triangles = std::max(most_triangles, c->triangles);
-      if (params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
-    }
-    if (params.progress) params.progress->finish();
-    if (vertices > UINT32_MAX) return Error{what + ": more than 2^32 vertices", ExitCode::kResourceLimit};
-    if (params.mesher.reserve)
-      if (Status s = params.mesher.reserve(most_vertices, most_triangles, noise_elsewhere, true); !s) return s.error();
-    if (Status s = params.rows.start(vertices, triangles, true); !s) return s.error();
-  } else if (rows) {
+  if (rows) {
     // The header's counts from a sample of one cell layer in 32 (at most 32 layers), meshed as
     // slabs of their own: about 1/32 more device time.
     const int samples = std::min(layers, 32);
@@ -812,7 +787,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     if (interrupted()) return interruptedError();
     const double scale = static_cast<double>(layers) / samples;
     if (Status s = params.rows.start(static_cast<uint64_t>(std::llround(sampled_vertices * scale)),
-                                     static_cast<uint64_t>(std::llround(sampled_triangles * scale)), false);
+                                     static_cast<uint64_t>(std::llround(sampled_triangles * scale)));
         !s)
       return s.error();
   }

@@ -103,11 +103,6 @@ struct EscapeSlab {
 // the plane function, when `takes` the run's largest slab (planes of res² counts up to limit).
 // `mesh` is called for the slabs in order, from one thread; its view stays valid until the second
 // call after it returns (the caller copies one slab out while the next is made).
-struct EscapeSlabCounts {
-  uint64_t vertices = 0;             // the slab's, its last plane's in-plane vertices among them
-  uint64_t triangles = 0;
-  uint64_t last_plane_vertices = 0;  // the in-plane vertices of its last plane (the next slab's first)
-};
 struct EscapeSlabMesher {
   std::function<bool(int res, int planes, int limit)> takes;
   std::function<Result<McSlabView>(const EscapeSlab&)> mesh;
@@ -115,12 +110,6 @@ struct EscapeSlabMesher {
   // with colours and as rows as EscapeSlab says (else it grows as the slabs do, which on a GPU
   // costs a host-visible allocation on the way from one slab's passes to the next).
   std::function<Status(uint64_t vertices, uint64_t triangles, bool colors, bool rows)> reserve;
-  // Optional, both or neither: whether the mesher can keep the counts of `points` grid points (up
-  // to `limit`) at once, and `count`, the first half of `mesh` alone: the slab's counts made and
-  // counted, and kept where they are until `mesh` is called for the same slab. A whole mesh's
-  // counts are then known before any of it is made.
-  std::function<bool(uint64_t points, int limit)> keeps;
-  std::function<Result<EscapeSlabCounts>(const EscapeSlab&)> count;
 };
 
 // Where a whole surface meshed elsewhere goes as a binary PLY's rows as they are made, in place of
@@ -129,10 +118,9 @@ struct EscapeSlabMesher {
 // set returned is empty, and `start` has been called.
 struct EscapeRowSink {
   bool colors = false;  // the vertex rows carry the seed noise colours (EscapeSlab::noise_colors)
-  // Once, before any slab: the whole mesh's vertices and triangles, `exact` (the mesher counted
-  // every slab first: EscapeSlabMesher::count) or estimated from a sample of its cell layers
-  // (within a few percent).
-  std::function<Status(uint64_t vertices, uint64_t triangles, bool exact)> start;
+  // Once, before any slab: the whole mesh's vertices and triangles, estimated from a sample of its
+  // cell layers (within a few percent; exact when every layer is sampled).
+  std::function<Status(uint64_t vertices, uint64_t triangles)> start;
   // Each slab's rows, in slab order, from one thread (not the mesher's); the face rows' ids are
   // the whole mesh's.
   std::function<Status(std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows)>

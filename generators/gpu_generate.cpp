@@ -367,31 +367,11 @@ Result<uint8_t*> GpuEscape::arena(uint64_t bytes) {
   return static_cast<uint8_t*>(arena_.mapped);
 }
 
-Result<GpuMesher::SlabTotals> countSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
-                                                const EscapeSlab& slab) {
-  const int planes = slab.last - slab.first + 1;
-  assert(GpuMesher::supports(slab.res, planes, slab.limit));
-  const uint32_t bits = escape.deviceBits(slab.limit);
-  Result<const Buffer*> counts =
-      mesher.residentCounts(slab.first, static_cast<uint64_t>(planes) * squaredResolution(slab.res) * bits / 8);
-  if (!counts) return counts.error();
-  if (Status s = escape.escapeInto(kernel, *slab.values, slab.first, planes, slab.limit, **counts); !s) return s.error();
-  Result<GpuMesher::SlabTotals> totals = mesher.countSlab(slab, bits, **counts);
-  const Status settled = escape.settle();
-  if (totals && !settled) return settled.error();
-  return totals;
-}
-
 Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
                                     const EscapeSlab& slab) {
   const int planes = slab.last - slab.first + 1;
   assert(GpuMesher::supports(slab.res, planes, slab.limit));
   const uint32_t bits = escape.deviceBits(slab.limit);
-  if (const Buffer* kept = mesher.resident(slab.first)) {  // counted before (countSlabOnDevice)
-    Result<McSlabView> mesh = mesher.meshSlab(slab, bits, kept);
-    mesher.dropResident(slab.first);
-    return mesh;
-  }
   Result<const Buffer*> counts = mesher.countsBuffer(static_cast<uint64_t>(planes) * squaredResolution(slab.res) * bits / 8);
   if (!counts) return counts.error();
   if (Status s = escape.escapeInto(kernel, *slab.values, slab.first, planes, slab.limit, **counts); !s) return s.error();

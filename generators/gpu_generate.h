@@ -151,11 +151,6 @@ class GpuEscape {
 // slab's mesh on the device: its counts by `escape` into the mesher's memory (escapeInto), then
 // marching cubes by `mesher`; nothing crosses to the host but the mesh. The slab must be one the
 // mesher takes (GpuMesher::supports). The body of an EscapeSlabMesher; one thread at a time.
-// The first half of meshSlabOnDevice alone: the slab's counts made into memory the mesher keeps
-// (residentCounts) and counted (countSlab); meshSlabOnDevice then meshes them without making them
-// again, and frees them.
-Result<GpuMesher::SlabTotals> countSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
-                                                const EscapeSlab& slab);
 Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
                                     const EscapeSlab& slab);
 

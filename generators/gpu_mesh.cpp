@@ -28,7 +28,7 @@ enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopie
 // Push constants of shaders/generate/mesh_slab.comp (std430: the double at 0, then the uints).
 struct MeshPush {
   double step;
-  uint32_t n, plane, planes, first, first_count, bits, above_at, stride, seed_frame;
+  uint32_t n, plane, planes, first, word_offset, bits, above_at, stride, seed_frame;
   uint32_t vertex_elements, triangle_elements, vertex_group_count, triangle_group_count, groups_x, pad;
   uint32_t rows, row_bytes, faces, vertex_base;
 };
@@ -109,7 +109,6 @@ Status GpuMesher::init() {
 
 GpuMesher::~GpuMesher() {
   const VkDevice device = context_.device;
-  for (auto& [key, b] : resident_) destroyBuffer(context_, b);
   for (Buffer* b : {&counts_, &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
                     &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_, &face_rows_, &readback_[0],
                     &readback_[1]})
@@ -172,58 +171,17 @@ Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, bo
   return okStatus();
 }
 
-Result<const Buffer*> GpuMesher::residentCounts(int key, uint64_t bytes) {
-  dropResident(key);
-  Result<Buffer> created = createBuffer(context_, std::max<uint64_t>(bytes, 16), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                        false, "escape counts kept on the device");
-  if (!created) return created.error();
-  return &(resident_[key] = *created);
-}
-
-const Buffer* GpuMesher::resident(int key) const {
-  auto found = resident_.find(key);
-  return found == resident_.end() ? nullptr : &found->second;
-}
-
-void GpuMesher::dropResident(int key) {
-  auto found = resident_.find(key);
-  if (found == resident_.end()) return;
-  destroyBuffer(context_, found->second);
-  resident_.erase(found);
-}
-
-uint64_t GpuMesher::residentLimit() const {
-  uint64_t heap = 0;
-  for (uint32_t h = 0; h < context_.memory.memoryHeapCount; ++h)
-    if (context_.memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
-      heap = std::max<uint64_t>(heap, context_.memory.memoryHeaps[h].size);
-  uint64_t limit = heap / 2;
-  if (context_.device_memory_budget) limit = std::min(limit, context_.device_memory_budget / 2);
-  return limit;
-}
-
 Result<const Buffer*> GpuMesher::countsBuffer(uint64_t bytes) {
   if (Status s = ensure(counts_, bytes, false, "escape counts of a slab"); !s) return s.error();
   return &counts_;
 }
 
-Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, const Buffer* counts) {
-  return run(slab, bits, counts ? *counts : counts_, nullptr);
-}
-
-Result<GpuMesher::SlabTotals> GpuMesher::countSlab(const EscapeSlab& slab, uint32_t bits, const Buffer& counts) {
-  SlabTotals totals;
-  Result<McSlabView> counted = run(slab, bits, counts, &totals);
-  if (!counted) return counted.error();
-  return totals;
-}
-
-Result<McSlabView> GpuMesher::run(const EscapeSlab& slab, uint32_t bits, const Buffer& counts, SlabTotals* count_only) {
+Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   const int planes = slab.last - slab.first + 1;
   assert(supports(slab.res, planes, slab.limit) && slab.values && slab.values->size() == static_cast<size_t>(slab.res));
   assert(bits == 8 || bits == 32);
   const uint64_t n = static_cast<uint64_t>(slab.res), plane = n * n;
-  assert(counts.size * 8 >= static_cast<uint64_t>(planes) * plane * bits);
+  assert(counts_.size * 8 >= static_cast<uint64_t>(planes) * plane * bits);
 
   // The inputs beside the counts: the axis, and the fractions t of every pair of counts (the CPU's
   // division).
@@ -254,7 +212,7 @@ Result<McSlabView> GpuMesher::run(const EscapeSlab& slab, uint32_t bits, const B
   push.plane = static_cast<uint32_t>(plane);
   push.planes = static_cast<uint32_t>(planes);
   push.first = static_cast<uint32_t>(slab.first);
-  push.first_count = 0;
+  push.word_offset = 0;
   push.bits = bits;
   push.above_at = slab.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(slab.level));
   push.stride = stride;
@@ -300,7 +258,7 @@ Result<McSlabView> GpuMesher::run(const EscapeSlab& slab, uint32_t bits, const B
   if (Status s = ensure(face_rows_, 4, false, "slab face rows"); !s) return s.error();
   auto bind = [&] {
     const VkDescriptorBufferInfo infos[kBindings] = {
-        {counts.buffer, 0, VK_WHOLE_SIZE},     {axis_.buffer, 0, VK_WHOLE_SIZE},
+        {counts_.buffer, 0, VK_WHOLE_SIZE},    {axis_.buffer, 0, VK_WHOLE_SIZE},
         {fractions_.buffer, 0, VK_WHOLE_SIZE}, {cases_.buffer, 0, VK_WHOLE_SIZE},
         {vertex_groups_.buffer, 0, VK_WHOLE_SIZE}, {triangle_groups_.buffer, 0, VK_WHOLE_SIZE},
         {totals_.buffer, 0, VK_WHOLE_SIZE},    {ids_y_.buffer, 0, VK_WHOLE_SIZE},
@@ -335,23 +293,6 @@ Result<McSlabView> GpuMesher::run(const EscapeSlab& slab, uint32_t bits, const B
     if (queries_) vkCmdResetQueryPool(commands, queries_, 0, kStamps);
     barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
     stamp(commands, kStart);
-    if (count_only) {
-      // The last plane's in-plane vertices: pass 0 over that plane alone, pass 2's vertex half,
-      // the total kept in totals[2] while the slab's own are counted.
-      const MeshPush whole = push;
-      push.planes = 1;
-      push.first_count = static_cast<uint32_t>((planes - 1) * plane);
-      push.vertex_elements = static_cast<uint32_t>(plane);
-      push.vertex_group_count = static_cast<uint32_t>((plane + kGroupElements - 1) / kGroupElements);
-      dispatch(commands, 0, push.vertex_group_count);
-      barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
-      dispatch(commands, 2, 1);
-      barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
-      const VkBufferCopy copy{0, 2 * sizeof(uint32_t), sizeof(uint32_t)};
-      vkCmdCopyBuffer(commands, totals_.buffer, totals_.buffer, 1, &copy);
-      barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
-      push = whole;
-    }
     dispatch(commands, 0, push.vertex_group_count);
     dispatch(commands, 1, push.triangle_group_count);
     barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
@@ -364,16 +305,6 @@ Result<McSlabView> GpuMesher::run(const EscapeSlab& slab, uint32_t bits, const B
   uint32_t totals[4];
   std::memcpy(totals, totals_.mapped, sizeof totals);
   const uint64_t vertices = totals[0], triangles = totals[1];
-  if (count_only) {
-    *count_only = {vertices, triangles, totals[2]};
-    if (queries_) {  // the counting's time (the later stamps are not written)
-      uint64_t ticks[2] = {};
-      VK_TRY(vkGetQueryPoolResults(context_.device, queries_, kStart, 2, sizeof(ticks), ticks, sizeof(uint64_t),
-                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-      times_.scan += static_cast<double>(ticks[1] - ticks[0]) * context_.facts.timestamp_period_ns * 1e-6;
-    }
-    return McSlabView{};
-  }
 
   // The vertices and triangles into device memory, then copied across to host-visible memory by
   // the transfer engine (a shader's scattered writes across the bus were several times slower).

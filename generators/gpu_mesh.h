@@ -13,7 +13,6 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -44,26 +43,7 @@ class GpuMesher {
   // countsBuffer holds, `bits` (8 or 32) each. The view is of host-visible memory that stays as it
   // is until the second call after this one (two buffers, used in turn). With slab.ply_rows, the
   // view has the binary PLY rows instead (McSlabView::vertex_rows and face_rows).
-  // With `counts`, the slab's counts are there instead of in countsBuffer.
-  Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits, const Buffer* counts = nullptr);
-
-  // The first half of meshSlab alone, for a slab whose counts stay in `counts` until it is meshed:
-  // its vertices (its last plane's in-plane ones among them) and triangles, and the in-plane
-  // vertices of its last plane (the next slab's first), so that a whole mesh's counts are known
-  // before any of it is made.
-  struct SlabTotals {
-    uint64_t vertices = 0, triangles = 0, last_plane_vertices = 0;
-  };
-  Result<SlabTotals> countSlab(const EscapeSlab& slab, uint32_t bits, const Buffer& counts);
-
-  // Counts kept on the device from countSlab to meshSlab, by a key (the slab's first plane): made
-  // by residentCounts (`bytes` of device memory), found by resident (null: none), freed by
-  // dropResident. residentLimit: the bytes of them the device should hold at once, half its
-  // largest device-local heap, within --max-device-memory.
-  Result<const Buffer*> residentCounts(int key, uint64_t bytes);
-  const Buffer* resident(int key) const;
-  void dropResident(int key);
-  uint64_t residentLimit() const;
+  Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits);
 
   // Grows the slab buffers for slabs of up to these counts (meshSlab grows them as needed).
   Status reserve(uint64_t vertices, uint64_t triangles, bool colors, bool rows);
@@ -82,7 +62,6 @@ class GpuMesher {
   Status ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what);
   void stamp(VkCommandBuffer commands, uint32_t query) const;
   Status readStamps();
-  Result<McSlabView> run(const EscapeSlab& slab, uint32_t bits, const Buffer& counts, SlabTotals* count_only);
 
   const VulkanContext& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
@@ -95,7 +74,6 @@ class GpuMesher {
   VkQueryPool queries_ = VK_NULL_HANDLE;
   Buffer counts_, axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
   Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_, vertex_rows_, face_rows_;
-  std::map<int, Buffer> resident_;
   Buffer readback_[2];  // host-visible, used in turn: a slab's positions, colours and triangles
   unsigned next_readback_ = 0;
   std::vector<double> axis_values_;       // what axis_ holds

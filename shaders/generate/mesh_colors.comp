@@ -17,7 +17,7 @@ layout(std430, set = 0, binding = 12) writeonly buffer Colors { float colors[]; 
 // mesh_slab.comp's push constants; this shader reads groups_x and rows.
 layout(push_constant) uniform Push {
   double step;
-  uint n, plane, planes, first, first_count, bits, above_at, stride, seed_frame;
+  uint n, plane, planes, first, word_offset, bits, above_at, stride, seed_frame;
   uint vertex_elements, triangle_elements, vertex_group_count, triangle_group_count;
   uint groups_x;  // groups along x of this dispatch (a group is y · groups_x + x)
   uint pad;

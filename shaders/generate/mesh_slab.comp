@@ -51,7 +51,7 @@ layout(push_constant) uniform Push {
   uint plane;             // n²
   uint planes;            // the slab's planes
   uint first;             // the grid index of its plane 0
-  uint first_count;       // the count of its plane 0's first point in `counts`
+  uint word_offset;       // of its counts in `counts`
   uint bits;              // 8 or 32 bits a count
   uint above_at;          // a point is above the level when its count is greater
   uint stride;            // fractions[v1 · stride + v2]
@@ -65,10 +65,10 @@ layout(push_constant) uniform Push {
 } pc;
 
 uint countAt(uint q, uint point) {
-  uint i = pc.first_count + q * pc.plane + point;
-  if (pc.bits == 32u) return counts[i];
+  uint i = q * pc.plane + point;
+  if (pc.bits == 32u) return counts[pc.word_offset + i];
   uint per = 32u / pc.bits;
-  return (counts[i / per] >> ((i % per) * pc.bits)) & ((1u << pc.bits) - 1u);
+  return (counts[pc.word_offset + i / per] >> ((i % per) * pc.bits)) & ((1u << pc.bits) - 1u);
 }
 uint aboveAt(uint q, uint point) { return countAt(q, point) > pc.above_at ? 1u : 0u; }
 
