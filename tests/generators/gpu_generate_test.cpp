@@ -10,6 +10,7 @@
 #include <random>
 #include <span>
 
+#include "converters/ply.h"
 #include "generators/julia.h"
 #include "generators/mandelbrot2d.h"
 #include "generators/mandelbulb.h"
@@ -19,6 +20,7 @@
 #include "vulkan/shader.h"
 
 #include "shaders/exact_fp64_test.comp.h"
+#include "test_support.h"
 
 namespace dpoint {
 namespace {
@@ -426,6 +428,50 @@ TEST_F(GpuGenerate, marchingCubesOnTheDeviceEqualsTheHosts) {
   ASSERT_FALSE(failed.ok());
   EXPECT_EQ(failed.error().code, ExitCode::kNoDevice);
   EXPECT_EQ(failed.error().message, "the device was lost");
+}
+
+// The mesh as the device's PLY rows (EscapeRowSink), written by a PlyRowStream: writePly's file of
+// the host's mesh, byte for byte, with the noise colours and without, odd and even resolutions
+// (rows of 27 and 24 bytes, slabs whose rows start anywhere in a word).
+TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
+  Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*context_);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  GpuMesher& mesher = **made;
+  test::TempDir dir;
+  for (int res : {44, 45}) {
+    for (bool colors : {true, false}) {
+      SCOPED_TRACE("res " + std::to_string(res) + (colors ? ", colours" : ""));
+      MandelbulbParams bulb;
+      bulb.resolution = res;
+      bulb.variant = MandelbulbVariant::kFast;
+      Result<PointSet> expected = generateMandelbulb(bulb);
+      ASSERT_TRUE(expected.ok());
+      PlyWriteOptions write;
+      if (colors) write.colors_of = seedColors;
+      ASSERT_TRUE(writePly(dir.file("host.ply"), *expected, write).ok());
+
+      bulb.planes = planes(mandelbulb(), GridAxis{res, -1.5, 1.5}, true);
+      bulb.full_counts = true;
+      bulb.noise_colors = colors;
+      GpuEscape* escape = packed_.get();
+      bulb.mesher.takes = &GpuMesher::supports;
+      bulb.mesher.mesh = [&](const EscapeSlab& slab) { return meshSlabOnDevice(*escape, mesher, mandelbulb(), slab); };
+      bulb.mesher.reserve = [&](uint64_t v, uint64_t t, bool c, bool r) { return mesher.reserve(v, t, c, r); };
+      Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("device.ply"), colors, 0, nullptr);
+      ASSERT_TRUE(stream.ok() && *stream);
+      PlyRowStream& to = **stream;
+      bulb.rows.colors = colors;
+      bulb.rows.start = [&](uint64_t v, uint64_t t) { return to.start(v, t); };
+      bulb.rows.slab = [&](std::span<const uint8_t> v, uint64_t n, std::span<const uint8_t> f) { return to.add(v, n, f); };
+      Result<PointSet> got = generateMandelbulb(bulb);
+      ASSERT_TRUE(got.ok()) << got.error().message;
+      EXPECT_EQ(got->size(), 0u);  // the rows went to the stream
+      ASSERT_TRUE(to.started());
+      ASSERT_TRUE(to.finish().ok());
+      EXPECT_EQ(to.vertices(), expected->size());
+      EXPECT_TRUE(test::readFile(dir.file("device.ply")) == test::readFile(dir.file("host.ply")));
+    }
+  }
 }
 
 bool sameBits(const PointSet& a, const PointSet& b) {
