@@ -11,7 +11,7 @@ void addGenerateDeviceOptions(CLI::App& command, GenerateDeviceOptions& options,
       .add_option("--device", options.device,
                   "Where the escape counts run: auto (a GPU with fp64 if there is one, else the CPU), none (the "
                   "CPU),\ncpu (lavapipe) or an index from `dpoint devices`; the counts are the CPU's bit for bit. "
-                  "Marching cubes\nand the noise colours run there too on a GPU (--mesh); writing stays on the CPU" +
+                  "Marching cubes,\nthe noise colours and a .ply's rows are made there too on a GPU (--mesh), and the rows written as\nthey come" +
                       (cpu_only_note.empty() ? std::string() : ".\n" + cpu_only_note))
       ->default_val("auto");
   command.add_flag("--validate", options.validate,
