@@ -77,17 +77,9 @@ Status GpuMesher::init() {
     passes_[pass] = *p;
   }
 
-  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings};
-  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = 1;
-  pool_info.pPoolSizes = &pool_size;
-  VK_TRY(vkCreateDescriptorPool(context_.device, &pool_info, nullptr, &pool_));
-  VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  allocate.descriptorPool = pool_;
-  allocate.descriptorSetCount = 1;
-  allocate.pSetLayouts = &set_layout_;
-  VK_TRY(vkAllocateDescriptorSets(context_.device, &allocate, &set_));
+  Result<VkDescriptorSet> set = storageSet(context_, set_layout_, kBindings, pool_);
+  if (!set) return set.error();
+  set_ = *set;
 
   // The case table: for mask m, 16 bytes: the triangle count, then its 3·count cube edges; then
   // the noise's permutation (a word each) and gradients (a float each).

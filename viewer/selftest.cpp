@@ -4,6 +4,7 @@
 
 #include "vulkan/buffers.h"
 #include "viewer/pipelines.h"
+#include "vulkan/shader.h"
 
 #include "shaders/selftest.comp.h"
 
@@ -59,28 +60,13 @@ Result<SelfTest> runPrecisionSelfTest(const VulkanContext& context) {
     pipeline_info.stage.pName = "main";
     pipeline_info.layout = layout;
     VK_TRY(vkCreateComputePipelines(context.device, context.pipeline_cache, 1, &pipeline_info, nullptr, &pipeline));
-    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
-    VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    pool_info.maxSets = 1;
-    pool_info.poolSizeCount = 1;
-    pool_info.pPoolSizes = &pool_size;
-    VK_TRY(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &pool));
-    VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    allocate.descriptorPool = pool;
-    allocate.descriptorSetCount = 1;
-    allocate.pSetLayouts = &set_layout;
-    VkDescriptorSet set = VK_NULL_HANDLE;
-    VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &set));
-    VkDescriptorBufferInfo buffer_info{data->buffer, 0, VK_WHOLE_SIZE};
-    VkWriteDescriptorSet write = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    write.dstSet = set;
-    write.descriptorCount = 1;
-    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    write.pBufferInfo = &buffer_info;
-    vkUpdateDescriptorSets(context.device, 1, &write, 0, nullptr);
+    Result<VkDescriptorSet> set = storageSet(context, set_layout, 1, pool);
+    if (!set) return set.error();
+    const VkDescriptorBufferInfo buffer_info[1] = {{data->buffer, 0, VK_WHOLE_SIZE}};
+    writeBufferDescriptors(context, *set, buffer_info);
     return submitOnce(context, [&](VkCommandBuffer commands) {
       vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-      vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+      vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &*set, 0, nullptr);
       vkCmdDispatch(commands, 1, 1, 1);
       VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;

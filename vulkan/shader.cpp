@@ -44,6 +44,23 @@ Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
   return layout;
 }
 
+Result<VkDescriptorSet> storageSet(const VulkanContext& context, VkDescriptorSetLayout layout, uint32_t descriptors,
+                                   VkDescriptorPool& pool) {
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, descriptors};
+  VkDescriptorPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &size;
+  VK_TRY(vkCreateDescriptorPool(context.device, &pool_info, nullptr, &pool));
+  VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  allocate.descriptorPool = pool;
+  allocate.descriptorSetCount = 1;
+  allocate.pSetLayouts = &layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &set));
+  return set;
+}
+
 Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
                                         VkShaderStageFlags stages) {
   VkPushConstantRange push{stages, 0, push_bytes};

@@ -23,6 +23,11 @@ Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
 Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
                                         VkShaderStageFlags stages);
 
+// A descriptor pool for one set of `descriptors` storage buffers (into `pool`, which the caller
+// destroys, also when the set cannot be allocated), and that set of `layout`.
+Result<VkDescriptorSet> storageSet(const VulkanContext& context, VkDescriptorSetLayout layout, uint32_t descriptors,
+                                   VkDescriptorPool& pool);
+
 // A compute pipeline of the SPIR-V `code` (entry point main) with `layout`, and the 32-bit
 // specialization constants 0, 1, … given (none: the shader's defaults).
 Result<VkPipeline> createComputePipeline(const VulkanContext& context, const uint32_t* code, size_t bytes,
