@@ -193,12 +193,12 @@ Result<std::unique_ptr<PlyRowStream>> rowStream(const OutputOptions& o, bool col
   return PlyRowStream::create(o.output, colors, o.common.threads, &progress);
 }
 
-EscapeRowSink rowSink(PlyRowStream& stream, bool colors) {
+EscapeRowSink rowSink(PlyRowStream& stream) {
   EscapeRowSink sink;
-  sink.colors = colors;
+  sink.colors = stream.colors();
   sink.start = [&stream](uint64_t vertices, uint64_t triangles) { return stream.start(vertices, triangles); };
-  sink.slab = [&stream](std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows) {
-    return stream.add(vertex_rows, vertices, face_rows);
+  sink.slab = [&stream](std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows) {
+    return stream.add(vertex_rows, face_rows);
   };
   return sink;
 }

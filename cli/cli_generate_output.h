@@ -71,7 +71,7 @@ bool canStreamRows(const OutputOptions& o, PointOrder order, bool auto_noise);
 // The stream and the generator's sink that feeds it (generators/escape_grid.h); the stream is null
 // where the output takes no positional writes (a pipe).
 Result<std::unique_ptr<PlyRowStream>> rowStream(const OutputOptions& o, bool colors, Progress& progress);
-EscapeRowSink rowSink(PlyRowStream& stream, bool colors);
+EscapeRowSink rowSink(PlyRowStream& stream);
 // finish for a set whose rows went to `stream` (started): its faces and header, the time line.
 int finishRows(Result<PointSet> generated, PlyRowStream& stream, const OutputOptions& o, PhaseClock& clock);
 // A set whose points are a function of their index (random2d): `count` of them, point i at at(i),

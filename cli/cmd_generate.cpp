@@ -64,7 +64,7 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
           Result<std::unique_ptr<PlyRowStream>> stream = rowStream(o->out, noise_made, progress);
           if (!stream) return reportError(stream.error());
           if (*stream) {
-            params->rows = rowSink(**stream, noise_made);
+            params->rows = rowSink(**stream);
             Result<PointSet> generated = generate(*params);
             if ((*stream)->started()) return finishRows(std::move(generated), **stream, o->out, clock);
             return finish(std::move(generated), o->out, *order, auto_noise, progress, clock, noise_made);

@@ -98,14 +98,15 @@ class PlyRowStream {
 
   // Once, before add: lays the header out for these estimated counts.
   Status start(uint64_t vertices, uint64_t faces);
-  // The next rows: `vertices` vertex rows, written now after the ones before; the face rows, kept.
-  // From one thread at a time.
-  Status add(std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows);
+  // The next rows: the vertex rows, written now after the ones before; the face rows, kept. Whole
+  // rows (rowBytes() and kFaceRowBytes each). From one thread at a time.
+  Status add(std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows);
   // The face rows and the real header, then the file is committed.
   Status finish();
 
   bool started() const { return started_; }
   bool colors() const { return colors_; }
+  size_t rowBytes() const { return colors_ ? 27 : 24; }  // a vertex row: x, y, z, and red, green, blue
   uint64_t vertices() const { return vertices_; }
   uint64_t faces() const { return faces_.size() / kFaceRowBytes; }
   // After finish: whether the vertex rows were moved (the estimate had other digits).

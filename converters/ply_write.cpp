@@ -303,11 +303,11 @@ Status PlyRowStream::start(uint64_t vertices, uint64_t faces) {
   return okStatus();
 }
 
-Status PlyRowStream::add(std::span<const uint8_t> vertex_rows, uint64_t vertices,
-                         std::span<const uint8_t> face_rows) {
+Status PlyRowStream::add(std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows) {
   assert(started_);
-  const size_t row_bytes = colors_ ? 27 : 24;
-  assert(vertex_rows.size() == vertices * row_bytes && face_rows.size() % kFaceRowBytes == 0);
+  const size_t row_bytes = rowBytes();
+  assert(vertex_rows.size() % row_bytes == 0 && face_rows.size() % kFaceRowBytes == 0);
+  const uint64_t vertices = vertex_rows.size() / row_bytes;
   // isPlanar's test, usually settled by the first row: a z that is not +0.
   for (uint64_t v = 0; v < vertices && !has_z_; ++v) {
     uint64_t z;
@@ -334,7 +334,7 @@ Status PlyRowStream::add(std::span<const uint8_t> vertex_rows, uint64_t vertices
 
 Status PlyRowStream::finish() {
   assert(started_);
-  const size_t row_bytes = colors_ ? 27 : 24;
+  const size_t row_bytes = rowBytes();
   const uint64_t vertex_bytes = vertices_ * row_bytes;
   const std::string header = rowStreamHeader(vertices_, faces(), colors_, has_z_);
   const bool move = header.size() != header_bytes_;

@@ -813,10 +813,9 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
         fail(Error{what + ": more than 2^32 vertices", ExitCode::kResourceLimit});
         break;
       }
-      const uint64_t slab_vertices = view->row_vertices;
-      vertices += slab_vertices;
-      writing = std::async(std::launch::async, [&, s, v = *view, slab_vertices] {
-        Status w = params.rows.slab(v.vertex_rows, slab_vertices, v.face_rows);
+      vertices += view->row_vertices;
+      writing = std::async(std::launch::async, [&, s, v = *view] {
+        Status w = params.rows.slab(v.vertex_rows, v.face_rows);
         if (w && params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
         return w;
       });

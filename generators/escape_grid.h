@@ -123,8 +123,7 @@ struct EscapeRowSink {
   std::function<Status(uint64_t vertices, uint64_t triangles)> start;
   // Each slab's rows, in slab order, from one thread (not the mesher's); the face rows' ids are
   // the whole mesh's.
-  std::function<Status(std::span<const uint8_t> vertex_rows, uint64_t vertices, std::span<const uint8_t> face_rows)>
-      slab;
+  std::function<Status(std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows)> slab;
 };
 
 struct EscapeSurfaceParams {

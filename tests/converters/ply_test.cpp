@@ -1284,7 +1284,7 @@ TEST(Ply, rowStreamWritesWritePlysFileWhateverTheEstimate) {
         for (const size_t piece : {size_t{0}, size_t{1}, size_t{300}, n - 301}) {
           const size_t fs = piece == n - 301 ? faces - f : faces / 3;
           ASSERT_TRUE((*stream)
-                          ->add({rows + v * row_bytes, piece * row_bytes}, piece,
+                          ->add({rows + v * row_bytes, piece * row_bytes},
                                 {face_rows + f * PlyRowStream::kFaceRowBytes, fs * PlyRowStream::kFaceRowBytes})
                           .ok());
           v += piece;
@@ -1312,7 +1312,7 @@ TEST(Ply, rowStreamAbandonedLeavesNothing) {
     ASSERT_TRUE(stream.ok() && *stream);
     ASSERT_TRUE((*stream)->start(10, 10).ok());
     const std::vector<uint8_t> rows(24 * 3, 0);
-    ASSERT_TRUE((*stream)->add(rows, 3, {}).ok());
+    ASSERT_TRUE((*stream)->add(rows, {}).ok());
   }
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
   // A pipe or a device takes no positional writes: no stream.

@@ -462,7 +462,7 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
       PlyRowStream& to = **stream;
       bulb.rows.colors = colors;
       bulb.rows.start = [&](uint64_t v, uint64_t t) { return to.start(v, t); };
-      bulb.rows.slab = [&](std::span<const uint8_t> v, uint64_t n, std::span<const uint8_t> f) { return to.add(v, n, f); };
+      bulb.rows.slab = [&](std::span<const uint8_t> v, std::span<const uint8_t> f) { return to.add(v, f); };
       Result<PointSet> got = generateMandelbulb(bulb);
       ASSERT_TRUE(got.ok()) << got.error().message;
       EXPECT_EQ(got->size(), 0u);  // the rows went to the stream
