@@ -21,7 +21,7 @@ constexpr uint32_t kGroupElements = 4096;
 constexpr uint32_t kBindings = 15;
 constexpr uint32_t kFaceRowBytes = 13;  // the byte 3, three uint ids
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
-// passes_: mesh_slab.comp's passes 0–4, then these.
+// passes_: mesh_slab.comp's passes 0–4 (those of slab_passes_ for the slab's bits), then these.
 constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7, kColoredVertexRowPass = 8;
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
 
@@ -68,15 +68,6 @@ Status GpuMesher::init() {
       pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!layout) return layout.error();
   layout_ = *layout;
-  // kPass, specialization constant 0: passes 0–4 (the colours' and the rows' pipelines are made at
-  // the first slab that wants them).
-  for (uint32_t pass = 0; pass < 5; ++pass) {
-    const uint32_t constants[1] = {pass};
-    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, constants);
-    if (!p) return p.error();
-    passes_[pass] = *p;
-  }
-
   Result<VkDescriptorSet> set = storageSet(context_, set_layout_, kBindings, pool_);
   if (!set) return set.error();
   set_ = *set;
@@ -107,8 +98,11 @@ GpuMesher::~GpuMesher() {
     destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
   if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
-  for (VkPipeline p : passes_)
-    if (p) vkDestroyPipeline(device, p, nullptr);
+  for (uint32_t i = 5; i < 9; ++i)
+    if (passes_[i]) vkDestroyPipeline(device, passes_[i], nullptr);
+  for (VkPipeline(&by_bits)[5] : slab_passes_)
+    for (VkPipeline p : by_bits)
+      if (p) vkDestroyPipeline(device, p, nullptr);
   if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
   if (set_layout_) vkDestroyDescriptorSetLayout(device, set_layout_, nullptr);
 }
@@ -209,6 +203,16 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   push.above_at = slab.level >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::floor(slab.level));
   push.stride = stride;
   push.seed_frame = slab.frame == GridFrame::kSeed ? 1u : 0u;
+  // mesh_slab.comp's passes 0–4 (kPass, kBits) for counts of these bits, made at the first slab
+  // that has them (a GpuEscape's bits are the same for every slab; the tests use both kinds).
+  VkPipeline (&slab_passes)[5] = slab_passes_[bits == 8 ? 0 : 1];
+  for (uint32_t pass = 0; pass < 5 && !slab_passes[pass]; ++pass) {
+    const uint32_t constants[2] = {pass, bits};
+    Result<VkPipeline> p = createComputePipeline(context_, kMeshSlabComp, sizeof(kMeshSlabComp), layout_, constants);
+    if (!p) return p.error();
+    slab_passes[pass] = *p;
+  }
+  for (uint32_t pass = 0; pass < 5; ++pass) passes_[pass] = slab_passes[pass];
   // Made at the first slab that wants them: mesh_colors.comp, and mesh_rows.comp's two kinds.
   auto made = [&](unsigned index, const uint32_t* code, size_t bytes, std::span<const uint32_t> constants) -> Status {
     if (passes_[index]) return okStatus();

@@ -25,6 +25,10 @@
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint kPass = 0;
+// Bits a count, 8 or 32 (the push constant `bits` before): a constant, so that a count's word and
+// shift are shifts and masks, not the integer divisions by a value known only at run time that
+// every count read cost.
+layout(constant_id = 1) const uint kBits = 8;
 const uint kRun = 16u;                // elements an invocation: kGroupElements in generators/gpu_mesh.cpp
 const uint kGroupElements = 256u * kRun;
 
@@ -52,7 +56,7 @@ layout(push_constant) uniform Push {
   uint planes;            // the slab's planes
   uint first;             // the grid index of its plane 0
   uint word_offset;       // of its counts in `counts`
-  uint bits;              // 8 or 32 bits a count
+  uint bits;              // 8 or 32 bits a count (kBits)
   uint above_at;          // a point is above the level when its count is greater
   uint stride;            // fractions[v1 · stride + v2]
   uint seed_frame;        // 1: (index + t) · step; 0: the axis values
@@ -66,16 +70,39 @@ layout(push_constant) uniform Push {
 
 uint countAt(uint q, uint point) {
   uint i = q * pc.plane + point;
-  if (pc.bits == 32u) return counts[pc.word_offset + i];
-  uint per = 32u / pc.bits;
-  return (counts[pc.word_offset + i / per] >> ((i % per) * pc.bits)) & ((1u << pc.bits) - 1u);
+  if (kBits == 32u) return counts[pc.word_offset + i];
+  const uint per = 32u / kBits;
+  return (counts[pc.word_offset + i / per] >> ((i % per) * kBits)) & ((1u << kBits) - 1u);
 }
 uint aboveAt(uint q, uint point) { return countAt(q, point) > pc.above_at ? 1u : 0u; }
 
-// Vertices of element e: the crossed y and z edges of an in-plane point, or its crossed x edge.
-uint vertexCount(uint e) {
-  uint section = e / pc.plane, point = e % pc.plane;
-  uint j = point / pc.n, k = point % pc.n;
+// An element's place: its section (vertex passes) or layer (triangle passes), its point in the
+// plane, and the point's row j and column k. An invocation's elements are consecutive, so only the
+// first is divided out; the others step from it (k fastest).
+struct Place {
+  uint section, point, j, k;
+};
+Place placeOf(uint e) {
+  Place p;
+  p.section = e / pc.plane;
+  p.point = e - p.section * pc.plane;
+  p.j = p.point / pc.n;
+  p.k = p.point - p.j * pc.n;
+  return p;
+}
+void stepPlace(inout Place p) {
+  ++p.point;
+  if (++p.k < pc.n) return;
+  p.k = 0u;
+  if (++p.j < pc.n) return;
+  p.j = 0u;
+  p.point = 0u;
+  ++p.section;
+}
+
+// Vertices of an element: the crossed y and z edges of an in-plane point, or its crossed x edge.
+uint vertexCount(Place p) {
+  uint section = p.section, point = p.point, j = p.j, k = p.k;
   uint q = section >> 1;
   uint a = aboveAt(q, point);
   if ((section & 1u) == 1u) return a != aboveAt(q + 1u, point) ? 1u : 0u;
@@ -85,10 +112,9 @@ uint vertexCount(uint e) {
   return c;
 }
 
-// The case of cell e (layer, j, k); 0 for the points without a cell (j or k last).
-uint cellMask(uint e) {
-  uint q = e / pc.plane, point = e % pc.plane;
-  uint j = point / pc.n, k = point % pc.n;
+// The case of the cell at a place (layer, j, k); 0 for the points without a cell (j or k last).
+uint cellMask(Place p) {
+  uint q = p.section, point = p.point, j = p.j, k = p.k;
   if (j + 1u >= pc.n || k + 1u >= pc.n) return 0u;
   uint row = pc.n;
   return aboveAt(q, point) | aboveAt(q + 1u, point) << 1 | aboveAt(q, point + row) << 2 |
@@ -115,8 +141,7 @@ uint exclusiveScan(uint v, out uint total) {
 
 // generators/escape_grid.cpp's SlabField::vertex: the vertex on the edge from (first + q, j, k)
 // along `axis`.
-void writeVertex(uint id, uint q, uint point, uint axis) {
-  uint j = point / pc.n, k = point % pc.n;
+void writeVertex(uint id, uint q, uint point, uint j, uint k, uint axis) {
   uint q2 = axis == 0u ? q + 1u : q;
   uint point2 = axis == 1u ? point + pc.n : axis == 2u ? point + 1u : point;
   uint v1 = countAt(q, point), v2 = countAt(q2, point2);
@@ -178,10 +203,12 @@ void main() {
   uint first_e = group * kGroupElements + gl_LocalInvocationID.x * kRun;
   uint c[kRun];
   uint sum = 0u;
+  Place place = placeOf(first_e);
   for (uint r = 0u; r < kRun; ++r) {
     uint e = first_e + r;
-    c[r] = e >= elements ? 0u : vertex_pass ? vertexCount(e) : caseByte(cellMask(e), 0u);
+    c[r] = e >= elements ? 0u : vertex_pass ? vertexCount(place) : caseByte(cellMask(place), 0u);
     sum += c[r];
+    stepPlace(place);
   }
   uint total;
   uint before = exclusiveScan(sum, total);
@@ -194,32 +221,32 @@ void main() {
     }
     return;
   }
+  place = placeOf(first_e);
   if (kPass == 3u) {
     uint id = vertex_groups[group] + before;
-    for (uint r = 0u; r < kRun; ++r) {
+    for (uint r = 0u; r < kRun; ++r, stepPlace(place)) {
       uint e = first_e + r;
       if (e >= elements) return;
       if (e == pc.plane) totals[2] = id;
       if (e == (2u * pc.planes - 2u) * pc.plane) totals[3] = id;
       if (c[r] == 0u) continue;
-      uint section = e / pc.plane, point = e % pc.plane;
-      uint q = section >> 1;
-      if ((section & 1u) == 1u) {
+      uint point = place.point, j = place.j, k = place.k;
+      uint q = place.section >> 1;
+      if ((place.section & 1u) == 1u) {
         ids_x[q * pc.plane + point] = id;
-        writeVertex(id, q, point, 0u);
+        writeVertex(id, q, point, j, k, 0u);
         ++id;
         continue;
       }
-      uint j = point / pc.n, k = point % pc.n;
       uint a = aboveAt(q, point);
       if (j + 1u < pc.n && a != aboveAt(q, point + pc.n)) {
         ids_y[q * pc.plane + point] = id;
-        writeVertex(id, q, point, 1u);
+        writeVertex(id, q, point, j, k, 1u);
         ++id;
       }
       if (k + 1u < pc.n && a != aboveAt(q, point + 1u)) {
         ids_z[q * pc.plane + point] = id;
-        writeVertex(id, q, point, 2u);
+        writeVertex(id, q, point, j, k, 2u);
         ++id;
       }
     }
@@ -227,11 +254,10 @@ void main() {
   }
   // kPass == 4: the triangles.
   uint first_triangle = triangle_groups[group] + before;
-  for (uint r = 0u; r < kRun; ++r) {
+  for (uint r = 0u; r < kRun; ++r, stepPlace(place)) {
     if (c[r] == 0u) continue;
-    uint e = first_e + r;
-    uint mask = cellMask(e);
-    uint q = e / pc.plane, point = e % pc.plane;
+    uint mask = cellMask(place);
+    uint q = place.section, point = place.point;
     for (uint t = 0u; t < 3u * c[r]; ++t) triangles[3u * first_triangle + t] = edgeId(caseByte(mask, 1u + t), q, point);
     first_triangle += c[r];
   }
