@@ -138,13 +138,13 @@ EscapeArena GenerateDevice::arena() {
 EscapeSlabMesher GenerateDevice::mesher(const EscapeKernelParams& kernel) {
   EscapeSlabMesher mesher;
   mesher.takes = &GpuMesher::supports;
-  mesher.mesh = [self = shared_from_this(), kernel](const EscapeSlab& slab) -> Result<McSlabView> {
+  mesher.mesh = [self = shared_from_this(), kernel](const EscapeSlab& slab, const EscapeSlab* next) -> Result<McSlabView> {
     if (!self->mesher_) {
       Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*self->context_);
       if (!made) return made.error();
       self->mesher_ = std::move(*made);
     }
-    Result<McSlabView> mesh = meshSlabOnDevice(*self->gpu_, *self->mesher_, kernel, slab);
+    Result<McSlabView> mesh = meshSlabOnDevice(*self->gpu_, *self->mesher_, kernel, slab, next);
     if (!mesh) return mesh.error();
     if (Status s = self->checkValidation(); !s) return s.error();
     return mesh;

@@ -763,11 +763,16 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     const int samples = std::min(layers, 16);
     double sampled_vertices = 0.0, sampled_triangles = 0.0;
     uint64_t most_vertices = 0, most_triangles = 0, most_plane = 0;  // of a sampled layer
-    for (int i = 0; i < samples && !interrupted(); ++i) {
+    auto sampled = [&](int i) {
       const int layer = first_layer + static_cast<int>((i + 0.5) * layers / samples);
       EscapeSlab slab = slabAt(layer, layer + 1);
       slab.noise_colors = false;
-      Result<McSlabView> view = params.mesher.mesh(slab);
+      return slab;
+    };
+    for (int i = 0; i < samples && !interrupted(); ++i) {
+      // Then the first slab's counts are made while the last sampled layer is meshed.
+      const EscapeSlab next = i + 1 < samples ? sampled(i + 1) : slabAt(slabFirst(0), slabLast(0));
+      Result<McSlabView> view = params.mesher.mesh(sampled(i), pending.empty() ? nullptr : &next);
       if (!view) return view.error();
       sampled_vertices += static_cast<double>(view->positions.size());
       sampled_triangles += static_cast<double>(view->triangles.size() / 3);
@@ -803,7 +808,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
       slab.ply_rows = true;
       slab.vertex_base = static_cast<uint32_t>(vertices);
-      Result<McSlabView> view = params.mesher.mesh(slab);
+      const EscapeSlab next = s + 1 < pending.size() ? slabAt(slabFirst(s + 1), slabLast(s + 1)) : EscapeSlab{};
+      Result<McSlabView> view = params.mesher.mesh(slab, s + 1 < pending.size() ? &next : nullptr);
       if (writing.valid())
         if (Status w = writing.get(); !w) fail(w.error());
       if (!view) fail(view.error());
@@ -828,7 +834,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     for (size_t s = 0; s < pending.size(); ++s) {
       if (interrupted()) break;
       const EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
-      Result<McSlabView> view = params.mesher.mesh(slab);
+      const EscapeSlab next = s + 1 < pending.size() ? slabAt(slabFirst(s + 1), slabLast(s + 1)) : EscapeSlab{};
+      Result<McSlabView> view = params.mesher.mesh(slab, s + 1 < pending.size() ? &next : nullptr);
       if (appending.valid()) appending.get();
       if (!view) fail(view.error());
       if (failed) break;

@@ -102,10 +102,11 @@ struct EscapeSlab {
 // there, the mesh marchingCubesSlab makes with this file's vertices, bit for bit. Used, in place of
 // the plane function, when `takes` the run's largest slab (planes of res² counts up to limit).
 // `mesh` is called for the slabs in order, from one thread; its view stays valid until the second
-// call after it returns (the caller copies one slab out while the next is made).
+// call after it returns (the caller copies one slab out while the next is made). `next`, where not
+// null, is the slab the following call will mesh: its counts may be made meanwhile.
 struct EscapeSlabMesher {
   std::function<bool(int res, int planes, int limit)> takes;
-  std::function<Result<McSlabView>(const EscapeSlab&)> mesh;
+  std::function<Result<McSlabView>(const EscapeSlab& slab, const EscapeSlab* next)> mesh;
   // Optional: memory for slabs of up to `vertices` vertices and `triangles` triangles made at once,
   // with colours and as rows as EscapeSlab says (else it grows as the slabs do, which on a GPU
   // costs a host-visible allocation on the way from one slab's passes to the next).

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstring>
 #include <type_traits>
+#include <utility>
 
 #include "core/parallel.h"
 #include "generators/escape_grid.h"
@@ -219,6 +220,21 @@ Status GpuEscape::finishAll() {
   return status;
 }
 
+void GpuEscape::stampStart(VkCommandBuffer commands, uint32_t query) const {
+  if (!queries_) return;
+  vkCmdResetQueryPool(commands, queries_, query, 2);
+  vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, query);
+}
+
+void GpuEscape::recordPoints(VkCommandBuffer commands, VkPipelineLayout layout, const void* push, uint32_t push_bytes,
+                             uint64_t points) const {
+  vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
+  // Groups in two dimensions, x at most the device's limit; the shaders skip points past count.
+  const uint64_t groups = (points + kGroupSize - 1) / kGroupSize;
+  const uint64_t x = std::min<uint64_t>(groups, std::max<uint32_t>(context_.facts.max_dispatch_groups_x, 1));
+  vkCmdDispatch(commands, static_cast<uint32_t>(x), static_cast<uint32_t>((groups + x - 1) / x), 1);
+}
+
 Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
                            uint32_t push_bytes, uint64_t points, void* destination, uint32_t count_bytes,
                            uint32_t device_bytes, EscapeTail* tail_destination) {
@@ -230,17 +246,10 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_TRY(vkBeginCommandBuffer(slot.commands, &begin));
   const uint32_t query = 2 * static_cast<uint32_t>(s);
-  if (queries_) {
-    vkCmdResetQueryPool(slot.commands, queries_, query, 2);
-    vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, query);
-  }
+  stampStart(slot.commands, query);
   vkCmdBindPipeline(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   vkCmdBindDescriptorSets(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
-  vkCmdPushConstants(slot.commands, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
-  // Groups in two dimensions, x at most the device's limit; the shaders skip points past count.
-  const uint64_t groups = (points + kGroupSize - 1) / kGroupSize;
-  const uint64_t x = std::min<uint64_t>(groups, std::max<uint32_t>(context_.facts.max_dispatch_groups_x, 1));
-  vkCmdDispatch(slot.commands, static_cast<uint32_t>(x), static_cast<uint32_t>((groups + x - 1) / x), 1);
+  recordPoints(slot.commands, layout, push, push_bytes, points);
   if (queries_) vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, query + 1);
   VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
@@ -301,9 +310,9 @@ Status GpuEscape::escapeInto(const EscapeKernelParams& kernel, const std::vector
   if (Status s = finishAll(); !s) return s;
   if (Status s = useAxis(axis); !s) return s;
   // Every call: a buffer made after another was destroyed may have its handle (NVIDIA's driver
-  // reuses them), so the handle cannot tell whether the sets are current; no dispatch is in flight
-  // after finishAll.
-  for (Slot& slot : slots_) writeSet(context_, slot.target_set, {&axis_, &target});
+  // reuses them), so the handle cannot tell whether the set is current; no dispatch is in flight
+  // after finishAll. One submission, slot 0's (escapeRows).
+  writeSet(context_, slots_[0].target_set, {&axis_, &target});
   return escapeRows(kernel, res, first, planes, limit, Target::kDevice, 0, nullptr);
 }
 
@@ -328,6 +337,19 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
   if (target == Target::kDevice) rows_per_chunk = std::max<uint64_t>(4, rows_per_chunk / 4 * 4);
   const uint64_t first_row = static_cast<uint64_t>(first) * res, end_row = first_row + static_cast<uint64_t>(planes) * res;
   const VkPipeline pipeline = escape_[static_cast<uint32_t>(kernel.kernel)];
+  // Into device memory, every chunk in one submission of slot 0's: nothing waits on the host
+  // between them (the chunks write words of their own), and the host is free once it is submitted.
+  Slot& device_slot = slots_[0];
+  if (target == Target::kDevice) {
+    VK_TRY(vkResetFences(context_.device, 1, &device_slot.fence));
+    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_TRY(vkBeginCommandBuffer(device_slot.commands, &begin));
+    stampStart(device_slot.commands, 0);
+    vkCmdBindPipeline(device_slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(device_slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, escape_layout_, 0, 1,
+                            &device_slot.target_set, 0, nullptr);
+  }
   size_t s = 0;
   for (uint64_t row = first_row; row < end_row; row += rows_per_chunk, s ^= 1) {
     const uint64_t rows = std::min(rows_per_chunk, end_row - row);
@@ -335,9 +357,11 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
     push.count = static_cast<uint32_t>(rows * res);
     const uint64_t bytes_before = (row - first_row) * res * device_bytes;
     push.word_offset = target == Target::kHost ? 0 : static_cast<uint32_t>(word_offset + bytes_before / 4);
-    const VkDescriptorSet set = target == Target::kArena  ? slots_[s].arena_set
-                                : target == Target::kDevice ? slots_[s].target_set
-                                                            : slots_[s].escape_set;
+    if (target == Target::kDevice) {
+      recordPoints(device_slot.commands, escape_layout_, &push, sizeof push, rows * res);
+      continue;
+    }
+    const VkDescriptorSet set = target == Target::kArena ? slots_[s].arena_set : slots_[s].escape_set;
     uint8_t* destination = target == Target::kHost ? counts + (row - first_row) * res * count_bytes : nullptr;
     if (Status st = dispatch(s, pipeline, escape_layout_, set, &push, sizeof push, rows * res, destination, count_bytes,
                              device_bytes, nullptr);
@@ -346,8 +370,21 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
       return st;
     }
   }
-  // Into device memory, the reader's own submission follows on the queue (escapeInto).
-  return target == Target::kDevice ? okStatus() : finishAll();
+  if (target != Target::kDevice) return finishAll();
+  // The reader's own submission follows on the queue (escapeInto); the counts need no barrier
+  // towards the host.
+  if (queries_) vkCmdWriteTimestamp(device_slot.commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 1);
+  VK_TRY(vkEndCommandBuffer(device_slot.commands));
+  VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &device_slot.commands;
+  VK_TRY(queueSubmit(context_, submit, device_slot.fence));
+  device_slot.points = (end_row - first_row) * res;
+  device_slot.destination = nullptr;
+  device_slot.count_bytes = count_bytes;
+  device_slot.device_bytes = device_bytes;
+  device_slot.tail_destination = nullptr;
+  return okStatus();
 }
 
 Result<uint8_t*> GpuEscape::arena(uint64_t bytes) {
@@ -368,17 +405,52 @@ Result<uint8_t*> GpuEscape::arena(uint64_t bytes) {
 }
 
 Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
-                                    const EscapeSlab& slab) {
-  const int planes = slab.last - slab.first + 1;
-  assert(GpuMesher::supports(slab.res, planes, slab.limit));
+                                    const EscapeSlab& slab, const EscapeSlab* next) {
+  assert(GpuMesher::supports(slab.res, slab.last - slab.first + 1, slab.limit));
   const uint32_t bits = escape.deviceBits(slab.limit);
-  Result<const Buffer*> counts = mesher.countsBuffer(static_cast<uint64_t>(planes) * squaredResolution(slab.res) * bits / 8);
-  if (!counts) return counts.error();
-  if (Status s = escape.escapeInto(kernel, *slab.values, slab.first, planes, slab.limit, **counts); !s) return s.error();
-  // The mesher's first submission waits on the device for the counts, not the host.
-  Result<McSlabView> mesh = mesher.meshSlab(slab, bits);
+  auto ahead = [&](const EscapeSlab& s, unsigned which) {
+    GpuMesher::CountsAhead a;
+    a.escape = &escape;
+    a.kernel = {static_cast<double>(kernel.kernel), kernel.c[0], kernel.c[1], kernel.c[2], kernel.c[3],
+                kernel.julia_threshold, kernel.axis_rho2, kernel.trap_c2};
+    a.values = s.values;
+    a.first = s.first, a.last = s.last, a.limit = s.limit;
+    a.which = which;
+    return a;
+  };
+  // Counts into counts buffer `which`, submitted and not waited for.
+  auto countsInto = [&](const EscapeSlab& s, unsigned which) -> Status {
+    const uint64_t bytes = static_cast<uint64_t>(s.last - s.first + 1) * squaredResolution(s.res) * bits / 8;
+    Result<const Buffer*> counts = mesher.countsBuffer(bytes, which);
+    if (!counts) return counts.error();
+    return escape.escapeInto(kernel, *s.values, s.first, s.last - s.first + 1, s.limit, **counts);
+  };
+  // This slab's counts: made ahead by the call before, or now.
+  unsigned which = 0;
+  const std::optional<GpuMesher::CountsAhead> made = std::exchange(mesher.counts_ahead, std::nullopt);
+  if (made && *made == ahead(slab, made->which)) {
+    which = made->which;
+  } else if (Status s = countsInto(slab, which); !s) {
+    return s.error();
+  }
+  // The next slab's into the other buffer once this one's scan is queued: the device makes them
+  // while the host reads the totals, before the mesh (a queue runs in order; the mesher's
+  // submissions wait on the device for counts, not the host).
+  std::function<Status()> while_scanning;
+  if (next && GpuMesher::supports(next->res, next->last - next->first + 1, next->limit))
+    while_scanning = [&]() -> Status {
+      if (Status s = countsInto(*next, which ^ 1u); !s) return s;
+      mesher.counts_ahead = ahead(*next, which ^ 1u);
+      return okStatus();
+    };
+  Result<McSlabView> mesh = mesher.meshSlab(slab, bits, which, while_scanning);
+  // The next slab's counts were made before this slab's mesh; this only counts their time.
   const Status settled = escape.settle();
-  if (mesh && !settled) return settled.error();
+  if (!mesh) {
+    mesher.counts_ahead.reset();
+    return mesh;
+  }
+  if (!settled) return settled.error();
   return mesh;
 }
 

@@ -76,7 +76,7 @@ class GpuEscape {
 
   // escapePlanes's counts into device memory (`target`, from its start) and nowhere else, for a
   // mesher on the device (generators/gpu_mesh.h), deviceBits(limit) bits each: packed as in the
-  // arena on a GPU, whole uint32 on lavapipe. Returns once the last dispatch is submitted: a
+  // arena on a GPU, whole uint32 on lavapipe. Returns once its one submission is on the queue: a
   // submission after it on the context's queue whose barrier waits for compute writes reads the
   // counts (no host round trip between); settle() once such a submission has finished.
   Status escapeInto(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
@@ -105,7 +105,7 @@ class GpuEscape {
     Buffer tails;  // mandelbrot2d's escape tails; made at the first perturbation call
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
     VkDescriptorSet arena_set = VK_NULL_HANDLE;  // the escape kernel writing into arena_
-    VkDescriptorSet target_set = VK_NULL_HANDLE;  // and into escapeInto's target
+    VkDescriptorSet target_set = VK_NULL_HANDLE;  // and into escapeInto's target (slot 0's only)
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
     void* destination = nullptr;             // where the counts of the dispatch in flight go; null: in place
@@ -127,6 +127,11 @@ class GpuEscape {
   Status dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
                   uint32_t push_bytes, uint64_t points, void* destination, uint32_t count_bytes,
                   uint32_t device_bytes, EscapeTail* tail_destination);
+  // Resets a slot's two timestamps (from `query`) and writes the first.
+  void stampStart(VkCommandBuffer commands, uint32_t query) const;
+  // Pushes the constants and dispatches groups for `points` points (the pipeline and set bound).
+  void recordPoints(VkCommandBuffer commands, VkPipelineLayout layout, const void* push, uint32_t push_bytes,
+                    uint64_t points) const;
   Status finish(Slot& slot);  // waits for the slot's dispatch and copies its counts (and tails) out
   Status finishAll();
 
@@ -150,8 +155,11 @@ class GpuEscape {
 
 // slab's mesh on the device: its counts by `escape` into the mesher's memory (escapeInto), then
 // marching cubes by `mesher`; nothing crosses to the host but the mesh. The slab must be one the
-// mesher takes (GpuMesher::supports). The body of an EscapeSlabMesher; one thread at a time.
+// mesher takes (GpuMesher::supports). With `next` (the slab the following call will mesh), its
+// counts are made while this slab's are scanned, so that the device does not wait for the host
+// between the slabs (GpuMesher::counts_ahead). The body of an EscapeSlabMesher; one thread at a
+// time.
 Result<McSlabView> meshSlabOnDevice(GpuEscape& escape, GpuMesher& mesher, const EscapeKernelParams& kernel,
-                                    const EscapeSlab& slab);
+                                    const EscapeSlab& slab, const EscapeSlab* next = nullptr);
 
 }  // namespace dpoint

@@ -87,12 +87,46 @@ Status GpuMesher::init() {
   std::memcpy(&cases[256 * 16 + 256 * 4], perlinGradients(), 48 * sizeof(float));
   if (Status s = uploadStorage(context_, cases_, cases.data(), cases.size(), "marching cubes cases"); !s) return s;
   if (Status s = ensure(totals_, 4 * sizeof(uint32_t), true, "meshing totals"); !s) return s;
+  for (Submission& submission : submissions_) {
+    Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
+    if (!commands) return commands.error();
+    submission.commands = *commands;
+    VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &submission.fence));
+  }
+  return okStatus();
+}
+
+Status GpuMesher::submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record) {
+  VK_TRY(vkResetFences(context_.device, 1, &submission.fence));
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_TRY(vkBeginCommandBuffer(submission.commands, &begin));
+  record(submission.commands);
+  VK_TRY(vkEndCommandBuffer(submission.commands));
+  VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  info.commandBufferCount = 1;
+  info.pCommandBuffers = &submission.commands;
+  VK_TRY(queueSubmit(context_, info, submission.fence));
+  submission.pending = true;
+  return okStatus();
+}
+
+Status GpuMesher::wait(Submission& submission) {
+  if (!submission.pending) return okStatus();
+  submission.pending = false;
+  VK_TRY(waitForFence(context_, submission.fence));
   return okStatus();
 }
 
 GpuMesher::~GpuMesher() {
   const VkDevice device = context_.device;
-  for (Buffer* b : {&counts_, &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
+  for (Submission& submission : submissions_) {
+    (void)wait(submission);
+    if (submission.fence) vkDestroyFence(device, submission.fence, nullptr);
+    if (submission.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &submission.commands);
+  }
+  for (Buffer* b : {&counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
                     &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_, &face_rows_, &readback_[0],
                     &readback_[1]})
     destroyBuffer(context_, *b);
@@ -157,17 +191,21 @@ Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, bo
   return okStatus();
 }
 
-Result<const Buffer*> GpuMesher::countsBuffer(uint64_t bytes) {
-  if (Status s = ensure(counts_, bytes, false, "escape counts of a slab"); !s) return s.error();
-  return &counts_;
+Result<const Buffer*> GpuMesher::countsBuffer(uint64_t bytes, unsigned which) {
+  assert(which < 2);
+  if (Status s = ensure(counts_[which], bytes, false, "escape counts of a slab"); !s) return s.error();
+  return &counts_[which];
 }
 
-Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
+Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, unsigned which,
+                                       const std::function<Status()>& while_scanning) {
+  assert(which < 2);
+  const Buffer& slab_counts = counts_[which];
   const int planes = slab.last - slab.first + 1;
   assert(supports(slab.res, planes, slab.limit) && slab.values && slab.values->size() == static_cast<size_t>(slab.res));
   assert(bits == 8 || bits == 32);
   const uint64_t n = static_cast<uint64_t>(slab.res), plane = n * n;
-  assert(counts_.size * 8 >= static_cast<uint64_t>(planes) * plane * bits);
+  assert(slab_counts.size * 8 >= static_cast<uint64_t>(planes) * plane * bits);
 
   // The inputs beside the counts: the axis, and the fractions t of every pair of counts (the CPU's
   // division).
@@ -254,7 +292,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   if (Status s = ensure(face_rows_, 4, false, "slab face rows"); !s) return s.error();
   auto bind = [&] {
     const VkDescriptorBufferInfo infos[kBindings] = {
-        {counts_.buffer, 0, VK_WHOLE_SIZE},    {axis_.buffer, 0, VK_WHOLE_SIZE},
+        {slab_counts.buffer, 0, VK_WHOLE_SIZE}, {axis_.buffer, 0, VK_WHOLE_SIZE},
         {fractions_.buffer, 0, VK_WHOLE_SIZE}, {cases_.buffer, 0, VK_WHOLE_SIZE},
         {vertex_groups_.buffer, 0, VK_WHOLE_SIZE}, {triangle_groups_.buffer, 0, VK_WHOLE_SIZE},
         {totals_.buffer, 0, VK_WHOLE_SIZE},    {ids_y_.buffer, 0, VK_WHOLE_SIZE},
@@ -284,8 +322,10 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   };
   const VkAccessFlags shader_rw = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
 
-  // The counts (written by GpuEscape's dispatches, submitted before) and the scans.
-  Status status = submitOnce(context_, [&](VkCommandBuffer commands) {
+  // The counts (written by GpuEscape's dispatches, submitted before) and the scans; while they
+  // run, what the caller has to submit next (the next slab's counts, queued before this slab's
+  // second submission, so that the device has them to do while the host reads the totals).
+  Status status = submit(submissions_[0], [&](VkCommandBuffer commands) {
     if (queries_) vkCmdResetQueryPool(commands, queries_, 0, kStamps);
     barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
     stamp(commands, kStart);
@@ -296,6 +336,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
     stamp(commands, kScanned);
     barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   });
+  if (status && while_scanning) status = while_scanning();
+  if (Status waited = wait(submissions_[0]); status && !waited) status = waited;
   if (!status) return status.error();
   if (Status s = invalidateBuffer(context_, totals_); !s) return s.error();
   uint32_t totals[4];
@@ -332,7 +374,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
   push.row_bytes = static_cast<uint32_t>(row_bytes);
   push.faces = static_cast<uint32_t>(triangles);
   push.vertex_base = slab.vertex_base;
-  status = submitOnce(context_, [&](VkCommandBuffer commands) {
+  status = submit(submissions_[1], [&](VkCommandBuffer commands) {
     stamp(commands, kStart2);
     dispatch(commands, 3, push.vertex_group_count);
     if (slab.noise_colors && vertices) {
@@ -365,6 +407,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits) {
     stamp(commands, kCopied);
     barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   });
+  if (Status waited = wait(submissions_[1]); status && !waited) status = waited;
   if (!status) return status.error();
   if (Status s = readStamps(); !s) return s.error();
   for (const Buffer* b : {&totals_, &readback})

@@ -7,13 +7,17 @@
 // The counts never leave the device: GpuEscape::escapeInto writes them into the mesher's memory
 // (generators/gpu_generate.h meshSlabOnDevice). Two submissions a slab: the counts and their scan,
 // then (with the output buffers grown to the totals) the vertices and triangles, copied across to
-// host-visible memory, where the caller reads them. One thread at a
+// host-visible memory, where the caller reads them; the next slab's counts are submitted between
+// them, into the other of two counts buffers. One thread at a
 // time may call a GpuMesher, and the same thread as the GpuEscape beside it: both record on the
 // context's one queue and pool.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/result.h"
@@ -35,18 +39,37 @@ class GpuMesher {
   // byte (the fraction table has (limit + 1)² entries) and element numbers below 2^31.
   static bool supports(int res, int planes, int limit);
 
-  // Device memory for a slab's counts, `bytes` of them: GpuEscape::escapeInto writes them there.
-  Result<const Buffer*> countsBuffer(uint64_t bytes);
+  // Device memory for a slab's counts, `bytes` of them, the first or the second of two (`which`):
+  // GpuEscape::escapeInto writes them there, one slab's while another's are meshed.
+  Result<const Buffer*> countsBuffer(uint64_t bytes, unsigned which);
 
   // marchingCubesSlab(res, res, slab.first, slab.last, slab.owns_last_plane, …, slab.seam_positions)
   // with SlabField's vertices (slab.level, frame, values, step) from the slab's final counts, which
-  // countsBuffer holds, `bits` (8 or 32) each. The view is of host-visible memory that stays as it
-  // is until the second call after this one (two buffers, used in turn). With slab.ply_rows, the
-  // view has the binary PLY rows instead (McSlabView::vertex_rows and face_rows).
-  Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits);
+  // countsBuffer(…, which) holds, `bits` (8 or 32) each. The view is of host-visible memory that
+  // stays as it is until the second call after this one (two buffers, used in turn). With
+  // slab.ply_rows, the view has the binary PLY rows instead (McSlabView::vertex_rows and
+  // face_rows). `while_scanning`, if set, is called once the first submission is on the queue
+  // and before the host waits for it: work submitted there (the next slab's counts into the other
+  // counts buffer) runs on the device while the host reads this slab's totals.
+  Result<McSlabView> meshSlab(const EscapeSlab& slab, uint32_t bits, unsigned which,
+                              const std::function<Status()>& while_scanning = {});
 
   // Grows the slab buffers for slabs of up to these counts (meshSlab grows them as needed).
   Status reserve(uint64_t vertices, uint64_t triangles, bool colors, bool rows);
+
+  // The counts made ahead into counts buffer `which` by meshSlabOnDevice (generators/gpu_generate.h)
+  // while the slab before was meshed: planes first..last of the grid `values` to `limit`, by the
+  // escape `escape` with the kernel `kernel` (its kind and constants); taken by the next call if it
+  // is for that slab.
+  struct CountsAhead {
+    const void* escape = nullptr;
+    std::array<double, 8> kernel{};
+    const std::vector<double>* values = nullptr;
+    int first = 0, last = 0, limit = 0;
+    unsigned which = 0;
+    bool operator==(const CountsAhead&) const = default;
+  };
+  std::optional<CountsAhead> counts_ahead;
 
   // The passes' time on the device (timestamps), in ms: counting and scanning, the vertices, the
   // triangles, and copying the mesh across to host-visible memory.
@@ -59,6 +82,15 @@ class GpuMesher {
  private:
   explicit GpuMesher(const VulkanContext& context) : context_(context) {}
   Status init();
+  // A command buffer and its fence, recorded again for each slab: the counts' scan (0) and the
+  // mesh (1).
+  struct Submission {
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    bool pending = false;
+  };
+  Status submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record);
+  Status wait(Submission& submission);
   Status ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what);
   void stamp(VkCommandBuffer commands, uint32_t query) const;
   Status readStamps();
@@ -73,7 +105,8 @@ class GpuMesher {
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
-  Buffer counts_, axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
+  Submission submissions_[2];
+  Buffer counts_[2], axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
   Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_, vertex_rows_, face_rows_;
   Buffer readback_[2];  // host-visible, used in turn: a slab's positions, colours and triangles
   unsigned next_readback_ = 0;

@@ -334,9 +334,9 @@ TEST_F(GpuGenerate, marchingCubesOnTheDeviceEqualsTheHosts) {
   auto on_device = [&](GpuEscape* escape, const EscapeKernelParams& kernel) {
     EscapeSlabMesher m;
     m.takes = &GpuMesher::supports;
-    m.mesh = [&, escape, kernel](const EscapeSlab& slab) {
+    m.mesh = [&, escape, kernel](const EscapeSlab& slab, const EscapeSlab* next) {
       ++meshed;
-      return meshSlabOnDevice(*escape, mesher, kernel, slab);
+      return meshSlabOnDevice(*escape, mesher, kernel, slab, next);
     };
     return m;
   };
@@ -421,7 +421,7 @@ TEST_F(GpuGenerate, marchingCubesOnTheDeviceEqualsTheHosts) {
   EXPECT_TRUE(sameMesh(*deep_cpu, *deep_gpu));
   // A mesher that fails: the run ends with its error.
   deep.max_iter = 100;
-  deep.mesher.mesh = [](const EscapeSlab&) -> Result<McSlabView> {
+  deep.mesher.mesh = [](const EscapeSlab&, const EscapeSlab*) -> Result<McSlabView> {
     return Error{"the device was lost", ExitCode::kNoDevice};
   };
   Result<PointSet> failed = generateMandelbulb(deep);
@@ -454,8 +454,16 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
       bulb.full_counts = true;
       bulb.noise_colors = colors;
       GpuEscape* escape = packed_.get();
+      // Each slab's counts are made once: those of the slab named as `next` while the one before
+      // is meshed, and taken from there.
+      const uint64_t points_before = escape->pointsDone();
+      uint64_t slab_points = 0, ahead = 0;
       bulb.mesher.takes = &GpuMesher::supports;
-      bulb.mesher.mesh = [&](const EscapeSlab& slab) { return meshSlabOnDevice(*escape, mesher, mandelbulb(), slab); };
+      bulb.mesher.mesh = [&](const EscapeSlab& slab, const EscapeSlab* next) {
+        slab_points += static_cast<uint64_t>(slab.last - slab.first + 1) * static_cast<uint64_t>(res * res);
+        ahead += next ? 1 : 0;
+        return meshSlabOnDevice(*escape, mesher, mandelbulb(), slab, next);
+      };
       bulb.mesher.reserve = [&](uint64_t v, uint64_t t, bool c, bool r) { return mesher.reserve(v, t, c, r); };
       Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("device.ply"), colors, 0, nullptr);
       ASSERT_TRUE(stream.ok() && *stream);
@@ -466,6 +474,8 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
       Result<PointSet> got = generateMandelbulb(bulb);
       ASSERT_TRUE(got.ok()) << got.error().message;
       EXPECT_EQ(got->size(), 0u);  // the rows went to the stream
+      EXPECT_GT(ahead, 1u);
+      EXPECT_EQ(escape->pointsDone() - points_before, slab_points);
       ASSERT_TRUE(to.started());
       ASSERT_TRUE(to.finish().ok());
       EXPECT_EQ(to.vertices(), expected->size());
