@@ -105,8 +105,9 @@ GenerateDevice::~GenerateDevice() {
     const GpuMesher::Times& t = mesher_->times();
     std::fprintf(stderr,
                  "dpoint: marching cubes on the device in %.1f ms of GPU time (counting and scanning %.1f, vertices "
-                 "%.1f, triangles %.1f, copying them across %.1f)\n",
-                 t.total(), t.scan, t.vertices, t.triangles, t.copy);
+                 "%.1f, triangles %.1f, %s %.1f)\n",
+                 t.total(), t.scan, t.vertices, t.triangles,
+                 t.copied_beside ? "the rows (copied across on the transfer queue, beside)" : "copying them across", t.copy);
   }
 }
 

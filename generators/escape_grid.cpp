@@ -821,7 +821,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       }
       vertices += view->row_vertices;
       writing = std::async(std::launch::async, [&, s, v = *view] {
-        Status w = params.rows.slab(v.vertex_rows, v.face_rows);
+        Status w = v.ready ? v.ready() : okStatus();
+        if (w) w = params.rows.slab(v.vertex_rows, v.face_rows);
         if (w && params.progress) params.progress->advance(static_cast<uint64_t>(slabLast(s) - slabFirst(s)));
         return w;
       });

@@ -87,6 +87,11 @@ Status GpuMesher::init() {
   std::memcpy(&cases[256 * 16 + 256 * 4], perlinGradients(), 48 * sizeof(float));
   if (Status s = uploadStorage(context_, cases_, cases.data(), cases.size(), "marching cubes cases"); !s) return s;
   if (Status s = ensure(totals_, 4 * sizeof(uint32_t), true, "meshing totals"); !s) return s;
+  if (copyBeside())
+    for (Copy& copy : copies_) {
+      VkSemaphoreCreateInfo semaphore_info = {VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+      VK_TRY(vkCreateSemaphore(context_.device, &semaphore_info, nullptr, &copy.ready));
+    }
   for (Submission& submission : submissions_) {
     Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
     if (!commands) return commands.error();
@@ -97,7 +102,8 @@ Status GpuMesher::init() {
   return okStatus();
 }
 
-Status GpuMesher::submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record) {
+Status GpuMesher::submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record,
+                         VkSemaphore signal) {
   VK_TRY(vkResetFences(context_.device, 1, &submission.fence));
   VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -107,8 +113,75 @@ Status GpuMesher::submit(Submission& submission, const std::function<void(VkComm
   VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
   info.commandBufferCount = 1;
   info.pCommandBuffers = &submission.commands;
+  if (signal) {
+    info.signalSemaphoreCount = 1;
+    info.pSignalSemaphores = &signal;
+  }
   VK_TRY(queueSubmit(context_, info, submission.fence));
   submission.pending = true;
+  return okStatus();
+}
+
+bool GpuMesher::copyBeside() const { return context_.transfer_queue != VK_NULL_HANDLE; }
+
+void GpuMesher::rowsOwnership(VkCommandBuffer commands, unsigned r, bool release) const {
+  // A queue family ownership transfer of the rows' buffers from the main queue's family to the
+  // transfer queue's: the release on the main queue, the acquire on the transfer queue.
+  VkBufferMemoryBarrier barriers[2] = {{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER}, {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER}};
+  const Buffer* buffers[2] = {&vertex_rows_[r], &face_rows_[r]};
+  for (int i = 0; i < 2; ++i) {
+    barriers[i].srcAccessMask = release ? VK_ACCESS_SHADER_WRITE_BIT : 0;
+    barriers[i].dstAccessMask = release ? 0 : VK_ACCESS_TRANSFER_READ_BIT;
+    barriers[i].srcQueueFamilyIndex = context_.facts.queue_family;
+    barriers[i].dstQueueFamilyIndex = *context_.facts.transfer_family;
+    barriers[i].buffer = buffers[i]->buffer;
+    barriers[i].offset = 0;
+    barriers[i].size = VK_WHOLE_SIZE;
+  }
+  vkCmdPipelineBarrier(commands, release ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                       release ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 2,
+                       barriers, 0, nullptr);
+}
+
+Status GpuMesher::submitCopy(Copy& copy, unsigned r, const Buffer& readback, uint64_t vertex_row_bytes,
+                             uint64_t face_row_bytes) {
+  if (!copy.commands) {
+    Result<VkCommandBuffer> commands = allocateCommandBuffer(context_, context_.transfer_pool);
+    if (!commands) return commands.error();
+    copy.commands = *commands;
+    VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &copy.fence));
+  }
+  VK_TRY(vkResetFences(context_.device, 1, &copy.fence));
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_TRY(vkBeginCommandBuffer(copy.commands, &begin));
+  rowsOwnership(copy.commands, r, false);
+  const VkBufferCopy vertex_copy{0, 0, vertex_row_bytes}, face_copy{0, vertex_row_bytes, face_row_bytes};
+  if (vertex_row_bytes) vkCmdCopyBuffer(copy.commands, vertex_rows_[r].buffer, readback.buffer, 1, &vertex_copy);
+  if (face_row_bytes) vkCmdCopyBuffer(copy.commands, face_rows_[r].buffer, readback.buffer, 1, &face_copy);
+  VkMemoryBarrier to_host = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(copy.commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                       nullptr, 0, nullptr);
+  VK_TRY(vkEndCommandBuffer(copy.commands));
+  const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  info.waitSemaphoreCount = 1;
+  info.pWaitSemaphores = &copy.ready;
+  info.pWaitDstStageMask = &wait_stage;
+  info.commandBufferCount = 1;
+  info.pCommandBuffers = &copy.commands;
+  VK_TRY(queueSubmit(context_, info, copy.fence, context_.transfer_queue));
+  copy.pending = true;
+  return okStatus();
+}
+
+Status GpuMesher::waitCopy(Copy& copy) {
+  if (!copy.pending) return okStatus();
+  copy.pending = false;
+  VK_TRY(waitForFence(context_, copy.fence));
   return okStatus();
 }
 
@@ -126,8 +199,15 @@ GpuMesher::~GpuMesher() {
     if (submission.fence) vkDestroyFence(device, submission.fence, nullptr);
     if (submission.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &submission.commands);
   }
+  for (Copy& copy : copies_) {
+    (void)waitCopy(copy);
+    if (copy.fence) vkDestroyFence(device, copy.fence, nullptr);
+    if (copy.ready) vkDestroySemaphore(device, copy.ready, nullptr);
+    if (copy.commands) vkFreeCommandBuffers(device, context_.transfer_pool, 1, &copy.commands);
+  }
   for (Buffer* b : {&counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
-                    &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_, &face_rows_, &readback_[0],
+                    &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_[0], &vertex_rows_[1], &face_rows_[0],
+                    &face_rows_[1], &readback_[0],
                     &readback_[1]})
     destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
@@ -182,8 +262,11 @@ Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, bo
   uint64_t readback = vertices * 3 * sizeof(double) + (colors ? vertices * 3 * sizeof(float) : 0) +
                       triangles * 3 * sizeof(uint32_t);
   if (rows) {
-    if (Status s = ensure(vertex_rows_, (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s) return s;
-    if (Status s = ensure(face_rows_, (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s) return s;
+    for (unsigned r = 0; r < (copyBeside() ? 2u : 1u); ++r) {
+      if (Status s = ensure(vertex_rows_[r], (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s) return s;
+      if (Status s = ensure(face_rows_[r], (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s)
+        return s;
+    }
     readback = vertices * row_bytes + triangles * kFaceRowBytes;
   }
   for (Buffer& b : readback_)
@@ -288,8 +371,12 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   if (Status s = ensure(positions_, 3 * sizeof(double), false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s.error();
   if (Status s = ensure(colors_, 3 * sizeof(float), false, "slab colours"); !s) return s.error();
-  if (Status s = ensure(vertex_rows_, 4, false, "slab vertex rows"); !s) return s.error();
-  if (Status s = ensure(face_rows_, 4, false, "slab face rows"); !s) return s.error();
+  // The rows' buffers: two where the transfer queue copies them out beside the next slab's work
+  // (one is read while the other is written), else one; used in turn with the readback buffers.
+  const bool beside = slab.ply_rows && copyBeside();
+  const unsigned r = beside ? next_readback_ : 0;
+  if (Status s = ensure(vertex_rows_[r], 4, false, "slab vertex rows"); !s) return s.error();
+  if (Status s = ensure(face_rows_[r], 4, false, "slab face rows"); !s) return s.error();
   auto bind = [&] {
     const VkDescriptorBufferInfo infos[kBindings] = {
         {slab_counts.buffer, 0, VK_WHOLE_SIZE}, {axis_.buffer, 0, VK_WHOLE_SIZE},
@@ -298,8 +385,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
         {totals_.buffer, 0, VK_WHOLE_SIZE},    {ids_y_.buffer, 0, VK_WHOLE_SIZE},
         {ids_z_.buffer, 0, VK_WHOLE_SIZE},     {ids_x_.buffer, 0, VK_WHOLE_SIZE},
         {positions_.buffer, 0, VK_WHOLE_SIZE}, {triangles_.buffer, 0, VK_WHOLE_SIZE},
-        {colors_.buffer, 0, VK_WHOLE_SIZE},    {vertex_rows_.buffer, 0, VK_WHOLE_SIZE},
-        {face_rows_.buffer, 0, VK_WHOLE_SIZE}};
+        {colors_.buffer, 0, VK_WHOLE_SIZE},    {vertex_rows_[r].buffer, 0, VK_WHOLE_SIZE},
+        {face_rows_[r].buffer, 0, VK_WHOLE_SIZE}};
     writeBufferDescriptors(context_, set_, infos);
   };
   bind();
@@ -355,20 +442,24 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   // The rows' buffers hold whole blocks of 4 rows (mesh_rows.comp writes whole words).
   const uint64_t vertex_row_bytes = slab.ply_rows ? vertices * row_bytes : 0;
   const uint64_t face_row_bytes = slab.ply_rows ? triangles * kFaceRowBytes : 0;
-  const uint64_t old_sizes[5] = {positions_.size, triangles_.size, colors_.size, vertex_rows_.size, face_rows_.size};
+  const uint64_t old_sizes[5] = {positions_.size, triangles_.size, colors_.size, vertex_rows_[r].size, face_rows_[r].size};
   if (Status s = ensure(positions_, position_bytes, false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, triangle_bytes, false, "slab triangles"); !s) return s.error();
   if (Status s = ensure(colors_, color_bytes, false, "slab colours"); !s) return s.error();
-  if (Status s = ensure(vertex_rows_, (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s)
+  if (Status s = ensure(vertex_rows_[r], (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s)
     return s.error();
-  if (Status s = ensure(face_rows_, (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s)
+  if (Status s = ensure(face_rows_[r], (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s)
     return s.error();
-  Buffer& readback = readback_[next_readback_];
+  const unsigned readback_index = next_readback_;
+  Buffer& readback = readback_[readback_index];
   next_readback_ ^= 1;
+  // The copy of two slabs before, out of these rows' buffers into this readback buffer, has been
+  // waited for by its reader (the view's contract); this only marks it done.
+  if (Status s = waitCopy(copies_[readback_index]); !s) return s.error();
   const uint64_t readback_bytes =
       slab.ply_rows ? vertex_row_bytes + face_row_bytes : position_bytes + color_bytes + triangle_bytes;
   if (Status s = ensure(readback, readback_bytes, true, "slab mesh for the host"); !s) return s.error();
-  const uint64_t new_sizes[5] = {positions_.size, triangles_.size, colors_.size, vertex_rows_.size, face_rows_.size};
+  const uint64_t new_sizes[5] = {positions_.size, triangles_.size, colors_.size, vertex_rows_[r].size, face_rows_[r].size};
   if (!std::equal(old_sizes, old_sizes + 5, new_sizes)) bind();
   push.rows = static_cast<uint32_t>(vertices);
   push.row_bytes = static_cast<uint32_t>(row_bytes);
@@ -390,6 +481,12 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
       if (vertices) dispatch(commands, slab.noise_colors ? kColoredVertexRowPass : kVertexRowPass, rowGroups(vertices));
       if (triangles) dispatch(commands, kFaceRowPass, rowGroups(triangles));
     }
+    if (beside) {
+      // The rows go to the transfer queue (released there), which copies them across.
+      stamp(commands, kCopied);
+      rowsOwnership(commands, r, true);
+      return;
+    }
     barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     auto across = [&](const Buffer& from, uint64_t at, uint64_t bytes) {
       if (bytes == 0) return;
@@ -397,8 +494,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
       vkCmdCopyBuffer(commands, from.buffer, readback.buffer, 1, &copy);
     };
     if (slab.ply_rows) {
-      across(vertex_rows_, 0, vertex_row_bytes);
-      across(face_rows_, vertex_row_bytes, face_row_bytes);
+      across(vertex_rows_[r], 0, vertex_row_bytes);
+      across(face_rows_[r], vertex_row_bytes, face_row_bytes);
     } else {
       across(positions_, 0, position_bytes);
       across(colors_, position_bytes, color_bytes);
@@ -406,12 +503,17 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
     }
     stamp(commands, kCopied);
     barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-  });
+  }, beside ? copies_[readback_index].ready : VK_NULL_HANDLE);
+  // Beside: the copy across on the transfer queue, once the rows are made (the semaphore); the
+  // host waits for it only where the rows are read (the view's `ready`).
+  if (status && beside) status = submitCopy(copies_[readback_index], r, readback, vertex_row_bytes, face_row_bytes);
   if (Status waited = wait(submissions_[1]); status && !waited) status = waited;
   if (!status) return status.error();
   if (Status s = readStamps(); !s) return s.error();
+  times_.copied_beside = beside;
   for (const Buffer* b : {&totals_, &readback})
-    if (Status s = invalidateBuffer(context_, *b); !s) return s.error();
+    if (b == &totals_ || !beside)
+      if (Status s = invalidateBuffer(context_, *b); !s) return s.error();
   std::memcpy(totals, totals_.mapped, sizeof totals);
 
   McSlabView out;
@@ -424,6 +526,11 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
     out.row_vertices = owned;
     out.vertex_rows = {rows, owned * row_bytes};
     out.face_rows = {rows + vertex_row_bytes, face_row_bytes};
+    if (beside)
+      out.ready = [this, readback_index]() -> Status {
+        if (Status s = waitCopy(copies_[readback_index]); !s) return s;
+        return invalidateBuffer(context_, readback_[readback_index]);
+      };
     return out;
   }
   const auto* positions = static_cast<const glm::dvec3*>(readback.mapped);

@@ -73,8 +73,11 @@ class GpuMesher {
 
   // The passes' time on the device (timestamps), in ms: counting and scanning, the vertices, the
   // triangles, and copying the mesh across to host-visible memory.
+  // copied_beside: the rows were copied across on the transfer queue, beside the next slab's work;
+  // `copy` is then the rows' pass alone.
   struct Times {
     double scan = 0.0, vertices = 0.0, triangles = 0.0, copy = 0.0;
+    bool copied_beside = false;
     double total() const { return scan + vertices + triangles + copy; }
   };
   const Times& times() const { return times_; }
@@ -89,8 +92,25 @@ class GpuMesher {
     VkFence fence = VK_NULL_HANDLE;
     bool pending = false;
   };
-  Status submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record);
+  // Records and submits; signals `signal` too where set.
+  Status submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record,
+                VkSemaphore signal = VK_NULL_HANDLE);
   Status wait(Submission& submission);
+  // A slab's rows copied across to its readback buffer on the context's transfer queue (where it
+  // has one), beside the next slab's work on the main queue: the semaphore the rows' submission
+  // signals, and the copy's command buffer and fence. One for each readback buffer.
+  struct Copy {
+    VkSemaphore ready = VK_NULL_HANDLE;
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    bool pending = false;
+  };
+  bool copyBeside() const;  // the device has a transfer queue: the rows are copied there
+  // The rows' buffers r released by the main queue's family (release) or acquired by the transfer
+  // queue's.
+  void rowsOwnership(VkCommandBuffer commands, unsigned r, bool release) const;
+  Status submitCopy(Copy& copy, unsigned r, const Buffer& readback, uint64_t vertex_row_bytes, uint64_t face_row_bytes);
+  Status waitCopy(Copy& copy);
   Status ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what);
   void stamp(VkCommandBuffer commands, uint32_t query) const;
   Status readStamps();
@@ -106,8 +126,10 @@ class GpuMesher {
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   Submission submissions_[2];
+  Copy copies_[2];
   Buffer counts_[2], axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
-  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_, vertex_rows_, face_rows_;
+  Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_;
+  Buffer vertex_rows_[2], face_rows_[2];  // the second only where the rows are copied beside (copyBeside)
   Buffer readback_[2];  // host-visible, used in turn: a slab's positions, colours and triangles
   unsigned next_readback_ = 0;
   std::vector<double> axis_values_;       // what axis_ holds

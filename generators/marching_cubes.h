@@ -30,6 +30,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/point_set.h"
+#include "core/result.h"
 
 namespace dpoint {
 
@@ -96,6 +97,9 @@ struct McSlabView {
   // its triangles' face rows.
   uint64_t row_vertices = 0;
   std::span<const uint8_t> vertex_rows, face_rows;
+  // Where set, the rows are still being copied into that memory (a GPU's transfer queue): the
+  // reader calls it first, once, from any one thread; it waits for the copy.
+  std::function<Status()> ready;
 };
 
 McSlabMesh marchingCubesSlab(int ny, int nz, int first, int last, bool owns_last_plane,

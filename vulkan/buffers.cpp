@@ -116,9 +116,9 @@ Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, con
 
 void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes) { context.device_memory_used.fetch_sub(bytes); }
 
-VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence) {
+VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence, VkQueue queue) {
   if (vulkanFaults().device_lost || context.injected_loss) return VK_ERROR_DEVICE_LOST;
-  return vkQueueSubmit(context.queue, 1, &submit, fence);
+  return vkQueueSubmit(queue ? queue : context.queue, 1, &submit, fence);
 }
 
 VkResult waitForFence(const VulkanContext& context, VkFence fence) {
@@ -142,9 +142,9 @@ static Status syncMapped(const VulkanContext& context, const Buffer& buffer, boo
 Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, true); }
 static Status flushBuffer(const VulkanContext& context, const Buffer& buffer) { return syncMapped(context, buffer, false); }
 
-Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context) {
+Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context, VkCommandPool pool) {
   VkCommandBufferAllocateInfo allocate = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  allocate.commandPool = context.command_pool;
+  allocate.commandPool = pool ? pool : context.command_pool;
   allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   allocate.commandBufferCount = 1;
   VkCommandBuffer commands = VK_NULL_HANDLE;

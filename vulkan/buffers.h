@@ -26,10 +26,11 @@ void destroyBuffer(const VulkanContext& context, Buffer& buffer);
 // Makes device writes visible to the host for a mapped, non-coherent buffer.
 Status invalidateBuffer(const VulkanContext& context, const Buffer& buffer);
 
-// vkQueueSubmit on the context's queue, or VK_ERROR_DEVICE_LOST without submitting under the
+// vkQueueSubmit on the context's queue (or `queue`: its transfer queue), or VK_ERROR_DEVICE_LOST without submitting under the
 // device-lost test switch (vulkanFaults) or once device-lost-wait has fired: every submission
 // goes through here.
-VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence);
+VkResult queueSubmit(const VulkanContext& context, const VkSubmitInfo& submit, VkFence fence,
+                     VkQueue queue = VK_NULL_HANDLE);
 
 // vkWaitForFences on one fence, without a timeout. Under the device-lost-wait test switch the wait
 // still happens (so no work is in flight when the caller frees what it used) and then reports
@@ -43,8 +44,8 @@ VkResult waitForFence(const VulkanContext& context, VkFence fence);
 Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, const std::string& what);
 void releaseDeviceMemory(const VulkanContext& context, VkDeviceSize bytes);
 
-// A primary command buffer from the context's pool (the caller frees it).
-Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context);
+// A primary command buffer from the context's pool, or `pool` (the caller frees it).
+Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context, VkCommandPool pool = VK_NULL_HANDLE);
 
 // Records with `record` into a fresh primary command buffer, submits it, waits.
 Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record);

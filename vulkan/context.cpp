@@ -106,6 +106,14 @@ DeviceFacts readFacts(VkPhysicalDevice physical, uint32_t index) {
       break;
     }
   }
+  for (uint32_t f = 0; f < family_count; ++f) {
+    const VkQueueFlags flags = families[f].queueFlags;
+    if ((flags & VK_QUEUE_TRANSFER_BIT) && !(flags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) &&
+        families[f].queueCount > 0) {
+      facts.transfer_family = f;
+      break;
+    }
+  }
   return facts;
 }
 
@@ -311,13 +319,20 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   VkPhysicalDeviceVulkan12Features enabled12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   enabled12.shaderBufferInt64Atomics = context->facts.int64_atomics;
   float priority = 1.0f;
-  VkDeviceQueueCreateInfo queue_info = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  queue_info.queueFamilyIndex = context->facts.queue_family;
-  queue_info.queueCount = 1;
-  queue_info.pQueuePriorities = &priority;
+  VkDeviceQueueCreateInfo queue_infos[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
+                                            {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
+  queue_infos[0].queueFamilyIndex = context->facts.queue_family;
+  queue_infos[0].queueCount = 1;
+  queue_infos[0].pQueuePriorities = &priority;
+  const std::optional<uint32_t> transfer = context->facts.transfer_family;
+  if (transfer) {
+    queue_infos[1].queueFamilyIndex = *transfer;
+    queue_infos[1].queueCount = 1;
+    queue_infos[1].pQueuePriorities = &priority;
+  }
   VkDeviceCreateInfo device_info = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  device_info.queueCreateInfoCount = 1;
-  device_info.pQueueCreateInfos = &queue_info;
+  device_info.queueCreateInfoCount = transfer ? 2 : 1;
+  device_info.pQueueCreateInfos = queue_infos;
   device_info.pEnabledFeatures = &enabled;
   device_info.pNext = &enabled12;
   VK_TRY(vkCreateDevice(context->physical, &device_info, nullptr, &context->device));
@@ -327,6 +342,11 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pool_info.queueFamilyIndex = context->facts.queue_family;
   VK_TRY(vkCreateCommandPool(context->device, &pool_info, nullptr, &context->command_pool));
+  if (transfer) {
+    vkGetDeviceQueue(context->device, *transfer, 0, &context->transfer_queue);
+    pool_info.queueFamilyIndex = *transfer;
+    VK_TRY(vkCreateCommandPool(context->device, &pool_info, nullptr, &context->transfer_pool));
+  }
   VkPipelineCacheCreateInfo cache_info = {VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
   VK_TRY(vkCreatePipelineCache(context->device, &cache_info, nullptr, &context->pipeline_cache));
   context->device_memory_budget = options.max_device_memory;
@@ -337,6 +357,7 @@ VulkanContext::~VulkanContext() {
   if (device) {
     vkDeviceWaitIdle(device);
     if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
+    if (transfer_pool) vkDestroyCommandPool(device, transfer_pool, nullptr);
     if (pipeline_cache) vkDestroyPipelineCache(device, pipeline_cache, nullptr);
     vkDestroyDevice(device, nullptr);
   }

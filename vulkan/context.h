@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct DeviceFacts {
   float timestamp_period_ns = 0.0f;  // 0: no timestamps on the graphics queue
   uint32_t queue_family = 0;
   bool has_graphics_queue = false;
+  // A family of transfer queues alone (a GPU's copy engines), where the device has one: copies on
+  // such a queue run beside the compute work of the main queue.
+  std::optional<uint32_t> transfer_family;
   bool vulkan12 = false;  // apiVersion ≥ 1.2
 };
 
@@ -87,6 +91,10 @@ class VulkanContext {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
   VkCommandPool command_pool = VK_NULL_HANDLE;
+  // The transfer queue of facts.transfer_family and its command pool (resettable buffers); null
+  // where the device has no such family (lavapipe).
+  VkQueue transfer_queue = VK_NULL_HANDLE;
+  VkCommandPool transfer_pool = VK_NULL_HANDLE;
   // Every pipeline is made through it: a device kept across renders (the Python module's
   // Renderer) compiles a pipeline it made before from the cache.
   VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
