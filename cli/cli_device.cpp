@@ -78,7 +78,9 @@ Result<std::shared_ptr<GenerateDevice>> GenerateDevice::open(const GenerateDevic
   }
   std::shared_ptr<GenerateDevice> device(new GenerateDevice());
   device->validate_ = options.validate;
-  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(ContextOptions{index, options.validate});
+  ContextOptions context_options{index, options.validate};
+  context_options.transfer_queue = true;  // the mesh's rows are copied out there (generators/gpu_mesh.h)
+  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(context_options);
   if (!context) return context.error();
   device->context_ = std::move(*context);
   Result<std::unique_ptr<GpuEscape>> gpu = GpuEscape::create(*device->context_);

@@ -324,9 +324,10 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   queue_infos[0].queueFamilyIndex = context->facts.queue_family;
   queue_infos[0].queueCount = 1;
   queue_infos[0].pQueuePriorities = &priority;
-  const std::optional<uint32_t> transfer = context->facts.transfer_family;
+  const bool transfer = options.transfer_queue && context->facts.transfer_family.has_value();
+  const uint32_t transfer_family = context->facts.transfer_family.value_or(0);
   if (transfer) {
-    queue_infos[1].queueFamilyIndex = *transfer;
+    queue_infos[1].queueFamilyIndex = transfer_family;
     queue_infos[1].queueCount = 1;
     queue_infos[1].pQueuePriorities = &priority;
   }
@@ -343,8 +344,8 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   pool_info.queueFamilyIndex = context->facts.queue_family;
   VK_TRY(vkCreateCommandPool(context->device, &pool_info, nullptr, &context->command_pool));
   if (transfer) {
-    vkGetDeviceQueue(context->device, *transfer, 0, &context->transfer_queue);
-    pool_info.queueFamilyIndex = *transfer;
+    vkGetDeviceQueue(context->device, transfer_family, 0, &context->transfer_queue);
+    pool_info.queueFamilyIndex = transfer_family;
     VK_TRY(vkCreateCommandPool(context->device, &pool_info, nullptr, &context->transfer_pool));
   }
   VkPipelineCacheCreateInfo cache_info = {VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};

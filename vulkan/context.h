@@ -51,6 +51,9 @@ struct ContextOptions {
   std::string device = "auto";  // auto (a discrete GPU if any, else the best other), cpu, or an index
   bool validate = false;        // enable VK_LAYER_KHRONOS_validation and collect its messages
   uint64_t max_device_memory = 0;  // --max-device-memory: a budget for every allocation; 0: none
+  // Open the transfer queue too, where the device has a transfer-only family (generation copies its
+  // mesh out there); others do without it.
+  bool transfer_queue = false;
 };
 
 // Test switches for the fault paths (issue #12), from the environment variable
@@ -92,7 +95,8 @@ class VulkanContext {
   VkQueue queue = VK_NULL_HANDLE;
   VkCommandPool command_pool = VK_NULL_HANDLE;
   // The transfer queue of facts.transfer_family and its command pool (resettable buffers); null
-  // where the device has no such family (lavapipe).
+  // unless ContextOptions::transfer_queue asked for it and the device has such a family (lavapipe
+  // has none).
   VkQueue transfer_queue = VK_NULL_HANDLE;
   VkCommandPool transfer_pool = VK_NULL_HANDLE;
   // Every pipeline is made through it: a device kept across renders (the Python module's

@@ -28,7 +28,9 @@ namespace {
 class GpuGenerate : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    Result<std::unique_ptr<VulkanContext>> created = VulkanContext::create(ContextOptions{"auto", true});
+    ContextOptions options{"auto", true};
+    options.transfer_queue = true;  // as `generate` opens it: a GPU's copies of the rows go there
+    Result<std::unique_ptr<VulkanContext>> created = VulkanContext::create(options);
     if (!created) {
       setup_error_ = created.error().message;
       return;
