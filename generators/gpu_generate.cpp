@@ -148,11 +148,7 @@ Status GpuEscape::init() {
     slot.perturbation_set = sets[1];
     slot.arena_set = sets[2];
     slot.target_set = sets[3];
-    Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
-    if (!commands) return commands.error();
-    slot.commands = *commands;
-    VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &slot.fence));
+    if (Status s = createCommandSlot(context_, slot.submission); !s) return s;
   }
   return okStatus();
 }
@@ -160,9 +156,7 @@ Status GpuEscape::init() {
 GpuEscape::~GpuEscape() {
   const VkDevice device = context_.device;
   for (Slot& slot : slots_) {
-    if (slot.points) waitForFence(context_, slot.fence);
-    if (slot.fence) vkDestroyFence(device, slot.fence, nullptr);
-    if (slot.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &slot.commands);
+    destroyCommandSlot(context_, slot.submission);  // waits for a dispatch in flight
     destroyBuffer(context_, slot.counts);
     destroyBuffer(context_, slot.tails);
   }
@@ -180,7 +174,7 @@ GpuEscape::~GpuEscape() {
 Status GpuEscape::finish(Slot& slot) {
   if (!slot.points) return okStatus();
   const auto start = std::chrono::steady_clock::now();
-  VK_TRY(waitForFence(context_, slot.fence));
+  if (Status s = waitCommandSlot(context_, slot.submission); !s) return s;
   const auto waited = std::chrono::steady_clock::now();
   const uint64_t points = slot.points;
   slot.points = 0;
@@ -241,26 +235,20 @@ Status GpuEscape::dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layou
   assert(points > 0 && points <= (tail_destination ? kGpuPerturbationChunkPoints : kGpuChunkPoints));
   Slot& slot = slots_[s];
   if (Status st = finish(slot); !st) return st;
-  VK_TRY(vkResetFences(context_.device, 1, &slot.fence));
-  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VK_TRY(vkBeginCommandBuffer(slot.commands, &begin));
+  if (Status st = beginCommandSlot(context_, slot.submission); !st) return st;
+  const VkCommandBuffer commands = slot.submission.commands;
   const uint32_t query = 2 * static_cast<uint32_t>(s);
-  stampStart(slot.commands, query);
-  vkCmdBindPipeline(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-  vkCmdBindDescriptorSets(slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
-  recordPoints(slot.commands, layout, push, push_bytes, points);
-  if (queries_) vkCmdWriteTimestamp(slot.commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, query + 1);
+  stampStart(commands, query);
+  vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+  recordPoints(commands, layout, push, push_bytes, points);
+  if (queries_) vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, query + 1);
   VkMemoryBarrier barrier = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
   barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(slot.commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
+  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
                        nullptr, 0, nullptr);
-  VK_TRY(vkEndCommandBuffer(slot.commands));
-  VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &slot.commands;
-  VK_TRY(queueSubmit(context_, submit, slot.fence));
+  if (Status st = submitCommandSlot(context_, slot.submission); !st) return st;
   slot.points = points;
   slot.destination = destination;
   slot.count_bytes = count_bytes;
@@ -340,14 +328,12 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
   // Into device memory, every chunk in one submission of slot 0's: nothing waits on the host
   // between them (the chunks write words of their own), and the host is free once it is submitted.
   Slot& device_slot = slots_[0];
+  const VkCommandBuffer device_commands = device_slot.submission.commands;
   if (target == Target::kDevice) {
-    VK_TRY(vkResetFences(context_.device, 1, &device_slot.fence));
-    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_TRY(vkBeginCommandBuffer(device_slot.commands, &begin));
-    stampStart(device_slot.commands, 0);
-    vkCmdBindPipeline(device_slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(device_slot.commands, VK_PIPELINE_BIND_POINT_COMPUTE, escape_layout_, 0, 1,
+    if (Status st = beginCommandSlot(context_, device_slot.submission); !st) return st;
+    stampStart(device_commands, 0);
+    vkCmdBindPipeline(device_commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(device_commands, VK_PIPELINE_BIND_POINT_COMPUTE, escape_layout_, 0, 1,
                             &device_slot.target_set, 0, nullptr);
   }
   size_t s = 0;
@@ -358,7 +344,7 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
     const uint64_t bytes_before = (row - first_row) * res * device_bytes;
     push.word_offset = target == Target::kHost ? 0 : static_cast<uint32_t>(word_offset + bytes_before / 4);
     if (target == Target::kDevice) {
-      recordPoints(device_slot.commands, escape_layout_, &push, sizeof push, rows * res);
+      recordPoints(device_commands, escape_layout_, &push, sizeof push, rows * res);
       continue;
     }
     const VkDescriptorSet set = target == Target::kArena ? slots_[s].arena_set : slots_[s].escape_set;
@@ -373,12 +359,8 @@ Status GpuEscape::escapeRows(const EscapeKernelParams& kernel, uint64_t res, int
   if (target != Target::kDevice) return finishAll();
   // The reader's own submission follows on the queue (escapeInto); the counts need no barrier
   // towards the host.
-  if (queries_) vkCmdWriteTimestamp(device_slot.commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 1);
-  VK_TRY(vkEndCommandBuffer(device_slot.commands));
-  VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &device_slot.commands;
-  VK_TRY(queueSubmit(context_, submit, device_slot.fence));
+  if (queries_) vkCmdWriteTimestamp(device_commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 1);
+  if (Status st = submitCommandSlot(context_, device_slot.submission); !st) return st;
   device_slot.points = (end_row - first_row) * res;
   device_slot.destination = nullptr;
   device_slot.count_bytes = count_bytes;

@@ -106,8 +106,7 @@ class GpuEscape {
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
     VkDescriptorSet arena_set = VK_NULL_HANDLE;  // the escape kernel writing into arena_
     VkDescriptorSet target_set = VK_NULL_HANDLE;  // and into escapeInto's target (slot 0's only)
-    VkCommandBuffer commands = VK_NULL_HANDLE;
-    VkFence fence = VK_NULL_HANDLE;
+    CommandSlot submission;                  // its dispatch's command buffer and fence
     void* destination = nullptr;             // where the counts of the dispatch in flight go; null: in place
     uint32_t count_bytes = 4;                // and the bytes of each there
     uint32_t device_bytes = 4;               // the bytes of each in `counts`

@@ -92,34 +92,17 @@ Status GpuMesher::init() {
       VkSemaphoreCreateInfo semaphore_info = {VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
       VK_TRY(vkCreateSemaphore(context_.device, &semaphore_info, nullptr, &copy.ready));
     }
-  for (Submission& submission : submissions_) {
-    Result<VkCommandBuffer> commands = allocateCommandBuffer(context_);
-    if (!commands) return commands.error();
-    submission.commands = *commands;
-    VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &submission.fence));
-  }
+  for (CommandSlot& slot : submissions_)
+    if (Status s = createCommandSlot(context_, slot); !s) return s;
   return okStatus();
 }
 
-Status GpuMesher::submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record,
-                         VkSemaphore signal) {
-  VK_TRY(vkResetFences(context_.device, 1, &submission.fence));
-  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VK_TRY(vkBeginCommandBuffer(submission.commands, &begin));
-  record(submission.commands);
-  VK_TRY(vkEndCommandBuffer(submission.commands));
-  VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  info.commandBufferCount = 1;
-  info.pCommandBuffers = &submission.commands;
-  if (signal) {
-    info.signalSemaphoreCount = 1;
-    info.pSignalSemaphores = &signal;
-  }
-  VK_TRY(queueSubmit(context_, info, submission.fence));
-  submission.pending = true;
-  return okStatus();
+Status GpuMesher::submit(CommandSlot& slot, const std::function<void(VkCommandBuffer)>& record, VkSemaphore signal) {
+  if (Status s = beginCommandSlot(context_, slot); !s) return s;
+  record(slot.commands);
+  SlotSync sync;
+  sync.signal = signal;
+  return submitCommandSlot(context_, slot, sync);
 }
 
 bool GpuMesher::copyBeside() const { return context_.transfer_queue != VK_NULL_HANDLE; }
@@ -145,65 +128,32 @@ void GpuMesher::rowsOwnership(VkCommandBuffer commands, unsigned r, bool release
 
 Status GpuMesher::submitCopy(Copy& copy, unsigned r, const Buffer& readback, uint64_t vertex_row_bytes,
                              uint64_t face_row_bytes) {
-  if (!copy.commands) {
-    Result<VkCommandBuffer> commands = allocateCommandBuffer(context_, context_.transfer_pool);
-    if (!commands) return commands.error();
-    copy.commands = *commands;
-    VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VK_TRY(vkCreateFence(context_.device, &fence_info, nullptr, &copy.fence));
-  }
-  VK_TRY(vkResetFences(context_.device, 1, &copy.fence));
-  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VK_TRY(vkBeginCommandBuffer(copy.commands, &begin));
-  rowsOwnership(copy.commands, r, false);
+  if (!copy.slot.commands)
+    if (Status s = createCommandSlot(context_, copy.slot, context_.transfer_pool); !s) return s;
+  if (Status s = beginCommandSlot(context_, copy.slot); !s) return s;
+  const VkCommandBuffer commands = copy.slot.commands;
+  rowsOwnership(commands, r, false);
   const VkBufferCopy vertex_copy{0, 0, vertex_row_bytes}, face_copy{0, vertex_row_bytes, face_row_bytes};
-  if (vertex_row_bytes) vkCmdCopyBuffer(copy.commands, vertex_rows_[r].buffer, readback.buffer, 1, &vertex_copy);
-  if (face_row_bytes) vkCmdCopyBuffer(copy.commands, face_rows_[r].buffer, readback.buffer, 1, &face_copy);
+  if (vertex_row_bytes) vkCmdCopyBuffer(commands, vertex_rows_[r].buffer, readback.buffer, 1, &vertex_copy);
+  if (face_row_bytes) vkCmdCopyBuffer(commands, face_rows_[r].buffer, readback.buffer, 1, &face_copy);
   VkMemoryBarrier to_host = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(copy.commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                       nullptr, 0, nullptr);
-  VK_TRY(vkEndCommandBuffer(copy.commands));
-  const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
-  VkSubmitInfo info = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  info.waitSemaphoreCount = 1;
-  info.pWaitSemaphores = &copy.ready;
-  info.pWaitDstStageMask = &wait_stage;
-  info.commandBufferCount = 1;
-  info.pCommandBuffers = &copy.commands;
-  VK_TRY(queueSubmit(context_, info, copy.fence, context_.transfer_queue));
-  copy.pending = true;
-  return okStatus();
-}
-
-Status GpuMesher::waitCopy(Copy& copy) {
-  if (!copy.pending) return okStatus();
-  copy.pending = false;
-  VK_TRY(waitForFence(context_, copy.fence));
-  return okStatus();
-}
-
-Status GpuMesher::wait(Submission& submission) {
-  if (!submission.pending) return okStatus();
-  submission.pending = false;
-  VK_TRY(waitForFence(context_, submission.fence));
-  return okStatus();
+  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr,
+                       0, nullptr);
+  SlotSync sync;
+  sync.queue = context_.transfer_queue;
+  sync.wait = copy.ready;
+  sync.wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  return submitCommandSlot(context_, copy.slot, sync);
 }
 
 GpuMesher::~GpuMesher() {
   const VkDevice device = context_.device;
-  for (Submission& submission : submissions_) {
-    (void)wait(submission);
-    if (submission.fence) vkDestroyFence(device, submission.fence, nullptr);
-    if (submission.commands) vkFreeCommandBuffers(device, context_.command_pool, 1, &submission.commands);
-  }
+  for (CommandSlot& slot : submissions_) destroyCommandSlot(context_, slot);
   for (Copy& copy : copies_) {
-    (void)waitCopy(copy);
-    if (copy.fence) vkDestroyFence(device, copy.fence, nullptr);
+    destroyCommandSlot(context_, copy.slot);
     if (copy.ready) vkDestroySemaphore(device, copy.ready, nullptr);
-    if (copy.commands) vkFreeCommandBuffers(device, context_.transfer_pool, 1, &copy.commands);
   }
   for (Buffer* b : {&counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
                     &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_[0], &vertex_rows_[1], &face_rows_[0],
@@ -424,7 +374,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
     barrier(commands, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   });
   if (status && while_scanning) status = while_scanning();
-  if (Status waited = wait(submissions_[0]); status && !waited) status = waited;
+  if (Status waited = waitCommandSlot(context_, submissions_[0]); status && !waited) status = waited;
   if (!status) return status.error();
   if (Status s = invalidateBuffer(context_, totals_); !s) return s.error();
   uint32_t totals[4];
@@ -455,7 +405,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   next_readback_ ^= 1;
   // The copy of two slabs before, out of these rows' buffers into this readback buffer, has been
   // waited for by its reader (the view's contract); this only marks it done.
-  if (Status s = waitCopy(copies_[readback_index]); !s) return s.error();
+  if (Status s = waitCommandSlot(context_, copies_[readback_index].slot); !s) return s.error();
   const uint64_t readback_bytes =
       slab.ply_rows ? vertex_row_bytes + face_row_bytes : position_bytes + color_bytes + triangle_bytes;
   if (Status s = ensure(readback, readback_bytes, true, "slab mesh for the host"); !s) return s.error();
@@ -507,7 +457,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   // Beside: the copy across on the transfer queue, once the rows are made (the semaphore); the
   // host waits for it only where the rows are read (the view's `ready`).
   if (status && beside) status = submitCopy(copies_[readback_index], r, readback, vertex_row_bytes, face_row_bytes);
-  if (Status waited = wait(submissions_[1]); status && !waited) status = waited;
+  if (Status waited = waitCommandSlot(context_, submissions_[1]); status && !waited) status = waited;
   if (!status) return status.error();
   if (Status s = readStamps(); !s) return s.error();
   times_.copied_beside = beside;
@@ -528,7 +478,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
     out.face_rows = {rows + vertex_row_bytes, face_row_bytes};
     if (beside)
       out.ready = [this, readback_index]() -> Status {
-        if (Status s = waitCopy(copies_[readback_index]); !s) return s;
+        if (Status s = waitCommandSlot(context_, copies_[readback_index].slot); !s) return s;
         return invalidateBuffer(context_, readback_[readback_index]);
       };
     return out;

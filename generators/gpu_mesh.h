@@ -85,32 +85,21 @@ class GpuMesher {
  private:
   explicit GpuMesher(const VulkanContext& context) : context_(context) {}
   Status init();
-  // A command buffer and its fence, recorded again for each slab: the counts' scan (0) and the
-  // mesh (1).
-  struct Submission {
-    VkCommandBuffer commands = VK_NULL_HANDLE;
-    VkFence fence = VK_NULL_HANDLE;
-    bool pending = false;
-  };
-  // Records and submits; signals `signal` too where set.
-  Status submit(Submission& submission, const std::function<void(VkCommandBuffer)>& record,
+  // Records into a slot and submits on the main queue; signals `signal` too where set.
+  Status submit(CommandSlot& slot, const std::function<void(VkCommandBuffer)>& record,
                 VkSemaphore signal = VK_NULL_HANDLE);
-  Status wait(Submission& submission);
   // A slab's rows copied across to its readback buffer on the context's transfer queue (where it
   // has one), beside the next slab's work on the main queue: the semaphore the rows' submission
-  // signals, and the copy's command buffer and fence. One for each readback buffer.
+  // signals, and the copy's submission. One for each readback buffer.
   struct Copy {
     VkSemaphore ready = VK_NULL_HANDLE;
-    VkCommandBuffer commands = VK_NULL_HANDLE;
-    VkFence fence = VK_NULL_HANDLE;
-    bool pending = false;
+    CommandSlot slot;
   };
   bool copyBeside() const;  // the device has a transfer queue: the rows are copied there
   // The rows' buffers r released by the main queue's family (release) or acquired by the transfer
   // queue's.
   void rowsOwnership(VkCommandBuffer commands, unsigned r, bool release) const;
   Status submitCopy(Copy& copy, unsigned r, const Buffer& readback, uint64_t vertex_row_bytes, uint64_t face_row_bytes);
-  Status waitCopy(Copy& copy);
   Status ensure(Buffer& buffer, uint64_t bytes, bool host_visible, const char* what);
   void stamp(VkCommandBuffer commands, uint32_t query) const;
   Status readStamps();
@@ -125,7 +114,7 @@ class GpuMesher {
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
-  Submission submissions_[2];
+  CommandSlot submissions_[2];  // recorded again for each slab: the counts' scan (0) and the mesh (1)
   Copy copies_[2];
   Buffer counts_[2], axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
   Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_;

@@ -1,6 +1,7 @@
 #include "vulkan/buffers.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
 #include "core/memory.h"
@@ -179,6 +180,58 @@ Status submitOnce(const VulkanContext& context, const std::function<void(VkComma
   if (result == VK_SUCCESS) result = waitForFence(context, fence);
   cleanup();
   if (result != VK_SUCCESS) return vulkanError("one-shot command submission", result);
+  return okStatus();
+}
+
+Status createCommandSlot(const VulkanContext& context, CommandSlot& slot, VkCommandPool pool) {
+  Result<VkCommandBuffer> commands = allocateCommandBuffer(context, pool);
+  if (!commands) return commands.error();
+  slot.commands = *commands;
+  slot.pool = pool ? pool : context.command_pool;
+  VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &slot.fence));
+  return okStatus();
+}
+
+void destroyCommandSlot(const VulkanContext& context, CommandSlot& slot) {
+  (void)waitCommandSlot(context, slot);
+  if (slot.fence) vkDestroyFence(context.device, slot.fence, nullptr);
+  if (slot.commands) vkFreeCommandBuffers(context.device, slot.pool, 1, &slot.commands);
+  slot = CommandSlot{};
+}
+
+Status beginCommandSlot(const VulkanContext& context, CommandSlot& slot) {
+  assert(!slot.pending);
+  VK_TRY(vkResetFences(context.device, 1, &slot.fence));
+  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_TRY(vkBeginCommandBuffer(slot.commands, &begin));
+  return okStatus();
+}
+
+Status submitCommandSlot(const VulkanContext& context, CommandSlot& slot, const SlotSync& sync) {
+  VK_TRY(vkEndCommandBuffer(slot.commands));
+  VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &slot.commands;
+  if (sync.wait) {
+    submit.waitSemaphoreCount = 1;
+    submit.pWaitSemaphores = &sync.wait;
+    submit.pWaitDstStageMask = &sync.wait_stage;
+  }
+  if (sync.signal) {
+    submit.signalSemaphoreCount = 1;
+    submit.pSignalSemaphores = &sync.signal;
+  }
+  VK_TRY(queueSubmit(context, submit, slot.fence, sync.queue));
+  slot.pending = true;
+  return okStatus();
+}
+
+Status waitCommandSlot(const VulkanContext& context, CommandSlot& slot) {
+  if (!slot.pending) return okStatus();
+  slot.pending = false;
+  VK_TRY(waitForFence(context, slot.fence));
   return okStatus();
 }
 

@@ -50,6 +50,32 @@ Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context, VkCo
 // Records with `record` into a fresh primary command buffer, submits it, waits.
 Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record);
 
+// A primary command buffer recorded anew for each of its submissions, and that submission's
+// fence: made once, then begun, submitted and waited for in turn (generation's slabs).
+struct CommandSlot {
+  VkCommandBuffer commands = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkCommandPool pool = VK_NULL_HANDLE;  // the pool the command buffer came from
+  bool pending = false;                 // submitted and not yet waited for
+};
+// The command buffer, from `pool` (else the context's), and an unsignalled fence.
+Status createCommandSlot(const VulkanContext& context, CommandSlot& slot, VkCommandPool pool = VK_NULL_HANDLE);
+// Waits for a pending submission, then frees both.
+void destroyCommandSlot(const VulkanContext& context, CommandSlot& slot);
+// Resets the fence and begins a one-time recording (after the last submission was waited for).
+Status beginCommandSlot(const VulkanContext& context, CommandSlot& slot);
+// Ends the recording and submits it on `queue` (null: the context's), first waiting for `wait` at
+// `wait_stage` and then signalling `signal`, each where set.
+struct SlotSync {
+  VkQueue queue = VK_NULL_HANDLE;
+  VkSemaphore wait = VK_NULL_HANDLE;
+  VkPipelineStageFlags wait_stage = 0;
+  VkSemaphore signal = VK_NULL_HANDLE;
+};
+Status submitCommandSlot(const VulkanContext& context, CommandSlot& slot, const SlotSync& sync = {});
+// Waits for the slot's submission if one is pending (waitForFence).
+Status waitCommandSlot(const VulkanContext& context, CommandSlot& slot);
+
 // Device-local memory for data the host uploads once: host-visible too (mapped, written in place)
 // where the device has such a heap large enough, else plain device-local (filled via staging).
 Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
