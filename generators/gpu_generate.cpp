@@ -55,20 +55,12 @@ void copyOut(void* to, const void* from, uint64_t count) {
   });
 }
 
+// Points the set's bindings 0, 1, … at the whole buffers, in order (vulkan/shader's
+// writeBufferDescriptors).
 void writeSet(const VulkanContext& context, VkDescriptorSet set, const std::vector<const Buffer*>& buffers) {
   std::vector<VkDescriptorBufferInfo> infos;
   for (const Buffer* b : buffers) infos.push_back({b->buffer, 0, VK_WHOLE_SIZE});
-  std::vector<VkWriteDescriptorSet> writes;
-  for (uint32_t i = 0; i < infos.size(); ++i) {
-    VkWriteDescriptorSet write = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    write.dstSet = set;
-    write.dstBinding = i;
-    write.descriptorCount = 1;
-    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    write.pBufferInfo = &infos[i];
-    writes.push_back(write);
-  }
-  vkUpdateDescriptorSets(context.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  writeBufferDescriptors(context, set, infos);
 }
 
 uint64_t squaredResolution(int res) { return static_cast<uint64_t>(res) * static_cast<uint64_t>(res); }
