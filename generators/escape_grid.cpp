@@ -86,8 +86,22 @@ int classificationLimit(const EscapeSurfaceParams& p) {
   return p.lazy && p.grid_out.empty() ? static_cast<int>(std::floor(p.level)) + 1 : p.max_iter;
 }
 
-uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share) {
+// Where a surface's mesh is made and held: by the host's workers (their buffers and the plane
+// function's blocks too), by a mesher elsewhere into the mesh in memory (those slabs copied in),
+// or by a mesher elsewhere as PLY rows written as they come (the face rows held to the end).
+enum class MeshPath { kHost, kElsewhere, kRows };
+
+uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share, MeshPath path = MeshPath::kHost) {
   const int res = params.axis.resolution;
+  const double vertices = share * estimatedVertices(res);
+  if (path != MeshPath::kHost) {
+    // The slabs' copies in host memory, two of them, a quarter over a slab's share (the mesher's
+    // own thickness), then the mesh, or its face rows: 13 bytes a triangle, two a vertex.
+    const double slab = static_cast<double>(meshSlabThickness(res, res - 1)) / (res - 1);
+    const double copies = 2.0 * 1.25 * slab * estimatedVertices(res) * static_cast<double>(kMeshBytesPerVertex);
+    const double held = vertices * (path == MeshPath::kRows ? 2.0 * 13.0 : static_cast<double>(kMeshBytesPerVertex));
+    return static_cast<uint64_t>(std::min(copies + held, 1e19));
+  }
   const unsigned threads = resolveThreads(params.threads);
   const SlabPlan plan =
       planSlabs(res - 1, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
@@ -99,7 +113,7 @@ uint64_t estimateLayerMemory(const EscapeSurfaceParams& params, double share) {
   if (params.planes)
     blocks = (threads + 2) * static_cast<uint64_t>(plan.thickness + 1) * squared(res) *
              static_cast<uint64_t>(escapeGridBytesPerCount(classificationLimit(params)));
-  const double mesh = share * estimatedVertices(res) * static_cast<double>(kMeshBytesPerVertex);
+  const double mesh = vertices * static_cast<double>(kMeshBytesPerVertex);
   return threads * per_worker + blocks + static_cast<uint64_t>(std::min(mesh, 1e19));
 }
 
@@ -589,27 +603,13 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
                            (layers < res - 1 ? " (planes " + std::to_string(first_layer) + ".." +
                                                    std::to_string(last_layer) + ")"
                                              : "");
-  if (Status s = checkMemory(what, estimateLayerMemory(params, share), params.max_memory); !s) return s.error();
-  const uint64_t limit = params.max_memory == 0 ? defaultMemoryLimit() : params.max_memory;
-
-  std::optional<AtomicFile> grid_file;
-  if (!params.grid_out.empty()) {
-    Result<AtomicFile> f = AtomicFile::create(params.grid_out);
-    if (!f) return f.error();
-    grid_file.emplace(std::move(f).value());
-  }
-  const int grid_bytes = escapeGridBytesPerCount(params.max_iter);
-
-  std::vector<double> values(static_cast<size_t>(res));
-  for (int i = 0; i < res; ++i) values[static_cast<size_t>(i)] = params.axis.value(i);
-
   const unsigned threads = resolveThreads(params.threads);
   SlabPlan plan = planSlabs(layers, threads, params.planes ? gpuSlabThickness(res) : kMaxSlabThickness);
   const int cap = classificationLimit(params);
   // Marching cubes elsewhere (a GPU) makes the slabs' counts and meshes, in slab order, in slabs of
   // its own thickness where it takes them; else the plane function's blocks of counts feed the
   // workers, or the workers count with the row function.
-  bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && !grid_file;
+  bool elsewhere = params.planes && params.mesher.mesh && cap == params.max_iter && params.grid_out.empty();
   if (elsewhere) {
     const int thickness = std::min(layers, meshSlabThickness(res, layers));
     if (params.mesher.takes(res, thickness + 1, cap))
@@ -626,6 +626,21 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   // The whole mesh as PLY rows, written as they come, where the mesher makes all of it.
   const bool rows = elsewhere && params.rows.slab && first_layer == 0 && last_layer == res - 1 &&
                     (!params.rows.colors || noise_elsewhere);
+  // What the path holds in memory, checked before anything is made or written.
+  const MeshPath path = rows ? MeshPath::kRows : elsewhere ? MeshPath::kElsewhere : MeshPath::kHost;
+  if (Status s = checkMemory(what, estimateLayerMemory(params, share, path), params.max_memory); !s) return s.error();
+  const uint64_t limit = params.max_memory == 0 ? defaultMemoryLimit() : params.max_memory;
+
+  std::optional<AtomicFile> grid_file;
+  if (!params.grid_out.empty()) {
+    Result<AtomicFile> f = AtomicFile::create(params.grid_out);
+    if (!f) return f.error();
+    grid_file.emplace(std::move(f).value());
+  }
+  const int grid_bytes = escapeGridBytesPerCount(params.max_iter);
+
+  std::vector<double> values(static_cast<size_t>(res));
+  for (int i = 0; i < res; ++i) values[static_cast<size_t>(i)] = params.axis.value(i);
   LayerMesh out;
   PointSet& mesh = out.mesh;
   // Reserving only claims address space; the pages are touched as the mesh grows, so an

@@ -486,6 +486,50 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
   }
 }
 
+// --max-memory is checked against what the path holds: the streamed rows hold the face rows (13
+// bytes a triangle) and two slabs' copies, the mesh in memory holds the mesh, the host's workers
+// their buffers and blocks too. At res 44 the estimates are about 240 KB, 380 KB and more than
+// 440 KB: 300 KB lets the streamed rows through and refuses the others, naming --max-memory.
+TEST_F(GpuGenerate, maxMemoryIsWhatTheStreamedRowsHold) {
+  Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*context_);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  GpuMesher& mesher = **made;
+  test::TempDir dir;
+  auto params = [&](bool mesher_elsewhere) {
+    MandelbulbParams bulb;
+    bulb.resolution = 44;
+    bulb.variant = MandelbulbVariant::kFast;
+    bulb.threads = 2;
+    bulb.max_memory = 300u << 10;
+    bulb.planes = planes(mandelbulb(), GridAxis{44, -1.5, 1.5}, true);
+    bulb.full_counts = true;
+    if (mesher_elsewhere) {
+      bulb.mesher.takes = &GpuMesher::supports;
+      bulb.mesher.mesh = [&](const EscapeSlab& slab, const EscapeSlab* next) {
+        return meshSlabOnDevice(*packed_, mesher, mandelbulb(), slab, next);
+      };
+    }
+    return bulb;
+  };
+  for (bool elsewhere : {false, true}) {
+    SCOPED_TRACE(elsewhere ? "the mesh in memory, made on the device" : "the host's workers");
+    Result<PointSet> refused = generateMandelbulb(params(elsewhere));
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.error().code, ExitCode::kResourceLimit);
+    EXPECT_NE(refused.error().message.find("--max-memory"), std::string::npos) << refused.error().message;
+  }
+  MandelbulbParams streamed = params(true);
+  Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("rows.ply"), false, 0, nullptr);
+  ASSERT_TRUE(stream.ok() && *stream);
+  PlyRowStream& to = **stream;
+  streamed.rows.start = [&](uint64_t v, uint64_t t) { return to.start(v, t); };
+  streamed.rows.slab = [&](std::span<const uint8_t> v, std::span<const uint8_t> f) { return to.add(v, f); };
+  Result<PointSet> got = generateMandelbulb(streamed);
+  ASSERT_TRUE(got.ok()) << got.error().message;
+  ASSERT_TRUE(to.finish().ok());
+  EXPECT_GT(to.vertices(), 0u);
+}
+
 bool sameBits(const PointSet& a, const PointSet& b) {
   return a.size() == b.size() && a.colors.size() == b.colors.size() &&
          std::memcmp(a.positions.data(), b.positions.data(), a.size() * sizeof(glm::dvec3)) == 0 &&
