@@ -155,10 +155,9 @@ GpuMesher::~GpuMesher() {
     destroyCommandSlot(context_, copy.slot);
     if (copy.ready) vkDestroySemaphore(device, copy.ready, nullptr);
   }
-  for (Buffer* b : {&counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_, &totals_, &ids_y_,
-                    &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_[0], &vertex_rows_[1], &face_rows_[0],
-                    &face_rows_[1], &readback_[0],
-                    &readback_[1]})
+  for (Buffer* b : {&counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_,
+                    &totals_, &ids_y_, &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_[0],
+                    &vertex_rows_[1], &face_rows_[0], &face_rows_[1], &readback_[0], &readback_[1]})
     destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
   if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
@@ -213,7 +212,8 @@ Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, bo
                       triangles * 3 * sizeof(uint32_t);
   if (rows) {
     for (unsigned r = 0; r < (copyBeside() ? 2u : 1u); ++r) {
-      if (Status s = ensure(vertex_rows_[r], (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s) return s;
+      if (Status s = ensure(vertex_rows_[r], (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s)
+        return s;
       if (Status s = ensure(face_rows_[r], (triangles + 3) / 4 * 4 * kFaceRowBytes, false, "slab face rows"); !s)
         return s;
     }
