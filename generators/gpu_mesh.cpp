@@ -18,7 +18,7 @@ namespace {
 // Elements a workgroup takes: 256 invocations of 16 (mesh_slab.comp's kGroupElements). Fewer,
 // larger groups keep the one-workgroup scan of their counts (pass 2) short.
 constexpr uint32_t kGroupElements = 4096;
-constexpr uint32_t kBindings = 15;
+constexpr uint32_t kBindings = 17;
 constexpr uint32_t kFaceRowBytes = 13;  // the byte 3, three uint ids
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
 // passes_: mesh_slab.comp's passes 0–4 (those of slab_passes_ for the slab's bits), then these.
@@ -155,7 +155,7 @@ GpuMesher::~GpuMesher() {
     destroyCommandSlot(context_, copy.slot);
     if (copy.ready) vkDestroySemaphore(device, copy.ready, nullptr);
   }
-  for (Buffer* b : {&counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_,
+  for (Buffer* b : {&element_edges_, &cell_cases_, &counts_[0], &counts_[1], &axis_, &fractions_, &cases_, &vertex_groups_, &triangle_groups_,
                     &totals_, &ids_y_, &ids_z_, &ids_x_, &positions_, &triangles_, &colors_, &vertex_rows_[0],
                     &vertex_rows_[1], &face_rows_[0], &face_rows_[1], &readback_[0], &readback_[1]})
     destroyBuffer(context_, *b);
@@ -318,6 +318,11 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   if (Status s = ensure(ids_y_, planes * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
   if (Status s = ensure(ids_z_, planes * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
   if (Status s = ensure(ids_x_, (planes - 1) * plane * sizeof(uint32_t), false, "vertex ids"); !s) return s.error();
+  // Passes 0 and 1 keep a byte an element (whole groups) for passes 3 and 4.
+  if (Status s = ensure(element_edges_, uint64_t{push.vertex_group_count} * kGroupElements, false, "crossed edges"); !s)
+    return s.error();
+  if (Status s = ensure(cell_cases_, uint64_t{push.triangle_group_count} * kGroupElements, false, "cell cases"); !s)
+    return s.error();
   if (Status s = ensure(positions_, 3 * sizeof(double), false, "slab vertices"); !s) return s.error();
   if (Status s = ensure(triangles_, 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s.error();
   if (Status s = ensure(colors_, 3 * sizeof(float), false, "slab colours"); !s) return s.error();
@@ -336,7 +341,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
         {ids_z_.buffer, 0, VK_WHOLE_SIZE},     {ids_x_.buffer, 0, VK_WHOLE_SIZE},
         {positions_.buffer, 0, VK_WHOLE_SIZE}, {triangles_.buffer, 0, VK_WHOLE_SIZE},
         {colors_.buffer, 0, VK_WHOLE_SIZE},    {vertex_rows_[r].buffer, 0, VK_WHOLE_SIZE},
-        {face_rows_[r].buffer, 0, VK_WHOLE_SIZE}};
+        {face_rows_[r].buffer, 0, VK_WHOLE_SIZE}, {element_edges_.buffer, 0, VK_WHOLE_SIZE},
+        {cell_cases_.buffer, 0, VK_WHOLE_SIZE}};
     writeBufferDescriptors(context_, set_, infos);
   };
   bind();
@@ -416,6 +422,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   push.faces = static_cast<uint32_t>(triangles);
   push.vertex_base = slab.vertex_base;
   status = submit(submissions_[1], [&](VkCommandBuffer commands) {
+    // What the first submission's passes wrote (the group offsets, the kept bytes).
+    barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
     stamp(commands, kStart2);
     dispatch(commands, 3, push.vertex_group_count);
     if (slab.noise_colors && vertices) {

@@ -118,6 +118,7 @@ class GpuMesher {
   Copy copies_[2];
   Buffer counts_[2], axis_, fractions_, cases_, vertex_groups_, triangle_groups_, totals_;
   Buffer ids_y_, ids_z_, ids_x_, positions_, triangles_, colors_;
+  Buffer element_edges_, cell_cases_;  // what passes 0 and 1 found, a byte an element, for passes 3 and 4
   Buffer vertex_rows_[2], face_rows_[2];  // the second only where the rows are copied beside (copyBeside)
   Buffer readback_[2];  // host-visible, used in turn: a slab's positions, colours and triangles
   unsigned next_readback_ = 0;

@@ -11,12 +11,13 @@
 // order is each element's first vertex id, which is marchingCubesSlab's next_id. Triangles: cells
 // in (layer, j, k) order, each cell's in table order; element e = layer · n² + point. Five passes
 // (kPass), each a workgroup of 256 invocations of kRun consecutive elements:
-//   0, 1  each group's vertex (0) or triangle (1) count;
+//   0, 1  each element's crossed edges (0) or cell case (1), kept a byte each, and each group's
+//         vertex or triangle count;
 //   2     the exclusive scan of those group counts (workgroup 0 the vertices, 1 the triangles),
 //         and the totals;
 //   3     the vertices: each element's ids (a shared-memory scan inside the group) into the id
-//         planes, and its positions;
-//   4     the triangles: each cell's case and the ids of its edges' vertices.
+//         planes, and its positions, from the crossed edges pass 0 kept;
+//   4     the triangles: the ids of each cell's edges' vertices, from the case pass 1 kept.
 // Positions: t = (level − v1)/(v2 − v1) comes from a table the host made with the CPU's own
 // division (the counts are small integers, so the pairs are few); the rest is fp64 add, sub and
 // mul, which round correctly in Vulkan, and nothing is fused (`precise`), as the CPU is built
@@ -48,6 +49,11 @@ layout(std430, set = 0, binding = 8) buffer IdsZ { uint ids_z[]; };
 layout(std430, set = 0, binding = 9) buffer IdsX { uint ids_x[]; };  // by layer · n² + point
 layout(std430, set = 0, binding = 10) writeonly buffer Positions { double positions[]; };  // 3 a vertex
 layout(std430, set = 0, binding = 11) writeonly buffer Triangles { uint triangles[]; };     // 3 a triangle
+// What passes 0 and 1 found, a byte an element (4 a word), for passes 3 and 4 to read instead of
+// reading the counts again: an element's crossed edges (bit 0 its y edge, or its x edge in an x
+// section; bit 1 its z edge), and a cell's case.
+layout(std430, set = 0, binding = 15) buffer ElementEdges { uint element_edges[]; };
+layout(std430, set = 0, binding = 16) buffer CellCases { uint cell_cases[]; };
 
 layout(push_constant) uniform Push {
   double step;            // the seed frame's grid step
@@ -100,16 +106,17 @@ void stepPlace(inout Place p) {
   ++p.section;
 }
 
-// Vertices of an element: the crossed y and z edges of an in-plane point, or its crossed x edge.
-uint vertexCount(Place p) {
+// An element's crossed edges, its vertices: bit 0 the y edge and bit 1 the z edge of an in-plane
+// point, or bit 0 the x edge.
+uint crossedEdges(Place p) {
   uint section = p.section, point = p.point, j = p.j, k = p.k;
   uint q = section >> 1;
   uint a = aboveAt(q, point);
   if ((section & 1u) == 1u) return a != aboveAt(q + 1u, point) ? 1u : 0u;
-  uint c = 0u;
-  if (j + 1u < pc.n && a != aboveAt(q, point + pc.n)) ++c;
-  if (k + 1u < pc.n && a != aboveAt(q, point + 1u)) ++c;
-  return c;
+  uint edges = 0u;
+  if (j + 1u < pc.n && a != aboveAt(q, point + pc.n)) edges |= 1u;
+  if (k + 1u < pc.n && a != aboveAt(q, point + 1u)) edges |= 2u;
+  return edges;
 }
 
 // The case of the cell at a place (layer, j, k); 0 for the points without a cell (j or k last).
@@ -201,14 +208,34 @@ void main() {
   if (group >= (vertex_pass ? pc.vertex_group_count : pc.triangle_group_count)) return;  // the whole group
   uint elements = vertex_pass ? pc.vertex_elements : pc.triangle_elements;
   uint first_e = group * kGroupElements + gl_LocalInvocationID.x * kRun;
+  // Each element's byte (crossed edges, or the cell's case) and its count: found in passes 0 and 1
+  // and kept, read back in passes 3 and 4. An invocation's 16 bytes are 4 whole words.
+  uint found[kRun];
   uint c[kRun];
   uint sum = 0u;
-  Place place = placeOf(first_e);
+  if (kPass <= 1u) {
+    Place place = placeOf(first_e);
+    for (uint r = 0u; r < kRun; ++r) {
+      uint e = first_e + r;
+      found[r] = e >= elements ? 0u : vertex_pass ? crossedEdges(place) : cellMask(place);
+      stepPlace(place);
+    }
+    for (uint w = 0u; w < kRun / 4u; ++w) {
+      uint word = found[4u * w] | found[4u * w + 1u] << 8 | found[4u * w + 2u] << 16 | found[4u * w + 3u] << 24;
+      if (vertex_pass)
+        element_edges[first_e / 4u + w] = word;
+      else
+        cell_cases[first_e / 4u + w] = word;
+    }
+  } else {
+    for (uint w = 0u; w < kRun / 4u; ++w) {
+      uint word = vertex_pass ? element_edges[first_e / 4u + w] : cell_cases[first_e / 4u + w];
+      for (uint b = 0u; b < 4u; ++b) found[4u * w + b] = (word >> (8u * b)) & 0xFFu;
+    }
+  }
   for (uint r = 0u; r < kRun; ++r) {
-    uint e = first_e + r;
-    c[r] = e >= elements ? 0u : vertex_pass ? vertexCount(place) : caseByte(cellMask(place), 0u);
+    c[r] = vertex_pass ? bitCount(found[r]) : caseByte(found[r], 0u);
     sum += c[r];
-    stepPlace(place);
   }
   uint total;
   uint before = exclusiveScan(sum, total);
@@ -221,7 +248,7 @@ void main() {
     }
     return;
   }
-  place = placeOf(first_e);
+  Place place = placeOf(first_e);
   if (kPass == 3u) {
     uint id = vertex_groups[group] + before;
     for (uint r = 0u; r < kRun; ++r, stepPlace(place)) {
@@ -238,13 +265,12 @@ void main() {
         ++id;
         continue;
       }
-      uint a = aboveAt(q, point);
-      if (j + 1u < pc.n && a != aboveAt(q, point + pc.n)) {
+      if ((found[r] & 1u) != 0u) {
         ids_y[q * pc.plane + point] = id;
         writeVertex(id, q, point, j, k, 1u);
         ++id;
       }
-      if (k + 1u < pc.n && a != aboveAt(q, point + 1u)) {
+      if ((found[r] & 2u) != 0u) {
         ids_z[q * pc.plane + point] = id;
         writeVertex(id, q, point, j, k, 2u);
         ++id;
@@ -256,7 +282,7 @@ void main() {
   uint first_triangle = triangle_groups[group] + before;
   for (uint r = 0u; r < kRun; ++r, stepPlace(place)) {
     if (c[r] == 0u) continue;
-    uint mask = cellMask(place);
+    uint mask = found[r];
     uint q = place.section, point = place.point;
     for (uint t = 0u; t < 3u * c[r]; ++t) triangles[3u * first_triangle + t] = edgeId(caseByte(mask, 1u + t), q, point);
     first_triangle += c[r];
