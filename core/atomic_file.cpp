@@ -126,18 +126,26 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
   return AtomicFile(path, temp, fd, false);
 }
 
-Status AtomicFile::writeAll(const char* data, size_t size) {
+// Every byte out, at the file's position (write) or from `offset` on (pwrite, offset ≥ 0), again
+// after a signal and after a short write.
+Status AtomicFile::writeFully(const char* data, size_t size, int64_t offset) {
   while (size > 0) {
-    ssize_t n = ::write(fd_, data, size);
+    const ssize_t n = offset < 0 ? ::write(fd_, data, size) : ::pwrite(fd_, data, size, static_cast<off_t>(offset));
     if (n < 0) {
       if (errno == EINTR) continue;
       return ioError("cannot write", path_, errno);
     }
     data += n;
     size -= static_cast<size_t>(n);
-    written_ += static_cast<uint64_t>(n);
+    if (offset >= 0) offset += n;
   }
   return okStatus();
+}
+
+Status AtomicFile::writeAll(const char* data, size_t size) {
+  Status s = writeFully(data, size, -1);
+  if (s) written_ += size;
+  return s;
 }
 
 Status AtomicFile::flush() {
@@ -159,20 +167,9 @@ Status AtomicFile::write(const void* data, size_t size) {
 }
 
 Status AtomicFile::writeAt(uint64_t offset, const void* data, size_t size) {
-  assert(fd_ >= 0 && !committed_ && !direct_ && buffer_.empty());
+  assert(fd_ >= 0 && !committed_ && !direct_ && buffer_.empty() && offset <= uint64_t{INT64_MAX});
   if (interrupted()) return interruptedError();
-  const char* bytes = static_cast<const char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return ioError("cannot write", path_, errno);
-    }
-    bytes += n;
-    size -= static_cast<size_t>(n);
-    offset += static_cast<uint64_t>(n);
-  }
-  return okStatus();
+  return writeFully(static_cast<const char*>(data), size, static_cast<int64_t>(offset));
 }
 
 Status AtomicFile::readAt(uint64_t offset, void* data, size_t size) {

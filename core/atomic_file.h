@@ -55,6 +55,7 @@ class AtomicFile {
  private:
   AtomicFile(std::string path, std::string temp_path, int fd, bool direct);
   Status flush();
+  Status writeFully(const char* data, size_t size, int64_t offset);
   Status writeAll(const char* data, size_t size);
 
   std::string path_;
