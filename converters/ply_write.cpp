@@ -267,10 +267,6 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   return file->commit();
 }
 
-}  // namespace dpoint
-
-namespace dpoint {
-
 Result<std::unique_ptr<PlyRowStream>> PlyRowStream::create(const std::string& path, bool colors, unsigned threads,
                                                            Progress* progress) {
   Result<AtomicFile> file = AtomicFile::create(path);
