@@ -771,6 +771,12 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     slab.noise_colors = noise_elsewhere;
     return slab;
   };
+  // Slab s meshed elsewhere, with the next slab named so that its counts are made meanwhile.
+  auto meshSlab = [&](size_t s, const EscapeSlab& slab) {
+    const bool more = s + 1 < pending.size();
+    const EscapeSlab next = more ? slabAt(slabFirst(s + 1), slabLast(s + 1)) : EscapeSlab{};
+    return params.mesher.mesh(slab, more ? &next : nullptr);
+  };
   if (rows) {
     // The header's counts from 16 cell layers spread over the grid (the middle of each sixteenth),
     // meshed as slabs of their own: each costs host round trips (32 of them took 0.2–0.5 s on an
@@ -823,8 +829,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
       slab.ply_rows = true;
       slab.vertex_base = static_cast<uint32_t>(vertices);
-      const EscapeSlab next = s + 1 < pending.size() ? slabAt(slabFirst(s + 1), slabLast(s + 1)) : EscapeSlab{};
-      Result<McSlabView> view = params.mesher.mesh(slab, s + 1 < pending.size() ? &next : nullptr);
+      Result<McSlabView> view = meshSlab(s, slab);
       if (writing.valid())
         if (Status w = writing.get(); !w) fail(w.error());
       if (!view) fail(view.error());
@@ -850,8 +855,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     for (size_t s = 0; s < pending.size(); ++s) {
       if (interrupted()) break;
       const EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
-      const EscapeSlab next = s + 1 < pending.size() ? slabAt(slabFirst(s + 1), slabLast(s + 1)) : EscapeSlab{};
-      Result<McSlabView> view = params.mesher.mesh(slab, s + 1 < pending.size() ? &next : nullptr);
+      Result<McSlabView> view = meshSlab(s, slab);
       if (appending.valid()) appending.get();
       if (!view) fail(view.error());
       if (failed) break;
