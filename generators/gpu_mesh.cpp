@@ -21,7 +21,7 @@ constexpr uint32_t kGroupElements = 4096;
 constexpr uint32_t kBindings = 17;
 constexpr uint32_t kFaceRowBytes = 13;  // the byte 3, three uint ids
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
-// passes_: mesh_slab.comp's passes 0–4 (those of slab_passes_ for the slab's bits), then these.
+// Passes 0–4 are mesh_slab.comp's (slab_passes_, for the counts' bits); passes_ holds these.
 constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7, kColoredVertexRowPass = 8;
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
 
@@ -161,8 +161,8 @@ GpuMesher::~GpuMesher() {
     destroyBuffer(context_, *b);
   if (pool_) vkDestroyDescriptorPool(device, pool_, nullptr);
   if (queries_) vkDestroyQueryPool(device, queries_, nullptr);
-  for (uint32_t i = 5; i < 9; ++i)
-    if (passes_[i]) vkDestroyPipeline(device, passes_[i], nullptr);
+  for (VkPipeline p : passes_)
+    if (p) vkDestroyPipeline(device, p, nullptr);
   for (VkPipeline(&by_bits)[5] : slab_passes_)
     for (VkPipeline p : by_bits)
       if (p) vkDestroyPipeline(device, p, nullptr);
@@ -283,7 +283,6 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
     if (!p) return p.error();
     slab_passes[pass] = *p;
   }
-  for (uint32_t pass = 0; pass < 5; ++pass) passes_[pass] = slab_passes[pass];
   // Made at the first slab that wants them: mesh_colors.comp, and mesh_rows.comp's two kinds.
   auto made = [&](unsigned index, const uint32_t* code, size_t bytes, std::span<const uint32_t> constants) -> Status {
     if (passes_[index]) return okStatus();
@@ -351,7 +350,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   auto dispatch = [&](VkCommandBuffer commands, uint32_t pass, uint32_t groups) {
     const uint32_t x = std::min(groups, max_x);
     push.groups_x = x;
-    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, passes_[pass]);
+    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pass < 5 ? slab_passes[pass] : passes_[pass]);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
     vkCmdPushConstants(commands, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     vkCmdDispatch(commands, x, (groups + x - 1) / x, 1);

@@ -107,8 +107,8 @@ class GpuMesher {
   const VulkanContext& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  // mesh_slab.comp's passes 0–4, mesh_colors.comp, and mesh_rows.comp's vertex rows, face rows and
-  // vertex rows with the colours; 0–4 are slab_passes_'s for the counts of this slab.
+  // By pass: mesh_colors.comp (5), and mesh_rows.comp's vertex rows, face rows and vertex rows with
+  // the colours (6–8); 0–4, mesh_slab.comp's, are in slab_passes_.
   VkPipeline passes_[9] = {};
   VkPipeline slab_passes_[2][5] = {};  // mesh_slab.comp's passes 0–4 for counts of 8 and 32 bits (kBits)
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
