@@ -14,6 +14,7 @@
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint kKind = 0;  // 0: Julia, 1: Mandelbulb (fast variant)
 layout(constant_id = 1) const uint kPacked = 1;  // 1: counts of `bits` packed; 0: uint32 (lavapipe)
+// constant_id 2 is exact_fp64.glsl's kExactFp64Bits: true on a GPU, false on lavapipe.
 
 layout(std430, set = 0, binding = 0) readonly buffer Axis { double values[]; };  // grid axis, res of them
 // The counts, `bits` (8, 16 or 32) each, packed little-endian: point t in bits

@@ -1,7 +1,8 @@
 #version 450
 // Test of exact_fp64.glsl (tests/generators/gpu_generate_test.cpp): sqrtRn and recipRn of every input, for
 // comparison with the CPU's IEEE sqrt and 1/x, with the built-in first guesses moved kSkew ulps
-// up or down (alternating by invocation), as a device with a less accurate sqrt or division would.
+// up or down (alternating by invocation), as a device with a less accurate sqrt or division would;
+// in either of the two forms (exact_fp64.glsl's kExactFp64Bits, constant_id 2).
 #extension GL_ARB_gpu_shader_int64 : require
 #extension GL_GOOGLE_include_directive : require
 

@@ -119,8 +119,9 @@ class GpuGenerate : public ::testing::Test {
 };
 
 // Runs shaders/generate/exact_fp64_test.comp on `inputs`: (sqrtRn, recipRn) of each, the first guesses moved
-// `skew` ulps.
-std::vector<double> runExactShader(const VulkanContext& context, const std::vector<double>& inputs, int32_t skew) {
+// `skew` ulps, in the bit-level form (`bits`) or the scaled one.
+std::vector<double> runExactShader(const VulkanContext& context, const std::vector<double>& inputs, int32_t skew,
+                                   bool bits) {
   const size_t n = inputs.size();
   const VkDeviceSize bytes = 3 * n * sizeof(double);
   Result<Buffer> data = createBuffer(context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "test data");
@@ -141,8 +142,9 @@ std::vector<double> runExactShader(const VulkanContext& context, const std::vect
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   info.stage.module = *module;
   info.stage.pName = "main";
-  const VkSpecializationMapEntry entry{0, 0, sizeof skew};
-  const VkSpecializationInfo specialization{1, &entry, sizeof skew, &skew};
+  const int32_t constants[2] = {skew, bits ? 1 : 0};  // constant_id 0 and 2 (exact_fp64.glsl's kExactFp64Bits)
+  const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(int32_t)}, {2, sizeof(int32_t), sizeof(int32_t)}};
+  const VkSpecializationInfo specialization{2, entries, sizeof constants, constants};
   info.stage.pSpecializationInfo = &specialization;
   info.layout = *layout;
   VkPipeline pipeline = VK_NULL_HANDLE;
@@ -210,20 +212,22 @@ TEST_F(GpuGenerate, exactSquareRootAndReciprocalEqualTheCpus) {
     for (double x : {square, inverse})
       for (double d : {std::nextafter(x, 0.0), x, std::nextafter(x, 8.0)}) inputs.push_back(d);
   }
-  for (int32_t skew : {0, 1, 4, 40}) {  // lavapipe's own guesses are already right: skewed ones are not
-    SCOPED_TRACE("guesses " + std::to_string(skew) + " ulps off");
-    const std::vector<double> out = runExactShader(*context_, inputs, skew);
-    ASSERT_EQ(out.size(), 2 * inputs.size());
-    size_t sqrt_differ = 0, recip_differ = 0;
-    for (size_t i = 0; i < inputs.size(); ++i) {
-      const double x = inputs[i];
-      if (!sameBits(out[2 * i], std::sqrt(x)) && sqrt_differ++ < 5)
-        ADD_FAILURE() << "sqrt(" << x << "): " << out[2 * i] << " vs " << std::sqrt(x);
-      if (!sameBits(out[2 * i + 1], 1.0 / x) && recip_differ++ < 5)
-        ADD_FAILURE() << "1/" << x << ": " << out[2 * i + 1] << " vs " << 1.0 / x;
+  for (bool bits : {true, false}) {  // the bit-level form (GPUs) and the scaled one (lavapipe)
+    for (int32_t skew : {0, 1, 4, 40}) {  // lavapipe's own guesses are already right: skewed ones are not
+      SCOPED_TRACE(std::string(bits ? "bit-level" : "scaled") + ", guesses " + std::to_string(skew) + " ulps off");
+      const std::vector<double> out = runExactShader(*context_, inputs, skew, bits);
+      ASSERT_EQ(out.size(), 2 * inputs.size());
+      size_t sqrt_differ = 0, recip_differ = 0;
+      for (size_t i = 0; i < inputs.size(); ++i) {
+        const double x = inputs[i];
+        if (!sameBits(out[2 * i], std::sqrt(x)) && sqrt_differ++ < 5)
+          ADD_FAILURE() << "sqrt(" << x << "): " << out[2 * i] << " vs " << std::sqrt(x);
+        if (!sameBits(out[2 * i + 1], 1.0 / x) && recip_differ++ < 5)
+          ADD_FAILURE() << "1/" << x << ": " << out[2 * i + 1] << " vs " << 1.0 / x;
+      }
+      EXPECT_EQ(sqrt_differ, 0u);
+      EXPECT_EQ(recip_differ, 0u);
     }
-    EXPECT_EQ(sqrt_differ, 0u);
-    EXPECT_EQ(recip_differ, 0u);
   }
 }
 
