@@ -2,17 +2,19 @@
 # Every mode of `render` on the GPU machine, two builds alternated (device tool; carry .gl and .gpu
 # as gpu_bench.sh says, the build before as .gpu/dpoint-$BASE, the current one as .gpu/dpoint):
 # the 16.7M-point `sierpinski --level 11 --unwelded` PLY at 1024x768, each mode one fresh process
-# per round with FRAMES (10) frames: the median GPU frame and the whole process's wall time.
-# Rows in $OUT/modes.tsv.   BASE=A ROUNDS=2 MODES="fp32 rte df64 native batch adaptive"
+# per round with FRAMES (10) frames: the median GPU frame, the whole process's wall time and the
+# picture's SHA-256 (16). Rows in $OUT/modes.tsv, each build's median wall time per mode and whether
+# the pictures agree in $OUT/modes-median.tsv. FRAMES=1 times what a host-side change (reading,
+# encoding) costs every mode.   BASE=A ROUNDS=2 MODES="fp32 split rte df64 native batch adaptive"
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 data=/tmp/dpoint-default
 mkdir -p "$data"
 [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
 rows=$out/modes.tsv
-printf 'round\tmode\tbuild\tgpu_ms_median\tprocess_ms\n' >"$rows"
+printf 'round\tmode\tbuild\tgpu_ms_median\tprocess_ms\tpng\n' >"$rows"
 for round in $(seq "${ROUNDS:-2}"); do
-  for mode in ${MODES:-fp32 rte df64 native batch adaptive}; do
+  for mode in ${MODES:-fp32 split rte df64 native batch adaptive}; do
     for build in "${BASE:-A}" current; do
       bin=.gpu/dpoint-$build
       [ "$build" = current ] && bin=.gpu/dpoint
@@ -20,12 +22,24 @@ for round in $(seq "${ROUNDS:-2}"); do
       s=$(date +%s%N)
       "$bin" render "$data/s11u.ply" --mode "$mode" --frames "${FRAMES:-10}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1 || true
       e=$(date +%s%N)
-      /usr/bin/python3 - "$round" "$mode" "$build" "$(( (e - s) / 1000000 ))" <<'PY' | tee -a "$rows"
+      png=$( [ -f /tmp/m.png ] && sha256sum </tmp/m.png | cut -c1-16 || echo -)
+      rm -f /tmp/m.png
+      /usr/bin/python3 - "$round" "$mode" "$build" "$(( (e - s) / 1000000 ))" "$png" <<'PY' | tee -a "$rows"
 import json, os, sys
-r, m, b, ms = sys.argv[1:5]
+r, m, b, ms, png = sys.argv[1:6]
 j = json.load(open("/tmp/r.json")) if os.path.exists("/tmp/r.json") else None
-print("\t".join([r, m, b, str(j["gpu_ms"]["median"]) if j else "", ms]))
+print("\t".join([r, m, b, str(j["gpu_ms"]["median"]) if j else "", ms, png]))
 PY
     done
   done
 done
+/usr/bin/python3 - "$rows" <<'PY' | tee "$out/modes-median.tsv"
+import csv, statistics, sys
+rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
+builds = list(dict.fromkeys(r["build"] for r in rows))
+print("mode\t" + "\t".join(f"{b}_ms" for b in builds) + "\tsame_png")
+for m in dict.fromkeys(r["mode"] for r in rows):
+    ms = [statistics.median(float(r["process_ms"]) for r in rows if r["mode"] == m and r["build"] == b) for b in builds]
+    same = len({r["png"] for r in rows if r["mode"] == m}) == 1
+    print(m + "\t" + "\t".join(f"{x:.0f}" for x in ms) + "\t" + ("yes" if same else "NO"))
+PY

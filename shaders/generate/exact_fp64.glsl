@@ -28,6 +28,28 @@
 const double kTwo52 = 4503599627370496.0lf;  // 2^52
 const double kTwo53 = 9007199254740992.0lf;  // 2^53
 
+// The corrections, for either form: the guess A moved an ulp at a time to the integer nearest
+// √N (N known modulo 2^64, as n_low) or 2^105 / Y.
+uint64_t nearestSqrt(uint64_t n_low, uint64_t a) {
+  for (int step = 0; step < 64; ++step) {
+    const int64_t residual = int64_t(n_low - a * a);  // N − A², exact while |N − A²| < 2^63
+    if (residual > int64_t(a)) a += 1;                 // N > A² + A: above A + 1/2
+    else if (residual <= -int64_t(a)) a -= 1;          // N ≤ A² − A: below A − 1/2
+    else break;
+  }
+  return a;
+}
+
+uint64_t nearestRecip(uint64_t y_int, uint64_t a) {
+  for (int step = 0; step < 64; ++step) {
+    const int64_t residual = int64_t(a * y_int);  // A·Y − 2^105 modulo 2^64
+    if (2 * residual > int64_t(y_int)) a -= 1;
+    else if (2 * residual < -int64_t(y_int)) a += 1;
+    else break;
+  }
+  return a;
+}
+
 // sqrtRn and recipRn in the scaled form, for any input: frexp and ldexp scale it into a binade.
 // Used on lavapipe (kExactFp64Bits false), and for the inputs the bit-level forms below do not take
 // (a subnormal x; a reciprocal that is not normal).
@@ -39,13 +61,8 @@ double sqrtRnScaled(double x) {
   precise double g = ldexp(x, -2 * k);  // x·2^-2k ∈ [1, 4), exact
   const uint64_t n_low = uint64_t(g * kTwo52) << 52;  // N mod 2^64, N = g·2^104
   precise double guess = clamp(EXACT_FP64_GUESS(sqrt(g)), 1.0lf, 2.0lf);
-  uint64_t a = uint64_t(guess * kTwo52);  // an integer: the guess lies on the 2^-52 grid of [1, 2]
-  for (int step = 0; step < 64; ++step) {
-    const int64_t residual = int64_t(n_low - a * a);  // N − A², exact while |N − A²| < 2^63
-    if (residual > int64_t(a)) a += 1;                 // N > A² + A: above A + 1/2
-    else if (residual <= -int64_t(a)) a -= 1;          // N ≤ A² − A: below A − 1/2
-    else break;
-  }
+  // An integer: the guess lies on the 2^-52 grid of [1, 2].
+  const uint64_t a = nearestSqrt(n_low, uint64_t(guess * kTwo52));
   return ldexp(double(a), k - 52);  // a ≤ 2^53: exact, and the scaling is exact
 }
 
@@ -56,13 +73,7 @@ double recipRnScaled(double y) {
   if (m == 1.0lf) return ldexp(1.0lf, 1 - e);
   const uint64_t y_int = uint64_t(m * kTwo52);  // Y ∈ (2^52, 2^53)
   precise double guess = clamp(EXACT_FP64_GUESS(1.0lf / m), 0.5lf, 1.0lf);
-  uint64_t a = uint64_t(guess * kTwo53);  // 1/m ∈ (1/2, 1): the 2^-53 grid
-  for (int step = 0; step < 64; ++step) {
-    const int64_t residual = int64_t(a * y_int);  // A·Y − 2^105 modulo 2^64
-    if (2 * residual > int64_t(y_int)) a -= 1;
-    else if (2 * residual < -int64_t(y_int)) a += 1;
-    else break;
-  }
+  const uint64_t a = nearestRecip(y_int, uint64_t(guess * kTwo53));  // 1/m ∈ (1/2, 1): the 2^-53 grid
   return ldexp(double(a), -52 - e);  // A·2^-53·2^(1−e)
 }
 
@@ -101,14 +112,7 @@ double sqrtRn(double x) {
   const int k = u >> 1;         // ⌊u/2⌋ (arithmetic shift): √x ∈ [2^k, 2^(k+1))
   // N mod 2^64, N = g·2^104 with g = x·2^-2k ∈ [1, 4): g·2^52 = M·2^(u − 2k).
   const uint64_t n_low = ((bits & kFraction) | kHidden) << (52 + (u & 1));
-  uint64_t a = gridOf(EXACT_FP64_GUESS(sqrt(x)), k);
-  for (int step = 0; step < 64; ++step) {
-    const int64_t residual = int64_t(n_low - a * a);  // N − A², exact while |N − A²| < 2^63
-    if (residual > int64_t(a)) a += 1;                 // N > A² + A: above A + 1/2
-    else if (residual <= -int64_t(a)) a -= 1;          // N ≤ A² − A: below A − 1/2
-    else break;
-  }
-  return fromGrid(a, k);
+  return fromGrid(nearestSqrt(n_low, gridOf(EXACT_FP64_GUESS(sqrt(x)), k)), k);
 }
 
 double recipRn(double y) {
@@ -119,12 +123,5 @@ double recipRn(double y) {
   const uint64_t y_int = (bits & kFraction) | kHidden;  // Y = m·2^52
   if (y_int == kHidden) return uint64BitsToDouble(uint64_t(1023 - u) << 52);  // 2^−u exactly
   // 1/y = (1/m)·2^−u ∈ [2^(−u−1), 2^−u): A = round(2^105 / Y) on that binade's grid.
-  uint64_t a = gridOf(EXACT_FP64_GUESS(1.0lf / y), -u - 1);
-  for (int step = 0; step < 64; ++step) {
-    const int64_t residual = int64_t(a * y_int);  // A·Y − 2^105 modulo 2^64
-    if (2 * residual > int64_t(y_int)) a -= 1;
-    else if (2 * residual < -int64_t(y_int)) a += 1;
-    else break;
-  }
-  return fromGrid(a, -u - 1);
+  return fromGrid(nearestRecip(y_int, gridOf(EXACT_FP64_GUESS(1.0lf / y), -u - 1)), -u - 1);
 }
