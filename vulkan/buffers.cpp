@@ -154,33 +154,16 @@ Result<VkCommandBuffer> allocateCommandBuffer(const VulkanContext& context, VkCo
 }
 
 Status submitOnce(const VulkanContext& context, const std::function<void(VkCommandBuffer)>& record) {
-  Result<VkCommandBuffer> allocated = allocateCommandBuffer(context);
-  if (!allocated) return allocated.error();
-  VkCommandBuffer commands = *allocated;
-  VkFence fence = VK_NULL_HANDLE;
-  auto cleanup = [&]() {
-    if (fence) vkDestroyFence(context.device, fence, nullptr);
-    vkFreeCommandBuffers(context.device, context.command_pool, 1, &commands);
-  };
-  VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VkResult result = vkBeginCommandBuffer(commands, &begin);
-  if (result == VK_SUCCESS) {
-    record(commands);
-    result = vkEndCommandBuffer(commands);
+  CommandSlot slot;
+  Status status = createCommandSlot(context, slot);
+  if (status) status = beginCommandSlot(context, slot);
+  if (status) {
+    record(slot.commands);
+    status = submitCommandSlot(context, slot);
   }
-  VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  if (result == VK_SUCCESS) result = vkCreateFence(context.device, &fence_info, nullptr, &fence);
-  if (result == VK_SUCCESS) {
-    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &commands;
-    result = queueSubmit(context, submit, fence);
-  }
-  if (result == VK_SUCCESS) result = waitForFence(context, fence);
-  cleanup();
-  if (result != VK_SUCCESS) return vulkanError("one-shot command submission", result);
-  return okStatus();
+  if (status) status = waitCommandSlot(context, slot);
+  destroyCommandSlot(context, slot);
+  return status;
 }
 
 Status createCommandSlot(const VulkanContext& context, CommandSlot& slot, VkCommandPool pool) {
