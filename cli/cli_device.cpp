@@ -152,9 +152,9 @@ EscapeSlabMesher GenerateDevice::mesher(const EscapeKernelParams& kernel) {
     if (Status s = self->checkValidation(); !s) return s.error();
     return mesh;
   };
-  mesher.reserve = [self = shared_from_this()](uint64_t vertices, uint64_t triangles, bool colors, bool rows) {
+  mesher.reserve = [self = shared_from_this()](uint64_t vertices, uint64_t triangles, bool colors, size_t row_bytes) {
     // After the first mesh call, which made the mesher.
-    return self->mesher_ ? self->mesher_->reserve(vertices, triangles, colors, rows) : okStatus();
+    return self->mesher_ ? self->mesher_->reserve(vertices, triangles, colors, row_bytes) : okStatus();
   };
   return mesher;
 }

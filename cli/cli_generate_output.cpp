@@ -203,11 +203,10 @@ EscapeRowSink rowSink(PlyRowStream& stream) {
   return sink;
 }
 
-int finishRows(Result<PointSet> generated, PlyRowStream& stream, const OutputOptions& o, PhaseClock& clock) {
-  if (!generated) return reportError(generated.error());
-  assert(stream.started() && generated->size() == 0);
-  const double generate_s = clock.lap();
-  if (Status s = stream.finish(); !s) return reportError(s.error());
+namespace {
+
+// The time line of a set whose rows went to `stream`, once it is finished (`generate_s` before).
+void reportRows(const PlyRowStream& stream, const OutputOptions& o, double generate_s, PhaseClock& clock) {
   if (!o.common.quiet)
     std::fprintf(stderr,
                  "time (s): generate %.2f, colours and offset 0.00, order 0.00, write %.2f; %llu points, %llu triangles%s; "
@@ -216,6 +215,36 @@ int finishRows(Result<PointSet> generated, PlyRowStream& stream, const OutputOpt
                  static_cast<unsigned long long>(stream.faces()),
                  stream.colors() ? "; the colours made with the mesh on the device" : "",
                  stream.moved() ? " (the header's estimated counts had other digits: the vertex rows were moved)" : "");
+}
+
+}  // namespace
+
+int finishRows(Result<PointSet> generated, PlyRowStream& stream, const OutputOptions& o, PhaseClock& clock) {
+  if (!generated) return reportError(generated.error());
+  assert(stream.started() && generated->size() == 0);
+  const double generate_s = clock.lap();
+  if (Status s = stream.finish(); !s) return reportError(s.error());
+  reportRows(stream, o, generate_s, clock);
+  return 0;
+}
+
+Result<std::unique_ptr<TileRowStream>> tileRowStream(const OutputOptions& o, TileSpec tile, const std::string& signature,
+                                                     bool colors, Progress& progress) {
+  return TileRowStream::create(o.output, tile, signature, colors, o.common.threads, &progress);
+}
+
+EscapeRowSink tileRowSink(TileRowStream& stream) {
+  EscapeRowSink sink = rowSink(stream.rows());
+  sink.float_colors = sink.colors;
+  return sink;
+}
+
+int finishTileRows(Result<PointTile> generated, TileRowStream& stream, const OutputOptions& o, PhaseClock& clock) {
+  if (!generated) return reportError(generated.error());
+  assert(stream.rows().started() && generated->points.size() == 0);
+  const double generate_s = clock.lap();
+  if (Status s = stream.finish(generated->owned, generated->foreign); !s) return reportError(s.error());
+  reportRows(stream.rows(), o, generate_s, clock);
   return 0;
 }
 

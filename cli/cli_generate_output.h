@@ -12,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "converters/ply.h"
+#include "converters/tile_file.h"
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
@@ -93,5 +94,12 @@ int finishMade(const PointFunction& points, const OutputOptions& o, PointOrder o
 // A tile: colours and offset on its points, then its part file.
 int finishTile(Result<PointTile> generated, const OutputOptions& o, bool auto_noise, const std::string& signature,
                Progress& progress);
+// A tile's part file as the device's rows, as it is made (converters/tile_file.h TileRowStream),
+// where canStreamRows holds: the stream (null where the output takes no positional writes), its
+// sink (colours as floats), and finishRows for it.
+Result<std::unique_ptr<TileRowStream>> tileRowStream(const OutputOptions& o, TileSpec tile, const std::string& signature,
+                                                     bool colors, Progress& progress);
+EscapeRowSink tileRowSink(TileRowStream& stream);
+int finishTileRows(Result<PointTile> generated, TileRowStream& stream, const OutputOptions& o, PhaseClock& clock);
 
 }  // namespace dpoint

@@ -53,7 +53,24 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
       Progress progress(progressSink(o->out.common.quiet), name);
       Result<Params> params = makeParams(*o, &progress);
       if (!params) return reportError(params.error());
-      if (tile) return finishTile(generate_tile(*params, *tile), o->out, auto_noise, signature, progress);
+      if (tile) {
+        if constexpr (requires { params->noise_colors; }) {
+          // Meshed on the device, the tile's part file too is written as it is made, from its rows.
+          if (params->mesher.mesh && canStreamRows(o->out, PointOrder::kInput, auto_noise)) {
+            const bool noise_made = coloursAtWrite(o->out, auto_noise);
+            Result<std::unique_ptr<TileRowStream>> stream = tileRowStream(o->out, *tile, signature, noise_made, progress);
+            if (!stream) return reportError(stream.error());
+            if (*stream) {
+              params->noise_colors = noise_made;
+              params->rows = tileRowSink(**stream);
+              Result<PointTile> generated = generate_tile(*params, *tile);
+              if ((*stream)->rows().started()) return finishTileRows(std::move(generated), **stream, o->out, clock);
+              return finishTile(std::move(generated), o->out, auto_noise, signature, progress);
+            }
+          }
+        }
+        return finishTile(generate_tile(*params, *tile), o->out, auto_noise, signature, progress);
+      }
       if (made && canFinishMade(o->out, auto_noise)) return finishMade(made(*params), o->out, *order, auto_noise, progress, clock);
       bool noise_made = false;
       if constexpr (requires { params->noise_colors; }) {

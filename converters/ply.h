@@ -86,12 +86,23 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
 // then follow; the real header goes over the estimated one, and where its length differs (the
 // counts' digits did) the vertex rows are moved first. The file is writePly's for the same mesh,
 // byte for byte, or nothing (a failed or abandoned stream leaves no file).
+// How a PlyRowStream's file is laid out where it is not writePly's (a tile's part file,
+// converters/tile_file.h): the vertex row's bytes, and the header for the counts (has_z: some vertex
+// has a z other than +0); the elements after the faces are finish()'s `trailer`.
+struct PlyRowLayout {
+  size_t row_bytes = 24;
+  std::function<std::string(uint64_t vertices, uint64_t faces, bool has_z)> header;
+};
+
 class PlyRowStream {
  public:
   // Opens the output (AtomicFile); null where it is not a regular file (a pipe or a device, which
   // take no positional writes: write the set with writePly instead).
   static Result<std::unique_ptr<PlyRowStream>> create(const std::string& path, bool colors, unsigned threads,
                                                       Progress* progress);
+  // The same with another layout; colors() says whether its rows carry colours.
+  static Result<std::unique_ptr<PlyRowStream>> create(const std::string& path, bool colors, PlyRowLayout layout,
+                                                      unsigned threads, Progress* progress);
   ~PlyRowStream();
   PlyRowStream(const PlyRowStream&) = delete;
   PlyRowStream& operator=(const PlyRowStream&) = delete;
@@ -101,12 +112,13 @@ class PlyRowStream {
   // The next rows: the vertex rows, written now after the ones before; the face rows, kept. Whole
   // rows (rowBytes() and kFaceRowBytes each). From one thread at a time.
   Status add(std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows);
-  // The face rows and the real header, then the file is committed.
-  Status finish();
+  // The face rows, then `trailer` (the layout's elements after them), and the real header, then the
+  // file is committed.
+  Status finish(std::span<const uint8_t> trailer = {});
 
   bool started() const { return started_; }
   bool colors() const { return colors_; }
-  size_t rowBytes() const { return colors_ ? 27 : 24; }  // a vertex row: x, y, z, and red, green, blue
+  size_t rowBytes() const { return layout_.row_bytes; }  // a vertex row: x, y, z, and the colours
   uint64_t vertices() const { return vertices_; }
   uint64_t faces() const { return faces_.size() / kFaceRowBytes; }
   // After finish: whether the vertex rows were moved (the estimate had other digits).
@@ -115,10 +127,11 @@ class PlyRowStream {
   static constexpr size_t kFaceRowBytes = 13;
 
  private:
-  PlyRowStream(AtomicFile file, bool colors, unsigned threads, Progress* progress);
+  PlyRowStream(AtomicFile file, bool colors, PlyRowLayout layout, unsigned threads, Progress* progress);
 
   AtomicFile file_;
   bool colors_ = false;
+  PlyRowLayout layout_;
   unsigned threads_ = 0;
   Progress* progress_ = nullptr;
   bool started_ = false, moved_ = false;

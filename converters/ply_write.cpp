@@ -269,30 +269,32 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 
 Result<std::unique_ptr<PlyRowStream>> PlyRowStream::create(const std::string& path, bool colors, unsigned threads,
                                                            Progress* progress) {
+  // writePly's layout for a generated surface (no source facts), colours as bytes.
+  PlyRowLayout layout;
+  layout.row_bytes = colors ? 27 : 24;
+  layout.header = [colors](uint64_t vertices, uint64_t faces, bool has_z) {
+    return plyHeader(PointSet(), vertices, faces, colors, has_z, PlyWriteOptions());
+  };
+  return create(path, colors, std::move(layout), threads, progress);
+}
+
+Result<std::unique_ptr<PlyRowStream>> PlyRowStream::create(const std::string& path, bool colors, PlyRowLayout layout,
+                                                           unsigned threads, Progress* progress) {
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
   if (!file->positional()) return std::unique_ptr<PlyRowStream>();
-  return std::unique_ptr<PlyRowStream>(new PlyRowStream(std::move(*file), colors, threads, progress));
+  return std::unique_ptr<PlyRowStream>(new PlyRowStream(std::move(*file), colors, std::move(layout), threads, progress));
 }
 
-PlyRowStream::PlyRowStream(AtomicFile file, bool colors, unsigned threads, Progress* progress)
-    : file_(std::move(file)), colors_(colors), threads_(threads), progress_(progress) {}
+PlyRowStream::PlyRowStream(AtomicFile file, bool colors, PlyRowLayout layout, unsigned threads, Progress* progress)
+    : file_(std::move(file)), colors_(colors), layout_(std::move(layout)), threads_(threads), progress_(progress) {}
 
 PlyRowStream::~PlyRowStream() = default;
-
-namespace {
-
-// The header of a generated surface (z present, no source facts) with these counts.
-std::string rowStreamHeader(uint64_t vertices, uint64_t faces, bool colors, bool has_z) {
-  return plyHeader(PointSet(), vertices, faces, colors, has_z, PlyWriteOptions());
-}
-
-}  // namespace
 
 Status PlyRowStream::start(uint64_t vertices, uint64_t faces) {
   assert(!started_);
   started_ = true;
-  header_bytes_ = rowStreamHeader(vertices, faces, colors_, true).size();
+  header_bytes_ = layout_.header(vertices, faces, true).size();
   // Address space only: the pages are touched as the rows arrive.
   faces_.reserve(static_cast<size_t>(static_cast<double>(faces) * 1.1 * kFaceRowBytes));
   adviseHugePages(faces_.data(), faces_.capacity());
@@ -328,17 +330,17 @@ Status PlyRowStream::add(std::span<const uint8_t> vertex_rows, std::span<const u
   return written;
 }
 
-Status PlyRowStream::finish() {
+Status PlyRowStream::finish(std::span<const uint8_t> trailer) {
   assert(started_);
   const size_t row_bytes = rowBytes();
   const uint64_t vertex_bytes = vertices_ * row_bytes;
-  const std::string header = rowStreamHeader(vertices_, faces(), colors_, has_z_);
+  const std::string header = layout_.header(vertices_, faces(), has_z_);
   const bool move = header.size() != header_bytes_;
   if (progress_) progress_->start("writing " + file_.path(), faces() + (move ? vertices_ : 0));
   // Moves the vertex rows from header_bytes_ to header.size(), a block at a time from the end that
   // goes first, so that no block is written over before it is read.
   if (move) {
-    moved_ = true;
+    moved_ = vertex_bytes > 0;
     constexpr uint64_t kBlock = uint64_t{64} << 20;
     std::vector<char> block(static_cast<size_t>(std::min(kBlock, std::max<uint64_t>(vertex_bytes, 1))));
     const bool later = header.size() > header_bytes_;
@@ -358,7 +360,10 @@ Status PlyRowStream::finish() {
     if (Status s = file_.writeAt(header.size() + vertex_bytes + at, faces_.data() + at, n); !s) return s;
     if (progress_) progress_->advance(n / kFaceRowBytes);
   }
-  if (Status s = file_.resize(header.size() + vertex_bytes + faces_.size()); !s) return s;
+  const uint64_t trailer_at = header.size() + vertex_bytes + faces_.size();
+  if (!trailer.empty())
+    if (Status s = file_.writeAt(trailer_at, trailer.data(), trailer.size()); !s) return s;
+  if (Status s = file_.resize(trailer_at + trailer.size()); !s) return s;
   if (progress_) progress_->finish();
   return file_.commit();
 }

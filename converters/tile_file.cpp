@@ -26,6 +26,7 @@ namespace {
 constexpr const char* kTileComment = "comment dpoint-tile ";
 constexpr const char* kOwnedComment = "comment dpoint-tile-owned ";
 constexpr const char* kSignatureComment = "comment dpoint-tile-of ";
+constexpr const char* kPadComment = "comment dpoint-tile-pad ";
 constexpr size_t kMaxHeaderBytes = 1 << 16;
 constexpr size_t kRowsPerBlock = size_t{1} << 16;  // rows read or written per block
 constexpr size_t kFaceBytes = 1 + 3 * sizeof(uint32_t);
@@ -146,7 +147,66 @@ Result<ParsedHeader> openTile(const std::string& path, File& file) {
   return h;
 }
 
+// The header of a tile file with these counts. Its length does not depend on them: a comment of
+// dots pads the four counts out to 20 digits each, so that a header laid out before they are known
+// (TileRowStream) is as long as the real one, which then goes over it.
+std::string tileHeader(TileSpec tile, const std::string& signature, bool colors, uint64_t owned, uint64_t vertices,
+                       uint64_t faces, uint64_t foreign) {
+  const std::string counts[4] = {std::to_string(owned), std::to_string(vertices), std::to_string(faces),
+                                 std::to_string(foreign)};
+  size_t pad = 0;
+  for (const std::string& c : counts) pad += 20 - c.size();
+  std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by dpoint\n";
+  header += kTileComment + std::to_string(tile.index) + "/" + std::to_string(tile.count) + "\n";
+  header += kOwnedComment + counts[0] + "\n";
+  header += kSignatureComment + signature + "\n";
+  header += kPadComment + std::string(pad, '.') + "\n";
+  header += "element vertex " + counts[1] + "\nproperty double x\nproperty double y\nproperty double z\n";
+  if (colors) header += "property float red\nproperty float green\nproperty float blue\n";
+  header += "element face " + counts[2] + "\nproperty list uchar uint vertex_indices\n";
+  header += "element dpoint_foreign " + counts[3] + "\nproperty uint tile\nproperty uint index\nend_header\n";
+  return header;
+}
+
+// The references' rows: tile and index of each copy.
+std::vector<uint8_t> foreignRows(std::span<const TileVertexRef> foreign) {
+  std::vector<uint8_t> rows(foreign.size() * kForeignBytes);
+  for (size_t f = 0; f < foreign.size(); ++f) {
+    const uint32_t row[2] = {foreign[f].tile, foreign[f].index};
+    std::memcpy(&rows[f * kForeignBytes], row, sizeof row);
+  }
+  return rows;
+}
+
 }  // namespace
+
+Result<std::unique_ptr<TileRowStream>> TileRowStream::create(const std::string& path, TileSpec tile,
+                                                             const std::string& signature, bool colors,
+                                                             unsigned threads, Progress* progress) {
+  assert(signature.find('\n') == std::string::npos);
+  std::unique_ptr<TileRowStream> out(new TileRowStream);
+  TileRowStream* self = out.get();
+  PlyRowLayout layout;
+  layout.row_bytes = colors ? kTileRowBytesColored : kTileRowBytes;
+  // The owned count and the references' are finish()'s; the estimate's header is as long. A tile
+  // with no vertices has no colours either, as writeTile's (then the header shrinks: nothing moves).
+  layout.header = [self, tile, signature, colors](uint64_t vertices, uint64_t faces, bool) {
+    return tileHeader(tile, signature, colors && vertices > 0, self->owned_, vertices, faces, self->foreign_);
+  };
+  Result<std::unique_ptr<PlyRowStream>> rows = PlyRowStream::create(path, colors, std::move(layout), threads, progress);
+  if (!rows) return rows.error();
+  if (!*rows) return std::unique_ptr<TileRowStream>();
+  out->rows_ = std::move(*rows);
+  return out;
+}
+
+Status TileRowStream::finish(uint32_t owned, std::span<const TileVertexRef> foreign) {
+  assert(uint64_t{owned} + foreign.size() == rows_->vertices());
+  owned_ = owned;
+  foreign_ = foreign.size();
+  const std::vector<uint8_t> trailer = foreignRows(foreign);
+  return rows_->finish(trailer);
+}
 
 Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature, Progress* progress,
                  unsigned threads) {
@@ -157,15 +217,8 @@ Status writeTile(const std::string& path, const PointTile& tile, const std::stri
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
   const size_t faces = p.triangles.size() / 3;
-  std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by dpoint\n";
-  header += kTileComment + std::to_string(tile.tile.index) + "/" + std::to_string(tile.tile.count) + "\n";
-  header += kOwnedComment + std::to_string(tile.owned) + "\n";
-  header += kSignatureComment + signature + "\n";
-  header += "element vertex " + std::to_string(p.size()) + "\nproperty double x\nproperty double y\nproperty double z\n";
-  if (p.hasColors()) header += "property float red\nproperty float green\nproperty float blue\n";
-  header += "element face " + std::to_string(faces) + "\nproperty list uchar uint vertex_indices\n";
-  header += "element dpoint_foreign " + std::to_string(tile.foreign.size()) +
-            "\nproperty uint tile\nproperty uint index\nend_header\n";
+  const std::string header =
+      tileHeader(tile.tile, signature, p.hasColors(), tile.owned, p.size(), faces, tile.foreign.size());
   if (Status s = file->write(header); !s) return s;
   if (progress) progress->start("writing " + path, p.size() + faces);
 
@@ -183,11 +236,8 @@ Status writeTile(const std::string& path, const PointTile& tile, const std::stri
       *file, vertex_chunks + face_chunks + 1, threads,
       [&](size_t k, std::vector<char>& block) -> Status {
         if (k == vertex_chunks + face_chunks) {  // the references
-          block.resize(tile.foreign.size() * kForeignBytes);
-          for (size_t f = 0; f < tile.foreign.size(); ++f) {
-            const uint32_t row[2] = {tile.foreign[f].tile, tile.foreign[f].index};
-            std::memcpy(&block[f * kForeignBytes], row, sizeof row);
-          }
+          const std::vector<uint8_t> rows = foreignRows(tile.foreign);
+          block.assign(rows.begin(), rows.end());
           return okStatus();
         }
         const auto [first, end] = rowsOf(k);

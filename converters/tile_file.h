@@ -5,10 +5,13 @@
 // that the colours come back exactly), `face` lists of 3 `uint`, and an element `dpoint_foreign` of
 // `uint tile, uint index` rows, one per copy. Header comments carry `dpoint-tile I/N`,
 // `dpoint-tile-owned COUNT` and `dpoint-tile-of SIGNATURE` (the generator and every option that
-// shapes the data, so that parts of different runs are never welded together).
+// shapes the data, so that parts of different runs are never welded together), then
+// `dpoint-tile-pad` and dots that make the header's length independent of the counts.
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,6 +26,27 @@ namespace dpoint {
 // line of text, no newline.
 Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature,
                  Progress* progress = nullptr, unsigned threads = 0);
+
+// The same file from rows made elsewhere (a device's marching cubes: generators/escape_grid.h
+// EscapeRowSink with float colours), written as they come: rows() takes the vertex rows (x, y, z as
+// doubles, with colours red, green, blue as floats: kTileRowBytesColored), owned vertices then the
+// copies, and the face rows; finish() the owned count and the copies' references. The file is
+// writeTile's for the same tile, byte for byte, or nothing.
+constexpr size_t kTileRowBytes = 24, kTileRowBytesColored = 36;
+class TileRowStream {
+ public:
+  // Null where `path` takes no positional writes (PlyRowStream::create).
+  static Result<std::unique_ptr<TileRowStream>> create(const std::string& path, TileSpec tile,
+                                                       const std::string& signature, bool colors, unsigned threads,
+                                                       Progress* progress);
+  PlyRowStream& rows() { return *rows_; }
+  Status finish(uint32_t owned, std::span<const TileVertexRef> foreign);
+
+ private:
+  TileRowStream() = default;
+  std::unique_ptr<PlyRowStream> rows_;
+  uint64_t owned_ = 0, foreign_ = 0;  // the header's, until finish
+};
 
 // What a tile file's header says.
 struct TileHeader {

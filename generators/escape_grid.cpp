@@ -590,6 +590,10 @@ namespace {
 struct LayerMesh {
   PointSet mesh;
   PositionArray seam;
+  // Where the rows went to params.rows instead (the mesh and seam then empty): the vertex rows the
+  // layers own, and the seam's copies that followed them.
+  bool streamed = false;
+  uint64_t row_vertices = 0, seam_rows = 0;
 };
 
 Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowFunction& row, int first_layer,
@@ -622,10 +626,11 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   const double reach = params.frame == GridFrame::kSeed
                            ? params.axis.hi - params.axis.lo
                            : std::max(std::fabs(params.axis.lo), std::fabs(params.axis.hi));
-  const bool noise_elsewhere = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
-  // The whole mesh as PLY rows, written as they come, where the mesher makes all of it.
-  const bool rows = elsewhere && params.rows.slab && first_layer == 0 && last_layer == res - 1 &&
-                    (!params.rows.colors || noise_elsewhere);
+  const bool noise_fits = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
+  // The mesh as PLY rows, written as they come, where the mesher makes all of it.
+  const bool rows = elsewhere && params.rows.slab && (!params.rows.colors || noise_fits);
+  // A part's seam copies have the colours only as rows (`seam` holds positions).
+  const bool noise_elsewhere = noise_fits && (rows || (first_layer == 0 && last_layer == res - 1));
   // What the path holds in memory, checked before anything is made or written.
   const MeshPath path = rows ? MeshPath::kRows : elsewhere ? MeshPath::kElsewhere : MeshPath::kHost;
   if (Status s = checkMemory(what, estimateLayerMemory(params, share, path), params.max_memory); !s) return s.error();
@@ -769,6 +774,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     slab.values = &values;
     slab.step = params.axis.step();
     slab.noise_colors = noise_elsewhere;
+    slab.float_colors = params.rows.float_colors;
     return slab;
   };
   // Slab s meshed elsewhere, with the next slab named so that its counts are made meanwhile.
@@ -807,7 +813,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       const double slab_layers = 1.25 * plan.thickness;
       if (Status s = params.mesher.reserve(
               static_cast<uint64_t>(slab_layers * static_cast<double>(most_vertices)) + 2 * most_plane,
-              static_cast<uint64_t>(slab_layers * static_cast<double>(most_triangles)), noise_elsewhere, true);
+              static_cast<uint64_t>(slab_layers * static_cast<double>(most_triangles)), noise_elsewhere,
+              slabAt(first_layer, last_layer).rowBytes());
           !s)
         return s.error();
     }
@@ -840,6 +847,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
         break;
       }
       vertices += view->row_vertices;
+      if (slab.seam_positions) out.seam_rows = view->last_plane_vertices;
       writing = std::async(std::launch::async, [&, s, v = *view] {
         Status w = v.ready ? v.ready() : okStatus();
         if (w) w = params.rows.slab(v.vertex_rows, v.face_rows);
@@ -849,6 +857,8 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
     }
     if (writing.valid())
       if (Status w = writing.get(); !w) fail(w.error());
+    out.streamed = true;
+    out.row_vertices = vertices;
   } else if (elsewhere) {
     // Each slab's mesh is copied into the mesh on a thread of its own while the next is made.
     std::future<void> appending;
@@ -942,20 +952,20 @@ Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, c
     }
     return out;
   }
-  EscapeSurfaceParams own = params;
-  own.noise_colors = false;  // a tile's seam copies would have none: its colours are made as written
-  Result<LayerMesh> part = meshLayers(own, row, static_cast<int>(range.begin), static_cast<int>(range.end));
+  Result<LayerMesh> part = meshLayers(params, row, static_cast<int>(range.begin), static_cast<int>(range.end));
   if (!part) return part.error();
+  const uint64_t owned = part->streamed ? part->row_vertices : part->mesh.size();
+  const uint64_t copies = part->streamed ? part->seam_rows : part->seam.size();
+  if (owned + copies > UINT32_MAX)
+    return Error{params.name + ": more than 2^32 vertices in tile " + std::to_string(tile.index), ExitCode::kResourceLimit};
   out.points = std::move(part->mesh);
-  out.owned = static_cast<uint32_t>(out.points.size());
+  out.owned = static_cast<uint32_t>(owned);
   // The seam plane's vertices open the next non-empty tile's own (canonical order: a plane's
   // in-plane edges come first).
   const uint32_t next = nextNonEmptyTile(layers, tile);
-  assert(part->seam.empty() || next < tile.count);
-  if (uint64_t{out.owned} + part->seam.size() > UINT32_MAX)
-    return Error{params.name + ": more than 2^32 vertices in tile " + std::to_string(tile.index), ExitCode::kResourceLimit};
-  for (size_t i = 0; i < part->seam.size(); ++i) {
-    out.points.positions.push_back(part->seam[i]);
+  assert(copies == 0 || next < tile.count);
+  for (uint64_t i = 0; i < copies; ++i) {
+    if (!part->streamed) out.points.positions.push_back(part->seam[i]);
     out.foreign.push_back({next, static_cast<uint32_t>(i)});
   }
   return out;

@@ -92,10 +92,13 @@ struct EscapeSlab {
   double step = 0.0;                            // GridAxis::step()
   bool noise_colors = false;                    // the vertices' seedColor too (generators/perlin.h)
   // The mesh as a binary PLY's rows (McSlabView::vertex_rows, face_rows): x, y, z as doubles, and
-  // with noise_colors red, green, blue as bytes; faces as the byte 3 and three uint ids, each the
-  // slab's own plus vertex_base. Not with seam_positions.
+  // with noise_colors red, green, blue as bytes (float_colors: as floats, a tile's part file's
+  // rows); faces as the byte 3 and three uint ids, each the slab's own plus vertex_base. With
+  // seam_positions the vertex rows go on with the seam plane's vertices (a tile's copies).
   bool ply_rows = false;
+  bool float_colors = false;
   uint32_t vertex_base = 0;
+  size_t rowBytes() const { return noise_colors ? (float_colors ? 36 : 27) : 24; }
 };
 
 // Marching cubes elsewhere (a GPU, generators/gpu_mesh.h): the counts and the mesh of a slab
@@ -110,15 +113,18 @@ struct EscapeSlabMesher {
   // Optional: memory for slabs of up to `vertices` vertices and `triangles` triangles made at once,
   // with colours and as rows as EscapeSlab says (else it grows as the slabs do, which on a GPU
   // costs a host-visible allocation on the way from one slab's passes to the next).
-  std::function<Status(uint64_t vertices, uint64_t triangles, bool colors, bool rows)> reserve;
+  // row_bytes: EscapeSlab::rowBytes() where the slabs are made as rows, else 0.
+  std::function<Status(uint64_t vertices, uint64_t triangles, bool colors, size_t row_bytes)> reserve;
 };
 
-// Where a whole surface meshed elsewhere goes as a binary PLY's rows as they are made, in place of
-// the mesh (a PlyRowStream, converters/ply.h, written while the device makes the next slab). Taken
-// only where the mesher meshes every slab, and with `colors` makes the noise colours too; then the
-// set returned is empty, and `start` has been called.
+// Where a surface meshed elsewhere goes as a binary PLY's rows as they are made, in place of the
+// mesh (a PlyRowStream, converters/ply.h, written while the device makes the next slab): the whole
+// surface, or a tile's part (its owned vertices, then the copies of the seam's, as
+// converters/tile_file.h lays them out). Taken only where the mesher meshes every slab, and with
+// `colors` makes the noise colours too; then the set returned is empty, and `start` has been called.
 struct EscapeRowSink {
-  bool colors = false;  // the vertex rows carry the seed noise colours (EscapeSlab::noise_colors)
+  bool colors = false;        // the vertex rows carry the seed noise colours (EscapeSlab::noise_colors)
+  bool float_colors = false;  // as floats (EscapeSlab::float_colors)
   // Once, before any slab: the whole mesh's vertices and triangles, estimated from a sample of its
   // cell layers (within a few percent; exact when every layer is sampled).
   std::function<Status(uint64_t vertices, uint64_t triangles)> start;
@@ -146,7 +152,7 @@ struct EscapeSurfaceParams {
   // vertices' seed noise colours too (generators/perlin.h seedColor, bit for bit), and the mesh has
   // them; otherwise the mesh has no colours, as without it.
   bool noise_colors = false;
-  EscapeRowSink rows;  // generateEscapeSurface only (not a tile's); empty: the mesh is returned
+  EscapeRowSink rows;  // empty: the mesh is returned
 };
 
 // The surface parameters of a fractal whose Params have the shared grid fields (resolution,
@@ -193,7 +199,9 @@ uint64_t estimateEscapeSurfaceMemory(const EscapeSurfaceParams& params);
 Result<PointSet> generateEscapeSurface(const EscapeSurfaceParams& params, const EscapeRowFunction& row);
 
 // Tile `tile` of the same mesh (core/tile.h): the vertices and triangles of its share of the cell
-// layers; concatenated in tile order they are generateEscapeSurface's. With grid_out, the tile's
+// layers; concatenated in tile order they are generateEscapeSurface's. Where params.rows took them
+// as rows (owned vertices, then the copies), the tile's points are empty, its owned count and
+// foreign references set. With grid_out, the tile's
 // planes of the grid file (its layers' first planes, and the last plane in the last tile), so the
 // pieces concatenated are the whole grid file. Same errors.
 Result<PointTile> generateEscapeSurfaceTile(const EscapeSurfaceParams& params, const EscapeRowFunction& row,

@@ -22,7 +22,8 @@ constexpr uint32_t kBindings = 17;
 constexpr uint32_t kFaceRowBytes = 13;  // the byte 3, three uint ids
 // Timestamps: the counts and scans (submission 1), the vertices, the triangles and the copies out.
 // Passes 0–4 are mesh_slab.comp's (slab_passes_, for the counts' bits); passes_ holds these.
-constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7, kColoredVertexRowPass = 8;
+constexpr uint32_t kColorPass = 5, kVertexRowPass = 6, kFaceRowPass = 7, kColoredVertexRowPass = 8,
+                   kFloatColoredVertexRowPass = 9;
 enum Stamp : uint32_t { kStart, kScanned, kStart2, kVertices, kTriangles, kCopied, kStamps };
 
 // Push constants of shaders/generate/mesh_slab.comp (std430: the double at 0, then the uints).
@@ -202,15 +203,14 @@ Status GpuMesher::readStamps() {
   return okStatus();
 }
 
-Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, bool rows) {
-  const uint64_t row_bytes = colors ? 27 : 24;
+Status GpuMesher::reserve(uint64_t vertices, uint64_t triangles, bool colors, size_t row_bytes) {
   if (Status s = ensure(positions_, vertices * 3 * sizeof(double), false, "slab vertices"); !s) return s;
   if (Status s = ensure(triangles_, triangles * 3 * sizeof(uint32_t), false, "slab triangles"); !s) return s;
   if (colors)
     if (Status s = ensure(colors_, vertices * 3 * sizeof(float), false, "slab colours"); !s) return s;
   uint64_t readback = vertices * 3 * sizeof(double) + (colors ? vertices * 3 * sizeof(float) : 0) +
                       triangles * 3 * sizeof(uint32_t);
-  if (rows) {
+  if (row_bytes) {
     for (unsigned r = 0; r < (copyBeside() ? 2u : 1u); ++r) {
       if (Status s = ensure(vertex_rows_[r], (vertices + 3) / 4 * 4 * row_bytes, false, "slab vertex rows"); !s)
         return s;
@@ -293,13 +293,18 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   };
   if (slab.noise_colors)
     if (Status s = made(kColorPass, kMeshColorsComp, sizeof(kMeshColorsComp), {}); !s) return s.error();
+  // The vertex rows' pass: without colours, with colour bytes, with float colours.
+  const uint32_t vertex_pass = !slab.noise_colors  ? kVertexRowPass
+                               : slab.float_colors ? kFloatColoredVertexRowPass
+                                                   : kColoredVertexRowPass;
   if (slab.ply_rows) {
-    assert(!slab.seam_positions);
     // kPass and kColors of mesh_rows.comp.
-    static constexpr uint32_t kVertices[2] = {0u, 0u}, kColored[2] = {0u, 1u}, kFaces[2] = {1u, 0u};
-    const uint32_t vertex_pass = slab.noise_colors ? kColoredVertexRowPass : kVertexRowPass;
-    if (Status s = made(vertex_pass, kMeshRowsComp, sizeof(kMeshRowsComp), slab.noise_colors ? kColored : kVertices); !s)
-      return s.error();
+    static constexpr uint32_t kVertices[2] = {0u, 0u}, kColored[2] = {0u, 1u}, kFloatColored[2] = {0u, 2u},
+                              kFaces[2] = {1u, 0u};
+    const uint32_t* constants = vertex_pass == kVertexRowPass ? kVertices
+                                : vertex_pass == kColoredVertexRowPass ? kColored
+                                                                       : kFloatColored;
+    if (Status s = made(vertex_pass, kMeshRowsComp, sizeof(kMeshRowsComp), {constants, 2}); !s) return s.error();
     if (Status s = made(kFaceRowPass, kMeshRowsComp, sizeof(kMeshRowsComp), kFaces); !s) return s.error();
   }
   const uint64_t vertex_elements = (2 * static_cast<uint64_t>(planes) - 1) * plane;
@@ -393,7 +398,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   // the next slab owns, are not known from the others until pass 3 has run) and the face rows.
   const uint64_t position_bytes = vertices * 3 * sizeof(double), triangle_bytes = triangles * 3 * sizeof(uint32_t);
   const uint64_t color_bytes = slab.noise_colors ? vertices * 3 * sizeof(float) : 0;
-  const uint64_t row_bytes = slab.noise_colors ? 27 : 24;
+  const uint64_t row_bytes = slab.rowBytes();
   // The rows' buffers hold whole blocks of 4 rows (mesh_rows.comp writes whole words).
   const uint64_t vertex_row_bytes = slab.ply_rows ? vertices * row_bytes : 0;
   const uint64_t face_row_bytes = slab.ply_rows ? triangles * kFaceRowBytes : 0;
@@ -435,7 +440,7 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
     stamp(commands, kTriangles);
     if (slab.ply_rows) {
       barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, shader_rw);
-      if (vertices) dispatch(commands, slab.noise_colors ? kColoredVertexRowPass : kVertexRowPass, rowGroups(vertices));
+      if (vertices) dispatch(commands, vertex_pass, rowGroups(vertices));
       if (triangles) dispatch(commands, kFaceRowPass, rowGroups(triangles));
     }
     if (beside) {
@@ -481,7 +486,8 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   if (slab.ply_rows) {
     const auto* rows = static_cast<const uint8_t*>(readback.mapped);
     out.row_vertices = owned;
-    out.vertex_rows = {rows, owned * row_bytes};
+    // A tile's last slab: the seam plane's rows follow, the copies the tile file holds.
+    out.vertex_rows = {rows, (slab.seam_positions ? vertices : owned) * row_bytes};
     out.face_rows = {rows + vertex_row_bytes, face_row_bytes};
     if (beside)
       out.ready = [this, readback_index]() -> Status {

@@ -55,7 +55,8 @@ class GpuMesher {
                               const std::function<Status()>& while_scanning = {});
 
   // Grows the slab buffers for slabs of up to these counts (meshSlab grows them as needed).
-  Status reserve(uint64_t vertices, uint64_t triangles, bool colors, bool rows);
+  // row_bytes: the slabs' vertex rows (EscapeSlab::rowBytes()), 0 where they are not made as rows.
+  Status reserve(uint64_t vertices, uint64_t triangles, bool colors, size_t row_bytes);
 
   // The counts made ahead into counts buffer `which` by meshSlabOnDevice (generators/gpu_generate.h)
   // while the slab before was meshed: planes first..last of the grid `values` to `limit`, by the
@@ -108,8 +109,8 @@ class GpuMesher {
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   // By pass: mesh_colors.comp (5), and mesh_rows.comp's vertex rows, face rows and vertex rows with
-  // the colours (6–8); 0–4, mesh_slab.comp's, are in slab_passes_.
-  VkPipeline passes_[9] = {};
+  // the colours as bytes and as floats (6–9); 0–4, mesh_slab.comp's, are in slab_passes_.
+  VkPipeline passes_[10] = {};
   VkPipeline slab_passes_[2][5] = {};  // mesh_slab.comp's passes 0–4 for counts of 8 and 32 bits (kBits)
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;

@@ -93,8 +93,9 @@ struct McSlabView {
   std::span<const glm::dvec3> seam_positions;
   std::span<const glm::vec3> colors;  // empty, or one a position (the mesher's noise colours)
   // Made as a binary PLY's rows instead (generators/escape_grid.h EscapeSlab::ply_rows; positions,
-  // triangles and colours then empty): the rows of the row_vertices vertices the slab owns, and
-  // its triangles' face rows.
+  // triangles and colours then empty): the rows of the row_vertices vertices the slab owns (with
+  // EscapeSlab::seam_positions followed by the last_plane_vertices copies of the seam's), and its
+  // triangles' face rows.
   uint64_t row_vertices = 0;
   std::span<const uint8_t> vertex_rows, face_rows;
   // Where set, the rows are still being copied into that memory (a GPU's transfer queue): the

@@ -2,7 +2,7 @@
 // A slab's mesh as a binary PLY's rows (issue #38 item 4; generators/gpu_mesh.h, EscapeSlab::
 // ply_rows), from what mesh_slab.comp's passes 3 and 4 made, so that the host only writes them:
 //   kPass 0  the vertex rows: x, y, z as doubles, then, with the colours, red, green, blue as bytes
-//            (converters/ply_write.cpp's colorByte);
+//            (converters/ply_write.cpp's colorByte) or, for a tile's part file, as floats;
 //   kPass 1  the face rows: the byte 3, then the three ids as uint, shifted by vertex_base.
 // Row r lies at byte r · row size, packed little-endian; an invocation makes 4 rows, whole words,
 // with the row size a constant (kColors) so that every byte's place is known when compiled (a
@@ -14,9 +14,9 @@
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const uint kPass = 0;
-// Vertex rows with the colour bytes (kPass 0).
-layout(constant_id = 1) const bool kColors = false;
-const uint kRowBytes = kPass == 1u ? 13u : kColors ? 27u : 24u;
+// The vertex rows' colours (kPass 0): 0 none, 1 bytes, 2 floats.
+layout(constant_id = 1) const uint kColors = 0u;
+const uint kRowBytes = kPass == 1u ? 13u : kColors == 2u ? 36u : kColors == 1u ? 27u : 24u;
 
 layout(std430, set = 0, binding = 10) readonly buffer Positions { double positions[]; };  // 3 a vertex
 layout(std430, set = 0, binding = 11) readonly buffer Triangles { uint triangles[]; };     // 3 a triangle
@@ -32,7 +32,7 @@ layout(push_constant) uniform Push {
   uint groups_x;     // groups along x of this dispatch (a group is y · groups_x + x)
   uint pad;
   uint rows;         // vertex rows
-  uint row_bytes;    // 24, or 27 with the colours (kColors)
+  uint row_bytes;    // 24, or 27 or 36 with the colours (kColors)
   uint faces;        // face rows
   uint vertex_base;  // added to the slab's vertex ids
 } pc;
@@ -46,15 +46,14 @@ uint colorByte(float c) {
 }
 
 // Each invocation's 4 rows as fields of 4 bytes, every index a constant once the loops are
-// unrolled (the row size is one): vertex rows x, y, z as low and high words and the colour bytes
-// in one; face rows the three ids.
-uint fields[4][7];
+// unrolled (the row size is one): vertex rows x, y, z as low and high words and the colours (the
+// bytes in one word, or a float a word); face rows the three ids.
+uint fields[4][9];
 // Byte o of row r: vertex rows 24 bytes of coordinates, then the colours; face rows the byte 3,
 // then the ids.
 uint rowByte(uint r, uint o) {
   if (kPass == 1u) return o == 0u ? 3u : (fields[r][(o - 1u) / 4u] >> (8u * ((o - 1u) % 4u))) & 0xFFu;
-  if (o < 24u) return (fields[r][o / 4u] >> (8u * (o % 4u))) & 0xFFu;
-  return (fields[r][6] >> (8u * (o - 24u))) & 0xFFu;
+  return (fields[r][o / 4u] >> (8u * (o % 4u))) & 0xFFu;
 }
 
 void main() {
@@ -71,9 +70,13 @@ void main() {
         fields[r][2u * d] = halves.x;
         fields[r][2u * d + 1u] = halves.y;
       }
-      fields[r][6] = kColors ? colorByte(colors[3u * id]) | colorByte(colors[3u * id + 1u]) << 8 |
-                                   colorByte(colors[3u * id + 2u]) << 16
-                             : 0u;
+      if (kColors == 2u) {
+        [[unroll]] for (uint c = 0u; c < 3u; ++c) fields[r][6u + c] = floatBitsToUint(colors[3u * id + c]);
+      } else {
+        fields[r][6] = kColors == 1u ? colorByte(colors[3u * id]) | colorByte(colors[3u * id + 1u]) << 8 |
+                                           colorByte(colors[3u * id + 2u]) << 16
+                                     : 0u;
+      }
     } else {
       [[unroll]] for (uint k = 0u; k < 3u; ++k) fields[r][k] = pc.vertex_base + triangles[3u * id + k];
     }

@@ -116,6 +116,43 @@ TEST(CliGenerateDevice, tilesOnTheDeviceMergeToTheCpuFile) {
   EXPECT_TRUE(readFile(dir.file("cpu.ply")) == readFile(dir.file("merged.ply")));
 }
 
+// A tile meshed on the device goes to its part file as the device's rows, as they are made
+// (converters/tile_file.h TileRowStream): owned vertices, then the seam's copies with their
+// colours as floats, the faces and the references. Every part is the host's byte for byte (empty
+// ones too, at the ends of 8 tiles; tiles of 16 or more cell layers, whose counts the header first
+// estimates from a sample, with 2), and the parts merge to the whole file.
+TEST(CliGenerateDevice, tilesMeshedOnTheDeviceAreWrittenAsTheirRowsAndAreTheHostsParts) {
+  struct Case {
+    int tiles;
+    const char* colors;
+  };
+  for (const Case c : {Case{8, "auto"}, Case{2, "none"}}) {
+    SCOPED_TRACE(std::to_string(c.tiles) + " tiles, --colors " + c.colors);
+    TempDir dir;
+    const std::vector<std::string> kind = {"generate", "mandelbulb", "--variant", "fast", "--resolution", "40",
+                                           "--colors", c.colors};
+    ASSERT_EQ(runDpoint(concat(kind, {"--device", "none", "-q", "-o", dir.file("whole.ply")})).exit_code, 0);
+    std::vector<std::string> merge = {"merge", "-q", "-o", dir.file("merged.ply")};
+    for (int i = 0; i < c.tiles; ++i) {
+      SCOPED_TRACE(i);
+      const std::string tile = std::to_string(i) + "/" + std::to_string(c.tiles);
+      const std::string host = dir.file("host-" + std::to_string(i) + ".ply");
+      merge.push_back(dir.file("device-" + std::to_string(i) + ".ply"));
+      ASSERT_EQ(runDpoint(concat(kind, {"--device", "none", "-q", "--tile", tile, "-o", host})).exit_code, 0);
+      test::CommandResult r =
+          runDpoint(concat(kind, {"--device", "cpu", "--mesh", "device", "--validate", "--tile", tile, "-o", merge.back()}));
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_NE(r.err.find("the rows made on the device and written as they came"), std::string::npos) << r.err;
+      const std::string part = readFile(merge.back());
+      EXPECT_NE(part.find("comment dpoint-tile " + tile + "\n"), std::string::npos);
+      EXPECT_TRUE(readFile(host) == part);
+    }
+    test::CommandResult r = runDpoint(merge);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(readFile(dir.file("whole.ply")) == readFile(dir.file("merged.ply")));
+  }
+}
+
 TEST(CliGenerateDevice, seedVariantAndMissingDevicesAreRefused) {
   TempDir dir;
   test::CommandResult r =

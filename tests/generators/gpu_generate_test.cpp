@@ -470,7 +470,7 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
         ahead += next ? 1 : 0;
         return meshSlabOnDevice(*escape, mesher, mandelbulb(), slab, next);
       };
-      bulb.mesher.reserve = [&](uint64_t v, uint64_t t, bool c, bool r) { return mesher.reserve(v, t, c, r); };
+      bulb.mesher.reserve = [&](uint64_t v, uint64_t t, bool c, size_t r) { return mesher.reserve(v, t, c, r); };
       Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("device.ply"), colors, 0, nullptr);
       ASSERT_TRUE(stream.ok() && *stream);
       PlyRowStream& to = **stream;
