@@ -246,62 +246,37 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
   const size_t slots = size > piece ? 2 : 1;
   struct Slot {
     Buffer staging;
-    VkCommandBuffer commands = VK_NULL_HANDLE;
-    VkFence fence = VK_NULL_HANDLE;
-    bool busy = false;
+    CommandSlot commands;
   };
   std::vector<Slot> slot(slots);
-  auto cleanup = [&]() {
-    for (Slot& s : slot) {
-      if (s.busy) waitForFence(context, s.fence);
-      if (s.fence) vkDestroyFence(context.device, s.fence, nullptr);
-      if (s.commands) vkFreeCommandBuffers(context.device, context.command_pool, 1, &s.commands);
-      destroyBuffer(context, s.staging);
-    }
-  };
   auto run = [&]() -> Status {
     for (Slot& s : slot) {
       Result<Buffer> staging = createBuffer(context, piece, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "staging");
       if (!staging) return staging.error();
       s.staging = *staging;
-      Result<VkCommandBuffer> commands = allocateCommandBuffer(context);
-      if (!commands) return commands.error();
-      s.commands = *commands;
-      VkFenceCreateInfo fence_info = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-      VK_TRY(vkCreateFence(context.device, &fence_info, nullptr, &s.fence));
+      if (Status made = createCommandSlot(context, s.commands); !made) return made;
     }
     size_t k = 0;
     for (VkDeviceSize offset = 0; offset < size; offset += piece, ++k) {
       Slot& s = slot[k % slots];
-      if (s.busy) {
-        VK_TRY(waitForFence(context, s.fence));
-        VK_TRY(vkResetFences(context.device, 1, &s.fence));
-        s.busy = false;
-      }
+      if (Status waited = waitCommandSlot(context, s.commands); !waited) return waited;
       const VkDeviceSize bytes = std::min(piece, size - offset);
       fillInParallel(fill, s.staging.mapped, offset, bytes, grain);
       if (Status status = flushBuffer(context, s.staging); !status) return status;
-      VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-      begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-      VK_TRY(vkBeginCommandBuffer(s.commands, &begin));
+      if (Status begun = beginCommandSlot(context, s.commands); !begun) return begun;
       VkBufferCopy copy{0, at + offset, bytes};
-      vkCmdCopyBuffer(s.commands, s.staging.buffer, target.buffer, 1, &copy);
-      VK_TRY(vkEndCommandBuffer(s.commands));
-      VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-      submit.commandBufferCount = 1;
-      submit.pCommandBuffers = &s.commands;
-      VK_TRY(queueSubmit(context, submit, s.fence));
-      s.busy = true;
+      vkCmdCopyBuffer(s.commands.commands, s.staging.buffer, target.buffer, 1, &copy);
+      if (Status submitted = submitCommandSlot(context, s.commands); !submitted) return submitted;
     }
-    for (Slot& s : slot) {
-      if (!s.busy) continue;
-      VK_TRY(waitForFence(context, s.fence));
-      s.busy = false;
-    }
+    for (Slot& s : slot)
+      if (Status waited = waitCommandSlot(context, s.commands); !waited) return waited;
     return okStatus();
   };
   Status status = run();
-  cleanup();
+  for (Slot& s : slot) {  // waits for a submission still pending (after a failure)
+    destroyCommandSlot(context, s.commands);
+    destroyBuffer(context, s.staging);
+  }
   return status;
 }
 
