@@ -214,7 +214,7 @@ void reportRows(const PlyRowStream& stream, const OutputOptions& o, double gener
                  generate_s, clock.lap(), static_cast<unsigned long long>(stream.vertices()),
                  static_cast<unsigned long long>(stream.faces()),
                  stream.colors() ? "; the colours made with the mesh on the device" : "",
-                 stream.moved() ? " (the header's estimated counts had other digits: the vertex rows were moved)" : "");
+                 stream.moved() ? " (the header laid out first had another length: the vertex rows were moved)" : "");
 }
 
 }  // namespace
@@ -234,8 +234,12 @@ Result<std::unique_ptr<TileRowStream>> tileRowStream(const OutputOptions& o, Til
 }
 
 EscapeRowSink tileRowSink(TileRowStream& stream) {
-  EscapeRowSink sink = rowSink(stream.rows());
-  sink.float_colors = sink.colors;
+  EscapeRowSink sink;
+  sink.colors = sink.float_colors = stream.rows().colors();
+  sink.start = [&stream](uint64_t vertices, uint64_t triangles) { return stream.start(vertices, triangles); };
+  sink.slab = [&stream](std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows) {
+    return stream.add(vertex_rows, face_rows);
+  };
   return sink;
 }
 

@@ -65,6 +65,7 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
               params->rows = tileRowSink(**stream);
               Result<PointTile> generated = generate_tile(*params, *tile);
               if ((*stream)->rows().started()) return finishTileRows(std::move(generated), **stream, o->out, clock);
+              stream->reset();  // not taken (an empty share, a mesh made on the host): its file goes
               return finishTile(std::move(generated), o->out, auto_noise, signature, progress);
             }
           }

@@ -28,10 +28,10 @@ Status writeTile(const std::string& path, const PointTile& tile, const std::stri
                  Progress* progress = nullptr, unsigned threads = 0);
 
 // The same file from rows made elsewhere (a device's marching cubes: generators/escape_grid.h
-// EscapeRowSink with float colours), written as they come: rows() takes the vertex rows (x, y, z as
-// doubles, with colours red, green, blue as floats: kTileRowBytesColored), owned vertices then the
-// copies, and the face rows; finish() the owned count and the copies' references. The file is
-// writeTile's for the same tile, byte for byte, or nothing.
+// EscapeRowSink with float colours), written as they come: start and add as PlyRowStream's, with
+// the vertex rows (x, y, z as doubles, with colours red, green, blue as floats:
+// kTileRowBytesColored) of the owned vertices, then the copies; finish() takes the owned count and
+// the copies' references. The file is writeTile's for the same tile, byte for byte, or nothing.
 constexpr size_t kTileRowBytes = 24, kTileRowBytesColored = 36;
 class TileRowStream {
  public:
@@ -39,8 +39,16 @@ class TileRowStream {
   static Result<std::unique_ptr<TileRowStream>> create(const std::string& path, TileSpec tile,
                                                        const std::string& signature, bool colors, unsigned threads,
                                                        Progress* progress);
-  PlyRowStream& rows() { return *rows_; }
+  TileRowStream(const TileRowStream&) = delete;  // the header's maker points at this object
+  TileRowStream& operator=(const TileRowStream&) = delete;
+
+  Status start(uint64_t vertices, uint64_t faces) { return rows_->start(vertices, faces); }
+  Status add(std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows) {
+    return rows_->add(vertex_rows, face_rows);
+  }
   Status finish(uint32_t owned, std::span<const TileVertexRef> foreign);
+  // The rows written so far, and after finish whether they were moved (PlyRowStream's).
+  const PlyRowStream& rows() const { return *rows_; }
 
  private:
   TileRowStream() = default;

@@ -629,8 +629,9 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
   const bool noise_fits = elsewhere && params.noise_colors && reach + 200.0 < 1000.0;
   // The mesh as PLY rows, written as they come, where the mesher makes all of it.
   const bool rows = elsewhere && params.rows.slab && (!params.rows.colors || noise_fits);
-  // A part's seam copies have the colours only as rows (`seam` holds positions).
-  const bool noise_elsewhere = noise_fits && (rows || (first_layer == 0 && last_layer == res - 1));
+  // As rows, the colours where the sink's rows have them (the rows' size is theirs); returned, only
+  // for the whole grid, since a part's seam copies then hold positions only.
+  const bool noise_elsewhere = noise_fits && (rows ? params.rows.colors : first_layer == 0 && last_layer == res - 1);
   // What the path holds in memory, checked before anything is made or written.
   const MeshPath path = rows ? MeshPath::kRows : elsewhere ? MeshPath::kElsewhere : MeshPath::kHost;
   if (Status s = checkMemory(what, estimateLayerMemory(params, share, path), params.max_memory); !s) return s.error();
@@ -836,6 +837,7 @@ Result<LayerMesh> meshLayers(const EscapeSurfaceParams& params, const EscapeRowF
       EscapeSlab slab = slabAt(slabFirst(s), slabLast(s));
       slab.ply_rows = true;
       slab.vertex_base = static_cast<uint32_t>(vertices);
+      assert(slab.noise_colors == params.rows.colors);  // the rows' size is the sink's
       Result<McSlabView> view = meshSlab(s, slab);
       if (writing.valid())
         if (Status w = writing.get(); !w) fail(w.error());

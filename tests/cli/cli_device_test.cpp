@@ -153,6 +153,39 @@ TEST(CliGenerateDevice, tilesMeshedOnTheDeviceAreWrittenAsTheirRowsAndAreTheHost
   }
 }
 
+// The header of a streamed tile is laid out from its sampled counts before its rows: where the
+// sample finds no vertex and the tile has some (the bulb's tip between the sampled layers), the
+// colour properties join the header and the rows move after it. Where the stream is opened but
+// the device does not take the rows (an empty share; --grid-out, which meshes on the host), the
+// part is written from the mesh instead. Each part is the host's byte for byte.
+TEST(CliGenerateDevice, streamedTilesWhoseHeaderGrowsOrWhoseRowsAreNotTakenAreTheHostsParts) {
+  TempDir dir;
+  struct Case {
+    std::vector<std::string> args;
+    bool streamed;
+  };
+  const std::vector<Case> cases = {
+      {{"--resolution", "120", "--bounds", "-2.28,1.5", "--tile", "0/3"}, true},
+      {{"--resolution", "40", "--tile", "45/50"}, false},
+      {{"--resolution", "40", "--tile", "2/5", "--grid-out", "GRID"}, false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args[1] + " " + c.args.back());
+    std::vector<std::string> args = concat({"generate", "mandelbulb", "--variant", "fast"}, c.args);
+    for (std::string& a : args)
+      if (a == "GRID") a = dir.file("grid");
+    ASSERT_EQ(runDpoint(concat(args, {"--device", "none", "-q", "-o", dir.file("host.ply")})).exit_code, 0);
+    test::CommandResult r =
+        runDpoint(concat(args, {"--device", "cpu", "--mesh", "device", "--validate", "-o", dir.file("device.ply")}));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err.find("the rows made on the device and written as they came (the header laid out first had "
+                         "another length: the vertex rows were moved)") != std::string::npos,
+              c.streamed)
+        << r.err;
+    EXPECT_TRUE(readFile(dir.file("host.ply")) == readFile(dir.file("device.ply")));
+  }
+}
+
 TEST(CliGenerateDevice, seedVariantAndMissingDevicesAreRefused) {
   TempDir dir;
   test::CommandResult r =
