@@ -29,8 +29,9 @@ void addEscapeCountsOption(CLI::App& command, GenerateDeviceOptions& options) {
   command
       .add_option("--mesh", options.mesh,
                   "Where marching cubes runs: host (the CPU's cores), device (the --device that counts; implies\n"
-                  "--counts full; counts of two bytes, past --max-iter 255, are meshed on the host), auto (device on\n"
-                  "a GPU, host on the CPU and on lavapipe). The output is the same bit for bit")
+                  "--counts full, wherever the mesh reads a count; counts of two bytes, past --max-iter 255, are\n"
+                  "meshed on the host), auto (device on a GPU, host on the CPU and on lavapipe). The output is the\n"
+                  "same bit for bit")
       ->check(oneOf("--mesh", {"auto", "host", "device"}))
       ->default_val("auto");
 }

@@ -79,8 +79,17 @@ class GpuEscape {
   // arena on a GPU, whole uint32 on lavapipe. Returns once its one submission is on the queue: a
   // submission after it on the context's queue whose barrier waits for compute writes reads the
   // counts (no host round trip between); settle() once such a submission has finished.
+  // With `cap` below the limit, for marching cubes (which reads a count above the level only where
+  // an edge crosses it): counts to the cap, floor(level) + 1, then to the limit only at the points at
+  // the cap that have a neighbour below it along an axis within the slab (shaders/generate/
+  // escape.comp, ESCAPE_REFINE); elsewhere a count at or above the level stays at the cap.
   Status escapeInto(const EscapeKernelParams& kernel, const std::vector<double>& axis, int first, int planes,
-                    int limit, const Buffer& target);
+                    int limit, const Buffer& target, int cap = -1);
+  // Whether meshSlabOnDevice counts to the cap first (escapeInto's `cap`): on a GPU, where the
+  // interior's iterations cost most (res-2048 Mandelbulb on an H200: see docs/performance.md);
+  // not on lavapipe, whose gathers make the list pass cost more than it saves. Tests set it.
+  bool refinesCounts() const { return refine_counts_; }
+  void setRefinesCounts(bool refine) { refine_counts_ = refine; }
   // Waits for the dispatches in flight and counts their time (pointsDone, gpuMs).
   Status settle() { return finishAll(); }
   uint32_t deviceBits(int limit) const;
@@ -120,8 +129,16 @@ class GpuEscape {
   enum class Target { kHost, kArena, kDevice };      // where a dispatch's counts go
   // Dispatches the rows of planes first..first + planes − 1 in chunks: copied out to `counts`
   // (kHost), or written in place from word `word_offset` of the arena or of escapeInto's target.
+  // Into device memory, with cap in [0, limit): counted to the cap, then to the limit where the
+  // mesh reads them (escapeInto).
   Status escapeRows(const EscapeKernelParams& kernel, uint64_t res, int first, int planes, int limit, Target target,
-                    uint64_t word_offset, uint8_t* counts);
+                    uint64_t word_offset, uint8_t* counts, int cap = -1);
+  // escape_refine's pipelines, set and a list of `list_bytes` at least (no dispatch in flight).
+  Status makeRefine(uint64_t list_bytes);
+  // Its two passes over the slab's `points` counts, capped at the push's cap (an
+  // EscapeRefinePush), into `commands` after the counts' dispatches (the push constants as given
+  // for the first; the second keeps them).
+  void recordRefine(VkCommandBuffer commands, uint32_t kernel, const void* push, uint64_t points) const;
   // Records and submits one dispatch into slot `s`, after finishing what the slot had in flight.
   Status dispatch(size_t s, VkPipeline pipeline, VkPipelineLayout layout, VkDescriptorSet set, const void* push,
                   uint32_t push_bytes, uint64_t points, void* destination, uint32_t count_bytes,
@@ -138,10 +155,18 @@ class GpuEscape {
   VkDescriptorSetLayout escape_set_layout_ = VK_NULL_HANDLE, perturbation_set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout escape_layout_ = VK_NULL_HANDLE, perturbation_layout_ = VK_NULL_HANDLE;
   VkPipeline escape_[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};  // by EscapeKernel
+  // escapeInto's counts to a cap, then past it where the mesh reads them: the list of those
+  // points and their pipelines (by kernel, then pass), made at the first such call.
+  VkDescriptorSetLayout refine_set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout refine_layout_ = VK_NULL_HANDLE;
+  VkPipeline refine_[2][2] = {};
+  VkDescriptorSet refine_set_ = VK_NULL_HANDLE;
+  Buffer refine_list_;
   VkPipeline perturbation_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   Slot slots_[2];
   const bool packed_counts_;  // escape.comp packs the counts, else writes uint32
+  bool refine_counts_ = false;  // refinesCounts(); init sets it from the device type
   VkQueryPool queries_ = VK_NULL_HANDLE;  // two timestamps per slot
   uint64_t points_done_ = 0;
   double gpu_ms_ = 0.0;

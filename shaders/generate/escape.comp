@@ -7,6 +7,13 @@
 // correctly rounded by exact_fp64.glsl; Julia's test sqrt(s) > 2 is replaced by its exact
 // equivalent s > 4 + 2^-50 (the threshold comes from the CPU), which needs no square root.
 // The kind is a specialization constant.
+//
+// Compiled again with ESCAPE_REFINE (generators/gpu_generate.h, GpuEscape::escapeInto's `cap`)
+// for marching cubes on the device: the counts of a slab made up to a cap only (floor(level) + 1,
+// where min(count, cap) > level exactly when count > level) save the Mandelbulb's interior its
+// iterations past the cap; pass 0 (kPass) then lists the points at the cap with a neighbour below
+// it, the only counts above the level that the mesh reads (an edge's crossing), and pass 1 counts
+// those to the limit, so the slab's counts are every count the mesh needs, bit for bit.
 #extension GL_ARB_gpu_shader_int64 : require
 #extension GL_GOOGLE_include_directive : require
 #include "exact_fp64.glsl"
@@ -22,7 +29,17 @@ layout(std430, set = 0, binding = 0) readonly buffer Axis { double values[]; }; 
 // is at most 255, else two (generators/escape_grid.h): a quarter of the bytes to write and copy
 // out at the usual limits. lavapipe writes 32 bits (kPacked = 0, bits = 32), which the host narrows
 // as it copies them: a shader with barriers took it a fifth more time, even where none ran.
+#ifdef ESCAPE_REFINE
+layout(constant_id = 3) const uint kPass = 0;  // 0: list the points to count on, 1: count them
+layout(std430, set = 0, binding = 1) buffer Counts { uint counts[]; };
+// The points (slab indices) whose counts the mesh needs past the cap, after their number.
+layout(std430, set = 0, binding = 2) buffer Refine {
+  uint refine_count;
+  uint refine[];
+};
+#else
 layout(std430, set = 0, binding = 1) writeonly buffer Counts { uint counts[]; };
+#endif
 
 layout(push_constant) uniform Push {
   dvec4 c;            // Julia's constant
@@ -35,6 +52,9 @@ layout(push_constant) uniform Push {
   uint limit;         // iterations at most
   uint bits;          // bits a count: 8, 16 or 32
   uint word_offset;   // the words of `counts` before this dispatch's first
+#ifdef ESCAPE_REFINE
+  uint cap;           // the counts' cap (pass 0: `count` points, the slab's; pass 1: limit is the run's)
+#endif
 };
 
 shared uint packed[128];  // this group's counts, packed: 256 of 16 bits at most
@@ -104,6 +124,45 @@ uint mandelbulbCount(double cx, double cy, double cz) {
   return limit;
 }
 
+#ifdef ESCAPE_REFINE
+// Count t of the slab, capped.
+uint countAt(uint t) {
+  if (kPacked == 0u) return counts[word_offset + t];
+  const uint per = 32u / bits;
+  return (counts[word_offset + t / per] >> ((t % per) * bits)) & ((1u << bits) - 1u);
+}
+
+void main() {
+  const uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
+  if (kPass == 0u) {
+    // Point t (plane p, row j, column k of the slab's `count` points) at the cap, with a neighbour
+    // along an axis below it: the edge between them crosses the level.
+    if (id >= count || countAt(id) < cap) return;
+    const uint t = id, plane = res * res;
+    const uint k = t % res, j = (t / res) % res, p = t / plane;
+    const bool crossing = (k > 0u && countAt(t - 1u) < cap) || (k + 1u < res && countAt(t + 1u) < cap) ||
+                          (j > 0u && countAt(t - res) < cap) || (j + 1u < res && countAt(t + res) < cap) ||
+                          (p > 0u && countAt(t - plane) < cap) || (p + 1u < count / plane && countAt(t + plane) < cap);
+    if (crossing) refine[atomicAdd(refine_count, 1u)] = t;
+    return;
+  }
+  // The listed points counted to the limit, the threads striding over the list; a count grows by
+  // its excess over the cap in its bits (no other thread writes them).
+  const uint n = refine_count, stride = gl_NumWorkGroups.x * gl_NumWorkGroups.y * 256u;
+  for (uint i = id; i < n; i += stride) {
+    const uint t = refine[i];
+    const uint row = first_row + t / res;
+    const double x = values[row / res], y = values[row % res], z = values[t % res];
+    const uint value = kKind == 0u ? juliaCount(x, y, z) : mandelbulbCount(x, y, z);
+    if (kPacked == 0u) {
+      counts[word_offset + t] = value;
+    } else {
+      const uint per = 32u / bits;
+      atomicAdd(counts[word_offset + t / per], (value - cap) << ((t % per) * bits));
+    }
+  }
+}
+#else
 void main() {
   const uint lid = gl_LocalInvocationID.x;
   const uint base = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u;
@@ -128,3 +187,4 @@ void main() {
   const uint word = base / per + lid;
   if (lid < words && word < (count + per - 1u) / per) counts[word_offset + word] = packed[lid];
 }
+#endif

@@ -446,7 +446,14 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
   test::TempDir dir;
   for (int res : {44, 45}) {
     for (bool colors : {true, false}) {
-      SCOPED_TRACE("res " + std::to_string(res) + (colors ? ", colours" : ""));
+     // The counts to the cap and then past it where an edge crosses the level (a GPU's default),
+     // packed as a GPU's and whole as lavapipe's, and all to the limit (lavapipe's): the same file.
+     for (int counts = 0; counts < 3; ++counts) {
+      const bool refine = counts < 2;
+      GpuEscape* escape = counts == 1 ? gpu_.get() : packed_.get();
+      SCOPED_TRACE("res " + std::to_string(res) + (colors ? ", colours" : "") + (refine ? ", refined" : "") +
+                   (counts == 1 ? ", uint32 counts" : ""));
+      escape->setRefinesCounts(refine);
       MandelbulbParams bulb;
       bulb.resolution = res;
       bulb.variant = MandelbulbVariant::kFast;
@@ -459,7 +466,6 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
       bulb.planes = planes(mandelbulb(), GridAxis{res, -1.5, 1.5}, true);
       bulb.full_counts = true;
       bulb.noise_colors = colors;
-      GpuEscape* escape = packed_.get();
       // Each slab's counts are made once: those of the slab named as `next` while the one before
       // is meshed, and taken from there.
       const uint64_t points_before = escape->pointsDone();
@@ -486,8 +492,10 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
       ASSERT_TRUE(to.finish().ok());
       EXPECT_EQ(to.vertices(), expected->size());
       EXPECT_TRUE(test::readFile(dir.file("device.ply")) == test::readFile(dir.file("host.ply")));
+     }
     }
   }
+  for (GpuEscape* escape : {gpu_.get(), packed_.get()}) escape->setRefinesCounts(context_->facts.type != "cpu");
 }
 
 // --max-memory is checked against what the path holds: the streamed rows hold the face rows (13
