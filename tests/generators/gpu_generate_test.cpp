@@ -498,6 +498,42 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
   for (GpuEscape* escape : {gpu_.get(), packed_.get()}) escape->setRefinesCounts(context_->facts.type != "cpu");
 }
 
+// Where the device has no room for the list of the points to count past the cap (a device memory
+// budget that the first run filled), the counts go to the limit instead, for the rest of the run:
+// the same mesh.
+TEST_F(GpuGenerate, countsGoToTheLimitWhereTheDeviceHasNoRoomForTheList) {
+  Result<std::unique_ptr<GpuMesher>> made = GpuMesher::create(*context_);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  GpuMesher& mesher = **made;
+  Result<std::unique_ptr<GpuEscape>> fresh = GpuEscape::create(*context_, true);  // no list made yet
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message;
+  GpuEscape& escape = **fresh;
+  MandelbulbParams bulb;
+  bulb.resolution = 44;
+  bulb.variant = MandelbulbVariant::kFast;
+  Result<PointSet> expected = generateMandelbulb(bulb);
+  ASSERT_TRUE(expected.ok());
+  bulb.planes = planes(mandelbulb(), GridAxis{44, -1.5, 1.5}, true);
+  bulb.full_counts = true;
+  bulb.mesher.takes = &GpuMesher::supports;
+  bulb.mesher.mesh = [&](const EscapeSlab& slab, const EscapeSlab* next) {
+    return meshSlabOnDevice(escape, mesher, mandelbulb(), slab, next);
+  };
+  // Every buffer but the list made, at a size no slab passes (the whole mesh has 5,404 vertices).
+  ASSERT_TRUE(mesher.reserve(100000, 200000, false, 0).ok());
+  escape.setRefinesCounts(false);
+  Result<PointSet> got = generateMandelbulb(bulb);
+  ASSERT_TRUE(got.ok()) << got.error().message;
+  EXPECT_TRUE(got->positions == expected->positions && got->triangles == expected->triangles);
+  context_->device_memory_budget = context_->device_memory_used.load();
+  escape.setRefinesCounts(true);
+  got = generateMandelbulb(bulb);
+  context_->device_memory_budget = 0;
+  ASSERT_TRUE(got.ok()) << got.error().message;
+  EXPECT_FALSE(escape.refinesCounts());
+  EXPECT_TRUE(got->positions == expected->positions && got->triangles == expected->triangles);
+}
+
 // --max-memory is checked against what the path holds: the streamed rows hold the face rows (13
 // bytes a triangle) and two slabs' copies, the mesh in memory holds the mesh, the host's workers
 // their buffers and blocks too. At res 44 the estimates are about 240 KB, 380 KB and more than
