@@ -48,10 +48,6 @@ struct PerturbationPush {
 };
 static_assert(sizeof(PerturbationPush) == 32);
 
-VkDescriptorSetLayoutBinding storage(uint32_t binding) {
-  return {binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-}
-
 // Copies `count` values of type From out of mapped memory as To (the same type, or lavapipe's
 // uint32 counts narrowed) on several threads: one thread copies at a fraction of the host's
 // bandwidth, and this copy is on the critical path of the thread that feeds the meshing workers.
@@ -104,21 +100,9 @@ Status GpuEscape::init() {
     query_info.queryCount = 4;
     VK_TRY(vkCreateQueryPool(context_.device, &query_info, nullptr, &queries_));
   }
-  Result<VkDescriptorSetLayout> escape_set = storageSetLayout(context_, {storage(0), storage(1)});
-  if (!escape_set) return escape_set.error();
-  escape_set_layout_ = *escape_set;
-  Result<VkDescriptorSetLayout> perturbation_set =
-      storageSetLayout(context_, {storage(0), storage(1), storage(2), storage(3), storage(4)});
-  if (!perturbation_set) return perturbation_set.error();
-  perturbation_set_layout_ = *perturbation_set;
-  Result<VkPipelineLayout> escape_layout =
-      pipelineLayout(context_, escape_set_layout_, sizeof(EscapePush), VK_SHADER_STAGE_COMPUTE_BIT);
-  if (!escape_layout) return escape_layout.error();
-  escape_layout_ = *escape_layout;
-  Result<VkPipelineLayout> perturbation_layout =
-      pipelineLayout(context_, perturbation_set_layout_, sizeof(PerturbationPush), VK_SHADER_STAGE_COMPUTE_BIT);
-  if (!perturbation_layout) return perturbation_layout.error();
-  perturbation_layout_ = *perturbation_layout;
+  if (Status s = computeLayouts(context_, 2, sizeof(EscapePush), escape_set_layout_, escape_layout_); !s) return s;
+  if (Status s = computeLayouts(context_, 5, sizeof(PerturbationPush), perturbation_set_layout_, perturbation_layout_); !s)
+    return s;
   // exact_fp64.glsl's square root and reciprocal in their bit-level form on a GPU, scaled on a
   // CPU device (lavapipe), each the faster there; the same counts.
   const uint32_t exact_bits = context_.facts.type == "cpu" ? 0u : 1u;
@@ -326,13 +310,8 @@ Status GpuEscape::escapeInto(const EscapeKernelParams& kernel, const std::vector
 
 Status GpuEscape::makeRefine(uint64_t list_bytes) {
   if (!refine_layout_) {
-    Result<VkDescriptorSetLayout> set = storageSetLayout(context_, {storage(0), storage(1), storage(2)});
-    if (!set) return set.error();
-    refine_set_layout_ = *set;
-    Result<VkPipelineLayout> layout =
-        pipelineLayout(context_, refine_set_layout_, sizeof(EscapeRefinePush), VK_SHADER_STAGE_COMPUTE_BIT);
-    if (!layout) return layout.error();
-    refine_layout_ = *layout;
+    if (Status s = computeLayouts(context_, 3, sizeof(EscapeRefinePush), refine_set_layout_, refine_layout_); !s)
+      return s;
     const uint32_t exact_bits = context_.facts.type == "cpu" ? 0u : 1u;  // as escape_'s
     for (uint32_t kind = 0; kind < 2; ++kind)
       for (uint32_t pass = 0; pass < 2; ++pass) {

@@ -59,16 +59,7 @@ Status GpuMesher::init() {
     query_info.queryCount = kStamps;
     VK_TRY(vkCreateQueryPool(context_.device, &query_info, nullptr, &queries_));
   }
-  std::vector<VkDescriptorSetLayoutBinding> bindings;
-  for (uint32_t b = 0; b < kBindings; ++b)
-    bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  Result<VkDescriptorSetLayout> set_layout = storageSetLayout(context_, bindings);
-  if (!set_layout) return set_layout.error();
-  set_layout_ = *set_layout;
-  Result<VkPipelineLayout> layout =
-      pipelineLayout(context_, set_layout_, sizeof(MeshPush), VK_SHADER_STAGE_COMPUTE_BIT);
-  if (!layout) return layout.error();
-  layout_ = *layout;
+  if (Status s = computeLayouts(context_, kBindings, sizeof(MeshPush), set_layout_, layout_); !s) return s;
   Result<VkDescriptorSet> set = storageSet(context_, set_layout_, kBindings, pool_);
   if (!set) return set.error();
   set_ = *set;

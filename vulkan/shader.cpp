@@ -74,6 +74,20 @@ Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescript
   return layout;
 }
 
+Status computeLayouts(const VulkanContext& context, uint32_t storage_buffers, uint32_t push_bytes,
+                      VkDescriptorSetLayout& set_layout, VkPipelineLayout& layout) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  for (uint32_t b = 0; b < storage_buffers; ++b)
+    bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  Result<VkDescriptorSetLayout> set = storageSetLayout(context, bindings);
+  if (!set) return set.error();
+  set_layout = *set;
+  Result<VkPipelineLayout> pipeline = pipelineLayout(context, set_layout, push_bytes, VK_SHADER_STAGE_COMPUTE_BIT);
+  if (!pipeline) return pipeline.error();
+  layout = *pipeline;
+  return okStatus();
+}
+
 void writeBufferDescriptors(const VulkanContext& context, VkDescriptorSet set,
                             std::span<const VkDescriptorBufferInfo> infos, bool first_is_uniform) {
   std::vector<VkWriteDescriptorSet> writes(infos.size());

@@ -23,6 +23,11 @@ Result<VkDescriptorSetLayout> storageSetLayout(const VulkanContext& context,
 Result<VkPipelineLayout> pipelineLayout(const VulkanContext& context, VkDescriptorSetLayout set, uint32_t push_bytes,
                                         VkShaderStageFlags stages);
 
+// Both for a compute shader of `storage_buffers` storage buffers (bindings 0, 1, …) and push_bytes
+// of push constants, into `set_layout` and `layout` (which the caller destroys, also on an error).
+Status computeLayouts(const VulkanContext& context, uint32_t storage_buffers, uint32_t push_bytes,
+                      VkDescriptorSetLayout& set_layout, VkPipelineLayout& layout);
+
 // A descriptor pool for one set of `descriptors` storage buffers (into `pool`, which the caller
 // destroys, also when the set cannot be allocated), and that set of `layout`.
 Result<VkDescriptorSet> storageSet(const VulkanContext& context, VkDescriptorSetLayout layout, uint32_t descriptors,
