@@ -193,15 +193,24 @@ Result<std::unique_ptr<PlyRowStream>> rowStream(const OutputOptions& o, bool col
   return PlyRowStream::create(o.output, colors, o.common.threads, &progress);
 }
 
-EscapeRowSink rowSink(PlyRowStream& stream) {
+namespace {
+
+// The generator's sink into a PlyRowStream or a TileRowStream (their start and add).
+template <typename Stream>
+EscapeRowSink sinkInto(Stream& stream, bool colors, bool float_colors) {
   EscapeRowSink sink;
-  sink.colors = stream.colors();
+  sink.colors = colors;
+  sink.float_colors = float_colors;
   sink.start = [&stream](uint64_t vertices, uint64_t triangles) { return stream.start(vertices, triangles); };
   sink.slab = [&stream](std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows) {
     return stream.add(vertex_rows, face_rows);
   };
   return sink;
 }
+
+}  // namespace
+
+EscapeRowSink rowSink(PlyRowStream& stream) { return sinkInto(stream, stream.colors(), false); }
 
 namespace {
 
@@ -234,13 +243,8 @@ Result<std::unique_ptr<TileRowStream>> tileRowStream(const OutputOptions& o, Til
 }
 
 EscapeRowSink tileRowSink(TileRowStream& stream) {
-  EscapeRowSink sink;
-  sink.colors = sink.float_colors = stream.rows().colors();
-  sink.start = [&stream](uint64_t vertices, uint64_t triangles) { return stream.start(vertices, triangles); };
-  sink.slab = [&stream](std::span<const uint8_t> vertex_rows, std::span<const uint8_t> face_rows) {
-    return stream.add(vertex_rows, face_rows);
-  };
-  return sink;
+  const bool colors = stream.rows().colors();
+  return sinkInto(stream, colors, colors);  // a part's colours are floats
 }
 
 int finishTileRows(Result<PointTile> generated, TileRowStream& stream, const OutputOptions& o, PhaseClock& clock) {

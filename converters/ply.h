@@ -78,14 +78,6 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
                       const PlyWriteOptions& options);
 
-// A binary PLY mesh whose rows are made elsewhere and written as they come (a device's marching
-// cubes: generators/escape_grid.h EscapeRowSink): vertex rows of x, y, z as doubles and, with
-// colours, red, green, blue as bytes; face rows of the byte 3 and three uint ids. The header holds
-// the counts, known only at the end, so it is laid out from estimates and the vertex rows are
-// written after it as they come. The face rows wait in memory until the last vertex is written,
-// then follow; the real header goes over the estimated one, and where its length differs (the
-// counts' digits did) the vertex rows are moved first. The file is writePly's for the same mesh,
-// byte for byte, or nothing (a failed or abandoned stream leaves no file).
 // How a PlyRowStream's file is laid out where it is not writePly's (a tile's part file,
 // converters/tile_file.h): the vertex row's bytes, and the header for the counts (has_z: some vertex
 // has a z other than +0); the elements after the faces are finish()'s `trailer`.
@@ -94,6 +86,14 @@ struct PlyRowLayout {
   std::function<std::string(uint64_t vertices, uint64_t faces, bool has_z)> header;
 };
 
+// A binary PLY mesh whose rows are made elsewhere and written as they come (a device's marching
+// cubes: generators/escape_grid.h EscapeRowSink): vertex rows of x, y, z as doubles and, with
+// colours, red, green, blue as bytes; face rows of the byte 3 and three uint ids. The header holds
+// the counts, known only at the end, so it is laid out from estimates and the vertex rows are
+// written after it as they come. The face rows wait in memory until the last vertex is written,
+// then follow; the real header goes over the estimated one, and where its length differs (the
+// counts' digits did) the vertex rows are moved first. The file is writePly's for the same mesh,
+// byte for byte, or nothing (a failed or abandoned stream leaves no file).
 class PlyRowStream {
  public:
   // Opens the output (AtomicFile); null where it is not a regular file (a pipe or a device, which

@@ -284,18 +284,15 @@ Result<McSlabView> GpuMesher::meshSlab(const EscapeSlab& slab, uint32_t bits, un
   };
   if (slab.noise_colors)
     if (Status s = made(kColorPass, kMeshColorsComp, sizeof(kMeshColorsComp), {}); !s) return s.error();
-  // The vertex rows' pass: without colours, with colour bytes, with float colours.
-  const uint32_t vertex_pass = !slab.noise_colors  ? kVertexRowPass
-                               : slab.float_colors ? kFloatColoredVertexRowPass
-                                                   : kColoredVertexRowPass;
+  // The vertex rows' colours, mesh_rows.comp's kColors (none, bytes, floats), and their pass.
+  const uint32_t row_colors = !slab.noise_colors ? 0u : slab.float_colors ? 2u : 1u;
+  static constexpr uint32_t kVertexRowPasses[3] = {kVertexRowPass, kColoredVertexRowPass, kFloatColoredVertexRowPass};
+  const uint32_t vertex_pass = kVertexRowPasses[row_colors];
   if (slab.ply_rows) {
     // kPass and kColors of mesh_rows.comp.
-    static constexpr uint32_t kVertices[2] = {0u, 0u}, kColored[2] = {0u, 1u}, kFloatColored[2] = {0u, 2u},
-                              kFaces[2] = {1u, 0u};
-    const uint32_t* constants = vertex_pass == kVertexRowPass ? kVertices
-                                : vertex_pass == kColoredVertexRowPass ? kColored
-                                                                       : kFloatColored;
-    if (Status s = made(vertex_pass, kMeshRowsComp, sizeof(kMeshRowsComp), {constants, 2}); !s) return s.error();
+    const uint32_t vertex_constants[2] = {0u, row_colors};
+    static constexpr uint32_t kFaces[2] = {1u, 0u};
+    if (Status s = made(vertex_pass, kMeshRowsComp, sizeof(kMeshRowsComp), vertex_constants); !s) return s.error();
     if (Status s = made(kFaceRowPass, kMeshRowsComp, sizeof(kMeshRowsComp), kFaces); !s) return s.error();
   }
   const uint64_t vertex_elements = (2 * static_cast<uint64_t>(planes) - 1) * plane;
