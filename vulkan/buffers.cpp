@@ -1,5 +1,7 @@
 #include "vulkan/buffers.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cstring>
@@ -54,10 +56,98 @@ Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, V
   return out;
 }
 
+// Pages of the process's own for a host-visible buffer, made present on every core: 2 MiB pages
+// where the kernel gives them (the mapping aligned to 2 MiB). Null where mmap fails.
+void* mapHostPages(size_t bytes) {
+  constexpr size_t kHuge = size_t{2} << 20;
+  void* raw = mmap(nullptr, bytes + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) return nullptr;
+  const uintptr_t start = reinterpret_cast<uintptr_t>(raw), aligned = (start + kHuge - 1) / kHuge * kHuge;
+  if (aligned > start) munmap(raw, aligned - start);
+  if (const size_t tail = start + bytes + kHuge - (aligned + bytes); tail) munmap(reinterpret_cast<void*>(aligned + bytes), tail);
+  auto* pages = reinterpret_cast<uint8_t*>(aligned);
+  madvise(pages, bytes, MADV_HUGEPAGE);
+  // A driver pins the pages it imports one at a time; faulted here they come from every core.
+  parallelFor((bytes + kHuge - 1) / kHuge, 0, [&](size_t piece, unsigned) {
+    const size_t end = std::min(bytes, (piece + 1) * kHuge);
+    for (size_t at = piece * kHuge; at < end; at += 4096) pages[at] = 0;
+  });
+  return pages;
+}
+
+// A host-visible buffer in memory of the process's own, imported (VK_EXT_external_memory_host);
+// an error where the device will not take it, for createBuffer to allocate instead.
+Result<Buffer> importHostBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
+                                const std::string& what) {
+  constexpr auto kHandle = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
+  VkPhysicalDeviceExternalBufferInfo query = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_BUFFER_INFO};
+  query.usage = usage;
+  query.handleType = kHandle;
+  VkExternalBufferProperties external = {VK_STRUCTURE_TYPE_EXTERNAL_BUFFER_PROPERTIES};
+  vkGetPhysicalDeviceExternalBufferProperties(context.physical, &query, &external);
+  if (!(external.externalMemoryProperties.externalMemoryFeatures & VK_EXTERNAL_MEMORY_FEATURE_IMPORTABLE_BIT))
+    return Error{"host memory cannot be imported for " + what, ExitCode::kNoDevice};
+  const VkDeviceSize align = std::max<VkDeviceSize>(context.host_import_alignment, 4096);
+  const size_t bytes = static_cast<size_t>((size + align - 1) / align * align);
+  void* pages = mapHostPages(bytes);
+  if (!pages) return Error{"no host memory for " + what, ExitCode::kResourceLimit};
+  Buffer out;
+  out.size = size;
+  out.host_pages = pages;
+  out.host_bytes = bytes;
+  auto failed = [&](const std::string& call, VkResult result) {
+    destroyBuffer(context, out);
+    return vulkanError(call + " (" + what + ", " + formatBytes(size) + ")", result);
+  };
+  VkExternalMemoryBufferCreateInfo external_info = {VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+  external_info.handleTypes = kHandle;
+  VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.pNext = &external_info;
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  if (VkResult r = vkCreateBuffer(context.device, &info, nullptr, &out.buffer); r != VK_SUCCESS)
+    return failed("vkCreateBuffer", r);
+  VkMemoryRequirements needs{};
+  vkGetBufferMemoryRequirements(context.device, out.buffer, &needs);
+  VkMemoryHostPointerPropertiesEXT pointer = {VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT};
+  if (VkResult r = context.host_pointer_properties(context.device, kHandle, pages, &pointer); r != VK_SUCCESS)
+    return failed("vkGetMemoryHostPointerPropertiesEXT", r);
+  Result<uint32_t> type = context.memoryType(needs.memoryTypeBits & pointer.memoryTypeBits,
+                                             VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+  if (!type || needs.size > bytes) {
+    destroyBuffer(context, out);
+    return Error{"no memory type imports host memory for " + what, ExitCode::kNoDevice};
+  }
+  if (Status budget = reserveDeviceMemory(context, bytes, what); !budget) {
+    destroyBuffer(context, out);
+    return budget.error();
+  }
+  out.allocated = bytes;
+  VkImportMemoryHostPointerInfoEXT import = {VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT};
+  import.handleType = kHandle;
+  import.pHostPointer = pages;
+  VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  allocate.pNext = &import;
+  allocate.allocationSize = bytes;
+  allocate.memoryTypeIndex = *type;
+  if (VkResult r = vkAllocateMemory(context.device, &allocate, nullptr, &out.memory); r != VK_SUCCESS)
+    return failed("vkAllocateMemory", r);
+  if (VkResult r = vkBindBufferMemory(context.device, out.buffer, out.memory, 0); r != VK_SUCCESS)
+    return failed("vkBindBufferMemory", r);
+  out.mapped = pages;
+  out.coherent = (context.memory.memoryTypes[*type].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+  return out;
+}
+
 }  // namespace
 
 Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
                             bool host_visible, const std::string& what) {
+  if (host_visible && context.host_import_alignment && size >= context.host_import_from) {
+    // Where the import fails (this use, the budget, the host's memory), the driver's memory.
+    if (Result<Buffer> imported = importHostBuffer(context, size, usage, what); imported) return imported;
+  }
   return allocateBuffer(context, size, usage, what, [&](const VkMemoryRequirements& needs) {
     return host_visible
         ? context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
@@ -101,6 +191,7 @@ Result<Buffer> createUploadTarget(const VulkanContext& context, VkDeviceSize siz
 void destroyBuffer(const VulkanContext& context, Buffer& buffer) {
   if (buffer.buffer) vkDestroyBuffer(context.device, buffer.buffer, nullptr);
   if (buffer.memory) vkFreeMemory(context.device, buffer.memory, nullptr);  // unmaps too
+  if (buffer.host_pages) munmap(buffer.host_pages, buffer.host_bytes);
   releaseDeviceMemory(context, buffer.allocated);
   buffer = Buffer{};
 }

@@ -15,10 +15,15 @@ struct Buffer {
   VkDeviceSize allocated = 0;  // counted in the context's device_memory_used
   void* mapped = nullptr;  // set when the memory is host-visible (mapped for the buffer's life)
   bool coherent = false;
+  // The process's own pages the memory was imported from (VulkanContext::host_import_alignment),
+  // unmapped once the memory is freed; null otherwise.
+  void* host_pages = nullptr;
+  size_t host_bytes = 0;
 };
 
 // Device-local when `host_visible` is false (filled through uploadBuffer), else host-visible
-// and mapped (cached preferred, for readback). Fails naming `what` and the size.
+// and mapped (cached preferred, for readback; imported from the process's own memory where the
+// context imports, from its host_import_from on). Fails naming `what` and the size.
 Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
                             bool host_visible, const std::string& what);
 void destroyBuffer(const VulkanContext& context, Buffer& buffer);

@@ -279,6 +279,19 @@ VKAPI_ATTR VkBool32 VKAPI_CALL VulkanContext::onMessage(VkDebugUtilsMessageSever
   return VK_FALSE;
 }
 
+namespace {
+
+bool hasDeviceExtension(VkPhysicalDevice physical, const char* name) {
+  uint32_t count = 0;
+  if (vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkExtensionProperties> extensions(count);
+  if (vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, extensions.data()) != VK_SUCCESS) return false;
+  return std::any_of(extensions.begin(), extensions.end(),
+                     [name](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+}  // namespace
+
 Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOptions& options) {
   std::unique_ptr<VulkanContext> context(new VulkanContext());
   VkDebugUtilsMessengerCreateInfoEXT messenger_info = {VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
@@ -331,12 +344,27 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
     queue_infos[1].queueCount = 1;
     queue_infos[1].pQueuePriorities = &priority;
   }
+  const bool host_import = options.import_host_memory.value_or(context->facts.type != "cpu") &&
+                           hasDeviceExtension(context->physical, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+  const char* device_extensions[] = {VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME};
   VkDeviceCreateInfo device_info = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   device_info.queueCreateInfoCount = transfer ? 2 : 1;
   device_info.pQueueCreateInfos = queue_infos;
   device_info.pEnabledFeatures = &enabled;
   device_info.pNext = &enabled12;
+  device_info.enabledExtensionCount = host_import ? 1 : 0;
+  device_info.ppEnabledExtensionNames = device_extensions;
   VK_TRY(vkCreateDevice(context->physical, &device_info, nullptr, &context->device));
+  if (host_import) {
+    VkPhysicalDeviceExternalMemoryHostPropertiesEXT import_facts = {
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT};
+    VkPhysicalDeviceProperties2 properties = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    properties.pNext = &import_facts;
+    vkGetPhysicalDeviceProperties2(context->physical, &properties);
+    context->host_pointer_properties = reinterpret_cast<PFN_vkGetMemoryHostPointerPropertiesEXT>(
+        vkGetDeviceProcAddr(context->device, "vkGetMemoryHostPointerPropertiesEXT"));
+    if (context->host_pointer_properties) context->host_import_alignment = import_facts.minImportedHostPointerAlignment;
+  }
   vkGetDeviceQueue(context->device, context->facts.queue_family, 0, &context->queue);
 
   VkCommandPoolCreateInfo pool_info = {VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};

@@ -498,6 +498,61 @@ TEST_F(GpuGenerate, rowsOnTheDeviceWriteTheHostsFile) {
   for (GpuEscape* escape : {gpu_.get(), packed_.get()}) escape->setRefinesCounts(context_->facts.type != "cpu");
 }
 
+// A GPU's host-visible buffers come from the process's own memory, imported (the readback
+// buffers the rows cross to the host in; ContextOptions::import_host_memory). Forced here on
+// lavapipe for every size, with the validation layer: the same file, no message.
+TEST_F(GpuGenerate, rowsReadBackThroughImportedHostMemoryWriteTheHostsFile) {
+  ContextOptions options{"auto", true};
+  options.import_host_memory = true;
+  Result<std::unique_ptr<VulkanContext>> context = VulkanContext::create(options);
+  ASSERT_TRUE(context.ok()) << context.error().message;
+  VulkanContext& imports = **context;
+  ASSERT_GT(imports.host_import_alignment, 0u);  // lavapipe has VK_EXT_external_memory_host
+  imports.host_import_from = 0;
+  {
+    Result<Buffer> buffer = createBuffer(imports, 1000, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "a test");
+    ASSERT_TRUE(buffer.ok()) << buffer.error().message;
+    EXPECT_TRUE(buffer->host_pages && buffer->mapped == buffer->host_pages);
+    EXPECT_EQ(buffer->host_bytes % imports.host_import_alignment, 0u);
+    EXPECT_EQ(imports.device_memory_used.load(), buffer->host_bytes);
+    destroyBuffer(imports, *buffer);
+    EXPECT_EQ(imports.device_memory_used.load(), 0u);
+  }
+  Result<std::unique_ptr<GpuEscape>> escape = GpuEscape::create(imports, true);
+  ASSERT_TRUE(escape.ok()) << escape.error().message;
+  Result<std::unique_ptr<GpuMesher>> mesher = GpuMesher::create(imports);
+  ASSERT_TRUE(mesher.ok()) << mesher.error().message;
+  test::TempDir dir;
+  MandelbulbParams bulb;
+  bulb.resolution = 45;
+  bulb.variant = MandelbulbVariant::kFast;
+  Result<PointSet> expected = generateMandelbulb(bulb);
+  ASSERT_TRUE(expected.ok());
+  PlyWriteOptions write;
+  write.colors_of = seedColors;
+  ASSERT_TRUE(writePly(dir.file("host.ply"), *expected, write).ok());
+  bulb.planes = planes(mandelbulb(), GridAxis{45, -1.5, 1.5}, true);
+  bulb.full_counts = true;
+  bulb.noise_colors = true;
+  bulb.mesher.takes = &GpuMesher::supports;
+  bulb.mesher.mesh = [&](const EscapeSlab& slab, const EscapeSlab* next) {
+    return meshSlabOnDevice(**escape, **mesher, mandelbulb(), slab, next);
+  };
+  bulb.mesher.reserve = [&](uint64_t v, uint64_t t, bool c, size_t r) { return (*mesher)->reserve(v, t, c, r); };
+  Result<std::unique_ptr<PlyRowStream>> stream = PlyRowStream::create(dir.file("device.ply"), true, 0, nullptr);
+  ASSERT_TRUE(stream.ok() && *stream);
+  bulb.rows.colors = true;
+  bulb.rows.start = [&](uint64_t v, uint64_t t) { return (*stream)->start(v, t); };
+  bulb.rows.slab = [&](std::span<const uint8_t> v, std::span<const uint8_t> f) { return (*stream)->add(v, f); };
+  Result<PointSet> got = generateMandelbulb(bulb);
+  ASSERT_TRUE(got.ok()) << got.error().message;
+  ASSERT_TRUE((*stream)->finish().ok());
+  EXPECT_TRUE(test::readFile(dir.file("device.ply")) == test::readFile(dir.file("host.ply")));
+  mesher->reset();
+  escape->reset();
+  for (const std::string& m : imports.validationMessages()) ADD_FAILURE() << m;
+}
+
 // Where the device has no room for the list of the points to count past the cap (a device memory
 // budget that the first run filled), the counts go to the limit instead, for the rest of the run:
 // the same mesh.
