@@ -67,6 +67,8 @@ void* mapHostPages(size_t bytes) {
   if (const size_t tail = start + bytes + kHuge - (aligned + bytes); tail) munmap(reinterpret_cast<void*>(aligned + bytes), tail);
   auto* pages = reinterpret_cast<uint8_t*>(aligned);
   madvise(pages, bytes, MADV_HUGEPAGE);
+  // A child process (a Python user's fork) gets none of them: pinned pages would be copied.
+  madvise(pages, bytes, MADV_DONTFORK);
   // A driver pins the pages it imports one at a time; faulted here they come from every core.
   parallelFor((bytes + kHuge - 1) / kHuge, 0, [&](size_t piece, unsigned) {
     const size_t end = std::min(bytes, (piece + 1) * kHuge);
