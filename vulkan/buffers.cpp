@@ -13,33 +13,61 @@ namespace dpoint {
 
 namespace {
 
+constexpr VkExternalMemoryHandleTypeFlagBits kHostAllocation = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
+
+// Pages of the process's own that a buffer's memory is imported from (VK_EXT_external_memory_host).
+struct HostPages {
+  void* pages = nullptr;
+  size_t bytes = 0;  // a multiple of the context's host_import_alignment
+};
+
 // A buffer of `size` bytes bound to memory of the type `pick` chooses from the buffer's allowed
-// types (mapped for the buffer's life when host-visible).
+// types (mapped for the buffer's life when host-visible); with `host`, memory imported from those
+// pages (of the types that may hold them), which the buffer then owns, also on an error.
 Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
                               const std::string& what,
-                              const std::function<Result<uint32_t>(const VkMemoryRequirements&)>& pick) {
+                              const std::function<Result<uint32_t>(const VkMemoryRequirements&)>& pick,
+                              const HostPages* host = nullptr) {
   assert(size > 0);
   Buffer out;
   out.size = size;
+  if (host) {
+    out.host_pages = host->pages;
+    out.host_bytes = host->bytes;
+  }
+  auto failed = [&](Error error) {
+    destroyBuffer(context, out);
+    return error;
+  };
+  VkExternalMemoryBufferCreateInfo external = {VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+  external.handleTypes = kHostAllocation;
   VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.pNext = host ? &external : nullptr;
   info.size = size;
   info.usage = usage;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   VkResult result = vkCreateBuffer(context.device, &info, nullptr, &out.buffer);
-  if (result != VK_SUCCESS) return vulkanError("vkCreateBuffer (" + what + ", " + formatBytes(size) + ")", result);
+  if (result != VK_SUCCESS) return failed(vulkanError("vkCreateBuffer (" + what + ", " + formatBytes(size) + ")", result));
   VkMemoryRequirements needs{};
   vkGetBufferMemoryRequirements(context.device, out.buffer, &needs);
+  VkImportMemoryHostPointerInfoEXT import = {VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT};
+  if (host) {
+    VkMemoryHostPointerPropertiesEXT pointer = {VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT};
+    result = context.host_pointer_properties(context.device, kHostAllocation, host->pages, &pointer);
+    if (result != VK_SUCCESS) return failed(vulkanError("vkGetMemoryHostPointerPropertiesEXT (" + what + ")", result));
+    if (needs.size > host->bytes)
+      return failed(Error{what + " needs more than the host pages to import", ExitCode::kNoDevice});
+    needs.memoryTypeBits &= pointer.memoryTypeBits;
+    needs.size = host->bytes;
+    import.handleType = kHostAllocation;
+    import.pHostPointer = host->pages;
+  }
   Result<uint32_t> type = pick(needs);
-  if (!type) {
-    vkDestroyBuffer(context.device, out.buffer, nullptr);
-    return type.error();
-  }
-  if (Status budget = reserveDeviceMemory(context, needs.size, what); !budget) {
-    vkDestroyBuffer(context.device, out.buffer, nullptr);
-    return budget.error();
-  }
+  if (!type) return failed(type.error());
+  if (Status budget = reserveDeviceMemory(context, needs.size, what); !budget) return failed(budget.error());
   out.allocated = needs.size;
   VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  allocate.pNext = host ? &import : nullptr;
   allocate.allocationSize = needs.size;
   allocate.memoryTypeIndex = *type;
   result = vkAllocateMemory(context.device, &allocate, nullptr, &out.memory);
@@ -47,12 +75,12 @@ Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, V
   VkMemoryPropertyFlags flags = context.memory.memoryTypes[*type].propertyFlags;
   if (result == VK_SUCCESS && (flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
     out.coherent = (flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
-    result = vkMapMemory(context.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+    if (host)
+      out.mapped = host->pages;
+    else
+      result = vkMapMemory(context.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
   }
-  if (result != VK_SUCCESS) {
-    destroyBuffer(context, out);
-    return vulkanError("allocating " + formatBytes(size) + " for " + what, result);
-  }
+  if (result != VK_SUCCESS) return failed(vulkanError("allocating " + formatBytes(size) + " for " + what, result));
   return out;
 }
 
@@ -77,84 +105,39 @@ void* mapHostPages(size_t bytes) {
   return pages;
 }
 
-// A host-visible buffer in memory of the process's own, imported (VK_EXT_external_memory_host);
-// an error where the device will not take it, for createBuffer to allocate instead.
+// A host-visible buffer in memory of the process's own, imported; an error where the device will
+// not take it, for createBuffer to allocate instead.
 Result<Buffer> importHostBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
-                                const std::string& what) {
-  constexpr auto kHandle = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
+                                const std::string& what, const std::function<Result<uint32_t>(const VkMemoryRequirements&)>& pick) {
   VkPhysicalDeviceExternalBufferInfo query = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_BUFFER_INFO};
   query.usage = usage;
-  query.handleType = kHandle;
+  query.handleType = kHostAllocation;
   VkExternalBufferProperties external = {VK_STRUCTURE_TYPE_EXTERNAL_BUFFER_PROPERTIES};
   vkGetPhysicalDeviceExternalBufferProperties(context.physical, &query, &external);
   if (!(external.externalMemoryProperties.externalMemoryFeatures & VK_EXTERNAL_MEMORY_FEATURE_IMPORTABLE_BIT))
     return Error{"host memory cannot be imported for " + what, ExitCode::kNoDevice};
   const VkDeviceSize align = std::max<VkDeviceSize>(context.host_import_alignment, 4096);
-  const size_t bytes = static_cast<size_t>((size + align - 1) / align * align);
-  void* pages = mapHostPages(bytes);
-  if (!pages) return Error{"no host memory for " + what, ExitCode::kResourceLimit};
-  Buffer out;
-  out.size = size;
-  out.host_pages = pages;
-  out.host_bytes = bytes;
-  auto failed = [&](const std::string& call, VkResult result) {
-    destroyBuffer(context, out);
-    return vulkanError(call + " (" + what + ", " + formatBytes(size) + ")", result);
-  };
-  VkExternalMemoryBufferCreateInfo external_info = {VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
-  external_info.handleTypes = kHandle;
-  VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  info.pNext = &external_info;
-  info.size = size;
-  info.usage = usage;
-  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  if (VkResult r = vkCreateBuffer(context.device, &info, nullptr, &out.buffer); r != VK_SUCCESS)
-    return failed("vkCreateBuffer", r);
-  VkMemoryRequirements needs{};
-  vkGetBufferMemoryRequirements(context.device, out.buffer, &needs);
-  VkMemoryHostPointerPropertiesEXT pointer = {VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT};
-  if (VkResult r = context.host_pointer_properties(context.device, kHandle, pages, &pointer); r != VK_SUCCESS)
-    return failed("vkGetMemoryHostPointerPropertiesEXT", r);
-  Result<uint32_t> type = context.memoryType(needs.memoryTypeBits & pointer.memoryTypeBits,
-                                             VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
-  if (!type || needs.size > bytes) {
-    destroyBuffer(context, out);
-    return Error{"no memory type imports host memory for " + what, ExitCode::kNoDevice};
-  }
-  if (Status budget = reserveDeviceMemory(context, bytes, what); !budget) {
-    destroyBuffer(context, out);
-    return budget.error();
-  }
-  out.allocated = bytes;
-  VkImportMemoryHostPointerInfoEXT import = {VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT};
-  import.handleType = kHandle;
-  import.pHostPointer = pages;
-  VkMemoryAllocateInfo allocate = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  allocate.pNext = &import;
-  allocate.allocationSize = bytes;
-  allocate.memoryTypeIndex = *type;
-  if (VkResult r = vkAllocateMemory(context.device, &allocate, nullptr, &out.memory); r != VK_SUCCESS)
-    return failed("vkAllocateMemory", r);
-  if (VkResult r = vkBindBufferMemory(context.device, out.buffer, out.memory, 0); r != VK_SUCCESS)
-    return failed("vkBindBufferMemory", r);
-  out.mapped = pages;
-  out.coherent = (context.memory.memoryTypes[*type].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
-  return out;
+  HostPages host;
+  host.bytes = static_cast<size_t>((size + align - 1) / align * align);
+  host.pages = mapHostPages(host.bytes);
+  if (!host.pages) return Error{"no host memory for " + what, ExitCode::kResourceLimit};
+  return allocateBuffer(context, size, usage, what, pick, &host);
 }
 
 }  // namespace
 
 Result<Buffer> createBuffer(const VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage,
                             bool host_visible, const std::string& what) {
-  if (host_visible && context.host_import_alignment && size >= context.host_import_from) {
-    // Where the import fails (this use, the budget, the host's memory), the driver's memory.
-    if (Result<Buffer> imported = importHostBuffer(context, size, usage, what); imported) return imported;
-  }
-  return allocateBuffer(context, size, usage, what, [&](const VkMemoryRequirements& needs) {
+  auto pick = [&](const VkMemoryRequirements& needs) {
     return host_visible
         ? context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
         : context.memoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  });
+  };
+  if (host_visible && context.host_import_alignment && size >= context.host_import_from) {
+    // Where the import fails (this use, the budget, the host's memory), the driver's memory.
+    if (Result<Buffer> imported = importHostBuffer(context, size, usage, what, pick); imported) return imported;
+  }
+  return allocateBuffer(context, size, usage, what, pick);
 }
 
 Status uploadStorage(const VulkanContext& context, Buffer& target, const void* data, size_t bytes,
