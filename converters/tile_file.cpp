@@ -168,14 +168,13 @@ std::string tileHeader(TileSpec tile, const std::string& signature, bool colors,
   return header;
 }
 
-// The references' rows: tile and index of each copy.
-std::vector<uint8_t> foreignRows(std::span<const TileVertexRef> foreign) {
-  std::vector<uint8_t> rows(foreign.size() * kForeignBytes);
+// The references' rows into `rows`: tile and index of each copy.
+void foreignRows(std::span<const TileVertexRef> foreign, std::vector<char>& rows) {
+  rows.resize(foreign.size() * kForeignBytes);
   for (size_t f = 0; f < foreign.size(); ++f) {
     const uint32_t row[2] = {foreign[f].tile, foreign[f].index};
     std::memcpy(&rows[f * kForeignBytes], row, sizeof row);
   }
-  return rows;
 }
 
 }  // namespace
@@ -204,8 +203,9 @@ Status TileRowStream::finish(uint32_t owned, std::span<const TileVertexRef> fore
   assert(uint64_t{owned} + foreign.size() == rows_->vertices());
   owned_ = owned;
   foreign_ = foreign.size();
-  const std::vector<uint8_t> trailer = foreignRows(foreign);
-  return rows_->finish(trailer);
+  std::vector<char> trailer;
+  foreignRows(foreign, trailer);
+  return rows_->finish({reinterpret_cast<const uint8_t*>(trailer.data()), trailer.size()});
 }
 
 Status writeTile(const std::string& path, const PointTile& tile, const std::string& signature, Progress* progress,
@@ -236,8 +236,7 @@ Status writeTile(const std::string& path, const PointTile& tile, const std::stri
       *file, vertex_chunks + face_chunks + 1, threads,
       [&](size_t k, std::vector<char>& block) -> Status {
         if (k == vertex_chunks + face_chunks) {  // the references
-          const std::vector<uint8_t> rows = foreignRows(tile.foreign);
-          block.assign(rows.begin(), rows.end());
+          foreignRows(tile.foreign, block);
           return okStatus();
         }
         const auto [first, end] = rowsOf(k);
