@@ -37,6 +37,8 @@ InputFile::~InputFile() {
 Result<size_t> InputFile::readAt(uint64_t offset, void* data, size_t size) const {
   // Every reader comes through here: an interrupted run stops reading (core/interrupt.h).
   if (interrupted()) return interruptedError();
+  // No bytes asked for: `data` may be an empty vector's null pointer, which memcpy must not get.
+  if (size == 0) return size_t{0};
   if (memory_) {
     if (offset >= size_) return size_t{0};
     const size_t n = static_cast<size_t>(std::min<uint64_t>(size, size_ - offset));
