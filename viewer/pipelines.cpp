@@ -252,15 +252,10 @@ Result<ComputePipelines> createComputePipelines(const VulkanContext& context, Pr
       storage(kBindingBatchPlan)});
   if (!splat_set) return fail(splat_set.error());
   p.splat_set = *splat_set;
-  Result<VkDescriptorSetLayout> resolve_set = storageSetLayout(context, {storage(0), storage(1), storage(2), storage(3)});
-  if (!resolve_set) return fail(resolve_set.error());
-  p.resolve_set = *resolve_set;
   Result<VkPipelineLayout> splat_layout = pipelineLayout(context, p.splat_set, sizeof(PushConstants), VK_SHADER_STAGE_COMPUTE_BIT);
   if (!splat_layout) return fail(splat_layout.error());
   p.splat_layout = *splat_layout;
-  Result<VkPipelineLayout> resolve_layout = pipelineLayout(context, p.resolve_set, sizeof(ResolvePush), VK_SHADER_STAGE_COMPUTE_BIT);
-  if (!resolve_layout) return fail(resolve_layout.error());
-  p.resolve_layout = *resolve_layout;
+  if (Status s = computeLayouts(context, 4, sizeof(ResolvePush), p.resolve_set, p.resolve_layout); !s) return fail(s.error());
   // The merges only where early depth is on (the plain path the tests compare with keeps an
   // atomic per point).
   variant.subgroup_merge = variant.early_depth && variant.subgroup_merge && context.facts.subgroup_merge;
