@@ -125,10 +125,6 @@ Status GpuEscape::init() {
   pool_info.pPoolSizes = &pool_size;
   VK_TRY(vkCreateDescriptorPool(context_.device, &pool_info, nullptr, &pool_));
   for (Slot& slot : slots_) {
-    Result<Buffer> counts = createBuffer(context_, kGpuChunkPoints * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                         true, "escape counts");
-    if (!counts) return counts.error();
-    slot.counts = *counts;
     const VkDescriptorSetLayout layouts[4] = {escape_set_layout_, perturbation_set_layout_, escape_set_layout_,
                                               escape_set_layout_};
     VkDescriptorSet sets[4] = {};
@@ -254,8 +250,21 @@ Status GpuEscape::useAxis(const std::vector<double>& axis) {
   if (axis == axis_values_) return okStatus();
   if (Status s = uploadStorage(context_, axis_, axis.data(), axis.size() * sizeof(double), "grid axis"); !s) return s;
   axis_values_ = axis;
-  for (Slot& slot : slots_) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
+  for (Slot& slot : slots_)
+    if (slot.counts.buffer) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
   arena_sets_stale_ = true;
+  return okStatus();
+}
+
+Status GpuEscape::makeCounts() {
+  for (Slot& slot : slots_) {
+    if (slot.counts.buffer) continue;
+    Result<Buffer> counts = createBuffer(context_, kGpuChunkPoints * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                         true, "escape counts");
+    if (!counts) return counts.error();
+    slot.counts = *counts;
+    if (axis_.buffer) writeSet(context_, slot.escape_set, {&axis_, &slot.counts});
+  }
   return okStatus();
 }
 
@@ -275,6 +284,8 @@ Status GpuEscape::escapePlanes(const EscapeKernelParams& kernel, const std::vect
   const uintptr_t arena = reinterpret_cast<uintptr_t>(arena_.mapped), at = reinterpret_cast<uintptr_t>(counts);
   const bool in_place = packed_counts_ && arena != 0 && at >= arena && at - arena + total <= arena_.size &&
                         (at - arena) % 4 == 0 && res * count_bytes % 4 == 0;
+  if (!in_place)
+    if (Status s = makeCounts(); !s) return s;
   if (in_place && arena_sets_stale_) {
     for (Slot& slot : slots_) writeSet(context_, slot.arena_set, {&axis_, &arena_});
     arena_sets_stale_ = false;
@@ -511,6 +522,7 @@ Status GpuEscape::perturbation(const std::vector<glm::dvec2>& orbit, const std::
   assert(orbit.size() >= 2 && !dcx.empty() && max_iter >= 0);
   if (dcy.empty()) return okStatus();
   if (Status s = finishAll(); !s) return s;
+  if (Status s = makeCounts(); !s) return s;
   for (Slot& slot : slots_) {
     if (slot.tails.buffer) continue;
     Result<Buffer> created = createBuffer(context_, kGpuPerturbationChunkPoints * sizeof(EscapeTail),

@@ -110,7 +110,7 @@ class GpuEscape {
 
  private:
   struct Slot {
-    Buffer counts;
+    Buffer counts;  // made by makeCounts
     Buffer tails;  // mandelbrot2d's escape tails; made at the first perturbation call
     VkDescriptorSet escape_set = VK_NULL_HANDLE, perturbation_set = VK_NULL_HANDLE;
     VkDescriptorSet arena_set = VK_NULL_HANDLE;  // the escape kernel writing into arena_
@@ -126,6 +126,10 @@ class GpuEscape {
   GpuEscape(const VulkanContext& context, bool pack_counts) : context_(context), packed_counts_(pack_counts) {}
   Status init();
   Status useAxis(const std::vector<double>& axis);  // uploads it where axis_ holds another
+  // The slots' staging buffers for counts copied out to the host (Target::kHost, perturbation),
+  // made at the first such call: counts in the arena or in device memory need none (2 × 32 MiB of
+  // host-visible memory that a device mesher's run never touched).
+  Status makeCounts();
   enum class Target { kHost, kArena, kDevice };      // where a dispatch's counts go
   // Dispatches the rows of planes first..first + planes − 1 in chunks: copied out to `counts`
   // (kHost), or written in place from word `word_offset` of the arena or of escapeInto's target.
