@@ -25,7 +25,7 @@ Spirv vertexShader(PrecisionMode mode, bool pull) {
   return pull && shaders.vertex_pull.code ? shaders.vertex_pull : shaders.vertex;
 }
 
-// 32-bit specialization constants 0, 1, …: the splat's 0 kProbe, 1 kEarlyDepth, 2 kSubgroupMerge, 3 kPairMerge and 4 kLargePoints, the resolve's
+// 32-bit specialization constants 0, 1, …: the splat's 0 kProbe, 1 kEarlyDepth, 2 kSubgroupMerge, 3 kPairMerge, 4 kLargePoints, 5 kRound and 6 kNearEndFirst, the resolve's
 // 0 kWriteDepth, the shading passes' radii (fill.comp's 0, smooth.comp's 0, smooth_edl.comp's 0-2).
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout,
                                    std::span<const uint32_t> constants) {
@@ -34,9 +34,10 @@ Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkP
 
 Result<VkPipeline> computePipeline(const VulkanContext& context, Spirv code, VkPipelineLayout layout, bool probe,
                                    const SplatVariant& v) {
-  const uint32_t constants[6] = {probe ? VK_TRUE : VK_FALSE, v.early_depth ? VK_TRUE : VK_FALSE,
+  const uint32_t constants[7] = {probe ? VK_TRUE : VK_FALSE, v.early_depth ? VK_TRUE : VK_FALSE,
                                  v.subgroup_merge ? VK_TRUE : VK_FALSE, v.pair_merge ? VK_TRUE : VK_FALSE,
-                                 v.large_points ? VK_TRUE : VK_FALSE, v.large_points && v.round ? VK_TRUE : VK_FALSE};
+                                 v.large_points ? VK_TRUE : VK_FALSE, v.large_points && v.round ? VK_TRUE : VK_FALSE,
+                                 v.near_end_first ? VK_TRUE : VK_FALSE};
   return computePipeline(context, code, layout, constants);
 }
 

@@ -31,7 +31,7 @@ struct PushConstants {
   uint32_t width = 0, height = 0;  // compute backend
   uint32_t count = 0;       // points in the chunk
   uint32_t list_first = 0;  // compute backend, per-batch modes: the chunk's first batch-list entry
-  uint32_t listed = 0;      // 1: this chunk's workgroups take their batches from the list
+  uint32_t listed = 0;      // bit 0: this chunk's workgroups take their batches from the list; bit 1: from its end
   // Round points (shaders/render/push.glsl's roundDepth; roundPointPush fills them).
   float depth_scale = 0.0f;
   float bulge = 0.0f;
@@ -93,6 +93,9 @@ struct SplatVariant {
   bool large_points = true;
   // With large_points: discs whose depth falls away to the rim (RenderOptions::round_points).
   bool round = false;
+  // A chunk whose push constant `listed` has bit 1 set runs its workgroups from its last to its
+  // first (RenderOptions::near_end_first).
+  bool near_end_first = false;
 };
 
 // `write_log` has the resolve also write each pixel's log distance (binding 3) for the shading.

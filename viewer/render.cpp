@@ -218,6 +218,7 @@ Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, co
           }, element, VkDeviceSize{32} << 20, plane * plane_bytes);
     }
     if (!status) return status;
+    if (compute && options.near_end_first.value_or(false)) detail::sampleSplatOrder(chunk, *view->set, view->offset);
     if (compute) {
       status = upload_colors(r.all_colors, *view, chunk.count, VkDeviceSize{chunk.first} * 4);
     } else {
@@ -471,6 +472,8 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   Camera camera = given_camera;
   RenderOptions options = given_options;
   const bool compute = options.backend == Backend::kCompute;
+  // Resolved once: the splat's pipeline and the upload (the chunks' order samples) both follow it.
+  options.near_end_first = compute && options.early_depth && options.near_end_first.value_or(context.facts.type == "cpu");
   // Positions come from a storage buffer in the compute backend, for native mode on a device
   // without double vertex attributes, and always for a mode with no vertex attributes (adaptive).
   const ModeShaders& shaders = modeInfo(options.mode).shaders;
@@ -491,7 +494,8 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
             createComputePipelines(context, options.mode, options.probe,
                                    SplatVariant{options.early_depth, options.subgroup_merge.value_or(context.facts.type != "cpu"),
                                                 options.pair_merge.value_or(context.facts.type != "cpu"),
-                                                options.point_size != 1.0f, options.round_points},
+                                                options.point_size != 1.0f, options.round_points,
+                                                *options.near_end_first},
                                    shading);
         if (!pipelines) return pipelines.error();
         r.compute = *pipelines;
@@ -534,6 +538,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   detail::roundPointPush(camera, options, r.round_depth_scale, r.round_bulge);
   if (status) status = createUniforms(context, r, camera, encoding);
   if (status) status = uploadBatchMatrices(context, r, options, encoding);
+  if (status && *options.near_end_first) out.reversed_chunks = detail::chooseSplatEnds(r, camera);
   Status made = pipelines_made.valid() ? pipelines_made.get() : okStatus();
   Status shade = shade_made.valid() ? shade_made.get() : okStatus();
   if (!status) return status.error();

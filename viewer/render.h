@@ -72,6 +72,14 @@ struct RenderOptions {
   // points: adaptive 5.21 -> 4.45 ms, batch 5.42 -> 4.80; bench/results/2026-11-26/h100/), not on
   // a CPU device, where lavapipe's 16.7M-point frames took 4-8% longer with it. Tests force it on.
   std::optional<bool> pair_merge;
+  // Compute backend: each chunk's workgroups run from whichever end of the chunk lies nearer the
+  // eye, reversed where its points come nearer along their order (a marching-cubes mesh seen from
+  // its last slabs), so that the early depth test skips more atomics. The same picture: the keys'
+  // atomicMax leaves one result in any order. None: on a CPU device, where lavapipe runs the groups
+  // about in the order given (the 1.55M-point Mandelbulb's 3-px discs at 1920x1080, fp32:
+  // 105 -> 93 ms); not on GPUs, which run thousands of groups at once. A finer sort, nearest group
+  // first, was slower on lavapipe than either end (docs/performance.md).
+  std::optional<bool> near_end_first;
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.
   uint64_t max_chunk_points = 0;
@@ -93,6 +101,7 @@ struct RenderResult {
   std::vector<glm::vec4> probe_clip;  // with `probe`: clip position of every point, in input order
   uint32_t chunks = 0;
   bool pulled_positions = false;   // native mode read positions from a storage buffer
+  uint32_t reversed_chunks = 0;    // chunks whose splat ran from their last group (near_end_first)
   uint64_t gpu_bytes = 0;          // point data on the GPU (positions + colours)
   // Per-batch modes: what the frame's plan loads (batches culled, at each tier, bytes per point).
   std::optional<BatchPlanStats> batch_plan;

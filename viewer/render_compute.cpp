@@ -4,6 +4,7 @@
 // the winner's colour. No rasterizer, no depth attachment: on GPUs whose graphics front end is
 // small next to their compute (H100/H200 run graphics on two TPCs) this is the fast path.
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -65,6 +66,33 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
   return r.shade.log ? createShadeDescriptors(context, r) : okStatus();
 }
 
+void sampleSplatOrder(Chunk& chunk, const PointSet& set, size_t offset) {
+  const size_t groups = (chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup;
+  chunk.order_step = std::max<size_t>(1, (groups + kOrderSamples - 1) / kOrderSamples);
+  chunk.order_samples.clear();
+  for (size_t g = 0; g < groups; g += chunk.order_step)
+    chunk.order_samples.push_back(set.positions[offset + g * kSplatPointsPerGroup]);
+}
+
+uint32_t chooseSplatEnds(Resources& r, const Camera& camera) {
+  const glm::dmat4 view = camera.view();
+  uint32_t reversed = 0;
+  for (Chunk& chunk : r.chunks) {
+    // The least-squares slope of the samples' distance in front of the eye (−z: the eye looks down
+    // −z) against their place in the chunk: negative where the points come nearer along it.
+    double n = 0.0, sum_k = 0.0, sum_d = 0.0, sum_kk = 0.0, sum_kd = 0.0;
+    for (size_t k = 0; k < chunk.order_samples.size(); ++k) {
+      const double d = -(view * glm::dvec4(chunk.order_samples[k], 1.0)).z;
+      if (!std::isfinite(d)) continue;
+      const double x = static_cast<double>(k);
+      n += 1.0, sum_k += x, sum_d += d, sum_kk += x * x, sum_kd += x * d;
+    }
+    chunk.reversed = n >= 2.0 && n * sum_kd - sum_k * sum_d < 0.0;
+    reversed += chunk.reversed ? 1u : 0u;
+  }
+  return reversed;
+}
+
 namespace {
 
 // A deliberately slowed build without a rebuild, for the test that `dpoint bench --baseline` flags
@@ -114,7 +142,8 @@ void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline spla
       push.height = height;
       push.count = static_cast<uint32_t>(chunk.count);
       push.list_first = chunk.list_first;
-      push.listed = chunk.listed ? 1u : 0u;
+      // Bit 1: the chunk runs from its end (RenderOptions::near_end_first).
+      push.listed = (chunk.listed ? 1u : 0u) | (chunk.reversed ? 2u : 0u);
       push.batch_shift = batchShift(options.mode);
       push.depth_scale = r.round_depth_scale;
       push.bulge = r.round_bulge;

@@ -10,12 +10,21 @@
 
 namespace dpoint::detail {
 
+// RenderOptions::near_end_first: the most points a chunk keeps to decide which of its ends is nearer.
+inline constexpr size_t kOrderSamples = 4096;
+
 struct Chunk {
   size_t first = 0, count = 0;
   // Compute backend, per-batch modes: the chunk's entries of the batch list (batches it overlaps
   // that the plan did not cull).
   bool listed = false;  // false: every batch of the chunk splatted, in order (no list)
   uint32_t list_first = 0, list_count = 0;
+  // With RenderOptions::near_end_first: the first point of every step-th group of
+  // kSplatPointsPerGroup points (at most kOrderSamples), whose depths along their order decide
+  // `reversed` for each view (chooseSplatEnds).
+  std::vector<glm::dvec3> order_samples;
+  size_t order_step = 1;
+  bool reversed = false;
   Buffer positions, colors, probe;
   VkDescriptorSet set = VK_NULL_HANDLE;
 };
@@ -90,6 +99,11 @@ Status createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t
 // Compute backend pieces (viewer/render_compute.cpp).
 Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height);
 Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe);
+// RenderOptions::near_end_first: keeps the chunk's order samples from its points, which are set's
+// from `offset` on; then, once the view is known, sets each chunk's `reversed` and returns how
+// many are.
+void sampleSplatOrder(Chunk& chunk, const PointSet& set, size_t offset);
+uint32_t chooseSplatEnds(Resources& r, const Camera& camera);
 // Clears the visibility buffer, splats every chunk with `splat`, resolves into the picture.
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
                    uint32_t width, uint32_t height, bool timed);

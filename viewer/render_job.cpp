@@ -1167,6 +1167,12 @@ std::string renderReportJson(const RenderRequest& request, const RenderOutcome& 
   // Only a mode with two raster paths (vertex input or pulling from a storage buffer) says which ran.
   const bool two_paths = modeInfo(mode).shaders.vertex_pull.code != nullptr;
   o.add("native_path", !two_paths ? V::null() : V::string(r.pulled_positions ? "pull" : "attribute"));
+  // The compute splat's order (RenderOptions::near_end_first): the set's, from its far end
+  // (reversed), or some chunks each way; null for the raster backend.
+  o.add("splat_order", outcome.backend != Backend::kCompute ? V::null()
+                       : V::string(r.reversed_chunks == 0                ? "input"
+                                   : r.reversed_chunks == r.chunks ? "reversed"
+                                                                   : "both"));
   if (const std::optional<ErrorReport>& error = outcome.error) {
     const ErrorStats& e = error->stats;
     o.add("error_px", anyMeasured(e) ? V::object(JsonObject()

@@ -6,13 +6,14 @@
 # OUT (default bench/results/DATE/lavapipe/ab-DATE.tsv); the last lines give each build's median
 # over the rounds.
 #   bench/scripts/lavapipe_ab.sh OLD_BIN NEW_BIN   (MODES, ROUNDS, FRAMES, BACKENDS to narrow;
-#   POINT_SIZE, 1 by default, for the splat of larger points: round ones, as a 3D set's default)
+#   POINT_SIZE, 1 by default, for the splat of larger points: round ones, as a 3D set's default;
+#   FILE, another set than the Sierpinski one, e.g. a Mandelbulb in its marching-cubes order)
 set -euo pipefail
 old=$1 new=$2
 data=${DATA:-/tmp/dpoint-lavapipe}
 out=${OUT:-bench/results/$(date +%F)/lavapipe/ab-$(date +%F).tsv}
 mkdir -p "$data" "$(dirname "$out")"
-file=$data/sierpinski-input.ply
+file=${FILE:-$data/sierpinski-input.ply}
 [ -s "$file" ] || "$new" generate sierpinski --level 11 --unwelded --order input -q -o "$file"
 printf 'round\tbuild\tmode\tbackend\tpoints\tgpu_ms_median\n' >"$out"
 for round in $(seq "${ROUNDS:-3}"); do

@@ -26,6 +26,10 @@ layout(constant_id = 4) const bool kLargePoints = true;
 // Larger points are discs whose depth falls away towards the rim (push.glsl's roundDepth), the
 // raster backend's points_round.frag; false: the rasterizer's squares at one depth.
 layout(constant_id = 5) const bool kRound = false;
+// Where bit 1 of pc.listed is set, workgroup k does what workgroup n − 1 − k of the chunk's n would
+// (RenderOptions::near_end_first: the chunk's nearer end first, so that kEarlyDepth skips more
+// atomics; their atomicMax leaves the same keys in any order). Bit 0 is then the batch list's.
+layout(constant_id = 6) const bool kNearEndFirst = false;
 layout(local_size_x = 256) in;
 const uint kPointsPerThread = 4u;  // kSplatPointsPerThread in viewer/pipelines.h
 
@@ -201,20 +205,23 @@ void main() {
   const uint kGroupShift = 10u;  // log2(kPointsPerThread · 256)
   int group_first;
   uint batch, tiers;
-  if (pc.listed == 0u) {
-    group_first = int(gl_WorkGroupID.x << kGroupShift);
+  uint workgroup = kNearEndFirst && (pc.listed & 2u) != 0u ? gl_NumWorkGroups.x - 1u - gl_WorkGroupID.x : gl_WorkGroupID.x;
+  bool listed = (kNearEndFirst ? pc.listed & 1u : pc.listed) != 0u;
+  if (!listed) {
+    group_first = int(workgroup << kGroupShift);
     batch = (pc.first_index + uint(group_first)) >> pc.batch_shift;
     tiers = batch_plan[batch];
   } else {
-    uint entry = batch_plan[pc.list_first + (gl_WorkGroupID.x >> (pc.batch_shift - kGroupShift))];
+    uint entry = batch_plan[pc.list_first + (workgroup >> (pc.batch_shift - kGroupShift))];
     batch = entry & 0x3FFFFFFFu;
     tiers = entry >> 30;
-    uint part = gl_WorkGroupID.x & ((1u << (pc.batch_shift - kGroupShift)) - 1u);
+    uint part = workgroup & ((1u << (pc.batch_shift - kGroupShift)) - 1u);
     group_first = int((batch << pc.batch_shift) + (part << kGroupShift)) - int(pc.first_index);
   }
   mat4 matrix = batch_mvp[batch];
 #else
-  uint group_first = gl_WorkGroupID.x * (kPointsPerThread * gl_WorkGroupSize.x);
+  uint group = kNearEndFirst && (pc.listed & 2u) != 0u ? gl_NumWorkGroups.x - 1u - gl_WorkGroupID.x : gl_WorkGroupID.x;
+  uint group_first = group * (kPointsPerThread * gl_WorkGroupSize.x);
 #endif
 #if defined(MODE_ADAPTIVE)
   // Chunks hold whole batches (group_first ≥ 0, even): as batch mode's pairs, thread t splats

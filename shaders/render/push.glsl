@@ -8,7 +8,7 @@ layout(push_constant) uniform Push {
   uint batch_shift;  // log2 of the points per batch
   uint width, height, count;  // compute backend: target size; points in this chunk (both backends)
   uint list_first;  // compute backend, per-batch modes: this chunk's first entry of the batch list
-  uint listed;      // 1: workgroups take their batches from the list; 0: the chunk's batches in order
+  uint listed;      // bit 0: workgroups take their batches from the list (else the chunk's in order); bit 1: from the chunk's end
   // Round points (RenderOptions::round_points): the perspective depth's (far − near) / near, 0 in
   // ortho; and how far the rim of a point's disc lies behind its centre: a share of the eye
   // distance in perspective, of the depth range in ortho (viewer/render.cpp's roundPointPush).

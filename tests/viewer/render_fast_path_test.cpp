@@ -128,6 +128,54 @@ TEST_P(FastPath, earlyDepthTestGivesThePlainPictureInEveryMode) {
   }
 }
 
+// RenderOptions::near_end_first: a chunk whose points come nearer along their order is splatted
+// from its far end, with the very same picture, in modes with and without batches, at every point
+// size and shape, over chunks that end inside a workgroup's points; a chunk seen from its first
+// points is left in its order.
+TEST_P(FastPath, nearEndFirstGivesTheSamePictureAndTurnsOnlyChunksThatComeNearer) {
+  if (GetParam() != Backend::kCompute) GTEST_SKIP() << "the order is for the compute backend";
+  const glm::dvec3 centre(6.378e6, 1.5, -2.25);
+  PointSet s = bigCloud(centre, 1e-3);  // x grows slowest along the order
+  colourByPosition(s);
+  for (double side : {1.0, -1.0}) {
+    CameraSpec spec;
+    spec.width = 160;
+    spec.height = 120;
+    spec.eye = centre + glm::dvec3(side * 0.05, 0.002, 0.001);  // nearly along x: the last points (+x) nearest, or the first
+    spec.target = centre;
+    spec.up = glm::dvec3(0, 1, 0);
+    Result<Camera> camera = makeCamera(spec, boundsOf(s));
+    ASSERT_TRUE(camera.ok()) << camera.error().message;
+    for (PrecisionMode mode : {PrecisionMode::kFp32, PrecisionMode::kDf64, PrecisionMode::kNative, PrecisionMode::kBatch,
+                               PrecisionMode::kAdaptive}) {
+      for (float size : {1.0f, 3.0f, 4.0f}) {
+        for (bool round : {false, true}) {
+          const std::string what = std::string(side > 0 ? "seen from its last points" : "seen from its first points") +
+                                   " " + std::string(modeName(mode)) + " " + std::to_string(size) + " px" + (round ? " round" : "");
+          RenderOptions options;
+          options.mode = mode;
+          options.backend = Backend::kCompute;
+          options.point_size = size;
+          options.round_points = round;
+          // Three chunks, each ending inside a group of 1024 points (and, in batch and adaptive
+          // modes, a batch: their workgroups then take the batch list).
+          options.max_chunk_points = 3000;
+          options.near_end_first = false;
+          Result<RenderResult> plain = renderPoints(*context_, s, *camera, options);
+          ASSERT_TRUE(plain.ok()) << what << ": " << plain.error().message;
+          options.near_end_first = true;
+          Result<RenderResult> turned = renderPoints(*context_, s, *camera, options);
+          ASSERT_TRUE(turned.ok()) << what << ": " << turned.error().message;
+          EXPECT_EQ(plain->reversed_chunks, 0u) << what;
+          EXPECT_EQ(turned->reversed_chunks, side > 0 ? turned->chunks : 0u) << what;
+          EXPECT_GT(turned->chunks, 2u) << what;
+          EXPECT_EQ(turned->image.rgba, plain->image.rgba) << what;
+        }
+      }
+    }
+  }
+}
+
 // Modes whose arithmetic per point does not depend on the other points (batch's does: its batches
 // are formed in storage order, so reordering moves their origins).
 TEST_P(FastPath, mortonOrderGivesTheInputOrderPictureTiesAside) {

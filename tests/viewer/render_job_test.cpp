@@ -160,7 +160,7 @@ TEST(RenderJob, reportHasTheKeysInOrderAndNullsWhereNothingWasMeasured) {
   for (const char* line : {"  \"width\": 64,\n  \"height\": 48,\n  \"point_size\": 2.5,\n  \"shading\": \"edl\",\n"
                            "  \"frames\": 2,\n  \"gpu_ms\": null,\n",
                            "  \"frame_ms\": {\"median\": 3, \"p95\": 4},\n", "\"phases_ms\": {\"read\": ",
-                           "  \"native_path\": null,\n  \"error_px\": null,\n",
+                           "  \"native_path\": null,\n  \"splat_order\": null,\n  \"error_px\": null,\n",
                            "  \"points_visible\": 3,\n  \"points_lost\": 3,\n  \"pixels_differing\": null,\n"
                            "  \"drawn_share\": null,\n  \"warnings\": []\n}\n"})
     EXPECT_NE(json.find(line), std::string::npos) << line << " in\n" << json;
