@@ -472,8 +472,11 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   Camera camera = given_camera;
   RenderOptions options = given_options;
   const bool compute = options.backend == Backend::kCompute;
-  // Resolved once: the splat's pipeline and the upload (the chunks' order samples) both follow it.
-  options.near_end_first = compute && options.early_depth && options.near_end_first.value_or(context.facts.type == "cpu");
+  // Resolved once: the splat's pipeline and the upload (the chunks' order samples) both follow it,
+  // and a stream's settled options, made afresh, do not change it.
+  const bool near_end_first =
+      compute && options.early_depth && options.near_end_first.value_or(context.facts.type == "cpu");
+  options.near_end_first = near_end_first;
   // Positions come from a storage buffer in the compute backend, for native mode on a device
   // without double vertex attributes, and always for a mode with no vertex attributes (adaptive).
   const ModeShaders& shaders = modeInfo(options.mode).shaders;
@@ -495,7 +498,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
                                    SplatVariant{options.early_depth, options.subgroup_merge.value_or(context.facts.type != "cpu"),
                                                 options.pair_merge.value_or(context.facts.type != "cpu"),
                                                 options.point_size != 1.0f, options.round_points,
-                                                *options.near_end_first},
+                                                near_end_first},
                                    shading);
         if (!pipelines) return pipelines.error();
         r.compute = *pipelines;
@@ -531,6 +534,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
     const Backend backend = options.backend;
     status = (*settle)(camera, options);
     assert(options.mode == mode && options.backend == backend);
+    options.near_end_first = near_end_first;
     (void)mode, (void)backend;
     if (status) make_pipelines();
   }
@@ -538,7 +542,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   detail::roundPointPush(camera, options, r.round_depth_scale, r.round_bulge);
   if (status) status = createUniforms(context, r, camera, encoding);
   if (status) status = uploadBatchMatrices(context, r, options, encoding);
-  if (status && *options.near_end_first) out.reversed_chunks = detail::chooseSplatEnds(r, camera);
+  if (status && near_end_first) out.reversed_chunks = detail::chooseSplatEnds(r, camera);
   Status made = pipelines_made.valid() ? pipelines_made.get() : okStatus();
   Status shade = shade_made.valid() ? shade_made.get() : okStatus();
   if (!status) return status.error();

@@ -176,6 +176,54 @@ TEST_P(FastPath, nearEndFirstGivesTheSamePictureAndTurnsOnlyChunksThatComeNearer
   }
 }
 
+// A stream settled after its upload (dpoint render's one pass over a file) gets its options made
+// afresh: its chunks still run from their nearer end, with the picture of the set in memory.
+TEST_P(FastPath, aSettledStreamKeepsItsSplatOrder) {
+  if (GetParam() != Backend::kCompute) GTEST_SKIP() << "the order is for the compute backend";
+  const glm::dvec3 centre(6.378e6, 1.5, -2.25);
+  PointSet s = bigCloud(centre, 1e-3);
+  colourByPosition(s);
+  CameraSpec spec;
+  spec.width = 160;
+  spec.height = 120;
+  spec.eye = centre + glm::dvec3(0.05, 0.002, 0.001);  // nearest the set's last points
+  spec.target = centre;
+  spec.up = glm::dvec3(0, 1, 0);
+  Result<Camera> camera = makeCamera(spec, boundsOf(s));
+  ASSERT_TRUE(camera.ok()) << camera.error().message;
+  PointStream stream;
+  stream.count = s.size();
+  stream.has_colors = true;
+  stream.read = [&](size_t first, size_t n, PointSet& block) -> Status {
+    block.positions.assign(s.positions.begin() + static_cast<std::ptrdiff_t>(first),
+                           s.positions.begin() + static_cast<std::ptrdiff_t>(first + n));
+    block.colors.assign(s.colors.begin() + static_cast<std::ptrdiff_t>(first),
+                        s.colors.begin() + static_cast<std::ptrdiff_t>(first + n));
+    return okStatus();
+  };
+  RenderOptions options;
+  options.backend = Backend::kCompute;
+  options.point_size = 3.0f;
+  options.round_points = true;
+  options.max_chunk_points = 3000;
+  options.near_end_first = true;
+  Result<RenderResult> whole = renderPoints(*context_, s, *camera, options);
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  const StreamSettle settle = [&](Camera&, RenderOptions& settled) -> Status {
+    settled = RenderOptions{};  // as the render job makes them: near_end_first unset
+    settled.backend = Backend::kCompute;
+    settled.point_size = 3.0f;
+    settled.round_points = true;
+    return okStatus();
+  };
+  Result<RenderResult> streamed = renderStreamOnce(*context_, stream, *camera, options, settle);
+  ASSERT_TRUE(streamed.ok()) << streamed.error().message;
+  EXPECT_EQ(whole->reversed_chunks, whole->chunks);
+  EXPECT_EQ(streamed->reversed_chunks, streamed->chunks);
+  EXPECT_GE(streamed->chunks, 3u);
+  EXPECT_TRUE(streamed->image.rgba == whole->image.rgba);
+}
+
 // Modes whose arithmetic per point does not depend on the other points (batch's does: its batches
 // are formed in storage order, so reordering moves their origins).
 TEST_P(FastPath, mortonOrderGivesTheInputOrderPictureTiesAside) {
