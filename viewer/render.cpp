@@ -299,7 +299,8 @@ Status createUniforms(const VulkanContext& context, Resources& r, const Camera& 
 // compute backend, for each chunk that culls a batch or starts inside one (tests' small chunks),
 // the list of the batches it overlaps that the plan keeps, batch | tiers << 30 (setting the
 // chunk's list_first and list_count). A chunk without a list is splatted whole, a workgroup per
-// 1024 points in order: no load of the list stands before its points' loads.
+// 1024 points (from either end: RenderOptions::near_end_first): no load of the list stands before
+// its points' loads.
 std::vector<uint32_t> batchPlanWords(Resources& r, const ModeEncoding& encoding, bool compute) {
   std::vector<uint32_t> words(encoding.batch_plan.begin(), encoding.batch_plan.end());
   if (!compute) return words;

@@ -78,7 +78,8 @@ struct RenderOptions {
   // atomicMax leaves one result in any order. None: on a CPU device, where lavapipe runs the groups
   // about in the order given (the 1.55M-point Mandelbulb's 3-px discs at 1920x1080, fp32:
   // 105 -> 93 ms); not on GPUs, which run thousands of groups at once. A finer sort, nearest group
-  // first, was slower on lavapipe than either end (docs/performance.md).
+  // first, was slower on lavapipe than either end (docs/performance.md). Off whatever it says with
+  // the raster backend or without early_depth, where the order saves nothing.
   std::optional<bool> near_end_first;
   // Points per draw; 0 takes the most the device allows (maxStorageBufferRange,
   // maxMemoryAllocationSize). Rounded down to whole batches. Tests set it small to cover chunking.

@@ -17,7 +17,7 @@ struct Chunk {
   size_t first = 0, count = 0;
   // Compute backend, per-batch modes: the chunk's entries of the batch list (batches it overlaps
   // that the plan did not cull).
-  bool listed = false;  // false: every batch of the chunk splatted, in order (no list)
+  bool listed = false;  // false: every batch of the chunk splatted, a workgroup per 1024 points (no list)
   uint32_t list_first = 0, list_count = 0;
   // With RenderOptions::near_end_first: the first point of every step-th group of
   // kSplatPointsPerGroup points (at most kOrderSamples), whose depths along their order decide

@@ -197,8 +197,9 @@ void splatPair(uint i, vec4 a, vec4 b) {
 // 8-byte loads, 0.095 ms with 16-byte ones). Every load is coalesced either way.
 void main() {
 #if defined(MODE_BATCH) || defined(MODE_ADAPTIVE)
-  // This workgroup's 1024 points: in a chunk splatted whole the next 1024 (in one batch: chunks
-  // without a list start at a batch), else a part of a listed batch. group_first is relative to
+  // This workgroup's 1024 points: in a chunk splatted whole its 1024 (in one batch: chunks
+  // without a list start at a batch), else a part of a listed batch; counted from the chunk's end
+  // where it runs from there (kNearEndFirst). group_first is relative to
   // the chunk (negative where a test's small chunk starts inside a batch). The matrix is loaded
   // once for all of a thread's points: 64 B of matrix for every 8 B point had made batch mode
   // slower than fp32.
