@@ -473,8 +473,9 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   Camera camera = given_camera;
   RenderOptions options = given_options;
   const bool compute = options.backend == Backend::kCompute;
-  // Resolved once: the splat's pipeline and the upload (the chunks' order samples) both follow it,
-  // and a stream's settled options, made afresh, do not change it.
+  // Resolved once: the splat's pipeline, the upload (the chunks' order samples, from
+  // options.near_end_first) and the choice of ends follow it; a stream's settled options, made
+  // afresh, do not change it.
   const bool near_end_first =
       compute && options.early_depth && options.near_end_first.value_or(context.facts.type == "cpu");
   options.near_end_first = near_end_first;
@@ -535,7 +536,6 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
     const Backend backend = options.backend;
     status = (*settle)(camera, options);
     assert(options.mode == mode && options.backend == backend);
-    options.near_end_first = near_end_first;
     (void)mode, (void)backend;
     if (status) make_pipelines();
   }

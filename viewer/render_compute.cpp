@@ -68,9 +68,9 @@ Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool
 
 void sampleSplatOrder(Chunk& chunk, const PointSet& set, size_t offset) {
   const size_t groups = (chunk.count + kSplatPointsPerGroup - 1) / kSplatPointsPerGroup;
-  chunk.order_step = std::max<size_t>(1, (groups + kOrderSamples - 1) / kOrderSamples);
+  const size_t step = std::max<size_t>(1, (groups + kOrderSamples - 1) / kOrderSamples);
   chunk.order_samples.clear();
-  for (size_t g = 0; g < groups; g += chunk.order_step)
+  for (size_t g = 0; g < groups; g += step)
     chunk.order_samples.push_back(set.positions[offset + g * kSplatPointsPerGroup]);
 }
 
@@ -79,13 +79,14 @@ uint32_t chooseSplatEnds(Resources& r, const Camera& camera) {
   uint32_t reversed = 0;
   for (Chunk& chunk : r.chunks) {
     // The least-squares slope of the samples' distance in front of the eye (−z: the eye looks down
-    // −z) against their place in the chunk: negative where the points come nearer along it.
-    double n = 0.0, sum_k = 0.0, sum_d = 0.0, sum_kk = 0.0, sum_kd = 0.0;
+    // −z) against their place in the chunk: negative where the points come nearer along it. Only
+    // its sign counts, that of n·Σkd − Σk·Σd (its denominator, n·Σk² − (Σk)², is positive).
+    double n = 0.0, sum_k = 0.0, sum_d = 0.0, sum_kd = 0.0;
     for (size_t k = 0; k < chunk.order_samples.size(); ++k) {
       const double d = -(view * glm::dvec4(chunk.order_samples[k], 1.0)).z;
       if (!std::isfinite(d)) continue;
       const double x = static_cast<double>(k);
-      n += 1.0, sum_k += x, sum_d += d, sum_kk += x * x, sum_kd += x * d;
+      n += 1.0, sum_k += x, sum_d += d, sum_kd += x * d;
     }
     chunk.reversed = n >= 2.0 && n * sum_kd - sum_k * sum_d < 0.0;
     reversed += chunk.reversed ? 1u : 0u;

@@ -23,7 +23,6 @@ struct Chunk {
   // kSplatPointsPerGroup points (at most kOrderSamples), whose depths along their order decide
   // `reversed` for each view (chooseSplatEnds).
   std::vector<glm::dvec3> order_samples;
-  size_t order_step = 1;
   bool reversed = false;
   Buffer positions, colors, probe;
   VkDescriptorSet set = VK_NULL_HANDLE;
