@@ -218,7 +218,7 @@ Status uploadPoints(const VulkanContext& context, Resources& r, size_t total, co
           }, element, VkDeviceSize{32} << 20, plane * plane_bytes);
     }
     if (!status) return status;
-    if (compute && options.near_end_first.value_or(false)) detail::sampleSplatOrder(chunk, *view->set, view->offset);
+    if (compute && options.near_end_first) detail::sampleSplatOrder(chunk, *view->set, view->offset);
     if (compute) {
       status = upload_colors(r.all_colors, *view, chunk.count, VkDeviceSize{chunk.first} * 4);
     } else {
@@ -476,8 +476,7 @@ Result<RenderResult> renderChunks(const VulkanContext& context, size_t total, co
   // Resolved once: the splat's pipeline, the upload (the chunks' order samples, from
   // options.near_end_first) and the choice of ends follow it; a stream's settled options, made
   // afresh, do not change it.
-  const bool near_end_first =
-      compute && options.early_depth && options.near_end_first.value_or(context.facts.type == "cpu");
+  const bool near_end_first = compute && options.early_depth && options.near_end_first;
   options.near_end_first = near_end_first;
   // Positions come from a storage buffer in the compute backend, for native mode on a device
   // without double vertex attributes, and always for a mode with no vertex attributes (adaptive).

@@ -4,7 +4,8 @@
 # default: round points, EDL) of the res-200 and res-420 Mandelbulbs and the Menger sponge at
 # 1024x768, each build one fresh process per round, alternated: the point size, the median GPU
 # frame of FRAMES (20) after the auto warm-up, and the whole process's wall time for one picture.
-# Rows in $OUT/default.tsv.   BASE=19318e9 ROUNDS=3 SETS="mb200 mb420 menger" (s11u: the 16.7M-point
+# Rows in $OUT/default.tsv. BUILDS ("BASE current") names more builds .gpu/dpoint-NAME to alternate.
+#   BASE=19318e9 ROUNDS=3 SETS="mb200 mb420 menger" (s11u: the 16.7M-point
 # `sierpinski --level 11 --unwelded`, as bench/scripts/local_targets.sh draws on lavapipe)
 set -euo pipefail
 source bench/scripts/gpu_env.sh
@@ -18,7 +19,7 @@ rows=$out/default.tsv
 printf 'round\tdataset\tbuild\tpoint_size\tgpu_ms_median\tprocess_ms\n' >"$rows"
 for round in $(seq "${ROUNDS:-3}"); do
   for set in ${SETS:-mb200 mb420 menger}; do
-    for build in "${BASE:-19318e9}" current; do
+    for build in ${BUILDS:-${BASE:-19318e9} current}; do
       bin=.gpu/dpoint-$build
       [ "$build" = current ] && bin=.gpu/dpoint
       rm -f /tmp/r.json

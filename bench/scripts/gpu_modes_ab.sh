@@ -1,26 +1,30 @@
 #!/usr/bin/env bash
-# Every mode of `render` on the GPU machine, two builds alternated (device tool; carry .gl and .gpu
-# as gpu_bench.sh says, the build before as .gpu/dpoint-$BASE, the current one as .gpu/dpoint):
-# the 16.7M-point `sierpinski --level 11 --unwelded` PLY at 1024x768, each mode one fresh process
-# per round with FRAMES (10) frames: the median GPU frame, the whole process's wall time and the
-# picture's SHA-256 (16). Rows in $OUT/modes.tsv, each build's median wall time per mode and whether
-# the pictures agree in $OUT/modes-median.tsv. FRAMES=1 times what a host-side change (reading,
-# encoding) costs every mode.   BASE=A ROUNDS=2 MODES="fp32 split rte df64 native batch adaptive"
+# Every mode of `render` on the GPU machine, builds alternated (device tool; carry .gl and .gpu as
+# gpu_bench.sh says, the build before as .gpu/dpoint-$BASE, the current one as .gpu/dpoint; BUILDS,
+# "BASE current", names more builds .gpu/dpoint-NAME): the 16.7M-point `sierpinski --level 11
+# --unwelded` PLY at 1024x768, each mode one fresh process per round with FRAMES (10) frames: the
+# median GPU frame, the whole process's wall time and the picture's SHA-256 (16). Rows in
+# $OUT/modes.tsv; each build's median wall time and GPU frame per mode, and whether the pictures
+# agree, in $OUT/modes-median.tsv. FRAMES=1 times what a host-side change (reading, encoding) costs
+# every mode. SET=mb420 draws the res-420 Mandelbulb (its default 3-px points) instead.
+#   BASE=A ROUNDS=2 MODES="fp32 split rte df64 native batch adaptive"
 set -euo pipefail
 source bench/scripts/gpu_env.sh
 data=/tmp/dpoint-default
 mkdir -p "$data"
-[ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
+set=${SET:-s11u}
+[ "$set" != s11u ] || [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
+[ "$set" != mb420 ] || [ -s "$data/mb420.ply" ] || .gpu/dpoint generate mandelbulb --resolution 420 -q -o "$data/mb420.ply"
 rows=$out/modes.tsv
 printf 'round\tmode\tbuild\tgpu_ms_median\tprocess_ms\tpng\n' >"$rows"
 for round in $(seq "${ROUNDS:-2}"); do
   for mode in ${MODES:-fp32 split rte df64 native batch adaptive}; do
-    for build in "${BASE:-A}" current; do
+    for build in ${BUILDS:-${BASE:-A} current}; do
       bin=.gpu/dpoint-$build
       [ "$build" = current ] && bin=.gpu/dpoint
       rm -f /tmp/r.json
       s=$(date +%s%N)
-      "$bin" render "$data/s11u.ply" --mode "$mode" --frames "${FRAMES:-10}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1 || true
+      "$bin" render "$data/$set.ply" --mode "$mode" --frames "${FRAMES:-10}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1 || true
       e=$(date +%s%N)
       png=$( [ -f /tmp/m.png ] && sha256sum </tmp/m.png | cut -c1-16 || echo -)
       rm -f /tmp/m.png
@@ -37,9 +41,12 @@ done
 import csv, statistics, sys
 rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
 builds = list(dict.fromkeys(r["build"] for r in rows))
-print("mode\t" + "\t".join(f"{b}_ms" for b in builds) + "\tsame_png")
+def med(m, b, key):
+    v = [float(r[key]) for r in rows if r["mode"] == m and r["build"] == b and r[key]]
+    return statistics.median(v) if v else float("nan")
+print("mode\t" + "\t".join(f"{b}_ms" for b in builds) + "\t" + "\t".join(f"{b}_gpu_ms" for b in builds) + "\tsame_png")
 for m in dict.fromkeys(r["mode"] for r in rows):
-    ms = [statistics.median(float(r["process_ms"]) for r in rows if r["mode"] == m and r["build"] == b) for b in builds]
     same = len({r["png"] for r in rows if r["mode"] == m}) == 1
-    print(m + "\t" + "\t".join(f"{x:.0f}" for x in ms) + "\t" + ("yes" if same else "NO"))
+    print(m + "\t" + "\t".join(f"{med(m, b, 'process_ms'):.0f}" for b in builds) + "\t"
+          + "\t".join(f"{med(m, b, 'gpu_ms_median'):.4f}" for b in builds) + "\t" + ("yes" if same else "NO"))
 PY

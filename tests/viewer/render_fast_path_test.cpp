@@ -177,7 +177,8 @@ TEST_P(FastPath, nearEndFirstGivesTheSamePictureAndTurnsOnlyChunksThatComeNearer
 }
 
 // A stream settled after its upload (dpoint render's one pass over a file) gets its options made
-// afresh: its chunks still run from their nearer end, with the picture of the set in memory.
+// afresh: its chunks still run from their nearer end, as chosen when its samples were kept at the
+// upload, whatever the settled options say, with the picture of the set in memory.
 TEST_P(FastPath, aSettledStreamKeepsItsSplatOrder) {
   if (GetParam() != Backend::kCompute) GTEST_SKIP() << "the order is for the compute backend";
   const glm::dvec3 centre(6.378e6, 1.5, -2.25);
@@ -210,7 +211,8 @@ TEST_P(FastPath, aSettledStreamKeepsItsSplatOrder) {
   Result<RenderResult> whole = renderPoints(*context_, s, *camera, options);
   ASSERT_TRUE(whole.ok()) << whole.error().message;
   const StreamSettle settle = [&](Camera&, RenderOptions& settled) -> Status {
-    settled = RenderOptions{};  // as the render job makes them: near_end_first unset
+    settled = RenderOptions{};  // made afresh, as the render job makes them
+    settled.near_end_first = false;
     settled.backend = Backend::kCompute;
     settled.point_size = 3.0f;
     settled.round_points = true;
