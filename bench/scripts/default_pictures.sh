@@ -4,7 +4,8 @@
 # numpy by picture_measures.py), then the whole `dpoint render` process at 1024x768, the two builds
 # alternated, ROUNDS runs each (median reported).
 #   bench/scripts/default_pictures.sh BASE_DPOINT NEW_DPOINT WORK [ROUNDS]
-# SETS: other sets (paths, or names made in WORK beforehand), e.g. SETS="s11u.ply mb420.ply"
+# SETS: other sets (paths, or names made in WORK beforehand), e.g. SETS="s11u.ply mb420.ply";
+# SIZES: other picture sizes, e.g. SIZES="1024x768 3840x2160"
 set -euo pipefail
 base=$1 new=$2 work=$3 rounds=${4:-5}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -21,7 +22,7 @@ echo "| --- | --- | --- | --- | --- | --- |"
 for f in $sets; do
   path=$f; [ -f "$path" ] || path=$work/$f
   name=$(basename "$f")
-  for size in 640x480 1024x768 1920x1080; do
+  for size in ${SIZES:-640x480 1024x768 1920x1080}; do
     for build in base new; do
       bin=$base; [ $build = new ] && bin=$new
       png=$work/$name-$size-$build.png
