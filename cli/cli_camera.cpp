@@ -18,7 +18,8 @@ void addCameraOptions(CLI::App& cmd, CameraCliOptions& o) {
   cmd.add_option("--view-center", o.view_center, "Orthographic window centre X,Y[,Z]");
   cmd.add_option("--view-width", o.view_width, "Orthographic window width (height follows the aspect)");
   cmd.add_option("--tolerance", o.tolerance,
-                 "adaptive mode: the error in pixels its per-batch choice of tiers keeps within, where 30 bits can")
+                 "adaptive mode: the error in pixels its per-batch choice of tiers keeps within, wherever its three\n"
+                 "tiers (30 bits) can")
       ->check([](const std::string& v) {
         Result<double> px = parseTolerance(v);
         return px ? std::string() : px.error().message;

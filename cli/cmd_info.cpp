@@ -69,7 +69,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--stream", o->stream,
                   "auto|on|off. on: read binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, twice, so a set\n"
                   "larger than memory is described in about 1.2 GB (no float32 merge count, which needs every point\n"
-                  "at once, and error bounds from the box of each 4096-point batch); auto: for such input of\n"
+                  "at once, and error bounds from the box of every 1024 points); auto: for such input of\n"
                   "more than 2^26 points")
       ->check(oneOf("--stream", {"auto", "on", "off"}))
       ->default_val("auto");

@@ -86,7 +86,7 @@ std::string adviceText(const InfoAdvice& advice) {
           ? "error bound by mode, for the view (" + viewName(advice.camera) + ", at most " + str(b.visible) +
                 " points visible; float floor " + formatBound(b.float_floor_px) +
                 "), from the box of\n"
-                "                    each 4096-point batch (a streamed set; its points give bounds no larger):\n"
+                "                    every 1024 points (a streamed set; its points give bounds no larger):\n"
           : "error bound by mode, for the view (" + viewName(advice.camera) + ", " + str(b.visible) +
                 " points visible; float floor " + formatBound(b.float_floor_px) + "):\n";
   for (PrecisionMode mode : kAllModes) {
