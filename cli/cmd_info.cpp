@@ -18,6 +18,7 @@ struct InfoCliOptions {
   CameraCliOptions camera;
   std::string max_memory;
   std::string stream = "auto";
+  std::string up_axis = "auto";
   int scene = -1;
   bool all_scenes = false;
   std::string columns;
@@ -34,7 +35,8 @@ int runInfo(const InfoCliOptions& o) {
   inputs.scene = o.scene;
   inputs.all_scenes = o.all_scenes;
   inputs.columns = columnsOf(o.columns);
-  const InfoOptions options{*spec, o.sample, *parseTolerance(o.camera.tolerance), o.common.threads};
+  InfoOptions options{*spec, o.sample, *parseTolerance(o.camera.tolerance), o.common.threads, std::nullopt};
+  if (o.up_axis != "auto") options.z_up = o.up_axis == "z";
   Result<InfoReport> report = describeFiles(inputs, options, progress);
   if (!report) return reportError(report.error());
   const std::string text = o.json ? infoReportJson(*report) : infoReportText(*report);
@@ -65,6 +67,9 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   cmd->add_flag("--all-scenes", o->all_scenes, "glTF: every scene, one after the other, as one set")->excludes(scene);
   addColumnsOption(*cmd, o->columns);
   addCameraOptions(*cmd, o->camera);
+  addChoiceOption(*cmd, "--up-axis", o->up_axis,
+                  "auto|y|z: the data's up for the --fit view, as `dpoint render` takes it. auto: z for LAS (surveys), y otherwise",
+                  {"auto", "y", "z"});
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,
                   "auto|on|off. on: read binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, twice, so a set\n"

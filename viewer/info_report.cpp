@@ -1,5 +1,6 @@
 #include "viewer/info_report.h"
 
+#include <algorithm>
 #include <array>
 #include <limits>
 #include <utility>
@@ -11,6 +12,7 @@
 #include "viewer/copc_view.h"
 #include "viewer/modes.h"
 #include "viewer/render.h"
+#include "viewer/render_job.h"
 
 namespace dpoint {
 namespace {
@@ -111,6 +113,19 @@ std::string adviceJson(const InfoAdvice& advice) {
          "\",\n  \"error_bound_px\": " + bounds.line();
 }
 
+// The view `dpoint render` takes for the same camera options (render_job's viewCameras): with z up
+// and no eye, fitted from the z-up three-quarter direction; a set in memory framed by its outline
+// (boundsWithOutline), as render frames it, so the two print the same bounds.
+Result<Camera> renderView(const InfoOptions& options, const Bounds& bounds, bool z_up) {
+  CameraSpec spec = options.camera;
+  if (z_up && !spec.eye) {
+    const RenderView view = viewsFor(1, true).front();
+    spec.fit_direction = view.direction;
+    spec.fit_up = view.up;
+  }
+  return makeCamera(spec, bounds);
+}
+
 }  // namespace
 
 Result<InfoReport> describePoints(const PointSet& points, const std::string& name, const InfoOptions& options) {
@@ -127,7 +142,7 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
     report.dimensions.push_back(range);
   }
   if (points.size() > 0) {
-    Result<Camera> camera = makeCamera(options.camera, boundsOf(points));
+    Result<Camera> camera = renderView(options, boundsWithOutline(points), options.z_up.value_or(points.z_up));
     if (!camera) return camera.error();
     report.advice = InfoAdvice{*camera, predictErrorBounds(points, *camera, {}, options.tolerance_px)};
   }
@@ -161,7 +176,9 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   report.info = info->info;
   report.streamed = true;
   if (boxes.count > 0) {
-    Result<Camera> camera = makeCamera(options.camera, boundsOfBoxes(boxes));
+    // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
+    // render's bounds of a 3D set may be somewhat larger (a closer fit).
+    Result<Camera> camera = renderView(options, boundsOfBoxes(boxes), options.z_up.value_or(false));
     if (!camera) return camera.error();
     report.advice = InfoAdvice{*camera, predictBoxBounds(boxes, *camera, {}, options.tolerance_px)};
   }
@@ -173,7 +190,15 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads);
   if (!stream) return stream.error();
   const std::string name = describeInputs(inputs.paths);
-  if (*stream) return describeStream(**stream, name, options, progress);
+  if (*stream) {
+    InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
+    if (!streamed.z_up)
+      streamed.z_up = std::all_of(inputs.paths.begin(), inputs.paths.end(), [](const std::string& path) {
+        const Result<FileFormat> format = formatOf(path);
+        return format && (*format == FileFormat::kLas || *format == FileFormat::kLaz);
+      });
+    return describeStream(**stream, name, streamed, progress);
+  }
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};
   read.max_memory = inputs.max_memory;
   read.columns = inputs.columns;

@@ -31,6 +31,9 @@ struct InfoOptions {
   size_t sample = 10000;             // points sampled for the nearest-neighbour distance (≥ 1)
   double tolerance_px = kDefaultTolerancePx;  // adaptive mode's tier choice, which its bound follows
   unsigned threads = 0;              // 0: all cores; the report does not depend on it
+  // --up-axis: the data's up for the fitted view, as `dpoint render` takes it; unset (auto): z for
+  // a set that records z up (LAS, a PLY written from LAS) and, streamed, for .las/.laz input.
+  std::optional<bool> z_up;
 };
 
 // Every mode's predicted error for one view (viewer/precision.h).

@@ -193,6 +193,40 @@ TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {
   EXPECT_LE(max_px[1], 0.01) << "native";
 }
 
+// `dpoint info` predicts each mode's error for the view `dpoint render` draws with the same camera
+// options: the outline-framed fit, from the z-up three-quarter direction for a survey (--up-axis
+// auto: LAS) and from the y-up one otherwise or with --up-axis y. (Render fits again, a little
+// farther, where a sparse set's default points would touch the edge; --point-size keeps its fit.)
+TEST(CliRender, infoPredictsTheBoundRenderPrintsForTheSameView) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "33", "--offset", "6378137,0,0", "--quiet", "-o",
+                       dir.file("far.ply")}).exit_code, 0);
+  const std::string survey = std::string(DPOINT_CORPUS_DIR) + "/las/simple.las";
+  struct Case {
+    std::string input;
+    std::vector<std::string> view;
+  };
+  for (const Case& c : {Case{dir.file("far.ply"), {}}, Case{survey, {}}, Case{survey, {"--up-axis", "y"}}}) {
+    std::vector<std::string> info = {"info", c.input, "--width", "320", "--height", "240", "--json"};
+    info.insert(info.end(), c.view.begin(), c.view.end());
+    const test::CommandResult described = runDpoint(info);
+    ASSERT_EQ(described.exit_code, 0) << described.err;
+    const size_t bounds = described.out.find("\"error_bound_px\"");
+    ASSERT_NE(bounds, std::string::npos) << described.out;
+    for (const char* mode : {"rte", "batch"}) {  // fp32's is null (unbounded) at the Earth's radius
+      SCOPED_TRACE(c.input + (c.view.empty() ? "" : " " + c.view[1]) + " " + mode);
+      const double predicted = jsonNumber(described.out.substr(bounds), mode);
+      std::vector<std::string> render = {"render", c.input, "-o", dir.file("r.png"), "--mode", mode, "--width", "320",
+                                         "--height", "240", "--point-size", "3", "--json", dir.file("r.json")};
+      render.insert(render.end(), c.view.begin(), c.view.end());
+      const test::CommandResult drawn = runDpoint(render);
+      ASSERT_EQ(drawn.exit_code, 0) << drawn.err;
+      EXPECT_GT(predicted, 0.0);
+      EXPECT_EQ(predicted, jsonNumber(readFile(dir.file("r.json")), "predicted_bound_px"));
+    }
+  }
+}
+
 // The default is --mode auto: it names the mode it took, its bound and the runner-up, and the
 // measured error stays within the bound. fp32 at the Earth's radius would not.
 TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
