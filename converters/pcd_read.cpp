@@ -533,6 +533,10 @@ class Reader {
   }
 
   Status readCompressed(Columns& columns, uint64_t n, uint32_t compressed, uint32_t uncompressed) {
+    // No LZF data for a non-empty block: lzf_decompress would read a first byte that is not there.
+    if (compressed == 0 && uncompressed != 0)
+      return Error{path_ + ": byte " + std::to_string(h_.data_offset) + ": a compressed size of 0 for the " +
+                   std::to_string(uncompressed) + " bytes the header declares"};
     std::vector<uint8_t> in(compressed), out(uncompressed);
     Result<size_t> got = file_.readAt(h_.data_offset + 8, in.data(), in.size());
     if (!got) return got.error();

@@ -345,6 +345,10 @@ TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
        "the LZF data is corrupt, not the 24 the header declares"},
       {head + "DATA binary_compressed\n" + std::string("\x05\0\0\0\x10\0\0\0", 8) + std::string(5, '\0'),
        "the uncompressed size 16 is not POINTS × bytes per point (2 × 12)"},
+      // A review finding: a compressed size of 0 for 24 bytes had lzf_decompress read a byte that
+      // is not there (a crash in every reader).
+      {head + "DATA binary_compressed\n" + std::string("\0\0\0\0\x18\0\0\0", 8),
+       "a compressed size of 0 for the 24 bytes the header declares"},
       {"VERSION 0.7\nFIELDS x y y\nSIZE 4 4 4\nPOINTS 1\nDATA ascii\n", "header line 2: field 'y' appears twice"},
       // A fuzz finding: a second field list (COLUMNS, PCD 0.5's FIELDS) longer than the COUNT line
       // before it had the fields read past the counts.
