@@ -3,8 +3,9 @@
 #include <condition_variable>
 #include <exception>
 #include <new>
-#include <string>
 #include <mutex>
+#include <string>
+#include <system_error>
 #include <thread>
 
 #include "core/parallel.h"
@@ -30,7 +31,7 @@ Status writeChunksInOrder(AtomicFile& file, size_t chunks, unsigned threads,
                           const std::function<Status(size_t chunk, std::vector<char>& bytes)>& make,
                           const std::function<void(size_t chunk)>& written) {
   threads = resolveThreads(threads);
-  if (threads <= 1 || chunks <= 1) {
+  auto one_thread = [&]() -> Status {
     std::vector<char> bytes;
     for (size_t k = 0; k < chunks; ++k) {
       if (Status s = make(k, bytes); !s) return s;
@@ -38,7 +39,8 @@ Status writeChunksInOrder(AtomicFile& file, size_t chunks, unsigned threads,
       if (written) written(k);
     }
     return okStatus();
-  }
+  };
+  if (threads <= 1 || chunks <= 1) return one_thread();
   // Chunk k lives in slot k % window from when a worker takes it until it has been written.
   const size_t window = 2 * size_t{threads};
   struct Slot {
@@ -74,7 +76,13 @@ Status writeChunksInOrder(AtomicFile& file, size_t chunks, unsigned threads,
   };
   std::vector<std::thread> pool;
   pool.reserve(threads);
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+  // A thread the system will not make (a process or address-space limit, --threads 30000): the
+  // chunks go to the workers made, or, with none, are made on this thread.
+  try {
+    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+  } catch (const std::system_error&) {
+  }
+  if (pool.empty()) return one_thread();
 
   Status result = okStatus();
   for (size_t k = 0; k < chunks; ++k) {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstddef>
 #include <functional>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -48,7 +49,12 @@ inline void parallelFor(size_t count, unsigned threads,
   }
   std::vector<std::thread> pool;
   pool.reserve(threads - 1);
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run, t);
+  // A thread the system will not make (a process or address-space limit, --threads 30000): the
+  // items go to the workers made, the caller among them, as they are handed out anyway.
+  try {
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run, t);
+  } catch (const std::system_error&) {
+  }
   run(0);
   for (std::thread& t : pool) t.join();
 }
