@@ -36,6 +36,20 @@ Status checkOutputFolder(const std::string& flag, const std::string& path) {
   return okStatus();
 }
 
+Status checkNotAlso(const std::string& flag, const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& others) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path mine = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  for (const auto& [what, other] : others) {
+    std::error_code e1, e2;
+    const bool same = fs::exists(path, e1) && fs::exists(other, e2) ? fs::equivalent(path, other, e1)
+                                                                    : mine == fs::weakly_canonical(fs::absolute(other, e2), e2);
+    if (same && !e1) return Error{flag + " " + path + ": is also " + what + " (" + other + ")", ExitCode::kUsage};
+  }
+  return okStatus();
+}
+
 Status writePointsWithNotes(const std::string& path, const PointSet& points, WriteOptions options) {
   std::vector<std::string> notices;
   options.notices = &notices;

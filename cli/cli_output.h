@@ -4,6 +4,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "converters/point_io.h"
 #include "core/result.h"
@@ -24,6 +26,13 @@ Status checkPointOutput(const std::string& path);
 // An output folder that is created when missing (bench --out): not a file, and the nearest folder
 // that exists can be written into. `flag` names the option in the message.
 Status checkOutputFolder(const std::string& flag, const std::string& path);
+
+// An output that is the same file as another path the command reads or writes (`others`: each
+// with what it is, "the input", "-o"): a usage error (exit 1) before any work, so that `render
+// IN -o p.png --json IN` does not replace its input by the report. Compared as files where both
+// exist, else by their absolute, normalised paths.
+Status checkNotAlso(const std::string& flag, const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& others);
 
 // writePoints, then each notice the writer gave ("dpoint: note: …" on stderr).
 Status writePointsWithNotes(const std::string& path, const PointSet& points, WriteOptions options);

@@ -1,6 +1,8 @@
 // dpoint generate KIND -o OUT: the datasets of the study (DESIGN §8).
 // Parsing and reporting only; every generator is a library function, and what is done to its
 // points after it is cli/cli_generate_output.h over generators/generate.h.
+#include <sys/stat.h>
+
 #include <charconv>
 #include <cstdio>
 #include <memory>
@@ -9,8 +11,10 @@
 #include "cli/cli_check.h"
 #include "cli/cli_device.h"
 #include "cli/cli_generate_output.h"
+#include "cli/cli_output.h"
 #include "cli/cli_text.h"
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "generators/generate.h"
 #include "generators/julia.h"
 #include "generators/mandelbrot2d.h"
@@ -31,6 +35,20 @@ Status parseBounds(const std::string& text, double& lo, double& hi) {
   return okStatus();
 }
 
+// Which file is at a path (device, inode, change time), to tell a file a run made from one that
+// was there before it; none where nothing is.
+struct FileIdentity {
+  dev_t device;
+  ino_t inode;
+  int64_t changed_ns;
+  bool operator==(const FileIdentity&) const = default;
+};
+std::optional<FileIdentity> fileIdentity(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+  return FileIdentity{st.st_dev, st.st_ino, int64_t{st.st_ctim.tv_sec} * 1000000000 + st.st_ctim.tv_nsec};
+}
+
 template <typename Params, typename Options>
 void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* cmd, bool auto_noise,
                   Result<PointSet> (*generate)(const Params&),
@@ -39,7 +57,7 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
                   PointFunction (*made)(const Params&) = nullptr) {
   cmd->callback([o, &run, cmd, auto_noise, generate, generate_tile, makeParams, made, name = cmd->get_name()] {
     const std::string signature = o->out.tile.empty() ? std::string() : tileSignature(name, cmd->config_to_str(true, false));
-    run = [o, auto_noise, generate, generate_tile, makeParams, made, name, signature] {
+    auto inner = [o, auto_noise, generate, generate_tile, makeParams, made, name, signature] {
       if (Status s = checkHandedBack(o->out); !s) return reportError(s.error());
       Result<PointOrder> order = parsePointOrder("--order", o->out.order);
       if (!order) return reportError(order.error());
@@ -90,6 +108,19 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
         }
       }
       return finish(generate(*params), o->out, *order, auto_noise, progress, clock, noise_made);
+    };
+    // --grid-out: never the output itself; and a grid this run wrote goes again when the run fails
+    // after it (the output could not be written, a stop), so a failed run leaves nothing.
+    run = [o, inner] {
+      std::string grid;
+      if constexpr (requires { o->params.grid_out; }) grid = o->params.grid_out;
+      if (grid.empty()) return inner();
+      if (Status s = checkNotAlso("--grid-out", grid, {{"-o", o->out.output}}); !s) return reportError(s.error());
+      const std::optional<FileIdentity> before = fileIdentity(grid);
+      const int code = inner();
+      if (code != 0)
+        if (const std::optional<FileIdentity> now = fileIdentity(grid); now && now != before) std::remove(grid.c_str());
+      return code;
     };
   });
 }
@@ -247,7 +278,8 @@ void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double&
   cmd->add_option("--frame", frame, "Coordinates: native (the fractal's own) or seed (grid corner at 0, as the original study's Python generator had it from skimage)")
       ->check(oneOf("--frame", {"native", "seed"}))
       ->default_val("native");
-  cmd->add_option("--grid-out", grid_out, "Also write the raw escape-count grid (uint8 if max_iter <= 255, else uint16)");
+  cmd->add_option("--grid-out", grid_out, "Also write the raw escape-count grid (uint8 if max_iter <= 255, else uint16)")
+      ->check(checkStatus(AtomicFile::checkTarget));
 }
 
 }  // namespace
@@ -342,7 +374,8 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   addGenerateDeviceOptions(*mandelbrot2d, m2->device,
                            "On a device: the perturbation deltas (the reference orbit stays on the CPU)");
   mandelbrot2d->add_option("--grid-out", m2->params.grid_out,
-                           "Also write the escape counts, row-major (uint8 if max_iter <= 255, else uint16)");
+                           "Also write the escape counts, row-major (uint8 if max_iter <= 255, else uint16)")
+      ->check(checkStatus(AtomicFile::checkTarget));
   addOutputOptions(*mandelbrot2d, m2->out, "smooth escape count, histogram-equalised over the view");
   registerKind(run, m2, mandelbrot2d, false, &generateMandelbrot2d, &generateMandelbrot2dTile, &mandelbrot2dParams);
 }

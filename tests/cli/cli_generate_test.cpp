@@ -71,6 +71,32 @@ TEST(CliGenerate, gridOutOfTheSeedVariantEqualsTheReference) {
   EXPECT_TRUE(readFile(dir.file("j.u8")) == readFile(DPOINT_REFERENCE_DIR "/julia_r64_i200_escape.u8"));
 }
 
+// A review finding: a run whose output failed left the --grid-out file it had written, and
+// `--grid-out X -o X` kept only one of them. Now the output never is the grid, a failed run takes
+// its grid away again, and a grid file that was there before a run refused up front stays.
+TEST(CliGenerate, aFailedRunLeavesNoGridAndTheGridIsNeverTheOutput) {
+  TempDir dir;
+  std::filesystem::create_symlink("/dev/full", dir.file("full.ply"));  // writing it fails: no space
+  test::CommandResult failed =
+      runDpoint({"generate", "mandelbulb", "--resolution", "20", "--grid-out", dir.file("g.bin"), "-o", dir.file("full.ply")});
+  EXPECT_EQ(failed.exit_code, 2) << failed.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("g.bin")));
+  test::writeFile(dir.file("kept.bin"), "before");
+  test::CommandResult refused = runDpoint({"generate", "julia", "--resolution", "20", "--grid-out", dir.file("kept.bin"),
+                                           "-o", dir.file("no-such-folder/x.ply")});
+  EXPECT_EQ(refused.exit_code, 1) << refused.err;
+  EXPECT_EQ(readFile(dir.file("kept.bin")), "before");
+  test::CommandResult same =
+      runDpoint({"generate", "mandelbulb", "--resolution", "20", "--grid-out", dir.file("x.ply"), "-o", dir.file("x.ply")});
+  EXPECT_EQ(same.exit_code, 1);
+  EXPECT_NE(same.err.find("--grid-out " + dir.file("x.ply") + ": is also -o"), std::string::npos) << same.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
+  test::CommandResult missing = runDpoint({"generate", "mandelbrot2d", "--resolution", "64", "--grid-out",
+                                           dir.file("no-such-folder/g.bin"), "-o", dir.file("m.ply")});
+  EXPECT_EQ(missing.exit_code, 1) << "checked before the work, as -o is";
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
+}
+
 TEST(CliGenerate, offsetTranslatesExactlyAndKeepsColours) {
   TempDir dir;
   ASSERT_EQ(runDpoint({"generate", "sierpinski", "--level", "2", "-o", dir.file("a.csv")}).exit_code, 0);

@@ -227,6 +227,23 @@ TEST(CliRender, infoPredictsTheBoundRenderPrintsForTheSameView) {
   }
 }
 
+// A review finding: `--json` naming the input replaced it by the report (exit 0), and naming -o
+// replaced the picture. Both are usage errors now, before any work, and nothing is written.
+TEST(CliRender, theReportIsNeitherTheInputNorThePicture) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "1", "--quiet", "-o", dir.file("m.ply")}).exit_code, 0);
+  const std::string input = readFile(dir.file("m.ply"));
+  test::CommandResult over_input = runDpoint({"render", dir.file("m.ply"), "-o", dir.file("m.png"), "--json", dir.file("m.ply")});
+  EXPECT_EQ(over_input.exit_code, 1);
+  EXPECT_NE(over_input.err.find("--json " + dir.file("m.ply") + ": is also an input"), std::string::npos) << over_input.err;
+  EXPECT_TRUE(readFile(dir.file("m.ply")) == input);
+  test::CommandResult over_picture =
+      runDpoint({"render", dir.file("m.ply"), "-o", dir.file("m.png"), "--json", dir.file("./m.png")});
+  EXPECT_EQ(over_picture.exit_code, 1);
+  EXPECT_NE(over_picture.err.find("is also -o"), std::string::npos) << over_picture.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m.png")));
+}
+
 // The default is --mode auto: it names the mode it took, its bound and the runner-up, and the
 // measured error stays within the bound. fp32 at the Earth's radius would not.
 TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
