@@ -24,6 +24,29 @@ std::string folderOf(const std::string& path) {
   return parent.empty() ? std::string(".") : parent.string();
 }
 
+// The longest file name a folder takes (NAME_MAX, 255 on Linux's file systems).
+size_t longestName(const std::string& folder) {
+  const long most = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+  return most > 0 ? static_cast<size_t>(most) : 255;
+}
+
+// A name longer than the folder takes: a usage error, before any work.
+Status checkName(const std::string& path, const std::string& folder) {
+  const size_t name = std::filesystem::path(path).filename().string().size(), most = longestName(folder);
+  if (name <= most) return okStatus();
+  return Error{path + ": the file name is " + std::to_string(name) + " bytes long, more than the " + std::to_string(most) +
+                   " its folder takes", ExitCode::kUsage};
+}
+
+// A temporary's name beside `path`: its name with `suffix`, or where that would be longer than the
+// folder takes (a name of 243-255 bytes), ".dpoint" with the suffix alone.
+std::string tempBeside(const std::string& path, const std::string& suffix) {
+  const std::filesystem::path p(path);
+  const std::string name = p.filename().string();
+  if (name.size() + suffix.size() <= longestName(folderOf(path))) return path + suffix;
+  return (p.parent_path() / (".dpoint" + suffix)).string();
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(std::string path, std::string temp_path, int fd, bool direct)
@@ -88,6 +111,7 @@ Status AtomicFile::checkTarget(const std::string& path) {
   }
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s;
+  if (Status s = checkName(path, folder); !s) return s;
   int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
   if (fd >= 0) {
     ::close(fd);
@@ -95,7 +119,7 @@ Status AtomicFile::checkTarget(const std::string& path) {
   }
   if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
     return ioError("cannot write into folder", folder, errno);
-  std::string temp = path + ".dpoint-XXXXXX";
+  std::string temp = tempBeside(path, ".dpoint-XXXXXX");
   fd = ::mkstemp(temp.data());
   if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
   ::close(fd);
@@ -111,6 +135,7 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
   if (special >= 0) return AtomicFile(path, "", special, true);
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s.error();
+  if (Status s = checkName(path, folder); !s) return s.error();
 
   int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
   if (fd >= 0) return AtomicFile(path, "", fd, false);
@@ -118,7 +143,7 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
     return ioError("cannot write into folder", folder, errno);
 
   // Fallback for file systems without O_TMPFILE: a named temporary beside the target.
-  std::string temp = path + ".dpoint-XXXXXX";
+  std::string temp = tempBeside(path, ".dpoint-XXXXXX");
   fd = ::mkstemp(temp.data());
   if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
   registerTemporaryFile(temp);  // removed by the interrupt watcher if it must end the process
@@ -208,7 +233,7 @@ Status AtomicFile::commit() {
   if (named.empty()) {
     // Give the unnamed file a temporary name, then rename it over the target (rename is atomic;
     // linkat alone would fail on an existing target).
-    named = path_ + ".dpoint-" + std::to_string(::getpid());
+    named = tempBeside(path_, ".dpoint-" + std::to_string(::getpid()));
     ::unlink(named.c_str());
     registerTemporaryFile(named);
     const std::string proc = "/proc/self/fd/" + std::to_string(fd_);

@@ -44,7 +44,8 @@ TEST(AtomicFile, rejectsMissingFolderAndFolderTarget) {
 // checkTarget finds what create would refuse, with create's message, and leaves nothing behind.
 TEST(AtomicFile, checkTargetRefusesWhatCreateRefusesAndWritesNothing) {
   TempDir dir;
-  for (const std::string& path : {dir.file("nope/out.txt"), dir.path(), std::string("/sys/dpoint-test.txt")}) {
+  for (const std::string& path :
+       {dir.file("nope/out.txt"), dir.path(), std::string("/sys/dpoint-test.txt"), dir.file(std::string(256, 'n'))}) {
     SCOPED_TRACE(path);
     Status checked = AtomicFile::checkTarget(path);
     Result<AtomicFile> created = AtomicFile::create(path);
@@ -55,6 +56,25 @@ TEST(AtomicFile, checkTargetRefusesWhatCreateRefusesAndWritesNothing) {
   EXPECT_TRUE(AtomicFile::checkTarget(dir.file("new.txt")).ok());
   EXPECT_TRUE(AtomicFile::checkTarget("/dev/null").ok());
   EXPECT_TRUE(dir.entries().empty());
+}
+
+// A review finding: a name of 243-255 bytes is a file the folder takes, but the temporary beside
+// it (the name and ".dpoint-PID") was not, and the run failed after all its work.
+TEST(AtomicFile, aNameUpToTheFoldersLongestIsWritten) {
+  TempDir dir;
+  for (size_t length : {size_t{240}, size_t{250}, size_t{255}}) {
+    const std::string path = dir.file(std::string(length, 'a'));
+    Result<AtomicFile> f = AtomicFile::create(path);
+    ASSERT_TRUE(f.ok()) << f.error().message;
+    ASSERT_TRUE(f->write("bytes").ok());
+    ASSERT_TRUE(f->commit().ok()) << length;
+    EXPECT_EQ(test::readFile(path), "bytes");
+  }
+  EXPECT_EQ(dir.entries().size(), 3u);  // no temporary left
+  Status long_name = AtomicFile::checkTarget(dir.file(std::string(256, 'b')));
+  ASSERT_FALSE(long_name.ok());
+  EXPECT_EQ(long_name.error().code, ExitCode::kUsage);
+  EXPECT_NE(long_name.error().message.find("the file name is 256 bytes long, more than the 255"), std::string::npos);
 }
 
 TEST(AtomicFile, writesDevicesDirectly) {
