@@ -487,8 +487,10 @@ ErrorBounds predictErrorBounds(const PointSet& points, const Camera& camera, std
   for (size_t m = 0; m < kModeCount; ++m) {
     out.px[m] = std::sqrt(out.px[m]) * (1.0 + 1e-9);
     out.computed[m] = s.wanted[m];
-    // Nothing of a refused mode reaches the picture; with no point in view every bound is 0.
-    if ((s.unbounded[m] || beyond_limit[m]) && out.visible > 0) out.px[m] = kInf;
+    // Nothing of a refused mode reaches the picture; with no point in view every bound is 0, but
+    // a mode whose encoding cannot hold a position draws nothing at all (renderPoints refuses the
+    // set), so auto must not take it even then (points at ±1e308 seen from where none is in view).
+    if (beyond_limit[m] || (s.unbounded[m] && out.visible > 0)) out.px[m] = kInf;
     // The encoding renderPoints would make: built here (per-batch modes), or the frame alone with
     // every position checked as prepareEncoding checks them (the pass's checks are its test).
     if (s.wanted[m] && !pass.refused[m] && !beyond_limit[m])
@@ -571,7 +573,7 @@ ErrorBounds predictBoxBounds(const BatchBoxes& boxes, const Camera& camera, std:
   for (size_t m = 0; m < kModeCount; ++m) {
     out.px[m] = std::sqrt(out.px[m]) * (1.0 + kBoxMargin);
     out.computed[m] = s.wanted[m];
-    if ((s.unbounded[m] || beyond_limit[m]) && out.visible > 0) out.px[m] = kInf;
+    if (beyond_limit[m] || (s.unbounded[m] && out.visible > 0)) out.px[m] = kInf;  // as predictErrorBounds
     // A mode that is not per batch encodes the frame alone: the boxes' position checks (every
     // coordinate's magnitude is largest at a box's min or max) stand for the encoder's, as a
     // point pass's checks do (predictErrorBounds).

@@ -283,6 +283,37 @@ TEST(Camera, rejectsBadOptionsNamingThem) {
 
 // The four views of `dpoint render --views 4`: the fit's direction and up steer the eye; the box
 // stays framed, the eye sits along the direction from the centre, and up points up on screen.
+// A review finding: data near the largest double (two points at 1e308) gave a fitted eye past it,
+// and the error blamed --view-center/--view-width, which were not given. Now it is bad input
+// (exit 2) saying why, and --ortho, which needs no eye that far, frames it. Points at ±1e308 whose
+// fit sees none of them: auto must not take fp32, whose encoding cannot hold them (it had, and
+// renderPoints then refused the set), so every mode past its range is unbounded.
+TEST(Camera, coordinatesNearTheLargestDoubleAreBadInputNamingWhy) {
+  PointSet same;
+  same.positions = {{1e308, 1e308, 1e308}, {1e308, 1e308, 1e308}};
+  CameraSpec spec;
+  Result<Camera> perspective = makeCamera(spec, boundsOf(same));
+  ASSERT_FALSE(perspective.ok());
+  EXPECT_EQ(perspective.error().code, ExitCode::kBadInput);
+  EXPECT_NE(perspective.error().message.find("too large to view in perspective"), std::string::npos) << perspective.error().message;
+  EXPECT_EQ(perspective.error().message.find("--view-center"), std::string::npos) << perspective.error().message;
+  spec.ortho = true;
+  EXPECT_TRUE(makeCamera(spec, boundsOf(same)).ok());
+  EXPECT_FALSE(makeCamera(CameraSpec{}, boundsOf(PointSet{PositionArray{{1e308, 1e308, 1e308}, {-1e308, -1e308, -1e308}}})).ok());
+  PointSet apart;  // past float32's range, and behind the eye
+  apart.positions = {{1e39, 0.0, 0.0}, {1e39, 1.0, 1.0}};
+  CameraSpec away;
+  away.eye = glm::dvec3(1e39 + 1e25, 0.0, 0.0);
+  away.target = glm::dvec3(1e39 + 2e25, 0.0, 0.0);
+  away.up = glm::dvec3(0.0, 1.0, 0.0);
+  Result<Camera> camera = makeCamera(away, boundsOf(apart));
+  ASSERT_TRUE(camera.ok()) << camera.error().message;
+  const ErrorBounds bounds = predictErrorBounds(apart, *camera);
+  EXPECT_EQ(bounds.visible, 0u);
+  EXPECT_TRUE(std::isinf(bounds.px[modeIndex(PrecisionMode::kFp32)]));
+  EXPECT_TRUE(std::isfinite(bounds.px[modeIndex(PrecisionMode::kNative)]));
+}
+
 TEST(Camera, fitDirectionAndUpSteerTheFramedView) {
   const Bounds bounds{{6.378e6, -2.0, 10.0}, {6.378e6 + 3.0, 1.0, 11.0}};
   const glm::dvec3 centre = 0.5 * (bounds.min + bounds.max);
