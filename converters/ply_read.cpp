@@ -435,6 +435,7 @@ class PlyParser {
     if (*first < 3 || std::memcmp(p, "ply", 3) != 0 || (*first > 3 && p[3] != '\n' && p[3] != '\r'))
       return Error{path_ + ": not a PLY file (it does not start with a 'ply' line)"};
     bool have_format = false;
+    std::unordered_set<std::string> element_names, property_names;  // the latter: the last element's
     for (int line_no = 1;; ++line_no) {
       std::string_view line;
       auto got = in_.nextLine(line, kMaxHeaderLine);
@@ -494,8 +495,10 @@ class PlyParser {
         if (hasControlByte(w[1])) return headerError(line_no, "element name " + quote(w[1]) + " has a control character");
         e.name = w[1];
         e.line = line_no;
-        for (const Element& other : elements_)
-          if (other.name == e.name) return headerError(line_no, "second element " + quote(e.name));
+        // Names seen kept in sets: a header of 100k properties had taken 17 s comparing each with
+        // every one before it (a review finding).
+        if (!element_names.insert(e.name).second) return headerError(line_no, "second element " + quote(e.name));
+        property_names.clear();
         elements_.push_back(std::move(e));
       } else if (key == "property") {
         if (elements_.empty()) return headerError(line_no, "property before any element");
@@ -516,8 +519,7 @@ class PlyParser {
         if (hasControlByte(w.back()))
           return headerError(line_no, "property name " + quote(w.back()) + " has a control character");
         prop.name = w.back();
-        for (const Property& other : elements_.back().properties)
-          if (other.name == prop.name) return headerError(line_no, "second property " + quote(prop.name));
+        if (!property_names.insert(prop.name).second) return headerError(line_no, "second property " + quote(prop.name));
         elements_.back().properties.push_back(std::move(prop));
       } else {
         return headerError(line_no, "unknown header keyword " + quote(key));
