@@ -804,6 +804,23 @@ TEST(Ply, plyRejectsUnknownHeaderKeyword) {
   EXPECT_TRUE(contains(r.error().message, "kw.ply: header line 3: unknown header keyword 'elemnt'"));
 }
 
+// A repeated element, or a property repeated within one element, is refused; the same name in two
+// elements is not a repeat (the names are kept in sets, per element for properties).
+TEST(Ply, plyRejectsRepeatedNamesOnly) {
+  TempDir dir;
+  auto prop = readText(dir, "p.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+                                     "property double z\nproperty double y\nend_header\n1 2 3 4\n");
+  ASSERT_FALSE(prop.ok());
+  EXPECT_TRUE(contains(prop.error().message, "p.ply: header line 7: second property 'y'")) << prop.error().message;
+  auto element = readText(dir, "e.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty double x\nproperty double y\n"
+                                        "property double z\nelement vertex 0\nend_header\n");
+  ASSERT_FALSE(element.ok());
+  EXPECT_TRUE(contains(element.error().message, "e.ply: header line 7: second element 'vertex'")) << element.error().message;
+  auto two = readText(dir, "two.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+                                      "property double z\nelement extra 1\nproperty double x\nend_header\n1 2 3\n4\n");
+  EXPECT_TRUE(two.ok()) << two.error().message;
+}
+
 TEST(Ply, plyRejectsUnsupportedPropertyType) {
   TempDir dir;
   auto r = readText(dir, "cloud.ply",
