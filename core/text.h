@@ -2,6 +2,7 @@
 // shortest round-trip form, JSON strings. Shared by the readers, the CLI and the bench report.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -54,7 +55,9 @@ inline std::string quotedExcerpt(std::string_view text) {
 }
 
 // A library's own message (tinygltf's, libdraco's) as part of a one-line error: trailing blanks
-// dropped, line ends become "; ", other control bytes \xNN. Not shortened. `empty` when nothing is left.
+// dropped, line ends become "; ", other control bytes \xNN, and a word longer than 200 bytes (a
+// data URI tinygltf quotes whole: 2.7 MB of base64 in one error line) cut to its first 80 and its
+// length. `empty` when nothing is left.
 inline std::string oneLineText(std::string_view text, std::string_view empty) {
   static const char kHex[] = "0123456789abcdef";
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.remove_suffix(1);
@@ -73,7 +76,21 @@ inline std::string oneLineText(std::string_view text, std::string_view empty) {
       out += static_cast<char>(c);
     }
   }
-  return out.empty() ? std::string(empty) : out;
+  constexpr size_t kLongWord = 200, kKept = 80;
+  std::string shortened;
+  for (size_t at = 0; at < out.size();) {
+    const size_t end = std::min(out.find(' ', at), out.size());
+    if (end - at <= kLongWord) {
+      shortened.append(out, at, end - at);
+    } else {
+      size_t cut = at + kKept;
+      while (cut > at && (static_cast<unsigned char>(out[cut]) & 0xC0) == 0x80) --cut;  // whole UTF-8 characters
+      shortened.append(out, at, cut - at).append("… (" + std::to_string(end - at) + " bytes)");
+    }
+    if (end < out.size()) shortened += ' ';
+    at = end + 1;
+  }
+  return shortened.empty() ? std::string(empty) : shortened;
 }
 
 // Decimal digits only (at most 19, so no overflow), no sign, no spaces: false otherwise.

@@ -454,6 +454,27 @@ TEST(Gltf, gltfRefusesBufferOutsideFolder) {
 
 TEST(Gltf, gltfReportsMalformedJsonOnOneLine) { expectReadError("{ \"asset\": ", {}); }
 
+// A review finding: tinygltf quotes a data URI it cannot decode whole, and a 2 MB one made a 2.7 MB
+// error line. The message keeps the URI's first 80 bytes and says how long it was.
+TEST(Gltf, aDataUriInAnErrorIsShortened) {
+  TempDir dir;
+  // 300,000 bytes of zeros as base64, where the buffer claims 400,000: tinygltf cannot decode it.
+  const std::string uri = "data:application/octet-stream;base64," + std::string(400000, 'A');
+  test::writeFile(dir.file("long.gltf"),
+                  R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 400000, "uri": ")" + uri +
+                      R"("}], "bufferViews": [{"buffer": 0, "byteLength": 36}], "accessors": [{"bufferView": 0,
+                      "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]}],
+                      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "nodes": [{"mesh": 0}],
+                      "scenes": [{"nodes": [0]}], "scene": 0})");
+  Result<PointSet> set = readGltf(dir.file("long.gltf"));
+  ASSERT_FALSE(set);
+  EXPECT_LT(set.error().message.size(), 400u) << set.error().message.substr(0, 400);
+  EXPECT_NE(set.error().message.find("data:application/octet-stream;base64,AAAA"), std::string::npos)
+      << set.error().message.substr(0, 400);
+  EXPECT_NE(set.error().message.find("… (" + std::to_string(uri.size()) + " bytes)"), std::string::npos)
+      << set.error().message.substr(0, 400);
+}
+
 TEST(Gltf, gltfReportsMissingFile) {
   TempDir dir;
   Result<PointSet> set = readGltf(dir.file("absent.glb"));
