@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cstring>
+#include <filesystem>
+#include <system_error>
 
 #include "converters/las.h"
 #include "converters/ply.h"
@@ -24,8 +26,33 @@ bool isCompleteTileSet(const std::vector<std::string>& paths) {
   return std::all_of(seen.begin(), seen.end(), [](bool s) { return s; }) && seen.size() == paths.size();
 }
 
+Status checkInputSet(const std::vector<std::string>& paths) {
+  if (paths.size() < 2) return okStatus();
+  for (size_t i = 1; i < paths.size(); ++i)
+    for (size_t j = 0; j < i; ++j) {
+      std::error_code e;
+      if (paths[i] == paths[j] || std::filesystem::equivalent(paths[i], paths[j], e))
+        return Error{paths[i] + ": given twice as an input (also " + paths[j] + ")", ExitCode::kUsage};
+    }
+  if (!std::all_of(paths.begin(), paths.end(), [](const std::string& path) { return isTileFile(path); }))
+    return okStatus();
+  std::vector<std::string> given;  // by index, of the first file's count
+  uint32_t count = 0;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    Result<TileHeader> h = readTileHeader(paths[i]);
+    if (!h) return h.error();
+    if (i == 0) count = h->tile.count, given.assign(count, "");
+    if (h->tile.count != count) return okStatus();  // tiles of several runs: file by file
+    if (!given[h->tile.index].empty())
+      return Error{paths[i] + ": tile " + std::to_string(h->tile.index) + " again (also " + given[h->tile.index] + ")"};
+    given[h->tile.index] = paths[i];
+  }
+  return okStatus();
+}
+
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
   if (paths.size() == 1) return readPoints(paths[0], options);
+  if (Status s = checkInputSet(paths); !s) return s.error();
   if (options.texture) {  // a texture is one file's: several are read without
     *options.texture = MeshTexture{};
     ReadOptions each = options;
@@ -95,6 +122,7 @@ PointInputStream::~PointInputStream() = default;
 
 Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
                                                                  unsigned threads) {
+  if (Status s = checkInputSet(paths); !s) return s.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
   std::vector<std::pair<std::string, uint64_t>> files;  // path, points to stream (all: UINT64_MAX)
   if (paths.size() > 1 && isCompleteTileSet(paths)) {

@@ -3,6 +3,8 @@
 // with the flag or file named; render and info take the tiles as the whole set.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <string>
 #include <vector>
 
@@ -258,6 +260,19 @@ TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   EXPECT_TRUE(readFile(dir.file("partial-off.png")) == readFile(dir.file("partial-on.png")));
+  // A review finding: a file or a tile given twice was read twice, a set too large with no word.
+  std::filesystem::copy_file(parts[1], dir.file("copy-of-1.ply"));
+  for (const char* stream : {"off", "on"}) {
+    SCOPED_TRACE(stream);
+    r = runDpoint({"info", parts[0], parts[1], parts[1], parts[2], parts[3], "--stream", stream});
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(parts[1] + ": given twice as an input"), std::string::npos) << r.err;
+    r = runDpoint({"render", parts[0], parts[1], dir.file("copy-of-1.ply"), parts[2], parts[3], "--stream", stream, "-o",
+                   dir.file("twice.png")});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(dir.file("copy-of-1.ply") + ": tile 1 again (also " + parts[1] + ")"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("twice.png")));
+  }
 }
 
 // A scheduler runs the tiles: GNU parallel (Debian `parallel`, installed by scripts/setup) runs 7
