@@ -123,9 +123,28 @@ Status readPlan(const JsonValue& json, const std::string& json_path, BenchRow& r
   return okStatus();
 }
 
+// A timed draw's picture and report: gone when the draw has been read, and on a stop (SIGINT,
+// SIGTERM) too, which the interrupt watcher deletes (a stopped bench had left them in the cache).
+struct ScratchFiles {
+  std::vector<std::string> paths;
+  explicit ScratchFiles(std::vector<std::string> p) : paths(std::move(p)) {
+    for (const std::string& path : paths) registerTemporaryFile(path);
+  }
+  ~ScratchFiles() {
+    for (const std::string& path : paths) {
+      std::error_code ec;
+      std::filesystem::remove(path, ec);
+      unregisterTemporaryFile(path);
+    }
+  }
+  ScratchFiles(const ScratchFiles&) = delete;
+  ScratchFiles& operator=(const ScratchFiles&) = delete;
+};
+
 // The timed draw: a fresh `dpoint render` process without the probe, exactly what a user runs.
 Status timeMode(const BenchCase& c, const Prepared& p, const BenchOptions& options, BenchRow& row) {
   const std::string json_path = cachePath(options, "timed-draw.json");
+  const ScratchFiles scratch({json_path, cachePath(options, "timed-draw.png")});
   std::vector<std::string> args = {"render", cachePath(options, cacheFileName(c)), "-o", cachePath(options, "timed-draw.png"),
                                    "--mode", std::string(modeName(row.mode)), "--backend",
                                    report::backendText(row.backend), "--device", options.device,
@@ -295,7 +314,6 @@ Result<BenchRun> runBench(const VulkanContext& context, const BenchOptions& opti
       }
     }
   }
-  for (const char* scratch : {"timed-draw.json", "timed-draw.png"}) std::filesystem::remove(cachePath(options, scratch), ec);
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return run;
 }

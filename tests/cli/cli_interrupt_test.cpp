@@ -109,7 +109,8 @@ class BackgroundRun {
 
 // Files a stopped run left: everything in `dir` but its inputs (`keep`) and the test's stderr
 // capture, except that a bench's finished datasets in its cache stay (whole files, made to be
-// reused); a named temporary (PATH.dpoint-…) anywhere counts.
+// reused); a named temporary (PATH.dpoint-…) anywhere counts, and so do a timed draw's picture and
+// report in the cache (timed-draw.*, which a stopped bench had left).
 std::vector<std::string> leftBehind(const TempDir& dir, const std::vector<std::string>& keep) {
   std::vector<std::string> left;
   std::error_code ec;
@@ -117,7 +118,8 @@ std::vector<std::string> leftBehind(const TempDir& dir, const std::vector<std::s
     const std::string name = e.path().filename();
     if (e.is_directory() || name == "stderr.txt" || std::find(keep.begin(), keep.end(), name) != keep.end()) continue;
     const bool cached = e.path().parent_path() == dir.file("cache");
-    if (!cached || name.find(".dpoint-") != std::string::npos) left.push_back(e.path().string());
+    if (!cached || name.find(".dpoint-") != std::string::npos || name.rfind("timed-draw", 0) == 0)
+      left.push_back(e.path().string());
   }
   return left;
 }
