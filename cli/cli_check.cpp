@@ -65,4 +65,20 @@ CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open
   });
 }
 
+CLI::Validator positiveNumber(const std::string& flag) {
+  return check([flag](const std::string& value) {
+    double v = 0.0;
+    if (!CLI::detail::lexical_cast(value, v)) return std::string();  // CLI11's conversion error follows
+    return v > 0.0 ? std::string() : flag + " " + value + ": must be a number above 0";
+  });
+}
+
+CLI::Validator nonNegativeNumber(const std::string& flag) {
+  return check([flag](const std::string& value) {
+    double v = 0.0;
+    if (!CLI::detail::lexical_cast(value, v)) return std::string();  // CLI11's conversion error follows
+    return v >= 0.0 ? std::string() : flag + " " + value + ": must be 0 or more";
+  });
+}
+
 }  // namespace dpoint

@@ -40,5 +40,9 @@ CLI::Option* addChoiceOption(CLI::App& command, const std::string& flag, std::st
 // "FLAG must be in RANGE UNIT, got VALUE" (the value in shortest form). Text that is no number is
 // left to CLI11's conversion.
 CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open_low, const std::string& unit);
+// "FLAG VALUE: must be a number above 0" / "…: must be 0 or more", in place of CLI11's
+// PositiveNumber and NonNegativeNumber, whose refusal printed the largest double in 309 digits.
+CLI::Validator positiveNumber(const std::string& flag);
+CLI::Validator nonNegativeNumber(const std::string& flag);
 
 }  // namespace dpoint

@@ -27,6 +27,7 @@ Result<std::vector<double>> parseNumbers(const std::string& flag, const std::str
     if (*p != ',') break;
     ++p;
   }
+  if (min_count == 1 && max_count == 1) return Error{flag + " " + text + ": must be a finite number", ExitCode::kUsage};
   std::string count = min_count == max_count ? std::to_string(min_count)
                                              : std::to_string(min_count) + " to " + std::to_string(max_count);
   return Error{flag + " " + text + ": must be " + count + " comma-separated finite numbers", ExitCode::kUsage};

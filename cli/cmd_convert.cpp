@@ -148,7 +148,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
                   "Default: a LAS input's own scale and offset (the same point records), else per axis the "
                   "data's own decimal step (0.01 for centimetres), else the finest the extent fits")
       ->default_str("auto")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber("--las-scale"));
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   addColumnsOption(*cmd, o->columns);
   addSampleOptions(*cmd, o->sample);
@@ -158,7 +158,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--drop", o->dimensions.drop, "Drop these dimensions (comma-separated names; all: every one)");
   auto* scene = cmd->add_option("--scene", o->scene,
                                 "glTF: walk scene N instead of the default scene (else scene 0)")
-                    ->check(CLI::NonNegativeNumber);
+                    ->check(nonNegativeNumber("--scene"));
   cmd->add_flag("--all-scenes", o->all_scenes, "glTF: walk every scene, one after the other")->excludes(scene);
   cmd->add_flag("--unique", o->unique,
                 "Drop points whose x,y,z exactly equal an earlier point's (first kept; triangles renumbered, "
@@ -171,7 +171,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
   cmd->add_option("--max-points", o->max_points,
                   "Refuse (exit 4) input of more than N points, before --unique; glTF and LAS are refused before "
                   "allocating")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber("--max-points"));
   cmd->add_option("--order", o->order, std::string(kPointOrderHelp) + "; applied last, after --unique")
       ->default_val("input");
   addMaxMemoryOption(*cmd, o->max_memory);

@@ -273,7 +273,7 @@ void addEscapeGridOptions(CLI::App* cmd, int& resolution, int& max_iter, double&
   cmd->add_option("--resolution", resolution, "Grid points per axis (2..65536)")->default_val(200);
   cmd->add_option("--max-iter", max_iter, "Iterations before a point counts as inside")->default_val(default_iter);
   cmd->add_option("--level", level, "Surface level on the escape-count field (default: max_iter/4)")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber("--level"));
   cmd->add_option("--bounds", bounds, "Grid range LO,HI on every axis")->default_val("-1.5,1.5");
   cmd->add_option("--frame", frame, "Coordinates: native (the fractal's own) or seed (grid corner at 0, as the original study's Python generator had it from skimage)")
       ->check(oneOf("--frame", {"native", "seed"}))

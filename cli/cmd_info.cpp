@@ -63,7 +63,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   cmd->add_flag("--allow-nonfinite", o->allow_nonfinite, "Accept nan/inf coordinates instead of rejecting them");
   // The same choice of glTF scene as `dpoint convert`.
   auto* scene = cmd->add_option("--scene", o->scene, "glTF: describe scene N instead of the default scene (else scene 0)")
-                    ->check(CLI::NonNegativeNumber);
+                    ->check(nonNegativeNumber("--scene"));
   cmd->add_flag("--all-scenes", o->all_scenes, "glTF: every scene, one after the other, as one set")->excludes(scene);
   addColumnsOption(*cmd, o->columns);
   addCameraOptions(*cmd, o->camera);

@@ -229,6 +229,14 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"info", in, "--sample", "0"}, "--sample 0: must be a number from 1 to 100000000 (dpoint info --help)"},
       {{"devices", "extra"}, "devices: unexpected argument 'extra' (dpoint devices --help)"},
       {{"bench", "--frames", "0", "--out", dir.file("b")}, "--frames 0: must be at least 1"},
+      // A review finding: CLI11's positive and non-negative checks printed the largest double in
+      // 309 digits; a lone number's refusal spoke of "1 comma-separated finite numbers".
+      {{"generate", "mandelbulb", "--level", "0", "-o", ply}, "--level 0: must be a number above 0"},
+      {{"convert", in, "-o", ply, "--max-points", "0"}, "--max-points 0: must be a number above 0"},
+      {{"convert", in, "-o", dir.file("o.las"), "--las-scale", "-1"}, "--las-scale -1: must be a number above 0"},
+      {{"info", in, "--scene", "-1"}, "--scene -1: must be 0 or more"},
+      {{"render", in, "-o", png, "--point-size", "nan"}, "--point-size nan: must be a finite number"},
+      {{"render", in, "-o", png, "--json", in}, "--json " + in + ": is also an input (" + in + ")"},
       // The other classes: bad input (2), no usable device (3), a resource limit (4).
       {{"convert", missing, "-o", ply}, missing + ": file not found", 2},
       {{"info", bad}, bad + ":2: 2 columns, expected 3 (x,y,z)", 2},
