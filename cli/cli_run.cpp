@@ -117,7 +117,20 @@ int reportError(const Error& error) {
     if (!t_capture->error) t_capture->error = error;
     return static_cast<int>(error.code);
   }
-  std::fprintf(stderr, "dpoint: error: %s\n", error.message.c_str());
+  // One line whatever the message quotes (a file name with a newline in it): control bytes as \xNN.
+  std::string line;
+  for (const char c : error.message) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      static const char kHex[] = "0123456789abcdef";
+      line += "\\x";
+      line += kHex[u >> 4];
+      line += kHex[u & 15];
+    } else {
+      line += c;
+    }
+  }
+  std::fprintf(stderr, "dpoint: error: %s\n", line.c_str());
   noteErrorReported();
   return static_cast<int>(error.code);
 }

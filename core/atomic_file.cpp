@@ -15,8 +15,11 @@ namespace {
 
 constexpr size_t kBufferSize = 1 << 20;
 
+// A full disk or quota is a resource limit (exit 4), as --max-memory's refusal is; any other
+// failure to write is the output's fault (exit 2).
 Error ioError(const std::string& what, const std::string& path, int err) {
-  return Error{what + " '" + path + "': " + std::strerror(err), ExitCode::kBadInput};
+  return Error{what + " '" + path + "': " + std::strerror(err),
+               err == ENOSPC || err == EDQUOT ? ExitCode::kResourceLimit : ExitCode::kBadInput};
 }
 
 std::string folderOf(const std::string& path) {

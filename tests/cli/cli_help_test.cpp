@@ -239,6 +239,8 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"render", in, "-o", png, "--json", in}, "--json " + in + ": is also an input (" + in + ")"},
       // The other classes: bad input (2), no usable device (3), a resource limit (4).
       {{"convert", missing, "-o", ply}, missing + ": file not found", 2},
+      // One line whatever a file's name holds (a review finding: a newline split the error).
+      {{"info", dir.file("new\nline.ply")}, dir.file("new\\x0aline.ply") + ": file not found", 2},
       {{"info", bad}, bad + ":2: 2 columns, expected 3 (x,y,z)", 2},
       {{"merge", in, "-o", ply}, in + ": not a PLY file (no 'ply' line at the start)", 2},
       {{"render", in, "-o", png, "--device", "99"}, "--device 99: only ", 3},
