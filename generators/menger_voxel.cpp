@@ -20,7 +20,7 @@ Result<PointSet> generateMengerVoxel(const MengerParams& params) {
   if (params.resolution < 2 || params.resolution > kMaxResolution)
     return Error{"--resolution " + std::to_string(params.resolution) + ": must be 2.." + std::to_string(kMaxResolution) +
                      " for the voxel method",
-                 params.resolution < 2 ? ExitCode::kUsage : ExitCode::kResourceLimit};
+                 ExitCode::kUsage};  // a range, as every generator's --resolution (--max-memory bounds the rest)
   const uint64_t res = static_cast<uint64_t>(params.resolution);
   const uint64_t padded = res + 2;
   // The field (one double a sample) dominates; the mesh is at most a few vertices per boundary voxel.

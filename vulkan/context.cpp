@@ -188,7 +188,7 @@ Result<uint32_t> chooseDevice(const std::vector<DeviceFacts>& all, const std::st
   }
   char* end = nullptr;
   unsigned long index = std::strtoul(wanted.c_str(), &end, 10);
-  if (wanted.empty() || *end != '\0')
+  if (wanted.empty() || *end != '\0' || wanted[0] < '0' || wanted[0] > '9')  // strtoul takes "-1" as ULONG_MAX
     return Error{"--device " + wanted + ": must be auto, cpu or a device index", ExitCode::kUsage};
   if (index >= all.size())
     return Error{"--device " + wanted + ": only " + std::to_string(all.size()) + " device(s) (dpoint devices lists them)",
