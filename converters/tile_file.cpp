@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -129,6 +130,8 @@ Result<ParsedHeader> parseHeader(const std::string& path, std::FILE* file) {
 }
 
 Result<ParsedHeader> openTile(const std::string& path, File& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return Error{path + ": is a folder, not a tile (.ply)"};
   file.reset(std::fopen(path.c_str(), "rb"));
   if (!file) return Error{path + ": cannot open: " + std::strerror(errno)};
   Result<ParsedHeader> h = parseHeader(path, file.get());

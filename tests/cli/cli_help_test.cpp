@@ -246,6 +246,7 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"info", dir.file("new\nline.ply")}, dir.file("new\\x0aline.ply") + ": file not found", 2},
       {{"info", bad}, bad + ":2: 2 columns, expected 3 (x,y,z)", 2},
       {{"merge", in, "-o", ply}, in + ": not a PLY file (no 'ply' line at the start)", 2},
+      {{"merge", dir.path(), "-o", ply}, dir.path() + ": is a folder, not a tile (.ply)", 2},
       {{"render", in, "-o", png, "--device", "99"}, "--device 99: only ", 3},
       {{"info", in, "--max-memory", "1"}, in + ": 1 lines needs about 24 bytes, more than the limit of 1 bytes", 4},
       {{"render", in, "-o", png, "--max-memory", "1"}, "a 1024x768 picture needs about 24.0 MiB, more than the limit", 4},
