@@ -8,6 +8,7 @@
 #include "converters/point_io.h"
 #include "core/interrupt.h"
 #include "core/json_writer.h"
+#include "core/memory.h"
 #include "core/text.h"
 #include "viewer/copc_view.h"
 #include "viewer/modes.h"
@@ -197,6 +198,10 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
         const Result<FileFormat> format = formatOf(path);
         return format && (*format == FileFormat::kLas || *format == FileFormat::kLaz);
       });
+    if (Status s = checkMemory(name + ": streaming " + std::to_string((*stream)->count()) + " points a block at a time",
+                               streamHostBytes((*stream)->count()), inputs.max_memory);
+        !s)
+      return s.error();
     return describeStream(**stream, name, streamed, progress);
   }
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};

@@ -4,6 +4,7 @@
 // point's clip position.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -131,6 +132,10 @@ struct PointStream {
 };
 // Points per block of a stream: with two blocks on the host (36 B a point), about 1.2 GB.
 inline constexpr uint64_t kStreamBlockPoints = uint64_t{1} << 24;
+// What a stream holds on the host, whatever the file's size: two blocks of at most
+// kStreamBlockPoints points (positions and colours, 36 B a point), the least --max-memory that
+// streaming `count` points takes (render and info refuse a smaller one, exit 4).
+inline uint64_t streamHostBytes(uint64_t count) { return 2 * std::min(count, kStreamBlockPoints) * 36; }
 
 // renderPoints for a stream (no probe: it keeps every point's clip position). The same picture
 // and the same errors as renderPoints of the whole set; the stream's errors end it.

@@ -244,6 +244,29 @@ TEST(CliRender, theReportIsNeitherTheInputNorThePicture) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("m.png")));
 }
 
+// A review finding: --max-memory did not bound a streamed set (50M let a 5M-point stream peak at
+// 590 MB). Streaming holds two blocks of points; a limit below them is refused before any work.
+TEST(CliRender, aStreamRespectsMaxMemory) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "20000", "--quiet", "-o", dir.file("r.ply")}).exit_code, 0);
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"render", dir.file("r.ply"), "-o", dir.file("r.png"), "--width", "64", "--height", "48"},
+        std::vector<std::string>{"info", dir.file("r.ply")}}) {
+    SCOPED_TRACE(args[0]);
+    std::vector<std::string> tight = args;
+    tight.insert(tight.end(), {"--stream", "on", "--max-memory", "1M"});
+    const test::CommandResult refused = runDpoint(tight);
+    EXPECT_EQ(refused.exit_code, 4);
+    EXPECT_NE(refused.err.find(dir.file("r.ply") + ": streaming 20000 points a block at a time needs about 1.4 MiB"),
+              std::string::npos)
+        << refused.err;
+    std::vector<std::string> enough = args;
+    enough.insert(enough.end(), {"--stream", "on", "--max-memory", "64M", "-q"});
+    EXPECT_EQ(runDpoint(enough).exit_code, 0);
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir.file("r.png")));
+}
+
 // The default is --mode auto: it names the mode it took, its bound and the runner-up, and the
 // measured error stays within the bound. fp32 at the Earth's radius would not.
 TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {
