@@ -117,11 +117,15 @@ int reportError(const Error& error) {
     if (!t_capture->error) t_capture->error = error;
     return static_cast<int>(error.code);
   }
-  // One line whatever the message quotes (a file name with a newline in it): control bytes as \xNN.
+  // One line whatever the message quotes (a file name with a newline in it): control bytes as \xNN,
+  // but for the indented lines of a message made so (bench's quote of a failed child's errors).
   std::string line;
-  for (const char c : error.message) {
+  for (size_t i = 0; i < error.message.size(); ++i) {
+    const char c = error.message[i];
     const unsigned char u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u == 0x7f) {
+    if (c == '\n' && error.message.compare(i + 1, 2, "  ") == 0) {
+      line += c;
+    } else if (u < 0x20 || u == 0x7f) {
       static const char kHex[] = "0123456789abcdef";
       line += "\\x";
       line += kHex[u >> 4];

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <malloc.h>
 #include <sys/resource.h>
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "core/ordered_write.h"
@@ -68,6 +70,13 @@ TEST(OrderedWrite, andParallelForFinishOnTheThreadsTheSystemGives) {
   GTEST_SKIP() << "a sanitizer's runtime maps memory of its own";
 #else
   TempDir dir;
+  // The chunks' allocations come from a heap grown beforehand, so that the limit below refuses
+  // thread stacks only: one malloc arena (a thread's own reserves 64 MB of address space), small
+  // blocks from the heap, and 32 MB of it kept once freed.
+  mallopt(M_ARENA_MAX, 1);
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  std::free(std::malloc(32 << 20));
   rlimit old{};
   ASSERT_EQ(getrlimit(RLIMIT_AS, &old), 0);
   for (size_t room : {size_t{40} << 20, size_t{2} << 20}) {
