@@ -19,9 +19,14 @@ Result<InputFile> InputFile::open(const std::string& path) {
     return Error{path + ": " + std::strerror(errno)};
   }
   if (S_ISDIR(st.st_mode)) return Error{path + ": is a folder, not a file"};
+  // Its size is what every reader goes by: a pipe or a device has none (it had read as "empty file").
+  if (!S_ISREG(st.st_mode))
+    return Error{path + ": not a regular file (" +
+                 (S_ISFIFO(st.st_mode) ? "a pipe" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "a socket") +
+                 "): dpoint reads files whose size it can see; copy it into one first"};
   int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return Error{path + ": cannot open: " + std::strerror(errno)};
-  return InputFile(path, fd, S_ISREG(st.st_mode) ? static_cast<uint64_t>(st.st_size) : 0);
+  return InputFile(path, fd, static_cast<uint64_t>(st.st_size));
 }
 
 InputFile InputFile::fromMemory(std::string name, std::string_view bytes) {

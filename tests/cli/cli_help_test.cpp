@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -179,6 +180,8 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
   test::writeFile(dir.file("bad.csv"), "x,y,z\n1,2\n");
   const std::string in = dir.file("one.csv"), png = dir.file("o.png"), ply = dir.file("o.ply");
   const std::string bad = dir.file("bad.csv"), missing = dir.file("missing.csv");
+  TempDir links;  // a device behind a point file's name (a review finding: it read as "empty file")
+  std::filesystem::create_symlink("/dev/zero", links.file("zero.ply"));
   struct Case {
     std::vector<std::string> args;
     std::string message;
@@ -242,6 +245,7 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"render", in, "-o", png, "--json", in}, "--json " + in + ": is also an input (" + in + ")"},
       // The other classes: bad input (2), no usable device (3), a resource limit (4).
       {{"convert", missing, "-o", ply}, missing + ": file not found", 2},
+      {{"info", links.file("zero.ply")}, links.file("zero.ply") + ": not a regular file (a device)", 2},
       // One line whatever a file's name holds (a review finding: a newline split the error).
       {{"info", dir.file("new\nline.ply")}, dir.file("new\\x0aline.ply") + ": file not found", 2},
       {{"info", bad}, bad + ":2: 2 columns, expected 3 (x,y,z)", 2},
