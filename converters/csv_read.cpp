@@ -420,6 +420,9 @@ struct Header {
   uint64_t data_offset = 0;     // byte where the first data line (or blank lines) start
   uint64_t first_data_line = 0; // 0-based line index at data_offset
   bool named = false;           // the first line is a header: with no rows after it, the set is empty
+  // A PTS file's count line: the points it declares, and its 1-based line number.
+  std::optional<uint64_t> declared;
+  uint64_t declared_line = 0;
 };
 
 // Finds the layout from the first non-blank line, skipping a UTF-8 BOM.
@@ -432,6 +435,8 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
   uint64_t line = 0;
   const bool pts = isPtsPath(file.path());
   bool counted = false;
+  std::optional<uint64_t> declared;
+  uint64_t declared_line = 0;
   while (true) {
     if (pos >= head.size()) {
       if (head.size() == file.size()) return Error{file.path() + ": no data rows"};
@@ -459,11 +464,15 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
     const char separator = separatorOf(text);
     if (pts && !counted && isCountLine(fields)) {  // the count line before a PTS file's rows
       counted = true;
+      uint64_t n = 0;
+      if (parseDecimalU64(fields[0], n)) declared = n, declared_line = line + 1;
       pos = nl + 1;
       ++line;
       continue;
     }
     Header header;
+    header.declared = declared;
+    header.declared_line = declared_line;
     if (!columns.empty()) {  // --columns: the names are given; a header line is passed over
       Result<Layout> layout = layoutFromNames(columns, separator);
       if (!layout) return layout.error();
@@ -708,6 +717,11 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   narrowDimensions(points.dimensions, threads);
   if (Status s = integerColors(path, points, layout.integer_colors); !s) return s.error();
   if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
+  // A count line that is not the rows' count: a file cut short, or rows added (a review finding:
+  // a count of 1e11 over one row was taken without a word).
+  if (header.declared && *header.declared != points.size())
+    return Error{path + ":" + std::to_string(header.declared_line) + ": the count line declares " +
+                 std::to_string(*header.declared) + " points, but the file has " + std::to_string(points.size()) + " rows"};
   if (options.progress) options.progress->finish();
   return points;
 }

@@ -235,6 +235,9 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
   EXPECT_EQ(pts->color_full_scale, 255);
   writeFile(dir.file("five.pts"), "2\n1 2 3 4 5\n");
   expectReadError(dir.file("five.pts"), {"five.pts:2: 5 columns in a PTS row", "7 (x y z intensity r g b)"});
+  // A count line that is not the rows' count (a file cut short, or one with rows added) is refused.
+  writeFile(dir.file("short.pts"), "\n100000000000\n1 2 3\n");
+  expectReadError(dir.file("short.pts"), {"short.pts:2: the count line declares 100000000000 points, but the file has 1 rows"});
   CsvReadOptions quality;
   quality.columns = {"z", "x", "y", "quality"};
   Result<PointSet> named = readCsv(dir.file("columns_in_another_order.txt"), quality);
