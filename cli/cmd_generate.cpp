@@ -35,18 +35,18 @@ Status parseBounds(const std::string& text, double& lo, double& hi) {
   return okStatus();
 }
 
-// Which file is at a path (device, inode, change time), to tell a file a run made from one that
-// was there before it; none where nothing is.
+// Which file is at a path (device, inode, whether a regular file), to tell a file a run made
+// (renamed into place: a new inode) from one that was there before it; none where nothing is.
 struct FileIdentity {
   dev_t device;
   ino_t inode;
-  int64_t changed_ns;
+  bool regular;
   bool operator==(const FileIdentity&) const = default;
 };
 std::optional<FileIdentity> fileIdentity(const std::string& path) {
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return std::nullopt;
-  return FileIdentity{st.st_dev, st.st_ino, int64_t{st.st_ctim.tv_sec} * 1000000000 + st.st_ctim.tv_nsec};
+  if (::lstat(path.c_str(), &st) != 0) return std::nullopt;
+  return FileIdentity{st.st_dev, st.st_ino, S_ISREG(st.st_mode)};
 }
 
 template <typename Params, typename Options>
@@ -118,8 +118,11 @@ void registerKind(RunCommand& run, const std::shared_ptr<Options>& o, CLI::App* 
       if (Status s = checkNotAlso("--grid-out", grid, {{"-o", o->out.output}}); !s) return reportError(s.error());
       const std::optional<FileIdentity> before = fileIdentity(grid);
       const int code = inner();
+      // Only a regular file the run put there (never a pipe, a device or the link to one, which a
+      // grid is written through, as a review found /dev/stdout removed so).
       if (code != 0)
-        if (const std::optional<FileIdentity> now = fileIdentity(grid); now && now != before) std::remove(grid.c_str());
+        if (const std::optional<FileIdentity> now = fileIdentity(grid); now && now->regular && now != before)
+          std::remove(grid.c_str());
       return code;
     };
   });

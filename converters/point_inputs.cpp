@@ -1,10 +1,11 @@
 #include "converters/point_inputs.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cstring>
-#include <filesystem>
-#include <system_error>
+#include <tuple>
 
 #include "converters/las.h"
 #include "converters/ply.h"
@@ -28,12 +29,24 @@ bool isCompleteTileSet(const std::vector<std::string>& paths) {
 
 Status checkInputSet(const std::vector<std::string>& paths) {
   if (paths.size() < 2) return okStatus();
-  for (size_t i = 1; i < paths.size(); ++i)
-    for (size_t j = 0; j < i; ++j) {
-      std::error_code e;
-      if (paths[i] == paths[j] || std::filesystem::equivalent(paths[i], paths[j], e))
-        return Error{paths[i] + ": given twice as an input (also " + paths[j] + ")", ExitCode::kUsage};
-    }
+  // Each file once by (device, inode), sorted: not every pair compared (3000 inputs took 10.7 s).
+  struct Seen {
+    dev_t device;
+    ino_t inode;
+    size_t index;
+  };
+  std::vector<Seen> seen;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    struct stat st {};
+    if (::stat(paths[i].c_str(), &st) == 0) seen.push_back({st.st_dev, st.st_ino, i});  // else: its reader names it
+  }
+  std::sort(seen.begin(), seen.end(), [](const Seen& a, const Seen& b) {
+    return std::tie(a.device, a.inode, a.index) < std::tie(b.device, b.inode, b.index);
+  });
+  for (size_t k = 1; k < seen.size(); ++k)
+    if (seen[k].device == seen[k - 1].device && seen[k].inode == seen[k - 1].inode)
+      return Error{paths[seen[k].index] + ": given twice as an input (also " + paths[seen[k - 1].index] + ")",
+                   ExitCode::kUsage};
   if (!std::all_of(paths.begin(), paths.end(), [](const std::string& path) { return isTileFile(path); }))
     return okStatus();
   std::vector<std::string> given;  // by index, of the first file's count

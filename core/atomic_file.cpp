@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -89,29 +90,56 @@ Status checkFolder(const std::string& path, const std::string& folder) {
   return okStatus();
 }
 
-// A path that exists already: a folder is refused; a device or a pipe (not a regular file) is
-// opened for writing as it is (special_fd; -1 when the path is absent or a regular file, which is
-// replaced by rename).
-Status openIfSpecial(const std::string& path, int& special_fd) {
+// A path the process's own descriptors stand behind (/dev/stdout, /dev/fd/N, /proc/self/fd/N):
+// written where it leads, never replaced by a rename (which, for a redirect to a regular file,
+// had put a file in place of the /dev/stdout link and left the redirect empty).
+bool isDescriptorPath(const std::string& path) { return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0; }
+
+// Where a symbolic link leads, link after link (at most 40), stopping at a descriptor path: the
+// output is written there and the link stays (a rename had put a file in place of the link).
+std::string followLinks(const std::string& path) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  for (int hops = 0; hops < 40 && !isDescriptorPath(p.string()); ++hops) {
+    std::error_code ec;
+    if (!fs::is_symlink(p, ec) || ec) break;
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = to.is_absolute() ? to : p.parent_path() / to;
+  }
+  return p.string();
+}
+
+// A path that exists already: a folder is refused; a device or a pipe (not a regular file), or a
+// descriptor path, is opened for writing as it is (special_fd; -1 when the path is absent or a
+// regular file, which is replaced by rename). With `probed` (checkTarget) nothing is opened: it
+// says whether the path is such a target, and only the right to write it is checked (opening a
+// named pipe and closing it would end its reader, and the real open would then wait for ever).
+Status openIfSpecial(const std::string& path, int& special_fd, bool* probed = nullptr) {
   special_fd = -1;
+  if (probed) *probed = false;
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return okStatus();
+  if (::stat(path.c_str(), &st) != 0 || (S_ISREG(st.st_mode) && !isDescriptorPath(path))) return okStatus();
   if (S_ISDIR(st.st_mode)) return Error{"cannot write '" + path + "': it is a folder"};
-  special_fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (probed) {
+    if (::access(path.c_str(), W_OK) != 0) return ioError("cannot open", path, errno);
+    *probed = true;
+    return okStatus();
+  }
+  special_fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (S_ISREG(st.st_mode) ? O_TRUNC : 0));
   if (special_fd < 0) return ioError("cannot open", path, errno);
   return okStatus();
 }
 
 }  // namespace
 
-Status AtomicFile::checkTarget(const std::string& path) {
-  if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
+Status AtomicFile::checkTarget(const std::string& given) {
+  if (given.empty()) return Error{"output path is empty", ExitCode::kUsage};
+  const std::string path = followLinks(given);
   int special = -1;
-  if (Status s = openIfSpecial(path, special); !s) return s;
-  if (special >= 0) {
-    ::close(special);
-    return okStatus();
-  }
+  bool probed = false;
+  if (Status s = openIfSpecial(path, special, &probed); !s) return s;
+  if (probed) return okStatus();
   const std::string folder = folderOf(path);
   if (Status s = checkFolder(path, folder); !s) return s;
   if (Status s = checkName(path, folder); !s) return s;
@@ -130,8 +158,9 @@ Status AtomicFile::checkTarget(const std::string& path) {
   return okStatus();
 }
 
-Result<AtomicFile> AtomicFile::create(const std::string& path) {
-  if (path.empty()) return Error{"output path is empty", ExitCode::kUsage};
+Result<AtomicFile> AtomicFile::create(const std::string& given) {
+  if (given.empty()) return Error{"output path is empty", ExitCode::kUsage};
+  const std::string path = followLinks(given);
   if (interrupted()) return interruptedError();
   int special = -1;
   if (Status s = openIfSpecial(path, special); !s) return s.error();
@@ -236,7 +265,9 @@ Status AtomicFile::commit() {
   if (named.empty()) {
     // Give the unnamed file a temporary name, then rename it over the target (rename is atomic;
     // linkat alone would fail on an existing target).
-    named = tempBeside(path_, ".dpoint-" + std::to_string(::getpid()));
+    // Unique in the process too: two outputs with long names share the folder's short form.
+    static std::atomic<uint64_t> commits{0};
+    named = tempBeside(path_, ".dpoint-" + std::to_string(::getpid()) + "-" + std::to_string(commits++));
     ::unlink(named.c_str());
     registerTemporaryFile(named);
     const std::string proc = "/proc/self/fd/" + std::to_string(fd_);

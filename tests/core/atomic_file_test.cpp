@@ -1,4 +1,8 @@
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 #include "core/atomic_file.h"
 #include "test_support.h"
@@ -75,6 +79,32 @@ TEST(AtomicFile, aNameUpToTheFoldersLongestIsWritten) {
   ASSERT_FALSE(long_name.ok());
   EXPECT_EQ(long_name.error().code, ExitCode::kUsage);
   EXPECT_NE(long_name.error().message.find("the file name is 256 bytes long, more than the 255"), std::string::npos);
+}
+
+// A review finding: an output named through a symbolic link replaced the link by a file (as root,
+// /dev/stdout redirected to a file was so replaced, and the file stayed empty). The link stays;
+// what it leads to is written, a regular file by rename beside it, a descriptor path directly.
+TEST(AtomicFile, aLinkIsWrittenThroughAndStays) {
+  TempDir dir;
+  test::writeFile(dir.file("target.txt"), "before");
+  std::filesystem::create_symlink("target.txt", dir.file("link.txt"));
+  Result<AtomicFile> f = AtomicFile::create(dir.file("link.txt"));
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  ASSERT_TRUE(f->write("after").ok());
+  ASSERT_TRUE(f->commit().ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(dir.file("link.txt")));
+  EXPECT_EQ(test::readFile(dir.file("target.txt")), "after");
+  // A link into /proc/self/fd: written where the descriptor leads, the link kept.
+  const int fd = ::open(dir.file("redirected.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ASSERT_GE(fd, 0);
+  std::filesystem::create_symlink("/proc/self/fd/" + std::to_string(fd), dir.file("out.txt"));
+  Result<AtomicFile> through = AtomicFile::create(dir.file("out.txt"));
+  ASSERT_TRUE(through.ok()) << through.error().message;
+  ASSERT_TRUE(through->write("picture").ok());
+  ASSERT_TRUE(through->commit().ok());
+  ::close(fd);
+  EXPECT_TRUE(std::filesystem::is_symlink(dir.file("out.txt")));
+  EXPECT_EQ(test::readFile(dir.file("redirected.txt")), "picture");
 }
 
 TEST(AtomicFile, writesDevicesDirectly) {
