@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "cli/version.h"
 #include "core/interrupt.h"
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -126,10 +127,7 @@ int reportError(const Error& error) {
     if (c == '\n' && error.message.compare(i + 1, 2, "  ") == 0) {
       line += c;
     } else if (u < 0x20 || u == 0x7f) {
-      static const char kHex[] = "0123456789abcdef";
-      line += "\\x";
-      line += kHex[u >> 4];
-      line += kHex[u & 15];
+      appendHexByte(line, u);
     } else {
       line += c;
     }

@@ -21,12 +21,20 @@ inline size_t utf8SequenceAt(std::string_view text, size_t i) {
   return n;
 }
 
+// A byte as \xNN (two lower-case hex digits), how a message shows a control byte or a byte that is
+// not UTF-8 so that it stays one printable line.
+inline void appendHexByte(std::string& out, unsigned char c) {
+  static const char kHex[] = "0123456789abcdef";
+  out += "\\x";
+  out += kHex[c >> 4];
+  out += kHex[c & 15];
+}
+
 // Bad input text quoted in a one-line error message: at most 40 characters, UTF-8 letters as they
 // are (a header `Höhe` reads as Höhe), control bytes and bytes that are not UTF-8 written as \xNN
 // so the message stays one printable line.
 inline std::string printableExcerpt(std::string_view text) {
   constexpr size_t kMax = 40;
-  static const char kHex[] = "0123456789abcdef";
   std::string out;
   for (size_t i = 0; i < text.size() && out.size() < kMax; ++i) {
     const unsigned char c = static_cast<unsigned char>(text[i]);
@@ -36,9 +44,7 @@ inline std::string printableExcerpt(std::string_view text) {
     } else if (c >= 0x20 && c < 0x7f) {
       out += static_cast<char>(c);
     } else {
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
+      appendHexByte(out, c);
     }
   }
   if (text.size() > kMax) out += "...";
@@ -59,7 +65,6 @@ inline std::string quotedExcerpt(std::string_view text) {
 // data URI tinygltf quotes whole: 2.7 MB of base64 in one error line) cut to its first 80 and its
 // length. `empty` when nothing is left.
 inline std::string oneLineText(std::string_view text, std::string_view empty) {
-  static const char kHex[] = "0123456789abcdef";
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.remove_suffix(1);
   std::string out;
   for (size_t i = 0; i < text.size(); ++i) {
@@ -69,9 +74,7 @@ inline std::string oneLineText(std::string_view text, std::string_view empty) {
     } else if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') {
       continue;
     } else if (c < 0x20 || c == 0x7f) {
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
+      appendHexByte(out, c);
     } else {
       out += static_cast<char>(c);
     }

@@ -345,15 +345,15 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     camera.eye = target + distance * direction;
     // Coordinates near the largest double: the fitted eye lies past it (a review finding, which was
     // blamed on --view-center/--view-width though neither was given).
-    if (!isFinite(camera.eye) && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's data aside)
+    auto too_large = [&](const std::string& why) {
       return Error{"the data's coordinates (up to " + shortest(std::max(maxAbs(bounds.min), maxAbs(bounds.max))) +
-                       ") are too large to view in perspective: its eye would lie past the largest double; try --ortho",
+                       ") are too large " + why + "; try --ortho",
                    ExitCode::kBadInput};
+    };
+    if (!isFinite(camera.eye) && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's data aside)
+      return too_large("to view in perspective: its eye would lie past the largest double");
     if (camera.eye == target) {
-      if (!spec.view_width && !spec.view_center)
-        return Error{"the data's coordinates (up to " + shortest(std::max(maxAbs(bounds.min), maxAbs(bounds.max))) +
-                         ") are too large for a perspective eye that does not round onto them; try --ortho",
-                     ExitCode::kBadInput};
+      if (!spec.view_width && !spec.view_center) return too_large("for a perspective eye that does not round onto them");
       return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +
                    "; the window is too small for coordinates this large");
     }

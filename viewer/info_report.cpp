@@ -1,6 +1,5 @@
 #include "viewer/info_report.h"
 
-#include <algorithm>
 #include <array>
 #include <limits>
 #include <utility>
@@ -8,7 +7,6 @@
 #include "converters/point_io.h"
 #include "core/interrupt.h"
 #include "core/json_writer.h"
-#include "core/memory.h"
 #include "core/text.h"
 #include "viewer/copc_view.h"
 #include "viewer/modes.h"
@@ -114,17 +112,24 @@ std::string adviceJson(const InfoAdvice& advice) {
          "\",\n  \"error_bound_px\": " + bounds.line();
 }
 
-// The view `dpoint render` takes for the same camera options (render_job's viewCameras): with z up
-// and no eye, fitted from the z-up three-quarter direction; a set in memory framed by its outline
-// (boundsWithOutline), as render frames it, so the two print the same bounds.
-Result<Camera> renderView(const InfoOptions& options, const Bounds& bounds, bool z_up) {
-  CameraSpec spec = options.camera;
-  if (z_up && !spec.eye) {
-    const RenderView view = viewsFor(1, true).front();
-    spec.fit_direction = view.direction;
-    spec.fit_up = view.up;
-  }
-  return makeCamera(spec, bounds);
+// The request render would make of info's view options: its camera, --up-axis and, for auto's
+// rule for surveys, the input paths (render_job's zUpFor and viewCameras then decide as for render).
+RenderRequest viewRequest(const InfoOptions& options, const std::vector<std::string>& inputs = {}) {
+  RenderRequest request;
+  request.camera = options.camera;
+  request.up_axis = !options.z_up ? UpAxis::kAuto : *options.z_up ? UpAxis::kZ : UpAxis::kY;
+  request.inputs = inputs;
+  return request;
+}
+
+// The one view `dpoint render` draws for the same options (a set in memory framed by its outline,
+// boundsWithOutline, as render frames it), so the two print the same bounds.
+Result<Camera> renderView(const InfoOptions& options, const Bounds& bounds, bool data_z_up) {
+  const RenderRequest request = viewRequest(options);
+  const bool z_up = zUpFor(request, data_z_up);
+  Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(1, z_up), bounds, z_up);
+  if (!cameras) return cameras.error();
+  return cameras->front();
 }
 
 }  // namespace
@@ -143,7 +148,7 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
     report.dimensions.push_back(range);
   }
   if (points.size() > 0) {
-    Result<Camera> camera = renderView(options, boundsWithOutline(points), options.z_up.value_or(points.z_up));
+    Result<Camera> camera = renderView(options, boundsWithOutline(points), points.z_up);
     if (!camera) return camera.error();
     report.advice = InfoAdvice{*camera, predictErrorBounds(points, *camera, {}, options.tolerance_px)};
   }
@@ -179,7 +184,7 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   if (boxes.count > 0) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
-    Result<Camera> camera = renderView(options, boundsOfBoxes(boxes), options.z_up.value_or(false));
+    Result<Camera> camera = renderView(options, boundsOfBoxes(boxes), false);
     if (!camera) return camera.error();
     report.advice = InfoAdvice{*camera, predictBoxBounds(boxes, *camera, {}, options.tolerance_px)};
   }
@@ -193,15 +198,8 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   const std::string name = describeInputs(inputs.paths);
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
-    if (!streamed.z_up)
-      streamed.z_up = std::all_of(inputs.paths.begin(), inputs.paths.end(), [](const std::string& path) {
-        const Result<FileFormat> format = formatOf(path);
-        return format && (*format == FileFormat::kLas || *format == FileFormat::kLaz);
-      });
-    if (Status s = checkMemory(name + ": streaming " + std::to_string((*stream)->count()) + " points a block at a time",
-                               streamHostBytes((*stream)->count()), inputs.max_memory);
-        !s)
-      return s.error();
+    streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
+    if (Status s = checkStreamMemory(name, (*stream)->count(), inputs.max_memory); !s) return s.error();
     return describeStream(**stream, name, streamed, progress);
   }
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "core/interrupt.h"
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
 #include "vulkan/buffers.h"
@@ -752,6 +753,11 @@ double percentileOf(std::vector<double> values, double p) {
   std::sort(values.begin(), values.end());
   size_t rank = static_cast<size_t>(std::ceil(p / 100.0 * static_cast<double>(values.size())));
   return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
+}
+
+Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit) {
+  return checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time",
+                     2 * std::min(count, kStreamBlockPoints) * 36, limit);
 }
 
 }  // namespace dpoint

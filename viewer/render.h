@@ -4,7 +4,6 @@
 // point's clip position.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -132,10 +131,10 @@ struct PointStream {
 };
 // Points per block of a stream: with two blocks on the host (36 B a point), about 1.2 GB.
 inline constexpr uint64_t kStreamBlockPoints = uint64_t{1} << 24;
-// What a stream holds on the host, whatever the file's size: two blocks of at most
-// kStreamBlockPoints points (positions and colours, 36 B a point), the least --max-memory that
-// streaming `count` points takes (render and info refuse a smaller one, exit 4).
-inline uint64_t streamHostBytes(uint64_t count) { return 2 * std::min(count, kStreamBlockPoints) * 36; }
+// --max-memory against what a stream of `count` points holds on the host, whatever the file's size:
+// two blocks of at most kStreamBlockPoints points (positions and colours, 36 B a point). render and
+// info refuse a smaller limit (exit 4, `name` and the need in the message).
+Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit);
 
 // renderPoints for a stream (no probe: it keeps every point's clip position). The same picture
 // and the same errors as renderPoints of the whole set; the stream's errors end it.

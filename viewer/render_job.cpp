@@ -287,10 +287,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (ply) {
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
     // --max-memory bounds a stream too (a review finding: 50M let a 5M-point stream peak at 590 MB).
-    if (Status s = checkMemory(inputs + ": streaming " + std::to_string(ply->count()) + " points a block at a time",
-                               streamHostBytes(ply->count()), request.max_memory);
-        !s)
-      return s.error();
+    if (Status s = checkStreamMemory(inputs, ply->count(), request.max_memory); !s) return s.error();
     set.count = ply->count(), set.has_colors = ply->hasColors();
     if (request.color == RenderColor::kAuto || request.color == RenderColor::kRgb) {
       if (Status s = readPreview(*ply, set); !s) return s.error();
