@@ -126,6 +126,7 @@ struct EdlPush {
 };
 inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
 inline constexpr uint32_t kShadeBindings = 7;  // shaders/render/shade_common.glsl
+inline constexpr uint32_t kShadeSets = 2;      // the hole filling's first pass, and its second and the rest
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
 inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
 // The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):

@@ -5,7 +5,8 @@
 //   0 depth (float, 0 = nothing drawn), 1 picture (RGBA8 as a uint): what the backend drew;
 //   3 log distance (kEmpty where nothing is drawn);
 //   4 log distance, 2 picture: after hole filling; 2 is then shaded where it is (each pixel by
-//     the invocation that reads it) and read back;
+//     the invocation that reads it) and read back. The filling runs twice: the second time with
+//     a descriptor set that swaps 1 with 2 and 3 with 4, which every later pass uses too;
 //   5 (sum, count) of the log distances along each row's window, 6 their mean over the square
 //     (kEmpty where nothing is drawn).
 // 0, 1 and 2 are the picture's rows; 3, 4, 5 and 6 have a margin of pc.margin pixels all round,
@@ -23,7 +24,7 @@ layout(push_constant) uniform Push {
   int edl_axis;          // eye-dome neighbours: (±edl_axis, 0), (0, ±edl_axis) and (±edl_diagonal, ±edl_diagonal)
   int edl_diagonal;
   float fill_threshold;  // hole filling: how much nearer (log2 eye distance) a surrounding pixel must stand
-  uint axis;             // smooth.comp: 0 rows, 1 columns
+  uint axis;             // smooth.comp: 0 rows, 1 columns; fill.comp: 0 the first pass, 1 the second
 } pc;
 
 #include "log_distance.glsl"

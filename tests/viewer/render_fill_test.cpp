@@ -194,6 +194,37 @@ TEST(RenderFill, fillingHidesTheBackSurfaceSeenThroughTheGaps) {
   EXPECT_EQ(blue, 0u) << "of 160 x 160 pixels inside the front plane";
 }
 
+// The same two planes with 30% of the front one's points missing (chosen by a hash of their
+// place): the holes meet in clusters, each open along several directions for more than the
+// filling's reach, and the first filling left the middle of a cluster showing the blue plane (76
+// px here); the smoothing spread each such spot over its square, and eye-dome lighting outlined
+// the square (936 px under 216 of 255 red, on a plane of 232-248). The second filling closes them
+// (fill.comp).
+TEST(RenderFill, fillingClosesClustersOfHoles) {
+  PointSet both = planeWithHole(0.1, {1, 0, 0}, false);
+  size_t kept = 0;
+  for (size_t k = 0; k < both.size(); ++k) {
+    const size_t i = k / 100, j = k % 100;
+    if ((i * 7919 + j * 104729 + i * j * 31) % 100 < 30) continue;
+    both.positions[kept] = both.positions[k];
+    both.colors[kept++] = both.colors[k];
+  }
+  both.positions.resize(kept);
+  both.colors.resize(kept);
+  const PointSet back = planeWithHole(0.0, {0, 0, 1}, false);
+  both.positions.insert(both.positions.end(), back.positions.begin(), back.positions.end());
+  both.colors.insert(both.colors.end(), back.colors.begin(), back.colors.end());
+  const Rendered r = renderDefault(both, "holed-planes", fromAbove(1.5));
+  size_t blue = 0, dark = 0;
+  for (uint32_t y = 120; y < 280; ++y)
+    for (uint32_t x = 120; x < 280; ++x) {
+      blue += (r.rgb(x, y) >> 16) > 0;
+      dark += (r.rgb(x, y) & 0xffu) < 216;  // the plane's red is 248 here, shaded by its slight tilt
+    }
+  EXPECT_EQ(blue, 0u) << "of 160 x 160 pixels inside the front plane, at " << r.point_size << " px";
+  EXPECT_EQ(dark, 0u) << "squares outlined around the spots of blue";
+}
+
 // A glTF mesh whose vertices lie far apart on screen (a CAD part: BoxTextured's 24 vertices, the
 // 2CylinderEngine's flat faces of long triangles) is drawn as points sampled on its surface: closed,
 // within the picture with a margin (no drawn pixel in the outer 2-pixel frame). As vertices, the box
