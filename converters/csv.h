@@ -89,8 +89,9 @@ struct CsvLayout {
 // error mid-way) leaves nothing at the path (AtomicFile).
 class CsvRowWriter {
  public:
-  // Checks options.decimals, creates the output and writes the header. `rows`: the expected
-  // count, for options.progress only.
+  // Checks options.decimals, creates the output and writes the header. `rows`: the count to come,
+  // for options.progress and for the free-space check (AtomicFile::checkSpace: at least two bytes
+  // a value), so never more than will be written.
   static Result<CsvRowWriter> create(const std::string& path, CsvLayout layout, const CsvWriteOptions& options,
                                      uint64_t rows = 0);
 

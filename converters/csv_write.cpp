@@ -159,7 +159,11 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
   if (!file) return file.error();
   layout.separator = csvSeparatorFor(path);
   CsvRowWriter writer(std::move(*file), layout, options);
-  if (Status s = writer.file_.write(RowFormatter(layout, options.decimals, options.at_scale).header()); !s) return s.error();
+  const std::string header = RowFormatter(layout, options.decimals, options.at_scale).header();
+  // At least a digit and a separator a value: refused at once where the disk cannot hold even that.
+  const uint64_t values = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0) + layout.dimensions.size();
+  if (Status s = writer.file_.checkSpace(header.size() + rows * values * 2); !s) return s.error();
+  if (Status s = writer.file_.write(header); !s) return s.error();
   if (options.progress) options.progress->start("writing " + path, rows);
   return writer;
 }

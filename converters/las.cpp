@@ -1089,6 +1089,9 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     Result<AtomicFile> created = AtomicFile::create(path);
     if (!created) return created.error();
     file.emplace(std::move(*created));
+    // A LAS file's size; a LAZ file's is not known before its chunks are compressed.
+    if (!laz)
+      if (Status s = file->checkSpace(point_offset + uint64_t{n} * l.record_length); !s) return s;
   }
   const auto write = [&](const void* data, size_t size) -> Status {
     if (!file) {

@@ -140,12 +140,18 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 
   const std::string header = plyHeader(points, n, faces, colors, points.hasZ(), options);
 
-  if (options.progress) options.progress->start("writing " + path, n + faces);
   const std::vector<Dimension>& dims = points.dimensions.all();
   const bool attributes = !dims.empty();
   const size_t color_bytes = !colors ? 0 : float_colors ? 12 : word_colors ? 6 : 3;
   size_t vertex_bytes = sizeof(glm::dvec3) + color_bytes;
   for (const Dimension& d : dims) vertex_bytes += plyTypeName(d.type) ? dimTypeSize(d.type) : sizeof(double);
+  // The file's size in binary; in ASCII at least a digit and a separator a value: refused at once
+  // where the disk cannot hold it (a generated set's rows are made as they are written).
+  const uint64_t values = 3 + (colors ? 3 : 0) + dims.size();
+  const uint64_t least = header.size() + (ascii ? uint64_t{n} * values * 2 + uint64_t{faces} * 8
+                                                 : uint64_t{n} * vertex_bytes + uint64_t{faces} * kFaceBytes);
+  if (Status s = file->checkSpace(least); !s) return s;
+  if (options.progress) options.progress->start("writing " + path, n + faces);
 
   // Chunk 0 is the header, then the vertex rows and the face rows kRowsPerChunk at a time.
   const size_t vertex_chunks = (n + kRowsPerChunk - 1) / kRowsPerChunk;

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -10,6 +11,7 @@
 #include <filesystem>
 
 #include "core/interrupt.h"
+#include "core/memory.h"
 
 namespace dpoint {
 namespace {
@@ -243,6 +245,19 @@ Status AtomicFile::readAt(uint64_t offset, void* data, size_t size) {
     offset += static_cast<uint64_t>(n);
   }
   return okStatus();
+}
+
+Status AtomicFile::checkSpace(uint64_t bytes) const {
+  assert(fd_ >= 0 && !committed_);
+  struct statvfs fs;
+  if (direct_ || ::fstatvfs(fd_, &fs) != 0 || fs.f_frsize == 0) return okStatus();
+  const uint64_t blocks = ::geteuid() == 0 ? fs.f_bfree : fs.f_bavail;
+  const uint64_t taken = bytesWritten();
+  const uint64_t free = blocks > UINT64_MAX / fs.f_frsize ? UINT64_MAX : blocks * fs.f_frsize;
+  if (bytes <= taken || bytes - taken <= free) return okStatus();
+  return Error{"cannot write '" + path_ + "': it takes " + formatBytes(bytes) + ", and the file system holding '" +
+                   folderOf(path_) + "' has " + formatBytes(free) + " free",
+               ExitCode::kResourceLimit};
 }
 
 Status AtomicFile::resize(uint64_t size) {

@@ -35,6 +35,14 @@ class AtomicFile {
   AtomicFile(const AtomicFile&) = delete;
   ~AtomicFile();  // discards the output unless commit() succeeded
 
+  // Fails (exit 4, a resource limit, the message naming the path, both sizes and the folder) when
+  // the file system holding the output has fewer than `bytes` free for this process (root may use
+  // the blocks kept for it): called by a writer that knows its file's size, or a lower bound of it,
+  // before it makes or writes anything, so that a file too large for the disk is refused at once
+  // and does not first fill the disk. The bytes already written count as taken; a pipe or device
+  // passes. A file system that cannot say passes too.
+  Status checkSpace(uint64_t bytes) const;
+
   // Buffered append. Errors (disk full) are reported here or at commit.
   Status write(const void* data, size_t size);
   Status write(std::string_view text) { return write(text.data(), text.size()); }

@@ -182,6 +182,25 @@ TEST(CliGenerate, anOrderOfMoreThan2To32PointsIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("big.ply")));
 }
 
+// A file larger than the disk: refused before any row is made (random2d's rows are made as they are
+// written into a .ply), naming what it takes and what is free, exit 4, nothing left: 2^40 points
+// are 24 TiB. Run under a file-size limit of 1 MiB, so that a writer without the check stops there
+// (SIGXFSZ) instead of filling the disk. (Into other formats the points are held first, and
+// --max-memory refuses so many.)
+TEST(CliGenerate, aFileLargerThanTheDiskIsRefusedBeforeAnyWork) {
+  TempDir dir;
+  for (const char* name : {"big.ply"}) {
+    const test::CommandResult r = test::runCommand(
+        {"/bin/sh", "-c", std::string("ulimit -f 2048; exec \"$0\" \"$@\""), DPOINT_EXE, "generate", "random2d",
+         "--count", "1099511627776", "-o", dir.file(name)},
+        std::chrono::seconds(120));
+    EXPECT_EQ(r.exit_code, static_cast<int>(ExitCode::kResourceLimit)) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("cannot write '" + dir.file(name) + "': it takes "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" free"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file(name))) << name;
+  }
+}
+
 TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {
   TempDir dir;
   for (const char* threads : {"1", "2"}) {

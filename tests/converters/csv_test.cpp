@@ -483,6 +483,19 @@ TEST(Csv, rowWriterInPiecesEqualsWriteCsv) {
         }
 }
 
+// Rows to come that cannot fit the disk even at two bytes a value: refused at create, exit 4,
+// nothing written (AtomicFile::checkSpace).
+TEST(Csv, rowWriterRefusesMoreRowsThanTheDiskHolds) {
+  TempDir dir;
+  Result<CsvRowWriter> big =
+      CsvRowWriter::create(dir.file("big.csv"), CsvLayout{}, CsvWriteOptions{-1, 1, nullptr}, uint64_t{1} << 60);
+  ASSERT_FALSE(big);
+  EXPECT_EQ(big.error().code, ExitCode::kResourceLimit);
+  EXPECT_NE(big.error().message.find("free"), std::string::npos) << big.error().message;
+  EXPECT_TRUE(dir.entries().empty());
+  EXPECT_TRUE(CsvRowWriter::create(dir.file("small.csv"), CsvLayout{}, CsvWriteOptions{-1, 1, nullptr}, 1000));
+}
+
 TEST(Csv, rowWriterWithoutCommitLeavesNothing) {
   TempDir dir;
   PointSet set = setFromDoubles(hardDoubles(3 * 200000), false);

@@ -35,6 +35,26 @@ TEST(AtomicFile, discardedWithoutCommitLeavesNothing) {
   EXPECT_EQ(test::readFile(dir.file("out.txt")), "previous");
 }
 
+// More bytes than the file system has free: a resource limit naming the path and the folder; what
+// fits, and a device (nothing to fill), pass.
+TEST(AtomicFile, checkSpaceRefusesMoreThanTheDiskHolds) {
+  TempDir dir;
+  Result<AtomicFile> f = AtomicFile::create(dir.file("out.bin"));
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  EXPECT_TRUE(f->checkSpace(4096).ok());
+  const Status huge = f->checkSpace(uint64_t{1} << 62);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_EQ(huge.error().code, ExitCode::kResourceLimit);
+  std::string expected = "cannot write '";  // appended, not concatenated: GCC 12's -Wrestrict misfires on that
+  expected += dir.file("out.bin");
+  expected += "': it takes 4294967296.00 GiB";
+  EXPECT_NE(huge.error().message.find(expected), std::string::npos) << huge.error().message;
+  EXPECT_NE(huge.error().message.find("free"), std::string::npos);
+  Result<AtomicFile> device = AtomicFile::create("/dev/null");
+  ASSERT_TRUE(device.ok());
+  EXPECT_TRUE(device->checkSpace(uint64_t{1} << 62).ok());
+}
+
 TEST(AtomicFile, rejectsMissingFolderAndFolderTarget) {
   TempDir dir;
   Result<AtomicFile> missing = AtomicFile::create(dir.file("nope/out.txt"));
