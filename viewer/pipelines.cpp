@@ -11,6 +11,7 @@
 #include "shaders/points_round.frag.h"
 #include "shaders/edl.comp.h"
 #include "shaders/fill.comp.h"
+#include "shaders/fill_again.comp.h"
 #include "shaders/log.comp.h"
 #include "shaders/smooth.comp.h"
 #include "shaders/smooth_edl.comp.h"
@@ -334,6 +335,7 @@ Result<ShadePipeline> createShadePipeline(const VulkanContext& context, ShadeRad
   const Stage stages[] = {
       {&p.log, {kLogComp, sizeof(kLogComp)}, {}},
       {&p.fill, {kFillComp, sizeof(kFillComp)}, {u(radii.fill)}},
+      {&p.fill_again, {kFillAgainComp, sizeof(kFillAgainComp)}, {u(radii.fill)}},
       {radii.fused ? &p.smooth_edl : &p.smooth,
        radii.fused ? Spirv{kSmoothEdlComp, sizeof(kSmoothEdlComp)} : Spirv{kSmoothComp, sizeof(kSmoothComp)},
        {u(radii.smooth), u(radii.edl_axis), u(radii.edl_diagonal)}},
@@ -363,6 +365,7 @@ void destroyShadePipeline(const VulkanContext& context, ShadePipeline& p) {
   if (p.edl) vkDestroyPipeline(context.device, p.edl, nullptr);
   if (p.log) vkDestroyPipeline(context.device, p.log, nullptr);
   if (p.fill) vkDestroyPipeline(context.device, p.fill, nullptr);
+  if (p.fill_again) vkDestroyPipeline(context.device, p.fill_again, nullptr);
   if (p.smooth_edl) vkDestroyPipeline(context.device, p.smooth_edl, nullptr);
   if (p.smooth) vkDestroyPipeline(context.device, p.smooth, nullptr);
   if (p.layout) vkDestroyPipelineLayout(context.device, p.layout, nullptr);

@@ -105,11 +105,12 @@ void destroyComputePipelines(const VulkanContext& context, ComputePipelines& pip
 
 // Shading after either backend (shaders/render/shade_common.glsl): reads a float depth per pixel
 // (0 = nothing drawn) and the RGBA8 picture, writes the shaded picture (bindings 0, 1, 2); every
-// binding is a storage texel buffer.
+// binding is a storage texel buffer, the candidates' (7) also fill_again's indirect dispatch.
 struct ShadePipeline {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline log = VK_NULL_HANDLE, fill = VK_NULL_HANDLE;
+  VkPipeline fill_again = VK_NULL_HANDLE;  // over the first filling's candidates, by an indirect dispatch
   // Then either smooth_edl (ShadeRadii::fused) or smooth twice and edl.
   VkPipeline smooth_edl = VK_NULL_HANDLE, smooth = VK_NULL_HANDLE, edl = VK_NULL_HANDLE;
 };
@@ -125,8 +126,10 @@ struct EdlPush {
   uint32_t axis = 0;            // smooth.comp's pass: 0 rows, 1 columns
 };
 inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
-inline constexpr uint32_t kShadeBindings = 7;  // shaders/render/shade_common.glsl
-inline constexpr uint32_t kShadeSets = 2;      // the hole filling's first pass, and its second and the rest
+inline constexpr uint32_t kShadeBindings = 8;  // shaders/render/shade_common.glsl
+// shade_common.glsl's binding 7: a count, the (x, y, z) of fill_again.comp's indirect dispatch and
+// one pixel index a candidate; fill_again.comp's workgroup size.
+inline constexpr uint32_t kCandidateHeader = 4, kCandidateGroup = 64;
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
 inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
 // The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):

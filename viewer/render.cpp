@@ -265,7 +265,7 @@ Status createTargets(const VulkanContext& context, Resources& r, uint32_t width,
 }
 
 Status createDescriptors(const VulkanContext& context, Resources& r, bool pulled, bool probe) {
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.log ? kShadeSets : 0);
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + (r.shade.log ? 1 : 0);
   if (Status status = detail::createDescriptorPool(context, r, sets, 5); !status)
     return status;
   for (Chunk& chunk : r.chunks) {
@@ -404,10 +404,10 @@ Status timeFrames(const VulkanContext& context, Resources& r, const RenderOption
 Status readPicture(const VulkanContext& context, Resources& r, uint32_t width, uint32_t height, RenderResult& out) {
   Clock::time_point start = Clock::now();
   Status status = submitOnce(context, [&](VkCommandBuffer commands) {
-    if (r.picture.buffer) {
-      // packed RGBA8 rows: shaded in place, or the compute resolve's
+    if (const Buffer& rows = r.shaded.buffer ? r.shaded : r.picture; rows.buffer) {
+      // packed RGBA8 rows: the eye-dome pass's, or the compute resolve's
       VkBufferCopy copy{0, 0, VkDeviceSize{width} * height * 4};
-      vkCmdCopyBuffer(commands, r.picture.buffer, r.readback.buffer, 1, &copy);
+      vkCmdCopyBuffer(commands, rows.buffer, r.readback.buffer, 1, &copy);
     } else {
       VkBufferImageCopy copy{};
       copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -647,7 +647,7 @@ bool shadingFits(const DeviceFacts& f, uint32_t width, uint32_t height, const Re
 Status detail::createDescriptorPool(const VulkanContext& context, Resources& r, uint32_t sets, uint32_t storage_per_set) {
   VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets},
                                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage_per_set * sets},
-                                   {VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, kShadeSets * kShadeBindings}};
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, kShadeBindings}};
   VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   info.maxSets = sets;
   info.poolSizeCount = r.shade.log ? 3 : 2;

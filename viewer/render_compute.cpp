@@ -39,8 +39,8 @@ Status createComputeTargets(const VulkanContext& context, Resources& r, uint32_t
 
 Status createComputeDescriptors(const VulkanContext& context, Resources& r, bool probe) {
   // One splat set per chunk (camera, positions, batches, probe, visibility), the resolve set
-  // (visibility, colours, picture, depth) and with eye-dome lighting its sets.
-  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.log ? kShadeSets : 0);
+  // (visibility, colours, picture, depth) and with eye-dome lighting its set.
+  const uint32_t sets = static_cast<uint32_t>(r.chunks.size()) + 1 + (r.shade.log ? 1 : 0);
   if (Status status = createDescriptorPool(context, r, sets, 5); !status) return status;
   auto whole = [](const Buffer& b) { return VkDescriptorBufferInfo{b.buffer, 0, VK_WHOLE_SIZE}; };
   auto allocate = [&](VkDescriptorSetLayout layout, VkDescriptorSet& set) -> Status {

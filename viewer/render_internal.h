@@ -55,11 +55,12 @@ struct Resources {
     for (VkBufferView view : shade_views)
       if (view) vkDestroyBufferView(device, view, nullptr);
     destroyBuffer(context, depth_values);
-    destroyBuffer(context, filled_picture);
+    destroyBuffer(context, shaded);
     destroyBuffer(context, log_distance);
     destroyBuffer(context, filled_log);
     destroyBuffer(context, partial);
     destroyBuffer(context, smoothed);
+    destroyBuffer(context, candidates);
     destroyShadePipeline(context, shade);
     destroyImage(context, color);
     destroyImage(context, depth);
@@ -80,16 +81,15 @@ struct Resources {
   ComputePipelines compute;
   Buffer all_colors, visibility, picture;
   VkDescriptorSet resolve_set = VK_NULL_HANDLE;
-  // Shading: each pixel's depth (from the depth attachment or the resolve), (raster) the plain
-  // picture in `picture`, the picture and log distance after the first hole filling, the buffers
-  // between the passes, and a texel-buffer view of each (in binding order). The second filling
-  // writes back into `picture` and `log_distance` (shade_set_again: the same views, those two
-  // pairs of bindings swapped), where the picture is then shaded and read back.
+  // Shading: each pixel's depth (from the depth attachment or the resolve), the shaded picture the
+  // readback takes instead of the plain one, and (raster) `picture` holds the plain one; the
+  // buffers between the passes (with the second hole filling's candidates, also its indirect
+  // dispatch), and a texel-buffer view of each (in binding order).
   ShadePipeline shade;
   EdlPush shade_push;  // also where the compute backend's resolve writes the log distances
-  Buffer depth_values, filled_picture, log_distance, filled_log, partial, smoothed;
+  Buffer depth_values, shaded, log_distance, filled_log, partial, smoothed, candidates;
   VkBufferView shade_views[kShadeBindings] = {};
-  VkDescriptorSet shade_set = VK_NULL_HANDLE, shade_set_again = VK_NULL_HANDLE;
+  VkDescriptorSet shade_set = VK_NULL_HANDLE;
   // Round points: PushConstants' depth_scale and bulge for this camera (roundPointPush).
   float round_depth_scale = 0.0f, round_bulge = 0.0f;
 };
@@ -109,11 +109,10 @@ uint32_t chooseSplatEnds(Resources& r, const Camera& camera);
 void recordCompute(VkCommandBuffer commands, const Resources& r, VkPipeline splat, const RenderOptions& options,
                    uint32_t width, uint32_t height, bool timed);
 
-// Shading pieces (viewer/render_shade.cpp). createShadeTargets makes the depth (and for raster,
-// picture) buffers and those between the passes, margins set, once r.shade is made
-// (createShadePipeline); call before the descriptor pool is made, which holds kShadeSets more sets
-// for it. recordShade copies the raster attachments into buffers when `raster`, then shades; the
-// picture to read back is then `picture`, shaded.
+// Shading pieces (viewer/render_shade.cpp). createShadeTargets makes the depth, shaded (and for
+// raster, plain picture) buffers and those between the passes, margins set, once r.shade is made
+// (createShadePipeline); call before the descriptor pool is made, which holds one more set for it. recordShade copies the raster attachments into buffers when
+// `raster`, then shades; the picture to read back is then `shaded`.
 Status createShadeTargets(const VulkanContext& context, Resources& r, const Camera& camera, const RenderOptions& options,
                           bool raster);
 Status createShadeDescriptors(const VulkanContext& context, Resources& r);

@@ -2,8 +2,7 @@
 // attachments are copied into buffers, the compute backend's resolve writes them there itself;
 // then the passes of shaders/render/shade_common.glsl (log distance, hole filling, the depth
 // smoothed along rows and columns, eye-dome lighting; the last three in one pass where the radii
-// are small, ShadeRadii::fused) shade the picture, which is then read back. The hole filling runs
-// twice, the second time into the buffers the first read (its own descriptor set).
+// are small, ShadeRadii::fused) write the shaded picture that is read back.
 //
 // On lavapipe each pass over 786K pixels costs several ms before it reads anything, a
 // storage-buffer load is a loop over the SIMD lanes, a log2 costs more than a load, llvmpipe runs
@@ -37,14 +36,16 @@ Status createShadeTargets(const VulkanContext& context, Resources& r, const Came
     const char* what;
   };
   for (const Target& t : {Target{raster ? &r.depth_values : nullptr, bytes, in_usage, "depth per pixel"},
-                          Target{raster ? &r.picture : nullptr, bytes, in_usage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                 "picture"},
-                          Target{&r.filled_picture, bytes, texel, "picture after the first hole filling"},
+                          Target{raster ? &r.picture : nullptr, bytes, in_usage, "picture before shading"},
+                          Target{&r.shaded, bytes, texel | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "shaded picture"},
                           Target{&r.log_distance, padded, margin | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "log distance"},
                           Target{&r.filled_log, padded, margin, "log distance after hole filling"},
                           // Only between the separate passes of smooth.comp and edl.comp.
                           Target{radii.fused ? nullptr : &r.partial, 2 * padded, margin, "row sums of the log distance"},
-                          Target{radii.fused ? nullptr : &r.smoothed, padded, margin, "smoothed log distance"}}) {
+                          Target{radii.fused ? nullptr : &r.smoothed, padded, margin, "smoothed log distance"},
+                          Target{&r.candidates, (kCandidateHeader + VkDeviceSize{push.width} * push.height) * 4,
+                                 texel | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                 "second hole filling's candidates"}}) {
     if (!t.buffer) continue;
     Result<Buffer> buffer = createBuffer(context, t.bytes, t.usage, false, t.what);
     if (!buffer) return buffer.error();
@@ -60,15 +61,11 @@ Status createShadeTargets(const VulkanContext& context, Resources& r, const Came
 }
 
 Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
-  const VkDescriptorSetLayout layouts[kShadeSets] = {r.shade.set_layout, r.shade.set_layout};
   VkDescriptorSetAllocateInfo allocate = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   allocate.descriptorPool = r.descriptor_pool;
-  allocate.descriptorSetCount = kShadeSets;
-  allocate.pSetLayouts = layouts;
-  VkDescriptorSet sets[kShadeSets];
-  VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, sets));
-  r.shade_set = sets[0];
-  r.shade_set_again = sets[1];
+  allocate.descriptorSetCount = 1;
+  allocate.pSetLayouts = &r.shade.set_layout;
+  VK_TRY(vkAllocateDescriptorSets(context.device, &allocate, &r.shade_set));
   // In binding order (shaders/render/shade_common.glsl): one texel a pixel. After the compute
   // backend there is no depth to read, and the fused pass makes no row sums or means: their
   // bindings, which no pass then reads, show the log distances.
@@ -79,32 +76,24 @@ Status createShadeDescriptors(const VulkanContext& context, Resources& r) {
     const Buffer& buffer;
     VkFormat format;
   } views[kShadeBindings] = {{depth, VK_FORMAT_R32_SFLOAT},           {r.picture, VK_FORMAT_R32_UINT},
-                             {r.filled_picture, VK_FORMAT_R32_UINT}, {r.log_distance, VK_FORMAT_R32_SFLOAT},
+                             {r.shaded, VK_FORMAT_R32_UINT},        {r.log_distance, VK_FORMAT_R32_SFLOAT},
                              {r.filled_log, VK_FORMAT_R32_SFLOAT},  {partial, VK_FORMAT_R32G32_SFLOAT},
-                             {smoothed, VK_FORMAT_R32_SFLOAT}};
+                             {smoothed, VK_FORMAT_R32_SFLOAT},      {r.candidates, VK_FORMAT_R32_UINT}};
+  VkWriteDescriptorSet writes[kShadeBindings];
   for (uint32_t b = 0; b < kShadeBindings; ++b) {
     VkBufferViewCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
     info.buffer = views[b].buffer.buffer;
     info.format = views[b].format;
     info.range = VK_WHOLE_SIZE;
     VK_TRY(vkCreateBufferView(context.device, &info, nullptr, &r.shade_views[b]));
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = r.shade_set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
+    writes[b].pTexelBufferView = &r.shade_views[b];
   }
-  // The second set reads what the first filling wrote (bindings 4 and 2 as 3 and 1) and writes
-  // into what it read: the second filling's output is then the smoothing's input (4) and the
-  // picture shaded in place (2).
-  const uint32_t swapped[kShadeBindings] = {0, 2, 1, 4, 3, 5, 6};
-  VkWriteDescriptorSet writes[kShadeSets * kShadeBindings];
-  for (uint32_t s = 0; s < kShadeSets; ++s)
-    for (uint32_t b = 0; b < kShadeBindings; ++b) {
-      VkWriteDescriptorSet& w = writes[s * kShadeBindings + b];
-      w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-      w.dstSet = s == 0 ? r.shade_set : r.shade_set_again;
-      w.dstBinding = b;
-      w.descriptorCount = 1;
-      w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
-      w.pTexelBufferView = &r.shade_views[s == 0 ? b : swapped[b]];
-    }
-  vkUpdateDescriptorSets(context.device, kShadeSets * kShadeBindings, writes, 0, nullptr);
+  vkUpdateDescriptorSets(context.device, kShadeBindings, writes, 0, nullptr);
   return okStatus();
 }
 
@@ -169,10 +158,12 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
     barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
   }
-  const auto bind = [&](VkDescriptorSet set) {
-    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.layout, 0, 1, &set, 0, nullptr);
-  };
-  bind(r.shade_set);
+  // No candidates yet, and no workgroups for fill_again.comp: (count, x, y, z) = (0, 0, 1, 1).
+  const uint32_t no_candidates[kCandidateHeader] = {0, 0, 1, 1};
+  vkCmdUpdateBuffer(commands, r.candidates.buffer, 0, sizeof no_candidates, no_candidates);
+  barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.layout, 0, 1, &r.shade_set, 0, nullptr);
   // A pass of `group`² invocations a workgroup, each shading block_x × block_y pixels.
   auto pass = [&](VkPipeline pipeline, uint32_t axis, uint32_t group, uint32_t block_x, uint32_t block_y) {
     EdlPush p = push;
@@ -190,13 +181,20 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
     pass(r.shade.log, 0, kShadeGroupSize, 1, 1);
     between();
   }
-  // The hole filling, then again over its own output (fill.comp: the second time only what is
-  // now surrounded on every side, such as the middle of a junction of cracks).
   pass(r.shade.fill, 0, kShadeGroupSize, 1, 1);
-  between();
-  bind(r.shade_set_again);
-  pass(r.shade.fill, 1, kShadeGroupSize, 1, 1);
-  between();
+  // The second filling over the first one's candidates (fill_again.comp): into the picture and log
+  // distance the first read, then copied into what it wrote.
+  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+          VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
+  for (uint32_t step : {0u, 1u}) {
+    EdlPush p = push;
+    p.axis = step;
+    vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(p), &p);
+    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.fill_again);
+    vkCmdDispatchIndirect(commands, r.candidates.buffer, sizeof(uint32_t));
+    between();
+  }
   if (r.shade.smooth_edl) {
     pass(r.shade.smooth_edl, 0, kShadeStripGroupSize, kShadeStripWidth, kShadeStripHeight);
   } else {
