@@ -170,10 +170,11 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
     }
     return okStatus();
   };
-  static_assert(kStreamBlockPoints % kStreamedInfoBoxPoints == 0 && kStreamedInfoBoxPoints == kBoxPoints,
+  static_assert(kStreamBlockUnit % kStreamedInfoBoxPoints == 0 && kStreamedInfoBoxPoints == kBoxPoints,
                 "the first pass's boxes are the batch boxes");
   Result<StreamedInfo> info = computeStreamedInfo(stream.count(), stream.hasColors(), stream.faceCount(), read,
-                                                  kStreamBlockPoints, options.sample, options.threads);
+                                                  options.stream_block ? options.stream_block : kStreamBlockPoints,
+                                                  options.sample, options.threads);
   if (!info) return info.error();
   progress.finish();
   const BatchBoxes boxes{static_cast<size_t>(stream.count()), std::move(info->boxes)};
@@ -199,6 +200,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
     streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
+    streamed.stream_block = streamBlockPoints(inputs.max_memory);
     if (Status s = checkStreamMemory(name, (*stream)->count(), inputs.max_memory); !s) return s.error();
     return describeStream(**stream, name, streamed, progress);
   }

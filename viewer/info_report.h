@@ -34,6 +34,9 @@ struct InfoOptions {
   // --up-axis: the data's up for the fitted view, as `dpoint render` takes it; unset (auto): z for
   // a set that records z up (LAS, a PLY written from LAS) and, streamed, for .las/.laz input.
   std::optional<bool> z_up;
+  // A stream's points a block (describeStream; the report is the same whatever it is):
+  // streamBlockPoints of --max-memory; 0: viewer/render.h's kStreamBlockPoints.
+  uint64_t stream_block = 0;
 };
 
 // Every mode's predicted error for one view (viewer/precision.h).

@@ -755,9 +755,18 @@ double percentileOf(std::vector<double> values, double p) {
   return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
 }
 
+static_assert(kStreamBlockUnit % kBatchSize == 0 && kStreamBlockUnit % kBoxPoints == 0 &&
+              kMinStreamBlockPoints % kStreamBlockUnit == 0 && kStreamBlockPoints % kStreamBlockUnit == 0);
+
+uint64_t streamBlockPoints(uint64_t limit) {
+  if (limit == 0) limit = defaultMemoryLimit();
+  const uint64_t fits = limit / (2 * kStreamPointBytes) / kStreamBlockUnit * kStreamBlockUnit;
+  return std::clamp(fits, kMinStreamBlockPoints, kStreamBlockPoints);
+}
+
 Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit) {
   return checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time",
-                     2 * std::min(count, kStreamBlockPoints) * 36, limit);
+                     2 * std::min(count, streamBlockPoints(limit)) * kStreamPointBytes, limit);
 }
 
 }  // namespace dpoint

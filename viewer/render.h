@@ -129,11 +129,19 @@ struct PointStream {
   bool has_colors = false;
   std::function<Status(size_t first, size_t n, PointSet& block)> read;
 };
-// Points per block of a stream: with two blocks on the host (36 B a point), about 1.2 GB.
+// Points per block of a stream: with two blocks on the host (36 B a point), about 1.2 GB at most;
+// fewer where --max-memory is lower (streamBlockPoints), down to kMinStreamBlockPoints (75 MB).
+// Always a multiple of kStreamBlockUnit: whole batches of every mode, whole boxes (kBoxPoints).
 inline constexpr uint64_t kStreamBlockPoints = uint64_t{1} << 24;
+inline constexpr uint64_t kMinStreamBlockPoints = uint64_t{1} << 20;
+inline constexpr uint64_t kStreamBlockUnit = uint64_t{1} << 16;
+inline constexpr uint64_t kStreamPointBytes = 36;  // a point's position and colour in a block
+// The block a stream is read in under the memory limit `limit` (0: the default, half of RAM): two
+// blocks in at most the limit, the picture and the report are the same whatever the block.
+uint64_t streamBlockPoints(uint64_t limit);
 // --max-memory against what a stream of `count` points holds on the host, whatever the file's size:
-// two blocks of at most kStreamBlockPoints points (positions and colours, 36 B a point). render and
-// info refuse a smaller limit (exit 4, `name` and the need in the message).
+// two blocks (streamBlockPoints). render and info refuse a limit that does not hold two of the
+// smallest (exit 4, `name` and the need in the message).
 Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit);
 
 // renderPoints for a stream (no probe: it keeps every point's clip position). The same picture

@@ -64,6 +64,7 @@ struct LoadedSet {
   // The set in memory; null: a stream.
   const PointSet* points() const { return owned ? &*owned : shared.get(); }
   std::unique_ptr<PointInputStream> stream;
+  uint64_t stream_block = kStreamBlockPoints;  // a stream's points a block (streamBlockPoints)
   size_t count = 0;
   Bounds bounds;
   bool has_colors = false;
@@ -85,12 +86,12 @@ struct LoadedSet {
 
 // The bounds and planarity of a streamed set: one pass over it, a block at a time.
 // One pass over a streamed set, a block at a time, showing `what` as progress.
-Status forEachBlock(PointInputStream& ply, Progress& progress, const std::string& what,
+Status forEachBlock(PointInputStream& ply, uint64_t points, Progress& progress, const std::string& what,
                     const std::function<void(const PointSet& block)>& visit) {
   PointSet block;
   progress.start(what, ply.count());
-  for (uint64_t first = 0; first < ply.count(); first += kStreamBlockPoints) {
-    const uint64_t n = std::min(kStreamBlockPoints, ply.count() - first);
+  for (uint64_t first = 0; first < ply.count(); first += points) {
+    const uint64_t n = std::min(points, ply.count() - first);
     if (interrupted()) return interruptedError();
     if (Status status = ply.read(first, n, block); !status) return status;
     progress.advance(n);
@@ -114,10 +115,10 @@ void gatherBlock(const PointSet& block, Bounds& bounds, BatchBoxes& boxes, Spaci
 }
 
 // The bounds pass on its own: every block gathered.
-Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, Progress& progress,
+Result<Bounds> streamBounds(const std::string& path, PointInputStream& ply, uint64_t points, Progress& progress,
                             SpacingSampler& sampler, BatchBoxes& boxes) {
   Bounds bounds = noBounds();
-  Status status = forEachBlock(ply, progress, "bounds of " + path + " (points)",
+  Status status = forEachBlock(ply, points, progress, "bounds of " + path + " (points)",
                                [&](const PointSet& block) { gatherBlock(block, bounds, boxes, sampler); });
   if (!status) return status.error();
   return bounds;
@@ -173,8 +174,8 @@ Status streamOutlineAndSpacing(const RenderRequest& request, const std::string& 
   progress.start(what, reread);
   PointSet block;
   for (const auto& [from, end] : runs)
-    for (uint64_t first = from; first < end; first += kStreamBlockPoints) {
-      const uint64_t n = std::min(kStreamBlockPoints, end - first);
+    for (uint64_t first = from; first < end; first += set.stream_block) {
+      const uint64_t n = std::min(set.stream_block, end - first);
       if (interrupted()) return interruptedError();
       if (Status status = ply.read(first, n, block); !status) return status;
       progress.advance(n);
@@ -288,6 +289,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
     // --max-memory bounds a stream too (a review finding: 50M let a 5M-point stream peak at 590 MB).
     if (Status s = checkStreamMemory(inputs, ply->count(), request.max_memory); !s) return s.error();
+    set.stream_block = streamBlockPoints(request.max_memory);
     set.count = ply->count(), set.has_colors = ply->hasColors();
     if (request.color == RenderColor::kAuto || request.color == RenderColor::kRgb) {
       if (Status s = readPreview(*ply, set); !s) return s.error();
@@ -298,7 +300,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
       if (set.one_pass) return set;
     }
     SpacingSampler sampler(needsSpacing(request) ? kSpacingSamples : 0, request.threads);
-    Result<Bounds> bounds = streamBounds(inputs, *ply, progress, sampler, set.boxes);
+    Result<Bounds> bounds = streamBounds(inputs, *ply, set.stream_block, progress, sampler, set.boxes);
     if (!bounds) return bounds.error();
     set.bounds = *bounds;
     if (Status s = streamOutlineAndSpacing(request, inputs, *ply, sampler.finish(), set, progress); !s) return s.error();
@@ -307,7 +309,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
       const std::string& name = request.color_attribute;
       if (Status s = ply->streamDimension(name); !s) return Error{inputs + ": --color " + name + ": " + s.error().message, ExitCode::kUsage};
       AttributeSampler values(name, ply->dimensions().find(name)->type, ply->count());
-      Status s = forEachBlock(*ply, progress, "values of " + name + " in " + inputs + " (points)",
+      Status s = forEachBlock(*ply, set.stream_block, progress, "values of " + name + " in " + inputs + " (points)",
                               [&](const PointSet& block) { values.add(block.dimensions.all().front()); });
       if (!s) return s.error();
       set.coloring = values.finish();
@@ -516,6 +518,10 @@ RenderOptions renderOptionsFor(const RenderRequest& request, const LoadedSet& se
   options.probe = request.error;
   options.native_path = request.native_path;
   options.max_chunk_points = request.chunk_points;
+  // A stream's chunks are its blocks (renderStream), at most set.stream_block points.
+  if (set.stream)
+    options.max_chunk_points = options.max_chunk_points ? std::min(options.max_chunk_points, set.stream_block)
+                                                        : set.stream_block;
   options.shading = shadingFor(request, set.bounds);
   options.edl = request.edl;
   if (!request.shading && options.shading == Shading::kEdl && !shadingFits(facts, camera.width, camera.height, options)) {

@@ -267,6 +267,38 @@ TEST(CliRender, aStreamRespectsMaxMemory) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("r.png")));
 }
 
+// A stream whose two blocks of 16.7M points would pass --max-memory is read in smaller blocks
+// instead of being refused (2M points took 144 MB, over a limit of 100M): the same picture and the
+// same report as in one block, for a 2D set (one pass) and a 3D one (bounds, outline, spacing and
+// elevation passes first).
+TEST(CliRender, aStreamIsReadInBlocksThatFitMaxMemory) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "2000000", "-q", "-o", dir.file("flat.ply")}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "2000000", "--offset", "0,0,1", "-q", "-o",
+                       dir.file("raised.ply")}).exit_code, 0);
+  for (const char* name : {"flat", "raised"}) {
+    SCOPED_TRACE(name);
+    std::string pictures[2], reports[2];
+    for (int k = 0; k < 2; ++k) {
+      std::vector<std::string> render = {"render", dir.file(std::string(name) + ".ply"), "--stream", "on", "--width",
+                                         "256", "--height", "192", "-q", "-o", dir.file(std::to_string(k) + ".png")};
+      std::vector<std::string> info = {"info", dir.file(std::string(name) + ".ply"), "--stream", "on"};
+      if (k == 1) {
+        render.insert(render.end(), {"--max-memory", "100M"});
+        info.insert(info.end(), {"--max-memory", "100M"});
+      }
+      const test::CommandResult drawn = runDpoint(render);
+      ASSERT_EQ(drawn.exit_code, 0) << drawn.err;
+      pictures[k] = test::readFile(dir.file(std::to_string(k) + ".png"));
+      const test::CommandResult told = runDpoint(info);
+      ASSERT_EQ(told.exit_code, 0) << told.err;
+      reports[k] = told.out;
+    }
+    EXPECT_TRUE(pictures[0] == pictures[1]) << "blocks of 1441792 points draw what one block draws";
+    EXPECT_EQ(reports[0], reports[1]);
+  }
+}
+
 // The default is --mode auto: it names the mode it took, its bound and the runner-up, and the
 // measured error stays within the bound. fp32 at the Earth's radius would not.
 TEST(CliRender, autoIsTheDefaultAndTakesAModeWithinTheLimit) {

@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "core/memory.h"
 #include "test_support.h"
+#include "viewer/render.h"
 
 
 namespace dpoint {
@@ -28,6 +30,25 @@ Camera cameraFor(const RenderRequest& request, const Bounds& bounds) {
   Result<std::vector<Camera>> cameras = viewCameras(request, viewsFor(1, zUpFor(request)), bounds, zUpFor(request));
   EXPECT_TRUE(cameras.ok());
   return cameras.ok() ? cameras->front() : Camera{};
+}
+
+// A stream's block under --max-memory: two of them (36 B a point) within the limit, whole units of
+// 65536 points, from 2^20 to 2^24 points; 0 is the default limit's. A limit that holds not even two
+// of the smallest is refused for a set that large.
+TEST(StreamBlocks, sizedByMaxMemory) {
+  const uint64_t mib = uint64_t{1} << 20;
+  EXPECT_EQ(streamBlockPoints(1024 * mib), 227 * kStreamBlockUnit);  // 2^30 / 72 = 14.9M points
+  EXPECT_EQ(streamBlockPoints(100 * mib), 22 * kStreamBlockUnit);
+  EXPECT_EQ(streamBlockPoints(10 * mib), kMinStreamBlockPoints);
+  EXPECT_EQ(streamBlockPoints(uint64_t{1} << 40), kStreamBlockPoints);
+  EXPECT_EQ(streamBlockPoints(0), streamBlockPoints(defaultMemoryLimit()));
+  for (uint64_t limit : {80 * mib, 100 * mib, 1000 * mib, 1200 * mib})
+    EXPECT_LE(2 * streamBlockPoints(limit) * kStreamPointBytes, limit) << limit;
+  EXPECT_TRUE(checkStreamMemory("s.ply", 100000000, 100 * mib));
+  EXPECT_TRUE(checkStreamMemory("s.ply", 1000, mib));
+  const Status tight = checkStreamMemory("s.ply", 100000000, 50 * mib);
+  ASSERT_FALSE(tight);
+  EXPECT_EQ(tight.error().code, ExitCode::kResourceLimit);
 }
 
 TEST(RenderJob, pointSizeGrowsOnlyForSparse3dSets) {
