@@ -422,6 +422,7 @@ Status writeGlb(const std::string& path, const PointSet& points, GlbWriteReport*
 
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
+  if (Status s = file->checkSpace(total); !s) return s;
   for (uint32_t word : {kGlbMagic, kGlbVersion, static_cast<uint32_t>(total),
                         static_cast<uint32_t>(json->size()), kChunkJson}) {
     if (Status s = writeU32(*file, word); !s) return s;

@@ -64,7 +64,13 @@ class Writer {
                    std::to_string(n) + " points of " + std::to_string(row_bytes_) + " bytes are more: write binary"};
     Result<AtomicFile> file = AtomicFile::create(path_);
     if (!file) return file.error();
-    if (Status s = file->write(header()); !s) return s;
+    const std::string head = header();
+    // binary: the file's size; ASCII: at least a digit and a separator a value; compressed: unknown.
+    if (options_.encoding != PcdEncoding::kBinaryCompressed) {
+      const uint64_t row = options_.encoding == PcdEncoding::kBinary ? row_bytes_ : 2 * fields_.size();
+      if (Status s = file->checkSpace(head.size() + uint64_t{n} * row); !s) return s;
+    }
+    if (Status s = file->write(head); !s) return s;
     if (options_.progress) options_.progress->start("writing " + path_, n);
     Status body = options_.encoding == PcdEncoding::kAscii    ? writeAscii(*file)
                   : options_.encoding == PcdEncoding::kBinary ? writeBinary(*file)

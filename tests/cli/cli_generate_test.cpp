@@ -201,6 +201,33 @@ TEST(CliGenerate, aFileLargerThanTheDiskIsRefusedBeforeAnyWork) {
   }
 }
 
+// Each format whose size is known before writing, on a file system of 1 MiB (a tmpfs, where this
+// machine lets the test mount one): the Menger sponge's 3-21 MiB are refused at once, naming the
+// file, what it takes and what is free, and nothing is left; a small set is written.
+TEST(CliGenerate, eachFormatLargerThanTheDiskIsRefused) {
+  TempDir dir;
+  const std::string small = dir.file("small");
+  std::filesystem::create_directory(small);
+  if (test::runCommand({"/bin/mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", small}).exit_code != 0)
+    GTEST_SKIP() << "cannot mount a 1 MiB tmpfs here";
+  struct Unmount {
+    std::string path;
+    ~Unmount() { test::runCommand({"/bin/umount", path}); }
+  } unmount{small};
+  for (const char* name : {"m.ply", "m.las", "m.csv", "m.glb", "m.pcd", "m.xyz"}) {
+    const std::string path = small + "/" + name;
+    const test::CommandResult r = runDpoint({"generate", "menger", "-q", "-o", path});
+    EXPECT_EQ(r.exit_code, static_cast<int>(ExitCode::kResourceLimit)) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("cannot write '" + path + "': it takes "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("has 1.0 MiB free"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(path)) << name;
+  }
+  const test::CommandResult fits =
+      runDpoint({"generate", "sierpinski", "--level", "3", "-q", "-o", small + "/s.ply"});
+  EXPECT_EQ(fits.exit_code, 0) << fits.err;
+  EXPECT_TRUE(std::filesystem::exists(small + "/s.ply"));
+}
+
 TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {
   TempDir dir;
   for (const char* threads : {"1", "2"}) {
