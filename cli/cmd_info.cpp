@@ -73,9 +73,9 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,
                   "auto|on|off. on: read binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, twice, so a set\n"
-                  "larger than memory is described in about 1.2 GB (no float32 merge count, which needs every point\n"
-                  "at once, and error bounds from the box of every 1024 points); auto: for such input of\n"
-                  "more than 2^26 points")
+                  "larger than memory is described in about 1.2 GB, or in smaller blocks under a lower --max-memory (no\n"
+                  "float32 merge count, which needs every point at once, and error bounds from the box of every 1024\n"
+                  "points); auto: for such input of more than 2^26 points")
       ->check(oneOf("--stream", {"auto", "on", "off"}))
       ->default_val("auto");
   addCommonOptions(*cmd, o->common);

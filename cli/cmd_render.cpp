@@ -379,9 +379,10 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
                   "device has)");
   addChoiceOption(*cmd, "--stream", o->stream,
                   "auto|on|off. on: draw binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, so a set larger\n"
-                  "than memory renders in about 1.2 GB of host memory (two blocks of 16M points); auto: for such\n"
-                  "input of more than 2^26 points. A streamed set's bound is predicted from the box of each batch\n"
-                  "(docs/precision.md); it gets no --error, --order or --views 4",
+                  "than memory renders in about 1.2 GB of host memory (two blocks of 16M points; smaller ones under a\n"
+                  "lower --max-memory, the same picture); auto: for such input of more than 2^26 points. A streamed\n"
+                  "set's bound is predicted from the box of each batch (docs/precision.md); it gets no --error,\n"
+                  "--order or --views 4",
                   {"auto", "on", "off"});
   cmd->add_option("--views", o->views,
                   "1, or 4: one PNG of four labelled views (front, side, top, three-quarter), each framed by --fit\n"
