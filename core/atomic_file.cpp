@@ -250,7 +250,8 @@ Status AtomicFile::readAt(uint64_t offset, void* data, size_t size) {
 Status AtomicFile::checkSpace(uint64_t bytes) const {
   assert(fd_ >= 0 && !committed_);
   struct statvfs fs;
-  if (direct_ || ::fstatvfs(fd_, &fs) != 0 || fs.f_frsize == 0) return okStatus();
+  // A file system that reports no size (some FUSE and network ones) cannot say what is free.
+  if (direct_ || ::fstatvfs(fd_, &fs) != 0 || fs.f_frsize == 0 || fs.f_blocks == 0) return okStatus();
   const uint64_t blocks = ::geteuid() == 0 ? fs.f_bfree : fs.f_bavail;
   const uint64_t taken = bytesWritten();
   const uint64_t free = blocks > UINT64_MAX / fs.f_frsize ? UINT64_MAX : blocks * fs.f_frsize;

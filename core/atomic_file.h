@@ -40,7 +40,8 @@ class AtomicFile {
   // the blocks kept for it): called by a writer that knows its file's size, or a lower bound of it,
   // before it makes or writes anything, so that a file too large for the disk is refused at once
   // and does not first fill the disk. The bytes already written count as taken; a pipe or device
-  // passes. A file system that cannot say passes too.
+  // passes. A file system that cannot say (no size) passes too; one that compresses may be refused a
+  // file that would have fitted.
   Status checkSpace(uint64_t bytes) const;
 
   // Buffered append. Errors (disk full) are reported here or at commit.

@@ -758,15 +758,15 @@ double percentileOf(std::vector<double> values, double p) {
 static_assert(kStreamBlockUnit % kBatchSize == 0 && kStreamBlockUnit % kBoxPoints == 0 &&
               kMinStreamBlockPoints % kStreamBlockUnit == 0 && kStreamBlockPoints % kStreamBlockUnit == 0);
 
-uint64_t streamBlockPoints(uint64_t limit) {
+uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes) {
   if (limit == 0) limit = defaultMemoryLimit();
-  const uint64_t fits = limit / (2 * kStreamPointBytes) / kStreamBlockUnit * kStreamBlockUnit;
+  const uint64_t fits = limit / (2 * point_bytes) / kStreamBlockUnit * kStreamBlockUnit;
   return std::clamp(fits, kMinStreamBlockPoints, kStreamBlockPoints);
 }
 
-Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit) {
+Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit, uint64_t point_bytes) {
   return checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time",
-                     2 * std::min(count, streamBlockPoints(limit)) * kStreamPointBytes, limit);
+                     2 * std::min(count, streamBlockPoints(limit, point_bytes)) * point_bytes, limit);
 }
 
 }  // namespace dpoint

@@ -137,12 +137,16 @@ inline constexpr uint64_t kMinStreamBlockPoints = uint64_t{1} << 20;
 inline constexpr uint64_t kStreamBlockUnit = uint64_t{1} << 16;
 inline constexpr uint64_t kStreamPointBytes = 36;  // a point's position and colour in a block
 // The block a stream is read in under the memory limit `limit` (0: the default, half of RAM): two
-// blocks in at most the limit, the picture and the report are the same whatever the block.
-uint64_t streamBlockPoints(uint64_t limit);
+// blocks of `point_bytes` a point in at most the limit (more than kStreamPointBytes where a
+// dimension comes with each point: render --color NAME); the picture and the report are the same
+// whatever the block. Only these blocks are counted: the device's memory (the host's on lavapipe)
+// and the picture's buffers are not.
+uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes = kStreamPointBytes);
 // --max-memory against what a stream of `count` points holds on the host, whatever the file's size:
 // two blocks (streamBlockPoints). render and info refuse a limit that does not hold two of the
 // smallest (exit 4, `name` and the need in the message).
-Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit);
+Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit,
+                         uint64_t point_bytes = kStreamPointBytes);
 
 // renderPoints for a stream (no probe: it keeps every point's clip position). The same picture
 // and the same errors as renderPoints of the whole set; the stream's errors end it.

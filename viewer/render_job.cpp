@@ -288,8 +288,10 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (ply) {
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
     // --max-memory bounds a stream too (a review finding: 50M let a 5M-point stream peak at 590 MB).
-    if (Status s = checkStreamMemory(inputs, ply->count(), request.max_memory); !s) return s.error();
-    set.stream_block = streamBlockPoints(request.max_memory);
+    // --color NAME reads the dimension with every block: at most 8 bytes a point.
+    const uint64_t point_bytes = kStreamPointBytes + (request.color == RenderColor::kAttribute ? sizeof(double) : 0);
+    if (Status s = checkStreamMemory(inputs, ply->count(), request.max_memory, point_bytes); !s) return s.error();
+    set.stream_block = streamBlockPoints(request.max_memory, point_bytes);
     set.count = ply->count(), set.has_colors = ply->hasColors();
     if (request.color == RenderColor::kAuto || request.color == RenderColor::kRgb) {
       if (Status s = readPreview(*ply, set); !s) return s.error();

@@ -39,7 +39,8 @@ void main() {
   bool filled = pairs >= 2;
   if (!filled && sides >= 3) {
     uint at = imageAtomicAdd(candidates, kCandidateCount, 1u);
-    if (at % kCandidateGroup == 0u) imageAtomicAdd(candidates, kCandidateGroups, 1u);
+    if (at % kCandidateGroup == 0u && at / kCandidateGroup < kCandidateGroupsMost)
+      imageAtomicAdd(candidates, kCandidateGroups, 1u);
     imageStore(candidates, kCandidateList + int(at), uvec4(uint(i)));
   }
   imageStore(filled_log, padded, vec4(filled ? log_sum / float(covered) : here));

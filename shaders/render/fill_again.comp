@@ -12,8 +12,8 @@
 //   1: the results are copied into 4 and 2.
 // Over the candidates alone (fill.comp: a pixel left open with a nearer pixel in at least 3
 // directions; 6-8% of the pixels of the Mandelbulb's pictures), not the whole picture: on lavapipe
-// a second pass over every pixel cost as much as the first, 7-10 ms a frame at 1024x768 and 116 ms
-// at 4K, where this costs 1.5 and 41 ms.
+// a second pass over every pixel cost as much as the first, 10-13 ms a frame at 1024x768 and
+// 123-132 ms at 4K, where this costs 4-5 and 47-71 ms.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "shade_common.glsl"
@@ -29,9 +29,8 @@ layout(set = 0, binding = 7, r32ui) uniform readonly uimageBuffer candidates;
 layout(constant_id = 0) const int kFillRadius = 2;  // fill.comp's
 #include "fill_search.glsl"
 
-void main() {
-  uint n = gl_GlobalInvocationID.x;
-  if (n >= imageLoad(candidates, kCandidateCount).r) return;
+// Candidate n, by step pc.axis.
+void candidate(uint n) {
   int i = int(imageLoad(candidates, kCandidateList + int(n)).r);
   // The pixel's row and column without an integer division (a loop over the lanes on lavapipe), as
   // points_resolve.comp finds them: i / width in float is off by at most one row below 2^22 rows.
@@ -52,4 +51,10 @@ void main() {
   bool filled = pairs >= 3;
   imageStore(log_distance, padded, vec4(filled ? log_sum / float(covered) : here));
   imageStore(picture, i, uvec4(filled ? packUnorm4x8(vec4(color_sum / float(covered), 1.0)) : imageLoad(filled_picture, i).r));
+}
+
+void main() {
+  // At most kCandidateGroupsMost workgroups (fill.comp): each invocation takes every so many.
+  uint count = imageLoad(candidates, kCandidateCount).r, stride = gl_NumWorkGroups.x * kCandidateGroup;
+  [[dont_unroll]] for (uint n = gl_GlobalInvocationID.x; n < count; n += stride) candidate(n);
 }
