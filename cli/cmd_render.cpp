@@ -104,13 +104,14 @@ Result<RenderRequest> requestOf(const RenderCliOptions& o) {
   request.columns = columnsOf(o.columns);
   request.threads = o.common.threads;
   if (Status s = checkRenderRequest(request); !s) return s.error();
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const std::string& input : o.inputs) inputs.push_back({"an input", input});
   if (!o.json.empty()) {  // the report is no input and no picture: neither is replaced by it
     std::vector<std::pair<std::string, std::string>> others = {{"-o", o.output}};
-    for (const std::string& input : o.inputs) others.push_back({"an input", input});
+    others.insert(others.end(), inputs.begin(), inputs.end());
     if (Status s = checkNotAlso("--json", o.json, others); !s) return s.error();
   }
-  for (const std::string& input : o.inputs)
-    if (Status s = checkNotAlso("-o", o.output, {{"an input", input}}); !s) return s.error();
+  if (Status s = checkNotAlso("-o", o.output, inputs); !s) return s.error();
   Result<uint64_t> device_memory =
       o.max_device_memory.empty() ? uint64_t{0} : parseMemorySize("--max-device-memory", o.max_device_memory);
   if (!device_memory) return device_memory.error();

@@ -133,6 +133,23 @@ Status openIfSpecial(const std::string& path, int& special_fd, bool* probed = nu
   return okStatus();
 }
 
+// The temporary a regular target is written to, in its folder (which must exist, be a folder and
+// take the target's name): unnamed (O_TMPFILE), or, on a file system without that, named beside
+// the target (`named`, else left empty).
+Result<int> openTemporary(const std::string& path, std::string& named) {
+  const std::string folder = folderOf(path);
+  if (Status s = checkFolder(path, folder); !s) return s.error();
+  if (Status s = checkName(path, folder); !s) return s.error();
+  int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
+  if (fd >= 0) return fd;
+  if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
+    return ioError("cannot write into folder", folder, errno);
+  named = tempBeside(path, ".dpoint-XXXXXX");
+  fd = ::mkstemp(named.data());
+  if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
+  return fd;
+}
+
 }  // namespace
 
 Status AtomicFile::checkTarget(const std::string& given) {
@@ -142,21 +159,11 @@ Status AtomicFile::checkTarget(const std::string& given) {
   bool probed = false;
   if (Status s = openIfSpecial(path, special, &probed); !s) return s;
   if (probed) return okStatus();
-  const std::string folder = folderOf(path);
-  if (Status s = checkFolder(path, folder); !s) return s;
-  if (Status s = checkName(path, folder); !s) return s;
-  int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
-  if (fd >= 0) {
-    ::close(fd);
-    return okStatus();
-  }
-  if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
-    return ioError("cannot write into folder", folder, errno);
-  std::string temp = tempBeside(path, ".dpoint-XXXXXX");
-  fd = ::mkstemp(temp.data());
-  if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
-  ::close(fd);
-  ::unlink(temp.c_str());
+  std::string named;
+  Result<int> fd = openTemporary(path, named);
+  if (!fd) return fd.error();
+  ::close(*fd);
+  if (!named.empty()) ::unlink(named.c_str());
   return okStatus();
 }
 
@@ -167,22 +174,14 @@ Result<AtomicFile> AtomicFile::create(const std::string& given) {
   int special = -1;
   if (Status s = openIfSpecial(path, special); !s) return s.error();
   if (special >= 0) return AtomicFile(path, "", special, true);
-  const std::string folder = folderOf(path);
-  if (Status s = checkFolder(path, folder); !s) return s.error();
-  if (Status s = checkName(path, folder); !s) return s.error();
-
-  int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
-  if (fd >= 0) return AtomicFile(path, "", fd, false);
-  if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
-    return ioError("cannot write into folder", folder, errno);
-
-  // Fallback for file systems without O_TMPFILE: a named temporary beside the target.
-  std::string temp = tempBeside(path, ".dpoint-XXXXXX");
-  fd = ::mkstemp(temp.data());
-  if (fd < 0) return ioError("cannot create a temporary file beside", path, errno);
-  registerTemporaryFile(temp);  // removed by the interrupt watcher if it must end the process
-  ::fchmod(fd, 0644);
-  return AtomicFile(path, temp, fd, false);
+  std::string named;
+  Result<int> fd = openTemporary(path, named);
+  if (!fd) return fd.error();
+  if (!named.empty()) {
+    registerTemporaryFile(named);  // removed by the interrupt watcher if it must end the process
+    ::fchmod(*fd, 0644);
+  }
+  return AtomicFile(path, named, *fd, false);
 }
 
 // Every byte out, at the file's position (write) or from `offset` on (pwrite, offset ≥ 0), again

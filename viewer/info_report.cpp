@@ -200,8 +200,9 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
     streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
-    streamed.stream_block = streamBlockPoints(inputs.max_memory);
-    if (Status s = checkStreamMemory(name, (*stream)->count(), inputs.max_memory); !s) return s.error();
+    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory);
+    if (!block) return block.error();
+    streamed.stream_block = *block;
     return describeStream(**stream, name, streamed, progress);
   }
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};

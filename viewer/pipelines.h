@@ -127,9 +127,9 @@ struct EdlPush {
 };
 inline constexpr float kShadeEmpty = 3.0e38f;    // shade_common.glsl's kEmpty: the log distance where nothing is drawn
 inline constexpr uint32_t kShadeBindings = 8;  // shaders/render/shade_common.glsl
-// shade_common.glsl's binding 7: a count, the (x, y, z) of fill_again.comp's indirect dispatch and
-// one pixel index a candidate; fill_again.comp's workgroup size.
-inline constexpr uint32_t kCandidateHeader = 4, kCandidateGroup = 64;
+// shade_common.glsl's binding 7: a count and the (x, y, z) of fill_again.comp's indirect dispatch,
+// then one pixel index a candidate.
+inline constexpr uint32_t kCandidateHeader = 4;
 inline constexpr uint32_t kShadeGroupSize = 16;  // local_size_x and _y of the shading passes but smooth_edl.comp
 inline constexpr uint32_t kShadeStripGroupSize = 8;  // smooth_edl.comp's
 // The shading passes' radii for a point size and an eye-dome radius (compiled into the shaders):

@@ -143,10 +143,10 @@ inline constexpr uint64_t kStreamPointBytes = 36;  // a point's position and col
 // and the picture's buffers are not.
 uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes = kStreamPointBytes);
 // --max-memory against what a stream of `count` points holds on the host, whatever the file's size:
-// two blocks (streamBlockPoints). render and info refuse a limit that does not hold two of the
-// smallest (exit 4, `name` and the need in the message).
-Status checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit,
-                         uint64_t point_bytes = kStreamPointBytes);
+// two blocks (streamBlockPoints). The block to read in; render and info refuse a limit that does
+// not hold two of the smallest (exit 4, `name` and the need in the message).
+Result<uint64_t> checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit,
+                                   uint64_t point_bytes = kStreamPointBytes);
 
 // renderPoints for a stream (no probe: it keeps every point's clip position). The same picture
 // and the same errors as renderPoints of the whole set; the stream's errors end it.

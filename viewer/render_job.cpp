@@ -84,8 +84,7 @@ struct LoadedSet {
   MeshTexture texture;                 // a glTF mesh's base-colour textures, for its surface's colours
 };
 
-// The bounds and planarity of a streamed set: one pass over it, a block at a time.
-// One pass over a streamed set, a block at a time, showing `what` as progress.
+// One pass over a streamed set, `points` a block, showing `what` as progress.
 Status forEachBlock(PointInputStream& ply, uint64_t points, Progress& progress, const std::string& what,
                     const std::function<void(const PointSet& block)>& visit) {
   PointSet block;
@@ -290,8 +289,9 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     // --max-memory bounds a stream too (a review finding: 50M let a 5M-point stream peak at 590 MB).
     // --color NAME reads the dimension with every block: at most 8 bytes a point.
     const uint64_t point_bytes = kStreamPointBytes + (request.color == RenderColor::kAttribute ? sizeof(double) : 0);
-    if (Status s = checkStreamMemory(inputs, ply->count(), request.max_memory, point_bytes); !s) return s.error();
-    set.stream_block = streamBlockPoints(request.max_memory, point_bytes);
+    Result<uint64_t> stream_block = checkStreamMemory(inputs, ply->count(), request.max_memory, point_bytes);
+    if (!stream_block) return stream_block.error();
+    set.stream_block = *stream_block;
     set.count = ply->count(), set.has_colors = ply->hasColors();
     if (request.color == RenderColor::kAuto || request.color == RenderColor::kRgb) {
       if (Status s = readPreview(*ply, set); !s) return s.error();

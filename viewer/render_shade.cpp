@@ -164,12 +164,16 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
   barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.layout, 0, 1, &r.shade_set, 0, nullptr);
-  // A pass of `group`² invocations a workgroup, each shading block_x × block_y pixels.
-  auto pass = [&](VkPipeline pipeline, uint32_t axis, uint32_t group, uint32_t block_x, uint32_t block_y) {
+  // A pipeline and its push constants with `axis`, for the dispatch that follows.
+  auto use = [&](VkPipeline pipeline, uint32_t axis) {
     EdlPush p = push;
     p.axis = axis;
     vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(p), &p);
     vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  };
+  // A pass of `group`² invocations a workgroup, each shading block_x × block_y pixels.
+  auto pass = [&](VkPipeline pipeline, uint32_t axis, uint32_t group, uint32_t block_x, uint32_t block_y) {
+    use(pipeline, axis);
     const uint32_t across = group * block_x, down = group * block_y;
     vkCmdDispatch(commands, (push.width + across - 1) / across, (push.height + down - 1) / down, 1);
   };
@@ -188,10 +192,7 @@ void recordShade(VkCommandBuffer commands, const Resources& r, const EdlPush& pu
           VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
   for (uint32_t step : {0u, 1u}) {
-    EdlPush p = push;
-    p.axis = step;
-    vkCmdPushConstants(commands, r.shade.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(p), &p);
-    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, r.shade.fill_again);
+    use(r.shade.fill_again, step);
     vkCmdDispatchIndirect(commands, r.candidates.buffer, sizeof(uint32_t));
     between();
   }

@@ -44,9 +44,11 @@ TEST(StreamBlocks, sizedByMaxMemory) {
   EXPECT_EQ(streamBlockPoints(0), streamBlockPoints(defaultMemoryLimit()));
   for (uint64_t limit : {80 * mib, 100 * mib, 1000 * mib, 1200 * mib})
     EXPECT_LE(2 * streamBlockPoints(limit) * kStreamPointBytes, limit) << limit;
-  EXPECT_TRUE(checkStreamMemory("s.ply", 100000000, 100 * mib));
+  const Result<uint64_t> fits = checkStreamMemory("s.ply", 100000000, 100 * mib);
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(*fits, streamBlockPoints(100 * mib));  // the block to read in
   EXPECT_TRUE(checkStreamMemory("s.ply", 1000, mib));
-  const Status tight = checkStreamMemory("s.ply", 100000000, 50 * mib);
+  const Result<uint64_t> tight = checkStreamMemory("s.ply", 100000000, 50 * mib);
   ASSERT_FALSE(tight);
   EXPECT_EQ(tight.error().code, ExitCode::kResourceLimit);
 }
