@@ -162,7 +162,8 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
   const std::string header = RowFormatter(layout, options.decimals, options.at_scale).header();
   // At least a digit and a separator a value: refused at once where the disk cannot hold even that.
   const uint64_t values = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0) + layout.dimensions.size();
-  if (Status s = writer.file_.checkSpace(header.size() + rows * values * 2); !s) return s.error();
+  if (Status s = writer.file_.checkSpace(header.size() + rows * values * AtomicFile::kLeastTextBytesPerValue); !s)
+    return s.error();
   if (Status s = writer.file_.write(header); !s) return s.error();
   if (options.progress) options.progress->start("writing " + path, rows);
   return writer;
@@ -258,6 +259,9 @@ Status writePts(const std::string& path, const PointSet& points, const CsvWriteO
   if (!file.ok()) return file.error();
   const Dimension* intensity = points.dimensions.find(dim::kIntensity);
   std::string out = std::to_string(points.size()) + "\n";
+  const uint64_t values = 3 + (intensity ? 1 : 0) + (points.hasColors() ? 3 : 0);
+  if (Status s = file->checkSpace(out.size() + points.size() * values * AtomicFile::kLeastTextBytesPerValue); !s)
+    return s;
   char buffer[kMaxFieldChars + 64];
   const bool at_scale = options.at_scale && options.decimals >= 0;
   auto number = [&](double v) {

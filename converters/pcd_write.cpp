@@ -67,7 +67,9 @@ class Writer {
     const std::string head = header();
     // binary: the file's size; ASCII: at least a digit and a separator a value; compressed: unknown.
     if (options_.encoding != PcdEncoding::kBinaryCompressed) {
-      const uint64_t row = options_.encoding == PcdEncoding::kBinary ? row_bytes_ : 2 * fields_.size();
+      const uint64_t row = options_.encoding == PcdEncoding::kBinary
+                               ? row_bytes_
+                               : AtomicFile::kLeastTextBytesPerValue * fields_.size();
       if (Status s = file->checkSpace(head.size() + uint64_t{n} * row); !s) return s;
     }
     if (Status s = file->write(head); !s) return s;

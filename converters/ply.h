@@ -107,7 +107,8 @@ class PlyRowStream {
   PlyRowStream(const PlyRowStream&) = delete;
   PlyRowStream& operator=(const PlyRowStream&) = delete;
 
-  // Once, before add: lays the header out for these estimated counts.
+  // Once, before add: lays the header out for these estimated counts. Fails (exit 4) where the disk
+  // cannot hold half the file they make (AtomicFile::checkSpace).
   Status start(uint64_t vertices, uint64_t faces);
   // The next rows: the vertex rows, written now after the ones before; the face rows, kept. Whole
   // rows (rowBytes() and kFaceRowBytes each). From one thread at a time.

@@ -148,7 +148,8 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   // The file's size in binary; in ASCII at least a digit and a separator a value: refused at once
   // where the disk cannot hold it (a generated set's rows are made as they are written).
   const uint64_t values = 3 + (colors ? 3 : 0) + dims.size();
-  const uint64_t least = header.size() + (ascii ? uint64_t{n} * values * 2 + uint64_t{faces} * 8
+  const uint64_t text = AtomicFile::kLeastTextBytesPerValue;
+  const uint64_t least = header.size() + (ascii ? uint64_t{n} * values * text + uint64_t{faces} * 8
                                                  : uint64_t{n} * vertex_bytes + uint64_t{faces} * kFaceBytes);
   if (Status s = file->checkSpace(least); !s) return s;
   if (options.progress) options.progress->start("writing " + path, n + faces);
@@ -301,6 +302,10 @@ Status PlyRowStream::start(uint64_t vertices, uint64_t faces) {
   assert(!started_);
   started_ = true;
   header_bytes_ = layout_.header(vertices, faces, true).size();
+  // The counts are a sample's estimate: refused at once only where the disk cannot hold half the
+  // file they make, so that an estimate a little high never refuses a file that would fit.
+  const uint64_t estimate = header_bytes_ + vertices * rowBytes() + faces * kFaceRowBytes;
+  if (Status s = file_.checkSpace(estimate / 2); !s) return s;
   // Address space only: the pages are touched as the rows arrive.
   faces_.reserve(static_cast<size_t>(static_cast<double>(faces) * 1.1 * kFaceRowBytes));
   adviseHugePages(faces_.data(), faces_.capacity());

@@ -255,8 +255,8 @@ Status AtomicFile::checkSpace(uint64_t bytes) const {
   const uint64_t taken = bytesWritten();
   const uint64_t free = blocks > UINT64_MAX / fs.f_frsize ? UINT64_MAX : blocks * fs.f_frsize;
   if (bytes <= taken || bytes - taken <= free) return okStatus();
-  return Error{"cannot write '" + path_ + "': it takes " + formatBytes(bytes) + ", and the file system holding '" +
-                   folderOf(path_) + "' has " + formatBytes(free) + " free",
+  return Error{"cannot write '" + path_ + "': it takes at least " + formatBytes(bytes) +
+                   ", and the file system holding '" + folderOf(path_) + "' has " + formatBytes(free) + " free",
                ExitCode::kResourceLimit};
 }
 

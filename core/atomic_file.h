@@ -43,6 +43,9 @@ class AtomicFile {
   // passes. A file system that cannot say (no size) passes too; one that compresses may be refused a
   // file that would have fitted.
   Status checkSpace(uint64_t bytes) const;
+  // The least a value takes in a text format (a digit and a separator): a text writer checks
+  // `values × kLeastTextBytesPerValue` plus its header, a lower bound of its file's size.
+  static constexpr uint64_t kLeastTextBytesPerValue = 2;
 
   // Buffered append. Errors (disk full) are reported here or at commit.
   Status write(const void* data, size_t size);

@@ -195,7 +195,7 @@ TEST(CliGenerate, aFileLargerThanTheDiskIsRefusedBeforeAnyWork) {
          "--count", "1099511627776", "-o", dir.file(name)},
         std::chrono::seconds(120));
     EXPECT_EQ(r.exit_code, static_cast<int>(ExitCode::kResourceLimit)) << name << ": " << r.err;
-    EXPECT_NE(r.err.find("cannot write '" + dir.file(name) + "': it takes "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("cannot write '" + dir.file(name) + "': it takes at least "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(" free"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir.file(name))) << name;
   }
@@ -214,14 +214,21 @@ TEST(CliGenerate, eachFormatLargerThanTheDiskIsRefused) {
     std::string path;
     ~Unmount() { test::runCommand({"/bin/umount", path}); }
   } unmount{small};
-  for (const char* name : {"m.ply", "m.las", "m.csv", "m.glb", "m.pcd", "m.xyz"}) {
+  for (const char* name : {"m.ply", "m.las", "m.csv", "m.glb", "m.pcd", "m.xyz", "m.pts"}) {
     const std::string path = small + "/" + name;
     const test::CommandResult r = runDpoint({"generate", "menger", "-q", "-o", path});
     EXPECT_EQ(r.exit_code, static_cast<int>(ExitCode::kResourceLimit)) << name << ": " << r.err;
-    EXPECT_NE(r.err.find("cannot write '" + path + "': it takes "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("cannot write '" + path + "': it takes at least "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("has 1.0 MiB free"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(path)) << name;
   }
+  // The device's rows, written as they are meshed: 4.8 MiB estimated, refused for half of it.
+  const std::string julia = small + "/j.ply";
+  const test::CommandResult rows = runDpoint(
+      {"generate", "julia", "--resolution", "192", "--device", "0", "--mesh", "device", "-q", "-o", julia});
+  EXPECT_EQ(rows.exit_code, static_cast<int>(ExitCode::kResourceLimit)) << rows.err;
+  EXPECT_NE(rows.err.find("cannot write '" + julia + "': it takes at least 2.4 MiB"), std::string::npos) << rows.err;
+  EXPECT_FALSE(std::filesystem::exists(julia));
   const test::CommandResult fits =
       runDpoint({"generate", "sierpinski", "--level", "3", "-q", "-o", small + "/s.ply"});
   EXPECT_EQ(fits.exit_code, 0) << fits.err;
