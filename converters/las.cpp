@@ -68,6 +68,12 @@ std::string textField(const char* p, size_t size) {
   return printableExcerpt(std::string_view(p, strnlen(p, size)));
 }
 
+// Whether every coordinate an axis with this scale and offset can store is finite: every stored
+// integer is within ±2^31. The reader refuses a header where it is not; the writer never makes one.
+bool frameIsFinite(double scale, double offset) {
+  return std::isfinite(std::fabs(scale) * 2147483648.0 + std::fabs(offset));
+}
+
 Result<LasHeader> parseHeader(const InputFile& file) {
   const std::string& path = file.path();
   char h[kHeaderSize14] = {};
@@ -124,8 +130,7 @@ Result<LasHeader> parseHeader(const InputFile& file) {
       return Error{path + ": header: " + axis + " offset " + num(offset) + " is not a finite number"};
     if (!std::isfinite(min) || !std::isfinite(max))
       return Error{path + ": header: " + axis + " bounds " + num(min) + " .. " + num(max) + " are not finite numbers"};
-    // Every stored integer is within ±2^31, so this bound makes every coordinate finite.
-    if (!std::isfinite(std::fabs(scale) * 2147483648.0 + std::fabs(offset)))
+    if (!frameIsFinite(scale, offset))
       return Error{path + ": header: " + axis + " scale " + num(scale) + " and offset " + num(offset) +
                    " give coordinates beyond double's range"};
     hd.scale[k] = scale;
@@ -596,7 +601,7 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
 class RecordEncoder {
  public:
   RecordEncoder(const PointSet& points, const WriterLayout& l, const glm::dvec3& offset, const glm::dvec3& scale)
-      : points_(points), offset_(offset), scale_(scale) {
+      : points_(points), offset_(offset), scale_(scale), format_(l.format) {
     for (const LasField& f : lasFields(l.format)) {
       Slot slot{f.type, f.offset, f.shift, f.bits, points.dimensions.find(f.name), Convert::kNone};
       if (!slot.source && std::strcmp(f.name, dim::kScanAngleRank) == 0) {
@@ -621,12 +626,17 @@ class RecordEncoder {
     returns_ = l.format >= 6 ? 15 : 5;
   }
 
-  void encode(size_t i, char* r) const {
+  // Encodes point i; false where one of its values does not fit its field (misfit(i) says which:
+  // the record then holds it rounded and clamped, and is not to be written).
+  bool encode(size_t i, char* r) const {
     const glm::dvec3& p = points_.positions[i];
     for (int k = 0; k < 3; ++k) storeUnaligned<int32_t>(r + 4 * k, static_cast<int32_t>(quantize(p[k], offset_[k], scale_[k])));
+    bool fits = true;
     for (const Slot& s : slots_) {
       if (s.bits) {
-        const uint32_t v = s.source ? static_cast<uint32_t>(std::clamp(s.source->value(i), 0.0, 255.0)) : s.missing;
+        const double value = s.source ? s.source->value(i) : s.missing;
+        fits &= fitsSlot(s, value);
+        const uint32_t v = static_cast<uint32_t>(std::clamp(value, 0.0, 255.0));
         r[s.offset] = static_cast<char>(static_cast<uint8_t>(r[s.offset]) | ((v & ((1u << s.bits) - 1)) << s.shift));
       } else if (!s.source) {
         if (s.missing) storeValue(r + s.offset, s.type, s.missing);
@@ -638,11 +648,32 @@ class RecordEncoder {
         const size_t w = dimTypeSize(s.type);
         std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
       } else {
-        storeValue(r + s.offset, s.type, s.source->value(i));
+        const double value = s.source->value(i);
+        fits &= fitsSlot(s, value);
+        storeValue(r + s.offset, s.type, value);
       }
     }
     if (rgb_at_)
       for (int c = 0; c < 3; ++c) storeUnaligned<uint16_t>(r + rgb_at_ + 2 * c, colorInteger(points_.colors[i][c], color_scale_));
+    return fits;
+  }
+
+  // Why point i's record would not hold its values: the first value that does not fit its field.
+  std::string misfit(size_t i) const {
+    for (const Slot& s : slots_) {
+      if (!s.source || s.convert != Convert::kNone) continue;
+      const double value = s.source->value(i);
+      if (fitsSlot(s, value)) continue;
+      const int bits = s.bits ? s.bits : static_cast<int>(8 * dimTypeSize(s.type));
+      const bool sign = !s.bits && dimTypeIsSigned(s.type);
+      const std::string lo = sign ? num(-std::ldexp(1.0, bits - 1)) : "0";
+      const std::string hi = std::to_string(bits == 64 && !sign ? UINT64_MAX : (uint64_t{1} << (bits - sign)) - 1);
+      const std::string what = s.bits ? std::to_string(bits) + (bits == 1 ? " bit" : " bits") : dimTypeName(s.type);
+      return "point " + str(i) + ": " + s.source->name + " = " + num(value) + " does not fit LAS point format " +
+             std::to_string(format_) + "'s " + s.source->name + ", a whole number " + lo + ".." + hi + " (" + what +
+             "); leave it out with --drop " + s.source->name;
+    }
+    return "point " + str(i) + ": a value does not fit its field";
   }
 
   // Points by return number 1..15 (1..5 in formats 0-5), for the header.
@@ -676,8 +707,17 @@ class RecordEncoder {
     uint32_t missing = 0;  // the value where the set lacks the dimension
   };
 
+  // Whether the field holds the value as it is: a whole number in its bits' or its type's range
+  // (any number for a float field). A conversion between the two scan-angle fields rounds by design.
+  static bool fitsSlot(const Slot& s, double value) {
+    if (s.convert != Convert::kNone) return true;
+    if (s.bits) return value >= 0.0 && value <= double((1u << s.bits) - 1) && value == std::floor(value);
+    return dimTypeIsFloat(s.type) || dimensionHolds(s.type, value);
+  }
+
   const PointSet& points_;
   glm::dvec3 offset_, scale_;
+  int format_;
   std::vector<Slot> slots_;
   uint32_t rgb_at_ = 0;
   double color_scale_ = 65535.0;
@@ -1044,6 +1084,12 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     q_min[k] = quantize(box.min[k], offset[k], scale[k]);
     q_max[k] = quantize(box.max[k], offset[k], scale[k]);
   }
+  for (int k = 0; k < 3; ++k)
+    if (!frameIsFinite(scale[k], offset[k]))
+      return Error{path + ": " + kAxis[k] + " spans " + num(box.min[k]) + " .. " + num(box.max[k]) +
+                   ": at the scale " + num(scale[k]) + " and offset " + num(offset[k]) +
+                   " LAS's 32-bit integers reach beyond double's range, which no reader takes; a LAS file cannot "
+                   "hold coordinates this large"};
   const bool fits = fitsInt32(q_min.x) && fitsInt32(q_min.y) && fitsInt32(q_min.z) && fitsInt32(q_max.x) &&
                     fitsInt32(q_max.y) && fitsInt32(q_max.z);
   for (size_t i = 0; !fits && i < n; ++i) {  // names the first point that does not fit
@@ -1102,10 +1148,21 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     return file->write(data, size);
   };
   if (options.progress) options.progress->start((laz ? "compressing " : "writing ") + path, n);
-  const auto encodeRecords = [&](size_t first, size_t last, std::vector<char>& out) {
+  // Each block's first point whose values do not fit their fields (the blocks of a batch run at
+  // once): the file is then refused, naming the first such point.
+  const auto encodeRecords = [&](size_t first, size_t last, std::vector<char>& out) -> size_t {
     out.assign((last - first) * l.record_length, 0);
     char* r = out.data();
-    for (size_t i = first; i < last; ++i, r += l.record_length) encoder.encode(i, r);
+    size_t misfit = SIZE_MAX;
+    for (size_t i = first; i < last; ++i, r += l.record_length)
+      if (!encoder.encode(i, r) && misfit == SIZE_MAX) misfit = i;
+    return misfit;
+  };
+  const auto refuse = [&](std::vector<size_t>& misfits) -> Status {
+    const size_t first = *std::min_element(misfits.begin(), misfits.end());
+    std::fill(misfits.begin(), misfits.end(), SIZE_MAX);
+    if (first == SIZE_MAX) return okStatus();
+    return Error{path + ": " + encoder.misfit(first)};
   };
 
   if (laz) {
@@ -1113,13 +1170,15 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     const size_t chunk_count = (n + kLazChunkPoints - 1) / kLazChunkPoints;
     std::vector<std::vector<uint8_t>> coded(chunk_count);
     std::vector<std::vector<char>> records(threads);
+    std::vector<size_t> misfits(2 * size_t{threads}, SIZE_MAX);
     for (size_t batch = 0; batch < chunk_count; batch += 2 * size_t{threads}) {
       const size_t batch_chunks = std::min<size_t>(2 * size_t{threads}, chunk_count - batch);
       parallelFor(batch_chunks, threads, [&](size_t j, unsigned worker) {
         const size_t c = batch + j, first = c * kLazChunkPoints, last = std::min(n, first + kLazChunkPoints);
-        encodeRecords(first, last, records[worker]);
-        coded[c] = encodeLazChunk(*laz, records[worker].data(), last - first);
+        misfits[j] = encodeRecords(first, last, records[worker]);
+        if (misfits[j] == SIZE_MAX) coded[c] = encodeLazChunk(*laz, records[worker].data(), last - first);
       });
+      if (Status s = refuse(misfits); !s) return s;
       if (interrupted()) return interruptedError();
       if (options.progress) options.progress->advance(std::min(n, (batch + batch_chunks) * kLazChunkPoints) - batch * kLazChunkPoints);
     }
@@ -1150,12 +1209,14 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     if (Status s = write(vlr_bytes.data(), vlr_bytes.size()); !s) return s;
     // Blocks are encoded on all cores a batch at a time, then written in order.
     std::vector<std::vector<char>> encoded(static_cast<size_t>(threads) * 4);
+    std::vector<size_t> misfits(encoded.size(), SIZE_MAX);
     for (size_t batch = 0; batch < blocks; batch += encoded.size()) {
       const size_t batch_blocks = std::min(encoded.size(), blocks - batch);
       parallelFor(batch_blocks, threads, [&](size_t j, unsigned) {
         const size_t first = (batch + j) * kWriteBlockPoints, last = std::min(n, first + kWriteBlockPoints);
-        encodeRecords(first, last, encoded[j]);
+        misfits[j] = encodeRecords(first, last, encoded[j]);
       });
+      if (Status s = refuse(misfits); !s) return s;
       for (size_t j = 0; j < batch_blocks; ++j) {
         if (Status s = write(encoded[j].data(), encoded[j].size()); !s) return s;
         if (options.progress) options.progress->advance(encoded[j].size() / l.record_length);

@@ -285,6 +285,72 @@ TEST(LasDimensions, aSetWithoutLasSourceGetsTheSmallestFormatThatHoldsIt) {
   EXPECT_EQ(back->dimensions.find(dim::kGpsTime)->get<double>(0), 12.25);
 }
 
+// A value its LAS field cannot hold as it is (a fraction, or beyond the field's bits or type) is
+// refused, naming the point, the dimension and the field's range, and nothing is written, as LAS
+// and as LAZ: the build before rounded, clamped or masked it silently (return 20 was written as 4,
+// intensity 0.25 as 0, 70000 as 65535). A whole value in range is written, whatever its type.
+TEST(LasDimensions, aValueItsFieldCannotHoldIsRefused) {
+  TempDir dir;
+  struct Case {
+    const char* name;
+    DimType type;
+    double value;
+    const char* says;
+  };
+  for (const Case& c : {Case{dim::kReturnNumber, DimType::kU8, 20, "return_number = 20 does not fit LAS point format 6's "
+                                                                   "return_number, a whole number 0..15 (4 bits)"},
+                        Case{dim::kScannerChannel, DimType::kU8, 5, "0..3 (2 bits)"},
+                        Case{dim::kSynthetic, DimType::kU8, 2, "0..1 (1 bit)"},
+                        Case{dim::kIntensity, DimType::kF64, 0.25, "intensity = 0.25 does not fit LAS point format 0's "
+                                                                   "intensity, a whole number 0..65535 (uint16)"},
+                        Case{dim::kIntensity, DimType::kF64, 70000, "0..65535 (uint16)"},
+                        Case{dim::kPointSourceId, DimType::kI32, -5, "0..65535 (uint16)"},
+                        Case{dim::kScanAngleRank, DimType::kI16, 200, "-128..127 (int8)"}}) {
+    for (const bool compress : {false, true}) {
+      PointSet set;
+      set.positions = {{0, 0, 0}, {1, 2, 3}, {4, 5, 6}};
+      Dimension& d = set.dimensions.add(c.name, c.type, 3);
+      d.setValue(0, 1.0);
+      d.setValue(2, c.value);
+      const std::string path = dir.file(compress ? "bad.laz" : "bad.las");
+      std::filesystem::remove(path);  // the case before wrote one
+      LasWriteOptions options;
+      options.compress = compress;
+      const Status s = writeLas(path, set, options);
+      ASSERT_FALSE(s) << c.name << " " << c.value;
+      EXPECT_EQ(s.error().code, ExitCode::kBadInput);
+      EXPECT_NE(s.error().message.find(path + ": point 2: "), std::string::npos) << s.error().message;
+      EXPECT_NE(s.error().message.find(c.says), std::string::npos) << s.error().message;
+      EXPECT_NE(s.error().message.find(std::string("--drop ") + c.name), std::string::npos) << s.error().message;
+      EXPECT_FALSE(std::filesystem::exists(path));
+      // The same dimension with a whole value in range is written and read back.
+      d.setValue(2, 1.0);
+      ASSERT_TRUE(writeLas(path, set, options)) << c.name;
+      Result<PointSet> back = readLas(path);
+      ASSERT_TRUE(back);
+      EXPECT_EQ(back->dimensions.find(c.name)->value(2), 1.0) << c.name;
+    }
+  }
+}
+
+// Coordinates so large that LAS's integers at any decimal scale reach beyond double's range are
+// refused, exit 2, nothing written: the build before wrote a file its own reader then refused.
+TEST(LasDimensions, coordinatesBeyondWhatLasHoldsAreRefused) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{1e308, 0, 0}, {-1e308, 0, 0}};
+  const Status s = writeLas(dir.file("big.las"), set);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().code, ExitCode::kBadInput);
+  EXPECT_NE(s.error().message.find("x spans -1e+308 .. 1e+308"), std::string::npos) << s.error().message;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("big.las")));
+  set.positions = {{1e300, 0, 0}, {-1e300, 0, 0}};  // still within reach: written and read back
+  ASSERT_TRUE(writeLas(dir.file("wide.las"), set));
+  Result<PointSet> back = readLas(dir.file("wide.las"));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_NEAR(back->positions[0].x, 1e300, 1e291);  // within a step of the scale
+}
+
 TEST(LasDimensions, mortonOrderAndUniqueCarryEachPointsAttributes) {
   PointSet set;
   Dimension& id = set.dimensions.add("id", DimType::kU32, 0);
