@@ -613,6 +613,8 @@ class RecordEncoder {
       }
       // A set without returns was one return a pulse: 1 of 1, as LAS readers expect.
       slot.missing = std::strcmp(f.name, dim::kReturnNumber) == 0 || std::strcmp(f.name, dim::kNumberOfReturns) == 0 ? 1 : 0;
+      slot.check = slot.source && slot.convert == Convert::kNone && !dimTypeIsFloat(f.type) &&
+                   !widens(slot.source->type, f.type);
       slots_.push_back(slot);
     }
     for (const LasExtraField& e : l.extra)
@@ -634,9 +636,12 @@ class RecordEncoder {
     bool fits = true;
     for (const Slot& s : slots_) {
       if (s.bits) {
-        const double value = s.source ? s.source->value(i) : s.missing;
-        fits &= fitsSlot(s, value);
-        const uint32_t v = static_cast<uint32_t>(std::clamp(value, 0.0, 255.0));
+        uint32_t v = s.missing;
+        if (s.source) {  // fitsSlot without a call to floor: whole and in range where v is the value
+          const double value = s.source->value(i);
+          v = value >= 0.0 && value <= 255.0 ? static_cast<uint32_t>(value) : value > 255.0 ? 255u : 0u;
+          fits &= static_cast<double>(v) == value && v < (1u << s.bits);
+        }
         r[s.offset] = static_cast<char>(static_cast<uint8_t>(r[s.offset]) | ((v & ((1u << s.bits) - 1)) << s.shift));
       } else if (!s.source) {
         if (s.missing) storeValue(r + s.offset, s.type, s.missing);
@@ -649,7 +654,7 @@ class RecordEncoder {
         std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
       } else {
         const double value = s.source->value(i);
-        fits &= fitsSlot(s, value);
+        if (s.check) fits &= dimensionHolds(s.type, value);
         storeValue(r + s.offset, s.type, value);
       }
     }
@@ -705,7 +710,17 @@ class RecordEncoder {
     const Dimension* source;
     Convert convert;
     uint32_t missing = 0;  // the value where the set lacks the dimension
+    bool check = false;    // whether a value of the source may not fit this integer field
   };
+
+  // Whether every value of type `from` is one of integer type `to` (a widening: no check needed).
+  static bool widens(DimType from, DimType to) {
+    if (dimTypeIsFloat(from)) return false;
+    const int bits = static_cast<int>(8 * dimTypeSize(from));
+    const double lo = dimTypeIsSigned(from) ? -std::ldexp(1.0, bits - 1) : 0.0;
+    const double hi = std::ldexp(1.0, dimTypeIsSigned(from) ? bits - 1 : bits) - 1.0;
+    return dimensionHolds(to, lo) && dimensionHolds(to, hi);
+  }
 
   // Whether the field holds the value as it is: a whole number in its bits' or its type's range
   // (any number for a float field). A conversion between the two scan-angle fields rounds by design.
