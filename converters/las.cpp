@@ -180,8 +180,12 @@ void copyField(const LasField& f, const char* record, Dimension& d, size_t i) {
   }
 }
 
-// An extra bytes field at `at` into point i of its dimension.
-void copyExtra(const char* at, Dimension& d, size_t i) {
+// An extra bytes field at `at` into point i of its dimension: as stored, or scaled.
+void copyExtra(const LasExtraField& f, const char* at, Dimension& d, size_t i) {
+  if (f.scaled) {
+    d.set<double>(i, loadDimValue(f.type, reinterpret_cast<const uint8_t*>(at)) * f.value_scale + f.value_offset);
+    return;
+  }
   const size_t w = dimTypeSize(d.type);
   std::memcpy(d.bytes.data() + i * w, at, w);
 }
@@ -212,7 +216,7 @@ class LasReader {
     // (lasExtraFields made every name unique.) Unset: decode() writes every field of every point
     // (the columns are a dozen, hundreds of MB at 16M points, no longer zeroed on one thread first).
     for (const LasField& f : fields_) points.dimensions.appendUnset(f.name, f.type, count);
-    for (const LasExtraField& f : extra_) points.dimensions.appendUnset(f.name, f.type, count);
+    for (const LasExtraField& f : extra_) points.dimensions.appendUnset(f.name, f.dimensionType(), count);
     columns_.clear();  // pointers once every column is in place (adding one may move the others)
     for (Dimension& d : points.dimensions.all()) columns_.push_back(&d);
     const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
@@ -306,7 +310,7 @@ class LasReader {
   void decodeFields(const char* record, size_t i) const {
     for (size_t k = 0; k < fields_.size(); ++k) copyField(fields_[k], record, *columns_[k], i);
     for (size_t k = 0; k < extra_.size(); ++k)
-      copyExtra(record + extra_at_ + extra_[k].offset, *columns_[fields_.size() + k], i);
+      copyExtra(extra_[k], record + extra_at_ + extra_[k].offset, *columns_[fields_.size() + k], i);
   }
 
   const InputFile& file_;
@@ -560,7 +564,7 @@ void storeValue(char* p, DimType type, double v) {
 
 // Which format, extra bytes, version and records the writer uses for `points` (las_fields.h).
 Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n, bool compress,
-                                  bool las14) {
+                                  bool las14, unsigned threads) {
   WriterLayout l;
   const LasSource* source = points.las ? &*points.las : nullptr;
   l.format = lasFormatFor(points, source ? source->point_format : -1, !compress);
@@ -576,8 +580,16 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
     // The other family's scan angle fills this format's, unless the set has that one too.
     const char* counterpart = d.name == dim::kScanAngle ? dim::kScanAngleRank : d.name == dim::kScanAngleRank ? dim::kScanAngle : nullptr;
     if (counterpart && isField(counterpart) && !points.dimensions.find(counterpart)) continue;
-    l.extra.push_back({d.name.substr(0, 32), d.type, at, static_cast<size_t>(&d - points.dimensions.all().data())});
-    at += static_cast<uint32_t>(dimTypeSize(d.type));
+    // The source's field where the dimension still fits it (its scale, no-data value, description).
+    std::optional<LasExtraField> field;
+    if (source)
+      for (const auto& [name, descriptor] : source->extra_bytes)
+        if (name == d.name) field = lasSourceExtraField(d, descriptor, threads);
+    if (!field) field = LasExtraField{d.name.substr(0, 32), d.type, 0};
+    field->offset = at;
+    field->dimension = static_cast<size_t>(&d - points.dimensions.all().data());
+    at += static_cast<uint32_t>(dimTypeSize(field->type));
+    l.extra.push_back(std::move(*field));
   }
   l.record_length = l.base_length + at;
   if (l.record_length > 65535)
@@ -617,9 +629,12 @@ class RecordEncoder {
                    !widens(slot.source->type, f.type);
       slots_.push_back(slot);
     }
-    for (const LasExtraField& e : l.extra)
-      slots_.push_back({e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
-                        Convert::kNone});
+    for (const LasExtraField& e : l.extra) {
+      Slot slot{e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
+                e.scaled ? Convert::kScaled : Convert::kNone};
+      slot.scale = e.value_scale, slot.add = e.value_offset;  // each value fits (lasSourceExtraField)
+      slots_.push_back(slot);
+    }
     rgb_at_ = points.hasColors() ? lasRgbOffset(l.format) : 0;
     // 8-bit values where the colours came from a LAS file that had them (PLY or CSV 8-bit colours
     // are scaled to 16 bits, as the specification asks).
@@ -649,6 +664,8 @@ class RecordEncoder {
         storeValue(r + s.offset, s.type, std::clamp(s.source->value(i) * 0.006, -90.0, 90.0));
       } else if (s.convert == Convert::kRankToAngle) {
         storeValue(r + s.offset, s.type, s.source->value(i) / 0.006);
+      } else if (s.convert == Convert::kScaled) {
+        storeValue(r + s.offset, s.type, std::nearbyint((s.source->value(i) - s.add) / s.scale));
       } else if (s.source->type == s.type) {
         const size_t w = dimTypeSize(s.type);
         std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
@@ -702,7 +719,7 @@ class RecordEncoder {
   }
 
  private:
-  enum class Convert { kNone, kAngleToRank, kRankToAngle };
+  enum class Convert { kNone, kAngleToRank, kRankToAngle, kScaled };
   struct Slot {
     DimType type;
     uint32_t offset;
@@ -711,6 +728,7 @@ class RecordEncoder {
     Convert convert;
     uint32_t missing = 0;  // the value where the set lacks the dimension
     bool check = false;    // whether a value of the source may not fit this integer field
+    double scale = 1.0, add = 0.0;  // kScaled: the stored number is (value - add) / scale
   };
 
   // Whether every value of type `from` is one of integer type `to` (a widening: no check needed).
@@ -854,7 +872,7 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   // The count is bounded by the file size already; the point set must also fit --max-memory.
   uint64_t point_bytes = sizeof(glm::dvec3) + (source == LasColorSource::kNone ? 0 : sizeof(glm::vec3));
   for (const LasField& f : lasFields(header->point_format)) point_bytes += dimTypeSize(f.type);
-  for (const LasExtraField& f : *extra) point_bytes += dimTypeSize(f.type);
+  for (const LasExtraField& f : *extra) point_bytes += dimTypeSize(f.dimensionType());
   if (Status fits = checkMemory(path + ": " + str(header->point_count) + " points", header->point_count * point_bytes,
                                 options.max_memory);
       !fits)
@@ -874,7 +892,7 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
     records.emplace(InputFile::fromMemory(path, decoded.view()));
     plain.compressed = false;
   }
-  LasReader reader(records ? *records : file, plain, source, options, std::move(*extra));
+  LasReader reader(records ? *records : file, plain, source, options, *extra);
   Result<PointSet> points = reader.run();
   if (!points) return points;
   LasSource las;
@@ -886,6 +904,8 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   las.file_source_id = header->file_source_id;
   for (const LasVlr& vlr : vlrs)
     if (isCrsRecord(vlr)) las.vlrs.push_back(vlr);
+  for (const LasExtraField& f : *extra)
+    if (!f.descriptor.empty()) las.extra_bytes.push_back({f.name, f.descriptor});
   points->las = std::move(las);
   return points;
 }
@@ -958,7 +978,7 @@ Result<std::unique_ptr<LasPointStream>> LasPointStream::open(const std::string& 
   if (!extra) extra = lasExtraFields(nullptr, extra_bytes, st.fields);
   st.extra = std::move(*extra);
   for (const LasField& f : st.fields) st.dimensions.append(f.name, f.type, 0);
-  for (const LasExtraField& f : st.extra) st.dimensions.append(f.name, f.type, 0);
+  for (const LasExtraField& f : st.extra) st.dimensions.append(f.name, f.dimensionType(), 0);
   if (st.header.compressed) {
     Result<LazChunks> chunks = openLazChunks(st.file);
     if (!chunks) return chunks.error();
@@ -1034,7 +1054,10 @@ Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
       for (size_t k = 0; k < st.streamed.size(); ++k) {
         const size_t index = st.streamed[k];
         if (index < st.fields.size()) copyField(st.fields[index], p, *columns[k], i);
-        else copyExtra(p + extra_at + st.extra[index - st.fields.size()].offset, *columns[k], i);
+        else {
+          const LasExtraField& f = st.extra[index - st.fields.size()];
+          copyExtra(f, p + extra_at + f.offset, *columns[k], i);
+        }
       }
     }
   });
@@ -1130,7 +1153,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
     options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset, threads);
   }
-  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14);
+  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, threads);
   if (!layout) return layout.error();
   WriterLayout& l = *layout;
   std::optional<LazInfo> laz;

@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <optional>
 #include <unordered_set>
+
+#include "core/bytes.h"
+#include "core/parallel.h"
 
 namespace dpoint {
 namespace {
@@ -76,6 +80,8 @@ const std::array<std::vector<LasField>, 11>& allFields() {
 
 constexpr std::array<uint32_t, 11> kRgbAt = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
 constexpr size_t kDescriptorBytes = 192;
+// Where a descriptor's name, minimum, maximum, scale and offset start (LAS 1.4 R15 table 24).
+constexpr size_t kNameAt = 4, kMinAt = 64, kMaxAt = 88, kScaleAt = 112, kOffsetAt = 136;
 
 bool hasField(int format, const std::string& name) {
   const std::vector<LasField>& fields = lasFields(format);
@@ -161,15 +167,26 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
       if (name.empty()) name = "extra";
       if (type) {
         const uint32_t width = static_cast<uint32_t>(dimTypeSize(*type));
-        for (uint32_t e = 0; e < elements; ++e)
-          out.push_back({unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width, 0});
+        for (uint32_t e = 0; e < elements; ++e) {
+          LasExtraField field{unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width};
+          // Bit 3: scale, bit 4: offset, one a value (LAS 1.4 R15 table 24).
+          field.scaled = (options & 0x18) != 0;
+          if (options & 0x08) field.value_scale = loadUnaligned<double>(d + kScaleAt + 8 * e);
+          if (options & 0x10) field.value_offset = loadUnaligned<double>(d + kOffsetAt + 8 * e);
+          if (!std::isfinite(field.value_scale) || field.value_scale == 0.0 || !std::isfinite(field.value_offset))
+            return Error{"extra bytes descriptor " + std::to_string(k) + " ('" + name + "'): scale " +
+                         std::to_string(field.value_scale) + " and offset " + std::to_string(field.value_offset) +
+                         " are not a finite non-zero scale and a finite offset"};
+          if (elements == 1) field.descriptor.assign(d, kDescriptorBytes);
+          out.push_back(std::move(field));
+        }
         std::fill(described.begin() + at, described.begin() + at + size, true);
       }
       at += size;
     }
   }
   for (uint32_t b = 0; b < extra; ++b)
-    if (!described[b]) out.push_back({unique("extra_byte_" + std::to_string(b)), DimType::kU8, b, 0});
+    if (!described[b]) out.push_back({unique("extra_byte_" + std::to_string(b)), DimType::kU8, b});
   std::sort(out.begin(), out.end(), [](const LasExtraField& a, const LasExtraField& b) { return a.offset < b.offset; });
   return out;
 }
@@ -182,10 +199,56 @@ LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields) {
   vlr.data.assign(fields.size() * kDescriptorBytes, '\0');
   for (size_t k = 0; k < fields.size(); ++k) {
     char* d = vlr.data.data() + k * kDescriptorBytes;
+    if (fields[k].descriptor.size() == kDescriptorBytes) {
+      std::memcpy(d, fields[k].descriptor.data(), kDescriptorBytes);
+      std::memset(d + kNameAt, 0, 32);
+    }
     d[2] = static_cast<char>(static_cast<uint8_t>(fields[k].type) + 1);
-    std::memcpy(d + 4, fields[k].name.data(), std::min<size_t>(fields[k].name.size(), 32));
+    std::memcpy(d + kNameAt, fields[k].name.data(), std::min<size_t>(fields[k].name.size(), 32));
   }
   return vlr;
+}
+
+std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::string& descriptor, unsigned threads) {
+  if (descriptor.size() != kDescriptorBytes) return std::nullopt;
+  const uint8_t data_type = static_cast<uint8_t>(descriptor[2]), options = static_cast<uint8_t>(descriptor[3]);
+  if (data_type < 1 || data_type > 10) return std::nullopt;
+  LasExtraField field{d.name.substr(0, 32), static_cast<DimType>(data_type - 1), 0};
+  field.scaled = (options & 0x18) != 0;
+  if (options & 0x08) field.value_scale = loadUnaligned<double>(descriptor.data() + kScaleAt);
+  if (options & 0x10) field.value_offset = loadUnaligned<double>(descriptor.data() + kOffsetAt);
+  if (field.scaled ? d.type != DimType::kF64 : d.type != field.type) return std::nullopt;
+  // Every value as the stored number (the same, or back through the scale exactly), and their range.
+  const size_t n = d.size(), block = size_t{1} << 16, blocks = (n + block - 1) / block;
+  struct Part {
+    bool fits = true;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+  };
+  std::vector<Part> parts(blocks);
+  parallelFor(blocks, threads, [&](size_t b, unsigned) {
+    Part& part = parts[b];
+    for (size_t i = b * block, end = std::min(n, i + block); i < end && part.fits; ++i) {
+      const double v = d.value(i);
+      const double stored = field.scaled ? std::nearbyint((v - field.value_offset) / field.value_scale) : v;
+      part.fits = !field.scaled ||
+                  (dimensionHolds(field.type, stored) && stored * field.value_scale + field.value_offset == v);
+      part.lo = std::min(part.lo, stored), part.hi = std::max(part.hi, stored);
+    }
+  });
+  Part all;
+  for (const Part& part : parts) all.fits &= part.fits, all.lo = std::min(all.lo, part.lo), all.hi = std::max(all.hi, part.hi);
+  if (!all.fits) return std::nullopt;
+  field.descriptor = descriptor;
+  // Bits 1 and 2: the minimum and maximum, as the stored type widened to 8 bytes.
+  const auto put = [&](size_t at, double v) {
+    char* p = field.descriptor.data() + at;
+    if (dimTypeIsFloat(field.type)) storeUnaligned<double>(p, v);
+    else if (dimTypeIsSigned(field.type)) storeUnaligned<int64_t>(p, static_cast<int64_t>(v));
+    else storeUnaligned<uint64_t>(p, static_cast<uint64_t>(v));
+  };
+  if (n > 0 && !std::isnan(all.lo) && (options & 0x02)) put(kMinAt, all.lo);
+  if (n > 0 && !std::isnan(all.hi) && (options & 0x04)) put(kMaxAt, all.hi);
+  return field;
 }
 
 int lasFormatFor(const PointSet& points, int preferred, bool waveforms) {

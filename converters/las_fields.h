@@ -7,7 +7,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/dimensions.h"
@@ -32,10 +34,23 @@ uint32_t lasRgbOffset(int point_format);
 
 // A dimension kept in a record's extra bytes: its name, type and byte offset after the base record.
 struct LasExtraField {
+  LasExtraField() = default;
+  LasExtraField(std::string name_, DimType type_, uint32_t offset_)
+      : name(std::move(name_)), type(type_), offset(offset_) {}
+
   std::string name;
-  DimType type;
-  uint32_t offset;
+  DimType type = DimType::kU8;  // as stored in the record
+  uint32_t offset = 0;
   size_t dimension = 0;  // the writer's: its index in the set's dimensions
+  // Options bit 3 or 4 of its descriptor (LAS 1.4 R15 table 24): the value is the stored number ·
+  // value_scale + value_offset, a float64 dimension (as X is X·scale + offset).
+  bool scaled = false;
+  double value_scale = 1.0, value_offset = 0.0;
+  // The 192 bytes of the descriptor of a one-value field (its no-data value, minimum, maximum and
+  // description with its scale): kept in LasSource, and written again where the field is.
+  std::string descriptor;
+
+  DimType dimensionType() const { return scaled ? DimType::kF64 : type; }
 };
 
 // The extra bytes of a record of `extra` bytes as the VLR `vlr` (null: none) describes them. Bytes
@@ -43,8 +58,14 @@ struct LasExtraField {
 // extra_byte_N (N: the byte's offset after the base record). A name that is already taken (a LAS
 // field, a repeated name) gets the suffix _2, _3, …. Errors name the descriptor.
 Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t extra, const std::vector<LasField>& base);
-// The extra bytes VLR describing `fields` (LAS 1.4 R15 table 24: 192 bytes a field).
+// The extra bytes VLR describing `fields` (LAS 1.4 R15 table 24: 192 bytes a field): each field's
+// own descriptor where it has one, with its name, else its type and name.
 LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields);
+// A field of the source's (LasSource::extra_bytes) that dimension `d` fits as it is: its stored
+// type (the same as d's), or its scaled one (d float64, every value a stored number · scale + offset
+// exactly); the descriptor's minimum and maximum made the set's. Nothing where it does not fit:
+// the dimension is then written as its own type.
+std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::string& descriptor, unsigned threads);
 
 // The point format that holds what `points` carries: `preferred` (the source's) when it holds every
 // LAS field the set has, its colours and the values of its fields; else the smallest of formats

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace dpoint {
@@ -78,21 +79,28 @@ std::optional<DimType> parseDimType(std::string_view name) {
   return std::nullopt;
 }
 
-double Dimension::value(size_t i) const {
+double loadDimValue(DimType type, const uint8_t* bytes) {
+  const auto load = [bytes]<typename T>(T) {
+    T v;
+    std::memcpy(&v, bytes, sizeof v);
+    return static_cast<double>(v);
+  };
   switch (type) {
-    case DimType::kU8: return get<uint8_t>(i);
-    case DimType::kI8: return get<int8_t>(i);
-    case DimType::kU16: return get<uint16_t>(i);
-    case DimType::kI16: return get<int16_t>(i);
-    case DimType::kU32: return get<uint32_t>(i);
-    case DimType::kI32: return get<int32_t>(i);
-    case DimType::kU64: return static_cast<double>(get<uint64_t>(i));
-    case DimType::kI64: return static_cast<double>(get<int64_t>(i));
-    case DimType::kF32: return get<float>(i);
-    case DimType::kF64: return get<double>(i);
+    case DimType::kU8: return load(uint8_t{});
+    case DimType::kI8: return load(int8_t{});
+    case DimType::kU16: return load(uint16_t{});
+    case DimType::kI16: return load(int16_t{});
+    case DimType::kU32: return load(uint32_t{});
+    case DimType::kI32: return load(int32_t{});
+    case DimType::kU64: return load(uint64_t{});
+    case DimType::kI64: return load(int64_t{});
+    case DimType::kF32: return load(float{});
+    case DimType::kF64: return load(double{});
   }
   return 0.0;
 }
+
+double Dimension::value(size_t i) const { return loadDimValue(type, bytes.data() + i * dimTypeSize(type)); }
 
 namespace {
 // v truncated and clamped to T's range (a plain cast of an out-of-range double is undefined).

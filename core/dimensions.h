@@ -37,6 +37,9 @@ const char* plyTypeName(DimType type);
 // Whether `v` is exactly a value of the type (a whole number in its range; for float32, a float;
 // NaN for the float types only).
 bool dimensionHolds(DimType type, double v);
+// A value of the type stored at `bytes` (host order, unaligned), as a double (exact but for 64-bit
+// integers beyond 2^53).
+double loadDimValue(DimType type, const uint8_t* bytes);
 // The type of a name as `dimTypeName` or PLY (uint8/uchar, int16/short, float64/double, …).
 std::optional<DimType> parseDimType(std::string_view name);
 

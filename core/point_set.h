@@ -40,6 +40,9 @@ struct LasSource {
   uint16_t global_encoding = 0;  // bit 4: the CRS is WKT (LAS 1.4)
   uint16_t file_source_id = 0;
   std::vector<LasVlr> vlrs;  // the coordinate system's (LASF_Projection); extra bytes are described anew
+  // The extra bytes descriptor (192 bytes) of each one-value field, by its dimension's name: its
+  // type, scale and offset, no-data value and description, for the LAS writer.
+  std::vector<std::pair<std::string, std::string>> extra_bytes;
 };
 
 // The arrays of positions and colours. Their `resize(n)` leaves the new elements unset (no pass

@@ -25,6 +25,7 @@ namespace {
 
 using test::readFile;
 using test::TempDir;
+using test::writeFile;
 
 template <typename T>
 T at(const std::string& bytes, size_t offset) {
@@ -229,6 +230,84 @@ TEST(LasDimensions, extraBytesBecomeDimensionsOfTheirDeclaredTypes) {
   EXPECT_EQ(d.find("Intensity")->type, DimType::kU32);
   EXPECT_EQ(d.find("Time")->type, DimType::kU64);
   EXPECT_TRUE(d.find(dim::kIntensity)) << "the LAS field keeps its own name beside the extra bytes' Intensity";
+}
+
+// The extra bytes descriptor of a file (the first LASF_Spec record 4): where it starts in the bytes.
+size_t descriptorAt(const std::string& file) {
+  size_t vlr = at<uint16_t>(file, 94);  // the header's size: the VLRs follow
+  for (uint32_t k = 0, vlrs = at<uint32_t>(file, 100); k < vlrs; ++k) {
+    const uint16_t length = at<uint16_t>(file, vlr + 20);
+    if (file.compare(vlr + 2, 9, "LASF_Spec") == 0 && at<uint16_t>(file, vlr + 18) == 4) return vlr + 54;
+    vlr += 54 + length;
+  }
+  return std::string::npos;
+}
+
+// An extra bytes field with a scale and offset (options bits 3 and 4, as Riegl's amplitudes and
+// deviations come) is its stored number · scale + offset, a float64 dimension, in every reader and
+// so in every format written from it; LAS → LAS writes the same records and the same descriptor
+// (its no-data value and description kept, its minimum and maximum the written set's). The build
+// before read the stored numbers (5 for 100.5) and wrote the descriptor without its scale and
+// offset, so other readers got 5 too.
+TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 2, 3}, {4, 5, 6}};
+  Dimension& amplitude = set.dimensions.add("amplitude", DimType::kU16, 3);
+  amplitude.set<uint16_t>(0, 5), amplitude.set<uint16_t>(1, 7), amplitude.set<uint16_t>(2, 65535);
+  ASSERT_TRUE(writeLas(dir.file("raw.las"), set));
+  // The descriptor made a scaled one: 0.1 and 100, no-data 65535, min and max 5 and 7, a description.
+  std::string file = readFile(dir.file("raw.las"));
+  const size_t d = descriptorAt(file);
+  ASSERT_NE(d, std::string::npos);
+  ASSERT_EQ(file[d + 2], 3) << "uint16";
+  file[d + 3] = 0x1F;
+  const auto put = [&]<typename T>(size_t offset, T v) { std::memcpy(file.data() + d + offset, &v, sizeof v); };
+  put(40, uint64_t{65535}), put(64, uint64_t{5}), put(88, uint64_t{7}), put(112, 0.1), put(136, 100.0);
+  std::memcpy(file.data() + d + 160, "amplitude in dB", 15);
+  writeFile(dir.file("scaled.las"), file);
+
+  Result<PointSet> read = readLas(dir.file("scaled.las"));
+  ASSERT_TRUE(read) << read.error().message;
+  const Dimension* a = read->dimensions.find("amplitude");
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->type, DimType::kF64);
+  EXPECT_EQ(a->get<double>(0), 5 * 0.1 + 100.0);
+  EXPECT_EQ(a->get<double>(1), 7 * 0.1 + 100.0);
+
+  // LAS → LAS (and LAZ): the same records, the same descriptor but its range (5 .. 65535 now).
+  for (const char* name : {"back.las", "back.laz"}) {
+    LasWriteOptions options;
+    options.compress = std::string(name).ends_with(".laz");
+    ASSERT_TRUE(writeLas(dir.file(name), *read, options));
+    Result<PointSet> again = readLas(dir.file(name));
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->dimensions.find("amplitude")->get<double>(1), 7 * 0.1 + 100.0) << name;
+  }
+  const std::string back = readFile(dir.file("back.las"));
+  EXPECT_TRUE(recordsOf(dir.file("back.las")).bytes == recordsOf(dir.file("scaled.las")).bytes);
+  const size_t b = descriptorAt(back);
+  ASSERT_NE(b, std::string::npos);
+  EXPECT_EQ(back.compare(b, 64, file, d, 64), 0) << "type, options, name, no-data";
+  EXPECT_EQ(at<uint64_t>(back, b + 64), 5u);
+  EXPECT_EQ(at<uint64_t>(back, b + 88), 65535u);
+  EXPECT_EQ(back.compare(b + 112, 80, file, d + 112, 80), 0) << "scale, offset, description";
+
+  // CSV has the values.
+  ASSERT_TRUE(writeCsv(dir.file("a.csv"), *read));
+  EXPECT_NE(readFile(dir.file("a.csv")).find(",100.5\n"), std::string::npos) << readFile(dir.file("a.csv"));
+
+  // A value the scale cannot store: the dimension is written as float64, unscaled, exactly.
+  read->dimensions.find("amplitude")->set<double>(2, 100.55);
+  ASSERT_TRUE(writeLas(dir.file("wide.las"), *read));
+  const std::string wide = readFile(dir.file("wide.las"));
+  const size_t w = descriptorAt(wide);
+  ASSERT_NE(w, std::string::npos);
+  EXPECT_EQ(wide[w + 2], 10) << "float64";
+  EXPECT_EQ(wide[w + 3], 0) << "no scale";
+  Result<PointSet> wide_back = readLas(dir.file("wide.las"));
+  ASSERT_TRUE(wide_back);
+  EXPECT_EQ(wide_back->dimensions.find("amplitude")->get<double>(2), 100.55);
 }
 
 // A fuzz finding (las, 236 bytes): a record length of 5120 made 5100 extra_byte dimensions, named
