@@ -100,7 +100,23 @@ double loadDimValue(DimType type, const uint8_t* bytes) {
   return 0.0;
 }
 
-double Dimension::value(size_t i) const { return loadDimValue(type, bytes.data() + i * dimTypeSize(type)); }
+// Its own switch, not loadDimValue at i · dimTypeSize(type): that form made a LAS → LAS convert of
+// 1.5M points 0.15 → 0.17 s on this 2-core VM (the size a call for every value).
+double Dimension::value(size_t i) const {
+  switch (type) {
+    case DimType::kU8: return get<uint8_t>(i);
+    case DimType::kI8: return get<int8_t>(i);
+    case DimType::kU16: return get<uint16_t>(i);
+    case DimType::kI16: return get<int16_t>(i);
+    case DimType::kU32: return get<uint32_t>(i);
+    case DimType::kI32: return get<int32_t>(i);
+    case DimType::kU64: return static_cast<double>(get<uint64_t>(i));
+    case DimType::kI64: return static_cast<double>(get<int64_t>(i));
+    case DimType::kF32: return get<float>(i);
+    case DimType::kF64: return get<double>(i);
+  }
+  return 0.0;
+}
 
 namespace {
 // v truncated and clamped to T's range (a plain cast of an out-of-range double is undefined).
