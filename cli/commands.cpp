@@ -4,12 +4,15 @@
 
 #include "cli/cli_check.h"
 #include "core/memory.h"
+#include "core/parallel.h"
 #include "core/text.h"
 
 namespace dpoint {
 
 void addCommonOptions(CLI::App& command, CommonOptions& options) {
-  command.add_option("--threads", options.threads, "Worker threads (0: all cores)")->default_val(0);
+  command.add_option("--threads", options.threads, "Worker threads (0: all cores; at most 4096)")
+      ->default_val(0)
+      ->check(numberIn("--threads", 0, kMostThreads, false, ""));
   command.add_flag("--quiet,-q", options.quiet, "No progress or report lines (warnings and errors still print)");
 }
 

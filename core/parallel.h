@@ -11,9 +11,12 @@
 
 namespace dpoint {
 
+// The most threads a job runs (--threads checks it; a caller of the library asking more gets this).
+inline constexpr unsigned kMostThreads = 4096;
+
 // 0 means "all cores".
 inline unsigned resolveThreads(unsigned requested) {
-  if (requested != 0) return requested;
+  if (requested != 0) return requested < kMostThreads ? requested : kMostThreads;
   unsigned n = std::thread::hardware_concurrency();
   return n == 0 ? 1 : n;
 }

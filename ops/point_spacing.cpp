@@ -86,12 +86,17 @@ PositionArray SpacingSampler::finish() const {
 
 SpacingSearch::SpacingSearch(const Box& box, uint64_t count, PositionArray samples, unsigned threads)
     : samples_(std::move(samples)), threads_(resolveThreads(threads)), origin_(box.min) {
-  const glm::dvec3 extent = box.max - box.min;
+  // Lengths are measured in units of about the box (a power of two: exact), so that volumes and
+  // squared distances neither overflow nor underflow at 1e200 or 1e-200.
+  const double largest_raw = std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
+  if (largest_raw > 0.0 && std::isfinite(largest_raw))
+    unit_ = std::ldexp(1.0, std::clamp(-std::ilogb(largest_raw), -1000, 1000));
+  const glm::dvec3 extent = (box.max - box.min) * unit_;
   const double largest = std::max({extent.x, extent.y, extent.z});
   const double n = double(std::max<uint64_t>(count, 1));
   const double volume = extent.x * extent.y * extent.z;
   const double face = std::max({extent.x * extent.y, extent.y * extent.z, extent.x * extent.z});
-  cell_ = 2.0 * std::max({std::cbrt(volume / n), std::sqrt(face / n), largest / double(kMaxCell)});
+  cell_ = 2.0 * std::max({std::cbrt(volume / n), std::sqrt(face / n), largest / double(kMaxCell)}) / unit_;
   if (!(cell_ > 0.0) || !std::isfinite(cell_)) samples_.clear();  // all points equal, or not finite
   inverse_cell_ = 1.0 / cell_;
 
@@ -129,9 +134,13 @@ SpacingSearch::SpacingSearch(const Box& box, uint64_t count, PositionArray sampl
   slot_samples_.resize(pairs.size());
   std::vector<uint32_t> fill(slot_start_.begin(), slot_start_.end() - 1);
   for (const auto& [slot, s] : pairs) slot_samples_[fill[slot]++] = s;
+  best_.assign(1, emptyBest());  // one list for finish() where add() sees no points; add() adds a worker's
+}
+
+std::vector<SpacingSearch::Best> SpacingSearch::emptyBest() const {
   Best none;
   none.fill(kInf);
-  best_.assign(threads_, std::vector<Best>(samples_.size(), none));
+  return std::vector<Best>(samples_.size(), none);
 }
 
 uint64_t SpacingSearch::cellKey(const glm::dvec3& p) const {
@@ -178,14 +187,18 @@ void SpacingSearch::add(std::span<const glm::dvec3> points) {
   if (samples_.empty()) return;
   constexpr size_t kBlock = size_t{1} << 16;
   const size_t blocks = (points.size() + kBlock - 1) / kBlock;
-  parallelFor(blocks, threads_, [&](size_t b, unsigned worker) {
+  // A list for each worker that runs, not each thread asked for (--threads 1000000 on 2050 points
+  // made 16 GB of them).
+  const unsigned workers = parallelWorkers(blocks, threads_);
+  while (best_.size() < workers) best_.push_back(emptyBest());
+  parallelFor(blocks, workers, [&](size_t b, unsigned worker) {
     std::vector<Best>& best = best_[worker];
     for (size_t i = b * kBlock, end = std::min(points.size(), i + kBlock); i < end; ++i) {
       const uint32_t slot = findSlot(cellKey(points[i]));
       if (slot == UINT32_MAX) continue;
       for (uint32_t k = slot_start_[slot]; k < slot_start_[slot + 1]; ++k) {
         const uint32_t s = slot_samples_[k];
-        const glm::dvec3 d = points[i] - samples_[s];
+        const glm::dvec3 d = (points[i] - samples_[s]) * unit_;
         const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
         Best& b2 = best[s];
         if (!(d2 > 0.0) || d2 >= b2.back()) continue;
@@ -204,7 +217,7 @@ std::vector<SpacingSample> SpacingSearch::finish() const {
     std::vector<double> all;
     for (const std::vector<Best>& worker : best_) all.insert(all.end(), worker[s].begin(), worker[s].end());
     std::nth_element(all.begin(), all.begin() + (kSpacingNeighbors - 1), all.end());
-    const double distance = std::sqrt(all[kSpacingNeighbors - 1]);
+    const double distance = std::sqrt(all[kSpacingNeighbors - 1]) / unit_;
     if (distance <= cell_) out.push_back({samples_[s], distance});
   }
   if (2 * out.size() < samples_.size()) out.clear();

@@ -59,12 +59,14 @@ class SpacingSearch {
   using Best = std::array<double, kSpacingNeighbors>;  // squared distances, ascending
   uint64_t cellKey(const glm::dvec3& p) const;
   uint32_t findSlot(uint64_t key) const;
+  std::vector<Best> emptyBest() const;  // a worker's lists before it has seen a point
 
   PositionArray samples_;
   std::vector<glm::i64vec3> sample_cells_;  // each sample's cell, ordered by x (mayUse)
   unsigned threads_;
   glm::dvec3 origin_{0.0};
   double cell_ = 0.0, inverse_cell_ = 0.0;
+  double unit_ = 1.0;  // distances are squared in this many per unit of length (a power of two)
   // A bit per hash of the kept cells' keys: 64 KiB, which L2 holds, so that a few percent of the
   // points that lie in no kept cell pass it (2^16 bits let a fifth of them through to the table).
   static constexpr size_t kFilterBits = size_t{1} << 19;

@@ -46,6 +46,9 @@ TEST(CliLimits, hugeCountsFailAtOnceNamingTheNumber) {
       {"--width 1000000", {"render", dir.file("small.csv"), "-o", dir.file("out.png"), "--width", "1000000"}, 4, "1000000x768"},
       {"--resolution 100000", {"generate", "mandelbulb", "--resolution", "100000", "-o", dir.file("out.ply")}, 1,
        "--resolution 100000: must be 2..65536"},
+      // The build before ran out of memory (SIGKILL) making a list a thread for the point spacing.
+      {"--threads 100000000", {"render", dir.file("small.csv"), "-o", dir.file("out.png"), "--threads", "100000000"}, 1,
+       "--threads 1e+08: must be in [0, 4096]"},
   };
   for (const Huge& c : cases) {
     SCOPED_TRACE(c.what);

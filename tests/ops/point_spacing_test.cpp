@@ -30,6 +30,32 @@ TEST(PointSpacing, aGridsSpacingIsItsStep) {
   }
 }
 
+// The same grid at 1e200 and 1e-200 (and powers of two near them) has its step, scaled (the
+// build before squared the distances as they were: infinite or 0 there, and found no spacing, so
+// `render` drew 3000 random points at 4 px where it draws them at 46 at scale 1).
+TEST(PointSpacing, aGridsSpacingHoldsAtAnyScale) {
+  const PositionArray unit = grid(100, 0.25, true);
+  for (double scale : {0x1p+664, 0x1p-664, 1e200, 1e-200}) {
+    PositionArray points = unit;
+    for (glm::dvec3& p : points) p *= scale;
+    const std::vector<SpacingSample> samples = sampleSpacing(points, boundingBox(points), 256);
+    ASSERT_GE(samples.size(), 200u) << scale;
+    size_t at_step = 0;
+    for (const SpacingSample& s : samples) at_step += std::abs(s.distance / scale - 0.25) < 1e-3;
+    EXPECT_GT(at_step, samples.size() * 9 / 10) << scale;
+  }
+}
+
+// Workers, not threads asked for: --threads 1000000 on a small set made a million per-worker lists
+// (16 GB, then the kernel's OOM kill); the result does not depend on it.
+TEST(PointSpacing, manyThreadsAskedMakeNoMoreWorkers) {
+  const PositionArray points = grid(60, 1.0, true);
+  const std::vector<SpacingSample> two = sampleSpacing(points, boundingBox(points), 256, 2);
+  const std::vector<SpacingSample> many = sampleSpacing(points, boundingBox(points), 256, 1000000);
+  ASSERT_EQ(many.size(), two.size());
+  for (size_t k = 0; k < two.size(); ++k) EXPECT_EQ(many[k].distance, two[k].distance);
+}
+
 TEST(PointSpacing, samplesDoNotDependOnOrderOrBlocks) {
   PositionArray points = grid(120, 1.0);
   std::mt19937 random(7);
