@@ -38,8 +38,7 @@ Status colorAndOffset(PointSet& points, const OutputOptions& o, bool auto_noise)
   if (o.offset.empty()) return okStatus();
   Result<glm::dvec3> offset = offsetOf(o);
   if (!offset) return offset.error();
-  offsetPoints(points, *offset);
-  return okStatus();
+  return offsetPoints(points, *offset);
 }
 
 // The set's vertices go to a .ply written here (not handed back), as they are (no --sample).

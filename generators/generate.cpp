@@ -1,10 +1,13 @@
 #include "generators/generate.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <vector>
 
 #include "core/memory.h"
+#include "core/text.h"
 #include "generators/perlin.h"
 
 namespace dpoint {
@@ -25,8 +28,19 @@ Status colorGenerated(PointSet& points, const PointColoring& coloring) {
   return okStatus();
 }
 
-void offsetPoints(PointSet& points, const glm::dvec3& offset) {
-  for (glm::dvec3& p : points.positions) p += offset;
+Status offsetPoints(PointSet& points, const glm::dvec3& offset) {
+  size_t beyond = SIZE_MAX;
+  for (size_t i = 0; i < points.size(); ++i) {
+    glm::dvec3& p = points.positions[i];
+    p += offset;
+    if (beyond == SIZE_MAX && !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) beyond = i;
+  }
+  if (beyond == SIZE_MAX) return okStatus();
+  return Error{"--offset " + formatNumber(offset.x) + "," + formatNumber(offset.y) + "," + formatNumber(offset.z) +
+                   ": point " + std::to_string(beyond) + " moved by it leaves double's range (" +
+                   formatNumber(points.positions[beyond].x) + ", " + formatNumber(points.positions[beyond].y) + ", " +
+                   formatNumber(points.positions[beyond].z) + ")",
+               ExitCode::kUsage};
 }
 
 std::string tileSignature(const std::string& kind, const std::string& option_lines) {

@@ -30,8 +30,9 @@ struct PointColoring {
 // offset) when the colours fit the memory limit (kResourceLimit otherwise).
 Status colorGenerated(PointSet& points, const PointColoring& coloring);
 
-// Every point moved by `offset`: exact double sums, one rounding each.
-void offsetPoints(PointSet& points, const glm::dvec3& offset);
+// Every point moved by `offset`: exact double sums, one rounding each. Fails (exit 1, naming the
+// first such point) where a sum leaves double's range: no file of infinite coordinates is written.
+Status offsetPoints(PointSet& points, const glm::dvec3& offset);
 
 // The kind and every option that shapes the points, from "name=value" lines (CLI11's
 // config_to_str, given or default), less those that only say where and how to run or write.

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -160,6 +161,12 @@ Status validate(const MengerParams& params) {
                  ExitCode::kUsage};
   if (!(params.size > 0.0) || !std::isfinite(params.size))
     return Error{"--size " + formatNumber(params.size) + ": must be a finite number above 0", ExitCode::kUsage};
+  // The lattice's k · size (k up to 3^level) must stay finite: 1e308 made infinite coordinates.
+  if (!std::isfinite(params.size * std::pow(3.0, n)))
+    return Error{"--size " + formatNumber(params.size) + ": too large for level " + std::to_string(n) +
+                     " (the lattice's coordinates reach size · 3^level, beyond double's range; at most " +
+                     formatNumber(std::numeric_limits<double>::max() / std::pow(3.0, n)) + ")",
+                 ExitCode::kUsage};
   return okStatus();
 }
 

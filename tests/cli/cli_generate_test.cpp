@@ -235,6 +235,21 @@ TEST(CliGenerate, eachFormatLargerThanTheDiskIsRefused) {
   EXPECT_TRUE(std::filesystem::exists(small + "/s.ply"));
 }
 
+// A sponge or an offset whose coordinates leave double's range is refused, exit 1, nothing
+// written: the build before wrote "inf" coordinates and "nan" colours that no reader takes.
+TEST(CliGenerate, coordinatesBeyondDoublesRangeAreRefused) {
+  TempDir dir;
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"generate", "menger", "--level", "1", "--size", "1e308", "-o", dir.file("m.csv")},
+        std::vector<std::string>{"generate", "menger", "--level", "1", "--size", "1e307", "--offset", "1.75e308,0,0",
+                                 "-o", dir.file("m.csv")}}) {
+    const test::CommandResult r = runDpoint(args);
+    EXPECT_EQ(r.exit_code, static_cast<int>(ExitCode::kUsage)) << r.err;
+    EXPECT_NE(r.err.find("double's range"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("m.csv")));
+  }
+}
+
 TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {
   TempDir dir;
   for (const char* threads : {"1", "2"}) {

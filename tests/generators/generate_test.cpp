@@ -32,9 +32,19 @@ TEST(Generate, colorsAreDroppedKeptOrNoiseWithinTheLimit) {
 
 TEST(Generate, offsetIsOneExactSumAPoint) {
   PointSet points = threePoints();
-  offsetPoints(points, {1e9, -0.5, 0.0});
+  ASSERT_TRUE(offsetPoints(points, {1e9, -0.5, 0.0}));
   EXPECT_EQ(points.positions[0], glm::dvec3(0.1 + 1e9, 0.2 - 0.5, 0.3));
   EXPECT_EQ(points.positions[2], glm::dvec3(-1.0 + 1e9, 0.0, 0.25));
+}
+
+// A sum beyond double's range is refused, naming the point (the build before wrote "inf").
+TEST(Generate, anOffsetBeyondDoublesRangeIsRefused) {
+  PointSet points;
+  points.positions = {{0, 0, 0}, {1e308, 0, 0}};
+  const Status s = offsetPoints(points, {1e308, 0.0, 0.0});
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().code, ExitCode::kUsage);
+  EXPECT_NE(s.error().message.find("point 1 moved by it leaves double's range"), std::string::npos) << s.error().message;
 }
 
 TEST(Generate, tileSignatureKeepsWhatShapesThePoints) {
