@@ -222,7 +222,7 @@ glm::dmat4 orthoProjection(double view_width, double view_height, double near_pl
 // segment along the view axis), where it is the degenerate floor or the box's largest side.
 double fitWidth(double fitted, const Bounds& bounds) {
   if (fitted > 0.0) return fitted;
-  return isDegenerate(bounds) ? 2.0 * minHalfExtent(0.5 * (bounds.min + bounds.max))
+  return isDegenerate(bounds) ? 2.0 * minHalfExtent(bounds.min)
                               : kFitMargin * maxAbs(bounds.max - bounds.min);
 }
 
@@ -291,7 +291,8 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
   const double aspect = double(spec.width) / double(spec.height);
   const double half_fov = spec.fov_degrees * std::numbers::pi / 360.0;
   const double half_fov_x = std::atan(std::tan(half_fov) * aspect);
-  const glm::dvec3 centre = 0.5 * (bounds.min + bounds.max);
+  // Halves first: the same bits as (min + max) / 2 (halving is exact), which overflowed past 9e307.
+  const glm::dvec3 centre = 0.5 * bounds.min + 0.5 * bounds.max;
   const glm::dvec3 extent = bounds.max - bounds.min;
   const glm::dvec3 up_y(0.0, 1.0, 0.0);
   double view_width = 0.0;  // ortho only
@@ -364,8 +365,14 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
 
   choosePlanes(camera, bounds);
   if (camera.ortho) {
-    camera.projection = orthoProjection(view_width, view_width * double(spec.height) / double(spec.width),
-                                        camera.near_plane, camera.far_plane);
+    // The aspect first: width · height alone overflows for a view over 2e305 wide (a blank picture).
+    const double view_height = view_width * (double(spec.height) / double(spec.width));
+    if (!std::isfinite(view_height) && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's aside)
+      return Error{"the view " + shortest(view_width) + " wide is " + shortest(view_height) + " high at " +
+                       std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                       ", beyond the largest double: the data are too large to view at this aspect",
+                   ExitCode::kBadInput};
+    camera.projection = orthoProjection(view_width, view_height, camera.near_plane, camera.far_plane);
   } else {
     camera.projection = perspectiveProjection(2.0 * half_fov, aspect, camera.near_plane, camera.far_plane);
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <unistd.h>
 #include <string>
 #include <utility>
@@ -289,16 +290,28 @@ TEST(Camera, rejectsBadOptionsNamingThem) {
 // fit sees none of them: auto must not take fp32, whose encoding cannot hold them (it had, and
 // renderPoints then refused the set), so every mode past its range is unbounded.
 TEST(Camera, coordinatesNearTheLargestDoubleAreBadInputNamingWhy) {
+  // One point at 1e308 is framed both ways: its centre is no longer (min + max) / 2, which
+  // overflowed (perspective refused it, and ortho drew nothing in a view infinitely wide).
   PointSet same;
   same.positions = {{1e308, 1e308, 1e308}, {1e308, 1e308, 1e308}};
-  CameraSpec spec;
-  Result<Camera> perspective = makeCamera(spec, boundsOf(same));
+  for (bool ortho : {false, true}) {
+    CameraSpec spec;
+    spec.ortho = ortho;
+    const Camera camera = make(spec, boundsOf(same));
+    expectUsable(camera);
+    const WindowPoint w = project(camera, same.positions[0]);
+    EXPECT_TRUE(w.visible) << ortho;
+    EXPECT_NEAR(w.x, camera.width / 2.0, 1.0) << ortho;
+    EXPECT_NEAR(w.y, camera.height / 2.0, 1.0) << ortho;
+  }
+  // A perspective eye past the largest double: refused, naming why.
+  const double most = std::numeric_limits<double>::max();
+  same.positions = {{most, most, most}, {most, most, most}};
+  Result<Camera> perspective = makeCamera(CameraSpec{}, boundsOf(same));
   ASSERT_FALSE(perspective.ok());
   EXPECT_EQ(perspective.error().code, ExitCode::kBadInput);
   EXPECT_NE(perspective.error().message.find("too large to view in perspective"), std::string::npos) << perspective.error().message;
   EXPECT_EQ(perspective.error().message.find("--view-center"), std::string::npos) << perspective.error().message;
-  spec.ortho = true;
-  EXPECT_TRUE(makeCamera(spec, boundsOf(same)).ok());
   EXPECT_FALSE(makeCamera(CameraSpec{}, boundsOf(PointSet{PositionArray{{1e308, 1e308, 1e308}, {-1e308, -1e308, -1e308}}})).ok());
   PointSet apart;  // past float32's range, and behind the eye
   apart.positions = {{1e39, 0.0, 0.0}, {1e39, 1.0, 1.0}};
@@ -363,6 +376,23 @@ TEST(Camera, fitFillsThePictureAtEveryScale) {
       }
     }
   }
+}
+
+// An orthographic fit of data 1.2e306 wide: the view's height from the aspect, not width · height
+// (which overflowed at 1024 × 768 and gave a blank picture and a bound of 0 px). Data spanning
+// more than the largest double have no finite view: refused, naming why.
+TEST(Camera, orthoFitOfDataNearTheLargestDoubleFillsThePicture) {
+  const Bounds bounds{glm::dvec3(0.0), glm::dvec3(1.2e306, 1.2e306, 0.0), true};
+  CameraSpec spec;
+  spec.ortho = true;
+  const Camera camera = make(spec, bounds);
+  expectFramed(camera, bounds, 0.85);
+  const Bounds widest{glm::dvec3(-1.6e308, -1.6e308, 0.0), glm::dvec3(1.6e308, 1.6e308, 0.0), true};
+  spec.width = 100, spec.height = 400;
+  Result<Camera> portrait = makeCamera(spec, widest);
+  ASSERT_FALSE(portrait);
+  EXPECT_EQ(portrait.error().code, ExitCode::kBadInput);
+  EXPECT_NE(portrait.error().message.find("beyond the largest double"), std::string::npos) << portrait.error().message;
 }
 
 // The fit of a set with an outline frames the points, not the box's empty corners: a Mandelbulb
