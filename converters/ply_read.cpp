@@ -323,8 +323,10 @@ class PlyParser {
       const bool fixed =
           std::none_of(e.properties.begin(), e.properties.end(), [](const Property& p) { return p.is_list; });
       if (!fixed)
-        return Error{path_ + ": element '" + e.name + "' (header line " + std::to_string(e.line) +
-                     ") has list rows before the vertices; such a file cannot be streamed"};
+        return Error{path_ + ": element '" + e.name + "' (header line " + std::to_string(e.line) + ") has " +
+                     (e.name == "vertex" ? std::string("a list property in its rows")
+                                         : std::string("list rows before the vertices")) +
+                     ", whose offsets are known only once read; such a file cannot be streamed (--stream off)"};
       if (e.name == "vertex") {
         stream_layout_ = vertexLayout(e, vertex_roles_);
         stream_begin_ = offset;

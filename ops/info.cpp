@@ -187,19 +187,30 @@ size_t countFloatMerges(const PositionArray& positions) {
   return merged;
 }
 
-// Bounds and float overflow of `positions` into `info` (min and max already set to a point).
+// Bounds and float overflow of `positions` into `info` (min and max start empty: noBounds). A NaN
+// coordinate has no place in them: it is passed over (with --allow-nonfinite it made the bounds
+// NaN or not by the points' order).
 void addBounds(PointSetInfo& info, const PositionArray& positions) {
   for (const glm::dvec3& p : positions) {
-    info.min = glm::min(info.min, p);
-    info.max = glm::max(info.max, p);
     for (int k = 0; k < 3; ++k) {
+      if (std::isnan(p[k])) continue;
+      info.min[k] = std::min(info.min[k], p[k]);
+      info.max[k] = std::max(info.max[k], p[k]);
       if (std::fabs(p[k]) > static_cast<double>(FLT_MAX)) ++info.float_overflow;
     }
   }
 }
 
-// Extent, largest magnitude and float32's spacing there, from the bounds.
+// Empty bounds, which any coordinate widens.
+void noBounds(PointSetInfo& info) {
+  info.min = glm::dvec3(std::numeric_limits<double>::infinity());
+  info.max = glm::dvec3(-std::numeric_limits<double>::infinity());
+}
+
+// Extent, largest magnitude and float32's spacing there, from the bounds (an axis of NaNs only: NaN).
 void finishBounds(PointSetInfo& info) {
+  for (int k = 0; k < 3; ++k)
+    if (info.min[k] > info.max[k]) info.min[k] = info.max[k] = std::numeric_limits<double>::quiet_NaN();
   info.extent = info.max - info.min;
   info.max_abs = std::max({std::fabs(info.min.x), std::fabs(info.min.y), std::fabs(info.min.z),
                            std::fabs(info.max.x), std::fabs(info.max.y), std::fabs(info.max.z)});
@@ -403,7 +414,7 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   info.has_colors = points.hasColors();
   if (points.positions.empty()) return info;
 
-  info.min = info.max = points.positions[0];
+  noBounds(info);
   addBounds(info, points.positions);
   finishBounds(info);
 
@@ -465,7 +476,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
         }
       overflow[worker] += over, nonfinite[worker] += bad;
     });
-    if (first == 0) info.min = info.max = block.positions[0];
+    if (first == 0) noBounds(info);
     if (std::all_of(nonfinite.begin(), nonfinite.end(), [](size_t c) { return c == 0; })) {
       // min and max of finite values in any grouping: the boxes' are the points'.
       for (size_t k = from; k < boxes.size(); ++k)

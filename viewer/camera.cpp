@@ -353,6 +353,15 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     };
     if (!isFinite(camera.eye) && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's data aside)
       return too_large("to view in perspective: its eye would lie past the largest double");
+    // A tiny --fov puts the fitted eye so far off that point − eye, in double, no longer places the
+    // points within half a pixel: its step at the eye's distance against a pixel there, whatever the
+    // scale (--fov 1e-15: the eye 1e17 of the data's sizes away, a blank picture and a bound of 0 px).
+    const double pixel = 2.0 * distance * std::tan(half_fov_x) / double(spec.width);
+    const double step = std::nextafter(distance, HUGE_VAL) - distance;
+    if (isFinite(camera.eye) && !(step <= 0.5 * pixel))
+      return usage("--fov " + shortest(spec.fov_degrees) + ": too narrow for double: the eye that frames the data lies " +
+                   shortest(distance) + " from it, where double's step (" + shortest(step) +
+                   ") is more than half a pixel (" + shortest(pixel) + "); use a wider --fov, or --ortho");
     if (camera.eye == target) {
       if (!spec.view_width && !spec.view_center) return too_large("for a perspective eye that does not round onto them");
       return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +
@@ -376,6 +385,16 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
   } else {
     camera.projection = perspectiveProjection(2.0 * half_fov, aspect, camera.near_plane, camera.far_plane);
   }
+  // Data too small for double's normal range (an extent of 1e-309: 2 / width overflows) or a view
+  // whose planes overflow draw nothing: refused, where the picture was blank with a bound of 0 px.
+  bool finite = std::isfinite(camera.near_plane) && std::isfinite(camera.far_plane);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) finite = finite && std::isfinite(camera.projection[c][r]);
+  if (!finite && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's data aside)
+    return Error{"the view of the data (from " + shortest(bounds.min) + " to " + shortest(bounds.max) +
+                     ") has no finite projection: its extent is below double's smallest normal number (2.2e-308) "
+                     "or its depth beyond the largest; scale the data",
+                 ExitCode::kBadInput};
   return camera;
 }
 

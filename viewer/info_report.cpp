@@ -309,8 +309,11 @@ std::string infoReportText(const InfoReport& report) {
           "extent:             " + vec(i.extent) + "\n" +
           "largest |coord|:    " + num(i.max_abs) + "\n" +
           "float32 spacing:    " + num(i.float_spacing) + " (at the largest |coordinate|)\n" +
-          "nearest neighbour:  " + num(i.min_neighbor_distance) + " (smallest non-zero, " + str(i.neighbor_sample) +
-          " points sampled)\n" +
+          "nearest neighbour:  " +
+          (i.min_neighbor_distance > 0.0
+               ? num(i.min_neighbor_distance) + " (smallest non-zero, " + str(i.neighbor_sample) + " points sampled)\n"
+               : "none found (no two points apart, or none with finite distances, of " + str(i.neighbor_sample) +
+                     " sampled)\n") +
           "float32 enough:     " + floatEnoughText(report) + "\n";
   if (report.advice) text += adviceText(*report.advice);
   return text;

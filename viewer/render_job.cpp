@@ -284,6 +284,11 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
     return Error{inputs + ": a streamed set (" + std::to_string(ply->count()) + " points) is read once: "
                  "--error, --order morton and --views 4 need it in memory (--stream off)", ExitCode::kUsage};
+  // A mesh's surface is sampled in memory: asked for on a stream, it is refused (it was drawn as
+  // its vertices without a word).
+  if (ply && request.surface == SurfaceChoice::kOn && ply->faceCount() > 0)
+    return Error{inputs + ": a streamed mesh (" + std::to_string(ply->count()) + " vertices) is drawn as its "
+                 "vertices: --surface on samples its surface in memory (--stream off)", ExitCode::kUsage};
   if (ply) {
     if (ply->count() == 0) return Error{inputs + ": no points to render", ExitCode::kBadInput};
     // --max-memory bounds a stream too (a review finding: 50M let a 5M-point stream peak at 590 MB).
@@ -322,21 +327,32 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   }
   // A mesh PLY is read with its faces when its surface may be drawn: asked for, or (auto) with few
   // enough vertices that they may lie far apart on screen (a 16th of the pixels; its header says).
-  const bool may_sample = request.surface != SurfaceChoice::kOff && request.inputs.size() == 1;
+  // Several PLY inputs (a complete tile set, whose parts are welded into the whole, or meshes side
+  // by side) are one mesh as well: their counts add up.
+  const bool may_sample = request.surface != SurfaceChoice::kOff;
   bool points_only = true;
   if (may_sample) {
-    Result<FileFormat> format = formatOf(request.inputs[0]);
-    if (format && *format == FileFormat::kPly)
-      if (Result<std::unique_ptr<PlyVertexStream>> header = PlyVertexStream::open(request.inputs[0]); header)
-        points_only = (*header)->faceCount() == 0 ||
-                      (request.surface == SurfaceChoice::kAuto &&
-                       (*header)->count() >= uint64_t{request.camera.width} * request.camera.height / 16);
+    uint64_t vertices = 0, faces = 0;
+    bool plys = true;
+    for (const std::string& input : request.inputs) {
+      Result<FileFormat> format = formatOf(input);
+      Result<std::unique_ptr<PlyVertexStream>> header =
+          format && *format == FileFormat::kPly ? PlyVertexStream::open(input) : Error{"not a PLY"};
+      if (!header) {
+        plys = false;
+        break;
+      }
+      vertices += (*header)->count(), faces += (*header)->faceCount();
+    }
+    points_only = !plys || faces == 0 ||
+                  (request.surface == SurfaceChoice::kAuto &&
+                   vertices >= uint64_t{request.camera.width} * request.camera.height / 16);
   }
   ReadOptions read_options{request.threads, false, &progress, points_only};
   read_options.max_memory = request.max_memory;
   read_options.las_color = lasColorOf(request.color);
   read_options.columns = request.columns;
-  if (may_sample) read_options.texture = &set.texture;  // a mesh's surface samples take its texture
+  if (may_sample && request.inputs.size() == 1) read_options.texture = &set.texture;  // its samples take its texture
   Result<PointSet> read = readPointInputs(request.inputs, read_options);
   if (!read) return read.error();
   set.owned = std::move(*read);

@@ -158,6 +158,35 @@ TEST(Info, nonFinitePointsAreLeftOutOfTheNearestDistance) {
   EXPECT_EQ(computeInfo(merged).float_merged, 1u);
 }
 
+// The bounds pass NaN coordinates over, whatever the points' order, whole or streamed: with a NaN
+// first they were NaN, with it later they were the other points' (helper review, --allow-nonfinite).
+// An axis of NaNs only is NaN; an infinity is a bound.
+TEST(Info, boundsPassNanOverInAnyOrder) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (bool nan_first : {true, false}) {
+    PointSet s;
+    s.positions = {{1.0, 1.0, nan}, {nan, 0.0, nan}};
+    if (nan_first) std::swap(s.positions[0], s.positions[1]);
+    const PointSetInfo whole = computeInfo(s);
+    EXPECT_EQ(whole.min.x, 1.0) << nan_first;
+    EXPECT_EQ(whole.max.x, 1.0) << nan_first;
+    EXPECT_EQ(whole.min.y, 0.0) << nan_first;
+    EXPECT_EQ(whole.max.y, 1.0) << nan_first;
+    EXPECT_TRUE(std::isnan(whole.min.z) && std::isnan(whole.max.z)) << nan_first;
+    const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+      out.positions.assign(s.positions.begin() + static_cast<long>(first), s.positions.begin() + static_cast<long>(first + n));
+      return okStatus();
+    };
+    Result<StreamedInfo> streamed = computeStreamedInfo(s.size(), false, 0, read, 1, s.size());
+    ASSERT_TRUE(streamed.ok());
+    EXPECT_EQ(streamed->info.min.x, 1.0) << nan_first;
+    EXPECT_EQ(streamed->info.min.y, 0.0) << nan_first;
+  }
+  PointSet with_inf;
+  with_inf.positions = {{0.0, 0.0, 0.0}, {inf, 1.0, 1.0}};
+  EXPECT_EQ(computeInfo(with_inf).max.x, inf);
+}
+
 TEST(Info, emptySetHasZeroCount) {
   const PointSetInfo i = computeInfo(PointSet{});
   EXPECT_EQ(i.count, 0u);

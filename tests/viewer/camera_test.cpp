@@ -395,6 +395,28 @@ TEST(Camera, orthoFitOfDataNearTheLargestDoubleFillsThePicture) {
   EXPECT_NE(portrait.error().message.find("beyond the largest double"), std::string::npos) << portrait.error().message;
 }
 
+// A --fov so narrow that double cannot place the points within half a pixel of the fitted eye, and
+// data below double's normal range, are refused naming why (each drew a blank picture with a bound
+// of 0 px, exit 0); --fov 1e-9 still frames the data.
+TEST(Camera, viewsBeyondDoubleAreRefused) {
+  const Bounds box{glm::dvec3(0.0), glm::dvec3(1.0), false};
+  CameraSpec narrow;
+  narrow.fov_degrees = 1e-15;
+  Result<Camera> blank = makeCamera(narrow, box);
+  ASSERT_FALSE(blank);
+  EXPECT_EQ(blank.error().code, ExitCode::kUsage);
+  EXPECT_NE(blank.error().message.find("--fov 1e-15: too narrow for double"), std::string::npos) << blank.error().message;
+  narrow.fov_degrees = 1e-9;
+  expectFramed(make(narrow, box), box, 0.85);
+  for (bool planar : {true, false}) {
+    const Bounds tiny{glm::dvec3(0.0), glm::dvec3(1e-309, 1e-309, planar ? 0.0 : 1e-309), planar};
+    Result<Camera> camera = makeCamera(CameraSpec{}, tiny);
+    ASSERT_FALSE(camera) << planar;
+    EXPECT_EQ(camera.error().code, ExitCode::kBadInput);
+    EXPECT_NE(camera.error().message.find("no finite projection"), std::string::npos) << camera.error().message;
+  }
+}
+
 // The fit of a set with an outline frames the points, not the box's empty corners: a Mandelbulb
 // (its box corners project ~1.4x wider than it) spans ≥ 85% of the smaller side, every point
 // inside the picture. With the box alone it spans ~72%.

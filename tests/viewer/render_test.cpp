@@ -339,6 +339,37 @@ TEST_P(Render, computeAgreesWithRasterAtPointSizes1To3) {
   }
 }
 
+// A large point whose centre lies just outside the picture still draws the part of its square
+// inside, on both backends alike (the rasterizer's guard band): the compute backend clipped such a
+// point by its centre, so points along the picture's edges were missing there and the backends
+// differed (35,560 pixels of a close-up Mandelbulb at 1024x768, 29,638 of them at its edges).
+TEST_P(Render, aLargePointJustOutsideThePictureDrawsItsPartInside) {
+  PointSet set;
+  set.positions = {{1.2, 0.0, 0.0}, {-1.0, -0.5, 0.0}, {0.0, 1.6, 0.0}};  // the last: its square is all outside
+  set.colors = {glm::vec3(1.0f), glm::vec3(1.0f), glm::vec3(1.0f)};
+  CameraSpec spec;
+  spec.width = 400, spec.height = 300;
+  spec.ortho = true;
+  spec.view_center = glm::dvec3(0.0);
+  spec.view_width = 2.0;
+  Result<Camera> camera = makeCamera(spec, boundsOf(set));
+  ASSERT_TRUE(camera.ok()) << camera.error().message;
+  RenderOptions options;
+  options.point_size = 100.0f;
+  options.backend = GetParam();
+  Result<RenderResult> r = renderPoints(*context_, set, *camera, options);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  const auto lit = [&](uint32_t x, uint32_t y) {
+    const size_t at = (size_t{y} * r->image.width + x) * 4;
+    return r->image.rgba[at] != 0 || r->image.rgba[at + 1] != 0 || r->image.rgba[at + 2] != 0;
+  };
+  // x = 1.2 is pixel 440 of 400: its square spans 390-489, so columns 390-399 of rows 100-199.
+  EXPECT_TRUE(lit(399, 150) && lit(390, 150) && lit(395, 100) && lit(395, 199));
+  EXPECT_FALSE(lit(389, 150) || lit(395, 99) || lit(395, 200));
+  EXPECT_TRUE(lit(0, 50) || lit(0, 249)) << "the point on the left edge, half inside";
+  EXPECT_EQ(litPixels(r->image, options.background_rgba8), size_t{10 * 100 + 50 * 100}) << "nothing of the third";
+}
+
 // Round points (RenderOptions::round_points) are the same discs on both backends, at one depth
 // per pixel that falls towards the rim: all but under 1% of the lit pixels agree (a pixel centre on
 // a disc's rim, lavapipe's sub-pixel snapping); and a disc is not its square: its corners are left
