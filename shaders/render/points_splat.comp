@@ -93,8 +93,10 @@ void splat(uint i, vec4 clip) {
   // picture, and only a centre beyond twice the view (a point no larger than the picture cannot
   // reach in from there; nor overflow the pixel coordinates) is left out here. Clipped by its
   // centre, the points along the picture's edges were missing, and compute and raster differed.
-  // (One max and one product: the two sides tested apart cost the H200's 16.7M-point frame 1.6%.)
-  const float reach = kLargePoints && pc.point_size != 1.0 ? 2.0 : 1.0;
+  // (The pipeline of larger points draws no 1-px ones: render.cpp. One max, and a product only in
+  // that pipeline: the two sides tested apart, each with a size read, cost the H200's 16.7M-point
+  // 3-px frame 1.6%.)
+  const float reach = kLargePoints ? 2.0 : 1.0;
   if (!(clip.w > 0.0) || clip.z < 0.0 || clip.z > clip.w || max(abs(clip.x), abs(clip.y)) > reach * clip.w) return;
   float depth = clip.z / clip.w;
   float x = (clip.x / clip.w * 0.5 + 0.5) * float(pc.width);
