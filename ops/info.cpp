@@ -424,13 +424,26 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   const size_t n = points.size();
   const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
   if (n >= 2) {
+    // Distances in units of about the set's extent (a power of two: exact), so that their squares
+    // neither overflow at 1e200 nor underflow at 1e-200 (where the nearest was found to be none);
+    // no larger than keeps the largest coordinate finite.
+    const double largest = std::max({info.extent.x, info.extent.y, info.extent.z});
+    double unit = 1.0;
+    if (largest > 0.0 && std::isfinite(largest)) {
+      int exponent = std::clamp(-std::ilogb(largest), -1000, 1000);
+      if (info.max_abs > 0.0 && std::isfinite(info.max_abs)) exponent = std::min(exponent, 1000 - std::ilogb(info.max_abs));
+      unit = std::ldexp(1.0, exponent);
+    }
     const size_t step = n / sample;
     PositionArray sampled(sample);
-    for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step];
+    for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step] * unit;
     std::vector<double> best2(sample, std::numeric_limits<double>::infinity());
-    PositionArray scratch = points.positions;  // the trees reorder it
+    PositionArray scratch(n);  // the trees reorder it
+    parallelFor((n + (size_t{1} << 16) - 1) >> 16, threads, [&](size_t b, unsigned) {
+      for (size_t i = b << 16, end = std::min(n, (b + 1) << 16); i < end; ++i) scratch[i] = points.positions[i] * unit;
+    });
     Forest(scratch, threads).nearestNonzero(sampled, best2, threads);
-    info.min_neighbor_distance = smallestDistance(best2);
+    info.min_neighbor_distance = smallestDistance(best2) / unit;
     info.neighbor_sample = sample;
   }
   return info;

@@ -187,6 +187,20 @@ TEST(Info, boundsPassNanOverInAnyOrder) {
   EXPECT_EQ(computeInfo(with_inf).max.x, inf);
 }
 
+// The nearest distance at any scale: a grid 1e-200 or 1e200 apart (the build before squared the
+// raw differences, 0 or infinite there, and found none); streamed sets still square them (left).
+TEST(Info, nearestNeighbourHoldsAtAnyScale) {
+  for (double scale : {1e-200, 1.0, 1e200}) {
+    PointSet s;
+    for (int k = 0; k < 1000; ++k) s.positions.emplace_back(k % 10 * scale, k / 10 % 10 * scale, k / 100 * scale);
+    const PointSetInfo info = computeInfo(s, s.size());
+    EXPECT_NEAR(info.min_neighbor_distance / scale, 1.0, 1e-12) << scale;
+  }
+  PointSet far;  // near the largest double, a tiny extent: the unit keeps the coordinates finite
+  far.positions = {{1e300, 0.0, 0.0}, {1e300 + 1e285, 0.0, 0.0}, {1e300 + 3e285, 0.0, 0.0}};
+  EXPECT_EQ(computeInfo(far).min_neighbor_distance, far.positions[1].x - far.positions[0].x);
+}
+
 TEST(Info, emptySetHasZeroCount) {
   const PointSetInfo i = computeInfo(PointSet{});
   EXPECT_EQ(i.count, 0u);
