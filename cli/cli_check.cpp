@@ -61,7 +61,7 @@ CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open
     double v = 0.0;
     if (!CLI::detail::lexical_cast(value, v)) return std::string();  // CLI11's conversion error follows
     if ((open_low ? v > lo : v >= lo) && v <= hi) return std::string();
-    return flag + " " + formatNumber(v) + ": must be in " + range;
+    return flag + " " + value + ": must be in " + range;  // as typed (1e+08 for 100000000 puzzled)
   });
 }
 

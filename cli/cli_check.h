@@ -37,7 +37,7 @@ CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed);
 CLI::Option* addChoiceOption(CLI::App& command, const std::string& flag, std::string& value, const std::string& help,
                              std::vector<std::string> allowed);
 // A number CLI11 reads as double in [lo, hi] (or (lo, hi] with `open_low`), else
-// "FLAG must be in RANGE UNIT, got VALUE" (the value in shortest form). Text that is no number is
+// "FLAG VALUE: must be in RANGE UNIT" (the value as typed). Text that is no number is
 // left to CLI11's conversion.
 CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open_low, const std::string& unit);
 // "FLAG VALUE: must be a number above 0" / "…: must be 0 or more", in place of CLI11's

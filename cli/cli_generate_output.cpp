@@ -62,7 +62,9 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
   cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");
   cmd.add_option("--tile", o.tile,
                  "I/N: compute only tile I (from 0) of N of the set, into a .ply part that `dpoint merge` welds with\n"
-                 "the others into the file one process writes, byte for byte (--order then goes to merge)");
+                 "the others into the file one process writes, byte for byte (--order then goes to merge)")
+      // An empty value wrote the whole set as if no --tile were given (a review finding).
+      ->check(check([](const std::string& v) { return v.empty() ? std::string("--tile: empty; give I/N, e.g. 0/4") : ""; }));
   addCommonOptions(cmd, o.common);
 }
 

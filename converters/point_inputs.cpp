@@ -37,11 +37,14 @@ Result<bool> checkInputSet(const std::vector<std::string>& paths) {
     return false;
   std::vector<std::string> given;  // by index, of the first file's count
   uint32_t count = 0;
+  std::string signature;
   for (size_t i = 0; i < paths.size(); ++i) {
     Result<TileHeader> h = readTileHeader(paths[i]);
     if (!h) return h.error();
-    if (i == 0) count = h->tile.count, given.assign(count, "");
-    if (h->tile.count != count) return false;  // tiles of several runs: file by file
+    if (i == 0) count = h->tile.count, given.assign(count, ""), signature = h->signature;
+    // Tiles of several runs (another count, or other options: a tile 0 of each was "tile 0 again"):
+    // file by file.
+    if (h->tile.count != count || h->signature != signature) return false;
     if (!given[h->tile.index].empty())
       return Error{paths[i] + ": tile " + std::to_string(h->tile.index) + " again (also " + given[h->tile.index] + ")"};
     given[h->tile.index] = paths[i];

@@ -48,7 +48,7 @@ TEST(CliLimits, hugeCountsFailAtOnceNamingTheNumber) {
        "--resolution 100000: must be 2..65536"},
       // The build before ran out of memory (SIGKILL) making a list a thread for the point spacing.
       {"--threads 100000000", {"render", dir.file("small.csv"), "-o", dir.file("out.png"), "--threads", "100000000"}, 1,
-       "--threads 1e+08: must be in [0, 4096]"},
+       "--threads 100000000: must be in [0, 4096]"},
   };
   for (const Huge& c : cases) {
     SCOPED_TRACE(c.what);

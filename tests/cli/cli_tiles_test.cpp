@@ -93,6 +93,7 @@ TEST(CliTiles, badTilesAreRefusedNamingTheFlag) {
       {{"julia", "--tile", "5/4", "-o", out}, "--tile: '5/4' asks for tile 5, but tiles are 0..3"},
       {{"julia", "--tile", "0/0", "-o", out}, "--tile: '0/0' asks for N outside"},
       {{"julia", "--tile", "x", "-o", out}, "--tile: 'x' is not I/N"},
+      {{"julia", "--tile", "", "-o", out}, "--tile: empty; give I/N"},  // wrote the whole set before
       {{"julia", "--tile", "0/2", "-o", dir.file("t.csv")}, "a tile is written as .ply"},
       {{"julia", "--tile", "0/2", "--order", "morton", "-o", out}, "--order morton needs the whole set"},
       {{"menger", "--method", "voxel", "--tile", "0/2", "-o", out}, "--method voxel has no split"},
@@ -284,6 +285,13 @@ TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   EXPECT_TRUE(readFile(dir.file("partial-off.png")) == readFile(dir.file("partial-on.png")));
+  // Tile 0 of another run (other options) beside this run's tile 0: two files, read file by file
+  // (it was refused as "tile 0 again").
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "30", "-q", "--tile", "0/4", "-o", dir.file("other-0.ply")})
+                .exit_code,
+            0);
+  r = runDpoint({"render", parts[0], dir.file("other-0.ply"), "-q", "-o", dir.file("two-runs.png")});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   // A review finding: a file or a tile given twice was read twice, a set too large with no word.
   std::filesystem::copy_file(parts[1], dir.file("copy-of-1.ply"));
   for (const char* stream : {"off", "on"}) {
