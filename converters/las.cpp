@@ -632,7 +632,7 @@ class RecordEncoder {
     for (const LasExtraField& e : l.extra) {
       Slot slot{e.type, l.base_length + e.offset, 0, 0, &points.dimensions.all()[e.dimension],
                 e.scaled ? Convert::kScaled : Convert::kNone};
-      slot.scale = e.value_scale, slot.add = e.value_offset;  // each value fits (lasSourceExtraField)
+      slot.field = &e;  // each value fits its scale (lasSourceExtraField)
       slots_.push_back(slot);
     }
     rgb_at_ = points.hasColors() ? lasRgbOffset(l.format) : 0;
@@ -665,7 +665,7 @@ class RecordEncoder {
       } else if (s.convert == Convert::kRankToAngle) {
         storeValue(r + s.offset, s.type, s.source->value(i) / 0.006);
       } else if (s.convert == Convert::kScaled) {
-        storeValue(r + s.offset, s.type, std::nearbyint((s.source->value(i) - s.add) / s.scale));
+        storeValue(r + s.offset, s.type, lasStoredNumber(*s.field, s.source->value(i)));
       } else if (s.source->type == s.type) {
         const size_t w = dimTypeSize(s.type);
         std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
@@ -728,7 +728,7 @@ class RecordEncoder {
     Convert convert;
     uint32_t missing = 0;  // the value where the set lacks the dimension
     bool check = false;    // whether a value of the source may not fit this integer field
-    double scale = 1.0, add = 0.0;  // kScaled: the stored number is (value - add) / scale
+    const LasExtraField* field = nullptr;  // kScaled: its scale and offset (lasStoredNumber)
   };
 
   // Whether every value of type `from` is one of integer type `to` (a widening: no check needed).

@@ -169,14 +169,14 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
         const uint32_t width = static_cast<uint32_t>(dimTypeSize(*type));
         for (uint32_t e = 0; e < elements; ++e) {
           LasExtraField field{unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width};
-          // Bit 3: scale, bit 4: offset, one a value (LAS 1.4 R15 table 24).
-          field.scaled = (options & 0x18) != 0;
-          if (options & 0x08) field.value_scale = loadUnaligned<double>(d + kScaleAt + 8 * e);
-          if (options & 0x10) field.value_offset = loadUnaligned<double>(d + kOffsetAt + 8 * e);
-          if (!std::isfinite(field.value_scale) || field.value_scale == 0.0 || !std::isfinite(field.value_offset))
-            return Error{"extra bytes descriptor " + std::to_string(k) + " ('" + name + "'): scale " +
-                         std::to_string(field.value_scale) + " and offset " + std::to_string(field.value_offset) +
-                         " are not a finite non-zero scale and a finite offset"};
+          // Bit 3: scale, bit 4: offset, one a value (LAS 1.4 R15 table 24). A scale of 0 or one
+          // not finite (or such an offset) says nothing: the field is read as stored.
+          const double scale = options & 0x08 ? loadUnaligned<double>(d + kScaleAt + 8 * e) : 1.0;
+          const double offset = options & 0x10 ? loadUnaligned<double>(d + kOffsetAt + 8 * e) : 0.0;
+          if ((options & 0x18) && std::isfinite(scale) && scale != 0.0 && std::isfinite(offset)) {
+            field.scaled = true;
+            field.value_scale = scale, field.value_offset = offset;
+          }
           if (elements == 1) field.descriptor.assign(d, kDescriptorBytes);
           out.push_back(std::move(field));
         }
@@ -213,12 +213,17 @@ std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::
   if (descriptor.size() != kDescriptorBytes) return std::nullopt;
   const uint8_t data_type = static_cast<uint8_t>(descriptor[2]), options = static_cast<uint8_t>(descriptor[3]);
   if (data_type < 1 || data_type > 10) return std::nullopt;
+  // As the reader takes it: scaled only by a finite, non-zero scale and a finite offset.
   LasExtraField field{d.name.substr(0, 32), static_cast<DimType>(data_type - 1), 0};
-  field.scaled = (options & 0x18) != 0;
-  if (options & 0x08) field.value_scale = loadUnaligned<double>(descriptor.data() + kScaleAt);
-  if (options & 0x10) field.value_offset = loadUnaligned<double>(descriptor.data() + kOffsetAt);
-  if (field.scaled ? d.type != DimType::kF64 : d.type != field.type) return std::nullopt;
-  // Every value as the stored number (the same, or back through the scale exactly), and their range.
+  const double scale = options & 0x08 ? loadUnaligned<double>(descriptor.data() + kScaleAt) : 1.0;
+  const double offset = options & 0x10 ? loadUnaligned<double>(descriptor.data() + kOffsetAt) : 0.0;
+  if ((options & 0x18) && std::isfinite(scale) && scale != 0.0 && std::isfinite(offset)) {
+    field.scaled = true;
+    field.value_scale = scale, field.value_offset = offset;
+  }
+  if (field.dimensionType() != d.type) return std::nullopt;
+  // Every value as a stored number (the same, or back through the scale exactly), and the values'
+  // range.
   const size_t n = d.size(), block = size_t{1} << 16, blocks = (n + block - 1) / block;
   struct Part {
     bool fits = true;
@@ -229,26 +234,28 @@ std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::
     Part& part = parts[b];
     for (size_t i = b * block, end = std::min(n, i + block); i < end && part.fits; ++i) {
       const double v = d.value(i);
-      const double stored = field.scaled ? std::nearbyint((v - field.value_offset) / field.value_scale) : v;
-      part.fits = !field.scaled ||
-                  (dimensionHolds(field.type, stored) && stored * field.value_scale + field.value_offset == v);
-      part.lo = std::min(part.lo, stored), part.hi = std::max(part.hi, stored);
+      if (field.scaled) {
+        const double stored = lasStoredNumber(field, v);
+        part.fits = dimensionHolds(field.type, stored) && stored * field.value_scale + field.value_offset == v;
+      }
+      part.lo = std::min(part.lo, v), part.hi = std::max(part.hi, v);
     }
   });
   Part all;
   for (const Part& part : parts) all.fits &= part.fits, all.lo = std::min(all.lo, part.lo), all.hi = std::max(all.hi, part.hi);
   if (!all.fits) return std::nullopt;
   field.descriptor = descriptor;
-  // Bits 1 and 2: the minimum and maximum, as the stored type widened to 8 bytes.
-  const auto put = [&](size_t at, double v) {
-    char* p = field.descriptor.data() + at;
-    if (dimTypeIsFloat(field.type)) storeUnaligned<double>(p, v);
-    else if (dimTypeIsSigned(field.type)) storeUnaligned<int64_t>(p, static_cast<int64_t>(v));
-    else storeUnaligned<uint64_t>(p, static_cast<uint64_t>(v));
-  };
-  if (n > 0 && !std::isnan(all.lo) && (options & 0x02)) put(kMinAt, all.lo);
-  if (n > 0 && !std::isnan(all.hi) && (options & 0x04)) put(kMaxAt, all.hi);
+  // Bits 1 and 2: the minimum and maximum, doubles of the values, scale and offset applied
+  // (R15: "fully transformed with any applicable scale or offset values").
+  if (n > 0 && all.lo <= all.hi && (options & 0x02)) storeUnaligned<double>(field.descriptor.data() + kMinAt, all.lo);
+  if (n > 0 && all.lo <= all.hi && (options & 0x04)) storeUnaligned<double>(field.descriptor.data() + kMaxAt, all.hi);
   return field;
+}
+
+double lasStoredNumber(const LasExtraField& field, double value) {
+  const double stored = (value - field.value_offset) / field.value_scale;
+  if (field.type == DimType::kF32) return static_cast<float>(stored);
+  return dimTypeIsFloat(field.type) ? stored : std::nearbyint(stored);
 }
 
 int lasFormatFor(const PointSet& points, int preferred, bool waveforms) {

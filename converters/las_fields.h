@@ -62,10 +62,13 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
 // own descriptor where it has one, with its name, else its type and name.
 LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields);
 // A field of the source's (LasSource::extra_bytes) that dimension `d` fits as it is: its stored
-// type (the same as d's), or its scaled one (d float64, every value a stored number · scale + offset
-// exactly); the descriptor's minimum and maximum made the set's. Nothing where it does not fit:
-// the dimension is then written as its own type.
+// type (the same as d's), or its scaled one (d float64, every value a stored number · scale +
+// offset exactly); the descriptor's minimum and maximum made the set's (doubles of the values).
+// Nothing where it does not fit: the dimension is then written as its own type.
 std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::string& descriptor, unsigned threads);
+// The number a scaled field stores for `value`: (value − offset) / scale, rounded to a whole number
+// for an integer type, to a float for float32.
+double lasStoredNumber(const LasExtraField& field, double value);
 
 // The point format that holds what `points` carries: `preferred` (the source's) when it holds every
 // LAS field the set has, its colours and the values of its fields; else the smallest of formats

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -100,11 +101,16 @@ float pnoise3(float x, float y, float z) {
 }
 
 glm::vec3 seedColor(const glm::dvec3& p) {
+  // A coordinate beyond float's range (a Menger sponge of size 1e40) was infinite as a float, its
+  // noise NaN: it is taken modulo the noise's period of 1024 first (float's own coordinates, the
+  // seed's, are left as they were).
+  const auto toFloat = [](double v) {
+    return static_cast<float>(std::fabs(v) <= double(std::numeric_limits<float>::max()) ? v : std::fmod(v, 1024.0));
+  };
   glm::vec3 color;
   for (int c = 0; c < 3; ++c) {
     const double offset = 100.0 * c;
-    const double n = pnoise3(static_cast<float>(p.x + offset), static_cast<float>(p.y + offset),
-                             static_cast<float>(p.z + offset));
+    const double n = pnoise3(toFloat(p.x + offset), toFloat(p.y + offset), toFloat(p.z + offset));
     color[c] = static_cast<float>(0.5 + 0.5 * n);
   }
   return color;

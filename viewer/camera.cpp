@@ -361,7 +361,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     if (isFinite(camera.eye) && !(step <= 0.5 * pixel))
       return usage("--fov " + shortest(spec.fov_degrees) + ": too narrow for double: the eye that frames the data lies " +
                    shortest(distance) + " from it, where double's step (" + shortest(step) +
-                   ") is more than half a pixel (" + shortest(pixel) + "); use a wider --fov, or --ortho");
+                   ") is more than half a pixel there (" + shortest(0.5 * pixel) + "); use a wider --fov, or --ortho");
     if (camera.eye == target) {
       if (!spec.view_width && !spec.view_center) return too_large("for a perspective eye that does not round onto them");
       return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +

@@ -248,6 +248,13 @@ TEST(CliGenerate, coordinatesBeyondDoublesRangeAreRefused) {
     EXPECT_NE(r.err.find("double's range"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir.file("m.csv")));
   }
+  // Beyond float's range but within double's: written, its noise colours finite (they were "nan":
+  // the noise took the coordinates as floats).
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "2", "--size", "1e40", "-q", "-o", dir.file("big.csv")}).exit_code, 0);
+  const std::string csv = readFile(dir.file("big.csv"));
+  EXPECT_EQ(csv.find("nan"), std::string::npos);
+  EXPECT_EQ(csv.find("inf"), std::string::npos);
+  EXPECT_EQ(runDpoint({"convert", dir.file("big.csv"), "-o", dir.file("big.ply")}).exit_code, 0);
 }
 
 TEST(CliGenerate, outputIsIdenticalForOneAndTwoThreads) {

@@ -263,7 +263,7 @@ TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
   ASSERT_EQ(file[d + 2], 3) << "uint16";
   file[d + 3] = 0x1F;
   const auto put = [&]<typename T>(size_t offset, T v) { std::memcpy(file.data() + d + offset, &v, sizeof v); };
-  put(40, uint64_t{65535}), put(64, uint64_t{5}), put(88, uint64_t{7}), put(112, 0.1), put(136, 100.0);
+  put(40, uint64_t{65535}), put(64, 100.5), put(88, 100.7), put(112, 0.1), put(136, 100.0);
   std::memcpy(file.data() + d + 160, "amplitude in dB", 15);
   writeFile(dir.file("scaled.las"), file);
 
@@ -275,7 +275,7 @@ TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
   EXPECT_EQ(a->get<double>(0), 5 * 0.1 + 100.0);
   EXPECT_EQ(a->get<double>(1), 7 * 0.1 + 100.0);
 
-  // LAS → LAS (and LAZ): the same records, the same descriptor but its range (5 .. 65535 now).
+  // LAS → LAS (and LAZ): the same records, the same descriptor but its range (of 65535 now too).
   for (const char* name : {"back.las", "back.laz"}) {
     LasWriteOptions options;
     options.compress = std::string(name).ends_with(".laz");
@@ -289,13 +289,51 @@ TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
   const size_t b = descriptorAt(back);
   ASSERT_NE(b, std::string::npos);
   EXPECT_EQ(back.compare(b, 64, file, d, 64), 0) << "type, options, name, no-data";
-  EXPECT_EQ(at<uint64_t>(back, b + 64), 5u);
-  EXPECT_EQ(at<uint64_t>(back, b + 88), 65535u);
+  // Min and max are doubles of the values, scale and offset applied (R15); the set's now reach the
+  // no-data value's 6653.5.
+  EXPECT_EQ(at<double>(back, b + 64), 5 * 0.1 + 100.0);
+  EXPECT_EQ(at<double>(back, b + 88), 65535 * 0.1 + 100.0);
   EXPECT_EQ(back.compare(b + 112, 80, file, d + 112, 80), 0) << "scale, offset, description";
 
   // CSV has the values.
   ASSERT_TRUE(writeCsv(dir.file("a.csv"), *read));
   EXPECT_NE(readFile(dir.file("a.csv")).find(",100.5\n"), std::string::npos) << readFile(dir.file("a.csv"));
+
+  // A scale of 0 says nothing: the field is read as stored, the other fields as they were (one such
+  // descriptor made every field of the file undescribed bytes).
+  {
+    std::string zero = file;
+    put(112, 0.0);
+    writeFile(dir.file("zero.las"), file);
+    file = zero;
+    Result<PointSet> raw = readLas(dir.file("zero.las"));
+    ASSERT_TRUE(raw);
+    ASSERT_TRUE(raw->dimensions.find("amplitude"));
+    EXPECT_EQ(raw->dimensions.find("amplitude")->type, DimType::kU16);
+    EXPECT_EQ(raw->dimensions.find("amplitude")->value(1), 7.0);
+  }
+
+  // A scaled float32 field: its stored floats back through the scale, not rounded to whole
+  // numbers (it was written as float64 and the record grew).
+  {
+    PointSet floats;
+    floats.positions = {{0, 0, 0}, {1, 2, 3}};
+    Dimension& width = floats.dimensions.add("echo_width", DimType::kF32, 2);
+    width.set<float>(0, 1.25f), width.set<float>(1, 3.1f);
+    ASSERT_TRUE(writeLas(dir.file("f.las"), floats));
+    std::string f = readFile(dir.file("f.las"));
+    const size_t fd = descriptorAt(f);
+    ASSERT_EQ(f[fd + 2], 9) << "float32";
+    f[fd + 3] = 0x08;
+    const double half = 0.5;
+    std::memcpy(f.data() + fd + 112, &half, sizeof half);
+    writeFile(dir.file("f-scaled.las"), f);
+    Result<PointSet> scaled = readLas(dir.file("f-scaled.las"));
+    ASSERT_TRUE(scaled);
+    EXPECT_EQ(scaled->dimensions.find("echo_width")->get<double>(1), double(3.1f) * 0.5);
+    ASSERT_TRUE(writeLas(dir.file("f-back.las"), *scaled));
+    EXPECT_TRUE(recordsOf(dir.file("f-back.las")).bytes == recordsOf(dir.file("f-scaled.las")).bytes);
+  }
 
   // A value the scale cannot store: the dimension is written as float64, unscaled, exactly.
   read->dimensions.find("amplitude")->set<double>(2, 100.55);
