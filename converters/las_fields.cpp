@@ -83,6 +83,19 @@ constexpr size_t kDescriptorBytes = 192;
 // Where a descriptor's name, minimum, maximum, scale and offset start (LAS 1.4 R15 table 24).
 constexpr size_t kNameAt = 4, kMinAt = 64, kMaxAt = 88, kScaleAt = 112, kOffsetAt = 136;
 
+// The scale and offset of element e of the descriptor at d into `field`: options bit 3 (scale) and
+// bit 4 (offset). A scale of 0 or one not finite (or such an offset) says nothing: the field is
+// then read as stored, as where neither bit is set.
+void takeScaling(const char* d, uint32_t e, LasExtraField& field) {
+  const uint8_t options = static_cast<uint8_t>(d[3]);
+  const double scale = options & 0x08 ? loadUnaligned<double>(d + kScaleAt + 8 * e) : 1.0;
+  const double offset = options & 0x10 ? loadUnaligned<double>(d + kOffsetAt + 8 * e) : 0.0;
+  if ((options & 0x18) && std::isfinite(scale) && scale != 0.0 && std::isfinite(offset)) {
+    field.scaled = true;
+    field.value_scale = scale, field.value_offset = offset;
+  }
+}
+
 bool hasField(int format, const std::string& name) {
   const std::vector<LasField>& fields = lasFields(format);
   return std::any_of(fields.begin(), fields.end(), [&](const LasField& f) { return name == f.name; });
@@ -169,14 +182,7 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
         const uint32_t width = static_cast<uint32_t>(dimTypeSize(*type));
         for (uint32_t e = 0; e < elements; ++e) {
           LasExtraField field{unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width};
-          // Bit 3: scale, bit 4: offset, one a value (LAS 1.4 R15 table 24). A scale of 0 or one
-          // not finite (or such an offset) says nothing: the field is read as stored.
-          const double scale = options & 0x08 ? loadUnaligned<double>(d + kScaleAt + 8 * e) : 1.0;
-          const double offset = options & 0x10 ? loadUnaligned<double>(d + kOffsetAt + 8 * e) : 0.0;
-          if ((options & 0x18) && std::isfinite(scale) && scale != 0.0 && std::isfinite(offset)) {
-            field.scaled = true;
-            field.value_scale = scale, field.value_offset = offset;
-          }
+          takeScaling(d, e, field);
           if (elements == 1) field.descriptor.assign(d, kDescriptorBytes);
           out.push_back(std::move(field));
         }
@@ -213,14 +219,8 @@ std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::
   if (descriptor.size() != kDescriptorBytes) return std::nullopt;
   const uint8_t data_type = static_cast<uint8_t>(descriptor[2]), options = static_cast<uint8_t>(descriptor[3]);
   if (data_type < 1 || data_type > 10) return std::nullopt;
-  // As the reader takes it: scaled only by a finite, non-zero scale and a finite offset.
   LasExtraField field{d.name.substr(0, 32), static_cast<DimType>(data_type - 1), 0};
-  const double scale = options & 0x08 ? loadUnaligned<double>(descriptor.data() + kScaleAt) : 1.0;
-  const double offset = options & 0x10 ? loadUnaligned<double>(descriptor.data() + kOffsetAt) : 0.0;
-  if ((options & 0x18) && std::isfinite(scale) && scale != 0.0 && std::isfinite(offset)) {
-    field.scaled = true;
-    field.value_scale = scale, field.value_offset = offset;
-  }
+  takeScaling(descriptor.data(), 0, field);  // as the reader takes it
   if (field.dimensionType() != d.type) return std::nullopt;
   // Every value as a stored number (the same, or back through the scale exactly), and the values'
   // range.

@@ -15,6 +15,7 @@
 #include <glm/ext/vector_int3_sized.hpp>
 
 #include "core/parallel.h"
+#include "ops/point_spacing.h"
 
 namespace dpoint {
 namespace {
@@ -424,16 +425,9 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   const size_t n = points.size();
   const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
   if (n >= 2) {
-    // Distances in units of about the set's extent (a power of two: exact), so that their squares
-    // neither overflow at 1e200 nor underflow at 1e-200 (where the nearest was found to be none);
-    // no larger than keeps the largest coordinate finite.
-    const double largest = std::max({info.extent.x, info.extent.y, info.extent.z});
-    double unit = 1.0;
-    if (largest > 0.0 && std::isfinite(largest)) {
-      int exponent = std::clamp(-std::ilogb(largest), -1000, 1000);
-      if (info.max_abs > 0.0 && std::isfinite(info.max_abs)) exponent = std::min(exponent, 1000 - std::ilogb(info.max_abs));
-      unit = std::ldexp(1.0, exponent);
-    }
+    // The points scaled to units of about the set's extent (lengthUnit): squared distances at
+    // 1e-200 underflowed, and the nearest was found to be none.
+    const double unit = lengthUnit(std::max({info.extent.x, info.extent.y, info.extent.z}), info.max_abs);
     const size_t step = n / sample;
     PositionArray sampled(sample);
     for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step] * unit;

@@ -86,11 +86,8 @@ PositionArray SpacingSampler::finish() const {
 
 SpacingSearch::SpacingSearch(const Box& box, uint64_t count, PositionArray samples, unsigned threads)
     : samples_(std::move(samples)), threads_(resolveThreads(threads)), origin_(box.min) {
-  // Lengths are measured in units of about the box (a power of two: exact), so that volumes and
-  // squared distances neither overflow nor underflow at 1e200 or 1e-200.
-  const double largest_raw = std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
-  if (largest_raw > 0.0 && std::isfinite(largest_raw))
-    unit_ = std::ldexp(1.0, std::clamp(-std::ilogb(largest_raw), -1000, 1000));
+  // Volumes and squared distances in units of about the box (lengthUnit).
+  unit_ = lengthUnit(std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z}));
   const glm::dvec3 extent = (box.max - box.min) * unit_;
   const double largest = std::max({extent.x, extent.y, extent.z});
   const double n = double(std::max<uint64_t>(count, 1));
@@ -222,6 +219,14 @@ std::vector<SpacingSample> SpacingSearch::finish() const {
   }
   if (2 * out.size() < samples_.size()) out.clear();
   return out;
+}
+
+double lengthUnit(double extent, double largest_coordinate) {
+  if (!(extent > 0.0) || !std::isfinite(extent)) return 1.0;
+  int exponent = std::clamp(-std::ilogb(extent), -1000, 1000);
+  if (largest_coordinate > 0.0 && std::isfinite(largest_coordinate))
+    exponent = std::min(exponent, 1000 - std::ilogb(largest_coordinate));
+  return std::ldexp(1.0, exponent);
 }
 
 std::vector<SpacingSample> sampleSpacing(const PositionArray& positions, const Box& box, size_t samples,

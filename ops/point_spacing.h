@@ -78,6 +78,12 @@ class SpacingSearch {
   std::vector<std::vector<Best>> best_;     // per worker, per sample
 };
 
+// A power of two near 1 / `extent` (1 where that is 0 or not finite): lengths of about the extent
+// are measured in it, so that their squares and volumes neither overflow at 1e200 nor underflow at
+// 1e-200; exact, as it moves only the exponent. With `largest_coordinate`, no larger than keeps
+// coordinates up to it finite, for a caller that scales the points themselves.
+double lengthUnit(double extent, double largest_coordinate = 0.0);
+
 // Both passes over a set in memory: up to `samples` samples. Empty when the set has fewer than 2
 // distinct positions or SpacingSearch finds too few. About 10 ms for 1.55M points on 2 cores.
 std::vector<SpacingSample> sampleSpacing(const PositionArray& positions, const Box& box, size_t samples,

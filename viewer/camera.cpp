@@ -59,6 +59,11 @@ std::string shortest(const glm::dvec3& v) {
 }
 
 bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool isFinite(const glm::dmat4& m) {
+  for (int c = 0; c < 4; ++c)
+    if (!isFinite(glm::dvec3(m[c])) || !std::isfinite(m[c].w)) return false;
+  return true;
+}
 
 double maxAbs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
 
@@ -387,9 +392,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
   }
   // Data too small for double's normal range (an extent of 1e-309: 2 / width overflows) or a view
   // whose planes overflow draw nothing: refused, where the picture was blank with a bound of 0 px.
-  bool finite = std::isfinite(camera.near_plane) && std::isfinite(camera.far_plane);
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) finite = finite && std::isfinite(camera.projection[c][r]);
+  const bool finite = std::isfinite(camera.near_plane) && std::isfinite(camera.far_plane) && isFinite(camera.projection);
   if (!finite && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's data aside)
     return Error{"the view of the data (from " + shortest(bounds.min) + " to " + shortest(bounds.max) +
                      ") has no finite projection: its extent is below double's smallest normal number (2.2e-308) "
