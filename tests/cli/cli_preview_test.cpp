@@ -3,46 +3,28 @@
 // decoded (stb_image) where a test looks at pixels; elsewhere whole files are compared.
 #include <gtest/gtest.h>
 
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb/stb_image.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "cli/cli_png.h"
 #include "test_support.h"
+
+// stb_image's implementation for cli_tests, after cli_png.h has declared it.
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
 
 namespace dpoint {
 namespace {
 
 using test::concat;
+using test::decodePng;
+using test::Pixels;
 using test::readFile;
 using test::runDpoint;
 using test::TempDir;
 using test::writeFile;
-
-// RGBA8 pixels of a PNG, row by row.
-struct Pixels {
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgba;
-  uint32_t at(int x, int y) const {
-    const uint8_t* p = &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4];
-    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-  }
-};
-
-Pixels decodePng(const std::string& png) {
-  Pixels image;
-  int channels = 0;
-  stbi_uc* data = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(png.data()), int(png.size()), &image.width,
-                                        &image.height, &channels, 4);
-  EXPECT_NE(data, nullptr) << stbi_failure_reason();
-  if (data == nullptr) return image;
-  image.rgba.assign(data, data + size_t(image.width) * size_t(image.height) * 4);
-  stbi_image_free(data);
-  return image;
-}
 
 // Renders `input` (200 x 160 unless asked) with the validation layer on; returns the PNG's bytes.
 std::string render(const TempDir& dir, const std::string& input, const std::string& name,

@@ -3,8 +3,6 @@
 // with the flag or file named; render and info take the tiles as the whole set.
 #include <gtest/gtest.h>
 
-#include <stb/stb_image.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/cli_png.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -243,20 +242,17 @@ TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
   test::CommandResult r = runDpoint(concat(concat({"render", "-q", "--validate"}, parts), {"-o", dir.file("tiles.png")}));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   {
-    int w[2], h[2], channels;
-    stbi_uc* pixels[2] = {stbi_load(dir.file("whole.png").c_str(), &w[0], &h[0], &channels, 4),
-                          stbi_load(dir.file("tiles.png").c_str(), &w[1], &h[1], &channels, 4)};
-    ASSERT_TRUE(pixels[0] && pixels[1]);
-    ASSERT_TRUE(w[0] == w[1] && h[0] == h[1]);
+    const test::Pixels whole = test::decodePng(readFile(dir.file("whole.png")));
+    const test::Pixels parted = test::decodePng(readFile(dir.file("tiles.png")));
+    ASSERT_TRUE(whole.width == parted.width && whole.height == parted.height && !whole.rgba.empty());
     int most = 0;
     size_t lit = 0;
-    for (size_t i = 0; i < size_t(w[0]) * size_t(h[0]) * 4; ++i) {
-      most = std::max(most, std::abs(int(pixels[0][i]) - int(pixels[1][i])));
-      lit += i % 4 == 0 && (pixels[0][i] || pixels[0][i + 1] || pixels[0][i + 2]);
+    for (size_t i = 0; i < whole.rgba.size(); ++i) {
+      most = std::max(most, std::abs(int(whole.rgba[i]) - int(parted.rgba[i])));
+      lit += i % 4 == 0 && (whole.rgba[i] || whole.rgba[i + 1] || whole.rgba[i + 2]);
     }
-    stbi_image_free(pixels[0]), stbi_image_free(pixels[1]);
     EXPECT_LE(most, 1) << "the same surface, its colours within a level";
-    EXPECT_GT(lit, size_t(w[0]) * size_t(h[0]) / 4) << "a surface, not 2020 vertices";
+    EXPECT_GT(lit, size_t(whole.width) * size_t(whole.height) / 4) << "a surface, not 2020 vertices";
   }
   // A stream is drawn as its vertices: --surface on is refused there, not passed over.
   r = runDpoint(concat(concat({"render", "--stream", "on", "--surface", "on"}, parts), {"-o", dir.file("no.png")}));
