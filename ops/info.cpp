@@ -461,7 +461,11 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   const uint64_t box_points = block_points % kStreamedInfoBoxPoints == 0 ? kStreamedInfoBoxPoints : block_points;
   PositionArray sampled;
   sampled.reserve(static_cast<size_t>(sample));
-  std::vector<double> best2;
+  // Each sampled point's differences to the points beside it in the file (0: none there), kept
+  // until the unit of length is known (below).
+  constexpr size_t kBeside = 2 * kFileNeighbors + 1;
+  PositionArray beside;
+  beside.reserve(static_cast<size_t>(sample) * kBeside);
   std::vector<Box>& boxes = out.boxes;
   boxes.reserve(static_cast<size_t>((count + box_points - 1) / box_points));
   PointSet block;
@@ -496,30 +500,55 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
     for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k) {
       const size_t at = static_cast<size_t>(k * step - first);
       sampled.push_back(block.positions[at]);
-      double bound2 = std::numeric_limits<double>::infinity();
-      for (size_t j = at - std::min<size_t>(at, kFileNeighbors); j <= std::min<size_t>(at + kFileNeighbors, n - 1); ++j) {
-        const glm::dvec3 d = block.positions[j] - sampled.back();
-        const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
-        if (d2 > 0.0 && d2 < bound2) bound2 = d2;
-      }
-      best2.push_back(bound2);
+      const size_t from_j = at - std::min<size_t>(at, kFileNeighbors), to_j = std::min<size_t>(at + kFileNeighbors, n - 1);
+      for (size_t j = from_j; j < from_j + kBeside; ++j)
+        beside.push_back(j <= to_j ? block.positions[j] - sampled.back() : glm::dvec3(0.0));
     }
   }
   finishBounds(info);
   if (count < 2) return out;
-  // Pass 2: by boxes where most are compact enough to look up; else by blocks.
-  const SampleBalls balls(sampled, best2, info.min, info.max, boxes);
-  std::vector<std::vector<uint32_t>> near(balls.compact() ? boxes.size() : 0);
+  // Pass 2 measures in units of about the set's extent (lengthUnit, as computeInfo): squared
+  // distances at 1e-200 underflowed, and at 1e200 overflowed, so that none was found. The unit
+  // moves only exponents, so the distances are the same bits; where squares of the extent are far
+  // from either end of double's range it is 1, and the points read again are not scaled.
+  double unit = lengthUnit(std::max({info.extent.x, info.extent.y, info.extent.z}), info.max_abs);
+  if (unit >= 0x1p-300 && unit <= 0x1p300) unit = 1.0;
+  std::vector<double> best2(sampled.size(), std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < sampled.size(); ++k) {
+    sampled[k] *= unit;
+    for (size_t j = k * kBeside; j < (k + 1) * kBeside; ++j) {
+      const glm::dvec3 d = beside[j] * unit;
+      const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+      if (d2 > 0.0 && d2 < best2[k]) best2[k] = d2;
+    }
+  }
+  std::vector<Box> scaled_boxes;
+  if (unit != 1.0) {
+    scaled_boxes.resize(boxes.size());
+    for (size_t b = 0; b < boxes.size(); ++b) scaled_boxes[b] = {boxes[b].min * unit, boxes[b].max * unit};
+  }
+  const std::vector<Box>& pass_boxes = unit != 1.0 ? scaled_boxes : boxes;
+  const BlockReader scaled_read = [&](uint64_t first, uint64_t n, PointSet& into) {
+    Status s = read(first, n, into);
+    if (s && unit != 1.0)
+      parallelFor((into.positions.size() + (size_t{1} << 16) - 1) >> 16, workers, [&](size_t b, unsigned) {
+        for (size_t i = b << 16, end = std::min(into.positions.size(), (b + 1) << 16); i < end; ++i) into.positions[i] *= unit;
+      });
+    return s;
+  };
+  // By boxes where most are compact enough to look up; else by blocks.
+  const SampleBalls balls(sampled, best2, info.min * unit, info.max * unit, pass_boxes);
+  std::vector<std::vector<uint32_t>> near(balls.compact() ? pass_boxes.size() : 0);
   std::vector<uint8_t> wide(near.size(), 0);
   parallelFor(near.size(), workers, [&](size_t b, unsigned) {
-    wide[b] = !balls.near(boxes[b].min, boxes[b].max, near[b]);
+    wide[b] = !balls.near(pass_boxes[b].min, pass_boxes[b].max, near[b]);
   });
   const size_t wide_boxes = static_cast<size_t>(std::count(wide.begin(), wide.end(), uint8_t{1}));
-  Status second = balls.compact() && 4 * wide_boxes <= boxes.size()
-      ? nearestByBoxes(count, read, block_points, box_points, sampled, best2, balls, wide, near, workers, block, out.points_read_again)
-      : nearestByBlocks(count, read, block_points, box_points, boxes, sampled, best2, threads, block, out.points_read_again);
+  Status second = balls.compact() && 4 * wide_boxes <= pass_boxes.size()
+      ? nearestByBoxes(count, scaled_read, block_points, box_points, sampled, best2, balls, wide, near, workers, block, out.points_read_again)
+      : nearestByBlocks(count, scaled_read, block_points, box_points, pass_boxes, sampled, best2, threads, block, out.points_read_again);
   if (!second) return second.error();
-  info.min_neighbor_distance = smallestDistance(best2);
+  info.min_neighbor_distance = smallestDistance(best2) / unit;
   info.neighbor_sample = sampled.size();
   return out;
 }

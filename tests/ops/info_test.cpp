@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "ops/info.h"
 
@@ -188,17 +190,34 @@ TEST(Info, boundsPassNanOverInAnyOrder) {
 }
 
 // The nearest distance at any scale: a grid 1e-200 or 1e200 apart (the build before squared the
-// raw differences, 0 or infinite there, and found none); streamed sets still square them (left).
+// raw differences, 0 or infinite there, and found none), whole or streamed; streamed in the grid's
+// order in blocks of 2 (the second pass by boxes) and shuffled (by blocks, whose points are scaled as read).
 TEST(Info, nearestNeighbourHoldsAtAnyScale) {
+  const auto streamed = [](const PointSet& s, uint64_t block) {
+    const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+      out.positions.assign(s.positions.begin() + static_cast<long>(first), s.positions.begin() + static_cast<long>(first + n));
+      return okStatus();
+    };
+    Result<StreamedInfo> info = computeStreamedInfo(s.size(), false, 0, read, block, 64);
+    EXPECT_TRUE(info.ok());
+    return info.ok() ? info->info.min_neighbor_distance : -1.0;
+  };
   for (double scale : {1e-200, 1.0, 1e200}) {
     PointSet s;
-    for (int k = 0; k < 1000; ++k) s.positions.emplace_back(k % 10 * scale, k / 10 % 10 * scale, k / 100 * scale);
+    for (int k = 0; k < 8000; ++k) s.positions.emplace_back(k % 20 * scale, k / 20 % 20 * scale, k / 400 * scale);
     const PointSetInfo info = computeInfo(s, s.size());
     EXPECT_NEAR(info.min_neighbor_distance / scale, 1.0, 1e-12) << scale;
+    EXPECT_EQ(streamed(s, 2), computeInfo(s, 64).min_neighbor_distance) << scale;  // boxes of 2: compact
+    PointSet shuffled = s;
+    std::mt19937 random(7);
+    std::shuffle(shuffled.positions.begin(), shuffled.positions.end(), random);
+    EXPECT_EQ(streamed(shuffled, 1024), computeInfo(shuffled, 64).min_neighbor_distance) << scale;
+    EXPECT_NEAR(streamed(shuffled, 1024) / scale, 1.0, 1e-12) << scale;
   }
   PointSet far;  // near the largest double, a tiny extent: the unit keeps the coordinates finite
   far.positions = {{1e300, 0.0, 0.0}, {1e300 + 1e285, 0.0, 0.0}, {1e300 + 3e285, 0.0, 0.0}};
   EXPECT_EQ(computeInfo(far).min_neighbor_distance, far.positions[1].x - far.positions[0].x);
+  EXPECT_EQ(streamed(far, 1), far.positions[1].x - far.positions[0].x);
 }
 
 TEST(Info, emptySetHasZeroCount) {
