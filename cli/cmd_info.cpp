@@ -39,6 +39,7 @@ int runInfo(const InfoCliOptions& o) {
   if (o.up_axis != "auto") options.z_up = o.up_axis == "z";
   Result<InfoReport> report = describeFiles(inputs, options, progress);
   if (!report) return reportError(report.error());
+  for (const std::string& notice : report->notices) std::fprintf(stderr, "dpoint: note: %s\n", notice.c_str());
   const std::string text = o.json ? infoReportJson(*report) : infoReportText(*report);
   std::fwrite(text.data(), 1, text.size(), stdout);
   return 0;

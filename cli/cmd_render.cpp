@@ -162,8 +162,9 @@ void printChoice(const ModePrediction& p, const DeviceFacts& f, Backend backend)
   if (!passed.empty()) std::printf("mode auto: faster modes passed over: %s\n", passed.c_str());
 }
 
-// The outcome's warnings, one line each on stderr.
+// The outcome's notes on its input and its warnings, one line each on stderr.
 void printWarnings(const RenderOutcome& outcome) {
+  for (const std::string& n : outcome.notices) std::fprintf(stderr, "dpoint: note: %s\n", n.c_str());
   for (const std::string& w : outcome.warnings) std::fprintf(stderr, "dpoint: warning: %s\n", w.c_str());
 }
 

@@ -848,6 +848,24 @@ std::vector<LasVlr> readVlrs(const InputFile& file, const LasHeader& h) {
 bool isCrsRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Projection"; }
 bool isExtraBytesRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Spec" && vlr.record_id == 4; }
 
+// The extra bytes of a record of `header`'s format, as the file's extra bytes record describes
+// them; where that record cannot be followed, the bytes as they are, one field a byte, and a
+// notice that says why (a reader that refused such files would refuse their points too).
+std::vector<LasExtraField> extraFieldsOf(const std::string& path, const LasHeader& header,
+                                         const std::vector<LasVlr>& vlrs, std::vector<std::string>* notices) {
+  const LasVlr* extra_vlr = nullptr;
+  for (const LasVlr& vlr : vlrs)
+    if (isExtraBytesRecord(vlr)) extra_vlr = &vlr;
+  const uint32_t extra_bytes = header.record_length - lasBaseRecordLength(header.point_format);
+  const std::vector<LasField> base = lasFields(header.point_format);
+  Result<std::vector<LasExtraField>> extra = lasExtraFields(extra_vlr, extra_bytes, base);
+  if (extra) return std::move(*extra);
+  if (notices)
+    notices->push_back(path + ": " + extra.error().message + "; its " + str(uint64_t{extra_bytes}) +
+                       " extra bytes a point are read as they are (extra_byte_0, ...)");
+  return *lasExtraFields(nullptr, extra_bytes, base);  // without a record it cannot fail
+}
+
 }  // namespace
 
 Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
@@ -863,16 +881,11 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   // The records' fields and extra bytes become dimensions; the coordinate system's records are
   // kept for the LAS writer.
   const std::vector<LasVlr> vlrs = readVlrs(file, *header);
-  const LasVlr* extra_vlr = nullptr;
-  for (const LasVlr& vlr : vlrs)
-    if (isExtraBytesRecord(vlr)) extra_vlr = &vlr;
-  const uint32_t extra_bytes = header->record_length - lasBaseRecordLength(header->point_format);
-  Result<std::vector<LasExtraField>> extra = lasExtraFields(extra_vlr, extra_bytes, lasFields(header->point_format));
-  if (!extra) extra = lasExtraFields(nullptr, extra_bytes, lasFields(header->point_format));  // bytes as they are
+  const std::vector<LasExtraField> extra = extraFieldsOf(path, *header, vlrs, options.notices);
   // The count is bounded by the file size already; the point set must also fit --max-memory.
   uint64_t point_bytes = sizeof(glm::dvec3) + (source == LasColorSource::kNone ? 0 : sizeof(glm::vec3));
   for (const LasField& f : lasFields(header->point_format)) point_bytes += dimTypeSize(f.type);
-  for (const LasExtraField& f : *extra) point_bytes += dimTypeSize(f.dimensionType());
+  for (const LasExtraField& f : extra) point_bytes += dimTypeSize(f.dimensionType());
   if (Status fits = checkMemory(path + ": " + str(header->point_count) + " points", header->point_count * point_bytes,
                                 options.max_memory);
       !fits)
@@ -892,7 +905,7 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
     records.emplace(InputFile::fromMemory(path, decoded.view()));
     plain.compressed = false;
   }
-  LasReader reader(records ? *records : file, plain, source, options, *extra);
+  LasReader reader(records ? *records : file, plain, source, options, extra);
   Result<PointSet> points = reader.run();
   if (!points) return points;
   LasSource las;
@@ -904,7 +917,7 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   las.file_source_id = header->file_source_id;
   for (const LasVlr& vlr : vlrs)
     if (isCrsRecord(vlr)) las.vlrs.push_back(vlr);
-  for (const LasExtraField& f : *extra)
+  for (const LasExtraField& f : extra)
     if (!f.descriptor.empty()) las.extra_bytes.push_back({f.name, f.descriptor});
   points->las = std::move(las);
   return points;
@@ -919,6 +932,7 @@ struct LasPointStream::State {
   std::vector<LasExtraField> extra;
   Dimensions dimensions;  // fields then extra, empty
   std::vector<size_t> streamed;
+  std::vector<std::string> notices;
   unsigned threads = 0;
   float color_divisor = 0.0f;  // 0: no colours
   // LAZ: the chunks, and the last chunks decoded (their records) for the next block.
@@ -968,15 +982,8 @@ Result<std::unique_ptr<LasPointStream>> LasPointStream::open(const std::string& 
   if (!header) return header.error();
   st.header = *header;
   st.threads = resolveThreads(threads);
-  const std::vector<LasVlr> vlrs = readVlrs(st.file, st.header);
-  const LasVlr* extra_vlr = nullptr;
-  for (const LasVlr& vlr : vlrs)
-    if (isExtraBytesRecord(vlr)) extra_vlr = &vlr;
   st.fields = lasFields(st.header.point_format);
-  const uint32_t extra_bytes = st.header.record_length - lasBaseRecordLength(st.header.point_format);
-  Result<std::vector<LasExtraField>> extra = lasExtraFields(extra_vlr, extra_bytes, st.fields);
-  if (!extra) extra = lasExtraFields(nullptr, extra_bytes, st.fields);
-  st.extra = std::move(*extra);
+  st.extra = extraFieldsOf(path, st.header, readVlrs(st.file, st.header), &st.notices);
   for (const LasField& f : st.fields) st.dimensions.append(f.name, f.type, 0);
   for (const LasExtraField& f : st.extra) st.dimensions.append(f.name, f.dimensionType(), 0);
   if (st.header.compressed) {
@@ -1021,6 +1028,7 @@ const LasHeader& LasPointStream::header() const { return state_->header; }
 uint64_t LasPointStream::count() const { return state_->header.point_count; }
 bool LasPointStream::hasColors() const { return state_->color_divisor != 0.0f; }
 const Dimensions& LasPointStream::dimensions() const { return state_->dimensions; }
+const std::vector<std::string>& LasPointStream::notices() const { return state_->notices; }
 void LasPointStream::streamDimensions(std::vector<size_t> which) { state_->streamed = std::move(which); }
 
 Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {

@@ -93,6 +93,9 @@ struct LasReadOptions {
   Progress* progress = nullptr;
   LasColorSource color = LasColorSource::kAuto;
   uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
+  // When not null, gets a line for what the reader read past: an extra bytes record it cannot
+  // follow, whose bytes are then read as they are (extra_byte_N, one byte each).
+  std::vector<std::string>* notices = nullptr;
 };
 
 // What writeLas chose and what the file cannot hold as given.
@@ -148,6 +151,8 @@ class LasPointStream {
   bool hasColors() const;
   // The record's fields and extra bytes as dimensions, as empty columns (names and types).
   const Dimensions& dimensions() const;
+  // What the reader read past, one line each (LasReadOptions::notices).
+  const std::vector<std::string>& notices() const;
   // From now on read() also fills these of dimensions() (by index) into the block; none by default.
   void streamDimensions(std::vector<size_t> which);
   Status read(uint64_t first, uint64_t n, PointSet& block);

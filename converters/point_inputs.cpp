@@ -146,6 +146,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       Result<std::unique_ptr<LasPointStream>> las = LasPointStream::open(path, threads);
       if (!las) return las.error();
       part.las = std::move(*las);
+      stream->notices_.insert(stream->notices_.end(), part.las->notices().begin(), part.las->notices().end());
     } else {
       Result<std::unique_ptr<PlyVertexStream>> ply =
           PlyVertexStream::open(path, PlyReadOptions{false, nullptr, threads, true});

@@ -44,6 +44,8 @@ class PointInputStream {
   // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
   // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
   uint64_t faceCount() const { return faces_; }
+  // What the readers read past in the headers, one line each (ReadOptions::notices).
+  const std::vector<std::string>& notices() const { return notices_; }
   // The first file's dimensions (PLY vertex properties), as empty columns.
   const Dimensions& dimensions() const;
   // From now on read() also gives each block dimension `name` (float64 where the files' types
@@ -59,6 +61,7 @@ class PointInputStream {
   uint64_t count_ = 0, faces_ = 0;
   bool has_colors_ = false;
   std::optional<Dimension> streamed_;  // streamDimension's name and type, no values
+  std::vector<std::string> notices_;
   PointSet scratch_;
 };
 

@@ -143,7 +143,8 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
     }
     case FileFormat::kLas:
     case FileFormat::kLaz:  // the LAS reader decodes LAZ (converters/laz_decode.h)
-      return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color, options.max_memory});
+      return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color, options.max_memory,
+                                          options.notices});
   }
   return Error{path + ": unreachable format"};
 }

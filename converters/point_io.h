@@ -47,7 +47,8 @@ struct ReadOptions {
   // colours (kRgb fails when it has none), kNone drops them; kIntensity and kClassification are
   // errors (only LAS has those fields).
   LasColorSource las_color = LasColorSource::kAuto;
-  // When not null, gets one line per thing the reader read past (a CSV header's further columns).
+  // When not null, gets one line per thing the reader read past (PCD: points without a return, a
+  // viewpoint not applied; LAS: an extra bytes record it cannot follow).
   std::vector<std::string>* notices = nullptr;
   // Text files: what each column holds (CsvReadOptions::columns); an error for other formats.
   std::vector<std::string> columns = {};

@@ -266,14 +266,19 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
   const uint64_t limit = take(memoryOption("max_memory", max_memory));
   GltfReadOptions g;
   g.scene = scene, g.all_scenes = all_scenes, g.max_points = max_points;
-  return std::make_shared<PointSet>(take(released([&] {
+  std::vector<std::string> notices;  // what the reader read past: Python's warnings, as the CLI's notes
+  auto set = std::make_shared<PointSet>(take(released([&] {
     Progress bar(progressFile(progress), "read");
     ReadOptions r{threads, allow_nonfinite, &bar};
     r.max_memory = limit;
     r.las_color = *source;
+    r.notices = &notices;
     if (columns) r.columns = *columns;
     return readInput(path, r, g, InputOptionNames{"scene and all_scenes", "max_points"});
   })));
+  for (const std::string& notice : notices)
+    if (PyErr_WarnEx(PyExc_UserWarning, notice.c_str(), 1) < 0) throw py::error_already_set();
+  return set;
 }
 
 // The samples of `mesh`, or of the file at `path` (read as convert --sample reads it, textures

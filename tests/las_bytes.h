@@ -33,6 +33,18 @@ inline std::string lasRecords(const std::string& file) {
   return file.substr(at<uint32_t>(file, 96), lasCount(file) * at<uint16_t>(file, 105));
 }
 
+// The first extra bytes descriptor of an uncompressed LAS file (the data of its first LASF_Spec
+// record 4): where it starts in the bytes; npos without one.
+inline size_t descriptorAt(const std::string& file) {
+  size_t vlr = at<uint16_t>(file, 94);  // the header's size: the VLRs follow
+  for (uint32_t k = 0, vlrs = at<uint32_t>(file, 100); k < vlrs; ++k) {
+    const uint16_t length = at<uint16_t>(file, vlr + 20);
+    if (file.compare(vlr + 2, 9, "LASF_Spec") == 0 && at<uint16_t>(file, vlr + 18) == 4) return vlr + 54;
+    vlr += 54 + length;
+  }
+  return std::string::npos;
+}
+
 // The offset of the laszip VLR's data (after its 54-byte header) in a LAZ file; 0 without one.
 inline size_t laszipVlrAt(const std::string& file) {
   size_t p = at<uint16_t>(file, 94);

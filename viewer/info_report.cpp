@@ -203,10 +203,14 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
     Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory);
     if (!block) return block.error();
     streamed.stream_block = *block;
-    return describeStream(**stream, name, streamed, progress);
+    Result<InfoReport> report = describeStream(**stream, name, streamed, progress);
+    if (report) report->notices = (*stream)->notices();
+    return report;
   }
+  std::vector<std::string> notices;
   ReadOptions read{options.threads, inputs.allow_nonfinite, &progress};
   read.max_memory = inputs.max_memory;
+  read.notices = &notices;
   read.columns = inputs.columns;
   const bool scenes = inputs.scene >= 0 || inputs.all_scenes;
   if (scenes && inputs.paths.size() != 1)
@@ -219,7 +223,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (inputs.paths.size() == 1 && isCopcPath(inputs.paths[0]) && !scenes) {
     Result<CopcQuery> query = copcQueryFor(options.camera, inputs.paths[0], options.threads, inputs.max_memory);
     if (!query) return query.error();
-    LasReadOptions las{options.threads, &progress, LasColorSource::kAuto, inputs.max_memory};
+    LasReadOptions las{options.threads, &progress, LasColorSource::kAuto, inputs.max_memory, &notices};
     copc.emplace();
     points = readCopcPoints(inputs.paths[0], *query, las, &*copc);
   } else {
@@ -236,6 +240,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   Result<InfoReport> report = describePoints(*points, name, options);
   if (!report) return report;
   report->copc = copc;
+  report->notices = std::move(notices);
   if (header) {
     const PointSetInfo& info = report->info;
     const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});

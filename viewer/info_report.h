@@ -70,6 +70,9 @@ struct InfoReport {
   // facts are of those points, the LAS header's of the whole file.
   std::optional<CopcReadStats> copc;
   std::optional<InfoAdvice> advice;  // none for an empty set
+  // What the readers read past (ReadOptions::notices), one line each: describeFiles's; the CLI
+  // prints them on stderr.
+  std::vector<std::string> notices;
 };
 
 // The report of a set in memory, named `name`. Non-finite positions are taken as they are (the

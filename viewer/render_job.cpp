@@ -74,6 +74,7 @@ struct LoadedSet {
   std::vector<SpacingSample> spacing;  // for the default point size
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
   uint64_t reread_points = 0;          // a stream: the points its outline and spacing read again
+  std::vector<std::string> notices;    // what the readers read past (ReadOptions::notices)
   // A stream drawn in one pass (renderOnce): its bounds, outline and spacing come with the upload,
   // its provisional camera and mode from `preview`, whole batches spread over the file.
   bool one_pass = false;
@@ -264,7 +265,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (request.inputs.size() == 1 && isCopcPath(request.inputs[0]) && request.stream != "on") {
     Result<CopcQuery> query = copcQueryFor(request.camera, request.inputs[0], request.threads, request.max_memory);
     if (!query) return query.error();
-    LasReadOptions las{request.threads, &progress, lasColorOf(request.color), request.max_memory};
+    LasReadOptions las{request.threads, &progress, lasColorOf(request.color), request.max_memory, &set.notices};
     CopcReadStats stats;
     Result<PointSet> read = readCopcPoints(request.inputs[0], *query, las, &stats);
     if (!read) return read.error();
@@ -279,6 +280,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (!opened) return opened.error();
   set.stream = std::move(*opened);
   PointInputStream* ply = set.stream.get();
+  if (ply) set.notices = ply->notices();
   if (ply && request.color == RenderColor::kAttribute && !ply->dimensions().find(request.color_attribute))
     return noSuchAttribute(inputs, request.color_attribute, ply->dimensions());
   if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
@@ -350,6 +352,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   }
   ReadOptions read_options{request.threads, false, &progress, points_only};
   read_options.max_memory = request.max_memory;
+  read_options.notices = &set.notices;
   read_options.las_color = lasColorOf(request.color);
   read_options.columns = request.columns;
   if (may_sample && request.inputs.size() == 1) read_options.texture = &set.texture;  // its samples take its texture
@@ -1027,6 +1030,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   outcome.streamed = set->stream != nullptr;
   outcome.points_read_again = set->reread_points;
   outcome.copc = set->copc;
+  outcome.notices = set->notices;
   if (set->owned && !set->owned->isMesh())  // drawn as its surface: what of its texture it lacks
     outcome.warnings.insert(outcome.warnings.end(), set->texture.notes.begin(), set->texture.notes.end());
   if (request.views == 4 && set->bounds.planar)

@@ -233,6 +233,9 @@ struct RenderOutcome {
   // whose bound is over kWrongBoundPx, --mode auto with no mode within its limit, a picture drawn
   // on under 1% of its pixels or on none ("view LABEL: " first for a view of a sheet).
   std::vector<std::string> warnings;
+  // What the readers read past (ReadOptions::notices: a PCD's points without a return, a LAS
+  // file's extra bytes record it cannot follow), one line each.
+  std::vector<std::string> notices;
   double drawn_share = std::nan("");  // one view: the share of pixels drawn (DrawnPixels::share)
   // One view:
   ModePrediction prediction;

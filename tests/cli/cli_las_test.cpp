@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "converters/point_io.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -238,6 +239,42 @@ TEST(CliLas, generateWritesLasAtTheFinestScaleItsExtentFits) {
   test::CommandResult info = runDpoint({"info", dir.file("r.las"), "--quiet"});
   EXPECT_NE(info.out.find("point format 0, 20-byte records (0 extra bytes), 100 points"), std::string::npos) << info.out;
   EXPECT_NE(info.out.find("LAS scale:          1e-09 1e-09 1\n"), std::string::npos) << info.out;
+}
+
+// A LAS file whose extra bytes record the reader cannot follow: every command that reads it says
+// so on stderr, once, as a note (the bytes are read as they are), in memory and streamed; the
+// build before said nothing.
+TEST(CliLas, anExtraBytesRecordItCannotFollowIsANoteOfEveryCommand) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 2, 3}, {2, 1, 0}};
+  set.dimensions.add("amplitude", DimType::kU16, 3);
+  ASSERT_TRUE(writePoints(dir.file("good.las"), set));
+  std::string file = readFile(dir.file("good.las"));
+  const size_t d = test::descriptorAt(file);
+  ASSERT_NE(d, std::string::npos);
+  file[d + 2] = 42;
+  writeFile(dir.file("broken.las"), file);
+  const std::string note = "dpoint: note: " + dir.file("broken.las") + ": extra bytes descriptor 0 ('amplitude'): data type 42";
+  const std::vector<std::vector<std::string>> commands = {
+      {"convert", dir.file("broken.las"), "-o", dir.file("b.csv"), "-q"},
+      {"info", dir.file("broken.las")},
+      {"info", dir.file("broken.las"), "--stream", "on"},
+      {"render", dir.file("broken.las"), "-o", dir.file("b.png"), "--width", "32", "--height", "24", "-q"},
+      {"render", dir.file("broken.las"), "-o", dir.file("s.png"), "--width", "32", "--height", "24", "--stream", "on", "-q"}};
+  for (const std::vector<std::string>& command : commands) {
+    test::CommandResult r = runDpoint(command);
+    ASSERT_EQ(r.exit_code, 0) << command[0] << " " << command.back() << ": " << r.err;
+    EXPECT_TRUE(test::contains(r.err, note)) << command[0] << " " << command.back() << ": " << r.err;
+    EXPECT_EQ(r.err.find(note), r.err.rfind(note)) << "once: " << r.err;
+  }
+  EXPECT_NE(readFile(dir.file("b.csv")).find("extra_byte_1"), std::string::npos);
+  for (const char* command : {"convert", "info"}) {
+    test::CommandResult r = command == std::string("info") ? runDpoint({"info", dir.file("good.las")})
+                                                           : runDpoint({"convert", dir.file("good.las"), "-o", dir.file("g.csv"), "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err.find("note:"), std::string::npos) << r.err;
+  }
 }
 
 TEST(CliLas, rendersALasFile) {

@@ -18,21 +18,17 @@
 #include "core/dimensions.h"
 #include "ops/point_filters.h"
 #include "ops/point_order.h"
+#include "las_bytes.h"
 #include "test_support.h"
 
 namespace dpoint {
 namespace {
 
+using test::at;
+using test::descriptorAt;
 using test::readFile;
 using test::TempDir;
 using test::writeFile;
-
-template <typename T>
-T at(const std::string& bytes, size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof v);
-  return v;
-}
 
 // The point records of a LAS file, its format and record length, read straight from the bytes.
 struct Records {
@@ -232,17 +228,6 @@ TEST(LasDimensions, extraBytesBecomeDimensionsOfTheirDeclaredTypes) {
   EXPECT_TRUE(d.find(dim::kIntensity)) << "the LAS field keeps its own name beside the extra bytes' Intensity";
 }
 
-// The extra bytes descriptor of a file (the first LASF_Spec record 4): where it starts in the bytes.
-size_t descriptorAt(const std::string& file) {
-  size_t vlr = at<uint16_t>(file, 94);  // the header's size: the VLRs follow
-  for (uint32_t k = 0, vlrs = at<uint32_t>(file, 100); k < vlrs; ++k) {
-    const uint16_t length = at<uint16_t>(file, vlr + 20);
-    if (file.compare(vlr + 2, 9, "LASF_Spec") == 0 && at<uint16_t>(file, vlr + 18) == 4) return vlr + 54;
-    vlr += 54 + length;
-  }
-  return std::string::npos;
-}
-
 // An extra bytes field with a scale and offset (options bits 3 and 4, as Riegl's amplitudes and
 // deviations come) is its stored number · scale + offset, a float64 dimension, in every reader and
 // so in every format written from it; LAS → LAS writes the same records and the same descriptor
@@ -346,6 +331,49 @@ TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
   Result<PointSet> wide_back = readLas(dir.file("wide.las"));
   ASSERT_TRUE(wide_back);
   EXPECT_EQ(wide_back->dimensions.find("amplitude")->get<double>(2), 100.55);
+}
+
+// An extra bytes record the reader cannot follow (a data type past LAS's 30, a descriptor past the
+// record's extra bytes, a length that is not whole descriptors) leaves the bytes as they are, one
+// dimension a byte, and says so through the notices, read whole or streamed; the build before
+// read them so without a word.
+TEST(LasDimensions, anExtraBytesRecordItCannotFollowIsReadAsBytesWithANotice) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 2, 3}};
+  Dimension& amplitude = set.dimensions.add("amplitude", DimType::kU16, 2);
+  amplitude.set<uint16_t>(0, 0x0102), amplitude.set<uint16_t>(1, 0x0304);
+  ASSERT_TRUE(writeLas(dir.file("good.las"), set));
+  std::string file = readFile(dir.file("good.las"));
+  const size_t d = descriptorAt(file);
+  ASSERT_NE(d, std::string::npos);
+  file[d + 2] = 31;
+  writeFile(dir.file("broken.las"), file);
+
+  std::vector<std::string> notices;
+  LasReadOptions options;
+  options.notices = &notices;
+  Result<PointSet> read = readLas(dir.file("broken.las"), options);
+  ASSERT_TRUE(read) << read.error().message;
+  EXPECT_FALSE(read->dimensions.find("amplitude"));
+  ASSERT_TRUE(read->dimensions.find("extra_byte_0") && read->dimensions.find("extra_byte_1"));
+  EXPECT_EQ(read->dimensions.find("extra_byte_1")->get<uint8_t>(1), 0x03);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_EQ(notices[0], dir.file("broken.las") +
+                            ": extra bytes descriptor 0 ('amplitude'): data type 31 is not one of LAS's 0 to 30; "
+                            "its 2 extra bytes a point are read as they are (extra_byte_0, ...)");
+  Result<std::unique_ptr<LasPointStream>> stream = LasPointStream::open(dir.file("broken.las"));
+  ASSERT_TRUE(stream);
+  EXPECT_EQ((*stream)->notices(), notices);
+  EXPECT_TRUE((*stream)->dimensions().find("extra_byte_0"));
+
+  // The file as written: no notice.
+  notices.clear();
+  ASSERT_TRUE(readLas(dir.file("good.las"), options));
+  EXPECT_TRUE(notices.empty());
+  stream = LasPointStream::open(dir.file("good.las"));
+  ASSERT_TRUE(stream);
+  EXPECT_TRUE((*stream)->notices().empty());
 }
 
 // A fuzz finding (las, 236 bytes): a record length of 5120 made 5100 extra_byte dimensions, named
