@@ -106,3 +106,24 @@ def test_set_and_remove_attribute(tmp_path):
         pass
     else:
         raise AssertionError("remove_attribute('missing') was accepted")
+
+
+def test_an_extra_bytes_record_the_reader_cannot_follow_is_a_warning(tmp_path):
+    """Read as one attribute a byte, with a UserWarning naming the file and the descriptor (the
+    build before read it so without a word)."""
+    import warnings
+    s = dpoint.PointSet(np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]))
+    s.set_attribute("amplitude", np.array([258, 772], dtype=np.uint16))
+    dpoint.write(s, tmp_path / "good.las")
+    b = bytearray((tmp_path / "good.las").read_bytes())
+    at = b.index(b"LASF_Spec") - 2 + 54  # the first descriptor: after the VLR's 54-byte header
+    b[at + 2] = 31  # data type 31: not one of LAS's 0 to 30
+    (tmp_path / "broken.las").write_bytes(bytes(b))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        back = dpoint.read(tmp_path / "broken.las")
+        dpoint.read(tmp_path / "good.las")
+    assert len(caught) == 1 and issubclass(caught[0].category, UserWarning)
+    assert "broken.las: extra bytes descriptor 0 ('amplitude'): data type 31" in str(caught[0].message)
+    assert "amplitude" not in back.attributes
+    assert list(back.attributes["extra_byte_1"]) == [1, 3]
