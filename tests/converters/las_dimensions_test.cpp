@@ -228,6 +228,26 @@ TEST(LasDimensions, extraBytesBecomeDimensionsOfTheirDeclaredTypes) {
   EXPECT_TRUE(d.find(dim::kIntensity)) << "the LAS field keeps its own name beside the extra bytes' Intensity";
 }
 
+// A LAS file writeLas makes at `path` of points (0,0,0), (1,2,3), … with one dimension, `values`
+// of `type` (an extra bytes field): its bytes, and where its extra bytes descriptor starts in them.
+struct OneFieldLas {
+  std::string bytes;
+  size_t descriptor = std::string::npos;
+};
+OneFieldLas oneFieldLas(const std::string& path, const std::string& name, DimType type, const std::vector<double>& values) {
+  PointSet set;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const double k = static_cast<double>(i);
+    set.positions.emplace_back(k, 2.0 * k, 3.0 * k);
+  }
+  Dimension& field = set.dimensions.add(name, type, values.size());
+  for (size_t i = 0; i < values.size(); ++i) field.setValue(i, values[i]);
+  if (!writeLas(path, set)) return {};
+  OneFieldLas las{readFile(path)};
+  las.descriptor = descriptorAt(las.bytes);
+  return las;
+}
+
 // An extra bytes field with a scale and offset (options bits 3 and 4, as Riegl's amplitudes and
 // deviations come) is its stored number · scale + offset, a float64 dimension, in every reader and
 // so in every format written from it; LAS → LAS writes the same records and the same descriptor
@@ -236,14 +256,10 @@ TEST(LasDimensions, extraBytesBecomeDimensionsOfTheirDeclaredTypes) {
 // offset, so other readers got 5 too.
 TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
   TempDir dir;
-  PointSet set;
-  set.positions = {{0, 0, 0}, {1, 2, 3}, {4, 5, 6}};
-  Dimension& amplitude = set.dimensions.add("amplitude", DimType::kU16, 3);
-  amplitude.set<uint16_t>(0, 5), amplitude.set<uint16_t>(1, 7), amplitude.set<uint16_t>(2, 65535);
-  ASSERT_TRUE(writeLas(dir.file("raw.las"), set));
   // The descriptor made a scaled one: 0.1 and 100, no-data 65535, min and max 5 and 7, a description.
-  std::string file = readFile(dir.file("raw.las"));
-  const size_t d = descriptorAt(file);
+  OneFieldLas written = oneFieldLas(dir.file("raw.las"), "amplitude", DimType::kU16, {5, 7, 65535});
+  std::string& file = written.bytes;
+  const size_t d = written.descriptor;
   ASSERT_NE(d, std::string::npos);
   ASSERT_EQ(file[d + 2], 3) << "uint16";
   file[d + 3] = 0x1F;
@@ -301,13 +317,10 @@ TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
   // A scaled float32 field: its stored floats back through the scale, not rounded to whole
   // numbers (it was written as float64 and the record grew).
   {
-    PointSet floats;
-    floats.positions = {{0, 0, 0}, {1, 2, 3}};
-    Dimension& width = floats.dimensions.add("echo_width", DimType::kF32, 2);
-    width.set<float>(0, 1.25f), width.set<float>(1, 3.1f);
-    ASSERT_TRUE(writeLas(dir.file("f.las"), floats));
-    std::string f = readFile(dir.file("f.las"));
-    const size_t fd = descriptorAt(f);
+    OneFieldLas float_las = oneFieldLas(dir.file("f.las"), "echo_width", DimType::kF32, {1.25, double(3.1f)});
+    std::string& f = float_las.bytes;
+    const size_t fd = float_las.descriptor;
+    ASSERT_NE(fd, std::string::npos);
     ASSERT_EQ(f[fd + 2], 9) << "float32";
     f[fd + 3] = 0x08;
     const double half = 0.5;
@@ -339,13 +352,9 @@ TEST(LasDimensions, scaledExtraBytesAreTheirScaledValues) {
 // read them so without a word.
 TEST(LasDimensions, anExtraBytesRecordItCannotFollowIsReadAsBytesWithANotice) {
   TempDir dir;
-  PointSet set;
-  set.positions = {{0, 0, 0}, {1, 2, 3}};
-  Dimension& amplitude = set.dimensions.add("amplitude", DimType::kU16, 2);
-  amplitude.set<uint16_t>(0, 0x0102), amplitude.set<uint16_t>(1, 0x0304);
-  ASSERT_TRUE(writeLas(dir.file("good.las"), set));
-  std::string file = readFile(dir.file("good.las"));
-  const size_t d = descriptorAt(file);
+  OneFieldLas good = oneFieldLas(dir.file("good.las"), "amplitude", DimType::kU16, {0x0102, 0x0304});
+  std::string& file = good.bytes;
+  const size_t d = good.descriptor;
   ASSERT_NE(d, std::string::npos);
   file[d + 2] = 31;
   writeFile(dir.file("broken.las"), file);
