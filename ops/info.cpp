@@ -222,6 +222,29 @@ void finishBounds(PointSetInfo& info) {
       : std::numeric_limits<double>::infinity();
 }
 
+// The difference from points[at] to the nearest of points[from..to] apart from it (0 where none
+// is, or none at a finite difference): the first bound on a sampled point's nearest distance in a
+// streamed set. Compared in a unit of their own (a power of two, exact), as the set's unit is not
+// known yet: squares of raw differences at 1e-200 are 0 and at 1e200 infinite.
+glm::dvec3 nearestBeside(const PositionArray& points, size_t from, size_t to, size_t at) {
+  double largest = 0.0;
+  for (size_t j = from; j <= to; ++j) {
+    const glm::dvec3 d = points[j] - points[at];
+    if (std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z))
+      largest = std::max({largest, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  }
+  if (largest == 0.0) return glm::dvec3(0.0);
+  const double local = std::ldexp(1.0, -std::ilogb(largest));
+  double best2 = std::numeric_limits<double>::infinity();
+  glm::dvec3 nearest(0.0);
+  for (size_t j = from; j <= to; ++j) {
+    const glm::dvec3 d = points[j] - points[at], s = d * local;
+    const double d2 = s.x * s.x + s.y * s.y + s.z * s.z;  // NaN where d is not finite: passed over
+    if (d2 > 0.0 && d2 < best2) best2 = d2, nearest = d;
+  }
+  return nearest;
+}
+
 // Boxes without queries that a run of boxes read again may span.
 constexpr size_t kJoinBoxes = 16;
 
@@ -461,11 +484,10 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   const uint64_t box_points = block_points % kStreamedInfoBoxPoints == 0 ? kStreamedInfoBoxPoints : block_points;
   PositionArray sampled;
   sampled.reserve(static_cast<size_t>(sample));
-  // Each sampled point's differences to the points beside it in the file (0: none there), kept
-  // until the unit of length is known (below).
-  constexpr size_t kBeside = 2 * kFileNeighbors + 1;
+  // Each sampled point's difference to the nearest point beside it in the file, kept until the
+  // unit of length is known (below).
   PositionArray beside;
-  beside.reserve(static_cast<size_t>(sample) * kBeside);
+  beside.reserve(static_cast<size_t>(sample));
   std::vector<Box>& boxes = out.boxes;
   boxes.reserve(static_cast<size_t>((count + box_points - 1) / box_points));
   PointSet block;
@@ -500,9 +522,8 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
     for (uint64_t k = (first + step - 1) / step; k < sample && k * step < first + n; ++k) {
       const size_t at = static_cast<size_t>(k * step - first);
       sampled.push_back(block.positions[at]);
-      const size_t from_j = at - std::min<size_t>(at, kFileNeighbors), to_j = std::min<size_t>(at + kFileNeighbors, n - 1);
-      for (size_t j = from_j; j < from_j + kBeside; ++j)
-        beside.push_back(j <= to_j ? block.positions[j] - sampled.back() : glm::dvec3(0.0));
+      beside.push_back(nearestBeside(block.positions, at - std::min<size_t>(at, kFileNeighbors),
+                                     std::min<size_t>(at + kFileNeighbors, n - 1), at));
     }
   }
   finishBounds(info);
@@ -516,11 +537,8 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   std::vector<double> best2(sampled.size(), std::numeric_limits<double>::infinity());
   for (size_t k = 0; k < sampled.size(); ++k) {
     sampled[k] *= unit;
-    for (size_t j = k * kBeside; j < (k + 1) * kBeside; ++j) {
-      const glm::dvec3 d = beside[j] * unit;
-      const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
-      if (d2 > 0.0 && d2 < best2[k]) best2[k] = d2;
-    }
+    const glm::dvec3 d = beside[k] * unit;
+    if (const double d2 = d.x * d.x + d.y * d.y + d.z * d.z; d2 > 0.0) best2[k] = d2;
   }
   std::vector<Box> scaled_boxes;
   if (unit != 1.0) {
