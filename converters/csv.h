@@ -53,6 +53,8 @@ struct CsvWriteOptions {
   // `decimals` digits and their trailing zeros trimmed (849087.70 → "849087.7"), colours in
   // shortest form. Ignored when decimals < 0.
   bool at_scale = false;
+  // When not null, gets a line for each dimension written under another name (csvColumnNames).
+  std::vector<std::string>* notices = nullptr;
 };
 
 Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options = {});
@@ -81,6 +83,12 @@ struct CsvLayout {
   // Colours as integers of this full scale (255, 65535: PointSet::color_full_scale), 0 as floats 0..1.
   uint16_t color_full_scale = 0;
 };
+
+// The header names CsvRowWriter gives layout.dimensions (writableNames): none holding a separator
+// (a comma, a semicolon, a space or a tab), a quote or a control character; none the reader takes
+// for a position's or a colour's column (x, y, z, r, g, b in any case; red, green or blue among the
+// first six columns); none twice. `renamed` gets a line for each name changed.
+std::vector<std::string> csvColumnNames(const CsvLayout& layout, std::vector<std::string>* renamed);
 
 // Rows appended in any number of calls give the same bytes as one writeCsv of all of them with
 // the same layout: rows are formatted in chunks on all cores and written in order, so neither

@@ -152,12 +152,36 @@ Status checkDecimals(int decimals) {
 
 }  // namespace
 
+std::vector<std::string> csvColumnNames(const CsvLayout& layout, std::vector<std::string>* renamed) {
+  const size_t first = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0);  // the first dimension's column
+  const auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  return writableNames(
+      layout.dimensions,
+      [](char c) { return isSpaceOrControl(c) || c == ',' || c == ';' || c == '"'; },
+      [&](const std::string& name, size_t k) {
+        const std::string l = lower(name);
+        if (l == "x" || l == "y" || l == "z" || l == "r" || l == "g" || l == "b") return true;
+        return first + k < 6 && (l == "red" || l == "green" || l == "blue");
+      },
+      renamed);
+}
+
 Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout layout,
                                           const CsvWriteOptions& options, uint64_t rows) {
   if (Status s = checkDecimals(options.decimals); !s) return s.error();
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
   layout.separator = csvSeparatorFor(path);
+  std::vector<std::string> renamed;
+  layout.dimensions = csvColumnNames(layout, &renamed);
+  if (options.notices)
+    for (const std::string& line : renamed)
+      options.notices->push_back(path + ": " + line +
+                                 " (a column's name holds no separator, and x, y, z, r, g and b name the position's and "
+                                 "colour's columns)");
   CsvRowWriter writer(std::move(*file), layout, options);
   const std::string header = RowFormatter(layout, options.decimals, options.at_scale).header();
   // At least a digit and a separator a value: refused at once where the disk cannot hold even that.
@@ -280,7 +304,18 @@ Status writePts(const std::string& path, const PointSet& points, const CsvWriteO
     }
   }
   if (Status s = file->write(out); !s) return s;
-  return file->commit();
+  if (Status s = file->commit(); !s) return s;
+  // What PTS cannot hold, said once the file is there.
+  if (options.notices) {
+    std::string dropped;
+    for (const Dimension& d : points.dimensions.all())
+      if (&d != intensity) dropped += (dropped.empty() ? "" : ", ") + d.name;
+    if (!dropped.empty())
+      options.notices->push_back(path + ": PTS holds x, y, z, intensity and r, g, b only: " + dropped + " left out");
+    if (points.hasColors() && points.color_full_scale == 65535)
+      options.notices->push_back(path + ": 16-bit colours written as 8-bit (PTS holds 0..255)");
+  }
+  return okStatus();
 }
 
 }  // namespace

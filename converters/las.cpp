@@ -7,12 +7,14 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <charconv>
 #include <cassert>
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <mutex>
 #include <optional>
+#include <unordered_set>
 #include <vector>
 
 #include <glm/common.hpp>
@@ -472,8 +474,10 @@ constexpr double kDecimalSteps[] = {1.0,  0.1,  0.01, 0.001, 1e-4,  1e-5, 1e-6,
 
 // The scale of axis k of a set without a LAS source or an asked one (las.h): the coarsest decimal
 // step at which every coordinate keeps its digits (the data's own step: 0.01 for centimetre
-// data), else the finest at which the extent fits the 32-bit integers.
-double chooseAxisScale(const PositionArray& positions, int k, double min, double max, unsigned threads) {
+// data), else the finest at which the extent fits the 32-bit integers. `rounded`: set when that
+// last is the case, and the coordinates lose digits to fit.
+double chooseAxisScale(const PositionArray& positions, int k, double min, double max, unsigned threads, bool& rounded) {
+  rounded = !positions.empty();
   double coarse = 1.0;
   while (!extentFits(min, max, coarse) && coarse < 1e300) coarse *= 10.0;
   if (coarse > 1.0 || positions.empty()) return coarse;  // a wider extent than 2^31 units: no finer step fits
@@ -481,7 +485,10 @@ double chooseAxisScale(const PositionArray& positions, int k, double min, double
   for (double step : kDecimalSteps) {
     if (!extentFits(min, max, step)) break;
     finest = step;
-    if (readsBackClosely(positions, k, chooseOffset(positions, k, min, max, step, threads), step, threads)) return step;
+    if (readsBackClosely(positions, k, chooseOffset(positions, k, min, max, step, threads), step, threads)) {
+      rounded = false;
+      return step;
+    }
   }
   return finest;
 }
@@ -493,6 +500,7 @@ struct WriterLayout {
   std::vector<LasExtraField> extra;  // dimensions kept as extra bytes, after the base record
   std::vector<LasVlr> vlrs, evlrs;
   uint16_t global_encoding = 0, file_source_id = 0;
+  std::vector<std::string> renamed;  // "dimension 'höhe' written as 'h__he'": extra bytes named anew
 };
 
 // The LAS 1.2 (227-byte) or 1.4 (375-byte) header. Creation day and year are 0 ("not given") so
@@ -574,6 +582,32 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   const auto isField = [&](const std::string& name) {
     return std::any_of(fields.begin(), fields.end(), [&](const LasField& f) { return name == f.name; });
   };
+  // Names the reader gives back as they are (lasExtraFields): letters, digits and '_', at most 32
+  // bytes, none a field's or the position's and colours', none twice.
+  std::unordered_set<std::string> taken = {"x", "y", "z", "red", "green", "blue"};
+  for (const LasField& f : fields) taken.insert(f.name);
+  const auto lasName = [&](const std::string& name) {
+    std::string base = name.substr(0, 32);
+    for (char& c : base)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) c = '_';
+    if (base.empty()) base = "extra";
+    std::string out = base;
+    for (int k = 2; taken.count(out); ++k) {
+      std::string suffix = "_";  // appended: GCC 12 warns falsely on "_" + string (bug 105651)
+      suffix += std::to_string(k);
+      out = base.substr(0, 32 - suffix.size());
+      out += suffix;
+    }
+    taken.insert(out);
+    if (out != name) {
+      std::string line = "dimension ";
+      line += quotedExcerpt(name);
+      line += " written as ";
+      line += quotedExcerpt(out);
+      l.renamed.push_back(std::move(line));
+    }
+    return out;
+  };
   uint32_t at = 0;
   for (const Dimension& d : points.dimensions.all()) {
     if (isField(d.name)) continue;
@@ -585,7 +619,8 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
     if (source)
       for (const auto& [name, descriptor] : source->extra_bytes)
         if (name == d.name) field = lasSourceExtraField(d, descriptor, threads);
-    if (!field) field = LasExtraField{d.name.substr(0, 32), d.type, 0};
+    if (!field) field = LasExtraField{d.name, d.type, 0};
+    field->name = lasName(field->name);
     field->offset = at;
     field->dimension = static_cast<size_t>(&d - points.dimensions.all().data());
     at += static_cast<uint32_t>(dimTypeSize(field->type));
@@ -1118,8 +1153,9 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   // Quantization is monotonic (a subtraction, a division by a positive number and a rounding, each
   // correctly rounded), so the box's corners hold the extreme integers: when they fit, all do, and
   // their decoded values are the exact bounds a reader finds.
+  glm::bvec3 rounded(false);
   if (options.scale == 0.0 && !keep_frame && n > 0)
-    for (int k = 0; k < 3; ++k) scale[k] = chooseAxisScale(points.positions, k, box.min[k], box.max[k], threads);
+    for (int k = 0; k < 3; ++k) scale[k] = chooseAxisScale(points.positions, k, box.min[k], box.max[k], threads, rounded[k]);
   // The source's offset where its integers still hold every point (LAS → LAS: the same records).
   glm::dvec3 offset(0.0), q_min(0.0), q_max(0.0);
   for (int k = 0; k < 3; ++k) {
@@ -1156,6 +1192,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
 
   if (options.report) {
     options.report->scale = scale;
+    options.report->rounded = rounded;
     // Points that read back as themselves cannot merge: the count's two sorts only run otherwise.
     bool exact = true;
     for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
@@ -1164,6 +1201,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, threads);
   if (!layout) return layout.error();
   WriterLayout& l = *layout;
+  if (options.report) options.report->renamed = l.renamed;
   std::optional<LazInfo> laz;
   if (options.compress) {
     Result<LazInfo> info = lazInfoForFormat(l.format, l.record_length);

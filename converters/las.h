@@ -101,6 +101,12 @@ struct LasReadOptions {
 // What writeLas chose and what the file cannot hold as given.
 struct LasWriteReport {
   glm::dvec3 scale{0.0};
+  // Axes whose scale the writer chose coarser than the coordinates' digits, the finest at which the
+  // extent fits the 32-bit integers: their coordinates move by up to half a step.
+  glm::bvec3 rounded{false};
+  // Extra bytes named anew, one line each ("dimension 'höhe' written as 'h__he'"): LAS names are up
+  // to 32 letters, digits or '_'.
+  std::vector<std::string> renamed;
   // Distinct positions that share their integers at that scale with another: they read back as one.
   uint64_t merged_points = 0;
 };

@@ -33,15 +33,12 @@ struct OutField {
 
 char pcdTypeOf(DimType type) { return dimTypeIsFloat(type) ? 'F' : dimTypeIsSigned(type) ? 'I' : 'U'; }
 
-// PCD field names are one token: a dimension's spaces become '_'.
+// PCL's name of a dimension: its normals' own, the others their names.
 std::string fieldName(const std::string& name) {
   if (name == "nx") return "normal_x";
   if (name == "ny") return "normal_y";
   if (name == "nz") return "normal_z";
-  std::string out = name;
-  for (char& c : out)
-    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') c = '_';
-  return out.empty() ? "_unnamed" : out;
+  return name;
 }
 
 bool exactlyFloat(double v) { return static_cast<double>(static_cast<float>(v)) == v || v != v; }
@@ -100,14 +97,26 @@ class Writer {
       alpha_ = alpha && alpha->type == DimType::kU8 ? alpha : nullptr;
       fields_.push_back({alpha_ ? "rgba" : "rgb", alpha_ ? 'U' : 'F', 4, Source::kRgb, nullptr});
     }
-    for (const Dimension& d : points_.dimensions.all()) {
-      if (&d == alpha_) continue;
-      fields_.push_back({fieldName(d.name), pcdTypeOf(d.type), static_cast<int>(dimTypeSize(d.type)), Source::kDimension, &d});
-    }
-    for (size_t a = 0; a < fields_.size(); ++a)
-      for (size_t b = a + 1; b < fields_.size(); ++b)
-        if (fields_[a].name == fields_[b].name)
-          return Error{"cannot write '" + path_ + "': two attributes would be the PCD field '" + fields_[a].name + "'"};
+    // Field names are one word each, none the position's or colour's, none twice (writableNames).
+    std::vector<std::string> names;
+    std::vector<const Dimension*> dims;
+    for (const Dimension& d : points_.dimensions.all())
+      if (&d != alpha_) names.push_back(fieldName(d.name)), dims.push_back(&d);
+    std::vector<std::string> renamed;
+    names = writableNames(
+        names, isSpaceOrControl,
+        [](const std::string& name, size_t) {
+          return name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba";
+        },
+        &renamed);
+    for (size_t k = 0; k < dims.size(); ++k)
+      fields_.push_back({names[k], pcdTypeOf(dims[k]->type), static_cast<int>(dimTypeSize(dims[k]->type)),
+                         Source::kDimension, dims[k]});
+    if (options_.notices && points_.hasColors() && points_.color_full_scale == 65535)
+      options_.notices->push_back(path_ + ": 16-bit colours written as 8-bit (PCD's rgb holds 0..255 a channel)");
+    if (options_.notices)
+      for (const std::string& line : renamed)
+        options_.notices->push_back(path_ + ": " + line + " (a PCD field's name is one word, not x, y, z, rgb or rgba)");
     return okStatus();
   }
 

@@ -66,6 +66,8 @@ struct PlyWriteOptions {
   // the file is the one the set holding those positions gives. The set then has no colours,
   // triangles or dimensions (colours may come from colors_of).
   MadePositions positions_of;
+  // When not null, gets a line for each dimension written under another name (plyPropertyNames).
+  std::vector<std::string>* notices = nullptr;
 };
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});
@@ -77,6 +79,10 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 // tile merge, converters/tile_file.h), whose file must be writePly's byte for byte.
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
                       const PlyWriteOptions& options);
+// The property names plyHeader gives `dimensions`: one word each, none that the readers take for a
+// position or a colour (x, y, z, red, green, blue), none twice (writableNames); `renamed` gets a
+// line for each name changed.
+std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, std::vector<std::string>* renamed);
 
 // How a PlyRowStream's file is laid out where it is not writePly's (a tile's part file,
 // converters/tile_file.h): the vertex row's bytes, and the header for the counts (has_z: some vertex

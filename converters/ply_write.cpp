@@ -89,6 +89,17 @@ void appendDimension(ChunkText& out, const Dimension& d, size_t i, char separato
 
 }  // namespace
 
+std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, std::vector<std::string>* renamed) {
+  std::vector<std::string> names;
+  for (const Dimension& d : dimensions.all()) names.push_back(d.name);
+  return writableNames(
+      names, isSpaceOrControl,
+      [](const std::string& name, size_t) {
+        return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue";
+      },
+      renamed);
+}
+
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
                       const PlyWriteOptions& options) {
   const bool ascii = options.encoding == PlyEncoding::kAscii;
@@ -102,12 +113,13 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
       header += std::string("property ") + (float_colors ? "float " : word_colors ? "ushort " : "uchar ") + c + "\n";
   // Dimensions as properties of their own type; PLY has no 64-bit integers, so those go as double
   // (exact below 2^53).
-  for (const Dimension& d : facts.dimensions.all()) {
-    const char* type = plyTypeName(d.type);
+  const std::vector<std::string> names = plyPropertyNames(facts.dimensions, nullptr);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const char* type = plyTypeName(facts.dimensions.all()[k].type);
     header += "property ";
     header += type ? type : "double";
     header += ' ';
-    header += d.name;
+    header += names[k];
     header += '\n';
   }
   if (faces) header += "element face " + std::to_string(faces) + "\nproperty list uchar uint vertex_indices\n";
@@ -126,6 +138,12 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
                  std::to_string(n) + " points"};
   if (points.triangles.size() % 3 != 0)
     return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
+  if (options.notices) {
+    std::vector<std::string> renamed;
+    plyPropertyNames(points.dimensions, &renamed);
+    for (const std::string& line : renamed)
+      options.notices->push_back(path + ": " + line + " (a PLY property's name is one word, not x, y, z, red, green or blue)");
+  }
   // Every index below n, checked before anything is written; the first bad one is named.
   if (const size_t bad = points.firstBadTriangleIndex(options.threads); bad < points.triangles.size())
     return Error{"cannot write '" + path + "': triangle index " + std::to_string(points.triangles[bad]) +

@@ -205,11 +205,12 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
   switch (*format) {
     case FileFormat::kCsv:
       return writeCsv(path, points,
-                      CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale});
+                      CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale,
+                                      options.notices});
     case FileFormat::kPly:
       return writePly(path, points,
                       PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
-                                      options.colors_of, options.positions_of});
+                                      options.colors_of, options.positions_of, options.notices});
     case FileFormat::kPcd:
       return writePcd(path, points,
                       PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads});
@@ -251,6 +252,22 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       } else {
         las.compress = *format == FileFormat::kLaz;
         if (Status s = writeLas(path, points, las); !s) return s;
+      }
+      if (options.notices) {
+        for (const std::string& line : report.renamed)
+          options.notices->push_back(path + ": " + line + " (a LAS extra bytes name is up to 32 letters, digits or '_')");
+        for (int k = 0; k < 3; ++k)
+          if (report.rounded[k]) {
+            std::string note = path;
+            note += ": ";
+            note += "xyz"[k];
+            note += " rounded to the LAS scale ";
+            note += formatNumber(report.scale[k]);
+            note += ", up to ";
+            note += formatNumber(report.scale[k] / 2);
+            note += " off: no step that keeps its digits lets its extent fit LAS's 32-bit integers";
+            options.notices->push_back(std::move(note));
+          }
       }
       if (report.merged_points != 0 && options.notices) {
         const glm::dvec3& sc = report.scale;

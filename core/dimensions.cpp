@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <unordered_set>
+
+#include "core/text.h"
 
 namespace dpoint {
 namespace {
@@ -77,6 +80,32 @@ std::optional<DimType> parseDimType(std::string_view name) {
   for (const TypeRow& r : kTypes)
     if (name == r.name || (r.ply && name == r.ply)) return r.type;
   return std::nullopt;
+}
+
+std::vector<std::string> writableNames(const std::vector<std::string>& names, const std::function<bool(char)>& bad,
+                                       const std::function<bool(const std::string&, size_t)>& reserved,
+                                       std::vector<std::string>* renamed) {
+  std::vector<std::string> out;
+  out.reserve(names.size());
+  std::unordered_set<std::string> taken;
+  for (size_t k = 0; k < names.size(); ++k) {
+    std::string name = names[k];
+    for (char& c : name)
+      if (bad(c)) c = '_';
+    if (name.empty()) name = "unnamed";
+    const std::string base = name;
+    for (int n = 2; taken.count(name) || reserved(name, k); ++n) name = base + "_" + std::to_string(n);
+    taken.insert(name);
+    if (renamed && name != names[k]) {
+      std::string line = "dimension ";
+      line += quotedExcerpt(names[k]);
+      line += " written as ";
+      line += quotedExcerpt(name);
+      renamed->push_back(std::move(line));
+    }
+    out.push_back(std::move(name));
+  }
+  return out;
 }
 
 double loadDimValue(DimType type, const uint8_t* bytes) {

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -42,6 +43,17 @@ bool dimensionHolds(DimType type, double v);
 double loadDimValue(DimType type, const uint8_t* bytes);
 // The type of a name as `dimTypeName` or PLY (uint8/uchar, int16/short, float64/double, …).
 std::optional<DimType> parseDimType(std::string_view name);
+
+// The names a writer gives dimensions `names` in a format that cannot hold every name as it is
+// (PLY's and PCD's one-word names, a CSV header's columns): each character `bad` is true of
+// becomes '_', an empty name "unnamed", and a name `reserved` is true of (given its index), or one
+// that repeats a name written before it, gets "_2" (or "_3", …). Each change is a line of
+// `renamed`: "dimension 'my value' written as 'my_value'".
+std::vector<std::string> writableNames(const std::vector<std::string>& names, const std::function<bool(char)>& bad,
+                                       const std::function<bool(const std::string&, size_t)>& reserved,
+                                       std::vector<std::string>* renamed);
+// A control character or a space (PLY's and PCD's names are one word).
+inline bool isSpaceOrControl(char c) { return static_cast<unsigned char>(c) <= 0x20 || c == 0x7f; }
 
 // A column's bytes. Their allocator leaves bytes made without a value unset (core/memory.h), so
 // that a reader which writes every value of a large column does not zero it on one thread first:

@@ -86,8 +86,10 @@ TEST(Pcd, everyEncodingReadsBackTheSamePointsColoursAndDimensions) {
     EXPECT_TRUE(contains(bytes, "FIELDS x y z rgb intensity normal_x gps_time scan_angle big depth\n"));
     EXPECT_TRUE(contains(bytes, "SIZE 8 8 8 4 2 4 8 1 8 4\nTYPE F F F F U F F I U I\n"));
     EXPECT_TRUE(contains(bytes, std::string("DATA ") + pcdEncodingName(encoding) + "\n"));
-    ASSERT_EQ(notices.size(), 1u);
+    ASSERT_EQ(notices.size(), 2u);
     EXPECT_TRUE(contains(notices[0], "written as double"));
+    EXPECT_TRUE(contains(notices[1], ": dimension 'scan angle' written as 'scan_angle' (a PCD field's name is one word"))
+        << notices[1];
     for (unsigned threads : {1u, 3u}) {
       PcdReadOptions options;
       options.threads = threads;
