@@ -634,6 +634,9 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   l.version_minor = v14 ? 4 : 2;
   // Bit 0: GPS time is adjusted standard time; bit 4 (1.4): the coordinate system is WKT.
   l.global_encoding = source ? static_cast<uint16_t>(source->global_encoding & (v14 ? 0x11 : 0x01)) : 0;
+  // Point formats 6-10 take their coordinate system as WKT (LAS 1.4 R15: the bit must be set; PDAL
+  // reports a file without it as an error), whatever the source said.
+  if (l.format >= 6) l.global_encoding |= 0x10;
   l.file_source_id = source ? source->file_source_id : 0;
   if (source)
     for (const LasVlr& vlr : source->vlrs) {
@@ -880,7 +883,11 @@ std::vector<LasVlr> readVlrs(const InputFile& file, const LasHeader& h) {
   return out;
 }
 
-bool isCrsRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Projection"; }
+// LASF_Projection's (GeoTIFF keys, OGC WKT), and libLAS's WKT record (liblas 2112), which files
+// written by libLAS and early PDAL carry beside or instead of them.
+bool isCrsRecord(const LasVlr& vlr) {
+  return vlr.user_id == "LASF_Projection" || (vlr.user_id == "liblas" && vlr.record_id == 2112);
+}
 bool isExtraBytesRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Spec" && vlr.record_id == 4; }
 
 // The extra bytes of a record of `header`'s format, as the file's extra bytes record describes

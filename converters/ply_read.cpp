@@ -456,9 +456,10 @@ class PlyParser {
         if (w.size() == 5 && w[2] == "up" && w[3] == "axis" && w[4] == "z") points_.z_up = true;
         // Colours that came as integers 0..255 (a CSV's), so CSV → PLY → CSV writes them so again.
         if (w.size() == 4 && w[2] == "colours" && w[3] == "0..255") integer_colours_ = true;
-        // A set read from LAS: its point format, version, scale and offset, so that LAS → PLY → LAS
-        // writes the same coordinates in the same format. Ignored unless all of it parses.
-        if (w.size() == 12 && w[2] == "las" && w[3] == "frame") {
+        // A set read from LAS: its point format, version, scale and offset, and (since 2026-11-30)
+        // its global encoding, so that LAS → PLY → LAS writes the same coordinates in the same
+        // format, its GPS times of the same kind. Ignored unless all of it parses.
+        if ((w.size() == 12 || w.size() == 13) && w[2] == "las" && w[3] == "frame") {
           LasSource las;
           double v[8];
           bool ok = true;
@@ -472,6 +473,10 @@ class PlyParser {
             las.version_minor = static_cast<int>(v[1]);
             las.scale = glm::dvec3(v[2], v[3], v[4]);
             las.offset = glm::dvec3(v[5], v[6], v[7]);
+            unsigned encoding = 0;
+            if (w.size() == 13 &&
+                std::from_chars(w[12].data(), w[12].data() + w[12].size(), encoding).ec == std::errc() && encoding <= 0xFFFF)
+              las.global_encoding = static_cast<uint16_t>(encoding);
             points_.las = las;
           }
         }

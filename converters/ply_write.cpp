@@ -46,6 +46,8 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
         facts += ' ';
         facts += formatNumber((*v)[k]);
       }
+    facts += ' ';
+    facts += std::to_string(l.global_encoding);  // bit 0: GPS times are adjusted standard time
     facts += '\n';
   }
   return facts;

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "converters/csv.h"
+#include "converters/ply.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -606,6 +607,41 @@ TEST(Las, writerRefusesNonFinitePointsAndBadScale) {
   EXPECT_EQ(s.error().code, ExitCode::kUsage);
   EXPECT_TRUE(contains(s.error().message, "LAS scale -1 is not a finite number > 0"));
   EXPECT_TRUE(dir.entries().empty());
+}
+
+// The header's global encoding: point formats 6-10 always say their coordinate system is WKT
+// (R15; the build before wrote 0 for a set from CSV, and PDAL reports that as an error), and a
+// LAS file's GPS time kind (bit 0: adjusted standard time) survives LAS -> PLY -> LAS (the build
+// before lost it, so 1815.las's times read back as seconds of a week). libLAS's WKT record
+// (liblas 2112, autzen.las) is kept with the other coordinate system records.
+TEST(Las, globalEncodingAndCoordinateSystemRecordsSurvive) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{1, 2, 3}};
+  set.dimensions.add("classification", DimType::kU8, 1).set<uint8_t>(0, 40);  // > 31: format 6
+  ASSERT_TRUE(writeLas(dir.file("six.las"), set));
+  std::string six = readFile(dir.file("six.las"));
+  ASSERT_EQ(static_cast<int>(six[104]), 6);
+  EXPECT_EQ(six[6] & 0x10, 0x10);
+
+  const std::string corpus = std::string(DPOINT_CORPUS_DIR);
+  Result<PointSet> gps = readLas(corpus + "/laz/1815.las");
+  ASSERT_TRUE(gps);
+  ASSERT_TRUE(writePly(dir.file("1815.ply"), *gps));
+  Result<PointSet> ply = readPly(dir.file("1815.ply"));
+  ASSERT_TRUE(ply && ply->las);
+  EXPECT_EQ(ply->las->global_encoding, 1);
+  ASSERT_TRUE(writeLas(dir.file("back.las"), *ply));
+  EXPECT_EQ(readFile(dir.file("back.las"))[6], 1);
+
+  Result<PointSet> autzen = readLas(corpus + "/las/autzen.las");
+  ASSERT_TRUE(autzen);
+  ASSERT_TRUE(writeLas(dir.file("autzen.las"), *autzen));
+  Result<PointSet> again = readLas(dir.file("autzen.las"));
+  ASSERT_TRUE(again && again->las);
+  bool liblas = false;
+  for (const LasVlr& vlr : again->las->vlrs) liblas = liblas || (vlr.user_id == "liblas" && vlr.record_id == 2112);
+  EXPECT_TRUE(liblas);
 }
 
 TEST(Las, writeReadOfEmptySetGivesEmptySet) {
