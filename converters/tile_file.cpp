@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cassert>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -320,6 +321,22 @@ Status readBytesAt(const InputFile& file, uint64_t offset, std::vector<char>& by
 }
 
 // Vertex rows [first, first + rows) of a tile into positions[0, rows) and, with colours, colors.
+// Vertex rows [first, first + rows) of a tile, as read into `bytes`: finite, as the PLY reader
+// has every vertex (the build before merged a tile's NaN into a file that dpoint then refused).
+Status finiteRows(const OpenTile& t, uint64_t first, size_t rows, const char* bytes) {
+  const size_t stride = t.stride();
+  for (size_t i = 0; i < rows; ++i) {
+    double p[3];
+    std::memcpy(p, bytes + i * stride, sizeof p);
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(p[k]))
+        return Error{t.file->path() + ": byte " + std::to_string(t.parsed.data_offset + (first + i) * stride + 8 * k) +
+                     ": vertex " + std::to_string(first + i) + ": " + "xyz"[k] + " is " + formatNumber(p[k]) +
+                     ", not a finite number"};
+  }
+  return okStatus();
+}
+
 Status readVertexRows(const OpenTile& t, uint64_t first, size_t rows, glm::dvec3* positions, glm::vec3* colors,
                       std::vector<char>& bytes) {
   const size_t stride = t.stride();
@@ -328,7 +345,7 @@ Status readVertexRows(const OpenTile& t, uint64_t first, size_t rows, glm::dvec3
     std::memcpy(&positions[i], &bytes[i * stride], sizeof(glm::dvec3));
     if (colors) std::memcpy(&colors[i], &bytes[i * stride + sizeof(glm::dvec3)], sizeof(glm::vec3));
   }
-  return okStatus();
+  return finiteRows(t, first, rows, bytes.data());
 }
 
 // Face rows [first, first + rows) of a tile into out[0, 3·rows), each index through remap after
@@ -727,6 +744,7 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
                                    block.rows * in_stride);
             !s)
           return s;
+        if (Status s = finiteRows(tile, block.first, block.rows, in.data()); !s) return s;
         // The copies of these rows, bit for bit the owner's. A copy that differs is kept (the
         // first by copying tile and copy, as mergeTiles reports it) and reported once every
         // block has been read, so that a read or face error comes first, as it does there.

@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <limits>
 
 #include "converters/ply.h"
 #include "test_support.h"
@@ -153,6 +155,25 @@ TEST(Tile, mergeRejectsACopyThatDiffersFromItsOwner) {
   r = mergeTiles({dir.file("a.ply"), dir.file("b.ply")});
   ASSERT_FALSE(r.ok());
   EXPECT_TRUE(contains(r.error().message, "refers to vertex 9 of tile 1, which does not exist"));
+}
+
+// A vertex that is not finite is refused where the tile is read, by the merge in memory and the one
+// that streams its rows to a PLY, naming the tile, the byte and the vertex, as the PLY reader names
+// them (the build before merged a NaN into a file dpoint then refused, with exit 0).
+TEST(Tile, mergeRefusesAVertexThatIsNotFinite) {
+  TempDir dir;
+  PointTile right = rightHalf();
+  right.points.positions[2].y = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(writeTile(dir.file("a.ply"), leftHalf(), "s").ok());
+  ASSERT_TRUE(writeTile(dir.file("b.ply"), right, "s").ok());
+  Result<PointSet> r = mergeTiles({dir.file("a.ply"), dir.file("b.ply")});
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "b.ply: byte ")) << r.error().message;
+  EXPECT_TRUE(contains(r.error().message, ": vertex 2: y is nan, not a finite number")) << r.error().message;
+  Status s = mergeTilesToPly({dir.file("a.ply"), dir.file("b.ply")}, dir.file("m.ply"), PlyWriteOptions{});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().message, r.error().message);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
 }
 
 TEST(Tile, readRejectsTruncatedAndMalformedFiles) {
