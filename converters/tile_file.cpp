@@ -134,7 +134,7 @@ Result<ParsedHeader> openTile(const std::string& path, File& file) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return Error{path + ": is a folder, not a tile (.ply)"};
   file.reset(std::fopen(path.c_str(), "rb"));
-  if (!file) return Error{path + ": cannot open: " + std::strerror(errno)};
+  if (!file) return cannotOpen(path, errno);
   Result<ParsedHeader> h = parseHeader(path, file.get());
   if (!h) return h.error();
   // The data must fill the rest of the file exactly.

@@ -1,6 +1,7 @@
 #include "core/input_file.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -11,6 +12,15 @@
 #include "core/interrupt.h"
 
 namespace dpoint {
+
+Error cannotOpen(const std::string& path, int error_number) {
+  std::string message = path + ": cannot open: " + std::strerror(error_number);
+  if (error_number != EMFILE && error_number != ENFILE) return Error{message};
+  struct rlimit limit {};
+  if (error_number == EMFILE && ::getrlimit(RLIMIT_NOFILE, &limit) == 0)
+    message += " (this process may hold " + std::to_string(limit.rlim_cur) + "; a shell raises that with `ulimit -n`)";
+  return Error{message, ExitCode::kResourceLimit};
+}
 
 Result<InputFile> InputFile::open(const std::string& path) {
   struct stat st {};
@@ -25,7 +35,7 @@ Result<InputFile> InputFile::open(const std::string& path) {
                  (S_ISFIFO(st.st_mode) ? "a pipe" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "a socket") +
                  "): dpoint reads files whose size it can see; copy it into one first"};
   int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Error{path + ": cannot open: " + std::strerror(errno)};
+  if (fd < 0) return cannotOpen(path, errno);
   return InputFile(path, fd, static_cast<uint64_t>(st.st_size));
 }
 

@@ -10,6 +10,10 @@
 
 namespace dpoint {
 
+// The error of a file that could not be opened (errno `error_number`), naming it; too many open
+// files is a resource limit (kResourceLimit), with the process's limit and how to raise it.
+Error cannotOpen(const std::string& path, int error_number);
+
 class InputFile {
  public:
   // Fails with a message naming the path when it does not exist, is a folder or cannot be read.

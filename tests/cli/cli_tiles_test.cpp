@@ -196,6 +196,35 @@ TEST(CliTiles, mergeKeepsToMaxMemoryWhenItStreams) {
             0);
 }
 
+// Every tile is open at once: dpoint raises its soft limit on open files to the hard one (80 tiles
+// under a soft limit of 40 merge), and where the hard limit itself is too low the error is a
+// resource limit (exit 4) that says so (the build before failed both with exit 2).
+TEST(CliTiles, mergeOfMoreTilesThanTheOpenFileLimitRaisesItOrSaysSo) {
+  TempDir dir;
+  std::vector<std::string> tiles;
+  for (int t = 0; t < 80; ++t) {
+    std::string name = "t";  // appended: GCC 12 warns falsely on "t" + string (bug 105651)
+    name += std::to_string(t);
+    tiles.push_back(dir.file(name + ".ply"));
+    ASSERT_EQ(runDpoint({"generate", "random2d", "-n", "200", "-q", "--tile", std::to_string(t) + "/80", "-o", tiles.back()})
+                  .exit_code,
+              0);
+  }
+  const auto merge = [&](const std::string& limits, const std::string& out) {
+    std::vector<std::string> argv = {"/bin/sh", "-c", limits + "; exec \"$0\" \"$@\"", DPOINT_EXE, "merge", "-q", "-o",
+                                     dir.file(out)};
+    argv.insert(argv.end(), tiles.begin(), tiles.end());
+    return runCommand(argv);
+  };
+  test::CommandResult raised = merge("ulimit -Sn 40", "raised.ply");
+  EXPECT_EQ(raised.exit_code, 0) << raised.err;
+  test::CommandResult low = merge("ulimit -n 40", "low.ply");
+  EXPECT_EQ(low.exit_code, 4) << low.err;
+  EXPECT_TRUE(test::contains(low.err, "cannot open: Too many open files (this process may hold 40; a shell raises that with `ulimit -n`)"))
+      << low.err;
+  EXPECT_FALSE(test::fileExists(dir.file("low.ply")));
+}
+
 TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
   TempDir dir;
   const std::vector<std::string> kind = {"mandelbulb", "--resolution", "29"};
