@@ -1,5 +1,6 @@
 #include "bench/baseline.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "bench/report_internal.h"
@@ -48,7 +49,9 @@ Result<Baseline> readBaseline(const std::string& path) {
       return badBaseline(path, "row " + std::to_string(i) + " lacks case, backend or mode");
     const JsonValue* gpu = row.find("gpu_ms");
     const JsonValue* median = gpu ? gpu->find("median") : nullptr;
-    if (!median || median->kind != JsonValue::Kind::kNumber || !(median->number > 0.0)) continue;  // not timed there
+    // Not timed there (a case that did not run), or not a time (1e999 parses as infinity).
+    if (!median || median->kind != JsonValue::Kind::kNumber || !(median->number > 0.0) || !std::isfinite(median->number))
+      continue;
     baseline.rows.push_back({name->text, backend->text, mode->text, median->number});
   }
   return baseline;

@@ -295,13 +295,19 @@ int runBenchReport(const BenchReportOptions& o) {
   if (report.baseline) {
     const BaselineReport& b = *report.baseline;
     std::printf("bench: against %s: %zu of %zu rows more than 5%% slower\n", b.path.c_str(), b.slower(), b.rows.size());
+    // A baseline of other cases compares nothing: said, so that a check of it cannot pass unseen.
+    if (b.rows.empty())
+      std::fprintf(stderr,
+                   "dpoint: warning: %s: no timed row of this run (its case, backend and mode) is in the baseline "
+                   "(%zu timed rows there): nothing was compared; record a baseline of this --suite and --sizes\n",
+                   b.path.c_str(), baseline->rows.size());
     for (const BaselineComparison& c : b.rows)
       if (c.slower)
         std::fprintf(stderr, "dpoint: warning: %s %s %s: %.4g ms against the baseline's %.4g ms (%.2fx)\n",
                      c.case_name.c_str(), c.backend.c_str(), c.mode.c_str(), c.now_ms, c.baseline_ms, c.ratio());
     if (!b.same_device)
-      std::fprintf(stderr, "dpoint: warning: the baseline ran on %s, this run on %s\n", b.device.c_str(),
-                   run->device.name.c_str());
+      std::fprintf(stderr, "dpoint: warning: the baseline ran on %s, this run on %s\n",
+                   b.device.empty() ? "a device it does not name" : b.device.c_str(), run->device.name.c_str());
   }
   return failOnValidationMessages(**context);
 }
