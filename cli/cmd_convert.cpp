@@ -73,6 +73,9 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress, M
 int runConvert(ConvertOptions& o) {
   Result<PointOrder> order = parsePointOrder("--order", o.order);
   if (!order) return reportError(order.error());
+  // The input is not replaced by what is made of it (README, exit codes): a failed or unwanted
+  // conversion would leave nothing to go back to.
+  if (Status s = checkNotAlso("-o", o.output, {{"the input", o.input}}); !s) return reportError(s.error());
   Result<uint64_t> limit = memoryLimitOf(o.max_memory);
   if (!limit) return reportError(limit.error());
   o.memory_limit = *limit;

@@ -28,6 +28,10 @@ struct MergeOptions {
 int runMerge(const MergeOptions& o) {
   Result<PointOrder> order = parsePointOrder("--order", o.order);
   if (!order) return reportError(order.error());
+  // No tile is replaced by the merge (README, exit codes): the set would no longer be whole.
+  std::vector<std::pair<std::string, std::string>> tiles;
+  for (const std::string& tile : o.inputs) tiles.push_back({"a tile", tile});
+  if (Status s = checkNotAlso("-o", o.output, tiles); !s) return reportError(s.error());
   uint64_t limit = 0;
   if (!o.max_memory.empty()) {
     Result<uint64_t> parsed = parseMemorySize("--max-memory", o.max_memory);

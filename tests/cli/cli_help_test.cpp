@@ -243,6 +243,9 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"info", in, "--scene", "-1"}, "--scene -1: must be 0 or more"},
       {{"render", in, "-o", png, "--point-size", "nan"}, "--point-size nan: must be a finite number"},
       {{"render", in, "-o", png, "--json", in}, "--json " + in + ": is also an input (" + in + ")"},
+      // README's promise for every command (a review finding: convert and merge replaced their input).
+      {{"convert", in, "-o", in}, "-o " + in + ": is also the input (" + in + ")"},
+      {{"merge", ply, in, "-o", in}, "-o " + in + ": is also a tile (" + in + ")"},
       // The other classes: bad input (2), no usable device (3), a resource limit (4).
       {{"convert", missing, "-o", ply}, missing + ": file not found", 2},
       {{"info", links.file("zero.ply")}, links.file("zero.ply") + ": not a regular file (a device)", 2},
