@@ -69,7 +69,8 @@ void setPositions(PointSet& set, const py::handle& value, bool allow_nonfinite) 
                       ExitCode::kBadInput});
     set.positions[i] = p;
   }
-  set.z_axis = planar ? ZAxis::kAbsent : ZAxis::kUnknown;
+  // (N, 2) is a 2D set; (N, 3) has z, even where every z is 0 (a flat scan), as a 3-column CSV has.
+  set.z_axis = planar ? ZAxis::kAbsent : ZAxis::kPresent;
 }
 
 // Keeps `kept` alive as long as `owner` (a pybind11 instance, which takes weak references): the
@@ -176,6 +177,9 @@ void setAttribute(const py::handle& self, PointSet& set, const std::string& name
     throw py::value_error("attribute '" + name + "': expected " + std::to_string(set.size()) +
                           " values (one per point) in one dimension");
   const DimType type = dimTypeOf(array, name);
+  // Values in the host's byte order: a big-endian column (FITS, HDF5) was copied as its bytes.
+  if (!array.dtype().attr("isnative").cast<bool>())
+    array = py::array::ensure(array.attr("astype")(array.dtype().attr("newbyteorder")("=")));
   py::array contiguous = py::array::ensure(array, py::array::c_style | py::array::forcecast);
   DimensionBytes bytes(set.size() * dimTypeSize(type));  // unset, then every byte copied
   if (!bytes.empty()) std::memcpy(bytes.data(), contiguous.data(), bytes.size());
@@ -231,10 +235,24 @@ py::array view3(const py::object& owner, const T* data, size_t rows) {
   return py::array_t<T>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(T)}, py::ssize_t{sizeof(T)}}, data, owner);
 }
 
+// Each line a UserWarning shown at the line that called the package's function: stack level 2, as
+// read, write and sample are called through their wrappers in dpoint/__init__.py.
+void warnAtCaller(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines)
+    if (PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 2) < 0) throw py::error_already_set();
+}
+
 // max_memory and the like: None or 0 (the default), bytes as a number, or a size as text ("8G").
-Result<uint64_t> memoryOption(const std::string& name, const py::object& value) {
-  if (value.is_none()) return uint64_t{0};
-  if (py::isinstance<py::bool_>(value) ||
+Result<uint64_t> memoryOption(const std::string& name, const py::object& given) {
+  if (given.is_none()) return uint64_t{0};
+  const bool boolean = py::isinstance<py::bool_>(given) ||
+                       (py::hasattr(given, "dtype") && py::str(given.attr("dtype").attr("kind")).cast<std::string>() == "b");
+  // A NumPy integer (numpy.int64(10**9)) as the Python int it stands for.
+  py::object value = given;
+  if (!boolean && !py::isinstance<py::int_>(given) && PyIndex_Check(given.ptr()))
+    value = py::reinterpret_steal<py::object>(PyNumber_Index(given.ptr()));
+  if (!value) throw py::error_already_set();
+  if (boolean ||
       !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) || py::isinstance<py::str>(value)))
     throw py::type_error(name + ": expected bytes (a number) or a size such as \"8G\", got " +
                          py::str(py::type::of(value)).cast<std::string>());
@@ -276,8 +294,7 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
     if (columns) r.columns = *columns;
     return readInput(path, r, g, InputOptionNames{"scene and all_scenes", "max_points"});
   })));
-  for (const std::string& notice : notices)
-    if (PyErr_WarnEx(PyExc_UserWarning, notice.c_str(), 1) < 0) throw py::error_already_set();
+  warnAtCaller(notices);
   return set;
 }
 
@@ -309,8 +326,7 @@ std::shared_ptr<PointSet> sampleMesh(const PointSet* mesh, const std::string& pa
     }
     return sampleSurface(*mesh, options, path.empty() ? std::string("the mesh") : path);
   })));
-  for (const std::string& note : texture.notes)
-    if (PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1) < 0) throw py::error_already_set();
+  warnAtCaller(texture.notes);
   return sampled;
 }
 
@@ -476,9 +492,11 @@ progress: lines on stderr.)");
         const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding));
         const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
+        std::vector<std::string> notices;  // what the file cannot hold as given: warnings, as the CLI's notes
         check(released([&] {
           Progress bar(progressFile(progress), "write");
           WriteOptions w;
+          w.notices = &notices;
           w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale.value_or(0.0);
           w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
           w.ply_colors = ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
@@ -490,6 +508,7 @@ progress: lines on stderr.)");
           if (Status s = filterPoints(copy, colors, unique, point_order, limit, threads, &bar); !s) return s;
           return writePoints(path, copy, w);
         }));
+        warnAtCaller(notices);
       },
       py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
       py::arg("ply_colors") = "uchar", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",

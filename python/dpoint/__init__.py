@@ -40,7 +40,15 @@ class RenderWarning(UserWarning):
     """A picture that is likely wrong or poor (render's warnings: a mode over half a pixel, a speck)."""
 
 
+def _plain(value):
+    """A NumPy scalar as the Python value it holds: numpy.True_ as True (a flag), numpy.int64(3) as 3."""
+    if getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+        return value.item()
+    return value
+
+
 def _value(value) -> str:
+    value = _plain(value)
     if isinstance(value, bool):
         raise TypeError("a flag takes True or False only as the whole value")
     if isinstance(value, str):
@@ -72,6 +80,7 @@ def _args(options: dict) -> list[str]:
     """Keyword arguments as the CLI's options: view_width=0.5 is ["--view-width", "0.5"]."""
     args = []
     for key, value in options.items():
+        value = _plain(value)
         if value is None or value is False:
             continue
         flag = "--" + key.replace("_", "-")
@@ -101,7 +110,12 @@ def _from_dataframe(frame, *, allow_nonfinite: bool = False) -> PointSet:
     r, g, b: integers 0..255 (as CSV files hold them) or floats 0..1 (linear). Without z the set is 2D.
     Every other column is an attribute in its dtype (integers, floats, bool), as to_dataframe gives them.
     """
-    columns = {str(c).lower(): c for c in frame.columns}
+    columns = {}
+    for c in frame.columns:
+        known = str(c).lower()
+        if known in ("x", "y", "z", "r", "g", "b") and known in columns:
+            raise Error(f"DataFrame: columns {columns[known]!r} and {c!r} are both {known} (names are taken in any case)")
+        columns.setdefault(known, c)
     missing = [c for c in ("x", "y") if c not in columns]
     if missing:
         raise Error(f"DataFrame: no column {', '.join(missing)} (columns: {', '.join(map(str, frame.columns))})")
@@ -140,7 +154,18 @@ def _to_dataframe(self):
         data["z"] = self.positions[:, 2]
     if self.colors is not None:
         data.update(r=self.colors[:, 0], g=self.colors[:, 1], b=self.colors[:, 2])
-    data.update(self.attributes)
+    # An attribute named as a position's or colour's column (a PLY property r, one named X) gets a
+    # column of its own, "r_2", with a warning: it overwrote the colour, or from_dataframe took it
+    # for the position.
+    known = {"x", "y", "z", "r", "g", "b"}  # in any case, as from_dataframe takes them
+    for name, values in self.attributes.items():
+        column, k = name, 2
+        while column.lower() in known or column in data:
+            column, k = f"{name}_{k}", k + 1
+        if column != name:
+            _warnings.warn(f"to_dataframe: attribute {name!r} is column {column!r} ({name.lower()} names the "
+                           "position's or colour's column)", UserWarning, stacklevel=2)
+        data[column] = values
     return pd.DataFrame(data, copy=True)
 
 

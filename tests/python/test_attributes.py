@@ -127,3 +127,16 @@ def test_an_extra_bytes_record_the_reader_cannot_follow_is_a_warning(tmp_path):
     assert "broken.las: extra bytes descriptor 0 ('amplitude'): data type 31" in str(caught[0].message)
     assert "amplitude" not in back.attributes
     assert list(back.attributes["extra_byte_1"]) == [1, 3]
+
+
+def test_big_endian_arrays_are_their_values():
+    """A column in the other byte order (FITS, HDF5) is its values (the build before copied its bytes:
+    258 for 1), through set_attribute and from_dataframe."""
+    import pandas as pd
+    s = dpoint.PointSet(np.zeros((3, 3)))
+    s.set_attribute("a", np.array([1, 2, 3], dtype=">u2"))
+    s.set_attribute("w", np.array([1.5, 2.0, -3.25], dtype=">f8"))
+    assert s.attributes["a"].tolist() == [1, 2, 3] and s.attributes["a"].dtype == np.uint16
+    assert s.attributes["w"].tolist() == [1.5, 2.0, -3.25]
+    frame = pd.DataFrame({"x": np.zeros(2), "y": np.zeros(2), "c": np.array([7, 9], dtype=">i4")})
+    assert dpoint.PointSet.from_dataframe(frame).attributes["c"].tolist() == [7, 9]

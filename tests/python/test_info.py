@@ -80,3 +80,11 @@ def test_a_bad_option_is_the_clis_error(tmp_path, cloud, options, flags):
 def test_info_of_a_missing_file_names_it(tmp_path):
     with pytest.raises(dpoint.Error, match=f"{tmp_path / 'gone.las'}: file not found"):
         dpoint.info(tmp_path / "gone.las")
+
+
+def test_numpy_scalars_are_options(cloud):
+    """numpy.int64 as a size and numpy.True_ as a flag, as their Python values (the build before
+    refused the first and passed the second to the CLI as the word True)."""
+    s, _, _ = cloud
+    assert dpoint.info(s, max_memory=np.int64(10**9))["points"] == len(s)
+    assert dpoint.info(s, sample=np.int64(5), width=np.int32(64))["neighbor_sample"] == 5

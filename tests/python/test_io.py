@@ -297,3 +297,15 @@ def test_read_info_and_render_take_columns_as_the_cli(tmp_path):
         assert picture.report["points"] == 3
     with pytest.raises(ValueError, match=r"4 columns, expected 3 \(q,x,y\)"):
         dpoint.read(path, columns=["q", "x", "y"])
+
+
+def test_write_notes_are_warnings_at_the_callers_line(tmp_path):
+    """What the file cannot hold as given comes as a UserWarning, as the CLI's notes (the build before
+    said nothing: -0.0 came back from GLB as +0.0 without a word), shown at the caller's line."""
+    import warnings
+    s = dpoint.PointSet(np.array([[-0.0, 1.0, 2.0], [1.0, 2.0, 3.0]]))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dpoint.write(s, tmp_path / "z.glb")
+    assert len(caught) == 1 and "will not read back bit-exactly" in str(caught[0].message)
+    assert caught[0].filename == __file__

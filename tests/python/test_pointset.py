@@ -302,3 +302,30 @@ def test_a_dataframe_goes_wherever_points_go(tmp_path, rng):
     assert np.array_equal(dpoint.read(tmp_path / "f.ply").positions, frame.to_numpy())
     assert dpoint.info(frame)["points"] == 30
     assert dpoint.render(frame, width=32, height=32, validate=True).points == 30
+
+
+def test_three_columns_keep_z_even_when_every_z_is_0(tmp_path):
+    """A flat (N, 3) scan is 3D, as a 3-column CSV is (the build before made it 2D: no z column)."""
+    s = dpoint.PointSet(np.array([[1.0, 2.0, 0.0], [3.0, 4.0, 0.0]]))
+    assert s.has_z
+    assert list(s.to_dataframe().columns) == ["x", "y", "z"]
+    dpoint.write(s, tmp_path / "flat.csv")
+    assert (tmp_path / "flat.csv").read_text().splitlines()[0] == "x,y,z"
+
+
+def test_dataframe_names_that_clash_are_renamed_or_refused():
+    """An attribute named as a position's or colour's column gets a column of its own, with a
+    warning (an attribute r overwrote the colour, one named X became x on the way back); a frame
+    with both z and Z is refused (z was taken and Z dropped)."""
+    s = dpoint.PointSet(np.array([[1.0, 2.0, 3.0]]), np.array([[255, 0, 0]], dtype=np.uint8))
+    s.set_attribute("X", np.array([100.0]))
+    s.set_attribute("R", np.array([0.25]))
+    with pytest.warns(UserWarning, match="attribute 'X' is column 'X_2'"):
+        frame = s.to_dataframe()
+    assert list(frame.columns) == ["x", "y", "z", "r", "g", "b", "X_2", "R_2"]
+    assert frame.r[0] == 1.0 and frame.R_2[0] == 0.25
+    back = dpoint.PointSet.from_dataframe(frame)
+    assert back.positions.tolist() == [[1.0, 2.0, 3.0]]
+    assert back.attributes["X_2"].tolist() == [100.0]
+    with pytest.raises(dpoint.Error, match="columns 'z' and 'Z' are both z"):
+        dpoint.PointSet.from_dataframe(pd.DataFrame({"x": [1.0], "y": [2.0], "z": [3.0], "Z": [30.0]}))
