@@ -61,8 +61,10 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
   addMaxMemoryOption(cmd, o.max_memory);
   cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");
   cmd.add_option("--tile", o.tile,
-                 "I/N: compute only tile I (from 0) of N of the set, into a .ply part that `dpoint merge` welds with\n"
-                 "the others into the file one process writes, byte for byte (--order then goes to merge)")
+                 "I/N: compute only tile I (from 0) of N (1 to " + std::to_string(kMaxTiles) +
+                     ") of the set, into a .ply part that `dpoint merge` welds with\n"
+                 "the others into the file one process writes, byte for byte (--order then goes to merge; --sample\n"
+                 "and --decimals to the merged file)")
       // An empty value wrote the whole set as if no --tile were given (a review finding).
       ->check(check([](const std::string& v) { return v.empty() ? std::string("--tile: empty; give I/N, e.g. 0/4") : ""; }));
   addCommonOptions(cmd, o.common);
@@ -284,7 +286,7 @@ Result<TileSpec> tileOptions(const OutputOptions& o) {
   if (!tile) return tile.error();
   Result<FileFormat> format = formatOf(o.output);
   if (!format || *format != FileFormat::kPly)
-    return Error{"--tile: -o " + o.output + ": a tile is written as .ply (dpoint merge makes the .ply, .csv or .glb)",
+    return Error{"--tile: -o " + o.output + ": a tile is written as .ply (dpoint merge makes any of " + std::string(kPointOutputFormats) + ")",
                  ExitCode::kUsage};
   if (o.order != "input")
     return Error{"--tile: --order " + o.order + " needs the whole set; give it to dpoint merge", ExitCode::kUsage};

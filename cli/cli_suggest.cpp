@@ -190,6 +190,10 @@ std::string usageMessage(const CLI::ParseError& error, const CLI::App& app, int 
       for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     return prefix + name + " is required" + help;
   }
+  // An option given more than once: "--frames: At Most 1 required but received 2".
+  static const std::regex kRepeated(R"(^(-[-\w]+): At Most 1 required but received (\d+)$)");
+  if (std::regex_match(what, m, kRepeated))
+    return m[1].str() + ": given " + m[2].str() + " times; give it once" + help;
   // A check's own message that names its option again: "--tolerance: --tolerance -1: ..." once.
   static const std::regex kTwice(R"(^(-[-\w]+): (\1 .*)$)");
   if (std::regex_match(what, m, kTwice)) return m[2].str();

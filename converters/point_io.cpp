@@ -215,11 +215,14 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return writePcd(path, points,
                       PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads});
     case FileFormat::kGlb:
-      if (points.positions.empty())  // named here: writeGlb's message does not know the path
-        return Error{path + ": " + writeGlb(path, points).error().message};
     {
       GlbWriteReport report;
-      if (Status s = writeGlb(path, points, &report); !s) return s;
+      if (Status s = writeGlb(path, points, &report); !s) {
+        // The set's own faults ("cannot write GLB: point 565 has a non-finite coordinate") are named
+        // here, where the path is known.
+        if (s.error().message.rfind("cannot write GLB: ", 0) == 0) return Error{path + ": " + s.error().message, s.error().code};
+        return s;
+      }
       if (report.inexact_points != 0 && options.notices)
         options.notices->push_back(
             path + ": " + std::to_string(report.inexact_points) + " of " + std::to_string(points.size()) +

@@ -243,6 +243,7 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"info", in, "--scene", "-1"}, "--scene -1: must be 0 or more"},
       {{"render", in, "-o", png, "--point-size", "nan"}, "--point-size nan: must be a finite number"},
       {{"render", in, "-o", png, "--json", in}, "--json " + in + ": is also an input (" + in + ")"},
+      {{"render", in, "-o", png, "--frames", "1", "--frames", "2"}, "--frames: given 2 times; give it once (dpoint render --help)"},
       // README's promise for every command (a review finding: convert and merge replaced their input).
       {{"convert", in, "-o", in}, "-o " + in + ": is also the input (" + in + ")"},
       {{"merge", ply, in, "-o", in}, "-o " + in + ": is also a tile (" + in + ")"},
