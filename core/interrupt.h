@@ -3,8 +3,10 @@
 // watchInterrupts(), called first thing in main, blocks both signals in every thread and starts
 // one thread that waits for them. On the first signal it records it and forwards it to the child
 // processes registered here (bench's dpoint runs). The work polls interrupted() and returns
-// interruptedError(): parallelFor stops handing out items, InputFile reads and AtomicFile writes
-// fail, the render and bench loops stop between frames and runs. The error unwinds like any
+// interruptedError(): InputFile reads and AtomicFile writes fail, the render and bench loops stop
+// between frames and runs, info's nearest-neighbour search and the Poisson elimination between
+// points. (parallelFor does not stop by itself: a pass whose items fill indices that the next one
+// follows must not be cut short without its caller knowing.) The error unwinds like any
 // other, so every AtomicFile's destructor discards its temporary file, and main exits
 // 128 + signal. Work that cannot poll (a library decoding, a GPU frame) is cut short:
 // kInterruptGraceMs after the signal, or at a second one, the watcher removes the named temporary

@@ -14,6 +14,7 @@
 #include <glm/common.hpp>
 #include <glm/ext/vector_int3_sized.hpp>
 
+#include "core/interrupt.h"
 #include "core/parallel.h"
 #include "ops/point_spacing.h"
 
@@ -137,6 +138,7 @@ class Forest {
   // a query far from a tree (a thin slab of a file in slab order) would visit much of it.
   void nearestNonzero(std::span<const glm::dvec3> queries, std::span<double> best2, unsigned threads) const {
     parallelFor(queries.size(), threads, [&](size_t k, unsigned) {
+      if (interrupted()) return;  // its caller checks (describePoints): Ctrl-C within a query's time
       std::vector<std::pair<double, size_t>> order(trees_.size());
       for (size_t t = 0; t < trees_.size(); ++t) order[t] = {trees_[t]->boxDistance2(queries[k]), t};
       std::sort(order.begin(), order.end());
@@ -566,6 +568,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
       ? nearestByBoxes(count, scaled_read, block_points, box_points, sampled, best2, balls, wide, near, workers, block, out.points_read_again)
       : nearestByBlocks(count, scaled_read, block_points, box_points, pass_boxes, sampled, best2, threads, block, out.points_read_again);
   if (!second) return second.error();
+  if (interrupted()) return interruptedError();  // the searches stop at Ctrl-C, leaving best2 unfinished
   info.min_neighbor_distance = smallestDistance(best2) / unit;
   info.neighbor_sample = sampled.size();
   return out;

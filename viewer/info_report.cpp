@@ -138,6 +138,7 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
   InfoReport report;
   report.name = name;
   report.info = computeInfo(points, options.sample, options.threads);
+  if (interrupted()) return interruptedError();  // its search stops at Ctrl-C, leaving its figures unfinished
   for (const Dimension& d : points.dimensions.all()) {
     DimensionRange range{d.name, d.type, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
     for (size_t i = 0; i < d.size(); ++i) {

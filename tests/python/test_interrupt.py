@@ -39,6 +39,10 @@ LONG_CALLS = {
     "generate": 'dpoint.write(dpoint.generate("mandelbulb", resolution=400, device="none"), out)',
     "render": ('dpoint.render(dpoint.PointSet(np.random.default_rng(0).random((2000, 3))), width=64, height=64, '
                'frames=1000000, warmup=0).save(out)'),
+    # The nearest-neighbour search of every one of 2M points (seconds on one core): it ran to its end
+    # before the build of 2026-11-30.
+    "info": ('r = dpoint.info(dpoint.PointSet(np.random.default_rng(0).random((2_000_000, 3))), sample=100_000_000, '
+             'threads=1); open(out, "w").write(str(r))'),
 }
 
 
