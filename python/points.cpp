@@ -165,6 +165,77 @@ DimType dimTypeOf(const py::array& array, const std::string& name) {
                        " is not an integer, float or bool type");
 }
 
+// A pickle's state of a set: a version, then every array as bytes and every fact (pointSetFromState).
+py::tuple pointSetState(const PointSet& s) {
+  const auto bytes = [](const void* data, size_t size) { return py::bytes(static_cast<const char*>(data), size); };
+  py::list dims;
+  for (const Dimension& d : s.dimensions.all())
+    dims.append(py::make_tuple(d.name, static_cast<int>(d.type), bytes(d.bytes.data(), d.bytes.size())));
+  py::object las = py::none();
+  if (s.las) {
+    const LasSource& l = *s.las;
+    py::list vlrs, extra;
+    for (const LasVlr& v : l.vlrs) vlrs.append(py::make_tuple(v.user_id, v.record_id, v.description, py::bytes(v.data), v.extended));
+    for (const auto& [name, descriptor] : l.extra_bytes) extra.append(py::make_tuple(name, py::bytes(descriptor)));
+    las = py::make_tuple(l.version_minor, l.point_format, py::make_tuple(l.scale.x, l.scale.y, l.scale.z),
+                         py::make_tuple(l.offset.x, l.offset.y, l.offset.z), l.global_encoding, l.file_source_id, vlrs, extra);
+  }
+  return py::make_tuple(1, bytes(s.positions.data(), s.positions.size() * sizeof(glm::dvec3)),
+                        bytes(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
+                        bytes(s.triangles.data(), s.triangles.size() * sizeof(uint32_t)), dims,
+                        s.color_full_scale, static_cast<int>(s.z_axis), s.z_up, las);
+}
+
+std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
+  if (t.size() != 9 || t[0].cast<int>() != 1) throw py::value_error("PointSet: not a pickle of this version's PointSet");
+  auto s = std::make_shared<PointSet>();
+  const auto fill = [](const py::handle& from, auto& to) {
+    const std::string b = from.cast<std::string>();
+    using T = typename std::decay_t<decltype(to)>::value_type;
+    if (b.size() % sizeof(T) != 0) throw py::value_error("PointSet: a pickled array is not whole values");
+    to.resize(b.size() / sizeof(T));
+    if (!b.empty()) std::memcpy(to.data(), b.data(), b.size());
+  };
+  fill(t[1], s->positions);
+  fill(t[2], s->colors);
+  fill(t[3], s->triangles);
+  for (const py::handle& d : t[4].cast<py::list>()) {
+    const py::tuple dim = d.cast<py::tuple>();
+    const int type = dim[1].cast<int>();
+    if (type < 0 || type >= static_cast<int>(kDimTypeCount)) throw py::value_error("PointSet: a pickled attribute's type");
+    Dimension& column = s->dimensions.append(dim[0].cast<std::string>(), static_cast<DimType>(type), 0);
+    const std::string b = dim[2].cast<std::string>();
+    if (b.size() != s->positions.size() * dimTypeSize(column.type)) throw py::value_error("PointSet: a pickled attribute's length");
+    column.bytes.assign(b.begin(), b.end());
+  }
+  if (s->colors.size() != 0 && s->colors.size() != s->positions.size())
+    throw py::value_error("PointSet: pickled colours for another count of points");
+  if (s->triangles.size() % 3 != 0 || s->firstBadTriangleIndex() != s->triangles.size())
+    throw py::value_error("PointSet: pickled triangles that name no point");
+  s->color_full_scale = t[5].cast<uint16_t>();
+  s->z_axis = static_cast<ZAxis>(t[6].cast<int>());
+  s->z_up = t[7].cast<bool>();
+  if (!t[8].is_none()) {
+    const py::tuple l = t[8].cast<py::tuple>();
+    LasSource las;
+    las.version_minor = l[0].cast<int>(), las.point_format = l[1].cast<int>();
+    const py::tuple scale = l[2].cast<py::tuple>(), offset = l[3].cast<py::tuple>();
+    for (int k = 0; k < 3; ++k) las.scale[k] = scale[k].cast<double>(), las.offset[k] = offset[k].cast<double>();
+    las.global_encoding = l[4].cast<uint16_t>(), las.file_source_id = l[5].cast<uint16_t>();
+    for (const py::handle& v : l[6].cast<py::list>()) {
+      const py::tuple r = v.cast<py::tuple>();
+      las.vlrs.push_back({r[0].cast<std::string>(), r[1].cast<uint16_t>(), r[2].cast<std::string>(), r[3].cast<std::string>(),
+                          r[4].cast<bool>()});
+    }
+    for (const py::handle& e : l[7].cast<py::list>()) {
+      const py::tuple r = e.cast<py::tuple>();
+      las.extra_bytes.push_back({r[0].cast<std::string>(), r[1].cast<std::string>()});
+    }
+    s->las = std::move(las);
+  }
+  return s;
+}
+
 // Sets (adds or replaces) a dimension from a 1-D array of one value per point, in the array's own
 // dtype. Views of a replaced column keep memory of their own (replaceKeepingViews).
 void setAttribute(const py::handle& self, PointSet& set, const std::string& name, const py::handle& value) {
@@ -418,6 +489,11 @@ that memory, without copying (writing into them changes the set).)")
       .def_property_readonly("has_z", &PointSet::hasZ, "Whether writers write z (False for a 2D set)")
       .def_readwrite("z_up", &PointSet::z_up, "The source says z is up (LAS): render's fitted views use it")
       .def("copy", [](const PointSet& s) { return std::make_shared<PointSet>(s); }, "A deep copy")
+      .def("__copy__", [](const PointSet& s) { return std::make_shared<PointSet>(s); })
+      .def("__deepcopy__", [](const PointSet& s, const py::dict&) { return std::make_shared<PointSet>(s); })
+      // Pickled whole (multiprocessing, joblib): every array as its bytes, the source's facts and a
+      // LAS source's frame and records, so the copy writes the files the set writes.
+      .def(py::pickle(&pointSetState, &pointSetFromState))
       .def("__repr__", [](const PointSet& s) {
         return "<dpoint.PointSet: " + std::to_string(s.size()) + " points" + (s.hasColors() ? ", colours" : "") +
                (s.isMesh() ? ", " + std::to_string(s.triangles.size() / 3) + " triangles" : "") +

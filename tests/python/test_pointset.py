@@ -329,3 +329,25 @@ def test_dataframe_names_that_clash_are_renamed_or_refused():
     assert back.attributes["X_2"].tolist() == [100.0]
     with pytest.raises(dpoint.Error, match="columns 'z' and 'Z' are both z"):
         dpoint.PointSet.from_dataframe(pd.DataFrame({"x": [1.0], "y": [2.0], "z": [3.0], "Z": [30.0]}))
+
+
+def test_pickle_and_copy_keep_the_whole_set(tmp_path):
+    """pickle (multiprocessing), copy.copy and copy.deepcopy give a set that writes the same files:
+    positions, colours, triangles, attributes in their dtypes, and a LAS source's frame and records
+    (the build before refused to pickle a PointSet)."""
+    import copy
+    import pathlib
+    import pickle
+    corpus = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "corpus" / "las"
+    las = dpoint.read(corpus / "autzen.las")
+    mesh = dpoint.generate("menger", level=1)
+    flat = dpoint.PointSet(np.array([[1.5, 2.5], [3.5, 4.5]]))
+    for name, s in [("las", las), ("mesh", mesh), ("flat", flat)]:
+        for made in (pickle.loads(pickle.dumps(s)), copy.copy(s), copy.deepcopy(s)):
+            assert made is not s and not np.shares_memory(made.positions, s.positions)
+            for ext in ("las", "ply", "csv"):
+                dpoint.write(s, tmp_path / f"a.{ext}")
+                dpoint.write(made, tmp_path / f"b.{ext}")
+                assert (tmp_path / f"a.{ext}").read_bytes() == (tmp_path / f"b.{ext}").read_bytes(), (name, ext)
+    with pytest.raises(ValueError, match="not a pickle of this version"):
+        dpoint.PointSet.__new__(dpoint.PointSet).__setstate__((2,))
