@@ -22,9 +22,11 @@ second with ``KeyboardInterrupt`` and leaves no output file. Long calls release 
 
 from __future__ import annotations
 
+import difflib as _difflib
 import json as _json
 import numbers as _numbers
 import os as _os
+import re as _re
 import warnings as _warnings
 
 from ._dpoint import DeviceError, Error, PointSet, RenderResult, __version__  # noqa: F401
@@ -78,6 +80,9 @@ def _column_names(columns):
 
 def _args(options: dict) -> list[str]:
     """Keyword arguments as the CLI's options: view_width=0.5 is ["--view-width", "0.5"]."""
+    if "help" in options or "h" in options:
+        raise TypeError("help is the CLI's option: help(dpoint.NAME) documents a function, `dpoint COMMAND --help` "
+                        "its options")
     args = []
     for key, value in options.items():
         value = _plain(value)
@@ -136,7 +141,11 @@ def _from_dataframe(frame, *, allow_nonfinite: bool = False) -> PointSet:
     for column in frame.columns:
         if str(column).lower() in used:
             continue
-        values = frame[column].to_numpy()
+        series = frame[column]
+        # pandas' nullable Int64, Float64 and boolean (convert_dtypes) as their NumPy dtypes where no
+        # value is missing: to_numpy() gives them as objects.
+        numpy_dtype = getattr(series.dtype, "numpy_dtype", None)
+        values = series.to_numpy(dtype=numpy_dtype) if numpy_dtype is not None and not series.isna().any() else series.to_numpy()
         if values.dtype.kind not in "biuf":
             raise Error(f"DataFrame: column {column!r} is {values.dtype}, not numbers: "
                         "an attribute holds integers, floats or bools")
@@ -241,20 +250,44 @@ def render(points, mode: str = "auto", *, progress: bool = False, **options) -> 
     return _render(points, mode, None, progress, options)
 
 
+def _keywords(name: str, function, options: dict) -> dict:
+    """read's, write's and sample's options checked against the names `function` takes (its
+    signature), with "did you mean" for a misspelt one (pybind11 printed its whole signature), None
+    leaving an option out as everywhere else, and NumPy scalars as their Python values."""
+    known = _re.findall(r"(\w+): ", function.__doc__.splitlines()[0].split("*,", 1)[1])
+    out = {}
+    for key, value in options.items():
+        if key not in known:
+            close = _difflib.get_close_matches(key, known, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else f" (its options: {', '.join(known)})"
+            raise TypeError(f"{name}: no option {key!r}{hint}")
+        value = _plain(value)
+        if value is not None:
+            out[key] = value
+    return out
+
+
 def read(path, **options) -> PointSet:
+    options = _keywords("read", _dpoint.read, options)
     if "columns" in options:
         options["columns"] = _column_names(options["columns"])
     return _dpoint.read(_os.fspath(path), **options)
 
 
 def write(points, path, **options) -> None:
+    options = _keywords("write", _dpoint.write, options)
     points, _ = _as_points(points) if not isinstance(points, PointSet) else (points, None)
     if points is None:
         raise TypeError("write: points must be a PointSet or an array, not a file name")
-    _dpoint.write(points, _os.fspath(path), **options)
+    try:
+        _dpoint.write(points, _os.fspath(path), **options)
+    except Error as e:  # the CLI's advice in the module's words
+        e.args = (_re.sub(r"--drop (\w+)", r"points.remove_attribute('\1') (on a copy)", str(e)),)
+        raise
 
 
 def sample(mesh, count, **options) -> PointSet:
+    options = _keywords("sample", _dpoint.sample, options)
     if isinstance(mesh, (str, _os.PathLike)):  # read with its textures, which colour the samples
         return _dpoint._sample_file(_os.fspath(mesh), count, **options)
     return _dpoint.sample(mesh, count, **options)
@@ -289,6 +322,11 @@ def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool
     sampled for the nearest-neighbour distance. columns: text files, what each column holds (as
     read's columns).
     """
+    sample = _plain(sample)
+    if isinstance(sample, bool) or not isinstance(sample, _numbers.Integral) or not 1 <= sample <= 100_000_000:
+        error = Error(f"sample {sample!r}: must be a number from 1 to 100000000 (as info's --sample)")
+        error.exit_code = 1  # a usage error, as the CLI's
+        raise error
     in_memory, inputs = _as_points(points)
     limit = _dpoint._memory_size("max_memory", max_memory)
     text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit,

@@ -56,3 +56,42 @@ def test_bad_calls_speak_the_clis_words(call, code, words):
     assert raised.value.exit_code == code
     assert words in str(raised.value)
     assert "\n" not in str(raised.value).strip()
+
+
+@pytest.mark.parametrize("call, kind, words", [
+    # A misspelt keyword of read, write or sample (pybind11 printed write's whole signature).
+    (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.csv", decimal=3), TypeError,
+     "write: no option 'decimal'; did you mean 'decimals'?"),
+    (lambda t: dpoint.read(t / "a.csv", thread=2), TypeError, "read: no option 'thread'; did you mean 'threads'?"),
+    (lambda t: dpoint.sample(dpoint.generate("menger", level=1), 10, sed=1), TypeError,
+     "sample: no option 'sed'; did you mean 'seed'?"),
+    # help= is the CLI's (render's raised CLI11's "This should be caught in your main function").
+    (lambda t: dpoint.render(CLOUD, help=True), TypeError, "help is the CLI's option"),
+    (lambda t: dpoint.generate("menger", help=True), TypeError, "help is the CLI's option"),
+    (lambda t: dpoint.info(CLOUD, sample=-1), dpoint.Error, "sample -1: must be a number from 1 to 100000000"),
+    # The LAS writer's advice in the module's words (it said "--drop intensity").
+    (lambda t: dpoint.write(_with_intensity(70000), t / "a.las"), dpoint.Error,
+     "leave it out with points.remove_attribute('intensity') (on a copy)"),
+])
+def test_python_mistakes_get_python_words(tmp_path, call, kind, words):
+    dpoint.write(dpoint.PointSet(CLOUD), tmp_path / "a.csv")
+    with pytest.raises(kind) as raised:
+        call(tmp_path)
+    assert words in str(raised.value)
+
+
+def _with_intensity(value):
+    s = dpoint.PointSet(CLOUD)
+    s.set_attribute("intensity", np.array([value, 0], dtype=np.uint32))
+    return s
+
+
+def test_none_leaves_an_option_out_and_numpy_and_nullable_values_are_taken(tmp_path):
+    """None leaves read's and write's options out, as everywhere else (pybind11 refused it), and
+    a DataFrame of pandas' nullable dtypes (convert_dtypes) gives its attributes (refused as objects)."""
+    import pandas as pd
+    dpoint.write(dpoint.PointSet(CLOUD), tmp_path / "a.csv", decimals=None, threads=np.int64(1))
+    assert len(dpoint.read(tmp_path / "a.csv", scene=None, max_points=None)) == 2
+    frame = pd.DataFrame({"x": [1.0, 2.0], "y": [3.0, 4.0], "i": [5, 6], "ok": [True, False]}).convert_dtypes()
+    s = dpoint.PointSet.from_dataframe(frame)
+    assert s.attributes["i"].tolist() == [5, 6] and s.attributes["ok"].tolist() == [1, 0]
