@@ -52,8 +52,27 @@ Result<bool> checkInputSet(const std::vector<std::string>& paths) {
   return paths.size() == count;  // each index once: all of them
 }
 
+namespace {
+
+// A note where tiles are read file by file (one alone, a set with tiles left out, tiles of several
+// runs, or tiles beside other files): each brings its copies of the seam vertices, which the
+// whole set holds once; the count of points is then not the merged set's.
+std::optional<std::string> tilesFileByFile(const std::vector<std::string>& paths) {
+  const size_t tiles = static_cast<size_t>(std::count_if(paths.begin(), paths.end(), isTileFile));
+  if (tiles == 0) return std::nullopt;
+  return describeInputs(paths) + ": " + (tiles == 1 ? std::string("a tile") : std::to_string(tiles) + " tiles") +
+         " of `generate --tile` read file by file, each with its copies of the seam vertices (a run's N tiles "
+         "given together are read as the merged set)";
+}
+
+}  // namespace
+
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
-  if (paths.size() == 1) return readPoints(paths[0], options);
+  if (paths.size() == 1) {
+    if (options.notices)
+      if (std::optional<std::string> note = tilesFileByFile(paths)) options.notices->push_back(*note);
+    return readPoints(paths[0], options);
+  }
   if (options.texture) {  // a texture is one file's: several are read without
     *options.texture = MeshTexture{};
     ReadOptions each = options;
@@ -67,6 +86,8 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     if (whole && options.points_only) whole->triangles.clear();
     return whole;
   }
+  if (options.notices)
+    if (std::optional<std::string> note = tilesFileByFile(paths)) options.notices->push_back(*note);
   PointSet out;
   bool any_colors = false;
   for (const std::string& path : paths) {
@@ -138,6 +159,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     }
   } else {
     for (const std::string& path : paths) files.emplace_back(path, UINT64_MAX);
+    if (std::optional<std::string> note = tilesFileByFile(paths)) stream->notices_.push_back(*note);
   }
   for (const auto& [path, owned] : files) {
     Part part;

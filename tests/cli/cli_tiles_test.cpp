@@ -225,6 +225,28 @@ TEST(CliTiles, mergeOfMoreTilesThanTheOpenFileLimitRaisesItOrSaysSo) {
   EXPECT_FALSE(test::fileExists(dir.file("low.ply")));
 }
 
+// Tiles read file by file (one alone, a set with a tile left out) bring their copies of the seam
+// vertices: info and render say so in a note, streamed or not; the whole set says nothing (the
+// build before counted the copies without a word).
+TEST(CliTiles, tilesReadFileByFileSaySo) {
+  TempDir dir;
+  ASSERT_FALSE(mergedTiles(dir, {"julia", "--resolution", "21"}, 3, "m.ply").empty());
+  const std::string p0 = dir.file("part-0.ply"), p1 = dir.file("part-1.ply"), p2 = dir.file("part-2.ply");
+  const std::string note = "dpoint: note: " + p0 + " and 1 more: 2 tiles of `generate --tile` read file by file";
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"info", p0, p1}, {"info", p0, p1, "--stream", "on"},
+        {"render", p0, p1, "-o", dir.file("r.png"), "--width", "32", "--height", "24", "-q"}}) {
+    test::CommandResult r = runDpoint(command);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::contains(r.err, note)) << command[0] << ": " << r.err;
+  }
+  test::CommandResult one = runDpoint({"info", p0});
+  EXPECT_TRUE(test::contains(one.err, p0 + ": a tile of `generate --tile` read file by file")) << one.err;
+  test::CommandResult all = runDpoint({"info", p0, p1, p2});
+  ASSERT_EQ(all.exit_code, 0) << all.err;
+  EXPECT_EQ(all.err.find("note:"), std::string::npos) << all.err;
+}
+
 TEST(CliTiles, renderAndInfoTakeTheTilesAsTheWholeSet) {
   TempDir dir;
   const std::vector<std::string> kind = {"mandelbulb", "--resolution", "29"};
