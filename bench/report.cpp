@@ -189,26 +189,39 @@ Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportCo
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return Error{"cannot create " + dir + ": " + ec.message(), ExitCode::kBadInput};
-  std::vector<std::string> written;
-  auto put = [&](const std::string& name, const std::string& text) -> Status {
+  // Every file is written in full before any replaces the last run's, and the last run's optional
+  // files this run does not make are removed: the folder holds one run's report (a full disk left
+  // a new results.json beside the last run's charts; a paper run kept a ci run's breakdown.svg).
+  std::vector<std::pair<std::string, AtomicFile>> files;
+  auto put = [&](const std::string& name, const void* data, size_t size) -> Status {
     const std::string path = (std::filesystem::path(dir) / name).string();
     Result<AtomicFile> file = AtomicFile::create(path);
     if (!file) return file.error();
-    Status status = file->write(text);
-    if (status) status = file->commit();
-    if (status) written.push_back(path);
-    return status;
+    if (Status s = file->checkSpace(size); !s) return s;
+    if (Status s = file->write(data, size); !s) return s;
+    files.emplace_back(path, std::move(*file));
+    return okStatus();
   };
-  if (Status s = put("results.json", resultsJson(run, context, failures)); !s) return s.error();
-  if (Status s = put("report.md", reportMarkdown(run, context, failures)); !s) return s.error();
-  if (Status s = put("speed_vs_error.svg", renderChartSvg(speedVsErrorChart(run))); !s) return s.error();
+  auto putText = [&](const std::string& name, const std::string& text) { return put(name, text.data(), text.size()); };
+  if (Status s = putText("results.json", resultsJson(run, context, failures)); !s) return s.error();
+  if (Status s = putText("report.md", reportMarkdown(run, context, failures)); !s) return s.error();
+  if (Status s = putText("speed_vs_error.svg", renderChartSvg(speedVsErrorChart(run))); !s) return s.error();
   if (std::optional<Chart> breakdown = breakdownChart(run)) {
-    if (Status s = put("breakdown.svg", renderChartSvg(*breakdown)); !s) return s.error();
+    if (Status s = putText("breakdown.svg", renderChartSvg(*breakdown)); !s) return s.error();
   }
   if (std::optional<Image> montage = montageImage(run)) {
-    const std::string path = (std::filesystem::path(dir) / "montage.png").string();
-    if (Status s = writePng(path, *montage); !s) return s.error();
+    Result<std::vector<unsigned char>> png = pngBytes(*montage, (std::filesystem::path(dir) / "montage.png").string());
+    if (!png) return png.error();
+    if (Status s = put("montage.png", png->data(), png->size()); !s) return s.error();
+  }
+  std::vector<std::string> written;
+  for (auto& [path, file] : files) {
+    if (Status s = file.commit(); !s) return s.error();
     written.push_back(path);
+  }
+  for (const char* optional : {"breakdown.svg", "montage.png"}) {
+    const std::filesystem::path stale = std::filesystem::path(dir) / optional;
+    if (std::find(written.begin(), written.end(), stale.string()) == written.end()) std::filesystem::remove(stale, ec);
   }
   return written;
 }

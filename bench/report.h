@@ -40,8 +40,10 @@ std::optional<Chart> breakdownChart(const BenchRun& run);
 // The montage case in every mode with its error heat maps; empty when the run had no montage case.
 std::optional<Image> montageImage(const BenchRun& run);
 
-// Writes every file above into `dir` (created if missing), each atomically; the SVGs and the PNG
-// only when there is something to draw. `failures` is checkRun(run). Returns the paths written.
+// Writes every file above into `dir` (created if missing); the SVGs and the PNG only when there is
+// something to draw. All are written in full before any replaces an earlier run's, and an earlier
+// run's optional file this run does not make is removed: the folder holds one run's report, or on
+// an error the last one's. `failures` is checkRun(run). Returns the paths written.
 Result<std::vector<std::string>> writeReport(const BenchRun& run, const ReportContext& context,
                                              const std::vector<CheckFailure>& failures, const std::string& dir);
 

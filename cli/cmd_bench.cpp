@@ -329,8 +329,9 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   CLI::App* bench = app.add_subcommand(
       "bench",
       "The speed-against-error report: every precision mode on both backends over a suite of datasets, timed\n"
-      "(GPU timestamps) and measured against the exact reference. Writes report.md, results.json,\n"
-      "speed_vs_error.svg, breakdown.svg and montage.png into --out. Datasets are made once with\n"
+      "(GPU timestamps) and measured against the exact reference. Writes report.md, results.json and\n"
+      "speed_vs_error.svg into --out, with breakdown.svg (the sweeps) and montage.png (its error maps) where\n"
+      "the run measured them; an earlier run's files there are replaced. Datasets are made once with\n"
       "`dpoint generate` into --cache and reused. Suites: ci (small, minutes on lavapipe), paper (the\n"
       "float-vs-double Vulkan study's datasets at 1920x1080, its RTX 3090 figures beside ours), hard (offset\n"
       "and deep-zoom sweeps, tiny, origin, degenerate), all (paper and hard).\n"

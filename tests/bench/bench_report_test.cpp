@@ -416,6 +416,23 @@ TEST(BenchReport, reportCitesNothingOutsideTheRepository) {
   EXPECT_NE(report.find("docs/precision.md"), std::string::npos) << "the checks cite the repository's own page";
 }
 
+// A run into the folder of an earlier one leaves one run's report: the earlier run's breakdown.svg,
+// which this run does not draw, goes (a paper run kept a ci run's chart beside its own report).
+TEST(BenchReport, aRunIntoAnEarlierRunsFolderLeavesOneRunsReport) {
+  BenchRun swept = madeUpRun({1e-4, 2e-4, 2e-5, 3e-5, 1e-5, 2e-5, 2e-5}, {1e-3, 1e-3, 1e-4, 1e-3, 2e-5, 5e-5, 5e-5});
+  swept.cases.front().sweep = Sweep::kOffset;
+  swept.cases.front().sweep_x = 1e6;
+  test::TempDir dir;
+  ASSERT_TRUE(writeReport(swept, testContext(), checkRun(swept), dir.path()));
+  ASSERT_TRUE(test::fileExists(dir.file("breakdown.svg"))) << "the swept run draws it";
+  const BenchRun speed = speedRun({{{1.0, 0.9, 1.1}, {1.2, 1.15, 1.3}}});
+  Result<std::vector<std::string>> written = writeReport(speed, testContext(), checkRun(speed), dir.path());
+  ASSERT_TRUE(written) << written.error().message;
+  EXPECT_FALSE(test::fileExists(dir.file("breakdown.svg")));
+  for (const std::string& path : *written) EXPECT_NE(path, dir.file("breakdown.svg"));
+  EXPECT_TRUE(test::fileExists(dir.file("report.md")));
+}
+
 TEST(BenchSuites, paperSuiteHoldsTheStudysDatasetsWithItsFigures) {
   const std::vector<BenchCase> paper = suiteCases(BenchSuite::kPaper);
   std::vector<std::string> labels;
