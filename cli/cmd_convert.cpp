@@ -21,7 +21,7 @@ struct ConvertOptions {
   std::string input, output;
   int decimals = -1;
   bool ply_ascii = false;
-  std::string ply_colors = "uchar";
+  std::string ply_colors = "auto";
   std::string pcd_encoding = "binary";
   bool allow_nonfinite = false;
   std::string columns;  // --columns x,y,z,-,intensity
@@ -84,7 +84,7 @@ int runConvert(ConvertOptions& o) {
   w.threads = o.common.threads;
   w.decimals = o.decimals;
   w.ply_encoding = o.ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
-  w.ply_colors = o.ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
+  w.ply_colors = parsePlyColorType(o.ply_colors).value_or(PlyColorType::kAuto);  // checked by the option
   w.pcd_encoding = *parsePcdEncoding(o.pcd_encoding);  // checked by the option's validator
   w.progress = &progress;
   w.las_scale = o.las_scale;
@@ -138,9 +138,11 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
                   "or for LAS input the file's step (scale 0.01: at most 2 digits, trailing zeros dropped)")
       ->check(CLI::Range(0, 100));
   cmd->add_flag("--ply-ascii", o->ply_ascii, "PLY: write ASCII instead of binary little-endian");
-  cmd->add_option("--ply-colors", o->ply_colors, "PLY: colour property type")
-      ->check(oneOf("--ply-colors", {"uchar", "float"}))
-      ->default_val("uchar");
+  cmd->add_option("--ply-colors", o->ply_colors,
+                  "PLY: colour property type. auto: ushort for 16-bit colours (LAS), every bit kept, else uchar;\n"
+                  "uchar: 8-bit (what Open3D and PCL read); ushort; float: exact")
+      ->check(oneOf("--ply-colors", {"auto", "uchar", "ushort", "float"}))
+      ->default_val("auto");
   cmd->add_option("--pcd-encoding", o->pcd_encoding,
                   "PCD: DATA ascii, binary (rows of the fields) or binary_compressed (LZF, the smallest)")
       ->check(oneOf("--pcd-encoding", {"ascii", "binary", "binary_compressed"}))

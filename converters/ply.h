@@ -22,6 +22,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -36,7 +37,12 @@
 namespace dpoint {
 
 enum class PlyEncoding { kBinary, kAscii };
-enum class PlyColorType { kUchar, kFloat };
+// The colour properties' type. kAuto: ushort for a set whose colours came as 16-bit integers
+// (PointSet::color_full_scale 65535: LAS), so they keep every bit, else uchar; kUchar: 8-bit
+// whatever the source (what Open3D and PCL read); kFloat: exact.
+enum class PlyColorType { kAuto, kUchar, kUshort, kFloat };
+// "auto", "uchar", "ushort" or "float"; nullopt for another word.
+std::optional<PlyColorType> parsePlyColorType(const std::string& text);
 
 struct PlyReadOptions {
   bool allow_nonfinite = false;
@@ -54,7 +60,7 @@ using ColorSource = std::function<void(const glm::dvec3* positions, size_t count
 
 struct PlyWriteOptions {
   PlyEncoding encoding = PlyEncoding::kBinary;
-  PlyColorType color_type = PlyColorType::kUchar;
+  PlyColorType color_type = PlyColorType::kAuto;
   Progress* progress = nullptr;
   unsigned threads = 0;  // rows formatted on this many cores (0: all); the bytes do not depend on it
   // Set, for a set without colours: the colours, made chunk by chunk as the rows are formatted

@@ -89,7 +89,20 @@ void appendDimension(ChunkText& out, const Dimension& d, size_t i, char separato
   }
 }
 
+// Whether colours go as ushort (PlyColorType).
+bool wordColors(PlyColorType type, const PointSet& facts) {
+  return type == PlyColorType::kUshort || (type == PlyColorType::kAuto && facts.color_full_scale == 65535);
+}
+
 }  // namespace
+
+std::optional<PlyColorType> parsePlyColorType(const std::string& text) {
+  if (text == "auto") return PlyColorType::kAuto;
+  if (text == "uchar") return PlyColorType::kUchar;
+  if (text == "ushort") return PlyColorType::kUshort;
+  if (text == "float") return PlyColorType::kFloat;
+  return std::nullopt;
+}
 
 std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, std::vector<std::string>* renamed) {
   std::vector<std::string> names;
@@ -106,7 +119,7 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
                       const PlyWriteOptions& options) {
   const bool ascii = options.encoding == PlyEncoding::kAscii;
   const bool float_colors = options.color_type == PlyColorType::kFloat;
-  const bool word_colors = !float_colors && facts.color_full_scale == 65535;
+  const bool word_colors = wordColors(options.color_type, facts);
   std::string header = std::string("ply\nformat ") + (ascii ? "ascii" : "binary_little_endian") +
                        " 1.0\ncomment written by dpoint\n" + sourceFacts(facts, has_z, colors) + "element vertex " +
                        std::to_string(vertices) + "\nproperty double x\nproperty double y\nproperty double z\n";
@@ -140,6 +153,9 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
                  std::to_string(n) + " points"};
   if (points.triangles.size() % 3 != 0)
     return Error{"cannot write '" + path + "': triangle index count is not a multiple of 3"};
+  if (options.notices && colors && options.color_type == PlyColorType::kAuto && wordColors(options.color_type, points))
+    options.notices->push_back(path + ": 16-bit colours written as ushort, every bit kept; Open3D and PCL take 8-bit "
+                               "PLY colours (--ply-colors uchar)");
   if (options.notices) {
     std::vector<std::string> renamed;
     plyPropertyNames(points.dimensions, &renamed);
@@ -155,7 +171,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
   const bool ascii = options.encoding == PlyEncoding::kAscii;
   const bool float_colors = options.color_type == PlyColorType::kFloat;
   // Integer colours as wide as they were read: 16-bit LAS colours as ushort, others as uchar.
-  const bool word_colors = !float_colors && points.color_full_scale == 65535;
+  const bool word_colors = wordColors(options.color_type, points);
   const size_t faces = points.triangles.size() / 3;
 
   const std::string header = plyHeader(points, n, faces, colors, points.hasZ(), options);

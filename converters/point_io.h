@@ -62,7 +62,7 @@ struct WriteOptions {
   int decimals = -1;  // CSV only
   bool decimals_at_scale = false;  // CSV: decimals is the input's step (CsvWriteOptions::at_scale)
   PlyEncoding ply_encoding = PlyEncoding::kBinary;
-  PlyColorType ply_colors = PlyColorType::kUchar;
+  PlyColorType ply_colors = PlyColorType::kAuto;
   PcdEncoding pcd_encoding = PcdEncoding::kBinary;
   Progress* progress = nullptr;
   double las_scale = 0.0;  // LAS: the coordinate step for x, y and z; 0: the source's, else 0.001 (converters/las.h)

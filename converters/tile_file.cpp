@@ -624,7 +624,8 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
 }
 
 bool canMergeToPly(const PlyWriteOptions& options) {
-  return options.encoding == PlyEncoding::kBinary && options.color_type == PlyColorType::kUchar;
+  return options.encoding == PlyEncoding::kBinary &&
+         (options.color_type == PlyColorType::kUchar || options.color_type == PlyColorType::kAuto);  // tiles' colours are 8-bit
 }
 
 Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string& output, const PlyWriteOptions& options,

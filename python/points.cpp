@@ -560,8 +560,9 @@ progress: lines on stderr.)");
                       ExitCode::kUsage});
         if (las_scale && !(std::isfinite(*las_scale) && *las_scale > 0.0))
           raise(Error{"las_scale " + formatNumber(*las_scale) + ": must be a finite number above 0", ExitCode::kUsage});
-        if (ply_colors != "uchar" && ply_colors != "float")
-          raise(Error{"ply_colors: '" + ply_colors + "' is not uchar or float", ExitCode::kUsage});
+        const std::optional<PlyColorType> ply_color_type = parsePlyColorType(ply_colors);
+        if (!ply_color_type)
+          raise(Error{"ply_colors: '" + ply_colors + "' is not auto, uchar, ushort or float", ExitCode::kUsage});
         if (color_format != "linear" && color_format != "srgb8")
           raise(Error{"color_format: '" + color_format + "' is not linear or srgb8", ExitCode::kUsage});
         const PointOrder point_order = take(parsePointOrder("order", order));
@@ -575,7 +576,7 @@ progress: lines on stderr.)");
           w.notices = &notices;
           w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale.value_or(0.0);
           w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
-          w.ply_colors = ply_colors == "float" ? PlyColorType::kFloat : PlyColorType::kUchar;
+          w.ply_colors = *ply_color_type;
           w.pcd_encoding = pcd;
           const ColorFilters colors{no_colors, color_format == "srgb8"};
           if (!colors.drop && !colors.srgb8 && !unique && point_order == PointOrder::kInput)
@@ -587,12 +588,12 @@ progress: lines on stderr.)");
         warnAtCaller(notices);
       },
       py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
-      py::arg("ply_colors") = "uchar", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
+      py::arg("ply_colors") = "auto", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
       R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .pcd, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
 
-decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (uchar or float),
+decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (auto: ushort for 16-bit colours, else uchar; uchar; ushort; float),
 pcd_encoding (ascii, binary or binary_compressed),
 las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");

@@ -102,7 +102,7 @@ def write(
     *,
     decimals: int = -1,
     ply_ascii: bool = False,
-    ply_colors: str = "uchar",
+    ply_colors: str = "auto",
     pcd_encoding: str = "binary",
     las_scale: Optional[float] = None,
     order: str = "input",

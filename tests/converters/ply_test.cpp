@@ -141,6 +141,45 @@ TEST(Ply, plyFloatColorsRoundTripExactly) {
   }
 }
 
+// The colour type: auto writes a LAS source's 16-bit colours as ushort (every bit, with a note that
+// Open3D and PCL read 8-bit ones), 8-bit ones as uchar; uchar is 8-bit whatever the source (the
+// build before wrote ushort where uchar was asked, and Open3D read colours up to 255).
+TEST(Ply, colourTypeAutoKeepsSixteenBitsAndUcharIsEightBits) {
+  TempDir dir;
+  PointSet wide;
+  wide.positions = {{0, 0, 0}, {1, 1, 1}};
+  wide.colors = {glm::vec3(25600.0f / 65535.0f, 0.5f, 1.0f), glm::vec3(0.0f, 1.0f / 65535.0f, 0.25f)};
+  wide.color_full_scale = 65535;
+  PointSet narrow = wide;
+  narrow.color_full_scale = 255;
+  const auto written = [&](const PointSet& set, PlyColorType type, std::vector<std::string>* notices) {
+    PlyWriteOptions options;
+    options.color_type = type;
+    options.notices = notices;
+    EXPECT_TRUE(writePly(dir.file("c.ply"), set, options).ok());
+    const std::string bytes = readFile(dir.file("c.ply"));
+    return bytes.substr(0, bytes.find("end_header"));
+  };
+  std::vector<std::string> notices;
+  EXPECT_TRUE(contains(written(wide, PlyColorType::kAuto, &notices), "property ushort red\n"));
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_TRUE(contains(notices[0], "c.ply: 16-bit colours written as ushort, every bit kept; Open3D and PCL take 8-bit"));
+  Result<PointSet> back = readPly(dir.file("c.ply"));
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(colorInteger(back->colors[1].g, 65535.0), 1) << "every bit";
+  notices.clear();
+  EXPECT_TRUE(contains(written(wide, PlyColorType::kUchar, &notices), "property uchar red\n"));
+  EXPECT_TRUE(notices.empty());
+  back = readPly(dir.file("c.ply"));
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(colorInteger(back->colors[0].r, 255.0), 100);
+  EXPECT_TRUE(contains(written(narrow, PlyColorType::kAuto, &notices), "property uchar red\n"));
+  EXPECT_TRUE(contains(written(narrow, PlyColorType::kUshort, &notices), "property ushort red\n"));
+  EXPECT_TRUE(notices.empty());
+  EXPECT_EQ(*parsePlyColorType("ushort"), PlyColorType::kUshort);
+  EXPECT_FALSE(parsePlyColorType("half"));
+}
+
 TEST(Ply, plyMeshRoundTripKeepsTriangles) {
   PointSet in;
   in.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};

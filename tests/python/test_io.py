@@ -123,7 +123,7 @@ def test_write_options_do_what_they_say(tmp_path, source):
     (dict(las_scale=-1.0), "las_scale -1: must be a finite number above 0"),
     (dict(las_scale=float("nan")), "las_scale nan: must be a finite number above 0"),
     (dict(order="hilbert"), "order hilbert: must be input or morton"),
-    (dict(ply_colors="half"), "ply_colors: 'half' is not uchar or float"),
+    (dict(ply_colors="half"), "ply_colors: 'half' is not auto, uchar, ushort or float"),
     (dict(color_format="srgb"), "color_format: 'srgb' is not linear or srgb8"),
     (dict(max_memory="lots"), "max_memory lots: not a size"),
     (dict(max_memory=-1), "max_memory -1: not a size in bytes"),
