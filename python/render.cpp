@@ -157,7 +157,10 @@ Jupyter the result shows as its picture.)")
            }, "The picture as the bytes of the PNG file the CLI writes")
       .def("save", [](const RenderResultPy& r, const std::filesystem::path& file) {  // a str or os.PathLike
              const std::string path = file.string();
-             check(checkPictureOutput(path));
+             Status ok = checkPictureOutput(path);
+             // The CLI's message names its flag: here the argument is save's.
+             if (!ok && ok.error().message.rfind("-o ", 0) == 0) ok = Error{"save: " + ok.error().message.substr(3), ok.error().code};
+             check(ok);
              check(writePng(path, r.image));
            }, py::arg("path"), "Writes the picture as PNG, whole or not at all");
 
