@@ -229,6 +229,8 @@ int runBenchReport(const BenchReportOptions& o) {
   // The default --out is checked here, when bench runs, not while the command line is built: a
   // folder no other command writes must not stop them (CLI11 validates a default_val at once).
   if (Status s = checkOutputFolder("--out", o.out); !s) return reportError(Error{s.error().message, ExitCode::kUsage});
+  // The cache as --out: a file given as it, or a place it cannot be made, is a usage error before any work.
+  if (Status s = checkOutputFolder("--cache", o.cache); !s) return reportError(Error{s.error().message, ExitCode::kUsage});
   std::optional<Baseline> baseline;  // read before the run: a bad file fails at once, not after it
   if (!o.baseline.empty()) {
     Result<Baseline> read = readBaseline(o.baseline);
@@ -344,7 +346,9 @@ void addBenchCommand(CLI::App& app, RunCommand& run) {
   bench->add_option("--out", r->out, "Folder for the report (created; files in it replaced)")
       ->check(checkStatus([](const std::string& v) { return checkOutputFolder("--out", v); }))
       ->default_str("bench-out");  // shown, not validated here: the default is checked when bench runs
-  bench->add_option("--cache", r->cache, "Folder the datasets are made in and reused from")->default_val("bench-cache");
+  bench->add_option("--cache", r->cache, "Folder the datasets are made in and reused from (created)")
+      ->check(checkStatus([](const std::string& v) { return checkOutputFolder("--cache", v); }))
+      ->default_str("bench-cache");  // as --out's: the default is checked when bench runs
   bench->add_option("--device", r->device, "auto (a discrete GPU if any, else lavapipe), cpu, or an index from `dpoint devices`")
       ->default_val("auto");
   bench->add_option("--backend", r->backend, "raster, compute or both")->default_val("both");

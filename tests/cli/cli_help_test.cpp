@@ -235,6 +235,8 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"info", in, "--sample", "0"}, "--sample 0: must be a number from 1 to 100000000 (dpoint info --help)"},
       {{"devices", "extra"}, "devices: unexpected argument 'extra' (dpoint devices --help)"},
       {{"bench", "--frames", "0", "--out", dir.file("b")}, "--frames 0: must be at least 1"},
+      // As --out (a review finding: a file given as --cache was exit 2, after the device started).
+      {{"bench", "--cache", in, "--out", dir.file("b")}, "--cache " + in + ": is a file, not a folder"},
       // A review finding: CLI11's positive and non-negative checks printed the largest double in
       // 309 digits; a lone number's refusal spoke of "1 comma-separated finite numbers".
       {{"generate", "mandelbulb", "--level", "0", "-o", ply}, "--level 0: must be a number above 0"},
