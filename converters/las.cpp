@@ -582,32 +582,6 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   const auto isField = [&](const std::string& name) {
     return std::any_of(fields.begin(), fields.end(), [&](const LasField& f) { return name == f.name; });
   };
-  // Names the reader gives back as they are (lasExtraFields): letters, digits and '_', at most 32
-  // bytes, none a field's or the position's and colours', none twice.
-  std::unordered_set<std::string> taken = {"x", "y", "z", "red", "green", "blue"};
-  for (const LasField& f : fields) taken.insert(f.name);
-  const auto lasName = [&](const std::string& name) {
-    std::string base = name.substr(0, 32);
-    for (char& c : base)
-      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) c = '_';
-    if (base.empty()) base = "extra";
-    std::string out = base;
-    for (int k = 2; taken.count(out); ++k) {
-      std::string suffix = "_";  // appended: GCC 12 warns falsely on "_" + string (bug 105651)
-      suffix += std::to_string(k);
-      out = base.substr(0, 32 - suffix.size());
-      out += suffix;
-    }
-    taken.insert(out);
-    if (out != name) {
-      std::string line = "dimension ";
-      line += quotedExcerpt(name);
-      line += " written as ";
-      line += quotedExcerpt(out);
-      l.renamed.push_back(std::move(line));
-    }
-    return out;
-  };
   uint32_t at = 0;
   for (const Dimension& d : points.dimensions.all()) {
     if (isField(d.name)) continue;
@@ -620,12 +594,22 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
       for (const auto& [name, descriptor] : source->extra_bytes)
         if (name == d.name) field = lasSourceExtraField(d, descriptor, threads);
     if (!field) field = LasExtraField{d.name, d.type, 0};
-    field->name = lasName(field->name);
     field->offset = at;
     field->dimension = static_cast<size_t>(&d - points.dimensions.all().data());
     at += static_cast<uint32_t>(dimTypeSize(field->type));
     l.extra.push_back(std::move(*field));
   }
+  // Names the reader gives back as they are (lasExtraFields): letters, digits and '_', at most 32
+  // bytes ("extra" where none is left, as the reader names such a field), none a field's or the
+  // position's and colours', none twice.
+  std::unordered_set<std::string> taken = {"x", "y", "z", "red", "green", "blue"};
+  for (const LasField& f : fields) taken.insert(f.name);
+  std::vector<std::string> names;
+  for (const LasExtraField& f : l.extra) names.push_back(f.name);
+  names = writableNames(
+      names, [](char c) { return !(std::isalnum(static_cast<unsigned char>(c)) || c == '_'); },
+      [&](const std::string& name, size_t) { return taken.count(name) != 0; }, &l.renamed, 32, "extra");
+  for (size_t k = 0; k < names.size(); ++k) l.extra[k].name = names[k];
   l.record_length = l.base_length + at;
   if (l.record_length > 65535)
     return Error{path + ": " + str(points.dimensions.count()) + " dimensions make a " + str(l.record_length) +

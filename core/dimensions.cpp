@@ -84,17 +84,22 @@ std::optional<DimType> parseDimType(std::string_view name) {
 
 std::vector<std::string> writableNames(const std::vector<std::string>& names, const std::function<bool(char)>& bad,
                                        const std::function<bool(const std::string&, size_t)>& reserved,
-                                       std::vector<std::string>* renamed) {
+                                       std::vector<std::string>* renamed, size_t most_bytes, const std::string& empty) {
   std::vector<std::string> out;
   out.reserve(names.size());
   std::unordered_set<std::string> taken;
   for (size_t k = 0; k < names.size(); ++k) {
-    std::string name = names[k];
+    std::string name = names[k].substr(0, most_bytes);
     for (char& c : name)
       if (bad(c)) c = '_';
-    if (name.empty()) name = "unnamed";
+    if (name.empty()) name = empty;
     const std::string base = name;
-    for (int n = 2; taken.count(name) || reserved(name, k); ++n) name = base + "_" + std::to_string(n);
+    for (int n = 2; taken.count(name) || reserved(name, k); ++n) {
+      std::string suffix = "_";  // appended: GCC 12 warns falsely on "_" + string (bug 105651)
+      suffix += std::to_string(n);
+      name = base.substr(0, most_bytes == std::string::npos ? std::string::npos : most_bytes - suffix.size());
+      name += suffix;
+    }
     taken.insert(name);
     if (renamed && name != names[k]) {
       std::string line = "dimension ";

@@ -45,13 +45,15 @@ double loadDimValue(DimType type, const uint8_t* bytes);
 std::optional<DimType> parseDimType(std::string_view name);
 
 // The names a writer gives dimensions `names` in a format that cannot hold every name as it is
-// (PLY's and PCD's one-word names, a CSV header's columns): each character `bad` is true of
-// becomes '_', an empty name "unnamed", and a name `reserved` is true of (given its index), or one
-// that repeats a name written before it, gets "_2" (or "_3", …). Each change is a line of
-// `renamed`: "dimension 'my value' written as 'my_value'".
+// (PLY's and PCD's one-word names, a CSV header's columns, LAS's 32 bytes): each character `bad` is
+// true of becomes '_', a name is cut to `most_bytes`, an empty one is `empty`, and a name
+// `reserved` is true of (given its index), or one that repeats a name written before it, gets
+// "_2" (or "_3", …) within those bytes. Each change is a line of `renamed`: "dimension 'my value'
+// written as 'my_value'".
 std::vector<std::string> writableNames(const std::vector<std::string>& names, const std::function<bool(char)>& bad,
                                        const std::function<bool(const std::string&, size_t)>& reserved,
-                                       std::vector<std::string>* renamed);
+                                       std::vector<std::string>* renamed, size_t most_bytes = std::string::npos,
+                                       const std::string& empty = "unnamed");
 // A control character or a space (PLY's and PCD's names are one word).
 inline bool isSpaceOrControl(char c) { return static_cast<unsigned char>(c) <= 0x20 || c == 0x7f; }
 
