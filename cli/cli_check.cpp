@@ -29,16 +29,12 @@ CLI::Validator oneOf(const std::string& flag, std::vector<std::string> allowed) 
   std::string list;
   for (size_t i = 0; i < allowed.size(); ++i)
     list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
-  const auto lower = [](std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-  };
   return CLI::Validator(
-      [flag, allowed = std::move(allowed), list, lower](std::string& value) -> std::string {
+      [flag, allowed = std::move(allowed), list](std::string& value) -> std::string {
         if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return std::string();
         // Another case of exactly one choice is that choice (EDL, Z).
-        const std::string folded = lower(value);
-        const auto same = [&](const std::string& a) { return lower(a) == folded; };
+        const std::string folded = lowerAscii(value);
+        const auto same = [&](const std::string& a) { return lowerAscii(a) == folded; };
         if (std::count_if(allowed.begin(), allowed.end(), same) == 1) {
           value = *std::find_if(allowed.begin(), allowed.end(), same);
           return std::string();

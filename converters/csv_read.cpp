@@ -253,10 +253,7 @@ std::vector<std::string> splitHeader(std::string_view line, bool spelled = false
   auto add = [&](std::string_view field) {
     while (!field.empty() && isBlank(field.front())) field.remove_prefix(1);
     while (!field.empty() && isBlank(field.back())) field.remove_suffix(1);
-    std::string lower(field);
-    if (!spelled)
-      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    fields.push_back(std::move(lower));
+    fields.push_back(spelled ? std::string(field) : lowerAscii(std::string(field)));
   };
   const char separator = separatorOf(line);
   if (separator == '\0') {
@@ -377,8 +374,7 @@ Result<Layout> layoutFromNames(const std::vector<std::string>& names, char separ
   Layout layout{Known::kXyz, static_cast<int>(names.size()), separator == '\0', separator ? separator : ',', "", {}, {}, false};
   int seen[6] = {0, 0, 0, 0, 0, 0};
   for (const std::string& spelled : names) {
-    std::string name = spelled;
-    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    std::string name = lowerAscii(spelled);
     if (name == "red") name = "r";
     if (name == "green") name = "g";
     if (name == "blue") name = "b";

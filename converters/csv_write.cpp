@@ -154,15 +154,11 @@ Status checkDecimals(int decimals) {
 
 std::vector<std::string> csvColumnNames(const CsvLayout& layout, std::vector<std::string>* renamed) {
   const size_t first = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0);  // the first dimension's column
-  const auto lower = [](std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-  };
   return writableNames(
       layout.dimensions,
       [](char c) { return isSpaceOrControl(c) || c == ',' || c == ';' || c == '"'; },
       [&](const std::string& name, size_t k) {
-        const std::string l = lower(name);
+        const std::string l = lowerAscii(name);
         if (l == "x" || l == "y" || l == "z" || l == "r" || l == "g" || l == "b") return true;
         return first + k < 6 && (l == "red" || l == "green" || l == "blue");
       },

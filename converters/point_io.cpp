@@ -78,8 +78,7 @@ Result<FileFormat> formatOf(const std::string& path) {
 }
 
 bool isCopcPath(const std::string& path) {
-  std::string lower = path;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string lower = lowerAscii(path);
   return lower.size() >= 9 && lower.compare(lower.size() - 9, 9, ".copc.laz") == 0;
 }
 

@@ -19,11 +19,12 @@ std::vector<std::string> splitAt(std::string_view text, char separator) {
   }
 }
 
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
+std::string lowerAscii(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
 }
+
+std::string lowerExtension(const std::string& path) { return lowerAscii(std::filesystem::path(path).extension().string()); }
 
 std::string formatNumber(double v, bool json) {
   if (json && !std::isfinite(v)) return "null";

@@ -113,6 +113,8 @@ std::vector<std::string> splitAt(std::string_view text, char separator);
 // A path's extension in lower case, with its dot (".las" for "SCAN.LAS"), "" when it has none: what
 // the readers and writers choose a format by.
 std::string lowerExtension(const std::string& path);
+// `text` with its ASCII letters in lower case (other bytes as they are).
+std::string lowerAscii(std::string text);
 
 // Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
 std::string formatNumber(double v, bool json = false);

@@ -31,9 +31,7 @@ namespace {
 // `path` ends with `extension` (lower case, with its dot), in any case.
 bool hasExtension(const std::string& path, const std::string& extension) {
   if (path.size() < extension.size()) return false;
-  std::string tail = path.substr(path.size() - extension.size());
-  std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return tail == extension;
+  return lowerAscii(path.substr(path.size() - extension.size())) == extension;
 }
 
 // The input as the run draws it: in memory, or a stream read a block at a time (a binary PLY
