@@ -13,8 +13,10 @@
 
 namespace dpoint {
 
-Result<bool> checkInputSet(const std::vector<std::string>& paths) {
-  if (paths.size() < 2) return false;
+Result<InputSet> checkInputSet(const std::vector<std::string>& paths) {
+  InputSet set;
+  set.tiles = static_cast<size_t>(std::count_if(paths.begin(), paths.end(), isTileFile));
+  if (paths.size() < 2) return set;
   // Each file once by (device, inode), sorted: not every pair compared (3000 inputs took 10.7 s).
   struct Seen {
     dev_t device;
@@ -33,8 +35,7 @@ Result<bool> checkInputSet(const std::vector<std::string>& paths) {
     if (seen[k].device == seen[k - 1].device && seen[k].inode == seen[k - 1].inode)
       return Error{paths[seen[k].index] + ": given twice as an input (also " + paths[seen[k - 1].index] + ")",
                    ExitCode::kUsage};
-  if (!std::all_of(paths.begin(), paths.end(), [](const std::string& path) { return isTileFile(path); }))
-    return false;
+  if (set.tiles != paths.size()) return set;
   std::vector<std::string> given;  // by index, of the first file's count
   uint32_t count = 0;
   std::string signature;
@@ -44,23 +45,24 @@ Result<bool> checkInputSet(const std::vector<std::string>& paths) {
     if (i == 0) count = h->tile.count, given.assign(count, ""), signature = h->signature;
     // Tiles of several runs (another count, or other options: a tile 0 of each was "tile 0 again"):
     // file by file.
-    if (h->tile.count != count || h->signature != signature) return false;
+    if (h->tile.count != count || h->signature != signature) return set;
     if (!given[h->tile.index].empty())
       return Error{paths[i] + ": tile " + std::to_string(h->tile.index) + " again (also " + given[h->tile.index] + ")"};
     given[h->tile.index] = paths[i];
   }
-  return paths.size() == count;  // each index once: all of them
+  set.whole = paths.size() == count;  // each index once: all of them
+  return set;
 }
 
 namespace {
 
 // A note where tiles are read file by file (one alone, a set with tiles left out, tiles of several
 // runs, or tiles beside other files): each brings its copies of the seam vertices, which the
-// whole set holds once; the count of points is then not the merged set's.
-std::optional<std::string> tilesFileByFile(const std::vector<std::string>& paths) {
-  const size_t tiles = static_cast<size_t>(std::count_if(paths.begin(), paths.end(), isTileFile));
-  if (tiles == 0) return std::nullopt;
-  return describeInputs(paths) + ": " + (tiles == 1 ? std::string("a tile") : std::to_string(tiles) + " tiles") +
+// whole set holds once; the count of points is then not the merged set's. None for a whole set or
+// no tile.
+std::optional<std::string> tilesFileByFile(const std::vector<std::string>& paths, const InputSet& set) {
+  if (set.whole || set.tiles == 0) return std::nullopt;
+  return describeInputs(paths) + ": " + (set.tiles == 1 ? std::string("a tile") : std::to_string(set.tiles) + " tiles") +
          " of `generate --tile` read file by file, each with its copies of the seam vertices (a run's N tiles "
          "given together are read as the merged set)";
 }
@@ -70,7 +72,8 @@ std::optional<std::string> tilesFileByFile(const std::vector<std::string>& paths
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
   if (paths.size() == 1) {
     if (options.notices)
-      if (std::optional<std::string> note = tilesFileByFile(paths)) options.notices->push_back(*note);
+      if (std::optional<std::string> note = tilesFileByFile(paths, InputSet{false, isTileFile(paths[0]) ? 1u : 0u}))
+        options.notices->push_back(*note);
     return readPoints(paths[0], options);
   }
   if (options.texture) {  // a texture is one file's: several are read without
@@ -79,15 +82,15 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     each.texture = nullptr;
     return readPointInputs(paths, each);
   }
-  Result<bool> whole_tile_set = checkInputSet(paths);
-  if (!whole_tile_set) return whole_tile_set.error();
-  if (*whole_tile_set) {
+  Result<InputSet> set = checkInputSet(paths);
+  if (!set) return set.error();
+  if (set->whole) {
     Result<PointSet> whole = mergeTiles(paths, 0, options.progress, options.threads);
     if (whole && options.points_only) whole->triangles.clear();
     return whole;
   }
   if (options.notices)
-    if (std::optional<std::string> note = tilesFileByFile(paths)) options.notices->push_back(*note);
+    if (std::optional<std::string> note = tilesFileByFile(paths, *set)) options.notices->push_back(*note);
   PointSet out;
   bool any_colors = false;
   for (const std::string& path : paths) {
@@ -146,11 +149,11 @@ PointInputStream::~PointInputStream() = default;
 
 Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
                                                                  unsigned threads) {
-  Result<bool> whole_tile_set = checkInputSet(paths);
-  if (!whole_tile_set) return whole_tile_set.error();
+  Result<InputSet> set = checkInputSet(paths);
+  if (!set) return set.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
   std::vector<std::pair<std::string, uint64_t>> files;  // path, points to stream (all: UINT64_MAX)
-  if (*whole_tile_set) {
+  if (set->whole) {
     files.resize(paths.size());
     for (const std::string& path : paths) {
       Result<TileHeader> h = readTileHeader(path);
@@ -159,7 +162,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     }
   } else {
     for (const std::string& path : paths) files.emplace_back(path, UINT64_MAX);
-    if (std::optional<std::string> note = tilesFileByFile(paths)) stream->notices_.push_back(*note);
+    if (std::optional<std::string> note = tilesFileByFile(paths, *set)) stream->notices_.push_back(*note);
   }
   for (const auto& [path, owned] : files) {
     Part part;

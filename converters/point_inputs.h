@@ -23,11 +23,15 @@ namespace dpoint {
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options = {});
 
 // Several inputs read as one set: no file given twice (a usage error), and no tile twice among
-// tiles of one count (bad input): either had given a set too large with no word. True when the
+// tiles of one count (bad input): either had given a set too large with no word. `whole` when the
 // paths are the tiles of one run, all N of them, each once (converters/tile_file.h), which are
 // read as the merged set; a tile set with tiles left out is read file by file, by design (the
-// tiles made so far). One path: false.
-Result<bool> checkInputSet(const std::vector<std::string>& paths);
+// tiles made so far), and so are one path's tile. `tiles`: how many of the paths are tiles.
+struct InputSet {
+  bool whole = false;
+  size_t tiles = 0;
+};
+Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 
 // One or several binary PLY, LAS or LAZ files as one stream of points (render's --stream): the points
 // readPointInputs(paths) gives, in its order, a block at a time (positions and colours, no
