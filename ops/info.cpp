@@ -224,6 +224,16 @@ void finishBounds(PointSetInfo& info) {
       : std::numeric_limits<double>::infinity();
 }
 
+// out[i] = in[i] · unit for every point, on `threads` cores (out may be in): the points in a unit of
+// length (lengthUnit).
+void scalePositions(const PositionArray& in, PositionArray& out, double unit, unsigned threads) {
+  const size_t n = in.size();
+  out.resize(n);
+  parallelFor((n + (size_t{1} << 16) - 1) >> 16, threads, [&](size_t b, unsigned) {
+    for (size_t i = b << 16, end = std::min(n, (b + 1) << 16); i < end; ++i) out[i] = in[i] * unit;
+  });
+}
+
 // The difference from points[at] to the nearest of points[from..to] apart from it (0 where none
 // is, or none at a finite difference): the first bound on a sampled point's nearest distance in a
 // streamed set. Compared in a unit of their own (a power of two, exact), as the set's unit is not
@@ -457,10 +467,8 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
     PositionArray sampled(sample);
     for (size_t k = 0; k < sample; ++k) sampled[k] = points.positions[k * step] * unit;
     std::vector<double> best2(sample, std::numeric_limits<double>::infinity());
-    PositionArray scratch(n);  // the trees reorder it
-    parallelFor((n + (size_t{1} << 16) - 1) >> 16, threads, [&](size_t b, unsigned) {
-      for (size_t i = b << 16, end = std::min(n, (b + 1) << 16); i < end; ++i) scratch[i] = points.positions[i] * unit;
-    });
+    PositionArray scratch;  // the trees reorder it
+    scalePositions(points.positions, scratch, unit, threads);
     Forest(scratch, threads).nearestNonzero(sampled, best2, threads);
     info.min_neighbor_distance = smallestDistance(best2) / unit;
     info.neighbor_sample = sample;
@@ -550,10 +558,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
   const std::vector<Box>& pass_boxes = unit != 1.0 ? scaled_boxes : boxes;
   const BlockReader scaled_read = [&](uint64_t first, uint64_t n, PointSet& into) {
     Status s = read(first, n, into);
-    if (s && unit != 1.0)
-      parallelFor((into.positions.size() + (size_t{1} << 16) - 1) >> 16, workers, [&](size_t b, unsigned) {
-        for (size_t i = b << 16, end = std::min(into.positions.size(), (b + 1) << 16); i < end; ++i) into.positions[i] *= unit;
-      });
+    if (s && unit != 1.0) scalePositions(into.positions, into.positions, unit, workers);
     return s;
   };
   // By boxes where most are compact enough to look up; else by blocks.
