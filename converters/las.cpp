@@ -19,6 +19,7 @@
 
 #include <glm/common.hpp>
 
+#include "converters/las_crs.h"
 #include "converters/las_fields.h"
 #include "converters/laz_decode.h"
 #include "converters/laz_encode.h"
@@ -501,6 +502,7 @@ struct WriterLayout {
   std::vector<LasVlr> vlrs, evlrs;
   uint16_t global_encoding = 0, file_source_id = 0;
   std::vector<std::string> renamed;  // "dimension 'höhe' written as 'h__he'": extra bytes named anew
+  std::string crs_note;  // what became of the source's CRS records (lasWktCrs), empty when nothing
 };
 
 // The LAS 1.2 (227-byte) or 1.4 (375-byte) header. Creation day and year are 0 ("not given") so
@@ -622,11 +624,17 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   // reports a file without it as an error), whatever the source said.
   if (l.format >= 6) l.global_encoding |= 0x10;
   l.file_source_id = source ? source->file_source_id : 0;
-  if (source)
-    for (const LasVlr& vlr : source->vlrs) {
-      if (vlr.extended && v14) l.evlrs.push_back(vlr);
-      else if (vlr.data.size() <= 65535) l.vlrs.push_back(vlr);
-    }
+  // Formats 6-10 hold their CRS as WKT alone: GeoTIFF keys are made WKT (converters/las_crs.h).
+  std::vector<LasVlr> crs = source ? source->vlrs : std::vector<LasVlr>();
+  if (l.format >= 6) {
+    LasWktCrs wkt = lasWktCrs(crs);
+    crs = std::move(wkt.records);
+    l.crs_note = std::move(wkt.note);
+  }
+  for (const LasVlr& vlr : crs) {
+    if (vlr.extended && v14) l.evlrs.push_back(vlr);
+    else if (vlr.data.size() <= 65535) l.vlrs.push_back(vlr);
+  }
   if (!l.extra.empty()) l.vlrs.push_back(lasExtraBytesVlr(l.extra));
   return l;
 }
@@ -1192,7 +1200,10 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, threads);
   if (!layout) return layout.error();
   WriterLayout& l = *layout;
-  if (options.report) options.report->renamed = l.renamed;
+  if (options.report) {
+    options.report->renamed = l.renamed;
+    options.report->crs = l.crs_note.empty() ? std::string() : "point format " + str(l.format) + " holds its CRS as WKT: " + l.crs_note;
+  }
   std::optional<LazInfo> laz;
   if (options.compress) {
     Result<LazInfo> info = lazInfoForFormat(l.format, l.record_length);

@@ -107,6 +107,9 @@ struct LasWriteReport {
   // Extra bytes named anew, one line each ("dimension 'höhe' written as 'h__he'"): LAS names are up
   // to 32 letters, digits or '_'.
   std::vector<std::string> renamed;
+  // What became of the source's CRS records in a point format 6–10 file, which holds WKT alone
+  // (converters/las_crs.h): made WKT, or left out and why; empty when they were kept as they were.
+  std::string crs;
   // Distinct positions that share their integers at that scale with another: they read back as one.
   uint64_t merged_points = 0;
 };

@@ -256,6 +256,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
         if (Status s = writeLas(path, points, las); !s) return s;
       }
       if (options.notices) {
+        if (!report.crs.empty()) options.notices->push_back(path + ": " + report.crs);
         for (const std::string& line : report.renamed)
           options.notices->push_back(path + ": " + line + " (a LAS extra bytes name is up to 32 letters, digits or '_')");
         for (int k = 0; k < 3; ++k)

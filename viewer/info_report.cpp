@@ -4,6 +4,7 @@
 #include <limits>
 #include <utility>
 
+#include "converters/las_crs.h"
 #include "converters/point_io.h"
 #include "core/interrupt.h"
 #include "core/json_writer.h"
@@ -54,7 +55,8 @@ std::string lasText(const LasFacts& las) {
          "LAS header bounds:  " + vec(h.min) + " .. " + vec(h.max) + " (" +
          (las.bounds_hold ? "hold the points" : "do not hold the points: the header is wrong, the points are used") +
          ")\n" +
-         "LAS software:       " + h.generating_software + "\n";
+         "LAS software:       " + h.generating_software + "\n" +
+         "LAS CRS:            " + (las.crs.empty() ? "none (no coordinate system records)" : las.crs) + "\n";
 }
 
 // The "las" member, its value over four lines as `dpoint info --json` has always printed it.
@@ -66,7 +68,8 @@ std::string lasJson(const LasFacts& las) {
          ", \"points\": " + str(h.point_count) + indent + "\"scale\": " + jsonVec(h.scale) +
          ", \"offset\": " + jsonVec(h.offset) + indent + "\"header_min\": " + jsonVec(h.min) +
          ", \"header_max\": " + jsonVec(h.max) + ", \"header_bounds_hold\": " + jsonBool(las.bounds_hold) + indent +
-         "\"generating_software\": " + jsonString(h.generating_software) + "}";
+         "\"generating_software\": " + jsonString(h.generating_software) + ", \"crs\": " +
+         (las.crs.empty() ? std::string("null") : jsonString(las.crs)) + "}";
 }
 
 std::string floatEnoughText(const InfoReport& report) {
@@ -245,7 +248,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (header) {
     const PointSetInfo& info = report->info;
     const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
-    report->las = LasFacts{std::move(*header), bounds_hold};
+    report->las = LasFacts{std::move(*header), bounds_hold, points->las ? lasCrsSummary(points->las->vlrs) : ""};
   }
   return report;
 }

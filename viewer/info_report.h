@@ -49,6 +49,7 @@ struct InfoAdvice {
 struct LasFacts {
   LasHeader header;
   bool bounds_hold = true;
+  std::string crs;  // lasCrsSummary of its CRS records; empty: none
 };
 
 // A dimension of the set (core/dimensions.h) and its range; min > max where the set is empty.

@@ -23,6 +23,7 @@ using test::TempDir;
 using test::writeFile;
 
 const std::string kCorpus = std::string(DPOINT_CORPUS_DIR) + "/las/";
+const std::string kLazCorpus = std::string(DPOINT_CORPUS_DIR) + "/laz/";
 
 size_t distinctPositions(PositionArray p) {
   std::sort(p.begin(), p.end(), [](const glm::dvec3& a, const glm::dvec3& b) {
@@ -171,13 +172,23 @@ TEST(CliLas, infoPrintsTheLasHeader) {
   for (const char* line : {"points:             22600\n",
                            "LAS:                version 1.4, point format 7, 36-byte records (0 extra bytes), 22600 points\n",
                            "LAS scale:          1.0000000000000002e-06 1.0000000000000002e-07 0.001\n",
-                           "LAS offset:         1 1 0\n", "(hold the points)"})
+                           "LAS offset:         1 1 0\n", "(hold the points)",
+                           "LAS CRS:            Geographic Coordinate System, WKT\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " in\n" << r.out;
+  // The CRS as the file gives it: GeoTIFF keys' EPSG codes and citation, or none.
+  for (const auto& [file, crs] : std::vector<std::pair<std::string, std::string>>{
+           {kLazCorpus + "1815.las", "EPSG:6580 + EPSG:5703 (NAD83(2011)), GeoTIFF keys"},
+           {kLazCorpus + "point-time.las", "EPSG:26910 (NAD83 / UTM zone 10N), GeoTIFF keys"},
+           {kCorpus + "1_4_w_evlr.las", "NAD83(HARN) / New Mexico Central (ftUS), WKT"},
+           {kCorpus + "simple.las", "none (no coordinate system records)"}}) {
+    test::CommandResult info = runDpoint({"info", file, "--quiet"});
+    EXPECT_NE(info.out.find("LAS CRS:            " + crs + "\n"), std::string::npos) << info.out;
+  }
   // A real file whose header bounds are its raw integers: read, and the bounds called wrong.
   test::CommandResult wrong = runDpoint({"info", kCorpus + "simple1_3.las", "--json"});
   ASSERT_EQ(wrong.exit_code, 0) << wrong.err;
   for (const char* part : {"\"las\": {\"version\": \"1.3\", \"point_format\": 4, \"record_length\": 57, \"points\": 999",
-                           "\"header_bounds_hold\": false", "\"points\": 999,"})
+                           "\"header_bounds_hold\": false", "\"points\": 999,", "\"crs\": \"a user-defined CRS + EPSG:5030, GeoTIFF keys\""})
     EXPECT_NE(wrong.out.find(part), std::string::npos) << part << " in\n" << wrong.out;
 }
 

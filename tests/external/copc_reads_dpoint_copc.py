@@ -7,9 +7,14 @@ The files: those the converter tests write (CONVERTERS_TESTS with DPOINT_COPC_OU
 files, a 300,000-point surface, a paged hierarchy, 0 and 1 point), and what `dpoint convert` and
 `generate` write as .copc.laz: the corpus's LAS 1.4 files, a fractal and 400,000 random points (each
 compared, as sorted records, with the same source converted to LAS).
+
+COPC holds point formats 6-8, whose CRS is WKT alone: LAS 1.2 files whose CRS is GeoTIFF keys (the
+corpus's 1815.las, EPSG:6580 + EPSG:5703) or libLAS's WKT record (point-time.las) become COPC files
+whose WKT copc.js finds and pyproj (PROJ's Python binding) reads as the same CRS.
 Usage: copc_reads_dpoint_copc.py DPOINT [CONVERTERS_TESTS]
 """
 import glob
+import json
 import os
 import struct
 import subprocess
@@ -104,6 +109,38 @@ def from_dpoint(exe, tmp):
     return files
 
 
+def walked_wkt(output, path):
+    """The WKT copc_walk.mjs printed for the file (None when copc.js found none)."""
+    for line in output.splitlines():
+        if line.startswith(os.path.basename(path) + ":"):
+            return json.loads(line.split(" wkt=", 1)[1])
+    check(False, f"copc.js printed no line for {path}")
+
+
+def crs_kept(exe, tmp):
+    """LAS 1.2 CRS records (GeoTIFF keys, libLAS WKT) reach COPC as WKT that copc.js and pyproj read."""
+    import pyproj  # Debian's python3-pyproj (scripts/setup)
+    cases = [("laz/1815.las", lambda crs: [s.to_epsg() for s in crs.sub_crs_list] == [6580, 5703],
+              "a compound CRS of EPSG:6580 and EPSG:5703"),
+             ("laz/point-time.las", lambda crs: crs.is_projected and crs.name == "NAD83 / UTM zone 10N",
+              "its libLAS record's projected NAD83 / UTM zone 10N")]
+    files = []
+    for source, _, _ in cases:
+        out = os.path.join(tmp, "crs-" + os.path.basename(source)[:-4] + ".copc.laz")
+        result = subprocess.run([exe, "convert", os.path.join(CORPUS, source), "-o", out], capture_output=True, text=True)
+        check(result.returncode == 0, f"convert {source} to COPC fails: {result.stderr[-1000:]}")
+        check("holds its CRS as WKT" in result.stderr, f"convert {source}: no note on its CRS: {result.stderr!r}")
+        files.append(out)
+    output = walk(files)
+    for (source, judge, meant), path in zip(cases, files):
+        wkt = walked_wkt(output, path)
+        check(wkt is not None, f"{path}: copc.js finds no WKT (the source {source} has a CRS)")
+        crs = pyproj.CRS.from_wkt(wkt)
+        check(judge(crs), f"{path}: pyproj reads the WKT as {crs.name!r}, not {meant}")
+        print(f"{os.path.basename(path)}: copc.js's WKT is {crs.name!r} ({meant}) for pyproj")
+    return len(files)
+
+
 def main():
     exe = sys.argv[1]
     tests = sys.argv[2] if len(sys.argv) > 2 else None
@@ -128,6 +165,7 @@ def main():
                 print(f"{os.path.basename(copc)}: {count} points, the records of its LAS twin, "
                       f"{os.path.getsize(copc) / max(1, os.path.getsize(las)):.3f} of its size")
             checked += len(converted)
+        checked += crs_kept(exe, tmp)
     check(checked > 0, "no COPC file was checked (pass CONVERTERS_TESTS, or let dpoint write .copc.laz)")
     print(f"{checked} COPC files pass copc.js's walk and read as plain LAZ")
 

@@ -6,7 +6,7 @@
 // and the counts add up to the header's point count. Prints one summary line per file:
 //
 //   node copc_walk.mjs FILE.copc.laz...
-//   FILE: format=7 points=22600 nodes=9 pages=1 levels=[1,8] bytes=...
+//   FILE: format=7 points=22600 nodes=9 pages=1 levels=[1,8] spacing=... wkt="PROJCS[..." (or null)
 import path from 'node:path';
 import { createRequire } from 'node:module';
 import { modulesDir } from './modules.mjs';
@@ -73,7 +73,8 @@ async function walk(file) {
     return fail(file, `the nodes hold ${total} points, the header says ${header.pointCount}`);
   const count = Object.keys(nodes).length;
   console.log(`${path.basename(file)}: format=${header.pointDataRecordFormat} points=${total} nodes=${count} ` +
-              `pages=${pages} levels=[${Array.from(levels, (n) => n || 0).join(',')}] spacing=${info.spacing}`);
+              `pages=${pages} levels=[${Array.from(levels, (n) => n || 0).join(',')}] spacing=${info.spacing} ` +
+              `wkt=${JSON.stringify(copc.wkt ?? null)}`);
 }
 
 const files = process.argv.slice(2);

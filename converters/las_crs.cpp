@@ -1,0 +1,284 @@
+#include "converters/las_crs.h"
+
+#include <dlfcn.h>
+#include <proj.h>
+#include <proj_experimental.h>
+
+#include <cstring>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "core/bytes.h"
+#include "core/text.h"
+
+#ifndef DPOINT_PROJ_SONAME
+#define DPOINT_PROJ_SONAME "libproj.so.25"
+#endif
+
+namespace dpoint {
+namespace {
+
+constexpr uint16_t kWktRecord = 2112, kGeoKeys = 34735, kGeoDoubles = 34736, kGeoAscii = 34737;
+// GeoTIFF keys (GeoTIFF 1.1, section 7) the conversion and the summary read.
+constexpr uint16_t kCitation = 1026, kGeographicType = 2048, kGeographicCitation = 2049, kProjectedType = 3072,
+                   kProjectedCitation = 3073, kProjLinearUnits = 3076, kVerticalType = 4096, kVerticalUnits = 4099;
+constexpr uint16_t kUserDefined = 32767;
+
+bool isLasfProjection(const LasVlr& vlr, uint16_t id) {
+  return vlr.user_id == "LASF_Projection" && vlr.record_id == id;
+}
+bool isGeoTiffRecord(const LasVlr& vlr) {
+  return vlr.user_id == "LASF_Projection" &&
+         (vlr.record_id == kGeoKeys || vlr.record_id == kGeoDoubles || vlr.record_id == kGeoAscii);
+}
+bool isLiblasWkt(const LasVlr& vlr) { return vlr.user_id == "liblas" && vlr.record_id == kWktRecord; }
+
+const LasVlr* findRecord(const std::vector<LasVlr>& vlrs, bool (*match)(const LasVlr&)) {
+  for (const LasVlr& vlr : vlrs)
+    if (match(vlr)) return &vlr;
+  return nullptr;
+}
+
+// A WKT record's text: up to its first NUL, without surrounding blanks.
+std::string wktText(const std::string& data) {
+  std::string text = data.substr(0, data.find('\0'));
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
+}
+
+// The name a WKT gives its CRS: the first quoted string (PROJCS["NAD83 / UTM zone 10N", ...).
+std::string wktName(const std::string& wkt) {
+  const size_t open = wkt.find('"');
+  if (open == std::string::npos) return {};
+  const size_t close = wkt.find('"', open + 1);
+  return close == std::string::npos ? std::string() : wkt.substr(open + 1, close - open - 1);
+}
+
+// The GeoTIFF keys whose values sit in the directory (short values), and the ASCII ones (citations),
+// of a LASF_Projection 34735 record and its 34737 parameters.
+struct GeoKeys {
+  std::map<uint16_t, uint16_t> shorts;
+  std::map<uint16_t, std::string> ascii;
+
+  std::optional<uint16_t> code(uint16_t key) const {  // an EPSG code: neither 0 nor user-defined
+    const auto it = shorts.find(key);
+    if (it == shorts.end() || it->second == 0 || it->second == kUserDefined) return std::nullopt;
+    return it->second;
+  }
+  std::string text(uint16_t key) const {
+    const auto it = ascii.find(key);
+    return it == ascii.end() ? std::string() : it->second;
+  }
+};
+
+std::optional<GeoKeys> geoKeys(const std::vector<LasVlr>& vlrs) {
+  const LasVlr* dir = findRecord(vlrs, [](const LasVlr& v) { return isLasfProjection(v, kGeoKeys); });
+  if (!dir || dir->data.size() < 8) return std::nullopt;
+  const LasVlr* ascii = findRecord(vlrs, [](const LasVlr& v) { return isLasfProjection(v, kGeoAscii); });
+  const char* d = dir->data.data();
+  const size_t count = std::min<size_t>(loadUnaligned<uint16_t>(d + 6), dir->data.size() / 8 - 1);
+  GeoKeys keys;
+  for (size_t k = 1; k <= count; ++k) {
+    const uint16_t id = loadUnaligned<uint16_t>(d + 8 * k), location = loadUnaligned<uint16_t>(d + 8 * k + 2);
+    const uint16_t n = loadUnaligned<uint16_t>(d + 8 * k + 4), value = loadUnaligned<uint16_t>(d + 8 * k + 6);
+    if (location == 0) {
+      keys.shorts[id] = value;
+    } else if (location == kGeoAscii && ascii && value < ascii->data.size()) {
+      std::string text = ascii->data.substr(value, n);
+      while (!text.empty() && (text.back() == '|' || text.back() == '\0' || text.back() == ' ')) text.pop_back();
+      keys.ascii[id] = std::move(text);
+    }
+  }
+  return keys;
+}
+
+std::string epsg(uint16_t code) { return "EPSG:" + std::to_string(code); }
+
+// "EPSG:26910 + EPSG:5703" or "user-defined", and the keys' citation in brackets where they have one.
+std::string keysName(const GeoKeys& keys) {
+  std::optional<uint16_t> horizontal = keys.code(kProjectedType);
+  if (!horizontal) horizontal = keys.code(kGeographicType);
+  std::string name = horizontal ? epsg(*horizontal) : "a user-defined CRS";
+  if (std::optional<uint16_t> vertical = keys.code(kVerticalType)) name += " + " + epsg(*vertical);
+  for (uint16_t key : {kProjectedCitation, kCitation, kGeographicCitation}) {  // the first that names something
+    const std::string citation = keys.text(key);
+    if (!citation.empty() && lowerAscii(citation) != "unknown") return name + " (" + citation + ")";
+  }
+  return name;
+}
+
+// --- PROJ, loaded on first use -------------------------------------------------------------------
+
+struct ProjApi {
+  decltype(&proj_context_create) context_create = nullptr;
+  decltype(&proj_context_destroy) context_destroy = nullptr;
+  decltype(&proj_log_level) log_level = nullptr;
+  decltype(&proj_create_from_database) create_from_database = nullptr;
+  decltype(&proj_destroy) destroy = nullptr;
+  decltype(&proj_get_name) get_name = nullptr;
+  decltype(&proj_as_wkt) as_wkt = nullptr;
+  decltype(&proj_crs_get_coordinate_system) crs_get_coordinate_system = nullptr;
+  decltype(&proj_cs_get_axis_info) cs_get_axis_info = nullptr;
+  decltype(&proj_uom_get_info_from_database) uom_get_info_from_database = nullptr;
+  decltype(&proj_crs_alter_cs_linear_unit) crs_alter_cs_linear_unit = nullptr;
+  decltype(&proj_create_compound_crs) create_compound_crs = nullptr;
+  std::string error;  // why PROJ cannot be used; empty when it can
+};
+
+ProjApi loadProj() {
+  ProjApi api;
+  void* library = dlopen(DPOINT_PROJ_SONAME, RTLD_NOW | RTLD_LOCAL);
+  if (!library) {
+    api.error = std::string("PROJ (" DPOINT_PROJ_SONAME ", Debian's libproj25) cannot be loaded: ") + dlerror();
+    return api;
+  }
+  const auto bind = [&](auto& function, const char* name) {
+    function = reinterpret_cast<std::remove_reference_t<decltype(function)>>(dlsym(library, name));
+    if (!function && api.error.empty()) api.error = std::string(DPOINT_PROJ_SONAME " has no ") + name;
+  };
+  bind(api.context_create, "proj_context_create");
+  bind(api.context_destroy, "proj_context_destroy");
+  bind(api.log_level, "proj_log_level");
+  bind(api.create_from_database, "proj_create_from_database");
+  bind(api.destroy, "proj_destroy");
+  bind(api.get_name, "proj_get_name");
+  bind(api.as_wkt, "proj_as_wkt");
+  bind(api.crs_get_coordinate_system, "proj_crs_get_coordinate_system");
+  bind(api.cs_get_axis_info, "proj_cs_get_axis_info");
+  bind(api.uom_get_info_from_database, "proj_uom_get_info_from_database");
+  bind(api.crs_alter_cs_linear_unit, "proj_crs_alter_cs_linear_unit");
+  bind(api.create_compound_crs, "proj_create_compound_crs");
+  return api;  // the library stays loaded for the process
+}
+
+const ProjApi& projApi() {
+  static const ProjApi api = loadProj();
+  return api;
+}
+
+// One conversion's PROJ context and objects, destroyed with it.
+class Proj {
+ public:
+  explicit Proj(const ProjApi& api) : api_(api), context_(api.context_create()) {
+    if (context_) api_.log_level(context_, PJ_LOG_NONE);  // errors come back as values, not on stderr
+  }
+  ~Proj() {
+    for (PJ* object : objects_) api_.destroy(object);
+    if (context_) api_.context_destroy(context_);
+  }
+  Proj(const Proj&) = delete;
+  Proj& operator=(const Proj&) = delete;
+
+  PJ_CONTEXT* context() const { return context_; }
+  PJ* keep(PJ* object) {
+    if (object) objects_.push_back(object);
+    return object;
+  }
+
+  // The EPSG CRS `code`, with its coordinate system's linear unit made EPSG unit `unit` (the
+  // GeoTIFF keys' ProjLinearUnits or VerticalUnits) where that is given and differs.
+  Result<PJ*> crs(uint16_t code, std::optional<uint16_t> unit, std::string* changed) {
+    const std::string text = std::to_string(code);
+    PJ* crs = keep(api_.create_from_database(context_, "EPSG", text.c_str(), PJ_CATEGORY_CRS, 0, nullptr));
+    if (!crs) return Error{epsg(code) + " is not a CRS in PROJ's database"};
+    if (!unit) return crs;
+    PJ* cs = keep(api_.crs_get_coordinate_system(context_, crs));
+    const char* unit_code = nullptr;
+    if (!cs || !api_.cs_get_axis_info(context_, cs, 0, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, &unit_code))
+      return crs;  // no axis to say its unit (a compound CRS has none of its own)
+    const std::string wanted = std::to_string(*unit);
+    if (unit_code && wanted == unit_code) return crs;
+    const char* name = nullptr;
+    double factor = 0.0;
+    const char* category = nullptr;
+    if (!api_.uom_get_info_from_database(context_, "EPSG", wanted.c_str(), &name, &factor, &category) || !category ||
+        std::strcmp(category, "linear") != 0)
+      return Error{"its linear unit EPSG:" + wanted + " is not a linear unit in PROJ's database"};
+    PJ* altered = keep(api_.crs_alter_cs_linear_unit(context_, crs, name, factor, "EPSG", wanted.c_str()));
+    if (!altered) return Error{"PROJ cannot give " + epsg(code) + " the linear unit EPSG:" + wanted};
+    if (changed) *changed += std::string(changed->empty() ? "" : ", ") + "in " + name;
+    return altered;
+  }
+
+ private:
+  const ProjApi& api_;
+  PJ_CONTEXT* context_;
+  std::vector<PJ*> objects_;
+};
+
+// The keys' CRS as OGC WKT 1, or why not.
+Result<std::string> keysAsWkt(const GeoKeys& keys) {
+  std::optional<uint16_t> horizontal = keys.code(kProjectedType);
+  std::optional<uint16_t> unit = keys.code(kProjLinearUnits);
+  if (!horizontal) {
+    horizontal = keys.code(kGeographicType);
+    unit.reset();
+  }
+  if (!horizontal) return Error{"the keys define it by parameters, not by an EPSG code, and dpoint makes WKT of EPSG codes only"};
+  const ProjApi& api = projApi();
+  if (!api.error.empty()) return Error{api.error};
+  Proj proj(api);
+  if (!proj.context()) return Error{"PROJ cannot make a context"};
+  std::string changed;
+  Result<PJ*> crs = proj.crs(*horizontal, unit, &changed);
+  if (!crs) return crs.error();
+  PJ* result = *crs;
+  if (std::optional<uint16_t> vertical_code = keys.code(kVerticalType)) {
+    Result<PJ*> vertical = proj.crs(*vertical_code, keys.code(kVerticalUnits), &changed);
+    if (!vertical) return vertical.error();
+    const std::string name = std::string(api.get_name(*crs)) + " + " + api.get_name(*vertical);
+    result = proj.keep(api.create_compound_crs(proj.context(), name.c_str(), *crs, *vertical));
+    if (!result) return Error{"PROJ cannot combine " + epsg(*horizontal) + " and " + epsg(*vertical_code)};
+  }
+  const char* const options[] = {"MULTILINE=NO", nullptr};
+  const char* wkt = api.as_wkt(proj.context(), result, PJ_WKT1_GDAL, options);
+  if (!wkt) return Error{"PROJ cannot write " + keysName(keys) + " as WKT 1"};
+  return std::string(wkt);
+}
+
+}  // namespace
+
+LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs) {
+  LasWktCrs out;
+  for (const LasVlr& vlr : vlrs)  // GeoTIFF keys are left out: formats 6-10 take WKT alone
+    if (!isGeoTiffRecord(vlr)) out.records.push_back(vlr);
+  if (findRecord(vlrs, [](const LasVlr& v) { return isLasfProjection(v, kWktRecord); })) return out;
+  // libLAS's WKT record becomes the LAS one; else the keys' CRS is made WKT.
+  for (LasVlr& record : out.records)
+    if (isLiblasWkt(record) && !wktText(record.data).empty()) {
+      const std::string text = wktText(record.data);
+      record = LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", text + '\0', record.extended};
+      out.note = "libLAS's WKT record (" + wktName(text) + ") written as the LAS WKT record (LASF_Projection 2112)";
+      return out;
+    }
+  const std::optional<GeoKeys> keys = geoKeys(vlrs);
+  if (!keys) return out;
+  Result<std::string> text = keysAsWkt(*keys);
+  if (text) {
+    out.records.push_back(LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", *text + '\0', false});
+    out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", written as WKT (" + wktName(*text) + ")";
+  } else {
+    out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", is left out and the file has no CRS: " +
+               text.error().message;
+  }
+  return out;
+}
+
+std::string lasCrsSummary(const std::vector<LasVlr>& vlrs) {
+  // The LAS WKT record, else the GeoTIFF keys (a LAS 1.2 file's CRS), else libLAS's WKT record.
+  const auto named = [](const LasVlr* record, const char* what) {
+    const std::string text = record ? wktText(record->data) : std::string();
+    if (text.empty()) return std::string();
+    const std::string name = wktName(text);
+    return (name.empty() ? std::string("unnamed") : name) + what;
+  };
+  std::string summary = named(findRecord(vlrs, [](const LasVlr& v) { return isLasfProjection(v, kWktRecord); }), ", WKT");
+  if (summary.empty())
+    if (std::optional<GeoKeys> keys = geoKeys(vlrs)) summary = keysName(*keys) + ", GeoTIFF keys";
+  if (summary.empty()) summary = named(findRecord(vlrs, isLiblasWkt), ", libLAS's WKT");
+  return summary;
+}
+
+}  // namespace dpoint

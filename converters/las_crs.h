@@ -1,0 +1,43 @@
+// The coordinate reference system of a LAS file's CRS records (LasSource::vlrs), as the writer
+// needs it and `info` shows it.
+//
+// LAS holds a CRS as GeoTIFF keys (LASF_Projection 34735, with its double (34736) and ASCII (34737)
+// parameters) or as OGC WKT (LASF_Projection 2112; libLAS and early PDAL also wrote their own
+// `liblas` 2112). Point formats 0–5 may use either; 6–10 must use WKT, and never both (LAS 1.4 R15,
+// "Coordinate Reference System Information"). So a LAS 1.2 file's GeoTIFF keys become WKT when its
+// points are written as format 6–10 (COPC's formats): from its libLAS WKT record where it has one,
+// else from the EPSG codes of its keys through PROJ's database (the projected or geographic CRS,
+// with the keys' linear unit, and a vertical CRS as a compound one), as OGC WKT 1 (the dialect LAS
+// names). PROJ (libproj, Debian's libproj25) is loaded when a conversion needs it, not linked: every
+// other run of dpoint starts without its forty libraries.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/point_set.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+// What the writer of a point format 6–10 file does with the source's CRS records.
+struct LasWktCrs {
+  // The records to write instead of the source's CRS records: the source's own where they are
+  // WKT already, else one LASF_Projection 2112 record; empty when no WKT could be made.
+  std::vector<LasVlr> records;
+  // One line for the user when the records changed ("the GeoTIFF keys (EPSG:26910, NAD83 / UTM zone
+  // 10N) written as WKT"), or why the file has no CRS now; empty when nothing changed.
+  std::string note;
+};
+
+// The CRS records for a file whose global encoding says WKT (point formats 6–10): `vlrs` are the
+// source's CRS records (isCrsRecord's, VLRs and EVLRs). Never fails: a CRS that cannot be made WKT
+// is left out, with a note saying why.
+LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs);
+
+// One line naming the CRS of these records without PROJ, for `info`: the WKT's name, or the GeoTIFF
+// keys' EPSG codes and citation ("EPSG:26910 + EPSG:5703 (NAD83 / UTM zone 10N), GeoTIFF keys");
+// empty when there are none.
+std::string lasCrsSummary(const std::vector<LasVlr>& vlrs);
+
+}  // namespace dpoint

@@ -1,0 +1,149 @@
+// A LAS file's CRS in point formats 6–10, which hold it as WKT alone (LAS 1.4 R15): GeoTIFF keys are
+// made WKT through PROJ from their EPSG codes (the keys' linear unit and a vertical CRS included),
+// libLAS's WKT record becomes the LAS one, a CRS that cannot be made WKT is left out with a note,
+// and formats 0–5 keep their records as they were. tests/external/copc_reads_dpoint_copc.py has
+// copc.js and pyproj read the WKT of the corpus's files written as COPC.
+#include "converters/las_crs.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "converters/las.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::TempDir;
+
+// A LASF_Projection 34735 record: the directory's header, then one entry a key (value in place).
+LasVlr geoKeys(const std::vector<std::pair<uint16_t, uint16_t>>& keys) {
+  std::vector<uint16_t> shorts = {1, 1, 0, static_cast<uint16_t>(keys.size())};
+  for (const auto& [id, value] : keys) shorts.insert(shorts.end(), {id, 0, 1, value});
+  std::string data(shorts.size() * 2, '\0');
+  std::memcpy(data.data(), shorts.data(), data.size());
+  return LasVlr{"LASF_Projection", 34735, "GeoTIFF GeoKeyDirectoryTag", data, false};
+}
+
+LasVlr wkt(const std::string& user, const std::string& text, bool extended = false) {
+  return LasVlr{user, 2112, "WKT", text + '\0', extended};
+}
+
+bool has(const std::vector<LasVlr>& records, const std::string& user, uint16_t id) {
+  for (const LasVlr& r : records)
+    if (r.user_id == user && r.record_id == id) return true;
+  return false;
+}
+
+const LasVlr* find(const std::vector<LasVlr>& records, const std::string& user, uint16_t id) {
+  for (const LasVlr& r : records)
+    if (r.user_id == user && r.record_id == id) return &r;
+  return nullptr;
+}
+
+TEST(LasCrs, geoTiffKeysBecomeWktWithTheirUnitAndVerticalCrs) {
+  // NAD83 / UTM zone 10N (metres in EPSG) whose keys say US survey feet, over NAVD88 height in feet.
+  const LasWktCrs crs = lasWktCrs({geoKeys({{1024, 1}, {3072, 26910}, {3076, 9003}, {4096, 5703}, {4099, 9003}})});
+  ASSERT_EQ(crs.records.size(), 1u);
+  const LasVlr& record = crs.records[0];
+  EXPECT_EQ(record.user_id, "LASF_Projection");
+  EXPECT_EQ(record.record_id, 2112);
+  ASSERT_FALSE(record.data.empty());
+  EXPECT_EQ(record.data.back(), '\0');  // LAS's WKT is a NUL-terminated string
+  const std::string text = record.data.substr(0, record.data.size() - 1);
+  EXPECT_EQ(text.rfind("COMPD_CS[\"NAD83 / UTM zone 10N + NAVD88 height", 0), 0u) << text;
+  EXPECT_NE(text.find("UNIT[\"US survey foot\""), std::string::npos) << text;
+  EXPECT_EQ(text.find("UNIT[\"metre\""), std::string::npos) << "every axis in the keys' unit: " << text;
+  EXPECT_EQ(text.find('\n'), std::string::npos) << "one line";
+  EXPECT_NE(crs.note.find("EPSG:26910 + EPSG:5703"), std::string::npos) << crs.note;
+  EXPECT_NE(crs.note.find("written as WKT"), std::string::npos) << crs.note;
+}
+
+TEST(LasCrs, aGeographicCrsIsMadeWktToo) {
+  const LasWktCrs crs = lasWktCrs({geoKeys({{1024, 2}, {2048, 4326}, {2054, 9102}})});
+  ASSERT_EQ(crs.records.size(), 1u);
+  EXPECT_EQ(crs.records[0].data.rfind("GEOGCS[\"WGS 84\"", 0), 0u) << crs.records[0].data;
+}
+
+TEST(LasCrs, aCrsWithoutAnEpsgCodeIsLeftOutWithANote) {
+  for (const LasVlr& keys : {geoKeys({{1024, 1}, {3072, 32767}}), geoKeys({{1024, 1}}),
+                             geoKeys({{1024, 1}, {3072, 60000}}), geoKeys({{1024, 1}, {3072, 26910}, {3076, 9102}})}) {
+    const LasWktCrs crs = lasWktCrs({keys});
+    EXPECT_TRUE(crs.records.empty());
+    EXPECT_NE(crs.note.find("left out and the file has no CRS"), std::string::npos) << crs.note;
+  }
+  // Why, in the note: no code, a code PROJ does not know, a unit that is an angle.
+  EXPECT_NE(lasWktCrs({geoKeys({{3072, 32767}})}).note.find("by parameters"), std::string::npos);
+  EXPECT_NE(lasWktCrs({geoKeys({{3072, 60000}})}).note.find("EPSG:60000 is not a CRS"), std::string::npos);
+  EXPECT_NE(lasWktCrs({geoKeys({{3072, 26910}, {3076, 9102}})}).note.find("not a linear unit"), std::string::npos);
+}
+
+TEST(LasCrs, libLasWktBecomesTheLasRecordAndWktStaysAsItIs) {
+  const std::string text = "PROJCS[\"NAD83 / UTM zone 10N\",GEOGCS[\"NAD83\"]]";
+  const LasWktCrs from_liblas = lasWktCrs({geoKeys({{3072, 26910}}), wkt("liblas", text)});
+  ASSERT_EQ(from_liblas.records.size(), 1u);  // the keys are left out beside WKT
+  EXPECT_EQ(from_liblas.records[0].user_id, "LASF_Projection");
+  EXPECT_EQ(from_liblas.records[0].data, text + '\0');
+  EXPECT_NE(from_liblas.note.find("libLAS's WKT record (NAD83 / UTM zone 10N)"), std::string::npos) << from_liblas.note;
+
+  // A WKT record already there (an EVLR here) is kept as it is, with no note; the keys go.
+  const LasWktCrs kept = lasWktCrs({geoKeys({{3072, 26910}}), wkt("LASF_Projection", text, true)});
+  ASSERT_EQ(kept.records.size(), 1u);
+  EXPECT_TRUE(kept.records[0].extended);
+  EXPECT_TRUE(kept.note.empty()) << kept.note;
+  EXPECT_TRUE(lasWktCrs({}).records.empty());
+  EXPECT_TRUE(lasWktCrs({}).note.empty());
+}
+
+TEST(LasCrs, summaryNamesTheCrsWithoutProj) {
+  EXPECT_EQ(lasCrsSummary({}), "");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{1024, 1}, {3072, 26910}, {4096, 5703}})}), "EPSG:26910 + EPSG:5703, GeoTIFF keys");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 32767}})}), "a user-defined CRS, GeoTIFF keys");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 26910}}), wkt("LASF_Projection", "PROJCS[\"A\",X]")}), "A, WKT");
+  EXPECT_EQ(lasCrsSummary({wkt("liblas", "PROJCS[\"B\",X]")}), "B, libLAS's WKT");
+  // A LAS 1.2 file's CRS is its keys, whatever libLAS wrote beside them.
+  EXPECT_EQ(lasCrsSummary({wkt("liblas", "PROJCS[\"B\",X]"), geoKeys({{3072, 26910}})}), "EPSG:26910, GeoTIFF keys");
+}
+
+// The writer: format 6 (COPC's, or --las14) gets the WKT and drops the keys, with a note in its
+// report; format 1 keeps the keys as they were. Both read back as written.
+TEST(LasCrs, theWriterPutsWktInFormat6AndKeepsKeysInFormat1) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{500000.0, 4000000.0, 10.0}, {500001.5, 4000002.0, 11.0}};
+  LasSource source;
+  source.point_format = 1;
+  source.scale = glm::dvec3(0.01);
+  source.vlrs = {geoKeys({{1024, 1}, {3072, 26910}, {3076, 9001}})};
+  set.las = source;
+  for (bool las14 : {false, true}) {
+    SCOPED_TRACE(las14 ? "format 6" : "format 1");
+    const std::string path = dir.file(las14 ? "six.las" : "one.las");
+    LasWriteReport report;
+    LasWriteOptions options;
+    options.las14 = las14;
+    options.report = &report;
+    ASSERT_TRUE(writeLas(path, set, options).ok());
+    Result<PointSet> back = readLas(path);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    ASSERT_TRUE(back->las.has_value());
+    EXPECT_EQ(back->las->point_format, las14 ? 6 : 1);
+    const std::vector<LasVlr>& records = back->las->vlrs;
+    EXPECT_EQ(has(records, "LASF_Projection", 34735), !las14);
+    EXPECT_EQ(has(records, "LASF_Projection", 2112), las14);
+    if (las14) {
+      EXPECT_NE(find(records, "LASF_Projection", 2112)->data.find("NAD83 / UTM zone 10N"), std::string::npos);
+      EXPECT_EQ(report.crs.rfind("point format 6 holds its CRS as WKT: the GeoTIFF keys' CRS, EPSG:26910", 0), 0u)
+          << report.crs;
+      EXPECT_EQ(back->las->global_encoding & 0x10, 0x10);
+    } else {
+      EXPECT_TRUE(report.crs.empty()) << report.crs;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dpoint
