@@ -187,8 +187,11 @@ class ByteReader {
  public:
   enum class Line { kLine, kEnd, kTooLong };
 
+  // The buffer starts at 64 KiB, which holds any header dpoint has seen, and doubles with each
+  // refill up to kBlockBytes: a binary file's header read no longer zeroes and fills 8 MiB that its
+  // rows, read on all cores from the file, never use (twice for a render: its probe and its read).
   ByteReader(const InputFile& file, Progress* progress)
-      : file_(file), progress_(progress), buf_(std::min<uint64_t>(kBlockBytes, file.size() + 1)) {}
+      : file_(file), progress_(progress), buf_(std::min<uint64_t>(kFirstBytes, file.size() + 1)) {}
 
   uint64_t offset() const { return start_ + pos_; }
   // The file offset just past the bytes read so far (each reported once to the progress).
@@ -242,7 +245,9 @@ class ByteReader {
     start_ += pos_;
     pos_ = 0;
     end_ = keep;
-    if (buf_.size() < n) buf_.resize(std::max(n, 2 * buf_.size()));
+    if (buf_.size() < n || (filled_ && buf_.size() < kBlockBytes && buf_.size() <= file_.size()))
+      buf_.resize(std::max(n, std::min(2 * buf_.size(), kBlockBytes)));
+    filled_ = true;
     while (end_ < n) {
       auto got = file_.readAt(start_ + end_, buf_.data() + end_, buf_.size() - end_);
       if (!got.ok()) return got.error();
@@ -255,7 +260,9 @@ class ByteReader {
 
   const InputFile& file_;
   Progress* progress_;
+  static constexpr size_t kFirstBytes = size_t{64} << 10;
   std::vector<char> buf_;
+  bool filled_ = false;  // a refill has happened: the next one doubles the buffer
   uint64_t start_ = 0;  // file offset of buf_[0]
   size_t pos_ = 0, end_ = 0;
 };

@@ -328,7 +328,7 @@ Status finiteRows(const OpenTile& t, uint64_t first, size_t rows, const char* by
   for (size_t i = 0; i < rows; ++i) {
     double p[3];
     std::memcpy(p, bytes + i * stride, sizeof p);
-    for (int k = 0; k < 3; ++k)
+    for (size_t k = 0; k < 3; ++k)
       if (!std::isfinite(p[k]))
         return Error{t.file->path() + ": byte " + std::to_string(t.parsed.data_offset + (first + i) * stride + 8 * k) +
                      ": vertex " + std::to_string(first + i) + ": " + "xyz"[k] + " is " + formatNumber(p[k]) +

@@ -10,6 +10,14 @@
 
 #include "core/parallel.h"
 
+// Valgrind's client requests (macros that do nothing outside valgrind), where its headers are.
+#if __has_include(<valgrind/memcheck.h>)
+#include <valgrind/memcheck.h>
+#define DPOINT_HAS_MEMCHECK 1
+#else
+#define DPOINT_HAS_MEMCHECK 0
+#endif
+
 namespace dpoint {
 
 uint64_t defaultMemoryLimit() {
@@ -81,18 +89,36 @@ void adviseHugePages(void* data, size_t bytes) {
 #endif
 }
 
+void* mapHugePages(size_t bytes) {
+  constexpr uintptr_t kHuge = uintptr_t{2} << 20;
+  void* raw = mmap(nullptr, bytes + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) return nullptr;
+  const uintptr_t start = reinterpret_cast<uintptr_t>(raw), aligned = (start + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+  const uintptr_t used_end = (aligned + bytes + page - 1) & ~(page - 1);
+  if (aligned > start) munmap(raw, aligned - start);
+  if (start + bytes + kHuge > used_end) munmap(reinterpret_cast<void*>(used_end), start + bytes + kHuge - used_end);
+  void* data = reinterpret_cast<void*>(aligned);
+#ifdef MADV_HUGEPAGE
+  (void)madvise(data, used_end - aligned, MADV_HUGEPAGE);  // a hint: without it the pages are 4 KiB
+#endif
+#if DPOINT_HAS_MEMCHECK
+  VALGRIND_MAKE_MEM_UNDEFINED(data, bytes);  // as fresh heap memory is: memcheck tracks what is written
+#endif
+  return data;
+}
+
+void unmapPages(void* data, size_t bytes) noexcept {
+  if (data) munmap(data, bytes);
+}
+
 LargeBuffer::LargeBuffer(size_t bytes) : size_(bytes) {
-  constexpr size_t kHuge = size_t{2} << 20;
-  if (bytes >= kHuge) {
-    const size_t length = (bytes + kHuge - 1) / kHuge * kHuge;
-    void* p = mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (p != MAP_FAILED) {
-      adviseHugePages(p, length);  // a hint: without it the pages are 4 KiB
+  if (bytes >= (size_t{2} << 20))
+    if (void* p = mapHugePages(bytes)) {
       data_ = static_cast<char*>(p);
-      mapped_ = length;
+      mapped_ = bytes;
       return;
     }
-  }
   data_ = new char[std::max<size_t>(bytes, 1)];
 }
 
@@ -115,7 +141,7 @@ LargeBuffer::~LargeBuffer() { release(); }
 
 void LargeBuffer::release() {
   if (!data_) return;
-  if (mapped_) munmap(data_, mapped_);
+  if (mapped_) unmapPages(data_, mapped_);
   else delete[] data_;
   data_ = nullptr;
 }

@@ -75,10 +75,16 @@ Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, V
   VkMemoryPropertyFlags flags = context.memory.memoryTypes[*type].propertyFlags;
   if (result == VK_SUCCESS && (flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
     out.coherent = (flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
-    if (host)
+    if (host) {
       out.mapped = host->pages;
-    else
+    } else {
       result = vkMapMemory(context.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+      // A CPU device's memory is the process's own heap, which the upload writes first: in 2 MiB
+      // pages it takes 512 times fewer faults (on the 2-core PVM test VM, 4,600 faults of about
+      // 12 us each for the 1.55M-point Mandelbulb's fp32 positions). Only a hint.
+      if (result == VK_SUCCESS && context.facts.type == "cpu" && size >= kHugeBlockBytes)
+        adviseHugePages(out.mapped, size);
+    }
   }
   if (result != VK_SUCCESS) return failed(vulkanError("allocating " + formatBytes(size) + " for " + what, result));
   return out;
@@ -88,13 +94,8 @@ Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, V
 // where the kernel gives them (the mapping aligned to 2 MiB). Null where mmap fails.
 void* mapHostPages(size_t bytes) {
   constexpr size_t kHuge = size_t{2} << 20;
-  void* raw = mmap(nullptr, bytes + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (raw == MAP_FAILED) return nullptr;
-  const uintptr_t start = reinterpret_cast<uintptr_t>(raw), aligned = (start + kHuge - 1) / kHuge * kHuge;
-  if (aligned > start) munmap(raw, aligned - start);
-  if (const size_t tail = start + bytes + kHuge - (aligned + bytes); tail) munmap(reinterpret_cast<void*>(aligned + bytes), tail);
-  auto* pages = reinterpret_cast<uint8_t*>(aligned);
-  madvise(pages, bytes, MADV_HUGEPAGE);
+  auto* pages = static_cast<uint8_t*>(mapHugePages(bytes));
+  if (!pages) return nullptr;
   // A child process (a Python user's fork) gets none of them: pinned pages would be copied.
   madvise(pages, bytes, MADV_DONTFORK);
   // A driver pins the pages it imports one at a time; faulted here they come from every core.

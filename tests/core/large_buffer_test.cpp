@@ -1,7 +1,13 @@
 // LargeBuffer (core/memory.h): a mapped buffer for large outputs and the heap for small ones; both
 // hold what is written, move without copying, and release once. ReleaseInBackground: an object
-// destroyed on a thread of its own, waited for.
+// destroyed on a thread of its own, waited for. DefaultInitAllocator: blocks of 2 MiB or more
+// mapped on their own in 2 MiB pages, given back when freed.
 #include <gtest/gtest.h>
+
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 #include <atomic>
 #include <chrono>
@@ -12,6 +18,7 @@
 
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "core/point_set.h"
 
 namespace dpoint {
 namespace {
@@ -68,6 +75,49 @@ TEST(ReleaseInBackground, destroysOnceOnAnotherThreadAndWaits) {
   EXPECT_NE(on.load(), std::this_thread::get_id());
   ReleaseInBackground empty;
   empty.wait();  // nothing to wait for
+}
+
+// The VmFlags of the mapping that holds `p` in /proc/self/smaps, "" where no mapping holds it.
+std::string vmFlagsAt(const void* p) {
+  std::ifstream smaps("/proc/self/smaps");
+  const uintptr_t at = reinterpret_cast<uintptr_t>(p);
+  bool inside = false;
+  for (std::string line; std::getline(smaps, line);) {
+    uintptr_t lo = 0, hi = 0;
+    char dash = 0;
+    std::istringstream range(line);
+    if (line.find("VmFlags:") == 0) {
+      if (inside) return line;
+    } else if (range >> std::hex >> lo >> dash >> hi) {
+      inside = dash == '-' && lo <= at && at < hi;
+    }
+  }
+  return "";
+}
+
+TEST(DefaultInitAllocator, largeBlocksAreTheirOwnMappingInHugePagesAndAreGivenBack) {
+  const void* first = nullptr;
+  {
+    PositionArray positions(size_t{1} << 20);  // 24 MiB
+    first = positions.data();
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(positions.data()) % (uintptr_t{2} << 20), 0u) << "2 MiB-aligned";
+    parallelFor(positions.size(), 2, [&](size_t i, unsigned) { positions[i] = glm::dvec3(static_cast<double>(i)); });
+    EXPECT_EQ(positions.back().z, static_cast<double>(positions.size() - 1));
+    // Transparent huge pages advised ("hg"), unless the kernel has none to give.
+    const std::string flags = vmFlagsAt(positions.data());
+    ASSERT_NE(flags, "");
+    if (std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled")) {
+      EXPECT_NE(flags.find(" hg"), std::string::npos) << flags;
+    }
+    positions.resize(positions.size() * 2);  // grows into a new mapping, the old one given back
+    EXPECT_EQ(positions[12345].x, 12345.0);
+    EXPECT_EQ(vmFlagsAt(first), "");
+    first = positions.data();
+  }
+  EXPECT_EQ(vmFlagsAt(first), "") << "freed";
+  // A small block comes from the heap as before.
+  ColorArray colors(1000);
+  EXPECT_EQ(vmFlagsAt(colors.data()).find(" hg"), std::string::npos);
 }
 
 }  // namespace
