@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "converters/csv.h"
 #include "converters/gltf_read.h"
+#include "converters/las_crs.h"
 #include "converters/point_io.h"
 #include "core/memory.h"
 #include "core/text.h"
@@ -34,6 +35,7 @@ struct ConvertOptions {
   uint64_t max_points = 0;
   std::string order = "input";
   double las_scale = 0.0;  // 0: the input LAS file's, else chosen from the data
+  std::string crs;  // --crs: EPSG:CODE, WKT or a file holding it; empty: the input's CRS records
   DimensionChoice dimensions;  // --keep, --drop
   std::string max_memory;
   uint64_t memory_limit = 0;  // max_memory parsed
@@ -88,6 +90,16 @@ int runConvert(ConvertOptions& o) {
   w.pcd_encoding = *parsePcdEncoding(o.pcd_encoding);  // checked by the option's validator
   w.progress = &progress;
   w.las_scale = o.las_scale;
+  if (!o.crs.empty()) {
+    const Result<FileFormat> las = formatOf(o.output);
+    if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
+      return reportError(Error{"--crs: only a LAS, LAZ or COPC output holds a coordinate reference system, not " +
+                                   quotedExcerpt(o.output),
+                               ExitCode::kUsage});
+    Result<std::string> wkt = crsAsWkt(o.crs);
+    if (!wkt) return reportError(wkt.error());
+    w.las_crs = std::move(*wkt);
+  }
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
   // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
   // point set; --unique and --order morton need the whole set, so they take the path below.
@@ -147,6 +159,10 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
                   "PCD: DATA ascii, binary (rows of the fields) or binary_compressed (LZF, the smallest)")
       ->check(oneOf("--pcd-encoding", {"ascii", "binary", "binary_compressed"}))
       ->default_val("binary");
+  cmd->add_option("--crs", o->crs,
+                  "LAS/LAZ/COPC: the coordinate reference system, as EPSG:CODE (EPSG:32633), WKT, or a file holding WKT\n"
+                  "(a .prj); written as WKT in a LAS 1.4 file, in place of the input's CRS records. Default: the input's")
+      ->type_name("CRS");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "
                   "down to a whole number); a point beyond the 32-bit integers at this step is an error (exit 2). "

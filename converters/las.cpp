@@ -574,7 +574,7 @@ void storeValue(char* p, DimType type, double v) {
 
 // Which format, extra bytes, version and records the writer uses for `points` (las_fields.h).
 Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n, bool compress,
-                                  bool las14, unsigned threads) {
+                                  bool las14, const std::string& crs_wkt, unsigned threads) {
   WriterLayout l;
   const LasSource* source = points.las ? &*points.las : nullptr;
   l.format = lasFormatFor(points, source ? source->point_format : -1, !compress);
@@ -616,7 +616,7 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   if (l.record_length > 65535)
     return Error{path + ": " + str(points.dimensions.count()) + " dimensions make a " + str(l.record_length) +
                  "-byte record, beyond LAS's 65535"};
-  const bool v14 = l.format >= 6 || (source && source->version_minor >= 4) || n > UINT32_MAX;
+  const bool v14 = l.format >= 6 || (source && source->version_minor >= 4) || n > UINT32_MAX || !crs_wkt.empty();
   l.version_minor = v14 ? 4 : 2;
   // Bit 0: GPS time is adjusted standard time; bit 4 (1.4): the coordinate system is WKT.
   l.global_encoding = source ? static_cast<uint16_t>(source->global_encoding & (v14 ? 0x11 : 0x01)) : 0;
@@ -626,7 +626,12 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   l.file_source_id = source ? source->file_source_id : 0;
   // Formats 6-10 hold their CRS as WKT alone: GeoTIFF keys are made WKT (converters/las_crs.h).
   std::vector<LasVlr> crs = source ? source->vlrs : std::vector<LasVlr>();
-  if (l.format >= 6) {
+  if (!crs_wkt.empty()) {  // the CRS given, as WKT, in a LAS 1.4 file
+    const std::string before = lasCrsSummary(crs);
+    if (!before.empty()) l.crs_note = "the input's CRS (" + before + ") replaced by " + wktName(crs_wkt);
+    crs = {lasWktRecord(crs_wkt)};
+    l.global_encoding |= 0x10;
+  } else if (l.format >= 6) {
     LasWktCrs wkt = lasWktCrs(crs);
     crs = std::move(wkt.records);
     l.crs_note = std::move(wkt.note);
@@ -1197,12 +1202,14 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
     options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset, threads);
   }
-  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, threads);
+  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, options.crs_wkt, threads);
   if (!layout) return layout.error();
   WriterLayout& l = *layout;
   if (options.report) {
     options.report->renamed = l.renamed;
-    options.report->crs = l.crs_note.empty() ? std::string() : "point format " + str(l.format) + " holds its CRS as WKT: " + l.crs_note;
+    options.report->crs = l.crs_note.empty() || !options.crs_wkt.empty()
+                              ? l.crs_note
+                              : "point format " + str(l.format) + " holds its CRS as WKT: " + l.crs_note;
   }
   std::optional<LazInfo> laz;
   if (options.compress) {

@@ -108,7 +108,8 @@ struct LasWriteReport {
   // to 32 letters, digits or '_'.
   std::vector<std::string> renamed;
   // What became of the source's CRS records in a point format 6–10 file, which holds WKT alone
-  // (converters/las_crs.h): made WKT, or left out and why; empty when they were kept as they were.
+  // (converters/las_crs.h): made WKT, or left out and why, or replaced by crs_wkt; empty when they
+  // were kept as they were.
   std::string crs;
   // Distinct positions that share their integers at that scale with another: they read back as one.
   uint64_t merged_points = 0;
@@ -128,6 +129,10 @@ struct LasWriteOptions {
   // Point formats 6–8 (LAS 1.4) whatever the set needs: 0 and 1 become 6, 2 and 3 become 7
   // (COPC's formats; a format 4/5 source with compress is written as 6 or 7 too).
   bool las14 = false;
+  // When not empty, the file's CRS (one line of OGC WKT 1, crsAsWkt's) in place of the source's CRS
+  // records: a LAS 1.4 file with the WKT bit set, whatever its point format (LAS 1.4 R15 allows
+  // WKT for every format; LAS 1.2 has GeoTIFF keys only).
+  std::string crs_wkt;
   // When set, the file's bytes are appended here and nothing is written at `path` (which names the
   // output in messages).
   std::string* memory = nullptr;

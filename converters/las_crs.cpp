@@ -5,9 +5,11 @@
 #include <proj_experimental.h>
 
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 #include "core/bytes.h"
 #include "core/text.h"
@@ -46,14 +48,6 @@ std::string wktText(const std::string& data) {
   const size_t first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) return {};
   return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
-}
-
-// The name a WKT gives its CRS: the first quoted string (PROJCS["NAD83 / UTM zone 10N", ...).
-std::string wktName(const std::string& wkt) {
-  const size_t open = wkt.find('"');
-  if (open == std::string::npos) return {};
-  const size_t close = wkt.find('"', open + 1);
-  return close == std::string::npos ? std::string() : wkt.substr(open + 1, close - open - 1);
 }
 
 // The GeoTIFF keys whose values sit in the directory (short values), and the ASCII ones (citations),
@@ -115,6 +109,8 @@ struct ProjApi {
   decltype(&proj_context_create) context_create = nullptr;
   decltype(&proj_context_destroy) context_destroy = nullptr;
   decltype(&proj_log_level) log_level = nullptr;
+  decltype(&proj_create) create = nullptr;
+  decltype(&proj_is_crs) is_crs = nullptr;
   decltype(&proj_create_from_database) create_from_database = nullptr;
   decltype(&proj_destroy) destroy = nullptr;
   decltype(&proj_get_name) get_name = nullptr;
@@ -141,6 +137,8 @@ ProjApi loadProj() {
   bind(api.context_create, "proj_context_create");
   bind(api.context_destroy, "proj_context_destroy");
   bind(api.log_level, "proj_log_level");
+  bind(api.create, "proj_create");
+  bind(api.is_crs, "proj_is_crs");
   bind(api.create_from_database, "proj_create_from_database");
   bind(api.destroy, "proj_destroy");
   bind(api.get_name, "proj_get_name");
@@ -240,6 +238,42 @@ Result<std::string> keysAsWkt(const GeoKeys& keys) {
 
 }  // namespace
 
+std::string wktName(const std::string& wkt) {
+  const size_t open = wkt.find('"');
+  if (open == std::string::npos) return {};
+  const size_t close = wkt.find('"', open + 1);
+  return close == std::string::npos ? std::string() : wkt.substr(open + 1, close - open - 1);
+}
+
+LasVlr lasWktRecord(const std::string& wkt) {
+  const bool extended = wkt.size() >= 65535;  // a VLR holds at most 65535 bytes; an EVLR more
+  return LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt + '\0', extended};
+}
+
+Result<std::string> crsAsWkt(const std::string& text) {
+  const std::string what = "--crs " + quotedExcerpt(text);
+  std::string definition = text;
+  if (text.find_first_of("[:{+") == std::string::npos) {  // no code, WKT, JSON or PROJ string: a file
+    std::ifstream file{text};
+    if (!file) return Error{what + ": no such file, and not EPSG:CODE or WKT", ExitCode::kUsage};
+    std::ostringstream read;
+    read << file.rdbuf();
+    definition = read.str();
+  }
+  const ProjApi& api = projApi();
+  if (!api.error.empty()) return Error{what + ": " + api.error, ExitCode::kUsage};
+  Proj proj(api);
+  if (!proj.context()) return Error{what + ": PROJ cannot make a context", ExitCode::kUsage};
+  PJ* crs = proj.keep(api.create(proj.context(), definition.c_str()));
+  if (!crs || !api.is_crs(crs))
+    return Error{what + ": not a coordinate reference system PROJ knows (give EPSG:CODE, WKT, or a file holding WKT)",
+                 ExitCode::kUsage};
+  const char* const options[] = {"MULTILINE=NO", nullptr};
+  const char* wkt = api.as_wkt(proj.context(), crs, PJ_WKT1_GDAL, options);
+  if (!wkt) return Error{what + ": PROJ cannot write it as WKT 1, the WKT LAS takes", ExitCode::kUsage};
+  return std::string(wkt);
+}
+
 LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs) {
   LasWktCrs out;
   for (const LasVlr& vlr : vlrs)  // GeoTIFF keys are left out: formats 6-10 take WKT alone
@@ -257,7 +291,7 @@ LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs) {
   if (!keys) return out;
   Result<std::string> text = keysAsWkt(*keys);
   if (text) {
-    out.records.push_back(LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", *text + '\0', false});
+    out.records.push_back(lasWktRecord(*text));
     out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", written as WKT (" + wktName(*text) + ")";
   } else {
     out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", is left out and the file has no CRS: " +

@@ -35,6 +35,17 @@ struct LasWktCrs {
 // is left out, with a note saying why.
 LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs);
 
+// The CRS that `text` gives (EPSG:CODE or another authority's code, WKT 1 or 2, PROJJSON, or the
+// path of a file holding one, such as a .prj), as one line of OGC WKT 1 for a LAS WKT record
+// (`--crs`). The error says why not, naming the text.
+Result<std::string> crsAsWkt(const std::string& text);
+
+// A LAS WKT record (LASF_Projection 2112) holding `wkt`.
+LasVlr lasWktRecord(const std::string& wkt);
+
+// The name a WKT gives its CRS (its first quoted string); empty when it has none.
+std::string wktName(const std::string& wkt);
+
 // One line naming the CRS of these records without PROJ, for `info`: the WKT's name, or the GeoTIFF
 // keys' EPSG codes and citation ("EPSG:26910 + EPSG:5703 (NAD83 / UTM zone 10N), GeoTIFF keys");
 // empty when there are none.

@@ -235,7 +235,12 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     case FileFormat::kLas:
     case FileFormat::kLaz: {
       LasWriteReport report;
-      LasWriteOptions las{options.las_scale, options.threads, options.progress, &report};
+      LasWriteOptions las;
+      las.scale = options.las_scale;
+      las.threads = options.threads;
+      las.progress = options.progress;
+      las.report = &report;
+      las.crs_wkt = options.las_crs;
       if (isCopcPath(path)) {
         // COPC: the LAS 1.4 file in memory (formats 6-8), then its octree of LAZ chunks.
         std::string bytes;

@@ -66,6 +66,7 @@ struct WriteOptions {
   PcdEncoding pcd_encoding = PcdEncoding::kBinary;
   Progress* progress = nullptr;
   double las_scale = 0.0;  // LAS: the coordinate step for x, y and z; 0: the source's, else 0.001 (converters/las.h)
+  std::string las_crs;  // LAS/LAZ/COPC: the CRS as one line of WKT 1 (crsAsWkt), in place of the source's
   // When not null, gets one line per thing the file cannot hold as given (GLB: points that will
   // not read back bit-exactly).
   std::vector<std::string>* notices = nullptr;

@@ -192,6 +192,42 @@ TEST(CliLas, infoPrintsTheLasHeader) {
     EXPECT_NE(wrong.out.find(part), std::string::npos) << part << " in\n" << wrong.out;
 }
 
+// --crs: the CRS given (EPSG:CODE, WKT, a file holding WKT) becomes the output's WKT record in a LAS
+// 1.4 file, in place of the input's records (a note says so); a code PROJ does not know, a missing
+// file and an output that holds no CRS are usage errors that write nothing.
+TEST(CliLas, crsGivenIsWrittenAsWkt) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"convert", kCorpus + "simple.las", "--crs", "EPSG:32633", "-o", dir.file("a.las")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  test::CommandResult info = runDpoint({"info", dir.file("a.las"), "--quiet"});
+  EXPECT_NE(info.out.find("LAS:                version 1.4, point format 3"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS CRS:            WGS 84 / UTM zone 33N, WKT\n"), std::string::npos) << info.out;
+  // A file holding WKT; the input's GeoTIFF keys replaced, with a note naming both.
+  writeFile(dir.file("utm33.prj"), "PROJCS[\"mine\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,"
+                                   "298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],"
+                                   "PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"central_meridian\",15],"
+                                   "PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],UNIT[\"metre\",1]]\n");
+  r = runDpoint({"convert", kLazCorpus + "point-time.las", "--crs", dir.file("utm33.prj"), "-o", dir.file("b.laz")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("the input's CRS (EPSG:26910 (NAD83 / UTM zone 10N), GeoTIFF keys) replaced by mine"),
+            std::string::npos)
+      << r.err;
+  info = runDpoint({"info", dir.file("b.laz"), "--quiet"});
+  EXPECT_NE(info.out.find("LAS CRS:            mine, WKT\n"), std::string::npos) << info.out;
+  for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--crs", "EPSG:999999", "-o", dir.file("c.las")}, "--crs 'EPSG:999999': not a coordinate reference system"},
+           {{"--crs", dir.file("none.prj"), "-o", dir.file("c.las")}, "no such file"},
+           {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")}, "only a LAS, LAZ or COPC output holds"}}) {
+    std::vector<std::string> command = {"convert", kCorpus + "simple.las"};
+    command.insert(command.end(), args.begin(), args.end());
+    test::CommandResult bad = runDpoint(command);
+    EXPECT_EQ(bad.exit_code, 1) << bad.err;
+    EXPECT_NE(bad.err.find(message), std::string::npos) << bad.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.las")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.ply")));
+}
+
 // LAZ reads as the LAS it was compressed from (converters/laz_decode.h), by name or by its header.
 TEST(CliLas, lazConvertsInfosAndRendersAsItsLas) {
   TempDir dir;

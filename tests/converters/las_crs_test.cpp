@@ -1,7 +1,7 @@
 // A LAS file's CRS in point formats 6–10, which hold it as WKT alone (LAS 1.4 R15): GeoTIFF keys are
 // made WKT through PROJ from their EPSG codes (the keys' linear unit and a vertical CRS included),
 // libLAS's WKT record becomes the LAS one, a CRS that cannot be made WKT is left out with a note,
-// and formats 0–5 keep their records as they were. tests/external/copc_reads_dpoint_copc.py has
+// and formats 0–5 keep their records as they were; a CRS given (`--crs`) is WKT in a LAS 1.4 file. tests/external/copc_reads_dpoint_copc.py has
 // copc.js and pyproj read the WKT of the corpus's files written as COPC.
 #include "converters/las_crs.h"
 
@@ -143,6 +143,48 @@ TEST(LasCrs, theWriterPutsWktInFormat6AndKeepsKeysInFormat1) {
       EXPECT_TRUE(report.crs.empty()) << report.crs;
     }
   }
+}
+
+// --crs: any definition PROJ reads becomes one line of WKT 1; the writer puts it in a LAS 1.4 file
+// with the WKT bit, in place of the source's records, whatever the point format.
+TEST(LasCrs, aGivenCrsIsWktInALas14File) {
+  Result<std::string> wgs84 = crsAsWkt("EPSG:4326");
+  ASSERT_TRUE(wgs84.ok()) << wgs84.error().message;
+  EXPECT_EQ(wgs84->rfind("GEOGCS[\"WGS 84\"", 0), 0u) << *wgs84;
+  Result<std::string> from_wkt2 = crsAsWkt(
+      "GEOGCRS[\"WGS 84\",DATUM[\"World Geodetic System 1984\",ELLIPSOID[\"WGS 84\",6378137,298.257223563]],"
+      "CS[ellipsoidal,2],AXIS[\"latitude\",north,ANGLEUNIT[\"degree\",0.0174532925199433]],"
+      "AXIS[\"longitude\",east,ANGLEUNIT[\"degree\",0.0174532925199433]]]");
+  ASSERT_TRUE(from_wkt2.ok()) << from_wkt2.error().message;
+  EXPECT_EQ(from_wkt2->rfind("GEOGCS[\"WGS 84\"", 0), 0u) << *from_wkt2;
+  for (const char* bad : {"EPSG:999999", "PROJCS[", "+proj=tmerc +nonsense", "no-such-file.prj"}) {
+    Result<std::string> wkt = crsAsWkt(bad);
+    EXPECT_FALSE(wkt.ok()) << bad;
+    if (!wkt.ok()) {
+      EXPECT_EQ(wkt.error().code, ExitCode::kUsage) << bad;
+    }
+  }
+
+  TempDir dir;
+  PointSet set;
+  set.positions = {{500000.0, 4000000.0, 10.0}};
+  LasSource source;
+  source.point_format = 1;
+  source.vlrs = {geoKeys({{1024, 1}, {3072, 26910}})};
+  set.las = source;
+  LasWriteReport report;
+  LasWriteOptions options;
+  options.crs_wkt = *wgs84;
+  options.report = &report;
+  ASSERT_TRUE(writeLas(dir.file("given.las"), set, options).ok());
+  Result<PointSet> back = readLas(dir.file("given.las"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->las->point_format, 1);
+  EXPECT_EQ(back->las->version_minor, 4);
+  EXPECT_EQ(back->las->global_encoding & 0x10, 0x10);
+  ASSERT_EQ(back->las->vlrs.size(), 1u);
+  EXPECT_EQ(back->las->vlrs[0].data, *wgs84 + '\0');
+  EXPECT_EQ(report.crs, "the input's CRS (EPSG:26910, GeoTIFF keys) replaced by WGS 84");
 }
 
 }  // namespace

@@ -10,7 +10,8 @@ compared, as sorted records, with the same source converted to LAS).
 
 COPC holds point formats 6-8, whose CRS is WKT alone: LAS 1.2 files whose CRS is GeoTIFF keys (the
 corpus's 1815.las, EPSG:6580 + EPSG:5703) or libLAS's WKT record (point-time.las) become COPC files
-whose WKT copc.js finds and pyproj (PROJ's Python binding) reads as the same CRS.
+whose WKT copc.js finds and pyproj (PROJ's Python binding) reads as the same CRS; so does a CSV given
+one with `--crs EPSG:32633`.
 Usage: copc_reads_dpoint_copc.py DPOINT [CONVERTERS_TESTS]
 """
 import glob
@@ -131,6 +132,14 @@ def crs_kept(exe, tmp):
         check(result.returncode == 0, f"convert {source} to COPC fails: {result.stderr[-1000:]}")
         check("holds its CRS as WKT" in result.stderr, f"convert {source}: no note on its CRS: {result.stderr!r}")
         files.append(out)
+    # A CSV, which has no CRS, given one with --crs.
+    csv = os.path.join(tmp, "utm33.csv")
+    with open(csv, "w") as f:
+        f.write("x,y,z\n" + "".join(f"{500000 + i * 0.25},{5400000 + i * 0.5},{i % 7}\n" for i in range(1000)))
+    out = os.path.join(tmp, "crs-utm33.copc.laz")
+    dpoint(exe, "convert", csv, "--crs", "EPSG:32633", "-o", out)
+    cases.append(("utm33.csv --crs EPSG:32633", lambda crs: crs.to_epsg() == 32633, "EPSG:32633"))
+    files.append(out)
     output = walk(files)
     for (source, judge, meant), path in zip(cases, files):
         wkt = walked_wkt(output, path)
