@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "converters/gltf_read.h"
+#include "converters/las_crs.h"
 #include "converters/point_io.h"
 #include "ops/mesh_sample.h"
 #include "core/memory.h"
@@ -552,7 +553,7 @@ progress: lines on stderr.)");
       "write",
       [](const std::shared_ptr<PointSet>& points, const std::string& path, int decimals, bool ply_ascii,
          const std::string& ply_colors, const std::string& pcd_encoding, std::optional<double> las_scale,
-         const std::string& order, bool no_colors,
+         const std::optional<std::string>& crs, const std::string& order, bool no_colors,
          const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
         // As convert's --decimals (0..100; -1 here: shortest round trip) and --las-scale (> 0), whatever the format.
         if (decimals < -1 || decimals > 100)
@@ -569,12 +570,22 @@ progress: lines on stderr.)");
         const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding));
         const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
+        std::string crs_wkt;  // as convert's --crs
+        if (crs) {
+          if (*formatOf(path) != FileFormat::kLas && *formatOf(path) != FileFormat::kLaz)
+            raise(Error{"crs: only a .las, .laz or .copc.laz file holds a coordinate reference system, not '" + path + "'",
+                        ExitCode::kUsage});
+          Result<std::string> wkt = crsAsWkt(*crs);
+          if (!wkt) raise(Error{"crs" + wkt.error().message.substr(std::string("--crs").size()), ExitCode::kUsage});
+          crs_wkt = std::move(*wkt);
+        }
         std::vector<std::string> notices;  // what the file cannot hold as given: warnings, as the CLI's notes
         check(released([&] {
           Progress bar(progressFile(progress), "write");
           WriteOptions w;
           w.notices = &notices;
           w.threads = threads, w.decimals = decimals, w.progress = &bar, w.las_scale = las_scale.value_or(0.0);
+          w.las_crs = crs_wkt;
           w.ply_encoding = ply_ascii ? PlyEncoding::kAscii : PlyEncoding::kBinary;
           w.ply_colors = *ply_color_type;
           w.pcd_encoding = pcd;
@@ -588,14 +599,16 @@ progress: lines on stderr.)");
         warnAtCaller(notices);
       },
       py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
-      py::arg("ply_colors") = "auto", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("order") = "input",
+      py::arg("ply_colors") = "auto", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("crs") = std::nullopt,
+      py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
       R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .pcd, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
 
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (auto: ushort for 16-bit colours, else uchar; uchar; ushort; float),
 pcd_encoding (ascii, binary or binary_compressed),
-las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does), order (input or morton), no_colors, color_format (linear or
+las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does),
+crs (LAS/LAZ/COPC: "EPSG:32633", WKT or a .prj file's path, as convert's --crs; None: the source's), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");
 }
 

@@ -105,6 +105,7 @@ def write(
     ply_colors: str = "auto",
     pcd_encoding: str = "binary",
     las_scale: Optional[float] = None,
+    crs: Optional[str] = None,
     order: str = "input",
     no_colors: bool = False,
     color_format: str = "linear",

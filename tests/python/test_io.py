@@ -44,6 +44,24 @@ def test_las_round_trip_is_exact_on_its_grid(tmp_path, rng):
     assert np.array_equal(dpoint.read(tmp_path / "g.las").positions, positions)
 
 
+def test_las_takes_a_crs_as_convert_does(tmp_path, cloud):
+    pyproj = pytest.importorskip("pyproj")  # Debian's python3-pyproj (scripts/setup)
+    s, _, _ = cloud
+    dpoint.write(s, tmp_path / "c.las", crs="EPSG:32633", las_scale=0.01)
+    data = (tmp_path / "c.las").read_bytes()
+    assert data[25] == 4 and data[6] & 0x10  # LAS 1.4, the WKT bit
+    start = data.index(b'PROJCS["WGS 84 / UTM zone 33N"')
+    wkt = data[start:data.index(b"\0", start)].decode()
+    assert pyproj.CRS.from_wkt(wkt).to_epsg() == 32633
+    for path, crs, words in [(tmp_path / "c.ply", "EPSG:32633", "crs: only a .las, .laz or .copc.laz file"),
+                             (tmp_path / "d.las", "EPSG:999999", "crs 'EPSG:999999': not a coordinate reference system")]:
+        with pytest.raises(dpoint.Error) as raised:
+            dpoint.write(s, path, crs=crs)
+        assert words in str(raised.value)
+        assert raised.value.exit_code == 1
+        assert not path.exists()
+
+
 @pytest.mark.parametrize("ext", ["ply", "glb"])
 def test_a_mesh_keeps_its_triangles(tmp_path, ext):
     mesh = dpoint.generate("menger", level=1, colors="none")
