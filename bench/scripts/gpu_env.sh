@@ -10,3 +10,17 @@ export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 export LD_LIBRARY_PATH=$PWD/.gpu/lib
 out=${OUT:-/tmp/out}
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+
+# The sets of the render A/Bs (gpu_modes_ab.sh, gpu_phases_ab.sh), made once with the current build
+# in /tmp/dpoint-default: s11u (`sierpinski --level 11 --unwelded`, 16.8M points) or mb420 (the
+# res-420 Mandelbulb, 1.55M). Prints the file's path.
+default_set() {
+  local data=/tmp/dpoint-default
+  mkdir -p "$data"
+  case $1 in
+    s11u) [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply" ;;
+    mb420) [ -s "$data/mb420.ply" ] || .gpu/dpoint generate mandelbulb --resolution 420 -q -o "$data/mb420.ply" ;;
+    *) echo "default_set: no set '$1' (s11u or mb420)" >&2; return 1 ;;
+  esac
+  echo "$data/$1.ply"
+}

@@ -10,11 +10,7 @@
 #   BASE=A ROUNDS=2 MODES="fp32 split rte df64 native batch adaptive"
 set -euo pipefail
 source bench/scripts/gpu_env.sh
-data=/tmp/dpoint-default
-mkdir -p "$data"
-set=${SET:-s11u}
-[ "$set" != s11u ] || [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
-[ "$set" != mb420 ] || [ -s "$data/mb420.ply" ] || .gpu/dpoint generate mandelbulb --resolution 420 -q -o "$data/mb420.ply"
+file=$(default_set "${SET:-s11u}")
 rows=$out/modes.tsv
 printf 'round\tmode\tbuild\tgpu_ms_median\tprocess_ms\tpng\n' >"$rows"
 for round in $(seq "${ROUNDS:-2}"); do
@@ -24,7 +20,7 @@ for round in $(seq "${ROUNDS:-2}"); do
       [ "$build" = current ] && bin=.gpu/dpoint
       rm -f /tmp/r.json
       s=$(date +%s%N)
-      "$bin" render "$data/$set.ply" --mode "$mode" --frames "${FRAMES:-10}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1 || true
+      "$bin" render "$file" --mode "$mode" --frames "${FRAMES:-10}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1 || true
       e=$(date +%s%N)
       png=$( [ -f /tmp/m.png ] && sha256sum </tmp/m.png | cut -c1-16 || echo -)
       rm -f /tmp/m.png

@@ -7,11 +7,7 @@
 # $OUT/phases-median.tsv.
 set -euo pipefail
 source bench/scripts/gpu_env.sh
-data=/tmp/dpoint-default
-mkdir -p "$data"
-set=${SET:-s11u}
-[ "$set" != s11u ] || [ -s "$data/s11u.ply" ] || .gpu/dpoint generate sierpinski --level 11 --unwelded -q -o "$data/s11u.ply"
-[ "$set" != mb420 ] || [ -s "$data/mb420.ply" ] || .gpu/dpoint generate mandelbulb --resolution 420 -q -o "$data/mb420.ply"
+file=$(default_set "${SET:-s11u}")
 rows=$out/phases.tsv
 printf 'round\tmode\tbuild\tprocess_ms\tread\tspacing\tcamera\tdevice\tmode_ms\trender\tpng\tupload\n' >"$rows"
 for round in $(seq "${ROUNDS:-6}"); do
@@ -20,7 +16,7 @@ for round in $(seq "${ROUNDS:-6}"); do
       bin=.gpu/dpoint-$build
       [ "$build" = current ] && bin=.gpu/dpoint
       s=$(date +%s%N)
-      "$bin" render "$data/$set.ply" --mode "$mode" --frames "${FRAMES:-1}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1
+      "$bin" render "$file" --mode "$mode" --frames "${FRAMES:-1}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1
       e=$(date +%s%N)
       /usr/bin/python3 - "$round" "$mode" "$build" "$(( (e - s) / 1000000 ))" <<'PY' | tee -a "$rows"
 import json, sys
