@@ -464,7 +464,7 @@ class PlyParser {
         // Colours that came as integers 0..255 (a CSV's), so CSV → PLY → CSV writes them so again.
         if (w.size() == 4 && w[2] == "colours" && w[3] == "0..255") integer_colours_ = true;
         // A set read from LAS: its point format, version, scale and offset, and (since 2026-11-30)
-        // its global encoding, so that LAS → PLY → LAS writes the same coordinates in the same
+        // its global encoding and CRS records, so that LAS → PLY → LAS writes the same coordinates in the same
         // format, its GPS times of the same kind. Ignored unless all of it parses.
         if ((w.size() == 12 || w.size() == 13) && w[2] == "las" && w[3] == "frame") {
           LasSource las;
@@ -487,9 +487,39 @@ class PlyParser {
             points_.las = las;
           }
         }
+        // Its CRS records (after the frame, which they belong to): record K's bytes in hex over one
+        // or more lines ('-': none). A record with a bad line is left out.
+        if (w.size() == 9 && w[2] == "las" && w[3] == "crs" && points_.las) {
+          size_t index = 0;
+          uint16_t record_id = 0;
+          const std::string_view hex = w[8] == "-" ? std::string_view() : w[8];
+          bool ok = std::from_chars(w[4].data(), w[4].data() + w[4].size(), index).ec == std::errc() &&
+                    std::from_chars(w[6].data(), w[6].data() + w[6].size(), record_id).ec == std::errc() &&
+                    (w[7] == "0" || w[7] == "1") && hex.size() % 2 == 0 && w[5].size() <= 16 && index < 1024;
+          std::string bytes;
+          const auto nibble = [](char c) { return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1; };
+          for (size_t k = 0; ok && k < hex.size(); k += 2) {
+            const int hi = nibble(hex[k]), lo = nibble(hex[k + 1]);
+            ok = hi >= 0 && lo >= 0;
+            bytes.push_back(static_cast<char>(hi * 16 + lo));
+          }
+          if (crs_records_.size() <= index) crs_records_.resize(index + 1);
+          auto& [vlr, good] = crs_records_[index];
+          if (vlr.user_id.empty()) {  // its first line
+            vlr = LasVlr{std::string(w[5]), record_id, {}, {}, w[7] == "1"};
+            good = true;
+          }
+          good = good && ok && vlr.user_id == w[5] && vlr.record_id == record_id;
+          vlr.data += bytes;
+        }
       }
       if (key == "comment" || key == "obj_info") continue;
-      if (key == "end_header") break;
+      if (key == "end_header") {
+        if (points_.las)
+          for (auto& [vlr, good] : crs_records_)
+            if (good) points_.las->vlrs.push_back(std::move(vlr));
+        break;
+      }
       if (key == "format") {
         if (w.size() != 3) return headerError(line_no, "expected 'format ENCODING 1.0', found " + quote(line));
         if (w[1] == "ascii")
@@ -1325,6 +1355,7 @@ class PlyParser {
   std::vector<Role> vertex_roles_, face_roles_;
   bool has_colors_ = false;
   bool integer_colours_ = false;  // the header's `comment dpoint: colours 0..255`
+  std::vector<std::pair<LasVlr, bool>> crs_records_;  // the header's `las crs` records, each whole or not
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;
   uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)

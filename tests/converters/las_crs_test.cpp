@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "converters/las.h"
+#include "converters/point_io.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -185,6 +186,45 @@ TEST(LasCrs, aGivenCrsIsWktInALas14File) {
   ASSERT_EQ(back->las->vlrs.size(), 1u);
   EXPECT_EQ(back->las->vlrs[0].data, *wgs84 + '\0');
   EXPECT_EQ(report.crs, "the input's CRS (EPSG:26910, GeoTIFF keys) replaced by WGS 84");
+}
+
+// LAS → PLY → LAS keeps the CRS records byte for byte (header comments, in lines Open3D's PLY reader
+// takes: open3d_reads_ply_and_glb.py), VLRs and EVLRs, two records of one id included; a damaged
+// record's line leaves that record out and the file reads.
+TEST(LasCrs, plyCarriesTheCrsRecordsOfItsLasSource) {
+  TempDir dir;
+  const std::string corpus = std::string(DPOINT_CORPUS_DIR);
+  for (const std::string& source : {corpus + "/las/autzen.las", corpus + "/las/1_4_w_evlr.las", corpus + "/laz/1815.las"}) {
+    SCOPED_TRACE(source);
+    Result<PointSet> las = readPoints(source);
+    ASSERT_TRUE(las.ok()) << las.error().message;
+    ASSERT_FALSE(las->las->vlrs.empty());
+    ASSERT_TRUE(writePoints(dir.file("c.ply"), *las).ok());
+    Result<PointSet> ply = readPoints(dir.file("c.ply"));
+    ASSERT_TRUE(ply.ok()) << ply.error().message;
+    ASSERT_TRUE(ply->las.has_value());
+    ASSERT_EQ(ply->las->vlrs.size(), las->las->vlrs.size());
+    for (size_t k = 0; k < las->las->vlrs.size(); ++k) {
+      const LasVlr &a = las->las->vlrs[k], &b = ply->las->vlrs[k];
+      EXPECT_EQ(a.user_id, b.user_id);
+      EXPECT_EQ(a.record_id, b.record_id);
+      EXPECT_EQ(a.extended, b.extended);
+      EXPECT_EQ(a.data, b.data) << k;
+    }
+    EXPECT_EQ(lasCrsSummary(ply->las->vlrs), lasCrsSummary(las->las->vlrs));
+  }
+  // autzen's PLY with its second record's first line damaged: the others come back.
+  Result<PointSet> autzen = readPoints(corpus + "/las/autzen.las");
+  ASSERT_TRUE(autzen.ok());
+  ASSERT_TRUE(writePoints(dir.file("a.ply"), *autzen).ok());
+  std::string bytes = test::readFile(dir.file("a.ply"));
+  const size_t line = bytes.find("comment dpoint: las crs 1 ");
+  ASSERT_NE(line, std::string::npos);
+  bytes[bytes.find('\n', line) - 1] = 'x';  // not a hex digit
+  test::writeFile(dir.file("a.ply"), bytes);
+  Result<PointSet> damaged = readPoints(dir.file("a.ply"));
+  ASSERT_TRUE(damaged.ok()) << damaged.error().message;
+  EXPECT_EQ(damaged->las->vlrs.size(), autzen->las->vlrs.size() - 1);
 }
 
 }  // namespace

@@ -35,6 +35,18 @@ with scratch() as d:
         check(np.array_equal(got, want_points), f"point cloud {args}: positions differ (max {np.abs(got - want_points).max()})")
         check(np.allclose(np.asarray(cloud.colors), want_colors, atol=1e-7), f"point cloud {args}: colours differ")
 
+    # A PLY from a LAS file carries its frame and CRS records in header comments (autzen.las: GeoTIFF
+    # keys and two 720-byte WKT records), in lines RPly, Open3D's PLY reader, takes (at most 1,024
+    # bytes: a longer one aborted it).
+    corpus_las = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "corpus", "las",
+                              "autzen.las")
+    las_ply = os.path.join(d, "autzen.ply")
+    dpoint(exe, "convert", corpus_las, "-o", las_ply, "--ply-colors", "uchar")
+    header = open(las_ply, "rb").read().split(b"end_header", 1)[0]
+    check(b"comment dpoint: las crs" in header, "the PLY of a LAS file has no CRS comment")
+    check(max(len(line) for line in header.split(b"\n")) <= 1000, "a PLY header line over 1,000 bytes")
+    check(len(o3d.io.read_point_cloud(las_ply).points) == 106, "Open3D reads other than autzen.las's 106 points")
+
     # PTS both ways: dpoint's (count line, x y z r g b with 0-255 colours) read by Open3D, and
     # Open3D's (x y z intensity r g b, ten decimals) read by dpoint as the points Open3D reads back.
     pts = os.path.join(d, "cloud.pts")
