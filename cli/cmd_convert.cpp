@@ -2,6 +2,7 @@
 // selection (converters/gltf_read.h says what a glTF file turns into, converters/las.h a LAS file).
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "cli/cli_check.h"
 #include "cli/cli_output.h"
@@ -35,7 +36,7 @@ struct ConvertOptions {
   uint64_t max_points = 0;
   std::string order = "input";
   double las_scale = 0.0;  // 0: the input LAS file's, else chosen from the data
-  std::string crs;  // --crs: EPSG:CODE, WKT or a file holding it; empty: the input's CRS records
+  std::optional<std::string> crs;  // --crs: EPSG:CODE, WKT or a file holding it; none: the input's CRS records
   DimensionChoice dimensions;  // --keep, --drop
   std::string max_memory;
   uint64_t memory_limit = 0;  // max_memory parsed
@@ -90,13 +91,13 @@ int runConvert(ConvertOptions& o) {
   w.pcd_encoding = *parsePcdEncoding(o.pcd_encoding);  // checked by the option's validator
   w.progress = &progress;
   w.las_scale = o.las_scale;
-  if (!o.crs.empty()) {
+  if (o.crs) {
     const Result<FileFormat> las = formatOf(o.output);
     if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
       return reportError(Error{"--crs: only a LAS, LAZ or COPC output holds a coordinate reference system, not " +
                                    quotedExcerpt(o.output),
                                ExitCode::kUsage});
-    Result<std::string> wkt = crsAsWkt(o.crs);
+    Result<std::string> wkt = crsAsWkt(*o.crs);
     if (!wkt) return reportError(wkt.error());
     w.las_crs = std::move(*wkt);
   }

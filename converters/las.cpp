@@ -627,12 +627,12 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   // Formats 6-10 hold their CRS as WKT alone: GeoTIFF keys are made WKT (converters/las_crs.h).
   std::vector<LasVlr> crs = source ? source->vlrs : std::vector<LasVlr>();
   if (!crs_wkt.empty()) {  // the CRS given, as WKT, in a LAS 1.4 file
-    const std::string before = lasCrsSummary(crs);
+    const std::string before = source ? lasCrsSummary(crs, lasSaysWkt(*source)) : std::string();
     if (!before.empty()) l.crs_note = "the input's CRS (" + before + ") replaced by " + wktName(crs_wkt);
     crs = {lasWktRecord(crs_wkt)};
     l.global_encoding |= 0x10;
   } else if (l.format >= 6) {
-    LasWktCrs wkt = lasWktCrs(crs);
+    LasWktCrs wkt = lasWktCrs(crs, source && lasSaysWkt(*source));
     crs = std::move(wkt.records);
     l.crs_note = std::move(wkt.note);
   }

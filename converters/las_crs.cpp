@@ -5,6 +5,7 @@
 #include <proj_experimental.h>
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -23,7 +24,7 @@ namespace {
 
 constexpr uint16_t kWktRecord = 2112, kGeoKeys = 34735, kGeoDoubles = 34736, kGeoAscii = 34737;
 // GeoTIFF keys (GeoTIFF 1.1, section 7) the conversion and the summary read.
-constexpr uint16_t kCitation = 1026, kGeographicType = 2048, kGeographicCitation = 2049, kProjectedType = 3072,
+constexpr uint16_t kModelType = 1024, kCitation = 1026, kGeographicType = 2048, kGeographicCitation = 2049, kProjectedType = 3072,
                    kProjectedCitation = 3073, kProjLinearUnits = 3076, kVerticalType = 4096, kVerticalUnits = 4099;
 constexpr uint16_t kUserDefined = 32767;
 
@@ -88,13 +89,39 @@ std::optional<GeoKeys> geoKeys(const std::vector<LasVlr>& vlrs) {
   return keys;
 }
 
+// The horizontal EPSG code the keys give, as their model type says (1: projected, ProjectedCSType;
+// 2: geographic, GeographicType; without one, whichever is there), with the linear unit key of a
+// projected one; or why none.
+struct Horizontal {
+  uint16_t code = 0;
+  std::optional<uint16_t> unit;
+};
+Result<Horizontal> horizontalOf(const GeoKeys& keys) {
+  const auto model = keys.shorts.find(kModelType);
+  const bool projected = model != keys.shorts.end() && model->second == 1;
+  const bool geographic = model != keys.shorts.end() && model->second == 2;
+  if (!geographic)
+    if (std::optional<uint16_t> code = keys.code(kProjectedType)) return Horizontal{*code, keys.code(kProjLinearUnits)};
+  if (projected) {
+    return Error{keys.shorts.count(kProjectedType)
+                     ? "the keys define their projection by parameters, not by an EPSG code, and dpoint makes WKT of "
+                       "EPSG codes only"
+                     : "the keys say projected but name no projected CRS"};
+  }
+  if (std::optional<uint16_t> code = keys.code(kGeographicType)) return Horizontal{*code, std::nullopt};
+  if (keys.shorts.count(kGeographicType) || keys.shorts.count(kProjectedType))
+    return Error{"the keys define their CRS by parameters, not by an EPSG code, and dpoint makes WKT of EPSG codes only"};
+  return Error{"the keys name no horizontal CRS"};
+}
+
 std::string epsg(uint16_t code) { return "EPSG:" + std::to_string(code); }
 
 // "EPSG:26910 + EPSG:5703" or "user-defined", and the keys' citation in brackets where they have one.
 std::string keysName(const GeoKeys& keys) {
-  std::optional<uint16_t> horizontal = keys.code(kProjectedType);
-  if (!horizontal) horizontal = keys.code(kGeographicType);
-  std::string name = horizontal ? epsg(*horizontal) : "a user-defined CRS";
+  Result<Horizontal> horizontal = horizontalOf(keys);
+  std::string name = horizontal                               ? epsg(horizontal->code)
+                     : keys.shorts.count(kProjectedType) || keys.shorts.count(kGeographicType) ? "a user-defined CRS"
+                                                                                                : "no horizontal CRS";
   if (std::optional<uint16_t> vertical = keys.code(kVerticalType)) name += " + " + epsg(*vertical);
   for (uint16_t key : {kProjectedCitation, kCitation, kGeographicCitation}) {  // the first that names something
     const std::string citation = keys.text(key);
@@ -114,6 +141,7 @@ struct ProjApi {
   decltype(&proj_create_from_database) create_from_database = nullptr;
   decltype(&proj_destroy) destroy = nullptr;
   decltype(&proj_get_name) get_name = nullptr;
+  decltype(&proj_get_type) get_type = nullptr;
   decltype(&proj_as_wkt) as_wkt = nullptr;
   decltype(&proj_crs_get_coordinate_system) crs_get_coordinate_system = nullptr;
   decltype(&proj_cs_get_axis_info) cs_get_axis_info = nullptr;
@@ -142,6 +170,7 @@ ProjApi loadProj() {
   bind(api.create_from_database, "proj_create_from_database");
   bind(api.destroy, "proj_destroy");
   bind(api.get_name, "proj_get_name");
+  bind(api.get_type, "proj_get_type");
   bind(api.as_wkt, "proj_as_wkt");
   bind(api.crs_get_coordinate_system, "proj_crs_get_coordinate_system");
   bind(api.cs_get_axis_info, "proj_cs_get_axis_info");
@@ -196,7 +225,7 @@ class Proj {
       return Error{"its linear unit EPSG:" + wanted + " is not a linear unit in PROJ's database"};
     PJ* altered = keep(api_.crs_alter_cs_linear_unit(context_, crs, name, factor, "EPSG", wanted.c_str()));
     if (!altered) return Error{"PROJ cannot give " + epsg(code) + " the linear unit EPSG:" + wanted};
-    if (changed) *changed += std::string(changed->empty() ? "" : ", ") + "in " + name;
+    if (changed) *changed += std::string(changed->empty() ? "" : "; ") + epsg(code) + " in the keys' unit, " + name;
     return altered;
   }
 
@@ -207,31 +236,39 @@ class Proj {
 };
 
 // The keys' CRS as OGC WKT 1, or why not.
-Result<std::string> keysAsWkt(const GeoKeys& keys) {
-  std::optional<uint16_t> horizontal = keys.code(kProjectedType);
-  std::optional<uint16_t> unit = keys.code(kProjLinearUnits);
-  if (!horizontal) {
-    horizontal = keys.code(kGeographicType);
-    unit.reset();
-  }
-  if (!horizontal) return Error{"the keys define it by parameters, not by an EPSG code, and dpoint makes WKT of EPSG codes only"};
+// WKT 1 of `crs`: one line; a 3D geographic CRS as a compound of its 2D one and ellipsoidal
+// heights, as WKT 1 has no 3D geographic CRS (GDAL writes the same).
+const char* wkt1(const ProjApi& api, Proj& proj, PJ* crs) {
+  const char* const options[] = {"MULTILINE=NO", "ALLOW_ELLIPSOIDAL_HEIGHT_AS_VERTICAL_CRS=YES", nullptr};
+  return api.as_wkt(proj.context(), crs, PJ_WKT1_GDAL, options);
+}
+
+// The keys' CRS as OGC WKT 1, or why not. `changed` gets what the WKT says other than the codes (a
+// unit of the keys', a vertical code left out).
+Result<std::string> keysAsWkt(const GeoKeys& keys, std::string* changed) {
+  Result<Horizontal> horizontal = horizontalOf(keys);
+  if (!horizontal) return horizontal.error();
   const ProjApi& api = projApi();
   if (!api.error.empty()) return Error{api.error};
   Proj proj(api);
   if (!proj.context()) return Error{"PROJ cannot make a context"};
-  std::string changed;
-  Result<PJ*> crs = proj.crs(*horizontal, unit, &changed);
+  Result<PJ*> crs = proj.crs(horizontal->code, horizontal->unit, changed);
   if (!crs) return crs.error();
   PJ* result = *crs;
   if (std::optional<uint16_t> vertical_code = keys.code(kVerticalType)) {
-    Result<PJ*> vertical = proj.crs(*vertical_code, keys.code(kVerticalUnits), &changed);
-    if (!vertical) return vertical.error();
-    const std::string name = std::string(api.get_name(*crs)) + " + " + api.get_name(*vertical);
-    result = proj.keep(api.create_compound_crs(proj.context(), name.c_str(), *crs, *vertical));
-    if (!result) return Error{"PROJ cannot combine " + epsg(*horizontal) + " and " + epsg(*vertical_code)};
+    // GeoTIFF 1.0's codes 5001-5035 are ellipsoidal heights, no EPSG vertical CRS: such a code (or
+    // one PROJ does not know) leaves the vertical part out, not the whole CRS.
+    Result<PJ*> vertical = proj.crs(*vertical_code, keys.code(kVerticalUnits), changed);
+    if (vertical && api.get_type(*vertical) == PJ_TYPE_VERTICAL_CRS) {
+      const std::string name = std::string(api.get_name(*crs)) + " + " + api.get_name(*vertical);
+      result = proj.keep(api.create_compound_crs(proj.context(), name.c_str(), *crs, *vertical));
+      if (!result) return Error{"PROJ cannot combine " + epsg(horizontal->code) + " and " + epsg(*vertical_code)};
+    } else if (changed) {
+      *changed += std::string(changed->empty() ? "" : "; ") + "its vertical code " + std::to_string(*vertical_code) +
+                  " left out: not a vertical CRS in PROJ's database";
+    }
   }
-  const char* const options[] = {"MULTILINE=NO", nullptr};
-  const char* wkt = api.as_wkt(proj.context(), result, PJ_WKT1_GDAL, options);
+  const char* wkt = wkt1(api, proj, result);
   if (!wkt) return Error{"PROJ cannot write " + keysName(keys) + " as WKT 1"};
   return std::string(wkt);
 }
@@ -252,13 +289,23 @@ LasVlr lasWktRecord(const std::string& wkt) {
 
 Result<std::string> crsAsWkt(const std::string& text) {
   const std::string what = "--crs " + quotedExcerpt(text);
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    return Error{what + ": empty; give EPSG:CODE, WKT, or a file holding WKT", ExitCode::kUsage};
+  // A regular file by that name holds the definition (a .prj); else the text is one.
   std::string definition = text;
-  if (text.find_first_of("[:{+") == std::string::npos) {  // no code, WKT, JSON or PROJ string: a file
-    std::ifstream file{text};
-    if (!file) return Error{what + ": no such file, and not EPSG:CODE or WKT", ExitCode::kUsage};
+  std::error_code error;
+  if (std::filesystem::is_regular_file(text, error)) {
+    constexpr uintmax_t kMaxBytes = uintmax_t{1} << 20;
+    if (std::filesystem::file_size(text, error) > kMaxBytes)
+      return Error{what + ": a file over 1 MiB, not a CRS definition", ExitCode::kUsage};
+    std::ifstream file{text, std::ios::binary};
     std::ostringstream read;
     read << file.rdbuf();
+    if (!file) return Error{what + ": cannot be read", ExitCode::kUsage};
     definition = read.str();
+    if (definition.rfind("\xEF\xBB\xBF", 0) == 0) definition.erase(0, 3);  // a UTF-8 byte order mark
+  } else if (text.find_first_of("[:{+") == std::string::npos) {
+    return Error{what + ": no such file, and not EPSG:CODE, WKT, PROJJSON or a PROJ string", ExitCode::kUsage};
   }
   const ProjApi& api = projApi();
   if (!api.error.empty()) return Error{what + ": " + api.error, ExitCode::kUsage};
@@ -266,53 +313,86 @@ Result<std::string> crsAsWkt(const std::string& text) {
   if (!proj.context()) return Error{what + ": PROJ cannot make a context", ExitCode::kUsage};
   PJ* crs = proj.keep(api.create(proj.context(), definition.c_str()));
   if (!crs || !api.is_crs(crs))
-    return Error{what + ": not a coordinate reference system PROJ knows (give EPSG:CODE, WKT, or a file holding WKT)",
+    return Error{what + ": not a coordinate reference system PROJ knows (give EPSG:CODE, WKT, PROJJSON, a PROJ "
+                        "string with +type=crs, or a file holding one)",
                  ExitCode::kUsage};
-  const char* const options[] = {"MULTILINE=NO", nullptr};
-  const char* wkt = api.as_wkt(proj.context(), crs, PJ_WKT1_GDAL, options);
+  const char* wkt = wkt1(api, proj, crs);
   if (!wkt) return Error{what + ": PROJ cannot write it as WKT 1, the WKT LAS takes", ExitCode::kUsage};
   return std::string(wkt);
 }
 
-LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs) {
+namespace {
+
+// A WKT's name for a message: at most 100 characters.
+std::string shortName(const std::string& wkt) {
+  std::string name = wktName(wkt);
+  if (name.size() > 100) name = name.substr(0, 97) + "...";
+  return name.empty() ? std::string("unnamed") : name;
+}
+
+bool isLasWkt(const LasVlr& v) { return isLasfProjection(v, kWktRecord) && !wktText(v.data).empty(); }
+bool isLiblasText(const LasVlr& v) { return isLiblasWkt(v) && !wktText(v.data).empty(); }
+
+}  // namespace
+
+LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit) {
+  // The source's CRS, as LAS says which record holds it: the WKT record where the global encoding
+  // says WKT, else the GeoTIFF keys (a LAS 1.2 file's), else a WKT record all the same, else
+  // libLAS's. The result holds one WKT record and no GeoTIFF keys.
   LasWktCrs out;
-  for (const LasVlr& vlr : vlrs)  // GeoTIFF keys are left out: formats 6-10 take WKT alone
-    if (!isGeoTiffRecord(vlr)) out.records.push_back(vlr);
-  if (findRecord(vlrs, [](const LasVlr& v) { return isLasfProjection(v, kWktRecord); })) return out;
-  // libLAS's WKT record becomes the LAS one; else the keys' CRS is made WKT.
-  for (LasVlr& record : out.records)
-    if (isLiblasWkt(record) && !wktText(record.data).empty()) {
-      const std::string text = wktText(record.data);
-      record = LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", text + '\0', record.extended};
-      out.note = "libLAS's WKT record (" + wktName(text) + ") written as the LAS WKT record (LASF_Projection 2112)";
+  const LasVlr* wkt = findRecord(vlrs, isLasWkt);
+  const std::optional<GeoKeys> keys = geoKeys(vlrs);
+  const auto keep = [&](bool (*except)(const LasVlr&)) {  // every record but the CRS ones, and `except`'s
+    for (const LasVlr& vlr : vlrs)
+      if (!isGeoTiffRecord(vlr) && !isLasfProjection(vlr, kWktRecord) && !isLiblasWkt(vlr)) out.records.push_back(vlr);
+    if (except)
+      if (const LasVlr* record = findRecord(vlrs, except)) out.records.push_back(*record);
+  };
+  if (wkt && (wkt_bit || !keys)) {
+    keep(isLasWkt);
+    return out;
+  }
+  std::string why;
+  if (keys) {
+    std::string changed;
+    Result<std::string> text = keysAsWkt(*keys, &changed);
+    if (text) {
+      keep(nullptr);
+      out.records.push_back(lasWktRecord(*text));
+      out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", written as WKT (" + shortName(*text) + ")";
+      if (!changed.empty()) out.note += ": " + changed;
       return out;
     }
-  const std::optional<GeoKeys> keys = geoKeys(vlrs);
-  if (!keys) return out;
-  Result<std::string> text = keysAsWkt(*keys);
-  if (text) {
-    out.records.push_back(lasWktRecord(*text));
-    out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", written as WKT (" + wktName(*text) + ")";
-  } else {
-    out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", is left out and the file has no CRS: " +
-               text.error().message;
+    why = text.error().message;
   }
+  if (wkt) {
+    keep(isLasWkt);
+    out.note = "its WKT record (" + shortName(wktText(wkt->data)) + ") kept, the GeoTIFF keys (" + keysName(*keys) +
+               ") left out: " + why;
+    return out;
+  }
+  if (const LasVlr* liblas = findRecord(vlrs, isLiblasText)) {
+    keep(nullptr);
+    const std::string text = wktText(liblas->data);
+    out.records.push_back(lasWktRecord(text));
+    out.note = "libLAS's WKT record (" + shortName(text) + ") written as the LAS WKT record (LASF_Projection 2112)";
+    if (keys) out.note += "; the GeoTIFF keys (" + keysName(*keys) + ") left out: " + why;
+    return out;
+  }
+  keep(nullptr);
+  if (keys) out.note = "the GeoTIFF keys' CRS, " + keysName(*keys) + ", is left out and the file has no CRS: " + why;
   return out;
 }
 
-std::string lasCrsSummary(const std::vector<LasVlr>& vlrs) {
-  // The LAS WKT record, else the GeoTIFF keys (a LAS 1.2 file's CRS), else libLAS's WKT record.
-  const auto named = [](const LasVlr* record, const char* what) {
-    const std::string text = record ? wktText(record->data) : std::string();
-    if (text.empty()) return std::string();
-    const std::string name = wktName(text);
-    return (name.empty() ? std::string("unnamed") : name) + what;
-  };
-  std::string summary = named(findRecord(vlrs, [](const LasVlr& v) { return isLasfProjection(v, kWktRecord); }), ", WKT");
-  if (summary.empty())
-    if (std::optional<GeoKeys> keys = geoKeys(vlrs)) summary = keysName(*keys) + ", GeoTIFF keys";
-  if (summary.empty()) summary = named(findRecord(vlrs, isLiblasWkt), ", libLAS's WKT");
-  return summary;
+std::string lasCrsSummary(const std::vector<LasVlr>& vlrs, bool wkt_bit) {
+  // As lasWktCrs chooses: the WKT record where the global encoding says WKT, else the GeoTIFF keys,
+  // else a WKT record, else libLAS's.
+  const LasVlr* wkt = findRecord(vlrs, isLasWkt);
+  const std::optional<GeoKeys> keys = geoKeys(vlrs);
+  if (wkt && (wkt_bit || !keys)) return shortName(wktText(wkt->data)) + ", WKT";
+  if (keys) return keysName(*keys) + ", GeoTIFF keys";
+  if (const LasVlr* liblas = findRecord(vlrs, isLiblasText)) return shortName(wktText(liblas->data)) + ", libLAS's WKT";
+  return {};
 }
 
 }  // namespace dpoint

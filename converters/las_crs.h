@@ -31,9 +31,11 @@ struct LasWktCrs {
 };
 
 // The CRS records for a file whose global encoding says WKT (point formats 6–10): `vlrs` are the
-// source's CRS records (isCrsRecord's, VLRs and EVLRs). Never fails: a CRS that cannot be made WKT
-// is left out, with a note saying why.
-LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs);
+// source's CRS records (isCrsRecord's, VLRs and EVLRs), `wkt_bit` its global encoding's WKT bit.
+// The source's CRS is its WKT record where that bit is set, else its GeoTIFF keys (made WKT), else
+// a WKT record all the same, else libLAS's. Never fails: a CRS that cannot be made WKT is left
+// out, with a note saying why.
+LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit);
 
 // The CRS that `text` gives (EPSG:CODE or another authority's code, WKT 1 or 2, PROJJSON, or the
 // path of a file holding one, such as a .prj), as one line of OGC WKT 1 for a LAS WKT record
@@ -46,9 +48,13 @@ LasVlr lasWktRecord(const std::string& wkt);
 // The name a WKT gives its CRS (its first quoted string); empty when it has none.
 std::string wktName(const std::string& wkt);
 
+// Whether a LAS source's CRS is WKT: its global encoding's WKT bit, or a point format 6–10, which
+// takes WKT whatever the bit says.
+inline bool lasSaysWkt(const LasSource& source) { return (source.global_encoding & 0x10) != 0 || source.point_format >= 6; }
+
 // One line naming the CRS of these records without PROJ, for `info`: the WKT's name, or the GeoTIFF
 // keys' EPSG codes and citation ("EPSG:26910 + EPSG:5703 (NAD83 / UTM zone 10N), GeoTIFF keys");
 // empty when there are none.
-std::string lasCrsSummary(const std::vector<LasVlr>& vlrs);
+std::string lasCrsSummary(const std::vector<LasVlr>& vlrs, bool wkt_bit);
 
 }  // namespace dpoint

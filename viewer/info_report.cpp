@@ -248,7 +248,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (header) {
     const PointSetInfo& info = report->info;
     const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
-    report->las = LasFacts{std::move(*header), bounds_hold, points->las ? lasCrsSummary(points->las->vlrs) : ""};
+    report->las = LasFacts{std::move(*header), bounds_hold, points->las ? lasCrsSummary(points->las->vlrs, lasSaysWkt(*points->las)) : ""};
   }
   return report;
 }

@@ -188,7 +188,7 @@ TEST(CliLas, infoPrintsTheLasHeader) {
   test::CommandResult wrong = runDpoint({"info", kCorpus + "simple1_3.las", "--json"});
   ASSERT_EQ(wrong.exit_code, 0) << wrong.err;
   for (const char* part : {"\"las\": {\"version\": \"1.3\", \"point_format\": 4, \"record_length\": 57, \"points\": 999",
-                           "\"header_bounds_hold\": false", "\"points\": 999,", "\"crs\": \"a user-defined CRS + EPSG:5030, GeoTIFF keys\""})
+                           "\"header_bounds_hold\": false", "\"points\": 999,", "\"crs\": \"no horizontal CRS + EPSG:5030, GeoTIFF keys\""})
     EXPECT_NE(wrong.out.find(part), std::string::npos) << part << " in\n" << wrong.out;
 }
 

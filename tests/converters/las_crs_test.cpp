@@ -47,7 +47,7 @@ const LasVlr* find(const std::vector<LasVlr>& records, const std::string& user, 
 
 TEST(LasCrs, geoTiffKeysBecomeWktWithTheirUnitAndVerticalCrs) {
   // NAD83 / UTM zone 10N (metres in EPSG) whose keys say US survey feet, over NAVD88 height in feet.
-  const LasWktCrs crs = lasWktCrs({geoKeys({{1024, 1}, {3072, 26910}, {3076, 9003}, {4096, 5703}, {4099, 9003}})});
+  const LasWktCrs crs = lasWktCrs({geoKeys({{1024, 1}, {3072, 26910}, {3076, 9003}, {4096, 5703}, {4099, 9003}})}, false);
   ASSERT_EQ(crs.records.size(), 1u);
   const LasVlr& record = crs.records[0];
   EXPECT_EQ(record.user_id, "LASF_Projection");
@@ -61,10 +61,33 @@ TEST(LasCrs, geoTiffKeysBecomeWktWithTheirUnitAndVerticalCrs) {
   EXPECT_EQ(text.find('\n'), std::string::npos) << "one line";
   EXPECT_NE(crs.note.find("EPSG:26910 + EPSG:5703"), std::string::npos) << crs.note;
   EXPECT_NE(crs.note.find("written as WKT"), std::string::npos) << crs.note;
+  EXPECT_NE(crs.note.find("EPSG:26910 in the keys' unit, US survey foot"), std::string::npos) << crs.note;
+}
+
+// What GDAL, libgeotiff and LAStools write: a projection by parameters on an EPSG geographic base
+// (model type 1, ProjectedCSType 32767, GeographicType 4269) is no lat/lon CRS; GeoTIFF 1.0's
+// ellipsoidal-height code 5030 leaves the vertical part out, not the projected CRS; keys beside a
+// libLAS WKT record or an empty WKT record are the LAS 1.2 file's CRS.
+TEST(LasCrs, keysAreReadAsGeoTiffMeansThem) {
+  const LasWktCrs custom = lasWktCrs({geoKeys({{1024, 1}, {2048, 4269}, {3072, 32767}})}, false);
+  EXPECT_TRUE(custom.records.empty());
+  EXPECT_NE(custom.note.find("projection by parameters"), std::string::npos) << custom.note;
+  EXPECT_NE(lasWktCrs({geoKeys({{1024, 1}, {2048, 4269}})}, false).note.find("name no projected CRS"), std::string::npos);
+  const LasWktCrs ellipsoidal = lasWktCrs({geoKeys({{1024, 1}, {3072, 32632}, {4096, 5030}})}, false);
+  ASSERT_EQ(ellipsoidal.records.size(), 1u) << ellipsoidal.note;
+  EXPECT_EQ(ellipsoidal.records[0].data.rfind("PROJCS[\"WGS 84 / UTM zone 32N\"", 0), 0u);
+  EXPECT_NE(ellipsoidal.note.find("vertical code 5030 left out"), std::string::npos) << ellipsoidal.note;
+  const LasWktCrs beside = lasWktCrs({geoKeys({{1024, 1}, {3072, 26910}}), wkt("liblas", "PROJCS[\"WGS 84 / UTM zone 33N\"]")}, false);
+  ASSERT_EQ(beside.records.size(), 1u);
+  EXPECT_NE(beside.records[0].data.find("UTM zone 10N"), std::string::npos);
+  const LasWktCrs empty = lasWktCrs({geoKeys({{1024, 1}, {3072, 26910}}), wkt("LASF_Projection", "")}, false);
+  ASSERT_EQ(empty.records.size(), 1u);
+  EXPECT_NE(empty.records[0].data.find("UTM zone 10N"), std::string::npos);
+  EXPECT_EQ(lasCrsSummary({geoKeys({{1024, 1}, {2048, 4269}, {3072, 32767}})}, false), "a user-defined CRS, GeoTIFF keys");
 }
 
 TEST(LasCrs, aGeographicCrsIsMadeWktToo) {
-  const LasWktCrs crs = lasWktCrs({geoKeys({{1024, 2}, {2048, 4326}, {2054, 9102}})});
+  const LasWktCrs crs = lasWktCrs({geoKeys({{1024, 2}, {2048, 4326}, {2054, 9102}})}, false);
   ASSERT_EQ(crs.records.size(), 1u);
   EXPECT_EQ(crs.records[0].data.rfind("GEOGCS[\"WGS 84\"", 0), 0u) << crs.records[0].data;
 }
@@ -72,41 +95,43 @@ TEST(LasCrs, aGeographicCrsIsMadeWktToo) {
 TEST(LasCrs, aCrsWithoutAnEpsgCodeIsLeftOutWithANote) {
   for (const LasVlr& keys : {geoKeys({{1024, 1}, {3072, 32767}}), geoKeys({{1024, 1}}),
                              geoKeys({{1024, 1}, {3072, 60000}}), geoKeys({{1024, 1}, {3072, 26910}, {3076, 9102}})}) {
-    const LasWktCrs crs = lasWktCrs({keys});
+    const LasWktCrs crs = lasWktCrs({keys}, false);
     EXPECT_TRUE(crs.records.empty());
     EXPECT_NE(crs.note.find("left out and the file has no CRS"), std::string::npos) << crs.note;
   }
   // Why, in the note: no code, a code PROJ does not know, a unit that is an angle.
-  EXPECT_NE(lasWktCrs({geoKeys({{3072, 32767}})}).note.find("by parameters"), std::string::npos);
-  EXPECT_NE(lasWktCrs({geoKeys({{3072, 60000}})}).note.find("EPSG:60000 is not a CRS"), std::string::npos);
-  EXPECT_NE(lasWktCrs({geoKeys({{3072, 26910}, {3076, 9102}})}).note.find("not a linear unit"), std::string::npos);
+  EXPECT_NE(lasWktCrs({geoKeys({{3072, 32767}})}, false).note.find("by parameters"), std::string::npos);
+  EXPECT_NE(lasWktCrs({geoKeys({{3072, 60000}})}, false).note.find("EPSG:60000 is not a CRS"), std::string::npos);
+  EXPECT_NE(lasWktCrs({geoKeys({{3072, 26910}, {3076, 9102}})}, false).note.find("not a linear unit"), std::string::npos);
 }
 
 TEST(LasCrs, libLasWktBecomesTheLasRecordAndWktStaysAsItIs) {
   const std::string text = "PROJCS[\"NAD83 / UTM zone 10N\",GEOGCS[\"NAD83\"]]";
-  const LasWktCrs from_liblas = lasWktCrs({geoKeys({{3072, 26910}}), wkt("liblas", text)});
+  const LasWktCrs from_liblas = lasWktCrs({geoKeys({{3072, 32767}}), wkt("liblas", text)}, false);
   ASSERT_EQ(from_liblas.records.size(), 1u);  // the keys are left out beside WKT
   EXPECT_EQ(from_liblas.records[0].user_id, "LASF_Projection");
   EXPECT_EQ(from_liblas.records[0].data, text + '\0');
   EXPECT_NE(from_liblas.note.find("libLAS's WKT record (NAD83 / UTM zone 10N)"), std::string::npos) << from_liblas.note;
 
   // A WKT record already there (an EVLR here) is kept as it is, with no note; the keys go.
-  const LasWktCrs kept = lasWktCrs({geoKeys({{3072, 26910}}), wkt("LASF_Projection", text, true)});
+  const LasWktCrs kept = lasWktCrs({geoKeys({{3072, 26910}}), wkt("LASF_Projection", text, true)}, true);
   ASSERT_EQ(kept.records.size(), 1u);
   EXPECT_TRUE(kept.records[0].extended);
   EXPECT_TRUE(kept.note.empty()) << kept.note;
-  EXPECT_TRUE(lasWktCrs({}).records.empty());
-  EXPECT_TRUE(lasWktCrs({}).note.empty());
+  EXPECT_TRUE(lasWktCrs({}, false).records.empty());
+  EXPECT_TRUE(lasWktCrs({}, false).note.empty());
 }
 
 TEST(LasCrs, summaryNamesTheCrsWithoutProj) {
-  EXPECT_EQ(lasCrsSummary({}), "");
-  EXPECT_EQ(lasCrsSummary({geoKeys({{1024, 1}, {3072, 26910}, {4096, 5703}})}), "EPSG:26910 + EPSG:5703, GeoTIFF keys");
-  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 32767}})}), "a user-defined CRS, GeoTIFF keys");
-  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 26910}}), wkt("LASF_Projection", "PROJCS[\"A\",X]")}), "A, WKT");
-  EXPECT_EQ(lasCrsSummary({wkt("liblas", "PROJCS[\"B\",X]")}), "B, libLAS's WKT");
+  EXPECT_EQ(lasCrsSummary({}, false), "");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{1024, 1}, {3072, 26910}, {4096, 5703}})}, false), "EPSG:26910 + EPSG:5703, GeoTIFF keys");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 32767}})}, false), "a user-defined CRS, GeoTIFF keys");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 26910}}), wkt("LASF_Projection", "PROJCS[\"A\",X]")}, true), "A, WKT");
+  EXPECT_EQ(lasCrsSummary({geoKeys({{3072, 26910}}), wkt("LASF_Projection", "PROJCS[\"A\",X]")}, false),
+            "EPSG:26910, GeoTIFF keys");  // a LAS 1.2 file's CRS is its keys
+  EXPECT_EQ(lasCrsSummary({wkt("liblas", "PROJCS[\"B\",X]")}, false), "B, libLAS's WKT");
   // A LAS 1.2 file's CRS is its keys, whatever libLAS wrote beside them.
-  EXPECT_EQ(lasCrsSummary({wkt("liblas", "PROJCS[\"B\",X]"), geoKeys({{3072, 26910}})}), "EPSG:26910, GeoTIFF keys");
+  EXPECT_EQ(lasCrsSummary({wkt("liblas", "PROJCS[\"B\",X]"), geoKeys({{3072, 26910}})}, false), "EPSG:26910, GeoTIFF keys");
 }
 
 // The writer: format 6 (COPC's, or --las14) gets the WKT and drops the keys, with a note in its
@@ -158,7 +183,18 @@ TEST(LasCrs, aGivenCrsIsWktInALas14File) {
       "AXIS[\"longitude\",east,ANGLEUNIT[\"degree\",0.0174532925199433]]]");
   ASSERT_TRUE(from_wkt2.ok()) << from_wkt2.error().message;
   EXPECT_EQ(from_wkt2->rfind("GEOGCS[\"WGS 84\"", 0), 0u) << *from_wkt2;
-  for (const char* bad : {"EPSG:999999", "PROJCS[", "+proj=tmerc +nonsense", "no-such-file.prj"}) {
+  // A 3D geographic CRS as WKT 1 holds it: the 2D one and ellipsoidal heights.
+  Result<std::string> wgs84_3d = crsAsWkt("EPSG:4979");
+  ASSERT_TRUE(wgs84_3d.ok()) << wgs84_3d.error().message;
+  EXPECT_EQ(wgs84_3d->rfind("COMPD_CS[", 0), 0u) << *wgs84_3d;
+  // A .prj with a UTF-8 byte order mark, by a name with a '+'.
+  TempDir prj;
+  test::writeFile(prj.file("utm+33.prj"), "\xEF\xBB\xBF" + *crsAsWkt("EPSG:32633"));
+  Result<std::string> from_file = crsAsWkt(prj.file("utm+33.prj"));
+  ASSERT_TRUE(from_file.ok()) << from_file.error().message;
+  EXPECT_EQ(*from_file, *crsAsWkt("EPSG:32633"));
+  for (const std::string& bad : {std::string("EPSG:999999"), std::string("PROJCS["), std::string("+proj=tmerc +nonsense"),
+                                 std::string("no-such-file.prj"), std::string(""), std::string("  "), prj.path()}) {
     Result<std::string> wkt = crsAsWkt(bad);
     EXPECT_FALSE(wkt.ok()) << bad;
     if (!wkt.ok()) {
@@ -211,7 +247,7 @@ TEST(LasCrs, plyCarriesTheCrsRecordsOfItsLasSource) {
       EXPECT_EQ(a.extended, b.extended);
       EXPECT_EQ(a.data, b.data) << k;
     }
-    EXPECT_EQ(lasCrsSummary(ply->las->vlrs), lasCrsSummary(las->las->vlrs));
+    EXPECT_EQ(lasCrsSummary(ply->las->vlrs, lasSaysWkt(*ply->las)), lasCrsSummary(las->las->vlrs, lasSaysWkt(*las->las)));
   }
   // autzen's PLY with its second record's first line damaged: the others come back.
   Result<PointSet> autzen = readPoints(corpus + "/las/autzen.las");
