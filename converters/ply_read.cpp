@@ -464,8 +464,9 @@ class PlyParser {
         // Colours that came as integers 0..255 (a CSV's), so CSV → PLY → CSV writes them so again.
         if (w.size() == 4 && w[2] == "colours" && w[3] == "0..255") integer_colours_ = true;
         // A set read from LAS: its point format, version, scale and offset, and (since 2026-11-30)
-        // its global encoding and CRS records, so that LAS → PLY → LAS writes the same coordinates in the same
-        // format, its GPS times of the same kind. Ignored unless all of it parses.
+        // its global encoding and CRS records, so that LAS → PLY → LAS writes the same coordinates
+        // in the same format, its GPS times of the same kind, in its CRS. Ignored unless all of it
+        // parses.
         if ((w.size() == 12 || w.size() == 13) && w[2] == "las" && w[3] == "frame") {
           LasSource las;
           double v[8];
