@@ -48,6 +48,17 @@ TEST(CliCopc, convertWritesCopcThatReadsAsTheSamePoints) {
   EXPECT_EQ(sorted(copc->positions), sorted(source->positions));  // the octree reorders, keeps every point
 }
 
+// info reads a COPC file's nodes and keeps its CRS: simple1_4.las's WKT is an EVLR, which the read
+// of the nodes (the hierarchy left behind) dropped: "none" where convert had copied it.
+TEST(CliCopc, infoNamesTheCrsOfAnEvlr) {
+  TempDir dir;
+  const std::string las = std::string(DPOINT_CORPUS_DIR) + "/las/simple1_4.las";
+  ASSERT_EQ(runDpoint({"convert", las, "-o", dir.file("s.copc.laz"), "-q"}).exit_code, 0);
+  test::CommandResult info = runDpoint({"info", dir.file("s.copc.laz"), "-q"});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("LAS CRS:            Geographic Coordinate System, WKT\n"), std::string::npos) << info.out;
+}
+
 TEST(CliCopc, aSmallWindowReadsAFewNodesAndTheReportSaysSo) {
   TempDir dir;
   // 600,000 points on a 2D square 1000 wide: several levels of nodes.
