@@ -880,11 +880,6 @@ std::vector<LasVlr> readVlrs(const InputFile& file, const LasHeader& h) {
   return out;
 }
 
-// LASF_Projection's (GeoTIFF keys, OGC WKT), and libLAS's WKT record (liblas 2112), which files
-// written by libLAS and early PDAL carry beside or instead of them.
-bool isCrsRecord(const LasVlr& vlr) {
-  return vlr.user_id == "LASF_Projection" || (vlr.user_id == "liblas" && vlr.record_id == 2112);
-}
 bool isExtraBytesRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Spec" && vlr.record_id == 4; }
 
 // The extra bytes of a record of `header`'s format, as the file's extra bytes record describes
@@ -906,6 +901,15 @@ std::vector<LasExtraField> extraFieldsOf(const std::string& path, const LasHeade
 }
 
 }  // namespace
+
+Result<std::vector<LasVlr>> readLasCrsRecords(const InputFile& file) {
+  Result<LasHeader> header = parseHeader(file);
+  if (!header) return header.error();
+  std::vector<LasVlr> crs;
+  for (LasVlr& vlr : readVlrs(file, *header))
+    if (isLasCrsRecord(vlr)) crs.push_back(std::move(vlr));
+  return crs;
+}
 
 Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   const std::string& path = file.path();
@@ -955,7 +959,7 @@ Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options) {
   las.global_encoding = header->global_encoding;
   las.file_source_id = header->file_source_id;
   for (const LasVlr& vlr : vlrs)
-    if (isCrsRecord(vlr)) las.vlrs.push_back(vlr);
+    if (isLasCrsRecord(vlr)) las.vlrs.push_back(vlr);
   for (const LasExtraField& f : extra)
     if (!f.descriptor.empty()) las.extra_bytes.push_back({f.name, f.descriptor});
   points->las = std::move(las);

@@ -235,7 +235,6 @@ class Proj {
   std::vector<PJ*> objects_;
 };
 
-// The keys' CRS as OGC WKT 1, or why not.
 // WKT 1 of `crs`: one line; a 3D geographic CRS as a compound of its 2D one and ellipsoidal
 // heights, as WKT 1 has no 3D geographic CRS (GDAL writes the same).
 const char* wkt1(const ProjApi& api, Proj& proj, PJ* crs) {
@@ -275,6 +274,8 @@ Result<std::string> keysAsWkt(const GeoKeys& keys, std::string* changed) {
 
 }  // namespace
 
+bool isLasCrsRecord(const LasVlr& vlr) { return vlr.user_id == "LASF_Projection" || isLiblasWkt(vlr); }
+
 std::string wktName(const std::string& wkt) {
   const size_t open = wkt.find('"');
   if (open == std::string::npos) return {};
@@ -287,8 +288,8 @@ LasVlr lasWktRecord(const std::string& wkt) {
   return LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt + '\0', extended};
 }
 
-Result<std::string> crsAsWkt(const std::string& text) {
-  const std::string what = "--crs " + quotedExcerpt(text);
+Result<std::string> crsAsWkt(const std::string& text, const std::string& option) {
+  const std::string what = option + " " + quotedExcerpt(text);
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     return Error{what + ": empty; give EPSG:CODE, WKT, or a file holding WKT", ExitCode::kUsage};
   // A regular file by that name holds the definition (a .prj); else the text is one.

@@ -20,6 +20,10 @@
 
 namespace dpoint {
 
+// A record of the coordinate system: LASF_Projection's (GeoTIFF keys, OGC WKT), and libLAS's WKT
+// record (liblas 2112), which files written by libLAS and early PDAL carry beside or instead of them.
+bool isLasCrsRecord(const LasVlr& vlr);
+
 // What the writer of a point format 6–10 file does with the source's CRS records.
 struct LasWktCrs {
   // The records to write instead of the source's CRS records: the source's own where they are
@@ -31,7 +35,7 @@ struct LasWktCrs {
 };
 
 // The CRS records for a file whose global encoding says WKT (point formats 6–10): `vlrs` are the
-// source's CRS records (isCrsRecord's, VLRs and EVLRs), `wkt_bit` its global encoding's WKT bit.
+// source's CRS records (isLasCrsRecord's, VLRs and EVLRs), `wkt_bit` its global encoding's WKT bit.
 // The source's CRS is its WKT record where that bit is set, else its GeoTIFF keys (made WKT), else
 // a WKT record all the same, else libLAS's. Never fails: a CRS that cannot be made WKT is left
 // out, with a note saying why.
@@ -39,8 +43,8 @@ LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit);
 
 // The CRS that `text` gives (EPSG:CODE or another authority's code, WKT 1 or 2, PROJJSON, or the
 // path of a file holding one, such as a .prj), as one line of OGC WKT 1 for a LAS WKT record
-// (`--crs`). The error says why not, naming the text.
-Result<std::string> crsAsWkt(const std::string& text);
+// (`--crs`). The error says why not, naming `option` and the text.
+Result<std::string> crsAsWkt(const std::string& text, const std::string& option = "--crs");
 
 // A LAS WKT record (LASF_Projection 2112) holding `wkt`.
 LasVlr lasWktRecord(const std::string& wkt);

@@ -52,7 +52,6 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
     // Its CRS records, byte for byte in hex, so that LAS → PLY → LAS keeps its coordinate system:
     // record K over lines "las crs K USER ID EXTENDED HEX" of at most 800 hex digits each ('-':
     // no bytes), as Open3D's PLY reader (RPly) stops at a header line over 1,024 bytes.
-    static constexpr char kHex[] = "0123456789abcdef";
     static constexpr size_t kLineBytes = 400;
     for (size_t k = 0; k < l.vlrs.size(); ++k) {
       const LasVlr& vlr = l.vlrs[k];
@@ -61,11 +60,8 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
                                std::to_string(vlr.record_id) + ' ' + (vlr.extended ? '1' : '0') + ' ';
       for (size_t at = 0; at < vlr.data.size() || at == 0; at += kLineBytes) {
         facts += head;
-        for (size_t i = at; i < std::min(vlr.data.size(), at + kLineBytes); ++i) {
-          const auto c = static_cast<unsigned char>(vlr.data[i]);
-          facts += kHex[c >> 4];
-          facts += kHex[c & 15];
-        }
+        for (size_t i = at; i < std::min(vlr.data.size(), at + kLineBytes); ++i)
+          appendHexDigits(facts, static_cast<unsigned char>(vlr.data[i]));
         if (vlr.data.empty()) facts += '-';
         facts += '\n';
       }

@@ -99,38 +99,18 @@ Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query,
   const uint32_t legacy = 0;
   const uint64_t none = 0;
   std::memcpy(bytes.data() + 107, &legacy, 4);  // formats 6-8: the legacy count is 0
+  std::memcpy(bytes.data() + 235, &none, 8);    // no EVLRs (the hierarchy stays behind)
+  std::memcpy(bytes.data() + 243, &legacy, 4);
   std::memcpy(bytes.data() + 247, &count, 8);
   bytes += *records;
   std::string().swap(*records);
-  // Of the EVLRs, the coordinate system's (a WKT record may be one); the hierarchy stays behind.
-  uint64_t evlr_at = 0;
-  uint32_t evlr_count = 0, kept = 0;
-  const uint64_t kept_at = bytes.size();
-  if (Result<size_t> got = file->readAt(235, &evlr_at, 8); !got || *got != 8) evlr_at = 0;
-  if (Result<size_t> got = file->readAt(243, &evlr_count, 4); !got || *got != 4) evlr_count = 0;
-  for (uint32_t k = 0; k < evlr_count && evlr_at != 0 && evlr_at <= file->size() && file->size() - evlr_at >= 60; ++k) {
-    char head[60];
-    if (Result<size_t> got = file->readAt(evlr_at, head, sizeof head); !got || *got != sizeof head) break;
-    uint64_t length = 0;
-    std::memcpy(&length, head + 20, 8);
-    if (length > file->size() - evlr_at - 60) break;
-    const std::string user(head + 2, strnlen(head + 2, 16));
-    if ((user == "LASF_Projection" || user == "liblas") && length <= (uint64_t{1} << 24)) {
-      const size_t at = bytes.size();
-      bytes.resize(at + 60 + static_cast<size_t>(length));
-      if (Result<size_t> got = file->readAt(evlr_at, bytes.data() + at, 60 + static_cast<size_t>(length));
-          !got || *got != 60 + length) {
-        bytes.resize(at);
-        break;
-      }
-      ++kept;
-    }
-    evlr_at += 60 + length;
-  }
-  const uint64_t kept_start = kept ? kept_at : none;
-  std::memcpy(bytes.data() + 235, &kept_start, 8);
-  std::memcpy(bytes.data() + 243, &kept, 4);
   Result<PointSet> points = readLas(InputFile::fromMemory(path, bytes), options);
+  // The coordinate system's records as the file has them, EVLRs too (a WKT record may be one).
+  if (points && points->las) {
+    Result<std::vector<LasVlr>> crs = readLasCrsRecords(*file);
+    if (!crs) return crs.error();
+    points->las->vlrs = std::move(*crs);
+  }
   if (stats) *stats = {read.points, read.bytes, read.nodes, file->size(), header->point_count};
   return points;
 }

@@ -64,7 +64,7 @@ class LargeBuffer {
  private:
   void release();
   char* data_ = nullptr;
-  size_t size_ = 0, mapped_ = 0;  // mapped_: the mapping's length, 0 for the heap
+  size_t size_ = 0, mapped_ = 0;  // mapped_: the bytes mapHugePages mapped (size_), 0 for the heap
 };
 
 // Blocks of DefaultInitAllocator this large or larger are mapped by mapHugePages.

@@ -21,13 +21,18 @@ inline size_t utf8SequenceAt(std::string_view text, size_t i) {
   return n;
 }
 
-// A byte as \xNN (two lower-case hex digits), how a message shows a control byte or a byte that is
-// not UTF-8 so that it stays one printable line.
-inline void appendHexByte(std::string& out, unsigned char c) {
+// A byte as two lower-case hex digits.
+inline void appendHexDigits(std::string& out, unsigned char c) {
   static const char kHex[] = "0123456789abcdef";
-  out += "\\x";
   out += kHex[c >> 4];
   out += kHex[c & 15];
+}
+
+// A byte as \xNN, how a message shows a control byte or a byte that is not UTF-8 so that it stays
+// one printable line.
+inline void appendHexByte(std::string& out, unsigned char c) {
+  out += "\\x";
+  appendHexDigits(out, c);
 }
 
 // Bad input text quoted in a one-line error message: at most 40 characters, UTF-8 letters as they

@@ -575,8 +575,8 @@ progress: lines on stderr.)");
           if (*formatOf(path) != FileFormat::kLas && *formatOf(path) != FileFormat::kLaz)
             raise(Error{"crs: only a .las, .laz or .copc.laz file holds a coordinate reference system, not '" + path + "'",
                         ExitCode::kUsage});
-          Result<std::string> wkt = crsAsWkt(*crs);
-          if (!wkt) raise(Error{"crs" + wkt.error().message.substr(std::string("--crs").size()), ExitCode::kUsage});
+          Result<std::string> wkt = crsAsWkt(*crs, "crs");
+          if (!wkt) raise(wkt.error());
           crs_wkt = std::move(*wkt);
         }
         std::vector<std::string> notices;  // what the file cannot hold as given: warnings, as the CLI's notes
