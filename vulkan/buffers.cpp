@@ -75,6 +75,7 @@ Result<Buffer> allocateBuffer(const VulkanContext& context, VkDeviceSize size, V
   VkMemoryPropertyFlags flags = context.memory.memoryTypes[*type].propertyFlags;
   if (result == VK_SUCCESS && (flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
     out.coherent = (flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    out.write_combined = !host && (flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT) == 0;
     if (host) {
       out.mapped = host->pages;
     } else {
@@ -300,12 +301,28 @@ namespace {
 // Calls fill on pieces of [offset, offset + bytes) from every core, each piece a multiple of
 // `grain` (the last one excepted) and about 1 MiB: the pieces are disjoint, so the bytes written
 // do not depend on the thread count.
-void fillInParallel(const UploadFill& fill, void* dst, VkDeviceSize offset, VkDeviceSize bytes, VkDeviceSize grain) {
+//
+// Into write-combined memory (`bounce`) each piece is filled 64 KiB at a time into a cached block
+// and copied across whole: a fill that stores a few bytes at a time, reading its source as it
+// goes, leaves the write-combining buffers part-full, and each one flushed early is a short write
+// over the bus. On an H200 the float-pair fill into the BAR ran at half speed that way once the
+// source sat in 2 MiB pages (bench/results/2026-12-01/h200/bounce/).
+void fillInParallel(const UploadFill& fill, void* dst, VkDeviceSize offset, VkDeviceSize bytes, VkDeviceSize grain,
+                    bool bounce) {
   const VkDeviceSize piece = std::max<VkDeviceSize>(grain, (VkDeviceSize{1} << 20) / grain * grain);
+  const VkDeviceSize block = std::max<VkDeviceSize>(grain, (VkDeviceSize{64} << 10) / grain * grain);
   const size_t pieces = static_cast<size_t>((bytes + piece - 1) / piece);
   parallelFor(pieces, pieces == 1 ? 1 : 0, [&](size_t k, unsigned) {
     const VkDeviceSize at = k * piece;
-    fill(static_cast<uint8_t*>(dst) + at, offset + at, std::min(piece, bytes - at));
+    const VkDeviceSize size = std::min(piece, bytes - at);
+    uint8_t* out = static_cast<uint8_t*>(dst) + at;
+    if (!bounce) return fill(out, offset + at, size);
+    std::vector<uint8_t, DefaultInitAllocator<uint8_t>> cached(std::min(block, size));
+    for (VkDeviceSize done = 0; done < size; done += block) {
+      const VkDeviceSize n = std::min(block, size - done);
+      fill(cached.data(), offset + at + done, n);
+      std::memcpy(out + done, cached.data(), n);
+    }
   });
 }
 
@@ -315,7 +332,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
                     VkDeviceSize grain, VkDeviceSize staging_limit, VkDeviceSize at) {
   assert(at <= target.size && size <= target.size - at && grain > 0);
   if (target.mapped) {
-    fillInParallel(fill, static_cast<uint8_t*>(target.mapped) + at, 0, size, grain);
+    fillInParallel(fill, static_cast<uint8_t*>(target.mapped) + at, 0, size, grain, target.write_combined);
     return flushBuffer(context, target);
   }
   // Two staging buffers: the cores fill one while the GPU copies out of the other.
@@ -338,7 +355,7 @@ Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize s
       Slot& s = slot[k % slots];
       if (Status waited = waitCommandSlot(context, s.commands); !waited) return waited;
       const VkDeviceSize bytes = std::min(piece, size - offset);
-      fillInParallel(fill, s.staging.mapped, offset, bytes, grain);
+      fillInParallel(fill, s.staging.mapped, offset, bytes, grain, s.staging.write_combined);
       if (Status status = flushBuffer(context, s.staging); !status) return status;
       if (Status begun = beginCommandSlot(context, s.commands); !begun) return begun;
       VkBufferCopy copy{0, at + offset, bytes};

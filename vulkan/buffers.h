@@ -15,6 +15,9 @@ struct Buffer {
   VkDeviceSize allocated = 0;  // counted in the context's device_memory_used
   void* mapped = nullptr;  // set when the memory is host-visible (mapped for the buffer's life)
   bool coherent = false;
+  // Host-visible but not cached: on a discrete GPU, device memory behind the BAR, which the CPU
+  // writes through write-combining buffers (uploadBuffer fills it through a cached bounce).
+  bool write_combined = false;
   // The process's own pages the memory was imported from (VulkanContext::host_import_alignment),
   // unmapped once the memory is freed; null otherwise.
   void* host_pages = nullptr;
@@ -92,8 +95,8 @@ using UploadFill = std::function<void(void* dst, VkDeviceSize offset, VkDeviceSi
 
 // Fills `size` bytes of `target` from byte `at` on (usage must include TRANSFER_DST) through
 // `fill`, whose offsets count from `at`, on every core, in pieces that are multiples of `grain`
-// bytes (a whole element): into mapped memory directly when the target is host-visible, else
-// through two staging buffers of at most `staging_limit` bytes, one filled while the GPU copies
+// bytes (a whole element): into mapped memory directly when the target is host-visible (through a
+// cached block per thread where it is write-combined), else through two staging buffers of at most `staging_limit` bytes, one filled while the GPU copies
 // out of the other.
 Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
                     VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20, VkDeviceSize at = 0);
