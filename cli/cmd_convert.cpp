@@ -161,8 +161,9 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(oneOf("--pcd-encoding", {"ascii", "binary", "binary_compressed"}))
       ->default_val("binary");
   cmd->add_option("--crs", o->crs,
-                  "LAS/LAZ/COPC: the coordinate reference system, as EPSG:CODE (EPSG:32633), WKT, or a file holding WKT\n"
-                  "(a .prj); written as WKT in a LAS 1.4 file, in place of the input's CRS records. Default: the input's")
+                  "LAS/LAZ/COPC: the coordinate reference system, as EPSG:CODE (EPSG:32633; with heights EPSG:6580+5703),\n"
+                  "WKT, or a file holding WKT (a .prj); written as WKT in a LAS 1.4 file, in place of the input's CRS\n"
+                  "records. Default: the input's")
       ->type_name("CRS");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "

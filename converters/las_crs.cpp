@@ -317,6 +317,11 @@ Result<std::string> crsAsWkt(const std::string& text, const std::string& option)
     return Error{what + ": not a coordinate reference system PROJ knows (give EPSG:CODE, WKT, PROJJSON, a PROJ "
                         "string with +type=crs, or a file holding one)",
                  ExitCode::kUsage};
+  // A height system alone says nothing of x and y, which every LAS point has.
+  if (api.get_type(crs) == PJ_TYPE_VERTICAL_CRS)
+    return Error{what + ": a vertical CRS alone, which places no x or y; give the horizontal CRS, or both "
+                        "(EPSG:HORIZONTAL+VERTICAL, e.g. EPSG:6580+5703)",
+                 ExitCode::kUsage};
   const char* wkt = wkt1(api, proj, crs);
   if (!wkt) return Error{what + ": PROJ cannot write it as WKT 1, the WKT LAS takes", ExitCode::kUsage};
   return std::string(wkt);

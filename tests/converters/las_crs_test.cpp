@@ -193,8 +193,18 @@ TEST(LasCrs, aGivenCrsIsWktInALas14File) {
   Result<std::string> from_file = crsAsWkt(prj.file("utm+33.prj"));
   ASSERT_TRUE(from_file.ok()) << from_file.error().message;
   EXPECT_EQ(*from_file, *crsAsWkt("EPSG:32633"));
+  // A horizontal CRS with a vertical one, in PROJ's EPSG:H+V form.
+  Result<std::string> compound = crsAsWkt("EPSG:6580+5703");
+  ASSERT_TRUE(compound.ok()) << compound.error().message;
+  EXPECT_EQ(compound->rfind("COMPD_CS[", 0), 0u) << *compound;
+  // A vertical CRS alone places no x or y: refused, pointing at the compound form.
+  Result<std::string> vertical = crsAsWkt("EPSG:5703");
+  ASSERT_FALSE(vertical.ok());
+  EXPECT_NE(vertical.error().message.find("a vertical CRS alone"), std::string::npos) << vertical.error().message;
+  EXPECT_NE(vertical.error().message.find("EPSG:6580+5703"), std::string::npos) << vertical.error().message;
   for (const std::string& bad : {std::string("EPSG:999999"), std::string("PROJCS["), std::string("+proj=tmerc +nonsense"),
-                                 std::string("no-such-file.prj"), std::string(""), std::string("  "), prj.path()}) {
+                                 std::string("no-such-file.prj"), std::string(""), std::string("  "), prj.path(),
+                                 std::string("EPSG:5703")}) {
     Result<std::string> wkt = crsAsWkt(bad);
     EXPECT_FALSE(wkt.ok()) << bad;
     if (!wkt.ok()) {
