@@ -41,6 +41,9 @@ LONG_CALLS = {
                'frames=1000000, warmup=0).save(out)'),
     # The nearest-neighbour search of every one of 2M points (seconds on one core): it ran to its end
     # before the build of 2026-11-30.
+    # A Poisson sample of 2M points (about a minute on 2 cores): its grid's sort and its candidates'
+    # placement did not stop (a SIGINT a second in took 6 s) before the build of 2026-12-01.
+    "sample": 'dpoint.write(dpoint.sample(dpoint.generate("sierpinski", level=6), 2_000_000, method="poisson"), out)',
     "info": ('r = dpoint.info(dpoint.PointSet(np.random.default_rng(0).random((2_000_000, 3))), sample=100_000_000, '
              'threads=1); open(out, "w").write(str(r))'),
 }
