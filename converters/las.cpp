@@ -1213,7 +1213,7 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     options.report->renamed = l.renamed;
     options.report->crs = l.crs_note.empty() || !options.crs_wkt.empty()
                               ? l.crs_note
-                              : "point format " + str(l.format) + " holds its CRS as WKT: " + l.crs_note;
+                              : "point format " + std::to_string(l.format) + " holds its CRS as WKT: " + l.crs_note;
   }
   std::optional<LazInfo> laz;
   if (options.compress) {

@@ -27,6 +27,14 @@ bool PointSet::isPlanar() const {
   return planar.load();
 }
 
+uint64_t heldBytes(const PointSet& points) {
+  uint64_t bytes = uint64_t{points.positions.capacity()} * sizeof(glm::dvec3) +
+                   uint64_t{points.colors.capacity()} * sizeof(glm::vec3) +
+                   uint64_t{points.triangles.capacity()} * sizeof(uint32_t);
+  for (const Dimension& d : points.dimensions.all()) bytes += d.bytes.capacity();
+  return bytes;
+}
+
 size_t PointSet::firstBadTriangleIndex(unsigned threads) const {
   constexpr size_t kIndicesPerItem = size_t{1} << 20;
   const size_t n = positions.size();

@@ -79,6 +79,9 @@ struct PointSet {
   size_t firstBadTriangleIndex(unsigned threads = 0) const;
 };
 
+// The bytes the set's arrays hold (their capacities): positions, colours, triangles and dimensions.
+uint64_t heldBytes(const PointSet& points);
+
 // Points that are not held but made on demand, `count` of them: make(begin, end, out) writes the
 // positions of points [begin, end) to out[0 .. end - begin). For a generator whose points are a
 // function of their index (random2d), so that a writer formats its rows straight from them and

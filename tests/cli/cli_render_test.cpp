@@ -267,6 +267,28 @@ TEST(CliRender, aStreamRespectsMaxMemory) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("r.png")));
 }
 
+// A CPU device's buffers (lavapipe's) are host memory: they count against --max-memory beside the
+// set read. 1M points hold 24 MB; fp32's positions and colours on the device take 16 MB more, so
+// 30M is refused (exit 4, naming --max-memory, no picture) where it passed before; 48M draws.
+TEST(CliRender, aCpuDevicesBuffersCountAgainstMaxMemory) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "1000000", "--quiet", "-o", dir.file("r.ply")}).exit_code, 0);
+  const std::vector<std::string> render = {"render", dir.file("r.ply"), "--device", "cpu", "--stream", "off", "--mode",
+                                           "fp32", "--width", "64", "--height", "48", "-q", "--max-memory"};
+  std::vector<std::string> tight = render;
+  tight.insert(tight.end(), {"30M", "-o", dir.file("tight.png")});
+  const test::CommandResult refused = runDpoint(tight);
+  EXPECT_EQ(refused.exit_code, 4) << refused.err;
+  EXPECT_NE(refused.err.find("on the CPU device (whose memory is the host's)"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("that --max-memory leaves beside the points read"), std::string::npos) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("tight.png")));
+  std::vector<std::string> enough = render;
+  enough.insert(enough.end(), {"48M", "-o", dir.file("enough.png")});
+  const test::CommandResult drawn = runDpoint(enough);
+  EXPECT_EQ(drawn.exit_code, 0) << drawn.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("enough.png")));
+}
+
 // A stream whose two blocks of 16.7M points would pass --max-memory is read in smaller blocks
 // instead of being refused (2M points took 144 MB, over a limit of 100M): the same picture and the
 // same report as in one block, for a 2D set (one pass) and a 3D one (bounds, outline, spacing and
