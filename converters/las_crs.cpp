@@ -145,6 +145,8 @@ struct ProjApi {
   decltype(&proj_as_wkt) as_wkt = nullptr;
   decltype(&proj_crs_get_coordinate_system) crs_get_coordinate_system = nullptr;
   decltype(&proj_cs_get_axis_info) cs_get_axis_info = nullptr;
+  decltype(&proj_cs_get_axis_count) cs_get_axis_count = nullptr;
+  decltype(&proj_get_source_crs) get_source_crs = nullptr;
   decltype(&proj_uom_get_info_from_database) uom_get_info_from_database = nullptr;
   decltype(&proj_crs_alter_cs_linear_unit) crs_alter_cs_linear_unit = nullptr;
   decltype(&proj_create_compound_crs) create_compound_crs = nullptr;
@@ -174,6 +176,8 @@ ProjApi loadProj() {
   bind(api.as_wkt, "proj_as_wkt");
   bind(api.crs_get_coordinate_system, "proj_crs_get_coordinate_system");
   bind(api.cs_get_axis_info, "proj_cs_get_axis_info");
+  bind(api.cs_get_axis_count, "proj_cs_get_axis_count");
+  bind(api.get_source_crs, "proj_get_source_crs");
   bind(api.uom_get_info_from_database, "proj_uom_get_info_from_database");
   bind(api.crs_alter_cs_linear_unit, "proj_crs_alter_cs_linear_unit");
   bind(api.create_compound_crs, "proj_create_compound_crs");
@@ -317,8 +321,16 @@ Result<std::string> crsAsWkt(const std::string& text, const std::string& option)
     return Error{what + ": not a coordinate reference system PROJ knows (give EPSG:CODE, WKT, PROJJSON, a PROJ "
                         "string with +type=crs, or a file holding one)",
                  ExitCode::kUsage};
-  // A height system alone says nothing of x and y, which every LAS point has.
-  if (api.get_type(crs) == PJ_TYPE_VERTICAL_CRS)
+  // A height system alone says nothing of x and y, which every LAS point has: a vertical CRS, also
+  // one bound to a transformation (GDAL writes a .prj with geoid grids so), or a one-axis one.
+  const PJ* placed = crs;
+  if (api.get_type(crs) == PJ_TYPE_BOUND_CRS)
+    if (const PJ* source = proj.keep(api.get_source_crs(proj.context(), crs))) placed = source;
+  int axes = 2;
+  if (api.get_type(placed) != PJ_TYPE_COMPOUND_CRS)
+    if (const PJ* cs = proj.keep(api.crs_get_coordinate_system(proj.context(), placed)))
+      axes = api.cs_get_axis_count(proj.context(), cs);
+  if (api.get_type(placed) == PJ_TYPE_VERTICAL_CRS || axes == 1)
     return Error{what + ": a vertical CRS alone, which places no x or y; give the horizontal CRS, or both "
                         "(EPSG:HORIZONTAL+VERTICAL, e.g. EPSG:6580+5703)",
                  ExitCode::kUsage};

@@ -723,26 +723,31 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
 }
 
 // A CPU device's memory is the host's (lavapipe, the default without a GPU): while a render of a
-// set in memory runs, its budget is what --max-memory leaves beside the points read and the
-// picture, or --max-device-memory where that is lower. A refusal is then exit 4 naming
-// --max-memory (vulkan/buffers.cpp). Put back at the end: a Python Renderer's device outlives it.
-// (A stream's blocks are sized to --max-memory before the device is known: not counted yet.)
+// set in memory runs, its budget is what --max-memory leaves beside the points read, or
+// --max-device-memory where that is lower. The picture's images and readback are the device's
+// buffers, charged there. A refusal is then exit 4 naming --max-memory (vulkan/buffers.cpp). Put
+// back at the end: a Python Renderer's device outlives it. (A stream's blocks are sized to
+// --max-memory before the device is known: its device buffers are not counted yet.)
 class HostMemoryBudget {
  public:
-  HostMemoryBudget(VulkanContext& context, const RenderRequest& request, const LoadedSet& set, uint64_t picture_bytes)
-      : context_(context), budget_(context.device_memory_budget), host_(context.budget_is_host_memory) {
+  HostMemoryBudget(VulkanContext& context, const RenderRequest& request, const LoadedSet& set)
+      : context_(context), budget_(context.device_memory_budget), host_(context.host_budget) {
     const PointSet* points = set.points();
     if (context.facts.type != "cpu" || !points) return;
     const uint64_t limit = request.max_memory ? request.max_memory : defaultMemoryLimit();
-    const uint64_t held = picture_bytes + heldBytes(*points);
+    const uint64_t held = heldBytes(*points);
     const uint64_t left = limit > held ? limit - held : 1;  // 0 would be no budget at all
     if (budget_ != 0 && budget_ <= left) return;
+    const std::string option =
+        request.max_memory ? "--max-memory " + formatBytes(limit) : "--max-memory (" + formatBytes(limit) + ", half of RAM)";
     context.device_memory_budget = left;
-    context.budget_is_host_memory = true;
+    context.host_budget = limit > held ? "the " + formatBytes(left) + " that " + option + " leaves beside the " +
+                                             formatBytes(held) + " of points read"
+                                       : option + ", which the " + formatBytes(held) + " of points read already take";
   }
   ~HostMemoryBudget() {
     context_.device_memory_budget = budget_;
-    context_.budget_is_host_memory = host_;
+    context_.host_budget = host_;
   }
   HostMemoryBudget(const HostMemoryBudget&) = delete;
   HostMemoryBudget& operator=(const HostMemoryBudget&) = delete;
@@ -750,7 +755,7 @@ class HostMemoryBudget {
  private:
   VulkanContext& context_;
   uint64_t budget_;
-  bool host_;
+  std::string host_;
 };
 
 }  // namespace
@@ -1080,7 +1085,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   else
     return made.error();
   outcome.phases.mark("device");  // what is left of making it once the input is in
-  const HostMemoryBudget host_budget(*outcome.context, request, *set, pixels * kPictureBytesPerPixel);
+  const HostMemoryBudget host_budget(*outcome.context, request, *set);
   const VulkanContext& context = *outcome.context;
   outcome.device = context.facts;
   outcome.backend = backendFor(request, set->count, spec.width, spec.height, context.facts);

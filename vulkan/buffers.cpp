@@ -187,12 +187,10 @@ Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, con
   const uint64_t used = context.device_memory_used.fetch_add(bytes) + bytes;
   if (context.device_memory_budget == 0 || used <= context.device_memory_budget) return okStatus();
   context.device_memory_used.fetch_sub(bytes);
-  if (context.budget_is_host_memory)
+  if (!context.host_budget.empty())
     return Error{"host memory: " + what + " needs " + formatBytes(bytes) + " more on the CPU device (whose memory is "
-                     "the host's), " + formatBytes(used) + " in all, above the " +
-                     formatBytes(context.device_memory_budget) +
-                     " that --max-memory leaves beside the points read; try a smaller set, size or --mode with fewer "
-                     "bytes a point, or a higher --max-memory",
+                     "the host's), " + formatBytes(used) + " in all, past " + context.host_budget +
+                     "; try a smaller set, size or --mode with fewer bytes a point, or a higher --max-memory",
                  ExitCode::kResourceLimit};
   return Error{"device memory: " + what + " needs " + formatBytes(bytes) + " more, " + formatBytes(used) +
                    " in all, above the budget of " + formatBytes(context.device_memory_budget) +

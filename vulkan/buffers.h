@@ -96,7 +96,7 @@ using UploadFill = std::function<void(void* dst, VkDeviceSize offset, VkDeviceSi
 // Fills `size` bytes of `target` from byte `at` on (usage must include TRANSFER_DST) through
 // `fill`, whose offsets count from `at`, on every core, in pieces that are multiples of `grain`
 // bytes (a whole element): into mapped memory directly when the target is host-visible (through a
-// cached block per thread where it is write-combined), else through two staging buffers of at most `staging_limit` bytes, one filled while the GPU copies
+// cached 64 KiB block where it is write-combined), else through two staging buffers of at most `staging_limit` bytes, one filled while the GPU copies
 // out of the other.
 Status uploadBuffer(const VulkanContext& context, Buffer& target, VkDeviceSize size, const UploadFill& fill,
                     VkDeviceSize grain = 1, VkDeviceSize staging_limit = 32u << 20, VkDeviceSize at = 0);

@@ -112,9 +112,11 @@ class VulkanContext {
   VkPhysicalDeviceMemoryProperties memory{};
   // Device memory allocated through vulkan/buffers and the budget it must stay in (0: none).
   uint64_t device_memory_budget = 0;
-  // The budget is what --max-memory leaves beside the host's own arrays: a CPU device's memory is
-  // the host's (set per render, viewer/render_job.cpp). Its refusal is then exit 4, naming --max-memory.
-  bool budget_is_host_memory = false;
+  // Where the budget is what --max-memory leaves beside the host's own arrays (a CPU device, whose
+  // memory is the host's; set per render, viewer/render_job.cpp): how, for the refusal, which is
+  // then exit 4 ("the 12.0 MiB that --max-memory 36.0 MiB leaves beside the 24.0 MiB of points
+  // read"). Empty otherwise.
+  std::string host_budget;
   mutable std::atomic<uint64_t> device_memory_used{0};
   // Set once the device-lost-wait test switch has reported a loss: from then on the device stays
   // lost for every submission and wait, as a real lost device does.

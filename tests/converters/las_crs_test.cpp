@@ -204,7 +204,14 @@ TEST(LasCrs, aGivenCrsIsWktInALas14File) {
   EXPECT_NE(vertical.error().message.find("EPSG:6580+5703"), std::string::npos) << vertical.error().message;
   for (const std::string& bad : {std::string("EPSG:999999"), std::string("PROJCS["), std::string("+proj=tmerc +nonsense"),
                                  std::string("no-such-file.prj"), std::string(""), std::string("  "), prj.path(),
-                                 std::string("EPSG:5703")}) {
+                                 std::string("EPSG:5703"),
+                                 // the same bound to a geoid model, as GDAL writes a .prj
+                                 std::string("VERT_CS[\"NAVD88 height\",VERT_DATUM[\"North American Vertical Datum 1988\",2005,"
+                                             "EXTENSION[\"PROJ4_GRIDS\",\"g2012a_conus.gtx\"]],UNIT[\"metre\",1],"
+                                             "AXIS[\"Gravity-related height\",UP]]"),
+                                 // a one-axis engineering CRS
+                                 std::string("ENGCRS[\"height only\",EDATUM[\"site\"],CS[vertical,1],"
+                                             "AXIS[\"height (H)\",up,LENGTHUNIT[\"metre\",1]]]")}) {
     Result<std::string> wkt = crsAsWkt(bad);
     EXPECT_FALSE(wkt.ok()) << bad;
     if (!wkt.ok()) {
