@@ -310,7 +310,7 @@ namespace {
 // Into write-combined memory (`bounce`) each piece is filled 64 KiB at a time into a cached block
 // and copied across whole: a fill that stores a few bytes at a time, reading its source as it
 // goes, leaves the write-combining buffers part-full, and each one flushed early is a short write
-// over the bus. On an H200 the float-pair fill into the BAR ran at half speed that way once the
+// over the bus. On an H200 the float-pair fill into the BAR ran 1.6x slower that way once the
 // source sat in 2 MiB pages (bench/results/2026-12-01/h200/bounce/).
 void fillInParallel(const UploadFill& fill, void* dst, VkDeviceSize offset, VkDeviceSize bytes, VkDeviceSize grain,
                     bool bounce) {
