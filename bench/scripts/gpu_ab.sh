@@ -31,8 +31,7 @@ for round in $(seq "${ROUNDS:-3}"); do
   for set in ${SETS:-sierpinski mandelbulb}; do
     for mode in ${MODES:-batch adaptive fp32 native}; do
       for build in ${BUILDS:-current}; do
-        bin=.gpu/dpoint-$build
-        [ "$build" = current ] && bin=.gpu/dpoint
+        bin=$(build_bin "$build")
         rm -f /tmp/r.json
         # shellcheck disable=SC2086
         "$bin" render "$data/$set.ply" --mode "$mode" $render --frames "${FRAMES:-50}" -q --json /tmp/r.json \

@@ -20,8 +20,7 @@ printf 'round\tdataset\tbuild\tpoint_size\tgpu_ms_median\tprocess_ms\n' >"$rows"
 for round in $(seq "${ROUNDS:-3}"); do
   for set in ${SETS:-mb200 mb420 menger}; do
     for build in ${BUILDS:-${BASE:-19318e9} current}; do
-      bin=.gpu/dpoint-$build
-      [ "$build" = current ] && bin=.gpu/dpoint
+      bin=$(build_bin "$build")
       rm -f /tmp/r.json
       "$bin" render "$data/$set.ply" --frames "${FRAMES:-20}" -q --json /tmp/r.json -o "$out/$set-$build.png" >/dev/null 2>&1 || true
       s=$(date +%s%N); "$bin" render "$data/$set.ply" -q -o /tmp/one.png >/dev/null 2>&1 || true; e=$(date +%s%N)

@@ -24,3 +24,9 @@ default_set() {
   esac
   echo "$data/$1.ply"
 }
+
+# The binary of a build the A/B scripts name in BUILDS: .gpu/dpoint for "current", else
+# .gpu/dpoint-NAME.
+build_bin() {
+  if [ "$1" = current ]; then echo .gpu/dpoint; else echo ".gpu/dpoint-$1"; fi
+}

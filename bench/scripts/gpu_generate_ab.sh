@@ -33,8 +33,7 @@ rows=$out/generate_ab.tsv
 printf 'round\tbuild\twall_s\tgpu_ms\tsha256\tgenerate_s\tcolours_s\twrite_s\n' >"$rows"
 for round in $(seq "${ROUNDS:-3}"); do
   for build in ${BUILDS:-A current}; do
-    bin=.gpu/dpoint-$build
-    [ "$build" = current ] && bin=.gpu/dpoint
+    bin=$(build_bin "$build")
     # shellcheck disable=SC2086
     /usr/bin/time -f "%e" -o "$data/time.txt" "$bin" generate $case --device 0 -o "$data/out.ply" 2>"$data/stderr.txt"
     gpu=$(sed -n 's/.* in \([0-9.]*\) ms of GPU time.*/\1/p' "$data/stderr.txt" | head -1)

@@ -14,8 +14,7 @@ printf 'backend\tmode\tbuild\texit\tmessages\tpng\n' >"$rows"
 for backend in compute raster; do
   for mode in ${MODES:-fp32 split rte df64 native batch adaptive}; do
     for build in "${BASE:-B}" current; do
-      bin=.gpu/dpoint-$build
-      [ "$build" = current ] && bin=.gpu/dpoint
+      bin=$(build_bin "$build")
       rm -f "$data/m.png"
       rc=0
       "$bin" render "$data/mb.ply" --backend "$backend" --mode "$mode" --width 1920 --height 1080 --validate \
@@ -28,8 +27,7 @@ for backend in compute raster; do
 done
 # --error: the raster backend's probe (the projected points written to a host-visible buffer).
 for build in "${BASE:-B}" current; do
-  bin=.gpu/dpoint-$build
-  [ "$build" = current ] && bin=.gpu/dpoint
+  bin=$(build_bin "$build")
   rc=0
   "$bin" render "$data/mb.ply" --backend raster --mode fp32 --error --validate -o "$data/m.png" 2>&1 | grep -E "^error:|validation" |
     sed "s/^/$build: /" | tee -a "$out/import_check_error.txt" || rc=$?

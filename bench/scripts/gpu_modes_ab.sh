@@ -16,8 +16,7 @@ printf 'round\tmode\tbuild\tgpu_ms_median\tprocess_ms\tpng\n' >"$rows"
 for round in $(seq "${ROUNDS:-2}"); do
   for mode in ${MODES:-fp32 split rte df64 native batch adaptive}; do
     for build in ${BUILDS:-${BASE:-A} current}; do
-      bin=.gpu/dpoint-$build
-      [ "$build" = current ] && bin=.gpu/dpoint
+      bin=$(build_bin "$build")
       rm -f /tmp/r.json
       s=$(date +%s%N)
       "$bin" render "$file" --mode "$mode" --frames "${FRAMES:-10}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1 || true

@@ -13,8 +13,7 @@ printf 'round\tmode\tbuild\tprocess_ms\tread\tspacing\tcamera\tdevice\tmode_ms\t
 for round in $(seq "${ROUNDS:-6}"); do
   for mode in ${MODES:-rte fp32}; do
     for build in ${BUILDS:-A current}; do
-      bin=.gpu/dpoint-$build
-      [ "$build" = current ] && bin=.gpu/dpoint
+      bin=$(build_bin "$build")
       s=$(date +%s%N)
       "$bin" render "$file" --mode "$mode" --frames "${FRAMES:-1}" -q --json /tmp/r.json -o /tmp/m.png >/dev/null 2>&1
       e=$(date +%s%N)

@@ -50,8 +50,7 @@ for set in ${SETS:-las mesh gltf pcd}; do
   cat "$file" >/dev/null
   for round in $(seq "${ROUNDS:-3}"); do
     for build in "${BASE:-a968b90}" current; do
-      bin=.gpu/dpoint-$build
-      [ "$build" = current ] && bin=.gpu/dpoint
+      bin=$(build_bin "$build")
       /usr/bin/time -f "%e %M" -o /tmp/read_time.txt "$bin" bench io "$file" -q >/tmp/read_io.json 2>/dev/null || true
       echo "" >/tmp/read_write.txt
       if [ "${WRITE:-0}" = 1 ]; then

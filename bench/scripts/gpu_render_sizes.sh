@@ -18,8 +18,7 @@ for round in $(seq "${ROUNDS:-5}"); do
   for set in ${SETS:-mb420 s11u}; do
     for size in 1024x768 1920x1080 3840x2160; do
       for build in ${BUILDS:-current}; do
-        bin=.gpu/dpoint-$build picture=$out/$set-4k-$build.png
-        [ "$build" = current ] && bin=.gpu/dpoint
+        bin=$(build_bin "$build") picture=$out/$set-4k-$build.png
         [ "${BUILDS:-current}" = current ] && picture=$out/$set-4k.png
         rm -f /tmp/k.json
         s=$(date +%s%N)

@@ -23,8 +23,7 @@ rows=$out/stream.tsv
 printf 'round\tbuild\twhat\twall_s\tmode\tpoint_size\tread_again\tpeak_rss_mb\tphases\n' >"$rows"
 for round in $(seq "${ROUNDS:-3}"); do
   for build in ${BUILDS:-current}; do
-    bin=.gpu/dpoint-$build
-    [ "$build" = current ] && bin=.gpu/dpoint
+    bin=$(build_bin "$build")
     whats="render"
     [ "${INFO:-0}" = 1 ] && whats="render info"
     for what in $whats; do
