@@ -140,11 +140,11 @@ struct LasWriteOptions {
 
 // Reads and checks the header only (everything the top comment lists, the file size included).
 Result<LasHeader> readLasHeader(const std::string& path);
-// The coordinate system's records of a LAS or LAZ file, VLRs and EVLRs (isLasCrsRecord's), as
-// readLas keeps them in PointSet::las.
 Result<PointSet> readLas(const std::string& path, const LasReadOptions& options = {});
 // The same from an open file (the fuzz target reads bytes as a file, InputFile::fromMemory).
 Result<PointSet> readLas(const InputFile& file, const LasReadOptions& options = {});
+// The coordinate system's records of a LAS or LAZ file, VLRs and EVLRs (isLasCrsRecord's), as
+// readLas keeps them in PointSet::las.
 Result<std::vector<LasVlr>> readLasCrsRecords(const InputFile& file);
 
 // Writes atomically (AtomicFile). Triangles are not stored. Fails (exit 2) on a non-finite

@@ -113,7 +113,7 @@ void unmapPages(void* data, size_t bytes) noexcept {
 }
 
 LargeBuffer::LargeBuffer(size_t bytes) : size_(bytes) {
-  if (bytes >= (size_t{2} << 20))
+  if (bytes >= kHugeBlockBytes)
     if (void* p = mapHugePages(bytes)) {
       data_ = static_cast<char*>(p);
       mapped_ = bytes;
