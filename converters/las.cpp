@@ -196,9 +196,9 @@ void copyExtra(const LasExtraField& f, const char* at, Dimension& d, size_t i) {
 class LasReader {
  public:
   LasReader(const InputFile& file, const LasHeader& header, LasColorSource source, const LasReadOptions& options,
-            std::vector<LasExtraField> extra)
+            const std::vector<LasExtraField>& extra)
       : file_(file), h_(header), source_(source), options_(options), fields_(lasFields(header.point_format)),
-        extra_(std::move(extra)) {
+        extra_(extra) {
     rgb_at_ = lasRgbOffset(h_.point_format);
     class_at_ = h_.point_format >= 6 ? 16 : 15;
     class_mask_ = h_.point_format >= 6 ? 0xFF : 0x1F;
@@ -218,9 +218,11 @@ class LasReader {
     // Every field of the record, and each extra byte field, as a dimension (core/dimensions.h).
     // (lasExtraFields made every name unique.) Unset: decode() writes every field of every point
     // (the columns are a dozen, hundreds of MB at 16M points, no longer zeroed on one thread first).
+    points.dimensions.reserve(fields_.size() + extra_.size());
     for (const LasField& f : fields_) points.dimensions.appendUnset(f.name, f.type, count);
     for (const LasExtraField& f : extra_) points.dimensions.appendUnset(f.name, f.dimensionType(), count);
     columns_.clear();  // pointers once every column is in place (adding one may move the others)
+    columns_.reserve(points.dimensions.count());
     for (Dimension& d : points.dimensions.all()) columns_.push_back(&d);
     const size_t block_points = std::max<size_t>(1, kBlockBytes / length);
     const size_t blocks = (count + block_points - 1) / block_points;
@@ -321,7 +323,7 @@ class LasReader {
   LasColorSource source_;
   const LasReadOptions& options_;
   const std::vector<LasField>& fields_;
-  std::vector<LasExtraField> extra_;
+  const std::vector<LasExtraField>& extra_;  // the caller's, which outlives the reader
   std::vector<Dimension*> columns_;  // fields_ then extra_, into the point set being read
   uint32_t extra_at_ = 0;
   size_t rgb_at_ = 0, class_at_ = 15;
@@ -1027,6 +1029,7 @@ Result<std::unique_ptr<LasPointStream>> LasPointStream::open(const std::string& 
   st.threads = resolveThreads(threads);
   st.fields = lasFields(st.header.point_format);
   st.extra = extraFieldsOf(path, st.header, readVlrs(st.file, st.header), &st.notices);
+  st.dimensions.reserve(st.fields.size() + st.extra.size());
   for (const LasField& f : st.fields) st.dimensions.append(f.name, f.type, 0);
   for (const LasExtraField& f : st.extra) st.dimensions.append(f.name, f.dimensionType(), 0);
   if (st.header.compressed) {

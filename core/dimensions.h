@@ -172,6 +172,8 @@ class Dimensions {
     return columns_.emplace_back(name, type, points, Dimension::Unset{});
   }
   bool remove(std::string_view name);
+  // Room for `columns` in all (a reader adding thousands: a LAS record's extra bytes).
+  void reserve(size_t columns) { columns_.reserve(columns); }
   // Every column resized to `points` (new values 0).
   void resize(size_t points);
   // The same with the new values unset (Dimension::resizeUnset).

@@ -14,6 +14,7 @@
 #include "converters/gltf_read.h"
 #include "converters/gltf_write.h"
 #include "converters/las.h"
+#include "converters/las_fields.h"
 #include "converters/ply.h"
 #include "core/dimensions.h"
 #include "ops/point_filters.h"
@@ -411,6 +412,27 @@ TEST(LasDimensions, theWidestRecordsExtraBytesAreNamedOnce) {
   EXPECT_EQ(points->dimensions.find("extra_byte_65514")->get<uint8_t>(0), 9);
   ASSERT_TRUE(writeLas(dir.file("back.las"), *points));
   EXPECT_TRUE(recordsOf(dir.file("back.las")).bytes == recordsOf(dir.file("wide.las")).bytes);
+}
+
+// Undescribed bytes among described fields come back in offset order, and one whose name a
+// descriptor already took gets a suffix (the fast path that names undescribed bytes without a
+// lookup must not skip that case).
+TEST(LasDimensions, undescribedBytesSitBetweenDescribedFieldsAndKeepTheirNamesUnique) {
+  LasVlr vlr;
+  vlr.user_id = "LASF_Spec";
+  vlr.record_id = 4;
+  vlr.data.assign(2 * 192, '\0');
+  vlr.data[2] = 0, vlr.data[3] = 1;  // one undocumented byte: offset 0, kept as extra_byte_0
+  vlr.data[192 + 2] = 3;             // uint16 at offsets 1-2, named as an undescribed byte would be
+  std::memcpy(vlr.data.data() + 192 + 4, "extra_byte_3", 12);
+  Result<std::vector<LasExtraField>> fields = lasExtraFields(&vlr, 5, lasFields(0));
+  ASSERT_TRUE(fields) << fields.error().message;
+  std::vector<std::string> names;
+  std::vector<uint32_t> offsets;
+  for (const LasExtraField& f : *fields) names.push_back(f.name), offsets.push_back(f.offset);
+  EXPECT_EQ(names, (std::vector<std::string>{"extra_byte_0", "extra_byte_3", "extra_byte_3_2", "extra_byte_4"}));
+  EXPECT_EQ(offsets, (std::vector<uint32_t>{0, 1, 3, 4}));
+  EXPECT_EQ((*fields)[1].type, DimType::kU16);
 }
 
 TEST(LasDimensions, aSetWithoutLasSourceGetsTheSmallestFormatThatHoldsIt) {
