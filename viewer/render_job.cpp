@@ -63,6 +63,7 @@ struct LoadedSet {
   const PointSet* points() const { return owned ? &*owned : shared.get(); }
   std::unique_ptr<PointInputStream> stream;
   uint64_t stream_block = kStreamBlockPoints;  // a stream's points a block (streamBlockPoints)
+  uint64_t stream_point_bytes = kStreamPointBytes;  // a stream's host bytes a point in a block
   size_t count = 0;
   Bounds bounds;
   bool has_colors = false;
@@ -297,6 +298,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     Result<uint64_t> stream_block = checkStreamMemory(inputs, ply->count(), request.max_memory, point_bytes);
     if (!stream_block) return stream_block.error();
     set.stream_block = *stream_block;
+    set.stream_point_bytes = point_bytes;
     set.count = ply->count(), set.has_colors = ply->hasColors();
     if (request.color == RenderColor::kAuto || request.color == RenderColor::kRgb) {
       if (Status s = readPreview(*ply, set); !s) return s.error();
@@ -722,28 +724,43 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
   return true;
 }
 
-// A CPU device's memory is the host's (lavapipe, the default without a GPU): while a render of a
-// set in memory runs, its budget is what --max-memory leaves beside the points read, or
-// --max-device-memory where that is lower. The picture's images and readback are the device's
-// buffers, charged there. A refusal is then exit 4 naming --max-memory (vulkan/buffers.cpp). Put
-// back at the end: a Python Renderer's device outlives it. (A stream's blocks are sized to
-// --max-memory before the device is known: its device buffers are not counted yet.)
+// The host bytes a stream's two blocks in flight hold (what checkStreamMemory charges).
+uint64_t streamHeldBytes(const LoadedSet& set) {
+  return 2 * std::min<uint64_t>(set.count, set.stream_block) * set.stream_point_bytes;
+}
+
+// A stream on a CPU device: its blocks were sized to --max-memory before the device was known;
+// the render pass's are now sized to half of it, the other half left to the device's copy of the
+// set (HostMemoryBudget). The passes before (bounds, outline) held no device memory.
+void shareStreamMemoryWithCpuDevice(const VulkanContext& context, const RenderRequest& request, LoadedSet& set) {
+  if (context.facts.type != "cpu" || !set.stream) return;
+  const uint64_t limit = request.max_memory ? request.max_memory : defaultMemoryLimit();
+  set.stream_block = std::min(set.stream_block, streamBlockPoints(limit / 2, set.stream_point_bytes));
+}
+
+// A CPU device's memory is the host's (lavapipe, the default without a GPU): while a render runs,
+// the device's budget is what --max-memory leaves beside the points read (a stream: its blocks),
+// or --max-device-memory where that is lower. The points' device copies, the picture's images and
+// the readback are the device's buffers, charged there; a stream's device copy is the whole set,
+// which without this bound took host memory past --max-memory. A refusal is then exit 4 naming
+// --max-memory (vulkan/buffers.cpp). Put back at the end: a Python Renderer's device outlives it.
 class HostMemoryBudget {
  public:
   HostMemoryBudget(VulkanContext& context, const RenderRequest& request, const LoadedSet& set)
       : context_(context), budget_(context.device_memory_budget), host_(context.host_budget) {
     const PointSet* points = set.points();
-    if (context.facts.type != "cpu" || !points) return;
+    if (context.facts.type != "cpu" || (!points && !set.stream)) return;
     const uint64_t limit = request.max_memory ? request.max_memory : defaultMemoryLimit();
-    const uint64_t held = heldBytes(*points);
+    const uint64_t held = points ? heldBytes(*points) : streamHeldBytes(set);
     const uint64_t left = limit > held ? limit - held : 1;  // 0 would be no budget at all
     if (budget_ != 0 && budget_ <= left) return;
     const std::string option =
         request.max_memory ? "--max-memory " + formatBytes(limit) : "--max-memory (" + formatBytes(limit) + ", half of RAM)";
     context.device_memory_budget = left;
+    const std::string what = points ? " of points read" : " of the stream's blocks";
     context.host_budget = limit > held ? "the " + formatBytes(left) + " that " + option + " leaves beside the " +
-                                             formatBytes(held) + " of points read"
-                                       : option + ", which the " + formatBytes(held) + " of points read already take";
+                                             formatBytes(held) + what
+                                       : option + ", which the " + formatBytes(held) + what + " already take";
   }
   ~HostMemoryBudget() {
     context_.device_memory_budget = budget_;
@@ -1085,6 +1102,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   else
     return made.error();
   outcome.phases.mark("device");  // what is left of making it once the input is in
+  shareStreamMemoryWithCpuDevice(*outcome.context, request, *set);
   const HostMemoryBudget host_budget(*outcome.context, request, *set);
   const VulkanContext& context = *outcome.context;
   outcome.device = context.facts;

@@ -288,6 +288,24 @@ TEST(CliRender, aCpuDevicesBuffersCountAgainstMaxMemory) {
   const test::CommandResult drawn = runDpoint(enough);
   EXPECT_EQ(drawn.exit_code, 0) << drawn.err;
   EXPECT_TRUE(std::filesystem::exists(dir.file("enough.png")));
+
+  // A stream's device copy is the whole set: beside its two blocks of 1M points (72 MB, 68.7 MiB) it does
+  // not fit 80M, which the build before let it pass unseen; 120M holds both.
+  std::vector<std::string> stream = render;
+  stream[5] = "on";
+  std::vector<std::string> stream_tight = stream;
+  stream_tight.insert(stream_tight.end(), {"80M", "-o", dir.file("stream-tight.png")});
+  const test::CommandResult stream_refused = runDpoint(stream_tight);
+  EXPECT_EQ(stream_refused.exit_code, 4) << stream_refused.err;
+  EXPECT_NE(stream_refused.err.find("that --max-memory 80.0 MiB leaves beside the 68.7 MiB of the stream's blocks"),
+            std::string::npos)
+      << stream_refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("stream-tight.png")));
+  std::vector<std::string> stream_enough = stream;
+  stream_enough.insert(stream_enough.end(), {"120M", "-o", dir.file("stream-enough.png")});
+  const test::CommandResult stream_drawn = runDpoint(stream_enough);
+  EXPECT_EQ(stream_drawn.exit_code, 0) << stream_drawn.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("stream-enough.png")));
 }
 
 // A stream whose two blocks of 16.7M points would pass --max-memory is read in smaller blocks
@@ -306,8 +324,8 @@ TEST(CliRender, aStreamIsReadInBlocksThatFitMaxMemory) {
       std::vector<std::string> render = {"render", dir.file(std::string(name) + ".ply"), "--stream", "on", "--width",
                                          "256", "--height", "192", "-q", "-o", dir.file(std::to_string(k) + ".png")};
       std::vector<std::string> info = {"info", dir.file(std::string(name) + ".ply"), "--stream", "on"};
-      if (k == 1) {
-        render.insert(render.end(), {"--max-memory", "100M"});
+      if (k == 1) {  // the render's blocks on a CPU device take half of --max-memory, beside its copy of the set
+        render.insert(render.end(), {"--max-memory", "150M"});
         info.insert(info.end(), {"--max-memory", "100M"});
       }
       const test::CommandResult drawn = runDpoint(render);
@@ -317,7 +335,7 @@ TEST(CliRender, aStreamIsReadInBlocksThatFitMaxMemory) {
       ASSERT_EQ(told.exit_code, 0) << told.err;
       reports[k] = told.out;
     }
-    EXPECT_TRUE(pictures[0] == pictures[1]) << "blocks of 1441792 points draw what one block draws";
+    EXPECT_TRUE(pictures[0] == pictures[1]) << "blocks of 1048576 points draw what one block draws";
     EXPECT_EQ(reports[0], reports[1]);
   }
 }
