@@ -162,8 +162,9 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->default_val("binary");
   cmd->add_option("--crs", o->crs,
                   "LAS/LAZ/COPC: the coordinate reference system, as EPSG:CODE (EPSG:32633; with heights EPSG:6580+5703),\n"
-                  "WKT, or a file holding WKT (a .prj); written as WKT in a LAS 1.4 file, in place of the input's CRS\n"
-                  "records. Default: the input's")
+                  "WKT, or a file holding WKT (a .prj), in place of the input's CRS records: an EPSG CRS as GeoTIFF keys\n"
+                  "in a LAS 1.2 file where nothing else needs LAS 1.4 (what every LAS reader takes), any other as WKT\n"
+                  "in a LAS 1.4 file. Default: the input's")
       ->type_name("CRS");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "

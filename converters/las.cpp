@@ -618,7 +618,11 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   if (l.record_length > 65535)
     return Error{path + ": " + str(points.dimensions.count()) + " dimensions make a " + str(l.record_length) +
                  "-byte record, beyond LAS's 65535"};
-  const bool v14 = l.format >= 6 || (source && source->version_minor >= 4) || n > UINT32_MAX || !crs_wkt.empty();
+  // A CRS given: GeoTIFF keys in a LAS 1.2 file where nothing else needs 1.4 and the keys can say it
+  // (an EPSG code: what every LAS reader takes), else WKT, which needs 1.4.
+  const bool needs14 = l.format >= 6 || (source && source->version_minor >= 4) || n > UINT32_MAX;
+  const std::vector<LasVlr> given_keys = !crs_wkt.empty() && !needs14 ? lasGeoKeyRecords(crs_wkt) : std::vector<LasVlr>();
+  const bool v14 = needs14 || (!crs_wkt.empty() && given_keys.empty());
   l.version_minor = v14 ? 4 : 2;
   // Bit 0: GPS time is adjusted standard time; bit 4 (1.4): the coordinate system is WKT.
   l.global_encoding = source ? static_cast<uint16_t>(source->global_encoding & (v14 ? 0x11 : 0x01)) : 0;
@@ -628,11 +632,15 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   l.file_source_id = source ? source->file_source_id : 0;
   // Formats 6-10 hold their CRS as WKT alone: GeoTIFF keys are made WKT (converters/las_crs.h).
   std::vector<LasVlr> crs = source ? source->vlrs : std::vector<LasVlr>();
-  if (!crs_wkt.empty()) {  // the CRS given, as WKT, in a LAS 1.4 file
+  if (!crs_wkt.empty()) {  // the CRS given: as GeoTIFF keys in LAS 1.2, or as WKT in LAS 1.4
     const std::string before = source ? lasCrsSummary(crs, lasSaysWkt(*source)) : std::string();
     if (!before.empty()) l.crs_note = "the input's CRS (" + before + ") replaced by " + wktName(crs_wkt);
-    crs = {lasWktRecord(crs_wkt)};
-    l.global_encoding |= 0x10;
+    if (!given_keys.empty()) {
+      crs = given_keys;
+    } else {
+      crs = {lasWktRecord(crs_wkt)};
+      l.global_encoding |= 0x10;
+    }
   } else if (l.format >= 6) {
     LasWktCrs wkt = lasWktCrs(crs, source && lasSaysWkt(*source));
     crs = std::move(wkt.records);

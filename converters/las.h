@@ -130,8 +130,10 @@ struct LasWriteOptions {
   // (COPC's formats; a format 4/5 source with compress is written as 6 or 7 too).
   bool las14 = false;
   // When not empty, the file's CRS (one line of OGC WKT 1, crsAsWkt's) in place of the source's CRS
-  // records: a LAS 1.4 file with the WKT bit set, whatever its point format (LAS 1.4 R15 allows
-  // WKT for every format; LAS 1.2 has GeoTIFF keys only).
+  // records: as GeoTIFF keys in a LAS 1.2 file where the point format, the count and the source's
+  // version allow 1.2 and the CRS is an EPSG one the keys hold (lasGeoKeyRecords), else a LAS 1.4
+  // file with the WKT bit set, whatever its point format (LAS 1.4 R15 allows WKT for every format;
+  // LAS 1.2 has GeoTIFF keys only).
   std::string crs_wkt;
   // When set, the file's bytes are appended here and nothing is written at `path` (which names the
   // output in messages).

@@ -4,6 +4,7 @@
 #include <proj.h>
 #include <proj_experimental.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -24,7 +25,7 @@ namespace {
 
 constexpr uint16_t kWktRecord = 2112, kGeoKeys = 34735, kGeoDoubles = 34736, kGeoAscii = 34737;
 // GeoTIFF keys (GeoTIFF 1.1, section 7) the conversion and the summary read.
-constexpr uint16_t kModelType = 1024, kCitation = 1026, kGeographicType = 2048, kGeographicCitation = 2049, kProjectedType = 3072,
+constexpr uint16_t kModelType = 1024, kRasterType = 1025, kCitation = 1026, kGeographicType = 2048, kGeographicCitation = 2049, kProjectedType = 3072,
                    kProjectedCitation = 3073, kProjLinearUnits = 3076, kVerticalType = 4096, kVerticalUnits = 4099;
 constexpr uint16_t kUserDefined = 32767;
 
@@ -150,6 +151,10 @@ struct ProjApi {
   decltype(&proj_uom_get_info_from_database) uom_get_info_from_database = nullptr;
   decltype(&proj_crs_alter_cs_linear_unit) crs_alter_cs_linear_unit = nullptr;
   decltype(&proj_create_compound_crs) create_compound_crs = nullptr;
+  decltype(&proj_get_id_auth_name) get_id_auth_name = nullptr;
+  decltype(&proj_get_id_code) get_id_code = nullptr;
+  decltype(&proj_crs_get_sub_crs) crs_get_sub_crs = nullptr;
+  decltype(&proj_is_equivalent_to) is_equivalent_to = nullptr;
   std::string error;  // why PROJ cannot be used; empty when it can
 };
 
@@ -181,6 +186,10 @@ ProjApi loadProj() {
   bind(api.uom_get_info_from_database, "proj_uom_get_info_from_database");
   bind(api.crs_alter_cs_linear_unit, "proj_crs_alter_cs_linear_unit");
   bind(api.create_compound_crs, "proj_create_compound_crs");
+  bind(api.get_id_auth_name, "proj_get_id_auth_name");
+  bind(api.get_id_code, "proj_get_id_code");
+  bind(api.crs_get_sub_crs, "proj_crs_get_sub_crs");
+  bind(api.is_equivalent_to, "proj_is_equivalent_to");
   return api;  // the library stays loaded for the process
 }
 
@@ -290,6 +299,87 @@ std::string wktName(const std::string& wkt) {
 LasVlr lasWktRecord(const std::string& wkt) {
   const bool extended = wkt.size() >= 65535;  // a VLR holds at most 65535 bytes; an EVLR more
   return LasVlr{"LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt + '\0', extended};
+}
+
+namespace {
+
+// The EPSG code of `object` where it has one that a GeoTIFF key holds (1-32766), and PROJ's database
+// defines it as the object says (axis order aside): a WKT that names EPSG:32633 but changes its
+// parameters keeps its WKT.
+std::optional<uint16_t> epsgCode(const ProjApi& api, Proj& proj, PJ* object) {
+  const char* authority = api.get_id_auth_name(object, 0);
+  const char* code = api.get_id_code(object, 0);
+  if (!authority || !code || std::strcmp(authority, "EPSG") != 0) return std::nullopt;
+  char* end = nullptr;
+  const long value = std::strtol(code, &end, 10);
+  if (*end != '\0' || value < 1 || value >= kUserDefined) return std::nullopt;
+  PJ* defined = proj.keep(api.create_from_database(proj.context(), "EPSG", code, PJ_CATEGORY_CRS, 0, nullptr));
+  if (!defined || !api.is_equivalent_to(object, defined, PJ_COMP_EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS))
+    return std::nullopt;
+  return static_cast<uint16_t>(value);
+}
+
+// The EPSG code of the unit of `crs`'s first axis, where it has one a key holds.
+std::optional<uint16_t> axisUnit(const ProjApi& api, Proj& proj, PJ* crs) {
+  PJ* cs = proj.keep(api.crs_get_coordinate_system(proj.context(), crs));
+  const char* authority = nullptr;
+  const char* code = nullptr;
+  if (!cs || !api.cs_get_axis_info(proj.context(), cs, 0, nullptr, nullptr, nullptr, nullptr, nullptr, &authority, &code) ||
+      !authority || !code || std::strcmp(authority, "EPSG") != 0)
+    return std::nullopt;
+  char* end = nullptr;
+  const long value = std::strtol(code, &end, 10);
+  if (*end != '\0' || value < 1 || value >= kUserDefined) return std::nullopt;
+  return static_cast<uint16_t>(value);
+}
+
+}  // namespace
+
+std::vector<LasVlr> lasGeoKeyRecords(const std::string& wkt) {
+  const ProjApi& api = projApi();
+  if (!api.error.empty()) return {};
+  Proj proj(api);
+  if (!proj.context()) return {};
+  PJ* crs = proj.keep(api.create(proj.context(), wkt.c_str()));
+  if (!crs || !api.is_crs(crs)) return {};
+  PJ* horizontal = crs;
+  PJ* vertical = nullptr;
+  if (api.get_type(crs) == PJ_TYPE_COMPOUND_CRS) {
+    horizontal = proj.keep(api.crs_get_sub_crs(proj.context(), crs, 0));
+    vertical = proj.keep(api.crs_get_sub_crs(proj.context(), crs, 1));
+    if (!horizontal || !vertical || api.get_type(vertical) != PJ_TYPE_VERTICAL_CRS) return {};
+  }
+  const PJ_TYPE type = api.get_type(horizontal);
+  if (type != PJ_TYPE_PROJECTED_CRS && type != PJ_TYPE_GEOGRAPHIC_2D_CRS) return {};
+  const std::optional<uint16_t> code = epsgCode(api, proj, horizontal);
+  if (!code) return {};
+  std::map<uint16_t, uint16_t> keys = {{kModelType, type == PJ_TYPE_PROJECTED_CRS ? 1 : 2}, {kRasterType, 1}};
+  keys[type == PJ_TYPE_PROJECTED_CRS ? kProjectedType : kGeographicType] = *code;
+  if (type == PJ_TYPE_PROJECTED_CRS)
+    if (std::optional<uint16_t> unit = axisUnit(api, proj, horizontal)) keys[kProjLinearUnits] = *unit;
+  if (vertical) {
+    const std::optional<uint16_t> vertical_code = epsgCode(api, proj, vertical);
+    if (!vertical_code) return {};
+    keys[kVerticalType] = *vertical_code;
+    if (std::optional<uint16_t> unit = axisUnit(api, proj, vertical)) keys[kVerticalUnits] = *unit;
+  }
+  // The citation: the CRS's name, '|'-ended as GeoTIFF's ASCII parameters are.
+  const char* name = api.get_name(crs);
+  std::string ascii = std::string(name ? name : "") + "|";
+  // The directory (GeoTIFF 1.1, 7.1): version 1.1.0 and the key count, then each key in order of
+  // its number: id, where its value is (0: in place; 34737: the ASCII parameters), count, value.
+  std::string directory;
+  const auto put = [&](uint16_t a, uint16_t b, uint16_t c, uint16_t d) {
+    for (uint16_t v : {a, b, c, d}) directory.append(reinterpret_cast<const char*>(&v), 2);
+  };
+  keys[kCitation] = 0;  // placed in order below
+  put(1, 1, 0, static_cast<uint16_t>(keys.size()));
+  for (const auto& [id, value] : keys) {
+    if (id == kCitation) put(id, kGeoAscii, static_cast<uint16_t>(ascii.size()), 0);
+    else put(id, 0, 1, value);
+  }
+  return {LasVlr{"LASF_Projection", kGeoKeys, "GeoTIFF GeoKeyDirectoryTag", directory, false},
+          LasVlr{"LASF_Projection", kGeoAscii, "GeoTIFF GeoAsciiParamsTag", ascii + '\0', false}};
 }
 
 Result<std::string> crsAsWkt(const std::string& text, const std::string& option) {

@@ -46,6 +46,12 @@ LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit);
 // (`--crs`). The error says why not, naming `option` and the text.
 Result<std::string> crsAsWkt(const std::string& text, const std::string& option = "--crs");
 
+// The GeoTIFF keys (LASF_Projection 34735, with the CRS's name in 34737) of `wkt` (crsAsWkt's),
+// for a LAS 1.2 file: where it is an EPSG projected or 2D geographic CRS, alone or with an EPSG
+// vertical CRS, as PROJ's database defines them (ProjectedCSType or GeographicType, the linear and
+// vertical units, VerticalCSType); empty for any other CRS, which only WKT in LAS 1.4 holds.
+std::vector<LasVlr> lasGeoKeyRecords(const std::string& wkt);
+
 // A LAS WKT record (LASF_Projection 2112) holding `wkt`.
 LasVlr lasWktRecord(const std::string& wkt);
 

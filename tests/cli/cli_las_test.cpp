@@ -192,16 +192,18 @@ TEST(CliLas, infoPrintsTheLasHeader) {
     EXPECT_NE(wrong.out.find(part), std::string::npos) << part << " in\n" << wrong.out;
 }
 
-// --crs: the CRS given (EPSG:CODE, WKT, a file holding WKT) becomes the output's WKT record in a LAS
-// 1.4 file, in place of the input's records (a note says so); a code PROJ does not know, a missing
-// file and an output that holds no CRS are usage errors that write nothing.
-TEST(CliLas, crsGivenIsWrittenAsWkt) {
+// --crs: the CRS given (EPSG:CODE, WKT, a file holding WKT) takes the place of the input's records (a
+// note says so): an EPSG one as GeoTIFF keys in the LAS 1.2 file the input makes, any other as the
+// WKT record of a LAS 1.4 file; a code PROJ does not know, a missing file and an output that holds
+// no CRS are usage errors that write nothing.
+TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
   TempDir dir;
   test::CommandResult r = runDpoint({"convert", kCorpus + "simple.las", "--crs", "EPSG:32633", "-o", dir.file("a.las")});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   test::CommandResult info = runDpoint({"info", dir.file("a.las"), "--quiet"});
-  EXPECT_NE(info.out.find("LAS:                version 1.4, point format 3"), std::string::npos) << info.out;
-  EXPECT_NE(info.out.find("LAS CRS:            WGS 84 / UTM zone 33N, WKT\n"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS:                version 1.2, point format 3"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS CRS:            EPSG:32633 (WGS 84 / UTM zone 33N), GeoTIFF keys\n"), std::string::npos)
+      << info.out;
   // A file holding WKT; the input's GeoTIFF keys replaced, with a note naming both.
   writeFile(dir.file("utm33.prj"), "PROJCS[\"mine\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,"
                                    "298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],"
