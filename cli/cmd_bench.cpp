@@ -53,6 +53,9 @@ uint64_t fileSize(const std::string& path) {
 }
 
 int runBenchIo(const BenchIoOptions& o) {
+  // As convert's -o: writing over the input would replace the file being timed (a review finding).
+  if (!o.write.empty())
+    if (Status s = checkNotAlso("--write", o.write, {{"the input", o.input}}); !s) return reportError(s.error());
   auto t0 = std::chrono::steady_clock::now();
   Result<PointSet> points = readPoints(o.input, ReadOptions{o.common.threads, false, nullptr});
   if (!points) return reportError(points.error());

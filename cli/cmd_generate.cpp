@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -32,6 +33,11 @@ Status parseBounds(const std::string& text, double& lo, double& hi) {
   if (!bounds) return bounds.error();
   lo = (*bounds)[0];
   hi = (*bounds)[1];
+  // Each a finite double, their span not (a review finding: -1e308,1e308 wrote NaN and infinite
+  // positions that no reader takes back).
+  if (!std::isfinite(hi - lo))
+    return Error{"--bounds " + text + ": HI - LO is beyond the largest double; give a range whose width is finite",
+                 ExitCode::kUsage};
   return okStatus();
 }
 

@@ -3,6 +3,7 @@
 // printing only: the run, its policies and its JSON report are viewer/render_job.h.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "cli/cli_camera.h"
@@ -272,8 +273,14 @@ int runRender(const RenderCliOptions& o) {
     printWarnings(*outcome);
     return finished();
   }
+  // The report comes after the picture (it times the PNG's writing): where it cannot be written,
+  // the picture goes too, as a failed run leaves nothing (a review finding: a full disk left it).
   if (!o.json.empty())
-    if (Status s = writeReport(o.json, *request, *outcome); !s) return reportError(s.error());
+    if (Status s = writeReport(o.json, *request, *outcome); !s) {
+      std::error_code ignored;
+      if (std::filesystem::is_regular_file(o.output, ignored)) std::filesystem::remove(o.output, ignored);
+      return reportError(s.error());
+    }
   if (!o.common.quiet) printOutcome(*request, o.output, *outcome);
   printWarnings(*outcome);
   return finished();

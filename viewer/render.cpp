@@ -61,6 +61,14 @@ Status checkOptions(const VulkanContext& context, size_t count, const Camera& ca
   if (count > UINT32_MAX)
     return Error{"more than 2^32 points (" + std::to_string(count) + ") are not supported", ExitCode::kResourceLimit};
   if (options.frames == 0) return Error{"--frames 0: must be at least 1", ExitCode::kUsage};
+  // Each draw has buffers of its own (a review finding: --chunk-points 1 made 100,000 draws of
+  // 100,000 points, which took 990 MB past --max-memory 200M; NVIDIA's driver allows 4,096
+  // allocations in all).
+  if (options.max_chunk_points && (count - 1) / options.max_chunk_points + 1 > kMaxChunks)
+    return Error{"--chunk-points " + std::to_string(options.max_chunk_points) + ": " + std::to_string(count) +
+                     " points would take more than " + std::to_string(kMaxChunks) + " draws; give at least " +
+                     std::to_string((count - 1) / kMaxChunks + 1),
+                 ExitCode::kUsage};
   const DeviceFacts& f = context.facts;
   if (!(options.point_size >= 1.0f) || options.point_size > f.max_point_size)
     return Error{"--point-size " + formatNumber(options.point_size) + ": must be 1.." + formatNumber(f.max_point_size) +

@@ -120,6 +120,10 @@ bool shadingFits(const DeviceFacts& facts, uint32_t width, uint32_t height, cons
 Result<RenderResult> renderPoints(const VulkanContext& context, const PointSet& points, const Camera& camera,
                                   const RenderOptions& options, const ModeEncoding* prepared = nullptr);
 
+// The most draws (chunks) --chunk-points may cut a set into: each has buffers of its own, a few
+// allocations of the 4,096 NVIDIA's driver allows.
+inline constexpr uint64_t kMaxChunks = 1024;
+
 // A point set read a block at a time, in order: how `dpoint render` draws a file larger than the
 // host memory should hold. read(first, n, block) replaces `block` with points [first, first + n)
 // (positions, and colours when has_colors); it is called for consecutive ranges from 0 on, each

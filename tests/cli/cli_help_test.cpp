@@ -249,6 +249,11 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       // README's promise for every command (a review finding: convert and merge replaced their input).
       {{"convert", in, "-o", in}, "-o " + in + ": is also the input (" + in + ")"},
       {{"merge", ply, in, "-o", in}, "-o " + in + ": is also a tile (" + in + ")"},
+      // Review findings: bench io --write over its input replaced it; a --bounds span past the
+      // largest double wrote NaN positions.
+      {{"bench", "io", in, "--write", in}, "--write " + in + ": is also the input (" + in + ")"},
+      {{"generate", "julia", "--resolution", "10", "--bounds=-1e308,1e308", "-o", ply},
+       "--bounds -1e308,1e308: HI - LO is beyond the largest double"},
       // The other classes: bad input (2), no usable device (3), a resource limit (4).
       {{"convert", missing, "-o", ply}, missing + ": file not found", 2},
       {{"info", links.file("zero.ply")}, links.file("zero.ply") + ": not a regular file (a device)", 2},

@@ -308,6 +308,37 @@ TEST(CliRender, aCpuDevicesBuffersCountAgainstMaxMemory) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("stream-enough.png")));
 }
 
+// A report that cannot be written fails the run, and the picture written before it goes too: a
+// failed run leaves nothing (a review finding: --json onto a full disk left the PNG).
+TEST(CliRender, aReportThatCannotBeWrittenTakesThePictureWithIt) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "100", "-q", "-o", dir.file("r.ply")}).exit_code, 0);
+  std::filesystem::create_symlink("/dev/full", dir.file("full.json"));
+  const test::CommandResult r = runDpoint({"render", dir.file("r.ply"), "--width", "32", "--height", "32", "-q", "-o",
+                                           dir.file("r.png"), "--json", dir.file("full.json")});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.png")));
+}
+
+// Each draw has buffers of its own: --chunk-points that would cut a set into more than kMaxChunks
+// draws is refused before any is made (a review finding: --chunk-points 1 over 100,000 points took
+// 990 MB past --max-memory 200M).
+TEST(CliRender, chunkPointsMakingThousandsOfDrawsIsRefused) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "2000", "-q", "-o", dir.file("r.ply")}).exit_code, 0);
+  const test::CommandResult refused = runDpoint({"render", dir.file("r.ply"), "--chunk-points", "1", "--width", "32",
+                                                 "--height", "32", "-q", "-o", dir.file("r.png")});
+  EXPECT_EQ(refused.exit_code, 1) << refused.err;
+  EXPECT_NE(refused.err.find("--chunk-points 1: 2000 points would take more than 1024 draws; give at least 2"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.png")));
+  const test::CommandResult drawn = runDpoint({"render", dir.file("r.ply"), "--chunk-points", "2", "--width", "32",
+                                               "--height", "32", "-q", "-o", dir.file("r.png")});
+  EXPECT_EQ(drawn.exit_code, 0) << drawn.err;
+}
+
 // A stream whose two blocks of 16.7M points would pass --max-memory is read in smaller blocks
 // instead of being refused (2M points took 144 MB, over a limit of 100M): the same picture and the
 // same report as in one block, for a 2D set (one pass) and a 3D one (bounds, outline, spacing and
