@@ -153,8 +153,9 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
   }
   if (points.size() > 0) {
     Result<Camera> camera = renderView(options, boundsWithOutline(points), points.z_up);
-    if (!camera) return camera.error();
-    report.advice = InfoAdvice{*camera, predictErrorBounds(points, *camera, {}, options.tolerance_px)};
+    if (!camera && camera.error().code != ExitCode::kBadInput) return camera.error();
+    if (camera) report.advice = InfoAdvice{*camera, predictErrorBounds(points, *camera, {}, options.tolerance_px)};
+    else report.no_view = camera.error().message;  // the data's (a review finding: info refused to describe them)
   }
   return report;
 }
@@ -190,8 +191,9 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
     Result<Camera> camera = renderView(options, boundsOfBoxes(boxes), false);
-    if (!camera) return camera.error();
-    report.advice = InfoAdvice{*camera, predictBoxBounds(boxes, *camera, {}, options.tolerance_px)};
+    if (!camera && camera.error().code != ExitCode::kBadInput) return camera.error();
+    if (camera) report.advice = InfoAdvice{*camera, predictBoxBounds(boxes, *camera, {}, options.tolerance_px)};
+    else report.no_view = camera.error().message;
   }
   return report;
 }
@@ -325,6 +327,7 @@ std::string infoReportText(const InfoReport& report) {
                      " sampled)\n") +
           "float32 enough:     " + floatEnoughText(report) + "\n";
   if (report.advice) text += adviceText(*report.advice);
+  if (!report.no_view.empty()) text += "view:               none: " + report.no_view + "\n";
   return text;
 }
 
@@ -356,6 +359,7 @@ std::string infoReportJson(const InfoReport& report) {
             ", \"file_bytes\": " + str(c->file_bytes) + "}";
   if (report.las) json += lasJson(*report.las);
   if (report.advice) json += adviceJson(*report.advice);
+  if (!report.no_view.empty()) json += ",\n  \"no_view\": " + jsonString(report.no_view);
   return json + "\n}\n";
 }
 

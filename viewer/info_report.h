@@ -70,7 +70,10 @@ struct InfoReport {
   // One COPC file, read by view (describeFiles): the points, bytes and nodes its view read; the
   // facts are of those points, the LAS header's of the whole file.
   std::optional<CopcReadStats> copc;
-  std::optional<InfoAdvice> advice;  // none for an empty set
+  std::optional<InfoAdvice> advice;  // none for an empty set, or one with no view
+  // Why a set of points has no view, so no bound by mode (its extent overflows a double: ±1e308);
+  // the rest of the report stands. Empty otherwise.
+  std::string no_view;
   // What the readers read past (ReadOptions::notices), one line each: describeFiles's; the CLI
   // prints them on stderr.
   std::vector<std::string> notices;

@@ -84,6 +84,14 @@ struct LoadedSet {
   MeshTexture texture;                 // a glTF mesh's base-colour textures, for its surface's colours
 };
 
+// A view the data cannot have (their extent overflows a double) names the inputs, as every error
+// of bad input does (a review finding: "the view inf wide ..." named no file); the options' own
+// errors stand as they are.
+Error viewErrorOf(const LoadedSet& set, Error error) {
+  if (error.code == ExitCode::kBadInput) error.message = set.inputs + ": " + error.message;
+  return error;
+}
+
 // One pass over a streamed set, `points` a block, showing `what` as progress.
 Status forEachBlock(PointInputStream& ply, uint64_t points, Progress& progress, const std::string& what,
                     const std::function<void(const PointSet& block)>& visit) {
@@ -701,7 +709,7 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
     if (wantsElevation(request, set.has_colors, set.bounds)) return read_again();
     Result<std::vector<Camera>> cameras = viewCameras(request, views, set.bounds, set.z_up);
     if (cameras) cameras = refitForPoints(request, set, views, context.facts, std::move(*cameras));
-    if (!cameras) return cameras.error();
+    if (!cameras) return viewErrorOf(set, cameras.error());
     camera = cameras->front();
     Result<ModePrediction> prediction = predictMode(request, context, set, camera);
     if (!prediction) return prediction.error();
@@ -1091,7 +1099,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   Result<std::vector<Camera>> cameras = std::vector<Camera>();
   if (!set->one_pass) {
     cameras = viewCameras(request, views, set->bounds, set->z_up);
-    if (!cameras) return cameras.error();
+    if (!cameras) return viewErrorOf(*set, cameras.error());
     outcome.phases.mark("camera");
   }
 
@@ -1122,7 +1130,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
     set->elevation = wantsElevation(request, set->has_colors, set->bounds);
     outcome.read_twice = true;
     cameras = viewCameras(request, views, set->bounds, set->z_up);
-    if (!cameras) return cameras.error();
+    if (!cameras) return viewErrorOf(*set, cameras.error());
   }
   cameras = refitForPoints(resolved, *set, views, context.facts, std::move(*cameras));
   if (!cameras) return cameras.error();

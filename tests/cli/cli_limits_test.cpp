@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,32 @@ struct Huge {
   int exit_code;
   std::string number;             // the message names it
 };
+
+// Finite data whose extent overflows a double (±1e308) have no view: info describes them all the
+// same and says why there is no bound by mode, in memory and streamed; render refuses them naming
+// the file (a review finding: both failed with a message that named nothing, and info printed
+// nothing).
+TEST(CliLimits, dataTooWideForAViewAreDescribedAndTheRefusalNamesThem) {
+  TempDir dir;
+  test::writeFile(dir.file("wide.csv"), "x,y,z\n1e308,2,3\n-1e308,5,6\n");
+  test::writeFile(dir.file("wide2d.csv"), "x,y\n1e308,0\n-1e308,1\n");
+  ASSERT_EQ(test::runDpoint({"convert", dir.file("wide.csv"), "-o", dir.file("wide.ply")}).exit_code, 0);
+  for (const std::string name : {"wide.csv", "wide2d.csv", "wide.ply"}) {
+    SCOPED_TRACE(name);
+    std::vector<std::vector<std::string>> infos = {{"info", dir.file(name)}};
+    if (name == "wide.ply") infos.push_back({"info", dir.file(name), "--stream", "on"});
+    for (const std::vector<std::string>& info : infos) {
+      const test::CommandResult told = test::runDpoint(info);
+      EXPECT_EQ(told.exit_code, 0) << told.err;
+      EXPECT_NE(told.out.find("points:             2\n"), std::string::npos) << told.out;
+      EXPECT_NE(told.out.find("view:               none: "), std::string::npos) << told.out;
+    }
+    const test::CommandResult drawn = test::runDpoint({"render", dir.file(name), "-o", dir.file("w.png"), "-q"});
+    EXPECT_EQ(drawn.exit_code, 2) << drawn.err;
+    EXPECT_EQ(drawn.err.rfind("dpoint: error: " + dir.file(name) + ": ", 0), 0u) << drawn.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("w.png")));
+  }
+}
 
 TEST(CliLimits, hugeCountsFailAtOnceNamingTheNumber) {
   TempDir dir;
