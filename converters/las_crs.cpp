@@ -399,6 +399,10 @@ Result<std::string> crsAsWkt(const std::string& text, const std::string& option)
     if (!file) return Error{what + ": cannot be read", ExitCode::kUsage};
     definition = read.str();
     if (definition.rfind("\xEF\xBB\xBF", 0) == 0) definition.erase(0, 3);  // a UTF-8 byte order mark
+  } else if (std::filesystem::exists(text, error)) {  // a folder or a device (a review finding: "no such file")
+    return Error{what + ": " + (std::filesystem::is_directory(text, error) ? "a folder" : "not a regular file") +
+                     ", not a file holding a CRS",
+                 ExitCode::kUsage};
   } else if (text.find_first_of("[:{+") == std::string::npos) {
     return Error{what + ": no such file, and not EPSG:CODE, WKT, PROJJSON or a PROJ string", ExitCode::kUsage};
   }

@@ -219,6 +219,8 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
   for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"--crs", "EPSG:999999", "-o", dir.file("c.las")}, "--crs 'EPSG:999999': not a coordinate reference system"},
            {{"--crs", dir.file("none.prj"), "-o", dir.file("c.las")}, "no such file"},
+           {{"--crs", dir.path(), "-o", dir.file("c.las")}, "a folder, not a file holding a CRS"},
+           {{"--crs", "/dev/zero", "-o", dir.file("c.las")}, "not a regular file, not a file holding a CRS"},
            {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")}, "only a LAS, LAZ or COPC output holds"}}) {
     std::vector<std::string> command = {"convert", kCorpus + "simple.las"};
     command.insert(command.end(), args.begin(), args.end());
