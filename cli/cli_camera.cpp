@@ -62,8 +62,8 @@ Result<CameraSpec> cameraSpec(const CameraCliOptions& o) {
     spec.view_center = glm::dvec3((*c)[0], (*c)[1], c->size() == 3 ? (*c)[2] : 0.0);
     spec.ortho = true;
   }
-  if (o.view_width != 0.0) {
-    spec.view_width = o.view_width;
+  if (o.view_width) {
+    spec.view_width = *o.view_width;
     spec.ortho = true;
   }
   return spec;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -15,7 +16,8 @@ struct CameraCliOptions {
   uint32_t width = 1024, height = 768;
   std::string eye, target, up, view_center;
   bool fit = false, ortho = false;
-  double fov = 45.0, view_width = 0.0;
+  double fov = 45.0;
+  std::optional<double> view_width;  // given: ortho at this width (0 or less is refused, as -1 was)
   // Not the camera's, but the view's precision target both commands predict for: adaptive mode's.
   std::string tolerance = "0.05";
 };

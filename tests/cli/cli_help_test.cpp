@@ -232,6 +232,7 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"render", in, "-o", png, "--frames", "0"}, "--frames 0: must be at least 1"},
       {{"render", in, "-o", png, "--stream", "sometimes"}, "--stream sometimes: must be auto, on or off"},
       {{"info", in, "--view-width", "-3"}, "--view-width -3: must be a finite number above 0"},
+      {{"info", in, "--view-width", "0"}, "--view-width 0: must be a finite number above 0"},  // 0 was "not given"
       {{"info", in, "--sample", "0"}, "--sample 0: must be a number from 1 to 100000000 (dpoint info --help)"},
       {{"devices", "extra"}, "devices: unexpected argument 'extra' (dpoint devices --help)"},
       {{"bench", "--frames", "0", "--out", dir.file("b")}, "--frames 0: must be at least 1"},
