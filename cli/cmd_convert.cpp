@@ -91,6 +91,19 @@ int runConvert(ConvertOptions& o) {
   w.pcd_encoding = *parsePcdEncoding(o.pcd_encoding);  // checked by the option's validator
   w.progress = &progress;
   w.las_scale = o.las_scale;
+  // Options that would do nothing are refused, as --crs for a PLY output is (a review finding:
+  // each passed silently).
+  if (o.dimensions.keep && !o.dimensions.drop.empty())
+    return reportError(Error{"--keep and --drop: give one of them (--keep names the dimensions that stay, --drop those "
+                             "that go)",
+                             ExitCode::kUsage});
+  if (o.las_scale != 0.0) {
+    const Result<FileFormat> las = formatOf(o.output);
+    if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
+      return reportError(Error{"--las-scale: only a LAS, LAZ or COPC output has a coordinate step, not " +
+                                   quotedExcerpt(o.output),
+                               ExitCode::kUsage});
+  }
   if (o.crs) {
     const Result<FileFormat> las = formatOf(o.output);
     if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
