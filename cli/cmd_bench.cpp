@@ -61,7 +61,12 @@ int runBenchIo(const BenchIoOptions& o) {
   if (!points) return reportError(points.error());
   const double read_s = secondsSince(t0);
   const double in_mb = static_cast<double>(fileSize(o.input)) / 1e6;
-  std::printf("{\"points\": %zu, \"read_s\": %.4f, \"read_MBps\": %.1f", points->size(), read_s, in_mb / read_s);
+  // One line, printed whole at the end: an interrupted or failed write leaves none (a review
+  // finding: half an object was left on stdout).
+  char line[256];
+  std::snprintf(line, sizeof line, "{\"points\": %zu, \"read_s\": %.4f, \"read_MBps\": %.1f", points->size(), read_s,
+                in_mb / read_s);
+  std::string json = line;
   if (!o.write.empty()) {
     WriteOptions w;
     w.threads = o.common.threads;
@@ -70,9 +75,10 @@ int runBenchIo(const BenchIoOptions& o) {
     if (Status s = writePoints(o.write, *points, w); !s) return reportError(s.error());
     const double write_s = secondsSince(t1);
     const double out_mb = static_cast<double>(fileSize(o.write)) / 1e6;
-    std::printf(", \"write_s\": %.4f, \"write_MBps\": %.1f", write_s, out_mb / write_s);
+    std::snprintf(line, sizeof line, ", \"write_s\": %.4f, \"write_MBps\": %.1f", write_s, out_mb / write_s);
+    json += line;
   }
-  std::printf("}\n");
+  std::printf("%s}\n", json.c_str());
   return 0;
 }
 

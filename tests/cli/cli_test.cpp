@@ -347,5 +347,20 @@ TEST(Cli, infoAdvisesEachModesErrorBoundForAView) {
   EXPECT_EQ(runDpoint({"info", dir.file("zoom.csv"), "--view-width", "-1"}).exit_code, 1);
 }
 
+// bench io prints its one JSON line whole at the end: a write that fails leaves nothing on stdout
+// (a review finding: an interrupted one left half an object there).
+TEST(CliBench, ioPrintsItsLineWholeOrNotAtAll) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "random2d", "--count", "1000", "-q", "-o", dir.file("r.ply")}).exit_code, 0);
+  std::filesystem::create_symlink("/dev/full", dir.file("full.csv"));
+  const test::CommandResult failed = runDpoint({"bench", "io", dir.file("r.ply"), "--write", dir.file("full.csv")});
+  EXPECT_EQ(failed.exit_code, 4) << failed.err;
+  EXPECT_EQ(failed.out, "");
+  const test::CommandResult timed = runDpoint({"bench", "io", dir.file("r.ply"), "--write", dir.file("w.csv")});
+  EXPECT_EQ(timed.exit_code, 0) << timed.err;
+  EXPECT_EQ(timed.out.rfind("{\"points\": 1000, \"read_s\": ", 0), 0u) << timed.out;
+  EXPECT_NE(timed.out.find("\"write_MBps\": "), std::string::npos) << timed.out;
+}
+
 }  // namespace
 }  // namespace dpoint
