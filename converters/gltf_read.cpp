@@ -308,7 +308,11 @@ class SceneReader {
 
   Status sceneRoots(std::vector<std::vector<int>>& scenes) const {
     if (model_.scenes.empty()) {
-      // No scene: every node without a parent (a converter's reading of "the whole file").
+      // No scene: every node without a parent (a converter's reading of "the whole file"), as
+      // scene 0; another --scene does not exist (a review finding: it read scene 0 in silence).
+      if (options_.scene > 0)
+        return fail("--scene: scene " + std::to_string(options_.scene) +
+                    " does not exist (the file has no scene; its root nodes are read as scene 0)");
       std::vector<bool> is_child(model_.nodes.size(), false);
       for (const tinygltf::Node& node : model_.nodes)
         for (int child : node.children) is_child[size_t(child)] = true;  // indices checked above

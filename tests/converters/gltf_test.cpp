@@ -619,6 +619,17 @@ TEST(Gltf, gltfSceneSelection) {
   Result<PointSet> missing = readGltf(dir.file("scene.gltf"), options);
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("--scene: scene 5 does not exist"), std::string::npos) << missing.error().message;
+  // A file without scenes is read as scene 0 (its root nodes): another does not exist (a review
+  // finding: --scene 9 read scene 0 in silence).
+  test::writeFile(dir.file("none.gltf"), replaced(fixtureGltf(), R"("scenes": [{"nodes": [0]}],)", ""));
+  options.scene = 0;
+  Result<PointSet> zero = readGltf(dir.file("none.gltf"), options);
+  ASSERT_TRUE(zero) << zero.error().message;
+  options.scene = 9;
+  Result<PointSet> nine = readGltf(dir.file("none.gltf"), options);
+  ASSERT_FALSE(nine);
+  EXPECT_NE(nine.error().message.find("--scene: scene 9 does not exist (the file has no scene"), std::string::npos)
+      << nine.error().message;
 }
 
 TEST(Gltf, gltfRefusesGltf1) {
