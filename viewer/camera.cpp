@@ -356,8 +356,15 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
                        ") are too large " + why + "; try --ortho",
                    ExitCode::kBadInput};
     };
-    if (!isFinite(camera.eye) && isFinite(bounds.min) && isFinite(bounds.max))  // (--allow-nonfinite's data aside)
+    if (!isFinite(camera.eye) && isFinite(bounds.min) && isFinite(bounds.max)) {  // (--allow-nonfinite's data aside)
+      // A field of view so narrow that the distance alone overflows is the option's (a review
+      // finding: --fov 1e-300 blamed coordinates of 0.99).
+      if (std::tan(half_fov) < 1e-10 && !std::isfinite(distance))
+        return Error{"--fov " + shortest(spec.fov_degrees) + ": so narrow a view puts the fitted eye past the largest "
+                         "double; give a wider --fov, or --ortho",
+                     ExitCode::kUsage};
       return too_large("to view in perspective: its eye would lie past the largest double");
+    }
     // A tiny --fov puts the fitted eye so far off that point − eye, in double, no longer places the
     // points within half a pixel: its step at the eye's distance against a pixel there, whatever the
     // scale (--fov 1e-15: the eye 1e17 of the data's sizes away, a blank picture and a bound of 0 px).

@@ -312,6 +312,14 @@ TEST(Camera, coordinatesNearTheLargestDoubleAreBadInputNamingWhy) {
   EXPECT_EQ(perspective.error().code, ExitCode::kBadInput);
   EXPECT_NE(perspective.error().message.find("too large to view in perspective"), std::string::npos) << perspective.error().message;
   EXPECT_EQ(perspective.error().message.find("--view-center"), std::string::npos) << perspective.error().message;
+  // A field of view so narrow that the distance overflows for a unit box: the option's fault, not
+  // the coordinates' (a review finding: "the data's coordinates (up to 0.99) are too large").
+  CameraSpec narrow;
+  narrow.fov_degrees = 1e-300;
+  Result<Camera> needle = makeCamera(narrow, boundsOf(PointSet{PositionArray{{-1, -1, -1}, {1, 1, 1}}}));
+  ASSERT_FALSE(needle.ok());
+  EXPECT_EQ(needle.error().code, ExitCode::kUsage);
+  EXPECT_EQ(needle.error().message.rfind("--fov 1e-300: so narrow a view", 0), 0u) << needle.error().message;
   EXPECT_FALSE(makeCamera(CameraSpec{}, boundsOf(PointSet{PositionArray{{1e308, 1e308, 1e308}, {-1e308, -1e308, -1e308}}})).ok());
   PointSet apart;  // past float32's range, and behind the eye
   apart.positions = {{1e39, 0.0, 0.0}, {1e39, 1.0, 1.0}};
