@@ -97,6 +97,13 @@ int runConvert(ConvertOptions& o) {
     return reportError(Error{"--keep and --drop: give one of them (--keep names the dimensions that stay, --drop those "
                              "that go)",
                              ExitCode::kUsage});
+  if (o.decimals >= 0) {
+    const Result<FileFormat> text = formatOf(o.output);
+    if (!text || *text != FileFormat::kCsv)
+      return reportError(Error{"--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals, not " +
+                                   quotedExcerpt(o.output),
+                               ExitCode::kUsage});
+  }
   if (o.las_scale != 0.0) {
     const Result<FileFormat> las = formatOf(o.output);
     if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
