@@ -570,6 +570,14 @@ progress: lines on stderr.)");
         const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding));
         const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
+        // As convert's: options the file would not use are refused, not passed over in silence.
+        const FileFormat written = *formatOf(path);
+        if (las_scale && written != FileFormat::kLas && written != FileFormat::kLaz)
+          raise(Error{"las_scale: only a .las, .laz or .copc.laz file has a coordinate step, not '" + path + "'",
+                      ExitCode::kUsage});
+        if (decimals >= 0 && written != FileFormat::kCsv)
+          raise(Error{"decimals: only a CSV file (.csv, .xyz, .txt, .asc, .pts) has decimals, not '" + path + "'",
+                      ExitCode::kUsage});
         std::string crs_wkt;  // as convert's --crs
         if (crs) {
           if (*formatOf(path) != FileFormat::kLas && *formatOf(path) != FileFormat::kLaz)

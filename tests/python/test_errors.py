@@ -69,6 +69,11 @@ def test_bad_calls_speak_the_clis_words(call, code, words):
     (lambda t: dpoint.render(CLOUD, help=True), TypeError, "help is the CLI's option"),
     (lambda t: dpoint.generate("menger", help=True), TypeError, "help is the CLI's option"),
     (lambda t: dpoint.info(CLOUD, sample=-1), dpoint.Error, "sample -1: must be a number from 1 to 100000000"),
+    # Options the file would not use, refused as convert's are (they passed in silence).
+    (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.ply", las_scale=0.01), dpoint.Error,
+     "las_scale: only a .las, .laz or .copc.laz file has a coordinate step"),
+    (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.las", decimals=3), dpoint.Error,
+     "decimals: only a CSV file (.csv, .xyz, .txt, .asc, .pts) has decimals"),
     # The LAS writer's advice in the module's words (it said "--drop intensity").
     (lambda t: dpoint.write(_with_intensity(70000), t / "a.las"), dpoint.Error,
      "leave it out with points.remove_attribute('intensity') (on a copy)"),
