@@ -303,20 +303,26 @@ LasVlr lasWktRecord(const std::string& wkt) {
 
 namespace {
 
-// The EPSG code of `object` where it has one that a GeoTIFF key holds (1-32766), and PROJ's database
-// defines it as the object says (axis order aside): a WKT that names EPSG:32633 but changes its
-// parameters keeps its WKT.
-std::optional<uint16_t> epsgCode(const ProjApi& api, Proj& proj, PJ* object) {
-  const char* authority = api.get_id_auth_name(object, 0);
-  const char* code = api.get_id_code(object, 0);
+// An EPSG code a GeoTIFF key holds (1-32766), from an authority's name and code.
+std::optional<uint16_t> keyCode(const char* authority, const char* code) {
   if (!authority || !code || std::strcmp(authority, "EPSG") != 0) return std::nullopt;
   char* end = nullptr;
   const long value = std::strtol(code, &end, 10);
   if (*end != '\0' || value < 1 || value >= kUserDefined) return std::nullopt;
+  return static_cast<uint16_t>(value);
+}
+
+// The EPSG code of `object` where it has one that a GeoTIFF key holds (1-32766), and PROJ's database
+// defines it as the object says (axis order aside): a WKT that names EPSG:32633 but changes its
+// parameters keeps its WKT.
+std::optional<uint16_t> epsgCode(const ProjApi& api, Proj& proj, PJ* object) {
+  const char* code = api.get_id_code(object, 0);
+  const std::optional<uint16_t> value = keyCode(api.get_id_auth_name(object, 0), code);
+  if (!value) return std::nullopt;
   PJ* defined = proj.keep(api.create_from_database(proj.context(), "EPSG", code, PJ_CATEGORY_CRS, 0, nullptr));
   if (!defined || !api.is_equivalent_to(object, defined, PJ_COMP_EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS))
     return std::nullopt;
-  return static_cast<uint16_t>(value);
+  return value;
 }
 
 // The EPSG code of the unit of `crs`'s first axis, where it has one a key holds.
@@ -324,13 +330,9 @@ std::optional<uint16_t> axisUnit(const ProjApi& api, Proj& proj, PJ* crs) {
   PJ* cs = proj.keep(api.crs_get_coordinate_system(proj.context(), crs));
   const char* authority = nullptr;
   const char* code = nullptr;
-  if (!cs || !api.cs_get_axis_info(proj.context(), cs, 0, nullptr, nullptr, nullptr, nullptr, nullptr, &authority, &code) ||
-      !authority || !code || std::strcmp(authority, "EPSG") != 0)
+  if (!cs || !api.cs_get_axis_info(proj.context(), cs, 0, nullptr, nullptr, nullptr, nullptr, nullptr, &authority, &code))
     return std::nullopt;
-  char* end = nullptr;
-  const long value = std::strtol(code, &end, 10);
-  if (*end != '\0' || value < 1 || value >= kUserDefined) return std::nullopt;
-  return static_cast<uint16_t>(value);
+  return keyCode(authority, code);
 }
 
 }  // namespace
