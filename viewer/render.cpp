@@ -775,7 +775,7 @@ uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes) {
 Result<uint64_t> checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit, uint64_t point_bytes) {
   const uint64_t block = streamBlockPoints(limit, point_bytes);
   if (Status s = checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time",
-                             2 * std::min(count, block) * point_bytes, limit);
+                             streamHeldBytes(count, block, point_bytes), limit);
       !s)
     return s.error();
   return block;

@@ -4,6 +4,7 @@
 // point's clip position.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -143,9 +144,13 @@ inline constexpr uint64_t kStreamPointBytes = 36;  // a point's position and col
 // The block a stream is read in under the memory limit `limit` (0: the default, half of RAM): two
 // blocks of `point_bytes` a point in at most the limit (more than kStreamPointBytes where a
 // dimension comes with each point: render --color NAME); the picture and the report are the same
-// whatever the block. Only these blocks are counted: the device's memory (the host's on lavapipe)
-// and the picture's buffers are not.
+// whatever the block. On a CPU device, whose memory is the host's, the render pass's blocks take
+// half of the limit and the device's buffers the rest (viewer/render_job.cpp's HostMemoryBudget).
 uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes = kStreamPointBytes);
+// The host bytes a stream of `count` points holds in blocks of `block`: two of them in flight.
+inline uint64_t streamHeldBytes(uint64_t count, uint64_t block, uint64_t point_bytes) {
+  return 2 * std::min(count, block) * point_bytes;
+}
 // --max-memory against what a stream of `count` points holds on the host, whatever the file's size:
 // two blocks (streamBlockPoints). The block to read in; render and info refuse a limit that does
 // not hold two of the smallest (exit 4, `name` and the need in the message).

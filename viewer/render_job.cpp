@@ -732,34 +732,25 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
   return true;
 }
 
-// The host bytes a stream's two blocks in flight hold (what checkStreamMemory charges).
-uint64_t streamHeldBytes(const LoadedSet& set) {
-  return 2 * std::min<uint64_t>(set.count, set.stream_block) * set.stream_point_bytes;
-}
-
-// A stream on a CPU device: its blocks were sized to --max-memory before the device was known;
-// the render pass's are now sized to half of it, the other half left to the device's copy of the
-// set (HostMemoryBudget). The passes before (bounds, outline) held no device memory.
-void shareStreamMemoryWithCpuDevice(const VulkanContext& context, const RenderRequest& request, LoadedSet& set) {
-  if (context.facts.type != "cpu" || !set.stream) return;
-  const uint64_t limit = request.max_memory ? request.max_memory : defaultMemoryLimit();
-  set.stream_block = std::min(set.stream_block, streamBlockPoints(limit / 2, set.stream_point_bytes));
-}
-
 // A CPU device's memory is the host's (lavapipe, the default without a GPU): while a render runs,
 // the device's budget is what --max-memory leaves beside the points read (a stream: its blocks),
 // or --max-device-memory where that is lower. The points' device copies, the picture's images and
 // the readback are the device's buffers, charged there; a stream's device copy is the whole set,
-// which without this bound took host memory past --max-memory. A refusal is then exit 4 naming
-// --max-memory (vulkan/buffers.cpp). Put back at the end: a Python Renderer's device outlives it.
+// which without this bound took host memory past --max-memory. A stream's blocks were sized to
+// --max-memory before the device was known: its render pass's are sized here to half of it, the
+// other half left to the device (the passes before, bounds and outline, held no device memory).
+// A refusal is then exit 4 naming --max-memory (vulkan/buffers.cpp). Put back at the end: a
+// Python Renderer's device outlives it.
 class HostMemoryBudget {
  public:
-  HostMemoryBudget(VulkanContext& context, const RenderRequest& request, const LoadedSet& set)
+  HostMemoryBudget(VulkanContext& context, const RenderRequest& request, LoadedSet& set)
       : context_(context), budget_(context.device_memory_budget), host_(context.host_budget) {
     const PointSet* points = set.points();
     if (context.facts.type != "cpu" || (!points && !set.stream)) return;
     const uint64_t limit = request.max_memory ? request.max_memory : defaultMemoryLimit();
-    const uint64_t held = points ? heldBytes(*points) : streamHeldBytes(set);
+    if (!points) set.stream_block = std::min(set.stream_block, streamBlockPoints(limit / 2, set.stream_point_bytes));
+    const uint64_t held =
+        points ? heldBytes(*points) : streamHeldBytes(set.count, set.stream_block, set.stream_point_bytes);
     const uint64_t left = limit > held ? limit - held : 1;  // 0 would be no budget at all
     if (budget_ != 0 && budget_ <= left) return;
     const std::string option =
@@ -1110,7 +1101,6 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
   else
     return made.error();
   outcome.phases.mark("device");  // what is left of making it once the input is in
-  shareStreamMemoryWithCpuDevice(*outcome.context, request, *set);
   const HostMemoryBudget host_budget(*outcome.context, request, *set);
   const VulkanContext& context = *outcome.context;
   outcome.device = context.facts;
