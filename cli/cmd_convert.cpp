@@ -93,27 +93,23 @@ int runConvert(ConvertOptions& o) {
   w.las_scale = o.las_scale;
   // Options that would do nothing are refused, as --crs for a PLY output is (a review finding:
   // each passed silently).
+  const Result<FileFormat> out_format = formatOf(o.output);
+  const bool to_las = out_format && (*out_format == FileFormat::kLas || *out_format == FileFormat::kLaz);
+  const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   if (o.dimensions.keep && !o.dimensions.drop.empty())
     return reportError(Error{"--keep and --drop: give one of them (--keep names the dimensions that stay, --drop those "
                              "that go)",
                              ExitCode::kUsage});
-  if (o.decimals >= 0) {
-    const Result<FileFormat> text = formatOf(o.output);
-    if (!text || *text != FileFormat::kCsv)
-      return reportError(Error{"--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals, not " +
-                                   quotedExcerpt(o.output),
-                               ExitCode::kUsage});
-  }
-  if (o.las_scale != 0.0) {
-    const Result<FileFormat> las = formatOf(o.output);
-    if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
-      return reportError(Error{"--las-scale: only a LAS, LAZ or COPC output has a coordinate step, not " +
-                                   quotedExcerpt(o.output),
-                               ExitCode::kUsage});
-  }
+  if (o.decimals >= 0 && !to_csv)
+    return reportError(Error{"--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals, not " +
+                                 quotedExcerpt(o.output),
+                             ExitCode::kUsage});
+  if (o.las_scale != 0.0 && !to_las)
+    return reportError(Error{"--las-scale: only a LAS, LAZ or COPC output has a coordinate step, not " +
+                                 quotedExcerpt(o.output),
+                             ExitCode::kUsage});
   if (o.crs) {
-    const Result<FileFormat> las = formatOf(o.output);
-    if (!las || (*las != FileFormat::kLas && *las != FileFormat::kLaz))
+    if (!to_las)
       return reportError(Error{"--crs: only a LAS, LAZ or COPC output holds a coordinate reference system, not " +
                                    quotedExcerpt(o.output),
                                ExitCode::kUsage});
@@ -124,8 +120,7 @@ int runConvert(ConvertOptions& o) {
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
   // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
   // point set; --unique and --order morton need the whole set, so they take the path below.
-  const Result<FileFormat> in_format = formatOf(o.input), out_format = formatOf(o.output);
-  const bool to_csv = out_format && *out_format == FileFormat::kCsv;
+  const Result<FileFormat> in_format = formatOf(o.input);
   const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
   if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !o.unique && *order == PointOrder::kInput &&
       !choose_dimensions && o.columns.empty() && o.sample.count == 0) {

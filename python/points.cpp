@@ -580,7 +580,7 @@ progress: lines on stderr.)");
                       ExitCode::kUsage});
         std::string crs_wkt;  // as convert's --crs
         if (crs) {
-          if (*formatOf(path) != FileFormat::kLas && *formatOf(path) != FileFormat::kLaz)
+          if (written != FileFormat::kLas && written != FileFormat::kLaz)
             raise(Error{"crs: only a .las, .laz or .copc.laz file holds a coordinate reference system, not '" + path + "'",
                         ExitCode::kUsage});
           Result<std::string> wkt = crsAsWkt(*crs, "crs");

@@ -1,6 +1,7 @@
 #include "viewer/info_report.h"
 
 #include <array>
+#include <functional>
 #include <limits>
 #include <utility>
 
@@ -135,6 +136,18 @@ Result<Camera> renderView(const InfoOptions& options, const Bounds& bounds, bool
   return cameras->front();
 }
 
+// The report's advice for `dpoint render`'s view of `bounds`, each mode's bound by `predict`; where
+// the data can have no view (their extent overflows a double: the camera's kBadInput), the report
+// says why instead (a review finding: info refused to describe them). The options' errors fail it.
+Status adviseFor(InfoReport& report, const InfoOptions& options, const Bounds& bounds, bool data_z_up,
+                 const std::function<ErrorBounds(const Camera&)>& predict) {
+  Result<Camera> camera = renderView(options, bounds, data_z_up);
+  if (camera) report.advice = InfoAdvice{*camera, predict(*camera)};
+  else if (camera.error().code == ExitCode::kBadInput) report.no_view = camera.error().message;
+  else return camera.error();
+  return okStatus();
+}
+
 }  // namespace
 
 Result<InfoReport> describePoints(const PointSet& points, const std::string& name, const InfoOptions& options) {
@@ -152,10 +165,11 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
     report.dimensions.push_back(range);
   }
   if (points.size() > 0) {
-    Result<Camera> camera = renderView(options, boundsWithOutline(points), points.z_up);
-    if (!camera && camera.error().code != ExitCode::kBadInput) return camera.error();
-    if (camera) report.advice = InfoAdvice{*camera, predictErrorBounds(points, *camera, {}, options.tolerance_px)};
-    else report.no_view = camera.error().message;  // the data's (a review finding: info refused to describe them)
+    if (Status s = adviseFor(report, options, boundsWithOutline(points), points.z_up, [&](const Camera& camera) {
+          return predictErrorBounds(points, camera, {}, options.tolerance_px);
+        });
+        !s)
+      return s.error();
   }
   return report;
 }
@@ -190,10 +204,11 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   if (boxes.count > 0) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
-    Result<Camera> camera = renderView(options, boundsOfBoxes(boxes), false);
-    if (!camera && camera.error().code != ExitCode::kBadInput) return camera.error();
-    if (camera) report.advice = InfoAdvice{*camera, predictBoxBounds(boxes, *camera, {}, options.tolerance_px)};
-    else report.no_view = camera.error().message;
+    if (Status s = adviseFor(report, options, boundsOfBoxes(boxes), false, [&](const Camera& camera) {
+          return predictBoxBounds(boxes, camera, {}, options.tolerance_px);
+        });
+        !s)
+      return s.error();
   }
   return report;
 }
