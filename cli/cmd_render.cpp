@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
 
 #include "cli/cli_camera.h"
 #include "cli/cli_check.h"
@@ -18,6 +19,7 @@
 #include "core/memory.h"
 #include "core/progress.h"
 #include "viewer/modes.h"
+#include "viewer/render.h"
 #include "viewer/render_job.h"
 
 namespace dpoint {
@@ -356,7 +358,10 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
   cmd->add_flag("--validate", o->validate, "Enable the Khronos validation layer; any message fails the run");
   addChoiceOption(*cmd, "--native-path", o->native_path, "native mode: auto, attribute (R64G64B64 vertex input) or pull",
                   {"auto", "attribute", "pull"});
-  cmd->add_option("--chunk-points", o->chunk_points, "Most points per draw (0: as the device allows)")->default_val(0);
+  cmd->add_option("--chunk-points", o->chunk_points,
+                  "Most points per draw (0: as the device allows); at most " + std::to_string(kMaxChunks) +
+                      " draws, so at least 1/" + std::to_string(kMaxChunks) + " of the points")
+      ->default_val(0);
   cmd->add_option("--order", o->order,
                   std::string(kPointOrderHelp) + "; applied as the set is loaded, before anything else")
       ->check(checkStatus([](const std::string& v) { return statusOf(parsePointOrder("--order", v)); }))

@@ -37,6 +37,10 @@ constexpr double kNearFloor = 1e-6;
 constexpr double kMinRelativeExtent = 1e-10;
 // Rounds of the perspective fit's correction for the eye's rounding (see fitPerspective).
 constexpr int kFitRounds = 4;
+// The share of its distance from the target by which rounding may move the fitted perspective eye
+// before the default view gives up on perspective: a box 9 ulps wide (1e-15 at 0.74) moves it by
+// ~5%, still the view asked for; a set 2 wide at x = 1e18 (double's step 128) by ~45%, edge-on.
+constexpr double kMaxEyeDrift = 0.2;
 // The outline's grid: rows along x on kOutlineGrid² cells over y, z (OutlineBuilder).
 constexpr int kOutlineGrid = 64;
 
@@ -128,8 +132,13 @@ PositionArray framedPoints(const Bounds& bounds) {
 // of the box, so the condition is checked again from the rounded eye and d grows by what is
 // missing (a few rounds; each misses by at most the rounding). d is at least kFitMargin times the
 // farthest point's distance from the target, so the eye is outside the data and every depth > 0.
-double fitPerspective(const PositionArray& points, glm::dvec3& target, const glm::dvec3& direction,
-                      const glm::dmat4& rotation, double tan_x, double tan_y, bool recentre) {
+struct PerspectiveFit {
+  double distance = 0.0;
+  bool framed = true;  // from the rounded eye, every point inside the shrunk frustum
+};
+
+PerspectiveFit fitPerspective(const PositionArray& points, glm::dvec3& target, const glm::dvec3& direction,
+                              const glm::dmat4& rotation, double tan_x, double tan_y, bool recentre) {
   const glm::dvec3 right(rotation[0][0], rotation[1][0], rotation[2][0]);
   const glm::dvec3 up(rotation[0][1], rotation[1][1], rotation[2][1]);
   const auto closedForm = [&](const glm::dvec3& t) {
@@ -155,18 +164,21 @@ double fitPerspective(const PositionArray& points, glm::dvec3& target, const glm
     target += (0.5 * (lo_x + hi_x) * distance) * right + (0.5 * (lo_y + hi_y) * distance) * up;
     distance = closedForm(target);
   }
-  for (int round = 0; round < kFitRounds; ++round) {
-    const glm::dvec3 eye = target + distance * direction;
+  const auto missingFrom = [&](const glm::dvec3& eye) {
     double missing = 0.0;
     for (const glm::dvec3& p : points) {
       const glm::dvec3 q = p - eye;
       const double need = std::max(std::abs(glm::dot(q, right)) / tan_x, std::abs(glm::dot(q, up)) / tan_y);
       missing = std::max(missing, need + glm::dot(q, direction));  // need − depth
     }
-    if (!(missing > 0.0)) break;
+    return missing;
+  };
+  for (int round = 0; round < kFitRounds; ++round) {
+    const double missing = missingFrom(target + distance * direction);
+    if (!(missing > 0.0)) return {distance, true};
     distance += 2.0 * missing;
   }
-  return distance;
+  return {distance, !(missingFrom(target + distance * direction) > 0.0)};
 }
 
 // Near and far planes enclosing the box. Depth along the view axis is linear, so its extremes over
@@ -190,8 +202,9 @@ void choosePlanes(Camera& camera, const Bounds& bounds) {
     camera.near_plane = nearest >= 0.0 ? 0.0 : nearest - pad;
     camera.far_plane = farthest + pad;
   } else {
-    // All corners at the eye (one point, looked at from itself) still needs a usable frustum.
-    camera.far_plane = std::max(farthest_distance * kFarMargin, minHalfExtent(camera.eye));
+    // All corners at the eye (one point, looked at from itself) still needs a usable frustum. Only
+    // then: a floor relative to the coordinates would clip a set 2 wide seen from 3 away at 1e18.
+    camera.far_plane = farthest_distance > 0.0 ? farthest_distance * kFarMargin : minHalfExtent(camera.eye);
     camera.near_plane = std::max(nearest * kNearMargin, camera.far_plane * kNearFloor);
   }
 }
@@ -229,6 +242,17 @@ double fitWidth(double fitted, const Bounds& bounds) {
   if (fitted > 0.0) return fitted;
   return isDegenerate(bounds) ? 2.0 * minHalfExtent(bounds.min)
                               : kFitMargin * maxAbs(bounds.max - bounds.min);
+}
+
+// An ortho window centred on the eye's view axis, wide enough for every corner of the box.
+double windowAround(const Camera& camera, const Bounds& bounds, double margin, double aspect) {
+  double half_x = 0.0, half_y = 0.0;
+  for (const glm::dvec3& corner : corners(bounds)) {
+    const glm::dvec4 e = camera.rotation * glm::dvec4(corner - camera.eye, 0.0);
+    half_x = std::max(half_x, std::abs(e.x));
+    half_y = std::max(half_y, std::abs(e.y));
+  }
+  return fitWidth(2.0 * margin * std::max(half_x, half_y * aspect), bounds);
 }
 
 Status checkSpec(const CameraSpec& spec) {
@@ -307,16 +331,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
   if (spec.eye) {
     camera.eye = *spec.eye;
     camera.rotation = lookAtRotation(*spec.target - *spec.eye, *spec.up);
-    if (camera.ortho) {
-      // Window centred on the view axis, wide enough for every corner.
-      double half_x = 0.0, half_y = 0.0;
-      for (const glm::dvec3& corner : corners(bounds)) {
-        const glm::dvec4 e = camera.rotation * glm::dvec4(corner - camera.eye, 0.0);
-        half_x = std::max(half_x, std::abs(e.x));
-        half_y = std::max(half_y, std::abs(e.y));
-      }
-      view_width = spec.view_width.value_or(fitWidth(2.0 * margin * std::max(half_x, half_y * aspect), bounds));
-    }
+    if (camera.ortho) view_width = spec.view_width.value_or(windowAround(camera, bounds, margin, aspect));
   } else if (camera.ortho) {
     // Straight down −z; the eye's x, y are the window centre, its height only sets the depth slab.
     view_width = spec.view_width.value_or(fitWidth(margin * std::max(extent.x, extent.y * aspect), bounds));
@@ -335,12 +350,14 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     // long when the box is.
     camera.rotation = lookAtRotation(-direction, up);
     double distance = 0.0;
+    bool framed = true;
     if (spec.view_width) {
       distance = 0.5 * *spec.view_width / std::tan(half_fov_x);  // the window is view_width wide at target
     } else if (!isDegenerate(bounds)) {
-      distance = fitPerspective(framedPoints(bounds), target, direction, camera.rotation,
-                                std::tan(half_fov_x) / margin, std::tan(half_fov) / margin,
-                                !spec.view_center);
+      const PerspectiveFit fit = fitPerspective(framedPoints(bounds), target, direction, camera.rotation,
+                                                std::tan(half_fov_x) / margin, std::tan(half_fov) / margin,
+                                                !spec.view_center);
+      distance = fit.distance, framed = fit.framed;
     } else if (bounds.planar) {
       // One point: framed as a square 2e-10 of its coordinates wide (kMinRelativeExtent).
       distance = kFitMargin * minHalfExtent(centre) / std::tan(half_fov_x);
@@ -365,23 +382,39 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
                      ExitCode::kUsage};
       return too_large("to view in perspective: its eye would lie past the largest double");
     }
-    // A tiny --fov puts the fitted eye so far off that point − eye, in double, no longer places the
-    // points within half a pixel: its step at the eye's distance against a pixel there, whatever the
-    // scale (--fov 1e-15: the eye 1e17 of the data's sizes away, a blank picture and a bound of 0 px).
-    const double pixel = 2.0 * distance * std::tan(half_fov_x) / double(spec.width);
-    const double step = std::nextafter(distance, HUGE_VAL) - distance;
-    if (isFinite(camera.eye) && !(step <= 0.5 * pixel))
-      return usage("--fov " + shortest(spec.fov_degrees) + ": too narrow for double: the eye that frames the data lies " +
-                   shortest(distance) + " from it, where double's step (" + shortest(step) +
-                   ") is more than half a pixel there (" + shortest(0.5 * pixel) + "); use a wider --fov, or --ortho");
-    if (camera.eye == target) {
-      if (!spec.view_width && !spec.view_center) return too_large("for a perspective eye that does not round onto them");
-      return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +
-                   "; the window is too small for coordinates this large");
+    // A set small against its coordinates (2 wide at x = 1e18, where double's step is 128): the
+    // eye rounds a large share of its distance away from where the fit put it, and sees the data
+    // edge-on or not at all (a blank picture, exit 0). The default view then draws them orthographic
+    // along the same direction, which needs no eye off the data's plane, and says so.
+    const double drift = safeLength((camera.eye - target) - distance * direction) / distance;
+    if (!spec.ortho && !spec.view_width && !spec.view_center && !isDegenerate(bounds) &&
+        (!framed || !(drift <= kMaxEyeDrift))) {
+      camera.ortho = true;
+      camera.eye = centre;
+      view_width = windowAround(camera, bounds, margin, aspect);
+      camera.note = "the data span " + shortest(extent) + " at coordinates up to " +
+                    shortest(std::max(maxAbs(bounds.min), maxAbs(bounds.max))) +
+                    ": too little for double to place a perspective eye near them; drawn orthographic from the "
+                    "same direction (--eye/--target/--up choose another view)";
+    } else {
+      // A tiny --fov puts the fitted eye so far off that point − eye, in double, no longer places the
+      // points within half a pixel: its step at the eye's distance against a pixel there, whatever the
+      // scale (--fov 1e-15: the eye 1e17 of the data's sizes away, a blank picture and a bound of 0 px).
+      const double pixel = 2.0 * distance * std::tan(half_fov_x) / double(spec.width);
+      const double step = std::nextafter(distance, HUGE_VAL) - distance;
+      if (isFinite(camera.eye) && !(step <= 0.5 * pixel))
+        return usage("--fov " + shortest(spec.fov_degrees) + ": too narrow for double: the eye that frames the data lies " +
+                     shortest(distance) + " from it, where double's step (" + shortest(step) +
+                     ") is more than half a pixel there (" + shortest(0.5 * pixel) + "); use a wider --fov, or --ortho");
+      if (camera.eye == target) {
+        if (!spec.view_width && !spec.view_center) return too_large("for a perspective eye that does not round onto them");
+        return usage("--view-center/--view-width: the perspective eye rounds onto the target " + shortest(target) +
+                     "; the window is too small for coordinates this large");
+      }
+      // One point stays exactly at the picture's centre: its eye is far enough (kMinRelativeExtent)
+      // for the rounded eye − target to give an accurate direction.
+      if (isDegenerate(bounds) && !spec.view_width) camera.rotation = lookAtRotation(target - camera.eye, up);
     }
-    // One point stays exactly at the picture's centre: its eye is far enough (kMinRelativeExtent)
-    // for the rounded eye − target to give an accurate direction.
-    if (isDegenerate(bounds) && !spec.view_width) camera.rotation = lookAtRotation(target - camera.eye, up);
   }
 
   choosePlanes(camera, bounds);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -59,6 +60,9 @@ struct Camera {
   // homogeneous, so no window position changes) to keep clip values near 1 at any scene scale.
   glm::dmat4 projection{1.0};
   double near_plane = 0.0, far_plane = 0.0;
+  // Why the view is not the one asked for (the default fit's orthographic fallback); empty when it
+  // is. `dpoint render` prints it as a warning and `dpoint info` beside the view.
+  std::string note;
 
   glm::dmat4 view() const;            // rotation · translate(−eye)
   glm::dmat4 viewProjection() const;  // projection · view()

@@ -100,6 +100,7 @@ std::string adviceText(const InfoAdvice& advice) {
                                                                             : "points leave their pixel";
     text += "  " + padded(std::string(modeName(mode)), 8) + " " + padded(formatBound(px), 12) + " " + verdict + "\n";
   }
+  if (!advice.camera.note.empty()) text += "view note:          " + advice.camera.note + "\n";
   return text;
 }
 
@@ -109,6 +110,7 @@ std::string adviceJson(const InfoAdvice& advice) {
   JsonObject view;
   view.add("width", JsonValue::integer(c.width)).add("height", JsonValue::integer(c.height));
   view.add("ortho", JsonValue::boolean(c.ortho)).add("points_visible", JsonValue::integer(b.visible));
+  if (!c.note.empty()) view.add("note", JsonValue::string(c.note));
   JsonObject bounds;  // null: unbounded (the mode may lose points)
   for (PrecisionMode mode : kAllModes) bounds.add(modeName(mode), JsonValue::number(b.px[modeIndex(mode)]));
   return ",\n  \"view\": " + view.line() + ",\n  \"float_floor_px\": " + formatNumber(b.float_floor_px, true) +

@@ -578,6 +578,7 @@ Status renderSheet(const RenderRequest& request, const VulkanContext& context, c
     if (!rendered) return rendered.error();
     const std::string mode(modeName(prediction->mode));
     const std::string label = "view " + std::string(views[i].label) + ": ";
+    if (!cameras[i].note.empty()) outcome.warnings.push_back(label + cameras[i].note);
     if (!prediction->warning.empty()) outcome.warnings.push_back(label + prediction->warning);
     const DrawnPixels drawn = drawnPixels(rendered->image, request.background_rgba8);
     if (std::string cover = coverWarning(drawn.share(), drawn.span()); !cover.empty())
@@ -607,6 +608,7 @@ Status renderOne(const RenderRequest& request, const VulkanContext& context, con
   Result<ModePrediction> prediction = predictMode(request, context, set, camera);
   if (!prediction) return prediction.error();
   outcome.prediction = std::move(*prediction);
+  if (!camera.note.empty()) outcome.warnings.push_back(camera.note);
   if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
   outcome.phases.mark("mode");
   const RenderOptions options =
@@ -715,6 +717,7 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
     if (!prediction) return prediction.error();
     if (prediction->mode != mode) return read_again();
     outcome.prediction = std::move(*prediction);
+    if (!camera.note.empty()) outcome.warnings.push_back(camera.note);
     if (!outcome.prediction.warning.empty()) outcome.warnings.push_back(outcome.prediction.warning);
     settled = renderOptionsFor(request, set, mode, camera, context.facts, outcome.warnings);
     outcome.point_size = settled.point_size;

@@ -193,6 +193,31 @@ TEST(CliRender, generatedFractalAtEarthRadiusShowsFloatFailing) {
   EXPECT_LE(max_px[1], 0.01) << "native";
 }
 
+// A Mandelbulb moved to x = 1e18 (double's step there is 128) lies flat in that plane, 2 wide. The
+// default perspective eye rounded into the plane and the picture showed nothing (exit 0, "the
+// picture shows nothing"). It is drawn orthographic from the fit's direction now, in memory and
+// streamed, and render and info say so.
+TEST(CliRender, aSetFlatFarFromTheOriginIsDrawnAndTheReportsSayHow) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "20", "--offset", "1e18,0,0", "--quiet", "-o",
+                       dir.file("flat.ply")}).exit_code, 0);
+  for (const char* stream : {"off", "on"}) {
+    SCOPED_TRACE(stream);
+    const test::CommandResult r = runDpoint({"render", dir.file("flat.ply"), "-o", dir.file("flat.png"), "--stream", stream,
+                                             "--width", "256", "--height", "192", "--json", dir.file("flat.json")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::contains(r.err, "at coordinates up to 1e+18: too little for double to place a perspective eye"))
+        << r.err;
+    EXPECT_FALSE(test::contains(r.err, "shows nothing")) << r.err;
+    EXPECT_GT(jsonNumber(readFile(dir.file("flat.json")), "drawn_share"), 0.05);
+  }
+  const test::CommandResult info = runDpoint({"info", dir.file("flat.ply")});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_TRUE(test::contains(info.out, "orthographic, 744 points visible")) << info.out;
+  EXPECT_TRUE(test::contains(info.out, "\nview note:          the data span (0, ")) << info.out;
+  EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("flat.ply"), "--json"}).out, "\"note\": \"the data span")) ;
+}
+
 // `dpoint info` predicts each mode's error for the view `dpoint render` draws with the same camera
 // options: the outline-framed fit, from the z-up three-quarter direction for a survey (--up-axis
 // auto: LAS) and from the y-up one otherwise or with --up-axis y. (Render fits again, a little
@@ -337,6 +362,8 @@ TEST(CliRender, chunkPointsMakingThousandsOfDrawsIsRefused) {
   const test::CommandResult drawn = runDpoint({"render", dir.file("r.ply"), "--chunk-points", "2", "--width", "32",
                                                "--height", "32", "-q", "-o", dir.file("r.png")});
   EXPECT_EQ(drawn.exit_code, 0) << drawn.err;
+  // The help says so too.
+  EXPECT_TRUE(test::contains(runDpoint({"render", "--help"}).out, "at most 1024 draws")) << "render --help";
 }
 
 // A stream whose two blocks of 16.7M points would pass --max-memory is read in smaller blocks

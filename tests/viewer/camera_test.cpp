@@ -428,6 +428,45 @@ TEST(Camera, viewsBeyondDoubleAreRefused) {
 // The fit of a set with an outline frames the points, not the box's empty corners: a Mandelbulb
 // (its box corners project ~1.4x wider than it) spans ≥ 85% of the smaller side, every point
 // inside the picture. With the box alone it spans ~72%.
+// A set 2 wide in the plane x = 1e18, where double's step is 128: the fitted perspective eye, a few
+// units off the plane, rounds into it and saw the data edge-on, and the planes' floor of 1e-10 of
+// the coordinates put the near plane at 100, behind every point (a blank picture, exit 0). The
+// default view draws it orthographic from the fit's direction, filling the picture, and says so; a
+// view given with --eye keeps its perspective and its points.
+TEST(Camera, aSetSmallAgainstItsCoordinatesIsDrawnOrthographicAndSaysSo) {
+  const Bounds flat{{1e18, -1.0, -1.0}, {1e18, 1.0, 1.0}};
+  const Camera fitted = make(CameraSpec{}, flat);
+  EXPECT_TRUE(fitted.ortho);
+  EXPECT_NE(fitted.note.find("drawn orthographic from the same direction"), std::string::npos) << fitted.note;
+  EXPECT_NE(fitted.note.find("up to 1e+18"), std::string::npos) << fitted.note;
+  expectFramed(fitted, flat, 0.85);
+  // From the fit's direction: the rotation's third row (the eye's +z) is it.
+  const glm::dvec3 direction = glm::normalize(glm::dvec3(0.6, 0.5, 1.0));
+  EXPECT_NEAR(fitted.rotation[0][2], direction.x, 1e-12);
+  EXPECT_NEAR(fitted.rotation[2][2], direction.z, 1e-12);
+  // A set that double can view in perspective keeps it, with no note: the same plane at x = 1e15
+  // (step 0.125), and a box 9 ulps wide (the rounded eye moves by ~5% of its distance).
+  const Camera near = make(CameraSpec{}, Bounds{{1e15, -1.0, -1.0}, {1e15, 1.0, 1.0}});
+  EXPECT_FALSE(near.ortho);
+  EXPECT_EQ(near.note, "");
+  const glm::dvec3 c(-0.7436450, 0.1318259, 0.3);
+  const Camera tiny = make(CameraSpec{}, Bounds{c - glm::dvec3(5e-16), c + glm::dvec3(5e-16)});
+  EXPECT_FALSE(tiny.ortho);
+  EXPECT_EQ(tiny.note, "");
+  // --ortho as asked, and an eye given in the plane: perspective, the points in front of it kept.
+  CameraSpec ortho;
+  ortho.ortho = true;
+  EXPECT_EQ(make(ortho, flat).note, "");
+  CameraSpec edge_on;
+  edge_on.eye = glm::dvec3(1e18, 0.0, 5.0);
+  edge_on.target = glm::dvec3(1e18, 0.0, 0.0);
+  edge_on.up = glm::dvec3(0.0, 1.0, 0.0);
+  const Camera given = make(edge_on, flat);
+  EXPECT_FALSE(given.ortho);
+  EXPECT_LT(given.near_plane, 4.0);
+  for (const WindowPoint& w : projectReference(cornersOf(flat), given)) EXPECT_TRUE(w.visible);
+}
+
 TEST(Camera, fitWithAnOutlineFramesTheDataNotItsBox) {
   MandelbulbParams params;
   params.resolution = 64;
