@@ -9,8 +9,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <optional>
 
@@ -30,13 +32,21 @@ namespace {
 Status integerColors(const std::string& path, PointSet& points, bool always) {
   float largest = 0.0f;
   for (const glm::vec3& c : points.colors) largest = std::max({largest, c.r, c.g, c.b});
-  if (!(largest > 1.0f) && !always) return okStatus();
+  if (!(largest > 1.0f) && !always) {
+    // Fractions 0..1: a negative one was clamped to 0 by every 8-bit writer in silence (a review finding).
+    for (size_t i = 0; i < points.colors.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        if (points.colors[i][k] < 0.0f)
+          return Error{path + ": data row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": " +
+                       formatNumber(points.colors[i][k]) + " (colours as fractions are 0..1, as integers 0..255)"};
+    return okStatus();
+  }
   const float full = largest > 255.0f ? 65535.0f : 255.0f;
   for (size_t i = 0; i < points.colors.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const float v = points.colors[i][k];
       if (!(v >= 0.0f && v <= full && v == std::floor(v)))
-        return Error{path + ": row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": " +
+        return Error{path + ": data row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": " +
                      formatNumber(v) + " among integer colours (values above 1 make every colour an integer 0.." +
                      formatNumber(full) + "; colours as fractions are 0..1)"};
     }
@@ -48,9 +58,11 @@ Status integerColors(const std::string& path, PointSet& points, bool always) {
 
 
 constexpr size_t kBlockSize = 8u << 20;
-// Longest line accepted: a row of six fixed-format DBL_MAX values fits in about 2 KB; anything far
-// longer is not a point row (and would otherwise make a block read unbounded).
-constexpr size_t kMaxLineLength = 64u << 10;
+// Longest line accepted: a row of six fixed-format DBL_MAX values fits in about 2 KB, and one of a
+// PCD feature of thousands of doubles (an FPFH is 33; a review made one of 6,000 that dpoint wrote
+// and could not read back at 64 KiB) in a few hundred; anything longer is not a point row (and
+// would otherwise make a block read unbounded).
+constexpr size_t kMaxLineLength = 512u << 10;
 
 // The known layouts. 2D files written with colours have `x,y,r,g,b` (the writer's planar form),
 // so that layout is read too.
@@ -118,12 +130,9 @@ struct LineError {
 
 class LineParser {
  public:
-  // dimensions: one column of doubles per further column of the layout; those with `as_float`
-  // set are parsed as float (a float32 dimension written in its shortest form reads back exactly).
-  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite, std::vector<double*> dimensions,
-             std::vector<bool> as_float)
-      : path_(path), layout_(layout), allow_nonfinite_(allow_nonfinite), dimensions_(std::move(dimensions)),
-        as_float_(std::move(as_float)) {}
+  // dimensions: one column of doubles per further column of the layout.
+  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite, std::vector<double*> dimensions)
+      : path_(path), layout_(layout), allow_nonfinite_(allow_nonfinite), dimensions_(std::move(dimensions)) {}
 
   // Parses one line (without its line end, '\r' already removed) of row `row`. Returns false on error.
   bool parse(const char* begin, const char* end, uint64_t line, uint64_t row, glm::dvec3& position,
@@ -144,15 +153,17 @@ class LineParser {
       }
       const char* number_end = field_end;
       while (number_end > number_begin && isBlank(number_end[-1])) --number_end;
-      if (number_begin == number_end) {
+      const int role = layout_.roles[static_cast<size_t>(column - 1)];
+      // An attribute's empty field is a missing value, NaN (pandas writes NaN so); a skipped column's
+      // is nothing. A position's or colour's is an error.
+      if (number_begin == number_end && role < kRoleDimension && role != kRoleSkip) {
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
       }
-      const int role = layout_.roles[static_cast<size_t>(column - 1)];
-      bool ok = role == kRoleSkip         ? true
-                : role >= kRoleDimension
-                    ? parseDimension(number_begin, number_end, static_cast<size_t>(role - kRoleDimension), row, line,
-                                     column, error)
+      double* dimension = role >= kRoleDimension ? &dimensions_[static_cast<size_t>(role - kRoleDimension)][row] : nullptr;
+      if (dimension && number_begin == number_end) *dimension = std::numeric_limits<double>::quiet_NaN();
+      bool ok = role == kRoleSkip || (dimension && number_begin == number_end) ? true
+                : dimension ? parseNumber(number_begin, number_end, *dimension, line, column, error)
                 : role < 3 ? parseNumber(number_begin, number_end, values[role], line, column, error)
                            : parseNumber(number_begin, number_end, colors[role - 3], line, column, error);
       if (!ok) return false;
@@ -192,16 +203,6 @@ class LineParser {
     return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + printableExcerpt(layout_.text) + ")";
   }
 
-  bool parseDimension(const char* begin, const char* end, size_t k, uint64_t row, uint64_t line, int column,
-                      LineError& error) const {
-    if (as_float_[k]) {
-      float f = 0.0f;
-      if (!parseNumber(begin, end, f, line, column, error)) return false;
-      dimensions_[k][row] = f;
-      return true;
-    }
-    return parseNumber(begin, end, dimensions_[k][row], line, column, error);
-  }
 
   template <typename T>
   bool parseNumber(const char* begin, const char* end, T& value, uint64_t line, int column,
@@ -236,7 +237,6 @@ class LineParser {
   const Layout& layout_;
   bool allow_nonfinite_;
   std::vector<double*> dimensions_;
-  std::vector<bool> as_float_;
 };
 
 // The first line's separator: ';' where it has one (a semicolon file's numbers may hold decimal
@@ -253,6 +253,8 @@ std::vector<std::string> splitHeader(std::string_view line, bool spelled = false
   auto add = [&](std::string_view field) {
     while (!field.empty() && isBlank(field.front())) field.remove_prefix(1);
     while (!field.empty() && isBlank(field.back())) field.remove_suffix(1);
+    // A quoted name (R's write.csv: "x","y","z").
+    if (field.size() >= 2 && field.front() == '"' && field.back() == '"') field = field.substr(1, field.size() - 2);
     fields.push_back(spelled ? std::string(field) : lowerAscii(std::string(field)));
   };
   const char separator = separatorOf(line);
@@ -284,6 +286,10 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
                                 std::vector<std::string> spelled, uint64_t line, std::string_view text,
                                 char separator) {
   if (fields.front().rfind("//", 0) == 0) fields.front().erase(0, 2);
+  if (fields.front().empty() && fields.size() > 1) {  // `// X Y Z`: the marker alone
+    fields.erase(fields.begin());
+    spelled.erase(spelled.begin());
+  }
   // The names people give the known columns (any case): geographic and surveyors' axes in the
   // first three columns, colour words in the three after the position (columns 3-5, or 2-4 in 2D). Further columns keep their
   // names (a column `h` after x,y,z stays a dimension `h`).
@@ -334,7 +340,8 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
                                                : "split at spaces and tabs";
   return Error{path + ":" + std::to_string(line) + ": header '" + excerpt(text.data(), text.data() + text.size()) +
                "' (" + split + ") is not one of x,y | x,y,z | x,y,r,g,b | x,y,z,r,g,b, or their names " +
-               "(lon,lat,alt | E,N,H | red,green,blue); further columns may follow"};
+               "(lon,lat,alt | E,N,H | red,green,blue); further columns may follow; --columns names each column "
+               "instead (e.g. y,x,z or -,x,y,z)"};
 }
 
 Result<Layout> layoutFromColumns(const std::string& path, size_t columns, uint64_t line, char separator) {
@@ -405,6 +412,24 @@ Result<Layout> layoutFromNames(const std::vector<std::string>& names, char separ
   return layout;
 }
 
+// Whether a field of the first line reads as a number (as LineParser would: a leading '+', a
+// decimal comma in a semicolon file, nan and inf).
+bool isNumberField(std::string_view field, char separator) {
+  if (field.size() >= 2 && field.front() == '+') field.remove_prefix(1);
+  double value = 0.0;
+  const fast_float::parse_options options{fast_float::chars_format::general, separator == ';' ? ',' : '.'};
+  const auto result = fast_float::from_chars_advanced(field.data(), field.data() + field.size(), value, options);
+  return result.ec == std::errc() && result.ptr == field.data() + field.size();
+}
+
+// With --columns, a first line is a header where a column given as x, y or z does not hold a
+// number (a row whose skipped first column is a label, `pt1,1,2,3`, is data: a review finding).
+bool isNamedLine(const std::vector<std::string>& fields, const Layout& layout, char separator) {
+  for (size_t k = 0; k < fields.size() && k < layout.roles.size(); ++k)
+    if (layout.roles[k] >= 0 && layout.roles[k] < 3 && !isNumberField(fields[k], separator)) return true;
+  return false;
+}
+
 // A line that is one whole number: a PTS file's point count.
 bool isCountLine(const std::vector<std::string>& fields) {
   return fields.size() == 1 && !fields[0].empty() &&
@@ -435,6 +460,16 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
   uint64_t declared_line = 0;
   while (true) {
     if (pos >= head.size()) {
+      if (head.size() == file.size() && declared == uint64_t{0}) {  // a PTS file of no points: its count line, 0
+        Header header;
+        header.layout = *layoutFromPtsColumns(file.path(), 3, line, ' ');
+        header.data_offset = file.size();
+        header.first_data_line = line;
+        header.named = true;
+        header.declared = declared;
+        header.declared_line = declared_line;
+        return header;
+      }
       if (head.size() == file.size()) return Error{file.path() + ": no data rows"};
       return Error{file.path() + ":" + std::to_string(line + 1) + ": line longer than " +
                    std::to_string(kMaxLineLength) + " bytes"};
@@ -456,12 +491,19 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
     if (text.find('\0') != std::string_view::npos)
       return Error{file.path() + ":" + std::to_string(line + 1) + ": binary data, not CSV text ('" +
                    excerpt(text.data(), text.data() + text.size()) + "')"};
+    if (text.find('\r') != std::string_view::npos)
+      return Error{file.path() + ":" + std::to_string(line + 1) +
+                   ": carriage returns inside a line: the file's lines end with CR alone (old Mac text); "
+                   "convert them to LF or CR LF"};
     std::vector<std::string> fields = splitHeader(text);
     const char separator = separatorOf(text);
     if (pts && !counted && isCountLine(fields)) {  // the count line before a PTS file's rows
       counted = true;
       uint64_t n = 0;
-      if (parseDecimalU64(fields[0], n)) declared = n, declared_line = line + 1;
+      if (!parseDecimalU64(fields[0], n))
+        return Error{file.path() + ":" + std::to_string(line + 1) + ": the count line " + printableExcerpt(fields[0]) +
+                     " is past 2^64 points"};
+      declared = n, declared_line = line + 1;
       pos = nl + 1;
       ++line;
       continue;
@@ -469,20 +511,50 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
     Header header;
     header.declared = declared;
     header.declared_line = declared_line;
+    const size_t marker = text.find_first_not_of(" \t");
+    if (text[marker] == '#') {
+      // A comment (numpy's savetxt writes its header as `# x,y,z`): the header where what follows
+      // the '#' names the columns, else passed over.
+      const std::string_view named = text.substr(marker + 1);
+      std::vector<std::string> names = splitHeader(named);
+      if (columns.empty() && !names.empty() && isHeaderLine(names)) {
+        Result<Layout> layout = layoutFromHeader(file.path(), std::move(names), splitHeader(named, true), line + 1,
+                                                 named, separatorOf(named));
+        if (layout) {
+          header.layout = *layout;
+          header.data_offset = std::min<uint64_t>(nl + 1, file.size());
+          header.first_data_line = line + 1;
+          header.named = true;
+          return header;
+        }
+      }
+      pos = nl + 1;
+      ++line;
+      continue;
+    }
     if (!columns.empty()) {  // --columns: the names are given; a header line is passed over
       Result<Layout> layout = layoutFromNames(columns, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
-      const bool named = isHeaderLine(fields);
+      const bool named = isNamedLine(fields, header.layout, separator);
       header.data_offset = named ? std::min<uint64_t>(nl + 1, file.size()) : pos;
       header.first_data_line = named ? line + 1 : line;
       header.named = named;
       return header;
     }
-    if (isHeaderLine(fields)) {
-      Result<Layout> layout =
-          layoutFromHeader(file.path(), std::move(fields), splitHeader(text, true), line + 1, text, separator);
+    // pandas' to_csv writes its index first, in a column without a name (`,x,y,z`): passed over.
+    const bool index_column = separator != '\0' && fields.size() > 1 && fields.front().empty() &&
+                              isHeaderLine(std::vector<std::string>(fields.begin() + 1, fields.end()));
+    if (isHeaderLine(fields) || index_column) {
+      std::vector<std::string> spelled = splitHeader(text, true);
+      if (index_column) fields.erase(fields.begin()), spelled.erase(spelled.begin());
+      Result<Layout> layout = layoutFromHeader(file.path(), std::move(fields), std::move(spelled), line + 1, text, separator);
       if (!layout) return layout.error();
+      if (index_column) {
+        layout->roles.insert(layout->roles.begin(), kRoleSkip);
+        ++layout->columns;
+        layout->text = "," + layout->text;
+      }
       header.layout = *layout;
       header.data_offset = std::min<uint64_t>(nl + 1, file.size());  // a header only: an empty set
       header.first_data_line = line + 1;
@@ -499,6 +571,18 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
   }
 }
 
+// Whether text that parsed to `v` fits `type`. A float32 dimension written in its shortest form
+// ("0.12345679") parses to the double nearest that text, not to the float: it fits when that is
+// the float's own shortest text (a column parsed as float rounded 0.123456789012345 to float32).
+bool textFits(DimType type, double v) {
+  if (dimensionHolds(type, v) || type != DimType::kF32) return dimensionHolds(type, v);
+  char text[32];
+  const auto written = std::to_chars(text, text + sizeof text, static_cast<float>(v));
+  double back = 0.0;
+  fast_float::from_chars(text, written.ptr, back);
+  return back == v;
+}
+
 // A column named as a known dimension (core/dimensions.h) takes its type when every value fits it
 // exactly (an intensity of whole numbers 0-65535 becomes uint16); any other stays double.
 void narrowDimensions(Dimensions& dimensions, unsigned threads) {
@@ -511,7 +595,7 @@ void narrowDimensions(Dimensions& dimensions, unsigned threads) {
     parallelFor((n + block - 1) / block, threads, [&](size_t b, unsigned) {
       for (size_t i = b * block; i < std::min(n, (b + 1) * block) && fits.load(std::memory_order_relaxed); ++i) {
         const double v = d.get<double>(i);
-        if (!dimensionHolds(known->type, v)) {
+        if (!textFits(known->type, v)) {
           fits = false;
           return;
         }
@@ -589,20 +673,17 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     return s.error();
   resizePrefaulted(points.positions, static_cast<size_t>(lines), threads);
   if (hasColorColumns(layout)) resizePrefaulted(points.colors, static_cast<size_t>(lines), threads);
-  // Further columns are read as doubles (floats for a known float32 dimension), then narrowed to
-  // their known type where every value fits it (narrowDimensions).
+  // Further columns are read as doubles, then narrowed to their known type where every value fits
+  // it (narrowDimensions).
   std::vector<double*> columns;
-  std::vector<bool> as_float;
   for (const std::string& name : layout.dimensions) {
     // Unset: a data row parses every column (or the read fails); a blank line's row is closed up below.
     Dimension& d = points.dimensions.appendUnset(name, DimType::kF64, static_cast<size_t>(lines));
     columns.push_back(reinterpret_cast<double*>(d.bytes.data()));
-    const KnownDimension* known = findKnownDimension(name);
-    as_float.push_back(known && known->type == DimType::kF32);
   }
 
   // Pass 2: parse. The first error by line number wins, whatever the thread count.
-  const LineParser parser(path, layout, options.allow_nonfinite, columns, as_float);
+  const LineParser parser(path, layout, options.allow_nonfinite, columns);
   const bool has_colors = hasColorColumns(layout);
   std::mutex error_mutex;
   std::optional<LineError> first_error;
@@ -672,7 +753,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
       if (text_end > p && text_end[-1] == '\r') --text_end;
       const char* first = p;
       while (first < text_end && isBlank(*first)) ++first;
-      if (first == text_end) {
+      if (first == text_end || *first == '#') {  // a blank line, or a comment (numpy's savetxt, many exports)
         blank_rows[b].push_back(row);
       } else if (!parser.parse(p, text_end, line_number, row, points.positions[row],
                                has_colors ? points.colors[row] : scratch_color, error)) {

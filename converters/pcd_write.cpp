@@ -90,7 +90,8 @@ class Writer {
     for (int axis = 0; axis < 3; ++axis) fields_.push_back({std::string(1, static_cast<char>('x' + axis)), 'F', single ? 4 : 8, static_cast<Source>(axis), nullptr});
     if (!single && options_.notices)
       options_.notices->push_back(path_ + ": x, y and z written as double (PCD TYPE F SIZE 8) to keep every coordinate; "
-                                  "PCL's typed loaders such as pcl::PointXYZ want float and leave double fields at 0");
+                                  "PCL's typed loaders such as pcl::PointXYZ want float and leave double fields at 0, "
+                                  "and Open3D reads them as 0 from binary data (it reads --pcd-encoding ascii exactly)");
     alpha_ = nullptr;
     if (points_.hasColors()) {
       const Dimension* alpha = points_.dimensions.find("alpha");
@@ -106,7 +107,8 @@ class Writer {
     names = writableNames(
         names, isSpaceOrControl,
         [](const std::string& name, size_t) {
-          return name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba";
+          // "_" is PCD's padding: every reader passes over such a field.
+          return name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba" || name == "_";
         },
         &renamed);
     for (size_t k = 0; k < dims.size(); ++k)
@@ -116,7 +118,7 @@ class Writer {
       options_.notices->push_back(path_ + ": 16-bit colours written as 8-bit (PCD's rgb holds 0..255 a channel)");
     if (options_.notices)
       for (const std::string& line : renamed)
-        options_.notices->push_back(path_ + ": " + line + " (a PCD field's name is one word, not x, y, z, rgb or rgba)");
+        options_.notices->push_back(path_ + ": " + line + " (a PCD field's name is one word, not x, y, z, rgb, rgba or _)");
     return okStatus();
   }
 

@@ -212,6 +212,13 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
       {"pts_without_count", "1.5 -2.25 3 7\n4 5 6.125 8\n", ".pts"},
       {"columns_skip_an_id", "id;Rechts;Hoch;Z\n7;1,5;-2,25;3\n8;4;5;6,125\n", ".csv", {"-", "x", "y", "z"}},
       {"columns_in_another_order", "3 1.5 -2.25 0.5\n6.125 4 5 0.25\n", ".txt", {"z", "X", "y", "quality"}},
+      // A review's findings: each was refused, or lost its first row.
+      {"columns_label_first_no_header", "pt1,1.5,-2.25,3\npt2,4,5,6.125\n", ".csv", {"-", "x", "y", "z"}},
+      {"pandas_index", ",x,y,z\n0,1.5,-2.25,3\n1,4,5,6.125\n"},
+      {"numpy_savetxt_header", "# x,y,z\n1.5,-2.25,3\n4,5,6.125\n"},
+      {"comment_lines", "# exported by a scanner\n1.5 -2.25 3\n# a comment between rows\n4 5 6.125\n", ".xyz"},
+      {"cloudcompare_spaced_marker", "// X Y Z\n1.5 -2.25 3\n4 5 6.125\n", ".xyz"},
+      {"quoted_header", "\"x\",\"y\",\"z\"\n1.5,-2.25,3\n4,5,6.125\n"},
   };
   for (const Variant& v : variants) {
     SCOPED_TRACE(v.name);
@@ -266,6 +273,52 @@ TEST(Csv, readsTheVariantsPeopleWriteToTheSamePoints) {
   writeFile(dir.file("unknown.csv"), "Rechts;Hoch;H\xc3\xb6henlage\n1;2;3\n");
   expectReadError(dir.file("unknown.csv"), {"unknown.csv:1: header 'Rechts;Hoch;H\xc3\xb6henlage' (split at semicolons)",
                                             "lon,lat,alt"});
+}
+
+// A review of the inputs people bring (2026-12-01): an attribute's empty field is a missing value
+// (pandas writes NaN so) and a skipped column's is nothing; a known float32 dimension keeps the
+// digits float32 cannot hold (nx was parsed as float: 0.123456789012345 became 0.12345679), and
+// its shortest float text still reads as float32; a negative colour fraction, a PTS count past
+// 2^64 and CR-only line ends are refused naming why; a PTS file of 0 points is an empty set.
+TEST(Csv, missingValuesFloatDimensionsAndOddLinesAreReadAsMeant) {
+  TempDir dir;
+  writeFile(dir.file("missing.csv"), "x,y,z,gps_time\n1,2,3,\n4,5,6,7.5\n");
+  Result<PointSet> missing = readCsv(dir.file("missing.csv"));
+  ASSERT_TRUE(missing.ok()) << missing.error().message;
+  ASSERT_NE(missing->dimensions.find("gps_time"), nullptr);
+  EXPECT_TRUE(std::isnan(missing->dimensions.find("gps_time")->value(0)));
+  EXPECT_EQ(missing->dimensions.find("gps_time")->value(1), 7.5);
+  writeFile(dir.file("empty_position.csv"), "x,y,z\n1,,3\n");
+  expectReadError(dir.file("empty_position.csv"), {"empty_position.csv:2: column 2: empty field"});
+  CsvReadOptions skip;
+  skip.columns = {"-", "x", "y", "z"};
+  writeFile(dir.file("empty_skipped.csv"), ",1,2,3\n");
+  Result<PointSet> skipped = readCsv(dir.file("empty_skipped.csv"), skip);
+  ASSERT_TRUE(skipped.ok()) << skipped.error().message;
+  EXPECT_EQ(skipped->size(), 1u);
+
+  writeFile(dir.file("normals.csv"), "x,y,z,nx,ny\n1,2,3,0.123456789012345,0.12345679\n4,5,6,0.5,0.25\n");
+  Result<PointSet> normals = readCsv(dir.file("normals.csv"));
+  ASSERT_TRUE(normals.ok()) << normals.error().message;
+  EXPECT_EQ(normals->dimensions.find("nx")->type, DimType::kF64);
+  EXPECT_EQ(normals->dimensions.find("nx")->value(0), 0.123456789012345);
+  EXPECT_EQ(normals->dimensions.find("ny")->type, DimType::kF32);
+  EXPECT_EQ(normals->dimensions.find("ny")->value(0), double(0.12345679f));
+
+  writeFile(dir.file("negative.csv"), "x,y,z,r,g,b\n1,2,3,0.5,0,1\n1,2,3,-5,0,1\n");
+  expectReadError(dir.file("negative.csv"), {"negative.csv: data row 2, colour column 1: -5", "fractions are 0..1"});
+  writeFile(dir.file("huge.pts"), "99999999999999999999\n1 2 3\n");
+  expectReadError(dir.file("huge.pts"), {"huge.pts:1: the count line 99999999999999999999 is past 2^64 points"});
+  writeFile(dir.file("mac.xyz"), "1 2 3\r4 5 6\r");
+  expectReadError(dir.file("mac.xyz"), {"mac.xyz:1: carriage returns inside a line", "CR alone"});
+  writeFile(dir.file("id.csv"), "id,x,y,z\n1,1,2,3\n");
+  expectReadError(dir.file("id.csv"), {"id.csv:1: header 'id,x,y,z'", "--columns names each column instead"});
+  for (const char* text : {"0\n", "0"}) {
+    writeFile(dir.file("none.pts"), text);
+    Result<PointSet> none = readCsv(dir.file("none.pts"));
+    ASSERT_TRUE(none.ok()) << none.error().message;
+    EXPECT_EQ(none->size(), 0u);
+  }
 }
 
 // The text exports (.xyz, .txt, .asc) are written with spaces and CloudCompare's comment header,
