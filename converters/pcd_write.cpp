@@ -6,7 +6,9 @@
 #include <charconv>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -30,6 +32,24 @@ struct OutField {
   Source source = Source::kDimension;
   const Dimension* dimension = nullptr;
 };
+
+// Fields written as one: a run of dimensions NAME_0 … NAME_n-1 of one type (a PCD field of COUNT n
+// as the reader names its values: an FPFH's 33) is the field NAME with COUNT n again, which PCL's
+// typed loaders look for. Binary and ASCII rows lay the values out as the n fields would;
+// binary_compressed keeps each point's n values together.
+struct FieldGroup {
+  std::string name;
+  size_t first = 0, count = 1;  // fields_[first, first + count)
+};
+
+// NAME where `name` is NAME_k, with k its index; nullopt otherwise.
+std::optional<std::string> countBase(const std::string& name, size_t k) {
+  std::string suffix(1, '_');  // appended: GCC 12's -Wrestrict misfires on "_" + std::string under -O2
+  suffix += std::to_string(k);
+  if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return std::nullopt;
+  return name.substr(0, name.size() - suffix.size());
+}
 
 char pcdTypeOf(DimType type) { return dimTypeIsFloat(type) ? 'F' : dimTypeIsSigned(type) ? 'I' : 'U'; }
 
@@ -119,7 +139,26 @@ class Writer {
     if (options_.notices)
       for (const std::string& line : renamed)
         options_.notices->push_back(path_ + ": " + line + " (a PCD field's name is one word, not x, y, z, rgb, rgba or _)");
+    groupCounts();
     return okStatus();
+  }
+
+  // FieldGroup: each run of NAME_0, NAME_1, … of one type whose NAME is no other field's.
+  void groupCounts() {
+    std::unordered_set<std::string> names;
+    for (const OutField& f : fields_) names.insert(f.name);
+    for (size_t i = 0; i < fields_.size();) {
+      const std::optional<std::string> base =
+          fields_[i].source == Source::kDimension ? countBase(fields_[i].name, 0) : std::nullopt;
+      size_t n = 1;
+      if (base && !names.count(*base) && *base != "_")
+        while (i + n < fields_.size() && fields_[i + n].source == Source::kDimension &&
+               fields_[i + n].type == fields_[i].type && fields_[i + n].size == fields_[i].size &&
+               countBase(fields_[i + n].name, n) == base)
+          ++n;
+      groups_.push_back({n > 1 ? *base : fields_[i].name, i, n});
+      i += n;
+    }
   }
 
   std::string header() const {
@@ -128,13 +167,13 @@ class Writer {
     if (!has_z_) h += "# dpoint: 2D (the source has x,y only; z is 0)\n";
     if (points_.z_up) h += "# dpoint: up axis z\n";
     h += "VERSION 0.7\nFIELDS";
-    for (const OutField& f : fields_) h += ' ' + f.name;
+    for (const FieldGroup& g : groups_) h += ' ' + g.name;
     h += "\nSIZE";
-    for (const OutField& f : fields_) h += ' ' + std::to_string(f.size);
+    for (const FieldGroup& g : groups_) h += ' ' + std::to_string(fields_[g.first].size);
     h += "\nTYPE";
-    for (const OutField& f : fields_) h += std::string(" ") + f.type;
+    for (const FieldGroup& g : groups_) h += std::string(" ") + fields_[g.first].type;
     h += "\nCOUNT";
-    for (size_t k = 0; k < fields_.size(); ++k) h += " 1";
+    for (const FieldGroup& g : groups_) h += ' ' + std::to_string(g.count);
     h += "\nWIDTH " + std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) +
          "\nDATA " + pcdEncodingName(options_.encoding) + "\n";
     return h;
@@ -195,11 +234,16 @@ class Writer {
 
   Status writeCompressed(AtomicFile& file) {
     const size_t n = points_.size();
-    // The fields one after another (each field's values for every point), then LZF.
+    // The fields one after another (each field's values for every point, a point's COUNT values
+    // together), then LZF.
     std::vector<uint8_t> columns(n * row_bytes_);
     uint8_t* out = columns.data();
-    for (const OutField& f : fields_)
-      for (size_t i = 0; i < n; ++i, out += f.size) store(f, i, out);
+    for (const FieldGroup& g : groups_)
+      for (size_t i = 0; i < n; ++i)
+        for (size_t k = g.first; k < g.first + g.count; ++k) {
+          store(fields_[k], i, out);
+          out += fields_[k].size;
+        }
     std::vector<uint8_t> packed(columns.size() + columns.size() / 16 + 64);
     unsigned int made = 0;
     if (!columns.empty()) {
@@ -284,6 +328,7 @@ class Writer {
   const PointSet& points_;
   const PcdWriteOptions& options_;
   std::vector<OutField> fields_;
+  std::vector<FieldGroup> groups_;
   const Dimension* alpha_ = nullptr;
   size_t row_bytes_ = 0;
   bool has_z_;  // PointSet::hasZ() once: for a set made in memory it looks at every point

@@ -312,7 +312,7 @@ TEST(CliConvertMeaning, integerColoursKeepTheirFormThroughPly) {
   writeFile(dir.file("bad.csv"), "x,y,z,r,g,b\n0,0,0,255,0,0\n1,0,0,0.5,64,32\n");
   test::CommandResult bad = runDpoint({"convert", dir.file("bad.csv"), "-o", dir.file("bad.ply")});
   EXPECT_NE(bad.exit_code, 0);
-  EXPECT_TRUE(test::contains(bad.err, "bad.csv: row 2, colour column 1: 0.5 among integer colours"));
+  EXPECT_TRUE(test::contains(bad.err, "bad.csv: data row 2, colour column 1: 0.5 among integer colours"));
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
 }
 

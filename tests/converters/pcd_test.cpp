@@ -38,6 +38,7 @@ PointSet richSet(size_t n) {
   }
   set.color_full_scale = 255;
   set.z_axis = ZAxis::kPresent;
+  set.dimensions.reserve(6);  // the references below outlive each add
   Dimension& intensity = set.dimensions.add("intensity", DimType::kU16, n);
   Dimension& nx = set.dimensions.add("nx", DimType::kF32, n);
   Dimension& gps = set.dimensions.add("gps_time", DimType::kF64, n);
@@ -418,6 +419,34 @@ TEST(Pcd, aDimensionNamedAsPaddingIsRenamedAndKept) {
   ASSERT_TRUE(back.ok()) << back.error().message;
   ASSERT_EQ(back->dimensions.all().size(), 1u);
   EXPECT_EQ(back->dimensions.all()[0].value(1), 7.25);
+}
+
+// A PCD field of COUNT n reads as NAME_0 … NAME_n-1 and is written back as that one field (a review
+// finding: an FPFH's 33 values came back as 33 fields, which pcl::FPFHSignature33 does not find),
+// in every encoding; binary_compressed keeps each point's values together. A run that is not one
+// (another type inside, or a field named as the run's name) stays as it is.
+TEST(Pcd, aCountFieldIsWrittenBackAsOneField) {
+  TempDir dir;
+  const std::string source = "VERSION 0.7\nFIELDS x y z h\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 3\nWIDTH 2\n"
+                             "HEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 10 11 12\n4 5 6 20 21 22\n";
+  writeFile(dir.file("h.pcd"), source);
+  Result<PointSet> set = readPcd(dir.file("h.pcd"));
+  ASSERT_TRUE(set.ok()) << set.error().message;
+  ASSERT_EQ(set->dimensions.all().size(), 3u);
+  EXPECT_EQ(set->dimensions.all()[2].name, "h_2");
+  for (PcdEncoding encoding : kEncodings) {
+    SCOPED_TRACE(pcdEncodingName(encoding));
+    const std::string path = dir.file(std::string("again_") + pcdEncodingName(encoding) + ".pcd");
+    ASSERT_TRUE(writePcd(path, *set, PcdWriteOptions{encoding, nullptr, nullptr}).ok());
+    EXPECT_TRUE(contains(readFile(path), "FIELDS x y z h\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 3\n")) << readFile(path);
+    Result<PointSet> back = readPcd(path);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    expectSame(*set, *back, pcdEncodingName(encoding));
+  }
+  PointSet mixed = *set;
+  mixed.dimensions.add("h", DimType::kU8, 2);  // a field named as the run's name: no group
+  ASSERT_TRUE(writePcd(dir.file("mixed.pcd"), mixed, PcdWriteOptions{PcdEncoding::kAscii, nullptr, nullptr}).ok());
+  EXPECT_TRUE(contains(readFile(dir.file("mixed.pcd")), "FIELDS x y z h_0 h_1 h_2 h\n"));
 }
 
 TEST(Pcd, convertsByExtensionWithTheEncodingAsked) {

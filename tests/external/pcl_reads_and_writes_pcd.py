@@ -148,4 +148,23 @@ with scratch() as d:
     v = read_binary_ply_vertices(ply)
     check(v["x"].tolist() == [1.5, 3.0] and v["y"].tolist() == [-2.25, 4.0] and v["z"].tolist() == [0.125, 5.0],
           f"float PCD: PCL reads {v}")
+
+    # A field of COUNT n (an FPFH's 33 values) is read as NAME_0 … NAME_n-1 and written back as the
+    # one field NAME of COUNT n, each point's values together in binary_compressed: PCL rewrites
+    # dpoint's file as ASCII with the same field and values.
+    counted = os.path.join(d, "counted.csv")
+    with open(counted, "w") as f:
+        f.write("x,y,z,h_0,h_1,h_2\n1,2,3,10.5,11.5,12.5\n4,5,6,20.25,21.25,22.25\n7,8,9,30,31,32\n")
+    for encoding in ("binary", "binary_compressed"):
+        pcd = os.path.join(d, f"counted_{encoding}.pcd")
+        dpoint(exe, "convert", counted, "-o", pcd, "--pcd-encoding", encoding, "-q")
+        ascii_pcd = os.path.join(d, f"counted_{encoding}_pcl.pcd")
+        run("pcl_convert_pcd_ascii_binary", pcd, ascii_pcd, "0", "17")
+        with open(ascii_pcd) as f:
+            text = f.read()
+        check("FIELDS x y z h\n" in text and "COUNT 1 1 1 3\n" in text, f"PCL's rewrite of {pcd}: {text[:400]!r}")
+        rows = [[float(v) for v in line.split()] for line in text.split("DATA ascii\n", 1)[1].splitlines() if line.strip()]
+        check(rows == [[1, 2, 3, 10.5, 11.5, 12.5], [4, 5, 6, 20.25, 21.25, 22.25], [7, 8, 9, 30, 31, 32]],
+              f"PCL reads dpoint's {encoding} COUNT 3 field as {rows}")
+    print("PCL reads a COUNT 3 field dpoint writes, binary and binary_compressed")
 print("PCD: pcl-tools and dpoint agree both ways")
