@@ -123,14 +123,18 @@ class Writer {
     std::vector<const Dimension*> dims;
     for (const Dimension& d : points_.dimensions.all())
       if (&d != alpha_) names.push_back(fieldName(d.name)), dims.push_back(&d);
-    std::vector<std::string> renamed;
     names = writableNames(
         names, isSpaceOrControl,
         [](const std::string& name, size_t) {
           // "_" is PCD's padding: every reader passes over such a field.
           return name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba" || name == "_";
         },
-        &renamed);
+        nullptr);
+    // Each change named by the dimension's own name (writableNames would name PCL's: nx as normal_x).
+    std::vector<std::string> renamed;
+    for (size_t k = 0; k < dims.size(); ++k)
+      if (names[k] != fieldName(dims[k]->name))
+        renamed.push_back("dimension " + quotedExcerpt(dims[k]->name) + " written as " + quotedExcerpt(names[k]));
     for (size_t k = 0; k < dims.size(); ++k)
       fields_.push_back({names[k], pcdTypeOf(dims[k]->type), static_cast<int>(dimTypeSize(dims[k]->type)),
                          Source::kDimension, dims[k]});

@@ -419,6 +419,15 @@ TEST(Pcd, aDimensionNamedAsPaddingIsRenamedAndKept) {
   ASSERT_TRUE(back.ok()) << back.error().message;
   ASSERT_EQ(back->dimensions.all().size(), 1u);
   EXPECT_EQ(back->dimensions.all()[0].value(1), 7.25);
+  // A set with both normal_x and nx: the notice names the dimension renamed (it named PCL's name).
+  PointSet both;
+  both.positions = {{1, 2, 3}};
+  both.dimensions.add("normal_x", DimType::kF64, 1);
+  both.dimensions.add("nx", DimType::kF64, 1);
+  notices.clear();
+  ASSERT_TRUE(writePcd(dir.file("both.pcd"), both, PcdWriteOptions{PcdEncoding::kAscii, nullptr, &notices}).ok());
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_TRUE(contains(notices[0], "dimension 'nx' written as 'normal_x_2'")) << notices[0];
 }
 
 // A PCD field of COUNT n reads as NAME_0 … NAME_n-1 and is written back as that one field (a review
