@@ -1,6 +1,9 @@
 #include "cli/cli_check.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <string_view>
 
 #include "cli/cli_suggest.h"
 #include "core/text.h"
@@ -74,6 +77,19 @@ CLI::Validator nonNegativeNumber(const std::string& flag) {
     double v = 0.0;
     if (!CLI::detail::lexical_cast(value, v)) return std::string();  // CLI11's conversion error follows
     return v >= 0.0 ? std::string() : flag + " " + value + ": must be 0 or more";
+  });
+}
+
+CLI::Validator wholeNumber64(const std::string& flag) {
+  return check([flag](const std::string& value) {
+    uint64_t v = 0;
+    std::string_view digits(value);
+    if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
+    const bool digits_only = !digits.empty() && digits.find_first_not_of("0123456789") == std::string_view::npos;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), v);  // refuses past 2^64 − 1
+    return digits_only && error == std::errc() && end == digits.data() + digits.size()
+               ? std::string()
+               : flag + " " + value + ": must be a whole number from 0 to 18446744073709551615";
   });
 }
 

@@ -44,5 +44,8 @@ CLI::Validator numberIn(const std::string& flag, double lo, double hi, bool open
 // PositiveNumber and NonNegativeNumber, whose refusal printed the largest double in 309 digits.
 CLI::Validator positiveNumber(const std::string& flag);
 CLI::Validator nonNegativeNumber(const std::string& flag);
+// "FLAG VALUE: must be a whole number from 0 to 18446744073709551615" for a uint64 option, where
+// CLI11 wrapped -1 and clamped 2^64 onto 2^64 − 1 (a review finding: five seeds, one set).
+CLI::Validator wholeNumber64(const std::string& flag);
 
 }  // namespace dpoint

@@ -363,7 +363,7 @@ void addGenerateCommand(CLI::App& app, RunCommand& run) {
   random2d->add_option("--count,-n", r->params.count, "Number of points")
       ->default_val(1000000)
       ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40));
-  random2d->add_option("--seed", r->params.seed, "Seed of the generator")->default_val(1);
+  random2d->add_option("--seed", r->params.seed, "Seed of the generator")->default_val(1)->check(wholeNumber64("--seed"));
   addOutputOptions(*random2d, r->out, "none");
   // Written to a .ply, its points are made as the rows are written (finishMade): no array of them.
   registerKind(run, r, random2d, false, &generateRandom2d, &generateRandom2dTile, &plainParams<Random2dParams>,

@@ -43,7 +43,8 @@ void addSampleOptions(CLI::App& command, SampleCliOptions& options) {
                   "each triangle its share of the points, spread evenly in it (as fast as uniform)",
                   {"uniform", "poisson", "stratified"});
   command.add_option("--sample-seed", options.seed, "Seed of --sample: the same seed gives the same points on any thread count")
-      ->default_val(0);
+      ->default_val(0)
+      ->check(wholeNumber64("--sample-seed"));
 }
 
 SampleOptions sampleOptionsOf(const SampleCliOptions& options, unsigned threads, uint64_t max_memory, Progress* progress) {

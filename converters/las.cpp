@@ -1211,11 +1211,18 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
 
   if (options.report) {
     options.report->scale = scale;
-    options.report->rounded = rounded;
     // Points that read back as themselves cannot merge: the count's two sorts only run otherwise.
+    // With the source's scale, each axis: a coordinate off its grid (a review finding: positions
+    // moved in Python by less than a step were rounded back without a word).
     bool exact = true;
-    for (int k = 0; k < 3 && exact; ++k) exact = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
+    for (int k = 0; k < 3 && (exact || keep_frame); ++k) {
+      const bool axis = readsBackExactly(points.positions, k, offset[k], scale[k], threads);
+      if (keep_frame && !axis) rounded[k] = true;
+      exact = exact && axis;
+    }
     options.report->merged_points = exact ? 0 : mergedPoints(points.positions, scale, offset, threads);
+    options.report->rounded = rounded;
+    options.report->source_scale = keep_frame;
   }
   Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, options.crs_wkt, threads);
   if (!layout) return layout.error();

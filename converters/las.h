@@ -104,6 +104,9 @@ struct LasWriteReport {
   // Axes whose scale the writer chose coarser than the coordinates' digits, the finest at which the
   // extent fits the 32-bit integers: their coordinates move by up to half a step.
   glm::bvec3 rounded{false};
+  // The scale is the source LAS file's (a set read from LAS): `rounded` then marks axes whose
+  // coordinates left its grid since (changed in Python) and moved back onto it.
+  bool source_scale = false;
   // Extra bytes named anew, one line each ("dimension 'höhe' written as 'h__he'"): LAS names are up
   // to 32 letters, digits or '_'.
   std::vector<std::string> renamed;

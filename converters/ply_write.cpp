@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cstring>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "core/atomic_file.h"
@@ -159,6 +160,14 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
   return header;
 }
 
+// Whether a 64-bit integer reads back from a double as itself.
+template <typename T>
+bool doubleHolds(T v) {
+  const double d = static_cast<double>(v);
+  const bool in_range = std::is_unsigned_v<T> ? d < 18446744073709551616.0 : d < 9223372036854775808.0;
+  return in_range && static_cast<T>(d) == v;  // (2^64 or 2^63: v rounded up past T, so not held)
+}
+
 Status writePly(const std::string& path, const PointSet& points, const PlyWriteOptions& options) {
   const MadePositions& made = options.positions_of;
   assert(!made || (points.positions.empty() && !points.hasColors() && !points.isMesh() && points.dimensions.empty()));
@@ -178,6 +187,19 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
     plyPropertyNames(points.dimensions, &renamed);
     for (const std::string& line : renamed)
       options.notices->push_back(path + ": " + line + " (a PLY property's name is one word, not x, y, z, red, green or blue)");
+    // PLY has no 64-bit integers: such a dimension goes as double, which past 2^53 loses digits (a
+    // review finding: ids 2^53 + 1 came back as 2^53 without a word).
+    for (const Dimension& d : points.dimensions.all()) {
+      if (d.type != DimType::kU64 && d.type != DimType::kI64) continue;
+      for (size_t i = 0; i < d.size(); ++i) {
+        const bool exact = d.type == DimType::kU64 ? doubleHolds(d.get<uint64_t>(i)) : doubleHolds(d.get<int64_t>(i));
+        if (exact) continue;
+        options.notices->push_back(path + ": dimension " + quotedExcerpt(d.name) + " (" + dimTypeName(d.type) +
+                                   ") written as double, as PLY has no 64-bit integers: values past 2^53 lose digits "
+                                   "(the first: point " + std::to_string(i) + "); LAS, PCD and GLB keep them");
+        break;
+      }
+    }
   }
   // Every index below n, checked before anything is written; the first bad one is named.
   if (const size_t bad = points.firstBadTriangleIndex(options.threads); bad < points.triangles.size())

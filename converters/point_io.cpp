@@ -275,11 +275,13 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
             std::string note = path;
             note += ": ";
             note += "xyz"[k];
-            note += " rounded to the LAS scale ";
+            note += report.source_scale ? " rounded to the source LAS file's scale " : " rounded to the LAS scale ";
             note += formatNumber(report.scale[k]);
             note += ", up to ";
             note += formatNumber(report.scale[k] / 2);
-            note += " off: no step that keeps its digits lets its extent fit LAS's 32-bit integers";
+            note += report.source_scale ? " off: coordinates changed since it was read left its grid (las_scale, "
+                                          "--las-scale, sets a finer one)"
+                                        : " off: no step that keeps its digits lets its extent fit LAS's 32-bit integers";
             options.notices->push_back(std::move(note));
           }
       }

@@ -49,6 +49,7 @@ void addCommands(py::module_& m) {
         if (sample < 1 || sample > 100000000)
           raise(Error{"sample " + std::to_string(sample) + ": must be a number from 1 to 100000000", ExitCode::kUsage});
         InfoOptions options{camera.spec, sample, camera.tolerance_px, threads, std::nullopt};
+        const SetInUse in_use(points.get());
         InfoReport report = take(released([&] {
           if (points) return describePoints(*points, "points", options);
           Progress bar(progressFile(progress), "info");

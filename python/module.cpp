@@ -4,6 +4,9 @@
 #include "cli/version.h"
 #include "python/module.h"
 
+#include <stdexcept>
+#include <unordered_set>
+
 namespace dpoint::python {
 
 bool catchesSigint() {
@@ -19,6 +22,28 @@ void raiseInterrupt() {
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   PyErr_SetNone(PyExc_KeyboardInterrupt);
   throw py::error_already_set();
+}
+
+namespace {
+// The sets calls are reading now (SetInUse), a set once per call.
+std::unordered_multiset<const PointSet*>& setsInUse() {
+  static std::unordered_multiset<const PointSet*> sets;
+  return sets;
+}
+}  // namespace
+
+SetInUse::SetInUse(const PointSet* set) : set_(set) {
+  if (set_) setsInUse().insert(set_);
+}
+
+SetInUse::~SetInUse() {
+  if (set_) setsInUse().erase(setsInUse().find(set_));
+}
+
+void checkNotInUse(const PointSet& set, const std::string& what) {
+  if (setsInUse().count(&set))
+    throw std::runtime_error(what + ": the set is being read by a dpoint call in another thread (write, info, render, "
+                          "sample); change it once that call returns");
 }
 
 namespace {

@@ -67,6 +67,24 @@ auto released(Work&& work) {
   return std::move(*result);
 }
 
+// A set that a call reads with the GIL released (write, info, render, sample): while it does, the
+// set's colours, triangles and attributes may not change (a review finding: set_attribute from
+// another thread while write ran reallocated the attributes under it and corrupted the heap).
+// Made, checked and ended with the GIL held, so the GIL guards the registry.
+class SetInUse {
+ public:
+  explicit SetInUse(const PointSet* set);
+  ~SetInUse();
+  SetInUse(const SetInUse&) = delete;
+  SetInUse& operator=(const SetInUse&) = delete;
+
+ private:
+  const PointSet* set_;
+};
+// Raises RuntimeError where a call in another thread is reading `set` (SetInUse): `what` is the
+// change refused.
+void checkNotInUse(const PointSet& set, const std::string& what);
+
 // Progress lines on stderr when asked (progress=True), else none.
 inline std::FILE* progressFile(bool progress) { return progress ? stderr : nullptr; }
 

@@ -116,6 +116,7 @@ void replaceKeepingViews(const py::handle& self, Vector& target, Vector values) 
 void setColors(PointSet& set, const py::handle& value, const py::handle& self = py::handle()) {
   if (value.is_none()) {
     set.colors.clear();
+    set.color_full_scale = 0;
     return;
   }
   py::array table = asTable(value, "colors", false);
@@ -128,11 +129,16 @@ void setColors(PointSet& set, const py::handle& value, const py::handle& self = 
   if (kind == 'u' && table.itemsize() == 1) {
     float byte_color[256];  // k / 255.0f, as the PLY reader rounds it
     for (int k = 0; k < 256; ++k) byte_color[k] = static_cast<float>(k) / 255.0f;
-    const auto view = py::array_t<uint8_t>::ensure(table).unchecked<2>();
+    const py::array_t<uint8_t> bytes = py::array_t<uint8_t>::ensure(table);  // named: the view points into it
+    const auto view = bytes.unchecked<2>();
     for (size_t i = 0; i < n; ++i)
       for (py::ssize_t c = 0; c < 3; ++c) colors[i][static_cast<int>(c)] = byte_color[view(static_cast<py::ssize_t>(i), c)];
   } else if (kind == 'f') {
-    const auto view = py::array_t<float>::ensure(table).unchecked<2>();
+    // Named: a converted array (float64, float16, big-endian) is a new one the view points into;
+    // as a temporary it was freed at once and read after (a review finding: a segfault, or
+    // garbage colours, for 100,000 float64 colours).
+    const py::array_t<float> floats = py::array_t<float>::ensure(table);
+    const auto view = floats.unchecked<2>();
     for (size_t i = 0; i < n; ++i)
       for (py::ssize_t c = 0; c < 3; ++c) {
         const float v = view(static_cast<py::ssize_t>(i), c);
@@ -149,6 +155,9 @@ void setColors(PointSet& set, const py::handle& value, const py::handle& self = 
     replaceKeepingViews(self, set.colors, std::move(colors));
   else
     set.colors = std::move(colors);
+  // New colours have no source form: a set read from a file of 0..255 integers wrote colours set
+  // after as 8-bit integers (a review finding: 0.123456 written as 31).
+  set.color_full_scale = 0;
 }
 
 // The dimension type of a NumPy dtype: its integer and float types, bool as uint8.
@@ -383,6 +392,7 @@ std::shared_ptr<PointSet> sampleMesh(const PointSet* mesh, const std::string& pa
   options.max_memory = take(memoryOption("max_memory", max_memory));
   MeshTexture texture;
   std::optional<PointSet> read;
+  const SetInUse in_use(mesh);
   auto sampled = std::make_shared<PointSet>(take(released([&]() -> Result<PointSet> {
     Progress bar(progressFile(progress), "sample");
     options.progress = &bar;
@@ -438,7 +448,10 @@ that memory, without copying (writing into them changes the set).)")
             if (!s.hasColors()) return py::none();
             return view3(self, reinterpret_cast<const float*>(s.colors.data()), s.size());
           },
-          [](const py::object& self, const py::object& colors) { setColors(self.cast<PointSet&>(), colors, self); },
+          [](const py::object& self, const py::object& colors) {
+            checkNotInUse(self.cast<const PointSet&>(), "colors");
+            setColors(self.cast<PointSet&>(), colors, self);
+          },
           "(N, 3) float32 view of the linear 0..1 colours (no copy), or None. Set from uint8 or floats, or None")
       .def_property(
           "triangles",
@@ -448,6 +461,7 @@ that memory, without copying (writing into them changes the set).)")
             return view3(self, s.triangles.data(), s.triangles.size() / 3);
           },
           [](const py::object& self, const py::object& triangles) {
+            checkNotInUse(self.cast<const PointSet&>(), "triangles");
             setTriangles(self.cast<PointSet&>(), triangles, self);
           },
           "(M, 3) uint32 view of the triangles' vertex indices (no copy), or None")
@@ -471,6 +485,7 @@ that memory, without copying (writing into them changes the set).)")
       .def(
           "set_attribute",
           [](const py::object& self, const std::string& name, const py::object& values) {
+            checkNotInUse(self.cast<const PointSet&>(), "set_attribute");
             setAttribute(self, self.cast<PointSet&>(), name, values);
           },
           py::arg("name"), py::arg("values"),
@@ -481,6 +496,7 @@ that memory, without copying (writing into them changes the set).)")
           "remove_attribute",
           [](const py::object& self, const std::string& name) {
             PointSet& s = self.cast<PointSet&>();
+            checkNotInUse(s, "remove_attribute");
             Dimension* d = s.dimensions.find(name);
             if (!d) throw py::key_error(name);
             retireKeepingViews(self, d->bytes);  // views of it stay valid
@@ -588,6 +604,7 @@ progress: lines on stderr.)");
           crs_wkt = std::move(*wkt);
         }
         std::vector<std::string> notices;  // what the file cannot hold as given: warnings, as the CLI's notes
+        const SetInUse in_use(points.get());
         check(released([&] {
           Progress bar(progressFile(progress), "write");
           WriteOptions w;

@@ -72,12 +72,14 @@ class Renderer {
 
 RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
                           const std::vector<std::string>& args, Renderer* renderer, bool progress) {
+  if (!points && inputs.empty()) raise(Error{"render: no points and no input files", ExitCode::kUsage});
   RenderRequest request = take(renderRequestOf(args));
   if (points) {
     request.points = points;
   } else {
     request.inputs = inputs;
   }
+  const SetInUse in_use(points.get());
   RenderOutcome outcome = take(released([&]() -> Result<RenderOutcome> {
     Progress bar(progressFile(progress), "render");
     Result<RenderOutcome> done = !renderer ? runRenderJob(request, bar)

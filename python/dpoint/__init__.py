@@ -54,6 +54,8 @@ def _value(value) -> str:
     if isinstance(value, bool):
         raise TypeError("a flag takes True or False only as the whole value")
     if isinstance(value, str):
+        if "\0" in value:
+            raise ValueError(f"embedded null byte in {value!r}")
         return value
     # float() and int() first: a subclass's repr is its own (NumPy 2 gives "np.float64(0.5)").
     if isinstance(value, _numbers.Integral):
@@ -61,7 +63,7 @@ def _value(value) -> str:
     if isinstance(value, _numbers.Real):
         return repr(float(value))  # the shortest text that reads back to the same double
     if isinstance(value, _os.PathLike):
-        return _os.fspath(value)
+        return _fspath(value)
     try:
         items = list(value)
     except TypeError:
@@ -96,14 +98,23 @@ def _args(options: dict) -> list[str]:
     return args
 
 
+def _fspath(path):
+    """os.fspath, refusing an embedded NUL as open() does: the library would cut the path there and
+    read or write another file."""
+    text = _os.fspath(path)
+    if ("\0" if isinstance(text, str) else b"\0") in text:
+        raise ValueError(f"embedded null byte in the path {text!r}")
+    return text
+
+
 def _as_points(points):
     """(PointSet, []) for a set in memory, (None, paths) for files."""
     if isinstance(points, PointSet):
         return points, []
     if isinstance(points, (str, _os.PathLike)):
-        return None, [_os.fspath(points)]
+        return None, [_fspath(points)]
     if isinstance(points, (list, tuple)) and points and all(isinstance(p, (str, _os.PathLike)) for p in points):
-        return None, [_os.fspath(p) for p in points]
+        return None, [_fspath(p) for p in points]
     if hasattr(points, "columns") and hasattr(points, "to_numpy"):  # a pandas DataFrame
         return PointSet.from_dataframe(points), []
     return PointSet(points), []
@@ -271,7 +282,7 @@ def read(path, **options) -> PointSet:
     options = _keywords("read", _dpoint.read, options)
     if "columns" in options:
         options["columns"] = _column_names(options["columns"])
-    return _dpoint.read(_os.fspath(path), **options)
+    return _dpoint.read(_fspath(path), **options)
 
 
 def write(points, path, **options) -> None:
@@ -280,7 +291,7 @@ def write(points, path, **options) -> None:
     if points is None:
         raise TypeError("write: points must be a PointSet or an array, not a file name")
     try:
-        _dpoint.write(points, _os.fspath(path), **options)
+        _dpoint.write(points, _fspath(path), **options)
     except Error as e:  # the CLI's advice in the module's words
         e.args = (_re.sub(r"--drop (\w+)", r"points.remove_attribute('\1') (on a copy)", str(e)),)
         raise
@@ -289,7 +300,7 @@ def write(points, path, **options) -> None:
 def sample(mesh, count, **options) -> PointSet:
     options = _keywords("sample", _dpoint.sample, options)
     if isinstance(mesh, (str, _os.PathLike)):  # read with its textures, which colour the samples
-        return _dpoint._sample_file(_os.fspath(mesh), count, **options)
+        return _dpoint._sample_file(_fspath(mesh), count, **options)
     return _dpoint.sample(mesh, count, **options)
 
 
@@ -356,6 +367,6 @@ def bench(suite: str = "ci", out="bench-out", *, progress: bool = False, **optio
     (``DPOINT_EXECUTABLE``, else the one built or installed with this module).
     """
     _os.environ["DPOINT_EXECUTABLE"] = _executable()
-    _dpoint._bench(_args({"suite": suite, "out": _os.fspath(out), **options}), progress)
-    with open(_os.path.join(_os.fspath(out), "results.json"), encoding="utf-8") as f:
+    _dpoint._bench(_args({"suite": suite, "out": _fspath(out), **options}), progress)
+    with open(_os.path.join(_fspath(out), "results.json"), encoding="utf-8") as f:
         return _json.load(f)

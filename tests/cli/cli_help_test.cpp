@@ -192,6 +192,12 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
        "--method voxl: must be exact or voxel; did you mean 'voxel'?"},
       {{"render", in, "-o", png, "--width", "-100"}, "--width -100: not a valid value for --width (dpoint render --help)"},
       {{"convert", in}, "convert: --output is required (dpoint convert --help)"},
+      // A review finding: CLI11 wrapped -1 and clamped 2^64 onto 2^64 - 1, the same set for both.
+      {{"generate", "random2d", "--seed", "-1", "-o", ply}, "--seed -1: must be a whole number from 0 to 18446744073709551615"},
+      {{"generate", "random2d", "--seed", "18446744073709551616", "-o", ply},
+       "--seed 18446744073709551616: must be a whole number from 0 to 18446744073709551615"},
+      {{"convert", in, "-o", ply, "--sample", "10", "--sample-seed", "-2"},
+       "--sample-seed -2: must be a whole number from 0 to 18446744073709551615"},
       {{"render", in, "-o", png, "--up-axis", "q"}, "--up-axis q: must be auto, y or z"},
       {{"render", in, "-o", png, "--shade", "edll"}, "--shade edll: must be auto, none or edl; did you mean 'edl'?"},
       {{"generate", "menger", "--size", "-1", "-o", ply}, "--size -1: must be a finite number above 0"},

@@ -333,3 +333,42 @@ def test_write_notes_are_warnings_at_the_callers_line(tmp_path):
         dpoint.write(s, tmp_path / "z.glb")
     assert len(caught) == 1 and "will not read back bit-exactly" in str(caught[0].message)
     assert caught[0].filename == __file__
+
+
+def test_a_path_with_a_null_byte_is_refused_as_open_refuses_it(tmp_path, cloud):
+    # A review finding: the library cut the path at the NUL and wrote (or read) another file.
+    s, _, _ = cloud
+    for call in (lambda: dpoint.write(s, str(tmp_path / "nul\0.ply")), lambda: dpoint.read(str(tmp_path / "a\0.ply")),
+                 lambda: dpoint.info(str(tmp_path / "a\0.ply")), lambda: dpoint.sample(str(tmp_path / "m\0.ply"), 10)):
+        with pytest.raises(ValueError, match="embedded null byte"):
+            call()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_positions_moved_off_a_las_files_grid_are_rounded_with_a_warning(tmp_path):
+    # A review finding: a set read from LAS, then moved by less than its scale, was written back at
+    # the source's scale and rounded onto its grid without a word.
+    import warnings
+    dpoint.write(dpoint.PointSet(np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]])), tmp_path / "src.las", las_scale=0.001)
+    r = dpoint.read(tmp_path / "src.las")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dpoint.write(r, tmp_path / "same.las")
+        assert caught == []  # on its grid: nothing to say
+        r.positions[:, 0] += 0.0004
+        dpoint.write(r, tmp_path / "moved.las")
+    assert len(caught) == 1 and "x rounded to the source LAS file's scale 0.001" in str(caught[0].message)
+
+
+def test_64_bit_integers_past_2_53_through_ply_are_warned_of(tmp_path):
+    # A review finding: PLY (no 64-bit integers) took ids of 2^53 + 1 as doubles without a word.
+    import warnings
+    s = dpoint.PointSet(np.zeros((2, 3)))
+    s.set_attribute("id", np.array([2**53 + 1, 7], np.uint64))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dpoint.write(s, tmp_path / "id.ply")
+        dpoint.write(s, tmp_path / "id.pcd")  # PCD keeps them
+    assert len(caught) == 1 and "'id' (uint64) written as double" in str(caught[0].message)
+    assert "(the first: point 0)" in str(caught[0].message)
+    assert dpoint.read(tmp_path / "id.pcd").attributes["id"][0] == 2**53 + 1
