@@ -154,18 +154,22 @@ class LineParser {
       const char* number_end = field_end;
       while (number_end > number_begin && isBlank(number_end[-1])) --number_end;
       const int role = layout_.roles[static_cast<size_t>(column - 1)];
-      // An attribute's empty field is a missing value, NaN (pandas writes NaN so); a skipped column's
-      // is nothing. A position's or colour's is an error.
-      if (number_begin == number_end && role < kRoleDimension && role != kRoleSkip) {
+      const bool empty = number_begin == number_end;
+      double* dimension = role >= kRoleDimension ? &dimensions_[static_cast<size_t>(role - kRoleDimension)][row] : nullptr;
+      bool ok = true;
+      if (role == kRoleSkip) {
+        // passed over, empty or not
+      } else if (dimension) {
+        // An attribute's empty field is a missing value, NaN (pandas writes NaN so).
+        if (empty) *dimension = std::numeric_limits<double>::quiet_NaN();
+        else ok = parseNumber(number_begin, number_end, *dimension, line, column, error);
+      } else if (empty) {  // a position's or a colour's
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
+      } else {
+        ok = role < 3 ? parseNumber(number_begin, number_end, values[role], line, column, error)
+                      : parseNumber(number_begin, number_end, colors[role - 3], line, column, error);
       }
-      double* dimension = role >= kRoleDimension ? &dimensions_[static_cast<size_t>(role - kRoleDimension)][row] : nullptr;
-      if (dimension && number_begin == number_end) *dimension = std::numeric_limits<double>::quiet_NaN();
-      bool ok = role == kRoleSkip || (dimension && number_begin == number_end) ? true
-                : dimension ? parseNumber(number_begin, number_end, *dimension, line, column, error)
-                : role < 3 ? parseNumber(number_begin, number_end, values[role], line, column, error)
-                           : parseNumber(number_begin, number_end, colors[role - 3], line, column, error);
       if (!ok) return false;
       p = field_end;
       if (p == end) break;
@@ -202,7 +206,6 @@ class LineParser {
     }
     return std::to_string(fields) + " columns, expected " + std::to_string(layout_.columns) + " (" + printableExcerpt(layout_.text) + ")";
   }
-
 
   template <typename T>
   bool parseNumber(const char* begin, const char* end, T& value, uint64_t line, int column,
@@ -575,7 +578,8 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
 // ("0.12345679") parses to the double nearest that text, not to the float: it fits when that is
 // the float's own shortest text (a column parsed as float rounded 0.123456789012345 to float32).
 bool textFits(DimType type, double v) {
-  if (dimensionHolds(type, v) || type != DimType::kF32) return dimensionHolds(type, v);
+  if (dimensionHolds(type, v)) return true;
+  if (type != DimType::kF32) return false;
   char text[32];
   const auto written = std::to_chars(text, text + sizeof text, static_cast<float>(v));
   double back = 0.0;

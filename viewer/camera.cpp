@@ -132,13 +132,8 @@ PositionArray framedPoints(const Bounds& bounds) {
 // of the box, so the condition is checked again from the rounded eye and d grows by what is
 // missing (a few rounds; each misses by at most the rounding). d is at least kFitMargin times the
 // farthest point's distance from the target, so the eye is outside the data and every depth > 0.
-struct PerspectiveFit {
-  double distance = 0.0;
-  bool framed = true;  // from the rounded eye, every point inside the shrunk frustum
-};
-
-PerspectiveFit fitPerspective(const PositionArray& points, glm::dvec3& target, const glm::dvec3& direction,
-                              const glm::dmat4& rotation, double tan_x, double tan_y, bool recentre) {
+double fitPerspective(const PositionArray& points, glm::dvec3& target, const glm::dvec3& direction,
+                      const glm::dmat4& rotation, double tan_x, double tan_y, bool recentre) {
   const glm::dvec3 right(rotation[0][0], rotation[1][0], rotation[2][0]);
   const glm::dvec3 up(rotation[0][1], rotation[1][1], rotation[2][1]);
   const auto closedForm = [&](const glm::dvec3& t) {
@@ -164,21 +159,18 @@ PerspectiveFit fitPerspective(const PositionArray& points, glm::dvec3& target, c
     target += (0.5 * (lo_x + hi_x) * distance) * right + (0.5 * (lo_y + hi_y) * distance) * up;
     distance = closedForm(target);
   }
-  const auto missingFrom = [&](const glm::dvec3& eye) {
+  for (int round = 0; round < kFitRounds; ++round) {
+    const glm::dvec3 eye = target + distance * direction;
     double missing = 0.0;
     for (const glm::dvec3& p : points) {
       const glm::dvec3 q = p - eye;
       const double need = std::max(std::abs(glm::dot(q, right)) / tan_x, std::abs(glm::dot(q, up)) / tan_y);
       missing = std::max(missing, need + glm::dot(q, direction));  // need − depth
     }
-    return missing;
-  };
-  for (int round = 0; round < kFitRounds; ++round) {
-    const double missing = missingFrom(target + distance * direction);
-    if (!(missing > 0.0)) return {distance, true};
+    if (!(missing > 0.0)) break;
     distance += 2.0 * missing;
   }
-  return {distance, !(missingFrom(target + distance * direction) > 0.0)};
+  return distance;
 }
 
 // Near and far planes enclosing the box. Depth along the view axis is linear, so its extremes over
@@ -350,14 +342,12 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     // long when the box is.
     camera.rotation = lookAtRotation(-direction, up);
     double distance = 0.0;
-    bool framed = true;
     if (spec.view_width) {
       distance = 0.5 * *spec.view_width / std::tan(half_fov_x);  // the window is view_width wide at target
     } else if (!isDegenerate(bounds)) {
-      const PerspectiveFit fit = fitPerspective(framedPoints(bounds), target, direction, camera.rotation,
-                                                std::tan(half_fov_x) / margin, std::tan(half_fov) / margin,
-                                                !spec.view_center);
-      distance = fit.distance, framed = fit.framed;
+      distance = fitPerspective(framedPoints(bounds), target, direction, camera.rotation,
+                                std::tan(half_fov_x) / margin, std::tan(half_fov) / margin,
+                                !spec.view_center);
     } else if (bounds.planar) {
       // One point: framed as a square 2e-10 of its coordinates wide (kMinRelativeExtent).
       distance = kFitMargin * minHalfExtent(centre) / std::tan(half_fov_x);
@@ -387,8 +377,7 @@ Result<Camera> makeCamera(const CameraSpec& spec, const Bounds& bounds) {
     // edge-on or not at all (a blank picture, exit 0). The default view then draws them orthographic
     // along the same direction, which needs no eye off the data's plane, and says so.
     const double drift = safeLength((camera.eye - target) - distance * direction) / distance;
-    if (!spec.ortho && !spec.view_width && !spec.view_center && !isDegenerate(bounds) &&
-        (!framed || !(drift <= kMaxEyeDrift))) {
+    if (!spec.ortho && !spec.view_width && !spec.view_center && !isDegenerate(bounds) && !(drift <= kMaxEyeDrift)) {
       camera.ortho = true;
       camera.eye = centre;
       view_width = windowAround(camera, bounds, margin, aspect);
