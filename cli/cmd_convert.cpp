@@ -25,6 +25,9 @@ struct ConvertOptions {
   bool ply_ascii = false;
   std::string ply_colors = "auto";
   std::string pcd_encoding = "binary";
+  // The options themselves: whether each was given (their values have defaults).
+  const CLI::Option* ply_colors_option = nullptr;
+  const CLI::Option* pcd_encoding_option = nullptr;
   bool allow_nonfinite = false;
   std::string columns;  // --columns x,y,z,-,intensity
   SampleCliOptions sample;  // --sample N: points on the mesh's surface instead of its vertices
@@ -104,6 +107,14 @@ int runConvert(ConvertOptions& o) {
     return reportError(Error{"--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals, not " +
                                  quotedExcerpt(o.output),
                              ExitCode::kUsage});
+  const bool to_ply = out_format && *out_format == FileFormat::kPly;
+  if ((o.ply_ascii || o.ply_colors_option->count()) && !to_ply)
+    return reportError(Error{std::string(o.ply_ascii ? "--ply-ascii" : "--ply-colors") + ": only a PLY output has it, not " +
+                                 quotedExcerpt(o.output),
+                             ExitCode::kUsage});
+  if (o.pcd_encoding_option->count() && !(out_format && *out_format == FileFormat::kPcd))
+    return reportError(Error{"--pcd-encoding: only a PCD output has an encoding, not " + quotedExcerpt(o.output),
+                             ExitCode::kUsage});
   if (o.las_scale != 0.0 && !to_las)
     return reportError(Error{"--las-scale: only a LAS, LAZ or COPC output has a coordinate step, not " +
                                  quotedExcerpt(o.output),
@@ -166,12 +177,12 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
                   "or for LAS input the file's step (scale 0.01: at most 2 digits, trailing zeros dropped)")
       ->check(CLI::Range(0, 100));
   cmd->add_flag("--ply-ascii", o->ply_ascii, "PLY: write ASCII instead of binary little-endian");
-  cmd->add_option("--ply-colors", o->ply_colors,
+  o->ply_colors_option = cmd->add_option("--ply-colors", o->ply_colors,
                   "PLY: colour property type. auto: ushort for 16-bit colours (LAS), every bit kept, else uchar;\n"
                   "uchar: 8-bit (what Open3D and PCL read); ushort; float: exact")
       ->check(oneOf("--ply-colors", {"auto", "uchar", "ushort", "float"}))
       ->default_val("auto");
-  cmd->add_option("--pcd-encoding", o->pcd_encoding,
+  o->pcd_encoding_option = cmd->add_option("--pcd-encoding", o->pcd_encoding,
                   "PCD: DATA ascii, binary (rows of the fields) or binary_compressed (LZF, the smallest)")
       ->check(oneOf("--pcd-encoding", {"ascii", "binary", "binary_compressed"}))
       ->default_val("binary");

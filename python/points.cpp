@@ -591,6 +591,11 @@ progress: lines on stderr.)");
         if (las_scale && written != FileFormat::kLas && written != FileFormat::kLaz)
           raise(Error{"las_scale: only a .las, .laz or .copc.laz file has a coordinate step, not '" + path + "'",
                       ExitCode::kUsage});
+        if ((ply_ascii || *ply_color_type != PlyColorType::kAuto) && written != FileFormat::kPly)
+          raise(Error{std::string(ply_ascii ? "ply_ascii" : "ply_colors") + ": only a .ply file has it, not '" + path + "'",
+                      ExitCode::kUsage});
+        if (pcd != PcdEncoding::kBinary && written != FileFormat::kPcd)
+          raise(Error{"pcd_encoding: only a .pcd file has an encoding, not '" + path + "'", ExitCode::kUsage});
         if (decimals >= 0 && written != FileFormat::kCsv)
           raise(Error{"decimals: only a CSV file (.csv, .xyz, .txt, .asc, .pts) has decimals, not '" + path + "'",
                       ExitCode::kUsage});

@@ -151,6 +151,10 @@ def test_write_options_do_what_they_say(tmp_path, source):
     (dict(color_format="srgb"), "color_format: 'srgb' is not linear or srgb8"),
     (dict(max_memory="lots"), "max_memory lots: not a size"),
     (dict(max_memory=-1), "max_memory -1: not a size in bytes"),
+    # Options the file does not use (a review finding: passed over in silence).
+    (dict(ply_ascii=True), "ply_ascii: only a .ply file has it"),
+    (dict(ply_colors="uchar"), "ply_colors: only a .ply file has it"),
+    (dict(pcd_encoding="ascii"), "pcd_encoding: only a .pcd file has an encoding"),
 ])
 def test_write_refuses_bad_options_and_writes_nothing(tmp_path, cloud, options, words):
     s, _, _ = cloud
