@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <unordered_map>
 
 #include "converters/gltf_read.h"
 #include "converters/las_crs.h"
@@ -74,6 +75,26 @@ void setPositions(PointSet& set, const py::handle& value, bool allow_nonfinite) 
   set.z_axis = planar ? ZAxis::kAbsent : ZAxis::kPresent;
 }
 
+// The NumPy views of each set alive now (their bases: viewBase), by set. The GIL guards it: views
+// are made and freed with it held.
+std::unordered_map<const PointSet*, size_t>& liveViews() {
+  static std::unordered_map<const PointSet*, size_t> views;
+  return views;
+}
+
+// A view's base: it holds the set's Python object, and counts among the set's live views while it
+// lives, so that storage no view can see is freed at once (retireKeepingViews).
+py::object viewBase(const py::object& self) {
+  const PointSet* set = &self.cast<const PointSet&>();
+  ++liveViews()[set];
+  auto* held = new std::pair<const PointSet*, py::object>(set, self);
+  return py::capsule(held, [](void* p) {
+    auto* pair = static_cast<std::pair<const PointSet*, py::object>*>(p);
+    if (--liveViews()[pair->first] == 0) liveViews().erase(pair->first);
+    delete pair;  // drops the set's reference (with the GIL, as every deallocation)
+  });
+}
+
 // Keeps `kept` alive as long as `owner` (a pybind11 instance, which takes weak references): the
 // patient of pybind11's own keep_alive, without an argument to hang it on.
 void keepWhileAlive(const py::handle& owner, py::object kept) {
@@ -95,6 +116,12 @@ void keepWhileAlive(const py::handle& owner, py::object kept) {
 template <typename Vector>
 void retireKeepingViews(const py::handle& self, Vector& target) {
   if (target.capacity() == 0) return;
+  // No view alive: nothing can see the storage, which is freed now (a review finding: removing and
+  // adding an attribute 200 times kept 1.5 GB until the set went).
+  if (!liveViews().count(&self.cast<const PointSet&>())) {
+    target = Vector();
+    return;
+  }
   auto* retired = new Vector(std::move(target));  // a move keeps the storage where it is
   keepWhileAlive(self, py::capsule(retired, [](void* p) { delete static_cast<Vector*>(p); }));
   target = Vector();
@@ -313,7 +340,7 @@ template <typename T>
 py::array view3(const py::object& owner, const T* data, size_t rows) {
   const auto n = static_cast<py::ssize_t>(rows);
   if (rows == 0) return py::array_t<T>({n, py::ssize_t{3}});
-  return py::array_t<T>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(T)}, py::ssize_t{sizeof(T)}}, data, owner);
+  return py::array_t<T>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(T)}, py::ssize_t{sizeof(T)}}, data, viewBase(owner));
 }
 
 // Each line a UserWarning shown at the line that called the package's function: stack level 2, as
@@ -476,7 +503,7 @@ that memory, without copying (writing into them changes the set).)")
               const std::vector<py::ssize_t> shape = {static_cast<py::ssize_t>(d.size())};
               const std::vector<py::ssize_t> strides = {static_cast<py::ssize_t>(dimTypeSize(d.type))};
               out[py::str(d.name)] = d.size() == 0 ? py::array(dtype, shape, strides)
-                                                   : py::array(dtype, shape, strides, d.bytes.data(), self);
+                                                   : py::array(dtype, shape, strides, d.bytes.data(), viewBase(self));
             }
             return out;
           },

@@ -410,3 +410,29 @@ def test_a_set_being_written_in_another_thread_cannot_change_under_it(tmp_path):
 def test_render_with_nothing_to_draw_is_an_error_not_a_crash():
     with pytest.raises(dpoint.Error, match="no points and no input files"):
         dpoint._dpoint._render(None, [], [], None, False)
+
+
+def _rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096
+
+
+def test_storage_no_view_can_see_is_freed_at_once():
+    # A review finding: removing and adding an attribute (or changing its dtype) kept every old
+    # storage while the set lived, for views that might exist: 1.5 GB after 200 rounds of 8 MB.
+    # Only a view alive keeps it now; the views themselves stay valid as before.
+    n = 1_000_000
+    s = dpoint.PointSet(np.zeros((n, 3)))
+    a64, a32 = np.arange(n, dtype=np.float64), np.arange(n, dtype=np.float32)
+    s.set_attribute("h", a64)
+    gc.collect()
+    before = _rss_bytes()
+    for _ in range(50):
+        s.remove_attribute("h")
+        s.set_attribute("h", a32)
+        s.set_attribute("h", a64)
+    grown = _rss_bytes() - before
+    assert grown < 100 << 20, f"{grown >> 20} MiB kept by 50 rounds of 12 MB"
+    view = s.attributes["h"]
+    s.remove_attribute("h")
+    assert np.array_equal(view, a64)  # a view alive keeps its storage
