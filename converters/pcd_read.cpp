@@ -748,22 +748,28 @@ class Reader {
       }
       return okStatus();
     }
+    // A leading '+' as the CSV reader takes it (fast_float and from_chars refuse it).
+    if (e - b >= 2 && *b == '+' && b[1] != '+' && b[1] != '-') ++b;
     if (f.type == 'F') {
+      // A number past the field's range is no infinity ("1e39" in an F 4 field was reported as
+      // "y is inf"); below it, zero, as PCL's strtod reads it.
+      const auto parse = [&](auto& v) -> Status {
+        auto r = fast_float::from_chars(b, e, v);
+        if (r.ec != std::errc() || r.ptr != e) return Error{"is not a number"};
+        const bool written_infinite = std::find_if(b, e, [](char c) { return c == 'i' || c == 'I'; }) != e;
+        if (std::isinf(v) && !written_infinite)
+          return Error{"is out of the field's range (F " + std::to_string(f.size) + ")"};
+        storeUnaligned(out, v);
+        return okStatus();
+      };
       if (f.size == 4) {
         float v = 0;
-        auto r = fast_float::from_chars(b, e, v);
-        if (r.ec != std::errc() || r.ptr != e) return Error{"is not a number"};
-        storeUnaligned(out, v);
-      } else {
-        double v = 0;
-        auto r = fast_float::from_chars(b, e, v);
-        if (r.ec != std::errc() || r.ptr != e) return Error{"is not a number"};
-        storeUnaligned(out, v);
+        return parse(v);
       }
-      return okStatus();
+      double v = 0;
+      return parse(v);
     }
     // Integers: as written, or a float form with no fraction ("3.0", "1e3").
-    if (*b == '+') ++b;
     int64_t i = 0;
     uint64_t u = 0;
     bool whole = false;

@@ -391,6 +391,7 @@ std::shared_ptr<PointSet> readFile(const std::string& path, unsigned threads, bo
     raise(Error{"colors: '" + colors + "' is not one of auto, rgb, intensity, classification, none", ExitCode::kUsage});
   const uint64_t limit = take(memoryOption("max_memory", max_memory));
   GltfReadOptions g;
+  if (scene < -1) raise(Error{"scene " + std::to_string(scene) + ": must be 0 or more", ExitCode::kUsage});  // as --scene
   g.scene = scene, g.all_scenes = all_scenes, g.max_points = max_points;
   std::vector<std::string> notices;  // what the reader read past: Python's warnings, as the CLI's notes
   auto set = std::make_shared<PointSet>(take(released([&] {

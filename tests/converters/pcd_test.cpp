@@ -365,6 +365,9 @@ TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
        "header line 2: two fields give the attribute 'a_0'"},
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 2 1\nPOINTS 1\nDATA ascii\n",
        "header line 5: field 'y': COUNT 2 (must be 1)"},
+      // A review finding: past float's range was reported as "y is inf" ('+1' is taken, below).
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n+1 1e39 3\n",
+       "line 7, column 2 (field 'y'): '1e39' is out of the field's range (F 4)"},
   };
   for (const Case& c : cases) {
     const std::string path = dir.file("bad.pcd");
@@ -374,6 +377,10 @@ TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
     EXPECT_TRUE(contains(set.error().message, path + ": ")) << set.error().message;
     EXPECT_TRUE(contains(set.error().message, c.error)) << set.error().message;
   }
+  writeFile(dir.file("plus.pcd"), "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n+1 +2.5 -3\n");
+  Result<PointSet> plus = readPcd(dir.file("plus.pcd"));
+  ASSERT_TRUE(plus.ok()) << plus.error().message;
+  EXPECT_EQ(plus->positions[0], glm::dvec3(1, 2.5, -3));
   // A binary infinity names its byte; --allow-nonfinite keeps it.
   std::string bytes = head + "DATA binary\n";
   const float rows[6] = {1, 2, 3, 4, -std::numeric_limits<float>::infinity(), 6};

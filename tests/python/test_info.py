@@ -88,3 +88,20 @@ def test_numpy_scalars_are_options(cloud):
     s, _, _ = cloud
     assert dpoint.info(s, max_memory=np.int64(10**9))["points"] == len(s)
     assert dpoint.info(s, sample=np.int64(5), width=np.int32(64))["neighbor_sample"] == 5
+
+
+def test_file_options_for_a_set_in_memory_are_refused():
+    # A review finding: stream=, columns= and allow_nonfinite= were passed over in silence.
+    s = dpoint.PointSet(np.zeros((3, 3)))
+    with pytest.raises(dpoint.Error, match="info: stream applies to files, not to a set in memory") as raised:
+        dpoint.info(s, stream="on")
+    assert raised.value.exit_code == 1
+    with pytest.raises(dpoint.Error, match="info: allow_nonfinite and columns apply to files"):
+        dpoint.info(s, columns="x,y,z", allow_nonfinite=True)
+    assert dpoint.info(s)["points"] == 3
+
+
+def test_read_refuses_a_negative_scene_as_the_cli_does(tmp_path):
+    dpoint.write(dpoint.PointSet(np.zeros((3, 3)), triangles=np.array([[0, 1, 2]])), tmp_path / "m.glb")
+    with pytest.raises(dpoint.Error, match="scene -2: must be 0 or more"):
+        dpoint.read(tmp_path / "m.glb", scene=-2)
