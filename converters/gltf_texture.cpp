@@ -3,6 +3,8 @@
 #include <stb_image.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "core/memory.h"
 
@@ -25,6 +27,23 @@ bool readPair(const tinygltf::Value& v, double& a, double& b) {
   a = v.Get(0).GetNumberAsDouble();
   b = v.Get(1).GetNumberAsDouble();
   return true;
+}
+
+// Whether every chunk of a PNG lies within its bytes, up to IEND (true for what is no PNG: stb_image
+// judges it). stb_image grows its buffer to an IDAT's declared length before reading it: a fuzz
+// finding's 2.4 KB image declaring 1.7 GB took 1.4 s under the sanitizers (a timeout), refused now
+// as the bad image it is.
+bool pngChunksFit(const unsigned char* bytes, size_t size) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || std::memcmp(bytes, kSignature, 8) != 0) return true;
+  for (size_t at = 8; at + 8 <= size;) {
+    const uint64_t length = (uint64_t{bytes[at]} << 24) | (uint64_t{bytes[at + 1]} << 16) |
+                            (uint64_t{bytes[at + 2]} << 8) | uint64_t{bytes[at + 3]};
+    if (length + 12 > size - at) return false;  // length, type, data, CRC
+    if (std::memcmp(bytes + at + 4, "IEND", 4) == 0) return true;
+    at += 12 + length;
+  }
+  return true;  // no IEND: stb_image says what it makes of that
 }
 
 }  // namespace
@@ -115,6 +134,10 @@ Result<int32_t> GltfTextures::image(int texture) {
   }
   if (size > size_t(INT32_MAX)) {
     note(image_at + " is larger than 2 GiB");
+    return -1;
+  }
+  if (!pngChunksFit(bytes, size)) {
+    note(image_at + " (a PNG) did not decode (a chunk's length runs past the image's bytes)");
     return -1;
   }
   int width = 0, height = 0, channels = 0;

@@ -158,6 +158,21 @@ TEST(MeshTexture, anImageThatDoesNotDecodeLeavesANoteAndTheVertexColours) {
   EXPECT_NE(texture.notes[0].find("sampled without it"), std::string::npos) << texture.notes[0];
 }
 
+// A fuzz finding: a PNG whose IDAT declares 1.7 GB in 2.4 KB made stb_image grow its buffer to that
+// first (1.4 s under the sanitizers). Its chunks are checked against its bytes: a note, at once.
+TEST(MeshTexture, aPngWhoseChunkRunsPastItsBytesLeavesANote) {
+  test::TempDir dir;
+  const std::string path = writeQuad(dir, "", "cut.png");
+  std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\0\x02\0\0\0\x02\x08\x02\0\0\0\0\0\0\0", 33);
+  png += std::string("\x65\x72\x6f\x8b", 4) + "IDAT" + std::string(64, 'x');  // 1.7 GB declared
+  test::writeFile(dir.file("cut.png"), png);
+  MeshTexture texture;
+  const PointSet sample = sampleWithTexture(path, texture, 100);
+  ASSERT_EQ(sample.size(), 100u);
+  ASSERT_EQ(texture.notes.size(), 1u);
+  EXPECT_NE(texture.notes[0].find("a chunk's length runs past the image's bytes"), std::string::npos) << texture.notes[0];
+}
+
 // BoxTextured as a GLB (the PNG in a bufferView) and as a .gltf with a data URI: the same samples
 // in the same colours, the logo's (several colours, not only white); the .gltf with the PNG beside
 // it samples MIRRORED_REPEAT and CLAMP_TO_EDGE, so its colours differ where u passes 1.
