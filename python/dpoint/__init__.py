@@ -333,21 +333,22 @@ def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool
     sampled for the nearest-neighbour distance. columns: text files, what each column holds (as
     read's columns).
     """
+    def usage_error(message):
+        error = Error(message)
+        error.exit_code = 1  # a usage error, as the CLI's
+        return error
+
     sample = _plain(sample)
     if isinstance(sample, bool) or not isinstance(sample, _numbers.Integral) or not 1 <= sample <= 100_000_000:
-        error = Error(f"sample {sample!r}: must be a number from 1 to 100000000 (as info's --sample)")
-        error.exit_code = 1  # a usage error, as the CLI's
-        raise error
+        raise usage_error(f"sample {sample!r}: must be a number from 1 to 100000000 (as info's --sample)")
     in_memory, inputs = _as_points(points)
     if in_memory is not None:  # options of reading files (a review finding: passed over in silence)
         given = [name for name, value, default in (("stream", stream, "auto"), ("allow_nonfinite", allow_nonfinite, False),
                                                    ("columns", columns, None))
                  if value != default]
         if given:
-            error = Error(f"info: {' and '.join(given)} {'applies' if len(given) == 1 else 'apply'} to files, "
-                          "not to a set in memory")
-            error.exit_code = 1
-            raise error
+            raise usage_error(f"info: {' and '.join(given)} {'applies' if len(given) == 1 else 'apply'} to files, "
+                              "not to a set in memory")
     limit = _dpoint._memory_size("max_memory", max_memory)
     text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit,
                          _column_names(columns) or [], progress)
