@@ -128,6 +128,18 @@ struct LineError {
   std::string message;
 };
 
+// A field's number as the reader takes it: after a leading '+' (CSV writers emit it; fast_float, as
+// std::from_chars, refuses it), and with a decimal comma where fields are separated by semicolons
+// ("1,5": the only comma a field can hold). The data rows and --columns' header test both read so.
+template <typename T>
+fast_float::from_chars_result parseField(const char* begin, const char* end, T& value, char separator) {
+  if (end - begin >= 2 && *begin == '+' && begin[1] != '-' && begin[1] != '+') ++begin;
+  const bool comma = separator == ';' && std::memchr(begin, ',', static_cast<size_t>(end - begin));
+  return comma ? fast_float::from_chars_advanced(begin, end, value,
+                                                 fast_float::parse_options{fast_float::chars_format::general, ','})
+               : fast_float::from_chars(begin, end, value);
+}
+
 class LineParser {
  public:
   // dimensions: one column of doubles per further column of the layout.
@@ -210,14 +222,7 @@ class LineParser {
   template <typename T>
   bool parseNumber(const char* begin, const char* end, T& value, uint64_t line, int column,
                    LineError& error) const {
-    const char* start = begin;
-    // fast_float follows std::from_chars and refuses a leading '+'; CSV writers emit it.
-    if (end - start >= 2 && *start == '+' && start[1] != '-' && start[1] != '+') ++start;
-    // A decimal comma where fields are separated by semicolons ("1,5"): the only comma a field can hold.
-    const bool comma = layout_.separator == ';' && std::memchr(start, ',', static_cast<size_t>(end - start));
-    auto result = comma ? fast_float::from_chars_advanced(start, end, value,
-                                                          fast_float::parse_options{fast_float::chars_format::general, ','})
-                        : fast_float::from_chars(start, end, value);
+    const auto result = parseField(begin, end, value, layout_.separator);
     // The message is built only on failure: this runs for every number of the file.
     auto fail = [&](const std::string& why) {
       error = {line, lineText(line) + "column " + std::to_string(column) + ": '" + excerpt(begin, end) + "' " + why};
@@ -415,14 +420,12 @@ Result<Layout> layoutFromNames(const std::vector<std::string>& names, char separ
   return layout;
 }
 
-// Whether a field of the first line reads as a number (as LineParser would: a leading '+', a
-// decimal comma in a semicolon file, nan and inf).
+// Whether a field of the first line reads as a number, as a data row's does (parseField).
 bool isNumberField(std::string_view field, char separator) {
-  if (field.size() >= 2 && field.front() == '+') field.remove_prefix(1);
   double value = 0.0;
-  const fast_float::parse_options options{fast_float::chars_format::general, separator == ';' ? ',' : '.'};
-  const auto result = fast_float::from_chars_advanced(field.data(), field.data() + field.size(), value, options);
-  return result.ec == std::errc() && result.ptr == field.data() + field.size();
+  const char* end = field.data() + field.size();
+  const auto result = parseField(field.data(), end, value, separator);
+  return result.ec == std::errc() && result.ptr == end;
 }
 
 // With --columns, a first line is a header where a column given as x, y or z does not hold a
