@@ -125,9 +125,13 @@ class Writer {
       if (&d != alpha_) names.push_back(fieldName(d.name)), dims.push_back(&d);
     names = writableNames(
         names, isSpaceOrControl,
-        [](const std::string& name, size_t) {
-          // "_" is PCD's padding: every reader passes over such a field.
-          return name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba" || name == "_";
+        [&](const std::string& name, size_t k) {
+          // "_" is PCD's padding: every reader passes over such a field. normal_x is nx's where the set
+          // has both (a reader takes normal_x as nx), so the dimension named normal_x is the one renamed.
+          if (name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba" || name == "_") return true;
+          const std::string& own = dims[k]->name;
+          return name == own && (own == "normal_x" || own == "normal_y" || own == "normal_z") &&
+                 points_.dimensions.find(std::string(1, 'n') + own.back());
         },
         nullptr);
     // Each change named by the dimension's own name (writableNames would name PCL's: nx as normal_x).

@@ -426,15 +426,25 @@ TEST(Pcd, aDimensionNamedAsPaddingIsRenamedAndKept) {
   ASSERT_TRUE(back.ok()) << back.error().message;
   ASSERT_EQ(back->dimensions.all().size(), 1u);
   EXPECT_EQ(back->dimensions.all()[0].value(1), 7.25);
-  // A set with both normal_x and nx: the notice names the dimension renamed (it named PCL's name).
-  PointSet both;
-  both.positions = {{1, 2, 3}};
-  both.dimensions.add("normal_x", DimType::kF64, 1);
-  both.dimensions.add("nx", DimType::kF64, 1);
-  notices.clear();
-  ASSERT_TRUE(writePcd(dir.file("both.pcd"), both, PcdWriteOptions{PcdEncoding::kAscii, nullptr, &notices}).ok());
-  ASSERT_EQ(notices.size(), 1u);
-  EXPECT_TRUE(contains(notices[0], "dimension 'nx' written as 'normal_x_2'")) << notices[0];
+  // A set with both normal_x and nx, in either order: nx keeps PCL's name, which every reader takes
+  // as nx, and the dimension named normal_x is renamed. Before, the first took the name, so
+  // normal_x's values came back as nx (a review finding).
+  for (const bool nx_first : {false, true}) {
+    PointSet both;
+    both.positions = {{1, 2, 3}};
+    both.dimensions.add(nx_first ? "nx" : "normal_x", DimType::kF64, 1).setValue(0, nx_first ? 0.5 : 0.25);
+    both.dimensions.add(nx_first ? "normal_x" : "nx", DimType::kF64, 1).setValue(0, nx_first ? 0.25 : 0.5);
+    notices.clear();
+    ASSERT_TRUE(writePcd(dir.file("both.pcd"), both, PcdWriteOptions{PcdEncoding::kAscii, nullptr, &notices}).ok());
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_TRUE(contains(notices[0], "dimension 'normal_x' written as 'normal_x_2'")) << notices[0];
+    Result<PointSet> read = readPcd(dir.file("both.pcd"));
+    ASSERT_TRUE(read.ok()) << read.error().message;
+    ASSERT_NE(read->dimensions.find("nx"), nullptr);
+    ASSERT_NE(read->dimensions.find("normal_x_2"), nullptr);
+    EXPECT_EQ(read->dimensions.find("nx")->value(0), 0.5) << nx_first;
+    EXPECT_EQ(read->dimensions.find("normal_x_2")->value(0), 0.25) << nx_first;
+  }
 }
 
 // A PCD field of COUNT n reads as NAME_0 … NAME_n-1 and is written back as that one field (a review
