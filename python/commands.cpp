@@ -40,9 +40,10 @@ void addCommands(py::module_& m) {
 
   m.def(
       "_info",
-      [](const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
+      [](const py::object& points_object, const std::vector<std::string>& inputs,
          const std::vector<std::string>& camera_args, size_t sample, unsigned threads, bool allow_nonfinite,
          const std::string& stream, uint64_t max_memory, const std::vector<std::string>& columns, bool progress) {
+        const std::shared_ptr<PointSet> points = heldSet(points_object);
         const CameraRequest camera = take(cameraRequestOf(camera_args));
         if (stream != "auto" && stream != "on" && stream != "off")
           raise(Error{"--stream " + stream + ": must be auto, on or off", ExitCode::kUsage});  // as the CLI's oneOf

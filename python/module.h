@@ -85,6 +85,35 @@ class SetInUse {
 // change refused.
 void checkNotInUse(const PointSet& set, const std::string& what);
 
+// What an instance of one of the module's classes holds, null for None. TypeError for anything
+// else, and for an instance made by T.__new__ without __init__, which holds nothing (a review
+// finding: using one read uninitialised memory). `made_by` says how one is made, for the message.
+template <typename T>
+std::shared_ptr<T> heldObject(const py::handle& object, const char* made_by) {
+  if (object.is_none()) return nullptr;
+  const std::string name = py::str(py::type::of<T>().attr("__name__"));
+  if (!py::isinstance<T>(object))
+    throw py::type_error("expected a dpoint." + name + ", not " + Py_TYPE(object.ptr())->tp_name);
+  try {
+    return py::cast<std::shared_ptr<T>>(object);
+  } catch (const py::cast_error&) {
+    throw py::type_error("this " + name + " holds nothing: it was made by " + name + ".__new__ without __init__ (" +
+                         made_by + ")");
+  }
+}
+// What `self` holds (heldObject; never None).
+template <typename T>
+T& heldBy(const py::handle& self, const char* made_by) {
+  if (self.is_none())
+    throw py::type_error("expected a dpoint." + std::string(py::str(py::type::of<T>().attr("__name__"))) + ", not None");
+  return *heldObject<T>(self, made_by);  // the Python object keeps it
+}
+// The set a dpoint.PointSet holds (heldObject), null for None.
+inline std::shared_ptr<PointSet> heldSet(const py::handle& object) {
+  return heldObject<PointSet>(object, "make one with dpoint.PointSet(positions)");
+}
+inline PointSet& setOf(const py::handle& self) { return heldBy<PointSet>(self, "make one with dpoint.PointSet(positions)"); }
+
 // Progress lines on stderr when asked (progress=True), else none.
 inline std::FILE* progressFile(bool progress) { return progress ? stderr : nullptr; }
 

@@ -85,7 +85,7 @@ std::unordered_map<const PointSet*, size_t>& liveViews() {
 // A view's base: it holds the set's Python object, and counts among the set's live views while it
 // lives, so that storage no view can see is freed at once (retireKeepingViews).
 py::object viewBase(const py::object& self) {
-  const PointSet* set = &self.cast<const PointSet&>();
+  const PointSet* set = &setOf(self);
   ++liveViews()[set];
   auto* held = new std::pair<const PointSet*, py::object>(set, self);
   return py::capsule(held, [](void* p) {
@@ -118,7 +118,7 @@ void retireKeepingViews(const py::handle& self, Vector& target) {
   if (target.capacity() == 0) return;
   // No view alive: nothing can see the storage, which is freed now (a review finding: removing and
   // adding an attribute 200 times kept 1.5 GB until the set went).
-  if (!liveViews().count(&self.cast<const PointSet&>())) {
+  if (!liveViews().count(&setOf(self))) {
     target = Vector();
     return;
   }
@@ -461,43 +461,43 @@ that memory, without copying (writing into them changes the set).)")
            }),
            py::arg("positions"), py::arg("colors") = py::none(), py::arg("triangles") = py::none(), py::kw_only(),
            py::arg("allow_nonfinite") = false)
-      .def("__len__", &PointSet::size)
+      .def("__len__", [](const py::object& self) { return setOf(self).size(); })
       .def_property_readonly(
           "positions",
           [](const py::object& self) {
-            const PointSet& s = self.cast<const PointSet&>();
+            const PointSet& s = setOf(self);
             return view3(self, reinterpret_cast<const double*>(s.positions.data()), s.size());
           },
           "(N, 3) float64 view of the positions (no copy)")
       .def_property(
           "colors",
           [](const py::object& self) -> py::object {
-            const PointSet& s = self.cast<const PointSet&>();
+            const PointSet& s = setOf(self);
             if (!s.hasColors()) return py::none();
             return view3(self, reinterpret_cast<const float*>(s.colors.data()), s.size());
           },
           [](const py::object& self, const py::object& colors) {
-            checkNotInUse(self.cast<const PointSet&>(), "colors");
-            setColors(self.cast<PointSet&>(), colors, self);
+            checkNotInUse(setOf(self), "colors");
+            setColors(setOf(self), colors, self);
           },
           "(N, 3) float32 view of the linear 0..1 colours (no copy), or None. Set from uint8 or floats, or None")
       .def_property(
           "triangles",
           [](const py::object& self) -> py::object {
-            const PointSet& s = self.cast<const PointSet&>();
+            const PointSet& s = setOf(self);
             if (!s.isMesh()) return py::none();
             return view3(self, s.triangles.data(), s.triangles.size() / 3);
           },
           [](const py::object& self, const py::object& triangles) {
-            checkNotInUse(self.cast<const PointSet&>(), "triangles");
-            setTriangles(self.cast<PointSet&>(), triangles, self);
+            checkNotInUse(setOf(self), "triangles");
+            setTriangles(setOf(self), triangles, self);
           },
           "(M, 3) uint32 view of the triangles' vertex indices (no copy), or None")
       .def_property_readonly(
           "attributes",
           [](const py::object& self) {
             // One NumPy view per dimension (core/dimensions.h), in its own dtype, no copy.
-            const PointSet& s = self.cast<const PointSet&>();
+            const PointSet& s = setOf(self);
             py::dict out;
             for (const Dimension& d : s.dimensions.all()) {
               const py::dtype dtype(dimTypeName(d.type));
@@ -513,8 +513,8 @@ that memory, without copying (writing into them changes the set).)")
       .def(
           "set_attribute",
           [](const py::object& self, const std::string& name, const py::object& values) {
-            checkNotInUse(self.cast<const PointSet&>(), "set_attribute");
-            setAttribute(self, self.cast<PointSet&>(), name, values);
+            checkNotInUse(setOf(self), "set_attribute");
+            setAttribute(self, setOf(self), name, values);
           },
           py::arg("name"), py::arg("values"),
           "Adds or replaces attribute `name` from a 1-D array of one value per point, kept in its dtype\n"
@@ -523,7 +523,7 @@ that memory, without copying (writing into them changes the set).)")
       .def(
           "remove_attribute",
           [](const py::object& self, const std::string& name) {
-            PointSet& s = self.cast<PointSet&>();
+            PointSet& s = setOf(self);
             checkNotInUse(s, "remove_attribute");
             Dimension* d = s.dimensions.find(name);
             if (!d) throw py::key_error(name);
@@ -531,15 +531,27 @@ that memory, without copying (writing into them changes the set).)")
             s.dimensions.remove(name);
           },
           py::arg("name"), "Removes attribute `name` (KeyError when the set has none of that name)")
-      .def_property_readonly("has_z", &PointSet::hasZ, "Whether writers write z (False for a 2D set)")
-      .def_readwrite("z_up", &PointSet::z_up, "The source says z is up (LAS): render's fitted views use it")
-      .def("copy", [](const PointSet& s) { return std::make_shared<PointSet>(s); }, "A deep copy")
-      .def("__copy__", [](const PointSet& s) { return std::make_shared<PointSet>(s); })
-      .def("__deepcopy__", [](const PointSet& s, const py::dict&) { return std::make_shared<PointSet>(s); })
+      .def_property_readonly("has_z", [](const py::object& self) { return setOf(self).hasZ(); },
+                             "Whether writers write z (False for a 2D set)")
+      .def_property(
+          "z_up", [](const py::object& self) { return setOf(self).z_up; },
+          [](const py::object& self, bool z_up) { setOf(self).z_up = z_up; },
+          "The source says z is up (LAS): render's fitted views use it")
+      .def("copy", [](const py::object& self) { return std::make_shared<PointSet>(setOf(self)); }, "A deep copy")
+      .def("__copy__", [](const py::object& self) { return std::make_shared<PointSet>(setOf(self)); })
+      .def("__deepcopy__",
+           [](const py::object& self, const py::dict&) { return std::make_shared<PointSet>(setOf(self)); })
       // Pickled whole (multiprocessing, joblib): every array as its bytes, the source's facts and a
       // LAS source's frame and records, so the copy writes the files the set writes.
-      .def(py::pickle(&pointSetState, &pointSetFromState))
-      .def("__repr__", [](const PointSet& s) {
+      .def(py::pickle([](const py::object& self) { return pointSetState(setOf(self)); }, &pointSetFromState))
+      .def("__repr__", [](const py::object& self) -> std::string {
+        const PointSet* held = nullptr;
+        try {
+          held = &setOf(self);
+        } catch (const py::type_error&) {  // a repr that raises hides the object in a debugger
+          return "<dpoint.PointSet: holds nothing (made by __new__ without __init__)>";
+        }
+        const PointSet& s = *held;
         return "<dpoint.PointSet: " + std::to_string(s.size()) + " points" + (s.hasColors() ? ", colours" : "") +
                (s.isMesh() ? ", " + std::to_string(s.triangles.size() / 3) + " triangles" : "") +
                (s.hasZ() ? "" : ", 2D") + ">";
@@ -549,9 +561,9 @@ that memory, without copying (writing into them changes the set).)")
 
   m.def(
       "sample",
-      [](const std::shared_ptr<PointSet>& mesh, uint64_t count, const std::string& method, uint64_t seed,
+      [](const py::object& mesh, uint64_t count, const std::string& method, uint64_t seed,
          unsigned threads, const py::object& max_memory, bool progress) {
-        return sampleMesh(mesh.get(), "", count, method, seed, threads, max_memory, progress);
+        return sampleMesh(&setOf(mesh), "", count, method, seed, threads, max_memory, progress);
       },
       py::arg("mesh"), py::arg("count"), py::kw_only(), py::arg("method") = "uniform", py::arg("seed") = uint64_t{0},
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
@@ -595,10 +607,11 @@ progress: lines on stderr.)");
 
   m.def(
       "write",
-      [](const std::shared_ptr<PointSet>& points, const std::string& path, int decimals, bool ply_ascii,
+      [](const py::object& points_object, const std::string& path, int decimals, bool ply_ascii,
          const std::string& ply_colors, const std::string& pcd_encoding, std::optional<double> las_scale,
          const std::optional<std::string>& crs, const std::string& order, bool no_colors,
          const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
+        const PointSet& points = setOf(points_object);
         // As convert's --decimals (0..100; -1 here: shortest round trip) and --las-scale (> 0), whatever the format.
         if (decimals < -1 || decimals > 100)
           raise(Error{"decimals: " + std::to_string(decimals) + " is not -1 (shortest round trip) or 0..100",
@@ -637,7 +650,7 @@ progress: lines on stderr.)");
           crs_wkt = std::move(*wkt);
         }
         std::vector<std::string> notices;  // what the file cannot hold as given: warnings, as the CLI's notes
-        const SetInUse in_use(points.get());
+        const SetInUse in_use(&points);
         check(released([&] {
           Progress bar(progressFile(progress), "write");
           WriteOptions w;
@@ -649,8 +662,8 @@ progress: lines on stderr.)");
           w.pcd_encoding = pcd;
           const ColorFilters colors{no_colors, color_format == "srgb8"};
           if (!colors.drop && !colors.srgb8 && !unique && point_order == PointOrder::kInput)
-            return writePoints(path, *points, w);
-          PointSet copy = *points;  // the caller's set stays as it is
+            return writePoints(path, points, w);
+          PointSet copy = points;  // the caller's set stays as it is
           if (Status s = filterPoints(copy, colors, unique, point_order, limit, threads, &bar); !s) return s;
           return writePoints(path, copy, w);
         }));

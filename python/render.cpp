@@ -70,8 +70,20 @@ class Renderer {
   std::shared_ptr<VulkanContext> context_;  // null once closed
 };
 
-RenderResultPy renderWith(const std::shared_ptr<PointSet>& points, const std::vector<std::string>& inputs,
-                          const std::vector<std::string>& args, Renderer* renderer, bool progress) {
+// What a RenderResult or _Renderer object holds (heldBy: TypeError for one made by __new__ alone).
+const RenderResultPy& resultOf(const py::handle& self) { return heldBy<RenderResultPy>(self, "dpoint.render makes one"); }
+Renderer& rendererOf(const py::handle& self) { return heldBy<Renderer>(self, "dpoint.Renderer() makes one"); }
+// A read-only property's getter for one of RenderResult's fields.
+template <auto Member>
+auto field() {
+  return [](const py::object& self) { return resultOf(self).*Member; };
+}
+
+RenderResultPy renderWith(const py::object& points_object, const std::vector<std::string>& inputs,
+                          const std::vector<std::string>& args, const py::object& renderer_object, bool progress) {
+  const std::shared_ptr<PointSet> points = heldSet(points_object);
+  const std::shared_ptr<Renderer> held_renderer = heldObject<Renderer>(renderer_object, "dpoint.Renderer() makes one");
+  Renderer* renderer = held_renderer.get();
   if (!points && inputs.empty()) raise(Error{"render: no points and no input files", ExitCode::kUsage});
   RenderRequest request = take(renderRequestOf(args));
   if (points) {
@@ -128,23 +140,24 @@ warnings: what makes the picture wrong or poor. save(path) writes the PNG the CL
 Jupyter the result shows as its picture.)")
       .def_property_readonly("image",
                              [](const py::object& self) {
-                               const RenderResultPy& r = self.cast<const RenderResultPy&>();
+                               const RenderResultPy& r = resultOf(self);
                                const auto h = static_cast<py::ssize_t>(r.image.height);
                                const auto w = static_cast<py::ssize_t>(r.image.width);
                                return py::array_t<uint8_t>({h, w, py::ssize_t{4}}, {w * 4, py::ssize_t{4}, py::ssize_t{1}},
                                                            r.image.rgba.data(), self);
                              })
-      .def_readonly("mode", &RenderResultPy::mode)
-      .def_readonly("backend", &RenderResultPy::backend)
-      .def_readonly("device", &RenderResultPy::device)
-      .def_readonly("points", &RenderResultPy::points)
-      .def_readonly("predicted_bound_px", &RenderResultPy::predicted_bound_px)
-      .def_readonly("bound_from_boxes", &RenderResultPy::bound_from_boxes)
-      .def_readonly("point_size", &RenderResultPy::point_size)
-      .def_readonly("gpu_ms", &RenderResultPy::gpu_ms)
-      .def_readonly("warnings", &RenderResultPy::warnings)
+      .def_property_readonly("mode", field<&RenderResultPy::mode>())
+      .def_property_readonly("backend", field<&RenderResultPy::backend>())
+      .def_property_readonly("device", field<&RenderResultPy::device>())
+      .def_property_readonly("points", field<&RenderResultPy::points>())
+      .def_property_readonly("predicted_bound_px", field<&RenderResultPy::predicted_bound_px>())
+      .def_property_readonly("bound_from_boxes", field<&RenderResultPy::bound_from_boxes>())
+      .def_property_readonly("point_size", field<&RenderResultPy::point_size>())
+      .def_property_readonly("gpu_ms", field<&RenderResultPy::gpu_ms>())
+      .def_property_readonly("warnings", field<&RenderResultPy::warnings>())
       .def_property_readonly("error_px",
-                             [](const RenderResultPy& r) -> py::object {
+                             [](const py::object& self) -> py::object {
+                               const RenderResultPy& r = resultOf(self);
                                if (!r.error) return py::none();
                                py::dict d;
                                d["max"] = r.error->max_px, d["p99"] = r.error->p99_px, d["rms"] = r.error->rms_px;
@@ -152,12 +165,13 @@ Jupyter the result shows as its picture.)")
                                d["points"] = r.error->points, d["lost"] = r.error->lost;
                                return d;
                              })
-      .def_readonly("_report_json", &RenderResultPy::report_json)
-      .def("png", [](const RenderResultPy& r) {
-             std::vector<unsigned char> bytes = take(pngBytes(r.image, "the picture"));
+      .def_property_readonly("_report_json", field<&RenderResultPy::report_json>())
+      .def("png", [](const py::object& self) {
+             std::vector<unsigned char> bytes = take(pngBytes(resultOf(self).image, "the picture"));
              return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
            }, "The picture as the bytes of the PNG file the CLI writes")
-      .def("save", [](const RenderResultPy& r, const std::filesystem::path& file) {  // a str or os.PathLike
+      .def("save", [](const py::object& self, const std::filesystem::path& file) {  // a str or os.PathLike
+             const RenderResultPy& r = resultOf(self);
              const std::string path = file.string();
              Status ok = checkPictureOutput(path);
              // The CLI's message names its flag: here the argument is save's.
@@ -169,8 +183,8 @@ Jupyter the result shows as its picture.)")
   py::class_<Renderer, std::shared_ptr<Renderer>>(m, "_Renderer")
       .def(py::init<const std::string&, bool, uint64_t>(), py::arg("device"), py::arg("validate"),
            py::arg("max_device_memory"))
-      .def_property_readonly("device", &Renderer::deviceName)
-      .def("close", &Renderer::close);
+      .def_property_readonly("device", [](const py::object& self) { return rendererOf(self).deviceName(); })
+      .def("close", [](const py::object& self) { rendererOf(self).close(); });
 
   m.def("_render", &renderWith, py::arg("points"), py::arg("inputs"), py::arg("args"), py::arg("renderer"),
         py::arg("progress"));

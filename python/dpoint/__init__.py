@@ -195,9 +195,18 @@ RenderResult.report = property(
     lambda self: _json.loads(self._report_json) if self._report_json else None,
     doc="render --json's object as a dict (None for a contact sheet)")
 RenderResult._repr_png_ = lambda self: self.png()
-RenderResult.__repr__ = lambda self: (
-    f"<dpoint.RenderResult: {self.image.shape[1]}x{self.image.shape[0]}, {self.points} points, mode {self.mode}, "
-    f"{self.backend} backend, bound {self.predicted_bound_px:.3g} px>")
+
+
+def _result_repr(self: RenderResult) -> str:
+    try:
+        image = self.image
+    except TypeError:  # made by __new__ alone: a repr that raises hides the object in a debugger
+        return "<dpoint.RenderResult: holds nothing (made by __new__ without __init__)>"
+    return (f"<dpoint.RenderResult: {image.shape[1]}x{image.shape[0]}, {self.points} points, mode {self.mode}, "
+            f"{self.backend} backend, bound {self.predicted_bound_px:.3g} px>")
+
+
+RenderResult.__repr__ = _result_repr
 
 
 def _warn(result: RenderResult) -> RenderResult:

@@ -377,6 +377,37 @@ def test_pickle_and_copy_keep_the_whole_set(tmp_path):
         dpoint.PointSet.__new__(dpoint.PointSet).__setstate__((2,))
 
 
+def test_an_object_made_by_new_alone_raises_instead_of_reading_garbage(tmp_path):
+    """PointSet.__new__(PointSet) without __init__ (as pickle does before __setstate__) holds no
+    set: its use read uninitialised memory (len gave garbage, write said "Unable to cast", a
+    _Renderer's close aborted the process). Every use now raises TypeError, and repr says so."""
+    bare = dpoint.PointSet.__new__(dpoint.PointSet)
+    uses = [lambda: len(bare), lambda: bare.positions, lambda: bare.colors, lambda: bare.attributes,
+            lambda: bare.triangles, lambda: bare.has_z, lambda: bare.z_up, lambda: bare.copy(),
+            lambda: bare.set_attribute("a", np.zeros(0)), lambda: bare.remove_attribute("a"),
+            lambda: setattr(bare, "colors", None), lambda: bare.__getstate__(),
+            lambda: dpoint.write(bare, tmp_path / "a.csv"), lambda: dpoint.info(bare),
+            lambda: dpoint.sample(bare, 10), lambda: dpoint.render(bare)]
+    for use in uses:
+        with pytest.raises(TypeError, match="holds nothing: it was made by PointSet.__new__ without __init__"):
+            use()
+    assert "holds nothing" in repr(bare)
+    assert not (tmp_path / "a.csv").exists()
+    result = dpoint.RenderResult.__new__(dpoint.RenderResult)
+    for use in [lambda: result.image, lambda: result.mode, lambda: result.error_px, lambda: result.png(),
+                lambda: result.save(tmp_path / "a.png")]:
+        with pytest.raises(TypeError, match="this RenderResult holds nothing"):
+            use()
+    assert "holds nothing" in repr(result)
+    renderer = dpoint._dpoint._Renderer.__new__(dpoint._dpoint._Renderer)
+    for use in [lambda: renderer.device, lambda: renderer.close()]:
+        with pytest.raises(TypeError, match="this _Renderer holds nothing"):
+            use()
+    # An object where a PointSet goes is named.
+    with pytest.raises(TypeError, match="expected a dpoint.PointSet, not int"):
+        dpoint._dpoint.write(3, str(tmp_path / "a.csv"))
+
+
 def test_a_set_being_written_in_another_thread_cannot_change_under_it(tmp_path):
     # A review finding: set_attribute from another thread while write ran (the GIL released)
     # reallocated the attributes under it and corrupted the heap. The change is refused meanwhile.
