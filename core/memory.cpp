@@ -42,7 +42,12 @@ Result<uint64_t> parseMemorySize(const std::string& flag, const std::string& tex
   else if (unit == "G" || unit == "GiB" || unit == "GB") scale = 1024.0 * 1024.0 * 1024.0;
   if (used == 0 || scale == 0.0 || !(value > 0.0) || !std::isfinite(value) || value * scale > 1e19)
     return Error{flag + " " + text + ": not a size (examples: 512M, 8G, 1000000)", ExitCode::kUsage};
-  return static_cast<uint64_t>(value * scale);
+  // A count of bytes is whole (1.5 was cut to 1 byte in silence, and 0.5 to 0, the default limit);
+  // a fraction of a unit is cut to the byte below (0.1G).
+  const double bytes = value * scale;
+  if (scale == 1.0 ? bytes != std::floor(bytes) : bytes < 1.0)
+    return Error{flag + " " + text + ": not a whole number of bytes (examples: 512M, 1.5G, 1000000)", ExitCode::kUsage};
+  return static_cast<uint64_t>(bytes);
 }
 
 std::string formatBytes(uint64_t bytes) {

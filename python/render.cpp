@@ -154,7 +154,7 @@ Jupyter the result shows as its picture.)")
       .def_property_readonly("bound_from_boxes", field<&RenderResultPy::bound_from_boxes>())
       .def_property_readonly("point_size", field<&RenderResultPy::point_size>())
       .def_property_readonly("gpu_ms", field<&RenderResultPy::gpu_ms>())
-      .def_property_readonly("warnings", field<&RenderResultPy::warnings>())
+      .def_property_readonly("_warnings", field<&RenderResultPy::warnings>())
       .def_property_readonly("error_px",
                              [](const py::object& self) -> py::object {
                                const RenderResultPy& r = resultOf(self);

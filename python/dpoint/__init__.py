@@ -12,7 +12,7 @@ Options are the CLI's, as keyword arguments: ``view_width=0.5`` is ``--view-widt
 is a comma list (``eye=(0, 0, 5)`` is ``--eye 0,0,5``), ``True`` gives a flag and ``False`` or
 ``None`` leaves the option out. They are parsed, checked and defaulted by the CLI's own parser, so
 ``dpoint generate KIND --help`` and ``dpoint render --help`` document them and a bad one raises the
-CLI's message.
+CLI's message, naming the keyword (``view_width -3: must be ...``).
 
 Errors: ``dpoint.Error`` (a ``ValueError``) for bad input or options, ``MemoryError`` for
 resource limits, ``dpoint.DeviceError`` (a ``RuntimeError``) for a missing device or a Vulkan
@@ -77,7 +77,55 @@ def _column_names(columns):
         return None
     if isinstance(columns, str):
         return columns.split(",")
-    return [str(c) for c in columns]
+    # bytes were taken as a list of numbers (a review finding: b"x,y,z" gave "--columns 44: named twice").
+    if isinstance(columns, (bytes, bytearray)) or not all(isinstance(c, str) for c in columns):
+        raise TypeError(f"columns: a str such as 'x,y,z,-,intensity' or a list of str, not {columns!r}")
+    return list(columns)
+
+
+def _usage_error(message: str) -> Error:
+    """dpoint.Error with the CLI's exit code of a usage error (1)."""
+    error = Error(message)
+    error.exit_code = 1
+    return error
+
+
+# Options that take a whole number of 0 or more, and the most each takes: a negative one gave
+# pybind11's dump of the whole signature (a review finding).
+_WHOLE = {"threads": 2**32 - 1, "count": 2**64 - 1, "seed": 2**64 - 1, "max_points": 2**64 - 1}
+
+
+def _check_whole(name: str, key: str, value) -> None:
+    most = _WHOLE.get(key)
+    if most is not None and isinstance(value, _numbers.Integral) and not isinstance(value, bool) \
+            and not 0 <= value <= most:
+        raise _usage_error(f"{name}: {key} {value}: must be a whole number from 0 to {most}")
+
+
+def _python_words(text: str, keys=None) -> str:
+    """A CLI message with the keyword arguments' names for its flags: "width -5: ..." for width=-5,
+    where it said "--width -5: ..." (a review finding). keys: the flags to name, else every one but
+    --help (where every option of the command is a keyword)."""
+    if keys is None:
+        return _re.sub(r"--(?!help\b)([a-z][a-z0-9]*(?:-[a-z0-9]+)*)", lambda m: m.group(1).replace("-", "_"), text)
+    for key in keys:
+        text = _re.sub("--" + _re.escape(key.replace("_", "-")) + r"(?![\w-])", key, text)
+    return text
+
+
+class _PythonWords:
+    """Errors raised inside speak of keyword arguments (_python_words)."""
+
+    def __init__(self, keys=None):
+        self.keys = keys
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, error, trace):
+        if isinstance(error, (Error, MemoryError, DeviceError)) and error.args and isinstance(error.args[0], str):
+            error.args = (_python_words(error.args[0], self.keys),) + error.args[1:]
+        return False
 
 
 def _args(options: dict) -> list[str]:
@@ -194,6 +242,9 @@ PointSet.to_dataframe = _to_dataframe
 RenderResult.report = property(
     lambda self: _json.loads(self._report_json) if self._report_json else None,
     doc="render --json's object as a dict (None for a contact sheet)")
+RenderResult.warnings = property(
+    lambda self: [_python_words(line) for line in self._warnings],
+    doc="What makes the picture wrong or poor, as the CLI's warnings (options named as keywords)")
 RenderResult._repr_png_ = lambda self: self.png()
 
 
@@ -254,7 +305,8 @@ def _render(points, mode, renderer, progress, options) -> RenderResult:
         raise TypeError("render: the picture and the report come back in the result (result.save(path), result.report)")
     in_memory, inputs = _as_points(points)
     args = _args({"mode": mode, **options})
-    return _warn(_dpoint._render(in_memory, inputs, args, renderer, progress))
+    with _PythonWords():
+        return _warn(_dpoint._render(in_memory, inputs, args, renderer, progress))
 
 
 def render(points, mode: str = "auto", *, progress: bool = False, **options) -> RenderResult:
@@ -282,6 +334,7 @@ def _keywords(name: str, function, options: dict) -> dict:
             hint = f"; did you mean {close[0]!r}?" if close else f" (its options: {', '.join(known)})"
             raise TypeError(f"{name}: no option {key!r}{hint}")
         value = _plain(value)
+        _check_whole(name, key, value)
         if value is not None:
             out[key] = value
     return out
@@ -291,7 +344,8 @@ def read(path, **options) -> PointSet:
     options = _keywords("read", _dpoint.read, options)
     if "columns" in options:
         options["columns"] = _column_names(options["columns"])
-    return _dpoint.read(_fspath(path), **options)
+    with _PythonWords():
+        return _dpoint.read(_fspath(path), **options)
 
 
 def write(points, path, **options) -> None:
@@ -300,7 +354,8 @@ def write(points, path, **options) -> None:
     if points is None:
         raise TypeError("write: points must be a PointSet or an array, not a file name")
     try:
-        _dpoint.write(points, _fspath(path), **options)
+        with _PythonWords(options):
+            _dpoint.write(points, _fspath(path), **options)
     except Error as e:  # the CLI's advice in the module's words
         e.args = (_re.sub(r"--drop (\w+)", r"points.remove_attribute('\1') (on a copy)", str(e)),)
         raise
@@ -308,9 +363,12 @@ def write(points, path, **options) -> None:
 
 def sample(mesh, count, **options) -> PointSet:
     options = _keywords("sample", _dpoint.sample, options)
-    if isinstance(mesh, (str, _os.PathLike)):  # read with its textures, which colour the samples
-        return _dpoint._sample_file(_fspath(mesh), count, **options)
-    return _dpoint.sample(mesh, count, **options)
+    count = _plain(count)
+    _check_whole("sample", "count", count)
+    with _PythonWords():
+        if isinstance(mesh, (str, _os.PathLike)):  # read with its textures, which colour the samples
+            return _dpoint._sample_file(_fspath(mesh), count, **options)
+        return _dpoint.sample(mesh, count, **options)
 
 
 read.__doc__ = _dpoint.read.__doc__
@@ -329,7 +387,8 @@ def generate(kind: str, *, progress: bool = False, **options) -> PointSet:
     """
     if not isinstance(kind, str):
         raise TypeError("generate: kind must be a string such as 'mandelbulb'")
-    return _dpoint._generate(kind, _args(options), progress)
+    with _PythonWords():
+        return _dpoint._generate(kind, _args(options), progress)
 
 
 def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool = False, stream: str = "auto",
@@ -342,25 +401,22 @@ def info(points, *, sample: int = 10000, threads: int = 0, allow_nonfinite: bool
     sampled for the nearest-neighbour distance. columns: text files, what each column holds (as
     read's columns).
     """
-    def usage_error(message):
-        error = Error(message)
-        error.exit_code = 1  # a usage error, as the CLI's
-        return error
-
-    sample = _plain(sample)
+    sample, threads = _plain(sample), _plain(threads)
+    _check_whole("info", "threads", threads)
     if isinstance(sample, bool) or not isinstance(sample, _numbers.Integral) or not 1 <= sample <= 100_000_000:
-        raise usage_error(f"sample {sample!r}: must be a number from 1 to 100000000 (as info's --sample)")
+        raise _usage_error(f"sample {sample!r}: must be a number from 1 to 100000000")
     in_memory, inputs = _as_points(points)
     if in_memory is not None:  # options of reading files (a review finding: passed over in silence)
         given = [name for name, value, default in (("stream", stream, "auto"), ("allow_nonfinite", allow_nonfinite, False),
                                                    ("columns", columns, None))
                  if value != default]
         if given:
-            raise usage_error(f"info: {' and '.join(given)} {'applies' if len(given) == 1 else 'apply'} to files, "
+            raise _usage_error(f"info: {' and '.join(given)} {'applies' if len(given) == 1 else 'apply'} to files, "
                               "not to a set in memory")
     limit = _dpoint._memory_size("max_memory", max_memory)
-    text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit,
-                         _column_names(columns) or [], progress)
+    with _PythonWords():
+        text = _dpoint._info(in_memory, inputs, _args(camera), sample, threads, allow_nonfinite, stream, limit,
+                             _column_names(columns) or [], progress)
     return _json.loads(text)
 
 
@@ -386,6 +442,7 @@ def bench(suite: str = "ci", out="bench-out", *, progress: bool = False, **optio
     (``DPOINT_EXECUTABLE``, else the one built or installed with this module).
     """
     _os.environ["DPOINT_EXECUTABLE"] = _executable()
-    _dpoint._bench(_args({"suite": suite, "out": _fspath(out), **options}), progress)
+    with _PythonWords():
+        _dpoint._bench(_args({"suite": suite, "out": _fspath(out), **options}), progress)
     with open(_os.path.join(_fspath(out), "results.json"), encoding="utf-8") as f:
         return _json.load(f)

@@ -233,6 +233,9 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"merge", "-o", ply}, "merge: TILES is required (dpoint merge --help)"},
       {{"merge", in, in}, "merge: --output is required (dpoint merge --help)"},
       {{"convert", in, "-o", ply, "--max-memory", "12Q"}, "--max-memory 12Q: not a size (examples: 512M, 8G, 1000000)"},
+      // A fraction of a byte was cut: 1.5 was 1 byte, 0.5 was 0 (the default limit); 0.1G is taken.
+      {{"convert", in, "-o", ply, "--max-memory", "1.5"}, "--max-memory 1.5: not a whole number of bytes"},
+      {{"convert", in, "-o", ply, "--max-memory", "0.5"}, "--max-memory 0.5: not a whole number of bytes"},
       {{"convert", in, "-o", dir.file("o.gltf")}, dir.file("o.gltf") + ": .gltf is read, not written; write .glb"},
       {{"render", in, "-o", dir.file("o.jpg")}, "-o " + dir.file("o.jpg") + ": the picture is written as PNG; name it .png"},
       {{"render", in, "-o", png, "--point-size", "0"}, "--point-size 0: must be 1.."},

@@ -6,6 +6,7 @@ names the executable in DPOINT_EXECUTABLE. By hand, from the repository root:
     PYTHONPATH=build/python DPOINT_EXECUTABLE=build/dpoint /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
 """
 import json
+import re
 import os
 import subprocess
 
@@ -47,6 +48,12 @@ def cli_error(*args):
     lines = [line for line in done.stderr.splitlines() if line.startswith("dpoint: error: ")]
     message = lines[0][len("dpoint: error: "):] if lines else done.stderr.splitlines()[0]
     return message, done.returncode
+
+
+def as_keywords(message):
+    """A CLI message as the module raises it: each flag but --help named as its keyword
+    (--view-width as view_width)."""
+    return re.sub(r"--(?!help\b)([a-z][a-z0-9-]*)", lambda m: m.group(1).replace("-", "_"), message)
 
 
 def cli_json(*args):

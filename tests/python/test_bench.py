@@ -14,9 +14,10 @@ def test_a_bad_option_is_the_clis_error(tmp_path):
     message, code = cli_error("bench", "--suite", "nightly", "--out", tmp_path / "out")
     with pytest.raises(dpoint.Error) as raised:
         dpoint.bench("nightly", out=tmp_path / "out", progress=False)
-    assert str(raised.value) == message == "--suite nightly: must be ci, paper, hard or all"
+    assert message == "--suite nightly: must be ci, paper, hard or all"
+    assert str(raised.value) == "suite nightly: must be ci, paper, hard or all"  # the keyword's name
     assert raised.value.exit_code == code == 1
-    with pytest.raises(dpoint.Error, match="--frames 0: must be at least 1"):
+    with pytest.raises(dpoint.Error, match="^frames 0: must be at least 1"):
         dpoint.bench(out=tmp_path / "out", frames=0, progress=False)
     assert not (tmp_path / "out").exists()
 
@@ -24,7 +25,7 @@ def test_a_bad_option_is_the_clis_error(tmp_path):
 def test_an_unknown_keyword_says_did_you_mean(tmp_path):
     with pytest.raises(dpoint.Error) as raised:
         dpoint.bench(out=tmp_path / "out", backnd="raster", progress=False)
-    assert str(raised.value) == ("bench: unknown option '--backnd'; did you mean '--backend'? "
+    assert str(raised.value) == ("bench: unknown option 'backnd'; did you mean 'backend'? "
                                  "(`dpoint bench --help` lists them)")
 
 

@@ -29,26 +29,36 @@ def test_each_failure_raises_its_kind_with_the_clis_code(call, kind, code):
 
 
 # The Python side of the bad-invocation table (tests/cli/cli_help_test.cpp, CliVoice): the same
-# words as the CLI's "dpoint: error: ..." line, with the same exit code, for the same mistakes.
+# words as the CLI's "dpoint: error: ..." line, with the same exit code, for the same mistakes, but
+# each option named as the keyword it is (the CLI's "width 0" was a review finding).
 CLOUD = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]
 
 
 @pytest.mark.parametrize("call, code, words", [
-    (lambda: dpoint.generate("menger", level=99), 1, "--level 99: must be 0..8 for menger"),
+    (lambda: dpoint.generate("menger", level=99), 1, "level 99: must be 0..8 for menger"),
     (lambda: dpoint.generate("menger", method="voxl"), 1,
-     "--method voxl: must be exact or voxel; did you mean 'voxel'?"),
-    (lambda: dpoint.generate("random2d", count=0), 1, "--count 0: must be a number from 1 to 1099511627776"),
+     "method voxl: must be exact or voxel; did you mean 'voxel'?"),
+    (lambda: dpoint.generate("random2d", count=0), 1, "count 0: must be a number from 1 to 1099511627776"),
     (lambda: dpoint.generate("nosuch"), 1, "generate: unknown kind 'nosuch' (kinds: mandelbulb, julia, menger,"),
-    (lambda: dpoint.generate("julia", c=(1, 2)), 1, "--c 1,2: must be 4 comma-separated finite numbers"),
-    (lambda: dpoint.render(CLOUD, shade="edll"), 1, "--shade edll: must be auto, none or edl; did you mean 'edl'?"),
-    (lambda: dpoint.render(CLOUD, fov=200), 1, "--fov 200: must be in (0, 180)"),
-    (lambda: dpoint.render(CLOUD, width=0), 1, "--width 0: must be at least 1"),
-    (lambda: dpoint.render(CLOUD, tolerance=-1), 1, "--tolerance -1: must be a number of pixels above 0"),
-    (lambda: dpoint.render(CLOUD, mode="emulated"), 1, "--mode emulated: must be auto, fp32, split, rte, df64"),
+    (lambda: dpoint.generate("julia", c=(1, 2)), 1, "c 1,2: must be 4 comma-separated finite numbers"),
+    (lambda: dpoint.render(CLOUD, shade="edll"), 1, "shade edll: must be auto, none or edl; did you mean 'edl'?"),
+    (lambda: dpoint.render(CLOUD, fov=200), 1, "fov 200: must be in (0, 180)"),
+    (lambda: dpoint.render(CLOUD, width=0), 1, "width 0: must be at least 1"),
+    (lambda: dpoint.render(CLOUD, tolerance=-1), 1, "tolerance -1: must be a number of pixels above 0"),
+    (lambda: dpoint.render(CLOUD, mode="emulated"), 1, "mode emulated: must be auto, fp32, split, rte, df64"),
     (lambda: dpoint.info(CLOUD, sample=0), 1, "sample 0: must be a number from 1 to 100000000"),
-    (lambda: dpoint.bench(frames=0), 1, "--frames 0: must be at least 1"),
+    (lambda: dpoint.bench(frames=0), 1, "frames 0: must be at least 1"),
     (lambda: dpoint.read("/nonexistent/x.ply"), 2, "/nonexistent/x.ply: file not found"),
-    (lambda: dpoint.render(CLOUD, device="99"), 3, "--device 99: only "),
+    (lambda: dpoint.render(CLOUD, device="99"), 3, "device 99: only "),
+    (lambda: dpoint.render(CLOUD, view_width=-3), 1, "view_width -3: must be a finite number above 0"),
+    (lambda: dpoint.info(CLOUD, view_width=0), 1, "view_width 0: must be a finite number above 0"),
+    (lambda: dpoint.info("/tmp/x.csv", stream="x"), 1, "stream x: must be auto, on or off"),
+    # Negative whole numbers gave pybind11's dump of the whole signature (a review finding).
+    (lambda: dpoint.read("/tmp/x.csv", threads=-1), 1, "read: threads -1: must be a whole number from 0 to 4294967295"),
+    (lambda: dpoint.read("/tmp/x.csv", max_points=-1), 1, "read: max_points -1: must be a whole number from 0"),
+    (lambda: dpoint.info(CLOUD, threads=-1), 1, "info: threads -1: must be a whole number from 0"),
+    (lambda: dpoint.sample(CLOUD, -5), 1, "sample: count -5: must be a whole number from 0"),
+    (lambda: dpoint.sample(CLOUD, 5, seed=2**64), 1, "sample: seed 18446744073709551616: must be a whole number"),
 ])
 def test_bad_calls_speak_the_clis_words(call, code, words):
     with pytest.raises((dpoint.Error, dpoint.DeviceError)) as raised:
@@ -56,6 +66,13 @@ def test_bad_calls_speak_the_clis_words(call, code, words):
     assert raised.value.exit_code == code
     assert words in str(raised.value)
     assert "\n" not in str(raised.value).strip()
+    assert "--" not in str(raised.value).replace("--help", "")
+
+
+def test_columns_as_bytes_are_refused_not_read_as_numbers():
+    # b"x,y,z" was a list of numbers: "--columns 44: named twice" (a review finding).
+    with pytest.raises(TypeError, match="columns: a str such as 'x,y,z,-,intensity' or a list of str, not b'x,y,z'"):
+        dpoint.read("/tmp/x.csv", columns=b"x,y,z")
 
 
 @pytest.mark.parametrize("call, kind, words", [

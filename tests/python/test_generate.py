@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import dpoint
-from conftest import SMALL_GENERATE, cli, cli_error, options_as_flags
+from conftest import as_keywords, SMALL_GENERATE, cli, cli_error, options_as_flags
 
 
 def test_every_kind_is_covered():
@@ -101,14 +101,14 @@ def test_a_bad_option_is_the_clis_error(tmp_path, kind, options, flags):
     message, code = cli_error("generate", kind, *flags, "-o", tmp_path / "x.ply")
     with pytest.raises(dpoint.Error) as raised:
         dpoint.generate(kind, **options)
-    assert str(raised.value) == message
+    assert str(raised.value) == as_keywords(message)
     assert raised.value.exit_code == code == 1
 
 
 def test_an_unknown_option_says_did_you_mean():
     with pytest.raises(dpoint.Error) as raised:
         dpoint.generate("mandelbulb", resolutoin=10)
-    assert str(raised.value) == ("generate mandelbulb: unknown option '--resolutoin'; did you mean '--resolution'? "
+    assert str(raised.value) == ("generate mandelbulb: unknown option 'resolutoin'; did you mean 'resolution'? "
                                  "(`dpoint generate mandelbulb --help` lists them)")
     with pytest.raises(dpoint.Error, match="unknown kind 'mandelbulp'; did you mean 'mandelbulb'"):
         dpoint.generate("mandelbulp")
@@ -127,7 +127,7 @@ def test_beyond_max_memory_is_a_memory_error():
     with pytest.raises(MemoryError) as raised:
         dpoint.generate("mandelbulb", resolution=100, device="none", max_memory="10K")
     assert str(raised.value) == "mandelbulb at resolution 100 needs about 2.9 MiB, more than the limit of 10240 bytes " \
-                                "(--max-memory)"
+                                "(max_memory)"
     assert raised.value.exit_code == 4
     with pytest.raises(MemoryError):
         dpoint.generate("random2d", count=10**6, max_memory=4096)
@@ -138,7 +138,7 @@ def test_no_such_device_is_a_device_error():
         dpoint.generate("julia", resolution=8, device="99")
     assert isinstance(raised.value, RuntimeError)
     assert raised.value.exit_code == 3
-    assert "--device 99" in str(raised.value)
+    assert "device 99" in str(raised.value) and "--" not in str(raised.value)
 
 
 def test_on_the_vulkan_device_the_counts_are_the_cpus():
