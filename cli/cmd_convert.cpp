@@ -96,38 +96,22 @@ int runConvert(ConvertOptions& o) {
   w.las_scale = o.las_scale;
   // Options that would do nothing are refused, as --crs for a PLY output is (a review finding:
   // each passed silently).
-  const Result<FileFormat> out_format = formatOf(o.output);
-  const bool to_las = out_format && (*out_format == FileFormat::kLas || *out_format == FileFormat::kLaz);
-  const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   if (o.dimensions.keep && !o.dimensions.drop.empty())
     return reportError(Error{"--keep and --drop: give one of them (--keep names the dimensions that stay, --drop those "
                              "that go)",
                              ExitCode::kUsage});
-  if (o.decimals >= 0 && !to_csv)
-    return reportError(Error{"--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals, not " +
-                                 quotedExcerpt(o.output),
-                             ExitCode::kUsage});
-  const bool to_ply = out_format && *out_format == FileFormat::kPly;
-  if ((o.ply_ascii || o.ply_colors_option->count()) && !to_ply)
-    return reportError(Error{std::string(o.ply_ascii ? "--ply-ascii" : "--ply-colors") + ": only a PLY output has it, not " +
-                                 quotedExcerpt(o.output),
-                             ExitCode::kUsage});
-  if (o.pcd_encoding_option->count() && !(out_format && *out_format == FileFormat::kPcd))
-    return reportError(Error{"--pcd-encoding: only a PCD output has an encoding, not " + quotedExcerpt(o.output),
-                             ExitCode::kUsage});
-  if (o.las_scale != 0.0 && !to_las)
-    return reportError(Error{"--las-scale: only a LAS, LAZ or COPC output has a coordinate step, not " +
-                                 quotedExcerpt(o.output),
-                             ExitCode::kUsage});
+  if (Status used = checkFormatOptionsUsed(o.output, {o.decimals >= 0, o.ply_ascii, o.ply_colors_option->count() > 0,
+                                                      o.pcd_encoding_option->count() > 0, o.las_scale != 0.0,
+                                                      o.crs.has_value()});
+      !used)
+    return reportError(used.error());
   if (o.crs) {
-    if (!to_las)
-      return reportError(Error{"--crs: only a LAS, LAZ or COPC output holds a coordinate reference system, not " +
-                                   quotedExcerpt(o.output),
-                               ExitCode::kUsage});
     Result<std::string> wkt = crsAsWkt(*o.crs);
     if (!wkt) return reportError(wkt.error());
     w.las_crs = std::move(*wkt);
   }
+  const Result<FileFormat> out_format = formatOf(o.output);
+  const bool to_csv = out_format && *out_format == FileFormat::kCsv;
   const ColorFilters filters{o.no_colors, o.color_format == "srgb8"};
   // glTF to CSV is written as the scene is walked, the same bytes as below without holding the
   // point set; --unique and --order morton need the whole set, so they take the path below.

@@ -202,6 +202,25 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
   return points;
 }
 
+Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven& given) {
+  const Result<FileFormat> format = formatOf(path);
+  if (!format) return okStatus();
+  const bool las = *format == FileFormat::kLas || *format == FileFormat::kLaz;
+  const auto refuse = [&](const std::string& option, const std::string& what) {
+    return Status(Error{option + ": only " + what + ", not " + quotedExcerpt(path), ExitCode::kUsage});
+  };
+  if (given.decimals && *format != FileFormat::kCsv)
+    return refuse("--decimals", "a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals");
+  if ((given.ply_ascii || given.ply_colors) && *format != FileFormat::kPly)
+    return refuse(given.ply_ascii ? "--ply-ascii" : "--ply-colors", "a PLY output (.ply) has it");
+  if (given.pcd_encoding && *format != FileFormat::kPcd) return refuse("--pcd-encoding", "a PCD output (.pcd) has an encoding");
+  if (given.las_scale && !las)
+    return refuse("--las-scale", "a LAS, LAZ or COPC output (.las, .laz, .copc.laz) has a coordinate step");
+  if (given.crs && !las)
+    return refuse("--crs", "a LAS, LAZ or COPC output (.las, .laz, .copc.laz) holds a coordinate reference system");
+  return okStatus();
+}
+
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();

@@ -89,6 +89,15 @@ struct InputOptionNames {
 // kResourceLimit, a LAS file's count taken from its header before anything is allocated.
 Result<PointSet> readInput(const std::string& path, const ReadOptions& read, GltfReadOptions gltf,
                            const InputOptionNames& names = {});
+// Which of a write's format options were given: each means something to one format only.
+struct FormatOptionsGiven {
+  bool decimals = false, ply_ascii = false, ply_colors = false, pcd_encoding = false, las_scale = false, crs = false;
+};
+// The usage error for the first option given that `path`'s format does not use (a review finding:
+// each was passed over in silence), named as the CLI's flag (the module names its keyword). An
+// unknown format passes: the write says what it is.
+Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven& given);
+
 // An empty set is written as an empty file of the format (a CSV header, a PLY or LAS of 0 points);
 // GLB cannot hold one (glTF accessors have at least one element), and says so.
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options = {});

@@ -627,24 +627,11 @@ progress: lines on stderr.)");
         const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding));
         const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
-        // As convert's: options the file would not use are refused, not passed over in silence.
-        const FileFormat written = *formatOf(path);
-        if (las_scale && written != FileFormat::kLas && written != FileFormat::kLaz)
-          raise(Error{"las_scale: only a .las, .laz or .copc.laz file has a coordinate step, not '" + path + "'",
-                      ExitCode::kUsage});
-        if ((ply_ascii || *ply_color_type != PlyColorType::kAuto) && written != FileFormat::kPly)
-          raise(Error{std::string(ply_ascii ? "ply_ascii" : "ply_colors") + ": only a .ply file has it, not '" + path + "'",
-                      ExitCode::kUsage});
-        if (pcd != PcdEncoding::kBinary && written != FileFormat::kPcd)
-          raise(Error{"pcd_encoding: only a .pcd file has an encoding, not '" + path + "'", ExitCode::kUsage});
-        if (decimals >= 0 && written != FileFormat::kCsv)
-          raise(Error{"decimals: only a CSV file (.csv, .xyz, .txt, .asc, .pts) has decimals, not '" + path + "'",
-                      ExitCode::kUsage});
+        // As convert's, named as its flags (the module's write names them as keywords).
+        check(checkFormatOptionsUsed(path, {decimals >= 0, ply_ascii, *ply_color_type != PlyColorType::kAuto,
+                                            pcd != PcdEncoding::kBinary, las_scale.has_value(), crs.has_value()}));
         std::string crs_wkt;  // as convert's --crs
         if (crs) {
-          if (written != FileFormat::kLas && written != FileFormat::kLaz)
-            raise(Error{"crs: only a .las, .laz or .copc.laz file holds a coordinate reference system, not '" + path + "'",
-                        ExitCode::kUsage});
           Result<std::string> wkt = crsAsWkt(*crs, "crs");
           if (!wkt) raise(wkt.error());
           crs_wkt = std::move(*wkt);

@@ -199,9 +199,9 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"convert", in, "-o", ply, "--sample", "10", "--sample-seed", "-2"},
        "--sample-seed -2: must be a whole number from 0 to 18446744073709551615"},
       // Options the output does not use were passed over in silence (a review finding).
-      {{"convert", in, "-o", png + ".csv", "--ply-ascii"}, "--ply-ascii: only a PLY output has it"},
-      {{"convert", in, "-o", png + ".pcd", "--ply-colors", "uchar"}, "--ply-colors: only a PLY output has it"},
-      {{"convert", in, "-o", ply, "--pcd-encoding", "ascii"}, "--pcd-encoding: only a PCD output has an encoding"},
+      {{"convert", in, "-o", png + ".csv", "--ply-ascii"}, "--ply-ascii: only a PLY output (.ply) has it"},
+      {{"convert", in, "-o", png + ".pcd", "--ply-colors", "uchar"}, "--ply-colors: only a PLY output (.ply) has it"},
+      {{"convert", in, "-o", ply, "--pcd-encoding", "ascii"}, "--pcd-encoding: only a PCD output (.pcd) has an encoding"},
       {{"render", in, "-o", png, "--up-axis", "q"}, "--up-axis q: must be auto, y or z"},
       {{"render", in, "-o", png, "--shade", "edll"}, "--shade edll: must be auto, none or edl; did you mean 'edl'?"},
       {{"generate", "menger", "--size", "-1", "-o", ply}, "--size -1: must be a finite number above 0"},

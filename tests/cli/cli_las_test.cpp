@@ -222,11 +222,11 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
            {{"--crs", dir.path(), "-o", dir.file("c.las")}, "a folder, not a file holding a CRS"},
            {{"--crs", "/dev/zero", "-o", dir.file("c.las")}, "not a regular file, not a file holding a CRS"},
            // Options that would do nothing (a review finding: they passed silently).
-           {{"--las-scale", "0.1", "-o", dir.file("c.ply")}, "--las-scale: only a LAS, LAZ or COPC output has"},
+           {{"--las-scale", "0.1", "-o", dir.file("c.ply")}, "--las-scale: only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) has"},
            {{"--decimals", "3", "-o", dir.file("c.las")}, "--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts)"},
            {{"--keep", "intensity", "--drop", "intensity", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
            {{"--keep", "intensity", "--drop", "all", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
-           {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")}, "only a LAS, LAZ or COPC output holds"}}) {
+           {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")}, "only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) holds"}}) {
     std::vector<std::string> command = {"convert", kCorpus + "simple.las"};
     command.insert(command.end(), args.begin(), args.end());
     test::CommandResult bad = runDpoint(command);

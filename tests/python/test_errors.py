@@ -88,9 +88,9 @@ def test_columns_as_bytes_are_refused_not_read_as_numbers():
     (lambda t: dpoint.info(CLOUD, sample=-1), dpoint.Error, "sample -1: must be a number from 1 to 100000000"),
     # Options the file would not use, refused as convert's are (they passed in silence).
     (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.ply", las_scale=0.01), dpoint.Error,
-     "las_scale: only a .las, .laz or .copc.laz file has a coordinate step"),
+     "las_scale: only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) has a coordinate step"),
     (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.las", decimals=3), dpoint.Error,
-     "decimals: only a CSV file (.csv, .xyz, .txt, .asc, .pts) has decimals"),
+     "decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals"),
     # The LAS writer's advice in the module's words (it said "--drop intensity").
     (lambda t: dpoint.write(_with_intensity(70000), t / "a.las"), dpoint.Error,
      "leave it out with points.remove_attribute('intensity') (on a copy)"),

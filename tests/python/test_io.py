@@ -59,7 +59,7 @@ def test_las_takes_a_crs_as_convert_does(tmp_path, cloud):
     start = data.index(b'PROJCS["')
     wkt = data[start:data.index(b"\0", start)].decode()
     assert pyproj.CRS.from_wkt(wkt).equals(pyproj.CRS.from_epsg(32633), ignore_axis_order=True)
-    for path, crs, words in [(tmp_path / "c.ply", "EPSG:32633", "crs: only a .las, .laz or .copc.laz file"),
+    for path, crs, words in [(tmp_path / "c.ply", "EPSG:32633", "crs: only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) holds"),
                              (tmp_path / "d.las", "EPSG:999999", "crs 'EPSG:999999': not a coordinate reference system")]:
         with pytest.raises(dpoint.Error) as raised:
             dpoint.write(s, path, crs=crs)
@@ -153,9 +153,9 @@ def test_write_options_do_what_they_say(tmp_path, source):
     (dict(max_memory=-1), "max_memory -1: not a size in bytes"),
     (dict(max_memory=1.5), "max_memory 1.5: not a whole number of bytes"),  # was 1 byte
     # Options the file does not use (a review finding: passed over in silence).
-    (dict(ply_ascii=True), "ply_ascii: only a .ply file has it"),
-    (dict(ply_colors="uchar"), "ply_colors: only a .ply file has it"),
-    (dict(pcd_encoding="ascii"), "pcd_encoding: only a .pcd file has an encoding"),
+    (dict(ply_ascii=True), "ply_ascii: only a PLY output (.ply) has it"),
+    (dict(ply_colors="uchar"), "ply_colors: only a PLY output (.ply) has it"),
+    (dict(pcd_encoding="ascii"), "pcd_encoding: only a PCD output (.pcd) has an encoding"),
 ])
 def test_write_refuses_bad_options_and_writes_nothing(tmp_path, cloud, options, words):
     s, _, _ = cloud
