@@ -41,6 +41,9 @@ struct CsvReadOptions {
   // r, g, b (red, green, blue), `-` to skip a column, any other name a dimension. A header line
   // is then skipped.
   std::vector<std::string> columns = {};
+  // When not null, gets a line for what the reader could not keep as written (a column of integers
+  // past 2^53 that also holds other values, read as doubles).
+  std::vector<std::string>* notices = nullptr;
   // Tests: runs once the lines are counted, before they are parsed (to change the file in between).
   std::function<void()> between_passes = {};
 };

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <optional>
 
@@ -128,6 +129,100 @@ struct LineError {
   std::string message;
 };
 
+// Whether [begin, end) is an integer's text: an optional sign, then digits only.
+bool isIntegerText(const char* begin, const char* end) {
+  if (begin < end && (*begin == '-' || *begin == '+')) ++begin;
+  return begin < end && std::all_of(begin, end, [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// Attribute columns of integers past 2^53, which a double rounds (nanosecond time stamps, 64-bit
+// ids: a review finding, 9007199254740993 was read as ...992). A field whose double is 2^53 or
+// more is read again from its text as a 64-bit integer, into the column's `values_` (made at its
+// first such field); a smaller one is its double, exact. The column becomes int64 (uint64 past
+// 2^63) where every field is a 64-bit integer, else it stays double with a note.
+class ExactColumns {
+ public:
+  static constexpr double kFirstInexact = 9007199254740992.0;  // 2^53: from here doubles skip integers
+
+  // base_bytes: what the set needs without these columns, checked against max_memory with them.
+  ExactColumns(size_t columns, size_t rows, uint64_t base_bytes, uint64_t max_memory)
+      : rows_(rows), base_bytes_(base_bytes), max_memory_(max_memory), once_(new std::once_flag[columns]),
+        values_(columns), not_integer_(new std::atomic<bool>[columns]()), refused_(new std::atomic<bool>[columns]()) {}
+
+  // Row `row` of column k holds [begin, end), whose double is kFirstInexact or more.
+  void read(size_t k, size_t row, const char* begin, const char* end) {
+    if (!isIntegerText(begin, end)) {
+      not_integer_[k].store(true, std::memory_order_relaxed);  // 1e20, inf, or a fraction past 2^53
+      return;
+    }
+    std::call_once(once_[k], [&] {
+      const uint64_t bytes = base_bytes_ + rows_ * sizeof(uint64_t) * (made_.fetch_add(1) + 1);
+      if (checkMemory("", bytes, max_memory_)) values_[k].resize(rows_);
+      else refused_[k] = true;
+    });
+    if (refused_[k].load(std::memory_order_relaxed)) return;
+    if (*begin == '+') ++begin;
+    std::from_chars_result got{};
+    if (*begin == '-') {
+      int64_t v = 0;
+      got = std::from_chars(begin, end, v);
+      values_[k][row] = static_cast<uint64_t>(v);
+    } else {
+      got = std::from_chars(begin, end, values_[k][row]);
+    }
+    if (got.ec != std::errc()) not_integer_[k].store(true, std::memory_order_relaxed);  // past 64 bits
+  }
+
+  // Makes each column read so int64 or uint64 where every value is a 64-bit integer, before the
+  // rows of blank lines are closed up; the others stay double, and `notices` says why.
+  void apply(Dimensions& dimensions, const std::string& path, std::vector<std::string>* notices) {
+    for (size_t k = 0; k < values_.size(); ++k) {
+      if (values_[k].empty() && !refused_[k]) continue;
+      Dimension& d = dimensions.all()[k];
+      const auto note = [&](const std::string& why) {
+        if (notices)
+          notices->push_back(path + ": column " + quotedExcerpt(d.name) +
+                             " has integers past 2^53, read as the nearest double: " + why);
+      };
+      if (refused_[k]) {
+        note("their 64-bit values need more memory than --max-memory allows");
+        continue;
+      }
+      bool whole = !not_integer_[k], negative = false, above_int64 = false;
+      const double* doubles = reinterpret_cast<const double*>(d.bytes.data());
+      std::vector<uint64_t>& exact = values_[k];
+      for (size_t i = 0; i < rows_ && whole; ++i) {
+        const double v = doubles[i];
+        negative = negative || v < 0.0;
+        if (std::fabs(v) >= kFirstInexact) {
+          above_int64 = above_int64 || (v > 0.0 && exact[i] > static_cast<uint64_t>(std::numeric_limits<int64_t>::max()));
+        } else if (v == std::trunc(v)) {  // false for NaN (an empty field)
+          exact[i] = static_cast<uint64_t>(static_cast<int64_t>(v));
+        } else {
+          whole = false;
+        }
+      }
+      if (!whole) {
+        note("the column also holds fields that are not 64-bit integers (a fraction, an empty field, a number past 64 bits)");
+      } else if (negative && above_int64) {
+        note("the column holds values below 0 and above 2^63, which no 64-bit type holds");
+      } else {
+        d.type = above_int64 ? DimType::kU64 : DimType::kI64;
+        std::memcpy(d.bytes.data(), exact.data(), rows_ * sizeof(uint64_t));
+      }
+      exact = {};
+    }
+  }
+
+ private:
+  size_t rows_;
+  uint64_t base_bytes_, max_memory_;
+  std::unique_ptr<std::once_flag[]> once_;
+  std::vector<std::vector<uint64_t>> values_;  // per column: empty, or one value per row (two's complement)
+  std::unique_ptr<std::atomic<bool>[]> not_integer_, refused_;
+  std::atomic<uint64_t> made_{0};
+};
+
 // A field's number as the reader takes it: after a leading '+' (CSV writers emit it; fast_float, as
 // std::from_chars, refuses it), and with a decimal comma where fields are separated by semicolons
 // ("1,5": the only comma a field can hold). The data rows and --columns' header test both read so.
@@ -143,8 +238,10 @@ fast_float::from_chars_result parseField(const char* begin, const char* end, T& 
 class LineParser {
  public:
   // dimensions: one column of doubles per further column of the layout.
-  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite, std::vector<double*> dimensions)
-      : path_(path), layout_(layout), allow_nonfinite_(allow_nonfinite), dimensions_(std::move(dimensions)) {}
+  LineParser(const std::string& path, const Layout& layout, bool allow_nonfinite, std::vector<double*> dimensions,
+             ExactColumns& exact)
+      : path_(path), layout_(layout), allow_nonfinite_(allow_nonfinite), dimensions_(std::move(dimensions)),
+        exact_(exact) {}
 
   // Parses one line (without its line end, '\r' already removed) of row `row`. Returns false on error.
   bool parse(const char* begin, const char* end, uint64_t line, uint64_t row, glm::dvec3& position,
@@ -175,6 +272,8 @@ class LineParser {
         // An attribute's empty field is a missing value, NaN (pandas writes NaN so).
         if (empty) *dimension = std::numeric_limits<double>::quiet_NaN();
         else ok = parseNumber(number_begin, number_end, *dimension, line, column, error);
+        if (ok && std::fabs(*dimension) >= ExactColumns::kFirstInexact)  // rare
+          exact_.read(static_cast<size_t>(role - kRoleDimension), row, number_begin, number_end);
       } else if (empty) {  // a position's or a colour's
         error = {line, lineText(line) + "column " + std::to_string(column) + ": empty field"};
         return false;
@@ -245,6 +344,7 @@ class LineParser {
   const Layout& layout_;
   bool allow_nonfinite_;
   std::vector<double*> dimensions_;
+  ExactColumns& exact_;
 };
 
 // The first line's separator: ';' where it has one (a semicolon file's numbers may hold decimal
@@ -690,7 +790,8 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
   }
 
   // Pass 2: parse. The first error by line number wins, whatever the thread count.
-  const LineParser parser(path, layout, options.allow_nonfinite, columns);
+  ExactColumns exact(columns.size(), static_cast<size_t>(lines), lines * row_bytes, options.max_memory);
+  const LineParser parser(path, layout, options.allow_nonfinite, columns, exact);
   const bool has_colors = hasColorColumns(layout);
   std::mutex error_mutex;
   std::optional<LineError> first_error;
@@ -774,6 +875,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     if (options.progress) options.progress->advance(block_end - block_start);
   });
   if (first_error) return Error{first_error->message};
+  exact.apply(points.dimensions, path, options.notices);
 
   // Blank lines left holes; close them (rare, so a single ordered pass is fine).
   size_t holes = 0;

@@ -130,7 +130,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
   switch (format) {
     case FileFormat::kCsv:
       return readCsv(path, CsvReadOptions{options.threads, options.allow_nonfinite, options.progress, options.max_memory,
-                                          options.columns});
+                                          options.columns, options.notices});
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
                                           options.max_memory});
