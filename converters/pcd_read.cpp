@@ -54,6 +54,7 @@ struct Header {
   size_t row_bytes = 0;
   bool has_z = false, two_d = false, z_up = false, colors = false, alpha = false;
   std::string viewpoint;  // the VIEWPOINT line when it is not the identity
+  std::optional<std::array<double, 7>> pose;  // its values
   std::vector<std::pair<std::string, DimType>> dimensions;
 };
 
@@ -209,18 +210,17 @@ class HeaderParser {
     }
     if (key == "VIEWPOINT") {
       if (values.size() != 7) return error("VIEWPOINT takes 7 numbers (tx ty tz qw qx qy qz)");
-      static constexpr double kIdentity[] = {0, 0, 0, 1, 0, 0, 0};
-      bool identity = true;
+      static constexpr std::array<double, 7> kIdentity = {0, 0, 0, 1, 0, 0, 0};
+      std::array<double, 7> pose{};
       for (size_t k = 0; k < 7; ++k) {
-        double v = 0;
-        auto r = fast_float::from_chars(values[k].data(), values[k].data() + values[k].size(), v);
-        if (r.ec != std::errc() || r.ptr != values[k].data() + values[k].size())
-          return error("VIEWPOINT value " + quotedExcerpt(values[k]) + " is not a number");
-        if (v != kIdentity[k]) identity = false;
+        auto r = fast_float::from_chars(values[k].data(), values[k].data() + values[k].size(), pose[k]);
+        if (r.ec != std::errc() || r.ptr != values[k].data() + values[k].size() || !std::isfinite(pose[k]))
+          return error("VIEWPOINT value " + quotedExcerpt(values[k]) + " is not a finite number");
       }
-      if (!identity) {
+      if (pose != kIdentity) {
         header_.viewpoint = "VIEWPOINT";
         for (std::string_view v : values) (header_.viewpoint += ' ') += v;
+        header_.pose = pose;
       }
       return okStatus();
     }
@@ -464,10 +464,11 @@ class Reader {
     if (Status s = dropNanPoints(points); !s) return s.error();
     if (h_.has_z && h_.two_d)  // without a z field, z is 0 already
       for (glm::dvec3& p : points.positions) p.z = 0.0;
+    points.viewpoint = h_.pose;
     if (options_.notices && !h_.viewpoint.empty())
       options_.notices->push_back(path_ + ": " + h_.viewpoint +
                                   " is not applied to the points (as PCL's loaders do not); the points are in the "
-                                  "sensor's frame, and a file dpoint writes does not keep it");
+                                  "sensor's frame, and only a PCD output keeps the viewpoint");
     return points;
   }
 

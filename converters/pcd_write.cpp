@@ -182,7 +182,9 @@ class Writer {
     for (const FieldGroup& g : groups_) h += std::string(" ") + fields_[g.first].type;
     h += "\nCOUNT";
     for (const FieldGroup& g : groups_) h += ' ' + std::to_string(g.count);
-    h += "\nWIDTH " + std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) +
+    h += "\nWIDTH " + std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT";
+    for (const double v : points_.viewpoint.value_or(std::array<double, 7>{0, 0, 0, 1, 0, 0, 0})) h += ' ' + formatNumber(v);
+    h += "\nPOINTS " + std::to_string(n) +
          "\nDATA " + pcdEncodingName(options_.encoding) + "\n";
     return h;
   }

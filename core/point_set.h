@@ -1,6 +1,7 @@
 // The data model (DESIGN §2): only what a scene needs.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -65,6 +66,9 @@ struct PointSet {
   // Facts of the source that the values cannot tell, set by the readers and kept by the filters.
   ZAxis z_axis = ZAxis::kUnknown;
   bool z_up = false;  // the source says z is up (LAS, or a PLY or CSV dpoint wrote from one)
+  // A PCD source's VIEWPOINT (tx ty tz qw qx qy qz), the sensor's pose, where it is not the
+  // identity: not applied to the points (as PCL's loaders do not), written back by the PCD writer.
+  std::optional<std::array<double, 7>> viewpoint;
 
   size_t size() const { return positions.size(); }
   bool hasColors() const { return !colors.empty(); }

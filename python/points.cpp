@@ -220,11 +220,13 @@ py::tuple pointSetState(const PointSet& s) {
   return py::make_tuple(1, bytes(s.positions.data(), s.positions.size() * sizeof(glm::dvec3)),
                         bytes(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
                         bytes(s.triangles.data(), s.triangles.size() * sizeof(uint32_t)), dims,
-                        s.color_full_scale, static_cast<int>(s.z_axis), s.z_up, las);
+                        s.color_full_scale, static_cast<int>(s.z_axis), s.z_up, las,
+                        s.viewpoint ? py::cast(std::vector<double>(s.viewpoint->begin(), s.viewpoint->end())) : py::none());
 }
 
 std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
-  if (t.size() != 9 || t[0].cast<int>() != 1) throw py::value_error("PointSet: not a pickle of this version's PointSet");
+  // 10 items since the viewpoint; a pickle of 9 (made before) loads without one.
+  if ((t.size() != 9 && t.size() != 10) || t[0].cast<int>() != 1) throw py::value_error("PointSet: not a pickle of this version's PointSet");
   auto s = std::make_shared<PointSet>();
   const auto fill = [](const py::handle& from, auto& to) {
     const std::string b = from.cast<std::string>();
@@ -252,6 +254,12 @@ std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
   s->color_full_scale = t[5].cast<uint16_t>();
   s->z_axis = static_cast<ZAxis>(t[6].cast<int>());
   s->z_up = t[7].cast<bool>();
+  if (t.size() == 10 && !t[9].is_none()) {
+    const std::vector<double> pose = t[9].cast<std::vector<double>>();
+    if (pose.size() != 7) throw py::value_error("PointSet: a pickled viewpoint is not 7 numbers");
+    s->viewpoint.emplace();
+    std::copy(pose.begin(), pose.end(), s->viewpoint->begin());
+  }
   if (!t[8].is_none()) {
     const py::tuple l = t[8].cast<py::tuple>();
     LasSource las;

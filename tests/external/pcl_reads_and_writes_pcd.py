@@ -167,4 +167,19 @@ with scratch() as d:
         check(rows == [[1, 2, 3, 10.5, 11.5, 12.5], [4, 5, 6, 20.25, 21.25, 22.25], [7, 8, 9, 30, 31, 32]],
               f"PCL reads dpoint's {encoding} COUNT 3 field as {rows}")
     print("PCL reads a COUNT 3 field dpoint writes, binary and binary_compressed")
+
+    # A VIEWPOINT (the sensor's pose) is carried through PCD → PCD: PCL reads the one dpoint writes.
+    posed = os.path.join(d, "posed.pcd")
+    with open(posed, "w") as f:
+        f.write("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+                "VIEWPOINT 1.5 -2 3.25 0.5 0.5 0.5 0.5\nPOINTS 1\nDATA ascii\n1 2 3\n")
+    for encoding in ("ascii", "binary", "binary_compressed"):
+        pcd = os.path.join(d, f"posed_{encoding}.pcd")
+        dpoint(exe, "convert", posed, "-o", pcd, "--pcd-encoding", encoding, "-q")
+        ascii_pcd = os.path.join(d, f"posed_{encoding}_pcl.pcd")
+        run("pcl_convert_pcd_ascii_binary", pcd, ascii_pcd, "0", "17")
+        with open(ascii_pcd) as f:
+            text = f.read()
+        check("VIEWPOINT 1.5 -2 3.25 0.5 0.5 0.5 0.5\n" in text, f"PCL's rewrite of {pcd}: {text[:400]!r}")
+    print("PCL reads the VIEWPOINT dpoint carries through, in every encoding")
 print("PCD: pcl-tools and dpoint agree both ways")

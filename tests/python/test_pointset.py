@@ -366,10 +366,14 @@ def test_pickle_and_copy_keep_the_whole_set(tmp_path):
     las = dpoint.read(corpus / "autzen.las")
     mesh = dpoint.generate("menger", level=1)
     flat = dpoint.PointSet(np.array([[1.5, 2.5], [3.5, 4.5]]))
-    for name, s in [("las", las), ("mesh", mesh), ("flat", flat)]:
+    (tmp_path / "posed.pcd").write_text("FIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nWIDTH 1\n"
+                                        "VIEWPOINT 1.5 2 3 0.5 0.5 0.5 0.5\nDATA ascii\n0.1 0.2 0.3\n")
+    with pytest.warns(UserWarning, match="VIEWPOINT"):
+        posed = dpoint.read(tmp_path / "posed.pcd")  # its viewpoint is kept for a PCD output
+    for name, s in [("las", las), ("mesh", mesh), ("flat", flat), ("posed", posed)]:
         for made in (pickle.loads(pickle.dumps(s)), copy.copy(s), copy.deepcopy(s)):
             assert made is not s and not np.shares_memory(made.positions, s.positions)
-            for ext in ("las", "ply", "csv"):
+            for ext in ("las", "ply", "csv", "pcd"):
                 dpoint.write(s, tmp_path / f"a.{ext}")
                 dpoint.write(made, tmp_path / f"b.{ext}")
                 assert (tmp_path / f"a.{ext}").read_bytes() == (tmp_path / f"b.{ext}").read_bytes(), (name, ext)
