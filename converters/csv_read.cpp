@@ -174,8 +174,10 @@ class ExactColumns {
   }
 
   // Makes each column read so int64 or uint64 where every value is a 64-bit integer, before the
-  // rows of blank lines are closed up; the others stay double, and `notices` says why.
-  void apply(Dimensions& dimensions, const std::string& path, std::vector<std::string>* notices) {
+  // rows of blank lines are closed up (`blank_rows`, passed over: a review finding, their unset
+  // values were read); the others stay double, and `notices` says why.
+  void apply(Dimensions& dimensions, const std::vector<std::vector<uint64_t>>& blank_rows, const std::string& path,
+             std::vector<std::string>* notices) {
     for (size_t k = 0; k < values_.size(); ++k) {
       if (values_[k].empty() && !refused_[k]) continue;
       Dimension& d = dimensions.all()[k];
@@ -189,7 +191,9 @@ class ExactColumns {
         continue;
       }
       bool whole = !not_integer_[k], negative = false, above_int64 = false;
-      const double* doubles = reinterpret_cast<const double*>(d.bytes.data());
+      double* doubles = reinterpret_cast<double*>(d.bytes.data());
+      for (const auto& rows : blank_rows)
+        for (const uint64_t row : rows) doubles[row] = 0.0;  // a row closed up after this
       std::vector<uint64_t>& exact = values_[k];
       for (size_t i = 0; i < rows_ && whole; ++i) {
         const double v = doubles[i];
@@ -203,7 +207,8 @@ class ExactColumns {
         }
       }
       if (!whole) {
-        note("the column also holds fields that are not 64-bit integers (a fraction, an empty field, a number past 64 bits)");
+        note("the column also holds fields that are no 64-bit integer (a fraction, an exponent such as 1e18, "
+             "an empty field, nan or inf, or a number past 64 bits)");
       } else if (negative && above_int64) {
         note("the column holds values below 0 and above 2^63, which no 64-bit type holds");
       } else {
@@ -875,7 +880,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     if (options.progress) options.progress->advance(block_end - block_start);
   });
   if (first_error) return Error{first_error->message};
-  exact.apply(points.dimensions, path, options.notices);
+  exact.apply(points.dimensions, blank_rows, path, options.notices);
 
   // Blank lines left holes; close them (rare, so a single ordered pass is fine).
   size_t holes = 0;

@@ -12,6 +12,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <unordered_set>
@@ -672,6 +673,8 @@ class RecordEncoder {
       slot.missing = std::strcmp(f.name, dim::kReturnNumber) == 0 || std::strcmp(f.name, dim::kNumberOfReturns) == 0 ? 1 : 0;
       slot.check = slot.source && slot.convert == Convert::kNone && !dimTypeIsFloat(f.type) &&
                    !widens(slot.source->type, f.type);
+      slot.whole64 = slot.source && slot.convert == Convert::kNone && isWhole64(f.type) &&
+                     isWhole64(slot.source->type) && slot.source->type != f.type;
       slots_.push_back(slot);
     }
     for (const LasExtraField& e : l.extra) {
@@ -714,6 +717,11 @@ class RecordEncoder {
       } else if (s.source->type == s.type) {
         const size_t w = dimTypeSize(s.type);
         std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
+      } else if (s.whole64) {  // int64 into uint64 or back, as integers: a double rounds past 2^53
+        uint64_t bits;
+        std::memcpy(&bits, s.source->bytes.data() + i * 8, 8);
+        fits &= bits <= static_cast<uint64_t>(std::numeric_limits<int64_t>::max());  // the sign bit clear both ways
+        std::memcpy(r + s.offset, &bits, 8);
       } else {
         const double value = s.source->value(i);
         if (s.check) fits &= dimensionHolds(s.type, value);
@@ -773,8 +781,11 @@ class RecordEncoder {
     Convert convert;
     uint32_t missing = 0;  // the value where the set lacks the dimension
     bool check = false;    // whether a value of the source may not fit this integer field
+    bool whole64 = false;  // int64 into uint64 or back: copied as integers
     const LasExtraField* field = nullptr;  // kScaled: its scale and offset (lasStoredNumber)
   };
+
+  static bool isWhole64(DimType type) { return type == DimType::kI64 || type == DimType::kU64; }
 
   // Whether every value of type `from` is one of integer type `to` (a widening: no check needed).
   static bool widens(DimType from, DimType to) {

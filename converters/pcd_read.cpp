@@ -214,13 +214,14 @@ class HeaderParser {
       std::array<double, 7> pose{};
       for (size_t k = 0; k < 7; ++k) {
         auto r = fast_float::from_chars(values[k].data(), values[k].data() + values[k].size(), pose[k]);
-        if (r.ec != std::errc() || r.ptr != values[k].data() + values[k].size() || !std::isfinite(pose[k]))
-          return error("VIEWPOINT value " + quotedExcerpt(values[k]) + " is not a finite number");
+        if (r.ec != std::errc() || r.ptr != values[k].data() + values[k].size())
+          return error("VIEWPOINT value " + quotedExcerpt(values[k]) + " is not a number");
       }
       if (pose != kIdentity) {
         header_.viewpoint = "VIEWPOINT";
         for (std::string_view v : values) (header_.viewpoint += ' ') += v;
-        header_.pose = pose;
+        // A pose with nan or inf is no pose: the file is read, the viewpoint dropped (the note).
+        if (std::all_of(pose.begin(), pose.end(), [](double v) { return std::isfinite(v); })) header_.pose = pose;
       }
       return okStatus();
     }
@@ -467,8 +468,9 @@ class Reader {
     points.viewpoint = h_.pose;
     if (options_.notices && !h_.viewpoint.empty())
       options_.notices->push_back(path_ + ": " + h_.viewpoint +
-                                  " is not applied to the points (as PCL's loaders do not); the points are in the "
-                                  "sensor's frame, and only a PCD output keeps the viewpoint");
+                                  " is not applied to the points (as PCL's loaders do not): they are in the sensor's "
+                                  "frame" + (h_.pose ? "; a PCD output gets the viewpoint back, other formats have no place for it"
+                                                     : "; it is not finite, so no output gets it"));
     return points;
   }
 

@@ -106,10 +106,14 @@ def _python_words(text: str, keys=None) -> str:
     """A CLI message with the keyword arguments' names for its flags: "width -5: ..." for width=-5,
     where it said "--width -5: ..." (a review finding). keys: the flags to name, else every one but
     --help (where every option of the command is a keyword)."""
+    # A flag starts the message or follows a space, a quote or a bracket: "--" inside a file's
+    # name is left as it is (a review finding: /tmp/no--such.csv was named /tmp/nosuch.csv).
+    before = r"(?<![^\s'\"(`])"
     if keys is None:
-        return _re.sub(r"--(?!help\b)([a-z][a-z0-9]*(?:-[a-z0-9]+)*)", lambda m: m.group(1).replace("-", "_"), text)
+        return _re.sub(before + r"--(?!help\b)([a-z][a-z0-9]*(?:-[a-z0-9]+)*)(?![\w-])",
+                       lambda m: m.group(1).replace("-", "_"), text)
     for key in keys:
-        text = _re.sub("--" + _re.escape(key.replace("_", "-")) + r"(?![\w-])", key, text)
+        text = _re.sub(before + "--" + _re.escape(key.replace("_", "-")) + r"(?![\w-])", key, text)
     return text
 
 

@@ -69,6 +69,12 @@ def test_bad_calls_speak_the_clis_words(call, code, words):
     assert "--" not in str(raised.value).replace("--help", "")
 
 
+def test_a_file_name_with_two_dashes_is_named_as_it_is(tmp_path):
+    # "--" inside a file's name is not a flag (a review finding: no--such.csv was named nosuch.csv).
+    with pytest.raises(dpoint.Error, match="no--such--file.csv: file not found"):
+        dpoint.read(tmp_path / "no--such--file.csv")
+
+
 def test_columns_as_bytes_are_refused_not_read_as_numbers():
     # b"x,y,z" was a list of numbers: "--columns 44: named twice" (a review finding).
     with pytest.raises(TypeError, match="columns: a str such as 'x,y,z,-,intensity' or a list of str, not b'x,y,z'"):
