@@ -5,9 +5,12 @@
 // (linear 0..1) and triangles (M, 3) uint32, each keeping the PointSet alive. Made from NumPy
 // arrays it copies them once into its own memory (the library's vectors cannot adopt NumPy's), so
 // a set made from an (N, 3) array holds the array and the copy until the caller drops the array.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include "converters/gltf_read.h"
@@ -545,6 +548,22 @@ that memory, without copying (writing into them changes the set).)")
           "z_up", [](const py::object& self) { return setOf(self).z_up; },
           [](const py::object& self, bool z_up) { setOf(self).z_up = z_up; },
           "The source says z is up (LAS): render's fitted views use it")
+      .def_property(
+          "viewpoint",
+          [](const py::object& self) -> py::object {
+            const std::optional<std::array<double, 7>>& v = setOf(self).viewpoint;
+            if (!v) return py::none();
+            return py::make_tuple((*v)[0], (*v)[1], (*v)[2], (*v)[3], (*v)[4], (*v)[5], (*v)[6]);
+          },
+          [](const py::object& self, const std::optional<std::vector<double>>& pose) {
+            PointSet& s = setOf(self);
+            if (pose && (pose->size() != 7 || !std::all_of(pose->begin(), pose->end(), [](double v) { return std::isfinite(v); })))
+              throw py::value_error("viewpoint: 7 finite numbers (tx, ty, tz, qw, qx, qy, qz), or None");
+            if (!pose) s.viewpoint.reset();
+            else std::copy(pose->begin(), pose->end(), s.viewpoint.emplace().begin());
+          },
+          "A PCD source's VIEWPOINT (tx, ty, tz, qw, qx, qy, qz), the sensor's pose, or None: not applied to\n"
+          "the positions, written back to a PCD output (set None after moving the points into the world)")
       .def("copy", [](const py::object& self) { return std::make_shared<PointSet>(setOf(self)); }, "A deep copy")
       .def("__copy__", [](const py::object& self) { return std::make_shared<PointSet>(setOf(self)); })
       .def("__deepcopy__",

@@ -241,6 +241,22 @@ def _to_dataframe(self):
     return pd.DataFrame(data, copy=True)
 
 
+def _restore_point_set(state) -> PointSet:
+    """A PointSet from PointSet.__getstate__'s state (pickle's way back)."""
+    points = PointSet.__new__(PointSet)
+    points.__setstate__(state)
+    return points
+
+
+def _not_pickled(self):
+    raise TypeError(f"cannot pickle a dpoint.{type(self).__name__}")
+
+
+# Pickled by __reduce__ in every protocol: protocols 0 and 1 went through copyreg, which made a
+# bare pybind11 object and aborted the interpreter (a review finding).
+PointSet.__reduce__ = lambda self: (_restore_point_set, (self.__getstate__(),))
+RenderResult.__reduce__ = _not_pickled
+_dpoint._Renderer.__reduce__ = _not_pickled
 PointSet.from_dataframe = staticmethod(_from_dataframe)
 PointSet.to_dataframe = _to_dataframe
 RenderResult.report = property(

@@ -370,6 +370,13 @@ def test_pickle_and_copy_keep_the_whole_set(tmp_path):
                                         "VIEWPOINT 1.5 2 3 0.5 0.5 0.5 0.5\nDATA ascii\n0.1 0.2 0.3\n")
     with pytest.warns(UserWarning, match="VIEWPOINT"):
         posed = dpoint.read(tmp_path / "posed.pcd")  # its viewpoint is kept for a PCD output
+    assert posed.viewpoint == (1.5, 2, 3, 0.5, 0.5, 0.5, 0.5)
+    moved = posed.copy()
+    moved.viewpoint = None  # after moving the points into the world
+    dpoint.write(moved, tmp_path / "moved.pcd")
+    assert b"VIEWPOINT 0 0 0 1 0 0 0\n" in (tmp_path / "moved.pcd").read_bytes()
+    with pytest.raises(ValueError, match="viewpoint: 7 finite numbers"):
+        moved.viewpoint = (1, 2, 3)
     for name, s in [("las", las), ("mesh", mesh), ("flat", flat), ("posed", posed)]:
         for made in (pickle.loads(pickle.dumps(s)), copy.copy(s), copy.deepcopy(s)):
             assert made is not s and not np.shares_memory(made.positions, s.positions)
@@ -377,6 +384,11 @@ def test_pickle_and_copy_keep_the_whole_set(tmp_path):
                 dpoint.write(s, tmp_path / f"a.{ext}")
                 dpoint.write(made, tmp_path / f"b.{ext}")
                 assert (tmp_path / f"a.{ext}").read_bytes() == (tmp_path / f"b.{ext}").read_bytes(), (name, ext)
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):  # 0 and 1 aborted the interpreter
+        again = pickle.loads(pickle.dumps(las, protocol=protocol))
+        assert np.array_equal(again.positions, las.positions) and again.attributes.keys() == las.attributes.keys()
+    with pytest.raises(TypeError, match="cannot pickle a dpoint.RenderResult"):
+        pickle.dumps(dpoint.render(flat, width=8, height=8), protocol=0)
     with pytest.raises(ValueError, match="not a pickle of this version"):
         dpoint.PointSet.__new__(dpoint.PointSet).__setstate__((2,))
 
