@@ -123,22 +123,28 @@ class Writer {
     std::vector<const Dimension*> dims;
     for (const Dimension& d : points_.dimensions.all())
       if (&d != alpha_) names.push_back(fieldName(d.name)), dims.push_back(&d);
+    // normal_x is nx's where the set has both (a reader takes normal_x as nx), so the dimension
+    // named normal_x is the one renamed.
+    const auto yields_to_nx = [&](const std::string& own) {
+      return (own == "normal_x" || own == "normal_y" || own == "normal_z") &&
+             points_.dimensions.find(std::string(1, 'n') + own.back());
+    };
     names = writableNames(
         names, isSpaceOrControl,
         [&](const std::string& name, size_t k) {
-          // "_" is PCD's padding: every reader passes over such a field. normal_x is nx's where the set
-          // has both (a reader takes normal_x as nx), so the dimension named normal_x is the one renamed.
+          // "_" is PCD's padding: every reader passes over such a field.
           if (name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba" || name == "_") return true;
-          const std::string& own = dims[k]->name;
-          return name == own && (own == "normal_x" || own == "normal_y" || own == "normal_z") &&
-                 points_.dimensions.find(std::string(1, 'n') + own.back());
+          return name == dims[k]->name && yields_to_nx(dims[k]->name);
         },
         nullptr);
     // Each change named by the dimension's own name (writableNames would name PCL's: nx as normal_x).
     std::vector<std::string> renamed;
     for (size_t k = 0; k < dims.size(); ++k)
       if (names[k] != fieldName(dims[k]->name))
-        renamed.push_back("dimension " + quotedExcerpt(dims[k]->name) + " written as " + quotedExcerpt(names[k]));
+        renamed.push_back("dimension " + quotedExcerpt(dims[k]->name) + " written as " + quotedExcerpt(names[k]) +
+                          (yields_to_nx(dims[k]->name)
+                               ? " (n" + dims[k]->name.substr(7) + " is written as " + dims[k]->name + ", PCL's name for it)"
+                               : std::string(" (a PCD field's name is one word, not x, y, z, rgb, rgba or _)")));
     for (size_t k = 0; k < dims.size(); ++k)
       fields_.push_back({names[k], pcdTypeOf(dims[k]->type), static_cast<int>(dimTypeSize(dims[k]->type)),
                          Source::kDimension, dims[k]});
@@ -146,7 +152,7 @@ class Writer {
       options_.notices->push_back(path_ + ": 16-bit colours written as 8-bit (PCD's rgb holds 0..255 a channel)");
     if (options_.notices)
       for (const std::string& line : renamed)
-        options_.notices->push_back(path_ + ": " + line + " (a PCD field's name is one word, not x, y, z, rgb, rgba or _)");
+        options_.notices->push_back(path_ + ": " + line);
     groupCounts();
     return okStatus();
   }

@@ -457,7 +457,9 @@ TEST(Pcd, aDimensionNamedAsPaddingIsRenamedAndKept) {
     notices.clear();
     ASSERT_TRUE(writePcd(dir.file("both.pcd"), both, PcdWriteOptions{PcdEncoding::kAscii, nullptr, &notices}).ok());
     ASSERT_EQ(notices.size(), 1u);
-    EXPECT_TRUE(contains(notices[0], "dimension 'normal_x' written as 'normal_x_2'")) << notices[0];
+    EXPECT_TRUE(contains(notices[0], "dimension 'normal_x' written as 'normal_x_2' (nx is written as normal_x, PCL's "
+                                     "name for it)"))
+        << notices[0];
     Result<PointSet> read = readPcd(dir.file("both.pcd"));
     ASSERT_TRUE(read.ok()) << read.error().message;
     ASSERT_NE(read->dimensions.find("nx"), nullptr);
