@@ -149,6 +149,14 @@ with scratch() as d:
     check(v["x"].tolist() == [1.5, 3.0] and v["y"].tolist() == [-2.25, 4.0] and v["z"].tolist() == [0.125, 5.0],
           f"float PCD: PCL reads {v}")
 
+    def pcl_ascii_rewrite(source, encoding):
+        """The text of PCL's ASCII rewrite of the PCD dpoint writes from `source` in `encoding`."""
+        stem = os.path.join(d, f"{os.path.splitext(os.path.basename(source))[0]}_{encoding}")
+        dpoint(exe, "convert", source, "-o", stem + ".pcd", "--pcd-encoding", encoding, "-q")
+        run("pcl_convert_pcd_ascii_binary", stem + ".pcd", stem + "_pcl.pcd", "0", "17")
+        with open(stem + "_pcl.pcd") as f:
+            return f.read()
+
     # A field of COUNT n (an FPFH's 33 values) is read as NAME_0 … NAME_n-1 and written back as the
     # one field NAME of COUNT n, each point's values together in binary_compressed: PCL rewrites
     # dpoint's file as ASCII with the same field and values.
@@ -156,13 +164,8 @@ with scratch() as d:
     with open(counted, "w") as f:
         f.write("x,y,z,h_0,h_1,h_2\n1,2,3,10.5,11.5,12.5\n4,5,6,20.25,21.25,22.25\n7,8,9,30,31,32\n")
     for encoding in ("binary", "binary_compressed"):
-        pcd = os.path.join(d, f"counted_{encoding}.pcd")
-        dpoint(exe, "convert", counted, "-o", pcd, "--pcd-encoding", encoding, "-q")
-        ascii_pcd = os.path.join(d, f"counted_{encoding}_pcl.pcd")
-        run("pcl_convert_pcd_ascii_binary", pcd, ascii_pcd, "0", "17")
-        with open(ascii_pcd) as f:
-            text = f.read()
-        check("FIELDS x y z h\n" in text and "COUNT 1 1 1 3\n" in text, f"PCL's rewrite of {pcd}: {text[:400]!r}")
+        text = pcl_ascii_rewrite(counted, encoding)
+        check("FIELDS x y z h\n" in text and "COUNT 1 1 1 3\n" in text, f"PCL's rewrite of {encoding}: {text[:400]!r}")
         rows = [[float(v) for v in line.split()] for line in text.split("DATA ascii\n", 1)[1].splitlines() if line.strip()]
         check(rows == [[1, 2, 3, 10.5, 11.5, 12.5], [4, 5, 6, 20.25, 21.25, 22.25], [7, 8, 9, 30, 31, 32]],
               f"PCL reads dpoint's {encoding} COUNT 3 field as {rows}")
@@ -174,12 +177,7 @@ with scratch() as d:
         f.write("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
                 "VIEWPOINT 1.5 -2 3.25 0.5 0.5 0.5 0.5\nPOINTS 1\nDATA ascii\n1 2 3\n")
     for encoding in ("ascii", "binary", "binary_compressed"):
-        pcd = os.path.join(d, f"posed_{encoding}.pcd")
-        dpoint(exe, "convert", posed, "-o", pcd, "--pcd-encoding", encoding, "-q")
-        ascii_pcd = os.path.join(d, f"posed_{encoding}_pcl.pcd")
-        run("pcl_convert_pcd_ascii_binary", pcd, ascii_pcd, "0", "17")
-        with open(ascii_pcd) as f:
-            text = f.read()
-        check("VIEWPOINT 1.5 -2 3.25 0.5 0.5 0.5 0.5\n" in text, f"PCL's rewrite of {pcd}: {text[:400]!r}")
+        text = pcl_ascii_rewrite(posed, encoding)
+        check("VIEWPOINT 1.5 -2 3.25 0.5 0.5 0.5 0.5\n" in text, f"PCL's rewrite of {encoding}: {text[:400]!r}")
     print("PCL reads the VIEWPOINT dpoint carries through, in every encoding")
 print("PCD: pcl-tools and dpoint agree both ways")
