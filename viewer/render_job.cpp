@@ -909,7 +909,8 @@ Status checkRenderRequest(const RenderRequest& request) {
       return Error{"--views 4 frames each view with --fit in perspective; drop --eye/--target/--up and --ortho",
                    ExitCode::kUsage};
     if (request.error || request.report)
-      return Error{"--views 4 makes a contact sheet; --error and --json measure one view (use --views 1)",
+      return Error{std::string("--views 4 makes a contact sheet; ") + (request.error ? "--error" : "--json") +
+                       " measures one view (use --views 1)",
                    ExitCode::kUsage};
     const uint32_t least = 2 + kContactSheetGap;  // two 1-px views and the line between them
     if (request.camera.width < least || request.camera.height < least)

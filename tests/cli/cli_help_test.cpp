@@ -243,6 +243,8 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"render", in, "-o", png, "--fov", "200"}, "--fov 200: must be in (0, 180)"},
       {{"render", in, "-o", png, "--tolerance", "-1"}, "--tolerance -1: must be a number of pixels above 0"},
       {{"render", in, "-o", png, "--frames", "0"}, "--frames 0: must be at least 1"},
+      {{"render", in, "-o", png, "--views", "4", "--json", dir.file("r.json")}, "--views 4 makes a contact sheet; --json measures one view"},
+      {{"render", in, "-o", png, "--views", "4", "--error"}, "--views 4 makes a contact sheet; --error measures one view"},
       {{"render", in, "-o", png, "--stream", "sometimes"}, "--stream sometimes: must be auto, on or off"},
       {{"info", in, "--view-width", "-3"}, "--view-width -3: must be a finite number above 0"},
       {{"info", in, "--view-width", "0"}, "--view-width 0: must be a finite number above 0"},  // 0 was "not given"

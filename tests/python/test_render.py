@@ -114,7 +114,7 @@ def test_a_contact_sheet(tmp_path):
     assert r.image.shape == (96, 128, 4)
     assert r.report is None
     assert r.png() == cli_png
-    with pytest.raises(dpoint.Error, match="^views 4 makes a contact sheet; error and json measure one view"):
+    with pytest.raises(dpoint.Error, match="^views 4 makes a contact sheet; error measures one view"):
         dpoint.render(bulb, views=4, error=True)
 
 
