@@ -635,7 +635,8 @@ progress: lines on stderr.)");
   m.def(
       "write",
       [](const py::object& points_object, const std::string& path, int decimals, bool ply_ascii,
-         const std::string& ply_colors, const std::string& pcd_encoding, std::optional<double> las_scale,
+         const std::optional<std::string>& ply_colors, const std::optional<std::string>& pcd_encoding,
+         std::optional<double> las_scale,
          const std::optional<std::string>& crs, const std::string& order, bool no_colors,
          const std::string& color_format, bool unique, unsigned threads, const py::object& max_memory, bool progress) {
         const PointSet& points = setOf(points_object);
@@ -645,18 +646,19 @@ progress: lines on stderr.)");
                       ExitCode::kUsage});
         if (las_scale && !(std::isfinite(*las_scale) && *las_scale > 0.0))
           raise(Error{"las_scale " + formatNumber(*las_scale) + ": must be a finite number above 0", ExitCode::kUsage});
-        const std::optional<PlyColorType> ply_color_type = parsePlyColorType(ply_colors);
+        // None: not given (as the CLI's options, given is refused for another format, even as the default).
+        const std::optional<PlyColorType> ply_color_type = parsePlyColorType(ply_colors.value_or("auto"));
         if (!ply_color_type)
-          raise(Error{"ply_colors: '" + ply_colors + "' is not auto, uchar, ushort or float", ExitCode::kUsage});
+          raise(Error{"ply_colors: '" + *ply_colors + "' is not auto, uchar, ushort or float", ExitCode::kUsage});
         if (color_format != "linear" && color_format != "srgb8")
           raise(Error{"color_format: '" + color_format + "' is not linear or srgb8", ExitCode::kUsage});
         const PointOrder point_order = take(parsePointOrder("order", order));
-        const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding));
+        const PcdEncoding pcd = take(parsePcdEncoding(pcd_encoding.value_or("binary")));
         const uint64_t limit = take(memoryOption("max_memory", max_memory));
         check(formatOf(path).ok() ? okStatus() : Status(formatOf(path).error()));
         // As convert's, named as its flags (the module's write names them as keywords).
-        check(checkFormatOptionsUsed(path, {decimals >= 0, ply_ascii, *ply_color_type != PlyColorType::kAuto,
-                                            pcd != PcdEncoding::kBinary, las_scale.has_value(), crs.has_value()}));
+        check(checkFormatOptionsUsed(path, {decimals >= 0, ply_ascii, ply_colors.has_value(), pcd_encoding.has_value(),
+                                            las_scale.has_value(), crs.has_value()}));
         std::string crs_wkt;  // as convert's --crs
         if (crs) {
           Result<std::string> wkt = crsAsWkt(*crs, "crs");
@@ -684,14 +686,14 @@ progress: lines on stderr.)");
         warnAtCaller(notices);
       },
       py::arg("points"), py::arg("path"), py::kw_only(), py::arg("decimals") = -1, py::arg("ply_ascii") = false,
-      py::arg("ply_colors") = "auto", py::arg("pcd_encoding") = "binary", py::arg("las_scale") = std::nullopt, py::arg("crs") = std::nullopt,
+      py::arg("ply_colors") = std::nullopt, py::arg("pcd_encoding") = std::nullopt, py::arg("las_scale") = std::nullopt, py::arg("crs") = std::nullopt,
       py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
       R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .pcd, .glb, .las or .laz (by extension), whole or not at all, as `dpoint convert` does.
 
-decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (auto: ushort for 16-bit colours, else uchar; uchar; ushort; float),
-pcd_encoding (ascii, binary or binary_compressed),
+decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (None or auto: ushort for 16-bit colours, else uchar; uchar; ushort; float),
+pcd_encoding (None: binary; ascii, binary or binary_compressed),
 las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does),
 crs (LAS/LAZ/COPC: "EPSG:32633", WKT or a .prj file's path, as convert's --crs; None: the source's), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");

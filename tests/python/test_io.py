@@ -156,6 +156,9 @@ def test_write_options_do_what_they_say(tmp_path, source):
     (dict(ply_ascii=True), "ply_ascii: only a PLY output (.ply) has it"),
     (dict(ply_colors="uchar"), "ply_colors: only a PLY output (.ply) has it"),
     (dict(pcd_encoding="ascii"), "pcd_encoding: only a PCD output (.pcd) has an encoding"),
+    # Given as the default is given, as the CLI's --pcd-encoding binary is (a review finding).
+    (dict(pcd_encoding="binary"), "pcd_encoding: only a PCD output (.pcd) has an encoding"),
+    (dict(ply_colors="auto"), "ply_colors: only a PLY output (.ply) has it"),
 ])
 def test_write_refuses_bad_options_and_writes_nothing(tmp_path, cloud, options, words):
     s, _, _ = cloud
