@@ -102,33 +102,24 @@ def _check_whole(name: str, key: str, value) -> None:
         raise _usage_error(f"{name}: {key} {value}: must be a whole number from 0 to {most}")
 
 
-def _python_words(text: str, keys=None) -> str:
-    """A CLI message with the keyword arguments' names for its flags: "width -5: ..." for width=-5,
-    where it said "--width -5: ..." (a review finding). keys: the flags to name, else every one but
-    --help (where every option of the command is a keyword)."""
-    # A flag starts the message or follows a space, a quote or a bracket: "--" inside a file's
-    # name is left as it is (a review finding: /tmp/no--such.csv was named /tmp/nosuch.csv).
-    before = r"(?<![^\s'\"(`])"
-    if keys is None:
-        return _re.sub(before + r"--(?!help\b)([a-z][a-z0-9]*(?:-[a-z0-9]+)*)(?![\w-])",
-                       lambda m: m.group(1).replace("-", "_"), text)
-    for key in keys:
-        text = _re.sub(before + "--" + _re.escape(key.replace("_", "-")) + r"(?![\w-])", key, text)
-    return text
+def _python_words(text: str) -> str:
+    """A CLI message with the keyword arguments' names for its flags (every one but --help; every
+    option of a command is a keyword): "width -5: ..." for width=-5, where it said "--width -5:
+    ..." (a review finding). A flag starts the message or follows a space, a quote or a bracket:
+    "--" inside a file's name is left as it is (/tmp/no--such.csv was named /tmp/nosuch.csv)."""
+    return _re.sub(r"(?<![^\s'\"(`])--(?!help\b)([a-z][a-z0-9]*(?:-[a-z0-9]+)*)(?![\w-])",
+                   lambda m: m.group(1).replace("-", "_"), text)
 
 
 class _PythonWords:
     """Errors raised inside speak of keyword arguments (_python_words)."""
-
-    def __init__(self, keys=None):
-        self.keys = keys
 
     def __enter__(self):
         return self
 
     def __exit__(self, kind, error, trace):
         if isinstance(error, (Error, MemoryError, DeviceError)) and error.args and isinstance(error.args[0], str):
-            error.args = (_python_words(error.args[0], self.keys),) + error.args[1:]
+            error.args = (_python_words(error.args[0]),) + error.args[1:]
         return False
 
 
@@ -374,10 +365,9 @@ def write(points, path, **options) -> None:
     if points is None:
         raise TypeError("write: points must be a PointSet or an array, not a file name")
     try:
-        with _PythonWords(options):
-            _dpoint.write(points, _fspath(path), **options)
-    except Error as e:  # the CLI's advice in the module's words
-        e.args = (_re.sub(r"--drop (\w+)", r"points.remove_attribute('\1') (on a copy)", str(e)),)
+        _dpoint.write(points, _fspath(path), **options)
+    except (Error, MemoryError) as e:  # the CLI's advice and flags in the module's words
+        e.args = (_python_words(_re.sub(r"--drop (\w+)", r"points.remove_attribute('\1') (on a copy)", str(e))),)
         raise
 
 
