@@ -228,12 +228,12 @@ class ExactColumns {
   std::atomic<uint64_t> made_{0};
 };
 
-// A field's number as the reader takes it: after a leading '+' (CSV writers emit it; fast_float, as
-// std::from_chars, refuses it), and with a decimal comma where fields are separated by semicolons
-// ("1,5": the only comma a field can hold). The data rows and --columns' header test both read so.
+// A field's number as the reader takes it: after a leading '+' (afterPlusSign), and with a decimal
+// comma where fields are separated by semicolons ("1,5": the only comma a field can hold). The data
+// rows and --columns' header test both read so.
 template <typename T>
 fast_float::from_chars_result parseField(const char* begin, const char* end, T& value, char separator) {
-  if (end - begin >= 2 && *begin == '+' && begin[1] != '-' && begin[1] != '+') ++begin;
+  begin = afterPlusSign(begin, end);
   const bool comma = separator == ';' && std::memchr(begin, ',', static_cast<size_t>(end - begin));
   return comma ? fast_float::from_chars_advanced(begin, end, value,
                                                  fast_float::parse_options{fast_float::chars_format::general, ','})

@@ -751,8 +751,7 @@ class Reader {
       }
       return okStatus();
     }
-    // A leading '+' as the CSV reader takes it (fast_float and from_chars refuse it).
-    if (e - b >= 2 && *b == '+' && b[1] != '+' && b[1] != '-') ++b;
+    b = afterPlusSign(b, e);
     if (f.type == 'F') {
       // A number past the field's range is no infinity ("1e39" in an F 4 field was reported as
       // "y is inf"); below it, zero, as PCL's strtod reads it.

@@ -93,13 +93,8 @@ inline double loadValue(Type t, const char* p) {
 // Parses one ASCII token as a value of type `t`. float32 is parsed straight to float so that the
 // value equals what a binary file would hold (no double rounding through double).
 bool parseAscii(Type t, std::string_view token, double& out) {
-  const char* first = token.data();
-  const char* last = first + token.size();
-  // printf("%+g") writers emit a '+', which from_chars does not take.
-  if (first != last && *first == '+') {
-    ++first;
-    if (first != last && *first == '-') return false;
-  }
+  const char* last = token.data() + token.size();
+  const char* first = afterPlusSign(token.data(), last);
   if (t == Type::kFloat32) {
     float f = 0;
     auto r = fast_float::from_chars(first, last, f);

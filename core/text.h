@@ -121,6 +121,13 @@ std::string lowerExtension(const std::string& path);
 // `text` with its ASCII letters in lower case (other bytes as they are).
 std::string lowerAscii(std::string text);
 
+// Where a number's text starts after a leading '+', which writers emit (printf's %+g) and
+// fast_float, as std::from_chars, refuses: "+1.5" from "1.5"; "+-1" and "++1" keep theirs and so do
+// not parse. The text readers (CSV, PCD, PLY) all take a '+' so.
+inline const char* afterPlusSign(const char* begin, const char* end) {
+  return end - begin >= 2 && *begin == '+' && begin[1] != '-' && begin[1] != '+' ? begin + 1 : begin;
+}
+
 // Shortest round-trip text; JSON has no infinity, so non-finite values become null there.
 std::string formatNumber(double v, bool json = false);
 // A JSON string literal: quotes, with '"', '\\' and control characters escaped.
