@@ -91,13 +91,14 @@ void checkNotInUse(const PointSet& set, const std::string& what);
 template <typename T>
 std::shared_ptr<T> heldObject(const py::handle& object, const char* made_by) {
   if (object.is_none()) return nullptr;
-  const std::string name = py::str(py::type::of<T>().attr("__name__"));
+  // The class's name for a message only: this runs at every property's read.
+  const auto name = [] { return std::string(py::str(py::type::of<T>().attr("__name__"))); };
   if (!py::isinstance<T>(object))
-    throw py::type_error("expected a dpoint." + name + ", not " + Py_TYPE(object.ptr())->tp_name);
+    throw py::type_error("expected a dpoint." + name() + ", not " + Py_TYPE(object.ptr())->tp_name);
   try {
     return py::cast<std::shared_ptr<T>>(object);
   } catch (const py::cast_error&) {
-    throw py::type_error("this " + name + " holds nothing: it was made by " + name + ".__new__ without __init__ (" +
+    throw py::type_error("this " + name() + " holds nothing: it was made by " + name() + ".__new__ without __init__ (" +
                          made_by + ")");
   }
 }

@@ -205,6 +205,21 @@ DimType dimTypeOf(const py::array& array, const std::string& name) {
                        " is not an integer, float or bool type");
 }
 
+// PointSet.viewpoint as Python has it (the property, the pickle): None, or a tuple of 7 numbers.
+py::object viewpointObject(const std::optional<std::array<double, 7>>& pose) {
+  return pose ? py::object(py::tuple(py::cast(*pose))) : py::object(py::none());
+}
+
+// And back: None, or 7 finite numbers (ValueError else; `what` names it in the message).
+std::optional<std::array<double, 7>> viewpointOf(const std::optional<std::vector<double>>& pose, const std::string& what) {
+  if (!pose) return std::nullopt;
+  if (pose->size() != 7 || !std::all_of(pose->begin(), pose->end(), [](double v) { return std::isfinite(v); }))
+    throw py::value_error(what + ": 7 finite numbers (tx, ty, tz, qw, qx, qy, qz), or None");
+  std::array<double, 7> out{};
+  std::copy(pose->begin(), pose->end(), out.begin());
+  return out;
+}
+
 // A pickle's state of a set: a version, then every array as bytes and every fact (pointSetFromState).
 py::tuple pointSetState(const PointSet& s) {
   const auto bytes = [](const void* data, size_t size) { return py::bytes(static_cast<const char*>(data), size); };
@@ -224,7 +239,7 @@ py::tuple pointSetState(const PointSet& s) {
                         bytes(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
                         bytes(s.triangles.data(), s.triangles.size() * sizeof(uint32_t)), dims,
                         s.color_full_scale, static_cast<int>(s.z_axis), s.z_up, las,
-                        s.viewpoint ? py::cast(std::vector<double>(s.viewpoint->begin(), s.viewpoint->end())) : py::none());
+                        viewpointObject(s.viewpoint));
 }
 
 std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
@@ -257,12 +272,7 @@ std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
   s->color_full_scale = t[5].cast<uint16_t>();
   s->z_axis = static_cast<ZAxis>(t[6].cast<int>());
   s->z_up = t[7].cast<bool>();
-  if (t.size() == 10 && !t[9].is_none()) {
-    const std::vector<double> pose = t[9].cast<std::vector<double>>();
-    if (pose.size() != 7) throw py::value_error("PointSet: a pickled viewpoint is not 7 numbers");
-    s->viewpoint.emplace();
-    std::copy(pose.begin(), pose.end(), s->viewpoint->begin());
-  }
+  if (t.size() == 10) s->viewpoint = viewpointOf(t[9].cast<std::optional<std::vector<double>>>(), "PointSet: a pickled viewpoint");
   if (!t[8].is_none()) {
     const py::tuple l = t[8].cast<py::tuple>();
     LasSource las;
@@ -488,8 +498,9 @@ that memory, without copying (writing into them changes the set).)")
             return view3(self, reinterpret_cast<const float*>(s.colors.data()), s.size());
           },
           [](const py::object& self, const py::object& colors) {
-            checkNotInUse(setOf(self), "colors");
-            setColors(setOf(self), colors, self);
+            PointSet& s = setOf(self);
+            checkNotInUse(s, "colors");
+            setColors(s, colors, self);
           },
           "(N, 3) float32 view of the linear 0..1 colours (no copy), or None. Set from uint8 or floats, or None")
       .def_property(
@@ -500,8 +511,9 @@ that memory, without copying (writing into them changes the set).)")
             return view3(self, s.triangles.data(), s.triangles.size() / 3);
           },
           [](const py::object& self, const py::object& triangles) {
-            checkNotInUse(setOf(self), "triangles");
-            setTriangles(setOf(self), triangles, self);
+            PointSet& s = setOf(self);
+            checkNotInUse(s, "triangles");
+            setTriangles(s, triangles, self);
           },
           "(M, 3) uint32 view of the triangles' vertex indices (no copy), or None")
       .def_property_readonly(
@@ -524,8 +536,9 @@ that memory, without copying (writing into them changes the set).)")
       .def(
           "set_attribute",
           [](const py::object& self, const std::string& name, const py::object& values) {
-            checkNotInUse(setOf(self), "set_attribute");
-            setAttribute(self, setOf(self), name, values);
+            PointSet& s = setOf(self);
+            checkNotInUse(s, "set_attribute");
+            setAttribute(self, s, name, values);
           },
           py::arg("name"), py::arg("values"),
           "Adds or replaces attribute `name` from a 1-D array of one value per point, kept in its dtype\n"
@@ -550,17 +563,9 @@ that memory, without copying (writing into them changes the set).)")
           "The source says z is up (LAS): render's fitted views use it")
       .def_property(
           "viewpoint",
-          [](const py::object& self) -> py::object {
-            const std::optional<std::array<double, 7>>& v = setOf(self).viewpoint;
-            if (!v) return py::none();
-            return py::make_tuple((*v)[0], (*v)[1], (*v)[2], (*v)[3], (*v)[4], (*v)[5], (*v)[6]);
-          },
+          [](const py::object& self) { return viewpointObject(setOf(self).viewpoint); },
           [](const py::object& self, const std::optional<std::vector<double>>& pose) {
-            PointSet& s = setOf(self);
-            if (pose && (pose->size() != 7 || !std::all_of(pose->begin(), pose->end(), [](double v) { return std::isfinite(v); })))
-              throw py::value_error("viewpoint: 7 finite numbers (tx, ty, tz, qw, qx, qy, qz), or None");
-            if (!pose) s.viewpoint.reset();
-            else std::copy(pose->begin(), pose->end(), s.viewpoint.emplace().begin());
+            setOf(self).viewpoint = viewpointOf(pose, "viewpoint");
           },
           "A PCD source's VIEWPOINT (tx, ty, tz, qw, qx, qy, qz), the sensor's pose, or None: not applied to\n"
           "the positions, written back to a PCD output (set None after moving the points into the world)")
