@@ -125,16 +125,19 @@ class Writer {
       if (&d != alpha_) names.push_back(fieldName(d.name)), dims.push_back(&d);
     // normal_x is nx's where the set has both (a reader takes normal_x as nx), so the dimension
     // named normal_x is the one renamed.
-    const auto yields_to_nx = [&](const std::string& own) {
-      return (own == "normal_x" || own == "normal_y" || own == "normal_z") &&
-             points_.dimensions.find(std::string(1, 'n') + own.back());
+    // The dimension (nx, ny, nz) that takes the PCL name `own` from a dimension so named, or "".
+    const auto normal_taking = [&](const std::string& own) {
+      if (own != "normal_x" && own != "normal_y" && own != "normal_z") return std::string();
+      std::string normal(1, 'n');  // appended: GCC 12's -Wrestrict misfires on "n" + std::string
+      normal += own.back();
+      return points_.dimensions.find(normal) ? normal : std::string();
     };
     names = writableNames(
         names, isSpaceOrControl,
         [&](const std::string& name, size_t k) {
           // "_" is PCD's padding: every reader passes over such a field.
           if (name == "x" || name == "y" || name == "z" || name == "rgb" || name == "rgba" || name == "_") return true;
-          return name == dims[k]->name && yields_to_nx(dims[k]->name);
+          return name == dims[k]->name && !normal_taking(dims[k]->name).empty();
         },
         nullptr);
     // Each change named by the dimension's own name (writableNames would name PCL's: nx as normal_x).
@@ -142,8 +145,8 @@ class Writer {
     for (size_t k = 0; k < dims.size(); ++k)
       if (names[k] != fieldName(dims[k]->name))
         renamed.push_back("dimension " + quotedExcerpt(dims[k]->name) + " written as " + quotedExcerpt(names[k]) +
-                          (yields_to_nx(dims[k]->name)
-                               ? " (n" + dims[k]->name.substr(7) + " is written as " + dims[k]->name + ", PCL's name for it)"
+                          (!normal_taking(dims[k]->name).empty()
+                               ? " (" + normal_taking(dims[k]->name) + " is written as " + dims[k]->name + ", PCL's name for it)"
                                : std::string(" (a PCD field's name is one word, not x, y, z, rgb, rgba or _)")));
     for (size_t k = 0; k < dims.size(); ++k)
       fields_.push_back({names[k], pcdTypeOf(dims[k]->type), static_cast<int>(dimTypeSize(dims[k]->type)),
