@@ -4,7 +4,8 @@
 // every precision mode on every backend asked for; each run is timed and measured against the
 // exact reference.
 //
-//   ci     small sets of every family and small versions of the hard cases: minutes on lavapipe
+//   ci     small sets of every family and small versions of the hard cases (their sweeps every other
+//          decade): minutes on lavapipe
 //   paper  the study's datasets at its sizes, 1920×1080, with its RTX 3090 figures beside ours
 //   hard   docs/precision.md, the hard cases: the offset sweep 1e0 … 1e8 (and the Earth's radius), the deep-zoom sweep
 //          1e-1 … 1e-15, tiny (1e-40, 1e-300), the Mandelbulb through its origin, degenerate sets

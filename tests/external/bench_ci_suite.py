@@ -182,8 +182,9 @@ with scratch() as d:
     # The sweeps the breakdown draws are all there, each step in every mode.
     zoom = {r["sweep"]["x"] for r in rows if r["sweep"] and r["sweep"]["kind"].startswith("deep zoom")}
     offset = {r["sweep"]["x"] for r in rows if r["sweep"] and r["sweep"]["kind"] == "offset"}
-    check(zoom == {10.0 ** -e for e in range(1, 16)}, f"deep-zoom sweep {sorted(zoom)}")
-    check(offset == {10.0 ** e for e in range(0, 9)}, f"offset sweep {sorted(offset)}")
+    # The ci suite's sweeps take every other decade (bench/suites.cpp).
+    check(zoom == {10.0 ** -e for e in range(1, 16, 2)}, f"deep-zoom sweep {sorted(zoom)}")
+    check(offset == {10.0 ** e for e in range(0, 9, 2)}, f"offset sweep {sorted(offset)}")
 
     families = len({r["family"] for r in rows})
     check_svg(os.path.join(out, "speed_vs_error.svg"), 2, families)  # a series per mode and backend
