@@ -28,10 +28,14 @@ def run_tool(argv, env=None):
     return result.stdout
 
 
-def reference_points(modules, model, out_csv):
+def reference_points_of(modules, jobs):
+    """The reference reader's points for each (model, out_csv) of `jobs`, read by one node process."""
     env = dict(os.environ, DPOINT_NODE_MODULES=modules)
-    run_tool(["node", os.path.join(NODE_DIR, "read_points.mjs"), model, "-o", out_csv], env)
-    return read_xyz(out_csv)
+    argv = ["node", os.path.join(NODE_DIR, "read_points.mjs")]
+    for model, out_csv in jobs:
+        argv += [model, "-o", out_csv]
+    run_tool(argv, env)
+    return [read_xyz(out_csv) for _, out_csv in jobs]
 
 
 def read_xyz(csv_path):

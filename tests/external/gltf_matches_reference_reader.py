@@ -12,6 +12,9 @@ tests/external/node/read_points.mjs, computes world-space positions in double fo
    so is gltfpack -mi (EXT_mesh_gpu_instancing: the reference reader applies instance T·R·S too).
 3. The Draco variant (gltf-transform draco: 14-bit positions) of every other model above, the
    same two ways, and assimp's own Draco model (draco/2CylinderEngine.gltf) against the reference.
+   These variants are made by one node process (node/draco_variants.mjs, the CLI's own transform;
+   it must write the CLI's very bytes for the engine), and the reference reader reads each batch of
+   files in one process: node start-ups were two thirds of this test's minute.
 
 "1e-9 relative" is per coordinate: |ours − theirs| ≤ 1e-9 · max(model extent, |theirs|), so points
 near the origin of a large model are held to the model's scale, far ones to their own magnitude.
@@ -23,7 +26,7 @@ import subprocess
 import sys
 
 from common import check, scratch
-from gltf_compare import glb_json, match_sorted, node_tools_dir, read_xyz, reference_points, run_tool, within
+from gltf_compare import NODE_DIR, glb_json, match_sorted, node_tools_dir, read_xyz, reference_points_of, run_tool, within
 
 exe, validator = sys.argv[1], sys.argv[2]
 models_dir = sys.argv[3] if len(sys.argv) > 3 else "/usr/share/assimp/models/glTF2"
@@ -126,75 +129,111 @@ def convert(model, out_csv):
     return result.returncode, result.stderr.strip()
 
 
-def compare_model(model, work):
-    """dpoint and the reference agree on `model`; returns the reference's points."""
-    stem = os.path.join(work, os.path.basename(model))
-    theirs = reference_points(modules, model, stem + ".ref.csv")
-    code, err = convert(model, stem + ".csv")
-    check(code == 0, f"dpoint convert {model} failed ({code}): {err}")
-    ok, message = match_sorted(read_xyz(stem + ".csv"), theirs, REL)
-    check(ok, f"{model}: {message}")
-    print(f"match  {os.path.relpath(model, models_dir) if model.startswith(models_dir) else os.path.basename(model)}: {message}")
-    return theirs
+def compare_models(models, work):
+    """dpoint and the reference agree on each of `models` (one node run reads them all); returns
+    the reference's points of each."""
+    stems = [os.path.join(work, os.path.basename(model)) for model in models]
+    references = reference_points_of(modules, [(model, stem + ".ref.csv") for model, stem in zip(models, stems)])
+    for model, stem, theirs in zip(models, stems, references):
+        code, err = convert(model, stem + ".csv")
+        check(code == 0, f"dpoint convert {model} failed ({code}): {err}")
+        ok, message = match_sorted(read_xyz(stem + ".csv"), theirs, REL)
+        check(ok, f"{model}: {message}")
+        shown = os.path.relpath(model, models_dir) if model.startswith(models_dir) else os.path.basename(model)
+        print(f"match  {shown}: {message}")
+    return references
 
 
-def compare_variant(original, original_points, name, command, bits, may_refuse, work):
+def variant_path(original, name, work):
     tag = name.replace(" ", "_").replace("-", "")
-    variant = os.path.join(work, f"{os.path.basename(original)}.{tag}.glb")
-    run_tool([variant if a == "OUT" else original if a == "IN" else a for a in command])
-    required = glb_json(variant).get("extensionsRequired", [])
-    code, err = convert(variant, variant + ".csv")
-    refusable = [e for e in may_refuse if e in required]
-    if code != 0 and refusable:
-        # A clean refusal: exit 2, one line, naming the extension dpoint does not decode.
-        check(code == 2, f"{name}: refused with exit {code}, not 2: {err}")
-        check(len(err.splitlines()) == 1 and refusable[0] in err,
-              f"{name}: the refusal must be one line naming {refusable[0]}: {err}")
-        print(f"skip   {os.path.basename(original)} {name}: refused cleanly ({err})")
-        return
-    check(code == 0, f"{name} (requires {required}): dpoint convert failed ({code}): {err}")
-    ours = read_xyz(variant + ".csv")
-    ok, message = match_sorted(ours, reference_points(modules, variant, variant + ".ref.csv"), REL)
-    check(ok, f"{name}: against the reference reader on the same file: {message}")
-    # Quantized: a coordinate moves at most half a step of `bits` over its mesh's box, which lies in
-    # the model's box (rotation can mix three components, hence the model's diagonal). Float data
-    # re-baked by flatten/join/gltfpack: float32 rounding of world coordinates.
-    lo, hi = original_points.min(axis=0), original_points.max(axis=0)
-    diagonal = float(((hi - lo) ** 2).sum() ** 0.5)
-    magnitude = float(abs(original_points).max())
-    step = diagonal / (2 ** bits - 1) if bits else 2.0 ** -23 * max(magnitude, diagonal)
-    if name in ROTATION_QUANTIZED:
-        check("EXT_mesh_gpu_instancing" in required, f"{name}: made no instanced nodes ({required})")
-        step += diagonal * 2.0 ** -13
-    ok2, message2 = within(ours, original_points, step)
-    check(ok2, f"{name}: against the original model: {message2}")
-    print(f"match  {os.path.basename(original)} {name}: {message}; original {message2}")
-    return required
+    return os.path.join(work, f"{os.path.basename(original)}.{tag}.glb")
+
+
+def make_draco_variants(pairs):
+    """`gltf-transform draco ORIGINAL VARIANT` for each pair, made by one node process
+    (draco_variants.mjs: the CLI's own transform) instead of a CLI start-up per model."""
+    argv = ["node", os.path.join(NODE_DIR, "draco_variants.mjs")]
+    for original, variant in pairs:
+        argv += [original, variant]
+    run_tool(argv, dict(os.environ, DPOINT_NODE_MODULES=modules))
+
+
+def compare_variants(jobs):
+    """Each job is (original, original_points, variant name, bits, extensions it may refuse, variant
+    file, made already). dpoint reads each variant; one node run reads them all for the reference.
+    Returns each job's extensionsRequired, None where dpoint refused the file cleanly."""
+    required_of, compared = [], []
+    for original, original_points, name, bits, may_refuse, variant in jobs:
+        required = glb_json(variant).get("extensionsRequired", [])
+        code, err = convert(variant, variant + ".csv")
+        refusable = [e for e in may_refuse if e in required]
+        if code != 0 and refusable:
+            # A clean refusal: exit 2, one line, naming the extension dpoint does not decode.
+            check(code == 2, f"{name}: refused with exit {code}, not 2: {err}")
+            check(len(err.splitlines()) == 1 and refusable[0] in err,
+                  f"{name}: the refusal must be one line naming {refusable[0]}: {err}")
+            print(f"skip   {os.path.basename(original)} {name}: refused cleanly ({err})")
+            required_of.append(None)
+            continue
+        check(code == 0, f"{name} (requires {required}): dpoint convert failed ({code}): {err}")
+        required_of.append(required)
+        compared.append((original, original_points, name, bits, variant, required))
+    references = reference_points_of(modules, [(job[4], job[4] + ".ref.csv") for job in compared])
+    for (original, original_points, name, bits, variant, required), theirs in zip(compared, references):
+        ours = read_xyz(variant + ".csv")
+        ok, message = match_sorted(ours, theirs, REL)
+        check(ok, f"{name}: against the reference reader on the same file: {message}")
+        # Quantized: a coordinate moves at most half a step of `bits` over its mesh's box, which lies in
+        # the model's box (rotation can mix three components, hence the model's diagonal). Float data
+        # re-baked by flatten/join/gltfpack: float32 rounding of world coordinates.
+        lo, hi = original_points.min(axis=0), original_points.max(axis=0)
+        diagonal = float(((hi - lo) ** 2).sum() ** 0.5)
+        magnitude = float(abs(original_points).max())
+        step = diagonal / (2 ** bits - 1) if bits else 2.0 ** -23 * max(magnitude, diagonal)
+        if name in ROTATION_QUANTIZED:
+            check("EXT_mesh_gpu_instancing" in required, f"{name}: made no instanced nodes ({required})")
+            step += diagonal * 2.0 ** -13
+        ok2, message2 = within(ours, original_points, step)
+        check(ok2, f"{name}: against the original model: {message2}")
+        print(f"match  {os.path.basename(original)} {name}: {message}; original {message2}")
+    return required_of
+
+
+def tool_variants(original, original_points, variants, work):
+    """The jobs of compare_variants for `variants` of `original`, each file made by its tool."""
+    jobs = []
+    for name, command, bits, may_refuse in variants:
+        variant = variant_path(original, name, work)
+        run_tool([variant if a == "OUT" else original if a == "IN" else a for a in command])
+        jobs.append((original, original_points, name, bits, may_refuse, variant))
+    return jobs
 
 
 with scratch() as work:
-    for relative in MODELS:
-        compare_model(os.path.join(models_dir, relative), work)
     hierarchy = os.path.join(work, "hierarchy.glb")
     write_hierarchy_glb(hierarchy)
-    hierarchy_points = compare_model(hierarchy, work)
+    models = [os.path.join(models_dir, relative) for relative in MODELS]
+    references = compare_models(models + [hierarchy], work)
+    points_of = dict(zip(models + [hierarchy], references))
+    hierarchy_points = points_of[hierarchy]
     check(len(hierarchy_points) == 2 * 8 + 30, f"hierarchy.glb: reference gives {len(hierarchy_points)} points")
 
     engine = os.path.join(models_dir, ENGINE)
-    engine_points = read_xyz(os.path.join(work, os.path.basename(engine) + ".ref.csv"))
-    for name, command, bits, may_refuse in VARIANTS:
-        compare_variant(engine, engine_points, name, command, bits, may_refuse, work)
-    for name, command, bits, may_refuse in VARIANTS[:4]:
-        compare_variant(hierarchy, hierarchy_points, name, command, bits, may_refuse, work)
+    jobs = tool_variants(engine, points_of[engine], VARIANTS, work)
+    jobs += tool_variants(hierarchy, hierarchy_points, VARIANTS[:4], work)
     draco = next(v for v in VARIANTS if v[0] == "gltf-transform draco")
-    compressed = []
-    for relative in MODELS:
-        if relative in (ENGINE, "draco/2CylinderEngine.gltf"):
-            continue
-        model = os.path.join(models_dir, relative)
-        required = compare_variant(model, read_xyz(os.path.join(work, os.path.basename(model) + ".ref.csv")), *draco, work)
-        if "KHR_draco_mesh_compression" in required:
-            compressed.append(relative)
+    others = [m for m, relative in zip(models, MODELS) if relative not in (ENGINE, "draco/2CylinderEngine.gltf")]
+    made = [variant_path(m, draco[0], work) for m in others]
+    # The engine once more, beside the CLI's variant of it: the script must write the CLI's very bytes.
+    engine_again = os.path.join(work, "engine-draco-by-script.glb")
+    make_draco_variants(list(zip(others, made)) + [(engine, engine_again)])
+    with open(engine_again, "rb") as a, open(variant_path(engine, draco[0], work), "rb") as b:
+        check(a.read() == b.read(), f"draco_variants.mjs and gltf-transform draco wrote different files for {ENGINE}")
+    first_other = len(jobs)
+    jobs += [(m, points_of[m], draco[0], draco[2], draco[3], v) for m, v in zip(others, made)]
+    required_of = compare_variants(jobs)
+    compressed = [os.path.relpath(m, models_dir) for m, required in zip(others, required_of[first_other:])
+                  if required is not None and "KHR_draco_mesh_compression" in required]
     # gltf-transform compresses triangle primitives only; the point and line modes stay plain.
     print(f"draco  {len(compressed)} of {len(MODELS) - 2} further models came out Draco-compressed")
     check(len(compressed) >= 10, f"only {compressed} were Draco-compressed")

@@ -2,7 +2,10 @@
 // the default scene (else scene 0), through glTF-Transform, written as CSV x,y,z in double with
 // the shortest round-trip digits.
 //
-//   node read_points.mjs IN.glb|IN.gltf [-o OUT.csv] [--all-vertices]
+//   node read_points.mjs IN.glb|IN.gltf [-o OUT.csv] [IN -o OUT ...] [--all-vertices]
+//
+// Several inputs, each with its -o, are read in turn by one node process (its start-up and the
+// decoders' is most of a small model's time; the tests read some 60 files).
 //
 // Per primitive it writes the vertices the primitive references: each distinct index once, in
 // increasing order, or every element of POSITION when it has no indices (dpoint's rule, issue #4).
@@ -18,14 +21,18 @@ const draco3d = (await load('draco3dgltf')).default;
 const { MeshoptDecoder } = await load('meshoptimizer');
 
 function parseArgs(argv) {
-  const args = { input: null, output: null, allVertices: false };
+  const usage = 'usage: read_points.mjs IN.glb [-o OUT.csv] [IN -o OUT ...] [--all-vertices]';
+  const args = { jobs: [], allVertices: false };
   for (let i = 0; i < argv.length; i++) {
-    if (argv[i] === '-o') args.output = argv[++i];
-    else if (argv[i] === '--all-vertices') args.allVertices = true;
-    else if (args.input === null) args.input = argv[i];
-    else throw new Error(`unexpected argument ${argv[i]}`);
+    if (argv[i] === '-o') {
+      const job = args.jobs[args.jobs.length - 1];
+      if (!job || job.output !== null || i + 1 >= argv.length) throw new Error(usage);
+      job.output = argv[++i];
+    } else if (argv[i] === '--all-vertices') args.allVertices = true;
+    else args.jobs.push({ input: argv[i], output: null });
   }
-  if (!args.input) throw new Error('usage: read_points.mjs IN.glb [-o OUT.csv] [--all-vertices]');
+  // Standard output takes one input only: several would run together there.
+  if (!args.jobs.length || (args.jobs.length > 1 && args.jobs.some((job) => job.output === null))) throw new Error(usage);
   return args;
 }
 
@@ -133,6 +140,23 @@ function writeMesh(node, m, out, allVertices) {
   }
 }
 
+async function readPoints(io, input, output, allVertices) {
+  const json = await io.readAsJSON(input);
+  const matrices = (json.json.nodes || []).map((n) => (n.matrix ? n.matrix.slice() : null));
+  const document = await io.readJSON(json);
+  const root = document.getRoot();
+  const nodeIndex = new Map(root.listNodes().map((node, i) => [node, i]));  // JSON order
+  if (nodeIndex.size !== matrices.length) throw new Error(`${input}: node list differs from the JSON`);
+  const scene = root.getDefaultScene() || root.listScenes()[0];
+  if (!scene) throw new Error(`${input}: no scene`);
+  const out = makeWriter(output);
+  out.line('x,y,z\n');
+  scene.traverse((node) => {
+    if (node.getMesh()) writeInstance(node, worldMatrix(node, nodeIndex, matrices), out, allVertices);
+  });
+  out.close();
+}
+
 const args = parseArgs(process.argv.slice(2));
 await MeshoptDecoder.ready;
 const io = new NodeIO()
@@ -141,17 +165,4 @@ const io = new NodeIO()
     'draco3d.decoder': await draco3d.createDecoderModule(),
     'meshopt.decoder': MeshoptDecoder,
   });
-const json = await io.readAsJSON(args.input);
-const matrices = (json.json.nodes || []).map((n) => (n.matrix ? n.matrix.slice() : null));
-const document = await io.readJSON(json);
-const root = document.getRoot();
-const nodeIndex = new Map(root.listNodes().map((node, i) => [node, i]));  // JSON order
-if (nodeIndex.size !== matrices.length) throw new Error('node list differs from the JSON');
-const scene = root.getDefaultScene() || root.listScenes()[0];
-if (!scene) throw new Error(`${args.input}: no scene`);
-const out = makeWriter(args.output);
-out.line('x,y,z\n');
-scene.traverse((node) => {
-  if (node.getMesh()) writeInstance(node, worldMatrix(node, nodeIndex, matrices), out, args.allVertices);
-});
-out.close();
+for (const job of args.jobs) await readPoints(io, job.input, job.output, args.allVertices);
