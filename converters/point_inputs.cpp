@@ -143,9 +143,38 @@ struct PointInputStream::Part {
     else las->streamDimensions(std::move(which));
   }
   Status read(uint64_t from, uint64_t n, PointSet& block) { return ply ? ply->read(from, n, block) : las->read(from, n, block); }
+  std::string path;
+};
+
+// A copy of a seam vertex: its owner's index among the owning part's points, and where the copy is.
+struct PointInputStream::TileCopies {
+  struct Copy {
+    uint64_t index;  // the owner, in its part
+    uint32_t part;   // the part (tile) holding the copy
+    uint32_t f;      // the copy's number there: rows[part] point f
+  };
+  std::vector<std::vector<Copy>> of;  // of[p]: the copies of part p's points, by index
+  std::vector<PointSet> rows;         // rows[p]: part p's copies as read, positions and colours
 };
 
 PointInputStream::~PointInputStream() = default;
+
+Status PointInputStream::checkCopies(size_t part, uint64_t first, const PointSet& rows) const {
+  if (!copies_) return okStatus();
+  const std::vector<TileCopies::Copy>& copies = copies_->of[part];
+  auto copy = std::lower_bound(copies.begin(), copies.end(), first,
+                               [](const TileCopies::Copy& c, uint64_t index) { return c.index < index; });
+  for (; copy != copies.end() && copy->index < first + rows.size(); ++copy) {
+    const PointSet& mine = copies_->rows[copy->part];
+    const size_t at = static_cast<size_t>(copy->index - first);
+    const bool same_position = std::memcmp(&rows.positions[at], &mine.positions[copy->f], sizeof(glm::dvec3)) == 0;
+    const bool same_color = !mine.hasColors() || !rows.hasColors() ||
+                            std::memcmp(&rows.colors[at], &mine.colors[copy->f], sizeof(glm::vec3)) == 0;
+    if (!same_position || !same_color)
+      return tileCopyDiffers(parts_[copy->part].path, parts_[part].first + copy->index, same_position);
+  }
+  return okStatus();
+}
 
 Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
                                                                  unsigned threads) {
@@ -166,6 +195,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
   }
   for (const auto& [path, owned] : files) {
     Part part;
+    part.path = path;
     Result<FileFormat> format = formatOf(path);
     if (format && (*format == FileFormat::kLas || *format == FileFormat::kLaz)) {
       Result<std::unique_ptr<LasPointStream>> las = LasPointStream::open(path, threads);
@@ -184,6 +214,27 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     if (part.count > 0) stream->has_colors_ = stream->has_colors_ || part.hasColors();
     stream->faces_ += part.faceCount();
     stream->parts_.push_back(std::move(part));
+  }
+  if (set->whole) {
+    // Every tile's copies, read once (a seam's worth of rows), to be checked as their owners pass.
+    Result<std::vector<std::vector<TileVertexRef>>> refs = readTileCopyRefs(paths, threads);
+    if (!refs) return refs.error();
+    auto copies = std::make_unique<TileCopies>();
+    copies->of.resize(stream->parts_.size());
+    copies->rows.resize(stream->parts_.size());
+    for (size_t t = 0; t < refs->size(); ++t) {
+      const std::vector<TileVertexRef>& mine = (*refs)[t];
+      if (mine.empty()) continue;
+      Part& part = stream->parts_[t];
+      if (Status s = part.read(part.count, mine.size(), copies->rows[t]); !s) return s.error();
+      for (size_t f = 0; f < mine.size(); ++f)
+        copies->of[mine[f].tile].push_back({mine[f].index, static_cast<uint32_t>(t), static_cast<uint32_t>(f)});
+    }
+    for (std::vector<TileCopies::Copy>& of : copies->of)
+      std::sort(of.begin(), of.end(), [](const TileCopies::Copy& a, const TileCopies::Copy& b) {
+        return std::tie(a.index, a.part, a.f) < std::tie(b.index, b.part, b.f);
+      });
+    stream->copies_ = std::move(copies);
   }
   return stream;
 }
@@ -206,6 +257,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   assert(first <= count_ && n <= count_ - first);
   if (parts_.size() == 1) {  // straight into the block
     if (Status s = parts_[0].read(first, n, block); !s) return s;
+    if (Status s = checkCopies(0, first, block); !s) return s;
     if (has_colors_ && !block.hasColors()) block.colors.assign(block.size(), glm::vec3(1.0f));
     return okStatus();
   }
@@ -219,6 +271,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     const uint64_t from = std::max(first, part.first), to = std::min(end, part.first + part.count);
     if (from >= to) continue;
     if (Status s = part.read(from - part.first, to - from, scratch_); !s) return s;
+    if (Status s = checkCopies(static_cast<size_t>(&part - parts_.data()), from - part.first, scratch_); !s) return s;
     const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
     if (streamed) {

@@ -36,9 +36,10 @@ Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 // One or several binary PLY, LAS or LAZ files as one stream of points (render's --stream): the points
 // readPointInputs(paths) gives, in its order, a block at a time (positions and colours, no
 // triangles). A complete tile set streams each tile's owned vertices in tile order (the merged
-// set, each seam vertex once); other files stream whole, one after another. Colours as in
-// readPointInputs: white for the files without in a mix. Only the headers are read by open();
-// errors (ASCII PLY, another format, a bad header) name the file.
+// set, each seam vertex once, each of its copies checked against it as it is read: a copy that
+// differs is mergeTiles' error); other files stream whole, one after another. Colours as in
+// readPointInputs: white for the files without in a mix. open() reads the headers (and a tile
+// set's copies); errors (ASCII PLY, another format, a bad header) name the file.
 class PointInputStream {
  public:
   static Result<std::unique_ptr<PointInputStream>> open(const std::vector<std::string>& paths, unsigned threads);
@@ -61,7 +62,12 @@ class PointInputStream {
  private:
   PointInputStream() = default;
   struct Part;
+  struct TileCopies;
+  // A complete tile set's copies of seam vertices, each checked against its owner as the owner's
+  // block is read (as mergeTiles checks them): a tile of another build is an error, not a seam.
+  Status checkCopies(size_t part, uint64_t first, const PointSet& rows) const;
   std::vector<Part> parts_;  // in stream order
+  std::unique_ptr<TileCopies> copies_;  // null but for a complete tile set
   uint64_t count_ = 0, faces_ = 0;
   bool has_colors_ = false;
   std::optional<Dimension> streamed_;  // streamDimension's name and type, no values

@@ -520,8 +520,7 @@ Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned thre
 }
 
 Error copyDiffers(const TileSet& set, uint32_t t, uint32_t at, bool same_position) {
-  return Error{set.path(t) + ": its copy of vertex " + std::to_string(at) + " differs from the owner's " +
-               (same_position ? "colour" : "position") + " (tiles of different builds or options?)"};
+  return tileCopyDiffers(set.path(t), at, same_position);
 }
 
 // A work item of the merge: kRowsPerBlock vertex or face rows of one tile.
@@ -541,6 +540,17 @@ void addBlocks(const TileSet& set, bool faces, const Rows& rows, std::vector<Row
 }
 
 }  // namespace
+
+Error tileCopyDiffers(const std::string& path, uint64_t vertex, bool same_position) {
+  return Error{path + ": its copy of vertex " + std::to_string(vertex) + " differs from the owner's " +
+               (same_position ? "colour" : "position") + " (tiles of different builds or options?)"};
+}
+
+Result<std::vector<std::vector<TileVertexRef>>> readTileCopyRefs(const std::vector<std::string>& paths, unsigned threads) {
+  Result<TileSet> set = openTileSet(paths, threads);
+  if (!set) return set.error();
+  return std::move(set->foreign);
+}
 
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory, Progress* progress,
                             unsigned threads) {

@@ -80,6 +80,15 @@ Result<PointTile> readTile(const std::string& path);
 // parts are read on `threads` cores (0: all), each block of rows straight into its place.
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory = 0,
                             Progress* progress = nullptr, unsigned threads = 0);
+// The copies' references of all N tiles of one run, in any order of `paths`, checked as mergeTiles
+// checks them (every tile once, one run, each reference to an owned vertex that exists), by tile:
+// refs[t][f] is the owner of tile t's copy f (its vertex owned + f). For a reader that streams the
+// owned vertices (PointInputStream), to check each copy against its owner as that passes.
+Result<std::vector<std::vector<TileVertexRef>>> readTileCopyRefs(const std::vector<std::string>& paths,
+                                                                 unsigned threads = 0);
+// mergeTiles' error for a copy in `path` of the whole set's vertex `vertex` that differs from it.
+Error tileCopyDiffers(const std::string& path, uint64_t vertex, bool same_position);
+
 // The same merge streamed into the binary PLY file writePly would write of mergeTiles' set, byte
 // for byte, without holding the set: every tile's rows are read, welded and made into the file's
 // rows on options.threads cores and written in order, the copies checked against their owners on
