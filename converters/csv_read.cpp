@@ -613,7 +613,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
       uint64_t n = 0;
       if (!parseDecimalU64(fields[0], n))
         return Error{file.path() + ":" + std::to_string(line + 1) + ": the count line " + printableExcerpt(fields[0]) +
-                     " is past 2^64 points"};
+                     " is 2^64 points or more"};
       declared = n, declared_line = line + 1;
       pos = nl + 1;
       ++line;

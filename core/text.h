@@ -101,13 +101,15 @@ inline std::string oneLineText(std::string_view text, std::string_view empty) {
   return shortened.empty() ? std::string(empty) : shortened;
 }
 
-// Decimal digits only (at most 19, so no overflow), no sign, no spaces: false otherwise.
+// Decimal digits only, no sign, no spaces, at most 2^64 - 1 (18446744073709551615): false otherwise.
 inline bool parseDecimalU64(std::string_view text, uint64_t& value) {
-  if (text.empty() || text.size() > 19) return false;
+  if (text.empty()) return false;
   value = 0;
   for (char c : text) {
     if (c < '0' || c > '9') return false;
-    value = value * 10 + static_cast<uint64_t>(c - '0');
+    if (__builtin_mul_overflow(value, uint64_t{10}, &value) ||
+        __builtin_add_overflow(value, static_cast<uint64_t>(c - '0'), &value))
+      return false;
   }
   return true;
 }

@@ -308,7 +308,14 @@ TEST(Csv, missingValuesFloatDimensionsAndOddLinesAreReadAsMeant) {
   writeFile(dir.file("negative.csv"), "x,y,z,r,g,b\n1,2,3,0.5,0,1\n1,2,3,-5,0,1\n");
   expectReadError(dir.file("negative.csv"), {"negative.csv: data row 2, colour column 1: -5", "fractions are 0..1"});
   writeFile(dir.file("huge.pts"), "99999999999999999999\n1 2 3\n");
-  expectReadError(dir.file("huge.pts"), {"huge.pts:1: the count line 99999999999999999999 is past 2^64 points"});
+  expectReadError(dir.file("huge.pts"), {"huge.pts:1: the count line 99999999999999999999 is 2^64 points or more"});
+  // Twenty digits: 2^64 - 1 is a count (of points the file lacks), 2^64 is past every count.
+  writeFile(dir.file("huge.pts"), "18446744073709551615\n1 2 3\n");
+  expectReadError(dir.file("huge.pts"), {"huge.pts:1: the count line declares 18446744073709551615 points, but the file has 1 rows"});
+  writeFile(dir.file("huge.pts"), "18446744073709551616\n1 2 3\n");
+  expectReadError(dir.file("huge.pts"), {"huge.pts:1: the count line 18446744073709551616 is 2^64 points or more"});
+  writeFile(dir.file("huge.pts"), "000000000000000000001\n1 2 3\n");
+  ASSERT_TRUE(readCsv(dir.file("huge.pts")).ok());
   writeFile(dir.file("mac.xyz"), "1 2 3\r4 5 6\r");
   expectReadError(dir.file("mac.xyz"), {"mac.xyz:1: carriage returns inside a line", "CR alone"});
   writeFile(dir.file("id.csv"), "id,x,y,z\n1,1,2,3\n");
