@@ -742,12 +742,13 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
 // which without this bound took host memory past --max-memory. A stream's blocks were sized to
 // --max-memory before the device was known: its render pass's are sized here to half of it, the
 // other half left to the device (the passes before, bounds and outline, held no device memory).
-// A refusal is then exit 4 naming --max-memory (vulkan/buffers.cpp). Put back at the end: a
+// A refusal is then exit 4 naming --max-memory (vulkan/buffers.cpp); where --max-device-memory
+// is given too, the tighter of the two refuses and names the other as the next limit. Put back at the end: a
 // Python Renderer's device outlives it.
 class HostMemoryBudget {
  public:
   HostMemoryBudget(VulkanContext& context, const RenderRequest& request, LoadedSet& set)
-      : context_(context), budget_(context.device_memory_budget), host_(context.host_budget) {
+      : context_(context), budget_(context.device_memory_budget), host_(context.host_budget), next_(context.next_budget) {
     const PointSet* points = set.points();
     if (context.facts.type != "cpu" || (!points && !set.stream)) return;
     const uint64_t limit = request.max_memory ? request.max_memory : defaultMemoryLimit();
@@ -755,18 +756,26 @@ class HostMemoryBudget {
     const uint64_t held =
         points ? heldBytes(*points) : streamHeldBytes(set.count, set.stream_block, set.stream_point_bytes);
     const uint64_t left = limit > held ? limit - held : 1;  // 0 would be no budget at all
-    if (budget_ != 0 && budget_ <= left) return;
     const std::string option =
         request.max_memory ? "--max-memory " + formatBytes(limit) : "--max-memory (" + formatBytes(limit) + ", half of RAM)";
-    context.device_memory_budget = left;
     const std::string what = points ? " of points read" : " of the stream's blocks";
-    context.host_budget = limit > held ? "the " + formatBytes(left) + " that " + option + " leaves beside the " +
-                                             formatBytes(held) + what
-                                       : option + ", which the " + formatBytes(held) + what + " already take";
+    const std::string host = limit > held ? "the " + formatBytes(left) + " that " + option + " leaves beside the " +
+                                                formatBytes(held) + what
+                                          : option + ", which the " + formatBytes(held) + what + " already take";
+    // The tighter bound refuses and names the looser (a review finding: raising the one named let
+    // the render run into the other with no warning).
+    if (budget_ != 0 && budget_ <= left) {
+      context.next_budget = host;
+      return;
+    }
+    if (budget_ != 0) context.next_budget = "--max-device-memory " + formatBytes(budget_);
+    context.device_memory_budget = left;
+    context.host_budget = host;
   }
   ~HostMemoryBudget() {
     context_.device_memory_budget = budget_;
     context_.host_budget = host_;
+    context_.next_budget = next_;
   }
   HostMemoryBudget(const HostMemoryBudget&) = delete;
   HostMemoryBudget& operator=(const HostMemoryBudget&) = delete;
@@ -774,7 +783,7 @@ class HostMemoryBudget {
  private:
   VulkanContext& context_;
   uint64_t budget_;
-  std::string host_;
+  std::string host_, next_;
 };
 
 }  // namespace

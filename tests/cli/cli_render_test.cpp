@@ -308,6 +308,24 @@ TEST(CliRender, aCpuDevicesBuffersCountAgainstMaxMemory) {
   EXPECT_NE(refused.err.find("that --max-memory 30.0 MiB leaves beside the 22.9 MiB of points read"), std::string::npos)
       << refused.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("tight.png")));
+  // With --max-device-memory as well, the tighter refuses and names the other, the next limit met
+  // by raising the one named alone.
+  std::vector<std::string> both = tight;
+  both.insert(both.end(), {"--max-device-memory", "1G"});
+  test::CommandResult next = runDpoint(both);
+  EXPECT_EQ(next.exit_code, 4) << next.err;
+  EXPECT_NE(next.err.find("22.9 MiB of points read (past it, --max-device-memory 1.00 GiB is the next limit)"),
+            std::string::npos)
+      << next.err;
+  both = render;
+  both.insert(both.end(), {"48M", "--max-device-memory", "10M", "-o", dir.file("tight.png")});
+  next = runDpoint(both);
+  EXPECT_EQ(next.exit_code, 3) << next.err;
+  EXPECT_NE(next.err.find("(--max-device-memory) (past it, the 25.1 MiB that --max-memory 48.0 MiB leaves beside the "
+                          "22.9 MiB of points read is the next limit)"),
+            std::string::npos)
+      << next.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("tight.png")));
   std::vector<std::string> enough = render;
   enough.insert(enough.end(), {"48M", "-o", dir.file("enough.png")});
   const test::CommandResult drawn = runDpoint(enough);
