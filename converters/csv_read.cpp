@@ -622,6 +622,12 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
     Header header;
     header.declared = declared;
     header.declared_line = declared_line;
+    // Where the rows start: after this line when it names the columns, else on it.
+    const auto dataFrom = [&](bool named) {
+      header.data_offset = named ? std::min<uint64_t>(nl + 1, file.size()) : pos;
+      header.first_data_line = named ? line + 1 : line;
+      header.named = named;
+    };
     const size_t marker = text.find_first_not_of(" \t");
     if (text[marker] == '#') {
       // A comment (numpy's savetxt writes its header as `# x,y,z`): the header where what follows
@@ -633,9 +639,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
                                                  named, separatorOf(named));
         if (layout) {
           header.layout = *layout;
-          header.data_offset = std::min<uint64_t>(nl + 1, file.size());
-          header.first_data_line = line + 1;
-          header.named = true;
+          dataFrom(true);
           return header;
         }
       }
@@ -647,10 +651,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
       Result<Layout> layout = layoutFromNames(columns, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
-      const bool named = isNamedLine(fields, header.layout, separator);
-      header.data_offset = named ? std::min<uint64_t>(nl + 1, file.size()) : pos;
-      header.first_data_line = named ? line + 1 : line;
-      header.named = named;
+      dataFrom(isNamedLine(fields, header.layout, separator));
       return header;
     }
     // pandas' to_csv writes its index first, in a column without a name (`,x,y,z`): passed over.
@@ -667,16 +668,13 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
         layout->text = "," + layout->text;
       }
       header.layout = *layout;
-      header.data_offset = std::min<uint64_t>(nl + 1, file.size());  // a header only: an empty set
-      header.first_data_line = line + 1;
-      header.named = true;
+      dataFrom(true);  // a header only: an empty set
     } else {
       Result<Layout> layout = pts ? layoutFromPtsColumns(file.path(), fields.size(), line + 1, separator)
                                   : layoutFromColumns(file.path(), fields.size(), line + 1, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
-      header.data_offset = pos;
-      header.first_data_line = line;
+      dataFrom(false);
     }
     return header;
   }
