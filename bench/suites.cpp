@@ -131,9 +131,10 @@ std::vector<BenchCase> hardCases(BenchSuite suite, bool small) {
   const uint32_t side = small ? 256 : 1024;
   // The ci version sweeps every other decade: each step is a child `dpoint render` per mode and
   // backend (0.3 s apiece on lavapipe under the validation layer), and the full sweeps made the CI
-  // bench half of the test suite's time. The hard suite keeps every decade; between them, the ci
-  // suite and tests/viewer/precision_test.cpp (widths 1e-4, 1e-6, 1e-12 and 1e-14 among others,
-  // every mode on both backends) leave out only the widths 1e-2, 1e-8 and 1e-10 in CI.
+  // bench half of the test suite's time. The hard suite keeps every decade. In CI, the ci suite
+  // and tests/viewer/precision_test.cpp (every mode on both backends: widths 1e-4, 1e-6, 1e-12 and
+  // 1e-14 among others, offsets 1e6, 6.378e6 and 1e8) leave out the deep-zoom widths 1e-2, 1e-8
+  // and 1e-10 and the offsets 1e1, 1e3, 1e5 and 1e7.
   const int step = small ? 2 : 1;
   for (int e = 0; e <= 8; e += step) {
     const double offset = e == 0 ? 1.0 : std::stod("1e" + std::to_string(e));

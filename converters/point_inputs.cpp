@@ -182,7 +182,14 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
   if (!set) return set.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
   std::vector<std::pair<std::string, uint64_t>> files;  // path, points to stream (all: UINT64_MAX)
+  // A tile set's copies' references, read before the parts are opened: reading them opens every
+  // file once more, and a set of hundreds of tiles must not take twice its files at once (a
+  // review finding: 700 tiles under `ulimit -n 1024`).
+  std::vector<std::vector<TileVertexRef>> refs;
   if (set->whole) {
+    Result<std::vector<std::vector<TileVertexRef>>> read = readTileCopyRefs(paths, threads);
+    if (!read) return read.error();
+    refs = std::move(*read);
     files.resize(paths.size());
     for (const std::string& path : paths) {
       Result<TileHeader> h = readTileHeader(path);
@@ -217,13 +224,11 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
   }
   if (set->whole) {
     // Every tile's copies, read once (a seam's worth of rows), to be checked as their owners pass.
-    Result<std::vector<std::vector<TileVertexRef>>> refs = readTileCopyRefs(paths, threads);
-    if (!refs) return refs.error();
     auto copies = std::make_unique<TileCopies>();
     copies->of.resize(stream->parts_.size());
     copies->rows.resize(stream->parts_.size());
-    for (size_t t = 0; t < refs->size(); ++t) {
-      const std::vector<TileVertexRef>& mine = (*refs)[t];
+    for (size_t t = 0; t < refs.size(); ++t) {
+      const std::vector<TileVertexRef>& mine = refs[t];
       if (mine.empty()) continue;
       Part& part = stream->parts_[t];
       if (Status s = part.read(part.count, mine.size(), copies->rows[t]); !s) return s.error();

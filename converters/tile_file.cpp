@@ -444,7 +444,9 @@ struct TileSet {
   }
 };
 
-Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned threads) {
+// `merged`: the set is to be merged, so its vertices must be addressable by 32-bit indices; a
+// stream of the owned vertices (readTileCopyRefs) has no such limit and no use for `global`.
+Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned threads, bool merged = true) {
   if (paths.empty()) return Error{"merge: no tiles given", ExitCode::kUsage};
   TileSet set;
   for (const std::string& path : paths) {
@@ -482,7 +484,7 @@ Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned thre
     set.base[t + 1] = set.base[t] + set.tile[t]->parsed.header.owned;
     set.face_base[t + 1] = set.face_base[t] + set.tile[t]->parsed.header.faces;
   }
-  if (set.vertices() > UINT32_MAX) return Error{"merge: more than 2^32 vertices", ExitCode::kResourceLimit};
+  if (merged && set.vertices() > UINT32_MAX) return Error{"merge: more than 2^32 vertices", ExitCode::kResourceLimit};
   // Colours or none, alike in every tile that has points (an empty one has nothing to colour).
   int coloured = -1;
   for (size_t i = 0; i < paths.size(); ++i) {
@@ -504,7 +506,7 @@ Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned thre
       errors[t] = s;
       return;
     }
-    set.global[t].resize(foreign.size());
+    if (merged) set.global[t].resize(foreign.size());
     for (size_t f = 0; f < foreign.size(); ++f) {
       const TileVertexRef& ref = foreign[f];
       if (ref.tile >= count || ref.tile == t || ref.index >= set.base[ref.tile + 1] - set.base[ref.tile]) {
@@ -512,7 +514,7 @@ Result<TileSet> openTileSet(const std::vector<std::string>& paths, unsigned thre
                           std::to_string(ref.index) + " of tile " + std::to_string(ref.tile) + ", which does not exist"};
         return;
       }
-      set.global[t][f] = static_cast<uint32_t>(set.base[ref.tile] + ref.index);
+      if (merged) set.global[t][f] = static_cast<uint32_t>(set.base[ref.tile] + ref.index);
     }
   });
   if (Status s = firstError(errors); !s) return s.error();
@@ -547,9 +549,9 @@ Error tileCopyDiffers(const std::string& path, uint64_t vertex, bool same_positi
 }
 
 Result<std::vector<std::vector<TileVertexRef>>> readTileCopyRefs(const std::vector<std::string>& paths, unsigned threads) {
-  Result<TileSet> set = openTileSet(paths, threads);
+  Result<TileSet> set = openTileSet(paths, threads, false);
   if (!set) return set.error();
-  return std::move(set->foreign);
+  return std::move(set->foreign);  // the files close here
 }
 
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory, Progress* progress,

@@ -81,9 +81,10 @@ Result<PointTile> readTile(const std::string& path);
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory = 0,
                             Progress* progress = nullptr, unsigned threads = 0);
 // The copies' references of all N tiles of one run, in any order of `paths`, checked as mergeTiles
-// checks them (every tile once, one run, each reference to an owned vertex that exists), by tile:
-// refs[t][f] is the owner of tile t's copy f (its vertex owned + f). For a reader that streams the
-// owned vertices (PointInputStream), to check each copy against its owner as that passes.
+// checks them (every tile once, one run, each reference to an owned vertex that exists; but any
+// number of vertices, 2^32 and more), by tile: refs[t][f] is the owner of tile t's copy f (its
+// vertex owned + f). For a reader that streams the owned vertices (PointInputStream), to check
+// each copy against its owner as that passes. It opens every file, and closes them on return.
 Result<std::vector<std::vector<TileVertexRef>>> readTileCopyRefs(const std::vector<std::string>& paths,
                                                                  unsigned threads = 0);
 // mergeTiles' error for a copy in `path` of the whole set's vertex `vertex` that differs from it.

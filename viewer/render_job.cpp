@@ -743,7 +743,8 @@ Result<bool> renderOnce(const RenderRequest& request, const VulkanContext& conte
 // --max-memory before the device was known: its render pass's are sized here to half of it, the
 // other half left to the device (the passes before, bounds and outline, held no device memory).
 // A refusal is then exit 4 naming --max-memory (vulkan/buffers.cpp); where --max-device-memory
-// is given too, the tighter of the two refuses and names the other as the next limit. Put back at the end: a
+// is given too, the tighter of the two refuses and names the other (--max-memory given or by its
+// default) as the next limit. Put back at the end: a
 // Python Renderer's device outlives it.
 class HostMemoryBudget {
  public:

@@ -187,15 +187,17 @@ Status reserveDeviceMemory(const VulkanContext& context, VkDeviceSize bytes, con
   const uint64_t used = context.device_memory_used.fetch_add(bytes) + bytes;
   if (context.device_memory_budget == 0 || used <= context.device_memory_budget) return okStatus();
   context.device_memory_used.fetch_sub(bytes);
-  const std::string next = context.next_budget.empty() ? "" : " (past it, " + context.next_budget + " is the next limit)";
+  const std::string next = context.next_budget.empty() ? "" : "past it, " + context.next_budget + " is the next limit";
   if (!context.host_budget.empty())
     return Error{"host memory: " + what + " needs " + formatBytes(bytes) + " more on the CPU device (whose memory is "
-                     "the host's), " + formatBytes(used) + " in all, past " + context.host_budget + next +
+                     "the host's), " + formatBytes(used) + " in all, past " + context.host_budget +
+                     (next.empty() ? "" : " (" + next + ")") +
                      "; try a smaller set, size or --mode with fewer bytes a point, or a higher --max-memory",
                  ExitCode::kResourceLimit};
   return Error{"device memory: " + what + " needs " + formatBytes(bytes) + " more, " + formatBytes(used) +
                    " in all, above the budget of " + formatBytes(context.device_memory_budget) +
-                   " (--max-device-memory)" + next + "; try a smaller set, size or --mode with fewer bytes a point",
+                   " (--max-device-memory" + (next.empty() ? "" : "; " + next) +
+                   "); try a smaller set, size or --mode with fewer bytes a point",
                ExitCode::kNoDevice};  // a Vulkan fault like a lost device (issue #12): exit 3
 }
 

@@ -117,9 +117,10 @@ class VulkanContext {
   // then exit 4 ("the 12.0 MiB that --max-memory 36.0 MiB leaves beside the 24.0 MiB of points
   // read"). Empty otherwise.
   std::string host_budget;
-  // Where both --max-device-memory and --max-memory bound a CPU device, the looser of the two, said
-  // in the refusal of the tighter so that one raised alone is not a surprise ("--max-device-memory
-  // 64.0 MiB", or host_budget's form). Empty otherwise.
+  // Where --max-device-memory is given for a CPU device, which --max-memory (given, or its default,
+  // half of RAM) bounds too: the looser of the two, said in the refusal of the tighter so that one
+  // raised alone is not a surprise ("--max-device-memory 64.0 MiB", or host_budget's form). Empty
+  // otherwise.
   std::string next_budget;
   mutable std::atomic<uint64_t> device_memory_used{0};
   // Set once the device-lost-wait test switch has reported a loss: from then on the device stays

@@ -321,7 +321,7 @@ TEST(CliRender, aCpuDevicesBuffersCountAgainstMaxMemory) {
   both.insert(both.end(), {"48M", "--max-device-memory", "10M", "-o", dir.file("tight.png")});
   next = runDpoint(both);
   EXPECT_EQ(next.exit_code, 3) << next.err;
-  EXPECT_NE(next.err.find("(--max-device-memory) (past it, the 25.1 MiB that --max-memory 48.0 MiB leaves beside the "
+  EXPECT_NE(next.err.find("(--max-device-memory; past it, the 25.1 MiB that --max-memory 48.0 MiB leaves beside the "
                           "22.9 MiB of points read is the next limit)"),
             std::string::npos)
       << next.err;

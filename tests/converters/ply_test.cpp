@@ -1262,6 +1262,16 @@ TEST(Ply, plyVertexStreamReadsAnyRangeAsReadPlyDoes) {
       expectSameColors(expected, block);
     }
   }
+  // A file larger than the memory limit is what a stream is for: it opens and reads where readPly
+  // refuses (the stream took readPly's memory check and refused a PLY of 3e9 points).
+  PlyReadOptions small = withThreads(1);
+  small.max_memory = 1 << 20;
+  EXPECT_FALSE(readPly(dir.file("s.ply"), small).ok());
+  auto stream = PlyVertexStream::open(dir.file("s.ply"), small);
+  ASSERT_TRUE(stream.ok()) << stream.error().message;
+  PointSet block;
+  ASSERT_TRUE((*stream)->read(in.size() - 10, 10, block).ok());
+  EXPECT_EQ(block.positions.back(), in.positions.back());
 }
 
 // Its errors are readPly's, with whole-file row numbers and byte offsets.
