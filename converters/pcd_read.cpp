@@ -151,7 +151,8 @@ class HeaderParser {
 
   Result<uint64_t> count(std::string_view token, const std::string& key) const {
     uint64_t v = 0;
-    if (!parseDecimalU64(token, v)) return error(key + " " + quotedExcerpt(token) + " is not a whole number");
+    if (!parseDecimalU64(token, v))
+      return error(key + " " + quotedExcerpt(token) + (allDecimalDigits(token) ? " is 2^64 or more" : " is not a whole number"));
     return v;
   }
 
@@ -741,8 +742,8 @@ class Reader {
     if (f.role == Role::kRgb && f.type != 'F') {  // rgba, or rgb as PCL 1.13 writes it in ASCII (TYPE U)
       uint64_t packed = 0;
       int32_t signed_packed = 0;
-      if (parseDecimalU64(token, packed)) {
-        if (packed > 0xFFFFFFFFu) return Error{"is beyond a packed 32-bit colour"};
+      if (allDecimalDigits(token)) {  // past 2^64 too: beyond 32 bits either way
+        if (!parseDecimalU64(token, packed) || packed > 0xFFFFFFFFu) return Error{"is beyond a packed 32-bit colour"};
         storeUnaligned(out, static_cast<uint32_t>(packed));
       } else if (auto r = std::from_chars(b, e, signed_packed); r.ec == std::errc() && r.ptr == e) {
         storeUnaligned(out, signed_packed);

@@ -114,6 +114,11 @@ inline bool parseDecimalU64(std::string_view text, uint64_t& value) {
   return true;
 }
 
+// Decimal digits only, at least one: a number parseDecimalU64 refuses only for its size.
+inline bool allDecimalDigits(std::string_view text) {
+  return !text.empty() && text.find_first_not_of("0123456789") == std::string_view::npos;
+}
+
 // `text` split at every `separator`, empty fields kept ("a,,b": a, "", b; "": one empty field).
 std::vector<std::string> splitAt(std::string_view text, char separator);
 

@@ -355,6 +355,12 @@ TEST(Pcd, badFilesAreRefusedNamingWhereAndWhy) {
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nWIDTH 3\nHEIGHT 2\nPOINTS 5\nDATA ascii\n",
        "header line 6: POINTS 5 is not WIDTH × HEIGHT (3 × 2)"},
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nSHAPE 3\n", "header line 4: unknown entry 'SHAPE'"},
+      // Digits past 2^64 are a number too large, not one that is not whole.
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nWIDTH 18446744073709551616\n",
+       "header line 4: WIDTH '18446744073709551616' is 2^64 or more"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nWIDTH 12a\n", "header line 4: WIDTH '12a' is not a whole number"},
+      {"VERSION 0.7\nFIELDS x y z rgba\nSIZE 4 4 4 4\nTYPE F F F U\nPOINTS 1\nDATA ascii\n1 2 3 18446744073709551616\n",
+       "'18446744073709551616' is beyond a packed 32-bit colour"},
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nPOINTS 1\nDATA zipped\n", "header line 5: DATA 'zipped' is not ascii, binary or binary_compressed"},
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nPOINTS 1\n", "the header ends without a DATA line"},
       {head + "DATA ascii\n1 2 3\n4 5\n", "line 11: 2 values; the header's fields need 3"},
