@@ -83,7 +83,8 @@ class RowFormatter {
 
   // Formats `count` rows into out (replacing its content); colors is read only with a colour layout.
   // dims (one per name of the layout, or null without any) are read at rows first … first + count.
-  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count, std::string& out,
+  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count,
+              std::vector<char, DefaultInitAllocator<char>>& out,
               const std::vector<Dimension>* dims = nullptr, size_t first = 0) const {
     const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u) + (dims ? dims->size() : 0u);
     const size_t row_max = fields * kMaxFieldChars;
@@ -213,7 +214,7 @@ Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* co
                      std::min(count, begin + kRowsPerChunk) - begin, texts_[k], dims, first + begin);
   });
   for (size_t k = 0; k < chunks; ++k) {
-    if (Status s = file_.write(texts_[k]); !s) return s;
+    if (Status s = file_.write(texts_[k].data(), texts_[k].size()); !s) return s;
   }
   if (progress_) progress_->advance(count);
   return okStatus();
