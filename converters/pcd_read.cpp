@@ -742,9 +742,11 @@ class Reader {
     if (f.role == Role::kRgb && f.type != 'F') {  // rgba, or rgb as PCL 1.13 writes it in ASCII (TYPE U)
       uint64_t packed = 0;
       int32_t signed_packed = 0;
-      if (allDecimalDigits(token)) {  // past 2^64 too: beyond 32 bits either way
-        if (!parseDecimalU64(token, packed) || packed > 0xFFFFFFFFu) return Error{"is beyond a packed 32-bit colour"};
+      if (parseDecimalU64(token, packed)) {
+        if (packed > 0xFFFFFFFFu) return Error{"is beyond a packed 32-bit colour"};
         storeUnaligned(out, static_cast<uint32_t>(packed));
+      } else if (allDecimalDigits(token)) {  // past 2^64
+        return Error{"is beyond a packed 32-bit colour"};
       } else if (auto r = std::from_chars(b, e, signed_packed); r.ec == std::errc() && r.ptr == e) {
         storeUnaligned(out, signed_packed);
       } else {
