@@ -124,8 +124,8 @@ class Writer {
     for (const Dimension& d : points_.dimensions.all())
       if (&d != alpha_) names.push_back(fieldName(d.name)), dims.push_back(&d);
     // normal_x is nx's where the set has both (a reader takes normal_x as nx), so the dimension
-    // named normal_x is the one renamed.
-    // The dimension (nx, ny, nz) that takes the PCL name `own` from a dimension so named, or "".
+    // named normal_x is the one renamed: normal_taking(own) is the dimension (nx, ny, nz) that
+    // takes the PCL name `own` from the dimension so named, or "".
     const auto normal_taking = [&](const std::string& own) {
       if (own != "normal_x" && own != "normal_y" && own != "normal_z") return std::string();
       std::string normal(1, 'n');  // appended: GCC 12's -Wrestrict misfires on "n" + std::string
@@ -142,12 +142,13 @@ class Writer {
         nullptr);
     // Each change named by the dimension's own name (writableNames would name PCL's: nx as normal_x).
     std::vector<std::string> renamed;
-    for (size_t k = 0; k < dims.size(); ++k)
-      if (names[k] != fieldName(dims[k]->name))
-        renamed.push_back("dimension " + quotedExcerpt(dims[k]->name) + " written as " + quotedExcerpt(names[k]) +
-                          (!normal_taking(dims[k]->name).empty()
-                               ? " (" + normal_taking(dims[k]->name) + " is written as " + dims[k]->name + ", PCL's name for it)"
-                               : std::string(" (a PCD field's name is one word, not x, y, z, rgb, rgba or _)")));
+    for (size_t k = 0; k < dims.size(); ++k) {
+      if (names[k] == fieldName(dims[k]->name)) continue;
+      const std::string taker = normal_taking(dims[k]->name);
+      renamed.push_back("dimension " + quotedExcerpt(dims[k]->name) + " written as " + quotedExcerpt(names[k]) +
+                        (!taker.empty() ? " (" + taker + " is written as " + dims[k]->name + ", PCL's name for it)"
+                                        : std::string(" (a PCD field's name is one word, not x, y, z, rgb, rgba or _)")));
+    }
     for (size_t k = 0; k < dims.size(); ++k)
       fields_.push_back({names[k], pcdTypeOf(dims[k]->type), static_cast<int>(dimTypeSize(dims[k]->type)),
                          Source::kDimension, dims[k]});
