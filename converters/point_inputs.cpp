@@ -10,6 +10,7 @@
 #include "converters/las.h"
 #include "converters/ply.h"
 #include "converters/tile_file.h"
+#include "core/memory.h"
 
 namespace dpoint {
 
@@ -177,7 +178,7 @@ Status PointInputStream::checkCopies(size_t part, uint64_t first, const PointSet
 }
 
 Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
-                                                                 unsigned threads) {
+                                                                 unsigned threads, uint64_t max_memory) {
   Result<InputSet> set = checkInputSet(paths);
   if (!set) return set.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
@@ -190,6 +191,18 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     Result<std::vector<std::vector<TileVertexRef>>> read = readTileCopyRefs(paths, threads);
     if (!read) return read.error();
     refs = std::move(*read);
+    // What the copies hold for the whole stream: each one's row (position and colour), its place
+    // among its owner's copies and, while they are read, its reference (a seam's worth of rows:
+    // 89,880 for 40 tiles of 1.36M points).
+    uint64_t copies = 0;
+    for (const std::vector<TileVertexRef>& mine : refs) copies += mine.size();
+    stream->held_bytes_ = copies * (sizeof(glm::dvec3) + sizeof(glm::vec3) + sizeof(TileCopies::Copy) +
+                                    sizeof(TileVertexRef));
+    if (Status s = checkMemory(describeInputs(paths) + ": the " + std::to_string(copies) + " seam copies of " +
+                                   std::to_string(paths.size()) + " tiles, held while they stream",
+                               stream->held_bytes_, max_memory);
+        !s)
+      return s.error();
     files.resize(paths.size());
     for (const std::string& path : paths) {
       Result<TileHeader> h = readTileHeader(path);
@@ -291,7 +304,8 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
 }
 
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
-                                                          const std::string& stream, unsigned threads) {
+                                                          const std::string& stream, unsigned threads,
+                                                          uint64_t max_memory) {
   const bool streamable = std::all_of(paths.begin(), paths.end(), [](const std::string& path) {
     Result<FileFormat> format = formatOf(path);
     return format && (*format == FileFormat::kPly || *format == FileFormat::kLas || *format == FileFormat::kLaz);
@@ -302,9 +316,9 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
       return Error{describeInputs(paths) + ": --stream on reads binary PLY, LAS and LAZ files", ExitCode::kUsage};
     return std::unique_ptr<PointInputStream>();
   }
-  Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(paths, threads);
+  Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(paths, threads, max_memory);
   if (!opened) {
-    if (stream == "on") return opened.error();
+    if (stream == "on" || opened.error().code == ExitCode::kResourceLimit) return opened.error();
     return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong
   }
   if (stream == "on" || (*opened)->count() > kStreamAbovePoints) return opened;

@@ -39,16 +39,21 @@ Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 // set, each seam vertex once, each of its copies checked against it as it is read: a copy that
 // differs is mergeTiles' error); other files stream whole, one after another. Colours as in
 // readPointInputs: white for the files without in a mix. open() reads the headers (and a tile
-// set's copies); errors (ASCII PLY, another format, a bad header) name the file.
+// set's copies); errors (ASCII PLY, another format, a bad header) name the file. The copies are
+// held for the whole stream: over `max_memory` (0: half of RAM) they are refused before they are
+// read (kResourceLimit), as mergeTiles refuses them.
 class PointInputStream {
  public:
-  static Result<std::unique_ptr<PointInputStream>> open(const std::vector<std::string>& paths, unsigned threads);
+  static Result<std::unique_ptr<PointInputStream>> open(const std::vector<std::string>& paths, unsigned threads,
+                                                        uint64_t max_memory = 0);
   ~PointInputStream();
   uint64_t count() const { return count_; }
   bool hasColors() const { return has_colors_; }
   // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
   // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
   uint64_t faceCount() const { return faces_; }
+  // Host bytes held for the whole stream beside its blocks: a tile set's copies (0 for other files).
+  uint64_t heldBytes() const { return held_bytes_; }
   // What the readers read past in the headers, one line each (ReadOptions::notices).
   const std::vector<std::string>& notices() const { return notices_; }
   // The first file's dimensions (PLY vertex properties), as empty columns.
@@ -68,7 +73,7 @@ class PointInputStream {
   Status checkCopies(size_t part, uint64_t first, const PointSet& rows) const;
   std::vector<Part> parts_;  // in stream order
   std::unique_ptr<TileCopies> copies_;  // null but for a complete tile set
-  uint64_t count_ = 0, faces_ = 0;
+  uint64_t count_ = 0, faces_ = 0, held_bytes_ = 0;
   bool has_colors_ = false;
   std::optional<Dimension> streamed_;  // streamDimension's name and type, no values
   std::vector<std::string> notices_;
@@ -79,10 +84,12 @@ class PointInputStream {
 // paths are binary PLY, LAS or LAZ files of more than kStreamAbovePoints points together; nullptr when the
 // set is to be read whole. With "on", input that cannot be streamed is an error (an ASCII PLY, a
 // bad header: the reader's; another format: kUsage). In memory such a set would take 36 B a point
-// (2.4 GB at 2^26) before the upload's own.
+// (2.4 GB at 2^26) before the upload's own. A tile set whose copies do not fit `max_memory` is
+// refused whatever `stream` says (kResourceLimit): read whole, it would need more.
 inline constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
-                                                          const std::string& stream, unsigned threads);
+                                                          const std::string& stream, unsigned threads,
+                                                          uint64_t max_memory = 0);
 
 // "a.ply" for one path, "a.ply and 3 more" for several: for messages and reports.
 std::string describeInputs(const std::vector<std::string>& paths);

@@ -217,13 +217,13 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
 
 Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& options, Progress& progress) {
   if (inputs.paths.empty()) return Error{"info: no input files", ExitCode::kUsage};
-  Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads);
+  Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads, inputs.max_memory);
   if (!stream) return stream.error();
   const std::string name = describeInputs(inputs.paths);
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
     streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
-    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory);
+    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, kStreamPointBytes, (*stream)->heldBytes());
     if (!block) return block.error();
     streamed.stream_block = *block;
     Result<InfoReport> report = describeStream(**stream, name, streamed, progress);

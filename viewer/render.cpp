@@ -772,10 +772,13 @@ uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes) {
   return std::clamp(fits, kMinStreamBlockPoints, kStreamBlockPoints);
 }
 
-Result<uint64_t> checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit, uint64_t point_bytes) {
-  const uint64_t block = streamBlockPoints(limit, point_bytes);
-  if (Status s = checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time",
-                             streamHeldBytes(count, block, point_bytes), limit);
+Result<uint64_t> checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit, uint64_t point_bytes,
+                                   uint64_t held) {
+  const uint64_t cap = limit ? limit : defaultMemoryLimit();
+  const uint64_t block = streamBlockPoints(cap > held ? cap - held : 1, point_bytes);
+  if (Status s = checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time" +
+                                 (held ? " beside " + formatBytes(held) + " of seam copies" : std::string()),
+                             streamHeldBytes(count, block, point_bytes) + held, limit);
       !s)
     return s.error();
   return block;

@@ -215,6 +215,42 @@ TEST(CliTiles, mergeKeepsToMaxMemoryWhenItStreams) {
             0);
 }
 
+// A streamed tile set holds its seam copies (a row, a place and a reference each: 60 bytes) for the
+// whole stream: --max-memory counts them beside the two blocks, refusing before they are read where
+// they alone do not fit (the build before held them uncounted).
+TEST(CliTiles, aStreamedTileSetCountsItsCopiesAgainstMaxMemory) {
+  TempDir dir;
+  ASSERT_FALSE(mergedTiles(dir, {"mandelbulb", "--resolution", "33", "--variant", "fast"}, 2, "good.ply").empty());
+  uint64_t owned = 0, copies = 0;
+  for (const char* name : {"part-0.ply", "part-1.ply"}) {
+    const std::string bytes = readFile(dir.file(name));
+    const uint64_t mine = std::stoull(bytes.substr(bytes.find("comment dpoint-tile-owned ") + 26));
+    owned += mine;
+    copies += std::stoull(bytes.substr(bytes.find("element vertex ") + 15)) - mine;
+  }
+  ASSERT_GT(copies, 0u);
+  const uint64_t held = copies * 60, blocks = 2 * owned * 36;  // two blocks of 36-byte points
+  const auto info = [&](uint64_t limit) {
+    return runDpoint({"info", "--stream", "on", "--max-memory", std::to_string(limit), dir.file("part-0.ply"),
+                      dir.file("part-1.ply")});
+  };
+  test::CommandResult r = info(held - 1);
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("the " + std::to_string(copies) + " seam copies of 2 tiles"), std::string::npos) << r.err;
+  r = info(blocks + held - 1);
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("points a block at a time beside"), std::string::npos) << r.err;
+  r = info(blocks + held);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(std::to_string(owned)), std::string::npos) << r.out;
+  r = runDpoint({"render", "-q", "--stream", "on", "--width", "32", "--height", "24", "--max-memory",
+                 std::to_string(blocks + held - 1), "-o", dir.file("small.png"), dir.file("part-0.ply"),
+                 dir.file("part-1.ply")});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("of seam copies"), std::string::npos) << r.err;
+  EXPECT_FALSE(test::fileExists(dir.file("small.png")));
+}
+
 // Every tile is open at once: dpoint raises its soft limit on open files to the hard one (80 tiles
 // under a soft limit of 40 merge), and where the hard limit itself is too low the error is a
 // resource limit (exit 4) that says so (the build before failed both with exit 2).
