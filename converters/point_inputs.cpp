@@ -106,6 +106,7 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     // Colours: white for the files without, before the first coloured one and after it.
     if (part->hasColors()) {
       any_colors = true;
+      out.colors_read_as_fractions = out.colors_read_as_fractions || part->colors_read_as_fractions;
       out.colors.resize(out.size(), glm::vec3(1.0f));
       out.colors.insert(out.colors.end(), part->colors.begin(), part->colors.end());
     } else if (any_colors) {

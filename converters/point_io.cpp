@@ -166,7 +166,8 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
                  (options.las_color == LasColorSource::kIntensity ? "intensity" : "classification") +
                  " needs a LAS file; this file has no such field"};
   Result<PointSet> points = readByFormat(path, *format, options);
-  if (!points || las) return points;
+  if (!points || las) return points;  // LAS colours are integers, or made here from intensity or class
+  points->colors_read_as_fractions = points->hasColors() && points->color_full_scale == 0;
   if (options.las_color == LasColorSource::kRgb && !points->hasColors())
     return Error{path + ": colour by RGB asked for, but the file has no colours"};
   if (options.las_color == LasColorSource::kNone) points->colors.clear();
@@ -183,7 +184,9 @@ Result<PointSet> readInput(const std::string& path, const ReadOptions& read, Glt
     gltf.threads = read.threads;
     gltf.max_points_name = names.max_points;
     if (!gltf.texture) gltf.texture = read.texture;
-    return readGltf(path, gltf);
+    Result<PointSet> points = readGltf(path, gltf);
+    if (points) points->colors_read_as_fractions = points->hasColors();
+    return points;
   }
   if (gltf.scene >= 0 || gltf.all_scenes)
     return Error{path + ": " + names.scenes + " apply to .glb/.gltf input only", ExitCode::kUsage};
@@ -221,12 +224,58 @@ Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven&
   return okStatus();
 }
 
+namespace {
+
+Status writeFormat(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options);
+
+// The integer full scale `format` writes a set's colours at (255, 65535), 0 where it keeps floats.
+double writtenColorScale(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options) {
+  switch (format) {
+    case FileFormat::kPly:
+      if (options.ply_colors == PlyColorType::kFloat) return 0.0;
+      return options.ply_colors == PlyColorType::kUshort ||
+                     (options.ply_colors == PlyColorType::kAuto && points.color_full_scale == 65535)
+                 ? 65535.0
+                 : 255.0;
+    case FileFormat::kPcd: return 255.0;
+    case FileFormat::kCsv: return isPtsPath(path) ? 255.0 : 0.0;
+    case FileFormat::kLas:
+    case FileFormat::kLaz: return points.color_full_scale == 255 && points.las ? 255.0 : 65535.0;
+    default: return 0.0;
+  }
+}
+
+}  // namespace
+
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
-  if ((options.colors_of || options.positions_of) && *format != FileFormat::kPly)
+  // Colours read as fractions that an integer format rounds: said once the file is there (a review
+  // of issue #38's wave: a float-colour PLY went to 8-bit PLY, PCD or PTS without a word).
+  const double full = writtenColorScale(path, *format, points, options);
+  const uint64_t off = options.notices && points.colors_read_as_fractions && points.hasColors() && full > 0.0
+                           ? colorsOffGrid(points.colors, full, options.threads)
+                           : 0;
+  if (Status s = writeFormat(path, *format, points, options); !s) return s;
+  if (off != 0) {
+    const bool bytes = full == 255.0;
+    std::string keeps = *format == FileFormat::kPly ? "--ply-colors float keeps them"
+                        : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with --ply-colors float, .csv or .glb keeps them"
+                        : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
+                                                      : "LAS holds 0..65535; .ply with --ply-colors float, .csv or .glb keeps them";
+    options.notices->push_back(path + ": " + std::to_string(off) + " of " + std::to_string(points.size()) +
+                               " points have colours read as fractions that are not " + (bytes ? "8" : "16") +
+                               "-bit values: written rounded to 0.." + (bytes ? "255" : "65535") + " (" + keeps + ")");
+  }
+  return okStatus();
+}
+
+namespace {
+
+Status writeFormat(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options) {
+  if ((options.colors_of || options.positions_of) && format != FileFormat::kPly)
     return Error{path + ": points made as the rows are written go to a .ply only"};
-  switch (*format) {
+  switch (format) {
     case FileFormat::kCsv:
       return writeCsv(path, points,
                       CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale,
@@ -256,7 +305,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
       return okStatus();
     }
     case FileFormat::kGltf:
-      return checkWrittenFormat(path, *format);
+      return checkWrittenFormat(path, format);
     case FileFormat::kLas:
     case FileFormat::kLaz: {
       LasWriteReport report;
@@ -282,7 +331,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
         if (Status s = out->write(file->data(), file->size()); !s) return s;
         if (Status s = out->commit(); !s) return s;
       } else {
-        las.compress = *format == FileFormat::kLaz;
+        las.compress = format == FileFormat::kLaz;
         if (Status s = writeLas(path, points, las); !s) return s;
       }
       if (options.notices) {
@@ -330,6 +379,8 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
   }
   return Error{path + ": unreachable format"};
 }
+
+}  // namespace
 
 Status selectDimensions(PointSet& points, const DimensionChoice& choice, const std::string& what) {
   const auto names = [](const std::string& list) {  // empty names (a doubled comma) are passed over

@@ -3,6 +3,7 @@
 #include <cassert>
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -25,6 +26,28 @@ bool PointSet::isPlanar() const {
     }
   });
   return planar.load();
+}
+
+uint64_t colorsOffGrid(const ColorArray& colors, double full, unsigned threads) {
+  constexpr size_t kBlock = size_t{1} << 18;
+  // A float within two of its ulps (2^-24 below 1) of k / full is k: what a reader of k / full
+  // written as float or double holds. Farther off, rounding changes the colour.
+  const double within = full * 0x1p-24;
+  std::atomic<uint64_t> off{0};
+  parallelFor((colors.size() + kBlock - 1) / kBlock, threads, [&](size_t b, unsigned) {
+    const size_t end = std::min(colors.size(), (b + 1) * kBlock);
+    uint64_t mine = 0;
+    for (size_t i = b * kBlock; i < end; ++i) {
+      bool on = true;
+      for (int k = 0; k < 3; ++k) {
+        const double c = static_cast<double>(colors[i][k]) * full;
+        on = on && std::abs(c - static_cast<double>(colorInteger(colors[i][k], full))) <= within;  // NaN: false
+      }
+      mine += on ? 0 : 1;
+    }
+    off.fetch_add(mine, std::memory_order_relaxed);
+  });
+  return off.load();
 }
 
 uint64_t heldBytes(const PointSet& points) {

@@ -60,6 +60,10 @@ struct PointSet {
   // The integer full scale the colours were read from (255, 65535), 0 when they came as floats or
   // were made here: a writer of integer colours scales by it, so 8-bit colours stay 8-bit.
   uint16_t color_full_scale = 0;
+  // The colours were read from a file as fractions (a PLY's float properties, a CSV's 0..1 columns,
+  // a glTF's COLOR_0; color_full_scale 0): a writer of 8- or 16-bit colours says where it rounds
+  // one. Colours made here (generate's, a sampled surface's blends) are rounded without a word.
+  bool colors_read_as_fractions = false;
   // Set by the LAS reader, kept by the filters, used by the LAS writer.
   std::optional<LasSource> las;
 
@@ -103,6 +107,11 @@ inline uint16_t colorInteger(float c, double full) {
   if (!(c > 0.0f)) return 0;
   return static_cast<uint16_t>((c < 1.0f ? static_cast<double>(c) : 1.0) * full + 0.5);
 }
+
+// The colours whose channels are not all integers of `full` (255, 65535) in 0..1, which a writer of
+// such integers changes (colorInteger; NaN and values outside 0..1 count): 0 for colours read as
+// k / full in float or double (within full · 2^-24 of k at that scale). On `threads`.
+uint64_t colorsOffGrid(const ColorArray& colors, double full, unsigned threads);
 
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {

@@ -316,5 +316,50 @@ TEST(CliConvertMeaning, integerColoursKeepTheirFormThroughPly) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
 }
 
+// Colours read as fractions that an integer format rounds are said (once the file is there; the
+// build before rounded them in silence); colours already on the format's grid, colours kept as
+// floats and colours made here (generate's) are not.
+TEST(CliConvertMeaning, fractionColoursRoundedToIntegersAreSaid) {
+  TempDir dir;
+  // Two of three points have a channel between 8-bit steps (0.5, 0.1); 0.2, 0.4, 0.6 and 128/255 are steps.
+  writeFile(dir.file("f.csv"), "x,y,z,r,g,b\n0,0,0,0.5,0.25,1\n1,0,0,0.2,0.4,0.6\n2,0,0,1,0.1,0.50196078\n");
+  for (const char* out : {"f.ply", "f.pcd", "f.pts", "f.las", "f.laz"}) {
+    const test::CommandResult r = runDpoint({"convert", dir.file("f.csv"), "-o", dir.file(out)});
+    ASSERT_EQ(r.exit_code, 0) << out << ": " << r.err;
+    const bool words = std::string(out).find(".la") != std::string::npos;
+    // At 16 bits 0.1 is 6553.5 too: the same two points.
+    EXPECT_TRUE(test::contains(r.err, dir.file(out) + ": 2 of 3 points have colours read as fractions that are not " +
+                                          (words ? "16-bit values: written rounded to 0..65535" : "8-bit values: written rounded to 0..255")))
+        << out << ": " << r.err;
+  }
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{dir.file("f.csv"), "-o", dir.file("kept.ply"), "--ply-colors", "float"},
+        {dir.file("f.csv"), "-o", dir.file("kept.glb")},
+        {dir.file("f.csv"), "-o", dir.file("kept.csv")},
+        {dir.file("f.ply"), "-o", dir.file("bytes.pcd")},           // its colours are 8-bit now
+        {dir.file("kept.ply"), "-o", dir.file("words.ply"), "--ply-colors", "ushort"}}) {
+    const test::CommandResult r = runDpoint(test::concat({"convert"}, args));
+    ASSERT_EQ(r.exit_code, 0) << args[2] << ": " << r.err;
+    if (args[2].find("words") != std::string::npos) {
+      EXPECT_TRUE(test::contains(r.err, "2 of 3 points have colours read as fractions that are not 16-bit")) << r.err;
+      continue;
+    }
+    EXPECT_FALSE(test::contains(r.err, "read as fractions")) << args[2] << ": " << r.err;
+  }
+  // A float PLY of 8-bit values (as other tools write them) and 0..255 integers convert without a word.
+  writeFile(dir.file("i.csv"), "x,y,z,r,g,b\n0,0,0,255,0,0\n1,0,0,128,64,32\n");
+  expectConverts({dir.file("i.csv"), "-o", dir.file("i.ply"), "--ply-colors", "float"});
+  for (const char* out : {"i.pcd", "i.pts", "i.las"}) {
+    const test::CommandResult r = runDpoint({"convert", dir.file("i.ply"), "-o", dir.file(out)});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_FALSE(test::contains(r.err, "read as fractions")) << out << ": " << r.err;
+  }
+  // Generated colours are rounded by design.
+  const test::CommandResult made =
+      runDpoint({"generate", "mandelbulb", "--resolution", "24", "-o", dir.file("made.pcd")});
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  EXPECT_FALSE(test::contains(made.err, "read as fractions")) << made.err;
+}
+
 }  // namespace
 }  // namespace dpoint
