@@ -361,5 +361,39 @@ TEST(CliConvertMeaning, fractionColoursRoundedToIntegersAreSaid) {
   EXPECT_FALSE(test::contains(made.err, "read as fractions")) << made.err;
 }
 
+// Only PLY and GLB hold triangles: converting a PLY mesh to another format reads its vertices and
+// stops before the faces (the build before read them all to drop them). A face list past repair
+// then does not stop a conversion that would not have written it; one to PLY still refuses it.
+TEST(CliConvertMeaning, aMeshToAPointFormatReadsNoFaces) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "17", "--variant", "fast", "-q", "-o",
+                       dir.file("m.ply")})
+                .exit_code,
+            0);
+  std::string bytes = readFile(dir.file("m.ply"));
+  ASSERT_TRUE(test::contains(bytes, "property list uchar uint vertex_indices"));
+  const uint64_t vertices = std::stoull(bytes.substr(bytes.find("element vertex ") + 15));
+  const size_t first_face = bytes.find("end_header\n") + 11 + vertices * (3 * 8 + 3);
+  ASSERT_LT(first_face + 13, bytes.size());
+  ASSERT_EQ(bytes[first_face], 3);
+  for (const char* out : {"good.pcd", "good.csv", "good.las"}) expectConverts({dir.file("m.ply"), "-o", dir.file(out)});
+  bytes[first_face + 1] = bytes[first_face + 2] = bytes[first_face + 3] = bytes[first_face + 4] = '\xff';  // index 2^32 - 1
+  writeFile(dir.file("bad.ply"), bytes);
+  for (const char* name : {"pcd", "csv", "las"}) {
+    const std::string out = dir.file(std::string("bad.") + name);
+    expectConverts({dir.file("bad.ply"), "-o", out});
+    EXPECT_EQ(readFile(out), readFile(dir.file(std::string("good.") + name))) << name;
+  }
+  for (const char* out : {"bad-out.ply", "bad-out.glb"}) {
+    const test::CommandResult r = runDpoint({"convert", dir.file("bad.ply"), "-o", dir.file(out)});
+    EXPECT_EQ(r.exit_code, 2) << out << ": " << r.err;
+    EXPECT_FALSE(test::fileExists(dir.file(out)));
+  }
+  // --sample needs the faces, whatever the output.
+  const test::CommandResult sampled =
+      runDpoint({"convert", dir.file("bad.ply"), "--sample", "100", "-o", dir.file("sampled.csv")});
+  EXPECT_EQ(sampled.exit_code, 2) << sampled.err;
+}
+
 }  // namespace
 }  // namespace dpoint
