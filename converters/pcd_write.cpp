@@ -280,37 +280,30 @@ class Writer {
     return okStatus();
   }
 
-  template <typename T>
-  static void appendNumber(std::string& text, T v) {
-    char buf[40];
-    auto r = std::to_chars(buf, buf + sizeof buf, v);
-    text.append(buf, r.ptr);
-  }
-
   // A field's stored bytes as ASCII, by its PCD type: integers as integers, floats in shortest
   // round-trip form. So rgb (TYPE F) is the float whose bits are the colour, as PCL reads it, and
   // rgba (TYPE U) the integer.
-  static void appendField(std::string& text, const OutField& f, const uint8_t* p) {
+  static void appendField(TextBuffer& text, const OutField& f, const uint8_t* p) {
     switch (f.type) {
       case 'F':
         if (f.size == 4)
-          appendNumber(text, loadUnaligned<float>(p));
+          text.appendNumber(loadUnaligned<float>(p));
         else
-          appendNumber(text, loadUnaligned<double>(p));
+          text.appendNumber(loadUnaligned<double>(p));
         break;
       case 'U':
         if (f.size == 8)
-          appendNumber(text, loadUnaligned<uint64_t>(p));
+          text.appendNumber(loadUnaligned<uint64_t>(p));
         else
-          appendNumber(text, f.size == 1 ? uint32_t{p[0]} : f.size == 2 ? uint32_t{loadUnaligned<uint16_t>(p)} : loadUnaligned<uint32_t>(p));
+          text.appendNumber(f.size == 1 ? uint32_t{p[0]} : f.size == 2 ? uint32_t{loadUnaligned<uint16_t>(p)} : loadUnaligned<uint32_t>(p));
         break;
       default:
         if (f.size == 8)
-          appendNumber(text, loadUnaligned<int64_t>(p));
+          text.appendNumber(loadUnaligned<int64_t>(p));
         else
-          appendNumber(text, f.size == 1   ? int32_t{static_cast<int8_t>(p[0])}
-                             : f.size == 2 ? int32_t{loadUnaligned<int16_t>(p)}
-                                           : loadUnaligned<int32_t>(p));
+          text.appendNumber(f.size == 1   ? int32_t{static_cast<int8_t>(p[0])}
+                            : f.size == 2 ? int32_t{loadUnaligned<int16_t>(p)}
+                                          : loadUnaligned<int32_t>(p));
         break;
     }
   }
@@ -324,19 +317,19 @@ class Writer {
     return writeChunksInOrder(
         file, (n + kAsciiRowsPerChunk - 1) / kAsciiRowsPerChunk, options_.threads,
         [&](size_t k, std::vector<char>& bytes) -> Status {
-          thread_local std::string text;
+          thread_local TextBuffer text;
           text.clear();
           const auto [first, last] = rowsOf(k);
           for (size_t i = first; i < last; ++i) {
             for (size_t f = 0; f < fields_.size(); ++f) {
-              if (f) text += ' ';
+              if (f) text.append(' ');
               uint8_t value[8];
               store(fields_[f], i, value);  // the binary writers' bytes, as text
               appendField(text, fields_[f], value);
             }
-            text += '\n';
+            text.append('\n');
           }
-          bytes.assign(text.begin(), text.end());
+          bytes.assign(text.data(), text.data() + text.size());
           return okStatus();
         },
         [&](size_t k) {

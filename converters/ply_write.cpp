@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "core/atomic_file.h"
-#include "core/memory.h"
 #include "core/ordered_write.h"
 #include "core/parallel.h"
 #include "core/text.h"
@@ -72,45 +71,14 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
   return facts;
 }
 
-// A chunk's ASCII rows, whose length is known only once formatted: numbers are formatted straight
-// into a per-thread buffer that grows without zeroing, and the chunk's bytes take the text at the
-// end in one copy. (Appending piece by piece to the chunk's std::vector<char> zero-filled each
-// growth and called memcpy per number: 27% of an ASCII PLY write's profile.)
-class ChunkText {
- public:
-  explicit ChunkText(std::vector<char>& bytes) : bytes_(bytes) {}
-  ~ChunkText() { bytes_.assign(text().data(), text().data() + used_); }
-  // Room for at least `size` more characters at the end; advance() takes those written.
-  char* room(size_t size) {
-    if (used_ + size > text().size()) text().resize(std::max(2 * text().size(), used_ + size + 4096));
-    return text().data() + used_;
-  }
-  void advance(size_t size) { used_ += size; }
-  void append(std::string_view piece) {
-    std::memcpy(room(piece.size()), piece.data(), piece.size());
-    used_ += piece.size();
-  }
-
- private:
-  static std::vector<char, DefaultInitAllocator<char>>& text() {
-    thread_local std::vector<char, DefaultInitAllocator<char>> buffer;
-    return buffer;
-  }
-  std::vector<char>& bytes_;
-  size_t used_ = 0;
-};
-
 template <typename T>
-void appendNumber(ChunkText& out, T value, char separator) {
-  constexpr size_t kMost = 40;  // a double's shortest form is at most 24 characters
-  char* text = out.room(kMost);
-  auto r = std::to_chars(text, text + kMost - 1, value);  // shortest round-trip form
-  *r.ptr = separator;
-  out.advance(static_cast<size_t>(r.ptr + 1 - text));
+void appendNumber(TextBuffer& out, T value, char separator) {
+  out.appendNumber(value);
+  out.append(separator);
 }
 
 // Value i of a dimension in ASCII: integers as integers, floats in shortest round-trip form.
-void appendDimension(ChunkText& out, const Dimension& d, size_t i, char separator) {
+void appendDimension(TextBuffer& out, const Dimension& d, size_t i, char separator) {
   switch (d.type) {
     case DimType::kF32: appendNumber(out, d.get<float>(i), separator); break;
     case DimType::kF64: appendNumber(out, d.get<double>(i), separator); break;
@@ -304,7 +272,10 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
       }
       return;
     }
-    ChunkText out(bytes);
+    // ASCII rows, whose length is known once formatted: into a per-thread TextBuffer, then the
+    // chunk's bytes in one copy.
+    thread_local TextBuffer out;
+    out.clear();
     for (size_t i = begin; i < end; ++i) {
       const glm::dvec3& p = chunk_positions[i - begin];
       appendNumber(out, p.x, ' ');
@@ -324,6 +295,7 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
       }
       for (size_t k = 0; k < dims.size(); ++k) appendDimension(out, dims[k], i, k + 1 == dims.size() ? '\n' : ' ');
     }
+    bytes.assign(out.data(), out.data() + out.size());
   };
   auto faceRows = [&](size_t begin, size_t end, std::vector<char>& bytes) {
     if (!ascii) {
@@ -335,11 +307,13 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
       }
       return;
     }
-    ChunkText out(bytes);
+    thread_local TextBuffer out;
+    out.clear();
     for (size_t f = begin; f < end; ++f) {
       out.append("3 ");
       for (size_t k = 0; k < 3; ++k) appendNumber(out, points.triangles[3 * f + k], k == 2 ? '\n' : ' ');
     }
+    bytes.assign(out.data(), out.data() + out.size());
   };
   const Status written = writeChunksInOrder(
       *file, 1 + vertex_chunks + face_chunks, options.threads,

@@ -3,10 +3,14 @@
 #pragma once
 
 #include <algorithm>
+#include <charconv>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "core/memory.h"
 
 namespace dpoint {
 
@@ -139,5 +143,37 @@ inline const char* afterPlusSign(const char* begin, const char* end) {
 std::string formatNumber(double v, bool json = false);
 // A JSON string literal: quotes, with '"', '\\' and control characters escaped.
 std::string jsonString(const std::string& s);
+
+// Text made a piece at a time, numbers formatted straight into it, in a buffer that grows without
+// zeroing (DefaultInitAllocator): the ASCII writers' rows. Appending each number to a std::vector<char>
+// or std::string (a memcpy call a number, a zero-fill a growth) was a quarter of an ASCII PLY write.
+class TextBuffer {
+ public:
+  void clear() { used_ = 0; }
+  size_t size() const { return used_; }
+  const char* data() const { return bytes_.data(); }
+  // Room for at least `size` more characters at the end; advance() takes those written.
+  char* room(size_t size) {
+    if (used_ + size > bytes_.size()) bytes_.resize(std::max(2 * bytes_.size(), used_ + size + 4096));
+    return bytes_.data() + used_;
+  }
+  void advance(size_t size) { used_ += size; }
+  void append(char c) { *room(1) = c, ++used_; }
+  void append(std::string_view piece) {
+    std::memcpy(room(piece.size()), piece.data(), piece.size());
+    used_ += piece.size();
+  }
+  // An integer, or a float in shortest round-trip form (std::to_chars).
+  template <typename T>
+  void appendNumber(T value) {
+    constexpr size_t kMost = 40;  // a double's shortest form is at most 24 characters
+    char* at = room(kMost);
+    used_ += static_cast<size_t>(std::to_chars(at, at + kMost, value).ptr - at);
+  }
+
+ private:
+  std::vector<char, DefaultInitAllocator<char>> bytes_;
+  size_t used_ = 0;
+};
 
 }  // namespace dpoint
