@@ -1264,6 +1264,10 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     // A LAS file's size; a LAZ file's is not known before its chunks are compressed.
     if (!laz)
       if (Status s = file->checkSpace(point_offset + uint64_t{n} * l.record_length); !s) return s;
+  } else if (!laz) {
+    // Its whole size at once: grown by appends, the string copied itself at each doubling (18% of a
+    // COPC write of 8.4M points).
+    options.memory->reserve(options.memory->size() + point_offset + size_t{n} * l.record_length);
   }
   const auto write = [&](const void* data, size_t size) -> Status {
     if (!file) {
