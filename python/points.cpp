@@ -239,12 +239,14 @@ py::tuple pointSetState(const PointSet& s) {
                         bytes(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
                         bytes(s.triangles.data(), s.triangles.size() * sizeof(uint32_t)), dims,
                         s.color_full_scale, static_cast<int>(s.z_axis), s.z_up, las,
-                        viewpointObject(s.viewpoint));
+                        viewpointObject(s.viewpoint), s.colors_read_as_fractions);
 }
 
 std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
-  // 10 items since the viewpoint; a pickle of 9 (made before) loads without one.
-  if ((t.size() != 9 && t.size() != 10) || t[0].cast<int>() != 1) throw py::value_error("PointSet: not a pickle of this version's PointSet");
+  // 10 items since the viewpoint, 11 since colors_read_as_fractions; a pickle of 9 or 10 (made
+  // before) loads without them.
+  if (t.size() < 9 || t.size() > 11 || t[0].cast<int>() != 1)
+    throw py::value_error("PointSet: not a pickle of this version's PointSet");
   auto s = std::make_shared<PointSet>();
   const auto fill = [](const py::handle& from, auto& to) {
     const std::string b = from.cast<std::string>();
@@ -272,7 +274,8 @@ std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
   s->color_full_scale = t[5].cast<uint16_t>();
   s->z_axis = static_cast<ZAxis>(t[6].cast<int>());
   s->z_up = t[7].cast<bool>();
-  if (t.size() == 10) s->viewpoint = viewpointOf(t[9].cast<std::optional<std::vector<double>>>(), "PointSet: a pickled viewpoint");
+  if (t.size() >= 10) s->viewpoint = viewpointOf(t[9].cast<std::optional<std::vector<double>>>(), "PointSet: a pickled viewpoint");
+  if (t.size() >= 11) s->colors_read_as_fractions = t[10].cast<bool>() && !s->colors.empty();
   if (!t[8].is_none()) {
     const py::tuple l = t[8].cast<py::tuple>();
     LasSource las;

@@ -483,3 +483,22 @@ def test_storage_no_view_can_see_is_freed_at_once():
     view = s.attributes["h"]
     s.remove_attribute("h")
     assert np.array_equal(view, a64)  # a view alive keeps its storage
+
+
+def test_colours_read_as_fractions_are_said_when_rounded_and_kept_by_pickle(tmp_path):
+    """A set read with colours between 8-bit steps warns when written to an 8-bit format, as the
+    CLI notes it; so does its pickled copy (the flag travels in the pickle). Generated colours and
+    colours already on the grid do not."""
+    import pickle
+    import warnings
+    (tmp_path / "f.csv").write_text("x,y,z,r,g,b\n0,0,0,0.5,0,0\n1,0,0,0.2,0.4,0.6\n")
+    read = dpoint.read(tmp_path / "f.csv")
+    for s in (read, pickle.loads(pickle.dumps(read)), read.copy()):
+        with pytest.warns(UserWarning, match=r"1 of 2 points have colours read as fractions that are not 8-bit"):
+            dpoint.write(s, tmp_path / "f.pcd")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dpoint.write(read, tmp_path / "f.csv.ply", ply_colors="float")
+        dpoint.write(dpoint.generate("menger", level=1), tmp_path / "m.pcd")
+        dpoint.write(dpoint.read(tmp_path / "f.pcd"), tmp_path / "again.pcd")  # now 8-bit values
+    assert not [w for w in caught if "read as fractions" in str(w.message)], [str(w.message) for w in caught]
