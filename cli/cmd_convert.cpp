@@ -61,14 +61,15 @@ GltfReadOptions gltfOptions(const ConvertOptions& o) {
 Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress, MeshTexture* texture) {
   GltfReadOptions g = gltfOptions(o);
   // Only PLY and GLB hold triangles: for the others (CSV, PTS, PCD, LAS, LAZ, COPC) a mesh's index
-  // list is neither built from a glTF file nor read from a PLY file's faces, unless --sample needs it
-  // (a PLY mesh to PCD read its faces only to drop them: 24% of the whole convert of a 643k-vertex
-  // Mandelbulb).
+  // list is not built from a glTF file, and a PLY file's triangle rows are not read where its size
+  // shows them whole (PlyReadOptions::faces_unkept), unless --sample needs them: a PLY mesh to PCD
+  // read its faces only to drop them.
   Result<FileFormat> out_format = formatOf(o.output);
   const bool triangles = !out_format || *out_format == FileFormat::kPly || *out_format == FileFormat::kGlb ||
                          *out_format == FileFormat::kGltf || o.sample.count != 0;
   g.triangles = triangles;
-  ReadOptions r{o.common.threads, o.allow_nonfinite, &progress, !triangles};
+  ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
+  r.faces_unkept = !triangles;
   r.max_memory = o.memory_limit;
   r.columns = columnsOf(o.columns);
   r.texture = texture;

@@ -1267,7 +1267,9 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
   } else if (!laz) {
     // Its whole size at once: grown by appends, the string copied itself at each doubling (18% of a
     // COPC write of 8.4M points).
-    options.memory->reserve(options.memory->size() + point_offset + size_t{n} * l.record_length);
+    size_t evlr_bytes = 0;
+    for (const LasVlr& evlr : l.evlrs) evlr_bytes += kEvlrHeaderBytes + evlr.data.size();
+    options.memory->reserve(options.memory->size() + point_offset + size_t{n} * l.record_length + evlr_bytes);
   }
   const auto write = [&](const void* data, size_t size) -> Status {
     if (!file) {

@@ -52,6 +52,12 @@ struct PlyReadOptions {
   // element, so faces and any later element are neither read nor checked.
   bool points_only = false;
   uint64_t max_memory = 0;  // bytes for the point set (--max-memory); 0: defaultMemoryLimit()
+  // The caller keeps no faces (a conversion to a point format): as points_only where the file's
+  // size shows its face rows whole (binary, the face element last, triangles of a one-byte count
+  // and 32-bit indices: 13 bytes each, the file ending with the last), so that a file cut short or
+  // with bytes after its end is still refused; else the faces are read and checked as ever. The
+  // triangles' indices are then not checked.
+  bool faces_unkept = false;
 };
 
 // Colours of `count` rows whose positions are `positions` into colors[0 .. count), made on demand;

@@ -304,13 +304,28 @@ class PlyParser {
                                 : e.name == "face" ? face_roles_
                                                    : std::vector<Role>(e.properties.size(), kSkip));
       if (!s.ok()) return s.error();
-      if ((stopped = options_.points_only && e.name == "vertex")) break;
+      if ((stopped = e.name == "vertex" && (options_.points_only || (options_.faces_unkept && facesWholeBySize(e)))))
+        break;
     }
     if (Status s = stopped ? okStatus() : checkEnd(); !s.ok()) return s.error();
     // Ends the line here, as readCsv does: left open, it went on counting the caller's next work
     // as reading time.
     if (options_.progress) options_.progress->finish();
     return std::move(points_);
+  }
+
+  // PlyReadOptions::faces_unkept, after the vertex element `vertex`: whether the rest of the file is
+  // exactly one element of whole triangle rows (a one-byte count, three 32-bit indices).
+  bool facesWholeBySize(const Element& vertex) const {
+    if (ascii_ || elements_.empty() || &elements_.back() == &vertex || elements_.back().name != "face" ||
+        &elements_[elements_.size() - 2] != &vertex)
+      return false;
+    const Element& face = elements_.back();
+    if (face.properties.size() != 1 || !face.properties[0].is_list || typeSize(face.properties[0].count_type) != 1 ||
+        typeSize(face.properties[0].type) != 4)
+      return false;
+    const uint64_t rows = in_.remaining() / 13;
+    return in_.remaining() % 13 == 0 && rows == face.count;
   }
 
   // PlyVertexStream: the header, then where the vertex rows start. Binary only, and every element

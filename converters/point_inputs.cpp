@@ -199,8 +199,8 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     for (const std::vector<TileVertexRef>& mine : refs) copies += mine.size();
     stream->held_bytes_ = copies * (sizeof(glm::dvec3) + sizeof(glm::vec3) + sizeof(TileCopies::Copy) +
                                     sizeof(TileVertexRef));
-    if (Status s = checkMemory(describeInputs(paths) + ": the " + std::to_string(copies) + " seam copies of " +
-                                   std::to_string(paths.size()) + " tiles, held while they stream",
+    if (Status s = checkMemory(describeInputs(paths) + ": holding the " + std::to_string(copies) + " seam copies of " +
+                                   std::to_string(paths.size()) + " tiles while they stream",
                                stream->held_bytes_, max_memory);
         !s)
       return s.error();
@@ -317,9 +317,13 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
       return Error{describeInputs(paths) + ": --stream on reads binary PLY, LAS and LAZ files", ExitCode::kUsage};
     return std::unique_ptr<PointInputStream>();
   }
-  Result<std::unique_ptr<PointInputStream>> opened = PointInputStream::open(paths, threads, max_memory);
+  // Under auto the set may yet be read whole: the copies are held to the default limit only, and
+  // --max-memory applies once the stream is chosen (checkStreamMemory with heldBytes). A stream
+  // that cannot open (an ASCII file, too many files for the open-file limit) is read whole.
+  Result<std::unique_ptr<PointInputStream>> opened =
+      PointInputStream::open(paths, threads, stream == "on" ? max_memory : 0);
   if (!opened) {
-    if (stream == "on" || opened.error().code == ExitCode::kResourceLimit) return opened.error();
+    if (stream == "on") return opened.error();
     return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong
   }
   if (stream == "on" || (*opened)->count() > kStreamAbovePoints) return opened;

@@ -84,8 +84,9 @@ class PointInputStream {
 // paths are binary PLY, LAS or LAZ files of more than kStreamAbovePoints points together; nullptr when the
 // set is to be read whole. With "on", input that cannot be streamed is an error (an ASCII PLY, a
 // bad header: the reader's; another format: kUsage). In memory such a set would take 36 B a point
-// (2.4 GB at 2^26) before the upload's own. A tile set whose copies do not fit `max_memory` is
-// refused whatever `stream` says (kResourceLimit): read whole, it would need more.
+// (2.4 GB at 2^26) before the upload's own. With "on", a tile set whose copies alone do not fit
+// `max_memory` is refused before they are read (kResourceLimit); under "auto" they are held to the
+// default limit, and the caller's checkStreamMemory counts them once the stream is chosen.
 inline constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
                                                           const std::string& stream, unsigned threads,

@@ -8,6 +8,7 @@
 
 #include "converters/copc.h"
 #include "converters/gltf_write.h"
+#include "converters/tile_file.h"
 #include "core/atomic_file.h"
 #include "core/text.h"
 #include "ops/point_filters.h"
@@ -133,7 +134,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
                                           options.columns, options.notices});
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
-                                          options.max_memory});
+                                          options.max_memory, options.faces_unkept});
     case FileFormat::kPcd:
       return readPcd(path, PcdReadOptions{options.allow_nonfinite, options.progress, options.threads, options.max_memory,
                                           options.notices});
@@ -167,7 +168,9 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
                  " needs a LAS file; this file has no such field"};
   Result<PointSet> points = readByFormat(path, *format, options);
   if (!points || las) return points;  // LAS colours are integers, or made here from intensity or class
-  points->colors_read_as_fractions = points->hasColors() && points->color_full_scale == 0;
+  // A tile of `generate --tile` holds generate's own colours as floats: made here, not read.
+  points->colors_read_as_fractions =
+      points->hasColors() && points->color_full_scale == 0 && !(*format == FileFormat::kPly && isTileFile(path));
   if (options.las_color == LasColorSource::kRgb && !points->hasColors())
     return Error{path + ": colour by RGB asked for, but the file has no colours"};
   if (options.las_color == LasColorSource::kNone) points->colors.clear();
@@ -253,19 +256,25 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
   // Colours read as fractions that an integer format rounds: said once the file is there (a review
   // of issue #38's wave: a float-colour PLY went to 8-bit PLY, PCD or PTS without a word).
   const double full = writtenColorScale(path, *format, points, options);
-  const uint64_t off = options.notices && points.colors_read_as_fractions && points.hasColors() && full > 0.0
-                           ? colorsOffGrid(points.colors, full, options.threads)
-                           : 0;
+  const ColorsOffGrid off = options.notices && points.colors_read_as_fractions && points.hasColors() && full > 0.0
+                                ? colorsOffGrid(points.colors, full, options.threads)
+                                : ColorsOffGrid{};
   if (Status s = writeFormat(path, *format, points, options); !s) return s;
-  if (off != 0) {
-    const bool bytes = full == 255.0;
-    std::string keeps = *format == FileFormat::kPly ? "--ply-colors float keeps them"
-                        : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with --ply-colors float, .csv or .glb keeps them"
-                        : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
-                                                      : "LAS holds 0..65535; .ply with --ply-colors float, .csv or .glb keeps them";
-    options.notices->push_back(path + ": " + std::to_string(off) + " of " + std::to_string(points.size()) +
-                               " points have colours read as fractions that are not " + (bytes ? "8" : "16") +
-                               "-bit values: written rounded to 0.." + (bytes ? "255" : "65535") + " (" + keeps + ")");
+  if (off.rounded != 0 || off.clamped != 0) {
+    const std::string scale = full == 255.0 ? "255" : "65535";
+    const std::string keeps = *format == FileFormat::kPly ? "ply_colors or --ply-colors float keeps them"
+                              : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with float colours, .csv or .glb keeps them"
+                              : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
+                                                            : "LAS holds 0..65535; .ply with float colours, .csv or .glb keeps them";
+    const std::string of = " of " + std::to_string(points.size()) + " points have colours read as fractions ";
+    if (off.rounded != 0)
+      options.notices->push_back(path + ": " + std::to_string(off.rounded) + of + "that are not " +
+                                 (full == 255.0 ? "8" : "16") + "-bit values: written rounded to 0.." + scale + " (" +
+                                 keeps + ")");
+    if (off.clamped != 0)
+      options.notices->push_back(path + ": " + std::to_string(off.clamped) + of +
+                                 "with a channel outside 0..1 or not a number: written clamped to 0.." + scale +
+                                 " (colours as fractions are 0..1)");
   }
   return okStatus();
 }

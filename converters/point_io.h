@@ -55,6 +55,7 @@ struct ReadOptions {
   // glTF input: when not null, receives its base-colour textures (GltfReadOptions::texture), for
   // sampling its surface; other formats leave it empty.
   MeshTexture* texture = nullptr;
+  bool faces_unkept = false;  // PLY: PlyReadOptions::faces_unkept (no faces kept; a whole file still checked)
 };
 
 struct WriteOptions {

@@ -28,26 +28,29 @@ bool PointSet::isPlanar() const {
   return planar.load();
 }
 
-uint64_t colorsOffGrid(const ColorArray& colors, double full, unsigned threads) {
+ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned threads) {
   constexpr size_t kBlock = size_t{1} << 18;
-  // A float within two of its ulps (2^-24 below 1) of k / full is k: what a reader of k / full
-  // written as float or double holds. Farther off, rounding changes the colour.
+  // k / full rounded to float is within half an ulp of it (2^-25 below 1, 2^-24 at 1 itself); a
+  // channel farther than full · 2^-24 from a step is changed by rounding.
   const double within = full * 0x1p-24;
-  std::atomic<uint64_t> off{0};
+  std::atomic<uint64_t> rounded{0}, clamped{0};
   parallelFor((colors.size() + kBlock - 1) / kBlock, threads, [&](size_t b, unsigned) {
     const size_t end = std::min(colors.size(), (b + 1) * kBlock);
-    uint64_t mine = 0;
+    uint64_t off = 0, out = 0;
     for (size_t i = b * kBlock; i < end; ++i) {
-      bool on = true;
+      bool outside = false, on = true;
       for (int k = 0; k < 3; ++k) {
-        const double c = static_cast<double>(colors[i][k]) * full;
-        on = on && std::abs(c - static_cast<double>(colorInteger(colors[i][k], full))) <= within;  // NaN: false
+        const float c = colors[i][k];
+        outside = outside || !(c >= 0.0f && c <= 1.0f);  // NaN too
+        on = on && std::abs(static_cast<double>(c) * full - static_cast<double>(colorInteger(c, full))) <= within;
       }
-      mine += on ? 0 : 1;
+      out += outside ? 1 : 0;
+      off += !outside && !on ? 1 : 0;
     }
-    off.fetch_add(mine, std::memory_order_relaxed);
+    rounded.fetch_add(off, std::memory_order_relaxed);
+    clamped.fetch_add(out, std::memory_order_relaxed);
   });
-  return off.load();
+  return {rounded.load(), clamped.load()};
 }
 
 uint64_t heldBytes(const PointSet& points) {

@@ -108,10 +108,13 @@ inline uint16_t colorInteger(float c, double full) {
   return static_cast<uint16_t>((c < 1.0f ? static_cast<double>(c) : 1.0) * full + 0.5);
 }
 
-// The colours whose channels are not all integers of `full` (255, 65535) in 0..1, which a writer of
-// such integers changes (colorInteger; NaN and values outside 0..1 count): 0 for colours read as
-// k / full in float or double (within full · 2^-24 of k at that scale). On `threads`.
-uint64_t colorsOffGrid(const ColorArray& colors, double full, unsigned threads);
+// The colours a writer of integers of `full` (255, 65535) changes (colorInteger): `clamped`, those
+// with a channel outside 0..1 or NaN; `rounded`, the others with a channel between two steps. Both
+// 0 for colours read as k / full in float or double (within full · 2^-24 of k at that scale).
+struct ColorsOffGrid {
+  uint64_t rounded = 0, clamped = 0;
+};
+ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned threads);
 
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {

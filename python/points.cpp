@@ -147,6 +147,7 @@ void setColors(PointSet& set, const py::handle& value, const py::handle& self = 
   if (value.is_none()) {
     set.colors.clear();
     set.color_full_scale = 0;
+    set.colors_read_as_fractions = false;
     return;
   }
   py::array table = asTable(value, "colors", false);
@@ -186,8 +187,10 @@ void setColors(PointSet& set, const py::handle& value, const py::handle& self = 
   else
     set.colors = std::move(colors);
   // New colours have no source form: a set read from a file of 0..255 integers wrote colours set
-  // after as 8-bit integers (a review finding: 0.123456 written as 31).
+  // after as 8-bit integers (a review finding: 0.123456 written as 31). Nor were they read from a
+  // file: a writer of integers rounds them as it rounds generated ones.
   set.color_full_scale = 0;
+  set.colors_read_as_fractions = false;
 }
 
 // The dimension type of a NumPy dtype: its integer and float types, bool as uint8.

@@ -362,8 +362,10 @@ TEST(CliConvertMeaning, fractionColoursRoundedToIntegersAreSaid) {
 }
 
 // Only PLY and GLB hold triangles: converting a PLY mesh to another format reads its vertices and
-// stops before the faces (the build before read them all to drop them). A face list past repair
-// then does not stop a conversion that would not have written it; one to PLY still refuses it.
+// stops before triangle rows whose size shows them whole (the build before read them all to drop
+// them). An index past the vertices then does not stop a conversion that would not have written
+// it; one to PLY still refuses it, and a file cut short or with bytes after its end is refused
+// whatever the output (a review finding: the first version passed them).
 TEST(CliConvertMeaning, aMeshToAPointFormatReadsNoFaces) {
   TempDir dir;
   ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "17", "--variant", "fast", "-q", "-o",
@@ -388,6 +390,17 @@ TEST(CliConvertMeaning, aMeshToAPointFormatReadsNoFaces) {
     const test::CommandResult r = runDpoint({"convert", dir.file("bad.ply"), "-o", dir.file(out)});
     EXPECT_EQ(r.exit_code, 2) << out << ": " << r.err;
     EXPECT_FALSE(test::fileExists(dir.file(out)));
+  }
+  for (const bool cut : {true, false}) {
+    SCOPED_TRACE(cut ? "cut short" : "bytes after the end");
+    const std::string good = readFile(dir.file("m.ply"));
+    writeFile(dir.file("broken.ply"), cut ? good.substr(0, good.size() - 100) : good + "garbage");
+    for (const char* out : {"broken.pcd", "broken.csv", "broken-out.ply"}) {
+      const test::CommandResult r = runDpoint({"convert", dir.file("broken.ply"), "-o", dir.file(out)});
+      EXPECT_EQ(r.exit_code, 2) << out << ": " << r.err;
+      EXPECT_TRUE(test::contains(r.err, dir.file("broken.ply"))) << r.err;
+      EXPECT_FALSE(test::fileExists(dir.file(out)));
+    }
   }
   // --sample needs the faces, whatever the output.
   const test::CommandResult sampled =

@@ -236,11 +236,15 @@ TEST(CliTiles, aStreamedTileSetCountsItsCopiesAgainstMaxMemory) {
   };
   test::CommandResult r = info(held - 1);
   EXPECT_EQ(r.exit_code, 4) << r.err;
-  EXPECT_NE(r.err.find("the " + std::to_string(copies) + " seam copies of 2 tiles"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("holding the " + std::to_string(copies) + " seam copies of 2 tiles while they stream needs"), std::string::npos) << r.err;
   r = info(blocks + held - 1);
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("points a block at a time beside"), std::string::npos) << r.err;
   r = info(blocks + held);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  // Under --stream auto a set this small is read whole: the copies' limit is the stream's (the
+  // first version refused it, naming a stream that was never to be).
+  r = runDpoint({"info", "--max-memory", std::to_string(held - 1), dir.file("part-0.ply"), dir.file("part-1.ply")});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(std::to_string(owned)), std::string::npos) << r.out;
   r = runDpoint({"render", "-q", "--stream", "on", "--width", "32", "--height", "24", "--max-memory",

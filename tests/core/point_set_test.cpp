@@ -9,27 +9,29 @@ namespace dpoint {
 namespace {
 
 // Colours read as k / 255 or k / 65535 (float or double, rounded to float) are on their grid; a
-// fraction between two steps, NaN and values outside 0..1 are not: a writer of integers changes them.
+// fraction between two steps is rounded, NaN and values outside 0..1 clamped, by a writer of integers.
 TEST(PointSet, colorsOffGridCountsTheColoursAnIntegerWriterChanges) {
   ColorArray colors;
   for (int k = 0; k < 256; ++k) {
     colors.push_back(glm::vec3(static_cast<float>(k) / 255.0f, static_cast<float>(k / 255.0), 1.0f));
   }
-  EXPECT_EQ(colorsOffGrid(colors, 255.0, 2), 0u);
-  EXPECT_EQ(colorsOffGrid(colors, 65535.0, 2), 0u);  // k / 255 is 257 k / 65535
+  EXPECT_EQ(colorsOffGrid(colors, 255.0, 2).rounded + colorsOffGrid(colors, 255.0, 2).clamped, 0u);
+  EXPECT_EQ(colorsOffGrid(colors, 65535.0, 2).rounded + colorsOffGrid(colors, 65535.0, 2).clamped, 0u);  // k / 255 is 257 k / 65535
   ColorArray words;
   for (int k = 0; k < 65536; k += 7) words.push_back(glm::vec3(static_cast<float>(k / 65535.0), 0.0f, 0.0f));
-  EXPECT_EQ(colorsOffGrid(words, 65535.0, 2), 0u);
-  EXPECT_GT(colorsOffGrid(words, 255.0, 2), words.size() * 9 / 10);
+  EXPECT_EQ(colorsOffGrid(words, 65535.0, 2).rounded, 0u);
+  EXPECT_GT(colorsOffGrid(words, 255.0, 2).rounded, words.size() * 9 / 10);
   ColorArray odd = {glm::vec3(0.5f, 0.0f, 0.0f), glm::vec3(0.0f, std::nanf(""), 0.0f), glm::vec3(0.0f, 0.0f, 1.5f),
                     glm::vec3(-0.25f, 0.0f, 0.0f), glm::vec3(0.2f, 0.4f, 0.6f)};
-  EXPECT_EQ(colorsOffGrid(odd, 255.0, 1), 4u);  // 0.2, 0.4, 0.6 are 51, 102, 153
-  EXPECT_EQ(colorsOffGrid(odd, 65535.0, 1), 4u);
-  EXPECT_EQ(colorsOffGrid(ColorArray(), 255.0, 0), 0u);
+  for (double full : {255.0, 65535.0}) {
+    EXPECT_EQ(colorsOffGrid(odd, full, 1).rounded, 1u);  // 0.5; 0.2, 0.4, 0.6 are 51, 102, 153
+    EXPECT_EQ(colorsOffGrid(odd, full, 1).clamped, 3u);  // NaN, 1.5, -0.25
+  }
+  EXPECT_EQ(colorsOffGrid(ColorArray(), 255.0, 0).rounded, 0u);
   // Many blocks on several threads count as one.
   ColorArray many(1000000, glm::vec3(0.0f));
   for (size_t i = 0; i < many.size(); i += 1000) many[i].g = 0.3f;
-  EXPECT_EQ(colorsOffGrid(many, 255.0, 4), 1000u);
+  EXPECT_EQ(colorsOffGrid(many, 255.0, 4).rounded, 1000u);
 }
 
 }  // namespace

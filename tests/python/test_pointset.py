@@ -496,8 +496,13 @@ def test_colours_read_as_fractions_are_said_when_rounded_and_kept_by_pickle(tmp_
     for s in (read, pickle.loads(pickle.dumps(read)), read.copy()):
         with pytest.warns(UserWarning, match=r"1 of 2 points have colours read as fractions that are not 8-bit"):
             dpoint.write(s, tmp_path / "f.pcd")
+    with pytest.warns(UserWarning, match=r"not 8-bit values: written rounded to 0\.\.255 \(ply_colors or --ply-colors"):
+        dpoint.write(read, tmp_path / "f.ply")
+    mine = read.copy()
+    mine.colors = read.colors  # colours set in Python are not read from a file
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        dpoint.write(mine, tmp_path / "mine.pcd")
         dpoint.write(read, tmp_path / "f.csv.ply", ply_colors="float")
         dpoint.write(dpoint.generate("menger", level=1), tmp_path / "m.pcd")
         dpoint.write(dpoint.read(tmp_path / "f.pcd"), tmp_path / "again.pcd")  # now 8-bit values
