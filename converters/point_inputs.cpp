@@ -37,21 +37,23 @@ Result<InputSet> checkInputSet(const std::vector<std::string>& paths) {
       return Error{paths[seen[k].index] + ": given twice as an input (also " + paths[seen[k - 1].index] + ")",
                    ExitCode::kUsage};
   if (set.tiles != paths.size()) return set;
-  std::vector<std::string> given;  // by index, of the first file's count
+  std::vector<std::pair<std::string, uint64_t>> given;  // by index, of the first file's count
   uint32_t count = 0;
   std::string signature;
   for (size_t i = 0; i < paths.size(); ++i) {
     Result<TileHeader> h = readTileHeader(paths[i]);
     if (!h) return h.error();
-    if (i == 0) count = h->tile.count, given.assign(count, ""), signature = h->signature;
+    if (i == 0) count = h->tile.count, given.assign(count, {}), signature = h->signature;
     // Tiles of several runs (another count, or other options: a tile 0 of each was "tile 0 again"):
     // file by file.
     if (h->tile.count != count || h->signature != signature) return set;
-    if (!given[h->tile.index].empty())
-      return Error{paths[i] + ": tile " + std::to_string(h->tile.index) + " again (also " + given[h->tile.index] + ")"};
-    given[h->tile.index] = paths[i];
+    if (!given[h->tile.index].first.empty())
+      return Error{paths[i] + ": tile " + std::to_string(h->tile.index) + " again (also " +
+                   given[h->tile.index].first + ")"};
+    given[h->tile.index] = {paths[i], h->owned};
   }
   set.whole = paths.size() == count;  // each index once: all of them
+  if (set.whole) set.in_tile_order = std::move(given);
   return set;
 }
 
@@ -73,7 +75,7 @@ std::optional<std::string> tilesFileByFile(const std::vector<std::string>& paths
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
   if (paths.size() == 1) {
     if (options.notices)
-      if (std::optional<std::string> note = tilesFileByFile(paths, InputSet{false, isTileFile(paths[0]) ? 1u : 0u}))
+      if (std::optional<std::string> note = tilesFileByFile(paths, InputSet{false, isTileFile(paths[0]) ? 1u : 0u, {}}))
         options.notices->push_back(*note);
     return readPoints(paths[0], options);
   }
@@ -204,12 +206,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
                                stream->held_bytes_, max_memory);
         !s)
       return s.error();
-    files.resize(paths.size());
-    for (const std::string& path : paths) {
-      Result<TileHeader> h = readTileHeader(path);
-      if (!h) return h.error();
-      files[h->tile.index] = {path, h->owned};
-    }
+    files = set->in_tile_order;
   } else {
     for (const std::string& path : paths) files.emplace_back(path, UINT64_MAX);
     if (std::optional<std::string> note = tilesFileByFile(paths, *set)) stream->notices_.push_back(*note);

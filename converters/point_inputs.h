@@ -30,6 +30,7 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
 struct InputSet {
   bool whole = false;
   size_t tiles = 0;
+  std::vector<std::pair<std::string, uint64_t>> in_tile_order;  // whole: tile t's path and owned vertices
 };
 Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 
