@@ -229,8 +229,6 @@ Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven&
 
 namespace {
 
-Status writeFormat(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options);
-
 // The integer full scale `format` writes a set's colours at (255, 65535), 0 where it keeps floats.
 double writtenColorScale(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options) {
   switch (format) {
@@ -247,39 +245,6 @@ double writtenColorScale(const std::string& path, FileFormat format, const Point
     default: return 0.0;
   }
 }
-
-}  // namespace
-
-Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
-  Result<FileFormat> format = formatOf(path);
-  if (!format) return format.error();
-  // Colours read as fractions that an integer format rounds: said once the file is there (a review
-  // of issue #38's wave: a float-colour PLY went to 8-bit PLY, PCD or PTS without a word).
-  const double full = writtenColorScale(path, *format, points, options);
-  const ColorsOffGrid off = options.notices && points.colors_read_as_fractions && points.hasColors() && full > 0.0
-                                ? colorsOffGrid(points.colors, full, options.threads)
-                                : ColorsOffGrid{};
-  if (Status s = writeFormat(path, *format, points, options); !s) return s;
-  if (off.rounded != 0 || off.clamped != 0) {
-    const std::string scale = full == 255.0 ? "255" : "65535";
-    const std::string keeps = *format == FileFormat::kPly ? "ply_colors or --ply-colors float keeps them"
-                              : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with float colours, .csv or .glb keeps them"
-                              : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
-                                                            : "LAS holds 0..65535; .ply with float colours, .csv or .glb keeps them";
-    const std::string of = " of " + std::to_string(points.size()) + " points have colours read as fractions ";
-    if (off.rounded != 0)
-      options.notices->push_back(path + ": " + std::to_string(off.rounded) + of + "that are not " +
-                                 (full == 255.0 ? "8" : "16") + "-bit values: written rounded to 0.." + scale + " (" +
-                                 keeps + ")");
-    if (off.clamped != 0)
-      options.notices->push_back(path + ": " + std::to_string(off.clamped) + of +
-                                 "with a channel outside 0..1 or not a number: written clamped to 0.." + scale +
-                                 " (colours as fractions are 0..1)");
-  }
-  return okStatus();
-}
-
-namespace {
 
 Status writeFormat(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options) {
   if ((options.colors_of || options.positions_of) && format != FileFormat::kPly)
@@ -390,6 +355,35 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
 }
 
 }  // namespace
+
+Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
+  Result<FileFormat> format = formatOf(path);
+  if (!format) return format.error();
+  // Colours read as fractions that an integer format rounds: said once the file is there (a review
+  // of issue #38's wave: a float-colour PLY went to 8-bit PLY, PCD or PTS without a word).
+  const double full = writtenColorScale(path, *format, points, options);
+  const ColorsOffGrid off = options.notices && points.colors_read_as_fractions && points.hasColors() && full > 0.0
+                                ? colorsOffGrid(points.colors, full, options.threads)
+                                : ColorsOffGrid{};
+  if (Status s = writeFormat(path, *format, points, options); !s) return s;
+  if (off.rounded != 0 || off.clamped != 0) {
+    const std::string scale = full == 255.0 ? "255" : "65535";
+    const std::string keeps = *format == FileFormat::kPly ? "ply_colors or --ply-colors float keeps them"
+                              : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with float colours, .csv or .glb keeps them"
+                              : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
+                                                            : "LAS holds 0..65535; .ply with float colours, .csv or .glb keeps them";
+    const std::string of = " of " + std::to_string(points.size()) + " points have colours read as fractions ";
+    if (off.rounded != 0)
+      options.notices->push_back(path + ": " + std::to_string(off.rounded) + of + "that are not " +
+                                 (full == 255.0 ? "8" : "16") + "-bit values: written rounded to 0.." + scale + " (" +
+                                 keeps + ")");
+    if (off.clamped != 0)
+      options.notices->push_back(path + ": " + std::to_string(off.clamped) + of +
+                                 "with a channel outside 0..1 or not a number: written clamped to 0.." + scale +
+                                 " (colours as fractions are 0..1)");
+  }
+  return okStatus();
+}
 
 Status selectDimensions(PointSet& points, const DimensionChoice& choice, const std::string& what) {
   const auto names = [](const std::string& list) {  // empty names (a doubled comma) are passed over

@@ -152,12 +152,6 @@ class TextBuffer {
   void clear() { used_ = 0; }
   size_t size() const { return used_; }
   const char* data() const { return bytes_.data(); }
-  // Room for at least `size` more characters at the end; advance() takes those written.
-  char* room(size_t size) {
-    if (used_ + size > bytes_.size()) bytes_.resize(std::max(2 * bytes_.size(), used_ + size + 4096));
-    return bytes_.data() + used_;
-  }
-  void advance(size_t size) { used_ += size; }
   void append(char c) { *room(1) = c, ++used_; }
   void append(std::string_view piece) {
     std::memcpy(room(piece.size()), piece.data(), piece.size());
@@ -172,6 +166,11 @@ class TextBuffer {
   }
 
  private:
+  // Room for at least `size` more characters at the end.
+  char* room(size_t size) {
+    if (used_ + size > bytes_.size()) bytes_.resize(std::max(2 * bytes_.size(), used_ + size + 4096));
+    return bytes_.data() + used_;
+  }
   std::vector<char, DefaultInitAllocator<char>> bytes_;
   size_t used_ = 0;
 };
