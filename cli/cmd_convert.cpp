@@ -65,8 +65,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress, M
   // shows them whole (PlyReadOptions::faces_unkept), unless --sample needs them: a PLY mesh to PCD
   // read its faces only to drop them.
   Result<FileFormat> out_format = formatOf(o.output);
-  const bool triangles = !out_format || *out_format == FileFormat::kPly || *out_format == FileFormat::kGlb ||
-                         *out_format == FileFormat::kGltf || o.sample.count != 0;
+  const bool triangles = !out_format || holdsTriangles(*out_format) || o.sample.count != 0;
   g.triangles = triangles;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.faces_unkept = !triangles;

@@ -49,7 +49,8 @@ int runMerge(const MergeOptions& o) {
     if (Status s = mergeTilesToPly(o.inputs, o.output, ply, limit); !s) return reportError(s.error());
     return 0;
   }
-  Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress, o.common.threads);
+  // For a format without triangles the tiles' face rows are not read.
+  Result<PointSet> merged = mergeTiles(o.inputs, limit, &progress, o.common.threads, !format || holdsTriangles(*format));
   if (!merged) return reportError(merged.error());
   PointSet& points = *merged;
   // From here on as `dpoint generate` finishes a whole set (cli_generate_output.cpp: finish).

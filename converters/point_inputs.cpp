@@ -88,9 +88,8 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
   Result<InputSet> set = checkInputSet(paths);
   if (!set) return set.error();
   if (set->whole) {
-    Result<PointSet> whole = mergeTiles(paths, 0, options.progress, options.threads);
-    if (whole && options.points_only) whole->triangles.clear();
-    return whole;
+    return mergeTiles(paths, options.max_memory, options.progress, options.threads,
+                      !options.points_only && !options.faces_unkept);
   }
   if (options.notices)
     if (std::optional<std::string> note = tilesFileByFile(paths, *set)) options.notices->push_back(*note);

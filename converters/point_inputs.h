@@ -19,7 +19,8 @@ namespace dpoint {
 // files is read file by file (a tile then brings its copies of seam vertices too). Colours: kept
 // when every file with points has them, none when none has; in a mix, the files without get white,
 // the colour the renderer gives a set without colours. One path is readPoints(path). Errors are
-// the files' own, naming the file.
+// the files' own, naming the file. A whole tile set is checked against options.max_memory (as
+// mergeTiles checks it), and with points_only or faces_unkept its face rows are not read.
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options = {});
 
 // Several inputs read as one set: no file given twice (a usage error), and no tile twice among

@@ -22,8 +22,8 @@ enum class FileFormat { kCsv, kPly, kPcd, kGlb, kGltf, kLas, kLaz };
 // From the extension, case-insensitive. Error names the path and the extensions accepted.
 Result<FileFormat> formatOf(const std::string& path);
 inline bool isGltf(FileFormat format) { return format == FileFormat::kGlb || format == FileFormat::kGltf; }
-// The error for a format that is read but not written (.gltf, LAZ), with what to write instead;
-// ok for the others. writePoints and the CLI's output check both give it.
+// The formats that hold a mesh's triangles; the others (CSV, PTS, PCD, LAS, LAZ, COPC) keep points only.
+inline bool holdsTriangles(FileFormat format) { return format == FileFormat::kPly || isGltf(format); }
 // True for a path ending in .copc.laz (any case): written as COPC (converters/copc.h), an octree
 // of LAZ 1.4 chunks that reads as plain LAZ too.
 bool isCopcPath(const std::string& path);
@@ -35,6 +35,8 @@ struct CopcReadStats {
 };
 Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query, const LasReadOptions& options,
                                 CopcReadStats* stats = nullptr);
+// The error for a format that is read but not written (.gltf), with what to write instead;
+// ok for the others. writePoints and the CLI's output check both give it.
 Status checkWrittenFormat(const std::string& path, FileFormat format);
 
 struct ReadOptions {

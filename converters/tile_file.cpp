@@ -555,14 +555,17 @@ Result<std::vector<std::vector<TileVertexRef>>> readTileCopyRefs(const std::vect
 }
 
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory, Progress* progress,
-                            unsigned threads) {
+                            unsigned threads, bool with_faces) {
   Result<TileSet> opened = openTileSet(paths, threads);
   if (!opened) return opened.error();
   const TileSet& set = *opened;
   const uint32_t count = set.count();
   const bool colors = set.colors;
-  const uint64_t vertices = set.vertices(), faces = set.faces();
-  const uint64_t bytes = vertices * (sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0)) + faces * 3 * sizeof(uint32_t);
+  const uint64_t vertices = set.vertices(), faces = with_faces ? set.faces() : 0;
+  uint64_t copies = 0;  // held beside the set until checked against their owners
+  for (uint32_t t = 0; t < count; ++t) copies += set.foreign[t].size();
+  const uint64_t bytes = (vertices + copies) * (sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0)) +
+                         faces * 3 * sizeof(uint32_t);
   if (Status s = checkMemory("merging " + std::to_string(count) + " tiles", bytes, max_memory); !s) return s.error();
 
   // Every tile's rows, kRowsPerBlock at a time on all cores, straight to their places: owned
@@ -579,7 +582,7 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
   }
   std::vector<RowBlock> blocks;
   addBlocks(set, false, [&](uint32_t t) { return set.tile[t]->parsed.header.vertices; }, blocks);
-  addBlocks(set, true, [&](uint32_t t) { return set.tile[t]->parsed.header.faces; }, blocks);
+  if (with_faces) addBlocks(set, true, [&](uint32_t t) { return set.tile[t]->parsed.header.faces; }, blocks);
   uint64_t all_rows = 0;  // every tile's vertex rows (copies included) and faces
   for (const RowBlock& block : blocks) all_rows += block.rows;
   if (progress) progress->start("merging " + std::to_string(count) + " tiles", all_rows);

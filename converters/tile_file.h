@@ -77,9 +77,11 @@ Result<PointTile> readTile(const std::string& path);
 // against its owner. Errors (kBadInput) name the file: a missing, repeated or extra tile, tiles of
 // different runs (signatures) or counts, a reference past its owner's vertices, a copy that differs
 // from its owner; kResourceLimit past 2^32 vertices or over `max_memory` (0: half of RAM). The
-// parts are read on `threads` cores (0: all), each block of rows straight into its place.
+// parts are read on `threads` cores (0: all), each block of rows straight into its place. Without
+// `faces` (for a point format) the face rows are not read: the set has no triangles, and their
+// bytes are neither held nor counted against max_memory (the tiles' sizes are still checked).
 Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_memory = 0,
-                            Progress* progress = nullptr, unsigned threads = 0);
+                            Progress* progress = nullptr, unsigned threads = 0, bool faces = true);
 // The copies' references of all N tiles of one run, in any order of `paths`, checked as mergeTiles
 // checks them (every tile once, one run, each reference to an owned vertex that exists; but any
 // number of vertices, 2^32 and more), by tile: refs[t][f] is the owner of tile t's copy f (its

@@ -183,7 +183,8 @@ TEST(CliTiles, mergeRefusesACopyThatDiffersFromItsOwner) {
   test::writeFile(dir.file(part), bytes);
   test::CommandResult streamed = runDpoint({"info", "--stream", "on", dir.file("part-0.ply"), dir.file("part-1.ply")});
   EXPECT_EQ(streamed.exit_code, 0) << streamed.err;
-  // With a bad face as well, both paths name the face: rows are read and checked before copies.
+  // With a bad face as well, the merge into a .ply names the face: rows are read and checked before
+  // copies. Into a .csv the faces are not read (a point format keeps none): the copy is named.
   std::string bad = bytes;
   bad[data + owned * 36] ^= 1;
   bad[data + vertices * 36] = 4;  // the first face's corner count
@@ -191,10 +192,85 @@ TEST(CliTiles, mergeRefusesACopyThatDiffersFromItsOwner) {
   for (const char* out : {"bad.ply", "bad.csv"}) {
     test::CommandResult r = runDpoint({"merge", "-q", dir.file("part-0.ply"), dir.file("part-1.ply"), "-o", dir.file(out)});
     EXPECT_EQ(r.exit_code, 2) << out;
-    EXPECT_NE(r.err.find(dir.file(part) + ": byte " + std::to_string(data + vertices * 36) + ": face 0 has 4 corners"),
-              std::string::npos)
-        << out << ": " << r.err;
+    const std::string named = std::string(out) == "bad.ply" ? ": byte " + std::to_string(data + vertices * 36) + ": face 0 has 4 corners"
+                                                            : ": its copy of vertex ";
+    EXPECT_NE(r.err.find(dir.file(part) + named), std::string::npos) << out << ": " << r.err;
   }
+}
+
+// The tiles' face rows are read only where the output holds triangles (PLY, GLB) or the reader
+// keeps them: merge to a point format, and render's points, pass over them (the tiles' sizes are
+// still checked). A face index past the vertices is then not seen, as nothing is written from it.
+TEST(CliTiles, aPointOutputReadsNoFacesOfTheTiles) {
+  TempDir dir;
+  const std::vector<std::string> kind = {"julia", "--resolution", "21"};
+  ASSERT_FALSE(mergedTiles(dir, kind, 2, "good.pcd").empty());
+  const std::string good_pcd = readFile(dir.file("good.pcd"));
+  const std::string bytes = readFile(dir.file("part-0.ply"));
+  const uint64_t vertices = std::stoull(bytes.substr(bytes.find("element vertex ") + 15));
+  const size_t face = bytes.find("end_header\n") + 11 + vertices * 36;  // rows of 3 double, 3 float
+  ASSERT_EQ(bytes[face], 3);
+  std::string bad = bytes;
+  bad.replace(face + 1, 4, "\xff\xff\xff\xff");  // the first face's first corner: vertex 2^32 - 1
+  test::writeFile(dir.file("part-0.ply"), bad);
+  const auto merge = [&](const std::string& out) {
+    return runDpoint({"merge", "-q", dir.file("part-0.ply"), dir.file("part-1.ply"), "-o", dir.file(out)});
+  };
+  for (const char* out : {"m.pcd", "m.csv", "m.las"}) EXPECT_EQ(merge(out).exit_code, 0) << out << ": " << merge(out).err;
+  EXPECT_TRUE(readFile(dir.file("m.pcd")) == good_pcd);
+  for (const char* out : {"m.ply", "m.glb"}) {
+    test::CommandResult r = merge(out);
+    EXPECT_EQ(r.exit_code, 2) << out;
+    EXPECT_TRUE(test::contains(r.err, dir.file("part-0.ply") + ": byte " + std::to_string(face) + ": face 0 uses vertex 4294967295"))
+        << out << ": " << r.err;
+    EXPECT_FALSE(test::fileExists(dir.file(out)));
+  }
+  // render of the vertices reads the set as points (the build before read and welded every face,
+  // then dropped them); info counts the triangles, so it reads them.
+  test::CommandResult r = runDpoint({"render", "-q", "--surface", "off", "--width", "32", "--height", "24", "-o",
+                                     dir.file("p.png"), dir.file("part-0.ply"), dir.file("part-1.ply")});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  r = runDpoint({"info", dir.file("part-0.ply"), dir.file("part-1.ply")});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  // A tile cut short is refused to every format.
+  test::writeFile(dir.file("part-0.ply"), bytes.substr(0, bytes.size() - 1));
+  for (const char* out : {"cut.pcd", "cut.ply"}) {
+    r = merge(out);
+    EXPECT_EQ(r.exit_code, 2) << out;
+    EXPECT_TRUE(test::contains(r.err, "(a truncated or padded tile)")) << r.err;
+  }
+}
+
+// A tile set read whole (render, info) is held to --max-memory as `dpoint merge` holds it: its
+// points, the seam copies beside them and the faces it reads (the build before read it whole under
+// any limit).
+TEST(CliTiles, aTileSetReadWholeKeepsToMaxMemory) {
+  TempDir dir;
+  ASSERT_FALSE(mergedTiles(dir, {"mandelbulb", "--resolution", "33", "--variant", "fast"}, 2, "good.ply").empty());
+  uint64_t vertices = 0, faces = 0;
+  for (const char* name : {"part-0.ply", "part-1.ply"}) {
+    const std::string bytes = readFile(dir.file(name));
+    vertices += std::stoull(bytes.substr(bytes.find("element vertex ") + 15));
+    faces += std::stoull(bytes.substr(bytes.find("element face ") + 13));
+  }
+  const uint64_t needs = vertices * 36 + faces * 12;  // every row of both parts; three indices a face
+  const auto info = [&](uint64_t limit) {
+    return runDpoint({"info", "--max-memory", std::to_string(limit), dir.file("part-0.ply"), dir.file("part-1.ply")});
+  };
+  test::CommandResult r = info(needs - 1);
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "merging 2 tiles needs about " + std::to_string(needs) + " bytes")) << r.err;
+  r = info(needs);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  // render of the vertices reads no faces: its limit is the points' and copies' (past its picture's).
+  const uint64_t points = vertices * 36;
+  ASSERT_GT(points, 32u * 24 * 32) << "a set too small to be refused after the picture";
+  r = runDpoint({"render", "-q", "--surface", "off", "--width", "32", "--height", "24", "--max-memory",
+                 std::to_string(points - 1), "-o", dir.file("p.png"), dir.file("part-0.ply"), dir.file("part-1.ply")});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "merging 2 tiles needs about " + std::to_string(points) + " bytes")) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "merging 2 tiles needs about")) << r.err;
+  EXPECT_FALSE(test::fileExists(dir.file("p.png")));
 }
 
 // The streamed merge into a .ply holds a few blocks a thread and the copies: --max-memory still
@@ -243,8 +319,13 @@ TEST(CliTiles, aStreamedTileSetCountsItsCopiesAgainstMaxMemory) {
   r = info(blocks + held);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   // Under --stream auto a set this small is read whole: the copies' limit is the stream's (the
-  // first version refused it, naming a stream that was never to be).
+  // first version refused it, naming a stream that was never to be), and the whole set's is the
+  // merge's (aTileSetReadWholeKeepsToMaxMemory).
   r = runDpoint({"info", "--max-memory", std::to_string(held - 1), dir.file("part-0.ply"), dir.file("part-1.ply")});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "merging 2 tiles needs about")) << r.err;
+  EXPECT_FALSE(test::contains(r.err, "while they stream")) << r.err;
+  r = runDpoint({"info", "--max-memory", "1G", dir.file("part-0.ply"), dir.file("part-1.ply")});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(std::to_string(owned)), std::string::npos) << r.out;
   r = runDpoint({"render", "-q", "--stream", "on", "--width", "32", "--height", "24", "--max-memory",
