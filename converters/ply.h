@@ -36,6 +36,10 @@
 
 namespace dpoint {
 
+// The header comment word of a tile of `generate --tile` (`comment dpoint-tile I/N`,
+// converters/tile_file.h): its float colours are generate's own, not read as fractions from a file.
+inline constexpr const char* kPlyTileCommentWord = "dpoint-tile";
+
 enum class PlyEncoding { kBinary, kAscii };
 // The colour properties' type. kAuto: ushort for a set whose colours came as 16-bit integers
 // (PointSet::color_full_scale 65535: LAS), so they keep every bit, else uchar; kUchar: 8-bit

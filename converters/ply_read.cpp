@@ -467,6 +467,7 @@ class PlyParser {
       if (line_no == 1) continue;  // the magic, checked above
       if (w.empty()) return headerError(line_no, "empty line");
       const std::string_view key = w[0];
+      if (key == "comment" && w.size() >= 2 && w[1] == kPlyTileCommentWord) tile_ = true;
       if (key == "comment" && w.size() >= 3 && w[1] == "dpoint:") {
         // The facts dpoint writes (ply_write.cpp): a 2D source, and z up.
         if (w[2] == "2D") points_.z_axis = ZAxis::kAbsent;
@@ -639,6 +640,9 @@ class PlyParser {
     if (has_colors_ && divisor_[kRed] == divisor_[kGreen] && divisor_[kGreen] == divisor_[kBlue] &&
         (divisor_[kRed] == 65535.0f || (divisor_[kRed] == 255.0f && (points_.las || integer_colours_))))
       points_.color_full_scale = static_cast<uint16_t>(divisor_[kRed]);
+    // Colours of a 0..1 scale that an integer writer may round (PointSet::colors_read_as_fractions),
+    // except a tile's, which generate made.
+    points_.colors_read_as_fractions = has_colors_ && points_.color_full_scale == 0 && !tile_;
     if (has_colors_ && !(found[kRed] && found[kGreen] && found[kBlue]))
       return headerError(std::max({found[kRed], found[kGreen], found[kBlue]}),
                          "vertex colours need all of red, green and blue");
@@ -1370,6 +1374,7 @@ class PlyParser {
   std::vector<Role> vertex_roles_, face_roles_;
   bool has_colors_ = false;
   bool integer_colours_ = false;  // the header's `comment dpoint: colours 0..255`
+  bool tile_ = false;  // the header's `comment dpoint-tile I/N` (kPlyTileCommentWord)
   std::vector<std::pair<LasVlr, bool>> crs_records_;  // the header's `las crs` records, each whole or not
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;

@@ -8,7 +8,6 @@
 
 #include "converters/copc.h"
 #include "converters/gltf_write.h"
-#include "converters/tile_file.h"
 #include "core/atomic_file.h"
 #include "core/text.h"
 #include "ops/point_filters.h"
@@ -168,9 +167,8 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
                  " needs a LAS file; this file has no such field"};
   Result<PointSet> points = readByFormat(path, *format, options);
   if (!points || las) return points;  // LAS colours are integers, or made here from intensity or class
-  // A tile of `generate --tile` holds generate's own colours as floats: made here, not read.
-  points->colors_read_as_fractions =
-      points->hasColors() && points->color_full_scale == 0 && !(*format == FileFormat::kPly && isTileFile(path));
+  // The PLY reader tells a tile's colours (generate's own) from a file's itself.
+  if (*format != FileFormat::kPly) points->colors_read_as_fractions = points->hasColors() && points->color_full_scale == 0;
   if (options.las_color == LasColorSource::kRgb && !points->hasColors())
     return Error{path + ": colour by RGB asked for, but the file has no colours"};
   if (options.las_color == LasColorSource::kNone) points->colors.clear();

@@ -25,7 +25,7 @@
 namespace dpoint {
 namespace {
 
-constexpr const char* kTileComment = "comment dpoint-tile ";
+const std::string kTileComment = std::string("comment ") + kPlyTileCommentWord + " ";
 constexpr const char* kOwnedComment = "comment dpoint-tile-owned ";
 constexpr const char* kSignatureComment = "comment dpoint-tile-of ";
 constexpr const char* kPadComment = "comment dpoint-tile-pad ";
@@ -66,9 +66,9 @@ Result<ParsedHeader> parseHeader(const std::string& path, std::FILE* file) {
   auto bad = [&](int at, const std::string& why) { return Error{path + ": header line " + std::to_string(at) + ": " + why}; };
   while (std::getline(lines, line)) {
     ++line_no;
-    if (startsWith(line, kTileComment)) {
-      const std::string spec = line.substr(std::strlen(kTileComment));
-      Result<TileSpec> t = parseTileSpec("dpoint-tile", spec);
+    if (startsWith(line, kTileComment.c_str())) {
+      const std::string spec = line.substr(kTileComment.size());
+      Result<TileSpec> t = parseTileSpec(kPlyTileCommentWord, spec);
       if (!t) return bad(line_no, "bad tile '" + spec + "'");
       h.tile = *t;
       has_tile = true;

@@ -359,6 +359,18 @@ TEST(CliConvertMeaning, fractionColoursRoundedToIntegersAreSaid) {
       runDpoint({"generate", "mandelbulb", "--resolution", "24", "-o", dir.file("made.pcd")});
   ASSERT_EQ(made.exit_code, 0) << made.err;
   EXPECT_FALSE(test::contains(made.err, "read as fractions")) << made.err;
+  // So are a tile's, read back (the PLY reader knows a tile by its header comment); a float PLY
+  // written from it is a file's like any other.
+  ASSERT_EQ(runDpoint({"generate", "mandelbulb", "--resolution", "24", "--tile", "0/2", "-q", "-o", dir.file("t.ply")})
+                .exit_code,
+            0);
+  test::CommandResult tile = runDpoint({"convert", dir.file("t.ply"), "-o", dir.file("t.pcd")});
+  ASSERT_EQ(tile.exit_code, 0) << tile.err;
+  EXPECT_FALSE(test::contains(tile.err, "read as fractions")) << tile.err;
+  expectConverts({dir.file("t.ply"), "-o", dir.file("tf.ply"), "--ply-colors", "float"});
+  tile = runDpoint({"convert", dir.file("tf.ply"), "-o", dir.file("tf.pcd")});
+  ASSERT_EQ(tile.exit_code, 0) << tile.err;
+  EXPECT_TRUE(test::contains(tile.err, "read as fractions")) << tile.err;
 }
 
 // Only PLY and GLB hold triangles: converting a PLY mesh to another format reads its vertices and
