@@ -29,6 +29,7 @@
 #include "core/point_set.h"
 #include "core/progress.h"
 #include "core/result.h"
+#include "core/text.h"
 
 namespace dpoint {
 
@@ -85,6 +86,10 @@ struct CsvLayout {
   char separator = ',';
   // Colours as integers of this full scale (255, 65535: PointSet::color_full_scale), 0 as floats 0..1.
   uint16_t color_full_scale = 0;
+  // Leica's PTS (isPtsPath): the count of rows in place of the names, no renaming (the names are
+  // not written), and the dimensions before the colours; writeCsv makes its layout (x y z,
+  // intensity, r g b of 0..255).
+  bool pts = false;
 };
 
 // The header names CsvRowWriter gives layout.dimensions (writableNames): none holding a separator
@@ -109,7 +114,8 @@ class CsvRowWriter {
   // colors: one per position when the layout has colours, else empty. Positions of a planar
   // layout must have z == +0.0 (z is not written).
   Status append(std::span<const glm::dvec3> positions, std::span<const glm::vec3> colors);
-  // Every row of `points` (the layout's columns; before any append): what writeCsv writes.
+  // Every row of `points` (the layout's columns; before any append): what writeCsv writes. Its
+  // dimensions are the layout's: all of them, or a PTS layout's intensity.
   Status appendSet(const PointSet& points);
   // Writes the rows still held and moves the file into place.
   Status commit();
@@ -117,7 +123,7 @@ class CsvRowWriter {
  private:
   CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOptions& options);
   Status writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count,
-                    const std::vector<Dimension>* dims = nullptr, size_t first = 0);
+                    const std::vector<const Dimension*>* dims = nullptr, size_t first = 0);
   Status flushPending();  // writes the rows held back for a whole batch
 
   AtomicFile file_;
@@ -131,7 +137,7 @@ class CsvRowWriter {
   std::vector<glm::vec3> pending_colors_;
   // One per chunk of a batch; grown without zeroing (std::string's resize zeroed 5% of a
   // PLY -> CSV conversion's time before each chunk's rows were formatted over it).
-  std::vector<std::vector<char, DefaultInitAllocator<char>>> texts_;
+  std::vector<TextBuffer> texts_;
 };
 
 }  // namespace dpoint

@@ -63,7 +63,8 @@ class RowFormatter {
  public:
   RowFormatter(const CsvLayout& layout, int decimals, bool at_scale)
       : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors),
-        separator_(layout.separator), color_full_scale_(layout.color_full_scale), dimension_names_(layout.dimensions) {}
+        separator_(layout.separator), color_full_scale_(layout.color_full_scale), pts_(layout.pts),
+        dimension_names_(layout.dimensions) {}
 
   std::string header() const {
     std::vector<std::string> names = {"x", "y"};
@@ -83,42 +84,42 @@ class RowFormatter {
 
   // Formats `count` rows into out (replacing its content); colors is read only with a colour layout.
   // dims (one per name of the layout, or null without any) are read at rows first … first + count.
-  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count,
-              std::vector<char, DefaultInitAllocator<char>>& out,
-              const std::vector<Dimension>* dims = nullptr, size_t first = 0) const {
+  void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count, TextBuffer& out,
+              const std::vector<const Dimension*>* dims = nullptr, size_t first = 0) const {
     const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u) + (dims ? dims->size() : 0u);
     const size_t row_max = fields * kMaxFieldChars;
-    // Start from the shortest-form size and grow only for long fixed-form rows.
-    if (out.size() < count * fields * 24 + row_max) out.resize(count * fields * 24 + row_max);
-    size_t used = 0;
+    out.clear();
+    out.reserve(count * fields * 24 + row_max);  // the shortest forms' size; grown only for long fixed-form rows
     for (size_t i = 0; i < count; ++i) {
-      if (out.size() - used < row_max) out.resize(2 * out.size());
-      char* p = out.data() + used;
-      char* const limit = out.data() + out.size();
-      const glm::dvec3& v = positions[i];
-      p = number(p, limit, v.x);
-      *p++ = separator_;
-      p = number(p, limit, v.y);
-      if (!planar_) {
+      out.appendWith(row_max, [&](char* p, char* limit) {
+        const glm::dvec3& v = positions[i];
+        p = number(p, limit, v.x);
         *p++ = separator_;
-        p = number(p, limit, v.z);
-      }
-      if (colors_) {
-        const glm::vec3& c = colors[i];
-        for (int k = 0; k < 3; ++k) {
+        p = number(p, limit, v.y);
+        if (!planar_) {
           *p++ = separator_;
-          p = color(p, limit, c[k]);
+          p = number(p, limit, v.z);
         }
-      }
-      if (dims)
-        for (const Dimension& d : *dims) {
-          *p++ = separator_;
-          p = dimensionValue(p, limit, d, first + i);
+        const auto dimensions = [&] {
+          if (dims)
+            for (const Dimension* d : *dims) {
+              *p++ = separator_;
+              p = dimensionValue(p, limit, *d, first + i);
+            }
+        };
+        if (pts_) dimensions();  // PTS: x y z intensity r g b
+        if (colors_) {
+          const glm::vec3& c = colors[i];
+          for (int k = 0; k < 3; ++k) {
+            *p++ = separator_;
+            p = color(p, limit, c[k]);
+          }
         }
-      *p++ = '\n';
-      used = static_cast<size_t>(p - out.data());
+        if (!pts_) dimensions();
+        *p++ = '\n';
+        return p;
+      });
     }
-    out.resize(used);
   }
 
  private:
@@ -141,6 +142,7 @@ class RowFormatter {
   bool colors_;
   char separator_;
   uint16_t color_full_scale_;
+  bool pts_;
   const std::vector<std::string>& dimension_names_;
 };
 
@@ -171,16 +173,17 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
   if (Status s = checkDecimals(options.decimals); !s) return s.error();
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
-  layout.separator = csvSeparatorFor(path);
+  layout.separator = layout.pts ? ' ' : csvSeparatorFor(path);
   std::vector<std::string> renamed;
-  layout.dimensions = csvColumnNames(layout, &renamed);
+  if (!layout.pts) layout.dimensions = csvColumnNames(layout, &renamed);
   if (options.notices)
     for (const std::string& line : renamed)
       options.notices->push_back(path + ": " + line +
                                  " (a column's name holds no separator, and x, y, z, r, g and b name the position's and "
                                  "colour's columns)");
   CsvRowWriter writer(std::move(*file), layout, options);
-  const std::string header = RowFormatter(layout, options.decimals, options.at_scale).header();
+  const std::string header =
+      layout.pts ? std::to_string(rows) + "\n" : RowFormatter(layout, options.decimals, options.at_scale).header();
   // At least a digit and a separator a value: refused at once where the disk cannot hold even that.
   const uint64_t values = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0) + layout.dimensions.size();
   if (Status s = writer.file_.checkSpace(header.size() + rows * values * AtomicFile::kLeastTextBytesPerValue); !s)
@@ -204,7 +207,7 @@ CsvRowWriter::CsvRowWriter(AtomicFile file, CsvLayout layout, const CsvWriteOpti
 }
 
 Status CsvRowWriter::writeBatch(const glm::dvec3* positions, const glm::vec3* colors, size_t count,
-                                const std::vector<Dimension>* dims, size_t first) {
+                                const std::vector<const Dimension*>* dims, size_t first) {
   assert(count <= batch_rows_);
   const RowFormatter formatter(layout_, decimals_, at_scale_);
   const size_t chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
@@ -254,8 +257,13 @@ Status CsvRowWriter::flushPending() {
 }
 
 Status CsvRowWriter::appendSet(const PointSet& points) {
-  assert(pending_positions_.empty() && points.dimensions.count() == layout_.dimensions.size());
-  const std::vector<Dimension>& dims = points.dimensions.all();
+  assert(pending_positions_.empty());
+  std::vector<const Dimension*> dims;
+  if (!layout_.pts)
+    for (const Dimension& d : points.dimensions.all()) dims.push_back(&d);
+  else if (const Dimension* intensity = points.dimensions.find(dim::kIntensity))
+    dims.push_back(intensity);
+  assert(dims.size() == layout_.dimensions.size());
   for (size_t at = 0; at < points.size(); at += batch_rows_)
     if (Status s = writeBatch(points.positions.data() + at, layout_.colors ? points.colors.data() + at : nullptr,
                               std::min(batch_rows_, points.size() - at), &dims, at);
@@ -276,32 +284,15 @@ namespace {
 // intensity where the set has one, and r g b as 0-255 integers where it has colours. A PTS row has
 // no room for other dimensions: they are not written.
 Status writePts(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
-  auto file = AtomicFile::create(path);
-  if (!file.ok()) return file.error();
   const Dimension* intensity = points.dimensions.find(dim::kIntensity);
-  std::string out = std::to_string(points.size()) + "\n";
-  const uint64_t values = 3 + (intensity ? 1 : 0) + (points.hasColors() ? 3 : 0);
-  if (Status s = file->checkSpace(out.size() + points.size() * values * AtomicFile::kLeastTextBytesPerValue); !s)
-    return s;
-  char buffer[kMaxFieldChars + 64];
-  const bool at_scale = options.at_scale && options.decimals >= 0;
-  auto number = [&](double v) {
-    out.append(buffer, formatCoordinate(buffer, buffer + sizeof(buffer), v, options.decimals, at_scale));
-  };
-  for (size_t i = 0; i < points.size(); ++i) {
-    const glm::dvec3& p = points.positions[i];
-    number(p.x), out += ' ', number(p.y), out += ' ', number(p.z);
-    if (intensity) out += ' ', out.append(buffer, dimensionValue(buffer, buffer + sizeof(buffer), *intensity, i));
-    if (points.hasColors())
-      for (int k = 0; k < 3; ++k) out += ' ', out += std::to_string(colorInteger(points.colors[i][k], 255.0));
-    out += '\n';
-    if (out.size() > (1u << 22)) {
-      if (Status s = file->write(out); !s) return s;
-      out.clear();
-    }
-  }
-  if (Status s = file->write(out); !s) return s;
-  if (Status s = file->commit(); !s) return s;
+  CsvLayout layout{false, points.hasColors(), {}};  // z always, 0 for a 2D set
+  layout.color_full_scale = 255;
+  layout.pts = true;
+  if (intensity) layout.dimensions.push_back(intensity->name);
+  Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
+  if (!writer) return writer.error();
+  if (Status s = writer->appendSet(points); !s) return s;
+  if (Status s = writer->commit(); !s) return s;
   // What PTS cannot hold, said once the file is there.
   if (options.notices) {
     std::string dropped;
@@ -321,10 +312,10 @@ bool isPtsPath(const std::string& path) { return lowerExtension(path) == ".pts";
 
 Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
   if (Status s = checkDecimals(options.decimals); !s) return s;
-  if (isPtsPath(path)) return writePts(path, points, options);
   if (!points.colors.empty() && points.colors.size() != points.positions.size())
     return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(points.positions.size()) + " points"};
+  if (isPtsPath(path)) return writePts(path, points, options);
   CsvLayout layout{!points.hasZ(), points.hasColors(), {}};
   // Integers where the colours came as integers from a text file or a PLY's 16-bit ones; a LAS
   // file's colours stay 0..1 values, as they always were in CSV.

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cassert>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
@@ -150,6 +151,10 @@ std::string jsonString(const std::string& s);
 class TextBuffer {
  public:
   void clear() { used_ = 0; }
+  // Room for `size` characters in all, made at once (a text whose size is about known).
+  void reserve(size_t size) {
+    if (size > bytes_.size()) bytes_.resize(size);
+  }
   size_t size() const { return used_; }
   const char* data() const { return bytes_.data(); }
   void append(char c) { *room(1) = c, ++used_; }
@@ -163,6 +168,15 @@ class TextBuffer {
     constexpr size_t kMost = 40;  // a double's shortest form is at most 24 characters
     char* at = room(kMost);
     used_ += static_cast<size_t>(std::to_chars(at, at + kMost, value).ptr - at);
+  }
+  // Up to `most` characters made by write(begin, limit), which returns the end of what it wrote:
+  // a row whose longest form is known, formatted with one check of the room.
+  template <typename Write>
+  void appendWith(size_t most, const Write& write) {
+    char* at = room(most);
+    char* end = write(at, at + most);
+    assert(end >= at && end <= at + most);
+    used_ += static_cast<size_t>(end - at);
   }
 
  private:
