@@ -9,6 +9,7 @@
 #include "converters/copc.h"
 #include "converters/gltf_write.h"
 #include "core/atomic_file.h"
+#include "core/parallel.h"
 #include "core/text.h"
 #include "ops/point_filters.h"
 
@@ -169,6 +170,21 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
   if (!points || las) return points;  // LAS colours are integers, or made here from intensity or class
   // The PLY reader tells a tile's colours (generate's own) from a file's itself.
   if (*format != FileFormat::kPly) points->colors_read_as_fractions = points->hasColors() && points->color_full_scale == 0;
+  // Float colours of whole numbers above 1 are 0..255 (or 0..65535) values, as some tools write
+  // a PLY's: read as CSV reads its integer colours, instead of clamped to white.
+  if (*format == FileFormat::kPly && points->colors_read_as_fractions)
+    if (const uint16_t full = wholeColorScale(points->colors, options.threads); full != 0) {
+      const float scale = 1.0f / static_cast<float>(full);
+      constexpr size_t kBlock = size_t{1} << 18;
+      parallelFor((points->size() + kBlock - 1) / kBlock, options.threads, [&](size_t b, unsigned) {
+        for (size_t i = b * kBlock; i < std::min(points->size(), (b + 1) * kBlock); ++i) points->colors[i] *= scale;
+      });
+      points->color_full_scale = full;
+      points->colors_read_as_fractions = false;
+      if (options.notices)
+        options.notices->push_back(path + ": its float colours are whole numbers above 1 (PLY's are 0..1): read as 0.." +
+                                   std::to_string(full) + " values");
+    }
   if (options.las_color == LasColorSource::kRgb && !points->hasColors())
     return Error{path + ": colour by RGB asked for, but the file has no colours"};
   if (options.las_color == LasColorSource::kNone) points->colors.clear();

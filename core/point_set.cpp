@@ -53,6 +53,31 @@ ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned thre
   return {rounded.load(), clamped.load()};
 }
 
+uint16_t wholeColorScale(const ColorArray& colors, unsigned threads) {
+  constexpr size_t kBlock = size_t{1} << 18;
+  const size_t blocks = (colors.size() + kBlock - 1) / kBlock;
+  std::vector<float> largest(blocks, 0.0f);
+  std::atomic<bool> whole{true};  // every channel an integer from 0 to 65535
+  // Fractions end the scan at their first channel between 0 and 1 (a file's usual colours).
+  parallelFor(blocks, threads, [&](size_t b, unsigned) {
+    const size_t end = std::min(colors.size(), (b + 1) * kBlock);
+    float most = 0.0f;
+    for (size_t i = b * kBlock; i < end && whole.load(std::memory_order_relaxed); ++i) {
+      bool integers = true;
+      for (int k = 0; k < 3; ++k) {
+        const float c = colors[i][k];
+        integers = integers && c >= 0.0f && c <= 65535.0f && c == std::floor(c);  // NaN fails
+        most = std::max(most, c);
+      }
+      if (!integers) whole.store(false, std::memory_order_relaxed);
+    }
+    largest[b] = most;
+  });
+  const float most = blocks == 0 ? 0.0f : *std::max_element(largest.begin(), largest.end());
+  if (!whole.load() || !(most > 1.0f)) return 0;
+  return most > 255.0f ? 65535 : 255;
+}
+
 uint64_t heldBytes(const PointSet& points) {
   uint64_t bytes = uint64_t{points.positions.capacity()} * sizeof(glm::dvec3) +
                    uint64_t{points.colors.capacity()} * sizeof(glm::vec3) +

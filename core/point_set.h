@@ -116,6 +116,12 @@ struct ColorsOffGrid {
 };
 ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned threads);
 
+// The integer scale of float colours written as 0..255 or 0..65535 values (as some tools write a
+// PLY's float red, green, blue): 255 where the largest channel is above 1 and at most 255, 65535
+// where it is above 255 and at most 65535, and every channel is an integer from 0 to it; else 0
+// (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions).
+uint16_t wholeColorScale(const ColorArray& colors, unsigned threads);
+
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {
   glm::dvec3 min{0.0}, max{0.0};

@@ -11,6 +11,7 @@
 #include "converters/las.h"
 #include "converters/ply.h"
 #include "test_config.h"
+#include "cli/cli_png.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -371,6 +372,52 @@ TEST(CliConvertMeaning, fractionColoursRoundedToIntegersAreSaid) {
   tile = runDpoint({"convert", dir.file("tf.ply"), "-o", dir.file("tf.pcd")});
   ASSERT_EQ(tile.exit_code, 0) << tile.err;
   EXPECT_TRUE(test::contains(tile.err, "read as fractions")) << tile.err;
+}
+
+// A PLY whose float colours are whole numbers above 1 (0..255 values, as some tools write them)
+// is read as CSV reads integer colours, with a note: the build before clamped every channel to 1,
+// and drew the set white. Fractions, HDR values among them and numbers between integers are read
+// as ever.
+TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
+  TempDir dir;
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                             "property float z\nproperty float red\nproperty float green\nproperty float blue\nend_header\n";
+  writeFile(dir.file("bytes.ply"), header + "0 0 0 255 128 0\n1 0 0 0 0 12\n");
+  writeFile(dir.file("words.ply"), header + "0 0 0 65535 256 0\n1 0 0 0 0 1\n");
+  writeFile(dir.file("hdr.ply"), header + "0 0 0 1.5 0.5 0\n1 0 0 0 0 1\n");
+  writeFile(dir.file("halves.ply"), header + "0 0 0 127.5 128 0\n1 0 0 0 0 12\n");
+  for (const auto& [name, csv] : std::vector<std::pair<std::string, std::string>>{
+           {"bytes", "0,0,0,255,128,0\n1,0,0,0,0,12\n"},
+           {"words", "0,0,0,65535,256,0\n1,0,0,0,0,1\n"},
+           {"hdr", "0,0,0,1.5,0.5,0\n1,0,0,0,0,1\n"},
+           {"halves", "0,0,0,127.5,128,0\n1,0,0,0,0,12\n"}}) {
+    const test::CommandResult r = runDpoint({"convert", dir.file(name + ".ply"), "-o", dir.file(name + ".csv")});
+    ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
+    EXPECT_EQ(readFile(dir.file(name + ".csv")), "x,y,z,r,g,b\n" + csv) << name;
+    const bool whole = name == "bytes" || name == "words";
+    EXPECT_EQ(test::contains(r.err, dir.file(name + ".ply") + ": its float colours are whole numbers above 1 (PLY's are 0..1): read as 0.." +
+                                        (name == "words" ? "65535" : "255") + " values"),
+              whole)
+        << name << ": " << r.err;
+  }
+  // To 8-bit outputs the values are the file's, with no rounding note.
+  const test::CommandResult pcd = runDpoint({"convert", dir.file("bytes.ply"), "-o", dir.file("bytes.ply.ply"), "--ply-ascii"});
+  ASSERT_EQ(pcd.exit_code, 0) << pcd.err;
+  EXPECT_TRUE(test::contains(readFile(dir.file("bytes.ply.ply")), "\n0 0 0 255 128 0\n1 0 0 0 0 12\n")) << readFile(dir.file("bytes.ply.ply"));
+  EXPECT_FALSE(test::contains(pcd.err, "read as fractions")) << pcd.err;
+  // render draws the colours (the build before drew 255, 128, 0 as white).
+  const test::CommandResult r = runDpoint({"render", "-q", "--width", "40", "--height", "30", "--point-size", "9",
+                                           "--fit", "-o", dir.file("bytes.png"), dir.file("bytes.ply")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const test::Pixels image = test::decodePng(readFile(dir.file("bytes.png")));
+  bool orange = false, white = false;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      orange = orange || image.at(x, y) == 0xff0080ffu;  // A B G R: 255, 128, 0
+      white = white || (image.at(x, y) & 0xffffffu) == 0xffffffu;
+    }
+  EXPECT_TRUE(orange);
+  EXPECT_FALSE(white);
 }
 
 // Only PLY and GLB hold triangles: converting a PLY mesh to another format reads its vertices and
