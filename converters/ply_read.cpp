@@ -596,24 +596,35 @@ class PlyParser {
     if (!vertex) return Error{path_ + ": the header declares no 'vertex' element"};
     int found[kRoleCount] = {};
     constexpr std::string_view kNames[] = {"", "x", "y", "z", "red", "green", "blue"};
-    for (size_t k = 0; k < vertex->properties.size(); ++k) {
-      const Property& p = vertex->properties[k];
-      for (int role = kX; role <= kBlue; ++role) {
-        if (p.name != kNames[role]) continue;
-        if (p.is_list) return headerError(p.line, "vertex property '" + p.name + "' is a list, not a number");
-        if (role >= kRed) {
-          if (p.type == Type::kUint8)
-            divisor_[role] = 255.0f;
-          else if (p.type == Type::kUint16)
-            divisor_[role] = 65535.0f;
-          else if (isInteger(p.type))
-            return headerError(p.line, "unsupported colour type '" + std::string(typeName(p.type)) + "' for '" +
-                                           p.name + "' (uchar, ushort, float or double)");
+    // Colours are red, green, blue, or else diffuse_red, diffuse_green, diffuse_blue (older
+    // scanners' and MeshLab's name for them, which Blender and MeshLab read as colours too).
+    const auto take = [&](std::string_view prefix, int first, int last) -> Status {
+      for (size_t k = 0; k < vertex->properties.size(); ++k) {
+        const Property& p = vertex->properties[k];
+        for (int role = first; role <= last; ++role) {
+          if (p.name.size() != prefix.size() + kNames[role].size() || !p.name.starts_with(prefix) ||
+              !p.name.ends_with(kNames[role]))
+            continue;
+          if (p.is_list) return headerError(p.line, "vertex property '" + p.name + "' is a list, not a number");
+          if (role >= kRed) {
+            if (p.type == Type::kUint8)
+              divisor_[role] = 255.0f;
+            else if (p.type == Type::kUint16)
+              divisor_[role] = 65535.0f;
+            else if (isInteger(p.type))
+              return headerError(p.line, "unsupported colour type '" + std::string(typeName(p.type)) + "' for '" +
+                                             p.name + "' (uchar, ushort, float or double)");
+          }
+          vertex_roles_[k] = static_cast<Role>(role);
+          found[role] = p.line;
         }
-        vertex_roles_[k] = static_cast<Role>(role);
-        found[role] = p.line;
       }
-    }
+      return okStatus();
+    };
+    if (Status s = take("", kX, kBlue); !s) return s;
+    const bool diffuse = !found[kRed] && !found[kGreen] && !found[kBlue];
+    if (diffuse)
+      if (Status s = take("diffuse_", kRed, kBlue); !s) return s;
     // Every other number of a vertex is a dimension of its own type, in the header's order (a
     // repeated name keeps its first property; a set of names, as a header may list thousands).
     std::unordered_set<std::string> named;
@@ -645,7 +656,8 @@ class PlyParser {
     points_.colors_read_as_fractions = has_colors_ && points_.color_full_scale == 0 && !tile_;
     if (has_colors_ && !(found[kRed] && found[kGreen] && found[kBlue]))
       return headerError(std::max({found[kRed], found[kGreen], found[kBlue]}),
-                         "vertex colours need all of red, green and blue");
+                         diffuse ? "vertex colours need all of diffuse_red, diffuse_green and diffuse_blue"
+                                 : "vertex colours need all of red, green and blue");
     for (const Element& e : elements_) {
       if (e.name != "face") continue;
       for (size_t k = 0; k < e.properties.size(); ++k) {

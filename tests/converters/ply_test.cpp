@@ -896,6 +896,52 @@ TEST(Ply, plyRejectsPartialColors) {
   EXPECT_TRUE(contains(r.error().message, "rg.ply: header line 8: vertex colours need all of red, green and blue"));
 }
 
+// diffuse_red, diffuse_green, diffuse_blue (older scanners' and MeshLab's names) are the colours
+// where red, green and blue are absent; beside them they stay a dimension. The build before read
+// them as three dimensions, and the set had no colours.
+TEST(Ply, diffuseColoursAreColoursWhereRedGreenBlueAreAbsent) {
+  TempDir dir;
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+  auto r = readText(dir, "d.ply",
+                    head + "property uchar diffuse_red\nproperty uchar diffuse_green\nproperty uchar diffuse_blue\n"
+                           "property uchar alpha\nend_header\n0 0 0 255 0 51 255\n1 0 0 0 102 0 128\n");
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_TRUE(r->hasColors());
+  EXPECT_EQ(r->colors[0], glm::vec3(1.0f, 0.0f, 0.2f));
+  EXPECT_EQ(r->colors[1], glm::vec3(0.0f, 0.4f, 0.0f));
+  ASSERT_EQ(r->dimensions.count(), 1u);
+  EXPECT_EQ(r->dimensions.all()[0].name, "alpha");
+  auto both = readText(dir, "both.ply",
+                       head + "property float red\nproperty float green\nproperty float blue\nproperty uchar diffuse_red\n"
+                              "end_header\n0 0 0 1 0 0 7\n1 0 0 0 1 0 9\n");
+  ASSERT_TRUE(both.ok()) << both.error().message;
+  EXPECT_EQ(both->colors[1], glm::vec3(0.0f, 1.0f, 0.0f));
+  ASSERT_NE(both->dimensions.find("diffuse_red"), nullptr);
+  EXPECT_EQ(both->dimensions.find("diffuse_red")->value(1), 9.0);
+  auto half = readText(dir, "half.ply", head + "property uchar diffuse_red\nend_header\n0 0 0 1\n1 0 0 2\n");
+  ASSERT_FALSE(half.ok());
+  EXPECT_TRUE(contains(half.error().message,
+                       "half.ply: header line 7: vertex colours need all of diffuse_red, diffuse_green and diffuse_blue"))
+      << half.error().message;
+  // Binary rows, and the stream, take them too.
+  PointSet set;
+  set.positions = {glm::dvec3(1, 2, 3)};
+  set.colors = {glm::vec3(1.0f, 0.0f, 0.2f)};
+  ASSERT_TRUE(writePly(dir.file("b.ply"), set, PlyWriteOptions{}).ok());
+  std::string bytes = test::readFile(dir.file("b.ply"));
+  for (const char* name : {"red", "green", "blue"}) {
+    const std::string from = std::string("property uchar ") + name + "\n";
+    bytes.replace(bytes.find(from), from.size(), std::string("property uchar diffuse_") + name + "\n");
+  }
+  test::writeFile(dir.file("db.ply"), bytes);
+  auto binary = readPly(dir.file("db.ply"));
+  ASSERT_TRUE(binary.ok()) << binary.error().message;
+  EXPECT_EQ(binary->colors, set.colors);
+  auto stream = PlyVertexStream::open(dir.file("db.ply"));
+  ASSERT_TRUE(stream.ok()) << stream.error().message;
+  EXPECT_TRUE((*stream)->hasColors());
+}
+
 TEST(Ply, plyRejectsTruncatedBinary) {
   TempDir dir;
   PointSet in = awkwardPoints();
