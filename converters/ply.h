@@ -1,4 +1,4 @@
-// PLY point and mesh files (ASCII and binary little-endian).
+// PLY point and mesh files (ASCII and binary little-endian; binary big-endian is read too).
 //
 // Reading: a `vertex` element with x, y, z of any numeric type (float and double are the usual
 // ones), optional red, green, blue (uchar scaled by 1/255, or float/double taken as 0..1),

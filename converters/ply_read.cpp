@@ -1,6 +1,7 @@
 // PLY reading (writing is in ply_write.cpp). Format: Greg Turk, "The PLY Polygon File Format" (1994), as written
 // by rply, Open3D, MeshLab and PCL. Only little-endian hosts: binary rows are read and written
-// with memcpy.
+// with memcpy; a binary_big_endian file's rows are put in the host's order as each block is read
+// (RowLayout::toHostOrder, and loadValue's and the triangle rows' swaps), then decoded alike.
 //
 // The header and every element are read in file order through one ByteReader, except the one
 // that matters for speed: a binary `vertex` element without list properties. Its rows all have
@@ -75,6 +76,9 @@ size_t typeSize(Type t) {
 std::string_view typeName(Type t) { return kTypeNames[static_cast<int>(t)].name; }
 bool isInteger(Type t) { return t < Type::kFloat32; }
 
+// A big-endian value's bytes reversed in place: the host's (little-endian) order.
+inline void reverseBytes(char* p, size_t size) { std::reverse(p, p + size); }
+
 // Every PLY scalar is exact in a double (integers are at most 32 bits).
 inline double loadValue(Type t, const char* p) {
   switch (t) {
@@ -88,6 +92,15 @@ inline double loadValue(Type t, const char* p) {
     case Type::kFloat64: return loadUnaligned<double>(p);
   }
   return 0;
+}
+
+// loadValue of a value stored in big-endian order when `big_endian`.
+inline double loadValue(Type t, const char* p, bool big_endian) {
+  if (!big_endian) return loadValue(t, p);
+  char bytes[8];
+  std::memcpy(bytes, p, typeSize(t));
+  reverseBytes(bytes, typeSize(t));
+  return loadValue(t, bytes);
 }
 
 // Parses one ASCII token as a value of type `t`. float32 is parsed straight to float so that the
@@ -401,6 +414,7 @@ class PlyParser {
                                  std::to_string(vertex_count_) + " 'vertex' rows, the data ends in row " +
                                  std::to_string(whole)});
       }
+      layout.toHostOrder(buffer.data(), static_cast<size_t>(to - from));
       const uint64_t bad = decodeVertices(layout, buffer.data(), from, to, positions, colors, first);
       if (bad != to) {
         double v[kRoleCount];
@@ -410,7 +424,7 @@ class PlyParser {
       if (options_.progress) options_.progress->advance(buffer.size());
     });
     if (first_error) return *first_error;
-    // The chosen dimensions, copied as stored (little-endian, as the host) from each row.
+    // The chosen dimensions, copied from each row in the host's (little-endian) order.
     block.dimensions = Dimensions();
     for (size_t which : streamed_dimensions_) {
       const Dimension& like = points_.dimensions.all()[which];
@@ -425,6 +439,7 @@ class PlyParser {
         Result<size_t> got = file_.readAt(stream_begin_ + from * layout.row_bytes, rows.data(), rows.size());
         if (!got) return got.error();
         if (*got < rows.size()) return Error{path_ + ": truncated while reading '" + like.name + "'"};
+        layout.toHostOrder(rows.data(), static_cast<size_t>(to - from));
         for (uint64_t r = from; r < to; ++r)
           std::memcpy(d.bytes.data() + (r - first) * at->bytes, rows.data() + (r - from) * layout.row_bytes + at->offset,
                       at->bytes);
@@ -537,7 +552,7 @@ class PlyParser {
         if (w[1] == "ascii")
           ascii_ = true;
         else if (w[1] == "binary_big_endian")
-          return headerError(line_no, "format binary_big_endian is unsupported (only ascii and binary_little_endian)");
+          big_endian_ = true;
         else if (w[1] != "binary_little_endian")
           return headerError(line_no, "unknown format " + quote(w[1]));
         if (w[2] != "1.0") return headerError(line_no, "unsupported format version " + quote(w[2]));
@@ -794,6 +809,8 @@ class PlyParser {
       uint32_t index[255];
       for (uint64_t r = first; r < whole; ++r, q += kRow) {
         std::memcpy(index, q + 1, k * sizeof(uint32_t));
+        if (big_endian_)
+          for (unsigned i = 0; i < k; ++i) reverseBytes(reinterpret_cast<char*>(&index[i]), sizeof(uint32_t));
         bool good = static_cast<uint8_t>(q[0]) == k;
         for (unsigned i = 0; i < k; ++i)
           good = good && (!is_signed || static_cast<int32_t>(index[i]) >= 0) && index[i] < vertices;
@@ -1101,8 +1118,16 @@ class PlyParser {
     };
     std::vector<Attribute> attributes;  // copied as they are into their dimension's column
     size_t row_bytes = 0, at[kRoleCount] = {};
+    std::vector<std::pair<size_t, size_t>> swapped;  // a big-endian file: each wider value's offset and size
     bool packed = true;     // adjacent double x, y, z and uchar colours: what dpoint and most tools write
     float byte_color[256];  // k / 255.0f, the same rounding as colorOf
+
+    // A big-endian file's rows into the host's order, in place (nothing for a little-endian one).
+    void toHostOrder(char* rows, size_t count) const {
+      if (swapped.empty()) return;
+      for (size_t r = 0; r < count; ++r, rows += row_bytes)
+        for (const auto& [offset, size] : swapped) reverseBytes(rows + offset, size);
+    }
 
     void load(const char* row, double* v) const {
       v[kZ] = 0.0;  // a 2D file has no z property
@@ -1113,6 +1138,8 @@ class PlyParser {
   RowLayout vertexLayout(const Element& e, const std::vector<Role>& roles) const {
     RowLayout layout;
     for (size_t k = 0; k < e.properties.size(); layout.row_bytes += typeSize(e.properties[k++].type)) {
+      if (big_endian_ && roles[k] != kSkip && typeSize(e.properties[k].type) > 1)
+        layout.swapped.push_back({layout.row_bytes, typeSize(e.properties[k].type)});
       if (roles[k] == kSkip) continue;
       if (roles[k] == kAttribute) {
         layout.attributes.push_back({layout.row_bytes, typeSize(e.properties[k].type), attribute_of_[k]});
@@ -1172,6 +1199,7 @@ class PlyParser {
         const uint64_t whole = first + *got / row_bytes;
         return fail(whole, truncated(e, whole));
       }
+      layout.toHostOrder(buffer.data(), static_cast<size_t>(last - first));
       const uint64_t bad = decodeVertices(layout, buffer.data(), first, last, positions, colors, 0, columns.data());
       if (bad != last) {
         double v[kRoleCount];
@@ -1226,7 +1254,7 @@ class PlyParser {
       auto avail = in_.require(size);
       if (!avail.ok()) return avail.error();
       if (*avail < size) return truncated(e, row);
-      const double value = loadValue(p.is_list ? p.count_type : p.type, in_.data());
+      const double value = loadValue(p.is_list ? p.count_type : p.type, in_.data(), big_endian_);
       in_.consume(size);
       if (!p.is_list) {
         values_[roles[k]] = value;
@@ -1243,7 +1271,7 @@ class PlyParser {
       auto got = in_.require(static_cast<size_t>(bytes));
       if (!got.ok()) return got.error();
       for (const char* q = in_.data(); q != in_.data() + bytes; q += typeSize(p.type))
-        polygon_.push_back(loadValue(p.type, q));
+        polygon_.push_back(loadValue(p.type, q, big_endian_));
       in_.consume(static_cast<size_t>(bytes));
     }
     return okStatus();
@@ -1382,6 +1410,7 @@ class PlyParser {
   const PlyReadOptions& options_;
   ByteReader in_;
   bool ascii_ = false;
+  bool big_endian_ = false;  // format binary_big_endian: every wider value's bytes reversed as read
   std::vector<Element> elements_;
   std::vector<Role> vertex_roles_, face_roles_;
   bool has_colors_ = false;

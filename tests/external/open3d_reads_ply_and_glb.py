@@ -1,5 +1,5 @@
 """Open3D reads dpoint's PLY (points and meshes, binary and ASCII), PTS and mesh GLB with the same
-values, and dpoint reads the PTS Open3D writes. (Open3D does not read POINTS primitives from glTF;
+values, and dpoint reads the PTS Open3D writes and a big-endian PLY as Open3D reads it. (Open3D does not read POINTS primitives from glTF;
 validator_accepts_glb.py checks those.)"""
 import json
 import os
@@ -88,4 +88,41 @@ with scratch() as d:
     err = np.abs(got - np.array(verts)).max()
     check(err <= 2e-7, f"mesh GLB: vertices off by {err}")
     check(np.array_equal(np.asarray(mesh.triangles), np.array(faces)), "mesh GLB: triangles differ")
-print("Open3D", o3d.__version__, "read dpoint's PLY points, PLY meshes, PTS and mesh GLB with the same values; dpoint read Open3D's PTS")
+
+    # A binary_big_endian PLY made by numpy (an older host's or tool's file): dpoint reads the
+    # positions, colours and triangles Open3D reads (dpoint refused the format before 2026-12-01).
+    n = 1000
+    rows = np.zeros(n, dtype=[("x", ">f8"), ("y", ">f4"), ("z", ">f8"), ("red", "u1"), ("green", "u1"),
+                              ("blue", "u1"), ("intensity", ">u2")])
+    rng = np.random.default_rng(3)
+    rows["x"] = 6378137.0 + rng.random(n)
+    rows["y"] = rng.random(n).astype(np.float32)
+    rows["z"] = -rng.random(n) * 1e-3
+    for c in ("red", "green", "blue"):
+        rows[c] = rng.integers(0, 256, n)
+    rows["intensity"] = rng.integers(0, 65536, n)
+    tris = np.zeros(n - 2, dtype=[("n", "u1"), ("i", ">i4", (3,))])
+    tris["n"] = 3
+    tris["i"] = np.stack([np.arange(n - 2), np.arange(1, n - 1), np.arange(2, n)], axis=1)
+    big = os.path.join(d, "big_endian.ply")
+    with open(big, "wb") as f:
+        f.write(("ply\nformat binary_big_endian 1.0\nelement vertex %d\nproperty double x\nproperty float y\n"
+                 "property double z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                 "property ushort intensity\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n"
+                 % (n, n - 2)).encode())
+        f.write(rows.tobytes())
+        f.write(tris.tobytes())
+    theirs = o3d.io.read_triangle_mesh(big)
+    check(len(theirs.vertices) == n, f"Open3D reads {len(theirs.vertices)} vertices of the big-endian PLY")
+    ours = os.path.join(d, "big_endian.csv")
+    dpoint(exe, "convert", big, "-o", ours)
+    got = np.loadtxt(ours, delimiter=",", skiprows=1)
+    check(np.array_equal(got[:, 0:3], np.asarray(theirs.vertices)), "big-endian PLY: dpoint reads other positions")
+    check(np.allclose(got[:, 3:6], np.asarray(theirs.vertex_colors), atol=1e-7), "big-endian PLY: other colours")
+    check(np.array_equal(got[:, 6], rows["intensity"].astype(np.float64)), "big-endian PLY: other intensities")
+    back = os.path.join(d, "big_endian_le.ply")
+    dpoint(exe, "convert", big, "-o", back)
+    check(np.array_equal(np.asarray(o3d.io.read_triangle_mesh(back).triangles), np.asarray(theirs.triangles)),
+          "big-endian PLY: dpoint reads other triangles")
+print("Open3D", o3d.__version__, "read dpoint's PLY points, PLY meshes, PTS and mesh GLB with the same values; dpoint read "
+      "Open3D's PTS and a big-endian PLY as Open3D reads it")
