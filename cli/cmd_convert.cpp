@@ -69,6 +69,7 @@ Result<PointSet> readConvertInput(const ConvertOptions& o, Progress& progress, M
   g.triangles = triangles;
   ReadOptions r{o.common.threads, o.allow_nonfinite, &progress};
   r.faces_unkept = !triangles;
+  if (o.no_colors) r.las_color = LasColorSource::kNone;  // not read, nor spoken of (the filter drops a glTF's)
   r.max_memory = o.memory_limit;
   r.columns = columnsOf(o.columns);
   r.texture = texture;

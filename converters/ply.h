@@ -96,9 +96,11 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,
                       const PlyWriteOptions& options);
 // The property names plyHeader gives `dimensions`: one word each, none that the readers take for a
-// position or a colour (x, y, z, red, green, blue), none twice (writableNames); `renamed` gets a
-// line for each name changed.
-std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, std::vector<std::string>* renamed);
+// position or a colour (x, y, z, red, green, blue; and, without `colors`, diffuse_red, diffuse_green
+// and diffuse_blue when all three are there), none twice (writableNames); `renamed` gets a line
+// for each name changed.
+inline constexpr const char* kDiffuseNames[] = {"diffuse_red", "diffuse_green", "diffuse_blue"};
+std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, bool colors, std::vector<std::string>* renamed);
 
 // How a PlyRowStream's file is laid out where it is not writePly's (a tile's part file,
 // converters/tile_file.h): the vertex row's bytes, and the header for the counts (has_z: some vertex

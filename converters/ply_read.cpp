@@ -637,7 +637,18 @@ class PlyParser {
       return okStatus();
     };
     if (Status s = take("", kX, kBlue); !s) return s;
-    const bool diffuse = !found[kRed] && !found[kGreen] && !found[kBlue];
+    // The diffuse names are taken whole only: all three, each a number of a colour's type (uchar,
+    // ushort, float, double); else they stay dimensions, as they were before they were taken (a
+    // review finding: a lone diffuse_red was refused, an int one too).
+    const bool diffuse = !found[kRed] && !found[kGreen] && !found[kBlue] && [&] {
+      for (int role = kRed; role <= kBlue; ++role)
+        if (std::none_of(vertex->properties.begin(), vertex->properties.end(), [&](const Property& p) {
+              return p.name == "diffuse_" + std::string(kNames[role]) && !p.is_list &&
+                     (p.type == Type::kUint8 || p.type == Type::kUint16 || !isInteger(p.type));
+            }))
+          return false;
+      return true;
+    }();
     if (diffuse)
       if (Status s = take("diffuse_", kRed, kBlue); !s) return s;
     // Every other number of a vertex is a dimension of its own type, in the header's order (a
@@ -671,8 +682,7 @@ class PlyParser {
     points_.colors_read_as_fractions = has_colors_ && points_.color_full_scale == 0 && !tile_;
     if (has_colors_ && !(found[kRed] && found[kGreen] && found[kBlue]))
       return headerError(std::max({found[kRed], found[kGreen], found[kBlue]}),
-                         diffuse ? "vertex colours need all of diffuse_red, diffuse_green and diffuse_blue"
-                                 : "vertex colours need all of red, green and blue");
+                         "vertex colours need all of red, green and blue");
     for (const Element& e : elements_) {
       if (e.name != "face") continue;
       for (size_t k = 0; k < e.properties.size(); ++k) {

@@ -103,13 +103,18 @@ std::optional<PlyColorType> parsePlyColorType(const std::string& text) {
   return std::nullopt;
 }
 
-std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, std::vector<std::string>* renamed) {
+std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, bool colors, std::vector<std::string>* renamed) {
   std::vector<std::string> names;
   for (const Dimension& d : dimensions.all()) names.push_back(d.name);
+  // All three diffuse names in a file without red, green, blue are read as its colours.
+  const bool diffuse = !colors && std::all_of(std::begin(kDiffuseNames), std::end(kDiffuseNames), [&](const char* n) {
+    return std::find(names.begin(), names.end(), n) != names.end();
+  });
   return writableNames(
       names, isSpaceOrControl,
-      [](const std::string& name, size_t) {
-        return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue";
+      [&](const std::string& name, size_t) {
+        return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue" ||
+               (diffuse && std::find(std::begin(kDiffuseNames), std::end(kDiffuseNames), name) != std::end(kDiffuseNames));
       },
       renamed);
 }
@@ -127,7 +132,7 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
       header += std::string("property ") + (float_colors ? "float " : word_colors ? "ushort " : "uchar ") + c + "\n";
   // Dimensions as properties of their own type; PLY has no 64-bit integers, so those go as double
   // (exact below 2^53).
-  const std::vector<std::string> names = plyPropertyNames(facts.dimensions, nullptr);
+  const std::vector<std::string> names = plyPropertyNames(facts.dimensions, colors, nullptr);
   for (size_t k = 0; k < names.size(); ++k) {
     const char* type = plyTypeName(facts.dimensions.all()[k].type);
     header += "property ";
@@ -165,9 +170,11 @@ Status writePly(const std::string& path, const PointSet& points, const PlyWriteO
                                "PLY colours (--ply-colors uchar)");
   if (options.notices) {
     std::vector<std::string> renamed;
-    plyPropertyNames(points.dimensions, &renamed);
+    plyPropertyNames(points.dimensions, colors, &renamed);
     for (const std::string& line : renamed)
-      options.notices->push_back(path + ": " + line + " (a PLY property's name is one word, not x, y, z, red, green or blue)");
+      options.notices->push_back(path + ": " + line +
+                                 " (a PLY property's name is one word, not x, y, z, red, green or blue, nor "
+                                 "diffuse_red, diffuse_green and diffuse_blue where the set has no colours)");
     // PLY has no 64-bit integers: such a dimension goes as double, which past 2^53 loses digits (a
     // review finding: ids 2^53 + 1 came back as 2^53 without a word).
     for (const Dimension& d : points.dimensions.all()) {

@@ -172,7 +172,8 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
   if (*format != FileFormat::kPly) points->colors_read_as_fractions = points->hasColors() && points->color_full_scale == 0;
   // Float colours of whole numbers above 1 are 0..255 (or 0..65535) values, as some tools write
   // a PLY's: read as CSV reads its integer colours, instead of clamped to white.
-  if (*format == FileFormat::kPly && points->colors_read_as_fractions)
+  // (Not for colours about to be dropped: --no-colors says nothing of them.)
+  if (*format == FileFormat::kPly && points->colors_read_as_fractions && options.las_color != LasColorSource::kNone)
     if (const uint16_t full = wholeColorScale(points->colors, options.threads); full != 0) {
       const float scale = 1.0f / static_cast<float>(full);
       constexpr size_t kBlock = size_t{1} << 18;

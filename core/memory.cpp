@@ -62,8 +62,12 @@ std::string formatBytes(uint64_t bytes) {
 Status checkMemory(const std::string& what, uint64_t needed, uint64_t limit) {
   if (limit == 0) limit = defaultMemoryLimit();
   if (needed <= limit) return okStatus();
-  return Error{what + " needs about " + formatBytes(needed) + ", more than the limit of " + formatBytes(limit) +
-                   " (--max-memory)",
+  std::string need = formatBytes(needed), most = formatBytes(limit);
+  if (need == most) {  // close to the limit: the bytes say which is larger ("1.3 MiB, more than 1.3 MiB" did not)
+    need += " (" + std::to_string(needed) + " bytes)";
+    most += " (" + std::to_string(limit) + " bytes)";
+  }
+  return Error{what + " needs about " + need + ", more than the limit of " + most + " (--max-memory)",
                ExitCode::kResourceLimit};
 }
 

@@ -400,6 +400,11 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
               whole)
         << name << ": " << r.err;
   }
+  // Colours dropped are not spoken of (a review finding).
+  const test::CommandResult dropped = runDpoint({"convert", dir.file("bytes.ply"), "-o", dir.file("none.csv"), "--no-colors"});
+  ASSERT_EQ(dropped.exit_code, 0) << dropped.err;
+  EXPECT_FALSE(test::contains(dropped.err, "whole numbers")) << dropped.err;
+  EXPECT_EQ(readFile(dir.file("none.csv")), "x,y,z\n0,0,0\n1,0,0\n");
   // To 8-bit outputs the values are the file's, with no rounding note.
   const test::CommandResult pcd = runDpoint({"convert", dir.file("bytes.ply"), "-o", dir.file("bytes.ply.ply"), "--ply-ascii"});
   ASSERT_EQ(pcd.exit_code, 0) << pcd.err;
