@@ -39,6 +39,13 @@ std::string mergedTiles(const TempDir& dir, const std::vector<std::string>& kind
   return r.exit_code == 0 ? readFile(dir.file(out_name)) : "";
 }
 
+// The number after `key` in a tile's header ("element vertex ", "comment dpoint-tile-owned ").
+uint64_t headerNumber(const std::string& bytes, const std::string& key) {
+  const size_t at = bytes.find(key);
+  EXPECT_NE(at, std::string::npos) << key;
+  return at == std::string::npos ? 0 : std::stoull(bytes.substr(at + key.size()));
+}
+
 std::string whole(const TempDir& dir, const std::vector<std::string>& kind, const std::string& out_name,
                   const std::vector<std::string>& args = {}) {
   test::CommandResult r = runDpoint(concat(concat(concat({"generate"}, kind), {"-q", "-o", dir.file(out_name)}), args));
@@ -207,7 +214,7 @@ TEST(CliTiles, aPointOutputReadsNoFacesOfTheTiles) {
   ASSERT_FALSE(mergedTiles(dir, kind, 2, "good.pcd").empty());
   const std::string good_pcd = readFile(dir.file("good.pcd"));
   const std::string bytes = readFile(dir.file("part-0.ply"));
-  const uint64_t vertices = std::stoull(bytes.substr(bytes.find("element vertex ") + 15));
+  const uint64_t vertices = headerNumber(bytes, "element vertex ");
   const size_t face = bytes.find("end_header\n") + 11 + vertices * 36;  // rows of 3 double, 3 float
   ASSERT_EQ(bytes[face], 3);
   std::string bad = bytes;
@@ -250,8 +257,8 @@ TEST(CliTiles, aTileSetReadWholeKeepsToMaxMemory) {
   uint64_t vertices = 0, faces = 0;
   for (const char* name : {"part-0.ply", "part-1.ply"}) {
     const std::string bytes = readFile(dir.file(name));
-    vertices += std::stoull(bytes.substr(bytes.find("element vertex ") + 15));
-    faces += std::stoull(bytes.substr(bytes.find("element face ") + 13));
+    vertices += headerNumber(bytes, "element vertex ");
+    faces += headerNumber(bytes, "element face ");
   }
   const uint64_t needs = vertices * 36 + faces * 12;  // every row of both parts; three indices a face
   const auto info = [&](uint64_t limit) {
@@ -300,9 +307,9 @@ TEST(CliTiles, aStreamedTileSetCountsItsCopiesAgainstMaxMemory) {
   uint64_t owned = 0, copies = 0;
   for (const char* name : {"part-0.ply", "part-1.ply"}) {
     const std::string bytes = readFile(dir.file(name));
-    const uint64_t mine = std::stoull(bytes.substr(bytes.find("comment dpoint-tile-owned ") + 26));
+    const uint64_t mine = headerNumber(bytes, "comment dpoint-tile-owned ");
     owned += mine;
-    copies += std::stoull(bytes.substr(bytes.find("element vertex ") + 15)) - mine;
+    copies += headerNumber(bytes, "element vertex ") - mine;
   }
   ASSERT_GT(copies, 0u);
   const uint64_t held = copies * 60, blocks = 2 * owned * 36;  // two blocks of 36-byte points
