@@ -106,15 +106,26 @@ std::optional<PlyColorType> parsePlyColorType(const std::string& text) {
 std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, bool colors, std::vector<std::string>* renamed) {
   std::vector<std::string> names;
   for (const Dimension& d : dimensions.all()) names.push_back(d.name);
-  // All three diffuse names in a file without red, green, blue are read as its colours.
+  const auto base = [](const std::string& name) {
+    return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue";
+  };
+  // A set without colours whose three diffuse names come out as written, each of a colour's type
+  // (uchar, ushort, float, or double, as 64-bit integers go), would read back with them as its
+  // colours: they are renamed then, and only then (names as cleaned: "diffuse blue" is written
+  // diffuse_blue; int ones stay dimensions when read, and keep their names).
+  const std::vector<std::string> plain = writableNames(names, isSpaceOrControl, [&](const std::string& n, size_t) { return base(n); }, nullptr);
   const bool diffuse = !colors && std::all_of(std::begin(kDiffuseNames), std::end(kDiffuseNames), [&](const char* n) {
-    return std::find(names.begin(), names.end(), n) != names.end();
+    const auto at = std::find(plain.begin(), plain.end(), n);
+    if (at == plain.end()) return false;
+    const DimType type = dimensions.all()[static_cast<size_t>(at - plain.begin())].type;
+    return type == DimType::kU8 || type == DimType::kU16 || type == DimType::kF32 || type == DimType::kF64 ||
+           plyTypeName(type) == nullptr;
   });
+  if (!diffuse) return renamed ? writableNames(names, isSpaceOrControl, [&](const std::string& n, size_t) { return base(n); }, renamed) : plain;
   return writableNames(
       names, isSpaceOrControl,
       [&](const std::string& name, size_t) {
-        return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue" ||
-               (diffuse && std::find(std::begin(kDiffuseNames), std::end(kDiffuseNames), name) != std::end(kDiffuseNames));
+        return base(name) || std::find(std::begin(kDiffuseNames), std::end(kDiffuseNames), name) != std::end(kDiffuseNames);
       },
       renamed);
 }

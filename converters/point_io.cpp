@@ -414,8 +414,11 @@ Status selectDimensions(PointSet& points, const DimensionChoice& choice, const s
         has += has.empty() ? "" : ", ";
         has += d.name;
       }
+      const bool diffuse = points.hasColors() && std::find(std::begin(kDiffuseNames), std::end(kDiffuseNames), name) !=
+                                                     std::end(kDiffuseNames);
       return Error{option + " " + name + ": " + what + " has no dimension '" + name + "' (" +
-                       (has.empty() ? std::string("it has none") : "it has " + has) + ")",
+                       (has.empty() ? std::string("it has none") : "it has " + has) + ")" +
+                       (diffuse ? "; a PLY's diffuse_red, diffuse_green and diffuse_blue are read as its colours" : ""),
                    ExitCode::kUsage};
     }
     return okStatus();

@@ -935,15 +935,32 @@ TEST(Ply, diffuseColoursAreColoursWhereRedGreenBlueAreAbsent) {
   ASSERT_TRUE(ints.ok()) << ints.error().message;
   EXPECT_FALSE(ints->hasColors());
   EXPECT_EQ(ints->dimensions.count(), 3u);
-  // Three such dimensions of a set without colours are written under other names, so that the file
-  // reads back with them as dimensions, not as colours; beside colours they keep their names.
+  // Written and read back, they stay dimensions; beside colours they keep their names too.
   ASSERT_TRUE(writePly(dir.file("ints-out.ply"), *ints, PlyWriteOptions{}).ok());
   auto back = readPly(dir.file("ints-out.ply"));
   ASSERT_TRUE(back.ok()) << back.error().message;
   EXPECT_FALSE(back->hasColors());
   ASSERT_EQ(back->dimensions.count(), 3u);
   EXPECT_EQ(back->dimensions.all()[1].value(1), 1000.0);
-  EXPECT_EQ(back->dimensions.find("diffuse_green"), nullptr);
+  // int ones read back as dimensions anyway: their names are kept (the first renaming version
+  // renamed them too, a review finding).
+  EXPECT_NE(back->dimensions.find("diffuse_green"), nullptr);
+  EXPECT_EQ(readFile(dir.file("ints-out.ply")).find("diffuse_green_2"), std::string::npos);
+  // Three of a colour's type are renamed, judged by the names as written: "diffuse blue" is written
+  // diffuse_blue (the first version judged the names before that, a review finding).
+  PointSet floats;
+  floats.positions = {glm::dvec3(1, 2, 3)};
+  for (const char* name : {"diffuse_red", "diffuse_green", "diffuse blue"})
+    floats.dimensions.add(name, DimType::kF32, 1).setValue(0, 0.25);
+  std::vector<std::string> notices;
+  PlyWriteOptions noted;
+  noted.notices = &notices;
+  ASSERT_TRUE(writePly(dir.file("floats.ply"), floats, noted).ok());
+  auto floats_back = readPly(dir.file("floats.ply"));
+  ASSERT_TRUE(floats_back.ok()) << floats_back.error().message;
+  EXPECT_FALSE(floats_back->hasColors());
+  EXPECT_EQ(floats_back->dimensions.count(), 3u);
+  EXPECT_EQ(notices.size(), 3u);
   PointSet coloured = *ints;
   coloured.colors.assign(coloured.size(), glm::vec3(0.5f));
   ASSERT_TRUE(writePly(dir.file("coloured.ply"), coloured, PlyWriteOptions{}).ok());
