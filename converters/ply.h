@@ -179,6 +179,10 @@ class PlyVertexStream {
   ~PlyVertexStream();
   uint64_t count() const;
   bool hasColors() const;
+  // Colours of a float or double type in a file not of `generate --tile`: 0..1 by PLY's rule, but
+  // some tools write 0..255 values there, which readPoints reads whole as such (wholeColorScale)
+  // and a stream can only clamp block by block.
+  bool floatColors() const;
   uint64_t faceCount() const;  // the header's `face` rows (0 without the element)
   // The vertex properties that are dimensions, as empty columns (names and types).
   const Dimensions& dimensions() const;

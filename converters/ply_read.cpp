@@ -370,6 +370,7 @@ class PlyParser {
   }
   uint64_t vertexCount() const { return vertex_count_; }
   bool hasColors() const { return has_colors_; }
+  bool floatColors() const { return has_colors_ && divisor_[kRed] == 1.0f && !tile_; }
   // The vertex properties that are dimensions (empty columns: names and types).
   const Dimensions& dimensions() const { return points_.dimensions; }
   // readStream fills these dimensions (indices into dimensions()) of each block too.
@@ -1474,6 +1475,7 @@ Result<std::unique_ptr<PlyVertexStream>> PlyVertexStream::open(const std::string
 PlyVertexStream::~PlyVertexStream() = default;
 uint64_t PlyVertexStream::count() const { return state_->parser.vertexCount(); }
 bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
+bool PlyVertexStream::floatColors() const { return state_->parser.floatColors(); }
 uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
 const Dimensions& PlyVertexStream::dimensions() const { return state_->parser.dimensions(); }
 void PlyVertexStream::streamDimensions(std::vector<size_t> which) { state_->parser.streamDimensions(std::move(which)); }

@@ -147,6 +147,7 @@ struct PointInputStream::Part {
   }
   Status read(uint64_t from, uint64_t n, PointSet& block) { return ply ? ply->read(from, n, block) : las->read(from, n, block); }
   std::string path;
+  bool watch_colors = false;  // a float-colour PLY whose colours above 1 are not yet said
 };
 
 // A copy of a seam vertex: its owner's index among the owning part's points, and where the copy is.
@@ -224,6 +225,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
           PlyVertexStream::open(path, PlyReadOptions{false, nullptr, threads, true});
       if (!ply) return ply.error();
       part.ply = std::move(*ply);
+      part.watch_colors = part.ply->floatColors();
     }
     part.count = std::min(owned, part.fileCount());
     part.first = stream->count_;
@@ -268,11 +270,23 @@ Status PointInputStream::streamDimension(const std::string& name) {
   return okStatus();
 }
 
+void PointInputStream::noteColorsAboveOne(Part& part, const glm::vec3* colors, size_t n) {
+  if (!part.watch_colors || colors == nullptr) return;
+  for (size_t i = 0; i < n; ++i)
+    if (colors[i].r > 1.0f || colors[i].g > 1.0f || colors[i].b > 1.0f) {
+      part.watch_colors = false;
+      notices_.push_back(part.path + ": float colours above 1 (0..255 values?) streamed as PLY's 0..1 and clamped; "
+                                     "--stream off reads whole-number colours as 0..255 values");
+      return;
+    }
+}
+
 Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   assert(first <= count_ && n <= count_ - first);
   if (parts_.size() == 1) {  // straight into the block
     if (Status s = parts_[0].read(first, n, block); !s) return s;
     if (Status s = checkCopies(0, first, block); !s) return s;
+    noteColorsAboveOne(parts_[0], block.hasColors() ? block.colors.data() : nullptr, block.size());
     if (has_colors_ && !block.hasColors()) block.colors.assign(block.size(), glm::vec3(1.0f));
     return okStatus();
   }
@@ -287,6 +301,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     if (from >= to) continue;
     if (Status s = part.read(from - part.first, to - from, scratch_); !s) return s;
     if (Status s = checkCopies(static_cast<size_t>(&part - parts_.data()), from - part.first, scratch_); !s) return s;
+    noteColorsAboveOne(part, scratch_.hasColors() ? scratch_.colors.data() : nullptr, scratch_.size());
     const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
     if (streamed) {

@@ -56,7 +56,8 @@ class PointInputStream {
   uint64_t faceCount() const { return faces_; }
   // Host bytes held for the whole stream beside its blocks: a tile set's copies (0 for other files).
   uint64_t heldBytes() const { return held_bytes_; }
-  // What the readers read past in the headers, one line each (ReadOptions::notices).
+  // What the readers read past in the headers, one line each (ReadOptions::notices); after the
+  // blocks are read, also what they met (float PLY colours above 1, clamped: once a file).
   const std::vector<std::string>& notices() const { return notices_; }
   // The first file's dimensions (PLY vertex properties), as empty columns.
   const Dimensions& dimensions() const;
@@ -73,6 +74,8 @@ class PointInputStream {
   // A complete tile set's copies of seam vertices, each checked against its owner as the owner's
   // block is read (as mergeTiles checks them): a tile of another build is an error, not a seam.
   Status checkCopies(size_t part, uint64_t first, const PointSet& rows) const;
+  // A float-colour PLY part's block with a channel above 1: said once a part (notices_).
+  void noteColorsAboveOne(Part& part, const glm::vec3* colors, size_t n);
   std::vector<Part> parts_;  // in stream order
   std::unique_ptr<TileCopies> copies_;  // null but for a complete tile set
   uint64_t count_ = 0, faces_ = 0, held_bytes_ = 0;

@@ -74,6 +74,7 @@ struct LoadedSet {
   BatchBoxes boxes;                    // a stream: the box of each batch, for its mode's bound
   uint64_t reread_points = 0;          // a stream: the points its outline and spacing read again
   std::vector<std::string> notices;    // what the readers read past (ReadOptions::notices)
+  size_t stream_notices = 0;           // a stream: how many of its notices came with its headers
   // A stream drawn in one pass (renderOnce): its bounds, outline and spacing come with the upload,
   // its provisional camera and mode from `preview`, whole batches spread over the file.
   bool one_pass = false;
@@ -287,7 +288,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   if (!opened) return opened.error();
   set.stream = std::move(*opened);
   PointInputStream* ply = set.stream.get();
-  if (ply) set.notices = ply->notices();
+  if (ply) set.notices = ply->notices(), set.stream_notices = ply->notices().size();
   if (ply && request.color == RenderColor::kAttribute && !ply->dimensions().find(request.color_attribute))
     return noSuchAttribute(inputs, request.color_attribute, ply->dimensions());
   if (ply && (request.error || request.order != PointOrder::kInput || request.views != 1))
@@ -1066,6 +1067,17 @@ float pointSizeFor(const RenderRequest& request, size_t count, const Bounds& box
   return static_cast<float>(std::clamp(std::ceil(spacing), 1.0, std::min(most, double(facts.max_point_size))));
 }
 
+namespace {
+
+// What a stream's readers met in its blocks (after its headers' notices): said with the others.
+void addStreamNotices(const LoadedSet& set, RenderOutcome& outcome) {
+  if (!set.stream) return;
+  const std::vector<std::string>& all = set.stream->notices();
+  outcome.notices.insert(outcome.notices.end(), all.begin() + static_cast<std::ptrdiff_t>(set.stream_notices), all.end());
+}
+
+}  // namespace
+
 Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progress,
                                    const std::function<void(const SheetView&)>& view_done) {
   if (Status s = checkRenderRequest(request); !s) return s.error();
@@ -1126,6 +1138,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
     if (!drawn) return drawn.error();
     if (*drawn) {
       outcome.validation_messages = context.validationMessages();
+      addStreamNotices(*set, outcome);
       outcome.read_set = ReleaseInBackground(std::move(*set));
       return outcome;
     }
@@ -1142,6 +1155,7 @@ Result<RenderOutcome> runRenderJob(const RenderRequest& request, Progress& progr
                                       : renderOne(resolved, context, *set, cameras->front(), outcome, progress);
   if (!rendered) return rendered.error();
   outcome.validation_messages = context.validationMessages();
+  addStreamNotices(*set, outcome);
   // Giving the set's memory back (s11u.ply's 600 MB: 20-50 ms) overlaps writing the picture.
   outcome.read_set = ReleaseInBackground(std::move(*set));
   return outcome;

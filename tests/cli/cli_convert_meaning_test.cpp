@@ -3,6 +3,7 @@
 // file's step, z-up from LAS. Real files, exit codes, messages by content, bytes.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -423,6 +424,24 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
     }
   EXPECT_TRUE(orange);
   EXPECT_FALSE(white);
+  // A stream takes float colours as 0..1 block by block: it clamps such values, and says so once
+  // the blocks are read (render and info); the whole read says nothing of the kind.
+  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                       "property float z\nproperty float red\nproperty float green\nproperty float blue\nend_header\n";
+  for (const std::array<float, 6>& row : {std::array<float, 6>{0, 0, 0, 255, 128, 0}, std::array<float, 6>{1, 0, 0, 0, 0, 12}})
+    binary.append(reinterpret_cast<const char*>(row.data()), sizeof row);
+  writeFile(dir.file("binary.ply"), binary);
+  const std::string streamed = dir.file("binary.ply") + ": float colours above 1 (0..255 values?) streamed as PLY's 0..1 and clamped";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"render", "-q", "--stream", "on", "--width", "40", "--height", "30", "-o", dir.file("s.png")},
+        {"info", "--stream", "on"}}) {
+    const test::CommandResult s = runDpoint(test::concat(args, {dir.file("binary.ply")}));
+    ASSERT_EQ(s.exit_code, 0) << args[0] << ": " << s.err;
+    EXPECT_TRUE(test::contains(s.err, streamed)) << args[0] << ": " << s.err;
+  }
+  const test::CommandResult whole = runDpoint({"info", "--stream", "off", dir.file("binary.ply")});
+  EXPECT_FALSE(test::contains(whole.err, "streamed as")) << whole.err;
+  EXPECT_TRUE(test::contains(whole.err, "read as 0..255 values")) << whole.err;
 }
 
 // Only PLY and GLB hold triangles: converting a PLY mesh to another format reads its vertices and
