@@ -30,7 +30,7 @@ namespace {
 // Colour columns hold floats 0..1, or integers 0..255 (or 0..65535) as spreadsheets and most point
 // tools write them: where a value above 1 appears, every colour must be such an integer, and the set
 // keeps the full scale (PointSet::color_full_scale), so 255,128,0 is written back as 255,128,0.
-Status integerColors(const std::string& path, PointSet& points, bool always) {
+Status integerColors(const std::string& path, PointSet& points, bool always, unsigned threads) {
   float largest = 0.0f;
   for (const glm::vec3& c : points.colors) largest = std::max({largest, c.r, c.g, c.b});
   if (!(largest > 1.0f) && !always) {
@@ -51,9 +51,7 @@ Status integerColors(const std::string& path, PointSet& points, bool always) {
                      formatNumber(v) + " among integer colours (values above 1 make every colour an integer 0.." +
                      formatNumber(full) + "; colours as fractions are 0..1)"};
     }
-  const float scale = 1.0f / full;
-  for (glm::vec3& c : points.colors) c *= scale;
-  points.color_full_scale = static_cast<uint16_t>(full);
+  takeColorsAsIntegers(points, static_cast<uint16_t>(full), threads);
   return okStatus();
 }
 
@@ -904,7 +902,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
     points.dimensions.resize(out);
   }
   narrowDimensions(points.dimensions, threads);
-  if (Status s = integerColors(path, points, layout.integer_colors); !s) return s.error();
+  if (Status s = integerColors(path, points, layout.integer_colors, threads); !s) return s.error();
   if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
   // A count line that is not the rows' count: a file cut short, or rows added (a review finding:
   // a count of 1e11 over one row was taken without a word).

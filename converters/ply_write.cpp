@@ -106,14 +106,24 @@ std::optional<PlyColorType> parsePlyColorType(const std::string& text) {
 std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, bool colors, std::vector<std::string>* renamed) {
   std::vector<std::string> names;
   for (const Dimension& d : dimensions.all()) names.push_back(d.name);
-  const auto base = [](const std::string& name) {
-    return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue";
+  const auto isDiffuse = [](const std::string& name) {
+    return std::find(std::begin(kDiffuseNames), std::end(kDiffuseNames), name) != std::end(kDiffuseNames);
+  };
+  // The names as written, with the diffuse ones reserved or not.
+  const auto written = [&](bool diffuse, std::vector<std::string>* lines) {
+    return writableNames(
+        names, isSpaceOrControl,
+        [&](const std::string& name, size_t) {
+          return name == "x" || name == "y" || name == "z" || name == "red" || name == "green" || name == "blue" ||
+                 (diffuse && isDiffuse(name));
+        },
+        lines);
   };
   // A set without colours whose three diffuse names come out as written, each of a colour's type
   // (uchar, ushort, float, or double, as 64-bit integers go), would read back with them as its
   // colours: they are renamed then, and only then (names as cleaned: "diffuse blue" is written
   // diffuse_blue; int ones stay dimensions when read, and keep their names).
-  const std::vector<std::string> plain = writableNames(names, isSpaceOrControl, [&](const std::string& n, size_t) { return base(n); }, nullptr);
+  const std::vector<std::string> plain = written(false, nullptr);
   const bool diffuse = !colors && std::all_of(std::begin(kDiffuseNames), std::end(kDiffuseNames), [&](const char* n) {
     const auto at = std::find(plain.begin(), plain.end(), n);
     if (at == plain.end()) return false;
@@ -121,13 +131,7 @@ std::vector<std::string> plyPropertyNames(const Dimensions& dimensions, bool col
     return type == DimType::kU8 || type == DimType::kU16 || type == DimType::kF32 || type == DimType::kF64 ||
            plyTypeName(type) == nullptr;
   });
-  if (!diffuse) return renamed ? writableNames(names, isSpaceOrControl, [&](const std::string& n, size_t) { return base(n); }, renamed) : plain;
-  return writableNames(
-      names, isSpaceOrControl,
-      [&](const std::string& name, size_t) {
-        return base(name) || std::find(std::begin(kDiffuseNames), std::end(kDiffuseNames), name) != std::end(kDiffuseNames);
-      },
-      renamed);
+  return diffuse || renamed ? written(diffuse, renamed) : plain;
 }
 
 std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, bool colors, bool has_z,

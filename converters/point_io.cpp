@@ -9,7 +9,6 @@
 #include "converters/copc.h"
 #include "converters/gltf_write.h"
 #include "core/atomic_file.h"
-#include "core/parallel.h"
 #include "core/text.h"
 #include "ops/point_filters.h"
 
@@ -175,13 +174,7 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
   // (Not for colours about to be dropped: --no-colors says nothing of them.)
   if (*format == FileFormat::kPly && points->colors_read_as_fractions && options.las_color != LasColorSource::kNone)
     if (const uint16_t full = wholeColorScale(points->colors, options.threads); full != 0) {
-      const float scale = 1.0f / static_cast<float>(full);
-      constexpr size_t kBlock = size_t{1} << 18;
-      parallelFor((points->size() + kBlock - 1) / kBlock, options.threads, [&](size_t b, unsigned) {
-        for (size_t i = b * kBlock; i < std::min(points->size(), (b + 1) * kBlock); ++i) points->colors[i] *= scale;
-      });
-      points->color_full_scale = full;
-      points->colors_read_as_fractions = false;
+      takeColorsAsIntegers(*points, full, options.threads);
       if (options.notices)
         options.notices->push_back(path + ": its float colours are whole numbers above 1 (PLY's are 0..1): read as 0.." +
                                    std::to_string(full) + " values");

@@ -78,6 +78,17 @@ uint16_t wholeColorScale(const ColorArray& colors, unsigned threads) {
   return most > 255.0f ? 65535 : 255;
 }
 
+void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
+  constexpr size_t kBlock = size_t{1} << 18;
+  const float scale = 1.0f / static_cast<float>(full);
+  parallelFor((points.colors.size() + kBlock - 1) / kBlock, threads, [&](size_t b, unsigned) {
+    const size_t end = std::min(points.colors.size(), (b + 1) * kBlock);
+    for (size_t i = b * kBlock; i < end; ++i) points.colors[i] *= scale;
+  });
+  points.color_full_scale = full;
+  points.colors_read_as_fractions = false;
+}
+
 uint64_t heldBytes(const PointSet& points) {
   uint64_t bytes = uint64_t{points.positions.capacity()} * sizeof(glm::dvec3) +
                    uint64_t{points.colors.capacity()} * sizeof(glm::vec3) +

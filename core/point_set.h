@@ -121,6 +121,9 @@ ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned thre
 // where it is above 255 and at most 65535, and every channel is an integer from 0 to it; else 0
 // (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions).
 uint16_t wholeColorScale(const ColorArray& colors, unsigned threads);
+// Colours read as integers of `full` (255, 65535) taken as 0..1 values: each channel divided by
+// it, and PointSet::color_full_scale set, so that a writer of integers writes them back as they were.
+void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads);
 
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {
