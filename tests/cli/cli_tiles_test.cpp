@@ -46,6 +46,21 @@ uint64_t headerNumber(const std::string& bytes, const std::string& key) {
   return at == std::string::npos ? 0 : std::stoull(bytes.substr(at + key.size()));
 }
 
+// Header counts summed over the parts part-0.ply … part-(parts − 1).ply that mergedTiles made.
+struct PartCounts {
+  uint64_t vertices = 0, faces = 0, owned = 0;  // vertices − owned: the seam copies
+};
+PartCounts partCounts(const TempDir& dir, uint32_t parts) {
+  PartCounts sum;
+  for (uint32_t i = 0; i < parts; ++i) {
+    const std::string bytes = readFile(dir.file("part-" + std::to_string(i) + ".ply"));
+    sum.vertices += headerNumber(bytes, "element vertex ");
+    sum.faces += headerNumber(bytes, "element face ");
+    sum.owned += headerNumber(bytes, "comment dpoint-tile-owned ");
+  }
+  return sum;
+}
+
 std::string whole(const TempDir& dir, const std::vector<std::string>& kind, const std::string& out_name,
                   const std::vector<std::string>& args = {}) {
   test::CommandResult r = runDpoint(concat(concat(concat({"generate"}, kind), {"-q", "-o", dir.file(out_name)}), args));
@@ -254,12 +269,7 @@ TEST(CliTiles, aPointOutputReadsNoFacesOfTheTiles) {
 TEST(CliTiles, aTileSetReadWholeKeepsToMaxMemory) {
   TempDir dir;
   ASSERT_FALSE(mergedTiles(dir, {"mandelbulb", "--resolution", "33", "--variant", "fast"}, 2, "good.ply").empty());
-  uint64_t vertices = 0, faces = 0;
-  for (const char* name : {"part-0.ply", "part-1.ply"}) {
-    const std::string bytes = readFile(dir.file(name));
-    vertices += headerNumber(bytes, "element vertex ");
-    faces += headerNumber(bytes, "element face ");
-  }
+  const auto [vertices, faces, owned] = partCounts(dir, 2);
   const uint64_t needs = vertices * 36 + faces * 12;  // every row of both parts; three indices a face
   const auto info = [&](uint64_t limit) {
     return runDpoint({"info", "--max-memory", std::to_string(limit), dir.file("part-0.ply"), dir.file("part-1.ply")});
@@ -304,13 +314,8 @@ TEST(CliTiles, mergeKeepsToMaxMemoryWhenItStreams) {
 TEST(CliTiles, aStreamedTileSetCountsItsCopiesAgainstMaxMemory) {
   TempDir dir;
   ASSERT_FALSE(mergedTiles(dir, {"mandelbulb", "--resolution", "33", "--variant", "fast"}, 2, "good.ply").empty());
-  uint64_t owned = 0, copies = 0;
-  for (const char* name : {"part-0.ply", "part-1.ply"}) {
-    const std::string bytes = readFile(dir.file(name));
-    const uint64_t mine = headerNumber(bytes, "comment dpoint-tile-owned ");
-    owned += mine;
-    copies += headerNumber(bytes, "element vertex ") - mine;
-  }
+  const PartCounts counts = partCounts(dir, 2);
+  const uint64_t owned = counts.owned, copies = counts.vertices - counts.owned;
   ASSERT_GT(copies, 0u);
   const uint64_t held = copies * 60, blocks = 2 * owned * 36;  // two blocks of 36-byte points
   const auto info = [&](uint64_t limit) {
