@@ -47,6 +47,9 @@ struct CsvReadOptions {
   std::vector<std::string>* notices = nullptr;
   // Tests: runs once the lines are counted, before they are parsed (to change the file in between).
   std::function<void()> between_passes = {};
+  // Lines before the file's first in the messages' line numbers: a slice of a larger file (a PTX
+  // scan's rows, InputFile::slice) names its lines as the file numbers them.
+  uint64_t first_line = 0;
 };
 
 struct CsvWriteOptions {
@@ -66,8 +69,24 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options 
 char csvSeparatorFor(const std::string& path);
 // A path ending .pts (any case): Leica's PTS text, read and written by the CSV code.
 bool isPtsPath(const std::string& path);
-// The same from an opened file, or from bytes in memory (InputFile::fromMemory).
+// The same from an opened file, or from bytes in memory (InputFile::fromMemory). A path ending
+// .ptx is read by readPtx.
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = {});
+// The CSV reader itself, whatever the file's name (readPtx reads each scan's rows with it).
+Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& options);
+
+// A path ending .ptx (any case): Leica's PTX text, read (not written) by the CSV code.
+bool isPtxPath(const std::string& path);
+// Leica PTX (converters/ptx_read.cpp): scans, each a ten-line header (the grid's columns and
+// rows, the scanner's registered position and axes, a 4x4 transformation in row-vector form, its
+// fourth row the translation) and columns x rows rows of `x y z [intensity] [r g b]` in the
+// scanner's frame. Each point is moved into the registered frame in double precision; a point
+// with no echo (0 0 0) is left out, with a note counting them. Intensity is the dimension
+// `intensity` as written (0..1 floats, float64), colours 0..255 integers; several scans are
+// joined in order, each point's scan (from 1) in `point_source_id`, white for a scan without
+// colours beside one with. Errors name the file and line. The line ends are counted once on all
+// cores to place the scans; each scan's rows are then read as the CSV reader reads a file.
+Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options);
 
 // Writes atomically (AtomicFile). Header `x,y` when the set has no z (PointSet::hasZ: a 2D
 // source, or a set made in memory whose every z is +0.0), else `x,y,z`; `,r,g,b` when it has

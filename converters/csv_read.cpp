@@ -556,13 +556,13 @@ struct Header {
 };
 
 // Finds the layout from the first non-blank line, skipping a UTF-8 BOM.
-Result<Header> readHeader(const InputFile& file, const std::vector<std::string>& columns) {
+Result<Header> readHeader(const InputFile& file, const std::vector<std::string>& columns, uint64_t first_line) {
   std::string head(std::min<uint64_t>(file.size(), kMaxLineLength + 4), '\0');
   Result<size_t> got = file.readAt(0, head.data(), head.size());
   if (!got) return got.error();
   head.resize(*got);
   size_t pos = head.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
-  uint64_t line = 0;
+  uint64_t line = first_line;
   const bool pts = isPtsPath(file.path());
   bool counted = false;
   std::optional<uint64_t> declared;
@@ -723,9 +723,13 @@ Result<PointSet> readCsv(const std::string& path, const CsvReadOptions& options)
 }
 
 Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
+  return isPtxPath(file.path()) ? readPtx(file, options) : readCsvRows(file, options);
+}
+
+Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& options) {
   const std::string& path = file.path();
   if (file.size() == 0) return Error{path + ": empty file"};
-  Result<Header> header_result = readHeader(file, options.columns);
+  Result<Header> header_result = readHeader(file, options.columns, options.first_line);
   if (!header_result) return header_result.error();
   const Header header = *header_result;
   const Layout& layout = header.layout;

@@ -655,14 +655,42 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   return l;
 }
 
-// Encodes point i of a set into a record of the layout's format.
+// Whether the set's intensity is float 0..1 values (PTX's, or one normalised by another tool):
+// every value from 0 to 1 and one between. LAS's intensity is a 16-bit integer normalised to the
+// sensor's range (LAS 1.4 R15: multiplied by 65,536 over the sensor's dynamic range), so the
+// writer takes such values as fractions of 65535. Whole numbers (0 and 1 alone too) are written as
+// they are.
+bool intensityOfFractions(const PointSet& points, unsigned threads) {
+  const Dimension* d = points.dimensions.find(dim::kIntensity);
+  if (!d || !dimTypeIsFloat(d->type) || d->size() == 0) return false;
+  constexpr size_t kBlock = size_t{1} << 16;
+  std::vector<uint8_t> outside((d->size() + kBlock - 1) / kBlock, 0), between(outside.size(), 0);
+  parallelFor(outside.size(), threads, [&](size_t b, unsigned) {
+    for (size_t i = b * kBlock, end = std::min(d->size(), i + kBlock); i < end; ++i) {
+      const double v = d->value(i);
+      if (!(v >= 0.0 && v <= 1.0)) {  // NaN too
+        outside[b] = 1;
+        return;
+      }
+      between[b] |= v > 0.0 && v < 1.0 ? 1 : 0;
+    }
+  });
+  return std::find(outside.begin(), outside.end(), 1) == outside.end() &&
+         std::find(between.begin(), between.end(), 1) != between.end();
+}
+
+// Encodes point i of a set into a record of the layout's format. `fraction_intensity`: the
+// intensity is 0..1 values (intensityOfFractions), written as round(v · 65535).
 class RecordEncoder {
  public:
-  RecordEncoder(const PointSet& points, const WriterLayout& l, const glm::dvec3& offset, const glm::dvec3& scale)
+  RecordEncoder(const PointSet& points, const WriterLayout& l, const glm::dvec3& offset, const glm::dvec3& scale,
+                bool fraction_intensity)
       : points_(points), offset_(offset), scale_(scale), format_(l.format) {
     for (const LasField& f : lasFields(l.format)) {
       Slot slot{f.type, f.offset, f.shift, f.bits, points.dimensions.find(f.name), Convert::kNone};
-      if (!slot.source && std::strcmp(f.name, dim::kScanAngleRank) == 0) {
+      if (fraction_intensity && slot.source && std::strcmp(f.name, dim::kIntensity) == 0) {
+        slot.convert = Convert::kFractionToWord;
+      } else if (!slot.source && std::strcmp(f.name, dim::kScanAngleRank) == 0) {
         slot.source = points.dimensions.find(dim::kScanAngle);
         slot.convert = Convert::kAngleToRank;
       } else if (!slot.source && std::strcmp(f.name, dim::kScanAngle) == 0) {
@@ -714,6 +742,8 @@ class RecordEncoder {
         storeValue(r + s.offset, s.type, s.source->value(i) / 0.006);
       } else if (s.convert == Convert::kScaled) {
         storeValue(r + s.offset, s.type, lasStoredNumber(*s.field, s.source->value(i)));
+      } else if (s.convert == Convert::kFractionToWord) {  // 0..1, so no clamping
+        storeUnaligned<uint16_t>(r + s.offset, static_cast<uint16_t>(s.source->value(i) * 65535.0 + 0.5));
       } else if (s.source->type == s.type) {
         const size_t w = dimTypeSize(s.type);
         std::memcpy(r + s.offset, s.source->bytes.data() + i * w, w);
@@ -772,7 +802,7 @@ class RecordEncoder {
   }
 
  private:
-  enum class Convert { kNone, kAngleToRank, kRankToAngle, kScaled };
+  enum class Convert { kNone, kAngleToRank, kRankToAngle, kScaled, kFractionToWord };
   struct Slot {
     DimType type;
     uint32_t offset;
@@ -1251,7 +1281,9 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     laz = std::move(*info);
     l.vlrs.push_back(LasVlr{"laszip encoded", 22204, "dpoint LAZ (LASzip 3.4 format)", laszipVlrData(*laz), false});
   }
-  const RecordEncoder encoder(points, l, offset, scale);
+  const bool fraction_intensity = intensityOfFractions(points, threads);
+  if (options.report) options.report->intensity_scaled = fraction_intensity;
+  const RecordEncoder encoder(points, l, offset, scale, fraction_intensity);
   std::string vlr_bytes;
   for (const LasVlr& vlr : l.vlrs) vlr_bytes += vlrBytes(vlr, false);
   const uint32_t point_offset = static_cast<uint32_t>((l.version_minor >= 4 ? kHeaderSize14 : kHeaderSize12) + vlr_bytes.size());

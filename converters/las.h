@@ -116,6 +116,8 @@ struct LasWriteReport {
   std::string crs;
   // Distinct positions that share their integers at that scale with another: they read back as one.
   uint64_t merged_points = 0;
+  // The intensity was float 0..1 values (PTX's, a normalised one), written as round(v · 65535).
+  bool intensity_scaled = false;
 };
 
 struct LasWriteOptions {

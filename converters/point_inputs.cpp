@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <cstring>
 #include <tuple>
 
@@ -11,6 +12,8 @@
 #include "converters/ply.h"
 #include "converters/tile_file.h"
 #include "core/memory.h"
+#include "core/parallel.h"
+#include "core/text.h"
 
 namespace dpoint {
 
@@ -59,6 +62,9 @@ Result<InputSet> checkInputSet(const std::vector<std::string>& paths) {
 
 namespace {
 
+// Rows of a float-colour PLY streamed whose colours decide whether they are 0..255 values.
+constexpr uint64_t kColorSampleRows = uint64_t{1} << 16;
+
 // A note where tiles are read file by file (one alone, a set with tiles left out, tiles of several
 // runs, or tiles beside other files): each brings its copies of the seam vertices, which the
 // whole set holds once; the count of points is then not the merged set's. None for a whole set or
@@ -94,7 +100,6 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
   if (options.notices)
     if (std::optional<std::string> note = tilesFileByFile(paths, *set)) options.notices->push_back(*note);
   PointSet out;
-  bool any_colors = false;
   for (const std::string& path : paths) {
     Result<PointSet> part = readPoints(path, options);
     if (!part) return part.error();
@@ -102,29 +107,8 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     if (out.size() + part->size() > UINT32_MAX && !part->triangles.empty())
       return Error{path + ": the inputs hold more than 2^32 points, past what triangle indices address",
                    ExitCode::kResourceLimit};
-    const uint32_t offset = static_cast<uint32_t>(out.size());
-    for (uint32_t index : part->triangles) out.triangles.push_back(offset + index);
-    // Colours: white for the files without, before the first coloured one and after it.
-    if (part->hasColors()) {
-      any_colors = true;
-      out.colors_read_as_fractions = out.colors_read_as_fractions || part->colors_read_as_fractions;
-      out.colors.resize(out.size(), glm::vec3(1.0f));
-      out.colors.insert(out.colors.end(), part->colors.begin(), part->colors.end());
-    } else if (any_colors) {
-      out.colors.resize(out.size() + part->size(), glm::vec3(1.0f));
-    }
-    // Dimensions: the union of the parts', 0 where a part lacks one; a name of two types keeps the
-    // first part's type (values converted).
-    for (const Dimension& d : part->dimensions.all()) {
-      Dimension* column = out.dimensions.find(d.name);
-      if (!column) column = &out.dimensions.add(d.name, d.type, out.size());
-      const size_t at = out.size();
-      column->resize(at + part->size());
-      if (column->type == d.type) std::memcpy(column->bytes.data() + at * dimTypeSize(d.type), d.bytes.data(), d.bytes.size());
-      else for (size_t i = 0; i < part->size(); ++i) column->setValue(at + i, d.value(i));
-    }
-    out.positions.insert(out.positions.end(), part->positions.begin(), part->positions.end());
-    out.dimensions.resize(out.size());
+    // Colours white for the files without; dimensions the union, 0 where a file lacks one.
+    appendPoints(out, *part);
     if (!out.las) out.las = part->las;  // the first LAS part's frame and coordinate system
   }
   return out;
@@ -148,6 +132,11 @@ struct PointInputStream::Part {
   Status read(uint64_t from, uint64_t n, PointSet& block) { return ply ? ply->read(from, n, block) : las->read(from, n, block); }
   std::string path;
   bool watch_colors = false;  // a float-colour PLY whose colours above 1 are not yet said
+  // A float-colour PLY whose first `sampled` rows' colours are whole numbers above 1: streamed as
+  // 0..color_scale values (255, 65535), as readPoints takes such a file's colours.
+  uint16_t color_scale = 0;
+  uint64_t sampled = 0;
+  bool scale_doubted = false;  // a later row's colour no such value: said
 };
 
 // A copy of a seam vertex: its owner's index among the owning part's points, and where the copy is.
@@ -185,6 +174,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
   Result<InputSet> set = checkInputSet(paths);
   if (!set) return set.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
+  stream->threads_ = threads;
   std::vector<std::pair<std::string, uint64_t>> files;  // path, points to stream (all: UINT64_MAX)
   // A tile set's copies' references, read before the parts are opened: reading them opens every
   // file once more, and a set of hundreds of tiles must not take twice its files at once (a
@@ -228,6 +218,23 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       part.watch_colors = part.ply->floatColors();
     }
     part.count = std::min(owned, part.fileCount());
+    if (part.watch_colors && part.count > 0) {
+      // A stream cannot scale colours it has drawn, so the scale is judged from the first rows.
+      PointSet sample;
+      part.sampled = std::min<uint64_t>(part.count, kColorSampleRows);
+      if (Status s = part.read(0, part.sampled, sample); !s) return s.error();
+      const WholeColorScale whole = wholeColorScale(sample.colors, 1);
+      const std::string first = part.sampled == part.count ? "" : " (in its first " + std::to_string(part.sampled) + " rows)";
+      if (whole.full != 0) {
+        part.color_scale = whole.full;
+        part.watch_colors = false;
+        stream->notices_.push_back(path + ": its float colours are whole numbers above 1 (PLY's are 0..1)" + first +
+                                   ": read as 0.." + std::to_string(whole.full) + " values");
+      } else if (whole.odd != UINT64_MAX) {
+        part.watch_colors = false;
+        stream->notices_.push_back(path + ": " + oddColorNote(sample.colors[whole.odd], whole.odd));
+      }
+    }
     part.first = stream->count_;
     stream->count_ += part.count;
     if (part.count > 0) stream->has_colors_ = stream->has_colors_ || part.hasColors();
@@ -281,11 +288,38 @@ void PointInputStream::noteColorsAboveOne(Part& part, const glm::vec3* colors, s
     }
 }
 
+void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t n, uint64_t first) {
+  if (part.color_scale == 0 || colors == nullptr) return;
+  constexpr size_t kBlock = size_t{1} << 16;
+  const float full = part.color_scale, scale = 1.0f / full;
+  std::vector<std::pair<size_t, glm::vec3>> odd((n + kBlock - 1) / kBlock, {SIZE_MAX, glm::vec3(0.0f)});
+  parallelFor(odd.size(), threads_, [&](size_t b, unsigned) {
+    for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const float c = colors[i][k];
+        if (!(c >= 0.0f && c <= full && c == std::floor(c)) && odd[b].first == SIZE_MAX) odd[b] = {i, colors[i]};
+      }
+      colors[i] *= scale;  // as takeColorsAsIntegers divides a whole read's
+    }
+  });
+  const auto first_odd = std::find_if(odd.begin(), odd.end(), [](const auto& o) { return o.first != SIZE_MAX; });
+  if (first_odd == odd.end() || part.scale_doubted) return;
+  part.scale_doubted = true;
+  const size_t at = first_odd->first;
+  const glm::vec3 c = first_odd->second;
+  notices_.push_back(part.path + ": vertex " + std::to_string(first + at) + "'s colour (" + formatNumber(c.r) + ", " +
+                     formatNumber(c.g) + ", " + formatNumber(c.b) + ") is not a whole number of 0 to " +
+                     std::to_string(part.color_scale) + " a channel, though the first " + std::to_string(part.sampled) +
+                     " rows' are: streamed as 0.." + std::to_string(part.color_scale) +
+                     " values, clamped; --stream off reads the file whole and judges every row");
+}
+
 Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   assert(first <= count_ && n <= count_ - first);
   if (parts_.size() == 1) {  // straight into the block
     if (Status s = parts_[0].read(first, n, block); !s) return s;
     if (Status s = checkCopies(0, first, block); !s) return s;
+    takeStreamedColors(parts_[0], block.hasColors() ? block.colors.data() : nullptr, block.size(), first);
     noteColorsAboveOne(parts_[0], block.hasColors() ? block.colors.data() : nullptr, block.size());
     if (has_colors_ && !block.hasColors()) block.colors.assign(block.size(), glm::vec3(1.0f));
     return okStatus();
@@ -301,6 +335,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     if (from >= to) continue;
     if (Status s = part.read(from - part.first, to - from, scratch_); !s) return s;
     if (Status s = checkCopies(static_cast<size_t>(&part - parts_.data()), from - part.first, scratch_); !s) return s;
+    takeStreamedColors(part, scratch_.hasColors() ? scratch_.colors.data() : nullptr, scratch_.size(), from - part.first);
     noteColorsAboveOne(part, scratch_.hasColors() ? scratch_.colors.data() : nullptr, scratch_.size());
     const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
@@ -339,11 +374,6 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
   }
   if (stream == "on" || (*opened)->count() > kStreamAbovePoints) return opened;
   return std::unique_ptr<PointInputStream>();
-}
-
-std::string describeInputs(const std::vector<std::string>& paths) {
-  if (paths.size() == 1) return paths[0];
-  return paths[0] + " and " + std::to_string(paths.size() - 1) + " more";
 }
 
 }  // namespace dpoint

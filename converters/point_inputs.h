@@ -56,8 +56,10 @@ class PointInputStream {
   uint64_t faceCount() const { return faces_; }
   // Host bytes held for the whole stream beside its blocks: a tile set's copies (0 for other files).
   uint64_t heldBytes() const { return held_bytes_; }
-  // What the readers read past in the headers, one line each (ReadOptions::notices); after the
-  // blocks are read, also what they met (float PLY colours above 1, clamped: once a file).
+  // What the readers read past in the headers, one line each (ReadOptions::notices), and a float
+  // PLY's colours read as 0..255 values from its first rows; after the blocks are read, also what
+  // they met (float PLY colours above 1, clamped, or a row's colours unlike the first rows': once
+  // a file).
   const std::vector<std::string>& notices() const { return notices_; }
   // The first file's dimensions (PLY vertex properties), as empty columns.
   const Dimensions& dimensions() const;
@@ -76,10 +78,15 @@ class PointInputStream {
   Status checkCopies(size_t part, uint64_t first, const PointSet& rows) const;
   // A float-colour PLY part's block with a channel above 1: said once a part (notices_).
   void noteColorsAboveOne(Part& part, const glm::vec3* colors, size_t n);
+  // A float-colour PLY part whose first rows' colours are whole numbers above 1 (wholeColorScale):
+  // each block's colours divided by their scale as a whole read divides them; a row of `first` on
+  // whose colour is not such a value is said once a part.
+  void takeStreamedColors(Part& part, glm::vec3* colors, size_t n, uint64_t first);
   std::vector<Part> parts_;  // in stream order
   std::unique_ptr<TileCopies> copies_;  // null but for a complete tile set
   uint64_t count_ = 0, faces_ = 0, held_bytes_ = 0;
   bool has_colors_ = false;
+  unsigned threads_ = 0;
   std::optional<Dimension> streamed_;  // streamDimension's name and type, no values
   std::vector<std::string> notices_;
   PointSet scratch_;
@@ -96,8 +103,5 @@ inline constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
                                                           const std::string& stream, unsigned threads,
                                                           uint64_t max_memory = 0);
-
-// "a.ply" for one path, "a.ply and 3 more" for several: for messages and reports.
-std::string describeInputs(const std::vector<std::string>& paths);
 
 }  // namespace dpoint

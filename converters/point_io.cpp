@@ -62,7 +62,8 @@ class CsvPointSink final : public GltfPointSink {
 
 Result<FileFormat> formatOf(const std::string& path) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".csv" || ext == ".xyz" || ext == ".txt" || ext == ".asc" || ext == ".pts") return FileFormat::kCsv;
+  if (ext == ".csv" || ext == ".xyz" || ext == ".txt" || ext == ".asc" || ext == ".pts" || ext == ".ptx")
+    return FileFormat::kCsv;
   if (ext == ".ply") return FileFormat::kPly;
   if (ext == ".glb") return FileFormat::kGlb;
   if (ext == ".gltf") return FileFormat::kGltf;
@@ -71,9 +72,9 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".laz") return FileFormat::kLaz;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
-    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .gltf, .las or .laz)",
+    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las or .laz)",
                  ExitCode::kUsage};
-  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .gltf, .las or .laz)",
+  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las or .laz)",
                ExitCode::kUsage};
 }
 
@@ -118,6 +119,8 @@ Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query,
 Status checkWrittenFormat(const std::string& path, FileFormat format) {
   if (format == FileFormat::kGltf)
     return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .pcd, .las)", ExitCode::kUsage};
+  if (isPtxPath(path))
+    return Error{path + ": .ptx is read, not written; write .pts or .las (or .csv, .ply, .pcd, .glb)", ExitCode::kUsage};
   return okStatus();
 }
 
@@ -172,13 +175,17 @@ Result<PointSet> readPoints(const std::string& path, const ReadOptions& options)
   // Float colours of whole numbers above 1 are 0..255 (or 0..65535) values, as some tools write
   // a PLY's: read as CSV reads its integer colours, instead of clamped to white.
   // (Not for colours about to be dropped: --no-colors says nothing of them.)
-  if (*format == FileFormat::kPly && points->colors_read_as_fractions && options.las_color != LasColorSource::kNone)
-    if (const uint16_t full = wholeColorScale(points->colors, options.threads); full != 0) {
-      takeColorsAsIntegers(*points, full, options.threads);
+  if (*format == FileFormat::kPly && points->colors_read_as_fractions && options.las_color != LasColorSource::kNone) {
+    const WholeColorScale whole = wholeColorScale(points->colors, options.threads);
+    if (whole.full != 0) {
+      takeColorsAsIntegers(*points, whole.full, options.threads);
       if (options.notices)
         options.notices->push_back(path + ": its float colours are whole numbers above 1 (PLY's are 0..1): read as 0.." +
-                                   std::to_string(full) + " values");
+                                   std::to_string(whole.full) + " values");
+    } else if (whole.odd != UINT64_MAX && options.notices) {
+      options.notices->push_back(path + ": " + oddColorNote(points->colors[whole.odd], whole.odd));
     }
+  }
   if (options.las_color == LasColorSource::kRgb && !points->hasColors())
     return Error{path + ": colour by RGB asked for, but the file has no colours"};
   if (options.las_color == LasColorSource::kNone) points->colors.clear();
@@ -318,6 +325,9 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       }
       if (options.notices) {
         if (!report.crs.empty()) options.notices->push_back(path + ": " + report.crs);
+        if (report.intensity_scaled)
+          options.notices->push_back(path + ": intensity of 0..1 values (as PTX holds it) written as 0..65535, "
+                                            "LAS's 16-bit intensity normalised to that range");
         for (const std::string& line : report.renamed)
           options.notices->push_back(path + ": " + line + " (a LAS extra bytes name is up to 32 letters, digits or '_')");
         for (int k = 0; k < 3; ++k)

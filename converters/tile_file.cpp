@@ -566,7 +566,8 @@ Result<PointSet> mergeTiles(const std::vector<std::string>& paths, uint64_t max_
   for (uint32_t t = 0; t < count; ++t) copies += set.foreign[t].size();
   const uint64_t bytes = (vertices + copies) * (sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0)) +
                          faces * 3 * sizeof(uint32_t);
-  if (Status s = checkMemory("merging " + std::to_string(count) + " tiles", bytes, max_memory); !s) return s.error();
+  if (Status s = checkMemory(describeInputs(paths) + ": merging " + std::to_string(count) + " tiles", bytes, max_memory); !s)
+    return s.error();
 
   // Every tile's rows, kRowsPerBlock at a time on all cores, straight to their places: owned
   // vertices into the set, copies beside it (checked below), faces through the weld.
@@ -660,7 +661,9 @@ Status mergeTilesToPly(const std::vector<std::string>& paths, const std::string&
     const uint64_t threads = resolveThreads(options.threads);
     const uint64_t bytes = copies * (in_stride + 2 * sizeof(TileVertexRef) + 3 * sizeof(uint32_t)) +
                            threads * kRowsPerBlock * (in_stride + 2 * std::max(out_stride, kFaceBytes));
-    if (Status s = checkMemory("merging " + std::to_string(count) + " tiles into " + output, bytes, max_memory); !s)
+    if (Status s = checkMemory(describeInputs(paths) + ": merging " + std::to_string(count) + " tiles into " + output, bytes,
+                               max_memory);
+        !s)
       return s;
   }
 

@@ -45,8 +45,16 @@ InputFile InputFile::fromMemory(std::string name, std::string_view bytes) {
   return InputFile(std::move(name), -1, bytes.size(), bytes.empty() ? &kEmpty : bytes.data());
 }
 
+InputFile InputFile::slice(uint64_t offset, uint64_t size) const {
+  offset = std::min(offset, size_);
+  InputFile part(path_, fd_, std::min(size, size_ - offset), memory_ ? memory_ + offset : nullptr);
+  part.base_ = base_ + offset;
+  part.owns_fd_ = false;
+  return part;
+}
+
 InputFile::~InputFile() {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ >= 0 && owns_fd_) ::close(fd_);
 }
 
 Result<size_t> InputFile::readAt(uint64_t offset, void* data, size_t size) const {
@@ -60,6 +68,11 @@ Result<size_t> InputFile::readAt(uint64_t offset, void* data, size_t size) const
     std::memcpy(data, memory_ + offset, n);
     return n;
   }
+  if (!owns_fd_) {  // a slice reads no further than its end
+    if (offset >= size_) return size_t{0};
+    size = static_cast<size_t>(std::min<uint64_t>(size, size_ - offset));
+  }
+  offset += base_;
   size_t total = 0;
   char* out = static_cast<char*>(data);
   while (total < size) {

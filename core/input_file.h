@@ -22,9 +22,14 @@ class InputFile {
   // `bytes` read as if they were a file named `name` (which names it in errors); no file is
   // opened. The bytes must outlive the InputFile.
   static InputFile fromMemory(std::string name, std::string_view bytes);
+  // Bytes [offset, offset + size) of this file read as a file of their own, under the same name
+  // (a PTX scan's rows for the CSV reader). It reads through this file's descriptor, so this file
+  // must outlive it; reads stop at its end.
+  InputFile slice(uint64_t offset, uint64_t size) const;
 
   InputFile(InputFile&& other) noexcept
-      : path_(std::move(other.path_)), fd_(other.fd_), size_(other.size_), memory_(other.memory_) {
+      : path_(std::move(other.path_)), fd_(other.fd_), size_(other.size_), memory_(other.memory_),
+        base_(other.base_), owns_fd_(other.owns_fd_) {
     other.fd_ = -1;
   }
   InputFile(const InputFile&) = delete;
@@ -47,6 +52,8 @@ class InputFile {
   int fd_ = -1;
   uint64_t size_ = 0;
   const char* memory_ = nullptr;  // fromMemory: the bytes (fd_ is -1)
+  uint64_t base_ = 0;             // a slice: where it starts in the file
+  bool owns_fd_ = true;           // false for a slice, which reads through its file's descriptor
 };
 
 }  // namespace dpoint

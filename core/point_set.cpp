@@ -10,6 +10,7 @@
 #include <glm/common.hpp>
 
 #include "core/parallel.h"
+#include "core/text.h"
 
 namespace dpoint {
 
@@ -53,29 +54,41 @@ ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned thre
   return {rounded.load(), clamped.load()};
 }
 
-uint16_t wholeColorScale(const ColorArray& colors, unsigned threads) {
+WholeColorScale wholeColorScale(const ColorArray& colors, unsigned threads) {
   constexpr size_t kBlock = size_t{1} << 18;
   const size_t blocks = (colors.size() + kBlock - 1) / kBlock;
-  std::vector<float> largest(blocks, 0.0f);
-  std::atomic<bool> whole{true};  // every channel an integer from 0 to 65535
+  std::vector<float> largest(blocks, 0.0f);  // the largest whole channel
+  std::vector<uint64_t> odd(blocks, UINT64_MAX);
   // Fractions end the scan at their first channel between 0 and 1 (a file's usual colours).
+  std::atomic<bool> fraction{false};
   parallelFor(blocks, threads, [&](size_t b, unsigned) {
     const size_t end = std::min(colors.size(), (b + 1) * kBlock);
     float most = 0.0f;
-    for (size_t i = b * kBlock; i < end && whole.load(std::memory_order_relaxed); ++i) {
+    for (size_t i = b * kBlock; i < end && !fraction.load(std::memory_order_relaxed); ++i) {
       bool integers = true;
       for (int k = 0; k < 3; ++k) {
         const float c = colors[i][k];
-        integers = integers && c >= 0.0f && c <= 65535.0f && c == std::floor(c);  // NaN fails
-        most = std::max(most, c);
+        if (c > 0.0f && c < 1.0f) fraction.store(true, std::memory_order_relaxed);
+        const bool whole = c >= 0.0f && c <= 65535.0f && c == std::floor(c);  // NaN fails
+        integers = integers && whole;
+        if (whole) most = std::max(most, c);
       }
-      if (!integers) whole.store(false, std::memory_order_relaxed);
+      if (!integers && odd[b] == UINT64_MAX) odd[b] = i;
     }
     largest[b] = most;
   });
+  WholeColorScale scale;
   const float most = blocks == 0 ? 0.0f : *std::max_element(largest.begin(), largest.end());
-  if (!whole.load() || !(most > 1.0f)) return 0;
-  return most > 255.0f ? 65535 : 255;
+  if (fraction.load() || !(most > 1.0f)) return scale;
+  scale.odd = blocks == 0 ? UINT64_MAX : *std::min_element(odd.begin(), odd.end());
+  if (scale.odd == UINT64_MAX) scale.full = most > 255.0f ? 65535 : 255;
+  return scale;
+}
+
+std::string oddColorNote(const glm::vec3& color, uint64_t vertex) {
+  return "its float colours are whole numbers above 1 (0..255 values?), but vertex " + std::to_string(vertex) + "'s (" +
+         formatNumber(color.r) + ", " + formatNumber(color.g) + ", " + formatNumber(color.b) +
+         ") is not a whole number of 0 to 65535 a channel: read as PLY's 0..1 values, those above 1 clamped";
 }
 
 void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
@@ -87,6 +100,29 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
   });
   points.color_full_scale = full;
   points.colors_read_as_fractions = false;
+}
+
+void appendPoints(PointSet& out, const PointSet& part) {
+  const size_t at = out.size();
+  const uint32_t offset = static_cast<uint32_t>(at);
+  for (uint32_t index : part.triangles) out.triangles.push_back(offset + index);
+  if (part.hasColors()) {
+    out.colors_read_as_fractions = out.colors_read_as_fractions || part.colors_read_as_fractions;
+    out.colors.resize(at, glm::vec3(1.0f));
+    out.colors.insert(out.colors.end(), part.colors.begin(), part.colors.end());
+  } else if (out.hasColors()) {
+    out.colors.resize(at + part.size(), glm::vec3(1.0f));
+  }
+  for (const Dimension& d : part.dimensions.all()) {
+    Dimension* column = out.dimensions.find(d.name);
+    if (!column) column = &out.dimensions.add(d.name, d.type, at);
+    column->resize(at + part.size());
+    if (column->type == d.type) std::memcpy(column->bytes.data() + at * dimTypeSize(d.type), d.bytes.data(), d.bytes.size());
+    else
+      for (size_t i = 0; i < part.size(); ++i) column->setValue(at + i, d.value(i));
+  }
+  out.positions.insert(out.positions.end(), part.positions.begin(), part.positions.end());
+  out.dimensions.resize(out.size());
 }
 
 uint64_t heldBytes(const PointSet& points) {

@@ -117,13 +117,30 @@ struct ColorsOffGrid {
 ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned threads);
 
 // The integer scale of float colours written as 0..255 or 0..65535 values (as some tools write a
-// PLY's float red, green, blue): 255 where the largest channel is above 1 and at most 255, 65535
-// where it is above 255 and at most 65535, and every channel is an integer from 0 to it; else 0
-// (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions).
-uint16_t wholeColorScale(const ColorArray& colors, unsigned threads);
+// PLY's float red, green, blue). `full`: 255 where the largest channel is above 1 and at most 255,
+// 65535 where it is above 255 and at most 65535, and every channel is an integer from 0 to it;
+// else 0 (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions). The
+// scan stops at the first channel between 0 and 1. `odd`: where no channel is such a fraction and
+// some are whole numbers above 1, the first colour with a channel no integer scale holds (negative,
+// NaN, past 65535, 127.5), which alone kept `full` 0; else UINT64_MAX.
+struct WholeColorScale {
+  uint16_t full = 0;
+  uint64_t odd = UINT64_MAX;
+};
+WholeColorScale wholeColorScale(const ColorArray& colors, unsigned threads);
+// What a reader says of WholeColorScale::odd (`color`, of vertex `vertex`): why colours of whole
+// numbers above 1 stay 0..1 values, clamped.
+std::string oddColorNote(const glm::vec3& color, uint64_t vertex);
 // Colours read as integers of `full` (255, 65535) taken as 0..1 values: each channel divided by
 // it, and PointSet::color_full_scale set, so that a writer of integers writes them back as they were.
 void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads);
+
+// `part`'s points after `out`'s: positions; colours, white for the points of either set without
+// where the other has them; dimensions, the union of both, 0 where a set lacks one (a name of two
+// types keeps out's type, values converted); triangles offset by out's size (the caller keeps the
+// total within 2^32). colors_read_as_fractions is kept where either has it; the other fields
+// (color_full_scale, las, z_axis) are the caller's.
+void appendPoints(PointSet& out, const PointSet& part);
 
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {

@@ -15,6 +15,12 @@
 
 namespace dpoint {
 
+// "a.ply" for one path, "a.ply and 3 more" for several: for messages and reports.
+inline std::string describeInputs(const std::vector<std::string>& paths) {
+  if (paths.size() == 1) return paths[0];
+  return paths[0] + " and " + std::to_string(paths.size() - 1) + " more";
+}
+
 // The length of the well-formed UTF-8 sequence of two to four bytes at text[i] (a lead byte C2-F4
 // and its continuation bytes), or 0.
 inline size_t utf8SequenceAt(std::string_view text, size_t i) {

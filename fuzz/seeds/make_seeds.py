@@ -27,6 +27,12 @@ write("csv", "xyrgb.csv", "x,y,r,g,b\n1,2,0.1,0.2,0.3\n")
 write("csv", "extremes.csv", "x,y,z\n1.7976931348623157e308,4.9e-324,-2.2250738585072014e-308\n"
       "123456789012345678901234567890,0.000000000000000000001,1e-400\n")
 write("csv", "nonfinite.csv", "x,y,z\nnan,inf,-inf\n")
+# Two PTX scans (the csv target reads every input as .ptx too): a rotation with a translation and
+# rows with intensity and colours, one with no echo; then an identity scan of x y z rows.
+PTX_TWO_SCANS = ("2\n1\n10 20 30\n1 0 0\n0 1 0\n0 0 1\n0 -1 0 0\n1 0 0 0\n0 0 1 0\n10 20 30 1\n"
+                 "1.5 2.5 -3 0.25 255 128 0\n0 0 0 0.5 0 0 0\n"
+                 "1\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n7 8 9\n")
+write("csv", "two_scans.ptx", PTX_TWO_SCANS)
 
 # ---- PCD: each encoding, PCL's header variants, an organized cloud with NaN points ----
 def lzf_literals(data, repeat_at=None):

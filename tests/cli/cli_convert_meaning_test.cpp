@@ -400,6 +400,11 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
                                         (name == "words" ? "65535" : "255") + " values"),
               whole)
         << name << ": " << r.err;
+    // One value no integer scale holds among whole ones above 1: said, naming it (a review finding).
+    EXPECT_EQ(test::contains(r.err, dir.file(name + ".ply") + ": its float colours are whole numbers above 1 (0..255 values?), "
+                                                              "but vertex 0's (127.5, 128, 0) is not a whole number of 0 to 65535"),
+              name == "halves")
+        << name << ": " << r.err;
   }
   // Colours dropped are not spoken of (a review finding).
   const test::CommandResult dropped = runDpoint({"convert", dir.file("bytes.ply"), "-o", dir.file("none.csv"), "--no-colors"});
@@ -424,24 +429,97 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
     }
   EXPECT_TRUE(orange);
   EXPECT_FALSE(white);
-  // A stream takes float colours as 0..1 block by block: it clamps such values, and says so once
-  // the blocks are read (render and info); the whole read says nothing of the kind.
-  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-                       "property float z\nproperty float red\nproperty float green\nproperty float blue\nend_header\n";
-  for (const std::array<float, 6>& row : {std::array<float, 6>{0, 0, 0, 255, 128, 0}, std::array<float, 6>{1, 0, 0, 0, 0, 12}})
-    binary.append(reinterpret_cast<const char*>(row.data()), sizeof row);
-  writeFile(dir.file("binary.ply"), binary);
-  const std::string streamed = dir.file("binary.ply") + ": float colours above 1 (0..255 values?) streamed as PLY's 0..1 and clamped";
+  // A stream judges the scale from a file's first 65,536 rows, as the whole read judges it from all
+  // (the build before clamped such colours to white in a stream), and says so.
+  const auto binaryPly = [&](const std::string& name, const std::vector<std::array<float, 6>>& rows) {
+    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(rows.size()) +
+                        "\nproperty float x\nproperty float y\nproperty float z\nproperty float red\nproperty float green\n"
+                        "property float blue\nend_header\n";
+    for (const std::array<float, 6>& row : rows) bytes.append(reinterpret_cast<const char*>(row.data()), sizeof row);
+    writeFile(dir.file(name), bytes);
+  };
+  binaryPly("binary.ply", {{0, 0, 0, 255, 128, 0}, {1, 0, 0, 0, 0, 12}});
+  const std::string scaled = dir.file("binary.ply") + ": its float colours are whole numbers above 1 (PLY's are 0..1): read as 0..255 values";
   for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"render", "-q", "--stream", "on", "--width", "40", "--height", "30", "-o", dir.file("s.png")},
-        {"info", "--stream", "on"}}) {
+       {std::vector<std::string>{"render", "-q", "--stream", "on", "--width", "40", "--height", "30", "--point-size", "9",
+                                 "--fit", "-o", dir.file("s.png")},
+        {"info", "--stream", "on"}, {"info", "--stream", "off"}}) {
     const test::CommandResult s = runDpoint(test::concat(args, {dir.file("binary.ply")}));
     ASSERT_EQ(s.exit_code, 0) << args[0] << ": " << s.err;
-    EXPECT_TRUE(test::contains(s.err, streamed)) << args[0] << ": " << s.err;
+    EXPECT_TRUE(test::contains(s.err, scaled)) << args[0] << ": " << s.err;
+    EXPECT_FALSE(test::contains(s.err, "clamped")) << args[0] << ": " << s.err;
   }
-  const test::CommandResult whole = runDpoint({"info", "--stream", "off", dir.file("binary.ply")});
-  EXPECT_FALSE(test::contains(whole.err, "streamed as")) << whole.err;
-  EXPECT_TRUE(test::contains(whole.err, "read as 0..255 values")) << whole.err;
+  EXPECT_EQ(readFile(dir.file("s.png")), readFile(dir.file("bytes.png")));  // the whole read's picture, streamed
+  // Past the first rows, a colour no such value is said, naming its vertex; fractions from the first
+  // row on are clamped above 1 as before.
+  std::vector<std::array<float, 6>> rows(70000, std::array<float, 6>{0, 0, 0, 200, 100, 0});
+  for (size_t i = 0; i < rows.size(); ++i) rows[i][0] = static_cast<float>(i);
+  rows[69000][4] = 0.5f;
+  binaryPly("late.ply", rows);
+  const test::CommandResult late = runDpoint({"info", "--stream", "on", dir.file("late.ply")});
+  ASSERT_EQ(late.exit_code, 0) << late.err;
+  EXPECT_TRUE(test::contains(late.err, dir.file("late.ply") + ": its float colours are whole numbers above 1 (PLY's are 0..1) "
+                                                              "(in its first 65536 rows): read as 0..255 values"))
+      << late.err;
+  EXPECT_TRUE(test::contains(late.err, dir.file("late.ply") + ": vertex 69000's colour (200, 0.5, 0) is not a whole number of "
+                                                              "0 to 255 a channel, though the first 65536 rows' are"))
+      << late.err;
+  binaryPly("fractions.ply", {{0, 0, 0, 0.5f, 0.25f, 0}, {1, 0, 0, 2, 0, 1}});
+  const test::CommandResult hdr = runDpoint({"info", "--stream", "on", dir.file("fractions.ply")});
+  ASSERT_EQ(hdr.exit_code, 0) << hdr.err;
+  EXPECT_TRUE(test::contains(hdr.err, dir.file("fractions.ply") +
+                                          ": float colours above 1 (0..255 values?) streamed as PLY's 0..1 and clamped"))
+      << hdr.err;
+}
+
+// A Leica PTX scan, the usual export of a terrestrial scanner, converts to LAS in its registered
+// frame: its 0..1 intensities as LAS's 16-bit ones (a note says so; the writer had refused 0.159304
+// as no whole number), its colours, the points with no echo left out. info and render read it
+// too; it is not written, and --columns does not apply.
+TEST(CliConvertMeaning, aPtxScanConvertsToLasWithItsIntensityAsSixteenBits) {
+  TempDir dir;
+  writeFile(dir.file("scan.ptx"), "2\n2\n558312.218127 5240857.469093 76.298415\n1 0 0\n0 1 0\n0 0 1\n"
+                                  "1 0 0 0\n0 1 0 0\n0 0 1 0\n558312.218127 5240857.469093 76.298415 1\n"
+                                  "0 0 0 0.500000 0 0 0\n"
+                                  "12.032272 -2.613480 -2.036392 0.159304 168 183 142\n"
+                                  "12.860123 -2.793289 -2.162979 0.183719 118 121 94\n"
+                                  "12.881760 -2.798019 -2.153061 1 0 0 0\n");
+  const test::CommandResult r = runDpoint({"convert", dir.file("scan.ptx"), "-o", dir.file("scan.las")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(test::contains(r.err, dir.file("scan.ptx") + ": 1 of its 4 rows are points with no echo")) << r.err;
+  EXPECT_TRUE(test::contains(r.err, dir.file("scan.las") + ": intensity of 0..1 values (as PTX holds it) written as 0..65535"))
+      << r.err;
+  Result<PointSet> las = readLas(dir.file("scan.las"));
+  ASSERT_TRUE(las.ok()) << las.error().message;
+  ASSERT_EQ(las->size(), 3u);
+  EXPECT_NEAR(las->positions[0].x, 558312.218127 + 12.032272, 1e-6);
+  EXPECT_NEAR(las->positions[0].y, 5240857.469093 - 2.613480, 1e-6);
+  const Dimension* intensity = las->dimensions.find("intensity");
+  ASSERT_NE(intensity, nullptr);
+  EXPECT_EQ(intensity->value(0), 10440.0);  // round(0.159304 · 65535)
+  EXPECT_EQ(intensity->value(1), 12040.0);  // round(0.183719 · 65535)
+  EXPECT_EQ(intensity->value(2), 65535.0);
+  ASSERT_TRUE(las->hasColors());
+  EXPECT_EQ(las->colors[0], glm::vec3(168.0f, 183.0f, 142.0f) / 255.0f);
+  // Whole intensities are written as they are, as before.
+  writeFile(dir.file("whole.csv"), "x,y,z,intensity\n1,2,3,0\n4,5,6,1\n");
+  const test::CommandResult whole = runDpoint({"convert", dir.file("whole.csv"), "-o", dir.file("whole.las")});
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_FALSE(test::contains(whole.err, "0..65535")) << whole.err;
+  EXPECT_EQ(readLas(dir.file("whole.las"))->dimensions.find("intensity")->value(1), 1.0);
+
+  const test::CommandResult info = runDpoint({"info", dir.file("scan.ptx")});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_TRUE(test::contains(info.out, " 3\ntriangles:")) << info.out;
+  EXPECT_EQ(runDpoint({"render", "-q", "--width", "32", "--height", "24", "-o", dir.file("scan.png"), dir.file("scan.ptx")}).exit_code,
+            0);
+  const test::CommandResult written = runDpoint({"convert", dir.file("scan.las"), "-o", dir.file("back.ptx")});
+  EXPECT_EQ(written.exit_code, 1);
+  EXPECT_TRUE(test::contains(written.err, ".ptx is read, not written")) << written.err;
+  EXPECT_FALSE(test::fileExists(dir.file("back.ptx")));
+  const test::CommandResult columns = runDpoint({"convert", dir.file("scan.ptx"), "--columns", "x,y,z", "-o", dir.file("c.csv")});
+  EXPECT_EQ(columns.exit_code, 1) << columns.err;
+  EXPECT_TRUE(test::contains(columns.err, "a PTX file's rows are x y z, an intensity and r g b")) << columns.err;
 }
 
 // Only PLY and GLB hold triangles: converting a PLY mesh to another format reads its vertices and

@@ -461,10 +461,40 @@ TEST(LasDimensions, aSetWithoutLasSourceGetsTheSmallestFormatThatHoldsIt) {
   EXPECT_EQ(back->dimensions.find(dim::kGpsTime)->get<double>(0), 12.25);
 }
 
+// A float intensity of 0..1 values (PTX's, a normalised one) is LAS's 16-bit intensity as a
+// fraction of 65535, LAS and LAZ alike, and the report says so; one of whole numbers (0 and 1
+// alone too) is written as it is. The build before refused 0.5 as no whole number.
+TEST(LasDimensions, anIntensityOfFractionsIsWrittenAsSixteenBits) {
+  TempDir dir;
+  for (const bool compress : {false, true}) {
+    for (const bool fractions : {true, false}) {
+      PointSet set;
+      set.positions = {{0, 0, 0}, {1, 2, 3}, {4, 5, 6}};
+      Dimension& d = set.dimensions.add(dim::kIntensity, DimType::kF32, 3);
+      d.setValue(1, fractions ? 0.5 : 0.0);
+      d.setValue(2, 1.0);
+      const std::string path = dir.file(compress ? "i.laz" : "i.las");
+      LasWriteReport report;
+      LasWriteOptions options;
+      options.compress = compress;
+      options.report = &report;
+      ASSERT_TRUE(writeLas(path, set, options)) << compress;
+      EXPECT_EQ(report.intensity_scaled, fractions);
+      Result<PointSet> back = readLas(path);
+      ASSERT_TRUE(back.ok()) << back.error().message;
+      const Dimension* intensity = back->dimensions.find(dim::kIntensity);
+      ASSERT_NE(intensity, nullptr);
+      EXPECT_EQ(intensity->value(1), fractions ? 32768.0 : 0.0);  // round(0.5 · 65535)
+      EXPECT_EQ(intensity->value(2), fractions ? 65535.0 : 1.0);
+    }
+  }
+}
+
 // A value its LAS field cannot hold as it is (a fraction, or beyond the field's bits or type) is
 // refused, naming the point, the dimension and the field's range, and nothing is written, as LAS
 // and as LAZ: the build before rounded, clamped or masked it silently (return 20 was written as 4,
-// intensity 0.25 as 0, 70000 as 65535). A whole value in range is written, whatever its type.
+// intensity 0.25 as 0, 70000 as 65535). A whole value in range is written, whatever its type, and
+// an intensity of 0..1 values as a fraction of 65535 (above).
 TEST(LasDimensions, aValueItsFieldCannotHoldIsRefused) {
   TempDir dir;
   struct Case {
@@ -477,7 +507,7 @@ TEST(LasDimensions, aValueItsFieldCannotHoldIsRefused) {
                                                                    "return_number, a whole number 0..15 (4 bits)"},
                         Case{dim::kScannerChannel, DimType::kU8, 5, "0..3 (2 bits)"},
                         Case{dim::kSynthetic, DimType::kU8, 2, "0..1 (1 bit)"},
-                        Case{dim::kIntensity, DimType::kF64, 0.25, "intensity = 0.25 does not fit LAS point format 0's "
+                        Case{dim::kIntensity, DimType::kF64, 1.25, "intensity = 1.25 does not fit LAS point format 0's "
                                                                    "intensity, a whole number 0..65535 (uint16)"},
                         Case{dim::kIntensity, DimType::kF64, 70000, "0..65535 (uint16)"},
                         Case{dim::kPointSourceId, DimType::kI32, -5, "0..65535 (uint16)"},

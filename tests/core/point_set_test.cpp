@@ -37,23 +37,32 @@ TEST(PointSet, colorsOffGridCountsTheColoursAnIntegerWriterChanges) {
 // Float colours of whole numbers above 1 are 0..255 or 0..65535 values; fractions, HDR values among
 // fractions, numbers between integers, a negative or NaN channel, or past 65535 are not.
 TEST(PointSet, wholeColorScaleTellsIntegerColoursWrittenAsFloats) {
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, 128.0f, 0.0f), glm::vec3(1.0f, 0.0f, 12.0f)}, 1), 255);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(2.0f, 0.0f, 0.0f)}, 1), 255);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(256.0f, 0.0f, 65535.0f)}, 1), 65535);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(1.0f, 0.0f, 1.0f), glm::vec3(0.5f, 0.25f, 0.0f)}, 1), 0);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(1.0f, 1.0f, 1.0f)}, 1), 0);  // 0/1 fractions
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(1.2f, 0.5f, 0.0f)}, 1), 0);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(127.5f, 0.0f, 0.0f)}, 1), 0);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, -1.0f, 0.0f)}, 1), 0);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, std::nanf(""), 0.0f)}, 1), 0);
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(65536.0f, 0.0f, 0.0f)}, 1), 0);
-  EXPECT_EQ(wholeColorScale(ColorArray(), 1), 0);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, 128.0f, 0.0f), glm::vec3(1.0f, 0.0f, 12.0f)}, 1).full, 255);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(2.0f, 0.0f, 0.0f)}, 1).full, 255);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(256.0f, 0.0f, 65535.0f)}, 1).full, 65535);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(1.0f, 0.0f, 1.0f), glm::vec3(0.5f, 0.25f, 0.0f)}, 1).full, 0);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(1.0f, 1.0f, 1.0f)}, 1).full, 0);  // 0/1 fractions
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(1.2f, 0.5f, 0.0f)}, 1).full, 0);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(127.5f, 0.0f, 0.0f)}, 1).full, 0);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, -1.0f, 0.0f)}, 1).full, 0);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, std::nanf(""), 0.0f)}, 1).full, 0);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(65536.0f, 0.0f, 0.0f)}, 1).full, 0);
+  EXPECT_EQ(wholeColorScale(ColorArray(), 1).full, 0);
   // Over many blocks and threads: one channel decides.
   ColorArray many(1000000, glm::vec3(0.0f));
   many[999999].r = 300.0f;
-  EXPECT_EQ(wholeColorScale(many, 4), 65535);
+  EXPECT_EQ(wholeColorScale(many, 4).full, 65535);
   many[5].b = 0.5f;
-  EXPECT_EQ(wholeColorScale(many, 4), 0);
+  EXPECT_EQ(wholeColorScale(many, 4).full, 0);
+  EXPECT_EQ(wholeColorScale(many, 4).odd, UINT64_MAX);  // fractions: no odd one
+  // Whole numbers above 1 but for one channel no integer scale holds: that colour, named.
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, 3.0f, 0.0f), glm::vec3(255.0f, -1.0f, 0.0f)}, 1).odd, 1u);
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(127.5f, 0.0f, 0.0f)}, 1).odd, UINT64_MAX);  // no whole one above 1
+  many[5].b = 0.0f;
+  many[700000].g = 70000.0f;
+  many[900000].g = -2.0f;
+  EXPECT_EQ(wholeColorScale(many, 4).full, 0);
+  EXPECT_EQ(wholeColorScale(many, 4).odd, 700000u);
 }
 
 }  // namespace

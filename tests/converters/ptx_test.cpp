@@ -1,0 +1,174 @@
+// Leica PTX files (converters/ptx_read.cpp): scans of a ten-line header and rows in the scanner's
+// frame, read into the registered frame, the points with no echo left out.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "converters/csv.h"
+#include "core/dimensions.h"
+#include "test_support.h"
+
+namespace dpoint {
+namespace {
+
+using test::TempDir;
+using test::writeFile;
+
+// A scan's header: columns, rows, the scanner's pose (unused by the reader) and the transformation
+// in PTX's row-vector form, its fourth row the translation.
+std::string header(int columns, int rows, const std::string& translation = "0 0 0",
+                   const std::string& rotation = "1 0 0 0\n0 1 0 0\n0 0 1 0\n") {
+  return std::to_string(columns) + "\n" + std::to_string(rows) + "\n" + translation + "\n1 0 0\n0 1 0\n0 0 1\n" + rotation +
+         translation + " 1\n";
+}
+
+Result<PointSet> readText(const TempDir& dir, const std::string& text, std::vector<std::string>* notices = nullptr,
+                          unsigned threads = 0) {
+  const std::string path = dir.file("scan.ptx");
+  writeFile(path, text);
+  CsvReadOptions options;
+  options.notices = notices;
+  options.threads = threads;
+  return readCsv(path, options);
+}
+
+TEST(Ptx, readsAScanIntoItsRegisteredFrameLeavingOutPointsWithNoEcho) {
+  TempDir dir;
+  const double tx = 558312.218127, ty = 5240857.469093, tz = 76.298415;
+  const std::string text = header(2, 2, "558312.218127 5240857.469093 76.298415") +
+                           "0 0 0 0.500000 0 0 0\n"
+                           "12.032272 -2.613480 -2.036392 0.159304 168 183 142\n"
+                           "12.860123 -2.793289 -2.162979 0.183719 118 121 94\n"
+                           "0 0 0 0.5 0 0 0\n";
+  std::vector<std::string> notices;
+  Result<PointSet> points = readText(dir, text, &notices);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  ASSERT_EQ(points->size(), 2u);
+  // A translation alone: x + tx, rounded once, as double adds them.
+  EXPECT_EQ(points->positions[0], glm::dvec3(12.032272 + tx, -2.613480 + ty, -2.036392 + tz));
+  EXPECT_EQ(points->positions[1], glm::dvec3(12.860123 + tx, -2.793289 + ty, -2.162979 + tz));
+  EXPECT_TRUE(points->hasZ());
+  ASSERT_TRUE(points->hasColors());
+  EXPECT_EQ(points->color_full_scale, 255);
+  EXPECT_EQ(points->colors[0], glm::vec3(168.0f, 183.0f, 142.0f) / 255.0f);
+  const Dimension* intensity = points->dimensions.find(dim::kIntensity);
+  ASSERT_NE(intensity, nullptr);
+  EXPECT_EQ(intensity->value(0), 0.159304);
+  EXPECT_EQ(intensity->value(1), 0.183719);
+  EXPECT_EQ(points->dimensions.find(dim::kPointSourceId), nullptr);  // one scan
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find("2 of its 4 rows are points with no echo"), std::string::npos) << notices[0];
+}
+
+TEST(Ptx, appliesTheRotationAsARowVectorTimesTheMatrix) {
+  TempDir dir;
+  // The transformation of rapidlasso's sample.ptx; CloudCompare reads its first point as
+  // (2.15576, 10.5531, 2.68531) (tests/external/cloudcompare_reads_ptx.py compares every point).
+  const std::string text = header(1, 2, "3.847211 12.235314 -0.425777",
+                                  "-0.955179 0.296021 -0.002106 0.000000\n"
+                                  "-0.296023 -0.955180 0.001152 0.000000\n"
+                                  "-0.001670 0.001724 0.999997 0.000000\n") +
+                           "1.111111 2.111111 3.111 0.111\r\n"
+                           "1.222222 2.222222 3.222 0.212\r\n";
+  Result<PointSet> points = readText(dir, text);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  ASSERT_EQ(points->size(), 2u);
+  const glm::dvec3 p = points->positions[0];
+  EXPECT_EQ(p.x, 1.111111 * -0.955179 + 2.111111 * -0.296023 + 3.111 * -0.001670 + 3.847211);
+  EXPECT_EQ(p.y, 1.111111 * 0.296021 + 2.111111 * -0.955180 + 3.111 * 0.001724 + 12.235314);
+  EXPECT_NEAR(p.x, 2.15576, 1e-5);
+  EXPECT_NEAR(p.y, 10.5531, 1e-4);
+  EXPECT_NEAR(p.z, 2.68531, 1e-5);
+  EXPECT_FALSE(points->hasColors());
+}
+
+TEST(Ptx, joinsScansTellingThemApartByPointSourceId) {
+  TempDir dir;
+  const std::string text = header(1, 2, "100 0 0") + "1 2 3 0.25\n4 5 6 1\n" + "\n" +  // a blank line between scans
+                           header(1, 1, "0 100 0") + "7 8 9 1 255 0 0\n" + header(0, 0) + "\n\n";
+  std::vector<std::string> notices;
+  Result<PointSet> points = readText(dir, text, &notices);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  ASSERT_EQ(points->size(), 3u);
+  EXPECT_EQ(points->positions[0], glm::dvec3(101, 2, 3));
+  EXPECT_EQ(points->positions[2], glm::dvec3(7, 108, 9));
+  const Dimension* source = points->dimensions.find(dim::kPointSourceId);
+  ASSERT_NE(source, nullptr);
+  EXPECT_EQ(source->type, DimType::kU16);
+  EXPECT_EQ(source->value(0), 1.0);
+  EXPECT_EQ(source->value(1), 1.0);
+  EXPECT_EQ(source->value(2), 2.0);
+  // The first scan's intensities are 0.25 and 1, the second's a whole 1: float64 in both.
+  const Dimension* intensity = points->dimensions.find(dim::kIntensity);
+  ASSERT_NE(intensity, nullptr);
+  EXPECT_EQ(intensity->type, DimType::kF64);
+  EXPECT_EQ(intensity->value(0), 0.25);
+  EXPECT_EQ(intensity->value(2), 1.0);
+  // The scan without colours is white beside the one with.
+  ASSERT_TRUE(points->hasColors());
+  EXPECT_EQ(points->colors[0], glm::vec3(1.0f));
+  EXPECT_EQ(points->colors[2], glm::vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(points->color_full_scale, 255);
+  EXPECT_TRUE(notices.empty());
+}
+
+TEST(Ptx, placesScansPastTheLineIndexsBlocksAlikeForAnyThreadCount) {
+  TempDir dir;
+  // 2 x 400,000 rows of about 25 bytes: the second scan's header lies past the index's first 8 MiB.
+  std::string text;
+  for (int scan = 0; scan < 2; ++scan) {
+    text += header(400, 1000, scan == 0 ? "0 0 0" : "1000 0 0");
+    for (int i = 0; i < 400000; ++i)
+      text += i % 7 == 3 ? "0 0 0 0\n" : std::to_string(i) + ".5 " + std::to_string(scan) + " -1.25 0.5\n";
+  }
+  Result<PointSet> one = readText(dir, text, nullptr, 1);
+  ASSERT_TRUE(one.ok()) << one.error().message;
+  Result<PointSet> four = readText(dir, text, nullptr, 4);
+  ASSERT_TRUE(four.ok()) << four.error().message;
+  const size_t kept = 400000 - 400000 / 7 - (400000 % 7 > 3 ? 1 : 0);
+  ASSERT_EQ(one->size(), 2 * kept);
+  EXPECT_EQ(one->positions, four->positions);
+  EXPECT_EQ(one->positions[kept - 1], glm::dvec3(399999.5, 0, -1.25));
+  EXPECT_EQ(one->positions[kept], glm::dvec3(1000.5, 1, -1.25));
+  EXPECT_EQ(one->positions.back(), glm::dvec3(400999.5, 1, -1.25));
+  EXPECT_EQ(one->dimensions.find(dim::kPointSourceId)->value(kept), 2.0);
+}
+
+TEST(Ptx, badFilesAreRefusedNamingTheLine) {
+  TempDir dir;
+  const auto error = [&](const std::string& text) {
+    Result<PointSet> points = readText(dir, text);
+    return points.ok() ? std::string("(read)") : points.error().message;
+  };
+  EXPECT_NE(error(header(3, 3) + "1 2 3 0.5\n1 2 3 0.5\n").find("scan.ptx:1: scan 1 (line 1) declares 3 x 3 = 9 points, "
+                                                                "but the file has 2 lines after its header (cut short?)"),
+            std::string::npos)
+      << error(header(3, 3) + "1 2 3 0.5\n");
+  EXPECT_NE(error("3\nthree\n").find("scan.ptx:2: not a whole number"), std::string::npos) << error("3\nthree\n");
+  EXPECT_NE(error(header(1, 1, "0 0 0", "1 0 0 0\n0 1 0 0\n0 0 1 0.5\n") + "1 2 3 4\n").find("scan.ptx:9: its fourth number must be 0"),
+            std::string::npos);
+  EXPECT_NE(error("2\n1\n0 0 0\n1 0 0\n").find("scan.ptx:5: the file ends inside a scan's header"), std::string::npos)
+      << error("2\n1\n0 0 0\n1 0 0\n");
+  // A row's bad number: its line in the file, past the header and the first scan.
+  const std::string two = header(1, 1) + "1 2 3 0.5\n" + header(1, 2) + "1 2 3 0.5\n1 2 x 0.5\n";
+  EXPECT_NE(error(two).find("scan.ptx:23:"), std::string::npos) << error(two);
+  EXPECT_NE(error(header(1, 1) + "1 2 3 0.5 9\n").find("scan.ptx:11: 5 fields, where a PTX row has"), std::string::npos)
+      << error(header(1, 1) + "1 2 3 0.5 9\n");
+  // A comment line among the rows: the next scan's header would be read from the wrong line.
+  EXPECT_NE(error(header(1, 2) + "1 2 3 0.5\n# a comment\n").find("declares 2 points, but 1 of its 2 lines are rows"),
+            std::string::npos)
+      << error(header(1, 2) + "1 2 3 0.5\n# a comment\n");
+  EXPECT_NE(error("").find("empty file"), std::string::npos);
+  EXPECT_NE(error("\n\n").find("no scan with points"), std::string::npos) << error("\n\n");
+  EXPECT_NE(error(header(0, 5)).find("no scan with points"), std::string::npos);
+
+  CsvReadOptions columns;
+  columns.columns = {"x", "y", "z"};
+  writeFile(dir.file("c.ptx"), header(1, 1) + "1 2 3\n");
+  Result<PointSet> refused = readCsv(dir.file("c.ptx"), columns);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, ExitCode::kUsage);
+}
+
+}  // namespace
+}  // namespace dpoint
