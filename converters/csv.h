@@ -50,6 +50,9 @@ struct CsvReadOptions {
   // Lines before the file's first in the messages' line numbers: a slice of a larger file (a PTX
   // scan's rows, InputFile::slice) names its lines as the file numbers them.
   uint64_t first_line = 0;
+  // Every line is a row (a PTX scan's): with `columns`, no header line is passed over, and a
+  // blank or comment line is an error naming it.
+  bool rows_only = false;
 };
 
 struct CsvWriteOptions {

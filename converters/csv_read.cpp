@@ -63,6 +63,10 @@ constexpr size_t kBlockSize = 8u << 20;
 // would otherwise make a block read unbounded).
 constexpr size_t kMaxLineLength = 512u << 10;
 
+// CsvReadOptions::rows_only's errors.
+constexpr const char* kBlankRow = "a blank line where every line is a row";
+constexpr const char* kCommentRow = "a comment line where every line is a row";
+
 // The known layouts. 2D files written with colours have `x,y,r,g,b` (the writer's planar form),
 // so that layout is read too.
 enum class Known { kXy, kXyz, kXyRgb, kXyzRgb };
@@ -556,7 +560,8 @@ struct Header {
 };
 
 // Finds the layout from the first non-blank line, skipping a UTF-8 BOM.
-Result<Header> readHeader(const InputFile& file, const std::vector<std::string>& columns, uint64_t first_line) {
+Result<Header> readHeader(const InputFile& file, const std::vector<std::string>& columns, uint64_t first_line,
+                          bool rows_only) {
   std::string head(std::min<uint64_t>(file.size(), kMaxLineLength + 4), '\0');
   Result<size_t> got = file.readAt(0, head.data(), head.size());
   if (!got) return got.error();
@@ -593,6 +598,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
     std::string_view text(head.data() + pos, nl - pos);
     if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
     if (text.find_first_not_of(" \t") == std::string_view::npos) {  // blank line before any data
+      if (rows_only) return Error{file.path() + ":" + std::to_string(line + 1) + ": " + kBlankRow};
       pos = nl + 1;
       ++line;
       continue;
@@ -627,6 +633,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
       header.named = named;
     };
     const size_t marker = text.find_first_not_of(" \t");
+    if (text[marker] == '#' && rows_only) return Error{file.path() + ":" + std::to_string(line + 1) + ": " + kCommentRow};
     if (text[marker] == '#') {
       // A comment (numpy's savetxt writes its header as `# x,y,z`): the header where what follows
       // the '#' names the columns, else passed over.
@@ -649,7 +656,7 @@ Result<Header> readHeader(const InputFile& file, const std::vector<std::string>&
       Result<Layout> layout = layoutFromNames(columns, separator);
       if (!layout) return layout.error();
       header.layout = *layout;
-      dataFrom(isNamedLine(fields, header.layout, separator));
+      dataFrom(!rows_only && isNamedLine(fields, header.layout, separator));
       return header;
     }
     // pandas' to_csv writes its index first, in a column without a name (`,x,y,z`): passed over.
@@ -729,7 +736,7 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options) {
 Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& options) {
   const std::string& path = file.path();
   if (file.size() == 0) return Error{path + ": empty file"};
-  Result<Header> header_result = readHeader(file, options.columns, options.first_line);
+  Result<Header> header_result = readHeader(file, options.columns, options.first_line, options.rows_only);
   if (!header_result) return header_result.error();
   const Header header = *header_result;
   const Layout& layout = header.layout;
@@ -866,6 +873,10 @@ Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& option
       if (text_end > p && text_end[-1] == '\r') --text_end;
       const char* first = p;
       while (first < text_end && isBlank(*first)) ++first;
+      if ((first == text_end || *first == '#') && options.rows_only) {
+        fail({line_number, path + ":" + std::to_string(line_number) + ": " + (first == text_end ? kBlankRow : kCommentRow)});
+        return;
+      }
       if (first == text_end || *first == '#') {  // a blank line, or a comment (numpy's savetxt, many exports)
         blank_rows[b].push_back(row);
       } else if (!parser.parse(p, text_end, line_number, row, points.positions[row],

@@ -659,36 +659,43 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
 // every value from 0 to 1 and one between. LAS's intensity is a 16-bit integer normalised to the
 // sensor's range (LAS 1.4 R15: multiplied by 65,536 over the sensor's dynamic range), so the
 // writer takes such values as fractions of 65535. Whole numbers (0 and 1 alone too) are written as
-// they are.
-bool intensityOfFractions(const PointSet& points, unsigned threads) {
+// they are. `outside`: where some value lies between 0 and 1, the first point whose intensity is
+// outside 0..1 (or NaN), which kept them from being fractions; else SIZE_MAX.
+struct FractionIntensity {
+  bool fractions = false;
+  size_t outside = SIZE_MAX;
+};
+FractionIntensity intensityOfFractions(const PointSet& points, unsigned threads) {
   const Dimension* d = points.dimensions.find(dim::kIntensity);
-  if (!d || !dimTypeIsFloat(d->type) || d->size() == 0) return false;
+  if (!d || !dimTypeIsFloat(d->type) || d->size() == 0) return {};
   constexpr size_t kBlock = size_t{1} << 16;
-  std::vector<uint8_t> outside((d->size() + kBlock - 1) / kBlock, 0), between(outside.size(), 0);
+  std::vector<size_t> outside((d->size() + kBlock - 1) / kBlock, SIZE_MAX);
+  std::vector<uint8_t> between(outside.size(), 0);
   parallelFor(outside.size(), threads, [&](size_t b, unsigned) {
     for (size_t i = b * kBlock, end = std::min(d->size(), i + kBlock); i < end; ++i) {
       const double v = d->value(i);
       if (!(v >= 0.0 && v <= 1.0)) {  // NaN too
-        outside[b] = 1;
-        return;
+        if (outside[b] == SIZE_MAX) outside[b] = i;
+        continue;
       }
       between[b] |= v > 0.0 && v < 1.0 ? 1 : 0;
     }
   });
-  return std::find(outside.begin(), outside.end(), 1) == outside.end() &&
-         std::find(between.begin(), between.end(), 1) != between.end();
+  if (std::find(between.begin(), between.end(), 1) == between.end()) return {};
+  const size_t first = *std::min_element(outside.begin(), outside.end());
+  return {first == SIZE_MAX, first};
 }
 
-// Encodes point i of a set into a record of the layout's format. `fraction_intensity`: the
+// Encodes point i of a set into a record of the layout's format. `intensity`: whether the
 // intensity is 0..1 values (intensityOfFractions), written as round(v · 65535).
 class RecordEncoder {
  public:
   RecordEncoder(const PointSet& points, const WriterLayout& l, const glm::dvec3& offset, const glm::dvec3& scale,
-                bool fraction_intensity)
-      : points_(points), offset_(offset), scale_(scale), format_(l.format) {
+                const FractionIntensity& intensity)
+      : points_(points), offset_(offset), scale_(scale), format_(l.format), intensity_outside_(intensity.outside) {
     for (const LasField& f : lasFields(l.format)) {
       Slot slot{f.type, f.offset, f.shift, f.bits, points.dimensions.find(f.name), Convert::kNone};
-      if (fraction_intensity && slot.source && std::strcmp(f.name, dim::kIntensity) == 0) {
+      if (intensity.fractions && slot.source && std::strcmp(f.name, dim::kIntensity) == 0) {
         slot.convert = Convert::kFractionToWord;
       } else if (!slot.source && std::strcmp(f.name, dim::kScanAngleRank) == 0) {
         slot.source = points.dimensions.find(dim::kScanAngle);
@@ -774,9 +781,13 @@ class RecordEncoder {
       const std::string lo = sign ? num(-std::ldexp(1.0, bits - 1)) : "0";
       const std::string hi = std::to_string(bits == 64 && !sign ? UINT64_MAX : (uint64_t{1} << (bits - sign)) - 1);
       const std::string what = s.bits ? std::to_string(bits) + (bits == 1 ? " bit" : " bits") : dimTypeName(s.type);
-      return "point " + str(i) + ": " + s.source->name + " = " + num(value) + " does not fit LAS point format " +
-             std::to_string(format_) + "'s " + s.source->name + ", a whole number " + lo + ".." + hi + " (" + what +
-             "); leave it out with --drop " + s.source->name;
+      std::string why = "point " + str(i) + ": " + s.source->name + " = " + num(value) + " does not fit LAS point format " +
+                        std::to_string(format_) + "'s " + s.source->name + ", a whole number " + lo + ".." + hi + " (" +
+                        what + "); leave it out with --drop " + s.source->name;
+      if (intensity_outside_ != SIZE_MAX && std::strcmp(s.source->name.c_str(), dim::kIntensity) == 0)
+        why += " (an intensity of 0..1 values is written as fractions of 65535, but point " + str(intensity_outside_) +
+               "'s is " + num(s.source->value(intensity_outside_)) + ")";
+      return why;
     }
     return "point " + str(i) + ": a value does not fit its field";
   }
@@ -837,6 +848,7 @@ class RecordEncoder {
   const PointSet& points_;
   glm::dvec3 offset_, scale_;
   int format_;
+  size_t intensity_outside_;  // intensityOfFractions' `outside`, for misfit's word
   std::vector<Slot> slots_;
   uint32_t rgb_at_ = 0;
   double color_scale_ = 65535.0;
@@ -1281,9 +1293,9 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     laz = std::move(*info);
     l.vlrs.push_back(LasVlr{"laszip encoded", 22204, "dpoint LAZ (LASzip 3.4 format)", laszipVlrData(*laz), false});
   }
-  const bool fraction_intensity = intensityOfFractions(points, threads);
-  if (options.report) options.report->intensity_scaled = fraction_intensity;
-  const RecordEncoder encoder(points, l, offset, scale, fraction_intensity);
+  const FractionIntensity intensity = intensityOfFractions(points, threads);
+  if (options.report) options.report->intensity_scaled = intensity.fractions;
+  const RecordEncoder encoder(points, l, offset, scale, intensity);
   std::string vlr_bytes;
   for (const LasVlr& vlr : l.vlrs) vlr_bytes += vlrBytes(vlr, false);
   const uint32_t point_offset = static_cast<uint32_t>((l.version_minor >= 4 ? kHeaderSize14 : kHeaderSize12) + vlr_bytes.size());

@@ -224,12 +224,12 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       part.sampled = std::min<uint64_t>(part.count, kColorSampleRows);
       if (Status s = part.read(0, part.sampled, sample); !s) return s.error();
       const WholeColorScale whole = wholeColorScale(sample.colors, 1);
-      const std::string first = part.sampled == part.count ? "" : " (in its first " + std::to_string(part.sampled) + " rows)";
+      const std::string first = part.sampled == part.count ? "" : " in its first " + std::to_string(part.sampled) + " rows";
       if (whole.full != 0) {
         part.color_scale = whole.full;
         part.watch_colors = false;
-        stream->notices_.push_back(path + ": its float colours are whole numbers above 1 (PLY's are 0..1)" + first +
-                                   ": read as 0.." + std::to_string(whole.full) + " values");
+        stream->notices_.push_back(path + ": its float colours are whole numbers above 1" + first +
+                                   " (PLY's are 0..1): read as 0.." + std::to_string(whole.full) + " values");
       } else if (whole.odd != UINT64_MAX) {
         part.watch_colors = false;
         stream->notices_.push_back(path + ": " + oddColorNote(sample.colors[whole.odd], whole.odd));
@@ -283,7 +283,7 @@ void PointInputStream::noteColorsAboveOne(Part& part, const glm::vec3* colors, s
     if (colors[i].r > 1.0f || colors[i].g > 1.0f || colors[i].b > 1.0f) {
       part.watch_colors = false;
       notices_.push_back(part.path + ": float colours above 1 (0..255 values?) streamed as PLY's 0..1 and clamped; "
-                                     "--stream off reads whole-number colours as 0..255 values");
+                                     "where every colour is a whole number, --stream off reads them as 0..255 values");
       return;
     }
 }
@@ -311,7 +311,7 @@ void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t 
                      formatNumber(c.g) + ", " + formatNumber(c.b) + ") is not a whole number of 0 to " +
                      std::to_string(part.color_scale) + " a channel, though the first " + std::to_string(part.sampled) +
                      " rows' are: streamed as 0.." + std::to_string(part.color_scale) +
-                     " values, clamped; --stream off reads the file whole and judges every row");
+                     " values, clamped (--stream off judges every row first, and then reads such colours as 0..1 values)");
 }
 
 Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {

@@ -16,6 +16,7 @@
 
 #include "converters/csv.h"
 #include "core/dimensions.h"
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/text.h"
 
@@ -68,19 +69,31 @@ class LineIndex {
   // Lines in the file: its line ends, and a last line without one.
   uint64_t lines() const { return lines_; }
 
-  // The byte where 0-based line `line` starts; the file's size for line lines().
-  Result<uint64_t> offsetOf(uint64_t line) const {
+  // The byte where 0-based line `line` starts; the file's size for line lines(). Asked in
+  // increasing order (the scans in turn), each block is read once: a cursor goes on from the
+  // line asked before (a file of 65,535 one-point scans had read its 8 MiB block for each).
+  Result<uint64_t> offsetOf(uint64_t line) {
     if (line == 0) return uint64_t{0};
     if (line >= lines_) return file_->size();
     // The line starts after the line-th line end, which lies in the block b where ends_[b] < line <= ends_[b + 1].
     const size_t b = static_cast<size_t>(std::lower_bound(ends_.begin() + 1, ends_.end(), line) - ends_.begin()) - 1;
     const uint64_t offset = uint64_t{b} * kIndexBlock;
-    std::vector<char> buffer(static_cast<size_t>(std::min<uint64_t>(kIndexBlock, file_->size() - offset)));
-    Result<size_t> got = file_->readAt(offset, buffer.data(), buffer.size());
-    if (!got) return got.error();
-    uint64_t wanted = line - ends_[b];
-    for (size_t i = 0; i < *got; ++i)
-      if (buffer[i] == '\n' && --wanted == 0) return offset + i + 1;
+    if (b != block_) {
+      buffer_.resize(static_cast<size_t>(std::min<uint64_t>(kIndexBlock, file_->size() - offset)));
+      Result<size_t> got = file_->readAt(offset, buffer_.data(), buffer_.size());
+      if (!got) return got.error();
+      buffer_.resize(*got);
+      block_ = b;
+      cursor_ = 0, cursor_line_ = ends_[b];
+    } else if (line <= cursor_line_) {  // behind the cursor: from the block's start
+      cursor_ = 0, cursor_line_ = ends_[b];
+    }
+    while (cursor_ < buffer_.size()) {
+      const void* nl = std::memchr(buffer_.data() + cursor_, '\n', buffer_.size() - cursor_);
+      if (!nl) break;
+      cursor_ = static_cast<size_t>(static_cast<const char*>(nl) - buffer_.data()) + 1;
+      if (++cursor_line_ == line) return offset + cursor_;
+    }
     return Error{file_->path() + ": the file changed while it was read (its lines moved); read it again once it is whole"};
   }
 
@@ -89,6 +102,10 @@ class LineIndex {
   const InputFile* file_;
   std::vector<uint64_t> ends_;  // ends_[b]: line ends before block b
   uint64_t lines_ = 0;
+  // offsetOf's block as read, and the place after its cursor_line_-th line end (counted from the file's start).
+  std::vector<char> buffer_;
+  size_t block_ = SIZE_MAX, cursor_ = 0;
+  uint64_t cursor_line_ = 0;
 };
 
 // The text's fields, split at runs of spaces and tabs (a CR at the end passed over).
@@ -104,19 +121,69 @@ std::vector<std::string_view> fieldsOf(std::string_view text) {
   return fields;
 }
 
+std::string countOf(size_t n, const char* what) { return std::to_string(n) + " " + what + (n == 1 ? "" : "s"); }
+
+// The text at `offset` holding its next `lines` lines where they are short: 1 KiB first (a scan's
+// header and rows are short), then up to `lines` of the longest a PTX line may be.
+Result<std::string> linesAt(const InputFile& file, uint64_t offset, size_t lines) {
+  std::string text;
+  for (const size_t bytes : {size_t{1024}, lines * kMaxPtxLine}) {
+    text.resize(static_cast<size_t>(std::min<uint64_t>(bytes, file.size() - offset)));
+    Result<size_t> got = file.readAt(offset, text.data(), text.size());
+    if (!got) return got.error();
+    text.resize(*got);
+    if (static_cast<size_t>(std::count(text.begin(), text.end(), '\n')) >= lines || offset + text.size() >= file.size())
+      break;
+  }
+  return text;
+}
+
+// The byte and 0-based line after the blank lines from `offset` (between scans, after the last),
+// read a chunk at a time (a file of two million blank lines had read 4 KiB for each).
+Status passBlankLines(const InputFile& file, uint64_t& offset, uint64_t& line) {
+  std::string text;
+  while (offset < file.size()) {
+    text.resize(static_cast<size_t>(std::min<uint64_t>(size_t{64} << 10, file.size() - offset)));
+    Result<size_t> got = file.readAt(offset, text.data(), text.size());
+    if (!got) return got.error();
+    text.resize(*got);
+    const bool last = offset + text.size() >= file.size();
+    size_t pos = 0;
+    bool text_found = false, cut = false;  // a line with text (the next scan's); a blank line going on past the chunk
+    while (pos < text.size()) {
+      const size_t nl = text.find('\n', pos);
+      const size_t stop = nl == std::string::npos ? text.size() : nl;
+      if (!std::all_of(text.begin() + static_cast<ptrdiff_t>(pos), text.begin() + static_cast<ptrdiff_t>(stop), isBlankChar)) {
+        text_found = true;
+        break;
+      }
+      if (nl == std::string::npos) {
+        if (last) pos = text.size();  // blanks to the end of the file
+        else cut = true;
+        break;
+      }
+      pos = nl + 1;
+      ++line;
+    }
+    offset += pos;
+    // A blank line longer than a chunk is left to the header's reader, which refuses it.
+    if (text_found || last || (cut && pos == 0)) break;
+  }
+  return okStatus();
+}
+
 // A scan's header: the grid and the transformation (row-vector form: p' = [x y z 1] M).
 struct ScanHeader {
   uint64_t columns = 0, rows = 0;
   std::array<std::array<double, 4>, 4> m{};
 };
 
-// The ten lines from `offset` (0-based line `line`); `text` gets them, and `data` the byte after them.
+// The ten lines from `offset` (0-based line `line`); `data` gets the byte after them.
 Result<ScanHeader> readScanHeader(const InputFile& file, uint64_t offset, uint64_t line, uint64_t& data) {
   const std::string& path = file.path();
-  std::string text(static_cast<size_t>(std::min<uint64_t>(kHeaderLines * kMaxPtxLine, file.size() - offset)), '\0');
-  Result<size_t> got = file.readAt(offset, text.data(), text.size());
-  if (!got) return got.error();
-  text.resize(*got);
+  Result<std::string> read = linesAt(file, offset, kHeaderLines);
+  if (!read) return read.error();
+  const std::string& text = *read;
   ScanHeader header;
   size_t pos = 0;
   constexpr const char* kWhat[] = {"the scan's column count",
@@ -134,15 +201,15 @@ Result<ScanHeader> readScanHeader(const InputFile& file, uint64_t offset, uint64
     const size_t nl = text.find('\n', pos);
     if (nl == std::string::npos && (text.size() - pos >= kMaxPtxLine || offset + text.size() < file.size()))
       return Error{at + "line longer than " + std::to_string(kMaxPtxLine) + " bytes where a PTX header has " + kWhat[k]};
-    const std::string_view this_line(text.data() + pos, (nl == std::string::npos ? text.size() : nl) - pos);
     if (pos >= text.size() && nl == std::string::npos)
       return Error{at + "the file ends inside a scan's header, which has ten lines (here " + kWhat[k] + ")"};
+    const std::string_view this_line(text.data() + pos, (nl == std::string::npos ? text.size() : nl) - pos);
     const std::vector<std::string_view> fields = fieldsOf(this_line);
     const size_t wanted = k < 2 ? 1 : k < 6 ? 3 : 4;
     const auto bad = [&](const std::string& why) {
       return Error{at + why + ": '" + printableExcerpt(std::string(this_line)) + "' where a PTX header has " + kWhat[k]};
     };
-    if (fields.size() != wanted) return bad(std::to_string(fields.size()) + (fields.size() == 1 ? " field" : " fields"));
+    if (fields.size() != wanted) return bad(countOf(fields.size(), "field"));
     if (k < 2) {
       uint64_t n = 0;
       if (!parseDecimalU64(std::string(fields[0]), n)) return bad("not a whole number of 0 to 2^64");
@@ -227,39 +294,64 @@ size_t registerScan(PointSet& scan, const ScanHeader& header, unsigned threads) 
   return none;
 }
 
-// The columns of the first row at `offset` (line `line`): x y z, an intensity, r g b.
-Result<std::vector<std::string>> rowColumns(const InputFile& file, uint64_t offset, uint64_t line) {
-  std::string text(static_cast<size_t>(std::min<uint64_t>(kMaxPtxLine, file.size() - offset)), '\0');
-  Result<size_t> got = file.readAt(offset, text.data(), text.size());
-  if (!got) return got.error();
-  text.resize(std::min(*got, text.find('\n')));
-  const size_t n = fieldsOf(text).size();
+// The columns of a scan's rows from its first (at `offset`, 0-based line `line`): x y z, an
+// intensity, r g b. Where the scan has a second row of another width, the first is the odd one
+// (the CSV reader would blame the second).
+Result<std::vector<std::string>> rowColumns(const InputFile& file, uint64_t offset, uint64_t line, uint64_t rows) {
+  Result<std::string> read = linesAt(file, offset, 2);
+  if (!read) return read.error();
+  const std::string_view text = *read;
+  const size_t nl = text.find('\n');
+  const std::string_view first = text.substr(0, nl);
+  const std::string_view next = nl == std::string_view::npos || rows < 2 ? std::string_view()
+                                                                         : text.substr(nl + 1, text.find('\n', nl + 1) - nl - 1);
+  // A blank or comment line is the CSV reader's to name (CsvReadOptions::rows_only).
+  const auto row = [](std::string_view text_line) {
+    const std::vector<std::string_view> fields = fieldsOf(text_line);
+    return fields.empty() || fields.front().front() == '#' ? std::optional<size_t>() : fields.size();
+  };
+  const std::optional<size_t> n = row(first), m = row(next);
   const std::string at = file.path() + ":" + std::to_string(line + 1) + ": ";
-  if (n == 3) return std::vector<std::string>{"x", "y", "z"};
-  if (n == 4) return std::vector<std::string>{"x", "y", "z", "intensity"};
-  if (n == 6) return std::vector<std::string>{"x", "y", "z", "r", "g", "b"};
-  if (n == 7) return std::vector<std::string>{"x", "y", "z", "intensity", "r", "g", "b"};
-  return Error{at + std::to_string(n) + " fields, where a PTX row has x y z, then an intensity, r g b or both (3, 4, 6 or 7)"};
+  if (n && m && *n != *m)
+    return Error{at + countOf(*n, "field") + ", where the scan's next row has " + std::to_string(*m) +
+                 " (a PTX scan's rows are alike: x y z, then an intensity, r g b or both)"};
+  const size_t width = n ? *n : m ? *m : 3;
+  if (width == 3) return std::vector<std::string>{"x", "y", "z"};
+  if (width == 4) return std::vector<std::string>{"x", "y", "z", "intensity"};
+  if (width == 6) return std::vector<std::string>{"x", "y", "z", "r", "g", "b"};
+  if (width == 7) return std::vector<std::string>{"x", "y", "z", "intensity", "r", "g", "b"};
+  return Error{file.path() + ":" + std::to_string(line + (n ? 1 : 2)) + ": " + countOf(width, "field") +
+               ", where a PTX row has x y z, then an intensity, r g b or both (3, 4, 6 or 7)"};
 }
 
-// The scans in order as one set: each point's scan (from 1) in point_source_id; a dimension of
+// A scan read: its number in the file (from 1, empty scans counted) and its points.
+struct Scan {
+  uint64_t number = 0;
+  PointSet points;
+};
+
+// The scans in order as one set: each point's scan number in point_source_id; a dimension of
 // different types in different scans (an intensity of whole numbers in one, narrowed to integers)
 // float64 in all; colours white for a scan without beside one with, and integers of one scale
 // where every scan's are.
-PointSet joinScans(std::vector<PointSet> scans, unsigned threads) {
+PointSet joinScans(std::vector<Scan> scans, unsigned threads) {
   std::vector<std::pair<std::string, DimType>> types;
-  for (const PointSet& scan : scans)
-    for (const Dimension& d : scan.dimensions.all()) {
+  size_t total = 0;
+  for (const Scan& scan : scans) {
+    total += scan.points.size();
+    for (const Dimension& d : scan.points.dimensions.all()) {
       auto it = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == d.name; });
       if (it == types.end()) types.emplace_back(d.name, d.type);
       else if (it->second != d.type) it->second = DimType::kF64;
     }
+  }
   uint16_t full = 0;
-  for (const PointSet& scan : scans) full = std::max(full, scan.color_full_scale);
+  for (const Scan& scan : scans) full = std::max(full, scan.points.color_full_scale);
   PointSet out;
   out.z_axis = ZAxis::kPresent;
-  for (size_t s = 0; s < scans.size(); ++s) {
-    PointSet& scan = scans[s];
+  out.positions.reserve(total);  // no copies as it grows (pages are touched as the scans arrive)
+  for (Scan& each : scans) {
+    PointSet& scan = each.points;
     for (Dimension& d : scan.dimensions.all()) {
       const DimType type = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == d.name; })->second;
       if (d.type == type) continue;
@@ -268,7 +360,7 @@ PointSet joinScans(std::vector<PointSet> scans, unsigned threads) {
       d = std::move(wide);
     }
     Dimension& source = scan.dimensions.append(dim::kPointSourceId, DimType::kU16, scan.size());
-    for (size_t i = 0; i < scan.size(); ++i) source.setValue(i, static_cast<double>(s + 1));
+    for (size_t i = 0; i < scan.size(); ++i) source.setValue(i, static_cast<double>(each.number));
     // Colours read as fractions beside integers: integers still where they are k / full.
     if (full != 0 && scan.hasColors() && scan.color_full_scale != full) {
       const ColorsOffGrid off = colorsOffGrid(scan.colors, full, threads);
@@ -290,34 +382,32 @@ Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options) {
     return Error{path + ": --columns is for CSV and text files; a PTX file's rows are x y z, an intensity and r g b",
                  ExitCode::kUsage};
   const unsigned threads = resolveThreads(options.threads);
-  if (options.progress) options.progress->start("indexing the lines of " + path, file.size());
-  Result<LineIndex> index = LineIndex::build(file, threads, options.progress);
+  const uint64_t limit = options.max_memory != 0 ? options.max_memory : defaultMemoryLimit();
+  Progress* progress = options.progress;
+  if (progress) progress->start("indexing the lines of " + path, file.size());
+  Result<LineIndex> index = LineIndex::build(file, threads, progress);
   if (!index) return index.error();
-  if (options.progress) options.progress->finish();
+  if (progress) progress->finish();
+  if (progress) progress->start("reading " + path, file.size());
 
-  std::vector<PointSet> scans;
-  uint64_t line = 0, offset = 0, no_echo = 0, rows_read = 0;
-  while (line < index->lines()) {
-    // Blank lines after the last scan (or between scans) are passed over.
-    {
-      std::string text(static_cast<size_t>(std::min<uint64_t>(kMaxPtxLine, file.size() - offset)), '\0');
-      Result<size_t> got = file.readAt(offset, text.data(), text.size());
-      if (!got) return got.error();
-      text.resize(*got);
-      const size_t nl = text.find('\n');
-      if (std::all_of(text.begin(), nl == std::string::npos ? text.end() : text.begin() + static_cast<ptrdiff_t>(nl),
-                      isBlankChar) &&
-          (nl != std::string::npos || offset + text.size() == file.size())) {
-        ++line;
-        offset = nl == std::string::npos ? file.size() : offset + nl + 1;
-        continue;
-      }
-    }
+  std::vector<Scan> scans;
+  uint64_t line = 0, offset = 0, no_echo = 0, rows_read = 0, held = 0, number = 0;
+  {  // a UTF-8 byte order mark, as an editor may leave
+    char bom[3] = {};
+    Result<size_t> got = file.readAt(0, bom, 3);
+    if (!got) return got.error();
+    if (*got == 3 && std::memcmp(bom, "\xEF\xBB\xBF", 3) == 0) offset = 3;
+  }
+  while (true) {
+    const uint64_t before = offset;
+    if (Status s = passBlankLines(file, offset, line); !s) return s.error();
+    if (offset >= file.size()) break;
     uint64_t data = 0;
     Result<ScanHeader> header = readScanHeader(file, offset, line, data);
     if (!header) return header.error();
+    ++number;
     const uint64_t first_row_line = line + kHeaderLines;
-    const std::string scan_name = "scan " + std::to_string(scans.size() + 1) + " (line " + std::to_string(line + 1) + ")";
+    const std::string scan_name = "scan " + std::to_string(number) + " (line " + std::to_string(line + 1) + ")";
     if (header->columns != 0 && header->rows > (UINT64_MAX - first_row_line) / header->columns)
       return Error{path + ":" + std::to_string(line + 1) + ": " + scan_name + " declares " + std::to_string(header->columns) +
                    " x " + std::to_string(header->rows) + " points, more than any file holds"};
@@ -331,33 +421,53 @@ Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options) {
     Result<uint64_t> end = index->offsetOf(end_line);
     if (!end) return end.error();
     if (points > 0) {
-      Result<std::vector<std::string>> columns = rowColumns(file, data, first_row_line);
+      if (number > 65535)
+        return Error{path + ":" + std::to_string(line + 1) + ": " + scan_name +
+                     ": more scans than a point source id (1 to 65535) tells apart"};
+      Result<std::vector<std::string>> columns = rowColumns(file, data, first_row_line, points);
       if (!columns) return columns.error();
+      // The whole file's rows against the limit, not each scan's alone.
+      const bool colors = columns->size() >= 6;
+      const uint64_t row_bytes = sizeof(glm::dvec3) + (colors ? sizeof(glm::vec3) : 0) +
+                                 sizeof(double) * (columns->size() % 3 == 1 ? 1 : 0);
+      if (points > (UINT64_MAX - held) / row_bytes)
+        return Error{path + ": " + std::to_string(rows_read + points) + " rows, more than memory holds", ExitCode::kResourceLimit};
+      if (Status s = checkMemory(path + ": " + std::to_string(rows_read + points) + " rows of " + countOf(number, "scan"),
+                                 held + points * row_bytes, limit);
+          !s)
+        return s.error();
       CsvReadOptions each = options;
       each.columns = std::move(*columns);
       each.first_line = first_row_line;
+      each.rows_only = true;
+      each.progress = nullptr;
+      each.max_memory = limit - held;
       const InputFile rows = file.slice(data, *end - data);
       Result<PointSet> scan = readCsvRows(rows, each);
       if (!scan) return scan.error();
-      if (scan->size() != points)  // blank or comment lines among the rows
-        return Error{path + ":" + std::to_string(line + 1) + ": " + scan_name + " declares " + std::to_string(points) +
-                     " points, but " + std::to_string(scan->size()) + " of its " + std::to_string(points) +
-                     " lines are rows (a PTX scan has no blank or comment lines)"};
+      if (scan->size() != points)  // rows_only makes every line a row: the file changed
+        return Error{path + ": the file changed while it was read (its lines moved); read it again once it is whole"};
       rows_read += points;
       no_echo += registerScan(*scan, *header, threads);
-      scans.push_back(std::move(*scan));
+      held += heldBytes(*scan);
+      scans.push_back({number, std::move(*scan)});
     }
     line = end_line;
     offset = *end;
+    if (progress) progress->advance(offset - before);
   }
-  if (scans.empty()) return Error{path + ": no scan with points (a PTX file is scans of a ten-line header and rows)"};
+  if (progress) progress->finish();
+  if (number == 0) return Error{path + ": no scan (a PTX file is scans of a ten-line header and their rows)"};
   if (no_echo > 0 && options.notices)
     options.notices->push_back(path + ": " + std::to_string(no_echo) + " of its " + std::to_string(rows_read) +
                                " rows are points with no echo (0 0 0 in the scanner's frame): left out");
-  if (scans.size() == 1) return std::move(scans.front());
-  if (scans.size() > 65535)
-    return Error{path + ": " + std::to_string(scans.size()) + " scans, more than a point source id (1 to 65535) tells apart"};
-  return joinScans(std::move(scans), options.threads);
+  if (scans.empty()) {  // scans of no rows: an empty set, as an empty LAS file is
+    PointSet none;
+    none.z_axis = ZAxis::kPresent;
+    return none;
+  }
+  if (scans.size() == 1) return std::move(scans.front().points);
+  return joinScans(std::move(scans), threads);
 }
 
 }  // namespace dpoint

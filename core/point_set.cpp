@@ -59,34 +59,36 @@ WholeColorScale wholeColorScale(const ColorArray& colors, unsigned threads) {
   const size_t blocks = (colors.size() + kBlock - 1) / kBlock;
   std::vector<float> largest(blocks, 0.0f);  // the largest whole channel
   std::vector<uint64_t> odd(blocks, UINT64_MAX);
-  // Fractions end the scan at their first channel between 0 and 1 (a file's usual colours).
-  std::atomic<bool> fraction{false};
+  // A block stops at its first odd colour once a whole channel above 1 is seen anywhere: the
+  // answer is then 0 and that colour, whatever the rest holds (a file of fractions is read to its end).
+  std::atomic<bool> above_one{false};
   parallelFor(blocks, threads, [&](size_t b, unsigned) {
     const size_t end = std::min(colors.size(), (b + 1) * kBlock);
     float most = 0.0f;
-    for (size_t i = b * kBlock; i < end && !fraction.load(std::memory_order_relaxed); ++i) {
+    for (size_t i = b * kBlock; i < end; ++i) {
       bool integers = true;
       for (int k = 0; k < 3; ++k) {
         const float c = colors[i][k];
-        if (c > 0.0f && c < 1.0f) fraction.store(true, std::memory_order_relaxed);
         const bool whole = c >= 0.0f && c <= 65535.0f && c == std::floor(c);  // NaN fails
         integers = integers && whole;
         if (whole) most = std::max(most, c);
       }
+      if (most > 1.0f) above_one.store(true, std::memory_order_relaxed);
       if (!integers && odd[b] == UINT64_MAX) odd[b] = i;
+      if (odd[b] != UINT64_MAX && above_one.load(std::memory_order_relaxed)) break;
     }
     largest[b] = most;
   });
   WholeColorScale scale;
   const float most = blocks == 0 ? 0.0f : *std::max_element(largest.begin(), largest.end());
-  if (fraction.load() || !(most > 1.0f)) return scale;
+  if (!above_one.load()) return scale;
   scale.odd = blocks == 0 ? UINT64_MAX : *std::min_element(odd.begin(), odd.end());
   if (scale.odd == UINT64_MAX) scale.full = most > 255.0f ? 65535 : 255;
   return scale;
 }
 
 std::string oddColorNote(const glm::vec3& color, uint64_t vertex) {
-  return "its float colours are whole numbers above 1 (0..255 values?), but vertex " + std::to_string(vertex) + "'s (" +
+  return "its float colours hold whole numbers above 1 (0..255 values?), but vertex " + std::to_string(vertex) + "'s (" +
          formatNumber(color.r) + ", " + formatNumber(color.g) + ", " + formatNumber(color.b) +
          ") is not a whole number of 0 to 65535 a channel: read as PLY's 0..1 values, those above 1 clamped";
 }

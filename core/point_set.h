@@ -119,10 +119,9 @@ ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned thre
 // The integer scale of float colours written as 0..255 or 0..65535 values (as some tools write a
 // PLY's float red, green, blue). `full`: 255 where the largest channel is above 1 and at most 255,
 // 65535 where it is above 255 and at most 65535, and every channel is an integer from 0 to it;
-// else 0 (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions). The
-// scan stops at the first channel between 0 and 1. `odd`: where no channel is such a fraction and
-// some are whole numbers above 1, the first colour with a channel no integer scale holds (negative,
-// NaN, past 65535, 127.5), which alone kept `full` 0; else UINT64_MAX.
+// else 0 (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions). `odd`:
+// where some channels are whole numbers above 1, the first colour with a channel no integer scale
+// holds (0.5, 127.5, negative, NaN, past 65535), which kept `full` 0; else UINT64_MAX.
 struct WholeColorScale {
   uint16_t full = 0;
   uint64_t odd = UINT64_MAX;

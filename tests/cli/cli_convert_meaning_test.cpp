@@ -401,7 +401,7 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
               whole)
         << name << ": " << r.err;
     // One value no integer scale holds among whole ones above 1: said, naming it (a review finding).
-    EXPECT_EQ(test::contains(r.err, dir.file(name + ".ply") + ": its float colours are whole numbers above 1 (0..255 values?), "
+    EXPECT_EQ(test::contains(r.err, dir.file(name + ".ply") + ": its float colours hold whole numbers above 1 (0..255 values?), "
                                                               "but vertex 0's (127.5, 128, 0) is not a whole number of 0 to 65535"),
               name == "halves")
         << name << ": " << r.err;
@@ -458,13 +458,13 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
   binaryPly("late.ply", rows);
   const test::CommandResult late = runDpoint({"info", "--stream", "on", dir.file("late.ply")});
   ASSERT_EQ(late.exit_code, 0) << late.err;
-  EXPECT_TRUE(test::contains(late.err, dir.file("late.ply") + ": its float colours are whole numbers above 1 (PLY's are 0..1) "
-                                                              "(in its first 65536 rows): read as 0..255 values"))
+  EXPECT_TRUE(test::contains(late.err, dir.file("late.ply") + ": its float colours are whole numbers above 1 in its first "
+                                                              "65536 rows (PLY's are 0..1): read as 0..255 values"))
       << late.err;
   EXPECT_TRUE(test::contains(late.err, dir.file("late.ply") + ": vertex 69000's colour (200, 0.5, 0) is not a whole number of "
                                                               "0 to 255 a channel, though the first 65536 rows' are"))
       << late.err;
-  binaryPly("fractions.ply", {{0, 0, 0, 0.5f, 0.25f, 0}, {1, 0, 0, 2, 0, 1}});
+  binaryPly("fractions.ply", {{0, 0, 0, 0.5f, 0.25f, 0}, {1, 0, 0, 1.5f, 0, 1}});
   const test::CommandResult hdr = runDpoint({"info", "--stream", "on", dir.file("fractions.ply")});
   ASSERT_EQ(hdr.exit_code, 0) << hdr.err;
   EXPECT_TRUE(test::contains(hdr.err, dir.file("fractions.ply") +

@@ -488,6 +488,18 @@ TEST(LasDimensions, anIntensityOfFractionsIsWrittenAsSixteenBits) {
       EXPECT_EQ(intensity->value(2), fractions ? 65535.0 : 1.0);
     }
   }
+  // One value outside 0..1 among fractions: refused, the message naming it beside the first misfit.
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 2, 3}, {4, 5, 6}};
+  Dimension& d = set.dimensions.add(dim::kIntensity, DimType::kF64, 3);
+  d.setValue(0, 0.5);
+  d.setValue(2, -0.125);
+  const Status s = writeLas(dir.file("neg.las"), set);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("point 0: intensity = 0.5 does not fit"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("(an intensity of 0..1 values is written as fractions of 65535, but point 2's is -0.125)"),
+            std::string::npos)
+      << s.error().message;
 }
 
 // A value its LAS field cannot hold as it is (a fraction, or beyond the field's bits or type) is

@@ -134,6 +134,39 @@ TEST(Ptx, placesScansPastTheLineIndexsBlocksAlikeForAnyThreadCount) {
   EXPECT_EQ(one->dimensions.find(dim::kPointSourceId)->value(kept), 2.0);
 }
 
+// Scans are numbered as the file has them, empty ones too (as CloudCompare counts them); many
+// small scans read in one pass over the file (a review found 65,535 one-point scans took 2 min);
+// a byte order mark is passed over; the limit on memory is the whole file's, not each scan's.
+TEST(Ptx, numbersEveryScanAndKeepsTheWholeFileToTheMemoryLimit) {
+  TempDir dir;
+  std::string text = "\xEF\xBB\xBF" + header(0, 0);
+  for (int scan = 0; scan < 20000; ++scan) text += header(1, 1, std::to_string(scan) + " 0 0") + "1 2 3 0.5\n";
+  Result<PointSet> points = readText(dir, text);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  ASSERT_EQ(points->size(), 20000u);
+  EXPECT_EQ(points->positions[19999], glm::dvec3(20000, 2, 3));
+  const Dimension* source = points->dimensions.find(dim::kPointSourceId);
+  ASSERT_NE(source, nullptr);
+  EXPECT_EQ(source->value(0), 2.0);  // the empty scan before it is scan 1
+  EXPECT_EQ(source->value(19999), 20001.0);
+
+  // Two scans of 1,000 rows, each within a limit of 40 KB (1,000 x 32 bytes), together not.
+  std::string two;
+  for (int scan = 0; scan < 2; ++scan) {
+    two += header(10, 100);
+    for (int i = 0; i < 1000; ++i) two += "1 2 3 0.5\n";
+  }
+  writeFile(dir.file("two.ptx"), two);
+  CsvReadOptions limited;
+  limited.max_memory = 40000;
+  Result<PointSet> refused = readCsv(dir.file("two.ptx"), limited);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, ExitCode::kResourceLimit);
+  EXPECT_NE(refused.error().message.find("2000 rows of 2 scans"), std::string::npos) << refused.error().message;
+  limited.max_memory = 64000;
+  EXPECT_TRUE(readCsv(dir.file("two.ptx"), limited).ok());
+}
+
 TEST(Ptx, badFilesAreRefusedNamingTheLine) {
   TempDir dir;
   const auto error = [&](const std::string& text) {
@@ -154,13 +187,28 @@ TEST(Ptx, badFilesAreRefusedNamingTheLine) {
   EXPECT_NE(error(two).find("scan.ptx:23:"), std::string::npos) << error(two);
   EXPECT_NE(error(header(1, 1) + "1 2 3 0.5 9\n").find("scan.ptx:11: 5 fields, where a PTX row has"), std::string::npos)
       << error(header(1, 1) + "1 2 3 0.5 9\n");
-  // A comment line among the rows: the next scan's header would be read from the wrong line.
-  EXPECT_NE(error(header(1, 2) + "1 2 3 0.5\n# a comment\n").find("declares 2 points, but 1 of its 2 lines are rows"),
+  // Every line of a scan is a row: a blank or comment line among them is named (the CSV reader
+  // passes them over, and the next scan's header would be read from the wrong line).
+  EXPECT_NE(error(header(1, 2) + "1 2 3 0.5\n# a comment\n").find("scan.ptx:12: a comment line where every line is a row"),
             std::string::npos)
       << error(header(1, 2) + "1 2 3 0.5\n# a comment\n");
+  EXPECT_NE(error(header(1, 2) + "\n1 2 3 0.5\n").find("scan.ptx:11: a blank line where every line is a row"),
+            std::string::npos)
+      << error(header(1, 2) + "\n1 2 3 0.5\n");
+  // A bad first row is that row's error, not taken for a header line (a review finding).
+  const std::string first = header(1, 1) + "1 2 3 0.5\n" + header(1, 2) + "abc 2 3 0.5\n1 2 3 0.5\n";
+  EXPECT_NE(error(first).find("scan.ptx:22: column 1: 'abc'"), std::string::npos) << error(first);
+  // A first row of another width than the second is the one blamed.
+  EXPECT_NE(error(header(1, 2) + "1 2 3\n1 2 3 0.5\n").find("scan.ptx:11: 3 fields, where the scan's next row has 4"),
+            std::string::npos)
+      << error(header(1, 2) + "1 2 3\n1 2 3 0.5\n");
   EXPECT_NE(error("").find("empty file"), std::string::npos);
-  EXPECT_NE(error("\n\n").find("no scan with points"), std::string::npos) << error("\n\n");
-  EXPECT_NE(error(header(0, 5)).find("no scan with points"), std::string::npos);
+  EXPECT_NE(error("\n\n").find("no scan"), std::string::npos) << error("\n\n");
+
+  // Scans of no rows are an empty set, as an empty LAS file is.
+  Result<PointSet> empty = readText(dir, header(0, 5) + header(3, 0));
+  ASSERT_TRUE(empty.ok()) << empty.error().message;
+  EXPECT_EQ(empty->size(), 0u);
 
   CsvReadOptions columns;
   columns.columns = {"x", "y", "z"};

@@ -54,10 +54,11 @@ TEST(PointSet, wholeColorScaleTellsIntegerColoursWrittenAsFloats) {
   EXPECT_EQ(wholeColorScale(many, 4).full, 65535);
   many[5].b = 0.5f;
   EXPECT_EQ(wholeColorScale(many, 4).full, 0);
-  EXPECT_EQ(wholeColorScale(many, 4).odd, UINT64_MAX);  // fractions: no odd one
+  EXPECT_EQ(wholeColorScale(many, 4).odd, 5u);  // one fraction beside whole values above 1: said
   // Whole numbers above 1 but for one channel no integer scale holds: that colour, named.
   EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, 3.0f, 0.0f), glm::vec3(255.0f, -1.0f, 0.0f)}, 1).odd, 1u);
   EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(127.5f, 0.0f, 0.0f)}, 1).odd, UINT64_MAX);  // no whole one above 1
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(0.5f, 1.0f, 0.0f), glm::vec3(1.5f, 0.0f, 0.0f)}, 1).odd, UINT64_MAX);
   many[5].b = 0.0f;
   many[700000].g = 70000.0f;
   many[900000].g = -2.0f;
