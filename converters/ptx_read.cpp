@@ -139,11 +139,13 @@ Result<std::string> linesAt(const InputFile& file, uint64_t offset, size_t lines
 }
 
 // The byte and 0-based line after the blank lines from `offset` (between scans, after the last),
-// read a chunk at a time (a file of two million blank lines had read 4 KiB for each).
+// read 256 bytes, then 64 KiB at a time (a file of two million blank lines had read 4 KiB for each).
 Status passBlankLines(const InputFile& file, uint64_t& offset, uint64_t& line) {
   std::string text;
+  size_t chunk = 256;  // most scans follow with no blank line: a short read first
   while (offset < file.size()) {
-    text.resize(static_cast<size_t>(std::min<uint64_t>(size_t{64} << 10, file.size() - offset)));
+    text.resize(static_cast<size_t>(std::min<uint64_t>(chunk, file.size() - offset)));
+    chunk = size_t{64} << 10;
     Result<size_t> got = file.readAt(offset, text.data(), text.size());
     if (!got) return got.error();
     text.resize(*got);
