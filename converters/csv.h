@@ -51,8 +51,11 @@ struct CsvReadOptions {
   // scan's rows, InputFile::slice) names its lines as the file numbers them.
   uint64_t first_line = 0;
   // Every line is a row (a PTX scan's): with `columns`, no header line is passed over, and a
-  // blank or comment line is an error naming it.
+  // blank or comment line is an error naming it; a bad colour is named by its line too.
   bool rows_only = false;
+  // Colours are whole numbers of 0 to 255, whatever the values (a PTX scan's): 1 is 1/255, and
+  // 256 or 0.5 an error naming the row.
+  bool colors_0_255 = false;
 };
 
 struct CsvWriteOptions {

@@ -30,26 +30,33 @@ namespace {
 // Colour columns hold floats 0..1, or integers 0..255 (or 0..65535) as spreadsheets and most point
 // tools write them: where a value above 1 appears, every colour must be such an integer, and the set
 // keeps the full scale (PointSet::color_full_scale), so 255,128,0 is written back as 255,128,0.
-Status integerColors(const std::string& path, PointSet& points, bool always, unsigned threads) {
+// `bytes`: every colour is a whole 0..255 value whatever the values (a PTX scan's). `rows_from`:
+// with CsvReadOptions::rows_only, the line before the first row, so that a row is named by its line.
+Status integerColors(const std::string& path, PointSet& points, bool always, bool bytes,
+                     std::optional<uint64_t> rows_from, unsigned threads) {
+  const auto at = [&](size_t i, int k) {
+    return rows_from ? path + ":" + std::to_string(*rows_from + i + 1) + ": colour column " + std::to_string(k + 1) + ": "
+                     : path + ": data row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": ";
+  };
   float largest = 0.0f;
   for (const glm::vec3& c : points.colors) largest = std::max({largest, c.r, c.g, c.b});
-  if (!(largest > 1.0f) && !always) {
+  if (!(largest > 1.0f) && !always && !bytes) {
     // Fractions 0..1: a negative one was clamped to 0 by every 8-bit writer in silence (a review finding).
     for (size_t i = 0; i < points.colors.size(); ++i)
       for (int k = 0; k < 3; ++k)
         if (points.colors[i][k] < 0.0f)
-          return Error{path + ": data row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": " +
-                       formatNumber(points.colors[i][k]) + " (colours as fractions are 0..1, as integers 0..255)"};
+          return Error{at(i, k) + formatNumber(points.colors[i][k]) + " (colours as fractions are 0..1, as integers 0..255)"};
     return okStatus();
   }
-  const float full = largest > 255.0f ? 65535.0f : 255.0f;
+  const float full = largest > 255.0f && !bytes ? 65535.0f : 255.0f;
   for (size_t i = 0; i < points.colors.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const float v = points.colors[i][k];
       if (!(v >= 0.0f && v <= full && v == std::floor(v)))
-        return Error{path + ": data row " + std::to_string(i + 1) + ", colour column " + std::to_string(k + 1) + ": " +
-                     formatNumber(v) + " among integer colours (values above 1 make every colour an integer 0.." +
-                     formatNumber(full) + "; colours as fractions are 0..1)"};
+        return Error{at(i, k) + formatNumber(v) +
+                     (bytes ? std::string(" (a colour here is a whole number of 0 to 255)")
+                            : " among integer colours (values above 1 make every colour an integer 0.." + formatNumber(full) +
+                                  "; colours as fractions are 0..1)")};
     }
   takeColorsAsIntegers(points, static_cast<uint16_t>(full), threads);
   return okStatus();
@@ -917,7 +924,10 @@ Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& option
     points.dimensions.resize(out);
   }
   narrowDimensions(points.dimensions, threads);
-  if (Status s = integerColors(path, points, layout.integer_colors, threads); !s) return s.error();
+  if (Status s = integerColors(path, points, layout.integer_colors, options.colors_0_255,
+                               options.rows_only ? std::optional<uint64_t>(options.first_line) : std::nullopt, threads);
+      !s)
+    return s.error();
   if (points.positions.empty() && !header.named) return Error{path + ": no data rows"};
   // A count line that is not the rows' count: a file cut short, or rows added (a review finding:
   // a count of 1e11 over one row was taken without a word).

@@ -307,11 +307,15 @@ void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t 
   part.scale_doubted = true;
   const size_t at = first_odd->first;
   const glm::vec3 c = first_odd->second;
+  // A whole value past 255 makes the whole read take 0..65535 values; anything else, 0..1 ones.
+  bool words = true;
+  for (int k = 0; k < 3; ++k) words = words && c[k] >= 0.0f && c[k] <= 65535.0f && c[k] == std::floor(c[k]);
   notices_.push_back(part.path + ": vertex " + std::to_string(first + at) + "'s colour (" + formatNumber(c.r) + ", " +
                      formatNumber(c.g) + ", " + formatNumber(c.b) + ") is not a whole number of 0 to " +
                      std::to_string(part.color_scale) + " a channel, though the first " + std::to_string(part.sampled) +
                      " rows' are: streamed as 0.." + std::to_string(part.color_scale) +
-                     " values, clamped (--stream off judges every row first, and then reads such colours as 0..1 values)");
+                     " values, clamped (--stream off judges every row first, and then reads the colours as " +
+                     (words ? "0..65535" : "0..1") + " values)");
 }
 
 Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {

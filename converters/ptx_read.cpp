@@ -28,8 +28,8 @@ namespace {
 
 constexpr size_t kIndexBlock = 8u << 20;
 constexpr uint64_t kHeaderLines = 10;
-// A header's ten lines of numbers, or a row: read this much at a time (a longer line is not PTX).
-constexpr size_t kMaxPtxLine = 4096;
+// The longest line read: the CSV reader's limit (a row padded with spaces is still a row).
+constexpr size_t kMaxPtxLine = 512u << 10;
 
 bool isBlankChar(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
@@ -145,7 +145,7 @@ Status passBlankLines(const InputFile& file, uint64_t& offset, uint64_t& line) {
   size_t chunk = 256;  // most scans follow with no blank line: a short read first
   while (offset < file.size()) {
     text.resize(static_cast<size_t>(std::min<uint64_t>(chunk, file.size() - offset)));
-    chunk = size_t{64} << 10;
+    chunk = std::max(chunk, size_t{64} << 10);
     Result<size_t> got = file.readAt(offset, text.data(), text.size());
     if (!got) return got.error();
     text.resize(*got);
@@ -168,8 +168,13 @@ Status passBlankLines(const InputFile& file, uint64_t& offset, uint64_t& line) {
       ++line;
     }
     offset += pos;
-    // A blank line longer than a chunk is left to the header's reader, which refuses it.
-    if (text_found || last || (cut && pos == 0)) break;
+    if (text_found || last) break;
+    // A blank line longer than the chunk: a larger one, up to the longest line read (then the
+    // header's reader refuses it).
+    if (cut && pos == 0) {
+      if (chunk >= kMaxPtxLine) break;
+      chunk = std::min(kMaxPtxLine, chunk * 4);
+    }
   }
   return okStatus();
 }
@@ -201,6 +206,10 @@ Result<ScanHeader> readScanHeader(const InputFile& file, uint64_t offset, uint64
   for (uint64_t k = 0; k < kHeaderLines; ++k) {
     const std::string at = path + ":" + std::to_string(line + k + 1) + ": ";
     const size_t nl = text.find('\n', pos);
+    const size_t cr = text.find('\r', pos);
+    if (cr != std::string::npos && cr + 1 < std::min(nl, text.size()))
+      return Error{at + "carriage returns inside a line: the file's lines end with CR alone (old Mac text); "
+                        "convert them to LF or CR LF"};
     if (nl == std::string::npos && (text.size() - pos >= kMaxPtxLine || offset + text.size() < file.size()))
       return Error{at + "line longer than " + std::to_string(kMaxPtxLine) + " bytes where a PTX header has " + kWhat[k]};
     if (pos >= text.size() && nl == std::string::npos)
@@ -241,6 +250,9 @@ bool isIdentity(const std::array<std::array<double, 4>, 4>& m) {
 }
 
 constexpr size_t kRows = size_t{1} << 16;
+// What a scan read costs beyond its points' arrays (a point set, its dimension, allocations):
+// counted against --max-memory, so that 65,535 one-point scans are not taken as 65,535 points.
+constexpr uint64_t kScanBytes = 1024;
 
 // Keeps the rows of `width` bytes whose keep[i] is set, in order, at the array's front: each block
 // of rows closed up on its own (all cores), then the blocks moved down in turn. Returns the rows kept.
@@ -297,32 +309,38 @@ size_t registerScan(PointSet& scan, const ScanHeader& header, unsigned threads) 
 }
 
 // The columns of a scan's rows from its first (at `offset`, 0-based line `line`): x y z, an
-// intensity, r g b. Where the scan has a second row of another width, the first is the odd one
-// (the CSV reader would blame the second).
+// intensity, r g b. Where its second and third rows agree with each other and not with the first,
+// the first is the odd one (the CSV reader would blame the second); else the CSV reader names the
+// first row unlike the first.
 Result<std::vector<std::string>> rowColumns(const InputFile& file, uint64_t offset, uint64_t line, uint64_t rows) {
-  Result<std::string> read = linesAt(file, offset, 2);
+  Result<std::string> read = linesAt(file, offset, 3);
   if (!read) return read.error();
   const std::string_view text = *read;
-  const size_t nl = text.find('\n');
-  const std::string_view first = text.substr(0, nl);
-  const std::string_view next = nl == std::string_view::npos || rows < 2 ? std::string_view()
-                                                                         : text.substr(nl + 1, text.find('\n', nl + 1) - nl - 1);
+  std::vector<std::string_view> lines;  // up to three rows, as far as the scan has them
+  for (size_t pos = 0; lines.size() < std::min<uint64_t>(rows, 3) && pos <= text.size();) {
+    const size_t nl = std::min(text.find('\n', pos), text.size());
+    lines.push_back(text.substr(pos, nl - pos));
+    pos = nl + 1;
+  }
   // A blank or comment line is the CSV reader's to name (CsvReadOptions::rows_only).
-  const auto row = [](std::string_view text_line) {
+  const auto width = [](std::string_view text_line) {
     const std::vector<std::string_view> fields = fieldsOf(text_line);
     return fields.empty() || fields.front().front() == '#' ? std::optional<size_t>() : fields.size();
   };
-  const std::optional<size_t> n = row(first), m = row(next);
-  const std::string at = file.path() + ":" + std::to_string(line + 1) + ": ";
-  if (n && m && *n != *m)
-    return Error{at + countOf(*n, "field") + ", where the scan's next row has " + std::to_string(*m) +
-                 " (a PTX scan's rows are alike: x y z, then an intensity, r g b or both)"};
-  const size_t width = n ? *n : m ? *m : 3;
-  if (width == 3) return std::vector<std::string>{"x", "y", "z"};
-  if (width == 4) return std::vector<std::string>{"x", "y", "z", "intensity"};
-  if (width == 6) return std::vector<std::string>{"x", "y", "z", "r", "g", "b"};
-  if (width == 7) return std::vector<std::string>{"x", "y", "z", "intensity", "r", "g", "b"};
-  return Error{file.path() + ":" + std::to_string(line + (n ? 1 : 2)) + ": " + countOf(width, "field") +
+  std::vector<std::optional<size_t>> widths;
+  for (std::string_view l : lines) widths.push_back(width(l));
+  const std::optional<size_t> n = widths.empty() ? std::nullopt : widths[0];
+  if (widths.size() == 3 && n && widths[1] && widths[1] == widths[2] && *widths[1] != *n)
+    return Error{file.path() + ":" + std::to_string(line + 1) + ": " + countOf(*n, "field") + ", where the scan's next rows have " +
+                 std::to_string(*widths[1]) + " (a PTX scan's rows are alike: x y z, then an intensity, r g b or both)"};
+  size_t row = 0;  // the first row with a width
+  while (row < widths.size() && !widths[row]) ++row;
+  const size_t w = row < widths.size() ? *widths[row] : 3;
+  if (w == 3) return std::vector<std::string>{"x", "y", "z"};
+  if (w == 4) return std::vector<std::string>{"x", "y", "z", "intensity"};
+  if (w == 6) return std::vector<std::string>{"x", "y", "z", "r", "g", "b"};
+  if (w == 7) return std::vector<std::string>{"x", "y", "z", "intensity", "r", "g", "b"};
+  return Error{file.path() + ":" + std::to_string(line + row + 1) + ": " + countOf(w, "field") +
                ", where a PTX row has x y z, then an intensity, r g b or both (3, 4, 6 or 7)"};
 }
 
@@ -351,7 +369,9 @@ PointSet joinScans(std::vector<Scan> scans, unsigned threads) {
   for (const Scan& scan : scans) full = std::max(full, scan.points.color_full_scale);
   PointSet out;
   out.z_axis = ZAxis::kPresent;
-  out.positions.reserve(total);  // no copies as it grows (pages are touched as the scans arrive)
+  // No copies as the set grows (pages are touched as the scans arrive and leave).
+  out.positions.reserve(total);
+  if (std::any_of(scans.begin(), scans.end(), [](const Scan& s) { return s.points.hasColors(); })) out.colors.reserve(total);
   for (Scan& each : scans) {
     PointSet& scan = each.points;
     for (Dimension& d : scan.dimensions.all()) {
@@ -369,6 +389,7 @@ PointSet joinScans(std::vector<Scan> scans, unsigned threads) {
       if (off.rounded != 0 || off.clamped != 0) full = 0;
     }
     appendPoints(out, scan);
+    for (Dimension& d : out.dimensions.all()) d.bytes.reserve(total * dimTypeSize(d.type));
     scan = PointSet();  // its memory back before the next is appended
   }
   out.color_full_scale = full;
@@ -442,16 +463,22 @@ Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options) {
       each.columns = std::move(*columns);
       each.first_line = first_row_line;
       each.rows_only = true;
+      each.colors_0_255 = true;
       each.progress = nullptr;
       each.max_memory = limit - held;
       const InputFile rows = file.slice(data, *end - data);
       Result<PointSet> scan = readCsvRows(rows, each);
-      if (!scan) return scan.error();
+      if (!scan) {  // which scan, and how many rows it declares (a scan cut short fails at the next header)
+        Error error = scan.error();
+        error.message += " (in " + scan_name + ", which declares " + std::to_string(header->columns) + " x " +
+                         std::to_string(header->rows) + " rows)";
+        return error;
+      }
       if (scan->size() != points)  // rows_only makes every line a row: the file changed
         return Error{path + ": the file changed while it was read (its lines moved); read it again once it is whole"};
       rows_read += points;
       no_echo += registerScan(*scan, *header, threads);
-      held += heldBytes(*scan);
+      held += heldBytes(*scan) + kScanBytes;
       scans.push_back({number, std::move(*scan)});
     }
     line = end_line;

@@ -58,10 +58,7 @@ WholeColorScale wholeColorScale(const ColorArray& colors, unsigned threads) {
   constexpr size_t kBlock = size_t{1} << 18;
   const size_t blocks = (colors.size() + kBlock - 1) / kBlock;
   std::vector<float> largest(blocks, 0.0f);  // the largest whole channel
-  std::vector<uint64_t> odd(blocks, UINT64_MAX);
-  // A block stops at its first odd colour once a whole channel above 1 is seen anywhere: the
-  // answer is then 0 and that colour, whatever the rest holds (a file of fractions is read to its end).
-  std::atomic<bool> above_one{false};
+  std::vector<uint64_t> odd(blocks, UINT64_MAX), odd_count(blocks, 0);
   parallelFor(blocks, threads, [&](size_t b, unsigned) {
     const size_t end = std::min(colors.size(), (b + 1) * kBlock);
     float most = 0.0f;
@@ -73,24 +70,30 @@ WholeColorScale wholeColorScale(const ColorArray& colors, unsigned threads) {
         integers = integers && whole;
         if (whole) most = std::max(most, c);
       }
-      if (most > 1.0f) above_one.store(true, std::memory_order_relaxed);
-      if (!integers && odd[b] == UINT64_MAX) odd[b] = i;
-      if (odd[b] != UINT64_MAX && above_one.load(std::memory_order_relaxed)) break;
+      if (integers) continue;
+      if (odd[b] == UINT64_MAX) odd[b] = i;
+      ++odd_count[b];
     }
     largest[b] = most;
   });
   WholeColorScale scale;
   const float most = blocks == 0 ? 0.0f : *std::max_element(largest.begin(), largest.end());
-  if (!above_one.load()) return scale;
-  scale.odd = blocks == 0 ? UINT64_MAX : *std::min_element(odd.begin(), odd.end());
-  if (scale.odd == UINT64_MAX) scale.full = most > 255.0f ? 65535 : 255;
+  if (!(most > 1.0f)) return scale;
+  uint64_t odds = 0;
+  for (uint64_t n : odd_count) odds += n;
+  if (odds == 0) {
+    scale.full = most > 255.0f ? 65535 : 255;
+  } else if (odds * 100 <= colors.size()) {  // nearly all whole: 0..255 values with a few odd ones
+    scale.odd = *std::min_element(odd.begin(), odd.end());
+  }
   return scale;
 }
 
 std::string oddColorNote(const glm::vec3& color, uint64_t vertex) {
-  return "its float colours hold whole numbers above 1 (0..255 values?), but vertex " + std::to_string(vertex) + "'s (" +
-         formatNumber(color.r) + ", " + formatNumber(color.g) + ", " + formatNumber(color.b) +
-         ") is not a whole number of 0 to 65535 a channel: read as PLY's 0..1 values, those above 1 clamped";
+  return "its float colours are nearly all whole numbers, some above 1 (0..255 values?), but vertex " + std::to_string(vertex) +
+         "'s (" + formatNumber(color.r) + ", " + formatNumber(color.g) + ", " + formatNumber(color.b) +
+         ") is not a whole number of 0 to 65535 a channel: read as PLY's 0..1 values (above 1 clamped where drawn or "
+         "written as integers)";
 }
 
 void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
@@ -103,6 +106,22 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
   points.color_full_scale = full;
   points.colors_read_as_fractions = false;
 }
+
+namespace {
+
+// Whether every value of type `from` is one of type `to`.
+bool typeHolds(DimType to, DimType from) {
+  if (to == from) return true;
+  if (to == DimType::kF64) return from != DimType::kI64 && from != DimType::kU64;
+  if (dimTypeIsFloat(from)) return false;
+  if (dimTypeIsFloat(to)) return dimTypeSize(from) <= 2;  // float32 holds 16-bit integers exactly
+  const int bits = static_cast<int>(8 * dimTypeSize(from));
+  const double lo = dimTypeIsSigned(from) ? -std::ldexp(1.0, bits - 1) : 0.0;
+  const double hi = std::ldexp(1.0, dimTypeIsSigned(from) ? bits - 1 : bits) - 1.0;
+  return dimensionHolds(to, lo) && dimensionHolds(to, hi);
+}
+
+}  // namespace
 
 void appendPoints(PointSet& out, const PointSet& part) {
   const size_t at = out.size();
@@ -118,6 +137,11 @@ void appendPoints(PointSet& out, const PointSet& part) {
   for (const Dimension& d : part.dimensions.all()) {
     Dimension* column = out.dimensions.find(d.name);
     if (!column) column = &out.dimensions.add(d.name, d.type, at);
+    if (!typeHolds(column->type, d.type)) {  // float64 for both (0..1 intensities had become 0 or 1 in a uint16 column)
+      Dimension wide(column->name, DimType::kF64, at);
+      for (size_t i = 0; i < at; ++i) wide.setValue(i, column->value(i));
+      *column = std::move(wide);
+    }
     column->resize(at + part.size());
     if (column->type == d.type) std::memcpy(column->bytes.data() + at * dimTypeSize(d.type), d.bytes.data(), d.bytes.size());
     else

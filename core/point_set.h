@@ -120,8 +120,9 @@ ColorsOffGrid colorsOffGrid(const ColorArray& colors, double full, unsigned thre
 // PLY's float red, green, blue). `full`: 255 where the largest channel is above 1 and at most 255,
 // 65535 where it is above 255 and at most 65535, and every channel is an integer from 0 to it;
 // else 0 (0..1 fractions, or values no integer scale explains, such as 1.2 among fractions). `odd`:
-// where some channels are whole numbers above 1, the first colour with a channel no integer scale
-// holds (0.5, 127.5, negative, NaN, past 65535), which kept `full` 0; else UINT64_MAX.
+// where some channels are whole numbers above 1 and at most 1% of the colours are not whole, the
+// first of those (a channel of 0.5, 127.5, negative, NaN or past 65535), which kept `full` 0; else
+// UINT64_MAX (HDR values, 1.5 beside 2 and 0.5, are not 0..255 values with a few odd ones).
 struct WholeColorScale {
   uint16_t full = 0;
   uint64_t odd = UINT64_MAX;
@@ -136,8 +137,8 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads);
 
 // `part`'s points after `out`'s: positions; colours, white for the points of either set without
 // where the other has them; dimensions, the union of both, 0 where a set lacks one (a name of two
-// types keeps out's type, values converted); triangles offset by out's size (the caller keeps the
-// total within 2^32). colors_read_as_fractions is kept where either has it; the other fields
+// types keeps out's type where it holds every value of part's, else both become float64);
+// triangles offset by out's size (the caller keeps the total within 2^32). colors_read_as_fractions is kept where either has it; the other fields
 // (color_full_scale, las, z_axis) are the caller's.
 void appendPoints(PointSet& out, const PointSet& part);
 

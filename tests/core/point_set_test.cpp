@@ -56,14 +56,50 @@ TEST(PointSet, wholeColorScaleTellsIntegerColoursWrittenAsFloats) {
   EXPECT_EQ(wholeColorScale(many, 4).full, 0);
   EXPECT_EQ(wholeColorScale(many, 4).odd, 5u);  // one fraction beside whole values above 1: said
   // Whole numbers above 1 but for one channel no integer scale holds: that colour, named.
-  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(255.0f, 3.0f, 0.0f), glm::vec3(255.0f, -1.0f, 0.0f)}, 1).odd, 1u);
+  ColorArray bytes(200, glm::vec3(255.0f, 3.0f, 0.0f));
+  bytes[101] = glm::vec3(255.0f, -1.0f, 0.0f);
+  bytes[150] = glm::vec3(0.5f, 0.0f, 0.0f);
+  EXPECT_EQ(wholeColorScale(bytes, 1).odd, 101u);
+  bytes[120].g = 2.5f;  // 3 odd ones in 200: more than 1%, no longer a few
+  EXPECT_EQ(wholeColorScale(bytes, 1).odd, UINT64_MAX);
   EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(127.5f, 0.0f, 0.0f)}, 1).odd, UINT64_MAX);  // no whole one above 1
   EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(0.5f, 1.0f, 0.0f), glm::vec3(1.5f, 0.0f, 0.0f)}, 1).odd, UINT64_MAX);
+  // HDR values with a whole one above 1 among them are not 0..255 values with an odd one (a review finding).
+  EXPECT_EQ(wholeColorScale(ColorArray{glm::vec3(0.5f, 0.25f, 0.125f), glm::vec3(2.0f, 1.0f, 1.0f), glm::vec3(1.5f, 0.5f, 0.5f)}, 1).odd,
+            UINT64_MAX);
   many[5].b = 0.0f;
   many[700000].g = 70000.0f;
   many[900000].g = -2.0f;
   EXPECT_EQ(wholeColorScale(many, 4).full, 0);
   EXPECT_EQ(wholeColorScale(many, 4).odd, 700000u);
+}
+
+// Sets joined (several inputs, a PTX file's scans): colours white for a set without beside one with,
+// dimensions the union, a type that holds the other's values kept, else float64 for both (a
+// review found a PTX's 0..1 intensities read after a LAS file's uint16 ones became 0 and 1).
+TEST(PointSet, appendPointsJoinsColoursAndWidensADimensionOnlyWhereItMust) {
+  PointSet out, bytes, fractions;
+  out.positions = {{1, 2, 3}};
+  out.dimensions.add("intensity", DimType::kU16, 1).setValue(0, 700.0);
+  bytes.positions = {{4, 5, 6}};
+  bytes.colors = {glm::vec3(0.5f)};
+  bytes.dimensions.add("intensity", DimType::kU8, 1).setValue(0, 7.0);
+  appendPoints(out, bytes);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out.colors, (ColorArray{glm::vec3(1.0f), glm::vec3(0.5f)}));
+  EXPECT_EQ(out.dimensions.find("intensity")->type, DimType::kU16);  // holds every uint8
+  fractions.positions = {{7, 8, 9}};
+  fractions.dimensions.add("intensity", DimType::kF64, 1).setValue(0, 0.25);
+  fractions.dimensions.add("gps_time", DimType::kF64, 1).setValue(0, 12.5);
+  appendPoints(out, fractions);
+  const Dimension* intensity = out.dimensions.find("intensity");
+  EXPECT_EQ(intensity->type, DimType::kF64);
+  EXPECT_EQ(intensity->value(0), 700.0);
+  EXPECT_EQ(intensity->value(1), 7.0);
+  EXPECT_EQ(intensity->value(2), 0.25);
+  EXPECT_EQ(out.dimensions.find("gps_time")->value(0), 0.0);
+  EXPECT_EQ(out.dimensions.find("gps_time")->value(2), 12.5);
+  EXPECT_EQ(out.colors.back(), glm::vec3(1.0f));
 }
 
 }  // namespace

@@ -100,6 +100,9 @@ def test_columns_as_bytes_are_refused_not_read_as_numbers():
     # The LAS writer's advice in the module's words (it said "--drop intensity").
     (lambda t: dpoint.write(_with_intensity(70000), t / "a.las"), dpoint.Error,
      "leave it out with points.remove_attribute('intensity') (on a copy)"),
+    # Formats read but not written (a review found write() made a CSV named .ptx, unreadable).
+    (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.ptx"), dpoint.Error, "a.ptx: .ptx is read, not written"),
+    (lambda t: dpoint.write(dpoint.PointSet(CLOUD), t / "a.gltf"), dpoint.Error, "a.gltf: .gltf is read, not written"),
 ])
 def test_python_mistakes_get_python_words(tmp_path, call, kind, words):
     dpoint.write(dpoint.PointSet(CLOUD), tmp_path / "a.csv")
