@@ -10,7 +10,6 @@
 #include <fast_float/fast_float.h>
 
 #include <algorithm>
-#include <array>
 #include <cstring>
 #include <optional>
 
@@ -182,7 +181,7 @@ Status passBlankLines(const InputFile& file, uint64_t& offset, uint64_t& line) {
 // A scan's header: the grid and the transformation (row-vector form: p' = [x y z 1] M).
 struct ScanHeader {
   uint64_t columns = 0, rows = 0;
-  std::array<std::array<double, 4>, 4> m{};
+  double m[4][4] = {};  // row-major, as the file writes it
 };
 
 // The ten lines from `offset` (0-based line `line`); `data` gets the byte after them.
@@ -242,7 +241,7 @@ Result<ScanHeader> readScanHeader(const InputFile& file, uint64_t offset, uint64
   return header;
 }
 
-bool isIdentity(const std::array<std::array<double, 4>, 4>& m) {
+bool isIdentity(const double (&m)[4][4]) {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c)
       if (m[r][c] != (r == c ? 1.0 : 0.0)) return false;
