@@ -349,49 +349,28 @@ struct Scan {
   PointSet points;
 };
 
-// The scans in order as one set: each point's scan number in point_source_id; a dimension of
-// different types in different scans (an intensity of whole numbers in one, narrowed to integers)
-// float64 in all; colours white for a scan without beside one with, and integers of one scale
-// where every scan's are.
-PointSet joinScans(std::vector<Scan> scans, unsigned threads) {
-  std::vector<std::pair<std::string, DimType>> types;
+// The scans in order as one set: each point's scan number in point_source_id; colours white for a
+// scan without beside one with (every scan's are 0..255 values: CsvReadOptions::colors_0_255); a
+// dimension of different types in different scans (an intensity of whole numbers in one, narrowed
+// to integers) float64 in all, as appendPoints widens it.
+PointSet joinScans(std::vector<Scan> scans) {
   size_t total = 0;
-  for (const Scan& scan : scans) {
-    total += scan.points.size();
-    for (const Dimension& d : scan.points.dimensions.all()) {
-      auto it = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == d.name; });
-      if (it == types.end()) types.emplace_back(d.name, d.type);
-      else if (it->second != d.type) it->second = DimType::kF64;
-    }
-  }
-  uint16_t full = 0;
-  for (const Scan& scan : scans) full = std::max(full, scan.points.color_full_scale);
+  for (const Scan& scan : scans) total += scan.points.size();
+  const bool colors = std::any_of(scans.begin(), scans.end(), [](const Scan& s) { return s.points.hasColors(); });
   PointSet out;
   out.z_axis = ZAxis::kPresent;
   // No copies as the set grows (pages are touched as the scans arrive and leave).
   out.positions.reserve(total);
-  if (std::any_of(scans.begin(), scans.end(), [](const Scan& s) { return s.points.hasColors(); })) out.colors.reserve(total);
+  if (colors) out.colors.reserve(total);
   for (Scan& each : scans) {
     PointSet& scan = each.points;
-    for (Dimension& d : scan.dimensions.all()) {
-      const DimType type = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == d.name; })->second;
-      if (d.type == type) continue;
-      Dimension wide(d.name, type, scan.size());
-      for (size_t i = 0; i < scan.size(); ++i) wide.setValue(i, d.value(i));
-      d = std::move(wide);
-    }
     Dimension& source = scan.dimensions.append(dim::kPointSourceId, DimType::kU16, scan.size());
     for (size_t i = 0; i < scan.size(); ++i) source.setValue(i, static_cast<double>(each.number));
-    // Colours read as fractions beside integers: integers still where they are k / full.
-    if (full != 0 && scan.hasColors() && scan.color_full_scale != full) {
-      const ColorsOffGrid off = colorsOffGrid(scan.colors, full, threads);
-      if (off.rounded != 0 || off.clamped != 0) full = 0;
-    }
     appendPoints(out, scan);
     for (Dimension& d : out.dimensions.all()) d.bytes.reserve(total * dimTypeSize(d.type));
     scan = PointSet();  // its memory back before the next is appended
   }
-  out.color_full_scale = full;
+  out.color_full_scale = colors ? 255 : 0;
   return out;
 }
 
@@ -495,7 +474,7 @@ Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options) {
     return none;
   }
   if (scans.size() == 1) return std::move(scans.front().points);
-  return joinScans(std::move(scans), threads);
+  return joinScans(std::move(scans));
 }
 
 }  // namespace dpoint
