@@ -54,7 +54,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "Counts, bounds, whether float32 can hold the data, and each render mode's predicted error in pixels for a\n"
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
   cmd->add_option("input", o->inputs,
-                  "Input files (.csv and text, .ptx, .ply, .pcd, .las, .laz, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
+                  "Input files (.csv and text, .ptx, .e57, .ply, .pcd, .las, .laz, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
                   "as the whole. Large binary PLY, LAS and LAZ input is streamed (--stream)")
       ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");

@@ -307,7 +307,7 @@ std::string renderDescription() {
 void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o, bool files) {
   if (files) {
     cmd->add_option("input", o->inputs,
-                    "Point sets (.csv and text, .ptx, .ply, .pcd, .las, .laz, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
+                    "Point sets (.csv and text, .ptx, .e57, .ply, .pcd, .las, .laz, .glb, .gltf), drawn as one; the N tiles of `generate --tile` as the\n"
                     "whole. Large binary PLY input is streamed (--stream)")
         ->required();
     cmd->add_option("-o,--output", o->output, "PNG to write")->required()->check(checkStatus(checkPictureOutput));

@@ -17,6 +17,37 @@
 
 namespace dpoint {
 
+PointSet joinScans(std::vector<NumberedScan> scans) {
+  size_t total = 0;
+  for (const NumberedScan& scan : scans) total += scan.points.size();
+  PointSet out;
+  out.z_axis = ZAxis::kPresent;
+  // No copies as the set grows (pages are touched as the scans arrive and leave).
+  out.positions.reserve(total);
+  uint16_t full = 0;
+  for (const NumberedScan& scan : scans) {
+    if (!scan.points.hasColors()) continue;
+    if (out.colors.capacity() == 0) {
+      out.colors.reserve(total);
+      full = scan.points.color_full_scale;
+    } else if (scan.points.color_full_scale != full) {
+      full = 65535;
+    }
+  }
+  for (NumberedScan& each : scans) {
+    PointSet& scan = each.points;
+    if (each.number != 0) {
+      Dimension& source = scan.dimensions.append(dim::kPointSourceId, DimType::kU16, scan.size());
+      for (size_t i = 0; i < scan.size(); ++i) source.set<uint16_t>(i, static_cast<uint16_t>(each.number));
+    }
+    appendPoints(out, scan);
+    for (Dimension& d : out.dimensions.all()) d.bytes.reserve(total * dimTypeSize(d.type));
+    scan = PointSet();  // its memory back before the next is appended
+  }
+  out.color_full_scale = full;
+  return out;
+}
+
 Result<InputSet> checkInputSet(const std::vector<std::string>& paths) {
   InputSet set;
   set.tiles = static_cast<size_t>(std::count_if(paths.begin(), paths.end(), isTileFile));

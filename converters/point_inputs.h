@@ -23,6 +23,16 @@ namespace dpoint {
 // mergeTiles checks it), and with points_only or faces_unkept its face rows are not read.
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options = {});
 
+// Scans of one file (PTX's, E57's data3D) as one set, in order: each point's scan number in
+// point_source_id (uint16), but for scans of number 0 (a scan with its own ids); colours white for a scan without beside one with; a dimension of
+// different types in different scans float64 in all (as appendPoints widens it); the colours'
+// integer scale the scans' own where they agree, else 65535 (which holds 8-bit values exactly).
+struct NumberedScan {
+  uint64_t number = 0;  // 1 to 65535, or 0: no point_source_id added
+  PointSet points;
+};
+PointSet joinScans(std::vector<NumberedScan> scans);
+
 // Several inputs read as one set: no file given twice (a usage error), and no tile twice among
 // tiles of one count (bad input): either had given a set too large with no word. `whole` when the
 // paths are the tiles of one run, all N of them, each once (converters/tile_file.h), which are

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "converters/copc.h"
+#include "converters/e57.h"
 #include "converters/gltf_write.h"
 #include "core/atomic_file.h"
 #include "core/text.h"
@@ -70,11 +71,12 @@ Result<FileFormat> formatOf(const std::string& path) {
   if (ext == ".pcd") return FileFormat::kPcd;
   if (ext == ".las") return FileFormat::kLas;
   if (ext == ".laz") return FileFormat::kLaz;
+  if (ext == ".e57") return FileFormat::kE57;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
-    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las or .laz)",
+    return Error{path + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las, .laz or .e57)",
                  ExitCode::kUsage};
-  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las or .laz)",
+  return Error{path + ": unknown file type '" + ext + "' (expected .csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las, .laz or .e57)",
                ExitCode::kUsage};
 }
 
@@ -121,6 +123,8 @@ Status checkWrittenFormat(const std::string& path, FileFormat format) {
     return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .pcd, .las)", ExitCode::kUsage};
   if (isPtxPath(path))
     return Error{path + ": .ptx is read, not written; write .pts or .las (or .csv, .ply, .pcd, .glb)", ExitCode::kUsage};
+  if (format == FileFormat::kE57)
+    return Error{path + ": .e57 is read, not written; write .las or .laz (or .csv, .ply, .pcd, .glb)", ExitCode::kUsage};
   return okStatus();
 }
 
@@ -152,6 +156,9 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
     case FileFormat::kLas:
     case FileFormat::kLaz:  // the LAS reader decodes LAZ (converters/laz_decode.h)
       return readLas(path, LasReadOptions{options.threads, options.progress, options.las_color, options.max_memory,
+                                          options.notices});
+    case FileFormat::kE57:
+      return readE57(path, E57ReadOptions{options.threads, options.progress, options.max_memory, options.allow_nonfinite,
                                           options.notices});
   }
   return Error{path + ": unreachable format"};
@@ -294,6 +301,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       return okStatus();
     }
     case FileFormat::kGltf:
+    case FileFormat::kE57:
       return checkWrittenFormat(path, format);
     case FileFormat::kLas:
     case FileFormat::kLaz: {

@@ -17,7 +17,7 @@
 
 namespace dpoint {
 
-enum class FileFormat { kCsv, kPly, kPcd, kGlb, kGltf, kLas, kLaz };
+enum class FileFormat { kCsv, kPly, kPcd, kGlb, kGltf, kLas, kLaz, kE57 };
 
 // From the extension, case-insensitive. Error names the path and the extensions accepted.
 Result<FileFormat> formatOf(const std::string& path);

@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "converters/csv.h"
+#include "converters/point_inputs.h"
 #include "core/dimensions.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -119,8 +120,6 @@ std::vector<std::string_view> fieldsOf(std::string_view text) {
   }
   return fields;
 }
-
-std::string countOf(size_t n, const char* what) { return std::to_string(n) + " " + what + (n == 1 ? "" : "s"); }
 
 // The text at `offset` holding its next `lines` lines where they are short: 1 KiB first (a scan's
 // header and rows are short), then up to `lines` of the longest a PTX line may be.
@@ -343,37 +342,6 @@ Result<std::vector<std::string>> rowColumns(const InputFile& file, uint64_t offs
                ", where a PTX row has x y z, then an intensity, r g b or both (3, 4, 6 or 7)"};
 }
 
-// A scan read: its number in the file (from 1, empty scans counted) and its points.
-struct Scan {
-  uint64_t number = 0;
-  PointSet points;
-};
-
-// The scans in order as one set: each point's scan number in point_source_id; colours white for a
-// scan without beside one with (every scan's are 0..255 values: CsvReadOptions::colors_0_255); a
-// dimension of different types in different scans (an intensity of whole numbers in one, narrowed
-// to integers) float64 in all, as appendPoints widens it.
-PointSet joinScans(std::vector<Scan> scans) {
-  size_t total = 0;
-  for (const Scan& scan : scans) total += scan.points.size();
-  const bool colors = std::any_of(scans.begin(), scans.end(), [](const Scan& s) { return s.points.hasColors(); });
-  PointSet out;
-  out.z_axis = ZAxis::kPresent;
-  // No copies as the set grows (pages are touched as the scans arrive and leave).
-  out.positions.reserve(total);
-  if (colors) out.colors.reserve(total);
-  for (Scan& each : scans) {
-    PointSet& scan = each.points;
-    Dimension& source = scan.dimensions.append(dim::kPointSourceId, DimType::kU16, scan.size());
-    for (size_t i = 0; i < scan.size(); ++i) source.setValue(i, static_cast<double>(each.number));
-    appendPoints(out, scan);
-    for (Dimension& d : out.dimensions.all()) d.bytes.reserve(total * dimTypeSize(d.type));
-    scan = PointSet();  // its memory back before the next is appended
-  }
-  out.color_full_scale = colors ? 255 : 0;
-  return out;
-}
-
 }  // namespace
 
 Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options) {
@@ -391,7 +359,7 @@ Result<PointSet> readPtx(const InputFile& file, const CsvReadOptions& options) {
   if (progress) progress->finish();
   if (progress) progress->start("reading " + path, file.size());
 
-  std::vector<Scan> scans;
+  std::vector<NumberedScan> scans;
   uint64_t line = 0, offset = 0, no_echo = 0, rows_read = 0, held = 0, number = 0;
   {  // a UTF-8 byte order mark, as an editor may leave
     char bom[3] = {};

@@ -67,6 +67,9 @@ inline std::string printableExcerpt(std::string_view text) {
   return out;
 }
 
+// "1 scan", "3 scans": a count and its noun, plural with an s.
+inline std::string countOf(uint64_t n, const char* what) { return std::to_string(n) + " " + what + (n == 1 ? "" : "s"); }
+
 // printableExcerpt in single quotes. (Built by appending: GCC 12 warns falsely on "'" + string,
 // bug 105651.)
 inline std::string quotedExcerpt(std::string_view text) {

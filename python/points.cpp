@@ -635,7 +635,7 @@ points on any thread count. A set without triangles raises ValueError.)");
       py::arg("colors") = "auto", py::arg("max_memory") = py::none(), py::arg("scene") = -1,
       py::arg("all_scenes") = false, py::arg("max_points") = uint64_t{0}, py::arg("columns") = py::none(),
       py::arg("progress") = false,
-      R"(Reads a .csv (or .xyz, .txt, .asc, .pts, .ptx), .ply, .pcd, .las, .laz, .glb or .gltf file (by extension) as `dpoint convert` does.
+      R"(Reads a .csv (or .xyz, .txt, .asc, .pts, .ptx), .e57, .ply, .pcd, .las, .laz, .glb or .gltf file (by extension) as `dpoint convert` does.
 
 colors: LAS colour source (auto, rgb, intensity, classification, none); other formats take auto,
 rgb or none. scene / all_scenes: glTF scenes (as --scene, --all-scenes). max_memory: bytes or

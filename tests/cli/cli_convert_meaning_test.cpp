@@ -484,6 +484,39 @@ TEST(CliConvertMeaning, aFloatPlyOfWholeColourValuesIsReadAsIntegers) {
 // frame: its 0..1 intensities as LAS's 16-bit ones (a note says so; the writer had refused 0.159304
 // as no whole number), its colours, the points with no echo left out. info and render read it
 // too; it is not written, and --columns does not apply.
+// An E57 file LAStools' las2e57 made from LAS: its 16-bit colours, point source ids and returns go
+// back to LAS fields; `info` and `render` read it; .e57 is not written.
+TEST(CliConvertMeaning, anE57ScanConvertsToLasKeepingItsColoursAndFields) {
+  TempDir dir;
+  const std::string e57 = std::string(DPOINT_SOURCE_DIR) + "/tests/data/e57/ColourRepresentation.e57";
+  const test::CommandResult r = runDpoint({"convert", e57, "-o", dir.file("scan.las")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Result<PointSet> las = readLas(dir.file("scan.las"));
+  ASSERT_TRUE(las.ok()) << las.error().message;
+  ASSERT_EQ(las->size(), 153u);
+  EXPECT_EQ(las->positions[0], glm::dvec3(-0.5, -0.015, -0.432));  // scaled integers of step 0.001
+  ASSERT_TRUE(las->hasColors());
+  EXPECT_EQ(las->colors[0], glm::vec3(0.0f, 0.0f, 65280.0f / 65535.0f));  // 16-bit, as the file has them
+  for (const char* name : {"point_source_id", "return_number", "number_of_returns"})
+    ASSERT_NE(las->dimensions.find(name), nullptr) << name;
+  EXPECT_EQ(las->dimensions.find("point_source_id")->value(0), 1.0);
+  EXPECT_EQ(las->dimensions.find("number_of_returns")->value(0), 1.0);
+
+  const test::CommandResult info = runDpoint({"info", dir.file("scan.las"), e57});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_TRUE(test::contains(info.out, " 306\ntriangles:")) << info.out;
+  EXPECT_EQ(runDpoint({"render", "-q", "--width", "32", "--height", "24", "-o", dir.file("scan.png"), e57}).exit_code, 0);
+  const test::CommandResult written = runDpoint({"convert", dir.file("scan.las"), "-o", dir.file("back.e57")});
+  EXPECT_EQ(written.exit_code, 1);
+  EXPECT_TRUE(test::contains(written.err, ".e57 is read, not written")) << written.err;
+  EXPECT_FALSE(test::fileExists(dir.file("back.e57")));
+  const test::CommandResult damaged = runDpoint({"convert", std::string(DPOINT_SOURCE_DIR) + "/tests/data/e57/bad-crc.e57",
+                                                 "-o", dir.file("bad.csv")});
+  EXPECT_EQ(damaged.exit_code, 2);
+  EXPECT_TRUE(test::contains(damaged.err, "bad-crc.e57: page 0 (bytes 0 to 1023) fails its CRC-32C checksum")) << damaged.err;
+  EXPECT_FALSE(test::fileExists(dir.file("bad.csv")));
+}
+
 TEST(CliConvertMeaning, aPtxScanConvertsToLasWithItsIntensityAsSixteenBits) {
   TempDir dir;
   writeFile(dir.file("scan.ptx"), "2\n2\n558312.218127 5240857.469093 76.298415\n1 0 0\n0 1 0\n0 0 1\n"

@@ -221,7 +221,7 @@ TEST(CliVoice, badInvocationsSpeakOneVoice) {
       {{"render", in, "-o", png, "--color", "intensity"}, "--color intensity: " + in + " has no dimension 'intensity'"},
       {{"generate", "mandelbulb", "--resolution", "100000", "-o", ply}, "--resolution 100000: must be 2..65536"},
       {{"generate", "mandelbrot2d", "--resolution", "1", "-o", ply}, "--resolution 1: must be 2.."},
-      {{"info", dir.path()}, dir.path() + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las or .laz)"},
+      {{"info", dir.path()}, dir.path() + ": is a folder, not a point file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .gltf, .las, .laz or .e57)"},
       {{"convert", dir.path(), "-o", ply}, dir.path() + ": is a folder, not a point file"},
       {{"info", in, "--scene", "1"}, in + ": --scene and --all-scenes apply to .glb/.gltf input only"},
       {{"info", in, in, "--all-scenes"}, in + " and 1 more: --scene and --all-scenes apply to one .glb/.gltf input"},

@@ -1,0 +1,52 @@
+// ASTM E57 (E2807), the exchange format of terrestrial laser scanners: read, not written.
+//
+// The file is pages of 1020 bytes and a CRC-32C each (every page read is checked); a 48-byte
+// header places an XML tree that names what the file holds. Each scan (a child of `data3D`) has a
+// pose (a unit quaternion and a translation) and its points as a compressed vector: records whose
+// fields the tree's prototype lists, each field a stream of bit-packed values (the bitpack codec,
+// the only one E57 defines) spread over data packets of up to 64 KiB.
+//
+// Read: every scan's points, moved by its pose into the file's frame in double precision.
+// Positions from cartesianX/Y/Z, else from sphericalRange/Azimuth/Elevation (x = r cos(el) cos(az),
+// y = r cos(el) sin(az), z = r sin(el)); a point whose cartesian (or spherical) invalid state is
+// not 0 (direction only, or no point) is left out with a note. Colours from colorRed/Green/Blue:
+// integers 0..255 or 0..65535 keep that scale (PointSet::color_full_scale), other ranges are
+// normalised by the scan's colorLimits (or the fields' own limits). Every other field is a
+// dimension of its own type (an integer field the smallest type holding its limits, a float field
+// float32 or float64, a scaled integer float64): intensity as `intensity`, returnIndex + 1 as
+// `return_number` and returnCount as `number_of_returns` (LAS's), the LAS extension's fields
+// (`las:classification`, …) by their LAS names, the others (rowIndex, timeStamp, …) by their own.
+// Several scans: each point's scan number (from 1, in the file's order) in point_source_id, as a
+// PTX file's scans are joined (converters/point_inputs.h). Images (images2D) are not read (a note).
+//
+// Errors name the file and what failed: a page's checksum, the XML's line, a scan and field. A
+// non-finite coordinate is an error unless allow_nonfinite. The points and each field's packed
+// bytes are checked against max_memory before they are allocated.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/input_file.h"
+#include "core/point_set.h"
+#include "core/progress.h"
+#include "core/result.h"
+
+namespace dpoint {
+
+struct E57ReadOptions {
+  unsigned threads = 0;  // 0: all cores
+  Progress* progress = nullptr;
+  uint64_t max_memory = 0;  // 0: defaultMemoryLimit()
+  bool allow_nonfinite = false;
+  std::vector<std::string>* notices = nullptr;  // points left out, images not read
+};
+
+Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options = {});
+Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options = {});
+
+// CRC-32C (Castagnoli) of `size` bytes, as E57 checks each page (stored big-endian after it).
+uint32_t crc32c(const uint8_t* data, size_t size);
+
+}  // namespace dpoint

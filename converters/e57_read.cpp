@@ -1,0 +1,807 @@
+// The E57 reader (converters/e57.h): the paged file, its XML tree (pugixml), and each scan's
+// compressed vector, whose packets are walked once to gather every field's bytes, then decoded on
+// all cores (a field's values are at fixed bit offsets, so any record is found without the others).
+#include "converters/e57.h"
+
+#include <fast_float/fast_float.h>
+#include <pugixml.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+#include "converters/point_inputs.h"
+#include "core/dimensions.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+#include "core/text.h"
+
+namespace dpoint {
+
+namespace {
+
+// CRC-32C, reflected, by eight bytes at a time (slicing-by-8 tables).
+struct Crc32cTables {
+  uint32_t t[8][256];
+  Crc32cTables() {
+    for (uint32_t i = 0; i < 256; ++i) {
+      uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1) ? (c >> 1) ^ 0x82F63B78u : c >> 1;
+      t[0][i] = c;
+    }
+    for (uint32_t i = 0; i < 256; ++i)
+      for (int k = 1; k < 8; ++k) t[k][i] = (t[k - 1][i] >> 8) ^ t[0][t[k - 1][i] & 0xFF];
+  }
+};
+
+#if defined(__x86_64__)
+__attribute__((target("sse4.2"))) uint32_t crc32cSse42(const uint8_t* data, size_t size) {
+  uint64_t crc = 0xFFFFFFFFu;
+  for (; size >= 8; data += 8, size -= 8) {
+    uint64_t word;
+    std::memcpy(&word, data, 8);
+    crc = __builtin_ia32_crc32di(crc, word);
+  }
+  uint32_t c = static_cast<uint32_t>(crc);
+  for (; size > 0; ++data, --size) c = __builtin_ia32_crc32qi(c, *data);
+  return c ^ 0xFFFFFFFFu;
+}
+#endif
+
+}  // namespace
+
+uint32_t crc32c(const uint8_t* data, size_t size) {
+#if defined(__x86_64__)
+  static const bool sse42 = __builtin_cpu_supports("sse4.2");
+  if (sse42) return crc32cSse42(data, size);
+#endif
+  static const Crc32cTables tables;
+  const auto& t = tables.t;
+  uint32_t c = 0xFFFFFFFFu;
+  for (; size >= 8; data += 8, size -= 8) {
+    uint32_t lo;
+    uint32_t hi;
+    std::memcpy(&lo, data, 4);
+    std::memcpy(&hi, data + 4, 4);
+    lo ^= c;
+    c = t[7][lo & 0xFF] ^ t[6][(lo >> 8) & 0xFF] ^ t[5][(lo >> 16) & 0xFF] ^ t[4][lo >> 24] ^ t[3][hi & 0xFF] ^
+        t[2][(hi >> 8) & 0xFF] ^ t[1][(hi >> 16) & 0xFF] ^ t[0][hi >> 24];
+  }
+  for (; size > 0; ++data, --size) c = (c >> 8) ^ t[0][(c ^ *data) & 0xFF];
+  return c ^ 0xFFFFFFFFu;
+}
+
+namespace {
+
+constexpr uint64_t kFileHeaderBytes = 48;
+constexpr uint64_t kSectionHeaderBytes = 32;
+constexpr size_t kPagesPerRead = 1024;      // pages read and checked at a time by a worker
+constexpr uint64_t kPacketWindow = 32u << 20;  // logical bytes of packets read at a time
+constexpr size_t kDecodeBlock = 1u << 16;   // records decoded at a time by a worker
+constexpr size_t kStreamPadding = 16;       // zero bytes after a field's bytes: a value read as 9 bytes
+
+template <typename T>
+T loadLe(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+
+// The file as E57 lays it out: pages of page_ bytes, the last 4 a checksum of the others.
+class PagedFile {
+ public:
+  static Result<PagedFile> open(const InputFile& file) {
+    PagedFile paged(file);
+    const std::string& path = file.path();
+    uint8_t header[kFileHeaderBytes] = {};
+    Result<size_t> got = file.readAt(0, header, sizeof header);
+    if (!got) return got.error();
+    if (*got < 8 || std::memcmp(header, "ASTM-E57", 8) != 0)
+      return Error{path + ": not an E57 file (it does not begin with ASTM-E57)"};
+    if (*got < kFileHeaderBytes) return Error{path + ": an E57 file cut short within its 48-byte header"};
+    const uint32_t major = loadLe<uint32_t>(header + 8);
+    const uint64_t length = loadLe<uint64_t>(header + 16);
+    paged.xml_offset_ = loadLe<uint64_t>(header + 24);
+    paged.xml_length_ = loadLe<uint64_t>(header + 32);
+    paged.page_ = loadLe<uint64_t>(header + 40);
+    if (major != 1)
+      return Error{path + ": E57 version " + std::to_string(major) + "." + std::to_string(loadLe<uint32_t>(header + 12)) +
+                   " (version 1 is read)"};
+    if (paged.page_ < 64 || paged.page_ > (1u << 20) || (paged.page_ & (paged.page_ - 1)) != 0)
+      return Error{path + ": E57 page size " + std::to_string(paged.page_) + " (a power of two from 64 to 1 MiB, 1024 as written)"};
+    if (length > file.size())
+      return Error{path + ": cut short: its header says " + std::to_string(length) + " bytes, the file has " +
+                   std::to_string(file.size())};
+    if (length % paged.page_ != 0)
+      return Error{path + ": its length " + std::to_string(length) + " is not whole pages of " + std::to_string(paged.page_) +
+                   " bytes"};
+    paged.length_ = length;
+    // The header's page first: a damaged page is named before what its bytes say is trusted.
+    std::vector<uint8_t> first(static_cast<size_t>(paged.logicalPage()));
+    if (length < paged.page_) return Error{path + ": cut short within its first page"};
+    if (Status s = paged.read(0, first.data(), first.size(), 1, nullptr); !s) return s.error();
+    if (paged.xml_length_ == 0) return Error{path + ": its XML section is empty"};
+    if (paged.xml_offset_ >= length || paged.logicalOf(paged.xml_offset_) + paged.xml_length_ > paged.logicalLength())
+      return Error{path + ": its XML section (at byte " + std::to_string(paged.xml_offset_) + ", " +
+                   std::to_string(paged.xml_length_) + " bytes) lies past the end of the file"};
+    return paged;
+  }
+
+  uint64_t page() const { return page_; }
+  uint64_t logicalPage() const { return page_ - 4; }
+  uint64_t physicalLength() const { return length_; }
+  uint64_t logicalLength() const { return length_ / page_ * logicalPage(); }
+  uint64_t logicalOf(uint64_t physical) const {
+    return physical / page_ * logicalPage() + std::min(physical % page_, logicalPage());
+  }
+  uint64_t xmlOffset() const { return xml_offset_; }
+  uint64_t xmlLength() const { return xml_length_; }
+  const std::string& path() const { return file_->path(); }
+
+  // Logical bytes [logical, logical + size) into out, every page they touch checked against its
+  // checksum; on `threads` cores, `progress` advanced by the bytes read.
+  Status read(uint64_t logical, uint8_t* out, uint64_t size, unsigned threads, Progress* progress) const {
+    if (size == 0) return okStatus();
+    if (logical > logicalLength() || size > logicalLength() - logical)
+      return Error{path() + ": a section runs past the end of the file (logical bytes " + std::to_string(logical) + " to " +
+                   std::to_string(logical + size) + " of " + std::to_string(logicalLength()) + "): cut short or damaged"};
+    const uint64_t lp = logicalPage();
+    const uint64_t first = logical / lp, last = (logical + size - 1) / lp;
+    const size_t groups = static_cast<size_t>((last - first) / kPagesPerRead + 1);
+    std::vector<std::optional<Error>> errors(groups);
+    std::vector<std::vector<uint8_t>> buffers(parallelWorkers(groups, threads));
+    parallelFor(groups, threads, [&](size_t g, unsigned worker) {
+      const uint64_t p0 = first + uint64_t{g} * kPagesPerRead;
+      const uint64_t p1 = std::min(last + 1, p0 + kPagesPerRead);
+      std::vector<uint8_t>& buffer = buffers[worker];
+      buffer.resize(static_cast<size_t>((p1 - p0) * page_));
+      Result<size_t> got = file_->readAt(p0 * page_, buffer.data(), buffer.size());
+      if (!got || *got != buffer.size()) {
+        errors[g] = got ? Error{path() + ": the file changed while it was read (shorter than its size)"} : got.error();
+        return;
+      }
+      for (uint64_t p = p0; p < p1; ++p) {
+        const uint8_t* bytes = buffer.data() + (p - p0) * page_;
+        const uint32_t stored = __builtin_bswap32(loadLe<uint32_t>(bytes + lp));
+        if (crc32c(bytes, static_cast<size_t>(lp)) != stored) {
+          errors[g] = Error{path() + ": page " + std::to_string(p) + " (bytes " + std::to_string(p * page_) + " to " +
+                            std::to_string((p + 1) * page_ - 1) + ") fails its CRC-32C checksum: the file is damaged"};
+          return;
+        }
+        // This page's part of [logical, logical + size).
+        const uint64_t begin = std::max(logical, p * lp), end = std::min(logical + size, (p + 1) * lp);
+        std::memcpy(out + (begin - logical), bytes + (begin - p * lp), static_cast<size_t>(end - begin));
+      }
+      if (progress) progress->advance((p1 - p0) * lp);
+    });
+    for (std::optional<Error>& e : errors)
+      if (e) return std::move(*e);
+    return okStatus();
+  }
+
+ private:
+  explicit PagedFile(const InputFile& file) : file_(&file) {}
+  const InputFile* file_;
+  uint64_t page_ = 1024, length_ = 0, xml_offset_ = 0, xml_length_ = 0;
+};
+
+bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// A number of the XML tree: a Float's or an Integer's text (empty: 0), or an attribute.
+std::optional<double> parseDouble(std::string_view text) {
+  while (!text.empty() && isBlank(text.front())) text.remove_prefix(1);
+  while (!text.empty() && isBlank(text.back())) text.remove_suffix(1);
+  if (text.empty()) return 0.0;
+  if (text.front() == '+') text.remove_prefix(1);
+  double v = 0.0;
+  const auto r = fast_float::from_chars(text.data(), text.data() + text.size(), v);
+  if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+std::optional<int64_t> parseInt64(std::string_view text) {
+  while (!text.empty() && isBlank(text.front())) text.remove_prefix(1);
+  while (!text.empty() && isBlank(text.back())) text.remove_suffix(1);
+  if (text.empty()) return int64_t{0};
+  if (text.front() == '+') text.remove_prefix(1);
+  int64_t v = 0;
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+// The element `name` of a Structure, as a number (its type Float, Integer or ScaledInteger);
+// `fallback` when it is missing.
+Result<double> numberOf(const pugi::xml_node& parent, const char* name, double fallback, const std::string& where) {
+  const pugi::xml_node node = parent.child(name);
+  if (!node) return fallback;
+  const std::string type = node.attribute("type").value();
+  const std::optional<double> v = parseDouble(node.text().get());
+  if (!v || (type != "Float" && type != "Integer" && type != "ScaledInteger"))
+    return Error{where + "/" + name + ": " + quotedExcerpt(node.text().get()) + " of type " + quotedExcerpt(type) +
+                 " is not a number"};
+  if (type == "ScaledInteger") {
+    const std::optional<double> scale = parseDouble(node.attribute("scale").value());
+    const std::optional<double> offset = parseDouble(node.attribute("offset").value());
+    if (!scale || !offset) return Error{where + "/" + name + ": a scale or offset that is not a number"};
+    return *v * (node.attribute("scale") ? *scale : 1.0) + *offset;
+  }
+  return *v;
+}
+
+// A field of a prototype: how its values are packed.
+enum class FieldKind { kFloat32, kFloat64, kInteger, kScaled };
+
+struct Field {
+  std::string name;
+  FieldKind kind = FieldKind::kFloat64;
+  int64_t minimum = INT64_MIN, maximum = INT64_MAX;
+  double scale = 1.0, offset = 0.0;
+  double float_minimum = -HUGE_VAL, float_maximum = HUGE_VAL;  // a Float's limits, where given
+  unsigned bits = 64;                                           // per value
+  std::vector<uint8_t> bytes;                                   // the packed values, then kStreamPadding zeros
+  uint64_t filled = 0;                                          // bytes gathered from packets
+
+  uint64_t neededBytes(uint64_t records) const { return (records * bits + 7) / 8; }
+  // Value i's packed bits.
+  uint64_t raw(size_t i) const {
+    const uint64_t bit = uint64_t{i} * bits;
+    const uint8_t* p = bytes.data() + bit / 8;
+    const unsigned shift = static_cast<unsigned>(bit % 8);
+    uint64_t v = loadLe<uint64_t>(p) >> shift;
+    if (shift != 0 && shift + bits > 64) v |= uint64_t{p[8]} << (64 - shift);
+    return bits == 64 ? v : v & ((uint64_t{1} << bits) - 1);
+  }
+  // An integer field's value i (the packed bits count up from the minimum).
+  int64_t integer(size_t i) const {
+    return bits == 0 ? minimum : static_cast<int64_t>(static_cast<uint64_t>(minimum) + raw(i));
+  }
+  double value(size_t i) const {
+    switch (kind) {
+      case FieldKind::kFloat32: return static_cast<double>(loadLe<float>(bytes.data() + i * 4));
+      case FieldKind::kFloat64: return loadLe<double>(bytes.data() + i * 8);
+      case FieldKind::kInteger: return static_cast<double>(integer(i));
+      case FieldKind::kScaled: return static_cast<double>(integer(i)) * scale + offset;
+    }
+    return 0.0;
+  }
+};
+
+// A prototype's field from its element.
+Result<Field> fieldOf(const pugi::xml_node& node, const std::string& where) {
+  Field f;
+  f.name = node.name();
+  const std::string type = node.attribute("type").value();
+  const std::string at = where + "/" + f.name;
+  const auto integerAttribute = [&](const char* name, int64_t fallback) -> Result<int64_t> {
+    const pugi::xml_attribute a = node.attribute(name);
+    if (!a) return fallback;
+    const std::optional<int64_t> v = parseInt64(a.value());
+    if (!v) return Error{at + ": " + name + " " + quotedExcerpt(a.value()) + " is not a 64-bit integer"};
+    return *v;
+  };
+  const auto doubleAttribute = [&](const char* name, double fallback) -> Result<double> {
+    const pugi::xml_attribute a = node.attribute(name);
+    if (!a) return fallback;
+    const std::optional<double> v = parseDouble(a.value());
+    if (!v) return Error{at + ": " + name + " " + quotedExcerpt(a.value()) + " is not a number"};
+    return *v;
+  };
+  if (type == "Float") {
+    const std::string precision = node.attribute("precision").value();
+    if (precision == "single") {
+      f.kind = FieldKind::kFloat32;
+      f.bits = 32;
+    } else if (precision.empty() || precision == "double") {
+      f.kind = FieldKind::kFloat64;
+      f.bits = 64;
+    } else {
+      return Error{at + ": precision " + quotedExcerpt(precision) + " (single or double)"};
+    }
+    Result<double> lo = doubleAttribute("minimum", -HUGE_VAL);
+    if (!lo) return lo.error();
+    Result<double> hi = doubleAttribute("maximum", HUGE_VAL);
+    if (!hi) return hi.error();
+    f.float_minimum = *lo;
+    f.float_maximum = *hi;
+    return f;
+  }
+  if (type != "Integer" && type != "ScaledInteger")
+    return Error{at + ": a field of type " + quotedExcerpt(type) +
+                 (type == "Structure" || type == "Vector" ? " (nested fields are not read)" : "") +
+                 " (a point's fields are Float, Integer or ScaledInteger)"};
+  f.kind = type == "Integer" ? FieldKind::kInteger : FieldKind::kScaled;
+  Result<int64_t> lo = integerAttribute("minimum", INT64_MIN);
+  if (!lo) return lo.error();
+  Result<int64_t> hi = integerAttribute("maximum", INT64_MAX);
+  if (!hi) return hi.error();
+  if (*hi < *lo) return Error{at + ": maximum " + std::to_string(*hi) + " is below minimum " + std::to_string(*lo)};
+  f.minimum = *lo;
+  f.maximum = *hi;
+  const uint64_t range = static_cast<uint64_t>(*hi) - static_cast<uint64_t>(*lo);
+  f.bits = static_cast<unsigned>(std::bit_width(range));
+  if (f.kind == FieldKind::kScaled) {
+    Result<double> scale = doubleAttribute("scale", 1.0);
+    if (!scale) return scale.error();
+    Result<double> offset = doubleAttribute("offset", 0.0);
+    if (!offset) return offset.error();
+    if (!(*scale != 0.0) || !std::isfinite(*scale) || !std::isfinite(*offset))
+      return Error{at + ": scale " + formatNumber(*scale) + " and offset " + formatNumber(*offset) +
+                   " (a finite, non-zero scale)"};
+    f.scale = *scale;
+    f.offset = *offset;
+  }
+  return f;
+}
+
+// The smallest dimension type that holds an integer field's limits.
+DimType integerType(int64_t lo, int64_t hi) {
+  if (lo >= 0) {
+    const uint64_t h = static_cast<uint64_t>(hi);
+    return h <= UINT8_MAX ? DimType::kU8 : h <= UINT16_MAX ? DimType::kU16 : h <= UINT32_MAX ? DimType::kU32 : DimType::kU64;
+  }
+  if (lo >= INT8_MIN && hi <= INT8_MAX) return DimType::kI8;
+  if (lo >= INT16_MIN && hi <= INT16_MAX) return DimType::kI16;
+  if (lo >= INT32_MIN && hi <= INT32_MAX) return DimType::kI32;
+  return DimType::kI64;
+}
+
+// The dimension a field is kept as: its name and type.
+std::pair<std::string, DimType> dimensionOf(const Field& f) {
+  std::string name = f.name;
+  if (name == "returnIndex" && f.kind == FieldKind::kInteger) name = dim::kReturnNumber;  // 0-based in E57, 1-based in LAS
+  if (name == "returnCount" && f.kind == FieldKind::kInteger) name = dim::kNumberOfReturns;
+  if (name.rfind("las:", 0) == 0) {  // the LAS extension's camelCase names as LAS's (pointSourceId → point_source_id)
+    std::string snake;
+    for (char c : name.substr(4)) {
+      if (c >= 'A' && c <= 'Z') {
+        snake += '_';
+        snake += static_cast<char>(c - 'A' + 'a');
+      } else {
+        snake += c;
+      }
+    }
+    name = snake;
+  }
+  switch (f.kind) {
+    case FieldKind::kFloat32: return {name, DimType::kF32};
+    case FieldKind::kFloat64:
+    case FieldKind::kScaled: return {name, DimType::kF64};
+    case FieldKind::kInteger: break;
+  }
+  if (f.name == "returnIndex" && f.minimum >= 0 && f.maximum < INT64_MAX) return {name, integerType(f.minimum + 1, f.maximum + 1)};
+  return {name, integerType(f.minimum, f.maximum)};
+}
+
+// A scan as the XML tree describes it.
+struct ScanInfo {
+  std::string label;  // "data3D 2 ('station 1')"
+  uint64_t section = 0, records = 0;
+  std::vector<Field> fields;
+  double rotation[4] = {1.0, 0.0, 0.0, 0.0};  // w x y z
+  double translation[3] = {0.0, 0.0, 0.0};
+  std::optional<double> color_limits[6];  // red, green, blue minimum and maximum, where given
+};
+
+Result<ScanInfo> scanInfoOf(const pugi::xml_node& scan, size_t index, const std::string& path) {
+  ScanInfo info;
+  const pugi::xml_node name = scan.child("name");
+  info.label = "data3D " + std::to_string(index + 1) +
+               (name && *name.text().get() ? " (" + quotedExcerpt(name.text().get()) + ")" : std::string());
+  const std::string where = path + ": " + info.label;
+  const pugi::xml_node points = scan.child("points");
+  if (!points || std::string(points.attribute("type").value()) != "CompressedVector")
+    return Error{where + ": no points (a CompressedVector)"};
+  const std::optional<int64_t> offset = parseInt64(points.attribute("fileOffset").value());
+  const std::optional<int64_t> records = parseInt64(points.attribute("recordCount").value());
+  if (!offset || *offset < 0 || !points.attribute("fileOffset"))
+    return Error{where + ": points: fileOffset " + quotedExcerpt(points.attribute("fileOffset").value()) + " is not a byte offset"};
+  if (!records || *records < 0)
+    return Error{where + ": points: recordCount " + quotedExcerpt(points.attribute("recordCount").value()) + " is not a count"};
+  info.section = static_cast<uint64_t>(*offset);
+  info.records = static_cast<uint64_t>(*records);
+  const pugi::xml_node prototype = points.child("prototype");
+  if (!prototype) return Error{where + ": points: no prototype"};
+  for (const pugi::xml_node& child : prototype.children()) {
+    if (child.type() != pugi::node_element) continue;
+    Result<Field> f = fieldOf(child, where + ": points");
+    if (!f) return f.error();
+    for (const Field& other : info.fields)
+      if (other.name == f->name) return Error{where + ": points: the field " + f->name + " twice"};
+    info.fields.push_back(std::move(*f));
+  }
+  if (info.fields.empty()) return Error{where + ": points: a prototype of no fields"};
+  for (const pugi::xml_node& codec : points.child("codecs").children())
+    if (codec.type() == pugi::node_element)
+      return Error{where + ": points: a codec other than bitpack (" + quotedExcerpt(codec.name()) + "), which E57 does not define"};
+  if (const pugi::xml_node pose = scan.child("pose")) {
+    const char* q[4] = {"w", "x", "y", "z"};
+    const char* t[3] = {"x", "y", "z"};
+    const pugi::xml_node rotation = pose.child("rotation"), translation = pose.child("translation");
+    for (int k = 0; k < 4 && rotation; ++k) {
+      Result<double> v = numberOf(rotation, q[k], k == 0 ? 1.0 : 0.0, where + ": pose/rotation");
+      if (!v) return v.error();
+      info.rotation[k] = *v;
+    }
+    for (int k = 0; k < 3 && translation; ++k) {
+      Result<double> v = numberOf(translation, t[k], 0.0, where + ": pose/translation");
+      if (!v) return v.error();
+      info.translation[k] = *v;
+    }
+    const double norm = std::sqrt(info.rotation[0] * info.rotation[0] + info.rotation[1] * info.rotation[1] +
+                                  info.rotation[2] * info.rotation[2] + info.rotation[3] * info.rotation[3]);
+    if (!(norm > 0.0) || !std::isfinite(norm) || !std::isfinite(info.translation[0]) ||
+        !std::isfinite(info.translation[1]) || !std::isfinite(info.translation[2]))
+      return Error{where + ": pose: a rotation of no length or a value that is not finite"};
+    for (double& c : info.rotation) c /= norm;  // a unit quaternion, as E57 says it is, to the last bit
+  }
+  if (const pugi::xml_node limits = scan.child("colorLimits")) {
+    const char* names[6] = {"colorRedMinimum", "colorRedMaximum", "colorGreenMinimum",
+                            "colorGreenMaximum", "colorBlueMinimum", "colorBlueMaximum"};
+    for (int k = 0; k < 6; ++k) {
+      if (!limits.child(names[k])) continue;
+      Result<double> v = numberOf(limits, names[k], 0.0, where + ": colorLimits");
+      if (!v) return v.error();
+      info.color_limits[k] = *v;
+    }
+  }
+  return info;
+}
+
+const Field* findField(const ScanInfo& scan, std::string_view name) {
+  for (const Field& f : scan.fields)
+    if (f.name == name) return &f;
+  return nullptr;
+}
+
+// The packets of a scan's compressed vector, walked once: each field's bytes gathered in order.
+Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Progress* progress) {
+  const std::string where = file.path() + ": " + scan.label + ": points";
+  if (scan.section >= file.physicalLength())
+    return Error{where + ": its section at byte " + std::to_string(scan.section) + " lies past the end of the file"};
+  const uint64_t start = file.logicalOf(scan.section);
+  uint8_t header[kSectionHeaderBytes];
+  if (Status s = file.read(start, header, sizeof header, 1, nullptr); !s) return s;
+  if (header[0] != 1)
+    return Error{where + ": the section at byte " + std::to_string(scan.section) + " is not a compressed vector (id " +
+                 std::to_string(header[0]) + ", not 1)"};
+  const uint64_t length = loadLe<uint64_t>(header + 8);
+  const uint64_t data = loadLe<uint64_t>(header + 16);
+  if (length < kSectionHeaderBytes || length > file.logicalLength() - start)
+    return Error{where + ": its section's length " + std::to_string(length) + " runs past the end of the file"};
+  const uint64_t end = start + length;
+  const uint64_t data_logical = file.logicalOf(data);
+  if (scan.records == 0) return okStatus();
+  if (data_logical < start + kSectionHeaderBytes || data_logical >= end)
+    return Error{where + ": its data (at byte " + std::to_string(data) + ") is not within its section"};
+  const size_t streams = scan.fields.size();
+  uint64_t needed = 0;
+  for (const Field& f : scan.fields) needed += f.neededBytes(scan.records);
+  if (needed > end - data_logical)  // before the fields' bytes are allocated
+    return Error{where + ": " + std::to_string(scan.records) + " records of its fields need " + std::to_string(needed) +
+                 " bytes, but its section holds " + std::to_string(end - data_logical) + " (cut short or damaged)"};
+  for (Field& f : scan.fields) {
+    f.bytes.assign(static_cast<size_t>(f.neededBytes(scan.records)) + kStreamPadding, 0);
+    f.filled = 0;
+  }
+  const auto complete = [&] {
+    for (const Field& f : scan.fields)
+      if (f.filled < f.neededBytes(scan.records)) return false;
+    return true;
+  };
+  std::vector<uint8_t> window;
+  uint64_t at = data_logical;
+  while (at < end && !complete()) {
+    const uint64_t size = std::min(kPacketWindow, end - at);
+    window.resize(static_cast<size_t>(size));
+    if (Status s = file.read(at, window.data(), size, threads, nullptr); !s) return s;
+    uint64_t pos = 0, taken = 0;
+    while (pos + 4 <= size && !complete()) {
+      const uint8_t* packet = window.data() + pos;
+      const uint64_t packet_length = uint64_t{loadLe<uint16_t>(packet + 2)} + 1;
+      const std::string packet_at = where + ": the packet at logical byte " + std::to_string(at + pos);
+      if (packet_length > end - (at + pos)) return Error{packet_at + " runs past its section (cut short or damaged)"};
+      if (pos + packet_length > size) break;  // the next window starts with it
+      if (packet[0] == 0 || packet[0] == 2) {  // an index or empty packet
+        pos += packet_length;
+        continue;
+      }
+      if (packet[0] != 1) return Error{packet_at + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
+      const uint64_t count = loadLe<uint16_t>(packet + 4);
+      if (count != streams)
+        return Error{packet_at + " has " + countOf(count, "bytestream") + " for a prototype of " + countOf(streams, "field")};
+      uint64_t offset = 6 + 2 * count;
+      for (size_t k = 0; k < streams; ++k) {
+        const uint64_t n = loadLe<uint16_t>(packet + 6 + 2 * k);
+        if (offset + n > packet_length)
+          return Error{packet_at + ": its buffers (" + std::to_string(offset + n) + " bytes) overrun the packet (" +
+                       std::to_string(packet_length) + ")"};
+        Field& f = scan.fields[k];
+        const uint64_t room = f.neededBytes(scan.records) - std::min(f.filled, f.neededBytes(scan.records));
+        const uint64_t take = std::min(n, room);  // a field's last word may be padded past its values
+        std::memcpy(f.bytes.data() + f.filled, packet + offset, static_cast<size_t>(take));
+        f.filled += take;
+        taken += take;
+        offset += n;
+      }
+      pos += packet_length;
+    }
+    if (progress) progress->advance(taken);
+    if (pos == 0) break;  // fewer than 4 bytes left: the fields' check below names the one cut short
+    at += pos;
+  }
+  for (const Field& f : scan.fields)
+    if (f.filled < f.neededBytes(scan.records))
+      return Error{where + ": the field " + f.name + " ends after " + std::to_string(f.filled * 8 / std::max(1u, f.bits)) +
+                   " of its " + std::to_string(scan.records) + " records (the file is cut short or damaged)"};
+  return okStatus();
+}
+
+// The colour channel of a field: an integer 0..full keeps its scale; else normalised by limits.
+struct ColorChannel {
+  const Field* field = nullptr;
+  double lo = 0.0, hi = 1.0;
+};
+
+// The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left out.
+Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57ReadOptions& options, uint64_t& left_out) {
+  const std::string where = file.path() + ": " + scan.label;
+  const unsigned threads = resolveThreads(options.threads);
+  const Field* c[3] = {findField(scan, "cartesianX"), findField(scan, "cartesianY"), findField(scan, "cartesianZ")};
+  const Field* s[3] = {findField(scan, "sphericalRange"), findField(scan, "sphericalAzimuth"),
+                       findField(scan, "sphericalElevation")};
+  const bool cartesian = c[0] && c[1] && c[2];
+  if (!cartesian && !(s[0] && s[1] && s[2]))
+    return Error{where + ": its points have neither cartesianX, cartesianY and cartesianZ nor sphericalRange, "
+                         "sphericalAzimuth and sphericalElevation"};
+  const Field* const* xyz = cartesian ? c : s;
+  const Field* invalid = findField(scan, cartesian ? "cartesianInvalidState" : "sphericalInvalidState");
+  const Field* rgb[3] = {findField(scan, "colorRed"), findField(scan, "colorGreen"), findField(scan, "colorBlue")};
+  const bool colors = rgb[0] && rgb[1] && rgb[2];
+  if (!colors && (rgb[0] || rgb[1] || rgb[2]))
+    return Error{where + ": its points have some of colorRed, colorGreen and colorBlue, not all three"};
+
+  // Colours: an integer 0..255 or 0..65535 keeps its scale; other limits are normalised.
+  uint16_t full = 0;
+  ColorChannel channel[3];
+  if (colors) {
+    bool integer_scale = true;
+    for (int k = 0; k < 3; ++k) {
+      const Field& f = *rgb[k];
+      channel[k].field = &f;
+      const bool integer = f.kind == FieldKind::kInteger;
+      channel[k].lo = scan.color_limits[2 * k] ? *scan.color_limits[2 * k]
+                      : integer                 ? static_cast<double>(f.minimum)
+                      : f.kind == FieldKind::kScaled ? static_cast<double>(f.minimum) * f.scale + f.offset
+                      : std::isfinite(f.float_minimum) ? f.float_minimum
+                                                       : 0.0;
+      channel[k].hi = scan.color_limits[2 * k + 1] ? *scan.color_limits[2 * k + 1]
+                      : integer                     ? static_cast<double>(f.maximum)
+                      : f.kind == FieldKind::kScaled ? static_cast<double>(f.maximum) * f.scale + f.offset
+                      : std::isfinite(f.float_maximum) ? f.float_maximum
+                                                       : 1.0;
+      if (!(channel[k].hi > channel[k].lo))
+        return Error{where + ": " + f.name + "'s limits " + formatNumber(channel[k].lo) + " to " + formatNumber(channel[k].hi) +
+                     " are no range"};
+      integer_scale = integer_scale && integer && channel[k].lo == 0.0 && channel[k].hi == channel[0].hi &&
+                      (channel[k].hi == 255.0 || channel[k].hi == 65535.0);
+    }
+    if (integer_scale) full = static_cast<uint16_t>(channel[0].hi);
+  }
+
+  // The other fields as dimensions.
+  std::vector<const Field*> kept;
+  for (const Field& f : scan.fields) {
+    const bool used = &f == xyz[0] || &f == xyz[1] || &f == xyz[2] || &f == invalid ||
+                      (colors && (&f == rgb[0] || &f == rgb[1] || &f == rgb[2]));
+    if (!used) kept.push_back(&f);
+  }
+  const size_t n = static_cast<size_t>(scan.records);
+  PointSet points;
+  points.z_axis = ZAxis::kPresent;
+  points.positions.resize(n);
+  if (colors) points.colors.resize(n);
+  for (const Field* f : kept) {
+    const auto [name, type] = dimensionOf(*f);
+    if (points.dimensions.find(name))
+      return Error{where + ": the fields " + f->name + " and another are both kept as the dimension " + name};
+    points.dimensions.appendUnset(name, type, n);
+  }
+
+  const double* q = scan.rotation;
+  const bool identity = q[0] == 1.0 && q[1] == 0.0 && q[2] == 0.0 && q[3] == 0.0 && scan.translation[0] == 0.0 &&
+                        scan.translation[1] == 0.0 && scan.translation[2] == 0.0;
+  // The rotation matrix of the unit quaternion (w, x, y, z).
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  const double m[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                          {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                          {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+  const double* t = scan.translation;
+  const size_t blocks = (n + kDecodeBlock - 1) / kDecodeBlock;
+  std::atomic<size_t> first_nonfinite{SIZE_MAX};
+  parallelFor(blocks, threads, [&](size_t b, unsigned) {
+    const size_t begin = b * kDecodeBlock, end = std::min(n, begin + kDecodeBlock);
+    for (size_t i = begin; i < end; ++i) {
+      glm::dvec3 p(xyz[0]->value(i), xyz[1]->value(i), xyz[2]->value(i));
+      if (!cartesian) {
+        const double r = p.x, az = p.y, el = p.z;
+        p = glm::dvec3(r * std::cos(el) * std::cos(az), r * std::cos(el) * std::sin(az), r * std::sin(el));
+      }
+      if (!identity)
+        p = glm::dvec3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t[0], m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t[1],
+                       m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t[2]);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        if (!invalid || invalid->integer(i) == 0) lowerAtomic(first_nonfinite, i);
+      }
+      points.positions[i] = p;
+      if (colors) {
+        glm::vec3& color = points.colors[i];
+        for (int k = 0; k < 3; ++k) {
+          const double v = channel[k].field->value(i);
+          color[k] = static_cast<float>(full != 0 ? v / full : (v - channel[k].lo) / (channel[k].hi - channel[k].lo));
+        }
+      }
+    }
+    for (size_t d = 0; d < kept.size(); ++d) {
+      const Field& f = *kept[d];
+      Dimension& dim = points.dimensions.all()[d];
+      const size_t width = dimTypeSize(dim.type);
+      const bool return_index = f.name == "returnIndex" && f.kind == FieldKind::kInteger && dim.name == dim::kReturnNumber;
+      for (size_t i = begin; i < end; ++i) {
+        uint8_t* out = dim.bytes.data() + i * width;
+        if (f.kind == FieldKind::kInteger) {
+          const int64_t v = f.integer(i) + (return_index ? 1 : 0);
+          switch (dim.type) {  // the type holds the field's limits (integerType)
+            case DimType::kU8: *out = static_cast<uint8_t>(v); break;
+            case DimType::kI8: { const int8_t a = static_cast<int8_t>(v); std::memcpy(out, &a, 1); break; }
+            case DimType::kU16: { const uint16_t a = static_cast<uint16_t>(v); std::memcpy(out, &a, 2); break; }
+            case DimType::kI16: { const int16_t a = static_cast<int16_t>(v); std::memcpy(out, &a, 2); break; }
+            case DimType::kU32: { const uint32_t a = static_cast<uint32_t>(v); std::memcpy(out, &a, 4); break; }
+            case DimType::kI32: { const int32_t a = static_cast<int32_t>(v); std::memcpy(out, &a, 4); break; }
+            default: std::memcpy(out, &v, 8); break;  // U64, I64: the same bits
+          }
+        } else if (dim.type == DimType::kF32) {
+          const float a = loadLe<float>(f.bytes.data() + i * 4);
+          std::memcpy(out, &a, 4);
+        } else {
+          const double a = f.value(i);
+          std::memcpy(out, &a, 8);
+        }
+      }
+    }
+  });
+  if (first_nonfinite.load() != SIZE_MAX && !options.allow_nonfinite) {
+    const size_t i = first_nonfinite.load();
+    return Error{where + ": point " + std::to_string(i) + " has a coordinate that is not finite (" +
+                 formatNumber(xyz[0]->value(i)) + ", " + formatNumber(xyz[1]->value(i)) + ", " + formatNumber(xyz[2]->value(i)) +
+                 "); --allow-nonfinite keeps it"};
+  }
+  points.color_full_scale = full;
+
+  // The points with an invalid state left out, in order.
+  if (invalid) {
+    size_t kept_points = 0;
+    for (size_t i = 0; i < n; ++i) {
+      if (invalid->integer(i) != 0) continue;
+      if (kept_points != i) {
+        points.positions[kept_points] = points.positions[i];
+        if (colors) points.colors[kept_points] = points.colors[i];
+        for (Dimension& d : points.dimensions.all()) d.copyFrom(kept_points, d, i);
+      }
+      ++kept_points;
+    }
+    left_out += n - kept_points;
+    points.positions.resize(kept_points);
+    if (colors) points.colors.resize(kept_points);
+    points.dimensions.resize(kept_points);
+  }
+  return points;
+}
+
+// Bytes held per point of a scan: positions, colours, dimensions, and the fields' packed values.
+uint64_t bytesPerRecord(const ScanInfo& scan) {
+  uint64_t bytes = sizeof(glm::dvec3);
+  bool colors = false;
+  for (const Field& f : scan.fields) {
+    bytes += (f.bits + 7) / 8;
+    if (f.name.rfind("color", 0) == 0) colors = true;
+    else bytes += 8;
+  }
+  return bytes + (colors ? sizeof(glm::vec3) : 0);
+}
+
+}  // namespace
+
+Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
+  const std::string& path = file.path();
+  if (file.size() == 0) return Error{path + ": empty file"};
+  Result<PagedFile> paged = PagedFile::open(file);
+  if (!paged) return paged.error();
+  const unsigned threads = resolveThreads(options.threads);
+  const uint64_t limit = options.max_memory != 0 ? options.max_memory : defaultMemoryLimit();
+
+  // The XML tree.
+  std::string xml(static_cast<size_t>(paged->xmlLength()), '\0');
+  if (Status s = paged->read(paged->logicalOf(paged->xmlOffset()), reinterpret_cast<uint8_t*>(xml.data()), xml.size(),
+                             threads, nullptr);
+      !s)
+    return s.error();
+  pugi::xml_document doc;
+  const pugi::xml_parse_result parsed = doc.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (!parsed) {
+    const auto offset = static_cast<size_t>(std::max<ptrdiff_t>(0, parsed.offset));
+    const size_t line = 1 + static_cast<size_t>(std::count(xml.begin(), xml.begin() + std::min(offset, xml.size()), '\n'));
+    return Error{path + ": its XML, line " + std::to_string(line) + ": " + parsed.description()};
+  }
+  const pugi::xml_node root = doc.child("e57Root");
+  if (!root) return Error{path + ": its XML has no e57Root"};
+  std::vector<ScanInfo> scans;
+  size_t index = 0;
+  for (const pugi::xml_node& child : root.child("data3D").children()) {
+    if (child.type() != pugi::node_element) continue;
+    Result<ScanInfo> info = scanInfoOf(child, index++, path);
+    if (!info) return info.error();
+    scans.push_back(std::move(*info));
+  }
+  size_t images = 0;
+  for (const pugi::xml_node& child : root.child("images2D").children())
+    if (child.type() == pugi::node_element) ++images;
+  std::string().swap(xml);
+
+  uint64_t total = 0, held = 0, bytes_to_read = 0;
+  for (const ScanInfo& scan : scans) {
+    if (scan.records > (UINT64_MAX / 2) / bytesPerRecord(scan) || total + scan.records < total)
+      return Error{path + ": " + scan.label + " declares " + std::to_string(scan.records) + " points, more than memory holds",
+                   ExitCode::kResourceLimit};
+    total += scan.records;
+    held += scan.records * bytesPerRecord(scan);
+    for (const Field& f : scan.fields) bytes_to_read += f.neededBytes(scan.records);
+  }
+  if (Status s = checkMemory(path + ": " + std::to_string(total) + " points in " + countOf(scans.size(), "scan"), held, limit); !s)
+    return s.error();
+  if (scans.size() > 65535 && std::count_if(scans.begin(), scans.end(), [](const ScanInfo& s) { return s.records > 0; }) > 1)
+    return Error{path + ": " + std::to_string(scans.size()) + " scans, more than a point source id (1 to 65535) tells apart"};
+
+  Progress* progress = options.progress;
+  if (progress) progress->start("reading " + path, bytes_to_read);
+  std::vector<NumberedScan> read;
+  uint64_t left_out = 0;
+  for (size_t k = 0; k < scans.size(); ++k) {
+    ScanInfo& scan = scans[k];
+    if (scan.records == 0) continue;
+    if (Status s = gatherFields(*paged, scan, threads, progress); !s) return s.error();
+    Result<PointSet> points = pointsOf(*paged, scan, options, left_out);
+    if (!points) return points.error();
+    for (Field& f : scan.fields) std::vector<uint8_t>().swap(f.bytes);
+    read.push_back({k + 1, std::move(*points)});
+  }
+  if (progress) progress->finish();
+  if (options.notices) {
+    if (left_out > 0)
+      options.notices->push_back(path + ": " + std::to_string(left_out) + " of its " + std::to_string(total) +
+                                 " points are marked invalid (no point, or a direction alone): left out");
+    if (images > 0) options.notices->push_back(path + ": its " + countOf(images, "image") + " (images2D) are not read");
+  }
+  if (read.empty()) {
+    PointSet none;
+    none.z_axis = ZAxis::kPresent;
+    return none;
+  }
+  if (read.size() == 1) return std::move(read.front().points);
+  // The file's own point source ids (an E57 written from LAS) are kept as they are.
+  for (NumberedScan& scan : read)
+    if (scan.points.dimensions.find(dim::kPointSourceId)) scan.number = 0;
+  return joinScans(std::move(read));
+}
+
+Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  return readE57(*file, options);
+}
+
+}  // namespace dpoint

@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""dpoint's E57 reader against libE57Format's verdicts (tests/data/e57/README.md).
+
+For each tests/data/e57/NAME.e57 with a NAME.libe57format.txt (what libE57Format, the E57
+reference implementation's heir, read from it: each scan's fields, its pose, every record of a
+small scan or every k-th of a large one, and each field's sum), `dpoint convert NAME.e57 -o
+NAME.csv` must give, with numpy computing what the E57 standard says from libE57Format's values:
+- each scan's valid points (invalid state 0), in order, the scans one after another (the dump
+  gives each record's place among its scan's valid ones);
+- positions: cartesian, or x = r cos(el) cos(az), y = r cos(el) sin(az), z = r sin(el), then
+  moved by the pose (the unit quaternion's rotation, then the translation): equal where there is no
+  pose and no spherical coordinates, else within a few units in the last place of the extent;
+- colours: the integers as the file has them (0..255 or 0..65535: CSV writes them at that scale);
+- the other fields as dimensions of their values (returnIndex + 1 as return_number, returnCount as
+  number_of_returns, las:pointSourceId as point_source_id, las:classification as classification),
+  and with several scans each point's scan number in point_source_id;
+- the sums of the valid points' coordinates, to 1e-12 of their size (every row, not the samples).
+bad-crc.e57 must be refused, as libE57Format refuses it, naming the damaged page.
+"""
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import pandas as pd
+
+DPOINT = sys.argv[1]
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "e57")
+failures = []
+
+
+def fail(name, what):
+    failures.append(f"{name}: {what}")
+
+
+def parse_judge(path):
+    scans = []
+    with open(path) as f:
+        for line in f:
+            words = line.split()
+            if words[0] == "scan":
+                scans.append({"records": int(words[3]), "fields": words[5:], "rows": {}, "pose": None, "limits": {}})
+            elif words[0] == "field" and words[2] == "Integer":
+                scans[-1]["limits"][words[1]] = (int(words[3]), int(words[4]))
+            elif words[0] == "pose":
+                scans[-1]["pose"] = None if words[1] == "none" else [float(w) for w in words[1:]]
+            elif words[0] == "r":  # the record, its place among the scan's valid ones, its values
+                scans[-1]["rows"][int(words[1])] = (int(words[2]), [float(w) for w in words[3:]])
+            elif words[0] == "sum":
+                scans[-1]["sums"] = [float(w) for w in words[1:]]
+    return scans
+
+
+def rotation(q):
+    w, x, y, z = np.array(q) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def expected_position(scan, values):
+    f = scan["fields"]
+    v = dict(zip(f, values))
+    if "cartesianX" in v:
+        p = np.array([v["cartesianX"], v["cartesianY"], v["cartesianZ"]])
+    else:
+        r, az, el = v["sphericalRange"], v["sphericalAzimuth"], v["sphericalElevation"]
+        p = np.array([r * math.cos(el) * math.cos(az), r * math.cos(el) * math.sin(az), r * math.sin(el)])
+    if scan["pose"] is not None:
+        p = rotation(scan["pose"][:4]) @ p + np.array(scan["pose"][4:])
+    return p
+
+
+def invalid(scan, values):
+    v = dict(zip(scan["fields"], values))
+    key = "cartesianInvalidState" if "cartesianX" in v else "sphericalInvalidState"
+    return v.get(key, 0) != 0
+
+
+DIMENSIONS = {"returnIndex": ("return_number", 1), "returnCount": ("number_of_returns", 0),
+              "las:pointSourceId": ("point_source_id", 0), "las:classification": ("classification", 0)}
+USED = {"cartesianX", "cartesianY", "cartesianZ", "cartesianInvalidState", "sphericalRange", "sphericalAzimuth",
+        "sphericalElevation", "sphericalInvalidState", "colorRed", "colorGreen", "colorBlue"}
+
+
+def check(name, work):
+    scans = parse_judge(os.path.join(DATA, name + ".libe57format.txt"))
+    out = os.path.join(work, name + ".csv")
+    run = subprocess.run([DPOINT, "convert", os.path.join(DATA, name + ".e57"), "-o", out, "-q"],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        fail(name, f"dpoint convert exit {run.returncode}: {run.stderr.strip()}")
+        return
+    table = pd.read_csv(out, dtype=np.float64, float_precision="round_trip") if os.path.getsize(out) > 0 else pd.DataFrame()
+    total_valid = 0
+    first_row = 0
+    several = sum(1 for s in scans if s["records"] > 0) > 1
+    for number, scan in enumerate(scans, start=1):
+        if scan["records"] == 0:
+            continue
+        for index, (place, values) in sorted(scan["rows"].items()):
+            if invalid(scan, values):
+                continue
+            row = first_row + place
+            got = table.iloc[row]
+            want = expected_position(scan, values)
+            exact = scan["pose"] is None and "cartesianX" in scan["fields"]
+            tolerance = 0.0 if exact else 8 * np.finfo(float).eps * max(1.0, float(np.max(np.abs(want))))
+            for k, axis in enumerate("xyz"):
+                if abs(got[axis] - want[k]) > tolerance:
+                    fail(name, f"scan {number} record {index} (row {row}): {axis} {got[axis]!r}, libE57Format "
+                               f"and the pose give {want[k]!r}")
+            v = dict(zip(scan["fields"], values))
+            if "colorRed" in v:
+                # 0..255 or 0..65535 integers in these files: CSV writes them as they are.
+                for channel, field in zip("rgb", ("colorRed", "colorGreen", "colorBlue")):
+                    if got[channel] != v[field]:
+                        fail(name, f"scan {number} record {index}: {channel} {got[channel]!r}, libE57Format {v[field]!r}")
+            for field in scan["fields"]:
+                if field in USED:
+                    continue
+                column, add = DIMENSIONS.get(field, (field, 0))
+                if column not in table.columns:
+                    fail(name, f"no column {column} for the field {field} (columns: {list(table.columns)})")
+                    return
+                want_value = v[field] + add
+                if abs(got[column] - want_value) > 1e-7 * max(1.0, abs(want_value)):
+                    fail(name, f"scan {number} record {index}: {column} {got[column]!r}, libE57Format {want_value!r}")
+            if several and "las:pointSourceId" not in scan["fields"] and got["point_source_id"] != number:
+                fail(name, f"scan {number} record {index}: point_source_id {got['point_source_id']!r}")
+        last = max(scan["rows"])  # the valid records: those before the last printed one, and it
+        valid = scan["rows"][last][0] + (0 if invalid(scan, scan["rows"][last][1]) else 1)
+        if last != scan["records"] - 1:
+            fail(name, f"scan {number}: the judge's dump ends at record {last} of {scan['records']}")
+        # Sums over every valid point (without a pose: equal to rounding; sums of positions with
+        # a pose or spherical coordinates are not what libE57Format summed).
+        if scan["pose"] is None and "cartesianX" in scan["fields"] and valid == scan["records"]:
+            part = table.iloc[first_row:first_row + valid]
+            for k, axis in enumerate("xyz"):
+                want = scan["sums"][scan["fields"].index("cartesian" + axis.upper())]
+                got_sum = math.fsum(part[axis])
+                if abs(got_sum - want) > 1e-12 * max(1.0, float(np.sum(np.abs(part[axis])))):
+                    fail(name, f"scan {number}: the sum of {axis} is {got_sum!r}, libE57Format's {want!r}")
+        first_row += valid
+        total_valid += valid
+    if len(table) != total_valid:
+        fail(name, f"{len(table)} rows, libE57Format's valid records {total_valid}")
+    print(f"{name}: {total_valid} points, {sum(len(s['rows']) for s in scans)} records compared", file=sys.stderr)
+
+
+with tempfile.TemporaryDirectory() as work:
+    names = sorted(f[:-len(".libe57format.txt")] for f in os.listdir(DATA) if f.endswith(".libe57format.txt"))
+    if len(names) < 6:
+        fail("tests/data/e57", f"only {len(names)} files with libE57Format's verdict")
+    for name in names:
+        check(name, work)
+    bad = subprocess.run([DPOINT, "convert", os.path.join(DATA, "bad-crc.e57"), "-o", os.path.join(work, "bad.csv")],
+                         capture_output=True, text=True)
+    if bad.returncode != 2 or "page 0" not in bad.stderr or "CRC-32C" not in bad.stderr or os.path.exists(
+            os.path.join(work, "bad.csv")):
+        fail("bad-crc", f"exit {bad.returncode}, {bad.stderr.strip()!r} (libE57Format: checksum mismatch, page 0)")
+
+for f in failures:
+    print("FAIL " + f, file=sys.stderr)
+sys.exit(1 if failures else 0)
