@@ -243,7 +243,7 @@ struct Field {
   double scale = 1.0, offset = 0.0;
   double float_minimum = -HUGE_VAL, float_maximum = HUGE_VAL;  // a Float's limits, where given
   unsigned bits = 64;                                           // per value
-  std::vector<uint8_t> bytes;                                   // the packed values, then kStreamPadding zeros
+  DimensionBytes bytes;  // the packed values, then kStreamPadding zeros (unset as sized: every byte is written)
   uint64_t filled = 0;                                          // bytes gathered from packets
 
   uint64_t neededBytes(uint64_t records) const { return (records * bits + 7) / 8; }
@@ -485,7 +485,8 @@ Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Pro
     return Error{where + ": " + std::to_string(scan.records) + " records of its fields need " + std::to_string(needed) +
                  " bytes, but its section holds " + std::to_string(end - data_logical) + " (cut short or damaged)"};
   for (Field& f : scan.fields) {
-    f.bytes.assign(static_cast<size_t>(f.neededBytes(scan.records)) + kStreamPadding, 0);
+    f.bytes.resize(static_cast<size_t>(f.neededBytes(scan.records)) + kStreamPadding);
+    std::fill(f.bytes.end() - kStreamPadding, f.bytes.end(), uint8_t{0});
     f.filled = 0;
   }
   const auto complete = [&] {
@@ -776,7 +777,7 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     if (Status s = gatherFields(*paged, scan, threads, progress); !s) return s.error();
     Result<PointSet> points = pointsOf(*paged, scan, options, left_out);
     if (!points) return points.error();
-    for (Field& f : scan.fields) std::vector<uint8_t>().swap(f.bytes);
+    for (Field& f : scan.fields) DimensionBytes().swap(f.bytes);
     read.push_back({k + 1, std::move(*points)});
   }
   if (progress) progress->finish();
