@@ -385,6 +385,7 @@ struct ScanInfo {
   double rotation[4] = {1.0, 0.0, 0.0, 0.0};  // w x y z
   double translation[3] = {0.0, 0.0, 0.0};
   std::optional<double> color_limits[6];  // red, green, blue minimum and maximum, where given
+  std::optional<double> intensity_limits[2];  // intensityMinimum, intensityMaximum, where given
 };
 
 Result<ScanInfo> scanInfoOf(const pugi::xml_node& scan, size_t index, const std::string& path) {
@@ -438,6 +439,15 @@ Result<ScanInfo> scanInfoOf(const pugi::xml_node& scan, size_t index, const std:
         !std::isfinite(info.translation[1]) || !std::isfinite(info.translation[2]))
       return Error{where + ": pose: a rotation of no length or a value that is not finite"};
     for (double& c : info.rotation) c /= norm;  // a unit quaternion, as E57 says it is, to the last bit
+  }
+  if (const pugi::xml_node limits = scan.child("intensityLimits")) {
+    const char* names[2] = {"intensityMinimum", "intensityMaximum"};
+    for (int k = 0; k < 2; ++k) {
+      if (!limits.child(names[k])) continue;
+      Result<double> v = numberOf(limits, names[k], 0.0, where + ": intensityLimits");
+      if (!v) return v.error();
+      info.intensity_limits[k] = *v;
+    }
   }
   if (const pugi::xml_node limits = scan.child("colorLimits")) {
     const char* names[6] = {"colorRedMinimum", "colorRedMaximum", "colorGreenMinimum",
@@ -548,8 +558,38 @@ struct ColorChannel {
   double lo = 0.0, hi = 1.0;
 };
 
+// The range an intensity is normalised from, to 0..1: the scan's intensityLimits, else the field's
+// own limits. None where its values are LAS's already (integers of 0..65535), where the range is
+// 0..1 (as FARO's float intensities are) or where none is known (a float without limits).
+struct IntensityRange {
+  double lo = 0.0, hi = 1.0;
+  const char* source = "";
+};
+std::optional<IntensityRange> intensityRange(const Field& f, const ScanInfo& scan) {
+  if (f.kind == FieldKind::kInteger && f.minimum >= 0 && f.maximum <= 65535) return std::nullopt;
+  double lo = 0.0, hi = 0.0;
+  const bool limits = scan.intensity_limits[0] && scan.intensity_limits[1];
+  if (limits) {
+    lo = *scan.intensity_limits[0];
+    hi = *scan.intensity_limits[1];
+  } else if (f.kind == FieldKind::kInteger) {
+    lo = static_cast<double>(f.minimum);
+    hi = static_cast<double>(f.maximum);
+  } else if (f.kind == FieldKind::kScaled) {
+    lo = static_cast<double>(f.minimum) * f.scale + f.offset;
+    hi = static_cast<double>(f.maximum) * f.scale + f.offset;
+    if (hi < lo) std::swap(lo, hi);
+  } else {
+    lo = f.float_minimum;
+    hi = f.float_maximum;
+  }
+  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi) || (lo == 0.0 && hi == 1.0)) return std::nullopt;
+  return IntensityRange{lo, hi, limits ? "its intensityLimits" : "the field's limits"};
+}
+
 // The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left out.
-Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57ReadOptions& options, uint64_t& left_out) {
+Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57ReadOptions& options, uint64_t& left_out,
+                          std::vector<std::string>& intensity_ranges) {
   const std::string where = file.path() + ": " + scan.label;
   const unsigned threads = resolveThreads(options.threads);
   const Field* c[3] = {findField(scan, "cartesianX"), findField(scan, "cartesianY"), findField(scan, "cartesianZ")};
@@ -606,10 +646,19 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
   points.z_axis = ZAxis::kPresent;
   points.positions.resize(n);
   if (colors) points.colors.resize(n);
-  for (const Field* f : kept) {
-    const auto [name, type] = dimensionOf(*f);
+  std::vector<std::optional<IntensityRange>> normalised(kept.size());
+  for (size_t d = 0; d < kept.size(); ++d) {
+    const Field* f = kept[d];
+    auto [name, type] = dimensionOf(*f);
     if (points.dimensions.find(name))
       return Error{where + ": the fields " + f->name + " and another are both kept as the dimension " + name};
+    if (name == dim::kIntensity && (normalised[d] = intensityRange(*f, scan))) {
+      type = DimType::kF32;
+      const std::string range = formatNumber(normalised[d]->lo) + ".." + formatNumber(normalised[d]->hi) + " (" +
+                                normalised[d]->source + ")";
+      if (std::find(intensity_ranges.begin(), intensity_ranges.end(), range) == intensity_ranges.end())
+        intensity_ranges.push_back(range);
+    }
     points.dimensions.appendUnset(name, type, n);
   }
 
@@ -654,7 +703,11 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
       const bool return_index = f.name == "returnIndex" && f.kind == FieldKind::kInteger && dim.name == dim::kReturnNumber;
       for (size_t i = begin; i < end; ++i) {
         uint8_t* out = dim.bytes.data() + i * width;
-        if (f.kind == FieldKind::kInteger) {
+        if (normalised[d]) {
+          const IntensityRange& r = *normalised[d];
+          const float a = static_cast<float>((f.value(i) - r.lo) / (r.hi - r.lo));
+          std::memcpy(out, &a, 4);
+        } else if (f.kind == FieldKind::kInteger) {
           const int64_t v = f.integer(i) + (return_index ? 1 : 0);
           switch (dim.type) {  // the type holds the field's limits (integerType)
             case DimType::kU8: *out = static_cast<uint8_t>(v); break;
@@ -735,7 +788,8 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   const pugi::xml_parse_result parsed = doc.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
   if (!parsed) {
     const auto offset = static_cast<size_t>(std::max<ptrdiff_t>(0, parsed.offset));
-    const size_t line = 1 + static_cast<size_t>(std::count(xml.begin(), xml.begin() + std::min(offset, xml.size()), '\n'));
+    const std::string_view before(xml.data(), std::min(offset, xml.size()));
+    const size_t line = 1 + static_cast<size_t>(std::count(before.begin(), before.end(), '\n'));
     return Error{path + ": its XML, line " + std::to_string(line) + ": " + parsed.description()};
   }
   const pugi::xml_node root = doc.child("e57Root");
@@ -771,11 +825,12 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   if (progress) progress->start("reading " + path, bytes_to_read);
   std::vector<NumberedScan> read;
   uint64_t left_out = 0;
+  std::vector<std::string> intensity_ranges;  // those normalised to 0..1, each once
   for (size_t k = 0; k < scans.size(); ++k) {
     ScanInfo& scan = scans[k];
     if (scan.records == 0) continue;
     if (Status s = gatherFields(*paged, scan, threads, progress); !s) return s.error();
-    Result<PointSet> points = pointsOf(*paged, scan, options, left_out);
+    Result<PointSet> points = pointsOf(*paged, scan, options, left_out, intensity_ranges);
     if (!points) return points.error();
     for (Field& f : scan.fields) DimensionBytes().swap(f.bytes);
     read.push_back({k + 1, std::move(*points)});
@@ -785,6 +840,8 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     if (left_out > 0)
       options.notices->push_back(path + ": " + std::to_string(left_out) + " of its " + std::to_string(total) +
                                  " points are marked invalid (no point, or a direction alone): left out");
+    for (const std::string& range : intensity_ranges)
+      options.notices->push_back(path + ": intensity of " + range + " read as 0..1 values, as LAS normalises it");
     if (images > 0) options.notices->push_back(path + ": its " + countOf(images, "image") + " (images2D) are not read");
   }
   if (read.empty()) {

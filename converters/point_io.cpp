@@ -334,7 +334,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       if (options.notices) {
         if (!report.crs.empty()) options.notices->push_back(path + ": " + report.crs);
         if (report.intensity_scaled)
-          options.notices->push_back(path + ": intensity of 0..1 values (as PTX holds it) written as 0..65535, "
+          options.notices->push_back(path + ": intensity of 0..1 values (as PTX and E57 scans hold it) written as 0..65535, "
                                             "LAS's 16-bit intensity normalised to that range");
         for (const std::string& line : report.renamed)
           options.notices->push_back(path + ": " + line + " (a LAS extra bytes name is up to 32 letters, digits or '_')");

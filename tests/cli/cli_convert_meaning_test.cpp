@@ -528,7 +528,7 @@ TEST(CliConvertMeaning, aPtxScanConvertsToLasWithItsIntensityAsSixteenBits) {
   const test::CommandResult r = runDpoint({"convert", dir.file("scan.ptx"), "-o", dir.file("scan.las")});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(test::contains(r.err, dir.file("scan.ptx") + ": 1 of its 4 rows are points with no echo")) << r.err;
-  EXPECT_TRUE(test::contains(r.err, dir.file("scan.las") + ": intensity of 0..1 values (as PTX holds it) written as 0..65535"))
+  EXPECT_TRUE(test::contains(r.err, dir.file("scan.las") + ": intensity of 0..1 values (as PTX and E57 scans hold it) written as 0..65535"))
       << r.err;
   Result<PointSet> las = readLas(dir.file("scan.las"));
   ASSERT_TRUE(las.ok()) << las.error().message;

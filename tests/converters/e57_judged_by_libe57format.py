@@ -12,7 +12,8 @@ NAME.csv` must give, with numpy computing what the E57 standard says from libE57
   pose and no spherical coordinates, else within a few units in the last place of the extent;
 - colours: the integers as the file has them (0..255 or 0..65535: CSV writes them at that scale);
 - the other fields as dimensions of their values (returnIndex + 1 as return_number, returnCount as
-  number_of_returns, las:pointSourceId as point_source_id, las:classification as classification),
+  number_of_returns, las:pointSourceId as point_source_id, las:classification as classification;
+  an intensity that is no 0..65535 integer, from its field's limits to 0..1),
   and with several scans each point's scan number in point_source_id;
 - the sums of the valid points' coordinates, to 1e-12 of their size (every row, not the samples).
 bad-crc.e57 must be refused, as libE57Format refuses it, naming the damaged page.
@@ -43,7 +44,10 @@ def parse_judge(path):
             if words[0] == "scan":
                 scans.append({"records": int(words[3]), "fields": words[5:], "rows": {}, "pose": None, "limits": {}})
             elif words[0] == "field" and words[2] == "Integer":
-                scans[-1]["limits"][words[1]] = (int(words[3]), int(words[4]))
+                scans[-1]["limits"][words[1]] = ("Integer", int(words[3]), int(words[4]))
+            elif words[0] == "field" and words[2] == "ScaledInteger":
+                ends = [int(words[3]) * float(words[5]) + float(words[6]), int(words[4]) * float(words[5]) + float(words[6])]
+                scans[-1]["limits"][words[1]] = ("ScaledInteger", min(ends), max(ends))
             elif words[0] == "pose":
                 scans[-1]["pose"] = None if words[1] == "none" else [float(w) for w in words[1:]]
             elif words[0] == "r":  # the record, its place among the scan's valid ones, its values
@@ -126,6 +130,9 @@ def check(name, work):
                     fail(name, f"no column {column} for the field {field} (columns: {list(table.columns)})")
                     return
                 want_value = v[field] + add
+                kind, lo, hi = scan["limits"].get(field, ("Float", 0, 1))
+                if field == "intensity" and not (kind == "Integer" and lo >= 0 and hi <= 65535) and (lo, hi) != (0, 1):
+                    want_value = (v[field] - lo) / (hi - lo)  # read as 0..1 (float32) from the field's limits
                 if abs(got[column] - want_value) > 1e-7 * max(1.0, abs(want_value)):
                     fail(name, f"scan {number} record {index}: {column} {got[column]!r}, libE57Format {want_value!r}")
             if several and "las:pointSourceId" not in scan["fields"] and got["point_source_id"] != number:

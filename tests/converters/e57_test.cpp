@@ -259,6 +259,41 @@ TEST(E57, coloursOfOtherLimitsAreNormalisedAndImagesAreSaid) {
   EXPECT_NE(notices[0].find("1 image (images2D)"), std::string::npos) << notices[0];
 }
 
+// Leica's signed intensities are read as 0..1 from the scan's intensityLimits (LAS then writes them
+// as 16 bits); integers of 0..65535 stay as they are.
+TEST(E57, anIntensityOfOtherLimitsIsReadAsFractions) {
+  TempDir dir;
+  const std::vector<float> x{1, 2, 3}, y{0, 0, 0}, z{0, 0, 0};
+  const std::vector<int64_t> signed_intensity{-2048, 0, 2047}, whole{0, 100, 2047};
+  E57File file;
+  const std::string xyz = "<cartesianX type=\"Float\" precision=\"single\"/><cartesianY type=\"Float\" "
+                          "precision=\"single\"/><cartesianZ type=\"Float\" precision=\"single\"/>";
+  const uint64_t a = file.compressedVector({packRaw(x), packRaw(y), packRaw(z), packBits(signed_intensity, -2048, 12)}, 1000);
+  const uint64_t b = file.compressedVector({packRaw(x), packRaw(y), packRaw(z), packBits(whole, 0, 11)}, 1000);
+  const std::string limits =
+      "<intensityLimits type=\"Structure\"><intensityMinimum type=\"Integer\">-2048</intensityMinimum>"
+      "<intensityMaximum type=\"Integer\">2047</intensityMaximum></intensityLimits>";
+  const std::string xml =
+      rootXml(scanXml(a, 3, xyz + "<intensity type=\"Integer\" minimum=\"-2048\" maximum=\"2047\"/>", limits) +
+              scanXml(b, 3, xyz + "<intensity type=\"Integer\" minimum=\"0\" maximum=\"2047\"/>"));
+  std::vector<std::string> notices;
+  E57ReadOptions options;
+  options.notices = &notices;
+  Result<PointSet> points = readBytes(dir, file.bytes(xml), options);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  const Dimension* intensity = points->dimensions.find("intensity");
+  ASSERT_NE(intensity, nullptr);
+  EXPECT_EQ(intensity->type, DimType::kF32);  // the scans' types joined: float32 holds both
+  EXPECT_EQ(intensity->value(0), 0.0);
+  EXPECT_EQ(intensity->value(1), static_cast<double>(static_cast<float>(2048.0 / 4095.0)));
+  EXPECT_EQ(intensity->value(2), 1.0);
+  EXPECT_EQ(intensity->value(4), 100.0);  // the second scan's 0..2047 integers as they are
+  EXPECT_EQ(points->dimensions.find("point_source_id")->value(5), 2.0);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find("intensity of -2048..2047 (its intensityLimits) read as 0..1 values"), std::string::npos)
+      << notices[0];
+}
+
 TEST(E57, aDamagedPageIsNamedAndAFileCutShortIsSaid) {
   TempDir dir;
   const size_t n = 600;

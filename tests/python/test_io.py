@@ -380,3 +380,26 @@ def test_64_bit_integers_past_2_53_through_ply_are_warned_of(tmp_path):
     assert len(caught) == 1 and "'id' (uint64) written as double" in str(caught[0].message)
     assert "(the first: point 0)" in str(caught[0].message)
     assert dpoint.read(tmp_path / "id.pcd").attributes["id"][0] == 2**53 + 1
+
+
+def test_read_e57_as_convert_does(tmp_path):
+    """An E57 file's scans: positions moved by the pose, invalid points left out with a warning,
+    each scan's number in point_source_id, the other fields as attributes; .e57 is not written."""
+    import os
+    import warnings
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "e57", "two_scans.e57")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        s = dpoint.read(path)
+    assert any("31 of its 5500 points are marked invalid" in str(w.message) for w in caught)
+    assert len(s) == 5469
+    a = s.attributes
+    assert sorted(a) == ["columnIndex", "intensity", "point_source_id", "rowIndex", "timeStamp"]
+    assert (a["point_source_id"][:2969] == 1).all() and (a["point_source_id"][2969:] == 2).all()
+    assert a["timeStamp"].dtype == np.float64 and a["rowIndex"].dtype == np.uint8
+    # The second scan has no pose: its doubles as libE57Format read them.
+    assert s.positions[2969].tolist() == [512439.73010199214, 5412365.7377148662, 200.86567118869814]
+    cli("convert", path, "-o", tmp_path / "c.ply")
+    assert np.array_equal(dpoint.read(tmp_path / "c.ply").positions, s.positions)
+    with pytest.raises(dpoint.Error, match=r"a\.e57: \.e57 is read, not written"):
+        dpoint.write(s, tmp_path / "a.e57")
