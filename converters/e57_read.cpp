@@ -125,7 +125,7 @@ class PagedFile {
     if (length < paged.page_) return Error{path + ": cut short within its first page"};
     if (Status s = paged.read(0, first.data(), first.size(), 1, nullptr); !s) return s.error();
     if (paged.xml_length_ == 0) return Error{path + ": its XML section is empty"};
-    if (paged.xml_offset_ >= length || paged.logicalOf(paged.xml_offset_) + paged.xml_length_ > paged.logicalLength())
+    if (paged.xml_offset_ >= length || paged.xml_length_ > paged.logicalLength() - paged.logicalOf(paged.xml_offset_))
       return Error{path + ": its XML section (at byte " + std::to_string(paged.xml_offset_) + ", " +
                    std::to_string(paged.xml_length_) + " bytes) lies past the end of the file"};
     return paged;
