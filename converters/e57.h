@@ -1,4 +1,4 @@
-// ASTM E57 (E2807), the exchange format of terrestrial laser scanners: read, not written.
+// ASTM E57 (E2807), the exchange format of terrestrial laser scanners: read and written.
 //
 // The file is pages of 1020 bytes and a CRC-32C each (every page read is checked); a 48-byte
 // header places an XML tree that names what the file holds. Each scan (a child of `data3D`) has a
@@ -43,8 +43,24 @@ struct E57ReadOptions {
   std::vector<std::string>* notices = nullptr;  // points left out, images not read
 };
 
+struct E57WriteOptions {
+  unsigned threads = 0;  // 0: all cores; the bytes do not depend on it
+  Progress* progress = nullptr;
+  std::vector<std::string>* notices = nullptr;  // dimensions renamed, triangles not written
+};
+
 Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options = {});
 Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options = {});
+
+// One scan (data3D) with no pose: x, y and z as doubles (every coordinate as it is), colours as
+// integers of their scale (0..255, or 0..65535 for 16-bit colours), each dimension a field:
+// integers as Integer of their values' own limits (packed in as few bits as those need), floats as
+// Float single or double; intensity as `intensity`, return_number - 1 as `returnIndex`,
+// number_of_returns as `returnCount`, nx/ny/nz as the normals extension's `nor:normalX/Y/Z`
+// (CloudCompare's), the other LAS fields as the LAS extension's (`las:classification`, …), other
+// names as XML names (renamed with a note). Triangles are not written. The same set makes the same
+// bytes (the GUIDs are made from what is written).
+Status writeE57(const std::string& path, const PointSet& points, const E57WriteOptions& options = {});
 
 // CRC-32C (Castagnoli) of `size` bytes, as E57 checks each page (stored big-endian after it).
 uint32_t crc32c(const uint8_t* data, size_t size);

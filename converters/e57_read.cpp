@@ -355,7 +355,9 @@ std::pair<std::string, DimType> dimensionOf(const Field& f) {
   std::string name = f.name;
   if (name == "returnIndex" && f.kind == FieldKind::kInteger) name = dim::kReturnNumber;  // 0-based in E57, 1-based in LAS
   if (name == "returnCount" && f.kind == FieldKind::kInteger) name = dim::kNumberOfReturns;
-  if (name.rfind("las:", 0) == 0) {  // the LAS extension's camelCase names as LAS's (pointSourceId → point_source_id)
+  if (name == "nor:normalX" || name == "nor:normalY" || name == "nor:normalZ") {  // the normals extension's (CloudCompare's)
+    name = std::string(1, 'n') + static_cast<char>('x' + (name.back() - 'X'));
+  } else if (name.rfind("las:", 0) == 0) {  // the LAS extension's camelCase names as LAS's (pointSourceId → point_source_id)
     std::string snake;
     for (char c : name.substr(4)) {
       if (c >= 'A' && c <= 'Z') {
@@ -522,10 +524,15 @@ Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Pro
         continue;
       }
       if (packet[0] != 1) return Error{packet_at + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
+      if (packet_length < 6)
+        return Error{packet_at + " is a data packet of " + std::to_string(packet_length) + " bytes, shorter than its 6-byte header"};
       const uint64_t count = loadLe<uint16_t>(packet + 4);
       if (count != streams)
         return Error{packet_at + " has " + countOf(count, "bytestream") + " for a prototype of " + countOf(streams, "field")};
       uint64_t offset = 6 + 2 * count;
+      if (offset > packet_length)
+        return Error{packet_at + ": its " + countOf(count, "buffer length") + " overrun the packet (" +
+                     std::to_string(packet_length) + " bytes)"};
       for (size_t k = 0; k < streams; ++k) {
         const uint64_t n = loadLe<uint16_t>(packet + 6 + 2 * k);
         if (offset + n > packet_length)
@@ -559,14 +566,19 @@ struct ColorChannel {
 };
 
 // The range an intensity is normalised from, to 0..1: the scan's intensityLimits, else the field's
-// own limits. None where its values are LAS's already (integers of 0..65535), where the range is
-// 0..1 (as FARO's float intensities are) or where none is known (a float without limits).
+// own limits. None where its values are LAS's already (integers of 0..65535, unless `fractions`),
+// where the range is 0..1 (as FARO's float intensities are) or where none is known (a float
+// without limits).
 struct IntensityRange {
   double lo = 0.0, hi = 1.0;
   const char* source = "";
 };
-std::optional<IntensityRange> intensityRange(const Field& f, const ScanInfo& scan) {
-  if (f.kind == FieldKind::kInteger && f.minimum >= 0 && f.maximum <= 65535) return std::nullopt;
+bool isLasIntensity(const Field& f) { return f.kind == FieldKind::kInteger && f.minimum >= 0 && f.maximum <= 65535; }
+
+// `fractions`: some scan of the file has an intensity that is no 0..65535 integer, so that every
+// scan's is read as 0..1 (one column of one meaning; integers beside fractions go nowhere).
+std::optional<IntensityRange> intensityRange(const Field& f, const ScanInfo& scan, bool fractions) {
+  if (isLasIntensity(f) && !fractions) return std::nullopt;
   double lo = 0.0, hi = 0.0;
   const bool limits = scan.intensity_limits[0] && scan.intensity_limits[1];
   if (limits) {
@@ -588,8 +600,8 @@ std::optional<IntensityRange> intensityRange(const Field& f, const ScanInfo& sca
 }
 
 // The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left out.
-Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57ReadOptions& options, uint64_t& left_out,
-                          std::vector<std::string>& intensity_ranges) {
+Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57ReadOptions& options, bool intensity_fractions,
+                          uint64_t& left_out, std::vector<std::string>& intensity_ranges) {
   const std::string where = file.path() + ": " + scan.label;
   const unsigned threads = resolveThreads(options.threads);
   const Field* c[3] = {findField(scan, "cartesianX"), findField(scan, "cartesianY"), findField(scan, "cartesianZ")};
@@ -652,7 +664,7 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
     auto [name, type] = dimensionOf(*f);
     if (points.dimensions.find(name))
       return Error{where + ": the fields " + f->name + " and another are both kept as the dimension " + name};
-    if (name == dim::kIntensity && (normalised[d] = intensityRange(*f, scan))) {
+    if (name == dim::kIntensity && (normalised[d] = intensityRange(*f, scan, intensity_fractions))) {
       type = DimType::kF32;
       const std::string range = formatNumber(normalised[d]->lo) + ".." + formatNumber(normalised[d]->hi) + " (" +
                                 normalised[d]->source + ")";
@@ -813,24 +825,37 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
       return Error{path + ": " + scan.label + " declares " + std::to_string(scan.records) + " points, more than memory holds",
                    ExitCode::kResourceLimit};
     total += scan.records;
-    held += scan.records * bytesPerRecord(scan);
+    const uint64_t bytes = scan.records * bytesPerRecord(scan);  // at most 2^63 (above)
+    held = held > UINT64_MAX - bytes ? UINT64_MAX : held + bytes;  // many scans of 2^56 records of no bits
     for (const Field& f : scan.fields) bytes_to_read += f.neededBytes(scan.records);
   }
   if (Status s = checkMemory(path + ": " + std::to_string(total) + " points in " + countOf(scans.size(), "scan"), held, limit); !s)
     return s.error();
-  if (scans.size() > 65535 && std::count_if(scans.begin(), scans.end(), [](const ScanInfo& s) { return s.records > 0; }) > 1)
-    return Error{path + ": " + std::to_string(scans.size()) + " scans, more than a point source id (1 to 65535) tells apart"};
+  // Scan numbers go to point_source_id where two or more scans hold points: the last such must fit.
+  size_t with_points = 0, last_with_points = 0;
+  for (size_t k = 0; k < scans.size(); ++k)
+    if (scans[k].records > 0) {
+      ++with_points;
+      last_with_points = k + 1;
+    }
+  if (with_points > 1 && last_with_points > 65535)
+    return Error{path + ": " + scans[last_with_points - 1].label +
+                 " holds points, and its number is past what a point source id (1 to 65535) holds"};
 
   Progress* progress = options.progress;
   if (progress) progress->start("reading " + path, bytes_to_read);
   std::vector<NumberedScan> read;
   uint64_t left_out = 0;
   std::vector<std::string> intensity_ranges;  // those normalised to 0..1, each once
+  const bool intensity_fractions = std::any_of(scans.begin(), scans.end(), [](const ScanInfo& scan) {
+    const Field* f = findField(scan, "intensity");
+    return scan.records > 0 && f && !isLasIntensity(*f);
+  });
   for (size_t k = 0; k < scans.size(); ++k) {
     ScanInfo& scan = scans[k];
     if (scan.records == 0) continue;
     if (Status s = gatherFields(*paged, scan, threads, progress); !s) return s.error();
-    Result<PointSet> points = pointsOf(*paged, scan, options, left_out, intensity_ranges);
+    Result<PointSet> points = pointsOf(*paged, scan, options, intensity_fractions, left_out, intensity_ranges);
     if (!points) return points.error();
     for (Field& f : scan.fields) DimensionBytes().swap(f.bytes);
     read.push_back({k + 1, std::move(*points)});
@@ -842,7 +867,12 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
                                  " points are marked invalid (no point, or a direction alone): left out");
     for (const std::string& range : intensity_ranges)
       options.notices->push_back(path + ": intensity of " + range + " read as 0..1 values, as LAS normalises it");
-    if (images > 0) options.notices->push_back(path + ": its " + countOf(images, "image") + " (images2D) are not read");
+    if (images > 0)
+      options.notices->push_back(path + ": its " + countOf(images, "image") + " (images2D) " + (images == 1 ? "is" : "are") +
+                                 " not read");
+    if (read.empty())
+      options.notices->push_back(path + ": " + (scans.empty() ? std::string("no scan (data3D is empty)")
+                                                               : "its " + countOf(scans.size(), "scan") + (scans.size() == 1 ? " holds" : " hold") + " no points"));
   }
   if (read.empty()) {
     PointSet none;
@@ -850,9 +880,34 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     return none;
   }
   if (read.size() == 1) return std::move(read.front().points);
-  // The file's own point source ids (an E57 written from LAS) are kept as they are.
-  for (NumberedScan& scan : read)
-    if (scan.points.dimensions.find(dim::kPointSourceId)) scan.number = 0;
+  // The file's own point source ids (an E57 written from LAS) are kept as they are, 0 for the scans
+  // without (scan numbers there could be ids of the others).
+  const bool own_ids = std::any_of(read.begin(), read.end(), [](const NumberedScan& scan) {
+    return scan.points.dimensions.find(dim::kPointSourceId) != nullptr;
+  });
+  if (options.notices) {  // what the join fills in
+    const auto lacking = [&](const auto& has) {
+      std::string numbers;
+      size_t count = 0;
+      for (const NumberedScan& scan : read)
+        if (!has(scan.points)) {
+          numbers += (count++ == 0 ? "" : ", ") + std::to_string(scan.number);
+        }
+      return count == read.size() ? std::string() : numbers;
+    };
+    if (const std::string none = lacking([](const PointSet& p) { return p.hasColors(); }); !none.empty())
+      options.notices->push_back(path + ": data3D " + none + " without colours beside scans with: their points are white");
+    std::vector<std::string> names;
+    for (const NumberedScan& scan : read)
+      for (const Dimension& d : scan.points.dimensions.all())
+        if (std::find(names.begin(), names.end(), d.name) == names.end()) names.push_back(d.name);
+    for (const std::string& name : names)
+      if (const std::string none = lacking([&](const PointSet& p) { return p.dimensions.find(name) != nullptr; });
+          !none.empty())
+        options.notices->push_back(path + ": data3D " + none + " without " + name + " beside scans with: 0 there");
+  }
+  if (own_ids)
+    for (NumberedScan& scan : read) scan.number = 0;
   return joinScans(std::move(read));
 }
 

@@ -328,7 +328,7 @@ void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t 
     for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
       for (int k = 0; k < 3; ++k) {
         const float c = colors[i][k];
-        if (!(c >= 0.0f && c <= full && c == std::floor(c)) && odd[b].first == SIZE_MAX) odd[b] = {i, colors[i]};
+        if (!isWholeChannel(c, full) && odd[b].first == SIZE_MAX) odd[b] = {i, colors[i]};
       }
       colors[i] *= scale;  // as takeColorsAsIntegers divides a whole read's
     }
@@ -340,7 +340,7 @@ void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t 
   const glm::vec3 c = first_odd->second;
   // A whole value past 255 makes the whole read take 0..65535 values; anything else, 0..1 ones.
   bool words = true;
-  for (int k = 0; k < 3; ++k) words = words && c[k] >= 0.0f && c[k] <= 65535.0f && c[k] == std::floor(c[k]);
+  for (int k = 0; k < 3; ++k) words = words && isWholeChannel(c[k], 65535.0f);
   notices_.push_back(part.path + ": vertex " + std::to_string(first + at) + "'s colour (" + formatNumber(c.r) + ", " +
                      formatNumber(c.g) + ", " + formatNumber(c.b) + ") is not a whole number of 0 to " +
                      std::to_string(part.color_scale) + " a channel, though the first " + std::to_string(part.sampled) +

@@ -123,8 +123,6 @@ Status checkWrittenFormat(const std::string& path, FileFormat format) {
     return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .pcd, .las)", ExitCode::kUsage};
   if (isPtxPath(path))
     return Error{path + ": .ptx is read, not written; write .pts or .las (or .csv, .ply, .pcd, .glb)", ExitCode::kUsage};
-  if (format == FileFormat::kE57)
-    return Error{path + ": .e57 is read, not written; write .las or .laz (or .csv, .ply, .pcd, .glb)", ExitCode::kUsage};
   return okStatus();
 }
 
@@ -262,6 +260,7 @@ double writtenColorScale(const std::string& path, FileFormat format, const Point
                  : 255.0;
     case FileFormat::kPcd: return 255.0;
     case FileFormat::kCsv: return isPtsPath(path) ? 255.0 : 0.0;
+    case FileFormat::kE57: return points.color_full_scale == 65535 ? 65535.0 : 255.0;
     case FileFormat::kLas:
     case FileFormat::kLaz: return points.color_full_scale == 255 && points.las ? 255.0 : 65535.0;
     default: return 0.0;
@@ -301,8 +300,9 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       return okStatus();
     }
     case FileFormat::kGltf:
-    case FileFormat::kE57:
       return checkWrittenFormat(path, format);
+    case FileFormat::kE57:
+      return writeE57(path, points, E57WriteOptions{options.threads, options.progress, options.notices});
     case FileFormat::kLas:
     case FileFormat::kLaz: {
       LasWriteReport report;
@@ -398,6 +398,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     const std::string keeps = *format == FileFormat::kPly ? "ply_colors or --ply-colors float keeps them"
                               : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with float colours, .csv or .glb keeps them"
                               : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
+                              : *format == FileFormat::kE57 ? "E57's colours are integers; .ply with float colours, .csv or .glb keeps them"
                                                             : "LAS holds 0..65535; .ply with float colours, .csv or .glb keeps them";
     const std::string of = " of " + std::to_string(points.size()) + " points have colours read as fractions ";
     if (off.rounded != 0)

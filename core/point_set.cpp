@@ -66,7 +66,7 @@ WholeColorScale wholeColorScale(const ColorArray& colors, unsigned threads) {
       bool integers = true;
       for (int k = 0; k < 3; ++k) {
         const float c = colors[i][k];
-        const bool whole = c >= 0.0f && c <= 65535.0f && c == std::floor(c);  // NaN fails
+        const bool whole = isWholeChannel(c, 65535.0f);
         integers = integers && whole;
         if (whole) most = std::max(most, c);
       }

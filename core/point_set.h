@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -107,6 +108,10 @@ inline uint16_t colorInteger(float c, double full) {
   if (!(c > 0.0f)) return 0;
   return static_cast<uint16_t>((c < 1.0f ? static_cast<double>(c) : 1.0) * full + 0.5);
 }
+
+// Whether colour channel `c` is a whole number from 0 to `full` (NaN is not): a float colour read
+// as an integer of that scale.
+inline bool isWholeChannel(float c, float full) { return c >= 0.0f && c <= full && c == std::floor(c); }
 
 // The colours a writer of integers of `full` (255, 65535) changes (colorInteger): `clamped`, those
 // with a channel outside 0..1 or NaN; `rounded`, the others with a channel between two steps. Both

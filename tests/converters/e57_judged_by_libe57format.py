@@ -13,10 +13,17 @@ NAME.csv` must give, with numpy computing what the E57 standard says from libE57
 - colours: the integers as the file has them (0..255 or 0..65535: CSV writes them at that scale);
 - the other fields as dimensions of their values (returnIndex + 1 as return_number, returnCount as
   number_of_returns, las:pointSourceId as point_source_id, las:classification as classification;
-  an intensity that is no 0..65535 integer, from its field's limits to 0..1),
+  an intensity that is no 0..65535 integer, and where one scan has such every scan's, from its
+  field's limits to 0..1),
   and with several scans each point's scan number in point_source_id;
 - the sums of the valid points' coordinates, to 1e-12 of their size (every row, not the samples).
 bad-crc.e57 must be refused, as libE57Format refuses it, naming the damaged page.
+
+Written: for each written/NAME.e57 (dpoint's E57 of tests/data/NAME's source, WRITTEN below, which
+libE57Format read into written/NAME.libe57format.txt), `dpoint convert SOURCE -o X.e57` must make
+those bytes again, and libE57Format's reading must be dpoint's reading of the source: positions
+equal, colours the same integers, each dimension its field (return_number - 1 as returnIndex,
+number_of_returns as returnCount, the other LAS fields as las:camelCase).
 """
 import math
 import os
@@ -89,6 +96,11 @@ USED = {"cartesianX", "cartesianY", "cartesianZ", "cartesianInvalidState", "sphe
         "sphericalElevation", "sphericalInvalidState", "colorRed", "colorGreen", "colorBlue"}
 
 
+def las_intensity(scan):
+    kind, lo, hi = scan["limits"].get("intensity", ("Float", 0, 1))
+    return kind == "Integer" and lo >= 0 and hi <= 65535
+
+
 def check(name, work):
     scans = parse_judge(os.path.join(DATA, name + ".libe57format.txt"))
     out = os.path.join(work, name + ".csv")
@@ -100,6 +112,8 @@ def check(name, work):
     table = pd.read_csv(out, dtype=np.float64, float_precision="round_trip") if os.path.getsize(out) > 0 else pd.DataFrame()
     total_valid = 0
     first_row = 0
+    # An intensity that is no 0..65535 integer in one scan makes every scan's 0..1.
+    fractions = any(s["records"] > 0 and "intensity" in s["fields"] and not las_intensity(s) for s in scans)
     several = sum(1 for s in scans if s["records"] > 0) > 1
     for number, scan in enumerate(scans, start=1):
         if scan["records"] == 0:
@@ -130,8 +144,8 @@ def check(name, work):
                     fail(name, f"no column {column} for the field {field} (columns: {list(table.columns)})")
                     return
                 want_value = v[field] + add
-                kind, lo, hi = scan["limits"].get(field, ("Float", 0, 1))
-                if field == "intensity" and not (kind == "Integer" and lo >= 0 and hi <= 65535) and (lo, hi) != (0, 1):
+                kind, lo, hi = scan["limits"].get(field, ("Float", 0, 1))  # these files' float intensities are 0..1
+                if field == "intensity" and (fractions or not las_intensity(scan)) and (lo, hi) != (0, 1):
                     want_value = (v[field] - lo) / (hi - lo)  # read as 0..1 (float32) from the field's limits
                 if abs(got[column] - want_value) > 1e-7 * max(1.0, abs(want_value)):
                     fail(name, f"scan {number} record {index}: {column} {got[column]!r}, libE57Format {want_value!r}")
@@ -157,7 +171,55 @@ def check(name, work):
     print(f"{name}: {total_valid} points, {sum(len(s['rows']) for s in scans)} records compared", file=sys.stderr)
 
 
+WRITTEN = {"1.2-with-color": os.path.join(DATA, "..", "laz", "1.2-with-color.las")}
+
+
+def camel(snake):
+    head, *rest = snake.split("_")
+    return head + "".join(w[:1].upper() + w[1:] for w in rest)
+
+
+def check_written(name, source, work):
+    out = os.path.join(work, name + ".e57")
+    run = subprocess.run([DPOINT, "convert", source, "-o", out, "-q"], capture_output=True, text=True)
+    if run.returncode != 0:
+        fail("written/" + name, f"dpoint convert exit {run.returncode}: {run.stderr.strip()}")
+        return
+    golden = os.path.join(DATA, "written", name + ".e57")
+    with open(out, "rb") as a, open(golden, "rb") as b:
+        if a.read() != b.read():
+            fail("written/" + name, "dpoint's E57 is not the bytes libE57Format read (tests/data/e57/written)")
+    csv = os.path.join(work, name + ".csv")
+    # 17 fixed decimals: every coordinate's double (a LAS source's CSV has its step's digits alone).
+    subprocess.run([DPOINT, "convert", source, "-o", csv, "-q", "--decimals", "17"], check=True)
+    table = pd.read_csv(csv, dtype=np.float64, float_precision="round_trip")
+    (scan,) = parse_judge(os.path.join(DATA, "written", name + ".libe57format.txt"))
+    if scan["records"] != len(table) or scan["pose"] is not None:
+        fail("written/" + name, f"{scan['records']} records (pose {scan['pose']}), the source has {len(table)} points")
+        return
+    column_of = {"cartesianX": "x", "cartesianY": "y", "cartesianZ": "z", "colorRed": "r", "colorGreen": "g",
+                 "colorBlue": "b", "intensity": "intensity", "returnIndex": "return_number",
+                 "returnCount": "number_of_returns"}
+    for column in table.columns:
+        if column not in column_of.values():
+            column_of["las:" + camel(column)] = column
+    if sorted(column_of[f] for f in scan["fields"]) != sorted(table.columns):
+        fail("written/" + name, f"fields {scan['fields']} for the columns {list(table.columns)}")
+        return
+    fractions = "r" in table.columns and table[["r", "g", "b"]].to_numpy().max() <= 1.0
+    for index, (_, values) in scan["rows"].items():
+        for field, value in zip(scan["fields"], values):
+            want = table.iloc[index][column_of[field]] - (1 if field == "returnIndex" else 0)
+            if field.startswith("color") and fractions:  # the CSV's 0..1 as the integers of the colour's scale
+                want = round(want * scan["limits"][field][2])
+            if value != want:
+                fail("written/" + name, f"record {index}: {field} {value!r}, the source's {column_of[field]} {want!r}")
+    print(f"written/{name}: {len(table)} points, {len(scan['rows'])} records compared", file=sys.stderr)
+
+
 with tempfile.TemporaryDirectory() as work:
+    for name, source in WRITTEN.items():
+        check_written(name, source, work)
     names = sorted(f[:-len(".libe57format.txt")] for f in os.listdir(DATA) if f.endswith(".libe57format.txt"))
     if len(names) < 6:
         fail("tests/data/e57", f"only {len(names)} files with libE57Format's verdict")

@@ -59,6 +59,18 @@ class E57File {
   // A compressed vector section of `streams` (one per prototype field, in order), each cut into
   // chunks of at most `chunk` bytes a packet; `extra_packets` puts an index packet and an empty
   // packet between the first two data packets. Returns its physical offset (the XML's fileOffset).
+  // A compressed vector section of these packets' bytes as they are.
+  uint64_t rawSection(const std::string& packets) {
+    align(4);
+    const uint64_t start = logical_.size();
+    logical_.append(32, '\0');
+    logical_[start] = 1;
+    logical_ += packets;
+    put<uint64_t>(logical_, start + 8, logical_.size() - start);
+    put<uint64_t>(logical_, start + 16, physicalOf(start + 32));
+    return physicalOf(start);
+  }
+
   uint64_t compressedVector(const std::vector<std::string>& streams, size_t chunk, bool extra_packets = false) {
     align(4);
     const uint64_t start = logical_.size();
@@ -287,11 +299,65 @@ TEST(E57, anIntensityOfOtherLimitsIsReadAsFractions) {
   EXPECT_EQ(intensity->value(0), 0.0);
   EXPECT_EQ(intensity->value(1), static_cast<double>(static_cast<float>(2048.0 / 4095.0)));
   EXPECT_EQ(intensity->value(2), 1.0);
-  EXPECT_EQ(intensity->value(4), 100.0);  // the second scan's 0..2047 integers as they are
+  // The second scan's 0..2047 integers too, from their field's limits: one column of one meaning.
+  EXPECT_EQ(intensity->value(4), static_cast<double>(static_cast<float>(100.0 / 2047.0)));
   EXPECT_EQ(points->dimensions.find("point_source_id")->value(5), 2.0);
-  ASSERT_EQ(notices.size(), 1u);
+  ASSERT_EQ(notices.size(), 2u);
   EXPECT_NE(notices[0].find("intensity of -2048..2047 (its intensityLimits) read as 0..1 values"), std::string::npos)
       << notices[0];
+  EXPECT_NE(notices[1].find("intensity of 0..2047 (the field's limits) read as 0..1 values"), std::string::npos)
+      << notices[1];
+
+  // A file of 0..2047 integers alone keeps them (LAS holds them as they are).
+  E57File whole_file;
+  const uint64_t c = whole_file.compressedVector({packRaw(x), packRaw(y), packRaw(z), packBits(whole, 0, 11)}, 1000);
+  Result<PointSet> kept = readBytes(
+      dir, whole_file.bytes(rootXml(scanXml(c, 3, xyz + "<intensity type=\"Integer\" minimum=\"0\" maximum=\"2047\"/>"))));
+  ASSERT_TRUE(kept.ok());
+  EXPECT_EQ(kept->dimensions.find("intensity")->type, DimType::kU16);
+  EXPECT_EQ(kept->dimensions.find("intensity")->value(1), 100.0);
+}
+
+TEST(E57, theJoinSaysWhatItFillsInAndManyEmptyRecordsAreAMemoryLimit) {
+  TempDir dir;
+  const std::vector<float> x{1, 2}, y{0, 0}, z{0, 0};
+  const std::vector<int64_t> red{10, 20}, row{3, 4};
+  const std::string xyz = "<cartesianX type=\"Float\" precision=\"single\"/><cartesianY type=\"Float\" "
+                          "precision=\"single\"/><cartesianZ type=\"Float\" precision=\"single\"/>";
+  const std::string rgb = "<colorRed type=\"Integer\" minimum=\"0\" maximum=\"255\"/><colorGreen type=\"Integer\" "
+                          "minimum=\"0\" maximum=\"255\"/><colorBlue type=\"Integer\" minimum=\"0\" maximum=\"255\"/>";
+  E57File file;
+  const uint64_t a = file.compressedVector(
+      {packRaw(x), packRaw(y), packRaw(z), packBits(red, 0, 8), packBits(red, 0, 8), packBits(red, 0, 8)}, 1000);
+  const uint64_t b = file.compressedVector({packRaw(x), packRaw(y), packRaw(z), packBits(row, 0, 3)}, 1000);
+  std::vector<std::string> notices;
+  E57ReadOptions options;
+  options.notices = &notices;
+  Result<PointSet> points = readBytes(
+      dir,
+      file.bytes(rootXml(scanXml(a, 2, xyz + rgb) + scanXml(b, 2, xyz + "<rowIndex type=\"Integer\" minimum=\"0\" maximum=\"7\"/>"))),
+      options);
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  EXPECT_EQ(points->colors[2], glm::vec3(1.0f));
+  EXPECT_EQ(points->dimensions.find("rowIndex")->value(0), 0.0);
+  EXPECT_EQ(points->dimensions.find("rowIndex")->value(3), 4.0);
+  ASSERT_EQ(notices.size(), 2u);
+  EXPECT_NE(notices[0].find("data3D 2 without colours beside scans with: their points are white"), std::string::npos)
+      << notices[0];
+  EXPECT_NE(notices[1].find("data3D 1 without rowIndex beside scans with: 0 there"), std::string::npos) << notices[1];
+
+  // Fields of no bits need no bytes, so the file's size does not bound the records: four scans of
+  // 2^56 points each are a memory limit (their sum wrapped to 0 and passed).
+  E57File empty;
+  const uint64_t e = empty.rawSection("");
+  const std::string zero = "<cartesianX type=\"Integer\" minimum=\"0\" maximum=\"0\"/><cartesianY type=\"Integer\" "
+                           "minimum=\"0\" maximum=\"0\"/><cartesianZ type=\"Integer\" minimum=\"0\" maximum=\"0\"/>";
+  std::string scans;
+  for (int k = 0; k < 4; ++k) scans += scanXml(e, uint64_t{1} << 56, zero);
+  Result<PointSet> huge = readBytes(dir, empty.bytes(rootXml(scans)));
+  ASSERT_FALSE(huge.ok());
+  EXPECT_EQ(huge.error().code, ExitCode::kResourceLimit) << huge.error().message;
+  EXPECT_EQ(huge.error().message.rfind(dir.file("scan.e57") + ": ", 0), 0u) << huge.error().message;
 }
 
 TEST(E57, aDamagedPageIsNamedAndAFileCutShortIsSaid) {
@@ -336,6 +402,21 @@ TEST(E57, badTreesAndPacketsAreNamed) {
     const std::vector<double> longer{1, 2, 3, 4, 5};  // two streams for three fields, bytes enough for three
     const uint64_t at = file.compressedVector({packRaw(longer), packRaw(longer)}, 100);
     EXPECT_NE(message(file, rootXml(scanXml(at, 3, xyz))).find("2 bytestreams for a prototype of 3 fields"), std::string::npos);
+  }
+  {
+    E57File file;  // a data packet of 4 bytes at the section's end: its count and lengths are not there
+    std::string packet(4, '\0');
+    packet[0] = 1;
+    put<uint16_t>(packet, 2, 3);
+    std::string empty(20, '\0');  // an empty packet of 20 bytes first
+    empty[0] = 2;
+    put<uint16_t>(empty, 2, 19);
+    const uint64_t at = file.rawSection(empty + packet);
+    EXPECT_NE(message(file, rootXml(scanXml(at, 1, "<cartesianX type=\"Integer\" minimum=\"0\" maximum=\"1\"/>"
+                                                     "<cartesianY type=\"Integer\" minimum=\"0\" maximum=\"1\"/>"
+                                                     "<cartesianZ type=\"Integer\" minimum=\"0\" maximum=\"1\"/>")))
+                  .find("is a data packet of 4 bytes, shorter than its 6-byte header"),
+              std::string::npos);
   }
   {
     E57File file;  // a record count the section cannot hold: refused before its bytes are allocated
@@ -390,6 +471,88 @@ TEST(E57, aNonFiniteCoordinateIsRefusedUnlessAllowedAndInvalidPointsAreLeftOut) 
   EXPECT_EQ(kept->positions[2].x, 3.0);
   ASSERT_EQ(notices.size(), 1u);
   EXPECT_NE(notices[0].find("1 of its 4 points are marked invalid"), std::string::npos) << notices[0];
+}
+
+// dpoint's own E57 files (libE57Format's reading of one is tests/data/e57/written): every field
+// back as it was, the same bytes on any thread count.
+TEST(E57, aWrittenSetReadsBackWithEveryFieldOnAnyThreadCount) {
+  TempDir dir;
+  PointSet set;
+  const size_t n = 5000;  // several packets
+  set.positions.resize(n);
+  set.colors.resize(n);
+  set.color_full_scale = 65535;
+  Dimension& intensity = set.dimensions.append("intensity", DimType::kU16, n);
+  Dimension& returns = set.dimensions.append("return_number", DimType::kU8, n);
+  Dimension& count = set.dimensions.append("number_of_returns", DimType::kU8, n);
+  Dimension& classification = set.dimensions.append("classification", DimType::kU8, n);
+  Dimension& time = set.dimensions.append("gps_time", DimType::kF64, n);
+  Dimension& nx = set.dimensions.append("nx", DimType::kF32, n);
+  Dimension& mine = set.dimensions.append("my value", DimType::kI32, n);
+  Dimension& big = set.dimensions.append("big", DimType::kU64, n);
+  Dimension& low = set.dimensions.append("low", DimType::kI64, n);
+  for (size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i);
+    set.positions[i] = glm::dvec3(512345.678 + t * 1e-3, 5412345.25 - t * 1e-7, std::sin(t));
+    set.colors[i] = glm::vec3(static_cast<float>(i % 65536) / 65535.0f, static_cast<float>(i * 7 % 65536) / 65535.0f, 1.0f);
+    intensity.set<uint16_t>(i, static_cast<uint16_t>(i * 13));
+    returns.set<uint8_t>(i, static_cast<uint8_t>(1 + i % 3));
+    count.set<uint8_t>(i, 3);
+    classification.set<uint8_t>(i, static_cast<uint8_t>(2 + i % 5));
+    time.set<double>(i, 245380.78254962614 + t * 1e-6);
+    nx.set<float>(i, static_cast<float>(std::cos(t)));
+    mine.set<int32_t>(i, -70000 + static_cast<int32_t>(i));
+    big.set<uint64_t>(i, (uint64_t{1} << 62) + i);
+    low.set<int64_t>(i, INT64_MIN + static_cast<int64_t>(i));
+  }
+  std::vector<std::string> notices;
+  E57WriteOptions one;
+  one.threads = 1;
+  one.notices = &notices;
+  ASSERT_TRUE(writeE57(dir.file("one.e57"), set, one).ok());
+  E57WriteOptions three;
+  three.threads = 3;
+  ASSERT_TRUE(writeE57(dir.file("three.e57"), set, three).ok());
+  EXPECT_EQ(test::readFile(dir.file("one.e57")), test::readFile(dir.file("three.e57")));
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find("dimension 'my value' written as 'my_value'"), std::string::npos) << notices[0];
+
+  Result<PointSet> back = readE57(dir.file("one.e57"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->size(), n);
+  EXPECT_EQ(back->color_full_scale, 65535);
+  EXPECT_EQ(std::memcmp(back->positions.data(), set.positions.data(), n * sizeof(glm::dvec3)), 0);
+  for (size_t i = 0; i < n; i += 7)
+    for (int k = 0; k < 3; ++k) ASSERT_NEAR(back->colors[i][k], set.colors[i][k], 1e-7f) << i;
+  for (const Dimension& d : set.dimensions.all()) {
+    const std::string name = d.name == "my value" ? "my_value" : d.name;
+    const Dimension* b = back->dimensions.find(name);
+    ASSERT_NE(b, nullptr) << name;
+    for (size_t i = 0; i < n; i += 7) {
+      if (d.type == DimType::kU64) ASSERT_EQ(b->get<uint64_t>(i), d.get<uint64_t>(i)) << name;
+      else if (d.type == DimType::kI64) ASSERT_EQ(b->get<int64_t>(i), d.get<int64_t>(i)) << name;
+      else ASSERT_EQ(b->value(i), d.value(i)) << name << " " << i;
+    }
+  }
+  // Integers pack in the bits their values need: the classification's 2..6 in 3.
+  const std::string bytes = test::readFile(dir.file("one.e57"));
+  EXPECT_NE(bytes.find("<las:classification type=\"Integer\" minimum=\"2\" maximum=\"6\"/>"), std::string::npos);
+  EXPECT_NE(bytes.find("<returnIndex type=\"Integer\" minimum=\"0\" maximum=\"2\"/>"), std::string::npos);
+  EXPECT_NE(bytes.find("<nor:normalX type=\"Float\" precision=\"single\"/>"), std::string::npos);
+
+  // A mesh's triangles are not written (said); an empty set is an empty file of one scan.
+  PointSet mesh;
+  mesh.positions = {glm::dvec3(0.0), glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(0.0, 1.0, 0.0)};
+  mesh.triangles = {0, 1, 2};
+  notices.clear();
+  ASSERT_TRUE(writeE57(dir.file("mesh.e57"), mesh, one).ok());
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find("triangles not written"), std::string::npos);
+  EXPECT_EQ(readE57(dir.file("mesh.e57"))->size(), 3u);
+  ASSERT_TRUE(writeE57(dir.file("empty.e57"), PointSet()).ok());
+  Result<PointSet> empty = readE57(dir.file("empty.e57"));
+  ASSERT_TRUE(empty.ok()) << empty.error().message;
+  EXPECT_EQ(empty->size(), 0u);
 }
 
 }  // namespace

@@ -384,7 +384,7 @@ def test_64_bit_integers_past_2_53_through_ply_are_warned_of(tmp_path):
 
 def test_read_e57_as_convert_does(tmp_path):
     """An E57 file's scans: positions moved by the pose, invalid points left out with a warning,
-    each scan's number in point_source_id, the other fields as attributes; .e57 is not written."""
+    each scan's number in point_source_id, the other fields as attributes; written back as one scan."""
     import os
     import warnings
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "e57", "two_scans.e57")
@@ -401,5 +401,8 @@ def test_read_e57_as_convert_does(tmp_path):
     assert s.positions[2969].tolist() == [512439.73010199214, 5412365.7377148662, 200.86567118869814]
     cli("convert", path, "-o", tmp_path / "c.ply")
     assert np.array_equal(dpoint.read(tmp_path / "c.ply").positions, s.positions)
-    with pytest.raises(dpoint.Error, match=r"a\.e57: \.e57 is read, not written"):
-        dpoint.write(s, tmp_path / "a.e57")
+    dpoint.write(s, tmp_path / "a.e57")
+    back = dpoint.read(tmp_path / "a.e57")
+    assert back.positions.tobytes() == s.positions.tobytes()
+    assert sorted(back.attributes) == sorted(a)
+    assert np.array_equal(back.attributes["timeStamp"], a["timeStamp"])

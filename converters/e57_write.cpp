@@ -1,0 +1,391 @@
+// The E57 writer (converters/e57.h): one scan, its records in data packets of whole 64-record
+// groups (so that every field's chunk is whole bytes, whatever its bit width), packed on all cores
+// a batch of packets at a time and paged with their CRC-32C as they are written.
+#include <algorithm>
+#include <bit>
+#include <cinttypes>
+#include <cmath>
+#include <cstring>
+#include <functional>
+
+#include "converters/e57.h"
+#include "core/atomic_file.h"
+#include "core/dimensions.h"
+#include "core/parallel.h"
+#include "core/text.h"
+
+namespace dpoint {
+
+namespace {
+
+constexpr uint64_t kPage = 1024, kLogicalPage = 1020;
+constexpr uint64_t kHeaderBytes = 48, kSectionHeaderBytes = 32;
+constexpr uint64_t kMostPacket = 65536;
+constexpr size_t kPacketsPerBatch = 256;
+
+uint64_t physicalOf(uint64_t logical) { return logical / kLogicalPage * kPage + logical % kLogicalPage; }
+
+// A field of the prototype and where its values come from.
+struct OutField {
+  enum class Kind { kFloat32, kFloat64, kInteger } kind = Kind::kFloat64;
+  std::string name;  // the XML element's
+  int64_t minimum = 0, maximum = 0;  // an Integer's limits: its values' own
+  unsigned bits = 64;
+  // The value of point i: an Integer's as int64, a Float's as double.
+  std::function<int64_t(size_t)> integer;
+  std::function<double(size_t)> real;
+};
+
+std::string numberText(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+// camelCase of a LAS field's snake_case name (point_source_id → pointSourceId), as the E57 LAS
+// extension names them.
+std::string camelCase(const std::string& snake) {
+  std::string out;
+  bool upper = false;
+  for (char c : snake) {
+    if (c == '_') {
+      upper = true;
+      continue;
+    }
+    out += upper && c >= 'a' && c <= 'z' ? static_cast<char>(c - 'a' + 'A') : c;
+    upper = false;
+  }
+  return out;
+}
+
+bool isNameChar(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
+}
+
+// Appends logical bytes, writing each whole page with its checksum.
+class PagedWriter {
+ public:
+  explicit PagedWriter(AtomicFile& file) : file_(file) { page_.reserve(kPage); }
+  Status append(const uint8_t* data, size_t size) {
+    while (size > 0) {
+      const size_t take = std::min<size_t>(size, kLogicalPage - page_.size());
+      page_.insert(page_.end(), data, data + take);
+      data += take;
+      size -= take;
+      if (page_.size() == kLogicalPage)
+        if (Status s = flush(); !s) return s;
+    }
+    return okStatus();
+  }
+  Status append(std::string_view text) { return append(reinterpret_cast<const uint8_t*>(text.data()), text.size()); }
+  // The last page, padded with zeros.
+  Status finish() {
+    if (page_.empty()) return okStatus();
+    page_.resize(kLogicalPage, 0);
+    return flush();
+  }
+
+ private:
+  Status flush() {
+    const uint32_t crc = __builtin_bswap32(crc32c(page_.data(), page_.size()));
+    page_.resize(kPage);
+    std::memcpy(page_.data() + kLogicalPage, &crc, 4);
+    Status s = file_.write(page_.data(), page_.size());
+    page_.clear();
+    return s;
+  }
+  AtomicFile& file_;
+  std::vector<uint8_t> page_;
+};
+
+template <typename T>
+void putLe(std::string& s, size_t at, T v) {
+  std::memcpy(s.data() + at, &v, sizeof v);
+}
+
+}  // namespace
+
+Status writeE57(const std::string& path, const PointSet& points, const E57WriteOptions& options) {
+  const size_t n = points.size();
+  const unsigned threads = resolveThreads(options.threads);
+  std::vector<std::string> notes;
+
+  // The prototype: x, y, z as doubles (every coordinate kept), colours, then the dimensions.
+  std::vector<OutField> fields;
+  for (int axis = 0; axis < 3; ++axis) {
+    OutField f;
+    f.name = std::string("cartesian") + static_cast<char>('X' + axis);
+    f.real = [&points, axis](size_t i) { return points.positions[i][axis]; };
+    fields.push_back(std::move(f));
+  }
+  const uint16_t full = points.color_full_scale == 65535 ? 65535 : 255;
+  if (points.hasColors()) {
+    const char* names[3] = {"colorRed", "colorGreen", "colorBlue"};
+    for (int k = 0; k < 3; ++k) {
+      OutField f;
+      f.kind = OutField::Kind::kInteger;
+      f.name = names[k];
+      f.maximum = full;
+      f.integer = [&points, k, full](size_t i) { return static_cast<int64_t>(colorInteger(points.colors[i][k], full)); };
+      fields.push_back(std::move(f));
+    }
+  }
+  bool las_namespace = false, normals_namespace = false;
+  std::vector<std::string> taken;
+  for (const OutField& f : fields) taken.push_back(f.name);
+  for (const Dimension& d : points.dimensions.all()) {
+    OutField f;
+    int64_t add = 0;
+    const KnownDimension* known = findKnownDimension(d.name);
+    if (d.name == dim::kIntensity) {
+      f.name = "intensity";
+    } else if (d.name == dim::kReturnNumber && !dimTypeIsFloat(d.type)) {
+      f.name = "returnIndex";  // 0-based in E57
+      add = -1;
+    } else if (d.name == dim::kNumberOfReturns && !dimTypeIsFloat(d.type)) {
+      f.name = "returnCount";
+    } else if (d.name == dim::kNormalX || d.name == dim::kNormalY || d.name == dim::kNormalZ) {
+      f.name = std::string("nor:normal") + static_cast<char>('X' + (d.name.back() - 'x'));
+      normals_namespace = true;
+    } else if (known && known->las_field) {
+      f.name = "las:" + camelCase(d.name);
+      las_namespace = true;
+    } else {  // an XML name: letters, digits, _ - . and not a digit first
+      f.name = d.name;
+      for (char& c : f.name)
+        if (!isNameChar(c)) c = '_';
+      if (f.name.empty() || !((f.name[0] >= 'a' && f.name[0] <= 'z') || (f.name[0] >= 'A' && f.name[0] <= 'Z') || f.name[0] == '_'))
+        f.name = "_" + f.name;
+      std::string base = f.name;
+      for (int k = 2; std::find(taken.begin(), taken.end(), f.name) != taken.end(); ++k) f.name = base + "_" + std::to_string(k);
+      if (f.name != d.name) notes.push_back("dimension " + quotedExcerpt(d.name) + " written as " + quotedExcerpt(f.name) +
+                                            " (an E57 field's name is an XML name, none a standard field's)");
+    }
+    if (std::find(taken.begin(), taken.end(), f.name) != taken.end())
+      return Error{path + ": two dimensions would both be the E57 field " + f.name, ExitCode::kUsage};
+    taken.push_back(f.name);
+    const Dimension* dp = &d;
+    if (d.type == DimType::kF32 || d.type == DimType::kF64) {
+      f.kind = d.type == DimType::kF32 ? OutField::Kind::kFloat32 : OutField::Kind::kFloat64;
+      f.bits = d.type == DimType::kF32 ? 32 : 64;
+      f.real = [dp](size_t i) { return dp->value(i); };
+    } else {
+      f.kind = OutField::Kind::kInteger;
+      if (d.type == DimType::kU64)
+        for (size_t i = 0; i < n; ++i)
+          if (dp->get<uint64_t>(i) > static_cast<uint64_t>(INT64_MAX))
+            return Error{path + ": point " + std::to_string(i) + ": " + d.name + " = " + std::to_string(dp->get<uint64_t>(i)) +
+                         " is past an E57 integer's 2^63 - 1"};
+      f.integer = [dp, add](size_t i) {
+        int64_t v = 0;
+        switch (dp->type) {
+          case DimType::kU64: v = static_cast<int64_t>(dp->get<uint64_t>(i)); break;
+          case DimType::kI64: v = dp->get<int64_t>(i); break;
+          default: v = static_cast<int64_t>(dp->value(i)); break;  // exact for the narrower integers
+        }
+        return v + add;
+      };
+    }
+    fields.push_back(std::move(f));
+  }
+
+  // An Integer's limits are its values' own, so that it packs in as few bits as they need.
+  for (OutField& f : fields) {
+    if (f.kind != OutField::Kind::kInteger) continue;
+    constexpr size_t kBlock = 1u << 16;
+    const size_t blocks = (n + kBlock - 1) / kBlock;
+    std::vector<int64_t> lo(blocks, INT64_MAX), hi(blocks, INT64_MIN);
+    parallelFor(blocks, threads, [&](size_t b, unsigned) {
+      for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
+        const int64_t v = f.integer(i);
+        lo[b] = std::min(lo[b], v);
+        hi[b] = std::max(hi[b], v);
+      }
+    });
+    f.minimum = n == 0 ? 0 : *std::min_element(lo.begin(), lo.end());
+    f.maximum = n == 0 ? 0 : *std::max_element(hi.begin(), hi.end());
+    if (f.name.rfind("color", 0) == 0) {  // colours keep their scale's limits, as readers take them for it
+      f.minimum = 0;
+      f.maximum = full;
+    }
+    f.bits = static_cast<unsigned>(std::bit_width(static_cast<uint64_t>(f.maximum) - static_cast<uint64_t>(f.minimum)));
+  }
+
+  // Packets of whole 64-record groups: every field's chunk is whole 8-byte words.
+  uint64_t group_bytes = 0;  // one group's bytes of every field
+  for (const OutField& f : fields) group_bytes += f.bits * 8;  // 64 records · bits / 8
+  const uint64_t header_bytes = 6 + 2 * fields.size();
+  if (header_bytes + group_bytes + 4 > kMostPacket)
+    return Error{path + ": " + std::to_string(fields.size()) + " fields, more than 64 records of them fit in an E57 packet "
+                 "(64 KiB); leave some dimensions out (--drop)", ExitCode::kUsage};
+  const uint64_t groups_per_packet =
+      group_bytes == 0 ? UINT64_MAX : std::max<uint64_t>(1, (kMostPacket - header_bytes - 4) / group_bytes);
+  const uint64_t records_per_packet = groups_per_packet == UINT64_MAX ? UINT64_MAX : groups_per_packet * 64;
+  const uint64_t packets = n == 0 || group_bytes == 0 ? 0 : (n + records_per_packet - 1) / records_per_packet;
+  const auto packetBytes = [&](uint64_t p, std::vector<uint64_t>* chunks) {
+    const uint64_t records = std::min<uint64_t>(records_per_packet, n - p * records_per_packet);
+    uint64_t bytes = header_bytes;
+    for (const OutField& f : fields) {
+      const uint64_t chunk = (records * f.bits + 63) / 64 * 8;
+      if (chunks) chunks->push_back(chunk);
+      bytes += chunk;
+    }
+    return (bytes + 3) / 4 * 4;
+  };
+  uint64_t section = kSectionHeaderBytes;
+  for (uint64_t p = 0; p < packets; ++p) section += packetBytes(p, nullptr);
+
+  // The XML tree, from the bounds and the fields.
+  glm::dvec3 lo(0.0), hi(0.0);
+  if (n > 0) {
+    const Box box = boundingBox(points.positions, 0, n);
+    lo = box.min;
+    hi = box.max;
+  }
+  std::string prototype;
+  for (const OutField& f : fields) {
+    prototype += "          <" + f.name;
+    if (f.kind == OutField::Kind::kInteger)
+      prototype += " type=\"Integer\" minimum=\"" + std::to_string(f.minimum) + "\" maximum=\"" + std::to_string(f.maximum) + "\"/>\n";
+    else
+      prototype += std::string(" type=\"Float\" precision=\"") + (f.kind == OutField::Kind::kFloat32 ? "single" : "double") + "\"/>\n";
+  }
+  // A GUID made from what is written, so that the same set makes the same file.
+  uint64_t hash = 1469598103934665603ull;
+  const auto mix = [&hash](const void* data, size_t size) {
+    for (size_t i = 0; i < size; ++i) hash = (hash ^ static_cast<const uint8_t*>(data)[i]) * 1099511628211ull;
+  };
+  mix(prototype.data(), prototype.size());
+  mix(&n, sizeof n);
+  mix(&lo, sizeof lo);
+  mix(&hi, sizeof hi);
+  char guid[64];
+  std::snprintf(guid, sizeof guid, "{dpoint-%016" PRIx64 "}", hash);
+  std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<e57Root type=\"Structure\" "
+                    "xmlns=\"http://www.astm.org/COMMIT/E57/2010-e57-v1.0\"";
+  if (las_namespace) xml += " xmlns:las=\"http://www.astm.org/COMMIT/E57/2010-las-v1.0\"";
+  if (normals_namespace) xml += " xmlns:nor=\"http://www.libe57.org/E57_NOR_surface_normals.txt\"";
+  xml += ">\n  <formatName type=\"String\"><![CDATA[ASTM E57 3D Imaging Data File]]></formatName>\n";
+  xml += "  <guid type=\"String\"><![CDATA[" + std::string(guid) + "]]></guid>\n";
+  xml += "  <versionMajor type=\"Integer\">1</versionMajor>\n  <versionMinor type=\"Integer\">0</versionMinor>\n";
+  xml += "  <e57LibraryVersion type=\"String\"><![CDATA[dpoint]]></e57LibraryVersion>\n";
+  xml += "  <coordinateMetadata type=\"String\"><![CDATA[]]></coordinateMetadata>\n";
+  xml += "  <data3D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n    <vectorChild type=\"Structure\">\n";
+  guid[std::strlen(guid) - 1] = '\0';
+  xml += "      <guid type=\"String\"><![CDATA[" + std::string(guid) + "-scan}]]></guid>\n";
+  if (n > 0) {
+    xml += "      <cartesianBounds type=\"Structure\">\n";
+    const char* axes[3] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) {
+      xml += std::string("        <") + axes[k] + "Minimum type=\"Float\">" + numberText(lo[k]) + "</" + axes[k] + "Minimum>\n";
+      xml += std::string("        <") + axes[k] + "Maximum type=\"Float\">" + numberText(hi[k]) + "</" + axes[k] + "Maximum>\n";
+    }
+    xml += "      </cartesianBounds>\n";
+  }
+  if (points.hasColors()) {
+    xml += "      <colorLimits type=\"Structure\">\n";
+    for (const char* c : {"Red", "Green", "Blue"}) {
+      xml += std::string("        <color") + c + "Minimum type=\"Integer\">0</color" + c + "Minimum>\n";
+      xml += std::string("        <color") + c + "Maximum type=\"Integer\">" + std::to_string(full) + "</color" + c + "Maximum>\n";
+    }
+    xml += "      </colorLimits>\n";
+  }
+  xml += "      <points type=\"CompressedVector\" fileOffset=\"" + std::to_string(physicalOf(kHeaderBytes)) +
+         "\" recordCount=\"" + std::to_string(n) + "\">\n        <prototype type=\"Structure\">\n" + prototype +
+         "        </prototype>\n        <codecs type=\"Vector\" allowHeterogeneousChildren=\"1\">\n        </codecs>\n"
+         "      </points>\n    </vectorChild>\n  </data3D>\n"
+         "  <images2D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n  </images2D>\n</e57Root>\n";
+
+  // The header: the file's length, the XML's place and length.
+  const uint64_t xml_logical = kHeaderBytes + section;
+  const uint64_t logical_end = xml_logical + xml.size();
+  const uint64_t file_length = (logical_end + kLogicalPage - 1) / kLogicalPage * kPage;
+  std::string header(kHeaderBytes, '\0');
+  std::memcpy(header.data(), "ASTM-E57", 8);
+  putLe<uint32_t>(header, 8, 1);
+  putLe<uint32_t>(header, 12, 0);
+  putLe<uint64_t>(header, 16, file_length);
+  putLe<uint64_t>(header, 24, physicalOf(xml_logical));
+  putLe<uint64_t>(header, 32, xml.size());
+  putLe<uint64_t>(header, 40, kPage);
+  std::string section_header(kSectionHeaderBytes, '\0');
+  section_header[0] = 1;
+  putLe<uint64_t>(section_header, 8, section);
+  putLe<uint64_t>(section_header, 16, physicalOf(kHeaderBytes + kSectionHeaderBytes));
+
+  Result<AtomicFile> out = AtomicFile::create(path);
+  if (!out) return out.error();
+  if (Status s = out->checkSpace(file_length); !s) return s;
+  PagedWriter writer(*out);
+  if (Status s = writer.append(header); !s) return s;
+  if (Status s = writer.append(section_header); !s) return s;
+  Progress* progress = options.progress;
+  if (progress) progress->start("writing " + path, n);
+  std::vector<std::string> batch;
+  for (uint64_t first = 0; first < packets; first += kPacketsPerBatch) {
+    const size_t count = static_cast<size_t>(std::min<uint64_t>(kPacketsPerBatch, packets - first));
+    batch.resize(count);
+    parallelFor(count, threads, [&](size_t b, unsigned) {
+      const uint64_t p = first + b;
+      std::vector<uint64_t> chunks;
+      std::string& packet = batch[b];
+      packet.assign(static_cast<size_t>(packetBytes(p, &chunks)), '\0');
+      packet[0] = 1;
+      putLe<uint16_t>(packet, 2, static_cast<uint16_t>(packet.size() - 1));
+      putLe<uint16_t>(packet, 4, static_cast<uint16_t>(fields.size()));
+      size_t at = static_cast<size_t>(header_bytes);
+      const size_t begin = static_cast<size_t>(p * records_per_packet);
+      const size_t end = static_cast<size_t>(std::min<uint64_t>(n, begin + records_per_packet));
+      for (size_t k = 0; k < fields.size(); ++k) {
+        putLe<uint16_t>(packet, 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
+        const OutField& f = fields[k];
+        uint8_t* bytes = reinterpret_cast<uint8_t*>(packet.data()) + at;
+        if (f.kind == OutField::Kind::kFloat64) {
+          for (size_t i = begin; i < end; ++i) {
+            const double v = f.real(i);
+            std::memcpy(bytes + (i - begin) * 8, &v, 8);
+          }
+        } else if (f.kind == OutField::Kind::kFloat32) {
+          for (size_t i = begin; i < end; ++i) {
+            const float v = static_cast<float>(f.real(i));
+            std::memcpy(bytes + (i - begin) * 4, &v, 4);
+          }
+        } else if (f.bits > 0) {  // least significant bit first, the value less the minimum
+          uint64_t word = 0;
+          unsigned filled = 0;
+          size_t out_byte = 0;
+          for (size_t i = begin; i < end; ++i) {
+            const uint64_t raw = static_cast<uint64_t>(f.integer(i)) - static_cast<uint64_t>(f.minimum);
+            word |= raw << filled;
+            if (filled + f.bits >= 64) {
+              std::memcpy(bytes + out_byte, &word, 8);
+              out_byte += 8;
+              const unsigned used = 64 - filled;
+              word = used == 64 ? 0 : raw >> used;
+              filled = filled + f.bits - 64;
+            } else {
+              filled += f.bits;
+            }
+          }
+          if (filled > 0) std::memcpy(bytes + out_byte, &word, std::min<size_t>(8, chunks[k] - out_byte));
+        }
+        at += static_cast<size_t>(chunks[k]);
+      }
+    });
+    for (size_t b = 0; b < count; ++b) {
+      if (Status s = writer.append(batch[b]); !s) return s;
+      if (progress) progress->advance(std::min<uint64_t>(records_per_packet, n - (first + b) * records_per_packet));
+    }
+  }
+  if (progress) progress->finish();
+  if (Status s = writer.append(xml); !s) return s;
+  if (Status s = writer.finish(); !s) return s;
+  if (Status s = out->commit(); !s) return s;
+  if (options.notices) {
+    for (const std::string& note : notes) options.notices->push_back(path + ": " + note);
+    if (points.isMesh()) options.notices->push_back(path + ": triangles not written (an E57 file holds points)");
+  }
+  return okStatus();
+}
+
+}  // namespace dpoint
