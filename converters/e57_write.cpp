@@ -6,7 +6,6 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstring>
-#include <functional>
 
 #include "converters/e57.h"
 #include "core/atomic_file.h"
@@ -31,10 +30,42 @@ struct OutField {
   std::string name;  // the XML element's
   int64_t minimum = 0, maximum = 0;  // an Integer's limits: its values' own
   unsigned bits = 64;
-  // The value of point i: an Integer's as int64, a Float's as double.
-  std::function<int64_t(size_t)> integer;
-  std::function<double(size_t)> real;
+  // Where the values come from: a coordinate or colour channel (axis), or a dimension (plus `add`).
+  enum class Source { kPosition, kColor, kDimension } source = Source::kPosition;
+  int axis = 0;
+  const Dimension* dimension = nullptr;
+  int64_t add = 0;
 };
+
+// fn(i, value) for points [begin, end) of an Integer field, the source's type settled once a range.
+template <typename T, typename Fn>
+void eachStored(const Dimension& d, int64_t add, size_t begin, size_t end, Fn&& fn) {
+  for (size_t i = begin; i < end; ++i) {
+    T v;
+    std::memcpy(&v, d.bytes.data() + i * sizeof(T), sizeof(T));
+    fn(i, static_cast<int64_t>(v) + add);
+  }
+}
+template <typename Fn>
+void eachInteger(const OutField& f, const PointSet& points, uint16_t full, size_t begin, size_t end, Fn&& fn) {
+  if (f.source == OutField::Source::kColor) {
+    for (size_t i = begin; i < end; ++i) fn(i, static_cast<int64_t>(colorInteger(points.colors[i][f.axis], full)));
+    return;
+  }
+  const Dimension& d = *f.dimension;
+  switch (d.type) {
+    case DimType::kU8: eachStored<uint8_t>(d, f.add, begin, end, fn); break;
+    case DimType::kI8: eachStored<int8_t>(d, f.add, begin, end, fn); break;
+    case DimType::kU16: eachStored<uint16_t>(d, f.add, begin, end, fn); break;
+    case DimType::kI16: eachStored<int16_t>(d, f.add, begin, end, fn); break;
+    case DimType::kU32: eachStored<uint32_t>(d, f.add, begin, end, fn); break;
+    case DimType::kI32: eachStored<int32_t>(d, f.add, begin, end, fn); break;
+    case DimType::kU64: eachStored<uint64_t>(d, f.add, begin, end, fn); break;  // at most 2^63 - 1 (checked)
+    case DimType::kI64: eachStored<int64_t>(d, f.add, begin, end, fn); break;
+    case DimType::kF32:
+    case DimType::kF64: break;  // Float fields
+  }
+}
 
 std::string numberText(double v) {
   char buffer[32];
@@ -115,7 +146,7 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   for (int axis = 0; axis < 3; ++axis) {
     OutField f;
     f.name = std::string("cartesian") + static_cast<char>('X' + axis);
-    f.real = [&points, axis](size_t i) { return points.positions[i][axis]; };
+    f.axis = axis;
     fields.push_back(std::move(f));
   }
   const uint16_t full = points.color_full_scale == 65535 ? 65535 : 255;
@@ -126,7 +157,8 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
       f.kind = OutField::Kind::kInteger;
       f.name = names[k];
       f.maximum = full;
-      f.integer = [&points, k, full](size_t i) { return static_cast<int64_t>(colorInteger(points.colors[i][k], full)); };
+      f.source = OutField::Source::kColor;
+      f.axis = k;
       fields.push_back(std::move(f));
     }
   }
@@ -165,10 +197,12 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
       return Error{path + ": two dimensions would both be the E57 field " + f.name, ExitCode::kUsage};
     taken.push_back(f.name);
     const Dimension* dp = &d;
+    f.source = OutField::Source::kDimension;
+    f.dimension = dp;
+    f.add = add;
     if (d.type == DimType::kF32 || d.type == DimType::kF64) {
       f.kind = d.type == DimType::kF32 ? OutField::Kind::kFloat32 : OutField::Kind::kFloat64;
       f.bits = d.type == DimType::kF32 ? 32 : 64;
-      f.real = [dp](size_t i) { return dp->value(i); };
     } else {
       f.kind = OutField::Kind::kInteger;
       if (d.type == DimType::kU64)
@@ -176,15 +210,6 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
           if (dp->get<uint64_t>(i) > static_cast<uint64_t>(INT64_MAX))
             return Error{path + ": point " + std::to_string(i) + ": " + d.name + " = " + std::to_string(dp->get<uint64_t>(i)) +
                          " is past an E57 integer's 2^63 - 1"};
-      f.integer = [dp, add](size_t i) {
-        int64_t v = 0;
-        switch (dp->type) {
-          case DimType::kU64: v = static_cast<int64_t>(dp->get<uint64_t>(i)); break;
-          case DimType::kI64: v = dp->get<int64_t>(i); break;
-          default: v = static_cast<int64_t>(dp->value(i)); break;  // exact for the narrower integers
-        }
-        return v + add;
-      };
     }
     fields.push_back(std::move(f));
   }
@@ -196,11 +221,13 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     const size_t blocks = (n + kBlock - 1) / kBlock;
     std::vector<int64_t> lo(blocks, INT64_MAX), hi(blocks, INT64_MIN);
     parallelFor(blocks, threads, [&](size_t b, unsigned) {
-      for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
-        const int64_t v = f.integer(i);
-        lo[b] = std::min(lo[b], v);
-        hi[b] = std::max(hi[b], v);
-      }
+      int64_t least = INT64_MAX, most = INT64_MIN;
+      eachInteger(f, points, full, b * kBlock, std::min(n, (b + 1) * kBlock), [&](size_t, int64_t v) {
+        least = std::min(least, v);
+        most = std::max(most, v);
+      });
+      lo[b] = least;
+      hi[b] = most;
     });
     f.minimum = n == 0 ? 0 : *std::min_element(lo.begin(), lo.end());
     f.maximum = n == 0 ? 0 : *std::max_element(hi.begin(), hi.end());
@@ -340,33 +367,30 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
         putLe<uint16_t>(packet, 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
         const OutField& f = fields[k];
         uint8_t* bytes = reinterpret_cast<uint8_t*>(packet.data()) + at;
-        if (f.kind == OutField::Kind::kFloat64) {
-          for (size_t i = begin; i < end; ++i) {
-            const double v = f.real(i);
-            std::memcpy(bytes + (i - begin) * 8, &v, 8);
-          }
-        } else if (f.kind == OutField::Kind::kFloat32) {
-          for (size_t i = begin; i < end; ++i) {
-            const float v = static_cast<float>(f.real(i));
-            std::memcpy(bytes + (i - begin) * 4, &v, 4);
-          }
+        if (f.source == OutField::Source::kPosition) {
+          for (size_t i = begin; i < end; ++i) std::memcpy(bytes + (i - begin) * 8, &points.positions[i][f.axis], 8);
+        } else if (f.kind != OutField::Kind::kInteger) {  // a float dimension: its bytes as they are
+          const size_t width = f.kind == OutField::Kind::kFloat64 ? 8 : 4;
+          std::memcpy(bytes, f.dimension->bytes.data() + begin * width, (end - begin) * width);
         } else if (f.bits > 0) {  // least significant bit first, the value less the minimum
           uint64_t word = 0;
           unsigned filled = 0;
           size_t out_byte = 0;
-          for (size_t i = begin; i < end; ++i) {
-            const uint64_t raw = static_cast<uint64_t>(f.integer(i)) - static_cast<uint64_t>(f.minimum);
+          const unsigned bits = f.bits;
+          const uint64_t minimum = static_cast<uint64_t>(f.minimum);
+          eachInteger(f, points, full, begin, end, [&](size_t, int64_t v) {
+            const uint64_t raw = static_cast<uint64_t>(v) - minimum;
             word |= raw << filled;
-            if (filled + f.bits >= 64) {
+            if (filled + bits >= 64) {
               std::memcpy(bytes + out_byte, &word, 8);
               out_byte += 8;
               const unsigned used = 64 - filled;
               word = used == 64 ? 0 : raw >> used;
-              filled = filled + f.bits - 64;
+              filled = filled + bits - 64;
             } else {
-              filled += f.bits;
+              filled += bits;
             }
-          }
+          });
           if (filled > 0) std::memcpy(bytes + out_byte, &word, std::min<size_t>(8, chunks[k] - out_byte));
         }
         at += static_cast<size_t>(chunks[k]);
