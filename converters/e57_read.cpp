@@ -697,7 +697,7 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
         p = glm::dvec3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t[0], m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t[1],
                        m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t[2]);
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        if (!invalid || invalid->integer(i) == 0) lowerAtomic(first_nonfinite, i);
+        if (!invalid || invalid->value(i) == 0.0) lowerAtomic(first_nonfinite, i);
       }
       points.positions[i] = p;
       if (colors) {
@@ -752,7 +752,7 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
   if (invalid) {
     size_t kept_points = 0;
     for (size_t i = 0; i < n; ++i) {
-      if (invalid->integer(i) != 0) continue;
+      if (invalid->value(i) != 0.0) continue;  // an Integer as E57 has it, or a Float of another writer
       if (kept_points != i) {
         points.positions[kept_points] = points.positions[i];
         if (colors) points.colors[kept_points] = points.colors[i];

@@ -35,6 +35,8 @@ struct OutField {
   int axis = 0;
   const Dimension* dimension = nullptr;
   int64_t add = 0;
+  bool limited = false;  // a Float's limits known (the intensity's): written as its minimum and maximum
+  double least = 0.0, most = 0.0;
 };
 
 // fn(i, value) for points [begin, end) of an Integer field, the source's type settled once a range.
@@ -90,7 +92,36 @@ std::string camelCase(const std::string& snake) {
 }
 
 bool isNameChar(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.' ||
+         (static_cast<unsigned char>(c) & 0x80);  // UTF-8: XML names take letters of every script
+}
+
+// The fields E57 gives a meaning (its standard point record).
+bool isStandardField(const std::string& name) {
+  static const char* const kNames[] = {"cartesianX", "cartesianY", "cartesianZ", "cartesianInvalidState",
+                                       "sphericalRange", "sphericalAzimuth", "sphericalElevation",
+                                       "sphericalInvalidState", "colorRed", "colorGreen", "colorBlue", "isColorInvalid",
+                                       "intensity", "isIntensityInvalid", "rowIndex", "columnIndex", "returnIndex",
+                                       "returnCount", "timeStamp", "isTimeStampInvalid"};
+  return std::any_of(std::begin(kNames), std::end(kNames), [&](const char* k) { return name == k; });
+}
+// Those an integer dimension of the same name is (as an E57 file read here gives it).
+bool isStandardIndex(const std::string& name) {
+  return name == "rowIndex" || name == "columnIndex" || name == "isColorInvalid" || name == "isIntensityInvalid" ||
+         name == "isTimeStampInvalid";
+}
+
+// The least value of an integer dimension (of none, 0).
+int64_t leastOf(const Dimension& d, unsigned threads) {
+  const size_t n = d.size();
+  constexpr size_t kBlock = 1u << 16;
+  std::vector<double> least((n + kBlock - 1) / kBlock, 0.0);
+  parallelFor(least.size(), threads, [&](size_t b, unsigned) {
+    double m = d.value(b * kBlock);
+    for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) m = std::min(m, d.value(i));
+    least[b] = m;
+  });
+  return least.empty() ? 0 : static_cast<int64_t>(*std::min_element(least.begin(), least.end()));
 }
 
 // Appends logical bytes, writing each whole page with its checksum.
@@ -109,6 +140,22 @@ class PagedWriter {
     return okStatus();
   }
   Status append(std::string_view text) { return append(reinterpret_cast<const uint8_t*>(text.data()), text.size()); }
+  // 128 bits of what has been written: every whole page's checksum, the bytes of the page begun,
+  // the prototype and the count (FNV-1a, twice with other seeds).
+  std::pair<uint64_t, uint64_t> digest(const std::string& prototype, uint64_t count) const {
+    uint64_t a = 1469598103934665603ull, b = 0x6c62272e07bb0142ull;
+    const auto mix = [&](const void* data, size_t size) {
+      for (size_t i = 0; i < size; ++i) {
+        a = (a ^ static_cast<const uint8_t*>(data)[i]) * 1099511628211ull;
+        b = (b ^ static_cast<const uint8_t*>(data)[i]) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
+      }
+    };
+    mix(crcs_.data(), crcs_.size() * sizeof(uint32_t));
+    mix(page_.data(), page_.size());
+    mix(prototype.data(), prototype.size());
+    mix(&count, sizeof count);
+    return {a, b};
+  }
   // The last page, padded with zeros.
   Status finish() {
     if (page_.empty()) return okStatus();
@@ -119,6 +166,7 @@ class PagedWriter {
  private:
   Status flush() {
     const uint32_t crc = __builtin_bswap32(crc32c(page_.data(), page_.size()));
+    crcs_.push_back(crc);
     page_.resize(kPage);
     std::memcpy(page_.data() + kLogicalPage, &crc, 4);
     Status s = file_.write(page_.data(), page_.size());
@@ -127,7 +175,22 @@ class PagedWriter {
   }
   AtomicFile& file_;
   std::vector<uint8_t> page_;
+  std::vector<uint32_t> crcs_;  // 4 bytes a KiB written
 };
+
+// Placeholders of the GUIDs' 36 characters in the XML, replaced once the points are written.
+constexpr const char* kFileGuidMarker = "00000000-0000-0000-0000-00000000file";
+constexpr const char* kScanGuidMarker = "00000000-0000-0000-0000-00000000scan";
+
+// 128 bits as an RFC 4122 UUID of version 5 (made from a name: here, the file's content).
+std::string uuidText(uint64_t hi, uint64_t lo) {
+  hi = (hi & ~0xF000ull) | 0x5000ull;                      // version 5
+  lo = (lo & 0x3FFFFFFFFFFFFFFFull) | 0x8000000000000000ull;  // the RFC 4122 variant
+  char text[40];
+  std::snprintf(text, sizeof text, "%08" PRIx64 "-%04" PRIx64 "-%04" PRIx64 "-%04" PRIx64 "-%012" PRIx64, hi >> 32,
+                (hi >> 16) & 0xFFFF, hi & 0xFFFF, lo >> 48, lo & uint64_t{0xFFFFFFFFFFFF});
+  return text;
+}
 
 template <typename T>
 void putLe(std::string& s, size_t at, T v) {
@@ -165,37 +228,58 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   bool las_namespace = false, normals_namespace = false;
   std::vector<std::string> taken;
   for (const OutField& f : fields) taken.push_back(f.name);
-  for (const Dimension& d : points.dimensions.all()) {
-    OutField f;
-    int64_t add = 0;
+  // First the dimensions that are E57 fields of their own (intensity, returns, normals, LAS's),
+  // then the others under XML names that are none of those and no standard field of another
+  // meaning (a float returnIndex or a cartesianInvalidState of a CSV would be read as E57's).
+  std::vector<std::string> names(points.dimensions.count());
+  std::vector<int64_t> adds(points.dimensions.count(), 0);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const Dimension& d = points.dimensions.all()[k];
     const KnownDimension* known = findKnownDimension(d.name);
+    const bool integer = !dimTypeIsFloat(d.type);
     if (d.name == dim::kIntensity) {
-      f.name = "intensity";
-    } else if (d.name == dim::kReturnNumber && !dimTypeIsFloat(d.type)) {
-      f.name = "returnIndex";  // 0-based in E57
-      add = -1;
-    } else if (d.name == dim::kNumberOfReturns && !dimTypeIsFloat(d.type)) {
-      f.name = "returnCount";
+      names[k] = "intensity";
+    } else if (d.name == dim::kReturnNumber && integer && leastOf(d, threads) >= 1) {  // 0-based in E57
+      names[k] = "returnIndex";
+      adds[k] = -1;
+    } else if (d.name == dim::kNumberOfReturns && integer) {
+      names[k] = "returnCount";
     } else if (d.name == dim::kNormalX || d.name == dim::kNormalY || d.name == dim::kNormalZ) {
-      f.name = std::string("nor:normal") + static_cast<char>('X' + (d.name.back() - 'x'));
+      names[k] = std::string("nor:normal") + static_cast<char>('X' + (d.name.back() - 'x'));
       normals_namespace = true;
-    } else if (known && known->las_field) {
-      f.name = "las:" + camelCase(d.name);
+    } else if (known && known->las_field && d.name != dim::kReturnNumber) {
+      names[k] = "las:" + camelCase(d.name);
       las_namespace = true;
-    } else {  // an XML name: letters, digits, _ - . and not a digit first
-      f.name = d.name;
-      for (char& c : f.name)
-        if (!isNameChar(c)) c = '_';
-      if (f.name.empty() || !((f.name[0] >= 'a' && f.name[0] <= 'z') || (f.name[0] >= 'A' && f.name[0] <= 'Z') || f.name[0] == '_'))
-        f.name = "_" + f.name;
-      std::string base = f.name;
-      for (int k = 2; std::find(taken.begin(), taken.end(), f.name) != taken.end(); ++k) f.name = base + "_" + std::to_string(k);
-      if (f.name != d.name) notes.push_back("dimension " + quotedExcerpt(d.name) + " written as " + quotedExcerpt(f.name) +
-                                            " (an E57 field's name is an XML name, none a standard field's)");
+    } else if ((isStandardIndex(d.name) && integer) || (d.name == "timeStamp")) {
+      names[k] = d.name;  // an E57 reading's own rowIndex, columnIndex, timeStamp, is…Invalid
+    } else {
+      continue;
     }
-    if (std::find(taken.begin(), taken.end(), f.name) != taken.end())
-      return Error{path + ": two dimensions would both be the E57 field " + f.name, ExitCode::kUsage};
-    taken.push_back(f.name);
+    taken.push_back(names[k]);
+  }
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (!names[k].empty()) continue;
+    const Dimension& d = points.dimensions.all()[k];
+    std::string name = d.name;  // an XML name: letters, digits, _ - . and UTF-8, not a digit first
+    for (char& c : name)
+      if (!isNameChar(c)) c = '_';
+    if (name.empty() || !((name[0] >= 'a' && name[0] <= 'z') || (name[0] >= 'A' && name[0] <= 'Z') || name[0] == '_' ||
+                          (static_cast<unsigned char>(name[0]) & 0x80)))
+      name = "_" + name;
+    const std::string base = name;
+    for (int n2 = 2; isStandardField(name) || std::find(taken.begin(), taken.end(), name) != taken.end(); ++n2)
+      name = base + "_" + std::to_string(n2);
+    if (name != d.name)
+      notes.push_back("dimension " + quotedExcerpt(d.name) + " written as " + quotedExcerpt(name) +
+                      " (an E57 field's name is an XML name, none taken or a standard field's of another meaning)");
+    names[k] = name;
+    taken.push_back(name);
+  }
+  for (size_t k = 0; k < names.size(); ++k) {
+    const Dimension& d = points.dimensions.all()[k];
+    OutField f;
+    f.name = names[k];
+    const int64_t add = adds[k];
     const Dimension* dp = &d;
     f.source = OutField::Source::kDimension;
     f.dimension = dp;
@@ -231,7 +315,7 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     });
     f.minimum = n == 0 ? 0 : *std::min_element(lo.begin(), lo.end());
     f.maximum = n == 0 ? 0 : *std::max_element(hi.begin(), hi.end());
-    if (f.name.rfind("color", 0) == 0) {  // colours keep their scale's limits, as readers take them for it
+    if (f.source == OutField::Source::kColor) {  // colours keep their scale's limits, as readers take them for it
       f.minimum = 0;
       f.maximum = full;
     }
@@ -259,15 +343,57 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     }
     return (bytes + 3) / 4 * 4;
   };
-  uint64_t section = kSectionHeaderBytes;
+  // A set of no points: one empty data packet, as libE57Format writes one (its Simple API reads
+  // the data packet at the data offset).
+  const std::string no_points = n == 0 ? std::string("\x01\x00\x07\x00\x00\x00\x00\x00", 8) : std::string();
+  uint64_t section = kSectionHeaderBytes + no_points.size();
   for (uint64_t p = 0; p < packets; ++p) section += packetBytes(p, nullptr);
 
   // The XML tree, from the bounds and the fields.
-  glm::dvec3 lo(0.0), hi(0.0);
-  if (n > 0) {
-    const Box box = boundingBox(points.positions, 0, n);
-    lo = box.min;
-    hi = box.max;
+  // The bounds of the finite coordinates (--allow-nonfinite sets may have others).
+  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+  {
+    constexpr size_t kBlock = 1u << 16;
+    std::vector<glm::dvec3> los((n + kBlock - 1) / kBlock, glm::dvec3(HUGE_VAL)), his(los.size(), glm::dvec3(-HUGE_VAL));
+    parallelFor(los.size(), threads, [&](size_t b, unsigned) {
+      for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i)
+        for (int k = 0; k < 3; ++k) {
+          const double v = points.positions[i][k];
+          if (!std::isfinite(v)) continue;
+          los[b][k] = std::min(los[b][k], v);
+          his[b][k] = std::max(his[b][k], v);
+        }
+    });
+    for (size_t b = 0; b < los.size(); ++b) {
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], los[b][k]);
+        hi[k] = std::max(hi[k], his[b][k]);
+      }
+    }
+  }
+  const bool bounded = lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
+  // The intensity's range, by which readers (PDAL, CloudCompare) normalise it: LAS's 0..65535 for
+  // integers that fit, 0..1 for floats of 0..1, else the values' own; a Float's also as its limits
+  // (libE57Format's Simple API takes a Float intensity's range from them).
+  for (OutField& f : fields) {
+    if (f.name != "intensity") continue;
+    if (f.kind == OutField::Kind::kInteger) {
+      const bool las = f.minimum >= 0 && f.maximum <= 65535;
+      f.least = las ? 0.0 : static_cast<double>(f.minimum);
+      f.most = las ? 65535.0 : static_cast<double>(f.maximum);
+      f.limited = true;
+      continue;
+    }
+    f.least = HUGE_VAL;
+    f.most = -HUGE_VAL;
+    for (size_t i = 0; i < n; ++i) {
+      const double v = f.dimension->value(i);
+      if (!std::isfinite(v)) continue;
+      f.least = std::min(f.least, v);
+      f.most = std::max(f.most, v);
+    }
+    if (f.least >= 0.0 && f.most <= 1.0) f.least = 0.0, f.most = 1.0;
+    f.limited = f.least <= f.most;  // some finite value
   }
   std::string prototype;
   for (const OutField& f : fields) {
@@ -275,32 +401,22 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     if (f.kind == OutField::Kind::kInteger)
       prototype += " type=\"Integer\" minimum=\"" + std::to_string(f.minimum) + "\" maximum=\"" + std::to_string(f.maximum) + "\"/>\n";
     else
-      prototype += std::string(" type=\"Float\" precision=\"") + (f.kind == OutField::Kind::kFloat32 ? "single" : "double") + "\"/>\n";
+      prototype += std::string(" type=\"Float\" precision=\"") + (f.kind == OutField::Kind::kFloat32 ? "single" : "double") +
+                   (f.limited ? "\" minimum=\"" + numberText(f.least) + "\" maximum=\"" + numberText(f.most) : std::string()) +
+                   "\"/>\n";
   }
-  // A GUID made from what is written, so that the same set makes the same file.
-  uint64_t hash = 1469598103934665603ull;
-  const auto mix = [&hash](const void* data, size_t size) {
-    for (size_t i = 0; i < size; ++i) hash = (hash ^ static_cast<const uint8_t*>(data)[i]) * 1099511628211ull;
-  };
-  mix(prototype.data(), prototype.size());
-  mix(&n, sizeof n);
-  mix(&lo, sizeof lo);
-  mix(&hi, sizeof hi);
-  char guid[64];
-  std::snprintf(guid, sizeof guid, "{dpoint-%016" PRIx64 "}", hash);
   std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<e57Root type=\"Structure\" "
                     "xmlns=\"http://www.astm.org/COMMIT/E57/2010-e57-v1.0\"";
   if (las_namespace) xml += " xmlns:las=\"http://www.astm.org/COMMIT/E57/2010-las-v1.0\"";
-  if (normals_namespace) xml += " xmlns:nor=\"http://www.libe57.org/E57_NOR_surface_normals.txt\"";
+  if (normals_namespace) xml += " xmlns:nor=\"http://www.libe57.org/E57_EXT_surface_normals.txt\"";
   xml += ">\n  <formatName type=\"String\"><![CDATA[ASTM E57 3D Imaging Data File]]></formatName>\n";
-  xml += "  <guid type=\"String\"><![CDATA[" + std::string(guid) + "]]></guid>\n";
+  xml += "  <guid type=\"String\"><![CDATA[" + std::string(kFileGuidMarker) + "]]></guid>\n";
   xml += "  <versionMajor type=\"Integer\">1</versionMajor>\n  <versionMinor type=\"Integer\">0</versionMinor>\n";
   xml += "  <e57LibraryVersion type=\"String\"><![CDATA[dpoint]]></e57LibraryVersion>\n";
   xml += "  <coordinateMetadata type=\"String\"><![CDATA[]]></coordinateMetadata>\n";
   xml += "  <data3D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n    <vectorChild type=\"Structure\">\n";
-  guid[std::strlen(guid) - 1] = '\0';
-  xml += "      <guid type=\"String\"><![CDATA[" + std::string(guid) + "-scan}]]></guid>\n";
-  if (n > 0) {
+  xml += "      <guid type=\"String\"><![CDATA[" + std::string(kScanGuidMarker) + "]]></guid>\n";
+  if (bounded) {
     xml += "      <cartesianBounds type=\"Structure\">\n";
     const char* axes[3] = {"x", "y", "z"};
     for (int k = 0; k < 3; ++k) {
@@ -309,6 +425,13 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     }
     xml += "      </cartesianBounds>\n";
   }
+  for (const OutField& f : fields)
+    if (f.name == "intensity" && f.limited) {
+      const char* type = f.kind == OutField::Kind::kInteger ? "Integer" : "Float";
+      xml += std::string("      <intensityLimits type=\"Structure\">\n        <intensityMinimum type=\"") + type + "\">" +
+             numberText(f.least) + "</intensityMinimum>\n        <intensityMaximum type=\"" + type + "\">" +
+             numberText(f.most) + "</intensityMaximum>\n      </intensityLimits>\n";
+    }
   if (points.hasColors()) {
     xml += "      <colorLimits type=\"Structure\">\n";
     for (const char* c : {"Red", "Green", "Blue"}) {
@@ -401,7 +524,15 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
       if (progress) progress->advance(std::min<uint64_t>(records_per_packet, n - (first + b) * records_per_packet));
     }
   }
+  if (Status s = writer.append(no_points); !s) return s;
   if (progress) progress->finish();
+  // The GUIDs, from what is written: the pages' checksums so far and the bytes of the last.
+  const auto [guid_hi, guid_lo] = writer.digest(prototype, n);
+  const std::string file_guid = uuidText(guid_hi, guid_lo), scan_guid = uuidText(guid_lo, guid_hi);
+  for (const auto& [marker, text] : {std::pair{kFileGuidMarker, file_guid}, std::pair{kScanGuidMarker, scan_guid}}) {
+    const size_t at = xml.find(marker);
+    xml.replace(at, text.size(), text);
+  }
   if (Status s = writer.append(xml); !s) return s;
   if (Status s = writer.finish(); !s) return s;
   if (Status s = out->commit(); !s) return s;

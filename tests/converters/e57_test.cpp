@@ -555,5 +555,74 @@ TEST(E57, aWrittenSetReadsBackWithEveryFieldOnAnyThreadCount) {
   EXPECT_EQ(empty->size(), 0u);
 }
 
+// A review of the writer: names that E57 gives a meaning, a dimension named like a colour, the
+// intensity's range, the GUIDs, bounds of non-finite sets, LAS's return 0, a float invalid state.
+TEST(E57, standardNamesAreRenamedAndEveryValueComesBack) {
+  TempDir dir;
+  PointSet set;
+  const size_t n = 300;
+  set.positions.resize(n);
+  Dimension& color_index = set.dimensions.append("color_index", DimType::kI32, n);
+  Dimension& return_index = set.dimensions.append("returnIndex", DimType::kF64, n);
+  Dimension& red = set.dimensions.append("colorRed", DimType::kU32, n);
+  Dimension& state = set.dimensions.append("cartesianInvalidState", DimType::kU8, n);
+  Dimension& returns = set.dimensions.append("return_number", DimType::kU8, n);
+  Dimension& intensity = set.dimensions.append("intensity", DimType::kF32, n);
+  for (size_t i = 0; i < n; ++i) {
+    set.positions[i] = glm::dvec3(static_cast<double>(i), 0.0, i == 7 ? NAN : 1.0);
+    color_index.set<int32_t>(i, -500 + static_cast<int32_t>(i) * 7);
+    return_index.set<double>(i, 0.5 * static_cast<double>(i));
+    red.set<uint32_t>(i, 1000 * static_cast<uint32_t>(i));
+    state.set<uint8_t>(i, static_cast<uint8_t>(i % 2));
+    returns.set<uint8_t>(i, static_cast<uint8_t>(i % 3));  // LAS's 0: no returnIndex of -1
+    intensity.set<float>(i, static_cast<float>(i) / 300.0f);
+  }
+  std::vector<std::string> notices;
+  E57WriteOptions options;
+  options.notices = &notices;
+  ASSERT_TRUE(writeE57(dir.file("a.e57"), set, options).ok());
+  EXPECT_EQ(notices.size(), 3u);  // returnIndex, colorRed, cartesianInvalidState renamed
+  Result<PointSet> back = readE57(dir.file("a.e57"), E57ReadOptions{0, nullptr, 0, true, nullptr});
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->size(), n);  // no point taken for invalid
+  EXPECT_FALSE(back->hasColors());
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{{"color_index", "color_index"},
+                                                                                {"returnIndex", "returnIndex_2"},
+                                                                                {"colorRed", "colorRed_2"},
+                                                                                {"cartesianInvalidState", "cartesianInvalidState_2"},
+                                                                                {"return_number", "return_number"},
+                                                                                {"intensity", "intensity"}}) {
+    const Dimension* b = back->dimensions.find(to);
+    ASSERT_NE(b, nullptr) << to;
+    for (size_t i = 0; i < n; ++i) ASSERT_EQ(b->value(i), set.dimensions.find(from)->value(i)) << to << " " << i;
+  }
+  const std::string bytes = test::readFile(dir.file("a.e57"));
+  // The intensity's range for readers that normalise by it, also as its Float's limits.
+  EXPECT_NE(bytes.find("<intensity type=\"Float\" precision=\"single\" minimum=\"0\" maximum=\"1\"/>"), std::string::npos);
+  EXPECT_NE(bytes.find("<intensityMaximum type=\"Float\">1</intensityMaximum>"), std::string::npos);
+  // Bounds of the finite coordinates (z: 1, not NaN).
+  EXPECT_NE(bytes.find("<zMinimum type=\"Float\">1</zMinimum>"), std::string::npos);
+  // GUIDs from the content: one value changed, other GUIDs.
+  const auto guidOf = [](const std::string& file) {
+    const size_t at = file.find("<guid type=\"String\"><![CDATA[");
+    return file.substr(at + 29, 36);
+  };
+  set.dimensions.find("color_index")->set<int32_t>(150, 1);
+  ASSERT_TRUE(writeE57(dir.file("b.e57"), set).ok());
+  EXPECT_NE(guidOf(bytes), guidOf(test::readFile(dir.file("b.e57"))));
+  EXPECT_EQ(guidOf(bytes)[14], '5');  // an RFC 4122 version 5 UUID
+
+  // Another writer's Float invalid state: 0.0 is valid.
+  E57File file;
+  const std::vector<double> x{1, 2, 3}, flags{0, 1, 0};
+  const uint64_t at = file.compressedVector({packRaw(x), packRaw(x), packRaw(x), packRaw(flags)}, 1000);
+  Result<PointSet> two = readBytes(dir, file.bytes(rootXml(scanXml(
+      at, 3, "<cartesianX type=\"Float\"/><cartesianY type=\"Float\"/><cartesianZ type=\"Float\"/>"
+             "<cartesianInvalidState type=\"Float\"/>"))));
+  ASSERT_TRUE(two.ok()) << two.error().message;
+  ASSERT_EQ(two->size(), 2u);
+  EXPECT_EQ(two->positions[1].x, 3.0);
+}
+
 }  // namespace
 }  // namespace dpoint
