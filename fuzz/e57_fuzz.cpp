@@ -22,18 +22,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.max_memory = fuzz::kMaxMemory;
   Result<PointSet> one = readE57(input, options);
   fuzz::checkOutcome(one, input.path());
-  if (one)
-    for (const Dimension& d : one->dimensions.all())
-      if (d.size() != one->size()) fuzz::broken("one value per point in each dimension", d.name);
   options.threads = 3;
   Result<PointSet> three = readE57(input, options);
-  if (one.ok() != three.ok()) fuzz::broken("the thread count does not change the outcome", input.path());
-  const auto same = [](const auto& a, const auto& b) {
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
-  };
-  if (one && !(same(one->positions, three->positions) && same(one->colors, three->colors)))
-    fuzz::broken("the thread count does not change the points", std::to_string(one->size()));
-  if (!one && one.error().message != three.error().message)
-    fuzz::broken("the thread count does not change the error", one.error().message + " | " + three.error().message);
+  fuzz::checkThreadCountsAgree(one, three, input.path());
   return 0;
 }

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <string_view>
 
@@ -41,11 +42,14 @@ inline void checkError(const Error& error, const std::string& name) {
     broken("an error exits 2 or 4", std::to_string(static_cast<int>(error.code)) + ": " + m);
 }
 
-// colours: none or one per point; triangles: whole, and every index names a point.
+// colours: none or one per point; dimensions: one value per point; triangles: whole, and every
+// index names a point.
 inline void checkPoints(const PointSet& points) {
   if (!points.colors.empty() && points.colors.size() != points.positions.size())
     broken("one colour per point", std::to_string(points.colors.size()) + " for " + std::to_string(points.size()));
   if (points.triangles.size() % 3 != 0) broken("whole triangles", std::to_string(points.triangles.size()));
+  for (const Dimension& d : points.dimensions.all())
+    if (d.size() != points.size()) broken("one value per point in each dimension", d.name);
   for (uint32_t index : points.triangles)
     if (index >= points.positions.size())
       broken("triangle indices name points", std::to_string(index) + " of " + std::to_string(points.size()));
@@ -54,6 +58,18 @@ inline void checkPoints(const PointSet& points) {
 inline void checkOutcome(const Result<PointSet>& result, const std::string& name) {
   if (result) checkPoints(*result);
   else checkError(result.error(), name);
+}
+
+// One input read on one thread and on three: the same outcome, positions, colours and error.
+inline void checkThreadCountsAgree(const Result<PointSet>& one, const Result<PointSet>& three, const std::string& name) {
+  if (one.ok() != three.ok()) broken("the thread count does not change the outcome", name);
+  const auto same = [](const auto& a, const auto& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+  };
+  if (one && !(same(one->positions, three->positions) && same(one->colors, three->colors)))
+    broken("the thread count does not change the points", std::to_string(one->size()));
+  if (!one && one.error().message != three.error().message)
+    broken("the thread count does not change the error", one.error().message + " | " + three.error().message);
 }
 
 }  // namespace dpoint::fuzz

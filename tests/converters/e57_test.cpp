@@ -482,6 +482,7 @@ TEST(E57, aWrittenSetReadsBackWithEveryFieldOnAnyThreadCount) {
   set.positions.resize(n);
   set.colors.resize(n);
   set.color_full_scale = 65535;
+  set.dimensions.reserve(9);  // the references below outlive each append
   Dimension& intensity = set.dimensions.append("intensity", DimType::kU16, n);
   Dimension& returns = set.dimensions.append("return_number", DimType::kU8, n);
   Dimension& count = set.dimensions.append("number_of_returns", DimType::kU8, n);
@@ -562,6 +563,7 @@ TEST(E57, standardNamesAreRenamedAndEveryValueComesBack) {
   PointSet set;
   const size_t n = 300;
   set.positions.resize(n);
+  set.dimensions.reserve(6);  // the references below outlive each append
   Dimension& color_index = set.dimensions.append("color_index", DimType::kI32, n);
   Dimension& return_index = set.dimensions.append("returnIndex", DimType::kF64, n);
   Dimension& red = set.dimensions.append("colorRed", DimType::kU32, n);
