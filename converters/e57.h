@@ -13,11 +13,14 @@
 // integers 0..255 or 0..65535 keep that scale (PointSet::color_full_scale), other ranges are
 // normalised by the scan's colorLimits (or the fields' own limits). Every other field is a
 // dimension of its own type (an integer field the smallest type holding its limits, a float field
-// float32 or float64, a scaled integer float64): intensity as `intensity`, returnIndex + 1 as
-// `return_number` and returnCount as `number_of_returns` (LAS's), the LAS extension's fields
-// (`las:classification`, …) by their LAS names, the others (rowIndex, timeStamp, …) by their own.
-// Several scans: each point's scan number (from 1, in the file's order) in point_source_id, as a
-// PTX file's scans are joined (converters/point_inputs.h). Images (images2D) are not read (a note).
+// float32 or float64, a scaled integer float64): intensity as `intensity` (read as 0..1 from the
+// scan's intensityLimits, else the field's limits, where some scan's is no 0..65535 integer),
+// returnIndex + 1 as `return_number` and returnCount as `number_of_returns` (LAS's), the LAS
+// extension's fields (`las:classification`, …) by their LAS names, the normals extension's
+// (`nor:normalX`, …) as nx, ny, nz, the others (rowIndex, timeStamp, …) by their own. Several
+// scans: each point's scan number (from 1, in the file's order) in point_source_id, as a PTX
+// file's scans are joined (converters/point_inputs.h), unless the file has its own ids; what the
+// join fills in (white colours, 0) is a note. Images (images2D) are not read (a note).
 //
 // Errors name the file and what failed: a page's checksum, the XML's line, a scan and field. A
 // non-finite coordinate is an error unless allow_nonfinite. The points and each field's packed
@@ -55,11 +58,12 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options = 
 // One scan (data3D) with no pose: x, y and z as doubles (every coordinate as it is), colours as
 // integers of their scale (0..255, or 0..65535 for 16-bit colours), each dimension a field:
 // integers as Integer of their values' own limits (packed in as few bits as those need), floats as
-// Float single or double; intensity as `intensity`, return_number - 1 as `returnIndex`,
-// number_of_returns as `returnCount`, nx/ny/nz as the normals extension's `nor:normalX/Y/Z`
-// (CloudCompare's), the other LAS fields as the LAS extension's (`las:classification`, …), other
-// names as XML names (renamed with a note). Triangles are not written. The same set makes the same
-// bytes (the GUIDs are made from what is written).
+// Float single or double; intensity as `intensity` with intensityLimits, return_number - 1 as
+// `returnIndex` (where every value is 1 or more), number_of_returns as `returnCount`, nx/ny/nz as
+// the normals extension's `nor:normalX/Y/Z`, the other LAS fields as the LAS extension's
+// (`las:classification`, …), other names as XML names that no standard field has (renamed with a
+// note). Triangles are not written. The same set makes the same bytes (the GUIDs are version 5
+// UUIDs of every page's checksum).
 Status writeE57(const std::string& path, const PointSet& points, const E57WriteOptions& options = {});
 
 // CRC-32C (Castagnoli) of `size` bytes, as E57 checks each page (stored big-endian after it).

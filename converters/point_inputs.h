@@ -24,9 +24,10 @@ namespace dpoint {
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options = {});
 
 // Scans of one file (PTX's, E57's data3D) as one set, in order: each point's scan number in
-// point_source_id (uint16), but for scans of number 0 (a scan with its own ids); colours white for a scan without beside one with; a dimension of
-// different types in different scans float64 in all (as appendPoints widens it); the colours'
-// integer scale the scans' own where they agree, else 65535 (which holds 8-bit values exactly).
+// point_source_id (uint16), but for scans of number 0 (where the file has its own ids); colours
+// white for a scan without beside one with; a dimension of different types in different scans
+// widened as appendPoints widens it; the colours' integer scale the scans' own where they agree,
+// else 65535 (which holds 8-bit values exactly).
 struct NumberedScan {
   uint64_t number = 0;  // 1 to 65535, or 0: no point_source_id added
   PointSet points;
