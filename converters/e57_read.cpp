@@ -13,8 +13,10 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <type_traits>
 
 #include "converters/point_inputs.h"
+#include "core/bytes.h"
 #include "core/dimensions.h"
 #include "core/memory.h"
 #include "core/parallel.h"
@@ -84,13 +86,6 @@ constexpr uint64_t kPacketWindow = 32u << 20;  // logical bytes of packets read 
 constexpr size_t kDecodeBlock = 1u << 16;   // records decoded at a time by a worker
 constexpr size_t kStreamPadding = 16;       // zero bytes after a field's bytes: a value read as 9 bytes
 
-template <typename T>
-T loadLe(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return v;
-}
-
 // The file as E57 lays it out: pages of page_ bytes, the last 4 a checksum of the others.
 class PagedFile {
  public:
@@ -103,13 +98,13 @@ class PagedFile {
     if (*got < 8 || std::memcmp(header, "ASTM-E57", 8) != 0)
       return Error{path + ": not an E57 file (it does not begin with ASTM-E57)"};
     if (*got < kFileHeaderBytes) return Error{path + ": an E57 file cut short within its 48-byte header"};
-    const uint32_t major = loadLe<uint32_t>(header + 8);
-    const uint64_t length = loadLe<uint64_t>(header + 16);
-    paged.xml_offset_ = loadLe<uint64_t>(header + 24);
-    paged.xml_length_ = loadLe<uint64_t>(header + 32);
-    paged.page_ = loadLe<uint64_t>(header + 40);
+    const uint32_t major = loadUnaligned<uint32_t>(header + 8);
+    const uint64_t length = loadUnaligned<uint64_t>(header + 16);
+    paged.xml_offset_ = loadUnaligned<uint64_t>(header + 24);
+    paged.xml_length_ = loadUnaligned<uint64_t>(header + 32);
+    paged.page_ = loadUnaligned<uint64_t>(header + 40);
     if (major != 1)
-      return Error{path + ": E57 version " + std::to_string(major) + "." + std::to_string(loadLe<uint32_t>(header + 12)) +
+      return Error{path + ": E57 version " + std::to_string(major) + "." + std::to_string(loadUnaligned<uint32_t>(header + 12)) +
                    " (version 1 is read)"};
     if (paged.page_ < 64 || paged.page_ > (1u << 20) || (paged.page_ & (paged.page_ - 1)) != 0)
       return Error{path + ": E57 page size " + std::to_string(paged.page_) + " (a power of two from 64 to 1 MiB, 1024 as written)"};
@@ -166,7 +161,7 @@ class PagedFile {
       }
       for (uint64_t p = p0; p < p1; ++p) {
         const uint8_t* bytes = buffer.data() + (p - p0) * page_;
-        const uint32_t stored = __builtin_bswap32(loadLe<uint32_t>(bytes + lp));
+        const uint32_t stored = __builtin_bswap32(loadUnaligned<uint32_t>(bytes + lp));
         if (crc32c(bytes, static_cast<size_t>(lp)) != stored) {
           errors[g] = Error{path() + ": page " + std::to_string(p) + " (bytes " + std::to_string(p * page_) + " to " +
                             std::to_string((p + 1) * page_ - 1) + ") fails its CRC-32C checksum: the file is damaged"};
@@ -191,26 +186,23 @@ class PagedFile {
 
 bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
-// A number of the XML tree: a Float's or an Integer's text (empty: 0), or an attribute.
-std::optional<double> parseDouble(std::string_view text) {
+// A number of the XML tree: a Float's or an Integer's text (empty: 0), or an attribute; blanks
+// about it passed over, a leading '+' taken as the text readers take it (afterPlusSign).
+template <typename T>
+std::optional<T> parseNumber(std::string_view text) {
   while (!text.empty() && isBlank(text.front())) text.remove_prefix(1);
   while (!text.empty() && isBlank(text.back())) text.remove_suffix(1);
-  if (text.empty()) return 0.0;
-  if (text.front() == '+') text.remove_prefix(1);
-  double v = 0.0;
-  const auto r = fast_float::from_chars(text.data(), text.data() + text.size(), v);
-  if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
-  return v;
-}
-
-std::optional<int64_t> parseInt64(std::string_view text) {
-  while (!text.empty() && isBlank(text.front())) text.remove_prefix(1);
-  while (!text.empty() && isBlank(text.back())) text.remove_suffix(1);
-  if (text.empty()) return int64_t{0};
-  if (text.front() == '+') text.remove_prefix(1);
-  int64_t v = 0;
-  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
+  if (text.empty()) return T{0};
+  const char* begin = afterPlusSign(text.data(), text.data() + text.size());
+  const char* end = text.data() + text.size();
+  T v{};
+  if constexpr (std::is_floating_point_v<T>) {
+    const auto r = fast_float::from_chars(begin, end, v);
+    if (r.ec != std::errc() || r.ptr != end) return std::nullopt;
+  } else {
+    const auto r = std::from_chars(begin, end, v);
+    if (r.ec != std::errc() || r.ptr != end) return std::nullopt;
+  }
   return v;
 }
 
@@ -220,13 +212,13 @@ Result<double> numberOf(const pugi::xml_node& parent, const char* name, double f
   const pugi::xml_node node = parent.child(name);
   if (!node) return fallback;
   const std::string type = node.attribute("type").value();
-  const std::optional<double> v = parseDouble(node.text().get());
+  const std::optional<double> v = parseNumber<double>(node.text().get());
   if (!v || (type != "Float" && type != "Integer" && type != "ScaledInteger"))
     return Error{where + "/" + name + ": " + quotedExcerpt(node.text().get()) + " of type " + quotedExcerpt(type) +
                  " is not a number"};
   if (type == "ScaledInteger") {
-    const std::optional<double> scale = parseDouble(node.attribute("scale").value());
-    const std::optional<double> offset = parseDouble(node.attribute("offset").value());
+    const std::optional<double> scale = parseNumber<double>(node.attribute("scale").value());
+    const std::optional<double> offset = parseNumber<double>(node.attribute("offset").value());
     if (!scale || !offset) return Error{where + "/" + name + ": a scale or offset that is not a number"};
     return *v * (node.attribute("scale") ? *scale : 1.0) + *offset;
   }
@@ -252,7 +244,7 @@ struct Field {
     const uint64_t bit = uint64_t{i} * bits;
     const uint8_t* p = bytes.data() + bit / 8;
     const unsigned shift = static_cast<unsigned>(bit % 8);
-    uint64_t v = loadLe<uint64_t>(p) >> shift;
+    uint64_t v = loadUnaligned<uint64_t>(p) >> shift;
     if (shift != 0 && shift + bits > 64) v |= uint64_t{p[8]} << (64 - shift);
     return bits == 64 ? v : v & ((uint64_t{1} << bits) - 1);
   }
@@ -262,8 +254,8 @@ struct Field {
   }
   double value(size_t i) const {
     switch (kind) {
-      case FieldKind::kFloat32: return static_cast<double>(loadLe<float>(bytes.data() + i * 4));
-      case FieldKind::kFloat64: return loadLe<double>(bytes.data() + i * 8);
+      case FieldKind::kFloat32: return static_cast<double>(loadUnaligned<float>(bytes.data() + i * 4));
+      case FieldKind::kFloat64: return loadUnaligned<double>(bytes.data() + i * 8);
       case FieldKind::kInteger: return static_cast<double>(integer(i));
       case FieldKind::kScaled: return static_cast<double>(integer(i)) * scale + offset;
     }
@@ -277,18 +269,14 @@ Result<Field> fieldOf(const pugi::xml_node& node, const std::string& where) {
   f.name = node.name();
   const std::string type = node.attribute("type").value();
   const std::string at = where + "/" + f.name;
-  const auto integerAttribute = [&](const char* name, int64_t fallback) -> Result<int64_t> {
+  // An attribute as a number of type T, `fallback` where it is missing.
+  const auto attribute = [&]<typename T>(const char* name, T fallback) -> Result<T> {
     const pugi::xml_attribute a = node.attribute(name);
     if (!a) return fallback;
-    const std::optional<int64_t> v = parseInt64(a.value());
-    if (!v) return Error{at + ": " + name + " " + quotedExcerpt(a.value()) + " is not a 64-bit integer"};
-    return *v;
-  };
-  const auto doubleAttribute = [&](const char* name, double fallback) -> Result<double> {
-    const pugi::xml_attribute a = node.attribute(name);
-    if (!a) return fallback;
-    const std::optional<double> v = parseDouble(a.value());
-    if (!v) return Error{at + ": " + name + " " + quotedExcerpt(a.value()) + " is not a number"};
+    const std::optional<T> v = parseNumber<T>(a.value());
+    if (!v)
+      return Error{at + ": " + name + " " + quotedExcerpt(a.value()) +
+                   (std::is_floating_point_v<T> ? " is not a number" : " is not a 64-bit integer")};
     return *v;
   };
   if (type == "Float") {
@@ -302,9 +290,9 @@ Result<Field> fieldOf(const pugi::xml_node& node, const std::string& where) {
     } else {
       return Error{at + ": precision " + quotedExcerpt(precision) + " (single or double)"};
     }
-    Result<double> lo = doubleAttribute("minimum", -HUGE_VAL);
+    Result<double> lo = attribute("minimum", -HUGE_VAL);
     if (!lo) return lo.error();
-    Result<double> hi = doubleAttribute("maximum", HUGE_VAL);
+    Result<double> hi = attribute("maximum", HUGE_VAL);
     if (!hi) return hi.error();
     f.float_minimum = *lo;
     f.float_maximum = *hi;
@@ -315,9 +303,9 @@ Result<Field> fieldOf(const pugi::xml_node& node, const std::string& where) {
                  (type == "Structure" || type == "Vector" ? " (nested fields are not read)" : "") +
                  " (a point's fields are Float, Integer or ScaledInteger)"};
   f.kind = type == "Integer" ? FieldKind::kInteger : FieldKind::kScaled;
-  Result<int64_t> lo = integerAttribute("minimum", INT64_MIN);
+  Result<int64_t> lo = attribute("minimum", int64_t{INT64_MIN});
   if (!lo) return lo.error();
-  Result<int64_t> hi = integerAttribute("maximum", INT64_MAX);
+  Result<int64_t> hi = attribute("maximum", int64_t{INT64_MAX});
   if (!hi) return hi.error();
   if (*hi < *lo) return Error{at + ": maximum " + std::to_string(*hi) + " is below minimum " + std::to_string(*lo)};
   f.minimum = *lo;
@@ -325,9 +313,9 @@ Result<Field> fieldOf(const pugi::xml_node& node, const std::string& where) {
   const uint64_t range = static_cast<uint64_t>(*hi) - static_cast<uint64_t>(*lo);
   f.bits = static_cast<unsigned>(std::bit_width(range));
   if (f.kind == FieldKind::kScaled) {
-    Result<double> scale = doubleAttribute("scale", 1.0);
+    Result<double> scale = attribute("scale", 1.0);
     if (!scale) return scale.error();
-    Result<double> offset = doubleAttribute("offset", 0.0);
+    Result<double> offset = attribute("offset", 0.0);
     if (!offset) return offset.error();
     if (!(*scale != 0.0) || !std::isfinite(*scale) || !std::isfinite(*offset))
       return Error{at + ": scale " + formatNumber(*scale) + " and offset " + formatNumber(*offset) +
@@ -399,8 +387,8 @@ Result<ScanInfo> scanInfoOf(const pugi::xml_node& scan, size_t index, const std:
   const pugi::xml_node points = scan.child("points");
   if (!points || std::string(points.attribute("type").value()) != "CompressedVector")
     return Error{where + ": no points (a CompressedVector)"};
-  const std::optional<int64_t> offset = parseInt64(points.attribute("fileOffset").value());
-  const std::optional<int64_t> records = parseInt64(points.attribute("recordCount").value());
+  const std::optional<int64_t> offset = parseNumber<int64_t>(points.attribute("fileOffset").value());
+  const std::optional<int64_t> records = parseNumber<int64_t>(points.attribute("recordCount").value());
   if (!offset || *offset < 0 || !points.attribute("fileOffset"))
     return Error{where + ": points: fileOffset " + quotedExcerpt(points.attribute("fileOffset").value()) + " is not a byte offset"};
   if (!records || *records < 0)
@@ -481,8 +469,8 @@ Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Pro
   if (header[0] != 1)
     return Error{where + ": the section at byte " + std::to_string(scan.section) + " is not a compressed vector (id " +
                  std::to_string(header[0]) + ", not 1)"};
-  const uint64_t length = loadLe<uint64_t>(header + 8);
-  const uint64_t data = loadLe<uint64_t>(header + 16);
+  const uint64_t length = loadUnaligned<uint64_t>(header + 8);
+  const uint64_t data = loadUnaligned<uint64_t>(header + 16);
   if (length < kSectionHeaderBytes || length > file.logicalLength() - start)
     return Error{where + ": its section's length " + std::to_string(length) + " runs past the end of the file"};
   const uint64_t end = start + length;
@@ -515,7 +503,7 @@ Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Pro
     uint64_t pos = 0, taken = 0;
     while (pos + 4 <= size && !complete()) {
       const uint8_t* packet = window.data() + pos;
-      const uint64_t packet_length = uint64_t{loadLe<uint16_t>(packet + 2)} + 1;
+      const uint64_t packet_length = uint64_t{loadUnaligned<uint16_t>(packet + 2)} + 1;
       const std::string packet_at = where + ": the packet at logical byte " + std::to_string(at + pos);
       if (packet_length > end - (at + pos)) return Error{packet_at + " runs past its section (cut short or damaged)"};
       if (pos + packet_length > size) break;  // the next window starts with it
@@ -526,7 +514,7 @@ Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Pro
       if (packet[0] != 1) return Error{packet_at + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
       if (packet_length < 6)
         return Error{packet_at + " is a data packet of " + std::to_string(packet_length) + " bytes, shorter than its 6-byte header"};
-      const uint64_t count = loadLe<uint16_t>(packet + 4);
+      const uint64_t count = loadUnaligned<uint16_t>(packet + 4);
       if (count != streams)
         return Error{packet_at + " has " + countOf(count, "bytestream") + " for a prototype of " + countOf(streams, "field")};
       uint64_t offset = 6 + 2 * count;
@@ -534,7 +522,7 @@ Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Pro
         return Error{packet_at + ": its " + countOf(count, "buffer length") + " overrun the packet (" +
                      std::to_string(packet_length) + " bytes)"};
       for (size_t k = 0; k < streams; ++k) {
-        const uint64_t n = loadLe<uint16_t>(packet + 6 + 2 * k);
+        const uint64_t n = loadUnaligned<uint16_t>(packet + 6 + 2 * k);
         if (offset + n > packet_length)
           return Error{packet_at + ": its buffers (" + std::to_string(offset + n) + " bytes) overrun the packet (" +
                        std::to_string(packet_length) + ")"};
@@ -731,7 +719,7 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
             default: std::memcpy(out, &v, 8); break;  // U64, I64: the same bits
           }
         } else if (dim.type == DimType::kF32) {
-          const float a = loadLe<float>(f.bytes.data() + i * 4);
+          const float a = loadUnaligned<float>(f.bytes.data() + i * 4);
           std::memcpy(out, &a, 4);
         } else {
           const double a = f.value(i);

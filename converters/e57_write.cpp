@@ -9,6 +9,7 @@
 
 #include "converters/e57.h"
 #include "core/atomic_file.h"
+#include "core/bytes.h"
 #include "core/dimensions.h"
 #include "core/parallel.h"
 #include "core/text.h"
@@ -67,12 +68,6 @@ void eachInteger(const OutField& f, const PointSet& points, uint16_t full, size_
     case DimType::kF32:
     case DimType::kF64: break;  // Float fields
   }
-}
-
-std::string numberText(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", v);
-  return buffer;
 }
 
 // camelCase of a LAS field's snake_case name (point_source_id → pointSourceId), as the E57 LAS
@@ -192,10 +187,6 @@ std::string uuidText(uint64_t hi, uint64_t lo) {
   return text;
 }
 
-template <typename T>
-void putLe(std::string& s, size_t at, T v) {
-  std::memcpy(s.data() + at, &v, sizeof v);
-}
 
 }  // namespace
 
@@ -402,7 +393,7 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
       prototype += " type=\"Integer\" minimum=\"" + std::to_string(f.minimum) + "\" maximum=\"" + std::to_string(f.maximum) + "\"/>\n";
     else
       prototype += std::string(" type=\"Float\" precision=\"") + (f.kind == OutField::Kind::kFloat32 ? "single" : "double") +
-                   (f.limited ? "\" minimum=\"" + numberText(f.least) + "\" maximum=\"" + numberText(f.most) : std::string()) +
+                   (f.limited ? "\" minimum=\"" + formatNumber(f.least) + "\" maximum=\"" + formatNumber(f.most) : std::string()) +
                    "\"/>\n";
   }
   std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<e57Root type=\"Structure\" "
@@ -420,8 +411,8 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     xml += "      <cartesianBounds type=\"Structure\">\n";
     const char* axes[3] = {"x", "y", "z"};
     for (int k = 0; k < 3; ++k) {
-      xml += std::string("        <") + axes[k] + "Minimum type=\"Float\">" + numberText(lo[k]) + "</" + axes[k] + "Minimum>\n";
-      xml += std::string("        <") + axes[k] + "Maximum type=\"Float\">" + numberText(hi[k]) + "</" + axes[k] + "Maximum>\n";
+      xml += std::string("        <") + axes[k] + "Minimum type=\"Float\">" + formatNumber(lo[k]) + "</" + axes[k] + "Minimum>\n";
+      xml += std::string("        <") + axes[k] + "Maximum type=\"Float\">" + formatNumber(hi[k]) + "</" + axes[k] + "Maximum>\n";
     }
     xml += "      </cartesianBounds>\n";
   }
@@ -429,8 +420,8 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     if (f.name == "intensity" && f.limited) {
       const char* type = f.kind == OutField::Kind::kInteger ? "Integer" : "Float";
       xml += std::string("      <intensityLimits type=\"Structure\">\n        <intensityMinimum type=\"") + type + "\">" +
-             numberText(f.least) + "</intensityMinimum>\n        <intensityMaximum type=\"" + type + "\">" +
-             numberText(f.most) + "</intensityMaximum>\n      </intensityLimits>\n";
+             formatNumber(f.least) + "</intensityMinimum>\n        <intensityMaximum type=\"" + type + "\">" +
+             formatNumber(f.most) + "</intensityMaximum>\n      </intensityLimits>\n";
     }
   if (points.hasColors()) {
     xml += "      <colorLimits type=\"Structure\">\n";
@@ -452,16 +443,16 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   const uint64_t file_length = (logical_end + kLogicalPage - 1) / kLogicalPage * kPage;
   std::string header(kHeaderBytes, '\0');
   std::memcpy(header.data(), "ASTM-E57", 8);
-  putLe<uint32_t>(header, 8, 1);
-  putLe<uint32_t>(header, 12, 0);
-  putLe<uint64_t>(header, 16, file_length);
-  putLe<uint64_t>(header, 24, physicalOf(xml_logical));
-  putLe<uint64_t>(header, 32, xml.size());
-  putLe<uint64_t>(header, 40, kPage);
+  storeUnaligned<uint32_t>(header.data() + 8, 1);
+  storeUnaligned<uint32_t>(header.data() + 12, 0);
+  storeUnaligned<uint64_t>(header.data() + 16, file_length);
+  storeUnaligned<uint64_t>(header.data() + 24, physicalOf(xml_logical));
+  storeUnaligned<uint64_t>(header.data() + 32, xml.size());
+  storeUnaligned<uint64_t>(header.data() + 40, kPage);
   std::string section_header(kSectionHeaderBytes, '\0');
   section_header[0] = 1;
-  putLe<uint64_t>(section_header, 8, section);
-  putLe<uint64_t>(section_header, 16, physicalOf(kHeaderBytes + kSectionHeaderBytes));
+  storeUnaligned<uint64_t>(section_header.data() + 8, section);
+  storeUnaligned<uint64_t>(section_header.data() + 16, physicalOf(kHeaderBytes + kSectionHeaderBytes));
 
   Result<AtomicFile> out = AtomicFile::create(path);
   if (!out) return out.error();
@@ -481,13 +472,13 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
       std::string& packet = batch[b];
       packet.assign(static_cast<size_t>(packetBytes(p, &chunks)), '\0');
       packet[0] = 1;
-      putLe<uint16_t>(packet, 2, static_cast<uint16_t>(packet.size() - 1));
-      putLe<uint16_t>(packet, 4, static_cast<uint16_t>(fields.size()));
+      storeUnaligned<uint16_t>(packet.data() + 2, static_cast<uint16_t>(packet.size() - 1));
+      storeUnaligned<uint16_t>(packet.data() + 4, static_cast<uint16_t>(fields.size()));
       size_t at = static_cast<size_t>(header_bytes);
       const size_t begin = static_cast<size_t>(p * records_per_packet);
       const size_t end = static_cast<size_t>(std::min<uint64_t>(n, begin + records_per_packet));
       for (size_t k = 0; k < fields.size(); ++k) {
-        putLe<uint16_t>(packet, 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
+        storeUnaligned<uint16_t>(packet.data() + 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
         const OutField& f = fields[k];
         uint8_t* bytes = reinterpret_cast<uint8_t*>(packet.data()) + at;
         if (f.source == OutField::Source::kPosition) {
