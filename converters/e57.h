@@ -23,8 +23,10 @@
 // join fills in (white colours, 0) is a note. Images (images2D) are not read (a note).
 //
 // Errors name the file and what failed: a page's checksum, the XML's line, a scan and field. A
-// non-finite coordinate is an error unless allow_nonfinite. The points and each field's packed
-// bytes are checked against max_memory before they are allocated.
+// non-finite coordinate is an error unless allow_nonfinite. The points are checked against
+// max_memory before they are allocated; the fields' packed bytes are read a window of packets at a
+// time and decoded as they come (a file whose packets give one field's values long before
+// another's, which no writer does, holds more of them, up to what max_memory leaves).
 #pragma once
 
 #include <cstdint>
@@ -44,6 +46,9 @@ struct E57ReadOptions {
   uint64_t max_memory = 0;  // 0: defaultMemoryLimit()
   bool allow_nonfinite = false;
   std::vector<std::string>* notices = nullptr;  // points left out, images not read
+  // Logical bytes of packets read at a time (0: 32 MiB; at least 64 KiB, a packet's most): tests
+  // make it small, so that small files take many windows.
+  uint64_t packet_window = 0;
 };
 
 struct E57WriteOptions {

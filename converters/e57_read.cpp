@@ -82,7 +82,8 @@ namespace {
 constexpr uint64_t kFileHeaderBytes = 48;
 constexpr uint64_t kSectionHeaderBytes = 32;
 constexpr size_t kPagesPerRead = 1024;      // pages read and checked at a time by a worker
-constexpr uint64_t kPacketWindow = 32u << 20;  // logical bytes of packets read at a time
+constexpr uint64_t kPacketWindow = 32u << 20;  // logical bytes of packets read at a time (E57ReadOptions::packet_window)
+constexpr uint64_t kLeastWindow = 64u << 10;   // a packet's most
 constexpr size_t kDecodeBlock = 1u << 16;   // records decoded at a time by a worker
 constexpr size_t kStreamPadding = 16;       // zero bytes after a field's bytes: a value read as 9 bytes
 
@@ -235,14 +236,17 @@ struct Field {
   double scale = 1.0, offset = 0.0;
   double float_minimum = -HUGE_VAL, float_maximum = HUGE_VAL;  // a Float's limits, where given
   unsigned bits = 64;                                           // per value
-  DimensionBytes bytes;  // the packed values, then kStreamPadding zeros (unset as sized: every byte is written)
-  uint64_t filled = 0;                                          // bytes gathered from packets
+  // The packed values' bytes [first_byte, filled) of the field's stream, then at least
+  // kStreamPadding bytes (PacketReader's rolling buffer).
+  DimensionBytes bytes;
+  uint64_t first_byte = 0, filled = 0;
 
   uint64_t neededBytes(uint64_t records) const { return (records * bits + 7) / 8; }
-  // Value i's packed bits.
+  const uint8_t* at(uint64_t byte) const { return bytes.data() + (byte - first_byte); }
+  // Value i's packed bits (its bytes held).
   uint64_t raw(size_t i) const {
     const uint64_t bit = uint64_t{i} * bits;
-    const uint8_t* p = bytes.data() + bit / 8;
+    const uint8_t* p = at(bit / 8);
     const unsigned shift = static_cast<unsigned>(bit % 8);
     uint64_t v = loadUnaligned<uint64_t>(p) >> shift;
     if (shift != 0 && shift + bits > 64) v |= uint64_t{p[8]} << (64 - shift);
@@ -254,8 +258,8 @@ struct Field {
   }
   double value(size_t i) const {
     switch (kind) {
-      case FieldKind::kFloat32: return static_cast<double>(loadUnaligned<float>(bytes.data() + i * 4));
-      case FieldKind::kFloat64: return loadUnaligned<double>(bytes.data() + i * 8);
+      case FieldKind::kFloat32: return static_cast<double>(loadUnaligned<float>(at(uint64_t{i} * 4)));
+      case FieldKind::kFloat64: return loadUnaligned<double>(at(uint64_t{i} * 8));
       case FieldKind::kInteger: return static_cast<double>(integer(i));
       case FieldKind::kScaled: return static_cast<double>(integer(i)) * scale + offset;
     }
@@ -458,93 +462,174 @@ const Field* findField(const ScanInfo& scan, std::string_view name) {
   return nullptr;
 }
 
-// The packets of a scan's compressed vector, walked once: each field's bytes gathered in order.
-Status gatherFields(const PagedFile& file, ScanInfo& scan, unsigned threads, Progress* progress) {
-  const std::string where = file.path() + ": " + scan.label + ": points";
-  if (scan.section >= file.physicalLength())
-    return Error{where + ": its section at byte " + std::to_string(scan.section) + " lies past the end of the file"};
-  const uint64_t start = file.logicalOf(scan.section);
-  uint8_t header[kSectionHeaderBytes];
-  if (Status s = file.read(start, header, sizeof header, 1, nullptr); !s) return s;
-  if (header[0] != 1)
-    return Error{where + ": the section at byte " + std::to_string(scan.section) + " is not a compressed vector (id " +
-                 std::to_string(header[0]) + ", not 1)"};
-  const uint64_t length = loadUnaligned<uint64_t>(header + 8);
-  const uint64_t data = loadUnaligned<uint64_t>(header + 16);
-  if (length < kSectionHeaderBytes || length > file.logicalLength() - start)
-    return Error{where + ": its section's length " + std::to_string(length) + " runs past the end of the file"};
-  const uint64_t end = start + length;
-  const uint64_t data_logical = file.logicalOf(data);
-  if (scan.records == 0) return okStatus();
-  if (data_logical < start + kSectionHeaderBytes || data_logical >= end)
-    return Error{where + ": its data (at byte " + std::to_string(data) + ") is not within its section"};
-  const size_t streams = scan.fields.size();
-  uint64_t needed = 0;
-  for (const Field& f : scan.fields) needed += f.neededBytes(scan.records);
-  if (needed > end - data_logical)  // before the fields' bytes are allocated
-    return Error{where + ": " + std::to_string(scan.records) + " records of its fields need " + std::to_string(needed) +
-                 " bytes, but its section holds " + std::to_string(end - data_logical) + " (cut short or damaged)"};
-  for (Field& f : scan.fields) {
-    f.bytes.resize(static_cast<size_t>(f.neededBytes(scan.records)) + kStreamPadding);
-    std::fill(f.bytes.end() - kStreamPadding, f.bytes.end(), uint8_t{0});
-    f.filled = 0;
+// The packets of a scan's compressed vector, read a window at a time in order: each field's bytes
+// appended to its rolling buffer (Field::bytes), from which the records every field holds whole
+// are decoded, then dropped (drop). Memory is a window and what the fields hold past the records
+// decoded: about one window where a writer spreads the fields evenly over its packets, as writers
+// do; a file that gives one field's values long before another's holds more, up to `budget`.
+class PacketReader {
+ public:
+  PacketReader(const PagedFile& file, ScanInfo& scan, uint64_t window, unsigned threads, Progress* progress, uint64_t budget)
+      : file_(file), scan_(scan), window_bytes_(window), threads_(threads), progress_(progress), budget_(budget),
+        where_(file.path() + ": " + scan.label + ": points") {}
+
+  // The section's header, and its data's place.
+  Status open() {
+    if (scan_.section >= file_.physicalLength())
+      return Error{where_ + ": its section at byte " + std::to_string(scan_.section) + " lies past the end of the file"};
+    const uint64_t start = file_.logicalOf(scan_.section);
+    uint8_t header[kSectionHeaderBytes];
+    if (Status s = file_.read(start, header, sizeof header, 1, nullptr); !s) return s;
+    if (header[0] != 1)
+      return Error{where_ + ": the section at byte " + std::to_string(scan_.section) + " is not a compressed vector (id " +
+                   std::to_string(header[0]) + ", not 1)"};
+    const uint64_t length = loadUnaligned<uint64_t>(header + 8);
+    const uint64_t data = loadUnaligned<uint64_t>(header + 16);
+    if (length < kSectionHeaderBytes || length > file_.logicalLength() - start)
+      return Error{where_ + ": its section's length " + std::to_string(length) + " runs past the end of the file"};
+    end_ = start + length;
+    at_ = file_.logicalOf(data);
+    if (scan_.records == 0) return okStatus();
+    if (at_ < start + kSectionHeaderBytes || at_ >= end_)
+      return Error{where_ + ": its data (at byte " + std::to_string(data) + ") is not within its section"};
+    uint64_t needed = 0;
+    for (const Field& f : scan_.fields) needed += f.neededBytes(scan_.records);
+    if (needed > end_ - at_)  // a count no section of this file holds, before anything is read
+      return Error{where_ + ": " + std::to_string(scan_.records) + " records of its fields need " + std::to_string(needed) +
+                   " bytes, but its section holds " + std::to_string(end_ - at_) + " (cut short or damaged)"};
+    for (Field& f : scan_.fields) {
+      f.first_byte = f.filled = 0;
+      f.bytes.assign(kStreamPadding, uint8_t{0});
+    }
+    return okStatus();
   }
-  const auto complete = [&] {
-    for (const Field& f : scan.fields)
-      if (f.filled < f.neededBytes(scan.records)) return false;
+
+  // The records every field holds whole (from the first): those that can be decoded.
+  uint64_t ready() const {
+    uint64_t ready = scan_.records;
+    for (const Field& f : scan_.fields)
+      if (f.bits != 0) ready = std::min(ready, f.filled * 8 / f.bits);
+    return ready;
+  }
+
+  // Windows of packets gathered until ready() grows: an error where the section ends first (a
+  // field cut short), a packet is malformed, or the fields would hold more than the budget.
+  Status next() {
+    const uint64_t before = ready();
+    while (!done() && ready() == before && at_ < end_) {
+      const uint64_t size = std::min(window_bytes_, end_ - at_);
+      window_.resize(static_cast<size_t>(size));
+      if (Status s = file_.read(at_, window_.data(), size, threads_, nullptr); !s) return s;
+      Result<uint64_t> used = gather(size);
+      if (!used) return used.error();
+      if (*used == 0) break;  // fewer than 4 bytes left: the check below names the field cut short
+      at_ += *used;
+    }
+    if (!done() && ready() == before)
+      for (const Field& f : scan_.fields)
+        if (f.filled < f.neededBytes(scan_.records))
+          return Error{where_ + ": the field " + f.name + " ends after " + std::to_string(f.filled * 8 / std::max(1u, f.bits)) +
+                       " of its " + std::to_string(scan_.records) + " records (the file is cut short or damaged)"};
+    for (Field& f : scan_.fields)  // the padding a value read as 9 bytes may touch
+      std::fill_n(f.bytes.data() + (f.filled - f.first_byte), kStreamPadding, uint8_t{0});
+    return okStatus();
+  }
+
+  // Records before `records` are decoded: their bytes are dropped (a partly used byte is kept).
+  void drop(uint64_t records) {
+    for (Field& f : scan_.fields) {
+      const uint64_t keep = records * f.bits / 8;  // the byte record `records` begins in
+      const size_t shift = static_cast<size_t>(keep - f.first_byte);
+      const size_t held = static_cast<size_t>(f.filled - f.first_byte);
+      if (shift == 0) continue;
+      std::memmove(f.bytes.data(), f.bytes.data() + shift, held - shift);
+      f.first_byte = keep;
+    }
+  }
+
+  bool done() const {
+    for (const Field& f : scan_.fields)
+      if (f.filled < f.neededBytes(scan_.records)) return false;
     return true;
-  };
-  std::vector<uint8_t> window;
-  uint64_t at = data_logical;
-  while (at < end && !complete()) {
-    const uint64_t size = std::min(kPacketWindow, end - at);
-    window.resize(static_cast<size_t>(size));
-    if (Status s = file.read(at, window.data(), size, threads, nullptr); !s) return s;
+  }
+
+ private:
+  // The whole packets at the window's start gathered; the bytes they take (0: none is whole).
+  Result<uint64_t> gather(uint64_t size) {
+    const size_t streams = scan_.fields.size();
     uint64_t pos = 0, taken = 0;
-    while (pos + 4 <= size && !complete()) {
-      const uint8_t* packet = window.data() + pos;
+    while (pos + 4 <= size && !done()) {
+      const uint8_t* packet = window_.data() + pos;
       const uint64_t packet_length = uint64_t{loadUnaligned<uint16_t>(packet + 2)} + 1;
-      const std::string packet_at = where + ": the packet at logical byte " + std::to_string(at + pos);
-      if (packet_length > end - (at + pos)) return Error{packet_at + " runs past its section (cut short or damaged)"};
+      const auto packet_at = [&] { return where_ + ": the packet at logical byte " + std::to_string(at_ + pos); };
+      if (packet_length > end_ - (at_ + pos)) return Error{packet_at() + " runs past its section (cut short or damaged)"};
       if (pos + packet_length > size) break;  // the next window starts with it
       if (packet[0] == 0 || packet[0] == 2) {  // an index or empty packet
         pos += packet_length;
         continue;
       }
-      if (packet[0] != 1) return Error{packet_at + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
+      if (packet[0] != 1) return Error{packet_at() + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
       if (packet_length < 6)
-        return Error{packet_at + " is a data packet of " + std::to_string(packet_length) + " bytes, shorter than its 6-byte header"};
+        return Error{packet_at() + " is a data packet of " + std::to_string(packet_length) +
+                     " bytes, shorter than its 6-byte header"};
       const uint64_t count = loadUnaligned<uint16_t>(packet + 4);
       if (count != streams)
-        return Error{packet_at + " has " + countOf(count, "bytestream") + " for a prototype of " + countOf(streams, "field")};
+        return Error{packet_at() + " has " + countOf(count, "bytestream") + " for a prototype of " + countOf(streams, "field")};
       uint64_t offset = 6 + 2 * count;
       if (offset > packet_length)
-        return Error{packet_at + ": its " + countOf(count, "buffer length") + " overrun the packet (" +
+        return Error{packet_at() + ": its " + countOf(count, "buffer length") + " overrun the packet (" +
                      std::to_string(packet_length) + " bytes)"};
       for (size_t k = 0; k < streams; ++k) {
         const uint64_t n = loadUnaligned<uint16_t>(packet + 6 + 2 * k);
         if (offset + n > packet_length)
-          return Error{packet_at + ": its buffers (" + std::to_string(offset + n) + " bytes) overrun the packet (" +
+          return Error{packet_at() + ": its buffers (" + std::to_string(offset + n) + " bytes) overrun the packet (" +
                        std::to_string(packet_length) + ")"};
-        Field& f = scan.fields[k];
-        const uint64_t room = f.neededBytes(scan.records) - std::min(f.filled, f.neededBytes(scan.records));
-        const uint64_t take = std::min(n, room);  // a field's last word may be padded past its values
-        std::memcpy(f.bytes.data() + f.filled, packet + offset, static_cast<size_t>(take));
-        f.filled += take;
-        taken += take;
+        Field& f = scan_.fields[k];
+        const uint64_t needed = f.neededBytes(scan_.records);
+        const uint64_t take = std::min(n, needed - std::min(f.filled, needed));  // a last word may be padded past the values
+        if (take > 0) {
+          if (Status s = append(f, packet + offset, take); !s) return s.error();
+          taken += take;
+        }
         offset += n;
       }
       pos += packet_length;
     }
-    if (progress) progress->advance(taken);
-    if (pos == 0) break;  // fewer than 4 bytes left: the fields' check below names the one cut short
-    at += pos;
+    if (progress_) progress_->advance(taken);
+    return pos;
   }
-  for (const Field& f : scan.fields)
-    if (f.filled < f.neededBytes(scan.records))
-      return Error{where + ": the field " + f.name + " ends after " + std::to_string(f.filled * 8 / std::max(1u, f.bits)) +
-                   " of its " + std::to_string(scan.records) + " records (the file is cut short or damaged)"};
-  return okStatus();
+
+  Status append(Field& f, const uint8_t* bytes, uint64_t n) {
+    const uint64_t held = f.filled - f.first_byte;
+    if (held + n + kStreamPadding > f.bytes.size()) {
+      uint64_t all = 0;
+      for (const Field& other : scan_.fields) all += other.bytes.size();
+      const uint64_t grown = std::max<uint64_t>(2 * f.bytes.size(), held + n + kStreamPadding);
+      if (all - f.bytes.size() + grown > budget_)
+        return Error{where_ + ": its fields' values are spread so unevenly over its packets that " +
+                         std::to_string(all - f.bytes.size() + grown) + " bytes of them would be held at once, more than " +
+                         "the memory limit leaves (--max-memory)",
+                     ExitCode::kResourceLimit};
+      f.bytes.resize(static_cast<size_t>(grown));
+    }
+    std::memcpy(f.bytes.data() + held, bytes, static_cast<size_t>(n));
+    f.filled += n;
+    return okStatus();
+  }
+
+  const PagedFile& file_;
+  ScanInfo& scan_;
+  uint64_t window_bytes_;
+  unsigned threads_;
+  Progress* progress_;
+  uint64_t budget_;
+  std::string where_;
+  uint64_t at_ = 0, end_ = 0;
+  std::vector<uint8_t> window_;
+};
+
+uint64_t windowOf(const E57ReadOptions& options) {
+  return options.packet_window == 0 ? kPacketWindow : std::max(options.packet_window, kLeastWindow);
 }
 
 // The colour channel of a field: an integer 0..full keeps its scale; else normalised by limits.
@@ -588,8 +673,10 @@ std::optional<IntensityRange> intensityRange(const Field& f, const ScanInfo& sca
 }
 
 // The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left out.
-Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57ReadOptions& options, bool intensity_fractions,
-                          uint64_t& left_out, std::vector<std::string>& intensity_ranges) {
+// Its packets read a window at a time (PacketReader), each window's records decoded on all cores;
+// the fields' bytes may hold up to `budget` bytes at once.
+Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOptions& options, uint64_t budget,
+                          bool intensity_fractions, uint64_t& left_out, std::vector<std::string>& intensity_ranges) {
   const std::string where = file.path() + ": " + scan.label;
   const unsigned threads = resolveThreads(options.threads);
   const Field* c[3] = {findField(scan, "cartesianX"), findField(scan, "cartesianY"), findField(scan, "cartesianZ")};
@@ -671,83 +758,93 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
                           {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
                           {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
   const double* t = scan.translation;
-  const size_t blocks = (n + kDecodeBlock - 1) / kDecodeBlock;
-  std::atomic<size_t> first_nonfinite{SIZE_MAX};
-  parallelFor(blocks, threads, [&](size_t b, unsigned) {
-    const size_t begin = b * kDecodeBlock, end = std::min(n, begin + kDecodeBlock);
-    for (size_t i = begin; i < end; ++i) {
-      glm::dvec3 p(xyz[0]->value(i), xyz[1]->value(i), xyz[2]->value(i));
-      if (!cartesian) {
-        const double r = p.x, az = p.y, el = p.z;
-        p = glm::dvec3(r * std::cos(el) * std::cos(az), r * std::cos(el) * std::sin(az), r * std::sin(el));
-      }
-      if (!identity)
-        p = glm::dvec3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t[0], m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t[1],
-                       m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t[2]);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        if (!invalid || invalid->value(i) == 0.0) lowerAtomic(first_nonfinite, i);
-      }
-      points.positions[i] = p;
-      if (colors) {
-        glm::vec3& color = points.colors[i];
-        for (int k = 0; k < 3; ++k) {
-          const double v = channel[k].field->value(i);
-          color[k] = static_cast<float>(full != 0 ? v / full : (v - channel[k].lo) / (channel[k].hi - channel[k].lo));
-        }
-      }
-    }
-    for (size_t d = 0; d < kept.size(); ++d) {
-      const Field& f = *kept[d];
-      Dimension& dim = points.dimensions.all()[d];
-      const size_t width = dimTypeSize(dim.type);
-      const bool return_index = f.name == "returnIndex" && f.kind == FieldKind::kInteger && dim.name == dim::kReturnNumber;
+  PacketReader reader(file, scan, windowOf(options), threads, options.progress, budget);
+  if (Status status = reader.open(); !status) return status.error();
+  size_t decoded = 0, kept_points = 0;
+  while (decoded < n) {
+    if (Status status = reader.next(); !status) return status.error();
+    const size_t ready = static_cast<size_t>(reader.ready());
+    const size_t blocks = (ready - decoded + kDecodeBlock - 1) / kDecodeBlock;
+    std::atomic<size_t> first_nonfinite{SIZE_MAX};
+    parallelFor(blocks, threads, [&](size_t b, unsigned) {
+      const size_t begin = decoded + b * kDecodeBlock, end = std::min(ready, begin + kDecodeBlock);
       for (size_t i = begin; i < end; ++i) {
-        uint8_t* out = dim.bytes.data() + i * width;
-        if (normalised[d]) {
-          const IntensityRange& r = *normalised[d];
-          const float a = static_cast<float>((f.value(i) - r.lo) / (r.hi - r.lo));
-          std::memcpy(out, &a, 4);
-        } else if (f.kind == FieldKind::kInteger) {
-          const int64_t v = f.integer(i) + (return_index ? 1 : 0);
-          switch (dim.type) {  // the type holds the field's limits (integerType)
-            case DimType::kU8: *out = static_cast<uint8_t>(v); break;
-            case DimType::kI8: { const int8_t a = static_cast<int8_t>(v); std::memcpy(out, &a, 1); break; }
-            case DimType::kU16: { const uint16_t a = static_cast<uint16_t>(v); std::memcpy(out, &a, 2); break; }
-            case DimType::kI16: { const int16_t a = static_cast<int16_t>(v); std::memcpy(out, &a, 2); break; }
-            case DimType::kU32: { const uint32_t a = static_cast<uint32_t>(v); std::memcpy(out, &a, 4); break; }
-            case DimType::kI32: { const int32_t a = static_cast<int32_t>(v); std::memcpy(out, &a, 4); break; }
-            default: std::memcpy(out, &v, 8); break;  // U64, I64: the same bits
+        glm::dvec3 p(xyz[0]->value(i), xyz[1]->value(i), xyz[2]->value(i));
+        if (!cartesian) {
+          const double r = p.x, az = p.y, el = p.z;
+          p = glm::dvec3(r * std::cos(el) * std::cos(az), r * std::cos(el) * std::sin(az), r * std::sin(el));
+        }
+        if (!identity)
+          p = glm::dvec3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t[0], m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t[1],
+                         m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t[2]);
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+          if (!invalid || invalid->value(i) == 0.0) lowerAtomic(first_nonfinite, i);
+        }
+        points.positions[i] = p;
+        if (colors) {
+          glm::vec3& color = points.colors[i];
+          for (int k = 0; k < 3; ++k) {
+            const double v = channel[k].field->value(i);
+            color[k] = static_cast<float>(full != 0 ? v / full : (v - channel[k].lo) / (channel[k].hi - channel[k].lo));
           }
-        } else if (dim.type == DimType::kF32) {
-          const float a = loadUnaligned<float>(f.bytes.data() + i * 4);
-          std::memcpy(out, &a, 4);
-        } else {
-          const double a = f.value(i);
-          std::memcpy(out, &a, 8);
         }
       }
-    }
-  });
-  if (first_nonfinite.load() != SIZE_MAX && !options.allow_nonfinite) {
-    const size_t i = first_nonfinite.load();
-    return Error{where + ": point " + std::to_string(i) + " has a coordinate that is not finite (" +
-                 formatNumber(xyz[0]->value(i)) + ", " + formatNumber(xyz[1]->value(i)) + ", " + formatNumber(xyz[2]->value(i)) +
-                 "); --allow-nonfinite keeps it"};
-  }
-  points.color_full_scale = full;
-
-  // The points with an invalid state left out, in order.
-  if (invalid) {
-    size_t kept_points = 0;
-    for (size_t i = 0; i < n; ++i) {
-      if (invalid->value(i) != 0.0) continue;  // an Integer as E57 has it, or a Float of another writer
-      if (kept_points != i) {
-        points.positions[kept_points] = points.positions[i];
-        if (colors) points.colors[kept_points] = points.colors[i];
-        for (Dimension& d : points.dimensions.all()) d.copyFrom(kept_points, d, i);
+      for (size_t d = 0; d < kept.size(); ++d) {
+        const Field& f = *kept[d];
+        Dimension& dim = points.dimensions.all()[d];
+        const size_t width = dimTypeSize(dim.type);
+        const bool return_index = f.name == "returnIndex" && f.kind == FieldKind::kInteger && dim.name == dim::kReturnNumber;
+        for (size_t i = begin; i < end; ++i) {
+          uint8_t* out = dim.bytes.data() + i * width;
+          if (normalised[d]) {
+            const IntensityRange& r = *normalised[d];
+            const float a = static_cast<float>((f.value(i) - r.lo) / (r.hi - r.lo));
+            std::memcpy(out, &a, 4);
+          } else if (f.kind == FieldKind::kInteger) {
+            const int64_t v = f.integer(i) + (return_index ? 1 : 0);
+            switch (dim.type) {  // the type holds the field's limits (integerType)
+              case DimType::kU8: *out = static_cast<uint8_t>(v); break;
+              case DimType::kI8: { const int8_t a = static_cast<int8_t>(v); std::memcpy(out, &a, 1); break; }
+              case DimType::kU16: { const uint16_t a = static_cast<uint16_t>(v); std::memcpy(out, &a, 2); break; }
+              case DimType::kI16: { const int16_t a = static_cast<int16_t>(v); std::memcpy(out, &a, 2); break; }
+              case DimType::kU32: { const uint32_t a = static_cast<uint32_t>(v); std::memcpy(out, &a, 4); break; }
+              case DimType::kI32: { const int32_t a = static_cast<int32_t>(v); std::memcpy(out, &a, 4); break; }
+              default: std::memcpy(out, &v, 8); break;  // U64, I64: the same bits
+            }
+          } else if (dim.type == DimType::kF32) {
+            const float a = loadUnaligned<float>(f.at(uint64_t{i} * 4));
+            std::memcpy(out, &a, 4);
+          } else {
+            const double a = f.value(i);
+            std::memcpy(out, &a, 8);
+          }
+        }
       }
-      ++kept_points;
+    });
+    if (first_nonfinite.load() != SIZE_MAX && !options.allow_nonfinite) {
+      const size_t i = first_nonfinite.load();
+      return Error{where + ": point " + std::to_string(i) + " has a coordinate that is not finite (" +
+                   formatNumber(xyz[0]->value(i)) + ", " + formatNumber(xyz[1]->value(i)) + ", " + formatNumber(xyz[2]->value(i)) +
+                   "); --allow-nonfinite keeps it"};
     }
+    // The points with an invalid state left out, in order (while the window's fields are held).
+    if (invalid) {
+      for (size_t i = decoded; i < ready; ++i) {
+        if (invalid->value(i) != 0.0) continue;  // an Integer as E57 has it, or a Float of another writer
+        if (kept_points != i) {
+          points.positions[kept_points] = points.positions[i];
+          if (colors) points.colors[kept_points] = points.colors[i];
+          for (Dimension& d : points.dimensions.all()) d.copyFrom(kept_points, d, i);
+        }
+        ++kept_points;
+      }
+    }
+    reader.drop(ready);
+    decoded = ready;
+  }
+  for (Field& f : scan.fields) DimensionBytes().swap(f.bytes);
+  points.color_full_scale = full;
+  if (invalid) {
     left_out += n - kept_points;
     points.positions.resize(kept_points);
     if (colors) points.colors.resize(kept_points);
@@ -756,14 +853,14 @@ Result<PointSet> pointsOf(const PagedFile& file, const ScanInfo& scan, const E57
   return points;
 }
 
-// Bytes held per point of a scan: positions, colours, dimensions, and the fields' packed values.
+// Bytes held per point of a scan: positions, colours and, at most, 8 for each other field (the
+// fields' packed values are held a window at a time: PacketReader).
 uint64_t bytesPerRecord(const ScanInfo& scan) {
   uint64_t bytes = sizeof(glm::dvec3);
   bool colors = false;
   for (const Field& f : scan.fields) {
-    bytes += (f.bits + 7) / 8;
     if (f.name.rfind("color", 0) == 0) colors = true;
-    else bytes += 8;
+    else if (f.name.rfind("cartesian", 0) != 0 && f.name.rfind("spherical", 0) != 0) bytes += 8;
   }
   return bytes + (colors ? sizeof(glm::vec3) : 0);
 }
@@ -809,7 +906,8 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
 
   uint64_t total = 0, held = 0, bytes_to_read = 0;
   for (const ScanInfo& scan : scans) {
-    if (scan.records > (UINT64_MAX / 2) / bytesPerRecord(scan) || total + scan.records < total)
+    if (scan.records > (UINT64_MAX / 2) / bytesPerRecord(scan) || scan.records > UINT64_MAX / 128 ||
+        total + scan.records < total)
       return Error{path + ": " + scan.label + " declares " + std::to_string(scan.records) + " points, more than memory holds",
                    ExitCode::kResourceLimit};
     total += scan.records;
@@ -817,8 +915,12 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     held = held > UINT64_MAX - bytes ? UINT64_MAX : held + bytes;  // many scans of 2^56 records of no bits
     for (const Field& f : scan.fields) bytes_to_read += f.neededBytes(scan.records);
   }
+  // Beside the points: a window of packets, and about as much of the fields' bytes (PacketReader).
+  const uint64_t window = windowOf(options);
+  held = std::min(held, UINT64_MAX - 2 * window) + 2 * window;
   if (Status s = checkMemory(path + ": " + std::to_string(total) + " points in " + countOf(scans.size(), "scan"), held, limit); !s)
     return s.error();
+  const uint64_t field_budget = limit - held + window;  // what the fields' bytes may take
   // Scan numbers go to point_source_id where two or more scans hold points: the last such must fit.
   size_t with_points = 0, last_with_points = 0;
   for (size_t k = 0; k < scans.size(); ++k)
@@ -842,10 +944,8 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   for (size_t k = 0; k < scans.size(); ++k) {
     ScanInfo& scan = scans[k];
     if (scan.records == 0) continue;
-    if (Status s = gatherFields(*paged, scan, threads, progress); !s) return s.error();
-    Result<PointSet> points = pointsOf(*paged, scan, options, intensity_fractions, left_out, intensity_ranges);
+    Result<PointSet> points = pointsOf(*paged, scan, options, field_budget, intensity_fractions, left_out, intensity_ranges);
     if (!points) return points.error();
-    for (Field& f : scan.fields) DimensionBytes().swap(f.bytes);
     read.push_back({k + 1, std::move(*points)});
   }
   if (progress) progress->finish();

@@ -56,9 +56,6 @@ class E57File {
  public:
   E57File() : logical_(48, '\0') {}
 
-  // A compressed vector section of `streams` (one per prototype field, in order), each cut into
-  // chunks of at most `chunk` bytes a packet; `extra_packets` puts an index packet and an empty
-  // packet between the first two data packets. Returns its physical offset (the XML's fileOffset).
   // A compressed vector section of these packets' bytes as they are.
   uint64_t rawSection(const std::string& packets) {
     align(4);
@@ -71,7 +68,12 @@ class E57File {
     return physicalOf(start);
   }
 
-  uint64_t compressedVector(const std::vector<std::string>& streams, size_t chunk, bool extra_packets = false) {
+  // A compressed vector section of `streams` (one per prototype field, in order), each cut into
+  // chunks of at most `chunk` bytes a packet; `extra_packets` puts an index packet and an empty
+  // packet between the first two data packets; `in_turn` gives each stream's bytes only once the
+  // streams before it have given all theirs. Returns its physical offset (the XML's fileOffset).
+  uint64_t compressedVector(const std::vector<std::string>& streams, size_t chunk, bool extra_packets = false,
+                            bool in_turn = false) {
     align(4);
     const uint64_t start = logical_.size();
     logical_.append(32, '\0');
@@ -89,8 +91,10 @@ class E57File {
       append<uint16_t>(packet, 0);  // its length, below
       append<uint16_t>(packet, static_cast<uint16_t>(streams.size()));
       std::vector<size_t> n(streams.size());
+      size_t turn = 0;
+      while (at[turn] == streams[turn].size()) ++turn;
       for (size_t k = 0; k < streams.size(); ++k) {
-        n[k] = std::min(chunk, streams[k].size() - at[k]);
+        n[k] = in_turn && k != turn ? 0 : std::min(chunk, streams[k].size() - at[k]);
         append<uint16_t>(packet, static_cast<uint16_t>(n[k]));
       }
       for (size_t k = 0; k < streams.size(); ++k) {
@@ -471,6 +475,63 @@ TEST(E57, aNonFiniteCoordinateIsRefusedUnlessAllowedAndInvalidPointsAreLeftOut) 
   EXPECT_EQ(kept->positions[2].x, 3.0);
   ASSERT_EQ(notices.size(), 1u);
   EXPECT_NE(notices[0].find("1 of its 4 points are marked invalid"), std::string::npos) << notices[0];
+}
+
+// Packets read a window at a time (64 KiB here): values straddling windows, fields whose records
+// run ahead of others' (bytes given evenly, or one field's all before the next's), invalid points
+// across windows; and the memory a file of fields in turn needs, refused where it is not left.
+TEST(E57, windowsOfPacketsReadTheSamePointsAsOneRead) {
+  TempDir dir;
+  const size_t n = 100000;
+  std::vector<int64_t> x(n), y(n), state(n);
+  std::vector<double> z(n);
+  for (size_t i = 0; i < n; ++i) {
+    x[i] = static_cast<int64_t>(i % 8) - 5;
+    y[i] = static_cast<int64_t>((i * 37) % 8000);
+    z[i] = 1e6 + static_cast<double>(i) / 3;
+    state[i] = i % 7 == 3 ? 1 : 0;
+  }
+  const std::vector<std::string> streams{packBits(x, -5, 3), packBits(y, 0, 13), packRaw(z), packBits(state, 0, 2)};
+  const std::string prototype =
+      "<cartesianX type=\"Integer\" minimum=\"-5\" maximum=\"2\"/>"
+      "<cartesianY type=\"ScaledInteger\" minimum=\"0\" maximum=\"8191\" scale=\"0.25\" offset=\"100\"/>"
+      "<cartesianZ type=\"Float\"/><cartesianInvalidState type=\"Integer\" minimum=\"0\" maximum=\"2\"/>";
+  for (const bool in_turn : {false, true}) {
+    E57File file;
+    const uint64_t at = file.compressedVector(streams, in_turn ? 60000 : 1000, false, in_turn);
+    const std::string bytes = file.bytes(rootXml(scanXml(at, n, prototype)));
+    for (const unsigned threads : {1u, 3u}) {
+      E57ReadOptions options;
+      options.threads = threads;
+      options.packet_window = 1;  // 64 KiB: about 20 windows
+      Result<PointSet> points = readBytes(dir, bytes, options);
+      ASSERT_TRUE(points.ok()) << points.error().message;
+      size_t k = 0;
+      for (size_t i = 0; i < n; ++i) {
+        if (state[i] != 0) continue;
+        ASSERT_LT(k, points->size());
+        ASSERT_EQ(points->positions[k], glm::dvec3(static_cast<double>(x[i]), static_cast<double>(y[i]) * 0.25 + 100, z[i]))
+            << "in turn " << in_turn << ", point " << i;
+        ++k;
+      }
+      EXPECT_EQ(points->size(), k);
+    }
+    // Points of 24 bytes and windows of 64 KiB are what such a file needs, beside the fields'
+    // bytes held until every field has given a record: 1 MB for fields in turn, 0.3 MB else.
+    E57ReadOptions tight;
+    tight.packet_window = 1;
+    tight.max_memory = n * 24 + 2 * (64u << 10) + 500000;
+    Result<PointSet> points = readBytes(dir, bytes, tight);
+    if (in_turn) {
+      ASSERT_FALSE(points.ok());
+      EXPECT_EQ(points.error().code, ExitCode::kResourceLimit);
+      EXPECT_NE(points.error().message.find("scan.e57: data3D 1: points: its fields' values are spread so unevenly"),
+                std::string::npos)
+          << points.error().message;
+    } else {
+      EXPECT_TRUE(points.ok()) << points.error().message;
+    }
+  }
 }
 
 // dpoint's own E57 files (libE57Format's reading of one is tests/data/e57/written): every field
