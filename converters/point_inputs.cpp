@@ -201,7 +201,8 @@ Status PointInputStream::checkCopies(size_t part, uint64_t first, const PointSet
 }
 
 Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
-                                                                 unsigned threads, uint64_t max_memory) {
+                                                                 unsigned threads, uint64_t max_memory,
+                                                                 bool allow_nonfinite) {
   Result<InputSet> set = checkInputSet(paths);
   if (!set) return set.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
@@ -243,7 +244,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       stream->notices_.insert(stream->notices_.end(), part.las->notices().begin(), part.las->notices().end());
     } else {
       Result<std::unique_ptr<PlyVertexStream>> ply =
-          PlyVertexStream::open(path, PlyReadOptions{false, nullptr, threads, true});
+          PlyVertexStream::open(path, PlyReadOptions{allow_nonfinite, nullptr, threads, true});
       if (!ply) return ply.error();
       part.ply = std::move(*ply);
       part.watch_colors = part.ply->floatColors();
@@ -387,7 +388,7 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
 
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
                                                           const std::string& stream, unsigned threads,
-                                                          uint64_t max_memory) {
+                                                          uint64_t max_memory, bool allow_nonfinite) {
   const bool streamable = std::all_of(paths.begin(), paths.end(), [](const std::string& path) {
     Result<FileFormat> format = formatOf(path);
     return format && (*format == FileFormat::kPly || *format == FileFormat::kLas || *format == FileFormat::kLaz);
@@ -402,7 +403,7 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
   // --max-memory applies once the stream is chosen (checkStreamMemory with heldBytes). A stream
   // that cannot open (an ASCII file, too many files for the open-file limit) is read whole.
   Result<std::unique_ptr<PointInputStream>> opened =
-      PointInputStream::open(paths, threads, stream == "on" ? max_memory : 0);
+      PointInputStream::open(paths, threads, stream == "on" ? max_memory : 0, allow_nonfinite);
   if (!opened) {
     if (stream == "on") return opened.error();
     return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong

@@ -54,11 +54,12 @@ Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 // readPointInputs: white for the files without in a mix. open() reads the headers (and a tile
 // set's copies); errors (ASCII PLY, another format, a bad header) name the file. The copies are
 // held for the whole stream: over `max_memory` (0: half of RAM) they are refused before they are
-// read (kResourceLimit), as mergeTiles refuses them.
+// read (kResourceLimit), as mergeTiles refuses them. A PLY's non-finite coordinate is its reader's
+// error unless `allow_nonfinite` (info's --allow-nonfinite), as readPointInputs takes it.
 class PointInputStream {
  public:
   static Result<std::unique_ptr<PointInputStream>> open(const std::vector<std::string>& paths, unsigned threads,
-                                                        uint64_t max_memory = 0);
+                                                        uint64_t max_memory = 0, bool allow_nonfinite = false);
   ~PointInputStream();
   uint64_t count() const { return count_; }
   bool hasColors() const { return has_colors_; }
@@ -113,6 +114,6 @@ class PointInputStream {
 inline constexpr uint64_t kStreamAbovePoints = uint64_t{1} << 26;
 Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std::string>& paths,
                                                           const std::string& stream, unsigned threads,
-                                                          uint64_t max_memory = 0);
+                                                          uint64_t max_memory = 0, bool allow_nonfinite = false);
 
 }  // namespace dpoint

@@ -195,6 +195,7 @@ size_t countFloatMerges(const PositionArray& positions) {
 // NaN or not by the points' order).
 void addBounds(PointSetInfo& info, const PositionArray& positions) {
   for (const glm::dvec3& p : positions) {
+    info.nonfinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
     for (int k = 0; k < 3; ++k) {
       if (std::isnan(p[k])) continue;
       info.min[k] = std::min(info.min[k], p[k]);

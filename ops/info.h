@@ -26,6 +26,9 @@ struct PointSetInfo {
   // lost), and coordinates beyond float range. float32 represents the set when both are zero.
   size_t float_merged = 0;
   size_t float_overflow = 0;
+  // Points with a coordinate that is NaN or infinite (read with --allow-nonfinite): their other
+  // coordinates count in the bounds; no mode can place them in a picture.
+  size_t nonfinite = 0;
   bool floatRepresents() const { return float_merged == 0 && float_overflow == 0; }
 };
 

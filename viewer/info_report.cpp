@@ -206,8 +206,14 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   if (boxes.count > 0) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
+    // A point no mode can place leaves its pixel in every mode, as predictErrorBounds says of a
+    // set read whole; the boxes pass its coordinates over.
+    const bool nonfinite = report.info.nonfinite > 0;
     if (Status s = adviseFor(report, options, boundsOfBoxes(boxes), false, [&](const Camera& camera) {
-          return predictBoxBounds(boxes, camera, {}, options.tolerance_px);
+          ErrorBounds bounds = predictBoxBounds(boxes, camera, {}, options.tolerance_px);
+          for (size_t m = 0; m < kModeCount && nonfinite; ++m)
+            if (bounds.computed[m]) bounds.px[m] = HUGE_VAL;
+          return bounds;
         });
         !s)
       return s.error();
@@ -217,7 +223,8 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
 
 Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& options, Progress& progress) {
   if (inputs.paths.empty()) return Error{"info: no input files", ExitCode::kUsage};
-  Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads, inputs.max_memory);
+  Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads, inputs.max_memory,
+                                                                     inputs.allow_nonfinite);
   if (!stream) return stream.error();
   const std::string name = describeInputs(inputs.paths);
   if (*stream) {
@@ -332,6 +339,9 @@ std::string infoReportText(const InfoReport& report) {
   if (report.las) text += lasText(*report.las);
   if (i.count == 0)
     return text + "bounds:             none (no points)\n" + "float32 enough:     nothing to hold (no points)\n";
+  if (i.nonfinite > 0)
+    text += "non-finite:         " + countOf(i.nonfinite, "point") + " with a coordinate nan or inf (--allow-nonfinite): " +
+            "no mode can place them\n";
   text += "min:                " + vec(i.min) + "\n" +
           "max:                " + vec(i.max) + "\n" +
           "extent:             " + vec(i.extent) + "\n" +
@@ -369,7 +379,8 @@ std::string infoReportJson(const InfoReport& report) {
                      ",\n  \"streamed\": " + jsonBool(report.streamed) +
                      ",\n  \"float32_merged_points\": " + (report.streamed ? "null" : str(i.float_merged)) +
                      ",\n  \"float32_overflow\": " + str(i.float_overflow) +
-                     ",\n  \"float32_represents\": " + represents;
+                     ",\n  \"float32_represents\": " + represents +
+                     ",\n  \"nonfinite_points\": " + str(i.nonfinite);
   if (const std::optional<CopcReadStats>& c = report.copc)
     json += ",\n  \"copc\": {\"points_read\": " + str(c->points) + ", \"bytes_read\": " + str(c->bytes) +
             ", \"nodes_read\": " + str(c->nodes) + ", \"file_points\": " + str(c->file_points) +

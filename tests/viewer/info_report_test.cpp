@@ -101,7 +101,20 @@ TEST(InfoReport, nonFinitePositionsGiveWhatDpointInfoGivesWithAllowNonfinite) {
   EXPECT_EQ(runDpoint({"info", path}).exit_code, 2) << "refused without --allow-nonfinite";
   const InfoReport report = expectDpointInfosReport(points, path, InfoOptions{}, {"--allow-nonfinite"});
   EXPECT_EQ(report.info.count, 4u);
+  EXPECT_EQ(report.info.nonfinite, 2u);
   EXPECT_TRUE(test::contains(infoReportJson(report), "\"max\": [null, 5, 6.5]"));
+  EXPECT_TRUE(test::contains(infoReportJson(report), "\"nonfinite_points\": 2"));
+  EXPECT_TRUE(test::contains(infoReportText(report), "non-finite:         2 points with a coordinate nan or inf"));
+  // Streamed, the same counts and bounds, and no mode bounded where a point has no place (the
+  // stream refused the file, --allow-nonfinite or not, before).
+  EXPECT_EQ(runDpoint({"info", "--stream", "on", path}).exit_code, 2) << "refused without --allow-nonfinite";
+  test::CommandResult streamed = runDpoint({"info", "--json", "--stream", "on", "--allow-nonfinite", path});
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+  for (const char* line : {"\"points\": 4", "\"max\": [null, 5, 6.5]", "\"nonfinite_points\": 2", "\"streamed\": true"})
+    EXPECT_TRUE(test::contains(streamed.out, line)) << line << "\n" << streamed.out;
+  EXPECT_TRUE(test::contains(streamed.out, "\"error_bound_px\": {\"fp32\": null, \"split\": null, \"rte\": null, "
+                                            "\"df64\": null, \"native\": null, \"batch\": null, \"adaptive\": null}"))
+      << streamed.out;
 }
 
 // An empty set: counts of 0 and no view, so no error bounds.
