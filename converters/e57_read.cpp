@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <tuple>
 #include <type_traits>
 
 #include "converters/point_inputs.h"
@@ -672,92 +673,193 @@ std::optional<IntensityRange> intensityRange(const Field& f, const ScanInfo& sca
   return IntensityRange{lo, hi, limits ? "its intensityLimits" : "the field's limits"};
 }
 
-// The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left out.
-// Its packets read a window at a time (PacketReader), each window's records decoded on all cores;
-// the fields' bytes may hold up to `budget` bytes at once.
+// How a scan's records become points: positions from the cartesian (or spherical) fields moved by
+// the pose, the invalid state, the colour channels, and every other field as a dimension (its
+// name, type and, for an intensity read as 0..1, its range). Its functions read the fields' held
+// bytes (PacketReader), so any record held is decoded without the others, on any thread.
+class ScanDecoder {
+ public:
+  static Result<ScanDecoder> of(const std::string& path, const ScanInfo& scan, bool intensity_fractions) {
+    ScanDecoder d;
+    d.where_ = path + ": " + scan.label;
+    const Field* c[3] = {findField(scan, "cartesianX"), findField(scan, "cartesianY"), findField(scan, "cartesianZ")};
+    const Field* s[3] = {findField(scan, "sphericalRange"), findField(scan, "sphericalAzimuth"),
+                         findField(scan, "sphericalElevation")};
+    d.cartesian_ = c[0] && c[1] && c[2];
+    if (!d.cartesian_ && !(s[0] && s[1] && s[2]))
+      return Error{d.where_ + ": its points have neither cartesianX, cartesianY and cartesianZ nor sphericalRange, "
+                              "sphericalAzimuth and sphericalElevation"};
+    for (int k = 0; k < 3; ++k) d.xyz_[k] = d.cartesian_ ? c[k] : s[k];
+    d.invalid_ = findField(scan, d.cartesian_ ? "cartesianInvalidState" : "sphericalInvalidState");
+    const Field* rgb[3] = {findField(scan, "colorRed"), findField(scan, "colorGreen"), findField(scan, "colorBlue")};
+    d.colors_ = rgb[0] && rgb[1] && rgb[2];
+    if (!d.colors_ && (rgb[0] || rgb[1] || rgb[2]))
+      return Error{d.where_ + ": its points have some of colorRed, colorGreen and colorBlue, not all three"};
+
+    // Colours: an integer 0..255 or 0..65535 keeps its scale; other limits are normalised.
+    if (d.colors_) {
+      bool integer_scale = true;
+      for (int k = 0; k < 3; ++k) {
+        const Field& f = *rgb[k];
+        ColorChannel& channel = d.channel_[k];
+        channel.field = &f;
+        const bool integer = f.kind == FieldKind::kInteger;
+        channel.lo = scan.color_limits[2 * k]          ? *scan.color_limits[2 * k]
+                     : integer                         ? static_cast<double>(f.minimum)
+                     : f.kind == FieldKind::kScaled    ? static_cast<double>(f.minimum) * f.scale + f.offset
+                     : std::isfinite(f.float_minimum)  ? f.float_minimum
+                                                       : 0.0;
+        channel.hi = scan.color_limits[2 * k + 1]      ? *scan.color_limits[2 * k + 1]
+                     : integer                         ? static_cast<double>(f.maximum)
+                     : f.kind == FieldKind::kScaled    ? static_cast<double>(f.maximum) * f.scale + f.offset
+                     : std::isfinite(f.float_maximum)  ? f.float_maximum
+                                                       : 1.0;
+        if (!(channel.hi > channel.lo))
+          return Error{d.where_ + ": " + f.name + "'s limits " + formatNumber(channel.lo) + " to " + formatNumber(channel.hi) +
+                       " are no range"};
+        integer_scale = integer_scale && integer && channel.lo == 0.0 && channel.hi == d.channel_[0].hi &&
+                        (channel.hi == 255.0 || channel.hi == 65535.0);
+      }
+      if (integer_scale) d.full_ = static_cast<uint16_t>(d.channel_[0].hi);
+    }
+
+    // The other fields as dimensions.
+    for (const Field& f : scan.fields) {
+      const bool used = &f == d.xyz_[0] || &f == d.xyz_[1] || &f == d.xyz_[2] || &f == d.invalid_ ||
+                        (d.colors_ && (&f == rgb[0] || &f == rgb[1] || &f == rgb[2]));
+      if (used) continue;
+      Kept kept;
+      kept.field = &f;
+      std::tie(kept.name, kept.type) = dimensionOf(f);
+      for (const Kept& other : d.kept_)
+        if (other.name == kept.name)
+          return Error{d.where_ + ": the fields " + f.name + " and another are both kept as the dimension " + kept.name};
+      if (kept.name == dim::kIntensity && (kept.normalised = intensityRange(f, scan, intensity_fractions)))
+        kept.type = DimType::kF32;
+      kept.return_index = f.name == "returnIndex" && f.kind == FieldKind::kInteger && kept.name == dim::kReturnNumber;
+      d.kept_.push_back(std::move(kept));
+    }
+
+    const double* q = scan.rotation;
+    d.identity_ = q[0] == 1.0 && q[1] == 0.0 && q[2] == 0.0 && q[3] == 0.0 && scan.translation[0] == 0.0 &&
+                  scan.translation[1] == 0.0 && scan.translation[2] == 0.0;
+    // The rotation matrix of the unit quaternion (w, x, y, z).
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    const double m[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                            {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                            {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+    std::memcpy(d.m_, m, sizeof m);
+    std::memcpy(d.t_, scan.translation, sizeof d.t_);
+    return d;
+  }
+
+  // A dimension a field is kept as.
+  struct Kept {
+    const Field* field = nullptr;
+    std::string name;
+    DimType type = DimType::kF64;
+    std::optional<IntensityRange> normalised;  // an intensity read as 0..1
+    bool return_index = false;                 // returnIndex, kept 1-based as return_number
+  };
+
+  const std::string& where() const { return where_; }
+  bool hasColors() const { return colors_; }
+  uint16_t colorFullScale() const { return full_; }
+  bool hasInvalidState() const { return invalid_ != nullptr; }
+  const std::vector<Kept>& kept() const { return kept_; }
+
+  // Record i is a point (its invalid state 0: an Integer as E57 has it, or a Float of another writer).
+  bool valid(size_t i) const { return !invalid_ || invalid_->value(i) == 0.0; }
+  glm::dvec3 position(size_t i) const {
+    glm::dvec3 p(xyz_[0]->value(i), xyz_[1]->value(i), xyz_[2]->value(i));
+    if (!cartesian_) {
+      const double r = p.x, az = p.y, el = p.z;
+      p = glm::dvec3(r * std::cos(el) * std::cos(az), r * std::cos(el) * std::sin(az), r * std::sin(el));
+    }
+    if (!identity_)
+      p = glm::dvec3(m_[0][0] * p.x + m_[0][1] * p.y + m_[0][2] * p.z + t_[0],
+                     m_[1][0] * p.x + m_[1][1] * p.y + m_[1][2] * p.z + t_[1],
+                     m_[2][0] * p.x + m_[2][1] * p.y + m_[2][2] * p.z + t_[2]);
+    return p;
+  }
+  glm::vec3 color(size_t i) const {
+    glm::vec3 color;
+    for (int k = 0; k < 3; ++k) {
+      const ColorChannel& c = channel_[k];
+      const double v = c.field->value(i);
+      color[k] = static_cast<float>(full_ != 0 ? v / full_ : (v - c.lo) / (c.hi - c.lo));
+    }
+    return color;
+  }
+  // Kept field d's value i into `out`, as its dimension's type.
+  void store(size_t d, size_t i, uint8_t* out) const {
+    const Kept& k = kept_[d];
+    const Field& f = *k.field;
+    if (k.normalised) {
+      const float a = static_cast<float>((f.value(i) - k.normalised->lo) / (k.normalised->hi - k.normalised->lo));
+      std::memcpy(out, &a, 4);
+    } else if (f.kind == FieldKind::kInteger) {
+      const int64_t v = f.integer(i) + (k.return_index ? 1 : 0);
+      switch (k.type) {  // the type holds the field's limits (integerType)
+        case DimType::kU8: *out = static_cast<uint8_t>(v); break;
+        case DimType::kI8: { const int8_t a = static_cast<int8_t>(v); std::memcpy(out, &a, 1); break; }
+        case DimType::kU16: { const uint16_t a = static_cast<uint16_t>(v); std::memcpy(out, &a, 2); break; }
+        case DimType::kI16: { const int16_t a = static_cast<int16_t>(v); std::memcpy(out, &a, 2); break; }
+        case DimType::kU32: { const uint32_t a = static_cast<uint32_t>(v); std::memcpy(out, &a, 4); break; }
+        case DimType::kI32: { const int32_t a = static_cast<int32_t>(v); std::memcpy(out, &a, 4); break; }
+        default: std::memcpy(out, &v, 8); break;  // U64, I64: the same bits
+      }
+    } else if (k.type == DimType::kF32) {
+      const float a = loadUnaligned<float>(f.at(uint64_t{i} * 4));
+      std::memcpy(out, &a, 4);
+    } else {
+      const double a = f.value(i);
+      std::memcpy(out, &a, 8);
+    }
+  }
+  // The error for record i's coordinate that is not finite.
+  Error nonfiniteError(size_t i, uint64_t point) const {
+    return Error{where_ + ": point " + std::to_string(point) + " has a coordinate that is not finite (" +
+                 formatNumber(xyz_[0]->value(i)) + ", " + formatNumber(xyz_[1]->value(i)) + ", " +
+                 formatNumber(xyz_[2]->value(i)) + "); --allow-nonfinite keeps it"};
+  }
+
+ private:
+  std::string where_;
+  const Field* xyz_[3] = {};
+  bool cartesian_ = true;
+  const Field* invalid_ = nullptr;
+  bool colors_ = false;
+  ColorChannel channel_[3];
+  uint16_t full_ = 0;
+  std::vector<Kept> kept_;
+  bool identity_ = true;
+  double m_[3][3] = {}, t_[3] = {};
+};
+
+// The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left
+// out. Its packets read a window at a time (PacketReader), each window's records decoded on all
+// cores; the fields' bytes may hold up to `budget` bytes at once.
 Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOptions& options, uint64_t budget,
                           bool intensity_fractions, uint64_t& left_out, std::vector<std::string>& intensity_ranges) {
-  const std::string where = file.path() + ": " + scan.label;
+  Result<ScanDecoder> decoder = ScanDecoder::of(file.path(), scan, intensity_fractions);
+  if (!decoder) return decoder.error();
+  const ScanDecoder& dec = *decoder;
   const unsigned threads = resolveThreads(options.threads);
-  const Field* c[3] = {findField(scan, "cartesianX"), findField(scan, "cartesianY"), findField(scan, "cartesianZ")};
-  const Field* s[3] = {findField(scan, "sphericalRange"), findField(scan, "sphericalAzimuth"),
-                       findField(scan, "sphericalElevation")};
-  const bool cartesian = c[0] && c[1] && c[2];
-  if (!cartesian && !(s[0] && s[1] && s[2]))
-    return Error{where + ": its points have neither cartesianX, cartesianY and cartesianZ nor sphericalRange, "
-                         "sphericalAzimuth and sphericalElevation"};
-  const Field* const* xyz = cartesian ? c : s;
-  const Field* invalid = findField(scan, cartesian ? "cartesianInvalidState" : "sphericalInvalidState");
-  const Field* rgb[3] = {findField(scan, "colorRed"), findField(scan, "colorGreen"), findField(scan, "colorBlue")};
-  const bool colors = rgb[0] && rgb[1] && rgb[2];
-  if (!colors && (rgb[0] || rgb[1] || rgb[2]))
-    return Error{where + ": its points have some of colorRed, colorGreen and colorBlue, not all three"};
-
-  // Colours: an integer 0..255 or 0..65535 keeps its scale; other limits are normalised.
-  uint16_t full = 0;
-  ColorChannel channel[3];
-  if (colors) {
-    bool integer_scale = true;
-    for (int k = 0; k < 3; ++k) {
-      const Field& f = *rgb[k];
-      channel[k].field = &f;
-      const bool integer = f.kind == FieldKind::kInteger;
-      channel[k].lo = scan.color_limits[2 * k] ? *scan.color_limits[2 * k]
-                      : integer                 ? static_cast<double>(f.minimum)
-                      : f.kind == FieldKind::kScaled ? static_cast<double>(f.minimum) * f.scale + f.offset
-                      : std::isfinite(f.float_minimum) ? f.float_minimum
-                                                       : 0.0;
-      channel[k].hi = scan.color_limits[2 * k + 1] ? *scan.color_limits[2 * k + 1]
-                      : integer                     ? static_cast<double>(f.maximum)
-                      : f.kind == FieldKind::kScaled ? static_cast<double>(f.maximum) * f.scale + f.offset
-                      : std::isfinite(f.float_maximum) ? f.float_maximum
-                                                       : 1.0;
-      if (!(channel[k].hi > channel[k].lo))
-        return Error{where + ": " + f.name + "'s limits " + formatNumber(channel[k].lo) + " to " + formatNumber(channel[k].hi) +
-                     " are no range"};
-      integer_scale = integer_scale && integer && channel[k].lo == 0.0 && channel[k].hi == channel[0].hi &&
-                      (channel[k].hi == 255.0 || channel[k].hi == 65535.0);
-    }
-    if (integer_scale) full = static_cast<uint16_t>(channel[0].hi);
-  }
-
-  // The other fields as dimensions.
-  std::vector<const Field*> kept;
-  for (const Field& f : scan.fields) {
-    const bool used = &f == xyz[0] || &f == xyz[1] || &f == xyz[2] || &f == invalid ||
-                      (colors && (&f == rgb[0] || &f == rgb[1] || &f == rgb[2]));
-    if (!used) kept.push_back(&f);
-  }
   const size_t n = static_cast<size_t>(scan.records);
   PointSet points;
   points.z_axis = ZAxis::kPresent;
   points.positions.resize(n);
-  if (colors) points.colors.resize(n);
-  std::vector<std::optional<IntensityRange>> normalised(kept.size());
-  for (size_t d = 0; d < kept.size(); ++d) {
-    const Field* f = kept[d];
-    auto [name, type] = dimensionOf(*f);
-    if (points.dimensions.find(name))
-      return Error{where + ": the fields " + f->name + " and another are both kept as the dimension " + name};
-    if (name == dim::kIntensity && (normalised[d] = intensityRange(*f, scan, intensity_fractions))) {
-      type = DimType::kF32;
-      const std::string range = formatNumber(normalised[d]->lo) + ".." + formatNumber(normalised[d]->hi) + " (" +
-                                normalised[d]->source + ")";
+  if (dec.hasColors()) points.colors.resize(n);
+  for (const ScanDecoder::Kept& k : dec.kept()) {
+    if (k.normalised) {
+      const std::string range = formatNumber(k.normalised->lo) + ".." + formatNumber(k.normalised->hi) + " (" +
+                                k.normalised->source + ")";
       if (std::find(intensity_ranges.begin(), intensity_ranges.end(), range) == intensity_ranges.end())
         intensity_ranges.push_back(range);
     }
-    points.dimensions.appendUnset(name, type, n);
+    points.dimensions.appendUnset(k.name, k.type, n);
   }
-
-  const double* q = scan.rotation;
-  const bool identity = q[0] == 1.0 && q[1] == 0.0 && q[2] == 0.0 && q[3] == 0.0 && scan.translation[0] == 0.0 &&
-                        scan.translation[1] == 0.0 && scan.translation[2] == 0.0;
-  // The rotation matrix of the unit quaternion (w, x, y, z).
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double m[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-                          {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-                          {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
-  const double* t = scan.translation;
   PacketReader reader(file, scan, windowOf(options), threads, options.progress, budget);
   if (Status status = reader.open(); !status) return status.error();
   size_t decoded = 0, kept_points = 0;
@@ -769,71 +871,28 @@ Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOp
     parallelFor(blocks, threads, [&](size_t b, unsigned) {
       const size_t begin = decoded + b * kDecodeBlock, end = std::min(ready, begin + kDecodeBlock);
       for (size_t i = begin; i < end; ++i) {
-        glm::dvec3 p(xyz[0]->value(i), xyz[1]->value(i), xyz[2]->value(i));
-        if (!cartesian) {
-          const double r = p.x, az = p.y, el = p.z;
-          p = glm::dvec3(r * std::cos(el) * std::cos(az), r * std::cos(el) * std::sin(az), r * std::sin(el));
-        }
-        if (!identity)
-          p = glm::dvec3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t[0], m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t[1],
-                         m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t[2]);
+        const glm::dvec3 p = dec.position(i);
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-          if (!invalid || invalid->value(i) == 0.0) lowerAtomic(first_nonfinite, i);
+          if (dec.valid(i)) lowerAtomic(first_nonfinite, i);
         }
         points.positions[i] = p;
-        if (colors) {
-          glm::vec3& color = points.colors[i];
-          for (int k = 0; k < 3; ++k) {
-            const double v = channel[k].field->value(i);
-            color[k] = static_cast<float>(full != 0 ? v / full : (v - channel[k].lo) / (channel[k].hi - channel[k].lo));
-          }
-        }
+        if (dec.hasColors()) points.colors[i] = dec.color(i);
       }
-      for (size_t d = 0; d < kept.size(); ++d) {
-        const Field& f = *kept[d];
+      for (size_t d = 0; d < dec.kept().size(); ++d) {
         Dimension& dim = points.dimensions.all()[d];
         const size_t width = dimTypeSize(dim.type);
-        const bool return_index = f.name == "returnIndex" && f.kind == FieldKind::kInteger && dim.name == dim::kReturnNumber;
-        for (size_t i = begin; i < end; ++i) {
-          uint8_t* out = dim.bytes.data() + i * width;
-          if (normalised[d]) {
-            const IntensityRange& r = *normalised[d];
-            const float a = static_cast<float>((f.value(i) - r.lo) / (r.hi - r.lo));
-            std::memcpy(out, &a, 4);
-          } else if (f.kind == FieldKind::kInteger) {
-            const int64_t v = f.integer(i) + (return_index ? 1 : 0);
-            switch (dim.type) {  // the type holds the field's limits (integerType)
-              case DimType::kU8: *out = static_cast<uint8_t>(v); break;
-              case DimType::kI8: { const int8_t a = static_cast<int8_t>(v); std::memcpy(out, &a, 1); break; }
-              case DimType::kU16: { const uint16_t a = static_cast<uint16_t>(v); std::memcpy(out, &a, 2); break; }
-              case DimType::kI16: { const int16_t a = static_cast<int16_t>(v); std::memcpy(out, &a, 2); break; }
-              case DimType::kU32: { const uint32_t a = static_cast<uint32_t>(v); std::memcpy(out, &a, 4); break; }
-              case DimType::kI32: { const int32_t a = static_cast<int32_t>(v); std::memcpy(out, &a, 4); break; }
-              default: std::memcpy(out, &v, 8); break;  // U64, I64: the same bits
-            }
-          } else if (dim.type == DimType::kF32) {
-            const float a = loadUnaligned<float>(f.at(uint64_t{i} * 4));
-            std::memcpy(out, &a, 4);
-          } else {
-            const double a = f.value(i);
-            std::memcpy(out, &a, 8);
-          }
-        }
+        for (size_t i = begin; i < end; ++i) dec.store(d, i, dim.bytes.data() + i * width);
       }
     });
-    if (first_nonfinite.load() != SIZE_MAX && !options.allow_nonfinite) {
-      const size_t i = first_nonfinite.load();
-      return Error{where + ": point " + std::to_string(i) + " has a coordinate that is not finite (" +
-                   formatNumber(xyz[0]->value(i)) + ", " + formatNumber(xyz[1]->value(i)) + ", " + formatNumber(xyz[2]->value(i)) +
-                   "); --allow-nonfinite keeps it"};
-    }
+    if (first_nonfinite.load() != SIZE_MAX && !options.allow_nonfinite)
+      return dec.nonfiniteError(first_nonfinite.load(), first_nonfinite.load());
     // The points with an invalid state left out, in order (while the window's fields are held).
-    if (invalid) {
+    if (dec.hasInvalidState()) {
       for (size_t i = decoded; i < ready; ++i) {
-        if (invalid->value(i) != 0.0) continue;  // an Integer as E57 has it, or a Float of another writer
+        if (!dec.valid(i)) continue;
         if (kept_points != i) {
           points.positions[kept_points] = points.positions[i];
-          if (colors) points.colors[kept_points] = points.colors[i];
+          if (dec.hasColors()) points.colors[kept_points] = points.colors[i];
           for (Dimension& d : points.dimensions.all()) d.copyFrom(kept_points, d, i);
         }
         ++kept_points;
@@ -843,11 +902,11 @@ Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOp
     decoded = ready;
   }
   for (Field& f : scan.fields) DimensionBytes().swap(f.bytes);
-  points.color_full_scale = full;
-  if (invalid) {
+  points.color_full_scale = dec.colorFullScale();
+  if (dec.hasInvalidState()) {
     left_out += n - kept_points;
     points.positions.resize(kept_points);
-    if (colors) points.colors.resize(kept_points);
+    if (dec.hasColors()) points.colors.resize(kept_points);
     points.dimensions.resize(kept_points);
   }
   return points;
