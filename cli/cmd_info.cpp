@@ -55,7 +55,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
       "view: the --fit view by default, or the one the camera options (as for `dpoint render`) describe");
   cmd->add_option("input", o->inputs,
                   "Input files (.csv and text, .ptx, .e57, .ply, .pcd, .las, .laz, .glb, .gltf), taken as one set; the N tiles of `generate --tile`\n"
-                  "as the whole. Large binary PLY, LAS and LAZ input is streamed (--stream)")
+                  "as the whole. Large binary PLY, LAS, LAZ and E57 input is streamed (--stream)")
       ->required();
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_option("--sample", o->sample, "Points sampled for the nearest-neighbour distance")
@@ -73,7 +73,7 @@ void addInfoCommand(CLI::App& app, RunCommand& run) {
                   {"auto", "y", "z"});
   addMaxMemoryOption(*cmd, o->max_memory);
   cmd->add_option("--stream", o->stream,
-                  "auto|on|off. on: read binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, twice, so a set\n"
+                  "auto|on|off. on: read binary PLY, LAS, LAZ or E57 input (a file, or tiles) a block at a time, twice, so a set\n"
                   "larger than memory is described in about 1.2 GB, or in smaller blocks under a lower --max-memory (no\n"
                   "float32 merge count, which needs every point at once, and error bounds from the box of every 1024\n"
                   "points); auto: for such input of more than 2^26 points")

@@ -392,7 +392,7 @@ void addRenderOptions(CLI::App* cmd, const std::shared_ptr<RenderCliOptions>& o,
                   "Refuse (exit 3, a Vulkan fault) to allocate more GPU memory than this, e.g. 2G (default: what the\n"
                   "device has)");
   addChoiceOption(*cmd, "--stream", o->stream,
-                  "auto|on|off. on: draw binary PLY, LAS or LAZ input (a file, or tiles) a block at a time, so a set larger\n"
+                  "auto|on|off. on: draw binary PLY, LAS, LAZ or E57 input (a file, or tiles) a block at a time, so a set larger\n"
                   "than memory renders in about 1.2 GB of host memory (two blocks of 16M points; smaller ones under a\n"
                   "lower --max-memory, the same picture); auto: for such input of more than 2^26 points. A streamed\n"
                   "set's bound is predicted from the box of each batch (docs/precision.md); it gets no --error,\n"

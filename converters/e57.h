@@ -30,6 +30,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,39 @@ struct E57WriteOptions {
 
 Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options = {});
 Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options = {});
+
+// An E57 file read a block of points at a time (render's and info's --stream): the points readE57
+// gives, in its order, positions and colours (white for a scan without beside scans with), and the
+// dimensions asked for; none is held beyond a block. open() reads the tree and walks every scan's
+// packets once (reading the file through, checking every page), keeping where each packet begins
+// and, where a scan has an invalid state, how many of every 65,536 records are points; read() then
+// starts at the packet before its first point, or goes on where the last read ended. The errors are
+// readE57's (a non-finite coordinate: at open where allow_nonfinite is false... no: when read).
+class E57PointStream {
+ public:
+  static Result<std::unique_ptr<E57PointStream>> open(const std::string& path, const E57ReadOptions& options = {});
+  ~E57PointStream();
+  uint64_t count() const;
+  bool hasColors() const;
+  // The scans' dimensions as readE57 joins them (a name's type float64 where the scans' differ;
+  // point_source_id for the scan numbers where several scans hold points), as empty columns.
+  const Dimensions& dimensions() const;
+  // readE57's notes: points left out, intensities read as 0..1, images, what the join fills in.
+  const std::vector<std::string>& notices() const;
+  // Host bytes the stream holds beside its blocks: the packets' places, the points' counts.
+  uint64_t heldBytes() const;
+  // From now on read() also fills these of dimensions() (by index) into the block; none by default.
+  void streamDimensions(std::vector<size_t> which);
+  Status read(uint64_t first, uint64_t n, PointSet& block);
+
+ private:
+  E57PointStream();
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// The records the file's scans declare (points, and those marked invalid), from its tree alone.
+Result<uint64_t> e57RecordCount(const std::string& path);
 
 // One scan (data3D) with no pose: x, y and z as doubles (every coordinate as it is), colours as
 // integers of their scale (0..255, or 0..65535 for 16-bit colours), each dimension a field:

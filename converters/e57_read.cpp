@@ -468,6 +468,8 @@ const Field* findField(const ScanInfo& scan, std::string_view name) {
 // are decoded, then dropped (drop). Memory is a window and what the fields hold past the records
 // decoded: about one window where a writer spreads the fields evenly over its packets, as writers
 // do; a file that gives one field's values long before another's holds more, up to `budget`.
+// A stream (E57PointStream) walks the packets once keeping where each begins (checkpoints), then
+// starts a read at the packet before its first record (seek), keeping only the fields it decodes.
 class PacketReader {
  public:
   PacketReader(const PagedFile& file, ScanInfo& scan, uint64_t window, unsigned threads, Progress* progress, uint64_t budget)
@@ -502,7 +504,29 @@ class PacketReader {
       f.first_byte = f.filled = 0;
       f.bytes.assign(kStreamPadding, uint8_t{0});
     }
+    keep_.assign(scan_.fields.size(), 1);
     return okStatus();
+  }
+
+  // Only these fields' bytes are held (the others are counted, not copied): a stream's walk keeps
+  // the invalid state alone, a read what it decodes.
+  void keepOnly(const std::vector<const Field*>& fields) {
+    for (size_t k = 0; k < scan_.fields.size(); ++k)
+      keep_[k] = std::find(fields.begin(), fields.end(), &scan_.fields[k]) != fields.end();
+  }
+  // From now on each data packet's logical offset, then every field's bytes gathered before it,
+  // are appended to `checkpoints` (1 + fields values a packet).
+  void recordCheckpoints(std::vector<uint64_t>* checkpoints) { checkpoints_ = checkpoints; }
+  // Reading from a recorded checkpoint at or before record `record` (each field's bytes there no
+  // more than the record's first byte): the packets from there, each field's bytes before the
+  // record's passed over. open() first.
+  void seek(const uint64_t* checkpoint, uint64_t record) {
+    at_ = checkpoint[0];
+    for (size_t k = 0; k < scan_.fields.size(); ++k) {
+      Field& f = scan_.fields[k];
+      f.filled = checkpoint[1 + k];
+      f.first_byte = record * f.bits / 8;
+    }
   }
 
   // The records every field holds whole (from the first): those that can be decoded.
@@ -514,11 +538,21 @@ class PacketReader {
   }
 
   // Windows of packets gathered until ready() grows: an error where the section ends first (a
-  // field cut short), a packet is malformed, or the fields would hold more than the budget.
-  Status next() {
+  // field cut short), a packet is malformed, or the fields would hold more than the budget. With
+  // `records`, a window of about the bytes those records take (a stream's small read), at least
+  // the least window (a packet's most) and at most the reader's.
+  Status next(uint64_t records = UINT64_MAX) {
     const uint64_t before = ready();
+    uint64_t want = window_bytes_;
+    if (records != UINT64_MAX) {
+      uint64_t bits = 0;
+      for (const Field& f : scan_.fields) bits += f.bits;
+      // Their bytes and an eighth more (packet headers, fields a little ahead of others).
+      const uint64_t bytes = records > UINT64_MAX / 16 / std::max<uint64_t>(bits, 1) ? UINT64_MAX : records * bits / 7;
+      want = std::clamp<uint64_t>(bytes, kLeastWindow, window_bytes_);
+    }
     while (!done() && ready() == before && at_ < end_) {
-      const uint64_t size = std::min(window_bytes_, end_ - at_);
+      const uint64_t size = std::min(want, end_ - at_);
       window_.resize(static_cast<size_t>(size));
       if (Status s = file_.read(at_, window_.data(), size, threads_, nullptr); !s) return s;
       Result<uint64_t> used = gather(size);
@@ -532,7 +566,7 @@ class PacketReader {
           return Error{where_ + ": the field " + f.name + " ends after " + std::to_string(f.filled * 8 / std::max(1u, f.bits)) +
                        " of its " + std::to_string(scan_.records) + " records (the file is cut short or damaged)"};
     for (Field& f : scan_.fields)  // the padding a value read as 9 bytes may touch
-      std::fill_n(f.bytes.data() + (f.filled - f.first_byte), kStreamPadding, uint8_t{0});
+      std::fill_n(f.bytes.data() + held(f), kStreamPadding, uint8_t{0});
     return okStatus();
   }
 
@@ -540,10 +574,9 @@ class PacketReader {
   void drop(uint64_t records) {
     for (Field& f : scan_.fields) {
       const uint64_t keep = records * f.bits / 8;  // the byte record `records` begins in
-      const size_t shift = static_cast<size_t>(keep - f.first_byte);
-      const size_t held = static_cast<size_t>(f.filled - f.first_byte);
-      if (shift == 0) continue;
-      std::memmove(f.bytes.data(), f.bytes.data() + shift, held - shift);
+      if (keep <= f.first_byte) continue;
+      const size_t shift = static_cast<size_t>(std::min(keep, f.filled) - std::min(f.first_byte, f.filled));
+      std::memmove(f.bytes.data(), f.bytes.data() + shift, held(f) - shift);
       f.first_byte = keep;
     }
   }
@@ -570,6 +603,10 @@ class PacketReader {
         continue;
       }
       if (packet[0] != 1) return Error{packet_at() + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
+      if (checkpoints_) {
+        checkpoints_->push_back(at_ + pos);
+        for (const Field& f : scan_.fields) checkpoints_->push_back(f.filled);
+      }
       if (packet_length < 6)
         return Error{packet_at() + " is a data packet of " + std::to_string(packet_length) +
                      " bytes, shorter than its 6-byte header"};
@@ -589,7 +626,7 @@ class PacketReader {
         const uint64_t needed = f.neededBytes(scan_.records);
         const uint64_t take = std::min(n, needed - std::min(f.filled, needed));  // a last word may be padded past the values
         if (take > 0) {
-          if (Status s = append(f, packet + offset, take); !s) return s.error();
+          if (Status s = append(f, keep_[k] != 0, packet + offset, take); !s) return s.error();
           taken += take;
         }
         offset += n;
@@ -600,8 +637,23 @@ class PacketReader {
     return pos;
   }
 
-  Status append(Field& f, const uint8_t* bytes, uint64_t n) {
-    const uint64_t held = f.filled - f.first_byte;
+  // The bytes a field holds: [first_byte, filled), none while a seek passes over bytes before them.
+  static size_t held(const Field& f) { return static_cast<size_t>(f.filled > f.first_byte ? f.filled - f.first_byte : 0); }
+
+  Status append(Field& f, bool keep, const uint8_t* bytes, uint64_t n) {
+    if (f.filled < f.first_byte) {  // before a seek's record
+      const uint64_t skip = std::min(n, f.first_byte - f.filled);
+      f.filled += skip;
+      bytes += skip;
+      n -= skip;
+    }
+    if (!keep) {
+      f.filled += n;
+      f.first_byte = std::max(f.first_byte, f.filled);
+      return okStatus();
+    }
+    if (n == 0) return okStatus();
+    const uint64_t held = PacketReader::held(f);
     if (held + n + kStreamPadding > f.bytes.size()) {
       uint64_t all = 0;
       for (const Field& other : scan_.fields) all += other.bytes.size();
@@ -627,6 +679,8 @@ class PacketReader {
   std::string where_;
   uint64_t at_ = 0, end_ = 0;
   std::vector<uint8_t> window_;
+  std::vector<char> keep_;
+  std::vector<uint64_t>* checkpoints_ = nullptr;
 };
 
 uint64_t windowOf(const E57ReadOptions& options) {
@@ -912,6 +966,73 @@ Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOp
   return points;
 }
 
+// What the XML tree says: the scans, and how many images it holds (not read).
+struct FileTree {
+  std::vector<ScanInfo> scans;
+  size_t images = 0;
+};
+
+Result<FileTree> readTree(const PagedFile& file, unsigned threads) {
+  const std::string& path = file.path();
+  std::string xml(static_cast<size_t>(file.xmlLength()), '\0');
+  if (Status s = file.read(file.logicalOf(file.xmlOffset()), reinterpret_cast<uint8_t*>(xml.data()), xml.size(), threads,
+                           nullptr);
+      !s)
+    return s.error();
+  pugi::xml_document doc;
+  const pugi::xml_parse_result parsed = doc.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (!parsed) {
+    const auto offset = static_cast<size_t>(std::max<ptrdiff_t>(0, parsed.offset));
+    const std::string_view before(xml.data(), std::min(offset, xml.size()));
+    const size_t line = 1 + static_cast<size_t>(std::count(before.begin(), before.end(), '\n'));
+    return Error{path + ": its XML, line " + std::to_string(line) + ": " + parsed.description()};
+  }
+  const pugi::xml_node root = doc.child("e57Root");
+  if (!root) return Error{path + ": its XML has no e57Root"};
+  FileTree tree;
+  size_t index = 0;
+  for (const pugi::xml_node& child : root.child("data3D").children()) {
+    if (child.type() != pugi::node_element) continue;
+    Result<ScanInfo> info = scanInfoOf(child, index++, path);
+    if (!info) return info.error();
+    tree.scans.push_back(std::move(*info));
+  }
+  for (const pugi::xml_node& child : root.child("images2D").children())
+    if (child.type() == pugi::node_element) ++tree.images;
+  return tree;
+}
+
+// What a scan brings to a join (joinScans): its number, whether it has colours, its dimensions.
+struct ScanFacts {
+  uint64_t number = 0;
+  bool colors = false;
+  std::vector<std::string> dimensions;
+};
+
+// One note for each thing the join of `scans` fills in: white for the scans without colours beside
+// scans with, 0 for a dimension some scans lack.
+void noteJoinFillIns(const std::string& path, const std::vector<ScanFacts>& scans, std::vector<std::string>& notices) {
+  const auto lacking = [&](const auto& has) {
+    std::string numbers;
+    size_t count = 0;
+    for (const ScanFacts& scan : scans)
+      if (!has(scan)) numbers += (count++ == 0 ? "" : ", ") + std::to_string(scan.number);
+    return count == scans.size() ? std::string() : numbers;
+  };
+  if (const std::string none = lacking([](const ScanFacts& f) { return f.colors; }); !none.empty())
+    notices.push_back(path + ": data3D " + none + " without colours beside scans with: their points are white");
+  std::vector<std::string> names;
+  for (const ScanFacts& scan : scans)
+    for (const std::string& name : scan.dimensions)
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  for (const std::string& name : names)
+    if (const std::string none = lacking([&](const ScanFacts& f) {
+          return std::find(f.dimensions.begin(), f.dimensions.end(), name) != f.dimensions.end();
+        });
+        !none.empty())
+      notices.push_back(path + ": data3D " + none + " without " + name + " beside scans with: 0 there");
+}
+
 // Bytes held per point of a scan: positions, colours and, at most, 8 for each other field (the
 // fields' packed values are held a window at a time: PacketReader).
 uint64_t bytesPerRecord(const ScanInfo& scan) {
@@ -934,34 +1055,10 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   const unsigned threads = resolveThreads(options.threads);
   const uint64_t limit = options.max_memory != 0 ? options.max_memory : defaultMemoryLimit();
 
-  // The XML tree.
-  std::string xml(static_cast<size_t>(paged->xmlLength()), '\0');
-  if (Status s = paged->read(paged->logicalOf(paged->xmlOffset()), reinterpret_cast<uint8_t*>(xml.data()), xml.size(),
-                             threads, nullptr);
-      !s)
-    return s.error();
-  pugi::xml_document doc;
-  const pugi::xml_parse_result parsed = doc.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
-  if (!parsed) {
-    const auto offset = static_cast<size_t>(std::max<ptrdiff_t>(0, parsed.offset));
-    const std::string_view before(xml.data(), std::min(offset, xml.size()));
-    const size_t line = 1 + static_cast<size_t>(std::count(before.begin(), before.end(), '\n'));
-    return Error{path + ": its XML, line " + std::to_string(line) + ": " + parsed.description()};
-  }
-  const pugi::xml_node root = doc.child("e57Root");
-  if (!root) return Error{path + ": its XML has no e57Root"};
-  std::vector<ScanInfo> scans;
-  size_t index = 0;
-  for (const pugi::xml_node& child : root.child("data3D").children()) {
-    if (child.type() != pugi::node_element) continue;
-    Result<ScanInfo> info = scanInfoOf(child, index++, path);
-    if (!info) return info.error();
-    scans.push_back(std::move(*info));
-  }
-  size_t images = 0;
-  for (const pugi::xml_node& child : root.child("images2D").children())
-    if (child.type() == pugi::node_element) ++images;
-  std::string().swap(xml);
+  Result<FileTree> tree = readTree(*paged, threads);
+  if (!tree) return tree.error();
+  std::vector<ScanInfo>& scans = tree->scans;
+  const size_t images = tree->images;
 
   uint64_t total = 0, held = 0, bytes_to_read = 0;
   for (const ScanInfo& scan : scans) {
@@ -1033,25 +1130,12 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     return scan.points.dimensions.find(dim::kPointSourceId) != nullptr;
   });
   if (options.notices) {  // what the join fills in
-    const auto lacking = [&](const auto& has) {
-      std::string numbers;
-      size_t count = 0;
-      for (const NumberedScan& scan : read)
-        if (!has(scan.points)) {
-          numbers += (count++ == 0 ? "" : ", ") + std::to_string(scan.number);
-        }
-      return count == read.size() ? std::string() : numbers;
-    };
-    if (const std::string none = lacking([](const PointSet& p) { return p.hasColors(); }); !none.empty())
-      options.notices->push_back(path + ": data3D " + none + " without colours beside scans with: their points are white");
-    std::vector<std::string> names;
-    for (const NumberedScan& scan : read)
-      for (const Dimension& d : scan.points.dimensions.all())
-        if (std::find(names.begin(), names.end(), d.name) == names.end()) names.push_back(d.name);
-    for (const std::string& name : names)
-      if (const std::string none = lacking([&](const PointSet& p) { return p.dimensions.find(name) != nullptr; });
-          !none.empty())
-        options.notices->push_back(path + ": data3D " + none + " without " + name + " beside scans with: 0 there");
+    std::vector<ScanFacts> facts;
+    for (const NumberedScan& scan : read) {
+      facts.push_back({scan.number, scan.points.hasColors(), {}});
+      for (const Dimension& d : scan.points.dimensions.all()) facts.back().dimensions.push_back(d.name);
+    }
+    noteJoinFillIns(path, facts, *options.notices);
   }
   if (own_ids)
     for (NumberedScan& scan : read) scan.number = 0;
@@ -1062,6 +1146,357 @@ Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options)
   Result<InputFile> file = InputFile::open(path);
   if (!file) return file.error();
   return readE57(*file, options);
+}
+
+
+Result<uint64_t> e57RecordCount(const std::string& path) {
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  if (file->size() == 0) return Error{path + ": empty file"};
+  Result<PagedFile> paged = PagedFile::open(*file);
+  if (!paged) return paged.error();
+  Result<FileTree> tree = readTree(*paged, 1);
+  if (!tree) return tree.error();
+  uint64_t records = 0;
+  for (const ScanInfo& scan : tree->scans) records = records > UINT64_MAX - scan.records ? UINT64_MAX : records + scan.records;
+  return records;
+}
+
+// ---- E57PointStream -------------------------------------------------------------------------------
+
+namespace {
+constexpr uint64_t kValidBlock = uint64_t{1} << 16;  // records a count of points is kept for
+}  // namespace
+
+struct E57PointStream::State {
+  // A scan that holds records, with what its reads need. Never moved: its decoder points into
+  // its fields.
+  struct Scan {
+    ScanInfo info;
+    std::optional<ScanDecoder> decoder;
+    uint64_t number = 0;  // its point_source_id, 0: none added
+    uint64_t first = 0;   // its first point in the stream
+    uint64_t points = 0;  // its records that are points
+    std::vector<uint64_t> checkpoints;   // each data packet: its logical offset, then every field's bytes before it
+    std::vector<uint64_t> valid_before;  // points before every kValidBlock-th record; empty: every record is one
+    std::vector<size_t> dimension_of;    // by kept field: its index in dimensions_, SIZE_MAX if none
+  };
+
+  std::optional<InputFile> file;
+  std::optional<PagedFile> paged;
+  E57ReadOptions options;
+  uint64_t window = kPacketWindow, budget = 0;
+  std::vector<std::unique_ptr<Scan>> scans;
+  uint64_t count = 0, held = 0;
+  bool colors = false;
+  size_t source_id = SIZE_MAX;  // the index of point_source_id in dimensions where it is the scan numbers
+  Dimensions dimensions;
+  std::vector<std::string> notices;
+  std::vector<size_t> streamed;  // dimensions read() fills, by index
+  // Where the last read ended: the scan, its next record and the point that record may be.
+  size_t at_scan = SIZE_MAX;
+  uint64_t at_record = 0, at_point = 0;
+  std::unique_ptr<PacketReader> reader;
+
+  // The fields a read decodes of `scan`: positions, invalid state, colours, the streamed dimensions.
+  std::vector<const Field*> neededFields(const Scan& scan) const {
+    std::vector<const Field*> fields;
+    for (const Field& f : scan.info.fields) {
+      const auto kept = std::find_if(scan.decoder->kept().begin(), scan.decoder->kept().end(),
+                                     [&](const ScanDecoder::Kept& k) { return k.field == &f; });
+      if (kept == scan.decoder->kept().end()) {  // a position, invalid state or colour field
+        fields.push_back(&f);
+        continue;
+      }
+      const size_t d = scan.dimension_of[static_cast<size_t>(kept - scan.decoder->kept().begin())];
+      if (std::find(streamed.begin(), streamed.end(), d) != streamed.end()) fields.push_back(&f);
+    }
+    return fields;
+  }
+
+  // A reader of scan s from its point `point` on: at_record and at_point set to the record of the
+  // kValidBlock (or the record itself) at or before it.
+  Status startAt(size_t s, uint64_t point) {
+    Scan& scan = *scans[s];
+    reader.reset();
+    for (const std::unique_ptr<Scan>& other : scans)
+      for (Field& f : other->info.fields) DimensionBytes().swap(f.bytes);
+    uint64_t record = point, before = point;
+    if (!scan.valid_before.empty()) {
+      const size_t b = static_cast<size_t>(
+          std::upper_bound(scan.valid_before.begin(), scan.valid_before.end(), point) - scan.valid_before.begin() - 1);
+      record = b * kValidBlock;
+      before = scan.valid_before[b];
+    }
+    // The last packet at whose start every field has given no more than the record's first byte.
+    const size_t stride = 1 + scan.info.fields.size();
+    const size_t packets = scan.checkpoints.size() / stride;
+    size_t lo = 0, hi = packets;  // the first packet past it: in (lo, hi]
+    while (hi - lo > 1) {
+      const size_t mid = lo + (hi - lo) / 2;
+      const uint64_t* c = scan.checkpoints.data() + mid * stride;
+      bool before_record = true;
+      for (size_t k = 0; k < scan.info.fields.size() && before_record; ++k)
+        before_record = c[1 + k] <= record * scan.info.fields[k].bits / 8;
+      (before_record ? lo : hi) = mid;
+    }
+    reader = std::make_unique<PacketReader>(*paged, scan.info, window, resolveThreads(options.threads), nullptr, budget);
+    if (Status st = reader->open(); !st) return st;
+    reader->keepOnly(neededFields(scan));
+    if (packets > 0) reader->seek(scan.checkpoints.data() + lo * stride, record);
+    at_scan = s;
+    at_record = record;
+    at_point = before;
+    return okStatus();
+  }
+};
+
+E57PointStream::E57PointStream() : state_(std::make_unique<State>()) {}
+E57PointStream::~E57PointStream() = default;
+uint64_t E57PointStream::count() const { return state_->count; }
+bool E57PointStream::hasColors() const { return state_->colors; }
+const Dimensions& E57PointStream::dimensions() const { return state_->dimensions; }
+const std::vector<std::string>& E57PointStream::notices() const { return state_->notices; }
+uint64_t E57PointStream::heldBytes() const { return state_->held; }
+void E57PointStream::streamDimensions(std::vector<size_t> which) {
+  state_->streamed = std::move(which);
+  state_->at_scan = SIZE_MAX;  // the next read keeps those fields too
+}
+
+Result<std::unique_ptr<E57PointStream>> E57PointStream::open(const std::string& path, const E57ReadOptions& options) {
+  std::unique_ptr<E57PointStream> stream(new E57PointStream());
+  State& st = *stream->state_;
+  Result<InputFile> file = InputFile::open(path);
+  if (!file) return file.error();
+  if (file->size() == 0) return Error{path + ": empty file"};
+  st.file.emplace(std::move(*file));
+  Result<PagedFile> paged = PagedFile::open(*st.file);
+  if (!paged) return paged.error();
+  st.paged.emplace(std::move(*paged));
+  st.options = options;
+  st.window = windowOf(options);
+  const unsigned threads = resolveThreads(options.threads);
+  const uint64_t limit = options.max_memory != 0 ? options.max_memory : defaultMemoryLimit();
+  st.budget = limit / 4;  // the fields' bytes of a block's packets: a window's worth as writers spread them
+  Result<FileTree> tree = readTree(*st.paged, threads);
+  if (!tree) return tree.error();
+  const bool intensity_fractions = std::any_of(tree->scans.begin(), tree->scans.end(), [](const ScanInfo& scan) {
+    const Field* f = findField(scan, "intensity");
+    return scan.records > 0 && f && !isLasIntensity(*f);
+  });
+  size_t with_records = 0;
+  for (size_t k = 0; k < tree->scans.size(); ++k) {
+    if (tree->scans[k].records == 0) continue;
+    if (tree->scans[k].records > UINT64_MAX / 128)
+      return Error{path + ": " + tree->scans[k].label + " declares " + std::to_string(tree->scans[k].records) +
+                       " points, more than memory holds",
+                   ExitCode::kResourceLimit};
+    auto scan = std::make_unique<State::Scan>();
+    scan->info = std::move(tree->scans[k]);
+    scan->number = k + 1;
+    st.scans.push_back(std::move(scan));
+    ++with_records;
+  }
+  if (with_records > 1 && st.scans.back()->number > 65535)
+    return Error{path + ": " + st.scans.back()->info.label +
+                 " holds points, and its number is past what a point source id (1 to 65535) holds"};
+  uint64_t bytes_to_read = 0;
+  for (const std::unique_ptr<State::Scan>& scan : st.scans)
+    for (const Field& f : scan->info.fields) bytes_to_read += f.neededBytes(scan->info.records);
+  Progress* progress = options.progress;
+  if (progress) progress->start("indexing " + path, bytes_to_read);
+  uint64_t left_out = 0, total = 0;
+  std::vector<std::string> intensity_ranges;
+  bool own_ids = false;
+  for (std::unique_ptr<State::Scan>& scan_ptr : st.scans) {
+    State::Scan& scan = *scan_ptr;
+    Result<ScanDecoder> decoder = ScanDecoder::of(path, scan.info, intensity_fractions);
+    if (!decoder) return decoder.error();
+    scan.decoder.emplace(std::move(*decoder));
+    const ScanDecoder& dec = *scan.decoder;
+    for (const ScanDecoder::Kept& k : dec.kept()) {
+      own_ids = own_ids || k.name == dim::kPointSourceId;
+      if (!k.normalised) continue;
+      const std::string range = formatNumber(k.normalised->lo) + ".." + formatNumber(k.normalised->hi) + " (" +
+                                k.normalised->source + ")";
+      if (std::find(intensity_ranges.begin(), intensity_ranges.end(), range) == intensity_ranges.end())
+        intensity_ranges.push_back(range);
+    }
+    // The walk: every packet's place, and the invalid state's points counted.
+    PacketReader reader(*st.paged, scan.info, st.window, threads, progress, st.budget);
+    if (Status s = reader.open(); !s) return s.error();
+    std::vector<const Field*> invalid;
+    for (const Field& f : scan.info.fields)
+      if (&f == findField(scan.info, "cartesianInvalidState") || &f == findField(scan.info, "sphericalInvalidState"))
+        if (dec.hasInvalidState()) invalid.push_back(&f);
+    reader.keepOnly(invalid);
+    reader.recordCheckpoints(&scan.checkpoints);
+    const uint64_t n = scan.info.records;
+    uint64_t decoded = 0, points = 0;
+    while (decoded < n) {
+      if (Status s = reader.next(); !s) return s.error();
+      const uint64_t ready = reader.ready();
+      if (dec.hasInvalidState())
+        for (uint64_t i = decoded; i < ready; ++i) {
+          if (i % kValidBlock == 0) scan.valid_before.push_back(points);
+          points += dec.valid(static_cast<size_t>(i));
+        }
+      else
+        points = ready;
+      reader.drop(ready);
+      decoded = ready;
+    }
+    if (dec.hasInvalidState()) scan.valid_before.push_back(points);
+    for (Field& f : scan.info.fields) DimensionBytes().swap(f.bytes);
+    scan.checkpoints.shrink_to_fit();
+    scan.points = points;
+    scan.first = st.count;
+    st.count += points;
+    total += n;
+    left_out += n - points;
+    st.colors = st.colors || (points > 0 && dec.hasColors());
+    st.held += (scan.checkpoints.size() + scan.valid_before.size()) * sizeof(uint64_t);
+  }
+  if (progress) progress->finish();
+
+  // The dimensions as the join makes them (joinScans, appendPoints): each name once, in the order
+  // met, the scan numbers after the first scan's where several scans hold records and none has
+  // ids, a type kept where it holds a later scan's, else float64.
+  std::vector<ScanFacts> facts;
+  for (std::unique_ptr<State::Scan>& scan : st.scans) {
+    facts.push_back({scan->number, scan->decoder->hasColors(), {}});
+    for (const ScanDecoder::Kept& k : scan->decoder->kept()) {
+      facts.back().dimensions.push_back(k.name);
+      size_t d = 0;
+      for (; d < st.dimensions.count(); ++d)
+        if (st.dimensions.all()[d].name == k.name) break;
+      if (d == st.dimensions.count()) st.dimensions.append(k.name, k.type, 0);
+      else if (!dimTypeHolds(st.dimensions.all()[d].type, k.type)) st.dimensions.all()[d].type = DimType::kF64;
+      scan->dimension_of.push_back(d);
+    }
+    if (scan == st.scans.front() && st.scans.size() > 1 && !own_ids) {
+      st.source_id = st.dimensions.count();
+      st.dimensions.append(dim::kPointSourceId, DimType::kU16, 0);
+    }
+  }
+  if (left_out > 0)
+    st.notices.push_back(path + ": " + std::to_string(left_out) + " of its " + std::to_string(total) +
+                         " points are marked invalid (no point, or a direction alone): left out");
+  for (const std::string& range : intensity_ranges)
+    st.notices.push_back(path + ": intensity of " + range + " read as 0..1 values, as LAS normalises it");
+  if (tree->images > 0)
+    st.notices.push_back(path + ": its " + countOf(tree->images, "image") + " (images2D) " +
+                         (tree->images == 1 ? "is" : "are") + " not read");
+  if (st.scans.empty())
+    st.notices.push_back(path + ": " + (tree->scans.empty() ? std::string("no scan (data3D is empty)")
+                                                            : "its " + countOf(tree->scans.size(), "scan") +
+                                                                  (tree->scans.size() == 1 ? " holds" : " hold") + " no points"));
+  if (st.scans.size() > 1) noteJoinFillIns(path, facts, st.notices);
+  return stream;
+}
+
+Status E57PointStream::read(uint64_t first, uint64_t n, PointSet& block) {
+  State& st = *state_;
+  assert(first <= st.count && n <= st.count - first);
+  block.triangles.clear();
+  block.z_axis = ZAxis::kPresent;
+  block.positions.resize(static_cast<size_t>(n));
+  block.colors.resize(st.colors ? static_cast<size_t>(n) : 0);
+  block.dimensions = Dimensions();
+  std::vector<Dimension*> out_dims;
+  block.dimensions.reserve(st.streamed.size());  // no append moves the columns out_dims points to
+  for (size_t d : st.streamed) {
+    const Dimension& of = st.dimensions.all()[d];
+    out_dims.push_back(&block.dimensions.appendUnset(of.name, of.type, static_cast<size_t>(n)));
+  }
+  const unsigned threads = resolveThreads(st.options.threads);
+  std::vector<uint64_t> records;  // of the current window: those read into the block, less `base`
+  uint64_t done = 0;
+  while (done < n) {
+    const uint64_t point = first + done;
+    // The scan holding the point: the last whose first point is at or before it, with points.
+    size_t s = static_cast<size_t>(std::upper_bound(st.scans.begin(), st.scans.end(), point,
+                                                    [](uint64_t p, const std::unique_ptr<State::Scan>& scan) {
+                                                      return p < scan->first;
+                                                    }) -
+                                   st.scans.begin() - 1);
+    while (st.scans[s]->points == 0 || point >= st.scans[s]->first + st.scans[s]->points) ++s;
+    State::Scan& scan = *st.scans[s];
+    const uint64_t local = point - scan.first;
+    if (st.at_scan != s || st.at_point > local || (st.at_point != local && scan.valid_before.empty()) ||
+        (!scan.valid_before.empty() && local - st.at_point > kValidBlock)) {
+      if (Status status = st.startAt(s, local); !status) return status;
+    }
+    const ScanDecoder& dec = *scan.decoder;
+    const uint64_t want = std::min(n - done, scan.points - local);
+    uint64_t taken = 0, skip = local - st.at_point;
+    while (taken < want) {
+      if (st.reader->ready() <= st.at_record)
+        if (Status status = st.reader->next(want - taken + skip); !status) return status;
+      const uint64_t ready = st.reader->ready();
+      const uint64_t base = st.at_record;
+      records.clear();
+      uint64_t r = st.at_record;
+      for (; r < ready && taken + records.size() < want; ++r) {
+        if (!dec.valid(static_cast<size_t>(r))) continue;
+        if (skip > 0) {
+          --skip;
+          ++st.at_point;
+          continue;
+        }
+        records.push_back(r - base);
+      }
+      const size_t got = records.size();
+      const uint64_t at = done + taken;
+      std::atomic<size_t> first_nonfinite{SIZE_MAX};
+      const size_t blocks = (got + kDecodeBlock - 1) / kDecodeBlock;
+      parallelFor(blocks, threads, [&](size_t b, unsigned) {
+        const size_t begin = b * kDecodeBlock, end = std::min(got, begin + kDecodeBlock);
+        for (size_t k = begin; k < end; ++k) {
+          const size_t i = static_cast<size_t>(base + records[k]);
+          const glm::dvec3 p = dec.position(i);
+          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) lowerAtomic(first_nonfinite, k);
+          block.positions[static_cast<size_t>(at) + k] = p;
+          if (st.colors) block.colors[static_cast<size_t>(at) + k] = dec.hasColors() ? dec.color(i) : glm::vec3(1.0f);
+        }
+        for (size_t o = 0; o < out_dims.size(); ++o) {
+          Dimension& dim = *out_dims[o];
+          const size_t d = st.streamed[o];
+          const size_t width = dimTypeSize(dim.type);
+          if (d == st.source_id) {
+            for (size_t k = begin; k < end; ++k) dim.setValue(static_cast<size_t>(at) + k, static_cast<double>(scan.number));
+            continue;
+          }
+          const auto kept = std::find(scan.dimension_of.begin(), scan.dimension_of.end(), d);
+          if (kept == scan.dimension_of.end()) {  // a dimension this scan lacks: 0, as the join fills it
+            std::fill_n(dim.bytes.data() + (static_cast<size_t>(at) + begin) * width, (end - begin) * width, uint8_t{0});
+            continue;
+          }
+          const size_t kd = static_cast<size_t>(kept - scan.dimension_of.begin());
+          if (dec.kept()[kd].type == dim.type) {
+            for (size_t k = begin; k < end; ++k)
+              dec.store(kd, static_cast<size_t>(base + records[k]), dim.bytes.data() + (static_cast<size_t>(at) + k) * width);
+          } else {  // widened to float64 where the scans' types differ
+            Dimension one(dim.name, dec.kept()[kd].type, 1);
+            for (size_t k = begin; k < end; ++k) {
+              dec.store(kd, static_cast<size_t>(base + records[k]), one.bytes.data());
+              dim.setValue(static_cast<size_t>(at) + k, one.value(0));
+            }
+          }
+        }
+      });
+      if (first_nonfinite.load() != SIZE_MAX && !st.options.allow_nonfinite) {
+        const size_t k = first_nonfinite.load();
+        return dec.nonfiniteError(static_cast<size_t>(base + records[k]), base + records[k]);
+      }
+      taken += got;
+      st.at_point += got;
+      st.at_record = r;
+      st.reader->drop(r);
+    }
+    done += taken;
+  }
+  return okStatus();
 }
 
 }  // namespace dpoint

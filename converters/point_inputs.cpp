@@ -8,6 +8,7 @@
 #include <cstring>
 #include <tuple>
 
+#include "converters/e57.h"
 #include "converters/las.h"
 #include "converters/ply.h"
 #include "converters/tile_file.h"
@@ -147,20 +148,24 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
 
 // One file of the stream: a binary PLY or a LAS/LAZ file.
 struct PointInputStream::Part {
-  std::unique_ptr<PlyVertexStream> ply;
+  std::unique_ptr<PlyVertexStream> ply;  // one of the three
   std::unique_ptr<LasPointStream> las;
+  std::unique_ptr<E57PointStream> e57;
   uint64_t first = 0;  // the part's first point in the stream
   uint64_t count = 0;  // points it streams (a tile: its owned vertices)
 
-  uint64_t fileCount() const { return ply ? ply->count() : las->count(); }
-  bool hasColors() const { return ply ? ply->hasColors() : las->hasColors(); }
+  uint64_t fileCount() const { return ply ? ply->count() : las ? las->count() : e57->count(); }
+  bool hasColors() const { return ply ? ply->hasColors() : las ? las->hasColors() : e57->hasColors(); }
   uint64_t faceCount() const { return ply ? ply->faceCount() : 0; }
-  const Dimensions& dimensions() const { return ply ? ply->dimensions() : las->dimensions(); }
+  const Dimensions& dimensions() const { return ply ? ply->dimensions() : las ? las->dimensions() : e57->dimensions(); }
   void streamDimensions(std::vector<size_t> which) {
     if (ply) ply->streamDimensions(std::move(which));
-    else las->streamDimensions(std::move(which));
+    else if (las) las->streamDimensions(std::move(which));
+    else e57->streamDimensions(std::move(which));
   }
-  Status read(uint64_t from, uint64_t n, PointSet& block) { return ply ? ply->read(from, n, block) : las->read(from, n, block); }
+  Status read(uint64_t from, uint64_t n, PointSet& block) {
+    return ply ? ply->read(from, n, block) : las ? las->read(from, n, block) : e57->read(from, n, block);
+  }
   std::string path;
   bool watch_colors = false;  // a float-colour PLY whose colours above 1 are not yet said
   // A float-colour PLY whose first `sampled` rows' colours are whole numbers above 1: streamed as
@@ -242,6 +247,16 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       if (!las) return las.error();
       part.las = std::move(*las);
       stream->notices_.insert(stream->notices_.end(), part.las->notices().begin(), part.las->notices().end());
+    } else if (format && *format == FileFormat::kE57) {
+      E57ReadOptions options;
+      options.threads = threads;
+      options.max_memory = max_memory;
+      options.allow_nonfinite = allow_nonfinite;
+      Result<std::unique_ptr<E57PointStream>> e57 = E57PointStream::open(path, options);
+      if (!e57) return e57.error();
+      part.e57 = std::move(*e57);
+      stream->held_bytes_ += part.e57->heldBytes();
+      stream->notices_.insert(stream->notices_.end(), part.e57->notices().begin(), part.e57->notices().end());
     } else {
       Result<std::unique_ptr<PlyVertexStream>> ply =
           PlyVertexStream::open(path, PlyReadOptions{allow_nonfinite, nullptr, threads, true});
@@ -391,13 +406,31 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
                                                           uint64_t max_memory, bool allow_nonfinite) {
   const bool streamable = std::all_of(paths.begin(), paths.end(), [](const std::string& path) {
     Result<FileFormat> format = formatOf(path);
-    return format && (*format == FileFormat::kPly || *format == FileFormat::kLas || *format == FileFormat::kLaz);
+    return format && (*format == FileFormat::kPly || *format == FileFormat::kLas || *format == FileFormat::kLaz ||
+                      *format == FileFormat::kE57);
   });
   if (stream == "off") return std::unique_ptr<PointInputStream>();
   if (!streamable) {
     if (stream == "on")
-      return Error{describeInputs(paths) + ": --stream on reads binary PLY, LAS and LAZ files", ExitCode::kUsage};
+      return Error{describeInputs(paths) + ": --stream on reads binary PLY, LAS, LAZ and E57 files", ExitCode::kUsage};
     return std::unique_ptr<PointInputStream>();
+  }
+  // An E57 stream reads its whole file as it opens (E57PointStream): under auto, E57 files whose
+  // scans declare no more records than a stream is for are read whole without that pass.
+  if (stream == "auto") {
+    uint64_t declared = 0;
+    bool all_e57 = true;
+    for (const std::string& path : paths) {
+      Result<FileFormat> format = formatOf(path);
+      if (!format || *format != FileFormat::kE57) {
+        all_e57 = false;
+        continue;
+      }
+      Result<uint64_t> records = e57RecordCount(path);
+      if (!records) return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong
+      declared += *records;
+    }
+    if (all_e57 && declared <= kStreamAbovePoints) return std::unique_ptr<PointInputStream>();
   }
   // Under auto the set may yet be read whole: the copies are held to the default limit only, and
   // --max-memory applies once the stream is chosen (checkStreamMemory with heldBytes). A stream

@@ -46,7 +46,7 @@ struct InputSet {
 };
 Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 
-// One or several binary PLY, LAS or LAZ files as one stream of points (render's --stream): the points
+// One or several binary PLY, LAS, LAZ or E57 files as one stream of points (render's --stream): the points
 // readPointInputs(paths) gives, in its order, a block at a time (positions and colours, no
 // triangles). A complete tile set streams each tile's owned vertices in tile order (the merged
 // set, each seam vertex once, each of its copies checked against it as it is read: a copy that
@@ -105,7 +105,7 @@ class PointInputStream {
 };
 
 // --stream auto|on|off of render and info: the stream when `stream` is "on", or "auto" and the
-// paths are binary PLY, LAS or LAZ files of more than kStreamAbovePoints points together; nullptr when the
+// paths are binary PLY, LAS, LAZ or E57 files of more than kStreamAbovePoints points together; nullptr when the
 // set is to be read whole. With "on", input that cannot be streamed is an error (an ASCII PLY, a
 // bad header: the reader's; another format: kUsage). In memory such a set would take 36 B a point
 // (2.4 GB at 2^26) before the upload's own. With "on", a tile set whose copies alone do not fit

@@ -248,4 +248,15 @@ size_t Dimensions::bytesPerPoint() const {
   return n;
 }
 
+bool dimTypeHolds(DimType to, DimType from) {
+  if (to == from) return true;
+  if (to == DimType::kF64) return from != DimType::kI64 && from != DimType::kU64;
+  if (dimTypeIsFloat(from)) return false;
+  if (dimTypeIsFloat(to)) return dimTypeSize(from) <= 2;  // float32 holds 16-bit integers exactly
+  const int bits = static_cast<int>(8 * dimTypeSize(from));
+  const double lo = dimTypeIsSigned(from) ? -std::ldexp(1.0, bits - 1) : 0.0;
+  const double hi = std::ldexp(1.0, dimTypeIsSigned(from) ? bits - 1 : bits) - 1.0;
+  return dimensionHolds(to, lo) && dimensionHolds(to, hi);
+}
+
 }  // namespace dpoint

@@ -38,6 +38,9 @@ const char* plyTypeName(DimType type);
 // Whether `v` is exactly a value of the type (a whole number in its range; for float32, a float;
 // NaN for the float types only).
 bool dimensionHolds(DimType type, double v);
+// Whether every value of type `from` is one of type `to` (a join keeps a column of `to` then,
+// else makes it float64: appendPoints).
+bool dimTypeHolds(DimType to, DimType from);
 // A value of the type stored at `bytes` (host order, unaligned), as a double (exact but for 64-bit
 // integers beyond 2^53).
 double loadDimValue(DimType type, const uint8_t* bytes);

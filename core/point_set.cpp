@@ -107,22 +107,6 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
   points.colors_read_as_fractions = false;
 }
 
-namespace {
-
-// Whether every value of type `from` is one of type `to`.
-bool typeHolds(DimType to, DimType from) {
-  if (to == from) return true;
-  if (to == DimType::kF64) return from != DimType::kI64 && from != DimType::kU64;
-  if (dimTypeIsFloat(from)) return false;
-  if (dimTypeIsFloat(to)) return dimTypeSize(from) <= 2;  // float32 holds 16-bit integers exactly
-  const int bits = static_cast<int>(8 * dimTypeSize(from));
-  const double lo = dimTypeIsSigned(from) ? -std::ldexp(1.0, bits - 1) : 0.0;
-  const double hi = std::ldexp(1.0, dimTypeIsSigned(from) ? bits - 1 : bits) - 1.0;
-  return dimensionHolds(to, lo) && dimensionHolds(to, hi);
-}
-
-}  // namespace
-
 void appendPoints(PointSet& out, const PointSet& part) {
   const size_t at = out.size();
   const uint32_t offset = static_cast<uint32_t>(at);
@@ -137,7 +121,7 @@ void appendPoints(PointSet& out, const PointSet& part) {
   for (const Dimension& d : part.dimensions.all()) {
     Dimension* column = out.dimensions.find(d.name);
     if (!column) column = &out.dimensions.add(d.name, d.type, at);
-    if (!typeHolds(column->type, d.type)) {  // float64 for both (0..1 intensities had become 0 or 1 in a uint16 column)
+    if (!dimTypeHolds(column->type, d.type)) {  // float64 for both (0..1 intensities had become 0 or 1 in a uint16 column)
       Dimension wide(column->name, DimType::kF64, at);
       for (size_t i = 0; i < at; ++i) wide.setValue(i, column->value(i));
       *column = std::move(wide);

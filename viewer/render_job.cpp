@@ -264,7 +264,7 @@ Status readPreview(PointInputStream& stream, LoadedSet& set) {
   return okStatus();
 }
 
-// Opens the input as a stream (large binary PLY, LAS or LAZ), reads a COPC file's view, or reads
+// Opens the input as a stream (large binary PLY, LAS, LAZ or E57), reads a COPC file's view, or reads
 // it whole.
 Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, RenderPhases& phases) {
   LoadedSet set;

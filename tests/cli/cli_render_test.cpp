@@ -628,6 +628,41 @@ TEST(CliRender, streamedPlyDrawsTheSamePicture) {
   EXPECT_FALSE(test::fileExists(dir.file("a.png")) || test::fileExists(dir.file("e.png")));
 }
 
+// An E57 file drawn a block at a time gives the picture the set in memory gives: libE57Format's
+// two posed scans with invalid points (joined, coloured by intensity and by scan number, which the
+// stream reads as the join makes them) and its spherical scan; info says the same of it.
+TEST(CliRender, streamedE57DrawsTheSamePicture) {
+  TempDir dir;
+  const std::string data = std::string(DPOINT_TESTS_DIR) + "/data/e57/";
+  for (const auto& [file, color] : std::vector<std::pair<std::string, std::string>>{
+           {"two_scans.e57", ""}, {"two_scans.e57", "intensity"}, {"two_scans.e57", "point_source_id"}, {"spherical.e57", ""}}) {
+    SCOPED_TRACE(file + " " + color);
+    for (const char* stream : {"off", "on"}) {
+      std::vector<std::string> args{"render", data + file, "-o", dir.file(stream + std::string(".png")), "--stream", stream,
+                                    "--validate", "--width", "160", "--height", "120", "--mode", "batch"};
+      if (!color.empty()) args.insert(args.end(), {"--color", color});
+      test::CommandResult r = runDpoint(args);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_EQ(r.out.find("(streamed)") != std::string::npos, stream == std::string("on")) << r.out;
+    }
+    EXPECT_TRUE(readFile(dir.file("off.png")) == readFile(dir.file("on.png")));
+  }
+  const test::CommandResult whole = runDpoint({"info", "--json", "--stream", "off", data + "two_scans.e57"});
+  const test::CommandResult streamed = runDpoint({"info", "--json", "--stream", "on", data + "two_scans.e57"});
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+  EXPECT_EQ(whole.err, streamed.err);  // the same notes: points left out, what the join fills in
+  const auto line = [](const std::string& json, const std::string& key) {  // the key's line of the report
+    const size_t at = json.find("\n  \"" + key + "\": ");
+    return at == std::string::npos ? std::string() : json.substr(at, json.find('\n', at + 1) - at);
+  };
+  for (const char* key : {"points", "min", "max", "min_neighbor_distance"}) {
+    EXPECT_FALSE(line(whole.out, key).empty()) << key;
+    EXPECT_EQ(line(whole.out, key), line(streamed.out, key)) << key;
+  }
+  EXPECT_TRUE(test::contains(streamed.out, "\"streamed\": true"));
+}
+
 // A stream drawn in one pass is encoded for the camera and mode its preview (whole batches spread
 // over the file) suggests; where the whole set wants otherwise, it is read again, and the picture
 // is still the one the set in memory gives. 300,000 2D points near the origin; the preview passes

@@ -687,5 +687,98 @@ TEST(E57, standardNamesAreRenamedAndEveryValueComesBack) {
   EXPECT_EQ(two->positions[1].x, 3.0);
 }
 
+// The points of `whole` [first, first + n) equal `block`'s: positions and colours bit for bit, and
+// every dimension's value.
+void expectBlockOf(const PointSet& whole, const PointSet& block, uint64_t first, uint64_t n, const std::string& what) {
+  ASSERT_EQ(block.size(), n) << what;
+  ASSERT_EQ(std::memcmp(block.positions.data(), whole.positions.data() + first, n * sizeof(glm::dvec3)), 0) << what;
+  ASSERT_EQ(block.hasColors(), whole.hasColors()) << what;
+  if (whole.hasColors()) {
+    ASSERT_EQ(std::memcmp(block.colors.data(), whole.colors.data() + first, n * sizeof(glm::vec3)), 0) << what;
+  }
+  ASSERT_EQ(block.dimensions.count(), whole.dimensions.count()) << what;
+  for (size_t d = 0; d < whole.dimensions.count(); ++d) {
+    const Dimension& a = whole.dimensions.all()[d];
+    const Dimension& b = block.dimensions.all()[d];
+    ASSERT_EQ(b.name, a.name) << what;
+    ASSERT_EQ(b.type, a.type) << what << " " << a.name;
+    const size_t w = dimTypeSize(a.type);
+    ASSERT_EQ(std::memcmp(b.bytes.data(), a.bytes.data() + first * w, n * w), 0) << what << " " << a.name;
+  }
+}
+
+// A stream (render's and info's --stream) gives readE57's points block by block, in blocks of
+// any size and in any order: libE57Format's files (poses, invalid points, a spherical scan, two
+// scans joined with their numbers and what the join fills in), dpoint's own, and a file of
+// packets given field by field, read 64 KiB at a time.
+TEST(E57, aStreamGivesWhatReadE57GivesInAnyBlocks) {
+  TempDir dir;
+  std::vector<std::string> paths;
+  for (const char* name : {"two_scans.e57", "spherical.e57", "bunnyInt32.e57", "ColouredCubeFloat.e57",
+                           "ColourRepresentation.e57", "written/1.2-with-color.e57", "ZeroPoints.e57"})
+    paths.push_back(std::string(DPOINT_TESTS_DIR) + "/data/e57/" + name);
+  {
+    const size_t n = 30000;
+    std::vector<int64_t> x(n), state(n);
+    std::vector<double> y(n);
+    for (size_t i = 0; i < n; ++i) {
+      x[i] = static_cast<int64_t>(i % 8) - 5;
+      y[i] = 1e6 + static_cast<double>(i) / 3;
+      state[i] = (i / 500) % 3 == 1 || i % 11 == 0 ? 1 : 0;  // runs of invalid records, and single ones
+    }
+    E57File file;
+    const uint64_t at = file.compressedVector({packBits(x, -5, 3), packRaw(y), packRaw(y), packBits(state, 0, 1), packRaw(y)},
+                                              4000, false, true);
+    const std::string prototype =
+        "<cartesianX type=\"Integer\" minimum=\"-5\" maximum=\"2\"/><cartesianY type=\"Float\"/>"
+        "<cartesianZ type=\"Float\"/><cartesianInvalidState type=\"Integer\" minimum=\"0\" maximum=\"1\"/>"
+        "<timeStamp type=\"Float\"/>";
+    paths.push_back(dir.file("in_turn.e57"));
+    writeFile(paths.back(), file.bytes(rootXml(scanXml(at, n, prototype))));
+  }
+  for (const std::string& path : paths) {
+    E57ReadOptions options;
+    options.packet_window = 1;  // 64 KiB
+    std::vector<std::string> whole_notices, notices;
+    options.notices = &whole_notices;
+    Result<PointSet> whole = readE57(path, options);
+    ASSERT_TRUE(whole.ok()) << whole.error().message;
+    options.notices = nullptr;
+    options.threads = 3;
+    Result<std::unique_ptr<E57PointStream>> stream = E57PointStream::open(path, options);
+    ASSERT_TRUE(stream.ok()) << stream.error().message;
+    E57PointStream& s = **stream;
+    ASSERT_EQ(s.count(), whole->size()) << path;
+    EXPECT_EQ(s.hasColors(), whole->hasColors()) << path;
+    EXPECT_EQ(s.notices(), whole_notices) << path;
+    ASSERT_EQ(s.dimensions().count(), whole->dimensions.count()) << path;
+    std::vector<size_t> all;
+    for (size_t d = 0; d < s.dimensions().count(); ++d) {
+      EXPECT_EQ(s.dimensions().all()[d].name, whole->dimensions.all()[d].name) << path;
+      EXPECT_EQ(s.dimensions().all()[d].type, whole->dimensions.all()[d].type) << path;
+      all.push_back(d);
+    }
+    s.streamDimensions(all);
+    const uint64_t count = s.count();
+    PointSet block;
+    ASSERT_TRUE(s.read(0, count, block).ok()) << path;
+    expectBlockOf(*whole, block, 0, count, path + " whole");
+    for (const uint64_t size : {uint64_t{1}, uint64_t{7}, uint64_t{999}, uint64_t{4096}}) {
+      if (count == 0) break;
+      // In order, then from the end backwards, then a stride that jumps about.
+      std::vector<uint64_t> firsts;
+      for (uint64_t f = 0; f < count && firsts.size() < 200; f += size) firsts.push_back(f);
+      for (uint64_t k = 0; k < 50 && k * size < count; ++k) firsts.push_back(count - std::min(count, (k + 1) * size));
+      for (uint64_t k = 0; k < 50; ++k) firsts.push_back(k * 7919 * size % count);
+      for (const uint64_t f : firsts) {
+        const uint64_t n = std::min(size, count - f);
+        Status st = s.read(f, n, block);
+        ASSERT_TRUE(st.ok()) << st.error().message;
+        expectBlockOf(*whole, block, f, n, path + " at " + std::to_string(f) + " size " + std::to_string(size));
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace dpoint

@@ -65,7 +65,10 @@ def test_ctrl_c_stops_a_long_call_leaving_no_output(tmp_path, name):
         ended = child.stdout.readline().strip()
         took = time.monotonic() - sent
         assert ended == "interrupted", child.stderr.read()
-        assert took < 2.0, f"KeyboardInterrupt {took:.2f} s after SIGINT"
+        # Well before any call would end (info's takes 9 s alone on the 2-core VM, the others
+        # longer): the bound tells stopped from ran on, with room for a loaded machine (2.05 s was
+        # seen with a build beside the suite, the SIGINT landing in info's one-thread sort).
+        assert took < 4.0, f"KeyboardInterrupt {took:.2f} s after SIGINT"
         assert child.stdout.readline().strip() == "handler restored"
         assert not out.exists()
         assert os.listdir(tmp_path) == []  # no temporary file left either
