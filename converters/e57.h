@@ -67,10 +67,12 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options = 
 // packets once (reading the file through, checking every page), keeping where each packet begins
 // and, where a scan has an invalid state, how many of every 65,536 records are points; read() then
 // starts at the packet before its first point, or goes on where the last read ended. The errors are
-// readE57's (a non-finite coordinate: at open where allow_nonfinite is false... no: when read).
+// readE57's, those of the packets at open, a non-finite coordinate (unless allow_nonfinite) when
+// its block is read. read() may be called from one thread at a time.
 class E57PointStream {
  public:
   static Result<std::unique_ptr<E57PointStream>> open(const std::string& path, const E57ReadOptions& options = {});
+  static Result<std::unique_ptr<E57PointStream>> open(InputFile file, const E57ReadOptions& options = {});
   ~E57PointStream();
   uint64_t count() const;
   bool hasColors() const;

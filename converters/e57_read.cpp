@@ -678,7 +678,7 @@ class PacketReader {
   uint64_t budget_;
   std::string where_;
   uint64_t at_ = 0, end_ = 0;
-  std::vector<uint8_t> window_;
+  DimensionBytes window_;  // unset as sized: the file's bytes overwrite it
   std::vector<char> keep_;
   std::vector<uint64_t>* checkpoints_ = nullptr;
 };
@@ -1264,12 +1264,17 @@ void E57PointStream::streamDimensions(std::vector<size_t> which) {
 }
 
 Result<std::unique_ptr<E57PointStream>> E57PointStream::open(const std::string& path, const E57ReadOptions& options) {
-  std::unique_ptr<E57PointStream> stream(new E57PointStream());
-  State& st = *stream->state_;
   Result<InputFile> file = InputFile::open(path);
   if (!file) return file.error();
-  if (file->size() == 0) return Error{path + ": empty file"};
-  st.file.emplace(std::move(*file));
+  return open(std::move(*file), options);
+}
+
+Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, const E57ReadOptions& options) {
+  std::unique_ptr<E57PointStream> stream(new E57PointStream());
+  State& st = *stream->state_;
+  const std::string path = input.path();
+  if (input.size() == 0) return Error{path + ": empty file"};
+  st.file.emplace(std::move(input));
   Result<PagedFile> paged = PagedFile::open(*st.file);
   if (!paged) return paged.error();
   st.paged.emplace(std::move(*paged));
