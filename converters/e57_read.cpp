@@ -853,7 +853,8 @@ class ScanDecoder {
       const float a = static_cast<float>((f.value(i) - k.normalised->lo) / (k.normalised->hi - k.normalised->lo));
       std::memcpy(out, &a, 4);
     } else if (f.kind == FieldKind::kInteger) {
-      const int64_t v = f.integer(i) + (k.return_index ? 1 : 0);
+      // + 1 in unsigned arithmetic: a returnIndex up to INT64_MAX is a uint64 column (dimensionOf).
+      const int64_t v = static_cast<int64_t>(static_cast<uint64_t>(f.integer(i)) + (k.return_index ? 1u : 0u));
       switch (k.type) {  // the type holds the field's limits (integerType)
         case DimType::kU8: *out = static_cast<uint8_t>(v); break;
         case DimType::kI8: { const int8_t a = static_cast<int8_t>(v); std::memcpy(out, &a, 1); break; }

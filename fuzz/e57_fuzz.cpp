@@ -39,8 +39,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::broken("a stream has the points a read has", std::to_string((*stream)->count()) + " for " + std::to_string(one->size()));
   const uint64_t count = (*stream)->count();
   PointSet block;
-  for (uint64_t first = 0, size = 997; first < count && first < 100000; first += size) {
-    const uint64_t n = std::min(size, count - first);
+  constexpr uint64_t kBlock = 997;
+  for (uint64_t first = 0; first < count && first < 100000; first += kBlock) {
+    const uint64_t n = std::min(kBlock, count - first);
     if (Status s = (*stream)->read(first, n, block); !s) {
       if (one && s.error().code != ExitCode::kResourceLimit) fuzz::broken("a file read whole streams", s.error().message);
       fuzz::checkError(s.error(), input.path());
