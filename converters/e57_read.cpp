@@ -86,6 +86,7 @@ constexpr size_t kPagesPerRead = 1024;      // pages read and checked at a time 
 constexpr uint64_t kPacketWindow = 32u << 20;  // logical bytes of packets read at a time (E57ReadOptions::packet_window)
 constexpr uint64_t kLeastWindow = 64u << 10;   // a packet's most
 constexpr size_t kDecodeBlock = 1u << 16;   // records decoded at a time by a worker
+constexpr uint64_t kMostConstantRecords = uint64_t{1} << 26;  // records of a scan whose fields take no bits
 constexpr size_t kStreamPadding = 16;       // zero bytes after a field's bytes: a value read as 9 bytes
 
 // The file as E57 lays it out: pages of page_ bytes, the last 4 a checksum of the others.
@@ -411,6 +412,13 @@ Result<ScanInfo> scanInfoOf(const pugi::xml_node& scan, size_t index, const std:
     info.fields.push_back(std::move(*f));
   }
   if (info.fields.empty()) return Error{where + ": points: a prototype of no fields"};
+  // Fields of no bits (each a constant) make every record the same point and take no bytes: a
+  // file of 1 KB could declare 2^35 of them, hours of streaming (a review finding).
+  const bool no_bits = std::all_of(info.fields.begin(), info.fields.end(), [](const Field& f) { return f.bits == 0; });
+  if (no_bits && info.records > kMostConstantRecords)
+    return Error{where + ": points: " + std::to_string(info.records) +
+                 " records whose fields all take no bits (each the same point, in no bytes): more than " +
+                 std::to_string(kMostConstantRecords) + " such records are taken for a damaged count"};
   for (const pugi::xml_node& codec : points.child("codecs").children())
     if (codec.type() == pugi::node_element)
       return Error{where + ": points: a codec other than bitpack (" + quotedExcerpt(codec.name()) + "), which E57 does not define"};
@@ -514,9 +522,14 @@ class PacketReader {
     for (size_t k = 0; k < scan_.fields.size(); ++k)
       keep_[k] = std::find(fields.begin(), fields.end(), &scan_.fields[k]) != fields.end();
   }
-  // From now on each data packet's logical offset, then every field's bytes gathered before it,
-  // are appended to `checkpoints` (1 + fields values a packet).
-  void recordCheckpoints(std::vector<uint64_t>* checkpoints) { checkpoints_ = checkpoints; }
+  // From now on a data packet's logical offset, then every field's bytes gathered before it, are
+  // appended to `checkpoints` (1 + fields values), for the first packet and then for one at least
+  // 256 KiB (and 32 times a checkpoint's own bytes) past the last: the index is a small share of
+  // the file however small its packets (a review finding: 2M empty packets took 1 GB).
+  void recordCheckpoints(std::vector<uint64_t>* checkpoints) {
+    checkpoints_ = checkpoints;
+    checkpoint_spacing_ = std::max<uint64_t>(256u << 10, 32 * 8 * (1 + scan_.fields.size()));
+  }
   // Reading from a recorded checkpoint at or before record `record` (each field's bytes there no
   // more than the record's first byte): the packets from there, each field's bytes before the
   // record's passed over. open() first.
@@ -603,7 +616,8 @@ class PacketReader {
         continue;
       }
       if (packet[0] != 1) return Error{packet_at() + " is of type " + std::to_string(packet[0]) + " (0, 1 or 2)"};
-      if (checkpoints_) {
+      if (checkpoints_ && (checkpoints_->empty() || at_ + pos - checkpoints_->end()[-static_cast<ptrdiff_t>(
+                                                                  1 + scan_.fields.size())] >= checkpoint_spacing_)) {
         checkpoints_->push_back(at_ + pos);
         for (const Field& f : scan_.fields) checkpoints_->push_back(f.filled);
       }
@@ -657,12 +671,13 @@ class PacketReader {
     if (held + n + kStreamPadding > f.bytes.size()) {
       uint64_t all = 0;
       for (const Field& other : scan_.fields) all += other.bytes.size();
-      const uint64_t grown = std::max<uint64_t>(2 * f.bytes.size(), held + n + kStreamPadding);
-      if (all - f.bytes.size() + grown > budget_)
+      const uint64_t others = all - f.bytes.size(), need = held + n + kStreamPadding;
+      if (others + need > budget_)
         return Error{where_ + ": its fields' values are spread so unevenly over its packets that " +
-                         std::to_string(all - f.bytes.size() + grown) + " bytes of them would be held at once, more than " +
+                         std::to_string(others + need) + " bytes of them would be held at once, more than " +
                          "the memory limit leaves (--max-memory)",
                      ExitCode::kResourceLimit};
+      const uint64_t grown = std::clamp<uint64_t>(2 * f.bytes.size(), need, budget_ - others);  // doubled, within the budget
       f.bytes.resize(static_cast<size_t>(grown));
     }
     std::memcpy(f.bytes.data() + held, bytes, static_cast<size_t>(n));
@@ -681,6 +696,7 @@ class PacketReader {
   DimensionBytes window_;  // unset as sized: the file's bytes overwrite it
   std::vector<char> keep_;
   std::vector<uint64_t>* checkpoints_ = nullptr;
+  uint64_t checkpoint_spacing_ = 0;
 };
 
 uint64_t windowOf(const E57ReadOptions& options) {
@@ -1073,7 +1089,8 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     for (const Field& f : scan.fields) bytes_to_read += f.neededBytes(scan.records);
   }
   // Beside the points: a window of packets, and about as much of the fields' bytes (PacketReader).
-  const uint64_t window = windowOf(options);
+  // (A window is no larger than the file: a small file is not charged 64 MiB, a review finding.)
+  const uint64_t window = std::min(windowOf(options), paged->logicalLength());
   held = std::min(held, UINT64_MAX - 2 * window) + 2 * window;
   if (Status s = checkMemory(path + ": " + std::to_string(total) + " points in " + countOf(scans.size(), "scan"), held, limit); !s)
     return s.error();
@@ -1220,8 +1237,8 @@ struct E57PointStream::State {
   Status startAt(size_t s, uint64_t point) {
     Scan& scan = *scans[s];
     reader.reset();
-    for (const std::unique_ptr<Scan>& other : scans)
-      for (Field& f : other->info.fields) DimensionBytes().swap(f.bytes);
+    if (at_scan < scans.size())  // the last read's scan gives its fields' bytes back (a review finding:
+      for (Field& f : scans[at_scan]->info.fields) DimensionBytes().swap(f.bytes);  // every scan's: 65,535 took 476 s)
     uint64_t record = point, before = point;
     if (!scan.valid_before.empty()) {
       const size_t b = static_cast<size_t>(
@@ -1351,6 +1368,11 @@ Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, co
         points = ready;
       reader.drop(ready);
       decoded = ready;
+      const uint64_t index = st.held + (scan.checkpoints.size() + scan.valid_before.size()) * sizeof(uint64_t);
+      if (index > limit / 2)
+        return Error{path + ": " + scan.info.label + ": its packets' index would take more than " + formatBytes(index) +
+                         ", more than half the memory limit (--max-memory; --stream off reads the file whole)",
+                     ExitCode::kResourceLimit};
     }
     if (dec.hasInvalidState()) scan.valid_before.push_back(points);
     for (Field& f : scan.info.fields) DimensionBytes().swap(f.bytes);
@@ -1370,7 +1392,7 @@ Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, co
   // ids, a type kept where it holds a later scan's, else float64.
   std::vector<ScanFacts> facts;
   for (std::unique_ptr<State::Scan>& scan : st.scans) {
-    facts.push_back({scan->number, scan->decoder->hasColors(), {}});
+    facts.push_back({scan->number, scan->points > 0 && scan->decoder->hasColors(), {}});  // as a read scan's hasColors()
     for (const ScanDecoder::Kept& k : scan->decoder->kept()) {
       facts.back().dimensions.push_back(k.name);
       size_t d = 0;

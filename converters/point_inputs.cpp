@@ -256,6 +256,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       if (!e57) return e57.error();
       part.e57 = std::move(*e57);
       stream->held_bytes_ += part.e57->heldBytes();
+      stream->e57_index_ = true;
       stream->notices_.insert(stream->notices_.end(), part.e57->notices().begin(), part.e57->notices().end());
     } else {
       Result<std::unique_ptr<PlyVertexStream>> ply =

@@ -66,8 +66,12 @@ class PointInputStream {
   // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
   // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
   uint64_t faceCount() const { return faces_; }
-  // Host bytes held for the whole stream beside its blocks: a tile set's copies (0 for other files).
+  // Host bytes held for the whole stream beside its blocks: a tile set's copies, E57 files' packet
+  // indexes (0 for other files), and what they are, for a message.
   uint64_t heldBytes() const { return held_bytes_; }
+  std::string heldWhat() const {
+    return copies_ && e57_index_ ? "seam copies and E57 packet indexes" : copies_ ? "seam copies" : "E57 packet indexes";
+  }
   // What the readers read past in the headers, one line each (ReadOptions::notices), and a float
   // PLY's colours read as 0..255 values from its first rows; after the blocks are read, also what
   // they met (float PLY colours above 1, clamped, or a row's colours unlike the first rows': once
@@ -98,6 +102,7 @@ class PointInputStream {
   std::unique_ptr<TileCopies> copies_;  // null but for a complete tile set
   uint64_t count_ = 0, faces_ = 0, held_bytes_ = 0;
   bool has_colors_ = false;
+  bool e57_index_ = false;  // held_bytes_ counts E57 packet indexes
   unsigned threads_ = 0;
   std::optional<Dimension> streamed_;  // streamDimension's name and type, no values
   std::vector<std::string> notices_;

@@ -138,6 +138,15 @@ Result<Camera> renderView(const InfoOptions& options, const Bounds& bounds, bool
   return cameras->front();
 }
 
+// A point with a coordinate nan or inf (--allow-nonfinite) has no place in any mode's picture: every
+// mode's bound is unbounded, read whole or streamed (the point passes and the boxes pass its
+// coordinates over, and a mode's own checks see an inf but not a nan).
+ErrorBounds unboundedWithNonfinite(ErrorBounds bounds, const PointSetInfo& info) {
+  for (size_t m = 0; m < kModeCount && info.nonfinite > 0; ++m)
+    if (bounds.computed[m]) bounds.px[m] = HUGE_VAL;
+  return bounds;
+}
+
 // The report's advice for `dpoint render`'s view of `bounds`, each mode's bound by `predict`; where
 // the data can have no view (their extent overflows a double: the camera's kBadInput), the report
 // says why instead (a review finding: info refused to describe them). The options' errors fail it.
@@ -168,7 +177,7 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
   }
   if (points.size() > 0) {
     if (Status s = adviseFor(report, options, boundsWithOutline(points), points.z_up, [&](const Camera& camera) {
-          return predictErrorBounds(points, camera, {}, options.tolerance_px);
+          return unboundedWithNonfinite(predictErrorBounds(points, camera, {}, options.tolerance_px), report.info);
         });
         !s)
       return s.error();
@@ -206,14 +215,8 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   if (boxes.count > 0) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
-    // A point no mode can place leaves its pixel in every mode, as predictErrorBounds says of a
-    // set read whole; the boxes pass its coordinates over.
-    const bool nonfinite = report.info.nonfinite > 0;
     if (Status s = adviseFor(report, options, boundsOfBoxes(boxes), false, [&](const Camera& camera) {
-          ErrorBounds bounds = predictBoxBounds(boxes, camera, {}, options.tolerance_px);
-          for (size_t m = 0; m < kModeCount && nonfinite; ++m)
-            if (bounds.computed[m]) bounds.px[m] = HUGE_VAL;
-          return bounds;
+          return unboundedWithNonfinite(predictBoxBounds(boxes, camera, {}, options.tolerance_px), report.info);
         });
         !s)
       return s.error();
@@ -230,7 +233,8 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
     streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
-    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, kStreamPointBytes, (*stream)->heldBytes());
+    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, kStreamPointBytes,
+                                                (*stream)->heldBytes(), (*stream)->heldWhat());
     if (!block) return block.error();
     streamed.stream_block = *block;
     Result<InfoReport> report = describeStream(**stream, name, streamed, progress);

@@ -773,11 +773,11 @@ uint64_t streamBlockPoints(uint64_t limit, uint64_t point_bytes) {
 }
 
 Result<uint64_t> checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit, uint64_t point_bytes,
-                                   uint64_t held) {
+                                   uint64_t held, const std::string& held_what) {
   const uint64_t cap = limit ? limit : defaultMemoryLimit();
   const uint64_t block = streamBlockPoints(cap > held ? cap - held : 1, point_bytes);
   if (Status s = checkMemory(name + ": streaming " + std::to_string(count) + " points a block at a time" +
-                                 (held ? " beside " + formatBytes(held) + " of seam copies" : std::string()),
+                                 (held ? " beside " + formatBytes(held) + " of " + held_what : std::string()),
                              streamHeldBytes(count, block, point_bytes) + held, limit);
       !s)
     return s.error();

@@ -153,11 +153,12 @@ inline uint64_t streamHeldBytes(uint64_t count, uint64_t block, uint64_t point_b
 }
 // --max-memory against what a stream of `count` points holds on the host, whatever the file's size:
 // two blocks (streamBlockPoints) and `held` bytes the stream keeps besides (a tile set's copies,
-// PointInputStream::heldBytes), the blocks sized in what `held` leaves. The block to read in;
-// render and info refuse a limit that does not hold two of the smallest (exit 4, `name` and the
-// need in the message).
+// an E57 file's packet index: PointInputStream::heldBytes, named by `held_what`), the blocks sized
+// in what `held` leaves. The block to read in; render and info refuse a limit that does not hold
+// two of the smallest (exit 4, `name` and the need in the message).
 Result<uint64_t> checkStreamMemory(const std::string& name, uint64_t count, uint64_t limit,
-                                   uint64_t point_bytes = kStreamPointBytes, uint64_t held = 0);
+                                   uint64_t point_bytes = kStreamPointBytes, uint64_t held = 0,
+                                   const std::string& held_what = "seam copies");
 
 // renderPoints for a stream (no probe: it keeps every point's clip position). The same picture
 // and the same errors as renderPoints of the whole set; the stream's errors end it.

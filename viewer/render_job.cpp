@@ -304,7 +304,8 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     // --max-memory bounds a stream too (a review finding: 50M let a 5M-point stream peak at 590 MB).
     // --color NAME reads the dimension with every block: at most 8 bytes a point.
     const uint64_t point_bytes = kStreamPointBytes + (request.color == RenderColor::kAttribute ? sizeof(double) : 0);
-    Result<uint64_t> stream_block = checkStreamMemory(inputs, ply->count(), request.max_memory, point_bytes, ply->heldBytes());
+    Result<uint64_t> stream_block = checkStreamMemory(inputs, ply->count(), request.max_memory, point_bytes, ply->heldBytes(),
+                                                      ply->heldWhat());
     if (!stream_block) return stream_block.error();
     set.stream_block = *stream_block;
     set.stream_point_bytes = point_bytes;

@@ -350,12 +350,13 @@ TEST(E57, theJoinSaysWhatItFillsInAndManyEmptyRecordsAreAMemoryLimit) {
       << notices[0];
   EXPECT_NE(notices[1].find("data3D 1 without rowIndex beside scans with: 0 there"), std::string::npos) << notices[1];
 
-  // Fields of no bits need no bytes, so the file's size does not bound the records: four scans of
-  // 2^56 points each are a memory limit (their sum wrapped to 0 and passed).
+  // The memory a tree declares is checked before any section is read: four scans of 2^56 points
+  // each are a memory limit (their sum wrapped to 0 and passed). (Fields of no bits, which need no
+  // bytes, cannot declare so many: aStreamsIndexIsSmallAndCountsOfNoBytesAreRefused.)
   E57File empty;
   const uint64_t e = empty.rawSection("");
-  const std::string zero = "<cartesianX type=\"Integer\" minimum=\"0\" maximum=\"0\"/><cartesianY type=\"Integer\" "
-                           "minimum=\"0\" maximum=\"0\"/><cartesianZ type=\"Integer\" minimum=\"0\" maximum=\"0\"/>";
+  const std::string zero = "<cartesianX type=\"Integer\" minimum=\"0\" maximum=\"1\"/><cartesianY type=\"Integer\" "
+                           "minimum=\"0\" maximum=\"1\"/><cartesianZ type=\"Integer\" minimum=\"0\" maximum=\"1\"/>";
   std::string scans;
   for (int k = 0; k < 4; ++k) scans += scanXml(e, uint64_t{1} << 56, zero);
   Result<PointSet> huge = readBytes(dir, empty.bytes(rootXml(scans)));
@@ -736,6 +737,24 @@ TEST(E57, aStreamGivesWhatReadE57GivesInAnyBlocks) {
     paths.push_back(dir.file("in_turn.e57"));
     writeFile(paths.back(), file.bytes(rootXml(scanXml(at, n, prototype))));
   }
+  {
+    // A scan with colours whose every point is invalid beside one without: no colours, no note
+    // of white (the stream said "data3D 2 without colours" where the whole read did not).
+    const std::vector<double> x{1, 2}, y{0, 0};
+    const std::vector<int64_t> invalid{1, 2}, red{10, 20};
+    E57File file;
+    const uint64_t a = file.compressedVector({packRaw(x), packRaw(y), packRaw(y), packBits(invalid, 0, 2), packBits(red, 0, 8),
+                                              packBits(red, 0, 8), packBits(red, 0, 8)},
+                                             100);
+    const uint64_t b = file.compressedVector({packRaw(x), packRaw(y), packRaw(y)}, 100);
+    const std::string xyz = "<cartesianX type=\"Float\"/><cartesianY type=\"Float\"/><cartesianZ type=\"Float\"/>";
+    const std::string colors =
+        "<cartesianInvalidState type=\"Integer\" minimum=\"0\" maximum=\"2\"/>"
+        "<colorRed type=\"Integer\" minimum=\"0\" maximum=\"255\"/><colorGreen type=\"Integer\" minimum=\"0\" "
+        "maximum=\"255\"/><colorBlue type=\"Integer\" minimum=\"0\" maximum=\"255\"/>";
+    paths.push_back(dir.file("invalid_coloured.e57"));
+    writeFile(paths.back(), file.bytes(rootXml(scanXml(a, 2, xyz + colors) + scanXml(b, 2, xyz))));
+  }
   for (const std::string& path : paths) {
     E57ReadOptions options;
     options.packet_window = 1;  // 64 KiB
@@ -777,6 +796,68 @@ TEST(E57, aStreamGivesWhatReadE57GivesInAnyBlocks) {
         expectBlockOf(*whole, block, f, n, path + " at " + std::to_string(f) + " size " + std::to_string(size));
       }
     }
+  }
+}
+
+// What a stream's open holds and refuses (review findings): its packet index stays a small share
+// of the file however small the packets (2M empty packets took 1 GB); a scan whose fields take no
+// bits cannot declare more than 2^26 records (a 1 KB file streamed 2^35 for hours); a small file's
+// whole read is not charged a 32 MiB window twice (--max-memory 64M refused every E57).
+TEST(E57, aStreamsIndexIsSmallAndCountsOfNoBytesAreRefused) {
+  TempDir dir;
+  {
+    std::string packets;
+    const size_t empty = 50000;
+    for (size_t k = 0; k < empty; ++k) {  // data packets of three empty bytestreams: 12 bytes each
+      std::string p(12, '\0');
+      p[0] = 1;
+      put<uint16_t>(p, 2, 11);
+      put<uint16_t>(p, 4, 3);
+      packets += p;
+    }
+    std::string last(12 + 24, '\0');  // then one point
+    last[0] = 1;
+    put<uint16_t>(last, 2, static_cast<uint16_t>(last.size() - 1));
+    put<uint16_t>(last, 4, 3);
+    for (int k = 0; k < 3; ++k) put<uint16_t>(last, 6 + 2 * static_cast<size_t>(k), 8);
+    for (int k = 0; k < 3; ++k) put<double>(last, 12 + 8 * static_cast<size_t>(k), 1.5 + k);
+    packets += last;
+    E57File file;
+    const uint64_t at = file.rawSection(packets);
+    const std::string bytes =
+        file.bytes(rootXml(scanXml(at, 1, "<cartesianX type=\"Float\"/><cartesianY type=\"Float\"/><cartesianZ type=\"Float\"/>")));
+    writeFile(dir.file("empty_packets.e57"), bytes);
+    Result<std::unique_ptr<E57PointStream>> stream = E57PointStream::open(dir.file("empty_packets.e57"));
+    ASSERT_TRUE(stream.ok()) << stream.error().message;
+    EXPECT_LE((*stream)->heldBytes(), bytes.size() / 32);
+    PointSet block;
+    ASSERT_TRUE((*stream)->read(0, 1, block).ok());
+    EXPECT_EQ(block.positions.at(0), glm::dvec3(1.5, 2.5, 3.5));
+  }
+  {
+    E57File file;
+    const uint64_t at = file.compressedVector({"", "", ""}, 100);
+    const std::string prototype =
+        "<cartesianX type=\"Integer\" minimum=\"1\" maximum=\"1\"/><cartesianY type=\"Integer\" minimum=\"2\" "
+        "maximum=\"2\"/><cartesianZ type=\"Integer\" minimum=\"3\" maximum=\"3\"/>";
+    writeFile(dir.file("constant.e57"), file.bytes(rootXml(scanXml(at, uint64_t{1} << 35, prototype))));
+    Result<std::unique_ptr<E57PointStream>> stream = E57PointStream::open(dir.file("constant.e57"));
+    ASSERT_FALSE(stream.ok());
+    EXPECT_NE(stream.error().message.find("34359738368 records whose fields all take no bits"), std::string::npos)
+        << stream.error().message;
+    E57File small;
+    std::string packet(12, '\0');  // one data packet of three empty bytestreams
+    packet[0] = 1;
+    put<uint16_t>(packet, 2, 11);
+    put<uint16_t>(packet, 4, 3);
+    const uint64_t at2 = small.rawSection(packet);
+    writeFile(dir.file("constant_small.e57"), small.bytes(rootXml(scanXml(at2, 1000, prototype))));
+    E57ReadOptions tight;
+    tight.max_memory = 1u << 20;  // 1 MiB: 1000 points of 24 bytes, and windows no larger than the file
+    Result<PointSet> read = readE57(dir.file("constant_small.e57"), tight);
+    ASSERT_TRUE(read.ok()) << read.error().message;
+    ASSERT_EQ(read->size(), 1000u);
+    EXPECT_EQ(read->positions[999], glm::dvec3(1, 2, 3));
   }
 }
 

@@ -105,6 +105,13 @@ TEST(InfoReport, nonFinitePositionsGiveWhatDpointInfoGivesWithAllowNonfinite) {
   EXPECT_TRUE(test::contains(infoReportJson(report), "\"max\": [null, 5, 6.5]"));
   EXPECT_TRUE(test::contains(infoReportJson(report), "\"nonfinite_points\": 2"));
   EXPECT_TRUE(test::contains(infoReportText(report), "non-finite:         2 points with a coordinate nan or inf"));
+  // No mode places the points: every bound unbounded (batch and adaptive said 0 px with an inf).
+  ASSERT_TRUE(report.advice.has_value());
+  for (size_t m = 0; m < kModeCount; ++m) {
+    if (report.advice->bounds.computed[m]) {
+      EXPECT_EQ(report.advice->bounds.px[m], HUGE_VAL) << m;
+    }
+  }
   // Streamed, the same counts and bounds, and no mode bounded where a point has no place (the
   // stream refused the file, --allow-nonfinite or not, before).
   EXPECT_EQ(runDpoint({"info", "--stream", "on", path}).exit_code, 2) << "refused without --allow-nonfinite";
