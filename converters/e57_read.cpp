@@ -560,7 +560,7 @@ class PacketReader {
     if (records != UINT64_MAX) {
       uint64_t bits = 0;
       for (const Field& f : scan_.fields) bits += f.bits;
-      // Their bytes and an eighth more (packet headers, fields a little ahead of others).
+      // Their bytes and a seventh more (packet headers, fields a little ahead of others).
       const uint64_t bytes = records > UINT64_MAX / 16 / std::max<uint64_t>(bits, 1) ? UINT64_MAX : records * bits / 7;
       want = std::clamp<uint64_t>(bytes, kLeastWindow, window_bytes_);
     }

@@ -146,7 +146,7 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
   return out;
 }
 
-// One file of the stream: a binary PLY or a LAS/LAZ file.
+// One file of the stream: a binary PLY, a LAS/LAZ or an E57 file.
 struct PointInputStream::Part {
   std::unique_ptr<PlyVertexStream> ply;  // one of the three
   std::unique_ptr<LasPointStream> las;
@@ -429,7 +429,7 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
       }
       Result<uint64_t> records = e57RecordCount(path);
       if (!records) return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong
-      declared += *records;
+      declared = declared > UINT64_MAX - *records ? UINT64_MAX : declared + *records;
     }
     if (all_e57 && declared <= kStreamAbovePoints) return std::unique_ptr<PointInputStream>();
   }
