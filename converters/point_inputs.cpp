@@ -313,6 +313,21 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
 
 const Dimensions& PointInputStream::dimensions() const { return parts_.front().dimensions(); }
 
+Dimensions PointInputStream::commonDimensions() const {
+  Dimensions common;
+  for (const Dimension& d : dimensions().all()) {
+    DimType type = d.type;
+    bool everywhere = true;
+    for (const Part& part : parts_) {
+      const Dimension* other = part.dimensions().find(d.name);
+      everywhere = everywhere && other != nullptr;
+      if (other && other->type != type) type = DimType::kF64;
+    }
+    if (everywhere) common.append(d.name, type, 0);
+  }
+  return common;
+}
+
 Status PointInputStream::streamDimension(const std::string& name) {
   for (Part& part : parts_) {
     const std::vector<Dimension>& all = part.dimensions().all();

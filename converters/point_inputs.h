@@ -79,6 +79,9 @@ class PointInputStream {
   const std::vector<std::string>& notices() const { return notices_; }
   // The first file's dimensions (PLY vertex properties), as empty columns.
   const Dimensions& dimensions() const;
+  // The dimensions every file has, as empty columns: each of the first file's type, float64 where
+  // the files' types differ (as streamDimension takes them).
+  Dimensions commonDimensions() const;
   // From now on read() also gives each block dimension `name` (float64 where the files' types
   // differ). Every file must have it: else an error naming the file (kUsage).
   Status streamDimension(const std::string& name);

@@ -212,6 +212,9 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   report.name = name;
   report.info = info->info;
   report.streamed = true;
+  // The dimensions by name and type; their ranges would need every value of each (not read).
+  const Dimensions common = stream.commonDimensions();
+  for (const Dimension& d : common.all()) report.dimensions.push_back({d.name, d.type, HUGE_VAL, -HUGE_VAL});
   if (boxes.count > 0) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
