@@ -836,6 +836,7 @@ class ScanDecoder {
   bool hasColors() const { return colors_; }
   uint16_t colorFullScale() const { return full_; }
   bool hasInvalidState() const { return invalid_ != nullptr; }
+  const Field* invalidField() const { return invalid_; }
   const std::vector<Kept>& kept() const { return kept_; }
 
   // Record i is a point (its invalid state 0: an Integer as E57 has it, or a Float of another writer).
@@ -908,6 +909,25 @@ class ScanDecoder {
   double m_[3][3] = {}, t_[3] = {};
 };
 
+// Whether some scan holding records has an intensity that is no 0..65535 integer: then every
+// scan's is read as 0..1 (intensityRange's `fractions`).
+bool intensityFractions(const std::vector<ScanInfo>& scans) {
+  return std::any_of(scans.begin(), scans.end(), [](const ScanInfo& scan) {
+    const Field* f = findField(scan, "intensity");
+    return scan.records > 0 && f && !isLasIntensity(*f);
+  });
+}
+
+// The range a scan's intensity is read as 0..1 from, added to `ranges` once (for the note).
+void addIntensityRange(const ScanDecoder& decoder, std::vector<std::string>& ranges) {
+  for (const ScanDecoder::Kept& k : decoder.kept()) {
+    if (!k.normalised) continue;
+    const std::string range =
+        formatNumber(k.normalised->lo) + ".." + formatNumber(k.normalised->hi) + " (" + k.normalised->source + ")";
+    if (std::find(ranges.begin(), ranges.end(), range) == ranges.end()) ranges.push_back(range);
+  }
+}
+
 // The scan's points: positions in the file's frame, colours, dimensions; the invalid ones left
 // out. Its packets read a window at a time (PacketReader), each window's records decoded on all
 // cores; the fields' bytes may hold up to `budget` bytes at once.
@@ -922,13 +942,8 @@ Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOp
   points.z_axis = ZAxis::kPresent;
   points.positions.resize(n);
   if (dec.hasColors()) points.colors.resize(n);
+  addIntensityRange(dec, intensity_ranges);
   for (const ScanDecoder::Kept& k : dec.kept()) {
-    if (k.normalised) {
-      const std::string range = formatNumber(k.normalised->lo) + ".." + formatNumber(k.normalised->hi) + " (" +
-                                k.normalised->source + ")";
-      if (std::find(intensity_ranges.begin(), intensity_ranges.end(), range) == intensity_ranges.end())
-        intensity_ranges.push_back(range);
-    }
     points.dimensions.appendUnset(k.name, k.type, n);
   }
   PacketReader reader(file, scan, windowOf(options), threads, options.progress, budget);
@@ -1050,6 +1065,30 @@ void noteJoinFillIns(const std::string& path, const std::vector<ScanFacts>& scan
       notices.push_back(path + ": data3D " + none + " without " + name + " beside scans with: 0 there");
 }
 
+// What a read of a file met, for its notes.
+struct FileFacts {
+  uint64_t left_out = 0, records = 0;  // points marked invalid, of the records
+  size_t images = 0, scans = 0, scans_with_records = 0;
+};
+
+// The notes of a file read whole or streamed: points left out, intensities read as 0..1, images
+// not read, no points.
+void noteFile(const std::string& path, const FileFacts& facts, const std::vector<std::string>& intensity_ranges,
+              std::vector<std::string>& notices) {
+  if (facts.left_out > 0)
+    notices.push_back(path + ": " + std::to_string(facts.left_out) + " of its " + std::to_string(facts.records) +
+                      " points are marked invalid (no point, or a direction alone): left out");
+  for (const std::string& range : intensity_ranges)
+    notices.push_back(path + ": intensity of " + range + " read as 0..1 values, as LAS normalises it");
+  if (facts.images > 0)
+    notices.push_back(path + ": its " + countOf(facts.images, "image") + " (images2D) " +
+                      (facts.images == 1 ? "is" : "are") + " not read");
+  if (facts.scans_with_records == 0)
+    notices.push_back(path + ": " + (facts.scans == 0 ? std::string("no scan (data3D is empty)")
+                                                      : "its " + countOf(facts.scans, "scan") +
+                                                            (facts.scans == 1 ? " holds" : " hold") + " no points"));
+}
+
 // Bytes held per point of a scan: positions, colours and, at most, 8 for each other field (the
 // fields' packed values are held a window at a time: PacketReader).
 uint64_t bytesPerRecord(const ScanInfo& scan) {
@@ -1111,10 +1150,7 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   std::vector<NumberedScan> read;
   uint64_t left_out = 0;
   std::vector<std::string> intensity_ranges;  // those normalised to 0..1, each once
-  const bool intensity_fractions = std::any_of(scans.begin(), scans.end(), [](const ScanInfo& scan) {
-    const Field* f = findField(scan, "intensity");
-    return scan.records > 0 && f && !isLasIntensity(*f);
-  });
+  const bool intensity_fractions = intensityFractions(scans);
   for (size_t k = 0; k < scans.size(); ++k) {
     ScanInfo& scan = scans[k];
     if (scan.records == 0) continue;
@@ -1123,19 +1159,7 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
     read.push_back({k + 1, std::move(*points)});
   }
   if (progress) progress->finish();
-  if (options.notices) {
-    if (left_out > 0)
-      options.notices->push_back(path + ": " + std::to_string(left_out) + " of its " + std::to_string(total) +
-                                 " points are marked invalid (no point, or a direction alone): left out");
-    for (const std::string& range : intensity_ranges)
-      options.notices->push_back(path + ": intensity of " + range + " read as 0..1 values, as LAS normalises it");
-    if (images > 0)
-      options.notices->push_back(path + ": its " + countOf(images, "image") + " (images2D) " + (images == 1 ? "is" : "are") +
-                                 " not read");
-    if (read.empty())
-      options.notices->push_back(path + ": " + (scans.empty() ? std::string("no scan (data3D is empty)")
-                                                               : "its " + countOf(scans.size(), "scan") + (scans.size() == 1 ? " holds" : " hold") + " no points"));
-  }
+  if (options.notices) noteFile(path, {left_out, total, images, scans.size(), read.size()}, intensity_ranges, *options.notices);
   if (read.empty()) {
     PointSet none;
     none.z_axis = ZAxis::kPresent;
@@ -1303,10 +1327,7 @@ Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, co
   st.budget = limit / 4;  // the fields' bytes of a block's packets: a window's worth as writers spread them
   Result<FileTree> tree = readTree(*st.paged, threads);
   if (!tree) return tree.error();
-  const bool intensity_fractions = std::any_of(tree->scans.begin(), tree->scans.end(), [](const ScanInfo& scan) {
-    const Field* f = findField(scan, "intensity");
-    return scan.records > 0 && f && !isLasIntensity(*f);
-  });
+  const bool intensity_fractions = intensityFractions(tree->scans);
   size_t with_records = 0;
   for (size_t k = 0; k < tree->scans.size(); ++k) {
     if (tree->scans[k].records == 0) continue;
@@ -1337,22 +1358,12 @@ Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, co
     if (!decoder) return decoder.error();
     scan.decoder.emplace(std::move(*decoder));
     const ScanDecoder& dec = *scan.decoder;
-    for (const ScanDecoder::Kept& k : dec.kept()) {
-      own_ids = own_ids || k.name == dim::kPointSourceId;
-      if (!k.normalised) continue;
-      const std::string range = formatNumber(k.normalised->lo) + ".." + formatNumber(k.normalised->hi) + " (" +
-                                k.normalised->source + ")";
-      if (std::find(intensity_ranges.begin(), intensity_ranges.end(), range) == intensity_ranges.end())
-        intensity_ranges.push_back(range);
-    }
+    addIntensityRange(dec, intensity_ranges);
+    for (const ScanDecoder::Kept& k : dec.kept()) own_ids = own_ids || k.name == dim::kPointSourceId;
     // The walk: every packet's place, and the invalid state's points counted.
     PacketReader reader(*st.paged, scan.info, st.window, threads, progress, st.budget);
     if (Status s = reader.open(); !s) return s.error();
-    std::vector<const Field*> invalid;
-    for (const Field& f : scan.info.fields)
-      if (&f == findField(scan.info, "cartesianInvalidState") || &f == findField(scan.info, "sphericalInvalidState"))
-        if (dec.hasInvalidState()) invalid.push_back(&f);
-    reader.keepOnly(invalid);
+    reader.keepOnly(dec.hasInvalidState() ? std::vector<const Field*>{dec.invalidField()} : std::vector<const Field*>{});
     reader.recordCheckpoints(&scan.checkpoints);
     const uint64_t n = scan.info.records;
     uint64_t decoded = 0, points = 0;
@@ -1407,18 +1418,7 @@ Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, co
       st.dimensions.append(dim::kPointSourceId, DimType::kU16, 0);
     }
   }
-  if (left_out > 0)
-    st.notices.push_back(path + ": " + std::to_string(left_out) + " of its " + std::to_string(total) +
-                         " points are marked invalid (no point, or a direction alone): left out");
-  for (const std::string& range : intensity_ranges)
-    st.notices.push_back(path + ": intensity of " + range + " read as 0..1 values, as LAS normalises it");
-  if (tree->images > 0)
-    st.notices.push_back(path + ": its " + countOf(tree->images, "image") + " (images2D) " +
-                         (tree->images == 1 ? "is" : "are") + " not read");
-  if (st.scans.empty())
-    st.notices.push_back(path + ": " + (tree->scans.empty() ? std::string("no scan (data3D is empty)")
-                                                            : "its " + countOf(tree->scans.size(), "scan") +
-                                                                  (tree->scans.size() == 1 ? " holds" : " hold") + " no points"));
+  noteFile(path, {left_out, total, tree->images, tree->scans.size(), st.scans.size()}, intensity_ranges, st.notices);
   if (st.scans.size() > 1) noteJoinFillIns(path, facts, st.notices);
   return stream;
 }
