@@ -1430,13 +1430,11 @@ Status E57PointStream::read(uint64_t first, uint64_t n, PointSet& block) {
   block.z_axis = ZAxis::kPresent;
   block.positions.resize(static_cast<size_t>(n));
   block.colors.resize(st.colors ? static_cast<size_t>(n) : 0);
-  block.dimensions = Dimensions();
+  std::vector<const Dimension*> like;
+  for (size_t d : st.streamed) like.push_back(&st.dimensions.all()[d]);
+  block.dimensions.shapeUnset(like, static_cast<size_t>(n));
   std::vector<Dimension*> out_dims;
-  block.dimensions.reserve(st.streamed.size());  // no append moves the columns out_dims points to
-  for (size_t d : st.streamed) {
-    const Dimension& of = st.dimensions.all()[d];
-    out_dims.push_back(&block.dimensions.appendUnset(of.name, of.type, static_cast<size_t>(n)));
-  }
+  for (Dimension& d : block.dimensions.all()) out_dims.push_back(&d);
   const unsigned threads = resolveThreads(st.options.threads);
   std::vector<uint64_t> records;  // of the current window: those read into the block, less `base`
   uint64_t done = 0;

@@ -1045,6 +1045,7 @@ struct LasPointStream::State {
   std::optional<LazChunks> laz;
   size_t cached_first = 0, cached_last = 0;  // chunks [first, last) in `cache`
   std::string cache;
+  std::vector<std::string> buffers;  // LAS: each core's records of a read
 
   explicit State(InputFile f) : file(std::move(f)) {}
 
@@ -1057,6 +1058,16 @@ struct LasPointStream::State {
       if (*got != n * length) return Error{file.path() + ": truncated: the file ends in point " + str(first + *got / length)};
       return okStatus();
     }
+    Result<const char*> at = lazRecords(first, n);
+    if (!at) return at.error();
+    std::memcpy(out, *at, static_cast<size_t>(n * length));
+    return okStatus();
+  }
+
+  // A LAZ file's records [first, first + n) (n > 0), decoded into `cache` where the last read did
+  // not leave them there: valid until the next call.
+  Result<const char*> lazRecords(uint64_t first, uint64_t n) {
+    const uint64_t length = header.record_length;
     const std::vector<uint64_t>& starts = laz->first_point;
     // The chunks holding the first and the last point.
     const auto chunkOf = [&](uint64_t point) {
@@ -1066,12 +1077,11 @@ struct LasPointStream::State {
     if (from < cached_first || to > cached_last) {
       const uint64_t begin = starts[from], end = to < starts.size() ? starts[to] : header.point_count;
       cache.resize(static_cast<size_t>((end - begin) * length));
-      if (Status s = decodeLazChunks(file, *laz, from, to, cache.data(), threads); !s) return s;
+      if (Status s = decodeLazChunks(file, *laz, from, to, cache.data(), threads); !s) return s.error();
       cached_first = from;
       cached_last = to;
     }
-    std::memcpy(out, cache.data() + (first - starts[cached_first]) * length, static_cast<size_t>(n * length));
-    return okStatus();
+    return static_cast<const char*>(cache.data() + (first - starts[cached_first]) * length);
   }
 };
 
@@ -1143,25 +1153,21 @@ Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
   const LasHeader& h = st.header;
   assert(first <= h.point_count && n <= h.point_count - first);
   const size_t count = static_cast<size_t>(n), length = h.record_length;
-  std::string records(count * length, '\0');
-  if (n > 0)
-    if (Status s = st.records(first, n, records.data()); !s) return s;
   block.triangles.clear();
   block.z_axis = ZAxis::kPresent;
   block.z_up = true;
   block.positions.resize(count);
   block.colors.resize(st.color_divisor != 0.0f ? count : 0);
-  block.dimensions = Dimensions();
-  for (size_t k : st.streamed)  // unset: every row's field is copied below
-    block.dimensions.appendUnset(st.dimensions.all()[k].name, st.dimensions.all()[k].type, count);
-  std::vector<Dimension*> columns;  // once every column is in place (appending may move the others)
+  std::vector<const Dimension*> like;
+  for (size_t k : st.streamed) like.push_back(&st.dimensions.all()[k]);
+  block.dimensions.shapeUnset(like, count);  // unset: every row's field is copied below
+  if (n == 0) return okStatus();
+  std::vector<Dimension*> columns;
   for (Dimension& d : block.dimensions.all()) columns.push_back(&d);
   const size_t rgb_at = lasRgbOffset(h.point_format), extra_at = lasBaseRecordLength(h.point_format);
-  const size_t chunk = size_t{1} << 15;
-  parallelFor((count + chunk - 1) / chunk, st.threads, [&](size_t c, unsigned) {
-    const size_t end = std::min(count, (c + 1) * chunk);
-    for (size_t i = c * chunk; i < end; ++i) {
-      const char* p = records.data() + i * length;
+  // Points [from, to) of the block from their records at `p`.
+  const auto decode = [&](const char* p, size_t from, size_t to) {
+    for (size_t i = from; i < to; ++i, p += length) {
       block.positions[i] = recordPosition(p, h.scale, h.offset);
       if (st.color_divisor != 0.0f)
         block.colors[i] = glm::vec3(loadUnaligned<uint16_t>(p + rgb_at), loadUnaligned<uint16_t>(p + rgb_at + 2),
@@ -1175,7 +1181,33 @@ Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
         }
       }
     }
+  };
+  const size_t chunk = size_t{1} << 15, chunks = (count + chunk - 1) / chunk;
+  if (st.laz) {  // decoded on all cores into the chunk cache, then read from there
+    Result<const char*> records = st.lazRecords(first, n);
+    if (!records) return records.error();
+    parallelFor(chunks, st.threads, [&](size_t c, unsigned) {
+      decode(*records + c * chunk * length, c * chunk, std::min(count, (c + 1) * chunk));
+    });
+    return okStatus();
+  }
+  // Each core reads its pieces into its own buffer, kept for the next block (no fresh pages).
+  st.buffers.resize(st.threads);
+  std::mutex failed;
+  std::optional<Error> error;
+  size_t error_chunk = SIZE_MAX;
+  parallelFor(chunks, st.threads, [&](size_t c, unsigned worker) {
+    const size_t from = c * chunk, to = std::min(count, from + chunk);
+    std::string& buffer = st.buffers[worker];
+    buffer.resize((to - from) * length);
+    if (Status s = st.records(first + from, to - from, buffer.data()); !s) {
+      std::lock_guard<std::mutex> lock(failed);
+      if (c < error_chunk) error_chunk = c, error = s.error();
+      return;
+    }
+    decode(buffer.data(), from, to);
   });
+  if (error) return *error;
   return okStatus();
 }
 

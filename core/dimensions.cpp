@@ -259,4 +259,17 @@ bool dimTypeHolds(DimType to, DimType from) {
   return dimensionHolds(to, lo) && dimensionHolds(to, hi);
 }
 
+void Dimensions::shapeUnset(const std::vector<const Dimension*>& like, size_t points) {
+  const bool same = like.size() == columns_.size() &&
+                    std::equal(like.begin(), like.end(), columns_.begin(), [](const Dimension* l, const Dimension& c) {
+                      return l->name == c.name && l->type == c.type;
+                    });
+  if (!same) {
+    columns_.clear();
+    columns_.reserve(like.size());
+    for (const Dimension* l : like) columns_.emplace_back(l->name, l->type, 0);
+  }
+  resizeUnset(points);
+}
+
 }  // namespace dpoint

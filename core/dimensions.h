@@ -174,6 +174,10 @@ class Dimensions {
   Dimension& appendUnset(const std::string& name, DimType type, size_t points) {
     return columns_.emplace_back(name, type, points, Dimension::Unset{});
   }
+  // The columns of `like` (names and types, in order), each of `points` values unset. Where the
+  // columns in place are those, they keep their memory: a stream's block read again and again is
+  // not given fresh pages each time (which the kernel zeroes on one thread).
+  void shapeUnset(const std::vector<const Dimension*>& like, size_t points);
   bool remove(std::string_view name);
   // Room for `columns` in all (a reader adding thousands: a LAS record's extra bytes).
   void reserve(size_t columns) { columns_.reserve(columns); }

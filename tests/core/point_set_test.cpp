@@ -102,5 +102,29 @@ TEST(PointSet, appendPointsJoinsColoursAndWidensADimensionOnlyWhereItMust) {
   EXPECT_EQ(out.colors.back(), glm::vec3(1.0f));
 }
 
+// A stream's block shaped again as the same columns keeps their memory (and the values in the
+// part both sizes share); other columns replace them.
+TEST(PointSet, shapeUnsetKeepsTheColumnsInPlaceWhereTheyAreTheSame) {
+  const Dimension intensity("intensity", DimType::kU16), time("gps_time", DimType::kF64);
+  Dimensions d;
+  d.shapeUnset({&intensity, &time}, 1000);
+  ASSERT_EQ(d.count(), 2u);
+  EXPECT_EQ(d.all()[0].name, "intensity");
+  EXPECT_EQ(d.all()[1].type, DimType::kF64);
+  EXPECT_EQ(d.all()[1].size(), 1000u);
+  d.all()[1].set<double>(3, 2.5);
+  const uint8_t* kept = d.all()[1].bytes.data();
+  d.shapeUnset({&intensity, &time}, 500);
+  d.shapeUnset({&intensity, &time}, 1000);
+  EXPECT_EQ(d.all()[1].bytes.data(), kept);
+  EXPECT_EQ(d.all()[1].get<double>(3), 2.5);
+  const Dimension time32("gps_time", DimType::kF32);
+  d.shapeUnset({&intensity, &time32}, 10);  // another type: new columns
+  EXPECT_EQ(d.all()[1].type, DimType::kF32);
+  EXPECT_EQ(d.all()[1].size(), 10u);
+  d.shapeUnset({}, 10);
+  EXPECT_TRUE(d.empty());
+}
+
 }  // namespace
 }  // namespace dpoint
