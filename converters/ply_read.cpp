@@ -398,6 +398,23 @@ class PlyParser {
       std::lock_guard<std::mutex> lock(error_mutex);
       if (row < error_row) error_row = row, first_error = std::move(error);
     };
+    // The chosen dimensions, copied from each row in the host's (little-endian) order as the row
+    // is decoded (one read of the rows for all of them).
+    struct Copied {
+      size_t offset, bytes;
+      uint8_t* to;
+    };
+    std::vector<Copied> copied;
+    std::vector<const Dimension*> like;
+    for (size_t which : streamed_dimensions_) like.push_back(&points_.dimensions.all()[which]);
+    block.dimensions.shapeUnset(like, static_cast<size_t>(n));
+    for (size_t which : streamed_dimensions_) {
+      const auto at = std::find_if(layout.attributes.begin(), layout.attributes.end(),
+                                   [&](const RowLayout::Attribute& a) { return a.dimension == which; });
+      assert(at != layout.attributes.end());
+      copied.push_back({at->offset, at->bytes, nullptr});
+    }
+    for (size_t k = 0; k < copied.size(); ++k) copied[k].to = block.dimensions.all()[k].bytes.data();
     const unsigned threads = resolveThreads(options_.threads);
     std::vector<std::vector<char>> buffers(threads);
     glm::dvec3* positions = block.positions.data();
@@ -422,30 +439,12 @@ class PlyParser {
         layout.load(buffer.data() + (bad - from) * layout.row_bytes, v);
         return fail(bad, nonfiniteError(v, bad, stream_begin_ + bad * layout.row_bytes));
       }
+      for (const Copied& c : copied)
+        for (uint64_t r = from; r < to; ++r)
+          std::memcpy(c.to + (r - first) * c.bytes, buffer.data() + (r - from) * layout.row_bytes + c.offset, c.bytes);
       if (options_.progress) options_.progress->advance(buffer.size());
     });
     if (first_error) return *first_error;
-    // The chosen dimensions, copied from each row in the host's (little-endian) order.
-    block.dimensions = Dimensions();
-    for (size_t which : streamed_dimensions_) {
-      const Dimension& like = points_.dimensions.all()[which];
-      Dimension& d = block.dimensions.append(like.name, like.type, static_cast<size_t>(n));
-      const auto at = std::find_if(layout.attributes.begin(), layout.attributes.end(),
-                                   [&](const RowLayout::Attribute& a) { return a.dimension == which; });
-      assert(at != layout.attributes.end());
-      std::vector<char> rows;
-      for (uint64_t from = first; from < first + n; from += block_rows) {
-        const uint64_t to = std::min(from + block_rows, first + n);
-        rows.resize(static_cast<size_t>((to - from) * layout.row_bytes));
-        Result<size_t> got = file_.readAt(stream_begin_ + from * layout.row_bytes, rows.data(), rows.size());
-        if (!got) return got.error();
-        if (*got < rows.size()) return Error{path_ + ": truncated while reading '" + like.name + "'"};
-        layout.toHostOrder(rows.data(), static_cast<size_t>(to - from));
-        for (uint64_t r = from; r < to; ++r)
-          std::memcpy(d.bytes.data() + (r - first) * at->bytes, rows.data() + (r - from) * layout.row_bytes + at->offset,
-                      at->bytes);
-      }
-    }
     return okStatus();
   }
 

@@ -328,15 +328,23 @@ Dimensions PointInputStream::commonDimensions() const {
   return common;
 }
 
-Status PointInputStream::streamDimension(const std::string& name) {
-  for (Part& part : parts_) {
-    const std::vector<Dimension>& all = part.dimensions().all();
-    const auto it = std::find_if(all.begin(), all.end(), [&](const Dimension& d) { return d.name == name; });
-    if (it == all.end()) return Error{"dimension '" + name + "' is not in every file streamed", ExitCode::kUsage};
-    part.streamDimensions({static_cast<size_t>(it - all.begin())});
-    if (!streamed_) streamed_.emplace(name, it->type);
-    else if (streamed_->type != it->type) streamed_->type = DimType::kF64;
+Status PointInputStream::streamDimensions(const std::vector<std::string>& names) {
+  std::vector<Dimension> streamed;
+  std::vector<std::vector<size_t>> which_of(parts_.size());
+  for (size_t p = 0; p < parts_.size(); ++p) {
+    const std::vector<Dimension>& all = parts_[p].dimensions().all();
+    std::vector<size_t>& which = which_of[p];
+    for (const std::string& name : names) {
+      const auto it = std::find_if(all.begin(), all.end(), [&](const Dimension& d) { return d.name == name; });
+      if (it == all.end()) return Error{"dimension '" + name + "' is not in every file streamed", ExitCode::kUsage};
+      which.push_back(static_cast<size_t>(it - all.begin()));
+      const size_t k = which.size() - 1;
+      if (streamed.size() == k) streamed.emplace_back(name, it->type);
+      else if (streamed[k].type != it->type) streamed[k].type = DimType::kF64;
+    }
   }
+  for (size_t p = 0; p < parts_.size(); ++p) parts_[p].streamDimensions(std::move(which_of[p]));
+  streamed_ = std::move(streamed);
   return okStatus();
 }
 
@@ -394,8 +402,9 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
   block.triangles.clear();
   block.positions.resize(static_cast<size_t>(n));
   block.colors.resize(has_colors_ ? static_cast<size_t>(n) : 0);
-  block.dimensions = Dimensions();
-  Dimension* streamed = streamed_ ? &block.dimensions.append(streamed_->name, streamed_->type, n) : nullptr;
+  std::vector<const Dimension*> like;
+  for (const Dimension& d : streamed_) like.push_back(&d);
+  block.dimensions.shapeUnset(like, n);
   const uint64_t end = first + n;
   for (Part& part : parts_) {
     const uint64_t from = std::max(first, part.first), to = std::min(end, part.first + part.count);
@@ -406,9 +415,13 @@ Status PointInputStream::read(uint64_t first, uint64_t n, PointSet& block) {
     noteColorsAboveOne(part, scratch_.hasColors() ? scratch_.colors.data() : nullptr, scratch_.size());
     const auto at = static_cast<ptrdiff_t>(from - first);
     std::copy(scratch_.positions.begin(), scratch_.positions.end(), block.positions.begin() + at);
-    if (streamed) {
-      const Dimension& d = scratch_.dimensions.all().front();
-      for (size_t i = 0; i < scratch_.size(); ++i) streamed->setValue(static_cast<size_t>(at) + i, d.value(i));
+    for (size_t k = 0; k < streamed_.size(); ++k) {
+      const Dimension& from_part = scratch_.dimensions.all()[k];
+      Dimension& into = block.dimensions.all()[k];
+      if (from_part.type == into.type)
+        std::copy(from_part.bytes.begin(), from_part.bytes.end(), into.bytes.begin() + at * ptrdiff_t(dimTypeSize(into.type)));
+      else  // float64: holds every other type's values (but 64-bit integers past 2^53, as everywhere)
+        for (size_t i = 0; i < scratch_.size(); ++i) into.setValue(static_cast<size_t>(at) + i, from_part.value(i));
     }
     if (!has_colors_) continue;
     if (scratch_.hasColors()) std::copy(scratch_.colors.begin(), scratch_.colors.end(), block.colors.begin() + at);

@@ -80,11 +80,12 @@ class PointInputStream {
   // The first file's dimensions (PLY vertex properties), as empty columns.
   const Dimensions& dimensions() const;
   // The dimensions every file has, as empty columns: each of the first file's type, float64 where
-  // the files' types differ (as streamDimension takes them).
+  // the files' types differ (as streamDimensions takes them).
   Dimensions commonDimensions() const;
-  // From now on read() also gives each block dimension `name` (float64 where the files' types
-  // differ). Every file must have it: else an error naming the file (kUsage).
-  Status streamDimension(const std::string& name);
+  // From now on read() also gives each block the dimensions `names`, in that order (float64 where
+  // the files' types differ), and no others (none: no dimensions). Every file must have each:
+  // else an error naming the dimension (kUsage), and the dimensions streamed are as they were.
+  Status streamDimensions(const std::vector<std::string>& names);
   // Points [first, first + n) into `block` (resized to n).
   Status read(uint64_t first, uint64_t n, PointSet& block);
 
@@ -107,7 +108,7 @@ class PointInputStream {
   bool has_colors_ = false;
   bool e57_index_ = false;  // held_bytes_ counts E57 packet indexes
   unsigned threads_ = 0;
-  std::optional<Dimension> streamed_;  // streamDimension's name and type, no values
+  std::vector<Dimension> streamed_;  // streamDimensions' names and types, no values
   std::vector<std::string> notices_;
   PointSet scratch_;
 };

@@ -1,6 +1,8 @@
 #include "viewer/info_report.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <utility>
@@ -8,6 +10,7 @@
 #include "converters/las_crs.h"
 #include "converters/point_io.h"
 #include "core/interrupt.h"
+#include "core/parallel.h"
 #include "core/json_writer.h"
 #include "core/text.h"
 #include "viewer/copc_view.h"
@@ -138,6 +141,44 @@ Result<Camera> renderView(const InfoOptions& options, const Bounds& bounds, bool
   return cameras->front();
 }
 
+// `range` widened to hold the values of `d` (the same name and type), NaN passed over, on all
+// cores: each chunk's first least and greatest value, then the chunks' in order, so the result is
+// the one a single loop gives (-0 before +0 stays).
+template <typename T>
+void widenRangeOf(DimensionRange& range, const Dimension& d, unsigned threads) {
+  constexpr size_t kChunk = size_t{1} << 16;
+  const size_t n = d.size(), chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::pair<double, double>> found(chunks, {HUGE_VAL, -HUGE_VAL});
+  parallelFor(chunks, threads, [&](size_t c, unsigned) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (size_t i = c * kChunk, end = std::min(n, i + kChunk); i < end; ++i) {
+      const double v = static_cast<double>(d.get<T>(i));
+      if (v < lo) lo = v;
+      if (v > hi) hi = v;
+    }
+    found[c] = {lo, hi};
+  });
+  for (const auto& [lo, hi] : found) {
+    if (lo < range.min) range.min = lo;
+    if (hi > range.max) range.max = hi;
+  }
+}
+
+void widenRange(DimensionRange& range, const Dimension& d, unsigned threads) {
+  switch (d.type) {
+    case DimType::kU8: return widenRangeOf<uint8_t>(range, d, threads);
+    case DimType::kI8: return widenRangeOf<int8_t>(range, d, threads);
+    case DimType::kU16: return widenRangeOf<uint16_t>(range, d, threads);
+    case DimType::kI16: return widenRangeOf<int16_t>(range, d, threads);
+    case DimType::kU32: return widenRangeOf<uint32_t>(range, d, threads);
+    case DimType::kI32: return widenRangeOf<int32_t>(range, d, threads);
+    case DimType::kU64: return widenRangeOf<uint64_t>(range, d, threads);
+    case DimType::kI64: return widenRangeOf<int64_t>(range, d, threads);
+    case DimType::kF32: return widenRangeOf<float>(range, d, threads);
+    case DimType::kF64: return widenRangeOf<double>(range, d, threads);
+  }
+}
+
 // A point with a coordinate nan or inf (--allow-nonfinite) has no place in any mode's picture: every
 // mode's bound is unbounded, read whole or streamed (the point passes and the boxes pass its
 // coordinates over, and a mode's own checks see an inf but not a nan).
@@ -167,13 +208,8 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
   report.info = computeInfo(points, options.sample, options.threads);
   if (interrupted()) return interruptedError();  // its search stops at Ctrl-C, leaving its figures unfinished
   for (const Dimension& d : points.dimensions.all()) {
-    DimensionRange range{d.name, d.type, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-    for (size_t i = 0; i < d.size(); ++i) {
-      const double v = d.value(i);
-      if (v < range.min) range.min = v;
-      if (v > range.max) range.max = v;
-    }
-    report.dimensions.push_back(range);
+    report.dimensions.push_back({d.name, d.type, HUGE_VAL, -HUGE_VAL});
+    widenRange(report.dimensions.back(), d, options.threads);
   }
   if (points.size() > 0) {
     if (Status s = adviseFor(report, options, boundsWithOutline(points), points.z_up, [&](const Camera& camera) {
@@ -189,12 +225,27 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
 Result<InfoReport> describeStream(PointInputStream& stream, const std::string& name, const InfoOptions& options,
                                   Progress& progress) {
   // The first pass shows; the second reads again only what the nearest distances need.
+  // The first pass brings the dimensions every file has too, for their ranges; the second reads
+  // positions only.
   progress.start("reading " + name + " (points)", stream.count());
   uint64_t first_pass = 0;
+  InfoReport report;
+  const Dimensions common = stream.commonDimensions();
+  for (const Dimension& d : common.all()) report.dimensions.push_back({d.name, d.type, HUGE_VAL, -HUGE_VAL});
+  std::vector<std::string> names;
+  for (const DimensionRange& d : report.dimensions) names.push_back(d.name);
+  if (Status s = stream.streamDimensions(names); !s) return s.error();
+  bool dimensions_streamed = !names.empty();
   const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
     if (interrupted()) return interruptedError();
+    if (first != first_pass && dimensions_streamed) {
+      if (Status s = stream.streamDimensions({}); !s) return s;
+      dimensions_streamed = false;
+    }
     if (Status s = stream.read(first, n, block); !s) return s;
     if (first == first_pass) {
+      for (size_t k = 0; k < report.dimensions.size(); ++k)
+        widenRange(report.dimensions[k], block.dimensions.all()[k], options.threads);
       first_pass += n;
       progress.advance(n);
     }
@@ -208,13 +259,9 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   if (!info) return info.error();
   progress.finish();
   const BatchBoxes boxes{static_cast<size_t>(stream.count()), std::move(info->boxes)};
-  InfoReport report;
   report.name = name;
   report.info = info->info;
   report.streamed = true;
-  // The dimensions by name and type; their ranges would need every value of each (not read).
-  const Dimensions common = stream.commonDimensions();
-  for (const Dimension& d : common.all()) report.dimensions.push_back({d.name, d.type, HUGE_VAL, -HUGE_VAL});
   if (boxes.count > 0) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
@@ -236,7 +283,10 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
     streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
-    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, kStreamPointBytes,
+    uint64_t point_bytes = kStreamPointBytes;  // and the first pass's dimensions
+    const Dimensions common = (*stream)->commonDimensions();
+    for (const Dimension& d : common.all()) point_bytes += dimTypeSize(d.type);
+    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, point_bytes,
                                                 (*stream)->heldBytes(), (*stream)->heldWhat());
     if (!block) return block.error();
     streamed.stream_block = *block;

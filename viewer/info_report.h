@@ -62,7 +62,7 @@ struct DimensionRange {
 struct InfoReport {
   std::string name;                  // the set's name in the report ("file"): the caller's
   PointSetInfo info;
-  std::vector<DimensionRange> dimensions;  // a set in memory's; a streamed set lists none
+  std::vector<DimensionRange> dimensions;  // a streamed set's: those every file has
   // Read a block at a time: float32's merged points, which need every point at once, are not
   // counted (info.float_merged stays 0, the JSON says null) and the bounds are from boxes.
   bool streamed = false;

@@ -326,7 +326,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
     phases.mark("bounds");
     if (request.color == RenderColor::kAttribute) {  // one more pass: the dimension's classes or percentiles
       const std::string& name = request.color_attribute;
-      if (Status s = ply->streamDimension(name); !s) return Error{inputs + ": --color " + name + ": " + s.error().message, ExitCode::kUsage};
+      if (Status s = ply->streamDimensions({name}); !s) return Error{inputs + ": --color " + name + ": " + s.error().message, ExitCode::kUsage};
       AttributeSampler values(name, ply->dimensions().find(name)->type, ply->count());
       Status s = forEachBlock(*ply, set.stream_block, progress, "values of " + name + " in " + inputs + " (points)",
                               [&](const PointSet& block) { values.add(block.dimensions.all().front()); });

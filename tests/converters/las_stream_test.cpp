@@ -10,6 +10,7 @@
 
 #include "converters/las.h"
 #include "converters/point_inputs.h"
+#include "converters/point_io.h"
 #include "test_support.h"
 
 namespace dpoint {
@@ -76,7 +77,7 @@ TEST(LasStream, renderAndInfoStreamLazAndLas) {
   ASSERT_TRUE(on) << on.error().message;
   ASSERT_TRUE(*on);
   EXPECT_EQ((*on)->count(), 110000u);
-  ASSERT_TRUE((*on)->streamDimension("classification").ok());
+  ASSERT_TRUE((*on)->streamDimensions({"classification"}).ok());
   PointSet block;
   ASSERT_TRUE((*on)->read(49990, 20, block).ok());  // across the first chunk's end
   ASSERT_EQ(block.dimensions.count(), 1u);
@@ -84,6 +85,78 @@ TEST(LasStream, renderAndInfoStreamLazAndLas) {
   Result<std::unique_ptr<PointInputStream>> automatic = openPointStream({laz}, "auto", 2);
   ASSERT_TRUE(automatic);
   EXPECT_FALSE(*automatic);
+}
+
+// Several dimensions at once from a mix of files (PLY, E57, LAS), as `info --stream` takes them
+// for their ranges: every value the whole read has, in blocks across the files' ends, float64
+// where the files' types differ; a name one file lacks changes nothing.
+TEST(LasStream, severalDimensionsStreamFromAMixOfFilesAsTheWholeReadHasThem) {
+  test::TempDir dir;
+  Result<PointSet> autzen = readLas(std::string(DPOINT_CORPUS_DIR) + "/laz/autzen_trim.laz");
+  ASSERT_TRUE(autzen) << autzen.error().message;
+  autzen->positions.resize(3000), autzen->colors.resize(3000);  // of its 110,000
+  for (Dimension& d : autzen->dimensions.all()) d.resize(3000);
+  autzen->las.reset();
+  const std::vector<std::string> paths{dir.file("autzen.ply"), std::string(DPOINT_TESTS_DIR) + "/data/e57/two_scans.e57",
+                                       std::string(DPOINT_CORPUS_DIR) + "/las/simple.las"};
+  ASSERT_TRUE(writePoints(paths[0], *autzen).ok());
+  Result<PointSet> whole = readPointInputs(paths);
+  ASSERT_TRUE(whole) << whole.error().message;
+  Result<std::unique_ptr<PointInputStream>> opened = openPointStream(paths, "on", 2);
+  ASSERT_TRUE(opened && *opened) << (opened ? "" : opened.error().message);
+  PointInputStream& stream = **opened;
+  ASSERT_EQ(stream.count(), whole->size());
+  const Dimensions common = stream.commonDimensions();
+  std::vector<std::string> names;
+  for (const Dimension& d : common.all()) names.push_back(d.name);
+  ASSERT_EQ(names, (std::vector<std::string>{"intensity", "point_source_id"}));
+  EXPECT_EQ(common.find("intensity")->type, DimType::kF64);  // uint16 in PLY and LAS, float32 in E57
+  EXPECT_EQ(common.find("point_source_id")->type, DimType::kU16);
+
+  const Status missing = stream.streamDimensions({"intensity", "classification"});  // not in the E57 file
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().code, ExitCode::kUsage);
+  EXPECT_TRUE(test::contains(missing.error().message, "'classification'")) << missing.error().message;
+  PointSet block;
+  ASSERT_TRUE(stream.read(0, 10, block).ok());
+  EXPECT_EQ(block.dimensions.count(), 0u);  // as before the refused call
+
+  ASSERT_TRUE(stream.streamDimensions(names).ok());
+  const uint64_t step = 1777;  // blocks across the files' ends
+  for (uint64_t first = 0; first < stream.count(); first += step) {
+    const uint64_t n = std::min(step, stream.count() - first);
+    ASSERT_TRUE(stream.read(first, n, block).ok());
+    ASSERT_EQ(block.dimensions.count(), names.size());
+    for (size_t k = 0; k < names.size(); ++k) {
+      const Dimension& got = block.dimensions.all()[k];
+      const Dimension* want = whole->dimensions.find(names[k]);
+      ASSERT_NE(want, nullptr);
+      ASSERT_EQ(got.name, names[k]);
+      ASSERT_EQ(got.type, common.all()[k].type);
+      for (uint64_t i = 0; i < n; ++i) ASSERT_EQ(got.value(i), want->value(first + i)) << names[k] << " point " << first + i;
+    }
+  }
+  ASSERT_TRUE(stream.streamDimensions({}).ok());
+  ASSERT_TRUE(stream.read(0, 10, block).ok());
+  EXPECT_EQ(block.dimensions.count(), 0u);
+
+  // One PLY file's every dimension, its own types, from one read of its rows.
+  Result<std::unique_ptr<PointInputStream>> ply = openPointStream({paths[0]}, "on", 2);
+  ASSERT_TRUE(ply && *ply);
+  names.clear();
+  for (const Dimension& d : autzen->dimensions.all()) names.push_back(d.name);
+  ASSERT_GE(names.size(), 10u);
+  ASSERT_TRUE((*ply)->streamDimensions(names).ok());
+  ASSERT_TRUE((*ply)->read(1000, 1500, block).ok());
+  ASSERT_EQ(block.dimensions.count(), names.size());
+  for (size_t k = 0; k < names.size(); ++k) {
+    const Dimension& got = block.dimensions.all()[k];
+    const Dimension& want = autzen->dimensions.all()[k];
+    ASSERT_EQ(got.type, want.type) << want.name;
+    const size_t w = dimTypeSize(want.type);
+    EXPECT_TRUE(std::equal(got.bytes.begin(), got.bytes.end(), want.bytes.begin() + static_cast<ptrdiff_t>(1000 * w)))
+        << want.name;
+  }
 }
 
 }  // namespace
