@@ -1,6 +1,7 @@
 #include "ops/info.h"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cfloat>
 #include <cmath>
@@ -160,34 +161,71 @@ double smallestDistance(const std::vector<double>& best2) {
 }
 
 // Counts distinct points that float32 rounding merges with another distinct point (of the finite
-// ones: a NaN would break the sort's ordering).
-size_t countFloatMerges(const PositionArray& positions) {
-  std::vector<uint32_t> order;
-  order.reserve(positions.size());
-  for (uint32_t i = 0; i < positions.size(); ++i) {
+// ones: a NaN would break the sort's ordering): in each run of equal float32 points, each distinct
+// double point past the first. The points are dealt into buckets by a hash of their float32 point
+// (a run is never split), each bucket sorted on its own, on all cores; at Ctrl-C the buckets left
+// are passed over (the caller checks interrupted()).
+size_t countFloatMerges(const PositionArray& positions, unsigned threads) {
+  const size_t n = positions.size();
+  // Points a worker deals at once: 65,536, or more where there would be over 1024 pieces (each
+  // piece keeps a count and a place per bucket).
+  const size_t piece_points = std::max<size_t>(size_t{1} << 16, (n + 1023) / 1024);
+  const size_t pieces = (n + piece_points - 1) / piece_points;
+  const unsigned buckets = static_cast<unsigned>(std::bit_ceil(std::clamp<size_t>(n / 4096, 1, 4096)));
+  const auto as_float = [&](uint32_t i) { return glm::vec3(positions[i]) + 0.0f; };  // -0 as +0: they are equal
+  const auto bucketOf = [&](const glm::vec3& f) {
+    uint64_t h = 0;
+    for (int k = 0; k < 3; ++k) h = (h ^ std::bit_cast<uint32_t>(f[k])) * 0x9E3779B97F4A7C15ull;
+    return static_cast<unsigned>((h >> 40) & (buckets - 1));
+  };
+  const auto finite = [&](size_t i) {
     const glm::dvec3& p = positions[i];
-    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) order.push_back(i);
-  }
-  auto as_float = [&](uint32_t i) { return glm::vec3(positions[i]); };
-  auto less_float = [](const glm::vec3& a, const glm::vec3& b) {
-    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
   };
-  auto less_double = [](const glm::dvec3& a, const glm::dvec3& b) {
-    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    glm::vec3 fa = as_float(a), fb = as_float(b);
-    if (less_float(fa, fb)) return true;
-    if (less_float(fb, fa)) return false;
-    return less_double(positions[a], positions[b]);
+  // Each piece's count per bucket, then where its points of each bucket go.
+  std::vector<uint32_t> counts(pieces * buckets, 0);
+  parallelFor(pieces, threads, [&](size_t piece, unsigned) {
+    uint32_t* c = counts.data() + piece * buckets;
+    for (size_t i = piece * piece_points, end = std::min(n, i + piece_points); i < end; ++i)
+      if (finite(i)) ++c[bucketOf(as_float(static_cast<uint32_t>(i)))];
   });
-  // Within a run of equal floats, every change of the double value is one more merged point.
-  size_t merged = 0;
-  for (size_t k = 1; k < order.size(); ++k) {
-    const uint32_t a = order[k - 1], b = order[k];
-    if (as_float(a) == as_float(b) && positions[a] != positions[b]) ++merged;
+  std::vector<size_t> bucket_begin(buckets + 1, 0), at(pieces * buckets);
+  size_t total = 0;
+  for (unsigned b = 0; b < buckets; ++b) {
+    bucket_begin[b] = total;
+    for (size_t piece = 0; piece < pieces; ++piece) at[piece * buckets + b] = total, total += counts[piece * buckets + b];
   }
-  return merged;
+  bucket_begin[buckets] = total;
+  std::vector<uint32_t> order(total);
+  parallelFor(pieces, threads, [&](size_t piece, unsigned) {
+    size_t* a = at.data() + piece * buckets;
+    for (size_t i = piece * piece_points, end = std::min(n, i + piece_points); i < end; ++i)
+      if (finite(i)) order[a[bucketOf(as_float(static_cast<uint32_t>(i)))]++] = static_cast<uint32_t>(i);
+  });
+  const auto less_float = [](const glm::vec3& a, const glm::vec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  const auto less_double = [](const glm::dvec3& a, const glm::dvec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  std::vector<size_t> merged(buckets, 0);
+  parallelFor(buckets, threads, [&](size_t b, unsigned) {
+    if (interrupted()) return;
+    const auto first = order.begin() + static_cast<ptrdiff_t>(bucket_begin[b]);
+    const auto last = order.begin() + static_cast<ptrdiff_t>(bucket_begin[b + 1]);
+    std::sort(first, last, [&](uint32_t x, uint32_t y) {
+      const glm::vec3 fx = as_float(x), fy = as_float(y);
+      if (less_float(fx, fy)) return true;
+      if (less_float(fy, fx)) return false;
+      return less_double(positions[x], positions[y]);
+    });
+    // Within a run of equal floats, every change of the double value is one more merged point.
+    for (auto k = first + (first != last); k < last; ++k)
+      if (as_float(k[-1]) == as_float(*k) && positions[k[-1]] != positions[*k]) ++merged[b];
+  });
+  size_t sum = 0;
+  for (size_t m : merged) sum += m;
+  return sum;
 }
 
 // Bounds and float overflow of `positions` into `info` (min and max start empty: noBounds). A NaN
@@ -456,7 +494,7 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
   finishBounds(info);
 
   // The merge count needs 32-bit indices; larger sets are beyond the renderer anyway.
-  if (info.float_overflow == 0 && points.size() <= UINT32_MAX) info.float_merged = countFloatMerges(points.positions);
+  if (info.float_overflow == 0 && points.size() <= UINT32_MAX) info.float_merged = countFloatMerges(points.positions, threads);
 
   const size_t n = points.size();
   const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));
