@@ -211,8 +211,15 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
     report.dimensions.push_back({d.name, d.type, HUGE_VAL, -HUGE_VAL});
     widenRange(report.dimensions.back(), d, options.threads);
   }
-  if (points.size() > 0) {
-    if (Status s = adviseFor(report, options, boundsWithOutline(points), points.z_up, [&](const Camera& camera) {
+  // A point with a nan or inf coordinate (--allow-nonfinite) has no place in a view: the view
+  // frames the others, as a stream's boxes pass it over (it framed an inf extent, 0 points visible).
+  PointSet finite;
+  if (report.info.nonfinite > 0)
+    for (const glm::dvec3& p : points.positions)
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) finite.positions.push_back(p);
+  const PointSet& framed = report.info.nonfinite > 0 ? finite : points;
+  if (framed.size() > 0) {
+    if (Status s = adviseFor(report, options, boundsWithOutline(framed), points.z_up, [&](const Camera& camera) {
           return unboundedWithNonfinite(predictErrorBounds(points, camera, {}, options.tolerance_px), report.info);
         });
         !s)

@@ -106,7 +106,10 @@ TEST(InfoReport, nonFinitePositionsGiveWhatDpointInfoGivesWithAllowNonfinite) {
   EXPECT_TRUE(test::contains(infoReportJson(report), "\"nonfinite_points\": 2"));
   EXPECT_TRUE(test::contains(infoReportText(report), "non-finite:         2 points with a coordinate nan or inf"));
   // No mode places the points: every bound unbounded (batch and adaptive said 0 px with an inf).
+  // The view frames the two finite points (it framed an inf extent: 0 points visible).
   ASSERT_TRUE(report.advice.has_value());
+  EXPECT_EQ(report.advice->bounds.visible, 2u);
+  EXPECT_TRUE(report.advice->camera.note.empty()) << report.advice->camera.note;
   for (size_t m = 0; m < kModeCount; ++m) {
     if (report.advice->bounds.computed[m]) {
       EXPECT_EQ(report.advice->bounds.px[m], HUGE_VAL) << m;
