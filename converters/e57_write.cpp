@@ -313,22 +313,49 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     f.bits = static_cast<unsigned>(std::bit_width(static_cast<uint64_t>(f.maximum) - static_cast<uint64_t>(f.minimum)));
   }
 
-  // Packets of whole 64-record groups: every field's chunk is whole 8-byte words.
+  // Packets of whole 64-record groups: every field's chunk is whole 8-byte words. Where one group
+  // of every field does not fit in a packet (more than about 120 double fields), each group is
+  // split over several packets by fields: a packet holds the group's chunks of some fields and
+  // none of the others, so that a reader holds at most one group's bytes ahead of any field.
   uint64_t group_bytes = 0;  // one group's bytes of every field
   for (const OutField& f : fields) group_bytes += f.bits * 8;  // 64 records · bits / 8
   const uint64_t header_bytes = 6 + 2 * fields.size();
-  if (header_bytes + group_bytes + 4 > kMostPacket)
-    return Error{path + ": " + std::to_string(fields.size()) + " fields, more than 64 records of them fit in an E57 packet "
-                 "(64 KiB); leave some dimensions out (--drop)", ExitCode::kUsage};
+  if (header_bytes + 64 * 8 + 4 > kMostPacket)  // a packet's header lists every field's length
+    return Error{path + ": " + std::to_string(fields.size()) + " fields, more than an E57 packet (64 KiB) can list; "
+                 "leave some dimensions out (--drop)", ExitCode::kUsage};
+  const uint64_t room = kMostPacket - header_bytes - 4;  // for the chunks
+  std::vector<std::pair<size_t, size_t>> slices;  // each packet's fields [first, last), in a group split by fields
+  if (header_bytes + group_bytes + 4 > kMostPacket) {
+    uint64_t bytes = 0;
+    for (size_t k = 0; k < fields.size(); ++k) {
+      if (slices.empty() || bytes + fields[k].bits * 8 > room) slices.emplace_back(k, k), bytes = 0;
+      slices.back().second = k + 1;
+      bytes += fields[k].bits * 8;
+    }
+  } else {
+    slices.emplace_back(0, fields.size());
+  }
   const uint64_t groups_per_packet =
-      group_bytes == 0 ? UINT64_MAX : std::max<uint64_t>(1, (kMostPacket - header_bytes - 4) / group_bytes);
+      slices.size() > 1 ? 1 : group_bytes == 0 ? UINT64_MAX : std::max<uint64_t>(1, room / group_bytes);
   const uint64_t records_per_packet = groups_per_packet == UINT64_MAX ? UINT64_MAX : groups_per_packet * 64;
-  const uint64_t packets = n == 0 || group_bytes == 0 ? 0 : (n + records_per_packet - 1) / records_per_packet;
+  const uint64_t packets =
+      n == 0 || group_bytes == 0 ? 0 : (n + records_per_packet - 1) / records_per_packet * slices.size();
+  // Packet p: records [begin, end) of fields [first, last).
+  struct Packet {
+    size_t begin, end, first, last;
+  };
+  const auto packetOf = [&](uint64_t p) {
+    const uint64_t records = p / slices.size() * records_per_packet;
+    const auto& [first, last] = slices[static_cast<size_t>(p % slices.size())];
+    return Packet{static_cast<size_t>(records), static_cast<size_t>(std::min<uint64_t>(n, records + records_per_packet)),
+                  first, last};
+  };
   const auto packetBytes = [&](uint64_t p, std::vector<uint64_t>* chunks) {
-    const uint64_t records = std::min<uint64_t>(records_per_packet, n - p * records_per_packet);
+    const Packet packet = packetOf(p);
     uint64_t bytes = header_bytes;
-    for (const OutField& f : fields) {
-      const uint64_t chunk = (records * f.bits + 63) / 64 * 8;
+    for (size_t k = 0; k < fields.size(); ++k) {
+      const uint64_t records = k >= packet.first && k < packet.last ? packet.end - packet.begin : 0;
+      const uint64_t chunk = (records * fields[k].bits + 63) / 64 * 8;
       if (chunks) chunks->push_back(chunk);
       bytes += chunk;
     }
@@ -475,10 +502,10 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
       storeUnaligned<uint16_t>(packet.data() + 2, static_cast<uint16_t>(packet.size() - 1));
       storeUnaligned<uint16_t>(packet.data() + 4, static_cast<uint16_t>(fields.size()));
       size_t at = static_cast<size_t>(header_bytes);
-      const size_t begin = static_cast<size_t>(p * records_per_packet);
-      const size_t end = static_cast<size_t>(std::min<uint64_t>(n, begin + records_per_packet));
+      const auto [begin, end, first_field, last_field] = packetOf(p);
       for (size_t k = 0; k < fields.size(); ++k) {
         storeUnaligned<uint16_t>(packet.data() + 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
+        if (k < first_field || k >= last_field) continue;  // none of this field here
         const OutField& f = fields[k];
         uint8_t* bytes = reinterpret_cast<uint8_t*>(packet.data()) + at;
         if (f.source == OutField::Source::kPosition) {
@@ -512,7 +539,8 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     });
     for (size_t b = 0; b < count; ++b) {
       if (Status s = writer.append(batch[b]); !s) return s;
-      if (progress) progress->advance(std::min<uint64_t>(records_per_packet, n - (first + b) * records_per_packet));
+      if (const Packet packet = packetOf(first + b); progress && packet.last == fields.size())
+        progress->advance(packet.end - packet.begin);
     }
   }
   if (Status s = writer.append(no_points); !s) return s;
