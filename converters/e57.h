@@ -56,6 +56,9 @@ struct E57WriteOptions {
   unsigned threads = 0;  // 0: all cores; the bytes do not depend on it
   Progress* progress = nullptr;
   std::vector<std::string>* notices = nullptr;  // dimensions renamed, triangles not written
+  // The file's coordinateMetadata: this where not empty (--crs, WKT), else the set's own `crs`,
+  // else a LAS source's coordinate system where it is WKT or can be made WKT.
+  std::string crs;
 };
 
 Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options = {});

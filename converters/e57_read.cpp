@@ -1002,6 +1002,7 @@ Result<PointSet> pointsOf(const PagedFile& file, ScanInfo& scan, const E57ReadOp
 struct FileTree {
   std::vector<ScanInfo> scans;
   size_t images = 0;
+  std::string crs;  // coordinateMetadata, trimmed
 };
 
 Result<FileTree> readTree(const PagedFile& file, unsigned threads) {
@@ -1031,6 +1032,10 @@ Result<FileTree> readTree(const PagedFile& file, unsigned threads) {
   }
   for (const pugi::xml_node& child : root.child("images2D").children())
     if (child.type() == pugi::node_element) ++tree.images;
+  for (const pugi::xml_node& part : root.child("coordinateMetadata").children())  // every text and CDATA section
+    if (part.type() == pugi::node_pcdata || part.type() == pugi::node_cdata) tree.crs += part.value();
+  const size_t first = tree.crs.find_first_not_of(" \t\r\n"), last = tree.crs.find_last_not_of(" \t\r\n");
+  tree.crs = first == std::string::npos ? std::string() : tree.crs.substr(first, last - first + 1);
   return tree;
 }
 
@@ -1163,9 +1168,13 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   if (read.empty()) {
     PointSet none;
     none.z_axis = ZAxis::kPresent;
+    none.crs = tree->crs;
     return none;
   }
-  if (read.size() == 1) return std::move(read.front().points);
+  if (read.size() == 1) {
+    read.front().points.crs = tree->crs;
+    return std::move(read.front().points);
+  }
   // The file's own point source ids (an E57 written from LAS) are kept as they are, 0 for the scans
   // without (scan numbers there could be ids of the others).
   const bool own_ids = std::any_of(read.begin(), read.end(), [](const NumberedScan& scan) {
@@ -1181,7 +1190,9 @@ Result<PointSet> readE57(const InputFile& file, const E57ReadOptions& options) {
   }
   if (own_ids)
     for (NumberedScan& scan : read) scan.number = 0;
-  return joinScans(std::move(read));
+  PointSet joined = joinScans(std::move(read));
+  joined.crs = tree->crs;
+  return joined;
 }
 
 Result<PointSet> readE57(const std::string& path, const E57ReadOptions& options) {

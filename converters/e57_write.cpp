@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "converters/e57.h"
+#include "converters/las_crs.h"
 #include "core/atomic_file.h"
 #include "core/bytes.h"
 #include "core/dimensions.h"
@@ -22,6 +23,46 @@ constexpr uint64_t kPage = 1024, kLogicalPage = 1020;
 constexpr uint64_t kHeaderBytes = 48, kSectionHeaderBytes = 32;
 constexpr uint64_t kMostPacket = 65536;
 constexpr size_t kPacketsPerBatch = 256;
+
+// The coordinate system the file states (E57WriteOptions::crs says which), as XML character data
+// (CDATA, whose end marker is split where the text holds one); a LAS source's records made WKT as
+// its writer makes them. Text that XML cannot hold (a control byte, a byte that is not UTF-8) is
+// left out, with a note, as is a LAS coordinate system that cannot be made WKT.
+std::string coordinateMetadata(const PointSet& points, const E57WriteOptions& options, std::vector<std::string>& notes) {
+  std::string crs = !options.crs.empty() ? options.crs : points.crs;
+  if (crs.empty() && points.las) {
+    std::vector<LasVlr> records;
+    for (const LasVlr& vlr : points.las->vlrs)
+      if (isLasCrsRecord(vlr)) records.push_back(vlr);
+    if (!records.empty()) {
+      LasWktCrs wkt = lasWktCrs(records, lasSaysWkt(*points.las));
+      const auto it = std::find_if(wkt.records.begin(), wkt.records.end(), [](const LasVlr& r) { return r.record_id == 2112; });
+      if (it != wkt.records.end()) crs.assign(it->data.c_str());  // up to a NUL that ends it
+      else if (!wkt.note.empty()) notes.push_back("coordinate system not written: " + wkt.note);
+      else notes.push_back("coordinate system not written: the LAS source's is not WKT and PROJ made none of it");
+    }
+  }
+  for (size_t i = 0; i < crs.size(); ++i) {
+    const auto c = static_cast<unsigned char>(crs[i]);
+    const size_t sequence = c >= 0x80 ? utf8SequenceAt(crs, i) : 1;
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f || sequence == 0) {
+      std::string byte;
+      appendHexByte(byte, c);
+      notes.push_back("coordinate system not written: its text " + quotedExcerpt(crs) + " holds a byte XML cannot hold (" +
+                      byte + ")");
+      return "";
+    }
+    i += sequence - 1;
+  }
+  std::string cdata;  // "]]>" as "]]" at the end of one section and ">" in the next
+  size_t at = 0;
+  for (size_t end; (end = crs.find("]]>", at)) != std::string::npos; at = end + 2) {
+    cdata.append(crs, at, end + 2 - at);
+    cdata += "]]><![CDATA[";
+  }
+  cdata.append(crs, at);
+  return cdata;
+}
 
 uint64_t physicalOf(uint64_t logical) { return logical / kLogicalPage * kPage + logical % kLogicalPage; }
 
@@ -431,7 +472,8 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   xml += "  <guid type=\"String\"><![CDATA[" + std::string(kFileGuidMarker) + "]]></guid>\n";
   xml += "  <versionMajor type=\"Integer\">1</versionMajor>\n  <versionMinor type=\"Integer\">0</versionMinor>\n";
   xml += "  <e57LibraryVersion type=\"String\"><![CDATA[dpoint]]></e57LibraryVersion>\n";
-  xml += "  <coordinateMetadata type=\"String\"><![CDATA[]]></coordinateMetadata>\n";
+  xml += "  <coordinateMetadata type=\"String\"><![CDATA[" + coordinateMetadata(points, options, notes) +
+         "]]></coordinateMetadata>\n";
   xml += "  <data3D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n    <vectorChild type=\"Structure\">\n";
   xml += "      <guid type=\"String\"><![CDATA[" + std::string(kScanGuidMarker) + "]]></guid>\n";
   if (bounded) {

@@ -142,6 +142,7 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
     // Colours white for the files without; dimensions the union, 0 where a file lacks one.
     appendPoints(out, *part);
     if (!out.las) out.las = part->las;  // the first LAS part's frame and coordinate system
+    if (out.crs.empty()) out.crs = part->crs;  // and the first other part's that states one
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include "converters/copc.h"
 #include "converters/e57.h"
 #include "converters/gltf_write.h"
+#include "converters/las_crs.h"
 #include "core/atomic_file.h"
 #include "core/text.h"
 #include "ops/point_filters.h"
@@ -242,8 +243,8 @@ Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven&
   if (given.pcd_encoding && *format != FileFormat::kPcd) return refuse("--pcd-encoding", "a PCD output (.pcd) has an encoding");
   if (given.las_scale && !las)
     return refuse("--las-scale", "a LAS, LAZ or COPC output (.las, .laz, .copc.laz) has a coordinate step");
-  if (given.crs && !las)
-    return refuse("--crs", "a LAS, LAZ or COPC output (.las, .laz, .copc.laz) holds a coordinate reference system");
+  if (given.crs && !las && *format != FileFormat::kE57)
+    return refuse("--crs", "a LAS, LAZ, COPC or E57 output (.las, .laz, .copc.laz, .e57) holds a coordinate reference system");
   return okStatus();
 }
 
@@ -302,7 +303,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
     case FileFormat::kGltf:
       return checkWrittenFormat(path, format);
     case FileFormat::kE57:
-      return writeE57(path, points, E57WriteOptions{options.threads, options.progress, options.notices});
+      return writeE57(path, points, E57WriteOptions{options.threads, options.progress, options.notices, options.las_crs});
     case FileFormat::kLas:
     case FileFormat::kLaz: {
       LasWriteReport report;
@@ -312,6 +313,14 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       las.progress = options.progress;
       las.report = &report;
       las.crs_wkt = options.las_crs;
+      // A coordinate system another format stated (an E57 file's), where no LAS source's and no
+      // --crs is given: made WKT by PROJ, or left out with a note.
+      std::string crs_note;
+      if (las.crs_wkt.empty() && !points.las && !points.crs.empty()) {
+        Result<std::string> wkt = crsAsWkt(points.crs, "the input's coordinate system");
+        if (wkt) las.crs_wkt = std::move(*wkt);
+        else crs_note = path + ": coordinate system not written: " + wkt.error().message;
+      }
       if (isCopcPath(path)) {
         // COPC: the LAS 1.4 file in memory (formats 6-8), then its octree of LAZ chunks.
         std::string bytes;
@@ -332,6 +341,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
         if (Status s = writeLas(path, points, las); !s) return s;
       }
       if (options.notices) {
+        if (!crs_note.empty()) options.notices->push_back(crs_note);
         if (!report.crs.empty()) options.notices->push_back(path + ": " + report.crs);
         if (report.intensity_scaled)
           options.notices->push_back(path + ": intensity of 0..1 values (as PTX and E57 scans hold it) written as 0..65535, "

@@ -69,7 +69,10 @@ struct WriteOptions {
   PcdEncoding pcd_encoding = PcdEncoding::kBinary;
   Progress* progress = nullptr;
   double las_scale = 0.0;  // LAS: the coordinate step for x, y and z; 0: the source's, else 0.001 (converters/las.h)
-  std::string las_crs;  // LAS/LAZ/COPC: the CRS as one line of WKT 1 (crsAsWkt), in place of the source's
+  // LAS/LAZ/COPC and E57: the CRS as one line of WKT 1 (crsAsWkt, --crs), in place of the source's.
+  // Without it a set read from a file other than LAS keeps its own (PointSet::crs): E57 writes it
+  // as it is, LAS where PROJ makes it WKT (else a note says it is left out).
+  std::string las_crs;
   // When not null, gets one line per thing the file cannot hold as given (GLB: points that will
   // not read back bit-exactly).
   std::vector<std::string>* notices = nullptr;

@@ -67,6 +67,10 @@ struct PointSet {
   bool colors_read_as_fractions = false;
   // Set by the LAS reader, kept by the filters, used by the LAS writer.
   std::optional<LasSource> las;
+  // The coordinate system a file other than LAS stated, as it gave it (an E57 file's
+  // coordinateMetadata: WKT, an EPSG code or free text); empty when none. The E57 writer writes it
+  // back, the LAS writer where PROJ makes it WKT (converters/point_io.cpp).
+  std::string crs;
 
   // Facts of the source that the values cannot tell, set by the readers and kept by the filters.
   ZAxis z_axis = ZAxis::kUnknown;

@@ -335,6 +335,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (!report) return report;
   report->copc = copc;
   report->notices = std::move(notices);
+  if (!points->las) report->crs = points->crs;
   if (header) {
     const PointSetInfo& info = report->info;
     const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
@@ -401,6 +402,10 @@ std::string infoReportText(const InfoReport& report) {
             str(c->bytes) + " of " + str(c->file_bytes) + " bytes (" + str(c->nodes) +
             " nodes); the facts below but the header's are of those points (--stream on reads all)\n";
   if (report.las) text += lasText(*report.las);
+  if (!report.crs.empty()) {
+    const std::string name = wktName(report.crs);
+    text += "CRS:                " + (name.empty() ? oneLineText(report.crs, "") : name + " (WKT)") + "\n";
+  }
   if (i.count == 0)
     return text + "bounds:             none (no points)\n" + "float32 enough:     nothing to hold (no points)\n";
   if (i.nonfinite > 0)
@@ -450,6 +455,7 @@ std::string infoReportJson(const InfoReport& report) {
             ", \"nodes_read\": " + str(c->nodes) + ", \"file_points\": " + str(c->file_points) +
             ", \"file_bytes\": " + str(c->file_bytes) + "}";
   if (report.las) json += lasJson(*report.las);
+  if (!report.crs.empty()) json += ",\n  \"crs\": " + jsonString(report.crs);
   if (report.advice) json += adviceJson(*report.advice);
   if (!report.no_view.empty()) json += ",\n  \"no_view\": " + jsonString(report.no_view);
   return json + "\n}\n";

@@ -67,6 +67,7 @@ struct InfoReport {
   // counted (info.float_merged stays 0, the JSON says null) and the bounds are from boxes.
   bool streamed = false;
   std::optional<LasFacts> las;       // one LAS file only
+  std::string crs;                   // the coordinate system another format stated (PointSet::crs, E57's)
   // One COPC file, read by view (describeFiles): the points, bytes and nodes its view read; the
   // facts are of those points, the LAS header's of the whole file.
   std::optional<CopcReadStats> copc;

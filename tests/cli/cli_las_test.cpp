@@ -226,7 +226,8 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
            {{"--decimals", "3", "-o", dir.file("c.las")}, "--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts)"},
            {{"--keep", "intensity", "--drop", "intensity", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
            {{"--keep", "intensity", "--drop", "all", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
-           {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")}, "only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) holds"}}) {
+           {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")},
+            "only a LAS, LAZ, COPC or E57 output (.las, .laz, .copc.laz, .e57) holds"}}) {
     std::vector<std::string> command = {"convert", kCorpus + "simple.las"};
     command.insert(command.end(), args.begin(), args.end());
     test::CommandResult bad = runDpoint(command);
@@ -235,6 +236,49 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir.file("c.las")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("c.ply")));
+}
+
+// E57's coordinateMetadata carries a CRS both ways: a LAS file's GeoTIFF keys become WKT there
+// (PROJ's), read back by info and written to LAS as keys again; --crs sets it; text PROJ does not
+// take goes to E57 as it is and is left out of LAS with a note; text XML cannot hold is left out.
+TEST(CliLas, e57CarriesTheCoordinateSystemToAndFromLas) {
+  TempDir dir;
+  test::CommandResult r = runDpoint({"convert", kCorpus + "autzen.las", "-o", dir.file("a.e57")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  test::CommandResult info = runDpoint({"info", dir.file("a.e57"), "--quiet"});
+  EXPECT_TRUE(test::contains(info.out, "CRS:                NAD83(HARN) / Oregon GIC Lambert (ft) (WKT)\n")) << info.out;
+  ASSERT_EQ(runDpoint({"convert", dir.file("a.e57"), "-o", dir.file("a.las"), "-q"}).exit_code, 0);
+  info = runDpoint({"info", dir.file("a.las"), "--quiet"});
+  EXPECT_TRUE(test::contains(info.out, "LAS CRS:            EPSG:2994 (")) << info.out;
+
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "simple.las", "--crs", "EPSG:32633", "-o", dir.file("b.e57"), "-q"}).exit_code, 0);
+  info = runDpoint({"info", dir.file("b.e57"), "--json", "--quiet"});
+  EXPECT_TRUE(test::contains(info.out, "\"crs\": \"PROJCS[\\\"WGS 84 / UTM zone 33N\\\"")) << info.out;
+
+  // Free text (a site grid's name, with "]]>", which ends XML character data): to E57 as it is,
+  // not to LAS.
+  PointSet site;
+  site.positions = {{1.0, 2.0, 3.0}, {4.0, 5.0, 6.0}};
+  site.crs = "site grid 7 ]]> north";
+  ASSERT_TRUE(writePoints(dir.file("site.e57"), site).ok());
+  Result<PointSet> back = readPoints(dir.file("site.e57"));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->crs, site.crs);
+  r = runDpoint({"convert", dir.file("site.e57"), "-o", dir.file("site.las")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "site.las: coordinate system not written: the input's coordinate system 'site grid 7 ]]> north'"))
+      << r.err;
+  info = runDpoint({"info", dir.file("site.las"), "--quiet"});
+  EXPECT_TRUE(test::contains(info.out, "LAS CRS:            none")) << info.out;
+  site.crs = "bad \x01 byte";
+  std::vector<std::string> notices;
+  WriteOptions write;
+  write.notices = &notices;
+  ASSERT_TRUE(writePoints(dir.file("bad.e57"), site, write).ok());
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_TRUE(test::contains(notices[0], "coordinate system not written: its text 'bad \\x01 byte' holds a byte XML cannot hold (\\x01)"))
+      << notices[0];
+  EXPECT_EQ(readPoints(dir.file("bad.e57"))->crs, "");
 }
 
 // LAZ reads as the LAS it was compressed from (converters/laz_decode.h), by name or by its header.

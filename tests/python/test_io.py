@@ -59,7 +59,17 @@ def test_las_takes_a_crs_as_convert_does(tmp_path, cloud):
     start = data.index(b'PROJCS["')
     wkt = data[start:data.index(b"\0", start)].decode()
     assert pyproj.CRS.from_wkt(wkt).equals(pyproj.CRS.from_epsg(32633), ignore_axis_order=True)
-    for path, crs, words in [(tmp_path / "c.ply", "EPSG:32633", "crs: only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) holds"),
+    # E57: its coordinateMetadata, as WKT, read back by info and taken to LAS as GeoTIFF keys.
+    dpoint.write(s, tmp_path / "e.e57", crs="EPSG:32633")
+    raw = (tmp_path / "e.e57").read_bytes()
+    data = b"".join(raw[k:k + 1020] for k in range(0, len(raw), 1024))  # pages less their checksums
+    start = data.index(b"<coordinateMetadata")
+    wkt = data[data.index(b"<![CDATA[", start) + 9:data.index(b"]]></coordinateMetadata>", start)].decode()
+    assert pyproj.CRS.from_wkt(wkt).equals(pyproj.CRS.from_epsg(32633), ignore_axis_order=True)
+    assert dpoint.info(tmp_path / "e.e57")["crs"] == wkt
+    dpoint.write(dpoint.read(tmp_path / "e.e57"), tmp_path / "e.las", las_scale=0.01)
+    assert dpoint.info(tmp_path / "e.las")["las"]["crs"] == "EPSG:32633 (WGS 84 / UTM zone 33N), GeoTIFF keys"
+    for path, crs, words in [(tmp_path / "c.ply", "EPSG:32633", "crs: only a LAS, LAZ, COPC or E57 output (.las, .laz, .copc.laz, .e57) holds"),
                              (tmp_path / "d.las", "EPSG:999999", "crs 'EPSG:999999': not a coordinate reference system")]:
         with pytest.raises(dpoint.Error) as raised:
             dpoint.write(s, path, crs=crs)
