@@ -513,6 +513,7 @@ Result<PointSet> sampleSurface(const PointSet& mesh, const SampleOptions& option
   out.z_axis = ZAxis::kPresent;
   out.z_up = mesh.z_up;
   out.color_full_scale = mesh.color_full_scale;
+  out.crs = mesh.crs;  // the surface's coordinate system is the points'
   std::vector<Placement> placements;
   sampler.placeAll(static_cast<uint64_t>(drawn), placements, out.positions);
   if (interrupted()) return interruptedError();
