@@ -1045,7 +1045,6 @@ struct LasPointStream::State {
   std::optional<LazChunks> laz;
   size_t cached_first = 0, cached_last = 0;  // chunks [first, last) in `cache`
   std::string cache;
-  std::vector<std::string> buffers;  // LAS: each core's records of a read
 
   explicit State(InputFile f) : file(std::move(f)) {}
 
@@ -1191,14 +1190,16 @@ Status LasPointStream::read(uint64_t first, uint64_t n, PointSet& block) {
     });
     return okStatus();
   }
-  // Each core reads its pieces into its own buffer, kept for the next block (no fresh pages).
-  st.buffers.resize(st.threads);
+  // Each core reads its pieces into its own buffer, for the whole read (fresh pages once a read and
+  // core, not for every piece). Freed after the read: a stream of many files holds none between
+  // reads (a review finding: kept, they grew with files × cores, past --max-memory).
+  std::vector<std::string> buffers(parallelWorkers(chunks, st.threads));
   std::mutex failed;
   std::optional<Error> error;
   size_t error_chunk = SIZE_MAX;
   parallelFor(chunks, st.threads, [&](size_t c, unsigned worker) {
     const size_t from = c * chunk, to = std::min(count, from + chunk);
-    std::string& buffer = st.buffers[worker];
+    std::string& buffer = buffers[worker];
     buffer.resize((to - from) * length);
     if (Status s = st.records(first + from, to - from, buffer.data()); !s) {
       std::lock_guard<std::mutex> lock(failed);

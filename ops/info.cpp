@@ -495,6 +495,7 @@ PointSetInfo computeInfo(const PointSet& points, size_t neighbor_sample, unsigne
 
   // The merge count needs 32-bit indices; larger sets are beyond the renderer anyway.
   if (info.float_overflow == 0 && points.size() <= UINT32_MAX) info.float_merged = countFloatMerges(points.positions, threads);
+  if (interrupted()) return info;  // unfinished: the caller checks (the trees below would run on)
 
   const size_t n = points.size();
   const size_t sample = std::min(n, std::max<size_t>(neighbor_sample, 1));

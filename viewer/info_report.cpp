@@ -240,7 +240,8 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   const Dimensions common = stream.commonDimensions();
   for (const Dimension& d : common.all()) report.dimensions.push_back({d.name, d.type, HUGE_VAL, -HUGE_VAL});
   std::vector<std::string> names;
-  for (const DimensionRange& d : report.dimensions) names.push_back(d.name);
+  if (options.stream_ranges)
+    for (const DimensionRange& d : report.dimensions) names.push_back(d.name);
   if (Status s = stream.streamDimensions(names); !s) return s.error();
   bool dimensions_streamed = !names.empty();
   const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& block) -> Status {
@@ -251,7 +252,7 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
     }
     if (Status s = stream.read(first, n, block); !s) return s;
     if (first == first_pass) {
-      for (size_t k = 0; k < report.dimensions.size(); ++k)
+      for (size_t k = 0; k < names.size(); ++k)  // none where the ranges are not read
         widenRange(report.dimensions[k], block.dimensions.all()[k], options.threads);
       first_pass += n;
       progress.advance(n);
@@ -290,15 +291,25 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (*stream) {
     InfoOptions streamed = options;  // z up for survey files, as render's --up-axis auto takes them
     streamed.z_up = zUpFor(viewRequest(options, inputs.paths));
-    uint64_t point_bytes = kStreamPointBytes;  // and the first pass's dimensions
+    uint64_t dimension_bytes = 0;  // the first pass's dimensions, a point
     const Dimensions common = (*stream)->commonDimensions();
-    for (const Dimension& d : common.all()) point_bytes += dimTypeSize(d.type);
-    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, point_bytes,
+    for (const Dimension& d : common.all()) dimension_bytes += dimTypeSize(d.type);
+    Result<uint64_t> block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, kStreamPointBytes + dimension_bytes,
                                                 (*stream)->heldBytes(), (*stream)->heldWhat());
+    if (!block && block.error().code == ExitCode::kResourceLimit && dimension_bytes > 0) {
+      // Their columns do not fit: the dimensions without their ranges, rather than no report (a
+      // review finding: 300 extra bytes a point made info refuse a file it described read whole).
+      block = checkStreamMemory(name, (*stream)->count(), inputs.max_memory, kStreamPointBytes, (*stream)->heldBytes(),
+                                (*stream)->heldWhat());
+      streamed.stream_ranges = false;
+    }
     if (!block) return block.error();
     streamed.stream_block = *block;
     Result<InfoReport> report = describeStream(**stream, name, streamed, progress);
     if (report) report->notices = (*stream)->notices();
+    if (report && !streamed.stream_ranges)
+      report->notices.push_back(name + ": the dimensions' ranges not read: their " + std::to_string(dimension_bytes) +
+                                " bytes a point do not fit --max-memory beside the blocks");
     return report;
   }
   std::vector<std::string> notices;

@@ -37,6 +37,9 @@ struct InfoOptions {
   // A stream's points a block (describeStream; the report is the same whatever it is):
   // streamBlockPoints of --max-memory; 0: viewer/render.h's kStreamBlockPoints.
   uint64_t stream_block = 0;
+  // The stream's first pass reads the dimensions every file has, for their ranges; false where
+  // their columns do not fit the block's memory (they are listed without ranges).
+  bool stream_ranges = true;
 };
 
 // Every mode's predicted error for one view (viewer/precision.h).

@@ -281,6 +281,31 @@ TEST(CliLas, e57CarriesTheCoordinateSystemToAndFromLas) {
   EXPECT_EQ(readPoints(dir.file("bad.e57"))->crs, "");
 }
 
+// Streamed info reads the dimensions' ranges in its first pass, as the whole read gives them; where
+// their columns do not fit --max-memory beside the blocks, it lists them without ranges and says
+// so, rather than refusing a file it can describe (a review finding).
+TEST(CliLas, streamedInfoGivesTheRangesOrSaysWhyNot) {
+  const std::string path = kCorpus + "extrabytes.las";  // 27 dimensions, 49 bytes a point
+  const test::CommandResult whole = runDpoint({"info", path, "--stream", "off"});
+  const test::CommandResult streamed = runDpoint({"info", path, "--stream", "on", "--max-memory", "1M"});
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+  const auto dimensionLines = [](const std::string& out) {
+    std::string lines;
+    for (size_t at = out.find("dimension:"); at != std::string::npos; at = out.find("dimension:", at + 1))
+      lines += out.substr(at, out.find('\n', at) + 1 - at);
+    return lines;
+  };
+  EXPECT_TRUE(test::contains(dimensionLines(whole.out), "dimension:          intensity (uint16) 0 .. 254\n")) << whole.out;
+  EXPECT_EQ(dimensionLines(whole.out), dimensionLines(streamed.out));
+  const test::CommandResult small = runDpoint({"info", path, "--stream", "on", "--max-memory", "100K"});
+  ASSERT_EQ(small.exit_code, 0) << small.err;
+  EXPECT_TRUE(test::contains(small.out, "dimension:          intensity (uint16)\n")) << small.out;
+  EXPECT_TRUE(test::contains(small.err, "extrabytes.las: the dimensions' ranges not read: their 49 bytes a point do not fit "
+                                        "--max-memory beside the blocks"))
+      << small.err;
+}
+
 // LAZ reads as the LAS it was compressed from (converters/laz_decode.h), by name or by its header.
 TEST(CliLas, lazConvertsInfosAndRendersAsItsLas) {
   TempDir dir;
