@@ -548,6 +548,7 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
     const size_t from = boxes.size(), added = static_cast<size_t>((n + box_points - 1) / box_points);
     boxes.resize(from + added);
     std::vector<size_t> overflow(workers, 0), nonfinite(workers, 0);
+    std::vector<Box> finite(added);  // each box's of its finite points (the box where all are)
     parallelFor(added, workers, [&](size_t k, unsigned worker) {
       const size_t lo = static_cast<size_t>(k * box_points), hi = std::min<size_t>(static_cast<size_t>(n), lo + box_points);
       boxes[from + k] = boundingBox(block.positions, lo, hi);
@@ -558,7 +559,17 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
           bad += !std::isfinite(block.positions[i][a]);
         }
       overflow[worker] += over, nonfinite[worker] += bad;
+      finite[k] = boxes[from + k];
+      if (bad == 0) return;
+      finite[k] = Box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)};
+      for (size_t i = lo; i < hi; ++i) {
+        const glm::dvec3& p = block.positions[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+        finite[k].min = glm::min(finite[k].min, p), finite[k].max = glm::max(finite[k].max, p);
+      }
     });
+    for (const Box& box : finite)
+      out.finite.min = glm::min(out.finite.min, box.min), out.finite.max = glm::max(out.finite.max, box.max);
     if (first == 0) noBounds(info);
     if (std::all_of(nonfinite.begin(), nonfinite.end(), [](size_t c) { return c == 0; })) {
       // min and max of finite values in any grouping: the boxes' are the points'.

@@ -2,6 +2,7 @@
 // would merge distinct points.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -51,6 +52,9 @@ struct StreamedInfo {
   // The box of every kStreamedInfoBoxPoints consecutive points, where the blocks are whole boxes
   // (else of every block): what the renderer's bound needs of a stream, for info's advice.
   std::vector<Box> boxes;
+  // The box of the points whose coordinates are all finite (min > max where none is): what a view
+  // frames where some are not (info.nonfinite), as the set read whole frames it.
+  Box finite{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)};
 };
 using BlockReader = std::function<Status(uint64_t first, uint64_t n, PointSet& block)>;
 Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64_t triangles, const BlockReader& read,

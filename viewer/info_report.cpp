@@ -270,10 +270,18 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   report.name = name;
   report.info = info->info;
   report.streamed = true;
-  if (boxes.count > 0) {
+  // A point with a nan or inf coordinate has no place in a view: the finite points' box is framed,
+  // as the set read whole frames them (a review finding: an inf framed an inf extent), and a set
+  // of none has no view.
+  Bounds framed = boxes.count > 0 ? boundsOfBoxes(boxes) : Bounds{};
+  if (report.info.nonfinite > 0) {
+    framed.min = info->finite.min, framed.max = info->finite.max;
+    framed.planar = framed.min.z == 0.0 && framed.max.z == 0.0;
+  }
+  if (boxes.count > 0 && framed.min.x <= framed.max.x) {
     // Without the outline `dpoint render` reads again for its fit: the boxes' box is framed, so
     // render's bounds of a 3D set may be somewhat larger (a closer fit).
-    if (Status s = adviseFor(report, options, boundsOfBoxes(boxes), false, [&](const Camera& camera) {
+    if (Status s = adviseFor(report, options, framed, false, [&](const Camera& camera) {
           return unboundedWithNonfinite(predictBoxBounds(boxes, camera, {}, options.tolerance_px), report.info);
         });
         !s)

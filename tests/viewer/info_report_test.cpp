@@ -120,7 +120,9 @@ TEST(InfoReport, nonFinitePositionsGiveWhatDpointInfoGivesWithAllowNonfinite) {
   EXPECT_EQ(runDpoint({"info", "--stream", "on", path}).exit_code, 2) << "refused without --allow-nonfinite";
   test::CommandResult streamed = runDpoint({"info", "--json", "--stream", "on", "--allow-nonfinite", path});
   ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
-  for (const char* line : {"\"points\": 4", "\"max\": [null, 5, 6.5]", "\"nonfinite_points\": 2", "\"streamed\": true"})
+  // The view frames the finite points, as read whole (it framed an inf extent: orthographic, a note).
+  for (const char* line : {"\"points\": 4", "\"max\": [null, 5, 6.5]", "\"nonfinite_points\": 2", "\"streamed\": true",
+                           "\"view\": {\"width\": 1024, \"height\": 768, \"ortho\": false, \"points_visible\": 4}"})
     EXPECT_TRUE(test::contains(streamed.out, line)) << line << "\n" << streamed.out;
   EXPECT_TRUE(test::contains(streamed.out, "\"error_bound_px\": {\"fp32\": null, \"split\": null, \"rte\": null, "
                                             "\"df64\": null, \"native\": null, \"batch\": null, \"adaptive\": null}"))
