@@ -330,21 +330,21 @@ Dimensions PointInputStream::commonDimensions() const {
 }
 
 Status PointInputStream::streamDimensions(const std::vector<std::string>& names) {
+  const Dimensions common = commonDimensions();  // their types: float64 where the files' differ
   std::vector<Dimension> streamed;
-  std::vector<std::vector<size_t>> which_of(parts_.size());
-  for (size_t p = 0; p < parts_.size(); ++p) {
-    const std::vector<Dimension>& all = parts_[p].dimensions().all();
-    std::vector<size_t>& which = which_of[p];
-    for (const std::string& name : names) {
-      const auto it = std::find_if(all.begin(), all.end(), [&](const Dimension& d) { return d.name == name; });
-      if (it == all.end()) return Error{"dimension '" + name + "' is not in every file streamed", ExitCode::kUsage};
-      which.push_back(static_cast<size_t>(it - all.begin()));
-      const size_t k = which.size() - 1;
-      if (streamed.size() == k) streamed.emplace_back(name, it->type);
-      else if (streamed[k].type != it->type) streamed[k].type = DimType::kF64;
-    }
+  for (const std::string& name : names) {
+    const Dimension* d = common.find(name);
+    if (!d) return Error{"dimension '" + name + "' is not in every file streamed", ExitCode::kUsage};
+    streamed.emplace_back(name, d->type);
   }
-  for (size_t p = 0; p < parts_.size(); ++p) parts_[p].streamDimensions(std::move(which_of[p]));
+  for (Part& part : parts_) {
+    const std::vector<Dimension>& all = part.dimensions().all();
+    std::vector<size_t> which;
+    for (const std::string& name : names)
+      which.push_back(static_cast<size_t>(
+          std::find_if(all.begin(), all.end(), [&](const Dimension& d) { return d.name == name; }) - all.begin()));
+    part.streamDimensions(std::move(which));
+  }
   streamed_ = std::move(streamed);
   return okStatus();
 }

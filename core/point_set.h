@@ -151,6 +151,9 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads);
 // (color_full_scale, las, z_axis) are the caller's.
 void appendPoints(PointSet& out, const PointSet& part);
 
+// Whether every coordinate is finite (no nan, no inf).
+inline bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
 // Smallest and largest coordinates of positions [first, last); asserts first < last.
 struct Box {
   glm::dvec3 min{0.0}, max{0.0};

@@ -47,9 +47,7 @@ std::pair<glm::dvec3, glm::dvec3> boxOf(std::span<const glm::dvec3> points) {
 class KdTree {
  public:
   explicit KdTree(std::span<glm::dvec3> points) {
-    const auto finite = std::partition(points.begin(), points.end(), [](const glm::dvec3& p) {
-      return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-    });
+    const auto finite = std::partition(points.begin(), points.end(), [](const glm::dvec3& p) { return isFinite(p); });
     pts_ = points.first(static_cast<size_t>(finite - points.begin()));
     axis_.assign(pts_.size(), 0);
     if (pts_.empty()) return;
@@ -178,16 +176,12 @@ size_t countFloatMerges(const PositionArray& positions, unsigned threads) {
     for (int k = 0; k < 3; ++k) h = (h ^ std::bit_cast<uint32_t>(f[k])) * 0x9E3779B97F4A7C15ull;
     return static_cast<unsigned>((h >> 40) & (buckets - 1));
   };
-  const auto finite = [&](size_t i) {
-    const glm::dvec3& p = positions[i];
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-  };
   // Each piece's count per bucket, then where its points of each bucket go.
   std::vector<uint32_t> counts(pieces * buckets, 0);
   parallelFor(pieces, threads, [&](size_t piece, unsigned) {
     uint32_t* c = counts.data() + piece * buckets;
     for (size_t i = piece * piece_points, end = std::min(n, i + piece_points); i < end; ++i)
-      if (finite(i)) ++c[bucketOf(as_float(static_cast<uint32_t>(i)))];
+      if (isFinite(positions[i])) ++c[bucketOf(as_float(static_cast<uint32_t>(i)))];
   });
   std::vector<size_t> bucket_begin(buckets + 1, 0), at(pieces * buckets);
   size_t total = 0;
@@ -200,7 +194,7 @@ size_t countFloatMerges(const PositionArray& positions, unsigned threads) {
   parallelFor(pieces, threads, [&](size_t piece, unsigned) {
     size_t* a = at.data() + piece * buckets;
     for (size_t i = piece * piece_points, end = std::min(n, i + piece_points); i < end; ++i)
-      if (finite(i)) order[a[bucketOf(as_float(static_cast<uint32_t>(i)))]++] = static_cast<uint32_t>(i);
+      if (isFinite(positions[i])) order[a[bucketOf(as_float(static_cast<uint32_t>(i)))]++] = static_cast<uint32_t>(i);
   });
   const auto less_float = [](const glm::vec3& a, const glm::vec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
@@ -233,7 +227,7 @@ size_t countFloatMerges(const PositionArray& positions, unsigned threads) {
 // NaN or not by the points' order).
 void addBounds(PointSetInfo& info, const PositionArray& positions) {
   for (const glm::dvec3& p : positions) {
-    info.nonfinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    info.nonfinite += !isFinite(p);
     for (int k = 0; k < 3; ++k) {
       if (std::isnan(p[k])) continue;
       info.min[k] = std::min(info.min[k], p[k]);
@@ -562,11 +556,9 @@ Result<StreamedInfo> computeStreamedInfo(uint64_t count, bool has_colors, uint64
       finite[k] = boxes[from + k];
       if (bad == 0) return;
       finite[k] = Box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)};
-      for (size_t i = lo; i < hi; ++i) {
-        const glm::dvec3& p = block.positions[i];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
-        finite[k].min = glm::min(finite[k].min, p), finite[k].max = glm::max(finite[k].max, p);
-      }
+      for (size_t i = lo; i < hi; ++i)
+        if (const glm::dvec3& p = block.positions[i]; isFinite(p))
+          finite[k].min = glm::min(finite[k].min, p), finite[k].max = glm::max(finite[k].max, p);
     });
     for (const Box& box : finite)
       out.finite.min = glm::min(out.finite.min, box.min), out.finite.max = glm::max(out.finite.max, box.max);

@@ -62,7 +62,7 @@ std::string shortest(const glm::dvec3& v) {
   return out;
 }
 
-bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+using dpoint::isFinite;  // core/point_set.h's, for a vector, beside this one for a matrix
 bool isFinite(const glm::dmat4& m) {
   for (int c = 0; c < 4; ++c)
     if (!isFinite(glm::dvec3(m[c])) || !std::isfinite(m[c].w)) return false;

@@ -214,9 +214,11 @@ Result<InfoReport> describePoints(const PointSet& points, const std::string& nam
   // A point with a nan or inf coordinate (--allow-nonfinite) has no place in a view: the view
   // frames the others, as a stream's boxes pass it over (it framed an inf extent, 0 points visible).
   PointSet finite;
-  if (report.info.nonfinite > 0)
+  if (report.info.nonfinite > 0) {
+    finite.positions.reserve(points.size() - report.info.nonfinite);
     for (const glm::dvec3& p : points.positions)
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) finite.positions.push_back(p);
+      if (isFinite(p)) finite.positions.push_back(p);
+  }
   const PointSet& framed = report.info.nonfinite > 0 ? finite : points;
   if (framed.size() > 0) {
     if (Status s = adviseFor(report, options, boundsWithOutline(framed), points.z_up, [&](const Camera& camera) {
