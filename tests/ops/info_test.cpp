@@ -73,6 +73,40 @@ TEST(Info, nearestNeighbourSkipsDuplicatesAndFindsTinySpacing) {
   EXPECT_EQ(i.min_neighbor_distance, 1e-40);
 }
 
+// Many copies of a few points (a scanner's returns at its origin, a set made from a grid) in no
+// order: the trees hold ranges of one point many times over, which a search visits once. The
+// nearest distance is still the set's own, here between two points beside a copied one; streamed
+// the same. (Before the build of 2026-12-02 a query visited every copy of its own point: 2M copies
+// beside one other point took minutes; `bench/results/2026-12-02/cpu/info-copies.md`.)
+TEST(Info, nearestNeighbourOfManyCopiesIsTheirNeighbours) {
+  PointSet s;
+  const glm::dvec3 a(6.378e6, 1.0, 2.0), b(-3.0, 4.0, 0.5), c(0.0, 0.0, 0.0);
+  for (int k = 0; k < 4000; ++k) s.positions.insert(s.positions.end(), {a, b, c});
+  // Beside a, a close pair: each nearer to the other than to a, so a search that took the copies'
+  // range for one point (the mutation x alone the same) misses the pair.
+  s.positions.push_back(a + glm::dvec3(0.0, 0.0, 0x1p-30));
+  s.positions.push_back(a + glm::dvec3(0.0, 0.0, 0x1p-30 + 0x1p-40));
+  for (int k = 0; k < 50; ++k) s.positions.emplace_back(k * 10.0, 100.0, 0.0);
+  std::mt19937 shuffle(5);
+  std::shuffle(s.positions.begin(), s.positions.end(), shuffle);
+  for (size_t sample : {size_t{10}, s.size()}) {
+    for (unsigned threads : {1u, 3u}) {
+      const PointSetInfo i = computeInfo(s, sample, threads);
+      // With every point a query, the pair finds each other; sampled sparsely, no nearer distance.
+      if (sample == s.size()) EXPECT_EQ(i.min_neighbor_distance, 0x1p-40) << threads;
+      else EXPECT_GE(i.min_neighbor_distance, 0x1p-40) << threads;
+      const BlockReader read = [&](uint64_t first, uint64_t n, PointSet& out) -> Status {
+        out.positions.assign(s.positions.begin() + static_cast<long>(first),
+                             s.positions.begin() + static_cast<long>(first + n));
+        return okStatus();
+      };
+      Result<StreamedInfo> streamed = computeStreamedInfo(s.size(), false, 0, read, 1000, sample, threads);
+      ASSERT_TRUE(streamed.ok());
+      EXPECT_EQ(streamed->info.min_neighbor_distance, i.min_neighbor_distance) << threads;
+    }
+  }
+}
+
 TEST(Info, overflowBeyondFloatRange) {
   PointSet s;
   s.positions = {{1e39, 0, 0}, {0, 0, 0}};
