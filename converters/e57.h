@@ -84,6 +84,8 @@ class E57PointStream {
   const Dimensions& dimensions() const;
   // readE57's notes: points left out, intensities read as 0..1, images, what the join fills in.
   const std::vector<std::string>& notices() const;
+  // The file's coordinate system (coordinateMetadata, as readE57's PointSet::crs); empty: none.
+  const std::string& crs() const;
   // Host bytes the stream holds beside its blocks: the packets' places, the points' counts.
   uint64_t heldBytes() const;
   // From now on read() also fills these of dimensions() (by index) into the block; none by default.

@@ -1245,6 +1245,7 @@ struct E57PointStream::State {
   size_t source_id = SIZE_MAX;  // the index of point_source_id in dimensions where it is the scan numbers
   Dimensions dimensions;
   std::vector<std::string> notices;
+  std::string crs;  // coordinateMetadata, as readE57 keeps it
   std::vector<size_t> streamed;  // dimensions read() fills, by index
   // Where the last read ended: the scan, its next record and the point that record may be.
   size_t at_scan = SIZE_MAX;
@@ -1310,6 +1311,7 @@ uint64_t E57PointStream::count() const { return state_->count; }
 bool E57PointStream::hasColors() const { return state_->colors; }
 const Dimensions& E57PointStream::dimensions() const { return state_->dimensions; }
 const std::vector<std::string>& E57PointStream::notices() const { return state_->notices; }
+const std::string& E57PointStream::crs() const { return state_->crs; }
 uint64_t E57PointStream::heldBytes() const { return state_->held; }
 void E57PointStream::streamDimensions(std::vector<size_t> which) {
   state_->streamed = std::move(which);
@@ -1338,6 +1340,7 @@ Result<std::unique_ptr<E57PointStream>> E57PointStream::open(InputFile input, co
   st.budget = limit / 4;  // the fields' bytes of a block's packets: a window's worth as writers spread them
   Result<FileTree> tree = readTree(*st.paged, threads);
   if (!tree) return tree.error();
+  st.crs = tree->crs;
   const bool intensity_fractions = intensityFractions(tree->scans);
   size_t with_records = 0;
   for (size_t k = 0; k < tree->scans.size(); ++k) {

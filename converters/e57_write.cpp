@@ -31,16 +31,9 @@ constexpr size_t kPacketsPerBatch = 256;
 std::string coordinateMetadata(const PointSet& points, const E57WriteOptions& options, std::vector<std::string>& notes) {
   std::string crs = !options.crs.empty() ? options.crs : points.crs;
   if (crs.empty() && points.las) {
-    std::vector<LasVlr> records;
-    for (const LasVlr& vlr : points.las->vlrs)
-      if (isLasCrsRecord(vlr)) records.push_back(vlr);
-    if (!records.empty()) {
-      LasWktCrs wkt = lasWktCrs(records, lasSaysWkt(*points.las));
-      const auto it = std::find_if(wkt.records.begin(), wkt.records.end(), [](const LasVlr& r) { return r.record_id == 2112; });
-      if (it != wkt.records.end()) crs.assign(it->data.c_str());  // up to a NUL that ends it
-      else if (!wkt.note.empty()) notes.push_back("coordinate system not written: " + wkt.note);
-      else notes.push_back("coordinate system not written: the LAS source's is not WKT and PROJ made none of it");
-    }
+    std::string why_not;
+    crs = lasSourceWkt(*points.las, why_not);
+    if (!why_not.empty()) notes.push_back("coordinate system not written: " + why_not);
   }
   for (size_t i = 0; i < crs.size(); ++i) {
     const auto c = static_cast<unsigned char>(crs[i]);

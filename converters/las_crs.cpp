@@ -449,6 +449,18 @@ bool isLiblasText(const LasVlr& v) { return isLiblasWkt(v) && !wktText(v.data).e
 
 }  // namespace
 
+std::string lasSourceWkt(const LasSource& source, std::string& why_not) {
+  std::vector<LasVlr> records;
+  for (const LasVlr& vlr : source.vlrs)
+    if (isLasCrsRecord(vlr)) records.push_back(vlr);
+  if (records.empty()) return "";
+  LasWktCrs wkt = lasWktCrs(records, lasSaysWkt(source));
+  const auto it = std::find_if(wkt.records.begin(), wkt.records.end(), [](const LasVlr& r) { return r.record_id == 2112; });
+  if (it != wkt.records.end()) return std::string(it->data.c_str());  // up to a NUL that ends it
+  why_not = !wkt.note.empty() ? wkt.note : "the LAS source's is not WKT and PROJ made none of it";
+  return "";
+}
+
 LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit) {
   // The source's CRS, as LAS says which record holds it: the WKT record where the global encoding
   // says WKT, else the GeoTIFF keys (a LAS 1.2 file's), else a WKT record all the same, else

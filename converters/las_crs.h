@@ -41,6 +41,11 @@ struct LasWktCrs {
 // out, with a note saying why.
 LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit);
 
+// A LAS source's coordinate system as one WKT text, for a format that holds WKT (E57, PCD, PLY):
+// its WKT record's, or its GeoTIFF keys made WKT by PROJ (lasWktCrs's choice). Empty where it has
+// no CRS records, or (with why in `why_not`) none that can be made WKT.
+std::string lasSourceWkt(const LasSource& source, std::string& why_not);
+
 // The CRS that `text` gives (EPSG:CODE or another authority's code, WKT 1 or 2, PROJJSON, or the
 // path of a file holding one, such as a .prj), as one line of OGC WKT 1 for a LAS WKT record
 // (`--crs`). The error says why not, naming `option` and the text.

@@ -54,6 +54,9 @@ struct PcdWriteOptions {
   Progress* progress = nullptr;
   std::vector<std::string>* notices = nullptr;  // coordinates written as double
   unsigned threads = 0;  // ASCII rows formatted on this many cores (0: all); the bytes do not depend on it
+  // The coordinate system the header states (`# dpoint: crs` lines) where the set has none of its
+  // own (PointSet::crs): a LAS source's made WKT (writePoints); null: none.
+  const std::string* crs = nullptr;
 };
 
 Result<PointSet> readPcd(const std::string& path, const PcdReadOptions& options = {});

@@ -53,6 +53,8 @@ struct Header {
   uint64_t lines = 0;        // the DATA line's number
   size_t row_bytes = 0;
   bool has_z = false, two_d = false, z_up = false, colors = false, alpha = false;
+  std::string crs;        // `# dpoint: crs` lines' bytes
+  bool crs_good = true;   // every one hex
   std::string viewpoint;  // the VIEWPOINT line when it is not the identity
   std::optional<std::array<double, 7>> pose;  // its values
   std::vector<std::pair<std::string, DimType>> dimensions;
@@ -131,6 +133,10 @@ class HeaderParser {
       if (tokens[0][0] == '#') {
         if (text.find("dpoint: 2D") != std::string_view::npos) header_.two_d = true;
         if (text.find("dpoint: up axis z") != std::string_view::npos) header_.z_up = true;
+        // The coordinate system another format stated (pcd_write.cpp), in hex over lines in order;
+        // left out where a line is bad.
+        if (tokens.size() == 4 && tokens[0] == "#" && tokens[1] == "dpoint:" && tokens[2] == "crs")
+          header_.crs_good = appendHexBytes(header_.crs, tokens[3]) && header_.crs_good;
         continue;
       }
       Status s = entry(tokens);
@@ -455,6 +461,7 @@ class Reader {
     points.color_full_scale = h_.colors ? 255 : 0;
     points.z_axis = h_.has_z && !h_.two_d ? ZAxis::kPresent : ZAxis::kAbsent;
     points.z_up = h_.z_up;
+    if (h_.crs_good) points.crs = h_.crs;
     if (options_.progress) options_.progress->start("reading " + path_, n);
 
     Columns columns(points);

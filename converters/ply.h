@@ -184,6 +184,8 @@ class PlyVertexStream {
   // and a stream can only clamp block by block.
   bool floatColors() const;
   uint64_t faceCount() const;  // the header's `face` rows (0 without the element)
+  // The coordinate system its header states (`comment dpoint: crs`, as readPly's PointSet::crs).
+  const std::string& crs() const;
   // The vertex properties that are dimensions, as empty columns (names and types).
   const Dimensions& dimensions() const;
   // From now on read() also fills these of dimensions() (by index) into the block; none by default.

@@ -369,6 +369,7 @@ class PlyParser {
     return okStatus();  // planElements found a vertex element
   }
   uint64_t vertexCount() const { return vertex_count_; }
+  const std::string& crs() const { return points_.crs; }  // the header's, once read
   bool hasColors() const { return has_colors_; }
   bool floatColors() const { return has_colors_ && divisor_[kRed] == 1.0f && !tile_; }
   // The vertex properties that are dimensions (empty columns: names and types).
@@ -524,12 +525,7 @@ class PlyParser {
                     std::from_chars(w[6].data(), w[6].data() + w[6].size(), record_id).ec == std::errc() &&
                     (w[7] == "0" || w[7] == "1") && hex.size() % 2 == 0 && w[5].size() <= 16 && index < 1024;
           std::string bytes;
-          const auto nibble = [](char c) { return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1; };
-          for (size_t k = 0; ok && k < hex.size(); k += 2) {
-            const int hi = nibble(hex[k]), lo = nibble(hex[k + 1]);
-            ok = hi >= 0 && lo >= 0;
-            bytes.push_back(static_cast<char>(hi * 16 + lo));
-          }
+          ok = ok && appendHexBytes(bytes, hex);
           if (crs_records_.size() <= index) crs_records_.resize(index + 1);
           auto& [vlr, good] = crs_records_[index];
           if (vlr.user_id.empty()) {  // its first line
@@ -539,12 +535,16 @@ class PlyParser {
           good = good && ok && vlr.user_id == w[5] && vlr.record_id == record_id;
           vlr.data += bytes;
         }
+        // The coordinate system another format stated, in hex over lines in order; left out where
+        // a line is bad.
+        if (w.size() == 4 && w[2] == "crs") crs_good_ = appendHexBytes(crs_, w[3]) && crs_good_;
       }
       if (key == "comment" || key == "obj_info") continue;
       if (key == "end_header") {
         if (points_.las)
           for (auto& [vlr, good] : crs_records_)
             if (good) points_.las->vlrs.push_back(std::move(vlr));
+        if (crs_good_) points_.crs = std::move(crs_);
         break;
       }
       if (key == "format") {
@@ -1427,6 +1427,8 @@ class PlyParser {
   bool integer_colours_ = false;  // the header's `comment dpoint: colours 0..255`
   bool tile_ = false;  // the header's `comment dpoint-tile I/N` (kPlyTileCommentWord)
   std::vector<std::pair<LasVlr, bool>> crs_records_;  // the header's `las crs` records, each whole or not
+  std::string crs_;        // the header's `crs` lines' bytes so far
+  bool crs_good_ = true;   // and whether every one was hex
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;
   uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)
@@ -1476,6 +1478,7 @@ uint64_t PlyVertexStream::count() const { return state_->parser.vertexCount(); }
 bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
 bool PlyVertexStream::floatColors() const { return state_->parser.floatColors(); }
 uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
+const std::string& PlyVertexStream::crs() const { return state_->parser.crs(); }
 const Dimensions& PlyVertexStream::dimensions() const { return state_->parser.dimensions(); }
 void PlyVertexStream::streamDimensions(std::vector<size_t> which) { state_->parser.streamDimensions(std::move(which)); }
 Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {

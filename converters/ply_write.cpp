@@ -31,6 +31,7 @@ uint16_t colorWord(float c) { return colorInteger(c, 65535.0); }
 // every z 0, as random2d and mandelbrot2d make theirs), and z as the up axis (LAS). Without the first,
 // a 2D set written as PLY would come back as a 3D one and convert to a 3-column CSV.
 std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
+  static constexpr size_t kCrsLineBytes = 400;  // 800 hex digits: a header line well under 1,024 bytes
   std::string facts;
   if (!has_z) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
   if (points.z_up) facts += "comment dpoint: up axis z\n";
@@ -53,21 +54,20 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
     // Its CRS records, byte for byte in hex, so that LAS → PLY → LAS keeps its coordinate system:
     // record K over lines "las crs K USER ID EXTENDED HEX" of at most 800 hex digits each ('-':
     // no bytes), as Open3D's PLY reader (RPly) stops at a header line over 1,024 bytes.
-    static constexpr size_t kLineBytes = 400;
+    static constexpr size_t kLineBytes = kCrsLineBytes;
     for (size_t k = 0; k < l.vlrs.size(); ++k) {
       const LasVlr& vlr = l.vlrs[k];
       if (vlr.user_id.empty() || vlr.user_id.find_first_of(" \t\r\n") != std::string::npos) continue;
       const std::string head = "comment dpoint: las crs " + std::to_string(k) + ' ' + vlr.user_id + ' ' +
                                std::to_string(vlr.record_id) + ' ' + (vlr.extended ? '1' : '0') + ' ';
-      for (size_t at = 0; at < vlr.data.size() || at == 0; at += kLineBytes) {
-        facts += head;
-        for (size_t i = at; i < std::min(vlr.data.size(), at + kLineBytes); ++i)
-          appendHexDigits(facts, static_cast<unsigned char>(vlr.data[i]));
-        if (vlr.data.empty()) facts += '-';
-        facts += '\n';
-      }
+      std::vector<std::string> pieces = hexPieces(vlr.data, kLineBytes);
+      if (pieces.empty()) pieces.emplace_back("-");
+      for (const std::string& piece : pieces) facts += head + piece + '\n';
     }
   }
+  // The coordinate system another format stated (E57's), byte for byte: lines "crs HEX" in order,
+  // so that E57 → PLY → LAS keeps it.
+  for (const std::string& piece : hexPieces(points.crs, kCrsLineBytes)) facts += "comment dpoint: crs " + piece + '\n';
   return facts;
 }
 

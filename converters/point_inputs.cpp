@@ -158,6 +158,8 @@ struct PointInputStream::Part {
   uint64_t fileCount() const { return ply ? ply->count() : las ? las->count() : e57->count(); }
   bool hasColors() const { return ply ? ply->hasColors() : las ? las->hasColors() : e57->hasColors(); }
   uint64_t faceCount() const { return ply ? ply->faceCount() : 0; }
+  // The coordinate system a PLY or E57 file states; a LAS file's records are not one (las.h).
+  std::string crs() const { return ply ? ply->crs() : e57 ? e57->crs() : std::string(); }
   const Dimensions& dimensions() const { return ply ? ply->dimensions() : las ? las->dimensions() : e57->dimensions(); }
   void streamDimensions(std::vector<size_t> which) {
     if (ply) ply->streamDimensions(std::move(which));
@@ -288,6 +290,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     stream->count_ += part.count;
     if (part.count > 0) stream->has_colors_ = stream->has_colors_ || part.hasColors();
     stream->faces_ += part.faceCount();
+    if (stream->crs_.empty()) stream->crs_ = part.crs();  // the first part's that states one, as readPointInputs
     stream->parts_.push_back(std::move(part));
   }
   if (set->whole) {

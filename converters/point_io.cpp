@@ -268,9 +268,22 @@ double writtenColorScale(const std::string& path, FileFormat format, const Point
   }
 }
 
+// Whether a LAS source's records state a coordinate system.
+bool hasLasCrsRecords(const PointSet& points) {
+  return points.las && std::any_of(points.las->vlrs.begin(), points.las->vlrs.end(), isLasCrsRecord);
+}
+
+// Whether the set states a coordinate system: its own (PointSet::crs), or a LAS source's records.
+bool statesCrs(const PointSet& points) { return !points.crs.empty() || hasLasCrsRecords(points); }
+
 Status writeFormat(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options) {
   if ((options.colors_of || options.positions_of) && format != FileFormat::kPly)
     return Error{path + ": points made as the rows are written go to a .ply only"};
+  // CSV and glTF have no place for it: said, not lost unseen.
+  if ((format == FileFormat::kCsv || format == FileFormat::kGlb) && options.notices && statesCrs(points))
+    options.notices->push_back(path + ": coordinate system not written: " +
+                               (format == FileFormat::kCsv ? "CSV" : "GLB") +
+                               " holds none (.las, .laz, .e57, .ply and .pcd keep it)");
   switch (format) {
     case FileFormat::kCsv:
       return writeCsv(path, points,
@@ -280,9 +293,14 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       return writePly(path, points,
                       PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
                                       options.colors_of, options.positions_of, options.notices});
-    case FileFormat::kPcd:
+    case FileFormat::kPcd: {
+      // A LAS source's records as WKT, as E57 takes them (PCD's header holds text, not records).
+      std::string crs, why_not;
+      if (points.crs.empty() && points.las) crs = lasSourceWkt(*points.las, why_not);
+      if (!why_not.empty() && options.notices) options.notices->push_back(path + ": coordinate system not written: " + why_not);
       return writePcd(path, points,
-                      PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads});
+                      PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads, &crs});
+    }
     case FileFormat::kGlb:
     {
       GlbWriteReport report;
@@ -313,10 +331,10 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       las.progress = options.progress;
       las.report = &report;
       las.crs_wkt = options.las_crs;
-      // A coordinate system another format stated (an E57 file's), where no LAS source's and no
-      // --crs is given: made WKT by PROJ, or left out with a note.
+      // A coordinate system another format stated (an E57 file's, or the module's `crs`), where no
+      // LAS source's records and no --crs give one: made WKT by PROJ, or left out with a note.
       std::string crs_note;
-      if (las.crs_wkt.empty() && !points.las && !points.crs.empty()) {
+      if (las.crs_wkt.empty() && !hasLasCrsRecords(points) && !points.crs.empty()) {
         Result<std::string> wkt = crsAsWkt(points.crs, "the input's coordinate system");
         if (wkt) las.crs_wkt = std::move(*wkt);
         else crs_note = path + ": coordinate system not written: " + wkt.error().message;

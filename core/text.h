@@ -39,6 +39,30 @@ inline void appendHexDigits(std::string& out, unsigned char c) {
   out += kHex[c & 15];
 }
 
+// Bytes as lower-case hex digits in pieces of at most `piece_bytes` bytes each (header comment
+// lines: Open3D's PLY and PCD readers stop at a line over 1,024 bytes); none for no bytes.
+inline std::vector<std::string> hexPieces(std::string_view bytes, size_t piece_bytes) {
+  std::vector<std::string> pieces;
+  for (size_t at = 0; at < bytes.size(); at += piece_bytes) {
+    std::string& piece = pieces.emplace_back();
+    for (size_t i = at; i < std::min(bytes.size(), at + piece_bytes); ++i) appendHexDigits(piece, static_cast<unsigned char>(bytes[i]));
+  }
+  return pieces;
+}
+
+// Appends the bytes that lower- or upper-case hex digits spell; false, appending nothing, where
+// `hex` is not an even number of them.
+inline bool appendHexBytes(std::string& out, std::string_view hex) {
+  const auto nibble = [](char c) {
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+  };
+  if (hex.size() % 2 != 0) return false;
+  for (char c : hex)
+    if (nibble(c) < 0) return false;
+  for (size_t k = 0; k < hex.size(); k += 2) out += static_cast<char>(nibble(hex[k]) * 16 + nibble(hex[k + 1]));
+  return true;
+}
+
 // A byte as \xNN, how a message shows a control byte or a byte that is not UTF-8 so that it stays
 // one printable line.
 inline void appendHexByte(std::string& out, unsigned char c) {

@@ -242,13 +242,13 @@ py::tuple pointSetState(const PointSet& s) {
                         bytes(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
                         bytes(s.triangles.data(), s.triangles.size() * sizeof(uint32_t)), dims,
                         s.color_full_scale, static_cast<int>(s.z_axis), s.z_up, las,
-                        viewpointObject(s.viewpoint), s.colors_read_as_fractions);
+                        viewpointObject(s.viewpoint), s.colors_read_as_fractions, py::bytes(s.crs));
 }
 
 std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
-  // 10 items since the viewpoint, 11 since colors_read_as_fractions; a pickle of 9 or 10 (made
-  // before) loads without them.
-  if (t.size() < 9 || t.size() > 11 || t[0].cast<int>() != 1)
+  // 10 items since the viewpoint, 11 since colors_read_as_fractions, 12 since the CRS; a pickle of
+  // 9 to 11 (made before) loads without them.
+  if (t.size() < 9 || t.size() > 12 || t[0].cast<int>() != 1)
     throw py::value_error("PointSet: not a pickle of this version's PointSet");
   auto s = std::make_shared<PointSet>();
   const auto fill = [](const py::handle& from, auto& to) {
@@ -279,6 +279,7 @@ std::shared_ptr<PointSet> pointSetFromState(const py::tuple& t) {
   s->z_up = t[7].cast<bool>();
   if (t.size() >= 10) s->viewpoint = viewpointOf(t[9].cast<std::optional<std::vector<double>>>(), "PointSet: a pickled viewpoint");
   if (t.size() >= 11) s->colors_read_as_fractions = t[10].cast<bool>() && !s->colors.empty();
+  if (t.size() >= 12) s->crs = t[11].cast<std::string>();
   if (!t[8].is_none()) {
     const py::tuple l = t[8].cast<py::tuple>();
     LasSource las;
@@ -567,6 +568,27 @@ that memory, without copying (writing into them changes the set).)")
           "z_up", [](const py::object& self) { return setOf(self).z_up; },
           [](const py::object& self, bool z_up) { setOf(self).z_up = z_up; },
           "The source says z is up (LAS): render's fitted views use it")
+      .def_property(
+          "crs",
+          [](const py::object& self) -> py::object {
+            const PointSet& s = setOf(self);
+            std::string text = s.crs, why_not;
+            if (text.empty() && s.las) text = lasSourceWkt(*s.las, why_not);
+            if (text.empty()) return py::none();
+            // Bytes that are not UTF-8 (a PLY header's hex may spell any) as surrogates, not an error.
+            return py::reinterpret_steal<py::object>(
+                PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "surrogateescape"));
+          },
+          [](const py::object& self, const std::optional<std::string>& crs) {
+            PointSet& s = setOf(self);
+            s.crs = crs.value_or("");
+            if (s.las)  // the source's records give way to it
+              std::erase_if(s.las->vlrs, [](const LasVlr& vlr) { return isLasCrsRecord(vlr); });
+          },
+          "The coordinate system the source states, as text (an E57 file's coordinateMetadata, a LAS file's\n"
+          "records as WKT, made by PROJ from GeoTIFF keys), or None. Set it (WKT, or any text: E57, PLY and\n"
+          "PCD keep it as it is, LAS takes what PROJ makes WKT of, as convert's --crs) or None to state none;\n"
+          "it replaces a LAS source's records")
       .def_property(
           "viewpoint",
           [](const py::object& self) { return viewpointObject(setOf(self).viewpoint); },

@@ -292,6 +292,39 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   return report;
 }
 
+// Whether any of `paths` is a LAS or LAZ file (its own CRS records, not PointSet::crs).
+bool anyLasPath(const std::vector<std::string>& paths) {
+  return std::any_of(paths.begin(), paths.end(), [](const std::string& path) {
+    Result<FileFormat> format = formatOf(path);
+    return format && (*format == FileFormat::kLas || *format == FileFormat::kLaz);
+  });
+}
+
+// What a single LAS or LAZ file states beside its points, for the report: its header, whether its
+// bounds hold the points `info` found, and its CRS records' summary. `vlrs` and `source` are the
+// records and frame a whole read kept; null: read here from the file (a streamed read).
+Result<std::optional<LasFacts>> lasFactsOf(const std::vector<std::string>& paths, const PointSetInfo& info,
+                                           const LasSource* source) {
+  if (paths.size() != 1 || !anyLasPath(paths)) return std::optional<LasFacts>();
+  Result<LasHeader> header = readLasHeader(paths[0]);
+  if (!header) return header.error();
+  const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
+  std::string crs;
+  if (source) {
+    crs = lasCrsSummary(source->vlrs, lasSaysWkt(*source));
+  } else {
+    Result<InputFile> file = InputFile::open(paths[0]);
+    if (!file) return file.error();
+    Result<std::vector<LasVlr>> vlrs = readLasCrsRecords(*file);
+    if (!vlrs) return vlrs.error();
+    LasSource frame;
+    frame.point_format = header->point_format;
+    frame.global_encoding = header->global_encoding;
+    crs = lasCrsSummary(*vlrs, lasSaysWkt(frame));
+  }
+  return std::optional<LasFacts>(LasFacts{std::move(*header), bounds_hold, std::move(crs)});
+}
+
 Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& options, Progress& progress) {
   if (inputs.paths.empty()) return Error{"info: no input files", ExitCode::kUsage};
   Result<std::unique_ptr<PointInputStream>> stream = openPointStream(inputs.paths, inputs.stream, options.threads, inputs.max_memory,
@@ -316,8 +349,15 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
     if (!block) return block.error();
     streamed.stream_block = *block;
     Result<InfoReport> report = describeStream(**stream, name, streamed, progress);
-    if (report) report->notices = (*stream)->notices();
-    if (report && !streamed.stream_ranges)
+    if (!report) return report;
+    report->notices = (*stream)->notices();
+    // What the files state, as the whole read gives it (a set streamed had no CRS and no LAS header
+    // facts before the build of 2026-12-02).
+    if (!anyLasPath(inputs.paths)) report->crs = (*stream)->crs();
+    Result<std::optional<LasFacts>> las = lasFactsOf(inputs.paths, report->info, nullptr);
+    if (!las) return las.error();
+    report->las = std::move(*las);
+    if (!streamed.stream_ranges)
       report->notices.push_back(name + ": the dimensions' ranges not read: their " + std::to_string(dimension_bytes) +
                                 " bytes a point do not fit --max-memory beside the blocks");
     return report;
@@ -345,23 +385,15 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
     points = scenes ? readInput(inputs.paths[0], read, gltf) : readPointInputs(inputs.paths, read);
   }
   if (!points) return points.error();
-  std::optional<LasHeader> header;  // one LAS file: its header too
-  if (Result<FileFormat> format = formatOf(inputs.paths[0]);
-      inputs.paths.size() == 1 && format && (*format == FileFormat::kLas || *format == FileFormat::kLaz)) {
-    Result<LasHeader> las = readLasHeader(inputs.paths[0]);
-    if (!las) return las.error();
-    header = std::move(*las);
-  }
   Result<InfoReport> report = describePoints(*points, name, options);
   if (!report) return report;
   report->copc = copc;
   report->notices = std::move(notices);
   if (!points->las) report->crs = points->crs;
-  if (header) {
-    const PointSetInfo& info = report->info;
-    const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
-    report->las = LasFacts{std::move(*header), bounds_hold, points->las ? lasCrsSummary(points->las->vlrs, lasSaysWkt(*points->las)) : ""};
-  }
+  const LasSource none;  // a LAS file read whole keeps its records; without them, none
+  Result<std::optional<LasFacts>> las = lasFactsOf(inputs.paths, report->info, points->las ? &*points->las : &none);
+  if (!las) return las.error();
+  report->las = std::move(*las);
   return report;
 }
 

@@ -281,6 +281,81 @@ TEST(CliLas, e57CarriesTheCoordinateSystemToAndFromLas) {
   EXPECT_EQ(readPoints(dir.file("bad.e57"))->crs, "");
 }
 
+// The coordinate system through PLY and PCD, whose headers carry it in hex comment lines (byte for
+// byte: WKT over many lines, "]]>", UTF-8); a LAS source's to PCD as WKT, back to LAS as its EPSG
+// code. Streamed info states it as the whole read does, and a LAS file's header facts. CSV and GLB
+// hold none, and say so. (Before the build of 2026-12-02, E57 → PLY → LAS and LAS → PCD → LAS lost
+// it without a word, and streamed info stated none.)
+TEST(CliLas, theCoordinateSystemSurvivesPlyAndPcdAndStreamedInfoStatesIt) {
+  TempDir dir;
+  ASSERT_EQ(runDpoint({"convert", kCorpus + "autzen.las", "-o", dir.file("a.e57"), "-q"}).exit_code, 0);
+  for (const char* via : {"a.ply", "a.pcd"}) {
+    SCOPED_TRACE(via);
+    ASSERT_EQ(runDpoint({"convert", dir.file("a.e57"), "-o", dir.file(via), "-q"}).exit_code, 0);
+    EXPECT_EQ(readPoints(dir.file(via))->crs, readPoints(dir.file("a.e57"))->crs);
+    ASSERT_EQ(runDpoint({"convert", dir.file(via), "-o", dir.file("back.las"), "-q"}).exit_code, 0);
+    test::CommandResult info = runDpoint({"info", dir.file("back.las"), "--quiet"});
+    EXPECT_TRUE(test::contains(info.out, "LAS CRS:            EPSG:2994 (")) << info.out;
+  }
+  test::CommandResult r = runDpoint({"convert", kCorpus + "autzen.las", "-o", dir.file("l.pcd")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(runDpoint({"convert", dir.file("l.pcd"), "-o", dir.file("l.las"), "-q"}).exit_code, 0);
+  EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("l.las"), "--quiet"}).out, "LAS CRS:            EPSG:2994 ("));
+
+  // Any text, as it is, in both headers; a PLY line whose hex is bad leaves it out, not the file.
+  PointSet site;
+  site.positions = {{1.0, 2.0, 3.0}, {4.0, 5.0, 6.0}};
+  site.crs = "LOCAL_CS[\"Höhe ]]> grid\",\n  UNIT[\"metre\",1]]\n" + std::string(1500, 'x');
+  for (const char* name : {"s.ply", "s.pcd"}) {
+    ASSERT_TRUE(writePoints(dir.file(name), site).ok());
+    Result<PointSet> back = readPoints(dir.file(name));
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->crs, site.crs) << name;
+    const std::string bytes = readFile(dir.file(name));
+    for (size_t at = 0, end; (end = bytes.find('\n', at)) != std::string::npos && bytes.compare(at, 10, "end_header") != 0 &&
+                             bytes.compare(at, 4, "DATA") != 0;
+         at = end + 1)
+      EXPECT_LT(end - at, 1024u) << name << ": a header line Open3D would stop at";
+  }
+  std::string ply = readFile(dir.file("s.ply"));
+  ply.replace(ply.find("comment dpoint: crs ") + 20, 2, "zz");
+  writeFile(dir.file("bad.ply"), ply);
+  Result<PointSet> bad = readPoints(dir.file("bad.ply"));
+  ASSERT_TRUE(bad) << bad.error().message;
+  EXPECT_EQ(bad->crs, "");
+  EXPECT_EQ(bad->positions, site.positions);
+
+  // Streamed, as read whole.
+  for (const char* name : {"a.e57", "a.ply"}) {
+    const test::CommandResult whole = runDpoint({"info", dir.file(name), "--stream", "off", "--json", "--quiet"});
+    const test::CommandResult streamed = runDpoint({"info", dir.file(name), "--stream", "on", "--json", "--quiet"});
+    ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+    const auto crsLine = [](const std::string& out) {
+      const size_t at = out.find("\n  \"crs\": ");
+      return at == std::string::npos ? std::string() : out.substr(at, out.find('\n', at + 1) - at);
+    };
+    EXPECT_TRUE(test::contains(crsLine(whole.out), "NAD83(HARN) / Oregon GIC Lambert (ft)")) << whole.out;
+    EXPECT_EQ(crsLine(streamed.out), crsLine(whole.out)) << name;
+  }
+  for (const std::string& las : {kCorpus + "autzen.las", kCorpus + "simple.laz"}) {
+    const auto lasLines = [](const std::string& out) { return out.substr(out.find("LAS:"), out.find("LAS CRS:") - out.find("LAS:")); };
+    const test::CommandResult whole = runDpoint({"info", las, "--stream", "off", "--quiet"});
+    const test::CommandResult streamed = runDpoint({"info", las, "--stream", "on", "--quiet"});
+    ASSERT_TRUE(test::contains(streamed.out, "LAS CRS:")) << streamed.out;
+    EXPECT_EQ(lasLines(streamed.out), lasLines(whole.out)) << las;
+    const auto crsOf = [](const std::string& out) { return out.substr(out.find("LAS CRS:"), out.find('\n', out.find("LAS CRS:")) - out.find("LAS CRS:")); };
+    EXPECT_EQ(crsOf(streamed.out), crsOf(whole.out)) << las;
+  }
+
+  for (const char* name : {"l.csv", "l.glb"}) {
+    r = runDpoint({"convert", kCorpus + "autzen.las", "-o", dir.file(name)});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::contains(r.err, std::string(name) + ": coordinate system not written: ")) << r.err;
+  }
+  r = runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("none.csv")});  // no CRS records: nothing to say
+  EXPECT_FALSE(test::contains(r.err, "coordinate system")) << r.err;
+}
+
 // Streamed info reads the dimensions' ranges in its first pass, as the whole read gives them; where
 // their columns do not fit --max-memory beside the blocks, it lists them without ranges and says
 // so, rather than refusing a file it can describe (a review finding).

@@ -1,5 +1,7 @@
 """dpoint.read and dpoint.write: every format round-trips, every option writes the bytes `dpoint
 convert` writes with the same option, and the limits and refusals are convert's."""
+import pathlib
+
 import numpy as np
 import pytest
 
@@ -76,6 +78,33 @@ def test_las_takes_a_crs_as_convert_does(tmp_path, cloud):
         assert words in str(raised.value)
         assert raised.value.exit_code == 1
         assert not path.exists()
+
+
+@pytest.mark.filterwarnings("ignore:.*written as double")
+def test_a_sets_crs_is_read_set_pickled_and_written(tmp_path, cloud):
+    """PointSet.crs: a LAS file's records as WKT (pyproj judges it), an E57's text, kept by pickle and
+    by PLY and PCD; set, it replaces a LAS source's records."""
+    import pickle
+    pyproj = pytest.importorskip("pyproj")
+    las_corpus = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "corpus" / "las"
+    autzen = dpoint.read(las_corpus / "autzen.las")
+    assert pyproj.CRS.from_wkt(autzen.crs).to_epsg() == 2994  # GeoTIFF keys made WKT by PROJ
+    assert dpoint.read(las_corpus / "simple.las").crs is None  # no records
+    s, _, _ = cloud
+    assert s.crs is None
+    s.crs = "site grid 7, Höhe ]]> north\nline two"
+    for ext in ["ply", "pcd", "e57"]:
+        dpoint.write(s, tmp_path / f"s.{ext}")
+        assert dpoint.read(tmp_path / f"s.{ext}").crs == s.crs, ext
+    assert pickle.loads(pickle.dumps(s)).crs == s.crs
+    # Set on a LAS set: the file written takes it in place of the source's records.
+    autzen.crs = "EPSG:32633"
+    dpoint.write(autzen, tmp_path / "a.las")
+    assert dpoint.info(tmp_path / "a.las")["las"]["crs"] == "EPSG:32633 (WGS 84 / UTM zone 33N), GeoTIFF keys"
+    autzen.crs = None
+    assert autzen.crs is None
+    dpoint.write(autzen, tmp_path / "none.las")
+    assert dpoint.info(tmp_path / "none.las")["las"]["crs"] is None
 
 
 @pytest.mark.parametrize("ext", ["ply", "glb"])
