@@ -215,17 +215,40 @@ size_t countFloatMerges(const PositionArray& positions, unsigned threads) {
   const auto less_double = [](const glm::dvec3& a, const glm::dvec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
   };
+  const auto less_point = [&](uint32_t x, uint32_t y) {
+    const glm::vec3 fx = as_float(x), fy = as_float(y);
+    if (less_float(fx, fy)) return true;
+    if (less_float(fy, fx)) return false;
+    return less_double(positions[x], positions[y]);
+  };
+  // A bucket of more than a core's share (points that round to a few float32 points: a small
+  // extent far from the origin, a deep zoom) is sorted on all cores: its pieces at once, then
+  // merged pair by pair. As one bucket it took one core (10M such points: info 9.0 s, now 6.3 s on
+  // this VM's two; bench/results/2026-12-02/cpu/info-copies.md).
+  const unsigned workers = resolveThreads(threads);
+  const size_t big = std::max<size_t>(size_t{1} << 16, total / (2 * workers) + 1);
+  std::vector<uint8_t> sorted(buckets, 0);
+  for (unsigned b = 0; b < buckets && workers > 1; ++b) {
+    const size_t size = bucket_begin[b + 1] - bucket_begin[b];
+    if (size < big || interrupted()) continue;
+    const size_t pieces_of = workers, step = (size + pieces_of - 1) / pieces_of;
+    const auto edge = [&](size_t k) { return order.begin() + static_cast<ptrdiff_t>(bucket_begin[b] + std::min(size, k * step)); };
+    parallelFor(pieces_of, threads, [&](size_t k, unsigned) {
+      if (!interrupted()) std::sort(edge(k), edge(k + 1), less_point);
+    });
+    for (size_t width = 1; width < pieces_of && !interrupted(); width *= 2)
+      parallelFor((pieces_of + 2 * width - 1) / (2 * width), threads, [&](size_t pair, unsigned) {
+        const size_t k = pair * 2 * width;
+        if (k + width < pieces_of) std::inplace_merge(edge(k), edge(k + width), edge(std::min(pieces_of, k + 2 * width)), less_point);
+      });
+    sorted[b] = 1;
+  }
   std::vector<size_t> merged(buckets, 0);
   parallelFor(buckets, threads, [&](size_t b, unsigned) {
     if (interrupted()) return;
     const auto first = order.begin() + static_cast<ptrdiff_t>(bucket_begin[b]);
     const auto last = order.begin() + static_cast<ptrdiff_t>(bucket_begin[b + 1]);
-    std::sort(first, last, [&](uint32_t x, uint32_t y) {
-      const glm::vec3 fx = as_float(x), fy = as_float(y);
-      if (less_float(fx, fy)) return true;
-      if (less_float(fy, fx)) return false;
-      return less_double(positions[x], positions[y]);
-    });
+    if (!sorted[b]) std::sort(first, last, less_point);
     // Within a run of equal floats, every change of the double value is one more merged point.
     for (auto k = first + (first != last); k < last; ++k)
       if (as_float(k[-1]) == as_float(*k) && positions[k[-1]] != positions[*k]) ++merged[b];
