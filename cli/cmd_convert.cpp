@@ -177,11 +177,12 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->check(oneOf("--pcd-encoding", {"ascii", "binary", "binary_compressed"}))
       ->default_val("binary");
   cmd->add_option("--crs", o->crs,
-                  "LAS/LAZ/COPC and E57: the coordinate reference system, as EPSG:CODE (EPSG:32633; with heights EPSG:6580+5703),\n"
+                  "LAS/LAZ/COPC, E57, PLY and PCD: the coordinate reference system, as EPSG:CODE (EPSG:32633; with heights EPSG:6580+5703),\n"
                   "WKT, or a file holding WKT (a .prj), in place of the input's CRS records: an EPSG CRS as GeoTIFF keys\n"
                   "in a LAS 1.2 file where nothing else needs LAS 1.4 (what every LAS reader takes), any other as WKT\n"
-                  "in a LAS 1.4 file; E57: its coordinateMetadata, as WKT. Default: the input's (an E57 file's\n"
-                  "coordinateMetadata goes to a LAS file where PROJ makes it WKT, and a LAS file's CRS to E57 as WKT)")
+                  "in a LAS 1.4 file; E57: its coordinateMetadata, as WKT; PLY and PCD: header comments, as WKT.\n"
+                  "Default: the input's (an E57 file's coordinateMetadata goes to a LAS file where PROJ makes it WKT,\n"
+                  "and a LAS file's CRS to E57 and PCD as WKT)")
       ->type_name("CRS");
   cmd->add_option("--las-scale", o->las_scale,
                   "LAS output: the coordinate step for x, y and z (the offset is the bounding box's minimum rounded "

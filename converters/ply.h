@@ -84,6 +84,9 @@ struct PlyWriteOptions {
   MadePositions positions_of;
   // When not null, gets a line for each dimension written under another name (plyPropertyNames).
   std::vector<std::string>* notices = nullptr;
+  // When not null, the coordinate system the header states (`comment dpoint: crs` lines) in place of
+  // the set's own and a LAS source's records (convert's --crs, as WKT).
+  const std::string* crs = nullptr;
 };
 
 Result<PointSet> readPly(const std::string& path, const PlyReadOptions& options = {});

@@ -30,7 +30,7 @@ uint16_t colorWord(float c) { return colorInteger(c, 65535.0); }
 // them back): a 2D set (its z are 0 but not a coordinate: read from 2D input, or made in memory with
 // every z 0, as random2d and mandelbrot2d make theirs), and z as the up axis (LAS). Without the first,
 // a 2D set written as PLY would come back as a 3D one and convert to a 3-column CSV.
-std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
+std::string sourceFacts(const PointSet& points, bool has_z, bool colors, const std::string* crs) {
   static constexpr size_t kCrsLineBytes = 400;  // 800 hex digits: a header line well under 1,024 bytes
   std::string facts;
   if (!has_z) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
@@ -55,7 +55,7 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
     // record K over lines "las crs K USER ID EXTENDED HEX" of at most 800 hex digits each ('-':
     // no bytes), as Open3D's PLY reader (RPly) stops at a header line over 1,024 bytes.
     static constexpr size_t kLineBytes = kCrsLineBytes;
-    for (size_t k = 0; k < l.vlrs.size(); ++k) {
+    for (size_t k = 0; k < l.vlrs.size() && !crs; ++k) {  // a CRS given replaces them
       const LasVlr& vlr = l.vlrs[k];
       if (vlr.user_id.empty() || vlr.user_id.find_first_of(" \t\r\n") != std::string::npos) continue;
       const std::string head = "comment dpoint: las crs " + std::to_string(k) + ' ' + vlr.user_id + ' ' +
@@ -67,7 +67,7 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors) {
   }
   // The coordinate system another format stated (E57's), byte for byte: lines "crs HEX" in order,
   // so that E57 → PLY → LAS keeps it.
-  for (const std::string& piece : hexPieces(points.crs, kCrsLineBytes)) facts += "comment dpoint: crs " + piece + '\n';
+  for (const std::string& piece : hexPieces(crs ? *crs : points.crs, kCrsLineBytes)) facts += "comment dpoint: crs " + piece + '\n';
   return facts;
 }
 
@@ -140,7 +140,7 @@ std::string plyHeader(const PointSet& facts, uint64_t vertices, uint64_t faces, 
   const bool float_colors = options.color_type == PlyColorType::kFloat;
   const bool word_colors = wordColors(options.color_type, facts);
   std::string header = std::string("ply\nformat ") + (ascii ? "ascii" : "binary_little_endian") +
-                       " 1.0\ncomment written by dpoint\n" + sourceFacts(facts, has_z, colors) + "element vertex " +
+                       " 1.0\ncomment written by dpoint\n" + sourceFacts(facts, has_z, colors, options.crs) + "element vertex " +
                        std::to_string(vertices) + "\nproperty double x\nproperty double y\nproperty double z\n";
   if (colors)
     for (const char* c : {"red", "green", "blue"})

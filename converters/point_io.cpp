@@ -243,8 +243,9 @@ Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven&
   if (given.pcd_encoding && *format != FileFormat::kPcd) return refuse("--pcd-encoding", "a PCD output (.pcd) has an encoding");
   if (given.las_scale && !las)
     return refuse("--las-scale", "a LAS, LAZ or COPC output (.las, .laz, .copc.laz) has a coordinate step");
-  if (given.crs && !las && *format != FileFormat::kE57)
-    return refuse("--crs", "a LAS, LAZ, COPC or E57 output (.las, .laz, .copc.laz, .e57) holds a coordinate reference system");
+  if (given.crs && !las && *format != FileFormat::kE57 && *format != FileFormat::kPly && *format != FileFormat::kPcd)
+    return refuse("--crs", "a LAS, LAZ, COPC, E57, PLY or PCD output (.las, .laz, .copc.laz, .e57, .ply, .pcd) holds a "
+                           "coordinate reference system");
   return okStatus();
 }
 
@@ -292,11 +293,12 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
     case FileFormat::kPly:
       return writePly(path, points,
                       PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
-                                      options.colors_of, options.positions_of, options.notices});
+                                      options.colors_of, options.positions_of, options.notices,
+                                      options.las_crs.empty() ? nullptr : &options.las_crs});
     case FileFormat::kPcd: {
       // A LAS source's records as WKT, as E57 takes them (PCD's header holds text, not records).
-      std::string crs, why_not;
-      if (points.crs.empty() && points.las) crs = lasSourceWkt(*points.las, why_not);
+      std::string crs = options.las_crs, why_not;  // --crs's, else the set's own, else a LAS source's
+      if (crs.empty() && points.crs.empty() && points.las) crs = lasSourceWkt(*points.las, why_not);
       if (!why_not.empty() && options.notices) options.notices->push_back(path + ": coordinate system not written: " + why_not);
       return writePcd(path, points,
                       PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads, &crs});

@@ -728,7 +728,7 @@ progress: lines on stderr.)");
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (None or auto: ushort for 16-bit colours, else uchar; uchar; ushort; float),
 pcd_encoding (None: binary; ascii, binary or binary_compressed),
 las_scale (LAS coordinate step; None: a LAS source's own, else chosen from the data as convert does),
-crs (LAS/LAZ/COPC: "EPSG:32633", WKT or a .prj file's path, as convert's --crs; None: the source's), order (input or morton), no_colors, color_format (linear or
+crs (LAS/LAZ/COPC, E57, PLY and PCD: "EPSG:32633", WKT or a .prj file's path, as convert's --crs; None: the source's), order (input or morton), no_colors, color_format (linear or
 srgb8), unique: as convert's options; they act on a copy, never on `points`.)");
 }
 

@@ -226,8 +226,8 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
            {{"--decimals", "3", "-o", dir.file("c.las")}, "--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts)"},
            {{"--keep", "intensity", "--drop", "intensity", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
            {{"--keep", "intensity", "--drop", "all", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
-           {{"--crs", "EPSG:4326", "-o", dir.file("c.ply")},
-            "only a LAS, LAZ, COPC or E57 output (.las, .laz, .copc.laz, .e57) holds"}}) {
+           {{"--crs", "EPSG:4326", "-o", dir.file("c.csv")},
+            "only a LAS, LAZ, COPC, E57, PLY or PCD output (.las, .laz, .copc.laz, .e57, .ply, .pcd) holds"}}) {
     std::vector<std::string> command = {"convert", kCorpus + "simple.las"};
     command.insert(command.end(), args.begin(), args.end());
     test::CommandResult bad = runDpoint(command);
@@ -236,6 +236,7 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir.file("c.las")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("c.ply")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.csv")));
 }
 
 // E57's coordinateMetadata carries a CRS both ways: a LAS file's GeoTIFF keys become WKT there
@@ -296,6 +297,15 @@ TEST(CliLas, theCoordinateSystemSurvivesPlyAndPcdAndStreamedInfoStatesIt) {
     ASSERT_EQ(runDpoint({"convert", dir.file(via), "-o", dir.file("back.las"), "-q"}).exit_code, 0);
     test::CommandResult info = runDpoint({"info", dir.file("back.las"), "--quiet"});
     EXPECT_TRUE(test::contains(info.out, "LAS CRS:            EPSG:2994 (")) << info.out;
+  }
+  // --crs in place of the source's, to PLY (whose LAS records then go) and PCD.
+  for (const char* via : {"g.ply", "g.pcd"}) {
+    SCOPED_TRACE(via);
+    ASSERT_EQ(runDpoint({"convert", kCorpus + "autzen.las", "--crs", "EPSG:32633", "-o", dir.file(via), "-q"}).exit_code, 0);
+    EXPECT_TRUE(test::contains(readPoints(dir.file(via))->crs, "PROJCS[\"WGS 84 / UTM zone 33N\""));
+    EXPECT_FALSE(test::contains(readFile(dir.file(via)), "las crs"));
+    ASSERT_EQ(runDpoint({"convert", dir.file(via), "-o", dir.file("g.las"), "-q"}).exit_code, 0);
+    EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("g.las"), "--quiet"}).out, "LAS CRS:            EPSG:32633 ("));
   }
   test::CommandResult r = runDpoint({"convert", kCorpus + "autzen.las", "-o", dir.file("l.pcd")});
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -71,7 +71,7 @@ def test_las_takes_a_crs_as_convert_does(tmp_path, cloud):
     assert dpoint.info(tmp_path / "e.e57")["crs"] == wkt
     dpoint.write(dpoint.read(tmp_path / "e.e57"), tmp_path / "e.las", las_scale=0.01)
     assert dpoint.info(tmp_path / "e.las")["las"]["crs"] == "EPSG:32633 (WGS 84 / UTM zone 33N), GeoTIFF keys"
-    for path, crs, words in [(tmp_path / "c.ply", "EPSG:32633", "crs: only a LAS, LAZ, COPC or E57 output (.las, .laz, .copc.laz, .e57) holds"),
+    for path, crs, words in [(tmp_path / "c.csv", "EPSG:32633", "crs: only a LAS, LAZ, COPC, E57, PLY or PCD output (.las, .laz, .copc.laz, .e57, .ply, .pcd) holds"),
                              (tmp_path / "d.las", "EPSG:999999", "crs 'EPSG:999999': not a coordinate reference system")]:
         with pytest.raises(dpoint.Error) as raised:
             dpoint.write(s, path, crs=crs)
