@@ -325,7 +325,7 @@ Dimensions PointInputStream::commonDimensions() const {
     for (const Part& part : parts_) {
       const Dimension* other = part.dimensions().find(d.name);
       everywhere = everywhere && other != nullptr;
-      if (other && other->type != type) type = DimType::kF64;
+      if (other && !dimTypeHolds(type, other->type)) type = DimType::kF64;  // appendPoints's rule
     }
     if (everywhere) common.append(d.name, type, 0);
   }
@@ -333,7 +333,7 @@ Dimensions PointInputStream::commonDimensions() const {
 }
 
 Status PointInputStream::streamDimensions(const std::vector<std::string>& names) {
-  const Dimensions common = commonDimensions();  // their types: float64 where the files' differ
+  const Dimensions common = commonDimensions();  // their types: as readPointInputs joins them
   std::vector<Dimension> streamed;
   for (const std::string& name : names) {
     const Dimension* d = common.find(name);

@@ -82,8 +82,9 @@ class PointInputStream {
   const std::vector<std::string>& notices() const { return notices_; }
   // The first file's dimensions (PLY vertex properties), as empty columns.
   const Dimensions& dimensions() const;
-  // The dimensions every file has, as empty columns: each of the first file's type, float64 where
-  // the files' types differ (as streamDimensions takes them).
+  // The dimensions every file has, as empty columns: each of the first file's type where that holds
+  // every later file's values (dimTypeHolds), else float64, as readPointInputs joins them (and as
+  // streamDimensions takes them).
   Dimensions commonDimensions() const;
   // From now on read() also gives each block the dimensions `names`, in that order (float64 where
   // the files' types differ), and no others (none: no dimensions). Every file must have each:

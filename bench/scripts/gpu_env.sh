@@ -30,3 +30,19 @@ default_set() {
 build_bin() {
   if [ "$1" = current ]; then echo .gpu/dpoint; else echo ".gpu/dpoint-$1"; fi
 }
+
+# The medians of a rows file (TSV with a header; columns wall_s and peak_kb) for each pair of the
+# two key columns named, in the order met: one line each, with every wall time.
+median_summary() {
+  /usr/bin/python3 - "$@" <<'PY'
+import csv, statistics, sys
+path, a, b = sys.argv[1:4]
+rows = list(csv.DictReader(open(path), delimiter="\t"))
+print(f"{a}\t{b}\tmedian_wall_s\tmedian_peak_mb\twalls")
+for key in dict.fromkeys((r[a], r[b]) for r in rows):
+    sel = [r for r in rows if (r[a], r[b]) == key]
+    w = [float(r["wall_s"]) for r in sel]
+    p = [float(r["peak_kb"]) / 1024 for r in sel]
+    print(f"{key[0]}\t{key[1]}\t{statistics.median(w):.3f}\t{statistics.median(p):.0f}\t" + " ".join(f"{x:.3f}" for x in w))
+PY
+}

@@ -88,8 +88,8 @@ TEST(LasStream, renderAndInfoStreamLazAndLas) {
 }
 
 // Several dimensions at once from a mix of files (PLY, E57, LAS), as `info --stream` takes them
-// for their ranges: every value the whole read has, in blocks across the files' ends, float64
-// where the files' types differ; a name one file lacks changes nothing.
+// for their ranges: every value the whole read has, in blocks across the files' ends, in the types
+// the whole read gives; a name one file lacks changes nothing.
 TEST(LasStream, severalDimensionsStreamFromAMixOfFilesAsTheWholeReadHasThem) {
   test::TempDir dir;
   Result<PointSet> autzen = readLas(std::string(DPOINT_CORPUS_DIR) + "/laz/autzen_trim.laz");
@@ -112,6 +112,7 @@ TEST(LasStream, severalDimensionsStreamFromAMixOfFilesAsTheWholeReadHasThem) {
   ASSERT_EQ(names, (std::vector<std::string>{"intensity", "point_source_id"}));
   EXPECT_EQ(common.find("intensity")->type, DimType::kF64);  // uint16 in PLY and LAS, float32 in E57
   EXPECT_EQ(common.find("point_source_id")->type, DimType::kU16);
+  for (const Dimension& d : common.all()) EXPECT_EQ(d.type, whole->dimensions.find(d.name)->type) << d.name;
 
   const Status missing = stream.streamDimensions({"intensity", "classification"});  // not in the E57 file
   ASSERT_FALSE(missing.ok());
@@ -139,6 +140,33 @@ TEST(LasStream, severalDimensionsStreamFromAMixOfFilesAsTheWholeReadHasThem) {
   ASSERT_TRUE(stream.streamDimensions({}).ok());
   ASSERT_TRUE(stream.read(0, 10, block).ok());
   EXPECT_EQ(block.dimensions.count(), 0u);
+
+  // A type that holds the later files' values is kept, as the whole read keeps it (before the
+  // build of 2026-12-02 the stream made it float64): uint16 then uint8 stays uint16; uint8 then
+  // int8 becomes float64 in both.
+  {
+    std::vector<std::string> pair{dir.file("wide.ply"), dir.file("narrow.ply")};
+    for (size_t f = 0; f < 2; ++f) {
+      PointSet set;
+      set.positions = {{0.0, 0.0, double(f)}, {1.0, 1.0, double(f)}};
+      set.dimensions.append("d", f == 0 ? DimType::kU16 : DimType::kU8, 2).setValue(1, 200.0 + double(f));
+      set.dimensions.append("e", f == 0 ? DimType::kU8 : DimType::kI8, 2).setValue(1, f == 0 ? 250.0 : -5.0);
+      ASSERT_TRUE(writePoints(pair[f], set).ok());
+    }
+    Result<PointSet> joined = readPointInputs(pair);
+    ASSERT_TRUE(joined) << joined.error().message;
+    Result<std::unique_ptr<PointInputStream>> two = openPointStream(pair, "on", 2);
+    ASSERT_TRUE(two && *two);
+    for (const char* name : {"d", "e"}) {
+      const DimType want = std::string(name) == "d" ? DimType::kU16 : DimType::kF64;
+      EXPECT_EQ(joined->dimensions.find(name)->type, want) << name;
+      EXPECT_EQ((*two)->commonDimensions().find(name)->type, want) << name;
+    }
+    ASSERT_TRUE((*two)->streamDimensions({"d", "e"}).ok());
+    ASSERT_TRUE((*two)->read(0, 4, block).ok());
+    for (size_t k = 0; k < 2; ++k)
+      for (size_t i = 0; i < 4; ++i) EXPECT_EQ(block.dimensions.all()[k].value(i), joined->dimensions.all()[k].value(i));
+  }
 
   // One PLY file's every dimension, its own types, from one read of its rows.
   Result<std::unique_ptr<PointInputStream>> ply = openPointStream({paths[0]}, "on", 2);
