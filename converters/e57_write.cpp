@@ -35,17 +35,12 @@ std::string coordinateMetadata(const PointSet& points, const E57WriteOptions& op
     crs = lasSourceWkt(*points.las, why_not);
     if (!why_not.empty()) notes.push_back("coordinate system not written: " + why_not);
   }
-  for (size_t i = 0; i < crs.size(); ++i) {
-    const auto c = static_cast<unsigned char>(crs[i]);
-    const size_t sequence = c >= 0x80 ? utf8SequenceAt(crs, i) : 1;
-    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f || sequence == 0) {
-      std::string byte;
-      appendHexByte(byte, c);
-      notes.push_back("coordinate system not written: its text " + quotedExcerpt(crs) + " holds a byte XML cannot hold (" +
-                      byte + ")");
-      return "";
-    }
-    i += sequence - 1;
+  if (const size_t bad = firstNonTextByte(crs); bad != std::string::npos) {
+    std::string byte;
+    appendHexByte(byte, static_cast<unsigned char>(crs[bad]));
+    notes.push_back("coordinate system not written: its text " + quotedExcerpt(crs) + " holds a byte XML cannot hold (" +
+                    byte + ")");
+    return "";
   }
   std::string cdata;  // "]]>" as "]]" at the end of one section and ">" in the next
   size_t at = 0;

@@ -449,6 +449,35 @@ bool isLiblasText(const LasVlr& v) { return isLiblasWkt(v) && !wktText(v.data).e
 
 }  // namespace
 
+StatedCrs statedCrs(const PointSet& points) {
+  StatedCrs stated{points.crs, {}};
+  if (points.las)
+    for (const LasVlr& vlr : points.las->vlrs)
+      if (isLasCrsRecord(vlr)) stated.records.push_back(vlr);
+  return stated;
+}
+
+bool StatedCrs::sameAs(const StatedCrs& other) const {
+  if (text != other.text || records.size() != other.records.size()) return false;
+  for (size_t k = 0; k < records.size(); ++k) {
+    const LasVlr &a = records[k], &b = other.records[k];
+    if (a.user_id != b.user_id || a.record_id != b.record_id || a.data != b.data) return false;
+  }
+  return true;
+}
+
+std::string headerCrsProblem(const std::string& crs) {
+  if (crs.size() > kMostHeaderCrsBytes)
+    return "its " + std::to_string(crs.size()) + " bytes are more than a header holds (" +
+           std::to_string(kMostHeaderCrsBytes) + ")";
+  if (const size_t bad = firstNonTextByte(crs); bad != std::string::npos) {
+    std::string byte;
+    appendHexByte(byte, static_cast<unsigned char>(crs[bad]));
+    return "its text " + quotedExcerpt(crs) + " holds a byte that is not text (" + byte + ")";
+  }
+  return "";
+}
+
 std::string lasSourceWkt(const LasSource& source, std::string& why_not) {
   std::vector<LasVlr> records;
   for (const LasVlr& vlr : source.vlrs)

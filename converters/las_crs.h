@@ -24,6 +24,17 @@ namespace dpoint {
 // record (liblas 2112), which files written by libLAS and early PDAL carry beside or instead of them.
 bool isLasCrsRecord(const LasVlr& vlr);
 
+// A set's coordinate system, as the set states it: text (PointSet::crs: an E57's, a PLY or PCD
+// header's, the module's) or a LAS source's CRS records. Where a set has both, the text is its CRS
+// (every writer and `info` take it so).
+struct StatedCrs {
+  std::string text;
+  std::vector<LasVlr> records;  // isLasCrsRecord's, in order
+  bool any() const { return !text.empty() || !records.empty(); }
+  bool sameAs(const StatedCrs& other) const;
+};
+StatedCrs statedCrs(const PointSet& points);
+
 // What the writer of a point format 6–10 file does with the source's CRS records.
 struct LasWktCrs {
   // The records to write instead of the source's CRS records: the source's own where they are
@@ -40,6 +51,14 @@ struct LasWktCrs {
 // a WKT record all the same, else libLAS's. Never fails: a CRS that cannot be made WKT is left
 // out, with a note saying why.
 LasWktCrs lasWktCrs(const std::vector<LasVlr>& vlrs, bool wkt_bit);
+
+// The most bytes of coordinate-system text a PLY or PCD header carries: a WKT is a few KB, and a
+// PCD reader takes a header of at most 1 MiB.
+inline constexpr size_t kMostHeaderCrsBytes = 65536;
+
+// Why coordinate-system text cannot go into a PLY or PCD header (more than kMostHeaderCrsBytes, a
+// byte that is not text: firstNonTextByte), for a note; empty where it can.
+std::string headerCrsProblem(const std::string& crs);
 
 // A LAS source's coordinate system as one WKT text, for a format that holds WKT (E57, PCD, PLY):
 // its WKT record's, or its GeoTIFF keys made WKT by PROJ (lasWktCrs's choice). Empty where it has

@@ -54,9 +54,8 @@ struct PcdWriteOptions {
   Progress* progress = nullptr;
   std::vector<std::string>* notices = nullptr;  // coordinates written as double
   unsigned threads = 0;  // ASCII rows formatted on this many cores (0: all); the bytes do not depend on it
-  // The coordinate system the header states (`# dpoint: crs` lines): convert's --crs in place of the
-  // set's own, or where the set has none of its own (PointSet::crs) a LAS source's made WKT
-  // (writePoints); null: the set's own.
+  // When not null, the coordinate-system text the header states (`# dpoint: crs` lines) in place of
+  // the set's own (PointSet::crs): --crs's WKT, a LAS source's made WKT, or none (writePoints).
   const std::string* crs = nullptr;
 };
 

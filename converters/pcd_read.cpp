@@ -14,6 +14,7 @@
 
 #include <fast_float/fast_float.h>
 
+#include "converters/las_crs.h"
 #include "converters/pcd.h"
 #include "core/bytes.h"
 #include "core/memory.h"
@@ -53,8 +54,9 @@ struct Header {
   uint64_t lines = 0;        // the DATA line's number
   size_t row_bytes = 0;
   bool has_z = false, two_d = false, z_up = false, colors = false, alpha = false;
-  std::string crs;        // `# dpoint: crs` lines' bytes
-  bool crs_good = true;   // every one hex
+  std::string crs;          // `# dpoint: crs` lines' bytes
+  bool crs_lines = false;   // any
+  bool crs_good = true;     // every one one word of hex
   std::string viewpoint;  // the VIEWPOINT line when it is not the identity
   std::optional<std::array<double, 7>> pose;  // its values
   std::vector<std::pair<std::string, DimType>> dimensions;
@@ -122,7 +124,9 @@ class HeaderParser {
       size_t end = head.find('\n', pos);
       const bool last = end == std::string::npos;
       if (last) {
-        if (head.size() < file_.size()) return Error{path_ + ": header line " + std::to_string(line_ + 1) + " is longer than 1 MiB"};
+        if (head.size() < file_.size())  // the line runs past the first 1 MiB, long or not (a review finding)
+          return Error{path_ + ": the header runs past its first 1 MiB (line " + std::to_string(line_ + 1) +
+                       " does not end in it); not a PCD file a reader takes"};
         end = head.size();
       }
       const std::string_view text(head.data() + pos, end - pos);
@@ -135,8 +139,10 @@ class HeaderParser {
         if (text.find("dpoint: up axis z") != std::string_view::npos) header_.z_up = true;
         // The coordinate system another format stated (pcd_write.cpp), in hex over lines in order;
         // left out where a line is bad.
-        if (tokens.size() == 4 && tokens[0] == "#" && tokens[1] == "dpoint:" && tokens[2] == "crs")
-          header_.crs_good = appendHexBytes(header_.crs, tokens[3]) && header_.crs_good;
+        if (tokens.size() >= 3 && tokens[0] == "#" && tokens[1] == "dpoint:" && tokens[2] == "crs") {
+          header_.crs_lines = true;
+          header_.crs_good = tokens.size() == 4 && appendHexBytes(header_.crs, tokens[3]) && header_.crs_good;
+        }
         continue;
       }
       Status s = entry(tokens);
@@ -461,7 +467,12 @@ class Reader {
     points.color_full_scale = h_.colors ? 255 : 0;
     points.z_axis = h_.has_z && !h_.two_d ? ZAxis::kPresent : ZAxis::kAbsent;
     points.z_up = h_.z_up;
-    if (h_.crs_good) points.crs = h_.crs;
+    if (h_.crs_lines) {
+      const std::string why = !h_.crs_good ? std::string("its '# dpoint: crs' lines are not hex, one word a line")
+                                           : headerCrsProblem(h_.crs);
+      if (why.empty()) points.crs = h_.crs;
+      else if (options_.notices) options_.notices->push_back(path_ + ": coordinate system left out: " + why);
+    }
     if (options_.progress) options_.progress->start("reading " + path_, n);
 
     Columns columns(points);

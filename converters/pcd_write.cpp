@@ -186,7 +186,7 @@ class Writer {
     if (points_.z_up) h += "# dpoint: up axis z\n";
     // The coordinate system another format stated (E57's), byte for byte in hex over lines of at
     // most 800 digits (Open3D reads a header line of up to 1,024 bytes), for pcd_read.cpp.
-    for (const std::string& piece : hexPieces(options_.crs && !options_.crs->empty() ? *options_.crs : points_.crs, 400))
+    for (const std::string& piece : hexPieces(options_.crs ? *options_.crs : points_.crs, 400))
       h += "# dpoint: crs " + piece + '\n';
     h += "VERSION 0.7\nFIELDS";
     for (const FieldGroup& g : groups_) h += ' ' + g.name;

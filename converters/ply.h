@@ -62,6 +62,7 @@ struct PlyReadOptions {
   // with bytes after its end is still refused; else the faces are read and checked as ever. The
   // triangles' indices are then not checked.
   bool faces_unkept = false;
+  std::vector<std::string>* notices = nullptr;  // what the header held that is left out (a bad CRS)
 };
 
 // Colours of `count` rows whose positions are `positions` into colors[0 .. count), made on demand;
@@ -84,8 +85,9 @@ struct PlyWriteOptions {
   MadePositions positions_of;
   // When not null, gets a line for each dimension written under another name (plyPropertyNames).
   std::vector<std::string>* notices = nullptr;
-  // When not null, the coordinate system the header states (`comment dpoint: crs` lines) in place of
-  // the set's own and a LAS source's records (convert's --crs, as WKT).
+  // When not null, the coordinate-system text the header states (`comment dpoint: crs` lines) in
+  // place of the set's own (PointSet::crs): --crs's WKT, or none (empty) where the set's cannot go
+  // in a header (writePoints). A LAS source's records are written where no text is.
   const std::string* crs = nullptr;
 };
 
@@ -187,8 +189,10 @@ class PlyVertexStream {
   // and a stream can only clamp block by block.
   bool floatColors() const;
   uint64_t faceCount() const;  // the header's `face` rows (0 without the element)
-  // The coordinate system its header states (`comment dpoint: crs`, as readPly's PointSet::crs).
+  // The coordinate system its header states (`comment dpoint: crs`, as readPly's PointSet::crs), and
+  // a LAS source's CRS records (`comment dpoint: las crs`, as readPly's PointSet::las).
   const std::string& crs() const;
+  std::vector<LasVlr> lasCrsRecords() const;
   // The vertex properties that are dimensions, as empty columns (names and types).
   const Dimensions& dimensions() const;
   // From now on read() also fills these of dimensions() (by index) into the block; none by default.

@@ -14,6 +14,7 @@
 // 4 MiB blocks (newlines counted, then each block's lines parsed into their rows: readAsciiRows),
 // each up to the first row of another kind, from which the row-by-row loop goes on. Vertices with
 // lists and other elements stay serial.
+#include "converters/las_crs.h"
 #include "converters/ply.h"
 
 #include <fast_float/fast_float.h>
@@ -370,6 +371,7 @@ class PlyParser {
   }
   uint64_t vertexCount() const { return vertex_count_; }
   const std::string& crs() const { return points_.crs; }  // the header's, once read
+  std::vector<LasVlr> lasCrsRecords() const { return points_.las ? points_.las->vlrs : std::vector<LasVlr>(); }
   bool hasColors() const { return has_colors_; }
   bool floatColors() const { return has_colors_ && divisor_[kRed] == 1.0f && !tile_; }
   // The vertex properties that are dimensions (empty columns: names and types).
@@ -536,15 +538,23 @@ class PlyParser {
           vlr.data += bytes;
         }
         // The coordinate system another format stated, in hex over lines in order; left out where
-        // a line is bad.
-        if (w.size() == 4 && w[2] == "crs") crs_good_ = appendHexBytes(crs_, w[3]) && crs_good_;
+        // a line is not one word of hex (a line with more words dropped a piece, a review finding).
+        if (w[2] == "crs") {
+          crs_lines_ = true;
+          crs_good_ = w.size() == 4 && appendHexBytes(crs_, w[3]) && crs_good_;
+        }
       }
       if (key == "comment" || key == "obj_info") continue;
       if (key == "end_header") {
         if (points_.las)
           for (auto& [vlr, good] : crs_records_)
             if (good) points_.las->vlrs.push_back(std::move(vlr));
-        if (crs_good_) points_.crs = std::move(crs_);
+        if (crs_lines_) {
+          const std::string why = !crs_good_ ? std::string("its 'comment dpoint: crs' lines are not hex, one word a line")
+                                             : headerCrsProblem(crs_);
+          if (why.empty()) points_.crs = std::move(crs_);
+          else if (options_.notices) options_.notices->push_back(path_ + ": coordinate system left out: " + why);
+        }
         break;
       }
       if (key == "format") {
@@ -1427,8 +1437,9 @@ class PlyParser {
   bool integer_colours_ = false;  // the header's `comment dpoint: colours 0..255`
   bool tile_ = false;  // the header's `comment dpoint-tile I/N` (kPlyTileCommentWord)
   std::vector<std::pair<LasVlr, bool>> crs_records_;  // the header's `las crs` records, each whole or not
-  std::string crs_;        // the header's `crs` lines' bytes so far
-  bool crs_good_ = true;   // and whether every one was hex
+  std::string crs_;         // the header's `crs` lines' bytes so far
+  bool crs_lines_ = false;  // whether it has any
+  bool crs_good_ = true;    // and whether every one was one word of hex
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;
   uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)
@@ -1479,6 +1490,7 @@ bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
 bool PlyVertexStream::floatColors() const { return state_->parser.floatColors(); }
 uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
 const std::string& PlyVertexStream::crs() const { return state_->parser.crs(); }
+std::vector<LasVlr> PlyVertexStream::lasCrsRecords() const { return state_->parser.lasCrsRecords(); }
 const Dimensions& PlyVertexStream::dimensions() const { return state_->parser.dimensions(); }
 void PlyVertexStream::streamDimensions(std::vector<size_t> which) { state_->parser.streamDimensions(std::move(which)); }
 Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {

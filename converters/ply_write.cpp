@@ -30,7 +30,9 @@ uint16_t colorWord(float c) { return colorInteger(c, 65535.0); }
 // them back): a 2D set (its z are 0 but not a coordinate: read from 2D input, or made in memory with
 // every z 0, as random2d and mandelbrot2d make theirs), and z as the up axis (LAS). Without the first,
 // a 2D set written as PLY would come back as a 3D one and convert to a 3-column CSV.
-std::string sourceFacts(const PointSet& points, bool has_z, bool colors, const std::string* crs) {
+std::string sourceFacts(const PointSet& points, bool has_z, bool colors, const std::string* given_crs) {
+  // The text wins over a LAS source's records, as every writer takes them (converters/las_crs.h).
+  const std::string& crs_text = given_crs ? *given_crs : points.crs;
   static constexpr size_t kCrsLineBytes = 400;  // 800 hex digits: a header line well under 1,024 bytes
   std::string facts;
   if (!has_z) facts += "comment dpoint: 2D (the source has x,y only; z is 0)\n";
@@ -55,7 +57,7 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors, const s
     // record K over lines "las crs K USER ID EXTENDED HEX" of at most 800 hex digits each ('-':
     // no bytes), as Open3D's PLY reader (RPly) stops at a header line over 1,024 bytes.
     static constexpr size_t kLineBytes = kCrsLineBytes;
-    for (size_t k = 0; k < l.vlrs.size() && !crs; ++k) {  // a CRS given replaces them
+    for (size_t k = 0; k < l.vlrs.size() && crs_text.empty(); ++k) {
       const LasVlr& vlr = l.vlrs[k];
       if (vlr.user_id.empty() || vlr.user_id.find_first_of(" \t\r\n") != std::string::npos) continue;
       const std::string head = "comment dpoint: las crs " + std::to_string(k) + ' ' + vlr.user_id + ' ' +
@@ -67,7 +69,7 @@ std::string sourceFacts(const PointSet& points, bool has_z, bool colors, const s
   }
   // The coordinate system another format stated (E57's), byte for byte: lines "crs HEX" in order,
   // so that E57 → PLY → LAS keeps it.
-  for (const std::string& piece : hexPieces(crs ? *crs : points.crs, kCrsLineBytes)) facts += "comment dpoint: crs " + piece + '\n';
+  for (const std::string& piece : hexPieces(crs_text, kCrsLineBytes)) facts += "comment dpoint: crs " + piece + '\n';
   return facts;
 }
 

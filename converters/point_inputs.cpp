@@ -10,6 +10,7 @@
 
 #include "converters/e57.h"
 #include "converters/las.h"
+#include "converters/las_crs.h"
 #include "converters/ply.h"
 #include "converters/tile_file.h"
 #include "core/memory.h"
@@ -108,6 +109,28 @@ std::optional<std::string> tilesFileByFile(const std::vector<std::string>& paths
          "given together are read as the merged set)";
 }
 
+// The coordinate system of several files read as one set: the first file's that states one (empty
+// files pass: they add no point). A later file that states another is said and left out, for a
+// whole read and a stream alike (a review finding: a stream took an empty file's, a whole read
+// the text of a later file over an earlier LAS file's records).
+class CrsChoice {
+ public:
+  void offer(const std::string& path, StatedCrs stated, std::vector<std::string>* notices) {
+    if (!stated.any()) return;
+    if (from_.empty()) {
+      from_ = path, chosen_ = std::move(stated);
+    } else if (!stated.sameAs(chosen_) && notices) {
+      notices->push_back(path + ": its coordinate system left out: the set takes " + from_ +
+                         "'s, the first file's that states one");
+    }
+  }
+  const StatedCrs& chosen() const { return chosen_; }
+
+ private:
+  std::string from_;
+  StatedCrs chosen_;
+};
+
 }  // namespace
 
 Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const ReadOptions& options) {
@@ -132,17 +155,24 @@ Result<PointSet> readPointInputs(const std::vector<std::string>& paths, const Re
   if (options.notices)
     if (std::optional<std::string> note = tilesFileByFile(paths, *set)) options.notices->push_back(*note);
   PointSet out;
+  CrsChoice crs;
   for (const std::string& path : paths) {
     Result<PointSet> part = readPoints(path, options);
     if (!part) return part.error();
     if (part->size() == 0) continue;
+    crs.offer(path, statedCrs(*part), options.notices);
     if (out.size() + part->size() > UINT32_MAX && !part->triangles.empty())
       return Error{path + ": the inputs hold more than 2^32 points, past what triangle indices address",
                    ExitCode::kResourceLimit};
     // Colours white for the files without; dimensions the union, 0 where a file lacks one.
     appendPoints(out, *part);
-    if (!out.las) out.las = part->las;  // the first LAS part's frame and coordinate system
-    if (out.crs.empty()) out.crs = part->crs;  // and the first other part's that states one
+    if (!out.las) out.las = part->las;  // the first LAS part's frame
+  }
+  // The chosen coordinate system, as text or as the frame's records (text: none beside it).
+  out.crs = crs.chosen().text;
+  if (out.las) {
+    std::erase_if(out.las->vlrs, [](const LasVlr& vlr) { return isLasCrsRecord(vlr); });
+    out.las->vlrs.insert(out.las->vlrs.end(), crs.chosen().records.begin(), crs.chosen().records.end());
   }
   return out;
 }
@@ -158,8 +188,6 @@ struct PointInputStream::Part {
   uint64_t fileCount() const { return ply ? ply->count() : las ? las->count() : e57->count(); }
   bool hasColors() const { return ply ? ply->hasColors() : las ? las->hasColors() : e57->hasColors(); }
   uint64_t faceCount() const { return ply ? ply->faceCount() : 0; }
-  // The coordinate system a PLY or E57 file states; a LAS file's records are not one (las.h).
-  std::string crs() const { return ply ? ply->crs() : e57 ? e57->crs() : std::string(); }
   const Dimensions& dimensions() const { return ply ? ply->dimensions() : las ? las->dimensions() : e57->dimensions(); }
   void streamDimensions(std::vector<size_t> which) {
     if (ply) ply->streamDimensions(std::move(which));
@@ -241,6 +269,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     for (const std::string& path : paths) files.emplace_back(path, UINT64_MAX);
     if (std::optional<std::string> note = tilesFileByFile(paths, *set)) stream->notices_.push_back(*note);
   }
+  CrsChoice crs;
   for (const auto& [path, owned] : files) {
     Part part;
     part.path = path;
@@ -290,9 +319,24 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     stream->count_ += part.count;
     if (part.count > 0) stream->has_colors_ = stream->has_colors_ || part.hasColors();
     stream->faces_ += part.faceCount();
-    if (stream->crs_.empty()) stream->crs_ = part.crs();  // the first part's that states one, as readPointInputs
+    if (part.count > 0) {  // the coordinate system as readPointInputs chooses it
+      StatedCrs stated;
+      if (part.ply) {
+        stated = {part.ply->crs(), part.ply->lasCrsRecords()};
+      } else if (part.e57) {
+        stated.text = part.e57->crs();
+      } else {
+        Result<InputFile> file = InputFile::open(path);
+        if (!file) return file.error();
+        Result<std::vector<LasVlr>> records = readLasCrsRecords(*file);
+        if (!records) return records.error();
+        stated.records = std::move(*records);
+      }
+      crs.offer(path, std::move(stated), &stream->notices_);
+    }
     stream->parts_.push_back(std::move(part));
   }
+  stream->crs_ = crs.chosen().text;  // empty where the chosen one is a LAS file's records
   if (set->whole) {
     // Every tile's copies, read once (a seam's worth of rows), to be checked as their owners pass.
     auto copies = std::make_unique<TileCopies>();

@@ -66,8 +66,9 @@ class PointInputStream {
   // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
   // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
   uint64_t faceCount() const { return faces_; }
-  // The coordinate system the first PLY or E57 file that states one states (readPointInputs's
-  // PointSet::crs); a LAS file's own records are read with its header (readLasCrsRecords).
+  // The coordinate system as text, where the first file that states one (readPointInputs's rule)
+  // states it so: a PLY, PCD or E57 file's (PointSet::crs); empty where that file states none or
+  // LAS records (a LAS file's are read with its header: readLasCrsRecords).
   const std::string& crs() const { return crs_; }
   // Host bytes held for the whole stream beside its blocks: a tile set's copies, E57 files' packet
   // indexes (0 for other files), and what they are, for a message.

@@ -139,7 +139,7 @@ Result<PointSet> readByFormat(const std::string& path, FileFormat format, const 
                                           options.columns, options.notices});
     case FileFormat::kPly:
       return readPly(path, PlyReadOptions{options.allow_nonfinite, options.progress, options.threads, options.points_only,
-                                          options.max_memory, options.faces_unkept});
+                                          options.max_memory, options.faces_unkept, options.notices});
     case FileFormat::kPcd:
       return readPcd(path, PcdReadOptions{options.allow_nonfinite, options.progress, options.threads, options.max_memory,
                                           options.notices});
@@ -277,6 +277,18 @@ bool hasLasCrsRecords(const PointSet& points) {
 // Whether the set states a coordinate system: its own (PointSet::crs), or a LAS source's records.
 bool statesCrs(const PointSet& points) { return !points.crs.empty() || hasLasCrsRecords(points); }
 
+// The coordinate-system text a PLY or PCD header states: --crs's WKT, else the set's own, else (for
+// PCD, `las_wkt`, which has no place for LAS records) a LAS source's made WKT. Text a header cannot
+// carry (headerCrsProblem) is left out with a note.
+std::string headerCrs(const std::string& path, const PointSet& points, const WriteOptions& options, bool las_wkt) {
+  std::string crs = !options.las_crs.empty() ? options.las_crs : points.crs, why_not;
+  if (crs.empty() && las_wkt && points.las) crs = lasSourceWkt(*points.las, why_not);
+  if (why_not.empty()) why_not = headerCrsProblem(crs);
+  if (why_not.empty()) return crs;
+  if (options.notices) options.notices->push_back(path + ": coordinate system not written: " + why_not);
+  return "";
+}
+
 Status writeFormat(const std::string& path, FileFormat format, const PointSet& points, const WriteOptions& options) {
   if ((options.colors_of || options.positions_of) && format != FileFormat::kPly)
     return Error{path + ": points made as the rows are written go to a .ply only"};
@@ -290,16 +302,15 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       return writeCsv(path, points,
                       CsvWriteOptions{options.decimals, options.threads, options.progress, options.decimals_at_scale,
                                       options.notices});
-    case FileFormat::kPly:
+    case FileFormat::kPly: {
+      const std::string crs = headerCrs(path, points, options, false);
       return writePly(path, points,
                       PlyWriteOptions{options.ply_encoding, options.ply_colors, options.progress, options.threads,
-                                      options.colors_of, options.positions_of, options.notices,
-                                      options.las_crs.empty() ? nullptr : &options.las_crs});
+                                      options.colors_of, options.positions_of, options.notices, &crs});
+    }
     case FileFormat::kPcd: {
       // A LAS source's records as WKT, as E57 takes them (PCD's header holds text, not records).
-      std::string crs = options.las_crs, why_not;  // --crs's, else the set's own, else a LAS source's
-      if (crs.empty() && points.crs.empty() && points.las) crs = lasSourceWkt(*points.las, why_not);
-      if (!why_not.empty() && options.notices) options.notices->push_back(path + ": coordinate system not written: " + why_not);
+      const std::string crs = headerCrs(path, points, options, true);
       return writePcd(path, points,
                       PcdWriteOptions{options.pcd_encoding, options.progress, options.notices, options.threads, &crs});
     }
@@ -334,9 +345,10 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       las.report = &report;
       las.crs_wkt = options.las_crs;
       // A coordinate system another format stated (an E57 file's, or the module's `crs`), where no
-      // LAS source's records and no --crs give one: made WKT by PROJ, or left out with a note.
+      // --crs gives one: made WKT by PROJ in place of a LAS source's records (the text wins, as
+      // every writer takes it), or left out with a note (the records, if any, then stay).
       std::string crs_note;
-      if (las.crs_wkt.empty() && !hasLasCrsRecords(points) && !points.crs.empty()) {
+      if (las.crs_wkt.empty() && !points.crs.empty()) {
         Result<std::string> wkt = crsAsWkt(points.crs, "the input's coordinate system");
         if (wkt) las.crs_wkt = std::move(*wkt);
         else crs_note = path + ": coordinate system not written: " + wkt.error().message;

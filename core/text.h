@@ -39,6 +39,19 @@ inline void appendHexDigits(std::string& out, unsigned char c) {
   out += kHex[c & 15];
 }
 
+// The offset of the first byte of `text` that is not plain text a header or an XML document can
+// carry (well-formed UTF-8 with no control byte but tab, line feed and carriage return, and no DEL),
+// or npos.
+inline size_t firstNonTextByte(std::string_view text) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const size_t sequence = c >= 0x80 ? utf8SequenceAt(text, i) : 1;
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f || sequence == 0) return i;
+    i += sequence - 1;
+  }
+  return std::string_view::npos;
+}
+
 // Bytes as lower-case hex digits in pieces of at most `piece_bytes` bytes each (header comment
 // lines: Open3D's PLY and PCD readers stop at a line over 1,024 bytes); none for no bytes.
 inline std::vector<std::string> hexPieces(std::string_view bytes, size_t piece_bytes) {

@@ -105,13 +105,15 @@ class KdTree {
     visit(pts_[mid], q, best);
     if (axis == kSame) return;
     const double diff = q[axis] - pts_[mid][axis];
-    // Points left of mid are <= the median along the axis, points right of it >= it.
+    // Points left of mid are <= the median along the axis, points right of it >= it. The far side
+    // is searched only where it may hold a point strictly nearer than `best` (visit keeps only
+    // those): on a grid of copied points, ties at `best` made most of the visits (a review finding).
     if (diff <= 0.0) {
       search(lo, mid, q, best);
-      if (diff * diff <= best) search(mid + 1, hi, q, best);
+      if (diff * diff < best) search(mid + 1, hi, q, best);
     } else {
       search(mid + 1, hi, q, best);
-      if (diff * diff <= best) search(lo, mid, q, best);
+      if (diff * diff < best) search(lo, mid, q, best);
     }
   }
 
@@ -155,7 +157,7 @@ class Forest {
         order[t] = {trees_[t] ? trees_[t]->boxDistance2(queries[k]) : std::numeric_limits<double>::infinity(), t};
       std::sort(order.begin(), order.end());
       for (const auto& [distance2, t] : order) {
-        if (distance2 > best2[k]) break;
+        if (distance2 >= best2[k]) break;  // no point there is strictly nearer
         trees_[t]->nearestNonzero(queries[k], best2[k]);
       }
     });

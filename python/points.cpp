@@ -579,9 +579,17 @@ that memory, without copying (writing into them changes the set).)")
             return py::reinterpret_steal<py::object>(
                 PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "surrogateescape"));
           },
-          [](const py::object& self, const std::optional<std::string>& crs) {
+          [](const py::object& self, const py::object& crs) {
             PointSet& s = setOf(self);
-            s.crs = crs.value_or("");
+            if (!crs.is_none() && !py::isinstance<py::str>(crs)) throw py::type_error("crs: a str or None");
+            // What the getter gives back (bytes that are not UTF-8 as surrogates) sets the same bytes.
+            std::string text;
+            if (!crs.is_none()) {
+              PyObject* bytes = PyUnicode_AsEncodedString(crs.ptr(), "utf-8", "surrogateescape");
+              if (!bytes) throw py::error_already_set();
+              text = py::reinterpret_steal<py::bytes>(bytes).cast<std::string>();
+            }
+            s.crs = std::move(text);
             if (s.las)  // the source's records give way to it
               std::erase_if(s.las->vlrs, [](const LasVlr& vlr) { return isLasCrsRecord(vlr); });
           },

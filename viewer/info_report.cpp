@@ -205,6 +205,7 @@ Status adviseFor(InfoReport& report, const InfoOptions& options, const Bounds& b
 Result<InfoReport> describePoints(const PointSet& points, const std::string& name, const InfoOptions& options) {
   InfoReport report;
   report.name = name;
+  report.crs = points.crs;  // the text, which every writer takes over a LAS source's records
   report.info = computeInfo(points, options.sample, options.threads);
   if (interrupted()) return interruptedError();  // its search stops at Ctrl-C, leaving its figures unfinished
   for (const Dimension& d : points.dimensions.all()) {
@@ -292,20 +293,13 @@ Result<InfoReport> describeStream(PointInputStream& stream, const std::string& n
   return report;
 }
 
-// Whether any of `paths` is a LAS or LAZ file (its own CRS records, not PointSet::crs).
-bool anyLasPath(const std::vector<std::string>& paths) {
-  return std::any_of(paths.begin(), paths.end(), [](const std::string& path) {
-    Result<FileFormat> format = formatOf(path);
-    return format && (*format == FileFormat::kLas || *format == FileFormat::kLaz);
-  });
-}
-
 // What a single LAS or LAZ file states beside its points, for the report: its header, whether its
 // bounds hold the points `info` found, and its CRS records' summary. `vlrs` and `source` are the
 // records and frame a whole read kept; null: read here from the file (a streamed read).
 Result<std::optional<LasFacts>> lasFactsOf(const std::vector<std::string>& paths, const PointSetInfo& info,
                                            const LasSource* source) {
-  if (paths.size() != 1 || !anyLasPath(paths)) return std::optional<LasFacts>();
+  const Result<FileFormat> format = paths.size() == 1 ? formatOf(paths[0]) : Result<FileFormat>(Error{""});
+  if (!format || (*format != FileFormat::kLas && *format != FileFormat::kLaz)) return std::optional<LasFacts>();
   Result<LasHeader> header = readLasHeader(paths[0]);
   if (!header) return header.error();
   const bool bounds_hold = info.count == 0 || lasBoundsContain(*header, Box{info.min, info.max});
@@ -353,7 +347,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
     report->notices = (*stream)->notices();
     // What the files state, as the whole read gives it (a set streamed had no CRS and no LAS header
     // facts before the build of 2026-12-02).
-    if (!anyLasPath(inputs.paths)) report->crs = (*stream)->crs();
+    report->crs = (*stream)->crs();
     Result<std::optional<LasFacts>> las = lasFactsOf(inputs.paths, report->info, nullptr);
     if (!las) return las.error();
     report->las = std::move(*las);
@@ -389,7 +383,6 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   if (!report) return report;
   report->copc = copc;
   report->notices = std::move(notices);
-  if (!points->las) report->crs = points->crs;
   const LasSource none;  // a LAS file read whole keeps its records; without them, none
   Result<std::optional<LasFacts>> las = lasFactsOf(inputs.paths, report->info, points->las ? &*points->las : &none);
   if (!las) return las.error();

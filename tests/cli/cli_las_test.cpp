@@ -9,7 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "converters/las_crs.h"
+#include "converters/point_inputs.h"
 #include "converters/point_io.h"
+#include "core/text.h"
 #include "las_bytes.h"
 #include "test_support.h"
 
@@ -364,6 +367,120 @@ TEST(CliLas, theCoordinateSystemSurvivesPlyAndPcdAndStreamedInfoStatesIt) {
   }
   r = runDpoint({"convert", kCorpus + "simple.las", "-o", dir.file("none.csv")});  // no CRS records: nothing to say
   EXPECT_FALSE(test::contains(r.err, "coordinate system")) << r.err;
+}
+
+// One rule for a set's coordinate system (review findings, 2026-12-02): where a set states it both
+// as text and as a LAS source's records, the text is its CRS for every writer and for `info` read
+// whole or streamed; of several files, the first that states one (an empty file states none), a
+// later other one said and left out; text a header cannot carry, or hex lines that are not whole,
+// left out with a note, not half read.
+TEST(CliLas, aSetsCoordinateSystemIsOneThingEverywhere) {
+  TempDir dir;
+  Result<PointSet> autzen = readPoints(kCorpus + "autzen.las");  // EPSG:2994 in GeoTIFF keys
+  ASSERT_TRUE(autzen) << autzen.error().message;
+  // Both: a PLY with the LAS frame's records and text (as a hand-edited file, or an old merge).
+  std::string ply;
+  {
+    PointSet both = *autzen;
+    ASSERT_TRUE(writePoints(dir.file("frame.ply"), both).ok());
+    ply = readFile(dir.file("frame.ply"));
+    ASSERT_TRUE(test::contains(ply, "comment dpoint: las crs "));
+    std::string line = "comment dpoint: crs ";
+    for (const char c : std::string("EPSG:32633")) appendHexDigits(line, static_cast<unsigned char>(c));
+    ply.insert(ply.find("element vertex"), line + "\n");
+    writeFile(dir.file("both.ply"), ply);
+  }
+  for (const char* mode : {"off", "on"}) {
+    const test::CommandResult info = runDpoint({"info", dir.file("both.ply"), "--stream", mode, "--quiet"});
+    EXPECT_TRUE(test::contains(info.out, "CRS:                EPSG:32633\n")) << mode << "\n" << info.out;
+  }
+  for (const char* out : {"both.las", "both.e57", "both.pcd"}) {
+    ASSERT_EQ(runDpoint({"convert", dir.file("both.ply"), "-o", dir.file(out), "-q"}).exit_code, 0) << out;
+    ASSERT_EQ(runDpoint({"convert", dir.file(out), "-o", dir.file("again.las"), "-q"}).exit_code, 0) << out;
+    EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("again.las"), "--quiet"}).out, "LAS CRS:            EPSG:32633 ("))
+        << out;
+  }
+
+  // Several files: the first that states one; an empty file states none; another is said.
+  PointSet empty, b;
+  empty.crs = "EPSG:4326";
+  b.positions = {{1.0, 2.0, 3.0}, {2.0, 3.0, 4.0}};
+  b.crs = "EPSG:32633";
+  ASSERT_TRUE(writePoints(dir.file("empty.ply"), empty).ok());
+  ASSERT_TRUE(writePoints(dir.file("b.ply"), b).ok());
+  b.crs = "EPSG:32634";
+  ASSERT_TRUE(writePoints(dir.file("c.ply"), b).ok());
+  for (const char* mode : {"off", "on"}) {
+    SCOPED_TRACE(mode);
+    const test::CommandResult info =
+        runDpoint({"info", dir.file("empty.ply"), dir.file("b.ply"), dir.file("c.ply"), "--stream", mode, "--json"});
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_TRUE(test::contains(info.out, "\"crs\": \"EPSG:32633\"")) << info.out;
+    EXPECT_TRUE(test::contains(info.err, "c.ply: its coordinate system left out: the set takes " + dir.file("b.ply") +
+                                             "'s, the first file's that states one"))
+        << info.err;
+    // A LAS file first: its records, and no text over them.
+    const test::CommandResult las = runDpoint({"info", kCorpus + "autzen.las", dir.file("b.ply"), "--stream", mode, "--json"});
+    ASSERT_EQ(las.exit_code, 0) << las.err;
+    EXPECT_FALSE(test::contains(las.out, "\"crs\": ")) << las.out;
+    EXPECT_TRUE(test::contains(las.err, "b.ply: its coordinate system left out")) << las.err;
+  }
+  Result<PointSet> joined = readPointInputs({kCorpus + "autzen.las", dir.file("b.ply")});
+  ASSERT_TRUE(joined);
+  EXPECT_EQ(joined->crs, "");
+  EXPECT_EQ(statedCrs(*joined).records.size(), statedCrs(*autzen).records.size());
+  joined = readPointInputs({dir.file("b.ply"), kCorpus + "autzen.las"});
+  ASSERT_TRUE(joined);
+  EXPECT_EQ(joined->crs, "EPSG:32633");
+  EXPECT_TRUE(statedCrs(*joined).records.empty());  // the text is its CRS, the frame's records gone
+
+  // What a header cannot carry: more than 64 KiB, a byte that is not text. Written without it.
+  for (const std::string& text : {std::string(kMostHeaderCrsBytes + 1, 'x'), std::string("Lambert \xe9tendu")}) {
+    for (const char* name : {"t.ply", "t.pcd"}) {
+      PointSet t = b;
+      t.crs = text;
+      std::vector<std::string> notices;
+      WriteOptions write;
+      write.notices = &notices;
+      ASSERT_TRUE(writePoints(dir.file(name), t, write).ok());
+      ASSERT_FALSE(notices.empty()) << name;
+      EXPECT_TRUE(test::contains(notices.back(), "coordinate system not written: ")) << notices.back();
+      EXPECT_EQ(readPoints(dir.file(name))->crs, "") << name;
+    }
+  }
+  // Hex lines that are not whole: left out, with a note (a line with a second word dropped a piece).
+  ply = readFile(dir.file("b.ply"));
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"comment dpoint: crs 45", "comment dpoint: crs 45 x"}, {"comment dpoint: crs 45", "comment dpoint: crs 4"},
+           {"comment dpoint: crs 45", "comment dpoint: crs zz"}, {"comment dpoint: crs 45", "comment dpoint: crs\ncomment dpoint: crs 45"}}) {
+    std::string bad = ply;
+    bad.replace(bad.find(from), from.size(), to);
+    writeFile(dir.file("bad.ply"), bad);
+    std::vector<std::string> notices;
+    ReadOptions read;
+    read.notices = &notices;
+    Result<PointSet> back = readPoints(dir.file("bad.ply"), read);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->crs, "") << to;
+    EXPECT_EQ(back->positions, b.positions);
+    ASSERT_EQ(notices.size(), 1u) << to;
+    EXPECT_TRUE(test::contains(notices[0], "bad.ply: coordinate system left out: its 'comment dpoint: crs' lines are not hex"))
+        << notices[0];
+  }
+  b.crs = "EPSG:32633";
+  ASSERT_TRUE(writePoints(dir.file("b.pcd"), b).ok());
+  std::string pcd = readFile(dir.file("b.pcd"));
+  pcd.replace(pcd.find("# dpoint: crs 45"), 16, "# dpoint: crs 45 x");
+  writeFile(dir.file("bad.pcd"), pcd);
+  std::vector<std::string> notices;
+  ReadOptions read;
+  read.notices = &notices;
+  Result<PointSet> back = readPoints(dir.file("bad.pcd"), read);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->crs, "");
+  EXPECT_TRUE(std::any_of(notices.begin(), notices.end(), [](const std::string& n) {
+    return test::contains(n, "bad.pcd: coordinate system left out: its '# dpoint: crs' lines are not hex");
+  }));
 }
 
 // Streamed info reads the dimensions' ranges in its first pass, as the whole read gives them; where

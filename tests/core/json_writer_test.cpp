@@ -1,5 +1,6 @@
 // The JSON writer the render report is built with (core/json_writer.h).
 #include "core/json_writer.h"
+#include "core/text.h"
 
 #include <gtest/gtest.h>
 
@@ -32,6 +33,14 @@ TEST(JsonWriter, keepsTheOrderEscapesStringsAndWritesNumbersShortest) {
             "}\n");
   EXPECT_EQ(inner.line(), "{\"b\": 2, \"a\": false}");
   EXPECT_EQ(JsonValue::integer(18446744073709551615ull).text(), "18446744073709551615");
+}
+
+// JSON is UTF-8: a byte that is not (a file name's, a header's text) is the replacement character,
+// not the raw byte that made the whole document unreadable (a review finding, 2026-12-02); UTF-8
+// letters stay as they are.
+TEST(JsonWriter, stringsAreUtf8WhateverBytesTheyHold) {
+  EXPECT_EQ(jsonString("H\xc3\xb6he \xe9tendu\xff \xe2\x82"), "\"H\xc3\xb6he \\ufffdtendu\\ufffd \\ufffd\\ufffd\"");
+  EXPECT_EQ(jsonString("\xf0\x9f\x98\x80\x01"), "\"\xf0\x9f\x98\x80\\u0001\"");
 }
 
 }  // namespace

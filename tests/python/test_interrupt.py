@@ -56,6 +56,13 @@ LONG_CALLS = {
 STOP_WAIT_S = 10.0
 
 
+def stderr_of(child):
+    """A failing child's stderr, for the assertion's message: ended first, as reading a running
+    child's stderr waits for its end."""
+    child.kill()
+    return child.stderr.read()
+
+
 class Lines:
     """The child's stdout a line at a time, each waited for at most `timeout` seconds (None: none
     came). A thread reads, so a child that never writes cannot hang the test."""
@@ -85,13 +92,13 @@ def test_ctrl_c_stops_a_long_call_leaving_no_output(tmp_path, name):
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=os.environ)
     lines = Lines(child.stdout)
     try:
-        assert lines.next(timeout=60) == "started", child.stderr.read()
+        assert lines.next(timeout=60) == "started", stderr_of(child)
         time.sleep(1.0)  # well inside the call
         assert child.poll() is None, child.stderr.read()
         child.send_signal(signal.SIGINT)
         ended = lines.next()
         assert ended is not None, f"no end {STOP_WAIT_S:.0f} s after SIGINT: the call ran on"
-        assert ended == "interrupted", child.stderr.read()
+        assert ended == "interrupted", stderr_of(child)
         assert lines.next() == "handler restored"
         assert not out.exists()
         assert os.listdir(tmp_path) == []  # no temporary file left either
@@ -129,7 +136,7 @@ def test_the_programs_own_handler_hears_ctrl_c(tmp_path):
     try:
         time.sleep(0.5)
         child.send_signal(signal.SIGINT)
-        assert child.wait(timeout=STOP_WAIT_S) == 7, child.stderr.read()  # a minute and more uninterrupted
+        assert child.wait(timeout=STOP_WAIT_S) == 7, stderr_of(child)  # a minute and more uninterrupted
         assert child.stdout.read().strip() == "handler"
         assert os.listdir(tmp_path) == []
     finally:

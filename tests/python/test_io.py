@@ -97,6 +97,7 @@ def test_a_sets_crs_is_read_set_pickled_and_written(tmp_path, cloud):
         dpoint.write(s, tmp_path / f"s.{ext}")
         assert dpoint.read(tmp_path / f"s.{ext}").crs == s.crs, ext
     assert pickle.loads(pickle.dumps(s)).crs == s.crs
+    assert dpoint.info(s)["crs"] == s.crs  # a set in memory, as a file read
     # Set on a LAS set: the file written takes it in place of the source's records.
     autzen.crs = "EPSG:32633"
     dpoint.write(autzen, tmp_path / "a.las")
