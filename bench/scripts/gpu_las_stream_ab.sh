@@ -38,13 +38,4 @@ for round in $(seq "${ROUNDS:-3}"); do
     [ "$what" = info ] || cmp -s "/tmp/$what-$base.png" "/tmp/$what-current.png" || echo "$what: the PNGs differ" | tee -a "$out/pngs.txt"
   done
 done
-/usr/bin/python3 - "$rows" <<'PY' | tee "$out/las-stream-summary.tsv"
-import csv, statistics, sys
-rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
-print("what\tbuild\tmedian_wall_s\tmedian_peak_mb\twalls")
-for key in dict.fromkeys((r["what"], r["build"]) for r in rows):
-    sel = [r for r in rows if (r["what"], r["build"]) == key]
-    w = [float(r["wall_s"]) for r in sel]
-    p = [float(r["peak_kb"]) / 1024 for r in sel]
-    print(f"{key[0]}\t{key[1]}\t{statistics.median(w):.3f}\t{statistics.median(p):.0f}\t" + " ".join(f"{x:.3f}" for x in w))
-PY
+median_summary "$rows" what build | tee "$out/las-stream-summary.tsv"
