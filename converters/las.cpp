@@ -577,7 +577,7 @@ void storeValue(char* p, DimType type, double v) {
 
 // Which format, extra bytes, version and records the writer uses for `points` (las_fields.h).
 Result<WriterLayout> writerLayout(const std::string& path, const PointSet& points, size_t n, bool compress,
-                                  bool las14, const std::string& crs_wkt, unsigned threads) {
+                                  bool las14, const std::string& crs_wkt, bool source_crs_dropped, unsigned threads) {
   WriterLayout l;
   const LasSource* source = points.las ? &*points.las : nullptr;
   l.format = lasFormatFor(points, source ? source->point_format : -1, !compress);
@@ -632,9 +632,9 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   if (l.format >= 6) l.global_encoding |= 0x10;
   l.file_source_id = source ? source->file_source_id : 0;
   // Formats 6-10 hold their CRS as WKT alone: GeoTIFF keys are made WKT (converters/las_crs.h).
-  std::vector<LasVlr> crs = source ? source->vlrs : std::vector<LasVlr>();
+  std::vector<LasVlr> crs = source && !source_crs_dropped ? source->vlrs : std::vector<LasVlr>();
   if (!crs_wkt.empty()) {  // the CRS given: as GeoTIFF keys in LAS 1.2, or as WKT in LAS 1.4
-    const std::string before = source ? lasCrsSummary(crs, lasSaysWkt(*source)) : std::string();
+    const std::string before = !crs.empty() ? lasCrsSummary(crs, lasSaysWkt(*source)) : std::string();
     if (!before.empty()) l.crs_note = "the input's CRS (" + before + ") replaced by " + wktName(crs_wkt);
     if (!given_keys.empty()) {
       crs = given_keys;
@@ -1310,7 +1310,8 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
     options.report->rounded = rounded;
     options.report->source_scale = keep_frame;
   }
-  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, options.crs_wkt, threads);
+  Result<WriterLayout> layout = writerLayout(path, points, n, options.compress, options.las14, options.crs_wkt,
+                                            options.source_crs_dropped, threads);
   if (!layout) return layout.error();
   WriterLayout& l = *layout;
   if (options.report) {

@@ -140,6 +140,10 @@ struct LasWriteOptions {
   // file with the WKT bit set, whatever its point format (LAS 1.4 R15 allows WKT for every format;
   // LAS 1.2 has GeoTIFF keys only).
   std::string crs_wkt;
+  // Set where the set's own CRS text (PointSet::crs) is its CRS over the source's records (the text
+  // wins: converters/las_crs.h): the records are not written, crs_wkt (the text made WKT; empty
+  // where PROJ made none) is, and no note says the input's CRS was replaced, as it was not.
+  bool source_crs_dropped = false;
   // When set, the file's bytes are appended here and nothing is written at `path` (which names the
   // output in messages).
   std::string* memory = nullptr;

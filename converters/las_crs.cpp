@@ -449,12 +449,24 @@ bool isLiblasText(const LasVlr& v) { return isLiblasWkt(v) && !wktText(v.data).e
 
 }  // namespace
 
-StatedCrs statedCrs(const PointSet& points) {
-  StatedCrs stated{points.crs, {}};
-  if (points.las)
-    for (const LasVlr& vlr : points.las->vlrs)
-      if (isLasCrsRecord(vlr)) stated.records.push_back(vlr);
+StatedCrs statedCrs(const std::optional<LasSource>& source) {
+  StatedCrs stated;
+  if (!source) return stated;
+  for (const LasVlr& vlr : source->vlrs)
+    if (isLasCrsRecord(vlr)) stated.records.push_back(vlr);
+  stated.wkt_bit = lasSaysWkt(*source);
   return stated;
+}
+
+StatedCrs statedCrs(const PointSet& points) {
+  StatedCrs stated = statedCrs(points.las);
+  stated.text = points.crs;
+  return stated;
+}
+
+std::string StatedCrs::describe() const {
+  if (!text.empty() || records.empty()) return text;
+  return lasCrsSummary(records, wkt_bit);
 }
 
 bool StatedCrs::sameAs(const StatedCrs& other) const {

@@ -30,10 +30,15 @@ bool isLasCrsRecord(const LasVlr& vlr);
 struct StatedCrs {
   std::string text;
   std::vector<LasVlr> records;  // isLasCrsRecord's, in order
+  bool wkt_bit = false;         // the records' source says WKT (lasSaysWkt)
   bool any() const { return !text.empty() || !records.empty(); }
   bool sameAs(const StatedCrs& other) const;
+  // For `info`: the text, else the records' lasCrsSummary; empty for none.
+  std::string describe() const;
 };
 StatedCrs statedCrs(const PointSet& points);
+// A LAS source's CRS records, as statedCrs takes them (none for none).
+StatedCrs statedCrs(const std::optional<LasSource>& source);
 
 // What the writer of a point format 6–10 file does with the source's CRS records.
 struct LasWktCrs {

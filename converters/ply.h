@@ -190,9 +190,10 @@ class PlyVertexStream {
   bool floatColors() const;
   uint64_t faceCount() const;  // the header's `face` rows (0 without the element)
   // The coordinate system its header states (`comment dpoint: crs`, as readPly's PointSet::crs), and
-  // a LAS source's CRS records (`comment dpoint: las crs`, as readPly's PointSet::las).
+  // a LAS source's frame and records (`comment dpoint: las frame` and `las crs`, as readPly's
+  // PointSet::las).
   const std::string& crs() const;
-  std::vector<LasVlr> lasCrsRecords() const;
+  const std::optional<LasSource>& las() const;
   // The vertex properties that are dimensions, as empty columns (names and types).
   const Dimensions& dimensions() const;
   // From now on read() also fills these of dimensions() (by index) into the block; none by default.

@@ -371,7 +371,7 @@ class PlyParser {
   }
   uint64_t vertexCount() const { return vertex_count_; }
   const std::string& crs() const { return points_.crs; }  // the header's, once read
-  std::vector<LasVlr> lasCrsRecords() const { return points_.las ? points_.las->vlrs : std::vector<LasVlr>(); }
+  const std::optional<LasSource>& las() const { return points_.las; }
   bool hasColors() const { return has_colors_; }
   bool floatColors() const { return has_colors_ && divisor_[kRed] == 1.0f && !tile_; }
   // The vertex properties that are dimensions (empty columns: names and types).
@@ -1490,7 +1490,7 @@ bool PlyVertexStream::hasColors() const { return state_->parser.hasColors(); }
 bool PlyVertexStream::floatColors() const { return state_->parser.floatColors(); }
 uint64_t PlyVertexStream::faceCount() const { return state_->parser.faceCount(); }
 const std::string& PlyVertexStream::crs() const { return state_->parser.crs(); }
-std::vector<LasVlr> PlyVertexStream::lasCrsRecords() const { return state_->parser.lasCrsRecords(); }
+const std::optional<LasSource>& PlyVertexStream::las() const { return state_->parser.las(); }
 const Dimensions& PlyVertexStream::dimensions() const { return state_->parser.dimensions(); }
 void PlyVertexStream::streamDimensions(std::vector<size_t> which) { state_->parser.streamDimensions(std::move(which)); }
 Status PlyVertexStream::read(uint64_t first, uint64_t n, PointSet& block) {

@@ -291,8 +291,9 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
       stream->e57_index_ = true;
       stream->notices_.insert(stream->notices_.end(), part.e57->notices().begin(), part.e57->notices().end());
     } else {
-      Result<std::unique_ptr<PlyVertexStream>> ply =
-          PlyVertexStream::open(path, PlyReadOptions{allow_nonfinite, nullptr, threads, true});
+      PlyReadOptions read{allow_nonfinite, nullptr, threads, true};
+      read.notices = &stream->notices_;  // a CRS left out, as the whole read says (a review finding)
+      Result<std::unique_ptr<PlyVertexStream>> ply = PlyVertexStream::open(path, read);
       if (!ply) return ply.error();
       part.ply = std::move(*ply);
       part.watch_colors = part.ply->floatColors();
@@ -322,7 +323,8 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     if (part.count > 0) {  // the coordinate system as readPointInputs chooses it
       StatedCrs stated;
       if (part.ply) {
-        stated = {part.ply->crs(), part.ply->lasCrsRecords()};
+        stated = statedCrs(part.ply->las());  // its CRS records only, as readPointInputs (a review finding)
+        stated.text = part.ply->crs();
       } else if (part.e57) {
         stated.text = part.e57->crs();
       } else {
@@ -330,13 +332,17 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
         if (!file) return file.error();
         Result<std::vector<LasVlr>> records = readLasCrsRecords(*file);
         if (!records) return records.error();
-        stated.records = std::move(*records);
+        LasSource frame;
+        frame.point_format = part.las->header().point_format;
+        frame.global_encoding = part.las->header().global_encoding;
+        frame.vlrs = std::move(*records);
+        stated = statedCrs(std::optional<LasSource>(std::move(frame)));
       }
       crs.offer(path, std::move(stated), &stream->notices_);
     }
     stream->parts_.push_back(std::move(part));
   }
-  stream->crs_ = crs.chosen().text;  // empty where the chosen one is a LAS file's records
+  stream->crs_ = crs.chosen();
   if (set->whole) {
     // Every tile's copies, read once (a seam's worth of rows), to be checked as their owners pass.
     auto copies = std::make_unique<TileCopies>();

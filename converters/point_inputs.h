@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "converters/las_crs.h"
 #include "converters/point_io.h"
 #include "core/point_set.h"
 #include "core/result.h"
@@ -66,10 +67,9 @@ class PointInputStream {
   // Faces in the files' headers: the merged set's triangles for a tile set (each triangle is in
   // one tile), the triangles readPointInputs would give otherwise (as far as every face is one).
   uint64_t faceCount() const { return faces_; }
-  // The coordinate system as text, where the first file that states one (readPointInputs's rule)
-  // states it so: a PLY, PCD or E57 file's (PointSet::crs); empty where that file states none or
-  // LAS records (a LAS file's are read with its header: readLasCrsRecords).
-  const std::string& crs() const { return crs_; }
+  // The coordinate system of the first file that states one (readPointInputs's rule): text (a PLY
+  // or E57 file's PointSet::crs) or a LAS source's records (converters/las_crs.h).
+  const StatedCrs& crs() const { return crs_; }
   // Host bytes held for the whole stream beside its blocks: a tile set's copies, E57 files' packet
   // indexes (0 for other files), and what they are, for a message.
   uint64_t heldBytes() const { return held_bytes_; }
@@ -110,7 +110,7 @@ class PointInputStream {
   std::vector<Part> parts_;  // in stream order
   std::unique_ptr<TileCopies> copies_;  // null but for a complete tile set
   uint64_t count_ = 0, faces_ = 0, held_bytes_ = 0;
-  std::string crs_;
+  StatedCrs crs_;
   bool has_colors_ = false;
   bool e57_index_ = false;  // held_bytes_ counts E57 packet indexes
   unsigned threads_ = 0;

@@ -295,7 +295,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
   // CSV and glTF have no place for it: said, not lost unseen.
   if ((format == FileFormat::kCsv || format == FileFormat::kGlb) && options.notices && statesCrs(points))
     options.notices->push_back(path + ": coordinate system not written: " +
-                               (format == FileFormat::kCsv ? "CSV" : "GLB") +
+                               (format == FileFormat::kCsv ? "a text file (CSV, XYZ, PTS)" : "GLB") +
                                " holds none (.las, .laz, .e57, .ply and .pcd keep it)");
   switch (format) {
     case FileFormat::kCsv:
@@ -346,12 +346,13 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       las.crs_wkt = options.las_crs;
       // A coordinate system another format stated (an E57 file's, or the module's `crs`), where no
       // --crs gives one: made WKT by PROJ in place of a LAS source's records (the text wins, as
-      // every writer takes it), or left out with a note (the records, if any, then stay).
+      // every writer takes it), or left out with a note (and the records with it).
       std::string crs_note;
       if (las.crs_wkt.empty() && !points.crs.empty()) {
         Result<std::string> wkt = crsAsWkt(points.crs, "the input's coordinate system");
         if (wkt) las.crs_wkt = std::move(*wkt);
         else crs_note = path + ": coordinate system not written: " + wkt.error().message;
+        las.source_crs_dropped = true;  // the text is the set's CRS, written or not (a review finding)
       }
       if (isCopcPath(path)) {
         // COPC: the LAS 1.4 file in memory (formats 6-8), then its octree of LAZ chunks.

@@ -21,14 +21,19 @@ inline std::string describeInputs(const std::vector<std::string>& paths) {
   return paths[0] + " and " + std::to_string(paths.size() - 1) + " more";
 }
 
-// The length of the well-formed UTF-8 sequence of two to four bytes at text[i] (a lead byte C2-F4
-// and its continuation bytes), or 0.
+// The length of the well-formed UTF-8 sequence of two to four bytes at text[i] (Unicode's table 3-7:
+// a lead byte C2-F4, its continuation bytes, and no overlong form, surrogate or code point past
+// U+10FFFF, which a strict decoder such as Python's refuses: a review finding), or 0.
 inline size_t utf8SequenceAt(std::string_view text, size_t i) {
   const unsigned char c = static_cast<unsigned char>(text[i]);
   const size_t n = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
   if (n == 0 || i + n > text.size()) return 0;
   for (size_t k = 1; k < n; ++k)
     if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return 0;
+  const unsigned char second = static_cast<unsigned char>(text[i + 1]);
+  if ((c == 0xE0 && second < 0xA0) || (c == 0xED && second > 0x9F) || (c == 0xF0 && second < 0x90) ||
+      (c == 0xF4 && second > 0x8F))
+    return 0;
   return n;
 }
 
@@ -40,13 +45,15 @@ inline void appendHexDigits(std::string& out, unsigned char c) {
 }
 
 // The offset of the first byte of `text` that is not plain text a header or an XML document can
-// carry (well-formed UTF-8 with no control byte but tab, line feed and carriage return, and no DEL),
-// or npos.
+// carry (well-formed UTF-8 with no control byte but tab, line feed and carriage return, no DEL, and
+// not U+FFFE or U+FFFF, which XML refuses), or npos.
 inline size_t firstNonTextByte(std::string_view text) {
   for (size_t i = 0; i < text.size(); ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     const size_t sequence = c >= 0x80 ? utf8SequenceAt(text, i) : 1;
     if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f || sequence == 0) return i;
+    if (c == 0xEF && text.compare(i + 1, 2, "\xBF\xBE") == 0) return i;  // U+FFFE
+    if (c == 0xEF && text.compare(i + 1, 2, "\xBF\xBF") == 0) return i;  // U+FFFF
     i += sequence - 1;
   }
   return std::string_view::npos;

@@ -205,7 +205,9 @@ Status adviseFor(InfoReport& report, const InfoOptions& options, const Bounds& b
 Result<InfoReport> describePoints(const PointSet& points, const std::string& name, const InfoOptions& options) {
   InfoReport report;
   report.name = name;
-  report.crs = points.crs;  // the text, which every writer takes over a LAS source's records
+  // The text, which every writer takes over a LAS source's records, else theirs (a LAS file's own
+  // are its LAS facts': describeFiles).
+  report.crs = statedCrs(points).describe();
   report.info = computeInfo(points, options.sample, options.threads);
   if (interrupted()) return interruptedError();  // its search stops at Ctrl-C, leaving its figures unfinished
   for (const Dimension& d : points.dimensions.all()) {
@@ -347,10 +349,11 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
     report->notices = (*stream)->notices();
     // What the files state, as the whole read gives it (a set streamed had no CRS and no LAS header
     // facts before the build of 2026-12-02).
-    report->crs = (*stream)->crs();
+    report->crs = (*stream)->crs().describe();
     Result<std::optional<LasFacts>> las = lasFactsOf(inputs.paths, report->info, nullptr);
     if (!las) return las.error();
     report->las = std::move(*las);
+    if (report->las && (*stream)->crs().text.empty()) report->crs.clear();  // its LAS CRS line says it
     if (!streamed.stream_ranges)
       report->notices.push_back(name + ": the dimensions' ranges not read: their " + std::to_string(dimension_bytes) +
                                 " bytes a point do not fit --max-memory beside the blocks");
@@ -387,6 +390,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   Result<std::optional<LasFacts>> las = lasFactsOf(inputs.paths, report->info, points->las ? &*points->las : &none);
   if (!las) return las.error();
   report->las = std::move(*las);
+  if (report->las && points->crs.empty()) report->crs.clear();  // its LAS CRS line says it
   return report;
 }
 

@@ -395,10 +395,37 @@ TEST(CliLas, aSetsCoordinateSystemIsOneThingEverywhere) {
     EXPECT_TRUE(test::contains(info.out, "CRS:                EPSG:32633\n")) << mode << "\n" << info.out;
   }
   for (const char* out : {"both.las", "both.e57", "both.pcd"}) {
-    ASSERT_EQ(runDpoint({"convert", dir.file("both.ply"), "-o", dir.file(out), "-q"}).exit_code, 0) << out;
+    const test::CommandResult r = runDpoint({"convert", dir.file("both.ply"), "-o", dir.file(out)});
+    ASSERT_EQ(r.exit_code, 0) << out << r.err;
+    EXPECT_FALSE(test::contains(r.err, "replaced")) << r.err;  // the set's CRS is the text: nothing replaced
     ASSERT_EQ(runDpoint({"convert", dir.file(out), "-o", dir.file("again.las"), "-q"}).exit_code, 0) << out;
     EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("again.las"), "--quiet"}).out, "LAS CRS:            EPSG:32633 ("))
         << out;
+  }
+
+  // Records alone (a PLY from LAS, several files): info states them, whole and streamed.
+  for (const char* mode : {"off", "on"}) {
+    const test::CommandResult frame = runDpoint({"info", dir.file("frame.ply"), "--stream", mode, "--quiet"});
+    EXPECT_TRUE(test::contains(frame.out, "CRS:                EPSG:2994 (")) << mode << "\n" << frame.out;
+    const test::CommandResult two = runDpoint({"info", kCorpus + "autzen.las", kCorpus + "simple.las", "--stream", mode, "--quiet"});
+    EXPECT_TRUE(test::contains(two.out, "CRS:                EPSG:2994 (")) << mode << "\n" << two.out;
+    const test::CommandResult one = runDpoint({"info", kCorpus + "autzen.las", "--stream", mode, "--quiet"});
+    EXPECT_FALSE(test::contains(one.out, "\nCRS:")) << one.out;  // its LAS CRS line says it
+    EXPECT_TRUE(test::contains(one.out, "LAS CRS:            EPSG:2994 (")) << one.out;
+  }
+  // Text PROJ makes nothing of, over records: the text is the CRS, so LAS gets none, and says so.
+  {
+    std::string text_ply = ply;
+    std::string line = "comment dpoint: crs ";
+    for (const char c : std::string("hello, not a crs")) appendHexDigits(line, static_cast<unsigned char>(c));
+    const size_t at = text_ply.find("comment dpoint: crs ");
+    text_ply.replace(at, text_ply.find('\n', at) - at, line);
+    writeFile(dir.file("text.ply"), text_ply);
+    const test::CommandResult r = runDpoint({"convert", dir.file("text.ply"), "-o", dir.file("text.las")});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(test::contains(r.err, "text.las: coordinate system not written: the input's coordinate system 'hello, not a crs'"))
+        << r.err;
+    EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("text.las"), "--quiet"}).out, "LAS CRS:            none"));
   }
 
   // Several files: the first that states one; an empty file states none; another is said.
@@ -419,10 +446,10 @@ TEST(CliLas, aSetsCoordinateSystemIsOneThingEverywhere) {
     EXPECT_TRUE(test::contains(info.err, "c.ply: its coordinate system left out: the set takes " + dir.file("b.ply") +
                                              "'s, the first file's that states one"))
         << info.err;
-    // A LAS file first: its records, and no text over them.
+    // A LAS file first: its records, not the later text.
     const test::CommandResult las = runDpoint({"info", kCorpus + "autzen.las", dir.file("b.ply"), "--stream", mode, "--json"});
     ASSERT_EQ(las.exit_code, 0) << las.err;
-    EXPECT_FALSE(test::contains(las.out, "\"crs\": ")) << las.out;
+    EXPECT_TRUE(test::contains(las.out, "\"crs\": \"EPSG:2994 (")) << las.out;
     EXPECT_TRUE(test::contains(las.err, "b.ply: its coordinate system left out")) << las.err;
   }
   Result<PointSet> joined = readPointInputs({kCorpus + "autzen.las", dir.file("b.ply")});
@@ -466,6 +493,9 @@ TEST(CliLas, aSetsCoordinateSystemIsOneThingEverywhere) {
     ASSERT_EQ(notices.size(), 1u) << to;
     EXPECT_TRUE(test::contains(notices[0], "bad.ply: coordinate system left out: its 'comment dpoint: crs' lines are not hex"))
         << notices[0];
+    const test::CommandResult streamed = runDpoint({"info", dir.file("bad.ply"), "--stream", "on"});  // said there too
+    EXPECT_TRUE(test::contains(streamed.err, "bad.ply: coordinate system left out: its 'comment dpoint: crs' lines are not hex"))
+        << streamed.err;
   }
   b.crs = "EPSG:32633";
   ASSERT_TRUE(writePoints(dir.file("b.pcd"), b).ok());

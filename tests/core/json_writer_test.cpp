@@ -41,6 +41,14 @@ TEST(JsonWriter, keepsTheOrderEscapesStringsAndWritesNumbersShortest) {
 TEST(JsonWriter, stringsAreUtf8WhateverBytesTheyHold) {
   EXPECT_EQ(jsonString("H\xc3\xb6he \xe9tendu\xff \xe2\x82"), "\"H\xc3\xb6he \\ufffdtendu\\ufffd \\ufffd\\ufffd\"");
   EXPECT_EQ(jsonString("\xf0\x9f\x98\x80\x01"), "\"\xf0\x9f\x98\x80\\u0001\"");
+  // Well-formed in shape but not UTF-8 (a second review's finding): a surrogate, overlong forms, a
+  // code point past U+10FFFF. Each byte is one replacement character.
+  for (const std::string bad : {"\xed\xa0\x80", "\xe0\x80\x80", "\xf0\x80\x80\x80", "\xf4\x90\x80\x80"})
+    EXPECT_EQ(jsonString(bad).find_first_of("\x80\xa0\x90"), std::string::npos) << jsonString(bad);
+  EXPECT_EQ(jsonString("\xed\x9f\xbf\xf4\x8f\xbf\xbf"), "\"\xed\x9f\xbf\xf4\x8f\xbf\xbf\"");  // U+D7FF, U+10FFFF
+  // XML refuses U+FFFE and U+FFFF: not text a header or an E57 file carries.
+  EXPECT_EQ(firstNonTextByte("ab\xef\xbf\xbe"), 2u);
+  EXPECT_EQ(firstNonTextByte("ab\xef\xbf\xbd"), std::string::npos);  // U+FFFD is
 }
 
 }  // namespace
