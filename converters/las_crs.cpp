@@ -490,12 +490,18 @@ std::string headerCrsProblem(const std::string& crs) {
   return "";
 }
 
+std::string HeaderCrsLines::take(const std::string& path, const char* spelled, std::vector<std::string>* notices) {
+  if (!seen_) return "";
+  const std::string why = !good_ ? "its '" + std::string(spelled) + "' lines are not hex, one word a line" : headerCrsProblem(text_);
+  if (why.empty()) return std::move(text_);
+  if (notices) notices->push_back(path + ": coordinate system left out: " + why);
+  return "";
+}
+
 std::string lasSourceWkt(const LasSource& source, std::string& why_not) {
-  std::vector<LasVlr> records;
-  for (const LasVlr& vlr : source.vlrs)
-    if (isLasCrsRecord(vlr)) records.push_back(vlr);
-  if (records.empty()) return "";
-  LasWktCrs wkt = lasWktCrs(records, lasSaysWkt(source));
+  const StatedCrs stated = statedCrs(std::optional<LasSource>(source));
+  if (stated.records.empty()) return "";
+  LasWktCrs wkt = lasWktCrs(stated.records, stated.wkt_bit);
   const auto it = std::find_if(wkt.records.begin(), wkt.records.end(), [](const LasVlr& r) { return r.record_id == 2112; });
   if (it != wkt.records.end()) return std::string(it->data.c_str());  // up to a NUL that ends it
   why_not = !wkt.note.empty() ? wkt.note : "the LAS source's is not WKT and PROJ made none of it";

@@ -13,10 +13,12 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/point_set.h"
 #include "core/result.h"
+#include "core/text.h"
 
 namespace dpoint {
 
@@ -64,6 +66,24 @@ inline constexpr size_t kMostHeaderCrsBytes = 65536;
 // Why coordinate-system text cannot go into a PLY or PCD header (more than kMostHeaderCrsBytes, a
 // byte that is not text: firstNonTextByte), for a note; empty where it can.
 std::string headerCrsProblem(const std::string& crs);
+
+// A PLY or PCD header's coordinate-system lines (`comment dpoint: crs HEX`, `# dpoint: crs HEX`),
+// read in order: the text, or none with a note where a line is not one word of hex or the text is
+// not what a header carries (headerCrsProblem).
+class HeaderCrsLines {
+ public:
+  // One line's words after "crs" (one: the hex).
+  void add(const std::vector<std::string_view>& words) {
+    seen_ = true;
+    good_ = words.size() == 1 && appendHexBytes(text_, words[0]) && good_;
+  }
+  // The text; `spelled` names the lines in the note (`path: coordinate system left out: …`).
+  std::string take(const std::string& path, const char* spelled, std::vector<std::string>* notices);
+
+ private:
+  std::string text_;
+  bool seen_ = false, good_ = true;
+};
 
 // A LAS source's coordinate system as one WKT text, for a format that holds WKT (E57, PCD, PLY):
 // its WKT record's, or its GeoTIFF keys made WKT by PROJ (lasWktCrs's choice). Empty where it has

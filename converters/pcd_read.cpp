@@ -54,9 +54,7 @@ struct Header {
   uint64_t lines = 0;        // the DATA line's number
   size_t row_bytes = 0;
   bool has_z = false, two_d = false, z_up = false, colors = false, alpha = false;
-  std::string crs;          // `# dpoint: crs` lines' bytes
-  bool crs_lines = false;   // any
-  bool crs_good = true;     // every one one word of hex
+  HeaderCrsLines crs;  // `# dpoint: crs` lines
   std::string viewpoint;  // the VIEWPOINT line when it is not the identity
   std::optional<std::array<double, 7>> pose;  // its values
   std::vector<std::pair<std::string, DimType>> dimensions;
@@ -139,10 +137,8 @@ class HeaderParser {
         if (text.find("dpoint: up axis z") != std::string_view::npos) header_.z_up = true;
         // The coordinate system another format stated (pcd_write.cpp), in hex over lines in order;
         // left out where a line is bad.
-        if (tokens.size() >= 3 && tokens[0] == "#" && tokens[1] == "dpoint:" && tokens[2] == "crs") {
-          header_.crs_lines = true;
-          header_.crs_good = tokens.size() == 4 && appendHexBytes(header_.crs, tokens[3]) && header_.crs_good;
-        }
+        if (tokens.size() >= 3 && tokens[0] == "#" && tokens[1] == "dpoint:" && tokens[2] == "crs")
+          header_.crs.add({tokens.begin() + 3, tokens.end()});
         continue;
       }
       Status s = entry(tokens);
@@ -467,12 +463,7 @@ class Reader {
     points.color_full_scale = h_.colors ? 255 : 0;
     points.z_axis = h_.has_z && !h_.two_d ? ZAxis::kPresent : ZAxis::kAbsent;
     points.z_up = h_.z_up;
-    if (h_.crs_lines) {
-      const std::string why = !h_.crs_good ? std::string("its '# dpoint: crs' lines are not hex, one word a line")
-                                           : headerCrsProblem(h_.crs);
-      if (why.empty()) points.crs = h_.crs;
-      else if (options_.notices) options_.notices->push_back(path_ + ": coordinate system left out: " + why);
-    }
+    points.crs = h_.crs.take(path_, "# dpoint: crs", options_.notices);
     if (options_.progress) options_.progress->start("reading " + path_, n);
 
     Columns columns(points);

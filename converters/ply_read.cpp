@@ -539,22 +539,14 @@ class PlyParser {
         }
         // The coordinate system another format stated, in hex over lines in order; left out where
         // a line is not one word of hex (a line with more words dropped a piece, a review finding).
-        if (w[2] == "crs") {
-          crs_lines_ = true;
-          crs_good_ = w.size() == 4 && appendHexBytes(crs_, w[3]) && crs_good_;
-        }
+        if (w[2] == "crs") crs_lines_.add({w.begin() + 3, w.end()});
       }
       if (key == "comment" || key == "obj_info") continue;
       if (key == "end_header") {
         if (points_.las)
           for (auto& [vlr, good] : crs_records_)
             if (good) points_.las->vlrs.push_back(std::move(vlr));
-        if (crs_lines_) {
-          const std::string why = !crs_good_ ? std::string("its 'comment dpoint: crs' lines are not hex, one word a line")
-                                             : headerCrsProblem(crs_);
-          if (why.empty()) points_.crs = std::move(crs_);
-          else if (options_.notices) options_.notices->push_back(path_ + ": coordinate system left out: " + why);
-        }
+        points_.crs = crs_lines_.take(path_, "comment dpoint: crs", options_.notices);
         break;
       }
       if (key == "format") {
@@ -1437,9 +1429,7 @@ class PlyParser {
   bool integer_colours_ = false;  // the header's `comment dpoint: colours 0..255`
   bool tile_ = false;  // the header's `comment dpoint-tile I/N` (kPlyTileCommentWord)
   std::vector<std::pair<LasVlr, bool>> crs_records_;  // the header's `las crs` records, each whole or not
-  std::string crs_;         // the header's `crs` lines' bytes so far
-  bool crs_lines_ = false;  // whether it has any
-  bool crs_good_ = true;    // and whether every one was one word of hex
+  HeaderCrsLines crs_lines_;  // the header's `crs` lines
   float divisor_[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1};
   uint64_t vertex_count_ = 0;
   uint64_t memory_limit_ = 0;  // --max-memory, resolved (checkSizes)

@@ -269,14 +269,6 @@ double writtenColorScale(const std::string& path, FileFormat format, const Point
   }
 }
 
-// Whether a LAS source's records state a coordinate system.
-bool hasLasCrsRecords(const PointSet& points) {
-  return points.las && std::any_of(points.las->vlrs.begin(), points.las->vlrs.end(), isLasCrsRecord);
-}
-
-// Whether the set states a coordinate system: its own (PointSet::crs), or a LAS source's records.
-bool statesCrs(const PointSet& points) { return !points.crs.empty() || hasLasCrsRecords(points); }
-
 // The coordinate-system text a PLY or PCD header states: --crs's WKT, else the set's own, else (for
 // PCD, `las_wkt`, which has no place for LAS records) a LAS source's made WKT. Text a header cannot
 // carry (headerCrsProblem) is left out with a note.
@@ -293,7 +285,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
   if ((options.colors_of || options.positions_of) && format != FileFormat::kPly)
     return Error{path + ": points made as the rows are written go to a .ply only"};
   // CSV and glTF have no place for it: said, not lost unseen.
-  if ((format == FileFormat::kCsv || format == FileFormat::kGlb) && options.notices && statesCrs(points))
+  if ((format == FileFormat::kCsv || format == FileFormat::kGlb) && options.notices && statedCrs(points).any())
     options.notices->push_back(path + ": coordinate system not written: " +
                                (format == FileFormat::kCsv ? "a text file (CSV, XYZ, PTS)" : "GLB") +
                                " holds none (.las, .laz, .e57, .ply and .pcd keep it)");
