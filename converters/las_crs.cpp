@@ -469,6 +469,12 @@ std::string StatedCrs::describe() const {
   return lasCrsSummary(records, wkt_bit);
 }
 
+std::string crsLabel(const StatedCrs& crs) {
+  if (crs.text.empty()) return crs.describe();
+  const std::string name = wktName(crs.text);
+  return !name.empty() && firstNonTextByte(name) == std::string::npos ? name : quotedExcerpt(crs.text);
+}
+
 bool StatedCrs::sameAs(const StatedCrs& other) const {
   if (text != other.text || records.size() != other.records.size()) return false;
   for (size_t k = 0; k < records.size(); ++k) {

@@ -38,6 +38,9 @@ struct StatedCrs {
   // For `info`: the text, else the records' lasCrsSummary; empty for none.
   std::string describe() const;
 };
+// A CRS in a few words, for a note: a WKT's name, other text quoted (an excerpt), else the records'
+// lasCrsSummary.
+std::string crsLabel(const StatedCrs& crs);
 StatedCrs statedCrs(const PointSet& points);
 // A LAS source's CRS records, as statedCrs takes them (none for none).
 StatedCrs statedCrs(const std::optional<LasSource>& source);

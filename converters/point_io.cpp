@@ -336,6 +336,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       las.progress = options.progress;
       las.report = &report;
       las.crs_wkt = options.las_crs;
+      las.source_crs_dropped = !options.las_crs.empty();  // writePoints says what --crs replaced
       // A coordinate system another format stated (an E57 file's, or the module's `crs`), where no
       // --crs gives one: made WKT by PROJ in place of a LAS source's records (the text wins, as
       // every writer takes it), or left out with a note (and the records with it).
@@ -428,6 +429,14 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
                                 ? colorsOffGrid(points.colors, full, options.threads)
                                 : ColorsOffGrid{};
   if (Status s = writeFormat(path, *format, points, options); !s) return s;
+  // --crs in place of the set's own CRS: said for every format that keeps one (it was said for LAS
+  // alone; the last note's list).
+  if (options.notices && !options.las_crs.empty() && *format != FileFormat::kCsv && *format != FileFormat::kGlb) {
+    const StatedCrs stated = statedCrs(points);
+    if (stated.any() && stated.text != options.las_crs)
+      options.notices->push_back(path + ": the input's CRS (" + crsLabel(stated) + ") replaced by " +
+                                 crsLabel(StatedCrs{options.las_crs, {}, false}));
+  }
   if (off.rounded != 0 || off.clamped != 0) {
     const std::string scale = full == 255.0 ? "255" : "65535";
     const std::string keeps = *format == FileFormat::kPly ? "ply_colors or --ply-colors float keeps them"

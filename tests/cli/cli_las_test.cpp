@@ -310,6 +310,21 @@ TEST(CliLas, theCoordinateSystemSurvivesPlyAndPcdAndStreamedInfoStatesIt) {
     ASSERT_EQ(runDpoint({"convert", dir.file(via), "-o", dir.file("g.las"), "-q"}).exit_code, 0);
     EXPECT_TRUE(test::contains(runDpoint({"info", dir.file("g.las"), "--quiet"}).out, "LAS CRS:            EPSG:32633 ("));
   }
+  // What --crs replaces is said for every output that keeps a CRS (it was said for LAS alone), and
+  // not where the input states none.
+  for (const char* to : {"r.ply", "r.pcd", "r.e57", "r.las", "r.copc.laz"}) {
+    SCOPED_TRACE(to);
+    const test::CommandResult given = runDpoint({"convert", dir.file("a.e57"), "--crs", "EPSG:32633", "-o", dir.file(to)});
+    ASSERT_EQ(given.exit_code, 0) << given.err;
+    EXPECT_TRUE(test::contains(given.err, "the input's CRS (NAD83(HARN) / Oregon GIC Lambert (ft)) replaced by WGS 84 / UTM zone 33N"))
+        << given.err;
+    EXPECT_EQ(given.err.find("replaced by", given.err.find("replaced by") + 1), std::string::npos) << given.err;
+  }
+  test::CommandResult plain = runDpoint({"convert", dir.file("r.ply"), "-o", dir.file("n.csv"), "-q"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  plain = runDpoint({"convert", dir.file("n.csv"), "--crs", "EPSG:32633", "-o", dir.file("n.ply")});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(test::contains(plain.err, "replaced")) << plain.err;
   test::CommandResult r = runDpoint({"convert", kCorpus + "autzen.las", "-o", dir.file("l.pcd")});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(runDpoint({"convert", dir.file("l.pcd"), "-o", dir.file("l.las"), "-q"}).exit_code, 0);
