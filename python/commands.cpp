@@ -58,6 +58,7 @@ void addCommands(py::module_& m) {
           files.columns = columns;
           return describeFiles(files, options, bar);
         }));
+        warnAtCaller(report.notices);  // what the readers read past, as read warns it (the CLI's notes)
         return infoReportJson(report);
       },
       py::arg("points"), py::arg("inputs"), py::arg("camera_args"), py::arg("sample"), py::arg("threads"),

@@ -40,6 +40,11 @@ SetInUse::~SetInUse() {
   if (set_) setsInUse().erase(setsInUse().find(set_));
 }
 
+void warnAtCaller(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines)
+    if (PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 2) < 0) throw py::error_already_set();
+}
+
 void checkNotInUse(const PointSet& set, const std::string& what) {
   if (setsInUse().count(&set))
     throw std::runtime_error(what + ": the set is being read by a dpoint call in another thread (write, info, render, "

@@ -115,6 +115,10 @@ inline std::shared_ptr<PointSet> heldSet(const py::handle& object) {
 }
 inline PointSet& setOf(const py::handle& self) { return heldBy<PointSet>(self, "make one with dpoint.PointSet(positions)"); }
 
+// Each line a UserWarning shown at the line that called the package's function: stack level 2, as
+// read, write, sample and info are called through their wrappers in dpoint/__init__.py.
+void warnAtCaller(const std::vector<std::string>& lines);
+
 // Progress lines on stderr when asked (progress=True), else none.
 inline std::FILE* progressFile(bool progress) { return progress ? stderr : nullptr; }
 

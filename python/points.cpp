@@ -371,13 +371,6 @@ py::array view3(const py::object& owner, const T* data, size_t rows) {
   return py::array_t<T>({n, py::ssize_t{3}}, {py::ssize_t{3 * sizeof(T)}, py::ssize_t{sizeof(T)}}, data, viewBase(owner));
 }
 
-// Each line a UserWarning shown at the line that called the package's function: stack level 2, as
-// read, write and sample are called through their wrappers in dpoint/__init__.py.
-void warnAtCaller(const std::vector<std::string>& lines) {
-  for (const std::string& line : lines)
-    if (PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 2) < 0) throw py::error_already_set();
-}
-
 // max_memory and the like: None or 0 (the default), bytes as a number, or a size as text ("8G").
 Result<uint64_t> memoryOption(const std::string& name, const py::object& given) {
   if (given.is_none()) return uint64_t{0};

@@ -1,9 +1,11 @@
 """dpoint.info: the object `dpoint info --json` prints, for a set in memory or files."""
+import json
+
 import numpy as np
 import pytest
 
 import dpoint
-from conftest import as_keywords, cli_error, cli_json, options_as_flags
+from conftest import as_keywords, cli, cli_error, cli_json, options_as_flags
 
 
 def without_file(report):
@@ -105,3 +107,26 @@ def test_read_refuses_a_negative_scene_as_the_cli_does(tmp_path):
     dpoint.write(dpoint.PointSet(np.zeros((3, 3)), triangles=np.array([[0, 1, 2]])), tmp_path / "m.glb")
     with pytest.raises(dpoint.Error, match="scene -2: must be 0 or more"):
         dpoint.read(tmp_path / "m.glb", scene=-2)
+
+
+@pytest.mark.parametrize("stream", ["off", "on"])
+def test_info_warns_what_the_cli_notes(tmp_path, stream):
+    """What the readers read past comes as a UserWarning at the caller, each of the CLI's notes (the
+    build before said nothing: read warned them, info did not)."""
+    import warnings
+
+    files = []
+    for name, crs in (("a.ply", "EPSG:4326"), ("b.ply", "EPSG:32633")):
+        s = dpoint.PointSet(np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.5]]))
+        s.crs = crs
+        dpoint.write(s, tmp_path / name)
+        files.append(tmp_path / name)
+    done = cli("info", *files, "--stream", stream, "--json")
+    notes = [line[len("dpoint: note: "):] for line in done.stderr.splitlines() if line.startswith("dpoint: note: ")]
+    assert notes and any("its coordinate system left out" in note for note in notes), done.stderr
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        report = dpoint.info(files, stream=stream)
+    assert [str(w.message) for w in caught] == notes
+    assert all(w.category is UserWarning and w.filename == __file__ for w in caught)
+    assert report == json.loads(done.stdout)
