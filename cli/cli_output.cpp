@@ -11,7 +11,7 @@
 
 namespace dpoint {
 
-std::string pointOutputHelp() { return "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz, .e57); written whole or not at all"; }
+std::string pointOutputHelp() { return "Output file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz, .e57); written whole or not at all"; }
 
 Status checkPointOutput(const std::string& path) {
   if (Status s = AtomicFile::checkTarget(path); !s) return s;  // first: a folder is no file of any type

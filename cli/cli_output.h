@@ -14,14 +14,14 @@ namespace dpoint {
 
 // The formats a point set is written as (.gltf and .laz are read only), as help and errors
 // list them.
-inline constexpr const char* kPointOutputFormats = ".csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz or .e57";
-// "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz, .e57); written whole or not at all": the -o help of the commands
+inline constexpr const char* kPointOutputFormats = ".csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz or .e57";
+// "Output file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz, .e57); written whole or not at all": the -o help of the commands
 // that write a point set.
 std::string pointOutputHelp();
 
 // -o of a point set: a place it can be written (AtomicFile::checkTarget: a missing folder, a folder
 // given as the file, a folder that cannot be written into), then a written format ("PATH: unknown
-// file type '.dat' (write .csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz or .e57)"). As validators, both are usage errors (exit 1).
+// file type '.dat' (write .csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz or .e57)"). As validators, both are usage errors (exit 1).
 Status checkPointOutput(const std::string& path);
 // An output folder that is created when missing (bench --out): not a file, and the nearest folder
 // that exists can be written into. `flag` names the option in the message.

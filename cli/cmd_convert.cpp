@@ -157,9 +157,9 @@ int runConvert(ConvertOptions& o) {
 
 void addConvertCommand(CLI::App& app, RunCommand& run) {
   auto o = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc, .pts), .ptx (read), .ply, .pcd, .glb, .las, .laz and .e57");
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a point set or mesh between .csv (and text: .xyz, .txt, .asc, .pts, .ptx), .ply, .pcd, .glb, .las, .laz and .e57");
   cmd->add_option("input", o->input, "Input file (.csv, .xyz, .txt, .asc, .pts, .ptx, .e57, .ply, .pcd, .glb, .gltf, .las, .laz)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz, .e57); written whole or not at all")
+  cmd->add_option("-o,--output", o->output, "Output file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz, .e57); written whole or not at all")
       ->required()
       ->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals,

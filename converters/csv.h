@@ -81,7 +81,8 @@ Result<PointSet> readCsv(const InputFile& file, const CsvReadOptions& options = 
 // The CSV reader itself, whatever the file's name (readPtx reads each scan's rows with it).
 Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& options);
 
-// A path ending .ptx (any case): Leica's PTX text, read (not written) by the CSV code.
+// A path ending .ptx (any case): Leica's PTX text, read by the CSV code (readPtx) and written by
+// writeCsv as one scan.
 bool isPtxPath(const std::string& path);
 // Leica PTX (converters/ptx_read.cpp): scans, each a ten-line header (the grid's columns and
 // rows, the scanner's registered position and axes, a 4x4 transformation in row-vector form, its
@@ -115,6 +116,13 @@ struct CsvLayout {
   // not written), and the dimensions before the colours; writeCsv makes its layout (x y z,
   // intensity, r g b of 0..255).
   bool pts = false;
+  // Leica's PTX (isPtxPath): a PTS layout whose header is one scan's ten lines (columns: the rows,
+  // one row; the scanner at `offset`, its axes the world's, and the translation `offset`), whose
+  // rows are the positions less `offset`, and whose rows carry an intensity of 0 where the set has
+  // none (`zero_intensity`: CloudCompare refuses rows without one). writeCsv makes its layout.
+  bool ptx = false;
+  glm::dvec3 offset{0.0};
+  bool zero_intensity = false;
 };
 
 // The header names CsvRowWriter gives layout.dimensions (writableNames): none holding a separator

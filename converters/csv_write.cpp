@@ -64,7 +64,8 @@ class RowFormatter {
   RowFormatter(const CsvLayout& layout, int decimals, bool at_scale)
       : decimals_(decimals), at_scale_(at_scale && decimals >= 0), planar_(layout.planar), colors_(layout.colors),
         separator_(layout.separator), color_full_scale_(layout.color_full_scale), pts_(layout.pts),
-        dimension_names_(layout.dimensions) {}
+        zero_intensity_(layout.zero_intensity), offset_(layout.offset),
+        offset_any_(layout.offset != glm::dvec3(0.0)), dimension_names_(layout.dimensions) {}
 
   std::string header() const {
     std::vector<std::string> names = {"x", "y"};
@@ -86,13 +87,13 @@ class RowFormatter {
   // dims (one per name of the layout, or null without any) are read at rows first … first + count.
   void format(const glm::dvec3* positions, const glm::vec3* colors, size_t count, TextBuffer& out,
               const std::vector<const Dimension*>* dims = nullptr, size_t first = 0) const {
-    const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u) + (dims ? dims->size() : 0u);
+    const size_t fields = (planar_ ? 2u : 3u) + (colors_ ? 3u : 0u) + (dims ? dims->size() : 0u) + (zero_intensity_ ? 1u : 0u);
     const size_t row_max = fields * kMaxFieldChars;
     out.clear();
     out.reserve(count * fields * 24 + row_max);  // the shortest forms' size; grown only for long fixed-form rows
     for (size_t i = 0; i < count; ++i) {
       out.appendWith(row_max, [&](char* p, char* limit) {
-        const glm::dvec3& v = positions[i];
+        const glm::dvec3 v = offset_any_ ? positions[i] - offset_ : positions[i];
         p = number(p, limit, v.x);
         *p++ = separator_;
         p = number(p, limit, v.y);
@@ -108,6 +109,10 @@ class RowFormatter {
             }
         };
         if (pts_) dimensions();  // PTS: x y z intensity r g b
+        if (zero_intensity_) {
+          *p++ = separator_;
+          *p++ = '0';
+        }
         if (colors_) {
           const glm::vec3& c = colors[i];
           for (int k = 0; k < 3; ++k) {
@@ -143,8 +148,27 @@ class RowFormatter {
   char separator_;
   uint16_t color_full_scale_;
   bool pts_;
+  bool zero_intensity_;
+  glm::dvec3 offset_;
+  bool offset_any_;
   const std::vector<std::string>& dimension_names_;
 };
+
+// A PTX scan's ten header lines (one scan of `rows` points, as columns of one row each): the
+// scanner's registered position `offset`, its axes the world's, and the transformation in row-vector
+// form, the identity but for the translation `offset` (p' = [x y z 1] M).
+std::string ptxHeader(uint64_t rows, const glm::dvec3& offset) {
+  std::string t;
+  for (int k = 0; k < 3; ++k) {
+    char buffer[32];  // a whole number below 2^52
+    const std::to_chars_result r = std::to_chars(buffer, buffer + sizeof buffer, offset[k], std::chars_format::fixed);
+    assert(r.ec == std::errc());
+    t += k ? " " : "";
+    t.append(buffer, r.ptr);
+  }
+  return std::to_string(rows) + "\n" + (rows ? "1" : "0") + "\n" + t + "\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n" + t +
+         " 1\n";
+}
 
 Status checkDecimals(int decimals) {
   if (decimals > kMaxDecimals)
@@ -182,10 +206,12 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
                                  " (a column's name holds no separator, and x, y, z, r, g and b name the position's and "
                                  "colour's columns)");
   CsvRowWriter writer(std::move(*file), layout, options);
-  const std::string header =
-      layout.pts ? std::to_string(rows) + "\n" : RowFormatter(layout, options.decimals, options.at_scale).header();
+  const std::string header = layout.ptx   ? ptxHeader(rows, layout.offset)
+                             : layout.pts ? std::to_string(rows) + "\n"
+                                          : RowFormatter(layout, options.decimals, options.at_scale).header();
   // At least a digit and a separator a value: refused at once where the disk cannot hold even that.
-  const uint64_t values = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0) + layout.dimensions.size();
+  const uint64_t values = (layout.planar ? 2 : 3) + (layout.colors ? 3 : 0) + layout.dimensions.size() +
+                          (layout.zero_intensity ? 1 : 0);
   if (Status s = writer.file_.checkSpace(header.size() + rows * values * AtomicFile::kLeastTextBytesPerValue); !s)
     return s.error();
   if (Status s = writer.file_.write(header); !s) return s.error();
@@ -261,7 +287,7 @@ Status CsvRowWriter::appendSet(const PointSet& points) {
   std::vector<const Dimension*> dims;
   if (!layout_.pts)
     for (const Dimension& d : points.dimensions.all()) dims.push_back(&d);
-  else if (const Dimension* intensity = points.dimensions.find(dim::kIntensity))
+  else if (const Dimension* intensity = points.dimensions.find(dim::kIntensity); intensity && !layout_.zero_intensity)
     dims.push_back(intensity);
   assert(dims.size() == layout_.dimensions.size());
   for (size_t at = 0; at < points.size(); at += batch_rows_)
@@ -280,28 +306,87 @@ Status CsvRowWriter::commit() {
 
 namespace {
 
+// PTX's translation for a set: each axis's bounds centre, rounded to a whole unit, where every
+// finite coordinate on it less that and added back is itself again (so the rows, small numbers a
+// reader may hold as float32, read back to the same doubles); else 0 on that axis. A whole unit
+// is a multiple of every coordinate's step below 2^53, so a coordinate within its own magnitude of
+// the centre always passes; one far from it (a point at 1e-9 in a set centred at 1e6) does not.
+glm::dvec3 ptxOffset(const PositionArray& positions, unsigned threads) {
+  constexpr size_t kBlock = 1u << 16;
+  const size_t blocks = (positions.size() + kBlock - 1) / kBlock;
+  const unsigned workers = resolveThreads(threads);
+  std::vector<Box> boxes(workers, Box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)});
+  parallelFor(blocks, workers, [&](size_t b, unsigned w) {
+    for (size_t i = b * kBlock, end = std::min(positions.size(), i + kBlock); i < end; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (std::isfinite(positions[i][k])) {
+          boxes[w].min[k] = std::min(boxes[w].min[k], positions[i][k]);
+          boxes[w].max[k] = std::max(boxes[w].max[k], positions[i][k]);
+        }
+  });
+  glm::dvec3 offset(0.0);
+  for (int k = 0; k < 3; ++k) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const Box& box : boxes) lo = std::min(lo, box.min[k]), hi = std::max(hi, box.max[k]);
+    const double centre = std::nearbyint(lo / 2 + hi / 2);
+    if (lo <= hi && std::isfinite(centre) && std::fabs(centre) < 0x1p52) offset[k] = centre + 0.0;  // never -0
+  }
+  if (offset == glm::dvec3(0.0)) return offset;
+  std::vector<std::array<uint8_t, 3>> inexact(workers, {0, 0, 0});
+  parallelFor(blocks, workers, [&](size_t b, unsigned w) {
+    for (size_t i = b * kBlock, end = std::min(positions.size(), i + kBlock); i < end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double v = positions[i][k];
+        if (std::isfinite(v) && (v - offset[k]) + offset[k] != v) inexact[w][k] = 1;
+      }
+  });
+  for (const auto& axes : inexact)
+    for (int k = 0; k < 3; ++k)
+      if (axes[k]) offset[k] = 0.0;
+  return offset;
+}
+
 // PTS (Leica Cyclone, FARO, CloudCompare): the point count, then a row per point, x y z, its
-// intensity where the set has one, and r g b as 0-255 integers where it has colours. A PTS row has
-// no room for other dimensions: they are not written.
-Status writePts(const std::string& path, const PointSet& points, const CsvWriteOptions& options) {
+// intensity where the set has one, and r g b as 0-255 integers where it has colours. PTX
+// (Leica's scans): one scan of the set's points (ptxHeader), each row x y z less ptxOffset, an
+// intensity (0 where the set has none) and r g b as PTS's. Neither row has room for other
+// dimensions: they are not written.
+Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvWriteOptions& options, bool ptx) {
+  const char* format = ptx ? "PTX" : "PTS";
   const Dimension* intensity = points.dimensions.find(dim::kIntensity);
   CsvLayout layout{false, points.hasColors(), {}};  // z always, 0 for a 2D set
   layout.color_full_scale = 255;
   layout.pts = true;
   if (intensity) layout.dimensions.push_back(intensity->name);
+  layout.ptx = ptx;
+  layout.zero_intensity = ptx && !intensity;
+  if (ptx) layout.offset = ptxOffset(points.positions, options.threads);
+  const glm::dvec3 offset = layout.offset;
   Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
   if (!writer) return writer.error();
   if (Status s = writer->appendSet(points); !s) return s;
   if (Status s = writer->commit(); !s) return s;
-  // What PTS cannot hold, said once the file is there.
+  // What PTS and PTX cannot hold, said once the file is there.
   if (options.notices) {
     std::string dropped;
     for (const Dimension& d : points.dimensions.all())
       if (&d != intensity) dropped += (dropped.empty() ? "" : ", ") + d.name;
     if (!dropped.empty())
-      options.notices->push_back(path + ": PTS holds x, y, z, intensity and r, g, b only: " + dropped + " left out");
+      options.notices->push_back(path + ": " + format + " holds x, y, z, intensity and r, g, b only: " + dropped +
+                                 " left out");
     if (points.hasColors() && points.color_full_scale == 65535)
-      options.notices->push_back(path + ": 16-bit colours written as 8-bit (PTS holds 0..255)");
+      options.notices->push_back(path + ": 16-bit colours written as 8-bit (" + format + " holds 0..255)");
+    if (ptx && !intensity && points.size() != 0)
+      options.notices->push_back(path + ": the set has no intensity: each row's is 0 (a PTX row carries one; "
+                                        "CloudCompare refuses rows without)");
+    if (ptx) {
+      const size_t at = std::count(points.positions.begin(), points.positions.end(), offset);
+      if (at != 0)
+        options.notices->push_back(path + ": " + countOf(at, "point") + " at the scan's origin (" +
+                                   formatNumber(offset.x) + ", " + formatNumber(offset.y) + ", " +
+                                   formatNumber(offset.z) + ") written as 0 0 0, which PTX readers (dpoint's, "
+                                   "CloudCompare's) take for a cell with no echo and leave out");
+    }
   }
   return okStatus();
 }
@@ -315,7 +400,7 @@ Status writeCsv(const std::string& path, const PointSet& points, const CsvWriteO
   if (!points.colors.empty() && points.colors.size() != points.positions.size())
     return Error{"point set has " + std::to_string(points.colors.size()) + " colours for " +
                  std::to_string(points.positions.size()) + " points"};
-  if (isPtsPath(path)) return writePts(path, points, options);
+  if (isPtsPath(path) || isPtxPath(path)) return writePtsOrPtx(path, points, options, isPtxPath(path));
   CsvLayout layout{!points.hasZ(), points.hasColors(), {}};
   // Integers where the colours came as integers from a text file or a PLY's 16-bit ones; a LAS
   // file's colours stay 0..1 values, as they always were in CSV.

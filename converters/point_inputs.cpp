@@ -416,7 +416,7 @@ void PointInputStream::noteColorsAboveOne(Part& part, const glm::vec3* colors, s
 void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t n, uint64_t first) {
   if (part.color_scale == 0 || colors == nullptr) return;
   constexpr size_t kBlock = size_t{1} << 16;
-  const float full = part.color_scale, scale = 1.0f / full;
+  const float full = part.color_scale;
   std::vector<std::pair<size_t, glm::vec3>> odd((n + kBlock - 1) / kBlock, {SIZE_MAX, glm::vec3(0.0f)});
   parallelFor(odd.size(), threads_, [&](size_t b, unsigned) {
     for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i) {
@@ -424,7 +424,7 @@ void PointInputStream::takeStreamedColors(Part& part, glm::vec3* colors, size_t 
         const float c = colors[i][k];
         if (!isWholeChannel(c, full) && odd[b].first == SIZE_MAX) odd[b] = {i, colors[i]};
       }
-      colors[i] *= scale;  // as takeColorsAsIntegers divides a whole read's
+      colors[i] /= full;  // as takeColorsAsIntegers divides a whole read's
     }
   });
   const auto first_odd = std::find_if(odd.begin(), odd.end(), [](const auto& o) { return o.first != SIZE_MAX; });

@@ -122,8 +122,6 @@ Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query,
 Status checkWrittenFormat(const std::string& path, FileFormat format) {
   if (format == FileFormat::kGltf)
     return Error{path + ": .gltf is read, not written; write .glb (or .csv, .ply, .pcd, .las)", ExitCode::kUsage};
-  if (isPtxPath(path))
-    return Error{path + ": .ptx is read, not written; write .pts or .las (or .csv, .ply, .pcd, .glb)", ExitCode::kUsage};
   return okStatus();
 }
 
@@ -237,7 +235,7 @@ Status checkFormatOptionsUsed(const std::string& path, const FormatOptionsGiven&
     return Status(Error{option + ": only " + what + ", not " + quotedExcerpt(path), ExitCode::kUsage});
   };
   if (given.decimals && *format != FileFormat::kCsv)
-    return refuse("--decimals", "a CSV output (.csv, .xyz, .txt, .asc, .pts) has decimals");
+    return refuse("--decimals", "a CSV output (.csv, .xyz, .txt, .asc, .pts, .ptx) has decimals");
   if ((given.ply_ascii || given.ply_colors) && *format != FileFormat::kPly)
     return refuse(given.ply_ascii ? "--ply-ascii" : "--ply-colors", "a PLY output (.ply) has it");
   if (given.pcd_encoding && *format != FileFormat::kPcd) return refuse("--pcd-encoding", "a PCD output (.pcd) has an encoding");
@@ -261,7 +259,7 @@ double writtenColorScale(const std::string& path, FileFormat format, const Point
                  ? 65535.0
                  : 255.0;
     case FileFormat::kPcd: return 255.0;
-    case FileFormat::kCsv: return isPtsPath(path) ? 255.0 : 0.0;
+    case FileFormat::kCsv: return isPtsPath(path) || isPtxPath(path) ? 255.0 : 0.0;
     case FileFormat::kE57: return points.color_full_scale == 65535 ? 65535.0 : 255.0;
     case FileFormat::kLas:
     case FileFormat::kLaz: return points.color_full_scale == 255 && points.las ? 255.0 : 65535.0;
@@ -287,7 +285,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
   // CSV and glTF have no place for it: said, not lost unseen.
   if ((format == FileFormat::kCsv || format == FileFormat::kGlb) && options.notices && statedCrs(points).any())
     options.notices->push_back(path + ": coordinate system not written: " +
-                               (format == FileFormat::kCsv ? "a text file (CSV, XYZ, PTS)" : "GLB") +
+                               (format == FileFormat::kCsv ? "a text file (CSV, XYZ, PTS, PTX)" : "GLB") +
                                " holds none (.las, .laz, .e57, .ply and .pcd keep it)");
   switch (format) {
     case FileFormat::kCsv:
@@ -441,7 +439,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
     const std::string scale = full == 255.0 ? "255" : "65535";
     const std::string keeps = *format == FileFormat::kPly ? "ply_colors or --ply-colors float keeps them"
                               : *format == FileFormat::kPcd ? "PCD's rgb holds 0..255 a channel; .ply with float colours, .csv or .glb keeps them"
-                              : *format == FileFormat::kCsv ? "PTS holds 0..255; .csv keeps them"
+                              : *format == FileFormat::kCsv ? (isPtxPath(path) ? "PTX holds 0..255; .csv keeps them" : "PTS holds 0..255; .csv keeps them")
                               : *format == FileFormat::kE57 ? "E57's colours are integers; .ply with float colours, .csv or .glb keeps them"
                                                             : "LAS holds 0..65535; .ply with float colours, .csv or .glb keeps them";
     const std::string of = " of " + std::to_string(points.size()) + " points have colours read as fractions ";

@@ -98,10 +98,13 @@ std::string oddColorNote(const glm::vec3& color, uint64_t vertex) {
 
 void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
   constexpr size_t kBlock = size_t{1} << 18;
-  const float scale = 1.0f / static_cast<float>(full);
+  // Divided, not multiplied by 1/full: k / 255.0f is the float the PLY, LAS and module readers make
+  // of k (229 * (1 / 255.0f) is a float above 229 / 255.0f), so a colour is one float whatever file
+  // it came from.
+  const float divisor = static_cast<float>(full);
   parallelFor((points.colors.size() + kBlock - 1) / kBlock, threads, [&](size_t b, unsigned) {
     const size_t end = std::min(points.colors.size(), (b + 1) * kBlock);
-    for (size_t i = b * kBlock; i < end; ++i) points.colors[i] *= scale;
+    for (size_t i = b * kBlock; i < end; ++i) points.colors[i] /= divisor;
   });
   points.color_full_scale = full;
   points.colors_read_as_fractions = false;

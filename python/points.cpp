@@ -724,7 +724,7 @@ progress: lines on stderr.)");
       py::arg("order") = "input",
       py::arg("no_colors") = false, py::arg("color_format") = "linear", py::arg("unique") = false,
       py::arg("threads") = 0u, py::arg("max_memory") = py::none(), py::arg("progress") = false,
-      R"(Writes a set as .csv (.xyz, .txt, .asc, .pts), .ply, .pcd, .glb, .las, .laz or .e57 (by extension), whole or not at all, as `dpoint convert` does.
+      R"(Writes a set as .csv (.xyz, .txt, .asc, .pts, .ptx), .ply, .pcd, .glb, .las, .laz or .e57 (by extension), whole or not at all, as `dpoint convert` does.
 
 decimals: CSV fixed digits (-1: shortest round trip). ply_ascii, ply_colors (None or auto: ushort for 16-bit colours, else uchar; uchar; ushort; float),
 pcd_encoding (None: binary; ascii, binary or binary_compressed),

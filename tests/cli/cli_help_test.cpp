@@ -124,7 +124,7 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
       {concat(slow, {dir.file("missing/x.ply")}),
        "cannot write '" + dir.file("missing/x.ply") + "': folder '" + dir.file("missing") + "' does not exist"},
       {concat(slow, {dir.path()}), "cannot write '" + dir.path() + "': it is a folder"},
-      {concat(slow, {dir.file("x.dat")}), dir.file("x.dat") + ": unknown file type '.dat' (write .csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz or .e57)"},
+      {concat(slow, {dir.file("x.dat")}), dir.file("x.dat") + ": unknown file type '.dat' (write .csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz or .e57)"},
       {concat(slow, {dir.file("x.gltf")}), dir.file("x.gltf") + ": .gltf is read, not written; write .glb"},
       {concat(slow, {"/sys/dpoint-test.ply"}), "'/sys/dpoint-test.ply': Permission denied"},  // even for root
       {{"merge", dir.file("no-such-tile.ply"), "-o", dir.file("missing/x.csv")}, "folder '" + dir.file("missing") + "' does not exist"},
@@ -155,10 +155,10 @@ TEST(CliHelp, badOutputIsRefusedBeforeAnyWorkAndNothingIsWritten) {
 TEST(CliHelp, everyListedOutputFormatIsWritten) {
   for (const char* command : {"merge", "convert"}) {
     test::CommandResult help = runDpoint({command, "--help"});
-    EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz, .e57)")) << command;
+    EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz, .e57)")) << command;
   }
   test::CommandResult help = runDpoint({"generate", "random2d", "--help"});
-  EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ply, .pcd, .glb, .las, .laz, .e57)")) << help.out;
+  EXPECT_TRUE(contains(help.out, "Output file (.csv, .xyz, .txt, .asc, .pts, .ptx, .ply, .pcd, .glb, .las, .laz, .e57)")) << help.out;
   EXPECT_FALSE(contains(help.out, ".gltf"));
   EXPECT_TRUE(contains(runDpoint({"--help"}).out, "CSV, PLY, GLB, LAS and LAZ"));
   TempDir dir;

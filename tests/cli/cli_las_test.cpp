@@ -226,7 +226,7 @@ TEST(CliLas, crsGivenIsWrittenAsKeysOrWkt) {
            {{"--crs", "/dev/zero", "-o", dir.file("c.las")}, "not a regular file, not a file holding a CRS"},
            // Options that would do nothing (a review finding: they passed silently).
            {{"--las-scale", "0.1", "-o", dir.file("c.ply")}, "--las-scale: only a LAS, LAZ or COPC output (.las, .laz, .copc.laz) has"},
-           {{"--decimals", "3", "-o", dir.file("c.las")}, "--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts)"},
+           {{"--decimals", "3", "-o", dir.file("c.las")}, "--decimals: only a CSV output (.csv, .xyz, .txt, .asc, .pts, .ptx)"},
            {{"--keep", "intensity", "--drop", "intensity", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
            {{"--keep", "intensity", "--drop", "all", "-o", dir.file("c.ply")}, "--keep and --drop: give one"},
            {{"--crs", "EPSG:4326", "-o", dir.file("c.csv")},

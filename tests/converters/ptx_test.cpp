@@ -115,8 +115,8 @@ TEST(Ptx, joinsScansTellingThemApartByPointSourceId) {
   // fractions in a scan without a value above 1, and 256 as a 16-bit scale: a review finding).
   Result<PointSet> dark = readText(dir, header(1, 1) + "1 2 3 0.5 0 1 1\n" + header(1, 1) + "1 2 3 0.5 10 20 30\n");
   ASSERT_TRUE(dark.ok()) << dark.error().message;
-  EXPECT_EQ(dark->colors[0], glm::vec3(0.0f, 1.0f, 1.0f) * (1.0f / 255.0f));  // as takeColorsAsIntegers scales
-  EXPECT_EQ(dark->colors[1], glm::vec3(10.0f, 20.0f, 30.0f) * (1.0f / 255.0f));
+  EXPECT_EQ(dark->colors[0], glm::vec3(0.0f, 1.0f, 1.0f) / 255.0f);  // as takeColorsAsIntegers scales
+  EXPECT_EQ(dark->colors[1], glm::vec3(10.0f, 20.0f, 30.0f) / 255.0f);
   EXPECT_EQ(dark->color_full_scale, 255);
 }
 
@@ -238,6 +238,45 @@ TEST(Ptx, badFilesAreRefusedNamingTheLine) {
   Result<PointSet> refused = readCsv(dir.file("c.ptx"), columns);
   ASSERT_FALSE(refused.ok());
   EXPECT_EQ(refused.error().code, ExitCode::kUsage);
+}
+
+// Written (writeCsv to .ptx): one scan whose translation is each axis's centre in whole units
+// where every coordinate less it and added back is itself (else 0), its rows shortest round trip,
+// an intensity of 0 where the set has none; read back to the same doubles. A point at the scan's
+// origin is a row of 0 0 0, which a reader takes for no echo: said, as it is lost.
+TEST(Ptx, writesOneScanAboutAWholeTranslationThatReadsBackExactly) {
+  TempDir dir;
+  PointSet far;
+  far.positions = {{0.0, 0.0, 0.0}, {1e6, 2e6 + 0.125, -1e6}, {1e6 + 0.1, 2e6, -1e6 - 0.3}};
+  std::vector<std::string> notices;
+  CsvWriteOptions options;
+  options.notices = &notices;
+  ASSERT_TRUE(writeCsv(dir.file("far.ptx"), far, options).ok());
+  const std::string text = test::readFile(dir.file("far.ptx"));
+  EXPECT_EQ(text, header(3, 1, "500000 1000000 -500000") +
+                      "-5e+05 -1e+06 5e+05 0\n5e+05 1000000.125 -5e+05 0\n500000.1 1e+06 -500000.30000000005 0\n");
+  Result<PointSet> back = readText(dir, text);
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->positions, far.positions);  // the world's origin too: it is not the scan's
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find("far.ptx: the set has no intensity: each row's is 0"), std::string::npos) << notices[0];
+
+  // Coordinates that a whole offset would not give back (0.1 - 1 + 1 is not 0.1): no translation
+  // on that axis, and the point at the origin said to be lost.
+  PointSet near;
+  near.positions = {{0.0, 0.0, 0.0}, {0.1, 0.2, 0.3}, {2.0, 3.0, 4.0}};
+  near.dimensions.add(dim::kIntensity, DimType::kF32, 3);
+  near.dimensions.find(dim::kIntensity)->set<float>(1, 0.25f);
+  notices.clear();
+  ASSERT_TRUE(writeCsv(dir.file("near.ptx"), near, options).ok());
+  EXPECT_TRUE(test::readFile(dir.file("near.ptx")).starts_with(header(3, 1))) << test::readFile(dir.file("near.ptx"));
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find("near.ptx: 1 point at the scan's origin (0, 0, 0) written as 0 0 0"), std::string::npos)
+      << notices[0];
+  back = readText(dir, test::readFile(dir.file("near.ptx")));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->positions, PositionArray(near.positions.begin() + 1, near.positions.end()));
+  EXPECT_EQ(back->dimensions.find(dim::kIntensity)->value(0), 0.25);
 }
 
 }  // namespace

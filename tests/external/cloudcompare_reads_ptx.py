@@ -1,4 +1,5 @@
-"""dpoint reads Leica PTX files as CloudCompare (Debian's cloudcompare, headless) reads them.
+"""dpoint reads Leica PTX files as CloudCompare (Debian's cloudcompare, headless) reads them, and
+writes PTX files that CloudCompare reads.
 
 Three files made here: one scan of 40 x 50 rows with a rotation and a survey-sized translation,
 intensities and colours, a tenth of its points with no echo (0 0 0); a file of three scans, one
@@ -8,7 +9,9 @@ opens each with a global shift (`-GLOBAL_SHIFT AUTO`: its coordinates are float3
 shift), merges the scans and writes ASCII; dpoint converts the same file to CSV. The two must
 hold the same points in the same order: positions within CloudCompare's float32 rounding about
 the shift (1e-4 of a unit here, against a translation of 5e6), colours equal, intensities equal
-to float32's rounding, the points with no echo left out by both."""
+to float32's rounding, the points with no echo left out by both. Each set dpoint read is written
+back to PTX by dpoint, and a deep zoom far from the origin without intensities; CloudCompare reads
+those, and dpoint reads back the doubles it wrote."""
 import math
 import os
 import random
@@ -81,6 +84,32 @@ def read_csv(path):
     return {name: rows[:, k] for k, name in enumerate(names)}
 
 
+def check_written(ptx, source, tmp):
+    """A PTX file dpoint wrote from `source` (read_csv's columns): CloudCompare reads its points
+    within float32 about its global shift, its colours equal and its intensities (0 where the source
+    has none) to float32's rounding; dpoint reads back every double as it was."""
+    name = os.path.basename(ptx)
+    n = len(source["x"])
+    theirs = cloudcompare(ptx, ptx + ".asc")
+    check(len(theirs["x"]) == n, f"{name}: CloudCompare read {len(theirs['x'])} points of {n}")
+    for axis in "xyz":
+        gap = np.abs(source[axis] - theirs[axis]).max()
+        check(gap < 1e-4, f"{name}: {axis} and CloudCompare's differ by up to {gap}")
+    intensity = source.get("intensity", np.zeros(n))
+    check(np.all(np.abs(intensity - theirs["intensity"]) <= 1e-7 * np.maximum(1.0, np.abs(intensity))),
+          f"{name}: intensities differ from CloudCompare's")
+    if "r" in source:
+        for c in "rgb":
+            check(np.array_equal(source[c], theirs[c]), f"{name}: {c} differs from CloudCompare's")
+    back = os.path.join(tmp, name + ".csv")
+    dpoint(exe, "convert", ptx, "-o", back)
+    again = read_csv(back)
+    for column in ("x", "y", "z", "r", "g", "b", "intensity"):
+        if column in source:
+            check(np.array_equal(again[column], source[column]), f"{name}: {column} read back differs")
+    print(f"{name}: {n} points written, read by CloudCompare and read back")
+
+
 rng = random.Random(20261201)
 cases = {
     "survey": [(40, 50, (558312.218127, 5240857.469093, 76.298415), rotation(rng), 7)],
@@ -130,4 +159,23 @@ with scratch() as tmp:
                       f"{name}: point {s}: colour {mine}, CloudCompare {[theirs[c][s] for c in 'rgb']}, "
                       f"file {expected[s][2]}")
         print(f"{name}: {n} points agree with CloudCompare's reading ({len(scans)} scan(s))")
+
+        # Written back by dpoint as one scan: CloudCompare reads the same points, intensities and
+        # colours, and dpoint reads back the very doubles it wrote (shortest round trip about the
+        # whole-unit translation).
+        written = os.path.join(tmp, name + "_written.ptx")
+        dpoint(exe, "convert", csv, "-o", written)
+        check_written(written, ours, tmp)
+
+    # A set with no intensity (each row's is 0), far from the origin: a deep zoom at 6.4e6 with a
+    # 1e-6 extent.
+    far = os.path.join(tmp, "far.csv")
+    with open(far, "w") as f:
+        f.write("x,y,z,r,g,b\n")
+        for i in range(500):
+            f.write(f"{6.4e6 + rng.random() * 1e-6!r},{-3.2e6 + rng.random() * 1e-6!r},{rng.random() * 1e-6!r},"
+                    f"{rng.randrange(256)},{rng.randrange(256)},{rng.randrange(256)}\n")
+    written = os.path.join(tmp, "far.ptx")
+    dpoint(exe, "convert", far, "-o", written)
+    check_written(written, read_csv(far), tmp)
 print("ok")

@@ -22,13 +22,13 @@ def source(tmp_path, rng):
     return path, dpoint.read(path)
 
 
-@pytest.mark.parametrize("ext", ["csv", "ply", "glb"])
+@pytest.mark.parametrize("ext", ["csv", "ply", "glb", "ptx"])
 def test_write_then_read_is_bit_exact(tmp_path, ext, cloud):
     s, positions, colors = cloud
     dpoint.write(s, tmp_path / f"c.{ext}")
     back = dpoint.read(tmp_path / f"c.{ext}")
     assert back.positions.tobytes() == positions.tobytes()
-    assert np.array_equal(back.colors, s.colors)
+    assert np.array_equal(back.colors, s.colors)  # PTX's 0..255 integers too: k / 255 in every reader
 
 
 def test_las_holds_positions_to_its_scale(tmp_path, cloud):
