@@ -116,10 +116,11 @@ struct CsvLayout {
   // not written), and the dimensions before the colours; writeCsv makes its layout (x y z,
   // intensity, r g b of 0..255).
   bool pts = false;
-  // Leica's PTX (isPtxPath): a PTS layout whose header is one scan's ten lines (columns: the rows,
-  // one row; the scanner at `offset`, its axes the world's, and the translation `offset`), whose
-  // rows are the positions less `offset`, and whose rows carry an intensity of 0 where the set has
-  // none (`zero_intensity`: CloudCompare refuses rows without one). writeCsv makes its layout.
+  // Leica's PTX (isPtxPath): a PTS layout of scans, each with its ten header lines (beginScan:
+  // columns, the scan's rows; one row; the scanner at `offset`, its axes the world's, and the
+  // translation `offset`), whose rows are the positions less `offset`, and whose rows carry an
+  // intensity of 0 where the set has none (`zero_intensity`: CloudCompare refuses rows without
+  // one). writeCsv makes its layout.
   bool ptx = false;
   glm::dvec3 offset{0.0};
   bool zero_intensity = false;
@@ -150,6 +151,11 @@ class CsvRowWriter {
   // Every row of `points` (the layout's columns; before any append): what writeCsv writes. Its
   // dimensions are the layout's: all of them, or a PTS layout's intensity.
   Status appendSet(const PointSet& points);
+  // Rows first … first + count - 1 of `points`, as appendSet writes them.
+  Status appendRows(const PointSet& points, size_t first, size_t count);
+  // A PTX layout: the next scan's header, `rows` points about `offset` (CsvLayout::ptx), whose rows
+  // follow (appendRows).
+  Status beginScan(uint64_t rows, const glm::dvec3& offset);
   // Writes the rows still held and moves the file into place.
   Status commit();
 

@@ -12,6 +12,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 
 #include "core/atomic_file.h"
 #include "converters/csv.h"
@@ -206,7 +207,8 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
                                  " (a column's name holds no separator, and x, y, z, r, g and b name the position's and "
                                  "colour's columns)");
   CsvRowWriter writer(std::move(*file), layout, options);
-  const std::string header = layout.ptx   ? ptxHeader(rows, layout.offset)
+  // PTX: each scan writes its own header (beginScan).
+  const std::string header = layout.ptx   ? std::string()
                              : layout.pts ? std::to_string(rows) + "\n"
                                           : RowFormatter(layout, options.decimals, options.at_scale).header();
   // At least a digit and a separator a value: refused at once where the disk cannot hold even that.
@@ -214,7 +216,8 @@ Result<CsvRowWriter> CsvRowWriter::create(const std::string& path, CsvLayout lay
                           (layout.zero_intensity ? 1 : 0);
   if (Status s = writer.file_.checkSpace(header.size() + rows * values * AtomicFile::kLeastTextBytesPerValue); !s)
     return s.error();
-  if (Status s = writer.file_.write(header); !s) return s.error();
+  if (!header.empty())
+    if (Status s = writer.file_.write(header); !s) return s.error();
   if (options.progress) options.progress->start("writing " + path, rows);
   return writer;
 }
@@ -282,17 +285,25 @@ Status CsvRowWriter::flushPending() {
   return s;
 }
 
-Status CsvRowWriter::appendSet(const PointSet& points) {
-  assert(pending_positions_.empty());
+Status CsvRowWriter::beginScan(uint64_t rows, const glm::dvec3& offset) {
+  assert(layout_.ptx && pending_positions_.empty());
+  layout_.offset = offset;
+  return file_.write(ptxHeader(rows, offset));
+}
+
+Status CsvRowWriter::appendSet(const PointSet& points) { return appendRows(points, 0, points.size()); }
+
+Status CsvRowWriter::appendRows(const PointSet& points, size_t first, size_t count) {
+  assert(pending_positions_.empty() && first <= points.size() && count <= points.size() - first);
   std::vector<const Dimension*> dims;
   if (!layout_.pts)
     for (const Dimension& d : points.dimensions.all()) dims.push_back(&d);
   else if (const Dimension* intensity = points.dimensions.find(dim::kIntensity); intensity && !layout_.zero_intensity)
     dims.push_back(intensity);
   assert(dims.size() == layout_.dimensions.size());
-  for (size_t at = 0; at < points.size(); at += batch_rows_)
+  for (size_t at = first, end = first + count; at < end; at += batch_rows_)
     if (Status s = writeBatch(points.positions.data() + at, layout_.colors ? points.colors.data() + at : nullptr,
-                              std::min(batch_rows_, points.size() - at), &dims, at);
+                              std::min(batch_rows_, end - at), &dims, at);
         !s)
       return s;
   return okStatus();
@@ -311,13 +322,13 @@ namespace {
 // reader may hold as float32, read back to the same doubles); else 0 on that axis. A whole unit
 // is a multiple of every coordinate's step below 2^53, so a coordinate within its own magnitude of
 // the centre always passes; one far from it (a point at 1e-9 in a set centred at 1e6) does not.
-glm::dvec3 ptxOffset(const PositionArray& positions, unsigned threads) {
+glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, unsigned threads) {
   constexpr size_t kBlock = 1u << 16;
-  const size_t blocks = (positions.size() + kBlock - 1) / kBlock;
+  const size_t blocks = (last - first + kBlock - 1) / kBlock;
   const unsigned workers = resolveThreads(threads);
   std::vector<Box> boxes(workers, Box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)});
   parallelFor(blocks, workers, [&](size_t b, unsigned w) {
-    for (size_t i = b * kBlock, end = std::min(positions.size(), i + kBlock); i < end; ++i)
+    for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i)
       for (int k = 0; k < 3; ++k)
         if (std::isfinite(positions[i][k])) {
           boxes[w].min[k] = std::min(boxes[w].min[k], positions[i][k]);
@@ -334,7 +345,7 @@ glm::dvec3 ptxOffset(const PositionArray& positions, unsigned threads) {
   if (offset == glm::dvec3(0.0)) return offset;
   std::vector<std::array<uint8_t, 3>> inexact(workers, {0, 0, 0});
   parallelFor(blocks, workers, [&](size_t b, unsigned w) {
-    for (size_t i = b * kBlock, end = std::min(positions.size(), i + kBlock); i < end; ++i)
+    for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i)
       for (int k = 0; k < 3; ++k) {
         const double v = positions[i][k];
         if (std::isfinite(v) && (v - offset[k]) + offset[k] != v) inexact[w][k] = 1;
@@ -346,11 +357,35 @@ glm::dvec3 ptxOffset(const PositionArray& positions, unsigned threads) {
   return offset;
 }
 
+// PTX's scans, [first, end) each: one per point_source_id where the set has several and each
+// one's points lie together, in order (as a PTX or E57 file of several scans reads), else one.
+// `ids` gets the scans' ids, where there are several.
+std::vector<std::pair<size_t, size_t>> ptxScans(const PointSet& points, std::vector<double>& ids) {
+  const std::vector<std::pair<size_t, size_t>> one = {{0, points.size()}};
+  const Dimension* source = points.dimensions.find(dim::kPointSourceId);
+  if (!source || points.size() == 0) return one;
+  std::vector<std::pair<size_t, size_t>> scans;
+  std::unordered_set<double> seen;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double id = source->value(i);
+    if (i != 0 && id == ids.back()) continue;
+    if (!seen.insert(id).second) {  // an id's points in two places: one scan
+      ids.clear();
+      return one;
+    }
+    if (i != 0) scans.back().second = i;
+    scans.emplace_back(i, points.size());
+    ids.push_back(id);
+  }
+  if (scans.size() == 1) ids.clear();
+  return scans.size() == 1 ? one : scans;
+}
+
 // PTS (Leica Cyclone, FARO, CloudCompare): the point count, then a row per point, x y z, its
 // intensity where the set has one, and r g b as 0-255 integers where it has colours. PTX
-// (Leica's scans): one scan of the set's points (ptxHeader), each row x y z less ptxOffset, an
-// intensity (0 where the set has none) and r g b as PTS's. Neither row has room for other
-// dimensions: they are not written.
+// (Leica's scans): a scan of the points of each point_source_id (ptxScans), each with its own
+// ptxOffset, each row x y z less it, an intensity (0 where the set has none) and r g b as PTS's.
+// Neither row has room for other dimensions: they are not written.
 Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvWriteOptions& options, bool ptx) {
   const char* format = ptx ? "PTX" : "PTS";
   const Dimension* intensity = points.dimensions.find(dim::kIntensity);
@@ -360,17 +395,33 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
   if (intensity) layout.dimensions.push_back(intensity->name);
   layout.ptx = ptx;
   layout.zero_intensity = ptx && !intensity;
-  if (ptx) layout.offset = ptxOffset(points.positions, options.threads);
-  const glm::dvec3 offset = layout.offset;
+  std::vector<double> ids;
+  const std::vector<std::pair<size_t, size_t>> scans =
+      ptx ? ptxScans(points, ids) : std::vector<std::pair<size_t, size_t>>{{0, points.size()}};
   Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
   if (!writer) return writer.error();
-  if (Status s = writer->appendSet(points); !s) return s;
+  size_t at_origin = 0;  // PTX rows of 0 0 0
+  glm::dvec3 origin(0.0);  // the first such scan's
+  if (ptx) {
+    for (const auto& [first, end] : scans) {
+      const glm::dvec3 offset = ptxOffset(points.positions, first, end, options.threads);
+      if (Status s = writer->beginScan(end - first, offset); !s) return s;
+      if (Status s = writer->appendRows(points, first, end - first); !s) return s;
+      const size_t here = static_cast<size_t>(
+          std::count(points.positions.begin() + std::ptrdiff_t(first), points.positions.begin() + std::ptrdiff_t(end), offset));
+      if (here != 0 && at_origin == 0) origin = offset;
+      at_origin += here;
+    }
+  } else if (Status s = writer->appendSet(points); !s) {
+    return s;
+  }
   if (Status s = writer->commit(); !s) return s;
   // What PTS and PTX cannot hold, said once the file is there.
   if (options.notices) {
+    const Dimension* as_scans = ids.empty() ? nullptr : points.dimensions.find(dim::kPointSourceId);
     std::string dropped;
     for (const Dimension& d : points.dimensions.all())
-      if (&d != intensity) dropped += (dropped.empty() ? "" : ", ") + d.name;
+      if (&d != intensity && &d != as_scans) dropped += (dropped.empty() ? "" : ", ") + d.name;
     if (!dropped.empty())
       options.notices->push_back(path + ": " + format + " holds x, y, z, intensity and r, g, b only: " + dropped +
                                  " left out");
@@ -379,14 +430,21 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
     if (ptx && !intensity && points.size() != 0)
       options.notices->push_back(path + ": the set has no intensity: each row's is 0 (a PTX row carries one; "
                                         "CloudCompare refuses rows without)");
-    if (ptx) {
-      const size_t at = std::count(points.positions.begin(), points.positions.end(), offset);
-      if (at != 0)
-        options.notices->push_back(path + ": " + countOf(at, "point") + " at the scan's origin (" +
-                                   formatNumber(offset.x) + ", " + formatNumber(offset.y) + ", " +
-                                   formatNumber(offset.z) + ") written as 0 0 0, which PTX readers (dpoint's, "
-                                   "CloudCompare's) take for a cell with no echo and leave out");
-    }
+    if (at_origin != 0)
+      options.notices->push_back(path + ": " + countOf(at_origin, "point") + " at " +
+                                 (scans.size() == 1 ? "the scan's origin (" : "its scan's origin (the first at (") +
+                                 formatNumber(origin.x) + ", " + formatNumber(origin.y) + ", " + formatNumber(origin.z) +
+                                 (scans.size() == 1 ? ")" : "))") +
+                                 " written as 0 0 0, which PTX readers (dpoint's, CloudCompare's) take for a cell "
+                                 "with no echo and leave out");
+    // The reader numbers the scans 1, 2, … in point_source_id: said where the ids were others.
+    bool renumbered = false;
+    for (size_t k = 0; k < ids.size(); ++k) renumbered = renumbered || ids[k] != static_cast<double>(k + 1);
+    if (renumbered)
+      options.notices->push_back(path + ": point_source_id written as " + countOf(ids.size(), "scan") +
+                                 ", one for each id in the set's order, which PTX readers number 1 to " +
+                                 std::to_string(ids.size()) + " (its ids were " + formatNumber(ids.front()) + ", " +
+                                 formatNumber(ids[1]) + (ids.size() > 2 ? ", …)" : ")"));
   }
   return okStatus();
 }

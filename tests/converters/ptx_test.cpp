@@ -279,5 +279,49 @@ TEST(Ptx, writesOneScanAboutAWholeTranslationThatReadsBackExactly) {
   EXPECT_EQ(back->dimensions.find(dim::kIntensity)->value(0), 0.25);
 }
 
+// A set of several scans (point_source_id in runs, as a PTX or E57 file of several scans reads) is
+// written as those scans, each about its own translation, and read back with the same ids; ids
+// other than 1, 2, … are said to be renumbered; ids whose points are not together make one scan.
+TEST(Ptx, writesAScanForEachPointSourceIdWhosePointsLieTogether) {
+  TempDir dir;
+  PointSet scans;
+  scans.positions = {{1000.5, 2000.25, 3.0}, {1001.0, 2000.0, 3.5}, {-50.0, 7.0, 1.0}, {-49.0, 8.0, 1.0}, {-51.0, 9.0, 2.0}};
+  Dimension& ids = scans.dimensions.add(dim::kPointSourceId, DimType::kU16, 5);
+  for (size_t i = 0; i < 5; ++i) ids.setValue(i, i < 2 ? 1.0 : 2.0);
+  std::vector<std::string> notices;
+  CsvWriteOptions options;
+  options.notices = &notices;
+  ASSERT_TRUE(writeCsv(dir.file("two.ptx"), scans, options).ok());
+  const std::string text = test::readFile(dir.file("two.ptx"));
+  EXPECT_TRUE(text.starts_with(header(2, 1, "1001 2000 3"))) << text;
+  EXPECT_TRUE(test::contains(text, "0 0.5 0\n" + header(3, 1, "-50 8 2"))) << text;
+  Result<PointSet> back = readText(dir, text);
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->positions, scans.positions);
+  ASSERT_NE(back->dimensions.find(dim::kPointSourceId), nullptr);
+  for (size_t i = 0; i < 5; ++i) EXPECT_EQ(back->dimensions.find(dim::kPointSourceId)->value(i), ids.value(i)) << i;
+  for (const std::string& note : notices) EXPECT_FALSE(test::contains(note, "point_source_id")) << note;
+
+  // Ids 7 and 3: two scans still, read back as 1 and 2, said.
+  for (size_t i = 0; i < 5; ++i) ids.setValue(i, i < 2 ? 7.0 : 3.0);
+  notices.clear();
+  ASSERT_TRUE(writeCsv(dir.file("renumbered.ptx"), scans, options).ok());
+  ASSERT_EQ(notices.size(), 2u);  // and no intensity
+  EXPECT_TRUE(test::contains(notices[1], "point_source_id written as 2 scans, one for each id in the set's order, which "
+                                         "PTX readers number 1 to 2 (its ids were 7, 3)"))
+      << notices[1];
+  back = readText(dir, test::readFile(dir.file("renumbered.ptx")));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->dimensions.find(dim::kPointSourceId)->value(4), 2.0);
+
+  // An id in two places: one scan, the ids left out.
+  ids.setValue(4, 7.0);
+  notices.clear();
+  ASSERT_TRUE(writeCsv(dir.file("one.ptx"), scans, options).ok());
+  EXPECT_TRUE(test::readFile(dir.file("one.ptx")).starts_with("5\n1\n")) << test::readFile(dir.file("one.ptx"));
+  EXPECT_TRUE(test::contains(notices[0], "one.ptx: PTX holds x, y, z, intensity and r, g, b only: point_source_id left out"))
+      << notices[0];
+}
+
 }  // namespace
 }  // namespace dpoint

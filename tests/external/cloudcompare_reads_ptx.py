@@ -104,7 +104,7 @@ def check_written(ptx, source, tmp):
     back = os.path.join(tmp, name + ".csv")
     dpoint(exe, "convert", ptx, "-o", back)
     again = read_csv(back)
-    for column in ("x", "y", "z", "r", "g", "b", "intensity"):
+    for column in ("x", "y", "z", "r", "g", "b", "intensity", "point_source_id"):  # the scans too
         if column in source:
             check(np.array_equal(again[column], source[column]), f"{name}: {column} read back differs")
     print(f"{name}: {n} points written, read by CloudCompare and read back")
@@ -160,9 +160,9 @@ with scratch() as tmp:
                       f"file {expected[s][2]}")
         print(f"{name}: {n} points agree with CloudCompare's reading ({len(scans)} scan(s))")
 
-        # Written back by dpoint as one scan: CloudCompare reads the same points, intensities and
-        # colours, and dpoint reads back the very doubles it wrote (shortest round trip about the
-        # whole-unit translation).
+        # Written back by dpoint, a scan for each of the set's (its point_source_id): CloudCompare
+        # reads the same points, intensities and colours, and dpoint reads back the very doubles it
+        # wrote (shortest round trip about each scan's whole-unit translation) and the scans.
         written = os.path.join(tmp, name + "_written.ptx")
         dpoint(exe, "convert", csv, "-o", written)
         check_written(written, ours, tmp)
