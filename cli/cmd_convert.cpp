@@ -123,7 +123,9 @@ int runConvert(ConvertOptions& o) {
   // point set; --unique and --order morton need the whole set, so they take the path below.
   const Result<FileFormat> in_format = formatOf(o.input);
   const bool choose_dimensions = o.dimensions.keep || !o.dimensions.drop.empty();
-  if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !o.unique && *order == PointOrder::kInput &&
+  // (PTS and PTX, whose rows are not CSV's, take the path below: a review found a .ptx of CSV rows.)
+  if (in_format && isGltf(*in_format) && to_csv && !isPtsPath(o.output) && !isPtxPath(o.output) && !o.unique &&
+      *order == PointOrder::kInput &&
       !choose_dimensions && o.columns.empty() && o.sample.count == 0) {
     if (Status s = convertGltfToCsv(o.input, gltfOptions(o), filters, o.output, w); !s) return reportError(s.error());
     return 0;

@@ -8,6 +8,7 @@
 // value in fixed form (as the seed printed its double colours with %.15f).
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -317,43 +318,98 @@ Status CsvRowWriter::commit() {
 
 namespace {
 
-// PTX's translation for a set: each axis's bounds centre, rounded to a whole unit, where every
-// finite coordinate on it less that and added back is itself again (so the rows, small numbers a
-// reader may hold as float32, read back to the same doubles); else 0 on that axis. A whole unit
-// is a multiple of every coordinate's step below 2^53, so a coordinate within its own magnitude of
-// the centre always passes; one far from it (a point at 1e-9 in a set centred at 1e6) does not.
-glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, unsigned threads) {
+// Whether a PTX row of these coordinates (the point less the translation) reads as 0 0 0, which PTX
+// readers take for a cell with no echo: as the rows format it (`decimals` < 0: shortest round
+// trip, where only ±0 is; else fixed digits, where a value that rounds to zero is too).
+bool zeroRow(const glm::dvec3& v, int decimals, bool at_scale) {
+  for (int k = 0; k < 3; ++k) {
+    if (v[k] == 0.0) continue;
+    if (decimals < 0 || !std::isfinite(v[k]) || std::fabs(v[k]) >= 1.0) return false;
+    char text[kMaxFieldChars];
+    const char* end = formatCoordinate(text, text + sizeof text, v[k], decimals, at_scale);
+    if (std::find_if(static_cast<const char*>(text), end, [](char c) { return c >= '1' && c <= '9'; }) != end) return false;
+  }
+  return true;
+}
+
+// PTX's translation for points [first, last): each axis's bounds centre, rounded to a whole unit,
+// where every coordinate on it less that and added back is itself, bit for bit (so the rows, small
+// numbers a reader may hold as float32, read back to the same doubles; -0 too); else 0 on that
+// axis. A whole unit is a multiple of every coordinate's step below 2^52, so a coordinate within
+// its own magnitude of the centre passes; one far from it (a point at 1e-9 in a set centred at 1e6)
+// does not. None where a coordinate is not finite (a reader's matrix product makes inf · 0 NaN on
+// the other axes). Where a point's row would read as no echo (zeroRow: a point on the translation,
+// or rounded onto it), the translation one unit off on an axis where that is exact, if one is.
+// `zero_rows` gets the count of such rows left.
+glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, int decimals, bool at_scale,
+                     unsigned threads, size_t& zero_rows) {
   constexpr size_t kBlock = 1u << 16;
   const size_t blocks = (last - first + kBlock - 1) / kBlock;
   const unsigned workers = resolveThreads(threads);
   std::vector<Box> boxes(workers, Box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)});
-  parallelFor(blocks, workers, [&](size_t b, unsigned w) {
-    for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i)
-      for (int k = 0; k < 3; ++k)
-        if (std::isfinite(positions[i][k])) {
-          boxes[w].min[k] = std::min(boxes[w].min[k], positions[i][k]);
-          boxes[w].max[k] = std::max(boxes[w].max[k], positions[i][k]);
-        }
-  });
-  glm::dvec3 offset(0.0);
-  for (int k = 0; k < 3; ++k) {
-    double lo = HUGE_VAL, hi = -HUGE_VAL;
-    for (const Box& box : boxes) lo = std::min(lo, box.min[k]), hi = std::max(hi, box.max[k]);
-    const double centre = std::nearbyint(lo / 2 + hi / 2);
-    if (lo <= hi && std::isfinite(centre) && std::fabs(centre) < 0x1p52) offset[k] = centre + 0.0;  // never -0
-  }
-  if (offset == glm::dvec3(0.0)) return offset;
-  std::vector<std::array<uint8_t, 3>> inexact(workers, {0, 0, 0});
+  std::vector<uint8_t> nonfinite(workers, 0);
   parallelFor(blocks, workers, [&](size_t b, unsigned w) {
     for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i)
       for (int k = 0; k < 3; ++k) {
         const double v = positions[i][k];
-        if (std::isfinite(v) && (v - offset[k]) + offset[k] != v) inexact[w][k] = 1;
+        if (!std::isfinite(v)) {
+          nonfinite[w] = 1;
+          continue;
+        }
+        boxes[w].min[k] = std::min(boxes[w].min[k], v);
+        boxes[w].max[k] = std::max(boxes[w].max[k], v);
       }
   });
-  for (const auto& axes : inexact)
+  glm::dvec3 offset(0.0);
+  const bool finite = std::find(nonfinite.begin(), nonfinite.end(), 1) == nonfinite.end();
+  for (int k = 0; k < 3 && finite; ++k) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const Box& box : boxes) lo = std::min(lo, box.min[k]), hi = std::max(hi, box.max[k]);
+    const double centre = std::nearbyint(lo / 2 + hi / 2);
+    if (lo <= hi && std::fabs(centre) < 0x1p52) offset[k] = centre + 0.0;  // never -0
+  }
+  // Per axis, whether some coordinate does not come back through `t` bit for bit; and the rows
+  // that would read as 0 0 0.
+  const auto check = [&](const glm::dvec3& t, std::array<uint8_t, 3>& inexact) {
+    std::vector<std::array<uint8_t, 3>> bad(workers, {0, 0, 0});
+    std::vector<size_t> zeros(workers, 0);
+    parallelFor(blocks, workers, [&](size_t b, unsigned w) {
+      for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i) {
+        const glm::dvec3& p = positions[i];
+        for (int k = 0; k < 3; ++k)
+          if (t[k] != 0.0 && std::bit_cast<uint64_t>((p[k] - t[k]) + t[k]) != std::bit_cast<uint64_t>(p[k]))
+            bad[w][k] = 1;
+        zeros[w] += zeroRow(p - t, decimals, at_scale);
+      }
+    });
+    inexact = {0, 0, 0};
+    for (const auto& axes : bad)
+      for (int k = 0; k < 3; ++k) inexact[k] |= axes[k];
+    size_t n = 0;
+    for (size_t z : zeros) n += z;
+    return n;
+  };
+  std::array<uint8_t, 3> inexact{};
+  size_t zeros = check(offset, inexact);
+  if (inexact != std::array<uint8_t, 3>{0, 0, 0}) {
     for (int k = 0; k < 3; ++k)
-      if (axes[k]) offset[k] = 0.0;
+      if (inexact[k]) offset[k] = 0.0;
+    zeros = check(offset, inexact);
+  }
+  for (int k = 0; k < 3 && zeros != 0 && finite; ++k)
+    for (const double step : {1.0, -1.0}) {
+      glm::dvec3 t = offset;
+      t[k] += step;
+      if (std::fabs(t[k]) >= 0x1p52) continue;
+      std::array<uint8_t, 3> off{};
+      const size_t left = check(t, off);
+      if (off == std::array<uint8_t, 3>{0, 0, 0} && left < zeros) {
+        offset = t;
+        zeros = left;
+        break;
+      }
+    }
+  zero_rows = zeros;
   return offset;
 }
 
@@ -404,11 +460,11 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
   glm::dvec3 origin(0.0);  // the first such scan's
   if (ptx) {
     for (const auto& [first, end] : scans) {
-      const glm::dvec3 offset = ptxOffset(points.positions, first, end, options.threads);
+      size_t here = 0;
+      const glm::dvec3 offset = ptxOffset(points.positions, first, end, options.decimals,
+                                          options.at_scale && options.decimals >= 0, options.threads, here);
       if (Status s = writer->beginScan(end - first, offset); !s) return s;
       if (Status s = writer->appendRows(points, first, end - first); !s) return s;
-      const size_t here = static_cast<size_t>(
-          std::count(points.positions.begin() + std::ptrdiff_t(first), points.positions.begin() + std::ptrdiff_t(end), offset));
       if (here != 0 && at_origin == 0) origin = offset;
       at_origin += here;
     }
@@ -435,6 +491,7 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
                                  (scans.size() == 1 ? "the scan's origin (" : "its scan's origin (the first at (") +
                                  formatNumber(origin.x) + ", " + formatNumber(origin.y) + ", " + formatNumber(origin.z) +
                                  (scans.size() == 1 ? ")" : "))") +
+                                 (options.decimals >= 0 ? ", to the rows' " + countOf(static_cast<uint64_t>(options.decimals), "decimal") + "," : std::string()) +
                                  " written as 0 0 0, which PTX readers (dpoint's, CloudCompare's) take for a cell "
                                  "with no echo and leave out");
     // The reader numbers the scans 1, 2, … in point_source_id: said where the ids were others.

@@ -240,8 +240,10 @@ Result<ScanHeader> readScanHeader(const InputFile& file, uint64_t offset, uint64
   return header;
 }
 
-bool isIdentity(const double (&m)[4][4]) {
-  for (int r = 0; r < 4; ++r)
+// Whether the transformation's rotation part (its first three rows) is the identity: a translation
+// alone, or nothing.
+bool isTranslation(const double (&m)[4][4]) {
+  for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c)
       if (m[r][c] != (r == c ? 1.0 : 0.0)) return false;
   return true;
@@ -279,7 +281,10 @@ size_t keepRows(char* data, size_t width, const std::vector<uint8_t>& keep, unsi
 size_t registerScan(PointSet& scan, const ScanHeader& header, unsigned threads) {
   const size_t n = scan.size();
   std::vector<uint8_t> keep(n);
-  const bool identity = isIdentity(header.m);
+  // A translation alone is added on the axes it moves, so that each coordinate is the row's plus
+  // it, rounded once: -0 stays -0 on an axis it leaves, and an inf on one axis makes no NaN on the
+  // others (as the product's inf · 0 would; a review finding, on PTX that dpoint writes).
+  const bool translation = isTranslation(header.m);
   const auto& m = header.m;
   std::vector<size_t> dropped((n + kRows - 1) / kRows, 0);
   parallelFor(dropped.size(), threads, [&](size_t b, unsigned) {
@@ -287,7 +292,11 @@ size_t registerScan(PointSet& scan, const ScanHeader& header, unsigned threads) 
       glm::dvec3& p = scan.positions[i];
       keep[i] = !(p.x == 0.0 && p.y == 0.0 && p.z == 0.0);
       dropped[b] += keep[i] ? 0 : 1;
-      if (identity) continue;
+      if (translation) {
+        for (int c = 0; c < 3; ++c)
+          if (m[3][c] != 0.0) p[c] += m[3][c];
+        continue;
+      }
       const glm::dvec3 q = p;
       for (int c = 0; c < 3; ++c) p[c] = q.x * m[0][c] + q.y * m[1][c] + q.z * m[2][c] + m[3][c];
     }

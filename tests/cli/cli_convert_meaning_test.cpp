@@ -584,6 +584,12 @@ TEST(CliConvertMeaning, aPtxScanConvertsToLasWithItsIntensityAsSixteenBits) {
   ASSERT_EQ(from_las.exit_code, 0) << from_las.err;
   EXPECT_TRUE(test::contains(from_las.err, "las.ptx: PTX holds x, y, z, intensity and r, g, b only: ")) << from_las.err;
   EXPECT_EQ(readPoints(dir.file("las.ptx"))->positions, las->positions);
+  // A glTF input takes the same path (a review finding: it was written as CSV rows).
+  ASSERT_EQ(runDpoint({"generate", "menger", "--level", "1", "--offset", "10,20,30", "-o", dir.file("m.glb"), "-q"}).exit_code, 0);
+  ASSERT_EQ(runDpoint({"convert", dir.file("m.glb"), "-o", dir.file("m.ptx"), "-q"}).exit_code, 0);
+  Result<PointSet> mesh = readPoints(dir.file("m.glb")), mesh_ptx = readPoints(dir.file("m.ptx"));
+  ASSERT_TRUE(mesh_ptx.ok()) << mesh_ptx.error().message;
+  EXPECT_EQ(mesh_ptx->positions, mesh->positions);
   const test::CommandResult columns = runDpoint({"convert", dir.file("scan.ptx"), "--columns", "x,y,z", "-o", dir.file("c.csv")});
   EXPECT_EQ(columns.exit_code, 1) << columns.err;
   EXPECT_TRUE(test::contains(columns.err, "a PTX file's rows are x y z, an intensity and r g b")) << columns.err;
