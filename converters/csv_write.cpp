@@ -370,8 +370,8 @@ glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, 
   }
   // Per axis, whether some coordinate does not come back through `t` bit for bit; and the rows
   // that would read as 0 0 0.
-  const auto check = [&](const glm::dvec3& t, std::array<uint8_t, 3>& inexact) {
-    std::vector<std::array<uint8_t, 3>> bad(workers, {0, 0, 0});
+  const auto check = [&](const glm::dvec3& t, glm::ivec3& inexact) {
+    std::vector<glm::ivec3> bad(workers, glm::ivec3(0));
     std::vector<size_t> zeros(workers, 0);
     parallelFor(blocks, workers, [&](size_t b, unsigned w) {
       for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i) {
@@ -382,16 +382,15 @@ glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, 
         zeros[w] += zeroRow(p - t, decimals, at_scale);
       }
     });
-    inexact = {0, 0, 0};
-    for (const auto& axes : bad)
-      for (int k = 0; k < 3; ++k) inexact[k] |= axes[k];
+    inexact = glm::ivec3(0);
+    for (const glm::ivec3& axes : bad) inexact |= axes;
     size_t n = 0;
     for (size_t z : zeros) n += z;
     return n;
   };
-  std::array<uint8_t, 3> inexact{};
+  glm::ivec3 inexact(0);
   size_t zeros = check(offset, inexact);
-  if (inexact != std::array<uint8_t, 3>{0, 0, 0}) {
+  if (inexact != glm::ivec3(0)) {
     for (int k = 0; k < 3; ++k)
       if (inexact[k]) offset[k] = 0.0;
     zeros = check(offset, inexact);
@@ -401,9 +400,9 @@ glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, 
       glm::dvec3 t = offset;
       t[k] += step;
       if (std::fabs(t[k]) >= 0x1p52) continue;
-      std::array<uint8_t, 3> off{};
+      glm::ivec3 off(0);
       const size_t left = check(t, off);
-      if (off == std::array<uint8_t, 3>{0, 0, 0} && left < zeros) {
+      if (off == glm::ivec3(0) && left < zeros) {
         offset = t;
         zeros = left;
         break;
