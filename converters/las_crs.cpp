@@ -469,6 +469,26 @@ std::string StatedCrs::describe() const {
   return lasCrsSummary(records, wkt_bit);
 }
 
+bool crsEquivalent(const StatedCrs& stated, const std::string& wkt) {
+  std::string mine = stated.text;
+  if (mine.empty() && !stated.records.empty()) {
+    std::string why_not;
+    LasSource frame;
+    frame.vlrs = stated.records;
+    frame.global_encoding = stated.wkt_bit ? 0x10 : 0;
+    mine = lasSourceWkt(frame, why_not);
+  }
+  if (mine.empty() || wkt.empty()) return false;
+  if (mine == wkt) return true;
+  const ProjApi& api = projApi();
+  if (!api.error.empty()) return false;
+  Proj proj(api);
+  if (!proj.context()) return false;
+  const PJ* a = proj.keep(api.create(proj.context(), mine.c_str()));
+  const PJ* b = proj.keep(api.create(proj.context(), wkt.c_str()));
+  return a && b && api.is_equivalent_to(a, b, PJ_COMP_EQUIVALENT);
+}
+
 std::string crsLabel(const StatedCrs& crs) {
   if (crs.text.empty()) return crs.describe();
   const std::string name = wktName(crs.text);

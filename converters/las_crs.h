@@ -41,6 +41,10 @@ struct StatedCrs {
 // A CRS in a few words, for a note: a WKT's name, other text quoted (an excerpt), else the records'
 // lasCrsSummary.
 std::string crsLabel(const StatedCrs& crs);
+// Whether `stated` (its text, or its LAS records made WKT) is the CRS `wkt` gives, to PROJ's
+// PJ_COMP_EQUIVALENT: names and identifiers aside (EPSG:2994's keys and its database entry are
+// named two ways). False where either is none or PROJ cannot tell.
+bool crsEquivalent(const StatedCrs& stated, const std::string& wkt);
 StatedCrs statedCrs(const PointSet& points);
 // A LAS source's CRS records, as statedCrs takes them (none for none).
 StatedCrs statedCrs(const std::optional<LasSource>& source);

@@ -431,7 +431,7 @@ Status writePoints(const std::string& path, const PointSet& points, const WriteO
   // alone; the last note's list).
   if (options.notices && !options.las_crs.empty() && *format != FileFormat::kCsv && *format != FileFormat::kGlb) {
     const StatedCrs stated = statedCrs(points);
-    if (stated.any() && stated.text != options.las_crs)
+    if (stated.any() && !crsEquivalent(stated, options.las_crs))  // naming the input's own is no change
       options.notices->push_back(path + ": the input's CRS (" + crsLabel(stated) + ") replaced by " +
                                  crsLabel(StatedCrs{options.las_crs, {}, false}));
   }
