@@ -13,7 +13,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <unordered_set>
 
 #include "core/atomic_file.h"
 #include "converters/csv.h"
@@ -412,33 +411,9 @@ glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, 
   return offset;
 }
 
-// PTX's scans, [first, end) each: one per point_source_id where the set has several and each
-// one's points lie together, in order (as a PTX or E57 file of several scans reads), else one.
-// `ids` gets the scans' ids, where there are several.
-std::vector<std::pair<size_t, size_t>> ptxScans(const PointSet& points, std::vector<double>& ids) {
-  const std::vector<std::pair<size_t, size_t>> one = {{0, points.size()}};
-  const Dimension* source = points.dimensions.find(dim::kPointSourceId);
-  if (!source || points.size() == 0) return one;
-  std::vector<std::pair<size_t, size_t>> scans;
-  std::unordered_set<double> seen;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const double id = source->value(i);
-    if (i != 0 && id == ids.back()) continue;
-    if (!seen.insert(id).second) {  // an id's points in two places: one scan
-      ids.clear();
-      return one;
-    }
-    if (i != 0) scans.back().second = i;
-    scans.emplace_back(i, points.size());
-    ids.push_back(id);
-  }
-  if (scans.size() == 1) ids.clear();
-  return scans.size() == 1 ? one : scans;
-}
-
 // PTS (Leica Cyclone, FARO, CloudCompare): the point count, then a row per point, x y z, its
 // intensity where the set has one, and r g b as 0-255 integers where it has colours. PTX
-// (Leica's scans): a scan of the points of each point_source_id (ptxScans), each with its own
+// (Leica's scans): a scan of the points of each point_source_id (pointSourceRuns), each with its own
 // ptxOffset, each row x y z less it, an intensity (0 where the set has none) and r g b as PTS's.
 // Neither row has room for other dimensions: they are not written.
 Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvWriteOptions& options, bool ptx) {
@@ -450,15 +425,16 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
   if (intensity) layout.dimensions.push_back(intensity->name);
   layout.ptx = ptx;
   layout.zero_intensity = ptx && !intensity;
-  std::vector<double> ids;
-  const std::vector<std::pair<size_t, size_t>> scans =
-      ptx ? ptxScans(points, ids) : std::vector<std::pair<size_t, size_t>>{{0, points.size()}};
+  const std::vector<SourceRun> scans = ptx ? pointSourceRuns(points) : std::vector<SourceRun>{{0, points.size(), 0.0}};
+  std::vector<double> ids;  // the scans' point_source_ids, where there are several
+  if (scans.size() > 1)
+    for (const SourceRun& scan : scans) ids.push_back(scan.id);
   Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
   if (!writer) return writer.error();
   size_t at_origin = 0;  // PTX rows of 0 0 0
   glm::dvec3 origin(0.0);  // the first such scan's
   if (ptx) {
-    for (const auto& [first, end] : scans) {
+    for (const auto& [first, end, id] : scans) {
       size_t here = 0;
       const glm::dvec3 offset = ptxOffset(points.positions, first, end, options.decimals,
                                           options.at_scale && options.decimals >= 0, options.threads, here);

@@ -101,7 +101,8 @@ class E57PointStream {
 // The records the file's scans declare (points, and those marked invalid), from its tree alone.
 Result<uint64_t> e57RecordCount(const std::string& path);
 
-// One scan (data3D) with no pose: x, y and z as doubles (every coordinate as it is), colours as
+// A scan (data3D) for each point_source_id whose points lie together (pointSourceRuns: as an E57 or
+// PTX file of several scans reads), else one, each with no pose: x, y and z as doubles (every coordinate as it is), colours as
 // integers of their scale (0..255, or 0..65535 for 16-bit colours), each dimension a field:
 // integers as Integer of their values' own limits (packed in as few bits as those need), floats as
 // Float single or double; intensity as `intensity` with intensityLimits, return_number - 1 as

@@ -367,20 +367,24 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   const uint64_t groups_per_packet =
       slices.size() > 1 ? 1 : group_bytes == 0 ? UINT64_MAX : std::max<uint64_t>(1, room / group_bytes);
   const uint64_t records_per_packet = groups_per_packet == UINT64_MAX ? UINT64_MAX : groups_per_packet * 64;
-  const uint64_t packets =
-      n == 0 || group_bytes == 0 ? 0 : (n + records_per_packet - 1) / records_per_packet * slices.size();
-  // Packet p: records [begin, end) of fields [first, last).
+  // The scans: one for each point_source_id whose points lie together (an E57 or PTX file of
+  // several scans reads so), else one; each its own compressed vector, its packets numbered from 0.
+  const std::vector<SourceRun> scans = pointSourceRuns(points);
+  const auto packetsOf = [&](const SourceRun& scan) -> uint64_t {
+    const uint64_t records = scan.end - scan.first;
+    return records == 0 || group_bytes == 0 ? 0 : (records + records_per_packet - 1) / records_per_packet * slices.size();
+  };
+  // Packet p of a scan: records [begin, end) of fields [first, last).
   struct Packet {
     size_t begin, end, first, last;
   };
-  const auto packetOf = [&](uint64_t p) {
-    const uint64_t records = p / slices.size() * records_per_packet;
+  const auto packetOf = [&](const SourceRun& scan, uint64_t p) {
+    const uint64_t records = scan.first + p / slices.size() * records_per_packet;
     const auto& [first, last] = slices[static_cast<size_t>(p % slices.size())];
-    return Packet{static_cast<size_t>(records), static_cast<size_t>(std::min<uint64_t>(n, records + records_per_packet)),
-                  first, last};
+    return Packet{static_cast<size_t>(records),
+                  static_cast<size_t>(std::min<uint64_t>(scan.end, records + records_per_packet)), first, last};
   };
-  const auto packetBytes = [&](uint64_t p, std::vector<uint64_t>* chunks) {
-    const Packet packet = packetOf(p);
+  const auto packetBytes = [&](const Packet& packet, std::vector<uint64_t>* chunks) {
     uint64_t bytes = header_bytes;
     for (size_t k = 0; k < fields.size(); ++k) {
       const uint64_t records = k >= packet.first && k < packet.last ? packet.end - packet.begin : 0;
@@ -390,20 +394,26 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     }
     return (bytes + 3) / 4 * 4;
   };
-  // A set of no points: one empty data packet, as libE57Format writes one (its Simple API reads
-  // the data packet at the data offset).
-  const std::string no_points = n == 0 ? std::string("\x01\x00\x07\x00\x00\x00\x00\x00", 8) : std::string();
-  uint64_t section = kSectionHeaderBytes + no_points.size();
-  for (uint64_t p = 0; p < packets; ++p) section += packetBytes(p, nullptr);
+  // A scan of no points (a set of none): one empty data packet, as libE57Format writes one (its
+  // Simple API reads the data packet at the data offset).
+  const std::string no_points("\x01\x00\x07\x00\x00\x00\x00\x00", 8);
+  std::vector<uint64_t> sections, section_at;  // each scan's section: its bytes, its logical offset
+  for (const SourceRun& scan : scans) {
+    uint64_t section = kSectionHeaderBytes + (scan.end == scan.first ? no_points.size() : 0);
+    for (uint64_t p = 0, count = packetsOf(scan); p < count; ++p) section += packetBytes(packetOf(scan, p), nullptr);
+    section_at.push_back(sections.empty() ? kHeaderBytes : section_at.back() + sections.back());
+    sections.push_back(section);
+  }
 
   // The XML tree, from the bounds and the fields.
-  // The bounds of the finite coordinates (--allow-nonfinite sets may have others).
-  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-  {
+  // Each scan's bounds of its finite coordinates (--allow-nonfinite sets may have others).
+  std::vector<Box> bounds;
+  for (const SourceRun& scan : scans) {
     constexpr size_t kBlock = 1u << 16;
-    std::vector<glm::dvec3> los((n + kBlock - 1) / kBlock, glm::dvec3(HUGE_VAL)), his(los.size(), glm::dvec3(-HUGE_VAL));
+    const size_t count = scan.end - scan.first;
+    std::vector<glm::dvec3> los((count + kBlock - 1) / kBlock, glm::dvec3(HUGE_VAL)), his(los.size(), glm::dvec3(-HUGE_VAL));
     parallelFor(los.size(), threads, [&](size_t b, unsigned) {
-      for (size_t i = b * kBlock, end = std::min(n, i + kBlock); i < end; ++i)
+      for (size_t i = scan.first + b * kBlock, end = std::min(scan.end, i + kBlock); i < end; ++i)
         for (int k = 0; k < 3; ++k) {
           const double v = points.positions[i][k];
           if (!std::isfinite(v)) continue;
@@ -411,14 +421,15 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
           his[b][k] = std::max(his[b][k], v);
         }
     });
+    Box box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)};
     for (size_t b = 0; b < los.size(); ++b) {
       for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], los[b][k]);
-        hi[k] = std::max(hi[k], his[b][k]);
+        box.min[k] = std::min(box.min[k], los[b][k]);
+        box.max[k] = std::max(box.max[k], his[b][k]);
       }
     }
+    bounds.push_back(box);
   }
-  const bool bounded = lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
   // The intensity's range, by which readers (PDAL, CloudCompare) normalise it: LAS's 0..65535 for
   // integers that fit, 0..1 for floats of 0..1, else the values' own; a Float's also as its limits
   // (libE57Format's Simple API takes a Float intensity's range from them).
@@ -462,40 +473,45 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   xml += "  <e57LibraryVersion type=\"String\"><![CDATA[dpoint]]></e57LibraryVersion>\n";
   xml += "  <coordinateMetadata type=\"String\"><![CDATA[" + coordinateMetadata(points, options, notes) +
          "]]></coordinateMetadata>\n";
-  xml += "  <data3D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n    <vectorChild type=\"Structure\">\n";
-  xml += "      <guid type=\"String\"><![CDATA[" + std::string(kScanGuidMarker) + "]]></guid>\n";
-  if (bounded) {
-    xml += "      <cartesianBounds type=\"Structure\">\n";
-    const char* axes[3] = {"x", "y", "z"};
-    for (int k = 0; k < 3; ++k) {
-      xml += std::string("        <") + axes[k] + "Minimum type=\"Float\">" + formatNumber(lo[k]) + "</" + axes[k] + "Minimum>\n";
-      xml += std::string("        <") + axes[k] + "Maximum type=\"Float\">" + formatNumber(hi[k]) + "</" + axes[k] + "Maximum>\n";
+  xml += "  <data3D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n";
+  for (size_t s = 0; s < scans.size(); ++s) {
+    xml += "    <vectorChild type=\"Structure\">\n";
+    xml += "      <guid type=\"String\"><![CDATA[" + std::string(kScanGuidMarker) + "]]></guid>\n";
+    const Box& box = bounds[s];
+    if (box.min.x <= box.max.x && box.min.y <= box.max.y && box.min.z <= box.max.z) {
+      xml += "      <cartesianBounds type=\"Structure\">\n";
+      const char* axes[3] = {"x", "y", "z"};
+      for (int k = 0; k < 3; ++k) {
+        xml += std::string("        <") + axes[k] + "Minimum type=\"Float\">" + formatNumber(box.min[k]) + "</" + axes[k] + "Minimum>\n";
+        xml += std::string("        <") + axes[k] + "Maximum type=\"Float\">" + formatNumber(box.max[k]) + "</" + axes[k] + "Maximum>\n";
+      }
+      xml += "      </cartesianBounds>\n";
     }
-    xml += "      </cartesianBounds>\n";
+    for (const OutField& f : fields)
+      if (f.name == "intensity" && f.limited) {
+        const char* type = f.kind == OutField::Kind::kInteger ? "Integer" : "Float";
+        xml += std::string("      <intensityLimits type=\"Structure\">\n        <intensityMinimum type=\"") + type + "\">" +
+               formatNumber(f.least) + "</intensityMinimum>\n        <intensityMaximum type=\"" + type + "\">" +
+               formatNumber(f.most) + "</intensityMaximum>\n      </intensityLimits>\n";
+      }
+    if (points.hasColors()) {
+      xml += "      <colorLimits type=\"Structure\">\n";
+      for (const char* c : {"Red", "Green", "Blue"}) {
+        xml += std::string("        <color") + c + "Minimum type=\"Integer\">0</color" + c + "Minimum>\n";
+        xml += std::string("        <color") + c + "Maximum type=\"Integer\">" + std::to_string(full) + "</color" + c + "Maximum>\n";
+      }
+      xml += "      </colorLimits>\n";
+    }
+    xml += "      <points type=\"CompressedVector\" fileOffset=\"" + std::to_string(physicalOf(section_at[s])) +
+           "\" recordCount=\"" + std::to_string(scans[s].end - scans[s].first) +
+           "\">\n        <prototype type=\"Structure\">\n" + prototype +
+           "        </prototype>\n        <codecs type=\"Vector\" allowHeterogeneousChildren=\"1\">\n        </codecs>\n"
+           "      </points>\n    </vectorChild>\n";
   }
-  for (const OutField& f : fields)
-    if (f.name == "intensity" && f.limited) {
-      const char* type = f.kind == OutField::Kind::kInteger ? "Integer" : "Float";
-      xml += std::string("      <intensityLimits type=\"Structure\">\n        <intensityMinimum type=\"") + type + "\">" +
-             formatNumber(f.least) + "</intensityMinimum>\n        <intensityMaximum type=\"" + type + "\">" +
-             formatNumber(f.most) + "</intensityMaximum>\n      </intensityLimits>\n";
-    }
-  if (points.hasColors()) {
-    xml += "      <colorLimits type=\"Structure\">\n";
-    for (const char* c : {"Red", "Green", "Blue"}) {
-      xml += std::string("        <color") + c + "Minimum type=\"Integer\">0</color" + c + "Minimum>\n";
-      xml += std::string("        <color") + c + "Maximum type=\"Integer\">" + std::to_string(full) + "</color" + c + "Maximum>\n";
-    }
-    xml += "      </colorLimits>\n";
-  }
-  xml += "      <points type=\"CompressedVector\" fileOffset=\"" + std::to_string(physicalOf(kHeaderBytes)) +
-         "\" recordCount=\"" + std::to_string(n) + "\">\n        <prototype type=\"Structure\">\n" + prototype +
-         "        </prototype>\n        <codecs type=\"Vector\" allowHeterogeneousChildren=\"1\">\n        </codecs>\n"
-         "      </points>\n    </vectorChild>\n  </data3D>\n"
-         "  <images2D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n  </images2D>\n</e57Root>\n";
+  xml += "  </data3D>\n  <images2D type=\"Vector\" allowHeterogeneousChildren=\"1\">\n  </images2D>\n</e57Root>\n";
 
   // The header: the file's length, the XML's place and length.
-  const uint64_t xml_logical = kHeaderBytes + section;
+  const uint64_t xml_logical = section_at.back() + sections.back();
   const uint64_t logical_end = xml_logical + xml.size();
   const uint64_t file_length = (logical_end + kLogicalPage - 1) / kLogicalPage * kPage;
   std::string header(kHeaderBytes, '\0');
@@ -506,81 +522,89 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   storeUnaligned<uint64_t>(header.data() + 24, physicalOf(xml_logical));
   storeUnaligned<uint64_t>(header.data() + 32, xml.size());
   storeUnaligned<uint64_t>(header.data() + 40, kPage);
-  std::string section_header(kSectionHeaderBytes, '\0');
-  section_header[0] = 1;
-  storeUnaligned<uint64_t>(section_header.data() + 8, section);
-  storeUnaligned<uint64_t>(section_header.data() + 16, physicalOf(kHeaderBytes + kSectionHeaderBytes));
-
   Result<AtomicFile> out = AtomicFile::create(path);
   if (!out) return out.error();
   if (Status s = out->checkSpace(file_length); !s) return s;
   PagedWriter writer(*out);
   if (Status s = writer.append(header); !s) return s;
-  if (Status s = writer.append(section_header); !s) return s;
   Progress* progress = options.progress;
   if (progress) progress->start("writing " + path, n);
   std::vector<std::string> batch;
-  for (uint64_t first = 0; first < packets; first += kPacketsPerBatch) {
-    const size_t count = static_cast<size_t>(std::min<uint64_t>(kPacketsPerBatch, packets - first));
-    batch.resize(count);
-    parallelFor(count, threads, [&](size_t b, unsigned) {
-      const uint64_t p = first + b;
-      std::vector<uint64_t> chunks;
-      std::string& packet = batch[b];
-      packet.assign(static_cast<size_t>(packetBytes(p, &chunks)), '\0');
-      packet[0] = 1;
-      storeUnaligned<uint16_t>(packet.data() + 2, static_cast<uint16_t>(packet.size() - 1));
-      storeUnaligned<uint16_t>(packet.data() + 4, static_cast<uint16_t>(fields.size()));
-      size_t at = static_cast<size_t>(header_bytes);
-      const auto [begin, end, first_field, last_field] = packetOf(p);
-      for (size_t k = 0; k < fields.size(); ++k) {
-        storeUnaligned<uint16_t>(packet.data() + 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
-        if (k < first_field || k >= last_field) continue;  // none of this field here
-        const OutField& f = fields[k];
-        uint8_t* bytes = reinterpret_cast<uint8_t*>(packet.data()) + at;
-        if (f.source == OutField::Source::kPosition) {
-          for (size_t i = begin; i < end; ++i) std::memcpy(bytes + (i - begin) * 8, &points.positions[i][f.axis], 8);
-        } else if (f.kind != OutField::Kind::kInteger) {  // a float dimension: its bytes as they are
-          const size_t width = f.kind == OutField::Kind::kFloat64 ? 8 : 4;
-          std::memcpy(bytes, f.dimension->bytes.data() + begin * width, (end - begin) * width);
-        } else if (f.bits > 0) {  // least significant bit first, the value less the minimum
-          uint64_t word = 0;
-          unsigned filled = 0;
-          size_t out_byte = 0;
-          const unsigned bits = f.bits;
-          const uint64_t minimum = static_cast<uint64_t>(f.minimum);
-          eachInteger(f, points, full, begin, end, [&](size_t, int64_t v) {
-            const uint64_t raw = static_cast<uint64_t>(v) - minimum;
-            word |= raw << filled;
-            if (filled + bits >= 64) {
-              std::memcpy(bytes + out_byte, &word, 8);
-              out_byte += 8;
-              const unsigned used = 64 - filled;
-              word = used == 64 ? 0 : raw >> used;
-              filled = filled + bits - 64;
-            } else {
-              filled += bits;
-            }
-          });
-          if (filled > 0) std::memcpy(bytes + out_byte, &word, std::min<size_t>(8, chunks[k] - out_byte));
+  for (size_t s = 0; s < scans.size(); ++s) {
+    const SourceRun& scan = scans[s];
+    // The section's header: its length, its data's place.
+    std::string section_header(kSectionHeaderBytes, '\0');
+    section_header[0] = 1;
+    storeUnaligned<uint64_t>(section_header.data() + 8, sections[s]);
+    storeUnaligned<uint64_t>(section_header.data() + 16, physicalOf(section_at[s] + kSectionHeaderBytes));
+    if (Status status = writer.append(section_header); !status) return status;
+    const uint64_t packets = packetsOf(scan);
+    for (uint64_t first = 0; first < packets; first += kPacketsPerBatch) {
+      const size_t count = static_cast<size_t>(std::min<uint64_t>(kPacketsPerBatch, packets - first));
+      batch.resize(count);
+      parallelFor(count, threads, [&](size_t b, unsigned) {
+        std::vector<uint64_t> chunks;
+        const Packet packet_of = packetOf(scan, first + b);
+        std::string& packet = batch[b];
+        packet.assign(static_cast<size_t>(packetBytes(packet_of, &chunks)), '\0');
+        packet[0] = 1;
+        storeUnaligned<uint16_t>(packet.data() + 2, static_cast<uint16_t>(packet.size() - 1));
+        storeUnaligned<uint16_t>(packet.data() + 4, static_cast<uint16_t>(fields.size()));
+        size_t at = static_cast<size_t>(header_bytes);
+        const auto [begin, end, first_field, last_field] = packet_of;
+        for (size_t k = 0; k < fields.size(); ++k) {
+          storeUnaligned<uint16_t>(packet.data() + 6 + 2 * k, static_cast<uint16_t>(chunks[k]));
+          if (k < first_field || k >= last_field) continue;  // none of this field here
+          const OutField& f = fields[k];
+          uint8_t* bytes = reinterpret_cast<uint8_t*>(packet.data()) + at;
+          if (f.source == OutField::Source::kPosition) {
+            for (size_t i = begin; i < end; ++i) std::memcpy(bytes + (i - begin) * 8, &points.positions[i][f.axis], 8);
+          } else if (f.kind != OutField::Kind::kInteger) {  // a float dimension: its bytes as they are
+            const size_t width = f.kind == OutField::Kind::kFloat64 ? 8 : 4;
+            std::memcpy(bytes, f.dimension->bytes.data() + begin * width, (end - begin) * width);
+          } else if (f.bits > 0) {  // least significant bit first, the value less the minimum
+            uint64_t word = 0;
+            unsigned filled = 0;
+            size_t out_byte = 0;
+            const unsigned bits = f.bits;
+            const uint64_t minimum = static_cast<uint64_t>(f.minimum);
+            eachInteger(f, points, full, begin, end, [&](size_t, int64_t v) {
+              const uint64_t raw = static_cast<uint64_t>(v) - minimum;
+              word |= raw << filled;
+              if (filled + bits >= 64) {
+                std::memcpy(bytes + out_byte, &word, 8);
+                out_byte += 8;
+                const unsigned used = 64 - filled;
+                word = used == 64 ? 0 : raw >> used;
+                filled = filled + bits - 64;
+              } else {
+                filled += bits;
+              }
+            });
+            if (filled > 0) std::memcpy(bytes + out_byte, &word, std::min<size_t>(8, chunks[k] - out_byte));
+          }
+          at += static_cast<size_t>(chunks[k]);
         }
-        at += static_cast<size_t>(chunks[k]);
+      });
+      for (size_t b = 0; b < count; ++b) {
+        if (Status status = writer.append(batch[b]); !status) return status;
+        if (const Packet packet = packetOf(scan, first + b); progress && packet.last == fields.size())
+          progress->advance(packet.end - packet.begin);
       }
-    });
-    for (size_t b = 0; b < count; ++b) {
-      if (Status s = writer.append(batch[b]); !s) return s;
-      if (const Packet packet = packetOf(first + b); progress && packet.last == fields.size())
-        progress->advance(packet.end - packet.begin);
     }
+    if (scan.end == scan.first)
+      if (Status status = writer.append(no_points); !status) return status;
   }
-  if (Status s = writer.append(no_points); !s) return s;
   if (progress) progress->finish();
   // The GUIDs, from what is written: the pages' checksums so far and the bytes of the last.
   const auto [guid_hi, guid_lo] = writer.digest(prototype, n);
-  const std::string file_guid = uuidText(guid_hi, guid_lo), scan_guid = uuidText(guid_lo, guid_hi);
-  for (const auto& [marker, text] : {std::pair{kFileGuidMarker, file_guid}, std::pair{kScanGuidMarker, scan_guid}}) {
-    const size_t at = xml.find(marker);
-    xml.replace(at, text.size(), text);
+  const std::string file_guid = uuidText(guid_hi, guid_lo);
+  xml.replace(xml.find(kFileGuidMarker), file_guid.size(), file_guid);
+  size_t at = 0;
+  for (size_t s = 0; s < scans.size(); ++s) {  // each scan's its own
+    const std::string scan_guid = uuidText(guid_lo + s, guid_hi);
+    at = xml.find(kScanGuidMarker, at);
+    xml.replace(at, scan_guid.size(), scan_guid);
   }
   if (Status s = writer.append(xml); !s) return s;
   if (Status s = writer.finish(); !s) return s;

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 #include <vector>
 
 #include <glm/common.hpp>
@@ -108,6 +109,22 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads) {
   });
   points.color_full_scale = full;
   points.colors_read_as_fractions = false;
+}
+
+std::vector<SourceRun> pointSourceRuns(const PointSet& points) {
+  const std::vector<SourceRun> one = {{0, points.size(), 0.0}};
+  const Dimension* source = points.dimensions.find(dim::kPointSourceId);
+  if (!source || points.size() == 0) return one;
+  std::vector<SourceRun> runs;
+  std::unordered_set<double> seen;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double id = source->value(i);
+    if (i != 0 && id == runs.back().id) continue;
+    if (!seen.insert(id).second) return one;  // an id's points in two places
+    if (i != 0) runs.back().end = i;
+    runs.push_back({i, points.size(), id});
+  }
+  return runs.size() == 1 ? one : runs;
 }
 
 void appendPoints(PointSet& out, const PointSet& part) {

@@ -151,6 +151,15 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads);
 // (color_full_scale, las, z_axis) are the caller's.
 void appendPoints(PointSet& out, const PointSet& part);
 
+// A set's scans as E57 and PTX write them: the runs of its point_source_id, [first, end) each with
+// its value, where it has several values and each value's points lie together (as an E57 or PTX file
+// of several scans reads: each point's scan); else one run of every point (`id` 0).
+struct SourceRun {
+  size_t first = 0, end = 0;
+  double id = 0.0;
+};
+std::vector<SourceRun> pointSourceRuns(const PointSet& points);
+
 // Whether every coordinate is finite (no nan, no inf).
 inline bool isFinite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 

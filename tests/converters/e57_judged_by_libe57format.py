@@ -49,9 +49,12 @@ def parse_judge(path):
         for line in f:
             words = line.split()
             if words[0] == "scan":
-                scans.append({"records": int(words[3]), "fields": words[5:], "rows": {}, "pose": None, "limits": {}})
+                scans.append({"records": int(words[3]), "fields": words[5:], "rows": {}, "pose": None, "limits": {},
+                              "precision": {}})
             elif words[0] == "field" and words[2] == "Integer":
                 scans[-1]["limits"][words[1]] = ("Integer", int(words[3]), int(words[4]))
+            elif words[0] == "field" and words[2] == "Float":
+                scans[-1]["precision"][words[1]] = words[3]
             elif words[0] == "field" and words[2] == "ScaledInteger":
                 ends = [int(words[3]) * float(words[5]) + float(words[6]), int(words[4]) * float(words[5]) + float(words[6])]
                 scans[-1]["limits"][words[1]] = ("ScaledInteger", min(ends), max(ends))
@@ -173,7 +176,9 @@ def check(name, work):
 
 WRITTEN = {"1.2-with-color": os.path.join(DATA, "..", "laz", "1.2-with-color.las"),
            # More fields than one 64-record group of fits in a packet: each group over two packets.
-           "130-doubles": os.path.join(DATA, "written", "130-doubles.ply")}
+           "130-doubles": os.path.join(DATA, "written", "130-doubles.ply"),
+           # Two scans read as one set (each point's scan in point_source_id): written as two.
+           "two_scans": os.path.join(DATA, "two_scans.e57")}
 LAS_FIELDS = {"scan_direction", "edge_of_flight_line", "classification", "synthetic", "key_point", "withheld",
               "scan_angle_rank", "scan_angle", "user_data", "point_source_id", "gps_time", "overlap",
               "scanner_channel", "nir"}  # the LAS fields the writer puts in the LAS extension (las:camelCase)
@@ -198,9 +203,15 @@ def check_written(name, source, work):
     # 17 fixed decimals: every coordinate's double (a LAS source's CSV has its step's digits alone).
     subprocess.run([DPOINT, "convert", source, "-o", csv, "-q", "--decimals", "17"], check=True)
     table = pd.read_csv(csv, dtype=np.float64, float_precision="round_trip")
-    (scan,) = parse_judge(os.path.join(DATA, "written", name + ".libe57format.txt"))
-    if scan["records"] != len(table) or scan["pose"] is not None:
-        fail("written/" + name, f"{scan['records']} records (pose {scan['pose']}), the source has {len(table)} points")
+    # A scan for each of the source's scans (point_source_id's runs), the source's points in order.
+    scans = parse_judge(os.path.join(DATA, "written", name + ".libe57format.txt"))
+    ids = table["point_source_id"].to_numpy() if "point_source_id" in table.columns else np.zeros(len(table))
+    runs = 1 + int(np.count_nonzero(ids[1:] != ids[:-1])) if len(ids) else 1
+    expected_scans = runs if runs == len(np.unique(ids)) else 1
+    if sum(scan["records"] for scan in scans) != len(table) or len(scans) != expected_scans or any(
+            scan["pose"] is not None for scan in scans):
+        fail("written/" + name, f"{[scan['records'] for scan in scans]} records in {len(scans)} scans (poses "
+             f"{[scan['pose'] for scan in scans]}), the source has {len(table)} points in {expected_scans}")
         return
     column_of = {"cartesianX": "x", "cartesianY": "y", "cartesianZ": "z", "colorRed": "r", "colorGreen": "g",
                  "colorBlue": "b", "intensity": "intensity", "returnIndex": "return_number",
@@ -208,18 +219,25 @@ def check_written(name, source, work):
     for column in table.columns:
         if column not in column_of.values():
             column_of[("las:" + camel(column)) if column in LAS_FIELDS else column] = column
-    if sorted(column_of[f] for f in scan["fields"]) != sorted(table.columns):
-        fail("written/" + name, f"fields {scan['fields']} for the columns {list(table.columns)}")
-        return
     fractions = "r" in table.columns and table[["r", "g", "b"]].to_numpy().max() <= 1.0
-    for index, (_, values) in scan["rows"].items():
-        for field, value in zip(scan["fields"], values):
-            want = table.iloc[index][column_of[field]] - (1 if field == "returnIndex" else 0)
-            if field.startswith("color") and fractions:  # the CSV's 0..1 as the integers of the colour's scale
-                want = round(want * scan["limits"][field][2])
-            if value != want:
-                fail("written/" + name, f"record {index}: {field} {value!r}, the source's {column_of[field]} {want!r}")
-    print(f"written/{name}: {len(table)} points, {len(scan['rows'])} records compared", file=sys.stderr)
+    first, compared = 0, 0
+    for scan in scans:
+        if sorted(column_of[f] for f in scan["fields"]) != sorted(table.columns):
+            fail("written/" + name, f"fields {scan['fields']} for the columns {list(table.columns)}")
+            return
+        for index, (_, values) in scan["rows"].items():
+            for field, value in zip(scan["fields"], values):
+                want = table.iloc[first + index][column_of[field]] - (1 if field == "returnIndex" else 0)
+                if field.startswith("color") and fractions:  # the CSV's 0..1 as the integers of the colour's scale
+                    want = round(want * scan["limits"][field][2])
+                if scan["precision"].get(field) == "single":  # the CSV's shortest float32 form
+                    value, want = np.float32(value), np.float32(want)
+                if value != want:
+                    fail("written/" + name, f"record {first + index}: {field} {value!r}, the source's "
+                         f"{column_of[field]} {want!r}")
+        first += scan["records"]
+        compared += len(scan["rows"])
+    print(f"written/{name}: {len(table)} points in {len(scans)} scan(s), {compared} records compared", file=sys.stderr)
 
 
 with tempfile.TemporaryDirectory() as work:

@@ -4,6 +4,7 @@
 // judgement (tests/converters/e57_judged_by_libe57format.py).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -925,6 +926,40 @@ TEST(E57, aStreamsIndexIsSmallAndCountsOfNoBytesAreRefused) {
     ASSERT_EQ(read->size(), 1000u);
     EXPECT_EQ(read->positions[999], glm::dvec3(1, 2, 3));
   }
+}
+
+// A set read from several scans (each point's scan in point_source_id, in runs) is written as those
+// scans, each its own data3D child with its own bounds and records, and read back with the same
+// ids; ids whose points are not together make one scan. (libE57Format read such a file:
+// tests/data/e57/written/two_scans.)
+TEST(E57, eachPointSourceIdsRunIsAScan) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{1.0, 2.0, 3.0}, {1.5, 2.5, 3.5}, {500.0, 600.0, 70.0}, {501.0, 601.0, 71.0}, {502.0, 602.0, 72.0}};
+  Dimension& ids = set.dimensions.add(dim::kPointSourceId, DimType::kU16, 5);
+  for (size_t i = 0; i < 5; ++i) ids.setValue(i, i < 2 ? 9.0 : 4.0);
+  ASSERT_TRUE(writeE57(dir.file("two.e57"), set).ok());
+  // The file's logical bytes: each 1,024-byte page less its 4-byte checksum.
+  const auto logical = [](const std::string& file) {
+    std::string out;
+    for (size_t at = 0; at < file.size(); at += 1024) out.append(file, at, std::min<size_t>(1020, file.size() - at));
+    return out;
+  };
+  const std::string bytes = logical(test::readFile(dir.file("two.e57")));
+  EXPECT_TRUE(test::contains(bytes, "recordCount=\"2\"")) << "the first scan's two records";
+  EXPECT_TRUE(test::contains(bytes, "recordCount=\"3\"")) << "the second scan's three";
+  EXPECT_TRUE(test::contains(bytes, "<xMinimum type=\"Float\">500</xMinimum>")) << "the second scan's bounds";
+  Result<PointSet> back = readE57(dir.file("two.e57"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->positions, set.positions);
+  for (size_t i = 0; i < 5; ++i) EXPECT_EQ(back->dimensions.find(dim::kPointSourceId)->value(i), ids.value(i)) << i;
+
+  ids.setValue(4, 9.0);  // 9's points in two places: one scan
+  ASSERT_TRUE(writeE57(dir.file("one.e57"), set).ok());
+  EXPECT_TRUE(test::contains(logical(test::readFile(dir.file("one.e57"))), "recordCount=\"5\""));
+  back = readE57(dir.file("one.e57"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->dimensions.find(dim::kPointSourceId)->value(4), 9.0);
 }
 
 }  // namespace
