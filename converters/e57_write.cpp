@@ -601,8 +601,8 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   const std::string file_guid = uuidText(guid_hi, guid_lo);
   xml.replace(xml.find(kFileGuidMarker), file_guid.size(), file_guid);
   size_t at = 0;
-  for (size_t s = 0; s < scans.size(); ++s) {  // each scan's its own
-    const std::string scan_guid = uuidText(guid_lo + s, guid_hi);
+  for (size_t s = 0; s < scans.size(); ++s) {  // each scan's its own: s in the 62 bits uuidText keeps whole
+    const std::string scan_guid = uuidText(guid_lo, guid_hi + s);
     at = xml.find(kScanGuidMarker, at);
     xml.replace(at, scan_guid.size(), scan_guid);
   }

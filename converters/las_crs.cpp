@@ -486,7 +486,12 @@ bool crsEquivalent(const StatedCrs& stated, const std::string& wkt) {
   if (!proj.context()) return false;
   const PJ* a = proj.keep(api.create(proj.context(), mine.c_str()));
   const PJ* b = proj.keep(api.create(proj.context(), wkt.c_str()));
-  return a && b && api.is_equivalent_to(a, b, PJ_COMP_EQUIVALENT);
+  if (a && b && api.is_equivalent_to(a, b, PJ_COMP_EQUIVALENT)) return true;
+  // The same definition as PROJ writes it (`wkt` is --crs's, made by crsAsWkt): PROJ renames a
+  // datum on the way ("NAD_1983_HARN" becomes "NAD83 (High Accuracy Reference Network)"), which
+  // the comparison above counts as a difference (a review finding).
+  const Result<std::string> written = crsAsWkt(mine, "the input's CRS");
+  return written && *written == wkt;
 }
 
 std::string crsLabel(const StatedCrs& crs) {

@@ -3,6 +3,7 @@
 #include <cassert>
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <unordered_set>
@@ -115,14 +116,21 @@ std::vector<SourceRun> pointSourceRuns(const PointSet& points) {
   const std::vector<SourceRun> one = {{0, points.size(), 0.0}};
   const Dimension* source = points.dimensions.find(dim::kPointSourceId);
   if (!source || points.size() == 0) return one;
+  // An id as one value: every NaN one (a review finding: NaN != NaN made each point a scan), -0 as 0.
+  const auto key = [](double v) { return std::isnan(v) ? ~uint64_t{0} : std::bit_cast<uint64_t>(v + 0.0); };
   std::vector<SourceRun> runs;
-  std::unordered_set<double> seen;
+  std::unordered_set<uint64_t> seen;
+  uint64_t last = 0;
   for (size_t i = 0; i < points.size(); ++i) {
     const double id = source->value(i);
-    if (i != 0 && id == runs.back().id) continue;
-    if (!seen.insert(id).second) return one;  // an id's points in two places
+    const uint64_t k = key(id);
+    if (i != 0 && k == last) continue;
+    // An id's points in two places, or more scans than a point source id numbers (the readers
+    // number a file's scans in it, up to 65,535): one.
+    if (!seen.insert(k).second || runs.size() == 65535) return one;
     if (i != 0) runs.back().end = i;
     runs.push_back({i, points.size(), id});
+    last = k;
   }
   return runs.size() == 1 ? one : runs;
 }

@@ -152,8 +152,9 @@ void takeColorsAsIntegers(PointSet& points, uint16_t full, unsigned threads);
 void appendPoints(PointSet& out, const PointSet& part);
 
 // A set's scans as E57 and PTX write them: the runs of its point_source_id, [first, end) each with
-// its value, where it has several values and each value's points lie together (as an E57 or PTX file
-// of several scans reads: each point's scan); else one run of every point (`id` 0).
+// its value, where it has several values (every NaN one value), each value's points lie together
+// (as an E57 or PTX file of several scans reads: each point's scan) and they are at most 65,535
+// (what the readers number); else one run of every point (`id` 0).
 struct SourceRun {
   size_t first = 0, end = 0;
   double id = 0.0;

@@ -327,6 +327,11 @@ TEST(CliLas, theCoordinateSystemSurvivesPlyAndPcdAndStreamedInfoStatesIt) {
     ASSERT_EQ(same.exit_code, 0) << same.err;
     EXPECT_FALSE(test::contains(same.err, "replaced")) << to << ": " << same.err;
   }
+  // Nor the input's own WKT given back, which PROJ rewrites renaming its datum.
+  writeFile(dir.file("own.wkt"), readPoints(dir.file("a.e57"))->crs);
+  const test::CommandResult own = runDpoint({"convert", dir.file("a.e57"), "--crs", dir.file("own.wkt"), "-o", dir.file("own.e57")});
+  ASSERT_EQ(own.exit_code, 0) << own.err;
+  EXPECT_FALSE(test::contains(own.err, "replaced")) << own.err;
   test::CommandResult plain = runDpoint({"convert", dir.file("r.ply"), "-o", dir.file("n.csv"), "-q"});
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   plain = runDpoint({"convert", dir.file("n.csv"), "--crs", "EPSG:32633", "-o", dir.file("n.ply")});

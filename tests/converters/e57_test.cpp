@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -953,6 +954,31 @@ TEST(E57, eachPointSourceIdsRunIsAScan) {
   ASSERT_TRUE(back.ok()) << back.error().message;
   EXPECT_EQ(back->positions, set.positions);
   for (size_t i = 0; i < 5; ++i) EXPECT_EQ(back->dimensions.find(dim::kPointSourceId)->value(i), ids.value(i)) << i;
+
+  // Every NaN is one id (a review finding: each NaN point was a scan of its own).
+  PointSet nan_set;
+  nan_set.positions = set.positions;
+  Dimension& nan_ids = nan_set.dimensions.add(dim::kPointSourceId, DimType::kF64, 5);
+  for (size_t i = 0; i < 5; ++i) nan_ids.set<double>(i, i < 3 ? std::nan("") : 2.0);
+  EXPECT_EQ(pointSourceRuns(nan_set).size(), 2u);
+
+  // More runs than a point source id numbers (65,535): one scan, which the reader can read; and
+  // every scan's GUID its own (a review finding: they repeated past 4,096 scans).
+  PointSet many;
+  many.positions.resize(65536);
+  Dimension& each = many.dimensions.add(dim::kPointSourceId, DimType::kU16, 65536);
+  for (size_t i = 0; i < 65536; ++i) many.positions[i] = glm::dvec3(static_cast<double>(i), 0.0, 0.0), each.setValue(i, double(i));
+  EXPECT_EQ(pointSourceRuns(many).size(), 1u);
+  many.positions.resize(5000);
+  many.dimensions.resize(5000);
+  ASSERT_TRUE(writeE57(dir.file("many.e57"), many).ok());
+  const std::string xml = logical(test::readFile(dir.file("many.e57")));
+  std::set<std::string> guids;
+  size_t scans = 0;
+  for (size_t at = 0; (at = xml.find("<guid type=\"String\"><![CDATA[", at)) != std::string::npos; ++at, ++scans)
+    guids.insert(xml.substr(at + 30, 36));
+  EXPECT_EQ(scans, 5001u);  // the file's and 5,000 scans'
+  EXPECT_EQ(guids.size(), scans);
 
   ids.setValue(4, 9.0);  // 9's points in two places: one scan
   ASSERT_TRUE(writeE57(dir.file("one.e57"), set).ok());
