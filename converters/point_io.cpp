@@ -419,7 +419,7 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
 Status writePoints(const std::string& path, const PointSet& points, const WriteOptions& options) {
   Result<FileFormat> format = formatOf(path);
   if (!format) return format.error();
-  if (Status s = checkWrittenFormat(path, *format); !s) return s;  // .gltf, .ptx (the CLI checks -o first)
+  if (Status s = checkWrittenFormat(path, *format); !s) return s;  // .gltf (the CLI checks -o first)
   // Colours read as fractions that an integer format rounds: said once the file is there (a review
   // of issue #38's wave: a float-colour PLY went to 8-bit PLY, PCD or PTS without a word).
   const double full = writtenColorScale(path, *format, points, options);
