@@ -342,31 +342,18 @@ bool zeroRow(const glm::dvec3& v, int decimals, bool at_scale) {
 // `zero_rows` gets the count of such rows left.
 glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, int decimals, bool at_scale,
                      unsigned threads, size_t& zero_rows) {
-  constexpr size_t kBlock = 1u << 16;
-  const size_t blocks = (last - first + kBlock - 1) / kBlock;
-  const unsigned workers = resolveThreads(threads);
-  std::vector<Box> boxes(workers, Box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)});
-  std::vector<uint8_t> nonfinite(workers, 0);
-  parallelFor(blocks, workers, [&](size_t b, unsigned w) {
-    for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i)
-      for (int k = 0; k < 3; ++k) {
-        const double v = positions[i][k];
-        if (!std::isfinite(v)) {
-          nonfinite[w] = 1;
-          continue;
-        }
-        boxes[w].min[k] = std::min(boxes[w].min[k], v);
-        boxes[w].max[k] = std::max(boxes[w].max[k], v);
-      }
-  });
+  bool nonfinite = false;
+  const Box box = finiteBox(positions, first, last, threads, &nonfinite);
   glm::dvec3 offset(0.0);
-  const bool finite = std::find(nonfinite.begin(), nonfinite.end(), 1) == nonfinite.end();
+  const bool finite = !nonfinite;
   for (int k = 0; k < 3 && finite; ++k) {
-    double lo = HUGE_VAL, hi = -HUGE_VAL;
-    for (const Box& box : boxes) lo = std::min(lo, box.min[k]), hi = std::max(hi, box.max[k]);
+    const double lo = box.min[k], hi = box.max[k];
     const double centre = std::nearbyint(lo / 2 + hi / 2);
     if (lo <= hi && std::fabs(centre) < 0x1p52) offset[k] = centre + 0.0;  // never -0
   }
+  constexpr size_t kBlock = 1u << 16;
+  const size_t blocks = (last - first + kBlock - 1) / kBlock;
+  const unsigned workers = resolveThreads(threads);
   // Per axis, whether some coordinate does not come back through `t` bit for bit; and the rows
   // that would read as 0 0 0.
   const auto check = [&](const glm::dvec3& t, glm::ivec3& inexact) {
@@ -426,9 +413,6 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
   layout.ptx = ptx;
   layout.zero_intensity = ptx && !intensity;
   const std::vector<SourceRun> scans = ptx ? pointSourceRuns(points) : std::vector<SourceRun>{{0, points.size(), 0.0}};
-  std::vector<double> ids;  // the scans' point_source_ids, where there are several
-  if (scans.size() > 1)
-    for (const SourceRun& scan : scans) ids.push_back(scan.id);
   Result<CsvRowWriter> writer = CsvRowWriter::create(path, std::move(layout), options, points.size());
   if (!writer) return writer.error();
   size_t at_origin = 0;  // PTX rows of 0 0 0
@@ -449,7 +433,7 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
   if (Status s = writer->commit(); !s) return s;
   // What PTS and PTX cannot hold, said once the file is there.
   if (options.notices) {
-    const Dimension* as_scans = ids.empty() ? nullptr : points.dimensions.find(dim::kPointSourceId);
+    const Dimension* as_scans = scans.size() > 1 ? points.dimensions.find(dim::kPointSourceId) : nullptr;
     std::string dropped;
     for (const Dimension& d : points.dimensions.all())
       if (&d != intensity && &d != as_scans) dropped += (dropped.empty() ? "" : ", ") + d.name;
@@ -471,12 +455,13 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
                                  "with no echo and leave out");
     // The reader numbers the scans 1, 2, … in point_source_id: said where the ids were others.
     bool renumbered = false;
-    for (size_t k = 0; k < ids.size(); ++k) renumbered = renumbered || ids[k] != static_cast<double>(k + 1);
+    for (size_t k = 0; k < scans.size() && scans.size() > 1; ++k)
+      renumbered = renumbered || scans[k].id != static_cast<double>(k + 1);
     if (renumbered)
-      options.notices->push_back(path + ": point_source_id written as " + countOf(ids.size(), "scan") +
+      options.notices->push_back(path + ": point_source_id written as " + countOf(scans.size(), "scan") +
                                  ", one for each id in the set's order, which PTX readers number 1 to " +
-                                 std::to_string(ids.size()) + " (its ids were " + formatNumber(ids.front()) + ", " +
-                                 formatNumber(ids[1]) + (ids.size() > 2 ? ", …)" : ")"));
+                                 std::to_string(scans.size()) + " (its ids were " + formatNumber(scans[0].id) + ", " +
+                                 formatNumber(scans[1].id) + (scans.size() > 2 ? ", …)" : ")"));
   }
   return okStatus();
 }

@@ -408,28 +408,7 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
   // The XML tree, from the bounds and the fields.
   // Each scan's bounds of its finite coordinates (--allow-nonfinite sets may have others).
   std::vector<Box> bounds;
-  for (const SourceRun& scan : scans) {
-    constexpr size_t kBlock = 1u << 16;
-    const size_t count = scan.end - scan.first;
-    std::vector<glm::dvec3> los((count + kBlock - 1) / kBlock, glm::dvec3(HUGE_VAL)), his(los.size(), glm::dvec3(-HUGE_VAL));
-    parallelFor(los.size(), threads, [&](size_t b, unsigned) {
-      for (size_t i = scan.first + b * kBlock, end = std::min(scan.end, i + kBlock); i < end; ++i)
-        for (int k = 0; k < 3; ++k) {
-          const double v = points.positions[i][k];
-          if (!std::isfinite(v)) continue;
-          los[b][k] = std::min(los[b][k], v);
-          his[b][k] = std::max(his[b][k], v);
-        }
-    });
-    Box box{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)};
-    for (size_t b = 0; b < los.size(); ++b) {
-      for (int k = 0; k < 3; ++k) {
-        box.min[k] = std::min(box.min[k], los[b][k]);
-        box.max[k] = std::max(box.max[k], his[b][k]);
-      }
-    }
-    bounds.push_back(box);
-  }
+  for (const SourceRun& scan : scans) bounds.push_back(finiteBox(points.positions, scan.first, scan.end, threads));
   // The intensity's range, by which readers (PDAL, CloudCompare) normalise it: LAS's 0..65535 for
   // integers that fit, 0..1 for floats of 0..1, else the values' own; a Float's also as its limits
   // (libE57Format's Simple API takes a Float intensity's range from them).

@@ -633,9 +633,9 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
   l.file_source_id = source ? source->file_source_id : 0;
   // Formats 6-10 hold their CRS as WKT alone: GeoTIFF keys are made WKT (converters/las_crs.h).
   std::vector<LasVlr> crs = source && !source_crs_dropped ? source->vlrs : std::vector<LasVlr>();
-  if (!crs_wkt.empty()) {  // the CRS given: as GeoTIFF keys in LAS 1.2, or as WKT in LAS 1.4
-    const std::string before = !crs.empty() ? lasCrsSummary(crs, lasSaysWkt(*source)) : std::string();
-    if (!before.empty()) l.crs_note = "the input's CRS (" + before + ") replaced by " + wktName(crs_wkt);
+  // The CRS given: as GeoTIFF keys in LAS 1.2, or as WKT in LAS 1.4. writePoints says what it
+  // replaced, as for every format that keeps a CRS.
+  if (!crs_wkt.empty()) {
     if (!given_keys.empty()) {
       crs = given_keys;
     } else {

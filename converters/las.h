@@ -142,7 +142,7 @@ struct LasWriteOptions {
   std::string crs_wkt;
   // Set where the set's own CRS text (PointSet::crs) is its CRS over the source's records (the text
   // wins: converters/las_crs.h): the records are not written, crs_wkt (the text made WKT; empty
-  // where PROJ made none) is, and no note says the input's CRS was replaced, as it was not.
+  // where PROJ made none, and then no CRS) is.
   bool source_crs_dropped = false;
   // When set, the file's bytes are appended here and nothing is written at `path` (which names the
   // output in messages).

@@ -334,7 +334,6 @@ Status writeFormat(const std::string& path, FileFormat format, const PointSet& p
       las.progress = options.progress;
       las.report = &report;
       las.crs_wkt = options.las_crs;
-      las.source_crs_dropped = !options.las_crs.empty();  // writePoints says what --crs replaced
       // A coordinate system another format stated (an E57 file's, or the module's `crs`), where no
       // --crs gives one: made WKT by PROJ in place of a LAS source's records (the text wins, as
       // every writer takes it), or left out with a note (and the records with it).

@@ -220,4 +220,34 @@ Box boundingBox(const PositionArray& positions, size_t first, size_t last) {
   return box;
 }
 
+Box finiteBox(const PositionArray& positions, size_t first, size_t last, unsigned threads, bool* nonfinite) {
+  assert(first <= last && last <= positions.size());
+  constexpr size_t kBlock = size_t{1} << 16;
+  const size_t blocks = (last - first + kBlock - 1) / kBlock;
+  const Box none{glm::dvec3(HUGE_VAL), glm::dvec3(-HUGE_VAL)};
+  std::vector<Box> boxes(blocks, none);
+  std::vector<uint8_t> odd(blocks, 0);
+  parallelFor(blocks, threads, [&](size_t b, unsigned) {
+    Box box = none;
+    for (size_t i = first + b * kBlock, end = std::min(last, i + kBlock); i < end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double v = positions[i][k];
+        if (!std::isfinite(v)) {
+          odd[b] = 1;
+          continue;
+        }
+        box.min[k] = std::min(box.min[k], v);
+        box.max[k] = std::max(box.max[k], v);
+      }
+    boxes[b] = box;
+  });
+  Box box = none;
+  for (const Box& b : boxes) {
+    box.min = glm::min(box.min, b.min);
+    box.max = glm::max(box.max, b.max);
+  }
+  if (nonfinite) *nonfinite = std::find(odd.begin(), odd.end(), uint8_t{1}) != odd.end();
+  return box;
+}
+
 }  // namespace dpoint

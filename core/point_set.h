@@ -171,4 +171,9 @@ struct Box {
 Box boundingBox(const PositionArray& positions, size_t first, size_t last);
 inline Box boundingBox(const PositionArray& positions) { return boundingBox(positions, 0, positions.size()); }
 
+// The box of the finite coordinates of positions [first, last), axis by axis (an axis with none
+// has min +inf and max -inf), on `threads` cores (0: all); `nonfinite` (if given) is whether some
+// coordinate was nan or inf. For sets that --allow-nonfinite let in.
+Box finiteBox(const PositionArray& positions, size_t first, size_t last, unsigned threads, bool* nonfinite = nullptr);
+
 }  // namespace dpoint
