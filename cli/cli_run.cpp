@@ -50,8 +50,8 @@ int runAppUnguarded(int argc, const char* const* argv_in) {
   for (const std::string& w : words) argv_words.push_back(w.c_str());
   const char* const* argv = argv_words.data();
   CLI::App app{"dpoint: double-precision point datasets. Generate fractal and test sets, convert between\n"
-               "CSV, PLY, GLB, LAS and LAZ, render them offscreen with Vulkan in seven precision modes, and inspect\n"
-               "the precision a dataset needs.\n"
+               "CSV and text exports (PTS, PTX), PLY, PCD, GLB, LAS, LAZ, COPC and E57, render them offscreen\n"
+               "with Vulkan in seven precision modes, and inspect the precision a dataset needs.\n"
                "Exit codes: 0 ok, 1 usage, 2 bad input, 3 no usable Vulkan device, 4 resource limit,\n"
                "130/143 stopped by SIGINT/SIGTERM (the output is not written).",
                "dpoint"};
