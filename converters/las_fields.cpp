@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iterator>
 #include <optional>
+#include <string_view>
 #include <unordered_set>
 
 #include "core/bytes.h"
@@ -122,10 +123,26 @@ bool holds(const PointSet& points, const Widest& widest, int f) {
   for (const Dimension& d : points.dimensions.all()) {
     const KnownDimension* known = findKnownDimension(d.name);
     if (!known || !known->las_field) continue;  // extra bytes in any format
+    // The angle in 0.006° steps only formats 6-10 hold as it is (a legacy format's whole degrees
+    // of ±90 rounded and clamped it without a word: a review finding); either holds the rank.
+    if (d.name == dim::kScanAngle && f < 6) return false;
     const bool scan_angle = d.name == dim::kScanAngle || d.name == dim::kScanAngleRank;
     if (!scan_angle && !hasField(f, d.name)) return false;
   }
   return f >= 6 || (widest.classification <= 31 && widest.returns <= 7);  // the narrower legacy fields
+}
+
+// Whether format `f` has a field the set lacks that a smaller format leaves out (colours, a legacy
+// format's GPS time, NIR, the wave packets): the source's format is then not kept, so that
+// --no-colors or --drop gps_time leave the field out instead of writing zeros (a review finding).
+bool lacksFields(const PointSet& points, int f) {
+  if (kRgbAt[static_cast<size_t>(f)] && !points.hasColors()) return true;
+  for (const LasField& field : lasFields(f)) {
+    const std::string_view name = field.name;
+    const bool optional = (name == dim::kGpsTime && f < 6) || name == dim::kNir || name.rfind("wave_", 0) == 0;
+    if (optional && !points.dimensions.find(field.name)) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -280,10 +297,11 @@ int lasFormatFor(const PointSet& points, int preferred, bool waveforms) {
   const Widest widest{largest(points, dim::kClassification),
                       std::max(largest(points, dim::kReturnNumber), largest(points, dim::kNumberOfReturns))};
   if (!waveforms) {
-    static constexpr int kBase[11] = {0, 1, 2, 3, 1, 3, 6, 7, 8, 6, 7};
+    static constexpr int kBase[11] = {0, 1, 2, 3, 1, 3, 6, 7, 8, 6, 8};  // 10 is 8's fields and wave packets
     if (preferred >= 0 && preferred <= 10) preferred = kBase[preferred];
   }
-  if (preferred >= 0 && preferred <= 10 && holds(points, widest, preferred)) return preferred;
+  if (preferred >= 0 && preferred <= 10 && holds(points, widest, preferred) && !lacksFields(points, preferred))
+    return preferred;
   for (int f : {0, 1, 2, 3, 6, 7, 8})
     if (holds(points, widest, f)) return f;
   if (!waveforms) return preferred >= 0 && preferred <= 10 ? preferred : 8;

@@ -71,11 +71,13 @@ std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::
 double lasStoredNumber(const LasExtraField& field, double value);
 
 // The point format that holds what `points` carries: `preferred` (the source's) when it holds every
-// LAS field the set has, its colours and the values of its fields; else the smallest of formats
-// 0-3 or, where a field or value needs LAS 1.4's, 6-8 (waveform fields: 4, 5, 9 or 10).
-// Without `waveforms` (LAZ, whose waveform items dpoint does not code) the formats 4, 5, 9 and 10
-// are never chosen: a waveform source's format becomes its base (1, 3, 6, 7), the others as above,
-// and the wave packet fields are left to the extra bytes.
+// LAS field the set has, its colours and the values of its fields, and the set has its colours,
+// GPS time (0-5), NIR and wave packets (else they would be zeros); else the smallest of formats
+// 0-3 or, where a field or value needs LAS 1.4's (`scan_angle`, classes past 31, returns past 7),
+// 6-8 (waveform fields: 4, 5, 9 or 10). Without `waveforms` (LAZ and COPC, whose waveform items
+// dpoint does not code) the formats 4, 5, 9 and 10 are never chosen: a waveform source's format
+// becomes its base (1, 3, 6, 8), the others as above, and the wave packet fields are left to the
+// extra bytes.
 int lasFormatFor(const PointSet& points, int preferred, bool waveforms = true);
 
 }  // namespace dpoint

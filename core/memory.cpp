@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "core/interrupt.h"
 #include "core/parallel.h"
 
 // Valgrind's client requests (macros that do nothing outside valgrind), where its headers are.
@@ -79,6 +80,7 @@ void prefaultForWrite(void* data, size_t bytes, unsigned threads) {
   const uintptr_t end = reinterpret_cast<uintptr_t>(data) + bytes;
   if (end > begin)
     parallelFor((end - begin + kChunk - 1) / kChunk, threads, [&](size_t chunk, unsigned) {
+      if (interrupted()) return;  // the first writes fault in what is left
       const uintptr_t first = begin + chunk * kChunk;
       (void)madvise(reinterpret_cast<void*>(first), std::min(kChunk, end - first), MADV_POPULATE_WRITE);
     });

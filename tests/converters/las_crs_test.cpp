@@ -136,18 +136,18 @@ TEST(LasCrs, summaryNamesTheCrsWithoutProj) {
 
 // The writer: format 6 (COPC's, or --las14) gets the WKT and drops the keys, with a note in its
 // report; format 1 keeps the keys as they were. Both read back as written.
-TEST(LasCrs, theWriterPutsWktInFormat6AndKeepsKeysInFormat1) {
+TEST(LasCrs, theWriterPutsWktInFormat6AndKeepsKeysInFormat0) {
   TempDir dir;
   PointSet set;
   set.positions = {{500000.0, 4000000.0, 10.0}, {500001.5, 4000002.0, 11.0}};
   LasSource source;
-  source.point_format = 1;
+  source.point_format = 0;  // a set without GPS time
   source.scale = glm::dvec3(0.01);
   source.vlrs = {geoKeys({{1024, 1}, {3072, 26910}, {3076, 9001}})};
   set.las = source;
   for (bool las14 : {false, true}) {
-    SCOPED_TRACE(las14 ? "format 6" : "format 1");
-    const std::string path = dir.file(las14 ? "six.las" : "one.las");
+    SCOPED_TRACE(las14 ? "format 6" : "format 0");
+    const std::string path = dir.file(las14 ? "six.las" : "zero.las");
     LasWriteReport report;
     LasWriteOptions options;
     options.las14 = las14;
@@ -156,7 +156,7 @@ TEST(LasCrs, theWriterPutsWktInFormat6AndKeepsKeysInFormat1) {
     Result<PointSet> back = readLas(path);
     ASSERT_TRUE(back.ok()) << back.error().message;
     ASSERT_TRUE(back->las.has_value());
-    EXPECT_EQ(back->las->point_format, las14 ? 6 : 1);
+    EXPECT_EQ(back->las->point_format, las14 ? 6 : 0);
     const std::vector<LasVlr>& records = back->las->vlrs;
     EXPECT_EQ(has(records, "LASF_Projection", 34735), !las14);
     EXPECT_EQ(has(records, "LASF_Projection", 2112), las14);
@@ -224,7 +224,7 @@ TEST(LasCrs, aGivenCrsIsWktInALas14File) {
   PointSet set;
   set.positions = {{500000.0, 4000000.0, 10.0}};
   LasSource source;
-  source.point_format = 1;
+  source.point_format = 0;  // a set without GPS time
   source.vlrs = {geoKeys({{1024, 1}, {3072, 26910}})};
   set.las = source;
   LasWriteReport report;
@@ -234,7 +234,7 @@ TEST(LasCrs, aGivenCrsIsWktInALas14File) {
   ASSERT_TRUE(writeLas(dir.file("given.las"), set, options).ok());
   Result<PointSet> back = readLas(dir.file("given.las"));
   ASSERT_TRUE(back.ok()) << back.error().message;
-  EXPECT_EQ(back->las->point_format, 1);
+  EXPECT_EQ(back->las->point_format, 0);
   EXPECT_EQ(back->las->version_minor, 4);
   EXPECT_EQ(back->las->global_encoding & 0x10, 0x10);
   ASSERT_EQ(back->las->vlrs.size(), 1u);

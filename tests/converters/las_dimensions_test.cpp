@@ -16,6 +16,7 @@
 #include "converters/las.h"
 #include "converters/las_fields.h"
 #include "converters/ply.h"
+#include "converters/point_io.h"
 #include "core/dimensions.h"
 #include "ops/point_filters.h"
 #include "ops/point_order.h"
@@ -459,6 +460,63 @@ TEST(LasDimensions, aSetWithoutLasSourceGetsTheSmallestFormatThatHoldsIt) {
   ASSERT_TRUE(back);
   EXPECT_EQ(back->dimensions.find(dim::kClassification)->get<uint8_t>(0), 64);
   EXPECT_EQ(back->dimensions.find(dim::kGpsTime)->get<double>(0), 12.25);
+}
+
+// The source's format is kept only where the set still has its colours, GPS time, NIR and wave
+// packets: --no-colors and --drop gps_time leave the fields out, not zeros in them (a review
+// finding). An angle in 0.006° steps needs format 6 (a legacy format's whole degrees clamped
+// 30000 to 90). COPC takes a waveform format's base with its colours (5 had lost them; 9 and 10
+// were refused).
+TEST(LasDimensions, aFieldTheSetLacksIsLeftOutNotWrittenAsZeros) {
+  TempDir dir;
+  Result<PointSet> simple = readLas(std::string(DPOINT_CORPUS_DIR) + "/las/simple.las");  // format 3
+  ASSERT_TRUE(simple);
+  PointSet no_colours = *simple;
+  no_colours.colors.clear();
+  ASSERT_TRUE(writeLas(dir.file("nc.las"), no_colours));
+  EXPECT_EQ(recordsOf(dir.file("nc.las")).format, 1);
+  PointSet no_time = *simple;
+  ASSERT_TRUE(no_time.dimensions.remove(dim::kGpsTime));
+  ASSERT_TRUE(writeLas(dir.file("nt.las"), no_time));
+  EXPECT_EQ(recordsOf(dir.file("nt.las")).format, 2);
+  ASSERT_TRUE(writeLas(dir.file("same.las"), *simple));
+  EXPECT_EQ(recordsOf(dir.file("same.las")).format, 3);
+
+  PointSet angles;
+  angles.positions = {{0, 0, 0}, {1, 1, 1}};
+  angles.dimensions.add(dim::kScanAngle, DimType::kI16, 2).set<int16_t>(1, 30000);
+  ASSERT_TRUE(writeLas(dir.file("angle.las"), angles));
+  EXPECT_EQ(recordsOf(dir.file("angle.las")).format, 6);
+  Result<PointSet> back = readLas(dir.file("angle.las"));
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->dimensions.find(dim::kScanAngle)->get<int16_t>(1), 30000);
+
+  for (const auto& [source, copc] : std::vector<std::pair<int, int>>{{4, 6}, {5, 7}, {9, 6}, {10, 8}}) {
+    SCOPED_TRACE("format " + std::to_string(source));
+    PointSet set;
+    set.positions = {{0, 0, 0}, {1, 1, 1}};
+    LasSource las;
+    las.point_format = source;
+    las.version_minor = 4;
+    set.las = las;
+    for (const LasField& f : lasFields(source)) set.dimensions.add(f.name, f.type, 2);
+    set.dimensions.find(dim::kWavePacketSize)->set<uint32_t>(1, 77);
+    if (source == 5 || source == 10) set.colors = {{0.0f, 1.0f, 1.0f}, {1.0f, 0.0f, 0.0f}};
+    if (source == 10) set.dimensions.find(dim::kNir)->set<uint16_t>(1, 4242);
+    const std::string path = dir.file("w" + std::to_string(source) + ".copc.laz");
+    ASSERT_TRUE(writePoints(path, set)) << path;
+    Result<PointSet> read = readPoints(path);
+    ASSERT_TRUE(read) << read.error().message;
+    EXPECT_EQ(read->las->point_format, copc);
+    EXPECT_EQ(read->hasColors(), !set.colors.empty());
+    if (read->hasColors()) {
+      EXPECT_EQ(read->colors[1], set.colors[1]);
+    }
+    EXPECT_EQ(read->dimensions.find(dim::kWavePacketSize)->value(1), 77.0);  // an extra bytes field
+    if (source == 10) {
+      EXPECT_EQ(read->dimensions.find(dim::kNir)->value(1), 4242.0);
+    }
+  }
 }
 
 // A float intensity of 0..1 values (PTX's, a normalised one) is LAS's 16-bit intensity as a
