@@ -89,8 +89,13 @@ Result<CopcHeader> readHeader(const InputFile& file, uint64_t& bytes_read) {
   info.gpstime_minimum = loadUnaligned<double>(d + 56);
   info.gpstime_maximum = loadUnaligned<double>(d + 64);
   const auto finite = [](double x) { return std::isfinite(x); };
+  // The cube's edge and faces finite too: a half size of 1e308 made every node's box NaN, and no
+  // point was read (a review finding).
+  bool faces = finite(2 * info.halfsize);
+  for (size_t a = 0; a < 3; ++a)
+    faces = faces && finite(info.center[a] - info.halfsize) && finite(info.center[a] + info.halfsize);
   if (!finite(info.center[0]) || !finite(info.center[1]) || !finite(info.center[2]) || !finite(info.halfsize) ||
-      !(info.halfsize > 0) || !finite(info.spacing) || !(info.spacing > 0))
+      !(info.halfsize > 0) || !faces || !finite(info.spacing) || !(info.spacing > 0))
     return Error{path + ": COPC info VLR: the cube (half size " + std::to_string(info.halfsize) + ") or spacing (" +
                  std::to_string(info.spacing) + ") is not positive and finite"};
   if (info.root_hier_size == 0 || info.root_hier_size % kEntryBytes != 0 ||

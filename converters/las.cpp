@@ -631,6 +631,11 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
       [&](const std::string& name, size_t) { return taken.count(name) != 0; }, &l.renamed, 32, "extra");
   for (size_t k = 0; k < names.size(); ++k) l.extra[k].name = names[k];
   l.record_length = l.base_length + at;
+  // Each extra bytes field is a 192-byte descriptor in one VLR, whose length is 16 bits: 342 of them
+  // wrapped it, and no reader found the records after (a review finding).
+  if (l.extra.size() * kExtraBytesDescriptorBytes > 65535)
+    return Error{path + ": " + str(l.extra.size()) + " dimensions as LAS extra bytes, past the " +
+                 str(65535 / kExtraBytesDescriptorBytes) + " whose descriptors one VLR holds (leave some out with --drop NAME)"};
   if (l.record_length > 65535)
     return Error{path + ": " + str(points.dimensions.count()) + " dimensions make a " + str(l.record_length) +
                  "-byte record, beyond LAS's 65535"};

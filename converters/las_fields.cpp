@@ -81,7 +81,6 @@ const std::array<std::vector<LasField>, 11>& allFields() {
 }
 
 constexpr std::array<uint32_t, 11> kRgbAt = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
-constexpr size_t kDescriptorBytes = 192;
 // Where a descriptor's name, minimum, maximum, scale and offset start (LAS 1.4 R15 table 24).
 constexpr size_t kNameAt = 4, kMinAt = 64, kMaxAt = 88, kScaleAt = 112, kOffsetAt = 136;
 
@@ -170,10 +169,10 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
   };
   uint32_t at = 0;
   if (vlr) {
-    if (vlr->data.size() % kDescriptorBytes != 0)
+    if (vlr->data.size() % kExtraBytesDescriptorBytes != 0)
       return Error{"extra bytes VLR: " + std::to_string(vlr->data.size()) + " bytes are not whole 192-byte descriptors"};
-    for (size_t k = 0; k * kDescriptorBytes < vlr->data.size(); ++k) {
-      const char* d = vlr->data.data() + k * kDescriptorBytes;
+    for (size_t k = 0; k * kExtraBytesDescriptorBytes < vlr->data.size(); ++k) {
+      const char* d = vlr->data.data() + k * kExtraBytesDescriptorBytes;
       const uint8_t data_type = static_cast<uint8_t>(d[2]), options = static_cast<uint8_t>(d[3]);
       std::string name(d + 4, strnlen(d + 4, 32));
       // Types 1-10 are one value; 11-20 and 21-30 (deprecated) two and three of them, kept as
@@ -201,7 +200,7 @@ Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t ex
         for (uint32_t e = 0; e < elements; ++e) {
           LasExtraField field{unique(elements == 1 ? name : name + "_" + std::to_string(e)), *type, at + e * width};
           takeScaling(d, e, field);
-          if (elements == 1) field.descriptor.assign(d, kDescriptorBytes);
+          if (elements == 1) field.descriptor.assign(d, kExtraBytesDescriptorBytes);
           out.push_back(std::move(field));
         }
         std::fill(described.begin() + at, described.begin() + at + size, true);
@@ -237,11 +236,11 @@ LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields) {
   vlr.user_id = "LASF_Spec";
   vlr.record_id = 4;
   vlr.description = "dpoint dimensions";
-  vlr.data.assign(fields.size() * kDescriptorBytes, '\0');
+  vlr.data.assign(fields.size() * kExtraBytesDescriptorBytes, '\0');
   for (size_t k = 0; k < fields.size(); ++k) {
-    char* d = vlr.data.data() + k * kDescriptorBytes;
-    if (fields[k].descriptor.size() == kDescriptorBytes) {
-      std::memcpy(d, fields[k].descriptor.data(), kDescriptorBytes);
+    char* d = vlr.data.data() + k * kExtraBytesDescriptorBytes;
+    if (fields[k].descriptor.size() == kExtraBytesDescriptorBytes) {
+      std::memcpy(d, fields[k].descriptor.data(), kExtraBytesDescriptorBytes);
       std::memset(d + kNameAt, 0, 32);
     }
     d[2] = static_cast<char>(static_cast<uint8_t>(fields[k].type) + 1);
@@ -251,7 +250,7 @@ LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields) {
 }
 
 std::optional<LasExtraField> lasSourceExtraField(const Dimension& d, const std::string& descriptor, unsigned threads) {
-  if (descriptor.size() != kDescriptorBytes) return std::nullopt;
+  if (descriptor.size() != kExtraBytesDescriptorBytes) return std::nullopt;
   const uint8_t data_type = static_cast<uint8_t>(descriptor[2]), options = static_cast<uint8_t>(descriptor[3]);
   if (data_type < 1 || data_type > 10) return std::nullopt;
   LasExtraField field{d.name.substr(0, 32), static_cast<DimType>(data_type - 1), 0};

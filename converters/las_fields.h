@@ -58,6 +58,8 @@ struct LasExtraField {
 // extra_byte_N (N: the byte's offset after the base record). A name that is already taken (a LAS
 // field, a repeated name) gets the suffix _2, _3, …. Errors name the descriptor.
 Result<std::vector<LasExtraField>> lasExtraFields(const LasVlr* vlr, uint32_t extra, const std::vector<LasField>& base);
+inline constexpr size_t kExtraBytesDescriptorBytes = 192;
+
 // The extra bytes VLR describing `fields` (LAS 1.4 R15 table 24: 192 bytes a field): each field's
 // own descriptor where it has one, with its name, else its type and name.
 LasVlr lasExtraBytesVlr(const std::vector<LasExtraField>& fields);

@@ -592,6 +592,9 @@ TEST(CopcRead, rejectsCorruptHierarchiesAndOffsetsByName) {
                              "not a whole number of 32-byte entries within the"));
   EXPECT_TRUE(test::contains(readError(copc, [&](std::string& c) { put<double>(c, info + 24, -1.0); }),
                              "is not positive and finite"));
+  // A half size whose edge is infinite: every node's box had been NaN, and no point read.
+  EXPECT_TRUE(test::contains(readError(copc, [&](std::string& c) { put<double>(c, info + 24, 1e308); }),
+                             "is not positive and finite"));
   // The root node's chunk past the end of the file.
   EXPECT_TRUE(test::contains(readError(copc, [&](std::string& c) { put<uint64_t>(c, root + 16, c.size() - 10); }),
                              "entry 0 (node 0-0-0-0): its chunk ("));

@@ -519,6 +519,29 @@ TEST(LasDimensions, aFieldTheSetLacksIsLeftOutNotWrittenAsZeros) {
   }
 }
 
+// Each extra bytes field is a 192-byte descriptor in one VLR of 16-bit length: 341 fit, 342 are
+// refused by name (they had wrapped the length, and no reader found the records after it).
+TEST(LasDimensions, moreExtraBytesFieldsThanOneVlrDescribesAreRefused) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0, 0, 0}};
+  for (int k = 0; k < 341; ++k) {
+    std::string name = "d";  // not "d" + …: GCC 12's -Wrestrict false alarm
+    name += std::to_string(k);
+    set.dimensions.add(name, DimType::kU8, 1);
+  }
+  ASSERT_TRUE(writeLas(dir.file("341.laz"), set, [] { LasWriteOptions o; o.compress = true; return o; }()));
+  Result<PointSet> back = readLas(dir.file("341.laz"));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_TRUE(back->dimensions.find("d340"));
+  set.dimensions.add("d341", DimType::kU8, 1);
+  const Status refused = writeLas(dir.file("342.las"), set);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().message, dir.file("342.las") + ": 342 dimensions as LAS extra bytes, past the 341 whose "
+                                                           "descriptors one VLR holds (leave some out with --drop NAME)");
+  EXPECT_FALSE(std::filesystem::exists(dir.file("342.las")));
+}
+
 // A float intensity of 0..1 values (PTX's, a normalised one) is LAS's 16-bit intensity as a
 // fraction of 65535, LAS and LAZ alike, and the report says so; one of whole numbers (0 and 1
 // alone too) is written as it is. The build before refused 0.5 as no whole number.
