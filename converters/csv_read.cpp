@@ -95,6 +95,8 @@ struct Layout {
   // in order; a PTS file's intensity sits between z and the colours.
   std::vector<int> roles;
   bool integer_colors = false;  // colours are 0-255 whatever their values (PTS)
+  // Header names taken as a known dimension's (knownSpelling): the name as spelled, and the known one.
+  std::vector<std::pair<std::string, std::string>> renamed = {};
 };
 // A column's role: 0-2 x, y, z; 3-5 r, g, b; kRoleDimension + k the k-th dimension; kRoleSkip
 // a column --columns says to pass over (`-`).
@@ -401,6 +403,28 @@ bool isHeaderLine(const std::vector<std::string>& fields) {
   return first.rfind("nan", 0) != 0 && first.rfind("inf", 0) != 0;
 }
 
+// The known dimension (core/dimensions.h) a further column's header name spells another way, or
+// "": CloudCompare's `Intensity` and `scalar_Intensity`, PDAL's `ReturnNumber`, `GpsTime`,
+// `ScanDirectionFlag` and `Infrared` (their text exports). A review found CloudCompare's
+// `Intensity` and `Classification` written to LAS as extra bytes beside zeros in LAS's fields.
+std::string knownSpelling(std::string_view name) {
+  const auto folded = [](std::string_view text) {
+    std::string out;
+    for (char c : text)
+      if (c != '_' && c != ' ') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+  };
+  std::string key = folded(name);
+  if (key.rfind("scalar", 0) == 0 && key.size() > 6 && folded(name.substr(0, 7)) == "scalar") key.erase(0, 6);
+  static const std::pair<std::string_view, std::string_view> kAliases[] = {
+      {"scandirectionflag", "scan_direction"}, {"infrared", "nir"}};
+  for (const auto& [alias, known] : kAliases)
+    if (key == alias) return std::string(known);
+  for (const KnownDimension& k : knownDimensions())
+    if (key == folded(k.name)) return k.name;
+  return "";
+}
+
 // A header names one of the known layouts, then, after x,y,z or x,y,z,r,g,b, optionally further
 // columns whose names are none of x, y, z, r, g, b (so `x,y,z,r,g` stays an error rather than
 // x,y,z and two extras).
@@ -446,7 +470,16 @@ Result<Layout> layoutFromHeader(const std::string& path, std::vector<std::string
     if (std::any_of(fields.begin() + std::ptrdiff_t(count), fields.end(), known_name)) break;
     Layout layout{known, static_cast<int>(fields.size()), separator == '\0', separator ? separator : ',', joined, {}, {}, false};
     for (size_t k = count; k < spelled.size(); ++k) {
-      const std::string& name = spelled[k];
+      std::string name = spelled[k];
+      // A known dimension spelt another way takes its name, where no column has that name already.
+      if (!findKnownDimension(name)) {
+        const std::string as_known = knownSpelling(name);
+        if (!as_known.empty() && std::find(spelled.begin(), spelled.end(), as_known) == spelled.end() &&
+            std::find(layout.dimensions.begin(), layout.dimensions.end(), as_known) == layout.dimensions.end()) {
+          layout.renamed.emplace_back(name, as_known);
+          name = as_known;
+        }
+      }
       if (name.empty())
         return Error{path + ":" + std::to_string(line) + ": column " + std::to_string(k + 1) + " has no name"};
       if (std::find(layout.dimensions.begin(), layout.dimensions.end(), name) != layout.dimensions.end())
@@ -899,6 +932,11 @@ Result<PointSet> readCsvRows(const InputFile& file, const CsvReadOptions& option
   });
   if (first_error) return Error{first_error->message};
   exact.apply(points.dimensions, blank_rows, path, options.notices);
+  if (options.notices && !layout.renamed.empty()) {
+    std::string list;
+    for (const auto& [spelt, known] : layout.renamed) list += (list.empty() ? "" : ", ") + spelt + " as " + known;
+    options.notices->push_back(path + ": columns read as the dimensions they name (LAS's fields where LAS is written): " + list);
+  }
 
   // Blank lines left holes; close them (rare, so a single ordered pass is fine).
   size_t holes = 0;

@@ -140,6 +140,36 @@ TEST(Csv, acceptsHeaderVariantsCrlfBomSpacesAndBlankLines) {
   EXPECT_EQ(d->positions[0], glm::dvec3(1, 2, 0));
 }
 
+// CloudCompare's and PDAL's text exports name the known dimensions their own way (`Intensity`,
+// `scalar_Classification`, `GpsTime`, `ScanDirectionFlag`): read as dpoint's names, with a note,
+// so LAS gets them in its fields (they had been extra bytes beside zeros). A column already named
+// as the known one keeps the other spelling; one that names nothing known keeps its name.
+TEST(Csv, knownDimensionsSpeltAsOtherToolsWriteThemTakeTheirNames) {
+  TempDir dir;
+  writeFile(dir.file("cc.txt"), "//X Y Z R G B Intensity scalar_Classification GpsTime ScanDirectionFlag Other\n"
+                                "1 2 3 10 20 30 500 2 7.5 1 9\n");
+  std::vector<std::string> notices;
+  CsvReadOptions options;
+  options.notices = &notices;
+  Result<PointSet> cc = readCsv(dir.file("cc.txt"), options);
+  ASSERT_TRUE(cc.ok()) << cc.error().message;
+  std::vector<std::string> names;
+  for (const Dimension& d : cc->dimensions.all()) names.push_back(d.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"intensity", "classification", "gps_time", "scan_direction", "Other"}));
+  EXPECT_EQ(cc->dimensions.find("intensity")->type, DimType::kU16);
+  EXPECT_EQ(cc->dimensions.find("classification")->value(0), 2.0);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_EQ(notices[0], dir.file("cc.txt") + ": columns read as the dimensions they name (LAS's fields where LAS is "
+                                             "written): Intensity as intensity, scalar_Classification as classification, "
+                                             "GpsTime as gps_time, ScanDirectionFlag as scan_direction");
+  writeFile(dir.file("both.csv"), "x,y,z,Intensity,intensity\n1,2,3,4,5\n");
+  notices.clear();
+  Result<PointSet> both = readCsv(dir.file("both.csv"), options);
+  ASSERT_TRUE(both.ok()) << both.error().message;
+  EXPECT_TRUE(both->dimensions.find("Intensity") && both->dimensions.find("intensity"));
+  EXPECT_TRUE(notices.empty());
+}
+
 TEST(Csv, writesPlanarSetsAsXy) {
   TempDir dir;
   PointSet s;
