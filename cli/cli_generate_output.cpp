@@ -56,7 +56,7 @@ void addOutputOptions(CLI::App& cmd, OutputOptions& o, const std::string& auto_c
       ->check(oneOf("--colors", {"auto", "noise", "none"}))
       ->default_val("auto");
   cmd.add_option("--offset", o.offset, "Translate every point by X,Y,Z (exact double sums, one rounding)");
-  cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point (default: shortest round trip)")
+  cmd.add_option("--decimals", o.decimals, "CSV: fixed digits after the point of coordinates and 0..1 colours (default: shortest round trip)")
       ->check(CLI::Range(0, 100));
   addMaxMemoryOption(cmd, o.max_memory);
   cmd.add_option("--order", o.order, kPointOrderHelp)->default_val("input");

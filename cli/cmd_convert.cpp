@@ -165,7 +165,7 @@ void addConvertCommand(CLI::App& app, RunCommand& run) {
       ->required()
       ->check(checkStatus(checkPointOutput));
   cmd->add_option("--decimals", o->decimals,
-                  "CSV: fixed digits after the point (15 gives the %.15f of the original study's Python generator); default: shortest round trip, "
+                  "CSV: fixed digits after the point of coordinates and 0..1 colours (15 gives the %.15f of the original study's Python generator); default: shortest round trip, "
                   "or for LAS input the file's step (scale 0.01: at most 2 digits, trailing zeros dropped)")
       ->check(CLI::Range(0, 100));
   cmd->add_flag("--ply-ascii", o->ply_ascii, "PLY: write ASCII instead of binary little-endian");

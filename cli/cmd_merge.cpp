@@ -74,7 +74,7 @@ void addMergeCommand(CLI::App& app, RunCommand& run) {
       "as the single `dpoint generate KIND` with these output options, vertex order included");
   cmd->add_option("tiles", o->inputs, "The tile parts (.ply)")->required();
   cmd->add_option("-o,--output", o->output, pointOutputHelp())->required()->check(checkStatus(checkPointOutput));
-  cmd->add_option("--decimals", o->decimals, "CSV: fixed digits after the point (default: shortest round trip)")
+  cmd->add_option("--decimals", o->decimals, "CSV: fixed digits after the point of coordinates and 0..1 colours (default: shortest round trip)")
       ->check(CLI::Range(0, 100));
   cmd->add_option("--max-memory", o->max_memory, "Refuse (exit 4) when the estimate is above this (default: half of RAM)");
   cmd->add_option("--order", o->order, kPointOrderHelp)->default_val("input");

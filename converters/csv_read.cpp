@@ -349,8 +349,9 @@ class LineParser {
     if (value == T(0) && hasNonzeroMantissa(begin, end))
       return fail(std::string("is out of ") + type + " range (underflows to zero)");
     if (!allow_nonfinite_ && !std::isfinite(value)) {
-      if (layout_.roles[static_cast<size_t>(column - 1)] >= kRoleDimension && std::isnan(value))
-        return true;  // an attribute may be NaN (a missing GPS time)
+      // An attribute may be NaN (a missing GPS time) or infinite, as PLY, PCD, GLB and E57 take it
+      // and dpoint's own CSV writes it (a review finding: `inf` written, then refused).
+      if (layout_.roles[static_cast<size_t>(column - 1)] >= kRoleDimension) return true;
       return fail("is not a finite number (--allow-nonfinite accepts it)");
     }
     return true;

@@ -318,6 +318,13 @@ TEST(Csv, missingValuesFloatDimensionsAndOddLinesAreReadAsMeant) {
   ASSERT_NE(missing->dimensions.find("gps_time"), nullptr);
   EXPECT_TRUE(std::isnan(missing->dimensions.find("gps_time")->value(0)));
   EXPECT_EQ(missing->dimensions.find("gps_time")->value(1), 7.5);
+  // An attribute may be infinite, as the writer writes it (it had been refused, coordinates alike).
+  writeFile(dir.file("inf.csv"), "x,y,z,v\n1,2,3,inf\n4,5,6,-inf\n");
+  Result<PointSet> infinite = readCsv(dir.file("inf.csv"));
+  ASSERT_TRUE(infinite.ok()) << infinite.error().message;
+  EXPECT_EQ(infinite->dimensions.find("v")->value(1), -HUGE_VAL);
+  writeFile(dir.file("inf_position.csv"), "x,y,z,v\n1,inf,3,4\n");
+  expectReadError(dir.file("inf_position.csv"), {"inf_position.csv:2: column 2: 'inf' is not a finite number"});
   writeFile(dir.file("empty_position.csv"), "x,y,z\n1,,3\n");
   expectReadError(dir.file("empty_position.csv"), {"empty_position.csv:2: column 2: empty field"});
   CsvReadOptions skip;
