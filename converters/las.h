@@ -167,12 +167,15 @@ Status writeLas(const std::string& path, const PointSet& points, const LasWriteO
 // positions, colours and the dimensions asked for, in bounded memory (LAZ: the chunks a block
 // covers are decoded, on all cores, and the last ones kept for the next block). Colours: the RGB
 // of formats that have it, divided by 255 when no channel of a sample exceeds 255 (an uncompressed
-// file: 4096 records spread over it; LAZ: its first, middle and last chunk), else by 65535: the
-// whole-file read's rule (readLas), decided before the first block, so a file whose only 16-bit
-// values lie outside the sample streams 257 times brighter than it reads whole.
+// file: 4096 records spread over it; LAZ: the first 4096 of its first, middle and last chunk), else
+// by 65535: the whole-file read's rule (readLas), decided before the first block, so a file whose
+// only 16-bit values lie outside the sample streams 257 times brighter than it reads whole.
 class LasPointStream {
  public:
-  static Result<std::unique_ptr<LasPointStream>> open(const std::string& path, unsigned threads = 0);
+  // The LAZ chunks a block needs are decoded only where their claimed points' records fit
+  // `max_memory` (checkMemory; 0: its default), else exit 4.
+  static Result<std::unique_ptr<LasPointStream>> open(const std::string& path, unsigned threads = 0,
+                                                      uint64_t max_memory = 0);
   ~LasPointStream();
   const LasHeader& header() const;
   uint64_t count() const;

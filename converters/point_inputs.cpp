@@ -238,7 +238,7 @@ Status PointInputStream::checkCopies(size_t part, uint64_t first, const PointSet
 
 Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vector<std::string>& paths,
                                                                  unsigned threads, uint64_t max_memory,
-                                                                 bool allow_nonfinite) {
+                                                                 bool allow_nonfinite, uint64_t chunk_memory) {
   Result<InputSet> set = checkInputSet(paths);
   if (!set) return set.error();
   std::unique_ptr<PointInputStream> stream(new PointInputStream());
@@ -275,7 +275,7 @@ Result<std::unique_ptr<PointInputStream>> PointInputStream::open(const std::vect
     part.path = path;
     Result<FileFormat> format = formatOf(path);
     if (format && (*format == FileFormat::kLas || *format == FileFormat::kLaz)) {
-      Result<std::unique_ptr<LasPointStream>> las = LasPointStream::open(path, threads);
+      Result<std::unique_ptr<LasPointStream>> las = LasPointStream::open(path, threads, chunk_memory);
       if (!las) return las.error();
       part.las = std::move(*las);
       stream->notices_.insert(stream->notices_.end(), part.las->notices().begin(), part.las->notices().end());
@@ -519,9 +519,10 @@ Result<std::unique_ptr<PointInputStream>> openPointStream(const std::vector<std:
   // --max-memory applies once the stream is chosen (checkStreamMemory with heldBytes). A stream
   // that cannot open (an ASCII file, too many files for the open-file limit) is read whole.
   Result<std::unique_ptr<PointInputStream>> opened =
-      PointInputStream::open(paths, threads, stream == "on" ? max_memory : 0, allow_nonfinite);
+      PointInputStream::open(paths, threads, stream == "on" ? max_memory : 0, allow_nonfinite, max_memory);
   if (!opened) {
-    if (stream == "on") return opened.error();
+    // A LAZ chunk past --max-memory is past it read whole too: said now, not after a whole read.
+    if (stream == "on" || opened.error().code == ExitCode::kResourceLimit) return opened.error();
     return std::unique_ptr<PointInputStream>();  // read whole: the reader reports what is wrong
   }
   if (stream == "on" || (*opened)->count() > kStreamAbovePoints) return opened;

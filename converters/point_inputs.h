@@ -56,11 +56,13 @@ Result<InputSet> checkInputSet(const std::vector<std::string>& paths);
 // set's copies); errors (ASCII PLY, another format, a bad header) name the file. The copies are
 // held for the whole stream: over `max_memory` (0: half of RAM) they are refused before they are
 // read (kResourceLimit), as mergeTiles refuses them. A PLY's non-finite coordinate is its reader's
-// error unless `allow_nonfinite` (info's --allow-nonfinite), as readPointInputs takes it.
+// error unless `allow_nonfinite` (info's --allow-nonfinite), as readPointInputs takes it. LAZ
+// chunks are decoded only where their claimed records fit `chunk_memory` (0: half of RAM).
 class PointInputStream {
  public:
   static Result<std::unique_ptr<PointInputStream>> open(const std::vector<std::string>& paths, unsigned threads,
-                                                        uint64_t max_memory = 0, bool allow_nonfinite = false);
+                                                        uint64_t max_memory = 0, bool allow_nonfinite = false,
+                                                        uint64_t chunk_memory = 0);
   ~PointInputStream();
   uint64_t count() const { return count_; }
   bool hasColors() const { return has_colors_; }

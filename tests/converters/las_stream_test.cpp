@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -185,6 +186,41 @@ TEST(LasStream, severalDimensionsStreamFromAMixOfFilesAsTheWholeReadHasThem) {
     EXPECT_TRUE(std::equal(got.bytes.begin(), got.bytes.end(), want.bytes.begin() + static_cast<ptrdiff_t>(1000 * w)))
         << want.name;
   }
+}
+
+}  // namespace
+}  // namespace dpoint
+
+namespace dpoint {
+namespace {
+
+// A LAZ file whose chunk claims 50M points: the stream's colour sample had allocated the claim
+// (3.7 GB from a 98 KB file, past --max-memory); the chunks are now checked against the limit
+// before they are decoded, and the sample takes 4096 records of a chunk.
+TEST(LasStream, aChunkClaimingMorePointsThanTheLimitIsRefusedBeforeItIsAllocated) {
+  test::TempDir dir;
+  Result<PointSet> simple = readLas(std::string(DPOINT_CORPUS_DIR) + "/las/simple.las");  // format 3: colours
+  ASSERT_TRUE(simple);
+  LasWriteOptions laz;
+  laz.compress = true;
+  ASSERT_TRUE(writeLas(dir.file("simple.laz"), *simple, laz));
+  std::string file = test::readFile(dir.file("simple.laz"));
+  const size_t vlr = file.find("laszip encoded");
+  ASSERT_NE(vlr, std::string::npos);
+  const size_t data = vlr - 2 + 54;  // the VLR's header is 54 bytes, its user id at 2
+  const uint32_t chunk = 0xFFFFFFFEu, count = 50000000u;
+  std::memcpy(&file[data + 12], &chunk, 4);  // the laszip VLR's chunk size
+  std::memcpy(&file[107], &count, 4);        // the legacy point count (LAS 1.2)
+  test::writeFile(dir.file("claims.laz"), file);
+  Result<std::unique_ptr<LasPointStream>> stream = LasPointStream::open(dir.file("claims.laz"), 1, 64u << 20);
+  ASSERT_FALSE(stream);
+  EXPECT_EQ(stream.error().code, ExitCode::kResourceLimit);
+  EXPECT_TRUE(test::contains(stream.error().message, "claims.laz: decoding LAZ chunks 0 to 0 (50000000 points) needs about"))
+      << stream.error().message;
+  // The file as written streams: the sample is a chunk's first 4096 records.
+  Result<std::unique_ptr<LasPointStream>> fine = LasPointStream::open(dir.file("simple.laz"), 1, 64u << 20);
+  ASSERT_TRUE(fine) << fine.error().message;
+  EXPECT_TRUE((*fine)->hasColors());
 }
 
 }  // namespace
