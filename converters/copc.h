@@ -130,8 +130,9 @@ struct CopcQuery {
 };
 
 // The hierarchy's nodes that `query` selects (with points or not), read lazily: a child page is
-// read only when its key is selected. Sorted by key. When the query selects everything, checks that
-// the nodes' points add up to the header's count. `bytes_read` (may be null) gets the pages' bytes.
+// read only when its key is selected. Sorted by key. When the query left no node or page out (a
+// read of everything, or a view that takes the whole tree), checks that the nodes' points add up
+// to the header's count. `bytes_read` (may be null) gets the pages' bytes.
 // Hostile input: every entry is checked (key within its level, chunk within the file, a page read
 // once, pages not adding up to more than the file); errors name the file, page and entry.
 Result<std::vector<CopcNode>> readCopcNodes(const InputFile& file, const CopcHeader& header, const CopcQuery& query,

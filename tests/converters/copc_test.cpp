@@ -612,6 +612,29 @@ TEST(CopcRead, rejectsCorruptHierarchiesAndOffsetsByName) {
   // A node's count off by one: the counts no longer add up.
   EXPECT_TRUE(test::contains(readError(copc, [&](std::string& c) { put<int32_t>(c, root + 28, at<int32_t>(c, root + 28) - 1); }),
                              "hierarchy: the nodes hold 19999 points, the header says 20000"));
+  // So too where a view's query takes every node (a fine resolution, a box around the cube): a
+  // damaged count had drawn "20000 of 0 points" with exit 0. A query that leaves nodes out cannot
+  // tell.
+  {
+    size_t leaf = 0;  // a node with points in the first child page
+    const uint64_t page = at<uint64_t>(copc, child_ref + 16);
+    for (uint64_t e = page; e < page + static_cast<uint64_t>(at<int32_t>(copc, child_ref + 24)) && !leaf; e += 32)
+      if (at<int32_t>(copc, e + 28) > 0) leaf = e;
+    ASSERT_NE(leaf, 0u);
+    std::string damaged = copc;
+    put<int32_t>(damaged, leaf + 28, at<int32_t>(damaged, leaf + 28) - 1);
+    const InputFile file = InputFile::fromMemory("bad.copc.laz", damaged);
+    CopcQuery all_levels;
+    all_levels.resolution = 1e-9;
+    all_levels.box = CopcBox{{-1e9, -1e9, -1e9}, {1e9, 1e9, 1e9}};
+    Result<std::string> read = readCopcRecords(file, all_levels);
+    ASSERT_FALSE(read);
+    EXPECT_TRUE(test::contains(read.error().message, "hierarchy: the nodes hold 19999 points, the header says 20000"));
+    CopcQuery coarse;
+    coarse.resolution = 1e9;  // the root alone
+    Result<std::string> root_alone = readCopcRecords(file, coarse);
+    EXPECT_TRUE(root_alone) << "a query of the root alone cannot check the count: " << root_alone.error().message;
+  }
   // The root's chunk corrupted: the error names the node and its offset.
   const uint64_t chunk = at<uint64_t>(copc, root + 16);
   const std::string corrupt = readError(copc, [&](std::string& c) {
