@@ -86,6 +86,12 @@ bool isCopcPath(const std::string& path) {
   return lower.size() >= 9 && lower.compare(lower.size() - 9, 9, ".copc.laz") == 0;
 }
 
+bool readsAsCopc(const std::string& path) {
+  if (lowerExtension(path) != ".laz") return false;
+  Result<InputFile> file = InputFile::open(path);
+  return file ? isCopc(*file) : isCopcPath(path);
+}
+
 Result<PointSet> readCopcPoints(const std::string& path, const CopcQuery& query, const LasReadOptions& options,
                                 CopcReadStats* stats) {
   Result<InputFile> file = InputFile::open(path);

@@ -27,6 +27,10 @@ inline bool holdsTriangles(FileFormat format) { return format == FileFormat::kPl
 // True for a path ending in .copc.laz (any case): written as COPC (converters/copc.h), an octree
 // of LAZ 1.4 chunks that reads as plain LAZ too.
 bool isCopcPath(const std::string& path);
+// Whether `info` and `render` read the file by view as COPC: a .laz file whose content is COPC
+// (its first VLR the COPC info), whatever its name says (a plain LAZ named .copc.laz had been
+// refused, a COPC named .laz read whole). A file that does not open goes by its name.
+bool readsAsCopc(const std::string& path);
 // The points of the COPC nodes `query` selects (readCopcRecords), read as readLas reads a file:
 // the header and VLRs of the file with those records after them. `stats` gets the points, bytes
 // and nodes read, and `file_bytes` the file's size.

@@ -372,7 +372,7 @@ Result<InfoReport> describeFiles(const InfoInputs& inputs, const InfoOptions& op
   gltf.all_scenes = inputs.all_scenes;
   std::optional<CopcReadStats> copc;
   Result<PointSet> points = PointSet{};
-  if (inputs.paths.size() == 1 && isCopcPath(inputs.paths[0]) && !scenes) {
+  if (inputs.paths.size() == 1 && readsAsCopc(inputs.paths[0]) && !scenes) {
     Result<CopcQuery> query = copcQueryFor(options.camera, inputs.paths[0], options.threads, inputs.max_memory);
     if (!query) return query.error();
     LasReadOptions las{options.threads, &progress, LasColorSource::kAuto, inputs.max_memory, &notices};

@@ -270,7 +270,7 @@ Result<LoadedSet> readInput(const RenderRequest& request, Progress& progress, Re
   LoadedSet set;
   set.inputs = describeInputs(request.inputs);
   const std::string& inputs = set.inputs;
-  if (request.inputs.size() == 1 && isCopcPath(request.inputs[0]) && request.stream != "on") {
+  if (request.inputs.size() == 1 && readsAsCopc(request.inputs[0]) && request.stream != "on") {
     Result<CopcQuery> query = copcQueryFor(request.camera, request.inputs[0], request.threads, request.max_memory);
     if (!query) return query.error();
     LasReadOptions las{request.threads, &progress, lasColorOf(request.color), request.max_memory, &set.notices};

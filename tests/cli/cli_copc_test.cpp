@@ -141,5 +141,24 @@ TEST(CliCopc, aPerspectiveViewReadsItsFrustumDeepWhereNear) {
   EXPECT_EQ(number(away, "nodes_read"), 1.0) << away;  // looking away from the set: the root only
 }
 
+// info and render go by the content: a plain LAZ named .copc.laz is read whole (it had been
+// refused, "not COPC: LAS 1.2", where convert read it), a COPC named .laz by view.
+TEST(CliCopc, infoAndRenderTellCopcByItsContentNotItsName) {
+  TempDir dir;
+  std::filesystem::copy_file(std::string(DPOINT_CORPUS_DIR) + "/las/simple.laz", dir.file("plain.copc.laz"));
+  for (const char* command : {"info", "render"}) {
+    std::vector<std::string> args = {command, dir.file("plain.copc.laz")};
+    if (std::string(command) == "render") args.insert(args.end(), {"-o", dir.file("p.png"), "--width", "64", "--height", "48"});
+    test::CommandResult plain = runDpoint(args);
+    EXPECT_EQ(plain.exit_code, 0) << command << ": " << plain.err;
+    EXPECT_FALSE(test::contains(plain.out, "read by view")) << plain.out;
+  }
+  ASSERT_EQ(runDpoint({"convert", std::string(DPOINT_CORPUS_DIR) + "/las/simple.las", "-o", dir.file("c.copc.laz")}).exit_code, 0);
+  std::filesystem::copy_file(dir.file("c.copc.laz"), dir.file("renamed.laz"));
+  test::CommandResult renamed = runDpoint({"info", dir.file("renamed.laz")});
+  EXPECT_EQ(renamed.exit_code, 0) << renamed.err;
+  EXPECT_TRUE(test::contains(renamed.out, "(read by view, of 1065 in the file: COPC)")) << renamed.out;
+}
+
 }  // namespace
 }  // namespace dpoint
