@@ -432,6 +432,14 @@ Status writeE57(const std::string& path, const PointSet& points, const E57WriteO
     if (f.least >= 0.0 && f.most <= 1.0) f.least = 0.0, f.most = 1.0;
     f.limited = f.least <= f.most;  // some finite value
   }
+  // Said where the values are neither LAS's 0..65535 integers nor 0..1: readers take an intensity
+  // relative to its limits, and dpoint's reads it back as 0..1 (a review found 10.5, 20, 30 come
+  // back as 0, 0.49, 1 without a word).
+  for (const OutField& f : fields)
+    if (f.name == "intensity" && f.limited && !(f.least == 0.0 && (f.most == 1.0 || f.most == 65535.0)))
+      notes.push_back("intensity of " + formatNumber(f.least) + ".." + formatNumber(f.most) +
+                      " written with that range as its limits: E57 readers take an intensity relative to its limits "
+                      "(dpoint reads it back as 0..1 values)");
   std::string prototype;
   for (const OutField& f : fields) {
     prototype += "          <" + f.name;

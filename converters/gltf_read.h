@@ -54,6 +54,9 @@ struct GltfReadOptions {
   // VEC2, through KHR_texture_transform) and each triangle's image, decoded (gltf_texture.h).
   MeshTexture* texture = nullptr;
   unsigned threads = 0;      // cores for a large primitive's vertices, indices and triangles (0: all)
+  // When not null, gets a note naming the vertex attributes no dimension holds (NORMAL, TEXCOORD_n
+  // where no texture is sampled, a VEC3 `_NAME`), once the scene is read.
+  std::vector<std::string>* notices = nullptr;
 };
 
 Result<PointSet> readGltf(const std::string& path, const GltfReadOptions& options = {});

@@ -515,6 +515,7 @@ struct WriterLayout {
   int format = 0, version_minor = 2;
   uint32_t record_length = 0, base_length = 0;
   std::vector<LasExtraField> extra;  // dimensions kept as extra bytes, after the base record
+  size_t described = 0;  // extra[0, described) have descriptors; the rest are undescribed bytes
   std::vector<LasVlr> vlrs, evlrs;
   uint16_t global_encoding = 0, file_source_id = 0;
   std::vector<std::string> renamed;  // "dimension 'höhe' written as 'h__he'": extra bytes named anew
@@ -631,10 +632,18 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
       [&](const std::string& name, size_t) { return taken.count(name) != 0; }, &l.renamed, 32, "extra");
   for (size_t k = 0; k < names.size(); ++k) l.extra[k].name = names[k];
   l.record_length = l.base_length + at;
-  // Each extra bytes field is a 192-byte descriptor in one VLR, whose length is 16 bits: 342 of them
+  // Trailing bytes a LAS file left undescribed (the reader's u8 `extra_byte_N` at byte N) stay
+  // undescribed: they read back as the same dimensions (65,515 of them had taken a descriptor each).
+  l.described = l.extra.size();
+  while (l.described > 0) {
+    const LasExtraField& f = l.extra[l.described - 1];
+    if (f.type != DimType::kU8 || f.scaled || !f.descriptor.empty() || f.name != "extra_byte_" + str(f.offset)) break;
+    --l.described;
+  }
+  // Each other field is a 192-byte descriptor in one VLR, whose length is 16 bits: 342 of them
   // wrapped it, and no reader found the records after (a review finding).
-  if (l.extra.size() * kExtraBytesDescriptorBytes > 65535)
-    return Error{path + ": " + str(l.extra.size()) + " dimensions as LAS extra bytes, past the " +
+  if (l.described * kExtraBytesDescriptorBytes > 65535)
+    return Error{path + ": " + str(l.described) + " dimensions as LAS extra bytes, past the " +
                  str(65535 / kExtraBytesDescriptorBytes) + " whose descriptors one VLR holds (leave some out with --drop NAME)"};
   if (l.record_length > 65535)
     return Error{path + ": " + str(points.dimensions.count()) + " dimensions make a " + str(l.record_length) +
@@ -671,7 +680,8 @@ Result<WriterLayout> writerLayout(const std::string& path, const PointSet& point
     if (vlr.extended && v14) l.evlrs.push_back(vlr);
     else if (vlr.data.size() <= 65535) l.vlrs.push_back(vlr);
   }
-  if (!l.extra.empty()) l.vlrs.push_back(lasExtraBytesVlr(l.extra));
+  if (l.described > 0)
+    l.vlrs.push_back(lasExtraBytesVlr({l.extra.begin(), l.extra.begin() + static_cast<ptrdiff_t>(l.described)}));
   return l;
 }
 

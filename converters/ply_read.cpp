@@ -664,6 +664,14 @@ class PlyParser {
       attribute_of_[k] = points_.dimensions.count();
       points_.dimensions.append(p.name, dimTypeOf(p.type), 0);
     }
+    // A list on a vertex holds several numbers a point, which no dimension does: said, not dropped
+    // without a word (a review finding).
+    std::string lists;
+    for (const Property& p : vertex->properties)
+      if (p.is_list) lists += (lists.empty() ? "" : ", ") + p.name;
+    if (!lists.empty() && options_.notices)
+      options_.notices->push_back(path_ + ": vertex list properties not read (a dimension holds one number a point): " +
+                                  lists);
     attribute_row_.assign(points_.dimensions.count(), 0.0);
     // x and y are needed; without z the file is 2D (z = 0).
     if (!found[kZ]) points_.z_axis = ZAxis::kAbsent;

@@ -326,6 +326,33 @@ TEST(E57, anIntensityOfOtherLimitsIsReadAsFractions) {
   EXPECT_EQ(kept->dimensions.find("intensity")->value(1), 100.0);
 }
 
+// The writer says where an intensity's values will come back as 0..1 (their range written as the
+// limits, by which readers take it): 10.5, 20, 30 had come back as 0, 0.49, 1 without a word. LAS's
+// 0..65535 integers and 0..1 values are written without one.
+TEST(E57, anIntensityReadersWillNormaliseIsSaidWhenWritten) {
+  TempDir dir;
+  PointSet set;
+  set.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  Dimension& intensity = set.dimensions.add("intensity", DimType::kF64, 3);
+  intensity.set<double>(0, 10.5), intensity.set<double>(1, 20), intensity.set<double>(2, 30);
+  std::vector<std::string> notices;
+  E57WriteOptions options;
+  options.notices = &notices;
+  ASSERT_TRUE(writeE57(dir.file("odd.e57"), set, options));
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_EQ(notices[0], dir.file("odd.e57") + ": intensity of 10.5..30 written with that range as its limits: E57 "
+                                              "readers take an intensity relative to its limits (dpoint reads it back "
+                                              "as 0..1 values)");
+  notices.clear();
+  intensity.set<double>(0, 0.25), intensity.set<double>(1, 0.5), intensity.set<double>(2, 1);
+  ASSERT_TRUE(writeE57(dir.file("fractions.e57"), set, options));
+  PointSet whole = set;
+  whole.dimensions = Dimensions();
+  whole.dimensions.add("intensity", DimType::kU16, 3).set<uint16_t>(1, 500);
+  ASSERT_TRUE(writeE57(dir.file("whole.e57"), whole, options));
+  EXPECT_TRUE(notices.empty()) << notices[0];
+}
+
 TEST(E57, theJoinSaysWhatItFillsInAndManyEmptyRecordsAreAMemoryLimit) {
   TempDir dir;
   const std::vector<float> x{1, 2}, y{0, 0}, z{0, 0};

@@ -376,6 +376,27 @@ TEST(Gltf, gltfMissingColoursTakeMaterialColour) {
   EXPECT_EQ(set->colors, expected);
 }
 
+// Vertex attributes no dimension holds are named in a note (a review found NORMAL, TEXCOORD_0 and
+// a VEC3 `_FOO` dropped without a word); POSITION, COLOR_0 and a SCALAR `_NAME` are read.
+TEST(Gltf, attributesNotReadAreNamedInANote) {
+  TempDir dir;
+  writeFile(dir.file("scene.gltf"),
+            replaced(fixtureGltf(), R"({"attributes": {"POSITION": 0}, "material": 0)",
+                     R"({"attributes": {"POSITION": 0, "NORMAL": 0, "TEXCOORD_0": 0, "_FOO": 0}, "material": 0)"));
+  std::vector<std::string> notices;
+  GltfReadOptions options;
+  options.notices = &notices;
+  Result<PointSet> set = readGltf(dir.file("scene.gltf"), options);
+  ASSERT_TRUE(set) << set.error().message;
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_EQ(notices[0], dir.file("scene.gltf") + ": vertex attributes not read (dpoint reads POSITION, COLOR_0 and "
+                                                  "SCALAR _NAME attributes): NORMAL, TEXCOORD_0, _FOO");
+  notices.clear();
+  writeFile(dir.file("plain.gltf"), fixtureGltf());  // only what is read: nothing said
+  ASSERT_TRUE(readGltf(dir.file("plain.gltf"), options));
+  EXPECT_TRUE(notices.empty());
+}
+
 TEST(Gltf, gltfRejectsNodeCycle) {
   expectReadError(replaced(fixtureGltf(), R"("scale": [1,1,3], "mesh": 0})",
                            R"("scale": [1,1,3], "mesh": 0, "children": [0]})"),

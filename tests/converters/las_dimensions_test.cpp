@@ -413,6 +413,12 @@ TEST(LasDimensions, theWidestRecordsExtraBytesAreNamedOnce) {
   EXPECT_EQ(points->dimensions.find("extra_byte_65514")->get<uint8_t>(0), 9);
   ASSERT_TRUE(writeLas(dir.file("back.las"), *points));
   EXPECT_TRUE(recordsOf(dir.file("back.las")).bytes == recordsOf(dir.file("wide.las")).bytes);
+  // Undescribed as they came (a descriptor each had wrapped the VLR's 16-bit length): read back
+  // as the same dimensions, without an extra bytes VLR.
+  Result<PointSet> back = readLas(dir.file("back.las"));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_TRUE(back->las->extra_bytes.empty());  // no descriptor
+  EXPECT_EQ(back->dimensions.find("extra_byte_65514")->get<uint8_t>(0), 9);
 }
 
 // Undescribed bytes among described fields come back in offset order, and one whose name a

@@ -433,6 +433,24 @@ TEST(Ply, plyRejectsTruncatedBinaryOfManyBlocks) {
                                               ": header line 4 declares 200000 'vertex' rows"));
 }
 
+// A list property on the vertex element is named in a note (it was dropped without a word); the
+// numbers after it are still read.
+TEST(Ply, aVertexListPropertyIsNamedInANote) {
+  TempDir dir;
+  writeFile(dir.file("list.ply"), "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                                  "property float z\nproperty list uchar int idx\nproperty short s\nend_header\n"
+                                  "1 2 3 2 10 11 -7\n4 5 6 0 32767\n");
+  std::vector<std::string> notices;
+  PlyReadOptions options;
+  options.notices = &notices;
+  Result<PointSet> set = readPly(dir.file("list.ply"), options);
+  ASSERT_TRUE(set.ok()) << set.error().message;
+  EXPECT_EQ(set->dimensions.find("s")->value(0), -7.0);
+  EXPECT_EQ(set->dimensions.find("s")->value(1), 32767.0);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_EQ(notices[0], dir.file("list.ply") + ": vertex list properties not read (a dimension holds one number a point): idx");
+}
+
 // An element before the vertices may hold longer lists than the size check assumes (one count
 // byte a row), so the vertex rows themselves run out: the whole rows are decoded, the cut reported.
 TEST(Ply, plyRejectsVerticesCutAfterALongList) {
