@@ -416,7 +416,7 @@ std::string knownSpelling(std::string_view name) {
     return out;
   };
   std::string key = folded(name);
-  if (key.rfind("scalar", 0) == 0 && key.size() > 6 && folded(name.substr(0, 7)) == "scalar") key.erase(0, 6);
+  if (key.size() > 6 && folded(name.substr(0, 7)) == "scalar") key.erase(0, 6);  // `scalar_` or `scalar `
   static const std::pair<std::string_view, std::string_view> kAliases[] = {
       {"scandirectionflag", "scan_direction"}, {"infrared", "nir"}};
   for (const auto& [alias, known] : kAliases)

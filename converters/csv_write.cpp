@@ -345,8 +345,7 @@ glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, 
   bool nonfinite = false;
   const Box box = finiteBox(positions, first, last, threads, &nonfinite);
   glm::dvec3 offset(0.0);
-  const bool finite = !nonfinite;
-  for (int k = 0; k < 3 && finite; ++k) {
+  for (int k = 0; k < 3 && !nonfinite; ++k) {
     const double lo = box.min[k], hi = box.max[k];
     const double centre = std::nearbyint(lo / 2 + hi / 2);
     if (lo <= hi && std::fabs(centre) < 0x1p52) offset[k] = centre + 0.0;  // never -0
@@ -381,7 +380,7 @@ glm::dvec3 ptxOffset(const PositionArray& positions, size_t first, size_t last, 
       if (inexact[k]) offset[k] = 0.0;
     zeros = check(offset, inexact);
   }
-  for (int k = 0; k < 3 && zeros != 0 && finite; ++k)
+  for (int k = 0; k < 3 && zeros != 0 && !nonfinite; ++k)
     for (const double step : {1.0, -1.0}) {
       glm::dvec3 t = offset;
       t[k] += step;
@@ -455,8 +454,8 @@ Status writePtsOrPtx(const std::string& path, const PointSet& points, const CsvW
                                  "with no echo and leave out");
     // The reader numbers the scans 1, 2, … in point_source_id: said where the ids were others.
     bool renumbered = false;
-    for (size_t k = 0; k < scans.size() && scans.size() > 1; ++k)
-      renumbered = renumbered || scans[k].id != static_cast<double>(k + 1);
+    if (scans.size() > 1)
+      for (size_t k = 0; k < scans.size(); ++k) renumbered = renumbered || scans[k].id != static_cast<double>(k + 1);
     if (renumbered)
       options.notices->push_back(path + ": point_source_id written as " + countOf(scans.size(), "scan") +
                                  ", one for each id in the set's order, which PTX readers number 1 to " +
